@@ -1,0 +1,84 @@
+// The FAST cable robot's model parameters: geometry and physical constants.
+//
+// Geometry (docs/model.md, paper eqs. 1-2): tower tops B_i in the global frame O-xyz
+// (x toward tower B1, z up); cabin anchor points in the cabin frame O'-x'y'z'. Cable i
+// runs from anchor point anchor_index[i] on the cabin up to tower i. The nominal FAST
+// layout is
+//   B_i = (r_b cos(pi (i-1)/3), r_b sin(pi (i-1)/3), H),             r_b = 300 m, H = 270 m
+//   A_j = r_a (cos(pi/6 + 2 pi j/3), sin(pi/6 + 2 pi j/3), 0),       r_a = 7.5 m, j = 0,1,2
+// with cables 1,2 on A_0, 3,4 on A_1 and 5,6 on A_2. The geometry is data: a real
+// installation loads its own coordinates from YAML (docs/model-format.md).
+//
+// Physical parameters (paper Table 1): EA = 1.6e11 Pa * 1.541e-4 m^2 = 2.4656e7 N and the
+// unstretched linear density 11.718 kg/m, per cable; cabin mass 30000 kg with its mass
+// centre at (0, 0, 0.5) m in the cabin frame; g = -9.8 m/s^2 (negative: z is up).
+#ifndef FASTCAL_CABLE_ROBOT_H_
+#define FASTCAL_CABLE_ROBOT_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace fastcal {
+
+// FAST has six cables and six degrees of freedom; fixed-size arrays keep the per-pose
+// solvers free of allocation.
+inline constexpr int kNumCables = 6;
+
+struct CableProperties {
+  // Upper end of the cable (tower top, pulley exit), global frame.
+  Eigen::Vector3d tower_top_m = Eigen::Vector3d::Zero();
+  // Index into CableRobot::anchor_points_cabin_m of the cabin point the cable is tied to.
+  int anchor_index = 0;
+  // Axial stiffness E*A of the unstretched cross-section.
+  double ea_n = 2.4656e7;
+  // Mass per unit unstretched length.
+  double linear_density_kg_per_m = 11.718;
+};
+
+struct CableRobot {
+  // Cabin anchor points in the cabin frame (several cables may share one).
+  std::vector<Eigen::Vector3d> anchor_points_cabin_m;
+  std::array<CableProperties, kNumCables> cables;
+  double cabin_mass_kg = 30000.0;
+  // Mass centre of the cabin in the cabin frame.
+  Eigen::Vector3d mass_centre_cabin_m = Eigen::Vector3d(0.0, 0.0, 0.5);
+  // Gravitational acceleration along z (negative: z is up).
+  double gravity_m_per_s2 = -9.8;
+
+  // The nominal FAST layout and parameters of the paper's Table 1.
+  static CableRobot NominalFast();
+
+  // Anchor point of cable i in the cabin frame.
+  const Eigen::Vector3d& AnchorOfCable(int i) const {
+    return anchor_points_cabin_m[cables[i].anchor_index];
+  }
+
+  // Checks physical sense: EA > 0, density > 0, mass > 0, g < 0, finite coordinates,
+  // anchor indices in range, no two tower tops coincident, no two distinct anchor points
+  // coincident. On failure returns false and names the offending key in *error (YAML key
+  // path, e.g. "cables[2].ea_n").
+  bool IsValid(std::string* error) const;
+};
+
+// Loads a model from YAML (format in docs/model-format.md). Keys that are absent take
+// the nominal values, except that a file that gives `cables` must give all six.
+// Unknown keys, wrong types and non-physical values are errors; *error then names the
+// file, the key and (where yaml-cpp knows it) the line.
+bool LoadCableRobot(const std::string& path, CableRobot* robot, std::string* error);
+bool ParseCableRobotYaml(const std::string& text, const std::string& source_name,
+                         CableRobot* robot, std::string* error);
+
+// Writes the model as YAML in the same format LoadCableRobot reads; values are written
+// with 17 significant digits so a save/load round trip is exact. `header_comment` (may be
+// empty) is written as leading '#' lines.
+std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_comment);
+// Writes atomically (temporary file, then rename): a failure leaves no partial file.
+bool SaveCableRobot(const CableRobot& robot, const std::string& path,
+                    const std::string& header_comment, std::string* error);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_CABLE_ROBOT_H_

@@ -1,0 +1,279 @@
+// Templated core of the statics solvers (statics.h), shared by the double API and by the
+// calibration's cost functions (scalar = ceres::Jet). Equations: statics.h and
+// docs/model.md.
+//
+// For a Jet scalar the iterations run in double (SolveStatics) and the result is then
+// replayed in Jet arithmetic from the converged double values:
+//   aas, aas-refined: the same explicit sequence of steps, each inner catenary solve
+//                     differentiated implicitly (catenary.h);
+//   exact:            one reduced Newton step from the converged point, whose derivative
+//                     is the implicit-function derivative of the solution.
+#ifndef FASTCAL_INTERNAL_STATICS_CORE_H_
+#define FASTCAL_INTERNAL_STATICS_CORE_H_
+
+#include <array>
+#include <cmath>
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/catenary.h"
+#include "fastcal/pose.h"
+#include "fastcal/scalar.h"
+
+namespace fastcal {
+
+template <typename T>
+using Vector3T = Eigen::Matrix<T, 3, 1>;
+
+// The statics model's parameters per cable, in scalar T (anchors repeated per cable).
+template <typename T>
+struct StaticsParameters {
+  std::array<Vector3T<T>, kNumCables> tower_top_m;     // global frame
+  std::array<Vector3T<T>, kNumCables> anchor_cabin_m;  // cabin frame
+  std::array<T, kNumCables> ea_n;
+  std::array<T, kNumCables> linear_density_kg_per_m;
+  T cabin_mass_kg;
+  Vector3T<T> mass_centre_cabin_m;
+  double gravity_m_per_s2 = -9.8;
+};
+
+StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot);
+
+template <typename T>
+StaticsParameters<double> ScalarParameters(const StaticsParameters<T>& p) {
+  StaticsParameters<double> d;
+  for (int i = 0; i < kNumCables; ++i) {
+    for (int j = 0; j < 3; ++j) {
+      d.tower_top_m[i][j] = ScalarValue(p.tower_top_m[i][j]);
+      d.anchor_cabin_m[i][j] = ScalarValue(p.anchor_cabin_m[i][j]);
+    }
+    d.ea_n[i] = ScalarValue(p.ea_n[i]);
+    d.linear_density_kg_per_m[i] = ScalarValue(p.linear_density_kg_per_m[i]);
+  }
+  d.cabin_mass_kg = ScalarValue(p.cabin_mass_kg);
+  for (int j = 0; j < 3; ++j) d.mass_centre_cabin_m[j] = ScalarValue(p.mass_centre_cabin_m[j]);
+  d.gravity_m_per_s2 = p.gravity_m_per_s2;
+  return d;
+}
+
+namespace internal {
+
+// Cable chords and lever arms at one pose.
+template <typename T>
+struct PoseGeometry {
+  std::array<Vector3T<T>, kNumCables> r;  // R a_i, global axes, from O'
+  std::array<T, kNumCables> span, rise, chord, ux, uy, w;
+  Vector3T<T> e;  // R r_e
+  T weight_n;     // m g (negative)
+};
+
+template <typename T>
+StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
+                              double vertical_span_fraction, PoseGeometry<T>* g, int* cable) {
+  using std::sqrt;
+  const Eigen::Matrix<T, 3, 3> rotation = pose.rotation.cast<T>();
+  const Vector3T<T> position = pose.position_m.cast<T>();
+  for (int i = 0; i < kNumCables; ++i) {
+    g->r[i] = rotation * p.anchor_cabin_m[i];
+    const Vector3T<T> c = p.tower_top_m[i] - (g->r[i] + position);
+    g->span[i] = sqrt(c[0] * c[0] + c[1] * c[1]);
+    g->rise[i] = c[2];
+    g->chord[i] = sqrt(g->span[i] * g->span[i] + c[2] * c[2]);
+    if (!(ScalarValue(g->span[i]) > vertical_span_fraction * ScalarValue(g->chord[i]))) {
+      *cable = i;
+      return StaticsStatus::kVerticalCable;
+    }
+    g->ux[i] = c[0] / g->span[i];
+    g->uy[i] = c[1] / g->span[i];
+    g->w[i] = p.linear_density_kg_per_m[i] * p.gravity_m_per_s2;
+  }
+  g->e = rotation * p.mass_centre_cabin_m;
+  g->weight_n = p.cabin_mass_kg * p.gravity_m_per_s2;
+  return StaticsStatus::kOk;
+}
+
+// Solves the six equilibrium rows for Fl given Fz_i = a_i Fl_i + b_i (statics.h).
+// Returns false when the matrix is singular to working precision.
+template <typename T>
+bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>& a,
+                      const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl) {
+  // Reciprocal condition number below which the 6x6 system counts as singular.
+  constexpr double kMinReciprocalCondition = 1e-13;
+  Eigen::Matrix<T, 6, 6> m;
+  Eigen::Matrix<T, 6, 1> rhs;
+  rhs << T(0), T(0), g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n, T(0);
+  for (int i = 0; i < kNumCables; ++i) {
+    const Vector3T<T>& r = g.r[i];
+    m(0, i) = g.ux[i];
+    m(1, i) = g.uy[i];
+    m(2, i) = a[i];
+    m(3, i) = r[1] * a[i] + r[2] * g.uy[i];
+    m(4, i) = r[0] * a[i] + r[2] * g.ux[i];
+    m(5, i) = r[1] * g.ux[i] - r[0] * g.uy[i];
+    rhs[2] -= b[i];
+    rhs[3] -= r[1] * b[i];
+    rhs[4] -= r[0] * b[i];
+  }
+  const Eigen::PartialPivLU<Eigen::Matrix<T, 6, 6>> lu(m);
+  if constexpr (kIsDouble<T>) {
+    if (!(lu.rcond() > kMinReciprocalCondition)) return false;
+  }
+  const Eigen::Matrix<T, 6, 1> x = lu.solve(rhs);
+  for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
+  return true;
+}
+
+template <typename T>
+struct CableState {
+  T fl, fz, s0;
+};
+
+// AAS secant lines Fz = a Fl + b. `secant` in/out: double solutions used as guesses when
+// `use_guess` and written back.
+template <typename T>
+StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
+                       const StaticsOptions& o, bool use_guess,
+                       std::array<CatenaryForces, kNumCables>* low,
+                       std::array<CatenaryForces, kNumCables>* high, std::array<T, kNumCables>* a,
+                       std::array<T, kNumCables>* b, int* cable, int* iterations) {
+  for (int i = 0; i < kNumCables; ++i) {
+    T fl1, fz1, fl2, fz2;
+    int it1 = 0, it2 = 0;
+    const CatenaryForces guess_low = (*low)[i], guess_high = (*high)[i];
+    const T s_low = T(o.secant_low_fraction) * g.chord[i];
+    const T s_high = T(o.secant_high_fraction) * g.chord[i];
+    CatenaryStatus s = SolveCatenaryForces(g.span[i], g.rise[i], s_low, p.ea_n[i], g.w[i],
+                                           o.catenary, use_guess ? &guess_low : nullptr, &fl1,
+                                           &fz1, &it1);
+    if (s == CatenaryStatus::kOk) {
+      s = SolveCatenaryForces(g.span[i], g.rise[i], s_high, p.ea_n[i], g.w[i], o.catenary,
+                              use_guess ? &guess_high : nullptr, &fl2, &fz2, &it2);
+    }
+    *iterations += it1 + it2;
+    if (s != CatenaryStatus::kOk) {
+      *cable = i;
+      return s == CatenaryStatus::kVerticalChord ? StaticsStatus::kVerticalCable
+                                                 : StaticsStatus::kCatenaryFailed;
+    }
+    (*a)[i] = (fz2 - fz1) / (fl2 - fl1);
+    (*b)[i] = fz1 - (*a)[i] * fl1;
+    (*low)[i] = CatenaryForces{ScalarValue(fl1), ScalarValue(fz1)};
+    (*high)[i] = CatenaryForces{ScalarValue(fl2), ScalarValue(fz2)};
+  }
+  return StaticsStatus::kOk;
+}
+
+// Puts each cable on its exact Fz(Fl) curve at the current Fl (solves Fz, s0). `guess`
+// (double) starts each solve.
+template <typename T>
+StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
+                              const StaticsOptions& o,
+                              const std::array<CatenaryCurvePoint, kNumCables>& guess,
+                              std::array<CableState<T>, kNumCables>* state, int* cable,
+                              int* iterations) {
+  for (int i = 0; i < kNumCables; ++i) {
+    CableState<T>& c = (*state)[i];
+    if (!(ScalarValue(c.fl) > 0.0)) {
+      *cable = i;
+      return StaticsStatus::kSlackCable;
+    }
+    int it = 0;
+    const CatenaryStatus s = SolveCatenaryLength(g.span[i], g.rise[i], c.fl, p.ea_n[i], g.w[i],
+                                                 o.catenary, &guess[i], &c.fz, &c.s0, &it);
+    *iterations += it;
+    if (s != CatenaryStatus::kOk) {
+      *cable = i;
+      return StaticsStatus::kCatenaryFailed;
+    }
+  }
+  return StaticsStatus::kOk;
+}
+
+// One Newton step on all 18 unknowns: each catenary linearised in (Fl, Fz, s0), ds0
+// eliminated with the normal n = (dZ/ds0, -dL/ds0), giving Fz = a Fl + b; then the 6x6
+// equilibrium solve, and ds0 from the linearisation. Writes the largest |dFl| relative to
+// the largest Fl and the largest end-point residual relative to the chord (before the
+// step) when those pointers are not null.
+template <typename T>
+StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
+                                std::array<CableState<T>, kNumCables>* state, int* cable,
+                                double* relative_step, double* relative_residual) {
+  std::array<T, kNumCables> a, b, fl_new;
+  std::array<CatenaryEnd<T>, kNumCables> ends;
+  std::array<T, kNumCables> g0, g1;
+  double max_residual = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableState<T>& c = (*state)[i];
+    const CatenaryEnd<T> e = CatenaryEndpoint(c.fl, c.fz, c.s0, p.ea_n[i], g.w[i]);
+    g0[i] = e.span_m - g.span[i];
+    g1[i] = e.rise_m - g.rise[i];
+    const double chord = ScalarValue(g.chord[i]);
+    max_residual = std::max(max_residual, std::max(std::abs(ScalarValue(g0[i])),
+                                                   std::abs(ScalarValue(g1[i]))) / chord);
+    const T n0 = e.drise[2], n1 = -e.dspan[2];
+    const T cc = n0 * g0[i] + n1 * g1[i];
+    const T pp = n0 * e.dspan[0] + n1 * e.drise[0];
+    const T qq = n0 * e.dspan[1] + n1 * e.drise[1];
+    a[i] = -pp / qq;
+    b[i] = c.fz - cc / qq - a[i] * c.fl;
+    ends[i] = e;
+  }
+  if (!SolveEquilibrium(g, a, b, &fl_new)) return StaticsStatus::kSingular;
+  double max_fl = 0.0, max_step = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    CableState<T>& c = (*state)[i];
+    const CatenaryEnd<T>& e = ends[i];
+    const T dfl = fl_new[i] - c.fl;
+    const T fz_new = a[i] * fl_new[i] + b[i];
+    const T dfz = fz_new - c.fz;
+    const T res0 = g0[i] + e.dspan[0] * dfl + e.dspan[1] * dfz;
+    const T res1 = g1[i] + e.drise[0] * dfl + e.drise[1] * dfz;
+    const T ds = -(e.dspan[2] * res0 + e.drise[2] * res1) /
+                 (e.dspan[2] * e.dspan[2] + e.drise[2] * e.drise[2]);
+    max_step = std::max(max_step, std::abs(ScalarValue(dfl)));
+    max_fl = std::max(max_fl, std::abs(ScalarValue(fl_new[i])));
+    c.fl = fl_new[i];
+    c.fz = fz_new;
+    c.s0 = c.s0 + ds;
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    if (!(ScalarValue((*state)[i].fl) > 0.0)) {
+      *cable = i;
+      return StaticsStatus::kSlackCable;
+    }
+  }
+  if (relative_step != nullptr) *relative_step = max_step / max_fl;
+  if (relative_residual != nullptr) *relative_residual = max_residual;
+  return StaticsStatus::kOk;
+}
+
+// Guess for the curve point at Fl from the secant data: linear interpolation of s0 in Fl
+// between the two secant lengths, Fz on the secant line.
+inline CatenaryCurvePoint CurveGuess(double fl, double chord, const CatenaryForces& low,
+                                     const CatenaryForces& high, const StaticsOptions& o) {
+  const double t = (fl - low.fl_n) / (high.fl_n - low.fl_n);
+  const double s_low = o.secant_low_fraction * chord, s_high = o.secant_high_fraction * chord;
+  CatenaryCurvePoint c;
+  c.s0_m = std::max(s_low + t * (s_high - s_low), 0.5 * s_low);
+  c.fz_n = low.fz_n + t * (high.fz_n - low.fz_n);
+  return c;
+}
+
+}  // namespace internal
+
+// Lower-end tensions |F_i| of the model at `pose`, in scalar T, for the calibration's
+// residuals. For a Jet the derivatives are those of the chosen method's solution (see
+// the file comment). `solution` (may be null) receives the double solution.
+template <typename T>
+StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose,
+                                 const StaticsOptions& options,
+                                 std::array<T, kNumCables>* tension_n,
+                                 StaticsSolution* solution = nullptr);
+
+}  // namespace fastcal
+
+#include "fastcal/internal/statics_jet.h"  // IWYU pragma: export
+
+#endif  // FASTCAL_INTERNAL_STATICS_CORE_H_

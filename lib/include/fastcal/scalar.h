@@ -1,0 +1,32 @@
+// Helpers that let one templated implementation serve double and ceres::Jet (the
+// Sophus/manif habit): the scalar part of a value, and asinh, which Ceres 2.1's Jet lacks.
+//   d/dx asinh(x) = 1 / sqrt(1 + x^2)
+#ifndef FASTCAL_SCALAR_H_
+#define FASTCAL_SCALAR_H_
+
+#include <cmath>
+#include <type_traits>
+
+#include <ceres/jet.h>
+
+namespace fastcal {
+
+inline double ScalarValue(double x) { return x; }
+template <typename T, int N>
+double ScalarValue(const ceres::Jet<T, N>& x) {
+  return ScalarValue(x.a);
+}
+
+inline double Asinh(double x) { return std::asinh(x); }
+template <typename T, int N>
+ceres::Jet<T, N> Asinh(const ceres::Jet<T, N>& x) {
+  using std::sqrt;
+  return ceres::Jet<T, N>(Asinh(x.a), x.v / sqrt(T(1) + x.a * x.a));
+}
+
+template <typename T>
+inline constexpr bool kIsDouble = std::is_same_v<T, double>;
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_SCALAR_H_

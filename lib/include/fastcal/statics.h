@@ -1,0 +1,118 @@
+// Statics of one cabin pose: the six cable forces, tensions and unstretched lengths.
+//
+// Unknowns per cable: the horizontal force Fl_i > 0, the vertical force Fz_i and the
+// unstretched length s0_i (the force on cable i at its lower end is
+// F_i = (-X_i/L_i Fl_i, -Y_i/L_i Fl_i, Fz_i), eqs. 17-18). Equations: each cable's two
+// catenary end conditions (catenary.h) and the cabin's equilibrium in vector form
+// (docs/model.md; note the corrected sign of the mass-centre term, not paper eq. 24):
+//     sum_i (-F_i) + W = 0,   sum_i r_i x (-F_i) + e x W = 0,
+// r_i = R a_i, e = R r_e, W = (0, 0, m g). With Fz_i = a_i Fl_i + b_i the six equilibrium
+// rows are linear in Fl (paper eqs. 26-30, rows 4-5 corrected):
+//     sum ux_i Fl_i = 0,  sum uy_i Fl_i = 0,  sum a_i Fl_i = m g - sum b_i,
+//     sum (ry_i a_i + rz_i uy_i) Fl_i = ey m g - sum ry_i b_i,
+//     sum (rx_i a_i + rz_i ux_i) Fl_i = ex m g - sum rx_i b_i,
+//     sum (ry_i ux_i - rx_i uy_i) Fl_i = 0,                        (u = (X, Y)/L)
+//
+// Methods:
+//  kAas        the paper's: a_i, b_i from the secant through the catenary solutions at
+//              s0 = 0.99 k_i and 1.01 k_i; one 6x6 solve. s0_i by one solve per cable.
+//  kAasRefined AAS, then N times: put each cable on its exact Fz(Fl) curve at the current
+//              Fl_i and re-linearise with the tangent (implicit derivative along the family
+//              of lengths); solve the 6x6 system again. Each step is a Newton step on the
+//              reduced system, so the error roughly squares per step.
+//  kExact      Newton on all 18 unknowns, started from AAS: each catenary is linearised
+//              in (Fl, Fz, s0), ds0 eliminated, leaving the same 6x6 system; iterated to
+//              `exact_relative_tolerance`. The reference the others are judged against.
+//
+// Nothing here allocates and nothing throws: an infeasible pose comes back as a status.
+#ifndef FASTCAL_STATICS_H_
+#define FASTCAL_STATICS_H_
+
+#include <array>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/catenary.h"
+#include "fastcal/pose.h"
+
+namespace fastcal {
+
+enum class StaticsMethod { kAas, kAasRefined, kExact };
+const char* StaticsMethodName(StaticsMethod method);  // "aas", "aas-refined", "exact"
+bool ParseStaticsMethod(const std::string& name, StaticsMethod* method);
+
+struct StaticsOptions {
+  StaticsMethod method = StaticsMethod::kAasRefined;
+  // Secant lengths of AAS as fractions of the chord length k (paper: 0.99 and 1.01).
+  double secant_low_fraction = 0.99;
+  double secant_high_fraction = 1.01;
+  // Re-linearisation steps of kAasRefined (>= 1).
+  int refinement_steps = 1;
+  // kExact stops when the largest Newton update of Fl is below this fraction of the
+  // largest Fl and every catenary end condition holds to catenary.relative_tolerance.
+  double exact_relative_tolerance = 1e-12;
+  int exact_max_iterations = 30;
+  // kAas only: solve for s0_i (one 2x2 Newton per cable). Off, s0 and the upper-end
+  // tension are reported as 0; the lower-end forces do not depend on it.
+  bool compute_unstretched_lengths = true;
+  // Start from the solution already in *solution (when its status is ok), e.g. the
+  // previous node of a trajectory: the secant solves and the exact Newton start there.
+  // A warm start that fails is retried cold.
+  bool warm_start = false;
+  // The per-cable Newton solves.
+  CatenarySolverOptions catenary;
+
+  bool IsValid(std::string* error) const;
+};
+
+enum class StaticsStatus {
+  kOk = 0,
+  kInvalidInput,    // non-finite pose or parameters
+  kVerticalCable,   // a chord is vertical: Fl's direction is undefined
+  kSlackCable,      // the equilibrium needs Fl_i <= 0: the pose cannot be held taut
+  kSingular,        // the 6x6 equilibrium matrix is singular
+  kCatenaryFailed,  // a per-cable solve did not converge
+  kNotConverged,    // kExact did not converge in exact_max_iterations
+};
+const char* StaticsStatusName(StaticsStatus status);
+
+struct CableSolution {
+  // Force applied ON the cable at its lower end by the cabin, global frame (N). The
+  // cabin feels -force_n.
+  Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
+  double horizontal_force_n = 0.0;    // Fl
+  double lower_tension_n = 0.0;       // |force_n|: what the cabin-side sensors measure
+  double upper_tension_n = 0.0;       // at the tower end: sqrt(Fl^2 + (Fz + w s0)^2)
+  double unstretched_length_m = 0.0;  // s0
+  double chord_length_m = 0.0;        // k = |B_i - (R a_i + r_p)|
+  // AAS secant solutions at s0 = low/high fraction * k (kept for warm starts).
+  CatenaryForces secant_low;
+  CatenaryForces secant_high;
+};
+
+struct StaticsSolution {
+  std::array<CableSolution, kNumCables> cables;
+  StaticsStatus status = StaticsStatus::kInvalidInput;
+  int cable = -1;                // 0-based cable concerned by a failure, else -1
+  int outer_iterations = 0;      // refinement steps or exact Newton iterations
+  int catenary_iterations = 0;   // total per-cable Newton iterations
+  // |sum(-F_i) + W| and |sum r_i x (-F_i) + e x W| of the returned forces.
+  double force_residual_n = 0.0;
+  double moment_residual_nm = 0.0;
+};
+
+// Solves the statics of `pose`. Returns solution->status. On failure the forces are
+// zero (never NaN) and `cable` names the cable concerned where there is one.
+StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose,
+                           const StaticsOptions& options, StaticsSolution* solution);
+
+// A one-line human-readable account of a solution's status, naming the cable (1-based).
+std::string DescribeStatus(const StaticsSolution& solution);
+
+}  // namespace fastcal
+
+#include "fastcal/internal/statics_core.h"  // IWYU pragma: export
+
+#endif  // FASTCAL_STATICS_H_

@@ -1,0 +1,83 @@
+// Nominal FAST model and physical validation (layout: cable_robot.h, paper eqs. 1-2 and
+// Table 1).
+#include "fastcal/cable_robot.h"
+
+#include <cmath>
+#include <sstream>
+
+namespace fastcal {
+namespace {
+// Two tower tops or two anchor points closer than this are "coincident".
+constexpr double kCoincidentDistanceM = 1e-6;
+}  // namespace
+
+CableRobot CableRobot::NominalFast() {
+  constexpr double kAnchorRadiusM = 7.5, kTowerRadiusM = 300.0, kTowerHeightM = 270.0;
+  CableRobot robot;
+  robot.anchor_points_cabin_m.clear();
+  for (int j = 0; j < 3; ++j) {
+    const double angle = M_PI / 6.0 + 2.0 * M_PI * j / 3.0;
+    robot.anchor_points_cabin_m.emplace_back(kAnchorRadiusM * std::cos(angle),
+                                             kAnchorRadiusM * std::sin(angle), 0.0);
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const double angle = M_PI * i / 3.0;
+    CableProperties& c = robot.cables[i];
+    c.tower_top_m = Eigen::Vector3d(kTowerRadiusM * std::cos(angle),
+                                    kTowerRadiusM * std::sin(angle), kTowerHeightM);
+    c.anchor_index = i / 2;
+    c.ea_n = 1.6e11 * 1.541e-4;
+    c.linear_density_kg_per_m = 11.718;
+  }
+  robot.cabin_mass_kg = 30000.0;
+  robot.mass_centre_cabin_m = Eigen::Vector3d(0.0, 0.0, 0.5);
+  robot.gravity_m_per_s2 = -9.8;
+  return robot;
+}
+
+bool CableRobot::IsValid(std::string* error) const {
+  std::ostringstream e;
+  auto fail = [&](const std::string& key, const std::string& why) {
+    if (error != nullptr) *error = key + ": " + why;
+    return false;
+  };
+  if (anchor_points_cabin_m.empty()) return fail("anchor_points_cabin_m", "at least one is needed");
+  for (size_t j = 0; j < anchor_points_cabin_m.size(); ++j) {
+    const std::string key = "anchor_points_cabin_m[" + std::to_string(j) + "]";
+    if (!anchor_points_cabin_m[j].allFinite()) return fail(key, "must be finite");
+    for (size_t k = 0; k < j; ++k) {
+      if ((anchor_points_cabin_m[j] - anchor_points_cabin_m[k]).norm() < kCoincidentDistanceM) {
+        return fail(key, "coincides with anchor_points_cabin_m[" + std::to_string(k) + "]");
+      }
+    }
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableProperties& c = cables[i];
+    const std::string key = "cables[" + std::to_string(i) + "]";
+    if (!c.tower_top_m.allFinite()) return fail(key + ".tower_top_m", "must be finite");
+    for (int k = 0; k < i; ++k) {
+      if ((c.tower_top_m - cables[k].tower_top_m).norm() < kCoincidentDistanceM) {
+        return fail(key + ".tower_top_m", "coincides with cables[" + std::to_string(k) + "]");
+      }
+    }
+    if (c.anchor_index < 0 || c.anchor_index >= static_cast<int>(anchor_points_cabin_m.size())) {
+      return fail(key + ".anchor", "index " + std::to_string(c.anchor_index) +
+                                       " is not an anchor point (0.." +
+                                       std::to_string(anchor_points_cabin_m.size() - 1) + ")");
+    }
+    if (!(c.ea_n > 0.0) || !std::isfinite(c.ea_n)) return fail(key + ".ea_n", "must be > 0");
+    if (!(c.linear_density_kg_per_m > 0.0) || !std::isfinite(c.linear_density_kg_per_m)) {
+      return fail(key + ".linear_density_kg_per_m", "must be > 0");
+    }
+  }
+  if (!(cabin_mass_kg > 0.0) || !std::isfinite(cabin_mass_kg)) {
+    return fail("cabin_mass_kg", "must be > 0");
+  }
+  if (!mass_centre_cabin_m.allFinite()) return fail("mass_centre_cabin_m", "must be finite");
+  if (!(gravity_m_per_s2 < 0.0) || !std::isfinite(gravity_m_per_s2)) {
+    return fail("gravity_m_per_s2", "must be < 0 (z is up)");
+  }
+  return true;
+}
+
+}  // namespace fastcal

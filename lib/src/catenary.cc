@@ -1,0 +1,248 @@
+// Newton solvers for the elastic catenary's two inverse problems (see catenary.h for the
+// equations). Both iterate on the end-point residual (span, rise) with the analytic
+// Jacobian, a step limit that keeps the positive unknown (Fl, or s0) positive, and
+// backtracking on the residual norm, which is what makes a cold start robust.
+#include "fastcal/catenary.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace fastcal {
+namespace {
+
+// Never let one Newton step shrink a positive unknown by more than this fraction: a
+// Newton step through zero lands on the mirror solution with Fl < 0 (model.md).
+constexpr double kMaxShrinkFraction = 0.9;
+// Backtracking halvings per Newton step.
+constexpr int kMaxBacktracks = 30;
+// Relative accuracy of the parabolic start's horizontal force: it is only a start.
+constexpr double kGuessRelativeTolerance = 1e-8;
+constexpr int kGuessMaxIterations = 100;
+
+bool AllFinite(std::initializer_list<double> values) {
+  for (double v : values) {
+    if (!std::isfinite(v)) return false;
+  }
+  return true;
+}
+
+// Unknowns u = (u0, u1) are (Fl, Fz) when fixed_index == 2 (s0 fixed), or (Fz, s0) when
+// fixed_index == 0 (Fl fixed). `positive` is the index in u that must stay > 0.
+struct Problem {
+  double span_m, rise_m, ea_n, w_n_per_m;
+  int fixed_index;
+  double fixed_value;
+
+  void Unpack(const double u[2], double* fl, double* fz, double* s0) const {
+    if (fixed_index == 2) {
+      *fl = u[0];
+      *fz = u[1];
+      *s0 = fixed_value;
+    } else {
+      *fl = fixed_value;
+      *fz = u[0];
+      *s0 = u[1];
+    }
+  }
+  // Residual and 2x2 Jacobian (row-major) with respect to u.
+  void Evaluate(const double u[2], double r[2], double jac[4]) const {
+    double fl, fz, s0;
+    Unpack(u, &fl, &fz, &s0);
+    const CatenaryEnd<double> e = CatenaryEndpoint(fl, fz, s0, ea_n, w_n_per_m);
+    r[0] = e.span_m - span_m;
+    r[1] = e.rise_m - rise_m;
+    const int c0 = fixed_index == 2 ? 0 : 1;
+    const int c1 = fixed_index == 2 ? 1 : 2;
+    jac[0] = e.dspan[c0];
+    jac[1] = e.dspan[c1];
+    jac[2] = e.drise[c0];
+    jac[3] = e.drise[c1];
+  }
+};
+
+CatenaryStatus Newton(const Problem& problem, int positive, double chord_m,
+                      const CatenarySolverOptions& options, double u[2], int* iterations) {
+  const double tolerance_m = options.relative_tolerance * chord_m;
+  double r[2], jac[4];
+  problem.Evaluate(u, r, jac);
+  double norm = std::hypot(r[0], r[1]);
+  for (int it = 0; it <= options.max_iterations; ++it) {
+    if (!std::isfinite(norm)) break;
+    if (std::max(std::abs(r[0]), std::abs(r[1])) <= tolerance_m) {
+      *iterations = it;
+      return CatenaryStatus::kOk;
+    }
+    if (it == options.max_iterations) break;
+    const double det = jac[0] * jac[3] - jac[1] * jac[2];
+    if (!(std::abs(det) > 0.0) || !std::isfinite(det)) break;
+    const double step[2] = {-(jac[3] * r[0] - jac[1] * r[1]) / det,
+                            -(-jac[2] * r[0] + jac[0] * r[1]) / det};
+    double lambda = 1.0;
+    if (u[positive] + step[positive] < (1.0 - kMaxShrinkFraction) * u[positive]) {
+      lambda = kMaxShrinkFraction * u[positive] / -step[positive];
+    }
+    double trial[2], r_trial[2], jac_trial[4], norm_trial = norm;
+    bool accepted = false;
+    for (int b = 0; b < kMaxBacktracks; ++b, lambda *= 0.5) {
+      trial[0] = u[0] + lambda * step[0];
+      trial[1] = u[1] + lambda * step[1];
+      problem.Evaluate(trial, r_trial, jac_trial);
+      norm_trial = std::hypot(r_trial[0], r_trial[1]);
+      if (std::isfinite(norm_trial) && norm_trial < norm) {
+        accepted = true;
+        break;
+      }
+    }
+    if (!accepted) {
+      // No decrease along the Newton direction: either converged to rounding (accept if
+      // already close) or stuck.
+      if (norm <= 1e3 * tolerance_m) {
+        *iterations = it;
+        return CatenaryStatus::kOk;
+      }
+      break;
+    }
+    u[0] = trial[0];
+    u[1] = trial[1];
+    std::copy(r_trial, r_trial + 2, r);
+    std::copy(jac_trial, jac_trial + 4, jac);
+    norm = norm_trial;
+  }
+  *iterations = options.max_iterations;
+  return CatenaryStatus::kNotConverged;
+}
+
+CatenaryStatus CheckCommon(double span_m, double rise_m, double ea_n, double w_n_per_m,
+                           const CatenarySolverOptions& options) {
+  if (!AllFinite({span_m, rise_m, ea_n, w_n_per_m}) || !(ea_n > 0.0) || w_n_per_m == 0.0 ||
+      span_m < 0.0) {
+    return CatenaryStatus::kInvalidInput;
+  }
+  if (span_m <= options.vertical_span_fraction * std::hypot(span_m, rise_m)) {
+    return CatenaryStatus::kVerticalChord;
+  }
+  return CatenaryStatus::kOk;
+}
+
+}  // namespace
+
+const char* CatenaryStatusName(CatenaryStatus status) {
+  switch (status) {
+    case CatenaryStatus::kOk:
+      return "ok";
+    case CatenaryStatus::kInvalidInput:
+      return "invalid input";
+    case CatenaryStatus::kVerticalChord:
+      return "vertical chord";
+    case CatenaryStatus::kNotConverged:
+      return "not converged";
+  }
+  return "unknown";
+}
+
+CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
+                                    double w_n_per_m) {
+  const double k = std::hypot(span_m, rise_m);
+  const double c = k / (span_m * ea_n);
+  const double b = w_n_per_m * w_n_per_m * std::pow(span_m, 4) / 12.0;
+  auto f = [&](double h) { return s0_m * s0_m * (1 + c * h) * (1 + c * h) - k * k - b / (h * h); };
+  auto df = [&](double h) { return 2 * s0_m * s0_m * c * (1 + c * h) + 2 * b / (h * h * h); };
+  // f is increasing in H with one positive root: bracket it, then safeguarded Newton.
+  // Elastic straight-bar force (s0 < k) or weight scale, whichever is larger.
+  const double scale = std::max(std::abs(w_n_per_m) * span_m, std::max(0.0, k / s0_m - 1.0) / c);
+  double lo = std::max(scale, 1e-300), hi = lo;
+  for (int i = 0; i < 200 && f(lo) > 0; ++i) lo *= 0.25;
+  for (int i = 0; i < 200 && f(hi) < 0; ++i) hi *= 4.0;
+  double h = std::sqrt(lo * hi);
+  for (int i = 0; i < kGuessMaxIterations; ++i) {
+    const double fh = f(h);
+    if (fh < 0) lo = h; else hi = h;
+    double next = h - fh / df(h);
+    if (!(next > lo && next < hi)) next = std::sqrt(lo * hi);
+    if (std::abs(next - h) <= kGuessRelativeTolerance * h) {
+      h = next;
+      break;
+    }
+    h = next;
+  }
+  CatenaryForces guess;
+  guess.fl_n = h;
+  guess.fz_n = -h * rise_m / span_m - 0.5 * w_n_per_m * s0_m;
+  return guess;
+}
+
+CatenaryStatus SolveCatenaryForcesDouble(double span_m, double rise_m, double s0_m, double ea_n,
+                                         double w_n_per_m, const CatenarySolverOptions& options,
+                                         const CatenaryForces* guess, CatenaryForces* forces,
+                                         int* iterations) {
+  *iterations = 0;
+  if (!std::isfinite(s0_m) || !(s0_m > 0.0)) return CatenaryStatus::kInvalidInput;
+  const CatenaryStatus common = CheckCommon(span_m, rise_m, ea_n, w_n_per_m, options);
+  if (common != CatenaryStatus::kOk) return common;
+  CatenaryForces start;
+  if (guess != nullptr && guess->fl_n > 0.0 && AllFinite({guess->fl_n, guess->fz_n})) {
+    start = *guess;
+  } else {
+    start = CatenaryInitialGuess(span_m, rise_m, s0_m, ea_n, w_n_per_m);
+  }
+  const Problem problem{span_m, rise_m, ea_n, w_n_per_m, /*fixed_index=*/2, s0_m};
+  double u[2] = {start.fl_n, start.fz_n};
+  const CatenaryStatus status =
+      Newton(problem, /*positive=*/0, std::hypot(span_m, rise_m), options, u, iterations);
+  forces->fl_n = u[0];
+  forces->fz_n = u[1];
+  return status;
+}
+
+CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl_n, double ea_n,
+                                         double w_n_per_m, const CatenarySolverOptions& options,
+                                         const CatenaryCurvePoint* guess,
+                                         CatenaryCurvePoint* point, int* iterations) {
+  *iterations = 0;
+  if (!std::isfinite(fl_n) || !(fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
+  const CatenaryStatus common = CheckCommon(span_m, rise_m, ea_n, w_n_per_m, options);
+  if (common != CatenaryStatus::kOk) return common;
+  const double k = std::hypot(span_m, rise_m);
+  CatenaryCurvePoint start;
+  if (guess != nullptr && guess->s0_m > 0.0 && AllFinite({guess->fz_n, guess->s0_m})) {
+    start = *guess;
+  } else {
+    // The parabolic relation of CatenaryInitialGuess, solved for s0 at H = fl.
+    const double c = k / (span_m * ea_n);
+    const double b = w_n_per_m * w_n_per_m * std::pow(span_m, 4) / 12.0;
+    start.s0_m = std::sqrt(k * k + b / (fl_n * fl_n)) / (1.0 + c * fl_n);
+    start.fz_n = -fl_n * rise_m / span_m - 0.5 * w_n_per_m * start.s0_m;
+  }
+  const Problem problem{span_m, rise_m, ea_n, w_n_per_m, /*fixed_index=*/0, fl_n};
+  double u[2] = {start.fz_n, start.s0_m};
+  const CatenaryStatus status = Newton(problem, /*positive=*/1, k, options, u, iterations);
+  point->fz_n = u[0];
+  point->s0_m = u[1];
+  return status;
+}
+
+std::vector<CatenaryPoint> CatenaryShape(double fl_n, double fz_n, double s0_m, double ea_n,
+                                         double w_n_per_m, int n) {
+  std::vector<CatenaryPoint> points;
+  n = std::max(n, 2);
+  points.reserve(n);
+  for (int i = 0; i < n; ++i) {
+    const double s = s0_m * i / (n - 1);
+    CatenaryPoint p;
+    p.s_m = s;
+    if (i == 0) {
+      p.span_m = 0.0;
+      p.rise_m = 0.0;
+    } else {
+      const CatenaryEnd<double> e = CatenaryEndpoint(fl_n, fz_n, s, ea_n, w_n_per_m);
+      p.span_m = e.span_m;
+      p.rise_m = e.rise_m;
+    }
+    p.tension_n = CatenaryTension(fl_n, fz_n, s, w_n_per_m);
+    points.push_back(p);
+  }
+  return points;
+}
+
+}  // namespace fastcal

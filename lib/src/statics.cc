@@ -1,0 +1,274 @@
+// The double-precision statics solvers (equations and methods: statics.h).
+#include "fastcal/statics.h"
+
+#include <cmath>
+#include <sstream>
+
+#include <Eigen/Geometry>
+
+namespace fastcal {
+namespace {
+
+bool ParametersUsable(const StaticsParameters<double>& p) {
+  for (int i = 0; i < kNumCables; ++i) {
+    if (!p.tower_top_m[i].allFinite() || !p.anchor_cabin_m[i].allFinite()) return false;
+    if (!(p.ea_n[i] > 0.0) || !std::isfinite(p.ea_n[i])) return false;
+    if (!(p.linear_density_kg_per_m[i] > 0.0) || !std::isfinite(p.linear_density_kg_per_m[i])) {
+      return false;
+    }
+  }
+  return p.cabin_mass_kg > 0.0 && std::isfinite(p.cabin_mass_kg) &&
+         p.mass_centre_cabin_m.allFinite() && p.gravity_m_per_s2 < 0.0 &&
+         std::isfinite(p.gravity_m_per_s2);
+}
+
+void FillSolution(const StaticsParameters<double>& p, const internal::PoseGeometry<double>& g,
+                  const std::array<internal::CableState<double>, kNumCables>& st,
+                  const std::array<CatenaryForces, kNumCables>& low,
+                  const std::array<CatenaryForces, kNumCables>& high, StaticsSolution* sol) {
+  Eigen::Vector3d force_sum = Eigen::Vector3d::Zero(), moment_sum = Eigen::Vector3d::Zero();
+  for (int i = 0; i < kNumCables; ++i) {
+    CableSolution& c = sol->cables[i];
+    c.horizontal_force_n = st[i].fl;
+    c.force_n = Eigen::Vector3d(-g.ux[i] * st[i].fl, -g.uy[i] * st[i].fl, st[i].fz);
+    c.lower_tension_n = c.force_n.norm();
+    c.unstretched_length_m = st[i].s0;
+    c.upper_tension_n =
+        st[i].s0 > 0.0 ? CatenaryTension(st[i].fl, st[i].fz, st[i].s0, g.w[i]) : 0.0;
+    c.chord_length_m = g.chord[i];
+    c.secant_low = low[i];
+    c.secant_high = high[i];
+    force_sum -= c.force_n;
+    moment_sum -= g.r[i].cross(c.force_n);
+  }
+  const Eigen::Vector3d weight(0.0, 0.0, g.weight_n);
+  force_sum += weight;
+  moment_sum += g.e.cross(weight);
+  sol->force_residual_n = force_sum.norm();
+  sol->moment_residual_nm = moment_sum.norm();
+}
+
+StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose,
+                      const StaticsOptions& o, const StaticsSolution* previous,
+                      StaticsSolution* sol) {
+  using internal::CableState;
+  sol->cables = {};
+  sol->cable = -1;
+  sol->outer_iterations = 0;
+  sol->catenary_iterations = 0;
+  sol->force_residual_n = 0.0;
+  sol->moment_residual_nm = 0.0;
+  if (!IsFinite(pose) || !ParametersUsable(p)) return StaticsStatus::kInvalidInput;
+
+  internal::PoseGeometry<double> g;
+  StaticsStatus status =
+      internal::ComputeGeometry(p, pose, o.catenary.vertical_span_fraction, &g, &sol->cable);
+  if (status != StaticsStatus::kOk) return status;
+
+  std::array<CatenaryForces, kNumCables> low{}, high{};
+  std::array<CableState<double>, kNumCables> st;
+  bool have_state = false;
+  if (previous != nullptr) {
+    for (int i = 0; i < kNumCables; ++i) {
+      low[i] = previous->cables[i].secant_low;
+      high[i] = previous->cables[i].secant_high;
+    }
+    if (o.method == StaticsMethod::kExact) {
+      for (int i = 0; i < kNumCables; ++i) {
+        const CableSolution& c = previous->cables[i];
+        st[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
+      }
+      have_state = true;
+    }
+  }
+
+  int* cable = &sol->cable;
+  int* its = &sol->catenary_iterations;
+  if (!have_state) {
+    std::array<double, kNumCables> a, b, fl;
+    status = internal::AasLines(p, g, o, previous != nullptr, &low, &high, &a, &b, cable, its);
+    if (status != StaticsStatus::kOk) return status;
+    if (!internal::SolveEquilibrium(g, a, b, &fl)) return StaticsStatus::kSingular;
+    for (int i = 0; i < kNumCables; ++i) {
+      if (!(fl[i] > 0.0)) {
+        *cable = i;
+        return StaticsStatus::kSlackCable;
+      }
+      st[i] = {fl[i], a[i] * fl[i] + b[i], 0.0};
+    }
+    const int projections = o.method == StaticsMethod::kAasRefined ? o.refinement_steps
+                            : o.method == StaticsMethod::kExact      ? 1
+                            : o.compute_unstretched_lengths          ? 1
+                                                                     : 0;
+    for (int step = 0; step < projections; ++step) {
+      std::array<CatenaryCurvePoint, kNumCables> guess;
+      for (int i = 0; i < kNumCables; ++i) {
+        guess[i] = internal::CurveGuess(st[i].fl, g.chord[i], low[i], high[i], o);
+      }
+      std::array<CableState<double>, kNumCables> projected = st;
+      status = internal::ProjectOnCurves(p, g, o, guess, &projected, cable, its);
+      if (status != StaticsStatus::kOk) return status;
+      if (o.method == StaticsMethod::kAas) {
+        // AAS keeps Fz on its secant line (which satisfies equilibrium); s0 is the length
+        // that yields Fl.
+        for (int i = 0; i < kNumCables; ++i) st[i].s0 = projected[i].s0;
+      } else {
+        st = projected;
+      }
+      if (o.method == StaticsMethod::kAasRefined) {
+        status = internal::ReducedNewtonStep(p, g, &st, cable, nullptr, nullptr);
+        if (status != StaticsStatus::kOk) return status;
+        ++sol->outer_iterations;
+      }
+    }
+  }
+
+  if (o.method == StaticsMethod::kExact) {
+    bool converged = false;
+    for (int it = 0; it < o.exact_max_iterations && !converged; ++it) {
+      double relative_step = 0.0, relative_residual = 0.0;
+      status = internal::ReducedNewtonStep(p, g, &st, cable, &relative_step, &relative_residual);
+      if (status != StaticsStatus::kOk) return status;
+      ++sol->outer_iterations;
+      converged = relative_step <= o.exact_relative_tolerance &&
+                  relative_residual <= o.exact_relative_tolerance;
+    }
+    if (!converged) return StaticsStatus::kNotConverged;
+  }
+  FillSolution(p, g, st, low, high, sol);
+  return StaticsStatus::kOk;
+}
+
+}  // namespace
+
+const char* StaticsMethodName(StaticsMethod method) {
+  switch (method) {
+    case StaticsMethod::kAas:
+      return "aas";
+    case StaticsMethod::kAasRefined:
+      return "aas-refined";
+    case StaticsMethod::kExact:
+      return "exact";
+  }
+  return "unknown";
+}
+
+bool ParseStaticsMethod(const std::string& name, StaticsMethod* method) {
+  for (StaticsMethod m : {StaticsMethod::kAas, StaticsMethod::kAasRefined, StaticsMethod::kExact}) {
+    if (name == StaticsMethodName(m)) {
+      *method = m;
+      return true;
+    }
+  }
+  return false;
+}
+
+const char* StaticsStatusName(StaticsStatus status) {
+  switch (status) {
+    case StaticsStatus::kOk:
+      return "ok";
+    case StaticsStatus::kInvalidInput:
+      return "invalid input";
+    case StaticsStatus::kVerticalCable:
+      return "vertical cable";
+    case StaticsStatus::kSlackCable:
+      return "slack cable";
+    case StaticsStatus::kSingular:
+      return "singular";
+    case StaticsStatus::kCatenaryFailed:
+      return "catenary not converged";
+    case StaticsStatus::kNotConverged:
+      return "not converged";
+  }
+  return "unknown";
+}
+
+bool StaticsOptions::IsValid(std::string* error) const {
+  std::ostringstream e;
+  if (!(secant_low_fraction > 0.0) || !(secant_high_fraction > secant_low_fraction) ||
+      !std::isfinite(secant_high_fraction)) {
+    e << "secant fractions must satisfy 0 < low < high (got " << secant_low_fraction << ", "
+      << secant_high_fraction << ")";
+  } else if (refinement_steps < 1) {
+    e << "refinement_steps must be >= 1 (got " << refinement_steps << ")";
+  } else if (!(exact_relative_tolerance > 0.0)) {
+    e << "exact_relative_tolerance must be > 0 (got " << exact_relative_tolerance << ")";
+  } else if (exact_max_iterations < 1) {
+    e << "exact_max_iterations must be >= 1 (got " << exact_max_iterations << ")";
+  } else if (!(catenary.relative_tolerance > 0.0) || catenary.max_iterations < 1) {
+    e << "catenary solver options must have relative_tolerance > 0 and max_iterations >= 1";
+  }
+  if (e.str().empty()) return true;
+  if (error != nullptr) *error = e.str();
+  return false;
+}
+
+StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot) {
+  StaticsParameters<double> p;
+  for (int i = 0; i < kNumCables; ++i) {
+    p.tower_top_m[i] = robot.cables[i].tower_top_m;
+    p.anchor_cabin_m[i] = robot.AnchorOfCable(i);
+    p.ea_n[i] = robot.cables[i].ea_n;
+    p.linear_density_kg_per_m[i] = robot.cables[i].linear_density_kg_per_m;
+  }
+  p.cabin_mass_kg = robot.cabin_mass_kg;
+  p.mass_centre_cabin_m = robot.mass_centre_cabin_m;
+  p.gravity_m_per_s2 = robot.gravity_m_per_s2;
+  return p;
+}
+
+StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parameters,
+                                         const Pose& pose, const StaticsOptions& options,
+                                         StaticsSolution* solution) {
+  const bool warm = options.warm_start && solution->status == StaticsStatus::kOk;
+  StaticsSolution previous;
+  if (warm) previous = *solution;
+  StaticsStatus status = Attempt(parameters, pose, options, warm ? &previous : nullptr, solution);
+  if (status != StaticsStatus::kOk && warm) {
+    status = Attempt(parameters, pose, options, nullptr, solution);
+  }
+  if (status != StaticsStatus::kOk) {
+    const int cable = solution->cable;
+    solution->cables = {};
+    solution->cable = cable;
+  }
+  solution->status = status;
+  return status;
+}
+
+StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose,
+                           const StaticsOptions& options, StaticsSolution* solution) {
+  return SolveStaticsWithParameters(MakeStaticsParameters(robot), pose, options, solution);
+}
+
+std::string DescribeStatus(const StaticsSolution& solution) {
+  std::ostringstream s;
+  const int c = solution.cable + 1;
+  switch (solution.status) {
+    case StaticsStatus::kOk:
+      s << "ok";
+      break;
+    case StaticsStatus::kInvalidInput:
+      s << "invalid input: the pose or the model has a non-finite or non-physical value";
+      break;
+    case StaticsStatus::kVerticalCable:
+      s << "cable " << c << " is vertical: its horizontal force direction is undefined";
+      break;
+    case StaticsStatus::kSlackCable:
+      s << "cable " << c
+        << " would be slack (horizontal force <= 0): the pose cannot be held with taut cables";
+      break;
+    case StaticsStatus::kSingular:
+      s << "the equilibrium equations are singular at this pose";
+      break;
+    case StaticsStatus::kCatenaryFailed:
+      s << "the catenary of cable " << c << " did not converge";
+      break;
+    case StaticsStatus::kNotConverged:
+      s << "the exact solver did not converge";
+      break;
+  }
+  return s.str();
+}
+
+}  // namespace fastcal
