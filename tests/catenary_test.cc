@@ -1,2 +1,244 @@
+// Tests of the elastic catenary (catenary.h): round trips, analytic Jacobian against
+// central differences, Jet and double paths, the stiff and weightless limits, and the
+// failure statuses.
+#include "fastcal/catenary.h"
+
+#include <cmath>
+#include <random>
+
+#include <ceres/jet.h>
 #include <gtest/gtest.h>
-TEST(Placeholder, Builds) { SUCCEED(); }
+
+namespace fastcal {
+namespace {
+
+constexpr double kEaN = 2.4656e7;
+constexpr double kWNPerM = 11.718 * -9.8;
+constexpr uint64_t kSeed = 20261121;
+// Chords met in the FAST workspace (cabin within ~110 m of the axis, 130-175 m high).
+constexpr double kMinSpanM = 180.0, kMaxSpanM = 420.0;
+constexpr double kMinRiseM = 90.0, kMaxRiseM = 145.0;
+// Round-trip tolerances: end point to 1e-9 of the chord, forces to 1e-8 relative.
+constexpr double kEndPointRelTol = 1e-9;
+constexpr double kForceRelTol = 1e-8;
+
+struct Chord {
+  double span_m, rise_m, s0_m;
+};
+
+std::vector<Chord> RandomChords(int n, double s0_low, double s0_high) {
+  std::mt19937_64 rng(kSeed);
+  std::uniform_real_distribution<double> span(kMinSpanM, kMaxSpanM), rise(kMinRiseM, kMaxRiseM),
+      frac(s0_low, s0_high);
+  std::vector<Chord> chords;
+  for (int i = 0; i < n; ++i) {
+    Chord c;
+    c.span_m = span(rng);
+    c.rise_m = rise(rng);
+    c.s0_m = frac(rng) * std::hypot(c.span_m, c.rise_m);
+    chords.push_back(c);
+  }
+  return chords;
+}
+
+TEST(CatenaryTest, ColdSolveConvergesOverWorkspaceLengthRange) {
+  const CatenarySolverOptions options;
+  for (const Chord& c : RandomChords(2000, 0.95, 1.05)) {
+    CatenaryForces f;
+    int iterations = 0;
+    ASSERT_EQ(SolveCatenaryForcesDouble(c.span_m, c.rise_m, c.s0_m, kEaN, kWNPerM, options,
+                                        nullptr, &f, &iterations),
+              CatenaryStatus::kOk)
+        << "span " << c.span_m << " rise " << c.rise_m << " s0/k "
+        << c.s0_m / std::hypot(c.span_m, c.rise_m);
+    EXPECT_GT(f.fl_n, 0.0);
+    const CatenaryEnd<double> e = CatenaryEndpoint(f.fl_n, f.fz_n, c.s0_m, kEaN, kWNPerM);
+    const double k = std::hypot(c.span_m, c.rise_m);
+    EXPECT_NEAR(e.span_m, c.span_m, kEndPointRelTol * k);
+    EXPECT_NEAR(e.rise_m, c.rise_m, kEndPointRelTol * k);
+  }
+}
+
+TEST(CatenaryTest, ForwardThenInverseRecoversForces) {
+  std::mt19937_64 rng(kSeed + 1);
+  std::uniform_real_distribution<double> fl(2e4, 4e5), slope(-1.2, -0.1), len(250.0, 450.0);
+  const CatenarySolverOptions options;
+  for (int i = 0; i < 500; ++i) {
+    const double fl_n = fl(rng), fz_n = slope(rng) * fl_n, s0_m = len(rng);
+    const CatenaryEnd<double> e = CatenaryEndpoint(fl_n, fz_n, s0_m, kEaN, kWNPerM);
+    CatenaryForces f;
+    int it = 0;
+    ASSERT_EQ(SolveCatenaryForcesDouble(e.span_m, e.rise_m, s0_m, kEaN, kWNPerM, options,
+                                        nullptr, &f, &it),
+              CatenaryStatus::kOk);
+    EXPECT_NEAR(f.fl_n, fl_n, kForceRelTol * fl_n);
+    EXPECT_NEAR(f.fz_n, fz_n, kForceRelTol * fl_n);
+    // The other inverse problem: the length that yields fl.
+    CatenaryCurvePoint p;
+    ASSERT_EQ(SolveCatenaryLengthDouble(e.span_m, e.rise_m, fl_n, kEaN, kWNPerM, options,
+                                        nullptr, &p, &it),
+              CatenaryStatus::kOk);
+    EXPECT_NEAR(p.s0_m, s0_m, kForceRelTol * s0_m);
+    EXPECT_NEAR(p.fz_n, fz_n, kForceRelTol * fl_n);
+  }
+}
+
+TEST(CatenaryTest, AnalyticJacobianMatchesCentralDifferences) {
+  // Relative step and agreement for central differences of smooth functions.
+  constexpr double kRelStep = 1e-6;
+  constexpr double kRelTol = 1e-6;
+  std::mt19937_64 rng(kSeed + 2);
+  std::uniform_real_distribution<double> fl(1e4, 5e5), slope(-1.5, 0.3), len(100.0, 450.0);
+  for (int i = 0; i < 200; ++i) {
+    const double x[3] = {fl(rng), 0.0, len(rng)};
+    double u[3] = {x[0], slope(rng) * x[0], x[2]};
+    const CatenaryEnd<double> e = CatenaryEndpoint(u[0], u[1], u[2], kEaN, kWNPerM);
+    for (int j = 0; j < 3; ++j) {
+      const double h = kRelStep * std::max(std::abs(u[j]), 1.0);
+      double up[3] = {u[0], u[1], u[2]}, dn[3] = {u[0], u[1], u[2]};
+      up[j] += h;
+      dn[j] -= h;
+      const CatenaryEnd<double> a = CatenaryEndpoint(up[0], up[1], up[2], kEaN, kWNPerM);
+      const CatenaryEnd<double> b = CatenaryEndpoint(dn[0], dn[1], dn[2], kEaN, kWNPerM);
+      const double dspan = (a.span_m - b.span_m) / (2 * h);
+      const double drise = (a.rise_m - b.rise_m) / (2 * h);
+      const double scale_span = std::abs(e.dspan[0]) + std::abs(e.dspan[1]) * u[0] / u[2] +
+                                std::abs(e.dspan[j]);
+      const double scale_rise = std::abs(e.drise[j]) + std::abs(e.drise[1]);
+      EXPECT_NEAR(e.dspan[j], dspan, kRelTol * scale_span) << "dspan/du" << j;
+      EXPECT_NEAR(e.drise[j], drise, kRelTol * scale_rise) << "drise/du" << j;
+    }
+  }
+}
+
+TEST(CatenaryTest, JetAndDoubleAgree) {
+  using Jet = ceres::Jet<double, 3>;
+  constexpr double kTol = 1e-12;
+  const double fl = 1.2e5, fz = -6e4, s0 = 321.0;
+  const CatenaryEnd<double> d = CatenaryEndpoint(fl, fz, s0, kEaN, kWNPerM);
+  const CatenaryEnd<Jet> j = CatenaryEndpoint(Jet(fl, 0), Jet(fz, 1), Jet(s0, 2), Jet(kEaN),
+                                              Jet(kWNPerM));
+  EXPECT_NEAR(j.span_m.a, d.span_m, kTol * s0);
+  EXPECT_NEAR(j.rise_m.a, d.rise_m, kTol * s0);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(j.span_m.v[k], d.dspan[k], kTol * (std::abs(d.dspan[k]) + 1e-3));
+    EXPECT_NEAR(j.rise_m.v[k], d.drise[k], kTol * (std::abs(d.drise[k]) + 1e-3));
+  }
+}
+
+TEST(CatenaryTest, JetInverseSolveCarriesImplicitDerivatives) {
+  // d(Fl, Fz)/d(span, rise, s0, EA, w) from the Jet path against central differences of
+  // the double solve.
+  using Jet = ceres::Jet<double, 5>;
+  constexpr double kRelTol = 1e-5;
+  const double in[5] = {290.0, 130.0, 318.0, kEaN, kWNPerM};
+  const CatenarySolverOptions options;
+  Jet fl, fz;
+  ASSERT_EQ(SolveCatenaryForces(Jet(in[0], 0), Jet(in[1], 1), Jet(in[2], 2), Jet(in[3], 3),
+                                Jet(in[4], 4), options, nullptr, &fl, &fz),
+            CatenaryStatus::kOk);
+  for (int k = 0; k < 5; ++k) {
+    const double h = 1e-6 * std::abs(in[k]);
+    double up[5], dn[5];
+    std::copy(in, in + 5, up);
+    std::copy(in, in + 5, dn);
+    up[k] += h;
+    dn[k] -= h;
+    double fl_up, fz_up, fl_dn, fz_dn;
+    ASSERT_EQ(SolveCatenaryForces(up[0], up[1], up[2], up[3], up[4], options, nullptr, &fl_up,
+                                  &fz_up),
+              CatenaryStatus::kOk);
+    ASSERT_EQ(SolveCatenaryForces(dn[0], dn[1], dn[2], dn[3], dn[4], options, nullptr, &fl_dn,
+                                  &fz_dn),
+              CatenaryStatus::kOk);
+    const double dfl = (fl_up - fl_dn) / (2 * h), dfz = (fz_up - fz_dn) / (2 * h);
+    EXPECT_NEAR(fl.v[k], dfl, kRelTol * (std::abs(dfl) + std::abs(fl.a) / std::abs(in[k])))
+        << "input " << k;
+    EXPECT_NEAR(fz.v[k], dfz, kRelTol * (std::abs(dfz) + std::abs(fl.a) / std::abs(in[k])))
+        << "input " << k;
+  }
+}
+
+TEST(CatenaryTest, VeryStiffCableTendsToInextensibleCatenary) {
+  // Inextensible catenary identity: s0^2 = Z^2 + (2H/|w| sinh(|w| L / (2H)))^2.
+  constexpr double kStiffEaN = 1e16;
+  constexpr double kRelTol = 1e-7;
+  const CatenarySolverOptions options;
+  for (const Chord& c : RandomChords(50, 1.001, 1.05)) {
+    CatenaryForces f;
+    int it = 0;
+    ASSERT_EQ(SolveCatenaryForcesDouble(c.span_m, c.rise_m, c.s0_m, kStiffEaN, kWNPerM, options,
+                                        nullptr, &f, &it),
+              CatenaryStatus::kOk);
+    const double h = f.fl_n, w = std::abs(kWNPerM);
+    const double arc = std::sqrt(c.rise_m * c.rise_m +
+                                 std::pow(2 * h / w * std::sinh(w * c.span_m / (2 * h)), 2));
+    EXPECT_NEAR(arc, c.s0_m, kRelTol * c.s0_m);
+  }
+}
+
+TEST(CatenaryTest, WeightlessCableTendsToStraightElasticBar) {
+  // T = EA (k/s0 - 1), along the chord, when the density -> 0.
+  constexpr double kTinyWNPerM = -1e-9;
+  constexpr double kRelTol = 1e-7;
+  const CatenarySolverOptions options;
+  for (const Chord& c : RandomChords(50, 0.96, 0.999)) {
+    CatenaryForces f;
+    int it = 0;
+    ASSERT_EQ(SolveCatenaryForcesDouble(c.span_m, c.rise_m, c.s0_m, kEaN, kTinyWNPerM, options,
+                                        nullptr, &f, &it),
+              CatenaryStatus::kOk);
+    const double k = std::hypot(c.span_m, c.rise_m);
+    const double tension = kEaN * (k / c.s0_m - 1.0);
+    EXPECT_NEAR(std::hypot(f.fl_n, f.fz_n), tension, kRelTol * tension);
+    EXPECT_NEAR(f.fz_n / f.fl_n, -c.rise_m / c.span_m, kRelTol);  // pulled along the chord
+  }
+}
+
+TEST(CatenaryTest, ShapeEndsOnChordAndTensionMatchesEnds) {
+  constexpr double kTol = 1e-9;
+  const double fl = 1.3e5, fz = -7e4, s0 = 330.0;
+  const CatenaryEnd<double> e = CatenaryEndpoint(fl, fz, s0, kEaN, kWNPerM);
+  const std::vector<CatenaryPoint> shape = CatenaryShape(fl, fz, s0, kEaN, kWNPerM, 11);
+  ASSERT_EQ(shape.size(), 11u);
+  EXPECT_EQ(shape.front().span_m, 0.0);
+  EXPECT_NEAR(shape.back().span_m, e.span_m, kTol * s0);
+  EXPECT_NEAR(shape.back().rise_m, e.rise_m, kTol * s0);
+  EXPECT_NEAR(shape.front().tension_n, std::hypot(fl, fz), kTol * fl);
+  EXPECT_NEAR(shape.back().tension_n, CatenaryTension(fl, fz, s0, kWNPerM), kTol * fl);
+  for (size_t i = 1; i < shape.size(); ++i) {
+    // Fz < 0 at the bottom: the cable rises and its tension grows toward the top.
+    EXPECT_GT(shape[i].rise_m, shape[i - 1].rise_m);
+    EXPECT_GT(shape[i].tension_n, shape[i - 1].tension_n);
+  }
+}
+
+TEST(CatenaryTest, BadInputGivesStatusNotNan) {
+  const CatenarySolverOptions options;
+  CatenaryForces f;
+  int it = 0;
+  EXPECT_EQ(SolveCatenaryForcesDouble(0.0, 150.0, 160.0, kEaN, kWNPerM, options, nullptr, &f,
+                                      &it),
+            CatenaryStatus::kVerticalChord);
+  EXPECT_EQ(SolveCatenaryForcesDouble(NAN, 150.0, 160.0, kEaN, kWNPerM, options, nullptr, &f,
+                                      &it),
+            CatenaryStatus::kInvalidInput);
+  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 150.0, -1.0, kEaN, kWNPerM, options, nullptr, &f,
+                                      &it),
+            CatenaryStatus::kInvalidInput);
+  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 150.0, 330.0, 0.0, kWNPerM, options, nullptr, &f,
+                                      &it),
+            CatenaryStatus::kInvalidInput);
+  CatenaryCurvePoint p;
+  EXPECT_EQ(SolveCatenaryLengthDouble(300.0, 150.0, -5.0, kEaN, kWNPerM, options, nullptr, &p,
+                                      &it),
+            CatenaryStatus::kInvalidInput);
+  CatenarySolverOptions one_step;
+  one_step.max_iterations = 1;
+  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 130.0, 0.95 * std::hypot(300.0, 130.0), kEaN,
+                                      kWNPerM, one_step, nullptr, &f, &it),
+            CatenaryStatus::kNotConverged);
+}
+
+}  // namespace
+}  // namespace fastcal
