@@ -1,2 +1,76 @@
+// Time per pose of the three statics methods (statics.h), cold and warm-started, at K2
+// and along the paper's 101-node line and half circle (focal attitude law).
+// Run: build/bench/statics_bench --benchmark_min_time=0.2
+// items_per_second is poses per second; time per pose = 1 / items_per_second.
 #include <benchmark/benchmark.h>
+
+#include <cmath>
+#include <vector>
+
+#include "fastcal/statics.h"
+
+namespace fastcal {
+namespace {
+
+constexpr int kPaperNodes = 101;
+
+std::vector<Pose> PaperTrajectory(bool circle) {
+  std::vector<Pose> poses;
+  for (int n = 0; n < kPaperNodes; ++n) {
+    Pose p;
+    if (circle) {
+      const double t = M_PI * n / (kPaperNodes - 1);
+      p.position_m = Eigen::Vector3d(50 * std::cos(t), 50 * std::sin(t), 150);
+    } else {
+      p.position_m = Eigen::Vector3d(50.0 - 100.0 * n / (kPaperNodes - 1), 0, 150);
+    }
+    p.rotation = FocalAttitude(p.position_m, FocalAttitudeLaw());
+    poses.push_back(p);
+  }
+  return poses;
+}
+
+StaticsMethod MethodOf(int64_t index) { return static_cast<StaticsMethod>(index); }
+
+void BM_SinglePoseCold(benchmark::State& state) {
+  const CableRobot robot = CableRobot::NominalFast();
+  Pose pose;
+  pose.position_m = Eigen::Vector3d(42.65, 33.73, 149.52);
+  pose.rotation = FocalAttitude(pose.position_m, FocalAttitudeLaw());
+  StaticsOptions options;
+  options.method = MethodOf(state.range(0));
+  StaticsSolution solution;
+  for (auto _ : state) {
+    SolveStatics(robot, pose, options, &solution);
+    benchmark::DoNotOptimize(solution);
+  }
+  state.SetLabel(StaticsMethodName(options.method));
+  state.SetItemsProcessed(state.iterations());
+}
+
+// range(0): method, range(1): 0 line / 1 half circle, range(2): warm start.
+void BM_PaperTrajectory(benchmark::State& state) {
+  const CableRobot robot = CableRobot::NominalFast();
+  const std::vector<Pose> poses = PaperTrajectory(state.range(1) == 1);
+  StaticsOptions options;
+  options.method = MethodOf(state.range(0));
+  options.warm_start = state.range(2) == 1;
+  StaticsSolution solution;
+  for (auto _ : state) {
+    for (const Pose& p : poses) {
+      SolveStatics(robot, p, options, &solution);
+      benchmark::DoNotOptimize(solution);
+    }
+  }
+  state.SetLabel(std::string(StaticsMethodName(options.method)) +
+                 (state.range(1) ? " circle" : " line") + (options.warm_start ? " warm" : " cold"));
+  state.SetItemsProcessed(state.iterations() * poses.size());
+}
+
+BENCHMARK(BM_SinglePoseCold)->DenseRange(0, 2);
+BENCHMARK(BM_PaperTrajectory)->ArgsProduct({{0, 1, 2}, {0, 1}, {0, 1}});
+
+}  // namespace
+}  // namespace fastcal
+
 BENCHMARK_MAIN();

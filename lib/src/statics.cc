@@ -130,8 +130,11 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose,
       status = internal::ReducedNewtonStep(p, g, &st, cable, &relative_step, &relative_residual);
       if (status != StaticsStatus::kOk) return status;
       ++sol->outer_iterations;
-      converged = relative_step <= o.exact_relative_tolerance &&
-                  relative_residual <= o.exact_relative_tolerance;
+      // Newton converges quadratically: a step of relative size d leaves an error of
+      // order d^2, so the tolerance is met once d <= sqrt(tolerance) and the end
+      // conditions held to the same order before the step.
+      const double step_bound = std::sqrt(o.exact_relative_tolerance);
+      converged = relative_step <= step_bound && relative_residual <= step_bound;
     }
     if (!converged) return StaticsStatus::kNotConverged;
   }

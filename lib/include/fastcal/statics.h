@@ -50,8 +50,9 @@ struct StaticsOptions {
   double secant_high_fraction = 1.01;
   // Re-linearisation steps of kAasRefined (>= 1).
   int refinement_steps = 1;
-  // kExact stops when the largest Newton update of Fl is below this fraction of the
-  // largest Fl and every catenary end condition holds to catenary.relative_tolerance.
+  // kExact stops when the relative error left after the last Newton step, estimated as
+  // the square of that step's largest |dFl| / max Fl (and of the end-point residual
+  // relative to the chord), is below this.
   double exact_relative_tolerance = 1e-12;
   int exact_max_iterations = 30;
   // kAas only: solve for s0_i (one 2x2 Newton per cable). Off, s0 and the upper-end
