@@ -1,2 +1,53 @@
-#include <cstdio>
-int main() { std::puts("fastcal: under construction"); return 0; }
+// fastcal: statics and calibration of the FAST cable robot from the command line.
+#include <cstring>
+#include <iostream>
+#include <string>
+
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
+#include "cli_util.h"
+#include "commands.h"
+
+namespace fastcal::cli {
+
+void ParseFlags(const std::vector<std::string>& args) {
+  std::vector<char*> ptrs;
+  for (const std::string& a : args) ptrs.push_back(const_cast<char*>(a.c_str()));
+  int n = static_cast<int>(ptrs.size());
+  char** p = ptrs.data();
+  gflags::ParseCommandLineFlags(&n, &p, /*remove_flags=*/true);
+}
+
+namespace {
+const char kUsage[] = R"(fastcal: statics and calibration of the FAST cable-driven parallel robot.
+
+Usage: fastcal <command> [--flag=value ...]
+
+Commands:
+  solve      cable forces, tensions and unstretched lengths at a pose or along a trajectory
+             (AAS, refined AAS, exact, or AAS against exact)
+
+Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
+)";
+}  // namespace
+}  // namespace fastcal::cli
+
+int main(int argc, char** argv) {
+  using namespace fastcal::cli;
+  google::InitGoogleLogging(argv[0]);
+  FLAGS_logtostderr = true;
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
+      !std::strcmp(argv[1], "help")) {
+    std::cout << kUsage;
+    return argc < 2 ? kExitUsage : 0;
+  }
+  if (!std::strcmp(argv[1], "--version")) {
+    std::cout << "fastcal " << FASTCAL_VERSION << "\n";
+    return 0;
+  }
+  const std::string command = argv[1];
+  if (command == "solve") return RunSolve(argc, argv);
+  std::cerr << "fastcal: unknown command '" << command << "'\n\n" << kUsage;
+  return kExitUsage;
+}

@@ -1,0 +1,135 @@
+#include "cli_util.h"
+
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+namespace fastcal::cli {
+
+bool WantsHelp(int argc, char** argv, int first) {
+  for (int i = first; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "-h" || a == "--help" || a == "-help" || a == "--helpfull") return true;
+  }
+  return false;
+}
+
+bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string& command,
+                            const std::set<std::string>& allowed,
+                            std::vector<std::string>* normalised, std::string* error) {
+  normalised->assign(1, argv[0]);
+  for (int i = first; i < argc; ++i) {
+    const std::string arg = argv[i];
+    if (arg.size() < 3 || arg[0] != '-') {
+      *error = "unexpected argument '" + arg + "' (flags are --name=value; see fastcal " +
+               command + " --help)";
+      return false;
+    }
+    const size_t start = arg[1] == '-' ? 2 : 1;
+    const size_t eq = arg.find('=');
+    std::string name = arg.substr(start, eq == std::string::npos ? std::string::npos : eq - start);
+    std::string bare = name;
+    if (!allowed.count(bare) && bare.rfind("no", 0) == 0 && allowed.count(bare.substr(2))) {
+      bare = bare.substr(2);  // gflags' --noflag form of a boolean
+    }
+    std::string underscored = name;
+    for (char& c : underscored) {
+      if (c == '-') c = '_';
+    }
+    if (!allowed.count(bare)) {
+      *error = "unknown flag --" + name + " (see fastcal " + command + " --help)";
+      return false;
+    }
+    normalised->push_back("--" + underscored +
+                          (eq == std::string::npos ? std::string() : arg.substr(eq)));
+  }
+  return true;
+}
+
+namespace {
+bool ParseList(const std::string& name, const std::string& text, int n, double* out,
+               std::string* error) {
+  std::stringstream ss(text);
+  std::string item;
+  int count = 0;
+  while (std::getline(ss, item, ',')) {
+    if (count >= n) break;
+    const char* begin = item.c_str();
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    while (end != nullptr && (*end == ' ' || *end == '\t')) ++end;
+    if (end == begin || *end != '\0') {
+      *error = "--" + name + ": '" + item + "' is not a number";
+      return false;
+    }
+    if (!std::isfinite(v)) {
+      *error = "--" + name + ": '" + item + "' is not finite";
+      return false;
+    }
+    out[count++] = v;
+  }
+  if (count != n || ss.rdbuf()->in_avail() > 0 || (!text.empty() && text.back() == ',')) {
+    *error = "--" + name + " needs " + std::to_string(n) + " comma-separated numbers, got '" +
+             text + "'";
+    return false;
+  }
+  return true;
+}
+}  // namespace
+
+bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vector3d* v,
+                  std::string* error) {
+  return ParseList(name, text, 3, v->data(), error);
+}
+
+bool ParseVector4(const std::string& name, const std::string& text, Eigen::Vector4d* v,
+                  std::string* error) {
+  return ParseList(name, text, 4, v->data(), error);
+}
+
+bool WriteOutput(const std::string& path, const std::string& content, std::string* error) {
+  if (path.empty() || path == "-") {
+    std::cout << content << std::flush;
+    return true;
+  }
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) {
+      *error = path + ": cannot open for writing";
+      return false;
+    }
+    out << content;
+    out.flush();
+    if (!out) {
+      out.close();
+      std::remove(tmp.c_str());
+      *error = path + ": write failed";
+      return false;
+    }
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
+    std::remove(tmp.c_str());
+    *error = path + ": cannot rename the temporary file into place";
+    return false;
+  }
+  return true;
+}
+
+void PrintError(const std::string& command, const std::string& message) {
+  std::cerr << "fastcal " << command << ": " << message << std::endl;
+}
+
+std::string FormatDouble(double value, int significant_digits) {
+  if (value == 0.0) return "0";  // no "-0" in tables
+  char buf[48];
+  std::snprintf(buf, sizeof(buf), "%.*g", significant_digits, value);
+  return buf;
+}
+
+}  // namespace fastcal::cli

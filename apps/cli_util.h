@@ -1,0 +1,46 @@
+// Helpers shared by the fastcal subcommands: flag checking, value parsing, atomic output.
+#ifndef FASTCAL_APPS_CLI_UTIL_H_
+#define FASTCAL_APPS_CLI_UTIL_H_
+
+#include <set>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace fastcal::cli {
+
+// Exit codes: 0 success, 1 a computation failed (infeasible pose, solver), 2 bad usage or
+// bad input (flags, files).
+inline constexpr int kExitFailure = 1;
+inline constexpr int kExitUsage = 2;
+
+// Checks every "--name[=value]" in argv[first..] against `allowed` (names with dashes as
+// the user types them), rewrites dashes in the names to the underscores gflags uses, and
+// returns the rewritten argument vector (argv[0] first). On an unknown flag or a
+// positional argument, returns false with the message in *error.
+bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string& command,
+                            const std::set<std::string>& allowed,
+                            std::vector<std::string>* normalised, std::string* error);
+
+// True when argv has -h, --help or -help.
+bool WantsHelp(int argc, char** argv, int first);
+
+// Parses "x,y,z" (three finite numbers) for flag `name`.
+bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vector3d* v,
+                  std::string* error);
+bool ParseVector4(const std::string& name, const std::string& text, Eigen::Vector4d* v,
+                  std::string* error);
+
+// Writes `content` to `path` through a temporary file and a rename, so that a failure
+// leaves no partial file; path "" or "-" writes to stdout.
+bool WriteOutput(const std::string& path, const std::string& content, std::string* error);
+
+// "fastcal <command>: <message>" on stderr.
+void PrintError(const std::string& command, const std::string& message);
+
+std::string FormatDouble(double value, int significant_digits = 10);
+
+}  // namespace fastcal::cli
+
+#endif  // FASTCAL_APPS_CLI_UTIL_H_

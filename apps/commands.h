@@ -1,0 +1,18 @@
+// The fastcal subcommands. Each maps its flags to library options in one place, calls
+// the library and prints; the library itself never reads flags.
+#ifndef FASTCAL_APPS_COMMANDS_H_
+#define FASTCAL_APPS_COMMANDS_H_
+
+#include <string>
+#include <vector>
+
+namespace fastcal::cli {
+
+int RunSolve(int argc, char** argv);
+
+// Parses already-checked flags (see CheckAndNormaliseFlags) with gflags.
+void ParseFlags(const std::vector<std::string>& args);
+
+}  // namespace fastcal::cli
+
+#endif  // FASTCAL_APPS_COMMANDS_H_

@@ -1,0 +1,496 @@
+// `fastcal solve`: cable forces, tensions and unstretched lengths for one pose or a
+// trajectory, by AAS, refined AAS or the exact solver, or AAS against exact ("compare",
+// the paper's Tables 2-5).
+#include <chrono>
+#include <iostream>
+#include <sstream>
+
+#include <gflags/gflags.h>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "fastcal/cable_robot.h"
+#include "fastcal/internal/json.h"
+#include "fastcal/statics.h"
+#include "fastcal/trajectory.h"
+
+DEFINE_string(model, "", "Model YAML (docs/model-format.md); empty = nominal FAST.");
+DEFINE_string(method, "aas-refined", "aas | aas-refined | exact | compare");
+DEFINE_string(position, "", "Single pose: x,y,z of the cabin frame origin (m).");
+DEFINE_string(rpy, "", "Attitude roll,pitch,yaw (deg), R = Rz(yaw) Ry(pitch) Rx(roll).");
+DEFINE_string(quat, "", "Attitude as unit quaternion w,x,y,z.");
+DEFINE_string(rotvec, "", "Attitude as rotation vector x,y,z (rad).");
+DEFINE_string(attitude_law, "", "'focal': attitude from the focal law; 'none': R = I.");
+DEFINE_double(tilt_fraction, 0.41, "Focal law: fraction of the off-axis angle.");
+DEFINE_string(focal_centre, "0,0,300", "Focal law and grids: focal-sphere centre x,y,z (m).");
+DEFINE_string(trajectory, "point", "point | line | arc | grid | random");
+DEFINE_string(from, "50,0,150", "line: first node x,y,z (m).");
+DEFINE_string(to, "-50,0,150", "line: last node x,y,z (m).");
+DEFINE_int32(nodes, 101, "line, arc: number of nodes.");
+DEFINE_string(centre, "0,0,150", "arc: centre x,y,z (m); the arc is horizontal.");
+DEFINE_double(radius, 50.0, "arc: radius (m).");
+DEFINE_double(start_deg, 0.0, "arc: first angle from +x toward +y (deg).");
+DEFINE_double(end_deg, 180.0, "arc: last angle (deg); 360 from start = full circle.");
+DEFINE_double(max_off_axis_deg, 40.0, "grid, random: largest off-axis angle (deg).");
+DEFINE_double(off_axis_step_deg, 5.0, "grid: ring spacing (deg).");
+DEFINE_double(azimuth_step_deg, 15.0, "grid: azimuth spacing (deg).");
+DEFINE_double(focal_radius, 160.0, "grid, random: focal-sphere radius (m).");
+DEFINE_int32(samples, 100, "random: number of poses.");
+DEFINE_uint64(seed, 1, "random: generator seed.");
+DEFINE_double(radial_spread, 0.0, "random: uniform offset along the sphere normal, +-m.");
+DEFINE_string(poses, "", "CSV of poses (x_m,y_m,z_m[,roll_deg,pitch_deg,yaw_deg|qw,qx,qy,qz]).");
+DEFINE_string(format, "csv", "csv | json");
+DEFINE_string(output, "", "Output file; empty or - = stdout. Written only on success.");
+DEFINE_double(secant_low, 0.99, "AAS: low secant length as a fraction of the chord.");
+DEFINE_double(secant_high, 1.01, "AAS: high secant length as a fraction of the chord.");
+DEFINE_int32(refinement_steps, 1, "aas-refined: re-linearisation steps.");
+DEFINE_double(exact_tolerance, 1e-12, "exact: relative tolerance on the forces.");
+DEFINE_bool(warm_start, true, "Start each trajectory node from the previous solution.");
+DEFINE_bool(keep_going, false, "Write infeasible poses as rows with their status instead of failing.");
+
+namespace fastcal::cli {
+namespace {
+
+constexpr char kCommand[] = "solve";
+constexpr double kNPerKn = 1e3;
+
+const char kHelp[] = R"(fastcal solve: cable forces of the FAST cable robot at a pose or along a trajectory.
+
+Usage:
+  fastcal solve --position=x,y,z [attitude] [options]
+  fastcal solve --trajectory=line|arc|grid|random [trajectory flags] [options]
+  fastcal solve --poses=FILE.csv [options]
+
+Attitude (one of; none means R = I, the neutral attitude):
+  --rpy=r,p,y            roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll)
+  --quat=w,x,y,z         unit quaternion (normalised if within 1e-3 of unit)
+  --rotvec=x,y,z         rotation vector in radians
+  --attitude-law=focal   tilt z' toward the focal-sphere centre by --tilt-fraction (0.41)
+                         of the off-axis angle (--focal-centre=0,0,300); 'none' = R = I
+  For trajectories only --attitude-law applies; a --poses file brings its own attitudes
+  unless --attitude-law=focal overrides them.
+
+Trajectories:
+  line    --from=50,0,150 --to=-50,0,150 --nodes=101        (the paper's Table 4)
+  arc     --centre=0,0,150 --radius=50 --start-deg=0 --end-deg=180 --nodes=101
+          (Table 5; --end-deg=360 is a full circle without a repeated node)
+  grid    focal-sphere cap: --max-off-axis-deg=40 --off-axis-step-deg=5
+          --azimuth-step-deg=15 --focal-radius=160
+  random  --samples=100 --seed=1 --max-off-axis-deg=40 --radial-spread=0
+  --poses=FILE.csv  x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz
+
+Method (--method):
+  aas          the paper's approximately analytical solution (secants at 0.99k, 1.01k)
+  aas-refined  AAS re-linearised on the exact Fz(Fl) tangent (default; ~1e-7 of exact)
+  exact        full coupled Newton solution to --exact-tolerance
+  compare      AAS and exact side by side with per-cable relative errors and their
+               maxima over the trajectory (printed on stderr; in JSON as a field)
+  --secant-low=0.99 --secant-high=1.01 --refinement-steps=1 --exact-tolerance=1e-12
+  --warm-start (default true): each trajectory node starts from the previous solution
+
+Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model.
+
+Output: CSV (default) or --format=json, to stdout or --output=FILE (written only when
+everything succeeded). CSV columns, units in the names:
+  node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status,
+  T1_kN..T6_kN            lower-end tensions (what the cabin-side sensors measure)
+  T1_upper_kN..           upper-end (tower) tensions
+  s0_1_m..s0_6_m          unstretched lengths
+  F1x_kN,F1y_kN,F1z_kN..  force on each cable at its lower end, global frame (the cabin
+                          feels the opposite)
+  force_residual_N,moment_residual_Nm   equilibrium residual of the returned forces
+  compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact.
+A summary line with the time per pose goes to stderr.
+
+A pose the cables cannot hold (a slack cable), a vertical cable or a solver failure is
+an error naming the node and cable (exit 1, no output) unless --keep-going, which writes
+the row with its status and empty numbers.
+
+Examples:
+  fastcal solve --position=0,0,140 --method=compare
+  fastcal solve --position=42.65,33.73,149.52 --attitude-law=focal --method=exact
+  fastcal solve --trajectory=arc --attitude-law=focal --method=compare --output=arc.csv
+)";
+
+const std::set<std::string> kFlags = {
+    "model", "method", "position", "rpy", "quat", "rotvec", "attitude-law", "tilt-fraction",
+    "focal-centre", "trajectory", "from", "to", "nodes", "centre", "radius", "start-deg",
+    "end-deg", "max-off-axis-deg", "off-axis-step-deg", "azimuth-step-deg", "focal-radius",
+    "samples", "seed", "radial-spread", "poses", "format", "output", "secant-low",
+    "secant-high", "refinement-steps", "exact-tolerance", "warm-start", "keep-going"};
+
+bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
+  FocalAttitudeLaw law;
+  law.tilt_fraction = FLAGS_tilt_fraction;
+  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
+  if (!std::isfinite(law.tilt_fraction)) {
+    *error = "--tilt-fraction must be finite";
+    return false;
+  }
+  if (!FLAGS_attitude_law.empty() && FLAGS_attitude_law != "focal" &&
+      FLAGS_attitude_law != "none") {
+    *error = "--attitude-law must be 'focal' or 'none', got '" + FLAGS_attitude_law + "'";
+    return false;
+  }
+  const int constant_attitudes =
+      !FLAGS_rpy.empty() + !FLAGS_quat.empty() + !FLAGS_rotvec.empty() + !FLAGS_attitude_law.empty();
+  if (constant_attitudes > 1) {
+    *error = "give at most one of --rpy, --quat, --rotvec, --attitude-law";
+    return false;
+  }
+  const bool focal = FLAGS_attitude_law == "focal";
+
+  std::vector<Eigen::Vector3d> positions;
+  if (!FLAGS_poses.empty()) {
+    if (FLAGS_trajectory != "point" || !FLAGS_position.empty()) {
+      *error = "--poses cannot be combined with --position or --trajectory";
+      return false;
+    }
+    if (!FLAGS_rpy.empty() || !FLAGS_quat.empty() || !FLAGS_rotvec.empty()) {
+      *error = "--poses brings its own attitudes; only --attitude-law=focal may override them";
+      return false;
+    }
+    if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
+    if (focal) {
+      for (Pose& p : *poses) p.rotation = FocalAttitude(p.position_m, law);
+    } else if (FLAGS_attitude_law == "none") {
+      for (Pose& p : *poses) p.rotation.setIdentity();
+    }
+    return true;
+  }
+
+  if (FLAGS_trajectory == "point") {
+    Eigen::Vector3d position;
+    if (FLAGS_position.empty()) {
+      *error = "give --position=x,y,z, a --trajectory or --poses (see fastcal solve --help)";
+      return false;
+    }
+    if (!ParseVector3("position", FLAGS_position, &position, error)) return false;
+    Pose pose;
+    pose.position_m = position;
+    if (!FLAGS_rpy.empty()) {
+      Eigen::Vector3d rpy;
+      if (!ParseVector3("rpy", FLAGS_rpy, &rpy, error)) return false;
+      pose.rotation = RotationFromRpyDeg(rpy[0], rpy[1], rpy[2]);
+    } else if (!FLAGS_quat.empty()) {
+      Eigen::Vector4d q;
+      if (!ParseVector4("quat", FLAGS_quat, &q, error)) return false;
+      std::string why;
+      if (!RotationFromQuaternion(q[0], q[1], q[2], q[3], &pose.rotation, &why)) {
+        *error = "--quat: " + why;
+        return false;
+      }
+    } else if (!FLAGS_rotvec.empty()) {
+      Eigen::Vector3d v;
+      if (!ParseVector3("rotvec", FLAGS_rotvec, &v, error)) return false;
+      pose.rotation = RotationFromRotationVector(v);
+    } else if (focal) {
+      pose.rotation = FocalAttitude(position, law);
+    }
+    poses->assign(1, pose);
+    return true;
+  }
+
+  if (!FLAGS_position.empty()) {
+    *error = "--position is for a single pose; drop it or --trajectory";
+    return false;
+  }
+  if (!FLAGS_rpy.empty() || !FLAGS_quat.empty() || !FLAGS_rotvec.empty()) {
+    *error = "a trajectory takes its attitude from --attitude-law=focal|none";
+    return false;
+  }
+  bool ok = false;
+  if (FLAGS_trajectory == "line") {
+    Eigen::Vector3d from, to;
+    ok = ParseVector3("from", FLAGS_from, &from, error) &&
+         ParseVector3("to", FLAGS_to, &to, error) &&
+         LinePositions(from, to, FLAGS_nodes, &positions, error);
+  } else if (FLAGS_trajectory == "arc") {
+    ArcSpec arc;
+    arc.radius_m = FLAGS_radius;
+    arc.start_deg = FLAGS_start_deg;
+    arc.end_deg = FLAGS_end_deg;
+    arc.nodes = FLAGS_nodes;
+    ok = ParseVector3("centre", FLAGS_centre, &arc.centre_m, error) &&
+         ArcPositions(arc, &positions, error);
+  } else if (FLAGS_trajectory == "grid") {
+    FocalGridSpec grid;
+    grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
+    grid.off_axis_step_deg = FLAGS_off_axis_step_deg;
+    grid.azimuth_step_deg = FLAGS_azimuth_step_deg;
+    grid.focal_centre_m = law.focal_centre_m;
+    grid.focal_radius_m = FLAGS_focal_radius;
+    ok = FocalSpherePositions(grid, &positions, error);
+  } else if (FLAGS_trajectory == "random") {
+    RandomWorkspaceSpec spec;
+    spec.samples = FLAGS_samples;
+    spec.max_off_axis_deg = FLAGS_max_off_axis_deg;
+    spec.radial_spread_m = FLAGS_radial_spread;
+    spec.sphere.focal_centre_m = law.focal_centre_m;
+    spec.sphere.focal_radius_m = FLAGS_focal_radius;
+    spec.seed = FLAGS_seed;
+    ok = RandomWorkspacePositions(spec, &positions, error);
+  } else {
+    *error = "--trajectory must be point, line, arc, grid or random, got '" + FLAGS_trajectory + "'";
+    return false;
+  }
+  if (!ok) {
+    *error = "--trajectory=" + FLAGS_trajectory + ": " + *error;
+    return false;
+  }
+  return focal ? PosesWithAttitudeLaw(positions, law, poses, error)
+               : PosesWithIdentityAttitude(positions, poses, error);
+}
+
+bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* error) {
+  *compare = FLAGS_method == "compare";
+  if (!*compare && !ParseStaticsMethod(FLAGS_method, &options->method)) {
+    *error = "--method must be aas, aas-refined, exact or compare, got '" + FLAGS_method + "'";
+    return false;
+  }
+  options->secant_low_fraction = FLAGS_secant_low;
+  options->secant_high_fraction = FLAGS_secant_high;
+  options->refinement_steps = FLAGS_refinement_steps;
+  options->exact_relative_tolerance = FLAGS_exact_tolerance;
+  options->warm_start = FLAGS_warm_start;
+  if (!options->IsValid(error)) return false;
+  if (FLAGS_format != "csv" && FLAGS_format != "json") {
+    *error = "--format must be csv or json, got '" + FLAGS_format + "'";
+    return false;
+  }
+  return true;
+}
+
+struct Run {
+  std::vector<StaticsSolution> solutions;
+  double seconds = 0.0;
+};
+
+// Solves every pose; on failure without --keep-going reports the node and stops.
+bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
+              const StaticsOptions& options, Run* run, std::string* error) {
+  run->solutions.resize(poses.size());
+  StaticsSolution current;
+  const auto start = std::chrono::steady_clock::now();
+  for (size_t n = 0; n < poses.size(); ++n) {
+    SolveStatics(robot, poses[n], options, &current);
+    run->solutions[n] = current;
+  }
+  run->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  for (size_t n = 0; n < poses.size(); ++n) {
+    if (run->solutions[n].status != StaticsStatus::kOk && !FLAGS_keep_going) {
+      std::ostringstream s;
+      s << "node " << n << " at position (" << poses[n].position_m.transpose()
+        << ") m: " << DescribeStatus(run->solutions[n])
+        << " [method " << StaticsMethodName(options.method) << "]";
+      *error = s.str();
+      return false;
+    }
+  }
+  return true;
+}
+
+std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run* aas,
+                    const Run* exact) {
+  std::ostringstream out;
+  out << "node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status";
+  if (single != nullptr) {
+    for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
+    for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_upper_kN";
+    for (int i = 1; i <= kNumCables; ++i) out << ",s0_" << i << "_m";
+    for (int i = 1; i <= kNumCables; ++i) out << ",F" << i << "x_kN,F" << i << "y_kN,F" << i << "z_kN";
+    out << ",force_residual_N,moment_residual_Nm";
+  } else {
+    for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_aas_kN";
+    for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_exact_kN";
+    for (int i = 1; i <= kNumCables; ++i) out << ",err" << i << "_pct";
+  }
+  out << "\n";
+  for (size_t n = 0; n < poses.size(); ++n) {
+    const Eigen::Vector3d rpy = RpyDegFromRotation(poses[n].rotation);
+    out << n;
+    for (int j = 0; j < 3; ++j) out << "," << FormatDouble(poses[n].position_m[j]);
+    for (int j = 0; j < 3; ++j) out << "," << FormatDouble(rpy[j]);
+    if (single != nullptr) {
+      const StaticsSolution& s = single->solutions[n];
+      out << "," << (s.status == StaticsStatus::kOk ? "ok" : DescribeStatus(s));
+      const bool ok = s.status == StaticsStatus::kOk;
+      auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
+      for (const CableSolution& c : s.cables) put(c.lower_tension_n / kNPerKn);
+      for (const CableSolution& c : s.cables) put(c.upper_tension_n / kNPerKn);
+      for (const CableSolution& c : s.cables) put(c.unstretched_length_m);
+      for (const CableSolution& c : s.cables) {
+        for (int j = 0; j < 3; ++j) put(c.force_n[j] / kNPerKn);
+      }
+      put(s.force_residual_n);
+      put(s.moment_residual_nm);
+    } else {
+      const StaticsSolution& a = aas->solutions[n];
+      const StaticsSolution& e = exact->solutions[n];
+      const bool ok = a.status == StaticsStatus::kOk && e.status == StaticsStatus::kOk;
+      out << "," << (ok ? "ok" : DescribeStatus(a.status != StaticsStatus::kOk ? a : e));
+      auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
+      for (const CableSolution& c : a.cables) put(c.lower_tension_n / kNPerKn);
+      for (const CableSolution& c : e.cables) put(c.lower_tension_n / kNPerKn);
+      for (int i = 0; i < kNumCables; ++i) {
+        put(ok ? 100.0 * (a.cables[i].lower_tension_n / e.cables[i].lower_tension_n - 1.0) : 0.0);
+      }
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+std::array<double, kNumCables> MaxAbsErrorPct(const Run& aas, const Run& exact) {
+  std::array<double, kNumCables> worst{};
+  for (size_t n = 0; n < aas.solutions.size(); ++n) {
+    if (aas.solutions[n].status != StaticsStatus::kOk ||
+        exact.solutions[n].status != StaticsStatus::kOk) {
+      continue;
+    }
+    for (int i = 0; i < kNumCables; ++i) {
+      worst[i] = std::max(worst[i], 100.0 * std::abs(aas.solutions[n].cables[i].lower_tension_n /
+                                                         exact.solutions[n].cables[i].lower_tension_n -
+                                                     1.0));
+    }
+  }
+  return worst;
+}
+
+void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
+  j->Key("status").String(s.status == StaticsStatus::kOk ? "ok" : DescribeStatus(s));
+  if (s.status != StaticsStatus::kOk) return;
+  j->Key("cables").BeginArray();
+  for (const CableSolution& c : s.cables) {
+    j->BeginObject();
+    j->Key("lower_tension_kN").Number(c.lower_tension_n / kNPerKn);
+    j->Key("upper_tension_kN").Number(c.upper_tension_n / kNPerKn);
+    j->Key("unstretched_length_m").Number(c.unstretched_length_m);
+    j->Key("chord_length_m").Number(c.chord_length_m);
+    j->Key("force_kN").NumberArray(std::array<double, 3>{
+        c.force_n[0] / kNPerKn, c.force_n[1] / kNPerKn, c.force_n[2] / kNPerKn});
+    j->EndObject();
+  }
+  j->EndArray();
+  j->Key("force_residual_N").Number(s.force_residual_n);
+  j->Key("moment_residual_Nm").Number(s.moment_residual_nm);
+  j->Key("outer_iterations").Int(s.outer_iterations);
+}
+
+std::string Json(const std::vector<Pose>& poses, const std::string& method, const Run* single,
+                 const Run* aas, const Run* exact) {
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("method").String(method);
+  j.Key("model").String(FLAGS_model.empty() ? "nominal FAST" : FLAGS_model);
+  j.Key("poses").BeginArray();
+  for (size_t n = 0; n < poses.size(); ++n) {
+    j.BeginObject();
+    j.Key("node").Int(static_cast<long long>(n));
+    j.Key("position_m").NumberArray(poses[n].position_m);
+    j.Key("rpy_deg").NumberArray(RpyDegFromRotation(poses[n].rotation));
+    if (single != nullptr) {
+      JsonSolution(&j, single->solutions[n]);
+    } else {
+      j.Key("aas").BeginObject();
+      JsonSolution(&j, aas->solutions[n]);
+      j.EndObject();
+      j.Key("exact").BeginObject();
+      JsonSolution(&j, exact->solutions[n]);
+      j.EndObject();
+    }
+    j.EndObject();
+  }
+  j.EndArray();
+  if (single == nullptr) {
+    j.Key("max_abs_relative_error_pct").NumberArray(MaxAbsErrorPct(*aas, *exact));
+    j.Key("seconds_per_pose_aas").Number(aas->seconds / poses.size());
+    j.Key("seconds_per_pose_exact").Number(exact->seconds / poses.size());
+  } else {
+    j.Key("seconds_per_pose").Number(single->seconds / poses.size());
+  }
+  j.EndObject();
+  return j.str();
+}
+
+std::string TimingLine(const char* name, const Run& run, size_t n, bool warm) {
+  std::ostringstream s;
+  s.precision(3);
+  s << name << (warm && n > 1 ? " (warm start)" : "") << ": " << 1e6 * run.seconds / n
+    << " us/pose";
+  return s.str();
+}
+
+}  // namespace
+
+int RunSolve(int argc, char** argv) {
+  if (WantsHelp(argc, argv, 2)) {
+    std::cout << kHelp;
+    return 0;
+  }
+  std::vector<std::string> args;
+  std::string error;
+  if (!CheckAndNormaliseFlags(argc, argv, 2, kCommand, kFlags, &args, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  ParseFlags(args);
+
+  CableRobot robot = CableRobot::NominalFast();
+  if (!FLAGS_model.empty() && !LoadCableRobot(FLAGS_model, &robot, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  StaticsOptions options;
+  bool compare = false;
+  std::vector<Pose> poses;
+  if (!SetOptionsFromFlags(&options, &compare, &error) || !BuildPoses(&poses, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  if (poses.empty()) {
+    PrintError(kCommand, "no poses to solve");
+    return kExitUsage;
+  }
+
+  std::string content;
+  std::ostringstream summary;
+  summary << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose, " : " poses, ");
+  if (!compare) {
+    Run run;
+    if (!SolveAll(robot, poses, options, &run, &error)) {
+      PrintError(kCommand, error);
+      return kExitFailure;
+    }
+    content = FLAGS_format == "json" ? Json(poses, FLAGS_method, &run, nullptr, nullptr)
+                                     : CsvRows(poses, &run, nullptr, nullptr);
+    summary << TimingLine(StaticsMethodName(options.method), run, poses.size(), options.warm_start);
+  } else {
+    Run aas, exact;
+    StaticsOptions o = options;
+    o.method = StaticsMethod::kAas;
+    if (!SolveAll(robot, poses, o, &aas, &error)) {
+      PrintError(kCommand, error);
+      return kExitFailure;
+    }
+    o.method = StaticsMethod::kExact;
+    if (!SolveAll(robot, poses, o, &exact, &error)) {
+      PrintError(kCommand, error);
+      return kExitFailure;
+    }
+    content = FLAGS_format == "json" ? Json(poses, "compare", nullptr, &aas, &exact)
+                                     : CsvRows(poses, nullptr, &aas, &exact);
+    summary << TimingLine("aas", aas, poses.size(), options.warm_start) << "; "
+            << TimingLine("exact", exact, poses.size(), options.warm_start) << "\n"
+            << "max |aas - exact| / exact per cable (%):";
+    for (double e : MaxAbsErrorPct(aas, exact)) summary << " " << FormatDouble(e, 4);
+  }
+  if (!WriteOutput(FLAGS_output, content, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  std::cerr << summary.str() << std::endl;
+  return 0;
+}
+
+}  // namespace fastcal::cli
