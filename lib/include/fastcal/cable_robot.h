@@ -36,6 +36,11 @@ struct CableProperties {
   double ea_n = 2.4656e7;
   // Mass per unit unstretched length.
   double linear_density_kg_per_m = 11.718;
+  // The cable's cabin-side tension sensor: measured = gain * lower-end tension + bias.
+  // Identity by default; a calibration may estimate them (YAML keys sensor_gain and
+  // sensor_bias_kN, optional).
+  double sensor_gain = 1.0;
+  double sensor_bias_n = 0.0;
 };
 
 struct CableRobot {

@@ -1,0 +1,94 @@
+// What a calibration estimates and how: the calibration spec (YAML, docs/calibration.md).
+//
+// The model's parameters are laid out as scalar "parameters", each free or fixed, with an
+// initial value and an optional Gaussian prior:
+//   mass_centre_m.{x,y,z}           m     cabin-frame mass centre (initial: the model's)
+//   cabin_mass_kg                   kg    (initial: the model's)
+//   linear_density_kg_per_m         kg/m  one value for all cables ("common") or
+//   linear_density_kg_per_m[i]            one per cable i = 1..6 ("per_cable")
+//   ea_n / ea_n[i]                  N     axial stiffness, common or per cable
+//   anchor_offset_m[j].{x,y,z}      m     added to cabin anchor point j = 1..n (cabin frame)
+//   tower_offset_m[i].{x,y,z}       m     added to tower top i = 1..6 (global frame)
+//   sensor_gain / sensor_gain[i]    1     measured = gain * model + bias
+//   sensor_bias_kN / sensor_bias_kN[i]  kN
+// Values in the file are in the unit the name carries (kN for the bias); inside
+// everything is SI (ParameterSpec::to_si converts).
+#ifndef FASTCAL_CALIBRATION_SPEC_H_
+#define FASTCAL_CALIBRATION_SPEC_H_
+
+#include <string>
+#include <vector>
+
+#include "fastcal/statics.h"
+
+namespace fastcal {
+
+enum class ParameterKind {
+  kMassCentre,     // component = axis 0..2
+  kCabinMass,
+  kLinearDensity,  // cable = 0..5, or -1 for common
+  kEa,             // cable = 0..5, or -1 for common
+  kAnchorOffset,   // index = anchor point, component = axis
+  kTowerOffset,    // index = cable/tower, component = axis
+  kSensorGain,     // cable = 0..5, or -1 for common
+  kSensorBias,     // cable = 0..5, or -1 for common
+};
+
+struct ParameterSpec {
+  ParameterKind kind = ParameterKind::kMassCentre;
+  int index = -1;      // cable, anchor point or tower (0-based); -1 = common to all cables
+  int component = -1;  // axis 0..2 for vector quantities, else -1
+  std::string name;    // as in the spec and the report, e.g. "mass_centre_m.x"
+  std::string unit;    // unit of values in files and reports: m, kg, kg/m, N, 1, kN
+  double to_si = 1.0;  // SI value = file value * to_si
+  bool free = false;
+  bool has_initial = false;  // else the model's value (offsets 0, gain 1, bias 0)
+  double initial_si = 0.0;
+  bool has_prior = false;
+  double prior_mean_si = 0.0;
+  double prior_sigma_si = 0.0;
+};
+
+enum class RobustLoss { kNone, kHuber, kCauchy };
+
+struct CalibrationSpec {
+  // Every parameter the spec names, free or fixed, in a canonical order (the order of
+  // the list in the file header above). Parameters the spec does not name are fixed at
+  // the model's values and not listed.
+  std::vector<ParameterSpec> parameters;
+  // Statics model inside the residuals. aas-refined by default: plain AAS's own 0.1-0.3%
+  // error is a bias, not noise, and would shift the estimates (docs/calibration.md).
+  StaticsMethod forward_model = StaticsMethod::kAasRefined;
+  // Tension noise: sigma_i^2 = sigma_abs^2 + (percent/100 * measured_i)^2.
+  double tension_sigma_n = 0.0;
+  double tension_sigma_percent = 3.0;
+  RobustLoss robust_loss = RobustLoss::kNone;
+  double robust_loss_scale = 1.0;  // in units of sigma (whitened residual)
+  // Fraction of the samples held out of the fit (chosen with `holdout_seed`) and used
+  // only to evaluate.
+  double holdout_fraction = 0.0;
+  unsigned long long holdout_seed = 1;
+  // Attitude used in the fit: the measured one (default) or the planned one.
+  bool use_planned_attitude = false;
+  // Ceres options.
+  int max_iterations = 100;
+  double function_tolerance = 1e-12;
+  double gradient_tolerance = 1e-12;
+  double parameter_tolerance = 1e-12;
+  int num_threads = 2;
+
+  bool IsValid(std::string* error) const;
+};
+
+// Parses a spec. Errors name the file, the line and the key; unknown keys and unknown
+// parameter names are errors. `num_anchor_points` bounds anchor_offset_m[j].
+bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
+                         std::string* error);
+bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
+                              int num_anchor_points, CalibrationSpec* spec, std::string* error);
+// The spec as YAML (same format), for provenance in summary.json and the report.
+std::string CalibrationSpecToYaml(const CalibrationSpec& spec);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_CALIBRATION_SPEC_H_
