@@ -1,0 +1,370 @@
+// Cabin trajectories (line, arc, focal-sphere grid, random workspace), poses from them,
+// and the pose CSV reader (conventions: trajectory.h).
+#include "fastcal/trajectory.h"
+
+#include <array>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <random>
+#include <sstream>
+#include <string_view>
+
+namespace fastcal {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+// Tolerance, in degrees or in steps, when deciding whether an angle is a whole turn or a
+// whole number of steps.
+constexpr double kAngleTolerance = 1e-9;
+// Largest grid FocalSpherePositions builds: guards against a step typed too small.
+constexpr double kMaxGridPositions = 1e7;
+
+bool Fail(std::string* error, const std::string& message) {
+  if (error != nullptr) *error = message;
+  return false;
+}
+
+std::string Num(double value) {
+  std::ostringstream s;
+  s << value;
+  return s.str();
+}
+
+bool IsPositiveFinite(double value) { return std::isfinite(value) && value > 0.0; }
+
+// Validates a sphere given by centre and radius; `prefix` names the struct member.
+bool CheckSphere(const FocalGridSpec& sphere, const std::string& prefix, std::string* error) {
+  if (!sphere.focal_centre_m.allFinite()) {
+    return Fail(error, prefix + "focal_centre_m must be finite");
+  }
+  if (!IsPositiveFinite(sphere.focal_radius_m)) {
+    return Fail(error, prefix + "focal_radius_m must be > 0 and finite (got " +
+                           Num(sphere.focal_radius_m) + ")");
+  }
+  return true;
+}
+
+bool CheckMaxOffAxis(double max_off_axis_deg, std::string* error) {
+  if (!(std::isfinite(max_off_axis_deg) && max_off_axis_deg >= 0.0 && max_off_axis_deg <= 90.0)) {
+    return Fail(error, "max_off_axis_deg must be in [0, 90] (got " + Num(max_off_axis_deg) + ")");
+  }
+  return true;
+}
+
+// Point of the focal sphere at off-axis angle theta and azimuth phi, at distance
+// `distance_m` from the centre.
+Eigen::Vector3d OnSphere(const Eigen::Vector3d& centre_m, double distance_m, double cos_theta,
+                         double sin_theta, double phi_rad) {
+  return centre_m + distance_m * Eigen::Vector3d(sin_theta * std::cos(phi_rad),
+                                                 sin_theta * std::sin(phi_rad), -cos_theta);
+}
+
+// Uniform in [0, 1) from the raw 64-bit output: the same on every standard library.
+double Uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
+
+bool CheckPositions(const std::vector<Eigen::Vector3d>& positions, std::string* error) {
+  for (size_t i = 0; i < positions.size(); ++i) {
+    if (!positions[i].allFinite()) {
+      return Fail(error, "positions[" + std::to_string(i) + "] must be finite");
+    }
+  }
+  return true;
+}
+
+// ---- CSV ----
+
+std::string_view Trim(std::string_view s) {
+  const size_t begin = s.find_first_not_of(" \t");
+  if (begin == std::string_view::npos) return {};
+  const size_t end = s.find_last_not_of(" \t");
+  return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string_view> SplitFields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      fields.push_back(Trim(line.substr(start)));
+      return fields;
+    }
+    fields.push_back(Trim(line.substr(start, comma - start)));
+    start = comma + 1;
+  }
+}
+
+// Parses a trimmed field; on failure *why says what is wrong with it.
+bool ParseNumber(std::string_view field, double* value, std::string* why) {
+  const std::string text(field);
+  if (text.empty()) {
+    *why = "empty field";
+    return false;
+  }
+  char* end = nullptr;
+  const double parsed = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size()) {
+    *why = "'" + text + "' is not a number";
+    return false;
+  }
+  if (!std::isfinite(parsed)) {
+    *why = "'" + text + "' is not finite";
+    return false;
+  }
+  *value = parsed;
+  return true;
+}
+
+enum Column { kX, kY, kZ, kRoll, kPitch, kYaw, kQw, kQx, kQy, kQz, kTime, kNumColumns };
+constexpr std::array<const char*, kNumColumns> kColumnNames = {
+    "x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg", "qw", "qx", "qy", "qz", "time_s"};
+
+bool IsSkipped(std::string_view line) {
+  const std::string_view trimmed = Trim(line);
+  return trimmed.empty() || trimmed.front() == '#';
+}
+
+}  // namespace
+
+bool LinePositions(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, int nodes,
+                   std::vector<Eigen::Vector3d>* positions, std::string* error) {
+  if (positions == nullptr) return Fail(error, "positions must not be null");
+  if (nodes < 2) return Fail(error, "nodes must be >= 2 (got " + std::to_string(nodes) + ")");
+  if (!from_m.allFinite()) return Fail(error, "from_m must be finite");
+  if (!to_m.allFinite()) return Fail(error, "to_m must be finite");
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(nodes);
+  for (int k = 0; k < nodes; ++k) {
+    const double t = static_cast<double>(k) / (nodes - 1);  // t = 1 exactly at the end
+    out.push_back((1.0 - t) * from_m + t * to_m);
+  }
+  *positions = std::move(out);
+  return true;
+}
+
+bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions,
+                  std::string* error) {
+  if (positions == nullptr) return Fail(error, "positions must not be null");
+  if (!spec.centre_m.allFinite()) return Fail(error, "centre_m must be finite");
+  if (!IsPositiveFinite(spec.radius_m)) {
+    return Fail(error, "radius_m must be > 0 and finite (got " + Num(spec.radius_m) + ")");
+  }
+  if (!std::isfinite(spec.start_deg)) return Fail(error, "start_deg must be finite");
+  if (!std::isfinite(spec.end_deg)) return Fail(error, "end_deg must be finite");
+  if (spec.nodes < 2) {
+    return Fail(error, "nodes must be >= 2 (got " + std::to_string(spec.nodes) + ")");
+  }
+  const double span_deg = spec.end_deg - spec.start_deg;
+  if (span_deg == 0.0) return Fail(error, "end_deg must differ from start_deg");
+  const bool full_turn = std::abs(std::abs(span_deg) - 360.0) <= kAngleTolerance;
+  if (std::abs(span_deg) > 360.0 && !full_turn) {
+    return Fail(error,
+                "|end_deg - start_deg| must be <= 360 (got " + Num(std::abs(span_deg)) + ")");
+  }
+  // A full turn divides into `nodes` steps so the end node (= start) is left out.
+  const int steps = full_turn ? spec.nodes : spec.nodes - 1;
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(spec.nodes);
+  for (int k = 0; k < spec.nodes; ++k) {
+    const double angle_rad = (spec.start_deg + span_deg * k / steps) * kDegToRad;
+    out.push_back(spec.centre_m +
+                  spec.radius_m * Eigen::Vector3d(std::cos(angle_rad), std::sin(angle_rad), 0.0));
+  }
+  *positions = std::move(out);
+  return true;
+}
+
+bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d>* positions,
+                          std::string* error) {
+  if (positions == nullptr) return Fail(error, "positions must not be null");
+  if (!CheckMaxOffAxis(spec.max_off_axis_deg, error)) return false;
+  if (!IsPositiveFinite(spec.off_axis_step_deg)) {
+    return Fail(error, "off_axis_step_deg must be > 0 and finite (got " +
+                           Num(spec.off_axis_step_deg) + ")");
+  }
+  if (!(IsPositiveFinite(spec.azimuth_step_deg) && spec.azimuth_step_deg <= 360.0)) {
+    return Fail(error,
+                "azimuth_step_deg must be in (0, 360] (got " + Num(spec.azimuth_step_deg) + ")");
+  }
+  if (!CheckSphere(spec, "", error)) return false;
+
+  // Rings theta_k = k step <= max; azimuths phi_j = j step < 360, both up to a tolerance.
+  const double rings = std::floor(spec.max_off_axis_deg / spec.off_axis_step_deg + kAngleTolerance);
+  const double azimuths = std::ceil(360.0 / spec.azimuth_step_deg - kAngleTolerance);
+  if (1.0 + rings * azimuths > kMaxGridPositions) {
+    return Fail(error, "off_axis_step_deg and azimuth_step_deg give " +
+                           Num(1.0 + rings * azimuths) + " positions (limit " +
+                           Num(kMaxGridPositions) + ")");
+  }
+  const int num_rings = static_cast<int>(rings);
+  const int num_azimuths = static_cast<int>(azimuths);
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(1 + num_rings * num_azimuths);
+  out.push_back(OnSphere(spec.focal_centre_m, spec.focal_radius_m, 1.0, 0.0, 0.0));
+  for (int k = 1; k <= num_rings; ++k) {
+    const double theta_rad =
+        std::min(k * spec.off_axis_step_deg, spec.max_off_axis_deg) * kDegToRad;
+    const double cos_theta = std::cos(theta_rad);
+    const double sin_theta = std::sin(theta_rad);
+    for (int j = 0; j < num_azimuths; ++j) {
+      out.push_back(OnSphere(spec.focal_centre_m, spec.focal_radius_m, cos_theta, sin_theta,
+                             j * spec.azimuth_step_deg * kDegToRad));
+    }
+  }
+  *positions = std::move(out);
+  return true;
+}
+
+bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
+                              std::vector<Eigen::Vector3d>* positions, std::string* error) {
+  if (positions == nullptr) return Fail(error, "positions must not be null");
+  if (spec.samples < 1) {
+    return Fail(error, "samples must be >= 1 (got " + std::to_string(spec.samples) + ")");
+  }
+  if (!CheckMaxOffAxis(spec.max_off_axis_deg, error)) return false;
+  if (!CheckSphere(spec.sphere, "sphere.", error)) return false;
+  if (!(std::isfinite(spec.radial_spread_m) && spec.radial_spread_m >= 0.0 &&
+        spec.radial_spread_m < spec.sphere.focal_radius_m)) {
+    return Fail(error, "radial_spread_m must be in [0, sphere.focal_radius_m) (got " +
+                           Num(spec.radial_spread_m) + ")");
+  }
+  std::mt19937_64 rng(spec.seed);
+  const double cos_max = std::cos(spec.max_off_axis_deg * kDegToRad);
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(spec.samples);
+  for (int i = 0; i < spec.samples; ++i) {
+    // Uniform cos(theta) and azimuth give a uniform density over the cap's area.
+    const double cos_theta = 1.0 - Uniform01(rng) * (1.0 - cos_max);
+    const double phi_rad = 2.0 * M_PI * Uniform01(rng);
+    const double offset_m = spec.radial_spread_m * (2.0 * Uniform01(rng) - 1.0);
+    const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+    out.push_back(OnSphere(spec.sphere.focal_centre_m, spec.sphere.focal_radius_m + offset_m,
+                           cos_theta, sin_theta, phi_rad));
+  }
+  *positions = std::move(out);
+  return true;
+}
+
+bool PosesWithAttitudeLaw(const std::vector<Eigen::Vector3d>& positions,
+                          const FocalAttitudeLaw& law, std::vector<Pose>* poses,
+                          std::string* error) {
+  if (poses == nullptr) return Fail(error, "poses must not be null");
+  if (!std::isfinite(law.tilt_fraction)) return Fail(error, "law.tilt_fraction must be finite");
+  if (!law.focal_centre_m.allFinite()) return Fail(error, "law.focal_centre_m must be finite");
+  if (!CheckPositions(positions, error)) return false;
+  std::vector<Pose> out(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) {
+    if (!(positions[i].z() < law.focal_centre_m.z())) {
+      return Fail(error, "positions[" + std::to_string(i) +
+                             "] must be below law.focal_centre_m (z_m " + Num(positions[i].z()) +
+                             " >= " + Num(law.focal_centre_m.z()) + ")");
+    }
+    out[i].position_m = positions[i];
+    out[i].rotation = FocalAttitude(positions[i], law);
+  }
+  *poses = std::move(out);
+  return true;
+}
+
+bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
+                               std::vector<Pose>* poses, std::string* error) {
+  if (poses == nullptr) return Fail(error, "poses must not be null");
+  if (!CheckPositions(positions, error)) return false;
+  std::vector<Pose> out(positions.size());
+  for (size_t i = 0; i < positions.size(); ++i) out[i].position_m = positions[i];
+  *poses = std::move(out);
+  return true;
+}
+
+bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
+                  std::string* error) {
+  if (poses == nullptr) return Fail(error, "poses must not be null");
+  std::ifstream in(path);
+  if (!in) return Fail(error, path + ": cannot open file");
+
+  std::array<int, kNumColumns> index;
+  index.fill(-1);
+  size_t num_fields = 0;
+  bool has_header = false;
+  bool has_rpy = false;
+  bool has_quaternion = false;
+  std::vector<Pose> out_poses;
+  std::vector<double> out_times;
+
+  std::string line;
+  long line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line_number == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // BOM
+    if (IsSkipped(line)) continue;
+    const std::string where = path + ":" + std::to_string(line_number) + ": ";
+    const std::vector<std::string_view> fields = SplitFields(line);
+
+    if (!has_header) {
+      has_header = true;
+      num_fields = fields.size();
+      for (size_t i = 0; i < fields.size(); ++i) {
+        for (int c = 0; c < kNumColumns; ++c) {
+          if (fields[i] != kColumnNames[c]) continue;
+          if (index[c] >= 0) {
+            return Fail(error, where + "duplicate column '" + kColumnNames[c] + "'");
+          }
+          index[c] = static_cast<int>(i);
+        }
+      }
+      has_rpy = index[kRoll] >= 0 || index[kPitch] >= 0 || index[kYaw] >= 0;
+      has_quaternion = index[kQw] >= 0 || index[kQx] >= 0 || index[kQy] >= 0 || index[kQz] >= 0;
+      if (has_rpy && has_quaternion) {
+        return Fail(error, where +
+                               "both roll/pitch/yaw and quaternion (qw,qx,qy,qz) columns; give "
+                               "one attitude");
+      }
+      std::vector<int> required = {kX, kY, kZ};
+      if (has_rpy) required.insert(required.end(), {kRoll, kPitch, kYaw});
+      if (has_quaternion) required.insert(required.end(), {kQw, kQx, kQy, kQz});
+      for (int c : required) {
+        if (index[c] < 0) {
+          return Fail(error, where + "missing column '" + kColumnNames[c] + "'");
+        }
+      }
+      continue;
+    }
+
+    if (fields.size() != num_fields) {
+      return Fail(error, where + "expected " + std::to_string(num_fields) +
+                             " fields (as in the header), got " + std::to_string(fields.size()));
+    }
+    std::array<double, kNumColumns> values{};
+    for (int c = 0; c < kNumColumns; ++c) {
+      if (index[c] < 0) continue;
+      std::string why;
+      if (!ParseNumber(fields[index[c]], &values[c], &why)) {
+        return Fail(error, where + "column '" + kColumnNames[c] + "': " + why);
+      }
+    }
+    Pose pose;
+    pose.position_m = Eigen::Vector3d(values[kX], values[kY], values[kZ]);
+    if (has_rpy) {
+      pose.rotation = RotationFromRpyDeg(values[kRoll], values[kPitch], values[kYaw]);
+    } else if (has_quaternion) {
+      std::string why;
+      if (!RotationFromQuaternion(values[kQw], values[kQx], values[kQy], values[kQz],
+                                  &pose.rotation, &why)) {
+        return Fail(error, where + "columns 'qw,qx,qy,qz': " + why);
+      }
+    }
+    out_poses.push_back(pose);
+    if (index[kTime] >= 0) out_times.push_back(values[kTime]);
+  }
+  if (in.bad()) return Fail(error, path + ": read error");
+  if (!has_header) return Fail(error, path + ": no header line (empty file)");
+  if (out_poses.empty()) return Fail(error, path + ": no data rows");
+
+  *poses = std::move(out_poses);
+  if (times_s != nullptr) *times_s = std::move(out_times);
+  return true;
+}
+
+}  // namespace fastcal

@@ -1,0 +1,135 @@
+// Cabin trajectories: sequences of cabin positions and poses to evaluate the statics on.
+//
+// The paper's section 4 scenarios (docs/model.md, "Reference values" and "Measured data"):
+//   - straight line G1 (50, 0, 150) m -> G2 (-50, 0, 150) m, 101 nodes   LinePositions
+//   - half circle of radius 50 m about (0, 0, 150) m, 0..180 deg, 101 nodes   ArcPositions
+//   - measured full circle of radius 71.11 m about (0, 0, 156.73) m   ArcPositions
+// and the workspace: the lower cap of the focal sphere (radius 160 m about (0, 0, 300) m)
+// up to 40 deg off-axis, as a regular grid (FocalSpherePositions) or uniformly sampled
+// with optional offsets off the sphere (RandomWorkspacePositions). Positions become poses
+// with the focal attitude law (pose.h) or the neutral attitude; recorded poses are read
+// from CSV (ReadPosesCsv).
+//
+// All positions are of the cabin-frame origin O' in the global frame O-xyz (z up), in
+// metres; angles in the specs are in degrees. Every function validates its arguments and
+// returns false with a message naming the offending parameter in *error (error may be
+// null); the output is written only on success.
+#ifndef FASTCAL_TRAJECTORY_H_
+#define FASTCAL_TRAJECTORY_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fastcal/pose.h"
+
+namespace fastcal {
+
+// `nodes` evenly spaced points from `from_m` to `to_m`, both ends included (exactly).
+// Requires nodes >= 2 and finite end points; equal end points give a stationary sequence.
+bool LinePositions(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, int nodes,
+                   std::vector<Eigen::Vector3d>* positions, std::string* error);
+
+// Horizontal circle or arc at the height of its centre.
+struct ArcSpec {
+  // Centre of the circle, global frame.
+  Eigen::Vector3d centre_m = Eigen::Vector3d::Zero();
+  // Radius, > 0.
+  double radius_m = 0.0;
+  // Polar angle of the first and last node, measured from +x toward +y (counter-clockwise
+  // seen from above); end_deg < start_deg runs clockwise. 0 < |end_deg - start_deg| <= 360.
+  double start_deg = 0.0;
+  double end_deg = 360.0;
+  // Number of nodes, >= 2.
+  int nodes = 101;
+};
+
+// Nodes at angles evenly spaced from start_deg to end_deg, both ends included:
+//   p_k = centre + radius (cos a_k, sin a_k, 0).
+// A full turn (|end_deg - start_deg| = 360 within 1e-9 deg) does not repeat the start
+// node at the end: the `nodes` points are distinct, spaced 360/nodes deg apart.
+// Multiple turns are rejected (they would repeat points).
+bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions, std::string* error);
+
+// Regular grid on the lower cap of the focal sphere.
+struct FocalGridSpec {
+  // Largest off-axis angle theta (angle at the focal centre from the downward vertical),
+  // in [0, 90].
+  double max_off_axis_deg = 40.0;
+  // Spacing of the off-axis rings, > 0.
+  double off_axis_step_deg = 5.0;
+  // Spacing of the azimuths on each ring, in (0, 360].
+  double azimuth_step_deg = 15.0;
+  // Centre and radius of the focal sphere, global frame.
+  Eigen::Vector3d focal_centre_m = Eigen::Vector3d(0.0, 0.0, 300.0);
+  double focal_radius_m = 160.0;
+};
+
+// Points C + R (sin(theta) cos(phi), sin(theta) sin(phi), -cos(theta)) with C, R the focal
+// centre and radius, for theta = 0, step, 2 step, ... <= max_off_axis_deg (max included
+// when it is a multiple of the step within 1e-9) and, for theta > 0, azimuths
+// phi = 0, azimuth_step, ... < 360 deg measured from +x toward +y. The axis point
+// (theta = 0) comes first and only once; then ring by ring, azimuth by azimuth.
+// The defaults give 1 + 8 * 24 = 193 points.
+bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d>* positions,
+                          std::string* error);
+
+// Random positions spread uniformly over the area of the focal sphere's lower cap.
+struct RandomWorkspaceSpec {
+  // Number of positions, >= 1.
+  int samples = 100;
+  // Largest off-axis angle, in [0, 90]; sphere.max_off_axis_deg is not used.
+  double max_off_axis_deg = 40.0;
+  // Each position is moved along the sphere's outward normal (away from the centre, so
+  // downward near the axis) by an offset uniform in [-spread, spread]. In [0, radius).
+  double radial_spread_m = 0.0;
+  // Only focal_centre_m and focal_radius_m are used.
+  FocalGridSpec sphere;
+  // Seed of the std::mt19937_64 generator: the same spec gives the same positions on
+  // every platform (raw generator output is converted without std distributions).
+  std::uint64_t seed = 0;
+};
+
+// Per sample: cos(theta) uniform in [cos(max_off_axis), 1], azimuth uniform in [0, 360),
+// radial offset uniform in [-spread, spread] (drawn even when spread = 0, so the spread
+// changes only the offsets, not the directions). Returns `samples` positions.
+bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
+                              std::vector<Eigen::Vector3d>* positions, std::string* error);
+
+// Poses at `positions` with the attitude of the focal attitude law (FocalAttitude, pose.h).
+// Positions must be finite and strictly below the focal centre (the law is defined for
+// the lower half space only); the law's fields must be finite. Empty input is allowed.
+bool PosesWithAttitudeLaw(const std::vector<Eigen::Vector3d>& positions,
+                          const FocalAttitudeLaw& law, std::vector<Pose>* poses,
+                          std::string* error);
+
+// Poses at finite `positions` with the neutral attitude R = I.
+bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
+                               std::vector<Pose>* poses, std::string* error);
+
+// Reads cabin poses from a CSV file.
+//
+// Format: plain comma-separated values without quoting; lines that are blank or whose
+// first non-blank character is '#' are skipped. The first other line is the header;
+// columns are found by (case-sensitive) name in any order and fields are trimmed of
+// spaces and tabs. Columns:
+//   x_m, y_m, z_m               position of O' in the global frame, required
+//   roll_deg, pitch_deg, yaw_deg   attitude, R = RotationFromRpyDeg(roll, pitch, yaw)
+//   qw, qx, qy, qz              or attitude as a unit quaternion (RotationFromQuaternion)
+//   time_s                      optional time stamp
+// At most one attitude kind, complete; none means R = I. Other columns are ignored, so a
+// calibration dataset CSV also serves as a pose file. Every data row must have as many
+// fields as the header; every used field must be a finite number (std::strtod, so the
+// decimal point of the current C locale, '.' by default; the whole field consumed). There must be
+// at least one data row.
+//
+// Errors read "<path>:<line>: column '<name>': <what>" (line 1-based in the file).
+// `times_s` may be null; otherwise it receives one time per pose, or is left empty when
+// the file has no time_s column. Times are not checked for order.
+bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
+                  std::string* error);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_TRAJECTORY_H_
