@@ -1,2 +1,408 @@
+// Tests of the SVG chart writer (svg_plot.h): nice ticks, XML escaping, well-formed
+// output, gaps and non-finite data, histogram counts, grouped-bar labels, the heatmap
+// cells and the "no data" charts.
+#include "fastcal/svg_plot.h"
+
 #include <gtest/gtest.h>
-TEST(Placeholder, Builds) { SUCCEED(); }
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <regex>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace fastcal {
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+// Minimal XML check: balanced start/end tags (a stack), quoted attributes, and every '&'
+// starting one of the five predefined entities. Returns "" or a description.
+std::string XmlProblem(const std::string& xml) {
+  std::vector<std::string> stack;
+  size_t i = 0;
+  while (i < xml.size()) {
+    const char c = xml[i];
+    if (c == '&') {
+      static const std::regex kEntity("^&(amp|lt|gt|quot|apos);");
+      if (!std::regex_search(xml.substr(i, 8), kEntity)) return "bare '&' at " + std::to_string(i);
+      ++i;
+      continue;
+    }
+    if (c == '>') return "stray '>' at " + std::to_string(i);
+    if (c != '<') {
+      ++i;
+      continue;
+    }
+    // Find the closing '>' outside quoted attribute values.
+    size_t j = i + 1;
+    bool in_quote = false;
+    while (j < xml.size() && (in_quote || xml[j] != '>')) {
+      if (xml[j] == '"') in_quote = !in_quote;
+      if (!in_quote && xml[j] == '<') return "'<' inside tag at " + std::to_string(j);
+      ++j;
+    }
+    if (j == xml.size()) return "unterminated tag at " + std::to_string(i);
+    const std::string tag = xml.substr(i + 1, j - i - 1);
+    i = j + 1;
+    if (tag.empty()) return "empty tag";
+    if (tag[0] == '/') {
+      const std::string name = tag.substr(1);
+      if (stack.empty() || stack.back() != name) return "unexpected </" + name + ">";
+      stack.pop_back();
+      continue;
+    }
+    const std::string name = tag.substr(0, tag.find_first_of(" \n/"));
+    if (name.empty()) return "nameless tag";
+    if (stack.empty() && name != "svg") return "content outside <svg>: " + name;
+    if (tag.back() != '/') stack.push_back(name);
+  }
+  if (!stack.empty()) return "unclosed <" + stack.back() + ">";
+  return "";
+}
+
+void ExpectValidSvg(const std::string& svg) {
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u) << svg.substr(0, 80);
+  ASSERT_GE(svg.size(), 6u);
+  EXPECT_EQ(svg.substr(svg.size() - 6), "</svg>");
+  EXPECT_EQ(XmlProblem(svg), "") << svg;
+}
+
+int Count(const std::string& text, const std::string& needle) {
+  int n = 0;
+  for (size_t p = text.find(needle); p != std::string::npos; p = text.find(needle, p + 1)) ++n;
+  return n;
+}
+
+// Attribute values of all elements starting with `element_prefix`, e.g. "<rect class=\"bar\"".
+std::vector<std::string> Attribute(const std::string& svg, const std::string& element_prefix,
+                                   const std::string& attribute) {
+  std::vector<std::string> values;
+  for (size_t p = svg.find(element_prefix); p != std::string::npos;
+       p = svg.find(element_prefix, p + 1)) {
+    const std::string tag = svg.substr(p, svg.find('>', p) - p);
+    const size_t a = tag.find(" " + attribute + "=\"");
+    if (a == std::string::npos) continue;
+    const size_t start = a + attribute.size() + 3;
+    values.push_back(tag.substr(start, tag.find('"', start) - start));
+  }
+  return values;
+}
+
+std::string Lower(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return s;
+}
+
+void ExpectNiceStep(double step) {
+  ASSERT_GT(step, 0.0);
+  const double mantissa = step / std::pow(10.0, std::floor(std::log10(step) + 1e-9));
+  const bool nice = std::fabs(mantissa - 1.0) < 1e-6 || std::fabs(mantissa - 2.0) < 1e-6 ||
+                    std::fabs(mantissa - 5.0) < 1e-6;
+  EXPECT_TRUE(nice) << "step " << step;
+}
+
+void ExpectGoodTicks(const std::vector<double>& ticks, double lo, double hi) {
+  ASSERT_GE(ticks.size(), 2u);
+  EXPECT_LE(ticks.front(), lo);
+  EXPECT_GE(ticks.back(), hi);
+  const double step = ticks[1] - ticks[0];
+  ExpectNiceStep(step);
+  for (size_t i = 1; i < ticks.size(); ++i) {
+    EXPECT_NEAR(ticks[i] - ticks[i - 1], step, 1e-9 * step) << "at " << i;
+  }
+}
+
+TEST(NiceTicks, UnitInterval) {
+  const std::vector<double> ticks = NiceTicks(0.0, 1.0, 5);
+  const std::vector<double> expected = {0.0, 0.2, 0.4, 0.6, 0.8, 1.0};
+  ASSERT_EQ(ticks.size(), expected.size());
+  for (size_t i = 0; i < ticks.size(); ++i) EXPECT_DOUBLE_EQ(ticks[i], expected[i]);
+}
+
+TEST(NiceTicks, MixedSignRange) {
+  const std::vector<double> ticks = NiceTicks(-3.7, 12.2, 5);
+  ExpectGoodTicks(ticks, -3.7, 12.2);
+  const std::vector<double> expected = {-5.0, 0.0, 5.0, 10.0, 15.0};
+  ASSERT_EQ(ticks.size(), expected.size());
+  for (size_t i = 0; i < ticks.size(); ++i) EXPECT_DOUBLE_EQ(ticks[i], expected[i]);
+}
+
+TEST(NiceTicks, DegenerateRangeIsPadded) {
+  for (double v : {149.5, 0.0, -2.5e-7, 3e12}) {
+    const std::vector<double> ticks = NiceTicks(v, v, 5);
+    ASSERT_GE(ticks.size(), 2u) << v;
+    for (size_t i = 1; i < ticks.size(); ++i) EXPECT_GT(ticks[i], ticks[i - 1]) << v;
+    EXPECT_LT(ticks.front(), v);
+    EXPECT_GT(ticks.back(), v);
+    ExpectGoodTicks(ticks, v, v);
+  }
+}
+
+TEST(NiceTicks, RandomRangesHaveNiceCoveringSteps) {
+  std::mt19937_64 rng(20261121);
+  std::uniform_real_distribution<double> exponent(-8.0, 8.0), unit(-1.0, 1.0);
+  std::uniform_int_distribution<int> target(2, 10);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const double scale = std::pow(10.0, exponent(rng));
+    const double a = unit(rng) * scale, b = a + std::fabs(unit(rng)) * scale * 0.5;
+    const int t = target(rng);
+    const std::vector<double> ticks = NiceTicks(a, b, t);
+    SCOPED_TRACE(::testing::Message() << "[" << a << ", " << b << "] target " << t);
+    ExpectGoodTicks(ticks, a, b);
+    EXPECT_LE(ticks.size(), static_cast<size_t>(2 * t + 3));
+  }
+}
+
+TEST(NiceTicks, SwappedAndNonFiniteInput) {
+  EXPECT_EQ(NiceTicks(1.0, 0.0, 5), NiceTicks(0.0, 1.0, 5));
+  EXPECT_TRUE(NiceTicks(kNaN, 1.0, 5).empty());
+  EXPECT_TRUE(NiceTicks(0.0, kInf, 5).empty());
+}
+
+TEST(XmlEscape, EscapesMarkupAndDropsForbiddenControls) {
+  EXPECT_EQ(XmlEscape("<a & \"b\">"), "&lt;a &amp; &quot;b&quot;&gt;");
+  EXPECT_EQ(XmlEscape("it's"), "it&apos;s");
+  EXPECT_EQ(XmlEscape(std::string("a\x01\tb\n")), "a\tb\n");
+  EXPECT_EQ(XmlEscape("\xCE\xB8 [rad]"), "\xCE\xB8 [rad]");  // UTF-8 passes through.
+}
+
+TEST(PlotSeriesColour, EightDistinctColoursThenCycle) {
+  std::set<std::string> colours;
+  for (int i = 0; i < 8; ++i) colours.insert(PlotSeriesColour(i));
+  EXPECT_EQ(colours.size(), 8u);
+  EXPECT_EQ(PlotSeriesColour(8), PlotSeriesColour(0));
+  EXPECT_EQ(PlotSeriesColour(-1), PlotSeriesColour(7));
+}
+
+PlotOptions Options() {
+  PlotOptions o;
+  o.title = "Cable length residuals";
+  o.x_label = "time [s]";
+  o.y_label = "residual [mm]";
+  return o;
+}
+
+TEST(SvgLinePlot, ContainsTitleLabelsAndOnePathPerSeries) {
+  std::vector<PlotSeries> series(3);
+  series[0].name = "cable 1";
+  series[1].name = "cable <2>";
+  series[1].dashed = true;
+  series[2].name = "measured";
+  series[2].markers_only = true;
+  for (int i = 0; i <= 50; ++i) {
+    for (int s = 0; s < 3; ++s) {
+      series[s].x.push_back(i * 0.2);
+      series[s].y.push_back(std::sin(i * 0.2 + s) * (s + 1));
+    }
+  }
+  const std::string svg = SvgLinePlot(series, Options());
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find("Cable length residuals"), std::string::npos);
+  EXPECT_NE(svg.find(">time [s]<"), std::string::npos);
+  EXPECT_NE(svg.find(">residual [mm]<"), std::string::npos);
+  EXPECT_NE(svg.find(">cable 1<"), std::string::npos);
+  EXPECT_NE(svg.find(">cable &lt;2&gt;<"), std::string::npos);
+  EXPECT_EQ(svg.find("cable <2>"), std::string::npos);
+  EXPECT_NE(svg.find(">measured<"), std::string::npos);
+  EXPECT_EQ(Count(svg, "<path"), 3);
+  EXPECT_EQ(Count(svg, "stroke-dasharray"), 2);  // The dashed path and its legend swatch.
+  EXPECT_NE(svg.find("width=\"720\" height=\"300\""), std::string::npos);
+  // Series colours come from the palette, in order.
+  const std::vector<std::string> strokes = Attribute(svg, "<path", "stroke");
+  ASSERT_EQ(strokes.size(), 2u);
+  EXPECT_EQ(strokes[0], PlotSeriesColour(0));
+  EXPECT_EQ(strokes[1], PlotSeriesColour(1));
+  EXPECT_EQ(Attribute(svg, "<path", "fill").back(), PlotSeriesColour(2));
+}
+
+TEST(SvgLinePlot, NonFiniteValuesMakeGapsNotNan) {
+  PlotSeries s;
+  s.name = "with gaps";
+  s.x = {0, 1, 2, 3, 4, 5, 6, 7};
+  s.y = {1, 2, kNaN, 3, 4, kInf, 5, -kInf};
+  s.x[4] = kNaN;  // Point 4 is also skipped: run {3} is an isolated point.
+  const std::string svg = SvgLinePlot({s}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Lower(svg).find("nan"), std::string::npos);
+  EXPECT_EQ(Lower(svg).find("inf"), std::string::npos);
+  // One path per series; each finite run is a subpath.
+  ASSERT_EQ(Count(svg, "<path"), 1);
+  const std::string d = Attribute(svg, "<path", "d")[0];
+  EXPECT_EQ(Count(d, "M"), 3) << d;  // {0,1}, {3}, {6}
+  EXPECT_EQ(Count(d, "L"), 1) << d;
+  EXPECT_EQ(Count(d, "a"), 4) << d;  // The isolated points are drawn as dots (2 arcs each).
+}
+
+TEST(SvgLinePlot, SinglePointAndConstantDataGiveSensibleAxes) {
+  PlotSeries s;
+  s.name = "one";
+  s.x = {149.5};
+  s.y = {149.5};
+  std::string svg = SvgLinePlot({s}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Lower(svg).find("nan"), std::string::npos);
+  EXPECT_NE(svg.find(">149.5<"), std::string::npos);  // The point sits on a padded axis.
+
+  s.x = {0, 1, 2};
+  s.y = {7, 7, 7};
+  svg = SvgLinePlot({s}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_GE(Count(svg, "<text"), 6);
+}
+
+TEST(SvgLinePlot, EmptyInputSaysNoData) {
+  for (const std::vector<PlotSeries>& input :
+       {std::vector<PlotSeries>{}, std::vector<PlotSeries>{PlotSeries{"x", {}, {}}},
+        std::vector<PlotSeries>{PlotSeries{"nan", {kNaN}, {1.0}}}}) {
+    const std::string svg = SvgLinePlot(input, Options());
+    ExpectValidSvg(svg);
+    EXPECT_NE(svg.find("no data"), std::string::npos);
+    EXPECT_NE(svg.find("Cable length residuals"), std::string::npos);
+  }
+}
+
+TEST(SvgLinePlot, SizeIsConfigurableAndTickLabelsAreCompact) {
+  PlotOptions o = Options();
+  o.width_px = 400;
+  o.height_px = 200;
+  PlotSeries s{"big", {0, 1, 2}, {0, 5e5, 1e6}};
+  const std::string svg = SvgLinePlot({s}, o);
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find("width=\"400\" height=\"200\" viewBox=\"0 0 400 200\""), std::string::npos);
+  EXPECT_NE(svg.find("e+05<"), std::string::npos);
+  EXPECT_EQ(svg.find("500000"), std::string::npos);
+}
+
+TEST(SvgHistogram, BarHeightsAreProportionalToCounts) {
+  HistogramSeries a{"before", {0.0, 0.1, 0.2, 1.0, 1.1, 2.9, kNaN}};
+  HistogramSeries b{"after", {0.0, 3.0, 2.95, 2.9}};
+  const std::string svg = SvgHistogram({a, b}, 3, Options());
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Lower(svg).find("nan"), std::string::npos);
+  EXPECT_NE(svg.find(">before (n=6)<"), std::string::npos);
+  EXPECT_NE(svg.find(">after (n=4)<"), std::string::npos);
+  const std::vector<std::string> counts = Attribute(svg, "<rect class=\"bar\"", "data-count");
+  const std::vector<std::string> heights = Attribute(svg, "<rect class=\"bar\"", "height");
+  const std::vector<std::string> xs = Attribute(svg, "<rect class=\"bar\"", "x");
+  // Edges 0, 1, 2, 3: "before" has 3, 2, 1; "after" has 1, 0 (no bar), 3.
+  ASSERT_EQ(counts, (std::vector<std::string>{"3", "2", "1", "1", "3"}));
+  ASSERT_EQ(heights.size(), counts.size());
+  const double per_count = std::stod(heights[0]) / 3.0;
+  for (size_t i = 0; i < counts.size(); ++i) {
+    EXPECT_NEAR(std::stod(heights[i]), per_count * std::stod(counts[i]), 0.11) << i;
+  }
+  // Common bin edges.
+  EXPECT_EQ(xs[0], xs[3]);
+  EXPECT_EQ(xs[2], xs[4]);
+  EXPECT_NE(svg.find(">residual [mm]<"), std::string::npos);
+}
+
+TEST(SvgHistogram, CountAxisDefaultsAndDegenerateValues) {
+  PlotOptions o = Options();
+  o.y_label.clear();
+  const std::string svg = SvgHistogram({{"same", {2.5, 2.5}}}, 10, o);
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find(">count<"), std::string::npos);
+  EXPECT_EQ(Attribute(svg, "<rect class=\"bar\"", "data-count"), std::vector<std::string>{"2"});
+  // Integer count axis: no fractional tick labels.
+  EXPECT_EQ(svg.find(">0.5<"), std::string::npos);
+}
+
+TEST(SvgHistogram, EmptyInputSaysNoData) {
+  for (const std::vector<HistogramSeries>& input :
+       {std::vector<HistogramSeries>{}, std::vector<HistogramSeries>{{"x", {kNaN, kInf}}}}) {
+    const std::string svg = SvgHistogram(input, 20, Options());
+    ExpectValidSvg(svg);
+    EXPECT_NE(svg.find("no data"), std::string::npos);
+  }
+}
+
+TEST(SvgGroupedBars, ValuesArePrintedWithThreeSignificantDigits) {
+  std::vector<BarGroup> groups = {
+      {"cable 1", {150.0, 0.25}}, {"cable 2", {1234.5, -0.001234}}, {"cable 3", {1e5, kNaN}}};
+  const std::string svg = SvgGroupedBars(groups, {"RMS [mm]", "bias <mm>"}, Options());
+  ExpectValidSvg(svg);
+  for (const char* label : {">150<", ">0.25<", ">1230<", ">-0.00123<", ">1e+05<", ">cable 1<",
+                            ">cable 3<", ">RMS [mm]<", ">bias &lt;mm&gt;<"}) {
+    EXPECT_NE(svg.find(label), std::string::npos) << label;
+  }
+  EXPECT_EQ(Count(svg, "<rect class=\"bar\""), 5);  // The NaN value has no bar.
+  EXPECT_EQ(Lower(svg).find("nan"), std::string::npos);
+}
+
+TEST(SvgGroupedBars, LongGroupLabelsAreRotated) {
+  std::vector<BarGroup> groups;
+  for (int i = 1; i <= 12; ++i) {
+    groups.push_back({"tower " + std::to_string(i) + " pulley exit", {1.0 * i, 2.0 * i}});
+  }
+  const std::string svg = SvgGroupedBars(groups, {"a", "b"}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find("rotate(-40"), std::string::npos);
+}
+
+TEST(SvgGroupedBars, EmptyInputSaysNoData) {
+  const std::string svg = SvgGroupedBars({}, {"a"}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find("no data"), std::string::npos);
+  EXPECT_NE(SvgGroupedBars({{"g", {kNaN}}}, {"a"}, Options()).find("no data"), std::string::npos);
+}
+
+TEST(SvgMatrixHeatmap, HasOneCellPerEntryWithItsValue) {
+  const std::vector<std::string> labels = {"EA", "rho", "m", "<dz>"};
+  const std::vector<std::vector<double>> m = {{1.0, 0.534, -0.25, 0.0},
+                                              {0.534, 1.0, -0.999, -0.001},
+                                              {-0.25, -0.999, 1.0, kNaN},
+                                              {0.0, -0.001, kNaN, 1.0}};
+  const std::string svg = SvgMatrixHeatmap(labels, m, Options());
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Count(svg, "<rect class=\"cell\""), 16);
+  const std::vector<std::string> values = Attribute(svg, "<rect class=\"cell\"", "data-value");
+  ASSERT_EQ(values.size(), 16u);
+  EXPECT_EQ(values[0], "1.00");
+  EXPECT_EQ(values[1], "0.53");
+  EXPECT_EQ(values[2], "-0.25");
+  EXPECT_EQ(values[6], "-1.00");
+  EXPECT_EQ(values[7], "0.00");  // -0.001 rounds to 0.00, not "-0.00".
+  EXPECT_EQ(values[11], "n/a");
+  EXPECT_NE(svg.find(">0.53</text>"), std::string::npos);
+  EXPECT_NE(svg.find(">-0.25</text>"), std::string::npos);
+  EXPECT_EQ(Count(svg, ">&lt;dz&gt;</text>"), 2);  // Row and column labels.
+  EXPECT_EQ(Lower(svg).find("nan"), std::string::npos);
+  // Diverging scale: +1 red, -1 blue.
+  EXPECT_EQ(Attribute(svg, "<rect class=\"cell\"", "fill")[0], "#b2182b");
+  EXPECT_EQ(Attribute(svg, "<rect class=\"cell\"", "fill")[6], "#2166ac");
+}
+
+TEST(SvgMatrixHeatmap, LongLabelsAreRotated) {
+  std::vector<std::string> labels;
+  for (int i = 0; i < 9; ++i) labels.push_back("anchor offset " + std::to_string(i) + " x");
+  const std::vector<std::vector<double>> m(9, std::vector<double>(9, 0.1));
+  const std::string svg = SvgMatrixHeatmap(labels, m, Options());
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Count(svg, "<rect class=\"cell\""), 81);
+  EXPECT_EQ(Count(svg, "rotate(-45"), 9);
+}
+
+TEST(SvgMatrixHeatmap, EmptyOrNonSquareSaysNoData) {
+  std::string svg = SvgMatrixHeatmap({}, {}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find("no data"), std::string::npos);
+  svg = SvgMatrixHeatmap({"a", "b"}, {{1.0, 0.0}, {0.0}}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find("no data"), std::string::npos);
+  EXPECT_EQ(Count(svg, "class=\"cell\""), 0);
+}
+
+TEST(XmlProblem, DetectsMalformedMarkup) {
+  EXPECT_EQ(XmlProblem("<svg><g></g></svg>"), "");
+  EXPECT_NE(XmlProblem("<svg><g></svg>"), "");
+  EXPECT_NE(XmlProblem("<svg><text>a & b</text></svg>"), "");
+  EXPECT_NE(XmlProblem("<svg><text>a < b</text></svg>"), "");
+}
+
+}  // namespace
+}  // namespace fastcal

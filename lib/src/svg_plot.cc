@@ -1,0 +1,791 @@
+// SVG chart writer for the HTML calibration report (svg_plot.h): nice ticks, compact
+// number formatting, layout, and the line, histogram, grouped-bar and heatmap charts.
+#include "fastcal/svg_plot.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+
+namespace fastcal {
+namespace {
+
+// Okabe-Ito, ordered for contrast on white (the pale yellow last).
+constexpr std::array<const char*, 8> kPalette = {"#0072B2", "#D55E00", "#009E73", "#CC79A7",
+                                                 "#E69F00", "#56B4E9", "#000000", "#F0E442"};
+
+constexpr int kMinWidthPx = 240, kMinHeightPx = 160, kMaxSizePx = 20000;
+constexpr double kFontPx = 12.0, kTickFontPx = 11.0, kTitleFontPx = 15.0;
+// Average glyph advance of Helvetica/Arial in em; slightly generous for safety.
+constexpr double kCharEm = 0.6;
+constexpr double kLegendRowPx = 18.0, kLegendSwatchPx = 22.0, kLegendGapPx = 18.0;
+constexpr double kTickLenPx = 4.0;
+constexpr const char* kGridColour = "#e3e3e3";
+constexpr const char* kAxisColour = "#444444";
+constexpr const char* kTextColour = "#222222";
+
+const char* Colour(size_t index) { return kPalette[index % kPalette.size()]; }
+
+// Pixel coordinate with one decimal, trailing ".0" dropped.
+std::string Px(double v) {
+  if (!std::isfinite(v)) return "0";
+  v = std::clamp(v, -1e7, 1e7);
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.1f", v);
+  std::string s(buf);
+  if (s.size() > 2 && s.compare(s.size() - 2, 2, ".0") == 0) s.resize(s.size() - 2);
+  if (s == "-0") s = "0";
+  return s;
+}
+
+std::string Fixed(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", std::clamp(decimals, 0, 20), v);
+  std::string s(buf);
+  // "-0.00" -> "0.00".
+  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
+  return s;
+}
+
+std::string Scientific(double v, int decimals) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*e", std::clamp(decimals, 0, 16), v);
+  return buf;
+}
+
+// Drops trailing zeros of the fraction (and a bare '.') in "12.50" or "1.20e+05".
+std::string StripZeros(std::string s) {
+  const size_t dot = s.find('.');
+  if (dot == std::string::npos) return s;
+  const size_t e = s.find('e');
+  const size_t end = e == std::string::npos ? s.size() : e;
+  size_t last = end;
+  while (last > dot + 1 && s[last - 1] == '0') --last;
+  if (last == dot + 1) last = dot;
+  return s.substr(0, last) + s.substr(end);
+}
+
+// Compact number with `sig` significant digits: fixed notation for 1e-3 <= |v| < 1e5,
+// scientific otherwise ("150", "0.25", "1e+05").
+std::string Compact(double v, int sig) {
+  if (!std::isfinite(v)) return "n/a";
+  if (v == 0.0) return "0";
+  const double a = std::fabs(v);
+  if (a >= 1e-3 && a < 1e5) {
+    const int exponent = static_cast<int>(std::floor(std::log10(a)));
+    if (exponent >= sig) {  // 1234.5 -> 1230: round the integer digits too.
+      const double unit = std::pow(10.0, exponent - sig + 1);
+      v = std::round(v / unit) * unit;
+    }
+    return StripZeros(Fixed(v, std::max(0, sig - 1 - exponent)));
+  }
+  return StripZeros(Scientific(v, sig - 1));
+}
+
+int FloorLog10(double v) { return static_cast<int>(std::floor(std::log10(v) + 1e-9)); }
+
+// Labels for evenly spaced ticks, all with the same number of decimals.
+std::vector<std::string> TickLabels(const std::vector<double>& ticks) {
+  std::vector<std::string> labels;
+  if (ticks.empty()) return labels;
+  const double step = ticks.size() > 1 ? ticks[1] - ticks[0] : 1.0;
+  double max_abs = 0.0;
+  for (double t : ticks) max_abs = std::max(max_abs, std::fabs(t));
+  const int step_exp = FloorLog10(step);
+  const bool fixed = max_abs == 0.0 || (max_abs >= 1e-3 && max_abs < 1e5);
+  for (double t : ticks) {
+    if (fixed) {
+      labels.push_back(Fixed(t, std::max(0, -step_exp)));
+    } else if (t == 0.0) {
+      labels.push_back("0");
+    } else {
+      labels.push_back(Scientific(t, std::clamp(FloorLog10(max_abs) - step_exp, 0, 15)));
+    }
+  }
+  return labels;
+}
+
+double TextWidth(const std::string& text, double font_px) {
+  size_t code_points = 0;
+  for (unsigned char c : text) code_points += (c & 0xC0) != 0x80;
+  return static_cast<double>(code_points) * font_px * kCharEm;
+}
+
+double MaxTextWidth(const std::vector<std::string>& texts, double font_px) {
+  double w = 0.0;
+  for (const std::string& t : texts) w = std::max(w, TextWidth(t, font_px));
+  return w;
+}
+
+std::vector<double> NiceTicksWithMinStep(double lo, double hi, int target, double min_step) {
+  if (!std::isfinite(lo) || !std::isfinite(hi)) return {};
+  if (lo > hi) std::swap(lo, hi);
+  target = std::clamp(target, 2, 50);
+  const double max_abs = std::max(std::fabs(lo), std::fabs(hi));
+  if (hi - lo <= 1e-12 * max_abs || hi - lo < 1e-290) {
+    const double centre = lo + 0.5 * (hi - lo);
+    const double pad = centre == 0.0 ? 1.0 : 0.01 * std::fabs(centre);
+    lo = centre - pad;
+    hi = centre + pad;
+  }
+  const double span = hi - lo;
+  if (!std::isfinite(span)) return {lo, hi};
+  const double raw = span / target;
+  const double magnitude = std::pow(10.0, std::floor(std::log10(raw)));
+  const double norm = raw / magnitude;
+  // Nearest of 1, 2, 5, 10 on a log scale.
+  double step = (norm < 1.4142   ? 1.0
+                 : norm < 3.1623 ? 2.0
+                 : norm < 7.0711 ? 5.0
+                                 : 10.0) *
+                magnitude;
+  step = std::max(step, min_step);
+  const double k_min = std::floor(lo / step + 1e-9);
+  double k_max = std::ceil(hi / step - 1e-9);
+  if (k_max <= k_min) k_max = k_min + 1.0;
+  // Dividing by an integer keeps e.g. 3 * 0.1 at the double nearest 0.3.
+  const double inverse = step < 1.0 ? std::round(1.0 / step) : 0.0;
+  std::vector<double> ticks;
+  for (double k = k_min; k <= k_max && ticks.size() < 1000; k += 1.0) {
+    ticks.push_back(step < 1.0 ? k / inverse : k * step);
+  }
+  return ticks;
+}
+
+// ---- SVG pieces -----------------------------------------------------------------------
+
+struct Box {
+  double x = 0, y = 0, w = 0, h = 0;
+};
+
+// Linear map from [lo, hi] to pixels [p_lo, p_hi].
+struct Scale {
+  double lo, hi, p_lo, p_hi;
+  double operator()(double v) const { return p_lo + (v - lo) / (hi - lo) * (p_hi - p_lo); }
+};
+
+void Text(std::string* out, double x, double y, const std::string& text, const char* anchor,
+          double font_px, const std::string& extra = "") {
+  *out += "<text x=\"" + Px(x) + "\" y=\"" + Px(y) + "\"";
+  if (anchor[0] != '\0') *out += std::string(" text-anchor=\"") + anchor + "\"";
+  if (font_px != kFontPx) *out += " font-size=\"" + Px(font_px) + "\"";
+  if (!extra.empty()) *out += " " + extra;
+  *out += ">" + XmlEscape(text) + "</text>\n";
+}
+
+void Line(std::string* out, double x1, double y1, double x2, double y2, const char* colour,
+          double width = 1.0, const std::string& extra = "") {
+  *out += "<line x1=\"" + Px(x1) + "\" y1=\"" + Px(y1) + "\" x2=\"" + Px(x2) + "\" y2=\"" + Px(y2) +
+          "\" stroke=\"" + colour + "\"";
+  if (width != 1.0) *out += " stroke-width=\"" + Px(width) + "\"";
+  if (!extra.empty()) *out += " " + extra;
+  *out += "/>\n";
+}
+
+std::string Rotate(double degrees, double x, double y) {
+  return "transform=\"rotate(" + Px(degrees) + " " + Px(x) + " " + Px(y) + ")\"";
+}
+
+struct Size {
+  int w, h;
+};
+
+Size ClampedSize(const PlotOptions& options) {
+  return {std::clamp(options.width_px, kMinWidthPx, kMaxSizePx),
+          std::clamp(options.height_px, kMinHeightPx, kMaxSizePx)};
+}
+
+// Opens the <svg>, writes background and title; the caller closes with CloseSvg.
+void OpenSvg(std::string* out, Size size, const std::string& title) {
+  const std::string w = std::to_string(size.w), h = std::to_string(size.h);
+  *out += "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + w + "\" height=\"" + h +
+          "\" viewBox=\"0 0 " + w + " " + h + "\" role=\"img\">\n";
+  if (!title.empty()) *out += "<title>" + XmlEscape(title) + "</title>\n";
+  *out += "<rect width=\"" + w + "\" height=\"" + h + "\" fill=\"#ffffff\"/>\n";
+  *out += std::string("<g font-family=\"Helvetica,Arial,sans-serif\" font-size=\"") + Px(kFontPx) +
+          "\" fill=\"" + kTextColour + "\">\n";
+  if (!title.empty()) {
+    Text(out, size.w / 2.0, 21.0, title, "middle", kTitleFontPx, "font-weight=\"bold\"");
+  }
+}
+
+void CloseSvg(std::string* out) { *out += "</g>\n</svg>"; }
+
+double TitleBottom(const PlotOptions& options) { return options.title.empty() ? 8.0 : 30.0; }
+
+std::string NoDataSvg(const PlotOptions& options, const std::string& message) {
+  const Size size = ClampedSize(options);
+  std::string out;
+  OpenSvg(&out, size, options.title);
+  Text(&out, size.w / 2.0, size.h / 2.0, message, "middle", 14.0, "fill=\"#777777\"");
+  CloseSvg(&out);
+  return out;
+}
+
+// ---- Legend ---------------------------------------------------------------------------
+
+enum class Swatch { kLine, kDashed, kMarker, kBox, kSolidBox };
+
+struct LegendItem {
+  std::string label;
+  const char* colour;
+  Swatch swatch;
+};
+
+double LegendItemWidth(const LegendItem& item) {
+  return kLegendSwatchPx + 5.0 + TextWidth(item.label, kFontPx);
+}
+
+// Splits items into rows no wider than `width`.
+std::vector<std::vector<size_t>> LegendRows(const std::vector<LegendItem>& items, double width) {
+  std::vector<std::vector<size_t>> rows;
+  double used = 0.0;
+  for (size_t i = 0; i < items.size(); ++i) {
+    const double w = LegendItemWidth(items[i]);
+    if (rows.empty() || used + kLegendGapPx + w > width) {
+      rows.emplace_back();
+      used = w;
+    } else {
+      used += kLegendGapPx + w;
+    }
+    rows.back().push_back(i);
+  }
+  return rows;
+}
+
+// Draws the rows centred horizontally in `svg_width`, starting at `top`.
+void DrawLegend(std::string* out, const std::vector<LegendItem>& items,
+                const std::vector<std::vector<size_t>>& rows, double svg_width, double top) {
+  for (size_t r = 0; r < rows.size(); ++r) {
+    double row_width = 0.0;
+    for (size_t i : rows[r]) row_width += LegendItemWidth(items[i]);
+    row_width += kLegendGapPx * static_cast<double>(rows[r].size() - 1);
+    double x = std::max(4.0, (svg_width - row_width) / 2.0);
+    const double mid = top + kLegendRowPx * (static_cast<double>(r) + 0.5);
+    for (size_t i : rows[r]) {
+      const LegendItem& item = items[i];
+      switch (item.swatch) {
+        case Swatch::kLine:
+        case Swatch::kDashed:
+          Line(out, x, mid, x + kLegendSwatchPx, mid, item.colour, 2.0,
+               item.swatch == Swatch::kDashed ? "stroke-dasharray=\"6 4\"" : "");
+          break;
+        case Swatch::kMarker:
+          *out += "<circle cx=\"" + Px(x + kLegendSwatchPx / 2) + "\" cy=\"" + Px(mid) +
+                  "\" r=\"3.5\" fill=\"" + item.colour + "\"/>\n";
+          break;
+        case Swatch::kBox:
+        case Swatch::kSolidBox:
+          *out += "<rect x=\"" + Px(x + 4) + "\" y=\"" + Px(mid - 5) +
+                  "\" width=\"14\" height=\"10\" fill=\"" + item.colour + "\"" +
+                  (item.swatch == Swatch::kBox ? " fill-opacity=\"0.45\"" : "") + " stroke=\"" +
+                  item.colour + "\"/>\n";
+          break;
+      }
+      Text(out, x + kLegendSwatchPx + 5.0, mid + 4.0, item.label, "", kFontPx);
+      x += LegendItemWidth(item) + kLegendGapPx;
+    }
+  }
+}
+
+// ---- Cartesian frame ------------------------------------------------------------------
+
+// Layout of a chart with a legend under the title, a y axis on the left and an x axis
+// below. Vertical extents are fixed first; the plot's left edge depends on the y tick
+// labels, which depend on the plot height.
+struct Frame {
+  Size size{0, 0};
+  std::vector<LegendItem> legend;
+  std::vector<std::vector<size_t>> legend_rows;
+  double legend_top = 0.0;
+  Box box;
+};
+
+Frame StartFrame(const PlotOptions& options, std::vector<LegendItem> legend,
+                 double x_labels_height) {
+  Frame f;
+  f.size = ClampedSize(options);
+  f.legend = std::move(legend);
+  f.legend_rows = LegendRows(f.legend, f.size.w - 16.0);
+  f.legend_top = TitleBottom(options);
+  const double top = f.legend_top + kLegendRowPx * static_cast<double>(f.legend_rows.size()) +
+                     (f.legend_rows.empty() ? 6.0 : 10.0);
+  const double bottom = kTickLenPx + x_labels_height + (options.x_label.empty() ? 6.0 : 26.0);
+  f.box.y = top;
+  f.box.h = std::max(40.0, f.size.h - top - bottom);
+  return f;
+}
+
+void FinishFrame(Frame* f, const PlotOptions& options,
+                 const std::vector<std::string>& y_tick_labels, double right) {
+  f->box.x = 8.0 + (options.y_label.empty() ? 0.0 : 20.0) +
+             MaxTextWidth(y_tick_labels, kTickFontPx) + kTickLenPx + 4.0;
+  f->box.w = std::max(40.0, f->size.w - f->box.x - right);
+}
+
+int YTickTarget(double plot_h) {
+  return std::clamp(static_cast<int>(std::lround(plot_h / 45.0)), 2, 8);
+}
+
+// Numeric x ticks with enough room between labels.
+std::vector<double> FitXTicks(double lo, double hi, double plot_w) {
+  int target = std::clamp(static_cast<int>(plot_w / 90.0), 2, 10);
+  while (true) {
+    std::vector<double> ticks = NiceTicks(lo, hi, target);
+    if (target <= 2 || ticks.size() < 2) return ticks;
+    const double spacing = plot_w / static_cast<double>(ticks.size() - 1);
+    if (spacing >= MaxTextWidth(TickLabels(ticks), kTickFontPx) + 12.0) return ticks;
+    --target;
+  }
+}
+
+void DrawYAxis(std::string* out, const Box& box, const Scale& ys, const std::vector<double>& ticks,
+               const PlotOptions& options) {
+  const std::vector<std::string> labels = TickLabels(ticks);
+  for (size_t i = 0; i < ticks.size(); ++i) {
+    const double y = ys(ticks[i]);
+    Line(out, box.x, y, box.x + box.w, y, kGridColour);
+    Line(out, box.x - kTickLenPx, y, box.x, y, kAxisColour);
+    Text(out, box.x - kTickLenPx - 3.0, y + 4.0, labels[i], "end", kTickFontPx);
+  }
+  if (!options.y_label.empty()) {
+    const double x = 16.0, y = box.y + box.h / 2.0;
+    Text(out, x, y, options.y_label, "middle", kFontPx, Rotate(-90.0, x, y));
+  }
+}
+
+void XLabel(std::string* out, const Box& box, const PlotOptions& options, Size size) {
+  if (options.x_label.empty()) return;
+  Text(out, box.x + box.w / 2.0, size.h - 8.0, options.x_label, "middle", kFontPx);
+}
+
+void DrawXAxis(std::string* out, const Box& box, const Scale& xs, const std::vector<double>& ticks,
+               const PlotOptions& options, Size size) {
+  const std::vector<std::string> labels = TickLabels(ticks);
+  const double bottom = box.y + box.h;
+  for (size_t i = 0; i < ticks.size(); ++i) {
+    const double x = xs(ticks[i]);
+    Line(out, x, box.y, x, bottom, kGridColour);
+    Line(out, x, bottom, x, bottom + kTickLenPx, kAxisColour);
+    Text(out, x, bottom + kTickLenPx + 13.0, labels[i], "middle", kTickFontPx);
+  }
+  XLabel(out, box, options, size);
+}
+
+void DrawBorder(std::string* out, const Box& box) {
+  *out += "<rect x=\"" + Px(box.x) + "\" y=\"" + Px(box.y) + "\" width=\"" + Px(box.w) +
+          "\" height=\"" + Px(box.h) + "\" fill=\"none\" stroke=\"" + kAxisColour + "\"/>\n";
+}
+
+constexpr double kXTickLabelsPx = 17.0;
+
+}  // namespace
+
+std::string XmlEscape(const std::string& text) {
+  std::string out;
+  out.reserve(text.size());
+  for (char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        if (static_cast<unsigned char>(c) >= 0x20 || c == '\t' || c == '\n' || c == '\r') {
+          out += c;
+        }
+    }
+  }
+  return out;
+}
+
+std::vector<double> NiceTicks(double lo, double hi, int target) {
+  return NiceTicksWithMinStep(lo, hi, target, 0.0);
+}
+
+std::string PlotSeriesColour(int index) {
+  const int n = static_cast<int>(kPalette.size());
+  return kPalette[((index % n) + n) % n];
+}
+
+std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions& options) {
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double x_lo = kInf, x_hi = -kInf, y_lo = kInf, y_hi = -kInf;
+  auto finite = [](double x, double y) { return std::isfinite(x) && std::isfinite(y); };
+  for (const PlotSeries& s : series) {
+    const size_t n = std::min(s.x.size(), s.y.size());
+    for (size_t i = 0; i < n; ++i) {
+      if (!finite(s.x[i], s.y[i])) continue;
+      x_lo = std::min(x_lo, s.x[i]);
+      x_hi = std::max(x_hi, s.x[i]);
+      y_lo = std::min(y_lo, s.y[i]);
+      y_hi = std::max(y_hi, s.y[i]);
+    }
+  }
+  if (x_lo > x_hi) return NoDataSvg(options, "no data");
+
+  std::vector<LegendItem> legend;
+  for (size_t i = 0; i < series.size(); ++i) {
+    if (series[i].name.empty()) continue;
+    legend.push_back({series[i].name, Colour(i),
+                      series[i].markers_only ? Swatch::kMarker
+                      : series[i].dashed     ? Swatch::kDashed
+                                             : Swatch::kLine});
+  }
+  Frame f = StartFrame(options, std::move(legend), kXTickLabelsPx);
+  const std::vector<double> y_ticks = NiceTicks(y_lo, y_hi, YTickTarget(f.box.h));
+  FinishFrame(&f, options, TickLabels(y_ticks), 30.0);
+  const std::vector<double> x_ticks = FitXTicks(x_lo, x_hi, f.box.w);
+  const Box& box = f.box;
+  const Scale xs{x_ticks.front(), x_ticks.back(), box.x, box.x + box.w};
+  const Scale ys{y_ticks.front(), y_ticks.back(), box.y + box.h, box.y};
+
+  std::string out;
+  OpenSvg(&out, f.size, options.title);
+  DrawYAxis(&out, box, ys, y_ticks, options);
+  DrawXAxis(&out, box, xs, x_ticks, options, f.size);
+
+  constexpr double kMarkerR = 3.0;
+  // An isolated point of a line (between gaps): a small stroked ring, reads as a dot.
+  constexpr const char* kDot = "m-1.2 0a1.2 1.2 0 1 0 2.4 0a1.2 1.2 0 1 0 -2.4 0";
+  for (size_t si = 0; si < series.size(); ++si) {
+    const PlotSeries& s = series[si];
+    const size_t n = std::min(s.x.size(), s.y.size());
+    std::string d;
+    size_t run = 0;  // Points in the current subpath.
+    for (size_t i = 0; i < n; ++i) {
+      if (!finite(s.x[i], s.y[i])) {
+        if (run == 1 && !s.markers_only) d += kDot;
+        run = 0;
+        continue;
+      }
+      const double px = xs(s.x[i]), py = ys(s.y[i]);
+      if (s.markers_only) {
+        d += "M" + Px(px - kMarkerR) + " " + Px(py) + "a3 3 0 1 0 6 0a3 3 0 1 0 -6 0Z";
+      } else {
+        d += (run == 0 ? "M" : "L") + Px(px) + " " + Px(py);
+      }
+      ++run;
+    }
+    if (run == 1 && !s.markers_only) d += kDot;
+    if (d.empty()) continue;
+    const char* colour = Colour(si);
+    if (s.markers_only) {
+      out += std::string("<path d=\"") + d + "\" fill=\"" + colour + "\"/>\n";
+    } else {
+      out += std::string("<path d=\"") + d + "\" fill=\"none\" stroke=\"" + colour +
+             "\" stroke-width=\"1.8\" stroke-linejoin=\"round\" stroke-linecap=\"round\"" +
+             (s.dashed ? " stroke-dasharray=\"6 5\"" : "") + "/>\n";
+    }
+  }
+  DrawBorder(&out, box);
+  DrawLegend(&out, f.legend, f.legend_rows, f.size.w, f.legend_top);
+  CloseSvg(&out);
+  return out;
+}
+
+std::string SvgHistogram(const std::vector<HistogramSeries>& series, int bins,
+                         const PlotOptions& options) {
+  bins = std::clamp(bins, 1, 1000);
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  double lo = kInf, hi = -kInf;
+  for (const HistogramSeries& s : series) {
+    for (double v : s.values) {
+      if (!std::isfinite(v)) continue;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+  }
+  if (lo > hi) return NoDataSvg(options, "no data");
+  if (hi - lo <= 1e-12 * std::max(std::fabs(lo), std::fabs(hi))) {
+    const double pad = lo == 0.0 ? 0.5 : 0.005 * std::fabs(lo);
+    lo -= pad;
+    hi += pad;
+  }
+  const double bin_width = (hi - lo) / bins;
+
+  std::vector<std::vector<long>> counts(series.size(), std::vector<long>(bins, 0));
+  long max_count = 0;
+  std::vector<LegendItem> legend;
+  for (size_t si = 0; si < series.size(); ++si) {
+    long n = 0;
+    for (double v : series[si].values) {
+      if (!std::isfinite(v)) continue;
+      const int b = std::clamp(static_cast<int>(std::floor((v - lo) / bin_width)), 0, bins - 1);
+      max_count = std::max(max_count, ++counts[si][b]);
+      ++n;
+    }
+    if (!series[si].name.empty()) {
+      legend.push_back(
+          {series[si].name + " (n=" + std::to_string(n) + ")", Colour(si), Swatch::kBox});
+    }
+  }
+
+  PlotOptions opts = options;
+  if (opts.y_label.empty()) opts.y_label = "count";
+  Frame f = StartFrame(opts, std::move(legend), kXTickLabelsPx);
+  const std::vector<double> y_ticks =
+      NiceTicksWithMinStep(0.0, static_cast<double>(max_count), YTickTarget(f.box.h), 1.0);
+  FinishFrame(&f, opts, TickLabels(y_ticks), 30.0);
+  const std::vector<double> x_ticks = FitXTicks(lo, hi, f.box.w);
+  const Box& box = f.box;
+  const Scale xs{x_ticks.front(), x_ticks.back(), box.x, box.x + box.w};
+  const Scale ys{y_ticks.front(), y_ticks.back(), box.y + box.h, box.y};
+
+  std::string out;
+  OpenSvg(&out, f.size, opts.title);
+  DrawYAxis(&out, box, ys, y_ticks, opts);
+  DrawXAxis(&out, box, xs, x_ticks, opts, f.size);
+  for (size_t si = 0; si < series.size(); ++si) {
+    const char* colour = Colour(si);
+    for (int b = 0; b < bins; ++b) {
+      const long c = counts[si][b];
+      if (c == 0) continue;
+      const double x0 = xs(lo + b * bin_width), x1 = xs(lo + (b + 1) * bin_width);
+      const double y = ys(static_cast<double>(c));
+      out += "<rect class=\"bar\" data-count=\"" + std::to_string(c) + "\" x=\"" + Px(x0) +
+             "\" y=\"" + Px(y) + "\" width=\"" + Px(x1 - x0) + "\" height=\"" +
+             Px(box.y + box.h - y) + "\" fill=\"" + colour + "\" fill-opacity=\"0.4\" stroke=\"" +
+             colour + "\" stroke-width=\"0.8\"/>\n";
+    }
+  }
+  DrawBorder(&out, box);
+  DrawLegend(&out, f.legend, f.legend_rows, f.size.w, f.legend_top);
+  CloseSvg(&out);
+  return out;
+}
+
+std::string SvgGroupedBars(const std::vector<BarGroup>& groups,
+                           const std::vector<std::string>& series_names,
+                           const PlotOptions& options) {
+  size_t num_series = series_names.size();
+  if (num_series == 0) {
+    for (const BarGroup& g : groups) num_series = std::max(num_series, g.values.size());
+  }
+  double v_min = 0.0, v_max = 0.0;
+  bool any = false, any_negative = false, any_positive = false;
+  std::vector<std::string> value_labels;
+  for (const BarGroup& g : groups) {
+    for (size_t s = 0; s < std::min(num_series, g.values.size()); ++s) {
+      const double v = g.values[s];
+      if (!std::isfinite(v)) continue;
+      any = true;
+      v_min = std::min(v_min, v);
+      v_max = std::max(v_max, v);
+      any_negative |= v < 0.0;
+      any_positive |= v >= 0.0;
+      value_labels.push_back(Compact(v, 3));
+    }
+  }
+  if (!any) return NoDataSvg(options, "no data");
+
+  std::vector<LegendItem> legend;
+  for (size_t s = 0; s < series_names.size(); ++s) {
+    if (!series_names[s].empty()) legend.push_back({series_names[s], Colour(s), Swatch::kSolidBox});
+  }
+  // Group labels: horizontal if they fit their slot, else rotated by 40 degrees. The
+  // slot width is estimated from the full width; the y labels take little of it.
+  const Size size = ClampedSize(options);
+  std::vector<std::string> group_labels;
+  for (const BarGroup& g : groups) group_labels.push_back(g.label);
+  const double max_group_label_w = MaxTextWidth(group_labels, kTickFontPx);
+  const double est_slot_w = (size.w - 90.0) / static_cast<double>(groups.size());
+  const bool rotate_groups = max_group_label_w > est_slot_w - 6.0;
+  constexpr double kRotateDeg = 40.0;
+  const double group_labels_h = rotate_groups
+                                    ? max_group_label_w * std::sin(kRotateDeg * M_PI / 180.0) + 16.0
+                                    : kXTickLabelsPx;
+
+  Frame f = StartFrame(options, std::move(legend), group_labels_h);
+  constexpr double kValueFontPx = 10.0;
+  const double bar_pitch_est = est_slot_w * 0.8 / static_cast<double>(num_series);
+  const double max_value_label_w = MaxTextWidth(value_labels, kValueFontPx);
+  const bool rotate_values = max_value_label_w > bar_pitch_est - 1.0;
+  // Head room so value labels stay inside the plot.
+  const double label_px = rotate_values ? max_value_label_w + 6.0 : kValueFontPx + 6.0;
+  const double top_px = any_positive ? label_px : 0.0;
+  const double bottom_px = any_negative ? label_px : 0.0;
+  double span = v_max - v_min;
+  if (span == 0.0) span = 1.0;
+  const double data_px = std::max(20.0, f.box.h - top_px - bottom_px);
+  const double per_px = span / data_px;
+  const std::vector<double> y_ticks =
+      NiceTicks(v_min - bottom_px * per_px, v_max + top_px * per_px, YTickTarget(f.box.h));
+  FinishFrame(&f, options, TickLabels(y_ticks), 12.0);
+  const Box& box = f.box;
+  const Scale ys{y_ticks.front(), y_ticks.back(), box.y + box.h, box.y};
+
+  std::string out;
+  OpenSvg(&out, f.size, options.title);
+  DrawYAxis(&out, box, ys, y_ticks, options);
+  const double slot_w = box.w / static_cast<double>(groups.size());
+  const double bar_w = slot_w * 0.8 / static_cast<double>(num_series);
+  const double bottom = box.y + box.h;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    const double cx = box.x + slot_w * (static_cast<double>(g) + 0.5);
+    if (g > 0) {
+      const double x = box.x + slot_w * static_cast<double>(g);
+      Line(&out, x, bottom, x, bottom + kTickLenPx, kAxisColour);
+    }
+    if (rotate_groups) {
+      const double y = bottom + kTickLenPx + 11.0;
+      Text(&out, cx + 4.0, y, groups[g].label, "end", kTickFontPx,
+           Rotate(-kRotateDeg, cx + 4.0, y));
+    } else {
+      Text(&out, cx, bottom + kTickLenPx + 13.0, groups[g].label, "middle", kTickFontPx);
+    }
+    const double x_first = box.x + slot_w * (static_cast<double>(g) + 0.1);
+    for (size_t s = 0; s < std::min(num_series, groups[g].values.size()); ++s) {
+      const double v = groups[g].values[s];
+      if (!std::isfinite(v)) continue;
+      const double x = x_first + bar_w * static_cast<double>(s);
+      const double y0 = ys(0.0), y1 = ys(v);
+      const char* colour = Colour(s);
+      out += "<rect class=\"bar\" x=\"" + Px(x) + "\" y=\"" + Px(std::min(y0, y1)) + "\" width=\"" +
+             Px(bar_w * 0.92) + "\" height=\"" + Px(std::fabs(y1 - y0)) + "\" fill=\"" + colour +
+             "\"/>\n";
+      const double lx = x + bar_w * 0.46;
+      const std::string label = Compact(v, 3);
+      if (rotate_values) {
+        const double ly = v < 0.0 ? y1 + 3.0 : y1 - 3.0;
+        Text(&out, lx, ly, label, v < 0.0 ? "end" : "start", kValueFontPx,
+             Rotate(-90.0, lx, ly) + " dy=\"0.35em\"");
+      } else {
+        Text(&out, lx, v < 0.0 ? y1 + kValueFontPx + 2.0 : y1 - 3.0, label, "middle", kValueFontPx);
+      }
+    }
+  }
+  if (y_ticks.front() < 0.0) Line(&out, box.x, ys(0.0), box.x + box.w, ys(0.0), kAxisColour);
+  XLabel(&out, box, options, f.size);
+  DrawBorder(&out, box);
+  DrawLegend(&out, f.legend, f.legend_rows, f.size.w, f.legend_top);
+  CloseSvg(&out);
+  return out;
+}
+
+namespace {
+
+// Diverging scale: -1 blue, 0 near-white, +1 red (ColorBrewer RdBu end points).
+std::string DivergingColour(double v) {
+  const double t = std::clamp(v, -1.0, 1.0);
+  constexpr double kMid[3] = {247, 247, 247}, kNeg[3] = {33, 102, 172}, kPos[3] = {178, 24, 43};
+  const double* end = t < 0.0 ? kNeg : kPos;
+  const double a = std::fabs(t);
+  char buf[8];
+  int rgb[3];
+  for (int i = 0; i < 3; ++i) {
+    rgb[i] = static_cast<int>(std::lround(kMid[i] + (end[i] - kMid[i]) * a));
+  }
+  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+  return buf;
+}
+
+}  // namespace
+
+std::string SvgMatrixHeatmap(const std::vector<std::string>& labels,
+                             const std::vector<std::vector<double>>& matrix,
+                             const PlotOptions& options) {
+  const size_t n = labels.size();
+  if (n == 0 || matrix.empty()) return NoDataSvg(options, "no data");
+  bool square = matrix.size() == n;
+  for (const std::vector<double>& row : matrix) square = square && row.size() == n;
+  if (!square) return NoDataSvg(options, "no data (matrix is not labels x labels)");
+
+  const Size size = ClampedSize(options);
+  const double label_w = MaxTextWidth(labels, kTickFontPx);
+  const double top = TitleBottom(options) + 6.0;
+  double left = 8.0 + (options.y_label.empty() ? 0.0 : 20.0) + label_w + 6.0;
+  constexpr double kColourBarPx = 64.0;  // Gap, bar and its labels on the right.
+  const double x_label_px = options.x_label.empty() ? 6.0 : 26.0;
+  auto cell_for = [&](double labels_h) {
+    const double avail_w = size.w - left - kColourBarPx;
+    const double avail_h = size.h - top - labels_h - x_label_px;
+    return std::max(4.0, std::min(avail_w, avail_h) / static_cast<double>(n));
+  };
+  double labels_h = 18.0;
+  double cell = cell_for(labels_h);
+  constexpr double kRotateDeg = 45.0;
+  const bool rotate = label_w > cell - 4.0;
+  if (rotate) {
+    labels_h = label_w * std::sin(kRotateDeg * M_PI / 180.0) + 16.0;
+    cell = cell_for(labels_h);
+  }
+  const double grid = cell * static_cast<double>(n);
+  // Centre labels, grid and colour bar horizontally.
+  const double shift = std::max(0.0, (size.w - left - grid - kColourBarPx) / 2.0);
+  left += shift;
+  const double value_font = std::clamp(cell * 0.28, 5.0, 12.0);
+
+  std::string out;
+  OpenSvg(&out, size, options.title);
+  for (size_t i = 0; i < n; ++i) {
+    for (size_t j = 0; j < n; ++j) {
+      const double v = matrix[i][j];
+      const double x = left + cell * static_cast<double>(j);
+      const double y = top + cell * static_cast<double>(i);
+      const bool ok = std::isfinite(v);
+      const std::string text = ok ? Fixed(v, 2) : "n/a";
+      out += "<rect class=\"cell\" data-value=\"" + text + "\" x=\"" + Px(x) + "\" y=\"" + Px(y) +
+             "\" width=\"" + Px(cell) + "\" height=\"" + Px(cell) + "\" fill=\"" +
+             (ok ? DivergingColour(v) : std::string("#d0d0d0")) + "\"/>\n";
+      const bool dark = ok && std::fabs(v) > 0.55;
+      Text(&out, x + cell / 2.0, y + cell / 2.0 + value_font * 0.35, text, "middle", value_font,
+           dark ? "fill=\"#ffffff\"" : "");
+    }
+  }
+  out += "<rect x=\"" + Px(left) + "\" y=\"" + Px(top) + "\" width=\"" + Px(grid) + "\" height=\"" +
+         Px(grid) + "\" fill=\"none\" stroke=\"" + kAxisColour + "\"/>\n";
+  for (size_t i = 0; i < n; ++i) {
+    const double c = cell * (static_cast<double>(i) + 0.5);
+    Text(&out, left - 5.0, top + c + 4.0, labels[i], "end", kTickFontPx);
+    const double x = left + c, y = top + grid + 14.0;
+    if (rotate) {
+      Text(&out, x + 4.0, y - 4.0, labels[i], "end", kTickFontPx,
+           Rotate(-kRotateDeg, x + 4.0, y - 4.0));
+    } else {
+      Text(&out, x, y, labels[i], "middle", kTickFontPx);
+    }
+  }
+  if (!options.y_label.empty()) {
+    const double x = shift + 16.0, y = top + grid / 2.0;
+    Text(&out, x, y, options.y_label, "middle", kFontPx, Rotate(-90.0, x, y));
+  }
+  if (!options.x_label.empty()) {
+    Text(&out, left + grid / 2.0, top + grid + labels_h + 18.0, options.x_label, "middle", kFontPx);
+  }
+  // Colour bar: stacked bands from +1 (top) to -1, no gradient so no element ids.
+  constexpr int kBands = 40;
+  const double bar_x = left + grid + 14.0, bar_w = 12.0;
+  const double bar_h = std::max(60.0, std::min(grid, 220.0));
+  const double band_h = bar_h / kBands;
+  for (int b = 0; b < kBands; ++b) {
+    const double v = 1.0 - (b + 0.5) * 2.0 / kBands;
+    out += "<rect x=\"" + Px(bar_x) + "\" y=\"" + Px(top + b * band_h) + "\" width=\"" + Px(bar_w) +
+           "\" height=\"" + Px(band_h + 0.5) + "\" fill=\"" + DivergingColour(v) + "\"/>\n";
+  }
+  out += "<rect x=\"" + Px(bar_x) + "\" y=\"" + Px(top) + "\" width=\"" + Px(bar_w) +
+         "\" height=\"" + Px(bar_h) + "\" fill=\"none\" stroke=\"" + kAxisColour + "\"/>\n";
+  for (int k = 0; k <= 4; ++k) {
+    const double v = 1.0 - 0.5 * k;
+    const double y = top + bar_h * k / 4.0;
+    Line(&out, bar_x + bar_w, y, bar_x + bar_w + 3.0, y, kAxisColour);
+    Text(&out, bar_x + bar_w + 5.0, y + 4.0, Fixed(v, 1), "", kTickFontPx);
+  }
+  CloseSvg(&out);
+  return out;
+}
+
+}  // namespace fastcal

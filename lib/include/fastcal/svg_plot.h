@@ -1,0 +1,92 @@
+// Dependency-free SVG chart writer for the self-contained HTML calibration report: line
+// plots, overlaid histograms, grouped bars and correlation heatmaps, each returned as one
+// <svg> element to inline in HTML (no JavaScript, no CSS, no external fonts, no element
+// ids, so several charts can share a page).
+//
+// Common conventions:
+//  - Series colours follow a fixed Okabe-Ito palette (PlotSeriesColour), cycling after 8.
+//  - Axis ticks are "nice" numbers (NiceTicks) and span the whole data range.
+//  - All user text is XML-escaped; numbers are written compactly ("150", "0.25", "1e+05")
+//    and non-finite values never reach the output as "nan" or "inf".
+//  - Empty input (or input with no finite value) gives a valid SVG that says "no data".
+//  - width_px and height_px are raised to at least 240 x 160 and capped at 20000.
+#ifndef FASTCAL_SVG_PLOT_H_
+#define FASTCAL_SVG_PLOT_H_
+
+#include <string>
+#include <vector>
+
+namespace fastcal {
+
+struct PlotSeries {
+  std::string name;  // Legend text; an empty name leaves the series out of the legend.
+  // Points (x[i], y[i]) for i < min(x.size(), y.size()). A point with a non-finite
+  // coordinate is skipped and breaks the line (a gap).
+  std::vector<double> x, y;
+  bool dashed = false;
+  bool markers_only = false;  // Dots at the points instead of a line.
+};
+
+struct PlotOptions {
+  std::string title, x_label, y_label;  // Axis labels should carry units, e.g. "t [s]".
+  int width_px = 720;
+  int height_px = 300;
+};
+
+// Lines (or markers) over shared axes. Each series with at least one finite point is
+// written as exactly one <path> element; gaps become separate subpaths ("M") of that
+// path, and an isolated point between gaps is drawn as a dot.
+std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions& options);
+
+struct HistogramSeries {
+  std::string name;
+  std::vector<double> values;  // Non-finite values are ignored.
+};
+
+// Overlaid translucent histograms with common bin edges spanning the finite values of all
+// series; `bins` is clamped to [1, 1000]. Each non-empty bin is one
+// <rect class="bar" data-count="N">; the legend gives each series' count n. The y label
+// defaults to "count".
+std::string SvgHistogram(const std::vector<HistogramSeries>& series, int bins,
+                         const PlotOptions& options);
+
+// One group per category (e.g. cable 1..6), one bar per series.
+struct BarGroup {
+  std::string label;
+  std::vector<double> values;  // values[s] belongs to series s; missing or non-finite: no bar.
+};
+
+// Grouped bars from a zero baseline, each a <rect class="bar">, with its value printed
+// above it (below it if negative) to 3 significant digits. Group labels are rotated when
+// they do not fit under their group.
+std::string SvgGroupedBars(const std::vector<BarGroup>& groups,
+                           const std::vector<std::string>& series_names,
+                           const PlotOptions& options);
+
+// Heatmap of a square matrix of values in [-1, 1] (e.g. parameter correlations; values
+// outside are clamped for colour only) on a diverging blue-white-red scale with a colour
+// bar. Row i / column j is labels[i] / labels[j]. Each cell is a
+// <rect class="cell" data-value="0.53"> followed by its value as text (2 decimals,
+// "n/a" if non-finite). Column labels are rotated when long. A matrix that is not
+// labels.size() x labels.size() gives a "no data" SVG naming the problem.
+std::string SvgMatrixHeatmap(const std::vector<std::string>& labels,
+                             const std::vector<std::vector<double>>& matrix,
+                             const PlotOptions& options);
+
+// Escapes & < > " ' for XML text and attribute values; drops control characters that
+// XML 1.0 forbids (all below 0x20 except tab, newline and carriage return).
+std::string XmlEscape(const std::string& text);
+
+// "Nice" axis ticks covering [lo, hi] (the first tick <= lo, the last >= hi): about
+// `target` ticks (clamped to [2, 50]) spaced by 1, 2 or 5 x 10^k. A degenerate range
+// (lo == hi) is padded by 1% of |lo| (by 1 if lo == 0). lo > hi is treated as swapped.
+// Returns an empty vector if lo or hi is not finite.
+std::vector<double> NiceTicks(double lo, double hi, int target);
+
+// Colour (e.g. "#0072B2") of series `index` in every chart, for matching tables or text
+// in the report to the plots. Cycles through the 8 Okabe-Ito colours.
+std::string PlotSeriesColour(int index);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_SVG_PLOT_H_
