@@ -1,0 +1,117 @@
+// Calibration: estimate model parameters from measured poses and tensions by weighted
+// least squares (Ceres), with identifiability analysis and uncertainties.
+//
+//   minimise  sum_samples sum_i rho(r_i^2) + sum_priors ((theta_k - mean_k)/sigma_k)^2
+//   r_i = (gain_i T_i(theta; pose) + bias_i - T_measured_i) / sigma_i
+// (internal/calibration_model.h). Derivatives are exact: the statics are differentiated
+// with ceres::Jet through the converged inner solves (implicit function theorem).
+//
+// Identifiability: the whitened Jacobian J (data and prior rows) with its columns scaled
+// to unit norm, D, has singular values s_1 >= ... >= s_n. A direction with
+// s_k / s_1 < undetermined_ratio is one the data and priors cannot determine: the
+// calibration is refused before solving and the direction is named as a combination of
+// parameters. Above it but below poorly_determined_ratio it is reported. The covariance
+// of the estimate is (J^T J)^-1 at the solution (ceres::Covariance), the formal one for
+// the stated noise; the reduced chi-square says whether that noise was right.
+#ifndef FASTCAL_CALIBRATION_H_
+#define FASTCAL_CALIBRATION_H_
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+
+namespace fastcal {
+
+struct CalibrationOptions {
+  // Called once per solver iteration with a one-line summary; the library never prints.
+  std::function<void(const std::string&)> progress;
+  // Singular-value ratio below which a direction counts as undetermined (refused).
+  double undetermined_ratio = 1e-8;
+  // Ratio below which a direction counts as poorly determined (reported).
+  double poorly_determined_ratio = 1e-3;
+  // |correlation| above which a pair of estimates is reported.
+  double strong_correlation = 0.9;
+  // A parameter with a prior whose posterior sigma exceeds this fraction of its prior
+  // sigma is reported as set mostly by the prior.
+  double prior_dominated_fraction = 0.5;
+};
+
+// A direction in parameter space: weights on parameter names (unit vector in the
+// column-scaled parameters; entries below 0.1 in magnitude omitted).
+struct ParameterDirection {
+  double singular_value_ratio = 0.0;
+  std::vector<std::pair<std::string, double>> weights;
+  std::string Describe() const;  // "cabin_mass_kg (+0.71) ~ sensor_gain (-0.71)"
+};
+
+struct Identifiability {
+  std::vector<double> singular_value_ratios;    // s_k / s_1, descending
+  std::vector<ParameterDirection> undetermined;  // ratio < undetermined_ratio
+  std::vector<ParameterDirection> poorly_determined;
+};
+
+struct ParameterEstimate {
+  std::string name;
+  std::string unit;   // of the values below (the spec's unit: kN for biases)
+  bool free = false;
+  double initial = 0.0;
+  double estimate = 0.0;
+  double sigma = 0.0;        // 0 for fixed parameters
+  bool has_prior = false;
+  double prior_mean = 0.0;
+  double prior_sigma = 0.0;
+  std::string note;          // e.g. "set mostly by its prior"
+};
+
+struct CalibrationResult {
+  std::vector<ParameterEstimate> parameters;  // every parameter the spec names
+  std::vector<std::string> free_names;
+  Eigen::MatrixXd correlation;                // free parameters, spec order
+  bool covariance_ok = false;
+  std::vector<std::string> strong_correlations;  // "a ~ b: +0.97"
+  // With priors, before and after solving; and from the data alone after solving.
+  Identifiability before, after, data_only;
+  CableRobot calibrated;
+  std::vector<bool> held_out;  // per dataset sample
+  int num_fit_samples = 0;
+  int num_residuals = 0;
+  int num_free = 0;
+  double initial_cost = 0.0;
+  double final_cost = 0.0;
+  double reduced_chi_square = 0.0;
+  int iterations = 0;
+  bool converged = false;
+  std::string termination;
+  std::string ceres_brief_report;
+  std::string ceres_full_report;
+  // The forward model's |T - T_exact| / T_exact over the dataset poses at the initial
+  // parameters (the model error, to compare with the noise level).
+  double forward_model_max_rel_error = 0.0;
+  double forward_model_rms_rel_error = 0.0;
+  double seconds = 0.0;
+};
+
+enum class CalibrationStatus {
+  kOk = 0,
+  kInvalidInput,    // bad spec, dataset, or fewer residuals than free parameters
+  kUndetermined,    // the data and priors cannot determine the free set (refused)
+  kInfeasible,      // the initial model cannot hold a sample's pose
+  kSolverFailed,    // Ceres failed
+};
+
+// Runs the calibration. On a status other than kOk, *error explains it (for kUndetermined:
+// the undetermined combinations and what to fix); `result` then holds what was computed
+// (for kUndetermined, `before`).
+CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec,
+                            const Dataset& data, const CalibrationOptions& options,
+                            CalibrationResult* result, std::string* error);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_CALIBRATION_H_

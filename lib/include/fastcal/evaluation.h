@@ -1,0 +1,63 @@
+// Model against measurement: per-cable statistics of (model - measured) lower-end
+// tension, the paper's Table 6. The model's prediction of what sensor i reads is
+//   predicted_i = gain_i * T_i(model, pose) + bias_i
+// with T_i the lower-end tension (statics.h) and the sensor gain and bias of the model
+// file (identity unless calibrated).
+#ifndef FASTCAL_EVALUATION_H_
+#define FASTCAL_EVALUATION_H_
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/dataset.h"
+#include "fastcal/statics.h"
+
+namespace fastcal {
+
+enum class AttitudeSource { kMeasured, kPlanned };
+
+struct CableErrorStats {
+  int samples = 0;
+  std::array<double, kNumCables> mean_n{};         // mean of model - measured
+  std::array<double, kNumCables> rms_n{};          // RMS of model - measured
+  std::array<double, kNumCables> max_abs_n{};      // largest |model - measured|
+  std::array<double, kNumCables> rms_percent{};    // RMS of 100 (model - measured)/measured
+  std::array<double, kNumCables> max_abs_percent{};
+};
+
+// Predicted sensor readings (N) for every sample. Uses the planned attitude when asked
+// (the dataset must have it). Fails naming the file and line of a sample whose pose the
+// model cannot hold.
+bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSource attitude,
+                     StaticsMethod method, std::vector<std::array<double, kNumCables>>* predicted,
+                     std::string* error);
+
+// Statistics over the samples with held_out[n] == select_held_out (all samples when
+// held_out is empty and select_held_out is false).
+CableErrorStats ErrorStats(const Dataset& data,
+                           const std::vector<std::array<double, kNumCables>>& predicted,
+                           const std::vector<bool>& held_out, bool select_held_out);
+
+// One row group of the RMS table: a model, an attitude source, and its statistics on the
+// fitted and the held-out samples.
+struct VariantEvaluation {
+  std::string name;
+  CableErrorStats fit;
+  CableErrorStats holdout;  // samples == 0 when nothing is held out
+  std::vector<std::array<double, kNumCables>> predicted_n;
+};
+bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dataset& data,
+                     AttitudeSource attitude, StaticsMethod method,
+                     const std::vector<bool>& held_out, VariantEvaluation* evaluation,
+                     std::string* error);
+
+// Which samples are held out of a fit: round(fraction * n) of them, chosen by a seeded
+// shuffle (std::mt19937_64), the same on every run with the same seed.
+std::vector<bool> HoldoutMask(int num_samples, double fraction, std::uint64_t seed);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_EVALUATION_H_

@@ -1,0 +1,162 @@
+// The map from the calibration's free-parameter vector theta (SI, spec order) to the
+// statics parameters and the sensor model, and the residual of one sample:
+//   r_i = (gain_i * T_i(theta; pose) + bias_i - T_measured_i) / sigma_i,   i = 1..6
+// with T_i the forward model's lower-end tension (statics.h) and
+//   sigma_i^2 = sigma_abs^2 + (percent/100 * T_measured_i)^2.
+// TensionResidual is a pure functor (const members, no side effects); TensionCost wraps
+// it with a Jet whose size is chosen at run time from the number of free parameters, so
+// the whole Jacobian comes from one pass through the statics.
+#ifndef FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
+#define FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <ceres/cost_function.h>
+#include <ceres/jet.h>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/statics.h"
+
+namespace fastcal::internal {
+
+// Largest number of free parameters one cost evaluation handles (Jet size).
+inline constexpr int kMaxFreeParameters = 64;
+
+class CalibrationModel {
+ public:
+  // `spec` must be valid for `robot` (anchor indices in range).
+  CalibrationModel(const CableRobot& robot, const CalibrationSpec& spec);
+
+  int num_free() const { return static_cast<int>(free_.size()); }
+  // Index into spec.parameters of free parameter k.
+  int spec_index(int k) const { return free_[k]; }
+  const CalibrationSpec& spec() const { return spec_; }
+  const StaticsParameters<double>& base() const { return base_; }
+  // Initial values of the free parameters (SI).
+  std::vector<double> InitialTheta() const;
+  // The value parameter `p` has in the base model (after fixed overrides), SI.
+  double BaseValue(const ParameterSpec& p) const;
+  // The calibrated model: the input robot with the parameters set to theta.
+  CableRobot ToRobot(const double* theta) const;
+
+  template <typename T>
+  void Assemble(const T* theta, StaticsParameters<T>* p, std::array<T, kNumCables>* gain,
+                std::array<T, kNumCables>* bias) const {
+    for (int i = 0; i < kNumCables; ++i) {
+      p->tower_top_m[i] = base_.tower_top_m[i].cast<T>();
+      p->anchor_cabin_m[i] = base_.anchor_cabin_m[i].cast<T>();
+      p->ea_n[i] = T(base_.ea_n[i]);
+      p->linear_density_kg_per_m[i] = T(base_.linear_density_kg_per_m[i]);
+      (*gain)[i] = T(base_gain_[i]);
+      (*bias)[i] = T(base_bias_n_[i]);
+    }
+    p->cabin_mass_kg = T(base_.cabin_mass_kg);
+    p->mass_centre_cabin_m = base_.mass_centre_cabin_m.cast<T>();
+    p->gravity_m_per_s2 = base_.gravity_m_per_s2;
+    for (int k = 0; k < num_free(); ++k) {
+      const ParameterSpec& s = spec_.parameters[free_[k]];
+      const T& v = theta[k];
+      switch (s.kind) {
+        case ParameterKind::kMassCentre:
+          p->mass_centre_cabin_m[s.component] = v;
+          break;
+        case ParameterKind::kCabinMass:
+          p->cabin_mass_kg = v;
+          break;
+        case ParameterKind::kLinearDensity:
+          for (int i = 0; i < kNumCables; ++i) {
+            if (s.index < 0 || s.index == i) p->linear_density_kg_per_m[i] = v;
+          }
+          break;
+        case ParameterKind::kEa:
+          for (int i = 0; i < kNumCables; ++i) {
+            if (s.index < 0 || s.index == i) p->ea_n[i] = v;
+          }
+          break;
+        case ParameterKind::kAnchorOffset:
+          for (int i = 0; i < kNumCables; ++i) {
+            if (anchor_of_cable_[i] == s.index) p->anchor_cabin_m[i][s.component] += v;
+          }
+          break;
+        case ParameterKind::kTowerOffset:
+          p->tower_top_m[s.index][s.component] += v;
+          break;
+        case ParameterKind::kSensorGain:
+          for (int i = 0; i < kNumCables; ++i) {
+            if (s.index < 0 || s.index == i) (*gain)[i] = v;
+          }
+          break;
+        case ParameterKind::kSensorBias:
+          for (int i = 0; i < kNumCables; ++i) {
+            if (s.index < 0 || s.index == i) (*bias)[i] = v;
+          }
+          break;
+      }
+    }
+  }
+
+ private:
+  CableRobot robot_;
+  CalibrationSpec spec_;
+  std::vector<int> free_;
+  std::array<int, kNumCables> anchor_of_cable_{};
+  StaticsParameters<double> base_;  // the robot with fixed overrides applied
+  std::array<double, kNumCables> base_gain_{}, base_bias_n_{};
+};
+
+// Whitening sigma of each cable's measured tension.
+std::array<double, kNumCables> TensionSigmas(const std::array<double, kNumCables>& measured_n,
+                                             double sigma_abs_n, double sigma_percent);
+
+struct TensionResidual {
+  const CalibrationModel* model;
+  Pose pose;
+  std::array<double, kNumCables> measured_n;
+  std::array<double, kNumCables> sigma_n;
+  StaticsOptions statics;
+
+  template <typename T>
+  bool operator()(const T* theta, T* residuals) const {
+    StaticsParameters<T> p;
+    std::array<T, kNumCables> gain, bias, tension;
+    model->Assemble(theta, &p, &gain, &bias);
+    if (ModelLowerTensions(p, pose, statics, &tension) != StaticsStatus::kOk) return false;
+    for (int i = 0; i < kNumCables; ++i) {
+      residuals[i] = (gain[i] * tension[i] + bias[i] - measured_n[i]) / sigma_n[i];
+    }
+    return true;
+  }
+};
+
+// ceres::CostFunction over one parameter block (theta) of size num_free <= 64.
+class TensionCost : public ceres::CostFunction {
+ public:
+  explicit TensionCost(const TensionResidual& functor);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  template <int N>
+  bool EvaluateJet(const double* theta, double* residuals, double* jacobian) const;
+  TensionResidual functor_;
+  int n_;
+};
+
+// (theta_k - mean) / sigma on one coordinate of theta.
+class PriorCost : public ceres::CostFunction {
+ public:
+  PriorCost(int num_free, int k, double mean, double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  int n_, k_;
+  double mean_, sigma_;
+};
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_INTERNAL_CALIBRATION_MODEL_H_

@@ -1,0 +1,100 @@
+// Model-minus-measured statistics (evaluation.h).
+#include "fastcal/evaluation.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+namespace fastcal {
+
+bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSource attitude,
+                     StaticsMethod method, std::vector<std::array<double, kNumCables>>* predicted,
+                     std::string* error) {
+  if (attitude == AttitudeSource::kPlanned && !data.has_planned_attitude) {
+    *error = data.path + ": no planned attitude columns (planned_roll_deg, ...)";
+    return false;
+  }
+  StaticsOptions options;
+  options.method = method;
+  options.warm_start = true;  // consecutive telemetry samples are close
+  options.compute_unstretched_lengths = false;
+  StaticsSolution solution;
+  predicted->assign(data.samples.size(), {});
+  for (size_t n = 0; n < data.samples.size(); ++n) {
+    const Sample& s = data.samples[n];
+    Pose pose = s.pose;
+    if (attitude == AttitudeSource::kPlanned) pose.rotation = s.planned_rotation;
+    if (SolveStatics(robot, pose, options, &solution) != StaticsStatus::kOk) {
+      *error = data.path + ":" + std::to_string(s.line) + ": the model cannot solve this pose: " +
+               DescribeStatus(solution);
+      return false;
+    }
+    for (int i = 0; i < kNumCables; ++i) {
+      (*predicted)[n][i] = robot.cables[i].sensor_gain * solution.cables[i].lower_tension_n +
+                           robot.cables[i].sensor_bias_n;
+    }
+  }
+  return true;
+}
+
+CableErrorStats ErrorStats(const Dataset& data,
+                           const std::vector<std::array<double, kNumCables>>& predicted,
+                           const std::vector<bool>& held_out, bool select_held_out) {
+  CableErrorStats st;
+  std::array<double, kNumCables> sum{}, sum2{}, sum2_pct{};
+  for (size_t n = 0; n < data.samples.size(); ++n) {
+    const bool h = !held_out.empty() && held_out[n];
+    if (h != select_held_out) continue;
+    ++st.samples;
+    for (int i = 0; i < kNumCables; ++i) {
+      const double measured = data.samples[n].tension_n[i];
+      const double d = predicted[n][i] - measured;
+      const double pct = 100.0 * d / measured;
+      sum[i] += d;
+      sum2[i] += d * d;
+      sum2_pct[i] += pct * pct;
+      st.max_abs_n[i] = std::max(st.max_abs_n[i], std::abs(d));
+      st.max_abs_percent[i] = std::max(st.max_abs_percent[i], std::abs(pct));
+    }
+  }
+  if (st.samples > 0) {
+    for (int i = 0; i < kNumCables; ++i) {
+      st.mean_n[i] = sum[i] / st.samples;
+      st.rms_n[i] = std::sqrt(sum2[i] / st.samples);
+      st.rms_percent[i] = std::sqrt(sum2_pct[i] / st.samples);
+    }
+  }
+  return st;
+}
+
+bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dataset& data,
+                     AttitudeSource attitude, StaticsMethod method,
+                     const std::vector<bool>& held_out, VariantEvaluation* evaluation,
+                     std::string* error) {
+  evaluation->name = name;
+  if (!PredictTensions(robot, data, attitude, method, &evaluation->predicted_n, error)) {
+    return false;
+  }
+  evaluation->fit = ErrorStats(data, evaluation->predicted_n, held_out, false);
+  evaluation->holdout = ErrorStats(data, evaluation->predicted_n, held_out, true);
+  return true;
+}
+
+std::vector<bool> HoldoutMask(int num_samples, double fraction, std::uint64_t seed) {
+  std::vector<bool> mask(std::max(num_samples, 0), false);
+  const int held = static_cast<int>(std::lround(fraction * num_samples));
+  if (held <= 0) return mask;
+  std::vector<int> order(num_samples);
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(seed);
+  // Fisher-Yates with the raw generator (std::shuffle's use of it is unspecified).
+  for (int i = num_samples - 1; i > 0; --i) {
+    const int j = static_cast<int>(rng() % static_cast<std::uint64_t>(i + 1));
+    std::swap(order[i], order[j]);
+  }
+  for (int k = 0; k < held; ++k) mask[order[k]] = true;
+  return mask;
+}
+
+}  // namespace fastcal
