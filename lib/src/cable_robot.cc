@@ -69,6 +69,10 @@ bool CableRobot::IsValid(std::string* error) const {
     if (!(c.linear_density_kg_per_m > 0.0) || !std::isfinite(c.linear_density_kg_per_m)) {
       return fail(key + ".linear_density_kg_per_m", "must be > 0");
     }
+    if (!(c.sensor_gain > 0.0) || !std::isfinite(c.sensor_gain)) {
+      return fail(key + ".sensor_gain", "must be > 0");
+    }
+    if (!std::isfinite(c.sensor_bias_n)) return fail(key + ".sensor_bias_kN", "must be finite");
   }
   if (!(cabin_mass_kg > 0.0) || !std::isfinite(cabin_mass_kg)) {
     return fail("cabin_mass_kg", "must be > 0");

@@ -1,0 +1,448 @@
+// YAML reading and writing of the cable robot model (format: docs/model-format.md).
+//
+// The model file is edited by hand and produced by calibration, so the reader is strict:
+// every error names the file, the line (from yaml-cpp's Mark) and the key path, and
+// unknown keys are errors so a misspelt key cannot silently fall back to the nominal
+// value. Numbers are parsed and written with <charconv> (locale-independent); the writer
+// emits the shortest decimal form that reads back to the same double (at most 17
+// significant digits), so a save/load round trip is bit-exact.
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <yaml-cpp/yaml.h>
+
+#include "fastcal/cable_robot.h"
+
+namespace fastcal {
+namespace {
+
+constexpr char kFormatName[] = "fastcal-model-1";
+constexpr char kRootPath[] = "(top level)";
+
+// Key path for error messages: "cabin" + "mass_kg" -> "cabin.mass_kg".
+std::string Join(const std::string& parent, const std::string& key) {
+  return parent.empty() ? key : parent + "." + key;
+}
+std::string Index(const std::string& parent, size_t i) {
+  return parent + "[" + std::to_string(i) + "]";
+}
+
+// 1-based line of a node, or 0 when yaml-cpp does not know it.
+int LineOf(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  return mark.line < 0 ? 0 : mark.line + 1;
+}
+
+// One key of a YAML mapping with its value.
+struct Entry {
+  YAML::Node key;
+  YAML::Node value;
+};
+
+class Parser {
+ public:
+  explicit Parser(const std::string& source) : source_(source) {}
+
+  const std::string& error() const { return error_; }
+
+  // Records the error "<source>:<line>: <path>: <what>" (":<line>" omitted when 0).
+  bool Fail(int line, const std::string& path, const std::string& what) {
+    error_ = source_;
+    if (line > 0) error_ += ":" + std::to_string(line);
+    error_ += ": " + path + ": " + what;
+    return false;
+  }
+  bool Fail(const YAML::Node& node, const std::string& path, const std::string& what) {
+    return Fail(LineOf(node), path, what);
+  }
+
+  // Line of the key path, or of its nearest ancestor present in the file; 0 if none.
+  int LineOfPath(std::string path) const {
+    while (!path.empty()) {
+      const auto it = lines_.find(path);
+      if (it != lines_.end()) return it->second;
+      const size_t cut = path.find_last_of(".[");
+      if (cut == std::string::npos) break;
+      path.resize(cut);
+    }
+    return 0;
+  }
+
+  // Reads a mapping into *entries, rejecting keys not in `allowed` and duplicates.
+  bool ReadMap(const YAML::Node& node, int line, const std::string& path,
+               const std::vector<std::string>& allowed, std::map<std::string, Entry>* entries) {
+    if (!node.IsMap()) return Fail(line, path, "expected a mapping of keys");
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar()) return Fail(kv.first, path, "keys must be plain names");
+      const std::string name = kv.first.Scalar();
+      const std::string key_path = Join(path == kRootPath ? "" : path, name);
+      bool known = false;
+      for (const std::string& a : allowed) known = known || a == name;
+      if (!known) {
+        std::string list;
+        for (const std::string& a : allowed) list += (list.empty() ? "" : ", ") + a;
+        return Fail(kv.first, key_path, "unknown key (allowed here: " + list + ")");
+      }
+      if (entries->count(name) != 0) return Fail(kv.first, key_path, "duplicate key");
+      (*entries)[name] = Entry{kv.first, kv.second};
+      lines_[key_path] = LineOf(kv.first);
+    }
+    return true;
+  }
+
+  bool ReadDouble(const YAML::Node& node, int line, const std::string& path, double* value) {
+    if (node.IsNull()) return Fail(line, path, "has no value (expected a number)");
+    if (!node.IsScalar()) return Fail(line, path, "expected a number");
+    if (node.Tag() == "!") {
+      return Fail(line, path, "expected a number, got the quoted text \"" + node.Scalar() + "\"");
+    }
+    const std::string& text = node.Scalar();
+    const std::string lower = ToLower(text);
+    if (lower == ".nan" || lower == ".inf" || lower == "+.inf" || lower == "-.inf") {
+      return Fail(line, path, "must be finite, got " + text);
+    }
+    // from_chars takes no leading '+'; YAML numbers may have one.
+    const char* begin = text.data();
+    const char* end = text.data() + text.size();
+    if (begin != end && *begin == '+') ++begin;
+    double parsed = 0.0;
+    const auto [ptr, ec] = std::from_chars(begin, end, parsed);
+    if (ec == std::errc::result_out_of_range) return Fail(line, path, "out of range: " + text);
+    if (ec != std::errc() || ptr != end || begin == end) {
+      return Fail(line, path, "expected a number, got \"" + text + "\"");
+    }
+    if (!std::isfinite(parsed)) return Fail(line, path, "must be finite, got " + text);
+    *value = parsed;
+    return true;
+  }
+
+  bool ReadInt(const YAML::Node& node, int line, const std::string& path, int* value) {
+    if (node.IsNull()) return Fail(line, path, "has no value (expected an integer)");
+    if (!node.IsScalar() || node.Tag() == "!") return Fail(line, path, "expected an integer");
+    const std::string& text = node.Scalar();
+    int parsed = 0;
+    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), parsed);
+    if (ec != std::errc() || ptr != text.data() + text.size() || text.empty()) {
+      return Fail(line, path, "expected an integer, got \"" + text + "\"");
+    }
+    *value = parsed;
+    return true;
+  }
+
+  // A flow or block list of exactly three numbers.
+  bool ReadVector3(const YAML::Node& node, int line, const std::string& path,
+                   Eigen::Vector3d* value) {
+    if (!node.IsSequence() || node.size() != 3) {
+      const std::string got =
+          node.IsSequence() ? std::to_string(node.size()) + " entries" : "no list";
+      return Fail(line, path, "expected a list of 3 numbers [x, y, z], got " + got);
+    }
+    Eigen::Vector3d v;
+    for (size_t k = 0; k < 3; ++k) {
+      const int element_line = LineOf(node[k]) > 0 ? LineOf(node[k]) : line;
+      if (!ReadDouble(node[k], element_line, Index(path, k), &v[k])) return false;
+    }
+    *value = v;
+    return true;
+  }
+
+  bool ReadCabin(const Entry& cabin, CableRobot* robot) {
+    const std::string path = "cabin";
+    std::map<std::string, Entry> keys;
+    if (!ReadMap(cabin.value, LineOf(cabin.key), path,
+                 {"mass_kg", "mass_centre_m", "anchor_points_m"}, &keys)) {
+      return false;
+    }
+    if (const auto it = keys.find("mass_kg"); it != keys.end()) {
+      if (!ReadDouble(it->second.value, LineOf(it->second.key), Join(path, "mass_kg"),
+                      &robot->cabin_mass_kg)) {
+        return false;
+      }
+    }
+    if (const auto it = keys.find("mass_centre_m"); it != keys.end()) {
+      if (!ReadVector3(it->second.value, LineOf(it->second.key), Join(path, "mass_centre_m"),
+                       &robot->mass_centre_cabin_m)) {
+        return false;
+      }
+    }
+    if (const auto it = keys.find("anchor_points_m"); it != keys.end()) {
+      const std::string list_path = Join(path, "anchor_points_m");
+      const YAML::Node& list = it->second.value;
+      const int line = LineOf(it->second.key);
+      if (!list.IsSequence() || list.size() == 0) {
+        return Fail(line, list_path, "expected a list of at least one point [x, y, z]");
+      }
+      std::vector<Eigen::Vector3d> points(list.size());
+      for (size_t j = 0; j < list.size(); ++j) {
+        const std::string point_path = Index(list_path, j);
+        const int point_line = LineOf(list[j]) > 0 ? LineOf(list[j]) : line;
+        lines_[point_path] = point_line;
+        if (!ReadVector3(list[j], point_line, point_path, &points[j])) return false;
+      }
+      robot->anchor_points_cabin_m = std::move(points);
+    }
+    return true;
+  }
+
+  bool ReadCables(const Entry& cables, CableRobot* robot) {
+    const std::string path = "cables";
+    const YAML::Node& list = cables.value;
+    const int line = LineOf(cables.key);
+    if (!list.IsSequence()) return Fail(line, path, "expected a list of 6 cables");
+    if (list.size() != kNumCables) {
+      return Fail(line, path,
+                  "expected exactly 6 entries (cable 1 first), got " + std::to_string(list.size()));
+    }
+    for (size_t i = 0; i < kNumCables; ++i) {
+      const std::string cable_path = Index(path, i);
+      const int cable_line = LineOf(list[i]) > 0 ? LineOf(list[i]) : line;
+      lines_[cable_path] = cable_line;
+      const std::vector<std::string> required = {"tower_top_m", "anchor", "ea_n",
+                                                 "linear_density_kg_per_m"};
+      std::vector<std::string> allowed = required;
+      allowed.push_back("sensor_gain");     // optional, default 1
+      allowed.push_back("sensor_bias_kN");  // optional, default 0
+      std::map<std::string, Entry> keys;
+      if (!ReadMap(list[i], cable_line, cable_path, allowed, &keys)) return false;
+      for (const std::string& name : required) {
+        if (keys.count(name) == 0) {
+          return Fail(cable_line, Join(cable_path, name),
+                      "missing (each cable must give tower_top_m, anchor, ea_n and "
+                      "linear_density_kg_per_m)");
+        }
+      }
+      CableProperties& c = robot->cables[i];
+      const Entry& tower = keys["tower_top_m"];
+      const Entry& anchor = keys["anchor"];
+      const Entry& ea = keys["ea_n"];
+      const Entry& density = keys["linear_density_kg_per_m"];
+      if (!ReadVector3(tower.value, LineOf(tower.key), Join(cable_path, "tower_top_m"),
+                       &c.tower_top_m) ||
+          !ReadInt(anchor.value, LineOf(anchor.key), Join(cable_path, "anchor"), &c.anchor_index) ||
+          !ReadDouble(ea.value, LineOf(ea.key), Join(cable_path, "ea_n"), &c.ea_n) ||
+          !ReadDouble(density.value, LineOf(density.key),
+                      Join(cable_path, "linear_density_kg_per_m"), &c.linear_density_kg_per_m)) {
+        return false;
+      }
+      c.sensor_gain = 1.0;
+      c.sensor_bias_n = 0.0;
+      if (keys.count("sensor_gain") &&
+          !ReadDouble(keys["sensor_gain"].value, LineOf(keys["sensor_gain"].key),
+                      Join(cable_path, "sensor_gain"), &c.sensor_gain)) {
+        return false;
+      }
+      if (keys.count("sensor_bias_kN")) {
+        double bias_kn = 0.0;
+        if (!ReadDouble(keys["sensor_bias_kN"].value, LineOf(keys["sensor_bias_kN"].key),
+                        Join(cable_path, "sensor_bias_kN"), &bias_kn)) {
+          return false;
+        }
+        c.sensor_bias_n = bias_kn * 1e3;
+      }
+    }
+    return true;
+  }
+
+  bool ReadRoot(const YAML::Node& root, CableRobot* robot) {
+    std::map<std::string, Entry> keys;
+    if (!ReadMap(root, LineOf(root), kRootPath, {"format", "gravity_m_per_s2", "cabin", "cables"},
+                 &keys)) {
+      return false;
+    }
+    if (const auto it = keys.find("format"); it != keys.end()) {
+      const YAML::Node& v = it->second.value;
+      if (!v.IsScalar() || v.Scalar() != kFormatName) {
+        return Fail(
+            it->second.key, "format",
+            std::string("must be ") + kFormatName + (v.IsScalar() ? ", got " + v.Scalar() : ""));
+      }
+    }
+    if (const auto it = keys.find("gravity_m_per_s2"); it != keys.end()) {
+      if (!ReadDouble(it->second.value, LineOf(it->second.key), "gravity_m_per_s2",
+                      &robot->gravity_m_per_s2)) {
+        return false;
+      }
+    }
+    if (const auto it = keys.find("cabin"); it != keys.end()) {
+      if (!ReadCabin(it->second, robot)) return false;
+    }
+    if (const auto it = keys.find("cables"); it != keys.end()) {
+      if (!ReadCables(it->second, robot)) return false;
+    }
+    return true;
+  }
+
+  // Turns IsValid's message (struct field names) into YAML key paths with a line.
+  bool FailValidation(std::string message) {
+    const std::pair<const char*, const char*> kRenames[] = {
+        {"anchor_points_cabin_m", "cabin.anchor_points_m"},
+        {"mass_centre_cabin_m", "cabin.mass_centre_m"},
+        {"cabin_mass_kg", "cabin.mass_kg"},
+    };
+    for (const auto& [from, to] : kRenames) {
+      for (size_t pos = message.find(from); pos != std::string::npos;
+           pos = message.find(from, pos + std::strlen(to))) {
+        message.replace(pos, std::strlen(from), to);
+      }
+    }
+    const size_t colon = message.find(": ");
+    const std::string path = message.substr(0, colon);
+    const std::string what = colon == std::string::npos ? "invalid" : message.substr(colon + 2);
+    return Fail(LineOfPath(path), path, what);
+  }
+
+ private:
+  static std::string ToLower(std::string s) {
+    for (char& ch : s) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    return s;
+  }
+
+  std::string source_;
+  std::string error_;
+  // Line of each key path read from the file, for validation errors.
+  std::map<std::string, int> lines_;
+};
+
+// Shortest decimal text that reads back to exactly `value` (at most 17 digits).
+std::string Num(double value) {
+  if (std::isnan(value)) return ".nan";
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+std::string Vec(const Eigen::Vector3d& v) {
+  return "[" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + "]";
+}
+
+}  // namespace
+
+bool ParseCableRobotYaml(const std::string& text, const std::string& source_name, CableRobot* robot,
+                         std::string* error) {
+  Parser parser(source_name);
+  CableRobot parsed = CableRobot::NominalFast();
+  try {
+    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    if (documents.size() > 1) {
+      parser.Fail(documents[1], kRootPath, "only one YAML document is allowed");
+    } else if (documents.empty() || documents[0].IsNull() ||  // empty file: all nominal
+               parser.ReadRoot(documents[0], &parsed)) {
+      std::string why;
+      if (!parsed.IsValid(&why)) parser.FailValidation(why);
+    }
+  } catch (const YAML::Exception& e) {
+    const int line = e.mark.line < 0 ? 0 : e.mark.line + 1;
+    parser.Fail(line, "YAML syntax error", e.msg);
+  }
+  if (!parser.error().empty()) {
+    if (error != nullptr) *error = parser.error();
+    return false;
+  }
+  *robot = std::move(parsed);
+  return true;
+}
+
+bool LoadCableRobot(const std::string& path, CableRobot* robot, std::string* error) {
+  std::error_code ec;
+  std::ifstream in(path, std::ios::binary);
+  if (!in || std::filesystem::is_directory(path, ec)) {
+    if (error != nullptr) *error = path + ": cannot open";
+    return false;
+  }
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) {
+    if (error != nullptr) *error = path + ": cannot read";
+    return false;
+  }
+  return ParseCableRobotYaml(text.str(), path, robot, error);
+}
+
+std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_comment) {
+  std::ostringstream out;
+  if (!header_comment.empty()) {
+    std::istringstream lines(header_comment);
+    for (std::string line; std::getline(lines, line);) {
+      out << (line.empty() ? "#" : "# " + line) << "\n";
+    }
+  }
+  out << "format: " << kFormatName << "\n";
+  out << "gravity_m_per_s2: " << Num(robot.gravity_m_per_s2) << "  # m/s^2, z up\n";
+  out << "cabin:\n";
+  out << "  mass_kg: " << Num(robot.cabin_mass_kg) << "\n";
+  out << "  mass_centre_m: " << Vec(robot.mass_centre_cabin_m) << "  # cabin frame\n";
+  out << "  anchor_points_m:  # cabin frame, m\n";
+  for (const Eigen::Vector3d& a : robot.anchor_points_cabin_m) out << "    - " << Vec(a) << "\n";
+  out << "cables:  # cable 1 first; tower tops in the global frame, m\n";
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableProperties& c = robot.cables[i];
+    out << "  - tower_top_m: " << Vec(c.tower_top_m) << "  # cable " << i + 1 << "\n";
+    out << "    anchor: " << c.anchor_index << "  # index into cabin.anchor_points_m\n";
+    out << "    ea_n: " << Num(c.ea_n) << "  # N\n";
+    out << "    linear_density_kg_per_m: " << Num(c.linear_density_kg_per_m) << "\n";
+    if (c.sensor_gain != 1.0 || c.sensor_bias_n != 0.0) {
+      out << "    sensor_gain: " << Num(c.sensor_gain) << "  # reading = gain * tension + bias\n";
+      out << "    sensor_bias_kN: " << Num(c.sensor_bias_n / 1e3) << "\n";
+    }
+  }
+  return out.str();
+}
+
+bool SaveCableRobot(const CableRobot& robot, const std::string& path,
+                    const std::string& header_comment, std::string* error) {
+  const std::string text = CableRobotToYaml(robot, header_comment);
+  const std::string temp = path + ".tmp." + std::to_string(::getpid());
+  auto fail = [&](const std::string& what, int errnum) {
+    if (error != nullptr) *error = path + ": " + what + ": " + std::strerror(errnum);
+    return false;
+  };
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) return fail("cannot write", errno);
+  size_t written = 0;
+  while (written < text.size()) {
+    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int errnum = n < 0 ? errno : EIO;
+      ::close(fd);
+      ::unlink(temp.c_str());
+      return fail("cannot write", errnum);
+    }
+    written += static_cast<size_t>(n);
+  }
+  // fsync so that the rename can never expose a file whose data is not on disk.
+  if (::fsync(fd) != 0) {
+    const int errnum = errno;
+    ::close(fd);
+    ::unlink(temp.c_str());
+    return fail("cannot write", errnum);
+  }
+  if (::close(fd) != 0) {
+    const int errnum = errno;
+    ::unlink(temp.c_str());
+    return fail("cannot write", errnum);
+  }
+  if (std::rename(temp.c_str(), path.c_str()) != 0) {
+    const int errnum = errno;
+    ::unlink(temp.c_str());
+    return fail("cannot replace", errnum);
+  }
+  return true;
+}
+
+}  // namespace fastcal

@@ -1,6 +1,7 @@
 // Attitude conversions and the focal attitude law (equations: pose.h).
 #include "fastcal/pose.h"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -11,6 +12,8 @@ namespace {
 constexpr double kDegToRad = M_PI / 180.0;
 // Below this |z x u| the position is on the focal axis and the law gives identity.
 constexpr double kOnAxisSine = 1e-12;
+// Below this cos(pitch) roll and yaw are indistinguishable (rounding level of R's entries).
+constexpr double kGimbalLockCos = 1e-12;
 }  // namespace
 
 bool IsFinite(const Pose& pose) {
@@ -25,16 +28,16 @@ Eigen::Matrix3d RotationFromRpyDeg(double roll_deg, double pitch_deg, double yaw
 }
 
 Eigen::Vector3d RpyDegFromRotation(const Eigen::Matrix3d& r) {
-  // R = Rz(y) Ry(p) Rx(r): R(2,0) = -sin p, R(2,1) = cos p sin r, R(1,0) = sin y cos p.
-  const double pitch = std::asin(std::clamp(-r(2, 0), -1.0, 1.0));
-  double roll, yaw;
-  if (std::abs(r(2, 0)) < 1.0 - 1e-12) {
-    roll = std::atan2(r(2, 1), r(2, 2));
-    yaw = std::atan2(r(1, 0), r(0, 0));
-  } else {  // gimbal lock: put all of the rotation about z into yaw
-    roll = 0.0;
-    yaw = std::atan2(-r(0, 1), r(1, 1));
-  }
+  // R = Rz(y) Ry(p) Rx(r): row 2 is (-sin p, cos p sin r, cos p cos r). Pitch from atan2, not
+  // asin(-R(2,0)), which loses half the digits near +-90 deg. Yaw from M = R Rx(roll)^T =
+  // Rz(y) Ry(p), whose M(0,1) = -sin y and M(1,1) = cos y are not scaled by cos p, so R is
+  // reproduced to rounding even at (and near) gimbal lock.
+  const double cos_pitch = std::hypot(r(2, 1), r(2, 2));
+  const double pitch = std::atan2(-r(2, 0), cos_pitch);
+  // Gimbal lock: put all of the rotation about z into yaw.
+  const double roll = cos_pitch < kGimbalLockCos ? 0.0 : std::atan2(r(2, 1), r(2, 2));
+  const double s = std::sin(roll), c = std::cos(roll);
+  const double yaw = std::atan2(s * r(0, 2) - c * r(0, 1), c * r(1, 1) - s * r(1, 2));
   return Eigen::Vector3d(roll, pitch, yaw) / kDegToRad;
 }
 
