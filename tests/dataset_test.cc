@@ -1,2 +1,584 @@
+// Tests of the measurement dataset CSV reader and writer and of the FNV-1a file digest
+// (fastcal/dataset.h, docs/data-format.md).
+#include "fastcal/dataset.h"
+
+#include <stdlib.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
-TEST(Placeholder, Builds) { SUCCEED(); }
+
+namespace fastcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Success when `text` contains `part`; the failure shows both.
+::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << text << "' does not contain '" << part << "'";
+}
+
+// Attitudes converted through a quaternion or angles agree to rounding only.
+constexpr double kRotationTolerance = 1e-12;
+// Thirteen columns: the required ones, attitude as angles.
+constexpr char kHeader[] =
+    "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n";
+constexpr char kRow[] = "0.5,1,2,140,0.1,0.2,0.3,150,151,152,153,154,155\n";
+
+class DatasetTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = ::testing::TempDir() + "dataset_test_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+  std::string PathOf(const std::string& name) const { return (dir_ / name).string(); }
+  std::vector<std::string> DirEntries() const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir_)) {
+      names.push_back(entry.path().filename().string());
+    }
+    return names;
+  }
+  void WriteText(const std::string& name, const std::string& text) const {
+    std::ofstream(PathOf(name), std::ios::binary) << text;
+  }
+
+  fs::path dir_;
+};
+
+// Parses `text` as "data.csv"; the error message of a failure, or "" on success.
+std::string ParseError(const std::string& text, bool skip = false) {
+  Dataset dataset;
+  std::string error;
+  DatasetReadOptions options;
+  options.skip_invalid_rows = skip;
+  if (ParseDataset(text, "data.csv", options, &dataset, &error)) return "";
+  return error;
+}
+
+Dataset ParseOk(const std::string& text, bool skip = false) {
+  Dataset dataset;
+  std::string error;
+  DatasetReadOptions options;
+  options.skip_invalid_rows = skip;
+  EXPECT_TRUE(ParseDataset(text, "data.csv", options, &dataset, &error)) << error;
+  return dataset;
+}
+
+void ExpectMatrixEq(const Eigen::Matrix3d& expected, const Eigen::Matrix3d& actual) {
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(expected(r, c), actual(r, c)) << r << "," << c;
+  }
+}
+
+void ExpectSamplesEqual(const Sample& expected, const Sample& actual, bool quaternion, bool planned,
+                        bool unstretched) {
+  EXPECT_EQ(expected.time_s, actual.time_s);
+  for (int k = 0; k < 3; ++k) EXPECT_EQ(expected.pose.position_m[k], actual.pose.position_m[k]);
+  ExpectMatrixEq(expected.pose.rotation, actual.pose.rotation);
+  if (quaternion) {
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_EQ(expected.measured_quaternion_wxyz[k], actual.measured_quaternion_wxyz[k]);
+    }
+  } else {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(expected.measured_rpy_deg[k], actual.measured_rpy_deg[k]);
+  }
+  EXPECT_EQ(actual.has_planned_attitude, planned);
+  if (planned) {
+    ExpectMatrixEq(expected.planned_rotation, actual.planned_rotation);
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(expected.planned_rpy_deg[k], actual.planned_rpy_deg[k]);
+  }
+  for (int i = 0; i < kNumCables; ++i) EXPECT_EQ(expected.tension_n[i], actual.tension_n[i]);
+  EXPECT_EQ(actual.has_unstretched_lengths, unstretched);
+  if (unstretched) {
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_EQ(expected.unstretched_length_m[i], actual.unstretched_length_m[i]);
+    }
+  }
+}
+
+// A random dataset with full-precision values, as a telemetry export would never give
+// them: the hardest case for an exact round trip.
+Dataset RandomDataset(unsigned seed, bool quaternion, bool optional_columns, int rows) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> position(-100.0, 100.0);
+  std::uniform_real_distribution<double> height(100.0, 170.0);
+  std::uniform_real_distribution<double> angle(-15.0, 15.0);
+  std::uniform_real_distribution<double> tension(20e3, 400e3);
+  std::uniform_real_distribution<double> length(200.0, 420.0);
+  std::normal_distribution<double> normal;
+  Dataset dataset;
+  dataset.attitude_as_quaternion = quaternion;
+  dataset.has_planned_attitude = optional_columns;
+  dataset.has_unstretched_lengths = optional_columns;
+  for (int n = 0; n < rows; ++n) {
+    Sample s;
+    s.time_s = 0.1 * n + 1e-3 * normal(rng);
+    s.pose.position_m = Eigen::Vector3d(position(rng), position(rng), height(rng));
+    if (quaternion) {
+      Eigen::Vector4d q(normal(rng), normal(rng), normal(rng), normal(rng));
+      q.normalize();
+      s.measured_quaternion_wxyz = q;
+      std::string error;
+      EXPECT_TRUE(RotationFromQuaternion(q[0], q[1], q[2], q[3], &s.pose.rotation, &error));
+    } else {
+      s.measured_rpy_deg = Eigen::Vector3d(angle(rng), angle(rng), 12.0 * angle(rng));
+      s.pose.rotation =
+          RotationFromRpyDeg(s.measured_rpy_deg[0], s.measured_rpy_deg[1], s.measured_rpy_deg[2]);
+    }
+    if (optional_columns) {
+      s.has_planned_attitude = true;
+      s.planned_rpy_deg = Eigen::Vector3d(angle(rng), angle(rng), angle(rng));
+      s.planned_rotation =
+          RotationFromRpyDeg(s.planned_rpy_deg[0], s.planned_rpy_deg[1], s.planned_rpy_deg[2]);
+      s.has_unstretched_lengths = true;
+      for (double& l : s.unstretched_length_m) l = length(rng);
+    }
+    for (double& t : s.tension_n) t = tension(rng);
+    dataset.samples.push_back(s);
+  }
+  return dataset;
+}
+
+TEST_F(DatasetTest, ReadsRowsAndConvertsKilonewtonsToNewtons) {
+  const Dataset d = ParseOk(std::string(kHeader) + kRow);
+  ASSERT_EQ(d.samples.size(), 1u);
+  const Sample& s = d.samples[0];
+  EXPECT_EQ(d.path, "data.csv");
+  EXPECT_FALSE(d.attitude_as_quaternion);
+  EXPECT_FALSE(d.has_planned_attitude);
+  EXPECT_FALSE(d.has_unstretched_lengths);
+  EXPECT_TRUE(d.skipped.empty());
+  EXPECT_EQ(s.line, 2);
+  EXPECT_EQ(s.time_s, 0.5);
+  EXPECT_EQ(s.pose.position_m, Eigen::Vector3d(1, 2, 140));
+  ExpectMatrixEq(RotationFromRpyDeg(0.1, 0.2, 0.3), s.pose.rotation);
+  for (int i = 0; i < kNumCables; ++i) EXPECT_EQ(s.tension_n[i], (150.0 + i) * 1000.0) << i;
+  EXPECT_FALSE(s.has_planned_attitude);
+  EXPECT_FALSE(s.has_unstretched_lengths);
+}
+
+TEST_F(DatasetTest, KilonewtonConversionIsTheCorrectlyRoundedDecimal) {
+  // 159.17 kN is 159170 N exactly; 0.1 kN is 100 N exactly, although 0.1 * 1000 in
+  // binary is not guaranteed to be; exponent forms are shifted too.
+  const Dataset d =
+      ParseOk(std::string(kHeader) + "0,0,0,140,0,0,0,159.17,0.1,1.5e2,2E-1,+7,0.000123456789\n");
+  ASSERT_EQ(d.samples.size(), 1u);
+  const auto& t = d.samples[0].tension_n;
+  EXPECT_EQ(t[0], 159170.0);
+  EXPECT_EQ(t[1], 100.0);
+  EXPECT_EQ(t[2], 150000.0);
+  EXPECT_EQ(t[3], 200.0);
+  EXPECT_EQ(t[4], 7000.0);
+  EXPECT_EQ(t[5], 0.123456789);
+}
+
+TEST_F(DatasetTest, ReadsQuaternionAttitude) {
+  const double half = 15.0 * M_PI / 180.0;  // 30 deg about z
+  std::ostringstream text;
+  text.precision(17);
+  text << "time_s,x_m,y_m,z_m,qw,qx,qy,qz,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
+       << "0,1,2,3," << std::cos(half) << ",0,0," << std::sin(half) << ",1,2,3,4,5,6\n";
+  const Dataset d = ParseOk(text.str());
+  ASSERT_EQ(d.samples.size(), 1u);
+  EXPECT_TRUE(d.attitude_as_quaternion);
+  const Eigen::Matrix3d expected =
+      Eigen::AngleAxisd(2.0 * half, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  EXPECT_LT((d.samples[0].pose.rotation - expected).cwiseAbs().maxCoeff(), kRotationTolerance);
+  EXPECT_EQ(d.samples[0].measured_quaternion_wxyz[3], std::sin(half));
+}
+
+TEST_F(DatasetTest, ColumnsInAnyOrder) {
+  const std::string text =
+      "s0_6_m,T6_kN,qz,planned_yaw_deg,z_m,s0_5_m,T5_kN,qy,planned_pitch_deg,y_m,s0_4_m,"
+      "T4_kN,qx,planned_roll_deg,x_m,s0_3_m,T3_kN,qw,time_s,s0_2_m,T2_kN,s0_1_m,T1_kN\n"
+      "306,16,0,3,140,305,15,0,2,-20,304,14,0,1,10,303,13,1,7.25,302,12,301,11\n";
+  const Dataset d = ParseOk(text);
+  ASSERT_EQ(d.samples.size(), 1u);
+  EXPECT_TRUE(d.attitude_as_quaternion);
+  EXPECT_TRUE(d.has_planned_attitude);
+  EXPECT_TRUE(d.has_unstretched_lengths);
+  const Sample& s = d.samples[0];
+  EXPECT_EQ(s.time_s, 7.25);
+  EXPECT_EQ(s.pose.position_m, Eigen::Vector3d(10, -20, 140));
+  ExpectMatrixEq(Eigen::Matrix3d::Identity(), s.pose.rotation);
+  ASSERT_TRUE(s.has_planned_attitude);
+  ExpectMatrixEq(RotationFromRpyDeg(1, 2, 3), s.planned_rotation);
+  EXPECT_EQ(s.planned_rpy_deg, Eigen::Vector3d(1, 2, 3));
+  ASSERT_TRUE(s.has_unstretched_lengths);
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_EQ(s.tension_n[i], (11.0 + i) * 1000.0) << i;
+    EXPECT_EQ(s.unstretched_length_m[i], 301.0 + i) << i;
+  }
+}
+
+TEST_F(DatasetTest, SkipsCommentsBlankLinesAndCarriageReturns) {
+  const std::string text = std::string("\xEF\xBB\xBF# exported 2024-05-01\r\n") +  // BOM
+                           "\n"
+                           "   # indented comment\n" +
+                           " time_s , x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,"
+                           "T4_kN,T5_kN,T6_kN\r\n" +
+                           "\t\n" + kRow + "# between rows\n" +
+                           "1.5, 1 ,2,140,0.1,0.2,0.3,150,151,152,153,154,155\r\n" + "\n";
+  const Dataset d = ParseOk(text);
+  ASSERT_EQ(d.samples.size(), 2u);
+  EXPECT_EQ(d.samples[0].line, 6);
+  EXPECT_EQ(d.samples[1].line, 8);
+  EXPECT_EQ(d.samples[1].time_s, 1.5);
+  EXPECT_EQ(d.samples[1].tension_n[5], 155000.0);
+}
+
+struct ErrorCase {
+  const char* name;
+  std::string text;
+  std::vector<std::string> expected;  // substrings of the message
+};
+
+TEST_F(DatasetTest, ErrorsNameFileLineAndColumn) {
+  const std::string comments = "# telemetry\n#\n\n";  // the header is on line 4
+  const std::string header = comments + kHeader;
+  const std::string rows = header + kRow + kRow;  // data on lines 5 and 6
+  const std::string q_header =
+      "time_s,x_m,y_m,z_m,qw,qx,qy,qz,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n";
+  const std::vector<ErrorCase> cases = {
+      {"not a number",
+       rows + "0,1,2,140,0,0,0,150,151,abc,153,154,155\n",
+       {"data.csv:7: column 'T3_kN': 'abc' is not a number"}},
+      {"trailing junk",
+       rows + "0,1,2,140,0,0,0,150,151,152,153,154,155kN\n",
+       {"data.csv:7: column 'T6_kN': '155kN' is not a number"}},
+      {"infinite",
+       rows + "0,1,2,140,0,0,0,150,151,inf,153,154,155\n",
+       {"data.csv:7: column 'T3_kN': value is not finite"}},
+      {"nan",
+       header + "0,nan,2,140,0,0,0,150,151,152,153,154,155\n",
+       {"data.csv:5: column 'x_m': value is not finite"}},
+      {"empty field",
+       header + "0,1,2,140,0,,0,150,151,152,153,154,155\n",
+       {"data.csv:5: column 'pitch_deg': missing value"}},
+      {"too few fields",
+       rows + "0,1,2,140,0,0,0,150,151,152,153,154\n",
+       {"data.csv:7: expected 13 fields, found 12"}},
+      {"too many fields",
+       header + "0,1,2,140,0,0,0,150,151,152,153,154,155,\n",
+       {"data.csv:5: expected 13 fields, found 14"}},
+      {"zero tension",
+       header + "0,1,2,140,0,0,0,150,151,152,0,154,155\n",
+       {"data.csv:5: column 'T4_kN': tension must be > 0: a slack or failed sensor"}},
+      {"negative tension",
+       header + "0,1,2,140,0,0,0,150,151,152,153,-154,155\n",
+       {"data.csv:5: column 'T5_kN': tension must be > 0"}},
+      {"non-unit quaternion",
+       q_header + "0,1,2,140,1,0.1,0,0,1,2,3,4,5,6\n",
+       {"data.csv:2: ", "qw,qx,qy,qz", "must be unit"}},
+      {"missing column",
+       "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,"
+       "T5_kN,T6_kN\n" +
+           std::string(kRow),
+       {"data.csv:1: missing column 'T4_kN'"}},
+      {"missing column after comments",
+       comments + "time_s,y_m,z_m\n",
+       {"data.csv:4: missing column 'x_m'"}},
+      {"unknown column",
+       "T7_kN," + std::string(kHeader) + "1," + kRow,
+       {"data.csv:1: unknown column 'T7_kN' (accepted: time_s, x_m,", "T6_kN", "s0_6_m"}},
+      {"unknown column typo",
+       comments + "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw,T1_kN\n",
+       {"data.csv:4: unknown column 'yaw' (accepted:"}},
+      {"duplicate column",
+       "time_s,x_m," + std::string(kHeader),
+       {"data.csv:1: duplicate column 'time_s' (fields 1 and 3)"}},
+      {"empty column name", "time_s,,x_m\n", {"data.csv:1: empty column name in field 2"}},
+      {"no attitude",
+       "time_s,x_m,y_m,z_m,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n",
+       {"data.csv:1: missing measured attitude"}},
+      {"two attitudes",
+       "qw,qx,qy,qz," + std::string(kHeader),
+       {"data.csv:1: measured attitude given twice"}},
+      {"partial angles",
+       "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,T1_kN\n",
+       {"data.csv:1: missing column 'yaw_deg'"}},
+      {"partial quaternion",
+       "time_s,x_m,y_m,z_m,qw,qx,qz,T1_kN\n",
+       {"data.csv:1: missing column 'qy'"}},
+      {"partial planned attitude",
+       "planned_roll_deg,planned_yaw_deg," + std::string(kHeader),
+       {"data.csv:1: missing column 'planned_pitch_deg' (the planned attitude needs all three"}},
+      {"partial unstretched lengths",
+       "s0_1_m,s0_2_m," + std::string(kHeader),
+       {"data.csv:1: missing column 's0_3_m' (the unstretched lengths need all six"}},
+      {"non-positive unstretched length",
+       "s0_1_m,s0_2_m,s0_3_m,s0_4_m,s0_5_m,s0_6_m," + std::string(kHeader) +
+           "300,300,300,300,-1,300," + kRow,
+       {"data.csv:2: column 's0_5_m': unstretched length must be > 0"}},
+  };
+  for (const ErrorCase& c : cases) {
+    const std::string error = ParseError(c.text);
+    ASSERT_FALSE(error.empty()) << c.name;
+    for (const std::string& part : c.expected) {
+      EXPECT_TRUE(Contains(error, part)) << c.name;
+    }
+  }
+}
+
+TEST_F(DatasetTest, NoDataRowsIsAnError) {
+  EXPECT_EQ(ParseError(std::string("# nothing yet\n") + kHeader + "\n# end\n"),
+            "data.csv: no data rows");
+  EXPECT_TRUE(Contains(ParseError(""), "data.csv: no header line"));
+  EXPECT_TRUE(Contains(ParseError("# only a comment\n\n"), "data.csv: no header line"));
+}
+
+TEST_F(DatasetTest, SkipInvalidRowsSkipsAndListsThem) {
+  const std::string text = std::string("# header follows\n") + kHeader +  // lines 1-2
+                           kRow +                                         // 3
+                           "1,1,2,140,0,0,0,150,151,abc,153,154,155\n"    // 4
+                           "2,1,2,140,0,0,0,150,151,152\n"                // 5
+                           "# a comment\n"                                // 6
+                           "3,1,2,140,0,0,0,150,151,152,153,0,155\n"      // 7
+                           "4,1,2,140,0,0,0,150,151,152,153,154,155\n";   // 8
+  EXPECT_TRUE(Contains(ParseError(text), "data.csv:4: column 'T3_kN'"));
+  const Dataset d = ParseOk(text, /*skip=*/true);
+  ASSERT_EQ(d.samples.size(), 2u);
+  EXPECT_EQ(d.samples[0].line, 3);
+  EXPECT_EQ(d.samples[1].line, 8);
+  EXPECT_EQ(d.samples[1].time_s, 4.0);
+  ASSERT_EQ(d.skipped.size(), 3u);
+  EXPECT_EQ(d.skipped[0], "data.csv:4: column 'T3_kN': 'abc' is not a number");
+  EXPECT_EQ(d.skipped[1], "data.csv:5: expected 13 fields, found 10");
+  EXPECT_TRUE(Contains(d.skipped[2], "data.csv:7: column 'T5_kN': tension must be > 0"));
+}
+
+TEST_F(DatasetTest, SkipInvalidRowsNeverSkipsHeaderErrorsOrEverything) {
+  EXPECT_TRUE(Contains(ParseError("T7_kN," + std::string(kHeader) + "1," + kRow, /*skip=*/true),
+                       "data.csv:1: unknown column 'T7_kN'"));
+  const std::string all_bad = std::string(kHeader) + "x,1,2,140,0,0,0,150,151,152,153,154,155\n" +
+                              "0,1,2,140,0,0,0,150,151,152,153,154\n";
+  const std::string error = ParseError(all_bad, /*skip=*/true);
+  EXPECT_TRUE(Contains(error, "data.csv: no valid data rows: all 2 rows skipped"));
+  EXPECT_TRUE(Contains(error, "data.csv:2: column 'time_s'"));
+}
+
+TEST_F(DatasetTest, RoundTripIsExact) {
+  constexpr int kRows = 50;
+  unsigned seed = 20240501;
+  for (const bool quaternion : {false, true}) {
+    for (const bool optional_columns : {false, true}) {
+      SCOPED_TRACE(::testing::Message()
+                   << "quaternion " << quaternion << ", optional " << optional_columns);
+      const Dataset original = RandomDataset(seed++, quaternion, optional_columns, kRows);
+      const std::string path = PathOf("round_trip.csv");
+      std::string error;
+      ASSERT_TRUE(WriteDataset(path, original, "provenance\nsecond line", &error)) << error;
+      Dataset read;
+      ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &read, &error)) << error;
+      EXPECT_EQ(read.path, path);
+      EXPECT_EQ(read.attitude_as_quaternion, quaternion);
+      EXPECT_EQ(read.has_planned_attitude, optional_columns);
+      EXPECT_EQ(read.has_unstretched_lengths, optional_columns);
+      ASSERT_EQ(read.samples.size(), original.samples.size());
+      for (size_t i = 0; i < read.samples.size(); ++i) {
+        ExpectSamplesEqual(original.samples[i], read.samples[i], quaternion, optional_columns,
+                           optional_columns);
+        EXPECT_EQ(read.samples[i].line, static_cast<int>(i) + 4);  // 2 comments, header
+      }
+    }
+  }
+}
+
+TEST_F(DatasetTest, WritesHeaderCommentReadableKilonewtonsAndRereadsTheSameFile) {
+  Dataset dataset =
+      ParseOk(std::string(kHeader) + "0.5,1,2,140.25,0.1,0.2,0.3,159.17,151,152,153,154,155.5\n");
+  const std::string path = PathOf("out.csv");
+  std::string error;
+  ASSERT_TRUE(WriteDataset(path, dataset, "from telemetry.csv\n\nfnv1a64 0123", &error)) << error;
+  std::ifstream in(path);
+  std::stringstream contents;
+  contents << in.rdbuf();
+  EXPECT_EQ(contents.str(),
+            "# from telemetry.csv\n#\n# fnv1a64 0123\n"
+            "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
+            "0.5,1,2,140.25,0.1,0.2,0.3,159.17,151,152,153,154,155.5\n");
+  // Writing what was read gives the same bytes.
+  Dataset again;
+  ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &again, &error)) << error;
+  const std::string path2 = PathOf("out2.csv");
+  ASSERT_TRUE(WriteDataset(path2, again, "from telemetry.csv\n\nfnv1a64 0123", &error));
+  std::string digest1, digest2;
+  ASSERT_TRUE(FileFnv1a64(path, &digest1, &error)) << error;
+  ASSERT_TRUE(FileFnv1a64(path2, &digest2, &error)) << error;
+  EXPECT_EQ(digest1, digest2);
+}
+
+TEST_F(DatasetTest, ExtremeTensionsRoundTripExactly) {
+  const std::vector<double> values = {std::numeric_limits<double>::denorm_min(),
+                                      std::numeric_limits<double>::min(),
+                                      1e-7,
+                                      0.1,
+                                      1.0 / 3.0,
+                                      159170.00000000003,
+                                      123456789.123,
+                                      std::numeric_limits<double>::max()};
+  Dataset dataset;
+  for (size_t start = 0; start < values.size(); ++start) {
+    Sample s;
+    for (int i = 0; i < kNumCables; ++i) s.tension_n[i] = values[(start + i) % values.size()];
+    dataset.samples.push_back(s);
+  }
+  const std::string path = PathOf("extreme.csv");
+  std::string error;
+  ASSERT_TRUE(WriteDataset(path, dataset, "", &error)) << error;
+  Dataset read;
+  ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &read, &error)) << error;
+  ASSERT_EQ(read.samples.size(), dataset.samples.size());
+  for (size_t k = 0; k < read.samples.size(); ++k) {
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_EQ(read.samples[k].tension_n[i], dataset.samples[k].tension_n[i]) << k << "," << i;
+    }
+  }
+}
+
+TEST_F(DatasetTest, WritesAttitudeFromRotationWhenOnlyTheRotationIsSet) {
+  // Samples built in code: pose.rotation set, the as-read attitude fields left at defaults.
+  const Eigen::Matrix3d rotation = RotationFromRpyDeg(3.0, -4.0, 100.0);
+  for (const bool quaternion : {false, true}) {
+    SCOPED_TRACE(quaternion ? "quaternion" : "angles");
+    Dataset dataset;
+    dataset.attitude_as_quaternion = quaternion;
+    dataset.has_planned_attitude = true;
+    Sample s;
+    s.pose.rotation = rotation;
+    s.has_planned_attitude = true;
+    s.planned_rotation = rotation.transpose();
+    s.tension_n.fill(150e3);
+    dataset.samples.push_back(s);
+    const std::string path = PathOf("built.csv");
+    std::string error;
+    ASSERT_TRUE(WriteDataset(path, dataset, "", &error)) << error;
+    Dataset read;
+    ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &read, &error)) << error;
+    ASSERT_EQ(read.samples.size(), 1u);
+    EXPECT_LT((read.samples[0].pose.rotation - rotation).cwiseAbs().maxCoeff(), kRotationTolerance);
+    EXPECT_LT((read.samples[0].planned_rotation - rotation.transpose()).cwiseAbs().maxCoeff(),
+              kRotationTolerance);
+  }
+}
+
+TEST_F(DatasetTest, WriteFailureLeavesNoFile) {
+  const Dataset dataset = RandomDataset(7, false, true, 3);
+  std::string error;
+  // Directory does not exist.
+  const std::string missing_dir = PathOf("no_such_dir/out.csv");
+  EXPECT_FALSE(WriteDataset(missing_dir, dataset, "", &error));
+  EXPECT_TRUE(Contains(error, missing_dir));
+  EXPECT_TRUE(DirEntries().empty());
+  // The target is a directory: the temporary file is written, the rename fails.
+  ASSERT_TRUE(fs::create_directory(PathOf("a_directory")));
+  error.clear();
+  EXPECT_FALSE(WriteDataset(PathOf("a_directory"), dataset, "", &error));
+  EXPECT_TRUE(Contains(error, "a_directory"));
+  EXPECT_EQ(DirEntries(), std::vector<std::string>{"a_directory"});
+  EXPECT_TRUE(fs::is_empty(PathOf("a_directory")));
+}
+
+TEST_F(DatasetTest, WriteRefusesDataTheReaderWouldReject) {
+  const Dataset good = RandomDataset(11, false, true, 3);
+  const std::string path = PathOf("bad.csv");
+  std::string error;
+
+  Dataset bad = good;
+  bad.samples[1].tension_n[2] = std::nan("");
+  EXPECT_FALSE(WriteDataset(path, bad, "", &error));
+  EXPECT_TRUE(Contains(error, "samples[1]: column 'T3_kN': value is not finite"));
+
+  bad = good;
+  bad.samples[2].tension_n[0] = 0.0;
+  EXPECT_FALSE(WriteDataset(path, bad, "", &error));
+  EXPECT_TRUE(Contains(error, "samples[2]: column 'T1_kN': tension must be > 0"));
+
+  bad = good;
+  bad.samples[0].has_unstretched_lengths = false;
+  EXPECT_FALSE(WriteDataset(path, bad, "", &error));
+  EXPECT_TRUE(Contains(error, "samples[0]: no unstretched lengths"));
+
+  bad = good;
+  bad.samples[0].pose.rotation(0, 0) = 2.0;
+  EXPECT_FALSE(WriteDataset(path, bad, "", &error));
+  EXPECT_TRUE(Contains(error, "samples[0]: pose.rotation is not a finite rotation matrix"));
+
+  bad = good;
+  bad.samples.clear();
+  EXPECT_FALSE(WriteDataset(path, bad, "", &error));
+  EXPECT_TRUE(Contains(error, "no samples"));
+
+  EXPECT_TRUE(DirEntries().empty());
+}
+
+TEST_F(DatasetTest, WriteReplacesAnExistingFile) {
+  const std::string path = PathOf("replace.csv");
+  WriteText("replace.csv", "old contents\n");
+  std::string error;
+  ASSERT_TRUE(WriteDataset(path, RandomDataset(3, true, false, 2), "", &error)) << error;
+  Dataset read;
+  ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &read, &error)) << error;
+  EXPECT_EQ(read.samples.size(), 2u);
+  EXPECT_EQ(DirEntries(), std::vector<std::string>{"replace.csv"});
+}
+
+TEST_F(DatasetTest, ReadMissingFileFails) {
+  const std::string path = PathOf("absent.csv");
+  Dataset dataset;
+  std::string error;
+  EXPECT_FALSE(ReadDataset(path, DatasetReadOptions(), &dataset, &error));
+  EXPECT_TRUE(Contains(error, path + ": cannot open"));
+}
+
+// FNV-1a 64 straight from its definition, for comparison.
+std::string ReferenceFnv1a64(const std::string& bytes) {
+  std::uint64_t hash = 14695981039346656037ULL;  // offset basis
+  for (const unsigned char byte : bytes) {
+    hash ^= byte;
+    hash *= 1099511628211ULL;  // FNV prime 2^40 + 2^8 + 0xb3
+  }
+  char hex[17];
+  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(hash));
+  return hex;
+}
+
+TEST_F(DatasetTest, FileFnv1a64MatchesTheDefinition) {
+  EXPECT_EQ(ReferenceFnv1a64(""), "cbf29ce484222325");  // published test vectors
+  EXPECT_EQ(ReferenceFnv1a64("a"), "af63dc4c8601ec8c");
+  const std::vector<std::string> contents = {
+      "", "a", "foobar", std::string("\0\xff\x80 binary\n", 11), std::string(200000, 'z')};
+  for (size_t k = 0; k < contents.size(); ++k) {
+    const std::string name = "file" + std::to_string(k);
+    WriteText(name, contents[k]);
+    std::string hex, error;
+    ASSERT_TRUE(FileFnv1a64(PathOf(name), &hex, &error)) << error;
+    EXPECT_EQ(hex, ReferenceFnv1a64(contents[k])) << k;
+  }
+  std::string hex, error;
+  WriteText("a.txt", "a");
+  ASSERT_TRUE(FileFnv1a64(PathOf("a.txt"), &hex, &error)) << error;
+  EXPECT_EQ(hex, "af63dc4c8601ec8c");
+  EXPECT_FALSE(FileFnv1a64(PathOf("absent"), &hex, &error));
+  EXPECT_TRUE(Contains(error, "absent: cannot open"));
+}
+
+}  // namespace
+}  // namespace fastcal

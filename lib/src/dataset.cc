@@ -1,0 +1,661 @@
+// Reader and writer of the measurement dataset CSV (docs/data-format.md) and the FNV-1a 64
+// file digest (declarations: dataset.h).
+#include "fastcal/dataset.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <charconv>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <exception>
+#include <functional>
+#include <limits>
+#include <string_view>
+
+#include <Eigen/LU>
+
+namespace fastcal {
+namespace {
+
+// Column identifiers, in the order WriteDataset writes them.
+enum Column : int {
+  kTime,
+  kX,
+  kY,
+  kZ,
+  kRoll,
+  kPitch,
+  kYaw,
+  kQw,
+  kQx,
+  kQy,
+  kQz,
+  kPlannedRoll,
+  kPlannedPitch,
+  kPlannedYaw,
+  kTension1,
+  kUnstretched1 = kTension1 + kNumCables,
+  kNumColumns = kUnstretched1 + kNumCables,
+};
+
+// clang-format off
+constexpr const char* kColumnNames[kNumColumns] = {
+    "time_s", "x_m", "y_m", "z_m",
+    "roll_deg", "pitch_deg", "yaw_deg",
+    "qw", "qx", "qy", "qz",
+    "planned_roll_deg", "planned_pitch_deg", "planned_yaw_deg",
+    "T1_kN", "T2_kN", "T3_kN", "T4_kN", "T5_kN", "T6_kN",
+    "s0_1_m", "s0_2_m", "s0_3_m", "s0_4_m", "s0_5_m", "s0_6_m"};
+// clang-format on
+
+// Files hold tensions in kN, memory in N: the decimal exponent shifts by this much.
+constexpr int kKilo = 3;
+// Exponents beyond this (e.g. "0e999999") are converted by multiplication instead of by
+// shifting the decimal text; such values are 0 or non-finite anyway.
+constexpr long kMaxShiftableExponent = 100000;
+// WriteDataset refuses a pose.rotation farther than this (max |R^T R - I| entry) from a
+// rotation: it could not be written as angles or a quaternion.
+constexpr double kRotationTolerance = 1e-6;
+
+constexpr std::uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ULL;
+constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
+
+bool IsTension(int column) { return column >= kTension1 && column < kTension1 + kNumCables; }
+bool IsUnstretched(int column) {
+  return column >= kUnstretched1 && column < kUnstretched1 + kNumCables;
+}
+
+std::string_view Trim(std::string_view s) {
+  const auto is_space = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+  while (!s.empty() && is_space(s.front())) s.remove_prefix(1);
+  while (!s.empty() && is_space(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+std::vector<std::string_view> SplitFields(std::string_view line) {
+  std::vector<std::string_view> fields;
+  size_t start = 0;
+  while (true) {
+    const size_t comma = line.find(',', start);
+    if (comma == std::string_view::npos) {
+      fields.push_back(Trim(line.substr(start)));
+      return fields;
+    }
+    fields.push_back(Trim(line.substr(start, comma - start)));
+    start = comma + 1;
+  }
+}
+
+bool IsCommentOrBlank(std::string_view line) {
+  const std::string_view t = Trim(line);
+  return t.empty() || t.front() == '#';
+}
+
+std::string Quoted(std::string_view s) { return "'" + std::string(s) + "'"; }
+
+std::string AcceptedColumns() {
+  std::string list;
+  for (int c = 0; c < kNumColumns; ++c) {
+    if (c > 0) list += ", ";
+    list += kColumnNames[c];
+  }
+  return list;
+}
+
+// Parses a whole trimmed field with std::strtod. Returns false when the field is not a
+// number (a message goes to *reason).
+bool ParseNumber(std::string_view field, double* value, std::string* reason) {
+  if (field.empty()) {
+    *reason = "missing value";
+    return false;
+  }
+  const std::string text(field);
+  char* end = nullptr;
+  // ERANGE is no error here: an underflow reads as 0 or a subnormal, an overflow as inf.
+  const double v = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size()) {
+    *reason = Quoted(field) + " is not a number";
+    return false;
+  }
+  if (!std::isfinite(v)) {
+    *reason = "value is not finite";
+    return false;
+  }
+  *value = v;
+  return true;
+}
+
+// `field` (already accepted by ParseNumber) times 10^kKilo, computed by shifting the
+// decimal exponent of the text, so the result is the correctly rounded value of the
+// decimal number and the writer's inverse shift round-trips exactly.
+double ScaleByKilo(std::string_view field, double parsed_value) {
+  const std::string text(field);
+  if (text.find_first_of("xX") != std::string::npos) return parsed_value * 1e3;  // hex float
+  const size_t e = text.find_first_of("eE");
+  std::string shifted;
+  if (e == std::string::npos) {
+    shifted = text + "e" + std::to_string(kKilo);
+  } else {
+    errno = 0;
+    const long exponent = std::strtol(text.c_str() + e + 1, nullptr, 10);
+    if (errno == ERANGE || std::labs(exponent) > kMaxShiftableExponent) {
+      return parsed_value * 1e3;
+    }
+    shifted = text.substr(0, e) + "e" + std::to_string(exponent + kKilo);
+  }
+  return std::strtod(shifted.c_str(), nullptr);
+}
+
+// The shortest decimal text that std::strtod reads back as value * 10^-shift exactly
+// after the reader shifts it back (shift 0: plain shortest round-trip formatting). Plain
+// notation for moderate exponents, scientific otherwise. `value` must be finite.
+std::string FormatNumber(double value, int shift) {
+  if (value == 0.0) return std::signbit(value) ? "-0" : "0";
+  char buffer[64];
+  const std::to_chars_result result =
+      std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::scientific);
+  std::string_view s(buffer, static_cast<size_t>(result.ptr - buffer));  // "-1.5917e+05"
+  std::string out;
+  if (s.front() == '-') {
+    out = "-";
+    s.remove_prefix(1);
+  }
+  const size_t e = s.find('e');
+  std::string digits;
+  for (char c : s.substr(0, e)) {
+    if (c != '.') digits += c;
+  }
+  const std::string exponent_text(s.substr(e + 1));
+  // value = d0.d1d2... * 10^exponent
+  const long exponent = std::strtol(exponent_text.c_str(), nullptr, 10) - shift;
+  const long n = static_cast<long>(digits.size());
+  if (exponent >= 0 && exponent <= 16) {
+    if (n <= exponent + 1) {
+      out += digits + std::string(static_cast<size_t>(exponent + 1 - n), '0');
+    } else {
+      out += digits.substr(0, static_cast<size_t>(exponent + 1)) + "." +
+             digits.substr(static_cast<size_t>(exponent + 1));
+    }
+  } else if (exponent < 0 && exponent >= -5) {
+    out += "0." + std::string(static_cast<size_t>(-exponent - 1), '0') + digits;
+  } else {
+    out += digits.substr(0, 1);
+    if (n > 1) out += "." + digits.substr(1);
+    out += "e" + std::to_string(exponent);
+  }
+  return out;
+}
+
+// Reads a whole file; false with a message (naming the file) on failure.
+bool ReadFileChunks(const std::string& path, const std::function<void(const char*, size_t)>& sink,
+                    std::string* error) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    *error = path + ": cannot open: " + std::strerror(errno);
+    return false;
+  }
+  char buffer[1 << 16];
+  while (true) {
+    const size_t n = std::fread(buffer, 1, sizeof(buffer), file);
+    if (n > 0) sink(buffer, n);
+    if (n < sizeof(buffer)) break;
+  }
+  const bool failed = std::ferror(file) != 0;
+  const int read_errno = errno;
+  std::fclose(file);
+  if (failed) {
+    *error = path + ": cannot read: " + std::strerror(read_errno);
+    return false;
+  }
+  return true;
+}
+
+// Writes `content` to a new temporary file beside `path`, then renames it over `path`.
+bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error) {
+  static std::atomic<unsigned> counter{0};
+  const std::string temp_path =
+      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
+  const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    *error = path + ": cannot write: " + std::strerror(errno);
+    return false;
+  }
+  const auto fail = [&](const char* what, int err) {
+    *error = path + ": " + what + ": " + std::strerror(err);
+    ::unlink(temp_path.c_str());
+    return false;
+  };
+  size_t written = 0;
+  while (written < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      return fail("cannot write", err);
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return fail("cannot write", err);
+  }
+  if (::close(fd) != 0) return fail("cannot write", errno);
+  if (std::rename(temp_path.c_str(), path.c_str()) != 0) return fail("cannot replace", errno);
+  return true;
+}
+
+// The header: which field holds each column (-1: absent).
+struct Header {
+  std::array<int, kNumColumns> field_of{};
+  std::vector<int> column_of_field;
+  bool quaternion = false;
+  bool planned = false;
+  bool unstretched = false;
+};
+
+// Checks that a group of columns is all present or all absent; on a partial group names
+// the first missing column. Returns whether the group is present.
+bool GroupPresent(const Header& header, int first, int count, const std::string& where,
+                  const char* group_note, bool* ok, std::string* error) {
+  int present = 0;
+  for (int c = first; c < first + count; ++c) present += header.field_of[c] >= 0 ? 1 : 0;
+  if (present == 0 || present == count) return present == count;
+  for (int c = first; c < first + count; ++c) {
+    if (header.field_of[c] < 0) {
+      *error = where + "missing column " + Quoted(kColumnNames[c]) + " (" + group_note + ")";
+      break;
+    }
+  }
+  *ok = false;
+  return false;
+}
+
+bool ParseHeader(std::string_view line, const std::string& where, Header* header,
+                 std::string* error) {
+  header->field_of.fill(-1);
+  const std::vector<std::string_view> fields = SplitFields(line);
+  for (size_t f = 0; f < fields.size(); ++f) {
+    const std::string_view name = fields[f];
+    if (name.empty()) {
+      *error = where + "empty column name in field " + std::to_string(f + 1);
+      return false;
+    }
+    int column = -1;
+    for (int c = 0; c < kNumColumns; ++c) {
+      if (name == kColumnNames[c]) column = c;
+    }
+    if (column < 0) {
+      *error = where + "unknown column " + Quoted(name) + " (accepted: " + AcceptedColumns() + ")";
+      return false;
+    }
+    if (header->field_of[column] >= 0) {
+      *error = where + "duplicate column " + Quoted(name) + " (fields " +
+               std::to_string(header->field_of[column] + 1) + " and " + std::to_string(f + 1) + ")";
+      return false;
+    }
+    header->field_of[column] = static_cast<int>(f);
+    header->column_of_field.push_back(column);
+  }
+  const auto require = [&](int column) {
+    if (header->field_of[column] >= 0) return true;
+    *error = where + "missing column " + Quoted(kColumnNames[column]);
+    return false;
+  };
+  for (int c = kTime; c <= kZ; ++c) {
+    if (!require(c)) return false;
+  }
+  bool ok = true;
+  const bool rpy = GroupPresent(*header, kRoll, 3, where,
+                                "the measured attitude as angles needs all three", &ok, error);
+  if (!ok) return false;
+  const bool quaternion = GroupPresent(
+      *header, kQw, 4, where, "the measured attitude as a quaternion needs all four", &ok, error);
+  if (!ok) return false;
+  if (rpy && quaternion) {
+    *error = where +
+             "measured attitude given twice: use either roll_deg,pitch_deg,yaw_deg or "
+             "qw,qx,qy,qz";
+    return false;
+  }
+  if (!rpy && !quaternion) {
+    *error = where + "missing measured attitude: columns roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz";
+    return false;
+  }
+  header->quaternion = quaternion;
+  for (int i = 0; i < kNumCables; ++i) {
+    if (!require(kTension1 + i)) return false;
+  }
+  header->planned = GroupPresent(*header, kPlannedRoll, 3, where,
+                                 "the planned attitude needs all three or none", &ok, error);
+  if (!ok) return false;
+  header->unstretched = GroupPresent(*header, kUnstretched1, kNumCables, where,
+                                     "the unstretched lengths need all six or none", &ok, error);
+  return ok;
+}
+
+// Parses one data row into *sample; on failure *reason says why (without file:line).
+bool ParseRow(std::string_view line, const Header& header, Sample* sample, std::string* reason) {
+  const std::vector<std::string_view> fields = SplitFields(line);
+  if (fields.size() != header.column_of_field.size()) {
+    *reason = "expected " + std::to_string(header.column_of_field.size()) + " fields, found " +
+              std::to_string(fields.size());
+    return false;
+  }
+  std::array<double, kNumColumns> value{};
+  for (size_t f = 0; f < fields.size(); ++f) {
+    const int column = header.column_of_field[f];
+    const auto fail = [&](const std::string& why) {
+      *reason = "column " + Quoted(kColumnNames[column]) + ": " + why;
+      return false;
+    };
+    std::string why;
+    if (!ParseNumber(fields[f], &value[column], &why)) return fail(why);
+    if (IsTension(column)) {
+      value[column] = ScaleByKilo(fields[f], value[column]);
+      if (!std::isfinite(value[column])) return fail("value is not finite in N");
+      if (!(value[column] > 0.0)) {
+        return fail("tension must be > 0: a slack or failed sensor (read " + Quoted(fields[f]) +
+                    ")");
+      }
+    }
+    if (IsUnstretched(column) && !(value[column] > 0.0)) {
+      return fail("unstretched length must be > 0 (read " + Quoted(fields[f]) + ")");
+    }
+  }
+  sample->time_s = value[kTime];
+  sample->pose.position_m = Eigen::Vector3d(value[kX], value[kY], value[kZ]);
+  if (header.quaternion) {
+    sample->measured_quaternion_wxyz =
+        Eigen::Vector4d(value[kQw], value[kQx], value[kQy], value[kQz]);
+    std::string why;
+    if (!RotationFromQuaternion(value[kQw], value[kQx], value[kQy], value[kQz],
+                                &sample->pose.rotation, &why)) {
+      *reason = "columns 'qw,qx,qy,qz': " + why;
+      return false;
+    }
+  } else {
+    sample->measured_rpy_deg = Eigen::Vector3d(value[kRoll], value[kPitch], value[kYaw]);
+    sample->pose.rotation = RotationFromRpyDeg(value[kRoll], value[kPitch], value[kYaw]);
+  }
+  sample->has_planned_attitude = header.planned;
+  if (header.planned) {
+    sample->planned_rpy_deg =
+        Eigen::Vector3d(value[kPlannedRoll], value[kPlannedPitch], value[kPlannedYaw]);
+    sample->planned_rotation =
+        RotationFromRpyDeg(value[kPlannedRoll], value[kPlannedPitch], value[kPlannedYaw]);
+  }
+  for (int i = 0; i < kNumCables; ++i) sample->tension_n[i] = value[kTension1 + i];
+  sample->has_unstretched_lengths = header.unstretched;
+  if (header.unstretched) {
+    for (int i = 0; i < kNumCables; ++i) {
+      sample->unstretched_length_m[i] = value[kUnstretched1 + i];
+    }
+  }
+  return true;
+}
+
+bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
+                      const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
+  Dataset result;
+  result.path = source_name;
+  Header header;
+  bool have_header = false;
+  int rows = 0;
+  std::string_view rest(text);
+  if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // UTF-8 byte order mark
+  for (int line_number = 1; !rest.empty(); ++line_number) {
+    const size_t newline = rest.find('\n');
+    const std::string_view line = rest.substr(0, newline);
+    rest.remove_prefix(newline == std::string_view::npos ? rest.size() : newline + 1);
+    if (IsCommentOrBlank(line)) continue;
+    const std::string where = source_name + ":" + std::to_string(line_number) + ": ";
+    if (!have_header) {
+      if (!ParseHeader(line, where, &header, error)) return false;
+      have_header = true;
+      continue;
+    }
+    ++rows;
+    Sample sample;
+    sample.line = line_number;
+    std::string reason;
+    if (ParseRow(line, header, &sample, &reason)) {
+      result.samples.push_back(std::move(sample));
+    } else if (options.skip_invalid_rows) {
+      result.skipped.push_back(where + reason);
+    } else {
+      *error = where + reason;
+      return false;
+    }
+  }
+  if (!have_header) {
+    *error = source_name + ": no header line (and no data rows)";
+    return false;
+  }
+  if (rows == 0) {
+    *error = source_name + ": no data rows";
+    return false;
+  }
+  if (result.samples.empty()) {
+    *error = source_name + ": no valid data rows: all " + std::to_string(rows) +
+             " rows skipped; first: " + result.skipped.front();
+    return false;
+  }
+  result.has_planned_attitude = header.planned;
+  result.has_unstretched_lengths = header.unstretched;
+  result.attitude_as_quaternion = header.quaternion;
+  *dataset = std::move(result);
+  return true;
+}
+
+bool IsRotation(const Eigen::Matrix3d& r) {
+  return r.allFinite() &&
+         ((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() <=
+          kRotationTolerance) &&
+         r.determinant() > 0.0;
+}
+
+// The numbers of one row in column order (columns the dataset does not write are left 0),
+// or false with a reason.
+bool RowValues(const Dataset& dataset, const Sample& s, std::array<double, kNumColumns>* value,
+               std::string* reason) {
+  if (!IsRotation(s.pose.rotation)) {
+    *reason = "pose.rotation is not a finite rotation matrix";
+    return false;
+  }
+  auto& v = *value;
+  v[kTime] = s.time_s;
+  for (int k = 0; k < 3; ++k) v[kX + k] = s.pose.position_m[k];
+  if (dataset.attitude_as_quaternion) {
+    Eigen::Matrix3d from_file;
+    std::string ignored;
+    const bool exact =
+        RotationFromQuaternion(s.measured_quaternion_wxyz[0], s.measured_quaternion_wxyz[1],
+                               s.measured_quaternion_wxyz[2], s.measured_quaternion_wxyz[3],
+                               &from_file, &ignored) &&
+        from_file == s.pose.rotation;
+    const Eigen::Vector4d q =
+        exact ? s.measured_quaternion_wxyz : QuaternionFromRotation(s.pose.rotation);
+    for (int k = 0; k < 4; ++k) v[kQw + k] = q[k];
+  } else {
+    const Eigen::Vector3d& r = s.measured_rpy_deg;
+    const bool exact = r.allFinite() && RotationFromRpyDeg(r[0], r[1], r[2]) == s.pose.rotation;
+    const Eigen::Vector3d rpy = exact ? r : RpyDegFromRotation(s.pose.rotation);
+    for (int k = 0; k < 3; ++k) v[kRoll + k] = rpy[k];
+  }
+  if (dataset.has_planned_attitude) {
+    if (!s.has_planned_attitude) {
+      *reason = "no planned attitude, which the dataset declares";
+      return false;
+    }
+    if (!IsRotation(s.planned_rotation)) {
+      *reason = "planned_rotation is not a finite rotation matrix";
+      return false;
+    }
+    const Eigen::Vector3d& r = s.planned_rpy_deg;
+    const bool exact = r.allFinite() && RotationFromRpyDeg(r[0], r[1], r[2]) == s.planned_rotation;
+    const Eigen::Vector3d rpy = exact ? r : RpyDegFromRotation(s.planned_rotation);
+    for (int k = 0; k < 3; ++k) v[kPlannedRoll + k] = rpy[k];
+  }
+  for (int i = 0; i < kNumCables; ++i) v[kTension1 + i] = s.tension_n[i];
+  if (dataset.has_unstretched_lengths) {
+    if (!s.has_unstretched_lengths) {
+      *reason = "no unstretched lengths, which the dataset declares";
+      return false;
+    }
+    for (int i = 0; i < kNumCables; ++i) v[kUnstretched1 + i] = s.unstretched_length_m[i];
+  }
+  for (int c = 0; c < kNumColumns; ++c) {
+    const std::string prefix = "column " + Quoted(kColumnNames[c]) + ": ";
+    if (!std::isfinite(v[c])) {
+      *reason = prefix + "value is not finite";
+      return false;
+    }
+    if (IsTension(c) && !(v[c] > 0.0)) {
+      *reason = prefix + "tension must be > 0";
+      return false;
+    }
+    if (IsUnstretched(c) && dataset.has_unstretched_lengths && !(v[c] > 0.0)) {
+      *reason = prefix + "unstretched length must be > 0";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
+                      const std::string& header_comment, std::string* error) {
+  if (dataset.samples.empty()) {
+    *error = path + ": no samples to write";
+    return false;
+  }
+  std::vector<int> columns;
+  for (int c = 0; c < kNumColumns; ++c) {
+    const bool rpy = c >= kRoll && c <= kYaw;
+    const bool quaternion = c >= kQw && c <= kQz;
+    const bool planned = c >= kPlannedRoll && c <= kPlannedYaw;
+    if ((rpy && dataset.attitude_as_quaternion) ||
+        (quaternion && !dataset.attitude_as_quaternion) ||
+        (planned && !dataset.has_planned_attitude) ||
+        (IsUnstretched(c) && !dataset.has_unstretched_lengths)) {
+      continue;
+    }
+    columns.push_back(c);
+  }
+  std::string text;
+  if (!header_comment.empty()) {
+    std::string_view rest(header_comment);
+    while (!rest.empty()) {
+      const size_t newline = rest.find('\n');
+      const std::string_view line = rest.substr(0, newline);
+      text += line.empty() ? "#\n" : "# " + std::string(line) + "\n";
+      rest.remove_prefix(newline == std::string_view::npos ? rest.size() : newline + 1);
+    }
+  }
+  for (size_t k = 0; k < columns.size(); ++k) {
+    text += (k > 0 ? "," : "") + std::string(kColumnNames[columns[k]]);
+  }
+  text += "\n";
+  for (size_t i = 0; i < dataset.samples.size(); ++i) {
+    std::array<double, kNumColumns> value{};
+    std::string reason;
+    if (!RowValues(dataset, dataset.samples[i], &value, &reason)) {
+      *error = path + ": samples[" + std::to_string(i) + "]: " + reason;
+      return false;
+    }
+    for (size_t k = 0; k < columns.size(); ++k) {
+      const int c = columns[k];
+      if (k > 0) text += ",";
+      text += FormatNumber(value[c], IsTension(c) ? kKilo : 0);
+    }
+    text += "\n";
+  }
+  return WriteFileAtomically(path, text, error);
+}
+
+}  // namespace
+
+bool ParseDataset(const std::string& text, const std::string& source_name,
+                  const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
+  std::string message;
+  bool ok = false;
+  try {
+    ok = ParseDatasetImpl(text, source_name, options, dataset, &message);
+  } catch (const std::exception& e) {
+    message = source_name + ": " + e.what();
+    ok = false;
+  }
+  if (!ok && error != nullptr) *error = message;
+  return ok;
+}
+
+bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dataset* dataset,
+                 std::string* error) {
+  std::string text;
+  std::string message;
+  bool ok = false;
+  try {
+    ok = ReadFileChunks(
+        path, [&text](const char* data, size_t size) { text.append(data, size); }, &message);
+  } catch (const std::exception& e) {
+    message = path + ": " + e.what();
+    ok = false;
+  }
+  if (!ok) {
+    if (error != nullptr) *error = message;
+    return false;
+  }
+  return ParseDataset(text, path, options, dataset, error);
+}
+
+bool WriteDataset(const std::string& path, const Dataset& dataset,
+                  const std::string& header_comment, std::string* error) {
+  std::string message;
+  bool ok = false;
+  try {
+    ok = WriteDatasetImpl(path, dataset, header_comment, &message);
+  } catch (const std::exception& e) {
+    message = path + ": " + e.what();
+    ok = false;
+  }
+  if (!ok && error != nullptr) *error = message;
+  return ok;
+}
+
+bool FileFnv1a64(const std::string& path, std::string* hex, std::string* error) {
+  std::uint64_t hash = kFnvOffsetBasis;
+  std::string message;
+  bool ok = false;
+  try {
+    ok = ReadFileChunks(
+        path,
+        [&hash](const char* data, size_t size) {
+          for (size_t i = 0; i < size; ++i) {
+            hash ^= static_cast<unsigned char>(data[i]);
+            hash *= kFnvPrime;
+          }
+        },
+        &message);
+  } catch (const std::exception& e) {
+    message = path + ": " + e.what();
+    ok = false;
+  }
+  if (!ok) {
+    if (error != nullptr) *error = message;
+    return false;
+  }
+  char buffer[17];
+  std::snprintf(buffer, sizeof(buffer), "%016llx", static_cast<unsigned long long>(hash));
+  *hex = buffer;
+  return true;
+}
+
+}  // namespace fastcal

@@ -1,0 +1,101 @@
+// The measurement dataset: a CSV telemetry export of measured cabin poses and measured
+// lower-end cable tensions (format: docs/data-format.md), its reader and writer, and a
+// file digest for provenance.
+//
+// Files give tensions in kN (column names say so: T1_kN ... T6_kN); in memory they are in
+// N, like every other quantity in the library. The kN <-> N conversion is done on the
+// decimal text (the exponent is shifted by 3), so a write/read round trip is bit-exact.
+#ifndef FASTCAL_DATASET_H_
+#define FASTCAL_DATASET_H_
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/pose.h"
+
+namespace fastcal {
+
+// One row of the dataset: one instant of telemetry.
+struct Sample {
+  // 1-based line of the row in the file it was read from (0 for samples built in code).
+  int line = 0;
+  double time_s = 0.0;
+  // Measured position of the cabin-frame origin and measured attitude, global frame.
+  Pose pose;
+  // The measured attitude as the file gives it (only the one matching
+  // Dataset::attitude_as_quaternion is filled by the reader). WriteDataset writes these
+  // numbers when they reproduce pose.rotation exactly, so a read/write round trip keeps
+  // them bit for bit; otherwise it writes the attitude converted from pose.rotation.
+  // Code that builds samples may leave them at their defaults and set pose.rotation only.
+  Eigen::Vector3d measured_rpy_deg = Eigen::Vector3d::Zero();
+  Eigen::Vector4d measured_quaternion_wxyz = Eigen::Vector4d(1.0, 0.0, 0.0, 0.0);
+  // Planned (commanded) attitude, when the file has the planned_*_deg columns.
+  bool has_planned_attitude = false;
+  Eigen::Matrix3d planned_rotation = Eigen::Matrix3d::Identity();
+  // As in the file; written when it reproduces planned_rotation exactly (as above).
+  Eigen::Vector3d planned_rpy_deg = Eigen::Vector3d::Zero();
+  // Measured lower-end cable tensions, cable i at index i-1 (> 0).
+  std::array<double, kNumCables> tension_n{};
+  // Commanded unstretched cable lengths, when the file has the s0_*_m columns (> 0).
+  bool has_unstretched_lengths = false;
+  std::array<double, kNumCables> unstretched_length_m{};
+};
+
+struct Dataset {
+  // The file (or source name) the dataset was read from; used in messages.
+  std::string path;
+  std::vector<Sample> samples;  // in file order
+  // Which optional column groups the file has (then every sample has them).
+  bool has_planned_attitude = false;
+  bool has_unstretched_lengths = false;
+  // Measured attitude given as qw,qx,qy,qz (true) or roll_deg,pitch_deg,yaw_deg (false).
+  bool attitude_as_quaternion = false;
+  // One message per row skipped under DatasetReadOptions::skip_invalid_rows, in file
+  // order, formatted like the error the row would otherwise have caused ("file:line: ...").
+  std::vector<std::string> skipped;
+};
+
+struct DatasetReadOptions {
+  // When true, a row with a problem in its values (wrong number of fields, a missing,
+  // non-numeric or non-finite value, a tension or unstretched length <= 0, a non-unit
+  // quaternion) is skipped and listed in Dataset::skipped instead of failing the read.
+  // Header errors are never skipped, and a file whose rows are all skipped is an error.
+  bool skip_invalid_rows = false;
+};
+
+// Reads a dataset file. On failure returns false and sets *error to a message naming the
+// file, the 1-based line and, where there is one, the column, e.g.
+//   data.csv:12: column 'T3_kN': 'abc' is not a number
+// *dataset is only written on success.
+bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dataset* dataset,
+                 std::string* error);
+// Same, from the file's text; `source_name` stands for the file name in messages and
+// becomes Dataset::path.
+bool ParseDataset(const std::string& text, const std::string& source_name,
+                  const DatasetReadOptions& options, Dataset* dataset, std::string* error);
+
+// Writes `dataset` in the format ReadDataset reads: `header_comment` (may be empty, may
+// have several lines) as leading '# ' lines, then the columns
+//   time_s, x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg (or qw, qx, qy, qz when
+//   dataset.attitude_as_quaternion), planned_roll_deg, planned_pitch_deg,
+//   planned_yaw_deg (if dataset.has_planned_attitude), T1_kN ... T6_kN,
+//   s0_1_m ... s0_6_m (if dataset.has_unstretched_lengths).
+// Numbers are written with the fewest significant digits (at most 17) that read back to
+// the same double, so Write then Read is exact. Refuses (returns false) data the reader
+// would reject: non-finite values, tensions or unstretched lengths <= 0, a sample lacking
+// a column group the dataset declares, no samples. Writes atomically (temporary file in
+// the same directory, then rename): a failure leaves no file behind.
+bool WriteDataset(const std::string& path, const Dataset& dataset,
+                  const std::string& header_comment, std::string* error);
+
+// FNV-1a 64-bit hash of the file's bytes as 16 lowercase hex digits, for provenance
+// (not a cryptographic digest). The empty file gives "cbf29ce484222325".
+bool FileFnv1a64(const std::string& path, std::string* hex, std::string* error);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_DATASET_H_
