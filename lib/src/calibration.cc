@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <sstream>
 
@@ -25,6 +26,29 @@ constexpr double kPositiveFloorFraction = 1e-3;
 constexpr int kQrChunkRows = 1024;
 // Weights below this are left out of a direction's description.
 constexpr double kDirectionWeightFloor = 0.1;
+
+// The largest sigma with which a parameter counts as determined (CalibrationOptions).
+double MaxSigma(const ParameterSpec& p, double initial, const CalibrationOptions& o) {
+  switch (p.kind) {
+    case ParameterKind::kMassCentre:
+      return o.max_sigma_mass_centre_m;
+    case ParameterKind::kCabinMass:
+      return o.max_sigma_cabin_mass_fraction * std::abs(initial);
+    case ParameterKind::kLinearDensity:
+      return o.max_sigma_density_fraction * std::abs(initial);
+    case ParameterKind::kEa:
+      return o.max_sigma_ea_fraction * std::abs(initial);
+    case ParameterKind::kAnchorOffset:
+      return o.max_sigma_anchor_offset_m;
+    case ParameterKind::kTowerOffset:
+      return o.max_sigma_tower_offset_m;
+    case ParameterKind::kSensorGain:
+      return o.max_sigma_sensor_gain;
+    case ParameterKind::kSensorBias:
+      return o.max_sigma_sensor_bias_n;
+  }
+  return std::numeric_limits<double>::infinity();
+}
 
 bool MustBePositive(ParameterKind k) {
   return k == ParameterKind::kLinearDensity || k == ParameterKind::kCabinMass ||
@@ -81,6 +105,16 @@ Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>
   Eigen::JacobiSVD<Eigen::MatrixXd> svd(scaled, Eigen::ComputeFullV);
   const Eigen::VectorXd s = svd.singularValues();
   const double s_max = s.size() > 0 ? s[0] : 0.0;
+  // var_j = sum_k (V_jk / s_k)^2 / scale_j^2.
+  out.sigma_si.assign(n, 0.0);
+  for (int j = 0; j < n; ++j) {
+    double var = 0.0;
+    for (int k = 0; k < s.size(); ++k) {
+      const double vjk = svd.matrixV()(j, k);
+      var += s[k] > 0.0 ? vjk * vjk / (s[k] * s[k]) : std::numeric_limits<double>::infinity();
+    }
+    out.sigma_si[j] = std::sqrt(var) / scale[j];
+  }
   for (int k = 0; k < s.size(); ++k) {
     const double ratio = s_max > 0.0 ? s[k] / s_max : 0.0;
     out.singular_value_ratios.push_back(ratio);
@@ -259,20 +293,47 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     return CalibrationStatus::kInfeasible;
   }
   result->before = Analyse(r, result->free_names, options);
+  std::ostringstream refuse;
   if (!result->before.undetermined.empty()) {
-    std::ostringstream s;
-    s << "the data" << (num_priors ? " and priors" : "")
-      << " cannot determine the free parameters; only these combinations are constrained "
-         "as a whole:\n";
+    refuse << "only these combinations are constrained as a whole (exact degeneracy):\n";
     for (const ParameterDirection& d : result->before.undetermined) {
       char ratio[32];
       std::snprintf(ratio, sizeof(ratio), "%.1e", d.singular_value_ratio);
-      s << "  - " << d.Describe() << "   (singular value ratio " << ratio << ")\n";
+      refuse << "  - " << d.Describe() << "   (singular value ratio " << ratio << ")\n";
     }
-    s << "Fix one parameter of each combination (free: false), give one a prior "
-         "(prior: {mean: ..., sigma: ...}), or add data that separates them (other "
-         "positions, zenith angles, attitudes).";
-    *error = s.str();
+  } else {
+    bool any = false;
+    for (int k = 0; k < n; ++k) {
+      const ParameterSpec& p = spec.parameters[cm.spec_index(k)];
+      const double limit = MaxSigma(p, theta[k], options);
+      const double sigma = result->before.sigma_si[k];
+      if (sigma > limit) {
+        if (!any) {
+          refuse << "these would be determined only to (1 sigma, from the stated noise):\n";
+          any = true;
+        }
+        char line[200];
+        std::snprintf(line, sizeof(line), "  - %s: +-%.3g %s (determined means +-%.3g %s or better)\n",
+                      p.name.c_str(), sigma / p.to_si, p.unit.c_str(), limit / p.to_si,
+                      p.unit.c_str());
+        refuse << line;
+      }
+    }
+    if (any) {
+      refuse << "the weakest directions in parameter space:\n";
+      for (const ParameterDirection& d : result->before.poorly_determined) {
+        char ratio[32];
+        std::snprintf(ratio, sizeof(ratio), "%.1e", d.singular_value_ratio);
+        refuse << "  - " << d.Describe() << "   (singular value ratio " << ratio << ")\n";
+      }
+    }
+  }
+  if (!refuse.str().empty()) {
+    *error = std::string("the data") + (num_priors ? " and priors" : "") +
+             " cannot determine the free parameters; " + refuse.str() +
+             "Fix one parameter of each combination (free: false), give it a prior "
+             "(prior: {mean: ..., sigma: ...}), or add data that separates them (other "
+             "positions, zenith angles, attitudes).";
     return CalibrationStatus::kUndetermined;
   }
 

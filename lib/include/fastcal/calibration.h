@@ -40,6 +40,18 @@ struct CalibrationOptions {
   // A parameter with a prior whose posterior sigma exceeds this fraction of its prior
   // sigma is reported as set mostly by the prior.
   double prior_dominated_fraction = 0.5;
+  // Largest standard deviation (predicted before solving from the stated noise, the
+  // data's poses and the priors) with which a free parameter still counts as determined.
+  // A free set with any parameter above its limit is refused. Relative limits are
+  // fractions of the parameter's initial value. Our judgement of "useful", for FAST:
+  double max_sigma_mass_centre_m = 0.05;
+  double max_sigma_cabin_mass_fraction = 0.05;
+  double max_sigma_density_fraction = 0.05;
+  double max_sigma_ea_fraction = 0.2;
+  double max_sigma_anchor_offset_m = 0.05;
+  double max_sigma_tower_offset_m = 0.2;
+  double max_sigma_sensor_gain = 0.05;
+  double max_sigma_sensor_bias_n = 5e3;
 };
 
 // A direction in parameter space: weights on parameter names (unit vector in the
@@ -52,6 +64,9 @@ struct ParameterDirection {
 
 struct Identifiability {
   std::vector<double> singular_value_ratios;    // s_k / s_1, descending
+  // Standard deviation of each free parameter (SI) from (J^T J)^-1; infinite along an
+  // undetermined direction.
+  std::vector<double> sigma_si;
   std::vector<ParameterDirection> undetermined;  // ratio < undetermined_ratio
   std::vector<ParameterDirection> poorly_determined;
 };
