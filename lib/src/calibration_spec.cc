@@ -1,0 +1,959 @@
+// The calibration spec: YAML reading, validation and writing (format: docs/calibration.md).
+//
+// The spec is edited by hand, so the reader is strict in the way the model reader is
+// (cable_robot_yaml.cc): unknown keys and unknown parameter names are errors, and every
+// error reads "<file>:<line>: <key path>: <what>". Parameters come out in the canonical
+// order of calibration_spec.h, which is the order of ParameterKind, whatever the order of
+// the keys in the file. Values in the file are in the unit the key names (kN for the
+// sensor bias and the absolute tension noise); they are stored in SI. The checks of
+// CalibrationSpec::IsValid and of the reader share one set of functions, so a spec built
+// in code and a spec read from a file are held to the same rules.
+#include "fastcal/calibration_spec.h"
+
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <array>
+#include <charconv>
+#include <cmath>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <optional>
+#include <set>
+#include <sstream>
+#include <string>
+#include <system_error>
+#include <tuple>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace fastcal {
+namespace {
+
+constexpr char kFormatName[] = "fastcal-calibration-spec-1";
+constexpr char kRootPath[] = "(top level)";
+constexpr double kNewtonsPerKilonewton = 1e3;
+constexpr char kAxes[] = "xyz";
+
+// ---------------------------------------------------------------------------------------
+// Facts about each parameter group, in canonical order (the order of ParameterKind).
+
+struct GroupInfo {
+  ParameterKind kind;
+  const char* key;   // key under `parameters:` and stem of the parameter names
+  const char* unit;  // unit of the values in the file
+  double to_si;      // SI value = file value * to_si
+};
+
+constexpr GroupInfo kGroups[] = {
+    {ParameterKind::kMassCentre, "mass_centre_m", "m", 1.0},
+    {ParameterKind::kCabinMass, "cabin_mass_kg", "kg", 1.0},
+    {ParameterKind::kLinearDensity, "linear_density_kg_per_m", "kg/m", 1.0},
+    {ParameterKind::kEa, "ea_n", "N", 1.0},
+    {ParameterKind::kAnchorOffset, "anchor_offset_m", "m", 1.0},
+    {ParameterKind::kTowerOffset, "tower_offset_m", "m", 1.0},
+    {ParameterKind::kSensorGain, "sensor_gain", "1", 1.0},
+    {ParameterKind::kSensorBias, "sensor_bias_kN", "kN", kNewtonsPerKilonewton},
+};
+
+// Null for a kind outside the enum (a spec built in code from a bad cast).
+const GroupInfo* InfoOf(ParameterKind kind) {
+  for (const GroupInfo& g : kGroups) {
+    if (g.kind == kind) return &g;
+  }
+  return nullptr;
+}
+
+// Groups that are either one parameter for all cables or one per cable.
+bool IsPerCableCapable(ParameterKind kind) {
+  return kind == ParameterKind::kLinearDensity || kind == ParameterKind::kEa ||
+         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias;
+}
+
+bool IsVector(ParameterKind kind) {
+  return kind == ParameterKind::kMassCentre || kind == ParameterKind::kAnchorOffset ||
+         kind == ParameterKind::kTowerOffset;
+}
+
+// "mass_centre_m.x", "cabin_mass_kg", "ea_n[3]", "anchor_offset_m[2].z" (1-based).
+std::string ParameterName(const GroupInfo& g, int index, int component) {
+  std::string name = g.key;
+  if (index >= 0) name += "[" + std::to_string(index + 1) + "]";
+  if (component >= 0 && component < 3) name += std::string(".") + kAxes[component];
+  return name;
+}
+
+// ---------------------------------------------------------------------------------------
+// Checks shared by the reader and CalibrationSpec::IsValid. Each returns what is wrong,
+// or an empty string.
+
+std::string CheckInitial(ParameterKind kind, double initial_si) {
+  if (!std::isfinite(initial_si)) return "must be finite";
+  const char* what = nullptr;
+  switch (kind) {
+    case ParameterKind::kCabinMass:
+      what = "a mass";
+      break;
+    case ParameterKind::kLinearDensity:
+      what = "a linear density";
+      break;
+    case ParameterKind::kEa:
+      what = "an axial stiffness EA";
+      break;
+    case ParameterKind::kSensorGain:
+      what = "a sensor gain";
+      break;
+    default:
+      break;
+  }
+  if (what != nullptr && !(initial_si > 0.0)) {
+    return std::string("must be > 0 (") + what + " is positive)";
+  }
+  return "";
+}
+
+std::string CheckPriorMean(double mean) { return std::isfinite(mean) ? "" : "must be finite"; }
+
+std::string CheckPositive(double value) {
+  return std::isfinite(value) && value > 0.0 ? "" : "must be > 0";
+}
+
+std::string CheckNonNegative(double value) {
+  return std::isfinite(value) && value >= 0.0 ? "" : "must be >= 0";
+}
+
+constexpr char kBothNoiseZero[] =
+    "tension_sigma_kN and tension_sigma_percent are both 0 (the residuals could not be "
+    "weighted)";
+
+std::string CheckHoldoutFraction(double fraction) {
+  return std::isfinite(fraction) && fraction >= 0.0 && fraction < 1.0 ? "" : "must be in [0, 1)";
+}
+
+std::string CheckAtLeastOne(int value) { return value >= 1 ? "" : "must be >= 1"; }
+
+const char* RobustLossName(RobustLoss loss) {
+  switch (loss) {
+    case RobustLoss::kNone:
+      return "none";
+    case RobustLoss::kHuber:
+      return "huber";
+    case RobustLoss::kCauchy:
+      return "cauchy";
+  }
+  return nullptr;
+}
+
+bool IsKnownMethod(StaticsMethod method) {
+  StaticsMethod parsed;
+  return ParseStaticsMethod(StaticsMethodName(method), &parsed) && parsed == method;
+}
+
+// ---------------------------------------------------------------------------------------
+// Number text.
+
+// Shortest decimal text that reads back to exactly `value`.
+std::string Num(double value) {
+  if (std::isnan(value)) return ".nan";
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+// A value stored in SI, as text in a unit `to_si` times larger: the shortest text t with
+// parse(t) * to_si == si when there is one, so that writing and reading back is exact.
+// For values the reader produced (si = file value * to_si) si / to_si already is such a
+// t; the search of the neighbours is a guard for values set in code.
+std::string NumInUnit(double si, double to_si) {
+  constexpr int kMaxUlpSteps = 4;
+  const double guess = si / to_si;
+  if (!std::isfinite(guess) || guess * to_si == si) return Num(guess);
+  double down = guess;
+  double up = guess;
+  for (int step = 0; step < kMaxUlpSteps; ++step) {
+    down = std::nextafter(down, -HUGE_VAL);
+    up = std::nextafter(up, HUGE_VAL);
+    if (down * to_si == si) return Num(down);
+    if (up * to_si == si) return Num(up);
+  }
+  return Num(guess);  // no exact preimage: the nearest
+}
+
+// ---------------------------------------------------------------------------------------
+// Reader.
+
+std::string Join(const std::string& parent, const std::string& key) {
+  return parent.empty() || parent == kRootPath ? key : parent + "." + key;
+}
+// Key paths number list elements from 1, like the parameter names.
+std::string Element(const std::string& parent, size_t i) {
+  return parent + "[" + std::to_string(i + 1) + "]";
+}
+
+int LineOf(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  return mark.line < 0 ? 0 : mark.line + 1;
+}
+
+std::string ListOf(const std::vector<std::string>& names) {
+  std::string list;
+  for (const std::string& n : names) list += (list.empty() ? "" : ", ") + n;
+  return list;
+}
+
+// A key of a mapping and its value.
+struct KeyValue {
+  YAML::Node key;
+  YAML::Node value;
+  int line = 0;  // of the key
+};
+using KeyMap = std::map<std::string, KeyValue>;
+
+// An entry as written in the file; fields not given stay empty, so that a per-cable
+// entry can override its group field by field.
+struct EntryText {
+  std::optional<bool> free;
+  std::optional<double> initial;                   // file unit
+  std::optional<std::pair<double, double>> prior;  // mean, sigma; file unit
+};
+
+EntryText Override(const EntryText& base, const EntryText& over) {
+  EntryText e = base;
+  if (over.free) e.free = over.free;
+  if (over.initial) e.initial = over.initial;
+  if (over.prior) e.prior = over.prior;
+  return e;
+}
+
+ParameterSpec MakeParameter(const GroupInfo& g, int index, int component, const EntryText& e) {
+  ParameterSpec p;
+  p.kind = g.kind;
+  p.index = index;
+  p.component = component;
+  p.name = ParameterName(g, index, component);
+  p.unit = g.unit;
+  p.to_si = g.to_si;
+  p.free = e.free.value_or(false);
+  p.has_initial = e.initial.has_value();
+  p.initial_si = p.has_initial ? *e.initial * g.to_si : 0.0;
+  p.has_prior = e.prior.has_value();
+  if (p.has_prior) {
+    p.prior_mean_si = e.prior->first * g.to_si;
+    p.prior_sigma_si = e.prior->second * g.to_si;
+  }
+  return p;
+}
+
+class Reader {
+ public:
+  Reader(const std::string& source, int num_anchor_points)
+      : source_(source), num_anchor_points_(num_anchor_points) {}
+
+  const std::string& error() const { return error_; }
+
+  // Records "<source>:<line>: <path>: <what>" (":<line>" left out when 0).
+  bool Fail(int line, const std::string& path, const std::string& what) {
+    error_ = source_;
+    if (line > 0) error_ += ":" + std::to_string(line);
+    error_ += ": " + path + ": " + what;
+    return false;
+  }
+
+  bool ReadRoot(const YAML::Node& root, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(root, LineOf(root), kRootPath,
+                 {"format", "forward_model", "noise", "robust_loss", "holdout", "attitude",
+                  "solver", "parameters"},
+                 &keys)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "format")) {
+      const YAML::Node& v = kv->value;
+      if (!v.IsScalar() || v.Scalar() != kFormatName) {
+        return Fail(
+            kv->line, "format",
+            std::string("must be ") + kFormatName + (v.IsScalar() ? ", got " + v.Scalar() : ""));
+      }
+    }
+    if (const KeyValue* kv = Find(keys, "forward_model")) {
+      std::string name;
+      if (!ReadText(*kv, "forward_model", &name)) return false;
+      if (!ParseStaticsMethod(name, &spec->forward_model)) {
+        return Fail(kv->line, "forward_model",
+                    "unknown forward model \"" + name + "\" (accepted: aas, aas-refined, exact)");
+      }
+    }
+    if (const KeyValue* kv = Find(keys, "attitude")) {
+      int choice = 0;
+      if (!ReadChoice(*kv, "attitude", {"measured", "planned"}, &choice)) return false;
+      spec->use_planned_attitude = choice == 1;
+    }
+    if (const KeyValue* kv = Find(keys, "noise"); kv != nullptr && !ReadNoise(*kv, spec)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "robust_loss");
+        kv != nullptr && !ReadRobustLoss(*kv, spec)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "holdout"); kv != nullptr && !ReadHoldout(*kv, spec)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "solver"); kv != nullptr && !ReadSolver(*kv, spec)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "parameters");
+        kv != nullptr && !ReadParameters(*kv, spec)) {
+      return false;
+    }
+    return true;
+  }
+
+ private:
+  static const KeyValue* Find(const KeyMap& keys, const std::string& name) {
+    const auto it = keys.find(name);
+    return it == keys.end() ? nullptr : &it->second;
+  }
+
+  // Reads a mapping (a missing value counts as an empty one), rejecting duplicate keys
+  // and keys not in `allowed`; `unknown` says what an unknown key is.
+  bool ReadMap(const YAML::Node& node, int line, const std::string& path,
+               const std::vector<std::string>& allowed, KeyMap* keys,
+               const std::string& unknown = "unknown key (allowed here: ") {
+    if (!node.IsDefined() || node.IsNull()) return true;
+    if (!node.IsMap()) return Fail(line, path, "expected a mapping of keys");
+    for (const auto& kv : node) {
+      if (!kv.first.IsScalar()) return Fail(LineOf(kv.first), path, "keys must be plain names");
+      const std::string name = kv.first.Scalar();
+      const std::string key_path = Join(path, name);
+      bool known = false;
+      for (const std::string& a : allowed) known = known || a == name;
+      if (!known) return Fail(LineOf(kv.first), key_path, unknown + ListOf(allowed) + ")");
+      if (keys->count(name) != 0) return Fail(LineOf(kv.first), key_path, "duplicate key");
+      const int key_line = LineOf(kv.first) > 0 ? LineOf(kv.first) : line;
+      (*keys)[name] = KeyValue{kv.first, kv.second, key_line};
+    }
+    return true;
+  }
+
+  bool ReadMap(const KeyValue& kv, const std::string& path, const std::vector<std::string>& allowed,
+               KeyMap* keys) {
+    return ReadMap(kv.value, kv.line, path, allowed, keys);
+  }
+
+  bool ReadText(const KeyValue& kv, const std::string& path, std::string* text) {
+    if (kv.value.IsNull()) return Fail(kv.line, path, "has no value");
+    if (!kv.value.IsScalar()) return Fail(kv.line, path, "expected a name");
+    *text = kv.value.Scalar();
+    return true;
+  }
+
+  bool ReadChoice(const KeyValue& kv, const std::string& path,
+                  const std::vector<std::string>& choices, int* choice) {
+    std::string text;
+    if (!ReadText(kv, path, &text)) return false;
+    for (size_t k = 0; k < choices.size(); ++k) {
+      if (text == choices[k]) {
+        *choice = static_cast<int>(k);
+        return true;
+      }
+    }
+    return Fail(kv.line, path,
+                "unknown value \"" + text + "\" (accepted: " + ListOf(choices) + ")");
+  }
+
+  // A finite number; quoted text, .nan and .inf are refused.
+  bool ReadDouble(const KeyValue& kv, const std::string& path, double* value) {
+    const YAML::Node& node = kv.value;
+    if (node.IsNull()) return Fail(kv.line, path, "has no value (expected a number)");
+    if (!node.IsScalar()) return Fail(kv.line, path, "expected a number");
+    const std::string& text = node.Scalar();
+    if (node.Tag() == "!") {
+      return Fail(kv.line, path, "expected a number, got the quoted text \"" + text + "\"");
+    }
+    for (const char* special : {".nan", ".NaN", ".NAN", ".inf", ".Inf", ".INF", "+.inf", "+.Inf",
+                                "+.INF", "-.inf", "-.Inf", "-.INF"}) {
+      if (text == special) return Fail(kv.line, path, "must be finite, got " + text);
+    }
+    const char* begin = text.data();
+    const char* end = text.data() + text.size();
+    if (begin != end && *begin == '+') ++begin;  // YAML allows it, from_chars does not
+    double parsed = 0.0;
+    const auto [ptr, ec] = std::from_chars(begin, end, parsed);
+    if (ec == std::errc::result_out_of_range) return Fail(kv.line, path, "out of range: " + text);
+    if (ec != std::errc() || ptr != end || begin == end) {
+      return Fail(kv.line, path, "expected a number, got \"" + text + "\"");
+    }
+    if (!std::isfinite(parsed)) return Fail(kv.line, path, "must be finite, got " + text);
+    *value = parsed;
+    return true;
+  }
+
+  template <typename Int>
+  bool ReadInteger(const KeyValue& kv, const std::string& path, Int* value) {
+    const YAML::Node& node = kv.value;
+    if (node.IsNull()) return Fail(kv.line, path, "has no value (expected an integer)");
+    if (!node.IsScalar() || node.Tag() == "!") return Fail(kv.line, path, "expected an integer");
+    const std::string& text = node.Scalar();
+    Int parsed = 0;
+    const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), parsed);
+    if (ec != std::errc() || ptr != text.data() + text.size() || text.empty()) {
+      return Fail(kv.line, path,
+                  std::string("expected ") +
+                      (std::is_signed<Int>::value ? "an integer" : "an integer >= 0") + ", got \"" +
+                      text + "\"");
+    }
+    *value = parsed;
+    return true;
+  }
+
+  bool ReadBool(const KeyValue& kv, const std::string& path, bool* value) {
+    const YAML::Node& node = kv.value;
+    if (node.IsNull()) return Fail(kv.line, path, "has no value (expected true or false)");
+    if (node.IsScalar() && node.Tag() != "!") {
+      const std::string& t = node.Scalar();
+      if (t == "true" || t == "True" || t == "TRUE" || t == "false" || t == "False" ||
+          t == "FALSE") {
+        *value = t[0] == 't' || t[0] == 'T';
+        return true;
+      }
+    }
+    return Fail(kv.line, path,
+                "expected true or false" +
+                    (node.IsScalar() ? ", got \"" + node.Scalar() + "\"" : std::string()));
+  }
+
+  // Fails with `what` unless it is empty.
+  bool Check(const std::string& what, int line, const std::string& path) {
+    return what.empty() || Fail(line, path, what);
+  }
+
+  bool ReadNoise(const KeyValue& noise, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(noise, "noise", {"tension_sigma_kN", "tension_sigma_percent"}, &keys)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "tension_sigma_kN")) {
+      const std::string path = "noise.tension_sigma_kN";
+      double kn = 0.0;
+      if (!ReadDouble(*kv, path, &kn) || !Check(CheckNonNegative(kn), kv->line, path)) {
+        return false;
+      }
+      spec->tension_sigma_n = kn * kNewtonsPerKilonewton;
+    }
+    if (const KeyValue* kv = Find(keys, "tension_sigma_percent")) {
+      const std::string path = "noise.tension_sigma_percent";
+      if (!ReadDouble(*kv, path, &spec->tension_sigma_percent) ||
+          !Check(CheckNonNegative(spec->tension_sigma_percent), kv->line, path)) {
+        return false;
+      }
+    }
+    if (spec->tension_sigma_n == 0.0 && spec->tension_sigma_percent == 0.0) {
+      return Fail(noise.line, "noise", kBothNoiseZero);
+    }
+    return true;
+  }
+
+  bool ReadRobustLoss(const KeyValue& loss, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(loss, "robust_loss", {"type", "scale"}, &keys)) return false;
+    if (const KeyValue* kv = Find(keys, "type")) {
+      int choice = 0;
+      if (!ReadChoice(*kv, "robust_loss.type", {"none", "huber", "cauchy"}, &choice)) {
+        return false;
+      }
+      const RobustLoss kLosses[] = {RobustLoss::kNone, RobustLoss::kHuber, RobustLoss::kCauchy};
+      spec->robust_loss = kLosses[choice];
+    }
+    if (const KeyValue* kv = Find(keys, "scale")) {
+      const std::string path = "robust_loss.scale";
+      if (!ReadDouble(*kv, path, &spec->robust_loss_scale) ||
+          !Check(CheckPositive(spec->robust_loss_scale), kv->line, path)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  bool ReadHoldout(const KeyValue& holdout, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(holdout, "holdout", {"fraction", "seed"}, &keys)) return false;
+    if (const KeyValue* kv = Find(keys, "fraction")) {
+      const std::string path = "holdout.fraction";
+      if (!ReadDouble(*kv, path, &spec->holdout_fraction) ||
+          !Check(CheckHoldoutFraction(spec->holdout_fraction), kv->line, path)) {
+        return false;
+      }
+    }
+    if (const KeyValue* kv = Find(keys, "seed")) {
+      if (!ReadInteger(*kv, "holdout.seed", &spec->holdout_seed)) return false;
+    }
+    return true;
+  }
+
+  bool ReadSolver(const KeyValue& solver, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(solver, "solver",
+                 {"max_iterations", "function_tolerance", "gradient_tolerance",
+                  "parameter_tolerance", "threads"},
+                 &keys)) {
+      return false;
+    }
+    const std::pair<const char*, int*> kInts[] = {{"max_iterations", &spec->max_iterations},
+                                                  {"threads", &spec->num_threads}};
+    for (const auto& [name, field] : kInts) {
+      const std::string path = Join("solver", name);
+      if (const KeyValue* kv = Find(keys, name)) {
+        if (!ReadInteger(*kv, path, field) || !Check(CheckAtLeastOne(*field), kv->line, path)) {
+          return false;
+        }
+      }
+    }
+    const std::pair<const char*, double*> kDoubles[] = {
+        {"function_tolerance", &spec->function_tolerance},
+        {"gradient_tolerance", &spec->gradient_tolerance},
+        {"parameter_tolerance", &spec->parameter_tolerance}};
+    for (const auto& [name, field] : kDoubles) {
+      const std::string path = Join("solver", name);
+      if (const KeyValue* kv = Find(keys, name)) {
+        if (!ReadDouble(*kv, path, field) || !Check(CheckPositive(*field), kv->line, path)) {
+          return false;
+        }
+      }
+    }
+    return true;
+  }
+
+  // The entry keys free / initial / prior out of `keys` (already read as a mapping).
+  bool ReadEntryKeys(const KeyMap& keys, const GroupInfo& g, const std::string& path,
+                     EntryText* entry) {
+    if (const KeyValue* kv = Find(keys, "free")) {
+      bool free = false;
+      if (!ReadBool(*kv, Join(path, "free"), &free)) return false;
+      entry->free = free;
+    }
+    if (const KeyValue* kv = Find(keys, "initial")) {
+      const std::string initial_path = Join(path, "initial");
+      double initial = 0.0;
+      if (!ReadDouble(*kv, initial_path, &initial) ||
+          !Check(CheckInitial(g.kind, initial * g.to_si), kv->line, initial_path)) {
+        return false;
+      }
+      entry->initial = initial;
+    }
+    if (const KeyValue* kv = Find(keys, "prior")) {
+      const std::string prior_path = Join(path, "prior");
+      KeyMap prior;
+      if (kv->value.IsNull())
+        return Fail(kv->line, prior_path, "has no value (expected {mean, sigma})");
+      if (!ReadMap(*kv, prior_path, {"mean", "sigma"}, &prior)) return false;
+      double mean = 0.0;
+      double sigma = 0.0;
+      for (const char* name : {"mean", "sigma"}) {
+        if (Find(prior, name) == nullptr) {
+          return Fail(kv->line, Join(prior_path, name),
+                      "missing (a prior needs both mean and sigma)");
+        }
+      }
+      const KeyValue& mean_kv = prior.at("mean");
+      const KeyValue& sigma_kv = prior.at("sigma");
+      const std::string mean_path = Join(prior_path, "mean");
+      const std::string sigma_path = Join(prior_path, "sigma");
+      if (!ReadDouble(mean_kv, mean_path, &mean) ||
+          !Check(CheckPriorMean(mean * g.to_si), mean_kv.line, mean_path) ||
+          !ReadDouble(sigma_kv, sigma_path, &sigma) ||
+          !Check(CheckPositive(sigma * g.to_si), sigma_kv.line, sigma_path)) {
+        return false;
+      }
+      entry->prior = std::make_pair(mean, sigma);
+    }
+    return true;
+  }
+
+  // A plain entry: {free, initial, prior}, all optional.
+  bool ReadEntry(const YAML::Node& node, int line, const GroupInfo& g, const std::string& path,
+                 EntryText* entry) {
+    KeyMap keys;
+    return ReadMap(node, line, path, {"free", "initial", "prior"}, &keys) &&
+           ReadEntryKeys(keys, g, path, entry);
+  }
+
+  // {x: entry, y: entry, z: entry}, each optional; a named axis yields a parameter.
+  bool ReadAxes(const YAML::Node& node, int line, const GroupInfo& g, int index,
+                const std::string& path, std::vector<ParameterSpec>* out) {
+    KeyMap keys;
+    if (!ReadMap(node, line, path, {"x", "y", "z"}, &keys)) return false;
+    for (int c = 0; c < 3; ++c) {
+      const std::string axis(1, kAxes[c]);
+      if (const KeyValue* kv = Find(keys, axis)) {
+        EntryText entry;
+        if (!ReadEntry(kv->value, kv->line, g, Join(path, axis), &entry)) return false;
+        out->push_back(MakeParameter(g, index, c, entry));
+      }
+    }
+    return true;
+  }
+
+  bool ReadPerCableGroup(const KeyValue& group, const GroupInfo& g, const std::string& path,
+                         std::vector<ParameterSpec>* out) {
+    KeyMap keys;
+    if (!ReadMap(group, path, {"mode", "free", "initial", "prior", "cables"}, &keys)) {
+      return false;
+    }
+    EntryText base;
+    if (!ReadEntryKeys(keys, g, path, &base)) return false;
+    int mode = 0;  // 0 common, 1 per_cable
+    if (const KeyValue* kv = Find(keys, "mode")) {
+      if (!ReadChoice(*kv, Join(path, "mode"), {"common", "per_cable"}, &mode)) return false;
+    }
+    const KeyValue* cables = Find(keys, "cables");
+    if (mode == 0) {
+      if (cables != nullptr) {
+        return Fail(cables->line, Join(path, "cables"),
+                    "only allowed with mode: per_cable (this group is common to all cables)");
+      }
+      out->push_back(MakeParameter(g, -1, -1, base));
+      return true;
+    }
+    std::array<EntryText, kNumCables> per_cable;
+    per_cable.fill(base);
+    if (cables != nullptr) {
+      const std::string list_path = Join(path, "cables");
+      const YAML::Node& list = cables->value;
+      if (!list.IsSequence() || list.size() != kNumCables) {
+        return Fail(cables->line, list_path,
+                    "expected a list of exactly 6 entries (cable 1 first), got " +
+                        (list.IsSequence() ? std::to_string(list.size()) + " entries"
+                                           : std::string("no list")));
+      }
+      for (size_t i = 0; i < kNumCables; ++i) {
+        const int line = LineOf(list[i]) > 0 ? LineOf(list[i]) : cables->line;
+        EntryText over;
+        if (!ReadEntry(list[i], line, g, Element(list_path, i), &over)) return false;
+        per_cable[i] = Override(base, over);
+      }
+    }
+    for (int i = 0; i < kNumCables; ++i) out->push_back(MakeParameter(g, i, -1, per_cable[i]));
+    return true;
+  }
+
+  // {all: entry} or a list of {x, y, z} maps, one per anchor point / tower.
+  bool ReadOffsets(const KeyValue& group, const GroupInfo& g, const std::string& path,
+                   std::vector<ParameterSpec>* out) {
+    const bool anchors = g.kind == ParameterKind::kAnchorOffset;
+    const int count = anchors ? num_anchor_points_ : kNumCables;
+    const std::string what = anchors ? "anchor points" : "towers";
+    if (group.value.IsSequence()) {
+      const YAML::Node& list = group.value;
+      if (static_cast<int>(list.size()) > count) {
+        return Fail(group.line, path,
+                    "has " + std::to_string(list.size()) + " entries but the model has " +
+                        std::to_string(count) + " " + what);
+      }
+      for (size_t j = 0; j < list.size(); ++j) {
+        const int line = LineOf(list[j]) > 0 ? LineOf(list[j]) : group.line;
+        if (!ReadAxes(list[j], line, g, static_cast<int>(j), Element(path, j), out)) {
+          return false;
+        }
+      }
+      return true;
+    }
+    if (!group.value.IsNull() && !group.value.IsMap()) {
+      return Fail(group.line, path,
+                  "expected {all: entry} or a list of {x, y, z} entries, one per " +
+                      what.substr(0, what.size() - 1));
+    }
+    KeyMap keys;
+    if (!ReadMap(group, path, {"all"}, &keys)) return false;
+    if (const KeyValue* kv = Find(keys, "all")) {
+      EntryText entry;
+      if (!ReadEntry(kv->value, kv->line, g, Join(path, "all"), &entry)) return false;
+      if (count < 1) return Fail(kv->line, Join(path, "all"), "the model has no " + what);
+      for (int j = 0; j < count; ++j) {
+        for (int c = 0; c < 3; ++c) out->push_back(MakeParameter(g, j, c, entry));
+      }
+    }
+    return true;
+  }
+
+  bool ReadParameters(const KeyValue& parameters, CalibrationSpec* spec) {
+    std::vector<std::string> accepted;
+    for (const GroupInfo& g : kGroups) accepted.push_back(g.key);
+    KeyMap keys;
+    if (!ReadMap(parameters.value, parameters.line, "parameters", accepted, &keys,
+                 "unknown parameter (accepted: ")) {
+      return false;
+    }
+    std::vector<ParameterSpec> out;
+    for (const GroupInfo& g : kGroups) {  // canonical order
+      const KeyValue* kv = Find(keys, g.key);
+      if (kv == nullptr) continue;
+      const std::string path = Join("parameters", g.key);
+      bool ok = true;
+      if (g.kind == ParameterKind::kMassCentre) {
+        ok = ReadAxes(kv->value, kv->line, g, -1, path, &out);
+      } else if (g.kind == ParameterKind::kCabinMass) {
+        EntryText entry;
+        ok = ReadEntry(kv->value, kv->line, g, path, &entry);
+        if (ok) out.push_back(MakeParameter(g, -1, -1, entry));
+      } else if (IsPerCableCapable(g.kind)) {
+        ok = ReadPerCableGroup(*kv, g, path, &out);
+      } else {
+        ok = ReadOffsets(*kv, g, path, &out);
+      }
+      if (!ok) return false;
+    }
+    spec->parameters = std::move(out);
+    return true;
+  }
+
+  std::string source_;
+  int num_anchor_points_;
+  std::string error_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Writer.
+
+// {free: ..., initial: ..., prior: {mean: ..., sigma: ...}} in the group's file unit.
+std::string EntryYaml(const ParameterSpec& p, const GroupInfo& g) {
+  std::string s = std::string("free: ") + (p.free ? "true" : "false");
+  if (p.has_initial) s += ", initial: " + NumInUnit(p.initial_si, g.to_si);
+  if (p.has_prior) {
+    s += ", prior: {mean: " + NumInUnit(p.prior_mean_si, g.to_si) +
+         ", sigma: " + NumInUnit(p.prior_sigma_si, g.to_si) + "}";
+  }
+  return "{" + s + "}";
+}
+
+// The named axes of one point (index ignored for the mass centre), "x: {...}" each.
+std::vector<std::string> AxisLines(const CalibrationSpec& spec, const GroupInfo& g, int index) {
+  std::vector<std::string> lines;
+  for (int c = 0; c < 3; ++c) {
+    for (const ParameterSpec& p : spec.parameters) {
+      if (p.kind == g.kind && p.component == c &&
+          (g.kind == ParameterKind::kMassCentre || p.index == index)) {
+        lines.push_back(std::string(1, kAxes[c]) + ": " + EntryYaml(p, g));
+        break;
+      }
+    }
+  }
+  return lines;
+}
+
+}  // namespace
+
+bool CalibrationSpec::IsValid(std::string* error) const {
+  auto fail = [error](const std::string& what) {
+    if (error != nullptr) *error = what;
+    return false;
+  };
+  if (!IsKnownMethod(forward_model)) return fail("forward_model: unknown statics method");
+  if (const std::string w = CheckNonNegative(tension_sigma_n); !w.empty()) {
+    return fail("tension_sigma_n: " + w);
+  }
+  if (const std::string w = CheckNonNegative(tension_sigma_percent); !w.empty()) {
+    return fail("tension_sigma_percent: " + w);
+  }
+  if (tension_sigma_n == 0.0 && tension_sigma_percent == 0.0) {
+    return fail(std::string("noise: ") + kBothNoiseZero);
+  }
+  if (RobustLossName(robust_loss) == nullptr) return fail("robust_loss: unknown loss");
+  if (const std::string w = CheckPositive(robust_loss_scale); !w.empty()) {
+    return fail("robust_loss_scale: " + w);
+  }
+  if (const std::string w = CheckHoldoutFraction(holdout_fraction); !w.empty()) {
+    return fail("holdout_fraction: " + w);
+  }
+  if (const std::string w = CheckAtLeastOne(max_iterations); !w.empty()) {
+    return fail("max_iterations: " + w);
+  }
+  if (const std::string w = CheckAtLeastOne(num_threads); !w.empty()) {
+    return fail("num_threads: " + w);
+  }
+  const std::pair<const char*, double> kTolerances[] = {
+      {"function_tolerance", function_tolerance},
+      {"gradient_tolerance", gradient_tolerance},
+      {"parameter_tolerance", parameter_tolerance}};
+  for (const auto& [name, value] : kTolerances) {
+    if (const std::string w = CheckPositive(value); !w.empty()) {
+      return fail(std::string(name) + ": " + w);
+    }
+  }
+
+  // (kind, index, component) with the fields that do not apply set to -1.
+  std::set<std::tuple<int, int, int>> seen;
+  std::set<int> kinds_common, kinds_per_cable;
+  for (size_t k = 0; k < parameters.size(); ++k) {
+    const ParameterSpec& p = parameters[k];
+    const std::string label = p.name.empty() ? "parameters[" + std::to_string(k) + "]" : p.name;
+    const GroupInfo* g = InfoOf(p.kind);
+    if (g == nullptr) return fail(label + ": unknown parameter kind");
+    if (p.name.empty()) return fail(label + ": has no name");
+    if (IsVector(p.kind) && (p.component < 0 || p.component > 2)) {
+      return fail(label + ": component must be 0, 1 or 2 (x, y, z)");
+    }
+    if (IsPerCableCapable(p.kind) && (p.index < -1 || p.index >= kNumCables)) {
+      return fail(label + ": index must be -1 (all cables) or a cable 0..5");
+    }
+    if (p.kind == ParameterKind::kAnchorOffset && p.index < 0) {
+      return fail(label + ": index must be an anchor point >= 0");
+    }
+    if (p.kind == ParameterKind::kTowerOffset && (p.index < 0 || p.index >= kNumCables)) {
+      return fail(label + ": index must be a tower 0..5");
+    }
+    if (!(std::isfinite(p.to_si) && p.to_si > 0.0)) return fail(label + ": to_si must be > 0");
+    if (p.has_initial) {
+      if (const std::string w = CheckInitial(p.kind, p.initial_si); !w.empty()) {
+        return fail(label + ".initial: " + w);
+      }
+    }
+    if (p.has_prior) {
+      if (const std::string w = CheckPriorMean(p.prior_mean_si); !w.empty()) {
+        return fail(label + ".prior.mean: " + w);
+      }
+      if (const std::string w = CheckPositive(p.prior_sigma_si); !w.empty()) {
+        return fail(label + ".prior.sigma: " + w);
+      }
+    }
+    const bool indexed =
+        p.kind != ParameterKind::kMassCentre && p.kind != ParameterKind::kCabinMass;
+    const auto key = std::make_tuple(static_cast<int>(p.kind), indexed ? p.index : -1,
+                                     IsVector(p.kind) ? p.component : -1);
+    if (!seen.insert(key).second) return fail(label + ": listed twice");
+    if (IsPerCableCapable(p.kind)) {
+      (p.index < 0 ? kinds_common : kinds_per_cable).insert(static_cast<int>(p.kind));
+      if (kinds_common.count(static_cast<int>(p.kind)) != 0 &&
+          kinds_per_cable.count(static_cast<int>(p.kind)) != 0) {
+        return fail(label + ": " + g->key +
+                    " is listed both for all cables (common) and per cable; choose one mode");
+      }
+    }
+  }
+  return true;
+}
+
+bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
+                              int num_anchor_points, CalibrationSpec* spec, std::string* error) {
+  Reader reader(source_name, num_anchor_points);
+  CalibrationSpec parsed;
+  try {
+    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
+    if (documents.size() > 1) {
+      reader.Fail(LineOf(documents[1]), kRootPath, "only one YAML document is allowed");
+    } else if (documents.empty() || documents[0].IsNull() ||  // empty file: all defaults
+               reader.ReadRoot(documents[0], &parsed)) {
+      // The reader checked every value where it read it; this only guards the two
+      // against drifting apart.
+      std::string why;
+      if (!parsed.IsValid(&why)) reader.Fail(0, kRootPath, why);
+    }
+  } catch (const YAML::Exception& e) {
+    reader.Fail(e.mark.line < 0 ? 0 : e.mark.line + 1, "YAML syntax error", e.msg);
+  } catch (const std::exception& e) {
+    reader.Fail(0, kRootPath, std::string("cannot read: ") + e.what());
+  }
+  if (!reader.error().empty()) {
+    if (error != nullptr) *error = reader.error();
+    return false;
+  }
+  *spec = std::move(parsed);
+  return true;
+}
+
+bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
+                         std::string* error) {
+  std::string text;
+  try {
+    std::error_code ec;
+    std::ifstream in(path, std::ios::binary);
+    if (!in || std::filesystem::is_directory(path, ec)) {
+      if (error != nullptr) *error = path + ": cannot open";
+      return false;
+    }
+    std::ostringstream contents;
+    contents << in.rdbuf();
+    if (in.bad()) {
+      if (error != nullptr) *error = path + ": cannot read";
+      return false;
+    }
+    text = contents.str();
+  } catch (const std::exception& e) {
+    if (error != nullptr) *error = path + ": cannot read: " + e.what();
+    return false;
+  }
+  return ParseCalibrationSpecYaml(text, path, num_anchor_points, spec, error);
+}
+
+std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
+  std::ostringstream out;
+  out << "format: " << kFormatName << "\n";
+  out << "forward_model: " << StaticsMethodName(spec.forward_model) << "\n";
+  out << "noise: {tension_sigma_kN: " << NumInUnit(spec.tension_sigma_n, kNewtonsPerKilonewton)
+      << ", tension_sigma_percent: " << Num(spec.tension_sigma_percent) << "}\n";
+  const char* loss = RobustLossName(spec.robust_loss);
+  out << "robust_loss: {type: " << (loss != nullptr ? loss : "unknown")
+      << ", scale: " << Num(spec.robust_loss_scale) << "}\n";
+  out << "holdout: {fraction: " << Num(spec.holdout_fraction) << ", seed: " << spec.holdout_seed
+      << "}\n";
+  out << "attitude: " << (spec.use_planned_attitude ? "planned" : "measured") << "\n";
+  out << "solver: {max_iterations: " << spec.max_iterations
+      << ", function_tolerance: " << Num(spec.function_tolerance)
+      << ", gradient_tolerance: " << Num(spec.gradient_tolerance)
+      << ", parameter_tolerance: " << Num(spec.parameter_tolerance)
+      << ", threads: " << spec.num_threads << "}\n";
+  if (spec.parameters.empty()) {
+    out << "parameters: {}\n";
+    return out.str();
+  }
+  out << "parameters:\n";
+  for (const GroupInfo& g : kGroups) {
+    std::vector<const ParameterSpec*> group;
+    for (const ParameterSpec& p : spec.parameters) {
+      if (p.kind == g.kind) group.push_back(&p);
+    }
+    if (group.empty()) continue;
+    out << "  " << g.key << ":";
+    if (g.kind == ParameterKind::kMassCentre) {
+      out << "\n";
+      for (const std::string& line : AxisLines(spec, g, -1)) out << "    " << line << "\n";
+    } else if (g.kind == ParameterKind::kCabinMass) {
+      out << " " << EntryYaml(*group.front(), g) << "\n";
+    } else if (IsPerCableCapable(g.kind)) {
+      if (group.front()->index < 0) {
+        const std::string entry = EntryYaml(*group.front(), g);
+        out << " {mode: common, " << entry.substr(1) << "\n";
+      } else {
+        // Cables not listed are written fixed without a value: the model's, as before.
+        out << "\n    mode: per_cable\n    cables:\n";
+        for (int i = 0; i < kNumCables; ++i) {
+          ParameterSpec fixed;
+          const ParameterSpec* p = &fixed;
+          for (const ParameterSpec* q : group) {
+            if (q->index == i) p = q;
+          }
+          out << "      - " << EntryYaml(*p, g) << "  # cable " << i + 1 << "\n";
+        }
+      }
+    } else {  // offsets: one list element per point up to the last one listed
+      int last = -1;
+      for (const ParameterSpec* p : group) last = std::max(last, p->index);
+      out << "\n";
+      const char* what = g.kind == ParameterKind::kAnchorOffset ? "anchor point" : "tower";
+      for (int j = 0; j <= last; ++j) {
+        const std::vector<std::string> lines = AxisLines(spec, g, j);
+        const std::string comment = std::string("  # ") + what + " " + std::to_string(j + 1);
+        if (lines.empty()) out << "    - {}" << comment << "\n";
+        for (size_t k = 0; k < lines.size(); ++k) {
+          out << (k == 0 ? "    - " : "      ") << lines[k] << (k == 0 ? comment : "") << "\n";
+        }
+      }
+    }
+  }
+  return out.str();
+}
+
+}  // namespace fastcal
