@@ -1,2 +1,406 @@
+// Tests of the telemetry simulator: exactness without noise, sensor model, noise
+// statistics, reproducibility, density mismatch, outliers, errors, CSV round trip.
+#include "fastcal/simulation.h"
+
 #include <gtest/gtest.h>
-TEST(Placeholder, Builds) { SUCCEED(); }
+#include <stdlib.h>
+
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "fastcal/dataset.h"
+#include "fastcal/statics.h"
+#include "fastcal/trajectory.h"
+
+namespace fastcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Exact statics converge to 1e-12; warm and cold starts agree far better than this.
+constexpr double kTensionRelTolerance = 1e-9;
+constexpr double kLengthTolerance_m = 1e-9;
+// Over N readings the sample RMS of a Gaussian has a standard error of sigma / sqrt(2N)
+// and the mean sigma / sqrt(N); these allow about 4.5 standard errors at N = 2160.
+constexpr double kNoiseSigma = 0.03;
+constexpr double kRmsTolerance = 0.0021;
+constexpr double kMeanTolerance = 0.0029;
+// Binomial: outlier fraction 0.1 over 2160 readings has a standard error of 0.0065.
+constexpr double kOutlierFraction = 0.1;
+constexpr double kOutlierFractionTolerance = 0.03;
+constexpr double kOutlierScalePercent = 30.0;
+
+// The paper's measured circle, with the focal attitude law.
+std::vector<Pose> Circle(int nodes) {
+  ArcSpec arc;
+  arc.centre_m = Eigen::Vector3d(0.0, 0.0, 156.73);
+  arc.radius_m = 71.11;
+  arc.start_deg = 0.0;
+  arc.end_deg = 360.0;
+  arc.nodes = nodes;
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Pose> poses;
+  std::string error;
+  EXPECT_TRUE(ArcPositions(arc, &positions, &error)) << error;
+  EXPECT_TRUE(PosesWithAttitudeLaw(positions, FocalAttitudeLaw(), &poses, &error)) << error;
+  return poses;
+}
+
+SimulationOptions NoNoise() {
+  SimulationOptions o;
+  o.tension_noise_percent = 0.0;
+  return o;
+}
+
+StaticsSolution ExactAt(const CableRobot& robot, const Pose& pose) {
+  StaticsOptions options;
+  options.method = StaticsMethod::kExact;
+  StaticsSolution s;
+  EXPECT_EQ(SolveStatics(robot, pose, options, &s), StaticsStatus::kOk) << DescribeStatus(s);
+  return s;
+}
+
+bool SameDataset(const Dataset& a, const Dataset& b) {
+  if (a.samples.size() != b.samples.size()) return false;
+  for (size_t n = 0; n < a.samples.size(); ++n) {
+    const Sample& x = a.samples[n];
+    const Sample& y = b.samples[n];
+    if (x.time_s != y.time_s || x.pose.position_m != y.pose.position_m ||
+        x.pose.rotation != y.pose.rotation || x.planned_rotation != y.planned_rotation ||
+        x.tension_n != y.tension_n || x.unstretched_length_m != y.unstretched_length_m) {
+      return false;
+    }
+  }
+  return true;
+}
+
+TEST(SimulationTest, WithoutNoiseTensionsAreTheExactStaticsAtThePlannedPose) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(36);
+  SimulationOptions options = NoNoise();
+  options.sample_interval_s = 0.5;
+  Dataset data;
+  CableRobot used;
+  SimulationSummary summary;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, &used, &summary, &error)) << error;
+  ASSERT_EQ(data.samples.size(), planned.size());
+  EXPECT_TRUE(data.has_planned_attitude);
+  EXPECT_TRUE(data.has_unstretched_lengths);
+  EXPECT_EQ(summary.samples, 36);
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_EQ(used.cables[i].linear_density_kg_per_m, truth.cables[i].linear_density_kg_per_m);
+    EXPECT_EQ(summary.tension_noise_rms_n[i], 0.0);
+  }
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const Sample& s = data.samples[n];
+    EXPECT_EQ(s.time_s, 0.5 * static_cast<double>(n));
+    EXPECT_EQ(s.pose.position_m, planned[n].position_m);
+    EXPECT_EQ(s.measured_rpy_deg, s.planned_rpy_deg) << "node " << n;
+    EXPECT_EQ(s.pose.rotation, s.planned_rotation) << "node " << n;
+    EXPECT_EQ(s.planned_rpy_deg, RpyDegFromRotation(planned[n].rotation));
+    const StaticsSolution exact = ExactAt(truth, planned[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_NEAR(s.tension_n[i], exact.cables[i].lower_tension_n,
+                  kTensionRelTolerance * exact.cables[i].lower_tension_n)
+          << "node " << n << " cable " << i + 1;
+      EXPECT_NEAR(s.unstretched_length_m[i], exact.cables[i].unstretched_length_m,
+                  kLengthTolerance_m);
+    }
+  }
+}
+
+TEST(SimulationTest, SensorGainAndBiasApplyToTheReading) {
+  CableRobot truth = CableRobot::NominalFast();
+  const double gains[kNumCables] = {1.02, 0.98, 1.0, 1.05, 0.95, 1.01};
+  const double biases_n[kNumCables] = {1500.0, -2000.0, 0.0, 500.0, 3000.0, -700.0};
+  for (int i = 0; i < kNumCables; ++i) {
+    truth.cables[i].sensor_gain = gains[i];
+    truth.cables[i].sensor_bias_n = biases_n[i];
+  }
+  const std::vector<Pose> planned = Circle(8);
+  Dataset data;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, NoNoise(), &data, nullptr, nullptr, &error)) << error;
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const StaticsSolution exact = ExactAt(truth, planned[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      const double expected_n = gains[i] * exact.cables[i].lower_tension_n + biases_n[i];
+      EXPECT_NEAR(data.samples[n].tension_n[i], expected_n, kTensionRelTolerance * expected_n)
+          << "node " << n << " cable " << i + 1;
+    }
+  }
+}
+
+TEST(SimulationTest, RelativeTensionNoiseHasTheRequestedSigma) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(360);
+  SimulationOptions options;
+  options.tension_noise_percent = 100.0 * kNoiseSigma;
+  Dataset data;
+  SimulationSummary summary;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, nullptr, &summary, &error)) << error;
+  double sum = 0.0, sum_sq = 0.0;
+  int count = 0;
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const StaticsSolution exact = ExactAt(truth, planned[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      const double e = data.samples[n].tension_n[i] / exact.cables[i].lower_tension_n - 1.0;
+      sum += e;
+      sum_sq += e * e;
+      ++count;
+    }
+  }
+  ASSERT_EQ(count, 2160);
+  EXPECT_NEAR(std::sqrt(sum_sq / count), kNoiseSigma, kRmsTolerance);
+  EXPECT_NEAR(sum / count, 0.0, kMeanTolerance);
+  EXPECT_EQ(summary.redrawn, 0);
+  // The summary reports the same noise, per cable (360 readings each: wider tolerance).
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_NEAR(summary.tension_noise_rms_relative[i], kNoiseSigma, 2.5 * kRmsTolerance);
+  }
+}
+
+TEST(SimulationTest, PoseErrorsHaveTheRequestedSigmas) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(360);
+  constexpr double kControlSigma_deg = 0.2;
+  constexpr double kMeasurementSigma_deg = 0.02;
+  constexpr double kPositionSigma_m = 0.01;
+  // RMS over 1080 values: standard error sigma / sqrt(2160) ~ 2.2% of sigma.
+  constexpr double kRelativeRmsTolerance = 0.1;
+  SimulationOptions options;
+  options.attitude_control_sigma_deg = kControlSigma_deg;
+  options.attitude_measurement_sigma_deg = kMeasurementSigma_deg;
+  options.position_measurement_sigma_m = kPositionSigma_m;
+  Dataset data;
+  SimulationSummary summary;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, nullptr, &summary, &error)) << error;
+  double attitude_sq = 0.0, position_sq = 0.0;
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const Sample& s = data.samples[n];
+    attitude_sq += (s.measured_rpy_deg - s.planned_rpy_deg).squaredNorm();
+    position_sq += (s.pose.position_m - planned[n].position_m).squaredNorm();
+  }
+  const double values = 3.0 * static_cast<double>(planned.size());
+  const double expected_attitude_deg = std::hypot(kControlSigma_deg, kMeasurementSigma_deg);
+  EXPECT_NEAR(std::sqrt(attitude_sq / values), expected_attitude_deg,
+              kRelativeRmsTolerance * expected_attitude_deg);
+  EXPECT_NEAR(std::sqrt(position_sq / values), kPositionSigma_m,
+              kRelativeRmsTolerance * kPositionSigma_m);
+  EXPECT_NEAR(summary.attitude_control_rms_deg, kControlSigma_deg,
+              kRelativeRmsTolerance * kControlSigma_deg);
+  EXPECT_NEAR(summary.attitude_measurement_rms_deg, kMeasurementSigma_deg,
+              kRelativeRmsTolerance * kMeasurementSigma_deg);
+  EXPECT_NEAR(summary.position_measurement_rms_m, kPositionSigma_m,
+              kRelativeRmsTolerance * kPositionSigma_m);
+}
+
+TEST(SimulationTest, TensionsComeFromTheActualNotThePlannedAttitude) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(12);
+  // No measurement noise: the measured pose is the actual one.
+  SimulationOptions options = NoNoise();
+  options.attitude_control_sigma_deg = 0.5;
+  Dataset data;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, nullptr, nullptr, &error)) << error;
+  double largest_change = 0.0;
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const Sample& s = data.samples[n];
+    const StaticsSolution actual = ExactAt(truth, s.pose);
+    const StaticsSolution at_plan = ExactAt(truth, planned[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_NEAR(s.tension_n[i], actual.cables[i].lower_tension_n,
+                  kTensionRelTolerance * actual.cables[i].lower_tension_n);
+      largest_change = std::max(largest_change,
+                                std::abs(s.tension_n[i] / at_plan.cables[i].lower_tension_n - 1.0));
+    }
+  }
+  EXPECT_GT(largest_change, 1e-3);  // a 0.5 deg attitude error moves tensions by ~1%
+}
+
+TEST(SimulationTest, SameSeedSameDatasetOtherSeedOtherDataset) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(24);
+  SimulationOptions options;
+  options.attitude_control_sigma_deg = 0.2;
+  options.attitude_measurement_sigma_deg = 0.02;
+  options.position_measurement_sigma_m = 0.01;
+  options.outlier_fraction = 0.05;
+  options.density_mismatch_percent = 1.0;
+  options.seed = 42;
+  Dataset a, b, c;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &a, nullptr, nullptr, &error)) << error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &b, nullptr, nullptr, &error)) << error;
+  options.seed = 43;
+  ASSERT_TRUE(Simulate(truth, planned, options, &c, nullptr, nullptr, &error)) << error;
+  EXPECT_TRUE(SameDataset(a, b));
+  EXPECT_FALSE(SameDataset(a, c));
+  for (size_t n = 0; n < a.samples.size(); ++n) {
+    EXPECT_NE(a.samples[n].tension_n[0], c.samples[n].tension_n[0]) << "node " << n;
+  }
+}
+
+TEST(SimulationTest, EachErrorSourceHasItsOwnStream) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(12);
+  SimulationOptions options;  // 3% tension noise
+  Dataset quiet, noisy_position;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &quiet, nullptr, nullptr, &error)) << error;
+  options.position_measurement_sigma_m = 0.05;
+  ASSERT_TRUE(Simulate(truth, planned, options, &noisy_position, nullptr, nullptr, &error))
+      << error;
+  for (size_t n = 0; n < planned.size(); ++n) {
+    EXPECT_EQ(quiet.samples[n].tension_n, noisy_position.samples[n].tension_n) << "node " << n;
+    EXPECT_NE(quiet.samples[n].pose.position_m, noisy_position.samples[n].pose.position_m);
+  }
+}
+
+TEST(SimulationTest, DensityMismatchChangesTheTruthReproducibly) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(6);
+  SimulationOptions options = NoNoise();
+  options.density_mismatch_percent = 5.0;
+  options.seed = 7;
+  CableRobot used_a, used_b;
+  SimulationSummary summary;
+  Dataset data;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, &used_a, &summary, &error)) << error;
+  ASSERT_TRUE(Simulate(truth, planned, options, nullptr, &used_b, nullptr, &error)) << error;
+  for (int i = 0; i < kNumCables; ++i) {
+    const double nominal = truth.cables[i].linear_density_kg_per_m;
+    EXPECT_NE(used_a.cables[i].linear_density_kg_per_m, nominal) << "cable " << i + 1;
+    EXPECT_EQ(used_a.cables[i].linear_density_kg_per_m, used_b.cables[i].linear_density_kg_per_m);
+    EXPECT_EQ(used_a.cables[i].linear_density_kg_per_m, nominal * summary.density_factor[i]);
+    EXPECT_LT(std::abs(summary.density_factor[i] - 1.0), 0.25);  // 5 sigma at 5%
+  }
+  // The tensions are those of the model actually used, not of the nominal one.
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const StaticsSolution exact = ExactAt(used_a, planned[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_NEAR(data.samples[n].tension_n[i], exact.cables[i].lower_tension_n,
+                  kTensionRelTolerance * exact.cables[i].lower_tension_n);
+    }
+  }
+}
+
+TEST(SimulationTest, OutlierFractionAndScaleAreRespected) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(360);
+  SimulationOptions options = NoNoise();  // readings are exact unless outliers
+  options.outlier_fraction = kOutlierFraction;
+  options.outlier_scale_percent = kOutlierScalePercent;
+  Dataset data;
+  SimulationSummary summary;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, nullptr, &summary, &error)) << error;
+  int changed = 0;
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const StaticsSolution exact = ExactAt(truth, planned[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      const double e = data.samples[n].tension_n[i] / exact.cables[i].lower_tension_n - 1.0;
+      EXPECT_LE(std::abs(e), kOutlierScalePercent / 100.0);
+      if (std::abs(e) > kTensionRelTolerance) ++changed;
+    }
+  }
+  int reported = 0;
+  for (int count : summary.outliers) reported += count;
+  EXPECT_EQ(changed, reported);
+  EXPECT_NEAR(static_cast<double>(changed) / 2160.0, kOutlierFraction, kOutlierFractionTolerance);
+}
+
+TEST(SimulationTest, InfeasiblePoseIsAnErrorNamingTheNode) {
+  const CableRobot truth = CableRobot::NominalFast();
+  std::vector<Pose> planned = Circle(4);
+  planned[2].position_m = Eigen::Vector3d(330.0, 0.0, 150.0);  // beyond the towers
+  planned[2].rotation.setIdentity();
+  Dataset data;
+  data.path = "untouched";
+  std::string error;
+  EXPECT_FALSE(Simulate(truth, planned, SimulationOptions(), &data, nullptr, nullptr, &error));
+  EXPECT_NE(error.find("node 2 "), std::string::npos) << error;
+  EXPECT_NE(error.find("330"), std::string::npos) << error;
+  EXPECT_NE(error.find("cable"), std::string::npos) << error;  // DescribeStatus names the cable
+  EXPECT_EQ(data.path, "untouched");
+}
+
+TEST(SimulationTest, InvalidOptionsAndInputsAreRejected) {
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(4);
+  std::string error;
+  auto rejects = [&](SimulationOptions o, const std::string& field) {
+    error.clear();
+    EXPECT_FALSE(o.IsValid(&error)) << field;
+    EXPECT_NE(error.find(field), std::string::npos) << error;
+    EXPECT_FALSE(Simulate(truth, planned, o, nullptr, nullptr, nullptr, &error)) << field;
+  };
+  SimulationOptions o;
+  EXPECT_TRUE(o.IsValid(&error)) << error;
+  o.attitude_control_sigma_deg = -0.1;
+  rejects(o, "attitude_control_sigma_deg");
+  o = SimulationOptions();
+  o.tension_noise_percent = NAN;
+  rejects(o, "tension_noise_percent");
+  o = SimulationOptions();
+  o.outlier_fraction = 1.5;
+  rejects(o, "outlier_fraction");
+  o = SimulationOptions();
+  o.outlier_scale_percent = 100.0;
+  rejects(o, "outlier_scale_percent");
+  o = SimulationOptions();
+  o.sample_interval_s = 0.0;
+  rejects(o, "sample_interval_s");
+
+  EXPECT_FALSE(Simulate(truth, {}, SimulationOptions(), nullptr, nullptr, nullptr, &error));
+  std::vector<Pose> bad = planned;
+  bad[1].position_m.x() = NAN;
+  EXPECT_FALSE(Simulate(truth, bad, SimulationOptions(), nullptr, nullptr, nullptr, &error));
+  EXPECT_NE(error.find("node 1"), std::string::npos) << error;
+  CableRobot negative_bias = truth;
+  negative_bias.cables[3].sensor_bias_n = -1e7;
+  EXPECT_FALSE(
+      Simulate(negative_bias, planned, SimulationOptions(), nullptr, nullptr, nullptr, &error));
+  EXPECT_NE(error.find("cable 4"), std::string::npos) << error;
+}
+
+TEST(SimulationTest, DatasetSurvivesWriteAndRead) {
+  std::string pattern = ::testing::TempDir() + "simulation_test_XXXXXX";
+  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+  const fs::path dir = pattern;
+  const std::string path = (dir / "sim.csv").string();
+
+  SimulationOptions options;
+  options.attitude_control_sigma_deg = 0.2;
+  options.attitude_measurement_sigma_deg = 0.02;
+  options.position_measurement_sigma_m = 0.01;
+  options.outlier_fraction = 0.05;
+  options.sample_interval_s = 0.1;
+  Dataset written, read;
+  std::string error;
+  ASSERT_TRUE(
+      Simulate(CableRobot::NominalFast(), Circle(36), options, &written, nullptr, nullptr, &error))
+      << error;
+  ASSERT_TRUE(WriteDataset(path, written, "simulated", &error)) << error;
+  ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &read, &error)) << error;
+  EXPECT_TRUE(read.has_planned_attitude);
+  EXPECT_TRUE(read.has_unstretched_lengths);
+  EXPECT_FALSE(read.attitude_as_quaternion);
+  EXPECT_TRUE(SameDataset(written, read));
+  for (size_t n = 0; n < read.samples.size(); ++n) {
+    EXPECT_EQ(read.samples[n].measured_rpy_deg, written.samples[n].measured_rpy_deg);
+    EXPECT_EQ(read.samples[n].planned_rpy_deg, written.samples[n].planned_rpy_deg);
+  }
+  std::error_code ignored;
+  fs::remove_all(dir, ignored);
+}
+
+}  // namespace
+}  // namespace fastcal

@@ -1,0 +1,273 @@
+// Synthetic telemetry from a truth model: attitude control error, pose and tension sensor
+// noise, outliers, sensor gain and bias, per-cable density mismatch (model: simulation.h).
+#include "fastcal/simulation.h"
+
+#include <cmath>
+#include <exception>
+#include <random>
+#include <sstream>
+
+namespace fastcal {
+namespace {
+
+constexpr double kNPerKn = 1e3;
+// Redraws allowed for one reading or density before giving up: the noise must be absurd
+// for one draw in a thousand to be acceptable.
+constexpr int kMaxRedraws = 1000;
+
+// Independent generator per error source, so each sigma affects only its own numbers.
+enum Stream : std::uint64_t {
+  kDensityStream = 0,
+  kAttitudeControlStream,
+  kAttitudeMeasurementStream,
+  kPositionStream,
+  kTensionNoiseStream,
+  kOutlierStream,
+};
+
+bool Fail(std::string* error, const std::string& message) {
+  if (error != nullptr) *error = message;
+  return false;
+}
+
+std::string Num(double value) {
+  std::ostringstream s;
+  s.precision(10);
+  s << value;
+  return s.str();
+}
+
+// SplitMix64 finaliser: spreads (seed, stream) over the generator's seed space.
+std::uint64_t MixSeed(std::uint64_t seed, std::uint64_t stream) {
+  std::uint64_t z = seed + 0x9e3779b97f4a7c15ULL * (stream + 1);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
+// Uniform and standard normal numbers from the raw 64-bit output of std::mt19937_64, the
+// same with every standard library (std distributions are not).
+class Random {
+ public:
+  Random(std::uint64_t seed, Stream stream) : engine_(MixSeed(seed, stream)) {}
+
+  // Uniform in [0, 1).
+  double Uniform01() { return static_cast<double>(engine_() >> 11) * 0x1.0p-53; }
+
+  // Standard normal, Box-Muller (pairs; the second value is kept for the next call).
+  double Normal() {
+    if (has_spare_) {
+      has_spare_ = false;
+      return spare_;
+    }
+    const double u1 = 1.0 - Uniform01();  // (0, 1]: log is finite
+    const double u2 = Uniform01();
+    const double r = std::sqrt(-2.0 * std::log(u1));
+    spare_ = r * std::sin(2.0 * M_PI * u2);
+    has_spare_ = true;
+    return r * std::cos(2.0 * M_PI * u2);
+  }
+
+  Eigen::Vector3d Normal3() {
+    const double x = Normal();
+    const double y = Normal();
+    return Eigen::Vector3d(x, y, Normal());
+  }
+
+ private:
+  std::mt19937_64 engine_;
+  bool has_spare_ = false;
+  double spare_ = 0.0;
+};
+
+bool NonNegativeFinite(double v) { return std::isfinite(v) && v >= 0.0; }
+
+// Adding +0 turns -0 into +0 and changes nothing else: no "-0" angles in the CSV.
+Eigen::Vector3d NoNegativeZero(const Eigen::Vector3d& v) { return (v.array() + 0.0).matrix(); }
+
+std::string Vec(const Eigen::Vector3d& v) {
+  return "(" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + ")";
+}
+
+bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
+                  const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
+                  SimulationSummary* summary, std::string* error) {
+  if (!options.IsValid(error)) return false;
+  std::string why;
+  if (!truth.IsValid(&why)) return Fail(error, "truth model: " + why);
+  if (planned.empty()) return Fail(error, "no planned poses");
+  for (size_t n = 0; n < planned.size(); ++n) {
+    if (!IsFinite(planned[n])) {
+      return Fail(error, "planned pose of node " + std::to_string(n) + " is not finite");
+    }
+  }
+
+  SimulationSummary stats;
+  stats.samples = static_cast<int>(planned.size());
+
+  // The truth model with its density mismatch, drawn once.
+  CableRobot model = truth;
+  Random density_rng(options.seed, kDensityStream);
+  for (int i = 0; i < kNumCables; ++i) {
+    double factor = 0.0;
+    for (int attempt = 0; !(factor > 0.0); ++attempt) {
+      if (attempt == kMaxRedraws) {
+        return Fail(error, "density_mismatch_percent " + Num(options.density_mismatch_percent) +
+                               " keeps giving a density <= 0 for cable " + std::to_string(i + 1));
+      }
+      if (attempt > 0) ++stats.redrawn;
+      factor = 1.0 + options.density_mismatch_percent / 100.0 * density_rng.Normal();
+    }
+    stats.density_factor[i] = factor;
+    model.cables[i].linear_density_kg_per_m *= factor;
+  }
+
+  Random control_rng(options.seed, kAttitudeControlStream);
+  Random attitude_rng(options.seed, kAttitudeMeasurementStream);
+  Random position_rng(options.seed, kPositionStream);
+  Random tension_rng(options.seed, kTensionNoiseStream);
+  Random outlier_rng(options.seed, kOutlierStream);
+
+  StaticsOptions statics;
+  statics.method = options.method;
+  // Consecutive nodes are usually close; a failed warm start is retried cold.
+  statics.warm_start = true;
+  StaticsSolution solution;
+
+  Dataset out;
+  out.path = "simulation";
+  out.has_planned_attitude = true;
+  out.has_unstretched_lengths = true;
+  out.attitude_as_quaternion = false;
+  out.samples.resize(planned.size());
+
+  double control_sq = 0.0, attitude_sq = 0.0, position_sq = 0.0;
+  std::array<double, kNumCables> noise_sq{}, relative_sq{};
+  for (size_t n = 0; n < planned.size(); ++n) {
+    Sample& s = out.samples[n];
+    s.time_s = static_cast<double>(n) * options.sample_interval_s;
+    s.has_planned_attitude = true;
+    s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned[n].rotation));
+    s.planned_rotation =
+        RotationFromRpyDeg(s.planned_rpy_deg[0], s.planned_rpy_deg[1], s.planned_rpy_deg[2]);
+
+    const Eigen::Vector3d control_deg = options.attitude_control_sigma_deg * control_rng.Normal3();
+    const Eigen::Vector3d actual_rpy_deg = NoNegativeZero(s.planned_rpy_deg + control_deg);
+    Pose actual;
+    actual.position_m = planned[n].position_m;
+    actual.rotation = RotationFromRpyDeg(actual_rpy_deg[0], actual_rpy_deg[1], actual_rpy_deg[2]);
+    if (SolveStatics(model, actual, statics, &solution) != StaticsStatus::kOk) {
+      std::string message =
+          "node " + std::to_string(n) + " at position " + Vec(actual.position_m) + " m";
+      if (options.attitude_control_sigma_deg > 0.0) {
+        message += ", actual attitude rpy " + Vec(actual_rpy_deg) + " deg";
+      }
+      return Fail(error, message + ": " + DescribeStatus(solution) + " [truth model, method " +
+                             StaticsMethodName(options.method) + "]");
+    }
+
+    const Eigen::Vector3d attitude_noise_deg =
+        options.attitude_measurement_sigma_deg * attitude_rng.Normal3();
+    s.measured_rpy_deg = NoNegativeZero(actual_rpy_deg + attitude_noise_deg);
+    s.pose.rotation =
+        RotationFromRpyDeg(s.measured_rpy_deg[0], s.measured_rpy_deg[1], s.measured_rpy_deg[2]);
+    const Eigen::Vector3d position_noise_m =
+        options.position_measurement_sigma_m * position_rng.Normal3();
+    s.pose.position_m = NoNegativeZero(actual.position_m + position_noise_m);
+    control_sq += control_deg.squaredNorm();
+    attitude_sq += attitude_noise_deg.squaredNorm();
+    position_sq += position_noise_m.squaredNorm();
+
+    s.has_unstretched_lengths = true;
+    for (int i = 0; i < kNumCables; ++i) {
+      const CableProperties& cable = model.cables[i];
+      const double reading_n =
+          cable.sensor_gain * solution.cables[i].lower_tension_n + cable.sensor_bias_n;
+      if (!(reading_n > 0.0)) {
+        return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
+                               ": sensor reading gain * tension + bias = " +
+                               Num(reading_n / kNPerKn) + " kN is not > 0 (check the bias)");
+      }
+      // Both draws are made for every reading, outlier or not, to keep streams aligned.
+      const bool outlier = outlier_rng.Uniform01() < options.outlier_fraction;
+      const double outlier_u = 2.0 * outlier_rng.Uniform01() - 1.0;
+      double measured_n = 0.0;
+      for (int attempt = 0; !(measured_n > 0.0); ++attempt) {
+        if (attempt == kMaxRedraws) {
+          return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
+                                 ": the tension noise keeps making the reading <= 0");
+        }
+        if (attempt > 0) ++stats.redrawn;
+        const double relative = options.tension_noise_percent / 100.0 * tension_rng.Normal();
+        const double absolute_n = options.tension_noise_kn * kNPerKn * tension_rng.Normal();
+        measured_n = outlier ? reading_n * (1.0 + options.outlier_scale_percent / 100.0 * outlier_u)
+                             : reading_n * (1.0 + relative) + absolute_n;
+      }
+      s.tension_n[i] = measured_n;
+      s.unstretched_length_m[i] = solution.cables[i].unstretched_length_m;
+      stats.outliers[i] += outlier ? 1 : 0;
+      noise_sq[i] += (measured_n - reading_n) * (measured_n - reading_n);
+      relative_sq[i] += (measured_n / reading_n - 1.0) * (measured_n / reading_n - 1.0);
+    }
+  }
+
+  const double count = static_cast<double>(planned.size());
+  for (int i = 0; i < kNumCables; ++i) {
+    stats.tension_noise_rms_n[i] = std::sqrt(noise_sq[i] / count);
+    stats.tension_noise_rms_relative[i] = std::sqrt(relative_sq[i] / count);
+  }
+  stats.attitude_control_rms_deg = std::sqrt(control_sq / (3.0 * count));
+  stats.attitude_measurement_rms_deg = std::sqrt(attitude_sq / (3.0 * count));
+  stats.position_measurement_rms_m = std::sqrt(position_sq / (3.0 * count));
+
+  if (dataset != nullptr) *dataset = std::move(out);
+  if (truth_used != nullptr) *truth_used = std::move(model);
+  if (summary != nullptr) *summary = stats;
+  return true;
+}
+
+}  // namespace
+
+bool SimulationOptions::IsValid(std::string* error) const {
+  const struct {
+    const char* name;
+    double value;
+  } non_negative[] = {
+      {"attitude_control_sigma_deg", attitude_control_sigma_deg},
+      {"attitude_measurement_sigma_deg", attitude_measurement_sigma_deg},
+      {"position_measurement_sigma_m", position_measurement_sigma_m},
+      {"tension_noise_percent", tension_noise_percent},
+      {"tension_noise_kn", tension_noise_kn},
+      {"density_mismatch_percent", density_mismatch_percent},
+  };
+  for (const auto& f : non_negative) {
+    if (!NonNegativeFinite(f.value)) {
+      return Fail(error,
+                  std::string(f.name) + " must be finite and >= 0 (got " + Num(f.value) + ")");
+    }
+  }
+  if (!(outlier_fraction >= 0.0 && outlier_fraction <= 1.0)) {
+    return Fail(error, "outlier_fraction must be in [0, 1] (got " + Num(outlier_fraction) + ")");
+  }
+  if (!(outlier_scale_percent >= 0.0 && outlier_scale_percent < 100.0)) {
+    return Fail(error, "outlier_scale_percent must be in [0, 100) (got " +
+                           Num(outlier_scale_percent) + ")");
+  }
+  if (!(std::isfinite(sample_interval_s) && sample_interval_s > 0.0)) {
+    return Fail(error,
+                "sample_interval_s must be finite and > 0 (got " + Num(sample_interval_s) + ")");
+  }
+  return true;
+}
+
+bool Simulate(const CableRobot& truth, const std::vector<Pose>& planned,
+              const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
+              SimulationSummary* summary, std::string* error) {
+  try {
+    return SimulateImpl(truth, planned, options, dataset, truth_used, summary, error);
+  } catch (const std::exception& e) {
+    return Fail(error, std::string("simulation failed: ") + e.what());
+  }
+}
+
+}  // namespace fastcal

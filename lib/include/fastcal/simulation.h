@@ -1,0 +1,114 @@
+// Synthetic telemetry: what the cabin's pose sensors and the six cable-tension sensors
+// would record along a planned trajectory, for a known ("truth") model.
+//
+// Per planned pose n (position p, planned attitude with roll/pitch/yaw a_plan):
+//   actual attitude     a_act  = a_plan + N(0, attitude_control_sigma_deg)      per rpy angle
+//   actual position     p_act  = p                        (the position is held exactly)
+//   truth statics       T_i, s0_i = SolveStatics(truth, (p_act, R(a_act)))
+//   sensor reading      y_i    = sensor_gain_i T_i + sensor_bias_n_i
+//   measured tension    m_i    = y_i (1 + N(0, tension_noise_percent / 100))
+//                                + N(0, 1000 tension_noise_kn)
+//                        or, with probability outlier_fraction, an outlier
+//                        m_i    = y_i (1 + U(-s, s) / 100),  s = outlier_scale_percent
+//   measured attitude   a_meas = a_act + N(0, attitude_measurement_sigma_deg)  per rpy angle
+//   measured position   p_meas = p + N(0, position_measurement_sigma_m)        per axis
+// with R(a) = RotationFromRpyDeg(a) and a_plan = RpyDegFromRotation(planned rotation).
+// The truth model's per-cable linear density is multiplied once, before the trajectory,
+// by (1 + N(0, density_mismatch_percent / 100)) (non-uniform cables: sensors, wiring).
+//
+// Random numbers: std::mt19937_64, converted by hand (uniform from the top 53 bits,
+// Gaussian by Box-Muller), so a seed gives the same dataset with every standard library.
+// Each error source has its own generator derived from the seed, and every draw is made
+// whatever its sigma, so changing one sigma changes only that source's numbers.
+#ifndef FASTCAL_SIMULATION_H_
+#define FASTCAL_SIMULATION_H_
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/dataset.h"
+#include "fastcal/pose.h"
+#include "fastcal/statics.h"
+
+namespace fastcal {
+
+struct SimulationOptions {
+  // Attitude control error: standard deviation of the actual minus the planned roll,
+  // pitch and yaw (deg, each axis independent). >= 0; default 0.
+  double attitude_control_sigma_deg = 0.0;
+  // Attitude sensor error: standard deviation of the measured minus the actual roll,
+  // pitch and yaw (deg). >= 0; default 0.
+  double attitude_measurement_sigma_deg = 0.0;
+  // Position sensor error: standard deviation of the measured minus the actual position
+  // per axis (m). The actual position is the planned one. >= 0; default 0.
+  double position_measurement_sigma_m = 0.0;
+  // Relative tension-sensor noise: standard deviation in percent of the reading. >= 0;
+  // default 3 (the paper's sensors).
+  double tension_noise_percent = 3.0;
+  // Absolute tension-sensor noise: standard deviation in kN, added to the relative one.
+  // >= 0; default 0.
+  double tension_noise_kn = 0.0;
+  // Probability that a tension reading is an outlier instead of reading + noise. In
+  // [0, 1]; default 0.
+  double outlier_fraction = 0.0;
+  // Half-width of an outlier's uniform relative error, in percent of the reading. In
+  // [0, 100) so that outliers stay positive; default 30.
+  double outlier_scale_percent = 30.0;
+  // Standard deviation of the per-cable density factor of the truth model, in percent.
+  // >= 0; default 0 (the truth model as given).
+  double density_mismatch_percent = 0.0;
+  // Seed of all generators; default 1.
+  std::uint64_t seed = 1;
+  // Statics method of the truth tensions and lengths; default exact.
+  StaticsMethod method = StaticsMethod::kExact;
+  // Time between samples (s): sample n has time_s = n * sample_interval_s. > 0; default 1.
+  double sample_interval_s = 1.0;
+
+  // False, with the offending field named in *error (may be null), for a value out of range.
+  bool IsValid(std::string* error) const;
+};
+
+// What Simulate added, for a summary.
+struct SimulationSummary {
+  int samples = 0;
+  // Per cable: RMS of measured minus sensor reading (N), outliers included; RMS of
+  // measured / reading - 1 (dimensionless); number of outliers.
+  std::array<double, kNumCables> tension_noise_rms_n{};
+  std::array<double, kNumCables> tension_noise_rms_relative{};
+  std::array<int, kNumCables> outliers{};
+  // Noise draws redrawn because they would have made a reading or a density <= 0 (the
+  // noise is then a truncated Gaussian; at realistic levels this count is 0).
+  int redrawn = 0;
+  // RMS over samples and axes of actual minus planned and measured minus actual
+  // attitude (deg, rpy), and of measured minus actual position (m).
+  double attitude_control_rms_deg = 0.0;
+  double attitude_measurement_rms_deg = 0.0;
+  double position_measurement_rms_m = 0.0;
+  // Density factors applied to the truth model, cable i at index i-1.
+  std::array<double, kNumCables> density_factor{};
+};
+
+// Simulates telemetry at the `planned` poses (position and planned attitude) with the
+// `truth` model, its sensor gains and biases included. Fills *dataset with one sample per
+// planned pose, in order: time, measured position and attitude (as roll/pitch/yaw;
+// Sample::measured_rpy_deg and pose.rotation agree exactly), the planned attitude
+// (planned_rpy_deg = RpyDegFromRotation(planned rotation), planned_rotation rebuilt from
+// those angles, so equal to the planned rotation to rounding), the measured tensions and,
+// as the commanded lengths, the truth solution's unstretched lengths. Every value is such
+// that WriteDataset then ReadDataset gives back the same dataset. *truth_used receives
+// the truth model after the density mismatch (the model the tensions come from).
+//
+// Returns false with *error set (the outputs untouched) when the options or the truth
+// model are invalid, there are no poses, a pose is not finite, or the truth model cannot
+// hold an actual pose (the message names the 0-based node, its position and the
+// DescribeStatus account). Any of dataset, truth_used, summary and error may be null.
+bool Simulate(const CableRobot& truth, const std::vector<Pose>& planned,
+              const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
+              SimulationSummary* summary, std::string* error);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_SIMULATION_H_
