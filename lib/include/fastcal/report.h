@@ -1,0 +1,72 @@
+// The calibration report: what a calibration (or an evaluation alone) found, written for
+// the engineers who run the cable robot and the colleagues they pass it on to.
+//
+//   report.md     Markdown: provenance, verdict, estimates, identifiability, RMS tables
+//   report.html   the same, self-contained (inline <style> and SVG plots; no scripts, no
+//                 external resources): correlation heatmap, RMS per cable as grouped bars,
+//                 measured and predicted tension per cable against time, residual histogram
+//   summary.json  the numbers, for scripts (units in the key names: _kN, _percent)
+//
+// Sections: provenance (inputs with FNV-1a digests, software version, command line,
+// forward model and its error against the exact statics, evaluation method, noise model,
+// robust loss, hold-out, Ceres options); verdict (termination, iterations, cost,
+// reduced chi-square and what it means); estimates with 1-sigma and priors;
+// identifiability (singular-value ratios, poorly determined and data-only directions,
+// strong correlations); RMS of model - measured per cable (the paper's Table 6) for each
+// variant on the fitted and the held-out samples; plots; how to use the calibrated model;
+// the Ceres full report. No dates: the same inputs give the same bytes.
+//
+// Tensions are in kN in every table, plot and JSON key (the library is SI inside).
+#ifndef FASTCAL_REPORT_H_
+#define FASTCAL_REPORT_H_
+
+#include <string>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+#include "fastcal/evaluation.h"
+
+namespace fastcal {
+
+struct ReportInputs {
+  // The input files as given on the command line; an empty model path means the built-in
+  // nominal FAST model, an empty spec path an evaluation without calibration.
+  std::string model_path, spec_path, data_path;
+  // FileFnv1a64 of each file (16 hex digits), filled by the caller; empty if not known.
+  std::string model_digest, spec_digest, data_digest;
+  std::string software_version;  // FASTCAL_VERSION
+  std::string command_line;
+  // Not owned; must outlive the calls. `data` is required. `spec` and `result` are null
+  // for an evaluation-only report (`fastcal evaluate`); `initial_model` may be null.
+  const CableRobot* initial_model = nullptr;
+  const CalibrationSpec* spec = nullptr;
+  const Dataset* data = nullptr;
+  const CalibrationResult* result = nullptr;
+  // The rows of the RMS table, in table order, e.g. "initial model, planned attitude",
+  // "initial model, measured attitude", "calibrated model, measured attitude". With a
+  // calibration result the last variant is the calibrated model and the one before it
+  // the "before" the plots compare it with; without one, the plots show every variant.
+  // predicted_n may be empty (then a variant is left out of the time and residual plots).
+  std::vector<VariantEvaluation> variants;
+  // Statics method of the evaluation, e.g. "exact".
+  std::string evaluation_method;
+};
+
+// The report as Markdown, HTML and JSON. Each is deterministic (no dates). They return
+// an empty string only if memory runs out; missing inputs (no data, no variants) give a
+// report that says what is missing.
+std::string ReportMarkdown(const ReportInputs& inputs);
+std::string ReportHtml(const ReportInputs& inputs);
+std::string SummaryJson(const ReportInputs& inputs);
+
+// Writes report.md, report.html and summary.json into `dir`, which must exist, each
+// atomically (temporary file in `dir`, then rename). On any failure removes what it wrote,
+// sets *error (naming the file and the reason) and returns false.
+bool WriteReportFiles(const std::string& dir, const ReportInputs& inputs, std::string* error);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_REPORT_H_

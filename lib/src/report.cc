@@ -1,0 +1,1447 @@
+// The calibration and evaluation report (report.h): the content is built once as a small
+// document (headings, paragraphs, lists, tables, preformatted blocks, SVG figures) and then
+// rendered as Markdown and as self-contained HTML; summary.json is written directly with
+// JsonWriter. Tensions are converted N -> kN here, at the edge, and only here.
+#include "fastcal/report.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <climits>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <new>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fastcal/internal/json.h"
+#include "fastcal/svg_plot.h"
+
+namespace fastcal {
+namespace {
+
+constexpr double kNPerKn = 1000.0;
+constexpr double kPercent = 100.0;
+// A correct noise model gives a reduced chi-square of 1 with a standard deviation of
+// sqrt(2 / dof); farther than this many standard deviations from 1 it is called off.
+constexpr double kChiSquareBandSigmas = 3.0;
+// Defaults of CalibrationOptions, quoted in the text (the result does not carry them).
+constexpr double kDefaultPoorlyDeterminedRatio = 1e-3;
+constexpr double kDefaultUndeterminedRatio = 1e-8;
+constexpr double kDefaultStrongCorrelation = 0.9;
+// Plot geometry (px) and histogram bins.
+constexpr int kCablePlotWidthPx = 540, kCablePlotHeightPx = 280;
+constexpr int kWidePlotWidthPx = 1000, kWidePlotHeightPx = 320;
+constexpr int kResidualBins = 40;
+
+// ---------------------------------------------------------------------------------------
+// Number formatting. Non-finite values read "n/a", never "nan" or "inf".
+
+// "-0.000" and "+0.00" -> "0.000", "0.00".
+std::string DropSignOfZero(std::string s) {
+  if (!s.empty() && (s[0] == '-' || s[0] == '+') &&
+      s.find_first_not_of("0.", 1) == std::string::npos) {
+    s.erase(0, 1);
+  }
+  return s;
+}
+
+std::string Printf(const char* format, double v) {
+  if (!std::isfinite(v)) return "n/a";
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), format, v);
+  return DropSignOfZero(buf);
+}
+std::string Sig6(double v) { return Printf("%.6g", v); }
+std::string Sig3(double v) { return Printf("%.3g", v); }
+std::string Kn3(double v_n) { return Printf("%.3f", v_n / kNPerKn); }
+std::string Pct(double fraction, const char* format = "%.3g") {
+  return Printf(format, fraction * kPercent);
+}
+std::string Int(long long v) { return std::to_string(v); }
+// An estimate to the precision its uncertainty supports: down to one digit below the
+// second significant digit of sigma ("0.24413" for 0.244125 +- 0.0044); 6 significant
+// digits when there is no usable sigma. summary.json keeps every digit.
+std::string EstimateText(double value, double sigma) {
+  constexpr int kMaxDecimals = 12;
+  if (!std::isfinite(value) || !std::isfinite(sigma) || sigma <= 0.0) return Sig6(value);
+  const int decimals =
+      std::clamp(2 - static_cast<int>(std::floor(std::log10(sigma))), 0, kMaxDecimals);
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.*f", decimals, value);
+  return DropSignOfZero(buf);
+}
+
+// ---------------------------------------------------------------------------------------
+// The document model.
+
+struct Span {
+  enum Kind { kPlain, kCode, kBold, kSwatch } kind;
+  std::string text;  // for kSwatch: the colour
+};
+
+// Inline text: plain, code, bold, and (HTML only) a colour swatch matching a plot series.
+class Text {
+ public:
+  Text() = default;
+  Text(const std::string& plain) { Plain(plain); }  // NOLINT: implicit by design
+  Text(const char* plain) { Plain(plain); }         // NOLINT
+  Text& Plain(const std::string& s) { return Add(Span::kPlain, s); }
+  Text& Code(const std::string& s) { return Add(Span::kCode, s); }
+  Text& Bold(const std::string& s) { return Add(Span::kBold, s); }
+  Text& Swatch(const std::string& colour) { return Add(Span::kSwatch, colour); }
+  const std::vector<Span>& spans() const { return spans_; }
+
+ private:
+  Text& Add(Span::Kind kind, const std::string& s) {
+    if (!s.empty()) spans_.push_back({kind, s});
+    return *this;
+  }
+  std::vector<Span> spans_;
+};
+
+struct Table {
+  Text caption;
+  std::vector<Text> header;
+  std::vector<bool> right_align;  // per column (numbers)
+  std::vector<std::vector<Text>> rows;
+};
+
+enum class Target { kBoth, kMarkdownOnly, kHtmlOnly };
+
+struct Block {
+  enum Kind { kHeading, kParagraph, kList, kTable, kPre, kFigure } kind = kParagraph;
+  Target target = Target::kBoth;
+  int level = 2;                  // kHeading
+  Text text;                      // kHeading, kParagraph; kPre and kFigure: summary / caption
+  std::vector<Text> items;        // kList
+  Table table;                    // kTable
+  std::string pre;                // kPre: preformatted text
+  bool collapsed = false;         // kPre: <details> in HTML
+  std::vector<std::string> svgs;  // kFigure: one or more charts, laid out in a grid
+};
+
+class Document {
+ public:
+  void Heading(int level, const Text& text) {
+    Block b;
+    b.kind = Block::kHeading;
+    b.level = level;
+    b.text = text;
+    blocks_.push_back(std::move(b));
+  }
+  void Paragraph(const Text& text, Target target = Target::kBoth) {
+    Block b;
+    b.kind = Block::kParagraph;
+    b.target = target;
+    b.text = text;
+    blocks_.push_back(std::move(b));
+  }
+  void List(std::vector<Text> items) {
+    if (items.empty()) return;
+    Block b;
+    b.kind = Block::kList;
+    b.items = std::move(items);
+    blocks_.push_back(std::move(b));
+  }
+  void AddTable(Table table, Target target = Target::kBoth) {
+    Block b;
+    b.kind = Block::kTable;
+    b.target = target;
+    b.table = std::move(table);
+    blocks_.push_back(std::move(b));
+  }
+  void Pre(const Text& summary, const std::string& text, bool collapsed) {
+    Block b;
+    b.kind = Block::kPre;
+    b.text = summary;
+    b.pre = text;
+    b.collapsed = collapsed;
+    blocks_.push_back(std::move(b));
+  }
+  void Figure(std::vector<std::string> svgs, const Text& caption) {
+    Block b;
+    b.kind = Block::kFigure;
+    b.target = Target::kHtmlOnly;
+    b.svgs = std::move(svgs);
+    b.text = caption;
+    blocks_.push_back(std::move(b));
+  }
+  const std::vector<Block>& blocks() const { return blocks_; }
+  std::string title;
+
+ private:
+  std::vector<Block> blocks_;
+};
+
+// ---------------------------------------------------------------------------------------
+// Facts derived from the inputs, shared by the document and the JSON.
+
+// RMS over all six cables of per-cable RMS values (same samples for every cable).
+double RmsAllCables(const std::array<double, kNumCables>& rms) {
+  double sum = 0.0;
+  for (double r : rms) sum += r * r;
+  return std::sqrt(sum / kNumCables);
+}
+
+int NumSamples(const ReportInputs& in) {
+  return in.data ? static_cast<int>(in.data->samples.size()) : 0;
+}
+int NumHeldOut(const ReportInputs& in) {
+  if (!in.result) return 0;
+  return static_cast<int>(std::count(in.result->held_out.begin(), in.result->held_out.end(), true));
+}
+bool AnyHoldout(const ReportInputs& in) {
+  for (const VariantEvaluation& v : in.variants) {
+    if (v.holdout.samples > 0) return true;
+  }
+  return false;
+}
+bool IsHeldOut(const ReportInputs& in, size_t n) {
+  return in.result && n < in.result->held_out.size() && in.result->held_out[n];
+}
+// Label of the samples a variant's `fit` statistics cover.
+std::string FitSamplesLabel(const ReportInputs& in) {
+  return in.result ? "fitted samples" : "all samples";
+}
+
+// Indices of the variants drawn in the time and residual plots: with a calibration the
+// one before the calibrated model and the calibrated model, otherwise all.
+std::vector<size_t> PlotVariants(const ReportInputs& in) {
+  std::vector<size_t> out;
+  const size_t n = in.variants.size();
+  if (in.result && n >= 2) return {n - 2, n - 1};
+  for (size_t i = 0; i < n; ++i) out.push_back(i);
+  return out;
+}
+bool HasPredictions(const ReportInputs& in, const VariantEvaluation& v) {
+  return in.data && !in.data->samples.empty() && v.predicted_n.size() == in.data->samples.size();
+}
+
+const char* RobustLossName(RobustLoss loss) {
+  switch (loss) {
+    case RobustLoss::kNone:
+      return "none";
+    case RobustLoss::kHuber:
+      return "huber";
+    case RobustLoss::kCauchy:
+      return "cauchy";
+  }
+  return "none";
+}
+
+std::string NoiseText(const CalibrationSpec& spec) {
+  return "σ = √[(" + Printf("%.6g", spec.tension_sigma_n / kNPerKn) + " kN)² + (" +
+         Printf("%.6g", spec.tension_sigma_percent) + " % of the measured tension)²]";
+}
+
+// Degrees of freedom of the chi-square (residuals minus free parameters), <= 0 if none.
+int DegreesOfFreedom(const CalibrationResult& r) { return r.num_residuals - r.num_free; }
+
+// One-line meaning of the reduced chi-square.
+std::string ChiSquareMeaning(const CalibrationResult& r) {
+  const double chi = r.reduced_chi_square;
+  if (!std::isfinite(chi)) return "not available.";
+  const int dof = DegreesOfFreedom(r);
+  const double band = dof > 0 ? kChiSquareBandSigmas * std::sqrt(2.0 / dof) : 0.0;
+  const std::string expected = dof > 0 ? " (a correct noise model gives 1 ± " + Sig3(band) +
+                                             " with " + Int(dof) + " degrees of freedom)"
+                                       : "";
+  if (dof > 0 && std::fabs(chi - 1.0) <= band) {
+    return "about 1: the residuals scatter as the noise model says" + expected + ".";
+  }
+  if (chi > 1.0) {
+    return "above 1: model error the free parameters cannot absorb, or noise underestimated" +
+           expected +
+           ". The ±1σ uncertainties below are formal (for the stated noise); "
+           "scaled by √(χ²/ν) = " +
+           Sig3(std::sqrt(chi)) + " they would match the observed scatter.";
+  }
+  return "below 1: the noise is overestimated (the residuals are smaller than the stated "
+         "σ)" +
+         expected + "; the ±1σ uncertainties below are then pessimistic.";
+}
+
+// ---------------------------------------------------------------------------------------
+// Document sections.
+
+Text FileText(const std::string& path, const std::string& digest, const char* absent) {
+  Text t;
+  if (path.empty()) return Text(absent);
+  t.Code(path);
+  if (!digest.empty()) t.Plain(" (fnv1a64 ").Code(digest).Plain(")");
+  return t;
+}
+
+void AddProvenance(const ReportInputs& in, Document* doc) {
+  doc->Heading(2, "Provenance");
+  Table t;
+  t.header = {"Item", "Value"};
+  t.right_align = {false, false};
+  auto row = [&t](const Text& key, const Text& value) { t.rows.push_back({key, value}); };
+  row("Model", FileText(in.model_path, in.model_digest, "nominal FAST model (built in)"));
+  if (in.spec || !in.spec_path.empty()) {
+    row("Calibration spec", FileText(in.spec_path, in.spec_digest, "given in code"));
+  }
+  Text data = FileText(in.data_path, in.data_digest, "given in code");
+  if (in.data) {
+    const Dataset& d = *in.data;
+    data.Plain(": " + Int(NumSamples(in)) + " samples");
+    if (!d.samples.empty()) {
+      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+      for (const Sample& s : d.samples) {
+        lo = std::min(lo, s.time_s);
+        hi = std::max(hi, s.time_s);
+      }
+      data.Plain(", t = " + Sig6(lo) + " to " + Sig6(hi) + " s");
+    }
+    data.Plain(d.attitude_as_quaternion ? ", attitude as quaternion" : ", attitude as angles");
+    if (d.has_planned_attitude) data.Plain(", with planned attitude");
+    if (!d.skipped.empty())
+      data.Plain(", " + Int(static_cast<long long>(d.skipped.size())) +
+                 " invalid rows skipped (listed at the end)");
+  } else {
+    data.Plain(" (no dataset given)");
+  }
+  row("Data", data);
+  row("Software",
+      Text("fastcal ")
+          .Plain(in.software_version.empty() ? "(version unknown)" : in.software_version));
+  row("Command line",
+      in.command_line.empty() ? Text("(not recorded)") : Text().Code(in.command_line));
+  if (in.spec) {
+    const CalibrationSpec& s = *in.spec;
+    row("Forward model (in the fit)", Text().Code(StaticsMethodName(s.forward_model)));
+    if (in.result) {
+      row("Forward model error vs exact",
+          Text("max " + Pct(in.result->forward_model_max_rel_error) + " %, RMS " +
+               Pct(in.result->forward_model_rms_rel_error) +
+               " % of the exact tension over the dataset poses (initial parameters); noise " +
+               Printf("%.6g", s.tension_sigma_percent) + " %"));
+    }
+  }
+  row("Evaluation statics",
+      in.evaluation_method.empty() ? Text("(not recorded)") : Text().Code(in.evaluation_method));
+  if (in.spec) {
+    const CalibrationSpec& s = *in.spec;
+    row("Noise model", NoiseText(s));
+    row("Robust loss", s.robust_loss == RobustLoss::kNone
+                           ? Text("none (least squares)")
+                           : Text(std::string(RobustLossName(s.robust_loss)) + ", scale " +
+                                  Sig6(s.robust_loss_scale) + " σ"));
+    row("Attitude in the fit", s.use_planned_attitude ? "planned" : "measured");
+    Text holdout("none: every sample is fitted");
+    if (s.holdout_fraction > 0.0) {
+      holdout = Text(Sig6(s.holdout_fraction) + " of the samples, chosen with seed " +
+                     std::to_string(s.holdout_seed));
+      if (in.result) holdout.Plain(": " + Int(NumHeldOut(in)) + " held out of the fit");
+    }
+    row("Hold-out", holdout);
+    row("Ceres options", "max " + Int(s.max_iterations) + " iterations; function, gradient, " +
+                             "parameter tolerance " + Sig3(s.function_tolerance) + ", " +
+                             Sig3(s.gradient_tolerance) + ", " + Sig3(s.parameter_tolerance) +
+                             "; " + Int(s.num_threads) + " threads");
+  }
+  if (in.result) row("Solve time", Printf("%.3g", in.result->seconds) + " s");
+  doc->AddTable(std::move(t));
+}
+
+std::string RmsAllText(const VariantEvaluation& v, bool holdout) {
+  const CableErrorStats& s = holdout ? v.holdout : v.fit;
+  return Kn3(RmsAllCables(s.rms_n)) + " kN";
+}
+
+void AddVerdict(const ReportInputs& in, Document* doc) {
+  if (!in.result) {
+    doc->Heading(2, "Summary");
+    Text t("Model tensions (statics: " +
+           (in.evaluation_method.empty() ? std::string("?") : in.evaluation_method) +
+           ", with the model's sensor gain and bias) against the " + Int(NumSamples(in)) +
+           " measured samples. RMS of model - measured over all six cables: ");
+    if (in.variants.empty()) t.Plain("no variant was evaluated.");
+    for (size_t i = 0; i < in.variants.size(); ++i) {
+      t.Plain(i ? "; " : "")
+          .Plain(in.variants[i].name + " ")
+          .Bold(RmsAllText(in.variants[i], false));
+      if (i + 1 == in.variants.size()) t.Plain(".");
+    }
+    doc->Paragraph(t);
+    return;
+  }
+  const CalibrationResult& r = *in.result;
+  doc->Heading(2, "Verdict");
+  Text t;
+  if (r.converged) {
+    t.Bold("Converged");
+  } else {
+    t.Bold("Did not converge");
+  }
+  t.Plain(" (termination: ")
+      .Code(r.termination.empty() ? "unknown" : r.termination)
+      .Plain(") after " + Int(r.iterations) + " iterations; cost " + Sig6(r.initial_cost) + " → " +
+             Sig6(r.final_cost) + ".");
+  if (!r.converged) {
+    t.Plain(" The estimates below are the last iterate: do not use them as they are.");
+  }
+  doc->Paragraph(t);
+  doc->Paragraph(Text("Reduced chi-square χ²/ν = ")
+                     .Bold(Printf("%.4g", r.reduced_chi_square))
+                     .Plain(" over " + Int(r.num_residuals) + " residuals and " + Int(r.num_free) +
+                            " free parameters: " + ChiSquareMeaning(r)));
+  const int total = NumSamples(in);
+  Text samples("Samples: " + Int(r.num_fit_samples) + " fitted, " + Int(NumHeldOut(in)) +
+               " held out (" + Int(total) + " in the dataset).");
+  const size_t n = in.variants.size();
+  if (n >= 2) {
+    const VariantEvaluation& before = in.variants[n - 2];
+    const VariantEvaluation& after = in.variants[n - 1];
+    samples
+        .Plain(" RMS of model - measured over all cables, fitted samples: " + before.name + " " +
+               RmsAllText(before, false) + " → " + after.name + " ")
+        .Bold(RmsAllText(after, false));
+    if (after.holdout.samples > 0) {
+      samples.Plain("; held-out samples: " + RmsAllText(before, true) + " → ")
+          .Bold(RmsAllText(after, true));
+    }
+    samples.Plain(".");
+  }
+  doc->Paragraph(samples);
+  if (!r.covariance_ok) {
+    doc->Paragraph(Text()
+                       .Bold("The covariance could not be computed:")
+                       .Plain(" the estimates have no uncertainties and no correlations."));
+  }
+  const size_t weak = r.after.undetermined.size() + r.after.poorly_determined.size() +
+                      r.data_only.undetermined.size() + r.data_only.poorly_determined.size();
+  if (weak > 0) {
+    doc->Paragraph("Identifiability: " + Int(static_cast<long long>(weak)) +
+                   " direction(s) in parameter space are poorly determined or held only by a "
+                   "prior; see Identifiability below.");
+  }
+}
+
+void AddEstimates(const CalibrationResult& r, Document* doc) {
+  doc->Heading(2, "Estimates");
+  doc->Paragraph(
+      "±1σ: formal standard deviation for the stated noise (covariance at the solution). "
+      "Priors are Gaussian, mean ± σ. Sensor biases are in kN, like the spec. Fixed "
+      "parameters keep their initial value.");
+  Table t;
+  t.header = {"Parameter", "Unit", "Initial", "Estimate", "±1σ", "Prior", "Note"};
+  t.right_align = {false, false, true, true, true, true, false};
+  for (const ParameterEstimate& p : r.parameters) {
+    std::string sigma = "fixed";
+    if (p.free) sigma = r.covariance_ok ? Sig3(p.sigma) : "n/a";
+    const std::string prior = p.has_prior ? Sig6(p.prior_mean) + " ± " + Sig3(p.prior_sigma) : "-";
+    t.rows.push_back({Text().Code(p.name), p.unit, Sig6(p.initial),
+                      p.free
+                          ? Text().Bold(EstimateText(p.estimate, r.covariance_ok ? p.sigma : 0.0))
+                          : Text(Sig6(p.estimate)),
+                      sigma, prior, p.note});
+  }
+  if (t.rows.empty()) {
+    doc->Paragraph("The spec names no parameter.");
+    return;
+  }
+  doc->AddTable(std::move(t));
+}
+
+std::string RatioText(double ratio) { return "s/s1 = " + Printf("%.2g", ratio); }
+
+std::vector<std::vector<double>> CorrelationRows(const CalibrationResult& r) {
+  std::vector<std::vector<double>> m(r.correlation.rows(),
+                                     std::vector<double>(r.correlation.cols()));
+  for (Eigen::Index i = 0; i < r.correlation.rows(); ++i) {
+    for (Eigen::Index j = 0; j < r.correlation.cols(); ++j) m[i][j] = r.correlation(i, j);
+  }
+  return m;
+}
+bool CorrelationUsable(const CalibrationResult& r) {
+  const Eigen::Index n = static_cast<Eigen::Index>(r.free_names.size());
+  return r.covariance_ok && n > 0 && r.correlation.rows() == n && r.correlation.cols() == n;
+}
+
+void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* doc) {
+  doc->Heading(2, "Identifiability");
+  doc->Paragraph(
+      "Singular values s of the whitened Jacobian (data and prior rows) with unit-norm "
+      "columns, relative to the largest (s/s1). A small ratio is a combination of parameters "
+      "the measurements barely change: below " +
+      Sig3(kDefaultPoorlyDeterminedRatio) + " it is reported as poorly determined, below " +
+      Sig3(kDefaultUndeterminedRatio) +
+      " as undetermined (default thresholds). \"Data alone\" leaves the priors out.");
+  const size_t rows =
+      std::max({r.before.singular_value_ratios.size(), r.after.singular_value_ratios.size(),
+                r.data_only.singular_value_ratios.size()});
+  if (rows > 0) {
+    Table t;
+    t.header = {"k", "s/s1 before (with priors)", "s/s1 after (with priors)",
+                "s/s1 after (data alone)"};
+    t.right_align = {true, true, true, true};
+    auto cell = [](const std::vector<double>& v, size_t k) -> Text {
+      return k < v.size() ? Text(Printf("%.3g", v[k])) : Text("-");
+    };
+    for (size_t k = 0; k < rows; ++k) {
+      t.rows.push_back({Int(static_cast<long long>(k + 1)), cell(r.before.singular_value_ratios, k),
+                        cell(r.after.singular_value_ratios, k),
+                        cell(r.data_only.singular_value_ratios, k)});
+    }
+    doc->AddTable(std::move(t));
+  }
+  std::vector<Text> items;
+  for (const ParameterDirection& d : r.before.undetermined) {
+    items.push_back(Text("Before solving, undetermined: ")
+                        .Code(d.Describe())
+                        .Plain(" (" + RatioText(d.singular_value_ratio) + ")."));
+  }
+  for (const ParameterDirection& d : r.before.poorly_determined) {
+    items.push_back(Text("Before solving, poorly determined: ")
+                        .Code(d.Describe())
+                        .Plain(" (" + RatioText(d.singular_value_ratio) + ")."));
+  }
+  for (const ParameterDirection& d : r.after.undetermined) {
+    items.push_back(Text()
+                        .Bold("Undetermined")
+                        .Plain(" at the solution: ")
+                        .Code(d.Describe())
+                        .Plain(" (" + RatioText(d.singular_value_ratio) +
+                               "): the data and priors cannot fix this combination."));
+  }
+  for (const ParameterDirection& d : r.after.poorly_determined) {
+    items.push_back(Text()
+                        .Bold("Poorly determined")
+                        .Plain(" at the solution: ")
+                        .Code(d.Describe())
+                        .Plain(" (" + RatioText(d.singular_value_ratio) +
+                               "): its estimate is uncertain; see the ±1σ column."));
+  }
+  for (const ParameterDirection& d : r.data_only.undetermined) {
+    items.push_back(
+        Text("The data alone cannot determine ")
+            .Code(d.Describe())
+            .Plain(" (" + RatioText(d.singular_value_ratio) + "); the prior holds it."));
+  }
+  for (const ParameterDirection& d : r.data_only.poorly_determined) {
+    items.push_back(Text("The data alone determine ")
+                        .Code(d.Describe())
+                        .Plain(" only poorly (" + RatioText(d.singular_value_ratio) +
+                               "); the prior helps fix it."));
+  }
+  const bool nothing_weak = r.after.undetermined.empty() && r.after.poorly_determined.empty() &&
+                            r.data_only.undetermined.empty() &&
+                            r.data_only.poorly_determined.empty();
+  if (nothing_weak) {
+    doc->Paragraph(
+        "Nothing is poorly determined: every free parameter is fixed by the data alone, "
+        "without help from a prior.");
+  }
+  doc->List(std::move(items));
+  if (!r.strong_correlations.empty()) {
+    std::vector<Text> pairs;
+    for (const std::string& c : r.strong_correlations) pairs.push_back(Text().Code(c));
+    doc->Paragraph("Strongly correlated pairs of estimates (|correlation| above " +
+                   Sig3(kDefaultStrongCorrelation) +
+                   " by default): the data fix their combination better than each one.");
+    doc->List(std::move(pairs));
+  } else if (r.covariance_ok) {
+    doc->Paragraph("No pair of estimates is strongly correlated (|correlation| above " +
+                   Sig3(kDefaultStrongCorrelation) + " by default).");
+  }
+  if (!CorrelationUsable(r)) return;
+  const std::vector<std::vector<double>> m = CorrelationRows(r);
+  // Markdown: the matrix as a table; HTML: a heatmap.
+  Table t;
+  t.caption = "Correlation of the estimates";
+  t.header.push_back("");
+  t.right_align.push_back(false);
+  for (const std::string& name : r.free_names) {
+    t.header.push_back(Text().Code(name));
+    t.right_align.push_back(true);
+  }
+  for (size_t i = 0; i < m.size(); ++i) {
+    std::vector<Text> row = {Text().Code(r.free_names[i])};
+    for (double v : m[i]) row.push_back(Printf("%+.2f", v));
+    t.rows.push_back(std::move(row));
+  }
+  doc->AddTable(std::move(t), Target::kMarkdownOnly);
+  if (with_plots) {
+    const int n = static_cast<int>(r.free_names.size());
+    PlotOptions o;
+    o.title = "Correlation of the estimates";
+    o.width_px = std::clamp(260 + 56 * n, 420, kWidePlotWidthPx);
+    o.height_px = std::clamp(200 + 44 * n, 320, 1400);
+    doc->Figure({SvgMatrixHeatmap(r.free_names, m, o)},
+                "Correlation of the free parameters' estimates (1: move together, -1: "
+                "opposite, 0: independent).");
+  }
+}
+
+// One statistics table: a row per variant (and per hold-out when present).
+Table StatsTable(const ReportInputs& in, const Text& caption,
+                 const std::array<double, kNumCables> CableErrorStats::*member, bool kn,
+                 bool holdout_rows, const char* format) {
+  Table t;
+  t.caption = caption;
+  t.header = {"Variant", "Samples"};
+  t.right_align = {false, true};
+  for (int i = 1; i <= kNumCables; ++i) {
+    t.header.push_back("T" + Int(i));
+    t.right_align.push_back(true);
+  }
+  const bool all_column = member == &CableErrorStats::rms_n;
+  if (all_column) {
+    t.header.push_back("all");
+    t.right_align.push_back(true);
+  }
+  auto add = [&](size_t index, const VariantEvaluation& v, const CableErrorStats& s,
+                 const std::string& suffix) {
+    std::vector<Text> row = {
+        Text().Swatch(PlotSeriesColour(static_cast<int>(index))).Plain(v.name + suffix),
+        Int(s.samples)};
+    for (double x : s.*member) row.push_back(kn ? Kn3(x) : Printf(format, x));
+    if (all_column) row.push_back(Text().Bold(Kn3(RmsAllCables(s.rms_n))));
+    t.rows.push_back(std::move(row));
+  };
+  for (size_t k = 0; k < in.variants.size(); ++k) {
+    add(k, in.variants[k], in.variants[k].fit, holdout_rows ? " (fit)" : "");
+  }
+  if (holdout_rows) {
+    for (size_t k = 0; k < in.variants.size(); ++k) {
+      if (in.variants[k].holdout.samples > 0) {
+        add(k, in.variants[k], in.variants[k].holdout, " (held out)");
+      }
+    }
+  }
+  return t;
+}
+
+std::string BarChart(const ReportInputs& in, bool holdout) {
+  std::vector<BarGroup> groups;
+  for (int i = 0; i < kNumCables; ++i) {
+    BarGroup g;
+    g.label = "T" + Int(i + 1);
+    for (const VariantEvaluation& v : in.variants) {
+      const CableErrorStats& s = holdout ? v.holdout : v.fit;
+      g.values.push_back(s.samples > 0 ? s.rms_n[i] / kNPerKn
+                                       : std::numeric_limits<double>::quiet_NaN());
+    }
+    groups.push_back(std::move(g));
+  }
+  std::vector<std::string> names;
+  for (const VariantEvaluation& v : in.variants) names.push_back(v.name);
+  PlotOptions o;
+  o.title = std::string("RMS of model - measured per cable, ") +
+            (holdout ? "held-out samples" : FitSamplesLabel(in));
+  o.y_label = "RMS [kN]";
+  o.width_px = kWidePlotWidthPx;
+  o.height_px = kWidePlotHeightPx;
+  return SvgGroupedBars(groups, names, o);
+}
+
+void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
+  doc->Heading(2, "Model against measurement");
+  const std::string method = in.evaluation_method.empty() ? "?" : in.evaluation_method;
+  doc->Paragraph(Text("Model minus measured lower-end tension per cable (the paper's Table 6), "
+                      "model tensions from the ")
+                     .Code(method)
+                     .Plain(" statics with the model's sensor gain and bias. \"all\": RMS over "
+                            "the six cables."));
+  if (in.variants.empty()) {
+    doc->Paragraph("No model variant was evaluated.");
+    return;
+  }
+  const int fit_n = in.variants.front().fit.samples;
+  doc->AddTable(StatsTable(
+      in, "RMS of model - measured [kN], " + FitSamplesLabel(in) + " (n = " + Int(fit_n) + ")",
+      &CableErrorStats::rms_n, true, false, nullptr));
+  const bool holdout = AnyHoldout(in);
+  if (holdout) {
+    Table t = StatsTable(in, "", &CableErrorStats::rms_n, true, false, nullptr);
+    t.rows.clear();
+    int n = 0;
+    for (size_t k = 0; k < in.variants.size(); ++k) {
+      const VariantEvaluation& v = in.variants[k];
+      if (v.holdout.samples == 0) continue;
+      n = v.holdout.samples;
+      std::vector<Text> row = {Text().Swatch(PlotSeriesColour(static_cast<int>(k))).Plain(v.name),
+                               Int(v.holdout.samples)};
+      for (double x : v.holdout.rms_n) row.push_back(Kn3(x));
+      row.push_back(Text().Bold(Kn3(RmsAllCables(v.holdout.rms_n))));
+      t.rows.push_back(std::move(row));
+    }
+    t.caption =
+        "RMS of model - measured [kN], held-out samples (n = " + Int(n) + "; not used in the fit)";
+    doc->AddTable(std::move(t));
+  }
+  if (with_plots) {
+    std::vector<std::string> svgs = {BarChart(in, false)};
+    if (holdout) svgs.push_back(BarChart(in, true));
+    doc->Figure(std::move(svgs), "RMS of model - measured per cable for each variant [kN].");
+  }
+  doc->AddTable(StatsTable(in, "RMS of 100 (model - measured) / measured [%]",
+                           &CableErrorStats::rms_percent, false, holdout, "%.2f"));
+  doc->AddTable(StatsTable(in, "Mean of model - measured (bias) [kN]", &CableErrorStats::mean_n,
+                           true, holdout, nullptr));
+  doc->AddTable(StatsTable(in, "Largest |model - measured| [kN]", &CableErrorStats::max_abs_n, true,
+                           holdout, nullptr));
+}
+
+// x coordinates of the time plots: time_s, or the sample index when time does not vary.
+std::vector<double> SampleAxis(const Dataset& d, std::string* label) {
+  std::vector<double> x;
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Sample& s : d.samples) {
+    lo = std::min(lo, s.time_s);
+    hi = std::max(hi, s.time_s);
+  }
+  const bool use_time = std::isfinite(lo) && std::isfinite(hi) && hi > lo;
+  *label = use_time ? "t [s]" : "sample index";
+  for (size_t n = 0; n < d.samples.size(); ++n) {
+    x.push_back(use_time ? d.samples[n].time_s : static_cast<double>(n));
+  }
+  return x;
+}
+
+// Puts `item` at index `slot` of `v`, padding with empty (unnamed, pointless) series: the
+// charts colour a series by its index, and a variant keeps its colour (its index in the
+// RMS table, PlotSeriesColour) in every chart.
+template <typename Series>
+void PutAt(std::vector<Series>* v, size_t slot, Series item) {
+  if (v->size() <= slot) v->resize(slot + 1);
+  (*v)[slot] = std::move(item);
+}
+
+// Colour slots of the measured tensions: black, and sky blue for held-out samples, after
+// the variants' slots.
+size_t MeasuredSlot(const ReportInputs& in) { return std::max<size_t>(6, in.variants.size() + 1); }
+size_t HeldOutSlot(const ReportInputs& in) {
+  return in.variants.size() <= 5 ? 5 : in.variants.size();
+}
+
+void AddPlots(const ReportInputs& in, Document* doc) {
+  doc->Heading(2, "Plots");
+  if (!in.data || in.data->samples.empty()) {
+    doc->Paragraph("No samples to plot.");
+    return;
+  }
+  const Dataset& d = *in.data;
+  std::string x_label;
+  const std::vector<double> x = SampleAxis(d, &x_label);
+  const std::vector<size_t> shown = PlotVariants(in);
+  const bool holdout = NumHeldOut(in) > 0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  // With a calibration the "before" variant is dashed, the calibrated one solid.
+  auto dashed = [&](size_t k) { return in.result != nullptr && k + 1 < shown.size(); };
+
+  // Tension against time, one plot per cable.
+  std::vector<std::string> cable_svgs;
+  for (int i = 0; i < kNumCables; ++i) {
+    std::vector<PlotSeries> series;
+    for (size_t k = 0; k < shown.size(); ++k) {
+      const VariantEvaluation& v = in.variants[shown[k]];
+      if (!HasPredictions(in, v)) continue;
+      PlotSeries p{v.name, x, {}, dashed(k), false};
+      for (const auto& predicted : v.predicted_n) p.y.push_back(predicted[i] / kNPerKn);
+      PutAt(&series, shown[k], std::move(p));
+    }
+    PlotSeries fitted{holdout ? "measured (fitted)" : "measured", x, {}, false, true};
+    PlotSeries held{"measured (held out)", x, {}, false, true};
+    for (size_t n = 0; n < d.samples.size(); ++n) {
+      const double t_kn = d.samples[n].tension_n[i] / kNPerKn;
+      fitted.y.push_back(IsHeldOut(in, n) ? nan : t_kn);
+      held.y.push_back(IsHeldOut(in, n) ? t_kn : nan);
+    }
+    if (holdout) PutAt(&series, HeldOutSlot(in), std::move(held));
+    PutAt(&series, MeasuredSlot(in), std::move(fitted));
+    PlotOptions o;
+    o.title = "Cable " + Int(i + 1) + ": tension";
+    o.x_label = x_label;
+    o.y_label = "T" + Int(i + 1) + " [kN]";
+    o.width_px = kCablePlotWidthPx;
+    o.height_px = kCablePlotHeightPx;
+    cable_svgs.push_back(SvgLinePlot(series, o));
+  }
+  doc->Figure(std::move(cable_svgs),
+              std::string("Measured lower-end tension (dots") +
+                  (holdout ? "; held-out samples in light blue" : "") +
+                  ") and the model predictions (lines) against time, per cable [kN].");
+
+  // Residual distribution, all cables and samples pooled.
+  std::vector<HistogramSeries> histograms;
+  bool any = false;
+  for (size_t k : shown) {
+    const VariantEvaluation& v = in.variants[k];
+    if (!HasPredictions(in, v)) continue;
+    HistogramSeries h{v.name, {}};
+    for (size_t n = 0; n < d.samples.size(); ++n) {
+      for (int i = 0; i < kNumCables; ++i) {
+        h.values.push_back((v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn);
+      }
+    }
+    PutAt(&histograms, k, std::move(h));
+    any = true;
+  }
+  if (!any) {
+    doc->Paragraph("No model predictions to plot residuals of.");
+    return;
+  }
+  PlotOptions o;
+  o.title = "Model - measured, all cables and samples";
+  o.x_label = "model - measured [kN]";
+  o.width_px = kWidePlotWidthPx;
+  o.height_px = kWidePlotHeightPx;
+  doc->Figure({SvgHistogram(histograms, kResidualBins, o)},
+              "Distribution of model - measured over all cables and samples [kN]: a "
+              "calibrated model should centre on 0 with the width of the sensor noise.");
+
+  // Residual against time, one plot per cable.
+  std::vector<std::string> residual_svgs;
+  for (int i = 0; i < kNumCables; ++i) {
+    std::vector<PlotSeries> series;
+    for (size_t k = 0; k < shown.size(); ++k) {
+      const VariantEvaluation& v = in.variants[shown[k]];
+      if (!HasPredictions(in, v)) continue;
+      PlotSeries p{v.name, x, {}, dashed(k), false};
+      for (size_t n = 0; n < d.samples.size(); ++n) {
+        p.y.push_back((v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn);
+      }
+      PutAt(&series, shown[k], std::move(p));
+    }
+    PlotOptions r;
+    r.title = "Cable " + Int(i + 1) + ": model - measured";
+    r.x_label = x_label;
+    r.y_label = "model - measured [kN]";
+    r.width_px = kCablePlotWidthPx;
+    r.height_px = kCablePlotHeightPx;
+    residual_svgs.push_back(SvgLinePlot(series, r));
+  }
+  doc->Figure(std::move(residual_svgs),
+              "Model - measured against time, per cable [kN]: a pattern that repeats with "
+              "the pose is model error; what remains after calibration should look like noise.");
+}
+
+void AddCalibratedModel(const ReportInputs& in, Document* doc) {
+  doc->Heading(2, "The calibrated model");
+  doc->Paragraph(Text("The calibrated model is ")
+                     .Code("model_calibrated.yaml")
+                     .Plain(" in the directory of this report (DIR below), in the same format as "
+                            "the input model; parameters the spec does not name keep their input "
+                            "values, and the estimated sensor gains and biases are in it. Check it "
+                            "on data it was not fitted to (another trajectory, another day), then "
+                            "use it like any model file:"));
+  const std::string data = in.data_path.empty() ? "OTHER_DATA.csv" : in.data_path;
+  doc->Pre("",
+           "fastcal evaluate --model=DIR/model_calibrated.yaml --data=" + data +
+               "\nfastcal solve --model=DIR/model_calibrated.yaml --position=0,0,140 "
+               "--method=exact",
+           false);
+}
+
+void AddAppendices(const ReportInputs& in, Document* doc) {
+  const bool spec = in.spec != nullptr;
+  const bool ceres = in.result && !in.result->ceres_full_report.empty();
+  const bool skipped = in.data && !in.data->skipped.empty();
+  if (!spec && !ceres && !skipped) return;
+  doc->Heading(2, "Details");
+  if (spec) doc->Pre("Calibration spec as used (YAML)", CalibrationSpecToYaml(*in.spec), true);
+  if (ceres) doc->Pre("Ceres full report", in.result->ceres_full_report, true);
+  if (skipped) {
+    std::string text;
+    for (const std::string& s : in.data->skipped) text += s + "\n";
+    doc->Pre("Skipped dataset rows (" + Int(static_cast<long long>(in.data->skipped.size())) + ")",
+             text, true);
+  }
+}
+
+Document BuildDocument(const ReportInputs& in, bool with_plots) {
+  Document doc;
+  doc.title = in.result ? "fastcal calibration report" : "fastcal evaluation report";
+  doc.Heading(1, doc.title);
+  doc.Paragraph(in.result
+                    ? "FAST feed-cabin cable robot: model parameters estimated from measured "
+                      "poses and cable tensions, and the model checked against the measurements "
+                      "before and after. Tensions in kN."
+                    : "FAST feed-cabin cable robot: model tensions checked against measured cable "
+                      "tensions. Tensions in kN.");
+  AddProvenance(in, &doc);
+  AddVerdict(in, &doc);
+  if (in.result) {
+    AddEstimates(*in.result, &doc);
+    AddIdentifiability(*in.result, with_plots, &doc);
+  }
+  AddRmsTables(in, with_plots, &doc);
+  if (with_plots) {
+    AddPlots(in, &doc);
+  } else {
+    doc.Heading(2, "Plots");
+    doc.Paragraph(
+        "The plots (tension and model - measured against time per cable, residual "
+        "distribution, RMS per cable, correlation heatmap) are in report.html.");
+  }
+  if (in.result) AddCalibratedModel(in, &doc);
+  AddAppendices(in, &doc);
+  return doc;
+}
+
+// ---------------------------------------------------------------------------------------
+// Markdown.
+
+// Escapes what would start markup in running text (no text here starts a line with
+// '#', '>' or '-', and no link reference is ever defined, so brackets are safe); '|' only
+// inside a table cell.
+std::string MarkdownEscape(const std::string& s, bool in_table) {
+  std::string out;
+  for (char c : s) {
+    if (c == '\\' || c == '`' || c == '*' || c == '_' || c == '<' || (in_table && c == '|')) {
+      out += '\\';
+    }
+    out += c == '\n' ? ' ' : c;
+  }
+  return out;
+}
+
+std::string MarkdownCode(std::string s, bool in_table) {
+  std::replace(s.begin(), s.end(), '\n', ' ');
+  // A fence longer than the longest run of backticks inside.
+  size_t longest = 0, run = 0;
+  for (char c : s) {
+    run = c == '`' ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  const std::string fence(longest + 1, '`');
+  const bool pad = !s.empty() && (s.front() == '`' || s.back() == '`');
+  // Inside a table a '|' ends the cell even in a code span; GFM accepts "\|" there.
+  std::string body;
+  for (char c : s) body += in_table && c == '|' ? std::string("\\|") : std::string(1, c);
+  return fence + (pad ? " " : "") + body + (pad ? " " : "") + fence;
+}
+
+std::string MarkdownInline(const Text& text, bool in_table = false) {
+  std::string out;
+  for (const Span& s : text.spans()) {
+    switch (s.kind) {
+      case Span::kPlain:
+        out += MarkdownEscape(s.text, in_table);
+        break;
+      case Span::kCode:
+        out += MarkdownCode(s.text, in_table);
+        break;
+      case Span::kBold:
+        out += "**" + MarkdownEscape(s.text, in_table) + "**";
+        break;
+      case Span::kSwatch:
+        break;
+    }
+  }
+  return out;
+}
+
+std::string MarkdownFence(const std::string& body) {
+  size_t longest = 0, run = 0;
+  for (char c : body) {
+    run = c == '`' ? run + 1 : 0;
+    longest = std::max(longest, run);
+  }
+  return std::string(std::max<size_t>(3, longest + 1), '`');
+}
+
+std::string RenderMarkdown(const Document& doc) {
+  std::string out;
+  for (const Block& b : doc.blocks()) {
+    if (b.target == Target::kHtmlOnly) continue;
+    switch (b.kind) {
+      case Block::kHeading:
+        out += std::string(b.level, '#') + " " + MarkdownInline(b.text) + "\n\n";
+        break;
+      case Block::kParagraph:
+        out += MarkdownInline(b.text) + "\n\n";
+        break;
+      case Block::kList:
+        for (const Text& item : b.items) out += "- " + MarkdownInline(item) + "\n";
+        out += "\n";
+        break;
+      case Block::kTable: {
+        const Table& t = b.table;
+        if (!t.caption.spans().empty()) out += "**" + MarkdownInline(t.caption) + "**\n\n";
+        out += "|";
+        for (const Text& h : t.header) out += " " + MarkdownInline(h, true) + " |";
+        out += "\n|";
+        for (size_t c = 0; c < t.header.size(); ++c) {
+          out += c < t.right_align.size() && t.right_align[c] ? " ---: |" : " --- |";
+        }
+        out += "\n";
+        for (const auto& row : t.rows) {
+          out += "|";
+          for (const Text& cell : row) out += " " + MarkdownInline(cell, true) + " |";
+          out += "\n";
+        }
+        out += "\n";
+        break;
+      }
+      case Block::kPre: {
+        if (!b.text.spans().empty()) out += "**" + MarkdownInline(b.text) + "**\n\n";
+        std::string body = b.pre;
+        if (!body.empty() && body.back() != '\n') body += '\n';
+        const std::string fence = MarkdownFence(body);
+        out += fence + "\n" + body + fence + "\n\n";
+        break;
+      }
+      case Block::kFigure:
+        break;
+    }
+  }
+  while (out.size() >= 2 && out[out.size() - 1] == '\n' && out[out.size() - 2] == '\n') {
+    out.pop_back();
+  }
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// HTML.
+
+constexpr char kCss[] = R"(
+body { margin: 0; background: #f4f5f7; color: #1d1f23;
+  font: 14px/1.5 "Helvetica Neue", Arial, sans-serif; }
+main { max-width: 1120px; margin: 0 auto; padding: 24px 32px 48px; background: #fff; }
+h1 { font-size: 26px; margin: 8px 0 4px; }
+h2 { font-size: 19px; margin: 32px 0 10px; padding-bottom: 4px; border-bottom: 2px solid #d7dbe0; }
+p { margin: 8px 0; max-width: 980px; }
+ul { margin: 6px 0 10px; padding-left: 22px; }
+code, pre { font: 12.5px/1.4 "DejaVu Sans Mono", Menlo, Consolas, monospace; }
+code { background: #f0f1f3; padding: 0 3px; border-radius: 3px; overflow-wrap: anywhere; }
+td code, th code { overflow-wrap: normal; }  /* names whole; long commands wrap at spaces */
+pre { background: #f6f7f9; border: 1px solid #e1e4e8; padding: 10px 12px; overflow-x: auto; }
+table { border-collapse: collapse; margin: 8px 0 18px; font-variant-numeric: tabular-nums; }
+caption { caption-side: top; text-align: left; font-weight: bold; padding: 4px 0; }
+th, td { border: 1px solid #d7dbe0; padding: 3px 9px; vertical-align: top; }
+th { background: #eef0f3; text-align: left; font-weight: 600; }
+td.num, th.num { text-align: right; white-space: nowrap; }
+tbody tr:nth-child(even) { background: #fafbfc; }
+.sw { display: inline-block; width: 10px; height: 10px; margin-right: 6px; border-radius: 2px; }
+figure { margin: 12px 0 22px; }
+figure .charts { display: flex; flex-wrap: wrap; gap: 12px 16px; }
+figure svg { max-width: 100%; height: auto; }
+figcaption { color: #555; font-size: 13px; margin-top: 4px; }
+details { margin: 8px 0; }
+summary { cursor: pointer; font-weight: 600; }
+)";
+
+std::string HtmlInline(const Text& text) {
+  std::string out;
+  for (const Span& s : text.spans()) {
+    switch (s.kind) {
+      case Span::kPlain:
+        out += XmlEscape(s.text);
+        break;
+      case Span::kCode:
+        out += "<code>" + XmlEscape(s.text) + "</code>";
+        break;
+      case Span::kBold:
+        out += "<strong>" + XmlEscape(s.text) + "</strong>";
+        break;
+      case Span::kSwatch:
+        out += "<span class=\"sw\" style=\"background:" + XmlEscape(s.text) + "\"></span>";
+        break;
+    }
+  }
+  return out;
+}
+
+std::string RenderHtml(const Document& doc) {
+  std::string out =
+      "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+      "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>" +
+      XmlEscape(doc.title) + "</title>\n<style>" + kCss + "</style>\n</head>\n<body>\n<main>\n";
+  for (const Block& b : doc.blocks()) {
+    if (b.target == Target::kMarkdownOnly) continue;
+    switch (b.kind) {
+      case Block::kHeading: {
+        const std::string tag = "h" + Int(std::clamp(b.level, 1, 6));
+        out += "<" + tag + ">" + HtmlInline(b.text) + "</" + tag + ">\n";
+        break;
+      }
+      case Block::kParagraph:
+        out += "<p>" + HtmlInline(b.text) + "</p>\n";
+        break;
+      case Block::kList:
+        out += "<ul>\n";
+        for (const Text& item : b.items) out += "<li>" + HtmlInline(item) + "</li>\n";
+        out += "</ul>\n";
+        break;
+      case Block::kTable: {
+        const Table& t = b.table;
+        auto cls = [&t](size_t c) {
+          return c < t.right_align.size() && t.right_align[c] ? " class=\"num\"" : "";
+        };
+        out += "<table>\n";
+        if (!t.caption.spans().empty()) out += "<caption>" + HtmlInline(t.caption) + "</caption>\n";
+        out += "<thead><tr>";
+        for (size_t c = 0; c < t.header.size(); ++c) {
+          out += std::string("<th") + cls(c) + ">" + HtmlInline(t.header[c]) + "</th>";
+        }
+        out += "</tr></thead>\n<tbody>\n";
+        for (const auto& row : t.rows) {
+          out += "<tr>";
+          for (size_t c = 0; c < row.size(); ++c) {
+            out += std::string("<td") + cls(c) + ">" + HtmlInline(row[c]) + "</td>";
+          }
+          out += "</tr>\n";
+        }
+        out += "</tbody>\n</table>\n";
+        break;
+      }
+      case Block::kPre:
+        if (b.collapsed) {
+          out += "<details>\n<summary>" + HtmlInline(b.text) + "</summary>\n<pre>" +
+                 XmlEscape(b.pre) + "</pre>\n</details>\n";
+        } else {
+          if (!b.text.spans().empty())
+            out += "<p><strong>" + HtmlInline(b.text) + "</strong></p>\n";
+          out += "<pre>" + XmlEscape(b.pre) + "</pre>\n";
+        }
+        break;
+      case Block::kFigure:
+        out += "<figure>\n<div class=\"charts\">\n";
+        for (const std::string& svg : b.svgs) out += svg + "\n";
+        out += "</div>\n<figcaption>" + HtmlInline(b.text) + "</figcaption>\n</figure>\n";
+        break;
+    }
+  }
+  out += "</main>\n</body>\n</html>\n";
+  return out;
+}
+
+// ---------------------------------------------------------------------------------------
+// JSON.
+
+void JsonFile(JsonWriter* w, const std::string& key, const std::string& path,
+              const std::string& digest) {
+  w->Key(key).BeginObject();
+  w->Key("path");
+  if (path.empty())
+    w->Null();
+  else
+    w->String(path);
+  w->Key("fnv1a64");
+  if (digest.empty())
+    w->Null();
+  else
+    w->String(digest);
+  w->EndObject();
+}
+
+template <typename Array>
+void JsonKnArray(JsonWriter* w, const std::string& key, const Array& values_n) {
+  std::vector<double> kn;
+  for (double v : values_n) kn.push_back(v / kNPerKn);
+  w->Key(key).NumberArray(kn);
+}
+
+void JsonStats(JsonWriter* w, const CableErrorStats& s) {
+  w->BeginObject();
+  w->Key("samples").Int(s.samples);
+  JsonKnArray(w, "rms_kN", s.rms_n);
+  w->Key("rms_all_cables_kN").Number(RmsAllCables(s.rms_n) / kNPerKn);
+  JsonKnArray(w, "max_abs_kN", s.max_abs_n);
+  w->Key("rms_percent").NumberArray(s.rms_percent);
+  w->Key("max_abs_percent").NumberArray(s.max_abs_percent);
+  JsonKnArray(w, "mean_kN", s.mean_n);
+  w->EndObject();
+}
+
+void JsonDirections(JsonWriter* w, const std::string& key,
+                    const std::vector<ParameterDirection>& directions) {
+  w->Key(key).BeginArray();
+  for (const ParameterDirection& d : directions) {
+    w->BeginObject();
+    w->Key("ratio").Number(d.singular_value_ratio);
+    w->Key("description").String(d.Describe());
+    w->Key("weights").BeginObject();
+    for (const auto& [name, weight] : d.weights) w->Key(name).Number(weight);
+    w->EndObject();
+    w->EndObject();
+  }
+  w->EndArray();
+}
+
+void JsonIdentifiability(JsonWriter* w, const std::string& key, const Identifiability& id) {
+  w->Key(key).BeginObject();
+  w->Key("singular_value_ratios").NumberArray(id.singular_value_ratios);
+  JsonDirections(w, "undetermined", id.undetermined);
+  JsonDirections(w, "poorly_determined", id.poorly_determined);
+  w->EndObject();
+}
+
+std::string RenderJson(const ReportInputs& in) {
+  JsonWriter w;
+  const CalibrationResult* r = in.result;
+  const CalibrationSpec* spec = in.spec;
+  w.BeginObject();
+  w.Key("report").String(r ? "calibration" : "evaluation");
+  w.Key("software_version").String(in.software_version);
+  w.Key("command_line").String(in.command_line);
+  w.Key("inputs").BeginObject();
+  JsonFile(&w, "model", in.model_path, in.model_digest);
+  JsonFile(&w, "spec", in.spec_path, in.spec_digest);
+  JsonFile(&w, "data", in.data_path, in.data_digest);
+  w.EndObject();
+  w.Key("spec_yaml");
+  if (spec)
+    w.String(CalibrationSpecToYaml(*spec));
+  else
+    w.Null();
+  w.Key("forward_model");
+  if (spec)
+    w.String(StaticsMethodName(spec->forward_model));
+  else
+    w.Null();
+  w.Key("evaluation_method").String(in.evaluation_method);
+  w.Key("noise");
+  if (spec) {
+    w.BeginObject();
+    w.Key("sigma_kN").Number(spec->tension_sigma_n / kNPerKn);
+    w.Key("sigma_percent").Number(spec->tension_sigma_percent);
+    w.EndObject();
+  } else {
+    w.Null();
+  }
+  w.Key("robust_loss");
+  if (spec) {
+    w.BeginObject();
+    w.Key("type").String(RobustLossName(spec->robust_loss));
+    w.Key("scale_sigma").Number(spec->robust_loss_scale);
+    w.EndObject();
+  } else {
+    w.Null();
+  }
+  w.Key("holdout");
+  if (spec) {
+    w.BeginObject();
+    w.Key("fraction").Number(spec->holdout_fraction);
+    w.Key("seed");
+    if (spec->holdout_seed <= static_cast<unsigned long long>(LLONG_MAX)) {
+      w.Int(static_cast<long long>(spec->holdout_seed));
+    } else {
+      w.String(std::to_string(spec->holdout_seed));
+    }
+    w.EndObject();
+  } else {
+    w.Null();
+  }
+  w.Key("solver");
+  if (r) {
+    w.BeginObject();
+    w.Key("termination").String(r->termination);
+    w.Key("converged").Bool(r->converged);
+    w.Key("iterations").Int(r->iterations);
+    w.Key("initial_cost").Number(r->initial_cost);
+    w.Key("final_cost").Number(r->final_cost);
+    w.Key("reduced_chi_square").Number(r->reduced_chi_square);
+    w.Key("num_residuals").Int(r->num_residuals);
+    w.Key("num_free").Int(r->num_free);
+    w.Key("covariance_ok").Bool(r->covariance_ok);
+    w.Key("seconds").Number(r->seconds);
+    w.EndObject();
+  } else {
+    w.Null();
+  }
+  w.Key("forward_model_error");
+  if (r) {
+    w.BeginObject();
+    w.Key("max_relative").Number(r->forward_model_max_rel_error);
+    w.Key("rms_relative").Number(r->forward_model_rms_rel_error);
+    w.EndObject();
+  } else {
+    w.Null();
+  }
+  w.Key("parameters").BeginArray();
+  if (r) {
+    for (const ParameterEstimate& p : r->parameters) {
+      w.BeginObject();
+      w.Key("name").String(p.name);
+      w.Key("unit").String(p.unit);
+      w.Key("free").Bool(p.free);
+      w.Key("initial").Number(p.initial);
+      w.Key("estimate").Number(p.estimate);
+      w.Key("sigma");
+      if (p.free && r->covariance_ok)
+        w.Number(p.sigma);
+      else
+        w.Null();
+      w.Key("prior");
+      if (p.has_prior) {
+        w.BeginObject();
+        w.Key("mean").Number(p.prior_mean);
+        w.Key("sigma").Number(p.prior_sigma);
+        w.EndObject();
+      } else {
+        w.Null();
+      }
+      w.Key("note").String(p.note);
+      w.EndObject();
+    }
+  }
+  w.EndArray();
+  w.Key("correlation");
+  if (r && CorrelationUsable(*r)) {
+    w.BeginObject();
+    w.Key("names").BeginArray();
+    for (const std::string& n : r->free_names) w.String(n);
+    w.EndArray();
+    w.Key("matrix").BeginArray();
+    for (const auto& row : CorrelationRows(*r)) w.NumberArray(row);
+    w.EndArray();
+    w.EndObject();
+  } else {
+    w.Null();
+  }
+  w.Key("strong_correlations").BeginArray();
+  if (r) {
+    for (const std::string& c : r->strong_correlations) w.String(c);
+  }
+  w.EndArray();
+  w.Key("identifiability");
+  if (r) {
+    w.BeginObject();
+    JsonIdentifiability(&w, "before", r->before);
+    JsonIdentifiability(&w, "after", r->after);
+    JsonIdentifiability(&w, "data_only", r->data_only);
+    w.EndObject();
+  } else {
+    w.Null();
+  }
+  w.Key("evaluation").BeginArray();
+  for (const VariantEvaluation& v : in.variants) {
+    w.BeginObject();
+    w.Key("name").String(v.name);
+    w.Key("fit");
+    JsonStats(&w, v.fit);
+    w.Key("holdout");
+    if (v.holdout.samples > 0)
+      JsonStats(&w, v.holdout);
+    else
+      w.Null();
+    w.EndObject();
+  }
+  w.EndArray();
+  w.Key("samples").BeginObject();
+  w.Key("total").Int(NumSamples(in));
+  w.Key("fitted");
+  if (r)
+    w.Int(r->num_fit_samples);
+  else
+    w.Null();
+  w.Key("held_out");
+  if (r)
+    w.Int(NumHeldOut(in));
+  else
+    w.Null();
+  w.EndObject();
+  w.EndObject();
+  return w.str();
+}
+
+// ---------------------------------------------------------------------------------------
+// Files.
+
+// Writes `content` to a new temporary file in the directory of `path`, flushes it to
+// disk and renames it to `path`. A failure leaves no temporary file.
+bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error) {
+  static std::atomic<unsigned> counter{0};
+  const std::string temp =
+      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    *error = path + ": cannot write: " + std::strerror(errno);
+    return false;
+  }
+  const auto fail = [&](const char* what, int err) {
+    *error = path + ": " + what + ": " + std::strerror(err);
+    ::unlink(temp.c_str());
+    return false;
+  };
+  size_t written = 0;
+  while (written < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      return fail("cannot write", err);
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return fail("cannot write", err);
+  }
+  if (::close(fd) != 0) return fail("cannot write", errno);
+  if (std::rename(temp.c_str(), path.c_str()) != 0) return fail("cannot rename into place", errno);
+  return true;
+}
+
+}  // namespace
+
+std::string ReportMarkdown(const ReportInputs& inputs) {
+  try {
+    return RenderMarkdown(BuildDocument(inputs, false));
+  } catch (const std::exception&) {
+    return std::string();
+  }
+}
+
+std::string ReportHtml(const ReportInputs& inputs) {
+  try {
+    return RenderHtml(BuildDocument(inputs, true));
+  } catch (const std::exception&) {
+    return std::string();
+  }
+}
+
+std::string SummaryJson(const ReportInputs& inputs) {
+  try {
+    return RenderJson(inputs);
+  } catch (const std::exception&) {
+    return std::string();
+  }
+}
+
+bool WriteReportFiles(const std::string& dir, const ReportInputs& inputs, std::string* error) {
+  std::string ignored;
+  if (error == nullptr) error = &ignored;
+  if (dir.empty()) {
+    *error = "report: no output directory given";
+    return false;
+  }
+  std::vector<std::string> written;
+  try {
+    const std::vector<std::pair<std::string, std::string>> files = {
+        {"report.md", ReportMarkdown(inputs)},
+        {"report.html", ReportHtml(inputs)},
+        {"summary.json", SummaryJson(inputs)}};
+    for (const auto& [name, content] : files) {
+      if (content.empty()) {
+        *error = name + ": could not be rendered (out of memory)";
+        break;
+      }
+      const std::string path = dir + (dir.back() == '/' ? "" : "/") + name;
+      if (!WriteFileAtomically(path, content, error)) break;
+      written.push_back(path);
+    }
+    if (written.size() == files.size()) return true;
+  } catch (const std::exception& e) {
+    *error = std::string("report: ") + e.what();
+  }
+  for (const std::string& path : written) ::unlink(path.c_str());
+  return false;
+}
+
+}  // namespace fastcal

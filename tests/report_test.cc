@@ -1,0 +1,499 @@
+// Tests of the calibration and evaluation report (fastcal/report.h): Markdown tables with
+// formatted numbers, self-contained HTML with inline SVG and no "nan"/"inf", well-formed
+// JSON, the evaluation-only report, and the atomic writing of the three files.
+#include "fastcal/report.h"
+
+#include <gtest/gtest.h>
+#include <stdlib.h>
+
+#include <algorithm>
+#include <array>
+#include <cctype>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fastcal {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr int kNumSamples = 20;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "the text does not contain '" << part << "'";
+}
+
+int Count(const std::string& text, const std::string& part) {
+  int n = 0;
+  for (size_t at = text.find(part); at != std::string::npos; at = text.find(part, at + 1)) ++n;
+  return n;
+}
+
+// Alphanumeric words of `text`, lowercased, that spell a non-finite number.
+std::vector<std::string> NonFiniteWords(const std::string& text) {
+  std::vector<std::string> found;
+  std::string word;
+  for (size_t i = 0; i <= text.size(); ++i) {
+    const unsigned char c = i < text.size() ? text[i] : ' ';
+    if (std::isalnum(c)) {
+      word += static_cast<char>(std::tolower(c));
+      continue;
+    }
+    if (word == "nan" || word == "inf" || word == "infinity") found.push_back(word);
+    word.clear();
+  }
+  return found;
+}
+
+// A strict recursive-descent JSON checker (RFC 8259 grammar, no extensions).
+class JsonChecker {
+ public:
+  explicit JsonChecker(const std::string& text) : s_(text) {}
+  bool Valid() {
+    SkipSpace();
+    if (!Value()) return false;
+    SkipSpace();
+    return i_ == s_.size();
+  }
+
+ private:
+  void SkipSpace() {
+    while (i_ < s_.size() && std::strchr(" \t\r\n", s_[i_]) != nullptr) ++i_;
+  }
+  bool Literal(const char* word) {
+    const size_t n = std::strlen(word);
+    if (s_.compare(i_, n, word) != 0) return false;
+    i_ += n;
+    return true;
+  }
+  bool String() {
+    if (i_ >= s_.size() || s_[i_] != '"') return false;
+    for (++i_; i_ < s_.size(); ++i_) {
+      const unsigned char c = s_[i_];
+      if (c == '"') {
+        ++i_;
+        return true;
+      }
+      if (c < 0x20) return false;
+      if (c == '\\') {
+        ++i_;
+        if (i_ >= s_.size() || std::strchr("\"\\/bfnrtu", s_[i_]) == nullptr) return false;
+      }
+    }
+    return false;
+  }
+  bool Number() {
+    const size_t start = i_;
+    if (i_ < s_.size() && s_[i_] == '-') ++i_;
+    const size_t digits = i_;
+    while (i_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[i_]))) ++i_;
+    if (i_ == digits) return false;
+    if (i_ < s_.size() && s_[i_] == '.') {
+      ++i_;
+      const size_t frac = i_;
+      while (i_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[i_]))) ++i_;
+      if (i_ == frac) return false;
+    }
+    if (i_ < s_.size() && (s_[i_] == 'e' || s_[i_] == 'E')) {
+      ++i_;
+      if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) ++i_;
+      const size_t exp = i_;
+      while (i_ < s_.size() && std::isdigit(static_cast<unsigned char>(s_[i_]))) ++i_;
+      if (i_ == exp) return false;
+    }
+    return i_ > start;
+  }
+  bool Sequence(char close, bool object) {
+    ++i_;
+    SkipSpace();
+    if (i_ < s_.size() && s_[i_] == close) {
+      ++i_;
+      return true;
+    }
+    while (true) {
+      SkipSpace();
+      if (object) {
+        if (!String()) return false;
+        SkipSpace();
+        if (i_ >= s_.size() || s_[i_] != ':') return false;
+        ++i_;
+        SkipSpace();
+      }
+      if (!Value()) return false;
+      SkipSpace();
+      if (i_ >= s_.size()) return false;
+      if (s_[i_] == close) {
+        ++i_;
+        return true;
+      }
+      if (s_[i_] != ',') return false;
+      ++i_;
+    }
+  }
+  bool Value() {
+    if (i_ >= s_.size()) return false;
+    switch (s_[i_]) {
+      case '{':
+        return Sequence('}', true);
+      case '[':
+        return Sequence(']', false);
+      case '"':
+        return String();
+      case 't':
+        return Literal("true");
+      case 'f':
+        return Literal("false");
+      case 'n':
+        return Literal("null");
+      default:
+        return Number();
+    }
+  }
+  const std::string& s_;
+  size_t i_ = 0;
+};
+
+TEST(JsonCheckerTest, AcceptsJsonAndRejectsBrokenText) {
+  EXPECT_TRUE(JsonChecker(R"({"a": [1, -2.5e3, null, true], "b": {"c": "x\"y"}})").Valid());
+  EXPECT_FALSE(JsonChecker(R"({"a": [1, 2})").Valid());
+  EXPECT_FALSE(JsonChecker(R"({"a": nan})").Valid());
+  EXPECT_FALSE(JsonChecker(R"({"a": 1,})").Valid());
+}
+
+// Statistics of a variant from its predictions, as EvaluateVariant would compute them.
+VariantEvaluation MakeVariant(const std::string& name, const Dataset& data,
+                              const std::vector<bool>& held_out, double offset_n, double wave_n) {
+  VariantEvaluation v;
+  v.name = name;
+  for (size_t n = 0; n < data.samples.size(); ++n) {
+    std::array<double, kNumCables> p{};
+    for (int i = 0; i < kNumCables; ++i) {
+      p[i] = data.samples[n].tension_n[i] + offset_n * (i + 1) / kNumCables +
+             wave_n * std::sin(0.7 * n + i);
+    }
+    v.predicted_n.push_back(p);
+  }
+  v.fit = ErrorStats(data, v.predicted_n, held_out, false);
+  v.holdout = ErrorStats(data, v.predicted_n, held_out, true);
+  return v;
+}
+
+class ReportTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    model_ = CableRobot::NominalFast();
+    data_.path = "circle.csv";
+    for (int n = 0; n < kNumSamples; ++n) {
+      Sample s;
+      s.line = n + 2;
+      s.time_s = 10.0 * n;
+      s.pose.position_m =
+          Eigen::Vector3d(71.11 * std::cos(0.3 * n), 71.11 * std::sin(0.3 * n), 156.73);
+      for (int i = 0; i < kNumCables; ++i) {
+        s.tension_n[i] = 1e3 * (180.0 + 40.0 * std::sin(0.3 * n + i));
+      }
+      data_.samples.push_back(s);
+    }
+    held_out_ = HoldoutMask(kNumSamples, 0.2, 1);
+
+    spec_.tension_sigma_percent = 3.0;
+    spec_.holdout_fraction = 0.2;
+    spec_.holdout_seed = 1;
+
+    CalibrationResult& r = result_;
+    ParameterEstimate x;
+    x.name = "mass_centre_m.x";
+    x.unit = "m";
+    x.free = true;
+    x.initial = 0.0;
+    x.estimate = 0.2213;
+    x.sigma = 0.0031;
+    ParameterEstimate rho;
+    rho.name = "linear_density_kg_per_m";
+    rho.unit = "kg/m";
+    rho.free = true;
+    rho.initial = 11.718;
+    rho.estimate = 11.93;
+    rho.sigma = 0.12;
+    rho.has_prior = true;
+    rho.prior_mean = 11.718;
+    rho.prior_sigma = 0.5;
+    rho.note = "set mostly by its prior";
+    ParameterEstimate mass;
+    mass.name = "cabin_mass_kg";
+    mass.unit = "kg";
+    mass.initial = mass.estimate = 30000.0;
+    r.parameters = {x, mass, rho};
+    r.free_names = {"mass_centre_m.x", "linear_density_kg_per_m"};
+    r.correlation.resize(2, 2);
+    r.correlation << 1.0, 0.95, 0.95, 1.0;
+    r.covariance_ok = true;
+    r.strong_correlations = {"mass_centre_m.x ~ linear_density_kg_per_m: +0.95"};
+    r.before.singular_value_ratios = {1.0, 2e-3};
+    r.after.singular_value_ratios = {1.0, 1.5e-3};
+    r.data_only.singular_value_ratios = {1.0, 1e-12};
+    ParameterDirection d;
+    d.singular_value_ratio = 1e-12;
+    d.weights = {{"linear_density_kg_per_m", 1.0}};
+    r.data_only.undetermined = {d};
+    r.calibrated = model_;
+    r.held_out = held_out_;
+    r.num_fit_samples = kNumSamples - 4;
+    r.num_residuals = 6 * r.num_fit_samples + 1;
+    r.num_free = 2;
+    r.initial_cost = 5123.4;
+    r.final_cost = 47.5;
+    r.reduced_chi_square = 0.98;
+    r.iterations = 7;
+    r.converged = true;
+    r.termination = "CONVERGENCE";
+    r.ceres_full_report = "Solver Summary (v 2.1.0-eigen)\n  <Residual blocks> & more\n";
+    r.forward_model_max_rel_error = 2.1e-4;
+    r.forward_model_rms_rel_error = 8e-5;
+    r.seconds = 1.25;
+
+    // The paper's Table 6, first row, as a variant with fixed statistics.
+    VariantEvaluation paper;
+    paper.name = "paper nominal";
+    paper.fit.samples = kNumSamples - 4;
+    paper.fit.rms_n = {22554, 17517, 20078, 18687, 17167, 18190};
+    VariantEvaluation before =
+        MakeVariant("nominal model, measured attitude", data_, held_out_, 20e3, 8e3);
+    VariantEvaluation after =
+        MakeVariant("calibrated model, measured attitude", data_, held_out_, 1e3, 4e3);
+    after.fit.rms_percent[2] = kNaN;  // a statistic that could not be computed
+    after.holdout.mean_n[4] = std::numeric_limits<double>::infinity();
+
+    inputs_.model_path = "";
+    inputs_.spec_path = "spec_mass_centre.yaml";
+    inputs_.data_path = "circle.csv";
+    inputs_.spec_digest = "0123456789abcdef";
+    inputs_.data_digest = "fedcba9876543210";
+    inputs_.software_version = "0.1.0";
+    inputs_.command_line = "fastcal calibrate --spec=spec_mass_centre.yaml --data=circle.csv";
+    inputs_.initial_model = &model_;
+    inputs_.spec = &spec_;
+    inputs_.data = &data_;
+    inputs_.result = &result_;
+    inputs_.variants = {paper, before, after};
+    inputs_.evaluation_method = "exact";
+  }
+
+  ReportInputs EvaluateOnly() const {
+    ReportInputs in = inputs_;
+    in.spec = nullptr;
+    in.spec_path.clear();
+    in.spec_digest.clear();
+    in.result = nullptr;
+    std::vector<bool> none;
+    in.variants = {MakeVariant("model, measured attitude", data_, none, 20e3, 8e3)};
+    return in;
+  }
+
+  CableRobot model_;
+  Dataset data_;
+  std::vector<bool> held_out_;
+  CalibrationSpec spec_;
+  CalibrationResult result_;
+  ReportInputs inputs_;
+};
+
+TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
+  const std::string md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md, "# fastcal calibration report"));
+  // Estimates: names, units, values, sigma, prior, note; a fixed parameter says so.
+  EXPECT_TRUE(Contains(md, "| `mass_centre_m.x` | m | 0 | **0.22130** | 0.0031 | - |"));
+  EXPECT_TRUE(Contains(md,
+                       "| `linear_density_kg_per_m` | kg/m | 11.718 | **11.930** | 0.12 | "
+                       "11.718 ± 0.5 | set mostly by its prior |"));
+  EXPECT_TRUE(Contains(md, "| `cabin_mass_kg` | kg | 30000 | 30000 | fixed |"));
+  // RMS table: the paper's numbers in kN with three decimals.
+  EXPECT_TRUE(Contains(md,
+                       "| paper nominal | 16 | 22.554 | 17.517 | 20.078 | 18.687 | 17.167 | "
+                       "18.190 |"));
+  EXPECT_TRUE(Contains(md, "RMS of model - measured [kN], fitted samples (n = 16)"));
+  EXPECT_TRUE(Contains(md, "held-out samples (n = 4"));
+  EXPECT_TRUE(Contains(md, "RMS of 100 (model - measured) / measured [%]"));
+  EXPECT_TRUE(Contains(md, "Largest |model - measured| [kN]"));
+  // Verdict, provenance, identifiability, calibrated model, Ceres report.
+  EXPECT_TRUE(Contains(md, "**Converged** (termination: `CONVERGENCE`) after 7 iterations"));
+  EXPECT_TRUE(Contains(md, "5123.4 → 47.5"));
+  EXPECT_TRUE(Contains(md, "χ²/ν = **0.98**"));
+  EXPECT_TRUE(Contains(md, "the residuals scatter as the noise model says"));
+  EXPECT_TRUE(Contains(md, "16 fitted, 4 held out (20 in the dataset)"));
+  EXPECT_TRUE(Contains(md, "nominal FAST model (built in)"));
+  EXPECT_TRUE(Contains(md, "`spec_mass_centre.yaml` (fnv1a64 `0123456789abcdef`)"));
+  EXPECT_TRUE(Contains(md, "max 0.021 %, RMS 0.008 %"));
+  EXPECT_TRUE(Contains(md, "The data alone cannot determine `linear_density_kg_per_m (+1.00)`"));
+  EXPECT_TRUE(Contains(md, "the prior holds it"));
+  EXPECT_TRUE(Contains(md, "`mass_centre_m.x ~ linear_density_kg_per_m: +0.95`"));
+  EXPECT_TRUE(Contains(md, "| `mass_centre_m.x` | +1.00 | +0.95 |"));
+  EXPECT_TRUE(Contains(md, "fastcal evaluate --model=DIR/model_calibrated.yaml --data=circle.csv"));
+  EXPECT_TRUE(Contains(md, "```\nSolver Summary (v 2.1.0-eigen)\n  <Residual blocks> & more\n```"));
+  EXPECT_TRUE(NonFiniteWords(md).empty()) << NonFiniteWords(md).front();
+  EXPECT_TRUE(Contains(md, "n/a"));
+}
+
+TEST_F(ReportTest, ChiSquareInterpretation) {
+  result_.reduced_chi_square = 9.0;
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_),
+                       "model error the free parameters cannot absorb, "
+                       "or noise underestimated"));
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "√(χ²/ν) = 3"));
+  result_.reduced_chi_square = 0.1;
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "the noise is overestimated"));
+  result_.converged = false;
+  result_.termination = "NO_CONVERGENCE";
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "**Did not converge**"));
+}
+
+TEST_F(ReportTest, SaysSoWhenNothingIsPoorlyDetermined) {
+  result_.data_only.undetermined.clear();
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "Nothing is poorly determined"));
+}
+
+TEST_F(ReportTest, HtmlIsSelfContainedWithPlotsAndNoNonFiniteNumbers) {
+  const std::string html = ReportHtml(inputs_);
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_TRUE(Contains(html, "<meta charset=\"utf-8\">"));
+  EXPECT_TRUE(Contains(html, "</html>"));
+  // Heatmap, RMS bars (fitted and held out), tension per cable, histogram, residual per
+  // cable.
+  EXPECT_GE(Count(html, "<svg"), 4);
+  EXPECT_EQ(Count(html, "<svg"), 1 + 2 + 6 + 1 + 6);
+  EXPECT_TRUE(Contains(html, "<details>\n<summary>Ceres full report</summary>"));
+  EXPECT_TRUE(Contains(html, "&lt;Residual blocks&gt; &amp; more"));
+  EXPECT_TRUE(Contains(html, "<td class=\"num\">22.554</td>"));
+  const std::vector<std::string> bad = NonFiniteWords(html);
+  EXPECT_TRUE(bad.empty()) << bad.front();
+  EXPECT_FALSE(Contains(html, "<script"));
+  // No external resources: the only URL is the SVG namespace name, which is not fetched.
+  std::string stripped = html;
+  const std::string ns = "xmlns=\"http://www.w3.org/2000/svg\"";
+  for (size_t at; (at = stripped.find(ns)) != std::string::npos;) stripped.erase(at, ns.size());
+  EXPECT_FALSE(Contains(stripped, "http://"));
+  EXPECT_FALSE(Contains(stripped, "https://"));
+  EXPECT_FALSE(Contains(stripped, "src="));
+  EXPECT_FALSE(Contains(stripped, "href="));
+  EXPECT_FALSE(Contains(stripped, "url("));
+}
+
+TEST_F(ReportTest, JsonIsWellFormedWithTheSummary) {
+  const std::string json = SummaryJson(inputs_);
+  EXPECT_TRUE(JsonChecker(json).Valid()) << json;
+  EXPECT_TRUE(Contains(json, "\"reduced_chi_square\": 0.98"));
+  EXPECT_TRUE(Contains(json, "\"software_version\": \"0.1.0\""));
+  EXPECT_TRUE(Contains(json, "\"fnv1a64\": \"fedcba9876543210\""));
+  EXPECT_TRUE(Contains(json, "\"spec_yaml\": \""));
+  EXPECT_TRUE(Contains(json, "\"rms_kN\": [22.554, 17.517, 20.078, 18.687, 17.167, 18.19]"));
+  EXPECT_TRUE(Contains(json, "\"prior\": null"));
+  EXPECT_TRUE(Contains(json, "\"matrix\": ["));
+  EXPECT_TRUE(Contains(json, "\"data_only\": {"));
+  EXPECT_TRUE(Contains(json,
+                       "\"samples\": {\n    \"total\": 20,\n    \"fitted\": 16,\n"
+                       "    \"held_out\": 4\n"));
+  EXPECT_TRUE(Contains(json, "null"));  // the NaN statistic
+  EXPECT_TRUE(NonFiniteWords(json).empty());
+}
+
+TEST_F(ReportTest, EvaluateOnlyReport) {
+  const ReportInputs in = EvaluateOnly();
+  const std::string md = ReportMarkdown(in);
+  const std::string html = ReportHtml(in);
+  const std::string json = SummaryJson(in);
+  EXPECT_TRUE(Contains(md, "# fastcal evaluation report"));
+  EXPECT_TRUE(Contains(md, "RMS of model - measured [kN], all samples (n = 20)"));
+  EXPECT_FALSE(Contains(md, "## Estimates"));
+  EXPECT_FALSE(Contains(md, "Calibration spec"));
+  EXPECT_FALSE(Contains(md, "model_calibrated.yaml"));
+  EXPECT_EQ(html.rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_GE(Count(html, "<svg"), 4);
+  EXPECT_TRUE(NonFiniteWords(html).empty());
+  EXPECT_TRUE(JsonChecker(json).Valid()) << json;
+  EXPECT_TRUE(Contains(json, "\"report\": \"evaluation\""));
+  EXPECT_TRUE(Contains(json, "\"solver\": null"));
+  EXPECT_TRUE(Contains(json, "\"holdout\": null"));
+}
+
+TEST_F(ReportTest, DegenerateInputsStillGiveAReport) {
+  ReportInputs in;
+  EXPECT_TRUE(Contains(ReportMarkdown(in), "No model variant was evaluated."));
+  EXPECT_EQ(ReportHtml(in).rfind("<!DOCTYPE html>", 0), 0u);
+  EXPECT_TRUE(JsonChecker(SummaryJson(in)).Valid());
+  // A result without covariance and variants without predictions.
+  result_.covariance_ok = false;
+  result_.correlation.resize(0, 0);
+  for (VariantEvaluation& v : inputs_.variants) v.predicted_n.clear();
+  const std::string html = ReportHtml(inputs_);
+  EXPECT_TRUE(Contains(html, "The covariance could not be computed"));
+  EXPECT_TRUE(NonFiniteWords(html).empty());
+  EXPECT_TRUE(JsonChecker(SummaryJson(inputs_)).Valid());
+  EXPECT_TRUE(Contains(SummaryJson(inputs_), "\"correlation\": null"));
+}
+
+class ReportFilesTest : public ReportTest {
+ protected:
+  void SetUp() override {
+    ReportTest::SetUp();
+    std::string pattern = ::testing::TempDir() + "report_test_XXXXXX";
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+  std::vector<std::string> Entries(const fs::path& dir) const {
+    std::vector<std::string> names;
+    for (const auto& entry : fs::directory_iterator(dir)) {
+      names.push_back(entry.path().filename().string());
+    }
+    std::sort(names.begin(), names.end());
+    return names;
+  }
+  static std::string ReadFile(const fs::path& path) {
+    std::ifstream in(path, std::ios::binary);
+    std::ostringstream s;
+    s << in.rdbuf();
+    return s.str();
+  }
+  fs::path dir_;
+};
+
+TEST_F(ReportFilesTest, WritesThreeFiles) {
+  std::string error;
+  ASSERT_TRUE(WriteReportFiles(dir_.string(), inputs_, &error)) << error;
+  EXPECT_EQ(Entries(dir_), (std::vector<std::string>{"report.html", "report.md", "summary.json"}));
+  EXPECT_EQ(ReadFile(dir_ / "report.md"), ReportMarkdown(inputs_));
+  EXPECT_EQ(ReadFile(dir_ / "report.html"), ReportHtml(inputs_));
+  EXPECT_EQ(ReadFile(dir_ / "summary.json"), SummaryJson(inputs_));
+}
+
+TEST_F(ReportFilesTest, MissingDirectoryFailsAndLeavesNothing) {
+  std::string error;
+  EXPECT_FALSE(WriteReportFiles((dir_ / "missing").string(), inputs_, &error));
+  EXPECT_TRUE(Contains(error, "missing/report.md"));
+  EXPECT_TRUE(Entries(dir_).empty());
+  EXPECT_FALSE(WriteReportFiles("", inputs_, &error));
+}
+
+TEST_F(ReportFilesTest, FailureHalfwayRemovesWhatItWrote) {
+  // summary.json cannot replace a directory: the two files written before are removed.
+  fs::create_directory(dir_ / "summary.json");
+  std::string error;
+  EXPECT_FALSE(WriteReportFiles(dir_.string(), inputs_, &error));
+  EXPECT_TRUE(Contains(error, "summary.json"));
+  EXPECT_EQ(Entries(dir_), std::vector<std::string>{"summary.json"});
+  EXPECT_TRUE(fs::is_directory(dir_ / "summary.json"));
+}
+
+}  // namespace
+}  // namespace fastcal
