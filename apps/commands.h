@@ -9,6 +9,9 @@
 namespace fastcal::cli {
 
 int RunSolve(int argc, char** argv);
+int RunCalibrate(int argc, char** argv);
+int RunEvaluate(int argc, char** argv);
+int RunSimulate(int argc, char** argv);
 
 // Parses already-checked flags (see CheckAndNormaliseFlags) with gflags.
 void ParseFlags(const std::vector<std::string>& args);

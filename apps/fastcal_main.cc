@@ -27,6 +27,10 @@ Usage: fastcal <command> [--flag=value ...]
 Commands:
   solve      cable forces, tensions and unstretched lengths at a pose or along a trajectory
              (AAS, refined AAS, exact, or AAS against exact)
+  calibrate  estimate mass centre, cable density, offsets, sensor gains... from measured
+             poses and tensions; refuse free sets the data cannot determine; report
+  evaluate   RMS of model minus measured tensions per cable, for any model file
+  simulate   synthetic telemetry from a "truth" model along a trajectory, with noise
 
 Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
 )";
@@ -48,6 +52,9 @@ int main(int argc, char** argv) {
   }
   const std::string command = argv[1];
   if (command == "solve") return RunSolve(argc, argv);
+  if (command == "calibrate") return RunCalibrate(argc, argv);
+  if (command == "evaluate") return RunEvaluate(argc, argv);
+  if (command == "simulate") return RunSimulate(argc, argv);
   std::cerr << "fastcal: unknown command '" << command << "'\n\n" << kUsage;
   return kExitUsage;
 }

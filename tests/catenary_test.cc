@@ -144,7 +144,7 @@ TEST(CatenaryTest, JetInverseSolveCarriesImplicitDerivatives) {
     std::copy(in, in + 5, dn);
     up[k] += h;
     dn[k] -= h;
-    double fl_up, fz_up, fl_dn, fz_dn;
+    double fl_up = 0, fz_up = 0, fl_dn = 0, fz_dn = 0;
     ASSERT_EQ(SolveCatenaryForces(up[0], up[1], up[2], up[3], up[4], options, nullptr, &fl_up,
                                   &fz_up),
               CatenaryStatus::kOk);

@@ -268,7 +268,9 @@ TEST(StaticsTest, RefinementConvergesQuadratically) {
     for (int i = 0; i < kNumCables; ++i) {
       err = std::max(err, std::abs(s.cables[i].lower_tension_n / exact.cables[i].lower_tension_n - 1));
     }
-    if (steps > 0) EXPECT_LT(err, std::max(10 * previous * previous, 1e-13)) << steps;
+    if (steps > 0) {
+      EXPECT_LT(err, std::max(10 * previous * previous, 1e-13)) << steps;
+    }
     previous = err;
   }
 }

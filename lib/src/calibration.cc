@@ -24,6 +24,10 @@ using internal::CalibrationModel;
 constexpr double kPositiveFloorFraction = 1e-3;
 // Rows of the Jacobian folded into its R factor at a time.
 constexpr int kQrChunkRows = 1024;
+// Samples (evenly spaced) on which the forward model is compared with exact.
+constexpr size_t kForwardErrorSamples = 2000;
+// A parameter with at least this weight in a weak direction gets a note.
+constexpr double kNoteWeight = 0.3;
 // Weights below this are left out of a direction's description.
 constexpr double kDirectionWeightFloor = 0.1;
 
@@ -61,8 +65,8 @@ class ProgressCallback : public ceres::IterationCallback {
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
     char line[200];
     std::snprintf(line, sizeof(line),
-                  "iter %3d  cost %.6e  cost_change %+.3e  |gradient| %.3e  |step| %.3e  %s",
-                  s.iteration, s.cost, -s.cost_change, s.gradient_max_norm, s.step_norm,
+                  "iter %3d  cost %.6e  decrease %+.3e  |gradient| %.3e  |step| %.3e  %s",
+                  s.iteration, s.cost, s.cost_change, s.gradient_max_norm, s.step_norm,
                   s.step_is_successful ? "" : "(rejected)");
     f_(line);
     return ceres::SOLVER_CONTINUE;
@@ -139,13 +143,23 @@ Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>
   return out;
 }
 
-bool JacobianR(ceres::Problem* problem, const std::vector<ceres::ResidualBlockId>* blocks,
-               Eigen::MatrixXd* r) {
+// R factors of the whitened Jacobian at the current parameters: of all rows, and of the
+// first `data_rows` rows (the data blocks are added before the priors) when not null.
+bool JacobianR(ceres::Problem* problem, int num_threads, int data_rows, Eigen::MatrixXd* r_all,
+               Eigen::MatrixXd* r_data) {
   ceres::Problem::EvaluateOptions eo;
-  if (blocks != nullptr) eo.residual_blocks = *blocks;
+  eo.num_threads = num_threads;
   ceres::CRSMatrix j;
   if (!problem->Evaluate(eo, nullptr, nullptr, nullptr, &j)) return false;
-  *r = RFactor(j);
+  *r_all = RFactor(j);
+  if (r_data != nullptr) {
+    ceres::CRSMatrix d = j;
+    d.num_rows = data_rows;
+    d.rows.resize(data_rows + 1);
+    d.cols.resize(d.rows.back());
+    d.values.resize(d.rows.back());
+    *r_data = RFactor(d);
+  }
   return true;
 }
 
@@ -233,7 +247,10 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     exact.method = StaticsMethod::kExact;
     double sum2 = 0.0;
     int count = 0;
-    for (const Sample& s : data.samples) {
+    // A diagnostic: evenly spaced samples suffice on a large dataset.
+    const size_t stride = std::max<size_t>(1, data.samples.size() / kForwardErrorSamples);
+    for (size_t index = 0; index < data.samples.size(); index += stride) {
+      const Sample& s = data.samples[index];
       Pose pose = s.pose;
       if (spec.use_planned_attitude) pose.rotation = s.planned_rotation;
       if (ModelLowerTensions(p, pose, statics, &t_model) != StaticsStatus::kOk ||
@@ -287,8 +304,9 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     }
   }
 
-  Eigen::MatrixXd r;
-  if (!JacobianR(&problem, nullptr, &r)) {
+  Eigen::MatrixXd r, r_data;
+  const int data_rows = kNumCables * static_cast<int>(data_blocks.size());
+  if (!JacobianR(&problem, spec.num_threads, data_rows, &r, nullptr)) {
     *error = "the initial model cannot be evaluated on every sample";
     return CalibrationStatus::kInfeasible;
   }
@@ -368,9 +386,9 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   const int dof = result->num_residuals - n;
   result->reduced_chi_square = 2.0 * summary.final_cost / dof;
 
-  if (JacobianR(&problem, nullptr, &r)) result->after = Analyse(r, result->free_names, options);
-  if (JacobianR(&problem, &data_blocks, &r)) {
-    result->data_only = Analyse(r, result->free_names, options);
+  if (JacobianR(&problem, spec.num_threads, data_rows, &r, &r_data)) {
+    result->after = Analyse(r, result->free_names, options);
+    result->data_only = Analyse(r_data, result->free_names, options);
   }
 
   Eigen::MatrixXd cov = Eigen::MatrixXd::Zero(n, n);
@@ -425,21 +443,21 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
           e.sigma > options.prior_dominated_fraction * e.prior_sigma) {
         e.note = "set mostly by its prior";
       }
-      for (const ParameterDirection& d : result->data_only.poorly_determined) {
-        for (const auto& w : d.weights) {
-          if (w.first == p.name && std::abs(w.second) >= 0.3) {
-            e.note += std::string(e.note.empty() ? "" : "; ") +
-                      "poorly determined by the data alone: " + d.Describe();
+      // One short note per kind; the directions themselves are listed once in the
+      // identifiability section.
+      auto in_direction = [&](const std::vector<ParameterDirection>& dirs) {
+        for (const ParameterDirection& d : dirs) {
+          for (const auto& w : d.weights) {
+            if (w.first == p.name && std::abs(w.second) >= kNoteWeight) return true;
           }
         }
-      }
-      for (const ParameterDirection& d : result->data_only.undetermined) {
-        for (const auto& w : d.weights) {
-          if (w.first == p.name && std::abs(w.second) >= 0.3) {
-            e.note += std::string(e.note.empty() ? "" : "; ") +
-                      "not determined by the data alone (held by a prior): " + d.Describe();
-          }
-        }
+        return false;
+      };
+      auto add = [&](const std::string& text) { e.note += (e.note.empty() ? "" : "; ") + text; };
+      if (in_direction(result->data_only.undetermined)) {
+        add("not determined by the data alone (held by a prior; see identifiability)");
+      } else if (in_direction(result->data_only.poorly_determined)) {
+        add("poorly determined by the data alone (see identifiability)");
       }
     } else {
       e.initial = e.estimate = (p.has_initial ? p.initial_si : cm.BaseValue(p)) / p.to_si;

@@ -1,0 +1,436 @@
+// `fastcal calibrate` and `fastcal evaluate`: fit model parameters to a telemetry export
+// and report; or evaluate a model against one. Outputs go to a temporary directory that
+// is renamed into place only when everything has been written.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <sstream>
+
+#include <gflags/gflags.h>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+#include "fastcal/evaluation.h"
+#include "fastcal/report.h"
+
+DECLARE_string(model);
+DECLARE_string(method);
+DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
+DEFINE_string(data, "", "Measurement CSV (docs/data-format.md).");
+DEFINE_string(out, "", "Output directory (must not exist, or be empty).");
+DEFINE_bool(skip_invalid_rows, false,
+            "Skip dataset rows with a missing, non-numeric or non-finite value (listed) "
+            "instead of failing.");
+DEFINE_bool(quiet, false, "calibrate: no per-iteration progress.");
+
+namespace fastcal::cli {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNPerKn = 1e3;
+
+const char kCalibrateHelp[] = R"(fastcal calibrate: estimate model parameters from measured cabin poses and cable tensions.
+
+Usage:
+  fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml]
+
+  --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
+  --spec=FILE         which parameters are free, initial values, priors, noise model,
+                      robust loss, forward model, hold-out (docs/calibration.md)
+  --data=FILE         telemetry export: time_s, x_m,y_m,z_m, roll_deg,pitch_deg,yaw_deg (or
+                      qw,qx,qy,qz), T1_kN..T6_kN, optional planned_*_deg and s0_*_m
+                      (docs/data-format.md)
+  --out=DIR           output directory; must not exist or be empty. Written only when the
+                      calibration succeeded: nothing is left behind on failure.
+  --skip-invalid-rows skip (and list) rows with missing, non-numeric or non-finite values
+  --quiet             no per-iteration solver progress
+
+Before solving, the free set is checked: if the data (and priors) cannot determine it --
+e.g. cabin mass together with a common sensor gain, or tower offsets from one circle --
+the calibration is refused with the combination named and what to fix (exit 1).
+
+Outputs in DIR:
+  model_calibrated.yaml   the calibrated model (loads into fastcal solve and evaluate)
+  report.html, report.md  estimates with sigmas, identifiability, RMS per cable before and
+                          after (the paper's Table 6), plots
+  summary.json            the same, machine-readable, with provenance (input digests)
+  residuals.csv           per sample: measured, nominal and calibrated tensions (kN)
+
+Exit codes: 0 ok, 1 the calibration failed or was refused, 2 bad input.
+
+Example (the bundled paper-like circle):
+  fastcal calibrate --spec=calibration_data/spec_mass_centre_density.yaml \
+    --data=calibration_data/circle_paper.csv --out=out/circle
+)";
+
+const char kEvaluateHelp[] = R"(fastcal evaluate: model-minus-measured tension statistics per cable.
+
+Usage:
+  fastcal evaluate --data=DATA.csv [--model=MODEL.yaml] [--out=DIR] [--method=exact]
+
+  --model=FILE   model to evaluate (e.g. DIR/model_calibrated.yaml from calibrate);
+                 default the nominal FAST model
+  --data=FILE    telemetry export (docs/data-format.md)
+  --method=M     statics method: exact (default), aas-refined, aas
+  --out=DIR      also write report.html, report.md, summary.json and residuals.csv
+  --skip-invalid-rows   skip (and list) malformed rows instead of failing
+
+Prints RMS, mean and max |model - measured| per cable in kN and percent, with the measured
+attitude and, when the data has it, the planned attitude. The model's sensor gain and
+bias (if any) are applied: predicted reading = gain * tension + bias.
+)";
+
+// Writes the given files into a fresh temporary sibling of `dir`, then renames it to
+// `dir`; on any failure removes the temporary directory.
+bool WriteDirectoryAtomically(const std::string& dir,
+                              const std::vector<std::pair<std::string, std::string>>& files,
+                              const std::function<bool(const std::string&, std::string*)>& extra,
+                              std::string* error) {
+  std::error_code ec;
+  const fs::path target(dir);
+  if (fs::exists(target, ec)) {
+    if (!fs::is_directory(target, ec) || !fs::is_empty(target, ec)) {
+      *error = dir + ": exists and is not an empty directory (choose a new --out)";
+      return false;
+    }
+  }
+  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  if (!fs::exists(parent, ec) && !fs::create_directories(parent, ec)) {
+    *error = parent.string() + ": cannot create: " + ec.message();
+    return false;
+  }
+  const fs::path tmp = parent / ("." + target.filename().string() + ".tmp." +
+                                 std::to_string(::getpid()));
+  fs::remove_all(tmp, ec);
+  if (!fs::create_directory(tmp, ec)) {
+    *error = tmp.string() + ": cannot create: " + ec.message();
+    return false;
+  }
+  auto fail = [&](const std::string& why) {
+    fs::remove_all(tmp, ec);
+    *error = why;
+    return false;
+  };
+  for (const auto& [name, content] : files) {
+    std::string why;
+    if (!WriteOutput((tmp / name).string(), content, &why)) return fail(why);
+  }
+  std::string why;
+  if (extra && !extra(tmp.string(), &why)) return fail(why);
+  if (fs::exists(target, ec)) fs::remove(target, ec);  // empty directory
+  fs::rename(tmp, target, ec);
+  if (ec) return fail(dir + ": cannot move the results into place: " + ec.message());
+  return true;
+}
+
+std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluation>& variants,
+                         const std::vector<bool>& held_out) {
+  std::ostringstream out;
+  out << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
+  out << "line,time_s,held_out";
+  for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
+  std::vector<std::string> tags;
+  for (size_t v = 0; v < variants.size(); ++v) {
+    std::string tag = "v" + std::to_string(v + 1);
+    tags.push_back(tag);
+    for (int i = 1; i <= kNumCables; ++i) out << "," << tag << "_T" << i << "_kN";
+  }
+  out << "\n";
+  for (size_t n = 0; n < data.samples.size(); ++n) {
+    const Sample& s = data.samples[n];
+    out << s.line << "," << FormatDouble(s.time_s) << ","
+        << (!held_out.empty() && held_out[n] ? 1 : 0);
+    for (double t : s.tension_n) out << "," << FormatDouble(t / kNPerKn);
+    for (const VariantEvaluation& v : variants) {
+      for (double t : v.predicted_n[n]) out << "," << FormatDouble(t / kNPerKn);
+    }
+    out << "\n";
+  }
+  std::ostringstream legend;
+  for (size_t v = 0; v < variants.size(); ++v) {
+    legend << "# " << tags[v] << " = " << variants[v].name << "\n";
+  }
+  return legend.str() + out.str();
+}
+
+std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
+  std::ostringstream s;
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "  %-42s %8s %8s %8s %8s %8s %8s\n", "RMS model - measured (kN)",
+                "T1", "T2", "T3", "T4", "T5", "T6");
+  s << buf;
+  for (const VariantEvaluation& v : variants) {
+    for (int part = 0; part < 2; ++part) {
+      const CableErrorStats& st = part == 0 ? v.fit : v.holdout;
+      if (st.samples == 0) continue;
+      std::string name = v.name + (part == 1 ? " [hold-out]" : "");
+      std::snprintf(buf, sizeof(buf), "  %-42.42s", name.c_str());
+      s << buf;
+      for (double r : st.rms_n) {
+        std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
+        s << buf;
+      }
+      s << "\n";
+    }
+  }
+  return s.str();
+}
+
+bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
+  *robot = CableRobot::NominalFast();
+  if (!FLAGS_model.empty() && !LoadCableRobot(FLAGS_model, robot, error)) return false;
+  if (FLAGS_data.empty()) {
+    *error = "--data=FILE.csv is required";
+    return false;
+  }
+  DatasetReadOptions read;
+  read.skip_invalid_rows = FLAGS_skip_invalid_rows;
+  if (!ReadDataset(FLAGS_data, read, data, error)) return false;
+  if (!data->skipped.empty()) {
+    std::cerr << "fastcal: skipped " << data->skipped.size() << " invalid row(s):\n";
+    for (const std::string& s : data->skipped) std::cerr << "  " << s << "\n";
+  }
+  return true;
+}
+
+std::string Digest(const std::string& path) {
+  std::string hex, error;
+  return !path.empty() && FileFnv1a64(path, &hex, &error) ? hex : "";
+}
+
+std::string CommandLine(int argc, char** argv) {
+  std::string s = "fastcal";
+  for (int i = 1; i < argc; ++i) s += std::string(" ") + argv[i];
+  return s;
+}
+
+}  // namespace
+
+int RunCalibrate(int argc, char** argv) {
+  const char* command = "calibrate";
+  if (WantsHelp(argc, argv, 2)) {
+    std::cout << kCalibrateHelp;
+    return 0;
+  }
+  std::vector<std::string> args;
+  std::string error;
+  if (!CheckAndNormaliseFlags(argc, argv, 2, command,
+                              {"model", "spec", "data", "out", "skip-invalid-rows", "quiet"},
+                              &args, &error)) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
+  ParseFlags(args);
+  if (FLAGS_spec.empty() || FLAGS_out.empty()) {
+    PrintError(command, "--spec=FILE.yaml, --data=FILE.csv and --out=DIR are required (see "
+                        "fastcal calibrate --help)");
+    return kExitUsage;
+  }
+  CableRobot model;
+  Dataset data;
+  CalibrationSpec spec;
+  if (!LoadInputs(&model, &data, &error) ||
+      !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(model.anchor_points_cabin_m.size()), &spec,
+                           &error)) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
+  {
+    std::error_code ec;
+    if (fs::exists(FLAGS_out, ec) && (!fs::is_directory(FLAGS_out, ec) || !fs::is_empty(FLAGS_out, ec))) {
+      PrintError(command, FLAGS_out + ": exists and is not an empty directory (choose a new --out)");
+      return kExitUsage;
+    }
+  }
+  std::cerr << "fastcal calibrate: " << data.samples.size() << " samples from " << data.path
+            << ", forward model " << StaticsMethodName(spec.forward_model) << "\n";
+  CalibrationOptions options;
+  if (!FLAGS_quiet) options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
+  CalibrationResult result;
+  const CalibrationStatus status = Calibrate(model, spec, data, options, &result, &error);
+  if (status != CalibrationStatus::kOk) {
+    PrintError(command, error);
+    return status == CalibrationStatus::kInvalidInput ? kExitUsage : kExitFailure;
+  }
+
+  const AttitudeSource fit_attitude =
+      spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured;
+  std::vector<VariantEvaluation> variants;
+  struct Variant {
+    std::string name;
+    const CableRobot* robot;
+    AttitudeSource attitude;
+  };
+  std::vector<Variant> list;
+  if (data.has_planned_attitude) list.push_back({"initial model, planned attitude", &model, AttitudeSource::kPlanned});
+  list.push_back({"initial model, measured attitude", &model, AttitudeSource::kMeasured});
+  list.push_back({std::string("calibrated model, ") +
+                      (spec.use_planned_attitude ? "planned" : "measured") + " attitude",
+                  &result.calibrated, fit_attitude});
+  for (const Variant& v : list) {
+    VariantEvaluation e;
+    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact,
+                         result.held_out, &e, &error)) {
+      PrintError(command, v.name + ": " + error);
+      return kExitFailure;
+    }
+    variants.push_back(std::move(e));
+  }
+
+  ReportInputs report;
+  report.model_path = FLAGS_model;
+  report.spec_path = FLAGS_spec;
+  report.data_path = FLAGS_data;
+  report.model_digest = Digest(FLAGS_model);
+  report.spec_digest = Digest(FLAGS_spec);
+  report.data_digest = Digest(FLAGS_data);
+  report.software_version = FASTCAL_VERSION;
+  report.command_line = CommandLine(argc, argv);
+  report.initial_model = &model;
+  report.spec = &spec;
+  report.data = &data;
+  report.result = &result;
+  report.variants = variants;
+  report.evaluation_method = "exact";
+
+  const std::string header = "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + "\n" +
+                             report.command_line + "\ndata " + FLAGS_data + " (fnv1a64 " +
+                             report.data_digest + ")";
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"model_calibrated.yaml", CableRobotToYaml(result.calibrated, header)},
+      {"residuals.csv", ResidualsCsv(data, variants, result.held_out)}};
+  if (!WriteDirectoryAtomically(
+          FLAGS_out, files,
+          [&](const std::string& dir, std::string* why) { return WriteReportFiles(dir, report, why); },
+          &error)) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
+
+  std::ostringstream s;
+  s << "\n" << result.ceres_brief_report << "\n";
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "reduced chi-square %.3f over %d residuals; %d samples fitted, %d held out; %.2f s\n",
+                result.reduced_chi_square, result.num_residuals, result.num_fit_samples,
+                static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
+  s << buf << "\n";
+  std::snprintf(buf, sizeof(buf), "  %-28s %6s %14s %14s %12s  %s\n", "parameter", "unit",
+                "initial", "estimate", "sigma", "note");
+  s << buf;
+  for (const ParameterEstimate& p : result.parameters) {
+    // Short flags here; the full notes are in the report.
+    std::string flags;
+    if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
+    if (p.note.find("not determined by the data alone") != std::string::npos) {
+      flags += "data cannot determine ";
+    } else if (p.note.find("poorly determined") != std::string::npos) {
+      flags += "weak in data ";
+    }
+    std::snprintf(buf, sizeof(buf), "  %-28.28s %6s %14.6g %14.6g %12s  %s\n", p.name.c_str(),
+                  p.unit.c_str(), p.initial, p.estimate,
+                  p.free ? FormatDouble(p.sigma, 3).c_str() : "fixed", flags.c_str());
+    s << buf;
+  }
+  for (const ParameterDirection& d : result.data_only.undetermined) {
+    s << "  the data alone cannot determine (a prior holds it): " << d.Describe() << "\n";
+  }
+  for (const ParameterDirection& d : result.data_only.poorly_determined) {
+    s << "  weak direction in the data alone: " << d.Describe() << "\n";
+  }
+  for (const std::string& c : result.strong_correlations) s << "  strongly correlated: " << c << "\n";
+  s << "\n" << RmsTable(variants) << "\nwrote " << FLAGS_out
+    << "/{model_calibrated.yaml, report.html, report.md, summary.json, residuals.csv}\n";
+  std::cerr << s.str();
+  return 0;
+}
+
+int RunEvaluate(int argc, char** argv) {
+  const char* command = "evaluate";
+  if (WantsHelp(argc, argv, 2)) {
+    std::cout << kEvaluateHelp;
+    return 0;
+  }
+  std::vector<std::string> args;
+  std::string error;
+  if (!CheckAndNormaliseFlags(argc, argv, 2, command,
+                              {"model", "data", "out", "method", "skip-invalid-rows"}, &args,
+                              &error)) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
+  ParseFlags(args);
+  StaticsMethod method = StaticsMethod::kExact;
+  if (!gflags::GetCommandLineFlagInfoOrDie("method").is_default &&
+      !ParseStaticsMethod(FLAGS_method, &method)) {
+    PrintError(command, "--method must be aas, aas-refined or exact, got '" + FLAGS_method + "'");
+    return kExitUsage;
+  }
+  CableRobot model;
+  Dataset data;
+  if (!LoadInputs(&model, &data, &error)) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
+  std::vector<VariantEvaluation> variants;
+  std::vector<std::pair<std::string, AttitudeSource>> list;
+  if (data.has_planned_attitude) list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
+  list.emplace_back("model, measured attitude", AttitudeSource::kMeasured);
+  for (const auto& [name, attitude] : list) {
+    VariantEvaluation e;
+    if (!EvaluateVariant(name, model, data, attitude, method, {}, &e, &error)) {
+      PrintError(command, error);
+      return kExitFailure;
+    }
+    variants.push_back(std::move(e));
+  }
+  if (!FLAGS_out.empty()) {
+    ReportInputs report;
+    report.model_path = FLAGS_model;
+    report.data_path = FLAGS_data;
+    report.model_digest = Digest(FLAGS_model);
+    report.data_digest = Digest(FLAGS_data);
+    report.software_version = FASTCAL_VERSION;
+    report.command_line = CommandLine(argc, argv);
+    report.initial_model = &model;
+    report.data = &data;
+    report.variants = variants;
+    report.evaluation_method = StaticsMethodName(method);
+    if (!WriteDirectoryAtomically(
+            FLAGS_out, {{"residuals.csv", ResidualsCsv(data, variants, {})}},
+            [&](const std::string& dir, std::string* why) { return WriteReportFiles(dir, report, why); },
+            &error)) {
+      PrintError(command, error);
+      return kExitUsage;
+    }
+  }
+  std::ostringstream s;
+  s << "fastcal evaluate: " << data.samples.size() << " samples, model "
+    << (FLAGS_model.empty() ? "nominal FAST" : FLAGS_model) << ", method "
+    << StaticsMethodName(method) << "\n\n" << RmsTable(variants);
+  char buf[160];
+  for (const VariantEvaluation& v : variants) {
+    s << "\n  " << v.name << ":\n";
+    std::snprintf(buf, sizeof(buf), "    %-22s", "RMS (%)");
+    s << buf;
+    for (double r : v.fit.rms_percent) { std::snprintf(buf, sizeof(buf), " %8.3f", r); s << buf; }
+    std::snprintf(buf, sizeof(buf), "\n    %-22s", "mean (kN)");
+    s << buf;
+    for (double r : v.fit.mean_n) { std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn); s << buf; }
+    std::snprintf(buf, sizeof(buf), "\n    %-22s", "max |error| (kN)");
+    s << buf;
+    for (double r : v.fit.max_abs_n) { std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn); s << buf; }
+    s << "\n";
+  }
+  if (!FLAGS_out.empty()) s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";
+  std::cout << s.str();
+  return 0;
+}
+
+}  // namespace fastcal::cli

@@ -1,0 +1,460 @@
+// `fastcal simulate`: synthetic telemetry (the dataset CSV that calibrate and evaluate read)
+// from a truth model along a trajectory, with attitude control error, pose and tension
+// sensor noise, outliers, sensor gain and bias and per-cable density mismatch; the truth
+// model is written beside the CSV.
+#include <gflags/gflags.h>
+#include <unistd.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "fastcal/cable_robot.h"
+#include "fastcal/dataset.h"
+#include "fastcal/simulation.h"
+#include "fastcal/statics.h"
+#include "fastcal/trajectory.h"
+
+// Shared with solve (solve_command.cc) and calibrate (calibrate_command.cc): gflags flags
+// are process-global, so they are defined once and declared here.
+DECLARE_string(method);
+DECLARE_string(attitude_law);
+DECLARE_double(tilt_fraction);
+DECLARE_string(focal_centre);
+DECLARE_string(trajectory);
+DECLARE_string(from);
+DECLARE_string(to);
+DECLARE_int32(nodes);
+DECLARE_string(centre);
+DECLARE_double(radius);
+DECLARE_double(start_deg);
+DECLARE_double(end_deg);
+DECLARE_double(max_off_axis_deg);
+DECLARE_double(off_axis_step_deg);
+DECLARE_double(azimuth_step_deg);
+DECLARE_double(focal_radius);
+DECLARE_int32(samples);
+DECLARE_uint64(seed);
+DECLARE_double(radial_spread);
+DECLARE_string(poses);
+DECLARE_string(out);
+
+DEFINE_string(truth, "", "simulate: truth model YAML; empty = nominal FAST.");
+DEFINE_string(mass_centre, "", "simulate: truth mass centre x,y,z in the cabin frame (m).");
+DEFINE_double(attitude_control_deg, 0.0, "simulate: sigma of actual - planned rpy (deg).");
+DEFINE_double(attitude_noise_deg, 0.0, "simulate: sigma of measured - actual rpy (deg).");
+DEFINE_double(position_noise_m, 0.0, "simulate: sigma of measured - actual position (m).");
+DEFINE_double(tension_noise_pct, 3.0, "simulate: relative tension noise sigma (%).");
+DEFINE_double(tension_noise_kn, 0.0, "simulate: absolute tension noise sigma (kN).");
+DEFINE_double(outlier_fraction, 0.0, "simulate: probability of an outlier reading.");
+DEFINE_double(outlier_scale_pct, 30.0, "simulate: outlier = reading (1 + U(-s, s)/100).");
+DEFINE_double(density_mismatch_pct, 0.0, "simulate: per-cable density factor sigma (%).");
+DEFINE_string(sensor_gain, "", "simulate: sensor gains g1,...,g6 or one for all.");
+DEFINE_string(sensor_bias_kn, "", "simulate: sensor biases b1,...,b6 or one for all (kN).");
+DEFINE_double(interval_s, 1.0, "simulate: time between samples (s).");
+
+namespace fastcal::cli {
+namespace {
+
+constexpr char kCommand[] = "simulate";
+constexpr double kNPerKn = 1e3;
+// The paper's measured circle (docs/model.md, "Measured data").
+const Eigen::Vector3d kCircleCentre_m(0.0, 0.0, 156.73);
+constexpr double kCircleRadius_m = 71.11;
+constexpr int kCircleNodes = 360;
+
+const char kHelp[] =
+    R"(fastcal simulate: synthetic telemetry of the FAST cable robot from a known truth model.
+
+Usage:
+  fastcal simulate --out=FILE.csv [--truth=MODEL.yaml] [trajectory] [errors] [options]
+
+Writes FILE.csv (the dataset format calibrate and evaluate read, docs/data-format.md) and
+the truth model actually used beside it as FILE.truth.yaml (FILE.csv minus ".csv", plus
+".truth.yaml"), both with the command line in a header comment. Both are written to
+temporary files and renamed into place: on any failure neither is left.
+
+Per planned pose (position p, planned attitude a_plan as roll,pitch,yaw):
+  actual attitude     a_act  = a_plan + N(0, attitude-control-deg)    per angle
+  actual position     p (held exactly)
+  truth tensions      T_i, s0_i from the truth model's statics at (p, a_act), --method
+  sensor reading      y_i = gain_i T_i + bias_i
+  measured tension    y_i (1 + N(0, tension-noise-pct/100)) + N(0, tension-noise-kn)
+                      or, with probability outlier-fraction, y_i (1 + U(-s, s)/100),
+                      s = outlier-scale-pct
+  measured attitude   a_act + N(0, attitude-noise-deg)                per angle
+  measured position   p + N(0, position-noise-m)                      per axis
+The CSV has time_s = n * interval-s, the measured pose (x_m,y_m,z_m,roll_deg,pitch_deg,
+yaw_deg), the planned attitude (planned_roll_deg,..), T1_kN..T6_kN and, as the commanded
+lengths, the truth solution's unstretched lengths s0_1_m..s0_6_m.
+
+Truth model:
+  --truth=FILE.yaml        model (docs/model-format.md); default the nominal FAST model
+  --mass-centre=x,y,z      override its mass centre, cabin frame (m)
+  --sensor-gain=g|g1,..,g6     override the sensor gains (one value = all cables)
+  --sensor-bias-kn=b|b1,..,b6  override the sensor biases (kN)
+  --density-mismatch-pct=0     multiply each cable's linear density by 1 + N(0, pct/100),
+                               drawn once (non-uniform cables); the result is the truth
+                               model written to FILE.truth.yaml
+  --method=exact           statics of the truth tensions: exact (default), aas-refined, aas
+
+Trajectory (--trajectory=, default circle):
+  circle  the paper's measured circle: centre (0,0,156.73), radius 71.11 m, full turn,
+          --nodes=360 (default for circle)
+  line    --from=50,0,150 --to=-50,0,150 --nodes=101
+  arc     --centre=0,0,150 --radius=50 --start-deg=0 --end-deg=180 --nodes=101
+  grid    focal-sphere cap: --max-off-axis-deg=40 --off-axis-step-deg=5
+          --azimuth-step-deg=15 --focal-radius=160
+  random  --samples=100 --max-off-axis-deg=40 --radial-spread=0 (m, off the sphere),
+          positions drawn with --seed
+  poses   --poses=FILE.csv: x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or
+          qw,qx,qy,qz (the planned attitudes); --poses alone implies this trajectory
+Planned attitude (--attitude-law): focal (default for trajectories: tilt z' toward
+--focal-centre=0,0,300 by --tilt-fraction=0.41 of the off-axis angle) or none (R = I).
+A --poses file keeps its own attitudes unless --attitude-law is given.
+
+Errors (all zero-mean Gaussian unless stated; one --seed=1 drives them all, each error
+source with its own generator, so changing one sigma leaves the others' numbers alone):
+  --attitude-control-deg=0   actual minus planned attitude, per angle (deg)
+  --attitude-noise-deg=0     measured minus actual attitude, per angle (deg)
+  --position-noise-m=0       measured minus actual position, per axis (m)
+  --tension-noise-pct=3      relative tension noise (%, the paper's sensors: ~3%)
+  --tension-noise-kn=0       absolute tension noise (kN), added to the relative one
+  --outlier-fraction=0       probability that a reading is an outlier instead
+  --outlier-scale-pct=30     outlier half-width (%), in [0, 100)
+A noise draw that would make a reading <= 0 is redrawn (counted in the summary).
+
+Output: --out=FILE.csv (required), --interval-s=1 between samples. A summary on stderr:
+samples, RMS of the noise added per cable (kN and %), outliers, pose-error RMS.
+
+Exit codes: 0 ok, 1 the truth model cannot hold a pose (the node is named), 2 bad input.
+
+Examples (the bundled datasets):
+  # the paper's measured circle, mass centre moved as the authors found it
+  fastcal simulate --mass-centre=0.22,0.11,0.5 --nodes=360 --attitude-control-deg=0.2 \
+    --attitude-noise-deg=0.02 --position-noise-m=0.01 --tension-noise-pct=3 --seed=1 \
+    --out=calibration_data/circle_paper.csv
+  # many zenith angles: 600 random poses on the focal-sphere cap up to 40 deg, +-3 m
+  fastcal simulate --trajectory=random --samples=600 --max-off-axis-deg=40 \
+    --radial-spread=3 --attitude-law=focal --mass-centre=0.22,0.11,0.5 \
+    --attitude-control-deg=0.2 --attitude-noise-deg=0.02 --position-noise-m=0.01 \
+    --tension-noise-pct=3 --seed=2 --out=calibration_data/workspace_multi_zenith.csv
+  # sensor gain errors and 2% outliers on a straight line
+  fastcal simulate --trajectory=line --sensor-gain=1.02,0.98,1,1,1.01,0.99 \
+    --outlier-fraction=0.02 --out=line.csv
+)";
+
+// clang-format off
+const std::set<std::string> kFlags = {
+    "truth", "mass-centre", "sensor-gain", "sensor-bias-kn", "density-mismatch-pct", "method",
+    "trajectory", "nodes", "from", "to", "centre", "radius", "start-deg", "end-deg",
+    "max-off-axis-deg", "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "samples",
+    "radial-spread", "poses", "attitude-law", "tilt-fraction", "focal-centre",
+    "attitude-control-deg", "attitude-noise-deg", "position-noise-m", "tension-noise-pct",
+    "tension-noise-kn", "outlier-fraction", "outlier-scale-pct", "seed", "interval-s", "out"};
+// clang-format on
+
+bool IsDefault(const char* flag) { return gflags::GetCommandLineFlagInfoOrDie(flag).is_default; }
+
+// "v" (the same for every cable) or "v1,...,v6": finite numbers.
+bool ParseOneOrSix(const std::string& name, const std::string& text,
+                   std::array<double, kNumCables>* values, std::string* error) {
+  std::vector<double> parsed;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, ',')) {
+    const char* begin = item.c_str();
+    char* end = nullptr;
+    const double v = std::strtod(begin, &end);
+    while (end != nullptr && (*end == ' ' || *end == '\t')) ++end;
+    if (end == begin || *end != '\0' || !std::isfinite(v)) {
+      *error = "--" + name + ": '" + item + "' is not a finite number";
+      return false;
+    }
+    parsed.push_back(v);
+  }
+  if ((parsed.size() != 1 && parsed.size() != kNumCables) || text.back() == ',') {
+    *error = "--" + name + " needs one value or six comma-separated values, got '" + text + "'";
+    return false;
+  }
+  for (int i = 0; i < kNumCables; ++i) (*values)[i] = parsed[parsed.size() == 1 ? 0 : i];
+  return true;
+}
+
+bool LoadTruth(CableRobot* truth, std::string* error) {
+  *truth = CableRobot::NominalFast();
+  if (!FLAGS_truth.empty() && !LoadCableRobot(FLAGS_truth, truth, error)) return false;
+  if (!FLAGS_mass_centre.empty() &&
+      !ParseVector3("mass-centre", FLAGS_mass_centre, &truth->mass_centre_cabin_m, error)) {
+    return false;
+  }
+  std::array<double, kNumCables> values{};
+  if (!FLAGS_sensor_gain.empty()) {
+    if (!ParseOneOrSix("sensor-gain", FLAGS_sensor_gain, &values, error)) return false;
+    for (int i = 0; i < kNumCables; ++i) truth->cables[i].sensor_gain = values[i];
+  }
+  if (!FLAGS_sensor_bias_kn.empty()) {
+    if (!ParseOneOrSix("sensor-bias-kn", FLAGS_sensor_bias_kn, &values, error)) return false;
+    for (int i = 0; i < kNumCables; ++i) truth->cables[i].sensor_bias_n = values[i] * kNPerKn;
+  }
+  std::string why;
+  if (!truth->IsValid(&why)) {
+    *error = "truth model: " + why;
+    return false;
+  }
+  return true;
+}
+
+bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
+  options->attitude_control_sigma_deg = FLAGS_attitude_control_deg;
+  options->attitude_measurement_sigma_deg = FLAGS_attitude_noise_deg;
+  options->position_measurement_sigma_m = FLAGS_position_noise_m;
+  options->tension_noise_percent = FLAGS_tension_noise_pct;
+  options->tension_noise_kn = FLAGS_tension_noise_kn;
+  options->outlier_fraction = FLAGS_outlier_fraction;
+  options->outlier_scale_percent = FLAGS_outlier_scale_pct;
+  options->density_mismatch_percent = FLAGS_density_mismatch_pct;
+  options->seed = FLAGS_seed;
+  options->sample_interval_s = FLAGS_interval_s;
+  options->method = StaticsMethod::kExact;
+  if (!IsDefault("method") && !ParseStaticsMethod(FLAGS_method, &options->method)) {
+    *error = "--method must be exact, aas-refined or aas, got '" + FLAGS_method + "'";
+    return false;
+  }
+  std::string why;
+  if (!options->IsValid(&why)) {
+    *error = "invalid error model: " + why;
+    return false;
+  }
+  return true;
+}
+
+bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
+  FocalAttitudeLaw law;
+  law.tilt_fraction = FLAGS_tilt_fraction;
+  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
+  if (!std::isfinite(law.tilt_fraction)) {
+    *error = "--tilt-fraction must be finite";
+    return false;
+  }
+  if (!IsDefault("attitude_law") && FLAGS_attitude_law != "focal" && FLAGS_attitude_law != "none") {
+    *error = "--attitude-law must be 'focal' or 'none', got '" + FLAGS_attitude_law + "'";
+    return false;
+  }
+  std::string trajectory = IsDefault("trajectory") ? "circle" : FLAGS_trajectory;
+  if (!FLAGS_poses.empty() && IsDefault("trajectory")) trajectory = "poses";
+  if ((trajectory == "poses") != !FLAGS_poses.empty()) {
+    *error = "--trajectory=poses and --poses=FILE go together";
+    return false;
+  }
+
+  if (trajectory == "poses") {
+    if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
+    if (FLAGS_attitude_law == "focal") {
+      std::vector<Eigen::Vector3d> positions;
+      for (const Pose& p : *poses) positions.push_back(p.position_m);
+      return PosesWithAttitudeLaw(positions, law, poses, error);
+    }
+    if (FLAGS_attitude_law == "none") {
+      for (Pose& p : *poses) p.rotation.setIdentity();
+    }
+    return true;
+  }
+
+  std::vector<Eigen::Vector3d> positions;
+  bool ok = false;
+  if (trajectory == "circle") {
+    for (const char* flag : {"centre", "radius", "start_deg", "end_deg"}) {
+      if (!IsDefault(flag)) {
+        *error =
+            "--trajectory=circle is the paper's fixed circle; use --trajectory=arc with "
+            "--centre, --radius, --start-deg, --end-deg";
+        return false;
+      }
+    }
+    ArcSpec arc;
+    arc.centre_m = kCircleCentre_m;
+    arc.radius_m = kCircleRadius_m;
+    arc.start_deg = 0.0;
+    arc.end_deg = 360.0;
+    arc.nodes = IsDefault("nodes") ? kCircleNodes : FLAGS_nodes;
+    ok = ArcPositions(arc, &positions, error);
+  } else if (trajectory == "line") {
+    Eigen::Vector3d from, to;
+    ok = ParseVector3("from", FLAGS_from, &from, error) &&
+         ParseVector3("to", FLAGS_to, &to, error) &&
+         LinePositions(from, to, FLAGS_nodes, &positions, error);
+  } else if (trajectory == "arc") {
+    ArcSpec arc;
+    arc.radius_m = FLAGS_radius;
+    arc.start_deg = FLAGS_start_deg;
+    arc.end_deg = FLAGS_end_deg;
+    arc.nodes = FLAGS_nodes;
+    ok = ParseVector3("centre", FLAGS_centre, &arc.centre_m, error) &&
+         ArcPositions(arc, &positions, error);
+  } else if (trajectory == "grid") {
+    FocalGridSpec grid;
+    grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
+    grid.off_axis_step_deg = FLAGS_off_axis_step_deg;
+    grid.azimuth_step_deg = FLAGS_azimuth_step_deg;
+    grid.focal_centre_m = law.focal_centre_m;
+    grid.focal_radius_m = FLAGS_focal_radius;
+    ok = FocalSpherePositions(grid, &positions, error);
+  } else if (trajectory == "random") {
+    RandomWorkspaceSpec spec;
+    spec.samples = FLAGS_samples;
+    spec.max_off_axis_deg = FLAGS_max_off_axis_deg;
+    spec.radial_spread_m = FLAGS_radial_spread;
+    spec.sphere.focal_centre_m = law.focal_centre_m;
+    spec.sphere.focal_radius_m = FLAGS_focal_radius;
+    spec.seed = FLAGS_seed;
+    ok = RandomWorkspacePositions(spec, &positions, error);
+  } else {
+    *error =
+        "--trajectory must be circle, line, arc, grid, random or poses, got '" + trajectory + "'";
+    return false;
+  }
+  if (!ok) {
+    *error = "--trajectory=" + trajectory + ": " + *error;
+    return false;
+  }
+  return FLAGS_attitude_law == "none" ? PosesWithIdentityAttitude(positions, poses, error)
+                                      : PosesWithAttitudeLaw(positions, law, poses, error);
+}
+
+std::string CommandLine(int argc, char** argv) {
+  std::string s = "fastcal";
+  for (int i = 1; i < argc; ++i) s += std::string(" ") + argv[i];
+  return s;
+}
+
+// FILE.csv -> FILE.truth.yaml; any other name gets ".truth.yaml" appended.
+std::string TruthPathFor(const std::string& csv_path) {
+  const std::string suffix = ".csv";
+  const bool has_suffix =
+      csv_path.size() > suffix.size() &&
+      csv_path.compare(csv_path.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return (has_suffix ? csv_path.substr(0, csv_path.size() - suffix.size()) : csv_path) +
+         ".truth.yaml";
+}
+
+// Writes both files to temporaries, then renames them into place; on failure removes
+// whatever it wrote, so that neither file is left.
+bool WriteBoth(const std::string& csv_path, const Dataset& dataset, const std::string& csv_header,
+               const std::string& yaml_path, const CableRobot& truth,
+               const std::string& yaml_header, std::string* error) {
+  const std::string tmp = ".tmp." + std::to_string(::getpid());
+  const std::string csv_tmp = csv_path + tmp;
+  const std::string yaml_tmp = yaml_path + tmp;
+  if (!WriteDataset(csv_tmp, dataset, csv_header, error)) {
+    *error = "writing " + csv_path + ": " + *error;
+    return false;
+  }
+  if (!SaveCableRobot(truth, yaml_tmp, yaml_header, error)) {
+    std::remove(csv_tmp.c_str());
+    *error = "writing " + yaml_path + ": " + *error;
+    return false;
+  }
+  if (std::rename(yaml_tmp.c_str(), yaml_path.c_str()) != 0) {
+    std::remove(csv_tmp.c_str());
+    std::remove(yaml_tmp.c_str());
+    *error = yaml_path + ": cannot rename the temporary file into place";
+    return false;
+  }
+  if (std::rename(csv_tmp.c_str(), csv_path.c_str()) != 0) {
+    std::remove(csv_tmp.c_str());
+    std::remove(yaml_path.c_str());
+    *error = csv_path + ": cannot rename the temporary file into place";
+    return false;
+  }
+  return true;
+}
+
+std::string Summary(const SimulationSummary& s, const SimulationOptions& options,
+                    const std::string& csv_path, const std::string& yaml_path) {
+  std::ostringstream out;
+  out << "fastcal simulate: " << s.samples << " samples -> " << csv_path << ", truth model -> "
+      << yaml_path << "\n  tension noise added, RMS per cable (kN):";
+  for (double v : s.tension_noise_rms_n) out << " " << FormatDouble(v / kNPerKn, 4);
+  out << "\n  tension noise added, RMS per cable (%):";
+  for (double v : s.tension_noise_rms_relative) out << " " << FormatDouble(100.0 * v, 4);
+  if (options.outlier_fraction > 0.0) {
+    out << "\n  outliers per cable:";
+    for (int n : s.outliers) out << " " << n;
+  }
+  out << "\n  attitude control error RMS " << FormatDouble(s.attitude_control_rms_deg, 4)
+      << " deg, attitude noise RMS " << FormatDouble(s.attitude_measurement_rms_deg, 4)
+      << " deg, position noise RMS " << FormatDouble(s.position_measurement_rms_m, 4) << " m";
+  if (options.density_mismatch_percent > 0.0) {
+    out << "\n  density factors:";
+    for (double f : s.density_factor) out << " " << FormatDouble(f, 6);
+  }
+  if (s.redrawn > 0) out << "\n  " << s.redrawn << " noise draws redrawn (reading <= 0)";
+  return out.str();
+}
+
+}  // namespace
+
+int RunSimulate(int argc, char** argv) {
+  if (WantsHelp(argc, argv, 2)) {
+    std::cout << kHelp;
+    return 0;
+  }
+  std::vector<std::string> args;
+  std::string error;
+  if (!CheckAndNormaliseFlags(argc, argv, 2, kCommand, kFlags, &args, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  ParseFlags(args);
+
+  if (FLAGS_out.empty() || FLAGS_out == "-") {
+    PrintError(kCommand, "give --out=FILE.csv (the truth model goes beside it)");
+    return kExitUsage;
+  }
+  CableRobot truth;
+  SimulationOptions options;
+  std::vector<Pose> poses;
+  if (!LoadTruth(&truth, &error) || !SetOptionsFromFlags(&options, &error) ||
+      !BuildPoses(&poses, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  if (poses.empty()) {
+    PrintError(kCommand, "no poses to simulate");
+    return kExitUsage;
+  }
+
+  Dataset dataset;
+  CableRobot truth_used;
+  SimulationSummary summary;
+  if (!Simulate(truth, poses, options, &dataset, &truth_used, &summary, &error)) {
+    PrintError(kCommand, error);
+    return kExitFailure;
+  }
+
+  const std::string csv_path = FLAGS_out;
+  const std::string yaml_path = TruthPathFor(csv_path);
+  const std::string command = CommandLine(argc, argv);
+  const std::string version = FASTCAL_VERSION;
+  const std::string csv_header =
+      "Simulated by fastcal " + version + "\n" + command + "\nTruth model: " + yaml_path;
+  const std::string yaml_header =
+      "Truth model of " + csv_path + ", simulated by fastcal " + version + "\n" + command;
+  if (!WriteBoth(csv_path, dataset, csv_header, yaml_path, truth_used, yaml_header, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  std::cerr << Summary(summary, options, csv_path, yaml_path) << std::endl;
+  return 0;
+}
+
+}  // namespace fastcal::cli
