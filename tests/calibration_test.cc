@@ -112,7 +112,7 @@ TEST(CalibrationTest, CostAtTruthIsZeroAndJacobianMatchesNumeric) {
   for (StaticsMethod forward : {StaticsMethod::kAas, StaticsMethod::kAasRefined, StaticsMethod::kExact}) {
     for (const Sample& s : data.samples) {
       internal::TensionResidual f{&model, s.pose, s.tension_n,
-                                  internal::TensionSigmas(s.tension_n, 0.0, 3.0), {}};
+                                  internal::TensionSigmas(s.tension_n, 0.0, 3.0), {}, {}};
       f.statics.method = forward;
       internal::TensionCost cost(f);
       double r[kNumCables], jac[kNumCables * 4];

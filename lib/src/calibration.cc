@@ -19,9 +19,6 @@ namespace {
 
 using internal::CalibrationModel;
 
-// Lower bound of a positive parameter (density, mass, EA, gain), as a fraction of its
-// initial value: keeps the solver out of non-physical territory without binding.
-constexpr double kPositiveFloorFraction = 1e-3;
 // Rows of the Jacobian folded into its R factor at a time.
 constexpr int kQrChunkRows = 1024;
 // Samples (evenly spaced) on which the forward model is compared with exact.
@@ -52,11 +49,6 @@ double MaxSigma(const ParameterSpec& p, double initial, const CalibrationOptions
       return o.max_sigma_sensor_bias_n;
   }
   return std::numeric_limits<double>::infinity();
-}
-
-bool MustBePositive(ParameterKind k) {
-  return k == ParameterKind::kLinearDensity || k == ParameterKind::kCabinMass ||
-         k == ParameterKind::kEa || k == ParameterKind::kSensorGain;
 }
 
 class ProgressCallback : public ceres::IterationCallback {
@@ -271,6 +263,11 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     result->forward_model_rms_rel_error = std::sqrt(sum2 / std::max(count, 1));
   }
 
+  StaticsParameters<double> initial_params;
+  {
+    std::array<double, kNumCables> gain, bias;
+    cm.Assemble(theta.data(), &initial_params, &gain, &bias);
+  }
   ceres::Problem problem;
   ceres::LossFunction* loss = nullptr;
   if (spec.robust_loss == RobustLoss::kHuber) loss = new ceres::HuberLoss(spec.robust_loss_scale);
@@ -286,6 +283,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     f.sigma_n = internal::TensionSigmas(sample.tension_n, spec.tension_sigma_n,
                                         spec.tension_sigma_percent);
     f.statics = statics;
+    SolveStaticsWithParameters(initial_params, f.pose, statics, &f.start);
     data_blocks.push_back(problem.AddResidualBlock(new internal::TensionCost(f), loss, theta.data()));
   }
   if (data_blocks.empty()) {
@@ -298,9 +296,6 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     if (p.has_prior) {
       problem.AddResidualBlock(new internal::PriorCost(n, k, p.prior_mean_si, p.prior_sigma_si),
                                nullptr, theta.data());
-    }
-    if (MustBePositive(p.kind)) {
-      problem.SetParameterLowerBound(theta.data(), k, kPositiveFloorFraction * theta[k]);
     }
   }
 

@@ -117,13 +117,27 @@ struct TensionResidual {
   std::array<double, kNumCables> measured_n;
   std::array<double, kNumCables> sigma_n;
   StaticsOptions statics;
+  // The statics solution at the initial parameters (status ok), a constant starting
+  // point: each evaluation warm-starts from a copy of it, since the parameters move
+  // little. With a status other than ok every evaluation starts cold.
+  StaticsSolution start;
 
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
     StaticsParameters<T> p;
     std::array<T, kNumCables> gain, bias, tension;
     model->Assemble(theta, &p, &gain, &bias);
-    if (ModelLowerTensions(p, pose, statics, &tension) != StaticsStatus::kOk) return false;
+    // Physical limits: a non-positive gain here, and non-positive mass, density or EA in
+    // the statics, make the evaluation fail, which Ceres treats as an infeasible step.
+    for (const T& g : gain) {
+      if (!(ScalarValue(g) > 0.0)) return false;
+    }
+    StaticsSolution solution = start;
+    StaticsOptions options = statics;
+    options.warm_start = true;
+    if (ModelLowerTensions(p, pose, options, &tension, &solution) != StaticsStatus::kOk) {
+      return false;
+    }
     for (int i = 0; i < kNumCables; ++i) {
       residuals[i] = (gain[i] * tension[i] + bias[i] - measured_n[i]) / sigma_n[i];
     }
