@@ -1,5 +1,7 @@
 #include "cli_util.h"
 
+#include "fastcal/internal/atomic_file.h"
+
 #include <unistd.h>
 
 #include <cmath>
@@ -97,28 +99,7 @@ bool WriteOutput(const std::string& path, const std::string& content, std::strin
     std::cout << content << std::flush;
     return true;
   }
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-    if (!out) {
-      *error = path + ": cannot open for writing";
-      return false;
-    }
-    out << content;
-    out.flush();
-    if (!out) {
-      out.close();
-      std::remove(tmp.c_str());
-      *error = path + ": write failed";
-      return false;
-    }
-  }
-  if (std::rename(tmp.c_str(), path.c_str()) != 0) {
-    std::remove(tmp.c_str());
-    *error = path + ": cannot rename the temporary file into place";
-    return false;
-  }
-  return true;
+  return internal::WriteFileAtomically(path, content, error);
 }
 
 void PrintError(const std::string& command, const std::string& message) {

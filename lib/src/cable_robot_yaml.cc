@@ -27,6 +27,8 @@
 
 #include "fastcal/cable_robot.h"
 
+#include "fastcal/internal/atomic_file.h"
+
 namespace fastcal {
 namespace {
 
@@ -406,43 +408,7 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
 bool SaveCableRobot(const CableRobot& robot, const std::string& path,
                     const std::string& header_comment, std::string* error) {
   const std::string text = CableRobotToYaml(robot, header_comment);
-  const std::string temp = path + ".tmp." + std::to_string(::getpid());
-  auto fail = [&](const std::string& what, int errnum) {
-    if (error != nullptr) *error = path + ": " + what + ": " + std::strerror(errnum);
-    return false;
-  };
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) return fail("cannot write", errno);
-  size_t written = 0;
-  while (written < text.size()) {
-    const ssize_t n = ::write(fd, text.data() + written, text.size() - written);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int errnum = n < 0 ? errno : EIO;
-      ::close(fd);
-      ::unlink(temp.c_str());
-      return fail("cannot write", errnum);
-    }
-    written += static_cast<size_t>(n);
-  }
-  // fsync so that the rename can never expose a file whose data is not on disk.
-  if (::fsync(fd) != 0) {
-    const int errnum = errno;
-    ::close(fd);
-    ::unlink(temp.c_str());
-    return fail("cannot write", errnum);
-  }
-  if (::close(fd) != 0) {
-    const int errnum = errno;
-    ::unlink(temp.c_str());
-    return fail("cannot write", errnum);
-  }
-  if (std::rename(temp.c_str(), path.c_str()) != 0) {
-    const int errnum = errno;
-    ::unlink(temp.c_str());
-    return fail("cannot replace", errnum);
-  }
-  return true;
+  return internal::WriteFileAtomically(path, text, error);
 }
 
 }  // namespace fastcal

@@ -4,6 +4,8 @@
 // JsonWriter. Tensions are converted N -> kN here, at the edge, and only here.
 #include "fastcal/report.h"
 
+#include "fastcal/internal/atomic_file.h"
+
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -1352,41 +1354,6 @@ std::string RenderJson(const ReportInputs& in) {
 // Files.
 
 // Writes `content` to a new temporary file in the directory of `path`, flushes it to
-// disk and renames it to `path`. A failure leaves no temporary file.
-bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error) {
-  static std::atomic<unsigned> counter{0};
-  const std::string temp =
-      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
-  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) {
-    *error = path + ": cannot write: " + std::strerror(errno);
-    return false;
-  }
-  const auto fail = [&](const char* what, int err) {
-    *error = path + ": " + what + ": " + std::strerror(err);
-    ::unlink(temp.c_str());
-    return false;
-  };
-  size_t written = 0;
-  while (written < content.size()) {
-    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd);
-      return fail("cannot write", err);
-    }
-    written += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    return fail("cannot write", err);
-  }
-  if (::close(fd) != 0) return fail("cannot write", errno);
-  if (std::rename(temp.c_str(), path.c_str()) != 0) return fail("cannot rename into place", errno);
-  return true;
-}
 
 }  // namespace
 
@@ -1433,7 +1400,7 @@ bool WriteReportFiles(const std::string& dir, const ReportInputs& inputs, std::s
         break;
       }
       const std::string path = dir + (dir.back() == '/' ? "" : "/") + name;
-      if (!WriteFileAtomically(path, content, error)) break;
+      if (!internal::WriteFileAtomically(path, content, error)) break;
       written.push_back(path);
     }
     if (written.size() == files.size()) return true;

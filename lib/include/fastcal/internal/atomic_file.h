@@ -1,0 +1,17 @@
+// Writing a file so that readers never see it half-written: a new temporary file beside
+// the target (O_EXCL, unique name), write, fsync, rename over the target; on any failure
+// the temporary file is removed and the target is untouched.
+#ifndef FASTCAL_INTERNAL_ATOMIC_FILE_H_
+#define FASTCAL_INTERNAL_ATOMIC_FILE_H_
+
+#include <string>
+
+namespace fastcal::internal {
+
+// On failure returns false with "<path>: <what>: <strerror>" in *error (may be null).
+bool WriteFileAtomically(const std::string& path, const std::string& content,
+                         std::string* error);
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_INTERNAL_ATOMIC_FILE_H_

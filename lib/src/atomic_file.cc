@@ -1,0 +1,53 @@
+// Atomic file writes (internal/atomic_file.h).
+#include "fastcal/internal/atomic_file.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+
+namespace fastcal::internal {
+
+// Writes `content` to a new temporary file beside `path`, then renames it over `path`.
+bool WriteFileAtomically(const std::string& path, const std::string& content,
+                         std::string* error) {
+  std::string ignored;
+  if (error == nullptr) error = &ignored;
+  static std::atomic<unsigned> counter{0};
+  const std::string temp_path =
+      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
+  const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd < 0) {
+    *error = path + ": cannot write: " + std::strerror(errno);
+    return false;
+  }
+  const auto fail = [&](const char* what, int err) {
+    *error = path + ": " + what + ": " + std::strerror(err);
+    ::unlink(temp_path.c_str());
+    return false;
+  };
+  size_t written = 0;
+  while (written < content.size()) {
+    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      return fail("cannot write", err);
+    }
+    written += static_cast<size_t>(n);
+  }
+  if (::fsync(fd) != 0) {
+    const int err = errno;
+    ::close(fd);
+    return fail("cannot write", err);
+  }
+  if (::close(fd) != 0) return fail("cannot write", errno);
+  if (std::rename(temp_path.c_str(), path.c_str()) != 0) return fail("cannot replace", errno);
+  return true;
+}
+
+}  // namespace fastcal::internal
