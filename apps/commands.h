@@ -6,12 +6,20 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 namespace fastcal::cli {
 
 int RunSolve(int argc, char** argv);
 int RunCalibrate(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
+
+// Positions of the trajectory `kind` (line, arc, grid, random) from the shared trajectory
+// flags; *known is false for any other kind.
+bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
+                                  std::vector<Eigen::Vector3d>* positions, bool* known,
+                                  std::string* error);
 
 // Parses already-checked flags (see CheckAndNormaliseFlags) with gflags.
 void ParseFlags(const std::vector<std::string>& args);

@@ -287,40 +287,14 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     arc.end_deg = 360.0;
     arc.nodes = IsDefault("nodes") ? kCircleNodes : FLAGS_nodes;
     ok = ArcPositions(arc, &positions, error);
-  } else if (trajectory == "line") {
-    Eigen::Vector3d from, to;
-    ok = ParseVector3("from", FLAGS_from, &from, error) &&
-         ParseVector3("to", FLAGS_to, &to, error) &&
-         LinePositions(from, to, FLAGS_nodes, &positions, error);
-  } else if (trajectory == "arc") {
-    ArcSpec arc;
-    arc.radius_m = FLAGS_radius;
-    arc.start_deg = FLAGS_start_deg;
-    arc.end_deg = FLAGS_end_deg;
-    arc.nodes = FLAGS_nodes;
-    ok = ParseVector3("centre", FLAGS_centre, &arc.centre_m, error) &&
-         ArcPositions(arc, &positions, error);
-  } else if (trajectory == "grid") {
-    FocalGridSpec grid;
-    grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
-    grid.off_axis_step_deg = FLAGS_off_axis_step_deg;
-    grid.azimuth_step_deg = FLAGS_azimuth_step_deg;
-    grid.focal_centre_m = law.focal_centre_m;
-    grid.focal_radius_m = FLAGS_focal_radius;
-    ok = FocalSpherePositions(grid, &positions, error);
-  } else if (trajectory == "random") {
-    RandomWorkspaceSpec spec;
-    spec.samples = FLAGS_samples;
-    spec.max_off_axis_deg = FLAGS_max_off_axis_deg;
-    spec.radial_spread_m = FLAGS_radial_spread;
-    spec.sphere.focal_centre_m = law.focal_centre_m;
-    spec.sphere.focal_radius_m = FLAGS_focal_radius;
-    spec.seed = FLAGS_seed;
-    ok = RandomWorkspacePositions(spec, &positions, error);
   } else {
-    *error =
-        "--trajectory must be circle, line, arc, grid, random or poses, got '" + trajectory + "'";
-    return false;
+    bool known = false;
+    ok = TrajectoryPositionsFromFlags(trajectory, law.focal_centre_m, &positions, &known, error);
+    if (!known) {
+      *error = "--trajectory must be circle, line, arc, grid, random or poses, got '" +
+               trajectory + "'";
+      return false;
+    }
   }
   if (!ok) {
     *error = "--trajectory=" + trajectory + ": " + *error;

@@ -119,6 +119,52 @@ const std::set<std::string> kFlags = {
     "samples", "seed", "radial-spread", "poses", "format", "output", "secant-low",
     "secant-high", "refinement-steps", "exact-tolerance", "warm-start", "keep-going"};
 
+}  // namespace
+
+bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
+                                  std::vector<Eigen::Vector3d>* positions, bool* known,
+                                  std::string* error) {
+  *known = true;
+  if (kind == "line") {
+    Eigen::Vector3d from, to;
+    return ParseVector3("from", FLAGS_from, &from, error) &&
+           ParseVector3("to", FLAGS_to, &to, error) &&
+           LinePositions(from, to, FLAGS_nodes, positions, error);
+  }
+  if (kind == "arc") {
+    ArcSpec arc;
+    arc.radius_m = FLAGS_radius;
+    arc.start_deg = FLAGS_start_deg;
+    arc.end_deg = FLAGS_end_deg;
+    arc.nodes = FLAGS_nodes;
+    return ParseVector3("centre", FLAGS_centre, &arc.centre_m, error) &&
+           ArcPositions(arc, positions, error);
+  }
+  if (kind == "grid") {
+    FocalGridSpec grid;
+    grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
+    grid.off_axis_step_deg = FLAGS_off_axis_step_deg;
+    grid.azimuth_step_deg = FLAGS_azimuth_step_deg;
+    grid.focal_centre_m = focal_centre_m;
+    grid.focal_radius_m = FLAGS_focal_radius;
+    return FocalSpherePositions(grid, positions, error);
+  }
+  if (kind == "random") {
+    RandomWorkspaceSpec spec;
+    spec.samples = FLAGS_samples;
+    spec.max_off_axis_deg = FLAGS_max_off_axis_deg;
+    spec.radial_spread_m = FLAGS_radial_spread;
+    spec.sphere.focal_centre_m = focal_centre_m;
+    spec.sphere.focal_radius_m = FLAGS_focal_radius;
+    spec.seed = FLAGS_seed;
+    return RandomWorkspacePositions(spec, positions, error);
+  }
+  *known = false;
+  return false;
+}
+
+namespace {
+
 bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
   FocalAttitudeLaw law;
   law.tilt_fraction = FLAGS_tilt_fraction;
@@ -199,38 +245,10 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     *error = "a trajectory takes its attitude from --attitude-law=focal|none";
     return false;
   }
-  bool ok = false;
-  if (FLAGS_trajectory == "line") {
-    Eigen::Vector3d from, to;
-    ok = ParseVector3("from", FLAGS_from, &from, error) &&
-         ParseVector3("to", FLAGS_to, &to, error) &&
-         LinePositions(from, to, FLAGS_nodes, &positions, error);
-  } else if (FLAGS_trajectory == "arc") {
-    ArcSpec arc;
-    arc.radius_m = FLAGS_radius;
-    arc.start_deg = FLAGS_start_deg;
-    arc.end_deg = FLAGS_end_deg;
-    arc.nodes = FLAGS_nodes;
-    ok = ParseVector3("centre", FLAGS_centre, &arc.centre_m, error) &&
-         ArcPositions(arc, &positions, error);
-  } else if (FLAGS_trajectory == "grid") {
-    FocalGridSpec grid;
-    grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
-    grid.off_axis_step_deg = FLAGS_off_axis_step_deg;
-    grid.azimuth_step_deg = FLAGS_azimuth_step_deg;
-    grid.focal_centre_m = law.focal_centre_m;
-    grid.focal_radius_m = FLAGS_focal_radius;
-    ok = FocalSpherePositions(grid, &positions, error);
-  } else if (FLAGS_trajectory == "random") {
-    RandomWorkspaceSpec spec;
-    spec.samples = FLAGS_samples;
-    spec.max_off_axis_deg = FLAGS_max_off_axis_deg;
-    spec.radial_spread_m = FLAGS_radial_spread;
-    spec.sphere.focal_centre_m = law.focal_centre_m;
-    spec.sphere.focal_radius_m = FLAGS_focal_radius;
-    spec.seed = FLAGS_seed;
-    ok = RandomWorkspacePositions(spec, &positions, error);
-  } else {
+  bool known = false;
+  const bool ok = TrajectoryPositionsFromFlags(FLAGS_trajectory, law.focal_centre_m, &positions,
+                                               &known, error);
+  if (!known) {
     *error = "--trajectory must be point, line, arc, grid or random, got '" + FLAGS_trajectory + "'";
     return false;
   }
