@@ -1,6 +1,7 @@
 // `fastcal calibrate` and `fastcal evaluate`: fit model parameters to a telemetry export
 // and report; or evaluate a model against one. Outputs go to a temporary directory that
 // is renamed into place only when everything has been written.
+#include <gflags/gflags.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -8,8 +9,6 @@
 #include <filesystem>
 #include <iostream>
 #include <sstream>
-
-#include <gflags/gflags.h>
 
 #include "cli_util.h"
 #include "commands.h"
@@ -36,7 +35,8 @@ namespace {
 namespace fs = std::filesystem;
 constexpr double kNPerKn = 1e3;
 
-const char kCalibrateHelp[] = R"(fastcal calibrate: estimate model parameters from measured cabin poses and cable tensions.
+const char kCalibrateHelp[] =
+    R"(fastcal calibrate: estimate model parameters from measured cabin poses and cable tensions.
 
 Usage:
   fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml]
@@ -106,8 +106,8 @@ bool WriteDirectoryAtomically(const std::string& dir,
     *error = parent.string() + ": cannot create: " + ec.message();
     return false;
   }
-  const fs::path tmp = parent / ("." + target.filename().string() + ".tmp." +
-                                 std::to_string(::getpid()));
+  const fs::path tmp =
+      parent / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
   fs::remove_all(tmp, ec);
   if (!fs::create_directory(tmp, ec)) {
     *error = tmp.string() + ": cannot create: " + ec.message();
@@ -222,15 +222,16 @@ int RunCalibrate(int argc, char** argv) {
   std::vector<std::string> args;
   std::string error;
   if (!CheckAndNormaliseFlags(argc, argv, 2, command,
-                              {"model", "spec", "data", "out", "skip-invalid-rows", "quiet"},
-                              &args, &error)) {
+                              {"model", "spec", "data", "out", "skip-invalid-rows", "quiet"}, &args,
+                              &error)) {
     PrintError(command, error);
     return kExitUsage;
   }
   ParseFlags(args);
   if (FLAGS_spec.empty() || FLAGS_out.empty()) {
-    PrintError(command, "--spec=FILE.yaml, --data=FILE.csv and --out=DIR are required (see "
-                        "fastcal calibrate --help)");
+    PrintError(command,
+               "--spec=FILE.yaml, --data=FILE.csv and --out=DIR are required (see "
+               "fastcal calibrate --help)");
     return kExitUsage;
   }
   CableRobot model;
@@ -244,15 +245,18 @@ int RunCalibrate(int argc, char** argv) {
   }
   {
     std::error_code ec;
-    if (fs::exists(FLAGS_out, ec) && (!fs::is_directory(FLAGS_out, ec) || !fs::is_empty(FLAGS_out, ec))) {
-      PrintError(command, FLAGS_out + ": exists and is not an empty directory (choose a new --out)");
+    if (fs::exists(FLAGS_out, ec) &&
+        (!fs::is_directory(FLAGS_out, ec) || !fs::is_empty(FLAGS_out, ec))) {
+      PrintError(command,
+                 FLAGS_out + ": exists and is not an empty directory (choose a new --out)");
       return kExitUsage;
     }
   }
   std::cerr << "fastcal calibrate: " << data.samples.size() << " samples from " << data.path
             << ", forward model " << StaticsMethodName(spec.forward_model) << "\n";
   CalibrationOptions options;
-  if (!FLAGS_quiet) options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
+  if (!FLAGS_quiet)
+    options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
   CalibrationResult result;
   const CalibrationStatus status = Calibrate(model, spec, data, options, &result, &error);
   if (status != CalibrationStatus::kOk) {
@@ -269,15 +273,16 @@ int RunCalibrate(int argc, char** argv) {
     AttitudeSource attitude;
   };
   std::vector<Variant> list;
-  if (data.has_planned_attitude) list.push_back({"initial model, planned attitude", &model, AttitudeSource::kPlanned});
+  if (data.has_planned_attitude)
+    list.push_back({"initial model, planned attitude", &model, AttitudeSource::kPlanned});
   list.push_back({"initial model, measured attitude", &model, AttitudeSource::kMeasured});
   list.push_back({std::string("calibrated model, ") +
                       (spec.use_planned_attitude ? "planned" : "measured") + " attitude",
                   &result.calibrated, fit_attitude});
   for (const Variant& v : list) {
     VariantEvaluation e;
-    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact,
-                         result.held_out, &e, &error)) {
+    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact, result.held_out,
+                         &e, &error)) {
       PrintError(command, v.name + ": " + error);
       return kExitFailure;
     }
@@ -308,7 +313,9 @@ int RunCalibrate(int argc, char** argv) {
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out)}};
   if (!WriteDirectoryAtomically(
           FLAGS_out, files,
-          [&](const std::string& dir, std::string* why) { return WriteReportFiles(dir, report, why); },
+          [&](const std::string& dir, std::string* why) {
+            return WriteReportFiles(dir, report, why);
+          },
           &error)) {
     PrintError(command, error);
     return kExitUsage;
@@ -317,9 +324,11 @@ int RunCalibrate(int argc, char** argv) {
   std::ostringstream s;
   s << "\n" << result.ceres_brief_report << "\n";
   char buf[200];
-  std::snprintf(buf, sizeof(buf), "reduced chi-square %.3f over %d residuals; %d samples fitted, %d held out; %.2f s\n",
-                result.reduced_chi_square, result.num_residuals, result.num_fit_samples,
-                static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
+  std::snprintf(
+      buf, sizeof(buf),
+      "reduced chi-square %.3f over %d residuals; %d samples fitted, %d held out; %.2f s\n",
+      result.reduced_chi_square, result.num_residuals, result.num_fit_samples,
+      static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
   s << buf << "\n";
   std::snprintf(buf, sizeof(buf), "  %-28s %6s %14s %14s %12s  %s\n", "parameter", "unit",
                 "initial", "estimate", "sigma", "note");
@@ -344,8 +353,10 @@ int RunCalibrate(int argc, char** argv) {
   for (const ParameterDirection& d : result.data_only.poorly_determined) {
     s << "  weak direction in the data alone: " << d.Describe() << "\n";
   }
-  for (const std::string& c : result.strong_correlations) s << "  strongly correlated: " << c << "\n";
-  s << "\n" << RmsTable(variants) << "\nwrote " << FLAGS_out
+  for (const std::string& c : result.strong_correlations)
+    s << "  strongly correlated: " << c << "\n";
+  s << "\n"
+    << RmsTable(variants) << "\nwrote " << FLAGS_out
     << "/{model_calibrated.yaml, report.html, report.md, summary.json, residuals.csv}\n";
   std::cerr << s.str();
   return 0;
@@ -380,7 +391,8 @@ int RunEvaluate(int argc, char** argv) {
   }
   std::vector<VariantEvaluation> variants;
   std::vector<std::pair<std::string, AttitudeSource>> list;
-  if (data.has_planned_attitude) list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
+  if (data.has_planned_attitude)
+    list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
   list.emplace_back("model, measured attitude", AttitudeSource::kMeasured);
   for (const auto& [name, attitude] : list) {
     VariantEvaluation e;
@@ -404,7 +416,9 @@ int RunEvaluate(int argc, char** argv) {
     report.evaluation_method = StaticsMethodName(method);
     if (!WriteDirectoryAtomically(
             FLAGS_out, {{"residuals.csv", ResidualsCsv(data, variants, {})}},
-            [&](const std::string& dir, std::string* why) { return WriteReportFiles(dir, report, why); },
+            [&](const std::string& dir, std::string* why) {
+              return WriteReportFiles(dir, report, why);
+            },
             &error)) {
       PrintError(command, error);
       return kExitUsage;
@@ -413,22 +427,33 @@ int RunEvaluate(int argc, char** argv) {
   std::ostringstream s;
   s << "fastcal evaluate: " << data.samples.size() << " samples, model "
     << (FLAGS_model.empty() ? "nominal FAST" : FLAGS_model) << ", method "
-    << StaticsMethodName(method) << "\n\n" << RmsTable(variants);
+    << StaticsMethodName(method) << "\n\n"
+    << RmsTable(variants);
   char buf[160];
   for (const VariantEvaluation& v : variants) {
     s << "\n  " << v.name << ":\n";
     std::snprintf(buf, sizeof(buf), "    %-22s", "RMS (%)");
     s << buf;
-    for (double r : v.fit.rms_percent) { std::snprintf(buf, sizeof(buf), " %8.3f", r); s << buf; }
+    for (double r : v.fit.rms_percent) {
+      std::snprintf(buf, sizeof(buf), " %8.3f", r);
+      s << buf;
+    }
     std::snprintf(buf, sizeof(buf), "\n    %-22s", "mean (kN)");
     s << buf;
-    for (double r : v.fit.mean_n) { std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn); s << buf; }
+    for (double r : v.fit.mean_n) {
+      std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
+      s << buf;
+    }
     std::snprintf(buf, sizeof(buf), "\n    %-22s", "max |error| (kN)");
     s << buf;
-    for (double r : v.fit.max_abs_n) { std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn); s << buf; }
+    for (double r : v.fit.max_abs_n) {
+      std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
+      s << buf;
+    }
     s << "\n";
   }
-  if (!FLAGS_out.empty()) s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";
+  if (!FLAGS_out.empty())
+    s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";
   std::cout << s.str();
   return 0;
 }

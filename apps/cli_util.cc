@@ -1,7 +1,5 @@
 #include "cli_util.h"
 
-#include "fastcal/internal/atomic_file.h"
-
 #include <unistd.h>
 
 #include <cmath>
@@ -10,6 +8,8 @@
 #include <fstream>
 #include <iostream>
 #include <sstream>
+
+#include "fastcal/internal/atomic_file.h"
 
 namespace fastcal::cli {
 
@@ -28,8 +28,8 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
   for (int i = first; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg.size() < 3 || arg[0] != '-') {
-      *error = "unexpected argument '" + arg + "' (flags are --name=value; see fastcal " +
-               command + " --help)";
+      *error = "unexpected argument '" + arg + "' (flags are --name=value; see fastcal " + command +
+               " --help)";
       return false;
     }
     const size_t start = arg[1] == '-' ? 2 : 1;

@@ -2,11 +2,10 @@
 #ifndef FASTCAL_APPS_CLI_UTIL_H_
 #define FASTCAL_APPS_CLI_UTIL_H_
 
+#include <Eigen/Core>
 #include <set>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace fastcal::cli {
 

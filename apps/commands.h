@@ -3,10 +3,9 @@
 #ifndef FASTCAL_APPS_COMMANDS_H_
 #define FASTCAL_APPS_COMMANDS_H_
 
+#include <Eigen/Core>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace fastcal::cli {
 

@@ -1,10 +1,10 @@
 // fastcal: statics and calibration of the FAST cable robot from the command line.
+#include <gflags/gflags.h>
+#include <glog/logging.h>
+
 #include <cstring>
 #include <iostream>
 #include <string>
-
-#include <gflags/gflags.h>
-#include <glog/logging.h>
 
 #include "cli_util.h"
 #include "commands.h"

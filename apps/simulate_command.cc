@@ -291,8 +291,8 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     bool known = false;
     ok = TrajectoryPositionsFromFlags(trajectory, law.focal_centre_m, &positions, &known, error);
     if (!known) {
-      *error = "--trajectory must be circle, line, arc, grid, random or poses, got '" +
-               trajectory + "'";
+      *error =
+          "--trajectory must be circle, line, arc, grid, random or poses, got '" + trajectory + "'";
       return false;
     }
   }

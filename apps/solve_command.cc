@@ -1,11 +1,11 @@
 // `fastcal solve`: cable forces, tensions and unstretched lengths for one pose or a
 // trajectory, by AAS, refined AAS or the exact solver, or AAS against exact ("compare",
 // the paper's Tables 2-5).
+#include <gflags/gflags.h>
+
 #include <chrono>
 #include <iostream>
 #include <sstream>
-
-#include <gflags/gflags.h>
 
 #include "cli_util.h"
 #include "commands.h"
@@ -46,7 +46,8 @@ DEFINE_double(secant_high, 1.01, "AAS: high secant length as a fraction of the c
 DEFINE_int32(refinement_steps, 1, "aas-refined: re-linearisation steps.");
 DEFINE_double(exact_tolerance, 1e-12, "exact: relative tolerance on the forces.");
 DEFINE_bool(warm_start, true, "Start each trajectory node from the previous solution.");
-DEFINE_bool(keep_going, false, "Write infeasible poses as rows with their status instead of failing.");
+DEFINE_bool(keep_going, false,
+            "Write infeasible poses as rows with their status instead of failing.");
 
 namespace fastcal::cli {
 namespace {
@@ -54,7 +55,8 @@ namespace {
 constexpr char kCommand[] = "solve";
 constexpr double kNPerKn = 1e3;
 
-const char kHelp[] = R"(fastcal solve: cable forces of the FAST cable robot at a pose or along a trajectory.
+const char kHelp[] =
+    R"(fastcal solve: cable forces of the FAST cable robot at a pose or along a trajectory.
 
 Usage:
   fastcal solve --position=x,y,z [attitude] [options]
@@ -112,12 +114,39 @@ Examples:
   fastcal solve --trajectory=arc --attitude-law=focal --method=compare --output=arc.csv
 )";
 
-const std::set<std::string> kFlags = {
-    "model", "method", "position", "rpy", "quat", "rotvec", "attitude-law", "tilt-fraction",
-    "focal-centre", "trajectory", "from", "to", "nodes", "centre", "radius", "start-deg",
-    "end-deg", "max-off-axis-deg", "off-axis-step-deg", "azimuth-step-deg", "focal-radius",
-    "samples", "seed", "radial-spread", "poses", "format", "output", "secant-low",
-    "secant-high", "refinement-steps", "exact-tolerance", "warm-start", "keep-going"};
+const std::set<std::string> kFlags = {"model",
+                                      "method",
+                                      "position",
+                                      "rpy",
+                                      "quat",
+                                      "rotvec",
+                                      "attitude-law",
+                                      "tilt-fraction",
+                                      "focal-centre",
+                                      "trajectory",
+                                      "from",
+                                      "to",
+                                      "nodes",
+                                      "centre",
+                                      "radius",
+                                      "start-deg",
+                                      "end-deg",
+                                      "max-off-axis-deg",
+                                      "off-axis-step-deg",
+                                      "azimuth-step-deg",
+                                      "focal-radius",
+                                      "samples",
+                                      "seed",
+                                      "radial-spread",
+                                      "poses",
+                                      "format",
+                                      "output",
+                                      "secant-low",
+                                      "secant-high",
+                                      "refinement-steps",
+                                      "exact-tolerance",
+                                      "warm-start",
+                                      "keep-going"};
 
 }  // namespace
 
@@ -178,8 +207,8 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     *error = "--attitude-law must be 'focal' or 'none', got '" + FLAGS_attitude_law + "'";
     return false;
   }
-  const int constant_attitudes =
-      !FLAGS_rpy.empty() + !FLAGS_quat.empty() + !FLAGS_rotvec.empty() + !FLAGS_attitude_law.empty();
+  const int constant_attitudes = !FLAGS_rpy.empty() + !FLAGS_quat.empty() + !FLAGS_rotvec.empty() +
+                                 !FLAGS_attitude_law.empty();
   if (constant_attitudes > 1) {
     *error = "give at most one of --rpy, --quat, --rotvec, --attitude-law";
     return false;
@@ -246,10 +275,11 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     return false;
   }
   bool known = false;
-  const bool ok = TrajectoryPositionsFromFlags(FLAGS_trajectory, law.focal_centre_m, &positions,
-                                               &known, error);
+  const bool ok =
+      TrajectoryPositionsFromFlags(FLAGS_trajectory, law.focal_centre_m, &positions, &known, error);
   if (!known) {
-    *error = "--trajectory must be point, line, arc, grid or random, got '" + FLAGS_trajectory + "'";
+    *error =
+        "--trajectory must be point, line, arc, grid or random, got '" + FLAGS_trajectory + "'";
     return false;
   }
   if (!ok) {
@@ -299,8 +329,8 @@ bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
     if (run->solutions[n].status != StaticsStatus::kOk && !FLAGS_keep_going) {
       std::ostringstream s;
       s << "node " << n << " at position (" << poses[n].position_m.transpose()
-        << ") m: " << DescribeStatus(run->solutions[n])
-        << " [method " << StaticsMethodName(options.method) << "]";
+        << ") m: " << DescribeStatus(run->solutions[n]) << " [method "
+        << StaticsMethodName(options.method) << "]";
       *error = s.str();
       return false;
     }
@@ -316,7 +346,8 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_upper_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",s0_" << i << "_m";
-    for (int i = 1; i <= kNumCables; ++i) out << ",F" << i << "x_kN,F" << i << "y_kN,F" << i << "z_kN";
+    for (int i = 1; i <= kNumCables; ++i)
+      out << ",F" << i << "x_kN,F" << i << "y_kN,F" << i << "z_kN";
     out << ",force_residual_N,moment_residual_Nm";
   } else {
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_aas_kN";
@@ -367,9 +398,10 @@ std::array<double, kNumCables> MaxAbsErrorPct(const Run& aas, const Run& exact) 
       continue;
     }
     for (int i = 0; i < kNumCables; ++i) {
-      worst[i] = std::max(worst[i], 100.0 * std::abs(aas.solutions[n].cables[i].lower_tension_n /
-                                                         exact.solutions[n].cables[i].lower_tension_n -
-                                                     1.0));
+      worst[i] =
+          std::max(worst[i], 100.0 * std::abs(aas.solutions[n].cables[i].lower_tension_n /
+                                                  exact.solutions[n].cables[i].lower_tension_n -
+                                              1.0));
     }
   }
   return worst;
@@ -385,8 +417,9 @@ void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
     j->Key("upper_tension_kN").Number(c.upper_tension_n / kNPerKn);
     j->Key("unstretched_length_m").Number(c.unstretched_length_m);
     j->Key("chord_length_m").Number(c.chord_length_m);
-    j->Key("force_kN").NumberArray(std::array<double, 3>{
-        c.force_n[0] / kNPerKn, c.force_n[1] / kNPerKn, c.force_n[2] / kNPerKn});
+    j->Key("force_kN")
+        .NumberArray(std::array<double, 3>{c.force_n[0] / kNPerKn, c.force_n[1] / kNPerKn,
+                                           c.force_n[2] / kNPerKn});
     j->EndObject();
   }
   j->EndArray();

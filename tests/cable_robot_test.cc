@@ -263,7 +263,8 @@ TEST(CableRobotYaml, PerturbedModelSaveLoadRoundTripIsExact) {
 }
 
 TEST(CableRobotYaml, CalibrationDataNominalFileEqualsNominal) {
-  const char* source_dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR") : FASTCAL_TEST_SOURCE_DIR);
+  const char* source_dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR")
+                                                              : FASTCAL_TEST_SOURCE_DIR);
   if (source_dir == nullptr) GTEST_SKIP() << "FASTCAL_SOURCE_DIR is not set (set by CTest)";
   CableRobot loaded;
   std::string error;

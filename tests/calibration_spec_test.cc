@@ -640,7 +640,8 @@ TEST(CalibrationSpecTest, IsValidRejectsEachImpossibleValue) {
 // Files in the source tree.
 
 std::string SourceDir() {
-  const char* dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR") : FASTCAL_TEST_SOURCE_DIR);
+  const char* dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR")
+                                                       : FASTCAL_TEST_SOURCE_DIR);
   return dir == nullptr ? "" : dir;
 }
 

@@ -3,10 +3,10 @@
 // over several seeds, Jacobian against central differences, and refused free sets.
 #include "fastcal/calibration.h"
 
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <random>
-
-#include <gtest/gtest.h>
 
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/calibration_model.h"
@@ -65,8 +65,8 @@ CalibrationSpec MassCentreAndDensitySpec(StaticsMethod forward) {
   CalibrationSpec spec;
   spec.forward_model = forward;
   for (int c = 0; c < 3; ++c) {
-    spec.parameters.push_back(Free(ParameterKind::kMassCentre, -1, c,
-                                   std::string("mass_centre_m.") + "xyz"[c]));
+    spec.parameters.push_back(
+        Free(ParameterKind::kMassCentre, -1, c, std::string("mass_centre_m.") + "xyz"[c]));
   }
   spec.parameters.push_back(Free(ParameterKind::kLinearDensity, -1, -1, "linear_density_kg_per_m"));
   spec.tension_sigma_percent = 3.0;
@@ -109,10 +109,11 @@ TEST(CalibrationTest, CostAtTruthIsZeroAndJacobianMatchesNumeric) {
   const internal::CalibrationModel model(CableRobot::NominalFast(), spec);
   const double truth[4] = {kTruthMassCentreM[0], kTruthMassCentreM[1], kTruthMassCentreM[2],
                            kTruthDensityKgPerM};
-  for (StaticsMethod forward : {StaticsMethod::kAas, StaticsMethod::kAasRefined, StaticsMethod::kExact}) {
+  for (StaticsMethod forward :
+       {StaticsMethod::kAas, StaticsMethod::kAasRefined, StaticsMethod::kExact}) {
     for (const Sample& s : data.samples) {
-      internal::TensionResidual f{&model, s.pose, s.tension_n,
-                                  internal::TensionSigmas(s.tension_n, 0.0, 3.0), {}, {}};
+      internal::TensionResidual f{
+          &model, s.pose, s.tension_n, internal::TensionSigmas(s.tension_n, 0.0, 3.0), {}, {}};
       f.statics.method = forward;
       internal::TensionCost cost(f);
       double r[kNumCables], jac[kNumCables * 4];
@@ -160,9 +161,9 @@ TEST(CalibrationTest, NoisyEstimatesWithinThreeSigmaAndSigmasMatchSpread) {
     const Dataset data = CircleData(Truth(), kNodes, 0.03, 1000 + seed);
     CalibrationResult result;
     std::string error;
-    ASSERT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), &result,
-                        &error),
-              CalibrationStatus::kOk)
+    ASSERT_EQ(
+        Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), &result, &error),
+        CalibrationStatus::kOk)
         << error;
     ASSERT_TRUE(result.covariance_ok);
     std::array<double, 4> e;
@@ -216,8 +217,7 @@ TEST(CalibrationTest, CabinMassAndCommonGainDegeneracyIsReported) {
   EXPECT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), &result, &error),
             CalibrationStatus::kOk)
       << error;
-  ASSERT_FALSE(result.data_only.undetermined.empty() &&
-               result.data_only.poorly_determined.empty());
+  ASSERT_FALSE(result.data_only.undetermined.empty() && result.data_only.poorly_determined.empty());
   const ParameterDirection& weak = result.data_only.undetermined.empty()
                                        ? result.data_only.poorly_determined[0]
                                        : result.data_only.undetermined[0];

@@ -3,11 +3,11 @@
 // failure statuses.
 #include "fastcal/catenary.h"
 
-#include <cmath>
-#include <random>
-
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
 
 namespace fastcal {
 namespace {
@@ -46,8 +46,8 @@ TEST(CatenaryTest, ColdSolveConvergesOverWorkspaceLengthRange) {
   for (const Chord& c : RandomChords(2000, 0.95, 1.05)) {
     CatenaryForces f;
     int iterations = 0;
-    ASSERT_EQ(SolveCatenaryForcesDouble(c.span_m, c.rise_m, c.s0_m, kEaN, kWNPerM, options,
-                                        nullptr, &f, &iterations),
+    ASSERT_EQ(SolveCatenaryForcesDouble(c.span_m, c.rise_m, c.s0_m, kEaN, kWNPerM, options, nullptr,
+                                        &f, &iterations),
               CatenaryStatus::kOk)
         << "span " << c.span_m << " rise " << c.rise_m << " s0/k "
         << c.s0_m / std::hypot(c.span_m, c.rise_m);
@@ -68,15 +68,15 @@ TEST(CatenaryTest, ForwardThenInverseRecoversForces) {
     const CatenaryEnd<double> e = CatenaryEndpoint(fl_n, fz_n, s0_m, kEaN, kWNPerM);
     CatenaryForces f;
     int it = 0;
-    ASSERT_EQ(SolveCatenaryForcesDouble(e.span_m, e.rise_m, s0_m, kEaN, kWNPerM, options,
-                                        nullptr, &f, &it),
+    ASSERT_EQ(SolveCatenaryForcesDouble(e.span_m, e.rise_m, s0_m, kEaN, kWNPerM, options, nullptr,
+                                        &f, &it),
               CatenaryStatus::kOk);
     EXPECT_NEAR(f.fl_n, fl_n, kForceRelTol * fl_n);
     EXPECT_NEAR(f.fz_n, fz_n, kForceRelTol * fl_n);
     // The other inverse problem: the length that yields fl.
     CatenaryCurvePoint p;
-    ASSERT_EQ(SolveCatenaryLengthDouble(e.span_m, e.rise_m, fl_n, kEaN, kWNPerM, options,
-                                        nullptr, &p, &it),
+    ASSERT_EQ(SolveCatenaryLengthDouble(e.span_m, e.rise_m, fl_n, kEaN, kWNPerM, options, nullptr,
+                                        &p, &it),
               CatenaryStatus::kOk);
     EXPECT_NEAR(p.s0_m, s0_m, kForceRelTol * s0_m);
     EXPECT_NEAR(p.fz_n, fz_n, kForceRelTol * fl_n);
@@ -102,8 +102,8 @@ TEST(CatenaryTest, AnalyticJacobianMatchesCentralDifferences) {
       const CatenaryEnd<double> b = CatenaryEndpoint(dn[0], dn[1], dn[2], kEaN, kWNPerM);
       const double dspan = (a.span_m - b.span_m) / (2 * h);
       const double drise = (a.rise_m - b.rise_m) / (2 * h);
-      const double scale_span = std::abs(e.dspan[0]) + std::abs(e.dspan[1]) * u[0] / u[2] +
-                                std::abs(e.dspan[j]);
+      const double scale_span =
+          std::abs(e.dspan[0]) + std::abs(e.dspan[1]) * u[0] / u[2] + std::abs(e.dspan[j]);
       const double scale_rise = std::abs(e.drise[j]) + std::abs(e.drise[1]);
       EXPECT_NEAR(e.dspan[j], dspan, kRelTol * scale_span) << "dspan/du" << j;
       EXPECT_NEAR(e.drise[j], drise, kRelTol * scale_rise) << "drise/du" << j;
@@ -116,8 +116,8 @@ TEST(CatenaryTest, JetAndDoubleAgree) {
   constexpr double kTol = 1e-12;
   const double fl = 1.2e5, fz = -6e4, s0 = 321.0;
   const CatenaryEnd<double> d = CatenaryEndpoint(fl, fz, s0, kEaN, kWNPerM);
-  const CatenaryEnd<Jet> j = CatenaryEndpoint(Jet(fl, 0), Jet(fz, 1), Jet(s0, 2), Jet(kEaN),
-                                              Jet(kWNPerM));
+  const CatenaryEnd<Jet> j =
+      CatenaryEndpoint(Jet(fl, 0), Jet(fz, 1), Jet(s0, 2), Jet(kEaN), Jet(kWNPerM));
   EXPECT_NEAR(j.span_m.a, d.span_m, kTol * s0);
   EXPECT_NEAR(j.rise_m.a, d.rise_m, kTol * s0);
   for (int k = 0; k < 3; ++k) {
@@ -145,12 +145,12 @@ TEST(CatenaryTest, JetInverseSolveCarriesImplicitDerivatives) {
     up[k] += h;
     dn[k] -= h;
     double fl_up = 0, fz_up = 0, fl_dn = 0, fz_dn = 0;
-    ASSERT_EQ(SolveCatenaryForces(up[0], up[1], up[2], up[3], up[4], options, nullptr, &fl_up,
-                                  &fz_up),
-              CatenaryStatus::kOk);
-    ASSERT_EQ(SolveCatenaryForces(dn[0], dn[1], dn[2], dn[3], dn[4], options, nullptr, &fl_dn,
-                                  &fz_dn),
-              CatenaryStatus::kOk);
+    ASSERT_EQ(
+        SolveCatenaryForces(up[0], up[1], up[2], up[3], up[4], options, nullptr, &fl_up, &fz_up),
+        CatenaryStatus::kOk);
+    ASSERT_EQ(
+        SolveCatenaryForces(dn[0], dn[1], dn[2], dn[3], dn[4], options, nullptr, &fl_dn, &fz_dn),
+        CatenaryStatus::kOk);
     const double dfl = (fl_up - fl_dn) / (2 * h), dfz = (fz_up - fz_dn) / (2 * h);
     EXPECT_NEAR(fl.v[k], dfl, kRelTol * (std::abs(dfl) + std::abs(fl.a) / std::abs(in[k])))
         << "input " << k;
@@ -171,8 +171,8 @@ TEST(CatenaryTest, VeryStiffCableTendsToInextensibleCatenary) {
                                         nullptr, &f, &it),
               CatenaryStatus::kOk);
     const double h = f.fl_n, w = std::abs(kWNPerM);
-    const double arc = std::sqrt(c.rise_m * c.rise_m +
-                                 std::pow(2 * h / w * std::sinh(w * c.span_m / (2 * h)), 2));
+    const double arc =
+        std::sqrt(c.rise_m * c.rise_m + std::pow(2 * h / w * std::sinh(w * c.span_m / (2 * h)), 2));
     EXPECT_NEAR(arc, c.s0_m, kRelTol * c.s0_m);
   }
 }
@@ -217,26 +217,21 @@ TEST(CatenaryTest, BadInputGivesStatusNotNan) {
   const CatenarySolverOptions options;
   CatenaryForces f;
   int it = 0;
-  EXPECT_EQ(SolveCatenaryForcesDouble(0.0, 150.0, 160.0, kEaN, kWNPerM, options, nullptr, &f,
-                                      &it),
+  EXPECT_EQ(SolveCatenaryForcesDouble(0.0, 150.0, 160.0, kEaN, kWNPerM, options, nullptr, &f, &it),
             CatenaryStatus::kVerticalChord);
-  EXPECT_EQ(SolveCatenaryForcesDouble(NAN, 150.0, 160.0, kEaN, kWNPerM, options, nullptr, &f,
-                                      &it),
+  EXPECT_EQ(SolveCatenaryForcesDouble(NAN, 150.0, 160.0, kEaN, kWNPerM, options, nullptr, &f, &it),
             CatenaryStatus::kInvalidInput);
-  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 150.0, -1.0, kEaN, kWNPerM, options, nullptr, &f,
-                                      &it),
+  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 150.0, -1.0, kEaN, kWNPerM, options, nullptr, &f, &it),
             CatenaryStatus::kInvalidInput);
-  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 150.0, 330.0, 0.0, kWNPerM, options, nullptr, &f,
-                                      &it),
+  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 150.0, 330.0, 0.0, kWNPerM, options, nullptr, &f, &it),
             CatenaryStatus::kInvalidInput);
   CatenaryCurvePoint p;
-  EXPECT_EQ(SolveCatenaryLengthDouble(300.0, 150.0, -5.0, kEaN, kWNPerM, options, nullptr, &p,
-                                      &it),
+  EXPECT_EQ(SolveCatenaryLengthDouble(300.0, 150.0, -5.0, kEaN, kWNPerM, options, nullptr, &p, &it),
             CatenaryStatus::kInvalidInput);
   CatenarySolverOptions one_step;
   one_step.max_iterations = 1;
-  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 130.0, 0.95 * std::hypot(300.0, 130.0), kEaN,
-                                      kWNPerM, one_step, nullptr, &f, &it),
+  EXPECT_EQ(SolveCatenaryForcesDouble(300.0, 130.0, 0.95 * std::hypot(300.0, 130.0), kEaN, kWNPerM,
+                                      one_step, nullptr, &f, &it),
             CatenaryStatus::kNotConverged);
 }
 

@@ -1,6 +1,7 @@
 // End-to-end tests of the fastcal command line as a user runs it: exit codes, messages
 // that name the file, line, column or flag, no output left behind on failure, and the
 // calibrate -> evaluate round trip. The binary comes from $FASTCAL_BIN (set by CTest).
+#include <gtest/gtest.h>
 #include <sys/wait.h>
 
 #include <cstdio>
@@ -10,8 +11,6 @@
 #include <regex>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace {
 
@@ -27,7 +26,8 @@ std::string Bin() {
   return bin ? bin : "";
 }
 std::string Source() {
-  const char* dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR") : FASTCAL_TEST_SOURCE_DIR);
+  const char* dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR")
+                                                       : FASTCAL_TEST_SOURCE_DIR);
   return dir ? dir : "";
 }
 
@@ -49,7 +49,8 @@ class CliTest : public ::testing::Test {
   void SetUp() override {
     if (Bin().empty() || Source().empty()) GTEST_SKIP() << "FASTCAL_BIN / FASTCAL_SOURCE_DIR unset";
     dir_ = fs::path(::testing::TempDir()) /
-           ("fastcal_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+           ("fastcal_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -73,7 +74,8 @@ TEST_F(CliTest, SolveK1CompareMatchesPaper) {
 
 TEST_F(CliTest, SolveJsonAndTrajectoryToFile) {
   const std::string out = Path("arc.json");
-  const CommandResult r = Fastcal("solve --trajectory=arc --attitude-law=focal --method=exact --format=json --output=" + out);
+  const CommandResult r = Fastcal(
+      "solve --trajectory=arc --attitude-law=focal --method=exact --format=json --output=" + out);
   ASSERT_EQ(r.code, 0) << r.output;
   std::ifstream in(out);
   std::stringstream text;
@@ -118,7 +120,8 @@ TEST_F(CliTest, SolveBadInputExitsNonZeroAndNamesTheProblem) {
 // reported RMS through evaluate.
 TEST_F(CliTest, SimulateCalibrateEvaluateRoundTrip) {
   const std::string data = Path("circle.csv");
-  CommandResult r = Fastcal("simulate --mass-centre=0.22,0.11,0.5 --nodes=48 --seed=3 --out=" + data);
+  CommandResult r =
+      Fastcal("simulate --mass-centre=0.22,0.11,0.5 --nodes=48 --seed=3 --out=" + data);
   ASSERT_EQ(r.code, 0) << r.output;
   ASSERT_TRUE(fs::exists(data));
   ASSERT_TRUE(fs::exists(Path("circle.truth.yaml")));
@@ -126,7 +129,8 @@ TEST_F(CliTest, SimulateCalibrateEvaluateRoundTrip) {
   r = Fastcal("calibrate --quiet --spec=" + Source() +
               "/calibration_data/spec_mass_centre_density.yaml --data=" + data + " --out=" + out);
   ASSERT_EQ(r.code, 0) << r.output;
-  for (const char* f : {"model_calibrated.yaml", "report.html", "report.md", "summary.json", "residuals.csv"}) {
+  for (const char* f :
+       {"model_calibrated.yaml", "report.html", "report.md", "summary.json", "residuals.csv"}) {
     EXPECT_TRUE(fs::exists(fs::path(out) / f)) << f;
   }
   const std::regex row("calibrated model, measured attitude\\s+([0-9. ]+)");
@@ -155,13 +159,15 @@ TEST_F(CliTest, CalibrateBadInputLeavesNoOutput) {
         "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
         "0,0,0,150,0,0,0,150,150,150,150,150,150\n"
         "1,0,0,150,0,0,0,150,150,abc,150,150,150\n");
-  CommandResult r = Fastcal("calibrate --spec=" + spec + " --data=" + Path("bad.csv") + " --out=" + out);
+  CommandResult r =
+      Fastcal("calibrate --spec=" + spec + " --data=" + Path("bad.csv") + " --out=" + out);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("bad.csv:3"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("T3_kN"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(out));
   // A missing tension column.
-  Write("short.csv", "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN\n");
+  Write("short.csv",
+        "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN\n");
   r = Fastcal("calibrate --spec=" + spec + " --data=" + Path("short.csv") + " --out=" + out);
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("T6_kN"), std::string::npos) << r.output;
@@ -190,7 +196,8 @@ TEST_F(CliTest, CalibrateBadInputLeavesNoOutput) {
   EXPECT_FALSE(fs::exists(out));
   // Nothing else was left next to it either (no temporary directory).
   int entries = 0;
-  for (const auto& e : fs::directory_iterator(dir_)) entries += e.path().filename().string()[0] == '.';
+  for (const auto& e : fs::directory_iterator(dir_))
+    entries += e.path().filename().string()[0] == '.';
   EXPECT_EQ(entries, 0);
 }
 

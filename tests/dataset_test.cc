@@ -2,8 +2,10 @@
 // (fastcal/dataset.h, docs/data-format.md).
 #include "fastcal/dataset.h"
 
+#include <gtest/gtest.h>
 #include <stdlib.h>
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -14,9 +16,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <gtest/gtest.h>
 
 namespace fastcal {
 namespace {

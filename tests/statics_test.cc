@@ -3,13 +3,13 @@
 // returned forces, the workspace cap, derivatives and failure statuses.
 #include "fastcal/statics.h"
 
+#include <ceres/jet.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
 #include <cmath>
 #include <random>
 #include <vector>
-
-#include <Eigen/Geometry>
-#include <ceres/jet.h>
-#include <gtest/gtest.h>
 
 namespace fastcal {
 namespace {
@@ -95,8 +95,7 @@ TEST(StaticsTest, K2MatchesPaperTable3) {
   // which no variant of the law we tried reaches (see docs/model.md, "K2").
   constexpr double kPaperExactKn[kNumCables] = {181.5009, 190.7462, 200.7024,
                                                 119.5531, 119.8599, 191.0149};
-  constexpr double kPaperAasErrorPct[kNumCables] = {0.1026, 0.1040, 0.0151,
-                                                    0.1397, 0.1407, 0.0108};
+  constexpr double kPaperAasErrorPct[kNumCables] = {0.1026, 0.1040, 0.0151, 0.1397, 0.1407, 0.0108};
   constexpr double kTensionTolKn = 0.2;
   constexpr double kErrorTolPct = 0.01;
   const CableRobot robot = CableRobot::NominalFast();
@@ -127,8 +126,8 @@ std::array<double, kNumCables> MaxAasErrorPct(const std::vector<Eigen::Vector3d>
     EXPECT_EQ(exact.status, StaticsStatus::kOk);
     EXPECT_EQ(aas.status, StaticsStatus::kOk);
     for (int i = 0; i < kNumCables; ++i) {
-      const double e = 100 * std::abs(aas.cables[i].lower_tension_n /
-                                          exact.cables[i].lower_tension_n - 1.0);
+      const double e =
+          100 * std::abs(aas.cables[i].lower_tension_n / exact.cables[i].lower_tension_n - 1.0);
       worst[i] = std::max(worst[i], e);
     }
   }
@@ -196,8 +195,8 @@ TEST(StaticsTest, WholeWorkspaceCap) {
                       : on_sphere                     ? worst_on
                                                       : worst_off;
       for (int i = 0; i < kNumCables; ++i) {
-        worst = std::max(worst, std::abs(s.cables[i].lower_tension_n /
-                                             exact.cables[i].lower_tension_n - 1.0));
+        worst = std::max(
+            worst, std::abs(s.cables[i].lower_tension_n / exact.cables[i].lower_tension_n - 1.0));
       }
     }
   }
@@ -218,10 +217,9 @@ TEST(StaticsTest, ExactSolutionSatisfiesEveryCatenary) {
     const Eigen::Vector3d chord =
         robot.cables[i].tower_top_m - (pose.rotation * robot.AnchorOfCable(i) + pose.position_m);
     const CableSolution& c = s.cables[i];
-    const CatenaryEnd<double> e =
-        CatenaryEndpoint(c.horizontal_force_n, c.force_n.z(), c.unstretched_length_m,
-                         robot.cables[i].ea_n,
-                         robot.cables[i].linear_density_kg_per_m * robot.gravity_m_per_s2);
+    const CatenaryEnd<double> e = CatenaryEndpoint(
+        c.horizontal_force_n, c.force_n.z(), c.unstretched_length_m, robot.cables[i].ea_n,
+        robot.cables[i].linear_density_kg_per_m * robot.gravity_m_per_s2);
     EXPECT_NEAR(e.span_m, chord.head<2>().norm(), kEndPointTolM);
     EXPECT_NEAR(e.rise_m, chord.z(), kEndPointTolM);
     // The horizontal force points from the tower back toward the cabin (eqs. 17-18).
@@ -266,7 +264,8 @@ TEST(StaticsTest, RefinementConvergesQuadratically) {
     ASSERT_EQ(SolveStatics(robot, pose, options, &s), StaticsStatus::kOk);
     double err = 0;
     for (int i = 0; i < kNumCables; ++i) {
-      err = std::max(err, std::abs(s.cables[i].lower_tension_n / exact.cables[i].lower_tension_n - 1));
+      err = std::max(err,
+                     std::abs(s.cables[i].lower_tension_n / exact.cables[i].lower_tension_n - 1));
     }
     if (steps > 0) {
       EXPECT_LT(err, std::max(10 * previous * previous, 1e-13)) << steps;
@@ -336,12 +335,24 @@ TEST(StaticsTest, JetTensionsMatchCentralDifferences) {
   const StaticsParameters<double> p0 = MakeStaticsParameters(robot);
   auto perturb = [](auto& p, int k, const auto& d) {
     switch (k) {
-      case 0: p.mass_centre_cabin_m[0] += d; break;
-      case 1: p.mass_centre_cabin_m[2] += d; break;
-      case 2: p.linear_density_kg_per_m[2] += d; break;
-      case 3: p.ea_n[0] += d; break;
-      case 4: p.tower_top_m[4][1] += d; break;
-      case 5: p.cabin_mass_kg += d; break;
+      case 0:
+        p.mass_centre_cabin_m[0] += d;
+        break;
+      case 1:
+        p.mass_centre_cabin_m[2] += d;
+        break;
+      case 2:
+        p.linear_density_kg_per_m[2] += d;
+        break;
+      case 3:
+        p.ea_n[0] += d;
+        break;
+      case 4:
+        p.tower_top_m[4][1] += d;
+        break;
+      case 5:
+        p.cabin_mass_kg += d;
+        break;
     }
   };
   const double steps[6] = {1e-4, 1e-4, 1e-5, 1e2, 1e-4, 1e-2};

@@ -12,8 +12,7 @@
 namespace fastcal::internal {
 
 // Writes `content` to a new temporary file beside `path`, then renames it over `path`.
-bool WriteFileAtomically(const std::string& path, const std::string& content,
-                         std::string* error) {
+bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error) {
   std::string ignored;
   if (error == nullptr) error = &ignored;
   static std::atomic<unsigned> counter{0};

@@ -8,6 +8,7 @@
 // significant digits), so a save/load round trip is bit-exact.
 #include <fcntl.h>
 #include <unistd.h>
+#include <yaml-cpp/yaml.h>
 
 #include <cctype>
 #include <cerrno>
@@ -23,10 +24,7 @@
 #include <utility>
 #include <vector>
 
-#include <yaml-cpp/yaml.h>
-
 #include "fastcal/cable_robot.h"
-
 #include "fastcal/internal/atomic_file.h"
 
 namespace fastcal {

@@ -1,15 +1,15 @@
 // The calibration problem, its identifiability analysis and covariance (calibration.h).
 #include "fastcal/calibration.h"
 
+#include <ceres/ceres.h>
+
+#include <Eigen/Dense>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <memory>
 #include <sstream>
-
-#include <Eigen/Dense>
-#include <ceres/ceres.h>
 
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/calibration_model.h"
@@ -126,9 +126,8 @@ Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>
     for (int c = 0; c < n; ++c) {
       if (std::abs(v[c]) >= kDirectionWeightFloor) w.emplace_back(names[c], v[c]);
     }
-    std::sort(w.begin(), w.end(), [](const auto& a, const auto& b) {
-      return std::abs(a.second) > std::abs(b.second);
-    });
+    std::sort(w.begin(), w.end(),
+              [](const auto& a, const auto& b) { return std::abs(a.second) > std::abs(b.second); });
     d.weights = w;
     (ratio < options.undetermined_ratio ? out.undetermined : out.poorly_determined).push_back(d);
   }
@@ -190,7 +189,8 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     }
   }
   if (spec.use_planned_attitude && !data.has_planned_attitude) {
-    *error = data.path + ": the spec fits with the planned attitude but the dataset has no "
+    *error = data.path +
+             ": the spec fits with the planned attitude but the dataset has no "
              "planned_roll_deg, planned_pitch_deg, planned_yaw_deg columns";
     return CalibrationStatus::kInvalidInput;
   }
@@ -208,8 +208,8 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     return CalibrationStatus::kInvalidInput;
   }
 
-  result->held_out = HoldoutMask(static_cast<int>(data.samples.size()), spec.holdout_fraction,
-                                 spec.holdout_seed);
+  result->held_out =
+      HoldoutMask(static_cast<int>(data.samples.size()), spec.holdout_fraction, spec.holdout_seed);
   std::vector<int> fit;
   for (size_t s = 0; s < data.samples.size(); ++s) {
     if (!result->held_out[s]) fit.push_back(static_cast<int>(s));
@@ -280,11 +280,12 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     f.pose = sample.pose;
     if (spec.use_planned_attitude) f.pose.rotation = sample.planned_rotation;
     f.measured_n = sample.tension_n;
-    f.sigma_n = internal::TensionSigmas(sample.tension_n, spec.tension_sigma_n,
-                                        spec.tension_sigma_percent);
+    f.sigma_n =
+        internal::TensionSigmas(sample.tension_n, spec.tension_sigma_n, spec.tension_sigma_percent);
     f.statics = statics;
     SolveStaticsWithParameters(initial_params, f.pose, statics, &f.start);
-    data_blocks.push_back(problem.AddResidualBlock(new internal::TensionCost(f), loss, theta.data()));
+    data_blocks.push_back(
+        problem.AddResidualBlock(new internal::TensionCost(f), loss, theta.data()));
   }
   if (data_blocks.empty()) {
     delete loss;
@@ -326,9 +327,9 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
           any = true;
         }
         char line[200];
-        std::snprintf(line, sizeof(line), "  - %s: +-%.3g %s (determined means +-%.3g %s or better)\n",
-                      p.name.c_str(), sigma / p.to_si, p.unit.c_str(), limit / p.to_si,
-                      p.unit.c_str());
+        std::snprintf(line, sizeof(line),
+                      "  - %s: +-%.3g %s (determined means +-%.3g %s or better)\n", p.name.c_str(),
+                      sigma / p.to_si, p.unit.c_str(), limit / p.to_si, p.unit.c_str());
         refuse << line;
       }
     }
@@ -460,8 +461,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     result->parameters.push_back(e);
   }
   result->calibrated = cm.ToRobot(theta.data());
-  result->seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return CalibrationStatus::kOk;
 }
 

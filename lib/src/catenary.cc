@@ -171,7 +171,10 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
   double h = std::sqrt(lo * hi);
   for (int i = 0; i < kGuessMaxIterations; ++i) {
     const double fh = f(h);
-    if (fh < 0) lo = h; else hi = h;
+    if (fh < 0)
+      lo = h;
+    else
+      hi = h;
     double next = h - fh / df(h);
     if (!(next > lo && next < hi)) next = std::sqrt(lo * hi);
     if (std::abs(next - h) <= kGuessRelativeTolerance * h) {
@@ -211,8 +214,8 @@ CatenaryStatus SolveCatenaryForcesDouble(double span_m, double rise_m, double s0
 
 CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl_n, double ea_n,
                                          double w_n_per_m, const CatenarySolverOptions& options,
-                                         const CatenaryCurvePoint* guess,
-                                         CatenaryCurvePoint* point, int* iterations) {
+                                         const CatenaryCurvePoint* guess, CatenaryCurvePoint* point,
+                                         int* iterations) {
   *iterations = 0;
   if (!std::isfinite(fl_n) || !(fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
   const CatenaryStatus common = CheckCommon(span_m, rise_m, ea_n, w_n_per_m, options);

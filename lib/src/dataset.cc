@@ -2,11 +2,10 @@
 // file digest (declarations: dataset.h).
 #include "fastcal/dataset.h"
 
-#include "fastcal/internal/atomic_file.h"
-
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
@@ -21,7 +20,7 @@
 #include <limits>
 #include <string_view>
 
-#include <Eigen/LU>
+#include "fastcal/internal/atomic_file.h"
 
 namespace fastcal {
 namespace {

@@ -26,8 +26,8 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
     Pose pose = s.pose;
     if (attitude == AttitudeSource::kPlanned) pose.rotation = s.planned_rotation;
     if (SolveStatics(robot, pose, options, &solution) != StaticsStatus::kOk) {
-      *error = data.path + ":" + std::to_string(s.line) + ": the model cannot solve this pose: " +
-               DescribeStatus(solution);
+      *error = data.path + ":" + std::to_string(s.line) +
+               ": the model cannot solve this pose: " + DescribeStatus(solution);
       return false;
     }
     for (int i = 0; i < kNumCables; ++i) {

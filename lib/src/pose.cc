@@ -1,11 +1,10 @@
 // Attitude conversions and the focal attitude law (equations: pose.h).
 #include "fastcal/pose.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-#include <Eigen/Geometry>
 
 namespace fastcal {
 namespace {
@@ -16,9 +15,7 @@ constexpr double kOnAxisSine = 1e-12;
 constexpr double kGimbalLockCos = 1e-12;
 }  // namespace
 
-bool IsFinite(const Pose& pose) {
-  return pose.position_m.allFinite() && pose.rotation.allFinite();
-}
+bool IsFinite(const Pose& pose) { return pose.position_m.allFinite() && pose.rotation.allFinite(); }
 
 Eigen::Matrix3d RotationFromRpyDeg(double roll_deg, double pitch_deg, double yaw_deg) {
   return (Eigen::AngleAxisd(yaw_deg * kDegToRad, Eigen::Vector3d::UnitZ()) *

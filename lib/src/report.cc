@@ -4,8 +4,6 @@
 // JsonWriter. Tensions are converted N -> kN here, at the edge, and only here.
 #include "fastcal/report.h"
 
-#include "fastcal/internal/atomic_file.h"
-
 #include <fcntl.h>
 #include <unistd.h>
 
@@ -23,6 +21,7 @@
 #include <utility>
 #include <vector>
 
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/svg_plot.h"
 

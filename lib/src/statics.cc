@@ -1,10 +1,9 @@
 // The double-precision statics solvers (equations and methods: statics.h).
 #include "fastcal/statics.h"
 
+#include <Eigen/Geometry>
 #include <cmath>
 #include <sstream>
-
-#include <Eigen/Geometry>
 
 namespace fastcal {
 namespace {
@@ -48,9 +47,8 @@ void FillSolution(const StaticsParameters<double>& p, const internal::PoseGeomet
   sol->moment_residual_nm = moment_sum.norm();
 }
 
-StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose,
-                      const StaticsOptions& o, const StaticsSolution* previous,
-                      StaticsSolution* sol) {
+StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, const StaticsOptions& o,
+                      const StaticsSolution* previous, StaticsSolution* sol) {
   using internal::CableState;
   sol->cables = {};
   sol->cable = -1;
@@ -97,9 +95,9 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose,
       st[i] = {fl[i], a[i] * fl[i] + b[i], 0.0};
     }
     const int projections = o.method == StaticsMethod::kAasRefined ? o.refinement_steps
-                            : o.method == StaticsMethod::kExact      ? 1
-                            : o.compute_unstretched_lengths          ? 1
-                                                                     : 0;
+                            : o.method == StaticsMethod::kExact    ? 1
+                            : o.compute_unstretched_lengths        ? 1
+                                                                   : 0;
     for (int step = 0; step < projections; ++step) {
       std::array<CatenaryCurvePoint, kNumCables> guess;
       for (int i = 0; i < kNumCables; ++i) {
@@ -239,8 +237,8 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   return status;
 }
 
-StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose,
-                           const StaticsOptions& options, StaticsSolution* solution) {
+StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const StaticsOptions& options,
+                           StaticsSolution* solution) {
   return SolveStaticsWithParameters(MakeStaticsParameters(robot), pose, options, solution);
 }
 

@@ -15,11 +15,10 @@
 #ifndef FASTCAL_CABLE_ROBOT_H_
 #define FASTCAL_CABLE_ROBOT_H_
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace fastcal {
 
@@ -73,8 +72,8 @@ struct CableRobot {
 // Unknown keys, wrong types and non-physical values are errors; *error then names the
 // file, the key and (where yaml-cpp knows it) the line.
 bool LoadCableRobot(const std::string& path, CableRobot* robot, std::string* error);
-bool ParseCableRobotYaml(const std::string& text, const std::string& source_name,
-                         CableRobot* robot, std::string* error);
+bool ParseCableRobotYaml(const std::string& text, const std::string& source_name, CableRobot* robot,
+                         std::string* error);
 
 // Writes the model as YAML in the same format LoadCableRobot reads; values are written
 // with 17 significant digits so a save/load round trip is exact. `header_comment` (may be

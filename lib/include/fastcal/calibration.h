@@ -21,11 +21,10 @@
 #ifndef FASTCAL_CALIBRATION_H_
 #define FASTCAL_CALIBRATION_H_
 
+#include <Eigen/Core>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
@@ -68,7 +67,7 @@ struct ParameterDirection {
 };
 
 struct Identifiability {
-  std::vector<double> singular_value_ratios;    // s_k / s_1, descending
+  std::vector<double> singular_value_ratios;  // s_k / s_1, descending
   // Standard deviation of each free parameter (SI) from (J^T J)^-1; infinite along an
   // undetermined direction.
   std::vector<double> sigma_si;
@@ -78,21 +77,21 @@ struct Identifiability {
 
 struct ParameterEstimate {
   std::string name;
-  std::string unit;   // of the values below (the spec's unit: kN for biases)
+  std::string unit;  // of the values below (the spec's unit: kN for biases)
   bool free = false;
   double initial = 0.0;
   double estimate = 0.0;
-  double sigma = 0.0;        // 0 for fixed parameters
+  double sigma = 0.0;  // 0 for fixed parameters
   bool has_prior = false;
   double prior_mean = 0.0;
   double prior_sigma = 0.0;
-  std::string note;          // e.g. "set mostly by its prior"
+  std::string note;  // e.g. "set mostly by its prior"
 };
 
 struct CalibrationResult {
   std::vector<ParameterEstimate> parameters;  // every parameter the spec names
   std::vector<std::string> free_names;
-  Eigen::MatrixXd correlation;                // free parameters, spec order
+  Eigen::MatrixXd correlation;  // free parameters, spec order
   bool covariance_ok = false;
   std::vector<std::string> strong_correlations;  // "a ~ b: +0.97"
   // With priors, before and after solving; and from the data alone after solving.
@@ -119,10 +118,10 @@ struct CalibrationResult {
 
 enum class CalibrationStatus {
   kOk = 0,
-  kInvalidInput,    // bad spec, dataset, or fewer residuals than free parameters
-  kUndetermined,    // the data and priors cannot determine the free set (refused)
-  kInfeasible,      // the initial model cannot hold a sample's pose
-  kSolverFailed,    // Ceres failed
+  kInvalidInput,  // bad spec, dataset, or fewer residuals than free parameters
+  kUndetermined,  // the data and priors cannot determine the free set (refused)
+  kInfeasible,    // the initial model cannot hold a sample's pose
+  kSolverFailed,  // Ceres failed
 };
 
 // Runs the calibration. On a status other than kOk, *error explains it (for kUndetermined:

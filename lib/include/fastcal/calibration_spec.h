@@ -24,7 +24,7 @@
 namespace fastcal {
 
 enum class ParameterKind {
-  kMassCentre,     // component = axis 0..2
+  kMassCentre,  // component = axis 0..2
   kCabinMass,
   kLinearDensity,  // cable = 0..5, or -1 for common
   kEa,             // cable = 0..5, or -1 for common

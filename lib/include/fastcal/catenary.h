@@ -13,7 +13,8 @@
 // and EA -> infinity (inextensible catenary) stay accurate:
 //   S = T0 + T1,  P = Fz (2 Fz + w s0)/S,  Q = T0 - P
 //   T1 - T0 = w s0 (2 Fz + w s0)/S
-//   asinh(a1) - asinh(a0) = asinh(w s0 Q / Fl^2)      [asinh x - asinh y = asinh(x sqrt(1+y^2) - y sqrt(1+x^2))]
+//   asinh(a1) - asinh(a0) = asinh(w s0 Q / Fl^2)      [asinh x - asinh y = asinh(x sqrt(1+y^2) - y
+//   sqrt(1+x^2))]
 // and the partial derivatives (for Newton and for implicit differentiation):
 //   dL/dFl = s0/EA + D/w - s0 Q/(T0 T1)         D = asinh(w s0 Q/Fl^2)
 //   dL/dFz = -Fl s0 (2 Fz + w s0)/(S T0 T1)
@@ -123,8 +124,8 @@ struct CatenaryCurvePoint {
 };
 CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl_n, double ea_n,
                                          double w_n_per_m, const CatenarySolverOptions& options,
-                                         const CatenaryCurvePoint* guess,
-                                         CatenaryCurvePoint* point, int* iterations);
+                                         const CatenaryCurvePoint* guess, CatenaryCurvePoint* point,
+                                         int* iterations);
 
 // Starting point used when no guess is given: solves the parabolic approximation
 //   s0^2 (1 + H k/(L EA))^2 - k^2 = w^2 L^4 / (12 H^2)
@@ -135,16 +136,15 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
 // Templated wrappers. For T = double they are the solves above; for a Jet they add one
 // Newton step in Jet arithmetic at the converged point (implicit differentiation).
 template <typename T>
-CatenaryStatus SolveCatenaryForces(const T& span_m, const T& rise_m, const T& s0_m,
-                                   const T& ea_n, const T& w_n_per_m,
-                                   const CatenarySolverOptions& options,
+CatenaryStatus SolveCatenaryForces(const T& span_m, const T& rise_m, const T& s0_m, const T& ea_n,
+                                   const T& w_n_per_m, const CatenarySolverOptions& options,
                                    const CatenaryForces* guess, T* fl_n, T* fz_n,
                                    int* iterations = nullptr) {
   CatenaryForces f;
   int it = 0;
-  const CatenaryStatus status = SolveCatenaryForcesDouble(
-      ScalarValue(span_m), ScalarValue(rise_m), ScalarValue(s0_m), ScalarValue(ea_n),
-      ScalarValue(w_n_per_m), options, guess, &f, &it);
+  const CatenaryStatus status =
+      SolveCatenaryForcesDouble(ScalarValue(span_m), ScalarValue(rise_m), ScalarValue(s0_m),
+                                ScalarValue(ea_n), ScalarValue(w_n_per_m), options, guess, &f, &it);
   if (iterations != nullptr) *iterations = it;
   if (status != CatenaryStatus::kOk) return status;
   if constexpr (kIsDouble<T>) {
@@ -168,9 +168,9 @@ CatenaryStatus SolveCatenaryLength(const T& span_m, const T& rise_m, const T& fl
                                    int* iterations = nullptr) {
   CatenaryCurvePoint c;
   int it = 0;
-  const CatenaryStatus status = SolveCatenaryLengthDouble(
-      ScalarValue(span_m), ScalarValue(rise_m), ScalarValue(fl_n), ScalarValue(ea_n),
-      ScalarValue(w_n_per_m), options, guess, &c, &it);
+  const CatenaryStatus status =
+      SolveCatenaryLengthDouble(ScalarValue(span_m), ScalarValue(rise_m), ScalarValue(fl_n),
+                                ScalarValue(ea_n), ScalarValue(w_n_per_m), options, guess, &c, &it);
   if (iterations != nullptr) *iterations = it;
   if (status != CatenaryStatus::kOk) return status;
   if constexpr (kIsDouble<T>) {
@@ -190,9 +190,9 @@ CatenaryStatus SolveCatenaryLength(const T& span_m, const T& rise_m, const T& fl
 
 // A point of the cable's shape (eqs. 11-13, in the cable plane) with the tension there.
 struct CatenaryPoint {
-  double s_m;        // unstretched arc length from the lower end
-  double span_m;     // horizontal distance from the lower end
-  double rise_m;     // height above the lower end
+  double s_m;     // unstretched arc length from the lower end
+  double span_m;  // horizontal distance from the lower end
+  double rise_m;  // height above the lower end
   double tension_n;
 };
 // n >= 2 points evenly spaced in s over [0, s0].

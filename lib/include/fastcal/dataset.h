@@ -8,11 +8,10 @@
 #ifndef FASTCAL_DATASET_H_
 #define FASTCAL_DATASET_H_
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/pose.h"

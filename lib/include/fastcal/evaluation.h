@@ -21,10 +21,10 @@ enum class AttitudeSource { kMeasured, kPlanned };
 
 struct CableErrorStats {
   int samples = 0;
-  std::array<double, kNumCables> mean_n{};         // mean of model - measured
-  std::array<double, kNumCables> rms_n{};          // RMS of model - measured
-  std::array<double, kNumCables> max_abs_n{};      // largest |model - measured|
-  std::array<double, kNumCables> rms_percent{};    // RMS of 100 (model - measured)/measured
+  std::array<double, kNumCables> mean_n{};       // mean of model - measured
+  std::array<double, kNumCables> rms_n{};        // RMS of model - measured
+  std::array<double, kNumCables> max_abs_n{};    // largest |model - measured|
+  std::array<double, kNumCables> rms_percent{};  // RMS of 100 (model - measured)/measured
   std::array<double, kNumCables> max_abs_percent{};
 };
 

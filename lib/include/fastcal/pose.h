@@ -12,9 +12,8 @@
 #ifndef FASTCAL_POSE_H_
 #define FASTCAL_POSE_H_
 
-#include <string>
-
 #include <Eigen/Core>
+#include <string>
 
 namespace fastcal {
 

@@ -4,10 +4,10 @@
 #ifndef FASTCAL_SCALAR_H_
 #define FASTCAL_SCALAR_H_
 
+#include <ceres/jet.h>
+
 #include <cmath>
 #include <type_traits>
-
-#include <ceres/jet.h>
 
 namespace fastcal {
 

@@ -28,10 +28,9 @@
 #ifndef FASTCAL_STATICS_H_
 #define FASTCAL_STATICS_H_
 
+#include <Eigen/Core>
 #include <array>
 #include <string>
-
-#include <Eigen/Core>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/catenary.h"
@@ -96,9 +95,9 @@ struct CableSolution {
 struct StaticsSolution {
   std::array<CableSolution, kNumCables> cables;
   StaticsStatus status = StaticsStatus::kInvalidInput;
-  int cable = -1;                // 0-based cable concerned by a failure, else -1
-  int outer_iterations = 0;      // refinement steps or exact Newton iterations
-  int catenary_iterations = 0;   // total per-cable Newton iterations
+  int cable = -1;               // 0-based cable concerned by a failure, else -1
+  int outer_iterations = 0;     // refinement steps or exact Newton iterations
+  int catenary_iterations = 0;  // total per-cable Newton iterations
   // |sum(-F_i) + W| and |sum r_i x (-F_i) + e x W| of the returned forces.
   double force_residual_n = 0.0;
   double moment_residual_nm = 0.0;
@@ -106,8 +105,8 @@ struct StaticsSolution {
 
 // Solves the statics of `pose`. Returns solution->status. On failure the forces are
 // zero (never NaN) and `cable` names the cable concerned where there is one.
-StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose,
-                           const StaticsOptions& options, StaticsSolution* solution);
+StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const StaticsOptions& options,
+                           StaticsSolution* solution);
 
 // A one-line human-readable account of a solution's status, naming the cable (1-based).
 std::string DescribeStatus(const StaticsSolution& solution);

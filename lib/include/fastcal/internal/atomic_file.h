@@ -9,8 +9,7 @@
 namespace fastcal::internal {
 
 // On failure returns false with "<path>: <what>: <strerror>" in *error (may be null).
-bool WriteFileAtomically(const std::string& path, const std::string& content,
-                         std::string* error);
+bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error);
 
 }  // namespace fastcal::internal
 

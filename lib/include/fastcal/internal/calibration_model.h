@@ -9,12 +9,12 @@
 #ifndef FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 #define FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 
+#include <ceres/cost_function.h>
+#include <ceres/jet.h>
+
 #include <array>
 #include <string>
 #include <vector>
-
-#include <ceres/cost_function.h>
-#include <ceres/jet.h>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"

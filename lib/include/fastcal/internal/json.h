@@ -73,11 +73,21 @@ class JsonWriter {
     std::string q = "\"";
     for (unsigned char c : s) {
       switch (c) {
-        case '"': q += "\\\""; break;
-        case '\\': q += "\\\\"; break;
-        case '\n': q += "\\n"; break;
-        case '\r': q += "\\r"; break;
-        case '\t': q += "\\t"; break;
+        case '"':
+          q += "\\\"";
+          break;
+        case '\\':
+          q += "\\\\";
+          break;
+        case '\n':
+          q += "\\n";
+          break;
+        case '\r':
+          q += "\\r";
+          break;
+        case '\t':
+          q += "\\t";
+          break;
         default:
           if (c < 0x20) {
             char buf[8];

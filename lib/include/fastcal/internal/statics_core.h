@@ -11,11 +11,10 @@
 #ifndef FASTCAL_INTERNAL_STATICS_CORE_H_
 #define FASTCAL_INTERNAL_STATICS_CORE_H_
 
-#include <array>
-#include <cmath>
-
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <limits>
 
 #include "fastcal/cable_robot.h"
@@ -171,9 +170,9 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
     const CatenaryForces guess_low = (*low)[i], guess_high = (*high)[i];
     const T s_low = T(o.secant_low_fraction) * g.chord[i];
     const T s_high = T(o.secant_high_fraction) * g.chord[i];
-    CatenaryStatus s = SolveCatenaryForces(g.span[i], g.rise[i], s_low, p.ea_n[i], g.w[i],
-                                           o.catenary, use_guess ? &guess_low : nullptr, &fl1,
-                                           &fz1, &it1);
+    CatenaryStatus s =
+        SolveCatenaryForces(g.span[i], g.rise[i], s_low, p.ea_n[i], g.w[i], o.catenary,
+                            use_guess ? &guess_low : nullptr, &fl1, &fz1, &it1);
     if (s == CatenaryStatus::kOk) {
       s = SolveCatenaryForces(g.span[i], g.rise[i], s_high, p.ea_n[i], g.w[i], o.catenary,
                               use_guess ? &guess_high : nullptr, &fl2, &fz2, &it2);
@@ -237,8 +236,8 @@ StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometr
     g0[i] = e.span_m - g.span[i];
     g1[i] = e.rise_m - g.rise[i];
     const double chord = ScalarValue(g.chord[i]);
-    max_residual = std::max(max_residual, std::max(std::abs(ScalarValue(g0[i])),
-                                                   std::abs(ScalarValue(g1[i]))) / chord);
+    max_residual = std::max(
+        max_residual, std::max(std::abs(ScalarValue(g0[i])), std::abs(ScalarValue(g1[i]))) / chord);
     const T n0 = e.drise[2], n1 = -e.dspan[2];
     const T cc = n0 * g0[i] + n1 * g1[i];
     const T pp = n0 * e.dspan[0] + n1 * e.drise[0];

@@ -17,8 +17,7 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
 template <typename T>
 StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose,
                                  const StaticsOptions& options,
-                                 std::array<T, kNumCables>* tension_n,
-                                 StaticsSolution* solution) {
+                                 std::array<T, kNumCables>* tension_n, StaticsSolution* solution) {
   using std::sqrt;
   StaticsSolution local;
   StaticsSolution* sol = solution != nullptr ? solution : &local;
@@ -35,8 +34,8 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
     if (status != StaticsStatus::kOk) return status;
     internal::PoseGeometry<T> g;
     int cable = -1, iterations = 0;
-    status = internal::ComputeGeometry(p, pose, options.catenary.vertical_span_fraction, &g,
-                                       &cable);
+    status =
+        internal::ComputeGeometry(p, pose, options.catenary.vertical_span_fraction, &g, &cable);
     if (status != StaticsStatus::kOk) return status;
     std::array<internal::CableState<T>, kNumCables> st;
     if (options.method == StaticsMethod::kExact) {
@@ -61,8 +60,8 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
         for (int step = 0; step < options.refinement_steps; ++step) {
           std::array<CatenaryCurvePoint, kNumCables> guess;
           for (int i = 0; i < kNumCables; ++i) {
-            guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), ScalarValue(g.chord[i]),
-                                            low[i], high[i], options);
+            guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), ScalarValue(g.chord[i]), low[i],
+                                            high[i], options);
           }
           status = internal::ProjectOnCurves(p, g, options, guess, &st, &cable, &iterations);
           if (status != StaticsStatus::kOk) return status;
