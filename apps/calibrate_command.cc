@@ -163,7 +163,7 @@ std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluatio
 std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
   std::ostringstream s;
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "  %-42s %8s %8s %8s %8s %8s %8s\n", "RMS model - measured (kN)",
+  std::snprintf(buf, sizeof(buf), "  %-46s %8s %8s %8s %8s %8s %8s\n", "RMS model - measured (kN)",
                 "T1", "T2", "T3", "T4", "T5", "T6");
   s << buf;
   for (const VariantEvaluation& v : variants) {
@@ -171,7 +171,7 @@ std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
       const CableErrorStats& st = part == 0 ? v.fit : v.holdout;
       if (st.samples == 0) continue;
       std::string name = v.name + (part == 1 ? " [hold-out]" : "");
-      std::snprintf(buf, sizeof(buf), "  %-42.42s", name.c_str());
+      std::snprintf(buf, sizeof(buf), "  %-46.46s", name.c_str());
       s << buf;
       for (double r : st.rms_n) {
         std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);

@@ -372,7 +372,8 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   result->ceres_full_report = summary.FullReport();
   result->initial_cost = summary.initial_cost;
   result->final_cost = summary.final_cost;
-  result->iterations = static_cast<int>(summary.iterations.size()) - 1;
+  // As Ceres counts them in its BriefReport.
+  result->iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
   result->converged = summary.termination_type == ceres::CONVERGENCE;
   result->termination = ceres::TerminationTypeToString(summary.termination_type);
   if (!summary.IsSolutionUsable()) {
