@@ -8,6 +8,9 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace fastcal::internal {
 
@@ -46,6 +49,30 @@ bool WriteFileAtomically(const std::string& path, const std::string& content, st
   }
   if (::close(fd) != 0) return fail("cannot write", errno);
   if (std::rename(temp_path.c_str(), path.c_str()) != 0) return fail("cannot replace", errno);
+  return true;
+}
+
+bool ReadTextFile(const std::string& path, std::string* text, std::string* error) {
+  std::string ignored;
+  if (error == nullptr) error = &ignored;
+  try {
+    std::error_code ec;
+    std::ifstream in(path, std::ios::binary);
+    if (!in || std::filesystem::is_directory(path, ec)) {
+      *error = path + ": cannot open";
+      return false;
+    }
+    std::ostringstream contents;
+    contents << in.rdbuf();
+    if (in.bad()) {
+      *error = path + ": cannot read";
+      return false;
+    }
+    *text = contents.str();
+  } catch (const std::exception& e) {
+    *error = path + ": cannot read: " + e.what();
+    return false;
+  }
   return true;
 }
 

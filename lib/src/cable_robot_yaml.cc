@@ -358,19 +358,9 @@ bool ParseCableRobotYaml(const std::string& text, const std::string& source_name
 }
 
 bool LoadCableRobot(const std::string& path, CableRobot* robot, std::string* error) {
-  std::error_code ec;
-  std::ifstream in(path, std::ios::binary);
-  if (!in || std::filesystem::is_directory(path, ec)) {
-    if (error != nullptr) *error = path + ": cannot open";
-    return false;
-  }
-  std::ostringstream text;
-  text << in.rdbuf();
-  if (in.bad()) {
-    if (error != nullptr) *error = path + ": cannot read";
-    return false;
-  }
-  return ParseCableRobotYaml(text.str(), path, robot, error);
+  std::string text;
+  if (!internal::ReadTextFile(path, &text, error)) return false;
+  return ParseCableRobotYaml(text, path, robot, error);
 }
 
 std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_comment) {

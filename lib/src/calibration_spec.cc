@@ -30,6 +30,8 @@
 #include <utility>
 #include <vector>
 
+#include "fastcal/internal/atomic_file.h"
+
 namespace fastcal {
 namespace {
 
@@ -134,18 +136,6 @@ std::string CheckHoldoutFraction(double fraction) {
 }
 
 std::string CheckAtLeastOne(int value) { return value >= 1 ? "" : "must be >= 1"; }
-
-const char* RobustLossName(RobustLoss loss) {
-  switch (loss) {
-    case RobustLoss::kNone:
-      return "none";
-    case RobustLoss::kHuber:
-      return "huber";
-    case RobustLoss::kCauchy:
-      return "cauchy";
-  }
-  return nullptr;
-}
 
 bool IsKnownMethod(StaticsMethod method) {
   StaticsMethod parsed;
@@ -761,7 +751,10 @@ bool CalibrationSpec::IsValid(std::string* error) const {
   if (tension_sigma_n == 0.0 && tension_sigma_percent == 0.0) {
     return fail(std::string("noise: ") + kBothNoiseZero);
   }
-  if (RobustLossName(robust_loss) == nullptr) return fail("robust_loss: unknown loss");
+  if (robust_loss != RobustLoss::kNone && robust_loss != RobustLoss::kHuber &&
+      robust_loss != RobustLoss::kCauchy) {
+    return fail("robust_loss: unknown loss");
+  }
   if (const std::string w = CheckPositive(robust_loss_scale); !w.empty()) {
     return fail("robust_loss_scale: " + w);
   }
@@ -867,24 +860,7 @@ bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source
 bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
                          std::string* error) {
   std::string text;
-  try {
-    std::error_code ec;
-    std::ifstream in(path, std::ios::binary);
-    if (!in || std::filesystem::is_directory(path, ec)) {
-      if (error != nullptr) *error = path + ": cannot open";
-      return false;
-    }
-    std::ostringstream contents;
-    contents << in.rdbuf();
-    if (in.bad()) {
-      if (error != nullptr) *error = path + ": cannot read";
-      return false;
-    }
-    text = contents.str();
-  } catch (const std::exception& e) {
-    if (error != nullptr) *error = path + ": cannot read: " + e.what();
-    return false;
-  }
+  if (!internal::ReadTextFile(path, &text, error)) return false;
   return ParseCalibrationSpecYaml(text, path, num_anchor_points, spec, error);
 }
 
@@ -954,6 +930,18 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
     }
   }
   return out.str();
+}
+
+const char* RobustLossName(RobustLoss loss) {
+  switch (loss) {
+    case RobustLoss::kNone:
+      return "none";
+    case RobustLoss::kHuber:
+      return "huber";
+    case RobustLoss::kCauchy:
+      return "cauchy";
+  }
+  return "none";
 }
 
 }  // namespace fastcal

@@ -226,18 +226,6 @@ bool HasPredictions(const ReportInputs& in, const VariantEvaluation& v) {
   return in.data && !in.data->samples.empty() && v.predicted_n.size() == in.data->samples.size();
 }
 
-const char* RobustLossName(RobustLoss loss) {
-  switch (loss) {
-    case RobustLoss::kNone:
-      return "none";
-    case RobustLoss::kHuber:
-      return "huber";
-    case RobustLoss::kCauchy:
-      return "cauchy";
-  }
-  return "none";
-}
-
 std::string NoiseText(const CalibrationSpec& spec) {
   return "σ = √[(" + Printf("%.6g", spec.tension_sigma_n / kNPerKn) + " kN)² + (" +
          Printf("%.6g", spec.tension_sigma_percent) + " % of the measured tension)²]";

@@ -50,6 +50,7 @@ struct ParameterSpec {
 };
 
 enum class RobustLoss { kNone, kHuber, kCauchy };
+const char* RobustLossName(RobustLoss loss);  // "none", "huber", "cauchy"
 
 struct CalibrationSpec {
   // Every parameter the spec names, free or fixed, in a canonical order (the order of

@@ -1,4 +1,4 @@
-// Writing a file so that readers never see it half-written: a new temporary file beside
+// Whole-file reads, and writes that readers never see half-written: a new temporary file beside
 // the target (O_EXCL, unique name), write, fsync, rename over the target; on any failure
 // the temporary file is removed and the target is untouched.
 #ifndef FASTCAL_INTERNAL_ATOMIC_FILE_H_
@@ -10,6 +10,10 @@ namespace fastcal::internal {
 
 // On failure returns false with "<path>: <what>: <strerror>" in *error (may be null).
 bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error);
+
+// Reads a whole file; "<path>: cannot open" / "<path>: cannot read" on failure (a
+// directory cannot be opened).
+bool ReadTextFile(const std::string& path, std::string* text, std::string* error);
 
 }  // namespace fastcal::internal
 
