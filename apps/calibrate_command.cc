@@ -252,7 +252,8 @@ int RunCalibrate(int argc, char** argv) {
       return kExitUsage;
     }
   }
-  std::cerr << "fastcal calibrate: " << data.samples.size() << " samples from " << data.path
+  std::cerr << "fastcal calibrate: " << data.samples.size()
+            << (data.samples.size() == 1 ? " sample from " : " samples from ") << data.path
             << ", forward model " << StaticsMethodName(spec.forward_model) << "\n";
   CalibrationOptions options;
   if (!FLAGS_quiet)

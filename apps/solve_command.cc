@@ -328,8 +328,9 @@ bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
   for (size_t n = 0; n < poses.size(); ++n) {
     if (run->solutions[n].status != StaticsStatus::kOk && !FLAGS_keep_going) {
       std::ostringstream s;
-      s << "node " << n << " at position (" << poses[n].position_m.transpose()
-        << ") m: " << DescribeStatus(run->solutions[n]) << " [method "
+      const Eigen::Vector3d& x = poses[n].position_m;
+      s << "node " << n << " at position (" << FormatDouble(x[0]) << ", " << FormatDouble(x[1])
+        << ", " << FormatDouble(x[2]) << ") m: " << DescribeStatus(run->solutions[n]) << " [method "
         << StaticsMethodName(options.method) << "]";
       *error = s.str();
       return false;
