@@ -1,5 +1,6 @@
 #include "cli_util.h"
 
+#include <gflags/gflags.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -46,6 +47,34 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
     if (!allowed.count(bare)) {
       *error = "unknown flag --" + name + " (see fastcal " + command + " --help)";
       return false;
+    }
+    // Check the value's type here: gflags would exit 1 with its own message.
+    gflags::CommandLineFlagInfo info;
+    if (eq != std::string::npos && gflags::GetCommandLineFlagInfo(underscored.c_str(), &info)) {
+      const std::string value = arg.substr(eq + 1);
+      const char* begin = value.c_str();
+      char* end = nullptr;
+      bool ok = true;
+      if (info.type == "int32" || info.type == "int64") {
+        std::strtoll(begin, &end, 10);
+        ok = !value.empty() && *end == '\0';
+      } else if (info.type == "uint32" || info.type == "uint64") {
+        std::strtoull(begin, &end, 10);
+        ok = !value.empty() && value[0] != '-' && *end == '\0';
+      } else if (info.type == "double") {
+        const double v = std::strtod(begin, &end);
+        ok = !value.empty() && *end == '\0' && std::isfinite(v);
+      } else if (info.type == "bool") {
+        ok = value == "true" || value == "false" || value == "1" || value == "0";
+      }
+      if (!ok) {
+        *error = "--" + name + ": '" + value + "' is not a valid " +
+                 (info.type == "bool"     ? std::string("true/false")
+                  : info.type == "double" ? std::string("finite number")
+                                          : std::string("whole number")) +
+                 " (see fastcal " + command + " --help)";
+        return false;
+      }
     }
     normalised->push_back("--" + underscored +
                           (eq == std::string::npos ? std::string() : arg.substr(eq)));

@@ -309,7 +309,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   result->before = Analyse(r, result->free_names, options);
   std::ostringstream refuse;
   if (!result->before.undetermined.empty()) {
-    refuse << "only these combinations are constrained as a whole (exact degeneracy):\n";
+    refuse << "no reading changes along these combinations of parameters (exact degeneracy):\n";
     for (const ParameterDirection& d : result->before.undetermined) {
       char ratio[32];
       std::snprintf(ratio, sizeof(ratio), "%.1e", d.singular_value_ratio);
@@ -334,7 +334,9 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
       }
     }
     if (any) {
-      refuse << "the weakest directions in parameter space:\n";
+      if (!result->before.poorly_determined.empty()) {
+        refuse << "the weakest directions in parameter space:\n";
+      }
       for (const ParameterDirection& d : result->before.poorly_determined) {
         char ratio[32];
         std::snprintf(ratio, sizeof(ratio), "%.1e", d.singular_value_ratio);
@@ -345,7 +347,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   if (!refuse.str().empty()) {
     *error = std::string("the data") + (num_priors ? " and priors" : "") +
              " cannot determine the free parameters; " + refuse.str() +
-             "Fix one parameter of each combination (free: false), give it a prior "
+             "Fix one of the parameters named (free: false), give it a prior "
              "(prior: {mean: ..., sigma: ...}), or add data that separates them (other "
              "positions, zenith angles, attitudes).";
     return CalibrationStatus::kUndetermined;
