@@ -215,19 +215,12 @@ std::string CommandLine(int argc, char** argv) {
 
 int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
-  if (WantsHelp(argc, argv, 2)) {
-    std::cout << kCalibrateHelp;
-    return 0;
+  int exit_code = 0;
+  if (!StartCommand(argc, argv, command, kCalibrateHelp,
+                    {"model", "spec", "data", "out", "skip-invalid-rows", "quiet"}, &exit_code)) {
+    return exit_code;
   }
-  std::vector<std::string> args;
   std::string error;
-  if (!CheckAndNormaliseFlags(argc, argv, 2, command,
-                              {"model", "spec", "data", "out", "skip-invalid-rows", "quiet"}, &args,
-                              &error)) {
-    PrintError(command, error);
-    return kExitUsage;
-  }
-  ParseFlags(args);
   if (FLAGS_spec.empty() || FLAGS_out.empty()) {
     PrintError(command,
                "--spec=FILE.yaml, --data=FILE.csv and --out=DIR are required (see "
@@ -365,19 +358,12 @@ int RunCalibrate(int argc, char** argv) {
 
 int RunEvaluate(int argc, char** argv) {
   const char* command = "evaluate";
-  if (WantsHelp(argc, argv, 2)) {
-    std::cout << kEvaluateHelp;
-    return 0;
+  int exit_code = 0;
+  if (!StartCommand(argc, argv, command, kEvaluateHelp,
+                    {"model", "data", "out", "method", "skip-invalid-rows"}, &exit_code)) {
+    return exit_code;
   }
-  std::vector<std::string> args;
   std::string error;
-  if (!CheckAndNormaliseFlags(argc, argv, 2, command,
-                              {"model", "data", "out", "method", "skip-invalid-rows"}, &args,
-                              &error)) {
-    PrintError(command, error);
-    return kExitUsage;
-  }
-  ParseFlags(args);
   StaticsMethod method = StaticsMethod::kExact;
   if (!gflags::GetCommandLineFlagInfoOrDie("method").is_default &&
       !ParseStaticsMethod(FLAGS_method, &method)) {

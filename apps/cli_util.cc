@@ -3,9 +3,11 @@
 #include <gflags/gflags.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <sstream>
@@ -78,6 +80,80 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
     }
     normalised->push_back("--" + underscored +
                           (eq == std::string::npos ? std::string() : arg.substr(eq)));
+  }
+  return true;
+}
+
+void ParseFlags(const std::vector<std::string>& args) {
+  std::vector<char*> ptrs;
+  for (const std::string& a : args) ptrs.push_back(const_cast<char*>(a.c_str()));
+  int n = static_cast<int>(ptrs.size());
+  char** p = ptrs.data();
+  gflags::ParseCommandLineFlags(&n, &p, /*remove_flags=*/true);
+}
+
+bool StartCommand(int argc, char** argv, const std::string& command, const char* help,
+                  const std::set<std::string>& allowed, int* exit_code) {
+  if (WantsHelp(argc, argv, 2)) {
+    std::cout << help;
+    *exit_code = 0;
+    return false;
+  }
+  std::vector<std::string> args;
+  std::string error;
+  if (!CheckAndNormaliseFlags(argc, argv, 2, command, allowed, &args, &error)) {
+    PrintError(command, error);
+    *exit_code = kExitUsage;
+    return false;
+  }
+  ParseFlags(args);
+  return true;
+}
+
+namespace {
+bool IsNameChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
+}  // namespace
+
+std::string WithFlagNames(const std::string& message,
+                          const std::vector<std::pair<std::string, std::string>>& field_to_flag) {
+  std::string out;
+  size_t i = 0;
+  while (i < message.size()) {
+    bool replaced = false;
+    // A name starts here only if the previous character does not continue a name
+    // ("sphere.radius_m" is one name, "x.y" too, but "(radius_m" starts one).
+    const bool at_start = i == 0 || !(IsNameChar(message[i - 1]) || message[i - 1] == '.');
+    if (at_start) {
+      for (const auto& [field, flag] : field_to_flag) {
+        if (message.compare(i, field.size(), field) != 0) continue;
+        const size_t end = i + field.size();
+        const bool name_goes_on =
+            end < message.size() &&
+            (IsNameChar(message[end]) || message[end] == '[' ||
+             (message[end] == '.' && end + 1 < message.size() && IsNameChar(message[end + 1])));
+        if (name_goes_on) continue;
+        out += flag;
+        i = end;
+        replaced = true;
+        break;
+      }
+    }
+    if (!replaced) out += message[i++];
+  }
+  return out;
+}
+
+bool CheckCanWrite(const std::string& path, bool force, std::string* error) {
+  if (path.empty() || path == "-") return true;
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(path, ec);
+  if (std::filesystem::is_directory(status)) {
+    *error = path + ": is a directory (give a file name)";
+    return false;
+  }
+  if (std::filesystem::exists(status) && !force) {
+    *error = path + ": exists; not overwritten (add --force to replace it, or choose another name)";
+    return false;
   }
   return true;
 }

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fastcal::cli {
@@ -24,6 +25,28 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
 
 // True when argv has -h, --help or -help.
 bool WantsHelp(int argc, char** argv, int first);
+
+// Parses already-checked flags (see CheckAndNormaliseFlags) with gflags.
+void ParseFlags(const std::vector<std::string>& args);
+
+// The start of every subcommand `fastcal <command> ...` (argv[1] is the command): prints
+// `help` to stdout when asked (-h, --help), else checks the flags against `allowed`
+// (names with dashes) and parses them into the FLAGS_ variables. Returns true when the
+// command should go on; otherwise *exit_code is 0 (help printed) or kExitUsage (the error
+// already printed on stderr).
+bool StartCommand(int argc, char** argv, const std::string& command, const char* help,
+                  const std::set<std::string>& allowed, int* exit_code);
+
+// `message` (from the library, which names its option fields) with each field name in
+// `field_to_flag` replaced by the flag that sets it, e.g. {"radius_m", "--radius"}. A name
+// is replaced only where it stands as a whole name (not inside a longer one such as
+// "sphere.radius_m").
+std::string WithFlagNames(const std::string& message,
+                          const std::vector<std::pair<std::string, std::string>>& field_to_flag);
+
+// Refuses to replace an existing `path` unless `force`: false with a message naming the
+// file and --force. A directory is refused even with `force`. "" and "-" (stdout) pass.
+bool CheckCanWrite(const std::string& path, bool force, std::string* error);
 
 // Parses "x,y,z" (three finite numbers) for flag `name`.
 bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vector3d* v,

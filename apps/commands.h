@@ -7,6 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/pose.h"
+
 namespace fastcal::cli {
 
 int RunSolve(int argc, char** argv);
@@ -20,8 +22,14 @@ bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d
                                   std::vector<Eigen::Vector3d>* positions, bool* known,
                                   std::string* error);
 
-// Parses already-checked flags (see CheckAndNormaliseFlags) with gflags.
-void ParseFlags(const std::vector<std::string>& args);
+// A trajectory generator's message (trajectory.h names its parameters) with the flag
+// names instead.
+std::string WithTrajectoryFlagNames(const std::string& message);
+
+// PosesWithAttitudeLaw, with its message in terms of the flags (--focal-centre, node i).
+bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
+                                const FocalAttitudeLaw& law, std::vector<Pose>* poses,
+                                std::string* error);
 
 }  // namespace fastcal::cli
 

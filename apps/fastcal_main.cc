@@ -11,14 +11,6 @@
 
 namespace fastcal::cli {
 
-void ParseFlags(const std::vector<std::string>& args) {
-  std::vector<char*> ptrs;
-  for (const std::string& a : args) ptrs.push_back(const_cast<char*>(a.c_str()));
-  int n = static_cast<int>(ptrs.size());
-  char** p = ptrs.data();
-  gflags::ParseCommandLineFlags(&n, &p, /*remove_flags=*/true);
-}
-
 namespace {
 const char kUsage[] = R"(fastcal: statics and calibration of the FAST cable-driven parallel robot.
 

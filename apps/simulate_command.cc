@@ -46,6 +46,7 @@ DECLARE_uint64(seed);
 DECLARE_double(radial_spread);
 DECLARE_string(poses);
 DECLARE_string(out);
+DECLARE_bool(force);
 
 DEFINE_string(truth, "", "simulate: truth model YAML; empty = nominal FAST.");
 DEFINE_string(mass_centre, "", "simulate: truth mass centre x,y,z in the cabin frame (m).");
@@ -75,12 +76,13 @@ const char kHelp[] =
     R"(fastcal simulate: synthetic telemetry of the FAST cable robot from a known truth model.
 
 Usage:
-  fastcal simulate --out=FILE.csv [--truth=MODEL.yaml] [trajectory] [errors] [options]
+  fastcal simulate --out=FILE.csv [--force] [--truth=MODEL.yaml] [trajectory] [errors]
 
 Writes FILE.csv (the dataset format calibrate and evaluate read, docs/data-format.md) and
 the truth model actually used beside it as FILE.truth.yaml (FILE.csv minus ".csv", plus
-".truth.yaml"), both with the command line in a header comment. Both are written to
-temporary files and renamed into place: on any failure neither is left.
+".truth.yaml"), both with the command line (without --force) in a header comment. Both
+are written to temporary files and renamed into place: on any failure neither is left.
+An existing FILE.csv or FILE.truth.yaml is refused (exit 2) unless --force.
 
 Per planned pose (position p, planned attitude a_plan as roll,pitch,yaw):
   actual attitude     a_act  = a_plan + N(0, attitude-control-deg)    per angle
@@ -132,7 +134,8 @@ source with its own generator, so changing one sigma leaves the others' numbers 
   --outlier-scale-pct=30     outlier half-width (%), in [0, 100)
 A noise draw that would make a reading <= 0 is redrawn (counted in the summary).
 
-Output: --out=FILE.csv (required), --interval-s=1 between samples. A summary on stderr:
+Output: --out=FILE.csv (required), --force to replace existing files, --interval-s=1
+between samples. A summary on stderr:
 samples, RMS of the noise added per cable (kN and %), outliers, pose-error RMS.
 
 Exit codes: 0 ok, 1 the truth model cannot hold a pose (the node is named), 2 bad input.
@@ -141,12 +144,13 @@ Examples (the bundled datasets):
   # the paper's measured circle, mass centre moved as the authors found it
   fastcal simulate --mass-centre=0.22,0.11,0.5 --nodes=360 --attitude-control-deg=0.2 \
     --attitude-noise-deg=0.02 --position-noise-m=0.01 --tension-noise-pct=3 --seed=1 \
-    --out=calibration_data/circle_paper.csv
+    --force --out=calibration_data/circle_paper.csv
   # many zenith angles: 600 random poses on the focal-sphere cap up to 40 deg, +-3 m
   fastcal simulate --trajectory=random --samples=600 --max-off-axis-deg=40 \
     --radial-spread=3 --attitude-law=focal --mass-centre=0.22,0.11,0.5 \
     --attitude-control-deg=0.2 --attitude-noise-deg=0.02 --position-noise-m=0.01 \
-    --tension-noise-pct=3 --seed=2 --out=calibration_data/workspace_multi_zenith.csv
+    --tension-noise-pct=3 --seed=2 --force \
+    --out=calibration_data/workspace_multi_zenith.csv
   # sensor gain errors and 2% outliers on a straight line
   fastcal simulate --trajectory=line --sensor-gain=1.02,0.98,1,1,1.01,0.99 \
     --outlier-fraction=0.02 --out=line.csv
@@ -159,7 +163,8 @@ const std::set<std::string> kFlags = {
     "max-off-axis-deg", "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "samples",
     "radial-spread", "poses", "attitude-law", "tilt-fraction", "focal-centre",
     "attitude-control-deg", "attitude-noise-deg", "position-noise-m", "tension-noise-pct",
-    "tension-noise-kn", "outlier-fraction", "outlier-scale-pct", "seed", "interval-s", "out"};
+    "tension-noise-kn", "outlier-fraction", "outlier-scale-pct", "seed", "interval-s", "out",
+    "force"};
 // clang-format on
 
 bool IsDefault(const char* flag) { return gflags::GetCommandLineFlagInfoOrDie(flag).is_default; }
@@ -199,7 +204,14 @@ bool LoadTruth(CableRobot* truth, std::string* error) {
   std::array<double, kNumCables> values{};
   if (!FLAGS_sensor_gain.empty()) {
     if (!ParseOneOrSix("sensor-gain", FLAGS_sensor_gain, &values, error)) return false;
-    for (int i = 0; i < kNumCables; ++i) truth->cables[i].sensor_gain = values[i];
+    for (int i = 0; i < kNumCables; ++i) {
+      if (!(values[i] > 0.0)) {
+        *error = "--sensor-gain: the gain of cable " + std::to_string(i + 1) +
+                 " must be > 0 (got " + FormatDouble(values[i]) + ")";
+        return false;
+      }
+      truth->cables[i].sensor_gain = values[i];
+    }
   }
   if (!FLAGS_sensor_bias_kn.empty()) {
     if (!ParseOneOrSix("sensor-bias-kn", FLAGS_sensor_bias_kn, &values, error)) return false;
@@ -231,7 +243,15 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   }
   std::string why;
   if (!options->IsValid(&why)) {
-    *error = "invalid error model: " + why;
+    *error = WithFlagNames(why, {{"attitude_control_sigma_deg", "--attitude-control-deg"},
+                                 {"attitude_measurement_sigma_deg", "--attitude-noise-deg"},
+                                 {"position_measurement_sigma_m", "--position-noise-m"},
+                                 {"tension_noise_percent", "--tension-noise-pct"},
+                                 {"tension_noise_kn", "--tension-noise-kn"},
+                                 {"outlier_fraction", "--outlier-fraction"},
+                                 {"outlier_scale_percent", "--outlier-scale-pct"},
+                                 {"density_mismatch_percent", "--density-mismatch-pct"},
+                                 {"sample_interval_s", "--interval-s"}});
     return false;
   }
   return true;
@@ -261,7 +281,7 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     if (FLAGS_attitude_law == "focal") {
       std::vector<Eigen::Vector3d> positions;
       for (const Pose& p : *poses) positions.push_back(p.position_m);
-      return PosesWithAttitudeLaw(positions, law, poses, error);
+      return PosesWithFocalLawFromFlags(positions, law, poses, error);
     }
     if (FLAGS_attitude_law == "none") {
       for (Pose& p : *poses) p.rotation.setIdentity();
@@ -297,16 +317,25 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     }
   }
   if (!ok) {
-    *error = "--trajectory=" + trajectory + ": " + *error;
+    *error = "--trajectory=" + trajectory + ": " + WithTrajectoryFlagNames(*error);
     return false;
   }
   return FLAGS_attitude_law == "none" ? PosesWithIdentityAttitude(positions, poses, error)
-                                      : PosesWithAttitudeLaw(positions, law, poses, error);
+                                      : PosesWithFocalLawFromFlags(positions, law, poses, error);
 }
 
+// The command line for the files' headers, without --force (it changes nothing in the
+// files, so a dataset regenerated with it is the same bit for bit).
 std::string CommandLine(int argc, char** argv) {
   std::string s = "fastcal";
-  for (int i = 1; i < argc; ++i) s += std::string(" ") + argv[i];
+  for (int i = 1; i < argc; ++i) {
+    std::string name = argv[i];
+    name = name.substr(0, name.find('='));
+    if (name == "--force" || name == "-force" || name == "--noforce" || name == "-noforce") {
+      continue;
+    }
+    s += std::string(" ") + argv[i];
+  }
   return s;
 }
 
@@ -378,20 +407,17 @@ std::string Summary(const SimulationSummary& s, const SimulationOptions& options
 }  // namespace
 
 int RunSimulate(int argc, char** argv) {
-  if (WantsHelp(argc, argv, 2)) {
-    std::cout << kHelp;
-    return 0;
-  }
-  std::vector<std::string> args;
-  std::string error;
-  if (!CheckAndNormaliseFlags(argc, argv, 2, kCommand, kFlags, &args, &error)) {
-    PrintError(kCommand, error);
-    return kExitUsage;
-  }
-  ParseFlags(args);
+  int exit_code = 0;
+  if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
 
   if (FLAGS_out.empty() || FLAGS_out == "-") {
     PrintError(kCommand, "give --out=FILE.csv (the truth model goes beside it)");
+    return kExitUsage;
+  }
+  std::string error;
+  if (!CheckCanWrite(FLAGS_out, FLAGS_force, &error) ||
+      !CheckCanWrite(TruthPathFor(FLAGS_out), FLAGS_force, &error)) {
+    PrintError(kCommand, error);
     return kExitUsage;
   }
   CableRobot truth;

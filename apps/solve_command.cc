@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <iostream>
+#include <regex>
 #include <sstream>
 
 #include "cli_util.h"
@@ -20,7 +21,9 @@ DEFINE_string(position, "", "Single pose: x,y,z of the cabin frame origin (m).")
 DEFINE_string(rpy, "", "Attitude roll,pitch,yaw (deg), R = Rz(yaw) Ry(pitch) Rx(roll).");
 DEFINE_string(quat, "", "Attitude as unit quaternion w,x,y,z.");
 DEFINE_string(rotvec, "", "Attitude as rotation vector x,y,z (rad).");
-DEFINE_string(attitude_law, "", "'focal': attitude from the focal law; 'none': R = I.");
+DEFINE_string(attitude_law, "",
+              "'focal': attitude from the focal law; 'none': R = I. Default: focal for "
+              "trajectories, R = I for one --position, the file's own for --poses.");
 DEFINE_double(tilt_fraction, 0.41, "Focal law: fraction of the off-axis angle.");
 DEFINE_string(focal_centre, "0,0,300", "Focal law and grids: focal-sphere centre x,y,z (m).");
 DEFINE_string(trajectory, "point", "point | line | arc | grid | random");
@@ -41,6 +44,7 @@ DEFINE_double(radial_spread, 0.0, "random: uniform offset along the sphere norma
 DEFINE_string(poses, "", "CSV of poses (x_m,y_m,z_m[,roll_deg,pitch_deg,yaw_deg|qw,qx,qy,qz]).");
 DEFINE_string(format, "csv", "csv | json");
 DEFINE_string(output, "", "Output file; empty or - = stdout. Written only on success.");
+DEFINE_bool(force, false, "Replace an existing output file (solve --output, simulate --out).");
 DEFINE_double(secant_low, 0.99, "AAS: low secant length as a fraction of the chord.");
 DEFINE_double(secant_high, 1.01, "AAS: high secant length as a fraction of the chord.");
 DEFINE_int32(refinement_steps, 1, "aas-refined: re-linearisation steps.");
@@ -63,14 +67,18 @@ Usage:
   fastcal solve --trajectory=line|arc|grid|random [trajectory flags] [options]
   fastcal solve --poses=FILE.csv [options]
 
-Attitude (one of; none means R = I, the neutral attitude):
+Attitude (at most one):
   --rpy=r,p,y            roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll)
   --quat=w,x,y,z         unit quaternion (normalised if within 1e-3 of unit)
   --rotvec=x,y,z         rotation vector in radians
   --attitude-law=focal   tilt z' toward the focal-sphere centre by --tilt-fraction (0.41)
-                         of the off-axis angle (--focal-centre=0,0,300); 'none' = R = I
-  For trajectories only --attitude-law applies; a --poses file brings its own attitudes
-  unless --attitude-law=focal overrides them.
+                         of the off-axis angle (--focal-centre=0,0,300)
+  --attitude-law=none    R = I, the neutral attitude
+  With no attitude flag: one --position has R = I; a --trajectory flies the focal law
+  (as the telescope does; --attitude-law=none gives R = I); a --poses file keeps its own
+  attitudes (R = I without attitude columns). --rpy, --quat and --rotvec are for one
+  --position only; --attitude-law=focal|none overrides a --poses file's attitudes.
+  The summary line on stderr says which attitude was used.
 
 Trajectories:
   line    --from=50,0,150 --to=-50,0,150 --nodes=101        (the paper's Table 4)
@@ -79,7 +87,9 @@ Trajectories:
   grid    focal-sphere cap: --max-off-axis-deg=40 --off-axis-step-deg=5
           --azimuth-step-deg=15 --focal-radius=160
   random  --samples=100 --seed=1 --max-off-axis-deg=40 --radial-spread=0
-  --poses=FILE.csv  x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz
+  --poses=FILE.csv  x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz,
+          time_s; a dataset's other columns (planned_*_deg, T<i>_kN, s0_<i>_m) are
+          ignored, so a calibration dataset works; any other column is an error
 
 Method (--method):
   aas          the paper's approximately analytical solution (secants at 0.99k, 1.01k)
@@ -90,10 +100,13 @@ Method (--method):
   --secant-low=0.99 --secant-high=1.01 --refinement-steps=1 --exact-tolerance=1e-12
   --warm-start (default true): each trajectory node starts from the previous solution
 
-Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model.
+Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model. solve
+reports the model's true cable tensions: a model's sensor_gain and sensor_bias_kN are
+not applied here (they are in evaluate and calibrate, which compare with readings).
 
 Output: CSV (default) or --format=json, to stdout or --output=FILE (written only when
-everything succeeded). CSV columns, units in the names:
+everything succeeded; an existing FILE is refused unless --force). CSV columns, units in
+the names:
   node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status,
   T1_kN..T6_kN            lower-end tensions (what the cabin-side sensors measure)
   T1_upper_kN..           upper-end (tower) tensions
@@ -102,7 +115,7 @@ everything succeeded). CSV columns, units in the names:
                           feels the opposite)
   force_residual_N,moment_residual_Nm   equilibrium residual of the returned forces
   compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact.
-A summary line with the time per pose goes to stderr.
+A summary line with the attitude used and the time per pose goes to stderr.
 
 A pose the cables cannot hold (a slack cable), a vertical cable or a solver failure is
 an error naming the node and cable (exit 1, no output) unless --keep-going, which writes
@@ -141,6 +154,7 @@ const std::set<std::string> kFlags = {"model",
                                       "poses",
                                       "format",
                                       "output",
+                                      "force",
                                       "secant-low",
                                       "secant-high",
                                       "refinement-steps",
@@ -148,7 +162,42 @@ const std::set<std::string> kFlags = {"model",
                                       "warm-start",
                                       "keep-going"};
 
+// The trajectory generators' parameter names (trajectory.h) and the flags that set them.
+const std::vector<std::pair<std::string, std::string>> kTrajectoryFlagNames = {
+    {"nodes", "--nodes"},
+    {"from_m", "--from"},
+    {"to_m", "--to"},
+    {"centre_m", "--centre"},
+    {"radius_m", "--radius"},
+    {"start_deg", "--start-deg"},
+    {"end_deg", "--end-deg"},
+    {"max_off_axis_deg", "--max-off-axis-deg"},
+    {"off_axis_step_deg", "--off-axis-step-deg"},
+    {"azimuth_step_deg", "--azimuth-step-deg"},
+    {"focal_centre_m", "--focal-centre"},
+    {"sphere.focal_centre_m", "--focal-centre"},
+    {"focal_radius_m", "--focal-radius"},
+    {"sphere.focal_radius_m", "--focal-radius"},
+    {"samples", "--samples"},
+    {"radial_spread_m", "--radial-spread"}};
+
 }  // namespace
+
+std::string WithTrajectoryFlagNames(const std::string& message) {
+  return WithFlagNames(message, kTrajectoryFlagNames);
+}
+
+bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
+                                const FocalAttitudeLaw& law, std::vector<Pose>* poses,
+                                std::string* error) {
+  if (PosesWithAttitudeLaw(positions, law, poses, error)) return true;
+  *error = "focal attitude law: " +
+           std::regex_replace(WithFlagNames(*error, {{"law.focal_centre_m", "--focal-centre"},
+                                                     {"law.tilt_fraction", "--tilt-fraction"}}),
+                              std::regex(R"(positions\[([0-9]+)\])"), "node $1") +
+           "; --attitude-law=none gives R = I";
+  return false;
+}
 
 bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
                                   std::vector<Eigen::Vector3d>* positions, bool* known,
@@ -194,7 +243,16 @@ bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d
 
 namespace {
 
-bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
+// "focal law (tilt fraction 0.41, focal centre 0,0,300 m)", for the summary line.
+std::string FocalLawDescription(const FocalAttitudeLaw& law) {
+  const Eigen::Vector3d& c = law.focal_centre_m;
+  return "focal law (tilt fraction " + FormatDouble(law.tilt_fraction) + ", focal centre " +
+         FormatDouble(c[0]) + "," + FormatDouble(c[1]) + "," + FormatDouble(c[2]) + " m)";
+}
+
+// The poses to solve from the pose, trajectory and attitude flags; *attitude says in words
+// which attitude they have (for the summary line).
+bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* error) {
   FocalAttitudeLaw law;
   law.tilt_fraction = FLAGS_tilt_fraction;
   if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
@@ -214,6 +272,8 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     return false;
   }
   const bool focal = FLAGS_attitude_law == "focal";
+  const bool none = FLAGS_attitude_law == "none";
+  const std::string identity = "R = I (--attitude-law=none)";
 
   std::vector<Eigen::Vector3d> positions;
   if (!FLAGS_poses.empty()) {
@@ -222,14 +282,21 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
       return false;
     }
     if (!FLAGS_rpy.empty() || !FLAGS_quat.empty() || !FLAGS_rotvec.empty()) {
-      *error = "--poses brings its own attitudes; only --attitude-law=focal may override them";
+      *error = "--poses brings its own attitudes; only --attitude-law=focal|none may override them";
       return false;
     }
     if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
     if (focal) {
-      for (Pose& p : *poses) p.rotation = FocalAttitude(p.position_m, law);
-    } else if (FLAGS_attitude_law == "none") {
+      positions.clear();
+      for (const Pose& p : *poses) positions.push_back(p.position_m);
+      *attitude = FocalLawDescription(law);
+      return PosesWithFocalLawFromFlags(positions, law, poses, error);
+    }
+    if (none) {
       for (Pose& p : *poses) p.rotation.setIdentity();
+      *attitude = identity;
+    } else {
+      *attitude = "as in " + FLAGS_poses + " (R = I if it has no attitude columns)";
     }
     return true;
   }
@@ -243,10 +310,12 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     if (!ParseVector3("position", FLAGS_position, &position, error)) return false;
     Pose pose;
     pose.position_m = position;
+    *attitude = "R = I (no attitude flag)";
     if (!FLAGS_rpy.empty()) {
       Eigen::Vector3d rpy;
       if (!ParseVector3("rpy", FLAGS_rpy, &rpy, error)) return false;
       pose.rotation = RotationFromRpyDeg(rpy[0], rpy[1], rpy[2]);
+      *attitude = "--rpy=" + FLAGS_rpy + " deg";
     } else if (!FLAGS_quat.empty()) {
       Eigen::Vector4d q;
       if (!ParseVector4("quat", FLAGS_quat, &q, error)) return false;
@@ -255,12 +324,18 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
         *error = "--quat: " + why;
         return false;
       }
+      *attitude = "--quat=" + FLAGS_quat;
     } else if (!FLAGS_rotvec.empty()) {
       Eigen::Vector3d v;
       if (!ParseVector3("rotvec", FLAGS_rotvec, &v, error)) return false;
       pose.rotation = RotationFromRotationVector(v);
+      *attitude = "--rotvec=" + FLAGS_rotvec + " rad";
     } else if (focal) {
-      pose.rotation = FocalAttitude(position, law);
+      if (!PosesWithFocalLawFromFlags({position}, law, poses, error)) return false;
+      *attitude = FocalLawDescription(law);
+      return true;
+    } else if (none) {
+      *attitude = identity;
     }
     poses->assign(1, pose);
     return true;
@@ -271,7 +346,9 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     return false;
   }
   if (!FLAGS_rpy.empty() || !FLAGS_quat.empty() || !FLAGS_rotvec.empty()) {
-    *error = "a trajectory takes its attitude from --attitude-law=focal|none";
+    *error =
+        "--rpy, --quat and --rotvec are for one --position; a trajectory flies the focal "
+        "attitude law (the default) or, with --attitude-law=none, R = I";
     return false;
   }
   bool known = false;
@@ -283,11 +360,17 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     return false;
   }
   if (!ok) {
-    *error = "--trajectory=" + FLAGS_trajectory + ": " + *error;
+    *error = "--trajectory=" + FLAGS_trajectory + ": " + WithTrajectoryFlagNames(*error);
     return false;
   }
-  return focal ? PosesWithAttitudeLaw(positions, law, poses, error)
-               : PosesWithIdentityAttitude(positions, poses, error);
+  // Trajectories fly the focal law unless told otherwise: that is how the telescope
+  // moves, and what the paper's Tables 4 and 5 use.
+  if (none) {
+    *attitude = identity;
+    return PosesWithIdentityAttitude(positions, poses, error);
+  }
+  *attitude = FocalLawDescription(law) + (focal ? "" : ", the default for trajectories");
+  return PosesWithFocalLawFromFlags(positions, law, poses, error);
 }
 
 bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* error) {
@@ -301,7 +384,12 @@ bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* er
   options->refinement_steps = FLAGS_refinement_steps;
   options->exact_relative_tolerance = FLAGS_exact_tolerance;
   options->warm_start = FLAGS_warm_start;
-  if (!options->IsValid(error)) return false;
+  if (!options->IsValid(error)) {
+    *error = WithFlagNames(*error, {{"secant fractions", "--secant-low and --secant-high"},
+                                    {"refinement_steps", "--refinement-steps"},
+                                    {"exact_relative_tolerance", "--exact-tolerance"}});
+    return false;
+  }
   if (FLAGS_format != "csv" && FLAGS_format != "json") {
     *error = "--format must be csv or json, got '" + FLAGS_format + "'";
     return false;
@@ -476,18 +564,14 @@ std::string TimingLine(const char* name, const Run& run, size_t n, bool warm) {
 }  // namespace
 
 int RunSolve(int argc, char** argv) {
-  if (WantsHelp(argc, argv, 2)) {
-    std::cout << kHelp;
-    return 0;
-  }
-  std::vector<std::string> args;
+  int exit_code = 0;
+  if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+
   std::string error;
-  if (!CheckAndNormaliseFlags(argc, argv, 2, kCommand, kFlags, &args, &error)) {
+  if (!CheckCanWrite(FLAGS_output, FLAGS_force, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  ParseFlags(args);
-
   CableRobot robot = CableRobot::NominalFast();
   if (!FLAGS_model.empty() && !LoadCableRobot(FLAGS_model, &robot, &error)) {
     PrintError(kCommand, error);
@@ -496,7 +580,8 @@ int RunSolve(int argc, char** argv) {
   StaticsOptions options;
   bool compare = false;
   std::vector<Pose> poses;
-  if (!SetOptionsFromFlags(&options, &compare, &error) || !BuildPoses(&poses, &error)) {
+  std::string attitude;
+  if (!SetOptionsFromFlags(&options, &compare, &error) || !BuildPoses(&poses, &attitude, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -507,7 +592,8 @@ int RunSolve(int argc, char** argv) {
 
   std::string content;
   std::ostringstream summary;
-  summary << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose, " : " poses, ");
+  summary << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose" : " poses")
+          << ", attitude " << attitude << "; ";
   if (!compare) {
     Run run;
     if (!SolveAll(robot, poses, options, &run, &error)) {

@@ -11,6 +11,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace {
 
@@ -199,6 +200,174 @@ TEST_F(CliTest, CalibrateBadInputLeavesNoOutput) {
   for (const auto& e : fs::directory_iterator(dir_))
     entries += e.path().filename().string()[0] == '.';
   EXPECT_EQ(entries, 0);
+}
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Generated trajectories fly the focal attitude law unless told otherwise; one --position
+// without an attitude flag keeps R = I. The summary line says which.
+TEST_F(CliTest, SolveTrajectoryDefaultsToFocalLawSinglePoseToIdentity) {
+  CommandResult r = Fastcal("solve --trajectory=grid --output=" + Path("grid.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;  // with R = I a grid node has a slack cable
+  EXPECT_NE(r.output.find("attitude focal law (tilt fraction 0.41"), std::string::npos) << r.output;
+  for (const char* kind : {"line", "arc", "grid", "random"}) {
+    const std::string plain = Path(std::string(kind) + "_default.csv");
+    const std::string focal = Path(std::string(kind) + "_focal.csv");
+    r = Fastcal(std::string("solve --trajectory=") + kind + " --output=" + plain);
+    ASSERT_EQ(r.code, 0) << kind << ": " << r.output;
+    r = Fastcal(std::string("solve --trajectory=") + kind +
+                " --attitude-law=focal --output=" + focal);
+    ASSERT_EQ(r.code, 0) << kind << ": " << r.output;
+    EXPECT_EQ(ReadFile(plain), ReadFile(focal)) << kind;
+  }
+  // The explicit way to R = I on a trajectory.
+  r = Fastcal("solve --trajectory=line --attitude-law=none --output=" + Path("none.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("attitude R = I (--attitude-law=none)"), std::string::npos) << r.output;
+  EXPECT_NE(ReadFile(Path("none.csv")).find("\n0,50,0,150,0,0,0,ok,"), std::string::npos);
+  EXPECT_EQ(ReadFile(Path("line_focal.csv")).find("\n0,50,0,150,0,0,0,ok,"), std::string::npos);
+  // --rpy is for one pose; the message says how to get R = I on a trajectory.
+  r = Fastcal("solve --trajectory=line --rpy=0,0,0");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--attitude-law=none"), std::string::npos) << r.output;
+  // One pose: R = I without an attitude flag, the focal law when asked.
+  r = Fastcal("solve --position=42.65,33.73,149.52");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("\n0,42.65,33.73,149.52,0,0,0,ok,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("attitude R = I (no attitude flag)"), std::string::npos) << r.output;
+  r = Fastcal("solve --position=42.65,33.73,149.52 --attitude-law=focal");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("\n0,42.65,33.73,149.52,0,0,0,ok,"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("attitude focal law"), std::string::npos) << r.output;
+  r = Fastcal("solve --help");
+  EXPECT_NE(r.output.find("a --trajectory flies the focal law"), std::string::npos);
+  EXPECT_NE(r.output.find("sensor_gain and sensor_bias_kN are\nnot applied here"),
+            std::string::npos);
+}
+
+// Existing output files are not replaced without --force (simulate --out and its truth
+// model, solve --output).
+TEST_F(CliTest, ExistingOutputFilesNeedForce) {
+  const std::string data = Path("line.csv");
+  const std::string truth = Path("line.truth.yaml");
+  const std::string simulate = "simulate --trajectory=line --nodes=5 --out=" + data;
+  CommandResult r = Fastcal(simulate + " --seed=1");
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string first = ReadFile(data);
+  r = Fastcal(simulate + " --seed=2");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find(data + ": exists"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadFile(data), first);
+  r = Fastcal(simulate + " --seed=2 --force");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(ReadFile(data), first);
+  // The truth model alone is enough to refuse: both files are written together.
+  fs::remove(data);
+  r = Fastcal(simulate);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find(truth + ": exists"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(data));
+  // A directory is never replaced.
+  r = Fastcal("simulate --trajectory=line --nodes=5 --force --out=" + dir_.string());
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("is a directory"), std::string::npos) << r.output;
+
+  const std::string out = Path("k1.csv");
+  r = Fastcal("solve --position=0,0,140 --output=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  Write("k1.csv", "keep me\n");
+  r = Fastcal("solve --position=0,0,140 --output=" + out);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find(out + ": exists"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadFile(out), "keep me\n");
+  r = Fastcal("solve --position=0,0,140 --force --output=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(ReadFile(out).find("T1_kN"), std::string::npos);
+}
+
+TEST_F(CliTest, SolvePosesFileWithUnknownColumnIsRefused) {
+  Write("poses.csv", "x_m,y_m,z_m,roll,pitch,yaw\n0,0,150,1,2,3\n");
+  CommandResult r = Fastcal("solve --poses=" + Path("poses.csv"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find(Path("poses.csv") + ":1: column 4 'roll': unknown column name"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("roll_deg"), std::string::npos) << r.output;
+  // A calibration dataset is still a pose file.
+  r = Fastcal("solve --poses=" + Source() + "/calibration_data/circle_paper.csv --method=aas");
+  EXPECT_EQ(r.code, 0) << r.output.substr(0, 2000);
+}
+
+// Bad numeric flag values are reported with the flag, not the library's field name.
+TEST_F(CliTest, BadValuesNameTheFlagNotTheOptionField) {
+  struct Case {
+    std::string args, flag, field;
+  };
+  const std::string sim = "simulate --out=" + Path("never.csv") + " ";
+  const std::vector<Case> cases = {
+      {"solve --position=0,0,140 --exact-tolerance=0", "--exact-tolerance",
+       "exact_relative_tolerance"},
+      {"solve --position=0,0,140 --refinement-steps=0", "--refinement-steps", "refinement_steps"},
+      {"solve --position=0,0,140 --secant-low=2", "--secant-low", "secant fractions"},
+      {"solve --trajectory=line --nodes=1", "--nodes", ": nodes must"},
+      {"solve --trajectory=arc --radius=0", "--radius", "radius_m"},
+      {"solve --trajectory=arc --end-deg=0", "--end-deg", "end_deg"},
+      {"solve --trajectory=grid --max-off-axis-deg=95", "--max-off-axis-deg", "max_off_axis_deg"},
+      {"solve --trajectory=grid --off-axis-step-deg=0", "--off-axis-step-deg", "off_axis_step_deg"},
+      {"solve --trajectory=grid --azimuth-step-deg=0", "--azimuth-step-deg", "azimuth_step_deg"},
+      {"solve --trajectory=grid --focal-radius=0", "--focal-radius", "focal_radius_m"},
+      {"solve --trajectory=random --samples=0", "--samples", ": samples must"},
+      {"solve --trajectory=random --radial-spread=500", "--radial-spread", "radial_spread_m"},
+      {"solve --trajectory=line --from=0,0,400", "--focal-centre", "law.focal_centre_m"},
+      {sim + "--attitude-control-deg=-1", "--attitude-control-deg", "attitude_control_sigma_deg"},
+      {sim + "--attitude-noise-deg=-1", "--attitude-noise-deg", "attitude_measurement_sigma_deg"},
+      {sim + "--position-noise-m=-1", "--position-noise-m", "position_measurement_sigma_m"},
+      {sim + "--tension-noise-pct=-1", "--tension-noise-pct", "tension_noise_percent"},
+      {sim + "--tension-noise-kn=-1", "--tension-noise-kn", "tension_noise_kn"},
+      {sim + "--outlier-fraction=2", "--outlier-fraction", "outlier_fraction"},
+      {sim + "--outlier-scale-pct=100", "--outlier-scale-pct", "outlier_scale_percent"},
+      {sim + "--density-mismatch-pct=-1", "--density-mismatch-pct", "density_mismatch_percent"},
+      {sim + "--interval-s=0", "--interval-s", "sample_interval_s"},
+      {sim + "--sensor-gain=0", "--sensor-gain", "cables[0]"},
+      {sim + "--nodes=1", "--nodes", ": nodes must"},
+      {sim + "--trajectory=random --radial-spread=-1", "--radial-spread", "radial_spread_m"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = Fastcal(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << ": " << r.output;
+    EXPECT_NE(r.output.find(c.flag), std::string::npos) << c.args << ": " << r.output;
+    EXPECT_EQ(r.output.find(c.field), std::string::npos) << c.args << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(Path("never.csv")));
+}
+
+// Every command starts the same way: --help, then the flag allow-list.
+TEST_F(CliTest, EveryCommandHasHelpAndRejectsUnknownFlags) {
+  for (const char* command : {"solve", "calibrate", "evaluate", "simulate"}) {
+    CommandResult r = Fastcal(std::string(command) + " --help");
+    EXPECT_EQ(r.code, 0) << command;
+    EXPECT_NE(r.output.find(std::string("fastcal ") + command + ":"), std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("Usage:"), std::string::npos) << r.output;
+    r = Fastcal(std::string(command) + " --bogus=1 -h");
+    EXPECT_EQ(r.code, 0) << command;  // help wins
+    r = Fastcal(std::string(command) + " --bogus=1");
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_NE(r.output.find(std::string("fastcal ") + command +
+                            ": unknown flag --bogus (see fastcal " + command + " --help)"),
+              std::string::npos)
+        << r.output;
+    r = Fastcal(std::string(command) + " stray");
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_NE(r.output.find("unexpected argument 'stray'"), std::string::npos) << r.output;
+  }
 }
 
 }  // namespace

@@ -408,18 +408,18 @@ TEST(ReadPosesCsv, RollPitchYawAndTimes) {
   EXPECT_LT((poses[1].rotation - RotationFromRpyDeg(0.0, -3.5, -10.0)).norm(), kRotationTolerance);
 }
 
-TEST(ReadPosesCsv, QuaternionWithExtraColumnsAndComments) {
+TEST(ReadPosesCsv, QuaternionWithDatasetColumnsAndComments) {
   const double c = std::cos(15.0 * kDegToRad), s = std::sin(15.0 * kDegToRad);
   const std::string row1 =
-      "a," + std::to_string(c) + ",10,0,20,0,150," + std::to_string(s) + ",159.17\r\n";
+      "2," + std::to_string(c) + ",10,0,20,0,150," + std::to_string(s) + ",159.17\r\n";
   const std::string path = WriteTempFile("trajectory_test_quaternion.csv",
                                          "# recorded on the measured circle\r\n"
                                          "\r\n"
-                                         "label,qw,x_m,qx,y_m,qy,z_m,qz,tension_1_kn\r\n"
+                                         "planned_yaw_deg,qw,x_m,qx,y_m,qy,z_m,qz,T1_kN\r\n"
                                          "   # a comment between rows\r\n" +
                                              row1 +
                                              "\r\n"
-                                             "b,1,0,0,0,0,140,0,not-a-number-but-ignored\r\n");
+                                             "b,1,0,0,0,0,140,0,not-a-number-but-unused\r\n");
   std::vector<Pose> poses;
   std::vector<double> times = {42.0};
   std::string error;
@@ -484,10 +484,57 @@ TEST(ReadPosesCsv, BadFilesReportFileLineAndColumn) {
                  ":2: columns 'qw,qx,qy,qz': quaternion (w,x,y,z) must be unit");
   ExpectCsvError("trajectory_test_duplicate.csv", "x_m,y_m,z_m,x_m\n1,2,3,4\n",
                  ":1: duplicate column 'x_m'");
+  ExpectCsvError("trajectory_test_duplicate_unused.csv", "x_m,y_m,z_m,T1_kN,T1_kN\n1,2,3,4,5\n",
+                 ":1: duplicate column 'T1_kN'");
+  ExpectCsvError("trajectory_test_empty_name.csv", "x_m,y_m,z_m,\n1,2,3,\n",
+                 ":1: column 4: empty column name");
   ExpectCsvError("trajectory_test_empty.csv", "", ": no header line");
   ExpectCsvError("trajectory_test_comments_only.csv", "# nothing\n\n", ": no header line");
   ExpectCsvError("trajectory_test_header_only.csv", "x_m,y_m,z_m\n# no rows\n", ": no data rows");
   ExpectCsvError("trajectory_test_does_not_exist_dir/poses.csv", "", ": cannot open file");
+}
+
+// A misspelt attitude column must not silently give R = I: every column is either used,
+// one of a dataset's (not used), or an error naming the file, line, column and name.
+TEST(ReadPosesCsv, UnknownColumnIsAnErrorListingTheAcceptedNames) {
+  const std::string path =
+      WriteTempFile("trajectory_test_unknown.csv", "x_m,y_m,z_m,roll,pitch,yaw\n0,0,150,1,2,3\n");
+  std::vector<Pose> poses;
+  std::string error;
+  EXPECT_FALSE(ReadPosesCsv(path, &poses, nullptr, &error));
+  EXPECT_TRUE(poses.empty());
+  EXPECT_NE(error.find(path + ":1: column 4 'roll': unknown column name"), std::string::npos)
+      << error;
+  for (const char* accepted : {"x_m", "roll_deg", "pitch_deg", "yaw_deg", "qw", "qz", "time_s",
+                               "planned_roll_deg", "T1_kN", "s0_1_m"}) {
+    EXPECT_NE(error.find(accepted), std::string::npos) << accepted << ": " << error;
+  }
+  // After comment lines the header's own line is named.
+  ExpectCsvError("trajectory_test_unknown_after_comment.csv",
+                 "# exported\nx_m,y_m,z_m,Roll_deg\n0,0,150,1\n",
+                 ":2: column 4 'Roll_deg': unknown column name (accepted: x_m, y_m, z_m, ");
+}
+
+// A whole dataset (every column it may have) reads as a pose file.
+TEST(ReadPosesCsv, DatasetColumnsAreAccepted) {
+  std::string header =
+      "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,planned_roll_deg,"
+      "planned_pitch_deg,planned_yaw_deg";
+  std::string row = "0,1,2,150,0,0,10,0,0,9";
+  for (int i = 1; i <= 6; ++i) {
+    header += ",T" + std::to_string(i) + "_kN";
+    row += ",150";
+  }
+  for (int i = 1; i <= 6; ++i) {
+    header += ",s0_" + std::to_string(i) + "_m";
+    row += ",250";
+  }
+  const std::string path = WriteTempFile("trajectory_test_dataset.csv", header + "\n" + row + "\n");
+  std::vector<Pose> poses;
+  std::string error;
+  ASSERT_TRUE(ReadPosesCsv(path, &poses, nullptr, &error)) << error;
+  ASSERT_EQ(poses.size(), 1u);
+  EXPECT_LT((poses[0].rotation - RotationFromRpyDeg(0.0, 0.0, 10.0)).norm(), kRotationTolerance);
 }
 
 }  // namespace

@@ -7,8 +7,11 @@
 #include <cstdlib>
 #include <fstream>
 #include <random>
+#include <set>
 #include <sstream>
 #include <string_view>
+
+#include "fastcal/cable_robot.h"
 
 namespace fastcal {
 namespace {
@@ -119,6 +122,25 @@ bool ParseNumber(std::string_view field, double* value, std::string* why) {
 enum Column { kX, kY, kZ, kRoll, kPitch, kYaw, kQw, kQx, kQy, kQz, kTime, kNumColumns };
 constexpr std::array<const char*, kNumColumns> kColumnNames = {
     "x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg", "qw", "qx", "qy", "qz", "time_s"};
+
+// The other columns of a measurement dataset (docs/data-format.md): accepted in a pose
+// file and not used, so that a dataset doubles as a pose file.
+std::vector<std::string> IgnoredDatasetColumns() {
+  std::vector<std::string> names = {"planned_roll_deg", "planned_pitch_deg", "planned_yaw_deg"};
+  for (int i = 1; i <= kNumCables; ++i) names.push_back("T" + std::to_string(i) + "_kN");
+  for (int i = 1; i <= kNumCables; ++i) names.push_back("s0_" + std::to_string(i) + "_m");
+  return names;
+}
+
+std::string AcceptedColumns() {
+  std::string list;
+  for (const char* name : kColumnNames) list += (list.empty() ? "" : ", ") + std::string(name);
+  const std::string n = std::to_string(kNumCables);
+  return list +
+         "; and, not used, the dataset columns planned_roll_deg, planned_pitch_deg, "
+         "planned_yaw_deg, T1_kN..T" +
+         n + "_kN, s0_1_m..s0_" + n + "_m";
+}
 
 bool IsSkipped(std::string_view line) {
   const std::string_view trimmed = Trim(line);
@@ -305,13 +327,30 @@ bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector
     if (!has_header) {
       has_header = true;
       num_fields = fields.size();
+      const std::vector<std::string> ignored = IgnoredDatasetColumns();
+      std::set<std::string_view> seen_ignored;
       for (size_t i = 0; i < fields.size(); ++i) {
+        const std::string column = "column " + std::to_string(i + 1);
+        if (fields[i].empty()) return Fail(error, where + column + ": empty column name");
+        bool known = false;
         for (int c = 0; c < kNumColumns; ++c) {
           if (fields[i] != kColumnNames[c]) continue;
           if (index[c] >= 0) {
             return Fail(error, where + "duplicate column '" + kColumnNames[c] + "'");
           }
           index[c] = static_cast<int>(i);
+          known = true;
+        }
+        for (const std::string& name : ignored) {
+          if (fields[i] != name) continue;
+          if (!seen_ignored.insert(fields[i]).second) {
+            return Fail(error, where + "duplicate column '" + name + "'");
+          }
+          known = true;
+        }
+        if (!known) {
+          return Fail(error, where + column + " '" + std::string(fields[i]) +
+                                 "': unknown column name (accepted: " + AcceptedColumns() + ")");
         }
       }
       has_rpy = index[kRoll] >= 0 || index[kPitch] >= 0 || index[kYaw] >= 0;

@@ -118,11 +118,16 @@ bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
 //   roll_deg, pitch_deg, yaw_deg   attitude, R = RotationFromRpyDeg(roll, pitch, yaw)
 //   qw, qx, qy, qz              or attitude as a unit quaternion (RotationFromQuaternion)
 //   time_s                      optional time stamp
-// At most one attitude kind, complete; none means R = I. Other columns are ignored, so a
-// calibration dataset CSV also serves as a pose file. Every data row must have as many
-// fields as the header; every used field must be a finite number (std::strtod, so the
-// decimal point of the current C locale, '.' by default; the whole field consumed). There must be
-// at least one data row.
+// At most one attitude kind, complete; none means R = I. The other columns of a
+// measurement dataset (planned_roll_deg, planned_pitch_deg, planned_yaw_deg, T1_kN..T6_kN,
+// s0_1_m..s0_6_m; dataset.h) are accepted and not used, so a dataset CSV also serves as a
+// pose file. Any other column name (a misspelt "roll" for "roll_deg" would otherwise turn
+// the attitude silently into R = I), or an empty one, is an error naming the 1-based
+// column number and listing the accepted names:
+//   "<path>:<line>: column <n> '<name>': unknown column name (accepted: x_m, ...)".
+// Every data row must have as many fields as the header; every used field must be a finite
+// number (std::strtod, so the decimal point of the current C locale, '.' by default; the
+// whole field consumed). There must be at least one data row.
 //
 // Errors read "<path>:<line>: column '<name>': <what>" (line 1-based in the file).
 // `times_s` may be null; otherwise it receives one time per pose, or is left empty when
