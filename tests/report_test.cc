@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/svg_plot.h"
+
 namespace fastcal {
 namespace {
 
@@ -342,6 +344,17 @@ TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
   EXPECT_TRUE(Contains(md, "n/a"));
 }
 
+TEST_F(ReportTest, ChiSquareBandSaysHowItIsComputed) {
+  // nu = 6 * 16 + 1 - 2 = 95 residuals minus free parameters; 3 sqrt(2 / 95) = 0.435.
+  const std::string md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md,
+                       "(expected 1 ± 3·√(2/ν) = 1 ± 0.435: within 3 standard deviations of "
+                       "χ²/ν for a correct noise model, ν = 95 degrees of freedom)"));
+  result_.num_residuals = 6 * 16 + 2;  // nu = 96 -> 0.433
+  result_.reduced_chi_square = 1.5;
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "1 ± 3·√(2/ν) = 1 ± 0.433:"));
+}
+
 TEST_F(ReportTest, ChiSquareInterpretation) {
   result_.reduced_chi_square = 9.0;
   EXPECT_TRUE(Contains(ReportMarkdown(inputs_),
@@ -384,6 +397,98 @@ TEST_F(ReportTest, HtmlIsSelfContainedWithPlotsAndNoNonFiniteNumbers) {
   EXPECT_FALSE(Contains(stripped, "src="));
   EXPECT_FALSE(Contains(stripped, "href="));
   EXPECT_FALSE(Contains(stripped, "url("));
+}
+
+// The <svg> element of `html` with the title `title`, or "".
+std::string SvgTitled(const std::string& html, const std::string& title) {
+  const size_t at = html.find("<title>" + title + "</title>");
+  if (at == std::string::npos) return "";
+  const size_t begin = html.rfind("<svg", at);
+  return html.substr(begin, html.find("</svg>", at) + 6 - begin);
+}
+
+TEST_F(ReportTest, TensionPlotsDrawMeasuredDotsUnderTheModelLines) {
+  const std::string svg = SvgTitled(ReportHtml(inputs_), "Cable 1: tension");
+  ASSERT_FALSE(svg.empty());
+  // Colours: a variant's index in the RMS table; measured (fitted) black, held out sky blue.
+  const std::string before = "stroke=\"" + PlotSeriesColour(1) + "\"";
+  const std::string after = "stroke=\"" + PlotSeriesColour(2) + "\"";
+  const std::string held = "stroke=\"" + PlotSeriesColour(5) + "\"";
+  const std::string measured = "stroke=\"" + PlotSeriesColour(6) + "\"";
+  ASSERT_NE(svg.find(measured), std::string::npos);
+  ASSERT_NE(svg.find(held), std::string::npos);
+  ASSERT_NE(svg.find(before), std::string::npos);
+  ASSERT_NE(svg.find(after), std::string::npos);
+  // Both measured series come before (under) both model lines.
+  EXPECT_LT(svg.find(measured), svg.find(before));
+  EXPECT_LT(svg.find(measured), svg.find(after));
+  EXPECT_LT(svg.find(held), svg.find(before));
+  EXPECT_LT(svg.find(held), svg.find(after));
+  // Small translucent dots; the lines opaque; the legend names all four series.
+  EXPECT_TRUE(Contains(svg, measured + " stroke-width=\"3.6\" stroke-linecap=\"round\" "
+                                       "stroke-opacity=\"0.45\""));
+  EXPECT_TRUE(Contains(svg, held + " stroke-width=\"3.6\" stroke-linecap=\"round\" "
+                                   "stroke-opacity=\"0.7\""));
+  EXPECT_EQ(Count(svg, "stroke-opacity"), 2);
+  for (const char* name :
+       {">nominal model, measured attitude<", ">calibrated model, measured attitude<",
+        ">measured (fitted)<", ">measured (held out)<"}) {
+    EXPECT_TRUE(Contains(svg, name));
+  }
+  EXPECT_TRUE(Contains(ReportHtml(inputs_),
+                       "Measured lower-end tension (translucent dots, drawn "
+                       "underneath"));
+  // 20 samples: nothing is thinned, and no caption says so.
+  EXPECT_FALSE(Contains(ReportHtml(inputs_), "Thinned"));
+}
+
+// A long dataset: the plots are thinned, with outliers kept, and the report stays small.
+TEST_F(ReportTest, LongDatasetsAreThinnedInThePlotsOnly) {
+  constexpr int kLong = 60000;
+  constexpr size_t kMaxHtmlBytes = 1500000;  // 1.5 MB; 31 MB before thinning.
+  Sample s = data_.samples.back();
+  data_.samples.clear();
+  for (int n = 0; n < kLong; ++n) {
+    s.line = n + 2;
+    s.time_s = 0.1 * n;
+    for (int i = 0; i < kNumCables; ++i) {
+      s.tension_n[i] = 1e3 * (180.0 + 40.0 * std::sin(1e-4 * n + i) + 3.0 * std::sin(7.3 * n));
+    }
+    data_.samples.push_back(s);
+  }
+  data_.samples[31337].tension_n[0] = 620e3;  // An outlier, far above the rest (< 225 kN).
+  held_out_ = HoldoutMask(kLong, 0.2, 1);
+  result_.held_out = held_out_;
+  result_.num_fit_samples =
+      kLong - static_cast<int>(std::count(held_out_.begin(), held_out_.end(), true));
+  inputs_.variants[0].fit.samples = result_.num_fit_samples;  // The paper's row.
+  inputs_.variants[1] =
+      MakeVariant("nominal model, measured attitude", data_, held_out_, 20e3, 8e3);
+  inputs_.variants[2] =
+      MakeVariant("calibrated model, measured attitude", data_, held_out_, 1e3, 4e3);
+  const std::string html = ReportHtml(inputs_);
+  EXPECT_LT(html.size(), kMaxHtmlBytes);
+  // Both time-plot figures say they were thinned and how.
+  EXPECT_EQ(Count(html,
+                  "Thinned for drawing (min/max per bucket): each series of more than 2000 "
+                  "points is cut into 1000 buckets of consecutive samples (about 60 per bucket "
+                  "for all 60000 samples)"),
+            2);
+  // No series has more than 2000 points.
+  for (size_t p = html.find("<path d=\""); p != std::string::npos;
+       p = html.find("<path d=\"", p + 1)) {
+    const std::string d = html.substr(p, html.find('"', p + 9) - p);
+    EXPECT_LE(Count(d, "M") + Count(d, "L"), 2000);
+  }
+  // The outlier is still drawn: cable 1's tension axis reaches 600 kN.
+  EXPECT_TRUE(Contains(SvgTitled(html, "Cable 1: tension"), ">600<"));
+  EXPECT_FALSE(Contains(SvgTitled(html, "Cable 2: tension"), ">600<"));
+  // The tables and the histogram use every sample.
+  const int fitted = result_.num_fit_samples;
+  EXPECT_TRUE(Contains(html, "fitted samples (n = " + std::to_string(fitted) + ")"));
+  EXPECT_TRUE(Contains(html, "held-out samples (n = " + std::to_string(kLong - fitted)));
+  EXPECT_TRUE(Contains(html, "(n=" + std::to_string(6 * kLong) + ")"));
+  EXPECT_TRUE(NonFiniteWords(html).empty());
 }
 
 TEST_F(ReportTest, JsonIsWellFormedWithTheSummary) {

@@ -5,6 +5,8 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -211,12 +213,175 @@ TEST(SvgLinePlot, ContainsTitleLabelsAndOnePathPerSeries) {
   EXPECT_EQ(Count(svg, "<path"), 3);
   EXPECT_EQ(Count(svg, "stroke-dasharray"), 2);  // The dashed path and its legend swatch.
   EXPECT_NE(svg.find("width=\"720\" height=\"300\""), std::string::npos);
-  // Series colours come from the palette, in order.
+  // Series colours come from the palette by index; the markers are drawn first.
   const std::vector<std::string> strokes = Attribute(svg, "<path", "stroke");
-  ASSERT_EQ(strokes.size(), 2u);
-  EXPECT_EQ(strokes[0], PlotSeriesColour(0));
-  EXPECT_EQ(strokes[1], PlotSeriesColour(1));
-  EXPECT_EQ(Attribute(svg, "<path", "fill").back(), PlotSeriesColour(2));
+  ASSERT_EQ(strokes.size(), 3u);
+  EXPECT_EQ(strokes[0], PlotSeriesColour(2));
+  EXPECT_EQ(strokes[1], PlotSeriesColour(0));
+  EXPECT_EQ(strokes[2], PlotSeriesColour(1));
+  // A marker is a zero-length subpath with round caps: one per point.
+  EXPECT_EQ(Count(Attribute(svg, "<path", "d")[0], "h0"), 51);
+  EXPECT_EQ(Attribute(svg, "<path", "stroke-linecap")[0], "round");
+}
+
+TEST(SvgLinePlot, MarkersAreSmallTranslucentAndUnderTheLines) {
+  // Index order: line, markers, dashed line. Drawing order must be markers first.
+  std::vector<PlotSeries> series(3);
+  series[0].name = "model before";
+  series[0].dashed = true;
+  series[1].name = "measured";
+  series[1].markers_only = true;
+  series[1].marker_radius_px = 1.5;
+  series[1].opacity = 0.4;
+  series[2].name = "model after";
+  for (int i = 0; i < 40; ++i) {
+    for (PlotSeries& s : series) {
+      s.x.push_back(i);
+      s.y.push_back(100.0 + i);  // All three on top of each other.
+    }
+  }
+  const std::string svg = SvgLinePlot(series, Options());
+  ExpectValidSvg(svg);
+  const size_t markers = svg.find("<path d=\"M");
+  ASSERT_NE(markers, std::string::npos);
+  EXPECT_NE(svg.find("stroke=\"" + PlotSeriesColour(1) + "\"", markers), std::string::npos);
+  EXPECT_LT(svg.find("stroke=\"" + PlotSeriesColour(1) + "\""),
+            svg.find("stroke=\"" + PlotSeriesColour(0) + "\""));
+  EXPECT_LT(svg.find("stroke=\"" + PlotSeriesColour(0) + "\""),
+            svg.find("stroke=\"" + PlotSeriesColour(2) + "\""));
+  // The markers' size and opacity; the lines stay opaque.
+  EXPECT_EQ(Attribute(svg, "<path", "stroke-width"), (std::vector<std::string>{"3", "1.8", "1.8"}));
+  EXPECT_EQ(Attribute(svg, "<path", "stroke-opacity"), std::vector<std::string>{"0.4"});
+  // The legend, in index order, says which is which: a dashed line, a dot, a line.
+  const size_t before = svg.find(">model before<"), measured = svg.find(">measured<"),
+               after = svg.find(">model after<");
+  ASSERT_NE(before, std::string::npos);
+  ASSERT_NE(measured, std::string::npos);
+  ASSERT_NE(after, std::string::npos);
+  EXPECT_LT(before, measured);
+  EXPECT_LT(measured, after);
+  EXPECT_EQ(Attribute(svg, "<circle", "fill"), std::vector<std::string>{PlotSeriesColour(1)});
+  EXPECT_EQ(Attribute(svg, "<circle", "fill-opacity"), std::vector<std::string>{"0.4"});
+}
+
+// The plot area (the border rect drawn after the series) as {left, top, right, bottom}.
+std::array<double, 4> PlotBox(const std::string& svg) {
+  const std::string tag = "<rect x=";
+  size_t at = std::string::npos;
+  for (size_t p = svg.find(tag); p != std::string::npos; p = svg.find(tag, p + 1)) {
+    if (svg.substr(p, svg.find('>', p) - p).find("fill=\"none\"") != std::string::npos) at = p;
+  }
+  if (at == std::string::npos) return {0, 0, 0, 0};
+  const std::string rect = svg.substr(at, svg.find('>', at) - at);
+  const double x = std::stod(Attribute(rect, "<rect", "x")[0]);
+  const double y = std::stod(Attribute(rect, "<rect", "y")[0]);
+  return {x, y, x + std::stod(Attribute(rect, "<rect", "width")[0]),
+          y + std::stod(Attribute(rect, "<rect", "height")[0])};
+}
+
+// The (x, y) pixel coordinates of "M"/"L" commands in a path's d attribute.
+std::vector<std::array<double, 2>> PathPoints(const std::string& d) {
+  std::vector<std::array<double, 2>> points;
+  static const std::regex kPoint("[ML](-?[0-9.]+) (-?[0-9.]+)");
+  for (std::sregex_iterator it(d.begin(), d.end(), kPoint), end; it != end; ++it) {
+    points.push_back({std::stod((*it)[1]), std::stod((*it)[2])});
+  }
+  return points;
+}
+
+TEST(SvgLinePlot, AxesAreSnugAroundTheData) {
+  // Times 0 ... 359 s used to get an axis to 400 s (10% empty); values 98 ... 262 one
+  // from 50 to 300.
+  PlotSeries s{"tension", {}, {}};
+  for (int i = 0; i < 360; ++i) {
+    s.x.push_back(i);
+    s.y.push_back(180.0 + 82.0 * std::sin(i * 0.0175));
+  }
+  for (int width : {540, 720, 1000}) {
+    PlotOptions o = Options();
+    o.width_px = width;
+    const std::string svg = SvgLinePlot({s}, o);
+    ExpectValidSvg(svg);
+    SCOPED_TRACE(width);
+    const std::array<double, 4> box = PlotBox(svg);
+    const std::vector<std::array<double, 2>> points = PathPoints(Attribute(svg, "<path", "d")[0]);
+    ASSERT_EQ(points.size(), 360u);
+    double left = 1e9, right = -1e9, top = 1e9, bottom = -1e9;
+    for (const auto& p : points) {
+      left = std::min(left, p[0]);
+      right = std::max(right, p[0]);
+      top = std::min(top, p[1]);
+      bottom = std::max(bottom, p[1]);
+    }
+    const double w = box[2] - box[0], h = box[3] - box[1];
+    // At most the margins (1% on x, 4% on y) plus rounding to 0.1 px.
+    EXPECT_LE(left - box[0], 0.011 * w);
+    EXPECT_LE(box[2] - right, 0.011 * w);
+    EXPECT_LE(top - box[1], 0.041 * h);
+    EXPECT_LE(box[3] - bottom, 0.041 * h);
+    EXPECT_GE(left, box[0]);
+    EXPECT_LE(right, box[2]);
+    // Every tick is inside the axis: no "400" past the last sample.
+    EXPECT_EQ(svg.find(">400<"), std::string::npos);
+    EXPECT_NE(svg.find(">0<"), std::string::npos);
+    EXPECT_GE(Count(svg, "text-anchor=\"middle\" font-size=\"11\""), 2);  // x tick labels
+  }
+}
+
+TEST(ThinMinMaxPerBucket, ShortSeriesAreUnchanged) {
+  PlotSeries s{"short", {0, 1, 2, kNaN}, {5, 6, 7, 8}, true, false, 2.0, 0.5};
+  int buckets = -1;
+  const PlotSeries t = ThinMinMaxPerBucket(s, 4, &buckets);
+  EXPECT_EQ(buckets, 0);
+  EXPECT_EQ(t.y, s.y);
+  EXPECT_EQ(t.name, "short");
+  EXPECT_TRUE(t.dashed);
+}
+
+TEST(ThinMinMaxPerBucket, KeepsOutliersOrderAndTheLimit) {
+  PlotSeries s{"long", {}, {}, false, true, 1.8, 0.45};
+  constexpr int kN = 60000;
+  for (int i = 0; i < kN; ++i) {
+    s.x.push_back(0.1 * i);
+    s.y.push_back(200.0 + 20.0 * std::sin(i * 1e-4) + std::sin(i * 7.3));
+  }
+  s.y[31337] = 900.0;  // Outliers a stride would drop.
+  s.y[4243] = -50.0;
+  int buckets = 0;
+  const PlotSeries t = ThinMinMaxPerBucket(s, 2000, &buckets);
+  EXPECT_EQ(buckets, 1000);
+  EXPECT_LE(t.x.size(), 2000u);
+  EXPECT_GE(t.x.size(), 1900u);
+  ASSERT_EQ(t.x.size(), t.y.size());
+  EXPECT_TRUE(t.markers_only);
+  EXPECT_EQ(t.opacity, 0.45);
+  EXPECT_TRUE(std::is_sorted(t.x.begin(), t.x.end()));
+  EXPECT_EQ(*std::max_element(t.y.begin(), t.y.end()), 900.0);
+  EXPECT_EQ(*std::min_element(t.y.begin(), t.y.end()), -50.0);
+  // The outliers keep their times.
+  EXPECT_DOUBLE_EQ(t.x[std::max_element(t.y.begin(), t.y.end()) - t.y.begin()], 3133.7);
+  // Every kept point is a point of the series.
+  for (size_t i = 0; i < t.x.size(); ++i) {
+    const size_t n = static_cast<size_t>(std::lround(t.x[i] * 10.0));
+    ASSERT_LT(n, s.y.size());
+    EXPECT_EQ(t.y[i], s.y[n]) << i;
+  }
+}
+
+TEST(ThinMinMaxPerBucket, GapsStillBreakTheLine) {
+  PlotSeries s{"gappy", {}, {}};
+  for (int i = 0; i < 10000; ++i) {
+    s.x.push_back(i);
+    s.y.push_back(i >= 5000 && i < 5100 ? kNaN : std::cos(i * 0.01));
+  }
+  int buckets = 0;
+  const PlotSeries t = ThinMinMaxPerBucket(s, 300, &buckets);
+  EXPECT_EQ(buckets, 100);  // A third of the points: min, max and a gap per bucket.
+  EXPECT_LE(t.x.size(), 300u);
+  EXPECT_TRUE(std::any_of(t.y.begin(), t.y.end(), [](double v) { return std::isnan(v); }));
+  const std::string svg = SvgLinePlot({t}, Options());
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Count(Attribute(svg, "<path", "d")[0], "M"), 2);  // Before and after the gap.
 }
 
 TEST(SvgLinePlot, NonFiniteValuesMakeGapsNotNan) {

@@ -41,6 +41,12 @@ constexpr double kDefaultStrongCorrelation = 0.9;
 constexpr int kCablePlotWidthPx = 540, kCablePlotHeightPx = 280;
 constexpr int kWidePlotWidthPx = 1000, kWidePlotHeightPx = 320;
 constexpr int kResidualBins = 40;
+// Longer plot series are thinned (ThinMinMaxPerBucket): at most this many points each,
+// about two per horizontal pixel of a cable plot; this bounds report.html's size.
+constexpr int kMaxPlotPointsPerSeries = 2000;
+// Measured tensions in the time plots: small translucent dots under the model lines
+// (the held-out ones, sky blue, less translucent to stay visible on white).
+constexpr double kMeasuredDotRadiusPx = 1.8, kMeasuredDotOpacity = 0.45, kHeldOutDotOpacity = 0.7;
 
 // ---------------------------------------------------------------------------------------
 // Number formatting. Non-finite values read "n/a", never "nan" or "inf".
@@ -240,9 +246,12 @@ std::string ChiSquareMeaning(const CalibrationResult& r) {
   if (!std::isfinite(chi)) return "not available.";
   const int dof = DegreesOfFreedom(r);
   const double band = dof > 0 ? kChiSquareBandSigmas * std::sqrt(2.0 / dof) : 0.0;
-  const std::string expected = dof > 0 ? " (a correct noise model gives 1 ± " + Sig3(band) +
-                                             " with " + Int(dof) + " degrees of freedom)"
-                                       : "";
+  const std::string sigmas = Printf("%g", kChiSquareBandSigmas);
+  const std::string expected =
+      dof > 0 ? " (expected 1 ± " + sigmas + "·√(2/ν) = 1 ± " + Sig3(band) + ": within " + sigmas +
+                    " standard deviations of χ²/ν for a correct noise model, ν = " + Int(dof) +
+                    " degrees of freedom)"
+              : "";
   if (dof > 0 && std::fabs(chi - 1.0) <= band) {
     return "about 1: the residuals scatter as the noise model says" + expected + ".";
   }
@@ -484,45 +493,24 @@ void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* d
     }
     doc->AddTable(std::move(t));
   }
+  // One item per direction: lead, the direction, its ratio in parentheses, the tail.
   std::vector<Text> items;
-  for (const ParameterDirection& d : r.before.undetermined) {
-    items.push_back(Text("Before solving, undetermined: ")
-                        .Code(d.Describe())
-                        .Plain(" (" + RatioText(d.singular_value_ratio) + ")."));
-  }
-  for (const ParameterDirection& d : r.before.poorly_determined) {
-    items.push_back(Text("Before solving, poorly determined: ")
-                        .Code(d.Describe())
-                        .Plain(" (" + RatioText(d.singular_value_ratio) + ")."));
-  }
-  for (const ParameterDirection& d : r.after.undetermined) {
-    items.push_back(Text()
-                        .Bold("Undetermined")
-                        .Plain(" at the solution: ")
-                        .Code(d.Describe())
-                        .Plain(" (" + RatioText(d.singular_value_ratio) +
-                               "): the data and priors cannot fix this combination."));
-  }
-  for (const ParameterDirection& d : r.after.poorly_determined) {
-    items.push_back(Text()
-                        .Bold("Poorly determined")
-                        .Plain(" at the solution: ")
-                        .Code(d.Describe())
-                        .Plain(" (" + RatioText(d.singular_value_ratio) +
-                               "): its estimate is uncertain; see the ±1σ column."));
-  }
-  for (const ParameterDirection& d : r.data_only.undetermined) {
-    items.push_back(
-        Text("The data alone cannot determine ")
-            .Code(d.Describe())
-            .Plain(" (" + RatioText(d.singular_value_ratio) + "); the prior holds it."));
-  }
-  for (const ParameterDirection& d : r.data_only.poorly_determined) {
-    items.push_back(Text("The data alone determine ")
-                        .Code(d.Describe())
-                        .Plain(" only poorly (" + RatioText(d.singular_value_ratio) +
-                               "); the prior helps fix it."));
-  }
+  auto add = [&items](const std::vector<ParameterDirection>& directions, const Text& lead,
+                      const std::string& open, const std::string& tail) {
+    for (const ParameterDirection& d : directions) {
+      items.push_back(
+          Text(lead).Code(d.Describe()).Plain(open + RatioText(d.singular_value_ratio) + tail));
+    }
+  };
+  add(r.before.undetermined, "Before solving, undetermined: ", " (", ").");
+  add(r.before.poorly_determined, "Before solving, poorly determined: ", " (", ").");
+  add(r.after.undetermined, Text().Bold("Undetermined").Plain(" at the solution: "), " (",
+      "): the data and priors cannot fix this combination.");
+  add(r.after.poorly_determined, Text().Bold("Poorly determined").Plain(" at the solution: "), " (",
+      "): its estimate is uncertain; see the ±1σ column.");
+  add(r.data_only.undetermined, "The data alone cannot determine ", " (", "); the prior holds it.");
+  add(r.data_only.poorly_determined, "The data alone determine ", " only poorly (",
+      "); the prior helps fix it.");
   const bool nothing_weak = r.after.undetermined.empty() && r.after.poorly_determined.empty() &&
                             r.data_only.undetermined.empty() &&
                             r.data_only.poorly_determined.empty();
@@ -572,10 +560,15 @@ void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* d
   }
 }
 
-// One statistics table: a row per variant (and per hold-out when present).
+// Which rows a statistics table has: each variant's statistics on the fitted (or all)
+// samples, on the held-out samples, or both (then suffixed "(fit)" and "(held out)").
+enum class StatsRows { kFit, kHeldOut, kFitAndHeldOut };
+
+// One statistics table: a row per variant and kind of samples; variants without held-out
+// samples have no held-out row.
 Table StatsTable(const ReportInputs& in, const Text& caption,
                  const std::array<double, kNumCables> CableErrorStats::*member, bool kn,
-                 bool holdout_rows, const char* format) {
+                 StatsRows rows, const char* format) {
   Table t;
   t.caption = caption;
   t.header = {"Variant", "Samples"};
@@ -589,25 +582,22 @@ Table StatsTable(const ReportInputs& in, const Text& caption,
     t.header.push_back("all");
     t.right_align.push_back(true);
   }
-  auto add = [&](size_t index, const VariantEvaluation& v, const CableErrorStats& s,
-                 const std::string& suffix) {
-    std::vector<Text> row = {
-        Text().Swatch(PlotSeriesColour(static_cast<int>(index))).Plain(v.name + suffix),
-        Int(s.samples)};
-    for (double x : s.*member) row.push_back(kn ? Kn3(x) : Printf(format, x));
-    if (all_column) row.push_back(Text().Bold(Kn3(RmsAllCables(s.rms_n))));
-    t.rows.push_back(std::move(row));
-  };
-  for (size_t k = 0; k < in.variants.size(); ++k) {
-    add(k, in.variants[k], in.variants[k].fit, holdout_rows ? " (fit)" : "");
-  }
-  if (holdout_rows) {
+  const bool both = rows == StatsRows::kFitAndHeldOut;
+  auto add_rows = [&](bool holdout, const std::string& suffix) {
     for (size_t k = 0; k < in.variants.size(); ++k) {
-      if (in.variants[k].holdout.samples > 0) {
-        add(k, in.variants[k], in.variants[k].holdout, " (held out)");
-      }
+      const VariantEvaluation& v = in.variants[k];
+      const CableErrorStats& s = holdout ? v.holdout : v.fit;
+      if (holdout && s.samples == 0) continue;
+      std::vector<Text> row = {
+          Text().Swatch(PlotSeriesColour(static_cast<int>(k))).Plain(v.name + suffix),
+          Int(s.samples)};
+      for (double x : s.*member) row.push_back(kn ? Kn3(x) : Printf(format, x));
+      if (all_column) row.push_back(Text().Bold(Kn3(RmsAllCables(s.rms_n))));
+      t.rows.push_back(std::move(row));
     }
-  }
+  };
+  if (rows != StatsRows::kHeldOut) add_rows(false, both ? " (fit)" : "");
+  if (rows != StatsRows::kFit) add_rows(true, both ? " (held out)" : "");
   return t;
 }
 
@@ -649,37 +639,29 @@ void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
   const int fit_n = in.variants.front().fit.samples;
   doc->AddTable(StatsTable(
       in, "RMS of model - measured [kN], " + FitSamplesLabel(in) + " (n = " + Int(fit_n) + ")",
-      &CableErrorStats::rms_n, true, false, nullptr));
+      &CableErrorStats::rms_n, true, StatsRows::kFit, nullptr));
   const bool holdout = AnyHoldout(in);
   if (holdout) {
-    Table t = StatsTable(in, "", &CableErrorStats::rms_n, true, false, nullptr);
-    t.rows.clear();
     int n = 0;
-    for (size_t k = 0; k < in.variants.size(); ++k) {
-      const VariantEvaluation& v = in.variants[k];
-      if (v.holdout.samples == 0) continue;
-      n = v.holdout.samples;
-      std::vector<Text> row = {Text().Swatch(PlotSeriesColour(static_cast<int>(k))).Plain(v.name),
-                               Int(v.holdout.samples)};
-      for (double x : v.holdout.rms_n) row.push_back(Kn3(x));
-      row.push_back(Text().Bold(Kn3(RmsAllCables(v.holdout.rms_n))));
-      t.rows.push_back(std::move(row));
-    }
-    t.caption =
-        "RMS of model - measured [kN], held-out samples (n = " + Int(n) + "; not used in the fit)";
-    doc->AddTable(std::move(t));
+    for (const VariantEvaluation& v : in.variants)
+      n = v.holdout.samples > 0 ? v.holdout.samples : n;
+    doc->AddTable(StatsTable(
+        in,
+        "RMS of model - measured [kN], held-out samples (n = " + Int(n) + "; not used in the fit)",
+        &CableErrorStats::rms_n, true, StatsRows::kHeldOut, nullptr));
   }
   if (with_plots) {
     std::vector<std::string> svgs = {BarChart(in, false)};
     if (holdout) svgs.push_back(BarChart(in, true));
     doc->Figure(std::move(svgs), "RMS of model - measured per cable for each variant [kN].");
   }
+  const StatsRows rows = holdout ? StatsRows::kFitAndHeldOut : StatsRows::kFit;
   doc->AddTable(StatsTable(in, "RMS of 100 (model - measured) / measured [%]",
-                           &CableErrorStats::rms_percent, false, holdout, "%.2f"));
+                           &CableErrorStats::rms_percent, false, rows, "%.2f"));
   doc->AddTable(StatsTable(in, "Mean of model - measured (bias) [kN]", &CableErrorStats::mean_n,
-                           true, holdout, nullptr));
+                           true, rows, nullptr));
   doc->AddTable(StatsTable(in, "Largest |model - measured| [kN]", &CableErrorStats::max_abs_n, true,
-                           holdout, nullptr));
+                           rows, nullptr));
 }
 
 // x coordinates of the time plots: time_s, or the sample index when time does not vary.
@@ -714,6 +696,26 @@ size_t HeldOutSlot(const ReportInputs& in) {
   return in.variants.size() <= 5 ? 5 : in.variants.size();
 }
 
+// Thins a series for drawing (ThinMinMaxPerBucket) and records in *buckets the number of
+// buckets of the longest series thinned.
+PlotSeries Thin(PlotSeries s, int* buckets) {
+  int b = 0;
+  PlotSeries thinned = ThinMinMaxPerBucket(s, kMaxPlotPointsPerSeries, &b);
+  *buckets = std::max(*buckets, b);
+  return thinned;
+}
+
+// Says in a figure caption that its series were thinned (buckets > 0), and how.
+std::string ThinningNote(int num_samples, int buckets) {
+  if (buckets <= 0) return "";
+  return " Thinned for drawing (min/max per bucket): each series of more than " +
+         Int(kMaxPlotPointsPerSeries) + " points is cut into " + Int(buckets) +
+         " buckets of consecutive samples (about " + Int((num_samples + buckets - 1) / buckets) +
+         " per bucket for all " + Int(num_samples) +
+         " samples) and only each bucket's lowest and highest value are plotted, so peaks "
+         "and outliers stay visible. The tables and statistics use all samples.";
+}
+
 void AddPlots(const ReportInputs& in, Document* doc) {
   doc->Heading(2, "Plots");
   if (!in.data || in.data->samples.empty()) {
@@ -721,15 +723,17 @@ void AddPlots(const ReportInputs& in, Document* doc) {
     return;
   }
   const Dataset& d = *in.data;
+  const int num_samples = NumSamples(in);
   std::string x_label;
   const std::vector<double> x = SampleAxis(d, &x_label);
   const std::vector<size_t> shown = PlotVariants(in);
   const bool holdout = NumHeldOut(in) > 0;
-  const double nan = std::numeric_limits<double>::quiet_NaN();
   // With a calibration the "before" variant is dashed, the calibrated one solid.
   auto dashed = [&](size_t k) { return in.result != nullptr && k + 1 < shown.size(); };
+  int buckets = 0;
 
-  // Tension against time, one plot per cable.
+  // Tension against time, one plot per cable: the measured tensions as small translucent
+  // dots, drawn first, and the model lines over them.
   std::vector<std::string> cable_svgs;
   for (int i = 0; i < kNumCables; ++i) {
     std::vector<PlotSeries> series;
@@ -738,17 +742,20 @@ void AddPlots(const ReportInputs& in, Document* doc) {
       if (!HasPredictions(in, v)) continue;
       PlotSeries p{v.name, x, {}, dashed(k), false};
       for (const auto& predicted : v.predicted_n) p.y.push_back(predicted[i] / kNPerKn);
-      PutAt(&series, shown[k], std::move(p));
+      PutAt(&series, shown[k], Thin(std::move(p), &buckets));
     }
-    PlotSeries fitted{holdout ? "measured (fitted)" : "measured", x, {}, false, true};
-    PlotSeries held{"measured (held out)", x, {}, false, true};
+    PlotSeries fitted{holdout ? "measured (fitted)" : "measured", {}, {}, false, true};
+    PlotSeries held{"measured (held out)", {}, {}, false, true};
     for (size_t n = 0; n < d.samples.size(); ++n) {
-      const double t_kn = d.samples[n].tension_n[i] / kNPerKn;
-      fitted.y.push_back(IsHeldOut(in, n) ? nan : t_kn);
-      held.y.push_back(IsHeldOut(in, n) ? t_kn : nan);
+      PlotSeries& m = IsHeldOut(in, n) ? held : fitted;
+      m.x.push_back(x[n]);
+      m.y.push_back(d.samples[n].tension_n[i] / kNPerKn);
     }
-    if (holdout) PutAt(&series, HeldOutSlot(in), std::move(held));
-    PutAt(&series, MeasuredSlot(in), std::move(fitted));
+    fitted.marker_radius_px = held.marker_radius_px = kMeasuredDotRadiusPx;
+    fitted.opacity = kMeasuredDotOpacity;
+    held.opacity = kHeldOutDotOpacity;
+    if (holdout) PutAt(&series, HeldOutSlot(in), Thin(std::move(held), &buckets));
+    PutAt(&series, MeasuredSlot(in), Thin(std::move(fitted), &buckets));
     PlotOptions o;
     o.title = "Cable " + Int(i + 1) + ": tension";
     o.x_label = x_label;
@@ -758,9 +765,11 @@ void AddPlots(const ReportInputs& in, Document* doc) {
     cable_svgs.push_back(SvgLinePlot(series, o));
   }
   doc->Figure(std::move(cable_svgs),
-              std::string("Measured lower-end tension (dots") +
+              std::string("Measured lower-end tension (translucent dots, drawn underneath") +
                   (holdout ? "; held-out samples in light blue" : "") +
-                  ") and the model predictions (lines) against time, per cable [kN].");
+                  ") and the model predictions (lines on top; dashed: before calibration) "
+                  "against time, per cable [kN]." +
+                  ThinningNote(num_samples, buckets));
 
   // Residual distribution, all cables and samples pooled.
   std::vector<HistogramSeries> histograms;
@@ -787,11 +796,13 @@ void AddPlots(const ReportInputs& in, Document* doc) {
   o.width_px = kWidePlotWidthPx;
   o.height_px = kWidePlotHeightPx;
   doc->Figure({SvgHistogram(histograms, kResidualBins, o)},
-              "Distribution of model - measured over all cables and samples [kN]: a "
-              "calibrated model should centre on 0 with the width of the sensor noise.");
+              "Distribution of model - measured over all cables and all " + Int(num_samples) +
+                  " samples [kN]: a calibrated model should centre on 0 with the width of the "
+                  "sensor noise.");
 
   // Residual against time, one plot per cable.
   std::vector<std::string> residual_svgs;
+  int residual_buckets = 0;
   for (int i = 0; i < kNumCables; ++i) {
     std::vector<PlotSeries> series;
     for (size_t k = 0; k < shown.size(); ++k) {
@@ -801,7 +812,7 @@ void AddPlots(const ReportInputs& in, Document* doc) {
       for (size_t n = 0; n < d.samples.size(); ++n) {
         p.y.push_back((v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn);
       }
-      PutAt(&series, shown[k], std::move(p));
+      PutAt(&series, shown[k], Thin(std::move(p), &residual_buckets));
     }
     PlotOptions r;
     r.title = "Cable " + Int(i + 1) + ": model - measured";
@@ -813,7 +824,8 @@ void AddPlots(const ReportInputs& in, Document* doc) {
   }
   doc->Figure(std::move(residual_svgs),
               "Model - measured against time, per cable [kN]: a pattern that repeats with "
-              "the pose is model error; what remains after calibration should look like noise.");
+              "the pose is model error; what remains after calibration should look like noise." +
+                  ThinningNote(num_samples, residual_buckets));
 }
 
 void AddCalibratedModel(const ReportInputs& in, Document* doc) {

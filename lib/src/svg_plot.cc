@@ -25,6 +25,7 @@ constexpr double kTickLenPx = 4.0;
 constexpr const char* kGridColour = "#e3e3e3";
 constexpr const char* kAxisColour = "#444444";
 constexpr const char* kTextColour = "#222222";
+constexpr double kMinOpacity = 0.05;
 
 const char* Colour(size_t index) { return kPalette[index % kPalette.size()]; }
 
@@ -119,17 +120,22 @@ double MaxTextWidth(const std::vector<std::string>& texts, double font_px) {
   return w;
 }
 
+// Orders [lo, hi] and pads a degenerate range by 1% of |centre| (by 1 if it is 0).
+void PadDegenerateRange(double* lo, double* hi) {
+  if (*lo > *hi) std::swap(*lo, *hi);
+  const double max_abs = std::max(std::fabs(*lo), std::fabs(*hi));
+  if (*hi - *lo <= 1e-12 * max_abs || *hi - *lo < 1e-290) {
+    const double centre = *lo + 0.5 * (*hi - *lo);
+    const double pad = centre == 0.0 ? 1.0 : 0.01 * std::fabs(centre);
+    *lo = centre - pad;
+    *hi = centre + pad;
+  }
+}
+
 std::vector<double> NiceTicksWithMinStep(double lo, double hi, int target, double min_step) {
   if (!std::isfinite(lo) || !std::isfinite(hi)) return {};
-  if (lo > hi) std::swap(lo, hi);
   target = std::clamp(target, 2, 50);
-  const double max_abs = std::max(std::fabs(lo), std::fabs(hi));
-  if (hi - lo <= 1e-12 * max_abs || hi - lo < 1e-290) {
-    const double centre = lo + 0.5 * (hi - lo);
-    const double pad = centre == 0.0 ? 1.0 : 0.01 * std::fabs(centre);
-    lo = centre - pad;
-    hi = centre + pad;
-  }
+  PadDegenerateRange(&lo, &hi);
   const double span = hi - lo;
   if (!std::isfinite(span)) return {lo, hi};
   const double raw = span / target;
@@ -232,6 +238,7 @@ struct LegendItem {
   std::string label;
   const char* colour;
   Swatch swatch;
+  double opacity = 1.0;  // kMarker: of the dot, as drawn in the chart.
 };
 
 double LegendItemWidth(const LegendItem& item) {
@@ -274,7 +281,9 @@ void DrawLegend(std::string* out, const std::vector<LegendItem>& items,
           break;
         case Swatch::kMarker:
           *out += "<circle cx=\"" + Px(x + kLegendSwatchPx / 2) + "\" cy=\"" + Px(mid) +
-                  "\" r=\"3.5\" fill=\"" + item.colour + "\"/>\n";
+                  "\" r=\"3.5\" fill=\"" + item.colour + "\"" +
+                  (item.opacity < 1.0 ? " fill-opacity=\"" + Compact(item.opacity, 2) + "\"" : "") +
+                  "/>\n";
           break;
         case Swatch::kBox:
         case Swatch::kSolidBox:
@@ -329,14 +338,45 @@ int YTickTarget(double plot_h) {
   return std::clamp(static_cast<int>(std::lround(plot_h / 45.0)), 2, 8);
 }
 
-// Numeric x ticks with enough room between labels.
-std::vector<double> FitXTicks(double lo, double hi, double plot_w) {
+// Margins of the snug axes, as fractions of the data span on each side.
+constexpr double kXMargin = 0.01, kYMargin = 0.04;
+
+// A numeric axis: the range it shows and its ticks, all inside that range.
+struct Axis {
+  double lo = 0.0, hi = 1.0;
+  std::vector<double> ticks;
+  double Step() const { return ticks.size() > 1 ? ticks[1] - ticks[0] : hi - lo; }
+};
+
+// Snug axis for data in [lo, hi] (finite): the data range widened by `margin` of its
+// span on each side (a degenerate range padded as in NiceTicks), and the nice ticks for
+// about `target` intervals that fall inside it; the target is raised until at least two
+// ticks are inside. The axis ends less than one tick step beyond the data.
+Axis SnugAxis(double lo, double hi, int target, double margin) {
+  PadDegenerateRange(&lo, &hi);
+  const double pad = margin * (hi - lo);
+  Axis axis;
+  axis.lo = lo - pad;
+  axis.hi = hi + pad;
+  const double eps = 1e-9 * (axis.hi - axis.lo);
+  for (int t = std::clamp(target, 2, 50); t <= 50; ++t) {
+    axis.ticks.clear();
+    for (double tick : NiceTicks(axis.lo, axis.hi, t)) {
+      if (tick >= axis.lo - eps && tick <= axis.hi + eps) axis.ticks.push_back(tick);
+    }
+    if (axis.ticks.size() >= 2) break;
+  }
+  return axis;
+}
+
+// Snug x axis with enough room between the tick labels.
+Axis FitXAxis(double lo, double hi, double plot_w, double margin) {
   int target = std::clamp(static_cast<int>(plot_w / 90.0), 2, 10);
   while (true) {
-    std::vector<double> ticks = NiceTicks(lo, hi, target);
-    if (target <= 2 || ticks.size() < 2) return ticks;
-    const double spacing = plot_w / static_cast<double>(ticks.size() - 1);
-    if (spacing >= MaxTextWidth(TickLabels(ticks), kTickFontPx) + 12.0) return ticks;
+    Axis axis = SnugAxis(lo, hi, target, margin);
+    if (target <= 2 || axis.ticks.size() < 2) return axis;
+    const double spacing = plot_w * axis.Step() / (axis.hi - axis.lo);
+    if (spacing >= MaxTextWidth(TickLabels(axis.ticks), kTickFontPx) + 12.0) return axis;
     --target;
   }
 }
@@ -439,29 +479,30 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
 
   std::vector<LegendItem> legend;
   for (size_t i = 0; i < series.size(); ++i) {
-    if (series[i].name.empty()) continue;
-    legend.push_back({series[i].name, Colour(i),
-                      series[i].markers_only ? Swatch::kMarker
-                      : series[i].dashed     ? Swatch::kDashed
-                                             : Swatch::kLine});
+    const PlotSeries& s = series[i];
+    if (s.name.empty()) continue;
+    legend.push_back({s.name, Colour(i),
+                      s.markers_only ? Swatch::kMarker
+                      : s.dashed     ? Swatch::kDashed
+                                     : Swatch::kLine,
+                      std::clamp(s.opacity, kMinOpacity, 1.0)});
   }
   Frame f = StartFrame(options, std::move(legend), kXTickLabelsPx);
-  const std::vector<double> y_ticks = NiceTicks(y_lo, y_hi, YTickTarget(f.box.h));
-  FinishFrame(&f, options, TickLabels(y_ticks), 30.0);
-  const std::vector<double> x_ticks = FitXTicks(x_lo, x_hi, f.box.w);
+  const Axis y_axis = SnugAxis(y_lo, y_hi, YTickTarget(f.box.h), kYMargin);
+  FinishFrame(&f, options, TickLabels(y_axis.ticks), 30.0);
+  const Axis x_axis = FitXAxis(x_lo, x_hi, f.box.w, kXMargin);
   const Box& box = f.box;
-  const Scale xs{x_ticks.front(), x_ticks.back(), box.x, box.x + box.w};
-  const Scale ys{y_ticks.front(), y_ticks.back(), box.y + box.h, box.y};
+  const Scale xs{x_axis.lo, x_axis.hi, box.x, box.x + box.w};
+  const Scale ys{y_axis.lo, y_axis.hi, box.y + box.h, box.y};
 
   std::string out;
   OpenSvg(&out, f.size, options.title);
-  DrawYAxis(&out, box, ys, y_ticks, options);
-  DrawXAxis(&out, box, xs, x_ticks, options, f.size);
+  DrawYAxis(&out, box, ys, y_axis.ticks, options);
+  DrawXAxis(&out, box, xs, x_axis.ticks, options, f.size);
 
-  constexpr double kMarkerR = 3.0;
   // An isolated point of a line (between gaps): a small stroked ring, reads as a dot.
   constexpr const char* kDot = "m-1.2 0a1.2 1.2 0 1 0 2.4 0a1.2 1.2 0 1 0 -2.4 0";
-  for (size_t si = 0; si < series.size(); ++si) {
+  auto draw = [&](size_t si) {
     const PlotSeries& s = series[si];
     const size_t n = std::min(s.x.size(), s.y.size());
     std::string d;
@@ -474,26 +515,79 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
       }
       const double px = xs(s.x[i]), py = ys(s.y[i]);
       if (s.markers_only) {
-        d += "M" + Px(px - kMarkerR) + " " + Px(py) + "a3 3 0 1 0 6 0a3 3 0 1 0 -6 0Z";
+        d += "M" + Px(px) + " " + Px(py) + "h0";
       } else {
         d += (run == 0 ? "M" : "L") + Px(px) + " " + Px(py);
       }
       ++run;
     }
     if (run == 1 && !s.markers_only) d += kDot;
-    if (d.empty()) continue;
-    const char* colour = Colour(si);
+    if (d.empty()) return;
+    const std::string colour = Colour(si);
+    const double opacity = std::clamp(s.opacity, kMinOpacity, 1.0);
+    const std::string opacity_attr =
+        opacity < 1.0 ? " stroke-opacity=\"" + Compact(opacity, 2) + "\"" : "";
     if (s.markers_only) {
-      out += std::string("<path d=\"") + d + "\" fill=\"" + colour + "\"/>\n";
+      const double r = std::clamp(s.marker_radius_px, 0.5, 10.0);
+      out += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + colour + "\" stroke-width=\"" +
+             Px(2.0 * r) + "\" stroke-linecap=\"round\"" + opacity_attr + "/>\n";
     } else {
-      out += std::string("<path d=\"") + d + "\" fill=\"none\" stroke=\"" + colour +
+      out += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + colour +
              "\" stroke-width=\"1.8\" stroke-linejoin=\"round\" stroke-linecap=\"round\"" +
-             (s.dashed ? " stroke-dasharray=\"6 5\"" : "") + "/>\n";
+             (s.dashed ? " stroke-dasharray=\"6 5\"" : "") + opacity_attr + "/>\n";
     }
+  };
+  // Markers underneath, lines on top.
+  for (size_t si = 0; si < series.size(); ++si) {
+    if (series[si].markers_only) draw(si);
+  }
+  for (size_t si = 0; si < series.size(); ++si) {
+    if (!series[si].markers_only) draw(si);
   }
   DrawBorder(&out, box);
   DrawLegend(&out, f.legend, f.legend_rows, f.size.w, f.legend_top);
   CloseSvg(&out);
+  return out;
+}
+
+PlotSeries ThinMinMaxPerBucket(const PlotSeries& series, int max_points, int* buckets) {
+  if (buckets != nullptr) *buckets = 0;
+  max_points = std::max(max_points, 4);
+  const size_t n = std::min(series.x.size(), series.y.size());
+  if (n <= static_cast<size_t>(max_points)) return series;
+  auto finite = [&series](size_t i) {
+    return std::isfinite(series.x[i]) && std::isfinite(series.y[i]);
+  };
+  bool any_gap = false;
+  for (size_t i = 0; i < n && !any_gap; ++i) any_gap = !finite(i);
+  const size_t num_buckets = static_cast<size_t>(max_points) / (any_gap ? 3 : 2);
+  PlotSeries out = series;
+  out.x.clear();
+  out.y.clear();
+  out.x.reserve(static_cast<size_t>(max_points));
+  out.y.reserve(static_cast<size_t>(max_points));
+  constexpr size_t kNone = static_cast<size_t>(-1);
+  for (size_t b = 0; b < num_buckets; ++b) {
+    // Bucket b holds the indices [n b / B, n (b + 1) / B): lengths differ by at most 1.
+    const size_t begin = n * b / num_buckets, end = n * (b + 1) / num_buckets;
+    size_t lo = kNone, hi = kNone, gap = kNone;
+    for (size_t i = begin; i < end; ++i) {
+      if (!finite(i)) {
+        if (gap == kNone) gap = i;
+        continue;
+      }
+      if (lo == kNone || series.y[i] < series.y[lo]) lo = i;
+      if (hi == kNone || series.y[i] > series.y[hi]) hi = i;
+    }
+    std::array<size_t, 3> keep = {lo, hi == lo ? kNone : hi, gap};
+    std::sort(keep.begin(), keep.end());  // kNone sorts last.
+    for (size_t i : keep) {
+      if (i == kNone) break;
+      out.x.push_back(series.x[i]);
+      out.y.push_back(series.y[i]);
+    }
+  }
+  if (buckets != nullptr) *buckets = static_cast<int>(num_buckets);
   return out;
 }
 
@@ -540,15 +634,15 @@ std::string SvgHistogram(const std::vector<HistogramSeries>& series, int bins,
   const std::vector<double> y_ticks =
       NiceTicksWithMinStep(0.0, static_cast<double>(max_count), YTickTarget(f.box.h), 1.0);
   FinishFrame(&f, opts, TickLabels(y_ticks), 30.0);
-  const std::vector<double> x_ticks = FitXTicks(lo, hi, f.box.w);
+  const Axis x_axis = FitXAxis(lo, hi, f.box.w, kXMargin);
   const Box& box = f.box;
-  const Scale xs{x_ticks.front(), x_ticks.back(), box.x, box.x + box.w};
+  const Scale xs{x_axis.lo, x_axis.hi, box.x, box.x + box.w};
   const Scale ys{y_ticks.front(), y_ticks.back(), box.y + box.h, box.y};
 
   std::string out;
   OpenSvg(&out, f.size, opts.title);
   DrawYAxis(&out, box, ys, y_ticks, opts);
-  DrawXAxis(&out, box, xs, x_ticks, opts, f.size);
+  DrawXAxis(&out, box, xs, x_axis.ticks, opts, f.size);
   for (size_t si = 0; si < series.size(); ++si) {
     const char* colour = Colour(si);
     for (int b = 0; b < bins; ++b) {

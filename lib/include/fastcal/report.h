@@ -4,7 +4,10 @@
 //   report.md     Markdown: provenance, verdict, estimates, identifiability, RMS tables
 //   report.html   the same, self-contained (inline <style> and SVG plots; no scripts, no
 //                 external resources): correlation heatmap, RMS per cable as grouped bars,
-//                 measured and predicted tension per cable against time, residual histogram
+//                 measured and predicted tension per cable against time, residual histogram;
+//                 time plots of long datasets are thinned (min/max per bucket, at most 2000
+//                 points a series, said in the caption), so the file stays under ~1 MB; the
+//                 tables, statistics and histogram use every sample
 //   summary.json  the numbers, for scripts (units in the key names: _kN, _percent)
 //
 // Sections: provenance (inputs with FNV-1a digests, software version, command line,

@@ -5,7 +5,10 @@
 //
 // Common conventions:
 //  - Series colours follow a fixed Okabe-Ito palette (PlotSeriesColour), cycling after 8.
-//  - Axis ticks are "nice" numbers (NiceTicks) and span the whole data range.
+//  - Axis ticks are "nice" numbers (NiceTicks). The axes of line plots and the value axis
+//    of histograms are snug: they span the data range plus a small margin (1% of the
+//    span on x, 4% on y), not out to the next tick, and the ticks are the nice numbers
+//    inside. Count and bar axes start at 0 and end at the first tick above the data.
 //  - All user text is XML-escaped; numbers are written compactly ("150", "0.25", "1e+05")
 //    and non-finite values never reach the output as "nan" or "inf".
 //  - Empty input (or input with no finite value) gives a valid SVG that says "no data".
@@ -24,7 +27,11 @@ struct PlotSeries {
   // coordinate is skipped and breaks the line (a gap).
   std::vector<double> x, y;
   bool dashed = false;
-  bool markers_only = false;  // Dots at the points instead of a line.
+  bool markers_only = false;      // Dots at the points instead of a line.
+  double marker_radius_px = 3.0;  // Dot radius of a markers_only series, clamped to [0.5, 10].
+  // Opacity of the dots or the line, clamped to [0.05, 1]; below 1 the grid and other
+  // series show through.
+  double opacity = 1.0;
 };
 
 struct PlotOptions {
@@ -35,8 +42,23 @@ struct PlotOptions {
 
 // Lines (or markers) over shared axes. Each series with at least one finite point is
 // written as exactly one <path> element; gaps become separate subpaths ("M") of that
-// path, and an isolated point between gaps is drawn as a dot.
+// path, and an isolated point between gaps is drawn as a dot. A markers_only series is
+// one zero-length subpath ("M x y h0") per point, stroked with round caps.
+// Z-order: all markers_only series are drawn first (underneath), then the lines, each
+// group in index order, so a line stays visible over dense measured points. Colours and
+// the legend follow the index.
 std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions& options);
+
+// Thins a long series for drawing while keeping its peaks and outliers (min/max per
+// bucket): if it has more than `max_points` points (at least 4), its indices are cut into
+// runs ("buckets") of consecutive points of nearly equal length, and each bucket keeps
+// its finite points of lowest and highest y, in their original order (one point if they
+// are the same), plus its first non-finite point if it has one, so that a line still
+// breaks there. There are max_points / 2 buckets, max_points / 3 if the series has a
+// non-finite point, so the result never has more than `max_points` points. Names and
+// style are kept; a series that is short enough is returned unchanged.
+// *buckets (if not null) is set to the number of buckets, 0 if nothing was thinned.
+PlotSeries ThinMinMaxPerBucket(const PlotSeries& series, int max_points, int* buckets = nullptr);
 
 struct HistogramSeries {
   std::string name;
