@@ -9,6 +9,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace fastcal {
@@ -205,6 +206,44 @@ TEST(StaticsTest, WholeWorkspaceCap) {
   EXPECT_LT(worst_refined, kRefinedRelTol);
   // AAS is an approximation: a zero error would mean the comparison compares nothing.
   EXPECT_GT(worst_on, 1e-3);
+}
+
+// The statics' inner tolerances are speed settings, not accuracy ones: a looser start
+// for exact and the 1e-10 catenary tolerance change no result beyond these bounds
+// (measured: exact 7e-14, aas 1e-11).
+TEST(StaticsTest, InnerTolerancesDoNotChangeResults) {
+  constexpr double kExactRelTol = 1e-12;
+  constexpr double kAasRelTol = 1e-9;
+  constexpr double kTightCatenaryTol = 1e-13;
+  const CableRobot robot = CableRobot::NominalFast();
+  for (const Eigen::Vector3d& p : WorkspaceCap()) {
+    const Pose pose = FocalPose(p);
+    for (StaticsMethod m :
+         {StaticsMethod::kAas, StaticsMethod::kAasRefined, StaticsMethod::kExact}) {
+      StaticsOptions fast, tight;
+      fast.method = tight.method = m;
+      tight.catenary.relative_tolerance = kTightCatenaryTol;
+      tight.exact_start_catenary_tolerance = kTightCatenaryTol;
+      StaticsSolution a, b;
+      ASSERT_EQ(SolveStatics(robot, pose, fast, &a), StaticsStatus::kOk) << p.transpose();
+      ASSERT_EQ(SolveStatics(robot, pose, tight, &b), StaticsStatus::kOk) << p.transpose();
+      EXPECT_EQ(a.outer_iterations, b.outer_iterations) << p.transpose();
+      const double tol = m == StaticsMethod::kExact ? kExactRelTol : kAasRelTol;
+      for (int i = 0; i < kNumCables; ++i) {
+        EXPECT_NEAR(a.cables[i].lower_tension_n, b.cables[i].lower_tension_n,
+                    tol * b.cables[i].lower_tension_n)
+            << StaticsMethodName(m) << " " << p.transpose();
+        EXPECT_NEAR(a.cables[i].unstretched_length_m, b.cables[i].unstretched_length_m,
+                    tol * b.cables[i].unstretched_length_m)
+            << StaticsMethodName(m) << " " << p.transpose();
+      }
+    }
+  }
+  StaticsOptions bad;
+  bad.exact_start_catenary_tolerance = 0.0;
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("exact_start_catenary_tolerance"), std::string::npos) << error;
 }
 
 TEST(StaticsTest, ExactSolutionSatisfiesEveryCatenary) {

@@ -16,12 +16,13 @@ namespace {
 constexpr double kMaxShrinkFraction = 0.9;
 // Backtracking halvings per Newton step.
 constexpr int kMaxBacktracks = 30;
-// A full Newton step smaller than this fraction of the unknowns leaves an error of order
-// its square (quadratic convergence), far below relative_tolerance: accept it without
-// another evaluation.
-constexpr double kFinalStepFraction = 1e-7;
-// Relative accuracy of the parabolic start's horizontal force: it is only a start.
-constexpr double kGuessRelativeTolerance = 1e-4;
+// Newton's error after a step of relative size d is about C d^2; C measured <= 1.5 over
+// the FAST workspace for both problems (tests/catenary_test.cc checks the outcome). A
+// step with C d^2 below the tolerance is accepted without another evaluation.
+constexpr double kQuadraticConstant = 2.0;
+// Relative accuracy of the parabolic start's horizontal force: it is only a start, and
+// the parabolic model itself is ~3e-3 off.
+constexpr double kGuessRelativeTolerance = 1e-3;
 constexpr int kGuessMaxIterations = 100;
 
 // std::hypot guards against overflow we cannot meet here and costs ~30x a sqrt.
@@ -34,42 +35,44 @@ bool AllFinite(std::initializer_list<double> values) {
   return true;
 }
 
-// Unknowns u = (u0, u1) are (Fl, Fz) when fixed_index == 2 (s0 fixed), or (Fz, s0) when
-// fixed_index == 0 (Fl fixed). `positive` is the index in u that must stay > 0.
+// The two inverse problems. Unknowns u = (Fl, Fz) at fixed s0 (kFixedLength), or
+// u = (Fz, s0) at fixed Fl; u[kPositive] must stay > 0.
+template <bool kFixedLength>
 struct Problem {
-  double span_m, rise_m, ea_n, w_n_per_m;
-  int fixed_index;
-  double fixed_value;
+  static constexpr int kPositive = kFixedLength ? 0 : 1;
+  double span_m, rise_m, ea_n, w_n_per_m, fixed_value;
 
-  void Unpack(const double u[2], double* fl, double* fz, double* s0) const {
-    if (fixed_index == 2) {
-      *fl = u[0];
-      *fz = u[1];
-      *s0 = fixed_value;
-    } else {
-      *fl = fixed_value;
-      *fz = u[0];
-      *s0 = u[1];
-    }
-  }
   // Residual and 2x2 Jacobian (row-major) with respect to u.
   void Evaluate(const double u[2], double r[2], double jac[4]) const {
-    double fl, fz, s0;
-    Unpack(u, &fl, &fz, &s0);
-    const CatenaryEnd<double> e = CatenaryEndpoint(fl, fz, s0, ea_n, w_n_per_m);
+    const CatenaryEnd<double> e = kFixedLength
+                                      ? CatenaryEndpoint(u[0], u[1], fixed_value, ea_n, w_n_per_m)
+                                      : CatenaryEndpoint(fixed_value, u[0], u[1], ea_n, w_n_per_m);
+    constexpr int c0 = kFixedLength ? 0 : 1;
     r[0] = e.span_m - span_m;
     r[1] = e.rise_m - rise_m;
-    const int c0 = fixed_index == 2 ? 0 : 1;
-    const int c1 = fixed_index == 2 ? 1 : 2;
     jac[0] = e.dspan[c0];
-    jac[1] = e.dspan[c1];
+    jac[1] = e.dspan[c0 + 1];
     jac[2] = e.drise[c0];
-    jac[3] = e.drise[c1];
+    jac[3] = e.drise[c0 + 1];
+  }
+  // Whether a Newton step is small enough to leave an error C d^2 below `tolerance`, d
+  // measured relative to its scale: forces relative to the lower-end tension (Fz alone
+  // may be near zero), the length relative to itself. Squared: no root, no division.
+  bool StepIsFinal(const double u[2], const double step[2], double tolerance) const {
+    if (kFixedLength) {
+      return kQuadraticConstant * (step[0] * step[0] + step[1] * step[1]) <=
+             tolerance * (u[0] * u[0] + u[1] * u[1]);
+    }
+    return kQuadraticConstant * step[0] * step[0] <=
+               tolerance * (fixed_value * fixed_value + u[0] * u[0]) &&
+           kQuadraticConstant * step[1] * step[1] <= tolerance * u[1] * u[1];
   }
 };
 
-CatenaryStatus Newton(const Problem& problem, int positive, double chord_m,
+template <bool kFixedLength>
+CatenaryStatus Newton(const Problem<kFixedLength>& problem, double chord_m,
                       const CatenarySolverOptions& options, double u[2], int* iterations) {
+  constexpr int positive = Problem<kFixedLength>::kPositive;
   const double tolerance_m = options.relative_tolerance * chord_m;
   double r[2], jac[4];
   problem.Evaluate(u, r, jac);
@@ -83,10 +86,11 @@ CatenaryStatus Newton(const Problem& problem, int positive, double chord_m,
     if (it == options.max_iterations) break;
     const double det = jac[0] * jac[3] - jac[1] * jac[2];
     if (!(std::abs(det) > 0.0) || !std::isfinite(det)) break;
-    const double step[2] = {-(jac[3] * r[0] - jac[1] * r[1]) / det,
-                            -(-jac[2] * r[0] + jac[0] * r[1]) / det};
-    if (std::abs(step[0]) <= kFinalStepFraction * std::abs(u[0]) &&
-        std::abs(step[1]) <= kFinalStepFraction * std::abs(u[1])) {
+    const double inv_det = 1.0 / det;
+    const double step[2] = {-(jac[3] * r[0] - jac[1] * r[1]) * inv_det,
+                            -(-jac[2] * r[0] + jac[0] * r[1]) * inv_det};
+    if (problem.StepIsFinal(u, step, options.relative_tolerance) &&
+        u[positive] + step[positive] > 0.0) {
       u[0] += step[0];
       u[1] += step[1];
       *iterations = it + 1;
@@ -160,36 +164,52 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
   const double k = Norm2(span_m, rise_m);
   const double c = k / (span_m * ea_n);
   const double b = w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0;
-  auto f = [&](double h) { return s0_m * s0_m * (1 + c * h) * (1 + c * h) - k * k - b / (h * h); };
-  auto df = [&](double h) { return 2 * s0_m * s0_m * c * (1 + c * h) + 2 * b / (h * h * h); };
-  // f is increasing in H with one positive root: bracket it, then safeguarded Newton.
-  // Elastic straight-bar force (s0 < k) or weight scale, whichever is larger.
-  const double scale = std::max(std::abs(w_n_per_m) * span_m, std::max(0.0, k / s0_m - 1.0) / c);
-  double lo = std::max(scale, 1e-300), hi = lo;
-  for (int i = 0; i < 200 && f(lo) > 0; ++i) lo *= 0.25;
-  for (int i = 0; i < 200 && f(hi) < 0; ++i) hi *= 4.0;
-  double h = std::sqrt(lo * hi);
+  // g(H) = H^2 (s0^2 (1 + c H)^2 - k^2) - b has its one positive root above
+  // H_t = max(0, (k/s0 - 1)/c) and is increasing and convex there, so Newton from an
+  // upper bound decreases monotonically onto the root. Upper bounds, with D^3 = b/(2 k s0 c):
+  //   g(H_t + D) >= 0                  (as s0 (1 + c H_t) >= k, g(H_t + d) >= 2 k s0 c d^3 - b)
+  //   g(H_t + D^3/H_t^2) >= 0, s0 < k   (same, with (H_t + d)^2 >= H_t^2)
+  //   g(sqrt(b/(s0^2 - k^2))) >= 0, s0 > k   (as (1 + c H)^2 >= 1)
+  // Taking the smaller of the two that apply leaves 1-4 Newton steps over the workspace.
+  auto g = [&](double h) {
+    const double q = s0_m * (1.0 + c * h);
+    return h * h * (q * q - k * k) - b;
+  };
+  auto dg = [&](double h) {
+    const double q = s0_m * (1.0 + c * h);
+    return 2.0 * h * (q * q - k * k) + 2.0 * h * h * q * s0_m * c;
+  };
+  const double d3 = b / (2.0 * k * s0_m * c);
+  double h;
+  if (s0_m < k) {
+    const double h_t = (k / s0_m - 1.0) / c;
+    const double d = d3 / (h_t * h_t);
+    h = h_t + (d * d * d <= d3 ? d : std::cbrt(d3));
+  } else {
+    const double h_s = s0_m > k ? std::sqrt(b / (s0_m * s0_m - k * k)) : HUGE_VAL;
+    h = h_s * h_s * h_s <= d3 ? h_s : std::cbrt(d3);
+  }
   for (int i = 0; i < kGuessMaxIterations; ++i) {
-    const double fh = f(h);
-    if (fh < 0)
-      lo = h;
-    else
-      hi = h;
-    double next = h - fh / df(h);
-    if (!(next > lo && next < hi)) next = std::sqrt(lo * hi);
-    if (std::abs(next - h) <= kGuessRelativeTolerance * h) {
-      h = next;
-      break;
-    }
-    h = next;
+    const double step = g(h) / dg(h);
+    if (!(step > 0.0)) break;  // at the root to rounding
+    h -= step;
+    if (step <= kGuessRelativeTolerance * h) break;
   }
   CatenaryForces guess;
   guess.fl_n = h;
   // Vertical force at the lower end of the inextensible catenary with horizontal force H:
   // Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
-  // parabolic limit -H Z/L + |w| s0/2 over the workspace.
+  // parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from one exp (tanh costs
+  // three times as much); its series below 1e-3, where 1 - exp(-2 lambda) cancels.
   const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h);
-  guess.fz_n = 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m / std::tanh(lambda));
+  double coth;
+  if (lambda < 1e-3) {
+    coth = 1.0 / lambda + lambda / 3.0;
+  } else {
+    const double e = std::exp(-2.0 * lambda);
+    coth = (1.0 + e) / (1.0 - e);
+  }
+  guess.fz_n = 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
   return guess;
 }
 
@@ -207,10 +227,9 @@ CatenaryStatus SolveCatenaryForcesDouble(double span_m, double rise_m, double s0
   } else {
     start = CatenaryInitialGuess(span_m, rise_m, s0_m, ea_n, w_n_per_m);
   }
-  const Problem problem{span_m, rise_m, ea_n, w_n_per_m, /*fixed_index=*/2, s0_m};
+  const Problem</*kFixedLength=*/true> problem{span_m, rise_m, ea_n, w_n_per_m, s0_m};
   double u[2] = {start.fl_n, start.fz_n};
-  const CatenaryStatus status =
-      Newton(problem, /*positive=*/0, Norm2(span_m, rise_m), options, u, iterations);
+  const CatenaryStatus status = Newton(problem, Norm2(span_m, rise_m), options, u, iterations);
   forces->fl_n = u[0];
   forces->fz_n = u[1];
   return status;
@@ -235,9 +254,9 @@ CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl
     start.s0_m = std::sqrt(k * k + b / (fl_n * fl_n)) / (1.0 + c * fl_n);
     start.fz_n = -fl_n * rise_m / span_m - 0.5 * w_n_per_m * start.s0_m;
   }
-  const Problem problem{span_m, rise_m, ea_n, w_n_per_m, /*fixed_index=*/0, fl_n};
+  const Problem</*kFixedLength=*/false> problem{span_m, rise_m, ea_n, w_n_per_m, fl_n};
   double u[2] = {start.fz_n, start.s0_m};
-  const CatenaryStatus status = Newton(problem, /*positive=*/1, k, options, u, iterations);
+  const CatenaryStatus status = Newton(problem, k, options, u, iterations);
   point->fz_n = u[0];
   point->s0_m = u[1];
   return status;

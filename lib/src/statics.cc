@@ -2,6 +2,7 @@
 #include "fastcal/statics.h"
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
@@ -83,8 +84,15 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
   int* cable = &sol->cable;
   int* its = &sol->catenary_iterations;
   if (!have_state) {
+    // For kExact, AAS is only the start: build it with loose per-cable solves.
+    StaticsOptions start_options = o;
+    if (o.method == StaticsMethod::kExact) {
+      start_options.catenary.relative_tolerance =
+          std::max(o.catenary.relative_tolerance, o.exact_start_catenary_tolerance);
+    }
+    const StaticsOptions& so = start_options;
     std::array<double, kNumCables> a, b, fl;
-    status = internal::AasLines(p, g, o, previous != nullptr, &low, &high, &a, &b, cable, its);
+    status = internal::AasLines(p, g, so, previous != nullptr, &low, &high, &a, &b, cable, its);
     if (status != StaticsStatus::kOk) return status;
     if (!internal::SolveEquilibrium(g, a, b, &fl)) return StaticsStatus::kSingular;
     for (int i = 0; i < kNumCables; ++i) {
@@ -104,7 +112,7 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
         guess[i] = internal::CurveGuess(st[i].fl, g.chord[i], low[i], high[i], o);
       }
       std::array<CableState<double>, kNumCables> projected = st;
-      status = internal::ProjectOnCurves(p, g, o, guess, &projected, cable, its);
+      status = internal::ProjectOnCurves(p, g, so, guess, &projected, cable, its);
       if (status != StaticsStatus::kOk) return status;
       if (o.method == StaticsMethod::kAas) {
         // AAS keeps Fz on its secant line (which satisfies equilibrium); s0 is the length
@@ -194,6 +202,9 @@ bool StaticsOptions::IsValid(std::string* error) const {
     e << "refinement_steps must be >= 1 (got " << refinement_steps << ")";
   } else if (!(exact_relative_tolerance > 0.0)) {
     e << "exact_relative_tolerance must be > 0 (got " << exact_relative_tolerance << ")";
+  } else if (!(exact_start_catenary_tolerance > 0.0)) {
+    e << "exact_start_catenary_tolerance must be > 0 (got " << exact_start_catenary_tolerance
+      << ")";
   } else if (exact_max_iterations < 1) {
     e << "exact_max_iterations must be >= 1 (got " << exact_max_iterations << ")";
   } else if (!(catenary.relative_tolerance > 0.0) || catenary.max_iterations < 1) {

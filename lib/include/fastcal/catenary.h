@@ -53,25 +53,33 @@ CatenaryEnd<T> CatenaryEndpoint(const T& fl_n, const T& fz_n, const T& s0_m, con
   using std::sqrt;
   const T ws = w_n_per_m * s0_m;
   const T fz1 = fz_n + ws;
-  const T t0 = sqrt(fl_n * fl_n + fz_n * fz_n);
-  const T t1 = sqrt(fl_n * fl_n + fz1 * fz1);
+  const T fl2 = fl_n * fl_n;
+  const T t0 = sqrt(fl2 + fz_n * fz_n);
+  const T t1 = sqrt(fl2 + fz1 * fz1);
   const T s = t0 + t1;
-  const T two_fz_ws = fz_n + fz1;
-  const T p = fz_n * two_fz_ws / s;
-  const T q = t0 - p;
-  const T d = Asinh(ws * q / (fl_n * fl_n));
-  const T d_over_w = d / w_n_per_m;
   const T t0t1 = t0 * t1;
-  const T cross = s0_m * two_fz_ws / (s * t0t1);
+  // One division for 1/S, 1/(T0 T1) and 1/T1: divisions dominate the cost of a solve.
+  const T inv_s_t0t1 = T(1) / (s * t0t1);
+  const T inv_s = inv_s_t0t1 * t0t1;
+  const T inv_t0t1 = inv_s_t0t1 * s;
+  const T inv_t1 = inv_t0t1 * t0;
+  const T inv_ea = T(1) / ea_n;
+  const T two_fz_ws = fz_n + fz1;
+  const T p = fz_n * two_fz_ws * inv_s;
+  const T q = t0 - p;
+  const T d = Asinh(ws * q / fl2);
+  const T d_over_w = d / w_n_per_m;
+  const T cross = s0_m * two_fz_ws * inv_s_t0t1;
+  const T s0_q_t0t1 = s0_m * q * inv_t0t1;
   CatenaryEnd<T> end;
-  end.span_m = fl_n * s0_m / ea_n + fl_n * d_over_w;
-  end.rise_m = -fz_n * s0_m / ea_n - ws * s0_m / (T(2) * ea_n) - s0_m * two_fz_ws / s;
-  end.dspan[0] = s0_m / ea_n + d_over_w - s0_m * q / t0t1;
+  end.span_m = (fl_n * s0_m) * inv_ea + fl_n * d_over_w;
+  end.rise_m = -(fz_n + T(0.5) * ws) * s0_m * inv_ea - s0_m * two_fz_ws * inv_s;
+  end.dspan[0] = s0_m * inv_ea + d_over_w - s0_q_t0t1;
   end.dspan[1] = -fl_n * cross;
-  end.dspan[2] = fl_n / ea_n + fl_n / t1;
+  end.dspan[2] = fl_n * (inv_ea + inv_t1);
   end.drise[0] = fl_n * cross;
-  end.drise[1] = -s0_m / ea_n - s0_m * q / t0t1;
-  end.drise[2] = -fz1 / ea_n - fz1 / t1;
+  end.drise[1] = -s0_m * inv_ea - s0_q_t0t1;
+  end.drise[2] = -fz1 * (inv_ea + inv_t1);
   return end;
 }
 

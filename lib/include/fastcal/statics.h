@@ -54,6 +54,10 @@ struct StaticsOptions {
   // relative to the chord), is below this.
   double exact_relative_tolerance = 1e-12;
   int exact_max_iterations = 30;
+  // kExact only: tolerance of the per-cable solves that build its AAS start (one Newton
+  // step each instead of two). The start is then ~1e-5 from AAS, itself ~1e-3 from the
+  // solution, so Newton needs the same number of steps and the result is unchanged.
+  double exact_start_catenary_tolerance = 1e-4;
   // kAas only: solve for s0_i (one 2x2 Newton per cable). Off, s0 and the upper-end
   // tension are reported as 0; the lower-end forces do not depend on it.
   bool compute_unstretched_lengths = true;
@@ -61,8 +65,11 @@ struct StaticsOptions {
   // previous node of a trajectory: the secant solves and the exact Newton start there.
   // A warm start that fails is retried cold.
   bool warm_start = false;
-  // The per-cable Newton solves.
-  CatenarySolverOptions catenary;
+  // The per-cable Newton solves. Their tolerance is looser than a lone solve's default
+  // (1e-12): inside the statics each result starts a Newton iteration (exact), is
+  // followed by one (aas-refined), or feeds a method whose own error is ~1e-3 (aas), so
+  // tighter buys no accuracy and costs an evaluation per solve.
+  CatenarySolverOptions catenary = {/*relative_tolerance=*/1e-10};
 
   bool IsValid(std::string* error) const;
 };

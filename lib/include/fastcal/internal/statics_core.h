@@ -101,7 +101,9 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
                       const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl) {
   // Smallest/largest pivot below which the 6x6 system counts as singular.
   constexpr double kMinReciprocalCondition = 1e-13;
-  Eigen::Matrix<T, 6, 6> m;
+  // Row-major, and for double full-length row operations below: fixed trip counts the
+  // compiler unrolls and vectorises (entries left of the pivot go stale, never read).
+  Eigen::Matrix<T, 6, 6, Eigen::RowMajor> m;
   Eigen::Matrix<T, 6, 1> rhs;
   rhs << T(0), T(0), g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n, T(0);
   for (int i = 0; i < kNumCables; ++i) {
@@ -120,6 +122,8 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
   // times faster than Eigen's blocked PartialPivLU plus its rcond() estimate.
   using std::abs;
   double max_pivot = 0.0, min_pivot = std::numeric_limits<double>::infinity();
+  std::array<T, 6> inv_pivot;
+#pragma GCC unroll 6
   for (int c = 0; c < 6; ++c) {
     int p = c;
     for (int r = c + 1; r < 6; ++r) {
@@ -133,9 +137,12 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
     max_pivot = std::max(max_pivot, pivot);
     min_pivot = std::min(min_pivot, pivot);
     if (!(pivot > 0.0)) return false;
+    inv_pivot[c] = T(1) / m(c, c);
+#pragma GCC unroll 6
     for (int r = c + 1; r < 6; ++r) {
-      const T f = m(r, c) / m(c, c);
-      for (int k = c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
+      const T f = m(r, c) * inv_pivot[c];
+#pragma GCC unroll 6
+      for (int k = kIsDouble<T> ? 0 : c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
       rhs[r] -= f * rhs[c];
     }
   }
@@ -145,7 +152,7 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
   for (int r = 5; r >= 0; --r) {
     T acc = rhs[r];
     for (int k = r + 1; k < 6; ++k) acc -= m(r, k) * x[k];
-    x[r] = acc / m(r, r);
+    x[r] = acc * inv_pivot[r];
   }
   for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
   return true;
