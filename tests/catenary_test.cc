@@ -106,6 +106,79 @@ TEST(CatenaryTest, AsinhMatchesStdAsinhOnBothSidesOfItsSwitch) {
   }
 }
 
+// The batch solvers take exactly the iterations of one-at-a-time solves, so results,
+// iteration counts and statuses are identical, bit for bit, also with failing problems
+// (invalid input, vertical chord) and far-off starts (limited, backtracked steps) in the
+// batch.
+TEST(CatenaryTest, BatchSolvesEqualSingleSolvesExactly) {
+  const CatenarySolverOptions options;
+  const std::vector<Chord> chords = RandomChords(kMaxCatenaryBatch - 3, 0.95, 1.05);
+  std::vector<CatenaryProblem> problems;
+  std::vector<CatenaryLengthProblem> length_problems;
+  for (const Chord& c : chords) {
+    problems.push_back({c.span_m, c.rise_m, c.s0_m, kEaN, kWNPerM, nullptr});
+    length_problems.push_back({c.span_m, c.rise_m, 1e5, kEaN, kWNPerM, nullptr});
+  }
+  problems.push_back({250.0, 120.0, -1.0, kEaN, kWNPerM, nullptr});  // invalid s0
+  problems.push_back({0.0, 120.0, 130.0, kEaN, kWNPerM, nullptr});   // vertical chord
+  // Far-off starts: Newton needs limited and backtracked steps (8 and 12 iterations).
+  const CatenaryForces bad_forces{1.0, -1e6};
+  const CatenaryCurvePoint bad_point{5e5, 0.5 * std::hypot(250.0, 120.0)};
+  problems.push_back({250.0, 120.0, 1.05 * std::hypot(250.0, 120.0), kEaN, kWNPerM, &bad_forces});
+  length_problems.push_back({250.0, 120.0, -5.0, kEaN, kWNPerM, nullptr});  // invalid Fl
+  length_problems.push_back({0.0, 120.0, 1e5, kEaN, kWNPerM, nullptr});     // vertical chord
+  length_problems.push_back({250.0, 120.0, 5e4, kEaN, kWNPerM, &bad_point});
+  const int n = static_cast<int>(problems.size());
+  ASSERT_EQ(n, kMaxCatenaryBatch);
+
+  std::vector<CatenaryForces> forces(n);
+  std::vector<CatenaryStatus> statuses(n);
+  std::vector<int> iterations(n);
+  SolveCatenaryForcesBatch(n, problems.data(), options, forces.data(), statuses.data(),
+                           iterations.data());
+  std::vector<CatenaryCurvePoint> points(n);
+  std::vector<CatenaryStatus> length_statuses(n);
+  std::vector<int> length_iterations(n);
+  SolveCatenaryLengthBatch(n, length_problems.data(), options, points.data(),
+                           length_statuses.data(), length_iterations.data());
+  int ok = 0;
+  for (int j = 0; j < n; ++j) {
+    const CatenaryProblem& c = problems[j];
+    CatenaryForces f;
+    int it = -1;
+    EXPECT_EQ(SolveCatenaryForcesDouble(c.span_m, c.rise_m, c.s0_m, c.ea_n, c.w_n_per_m, options,
+                                        c.guess, &f, &it),
+              statuses[j])
+        << j;
+    EXPECT_EQ(it, iterations[j]) << j;
+    if (statuses[j] == CatenaryStatus::kOk) {
+      ++ok;
+      EXPECT_EQ(f.fl_n, forces[j].fl_n) << j;
+      EXPECT_EQ(f.fz_n, forces[j].fz_n) << j;
+    }
+    const CatenaryLengthProblem& l = length_problems[j];
+    CatenaryCurvePoint point;
+    EXPECT_EQ(SolveCatenaryLengthDouble(l.span_m, l.rise_m, l.fl_n, l.ea_n, l.w_n_per_m, options,
+                                        l.guess, &point, &it),
+              length_statuses[j])
+        << j;
+    EXPECT_EQ(it, length_iterations[j]) << j;
+    if (length_statuses[j] == CatenaryStatus::kOk) {
+      ++ok;
+      EXPECT_EQ(point.fz_n, points[j].fz_n) << j;
+      EXPECT_EQ(point.s0_m, points[j].s0_m) << j;
+    }
+  }
+  // The batch must hold the failures it was given and real solutions besides.
+  EXPECT_EQ(statuses[n - 3], CatenaryStatus::kInvalidInput);
+  EXPECT_EQ(statuses[n - 2], CatenaryStatus::kVerticalChord);
+  EXPECT_EQ(length_statuses[n - 3], CatenaryStatus::kInvalidInput);
+  EXPECT_EQ(length_statuses[n - 2], CatenaryStatus::kVerticalChord);
+  EXPECT_GE(ok, 2 * (n - 2));
+  EXPECT_GE(iterations[n - 1], 5);
+  EXPECT_GE(length_iterations[n - 1], 5);
+}
+
 TEST(CatenaryTest, ForwardThenInverseRecoversForces) {
   std::mt19937_64 rng(kSeed + 1);
   std::uniform_real_distribution<double> fl(2e4, 4e5), slope(-1.2, -0.1), len(250.0, 450.0);

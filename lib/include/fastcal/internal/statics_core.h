@@ -171,6 +171,41 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                        std::array<CatenaryForces, kNumCables>* low,
                        std::array<CatenaryForces, kNumCables>* high, std::array<T, kNumCables>* a,
                        std::array<T, kNumCables>* b, int* cable, int* iterations) {
+  if constexpr (kIsDouble<T>) {
+    // All twelve solves at once (low lengths, then high): same results, overlapped.
+    CatenaryProblem problems[2 * kNumCables];
+    CatenaryForces solved[2 * kNumCables];
+    CatenaryStatus statuses[2 * kNumCables];
+    int its[2 * kNumCables];
+    for (int i = 0; i < kNumCables; ++i) {
+      for (int h = 0; h < 2; ++h) {
+        CatenaryProblem& c = problems[i + h * kNumCables];
+        c.span_m = g.span[i];
+        c.rise_m = g.rise[i];
+        c.s0_m = (h == 0 ? o.secant_low_fraction : o.secant_high_fraction) * g.chord[i];
+        c.ea_n = p.ea_n[i];
+        c.w_n_per_m = g.w[i];
+        c.guess = use_guess ? (h == 0 ? &(*low)[i] : &(*high)[i]) : nullptr;
+      }
+    }
+    SolveCatenaryForcesBatch(2 * kNumCables, problems, o.catenary, solved, statuses, its);
+    for (int i = 0; i < kNumCables; ++i) {
+      *iterations += its[i] + its[i + kNumCables];
+      for (CatenaryStatus s : {statuses[i], statuses[i + kNumCables]}) {
+        if (s != CatenaryStatus::kOk) {
+          *cable = i;
+          return s == CatenaryStatus::kVerticalChord ? StaticsStatus::kVerticalCable
+                                                     : StaticsStatus::kCatenaryFailed;
+        }
+      }
+      const CatenaryForces &f1 = solved[i], &f2 = solved[i + kNumCables];
+      (*a)[i] = (f2.fz_n - f1.fz_n) / (f2.fl_n - f1.fl_n);
+      (*b)[i] = f1.fz_n - (*a)[i] * f1.fl_n;
+      (*low)[i] = f1;
+      (*high)[i] = f2;
+    }
+    return StaticsStatus::kOk;
+  }
   for (int i = 0; i < kNumCables; ++i) {
     T fl1, fz1, fl2, fz2;
     int it1 = 0, it2 = 0;
@@ -207,11 +242,34 @@ StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<
                               std::array<CableState<T>, kNumCables>* state, int* cable,
                               int* iterations) {
   for (int i = 0; i < kNumCables; ++i) {
-    CableState<T>& c = (*state)[i];
-    if (!(ScalarValue(c.fl) > 0.0)) {
+    if (!(ScalarValue((*state)[i].fl) > 0.0)) {
       *cable = i;
       return StaticsStatus::kSlackCable;
     }
+  }
+  if constexpr (kIsDouble<T>) {
+    // The six solves at once: same results, overlapped (catenary.h).
+    CatenaryLengthProblem problems[kNumCables];
+    CatenaryCurvePoint points[kNumCables];
+    CatenaryStatus statuses[kNumCables];
+    int its[kNumCables];
+    for (int i = 0; i < kNumCables; ++i) {
+      problems[i] = {g.span[i], g.rise[i], (*state)[i].fl, p.ea_n[i], g.w[i], &guess[i]};
+    }
+    SolveCatenaryLengthBatch(kNumCables, problems, o.catenary, points, statuses, its);
+    for (int i = 0; i < kNumCables; ++i) {
+      *iterations += its[i];
+      if (statuses[i] != CatenaryStatus::kOk) {
+        *cable = i;
+        return StaticsStatus::kCatenaryFailed;
+      }
+      (*state)[i].fz = points[i].fz_n;
+      (*state)[i].s0 = points[i].s0_m;
+    }
+    return StaticsStatus::kOk;
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    CableState<T>& c = (*state)[i];
     int it = 0;
     const CatenaryStatus s = SolveCatenaryLength(g.span[i], g.rise[i], c.fl, p.ea_n[i], g.w[i],
                                                  o.catenary, &guess[i], &c.fz, &c.s0, &it);
