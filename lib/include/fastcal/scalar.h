@@ -9,6 +9,14 @@
 #include <cmath>
 #include <type_traits>
 
+// For the few small functions on the statics' hot path that the compiler's heuristics
+// leave out of line.
+#if defined(__GNUC__)
+#define FASTCAL_ALWAYS_INLINE inline __attribute__((always_inline))
+#else
+#define FASTCAL_ALWAYS_INLINE inline
+#endif
+
 namespace fastcal {
 
 inline double ScalarValue(double x) { return x; }
