@@ -371,6 +371,50 @@ TEST(StaticsTest, WarmStartGivesTheColdSolution) {
   }
 }
 
+// Solutions of the equations that describe no cable are refused (StaticsOptions'
+// max_strain, max_length_ratio), for every method and also after a warm start.
+TEST(StaticsTest, SolutionsOutsideTheModelsRangeAreRefused) {
+  const CableRobot robot = CableRobot::NominalFast();
+  // 10 m below the tower tops the cables are nearly horizontal: exact needs 1898 kN per
+  // cable, 7.7% strain.
+  Pose high;
+  high.position_m = Eigen::Vector3d(0, 0, 260);
+  EXPECT_EQ(Solve(robot, high, StaticsMethod::kExact).status, StaticsStatus::kOverstretchedCable);
+  // 1 cm below them aas-refined's Newton step overshoots to s0 < 0.
+  Pose top;
+  top.position_m = Eigen::Vector3d(0, 0, 269.99);
+  EXPECT_EQ(Solve(robot, top, StaticsMethod::kAasRefined).status,
+            StaticsStatus::kOverstretchedCable);
+  // 43 deg off axis cable 3 nearly goes slack: AAS's secant, extrapolated, gives it
+  // s0 = 6.5e6 m (exact: 474 m, 1.33 chords, inside the limit).
+  const Pose edge = FocalPose(Eigen::Vector3d(109.2820323, 29.2820323, 186.862915));
+  const StaticsSolution aas = Solve(robot, edge, StaticsMethod::kAas);
+  EXPECT_EQ(aas.status, StaticsStatus::kSlackCable);
+  EXPECT_EQ(aas.cable, 2);
+  EXPECT_EQ(Solve(robot, edge, StaticsMethod::kExact).status, StaticsStatus::kOk);
+  // Warm-started from K2, exact's Newton reaches a root with s0 = 4.9 m and 1.45e6 kN:
+  // refused, then retried cold, which reports the slack cable.
+  StaticsOptions warm;
+  warm.method = StaticsMethod::kExact;
+  warm.warm_start = true;
+  StaticsSolution s;
+  ASSERT_EQ(SolveStatics(robot, FocalPose(Eigen::Vector3d(42.65, 33.73, 149.52)), warm, &s),
+            StaticsStatus::kOk);
+  EXPECT_NE(SolveStatics(robot, top, warm, &s), StaticsStatus::kOk);
+  for (const CableSolution& c : s.cables) EXPECT_EQ(c.lower_tension_n, 0.0);
+  // The limits are options: allow 10% strain and the 260 m pose solves.
+  StaticsOptions lenient;
+  lenient.method = StaticsMethod::kExact;
+  lenient.max_strain = 0.1;
+  ASSERT_EQ(SolveStatics(robot, high, lenient, &s), StaticsStatus::kOk);
+  EXPECT_NEAR(s.cables[0].lower_tension_n / kKn, 1898.49, 0.01);
+  StaticsOptions bad;
+  bad.max_strain = 0.0;
+  std::string error;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("max_strain"), std::string::npos) << error;
+}
+
 TEST(StaticsTest, InfeasibleAndInvalidPosesReportStatusNotNan) {
   const CableRobot robot = CableRobot::NominalFast();
   Pose outside;  // beyond the tower circle: the far cables cannot pull it back

@@ -48,6 +48,36 @@ void FillSolution(const StaticsParameters<double>& p, const internal::PoseGeomet
   sol->moment_residual_nm = moment_sum.norm();
 }
 
+// The model-range limits of StaticsOptions, on the finished solution: s0 in
+// (0, max_length_ratio k] (when computed: AAS may skip it), then every cable's lower and
+// upper tension within max_strain EA.
+StaticsStatus CheckModelRange(const StaticsParameters<double>& p,
+                              const internal::PoseGeometry<double>& g,
+                              const std::array<internal::CableState<double>, kNumCables>& st,
+                              bool have_lengths, const StaticsOptions& o, int* cable) {
+  for (int i = 0; i < kNumCables; ++i) {
+    const double lower_n = std::sqrt(st[i].fl * st[i].fl + st[i].fz * st[i].fz);
+    double upper_n = lower_n;
+    if (have_lengths) {
+      const double s0_m = st[i].s0;
+      if (s0_m > o.max_length_ratio * g.chord[i]) {
+        *cable = i;
+        return StaticsStatus::kSlackCable;
+      }
+      if (!(s0_m > 0.0)) {
+        *cable = i;
+        return StaticsStatus::kOverstretchedCable;
+      }
+      upper_n = CatenaryTension(st[i].fl, st[i].fz, s0_m, g.w[i]);
+    }
+    if (!(std::max(lower_n, upper_n) <= o.max_strain * p.ea_n[i])) {
+      *cable = i;
+      return StaticsStatus::kOverstretchedCable;
+    }
+  }
+  return StaticsStatus::kOk;
+}
+
 StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, const StaticsOptions& o,
                       const StaticsSolution* previous, StaticsSolution* sol) {
   using internal::CableState;
@@ -144,6 +174,9 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
     }
     if (!converged) return StaticsStatus::kNotConverged;
   }
+  const bool have_lengths = o.method != StaticsMethod::kAas || o.compute_unstretched_lengths;
+  status = CheckModelRange(p, g, st, have_lengths, o, cable);
+  if (status != StaticsStatus::kOk) return status;
   FillSolution(p, g, st, low, high, sol);
   return StaticsStatus::kOk;
 }
@@ -188,6 +221,8 @@ const char* StaticsStatusName(StaticsStatus status) {
       return "catenary not converged";
     case StaticsStatus::kNotConverged:
       return "not converged";
+    case StaticsStatus::kOverstretchedCable:
+      return "overstretched cable";
   }
   return "unknown";
 }
@@ -205,6 +240,9 @@ bool StaticsOptions::IsValid(std::string* error) const {
   } else if (!(exact_start_catenary_tolerance > 0.0)) {
     e << "exact_start_catenary_tolerance must be > 0 (got " << exact_start_catenary_tolerance
       << ")";
+  } else if (!(max_strain > 0.0) || !(max_length_ratio > 1.0)) {
+    e << "max_strain must be > 0 and max_length_ratio > 1 (got " << max_strain << ", "
+      << max_length_ratio << ")";
   } else if (exact_max_iterations < 1) {
     e << "exact_max_iterations must be >= 1 (got " << exact_max_iterations << ")";
   } else if (!(catenary.relative_tolerance > 0.0) || catenary.max_iterations < 1) {
@@ -268,7 +306,9 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       break;
     case StaticsStatus::kSlackCable:
       s << "cable " << c
-        << " would be slack (horizontal force <= 0): the pose cannot be held with taut cables";
+        << " would be slack (horizontal force <= 0, or so long that it hangs in a loop: "
+           "unstretched length above max_length_ratio, 1.5 by default, times its chord): "
+           "the pose cannot be held with taut cables";
       break;
     case StaticsStatus::kSingular:
       s << "the equilibrium equations are singular at this pose";
@@ -278,6 +318,11 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       break;
     case StaticsStatus::kNotConverged:
       s << "the exact solver did not converge";
+      break;
+    case StaticsStatus::kOverstretchedCable:
+      s << "cable " << c
+        << " would be stretched beyond the model's elastic range (tension above max_strain, "
+           "3% by default, times EA): the pose cannot be held as modelled";
       break;
   }
   return s.str();

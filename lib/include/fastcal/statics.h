@@ -61,6 +61,15 @@ struct StaticsOptions {
   // kAas only: solve for s0_i (one 2x2 Newton per cable). Off, s0 and the upper-end
   // tension are reported as 0; the lower-end forces do not depend on it.
   bool compute_unstretched_lengths = true;
+  // Limits of the model's range, checked on every solution. A cable whose tension
+  // exceeds max_strain EA (or whose s0 <= 0) is refused as kOverstretchedCable: a linear
+  // elastic bar stretched by several percent is no steel cable. One whose unstretched
+  // length exceeds max_length_ratio times its chord is refused as kSlackCable: it hangs
+  // in a deep loop, which is where AAS's secant, extrapolated, stops meaning anything.
+  // Over the workspace cap +-3 m the highest strain is 1.41% and s0/k lies in
+  // [0.986, 1.004] (nominal FAST, all three methods).
+  double max_strain = 0.03;
+  double max_length_ratio = 1.5;
   // Start from the solution already in *solution (when its status is ok), e.g. the
   // previous node of a trajectory: the secant solves and the exact Newton start there.
   // A warm start that fails is retried cold.
@@ -76,12 +85,13 @@ struct StaticsOptions {
 
 enum class StaticsStatus {
   kOk = 0,
-  kInvalidInput,    // non-finite pose or parameters
-  kVerticalCable,   // a chord is vertical: Fl's direction is undefined
-  kSlackCable,      // the equilibrium needs Fl_i <= 0: the pose cannot be held taut
-  kSingular,        // the 6x6 equilibrium matrix is singular
-  kCatenaryFailed,  // a per-cable solve did not converge
-  kNotConverged,    // kExact did not converge in exact_max_iterations
+  kInvalidInput,        // non-finite pose or parameters
+  kVerticalCable,       // a chord is vertical: Fl's direction is undefined
+  kSlackCable,          // the equilibrium needs Fl_i <= 0: the pose cannot be held taut
+  kSingular,            // the 6x6 equilibrium matrix is singular
+  kCatenaryFailed,      // a per-cable solve did not converge
+  kNotConverged,        // kExact did not converge in exact_max_iterations
+  kOverstretchedCable,  // a tension above max_strain EA, or s0 <= 0
 };
 const char* StaticsStatusName(StaticsStatus status);
 
