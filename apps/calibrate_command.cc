@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -25,8 +26,8 @@ DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).
 DEFINE_string(data, "", "Measurement CSV (docs/data-format.md).");
 DEFINE_string(out, "", "Output directory (must not exist, or be empty).");
 DEFINE_bool(skip_invalid_rows, false,
-            "Skip dataset rows with a missing, non-numeric or non-finite value (listed) "
-            "instead of failing.");
+            "Skip dataset rows that are malformed or whose pose the model cannot solve "
+            "(listed on stderr and in the report) instead of failing.");
 DEFINE_bool(quiet, false, "calibrate: no per-iteration progress.");
 
 namespace fastcal::cli {
@@ -49,7 +50,10 @@ Usage:
                       (docs/data-format.md)
   --out=DIR           output directory; must not exist or be empty. Written only when the
                       calibration succeeded: nothing is left behind on failure.
-  --skip-invalid-rows skip (and list) rows with missing, non-numeric or non-finite values
+  --skip-invalid-rows skip rows that are malformed (a missing, non-numeric or non-finite
+                      value, a tension <= 0...) or whose pose the initial model cannot
+                      solve (e.g. outside the workspace), instead of failing; each is
+                      listed with its line on stderr, in the report and in summary.json
   --quiet             no per-iteration solver progress
 
 Before solving, the free set is checked: if the data (and priors) cannot determine it --
@@ -63,7 +67,13 @@ Outputs in DIR:
   summary.json            the same, machine-readable, with provenance (input digests)
   residuals.csv           per sample: measured, nominal and calibrated tensions (kN)
 
-Exit codes: 0 ok, 1 the calibration failed or was refused, 2 bad input.
+After the fit, a reduced chi-square outside 1 +- 3 sqrt(2/nu) (nu: residuals minus free
+parameters) means the fit does not match the spec's noise: a "warning: poor fit" (or
+"noise overstated") line ends stderr and the report's verdict opens with it. The exit
+code stays 0: the outputs are written, as a record of the failed fit.
+
+Exit codes: 0 ok (also for a poor fit: see the warning), 1 the calibration failed or was
+refused, or a row's pose cannot be solved (without --skip-invalid-rows), 2 bad input.
 
 Example (the bundled paper-like circle):
   fastcal calibrate --spec=calibration_data/spec_mass_centre_density.yaml \
@@ -80,7 +90,9 @@ Usage:
   --data=FILE    telemetry export (docs/data-format.md)
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
-  --skip-invalid-rows   skip (and list) malformed rows instead of failing
+  --skip-invalid-rows   skip rows that are malformed or whose pose the model cannot solve
+                 (with --method, at each attitude) instead of failing; each is listed
+                 with its line on stderr and, with --out, in the report and summary.json
 
 Prints RMS, mean and max |model - measured| per cable in kN and percent, with the measured
 attitude and, when the data has it, the planned attitude. The model's sensor gain and
@@ -93,14 +105,9 @@ bool WriteDirectoryAtomically(const std::string& dir,
                               const std::vector<std::pair<std::string, std::string>>& files,
                               const std::function<bool(const std::string&, std::string*)>& extra,
                               std::string* error) {
+  if (!CheckOutputDirectory(dir, error)) return false;
   std::error_code ec;
   const fs::path target(dir);
-  if (fs::exists(target, ec)) {
-    if (!fs::is_directory(target, ec) || !fs::is_empty(target, ec)) {
-      *error = dir + ": exists and is not an empty directory (choose a new --out)";
-      return false;
-    }
-  }
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::exists(parent, ec) && !fs::create_directories(parent, ec)) {
     *error = parent.string() + ": cannot create: " + ec.message();
@@ -184,20 +191,38 @@ std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
 }
 
 bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
-  *robot = CableRobot::NominalFast();
-  if (!FLAGS_model.empty() && !LoadCableRobot(FLAGS_model, robot, error)) return false;
+  if (!LoadModelFlag("model", FLAGS_model, robot, error)) return false;
   if (FLAGS_data.empty()) {
     *error = "--data=FILE.csv is required";
     return false;
   }
   DatasetReadOptions read;
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
-  if (!ReadDataset(FLAGS_data, read, data, error)) return false;
-  if (!data->skipped.empty()) {
-    std::cerr << "fastcal: skipped " << data->skipped.size() << " invalid row(s):\n";
-    for (const std::string& s : data->skipped) std::cerr << "  " << s << "\n";
-  }
-  return true;
+  return ReadDataset(FLAGS_data, read, data, error);
+}
+
+// Lists the rows --skip-invalid-rows skipped (malformed, or a pose the model cannot solve)
+// on stderr. False, with the message, when no sample is left.
+bool ReportSkipped(const char* command, const Dataset& data, std::string* error) {
+  if (data.skipped.empty()) return true;
+  std::cerr << "fastcal " << command << ": --skip-invalid-rows skipped " << data.skipped.size()
+            << (data.skipped.size() == 1 ? " row" : " rows") << " of " << data.path << ", "
+            << data.samples.size() << " left:\n";
+  for (const std::string& s : data.skipped) std::cerr << "  " << s << "\n";
+  if (!data.samples.empty()) return true;
+  *error = data.path + ": no sample left: the model cannot solve any valid row";
+  return false;
+}
+
+// " (3 rows skipped)" for the summary line; "" when none was.
+std::string SkippedNote(const Dataset& data) {
+  const size_t n = data.skipped.size();
+  return n == 0 ? "" : " (" + std::to_string(n) + (n == 1 ? " row" : " rows") + " skipped)";
+}
+
+// What to add to the message of a pose the model cannot solve.
+std::string SkipHint() {
+  return FLAGS_skip_invalid_rows ? "" : " (--skip-invalid-rows skips such rows, and lists them)";
 }
 
 std::string Digest(const std::string& path) {
@@ -209,6 +234,26 @@ std::string CommandLine(int argc, char** argv) {
   std::string s = "fastcal";
   for (int i = 1; i < argc; ++i) s += std::string(" ") + argv[i];
   return s;
+}
+
+// A warning line when the reduced chi-square is outside the band of a correct noise
+// model (the report's verdict says the same); "" inside it.
+std::string ChiSquareWarning(const CalibrationResult& result, const ChiSquareBand& band) {
+  if (band.within || band.degrees_of_freedom <= 0) return "";
+  const double chi = result.reduced_chi_square;
+  char buf[400];
+  std::snprintf(buf, sizeof(buf),
+                "fastcal calibrate: warning: %s: reduced chi-square %.3g is outside 1 +- %.3g "
+                "(%g sigma, %d degrees of freedom): %s\n",
+                !(chi < 1.0) ? "poor fit" : "noise overstated", chi, band.half_width,
+                kChiSquareBandSigmas, band.degrees_of_freedom,
+                !std::isfinite(chi) ? "not a number; do not use the estimates"
+                : chi > 1.0
+                    ? "the residuals are larger than the spec's noise; do not use the estimates "
+                      "and sigmas as they are (report.md, Verdict)"
+                    : "the residuals are smaller than the spec's noise; the sigmas are "
+                      "pessimistic (report.md, Verdict)");
+  return buf;
 }
 
 }  // namespace
@@ -232,34 +277,41 @@ int RunCalibrate(int argc, char** argv) {
   CalibrationSpec spec;
   if (!LoadInputs(&model, &data, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(model.anchor_points_cabin_m.size()), &spec,
-                           &error)) {
+                           &error) ||
+      !CheckOutputDirectory(FLAGS_out, &error)) {
     PrintError(command, error);
     return kExitUsage;
   }
-  {
-    std::error_code ec;
-    if (fs::exists(FLAGS_out, ec) &&
-        (!fs::is_directory(FLAGS_out, ec) || !fs::is_empty(FLAGS_out, ec))) {
-      PrintError(command,
-                 FLAGS_out + ": exists and is not an empty directory (choose a new --out)");
-      return kExitUsage;
-    }
+  const AttitudeSource fit_attitude =
+      spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured;
+  if (FLAGS_skip_invalid_rows) {
+    // What must solve: the "initial model" rows of the table (exact, every attitude the
+    // data has), and the fit's start, the spec's initial values (its forward model and
+    // exact, at the fit's attitude).
+    const std::string name = "the initial model";
+    SkipUnsolvableSamples(model, name, {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
+                          {StaticsMethod::kExact}, &data);
+    SkipUnsolvableSamples(InitialCalibrationModel(model, spec), name, {fit_attitude},
+                          {spec.forward_model, StaticsMethod::kExact}, &data);
+  }
+  if (!ReportSkipped(command, data, &error)) {
+    PrintError(command, error);
+    return kExitFailure;
   }
   std::cerr << "fastcal calibrate: " << data.samples.size()
             << (data.samples.size() == 1 ? " sample from " : " samples from ") << data.path
-            << ", forward model " << StaticsMethodName(spec.forward_model) << "\n";
+            << SkippedNote(data) << ", model " << ModelName(FLAGS_model) << ", forward model "
+            << StaticsMethodName(spec.forward_model) << "\n";
   CalibrationOptions options;
   if (!FLAGS_quiet)
     options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
   CalibrationResult result;
   const CalibrationStatus status = Calibrate(model, spec, data, options, &result, &error);
   if (status != CalibrationStatus::kOk) {
-    PrintError(command, error);
+    PrintError(command, error + (status == CalibrationStatus::kInfeasible ? SkipHint() : ""));
     return status == CalibrationStatus::kInvalidInput ? kExitUsage : kExitFailure;
   }
 
-  const AttitudeSource fit_attitude =
-      spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured;
   std::vector<VariantEvaluation> variants;
   struct Variant {
     std::string name;
@@ -318,11 +370,13 @@ int RunCalibrate(int argc, char** argv) {
   std::ostringstream s;
   s << "\n" << result.ceres_brief_report << "\n";
   char buf[200];
-  std::snprintf(
-      buf, sizeof(buf),
-      "reduced chi-square %.3f over %d residuals; %d samples fitted, %d held out; %.2f s\n",
-      result.reduced_chi_square, result.num_residuals, result.num_fit_samples,
-      static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
+  const ChiSquareBand band = ReducedChiSquareBand(result);
+  std::snprintf(buf, sizeof(buf),
+                "reduced chi-square %.3f (expected 1 +- %.3g) over %d residuals; %d samples "
+                "fitted, %d held out; %.2f s\n",
+                result.reduced_chi_square, band.half_width, result.num_residuals,
+                result.num_fit_samples,
+                static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
   s << buf << "\n";
   std::snprintf(buf, sizeof(buf), "  %-28s %6s %14s %14s %12s  %s\n", "parameter", "unit",
                 "initial", "estimate", "sigma", "note");
@@ -352,7 +406,7 @@ int RunCalibrate(int argc, char** argv) {
   s << "\n"
     << RmsTable(variants) << "\nwrote " << FLAGS_out
     << "/{model_calibrated.yaml, report.html, report.md, summary.json, residuals.csv}\n";
-  std::cerr << s.str();
+  std::cerr << s.str() << ChiSquareWarning(result, band);
   return 0;
 }
 
@@ -365,16 +419,24 @@ int RunEvaluate(int argc, char** argv) {
   }
   std::string error;
   StaticsMethod method = StaticsMethod::kExact;
-  if (!gflags::GetCommandLineFlagInfoOrDie("method").is_default &&
-      !ParseStaticsMethod(FLAGS_method, &method)) {
+  if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &method)) {
     PrintError(command, "--method must be aas, aas-refined or exact, got '" + FLAGS_method + "'");
     return kExitUsage;
   }
   CableRobot model;
   Dataset data;
-  if (!LoadInputs(&model, &data, &error)) {
+  if (!LoadInputs(&model, &data, &error) ||
+      (!FLAGS_out.empty() && !CheckOutputDirectory(FLAGS_out, &error))) {
     PrintError(command, error);
     return kExitUsage;
+  }
+  if (FLAGS_skip_invalid_rows) {
+    SkipUnsolvableSamples(model, "the model", {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
+                          {method}, &data);
+  }
+  if (!ReportSkipped(command, data, &error)) {
+    PrintError(command, error);
+    return kExitFailure;
   }
   std::vector<VariantEvaluation> variants;
   std::vector<std::pair<std::string, AttitudeSource>> list;
@@ -384,7 +446,7 @@ int RunEvaluate(int argc, char** argv) {
   for (const auto& [name, attitude] : list) {
     VariantEvaluation e;
     if (!EvaluateVariant(name, model, data, attitude, method, {}, &e, &error)) {
-      PrintError(command, error);
+      PrintError(command, error + SkipHint());
       return kExitFailure;
     }
     variants.push_back(std::move(e));
@@ -412,9 +474,9 @@ int RunEvaluate(int argc, char** argv) {
     }
   }
   std::ostringstream s;
-  s << "fastcal evaluate: " << data.samples.size() << " samples, model "
-    << (FLAGS_model.empty() ? "nominal FAST" : FLAGS_model) << ", method "
-    << StaticsMethodName(method) << "\n\n"
+  s << "fastcal evaluate: " << data.samples.size() << " samples";
+  s << SkippedNote(data);
+  s << ", model " << ModelName(FLAGS_model) << ", method " << StaticsMethodName(method) << "\n\n"
     << RmsTable(variants);
   char buf[160];
   for (const VariantEvaluation& v : variants) {

@@ -28,6 +28,7 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
                             const std::set<std::string>& allowed,
                             std::vector<std::string>* normalised, std::string* error) {
   normalised->assign(1, argv[0]);
+  std::set<std::string> seen;
   for (int i = first; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg.size() < 3 || arg[0] != '-') {
@@ -48,6 +49,10 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
     }
     if (!allowed.count(bare)) {
       *error = "unknown flag --" + name + " (see fastcal " + command + " --help)";
+      return false;
+    }
+    if (!seen.insert(bare).second) {
+      *error = "--" + bare + " given twice; give each flag once";
       return false;
     }
     // Check the value's type here: gflags would exit 1 with its own message.
@@ -110,6 +115,36 @@ bool StartCommand(int argc, char** argv, const std::string& command, const char*
   return true;
 }
 
+bool FlagGiven(const std::string& name) {
+  std::string underscored = name;
+  for (char& c : underscored) {
+    if (c == '-') c = '_';
+  }
+  return !gflags::GetCommandLineFlagInfoOrDie(underscored.c_str()).is_default;
+}
+
+bool CheckFlagsApply(const std::vector<FlagScope>& scopes, const std::string& mode,
+                     std::string* error) {
+  for (const FlagScope& scope : scopes) {
+    if (scope.applies || !FlagGiven(scope.flag)) continue;
+    *error = "--" + scope.flag + " applies to " + scope.belongs_to + ", not to " + mode;
+    return false;
+  }
+  return true;
+}
+
+std::string ModelName(const std::string& model_path) {
+  return model_path.empty() ? "nominal FAST" : model_path;
+}
+
+bool LoadModelFlag(const std::string& flag, const std::string& path, CableRobot* robot,
+                   std::string* error) {
+  *robot = CableRobot::NominalFast();
+  if (path.empty() || LoadCableRobot(path, robot, error)) return true;
+  *error = WithFlagNames(*error, {{"the model file", "--" + flag}});
+  return false;
+}
+
 namespace {
 bool IsNameChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_'; }
 }  // namespace
@@ -153,6 +188,26 @@ bool CheckCanWrite(const std::string& path, bool force, std::string* error) {
   }
   if (std::filesystem::exists(status) && !force) {
     *error = path + ": exists; not overwritten (add --force to replace it, or choose another name)";
+    return false;
+  }
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
+    *error = path + ": cannot write: directory '" + parent.string() + "' does not exist";
+    return false;
+  }
+  return true;
+}
+
+bool CheckOutputDirectory(const std::string& dir, std::string* error) {
+  std::error_code ec;
+  const std::filesystem::file_status status = std::filesystem::status(dir, ec);
+  if (!std::filesystem::exists(status)) return true;
+  if (!std::filesystem::is_directory(status)) {
+    *error = dir + ": is a file, not a directory (--out names a new or empty directory)";
+    return false;
+  }
+  if (!std::filesystem::is_empty(dir, ec)) {
+    *error = dir + ": exists and is not an empty directory (choose a new --out)";
     return false;
   }
   return true;

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "fastcal/cable_robot.h"
+
 namespace fastcal::cli {
 
 // Exit codes: 0 success, 1 a computation failed (infeasible pose, solver), 2 bad usage or
@@ -17,8 +19,9 @@ inline constexpr int kExitUsage = 2;
 
 // Checks every "--name[=value]" in argv[first..] against `allowed` (names with dashes as
 // the user types them), rewrites dashes in the names to the underscores gflags uses, and
-// returns the rewritten argument vector (argv[0] first). On an unknown flag or a
-// positional argument, returns false with the message in *error.
+// returns the rewritten argument vector (argv[0] first). On an unknown flag, a flag given
+// twice (--noforce and --force count as one flag) or a positional argument, returns false
+// with the message in *error.
 bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string& command,
                             const std::set<std::string>& allowed,
                             std::vector<std::string>* normalised, std::string* error);
@@ -37,6 +40,30 @@ void ParseFlags(const std::vector<std::string>& args);
 bool StartCommand(int argc, char** argv, const std::string& command, const char* help,
                   const std::set<std::string>& allowed, int* exit_code);
 
+// True when flag `name` (with dashes, as the user types it) was given on the command line.
+bool FlagGiven(const std::string& name);
+
+// A flag that only some modes of a command use, e.g. --radius (--trajectory=arc).
+struct FlagScope {
+  std::string flag;        // name with dashes, as the user types it
+  bool applies = false;    // to the mode of this command line
+  std::string belongs_to;  // where it applies, e.g. "--trajectory=arc"
+};
+
+// Refuses a flag given on the command line that does not apply to the chosen mode (its
+// words, e.g. "--trajectory=grid"): false with "--radius applies to --trajectory=arc, not
+// to --trajectory=grid" in *error. Flags are never a silent default.
+bool CheckFlagsApply(const std::vector<FlagScope>& scopes, const std::string& mode,
+                     std::string* error);
+
+// "nominal FAST" for an empty --model, else the path: the model named in summaries.
+std::string ModelName(const std::string& model_path);
+
+// The model of flag `flag` (e.g. "model"): the nominal FAST model when `path` is empty,
+// else LoadCableRobot(path) with the library's words for the file replaced by the flag.
+bool LoadModelFlag(const std::string& flag, const std::string& path, CableRobot* robot,
+                   std::string* error);
+
 // `message` (from the library, which names its option fields) with each field name in
 // `field_to_flag` replaced by the flag that sets it, e.g. {"radius_m", "--radius"}. A name
 // is replaced only where it stands as a whole name (not inside a longer one such as
@@ -45,8 +72,13 @@ std::string WithFlagNames(const std::string& message,
                           const std::vector<std::pair<std::string, std::string>>& field_to_flag);
 
 // Refuses to replace an existing `path` unless `force`: false with a message naming the
-// file and --force. A directory is refused even with `force`. "" and "-" (stdout) pass.
+// file and --force. A directory is refused even with `force`, and so is a path whose
+// directory does not exist (named). "" and "-" (stdout) pass.
 bool CheckCanWrite(const std::string& path, bool force, std::string* error);
+
+// An output directory (calibrate/evaluate --out) must be new or empty: false with a
+// message naming `dir` (a file, or a non-empty directory) otherwise.
+bool CheckOutputDirectory(const std::string& dir, std::string* error);
 
 // Parses "x,y,z" (three finite numbers) for flag `name`.
 bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vector3d* v,

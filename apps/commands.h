@@ -7,6 +7,7 @@
 #include <string>
 #include <vector>
 
+#include "cli_util.h"
 #include "fastcal/pose.h"
 
 namespace fastcal::cli {
@@ -21,6 +22,14 @@ int RunSimulate(int argc, char** argv);
 bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
                                   std::vector<Eigen::Vector3d>* positions, bool* known,
                                   std::string* error);
+
+// The scopes of the trajectory flags (cli_util.h) for trajectory `kind` (line, arc, grid,
+// random, circle with `with_circle` (simulate's, which takes --nodes), or another mode:
+// point, poses): each generator's parameters apply to their generators only,
+// --tilt-fraction to the focal attitude law (`focal_law`: the poses fly it),
+// --focal-centre to that law and to the focal-sphere trajectories grid and random.
+std::vector<FlagScope> TrajectoryFlagScopes(const std::string& kind, bool focal_law,
+                                            bool with_circle);
 
 // A trajectory generator's message (trajectory.h names its parameters) with the flag
 // names instead.

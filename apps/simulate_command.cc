@@ -122,6 +122,9 @@ Trajectory (--trajectory=, default circle):
 Planned attitude (--attitude-law): focal (default for trajectories: tilt z' toward
 --focal-centre=0,0,300 by --tilt-fraction=0.41 of the off-axis angle) or none (R = I).
 A --poses file keeps its own attitudes unless --attitude-law is given.
+A trajectory flag given for another trajectory (--nodes with grid, --radius with the
+default circle, --tilt-fraction with --attitude-law=none) is an error naming it (exit 2),
+never silently ignored; so is a flag given twice.
 
 Errors (all zero-mean Gaussian unless stated; one --seed=1 drives them all, each error
 source with its own generator, so changing one sigma leaves the others' numbers alone):
@@ -167,8 +170,6 @@ const std::set<std::string> kFlags = {
     "force"};
 // clang-format on
 
-bool IsDefault(const char* flag) { return gflags::GetCommandLineFlagInfoOrDie(flag).is_default; }
-
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
 bool ParseOneOrSix(const std::string& name, const std::string& text,
                    std::array<double, kNumCables>* values, std::string* error) {
@@ -195,8 +196,7 @@ bool ParseOneOrSix(const std::string& name, const std::string& text,
 }
 
 bool LoadTruth(CableRobot* truth, std::string* error) {
-  *truth = CableRobot::NominalFast();
-  if (!FLAGS_truth.empty() && !LoadCableRobot(FLAGS_truth, truth, error)) return false;
+  if (!LoadModelFlag("truth", FLAGS_truth, truth, error)) return false;
   if (!FLAGS_mass_centre.empty() &&
       !ParseVector3("mass-centre", FLAGS_mass_centre, &truth->mass_centre_cabin_m, error)) {
     return false;
@@ -237,7 +237,7 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->seed = FLAGS_seed;
   options->sample_interval_s = FLAGS_interval_s;
   options->method = StaticsMethod::kExact;
-  if (!IsDefault("method") && !ParseStaticsMethod(FLAGS_method, &options->method)) {
+  if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &options->method)) {
     *error = "--method must be exact, aas-refined or aas, got '" + FLAGS_method + "'";
     return false;
   }
@@ -257,6 +257,33 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   return true;
 }
 
+// Refuses a trajectory flag given for another trajectory than `trajectory` (or, for
+// --tilt-fraction and --focal-centre, without the focal law): flags are never silently
+// ignored. An unknown trajectory is left to BuildPoses to name.
+bool CheckFlagsApplyToTrajectory(const std::string& trajectory, std::string* error) {
+  if (trajectory == "circle") {
+    for (const char* flag : {"centre", "radius", "start-deg", "end-deg"}) {
+      if (FlagGiven(flag)) {
+        *error = std::string("--") + flag +
+                 ": --trajectory=circle (the default) is the paper's fixed circle; use "
+                 "--trajectory=arc with --centre, --radius, --start-deg, --end-deg";
+        return false;
+      }
+    }
+  }
+  const std::set<std::string> kinds = {"circle", "line", "arc", "grid", "random", "poses"};
+  if (!kinds.count(trajectory)) return true;
+  const bool focal_law =
+      FLAGS_attitude_law == "focal" || (trajectory != "poses" && FLAGS_attitude_law != "none");
+  const std::vector<FlagScope> scopes =
+      TrajectoryFlagScopes(trajectory, focal_law, /*with_circle=*/true);
+  std::string mode = "--trajectory=" + trajectory;
+  if (trajectory == "poses") mode = "--poses";
+  if (trajectory == "circle" && !FlagGiven("trajectory")) mode += " (the default)";
+  if (FlagGiven("attitude-law")) mode += " with --attitude-law=" + FLAGS_attitude_law;
+  return CheckFlagsApply(scopes, mode, error);
+}
+
 bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
   FocalAttitudeLaw law;
   law.tilt_fraction = FLAGS_tilt_fraction;
@@ -265,16 +292,17 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     *error = "--tilt-fraction must be finite";
     return false;
   }
-  if (!IsDefault("attitude_law") && FLAGS_attitude_law != "focal" && FLAGS_attitude_law != "none") {
+  if (FlagGiven("attitude-law") && FLAGS_attitude_law != "focal" && FLAGS_attitude_law != "none") {
     *error = "--attitude-law must be 'focal' or 'none', got '" + FLAGS_attitude_law + "'";
     return false;
   }
-  std::string trajectory = IsDefault("trajectory") ? "circle" : FLAGS_trajectory;
-  if (!FLAGS_poses.empty() && IsDefault("trajectory")) trajectory = "poses";
+  std::string trajectory = FlagGiven("trajectory") ? FLAGS_trajectory : "circle";
+  if (!FLAGS_poses.empty() && !FlagGiven("trajectory")) trajectory = "poses";
   if ((trajectory == "poses") != !FLAGS_poses.empty()) {
     *error = "--trajectory=poses and --poses=FILE go together";
     return false;
   }
+  if (!CheckFlagsApplyToTrajectory(trajectory, error)) return false;
 
   if (trajectory == "poses") {
     if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
@@ -292,20 +320,12 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
   std::vector<Eigen::Vector3d> positions;
   bool ok = false;
   if (trajectory == "circle") {
-    for (const char* flag : {"centre", "radius", "start_deg", "end_deg"}) {
-      if (!IsDefault(flag)) {
-        *error =
-            "--trajectory=circle is the paper's fixed circle; use --trajectory=arc with "
-            "--centre, --radius, --start-deg, --end-deg";
-        return false;
-      }
-    }
     ArcSpec arc;
     arc.centre_m = kCircleCentre_m;
     arc.radius_m = kCircleRadius_m;
     arc.start_deg = 0.0;
     arc.end_deg = 360.0;
-    arc.nodes = IsDefault("nodes") ? kCircleNodes : FLAGS_nodes;
+    arc.nodes = FlagGiven("nodes") ? FLAGS_nodes : kCircleNodes;
     ok = ArcPositions(arc, &positions, error);
   } else {
     bool known = false;

@@ -67,6 +67,11 @@ Usage:
   fastcal solve --trajectory=line|arc|grid|random [trajectory flags] [options]
   fastcal solve --poses=FILE.csv [options]
 
+Each flag belongs to a mode: a flag given for another one (--nodes with --position,
+--radius with --trajectory=grid, --tilt-fraction without the focal law, --refinement-steps
+with --method=exact, --force without --output) is an error naming it and where it
+belongs (exit 2), never silently ignored; so is a flag given twice.
+
 Attitude (at most one):
   --rpy=r,p,y            roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll)
   --quat=w,x,y,z         unit quaternion (normalised if within 1e-3 of unit)
@@ -87,6 +92,7 @@ Trajectories:
   grid    focal-sphere cap: --max-off-axis-deg=40 --off-axis-step-deg=5
           --azimuth-step-deg=15 --focal-radius=160
   random  --samples=100 --seed=1 --max-off-axis-deg=40 --radial-spread=0
+          (grid and random also use --focal-centre, the focal sphere's centre)
   --poses=FILE.csv  x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz,
           time_s; a dataset's other columns (planned_*_deg, T<i>_kN, s0_<i>_m) are
           ignored, so a calibration dataset works; any other column is an error
@@ -97,7 +103,8 @@ Method (--method):
   exact        full coupled Newton solution to --exact-tolerance
   compare      AAS and exact side by side with per-cable relative errors and their
                maxima over the trajectory (printed on stderr; in JSON as a field)
-  --secant-low=0.99 --secant-high=1.01 --refinement-steps=1 --exact-tolerance=1e-12
+  --secant-low=0.99 --secant-high=1.01 (every method: exact starts from AAS)
+  --refinement-steps=1 (aas-refined only) --exact-tolerance=1e-12 (exact, compare)
   --warm-start (default true): each trajectory node starts from the previous solution
 
 Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model. solve
@@ -105,8 +112,8 @@ reports the model's true cable tensions: a model's sensor_gain and sensor_bias_k
 not applied here (they are in evaluate and calibrate, which compare with readings).
 
 Output: CSV (default) or --format=json, to stdout or --output=FILE (written only when
-everything succeeded; an existing FILE is refused unless --force). CSV columns, units in
-the names:
+everything succeeded; an existing FILE is refused unless --force, which needs --output).
+CSV columns, units in the names:
   node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status,
   T1_kN..T6_kN            lower-end tensions (what the cabin-side sensors measure)
   T1_upper_kN..           upper-end (tower) tensions
@@ -115,11 +122,13 @@ the names:
                           feels the opposite)
   force_residual_N,moment_residual_Nm   equilibrium residual of the returned forces
   compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact.
-A summary line with the attitude used and the time per pose goes to stderr.
+A summary line on stderr names the model (its file, or "nominal FAST"), the attitude
+used and the time per pose.
 
 A pose the cables cannot hold (a slack cable), a vertical cable or a solver failure is
 an error naming the node and cable (exit 1, no output) unless --keep-going, which writes
-the row with its status and empty numbers.
+the row with its status and empty numbers and exits 0; the summary then says how many
+poses failed, as in 289 poses (69 failed), and names the first.
 
 Examples:
   fastcal solve --position=0,0,140 --method=compare
@@ -181,7 +190,43 @@ const std::vector<std::pair<std::string, std::string>> kTrajectoryFlagNames = {
     {"samples", "--samples"},
     {"radial_spread_m", "--radial-spread"}};
 
+// The trajectory kinds whose generator uses each flag (TrajectoryPositionsFromFlags).
+const std::vector<std::pair<std::string, std::vector<std::string>>> kTrajectoryFlagKinds = {
+    {"from", {"line"}},
+    {"to", {"line"}},
+    {"nodes", {"line", "arc"}},
+    {"centre", {"arc"}},
+    {"radius", {"arc"}},
+    {"start-deg", {"arc"}},
+    {"end-deg", {"arc"}},
+    {"max-off-axis-deg", {"grid", "random"}},
+    {"off-axis-step-deg", {"grid"}},
+    {"azimuth-step-deg", {"grid"}},
+    {"focal-radius", {"grid", "random"}},
+    {"samples", {"random"}},
+    {"radial-spread", {"random"}}};
+
 }  // namespace
+
+std::vector<FlagScope> TrajectoryFlagScopes(const std::string& kind, bool focal_law,
+                                            bool with_circle) {
+  std::vector<FlagScope> scopes;
+  for (auto [flag, kinds] : kTrajectoryFlagKinds) {
+    if (with_circle && flag == "nodes") kinds.push_back("circle");
+    FlagScope scope{flag, false, "--trajectory="};
+    for (size_t i = 0; i < kinds.size(); ++i) {
+      scope.applies = scope.applies || kinds[i] == kind;
+      scope.belongs_to += (i == 0 ? "" : i + 1 < kinds.size() ? ", " : " or ") + kinds[i];
+    }
+    scopes.push_back(scope);
+  }
+  const std::string law =
+      "the focal attitude law (--attitude-law=focal, the default for trajectories)";
+  scopes.push_back({"tilt-fraction", focal_law, law});
+  scopes.push_back({"focal-centre", focal_law || kind == "grid" || kind == "random",
+                    law + " and --trajectory=grid or random"});
+  return scopes;
+}
 
 std::string WithTrajectoryFlagNames(const std::string& message) {
   return WithFlagNames(message, kTrajectoryFlagNames);
@@ -373,6 +418,31 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
   return PosesWithFocalLawFromFlags(positions, law, poses, error);
 }
 
+// Refuses a flag given for another mode than this command line's (a trajectory's
+// parameters, the focal law's, a method's, --force without --output): flags are never
+// silently ignored. An unknown mode is left to BuildPoses to name.
+bool CheckFlagsApplyToMode(std::string* error) {
+  const std::string kind = !FLAGS_poses.empty() ? "poses" : FLAGS_trajectory;
+  const bool generated = kind == "line" || kind == "arc" || kind == "grid" || kind == "random";
+  if (!generated && kind != "poses" && !(kind == "point" && !FLAGS_position.empty())) return true;
+  const bool focal_law =
+      FLAGS_attitude_law == "focal" || (generated && FLAGS_attitude_law != "none");
+  std::vector<FlagScope> scopes = TrajectoryFlagScopes(kind, focal_law, /*with_circle=*/false);
+  scopes.push_back({"seed", kind == "random", "--trajectory=random"});
+  std::string mode = kind == "point"   ? "a single --position"
+                     : kind == "poses" ? "--poses"
+                                       : "--trajectory=" + kind;
+  if (FlagGiven("attitude-law")) mode += " with --attitude-law=" + FLAGS_attitude_law;
+  const std::vector<FlagScope> method_scopes = {
+      {"refinement-steps", FLAGS_method == "aas-refined", "--method=aas-refined (the default)"},
+      {"exact-tolerance", FLAGS_method == "exact" || FLAGS_method == "compare",
+       "--method=exact or compare"}};
+  const bool to_file = !FLAGS_output.empty() && FLAGS_output != "-";
+  return CheckFlagsApply(scopes, mode, error) &&
+         CheckFlagsApply(method_scopes, "--method=" + FLAGS_method, error) &&
+         CheckFlagsApply({{"force", to_file, "--output=FILE"}}, "output to stdout", error);
+}
+
 bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* error) {
   *compare = FLAGS_method == "compare";
   if (!*compare && !ParseStaticsMethod(FLAGS_method, &options->method)) {
@@ -402,6 +472,17 @@ struct Run {
   double seconds = 0.0;
 };
 
+// "node 3 at position (x, y, z) m: <why> [method exact]".
+std::string NodeFailure(const std::vector<Pose>& poses, size_t n, const StaticsSolution& solution,
+                        StaticsMethod method) {
+  std::ostringstream s;
+  const Eigen::Vector3d& x = poses[n].position_m;
+  s << "node " << n << " at position (" << FormatDouble(x[0]) << ", " << FormatDouble(x[1]) << ", "
+    << FormatDouble(x[2]) << ") m: " << DescribeStatus(solution) << " [method "
+    << StaticsMethodName(method) << "]";
+  return s.str();
+}
+
 // Solves every pose; on failure without --keep-going reports the node and stops.
 bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
               const StaticsOptions& options, Run* run, std::string* error) {
@@ -415,12 +496,7 @@ bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
   run->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   for (size_t n = 0; n < poses.size(); ++n) {
     if (run->solutions[n].status != StaticsStatus::kOk && !FLAGS_keep_going) {
-      std::ostringstream s;
-      const Eigen::Vector3d& x = poses[n].position_m;
-      s << "node " << n << " at position (" << FormatDouble(x[0]) << ", " << FormatDouble(x[1])
-        << ", " << FormatDouble(x[2]) << ") m: " << DescribeStatus(run->solutions[n]) << " [method "
-        << StaticsMethodName(options.method) << "]";
-      *error = s.str();
+      *error = NodeFailure(poses, n, run->solutions[n], options.method);
       return false;
     }
   }
@@ -522,7 +598,7 @@ std::string Json(const std::vector<Pose>& poses, const std::string& method, cons
   JsonWriter j;
   j.BeginObject();
   j.Key("method").String(method);
-  j.Key("model").String(FLAGS_model.empty() ? "nominal FAST" : FLAGS_model);
+  j.Key("model").String(ModelName(FLAGS_model));
   j.Key("poses").BeginArray();
   for (size_t n = 0; n < poses.size(); ++n) {
     j.BeginObject();
@@ -553,6 +629,27 @@ std::string Json(const std::vector<Pose>& poses, const std::string& method, cons
   return j.str();
 }
 
+// The poses that failed in any of the runs (only under --keep-going), for the summary.
+struct Failures {
+  size_t count = 0;
+  std::string first;  // NodeFailure of the first
+};
+Failures CountFailures(const std::vector<Pose>& poses,
+                       const std::vector<std::pair<const Run*, StaticsMethod>>& runs) {
+  Failures f;
+  for (size_t n = 0; n < poses.size(); ++n) {
+    bool ok = true;
+    for (const auto& [run, method] : runs) {
+      const StaticsSolution& s = run->solutions[n];
+      if (s.status == StaticsStatus::kOk || !ok) continue;
+      ok = false;
+      if (f.first.empty()) f.first = NodeFailure(poses, n, s, method);
+    }
+    f.count += ok ? 0 : 1;
+  }
+  return f;
+}
+
 std::string TimingLine(const char* name, const Run& run, size_t n, bool warm) {
   std::ostringstream s;
   s.precision(3);
@@ -572,8 +669,8 @@ int RunSolve(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  CableRobot robot = CableRobot::NominalFast();
-  if (!FLAGS_model.empty() && !LoadCableRobot(FLAGS_model, &robot, &error)) {
+  CableRobot robot;
+  if (!LoadModelFlag("model", FLAGS_model, &robot, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -581,7 +678,8 @@ int RunSolve(int argc, char** argv) {
   bool compare = false;
   std::vector<Pose> poses;
   std::string attitude;
-  if (!SetOptionsFromFlags(&options, &compare, &error) || !BuildPoses(&poses, &attitude, &error)) {
+  if (!SetOptionsFromFlags(&options, &compare, &error) || !CheckFlagsApplyToMode(&error) ||
+      !BuildPoses(&poses, &attitude, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -591,9 +689,8 @@ int RunSolve(int argc, char** argv) {
   }
 
   std::string content;
-  std::ostringstream summary;
-  summary << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose" : " poses")
-          << ", attitude " << attitude << "; ";
+  std::ostringstream timing;
+  Failures failures;
   if (!compare) {
     Run run;
     if (!SolveAll(robot, poses, options, &run, &error)) {
@@ -602,7 +699,8 @@ int RunSolve(int argc, char** argv) {
     }
     content = FLAGS_format == "json" ? Json(poses, FLAGS_method, &run, nullptr, nullptr)
                                      : CsvRows(poses, &run, nullptr, nullptr);
-    summary << TimingLine(StaticsMethodName(options.method), run, poses.size(), options.warm_start);
+    timing << TimingLine(StaticsMethodName(options.method), run, poses.size(), options.warm_start);
+    failures = CountFailures(poses, {{&run, options.method}});
   } else {
     Run aas, exact;
     StaticsOptions o = options;
@@ -618,16 +716,26 @@ int RunSolve(int argc, char** argv) {
     }
     content = FLAGS_format == "json" ? Json(poses, "compare", nullptr, &aas, &exact)
                                      : CsvRows(poses, nullptr, &aas, &exact);
-    summary << TimingLine("aas", aas, poses.size(), options.warm_start) << "; "
-            << TimingLine("exact", exact, poses.size(), options.warm_start) << "\n"
-            << "max |aas - exact| / exact per cable (%):";
-    for (double e : MaxAbsErrorPct(aas, exact)) summary << " " << FormatDouble(e, 4);
+    timing << TimingLine("aas", aas, poses.size(), options.warm_start) << "; "
+           << TimingLine("exact", exact, poses.size(), options.warm_start) << "\n"
+           << "max |aas - exact| / exact per cable (%):";
+    for (double e : MaxAbsErrorPct(aas, exact)) timing << " " << FormatDouble(e, 4);
+    failures = CountFailures(poses, {{&aas, StaticsMethod::kAas}, {&exact, StaticsMethod::kExact}});
   }
   if (!WriteOutput(FLAGS_output, content, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  std::cerr << summary.str() << std::endl;
+  std::cerr << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose" : " poses");
+  if (failures.count > 0) std::cerr << " (" << failures.count << " failed)";
+  std::cerr << ", model " << ModelName(FLAGS_model) << ", attitude " << attitude << "; "
+            << timing.str() << std::endl;
+  if (failures.count > 0) {
+    std::cerr << "fastcal solve: " << failures.count << " of " << poses.size()
+              << " poses failed; --keep-going wrote them with their status and empty numbers "
+                 "(exit 0). First: "
+              << failures.first << std::endl;
+  }
   return 0;
 }
 

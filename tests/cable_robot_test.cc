@@ -284,8 +284,23 @@ TEST(CableRobotYaml, AbsentKeysTakeNominalValues) {
   expected.cabin_mass_kg = 31000.5;
   ExpectIdentical(loaded, expected);
 
-  ASSERT_TRUE(ParseCableRobotYaml("", "empty.yaml", &loaded, &error)) << error;
+  ASSERT_TRUE(ParseCableRobotYaml("{}", "braces.yaml", &loaded, &error)) << error;
   ExpectIdentical(loaded, CableRobot::NominalFast());
+}
+
+// An empty document is most likely a truncated or wrong file, not a request for the
+// nominal model (which needs no file): an error naming the file, and *robot untouched.
+TEST(CableRobotYaml, EmptyDocumentIsAnError) {
+  for (const char* text : {"", "\n  \n", "# only a comment\n\n  # another\n", "---\n"}) {
+    CableRobot loaded = CableRobot::NominalFast();
+    loaded.cabin_mass_kg = 12345.0;
+    std::string error;
+    EXPECT_FALSE(ParseCableRobotYaml(text, "empty.yaml", &loaded, &error)) << '"' << text << '"';
+    EXPECT_EQ(error,
+              "empty.yaml: empty model file: omit the model file for the nominal FAST layout")
+        << '"' << text << '"';
+    EXPECT_EQ(loaded.cabin_mass_kg, 12345.0);
+  }
 }
 
 TEST(CableRobotYaml, AnchorPointsReplaceTheNominalList) {

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "fastcal/evaluation.h"
@@ -266,6 +267,29 @@ TEST(CalibrationTest, HoldoutMaskIsSeededAndSized) {
   EXPECT_EQ(std::count(a.begin(), a.end(), true), 20);
   const std::vector<bool> none = HoldoutMask(10, 0.0, 1);
   EXPECT_EQ(std::count(none.begin(), none.end(), true), 0);
+}
+
+// The band of a correct noise model, 1 +- 3 sqrt(2 / nu), shared by the report and the CLI.
+TEST(CalibrationTest, ReducedChiSquareBand) {
+  CalibrationResult r;
+  r.num_residuals = 52;
+  r.num_free = 2;  // nu = 50: 3 sqrt(2 / 50) = 0.6
+  r.reduced_chi_square = 1.59;
+  ChiSquareBand band = ReducedChiSquareBand(r);
+  EXPECT_EQ(band.degrees_of_freedom, 50);
+  EXPECT_NEAR(band.half_width, 0.6, 1e-15);
+  EXPECT_TRUE(band.within);
+  r.reduced_chi_square = 0.39;
+  EXPECT_FALSE(ReducedChiSquareBand(r).within);
+  r.reduced_chi_square = 17.5;
+  EXPECT_FALSE(ReducedChiSquareBand(r).within);
+  r.reduced_chi_square = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_FALSE(ReducedChiSquareBand(r).within);
+  r.reduced_chi_square = 1.0;
+  r.num_free = 52;  // no degrees of freedom: no band
+  band = ReducedChiSquareBand(r);
+  EXPECT_EQ(band.half_width, 0.0);
+  EXPECT_FALSE(band.within);
 }
 
 }  // namespace

@@ -138,6 +138,7 @@ TEST_F(CliTest, SimulateCalibrateEvaluateRoundTrip) {
   std::smatch cal;
   ASSERT_TRUE(std::regex_search(r.output, cal, row)) << r.output;
   const std::string calibrated_rms = cal[1].str();
+  EXPECT_EQ(r.output.find("warning"), std::string::npos) << r.output;  // chi-square in its band
   r = Fastcal("evaluate --model=" + out + "/model_calibrated.yaml --data=" + data);
   ASSERT_EQ(r.code, 0) << r.output;
   const std::regex eval_row("model, measured attitude\\s+([0-9. ]+)");
@@ -368,6 +369,247 @@ TEST_F(CliTest, EveryCommandHasHelpAndRejectsUnknownFlags) {
     EXPECT_EQ(r.code, 2) << command;
     EXPECT_NE(r.output.find("unexpected argument 'stray'"), std::string::npos) << r.output;
   }
+}
+
+// A flag that the chosen mode does not use is refused, naming the flag and where it
+// belongs, instead of being silently ignored; the same flags pass in their own mode.
+TEST_F(CliTest, FlagsOfAnotherModeAreRefused) {
+  struct Case {
+    std::string args, message;
+  };
+  const std::string sim = "simulate --out=" + Path("never.csv") + " ";
+  const std::vector<Case> cases = {
+      {"solve --position=0,0,140 --nodes=5 --radius=3",
+       "--nodes applies to --trajectory=line or arc, not to a single --position"},
+      {"solve --position=0,0,140 --nodes=101",  // given, even at its default value
+       "--nodes applies to --trajectory=line or arc, not to a single --position"},
+      {"solve --trajectory=grid --nodes=5",
+       "--nodes applies to --trajectory=line or arc, not to --trajectory=grid"},
+      {"solve --trajectory=arc --from=1,2,3",
+       "--from applies to --trajectory=line, not to --trajectory=arc"},
+      {"solve --trajectory=line --seed=3",
+       "--seed applies to --trajectory=random, not to --trajectory=line"},
+      {"solve --poses=" + Source() + "/calibration_data/circle_paper.csv --samples=3",
+       "--samples applies to --trajectory=random, not to --poses"},
+      {"solve --position=0,0,140 --tilt-fraction=0.3",
+       "--tilt-fraction applies to the focal attitude law"},
+      {"solve --trajectory=line --attitude-law=none --focal-centre=0,0,290",
+       "not to --trajectory=line with --attitude-law=none"},
+      {"solve --position=0,0,140 --method=exact --refinement-steps=2",
+       "--refinement-steps applies to --method=aas-refined (the default), not to --method=exact"},
+      {"solve --position=0,0,140 --exact-tolerance=1e-9",
+       "--exact-tolerance applies to --method=exact or compare, not to --method=aas-refined"},
+      {"solve --position=0,0,140 --force", "--force applies to --output=FILE"},
+      {sim + "--trajectory=grid --nodes=3",
+       "--nodes applies to --trajectory=line, arc or circle, not to --trajectory=grid"},
+      {sim + "--radius=30", "--radius: --trajectory=circle (the default) is the paper's fixed"},
+      {sim + "--trajectory=line --attitude-law=none --tilt-fraction=0.2",
+       "--tilt-fraction applies to the focal attitude law"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = Fastcal(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << ": " << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << c.args << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(Path("never.csv")));
+  for (const std::string& args :
+       std::vector<std::string>{"solve --trajectory=arc --nodes=5 --radius=3",
+                                "solve --trajectory=random --seed=3 --samples=3",
+                                "solve --trajectory=grid --focal-centre=0,0,301 "
+                                "--attitude-law=none --max-off-axis-deg=10",
+                                "solve --position=0,0,140 --attitude-law=focal --tilt-fraction=0.3",
+                                "solve --position=0,0,140 --method=compare --exact-tolerance=1e-9",
+                                "solve --position=0,0,140 --refinement-steps=2",
+                                "simulate --nodes=4 --out=" + Path("circle.csv")}) {
+    const CommandResult r = Fastcal(args);
+    EXPECT_EQ(r.code, 0) << args << ": " << r.output;
+  }
+}
+
+TEST_F(CliTest, FlagGivenTwiceIsRefused) {
+  for (const char* args : {"solve --position=0,0,140 --position=1,1,140",
+                           "solve --position=0,0,140 --method=aas --method=exact"}) {
+    const CommandResult r = Fastcal(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.output.find("given twice"), std::string::npos) << r.output;
+  }
+  EXPECT_NE(Fastcal("solve --position=0,0,140 --position=1,1,140").output.find("--position"),
+            std::string::npos);
+  const CommandResult r = Fastcal("simulate --out=" + Path("a.csv") + " --force --noforce");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--force given twice"), std::string::npos) << r.output;
+}
+
+// --keep-going exits 0 but the summary says how many poses failed, and the first.
+TEST_F(CliTest, KeepGoingSummarySaysHowManyPosesFailed) {
+  const std::string grid = "solve --trajectory=grid --max-off-axis-deg=60 --output=";
+  CommandResult r = Fastcal(grid + Path("never.csv"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_FALSE(fs::exists(Path("never.csv")));
+  for (const char* method : {"aas-refined", "compare"}) {
+    r = Fastcal(grid + Path("grid.csv") + " --force --keep-going --method=" + method);
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(r.output, m, std::regex("289 poses \\(([0-9]+) failed\\)")))
+        << r.output;
+    const std::string failed = m[1].str();
+    EXPECT_GT(std::stoi(failed), 0);
+    EXPECT_NE(r.output.find(failed + " of 289 poses failed; --keep-going wrote them"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("First: node "), std::string::npos) << r.output;
+  }
+  r = Fastcal("solve --trajectory=grid --keep-going");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("failed"), std::string::npos) << r.output.substr(r.output.size() - 500);
+}
+
+// A reduced chi-square far outside its band is a warning on stderr and a failure in the
+// report's verdict, not silence. The dataset is the example of docs/data-format.md.
+TEST_F(CliTest, CalibratePoorFitWarns) {
+  Write("example.csv",
+        "# FAST telemetry export, 2024-05-01, circle of radius 71.11 m\n"
+        "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
+        "0,71.11,0,156.73,0.02,-5.31,0.11,212.4,187.9,143.2,151.7,190.3,205.8\n"
+        "2.5,70.96,4.65,156.73,0.35,-5.30,0.09,214.0,190.2,141.8,149.9,188.6,207.1\n");
+  const std::string out = Path("cal");
+  const CommandResult r = Fastcal(
+      "calibrate --quiet --spec=" + Source() +
+      "/calibration_data/spec_mass_centre.yaml --data=" + Path("example.csv") + " --out=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(std::regex_search(
+      r.output, std::regex("fastcal calibrate: warning: poor fit: reduced chi-square [0-9.]+ is "
+                           "outside 1 \\+- 1.34 \\(3 sigma, 10 degrees of freedom\\)")))
+      << r.output;
+  EXPECT_NE(ReadFile(out + "/report.md").find("## Verdict\n\n**Poor fit:"), std::string::npos);
+  EXPECT_NE(ReadFile(out + "/summary.json").find("\"reduced_chi_square_within_band\": false"),
+            std::string::npos);
+}
+
+// An empty model file is an error, not the nominal model; the summary names the model.
+TEST_F(CliTest, EmptyModelFileIsRefusedAndSolveNamesTheModel) {
+  Write("empty.yaml", "");
+  Write("comments.yaml", "# nothing here\n\n   \n");
+  for (const char* name : {"empty.yaml", "comments.yaml"}) {
+    const CommandResult r = Fastcal("solve --position=0,0,140 --model=" + Path(name));
+    EXPECT_EQ(r.code, 2) << r.output;
+    EXPECT_NE(
+        r.output.find(Path(name) + ": empty model file: omit --model for the nominal FAST layout"),
+        std::string::npos)
+        << r.output;
+  }
+  CommandResult r = Fastcal("simulate --out=" + Path("a.csv") + " --truth=" + Path("empty.yaml"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("omit --truth for the nominal FAST layout"), std::string::npos)
+      << r.output;
+  r = Fastcal("solve --position=0,0,140");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("fastcal solve: 1 pose, model nominal FAST, attitude"), std::string::npos)
+      << r.output;
+  const std::string model = Source() + "/calibration_data/nominal_fast.yaml";
+  r = Fastcal("solve --position=0,0,140 --model=" + model);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("fastcal solve: 1 pose, model " + model + ", attitude"),
+            std::string::npos)
+      << r.output;
+}
+
+// Messages name what the user gave, not internal names or a run-on column name.
+TEST_F(CliTest, OutputAndSeparatorMessagesNameTheProblem) {
+  Write("plain", "a file\n");
+  const std::string spec = Source() + "/calibration_data/spec_mass_centre.yaml";
+  const std::string data = Source() + "/calibration_data/circle_paper.csv";
+  CommandResult r =
+      Fastcal("calibrate --spec=" + spec + " --data=" + data + " --out=" + Path("plain"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find(Path("plain") + ": is a file, not a directory"), std::string::npos)
+      << r.output;
+  r = Fastcal("evaluate --data=" + data + " --out=" + Path("plain"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("is a file, not a directory"), std::string::npos) << r.output;
+  EXPECT_EQ(ReadFile(Path("plain")), "a file\n");
+
+  const std::string missing = Path("missingdir") + "/a.csv";
+  for (const std::string& args : std::vector<std::string>{
+           "simulate --nodes=4 --out=" + missing, "solve --position=0,0,140 --output=" + missing}) {
+    r = Fastcal(args);
+    EXPECT_EQ(r.code, 2) << args;
+    EXPECT_NE(r.output.find(missing + ": cannot write: directory '" + Path("missingdir") +
+                            "' does not exist"),
+              std::string::npos)
+        << r.output;
+    EXPECT_EQ(r.output.find(".tmp"), std::string::npos) << r.output;
+  }
+
+  Write("semicolon.csv",
+        "time_s;x_m;y_m;z_m;roll_deg;pitch_deg;yaw_deg;T1_kN;T2_kN;T3_kN;T4_kN;T5_kN;T6_kN\n"
+        "0;0;0;150;0;0;0;150;150;150;150;150;150\n");
+  for (const std::string command : {"evaluate --data=", "solve --poses="}) {
+    r = Fastcal(command + Path("semicolon.csv"));
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_NE(r.output.find(Path("semicolon.csv") +
+                            ":1: the header is separated by ';': fields must be separated by "
+                            "commas"),
+              std::string::npos)
+        << r.output;
+  }
+}
+
+// A row whose pose the model cannot hold fails evaluate and calibrate (exit 1, line named,
+// --skip-invalid-rows suggested); with --skip-invalid-rows it is skipped and listed on
+// stderr, in report.md and in summary.json.
+TEST_F(CliTest, SkipInvalidRowsSkipsPosesTheModelCannotSolve) {
+  std::istringstream circle(ReadFile(Source() + "/calibration_data/circle_paper.csv"));
+  std::string text, line;
+  int line_number = 0, rows = 0, bad_line = 0;
+  while (std::getline(circle, line) && rows < 40) {
+    ++line_number;
+    if (line.empty() || line[0] == '#') {
+      text += line + "\n";
+      continue;
+    }
+    if (line.rfind("time_s", 0) != 0 && ++rows == 10) {  // x_m = 400: outside the towers
+      const size_t x = line.find(',');
+      line = line.substr(0, x) + ",400" + line.substr(line.find(',', x + 1));
+      bad_line = line_number;
+    }
+    text += line + "\n";
+  }
+  Write("bad.csv", text);
+  const std::string data = Path("bad.csv");
+  const std::string where = data + ":" + std::to_string(bad_line) + ": ";
+  const std::string spec =
+      " --quiet --spec=" + Source() + "/calibration_data/spec_mass_centre.yaml --out=";
+  CommandResult r = Fastcal("evaluate --data=" + data);
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find(where + "the model cannot solve this pose"), std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("--skip-invalid-rows skips such rows"), std::string::npos);
+  r = Fastcal("calibrate --data=" + data + spec + Path("never"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find(where + "the initial model cannot solve this pose"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(Path("never")));
+
+  r = Fastcal("evaluate --skip-invalid-rows --data=" + data + " --out=" + Path("eval"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("--skip-invalid-rows skipped 1 row of " + data + ", 39 left:\n  " +
+                          where + "the model cannot solve this pose (planned attitude, exact)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("39 samples (1 row skipped)"), std::string::npos) << r.output;
+  EXPECT_NE(ReadFile(Path("eval") + "/summary.json").find("\"skipped\": 1"), std::string::npos);
+  r = Fastcal("calibrate --skip-invalid-rows --data=" + data + spec + Path("cal"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find(where + "the initial model cannot solve this pose"), std::string::npos)
+      << r.output;
+  const std::string json = ReadFile(Path("cal") + "/summary.json");
+  EXPECT_NE(json.find("\"skipped_rows\": [\n      \"" + where + "the initial model cannot solve"),
+            std::string::npos)
+      << json;
+  const std::string md = ReadFile(Path("cal") + "/report.md");
+  EXPECT_NE(md.find("1 row skipped"), std::string::npos);
+  EXPECT_NE(md.find(where + "the initial model cannot solve this pose"), std::string::npos);
 }
 
 }  // namespace

@@ -368,6 +368,27 @@ TEST_F(ReportTest, ChiSquareInterpretation) {
   EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "**Did not converge**"));
 }
 
+// Outside the band the verdict opens with a failure, not "Converged"; inside it does not.
+TEST_F(ReportTest, ChiSquareOutsideTheBandReadsAsAFailure) {
+  std::string md = ReportMarkdown(inputs_);  // 0.98, within 1 +- 0.435
+  EXPECT_FALSE(Contains(md, "Poor fit"));
+  EXPECT_FALSE(Contains(md, "Noise overstated"));
+  EXPECT_TRUE(Contains(SummaryJson(inputs_), "\"reduced_chi_square_within_band\": true"));
+  result_.reduced_chi_square = 17.5;
+  md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md,
+                       "## Verdict\n\n**Poor fit: the model does not explain the measurements.** "
+                       "χ²/ν = 17.5 is outside 1 ± 0.435, the band of a correct noise model: the "
+                       "residuals are 4.18 times the stated noise. Do not use the estimates"))
+      << md;
+  EXPECT_TRUE(Contains(ReportHtml(inputs_), "Poor fit: the model does not explain"));
+  const std::string json = SummaryJson(inputs_);
+  EXPECT_TRUE(Contains(json, "\"reduced_chi_square_within_band\": false")) << json;
+  EXPECT_TRUE(Contains(json, "\"reduced_chi_square_band_half_width\": 0.435")) << json;
+  result_.reduced_chi_square = 0.1;
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "**Noise overstated:** χ²/ν = 0.1 is outside"));
+}
+
 TEST_F(ReportTest, SaysSoWhenNothingIsPoorlyDetermined) {
   result_.data_only.undetermined.clear();
   EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "Nothing is poorly determined"));
@@ -504,9 +525,28 @@ TEST_F(ReportTest, JsonIsWellFormedWithTheSummary) {
   EXPECT_TRUE(Contains(json, "\"data_only\": {"));
   EXPECT_TRUE(Contains(json,
                        "\"samples\": {\n    \"total\": 20,\n    \"fitted\": 16,\n"
-                       "    \"held_out\": 4\n"));
+                       "    \"held_out\": 4,\n    \"skipped\": 0,\n    \"skipped_rows\": []\n"))
+      << json;
   EXPECT_TRUE(Contains(json, "null"));  // the NaN statistic
   EXPECT_TRUE(NonFiniteWords(json).empty());
+}
+
+// Rows skipped under --skip-invalid-rows (malformed or unsolvable) are counted and listed
+// in every report file, never dropped silently.
+TEST_F(ReportTest, SkippedRowsAreCountedAndListed) {
+  data_.skipped = {"circle.csv:7: column 'T3_kN': 'x' is not a number",
+                   "circle.csv:9: the model cannot solve this pose (measured attitude, exact): "
+                   "cable 1 is slack"};
+  const std::string md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md, "2 rows skipped: malformed, or a pose the model cannot solve")) << md;
+  EXPECT_TRUE(Contains(md, "circle.csv:9: the model cannot solve this pose")) << md;
+  EXPECT_TRUE(Contains(ReportHtml(inputs_), "circle.csv:9: the model cannot solve this pose"));
+  const std::string json = SummaryJson(inputs_);
+  EXPECT_TRUE(JsonChecker(json).Valid()) << json;
+  EXPECT_TRUE(Contains(json,
+                       "\"skipped\": 2,\n    \"skipped_rows\": [\n      \"circle.csv:7: column "
+                       "'T3_kN': 'x' is not a number\",\n      \"circle.csv:9: the model cannot"))
+      << json;
 }
 
 TEST_F(ReportTest, EvaluateOnlyReport) {

@@ -515,6 +515,14 @@ TEST(ReadPosesCsv, UnknownColumnIsAnErrorListingTheAcceptedNames) {
                  ":2: column 4 'Roll_deg': unknown column name (accepted: x_m, y_m, z_m, ");
 }
 
+// A spreadsheet export with ';' or tabs is not one long unknown column name.
+TEST(ReadPosesCsv, SemicolonOrTabSeparatorIsNamed) {
+  ExpectCsvError("trajectory_test_semicolon.csv", "# exported\nx_m;y_m;z_m\n0;0;150\n",
+                 ":2: the header is separated by ';': fields must be separated by commas");
+  ExpectCsvError("trajectory_test_tab.csv", "x_m\ty_m\tz_m\n0\t0\t150\n",
+                 ":1: the header is separated by tabs: fields must be separated by commas");
+}
+
 // A whole dataset (every column it may have) reads as a pose file.
 TEST(ReadPosesCsv, DatasetColumnsAreAccepted) {
   std::string header =

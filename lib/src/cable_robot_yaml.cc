@@ -66,6 +66,11 @@ class Parser {
     error_ += ": " + path + ": " + what;
     return false;
   }
+  // Records "<source>: <what>": a problem of the whole file.
+  bool FailFile(const std::string& what) {
+    error_ = source_ + ": " + what;
+    return false;
+  }
   bool Fail(const YAML::Node& node, const std::string& path, const std::string& what) {
     return Fail(LineOf(node), path, what);
   }
@@ -340,8 +345,10 @@ bool ParseCableRobotYaml(const std::string& text, const std::string& source_name
     const std::vector<YAML::Node> documents = YAML::LoadAll(text);
     if (documents.size() > 1) {
       parser.Fail(documents[1], kRootPath, "only one YAML document is allowed");
-    } else if (documents.empty() || documents[0].IsNull() ||  // empty file: all nominal
-               parser.ReadRoot(documents[0], &parsed)) {
+    } else if (documents.empty() || documents[0].IsNull()) {
+      // Most likely a truncated or wrong file: the nominal model is had without one.
+      parser.FailFile("empty model file: omit the model file for the nominal FAST layout");
+    } else if (parser.ReadRoot(documents[0], &parsed)) {
       std::string why;
       if (!parsed.IsValid(&why)) parser.FailValidation(why);
     }

@@ -166,6 +166,21 @@ std::string ParameterDirection::Describe() const {
   return s.str();
 }
 
+CableRobot InitialCalibrationModel(const CableRobot& model, const CalibrationSpec& spec) {
+  const CalibrationModel cm(model, spec);
+  return cm.ToRobot(cm.InitialTheta().data());
+}
+
+ChiSquareBand ReducedChiSquareBand(const CalibrationResult& result) {
+  ChiSquareBand band;
+  band.degrees_of_freedom = result.num_residuals - result.num_free;
+  if (band.degrees_of_freedom <= 0) return band;
+  band.half_width = kChiSquareBandSigmas * std::sqrt(2.0 / band.degrees_of_freedom);
+  band.within = std::isfinite(result.reduced_chi_square) &&
+                std::fabs(result.reduced_chi_square - 1.0) <= band.half_width;
+  return band;
+}
+
 CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec,
                             const Dataset& data, const CalibrationOptions& options,
                             CalibrationResult* result, std::string* error) {

@@ -21,6 +21,7 @@
 #include <string_view>
 
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/csv.h"
 
 namespace fastcal {
 namespace {
@@ -247,6 +248,11 @@ bool GroupPresent(const Header& header, int first, int count, const std::string&
 bool ParseHeader(std::string_view line, const std::string& where, Header* header,
                  std::string* error) {
   header->field_of.fill(-1);
+  const std::string separator_error = internal::WrongSeparatorMessage(line);
+  if (!separator_error.empty()) {
+    *error = where + separator_error;
+    return false;
+  }
   const std::vector<std::string_view> fields = SplitFields(line);
   for (size_t f = 0; f < fields.size(); ++f) {
     const std::string_view name = fields[f];

@@ -7,6 +7,22 @@
 #include <random>
 
 namespace fastcal {
+namespace {
+
+Pose PoseOf(const Sample& sample, AttitudeSource attitude) {
+  Pose pose = sample.pose;
+  if (attitude == AttitudeSource::kPlanned) pose.rotation = sample.planned_rotation;
+  return pose;
+}
+
+// "<file>:<line>: <model> cannot solve this pose<detail>: <why>".
+std::string CannotSolve(const Dataset& data, const Sample& sample, const std::string& model,
+                        const std::string& detail, const StaticsSolution& solution) {
+  return data.path + ":" + std::to_string(sample.line) + ": " + model + " cannot solve this pose" +
+         detail + ": " + DescribeStatus(solution);
+}
+
+}  // namespace
 
 bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSource attitude,
                      StaticsMethod method, std::vector<std::array<double, kNumCables>>* predicted,
@@ -23,11 +39,8 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
   predicted->assign(data.samples.size(), {});
   for (size_t n = 0; n < data.samples.size(); ++n) {
     const Sample& s = data.samples[n];
-    Pose pose = s.pose;
-    if (attitude == AttitudeSource::kPlanned) pose.rotation = s.planned_rotation;
-    if (SolveStatics(robot, pose, options, &solution) != StaticsStatus::kOk) {
-      *error = data.path + ":" + std::to_string(s.line) +
-               ": the model cannot solve this pose: " + DescribeStatus(solution);
+    if (SolveStatics(robot, PoseOf(s, attitude), options, &solution) != StaticsStatus::kOk) {
+      *error = CannotSolve(data, s, "the model", "", solution);
       return false;
     }
     for (int i = 0; i < kNumCables; ++i) {
@@ -36,6 +49,43 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
     }
   }
   return true;
+}
+
+int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name,
+                          const std::vector<AttitudeSource>& attitudes,
+                          const std::vector<StaticsMethod>& methods, Dataset* data) {
+  StaticsOptions options;
+  options.compute_unstretched_lengths = false;  // as PredictTensions and Calibrate solve
+  StaticsSolution solution;
+  std::vector<Sample> kept;
+  kept.reserve(data->samples.size());
+  int removed = 0;
+  for (Sample& s : data->samples) {
+    std::string why;
+    for (AttitudeSource attitude : attitudes) {
+      if (attitude == AttitudeSource::kPlanned && !data->has_planned_attitude) continue;
+      for (StaticsMethod method : methods) {
+        options.method = method;
+        if (!why.empty() ||
+            SolveStatics(robot, PoseOf(s, attitude), options, &solution) == StaticsStatus::kOk) {
+          continue;
+        }
+        why = CannotSolve(*data, s, model_name,
+                          std::string(" (") +
+                              (attitude == AttitudeSource::kPlanned ? "planned" : "measured") +
+                              " attitude, " + StaticsMethodName(method) + ")",
+                          solution);
+      }
+    }
+    if (why.empty()) {
+      kept.push_back(std::move(s));
+    } else {
+      data->skipped.push_back(why);
+      ++removed;
+    }
+  }
+  data->samples = std::move(kept);
+  return removed;
 }
 
 CableErrorStats ErrorStats(const Dataset& data,

@@ -30,9 +30,6 @@ namespace {
 
 constexpr double kNPerKn = 1000.0;
 constexpr double kPercent = 100.0;
-// A correct noise model gives a reduced chi-square of 1 with a standard deviation of
-// sqrt(2 / dof); farther than this many standard deviations from 1 it is called off.
-constexpr double kChiSquareBandSigmas = 3.0;
 // Defaults of CalibrationOptions, quoted in the text (the result does not carry them).
 constexpr double kDefaultPoorlyDeterminedRatio = 1e-3;
 constexpr double kDefaultUndeterminedRatio = 1e-8;
@@ -237,22 +234,20 @@ std::string NoiseText(const CalibrationSpec& spec) {
          Printf("%.6g", spec.tension_sigma_percent) + " % of the measured tension)²]";
 }
 
-// Degrees of freedom of the chi-square (residuals minus free parameters), <= 0 if none.
-int DegreesOfFreedom(const CalibrationResult& r) { return r.num_residuals - r.num_free; }
-
 // One-line meaning of the reduced chi-square.
 std::string ChiSquareMeaning(const CalibrationResult& r) {
   const double chi = r.reduced_chi_square;
   if (!std::isfinite(chi)) return "not available.";
-  const int dof = DegreesOfFreedom(r);
-  const double band = dof > 0 ? kChiSquareBandSigmas * std::sqrt(2.0 / dof) : 0.0;
+  const ChiSquareBand band = ReducedChiSquareBand(r);
+  const int dof = band.degrees_of_freedom;
   const std::string sigmas = Printf("%g", kChiSquareBandSigmas);
   const std::string expected =
-      dof > 0 ? " (expected 1 ± " + sigmas + "·√(2/ν) = 1 ± " + Sig3(band) + ": within " + sigmas +
-                    " standard deviations of χ²/ν for a correct noise model, ν = " + Int(dof) +
-                    " degrees of freedom)"
-              : "";
-  if (dof > 0 && std::fabs(chi - 1.0) <= band) {
+      dof > 0
+          ? " (expected 1 ± " + sigmas + "·√(2/ν) = 1 ± " + Sig3(band.half_width) + ": within " +
+                sigmas + " standard deviations of χ²/ν for a correct noise model, ν = " + Int(dof) +
+                " degrees of freedom)"
+          : "";
+  if (band.within) {
     return "about 1: the residuals scatter as the noise model says" + expected + ".";
   }
   if (chi > 1.0) {
@@ -304,7 +299,8 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
     if (d.has_planned_attitude) data.Plain(", with planned attitude");
     if (!d.skipped.empty())
       data.Plain(", " + Int(static_cast<long long>(d.skipped.size())) +
-                 " invalid rows skipped (listed at the end)");
+                 (d.skipped.size() == 1 ? " row" : " rows") +
+                 " skipped: malformed, or a pose the model cannot solve (listed at the end)");
   } else {
     data.Plain(" (no dataset given)");
   }
@@ -375,6 +371,28 @@ void AddVerdict(const ReportInputs& in, Document* doc) {
   }
   const CalibrationResult& r = *in.result;
   doc->Heading(2, "Verdict");
+  const ChiSquareBand band = ReducedChiSquareBand(r);
+  if (band.degrees_of_freedom > 0 && std::isfinite(r.reduced_chi_square) && !band.within) {
+    const std::string outside = " χ²/ν = " + Printf("%.4g", r.reduced_chi_square) +
+                                " is outside 1 ± " + Sig3(band.half_width) +
+                                ", the band of a correct noise model: ";
+    if (r.reduced_chi_square > 1.0) {
+      doc->Paragraph(Text()
+                         .Bold("Poor fit: the model does not explain the measurements.")
+                         .Plain(outside + "the residuals are " +
+                                Sig3(std::sqrt(r.reduced_chi_square)) +
+                                " times the stated noise. Do not use the estimates and their "
+                                "±1σ as they are: look for model error the free parameters "
+                                "cannot absorb (outliers, a parameter held fixed, bad poses) or "
+                                "state the real noise in the spec."));
+    } else {
+      doc->Paragraph(Text()
+                         .Bold("Noise overstated:")
+                         .Plain(outside +
+                                "the residuals are smaller than the stated noise, so the ±1σ "
+                                "below are pessimistic."));
+    }
+  }
   Text t;
   if (r.converged) {
     t.Bold("Converged");
@@ -1245,6 +1263,9 @@ std::string RenderJson(const ReportInputs& in) {
     w.Key("initial_cost").Number(r->initial_cost);
     w.Key("final_cost").Number(r->final_cost);
     w.Key("reduced_chi_square").Number(r->reduced_chi_square);
+    const ChiSquareBand band = ReducedChiSquareBand(*r);
+    w.Key("reduced_chi_square_band_half_width").Number(band.half_width);
+    w.Key("reduced_chi_square_within_band").Bool(band.within);
     w.Key("num_residuals").Int(r->num_residuals);
     w.Key("num_free").Int(r->num_free);
     w.Key("covariance_ok").Bool(r->covariance_ok);
@@ -1344,6 +1365,14 @@ std::string RenderJson(const ReportInputs& in) {
     w.Int(NumHeldOut(in));
   else
     w.Null();
+  // Rows left out of the dataset (malformed, or a pose the model cannot solve), each
+  // "file:line: why".
+  w.Key("skipped").Int(in.data ? static_cast<long long>(in.data->skipped.size()) : 0);
+  w.Key("skipped_rows").BeginArray();
+  if (in.data) {
+    for (const std::string& why : in.data->skipped) w.String(why);
+  }
+  w.EndArray();
   w.EndObject();
   w.EndObject();
   return w.str();

@@ -12,6 +12,7 @@
 #include <string_view>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/internal/csv.h"
 
 namespace fastcal {
 namespace {
@@ -325,6 +326,8 @@ bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector
     const std::vector<std::string_view> fields = SplitFields(line);
 
     if (!has_header) {
+      const std::string separator_error = internal::WrongSeparatorMessage(line);
+      if (!separator_error.empty()) return Fail(error, where + separator_error);
       has_header = true;
       num_fields = fields.size();
       const std::vector<std::string> ignored = IgnoredDatasetColumns();

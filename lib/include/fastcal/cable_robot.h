@@ -68,7 +68,9 @@ struct CableRobot {
 };
 
 // Loads a model from YAML (format in docs/model-format.md). Keys that are absent take
-// the nominal values, except that a file that gives `cables` must give all six.
+// the nominal values, except that a file that gives `cables` must give all six. A file
+// with no document (empty, or only comments and white space) is an error: the nominal
+// model is CableRobot::NominalFast(), without a file.
 // Unknown keys, wrong types and non-physical values are errors; *error then names the
 // file, the key and (where yaml-cpp knows it) the line.
 bool LoadCableRobot(const std::string& path, CableRobot* robot, std::string* error);

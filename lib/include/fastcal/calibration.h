@@ -116,6 +116,20 @@ struct CalibrationResult {
   double seconds = 0.0;
 };
 
+// Whether the reduced chi-square agrees with the stated noise. For a correct noise model
+// chi^2/nu is 1 with a standard deviation of sqrt(2 / nu), nu = residuals - free
+// parameters; farther from 1 than kChiSquareBandSigmas of those, the fit is off: model
+// error the free parameters cannot absorb, or noise misstated. The report's verdict and
+// `fastcal calibrate` use this band.
+inline constexpr double kChiSquareBandSigmas = 3.0;
+struct ChiSquareBand {
+  int degrees_of_freedom = 0;  // nu; <= 0: no band
+  double half_width = 0.0;     // kChiSquareBandSigmas sqrt(2 / nu); 0 without a band
+  // |chi^2/nu - 1| <= half_width; false without a band or a finite chi^2/nu.
+  bool within = false;
+};
+ChiSquareBand ReducedChiSquareBand(const CalibrationResult& result);
+
 enum class CalibrationStatus {
   kOk = 0,
   kInvalidInput,  // bad spec, dataset, or fewer residuals than free parameters
@@ -123,6 +137,10 @@ enum class CalibrationStatus {
   kInfeasible,    // the initial model cannot hold a sample's pose
   kSolverFailed,  // Ceres failed
 };
+
+// The model the calibration starts from: `model` with the spec's initial values applied
+// (the "initial model" of Calibrate's messages).
+CableRobot InitialCalibrationModel(const CableRobot& model, const CalibrationSpec& spec);
 
 // Runs the calibration. On a status other than kOk, *error explains it (for kUndetermined:
 // the undetermined combinations and what to fix); `result` then holds what was computed

@@ -54,7 +54,8 @@ struct Dataset {
   // Measured attitude given as qw,qx,qy,qz (true) or roll_deg,pitch_deg,yaw_deg (false).
   bool attitude_as_quaternion = false;
   // One message per row skipped under DatasetReadOptions::skip_invalid_rows, in file
-  // order, formatted like the error the row would otherwise have caused ("file:line: ...").
+  // order, formatted like the error the row would otherwise have caused ("file:line: ...");
+  // then those of samples removed by SkipUnsolvableSamples (evaluation.h).
   std::vector<std::string> skipped;
 };
 

@@ -35,6 +35,17 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
                      StaticsMethod method, std::vector<std::array<double, kNumCables>>* predicted,
                      std::string* error);
 
+// Removes from data->samples every sample whose pose `robot` cannot solve (SolveStatics
+// not ok) with one of `methods` at one of `attitudes` (kPlanned only when the data has a
+// planned attitude), and appends one message per removed sample to data->skipped, after
+// the rows the reader skipped: "<file>:<line>: <model_name> cannot solve this pose
+// (<attitude> attitude, <method>): <why>". Returns how many were removed. For callers
+// that skip invalid rows (fastcal --skip-invalid-rows): a dataset row the model cannot
+// hold, e.g. a position outside the workspace, then goes the way of a malformed one.
+int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name,
+                          const std::vector<AttitudeSource>& attitudes,
+                          const std::vector<StaticsMethod>& methods, Dataset* data);
+
 // Statistics over the samples with held_out[n] == select_held_out (all samples when
 // held_out is empty and select_held_out is false).
 CableErrorStats ErrorStats(const Dataset& data,

@@ -12,8 +12,9 @@
 //
 // Sections: provenance (inputs with FNV-1a digests, software version, command line,
 // forward model and its error against the exact statics, evaluation method, noise model,
-// robust loss, hold-out, Ceres options); verdict (termination, iterations, cost,
-// reduced chi-square and what it means); estimates with 1-sigma and priors;
+// robust loss, hold-out, Ceres options, rows skipped); verdict (opening with "Poor fit"
+// when the reduced chi-square is outside ReducedChiSquareBand, calibration.h; termination,
+// iterations, cost, reduced chi-square and what it means); estimates with 1-sigma and priors;
 // identifiability (singular-value ratios, poorly determined and data-only directions,
 // strong correlations); RMS of model - measured per cable (the paper's Table 6) for each
 // variant on the fitted and the held-out samples; plots; how to use the calibrated model;

@@ -1,0 +1,24 @@
+// Helpers shared by the CSV readers (dataset.cc, trajectory.cc).
+#ifndef FASTCAL_INTERNAL_CSV_H_
+#define FASTCAL_INTERNAL_CSV_H_
+
+#include <string>
+#include <string_view>
+
+namespace fastcal::internal {
+
+// For a header line without a comma but with ';' or tabs (a spreadsheet export in another
+// locale): the message that the separator must be a comma. "" for any other line.
+inline std::string WrongSeparatorMessage(std::string_view header) {
+  if (header.find(',') != std::string_view::npos) return "";
+  const char* separator = header.find(';') != std::string_view::npos    ? "';'"
+                          : header.find('\t') != std::string_view::npos ? "tabs"
+                                                                        : nullptr;
+  if (separator == nullptr) return "";
+  return std::string("the header is separated by ") + separator +
+         ": fields must be separated by commas";
+}
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_INTERNAL_CSV_H_
