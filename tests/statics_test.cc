@@ -284,39 +284,6 @@ TEST(StaticsTest, InnerTolerancesDoNotChangeResults) {
   EXPECT_NE(error.find("exact_start_catenary_tolerance"), std::string::npos) << error;
 }
 
-// The guess for each cable's curve point at the AAS force (internal::CurveGuess) is what
-// makes one catenary evaluation enough there: the parabolic model corrected by its error
-// at the secant points. Measured max over the cap +-3 m: 6.7e-5 in s0, 1.4e-5 in Fz.
-TEST(StaticsTest, CurveGuessIsCloseOverTheWorkspace) {
-  constexpr double kS0RelTol = 1e-4;
-  constexpr double kFzRelTol = 3e-5;  // of the lower-end tension
-  const CableRobot robot = CableRobot::NominalFast();
-  const StaticsParameters<double> p = MakeStaticsParameters(robot);
-  const StaticsOptions options;
-  for (const Eigen::Vector3d& position : WorkspaceCap()) {
-    const Pose pose = FocalPose(position);
-    const StaticsSolution aas = Solve(robot, pose, StaticsMethod::kAas);
-    ASSERT_EQ(aas.status, StaticsStatus::kOk);
-    internal::PoseGeometry<double> g;
-    int cable = -1;
-    ASSERT_EQ(internal::ComputeGeometry(p, pose, 1e-9, &g, &cable), StaticsStatus::kOk);
-    for (int i = 0; i < kNumCables; ++i) {
-      const CableSolution& c = aas.cables[i];
-      const CatenaryCurvePoint guess =
-          internal::CurveGuess(c.horizontal_force_n, g.span[i], g.rise[i], g.chord[i], p.ea_n[i],
-                               g.w[i], c.secant_low, c.secant_high, options);
-      CatenaryCurvePoint truth;
-      int iterations = 0;
-      ASSERT_EQ(
-          SolveCatenaryLengthDouble(g.span[i], g.rise[i], c.horizontal_force_n, p.ea_n[i], g.w[i],
-                                    CatenarySolverOptions(), nullptr, &truth, &iterations),
-          CatenaryStatus::kOk);
-      EXPECT_NEAR(guess.s0_m, truth.s0_m, kS0RelTol * truth.s0_m) << position.transpose();
-      EXPECT_NEAR(guess.fz_n, truth.fz_n, kFzRelTol * c.lower_tension_n) << position.transpose();
-    }
-  }
-}
-
 TEST(StaticsTest, ExactSolutionSatisfiesEveryCatenary) {
   constexpr double kEndPointTolM = 1e-8;
   const CableRobot robot = CableRobot::NominalFast();

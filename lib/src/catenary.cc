@@ -150,23 +150,6 @@ CatenaryStatus NewtonFrom(const Problem<kFixedLength>& problem, double tolerance
   return CatenaryStatus::kNotConverged;
 }
 
-// Vertical force at the lower end of the inextensible catenary with horizontal force H:
-// Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
-// parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from one exp (tanh costs
-// three times as much); its series below 1e-3, where 1 - exp(-2 lambda) cancels.
-double InextensibleLowerFz(double span_m, double rise_m, double s0_m, double h_n,
-                           double w_n_per_m) {
-  const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h_n);
-  double coth;
-  if (lambda < 1e-3) {
-    coth = 1.0 / lambda + lambda / 3.0;
-  } else {
-    const double e = std::exp(-2.0 * lambda);
-    coth = (1.0 + e) / (1.0 - e);
-  }
-  return 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
-}
-
 CatenaryStatus CheckCommon(double span_m, double rise_m, double ea_n, double w_n_per_m,
                            const CatenarySolverOptions& options) {
   if (!AllFinite({span_m, rise_m, ea_n, w_n_per_m}) || !(ea_n > 0.0) || w_n_per_m == 0.0 ||
@@ -231,17 +214,22 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
     h -= step;
     if (step <= kGuessRelativeTolerance * h) break;
   }
-  return CatenaryForces{h, InextensibleLowerFz(span_m, rise_m, s0_m, h, w_n_per_m)};
-}
-
-CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,
-                                      double w_n_per_m) {
-  // The parabolic relation of CatenaryInitialGuess, solved for s0 at H = fl.
-  const double k = Norm2(span_m, rise_m);
-  const double c = k / (span_m * ea_n);
-  const double b = w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0;
-  const double s0_m = std::sqrt(k * k + b / (fl_n * fl_n)) / (1.0 + c * fl_n);
-  return CatenaryCurvePoint{InextensibleLowerFz(span_m, rise_m, s0_m, fl_n, w_n_per_m), s0_m};
+  CatenaryForces guess;
+  guess.fl_n = h;
+  // Vertical force at the lower end of the inextensible catenary with horizontal force H:
+  // Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
+  // parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from one exp (tanh costs
+  // three times as much); its series below 1e-3, where 1 - exp(-2 lambda) cancels.
+  const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h);
+  double coth;
+  if (lambda < 1e-3) {
+    coth = 1.0 / lambda + lambda / 3.0;
+  } else {
+    const double e = std::exp(-2.0 * lambda);
+    coth = (1.0 + e) / (1.0 - e);
+  }
+  guess.fz_n = 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
+  return guess;
 }
 
 namespace {
@@ -276,12 +264,18 @@ CatenaryStatus Start(const CatenaryLengthProblem& c, const CatenarySolverOptions
   if (!std::isfinite(c.fl_n) || !(c.fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
   const CatenaryStatus common = CheckCommon(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, options);
   if (common != CatenaryStatus::kOk) return common;
-  const CatenaryCurvePoint start =
-      c.guess != nullptr && c.guess->s0_m > 0.0 && AllFinite({c.guess->fz_n, c.guess->s0_m})
-          ? *c.guess
-          : CatenaryCurveGuess(c.span_m, c.rise_m, c.fl_n, c.ea_n, c.w_n_per_m);
-  u[0] = start.fz_n;
-  u[1] = start.s0_m;
+  if (c.guess != nullptr && c.guess->s0_m > 0.0 && AllFinite({c.guess->fz_n, c.guess->s0_m})) {
+    u[0] = c.guess->fz_n;
+    u[1] = c.guess->s0_m;
+  } else {
+    // The parabolic relation of CatenaryInitialGuess, solved for s0 at H = fl.
+    const double k = Norm2(c.span_m, c.rise_m);
+    const double cc = k / (c.span_m * c.ea_n);
+    const double b =
+        c.w_n_per_m * c.w_n_per_m * (c.span_m * c.span_m) * (c.span_m * c.span_m) / 12.0;
+    u[1] = std::sqrt(k * k + b / (c.fl_n * c.fl_n)) / (1.0 + cc * c.fl_n);
+    u[0] = -c.fl_n * c.rise_m / c.span_m - 0.5 * c.w_n_per_m * u[1];
+  }
   return CatenaryStatus::kOk;
 }
 

@@ -114,9 +114,7 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
   int* cable = &sol->cable;
   int* its = &sol->catenary_iterations;
   if (!have_state) {
-    // For kExact, AAS is only the start: build its secants with loose per-cable solves.
-    // (Not its s0 projections: CurveGuess is within a few cm there, which passes a loose
-    // tolerance unimproved and costs the exact Newton a third step at the cap's edge.)
+    // For kExact, AAS is only the start: build it with loose per-cable solves.
     StaticsOptions start_options = o;
     if (o.method == StaticsMethod::kExact) {
       start_options.catenary.relative_tolerance =
@@ -141,11 +139,10 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
     for (int step = 0; step < projections; ++step) {
       std::array<CatenaryCurvePoint, kNumCables> guess;
       for (int i = 0; i < kNumCables; ++i) {
-        guess[i] = internal::CurveGuess(st[i].fl, g.span[i], g.rise[i], g.chord[i], p.ea_n[i],
-                                        g.w[i], low[i], high[i], o);
+        guess[i] = internal::CurveGuess(st[i].fl, g.chord[i], low[i], high[i], o);
       }
       std::array<CableState<double>, kNumCables> projected = st;
-      status = internal::ProjectOnCurves(p, g, o, guess, &projected, cable, its);
+      status = internal::ProjectOnCurves(p, g, so, guess, &projected, cable, its);
       if (status != StaticsStatus::kOk) return status;
       if (o.method == StaticsMethod::kAas) {
         // AAS keeps Fz on its secant line (which satisfies equilibrium); s0 is the length

@@ -143,13 +143,6 @@ CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl
 CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
                                     double w_n_per_m);
 
-// Starting point of the fixed-Fl problem when no guess is given: the same parabolic
-// relation solved for s0 at H = fl, and Fz from the inextensible catenary. Its error
-// varies smoothly along a cable's family of lengths, so correcting it by its error at
-// two known points of the family gives a close guess in between (statics' CurveGuess).
-CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,
-                                      double w_n_per_m);
-
 // Templated wrappers. For T = double they are the solves above; for a Jet they add one
 // Newton step in Jet arithmetic at the converged point (implicit differentiation).
 template <typename T>

@@ -54,8 +54,8 @@ struct StaticsOptions {
   // relative to the chord), is below this.
   double exact_relative_tolerance = 1e-12;
   int exact_max_iterations = 30;
-  // kExact only: tolerance of the secant solves that build its AAS start (the cold
-  // start's one evaluation instead of two). The start is then ~1e-5 from AAS, itself ~1e-3 from the
+  // kExact only: tolerance of the per-cable solves that build its AAS start (one Newton
+  // step each instead of two). The start is then ~1e-5 from AAS, itself ~1e-3 from the
   // solution, so Newton needs the same number of steps and the result is unchanged.
   double exact_start_catenary_tolerance = 1e-4;
   // kAas only: solve for s0_i (one 2x2 Newton per cable). Off, s0 and the upper-end

@@ -340,23 +340,15 @@ StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometr
   return StaticsStatus::kOk;
 }
 
-// Guess for cable i's curve point at Fl from its secant data: the parabolic model's point
-// (CatenaryCurveGuess) corrected by the model's error at the two secant points, where the
-// exact points are known, interpolated linearly in Fl. The model's error varies slowly
-// along the family of lengths: over the workspace cap +-3 m this guess is within 7e-5 in
-// s0 and 1.4e-5 (of the tension) in Fz, against 5.6e-3 for interpolating s0 itself.
-inline CatenaryCurvePoint CurveGuess(double fl, double span, double rise, double chord, double ea,
-                                     double w, const CatenaryForces& low,
+// Guess for the curve point at Fl from the secant data: linear interpolation of s0 in Fl
+// between the two secant lengths, Fz on the secant line.
+inline CatenaryCurvePoint CurveGuess(double fl, double chord, const CatenaryForces& low,
                                      const CatenaryForces& high, const StaticsOptions& o) {
   const double t = (fl - low.fl_n) / (high.fl_n - low.fl_n);
   const double s_low = o.secant_low_fraction * chord, s_high = o.secant_high_fraction * chord;
-  const CatenaryCurvePoint m = CatenaryCurveGuess(span, rise, fl, ea, w);
-  const CatenaryCurvePoint m_low = CatenaryCurveGuess(span, rise, low.fl_n, ea, w);
-  const CatenaryCurvePoint m_high = CatenaryCurveGuess(span, rise, high.fl_n, ea, w);
   CatenaryCurvePoint c;
-  c.s0_m =
-      std::max(m.s0_m + (1 - t) * (s_low - m_low.s0_m) + t * (s_high - m_high.s0_m), 0.5 * s_low);
-  c.fz_n = m.fz_n + (1 - t) * (low.fz_n - m_low.fz_n) + t * (high.fz_n - m_high.fz_n);
+  c.s0_m = std::max(s_low + t * (s_high - s_low), 0.5 * s_low);
+  c.fz_n = low.fz_n + t * (high.fz_n - low.fz_n);
   return c;
 }
 

@@ -60,9 +60,7 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
         for (int step = 0; step < options.refinement_steps; ++step) {
           std::array<CatenaryCurvePoint, kNumCables> guess;
           for (int i = 0; i < kNumCables; ++i) {
-            guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), ScalarValue(g.span[i]),
-                                            ScalarValue(g.rise[i]), ScalarValue(g.chord[i]),
-                                            ScalarValue(p.ea_n[i]), ScalarValue(g.w[i]), low[i],
+            guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), ScalarValue(g.chord[i]), low[i],
                                             high[i], options);
           }
           status = internal::ProjectOnCurves(p, g, options, guess, &st, &cable, &iterations);
