@@ -1198,6 +1198,20 @@ void JsonIdentifiability(JsonWriter* w, const std::string& key, const Identifiab
   w->EndObject();
 }
 
+// Writes `key` with the object `body` writes, or null when `present` is false (the
+// summary's sections that only a calibration, or only a spec, has).
+template <typename Body>
+void ObjectOrNull(JsonWriter* w, const char* key, bool present, Body&& body) {
+  w->Key(key);
+  if (!present) {
+    w->Null();
+    return;
+  }
+  w->BeginObject();
+  body();
+  w->EndObject();
+}
+
 std::string RenderJson(const ReportInputs& in) {
   JsonWriter w;
   const CalibrationResult* r = in.result;
@@ -1222,27 +1236,15 @@ std::string RenderJson(const ReportInputs& in) {
   else
     w.Null();
   w.Key("evaluation_method").String(in.evaluation_method);
-  w.Key("noise");
-  if (spec) {
-    w.BeginObject();
+  ObjectOrNull(&w, "noise", spec != nullptr, [&] {
     w.Key("sigma_kN").Number(spec->tension_sigma_n / kNPerKn);
     w.Key("sigma_percent").Number(spec->tension_sigma_percent);
-    w.EndObject();
-  } else {
-    w.Null();
-  }
-  w.Key("robust_loss");
-  if (spec) {
-    w.BeginObject();
+  });
+  ObjectOrNull(&w, "robust_loss", spec != nullptr, [&] {
     w.Key("type").String(RobustLossName(spec->robust_loss));
     w.Key("scale_sigma").Number(spec->robust_loss_scale);
-    w.EndObject();
-  } else {
-    w.Null();
-  }
-  w.Key("holdout");
-  if (spec) {
-    w.BeginObject();
+  });
+  ObjectOrNull(&w, "holdout", spec != nullptr, [&] {
     w.Key("fraction").Number(spec->holdout_fraction);
     w.Key("seed");
     if (spec->holdout_seed <= static_cast<unsigned long long>(LLONG_MAX)) {
@@ -1250,13 +1252,8 @@ std::string RenderJson(const ReportInputs& in) {
     } else {
       w.String(std::to_string(spec->holdout_seed));
     }
-    w.EndObject();
-  } else {
-    w.Null();
-  }
-  w.Key("solver");
-  if (r) {
-    w.BeginObject();
+  });
+  ObjectOrNull(&w, "solver", r != nullptr, [&] {
     w.Key("termination").String(r->termination);
     w.Key("converged").Bool(r->converged);
     w.Key("iterations").Int(r->iterations);
@@ -1270,19 +1267,11 @@ std::string RenderJson(const ReportInputs& in) {
     w.Key("num_free").Int(r->num_free);
     w.Key("covariance_ok").Bool(r->covariance_ok);
     w.Key("seconds").Number(r->seconds);
-    w.EndObject();
-  } else {
-    w.Null();
-  }
-  w.Key("forward_model_error");
-  if (r) {
-    w.BeginObject();
+  });
+  ObjectOrNull(&w, "forward_model_error", r != nullptr, [&] {
     w.Key("max_relative").Number(r->forward_model_max_rel_error);
     w.Key("rms_relative").Number(r->forward_model_rms_rel_error);
-    w.EndObject();
-  } else {
-    w.Null();
-  }
+  });
   w.Key("parameters").BeginArray();
   if (r) {
     for (const ParameterEstimate& p : r->parameters) {
@@ -1297,48 +1286,33 @@ std::string RenderJson(const ReportInputs& in) {
         w.Number(p.sigma);
       else
         w.Null();
-      w.Key("prior");
-      if (p.has_prior) {
-        w.BeginObject();
+      ObjectOrNull(&w, "prior", p.has_prior, [&] {
         w.Key("mean").Number(p.prior_mean);
         w.Key("sigma").Number(p.prior_sigma);
-        w.EndObject();
-      } else {
-        w.Null();
-      }
+      });
       w.Key("note").String(p.note);
       w.EndObject();
     }
   }
   w.EndArray();
-  w.Key("correlation");
-  if (r && CorrelationUsable(*r)) {
-    w.BeginObject();
+  ObjectOrNull(&w, "correlation", r && CorrelationUsable(*r), [&] {
     w.Key("names").BeginArray();
     for (const std::string& n : r->free_names) w.String(n);
     w.EndArray();
     w.Key("matrix").BeginArray();
     for (const auto& row : CorrelationRows(*r)) w.NumberArray(row);
     w.EndArray();
-    w.EndObject();
-  } else {
-    w.Null();
-  }
+  });
   w.Key("strong_correlations").BeginArray();
   if (r) {
     for (const std::string& c : r->strong_correlations) w.String(c);
   }
   w.EndArray();
-  w.Key("identifiability");
-  if (r) {
-    w.BeginObject();
+  ObjectOrNull(&w, "identifiability", r != nullptr, [&] {
     JsonIdentifiability(&w, "before", r->before);
     JsonIdentifiability(&w, "after", r->after);
     JsonIdentifiability(&w, "data_only", r->data_only);
-    w.EndObject();
-  } else {
-    w.Null();
-  }
+  });
   w.Key("evaluation").BeginArray();
   for (const VariantEvaluation& v : in.variants) {
     w.BeginObject();
