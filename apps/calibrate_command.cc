@@ -256,6 +256,24 @@ std::string ChiSquareWarning(const CalibrationResult& result, const ChiSquareBan
   return buf;
 }
 
+// Writes `files` and the report files into --out as one directory (built as a hidden
+// sibling and renamed into place). False, with the error printed, on failure.
+bool WriteOutDirectory(const char* command,
+                       const std::vector<std::pair<std::string, std::string>>& files,
+                       const ReportInputs& report) {
+  std::string error;
+  if (WriteDirectoryAtomically(
+          FLAGS_out, files,
+          [&](const std::string& dir, std::string* why) {
+            return WriteReportFiles(dir, report, why);
+          },
+          &error)) {
+    return true;
+  }
+  PrintError(command, error);
+  return false;
+}
+
 }  // namespace
 
 int RunCalibrate(int argc, char** argv) {
@@ -357,15 +375,7 @@ int RunCalibrate(int argc, char** argv) {
   const std::vector<std::pair<std::string, std::string>> files = {
       {"model_calibrated.yaml", CableRobotToYaml(result.calibrated, header)},
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out)}};
-  if (!WriteDirectoryAtomically(
-          FLAGS_out, files,
-          [&](const std::string& dir, std::string* why) {
-            return WriteReportFiles(dir, report, why);
-          },
-          &error)) {
-    PrintError(command, error);
-    return kExitUsage;
-  }
+  if (!WriteOutDirectory(command, files, report)) return kExitUsage;
 
   std::ostringstream s;
   s << "\n" << result.ceres_brief_report << "\n";
@@ -463,13 +473,8 @@ int RunEvaluate(int argc, char** argv) {
     report.data = &data;
     report.variants = variants;
     report.evaluation_method = StaticsMethodName(method);
-    if (!WriteDirectoryAtomically(
-            FLAGS_out, {{"residuals.csv", ResidualsCsv(data, variants, {})}},
-            [&](const std::string& dir, std::string* why) {
-              return WriteReportFiles(dir, report, why);
-            },
-            &error)) {
-      PrintError(command, error);
+    if (!WriteOutDirectory(command, {{"residuals.csv", ResidualsCsv(data, variants, {})}},
+                           report)) {
       return kExitUsage;
     }
   }
