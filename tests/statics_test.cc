@@ -444,6 +444,15 @@ TEST(StaticsTest, InfeasibleAndInvalidPosesReportStatusNotNan) {
   std::string error;
   EXPECT_FALSE(options.IsValid(&error));
   EXPECT_NE(error.find("secant"), std::string::npos);
+  // SolveStatics checks the options itself: swapped secants, no refinement step.
+  StaticsSolution s;
+  EXPECT_EQ(SolveStatics(robot, ok, options, &s), StaticsStatus::kInvalidInput);
+  StaticsOptions no_steps;
+  no_steps.refinement_steps = 0;
+  EXPECT_EQ(SolveStatics(robot, ok, no_steps, &s), StaticsStatus::kInvalidInput);
+  for (const CableSolution& c : s.cables) EXPECT_EQ(c.lower_tension_n, 0.0);
+  // A default-constructed robot has no anchor points: invalid input, not a crash.
+  EXPECT_EQ(SolveStatics(CableRobot(), ok, StaticsOptions(), &s), StaticsStatus::kInvalidInput);
 }
 
 TEST(StaticsTest, JetTensionsMatchCentralDifferences) {

@@ -44,8 +44,7 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
       return false;
     }
     for (int i = 0; i < kNumCables; ++i) {
-      (*predicted)[n][i] = robot.cables[i].sensor_gain * solution.cables[i].lower_tension_n +
-                           robot.cables[i].sensor_bias_n;
+      (*predicted)[n][i] = robot.cables[i].SensorReadingN(solution.cables[i].lower_tension_n);
     }
   }
   return true;

@@ -181,8 +181,7 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
     s.has_unstretched_lengths = true;
     for (int i = 0; i < kNumCables; ++i) {
       const CableProperties& cable = model.cables[i];
-      const double reading_n =
-          cable.sensor_gain * solution.cables[i].lower_tension_n + cable.sensor_bias_n;
+      const double reading_n = cable.SensorReadingN(solution.cables[i].lower_tension_n);
       if (!(reading_n > 0.0)) {
         return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
                                ": sensor reading gain * tension + bias = " +

@@ -227,29 +227,73 @@ const char* StaticsStatusName(StaticsStatus status) {
   return "unknown";
 }
 
-bool StaticsOptions::IsValid(std::string* error) const {
-  std::ostringstream e;
-  if (!(secant_low_fraction > 0.0) || !(secant_high_fraction > secant_low_fraction) ||
-      !std::isfinite(secant_high_fraction)) {
-    e << "secant fractions must satisfy 0 < low < high (got " << secant_low_fraction << ", "
-      << secant_high_fraction << ")";
-  } else if (refinement_steps < 1) {
-    e << "refinement_steps must be >= 1 (got " << refinement_steps << ")";
-  } else if (!(exact_relative_tolerance > 0.0)) {
-    e << "exact_relative_tolerance must be > 0 (got " << exact_relative_tolerance << ")";
-  } else if (!(exact_start_catenary_tolerance > 0.0)) {
-    e << "exact_start_catenary_tolerance must be > 0 (got " << exact_start_catenary_tolerance
-      << ")";
-  } else if (!(max_strain > 0.0) || !(max_length_ratio > 1.0)) {
-    e << "max_strain must be > 0 and max_length_ratio > 1 (got " << max_strain << ", "
-      << max_length_ratio << ")";
-  } else if (exact_max_iterations < 1) {
-    e << "exact_max_iterations must be >= 1 (got " << exact_max_iterations << ")";
-  } else if (!(catenary.relative_tolerance > 0.0) || catenary.max_iterations < 1) {
-    e << "catenary solver options must have relative_tolerance > 0 and max_iterations >= 1";
+namespace {
+
+// Which rule of StaticsOptions::IsValid `o` breaks first (kNone: none). Separate from the
+// message so that SolveStatics can check without allocating.
+enum class OptionsRule {
+  kNone,
+  kSecants,
+  kRefinementSteps,
+  kExactTolerance,
+  kExactStartTolerance,
+  kModelRange,
+  kExactIterations,
+  kCatenary
+};
+
+OptionsRule BrokenRule(const StaticsOptions& o) {
+  if (!(o.secant_low_fraction > 0.0) || !(o.secant_high_fraction > o.secant_low_fraction) ||
+      !std::isfinite(o.secant_high_fraction)) {
+    return OptionsRule::kSecants;
   }
-  if (e.str().empty()) return true;
-  if (error != nullptr) *error = e.str();
+  if (o.refinement_steps < 1) return OptionsRule::kRefinementSteps;
+  if (!(o.exact_relative_tolerance > 0.0)) return OptionsRule::kExactTolerance;
+  if (!(o.exact_start_catenary_tolerance > 0.0)) return OptionsRule::kExactStartTolerance;
+  if (!(o.max_strain > 0.0) || !(o.max_length_ratio > 1.0)) return OptionsRule::kModelRange;
+  if (o.exact_max_iterations < 1) return OptionsRule::kExactIterations;
+  if (!(o.catenary.relative_tolerance > 0.0) || o.catenary.max_iterations < 1) {
+    return OptionsRule::kCatenary;
+  }
+  return OptionsRule::kNone;
+}
+
+}  // namespace
+
+bool StaticsOptions::IsValid(std::string* error) const {
+  const OptionsRule rule = BrokenRule(*this);
+  if (rule == OptionsRule::kNone) return true;
+  if (error == nullptr) return false;
+  std::ostringstream e;
+  switch (rule) {
+    case OptionsRule::kNone:
+      break;
+    case OptionsRule::kSecants:
+      e << "secant fractions must satisfy 0 < low < high (got " << secant_low_fraction << ", "
+        << secant_high_fraction << ")";
+      break;
+    case OptionsRule::kRefinementSteps:
+      e << "refinement_steps must be >= 1 (got " << refinement_steps << ")";
+      break;
+    case OptionsRule::kExactTolerance:
+      e << "exact_relative_tolerance must be > 0 (got " << exact_relative_tolerance << ")";
+      break;
+    case OptionsRule::kExactStartTolerance:
+      e << "exact_start_catenary_tolerance must be > 0 (got " << exact_start_catenary_tolerance
+        << ")";
+      break;
+    case OptionsRule::kModelRange:
+      e << "max_strain must be > 0 and max_length_ratio > 1 (got " << max_strain << ", "
+        << max_length_ratio << ")";
+      break;
+    case OptionsRule::kExactIterations:
+      e << "exact_max_iterations must be >= 1 (got " << exact_max_iterations << ")";
+      break;
+    case OptionsRule::kCatenary:
+      e << "catenary solver options must have relative_tolerance > 0 and max_iterations >= 1";
+      break;
+  }
+  *error = e.str();
   return false;
 }
 
@@ -270,6 +314,13 @@ StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot) {
 StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parameters,
                                          const Pose& pose, const StaticsOptions& options,
                                          StaticsSolution* solution) {
+  if (BrokenRule(options) != OptionsRule::kNone) {
+    // Invalid options are invalid input (StaticsOptions::IsValid says which).
+    const StaticsStatus status = solution->status = StaticsStatus::kInvalidInput;
+    solution->cables = {};
+    solution->cable = -1;
+    return status;
+  }
   const bool warm = options.warm_start && solution->status == StaticsStatus::kOk;
   StaticsSolution previous;
   if (warm) previous = *solution;
@@ -288,6 +339,16 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
 
 StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const StaticsOptions& options,
                            StaticsSolution* solution) {
+  // MakeStaticsParameters indexes the anchors: a robot without them (default-constructed)
+  // is invalid input, not a crash.
+  for (const CableProperties& c : robot.cables) {
+    if (c.anchor_index < 0 ||
+        c.anchor_index >= static_cast<int>(robot.anchor_points_cabin_m.size())) {
+      solution->cables = {};
+      solution->cable = -1;
+      return solution->status = StaticsStatus::kInvalidInput;
+    }
+  }
   return SolveStaticsWithParameters(MakeStaticsParameters(robot), pose, options, solution);
 }
 
@@ -299,7 +360,8 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       s << "ok";
       break;
     case StaticsStatus::kInvalidInput:
-      s << "invalid input: the pose or the model has a non-finite or non-physical value";
+      s << "invalid input: the pose or the model has a non-finite or non-physical value, or "
+           "the options are invalid (StaticsOptions::IsValid says which)";
       break;
     case StaticsStatus::kVerticalCable:
       s << "cable " << c << " is vertical: its horizontal force direction is undefined";

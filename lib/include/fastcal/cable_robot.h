@@ -40,6 +40,10 @@ struct CableProperties {
   // sensor_bias_kN, optional).
   double sensor_gain = 1.0;
   double sensor_bias_n = 0.0;
+
+  // What this cable's sensor reads when the cable's lower-end tension is `tension_n`
+  // (e.g. StaticsSolution's lower_tension_n, which is the true tension).
+  double SensorReadingN(double tension_n) const { return sensor_gain * tension_n + sensor_bias_n; }
 };
 
 struct CableRobot {

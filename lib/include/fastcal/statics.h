@@ -99,8 +99,10 @@ struct CableSolution {
   // Force applied ON the cable at its lower end by the cabin, global frame (N). The
   // cabin feels -force_n.
   Eigen::Vector3d force_n = Eigen::Vector3d::Zero();
-  double horizontal_force_n = 0.0;    // Fl
-  double lower_tension_n = 0.0;       // |force_n|: what the cabin-side sensors measure
+  double horizontal_force_n = 0.0;  // Fl
+  // |force_n|, the true tension at the cabin end. The cabin-side sensor reads it through
+  // its gain and bias: CableProperties::SensorReadingN (identity unless calibrated).
+  double lower_tension_n = 0.0;
   double upper_tension_n = 0.0;       // at the tower end: sqrt(Fl^2 + (Fz + w s0)^2)
   double unstretched_length_m = 0.0;  // s0
   double chord_length_m = 0.0;        // k = |B_i - (R a_i + r_p)|
@@ -120,8 +122,11 @@ struct StaticsSolution {
   double moment_residual_nm = 0.0;
 };
 
-// Solves the statics of `pose`. Returns solution->status. On failure the forces are
-// zero (never NaN) and `cable` names the cable concerned where there is one.
+// Solves the statics of `pose`. Returns solution->status: kInvalidInput also for options
+// that StaticsOptions::IsValid refuses and for a robot whose anchor indices are out of
+// range (a default-constructed CableRobot: start from NominalFast() or a YAML file). On
+// failure the forces are zero (never NaN) and `cable` names the cable concerned where
+// there is one.
 StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const StaticsOptions& options,
                            StaticsSolution* solution);
 
