@@ -427,6 +427,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   if (summary.IsSolutionUsable()) {
     // Second pass: weights (and warm starts) from the first fit's prediction.
     predicted_sigmas(theta, &sigmas, &starts);
+    problem_owner.reset();  // one problem in memory at a time (~300 MB at 1e5 samples)
     problem_owner = build_problem(&data_blocks);
     if (options.progress) options.progress("reweighted from the first fit's prediction:");
     ceres::Solve(so, problem_owner.get(), &summary);
