@@ -425,7 +425,9 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   ceres::Solve(so, problem_owner.get(), &summary);
   int iterations = summary.num_successful_steps + summary.num_unsuccessful_steps;
   const double first_initial_cost = summary.initial_cost;
-  if (summary.IsSolutionUsable()) {
+  const std::string first_brief = summary.BriefReport(), first_full = summary.FullReport();
+  const bool two_passes = summary.IsSolutionUsable();
+  if (two_passes) {
     // Second pass: weights (and warm starts) from the first fit's prediction.
     predicted_sigmas(theta, &sigmas, &starts);
     problem_owner.reset();  // one problem in memory at a time (~300 MB at 1e5 samples)
@@ -435,9 +437,16 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
     iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
   }
   ceres::Problem& problem = *problem_owner;
-  result->ceres_brief_report = summary.BriefReport();
-  result->ceres_full_report = summary.FullReport();
-  result->initial_cost = first_initial_cost;  // at the initial parameters, first weights
+  // Both passes, each with its own weights (so their costs do not compare across passes).
+  result->ceres_brief_report = two_passes
+                                   ? "pass 1 (weights from the initial model): " + first_brief +
+                                         "\npass 2 (weights from pass 1): " + summary.BriefReport()
+                                   : summary.BriefReport();
+  result->ceres_full_report = two_passes ? "Pass 1, weights from the initial model\n" + first_full +
+                                               "\nPass 2, weights from pass 1's prediction\n" +
+                                               summary.FullReport()
+                                         : summary.FullReport();
+  result->initial_cost = first_initial_cost;  // pass 1's, at the initial parameters
   result->final_cost = summary.final_cost;
   // As Ceres counts them in its BriefReport, both passes.
   result->iterations = iterations;

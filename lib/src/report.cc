@@ -231,7 +231,7 @@ bool HasPredictions(const ReportInputs& in, const VariantEvaluation& v) {
 
 std::string NoiseText(const CalibrationSpec& spec) {
   return "σ = √[(" + Printf("%.6g", spec.tension_sigma_n / kNPerKn) + " kN)² + (" +
-         Printf("%.6g", spec.tension_sigma_percent) + " % of the measured tension)²]";
+         Printf("%.6g", spec.tension_sigma_percent) + " % of the predicted reading)²]";
 }
 
 // One-line meaning of the reduced chi-square.

@@ -368,9 +368,9 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       break;
     case StaticsStatus::kSlackCable:
       s << "cable " << c
-        << " would be slack (horizontal force <= 0, or so long that it hangs in a loop: "
-           "unstretched length above max_length_ratio, 1.5 by default, times its chord): "
-           "the pose cannot be held with taut cables";
+        << " would be slack (horizontal force <= 0, or an unstretched length over 1.5 times "
+           "its chord, StaticsOptions::max_length_ratio): the pose cannot be held with taut "
+           "cables";
       break;
     case StaticsStatus::kSingular:
       s << "the equilibrium equations are singular at this pose";
@@ -383,8 +383,9 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       break;
     case StaticsStatus::kOverstretchedCable:
       s << "cable " << c
-        << " would be stretched beyond the model's elastic range (tension above max_strain, "
-           "3% by default, times EA): the pose cannot be held as modelled";
+        << " would be stretched beyond the model's elastic range (strain over 5%, "
+           "StaticsOptions::max_strain, or an unstretched length <= 0): the pose cannot be held "
+           "as modelled";
       break;
   }
   return s.str();

@@ -60,7 +60,8 @@ struct CalibrationSpec {
   // Statics model inside the residuals. aas-refined by default: plain AAS's own 0.1-0.3%
   // error is a bias, not noise, and would shift the estimates (docs/calibration.md).
   StaticsMethod forward_model = StaticsMethod::kAasRefined;
-  // Tension noise: sigma_i^2 = sigma_abs^2 + (percent/100 * measured_i)^2.
+  // Tension noise: sigma_i^2 = sigma_abs^2 + (percent/100 * predicted_i)^2, predicted_i
+  // the model's reading (docs/calibration.md: why not the measured one).
   double tension_sigma_n = 0.0;
   double tension_sigma_percent = 3.0;
   RobustLoss robust_loss = RobustLoss::kNone;
