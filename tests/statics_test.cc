@@ -70,15 +70,21 @@ std::vector<Eigen::Vector3d> WorkspaceCap() {
   return points;
 }
 
+// Exact and AAS at K1 = (0, 0, 140), R = I (paper Table 2).
+void SolveK1(const CableRobot& robot, StaticsSolution* exact, StaticsSolution* aas) {
+  Pose pose;
+  pose.position_m = Eigen::Vector3d(0, 0, 140);
+  *exact = Solve(robot, pose, StaticsMethod::kExact);
+  *aas = Solve(robot, pose, StaticsMethod::kAas);
+}
+
 TEST(StaticsTest, K1MatchesPaperTable2) {
   // Paper Table 2 values and the precision they are printed to.
   constexpr double kExactKn = 159.17, kAasKn = 158.98, kAasErrorPct = -0.117;
   constexpr double kTensionTolKn = 0.005, kErrorTolPct = 0.0005;
   const CableRobot robot = CableRobot::NominalFast();
-  Pose pose;
-  pose.position_m = Eigen::Vector3d(0, 0, 140);
-  const StaticsSolution exact = Solve(robot, pose, StaticsMethod::kExact);
-  const StaticsSolution aas = Solve(robot, pose, StaticsMethod::kAas);
+  StaticsSolution exact, aas;
+  SolveK1(robot, &exact, &aas);
   ASSERT_EQ(exact.status, StaticsStatus::kOk);
   ASSERT_EQ(aas.status, StaticsStatus::kOk);
   for (int i = 0; i < kNumCables; ++i) {
@@ -115,10 +121,8 @@ TEST(StaticsTest, K1PerCableSpreadOfTable2ComesFromPiTruncatedTo3_1415) {
     robot.anchor_points_cabin_m[j].head<2>() =
         anchor_radius_m * Eigen::Vector2d(std::cos(t), std::sin(t));
   }
-  Pose pose;
-  pose.position_m = Eigen::Vector3d(0, 0, 140);
-  const StaticsSolution exact = Solve(robot, pose, StaticsMethod::kExact);
-  const StaticsSolution aas = Solve(robot, pose, StaticsMethod::kAas);
+  StaticsSolution exact, aas;
+  SolveK1(robot, &exact, &aas);
   ASSERT_EQ(exact.status, StaticsStatus::kOk);
   ASSERT_EQ(aas.status, StaticsStatus::kOk);
   for (int i = 0; i < kNumCables; ++i) {

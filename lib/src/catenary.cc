@@ -352,24 +352,31 @@ void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, 
 
 }  // namespace
 
-void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
-                              const CatenarySolverOptions& options, CatenaryForces* forces,
-                              CatenaryStatus* statuses, int* iterations) {
+namespace {
+
+// SolveBatch with each solution converted to its public type, written where ok.
+template <typename Spec, typename Out>
+void SolveBatchInto(int n, const Spec* problems, const CatenarySolverOptions& options, Out* out,
+                    CatenaryStatus* statuses, int* iterations) {
   double u[kMaxCatenaryBatch][2];
   SolveBatch(n, problems, options, u, statuses, iterations);
   for (int j = 0; j < std::min(n, kMaxCatenaryBatch); ++j) {
-    if (statuses[j] == CatenaryStatus::kOk) forces[j] = CatenaryForces{u[j][0], u[j][1]};
+    if (statuses[j] == CatenaryStatus::kOk) out[j] = Out{u[j][0], u[j][1]};
   }
+}
+
+}  // namespace
+
+void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
+                              const CatenarySolverOptions& options, CatenaryForces* forces,
+                              CatenaryStatus* statuses, int* iterations) {
+  SolveBatchInto(n, problems, options, forces, statuses, iterations);
 }
 
 void SolveCatenaryLengthBatch(int n, const CatenaryLengthProblem* problems,
                               const CatenarySolverOptions& options, CatenaryCurvePoint* points,
                               CatenaryStatus* statuses, int* iterations) {
-  double u[kMaxCatenaryBatch][2];
-  SolveBatch(n, problems, options, u, statuses, iterations);
-  for (int j = 0; j < std::min(n, kMaxCatenaryBatch); ++j) {
-    if (statuses[j] == CatenaryStatus::kOk) points[j] = CatenaryCurvePoint{u[j][0], u[j][1]};
-  }
+  SolveBatchInto(n, problems, options, points, statuses, iterations);
 }
 
 CatenaryStatus SolveCatenaryForcesDouble(double span_m, double rise_m, double s0_m, double ea_n,
