@@ -255,7 +255,12 @@ TEST(StaticsTest, WholeWorkspaceCap) {
 // (measured: exact 7e-14, aas 1e-11).
 TEST(StaticsTest, InnerTolerancesDoNotChangeResults) {
   constexpr double kExactRelTol = 1e-12;
-  constexpr double kAasRelTol = 1e-9;
+  constexpr double kRefinedRelTol = 1e-9;
+  // aas ends its secant solves at aas_secant_tolerance = 1e-6, which bounds the relative
+  // error those solves leave in the forces (measured: 2.9e-7 over the cap); s0 comes
+  // from a tight solve and moves by ~2e-6 m.
+  constexpr double kAasRelTol = 1e-6;
+  constexpr double kAasLengthTolM = 1e-5;
   constexpr double kTightCatenaryTol = 1e-13;
   const CableRobot robot = CableRobot::NominalFast();
   for (const Eigen::Vector3d& p : WorkspaceCap()) {
@@ -266,17 +271,21 @@ TEST(StaticsTest, InnerTolerancesDoNotChangeResults) {
       fast.method = tight.method = m;
       tight.catenary.relative_tolerance = kTightCatenaryTol;
       tight.exact_start_catenary_tolerance = kTightCatenaryTol;
+      tight.aas_secant_tolerance = kTightCatenaryTol;
       StaticsSolution a, b;
       ASSERT_EQ(SolveStatics(robot, pose, fast, &a), StaticsStatus::kOk) << p.transpose();
       ASSERT_EQ(SolveStatics(robot, pose, tight, &b), StaticsStatus::kOk) << p.transpose();
       EXPECT_EQ(a.outer_iterations, b.outer_iterations) << p.transpose();
-      const double tol = m == StaticsMethod::kExact ? kExactRelTol : kAasRelTol;
+      const double tol = m == StaticsMethod::kExact ? kExactRelTol
+                         : m == StaticsMethod::kAas ? kAasRelTol
+                                                    : kRefinedRelTol;
       for (int i = 0; i < kNumCables; ++i) {
         EXPECT_NEAR(a.cables[i].lower_tension_n, b.cables[i].lower_tension_n,
                     tol * b.cables[i].lower_tension_n)
             << StaticsMethodName(m) << " " << p.transpose();
-        EXPECT_NEAR(a.cables[i].unstretched_length_m, b.cables[i].unstretched_length_m,
-                    tol * b.cables[i].unstretched_length_m)
+        EXPECT_NEAR(
+            a.cables[i].unstretched_length_m, b.cables[i].unstretched_length_m,
+            m == StaticsMethod::kAas ? kAasLengthTolM : tol * b.cables[i].unstretched_length_m)
             << StaticsMethodName(m) << " " << p.transpose();
       }
     }
@@ -286,6 +295,10 @@ TEST(StaticsTest, InnerTolerancesDoNotChangeResults) {
   std::string error;
   EXPECT_FALSE(bad.IsValid(&error));
   EXPECT_NE(error.find("exact_start_catenary_tolerance"), std::string::npos) << error;
+  bad = StaticsOptions();
+  bad.aas_secant_tolerance = -1.0;
+  EXPECT_FALSE(bad.IsValid(&error));
+  EXPECT_NE(error.find("aas_secant_tolerance"), std::string::npos) << error;
 }
 
 TEST(StaticsTest, ExactSolutionSatisfiesEveryCatenary) {
@@ -356,9 +369,13 @@ TEST(StaticsTest, RefinementConvergesQuadratically) {
 }
 
 TEST(StaticsTest, WarmStartGivesTheColdSolution) {
-  constexpr double kRelTol = 1e-9;
+  // aas: its secant solves stop at StaticsOptions::aas_secant_tolerance (1e-6), so warm
+  // and cold may end on different points within it. The others converge further.
+  constexpr double kAasRelTol = 1e-6;
+  constexpr double kConvergedRelTol = 1e-9;
   const CableRobot robot = CableRobot::NominalFast();
   for (StaticsMethod m : {StaticsMethod::kAas, StaticsMethod::kAasRefined, StaticsMethod::kExact}) {
+    const double kRelTol = m == StaticsMethod::kAas ? kAasRelTol : kConvergedRelTol;
     StaticsOptions warm;
     warm.method = m;
     warm.warm_start = true;

@@ -236,7 +236,7 @@ enum class OptionsRule {
   kSecants,
   kRefinementSteps,
   kExactTolerance,
-  kExactStartTolerance,
+  kStartTolerance,
   kModelRange,
   kExactIterations,
   kCatenary
@@ -249,7 +249,9 @@ OptionsRule BrokenRule(const StaticsOptions& o) {
   }
   if (o.refinement_steps < 1) return OptionsRule::kRefinementSteps;
   if (!(o.exact_relative_tolerance > 0.0)) return OptionsRule::kExactTolerance;
-  if (!(o.exact_start_catenary_tolerance > 0.0)) return OptionsRule::kExactStartTolerance;
+  if (!(o.exact_start_catenary_tolerance > 0.0) || !(o.aas_secant_tolerance > 0.0)) {
+    return OptionsRule::kStartTolerance;
+  }
   if (!(o.max_strain > 0.0) || !(o.max_length_ratio > 1.0)) return OptionsRule::kModelRange;
   if (o.exact_max_iterations < 1) return OptionsRule::kExactIterations;
   if (!(o.catenary.relative_tolerance > 0.0) || o.catenary.max_iterations < 1) {
@@ -278,9 +280,9 @@ bool StaticsOptions::IsValid(std::string* error) const {
     case OptionsRule::kExactTolerance:
       e << "exact_relative_tolerance must be > 0 (got " << exact_relative_tolerance << ")";
       break;
-    case OptionsRule::kExactStartTolerance:
-      e << "exact_start_catenary_tolerance must be > 0 (got " << exact_start_catenary_tolerance
-        << ")";
+    case OptionsRule::kStartTolerance:
+      e << "exact_start_catenary_tolerance and aas_secant_tolerance must be > 0 (got "
+        << exact_start_catenary_tolerance << ", " << aas_secant_tolerance << ")";
       break;
     case OptionsRule::kModelRange:
       e << "max_strain must be > 0 and max_length_ratio > 1 (got " << max_strain << ", "

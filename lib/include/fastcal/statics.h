@@ -58,6 +58,12 @@ struct StaticsOptions {
   // step each instead of two). The start is then ~1e-5 from AAS, itself ~1e-3 from the
   // solution, so Newton needs the same number of steps and the result is unchanged.
   double exact_start_catenary_tolerance = 1e-4;
+  // aas and aas-refined: tolerance of the twelve secant solves (the looser of this and
+  // catenary.relative_tolerance). The secants only define AAS's straight lines, whose own
+  // error is ~1e-3; at 1e-6 each solve ends after one Newton step instead of two, and the
+  // AAS forces differ from fully converged secants' by at most 2.9e-7 relative over the
+  // workspace cap (s0 by 2 um; tests/statics_test.cc).
+  double aas_secant_tolerance = 1e-6;
   // kAas only: solve for s0_i (one 2x2 Newton per cable). Off, s0 and the upper-end
   // tension are reported as 0; the lower-end forces do not depend on it.
   bool compute_unstretched_lengths = true;

@@ -171,6 +171,9 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                        std::array<CatenaryForces, kNumCables>* low,
                        std::array<CatenaryForces, kNumCables>* high, std::array<T, kNumCables>* a,
                        std::array<T, kNumCables>* b, int* cable, int* iterations) {
+  CatenarySolverOptions secant_options = o.catenary;
+  secant_options.relative_tolerance =
+      std::max(o.catenary.relative_tolerance, o.aas_secant_tolerance);
   if constexpr (kIsDouble<T>) {
     // All twelve solves at once (low lengths, then high): same results, overlapped.
     CatenaryProblem problems[2 * kNumCables];
@@ -188,7 +191,7 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
         c.guess = use_guess ? (h == 0 ? &(*low)[i] : &(*high)[i]) : nullptr;
       }
     }
-    SolveCatenaryForcesBatch(2 * kNumCables, problems, o.catenary, solved, statuses, its);
+    SolveCatenaryForcesBatch(2 * kNumCables, problems, secant_options, solved, statuses, its);
     for (int i = 0; i < kNumCables; ++i) {
       *iterations += its[i] + its[i + kNumCables];
       for (CatenaryStatus s : {statuses[i], statuses[i + kNumCables]}) {
@@ -213,10 +216,10 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
     const T s_low = T(o.secant_low_fraction) * g.chord[i];
     const T s_high = T(o.secant_high_fraction) * g.chord[i];
     CatenaryStatus s =
-        SolveCatenaryForces(g.span[i], g.rise[i], s_low, p.ea_n[i], g.w[i], o.catenary,
+        SolveCatenaryForces(g.span[i], g.rise[i], s_low, p.ea_n[i], g.w[i], secant_options,
                             use_guess ? &guess_low : nullptr, &fl1, &fz1, &it1);
     if (s == CatenaryStatus::kOk) {
-      s = SolveCatenaryForces(g.span[i], g.rise[i], s_high, p.ea_n[i], g.w[i], o.catenary,
+      s = SolveCatenaryForces(g.span[i], g.rise[i], s_high, p.ea_n[i], g.w[i], secant_options,
                               use_guess ? &guess_high : nullptr, &fl2, &fz2, &it2);
     }
     *iterations += it1 + it2;
