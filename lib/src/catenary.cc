@@ -24,6 +24,9 @@ constexpr double kQuadraticConstant = 2.0;
 // the parabolic model itself is ~3e-3 off.
 constexpr double kGuessRelativeTolerance = 1e-3;
 constexpr int kGuessMaxIterations = 100;
+// Below this, coth's series to lambda^5 is within 1e-6 relative: plenty for a start
+// that is itself ~1e-3 off, and it saves an exp.
+constexpr double kCothSeriesMaxLambda = 0.5;
 
 // std::hypot guards against overflow we cannot meet here and costs ~30x a sqrt.
 inline double Norm2(double a, double b) { return std::sqrt(a * a + b * b); }
@@ -43,7 +46,7 @@ struct Problem {
   double span_m, rise_m, ea_n, w_n_per_m, fixed_value;
 
   // Residual and 2x2 Jacobian (row-major) with respect to u.
-  void Evaluate(const double u[2], double r[2], double jac[4]) const {
+  FASTCAL_ALWAYS_INLINE void Evaluate(const double u[2], double r[2], double jac[4]) const {
     const CatenaryEnd<double> e = kFixedLength
                                       ? CatenaryEndpoint(u[0], u[1], fixed_value, ea_n, w_n_per_m)
                                       : CatenaryEndpoint(fixed_value, u[0], u[1], ea_n, w_n_per_m);
@@ -78,10 +81,11 @@ enum class NewtonMove {
 };
 
 template <bool kFixedLength>
-NewtonMove NextNewtonMove(const Problem<kFixedLength>& problem, double tolerance_m,
-                          const CatenarySolverOptions& options, int it, double u[2],
-                          const double r[2], const double jac[4], double norm, double step[2],
-                          double* lambda) {
+FASTCAL_ALWAYS_INLINE NewtonMove NextNewtonMove(const Problem<kFixedLength>& problem,
+                                                double tolerance_m,
+                                                const CatenarySolverOptions& options, int it,
+                                                double u[2], const double r[2], const double jac[4],
+                                                double norm, double step[2], double* lambda) {
   constexpr int positive = Problem<kFixedLength>::kPositive;
   if (!std::isfinite(norm)) return NewtonMove::kFail;
   if (std::max(std::abs(r[0]), std::abs(r[1])) <= tolerance_m) return NewtonMove::kConverged;
@@ -150,13 +154,14 @@ CatenaryStatus NewtonFrom(const Problem<kFixedLength>& problem, double tolerance
   return CatenaryStatus::kNotConverged;
 }
 
-CatenaryStatus CheckCommon(double span_m, double rise_m, double ea_n, double w_n_per_m,
-                           const CatenarySolverOptions& options) {
+// chord_m: Norm2(span_m, rise_m), computed once per problem by the caller.
+CatenaryStatus CheckCommon(double span_m, double rise_m, double chord_m, double ea_n,
+                           double w_n_per_m, const CatenarySolverOptions& options) {
   if (!AllFinite({span_m, rise_m, ea_n, w_n_per_m}) || !(ea_n > 0.0) || w_n_per_m == 0.0 ||
       span_m < 0.0) {
     return CatenaryStatus::kInvalidInput;
   }
-  if (span_m <= options.vertical_span_fraction * Norm2(span_m, rise_m)) {
+  if (span_m <= options.vertical_span_fraction * chord_m) {
     return CatenaryStatus::kVerticalChord;
   }
   return CatenaryStatus::kOk;
@@ -178,9 +183,11 @@ const char* CatenaryStatusName(CatenaryStatus status) {
   return "unknown";
 }
 
-CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
-                                    double w_n_per_m) {
-  const double k = Norm2(span_m, rise_m);
+namespace {
+
+// CatenaryInitialGuess with the chord k = Norm2(span_m, rise_m) already known.
+CatenaryForces InitialGuess(double span_m, double rise_m, double k, double s0_m, double ea_n,
+                            double w_n_per_m) {
   const double c = k / (span_m * ea_n);
   const double b = w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0;
   // g(H) = H^2 (s0^2 (1 + c H)^2 - k^2) - b has its one positive root above
@@ -218,18 +225,27 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
   guess.fl_n = h;
   // Vertical force at the lower end of the inextensible catenary with horizontal force H:
   // Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
-  // parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from one exp (tanh costs
-  // three times as much); its series below 1e-3, where 1 - exp(-2 lambda) cancels.
+  // parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from its Laurent series
+  // up to lambda^5 (FAST's cables have lambda in ~[0.05, 0.6]), from one exp beyond
+  // (tanh costs three times as much).
   const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h);
   double coth;
-  if (lambda < 1e-3) {
-    coth = 1.0 / lambda + lambda / 3.0;
+  if (lambda < kCothSeriesMaxLambda) {
+    const double l2 = lambda * lambda;
+    coth = 1.0 / lambda + lambda * (1.0 / 3.0 + l2 * (-1.0 / 45.0 + l2 * (2.0 / 945.0)));
   } else {
     const double e = std::exp(-2.0 * lambda);
     coth = (1.0 + e) / (1.0 - e);
   }
   guess.fz_n = 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
   return guess;
+}
+
+}  // namespace
+
+CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
+                                    double w_n_per_m) {
+  return InitialGuess(span_m, rise_m, Norm2(span_m, rise_m), s0_m, ea_n, w_n_per_m);
 }
 
 namespace {
@@ -243,15 +259,17 @@ Problem</*kFixedLength=*/false> MakeProblem(const CatenaryLengthProblem& c) {
 
 // Checks a problem and writes its start to u: (Fl, Fz) from the guess or the parabolic
 // start, at fixed length.
-CatenaryStatus Start(const CatenaryProblem& c, const CatenarySolverOptions& options, double u[2]) {
+CatenaryStatus Start(const CatenaryProblem& c, double chord_m, const CatenarySolverOptions& options,
+                     double u[2]) {
   if (!std::isfinite(c.s0_m) || !(c.s0_m > 0.0)) return CatenaryStatus::kInvalidInput;
-  const CatenaryStatus common = CheckCommon(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, options);
+  const CatenaryStatus common =
+      CheckCommon(c.span_m, c.rise_m, chord_m, c.ea_n, c.w_n_per_m, options);
   if (common != CatenaryStatus::kOk) return common;
   CatenaryForces start;
   if (c.guess != nullptr && c.guess->fl_n > 0.0 && AllFinite({c.guess->fl_n, c.guess->fz_n})) {
     start = *c.guess;
   } else {
-    start = CatenaryInitialGuess(c.span_m, c.rise_m, c.s0_m, c.ea_n, c.w_n_per_m);
+    start = InitialGuess(c.span_m, c.rise_m, chord_m, c.s0_m, c.ea_n, c.w_n_per_m);
   }
   u[0] = start.fl_n;
   u[1] = start.fz_n;
@@ -259,17 +277,18 @@ CatenaryStatus Start(const CatenaryProblem& c, const CatenarySolverOptions& opti
 }
 
 // The same at fixed horizontal force: u = (Fz, s0).
-CatenaryStatus Start(const CatenaryLengthProblem& c, const CatenarySolverOptions& options,
-                     double u[2]) {
+CatenaryStatus Start(const CatenaryLengthProblem& c, double chord_m,
+                     const CatenarySolverOptions& options, double u[2]) {
   if (!std::isfinite(c.fl_n) || !(c.fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
-  const CatenaryStatus common = CheckCommon(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, options);
+  const CatenaryStatus common =
+      CheckCommon(c.span_m, c.rise_m, chord_m, c.ea_n, c.w_n_per_m, options);
   if (common != CatenaryStatus::kOk) return common;
   if (c.guess != nullptr && c.guess->s0_m > 0.0 && AllFinite({c.guess->fz_n, c.guess->s0_m})) {
     u[0] = c.guess->fz_n;
     u[1] = c.guess->s0_m;
   } else {
     // The parabolic relation of CatenaryInitialGuess, solved for s0 at H = fl.
-    const double k = Norm2(c.span_m, c.rise_m);
+    const double k = chord_m;
     const double cc = k / (c.span_m * c.ea_n);
     const double b =
         c.w_n_per_m * c.w_n_per_m * (c.span_m * c.span_m) * (c.span_m * c.span_m) / 12.0;
@@ -297,10 +316,11 @@ void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, 
   n = std::min(n, kMaxCatenaryBatch);
   for (int j = 0; j < n; ++j) {
     iterations[j] = 0;
-    statuses[j] = Start(specs[j], options, u[j]);
+    const double chord_m = Norm2(specs[j].span_m, specs[j].rise_m);
+    statuses[j] = Start(specs[j], chord_m, options, u[j]);
     if (statuses[j] != CatenaryStatus::kOk) continue;
     st[j].problem = MakeProblem(specs[j]);
-    st[j].tolerance_m = options.relative_tolerance * Norm2(specs[j].span_m, specs[j].rise_m);
+    st[j].tolerance_m = options.relative_tolerance * chord_m;
     active[num_active++] = j;
   }
   for (int a = 0; a < num_active; ++a) {
