@@ -185,6 +185,25 @@ const char* CatenaryStatusName(CatenaryStatus status) {
 
 namespace {
 
+// Vertical force at the lower end of the inextensible catenary with horizontal force H:
+// Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
+// parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from its Laurent series
+// up to lambda^5 (FAST's cables have lambda in ~[0.05, 0.6]), from one exp beyond
+// (tanh costs three times as much).
+double InextensibleLowerFz(double span_m, double rise_m, double s0_m, double h_n,
+                           double w_n_per_m) {
+  const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h_n);
+  double coth;
+  if (lambda < kCothSeriesMaxLambda) {
+    const double l2 = lambda * lambda;
+    coth = 1.0 / lambda + lambda * (1.0 / 3.0 + l2 * (-1.0 / 45.0 + l2 * (2.0 / 945.0)));
+  } else {
+    const double e = std::exp(-2.0 * lambda);
+    coth = (1.0 + e) / (1.0 - e);
+  }
+  return 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
+}
+
 // CatenaryInitialGuess with the chord k = Norm2(span_m, rise_m) already known.
 CatenaryForces InitialGuess(double span_m, double rise_m, double k, double s0_m, double ea_n,
                             double w_n_per_m) {
@@ -221,24 +240,7 @@ CatenaryForces InitialGuess(double span_m, double rise_m, double k, double s0_m,
     h -= step;
     if (step <= kGuessRelativeTolerance * h) break;
   }
-  CatenaryForces guess;
-  guess.fl_n = h;
-  // Vertical force at the lower end of the inextensible catenary with horizontal force H:
-  // Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
-  // parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from its Laurent series
-  // up to lambda^5 (FAST's cables have lambda in ~[0.05, 0.6]), from one exp beyond
-  // (tanh costs three times as much).
-  const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h);
-  double coth;
-  if (lambda < kCothSeriesMaxLambda) {
-    const double l2 = lambda * lambda;
-    coth = 1.0 / lambda + lambda * (1.0 / 3.0 + l2 * (-1.0 / 45.0 + l2 * (2.0 / 945.0)));
-  } else {
-    const double e = std::exp(-2.0 * lambda);
-    coth = (1.0 + e) / (1.0 - e);
-  }
-  guess.fz_n = 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
-  return guess;
+  return CatenaryForces{h, InextensibleLowerFz(span_m, rise_m, s0_m, h, w_n_per_m)};
 }
 
 }  // namespace
@@ -246,6 +248,36 @@ CatenaryForces InitialGuess(double span_m, double rise_m, double k, double s0_m,
 CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
                                     double w_n_per_m) {
   return InitialGuess(span_m, rise_m, Norm2(span_m, rise_m), s0_m, ea_n, w_n_per_m);
+}
+
+ParabolicCatenaryModel::ParabolicCatenaryModel(double span_m, double rise_m, double ea_n,
+                                               double w_n_per_m)
+    : k_(Norm2(span_m, rise_m)),
+      c_(k_ / (span_m * ea_n)),
+      b_(w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0),
+      half_w_(0.5 * std::abs(w_n_per_m)),
+      rise_m_(rise_m),
+      lambda_h_(0.5 * std::abs(w_n_per_m) * span_m) {}
+
+CatenaryCurvePoint ParabolicCatenaryModel::AtHorizontalForce(double fl_n) const {
+  const double inv_fl = 1.0 / fl_n;
+  const double s0_m = std::sqrt(k_ * k_ + b_ * inv_fl * inv_fl) / (1.0 + c_ * fl_n);
+  // InextensibleLowerFz with lambda = lambda_h / H and its series' 1/lambda = H / lambda_h.
+  const double lambda = lambda_h_ * inv_fl;
+  double coth;
+  if (lambda < kCothSeriesMaxLambda) {
+    const double l2 = lambda * lambda;
+    coth = fl_n / lambda_h_ + lambda * (1.0 / 3.0 + l2 * (-1.0 / 45.0 + l2 * (2.0 / 945.0)));
+  } else {
+    const double e = std::exp(-2.0 * lambda);
+    coth = (1.0 + e) / (1.0 - e);
+  }
+  return CatenaryCurvePoint{half_w_ * (s0_m - rise_m_ * coth), s0_m};
+}
+
+CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,
+                                      double w_n_per_m) {
+  return ParabolicCatenaryModel(span_m, rise_m, ea_n, w_n_per_m).AtHorizontalForce(fl_n);
 }
 
 namespace {

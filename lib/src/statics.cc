@@ -114,13 +114,7 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
   int* cable = &sol->cable;
   int* its = &sol->catenary_iterations;
   if (!have_state) {
-    // For kExact, AAS is only the start: build it with loose per-cable solves.
-    StaticsOptions start_options = o;
-    if (o.method == StaticsMethod::kExact) {
-      start_options.catenary.relative_tolerance =
-          std::max(o.catenary.relative_tolerance, o.exact_start_catenary_tolerance);
-    }
-    const StaticsOptions& so = start_options;
+    const StaticsOptions so = internal::AasStageOptions(o);
     std::array<double, kNumCables> a, b, fl;
     status = internal::AasLines(p, g, so, previous != nullptr, &low, &high, &a, &b, cable, its);
     if (status != StaticsStatus::kOk) return status;
@@ -139,7 +133,8 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
     for (int step = 0; step < projections; ++step) {
       std::array<CatenaryCurvePoint, kNumCables> guess;
       for (int i = 0; i < kNumCables; ++i) {
-        guess[i] = internal::CurveGuess(st[i].fl, g.chord[i], low[i], high[i], o);
+        guess[i] = internal::CurveGuess(st[i].fl, g, i, p.ea_n[i], low[i], high[i], o,
+                                        /*model_corrected=*/o.method != StaticsMethod::kExact);
       }
       std::array<CableState<double>, kNumCables> projected = st;
       status = internal::ProjectOnCurves(p, g, so, guess, &projected, cable, its);
@@ -249,7 +244,8 @@ OptionsRule BrokenRule(const StaticsOptions& o) {
   }
   if (o.refinement_steps < 1) return OptionsRule::kRefinementSteps;
   if (!(o.exact_relative_tolerance > 0.0)) return OptionsRule::kExactTolerance;
-  if (!(o.exact_start_catenary_tolerance > 0.0) || !(o.aas_secant_tolerance > 0.0)) {
+  if (!(o.exact_start_catenary_tolerance > 0.0) || !(o.aas_secant_tolerance > 0.0) ||
+      !(o.aas_length_tolerance > 0.0)) {
     return OptionsRule::kStartTolerance;
   }
   if (!(o.max_strain > 0.0) || !(o.max_length_ratio > 1.0)) return OptionsRule::kModelRange;
@@ -281,8 +277,10 @@ bool StaticsOptions::IsValid(std::string* error) const {
       e << "exact_relative_tolerance must be > 0 (got " << exact_relative_tolerance << ")";
       break;
     case OptionsRule::kStartTolerance:
-      e << "exact_start_catenary_tolerance and aas_secant_tolerance must be > 0 (got "
-        << exact_start_catenary_tolerance << ", " << aas_secant_tolerance << ")";
+      e << "exact_start_catenary_tolerance, aas_secant_tolerance and aas_length_tolerance "
+           "must be > 0 (got "
+        << exact_start_catenary_tolerance << ", " << aas_secant_tolerance << ", "
+        << aas_length_tolerance << ")";
       break;
     case OptionsRule::kModelRange:
       e << "max_strain must be > 0 and max_length_ratio > 1 (got " << max_strain << ", "

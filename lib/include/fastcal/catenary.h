@@ -139,9 +139,23 @@ CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl
 
 // Starting point used when no guess is given: solves the parabolic approximation
 //   s0^2 (1 + H k/(L EA))^2 - k^2 = w^2 L^4 / (12 H^2)
-// for the horizontal force H, then Fz = -H Z/L - w s0/2.
+// for the horizontal force H, then Fz from the inextensible catenary with that H.
 CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
                                     double w_n_per_m);
+// The same relation solved for s0 at H = fl_n (explicit), Fz as above. Its error varies
+// slowly along a cable's family of lengths; the statics' AAS corrects it by its error at
+// the two secant points, where the exact points are known.
+CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,
+                                      double w_n_per_m);
+// The same for one chord at several horizontal forces (its constants computed once).
+class ParabolicCatenaryModel {
+ public:
+  ParabolicCatenaryModel(double span_m, double rise_m, double ea_n, double w_n_per_m);
+  CatenaryCurvePoint AtHorizontalForce(double fl_n) const;
+
+ private:
+  double k_, c_, b_, half_w_, rise_m_, lambda_h_;
+};
 
 // Templated wrappers. For T = double they are the solves above; for a Jet they add one
 // Newton step in Jet arithmetic at the converged point (implicit differentiation).

@@ -64,6 +64,11 @@ struct StaticsOptions {
   // AAS forces differ from fully converged secants' by at most 2.9e-7 relative over the
   // workspace cap (s0 by 2 um; tests/statics_test.cc).
   double aas_secant_tolerance = 1e-6;
+  // aas and aas-refined: tolerance of the per-cable solves for s0 at the AAS horizontal
+  // forces (the looser of this and catenary.relative_tolerance). They start from a
+  // model-corrected guess ~1e-5 off, so at 1e-8 one Newton step ends them, leaving s0
+  // within ~1e-8 relative (3 um on a 300 m cable).
+  double aas_length_tolerance = 1e-8;
   // kAas only: solve for s0_i (one 2x2 Newton per cable). Off, s0 and the upper-end
   // tension are reported as 0; the lower-end forces do not depend on it.
   bool compute_unstretched_lengths = true;

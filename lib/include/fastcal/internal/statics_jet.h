@@ -57,13 +57,17 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
       if (!internal::SolveEquilibrium(g, a, b, &fl)) return StaticsStatus::kSingular;
       for (int i = 0; i < kNumCables; ++i) st[i] = {fl[i], a[i] * fl[i] + b[i], T(0)};
       if (options.method == StaticsMethod::kAasRefined) {
+        const StaticsParameters<double> pd = ScalarParameters(p);
+        internal::PoseGeometry<double> gd;
+        internal::ComputeGeometry(pd, pose, options.catenary.vertical_span_fraction, &gd, &cable);
         for (int step = 0; step < options.refinement_steps; ++step) {
           std::array<CatenaryCurvePoint, kNumCables> guess;
           for (int i = 0; i < kNumCables; ++i) {
-            guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), ScalarValue(g.chord[i]), low[i],
-                                            high[i], options);
+            guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), gd, i, pd.ea_n[i], low[i],
+                                            high[i], options, /*model_corrected=*/true);
           }
-          status = internal::ProjectOnCurves(p, g, options, guess, &st, &cable, &iterations);
+          status = internal::ProjectOnCurves(p, g, internal::AasStageOptions(options), guess, &st,
+                                             &cable, &iterations);
           if (status != StaticsStatus::kOk) return status;
           status = internal::ReducedNewtonStep(p, g, &st, &cable, nullptr, nullptr);
           if (status != StaticsStatus::kOk) return status;
