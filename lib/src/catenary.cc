@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <type_traits>
 
 namespace fastcal {
 namespace {
@@ -204,50 +205,88 @@ double InextensibleLowerFz(double span_m, double rise_m, double s0_m, double h_n
   return 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
 }
 
-// CatenaryInitialGuess with the chord k = Norm2(span_m, rise_m) already known.
-CatenaryForces InitialGuess(double span_m, double rise_m, double k, double s0_m, double ea_n,
-                            double w_n_per_m) {
-  const double c = k / (span_m * ea_n);
-  const double b = w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0;
-  // g(H) = H^2 (s0^2 (1 + c H)^2 - k^2) - b has its one positive root above
-  // H_t = max(0, (k/s0 - 1)/c) and is increasing and convex there, so Newton from an
-  // upper bound decreases monotonically onto the root. Upper bounds, with D^3 = b/(2 k s0 c):
-  //   g(H_t + D) >= 0                  (as s0 (1 + c H_t) >= k, g(H_t + d) >= 2 k s0 c d^3 - b)
-  //   g(H_t + D^3/H_t^2) >= 0, s0 < k   (same, with (H_t + d)^2 >= H_t^2)
-  //   g(sqrt(b/(s0^2 - k^2))) >= 0, s0 > k   (as (1 + c H)^2 >= 1)
-  // Taking the smaller of the two that apply leaves 1-4 Newton steps over the workspace.
-  auto g = [&](double h) {
-    const double q = s0_m * (1.0 + c * h);
-    return h * h * (q * q - k * k) - b;
-  };
-  auto dg = [&](double h) {
-    const double q = s0_m * (1.0 + c * h);
-    return 2.0 * h * (q * q - k * k) + 2.0 * h * h * q * s0_m * c;
-  };
-  const double d3 = b / (2.0 * k * s0_m * c);
-  double h;
+// CatenaryInitialGuess in three steps, so that a batch can run them in lockstep (Guess,
+// GuessBatch): the start's division chain (~4 divisions, then one per Newton step) is
+// latency, and independent chains side by side overlap.
+//
+// g(H) = H^2 (s0^2 (1 + c H)^2 - k^2) - b has its one positive root above
+// H_t = max(0, (k/s0 - 1)/c) and is increasing and convex there, so Newton from an
+// upper bound decreases monotonically onto the root. Upper bounds, with D^3 = b/(2 k s0 c):
+//   g(H_t + D) >= 0                  (as s0 (1 + c H_t) >= k, g(H_t + d) >= 2 k s0 c d^3 - b)
+//   g(H_t + D^3/H_t^2) >= 0, s0 < k   (same, with (H_t + d)^2 >= H_t^2)
+//   g(sqrt(b/(s0^2 - k^2))) >= 0, s0 > k   (as (1 + c H)^2 >= 1)
+// Taking the smaller of the two that apply leaves 1-4 Newton steps over the workspace.
+struct GuessState {
+  double k, s0, c, b, h;
+};
+
+GuessState GuessSetup(double span_m, double k, double s0_m, double ea_n, double w_n_per_m) {
+  GuessState st;
+  st.k = k;
+  st.s0 = s0_m;
+  st.c = k / (span_m * ea_n);
+  st.b = w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0;
+  const double d3 = st.b / (2.0 * k * s0_m * st.c);
   if (s0_m < k) {
-    const double h_t = (k / s0_m - 1.0) / c;
+    const double h_t = (k / s0_m - 1.0) / st.c;
     const double d = d3 / (h_t * h_t);
-    h = h_t + (d * d * d <= d3 ? d : std::cbrt(d3));
+    st.h = h_t + (d * d * d <= d3 ? d : std::cbrt(d3));
   } else {
-    const double h_s = s0_m > k ? std::sqrt(b / (s0_m * s0_m - k * k)) : HUGE_VAL;
-    h = h_s * h_s * h_s <= d3 ? h_s : std::cbrt(d3);
+    const double h_s = s0_m > k ? std::sqrt(st.b / (s0_m * s0_m - k * k)) : HUGE_VAL;
+    st.h = h_s * h_s * h_s <= d3 ? h_s : std::cbrt(d3);
   }
-  for (int i = 0; i < kGuessMaxIterations; ++i) {
-    const double step = g(h) / dg(h);
-    if (!(step > 0.0)) break;  // at the root to rounding
-    h -= step;
-    if (step <= kGuessRelativeTolerance * h) break;
+  return st;
+}
+
+// One Newton step on g; true when the start is final.
+FASTCAL_ALWAYS_INLINE bool GuessStep(GuessState* st) {
+  const double h = st->h;
+  const double q = st->s0 * (1.0 + st->c * h);
+  const double qk = q * q - st->k * st->k;
+  const double step = (h * h * qk - st->b) / (2.0 * h * qk + 2.0 * h * h * q * st->s0 * st->c);
+  if (!(step > 0.0)) return true;  // at the root to rounding
+  st->h = h - step;
+  return step <= kGuessRelativeTolerance * st->h;
+}
+
+// CatenaryInitialGuess with the chord k = Norm2(span_m, rise_m) already known.
+CatenaryForces Guess(double span_m, double rise_m, double k, double s0_m, double ea_n,
+                     double w_n_per_m) {
+  GuessState st = GuessSetup(span_m, k, s0_m, ea_n, w_n_per_m);
+  for (int i = 0; i < kGuessMaxIterations && !GuessStep(&st); ++i) {
   }
-  return CatenaryForces{h, InextensibleLowerFz(span_m, rise_m, s0_m, h, w_n_per_m)};
+  return CatenaryForces{st.h, InextensibleLowerFz(span_m, rise_m, s0_m, st.h, w_n_per_m)};
+}
+
+// Guess for problems[j], j in which[0..n), written to u[j]; the same results as Guess.
+void GuessBatch(int n, const int* which, const CatenaryProblem* problems, const double* chord_m,
+                double (*u)[2]) {
+  GuessState st[kMaxCatenaryBatch];
+  int active[kMaxCatenaryBatch];
+  for (int a = 0; a < n; ++a) {
+    const CatenaryProblem& c = problems[which[a]];
+    st[a] = GuessSetup(c.span_m, chord_m[which[a]], c.s0_m, c.ea_n, c.w_n_per_m);
+    active[a] = a;
+  }
+  for (int i = 0, num_active = n; i < kGuessMaxIterations && num_active > 0; ++i) {
+    int still = 0;
+    for (int q = 0; q < num_active; ++q) {
+      if (!GuessStep(&st[active[q]])) active[still++] = active[q];
+    }
+    num_active = still;
+  }
+  for (int a = 0; a < n; ++a) {
+    const CatenaryProblem& c = problems[which[a]];
+    u[which[a]][0] = st[a].h;
+    u[which[a]][1] = InextensibleLowerFz(c.span_m, c.rise_m, c.s0_m, st[a].h, c.w_n_per_m);
+  }
 }
 
 }  // namespace
 
 CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
                                     double w_n_per_m) {
-  return InitialGuess(span_m, rise_m, Norm2(span_m, rise_m), s0_m, ea_n, w_n_per_m);
+  return Guess(span_m, rise_m, Norm2(span_m, rise_m), s0_m, ea_n, w_n_per_m);
 }
 
 ParabolicCatenaryModel::ParabolicCatenaryModel(double span_m, double rise_m, double ea_n,
@@ -289,28 +328,26 @@ Problem</*kFixedLength=*/false> MakeProblem(const CatenaryLengthProblem& c) {
   return {c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, c.fl_n};
 }
 
-// Checks a problem and writes its start to u: (Fl, Fz) from the guess or the parabolic
-// start, at fixed length.
+// Checks a problem and writes its start to u: (Fl, Fz) from the guess, at fixed length;
+// without one, *needs_guess is set and the caller runs GuessBatch (the parabolic start).
 CatenaryStatus Start(const CatenaryProblem& c, double chord_m, const CatenarySolverOptions& options,
-                     double u[2]) {
+                     double u[2], bool* needs_guess) {
   if (!std::isfinite(c.s0_m) || !(c.s0_m > 0.0)) return CatenaryStatus::kInvalidInput;
   const CatenaryStatus common =
       CheckCommon(c.span_m, c.rise_m, chord_m, c.ea_n, c.w_n_per_m, options);
   if (common != CatenaryStatus::kOk) return common;
-  CatenaryForces start;
   if (c.guess != nullptr && c.guess->fl_n > 0.0 && AllFinite({c.guess->fl_n, c.guess->fz_n})) {
-    start = *c.guess;
+    u[0] = c.guess->fl_n;
+    u[1] = c.guess->fz_n;
   } else {
-    start = InitialGuess(c.span_m, c.rise_m, chord_m, c.s0_m, c.ea_n, c.w_n_per_m);
+    *needs_guess = true;
   }
-  u[0] = start.fl_n;
-  u[1] = start.fz_n;
   return CatenaryStatus::kOk;
 }
 
-// The same at fixed horizontal force: u = (Fz, s0).
+// The same at fixed horizontal force: u = (Fz, s0), the cold start computed here.
 CatenaryStatus Start(const CatenaryLengthProblem& c, double chord_m,
-                     const CatenarySolverOptions& options, double u[2]) {
+                     const CatenarySolverOptions& options, double u[2], bool* /*needs_guess*/) {
   if (!std::isfinite(c.fl_n) || !(c.fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
   const CatenaryStatus common =
       CheckCommon(c.span_m, c.rise_m, chord_m, c.ea_n, c.w_n_per_m, options);
@@ -345,15 +382,22 @@ void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, 
   };
   State st[kMaxCatenaryBatch];
   int active[kMaxCatenaryBatch], num_active = 0;
+  int cold[kMaxCatenaryBatch], num_cold = 0;
+  double chord_m[kMaxCatenaryBatch];
   n = std::min(n, kMaxCatenaryBatch);
   for (int j = 0; j < n; ++j) {
     iterations[j] = 0;
-    const double chord_m = Norm2(specs[j].span_m, specs[j].rise_m);
-    statuses[j] = Start(specs[j], chord_m, options, u[j]);
+    chord_m[j] = Norm2(specs[j].span_m, specs[j].rise_m);
+    bool needs_guess = false;
+    statuses[j] = Start(specs[j], chord_m[j], options, u[j], &needs_guess);
     if (statuses[j] != CatenaryStatus::kOk) continue;
+    if (needs_guess) cold[num_cold++] = j;
     st[j].problem = MakeProblem(specs[j]);
-    st[j].tolerance_m = options.relative_tolerance * chord_m;
+    st[j].tolerance_m = options.relative_tolerance * chord_m[j];
     active[num_active++] = j;
+  }
+  if constexpr (std::is_same_v<Spec, CatenaryProblem>) {
+    if (num_cold > 0) GuessBatch(num_cold, cold, specs, chord_m, u);
   }
   for (int a = 0; a < num_active; ++a) {
     State& s = st[active[a]];
