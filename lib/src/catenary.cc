@@ -25,9 +25,6 @@ constexpr double kQuadraticConstant = 2.0;
 // the parabolic model itself is ~3e-3 off.
 constexpr double kGuessRelativeTolerance = 1e-3;
 constexpr int kGuessMaxIterations = 100;
-// Below this, coth's series to lambda^5 is within 1e-6 relative: plenty for a start
-// that is itself ~1e-3 off, and it saves an exp.
-constexpr double kCothSeriesMaxLambda = 0.5;
 
 // std::hypot guards against overflow we cannot meet here and costs ~30x a sqrt.
 inline double Norm2(double a, double b) { return std::sqrt(a * a + b * b); }
@@ -188,21 +185,11 @@ namespace {
 
 // Vertical force at the lower end of the inextensible catenary with horizontal force H:
 // Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
-// parabolic limit -H Z/L + |w| s0/2 over the workspace. coth from its Laurent series
-// up to lambda^5 (FAST's cables have lambda in ~[0.05, 0.6]), from one exp beyond
-// (tanh costs three times as much).
+// parabolic limit -H Z/L + |w| s0/2 over the workspace.
 double InextensibleLowerFz(double span_m, double rise_m, double s0_m, double h_n,
                            double w_n_per_m) {
   const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h_n);
-  double coth;
-  if (lambda < kCothSeriesMaxLambda) {
-    const double l2 = lambda * lambda;
-    coth = 1.0 / lambda + lambda * (1.0 / 3.0 + l2 * (-1.0 / 45.0 + l2 * (2.0 / 945.0)));
-  } else {
-    const double e = std::exp(-2.0 * lambda);
-    coth = (1.0 + e) / (1.0 - e);
-  }
-  return 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * coth);
+  return 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * StartCoth(lambda, 1.0 / lambda));
 }
 
 // CatenaryInitialGuess in three steps, so that a batch can run them in lockstep (Guess,
@@ -287,31 +274,6 @@ void GuessBatch(int n, const int* which, const CatenaryProblem* problems, const 
 CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
                                     double w_n_per_m) {
   return Guess(span_m, rise_m, Norm2(span_m, rise_m), s0_m, ea_n, w_n_per_m);
-}
-
-ParabolicCatenaryModel::ParabolicCatenaryModel(double span_m, double rise_m, double ea_n,
-                                               double w_n_per_m)
-    : k_(Norm2(span_m, rise_m)),
-      c_(k_ / (span_m * ea_n)),
-      b_(w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0),
-      half_w_(0.5 * std::abs(w_n_per_m)),
-      rise_m_(rise_m),
-      lambda_h_(0.5 * std::abs(w_n_per_m) * span_m) {}
-
-CatenaryCurvePoint ParabolicCatenaryModel::AtHorizontalForce(double fl_n) const {
-  const double inv_fl = 1.0 / fl_n;
-  const double s0_m = std::sqrt(k_ * k_ + b_ * inv_fl * inv_fl) / (1.0 + c_ * fl_n);
-  // InextensibleLowerFz with lambda = lambda_h / H and its series' 1/lambda = H / lambda_h.
-  const double lambda = lambda_h_ * inv_fl;
-  double coth;
-  if (lambda < kCothSeriesMaxLambda) {
-    const double l2 = lambda * lambda;
-    coth = fl_n / lambda_h_ + lambda * (1.0 / 3.0 + l2 * (-1.0 / 45.0 + l2 * (2.0 / 945.0)));
-  } else {
-    const double e = std::exp(-2.0 * lambda);
-    coth = (1.0 + e) / (1.0 - e);
-  }
-  return CatenaryCurvePoint{half_w_ * (s0_m - rise_m_ * coth), s0_m};
 }
 
 CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,

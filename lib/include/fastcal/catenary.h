@@ -148,13 +148,41 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
 CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,
                                       double w_n_per_m);
 // The same for one chord at several horizontal forces (its constants computed once).
+// coth(lambda) for the starts' inextensible-catenary Fz, given also 1/lambda: its Laurent
+// series to lambda^5 below lambda = 0.5 (within 1e-6 relative, plenty for a start that is
+// itself ~1e-3 off; FAST's cables have lambda in ~[0.05, 0.6]), else from one exp (tanh
+// costs three times as much).
+inline double StartCoth(double lambda, double inv_lambda) {
+  if (lambda < 0.5) {
+    const double l2 = lambda * lambda;
+    return inv_lambda + lambda * (1.0 / 3.0 + l2 * (-1.0 / 45.0 + l2 * (2.0 / 945.0)));
+  }
+  const double e = std::exp(-2.0 * lambda);
+  return (1.0 + e) / (1.0 - e);
+}
+
+// Inline: the statics evaluate it three times per cable, side by side.
 class ParabolicCatenaryModel {
  public:
-  ParabolicCatenaryModel(double span_m, double rise_m, double ea_n, double w_n_per_m);
-  CatenaryCurvePoint AtHorizontalForce(double fl_n) const;
+  ParabolicCatenaryModel(double span_m, double rise_m, double ea_n, double w_n_per_m)
+      : k_(std::sqrt(span_m * span_m + rise_m * rise_m)),
+        c_(k_ / (span_m * ea_n)),
+        b_(w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0),
+        half_w_(0.5 * std::abs(w_n_per_m)),
+        rise_m_(rise_m),
+        lambda_h_(half_w_ * span_m),
+        inv_lambda_h_(1.0 / lambda_h_) {}
+
+  CatenaryCurvePoint AtHorizontalForce(double fl_n) const {
+    const double inv_fl = 1.0 / fl_n;
+    const double s0_m = std::sqrt(k_ * k_ + b_ * inv_fl * inv_fl) / (1.0 + c_ * fl_n);
+    // Fz of CatenaryInitialGuess (the inextensible catenary), lambda = lambda_h / H.
+    const double coth = StartCoth(lambda_h_ * inv_fl, fl_n * inv_lambda_h_);
+    return CatenaryCurvePoint{half_w_ * (s0_m - rise_m_ * coth), s0_m};
+  }
 
  private:
-  double k_, c_, b_, half_w_, rise_m_, lambda_h_;
+  double k_, c_, b_, half_w_, rise_m_, lambda_h_, inv_lambda_h_;
 };
 
 // Templated wrappers. For T = double they are the solves above; for a Jet they add one
