@@ -22,19 +22,23 @@ bool ParametersUsable(const StaticsParameters<double>& p) {
          std::isfinite(p.gravity_m_per_s2);
 }
 
-void FillSolution(const StaticsParameters<double>& p, const internal::PoseGeometry<double>& g,
+// Tensions of each cable's ends (CheckModelRange computes them, FillSolution reports them).
+struct EndTensions {
+  std::array<double, kNumCables> lower_n, upper_n;
+};
+
+void FillSolution(const internal::PoseGeometry<double>& g,
                   const std::array<internal::CableState<double>, kNumCables>& st,
-                  const std::array<CatenaryForces, kNumCables>& low,
+                  const EndTensions& tensions, const std::array<CatenaryForces, kNumCables>& low,
                   const std::array<CatenaryForces, kNumCables>& high, StaticsSolution* sol) {
   Eigen::Vector3d force_sum = Eigen::Vector3d::Zero(), moment_sum = Eigen::Vector3d::Zero();
   for (int i = 0; i < kNumCables; ++i) {
     CableSolution& c = sol->cables[i];
     c.horizontal_force_n = st[i].fl;
     c.force_n = Eigen::Vector3d(-g.ux[i] * st[i].fl, -g.uy[i] * st[i].fl, st[i].fz);
-    c.lower_tension_n = c.force_n.norm();
+    c.lower_tension_n = tensions.lower_n[i];
     c.unstretched_length_m = st[i].s0;
-    c.upper_tension_n =
-        st[i].s0 > 0.0 ? CatenaryTension(st[i].fl, st[i].fz, st[i].s0, g.w[i]) : 0.0;
+    c.upper_tension_n = tensions.upper_n[i];
     c.chord_length_m = g.chord[i];
     c.secant_low = low[i];
     c.secant_high = high[i];
@@ -50,14 +54,17 @@ void FillSolution(const StaticsParameters<double>& p, const internal::PoseGeomet
 
 // The model-range limits of StaticsOptions, on the finished solution: s0 in
 // (0, max_length_ratio k] (when computed: AAS may skip it), then every cable's lower and
-// upper tension within max_strain EA.
+// upper tension within max_strain EA. Writes the tensions (upper 0 without s0).
 StaticsStatus CheckModelRange(const StaticsParameters<double>& p,
                               const internal::PoseGeometry<double>& g,
                               const std::array<internal::CableState<double>, kNumCables>& st,
-                              bool have_lengths, const StaticsOptions& o, int* cable) {
+                              bool have_lengths, const StaticsOptions& o, EndTensions* tensions,
+                              int* cable) {
   for (int i = 0; i < kNumCables; ++i) {
     const double lower_n = std::sqrt(st[i].fl * st[i].fl + st[i].fz * st[i].fz);
     double upper_n = lower_n;
+    tensions->lower_n[i] = lower_n;
+    tensions->upper_n[i] = 0.0;
     if (have_lengths) {
       const double s0_m = st[i].s0;
       if (s0_m > o.max_length_ratio * g.chord[i]) {
@@ -69,6 +76,7 @@ StaticsStatus CheckModelRange(const StaticsParameters<double>& p,
         return StaticsStatus::kOverstretchedCable;
       }
       upper_n = CatenaryTension(st[i].fl, st[i].fz, s0_m, g.w[i]);
+      tensions->upper_n[i] = upper_n;
     }
     if (!(std::max(lower_n, upper_n) <= o.max_strain * p.ea_n[i])) {
       *cable = i;
@@ -81,7 +89,8 @@ StaticsStatus CheckModelRange(const StaticsParameters<double>& p,
 StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, const StaticsOptions& o,
                       const StaticsSolution* previous, StaticsSolution* sol) {
   using internal::CableState;
-  sol->cables = {};
+  // sol->cables is left as it is: FillSolution writes all of it on success, and
+  // SolveStaticsWithParameters zeroes it on failure.
   sol->cable = -1;
   sol->outer_iterations = 0;
   sol->catenary_iterations = 0;
@@ -170,9 +179,10 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
     if (!converged) return StaticsStatus::kNotConverged;
   }
   const bool have_lengths = o.method != StaticsMethod::kAas || o.compute_unstretched_lengths;
-  status = CheckModelRange(p, g, st, have_lengths, o, cable);
+  EndTensions tensions;
+  status = CheckModelRange(p, g, st, have_lengths, o, &tensions, cable);
   if (status != StaticsStatus::kOk) return status;
-  FillSolution(p, g, st, low, high, sol);
+  FillSolution(g, st, tensions, low, high, sol);
   return StaticsStatus::kOk;
 }
 
