@@ -106,6 +106,38 @@ TEST(CatenaryTest, AsinhMatchesStdAsinhOnBothSidesOfItsSwitch) {
   }
 }
 
+// The double end point takes eq. 14's bracket D = asinh(Fz1/Fl) - asinh(Fz/Fl) as the log
+// of a ratio when Fz and Fz1 share a sign and |D| >= 1/16, else through Asinh (as a Jet
+// always does). Both agree with the bracket evaluated directly in long double, for cables
+// pulled down, up and with their low point inside, and for D down to ~1e-6.
+TEST(CatenaryTest, EndPointAngleDifferenceMatchesLongDouble) {
+  constexpr double kSpanRelTol = 1e-13;
+  std::mt19937_64 rng(kSeed);
+  std::uniform_real_distribution<double> log10_fl(3.0, 6.0), fz_over_fl(-3.0, 3.0), s0(10.0, 500.0),
+      log10_w(0.0, 2.5);
+  constexpr double kEa = 2.4656e7;
+  int ratio_form = 0, asinh_form = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const double fl = std::pow(10.0, log10_fl(rng)), fz = fz_over_fl(rng) * fl;
+    const double s = s0(rng), w = -std::pow(10.0, log10_w(rng));
+    const double fz1 = fz + w * s;
+    // The reference takes Fz1 = Fz + w s0 without the rounding of the double sum, which
+    // the end point's x = w s0 Q / Fl^2 avoids too.
+    const long double fz1_exact = static_cast<long double>(fz) + static_cast<long double>(w) * s;
+    const long double d =
+        std::asinh(fz1_exact / fl) - std::asinh(static_cast<long double>(fz) / fl);
+    const long double span = static_cast<long double>(fl) * s / kEa + fl / w * d;
+    const CatenaryEnd<double> e = CatenaryEndpoint(fl, fz, s, kEa, w);
+    EXPECT_NEAR(e.span_m, static_cast<double>(span), kSpanRelTol * std::abs(e.span_m))
+        << "fl " << fl << " fz " << fz << " s0 " << s << " w " << w;
+    const bool same_sign = (fz >= 0.0) == (fz1 >= 0.0);
+    (same_sign && std::abs(d) >= 1.0 / 16 ? ratio_form : asinh_form)++;
+  }
+  // Both forms were exercised.
+  EXPECT_GT(ratio_form, 1000);
+  EXPECT_GT(asinh_form, 1000);
+}
+
 // The batch solvers take exactly the iterations of one-at-a-time solves, so results,
 // iteration counts and statuses are identical, bit for bit, also with failing problems
 // (invalid input, vertical chord) and far-off starts (limited, backtracked steps) in the

@@ -31,11 +31,35 @@
 
 #include <cmath>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "fastcal/scalar.h"
 
 namespace fastcal {
+
+// D = asinh((Fz + w s0)/Fl) - asinh(Fz/Fl) (eq. 14's bracket). In general D = asinh(x)
+// with x = sinh D = w s0 Q / Fl^2 (the form that does not cancel, docs/model.md). For
+// double, where Fz and Fz1 = Fz + w s0 have one sign (always for FAST: Fz1 < Fz < 0) and
+// |D| >= 1/16, exp D = (Fz1 + T1) / (Fz + T0) with each factor in whichever of its forms,
+// F + T or Fl^2 / (T - F), does not cancel: one division like x's, and no square root
+// (asinh's sqrt(1 + x^2) sat on every evaluation's critical path). Below |D| = 1/16 the
+// log of a ratio near 1 loses relative accuracy, and asinh is used.
+template <typename T>
+FASTCAL_ALWAYS_INLINE T CatenaryAngleDifference(const T& fz_n, const T& fz1_n, const T& t0_n,
+                                                const T& t1_n, const T& ws, const T& q,
+                                                const T& fl2) {
+  if constexpr (std::is_same_v<T, double>) {
+    constexpr double kMinRatio = 0.9394130628134758;  // exp(-1/16)
+    constexpr double kMaxRatio = 1.0644944589178593;  // exp(1/16)
+    const bool up = fz_n >= 0.0;
+    if (up == (fz1_n >= 0.0)) {
+      const double ratio = up ? (fz1_n + t1_n) / (fz_n + t0_n) : (t0_n - fz_n) / (t1_n - fz1_n);
+      if (ratio <= kMinRatio || ratio >= kMaxRatio) return std::log(ratio);
+    }
+  }
+  return Asinh(ws * q / fl2);
+}
 
 // Span and rise of the upper end and their partials with respect to (Fl, Fz, s0).
 template <typename T>
@@ -69,7 +93,7 @@ FASTCAL_ALWAYS_INLINE CatenaryEnd<T> CatenaryEndpoint(const T& fl_n, const T& fz
   const T two_fz_ws = fz_n + fz1;
   const T p = fz_n * two_fz_ws * inv_s;
   const T q = t0 - p;
-  const T d = Asinh(ws * q / fl2);
+  const T d = CatenaryAngleDifference(fz_n, fz1, t0, t1, ws, q, fl2);
   const T d_over_w = d / w_n_per_m;
   const T cross = s0_m * two_fz_ws * inv_s_t0t1;
   const T s0_q_t0t1 = s0_m * q * inv_t0t1;
