@@ -1,7 +1,8 @@
 // Newton solvers for the elastic catenary's two inverse problems (see catenary.h for the
 // equations). Both iterate on the end-point residual (span, rise) with the analytic
 // Jacobian, a step limit that keeps the positive unknown (Fl, or s0) positive, and
-// backtracking on the residual norm, which is what makes a cold start robust.
+// backtracking on the residual norm, which is what makes a cold start robust. The norm is
+// kept squared: it is only compared, and a square root on it sat on the critical path.
 #include "fastcal/catenary.h"
 
 #include <algorithm>
@@ -28,6 +29,7 @@ constexpr int kGuessMaxIterations = 100;
 
 // std::hypot guards against overflow we cannot meet here and costs ~30x a sqrt.
 inline double Norm2(double a, double b) { return std::sqrt(a * a + b * b); }
+inline double SquaredNorm(double a, double b) { return a * a + b * b; }
 
 bool AllFinite(std::initializer_list<double> values) {
   for (double v : values) {
@@ -106,7 +108,7 @@ FASTCAL_ALWAYS_INLINE NewtonMove NextNewtonMove(const Problem<kFixedLength>& pro
   return NewtonMove::kTry;
 }
 
-// Newton from u (with its residual r, Jacobian jac and norm) at iteration `it`, with
+// Newton from u (with its residual r, Jacobian jac and squared norm) at iteration `it`, with
 // backtracking on the residual norm.
 template <bool kFixedLength>
 CatenaryStatus NewtonFrom(const Problem<kFixedLength>& problem, double tolerance_m,
@@ -127,7 +129,7 @@ CatenaryStatus NewtonFrom(const Problem<kFixedLength>& problem, double tolerance
       trial[0] = u[0] + lambda * step[0];
       trial[1] = u[1] + lambda * step[1];
       problem.Evaluate(trial, r_trial, jac_trial);
-      norm_trial = Norm2(r_trial[0], r_trial[1]);
+      norm_trial = SquaredNorm(r_trial[0], r_trial[1]);
       if (std::isfinite(norm_trial) && norm_trial < norm) {
         accepted = true;
         break;
@@ -136,7 +138,7 @@ CatenaryStatus NewtonFrom(const Problem<kFixedLength>& problem, double tolerance
     if (!accepted) {
       // No decrease along the Newton direction: either converged to rounding (accept if
       // already close) or stuck.
-      if (norm <= 1e3 * tolerance_m) {
+      if (norm <= 1e6 * tolerance_m * tolerance_m) {  // |r| <= 1e3 tolerance
         *iterations = it;
         return CatenaryStatus::kOk;
       }
@@ -364,7 +366,7 @@ void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, 
   for (int a = 0; a < num_active; ++a) {
     State& s = st[active[a]];
     s.problem.Evaluate(u[active[a]], s.r, s.jac);
-    s.norm = Norm2(s.r[0], s.r[1]);
+    s.norm = SquaredNorm(s.r[0], s.r[1]);
   }
   for (int it = 0; num_active > 0; ++it) {
     int pending[kMaxCatenaryBatch], num_pending = 0;
@@ -393,7 +395,7 @@ void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, 
     for (int q = 0; q < num_pending; ++q) {
       const int j = pending[q];
       State& s = st[j];
-      const double norm_trial = Norm2(s.r_trial[0], s.r_trial[1]);
+      const double norm_trial = SquaredNorm(s.r_trial[0], s.r_trial[1]);
       if (std::isfinite(norm_trial) && norm_trial < s.norm) {
         std::copy(s.trial, s.trial + 2, u[j]);
         std::copy(s.r_trial, s.r_trial + 2, s.r);
