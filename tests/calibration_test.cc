@@ -102,6 +102,30 @@ TEST(CalibrationTest, NoiseFreeDataRecoversTruth) {
   EXPECT_TRUE(result.before.undetermined.empty());
 }
 
+// A fit through AAS converges like one through exact: Calibrate solves with
+// ModelFitStaticsOptions. With AAS's loose control-loop tolerances (the default
+// StaticsOptions) Ceres took 17 iterations instead of 6 on 1e4 samples.
+TEST(CalibrationTest, AasForwardModelConvergesLikeExact) {
+  constexpr int kExtraIterations = 2;
+  constexpr double kNoiseFraction = 0.03;  // as the spec's sigma
+  const Dataset data = CircleData(Truth(), 200, kNoiseFraction, 7);
+  int iterations[2] = {0, 0};
+  for (int k = 0; k < 2; ++k) {
+    const CalibrationSpec spec =
+        MassCentreAndDensitySpec(k == 0 ? StaticsMethod::kAas : StaticsMethod::kExact);
+    CalibrationResult result;
+    std::string error;
+    ASSERT_EQ(
+        Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), &result, &error),
+        CalibrationStatus::kOk)
+        << error;
+    EXPECT_TRUE(result.converged) << result.termination;
+    iterations[k] = result.iterations;
+  }
+  EXPECT_LE(iterations[0], iterations[1] + kExtraIterations)
+      << "aas " << iterations[0] << ", exact " << iterations[1];
+}
+
 TEST(CalibrationTest, CostAtTruthIsZeroAndJacobianMatchesNumeric) {
   constexpr double kCostTol = 1e-18;
   constexpr double kJacobianRelTol = 1e-5;

@@ -241,9 +241,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   }
 
   std::vector<double> theta = cm.InitialTheta();
-  StaticsOptions statics;
-  statics.method = spec.forward_model;
-  statics.compute_unstretched_lengths = false;
+  const StaticsOptions statics = ModelFitStaticsOptions(spec.forward_model);
 
   // The forward model's own error against exact on the dataset poses (initial model).
   {

@@ -31,10 +31,8 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
     *error = data.path + ": no planned attitude columns (planned_roll_deg, ...)";
     return false;
   }
-  StaticsOptions options;
-  options.method = method;
+  StaticsOptions options = ModelFitStaticsOptions(method);  // as Calibrate solves
   options.warm_start = true;  // consecutive telemetry samples are close
-  options.compute_unstretched_lengths = false;
   StaticsSolution solution;
   predicted->assign(data.samples.size(), {});
   for (size_t n = 0; n < data.samples.size(); ++n) {
@@ -53,8 +51,7 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
 int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name,
                           const std::vector<AttitudeSource>& attitudes,
                           const std::vector<StaticsMethod>& methods, Dataset* data) {
-  StaticsOptions options;
-  options.compute_unstretched_lengths = false;  // as PredictTensions and Calibrate solve
+  StaticsOptions options = ModelFitStaticsOptions(StaticsMethod::kAas);  // as Calibrate
   StaticsSolution solution;
   std::vector<Sample> kept;
   kept.reserve(data->samples.size());

@@ -307,6 +307,15 @@ bool StaticsOptions::IsValid(std::string* error) const {
   return false;
 }
 
+StaticsOptions ModelFitStaticsOptions(StaticsMethod method) {
+  StaticsOptions o;
+  o.method = method;
+  o.compute_unstretched_lengths = false;
+  o.aas_secant_tolerance = o.catenary.relative_tolerance;
+  o.aas_length_tolerance = o.catenary.relative_tolerance;
+  return o;
+}
+
 StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot) {
   StaticsParameters<double> p;
   for (int i = 0; i < kNumCables; ++i) {
