@@ -75,16 +75,24 @@ CalibrationSpec MassCentreAndDensitySpec(StaticsMethod forward) {
   return spec;
 }
 
+// Calibrate from the nominal model with default options; the error message on failure.
+::testing::AssertionResult CalibrateNominal(const CalibrationSpec& spec, const Dataset& data,
+                                            CalibrationResult* result) {
+  std::string error;
+  if (Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), result, &error) ==
+      CalibrationStatus::kOk) {
+    return ::testing::AssertionSuccess();
+  }
+  return ::testing::AssertionFailure() << error;
+}
+
 TEST(CalibrationTest, NoiseFreeDataRecoversTruth) {
   constexpr double kRelTol = 1e-6;
   constexpr int kNodes = 36;
   const Dataset data = CircleData(Truth(), kNodes, 0.0, 1);
   const CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
   CalibrationResult result;
-  std::string error;
-  ASSERT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), &result, &error),
-            CalibrationStatus::kOk)
-      << error;
+  ASSERT_TRUE(CalibrateNominal(spec, data, &result));
   // The problem's size is what the spec implies.
   EXPECT_EQ(result.num_free, 4);
   EXPECT_EQ(result.num_residuals, kNumCables * kNodes);
@@ -114,11 +122,7 @@ TEST(CalibrationTest, AasForwardModelConvergesLikeExact) {
     const CalibrationSpec spec =
         MassCentreAndDensitySpec(k == 0 ? StaticsMethod::kAas : StaticsMethod::kExact);
     CalibrationResult result;
-    std::string error;
-    ASSERT_EQ(
-        Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), &result, &error),
-        CalibrationStatus::kOk)
-        << error;
+    ASSERT_TRUE(CalibrateNominal(spec, data, &result));
     EXPECT_TRUE(result.converged) << result.termination;
     iterations[k] = result.iterations;
   }
@@ -185,11 +189,7 @@ TEST(CalibrationTest, NoisyEstimatesWithinThreeSigmaAndSigmasMatchSpread) {
   for (int seed = 0; seed < kSeeds; ++seed) {
     const Dataset data = CircleData(Truth(), kNodes, 0.03, 1000 + seed);
     CalibrationResult result;
-    std::string error;
-    ASSERT_EQ(
-        Calibrate(CableRobot::NominalFast(), spec, data, CalibrationOptions(), &result, &error),
-        CalibrationStatus::kOk)
-        << error;
+    ASSERT_TRUE(CalibrateNominal(spec, data, &result));
     ASSERT_TRUE(result.covariance_ok);
     std::array<double, 4> e;
     for (int k = 0; k < 4; ++k) {
