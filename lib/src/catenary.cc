@@ -278,11 +278,6 @@ CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, d
   return Guess(span_m, rise_m, Norm2(span_m, rise_m), s0_m, ea_n, w_n_per_m);
 }
 
-CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,
-                                      double w_n_per_m) {
-  return ParabolicCatenaryModel(span_m, rise_m, ea_n, w_n_per_m).AtHorizontalForce(fl_n);
-}
-
 namespace {
 
 Problem</*kFixedLength=*/true> MakeProblem(const CatenaryProblem& c) {
@@ -320,13 +315,10 @@ CatenaryStatus Start(const CatenaryLengthProblem& c, double chord_m,
     u[0] = c.guess->fz_n;
     u[1] = c.guess->s0_m;
   } else {
-    // The parabolic relation of CatenaryInitialGuess, solved for s0 at H = fl.
-    const double k = chord_m;
-    const double cc = k / (c.span_m * c.ea_n);
-    const double b =
-        c.w_n_per_m * c.w_n_per_m * (c.span_m * c.span_m) * (c.span_m * c.span_m) / 12.0;
-    u[1] = std::sqrt(k * k + b / (c.fl_n * c.fl_n)) / (1.0 + cc * c.fl_n);
-    u[0] = -c.fl_n * c.rise_m / c.span_m - 0.5 * c.w_n_per_m * u[1];
+    const CatenaryCurvePoint start =
+        ParabolicCatenaryModel(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m).AtHorizontalForce(c.fl_n);
+    u[0] = start.fz_n;
+    u[1] = start.s0_m;
   }
   return CatenaryStatus::kOk;
 }

@@ -166,12 +166,6 @@ CatenaryStatus SolveCatenaryLengthDouble(double span_m, double rise_m, double fl
 // for the horizontal force H, then Fz from the inextensible catenary with that H.
 CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
                                     double w_n_per_m);
-// The same relation solved for s0 at H = fl_n (explicit), Fz as above. Its error varies
-// slowly along a cable's family of lengths; the statics' AAS corrects it by its error at
-// the two secant points, where the exact points are known.
-CatenaryCurvePoint CatenaryCurveGuess(double span_m, double rise_m, double fl_n, double ea_n,
-                                      double w_n_per_m);
-// The same for one chord at several horizontal forces (its constants computed once).
 // coth(lambda) for the starts' inextensible-catenary Fz, given also 1/lambda: its Laurent
 // series to lambda^5 below lambda = 0.5 (within 1e-6 relative, plenty for a start that is
 // itself ~1e-3 off; FAST's cables have lambda in ~[0.05, 0.6]), else from one exp (tanh
@@ -185,7 +179,10 @@ inline double StartCoth(double lambda, double inv_lambda) {
   return (1.0 + e) / (1.0 - e);
 }
 
-// Inline: the statics evaluate it three times per cable, side by side.
+// The same parabolic relation for one chord, solved for s0 at a given H = Fl (explicit),
+// Fz as above: a point near the cable's Fz(Fl) curve. Its error varies slowly along the
+// family of lengths; the statics' AAS corrects it by its error at the two secant points,
+// where the exact points are known. Inline: evaluated three times per cable, side by side.
 class ParabolicCatenaryModel {
  public:
   ParabolicCatenaryModel(double span_m, double rise_m, double ea_n, double w_n_per_m)

@@ -346,7 +346,7 @@ StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometr
 // Guess for cable i's curve point at Fl from its secant data. Linear: s0 interpolated
 // linearly in Fl between the two secant lengths, Fz on the secant line (5.6e-3 off in
 // s0 over the workspace cap). Model-corrected: the parabolic model's point
-// (CatenaryCurveGuess) corrected by the model's error at the two secant points,
+// (ParabolicCatenaryModel) corrected by the model's error at the two secant points,
 // interpolated linearly in Fl (6.7e-5 in s0, 1.4e-5 of the tension in Fz).
 inline CatenaryCurvePoint CurveGuess(double fl, const PoseGeometry<double>& g, int i, double ea_n,
                                      const CatenaryForces& low, const CatenaryForces& high,
