@@ -250,15 +250,15 @@ TEST(StaticsTest, WholeWorkspaceCap) {
   EXPECT_GT(worst_on, 1e-3);
 }
 
-// The statics' inner tolerances are speed settings, not accuracy ones: a looser start
-// for exact and the 1e-10 catenary tolerance change no result beyond these bounds
-// (measured: exact 7e-14, aas 1e-11).
+// The statics' inner tolerances are speed settings, not accuracy ones: against solves
+// converged to 1e-13 they change no result beyond these bounds (measured over the cap:
+// exact 5e-14, aas-refined 7.5e-12, aas 2.9e-7).
 TEST(StaticsTest, InnerTolerancesDoNotChangeResults) {
   constexpr double kExactRelTol = 1e-12;
   constexpr double kRefinedRelTol = 1e-9;
   // aas ends its secant solves at aas_secant_tolerance = 1e-6, which bounds the relative
-  // error those solves leave in the forces (measured: 2.9e-7 over the cap); s0 comes
-  // from a tight solve and moves by ~2e-6 m.
+  // error those solves leave in the forces (measured: 2.9e-7 over the cap); its s0
+  // solves end at aas_length_tolerance = 1e-8, and s0 moves by ~2e-6 m.
   constexpr double kAasRelTol = 1e-6;
   constexpr double kAasLengthTolM = 1e-5;
   constexpr double kTightCatenaryTol = 1e-13;
@@ -304,6 +304,35 @@ TEST(StaticsTest, InnerTolerancesDoNotChangeResults) {
   bad.aas_length_tolerance = 0.0;
   EXPECT_FALSE(bad.IsValid(&error));
   EXPECT_NE(error.find("aas_length_tolerance"), std::string::npos) << error;
+}
+
+// Each inner tolerance acts on its own stage only: aas_length_tolerance on the s0 solves
+// (so AAS's forces without s0 do not move at all), aas_secant_tolerance on the secants of
+// aas and aas-refined (not exact's start).
+TEST(StaticsTest, EachInnerToleranceActsOnItsOwnStage) {
+  constexpr double kLooseTolerance = 1e-4;
+  const CableRobot robot = CableRobot::NominalFast();
+  const Pose pose = FocalPose(Eigen::Vector3d(42.65, 33.73, 149.52));
+  StaticsOptions forces_only;
+  forces_only.method = StaticsMethod::kAas;
+  forces_only.compute_unstretched_lengths = false;
+  StaticsOptions loose_length = forces_only;
+  loose_length.aas_length_tolerance = kLooseTolerance;
+  StaticsOptions exact;
+  exact.method = StaticsMethod::kExact;
+  StaticsOptions loose_secant = exact;
+  loose_secant.aas_secant_tolerance = kLooseTolerance * 100;
+  for (const auto& [a, b] :
+       {std::pair{forces_only, loose_length}, std::pair{exact, loose_secant}}) {
+    StaticsSolution sa, sb;
+    ASSERT_EQ(SolveStatics(robot, pose, a, &sa), StaticsStatus::kOk);
+    ASSERT_EQ(SolveStatics(robot, pose, b, &sb), StaticsStatus::kOk);
+    EXPECT_EQ(sa.catenary_iterations, sb.catenary_iterations) << StaticsMethodName(a.method);
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_EQ(sa.cables[i].lower_tension_n, sb.cables[i].lower_tension_n)
+          << StaticsMethodName(a.method) << " cable " << i + 1;
+    }
+  }
 }
 
 // The guess for each cable's curve point at the AAS force (internal::CurveGuess,

@@ -123,9 +123,9 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
   int* cable = &sol->cable;
   int* its = &sol->catenary_iterations;
   if (!have_state) {
-    const StaticsOptions so = internal::AasStageOptions(o);
+    const StaticsOptions so = internal::AasLengthStageOptions(o);
     std::array<double, kNumCables> a, b, fl;
-    status = internal::AasLines(p, g, so, previous != nullptr, &low, &high, &a, &b, cable, its);
+    status = internal::AasLines(p, g, o, previous != nullptr, &low, &high, &a, &b, cable, its);
     if (status != StaticsStatus::kOk) return status;
     if (!internal::SolveEquilibrium(g, a, b, &fl)) return StaticsStatus::kSingular;
     for (int i = 0; i < kNumCables; ++i) {

@@ -163,6 +163,28 @@ struct CableState {
   T fl, fz, s0;
 };
 
+// The per-cable solver options of AAS's secants: catenary.relative_tolerance loosened to
+// aas_secant_tolerance, or for kExact's start to exact_start_catenary_tolerance.
+inline CatenarySolverOptions AasSecantSolverOptions(const StaticsOptions& o) {
+  CatenarySolverOptions c = o.catenary;
+  c.relative_tolerance = std::max(c.relative_tolerance, o.method == StaticsMethod::kExact
+                                                            ? o.exact_start_catenary_tolerance
+                                                            : o.aas_secant_tolerance);
+  return c;
+}
+
+// The options of the s0 solves at the AAS forces (ProjectOnCurves): catenary's tolerance
+// loosened to aas_length_tolerance, or for kExact's start to
+// exact_start_catenary_tolerance.
+inline StaticsOptions AasLengthStageOptions(const StaticsOptions& o) {
+  StaticsOptions so = o;
+  so.catenary.relative_tolerance =
+      std::max(o.catenary.relative_tolerance, o.method == StaticsMethod::kExact
+                                                  ? o.exact_start_catenary_tolerance
+                                                  : o.aas_length_tolerance);
+  return so;
+}
+
 // AAS secant lines Fz = a Fl + b. `secant` in/out: double solutions used as guesses when
 // `use_guess` and written back.
 template <typename T>
@@ -171,9 +193,7 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                        std::array<CatenaryForces, kNumCables>* low,
                        std::array<CatenaryForces, kNumCables>* high, std::array<T, kNumCables>* a,
                        std::array<T, kNumCables>* b, int* cable, int* iterations) {
-  CatenarySolverOptions secant_options = o.catenary;
-  secant_options.relative_tolerance =
-      std::max(o.catenary.relative_tolerance, o.aas_secant_tolerance);
+  const CatenarySolverOptions secant_options = AasSecantSolverOptions(o);
   if constexpr (kIsDouble<T>) {
     // All twelve solves at once (low lengths, then high): same results, overlapped.
     CatenaryProblem problems[2 * kNumCables];
@@ -344,7 +364,7 @@ StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometr
 }
 
 // Guess for cable i's curve point at Fl from its secant data. Linear: s0 interpolated
-// linearly in Fl between the two secant lengths, Fz on the secant line (5.6e-3 off in
+// linearly in Fl between the two secant lengths, Fz on the secant line (5.8e-3 off in
 // s0 over the workspace cap). Model-corrected: the parabolic model's point
 // (ParabolicCatenaryModel) corrected by the model's error at the two secant points,
 // interpolated linearly in Fl (6.7e-5 in s0, 1.4e-5 of the tension in Fz).
@@ -368,18 +388,6 @@ inline CatenaryCurvePoint CurveGuess(double fl, const PoseGeometry<double>& g, i
   }
   c.s0_m = std::max(c.s0_m, 0.5 * s_low);
   return c;
-}
-
-// The options of the solves that build the AAS solution: looser per-cable tolerances
-// where the method does not need more (StaticsOptions' exact_start_catenary_tolerance,
-// aas_length_tolerance).
-inline StaticsOptions AasStageOptions(const StaticsOptions& o) {
-  StaticsOptions so = o;
-  so.catenary.relative_tolerance =
-      std::max(o.catenary.relative_tolerance, o.method == StaticsMethod::kExact
-                                                  ? o.exact_start_catenary_tolerance
-                                                  : o.aas_length_tolerance);
-  return so;
 }
 
 }  // namespace internal

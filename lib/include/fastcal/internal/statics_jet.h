@@ -66,8 +66,8 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
             guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), gd, i, pd.ea_n[i], low[i],
                                             high[i], options, /*model_corrected=*/true);
           }
-          status = internal::ProjectOnCurves(p, g, internal::AasStageOptions(options), guess, &st,
-                                             &cable, &iterations);
+          status = internal::ProjectOnCurves(p, g, internal::AasLengthStageOptions(options), guess,
+                                             &st, &cable, &iterations);
           if (status != StaticsStatus::kOk) return status;
           status = internal::ReducedNewtonStep(p, g, &st, &cable, nullptr, nullptr);
           if (status != StaticsStatus::kOk) return status;
