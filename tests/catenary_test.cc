@@ -59,6 +59,57 @@ TEST(CatenaryTest, ColdSolveConvergesOverWorkspaceLengthRange) {
   }
 }
 
+// A lone fixed-length solve of chord c (its span and s0) with the given rise and load.
+CatenaryStatus SolveChord(const Chord& c, double rise_m, double w_n_per_m,
+                          const CatenaryForces* guess, CatenaryForces* forces, int* iterations) {
+  return SolveCatenaryForcesDouble(c.span_m, rise_m, c.s0_m, kEaN, w_n_per_m,
+                                   CatenarySolverOptions(), guess, forces, iterations);
+}
+
+// A cold solve's start, computed for the whole batch in lockstep, is CatenaryInitialGuess:
+// a solve started there explicitly takes the same steps to the same bits.
+TEST(CatenaryTest, ColdStartIsCatenaryInitialGuess) {
+  for (const Chord& c : RandomChords(2000, 0.95, 1.05)) {
+    CatenaryForces cold, warm;
+    int it_cold = 0, it_warm = 0;
+    ASSERT_EQ(SolveChord(c, c.rise_m, kWNPerM, nullptr, &cold, &it_cold), CatenaryStatus::kOk);
+    const CatenaryForces start = CatenaryInitialGuess(c.span_m, c.rise_m, c.s0_m, kEaN, kWNPerM);
+    ASSERT_EQ(SolveChord(c, c.rise_m, kWNPerM, &start, &warm, &it_warm), CatenaryStatus::kOk);
+    EXPECT_EQ(cold.fl_n, warm.fl_n);
+    EXPECT_EQ(cold.fz_n, warm.fz_n);
+    EXPECT_EQ(it_cold, it_warm);
+  }
+}
+
+// A load pointing up (w > 0) is the mirror image in z of gravity: rise, Fz and w change
+// sign. Both cold starts respect that, so both inverse problems give the mirrored
+// solution in about the same number of steps.
+TEST(CatenaryTest, UpwardLoadMirrorsGravity) {
+  constexpr double kMirrorRelTol = 1e-9;
+  constexpr int kMaxExtraIterations = 1;
+  const CatenarySolverOptions options;
+  for (const Chord& c : RandomChords(500, 0.97, 1.03)) {
+    CatenaryForces down, up;
+    int it_down = 0, it_up = 0;
+    ASSERT_EQ(SolveChord(c, c.rise_m, kWNPerM, nullptr, &down, &it_down), CatenaryStatus::kOk);
+    ASSERT_EQ(SolveChord(c, -c.rise_m, -kWNPerM, nullptr, &up, &it_up), CatenaryStatus::kOk);
+    const double t = std::hypot(down.fl_n, down.fz_n);
+    EXPECT_NEAR(up.fl_n, down.fl_n, kMirrorRelTol * t);
+    EXPECT_NEAR(up.fz_n, -down.fz_n, kMirrorRelTol * t);
+    EXPECT_LE(std::abs(it_up - it_down), kMaxExtraIterations);
+    CatenaryCurvePoint p_down, p_up;
+    ASSERT_EQ(SolveCatenaryLengthDouble(c.span_m, c.rise_m, down.fl_n, kEaN, kWNPerM, options,
+                                        nullptr, &p_down, &it_down),
+              CatenaryStatus::kOk);
+    ASSERT_EQ(SolveCatenaryLengthDouble(c.span_m, -c.rise_m, down.fl_n, kEaN, -kWNPerM, options,
+                                        nullptr, &p_up, &it_up),
+              CatenaryStatus::kOk);
+    EXPECT_NEAR(p_up.s0_m, p_down.s0_m, kMirrorRelTol * p_down.s0_m);
+    EXPECT_NEAR(p_up.fz_n, -p_down.fz_n, kMirrorRelTol * t);
+    EXPECT_LE(std::abs(it_up - it_down), kMaxExtraIterations);
+  }
+}
+
 // The cold start is the parabolic elastic catenary: close to the solution over the
 // workspace's lengths (measured max 0.48% within 1% of the chord length, where AAS's
 // secant lengths are, and 3.3% over 0.95k..1.05k), so Newton needs at most three

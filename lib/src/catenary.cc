@@ -186,12 +186,14 @@ const char* CatenaryStatusName(CatenaryStatus status) {
 namespace {
 
 // Vertical force at the lower end of the inextensible catenary with horizontal force H:
-// Fz = (|w|/2) (s0 - Z coth(lambda)), lambda = |w| L / (2H); ten times closer than its
-// parabolic limit -H Z/L + |w| s0/2 over the workspace.
+// Fz = -(w/2) s0 - (|w|/2) Z coth(lambda), lambda = |w| L / (2H) (for gravity, w < 0:
+// (|w|/2)(s0 - Z coth)); ten times closer than its parabolic limit -H Z/L - w s0/2 over
+// the workspace.
 double InextensibleLowerFz(double span_m, double rise_m, double s0_m, double h_n,
                            double w_n_per_m) {
   const double lambda = std::abs(w_n_per_m) * span_m / (2.0 * h_n);
-  return 0.5 * std::abs(w_n_per_m) * (s0_m - rise_m * StartCoth(lambda, 1.0 / lambda));
+  return -0.5 * w_n_per_m * s0_m -
+         0.5 * std::abs(w_n_per_m) * rise_m * StartCoth(lambda, 1.0 / lambda);
 }
 
 // CatenaryInitialGuess in three steps, so that a batch can run them in lockstep (Guess,

@@ -189,9 +189,10 @@ class ParabolicCatenaryModel {
       : k_(std::sqrt(span_m * span_m + rise_m * rise_m)),
         c_(k_ / (span_m * ea_n)),
         b_(w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0),
-        half_w_(0.5 * std::abs(w_n_per_m)),
+        half_w_(0.5 * w_n_per_m),
+        half_abs_w_(0.5 * std::abs(w_n_per_m)),
         rise_m_(rise_m),
-        lambda_h_(half_w_ * span_m),
+        lambda_h_(half_abs_w_ * span_m),
         inv_lambda_h_(1.0 / lambda_h_) {}
 
   CatenaryCurvePoint AtHorizontalForce(double fl_n) const {
@@ -199,11 +200,11 @@ class ParabolicCatenaryModel {
     const double s0_m = std::sqrt(k_ * k_ + b_ * inv_fl * inv_fl) / (1.0 + c_ * fl_n);
     // Fz of CatenaryInitialGuess (the inextensible catenary), lambda = lambda_h / H.
     const double coth = StartCoth(lambda_h_ * inv_fl, fl_n * inv_lambda_h_);
-    return CatenaryCurvePoint{half_w_ * (s0_m - rise_m_ * coth), s0_m};
+    return CatenaryCurvePoint{-half_w_ * s0_m - half_abs_w_ * rise_m_ * coth, s0_m};
   }
 
  private:
-  double k_, c_, b_, half_w_, rise_m_, lambda_h_, inv_lambda_h_;
+  double k_, c_, b_, half_w_, half_abs_w_, rise_m_, lambda_h_, inv_lambda_h_;
 };
 
 // Templated wrappers. For T = double they are the solves above; for a Jet they add one
