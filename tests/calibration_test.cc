@@ -143,7 +143,7 @@ TEST(CalibrationTest, CostAtTruthIsZeroAndJacobianMatchesNumeric) {
     for (const Sample& s : data.samples) {
       internal::TensionResidual f{
           &model, s.pose, s.tension_n, internal::TensionSigmas(s.tension_n, 0.0, 3.0), {}, {}};
-      f.statics.method = forward;
+      f.statics = ModelFitStaticsOptions(forward);  // as Calibrate
       internal::TensionCost cost(f);
       double r[kNumCables], jac[kNumCables * 4];
       const double* params[1] = {truth};

@@ -128,8 +128,9 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
   Random tension_rng(options.seed, kTensionNoiseStream);
   Random outlier_rng(options.seed, kOutlierStream);
 
-  StaticsOptions statics;
-  statics.method = options.method;
+  // Synthetic truth: converged per-cable solves, as a fit uses, plus s0.
+  StaticsOptions statics = ModelFitStaticsOptions(options.method);
+  statics.compute_unstretched_lengths = true;
   // Consecutive nodes are usually close; a failed warm start is retried cold.
   statics.warm_start = true;
   StaticsSolution solution;

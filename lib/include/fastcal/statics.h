@@ -54,9 +54,10 @@ struct StaticsOptions {
   // relative to the chord), is below this.
   double exact_relative_tolerance = 1e-12;
   int exact_max_iterations = 30;
-  // kExact only: tolerance of the per-cable solves that build its AAS start (one Newton
-  // step each instead of two). The start is then ~1e-5 from AAS, itself ~1e-3 from the
-  // solution, so Newton needs the same number of steps and the result is unchanged.
+  // kExact only: tolerance of the per-cable solves that build its AAS start (the secants
+  // then end at their cold start's evaluation, the s0 solves after one Newton step). The
+  // start is then ~1e-5 from AAS, itself ~1e-3 from the solution, so Newton needs the
+  // same number of steps and the result is unchanged.
   double exact_start_catenary_tolerance = 1e-4;
   // aas and aas-refined: tolerance of the twelve secant solves (the looser of this and
   // catenary.relative_tolerance). The secants only define AAS's straight lines, whose own
