@@ -8,7 +8,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <type_traits>
 
 namespace fastcal {
 namespace {
@@ -197,7 +196,7 @@ double InextensibleLowerFz(double span_m, double rise_m, double s0_m, double h_n
 }
 
 // CatenaryInitialGuess in three steps, so that a batch can run them in lockstep (Guess,
-// GuessBatch): the start's division chain (~4 divisions, then one per Newton step) is
+// ColdStarts): the start's division chain (~4 divisions, then one per Newton step) is
 // latency, and independent chains side by side overlap.
 //
 // g(H) = H^2 (s0^2 (1 + c H)^2 - k^2) - b has its one positive root above
@@ -249,8 +248,9 @@ CatenaryForces Guess(double span_m, double rise_m, double k, double s0_m, double
   return CatenaryForces{st.h, InextensibleLowerFz(span_m, rise_m, s0_m, st.h, w_n_per_m)};
 }
 
-// Guess for problems[j], j in which[0..n), written to u[j]; the same results as Guess.
-void GuessBatch(int n, const int* which, const CatenaryProblem* problems, const double* chord_m,
+// Cold starts of problems[j], j in which[0..n), written to u[j]. At fixed length: Guess,
+// in lockstep with the same results.
+void ColdStarts(int n, const int* which, const CatenaryProblem* problems, const double* chord_m,
                 double (*u)[2]) {
   GuessState st[kMaxCatenaryBatch];
   int active[kMaxCatenaryBatch];
@@ -273,6 +273,18 @@ void GuessBatch(int n, const int* which, const CatenaryProblem* problems, const 
   }
 }
 
+// At fixed horizontal force: the parabolic model's point (explicit, nothing to overlap).
+void ColdStarts(int n, const int* which, const CatenaryLengthProblem* problems,
+                const double* /*chord_m*/, double (*u)[2]) {
+  for (int a = 0; a < n; ++a) {
+    const CatenaryLengthProblem& c = problems[which[a]];
+    const CatenaryCurvePoint start =
+        ParabolicCatenaryModel(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m).AtHorizontalForce(c.fl_n);
+    u[which[a]][0] = start.fz_n;
+    u[which[a]][1] = start.s0_m;
+  }
+}
+
 }  // namespace
 
 CatenaryForces CatenaryInitialGuess(double span_m, double rise_m, double s0_m, double ea_n,
@@ -289,8 +301,8 @@ Problem</*kFixedLength=*/false> MakeProblem(const CatenaryLengthProblem& c) {
   return {c.span_m, c.rise_m, c.ea_n, c.w_n_per_m, c.fl_n};
 }
 
-// Checks a problem and writes its start to u: (Fl, Fz) from the guess, at fixed length;
-// without one, *needs_guess is set and the caller runs GuessBatch (the parabolic start).
+// Checks a problem and writes its start to u, (Fl, Fz) at fixed length, from its guess;
+// without one, *needs_guess is set and the caller runs ColdStarts for the batch.
 CatenaryStatus Start(const CatenaryProblem& c, double chord_m, const CatenarySolverOptions& options,
                      double u[2], bool* needs_guess) {
   if (!std::isfinite(c.s0_m) || !(c.s0_m > 0.0)) return CatenaryStatus::kInvalidInput;
@@ -306,9 +318,9 @@ CatenaryStatus Start(const CatenaryProblem& c, double chord_m, const CatenarySol
   return CatenaryStatus::kOk;
 }
 
-// The same at fixed horizontal force: u = (Fz, s0), the cold start computed here.
+// The same at fixed horizontal force: u = (Fz, s0).
 CatenaryStatus Start(const CatenaryLengthProblem& c, double chord_m,
-                     const CatenarySolverOptions& options, double u[2], bool* /*needs_guess*/) {
+                     const CatenarySolverOptions& options, double u[2], bool* needs_guess) {
   if (!std::isfinite(c.fl_n) || !(c.fl_n > 0.0)) return CatenaryStatus::kInvalidInput;
   const CatenaryStatus common =
       CheckCommon(c.span_m, c.rise_m, chord_m, c.ea_n, c.w_n_per_m, options);
@@ -317,10 +329,7 @@ CatenaryStatus Start(const CatenaryLengthProblem& c, double chord_m,
     u[0] = c.guess->fz_n;
     u[1] = c.guess->s0_m;
   } else {
-    const CatenaryCurvePoint start =
-        ParabolicCatenaryModel(c.span_m, c.rise_m, c.ea_n, c.w_n_per_m).AtHorizontalForce(c.fl_n);
-    u[0] = start.fz_n;
-    u[1] = start.s0_m;
+    *needs_guess = true;
   }
   return CatenaryStatus::kOk;
 }
@@ -354,9 +363,7 @@ void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, 
     st[j].tolerance_m = options.relative_tolerance * chord_m[j];
     active[num_active++] = j;
   }
-  if constexpr (std::is_same_v<Spec, CatenaryProblem>) {
-    if (num_cold > 0) GuessBatch(num_cold, cold, specs, chord_m, u);
-  }
+  if (num_cold > 0) ColdStarts(num_cold, cold, specs, chord_m, u);
   for (int a = 0; a < num_active; ++a) {
     State& s = st[active[a]];
     s.problem.Evaluate(u[active[a]], s.r, s.jac);
