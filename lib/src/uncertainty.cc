@@ -1,0 +1,265 @@
+// Uncertainty budget of a linearised least-squares estimate (uncertainty.h): robust scale,
+// integrated autocorrelation time, overlapping-batch-means long-run covariance, consider
+// parameters and the score test.
+#include "fastcal/uncertainty.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <limits>
+#include <unsupported/Eigen/FFT>
+
+namespace fastcal {
+namespace {
+
+// 1 / Phi^-1(3/4): the MAD of a standard normal sample is 1 / this.
+constexpr double kMadToSigma = 1.4826;
+// Sokal's window must end before this fraction of the series, or tau is unreliable.
+constexpr double kMaxWindowFraction = 0.25;
+// Fewer samples than this and the long-run covariance is not estimated.
+constexpr int kMinSamplesForCorrelation = 10;
+
+double Median(std::vector<double>* v) {
+  const size_t n = v->size();
+  const auto mid = v->begin() + static_cast<std::ptrdiff_t>(n / 2);
+  std::nth_element(v->begin(), mid, v->end());
+  if (n % 2 == 1) return *mid;
+  return 0.5 * (*mid + *std::max_element(v->begin(), mid));
+}
+
+// Autocovariances c_0 .. c_{max_lag} of a mean-subtracted series, by FFT of the series
+// zero-padded to at least twice its length (so the circular correlation is the linear one).
+std::vector<double> Autocovariance(const Eigen::VectorXd& x, int max_lag) {
+  const int n = static_cast<int>(x.size());
+  int size = 1;
+  while (size < 2 * n) size *= 2;
+  std::vector<double> padded(size, 0.0);
+  for (int t = 0; t < n; ++t) padded[t] = x[t];
+  Eigen::FFT<double> fft;
+  std::vector<std::complex<double>> spectrum;
+  fft.fwd(spectrum, padded);
+  for (std::complex<double>& c : spectrum) c = std::norm(c);
+  std::vector<double> correlation;
+  fft.inv(correlation, spectrum);
+  std::vector<double> c(max_lag + 1);
+  for (int k = 0; k <= max_lag; ++k) c[k] = correlation[k] / n;
+  return c;
+}
+
+// Rows of x scaled to unit diagonal: D M D with D = diag(M)^-1/2 (d returned); then
+// inverse as D (D M D)^-1 D. False when M is not positive definite.
+bool InverseOfPositiveDefinite(const Eigen::MatrixXd& m, Eigen::MatrixXd* inverse) {
+  const int n = static_cast<int>(m.rows());
+  Eigen::VectorXd d(n);
+  for (int k = 0; k < n; ++k) {
+    if (!(m(k, k) > 0.0) || !std::isfinite(m(k, k))) return false;
+    d[k] = 1.0 / std::sqrt(m(k, k));
+  }
+  const Eigen::MatrixXd scaled = d.asDiagonal() * m * d.asDiagonal();
+  const Eigen::LLT<Eigen::MatrixXd> llt(scaled);
+  if (llt.info() != Eigen::Success) return false;
+  *inverse = d.asDiagonal() * llt.solve(Eigen::MatrixXd::Identity(n, n)) * d.asDiagonal();
+  return inverse->allFinite();
+}
+
+double SqrtNonNegative(double v) { return std::sqrt(std::max(v, 0.0)); }
+
+// The statistical covariance: P_data (or the formal one without scores), each variance
+// raised to the floor misfit^2 P_formal, the correlations of P_data kept.
+Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& formal, const Eigen::MatrixXd& data,
+                                      double misfit_factor) {
+  const int n = static_cast<int>(formal.rows());
+  Eigen::VectorXd scale = Eigen::VectorXd::Ones(n);
+  for (int k = 0; k < n; ++k) {
+    const double floor = misfit_factor * misfit_factor * formal(k, k);
+    if (!(data(k, k) > 0.0)) return misfit_factor * misfit_factor * formal;
+    if (data(k, k) < floor) scale[k] = std::sqrt(floor / data(k, k));
+  }
+  return scale.asDiagonal() * data * scale.asDiagonal();
+}
+
+// The influence series' largest tau, and the bandwidth it calls for.
+void ChooseBandwidth(const Eigen::MatrixXd& influence, UncertaintyBudget* b,
+                     std::vector<double>* tau) {
+  const int n_samples = static_cast<int>(influence.rows());
+  b->tau = 1.0;
+  for (int k = 0; k < influence.cols(); ++k) {
+    const AutocorrelationTime a = IntegratedAutocorrelationTime(influence.col(k));
+    (*tau)[k] = a.tau;
+    b->tau = std::max(b->tau, a.tau);
+    b->correlation_reliable = b->correlation_reliable && a.reliable;
+  }
+  const double wanted = std::ceil(kBandwidthPerTau * b->tau);
+  b->bandwidth = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(n_samples)));
+}
+
+// The batch correction at the chosen bandwidth, halving it while the correction says the
+// fit absorbed most of a batch (then the widening is a lower bound).
+Eigen::VectorXd CorrectionWithinLimit(const BudgetInputs& in, UncertaintyBudget* b) {
+  Eigen::VectorXd c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, b->bandwidth);
+  while (b->bandwidth > 1 && !(c.maxCoeff() <= kMaxBatchCorrection)) {
+    b->bandwidth = std::max(1, b->bandwidth / 2);
+    b->correlation_reliable = false;
+    c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, b->bandwidth);
+  }
+  b->max_batch_correction = c.size() > 0 ? c.maxCoeff() : 1.0;
+  return c.cwiseMax(1.0);
+}
+
+}  // namespace
+
+RobustScale RobustScaleOf(std::vector<double> values) {
+  RobustScale s;
+  if (values.empty()) return s;
+  s.centre = Median(&values);
+  for (double& v : values) v = std::abs(v - s.centre);
+  s.scale = kMadToSigma * Median(&values);
+  return s;
+}
+
+AutocorrelationTime IntegratedAutocorrelationTime(const Eigen::Ref<const Eigen::VectorXd>& series,
+                                                  double window_factor) {
+  AutocorrelationTime a;
+  const int n = static_cast<int>(series.size());
+  if (n < 2) return a;
+  const Eigen::VectorXd x = series.array() - series.mean();
+  const int max_window = std::max(1, static_cast<int>(kMaxWindowFraction * n));
+  const std::vector<double> c = Autocovariance(x, max_window);
+  if (!(c[0] > 0.0)) return a;  // a constant series: no information about its memory
+  double tau = 1.0;
+  for (int w = 1; w <= max_window; ++w) {
+    tau += 2.0 * c[w] / c[0];
+    if (w >= window_factor * tau) {
+      a.tau = std::max(tau, 1.0 / n);
+      a.window = w;
+      return a;
+    }
+  }
+  a.tau = std::max(tau, 1.0);
+  a.window = max_window;
+  a.reliable = false;
+  return a;
+}
+
+Eigen::MatrixXd LongRunCovarianceOfSum(const Eigen::MatrixXd& scores, int bandwidth) {
+  const int n_samples = static_cast<int>(scores.rows());
+  const int n = static_cast<int>(scores.cols());
+  if (n_samples < 1) return Eigen::MatrixXd::Zero(n, n);
+  const int l = std::clamp(bandwidth, 1, n_samples);
+  const int batches = n_samples - l + 1;
+  Eigen::MatrixXd windows(batches, n);
+  Eigen::RowVectorXd window = scores.topRows(l).colwise().sum();
+  for (int j = 0; j < batches; ++j) {
+    if (j > 0) window += scores.row(j + l - 1) - scores.row(j - 1);
+    windows.row(j) = window;
+  }
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n, n);
+  sum.selfadjointView<Eigen::Lower>().rankUpdate(windows.transpose());
+  sum = sum.selfadjointView<Eigen::Lower>();
+  return static_cast<double>(n_samples) / (static_cast<double>(batches) * l) * sum;
+}
+
+Eigen::VectorXd BatchCorrection(const SampleJacobians& jacobians, int rows_per_sample,
+                                const Eigen::MatrixXd& inverse_information, int bandwidth) {
+  const int n = static_cast<int>(inverse_information.rows());
+  const int n_samples = static_cast<int>(jacobians.rows());
+  if (n_samples == 0 || rows_per_sample < 1 || jacobians.cols() != rows_per_sample * n) {
+    return Eigen::VectorXd::Ones(n);
+  }
+  const int l = std::clamp(bandwidth, 1, n_samples);
+  const int batches = n_samples - l + 1;
+  const int stride = std::max(1, l / 16);
+  // Per sample J_t^T J_t, added to and removed from the running window sum.
+  using Rows = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  auto information = [&](int t) {
+    const Eigen::MatrixXd j =
+        Eigen::Map<const Rows>(jacobians.row(t).data(), rows_per_sample, n).cast<double>();
+    return Eigen::MatrixXd(j.transpose() * j);
+  };
+  Eigen::MatrixXd window = Eigen::MatrixXd::Zero(n, n);
+  for (int t = 0; t < l; ++t) window += information(t);
+  Eigen::VectorXd kept = Eigen::VectorXd::Zero(n), all = Eigen::VectorXd::Zero(n);
+  for (int j = 0; j < batches; ++j) {
+    if (j > 0) window += information(j + l - 1) - information(j - 1);
+    if (j % stride != 0) continue;
+    const Eigen::MatrixXd absorbed = window * inverse_information * window;
+    all += window.diagonal();
+    kept += window.diagonal() - absorbed.diagonal();
+  }
+  Eigen::VectorXd c(n);
+  for (int k = 0; k < n; ++k) {
+    c[k] = kept[k] > 0.0 ? all[k] / kept[k] : std::numeric_limits<double>::infinity();
+  }
+  return c;
+}
+
+bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
+  *b = UncertaintyBudget();
+  const int n = static_cast<int>(in.information.rows());
+  b->consider_groups = in.consider_groups;
+  if (n == 0 || !InverseOfPositiveDefinite(in.information, &b->formal)) return false;
+  const int dof = in.num_residuals - n;
+  b->reduced_chi_square = dof > 0 ? in.chi_square / dof : std::numeric_limits<double>::quiet_NaN();
+  b->misfit_factor =
+      std::isfinite(b->reduced_chi_square) ? std::sqrt(std::max(1.0, b->reduced_chi_square)) : 1.0;
+  b->samples = static_cast<int>(in.scores.rows());
+  std::vector<double> tau(n, 1.0);
+  Eigen::MatrixXd data = b->formal;
+  if (b->samples >= kMinSamplesForCorrelation && in.scores.cols() == n && dof > 0) {
+    ChooseBandwidth(in.scores * b->formal, b, &tau);
+    const Eigen::VectorXd root_c = CorrectionWithinLimit(in, b).cwiseSqrt();
+    Eigen::MatrixXd meat =
+        root_c.asDiagonal() * LongRunCovarianceOfSum(in.scores, b->bandwidth) * root_c.asDiagonal();
+    meat.diagonal() += in.prior_information;
+    data = b->formal * meat * b->formal;
+  }
+  b->effective_samples = b->samples / b->tau;
+  b->statistical = StatisticalCovariance(b->formal, data, b->misfit_factor);
+
+  const int q = static_cast<int>(in.consider_sigma.size());
+  const int groups = static_cast<int>(in.consider_groups.size());
+  b->systematic = Eigen::MatrixXd::Zero(n, n);
+  std::vector<Eigen::MatrixXd> by_group(groups, Eigen::MatrixXd::Zero(n, n));
+  if (q > 0) {
+    b->sensitivity = -b->formal * in.consider_cross;
+    for (int j = 0; j < q; ++j) {
+      const Eigen::VectorXd s = b->sensitivity.col(j);
+      const Eigen::MatrixXd part = in.consider_sigma[j] * in.consider_sigma[j] * s * s.transpose();
+      b->systematic += part;
+      by_group[in.consider_group[j]] += part;
+    }
+  }
+  b->total = b->statistical + b->systematic;
+  for (int k = 0; k < n; ++k) {
+    ParameterBudget p;
+    p.formal = SqrtNonNegative(b->formal(k, k));
+    p.statistical = SqrtNonNegative(b->statistical(k, k));
+    p.widening = p.formal > 0.0 ? p.statistical / p.formal : 1.0;
+    p.tau = tau[k];
+    p.systematic = SqrtNonNegative(b->systematic(k, k));
+    p.total = SqrtNonNegative(b->total(k, k));
+    for (int g = 0; g < groups; ++g)
+      p.systematic_by_group.push_back(SqrtNonNegative(by_group[g](k, k)));
+    b->parameters.push_back(p);
+  }
+  b->ok = true;
+  return true;
+}
+
+Eigen::VectorXd ScoreTestDecrease(const Eigen::MatrixXd& information, const Eigen::MatrixXd& cross,
+                                  const Eigen::VectorXd& self, const Eigen::VectorXd& gradient) {
+  const int q = static_cast<int>(self.size());
+  Eigen::VectorXd decrease = Eigen::VectorXd::Constant(q, std::numeric_limits<double>::quiet_NaN());
+  Eigen::MatrixXd inverse;
+  if (information.rows() > 0 && !InverseOfPositiveDefinite(information, &inverse)) return decrease;
+  for (int j = 0; j < q; ++j) {
+    double a = self[j];
+    if (information.rows() > 0) a -= cross.col(j).dot(inverse * cross.col(j));
+    if (!(self[j] > 0.0) || !(a > kScoreSpanTolerance * self[j])) continue;
+    decrease[j] = gradient[j] * gradient[j] / a;
+  }
+  return decrease;
+}
+
+}  // namespace fastcal
