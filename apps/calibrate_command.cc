@@ -236,24 +236,155 @@ std::string CommandLine(int argc, char** argv) {
   return s;
 }
 
-// A warning line when the reduced chi-square is outside the band of a correct noise
-// model (the report's verdict says the same); "" inside it.
-std::string ChiSquareWarning(const CalibrationResult& result, const ChiSquareBand& band) {
-  if (band.within || band.degrees_of_freedom <= 0) return "";
-  const double chi = result.reduced_chi_square;
-  char buf[400];
+// The verdict as a last stderr line when it is not plain ok: a failed fit is a
+// warning ("do not use"), a misfit scaled into the sigmas a note; "" when ok.
+std::string ChiSquareWarning(const CalibrationResult& result) {
+  switch (result.verdict) {
+    case FitVerdict::kOk:
+      return "";
+    case FitVerdict::kFailed:
+      return "fastcal calibrate: warning: the fit failed: " + result.verdict_text +
+             " (report.md, Verdict)\n";
+    case FitVerdict::kMisfit:
+      return "fastcal calibrate: note: misfit scaled into sigma_total: " + result.verdict_text +
+             " (report.md, Verdict)\n";
+    case FitVerdict::kNoiseOverstated:
+      return "fastcal calibrate: note: noise overstated: " + result.verdict_text + "\n";
+  }
+  return "";
+}
+
+// "1.23 mm", "0.031 kg/m": a sigma in the parameter's unit, 2 significant digits, with
+// lengths shown in mm below 1 m.
+std::string SigmaText(double sigma, const std::string& unit) {
+  if (unit == "m" && std::abs(sigma) < 1.0) return FormatDouble(sigma * 1e3, 2) + " mm";
+  return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
+}
+
+// The estimates: value +- sigma_total first, then its parts.
+std::string EstimatesTable(const CalibrationResult& result) {
+  std::ostringstream s;
+  char buf[260];
+  std::snprintf(buf, sizeof(buf), "  %-28s %6s %14s %14s %11s %11s %8s %11s  %s\n", "parameter",
+                "unit", "initial", "estimate", "sigma_total", "formal", "widening", "systematic",
+                "note");
+  s << buf;
+  for (const ParameterEstimate& p : result.parameters) {
+    // Short flags here; the full notes are in the report.
+    std::string flags;
+    if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
+    if (p.note.find("not determined by the data alone") != std::string::npos) {
+      flags += "data cannot determine ";
+    } else if (p.note.find("poorly determined") != std::string::npos) {
+      flags += "weak in data ";
+    }
+    if (p.consider) flags += "consider (fixed, prior sigma) ";
+    const std::string total = p.free || p.consider ? FormatDouble(p.sigma_total, 3) : "fixed";
+    std::snprintf(buf, sizeof(buf), "  %-28.28s %6s %14.6g %14.6g %11s %11s %8s %11s  %s\n",
+                  p.name.c_str(), p.unit.c_str(), p.initial, p.estimate, total.c_str(),
+                  p.free ? FormatDouble(p.sigma, 3).c_str() : "",
+                  p.free ? ("x" + FormatDouble(p.widening, 3)).c_str() : "",
+                  p.free ? FormatDouble(p.sigma_systematic, 3).c_str() : "", flags.c_str());
+    s << buf;
+  }
+  return s.str();
+}
+
+// What each consider group adds to each estimate ("sensor_gain: 9 mm on mass_centre_m.x").
+std::string ConsiderLines(const CalibrationResult& result) {
+  std::ostringstream s;
+  const std::vector<std::string>& groups = result.budget.consider_groups;
+  for (size_t g = 0; g < groups.size(); ++g) {
+    std::string line;
+    for (const ParameterEstimate& p : result.parameters) {
+      if (!p.free || g >= p.systematic_by_group.size()) continue;
+      line += (line.empty() ? "" : ", ") + SigmaText(p.systematic_by_group[g], p.unit) + " on " +
+              p.name;
+    }
+    s << "  systematic, from " << groups[g] << ": " << line << "\n";
+  }
+  return s.str();
+}
+
+std::string GrossErrorLines(const CalibrationResult& result) {
+  const GrossErrorSummary& g = result.gross_error_summary;
+  if (!g.enabled) return "  gross errors: not screened (gross_errors.detect: false)\n";
+  std::ostringstream s;
+  const size_t count = result.gross_errors.size();
+  s << "  gross errors (more than " << FormatDouble(g.threshold_sigmas, 3)
+    << " robust sigmas from the model): " << count << (count == 1 ? " reading" : " readings")
+    << ", kept out of the fit\n";
+  constexpr size_t kShown = 10;
+  for (size_t k = 0; k < std::min(count, kShown); ++k) {
+    const ReadingResidual& e = result.gross_errors[k];
+    char buf[200];
+    std::snprintf(buf, sizeof(buf),
+                  "    line %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
+                  e.line, e.cable, e.measured_n / kNPerKn, e.predicted_n / kNPerKn,
+                  e.residual_sigma, e.held_out ? " (held out)" : "");
+    s << buf;
+  }
+  if (count > kShown) s << "    ... " << count - kShown << " more in summary.json (outliers)\n";
+  return s.str();
+}
+
+std::string MisfitLine(const CalibrationResult& result) {
+  constexpr size_t kShown = 5;
+  if (result.misfit_ranking.empty()) return "";
+  std::string line = "  the misfit is best explained by freeing:";
+  for (size_t k = 0; k < std::min(kShown, result.misfit_ranking.size()); ++k) {
+    const MisfitCandidate& c = result.misfit_ranking[k];
+    line += std::string(k ? ", " : " ") + c.name + " (chi-square -" +
+            FormatDouble(c.expected_decrease, 3) + ")";
+  }
+  return line + "\n";
+}
+
+std::string CrossValidationLine(const CalibrationResult& result) {
+  const CrossValidation& cv = result.cross_validation;
+  if (cv.folds_used == 0) return "";
+  std::ostringstream s;
+  char buf[200];
+  std::snprintf(
+      buf, sizeof(buf), "  %-46.46s",
+      ("calibrated, block cross-validation (" + std::to_string(cv.folds_used) + " blocks)")
+          .c_str());
+  s << buf;
+  for (double r : cv.rms_n) {
+    std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
+    s << buf;
+  }
+  return s.str() + "\n";
+}
+
+std::string CalibrationConsole(const CalibrationResult& result, const Dataset& data,
+                               const std::vector<VariantEvaluation>& variants) {
+  std::ostringstream s;
+  s << "\n" << result.ceres_brief_report << "\n";
+  char buf[300];
+  const ChiSquareBand band = ReducedChiSquareBand(result);
   std::snprintf(buf, sizeof(buf),
-                "fastcal calibrate: warning: %s: reduced chi-square %.3g is outside 1 +- %.3g "
-                "(%g sigma, %d degrees of freedom): %s\n",
-                !(chi < 1.0) ? "poor fit" : "noise overstated", chi, band.half_width,
-                kChiSquareBandSigmas, band.degrees_of_freedom,
-                !std::isfinite(chi) ? "not a number; do not use the estimates"
-                : chi > 1.0
-                    ? "the residuals are larger than the spec's noise; do not use the estimates "
-                      "and sigmas as they are (report.md, Verdict)"
-                    : "the residuals are smaller than the spec's noise; the sigmas are "
-                      "pessimistic (report.md, Verdict)");
-  return buf;
+                "reduced chi-square %.3f (expected 1 +- %.3g) over %d residuals; %d samples "
+                "fitted, %d held out; %.2f s\n",
+                result.reduced_chi_square, band.half_width, result.num_residuals,
+                result.num_fit_samples,
+                static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
+  s << buf << "verdict: " << FitVerdictName(result.verdict) << ": " << result.verdict_text << "\n\n"
+    << EstimatesTable(result) << ConsiderLines(result);
+  for (const std::string& note : result.notes) s << "  " << note << "\n";
+  for (const ParameterDirection& d : result.data_only.undetermined) {
+    s << "  the data alone cannot determine (a prior holds it): " << d.Describe() << "\n";
+  }
+  for (const ParameterDirection& d : result.data_only.poorly_determined) {
+    s << "  weak direction in the data alone: " << d.Describe() << "\n";
+  }
+  for (const std::string& c : result.strong_correlations) {
+    s << "  strongly correlated: " << c << "\n";
+  }
+  s << GrossErrorLines(result) << MisfitLine(result) << "\n"
+    << RmsTable(variants) << CrossValidationLine(result) << "\nwrote " << FLAGS_out
+    << "/{model_calibrated.yaml, report.html, report.md, summary.json, residuals.csv}\n";
+  return s.str();
 }
 
 // Writes `files` and the report files into --out as one directory (built as a hidden
@@ -346,7 +477,7 @@ int RunCalibrate(int argc, char** argv) {
   for (const Variant& v : list) {
     VariantEvaluation e;
     if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact, result.held_out,
-                         &e, &error)) {
+                         &e, &error, result.excluded)) {
       PrintError(command, v.name + ": " + error);
       return kExitFailure;
     }
@@ -377,46 +508,7 @@ int RunCalibrate(int argc, char** argv) {
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out)}};
   if (!WriteOutDirectory(command, files, report)) return kExitUsage;
 
-  std::ostringstream s;
-  s << "\n" << result.ceres_brief_report << "\n";
-  char buf[200];
-  const ChiSquareBand band = ReducedChiSquareBand(result);
-  std::snprintf(buf, sizeof(buf),
-                "reduced chi-square %.3f (expected 1 +- %.3g) over %d residuals; %d samples "
-                "fitted, %d held out; %.2f s\n",
-                result.reduced_chi_square, band.half_width, result.num_residuals,
-                result.num_fit_samples,
-                static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
-  s << buf << "\n";
-  std::snprintf(buf, sizeof(buf), "  %-28s %6s %14s %14s %12s  %s\n", "parameter", "unit",
-                "initial", "estimate", "sigma", "note");
-  s << buf;
-  for (const ParameterEstimate& p : result.parameters) {
-    // Short flags here; the full notes are in the report.
-    std::string flags;
-    if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
-    if (p.note.find("not determined by the data alone") != std::string::npos) {
-      flags += "data cannot determine ";
-    } else if (p.note.find("poorly determined") != std::string::npos) {
-      flags += "weak in data ";
-    }
-    std::snprintf(buf, sizeof(buf), "  %-28.28s %6s %14.6g %14.6g %12s  %s\n", p.name.c_str(),
-                  p.unit.c_str(), p.initial, p.estimate,
-                  p.free ? FormatDouble(p.sigma, 3).c_str() : "fixed", flags.c_str());
-    s << buf;
-  }
-  for (const ParameterDirection& d : result.data_only.undetermined) {
-    s << "  the data alone cannot determine (a prior holds it): " << d.Describe() << "\n";
-  }
-  for (const ParameterDirection& d : result.data_only.poorly_determined) {
-    s << "  weak direction in the data alone: " << d.Describe() << "\n";
-  }
-  for (const std::string& c : result.strong_correlations)
-    s << "  strongly correlated: " << c << "\n";
-  s << "\n"
-    << RmsTable(variants) << "\nwrote " << FLAGS_out
-    << "/{model_calibrated.yaml, report.html, report.md, summary.json, residuals.csv}\n";
-  std::cerr << s.str() << ChiSquareWarning(result, band);
+  std::cerr << CalibrationConsole(result, data, variants) << ChiSquareWarning(result);
   return 0;
 }
 

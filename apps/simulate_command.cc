@@ -61,6 +61,14 @@ DEFINE_double(density_mismatch_pct, 0.0, "simulate: per-cable density factor sig
 DEFINE_string(sensor_gain, "", "simulate: sensor gains g1,...,g6 or one for all.");
 DEFINE_string(sensor_bias_kn, "", "simulate: sensor biases b1,...,b6 or one for all (kN).");
 DEFINE_double(interval_s, 1.0, "simulate: time between samples (s).");
+DEFINE_double(attitude_control_time_s, 0.0,
+              "simulate: correlation time of the attitude control error (s); 0 = white.");
+DEFINE_double(tension_drift_pct, 0.0, "simulate: slow tension error sigma per cable (%).");
+DEFINE_double(tension_drift_time_s, 0.0, "simulate: its correlation time (s).");
+DEFINE_double(mass_centre_drift_m, 0.0, "simulate: mass-centre drift sigma per axis (m).");
+DEFINE_double(mass_centre_drift_time_s, 0.0, "simulate: its correlation time (s).");
+DEFINE_double(sensor_gain_spread_pct, 0.0, "simulate: per-cable gain spread drawn once (%).");
+DEFINE_double(sensor_bias_spread_kn, 0.0, "simulate: per-cable bias spread drawn once (kN).");
 
 namespace fastcal::cli {
 namespace {
@@ -84,14 +92,21 @@ the truth model actually used beside it as FILE.truth.yaml (FILE.csv minus ".csv
 are written to temporary files and renamed into place: on any failure neither is left.
 An existing FILE.csv or FILE.truth.yaml is refused (exit 2) unless --force.
 
-Per planned pose (position p, planned attitude a_plan as roll,pitch,yaw):
-  actual attitude     a_act  = a_plan + N(0, attitude-control-deg)    per angle
+Per planned pose n at time t = n * interval-s (position p, planned attitude a_plan as
+roll,pitch,yaw):
+  actual attitude     a_act  = a_plan + c(t), c per angle AR(1): sigma
+                      attitude-control-deg, correlation time attitude-control-time-s
   actual position     p (held exactly)
+  mass centre         the truth model's + d(t), d per axis AR(1): sigma
+                      mass-centre-drift-m, correlation time mass-centre-drift-time-s
   truth tensions      T_i, s0_i from the truth model's statics at (p, a_act), --method
   sensor reading      y_i = gain_i T_i + bias_i
-  measured tension    y_i (1 + N(0, tension-noise-pct/100)) + N(0, tension-noise-kn)
-                      or, with probability outlier-fraction, y_i (1 + U(-s, s)/100),
-                      s = outlier-scale-pct
+  measured tension    y_i (1 + N(0, tension-noise-pct/100) + u_i(t)) + N(0, tension-noise-kn),
+                      u_i per cable AR(1): sigma tension-drift-pct/100, correlation time
+                      tension-drift-time-s (a slow sensor error); or, with probability
+                      outlier-fraction, y_i (1 + U(-s, s)/100), s = outlier-scale-pct
+An AR(1) process with correlation time tau steps by phi = exp(-interval / tau) and starts
+stationary; tau = 0 draws it afresh every sample (white).
   measured attitude   a_act + N(0, attitude-noise-deg)                per angle
   measured position   p + N(0, position-noise-m)                      per axis
 The CSV has time_s = n * interval-s, the measured pose (x_m,y_m,z_m,roll_deg,pitch_deg,
@@ -106,6 +121,9 @@ Truth model:
   --density-mismatch-pct=0     multiply each cable's linear density by 1 + N(0, pct/100),
                                drawn once (non-uniform cables); the result is the truth
                                model written to FILE.truth.yaml
+  --sensor-gain-spread-pct=0   multiply each cable's sensor gain by 1 + N(0, pct/100),
+                               drawn once (written to FILE.truth.yaml)
+  --sensor-bias-spread-kn=0    add N(0, kN) to each cable's sensor bias, drawn once
   --method=exact           statics of the truth tensions: exact (default), aas-refined, aas
 
 Trajectory (--trajectory=, default circle):
@@ -129,6 +147,11 @@ never silently ignored; so is a flag given twice.
 Errors (all zero-mean Gaussian unless stated; one --seed=1 drives them all, each error
 source with its own generator, so changing one sigma leaves the others' numbers alone):
   --attitude-control-deg=0   actual minus planned attitude, per angle (deg)
+  --attitude-control-time-s=0  its correlation time (s); 0 = white
+  --mass-centre-drift-m=0    drift of the mass centre about the truth model's, per axis (m)
+  --mass-centre-drift-time-s=0 its correlation time (s)
+  --tension-drift-pct=0      slow relative tension error per cable (%)
+  --tension-drift-time-s=0   its correlation time (s)
   --attitude-noise-deg=0     measured minus actual attitude, per angle (deg)
   --position-noise-m=0       measured minus actual position, per axis (m)
   --tension-noise-pct=3      relative tension noise (%, the paper's sensors: ~3%)
@@ -154,6 +177,14 @@ Examples (the bundled datasets):
     --attitude-control-deg=0.2 --attitude-noise-deg=0.02 --position-noise-m=0.01 \
     --tension-noise-pct=3 --seed=2 --force \
     --out=calibration_data/workspace_multi_zenith.csv
+  # realistic telemetry: rings over the cap, smooth control error, slow tension error,
+  # drifting mass centre, per-cable densities, gains and biases (calibration_data/README.md)
+  fastcal simulate --trajectory=grid --max-off-axis-deg=40 --off-axis-step-deg=5 \
+    --azimuth-step-deg=1 --mass-centre=0.22,0.11,0.5 --attitude-control-deg=0.2 \
+    --attitude-control-time-s=60 --attitude-noise-deg=0.02 --position-noise-m=0.01 \
+    --tension-noise-pct=3 --tension-drift-pct=2 --tension-drift-time-s=120 \
+    --mass-centre-drift-m=0.02 --mass-centre-drift-time-s=1800 --density-mismatch-pct=1.5 \
+    --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=2 --seed=5 --out=realistic.csv
   # sensor gain errors and 2% outliers on a straight line
   fastcal simulate --trajectory=line --sensor-gain=1.02,0.98,1,1,1.01,0.99 \
     --outlier-fraction=0.02 --out=line.csv
@@ -167,7 +198,9 @@ const std::set<std::string> kFlags = {
     "radial-spread", "poses", "attitude-law", "tilt-fraction", "focal-centre",
     "attitude-control-deg", "attitude-noise-deg", "position-noise-m", "tension-noise-pct",
     "tension-noise-kn", "outlier-fraction", "outlier-scale-pct", "seed", "interval-s", "out",
-    "force"};
+    "force", "attitude-control-time-s", "tension-drift-pct", "tension-drift-time-s",
+    "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-pct",
+    "sensor-bias-spread-kn"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -234,6 +267,13 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->outlier_fraction = FLAGS_outlier_fraction;
   options->outlier_scale_percent = FLAGS_outlier_scale_pct;
   options->density_mismatch_percent = FLAGS_density_mismatch_pct;
+  options->attitude_control_time_s = FLAGS_attitude_control_time_s;
+  options->tension_drift_percent = FLAGS_tension_drift_pct;
+  options->tension_drift_time_s = FLAGS_tension_drift_time_s;
+  options->mass_centre_drift_m = FLAGS_mass_centre_drift_m;
+  options->mass_centre_drift_time_s = FLAGS_mass_centre_drift_time_s;
+  options->sensor_gain_spread_percent = FLAGS_sensor_gain_spread_pct;
+  options->sensor_bias_spread_kn = FLAGS_sensor_bias_spread_kn;
   options->seed = FLAGS_seed;
   options->sample_interval_s = FLAGS_interval_s;
   options->method = StaticsMethod::kExact;
@@ -251,6 +291,13 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
                                  {"outlier_fraction", "--outlier-fraction"},
                                  {"outlier_scale_percent", "--outlier-scale-pct"},
                                  {"density_mismatch_percent", "--density-mismatch-pct"},
+                                 {"attitude_control_time_s", "--attitude-control-time-s"},
+                                 {"tension_drift_percent", "--tension-drift-pct"},
+                                 {"tension_drift_time_s", "--tension-drift-time-s"},
+                                 {"mass_centre_drift_m", "--mass-centre-drift-m"},
+                                 {"mass_centre_drift_time_s", "--mass-centre-drift-time-s"},
+                                 {"sensor_gain_spread_percent", "--sensor-gain-spread-pct"},
+                                 {"sensor_bias_spread_kn", "--sensor-bias-spread-kn"},
                                  {"sample_interval_s", "--interval-s"}});
     return false;
   }
@@ -419,6 +466,16 @@ std::string Summary(const SimulationSummary& s, const SimulationOptions& options
   if (options.density_mismatch_percent > 0.0) {
     out << "\n  density factors:";
     for (double f : s.density_factor) out << " " << FormatDouble(f, 6);
+  }
+  if (options.tension_drift_percent > 0.0) {
+    out << "\n  slow tension error RMS per cable (%):";
+    for (double v : s.tension_drift_rms_relative) out << " " << FormatDouble(100.0 * v, 4);
+  }
+  if (options.mass_centre_drift_m > 0.0) {
+    out << "\n  mass centre drift RMS " << FormatDouble(s.mass_centre_drift_rms_m, 4)
+        << " m per axis; average actual mass centre (" << FormatDouble(s.mass_centre_mean_m.x(), 6)
+        << ", " << FormatDouble(s.mass_centre_mean_m.y(), 6) << ", "
+        << FormatDouble(s.mass_centre_mean_m.z(), 6) << ") m";
   }
   if (s.redrawn > 0) out << "\n  " << s.redrawn << " noise draws redrawn (reading <= 0)";
   return out.str();

@@ -478,8 +478,9 @@ TEST_F(CliTest, CalibratePoorFitWarns) {
       "/calibration_data/spec_mass_centre.yaml --data=" + Path("example.csv") + " --out=" + out);
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(std::regex_search(
-      r.output, std::regex("fastcal calibrate: warning: poor fit: reduced chi-square [0-9.]+ is "
-                           "outside 1 \\+- 1.34 \\(3 sigma, 10 degrees of freedom\\)")))
+      r.output, std::regex("fastcal calibrate: note: misfit scaled into sigma_total: reduced "
+                           "chi-square [0-9.]+ is above 1 \\+ 1.34: the residuals are [0-9.]+ "
+                           "times the stated noise")))
       << r.output;
   EXPECT_NE(ReadFile(out + "/report.md").find("## Verdict\n\n**Poor fit:"), std::string::npos);
   EXPECT_NE(ReadFile(out + "/summary.json").find("\"reduced_chi_square_within_band\": false"),

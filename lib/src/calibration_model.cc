@@ -128,11 +128,11 @@ CableRobot CalibrationModel::ToRobot(const double* theta) const {
   return out;
 }
 
-std::array<double, kNumCables> TensionSigmas(const std::array<double, kNumCables>& measured_n,
+std::array<double, kNumCables> TensionSigmas(const std::array<double, kNumCables>& reading_n,
                                              double sigma_abs_n, double sigma_percent) {
   std::array<double, kNumCables> s;
   for (int i = 0; i < kNumCables; ++i) {
-    const double rel = sigma_percent / 100.0 * measured_n[i];
+    const double rel = sigma_percent / 100.0 * reading_n[i];
     s[i] = std::sqrt(sigma_abs_n * sigma_abs_n + rel * rel);
   }
   return s;

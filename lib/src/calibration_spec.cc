@@ -137,6 +137,12 @@ std::string CheckHoldoutFraction(double fraction) {
 
 std::string CheckAtLeastOne(int value) { return value >= 1 ? "" : "must be >= 1"; }
 
+std::string CheckAtLeastTwo(int value) { return value >= 2 ? "" : "must be >= 2"; }
+
+std::string CheckFraction(double fraction) {
+  return std::isfinite(fraction) && fraction > 0.0 && fraction <= 1.0 ? "" : "must be in (0, 1]";
+}
+
 bool IsKnownMethod(StaticsMethod method) {
   StaticsMethod parsed;
   return ParseStaticsMethod(StaticsMethodName(method), &parsed) && parsed == method;
@@ -256,8 +262,8 @@ class Reader {
   bool ReadRoot(const YAML::Node& root, CalibrationSpec* spec) {
     KeyMap keys;
     if (!ReadMap(root, LineOf(root), kRootPath,
-                 {"format", "forward_model", "noise", "robust_loss", "holdout", "attitude",
-                  "solver", "parameters"},
+                 {"format", "forward_model", "noise", "robust_loss", "gross_errors", "holdout",
+                  "cross_validation", "attitude", "solver", "parameters"},
                  &keys)) {
       return false;
     }
@@ -289,7 +295,15 @@ class Reader {
         kv != nullptr && !ReadRobustLoss(*kv, spec)) {
       return false;
     }
+    if (const KeyValue* kv = Find(keys, "gross_errors");
+        kv != nullptr && !ReadGrossErrors(*kv, spec)) {
+      return false;
+    }
     if (const KeyValue* kv = Find(keys, "holdout"); kv != nullptr && !ReadHoldout(*kv, spec)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "cross_validation");
+        kv != nullptr && !ReadCrossValidation(*kv, spec)) {
       return false;
     }
     if (const KeyValue* kv = Find(keys, "solver"); kv != nullptr && !ReadSolver(*kv, spec)) {
@@ -468,9 +482,54 @@ class Reader {
     return true;
   }
 
+  bool ReadGrossErrors(const KeyValue& gross, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(gross, "gross_errors", {"detect", "threshold_sigmas", "max_fraction"}, &keys)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "detect")) {
+      if (!ReadBool(*kv, "gross_errors.detect", &spec->detect_gross_errors)) return false;
+    }
+    if (const KeyValue* kv = Find(keys, "threshold_sigmas")) {
+      const std::string path = "gross_errors.threshold_sigmas";
+      if (!ReadDouble(*kv, path, &spec->gross_error_threshold_sigmas) ||
+          !Check(CheckPositive(spec->gross_error_threshold_sigmas), kv->line, path)) {
+        return false;
+      }
+    }
+    if (const KeyValue* kv = Find(keys, "max_fraction")) {
+      const std::string path = "gross_errors.max_fraction";
+      if (!ReadDouble(*kv, path, &spec->max_gross_error_fraction) ||
+          !Check(CheckFraction(spec->max_gross_error_fraction), kv->line, path)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  bool ReadCrossValidation(const KeyValue& cv, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(cv, "cross_validation", {"blocks"}, &keys)) return false;
+    if (const KeyValue* kv = Find(keys, "blocks")) {
+      const std::string path = "cross_validation.blocks";
+      if (!ReadInteger(*kv, path, &spec->cross_validation_blocks) ||
+          !Check(CheckAtLeastTwo(spec->cross_validation_blocks), kv->line, path)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
   bool ReadHoldout(const KeyValue& holdout, CalibrationSpec* spec) {
     KeyMap keys;
-    if (!ReadMap(holdout, "holdout", {"fraction", "seed"}, &keys)) return false;
+    if (!ReadMap(holdout, "holdout", {"fraction", "seed", "blocks"}, &keys)) return false;
+    if (const KeyValue* kv = Find(keys, "blocks")) {
+      const std::string path = "holdout.blocks";
+      if (!ReadInteger(*kv, path, &spec->holdout_blocks) ||
+          !Check(CheckAtLeastTwo(spec->holdout_blocks), kv->line, path)) {
+        return false;
+      }
+    }
     if (const KeyValue* kv = Find(keys, "fraction")) {
       const std::string path = "holdout.fraction";
       if (!ReadDouble(*kv, path, &spec->holdout_fraction) ||
@@ -761,6 +820,18 @@ bool CalibrationSpec::IsValid(std::string* error) const {
   if (const std::string w = CheckHoldoutFraction(holdout_fraction); !w.empty()) {
     return fail("holdout_fraction: " + w);
   }
+  if (const std::string w = CheckAtLeastTwo(holdout_blocks); !w.empty()) {
+    return fail("holdout_blocks: " + w);
+  }
+  if (const std::string w = CheckAtLeastTwo(cross_validation_blocks); !w.empty()) {
+    return fail("cross_validation_blocks: " + w);
+  }
+  if (const std::string w = CheckPositive(gross_error_threshold_sigmas); !w.empty()) {
+    return fail("gross_error_threshold_sigmas: " + w);
+  }
+  if (const std::string w = CheckFraction(max_gross_error_fraction); !w.empty()) {
+    return fail("max_gross_error_fraction: " + w);
+  }
   if (const std::string w = CheckAtLeastOne(max_iterations); !w.empty()) {
     return fail("max_iterations: " + w);
   }
@@ -873,8 +944,12 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
   const char* loss = RobustLossName(spec.robust_loss);
   out << "robust_loss: {type: " << (loss != nullptr ? loss : "unknown")
       << ", scale: " << Num(spec.robust_loss_scale) << "}\n";
+  out << "gross_errors: {detect: " << (spec.detect_gross_errors ? "true" : "false")
+      << ", threshold_sigmas: " << Num(spec.gross_error_threshold_sigmas)
+      << ", max_fraction: " << Num(spec.max_gross_error_fraction) << "}\n";
   out << "holdout: {fraction: " << Num(spec.holdout_fraction) << ", seed: " << spec.holdout_seed
-      << "}\n";
+      << ", blocks: " << spec.holdout_blocks << "}\n";
+  out << "cross_validation: {blocks: " << spec.cross_validation_blocks << "}\n";
   out << "attitude: " << (spec.use_planned_attitude ? "planned" : "measured") << "\n";
   out << "solver: {max_iterations: " << spec.max_iterations
       << ", function_tolerance: " << Num(spec.function_tolerance)
@@ -930,6 +1005,46 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
     }
   }
   return out.str();
+}
+
+std::vector<ParameterSpec> AllModelParameters(int num_anchor_points) {
+  std::vector<ParameterSpec> all;
+  const EntryText fixed;
+  for (const GroupInfo& g : kGroups) {
+    if (g.kind == ParameterKind::kMassCentre) {
+      for (int c = 0; c < 3; ++c) all.push_back(MakeParameter(g, -1, c, fixed));
+    } else if (g.kind == ParameterKind::kCabinMass) {
+      all.push_back(MakeParameter(g, -1, -1, fixed));
+    } else if (IsPerCableCapable(g.kind)) {
+      for (int i = -1; i < kNumCables; ++i) all.push_back(MakeParameter(g, i, -1, fixed));
+    } else {
+      const int count = g.kind == ParameterKind::kAnchorOffset ? num_anchor_points : kNumCables;
+      for (int j = 0; j < count; ++j) {
+        for (int c = 0; c < 3; ++c) all.push_back(MakeParameter(g, j, c, fixed));
+      }
+    }
+  }
+  return all;
+}
+
+bool SameParameter(const ParameterSpec& a, const ParameterSpec& b) {
+  if (a.kind != b.kind) return false;
+  switch (a.kind) {
+    case ParameterKind::kMassCentre:
+      return a.component == b.component;
+    case ParameterKind::kCabinMass:
+      return true;
+    case ParameterKind::kAnchorOffset:
+    case ParameterKind::kTowerOffset:
+      return a.index == b.index && a.component == b.component;
+    default:
+      return a.index == b.index;
+  }
+}
+
+const char* ParameterGroupName(ParameterKind kind) {
+  const GroupInfo* g = InfoOf(kind);
+  return g != nullptr ? g->key : "unknown";
 }
 
 const char* RobustLossName(RobustLoss loss) {

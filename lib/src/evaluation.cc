@@ -86,7 +86,8 @@ int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name
 
 CableErrorStats ErrorStats(const Dataset& data,
                            const std::vector<std::array<double, kNumCables>>& predicted,
-                           const std::vector<bool>& held_out, bool select_held_out) {
+                           const std::vector<bool>& held_out, bool select_held_out,
+                           const ReadingMask& excluded) {
   CableErrorStats st;
   std::array<double, kNumCables> sum{}, sum2{}, sum2_pct{};
   for (size_t n = 0; n < data.samples.size(); ++n) {
@@ -94,6 +95,10 @@ CableErrorStats ErrorStats(const Dataset& data,
     if (h != select_held_out) continue;
     ++st.samples;
     for (int i = 0; i < kNumCables; ++i) {
+      if (!excluded.empty() && excluded[n][i]) {
+        ++st.excluded[i];
+        continue;
+      }
       const double measured = data.samples[n].tension_n[i];
       const double d = predicted[n][i] - measured;
       const double pct = 100.0 * d / measured;
@@ -104,12 +109,12 @@ CableErrorStats ErrorStats(const Dataset& data,
       st.max_abs_percent[i] = std::max(st.max_abs_percent[i], std::abs(pct));
     }
   }
-  if (st.samples > 0) {
-    for (int i = 0; i < kNumCables; ++i) {
-      st.mean_n[i] = sum[i] / st.samples;
-      st.rms_n[i] = std::sqrt(sum2[i] / st.samples);
-      st.rms_percent[i] = std::sqrt(sum2_pct[i] / st.samples);
-    }
+  for (int i = 0; i < kNumCables; ++i) {
+    const int readings = st.samples - st.excluded[i];
+    if (readings == 0) continue;
+    st.mean_n[i] = sum[i] / readings;
+    st.rms_n[i] = std::sqrt(sum2[i] / readings);
+    st.rms_percent[i] = std::sqrt(sum2_pct[i] / readings);
   }
   return st;
 }
@@ -117,29 +122,40 @@ CableErrorStats ErrorStats(const Dataset& data,
 bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dataset& data,
                      AttitudeSource attitude, StaticsMethod method,
                      const std::vector<bool>& held_out, VariantEvaluation* evaluation,
-                     std::string* error) {
+                     std::string* error, const ReadingMask& excluded) {
   evaluation->name = name;
   if (!PredictTensions(robot, data, attitude, method, &evaluation->predicted_n, error)) {
     return false;
   }
-  evaluation->fit = ErrorStats(data, evaluation->predicted_n, held_out, false);
-  evaluation->holdout = ErrorStats(data, evaluation->predicted_n, held_out, true);
+  evaluation->fit = ErrorStats(data, evaluation->predicted_n, held_out, false, excluded);
+  evaluation->holdout = ErrorStats(data, evaluation->predicted_n, held_out, true, excluded);
   return true;
 }
 
-std::vector<bool> HoldoutMask(int num_samples, double fraction, std::uint64_t seed) {
+int BlockOfSample(int sample, int num_samples, int blocks) {
+  if (num_samples <= 0 || blocks <= 1) return 0;
+  // The largest b whose start floor(b n / blocks) is <= sample.
+  return static_cast<int>(((static_cast<long long>(sample) + 1) * blocks - 1) / num_samples);
+}
+
+std::vector<bool> HoldoutMask(int num_samples, double fraction, std::uint64_t seed, int blocks) {
   std::vector<bool> mask(std::max(num_samples, 0), false);
-  const int held = static_cast<int>(std::lround(fraction * num_samples));
-  if (held <= 0) return mask;
-  std::vector<int> order(num_samples);
+  blocks = std::clamp(blocks, 1, std::max(num_samples, 1));
+  int held = static_cast<int>(std::lround(fraction * blocks));
+  if (fraction > 0.0) held = std::max(held, 1);
+  held = std::min(held, blocks - 1);  // something must be left to fit
+  if (held <= 0 || num_samples <= 0) return mask;
+  std::vector<int> order(blocks);
   std::iota(order.begin(), order.end(), 0);
   std::mt19937_64 rng(seed);
   // Fisher-Yates with the raw generator (std::shuffle's use of it is unspecified).
-  for (int i = num_samples - 1; i > 0; --i) {
+  for (int i = blocks - 1; i > 0; --i) {
     const int j = static_cast<int>(rng() % static_cast<std::uint64_t>(i + 1));
     std::swap(order[i], order[j]);
   }
-  for (int k = 0; k < held; ++k) mask[order[k]] = true;
+  std::vector<bool> held_block(blocks, false);
+  for (int k = 0; k < held; ++k) held_block[order[k]] = true;
+  for (int t = 0; t < num_samples; ++t) mask[t] = held_block[BlockOfSample(t, num_samples, blocks)];
   return mask;
 }
 

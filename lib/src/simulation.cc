@@ -23,6 +23,9 @@ enum Stream : std::uint64_t {
   kPositionStream,
   kTensionNoiseStream,
   kOutlierStream,
+  kTensionDriftStream,
+  kMassCentreDriftStream,
+  kSensorSpreadStream,
 };
 
 bool Fail(std::string* error, const std::string& message) {
@@ -80,7 +83,82 @@ class Random {
   double spare_ = 0.0;
 };
 
+// A stationary AR(1) process (simulation.h): x_0 = s N(0, 1), then
+// x_n = phi x_{n-1} + s sqrt(1 - phi^2) N(0, 1), phi = exp(-dt / tau), 0 for tau = 0.
+class Ar1 {
+ public:
+  Ar1(double sigma, double time_s, double dt)
+      : sigma_(sigma), phi_(time_s > 0.0 ? std::exp(-dt / time_s) : 0.0) {}
+  double Next(Random* rng) {
+    const double xi = rng->Normal();
+    x_ = first_ ? sigma_ * xi : phi_ * x_ + sigma_ * std::sqrt(1.0 - phi_ * phi_) * xi;
+    first_ = false;
+    return x_;
+  }
+
+ private:
+  double sigma_, phi_;
+  double x_ = 0.0;
+  bool first_ = true;
+};
+
+// Three independent AR(1) processes, drawn x, y, z in turn.
+class Ar1Vector {
+ public:
+  Ar1Vector(double sigma, double time_s, double dt)
+      : x_{Ar1(sigma, time_s, dt), Ar1(sigma, time_s, dt), Ar1(sigma, time_s, dt)} {}
+  Eigen::Vector3d Next(Random* rng) {
+    const double a = x_[0].Next(rng);
+    const double b = x_[1].Next(rng);
+    return Eigen::Vector3d(a, b, x_[2].Next(rng));
+  }
+
+ private:
+  std::array<Ar1, 3> x_;
+};
+
 bool NonNegativeFinite(double v) { return std::isfinite(v) && v >= 0.0; }
+
+// 1 + spread N(0, 1), redrawn while <= 0 (counted in *redrawn); false after kMaxRedraws.
+bool PositiveFactor(double spread, Random* rng, int* redrawn, double* factor) {
+  *factor = 0.0;
+  for (int attempt = 0; !(*factor > 0.0); ++attempt) {
+    if (attempt == kMaxRedraws) return false;
+    if (attempt > 0) ++*redrawn;
+    *factor = 1.0 + spread * rng->Normal();
+  }
+  return true;
+}
+
+// The truth model with what is drawn once: density mismatch, gain and bias spreads.
+bool DrawTruthModel(const SimulationOptions& options, CableRobot* model, SimulationSummary* stats,
+                    std::string* error) {
+  Random density_rng(options.seed, kDensityStream);
+  for (int i = 0; i < kNumCables; ++i) {
+    double factor = 0.0;
+    if (!PositiveFactor(options.density_mismatch_percent / 100.0, &density_rng, &stats->redrawn,
+                        &factor)) {
+      return Fail(error, "density_mismatch_percent " + Num(options.density_mismatch_percent) +
+                             " keeps giving a density <= 0 for cable " + std::to_string(i + 1));
+    }
+    stats->density_factor[i] = factor;
+    model->cables[i].linear_density_kg_per_m *= factor;
+  }
+  Random sensor_rng(options.seed, kSensorSpreadStream);
+  for (int i = 0; i < kNumCables; ++i) {
+    double factor = 0.0;
+    if (!PositiveFactor(options.sensor_gain_spread_percent / 100.0, &sensor_rng, &stats->redrawn,
+                        &factor)) {
+      return Fail(error, "sensor_gain_spread_percent " + Num(options.sensor_gain_spread_percent) +
+                             " keeps giving a gain <= 0 for cable " + std::to_string(i + 1));
+    }
+    model->cables[i].sensor_gain *= factor;
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    model->cables[i].sensor_bias_n += options.sensor_bias_spread_kn * kNPerKn * sensor_rng.Normal();
+  }
+  return true;
+}
 
 // Adding +0 turns -0 into +0 and changes nothing else: no "-0" angles in the CSV.
 Eigen::Vector3d NoNegativeZero(const Eigen::Vector3d& v) { return (v.array() + 0.0).matrix(); }
@@ -105,28 +183,26 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
   SimulationSummary stats;
   stats.samples = static_cast<int>(planned.size());
 
-  // The truth model with its density mismatch, drawn once.
+  // The truth model with what is drawn once.
   CableRobot model = truth;
-  Random density_rng(options.seed, kDensityStream);
-  for (int i = 0; i < kNumCables; ++i) {
-    double factor = 0.0;
-    for (int attempt = 0; !(factor > 0.0); ++attempt) {
-      if (attempt == kMaxRedraws) {
-        return Fail(error, "density_mismatch_percent " + Num(options.density_mismatch_percent) +
-                               " keeps giving a density <= 0 for cable " + std::to_string(i + 1));
-      }
-      if (attempt > 0) ++stats.redrawn;
-      factor = 1.0 + options.density_mismatch_percent / 100.0 * density_rng.Normal();
-    }
-    stats.density_factor[i] = factor;
-    model.cables[i].linear_density_kg_per_m *= factor;
-  }
+  if (!DrawTruthModel(options, &model, &stats, error)) return false;
+  const Eigen::Vector3d mass_centre_m = model.mass_centre_cabin_m;
 
   Random control_rng(options.seed, kAttitudeControlStream);
   Random attitude_rng(options.seed, kAttitudeMeasurementStream);
   Random position_rng(options.seed, kPositionStream);
   Random tension_rng(options.seed, kTensionNoiseStream);
   Random outlier_rng(options.seed, kOutlierStream);
+  Random drift_rng(options.seed, kTensionDriftStream);
+  Random mass_centre_rng(options.seed, kMassCentreDriftStream);
+  const double dt = options.sample_interval_s;
+  Ar1Vector control(options.attitude_control_sigma_deg, options.attitude_control_time_s, dt);
+  Ar1Vector mass_centre_drift(options.mass_centre_drift_m, options.mass_centre_drift_time_s, dt);
+  std::vector<Ar1> tension_drift(
+      kNumCables, Ar1(options.tension_drift_percent / 100.0, options.tension_drift_time_s, dt));
+  Eigen::Vector3d mass_centre_sum = Eigen::Vector3d::Zero();
+  double mass_centre_sq = 0.0;
+  std::array<double, kNumCables> drift_sq{};
 
   // Synthetic truth: converged per-cable solves, as a fit uses, plus s0.
   StaticsOptions statics = ModelFitStaticsOptions(options.method);
@@ -152,7 +228,11 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
     s.planned_rotation =
         RotationFromRpyDeg(s.planned_rpy_deg[0], s.planned_rpy_deg[1], s.planned_rpy_deg[2]);
 
-    const Eigen::Vector3d control_deg = options.attitude_control_sigma_deg * control_rng.Normal3();
+    const Eigen::Vector3d control_deg = control.Next(&control_rng);
+    const Eigen::Vector3d drift_m = mass_centre_drift.Next(&mass_centre_rng);
+    model.mass_centre_cabin_m = mass_centre_m + drift_m;
+    mass_centre_sum += model.mass_centre_cabin_m;
+    mass_centre_sq += drift_m.squaredNorm();
     const Eigen::Vector3d actual_rpy_deg = NoNegativeZero(s.planned_rpy_deg + control_deg);
     Pose actual;
     actual.position_m = planned[n].position_m;
@@ -188,6 +268,8 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
                                ": sensor reading gain * tension + bias = " +
                                Num(reading_n / kNPerKn) + " kN is not > 0 (check the bias)");
       }
+      const double drift = tension_drift[i].Next(&drift_rng);
+      drift_sq[i] += drift * drift;
       // Both draws are made for every reading, outlier or not, to keep streams aligned.
       const bool outlier = outlier_rng.Uniform01() < options.outlier_fraction;
       const double outlier_u = 2.0 * outlier_rng.Uniform01() - 1.0;
@@ -201,7 +283,7 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
         const double relative = options.tension_noise_percent / 100.0 * tension_rng.Normal();
         const double absolute_n = options.tension_noise_kn * kNPerKn * tension_rng.Normal();
         measured_n = outlier ? reading_n * (1.0 + options.outlier_scale_percent / 100.0 * outlier_u)
-                             : reading_n * (1.0 + relative) + absolute_n;
+                             : reading_n * (1.0 + relative + drift) + absolute_n;
       }
       s.tension_n[i] = measured_n;
       s.unstretched_length_m[i] = solution.cables[i].unstretched_length_m;
@@ -215,7 +297,11 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
   for (int i = 0; i < kNumCables; ++i) {
     stats.tension_noise_rms_n[i] = std::sqrt(noise_sq[i] / count);
     stats.tension_noise_rms_relative[i] = std::sqrt(relative_sq[i] / count);
+    stats.tension_drift_rms_relative[i] = std::sqrt(drift_sq[i] / count);
   }
+  stats.mass_centre_mean_m = mass_centre_sum / count;
+  stats.mass_centre_drift_rms_m = std::sqrt(mass_centre_sq / (3.0 * count));
+  model.mass_centre_cabin_m = mass_centre_m;  // the truth written out: the mean
   stats.attitude_control_rms_deg = std::sqrt(control_sq / (3.0 * count));
   stats.attitude_measurement_rms_deg = std::sqrt(attitude_sq / (3.0 * count));
   stats.position_measurement_rms_m = std::sqrt(position_sq / (3.0 * count));
@@ -234,6 +320,13 @@ bool SimulationOptions::IsValid(std::string* error) const {
     double value;
   } non_negative[] = {
       {"attitude_control_sigma_deg", attitude_control_sigma_deg},
+      {"attitude_control_time_s", attitude_control_time_s},
+      {"tension_drift_percent", tension_drift_percent},
+      {"tension_drift_time_s", tension_drift_time_s},
+      {"mass_centre_drift_m", mass_centre_drift_m},
+      {"mass_centre_drift_time_s", mass_centre_drift_time_s},
+      {"sensor_gain_spread_percent", sensor_gain_spread_percent},
+      {"sensor_bias_spread_kn", sensor_bias_spread_kn},
       {"attitude_measurement_sigma_deg", attitude_measurement_sigma_deg},
       {"position_measurement_sigma_m", position_measurement_sigma_m},
       {"tension_noise_percent", tension_noise_percent},

@@ -15,9 +15,18 @@
 // to unit norm, D, has singular values s_1 >= ... >= s_n. A direction with
 // s_k / s_1 < undetermined_ratio is one the data and priors cannot determine: the
 // calibration is refused before solving and the direction is named as a combination of
-// parameters. Above it but below poorly_determined_ratio it is reported. The covariance
-// of the estimate is (J^T J)^-1 at the solution (ceres::Covariance), the formal one for
-// the stated noise; the reduced chi-square says whether that noise was right.
+// parameters. Above it but below poorly_determined_ratio it is reported.
+//
+// Calibrate is a pipeline of stages (calibration.cc), each a function over one run's
+// state: validate the inputs; measure the forward model's own error; predict the
+// readings at the initial model and screen them for gross errors (gross_errors.h); build
+// the problem and check the free set is identifiable; solve and reweight (iteratively
+// reweighted least squares: weights from the predicted readings, gross errors re-judged
+// after each pass until the set settles); the uncertainty budget (uncertainty.h: formal
+// covariance (J^T J)^-1, widened by the misfit and the residuals' time correlation,
+// plus consider parameters); diagnostics (score test of every fixed parameter, block
+// cross-validation, residual autocorrelation, worst readings); the parameter table and
+// the verdict.
 #ifndef FASTCAL_CALIBRATION_H_
 #define FASTCAL_CALIBRATION_H_
 
@@ -29,6 +38,8 @@
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
+#include "fastcal/evaluation.h"
+#include "fastcal/uncertainty.h"
 
 namespace fastcal {
 
@@ -56,6 +67,17 @@ struct CalibrationOptions {
   double max_sigma_tower_offset_m = 0.2;
   double max_sigma_sensor_gain = 0.05;
   double max_sigma_sensor_bias_n = 5e3;
+  // A reduced chi-square above this is a fit that failed (the typical residual 5 times
+  // the stated noise): the model does not describe the data, and the linearised
+  // uncertainties no longer mean anything. Between the band and this the misfit is
+  // scaled into the uncertainties (the paper's own fit, 10-20 kN RMS against ~5 kN of
+  // sensor noise, is a chi^2/nu of about 4-16: usable, with wider sigmas).
+  double failed_fit_reduced_chi_square = 25.0;
+  // Least-squares passes at most: 2 when nothing changes (weights from the initial
+  // model, then from the first fit), more while the set of gross errors still changes.
+  int max_passes = 4;
+  // Readings listed as the worst fitted ones (largest |residual| / sigma).
+  int worst_readings = 10;
 };
 
 // A direction in parameter space: weights on parameter names (unit vector in the
@@ -79,20 +101,97 @@ struct ParameterEstimate {
   std::string name;
   std::string unit;  // of the values below (the spec's unit: kN for biases)
   bool free = false;
+  bool consider = false;  // fixed with a prior: its sigma enters the others' budget
   double initial = 0.0;
   double estimate = 0.0;
-  double sigma = 0.0;  // 0 for fixed parameters
+  // Formal sigma: (J^T J)^-1 for the stated noise and independent samples. 0 if fixed.
+  double sigma = 0.0;
+  // The uncertainty to quote (uncertainty.h), and its parts: statistical (the formal
+  // one widened by what the data show: misfit and time-correlated residuals),
+  // systematic (the consider parameters), sigma_total^2 = statistical^2 + systematic^2.
+  double sigma_total = 0.0;
+  double sigma_statistical = 0.0;
+  double sigma_systematic = 0.0;
+  double widening = 1.0;  // sigma_statistical / sigma
+  double tau = 1.0;       // integrated autocorrelation time of its influence series
+  // Systematic part per consider group (CalibrationResult::budget.consider_groups).
+  std::vector<double> systematic_by_group;
   bool has_prior = false;
   double prior_mean = 0.0;
   double prior_sigma = 0.0;
   std::string note;  // e.g. "set mostly by its prior"
 };
 
+// One tension reading: a gross error, or one of the worst fitted readings.
+struct ReadingResidual {
+  int sample = -1;  // index into Dataset::samples
+  int line = 0;     // line in the file
+  int cable = 0;    // 1 .. 6
+  double measured_n = 0.0;
+  double predicted_n = 0.0;     // the model's reading at the solution
+  double residual_sigma = 0.0;  // (predicted - measured) / sigma at the solution
+  bool held_out = false;
+};
+
+struct GrossErrorSummary {
+  bool enabled = false;
+  double threshold_sigmas = 0.0;
+  // Per cable, of the fitted readings' whitened residuals at the solution: median and
+  // robust scale (1.4826 MAD, at least 1), and readings flagged (fitted and held out).
+  std::array<double, kNumCables> centre{};
+  std::array<double, kNumCables> scale{};
+  std::array<int, kNumCables> count{};
+  int fitted_readings = 0;  // readings of the fitted samples
+  int fitted_flagged = 0;
+  bool settled = true;  // the flagged set stopped changing before max_passes
+};
+
+// The chi-square decrease expected from freeing a fixed parameter (score test).
+struct MisfitCandidate {
+  std::string name;
+  double expected_decrease = 0.0;
+};
+
+// Block cross-validation (linearised: each block predicted by one Gauss-Newton step
+// from the full fit without it; exact for a linear model).
+struct CrossValidation {
+  int blocks = 0;  // 0: not computed
+  int folds_used = 0;
+  std::array<double, kNumCables> rms_n{};      // predicted-by-the-rest minus measured
+  std::array<double, kNumCables> fit_rms_n{};  // the fit's own, same readings
+};
+
+enum class FitVerdict {
+  kOk,               // reduced chi-square within its band
+  kNoiseOverstated,  // below the band: the sigmas are pessimistic
+  kMisfit,           // above the band: the misfit is scaled into sigma_total
+  kFailed,           // not converged, or chi^2/nu above failed_fit_reduced_chi_square
+};
+const char* FitVerdictName(FitVerdict verdict);  // "ok", "noise overstated", ...
+
 struct CalibrationResult {
   std::vector<ParameterEstimate> parameters;  // every parameter the spec names
   std::vector<std::string> free_names;
-  Eigen::MatrixXd correlation;  // free parameters, spec order
+  // Correlation of the estimates from the total covariance; free parameters, spec order.
+  Eigen::MatrixXd correlation;
   bool covariance_ok = false;
+  // The budget of the free parameters (SI units, free order).
+  UncertaintyBudget budget;
+  // Gross errors among the readings, in file order, and the screen's numbers.
+  std::vector<ReadingResidual> gross_errors;
+  GrossErrorSummary gross_error_summary;
+  ReadingMask excluded;  // per dataset sample: readings kept out (the gross errors)
+  // The fitted readings with the largest |residual| / sigma, largest first.
+  std::vector<ReadingResidual> worst_readings;
+  // Every fixed parameter the model has, by the chi-square decrease expected from
+  // freeing it, largest first (candidates already spanned by the free set left out).
+  std::vector<MisfitCandidate> misfit_ranking;
+  CrossValidation cross_validation;
+  // Integrated autocorrelation time of each cable's whitened residuals (file order).
+  std::array<double, kNumCables> residual_tau{};
+  FitVerdict verdict = FitVerdict::kOk;
+  std::string verdict_text;                      // one paragraph: what the verdict means here
+  std::vector<std::string> notes;                // further facts the report and console show
   std::vector<std::string> strong_correlations;  // "a ~ b: +0.97"
   // With priors, before and after solving; and from the data alone after solving.
   Identifiability before, after, data_only;
@@ -132,10 +231,11 @@ ChiSquareBand ReducedChiSquareBand(const CalibrationResult& result);
 
 enum class CalibrationStatus {
   kOk = 0,
-  kInvalidInput,  // bad spec, dataset, or fewer residuals than free parameters
-  kUndetermined,  // the data and priors cannot determine the free set (refused)
-  kInfeasible,    // the initial model cannot hold a sample's pose
-  kSolverFailed,  // Ceres failed
+  kInvalidInput,       // bad spec, dataset, or fewer residuals than free parameters
+  kUndetermined,       // the data and priors cannot determine the free set (refused)
+  kInfeasible,         // the initial model cannot hold a sample's pose
+  kSolverFailed,       // Ceres failed
+  kMostlyGrossErrors,  // more than max_gross_error_fraction of the readings flagged
 };
 
 // The model the calibration starts from: `model` with the spec's initial values applied

@@ -44,9 +44,14 @@ struct ParameterSpec {
   bool free = false;
   bool has_initial = false;  // else the model's value (offsets 0, gain 1, bias 0)
   double initial_si = 0.0;
+  // A Gaussian prior. On a free parameter it is added to the fit; on a fixed one it makes
+  // it a consider parameter: held at its value, its sigma propagated into the estimates'
+  // uncertainty (calibration.h, uncertainty.h).
   bool has_prior = false;
   double prior_mean_si = 0.0;
   double prior_sigma_si = 0.0;
+
+  bool IsConsider() const { return !free && has_prior; }
 };
 
 enum class RobustLoss { kNone, kHuber, kCauchy };
@@ -66,10 +71,23 @@ struct CalibrationSpec {
   double tension_sigma_percent = 3.0;
   RobustLoss robust_loss = RobustLoss::kNone;
   double robust_loss_scale = 1.0;  // in units of sigma (whitened residual)
-  // Fraction of the samples held out of the fit (chosen with `holdout_seed`) and used
-  // only to evaluate.
+  // Fraction of the samples held out of the fit and used only to evaluate: whole
+  // contiguous blocks (the samples cut into `holdout_blocks` blocks in file order, the
+  // held ones chosen with `holdout_seed`), since a single sample of a slow trajectory is
+  // predicted by its neighbours.
   double holdout_fraction = 0.0;
   unsigned long long holdout_seed = 1;
+  int holdout_blocks = 10;
+  // Block cross-validation: the fitted samples cut into this many contiguous blocks, each
+  // predicted by the fit without it (linearised: one Gauss-Newton step). >= 2.
+  int cross_validation_blocks = 10;
+  // Gross errors: a reading whose whitened residual is more than
+  // `gross_error_threshold_sigmas` robust sigmas (1.4826 MAD of its cable's residuals,
+  // at least 1) from its cable's median is kept out of the fit and named. More than
+  // `max_gross_error_fraction` of the readings flagged refuses the dataset.
+  bool detect_gross_errors = true;
+  double gross_error_threshold_sigmas = 5.0;
+  double max_gross_error_fraction = 0.25;
   // Attitude used in the fit: the measured one (default) or the planned one.
   bool use_planned_attitude = false;
   // Ceres options.
@@ -90,6 +108,20 @@ bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source
                               int num_anchor_points, CalibrationSpec* spec, std::string* error);
 // The spec as YAML (same format), for provenance in summary.json and the report.
 std::string CalibrationSpecToYaml(const CalibrationSpec& spec);
+
+// Every parameter a spec can name for a model with `num_anchor_points` anchor points, in
+// canonical order: each per-cable group both common and per cable, every offset axis.
+// Names, units and to_si as the reader gives them; all fixed, without initial or prior.
+// (The candidates of the calibration's misfit ranking.)
+std::vector<ParameterSpec> AllModelParameters(int num_anchor_points);
+
+// Whether two specs name the same parameter: same kind, and the same axis, cable, anchor
+// point or tower where the kind has one (a per-cable group's common parameter, index -1,
+// is not any one cable's).
+bool SameParameter(const ParameterSpec& a, const ParameterSpec& b);
+
+// The spec's group key of a parameter kind ("sensor_gain", "mass_centre_m", ...).
+const char* ParameterGroupName(ParameterKind kind);
 
 }  // namespace fastcal
 

@@ -21,6 +21,9 @@ enum class AttitudeSource { kMeasured, kPlanned };
 
 struct CableErrorStats {
   int samples = 0;
+  // Readings left out per cable (gross errors, when the caller excludes them); the
+  // statistics of cable i are over samples - excluded[i] readings.
+  std::array<int, kNumCables> excluded{};
   std::array<double, kNumCables> mean_n{};       // mean of model - measured
   std::array<double, kNumCables> rms_n{};        // RMS of model - measured
   std::array<double, kNumCables> max_abs_n{};    // largest |model - measured|
@@ -46,11 +49,16 @@ int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name
                           const std::vector<AttitudeSource>& attitudes,
                           const std::vector<StaticsMethod>& methods, Dataset* data);
 
+// Readings to leave out of statistics: excluded[n][i] for cable i of sample n (empty:
+// none), e.g. the gross errors a calibration flagged.
+using ReadingMask = std::vector<std::array<bool, kNumCables>>;
+
 // Statistics over the samples with held_out[n] == select_held_out (all samples when
-// held_out is empty and select_held_out is false).
+// held_out is empty and select_held_out is false), without the excluded readings.
 CableErrorStats ErrorStats(const Dataset& data,
                            const std::vector<std::array<double, kNumCables>>& predicted,
-                           const std::vector<bool>& held_out, bool select_held_out);
+                           const std::vector<bool>& held_out, bool select_held_out,
+                           const ReadingMask& excluded = {});
 
 // One row group of the RMS table: a model, an attitude source, and its statistics on the
 // fitted and the held-out samples.
@@ -63,11 +71,18 @@ struct VariantEvaluation {
 bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dataset& data,
                      AttitudeSource attitude, StaticsMethod method,
                      const std::vector<bool>& held_out, VariantEvaluation* evaluation,
-                     std::string* error);
+                     std::string* error, const ReadingMask& excluded = {});
 
-// Which samples are held out of a fit: round(fraction * n) of them, chosen by a seeded
-// shuffle (std::mt19937_64), the same on every run with the same seed.
-std::vector<bool> HoldoutMask(int num_samples, double fraction, std::uint64_t seed);
+// Contiguous block b of n samples cut into `blocks` (b = 0 .. blocks - 1): samples
+// [b n / blocks, (b + 1) n / blocks).
+int BlockOfSample(int sample, int num_samples, int blocks);
+
+// Which samples are held out of a fit: whole contiguous blocks (BlockOfSample), as many
+// as round(fraction * blocks) and at least one when fraction > 0, chosen by a seeded
+// shuffle (std::mt19937_64), the same on every run with the same seed. Blocks, because
+// a single sample of a slow trajectory is predicted by its neighbours on either side.
+std::vector<bool> HoldoutMask(int num_samples, double fraction, std::uint64_t seed,
+                              int blocks = 10);
 
 }  // namespace fastcal
 

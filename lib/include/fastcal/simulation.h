@@ -1,20 +1,31 @@
 // Synthetic telemetry: what the cabin's pose sensors and the six cable-tension sensors
 // would record along a planned trajectory, for a known ("truth") model.
 //
-// Per planned pose n (position p, planned attitude with roll/pitch/yaw a_plan):
-//   actual attitude     a_act  = a_plan + N(0, attitude_control_sigma_deg)      per rpy angle
+// Per planned pose n at time t_n = n dt (position p, planned attitude a_plan):
+//   actual attitude     a_act  = a_plan + c_n,  c the attitude control error, per rpy
+//                                angle AR(1) with sigma attitude_control_sigma_deg and
+//                                correlation time attitude_control_time_s (0: white)
 //   actual position     p_act  = p                        (the position is held exactly)
-//   truth statics       T_i, s0_i = SolveStatics(truth, (p_act, R(a_act)))
+//   mass centre         e_n    = e + d_n, d per axis AR(1) with sigma mass_centre_drift_m
+//                                and correlation time mass_centre_drift_time_s
+//   truth statics       T_i, s0_i = SolveStatics(truth with e_n, (p_act, R(a_act)))
 //   sensor reading      y_i    = sensor_gain_i T_i + sensor_bias_n_i
-//   measured tension    m_i    = y_i (1 + N(0, tension_noise_percent / 100))
+//   measured tension    m_i    = y_i (1 + N(0, tension_noise_percent / 100) + u_i,n)
 //                                + N(0, 1000 tension_noise_kn)
+//                        u_i per cable AR(1) with sigma tension_drift_percent / 100 and
+//                        correlation time tension_drift_time_s (a slow sensor error)
 //                        or, with probability outlier_fraction, an outlier
 //                        m_i    = y_i (1 + U(-s, s) / 100),  s = outlier_scale_percent
 //   measured attitude   a_meas = a_act + N(0, attitude_measurement_sigma_deg)  per rpy angle
 //   measured position   p_meas = p + N(0, position_measurement_sigma_m)        per axis
 // with R(a) = RotationFromRpyDeg(a) and a_plan = RpyDegFromRotation(planned rotation).
-// The truth model's per-cable linear density is multiplied once, before the trajectory,
-// by (1 + N(0, density_mismatch_percent / 100)) (non-uniform cables: sensors, wiring).
+// An AR(1) process x with sigma s and correlation time tau starts stationary,
+// x_0 = s N(0, 1), and steps x_n = phi x_{n-1} + s sqrt(1 - phi^2) N(0, 1),
+// phi = exp(-dt / tau) (phi = 0, white, for tau = 0).
+// Drawn once, before the trajectory (the truth model written out has them): each cable's
+// linear density times (1 + N(0, density_mismatch_percent / 100)) (non-uniform cables:
+// sensors, wiring); its sensor gain times (1 + N(0, sensor_gain_spread_percent / 100));
+// its sensor bias plus N(0, 1000 sensor_bias_spread_kn) N.
 //
 // Random numbers: std::mt19937_64, converted by hand (uniform from the top 53 bits,
 // Gaussian by Box-Muller), so a seed gives the same dataset with every standard library.
@@ -39,6 +50,22 @@ struct SimulationOptions {
   // Attitude control error: standard deviation of the actual minus the planned roll,
   // pitch and yaw (deg, each axis independent). >= 0; default 0.
   double attitude_control_sigma_deg = 0.0;
+  // Its correlation time (s): 0 draws it afresh for every sample (white); a real
+  // controller's error is smooth. >= 0; default 0.
+  double attitude_control_time_s = 0.0;
+  // Slow (time-correlated) relative tension error per cable, AR(1): standard deviation
+  // in percent of the reading and correlation time (s). >= 0; default 0 (none).
+  double tension_drift_percent = 0.0;
+  double tension_drift_time_s = 0.0;
+  // Drift of the cabin's mass centre about the truth model's, per axis AR(1): standard
+  // deviation (m) and correlation time (s). >= 0; default 0 (none). The truth model
+  // written out keeps the mean; SimulationSummary has the realised average.
+  double mass_centre_drift_m = 0.0;
+  double mass_centre_drift_time_s = 0.0;
+  // Spread of the per-cable sensor gains (percent) and biases (kN) drawn once about the
+  // truth model's. >= 0; default 0.
+  double sensor_gain_spread_percent = 0.0;
+  double sensor_bias_spread_kn = 0.0;
   // Attitude sensor error: standard deviation of the measured minus the actual roll,
   // pitch and yaw (deg). >= 0; default 0.
   double attitude_measurement_sigma_deg = 0.0;
@@ -89,6 +116,12 @@ struct SimulationSummary {
   double position_measurement_rms_m = 0.0;
   // Density factors applied to the truth model, cable i at index i-1.
   std::array<double, kNumCables> density_factor{};
+  // Per cable: RMS of the slow tension error u (dimensionless).
+  std::array<double, kNumCables> tension_drift_rms_relative{};
+  // Average over the samples of the actual mass centre (cabin frame, m), and the RMS
+  // over samples and axes of its drift about the truth model's.
+  Eigen::Vector3d mass_centre_mean_m = Eigen::Vector3d::Zero();
+  double mass_centre_drift_rms_m = 0.0;
 };
 
 // Simulates telemetry at the `planned` poses (position and planned attitude) with the

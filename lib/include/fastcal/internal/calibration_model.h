@@ -2,7 +2,9 @@
 // statics parameters and the sensor model, and the residual of one sample:
 //   r_i = (gain_i * T_i(theta; pose) + bias_i - T_measured_i) / sigma_i,   i = 1..6
 // with T_i the forward model's lower-end tension (statics.h) and
-//   sigma_i^2 = sigma_abs^2 + (percent/100 * T_measured_i)^2.
+//   sigma_i^2 = sigma_abs^2 + (percent/100 * T_predicted_i)^2
+// (the predicted reading at the previous pass's parameters: calibration.cc), and
+// r_i = 0 for a reading kept out of the fit (a gross error).
 // TensionResidual is a pure functor (const members, no side effects); TensionCost wraps
 // it with a Jet whose size is chosen at run time from the number of free parameters, so
 // the whole Jacobian comes from one pass through the statics.
@@ -107,8 +109,8 @@ class CalibrationModel {
   std::array<double, kNumCables> base_gain_{}, base_bias_n_{};
 };
 
-// Whitening sigma of each cable's measured tension.
-std::array<double, kNumCables> TensionSigmas(const std::array<double, kNumCables>& measured_n,
+// Whitening sigma of each cable's reading: sqrt(abs^2 + (percent/100 * reading)^2).
+std::array<double, kNumCables> TensionSigmas(const std::array<double, kNumCables>& reading_n,
                                              double sigma_abs_n, double sigma_percent);
 
 struct TensionResidual {
@@ -121,6 +123,8 @@ struct TensionResidual {
   // point: each evaluation warm-starts from a copy of it, since the parameters move
   // little. With a status other than ok every evaluation starts cold.
   StaticsSolution start;
+  // Readings kept out of the fit: their residual is 0, whatever the parameters.
+  std::array<bool, kNumCables> excluded{};
 
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
@@ -139,7 +143,8 @@ struct TensionResidual {
       return false;
     }
     for (int i = 0; i < kNumCables; ++i) {
-      residuals[i] = (gain[i] * tension[i] + bias[i] - measured_n[i]) / sigma_n[i];
+      residuals[i] =
+          excluded[i] ? T(0.0) : (gain[i] * tension[i] + bias[i] - measured_n[i]) / sigma_n[i];
     }
     return true;
   }
