@@ -331,13 +331,22 @@ std::string GrossErrorLines(const CalibrationResult& result) {
 std::string MisfitLine(const CalibrationResult& result) {
   constexpr size_t kShown = 5;
   if (result.misfit_ranking.empty()) return "";
+  const MisfitCandidate& top = result.misfit_ranking.front();
+  if (!top.significant) {
+    return "  no fixed parameter explains a significant part of the misfit (largest expected "
+           "chi-square decrease " +
+           FormatDouble(top.expected_decrease, 3) + ", from " + top.name +
+           "; white noise alone reaches " + FormatDouble(result.misfit_threshold, 3) + ")\n";
+  }
   std::string line = "  the misfit is best explained by freeing:";
   for (size_t k = 0; k < std::min(kShown, result.misfit_ranking.size()); ++k) {
     const MisfitCandidate& c = result.misfit_ranking[k];
-    line += std::string(k ? ", " : " ") + c.name + " (chi-square -" +
+    if (!c.significant) break;
+    line += std::string(k ? ", " : " ") + c.name + " (about " +
             FormatDouble(c.expected_decrease, 3) + ")";
   }
-  return line + "\n";
+  return line + "  [expected chi-square decrease; white noise alone reaches " +
+         FormatDouble(result.misfit_threshold, 3) + "]\n";
 }
 
 std::string CrossValidationLine(const CalibrationResult& result) {

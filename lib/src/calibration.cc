@@ -33,6 +33,18 @@ constexpr double kNoteWeight = 0.3;
 // Weights below this are left out of a direction's description.
 constexpr double kDirectionWeightFloor = 0.1;
 constexpr double kNPerKn = 1e3;
+// Chance that noise alone makes some candidate of the misfit ranking "significant".
+constexpr double kMisfitFamilyError = 0.01;
+
+// x with P(chi-square(1 dof) > x) = tail, i.e. erfc(sqrt(x / 2)) = tail, by bisection.
+double ChiSquare1Quantile(double tail) {
+  double lo = 0.0, hi = 1e3;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (std::erfc(std::sqrt(0.5 * mid)) > tail ? lo : hi) = mid;
+  }
+  return 0.5 * (lo + hi);
+}
 
 // ---------------------------------------------------------------------------------------
 // The state of one calibration, passed from stage to stage.
@@ -211,6 +223,12 @@ bool JacobianR(ceres::Problem* problem, int num_threads, int data_rows, Eigen::M
     *r_data = RFactor(d);
   }
   return true;
+}
+
+std::string Fixed(const char* format, double v) {
+  char text[64];
+  std::snprintf(text, sizeof(text), format, v);
+  return text;
 }
 
 std::string RatioText(double ratio) {
@@ -570,13 +588,30 @@ ReadingResidual ReadingAt(const Run& run, int t, int i) {
   return g;
 }
 
+// More than half of the fitted readings farther from the fit than the threshold in
+// stated sigmas: the robust screen breaks down at half (a median inside the gross
+// errors), so this is judged against the stated noise instead.
+constexpr double kMostlyFarFraction = 0.5;
+
+std::string MostlyGrossErrorsMessage(const Run& run, int flagged, int readings, const char* how,
+                                     double limit) {
+  char text[400];
+  std::snprintf(text, sizeof(text),
+                "%d of the %d fitted readings (%.0f%%) are %s, more than the %.0f%% allowed: "
+                "the data are mostly not what the model predicts. Check the export (units, "
+                "column order, a dead sensor), the model and the stated noise; ",
+                flagged, readings, 100.0 * flagged / std::max(1, readings), how, 100.0 * limit);
+  return text;
+}
+
 CalibrationStatus NameGrossErrors(Run& run) {
   CalibrationResult& r = *run.result;
   GrossErrorSummary& g = r.gross_error_summary;
   g.enabled = run.spec.detect_gross_errors;
   g.threshold_sigmas = run.spec.gross_error_threshold_sigmas;
+  g.fitted_readings = kNumCables * r.num_fit_samples;
   r.excluded = run.excluded;
-  if (run.excluded.empty()) return CalibrationStatus::kOk;
+  if (!g.enabled) return CalibrationStatus::kOk;
   for (size_t t = 0; t < run.excluded.size(); ++t) {
     for (int i = 0; i < kNumCables; ++i) {
       if (!run.excluded[t][i]) continue;
@@ -585,22 +620,38 @@ CalibrationStatus NameGrossErrors(Run& run) {
     }
   }
   g.fitted_flagged = CountExcluded(run);
-  g.fitted_readings = kNumCables * r.num_fit_samples;
-  const double fraction = static_cast<double>(g.fitted_flagged) / std::max(1, g.fitted_readings);
-  if (fraction <= run.spec.max_gross_error_fraction) return CalibrationStatus::kOk;
-  char text[400];
-  std::snprintf(text, sizeof(text),
-                "%d of the %d fitted readings (%.0f%%) are gross errors (more than %g robust "
-                "sigmas from the model), more than the %.0f%% allowed "
-                "(gross_errors.max_fraction): the data are mostly not what the model "
-                "predicts. Check the export (units, column order, a dead sensor) and the "
-                "model; the first is ",
-                g.fitted_flagged, g.fitted_readings, 100.0 * fraction, g.threshold_sigmas,
-                100.0 * run.spec.max_gross_error_fraction);
+  int far = 0;
+  const ReadingResidual* first_far = nullptr;
+  for (int t : run.fit) {
+    for (int i = 0; i < kNumCables; ++i) {
+      if (std::abs(run.at.whitened[t][i]) <= g.threshold_sigmas) continue;
+      ++far;
+      if (first_far == nullptr && r.gross_errors.empty()) {
+        r.gross_errors.push_back(ReadingAt(run, t, i));  // named in the refusal only
+        first_far = &r.gross_errors.back();
+      }
+    }
+  }
+  const std::string threshold = Fixed("%g", g.threshold_sigmas);
+  std::string message;
+  if (g.fitted_flagged > run.spec.max_gross_error_fraction * g.fitted_readings) {
+    message = MostlyGrossErrorsMessage(
+        run, g.fitted_flagged, g.fitted_readings,
+        ("gross errors (more than " + threshold + " robust sigmas from the model)").c_str(),
+        run.spec.max_gross_error_fraction);
+  } else if (far > kMostlyFarFraction * g.fitted_readings) {
+    message = MostlyGrossErrorsMessage(
+        run, far, g.fitted_readings,
+        ("farther than " + threshold + " stated sigmas from the best fit").c_str(),
+        kMostlyFarFraction);
+  } else {
+    if (first_far != nullptr) r.gross_errors.clear();
+    return CalibrationStatus::kOk;
+  }
   const ReadingResidual& first = r.gross_errors.front();
   return run.Fail(CalibrationStatus::kMostlyGrossErrors,
-                  text + run.data.path + ":" + std::to_string(first.line) + " cable " +
-                      std::to_string(first.cable));
+                  message + "the first is " + run.data.path + ":" + std::to_string(first.line) +
+                      " cable " + std::to_string(first.cable));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -734,13 +785,18 @@ void RankMisfit(Run& run, const internal::Linearisation& lin,
     gradient[j] += (value_si[j] - c.prior_mean_si) * w;
   }
   const Eigen::VectorXd decrease = ScoreTestDecrease(information, lin.cross, self, gradient);
-  std::vector<MisfitCandidate>& ranking = run.result->misfit_ranking;
+  CalibrationResult& r = *run.result;
+  std::vector<MisfitCandidate>& ranking = r.misfit_ranking;
   for (size_t j = 0; j < candidates.size(); ++j) {
-    if (std::isfinite(decrease[j])) ranking.push_back({candidates[j].name, decrease[j]});
+    if (std::isfinite(decrease[j])) ranking.push_back({candidates[j].name, decrease[j], false});
   }
   std::stable_sort(ranking.begin(), ranking.end(), [](const auto& a, const auto& b) {
     return a.expected_decrease > b.expected_decrease;
   });
+  const double misfit2 = r.budget.misfit_factor * r.budget.misfit_factor;
+  r.misfit_threshold =
+      ChiSquare1Quantile(kMisfitFamilyError / std::max<size_t>(1, ranking.size())) * misfit2;
+  for (MisfitCandidate& c : ranking) c.significant = c.expected_decrease > r.misfit_threshold;
 }
 
 // Each block predicted by the fit without it: theta + (M - M_k)^-1 J_k^T r_k, one
@@ -885,12 +941,6 @@ void FillParameterTable(Run& run) {
 // ---------------------------------------------------------------------------------------
 // Stage: the verdict, and the notes a reader needs beside it.
 
-std::string Fixed(const char* format, double v) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, v);
-  return text;
-}
-
 void DecideVerdict(Run& run) {
   CalibrationResult& r = *run.result;
   const ChiSquareBand band = ReducedChiSquareBand(r);
@@ -926,7 +976,10 @@ void DecideVerdict(Run& run) {
         "of it";
   }
   const UncertaintyBudget& b = r.budget;
-  if (r.covariance_ok && b.bandwidth > 0) {
+  if (r.covariance_ok && b.samples > 0 && !b.correlated) {
+    r.notes.push_back("residuals uncorrelated in time (largest autocorrelation time " +
+                      Fixed("%.3g", b.tau) + " samples, not significantly above 1)");
+  } else if (r.covariance_ok && b.correlated) {
     r.notes.push_back("residuals correlated in time: " + Fixed("%.3g", b.effective_samples) +
                       " effective independent samples of " + std::to_string(b.samples) +
                       " (autocorrelation time " + Fixed("%.3g", b.tau) + " samples, bandwidth " +

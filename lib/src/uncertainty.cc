@@ -19,6 +19,9 @@ constexpr double kMadToSigma = 1.4826;
 constexpr double kMaxWindowFraction = 0.25;
 // Fewer samples than this and the long-run covariance is not estimated.
 constexpr int kMinSamplesForCorrelation = 10;
+// How many of its standard deviations a tau must exceed 1 by to count as correlated: the
+// largest of n parameters' taus is judged, so a 3-sigma rule, not 2.
+constexpr double kTauSignificance = 3.0;
 
 double Median(std::vector<double>* v) {
   const size_t n = v->size();
@@ -79,7 +82,9 @@ Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& formal, const Eigen
   return scale.asDiagonal() * data * scale.asDiagonal();
 }
 
-// The influence series' largest tau, and the bandwidth it calls for.
+// The influence series' largest tau, and the bandwidth it calls for. Sets b->correlated
+// when some tau is above 1 by more than kTauSignificance standard deviations of tau for
+// a white series, sqrt((4 W + 2) / N) with W the window (Madras and Sokal 1988).
 void ChooseBandwidth(const Eigen::MatrixXd& influence, UncertaintyBudget* b,
                      std::vector<double>* tau) {
   const int n_samples = static_cast<int>(influence.rows());
@@ -89,6 +94,8 @@ void ChooseBandwidth(const Eigen::MatrixXd& influence, UncertaintyBudget* b,
     (*tau)[k] = a.tau;
     b->tau = std::max(b->tau, a.tau);
     b->correlation_reliable = b->correlation_reliable && a.reliable;
+    const double sd = std::sqrt((4.0 * a.window + 2.0) / n_samples);
+    b->correlated = b->correlated || a.tau - 1.0 > kTauSignificance * sd;
   }
   const double wanted = std::ceil(kBandwidthPerTau * b->tau);
   b->bandwidth = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(n_samples)));
@@ -208,6 +215,8 @@ bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
   Eigen::MatrixXd data = b->formal;
   if (b->samples >= kMinSamplesForCorrelation && in.scores.cols() == n && dof > 0) {
     ChooseBandwidth(in.scores * b->formal, b, &tau);
+  }
+  if (b->correlated) {
     const Eigen::VectorXd root_c = CorrectionWithinLimit(in, b).cwiseSqrt();
     Eigen::MatrixXd meat =
         root_c.asDiagonal() * LongRunCovarianceOfSum(in.scores, b->bandwidth) * root_c.asDiagonal();

@@ -150,6 +150,9 @@ struct GrossErrorSummary {
 struct MisfitCandidate {
   std::string name;
   double expected_decrease = 0.0;
+  // Above CalibrationResult::misfit_threshold: more than noise alone would give the
+  // largest of all the candidates.
+  bool significant = false;
 };
 
 // Block cross-validation (linearised: each block predicted by one Gauss-Newton step
@@ -186,6 +189,11 @@ struct CalibrationResult {
   // Every fixed parameter the model has, by the chi-square decrease expected from
   // freeing it, largest first (candidates already spanned by the free set left out).
   std::vector<MisfitCandidate> misfit_ranking;
+  // The decrease that freeing the best of q candidates reaches from white noise alone
+  // with probability 1% (chi-square with 1 degree of freedom at 1 - 0.01 / q), times
+  // max(1, chi2/nu). Time-correlated residuals inflate every candidate's decrease alike
+  // (by up to the widening squared), so then compare the candidates with each other.
+  double misfit_threshold = 0.0;
   CrossValidation cross_validation;
   // Integrated autocorrelation time of each cable's whitened residuals (file order).
   std::array<double, kNumCables> residual_tau{};

@@ -31,7 +31,10 @@
 //
 // The bandwidth follows the residuals' memory: L = ceil(kBandwidthPerTau * tau), tau the
 // largest integrated autocorrelation time 1 + 2 sum_k rho_k (Sokal's window) of the
-// parameters' influence series u_t = M^-1 s_t; halved while some c_k exceeds
+// parameters' influence series u_t = M^-1 s_t. Only when some tau is significantly above
+// 1 (the residuals are correlated) is P_data used at all: on white residuals it would
+// add its own sampling noise (a third of the variance at 9 batches) and nothing else,
+// and the Birge ratio below already covers the misfit. L is halved while some c_k exceeds
 // kMaxBatchCorrection (the fit then absorbs most of a batch's slow error and the residuals
 // can no longer measure it: the budget says its widening is a lower bound). The
 // statistical variance is max(P_formal * max(1, chi2/nu), P_data) per parameter (the
@@ -145,8 +148,10 @@ struct UncertaintyBudget {
   double max_batch_correction = 1.0;  // the largest c_k at L
   double tau = 1.0;                   // largest of the parameters' tau
   double effective_samples = 0.0;     // N / tau
-  bool correlation_reliable = true;   // false: the memory is too long to measure (cap hit)
-  bool ok = false;                    // M was invertible
+  // The residuals are correlated in time (some tau significantly above 1): P_data used.
+  bool correlated = false;
+  bool correlation_reliable = true;  // false: the memory is too long to measure (cap hit)
+  bool ok = false;                   // M was invertible
 };
 
 // The budget. False (and budget->ok false) when M is not positive definite.
