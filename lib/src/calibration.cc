@@ -82,7 +82,6 @@ struct Run {
   std::vector<std::array<double, kNumCables>> sigma_n;
   ReadingMask excluded;
   std::unique_ptr<ceres::Problem> problem;
-  int data_rows = 0;
 
   Pose PoseOf(const Sample& s) const {
     Pose pose = s.pose;
@@ -143,20 +142,16 @@ class ProgressCallback : public ceres::IterationCallback {
 // a tall Jacobian never has to be dense in memory, and without squaring its condition.
 Eigen::MatrixXd RFactor(const ceres::CRSMatrix& j) {
   const int n = j.num_cols;
-  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(n, n);
+  Eigen::MatrixXd r(0, n);
   for (int start = 0; start < j.num_rows; start += kQrChunkRows) {
     const int rows = std::min(kQrChunkRows, j.num_rows - start);
-    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(n + rows, n);
-    m.topRows(n) = r;
+    Eigen::MatrixXd m = Eigen::MatrixXd::Zero(rows, n);
     for (int i = 0; i < rows; ++i) {
-      for (int p = j.rows[start + i]; p < j.rows[start + i + 1]; ++p) {
-        m(n + i, j.cols[p]) = j.values[p];
-      }
+      for (int p = j.rows[start + i]; p < j.rows[start + i + 1]; ++p) m(i, j.cols[p]) = j.values[p];
     }
-    Eigen::HouseholderQR<Eigen::MatrixXd> qr(m);
-    r = qr.matrixQR().topRows(n).triangularView<Eigen::Upper>();
+    r = internal::FoldRows(r, m);
   }
-  return r;
+  return r.rows() == n ? r : Eigen::MatrixXd(Eigen::MatrixXd::Zero(n, n));
 }
 
 Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>& names,
@@ -205,23 +200,13 @@ Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>
   return out;
 }
 
-// R factors of the whitened Jacobian at the current parameters: of all rows, and of the
-// first `data_rows` rows (the data blocks are added before the priors) when not null.
-bool JacobianR(ceres::Problem* problem, int num_threads, int data_rows, Eigen::MatrixXd* r_all,
-               Eigen::MatrixXd* r_data) {
+// R factor of the whitened Jacobian (data and prior rows) at the current parameters.
+bool JacobianR(ceres::Problem* problem, int num_threads, Eigen::MatrixXd* r) {
   ceres::Problem::EvaluateOptions eo;
   eo.num_threads = num_threads;
   ceres::CRSMatrix j;
   if (!problem->Evaluate(eo, nullptr, nullptr, nullptr, &j)) return false;
-  *r_all = RFactor(j);
-  if (r_data != nullptr) {
-    ceres::CRSMatrix d = j;
-    d.num_rows = data_rows;
-    d.rows.resize(data_rows + 1);
-    d.cols.resize(d.rows.back());
-    d.values.resize(d.rows.back());
-    *r_data = RFactor(d);
-  }
+  *r = RFactor(j);
   return true;
 }
 
@@ -430,7 +415,6 @@ void BuildProblem(Run& run) {
     if (!run.excluded.empty()) f.excluded = run.excluded[t];
     run.problem->AddResidualBlock(new internal::TensionCost(f), loss, run.theta.data());
   }
-  run.data_rows = kNumCables * static_cast<int>(run.fit.size());
   for (int k = 0; k < run.n; ++k) {
     const ParameterSpec& p = run.Free(k);
     if (p.has_prior) {
@@ -479,7 +463,7 @@ std::string DescribeRefusal(const Run& run) {
 
 CalibrationStatus CheckIdentifiability(Run& run) {
   Eigen::MatrixXd r;
-  if (!JacobianR(run.problem.get(), run.spec.num_threads, run.data_rows, &r, nullptr)) {
+  if (!JacobianR(run.problem.get(), run.spec.num_threads, &r)) {
     return run.Fail(CalibrationStatus::kInfeasible,
                     "the initial model cannot be evaluated on every sample");
   }
@@ -749,7 +733,8 @@ void FillCorrelation(Run& run) {
 CalibrationStatus Linearise(Run& run, const std::vector<ParameterSpec>& candidates,
                             internal::Linearisation* lin) {
   internal::LinearisationInputs in;
-  in.at_solution = run.cm->ToRobot(run.theta.data());
+  in.fitted = run.cm.get();
+  in.theta = run.theta.data();
   in.data = &run.data;
   in.fit = run.fit;
   in.sigma_n = run.sigma_n;
@@ -760,13 +745,25 @@ CalibrationStatus Linearise(Run& run, const std::vector<ParameterSpec>& candidat
   in.use_planned_attitude = run.spec.use_planned_attitude;
   in.statics = run.statics;
   in.loss = run.loss.get();
-  for (int k = 0; k < run.n; ++k) in.free.push_back(run.Free(k));
   in.candidates = candidates;
   in.cross_validation_blocks = run.spec.cross_validation_blocks;
   in.num_threads = run.spec.num_threads;
   std::string why;
   if (!internal::Linearise(in, lin, &why)) return run.Fail(CalibrationStatus::kSolverFailed, why);
   return CalibrationStatus::kOk;
+}
+
+// The identifiability at the solution, from the linearisation's R factor: of the data
+// alone, and with the priors' rows folded in.
+void AnalyseAtSolution(Run& run, const internal::Linearisation& lin) {
+  CalibrationResult& r = *run.result;
+  Eigen::MatrixXd priors = Eigen::MatrixXd::Zero(run.n, run.n);
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    if (p.has_prior) priors(k, k) = 1.0 / p.prior_sigma_si;
+  }
+  r.data_only = Analyse(lin.r_factor, r.free_names, run.options);
+  r.after = Analyse(internal::FoldRows(lin.r_factor, priors), r.free_names, run.options);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -794,8 +791,11 @@ void RankMisfit(Run& run, const internal::Linearisation& lin,
     return a.expected_decrease > b.expected_decrease;
   });
   const double misfit2 = r.budget.misfit_factor * r.budget.misfit_factor;
+  // A subsample's J_c^T r, scaled up, carries its noise scaled up as much.
+  const double subsample = static_cast<double>(run.fit.size()) / std::max(1, lin.candidate_samples);
   r.misfit_threshold =
-      ChiSquare1Quantile(kMisfitFamilyError / std::max<size_t>(1, ranking.size())) * misfit2;
+      ChiSquare1Quantile(kMisfitFamilyError / std::max<size_t>(1, ranking.size())) * misfit2 *
+      subsample;
   for (MisfitCandidate& c : ranking) c.significant = c.expected_decrease > r.misfit_threshold;
 }
 
@@ -846,11 +846,6 @@ void FindWorstReadings(Run& run) {
 
 CalibrationStatus EstimateUncertaintyAndDiagnose(Run& run) {
   CalibrationResult& r = *run.result;
-  Eigen::MatrixXd r_all, r_data;
-  if (JacobianR(run.problem.get(), run.spec.num_threads, run.data_rows, &r_all, &r_data)) {
-    r.after = Analyse(r_all, r.free_names, run.options);
-    r.data_only = Analyse(r_data, r.free_names, run.options);
-  }
   run.problem.reset();  // its residuals hold a copy of every warm start
   std::vector<double> value_si;
   const std::vector<ParameterSpec> candidates = Candidates(run, &value_si);
@@ -858,6 +853,7 @@ CalibrationStatus EstimateUncertaintyAndDiagnose(Run& run) {
   if (const CalibrationStatus s = Linearise(run, candidates, &lin); s != CalibrationStatus::kOk) {
     return s;
   }
+  AnalyseAtSolution(run, lin);
   const BudgetInputs inputs = MakeBudgetInputs(run, lin, candidates);
   r.covariance_ok = ComputeUncertaintyBudget(inputs, &r.budget);
   FillCorrelation(run);

@@ -1,13 +1,18 @@
 // The calibration linearised at its solution (internal/calibration_linearisation.h).
 #include "fastcal/internal/calibration_linearisation.h"
 
+#include <Eigen/QR>
 #include <algorithm>
+#include <cmath>
 #include <thread>
-
-#include "fastcal/internal/calibration_model.h"
 
 namespace fastcal::internal {
 namespace {
+
+// Rows of the free Jacobian folded into the R factor at a time.
+constexpr int kQrChunkRows = 1024;
+
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 bool IsPerCableGroup(ParameterKind kind) {
   return kind == ParameterKind::kLinearDensity || kind == ParameterKind::kEa ||
@@ -20,20 +25,62 @@ bool Covers(const ParameterSpec& p, const ParameterSpec& b) {
   return SameParameter(p, b) || (p.kind == b.kind && IsPerCableGroup(p.kind) && p.index < 0);
 }
 
-// What one thread adds up over its share of the samples.
-struct Sums {
-  Eigen::MatrixXd information, cross;
-  Eigen::VectorXd self, gradient;
+// Calls fn(thread, begin, end) on `threads` contiguous chunks of [0, count), in parallel.
+template <typename Fn>
+void ParallelChunks(int count, int threads, const Fn& fn) {
+  threads = std::clamp(threads, 1, std::max(1, count));
+  std::vector<std::thread> workers;
+  for (int w = 0; w < threads; ++w) {
+    const int begin = static_cast<int>(static_cast<long long>(count) * w / threads);
+    const int end = static_cast<int>(static_cast<long long>(count) * (w + 1) / threads);
+    workers.emplace_back([&fn, w, begin, end] { fn(w, begin, end); });
+  }
+  for (std::thread& t : workers) t.join();
+}
+
+// The fit's residual of fitted sample j, through `model`.
+TensionResidual ResidualOf(const LinearisationInputs& in, const CalibrationModel* model, int j) {
+  const Sample& sample = in.data->samples[in.fit[j]];
+  TensionResidual f{
+      model,         sample.pose, sample.tension_n,
+      in.sigma_n[j], in.statics,  in.starts.empty() ? StaticsSolution() : in.starts[j]};
+  if (in.use_planned_attitude) f.pose.rotation = sample.planned_rotation;
+  if (!in.excluded.empty()) f.excluded = in.excluded[in.fit[j]];
+  return f;
+}
+
+// Residuals and Jacobian (rows of excluded readings zero) of `f` at `theta`, and the
+// robust loss's IRLS weight sqrt(rho'(|r|^2)) (1 without a loss).
+bool EvaluateSample(const TensionResidual& f, const double* theta, const ceres::LossFunction* loss,
+                    Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j, double* weight) {
+  const TensionCost cost(f);
+  const double* parameters[1] = {theta};
+  double* jacobians[1] = {j->data()};
+  if (!cost.Evaluate(parameters, r->data(), jacobians)) return false;
+  for (int i = 0; i < kNumCables; ++i) {
+    if (f.excluded[i]) j->row(i).setZero();  // r_i is 0 already
+  }
+  *weight = 1.0;
+  if (loss != nullptr) {
+    double rho[3];
+    loss->Evaluate(r->squaredNorm(), rho);
+    *weight = std::sqrt(std::max(rho[1], 0.0));
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------
+// The free pass.
+
+struct FreeSums {
+  Eigen::MatrixXd information, r_factor, pending;
+  int pending_rows = 0;
   double chi_square = 0.0;
   int readings = 0;
   std::vector<FoldSums> folds;
 
-  Sums(int n, int q, int blocks)
-      : information(Eigen::MatrixXd::Zero(n, n)),
-        cross(Eigen::MatrixXd::Zero(n, q)),
-        self(Eigen::VectorXd::Zero(q)),
-        gradient(Eigen::VectorXd::Zero(q)),
-        folds(blocks) {
+  FreeSums(int n, int blocks)
+      : information(Eigen::MatrixXd::Zero(n, n)), pending(kQrChunkRows, n), folds(blocks) {
     for (FoldSums& f : folds) {
       f.information = Eigen::MatrixXd::Zero(n, n);
       f.gradient = Eigen::VectorXd::Zero(n);
@@ -44,11 +91,21 @@ struct Sums {
     }
   }
 
-  void Add(const Sums& o) {
+  void AddRows(const Eigen::MatrixXd& rows) {
+    if (pending_rows + rows.rows() > pending.rows()) Flush();
+    pending.middleRows(pending_rows, rows.rows()) = rows;
+    pending_rows += static_cast<int>(rows.rows());
+  }
+  void Flush() {
+    r_factor = FoldRows(r_factor, pending.topRows(pending_rows));
+    pending_rows = 0;
+  }
+
+  void Add(FreeSums& o) {
+    o.Flush();
+    Flush();
+    r_factor = FoldRows(r_factor, o.r_factor);
     information += o.information;
-    cross += o.cross;
-    self += o.self;
-    gradient += o.gradient;
     chi_square += o.chi_square;
     readings += o.readings;
     for (size_t k = 0; k < folds.size(); ++k) {
@@ -67,9 +124,70 @@ struct Sums {
   }
 };
 
-using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// The cross-validation block sums of one sample: raw (unweighted) rows in newtons.
+void AddToFold(const TensionResidual& f, const Eigen::Matrix<double, kNumCables, 1>& r,
+               const RowMatrix& j, double weight, FoldSums* fold) {
+  ++fold->samples;
+  fold->information.noalias() += weight * weight * j.transpose() * j;
+  fold->gradient.noalias() += weight * weight * j.transpose() * r;
+  for (int i = 0; i < kNumCables; ++i) {
+    if (f.excluded[i]) continue;
+    const double s = f.sigma_n[i];
+    const Eigen::VectorXd ji = s * j.row(i).transpose();  // N per parameter unit
+    const double ri = s * r[i];                           // N
+    ++fold->readings[i];
+    fold->sse_n2[i] += ri * ri;
+    fold->cross_n2[i] += ri * ji;
+    fold->normal_n2[i].noalias() += ji * ji.transpose();
+  }
+}
 
-// Columns of `basis` (6 x K) summed into the parameters' columns (6 x columns.size()).
+bool AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisation* out,
+                    FreeSums* sums, int* failed) {
+  const int n = in.fitted->num_free();
+  const int num_fit = static_cast<int>(in.fit.size());
+  RowMatrix j(kNumCables, n);
+  Eigen::Matrix<double, kNumCables, 1> r;
+  for (int t = begin; t < end; ++t) {
+    const TensionResidual f = ResidualOf(in, in.fitted, t);
+    double weight = 1.0;
+    if (!EvaluateSample(f, in.theta, in.loss, &r, &j, &weight)) {
+      *failed = t;
+      return false;
+    }
+    const Eigen::MatrixXd jw = weight * j;
+    const Eigen::VectorXd rw = weight * r;
+    out->residuals.row(t) = r.transpose();
+    out->scores.row(t) = rw.transpose() * jw;
+    for (int i = 0; i < kNumCables; ++i) {
+      out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
+    }
+    sums->information.noalias() += jw.transpose() * jw;
+    sums->AddRows(jw);
+    sums->chi_square += rw.squaredNorm();
+    for (bool e : f.excluded) sums->readings += !e;
+    const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
+    AddToFold(f, r, j, weight, &sums->folds[block]);
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------------------
+// The candidate pass.
+
+struct CandidatePass {
+  const LinearisationInputs& in;
+  CalibrationModel basis;
+  std::vector<double> theta;
+  std::vector<std::vector<int>> free_columns, candidate_columns;
+};
+
+struct CandidateSums {
+  Eigen::MatrixXd cross;
+  Eigen::VectorXd self, gradient;
+};
+
+// Columns of `basis` (6 x K) summed into the parameters' columns.
 Eigen::MatrixXd Combine(const RowMatrix& basis, const std::vector<std::vector<int>>& columns) {
   Eigen::MatrixXd j = Eigen::MatrixXd::Zero(basis.rows(), static_cast<int>(columns.size()));
   for (size_t k = 0; k < columns.size(); ++k) {
@@ -78,76 +196,109 @@ Eigen::MatrixXd Combine(const RowMatrix& basis, const std::vector<std::vector<in
   return j;
 }
 
-// The shared, read-only part of a pass.
-struct Pass {
-  const LinearisationInputs& in;
-  CalibrationModel model;
-  std::vector<double> theta;
-  std::vector<std::vector<int>> free_columns, candidate_columns;
-};
-
-// Samples [begin, end) of the fitted ones into *sums and rows of *out; false with the
-// failing fitted sample in *failed.
-bool Accumulate(const Pass& pass, int begin, int end, Linearisation* out, Sums* sums, int* failed) {
-  const LinearisationInputs& in = pass.in;
-  const int k_basis = pass.model.num_free();
-  const int num_fit = static_cast<int>(in.fit.size());
-  RowMatrix basis(kNumCables, k_basis);
-  for (int j = begin; j < end; ++j) {
-    const Sample& sample = in.data->samples[in.fit[j]];
-    TensionResidual f{&pass.model,      sample.pose,
-                      sample.tension_n, in.sigma_n[j],
-                      in.statics,       in.starts.empty() ? StaticsSolution() : in.starts[j]};
-    if (in.use_planned_attitude) f.pose.rotation = sample.planned_rotation;
-    if (!in.excluded.empty()) f.excluded = in.excluded[in.fit[j]];
-    const TensionCost cost(f);
-    Eigen::Matrix<double, kNumCables, 1> r;
-    const double* parameters[1] = {pass.theta.data()};
-    double* jacobians[1] = {basis.data()};
-    if (!cost.Evaluate(parameters, r.data(), jacobians)) {
-      *failed = j;
+bool AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
+                          int end, CandidateSums* sums, int* failed) {
+  RowMatrix b(kNumCables, pass.basis.num_free());
+  Eigen::Matrix<double, kNumCables, 1> r;
+  for (int k = begin; k < end; ++k) {
+    const TensionResidual f = ResidualOf(pass.in, &pass.basis, samples[k]);
+    double weight = 1.0;
+    if (!EvaluateSample(f, pass.theta.data(), pass.in.loss, &r, &b, &weight)) {
+      *failed = samples[k];
       return false;
     }
-    for (int i = 0; i < kNumCables; ++i) {
-      if (f.excluded[i]) basis.row(i).setZero();  // r_i is 0 already
-    }
-    const Eigen::MatrixXd jx_raw = Combine(basis, pass.free_columns);
-    const Eigen::MatrixXd jc_raw = Combine(basis, pass.candidate_columns);
-    double weight = 1.0;  // sqrt(rho'(|r|^2)): the robust loss's IRLS weight
-    if (in.loss != nullptr) {
-      double rho[3];
-      in.loss->Evaluate(r.squaredNorm(), rho);
-      weight = std::sqrt(std::max(rho[1], 0.0));
-    }
-    const Eigen::VectorXd rw = weight * r;
-    const Eigen::MatrixXd jx = weight * jx_raw;
-    const Eigen::MatrixXd jc = weight * jc_raw;
-    out->residuals.row(j) = r.transpose();
-    out->scores.row(j) = rw.transpose() * jx;
-    sums->information.noalias() += jx.transpose() * jx;
-    for (int i = 0; i < kNumCables; ++i) {
-      out->jacobians.row(j).segment(i * jx.cols(), jx.cols()) = jx.row(i).cast<float>();
-    }
+    const Eigen::MatrixXd jx = weight * Combine(b, pass.free_columns);
+    const Eigen::MatrixXd jc = weight * Combine(b, pass.candidate_columns);
     sums->cross.noalias() += jx.transpose() * jc;
     sums->self += jc.colwise().squaredNorm().transpose();
-    sums->gradient.noalias() += jc.transpose() * rw;
-    sums->chi_square += rw.squaredNorm();
-    FoldSums& fold = sums->folds[BlockOfSample(j, num_fit, static_cast<int>(sums->folds.size()))];
-    ++fold.samples;
-    fold.information.noalias() += jx.transpose() * jx;
-    fold.gradient.noalias() += jx.transpose() * rw;
-    for (int i = 0; i < kNumCables; ++i) {
-      if (f.excluded[i]) continue;
-      ++sums->readings;
-      const double s = in.sigma_n[j][i];
-      const Eigen::VectorXd ji = s * jx_raw.row(i).transpose();  // N per parameter unit
-      const double ri = s * r[i];                                // N
-      ++fold.readings[i];
-      fold.sse_n2[i] += ri * ri;
-      fold.cross_n2[i] += ri * ji;
-      fold.normal_n2[i].noalias() += ji * ji.transpose();
-    }
+    sums->gradient.noalias() += weight * (jc.transpose() * r);
   }
+  return true;
+}
+
+// Evenly spaced fitted samples, at most kMaxCandidateSamples of them.
+std::vector<int> CandidateSamples(int num_fit) {
+  std::vector<int> samples;
+  const int used = std::min(num_fit, kMaxCandidateSamples);
+  for (int k = 0; k < used; ++k) {
+    samples.push_back(static_cast<int>(static_cast<long long>(k) * num_fit / used));
+  }
+  return samples;
+}
+
+std::string CannotSolve(const LinearisationInputs& in, int fitted_sample) {
+  const Sample& s = in.data->samples[in.fit[fitted_sample]];
+  return in.data->path + ":" + std::to_string(s.line) +
+         ": the calibrated model cannot solve this pose";
+}
+
+bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::string* error) {
+  const int n = in.fitted->num_free();
+  const int num_fit = static_cast<int>(in.fit.size());
+  const int blocks = std::clamp(in.cross_validation_blocks, 1, std::max(1, num_fit));
+  out->scores = Eigen::MatrixXd::Zero(num_fit, n);
+  out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
+  out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
+  const int threads = std::clamp(in.num_threads, 1, std::max(1, num_fit));
+  std::vector<FreeSums> sums(threads, FreeSums(n, blocks));
+  std::vector<int> failed(threads, -1);
+  ParallelChunks(num_fit, threads, [&](int w, int begin, int end) {
+    AccumulateFree(in, begin, end, out, &sums[w], &failed[w]);
+  });
+  for (int w = 0; w < threads; ++w) {
+    if (failed[w] >= 0) {
+      *error = CannotSolve(in, failed[w]);
+      return false;
+    }
+    if (w > 0) sums[0].Add(sums[w]);
+  }
+  sums[0].Flush();
+  out->information = std::move(sums[0].information);
+  out->r_factor = std::move(sums[0].r_factor);
+  out->chi_square = sums[0].chi_square;
+  out->readings = sums[0].readings;
+  out->folds = std::move(sums[0].folds);
+  return true;
+}
+
+bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std::string* error) {
+  const int n = in.fitted->num_free();
+  const int q = static_cast<int>(in.candidates.size());
+  const int num_anchor_points = static_cast<int>(in.fitted->robot().anchor_points_cabin_m.size());
+  CalibrationSpec basis_spec;
+  basis_spec.parameters = BasisParameters(num_anchor_points);
+  CandidatePass pass{in, CalibrationModel(in.fitted->ToRobot(in.theta), basis_spec), {}, {}, {}};
+  pass.theta = pass.basis.InitialTheta();
+  for (int k = 0; k < n; ++k) {
+    const ParameterSpec& p = in.fitted->spec().parameters[in.fitted->spec_index(k)];
+    pass.free_columns.push_back(BasisColumns(p, num_anchor_points));
+  }
+  for (const ParameterSpec& p : in.candidates) {
+    pass.candidate_columns.push_back(BasisColumns(p, num_anchor_points));
+  }
+  const std::vector<int> samples = CandidateSamples(static_cast<int>(in.fit.size()));
+  const int threads = std::clamp(in.num_threads, 1, std::max(1, static_cast<int>(samples.size())));
+  std::vector<CandidateSums> sums(
+      threads, {Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q), Eigen::VectorXd::Zero(q)});
+  std::vector<int> failed(threads, -1);
+  ParallelChunks(static_cast<int>(samples.size()), threads, [&](int w, int begin, int end) {
+    AccumulateCandidates(pass, samples, begin, end, &sums[w], &failed[w]);
+  });
+  for (int w = 0; w < threads; ++w) {
+    if (failed[w] >= 0) {
+      *error = CannotSolve(in, failed[w]);
+      return false;
+    }
+    if (w == 0) continue;
+    sums[0].cross += sums[w].cross;
+    sums[0].self += sums[w].self;
+    sums[0].gradient += sums[w].gradient;
+  }
+  const double scale = static_cast<double>(in.fit.size()) / std::max<size_t>(1, samples.size());
+  out->cross = scale * sums[0].cross;
+  out->self = scale * sums[0].self;
+  out->gradient = scale * sums[0].gradient;
+  out->candidate_samples = static_cast<int>(samples.size());
   return true;
 }
 
@@ -172,55 +323,22 @@ std::vector<int> BasisColumns(const ParameterSpec& p, int num_anchor_points) {
   return columns;
 }
 
-bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error) {
-  const int num_anchor_points = static_cast<int>(in.at_solution.anchor_points_cabin_m.size());
-  CalibrationSpec basis_spec;
-  basis_spec.parameters = BasisParameters(num_anchor_points);
-  Pass pass{in, CalibrationModel(in.at_solution, basis_spec), {}, {}, {}};
-  pass.theta = pass.model.InitialTheta();
-  for (const ParameterSpec& p : in.free) {
-    pass.free_columns.push_back(BasisColumns(p, num_anchor_points));
-  }
-  for (const ParameterSpec& p : in.candidates) {
-    pass.candidate_columns.push_back(BasisColumns(p, num_anchor_points));
-  }
-  const int n = static_cast<int>(in.free.size());
-  const int q = static_cast<int>(in.candidates.size());
-  const int num_fit = static_cast<int>(in.fit.size());
-  const int blocks = std::clamp(in.cross_validation_blocks, 1, std::max(1, num_fit));
-  *out = Linearisation();
-  out->scores = Eigen::MatrixXd::Zero(num_fit, n);
-  out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
-  out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
+Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows) {
+  const int n = static_cast<int>(rows.cols());
+  Eigen::MatrixXd m(top.rows() + rows.rows(), n);
+  m.topRows(top.rows()) = top;
+  m.bottomRows(rows.rows()) = rows;
+  if (m.rows() == 0) return Eigen::MatrixXd::Zero(n, n);
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(m);
+  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(n, n);
+  const int k = static_cast<int>(std::min<Eigen::Index>(n, m.rows()));
+  r.topRows(k) = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
+  return r;
+}
 
-  const int threads = std::clamp(in.num_threads, 1, std::max(1, num_fit));
-  std::vector<Sums> sums(threads, Sums(n, q, blocks));
-  std::vector<int> failed(threads, -1);
-  std::vector<std::thread> workers;
-  for (int w = 0; w < threads; ++w) {
-    const int begin = static_cast<int>(static_cast<long long>(num_fit) * w / threads);
-    const int end = static_cast<int>(static_cast<long long>(num_fit) * (w + 1) / threads);
-    workers.emplace_back(
-        [&, w, begin, end] { Accumulate(pass, begin, end, out, &sums[w], &failed[w]); });
-  }
-  for (std::thread& t : workers) t.join();
-  for (int w = 0; w < threads; ++w) {
-    if (failed[w] >= 0) {
-      const Sample& s = in.data->samples[in.fit[failed[w]]];
-      *error = in.data->path + ":" + std::to_string(s.line) +
-               ": the calibrated model cannot solve this pose";
-      return false;
-    }
-    if (w > 0) sums[0].Add(sums[w]);
-  }
-  out->information = std::move(sums[0].information);
-  out->cross = std::move(sums[0].cross);
-  out->self = std::move(sums[0].self);
-  out->gradient = std::move(sums[0].gradient);
-  out->chi_square = sums[0].chi_square;
-  out->readings = sums[0].readings;
-  out->folds = std::move(sums[0].folds);
-  return true;
+bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error) {
+  *out = Linearisation();
+  return LineariseFree(in, out, error) && LineariseCandidates(in, out, error);
 }
 
 }  // namespace fastcal::internal

@@ -1,17 +1,25 @@
-// The calibration problem linearised at its solution, one pass over the fitted samples,
-// for the uncertainty budget and the diagnostics (uncertainty.h, calibration.h).
+// The calibration problem linearised at its solution, for the uncertainty budget and the
+// diagnostics (uncertainty.h, calibration.h). Two passes over the fitted samples:
 //
-// Every parameter a spec can name is a sum of "basis" parameters: mass centre x, y, z,
-// cabin mass, and per cable i: density_i, EA_i, gain_i, bias_i, with every anchor and
-// tower offset axis (3 + 1 + 4 * 6 + 3 * anchor points + 18 <= 64, one ceres::Jet). A
-// common group's parameter (all cables at once) is the sum of its six per-cable columns.
-// So one Jet pass through the statics gives, per sample t, the whitened residuals r_t
-// and the basis Jacobian B_t (6 x K), and from it the free Jacobian J_x = B_t A_x and
-// that of every fixed candidate J_c = B_t A_c (A: 0/1 maps). Accumulated:
-//   J_x^T J_x, the scores s_t = J_x^T r_t (kept per sample, time order),
-//   J_x^T J_c, diag(J_c^T J_c), J_c^T r             (score test, consider parameters)
-//   per cross-validation block k: J_x^T J_x, J_x^T r, and per cable i the sums of
-//   (sigma r)^2, sigma^2 r J_x,i and sigma^2 J_x,i^T J_x,i        (tension units, N)
+// Free parameters (every fitted sample): the fit's own residual with a ceres::Jet over
+// the n free parameters gives the whitened residuals r_t and J_t (6 x n). Accumulated:
+//   J_x^T J_x and its R factor (chunked QR, as the identifiability check wants it),
+//   the scores s_t = J_t^T r_t and J_t (kept per sample, time order: the long-run
+//   covariance), and per cross-validation block k: J_x^T J_x, J_x^T r, and per cable i
+//   the sums of (sigma r)^2, sigma^2 r J_x,i and sigma^2 J_x,i^T J_x,i (tension units).
+//
+// Candidates (every fixed parameter the model has): every parameter a spec can name is a
+// sum of "basis" parameters (mass centre x, y, z, cabin mass, per cable i density_i,
+// EA_i, gain_i, bias_i, every anchor and tower offset axis: 3 + 1 + 24 + 3 * anchor
+// points + 18 <= 64, one Jet); a common group's parameter is the sum of its six per-cable
+// columns. One basis pass gives B_t (6 x K), so J_x = B_t A_x and J_c = B_t A_c (A: 0/1
+// maps), accumulated as J_x^T J_c, diag(J_c^T J_c) and J_c^T r. This pass costs ~25 us a
+// sample (a 64-wide Jet through the statics), so on long datasets it runs on at most
+// kMaxCandidateSamples evenly spaced samples and its sums are scaled by N / N_used:
+// J_x^T J_c and diag(J_c^T J_c) involve no noise and are smooth along the poses (a
+// quadrature), while J_c^T r then carries N / N_used times its noise (the misfit
+// ranking's threshold is raised by that factor).
+//
 // Readings kept out of the fit (gross errors) have r = 0 and J = 0. With a robust loss,
 // each sample's rows are scaled by sqrt(rho'(|r_t|^2)) (its iteratively reweighted
 // least-squares weight at the solution).
@@ -29,13 +37,18 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/internal/calibration_model.h"
 #include "fastcal/statics.h"
 #include "fastcal/uncertainty.h"
 
 namespace fastcal::internal {
 
+// The candidate pass's sample budget (see above).
+inline constexpr int kMaxCandidateSamples = 20000;
+
 struct LinearisationInputs {
-  CableRobot at_solution;  // the calibrated model
+  const CalibrationModel* fitted = nullptr;  // the fit's model (its free set)
+  const double* theta = nullptr;             // the solution
   const Dataset* data = nullptr;
   std::vector<int> fit;  // fitted samples, dataset indices in file order
   // Per fitted sample: the fit's whitening sigmas, and the statics at the solution
@@ -46,7 +59,6 @@ struct LinearisationInputs {
   bool use_planned_attitude = false;
   StaticsOptions statics;
   const ceres::LossFunction* loss = nullptr;  // the fit's robust loss, or null
-  std::vector<ParameterSpec> free;            // the free parameters, in theta order
   std::vector<ParameterSpec> candidates;      // fixed parameters to differentiate against
   int cross_validation_blocks = 10;
   int num_threads = 1;
@@ -64,25 +76,31 @@ struct FoldSums {
 
 struct Linearisation {
   Eigen::MatrixXd information;  // J_x^T J_x over the data (no priors)
+  Eigen::MatrixXd r_factor;     // upper triangular R, R^T R = J_x^T J_x
   Eigen::MatrixXd scores;       // s_t, one row per fitted sample
-  SampleJacobians jacobians;    // J_x,t (6 x n, row after row), one row per fitted sample
-  Eigen::MatrixXd cross;        // J_x^T J_c
-  Eigen::VectorXd self;         // diag(J_c^T J_c)
-  Eigen::VectorXd gradient;     // J_c^T r
+  SampleJacobians jacobians;    // J_t (6 x n, row after row), one row per fitted sample
   Eigen::MatrixXd residuals;    // r_t (fitted samples x 6); 0 where excluded
   double chi_square = 0.0;      // sum r^2 over the data
   int readings = 0;             // readings not excluded
   std::vector<FoldSums> folds;
+  // Candidates (scaled to all fitted samples).
+  Eigen::MatrixXd cross;      // J_x^T J_c
+  Eigen::VectorXd self;       // diag(J_c^T J_c)
+  Eigen::VectorXd gradient;   // J_c^T r
+  int candidate_samples = 0;  // N_used
 };
 
-// The basis columns a parameter (of a spec or a candidate) is the sum of; indices into
-// the basis of BasisParameters(num_anchor_points).
-std::vector<int> BasisColumns(const ParameterSpec& p, int num_anchor_points);
 // The basis parameters, in order (all free, no initial: the model's values).
 std::vector<ParameterSpec> BasisParameters(int num_anchor_points);
+// The basis columns a parameter (of a spec or a candidate) is the sum of.
+std::vector<int> BasisColumns(const ParameterSpec& p, int num_anchor_points);
 
-// One pass. False, with *error naming the sample's line, when the statics fail there.
+// Both passes. False, with *error naming the sample's line, when the statics fail there.
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error);
+
+// Upper-triangular R with R^T R = A^T A for A the rows of `top` stacked on `rows` (a QR
+// of the stack; `top` may be empty).
+Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows);
 
 }  // namespace fastcal::internal
 

@@ -36,6 +36,7 @@ class CalibrationModel {
   // Index into spec.parameters of free parameter k.
   int spec_index(int k) const { return free_[k]; }
   const CalibrationSpec& spec() const { return spec_; }
+  const CableRobot& robot() const { return robot_; }
   const StaticsParameters<double>& base() const { return base_; }
   // Initial values of the free parameters (SI).
   std::vector<double> InitialTheta() const;
