@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -228,6 +229,38 @@ std::string SkipHint() {
 std::string Digest(const std::string& path) {
   std::string hex, error;
   return !path.empty() && FileFnv1a64(path, &hex, &error) ? hex : "";
+}
+
+// The current date and time, UTC, ISO 8601 ("2026-11-22T15:04:05Z").
+std::string UtcNow() {
+  const std::time_t now = std::time(nullptr);
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+// The comment lines at the top of model_calibrated.yaml: provenance, a warning when the
+// fit failed (the file is still written, as a record), and each free estimate with its
+// sigma_total (the file's values have no room for uncertainties).
+std::string CalibratedModelHeader(const CalibrationResult& result, const ReportInputs& report) {
+  std::string header;
+  if (result.verdict == FitVerdict::kFailed) {
+    header += "WARNING: THIS CALIBRATION FAILED; DO NOT USE THIS MODEL.\n" + result.verdict_text +
+              ".\n(report.md, Verdict)\n";
+  }
+  header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
+            "\n" + report.command_line + "\ndata " + report.data_path + " (fnv1a64 " +
+            report.data_digest + ")\nverdict: " + FitVerdictName(result.verdict) +
+            "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
+            "budget):";
+  for (const ParameterEstimate& p : result.parameters) {
+    if (!p.free) continue;
+    header += "\n  " + p.name + " = " + FormatDouble(p.estimate, 8) + " +- " +
+              FormatDouble(p.sigma_total, 3) + (p.unit == "1" ? "" : " " + p.unit);
+  }
+  return header;
 }
 
 std::string CommandLine(int argc, char** argv) {
@@ -502,6 +535,7 @@ int RunCalibrate(int argc, char** argv) {
   report.data_digest = Digest(FLAGS_data);
   report.software_version = FASTCAL_VERSION;
   report.command_line = CommandLine(argc, argv);
+  report.run_utc = UtcNow();
   report.initial_model = &model;
   report.spec = &spec;
   report.data = &data;
@@ -509,11 +543,9 @@ int RunCalibrate(int argc, char** argv) {
   report.variants = variants;
   report.evaluation_method = "exact";
 
-  const std::string header = "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + "\n" +
-                             report.command_line + "\ndata " + FLAGS_data + " (fnv1a64 " +
-                             report.data_digest + ")";
   const std::vector<std::pair<std::string, std::string>> files = {
-      {"model_calibrated.yaml", CableRobotToYaml(result.calibrated, header)},
+      {"model_calibrated.yaml",
+       CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))},
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out)}};
   if (!WriteOutDirectory(command, files, report)) return kExitUsage;
 
@@ -570,6 +602,7 @@ int RunEvaluate(int argc, char** argv) {
     report.data_digest = Digest(FLAGS_data);
     report.software_version = FASTCAL_VERSION;
     report.command_line = CommandLine(argc, argv);
+    report.run_utc = UtcNow();
     report.initial_model = &model;
     report.data = &data;
     report.variants = variants;

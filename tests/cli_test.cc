@@ -482,7 +482,9 @@ TEST_F(CliTest, CalibratePoorFitWarns) {
                            "chi-square [0-9.]+ is above 1 \\+ 1.34: the residuals are [0-9.]+ "
                            "times the stated noise")))
       << r.output;
-  EXPECT_NE(ReadFile(out + "/report.md").find("## Verdict\n\n**Poor fit:"), std::string::npos);
+  EXPECT_NE(ReadFile(out + "/report.md").find("## Verdict\n\n**Misfit, scaled into the "
+                                              "uncertainties:** reduced chi-square"),
+            std::string::npos);
   EXPECT_NE(ReadFile(out + "/summary.json").find("\"reduced_chi_square_within_band\": false"),
             std::string::npos);
 }

@@ -197,8 +197,9 @@ class ReportTest : public ::testing::Test {
       Sample s;
       s.line = n + 2;
       s.time_s = 10.0 * n;
+      // Steps of 0.05 rad, a trajectory: lines join consecutive samples in the plots.
       s.pose.position_m =
-          Eigen::Vector3d(71.11 * std::cos(0.3 * n), 71.11 * std::sin(0.3 * n), 156.73);
+          Eigen::Vector3d(71.11 * std::cos(0.05 * n), 71.11 * std::sin(0.05 * n), 156.73);
       for (int i = 0; i < kNumCables; ++i) {
         s.tension_n[i] = 1e3 * (180.0 + 40.0 * std::sin(0.3 * n + i));
       }
@@ -218,6 +219,11 @@ class ReportTest : public ::testing::Test {
     x.initial = 0.0;
     x.estimate = 0.2213;
     x.sigma = 0.0031;
+    x.sigma_statistical = 0.0040;
+    x.sigma_systematic = 0.0030;
+    x.sigma_total = 0.0050;
+    x.widening = 0.004 / 0.0031;
+    x.systematic_by_group = {0.0030};
     ParameterEstimate rho;
     rho.name = "linear_density_kg_per_m";
     rho.unit = "kg/m";
@@ -225,6 +231,10 @@ class ReportTest : public ::testing::Test {
     rho.initial = 11.718;
     rho.estimate = 11.93;
     rho.sigma = 0.12;
+    rho.sigma_statistical = 0.12;
+    rho.sigma_total = 0.13;
+    rho.sigma_systematic = 0.05;
+    rho.systematic_by_group = {0.05};
     rho.has_prior = true;
     rho.prior_mean = 11.718;
     rho.prior_sigma = 0.5;
@@ -233,7 +243,45 @@ class ReportTest : public ::testing::Test {
     mass.name = "cabin_mass_kg";
     mass.unit = "kg";
     mass.initial = mass.estimate = 30000.0;
-    r.parameters = {x, mass, rho};
+    ParameterEstimate gain;
+    gain.name = "sensor_gain[3]";
+    gain.unit = "1";
+    gain.consider = true;
+    gain.initial = gain.estimate = 1.0;
+    gain.has_prior = true;
+    gain.prior_mean = 1.0;
+    gain.prior_sigma = 0.01;
+    gain.sigma_total = 0.01;
+    r.parameters = {x, mass, rho, gain};
+    r.budget.consider_groups = {"sensor_gain"};
+    r.budget.misfit_factor = 1.0;
+    r.budget.samples = kNumSamples - 4;
+    r.budget.correlated = true;
+    r.budget.tau = 2.5;
+    r.budget.bandwidth = 20;
+    r.budget.effective_samples = 6.4;
+    r.verdict = FitVerdict::kOk;
+    r.verdict_text = "reduced chi-square 0.98 agrees with the stated noise (1 +- 0.435)";
+    r.misfit_ranking = {{"sensor_gain[3]", 410.0, true}, {"tower_offset_m[2].z", 12.0, false}};
+    r.misfit_threshold = 15.1;
+    r.excluded.assign(kNumSamples, {});
+    r.excluded[7][2] = true;
+    ReadingResidual gross;
+    gross.sample = 7;
+    gross.line = 9;
+    gross.cable = 3;
+    gross.measured_n = 99999e3;
+    gross.predicted_n = 154.342e3;
+    gross.residual_sigma = -21563.5;
+    r.gross_errors = {gross};
+    r.gross_error_summary.enabled = true;
+    r.gross_error_summary.threshold_sigmas = 5;
+    r.gross_error_summary.count = {0, 0, 1, 0, 0, 0};
+    r.gross_error_summary.scale = {1, 1, 1.2, 1, 1, 1};
+    r.cross_validation.blocks = 10;
+    r.cross_validation.folds_used = 10;
+    r.cross_validation.rms_n = {5100, 5200, 5300, 5400, 5500, 5600};
+    r.cross_validation.fit_rms_n = {5000, 5100, 5200, 5300, 5400, 5500};
     r.free_names = {"mass_centre_m.x", "linear_density_kg_per_m"};
     r.correlation.resize(2, 2);
     r.correlation << 1.0, 0.95, 0.95, 1.0;
@@ -281,6 +329,7 @@ class ReportTest : public ::testing::Test {
     inputs_.data_digest = "fedcba9876543210";
     inputs_.software_version = "0.1.0";
     inputs_.command_line = "fastcal calibrate --spec=spec_mass_centre.yaml --data=circle.csv";
+    inputs_.run_utc = "2026-11-22T15:04:05Z";
     inputs_.initial_model = &model_;
     inputs_.spec = &spec_;
     inputs_.data = &data_;
@@ -311,12 +360,16 @@ class ReportTest : public ::testing::Test {
 TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
   const std::string md = ReportMarkdown(inputs_);
   EXPECT_TRUE(Contains(md, "# fastcal calibration report"));
-  // Estimates: names, units, values, sigma, prior, note; a fixed parameter says so.
-  EXPECT_TRUE(Contains(md, "| `mass_centre_m.x` | m | 0 | **0.22130** | 0.0031 | - |"));
+  // Estimates: names, units, values to the precision sigma_total supports, sigma_total,
+  // the formal sigma and the widening, prior, note; a fixed and a consider parameter say so.
   EXPECT_TRUE(Contains(md,
-                       "| `linear_density_kg_per_m` | kg/m | 11.718 | **11.930** | 0.12 | "
-                       "11.718 ± 0.5 | set mostly by its prior |"));
+                       "| `mass_centre_m.x` | m | 0 | **0.22130** | **0.005** | 0.0031 | "
+                       "× 1.29 | - |"));
+  EXPECT_TRUE(Contains(md,
+                       "| `linear_density_kg_per_m` | kg/m | 11.718 | **11.930** | **0.13** | 0.12 "
+                       "| × 1 | 11.718 ± 0.5 | set mostly by its prior |"));
   EXPECT_TRUE(Contains(md, "| `cabin_mass_kg` | kg | 30000 | 30000 | fixed |"));
+  EXPECT_TRUE(Contains(md, "| `sensor_gain[3]` | 1 | 1 | 1 | 0.01 (consider) |"));
   // RMS table: the paper's numbers in kN with three decimals.
   EXPECT_TRUE(Contains(md,
                        "| paper nominal | 16 | 22.554 | 17.517 | 20.078 | 18.687 | 17.167 | "
@@ -332,6 +385,7 @@ TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
   EXPECT_TRUE(Contains(md, "the residuals scatter as the noise model says"));
   EXPECT_TRUE(Contains(md, "16 fitted, 4 held out (20 in the dataset)"));
   EXPECT_TRUE(Contains(md, "nominal FAST model (built in)"));
+  EXPECT_TRUE(Contains(md, "| Run (UTC) | 2026-11-22T15:04:05Z |"));
   EXPECT_TRUE(Contains(md, "`spec_mass_centre.yaml` (fnv1a64 `0123456789abcdef`)"));
   EXPECT_TRUE(Contains(md, "max 0.021 %, RMS 0.008 %"));
   EXPECT_TRUE(Contains(md, "The data alone cannot determine `linear_density_kg_per_m (+1.00)`"));
@@ -368,25 +422,93 @@ TEST_F(ReportTest, ChiSquareInterpretation) {
   EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "**Did not converge**"));
 }
 
-// Outside the band the verdict opens with a failure, not "Converged"; inside it does not.
-TEST_F(ReportTest, ChiSquareOutsideTheBandReadsAsAFailure) {
+std::string SvgTitled(const std::string& html, const std::string& title);
+
+// The verdict opens with the calibration's own: good, misfit scaled, noise overstated or
+// failed, with its text; the band's numbers stay in summary.json.
+TEST_F(ReportTest, VerdictOpensWithTheCalibrationsVerdict) {
   std::string md = ReportMarkdown(inputs_);  // 0.98, within 1 +- 0.435
-  EXPECT_FALSE(Contains(md, "Poor fit"));
-  EXPECT_FALSE(Contains(md, "Noise overstated"));
+  EXPECT_TRUE(Contains(md, "## Verdict\n\n**Good fit:** reduced chi-square 0.98 agrees"));
   EXPECT_TRUE(Contains(SummaryJson(inputs_), "\"reduced_chi_square_within_band\": true"));
   result_.reduced_chi_square = 17.5;
+  result_.verdict = FitVerdict::kMisfit;
+  result_.verdict_text = "reduced chi-square 17.5 is above 1 + 0.435: the residuals are 4.18 times";
   md = ReportMarkdown(inputs_);
   EXPECT_TRUE(Contains(md,
-                       "## Verdict\n\n**Poor fit: the model does not explain the measurements.** "
-                       "χ²/ν = 17.5 is outside 1 ± 0.435, the band of a correct noise model: the "
-                       "residuals are 4.18 times the stated noise. Do not use the estimates"))
+                       "## Verdict\n\n**Misfit, scaled into the uncertainties:** reduced "
+                       "chi-square 17.5 is above 1 + 0.435"))
       << md;
-  EXPECT_TRUE(Contains(ReportHtml(inputs_), "Poor fit: the model does not explain"));
   const std::string json = SummaryJson(inputs_);
   EXPECT_TRUE(Contains(json, "\"reduced_chi_square_within_band\": false")) << json;
   EXPECT_TRUE(Contains(json, "\"reduced_chi_square_band_half_width\": 0.435")) << json;
-  result_.reduced_chi_square = 0.1;
-  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "**Noise overstated:** χ²/ν = 0.1 is outside"));
+  EXPECT_TRUE(Contains(json, "\"status\": \"misfit scaled\"")) << json;
+  result_.verdict = FitVerdict::kFailed;
+  result_.verdict_text = "do not use the estimates";
+  EXPECT_TRUE(Contains(ReportHtml(inputs_), "<strong>The fit failed:</strong> do not use"));
+  result_.verdict = FitVerdict::kNoiseOverstated;
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "**Noise overstated:**"));
+}
+
+// The budget's parts per parameter, what each consider group adds, the residuals'
+// memory; the gross errors by line and cable; the misfit ranking; cross-validation.
+TEST_F(ReportTest, DiagnosticSectionsNameTheirNumbers) {
+  const std::string md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md, "## Uncertainty budget"));
+  EXPECT_TRUE(Contains(md,
+                       "| formal σ | misfit × | correlation × | statistical σ | systematic: "
+                       "`sensor_gain` | systematic σ | **σ\\_total** |"));
+  EXPECT_TRUE(Contains(md,
+                       "| `mass_centre_m.x` | m | 0.0031 | 1 | 1.29 | 0.004 | 0.003 | 0.003 "
+                       "| **0.005** |"))
+      << md;
+  EXPECT_TRUE(Contains(md,
+                       "- `sensor_gain`: 3 mm on `mass_centre_m.x`, 0.05 kg/m on "
+                       "`linear_density_kg_per_m`"));
+  EXPECT_TRUE(Contains(md, "carry about 6.4 independent pieces of information"));
+  EXPECT_TRUE(Contains(md, "## Gross errors and worst readings"));
+  EXPECT_TRUE(Contains(md, "| 9 | 3 | 99999.000 | 154.342 | -21563.5 |  |"));
+  EXPECT_TRUE(Contains(md, "| gross errors | 0 | 0 | 1 | 0 | 0 | 0 |"));
+  EXPECT_TRUE(Contains(md,
+                       "**The misfit is best explained by freeing:** `sensor_gain[3]` "
+                       "(about 410)."));
+  EXPECT_TRUE(Contains(md, "| 2 | `tower_offset_m[2].z` | 12 | no |"));
+  EXPECT_TRUE(Contains(md, "| **calibrated, cross-validated** | 5.100 | 5.200 |"));
+  const std::string json = SummaryJson(inputs_);
+  EXPECT_TRUE(JsonChecker(json).Valid());
+  EXPECT_TRUE(Contains(json,
+                       "\"outliers\": [\n    {\n      \"line\": 9,\n      \"cable\": 3,\n"
+                       "      \"measured_kN\": 99999,\n      \"predicted_kN\": 154.342,\n"
+                       "      \"residual_sigma\": -21563.5,"))
+      << json;
+  EXPECT_TRUE(Contains(json, "\"sigma_total\": 0.005,"));
+  EXPECT_TRUE(Contains(json, "\"systematic_by_group\": {\n          \"sensor_gain\": 0.003\n"));
+  EXPECT_TRUE(Contains(json, "\"run_utc\": \"2026-11-22T15:04:05Z\""));
+  EXPECT_TRUE(Contains(json,
+                       "\"name\": \"sensor_gain[3]\",\n      "
+                       "\"expected_chi_square_decrease\": 410,"));
+}
+
+// The gross error is left out of the plots (it would flatten them) and said so; an
+// unordered set of samples is drawn as dots, a trajectory with lines; the page prints
+// with its details open and long lines wrapped.
+TEST_F(ReportTest, PlotsSuitTheDataAndLeaveGrossErrorsOut) {
+  std::string html = ReportHtml(inputs_);
+  EXPECT_TRUE(Contains(html, "Gross errors are not drawn."));
+  EXPECT_TRUE(Contains(html, "<title>Residual against off-axis angle</title>"));
+  EXPECT_TRUE(Contains(html, "<title>Residual against azimuth</title>"));
+  EXPECT_TRUE(Contains(html, "<title>Predicted against measured</title>"));
+  EXPECT_TRUE(Contains(html, "@media print"));
+  EXPECT_TRUE(Contains(html, "details::details-content { content-visibility: visible;"));
+  EXPECT_TRUE(Contains(html, "lines on top; dashed: before calibration"));
+  for (size_t n = 0; n < data_.samples.size(); ++n) {  // random order: not a trajectory
+    data_.samples[n].pose.position_m =
+        Eigen::Vector3d(71.11 * std::cos(2.4 * n), 71.11 * std::sin(2.4 * n), 156.73);
+  }
+  html = ReportHtml(inputs_);
+  EXPECT_TRUE(Contains(html, "dots on top: the samples are not a trajectory"));
+  const std::string svg = SvgTitled(html, "Cable 1: tension");
+  const std::string after = "stroke=\"" + PlotSeriesColour(2) + "\"";
+  EXPECT_TRUE(Contains(svg, after + " stroke-width=\"3.6\" stroke-linecap=\"round\"")) << svg;
 }
 
 TEST_F(ReportTest, SaysSoWhenNothingIsPoorlyDetermined) {
@@ -400,9 +522,9 @@ TEST_F(ReportTest, HtmlIsSelfContainedWithPlotsAndNoNonFiniteNumbers) {
   EXPECT_TRUE(Contains(html, "<meta charset=\"utf-8\">"));
   EXPECT_TRUE(Contains(html, "</html>"));
   // Heatmap, RMS bars (fitted and held out), tension per cable, histogram, residual per
-  // cable.
+  // cable, residual against off-axis angle and azimuth, predicted against measured.
   EXPECT_GE(Count(html, "<svg"), 4);
-  EXPECT_EQ(Count(html, "<svg"), 1 + 2 + 6 + 1 + 6);
+  EXPECT_EQ(Count(html, "<svg"), 1 + 2 + 6 + 1 + 6 + 3);
   EXPECT_TRUE(Contains(html, "<details>\n<summary>Ceres full report</summary>"));
   EXPECT_TRUE(Contains(html, "&lt;Residual blocks&gt; &amp; more"));
   EXPECT_TRUE(Contains(html, "<td class=\"num\">22.554</td>"));
@@ -478,6 +600,8 @@ TEST_F(ReportTest, LongDatasetsAreThinnedInThePlotsOnly) {
     data_.samples.push_back(s);
   }
   data_.samples[31337].tension_n[0] = 620e3;  // An outlier, far above the rest (< 225 kN).
+  result_.excluded.clear();                   // not flagged as a gross error: drawn
+  result_.gross_errors.clear();
   held_out_ = HoldoutMask(kLong, 0.2, 1);
   result_.held_out = held_out_;
   result_.num_fit_samples =

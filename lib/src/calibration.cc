@@ -978,7 +978,7 @@ void DecideVerdict(Run& run) {
   } else if (r.covariance_ok && b.correlated) {
     r.notes.push_back("residuals correlated in time: " + Fixed("%.3g", b.effective_samples) +
                       " effective independent samples of " + std::to_string(b.samples) +
-                      " (autocorrelation time " + Fixed("%.3g", b.tau) + " samples, bandwidth " +
+                      " (autocorrelation time " + Fixed("%.3g", b.tau) + " samples, batch length " +
                       std::to_string(b.bandwidth) + ")" +
                       (b.correlation_reliable
                            ? ""

@@ -23,13 +23,29 @@
 
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/json.h"
+#include "fastcal/internal/report_document.h"
+#include "fastcal/internal/report_sections.h"
 #include "fastcal/svg_plot.h"
 
 namespace fastcal {
 namespace {
 
+// The report's document model and number formatting (internal/report_document.h).
+using internal::Block;
+using internal::Document;
+using internal::EstimateText;
+using internal::Int;
+using internal::Kn3;
+using internal::Pct;
+using internal::Printf;
+using internal::Sig3;
+using internal::Sig6;
+using internal::Span;
+using internal::Table;
+using internal::Target;
+using internal::Text;
+
 constexpr double kNPerKn = 1000.0;
-constexpr double kPercent = 100.0;
 // Defaults of CalibrationOptions, quoted in the text (the result does not carry them).
 constexpr double kDefaultPoorlyDeterminedRatio = 1e-3;
 constexpr double kDefaultUndeterminedRatio = 1e-8;
@@ -44,146 +60,6 @@ constexpr int kMaxPlotPointsPerSeries = 2000;
 // Measured tensions in the time plots: small translucent dots under the model lines
 // (the held-out ones, sky blue, less translucent to stay visible on white).
 constexpr double kMeasuredDotRadiusPx = 1.8, kMeasuredDotOpacity = 0.45, kHeldOutDotOpacity = 0.7;
-
-// ---------------------------------------------------------------------------------------
-// Number formatting. Non-finite values read "n/a", never "nan" or "inf".
-
-// "-0.000" and "+0.00" -> "0.000", "0.00".
-std::string DropSignOfZero(std::string s) {
-  if (!s.empty() && (s[0] == '-' || s[0] == '+') &&
-      s.find_first_not_of("0.", 1) == std::string::npos) {
-    s.erase(0, 1);
-  }
-  return s;
-}
-
-std::string Printf(const char* format, double v) {
-  if (!std::isfinite(v)) return "n/a";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, v);
-  return DropSignOfZero(buf);
-}
-std::string Sig6(double v) { return Printf("%.6g", v); }
-std::string Sig3(double v) { return Printf("%.3g", v); }
-std::string Kn3(double v_n) { return Printf("%.3f", v_n / kNPerKn); }
-std::string Pct(double fraction, const char* format = "%.3g") {
-  return Printf(format, fraction * kPercent);
-}
-std::string Int(long long v) { return std::to_string(v); }
-// An estimate to the precision its uncertainty supports: down to one digit below the
-// second significant digit of sigma ("0.24413" for 0.244125 +- 0.0044); 6 significant
-// digits when there is no usable sigma. summary.json keeps every digit.
-std::string EstimateText(double value, double sigma) {
-  constexpr int kMaxDecimals = 12;
-  if (!std::isfinite(value) || !std::isfinite(sigma) || sigma <= 0.0) return Sig6(value);
-  const int decimals =
-      std::clamp(2 - static_cast<int>(std::floor(std::log10(sigma))), 0, kMaxDecimals);
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", decimals, value);
-  return DropSignOfZero(buf);
-}
-
-// ---------------------------------------------------------------------------------------
-// The document model.
-
-struct Span {
-  enum Kind { kPlain, kCode, kBold, kSwatch } kind;
-  std::string text;  // for kSwatch: the colour
-};
-
-// Inline text: plain, code, bold, and (HTML only) a colour swatch matching a plot series.
-class Text {
- public:
-  Text() = default;
-  Text(const std::string& plain) { Plain(plain); }  // NOLINT: implicit by design
-  Text(const char* plain) { Plain(plain); }         // NOLINT
-  Text& Plain(const std::string& s) { return Add(Span::kPlain, s); }
-  Text& Code(const std::string& s) { return Add(Span::kCode, s); }
-  Text& Bold(const std::string& s) { return Add(Span::kBold, s); }
-  Text& Swatch(const std::string& colour) { return Add(Span::kSwatch, colour); }
-  const std::vector<Span>& spans() const { return spans_; }
-
- private:
-  Text& Add(Span::Kind kind, const std::string& s) {
-    if (!s.empty()) spans_.push_back({kind, s});
-    return *this;
-  }
-  std::vector<Span> spans_;
-};
-
-struct Table {
-  Text caption;
-  std::vector<Text> header;
-  std::vector<bool> right_align;  // per column (numbers)
-  std::vector<std::vector<Text>> rows;
-};
-
-enum class Target { kBoth, kMarkdownOnly, kHtmlOnly };
-
-struct Block {
-  enum Kind { kHeading, kParagraph, kList, kTable, kPre, kFigure } kind = kParagraph;
-  Target target = Target::kBoth;
-  int level = 2;                  // kHeading
-  Text text;                      // kHeading, kParagraph; kPre and kFigure: summary / caption
-  std::vector<Text> items;        // kList
-  Table table;                    // kTable
-  std::string pre;                // kPre: preformatted text
-  bool collapsed = false;         // kPre: <details> in HTML
-  std::vector<std::string> svgs;  // kFigure: one or more charts, laid out in a grid
-};
-
-class Document {
- public:
-  void Heading(int level, const Text& text) {
-    Block b;
-    b.kind = Block::kHeading;
-    b.level = level;
-    b.text = text;
-    blocks_.push_back(std::move(b));
-  }
-  void Paragraph(const Text& text, Target target = Target::kBoth) {
-    Block b;
-    b.kind = Block::kParagraph;
-    b.target = target;
-    b.text = text;
-    blocks_.push_back(std::move(b));
-  }
-  void List(std::vector<Text> items) {
-    if (items.empty()) return;
-    Block b;
-    b.kind = Block::kList;
-    b.items = std::move(items);
-    blocks_.push_back(std::move(b));
-  }
-  void AddTable(Table table, Target target = Target::kBoth) {
-    Block b;
-    b.kind = Block::kTable;
-    b.target = target;
-    b.table = std::move(table);
-    blocks_.push_back(std::move(b));
-  }
-  void Pre(const Text& summary, const std::string& text, bool collapsed) {
-    Block b;
-    b.kind = Block::kPre;
-    b.text = summary;
-    b.pre = text;
-    b.collapsed = collapsed;
-    blocks_.push_back(std::move(b));
-  }
-  void Figure(std::vector<std::string> svgs, const Text& caption) {
-    Block b;
-    b.kind = Block::kFigure;
-    b.target = Target::kHtmlOnly;
-    b.svgs = std::move(svgs);
-    b.text = caption;
-    blocks_.push_back(std::move(b));
-  }
-  const std::vector<Block>& blocks() const { return blocks_; }
-  std::string title;
-
- private:
-  std::vector<Block> blocks_;
-};
 
 // ---------------------------------------------------------------------------------------
 // Facts derived from the inputs, shared by the document and the JSON.
@@ -252,10 +128,8 @@ std::string ChiSquareMeaning(const CalibrationResult& r) {
   }
   if (chi > 1.0) {
     return "above 1: model error the free parameters cannot absorb, or noise underestimated" +
-           expected +
-           ". The ±1σ uncertainties below are formal (for the stated noise); "
-           "scaled by √(χ²/ν) = " +
-           Sig3(std::sqrt(chi)) + " they would match the observed scatter.";
+           expected + ". σ_total below is scaled by at least √(χ²/ν) = " + Sig3(std::sqrt(chi)) +
+           "; the formal σ is for the stated noise.";
   }
   return "below 1: the noise is overestimated (the residuals are smaller than the stated "
          "σ)" +
@@ -310,6 +184,7 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
           .Plain(in.software_version.empty() ? "(version unknown)" : in.software_version));
   row("Command line",
       in.command_line.empty() ? Text("(not recorded)") : Text().Code(in.command_line));
+  row("Run (UTC)", in.run_utc.empty() ? "(not recorded)" : in.run_utc);
   if (in.spec) {
     const CalibrationSpec& s = *in.spec;
     row("Forward model (in the fit)", Text().Code(StaticsMethodName(s.forward_model)));
@@ -331,13 +206,20 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
                            : Text(std::string(RobustLossName(s.robust_loss)) + ", scale " +
                                   Sig6(s.robust_loss_scale) + " σ"));
     row("Attitude in the fit", s.use_planned_attitude ? "planned" : "measured");
+    row("Gross errors", s.detect_gross_errors
+                            ? "readings more than " + Sig3(s.gross_error_threshold_sigmas) +
+                                  " robust σ from the model are kept out; refused above " +
+                                  Sig3(100.0 * s.max_gross_error_fraction) + " % of them"
+                            : std::string("not screened"));
     Text holdout("none: every sample is fitted");
     if (s.holdout_fraction > 0.0) {
-      holdout = Text(Sig6(s.holdout_fraction) + " of the samples, chosen with seed " +
-                     std::to_string(s.holdout_seed));
-      if (in.result) holdout.Plain(": " + Int(NumHeldOut(in)) + " held out of the fit");
+      holdout =
+          Text(Sig6(s.holdout_fraction) + " of the samples as whole contiguous blocks (of " +
+               Int(s.holdout_blocks) + "), chosen with seed " + std::to_string(s.holdout_seed));
+      if (in.result) holdout.Plain(": " + Int(NumHeldOut(in)) + " samples held out of the fit");
     }
     row("Hold-out", holdout);
+    row("Cross-validation", Int(s.cross_validation_blocks) + " contiguous blocks");
     row("Ceres options", "max " + Int(s.max_iterations) + " iterations; function, gradient, " +
                              "parameter tolerance " + Sig3(s.function_tolerance) + ", " +
                              Sig3(s.gradient_tolerance) + ", " + Sig3(s.parameter_tolerance) +
@@ -371,28 +253,35 @@ void AddVerdict(const ReportInputs& in, Document* doc) {
   }
   const CalibrationResult& r = *in.result;
   doc->Heading(2, "Verdict");
-  const ChiSquareBand band = ReducedChiSquareBand(r);
-  if (band.degrees_of_freedom > 0 && std::isfinite(r.reduced_chi_square) && !band.within) {
-    const std::string outside = " χ²/ν = " + Printf("%.4g", r.reduced_chi_square) +
-                                " is outside 1 ± " + Sig3(band.half_width) +
-                                ", the band of a correct noise model: ";
-    if (r.reduced_chi_square > 1.0) {
-      doc->Paragraph(Text()
-                         .Bold("Poor fit: the model does not explain the measurements.")
-                         .Plain(outside + "the residuals are " +
-                                Sig3(std::sqrt(r.reduced_chi_square)) +
-                                " times the stated noise. Do not use the estimates and their "
-                                "±1σ as they are: look for model error the free parameters "
-                                "cannot absorb (outliers, a parameter held fixed, bad poses) or "
-                                "state the real noise in the spec."));
-    } else {
-      doc->Paragraph(Text()
-                         .Bold("Noise overstated:")
-                         .Plain(outside +
-                                "the residuals are smaller than the stated noise, so the ±1σ "
-                                "below are pessimistic."));
-    }
+  const char* lead = "Good fit:";
+  switch (r.verdict) {
+    case FitVerdict::kOk:
+      break;
+    case FitVerdict::kNoiseOverstated:
+      lead = "Noise overstated:";
+      break;
+    case FitVerdict::kMisfit:
+      lead = "Misfit, scaled into the uncertainties:";
+      break;
+    case FitVerdict::kFailed:
+      lead = "The fit failed:";
+      break;
   }
+  doc->Paragraph(Text().Bold(lead).Plain(" " + r.verdict_text + "."));
+  std::vector<Text> notes;
+  if (!r.gross_errors.empty()) {
+    notes.push_back(Int(static_cast<long long>(r.gross_errors.size())) +
+                    (r.gross_errors.size() == 1 ? " reading was flagged as a gross error"
+                                                : " readings were flagged as gross errors") +
+                    " and kept out of the fit (see Gross errors and worst readings).");
+  }
+  for (const std::string& note : r.notes) notes.push_back(note + ".");
+  if (!r.misfit_ranking.empty() && r.misfit_ranking.front().significant) {
+    notes.push_back(Text("The misfit is best explained by freeing ")
+                        .Code(r.misfit_ranking.front().name)
+                        .Plain(" (see What would explain the misfit)."));
+  }
+  doc->List(std::move(notes));
   Text t;
   if (r.converged) {
     t.Bold("Converged");
@@ -446,21 +335,28 @@ void AddVerdict(const ReportInputs& in, Document* doc) {
 void AddEstimates(const CalibrationResult& r, Document* doc) {
   doc->Heading(2, "Estimates");
   doc->Paragraph(
-      "±1σ: formal standard deviation for the stated noise (covariance at the solution). "
-      "Priors are Gaussian, mean ± σ. Sensor biases are in kN, like the spec. Fixed "
-      "parameters keep their initial value.");
+      "± σ_total: the uncertainty to quote (see Uncertainty budget); formal σ: for the "
+      "stated noise and independent samples only. Priors are Gaussian, mean ± σ. Sensor "
+      "biases are in kN, like the spec. Fixed parameters keep their initial value; a "
+      "consider parameter (fixed, with a prior) shows its prior σ.");
   Table t;
-  t.header = {"Parameter", "Unit", "Initial", "Estimate", "±1σ", "Prior", "Note"};
-  t.right_align = {false, false, true, true, true, true, false};
+  t.header = {"Parameter", "Unit",     "Initial", "Estimate", "± σ_total",
+              "formal σ",  "widening", "Prior",   "Note"};
+  t.right_align = {false, false, true, true, true, true, true, true, false};
   for (const ParameterEstimate& p : r.parameters) {
-    std::string sigma = "fixed";
-    if (p.free) sigma = r.covariance_ok ? Sig3(p.sigma) : "n/a";
+    std::string total = "fixed", formal = "", widening = "";
+    if (p.consider) total = Sig3(p.sigma_total) + " (consider)";
+    if (p.free) {
+      total = r.covariance_ok ? Sig3(p.sigma_total) : "n/a";
+      formal = r.covariance_ok ? Sig3(p.sigma) : "n/a";
+      widening = r.covariance_ok ? "× " + Printf("%.3g", p.widening) : "";
+    }
     const std::string prior = p.has_prior ? Sig6(p.prior_mean) + " ± " + Sig3(p.prior_sigma) : "-";
-    t.rows.push_back({Text().Code(p.name), p.unit, Sig6(p.initial),
-                      p.free
-                          ? Text().Bold(EstimateText(p.estimate, r.covariance_ok ? p.sigma : 0.0))
-                          : Text(Sig6(p.estimate)),
-                      sigma, prior, p.note});
+    t.rows.push_back(
+        {Text().Code(p.name), p.unit, Sig6(p.initial),
+         p.free ? Text().Bold(EstimateText(p.estimate, r.covariance_ok ? p.sigma_total : 0.0))
+                : Text(Sig6(p.estimate)),
+         p.free ? Text().Bold(total) : Text(total), formal, widening, prior, p.note});
   }
   if (t.rows.empty()) {
     doc->Paragraph("The spec names no parameter.");
@@ -746,8 +642,19 @@ void AddPlots(const ReportInputs& in, Document* doc) {
   const std::vector<double> x = SampleAxis(d, &x_label);
   const std::vector<size_t> shown = PlotVariants(in);
   const bool holdout = NumHeldOut(in) > 0;
-  // With a calibration the "before" variant is dashed, the calibrated one solid.
+  // With a calibration the "before" variant is dashed, the calibrated one solid. Lines
+  // join consecutive samples only along a trajectory; an unordered set gets dots.
   auto dashed = [&](size_t k) { return in.result != nullptr && k + 1 < shown.size(); };
+  const bool ordered = internal::IsTrajectory(d);
+  auto model_series = [&](const std::string& name, size_t k) {
+    PlotSeries p{name, x, {}, dashed(k), !ordered};
+    p.marker_radius_px = kMeasuredDotRadiusPx;
+    return p;
+  };
+  // Gross errors are not drawn: one 99999 kN reading would flatten every other point.
+  auto drawn = [&](size_t n, int i) {
+    return !in.result || n >= in.result->excluded.size() || !in.result->excluded[n][i];
+  };
   int buckets = 0;
 
   // Tension against time, one plot per cable: the measured tensions as small translucent
@@ -758,13 +665,14 @@ void AddPlots(const ReportInputs& in, Document* doc) {
     for (size_t k = 0; k < shown.size(); ++k) {
       const VariantEvaluation& v = in.variants[shown[k]];
       if (!HasPredictions(in, v)) continue;
-      PlotSeries p{v.name, x, {}, dashed(k), false};
+      PlotSeries p = model_series(v.name, k);
       for (const auto& predicted : v.predicted_n) p.y.push_back(predicted[i] / kNPerKn);
       PutAt(&series, shown[k], Thin(std::move(p), &buckets));
     }
     PlotSeries fitted{holdout ? "measured (fitted)" : "measured", {}, {}, false, true};
     PlotSeries held{"measured (held out)", {}, {}, false, true};
     for (size_t n = 0; n < d.samples.size(); ++n) {
+      if (!drawn(n, i)) continue;
       PlotSeries& m = IsHeldOut(in, n) ? held : fitted;
       m.x.push_back(x[n]);
       m.y.push_back(d.samples[n].tension_n[i] / kNPerKn);
@@ -782,11 +690,15 @@ void AddPlots(const ReportInputs& in, Document* doc) {
     o.height_px = kCablePlotHeightPx;
     cable_svgs.push_back(SvgLinePlot(series, o));
   }
+  const std::string not_drawn =
+      in.result && !in.result->gross_errors.empty() ? " Gross errors are not drawn." : "";
   doc->Figure(std::move(cable_svgs),
               std::string("Measured lower-end tension (translucent dots, drawn underneath") +
-                  (holdout ? "; held-out samples in light blue" : "") +
-                  ") and the model predictions (lines on top; dashed: before calibration) "
-                  "against time, per cable [kN]." +
+                  (holdout ? "; held-out samples in light blue" : "") + ") and the model " +
+                  (ordered ? "predictions (lines on top; dashed: before calibration)"
+                           : "predictions (dots on top: the samples are not a trajectory, so "
+                             "nothing joins them)") +
+                  " against time, per cable [kN]." + not_drawn +
                   ThinningNote(num_samples, buckets));
 
   // Residual distribution, all cables and samples pooled.
@@ -798,7 +710,8 @@ void AddPlots(const ReportInputs& in, Document* doc) {
     HistogramSeries h{v.name, {}};
     for (size_t n = 0; n < d.samples.size(); ++n) {
       for (int i = 0; i < kNumCables; ++i) {
-        h.values.push_back((v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn);
+        if (drawn(n, i))
+          h.values.push_back((v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn);
       }
     }
     PutAt(&histograms, k, std::move(h));
@@ -826,9 +739,10 @@ void AddPlots(const ReportInputs& in, Document* doc) {
     for (size_t k = 0; k < shown.size(); ++k) {
       const VariantEvaluation& v = in.variants[shown[k]];
       if (!HasPredictions(in, v)) continue;
-      PlotSeries p{v.name, x, {}, dashed(k), false};
+      PlotSeries p = model_series(v.name, k);
       for (size_t n = 0; n < d.samples.size(); ++n) {
-        p.y.push_back((v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn);
+        p.y.push_back(drawn(n, i) ? (v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn
+                                  : NAN);
       }
       PutAt(&series, shown[k], Thin(std::move(p), &residual_buckets));
     }
@@ -843,7 +757,8 @@ void AddPlots(const ReportInputs& in, Document* doc) {
   doc->Figure(std::move(residual_svgs),
               "Model - measured against time, per cable [kN]: a pattern that repeats with "
               "the pose is model error; what remains after calibration should look like noise." +
-                  ThinningNote(num_samples, residual_buckets));
+                  not_drawn + ThinningNote(num_samples, residual_buckets));
+  if (in.result) internal::AddDiagnosticPlots(in, doc);
 }
 
 void AddCalibratedModel(const ReportInputs& in, Document* doc) {
@@ -893,16 +808,21 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
   AddVerdict(in, &doc);
   if (in.result) {
     AddEstimates(*in.result, &doc);
+    internal::AddUncertaintyBudget(*in.result, &doc);
+    internal::AddGrossErrors(in, &doc);
+    internal::AddMisfitRanking(*in.result, &doc);
     AddIdentifiability(*in.result, with_plots, &doc);
   }
   AddRmsTables(in, with_plots, &doc);
+  if (in.result) internal::AddCrossValidation(*in.result, &doc);
   if (with_plots) {
     AddPlots(in, &doc);
   } else {
     doc.Heading(2, "Plots");
     doc.Paragraph(
-        "The plots (tension and model - measured against time per cable, residual "
-        "distribution, RMS per cable, correlation heatmap) are in report.html.");
+        "The plots (tension and model - measured against time per cable, residual against "
+        "off-axis angle and azimuth, predicted against measured, residual distribution, RMS "
+        "per cable, correlation heatmap) are in report.html.");
   }
   if (in.result) AddCalibratedModel(in, &doc);
   AddAppendices(in, &doc);
@@ -1050,6 +970,15 @@ figure svg { max-width: 100%; height: auto; }
 figcaption { color: #555; font-size: 13px; margin-top: 4px; }
 details { margin: 8px 0; }
 summary { cursor: pointer; font-weight: 600; }
+@media print {
+  body { background: #fff; font-size: 11px; }
+  main { max-width: none; padding: 0; }
+  details::details-content { content-visibility: visible; display: block; }
+  details > * { display: block; }
+  pre, code { white-space: pre-wrap; overflow-wrap: anywhere; }
+  table, figure, pre { break-inside: avoid; }
+  h2 { break-after: avoid; }
+}
 )";
 
 std::string HtmlInline(const Text& text) {
@@ -1220,6 +1149,11 @@ std::string RenderJson(const ReportInputs& in) {
   w.Key("report").String(r ? "calibration" : "evaluation");
   w.Key("software_version").String(in.software_version);
   w.Key("command_line").String(in.command_line);
+  w.Key("run_utc");
+  if (in.run_utc.empty())
+    w.Null();
+  else
+    w.String(in.run_utc);
   w.Key("inputs").BeginObject();
   JsonFile(&w, "model", in.model_path, in.model_digest);
   JsonFile(&w, "spec", in.spec_path, in.spec_digest);
@@ -1246,6 +1180,7 @@ std::string RenderJson(const ReportInputs& in) {
   });
   ObjectOrNull(&w, "holdout", spec != nullptr, [&] {
     w.Key("fraction").Number(spec->holdout_fraction);
+    w.Key("blocks").Int(spec->holdout_blocks);
     w.Key("seed");
     if (spec->holdout_seed <= static_cast<unsigned long long>(LLONG_MAX)) {
       w.Int(static_cast<long long>(spec->holdout_seed));
@@ -1281,11 +1216,32 @@ std::string RenderJson(const ReportInputs& in) {
       w.Key("free").Bool(p.free);
       w.Key("initial").Number(p.initial);
       w.Key("estimate").Number(p.estimate);
-      w.Key("sigma");
+      w.Key("consider").Bool(p.consider);
+      w.Key("sigma");  // formal
       if (p.free && r->covariance_ok)
         w.Number(p.sigma);
       else
         w.Null();
+      w.Key("sigma_total");
+      if ((p.free && r->covariance_ok) || p.consider)
+        w.Number(p.sigma_total);
+      else
+        w.Null();
+      ObjectOrNull(&w, "budget", p.free && r->covariance_ok, [&] {
+        w.Key("formal").Number(p.sigma);
+        w.Key("statistical").Number(p.sigma_statistical);
+        w.Key("widening").Number(p.widening);
+        w.Key("misfit_factor").Number(r->budget.misfit_factor);
+        w.Key("correlation_factor").Number(p.widening / r->budget.misfit_factor);
+        w.Key("autocorrelation_time_samples").Number(p.tau);
+        w.Key("systematic").Number(p.sigma_systematic);
+        w.Key("systematic_by_group").BeginObject();
+        for (size_t g = 0; g < r->budget.consider_groups.size(); ++g) {
+          w.Key(r->budget.consider_groups[g])
+              .Number(g < p.systematic_by_group.size() ? p.systematic_by_group[g] : 0.0);
+        }
+        w.EndObject();
+      });
       ObjectOrNull(&w, "prior", p.has_prior, [&] {
         w.Key("mean").Number(p.prior_mean);
         w.Key("sigma").Number(p.prior_sigma);
@@ -1308,6 +1264,7 @@ std::string RenderJson(const ReportInputs& in) {
     for (const std::string& c : r->strong_correlations) w.String(c);
   }
   w.EndArray();
+  if (r) internal::WriteDiagnosticsJson(*r, &w);
   ObjectOrNull(&w, "identifiability", r != nullptr, [&] {
     JsonIdentifiability(&w, "before", r->before);
     JsonIdentifiability(&w, "after", r->after);

@@ -10,15 +10,22 @@
 //                 tables, statistics and histogram use every sample
 //   summary.json  the numbers, for scripts (units in the key names: _kN, _percent)
 //
-// Sections: provenance (inputs with FNV-1a digests, software version, command line,
-// forward model and its error against the exact statics, evaluation method, noise model,
-// robust loss, hold-out, Ceres options, rows skipped); verdict (opening with "Poor fit"
-// when the reduced chi-square is outside ReducedChiSquareBand, calibration.h; termination,
-// iterations, cost, reduced chi-square and what it means); estimates with 1-sigma and priors;
-// identifiability (singular-value ratios, poorly determined and data-only directions,
-// strong correlations); RMS of model - measured per cable (the paper's Table 6) for each
-// variant on the fitted and the held-out samples; plots; how to use the calibrated model;
-// the Ceres full report. No dates: the same inputs give the same bytes.
+// Sections: provenance (inputs with FNV-1a digests, software version, command line, the
+// run's UTC date and time, forward model and its error against the exact statics,
+// evaluation method, noise model, robust loss, gross-error screen, hold-out and
+// cross-validation blocks, Ceres options, rows skipped); verdict (CalibrationResult's:
+// ok, noise overstated, misfit scaled into the uncertainties, or failed; termination,
+// iterations, cost, reduced chi-square and what it means, notes); estimates with
+// sigma_total, the formal sigma and priors; the uncertainty budget (formal, widening,
+// systematic per consider group); gross errors and the worst readings; what would explain
+// the misfit (score test); identifiability (singular-value ratios, poorly determined and
+// data-only directions, strong correlations); RMS of model - measured per cable (the
+// paper's Table 6) for each variant on the fitted and the held-out samples, and block
+// cross-validation; plots (per-cable tension and residual against time, joined by lines
+// only for a trajectory; residual against off-axis angle and azimuth; predicted against
+// measured; residual histogram; RMS bars; correlation heatmap); how to use the
+// calibrated model; the Ceres full report. The only date is ReportInputs::run_utc,
+// which the caller gives: the same inputs give the same bytes.
 //
 // Tensions are in kN in every table, plot and JSON key (the library is SI inside).
 #ifndef FASTCAL_REPORT_H_
@@ -43,6 +50,8 @@ struct ReportInputs {
   std::string model_digest, spec_digest, data_digest;
   std::string software_version;  // FASTCAL_VERSION
   std::string command_line;
+  // When the run happened, UTC, e.g. "2026-11-22T15:04:05Z"; empty: not recorded.
+  std::string run_utc;
   // Not owned; must outlive the calls. `data` is required. `spec` and `result` are null
   // for an evaluation-only report (`fastcal evaluate`); `initial_model` may be null.
   const CableRobot* initial_model = nullptr;
@@ -59,7 +68,8 @@ struct ReportInputs {
   std::string evaluation_method;
 };
 
-// The report as Markdown, HTML and JSON. Each is deterministic (no dates). They return
+// The report as Markdown, HTML and JSON. Each is deterministic (its only date is
+// run_utc). They return
 // an empty string only if memory runs out; missing inputs (no data, no variants) give a
 // report that says what is missing.
 std::string ReportMarkdown(const ReportInputs& inputs);

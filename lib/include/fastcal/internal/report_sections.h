@@ -1,0 +1,40 @@
+// The calibration report's diagnostic sections (report_diagnostics.cc), shared by the
+// Markdown/HTML document and summary.json (report.cc): the uncertainty budget, the gross
+// errors and worst readings, the misfit ranking, block cross-validation, and the plots
+// that suit unordered data (residual against the pose's off-axis angle and azimuth,
+// predicted against measured).
+#ifndef FASTCAL_INTERNAL_REPORT_SECTIONS_H_
+#define FASTCAL_INTERNAL_REPORT_SECTIONS_H_
+
+#include "fastcal/calibration.h"
+#include "fastcal/dataset.h"
+#include "fastcal/internal/json.h"
+#include "fastcal/internal/report_document.h"
+#include "fastcal/report.h"
+
+namespace fastcal::internal {
+
+// Whether the samples follow a trajectory (consecutive positions close against their
+// spread: lines join them) or are an unordered set (dots only): the median step between
+// consecutive positions below kTrajectoryStepFraction of the positions' RMS spread.
+inline constexpr double kTrajectoryStepFraction = 0.2;
+bool IsTrajectory(const Dataset& data);
+
+// Off-axis angle (deg, 0 at the bottom of the focal sphere) and azimuth (deg, [0, 360)
+// from +x toward +y) of a position seen from the focal centre (0, 0, 300) m.
+double OffAxisDeg(const Eigen::Vector3d& position_m);
+double AzimuthDeg(const Eigen::Vector3d& position_m);
+
+void AddUncertaintyBudget(const CalibrationResult& r, Document* doc);
+void AddGrossErrors(const ReportInputs& in, Document* doc);
+void AddMisfitRanking(const CalibrationResult& r, Document* doc);
+void AddCrossValidation(const CalibrationResult& r, Document* doc);
+void AddDiagnosticPlots(const ReportInputs& in, Document* doc);
+
+// summary.json's keys for the same: verdict, uncertainty_budget, gross_errors, outliers,
+// worst_readings, misfit_ranking, cross_validation, residual_autocorrelation_time.
+void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w);
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_INTERNAL_REPORT_SECTIONS_H_

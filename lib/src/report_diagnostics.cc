@@ -1,0 +1,428 @@
+// The calibration report's diagnostic sections (internal/report_sections.h): what the
+// uncertainty is made of (uncertainty.h), which readings were gross errors
+// (gross_errors.h), what would explain the misfit (the score test), how well each block
+// of the data is predicted by the rest, and plots against the pose.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <vector>
+
+#include "fastcal/internal/report_sections.h"
+#include "fastcal/svg_plot.h"
+
+namespace fastcal::internal {
+namespace {
+
+constexpr double kNPerKn = kReportNPerKn;
+// The focal centre of the off-axis angle and azimuth (docs/model.md, "Workspace").
+const Eigen::Vector3d kFocalCentre_m(0.0, 0.0, 300.0);
+// Rows at most in the report's tables of readings (summary.json has them all).
+constexpr size_t kMaxReadingRows = 50;
+constexpr size_t kMisfitRows = 10;
+// Plot geometry (px); scatter series thinned to this many points (min/max per bucket).
+constexpr int kScatterWidthPx = 540, kScatterHeightPx = 320;
+constexpr int kMaxScatterPoints = 2000;
+constexpr double kDotRadiusPx = 1.6, kDotOpacity = 0.5;
+
+std::string Sigma(double v) { return Sig3(v); }
+
+// "9 mm" for metres below 1 m, else the value and its unit.
+std::string WithUnit(double v, const std::string& unit) {
+  if (unit == "m" && std::abs(v) < 1.0) return Printf("%.2g", v * 1e3) + " mm";
+  return Printf("%.2g", v) + (unit == "1" ? "" : " " + unit);
+}
+
+std::vector<const ParameterEstimate*> FreeEstimates(const CalibrationResult& r) {
+  std::vector<const ParameterEstimate*> free;
+  for (const ParameterEstimate& p : r.parameters) {
+    if (p.free) free.push_back(&p);
+  }
+  return free;
+}
+
+// ---------------------------------------------------------------------------------------
+// The uncertainty budget.
+
+Text BudgetIntro(const CalibrationResult& r) {
+  const UncertaintyBudget& b = r.budget;
+  Text t(
+      "σ_total, the uncertainty to quote, is the root-sum-square of a statistical part and a "
+      "systematic part. Statistical: the formal σ (the stated noise, independent samples) "
+      "widened by what the data themselves show: by the misfit, √max(1, χ²/ν) = " +
+      Sig3(b.misfit_factor) +
+      " here, and by residuals correlated in time along the "
+      "trajectory, measured from the data (long-run covariance of the fit's scores by "
+      "overlapping batch means, corrected for what the fit absorbs). Systematic: parameters "
+      "held fixed but given a prior (consider parameters), their prior σ propagated through "
+      "the sensitivity of the estimates to them. docs/calibration.md gives the formulas.");
+  return t;
+}
+
+std::string CorrelationSentence(const UncertaintyBudget& b) {
+  if (b.samples == 0) return "";
+  if (!b.correlated) {
+    return "The residuals are not correlated in time (largest autocorrelation time " + Sig3(b.tau) +
+           " samples, not significantly above 1): no widening for correlation.";
+  }
+  std::string s =
+      "The residuals are correlated in time: the parameters' influence series have "
+      "autocorrelation times up to " +
+      Sig3(b.tau) + " samples, so the " + Int(b.samples) + " samples carry about " +
+      Sig3(b.effective_samples) + " independent pieces of information (batch length " +
+      Int(b.bandwidth) + ").";
+  if (!b.correlation_reliable) {
+    s += " Their memory is too long for these data to measure it fully (the fit absorbs most "
+         "of a batch's slow error): the widening is a lower bound; longer or more varied data "
+         "would tell.";
+  }
+  return s;
+}
+
+}  // namespace
+
+bool IsTrajectory(const Dataset& data) {
+  const size_t n = data.samples.size();
+  if (n < 3) return true;
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Sample& s : data.samples) mean += s.pose.position_m;
+  mean /= static_cast<double>(n);
+  double spread2 = 0.0;
+  for (const Sample& s : data.samples) spread2 += (s.pose.position_m - mean).squaredNorm();
+  const double spread = std::sqrt(spread2 / n);
+  std::vector<double> steps;
+  for (size_t t = 1; t < n; ++t) {
+    steps.push_back((data.samples[t].pose.position_m - data.samples[t - 1].pose.position_m).norm());
+  }
+  std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
+  return steps[steps.size() / 2] <= kTrajectoryStepFraction * spread;
+}
+
+double OffAxisDeg(const Eigen::Vector3d& position_m) {
+  const Eigen::Vector3d d = position_m - kFocalCentre_m;
+  return std::atan2(std::hypot(d.x(), d.y()), -d.z()) * 180.0 / M_PI;
+}
+
+double AzimuthDeg(const Eigen::Vector3d& position_m) {
+  const double a = std::atan2(position_m.y(), position_m.x()) * 180.0 / M_PI;
+  return a < 0.0 ? a + 360.0 : a;
+}
+
+void AddUncertaintyBudget(const CalibrationResult& r, Document* doc) {
+  doc->Heading(2, "Uncertainty budget");
+  if (!r.covariance_ok) {
+    doc->Paragraph("Not available: the covariance could not be computed.");
+    return;
+  }
+  const UncertaintyBudget& b = r.budget;
+  doc->Paragraph(BudgetIntro(r));
+  Table t;
+  t.caption = "Parts of σ_total per free parameter, in the parameter's unit";
+  t.header = {"Parameter", "Unit", "formal σ", "misfit ×", "correlation ×", "statistical σ"};
+  t.right_align = {false, false, true, true, true, true};
+  for (const std::string& g : b.consider_groups) {
+    t.header.push_back(Text("systematic: ").Code(g));
+    t.right_align.push_back(true);
+  }
+  t.header.push_back("systematic σ");
+  t.header.push_back(Text().Bold("σ_total"));
+  t.right_align.insert(t.right_align.end(), {true, true});
+  for (const ParameterEstimate* p : FreeEstimates(r)) {
+    const double misfit = b.misfit_factor;
+    std::vector<Text> row = {Text().Code(p->name),
+                             p->unit,
+                             Sigma(p->sigma),
+                             Printf("%.3g", misfit),
+                             Printf("%.3g", p->widening / misfit),
+                             Sigma(p->sigma_statistical)};
+    for (size_t g = 0; g < b.consider_groups.size(); ++g) {
+      row.push_back(g < p->systematic_by_group.size() ? Sigma(p->systematic_by_group[g]) : "-");
+    }
+    row.push_back(Sigma(p->sigma_systematic));
+    row.push_back(Text().Bold(Sigma(p->sigma_total)));
+    t.rows.push_back(std::move(row));
+  }
+  doc->AddTable(std::move(t));
+  doc->Paragraph(CorrelationSentence(b));
+  std::vector<Text> groups;
+  for (size_t g = 0; g < b.consider_groups.size(); ++g) {
+    Text item = Text().Code(b.consider_groups[g]).Plain(": ");
+    bool first = true;
+    for (const ParameterEstimate* p : FreeEstimates(r)) {
+      if (g >= p->systematic_by_group.size()) continue;
+      item.Plain(std::string(first ? "" : ", ") + WithUnit(p->systematic_by_group[g], p->unit) +
+                 " on ")
+          .Code(p->name);
+      first = false;
+    }
+    groups.push_back(std::move(item));
+  }
+  if (!groups.empty()) {
+    doc->Paragraph("What each group of consider parameters adds (1σ of its prior):");
+    doc->List(std::move(groups));
+  } else {
+    doc->Paragraph(
+        "No consider parameters: the systematic part is 0. A parameter held fixed but known "
+        "only to a tolerance (a sensor's gain, a tower's survey) belongs in the spec as "
+        "free: false with a prior; the misfit ranking below shows which ones the data point "
+        "at.");
+  }
+}
+
+void AddGrossErrors(const ReportInputs& in, Document* doc) {
+  const CalibrationResult& r = *in.result;
+  const GrossErrorSummary& g = r.gross_error_summary;
+  doc->Heading(2, "Gross errors and worst readings");
+  if (!g.enabled) {
+    doc->Paragraph(Text("Not screened (").Code("gross_errors: {detect: false}").Plain(")."));
+  } else {
+    doc->Paragraph(
+        "A reading more than " + Sig3(g.threshold_sigmas) +
+        " robust σ from the model (the median and 1.4826 × MAD of its cable's whitened "
+        "residuals, at least the stated noise) is a gross error: kept out of the fit and of "
+        "the statistics, and re-judged after every pass so that gross errors cannot hide "
+        "each other. " +
+        Int(static_cast<long long>(r.gross_errors.size())) +
+        (r.gross_errors.size() == 1 ? " reading was" : " readings were") + " flagged.");
+    Table s;
+    s.caption = "Per cable";
+    s.header = {"", "T1", "T2", "T3", "T4", "T5", "T6"};
+    s.right_align = {false, true, true, true, true, true, true};
+    std::vector<Text> count = {"gross errors"}, centre = {"median residual [σ]"},
+                      scale = {"robust scale [σ]"};
+    for (int i = 0; i < kNumCables; ++i) {
+      count.push_back(Int(g.count[i]));
+      centre.push_back(Printf("%+.2f", g.centre[i]));
+      scale.push_back(Printf("%.2f", g.scale[i]));
+    }
+    s.rows = {count, centre, scale};
+    doc->AddTable(std::move(s));
+  }
+  auto readings = [&](const std::vector<ReadingResidual>& list, const Text& caption) {
+    Table t;
+    t.caption = caption;
+    t.header = {"Line",    "Cable", "Measured [kN]", "Predicted [kN]", "(model - measured) / σ",
+                "Held out"};
+    t.right_align = {true, true, true, true, true, false};
+    for (size_t k = 0; k < std::min(list.size(), kMaxReadingRows); ++k) {
+      const ReadingResidual& e = list[k];
+      t.rows.push_back({Int(e.line), Int(e.cable), Kn3(e.measured_n), Kn3(e.predicted_n),
+                        Printf("%+.1f", e.residual_sigma), e.held_out ? "yes" : ""});
+    }
+    doc->AddTable(std::move(t));
+    if (list.size() > kMaxReadingRows) {
+      doc->Paragraph("... and " + Int(static_cast<long long>(list.size() - kMaxReadingRows)) +
+                     " more, all in summary.json.");
+    }
+  };
+  if (!r.gross_errors.empty()) readings(r.gross_errors, "Gross errors (line in the data file)");
+  if (!r.worst_readings.empty()) {
+    readings(r.worst_readings, "The worst fitted readings (largest |model - measured| / σ)");
+  }
+}
+
+void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
+  doc->Heading(2, "What would explain the misfit");
+  doc->Paragraph(
+      "For every parameter held fixed (each group's common value and each cable's, every "
+      "offset axis), the chi-square decrease expected from freeing it, from a score test "
+      "at the solution (no refit; exact for a linear model). White noise alone lets the "
+      "best of these reach about " +
+      Sig3(r.misfit_threshold) +
+      "; residuals correlated in time inflate them all alike, so compare them with each "
+      "other.");
+  if (r.misfit_ranking.empty()) {
+    doc->Paragraph("No candidate: every parameter is free or spanned by the free ones.");
+    return;
+  }
+  Text lead;
+  if (r.misfit_ranking.front().significant) {
+    lead.Bold("The misfit is best explained by freeing:").Plain(" ");
+    for (size_t k = 0; k < std::min<size_t>(3, r.misfit_ranking.size()); ++k) {
+      const MisfitCandidate& c = r.misfit_ranking[k];
+      if (!c.significant) break;
+      lead.Plain(k ? ", " : "").Code(c.name).Plain(" (about " + Sig3(c.expected_decrease) + ")");
+    }
+    lead.Plain(
+        ". Free it (with a prior if the data alone cannot hold it) or give it a "
+        "consider prior, and calibrate again.");
+  } else {
+    lead.Plain("No fixed parameter explains more of the misfit than noise alone would.");
+  }
+  doc->Paragraph(lead);
+  Table t;
+  t.header = {"Rank", "Parameter", "Expected χ² decrease", "Above the noise"};
+  t.right_align = {true, false, true, false};
+  for (size_t k = 0; k < std::min(kMisfitRows, r.misfit_ranking.size()); ++k) {
+    const MisfitCandidate& c = r.misfit_ranking[k];
+    t.rows.push_back({Int(static_cast<long long>(k + 1)), Text().Code(c.name),
+                      Sig3(c.expected_decrease), c.significant ? "yes" : "no"});
+  }
+  doc->AddTable(std::move(t));
+}
+
+void AddCrossValidation(const CalibrationResult& r, Document* doc) {
+  const CrossValidation& cv = r.cross_validation;
+  if (cv.folds_used == 0) return;
+  Table t;
+  t.caption = Text("Block cross-validation (" + Int(cv.folds_used) + " of " + Int(cv.blocks) +
+                   " blocks): RMS of model - measured [kN]");
+  t.header = {"", "T1", "T2", "T3", "T4", "T5", "T6"};
+  t.right_align = {false, true, true, true, true, true, true};
+  std::vector<Text> fit = {"calibrated, fitted"},
+                    held = {Text().Bold("calibrated, cross-validated")};
+  for (int i = 0; i < kNumCables; ++i) {
+    fit.push_back(Kn3(cv.fit_rms_n[i]));
+    held.push_back(Kn3(cv.rms_n[i]));
+  }
+  t.rows = {fit, held};
+  doc->AddTable(std::move(t));
+  doc->Paragraph(
+      "The fitted samples cut into " + Int(cv.blocks) +
+      " contiguous blocks, each predicted by the fit without it: one Gauss-Newton step from "
+      "the full fit (exact for a linear model). Contiguous blocks, not single samples: a sample of "
+      "a slow trajectory "
+      "is predicted by its neighbours. Cross-validated RMS well above the fitted one means "
+      "the fit follows the data where it should not (too many free parameters, or slow "
+      "errors it absorbs).");
+}
+
+void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
+  const CalibrationResult& r = *in.result;
+  if (in.variants.empty() || !in.data) return;
+  const VariantEvaluation& v = in.variants.back();
+  const Dataset& d = *in.data;
+  if (v.predicted_n.size() != d.samples.size()) return;
+  std::vector<PlotSeries> zenith(kNumCables), azimuth(kNumCables), versus(kNumCables + 1);
+  int excluded = 0;
+  double lo = INFINITY, hi = -INFINITY;
+  for (int i = 0; i < kNumCables; ++i) {
+    for (PlotSeries* s : {&zenith[i], &azimuth[i], &versus[i]}) {
+      s->name = "T" + Int(i + 1);
+      s->markers_only = true;
+      s->marker_radius_px = kDotRadiusPx;
+      s->opacity = kDotOpacity;
+    }
+    for (size_t n = 0; n < d.samples.size(); ++n) {
+      if (n < r.excluded.size() && r.excluded[n][i]) {
+        ++excluded;
+        continue;
+      }
+      const Sample& s = d.samples[n];
+      const double residual_kn = (v.predicted_n[n][i] - s.tension_n[i]) / kNPerKn;
+      zenith[i].x.push_back(OffAxisDeg(s.pose.position_m));
+      zenith[i].y.push_back(residual_kn);
+      azimuth[i].x.push_back(AzimuthDeg(s.pose.position_m));
+      azimuth[i].y.push_back(residual_kn);
+      versus[i].x.push_back(s.tension_n[i] / kNPerKn);
+      versus[i].y.push_back(v.predicted_n[n][i] / kNPerKn);
+      lo = std::min(lo, s.tension_n[i] / kNPerKn);
+      hi = std::max(hi, s.tension_n[i] / kNPerKn);
+    }
+    for (PlotSeries* s : {&zenith[i], &azimuth[i], &versus[i]}) {
+      *s = ThinMinMaxPerBucket(*s, kMaxScatterPoints);
+    }
+  }
+  versus[kNumCables] = PlotSeries{"predicted = measured", {lo, hi}, {lo, hi}, true, false};
+  PlotOptions o;
+  o.width_px = kScatterWidthPx;
+  o.height_px = kScatterHeightPx;
+  o.y_label = "model - measured [kN]";
+  o.title = "Residual against off-axis angle";
+  o.x_label = "off-axis angle from the focal centre [deg]";
+  const std::string a = SvgLinePlot(zenith, o);
+  o.title = "Residual against azimuth";
+  o.x_label = "azimuth [deg]";
+  const std::string b = SvgLinePlot(azimuth, o);
+  o.title = "Predicted against measured";
+  o.x_label = "measured [kN]";
+  o.y_label = "predicted by the calibrated model [kN]";
+  const std::string c = SvgLinePlot(versus, o);
+  doc->Figure({a, b, c},
+              "The calibrated model's residuals per cable against where the cabin was (off-axis "
+              "angle and azimuth seen from the focal centre): a trend or a wave is model error "
+              "that depends on the pose, not noise. Last: predicted against measured tension, "
+              "with the diagonal." +
+                  (excluded > 0 ? " " + Int(excluded) + " gross errors are not drawn." : ""));
+}
+
+void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
+  w->Key("verdict").BeginObject();
+  w->Key("status").String(FitVerdictName(r.verdict));
+  w->Key("text").String(r.verdict_text);
+  w->Key("notes").BeginArray();
+  for (const std::string& n : r.notes) w->String(n);
+  w->EndArray();
+  w->EndObject();
+
+  const UncertaintyBudget& b = r.budget;
+  w->Key("uncertainty_budget").BeginObject();
+  w->Key("reduced_chi_square").Number(b.reduced_chi_square);
+  w->Key("misfit_factor").Number(b.misfit_factor);
+  w->Key("residuals_correlated").Bool(b.correlated);
+  w->Key("autocorrelation_time_samples").Number(b.tau);
+  w->Key("batch_length_samples").Int(b.bandwidth);
+  w->Key("samples").Int(b.samples);
+  w->Key("effective_samples").Number(b.effective_samples);
+  w->Key("correlation_reliable").Bool(b.correlation_reliable);
+  w->Key("consider_groups").BeginArray();
+  for (const std::string& g : b.consider_groups) w->String(g);
+  w->EndArray();
+  w->EndObject();
+
+  const GrossErrorSummary& g = r.gross_error_summary;
+  w->Key("gross_errors").BeginObject();
+  w->Key("detect").Bool(g.enabled);
+  w->Key("threshold_sigmas").Number(g.threshold_sigmas);
+  w->Key("count_per_cable").NumberArray(std::vector<double>(g.count.begin(), g.count.end()));
+  w->Key("robust_centre_sigma").NumberArray(g.centre);
+  w->Key("robust_scale_sigma").NumberArray(g.scale);
+  w->Key("fitted_readings").Int(g.fitted_readings);
+  w->Key("fitted_flagged").Int(g.fitted_flagged);
+  w->Key("settled").Bool(g.settled);
+  w->EndObject();
+
+  auto readings = [&](const char* key, const std::vector<ReadingResidual>& list) {
+    w->Key(key).BeginArray();
+    for (const ReadingResidual& e : list) {
+      w->BeginObject();
+      w->Key("line").Int(e.line);
+      w->Key("cable").Int(e.cable);
+      w->Key("measured_kN").Number(e.measured_n / kNPerKn);
+      w->Key("predicted_kN").Number(e.predicted_n / kNPerKn);
+      w->Key("residual_sigma").Number(e.residual_sigma);
+      w->Key("held_out").Bool(e.held_out);
+      w->EndObject();
+    }
+    w->EndArray();
+  };
+  readings("outliers", r.gross_errors);
+  readings("worst_readings", r.worst_readings);
+
+  w->Key("misfit_ranking").BeginArray();
+  for (const MisfitCandidate& c : r.misfit_ranking) {
+    w->BeginObject();
+    w->Key("name").String(c.name);
+    w->Key("expected_chi_square_decrease").Number(c.expected_decrease);
+    w->Key("significant").Bool(c.significant);
+    w->EndObject();
+  }
+  w->EndArray();
+  w->Key("misfit_noise_threshold").Number(r.misfit_threshold);
+
+  const CrossValidation& cv = r.cross_validation;
+  w->Key("cross_validation").BeginObject();
+  w->Key("blocks").Int(cv.blocks);
+  w->Key("blocks_used").Int(cv.folds_used);
+  std::vector<double> rms, fit;
+  for (int i = 0; i < kNumCables; ++i) {
+    rms.push_back(cv.rms_n[i] / kNPerKn);
+    fit.push_back(cv.fit_rms_n[i] / kNPerKn);
+  }
+  w->Key("rms_kN").NumberArray(rms);
+  w->Key("fit_rms_kN").NumberArray(fit);
+  w->EndObject();
+  w->Key("residual_autocorrelation_time_samples").NumberArray(r.residual_tau);
+}
+
+}  // namespace fastcal::internal
