@@ -78,6 +78,11 @@ void ExpectSameSpec(const CalibrationSpec& a, const CalibrationSpec& b) {
   EXPECT_EQ(a.gradient_tolerance, b.gradient_tolerance);
   EXPECT_EQ(a.parameter_tolerance, b.parameter_tolerance);
   EXPECT_EQ(a.num_threads, b.num_threads);
+  EXPECT_EQ(a.holdout_blocks, b.holdout_blocks);
+  EXPECT_EQ(a.cross_validation_blocks, b.cross_validation_blocks);
+  EXPECT_EQ(a.detect_gross_errors, b.detect_gross_errors);
+  EXPECT_EQ(a.gross_error_threshold_sigmas, b.gross_error_threshold_sigmas);
+  EXPECT_EQ(a.max_gross_error_fraction, b.max_gross_error_fraction);
   ASSERT_EQ(a.parameters.size(), b.parameters.size());
   for (size_t k = 0; k < a.parameters.size(); ++k) {
     ExpectSameParameter(a.parameters[k], b.parameters[k]);
@@ -91,7 +96,9 @@ noise:
   tension_sigma_kN: 0.5
   tension_sigma_percent: 2.5
 robust_loss: {type: huber, scale: 1.5}
-holdout: {fraction: 0.2, seed: 7}
+gross_errors: {detect: false, threshold_sigmas: 6, max_fraction: 0.1}
+holdout: {fraction: 0.2, seed: 7, blocks: 5}
+cross_validation: {blocks: 8}
 attitude: planned
 solver: {max_iterations: 50, function_tolerance: 1e-10, gradient_tolerance: 1e-11, parameter_tolerance: 1e-9, threads: 4}
 parameters:
@@ -119,6 +126,13 @@ TEST(CalibrationSpecTest, EmptySpecHasTheDefaults) {
   }
   EXPECT_EQ(defaults.forward_model, StaticsMethod::kAasRefined);
   EXPECT_EQ(defaults.tension_sigma_percent, 3.0);
+  // Gross errors screened by default, at 5 robust sigmas; hold-out and cross-validation
+  // by 10 contiguous blocks.
+  EXPECT_TRUE(defaults.detect_gross_errors);
+  EXPECT_EQ(defaults.gross_error_threshold_sigmas, 5.0);
+  EXPECT_EQ(defaults.max_gross_error_fraction, 0.25);
+  EXPECT_EQ(defaults.holdout_blocks, 10);
+  EXPECT_EQ(defaults.cross_validation_blocks, 10);
   EXPECT_TRUE(defaults.IsValid(nullptr));
 }
 
@@ -131,6 +145,11 @@ TEST(CalibrationSpecTest, OptionsAreRead) {
   EXPECT_EQ(spec.robust_loss_scale, 1.5);
   EXPECT_EQ(spec.holdout_fraction, 0.2);
   EXPECT_EQ(spec.holdout_seed, 7u);
+  EXPECT_EQ(spec.holdout_blocks, 5);
+  EXPECT_EQ(spec.cross_validation_blocks, 8);
+  EXPECT_FALSE(spec.detect_gross_errors);
+  EXPECT_EQ(spec.gross_error_threshold_sigmas, 6.0);
+  EXPECT_EQ(spec.max_gross_error_fraction, 0.1);
   EXPECT_TRUE(spec.use_planned_attitude);
   EXPECT_EQ(spec.max_iterations, 50);
   EXPECT_EQ(spec.function_tolerance, 1e-10);
@@ -461,6 +480,12 @@ const ErrorCase kErrorCases[] = {
     {"holdout: {fraction: 1}\n", 1, "holdout.fraction", "[0, 1)"},
     {"holdout:\n  fraction: -0.1\n", 2, "holdout.fraction", "[0, 1)"},
     {"holdout:\n  seed: -1\n", 2, "holdout.seed", "integer"},
+    {"holdout: {blocks: 1}\n", 1, "holdout.blocks", ">= 2"},
+    {"cross_validation: {blocks: 0}\n", 1, "cross_validation.blocks", ">= 2"},
+    {"cross_validation: {folds: 5}\n", 1, "cross_validation.folds", "unknown key"},
+    {"gross_errors: {detect: maybe}\n", 1, "gross_errors.detect", "true or false"},
+    {"gross_errors:\n  threshold_sigmas: 0\n", 2, "gross_errors.threshold_sigmas", "> 0"},
+    {"gross_errors: {max_fraction: 1.5}\n", 1, "gross_errors.max_fraction", "(0, 1]"},
     {"solver:\n  threads: 0\n", 2, "solver.threads", ">= 1"},
     {"solver:\n  max_iterations: 0\n", 2, "solver.max_iterations", ">= 1"},
     {"solver:\n  max_iterations: 1.5\n", 2, "solver.max_iterations", "integer"},
@@ -527,6 +552,38 @@ TEST(CalibrationSpecTest, ErrorsNameTheFileTheLineAndTheKey) {
   }
 }
 
+// A fixed parameter with a prior is a consider parameter (it was silently ignored).
+TEST(CalibrationSpecTest, FixedWithPriorIsAConsiderParameter) {
+  const CalibrationSpec spec = ParseOk(
+      "parameters:\n  sensor_gain: {mode: per_cable, free: false, prior: {mean: 1, sigma: 0.01}}\n"
+      "  cabin_mass_kg: {free: true, prior: {mean: 30000, sigma: 300}}\n"
+      "  ea_n: {free: false}\n");
+  int consider = 0;
+  for (const ParameterSpec& p : spec.parameters) {
+    consider += p.IsConsider();
+    EXPECT_EQ(p.IsConsider(), p.kind == ParameterKind::kSensorGain) << p.name;
+  }
+  EXPECT_EQ(consider, kNumCables);
+}
+
+// The candidates of the misfit ranking: every parameter a spec can name.
+TEST(CalibrationSpecTest, AllModelParametersNamesEveryParameterOnce) {
+  const std::vector<ParameterSpec> all = AllModelParameters(3);
+  // 3 mass centre, 1 cabin mass, 4 per-cable groups x (common + 6), 3 x 3 anchor, 6 x 3 tower.
+  EXPECT_EQ(all.size(), 3u + 1u + 4u * 7u + 9u + 18u);
+  for (size_t a = 0; a < all.size(); ++a) {
+    EXPECT_FALSE(all[a].free);
+    for (size_t b = a + 1; b < all.size(); ++b) {
+      EXPECT_FALSE(SameParameter(all[a], all[b])) << all[a].name << " " << all[b].name;
+      EXPECT_NE(all[a].name, all[b].name);
+    }
+  }
+  EXPECT_EQ(all[0].name, "mass_centre_m.x");
+  EXPECT_EQ(all.back().name, "sensor_bias_kN[6]");
+  EXPECT_EQ(all.back().to_si, kNewtonsPerKilonewton);
+  EXPECT_STREQ(ParameterGroupName(ParameterKind::kTowerOffset), "tower_offset_m");
+}
+
 TEST(CalibrationSpecTest, AllShorthandNeedsAnchorPoints) {
   const std::string error = ParseError("parameters: {anchor_offset_m: {all: {}}}\n", 0);
   EXPECT_NE(error.find("anchor_offset_m.all"), std::string::npos) << error;
@@ -579,6 +636,11 @@ TEST(CalibrationSpecTest, IsValidRejectsEachImpossibleValue) {
       {"both 0", [](CalibrationSpec* s) { s->tension_sigma_percent = 0; }},
       {"robust_loss_scale", [](CalibrationSpec* s) { s->robust_loss_scale = 0; }},
       {"holdout_fraction", [](CalibrationSpec* s) { s->holdout_fraction = 1; }},
+      {"holdout_blocks", [](CalibrationSpec* s) { s->holdout_blocks = 1; }},
+      {"cross_validation_blocks", [](CalibrationSpec* s) { s->cross_validation_blocks = 1; }},
+      {"gross_error_threshold_sigmas",
+       [](CalibrationSpec* s) { s->gross_error_threshold_sigmas = 0; }},
+      {"max_gross_error_fraction", [](CalibrationSpec* s) { s->max_gross_error_fraction = 0; }},
       {"max_iterations", [](CalibrationSpec* s) { s->max_iterations = 0; }},
       {"num_threads", [](CalibrationSpec* s) { s->num_threads = 0; }},
       {"function_tolerance", [](CalibrationSpec* s) { s->function_tolerance = 0; }},

@@ -482,8 +482,9 @@ TEST_F(CliTest, CalibratePoorFitWarns) {
                            "chi-square [0-9.]+ is above 1 \\+ 1.34: the residuals are [0-9.]+ "
                            "times the stated noise")))
       << r.output;
-  EXPECT_NE(ReadFile(out + "/report.md").find("## Verdict\n\n**Misfit, scaled into the "
-                                              "uncertainties:** reduced chi-square"),
+  EXPECT_NE(ReadFile(out + "/report.md")
+                .find("## Verdict\n\n**Misfit, scaled into the "
+                      "uncertainties:** reduced chi-square"),
             std::string::npos);
   EXPECT_NE(ReadFile(out + "/summary.json").find("\"reduced_chi_square_within_band\": false"),
             std::string::npos);
@@ -613,6 +614,101 @@ TEST_F(CliTest, SkipInvalidRowsSkipsPosesTheModelCannotSolve) {
   const std::string md = ReadFile(Path("cal") + "/report.md");
   EXPECT_NE(md.find("1 row skipped"), std::string::npos);
   EXPECT_NE(md.find(where + "the initial model cannot solve this pose"), std::string::npos);
+}
+
+// A mistyped reading (T3_kN = 99999 on line 9) is named by line and cable on the
+// console and in summary.json, kept out of the fit, and the estimates stay sane.
+TEST_F(CliTest, CalibrateNamesAGrossErrorByLineAndCable) {
+  // Line 9 of the bundled circle with its T3_kN replaced by 99999.
+  std::ifstream in(Source() + "/calibration_data/circle_paper.csv");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  ASSERT_GT(lines.size(), 9u);
+  auto split = [](const std::string& line) {
+    std::vector<std::string> fields;
+    std::stringstream row(line);
+    for (std::string f; std::getline(row, f, ',');) fields.push_back(f);
+    return fields;
+  };
+  const std::vector<std::string> names = split(lines[3]);  // after three comment lines
+  const size_t t3 = std::find(names.begin(), names.end(), "T3_kN") - names.begin();
+  std::vector<std::string> fields = split(lines[8]);
+  ASSERT_LT(t3, fields.size());
+  fields[t3] = "99999";
+  lines[8].clear();
+  for (size_t k = 0; k < fields.size(); ++k) lines[8] += (k ? "," : "") + fields[k];
+  std::string all;
+  for (const std::string& l : lines) all += l + "\n";
+  Write("typo.csv", all);
+  const std::string out = Path("typo");
+  const CommandResult r =
+      Fastcal("calibrate --quiet --spec=" + Source() +
+              "/calibration_data/spec_mass_centre_density.yaml --data=" + Path("typo.csv") +
+              " --out=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("gross errors (more than 5 robust sigmas from the model): 1 reading"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("line 9, cable 3: measured 99999.000 kN"), std::string::npos) << r.output;
+  const std::string json = ReadFile(out + "/summary.json");
+  EXPECT_NE(json.find("\"outliers\": [\n    {\n      \"line\": 9,\n      \"cable\": 3,"),
+            std::string::npos)
+      << json;
+  // The density stays near the truth (11.718; the gross error pulled it to 21.2).
+  const std::string model = ReadFile(out + "/model_calibrated.yaml");
+  EXPECT_NE(model.find("#   linear_density_kg_per_m = 11.7"), std::string::npos) << model;
+  EXPECT_NE(model.find("# verdict: ok"), std::string::npos) << model;
+}
+
+// A fixed parameter with a prior is a consider parameter: its contribution to each
+// estimate is named on the console; the new simulate flags work and are checked.
+TEST_F(CliTest, ConsiderParametersAndRealisticSimulation) {
+  const std::string data = Path("real.csv");
+  CommandResult r = Fastcal(
+      "simulate --nodes=120 --mass-centre=0.22,0.11,0.5 --attitude-control-deg=0.2 "
+      "--attitude-control-time-s=30 --tension-drift-pct=1 --tension-drift-time-s=60 "
+      "--mass-centre-drift-m=0.005 --mass-centre-drift-time-s=300 --sensor-gain-spread-pct=1 "
+      "--sensor-bias-spread-kn=1 --seed=4 --out=" +
+      data);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("slow tension error RMS per cable (%)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("average actual mass centre"), std::string::npos) << r.output;
+  Write("consider.yaml",
+        "parameters:\n  mass_centre_m: {x: {free: true}, y: {free: true}}\n"
+        "  sensor_gain: {mode: per_cable, free: false, prior: {mean: 1, sigma: 0.01}}\n");
+  r = Fastcal("calibrate --quiet --spec=" + Path("consider.yaml") + " --data=" + data +
+              " --out=" + Path("cons"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(std::regex_search(
+      r.output, std::regex("systematic, from sensor_gain: [0-9.]+ mm on mass_centre_m.x, "
+                           "[0-9.]+ mm on mass_centre_m.y")))
+      << r.output;
+  EXPECT_NE(r.output.find("consider (fixed, prior sigma)"), std::string::npos) << r.output;
+  r = Fastcal("simulate --tension-drift-time-s=-1 --out=" + Path("bad.csv"));
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--tension-drift-time-s"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(Path("bad.csv")));
+}
+
+// A fit that failed still writes its outputs, as a record, and the model file says so.
+// (Screened for gross errors, these data would be refused as mostly gross errors.)
+TEST_F(CliTest, FailedFitIsMarkedInTheModelFile) {
+  Write("unscreened.yaml",
+        "gross_errors: {detect: false}\nparameters: {mass_centre_m: {x: {free: true}}}\n");
+  Write("far.csv",
+        "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
+        "0,71.11,0,156.73,0.02,-5.31,0.11,412.4,87.9,243.2,51.7,290.3,105.8\n"
+        "1,70.96,4.65,156.73,0.35,-5.30,0.09,114.0,290.2,41.8,249.9,88.6,307.1\n"
+        "2,70.5,9.2,156.73,0.5,-5.2,0.1,300.0,100.0,300.0,100.0,300.0,100.0\n");
+  const std::string out = Path("far");
+  const CommandResult r = Fastcal("calibrate --quiet --spec=" + Path("unscreened.yaml") +
+                                  " --data=" + Path("far.csv") + " --out=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("fastcal calibrate: warning: the fit failed"), std::string::npos)
+      << r.output;
+  const std::string model = ReadFile(out + "/model_calibrated.yaml");
+  EXPECT_EQ(model.rfind("# WARNING: THIS CALIBRATION FAILED; DO NOT USE THIS MODEL.", 0), 0u)
+      << model;
 }
 
 }  // namespace

@@ -263,6 +263,131 @@ TEST(SimulationTest, EachErrorSourceHasItsOwnStream) {
   }
 }
 
+// Lag-k autocorrelation of a series.
+double Autocorrelation(const std::vector<double>& x, int lag) {
+  double mean = 0.0;
+  for (double v : x) mean += v / x.size();
+  double c0 = 0.0, ck = 0.0;
+  for (size_t t = 0; t < x.size(); ++t) {
+    c0 += (x[t] - mean) * (x[t] - mean);
+    if (t + lag < x.size()) ck += (x[t] - mean) * (x[t + lag] - mean);
+  }
+  return ck / c0;
+}
+
+// The slow tension error is an AR(1) per cable: its RMS and its lag-1 correlation
+// exp(-dt / tau) are those asked for, and it is the same error the summary reports.
+TEST(SimulationTest, TensionDriftIsAnAr1WithTheRequestedSigmaAndTime) {
+  constexpr int kNodes = 2000;
+  constexpr double kDriftPercent = 2.0, kTime_s = 20.0, kInterval_s = 1.0;
+  constexpr double kRmsRelTol = 0.25;  // 2000 samples of tau ~ 39: ~50 independent
+  constexpr double kRhoTol = 0.03;
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(kNodes);
+  SimulationOptions options = NoNoise();
+  options.tension_drift_percent = kDriftPercent;
+  options.tension_drift_time_s = kTime_s;
+  options.sample_interval_s = kInterval_s;
+  Dataset quiet, drifting;
+  SimulationSummary summary;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, NoNoise(), &quiet, nullptr, nullptr, &error)) << error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &drifting, nullptr, &summary, &error)) << error;
+  for (int i = 0; i < kNumCables; ++i) {
+    std::vector<double> u;
+    double sum2 = 0.0;
+    for (int n = 0; n < kNodes; ++n) {
+      u.push_back(drifting.samples[n].tension_n[i] / quiet.samples[n].tension_n[i] - 1.0);
+      sum2 += u.back() * u.back();
+    }
+    EXPECT_NEAR(std::sqrt(sum2 / kNodes), summary.tension_drift_rms_relative[i], 1e-12);
+    EXPECT_NEAR(summary.tension_drift_rms_relative[i], kDriftPercent / 100.0,
+                kRmsRelTol * kDriftPercent / 100.0)
+        << "cable " << i + 1;
+    EXPECT_NEAR(Autocorrelation(u, 1), std::exp(-kInterval_s / kTime_s), kRhoTol);
+  }
+  // The poses are untouched: each error source has its own stream.
+  for (int n = 0; n < kNodes; ++n) {
+    EXPECT_EQ(drifting.samples[n].pose.rotation, quiet.samples[n].pose.rotation);
+  }
+}
+
+// A smooth attitude control error: correlated from sample to sample; without a time it
+// is white, the same numbers as before this option existed.
+TEST(SimulationTest, AttitudeControlErrorCanBeSmooth) {
+  constexpr int kNodes = 1000;
+  constexpr double kSigmaDeg = 0.2, kTime_s = 30.0;
+  constexpr double kRhoTol = 0.05;
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(kNodes);
+  SimulationOptions options = NoNoise();
+  options.attitude_control_sigma_deg = kSigmaDeg;
+  for (double time_s : {0.0, kTime_s}) {
+    options.attitude_control_time_s = time_s;
+    Dataset data;
+    std::string error;
+    ASSERT_TRUE(Simulate(truth, planned, options, &data, nullptr, nullptr, &error)) << error;
+    std::vector<double> roll;
+    for (const Sample& s : data.samples)
+      roll.push_back(s.measured_rpy_deg[0] - s.planned_rpy_deg[0]);
+    EXPECT_NEAR(Autocorrelation(roll, 1), time_s > 0 ? std::exp(-1.0 / time_s) : 0.0, kRhoTol)
+        << "time " << time_s;
+  }
+}
+
+// The mass centre drifts about the truth model's: the tensions follow it, the truth
+// model written out keeps the mean, the summary has the drift's RMS and average.
+TEST(SimulationTest, MassCentreDriftsAboutTheTruth) {
+  constexpr int kNodes = 600;
+  constexpr double kDrift_m = 0.05, kTime_s = 50.0;
+  constexpr double kRmsRelTol = 0.35;  // ~12 independent stretches per axis
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(kNodes);
+  SimulationOptions options = NoNoise();
+  options.mass_centre_drift_m = kDrift_m;
+  options.mass_centre_drift_time_s = kTime_s;
+  Dataset data, quiet;
+  CableRobot used;
+  SimulationSummary summary;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, &used, &summary, &error)) << error;
+  ASSERT_TRUE(Simulate(truth, planned, NoNoise(), &quiet, nullptr, nullptr, &error)) << error;
+  EXPECT_EQ(used.mass_centre_cabin_m, truth.mass_centre_cabin_m);
+  EXPECT_NEAR(summary.mass_centre_drift_rms_m, kDrift_m, kRmsRelTol * kDrift_m);
+  EXPECT_GT((summary.mass_centre_mean_m - truth.mass_centre_cabin_m).norm(), 0.0);
+  int moved = 0;
+  for (int n = 0; n < kNodes; ++n) moved += data.samples[n].tension_n != quiet.samples[n].tension_n;
+  EXPECT_EQ(moved, kNodes);
+}
+
+// Gains and biases drawn once per cable about the truth's: in the truth model written
+// out, and the readings are gain * tension + bias with them.
+TEST(SimulationTest, SensorGainAndBiasSpreadsAreDrawnOnceAndWrittenOut) {
+  constexpr double kGainSpreadPercent = 1.0, kBiasSpreadKn = 2.0;
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(8);
+  SimulationOptions options = NoNoise();
+  options.sensor_gain_spread_percent = kGainSpreadPercent;
+  options.sensor_bias_spread_kn = kBiasSpreadKn;
+  Dataset data;
+  CableRobot used;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &data, &used, nullptr, &error)) << error;
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_NE(used.cables[i].sensor_gain, 1.0);
+    EXPECT_LT(std::abs(used.cables[i].sensor_gain - 1.0), 5 * kGainSpreadPercent / 100.0);
+    EXPECT_NE(used.cables[i].sensor_bias_n, 0.0);
+    EXPECT_LT(std::abs(used.cables[i].sensor_bias_n), 5 * kBiasSpreadKn * 1e3);
+  }
+  for (size_t n = 0; n < planned.size(); ++n) {
+    const StaticsSolution exact = ExactAt(used, planned[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      const double reading = used.cables[i].SensorReadingN(exact.cables[i].lower_tension_n);
+      EXPECT_NEAR(data.samples[n].tension_n[i], reading, kTensionRelTolerance * reading);
+    }
+  }
+}
+
 TEST(SimulationTest, DensityMismatchChangesTheTruthReproducibly) {
   const CableRobot truth = CableRobot::NominalFast();
   const std::vector<Pose> planned = Circle(6);
@@ -358,6 +483,21 @@ TEST(SimulationTest, InvalidOptionsAndInputsAreRejected) {
   o = SimulationOptions();
   o.sample_interval_s = 0.0;
   rejects(o, "sample_interval_s");
+  const std::pair<const char*, double SimulationOptions::*> kNonNegative[] = {
+      {"attitude_control_time_s", &SimulationOptions::attitude_control_time_s},
+      {"tension_drift_percent", &SimulationOptions::tension_drift_percent},
+      {"tension_drift_time_s", &SimulationOptions::tension_drift_time_s},
+      {"mass_centre_drift_m", &SimulationOptions::mass_centre_drift_m},
+      {"mass_centre_drift_time_s", &SimulationOptions::mass_centre_drift_time_s},
+      {"sensor_gain_spread_percent", &SimulationOptions::sensor_gain_spread_percent},
+      {"sensor_bias_spread_kn", &SimulationOptions::sensor_bias_spread_kn}};
+  for (const auto& [name, field] : kNonNegative) {
+    o = SimulationOptions();
+    o.*field = -1.0;
+    rejects(o, name);
+    o.*field = INFINITY;
+    rejects(o, name);
+  }
 
   EXPECT_FALSE(Simulate(truth, {}, SimulationOptions(), nullptr, nullptr, nullptr, &error));
   std::vector<Pose> bad = planned;
