@@ -524,8 +524,16 @@ int RunSimulate(int argc, char** argv) {
   const std::string version = FASTCAL_VERSION;
   const std::string csv_header =
       "Simulated by fastcal " + version + "\n" + command + "\nTruth model: " + yaml_path;
-  const std::string yaml_header =
+  std::string yaml_header =
       "Truth model of " + csv_path + ", simulated by fastcal " + version + "\n" + command;
+  if (options.mass_centre_drift_m > 0.0) {
+    const Eigen::Vector3d& m = summary.mass_centre_mean_m;
+    yaml_header += "\nThe mass centre drifted about mass_centre_m below (AR(1), sigma " +
+                   FormatDouble(options.mass_centre_drift_m) + " m per axis, correlation time " +
+                   FormatDouble(options.mass_centre_drift_time_s) +
+                   " s); its average over the samples was (" + FormatDouble(m.x(), 6) + ", " +
+                   FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
+  }
   if (!WriteBoth(csv_path, dataset, csv_header, yaml_path, truth_used, yaml_header, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
