@@ -44,8 +44,11 @@ Usage:
   fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml]
 
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
-  --spec=FILE         which parameters are free, initial values, priors, noise model,
-                      robust loss, forward model, hold-out (docs/calibration.md)
+  --spec=FILE         which parameters are free, initial values, priors (a fixed
+                      parameter with a prior is a consider parameter), noise model,
+                      gross-error screen, robust loss, forward model, hold-out
+                      (docs/calibration.md; calibration_data/spec_realistic.yaml is the
+                      one recommended for real telemetry)
   --data=FILE         telemetry export: time_s, x_m,y_m,z_m, roll_deg,pitch_deg,yaw_deg (or
                       qw,qx,qy,qz), T1_kN..T6_kN, optional planned_*_deg and s0_*_m
                       (docs/data-format.md)
@@ -61,19 +64,36 @@ Before solving, the free set is checked: if the data (and priors) cannot determi
 e.g. cabin mass together with a common sensor gain, or tower offsets from one circle --
 the calibration is refused with the combination named and what to fix (exit 1).
 
+Gross errors: a reading more than 5 robust sigmas from the model (the spec's
+gross_errors) is kept out of the fit and named by file line and cable; a dataset
+mostly made of them is refused (exit 1).
+
+Each estimate comes with sigma_total, the uncertainty to quote: the formal sigma (stated
+noise, independent samples) widened by the misfit and by residuals correlated in time,
+plus what the consider parameters add. The console and report show its parts, the
+gross errors, the fixed parameters whose freeing would explain most of the misfit, and
+a block cross-validation RMS (docs/calibration.md).
+
 Outputs in DIR:
-  model_calibrated.yaml   the calibrated model (loads into fastcal solve and evaluate)
-  report.html, report.md  estimates with sigmas, identifiability, RMS per cable before and
-                          after (the paper's Table 6), plots
-  summary.json            the same, machine-readable, with provenance (input digests)
+  model_calibrated.yaml   the calibrated model (loads into fastcal solve and evaluate);
+                          its comments list each estimate +- sigma_total, and open with
+                          a warning if the fit failed
+  report.html, report.md  verdict, estimates with sigma_total, uncertainty budget, gross
+                          errors and worst readings, misfit ranking, identifiability, RMS
+                          per cable before and after (the paper's Table 6), block
+                          cross-validation, plots
+  summary.json            the same, machine-readable (outliers: line, cable, measured_kN,
+                          predicted_kN, residual_sigma), with provenance and the UTC time
   residuals.csv           per sample: measured, nominal and calibrated tensions (kN)
 
-After the fit, a reduced chi-square outside 1 +- 3 sqrt(2/nu) (nu: residuals minus free
-parameters) means the fit does not match the spec's noise: a "warning: poor fit" (or
-"noise overstated") line ends stderr and the report's verdict opens with it. The exit
-code stays 0: the outputs are written, as a record of the failed fit.
+Verdict, from the reduced chi-square against its band 1 +- 3 sqrt(2/nu) (nu: residuals
+minus free parameters): ok; noise overstated (below; the sigmas are pessimistic);
+misfit (above: scaled into sigma_total, a note ends stderr); failed (chi^2/nu above 25,
+the residuals 5 times the stated noise, or no convergence: "warning: the fit failed"
+ends stderr and model_calibrated.yaml opens with a warning). The exit code stays 0 for
+all four: the outputs are written, as a record.
 
-Exit codes: 0 ok (also for a poor fit: see the warning), 1 the calibration failed or was
+Exit codes: 0 the outputs were written (see the verdict), 1 the calibration failed or was
 refused, or a row's pose cannot be solved (without --skip-invalid-rows), 2 bad input.
 
 Example (the bundled paper-like circle):
@@ -323,17 +343,26 @@ std::string EstimatesTable(const CalibrationResult& result) {
   return s.str();
 }
 
-// What each consider group adds to each estimate ("sensor_gain: 9 mm on mass_centre_m.x").
+// What each consider group adds to the estimates it matters most for, largest share of
+// sigma_total first ("sensor_gain: 9 mm on mass_centre_m.x"); the report has them all.
 std::string ConsiderLines(const CalibrationResult& result) {
+  constexpr size_t kShown = 4;
   std::ostringstream s;
   const std::vector<std::string>& groups = result.budget.consider_groups;
   for (size_t g = 0; g < groups.size(); ++g) {
-    std::string line;
+    std::vector<const ParameterEstimate*> on;
     for (const ParameterEstimate& p : result.parameters) {
-      if (!p.free || g >= p.systematic_by_group.size()) continue;
-      line += (line.empty() ? "" : ", ") + SigmaText(p.systematic_by_group[g], p.unit) + " on " +
-              p.name;
+      if (p.free && g < p.systematic_by_group.size() && p.sigma_total > 0) on.push_back(&p);
     }
+    std::stable_sort(on.begin(), on.end(), [g](const auto* a, const auto* b) {
+      return a->systematic_by_group[g] / a->sigma_total > b->systematic_by_group[g] / b->sigma_total;
+    });
+    std::string line;
+    for (size_t k = 0; k < std::min(kShown, on.size()); ++k) {
+      line += (k ? ", " : "") + SigmaText(on[k]->systematic_by_group[g], on[k]->unit) + " on " +
+              on[k]->name;
+    }
+    if (on.size() > kShown) line += ", ... (report.md, Uncertainty budget)";
     s << "  systematic, from " << groups[g] << ": " << line << "\n";
   }
   return s.str();
@@ -366,8 +395,8 @@ std::string MisfitLine(const CalibrationResult& result) {
   if (result.misfit_ranking.empty()) return "";
   const MisfitCandidate& top = result.misfit_ranking.front();
   if (!top.significant) {
-    return "  no fixed parameter explains a significant part of the misfit (largest expected "
-           "chi-square decrease " +
+    return "  freeing no fixed parameter would lower the chi-square by more than noise alone "
+           "(largest expected decrease " +
            FormatDouble(top.expected_decrease, 3) + ", from " + top.name +
            "; white noise alone reaches " + FormatDouble(result.misfit_threshold, 3) + ")\n";
   }
