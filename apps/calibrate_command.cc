@@ -355,7 +355,8 @@ std::string ConsiderLines(const CalibrationResult& result) {
       if (p.free && g < p.systematic_by_group.size() && p.sigma_total > 0) on.push_back(&p);
     }
     std::stable_sort(on.begin(), on.end(), [g](const auto* a, const auto* b) {
-      return a->systematic_by_group[g] / a->sigma_total > b->systematic_by_group[g] / b->sigma_total;
+      return a->systematic_by_group[g] / a->sigma_total >
+             b->systematic_by_group[g] / b->sigma_total;
     });
     std::string line;
     for (size_t k = 0; k < std::min(kShown, on.size()); ++k) {
@@ -478,6 +479,38 @@ bool WriteOutDirectory(const char* command,
 
 }  // namespace
 
+// The RMS table's rows: the initial model at each attitude the data has, and the
+// calibrated one at the fit's attitude (exact statics; gross errors left out).
+bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec,
+                            const Dataset& data, const CalibrationResult& result,
+                            std::vector<VariantEvaluation>* variants, std::string* error) {
+  struct Variant {
+    std::string name;
+    const CableRobot* robot;
+    AttitudeSource attitude;
+  };
+  std::vector<Variant> list;
+  if (data.has_planned_attitude) {
+    list.push_back({"initial model, planned attitude", &model, AttitudeSource::kPlanned});
+  }
+  list.push_back({"initial model, measured attitude", &model, AttitudeSource::kMeasured});
+  list.push_back(
+      {std::string("calibrated model, ") + (spec.use_planned_attitude ? "planned" : "measured") +
+           " attitude",
+       &result.calibrated,
+       spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured});
+  for (const Variant& v : list) {
+    VariantEvaluation e;
+    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact, result.held_out,
+                         &e, error, result.excluded)) {
+      *error = v.name + ": " + *error;
+      return false;
+    }
+    variants->push_back(std::move(e));
+  }
+  return true;
+}
+
 int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
@@ -533,26 +566,9 @@ int RunCalibrate(int argc, char** argv) {
   }
 
   std::vector<VariantEvaluation> variants;
-  struct Variant {
-    std::string name;
-    const CableRobot* robot;
-    AttitudeSource attitude;
-  };
-  std::vector<Variant> list;
-  if (data.has_planned_attitude)
-    list.push_back({"initial model, planned attitude", &model, AttitudeSource::kPlanned});
-  list.push_back({"initial model, measured attitude", &model, AttitudeSource::kMeasured});
-  list.push_back({std::string("calibrated model, ") +
-                      (spec.use_planned_attitude ? "planned" : "measured") + " attitude",
-                  &result.calibrated, fit_attitude});
-  for (const Variant& v : list) {
-    VariantEvaluation e;
-    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact, result.held_out,
-                         &e, &error, result.excluded)) {
-      PrintError(command, v.name + ": " + error);
-      return kExitFailure;
-    }
-    variants.push_back(std::move(e));
+  if (!EvaluateBeforeAndAfter(model, spec, data, result, &variants, &error)) {
+    PrintError(command, error);
+    return kExitFailure;
   }
 
   ReportInputs report;

@@ -234,25 +234,22 @@ std::string RmsAllText(const VariantEvaluation& v, bool holdout) {
   return Kn3(RmsAllCables(s.rms_n)) + " kN";
 }
 
-void AddVerdict(const ReportInputs& in, Document* doc) {
-  if (!in.result) {
-    doc->Heading(2, "Summary");
-    Text t("Model tensions (statics: " +
-           (in.evaluation_method.empty() ? std::string("?") : in.evaluation_method) +
-           ", with the model's sensor gain and bias) against the " + Int(NumSamples(in)) +
-           " measured samples. RMS of model - measured over all six cables: ");
-    if (in.variants.empty()) t.Plain("no variant was evaluated.");
-    for (size_t i = 0; i < in.variants.size(); ++i) {
-      t.Plain(i ? "; " : "")
-          .Plain(in.variants[i].name + " ")
-          .Bold(RmsAllText(in.variants[i], false));
-      if (i + 1 == in.variants.size()) t.Plain(".");
-    }
-    doc->Paragraph(t);
-    return;
+void AddEvaluationSummary(const ReportInputs& in, Document* doc) {
+  doc->Heading(2, "Summary");
+  Text t("Model tensions (statics: " +
+         (in.evaluation_method.empty() ? std::string("?") : in.evaluation_method) +
+         ", with the model's sensor gain and bias) against the " + Int(NumSamples(in)) +
+         " measured samples. RMS of model - measured over all six cables: ");
+  if (in.variants.empty()) t.Plain("no variant was evaluated.");
+  for (size_t i = 0; i < in.variants.size(); ++i) {
+    t.Plain(i ? "; " : "").Plain(in.variants[i].name + " ").Bold(RmsAllText(in.variants[i], false));
+    if (i + 1 == in.variants.size()) t.Plain(".");
   }
-  const CalibrationResult& r = *in.result;
-  doc->Heading(2, "Verdict");
+  doc->Paragraph(t);
+}
+
+// The verdict's first paragraph and the notes a reader needs beside it.
+void AddVerdictLead(const CalibrationResult& r, Document* doc) {
   const char* lead = "Good fit:";
   switch (r.verdict) {
     case FitVerdict::kOk:
@@ -282,6 +279,16 @@ void AddVerdict(const ReportInputs& in, Document* doc) {
                         .Plain(" (see What would explain the misfit)."));
   }
   doc->List(std::move(notes));
+}
+
+void AddVerdict(const ReportInputs& in, Document* doc) {
+  if (!in.result) {
+    AddEvaluationSummary(in, doc);
+    return;
+  }
+  const CalibrationResult& r = *in.result;
+  doc->Heading(2, "Verdict");
+  AddVerdictLead(r, doc);
   Text t;
   if (r.converged) {
     t.Bold("Converged");
@@ -630,134 +637,157 @@ std::string ThinningNote(int num_samples, int buckets) {
          "and outliers stay visible. The tables and statistics use all samples.";
 }
 
-void AddPlots(const ReportInputs& in, Document* doc) {
-  doc->Heading(2, "Plots");
-  if (!in.data || in.data->samples.empty()) {
-    doc->Paragraph("No samples to plot.");
-    return;
-  }
-  const Dataset& d = *in.data;
-  const int num_samples = NumSamples(in);
+// What every time plot shares: the x axis, the variants drawn, and how.
+struct TimePlots {
+  const ReportInputs& in;
+  const Dataset& d;
   std::string x_label;
-  const std::vector<double> x = SampleAxis(d, &x_label);
-  const std::vector<size_t> shown = PlotVariants(in);
-  const bool holdout = NumHeldOut(in) > 0;
-  // With a calibration the "before" variant is dashed, the calibrated one solid. Lines
-  // join consecutive samples only along a trajectory; an unordered set gets dots.
-  auto dashed = [&](size_t k) { return in.result != nullptr && k + 1 < shown.size(); };
-  const bool ordered = internal::IsTrajectory(d);
-  auto model_series = [&](const std::string& name, size_t k) {
-    PlotSeries p{name, x, {}, dashed(k), !ordered};
+  std::vector<double> x;
+  std::vector<size_t> shown;  // PlotVariants
+  bool holdout = false;
+  bool ordered = true;  // a trajectory: lines join the samples; else dots
+  std::string not_drawn;
+
+  TimePlots(const ReportInputs& inputs)  // NOLINT: a view of the inputs
+      : in(inputs), d(*inputs.data), x(SampleAxis(d, &x_label)), shown(PlotVariants(inputs)) {
+    holdout = NumHeldOut(in) > 0;
+    ordered = internal::IsTrajectory(d);
+    if (in.result && !in.result->gross_errors.empty()) not_drawn = " Gross errors are not drawn.";
+  }
+  // With a calibration the "before" variant is dashed, the calibrated one solid.
+  PlotSeries Model(const std::string& name, size_t k) const {
+    PlotSeries p{name, x, {}, in.result != nullptr && k + 1 < shown.size(), !ordered};
     p.marker_radius_px = kMeasuredDotRadiusPx;
     return p;
-  };
+  }
   // Gross errors are not drawn: one 99999 kN reading would flatten every other point.
-  auto drawn = [&](size_t n, int i) {
+  bool Drawn(size_t n, int i) const {
     return !in.result || n >= in.result->excluded.size() || !in.result->excluded[n][i];
-  };
-  int buckets = 0;
+  }
+  double ResidualKn(const VariantEvaluation& v, size_t n, int i) const {
+    return (v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn;
+  }
+};
 
-  // Tension against time, one plot per cable: the measured tensions as small translucent
-  // dots, drawn first, and the model lines over them.
-  std::vector<std::string> cable_svgs;
+PlotOptions CablePlotOptions(const std::string& title, const std::string& x_label,
+                             const std::string& y_label) {
+  PlotOptions o;
+  o.title = title;
+  o.x_label = x_label;
+  o.y_label = y_label;
+  o.width_px = kCablePlotWidthPx;
+  o.height_px = kCablePlotHeightPx;
+  return o;
+}
+
+// Tension against time, one plot per cable: the measured tensions as small translucent
+// dots, drawn first, and the model over them.
+void AddTensionPlots(const TimePlots& t, Document* doc) {
+  int buckets = 0;
+  std::vector<std::string> svgs;
   for (int i = 0; i < kNumCables; ++i) {
     std::vector<PlotSeries> series;
-    for (size_t k = 0; k < shown.size(); ++k) {
-      const VariantEvaluation& v = in.variants[shown[k]];
-      if (!HasPredictions(in, v)) continue;
-      PlotSeries p = model_series(v.name, k);
+    for (size_t k = 0; k < t.shown.size(); ++k) {
+      const VariantEvaluation& v = t.in.variants[t.shown[k]];
+      if (!HasPredictions(t.in, v)) continue;
+      PlotSeries p = t.Model(v.name, k);
       for (const auto& predicted : v.predicted_n) p.y.push_back(predicted[i] / kNPerKn);
-      PutAt(&series, shown[k], Thin(std::move(p), &buckets));
+      PutAt(&series, t.shown[k], Thin(std::move(p), &buckets));
     }
-    PlotSeries fitted{holdout ? "measured (fitted)" : "measured", {}, {}, false, true};
+    PlotSeries fitted{t.holdout ? "measured (fitted)" : "measured", {}, {}, false, true};
     PlotSeries held{"measured (held out)", {}, {}, false, true};
-    for (size_t n = 0; n < d.samples.size(); ++n) {
-      if (!drawn(n, i)) continue;
-      PlotSeries& m = IsHeldOut(in, n) ? held : fitted;
-      m.x.push_back(x[n]);
-      m.y.push_back(d.samples[n].tension_n[i] / kNPerKn);
+    for (size_t n = 0; n < t.d.samples.size(); ++n) {
+      if (!t.Drawn(n, i)) continue;
+      PlotSeries& m = IsHeldOut(t.in, n) ? held : fitted;
+      m.x.push_back(t.x[n]);
+      m.y.push_back(t.d.samples[n].tension_n[i] / kNPerKn);
     }
     fitted.marker_radius_px = held.marker_radius_px = kMeasuredDotRadiusPx;
     fitted.opacity = kMeasuredDotOpacity;
     held.opacity = kHeldOutDotOpacity;
-    if (holdout) PutAt(&series, HeldOutSlot(in), Thin(std::move(held), &buckets));
-    PutAt(&series, MeasuredSlot(in), Thin(std::move(fitted), &buckets));
-    PlotOptions o;
-    o.title = "Cable " + Int(i + 1) + ": tension";
-    o.x_label = x_label;
-    o.y_label = "T" + Int(i + 1) + " [kN]";
-    o.width_px = kCablePlotWidthPx;
-    o.height_px = kCablePlotHeightPx;
-    cable_svgs.push_back(SvgLinePlot(series, o));
+    if (t.holdout) PutAt(&series, HeldOutSlot(t.in), Thin(std::move(held), &buckets));
+    PutAt(&series, MeasuredSlot(t.in), Thin(std::move(fitted), &buckets));
+    svgs.push_back(SvgLinePlot(series, CablePlotOptions("Cable " + Int(i + 1) + ": tension",
+                                                        t.x_label, "T" + Int(i + 1) + " [kN]")));
   }
-  const std::string not_drawn =
-      in.result && !in.result->gross_errors.empty() ? " Gross errors are not drawn." : "";
-  doc->Figure(std::move(cable_svgs),
+  doc->Figure(std::move(svgs),
               std::string("Measured lower-end tension (translucent dots, drawn underneath") +
-                  (holdout ? "; held-out samples in light blue" : "") + ") and the model " +
-                  (ordered ? "predictions (lines on top; dashed: before calibration)"
-                           : "predictions (dots on top: the samples are not a trajectory, so "
-                             "nothing joins them)") +
-                  " against time, per cable [kN]." + not_drawn +
-                  ThinningNote(num_samples, buckets));
+                  (t.holdout ? "; held-out samples in light blue" : "") + ") and the model " +
+                  (t.ordered ? "predictions (lines on top; dashed: before calibration)"
+                             : "predictions (dots on top: the samples are not a trajectory, so "
+                               "nothing joins them)") +
+                  " against time, per cable [kN]." + t.not_drawn +
+                  ThinningNote(NumSamples(t.in), buckets));
+}
 
-  // Residual distribution, all cables and samples pooled.
+// Residual distribution, all cables and samples pooled. False when no variant has
+// predictions.
+bool AddResidualHistogram(const TimePlots& t, Document* doc) {
   std::vector<HistogramSeries> histograms;
   bool any = false;
-  for (size_t k : shown) {
-    const VariantEvaluation& v = in.variants[k];
-    if (!HasPredictions(in, v)) continue;
+  for (size_t k : t.shown) {
+    const VariantEvaluation& v = t.in.variants[k];
+    if (!HasPredictions(t.in, v)) continue;
     HistogramSeries h{v.name, {}};
-    for (size_t n = 0; n < d.samples.size(); ++n) {
+    for (size_t n = 0; n < t.d.samples.size(); ++n) {
       for (int i = 0; i < kNumCables; ++i) {
-        if (drawn(n, i))
-          h.values.push_back((v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn);
+        if (t.Drawn(n, i)) h.values.push_back(t.ResidualKn(v, n, i));
       }
     }
     PutAt(&histograms, k, std::move(h));
     any = true;
   }
-  if (!any) {
-    doc->Paragraph("No model predictions to plot residuals of.");
-    return;
-  }
+  if (!any) return false;
   PlotOptions o;
   o.title = "Model - measured, all cables and samples";
   o.x_label = "model - measured [kN]";
   o.width_px = kWidePlotWidthPx;
   o.height_px = kWidePlotHeightPx;
   doc->Figure({SvgHistogram(histograms, kResidualBins, o)},
-              "Distribution of model - measured over all cables and all " + Int(num_samples) +
+              "Distribution of model - measured over all cables and all " + Int(NumSamples(t.in)) +
                   " samples [kN]: a calibrated model should centre on 0 with the width of the "
                   "sensor noise.");
+  return true;
+}
 
-  // Residual against time, one plot per cable.
-  std::vector<std::string> residual_svgs;
-  int residual_buckets = 0;
+// Residual against time, one plot per cable.
+void AddResidualTimePlots(const TimePlots& t, Document* doc) {
+  std::vector<std::string> svgs;
+  int buckets = 0;
   for (int i = 0; i < kNumCables; ++i) {
     std::vector<PlotSeries> series;
-    for (size_t k = 0; k < shown.size(); ++k) {
-      const VariantEvaluation& v = in.variants[shown[k]];
-      if (!HasPredictions(in, v)) continue;
-      PlotSeries p = model_series(v.name, k);
-      for (size_t n = 0; n < d.samples.size(); ++n) {
-        p.y.push_back(drawn(n, i) ? (v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn
-                                  : NAN);
+    for (size_t k = 0; k < t.shown.size(); ++k) {
+      const VariantEvaluation& v = t.in.variants[t.shown[k]];
+      if (!HasPredictions(t.in, v)) continue;
+      PlotSeries p = t.Model(v.name, k);
+      for (size_t n = 0; n < t.d.samples.size(); ++n) {
+        p.y.push_back(t.Drawn(n, i) ? t.ResidualKn(v, n, i) : NAN);
       }
-      PutAt(&series, shown[k], Thin(std::move(p), &residual_buckets));
+      PutAt(&series, t.shown[k], Thin(std::move(p), &buckets));
     }
-    PlotOptions r;
-    r.title = "Cable " + Int(i + 1) + ": model - measured";
-    r.x_label = x_label;
-    r.y_label = "model - measured [kN]";
-    r.width_px = kCablePlotWidthPx;
-    r.height_px = kCablePlotHeightPx;
-    residual_svgs.push_back(SvgLinePlot(series, r));
+    svgs.push_back(
+        SvgLinePlot(series, CablePlotOptions("Cable " + Int(i + 1) + ": model - measured",
+                                             t.x_label, "model - measured [kN]")));
   }
-  doc->Figure(std::move(residual_svgs),
+  doc->Figure(std::move(svgs),
               "Model - measured against time, per cable [kN]: a pattern that repeats with "
               "the pose is model error; what remains after calibration should look like noise." +
-                  not_drawn + ThinningNote(num_samples, residual_buckets));
+                  t.not_drawn + ThinningNote(NumSamples(t.in), buckets));
+}
+
+void AddPlots(const ReportInputs& in, Document* doc) {
+  doc->Heading(2, "Plots");
+  if (!in.data || in.data->samples.empty()) {
+    doc->Paragraph("No samples to plot.");
+    return;
+  }
+  const TimePlots t(in);
+  AddTensionPlots(t, doc);
+  if (!AddResidualHistogram(t, doc)) {
+    doc->Paragraph("No model predictions to plot residuals of.");
+    return;
+  }
+  AddResidualTimePlots(t, doc);
   if (in.result) internal::AddDiagnosticPlots(in, doc);
 }
 
@@ -1141,170 +1171,207 @@ void ObjectOrNull(JsonWriter* w, const char* key, bool present, Body&& body) {
   w->EndObject();
 }
 
-std::string RenderJson(const ReportInputs& in) {
-  JsonWriter w;
+// What was run, on what: version, command line, time, inputs, spec.
+void JsonProvenance(const ReportInputs& in, JsonWriter* w) {
   const CalibrationResult* r = in.result;
   const CalibrationSpec* spec = in.spec;
-  w.BeginObject();
-  w.Key("report").String(r ? "calibration" : "evaluation");
-  w.Key("software_version").String(in.software_version);
-  w.Key("command_line").String(in.command_line);
-  w.Key("run_utc");
+  w->Key("report").String(r ? "calibration" : "evaluation");
+  w->Key("software_version").String(in.software_version);
+  w->Key("command_line").String(in.command_line);
+  w->Key("run_utc");
   if (in.run_utc.empty())
-    w.Null();
+    w->Null();
   else
-    w.String(in.run_utc);
-  w.Key("inputs").BeginObject();
-  JsonFile(&w, "model", in.model_path, in.model_digest);
-  JsonFile(&w, "spec", in.spec_path, in.spec_digest);
-  JsonFile(&w, "data", in.data_path, in.data_digest);
-  w.EndObject();
-  w.Key("spec_yaml");
+    w->String(in.run_utc);
+  w->Key("inputs").BeginObject();
+  JsonFile(w, "model", in.model_path, in.model_digest);
+  JsonFile(w, "spec", in.spec_path, in.spec_digest);
+  JsonFile(w, "data", in.data_path, in.data_digest);
+  w->EndObject();
+  w->Key("spec_yaml");
   if (spec)
-    w.String(CalibrationSpecToYaml(*spec));
+    w->String(CalibrationSpecToYaml(*spec));
   else
-    w.Null();
-  w.Key("forward_model");
+    w->Null();
+  w->Key("forward_model");
   if (spec)
-    w.String(StaticsMethodName(spec->forward_model));
+    w->String(StaticsMethodName(spec->forward_model));
   else
-    w.Null();
-  w.Key("evaluation_method").String(in.evaluation_method);
-  ObjectOrNull(&w, "noise", spec != nullptr, [&] {
-    w.Key("sigma_kN").Number(spec->tension_sigma_n / kNPerKn);
-    w.Key("sigma_percent").Number(spec->tension_sigma_percent);
+    w->Null();
+  w->Key("evaluation_method").String(in.evaluation_method);
+}
+
+// The spec's noise model, robust loss and hold-out.
+void JsonSpecOptions(const ReportInputs& in, JsonWriter* w) {
+  const CalibrationSpec* spec = in.spec;
+  ObjectOrNull(w, "noise", spec != nullptr, [&] {
+    w->Key("sigma_kN").Number(spec->tension_sigma_n / kNPerKn);
+    w->Key("sigma_percent").Number(spec->tension_sigma_percent);
   });
-  ObjectOrNull(&w, "robust_loss", spec != nullptr, [&] {
-    w.Key("type").String(RobustLossName(spec->robust_loss));
-    w.Key("scale_sigma").Number(spec->robust_loss_scale);
+  ObjectOrNull(w, "robust_loss", spec != nullptr, [&] {
+    w->Key("type").String(RobustLossName(spec->robust_loss));
+    w->Key("scale_sigma").Number(spec->robust_loss_scale);
   });
-  ObjectOrNull(&w, "holdout", spec != nullptr, [&] {
-    w.Key("fraction").Number(spec->holdout_fraction);
-    w.Key("blocks").Int(spec->holdout_blocks);
-    w.Key("seed");
+  ObjectOrNull(w, "holdout", spec != nullptr, [&] {
+    w->Key("fraction").Number(spec->holdout_fraction);
+    w->Key("blocks").Int(spec->holdout_blocks);
+    w->Key("seed");
     if (spec->holdout_seed <= static_cast<unsigned long long>(LLONG_MAX)) {
-      w.Int(static_cast<long long>(spec->holdout_seed));
+      w->Int(static_cast<long long>(spec->holdout_seed));
     } else {
-      w.String(std::to_string(spec->holdout_seed));
+      w->String(std::to_string(spec->holdout_seed));
     }
   });
-  ObjectOrNull(&w, "solver", r != nullptr, [&] {
-    w.Key("termination").String(r->termination);
-    w.Key("converged").Bool(r->converged);
-    w.Key("iterations").Int(r->iterations);
-    w.Key("initial_cost").Number(r->initial_cost);
-    w.Key("final_cost").Number(r->final_cost);
-    w.Key("reduced_chi_square").Number(r->reduced_chi_square);
+}
+
+// The solver's summary and the forward model's own error.
+void JsonSolver(const ReportInputs& in, JsonWriter* w) {
+  const CalibrationResult* r = in.result;
+  ObjectOrNull(w, "solver", r != nullptr, [&] {
+    w->Key("termination").String(r->termination);
+    w->Key("converged").Bool(r->converged);
+    w->Key("iterations").Int(r->iterations);
+    w->Key("initial_cost").Number(r->initial_cost);
+    w->Key("final_cost").Number(r->final_cost);
+    w->Key("reduced_chi_square").Number(r->reduced_chi_square);
     const ChiSquareBand band = ReducedChiSquareBand(*r);
-    w.Key("reduced_chi_square_band_half_width").Number(band.half_width);
-    w.Key("reduced_chi_square_within_band").Bool(band.within);
-    w.Key("num_residuals").Int(r->num_residuals);
-    w.Key("num_free").Int(r->num_free);
-    w.Key("covariance_ok").Bool(r->covariance_ok);
-    w.Key("seconds").Number(r->seconds);
+    w->Key("reduced_chi_square_band_half_width").Number(band.half_width);
+    w->Key("reduced_chi_square_within_band").Bool(band.within);
+    w->Key("num_residuals").Int(r->num_residuals);
+    w->Key("num_free").Int(r->num_free);
+    w->Key("covariance_ok").Bool(r->covariance_ok);
+    w->Key("seconds").Number(r->seconds);
   });
-  ObjectOrNull(&w, "forward_model_error", r != nullptr, [&] {
-    w.Key("max_relative").Number(r->forward_model_max_rel_error);
-    w.Key("rms_relative").Number(r->forward_model_rms_rel_error);
+  ObjectOrNull(w, "forward_model_error", r != nullptr, [&] {
+    w->Key("max_relative").Number(r->forward_model_max_rel_error);
+    w->Key("rms_relative").Number(r->forward_model_rms_rel_error);
   });
-  w.Key("parameters").BeginArray();
+}
+
+// Every parameter the spec names, with its budget.
+void JsonParameters(const ReportInputs& in, JsonWriter* w) {
+  const CalibrationResult* r = in.result;
+  w->Key("parameters").BeginArray();
   if (r) {
     for (const ParameterEstimate& p : r->parameters) {
-      w.BeginObject();
-      w.Key("name").String(p.name);
-      w.Key("unit").String(p.unit);
-      w.Key("free").Bool(p.free);
-      w.Key("initial").Number(p.initial);
-      w.Key("estimate").Number(p.estimate);
-      w.Key("consider").Bool(p.consider);
-      w.Key("sigma");  // formal
+      w->BeginObject();
+      w->Key("name").String(p.name);
+      w->Key("unit").String(p.unit);
+      w->Key("free").Bool(p.free);
+      w->Key("initial").Number(p.initial);
+      w->Key("estimate").Number(p.estimate);
+      w->Key("consider").Bool(p.consider);
+      w->Key("sigma");  // formal
       if (p.free && r->covariance_ok)
-        w.Number(p.sigma);
+        w->Number(p.sigma);
       else
-        w.Null();
-      w.Key("sigma_total");
+        w->Null();
+      w->Key("sigma_total");
       if ((p.free && r->covariance_ok) || p.consider)
-        w.Number(p.sigma_total);
+        w->Number(p.sigma_total);
       else
-        w.Null();
-      ObjectOrNull(&w, "budget", p.free && r->covariance_ok, [&] {
-        w.Key("formal").Number(p.sigma);
-        w.Key("statistical").Number(p.sigma_statistical);
-        w.Key("widening").Number(p.widening);
-        w.Key("misfit_factor").Number(r->budget.misfit_factor);
-        w.Key("correlation_factor").Number(p.widening / r->budget.misfit_factor);
-        w.Key("autocorrelation_time_samples").Number(p.tau);
-        w.Key("systematic").Number(p.sigma_systematic);
-        w.Key("systematic_by_group").BeginObject();
+        w->Null();
+      ObjectOrNull(w, "budget", p.free && r->covariance_ok, [&] {
+        w->Key("formal").Number(p.sigma);
+        w->Key("statistical").Number(p.sigma_statistical);
+        w->Key("widening").Number(p.widening);
+        w->Key("misfit_factor").Number(r->budget.misfit_factor);
+        w->Key("correlation_factor").Number(p.widening / r->budget.misfit_factor);
+        w->Key("autocorrelation_time_samples").Number(p.tau);
+        w->Key("systematic").Number(p.sigma_systematic);
+        w->Key("systematic_by_group").BeginObject();
         for (size_t g = 0; g < r->budget.consider_groups.size(); ++g) {
-          w.Key(r->budget.consider_groups[g])
+          w->Key(r->budget.consider_groups[g])
               .Number(g < p.systematic_by_group.size() ? p.systematic_by_group[g] : 0.0);
         }
-        w.EndObject();
+        w->EndObject();
       });
-      ObjectOrNull(&w, "prior", p.has_prior, [&] {
-        w.Key("mean").Number(p.prior_mean);
-        w.Key("sigma").Number(p.prior_sigma);
+      ObjectOrNull(w, "prior", p.has_prior, [&] {
+        w->Key("mean").Number(p.prior_mean);
+        w->Key("sigma").Number(p.prior_sigma);
       });
-      w.Key("note").String(p.note);
-      w.EndObject();
+      w->Key("note").String(p.note);
+      w->EndObject();
     }
   }
-  w.EndArray();
-  ObjectOrNull(&w, "correlation", r && CorrelationUsable(*r), [&] {
-    w.Key("names").BeginArray();
-    for (const std::string& n : r->free_names) w.String(n);
-    w.EndArray();
-    w.Key("matrix").BeginArray();
-    for (const auto& row : CorrelationRows(*r)) w.NumberArray(row);
-    w.EndArray();
+  w->EndArray();
+}
+
+// Correlation, the diagnostics of calibration.h and identifiability.
+void JsonCorrelations(const ReportInputs& in, JsonWriter* w) {
+  const CalibrationResult* r = in.result;
+  ObjectOrNull(w, "correlation", r && CorrelationUsable(*r), [&] {
+    w->Key("names").BeginArray();
+    for (const std::string& n : r->free_names) w->String(n);
+    w->EndArray();
+    w->Key("matrix").BeginArray();
+    for (const auto& row : CorrelationRows(*r)) w->NumberArray(row);
+    w->EndArray();
   });
-  w.Key("strong_correlations").BeginArray();
+  w->Key("strong_correlations").BeginArray();
   if (r) {
-    for (const std::string& c : r->strong_correlations) w.String(c);
+    for (const std::string& c : r->strong_correlations) w->String(c);
   }
-  w.EndArray();
-  if (r) internal::WriteDiagnosticsJson(*r, &w);
-  ObjectOrNull(&w, "identifiability", r != nullptr, [&] {
-    JsonIdentifiability(&w, "before", r->before);
-    JsonIdentifiability(&w, "after", r->after);
-    JsonIdentifiability(&w, "data_only", r->data_only);
+  w->EndArray();
+  if (r) internal::WriteDiagnosticsJson(*r, w);
+  ObjectOrNull(w, "identifiability", r != nullptr, [&] {
+    JsonIdentifiability(w, "before", r->before);
+    JsonIdentifiability(w, "after", r->after);
+    JsonIdentifiability(w, "data_only", r->data_only);
   });
-  w.Key("evaluation").BeginArray();
+}
+
+// The RMS tables of each variant.
+void JsonEvaluation(const ReportInputs& in, JsonWriter* w) {
+  w->Key("evaluation").BeginArray();
   for (const VariantEvaluation& v : in.variants) {
-    w.BeginObject();
-    w.Key("name").String(v.name);
-    w.Key("fit");
-    JsonStats(&w, v.fit);
-    w.Key("holdout");
+    w->BeginObject();
+    w->Key("name").String(v.name);
+    w->Key("fit");
+    JsonStats(w, v.fit);
+    w->Key("holdout");
     if (v.holdout.samples > 0)
-      JsonStats(&w, v.holdout);
+      JsonStats(w, v.holdout);
     else
-      w.Null();
-    w.EndObject();
+      w->Null();
+    w->EndObject();
   }
-  w.EndArray();
-  w.Key("samples").BeginObject();
-  w.Key("total").Int(NumSamples(in));
-  w.Key("fitted");
+  w->EndArray();
+}
+
+// How many samples, fitted, held out and skipped.
+void JsonSamples(const ReportInputs& in, JsonWriter* w) {
+  const CalibrationResult* r = in.result;
+  w->Key("samples").BeginObject();
+  w->Key("total").Int(NumSamples(in));
+  w->Key("fitted");
   if (r)
-    w.Int(r->num_fit_samples);
+    w->Int(r->num_fit_samples);
   else
-    w.Null();
-  w.Key("held_out");
+    w->Null();
+  w->Key("held_out");
   if (r)
-    w.Int(NumHeldOut(in));
+    w->Int(NumHeldOut(in));
   else
-    w.Null();
+    w->Null();
   // Rows left out of the dataset (malformed, or a pose the model cannot solve), each
   // "file:line: why".
-  w.Key("skipped").Int(in.data ? static_cast<long long>(in.data->skipped.size()) : 0);
-  w.Key("skipped_rows").BeginArray();
+  w->Key("skipped").Int(in.data ? static_cast<long long>(in.data->skipped.size()) : 0);
+  w->Key("skipped_rows").BeginArray();
   if (in.data) {
-    for (const std::string& why : in.data->skipped) w.String(why);
+    for (const std::string& why : in.data->skipped) w->String(why);
   }
-  w.EndArray();
-  w.EndObject();
+  w->EndArray();
+  w->EndObject();
+}
+
+std::string RenderJson(const ReportInputs& in) {
+  JsonWriter w;
+  w.BeginObject();
+  for (const auto section : {JsonProvenance, JsonSpecOptions, JsonSolver, JsonParameters,
+                             JsonCorrelations, JsonEvaluation, JsonSamples}) {
+    section(in, &w);
+  }
   w.EndObject();
   return w.str();
 }

@@ -346,7 +346,9 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
                   (excluded > 0 ? " " + Int(excluded) + " gross errors are not drawn." : ""));
 }
 
-void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
+namespace {
+
+void JsonVerdictAndBudget(const CalibrationResult& r, JsonWriter* w) {
   w->Key("verdict").BeginObject();
   w->Key("status").String(FitVerdictName(r.verdict));
   w->Key("text").String(r.verdict_text);
@@ -369,7 +371,24 @@ void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
   for (const std::string& g : b.consider_groups) w->String(g);
   w->EndArray();
   w->EndObject();
+}
 
+void JsonReadings(const char* key, const std::vector<ReadingResidual>& list, JsonWriter* w) {
+  w->Key(key).BeginArray();
+  for (const ReadingResidual& e : list) {
+    w->BeginObject();
+    w->Key("line").Int(e.line);
+    w->Key("cable").Int(e.cable);
+    w->Key("measured_kN").Number(e.measured_n / kNPerKn);
+    w->Key("predicted_kN").Number(e.predicted_n / kNPerKn);
+    w->Key("residual_sigma").Number(e.residual_sigma);
+    w->Key("held_out").Bool(e.held_out);
+    w->EndObject();
+  }
+  w->EndArray();
+}
+
+void JsonGrossErrors(const CalibrationResult& r, JsonWriter* w) {
   const GrossErrorSummary& g = r.gross_error_summary;
   w->Key("gross_errors").BeginObject();
   w->Key("detect").Bool(g.enabled);
@@ -381,24 +400,11 @@ void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
   w->Key("fitted_flagged").Int(g.fitted_flagged);
   w->Key("settled").Bool(g.settled);
   w->EndObject();
+  JsonReadings("outliers", r.gross_errors, w);
+  JsonReadings("worst_readings", r.worst_readings, w);
+}
 
-  auto readings = [&](const char* key, const std::vector<ReadingResidual>& list) {
-    w->Key(key).BeginArray();
-    for (const ReadingResidual& e : list) {
-      w->BeginObject();
-      w->Key("line").Int(e.line);
-      w->Key("cable").Int(e.cable);
-      w->Key("measured_kN").Number(e.measured_n / kNPerKn);
-      w->Key("predicted_kN").Number(e.predicted_n / kNPerKn);
-      w->Key("residual_sigma").Number(e.residual_sigma);
-      w->Key("held_out").Bool(e.held_out);
-      w->EndObject();
-    }
-    w->EndArray();
-  };
-  readings("outliers", r.gross_errors);
-  readings("worst_readings", r.worst_readings);
-
+void JsonMisfitAndValidation(const CalibrationResult& r, JsonWriter* w) {
   w->Key("misfit_ranking").BeginArray();
   for (const MisfitCandidate& c : r.misfit_ranking) {
     w->BeginObject();
@@ -423,6 +429,14 @@ void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
   w->Key("fit_rms_kN").NumberArray(fit);
   w->EndObject();
   w->Key("residual_autocorrelation_time_samples").NumberArray(r.residual_tau);
+}
+
+}  // namespace
+
+void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
+  JsonVerdictAndBudget(r, w);
+  JsonGrossErrors(r, w);
+  JsonMisfitAndValidation(r, w);
 }
 
 }  // namespace fastcal::internal
