@@ -158,11 +158,14 @@ bool WriteDirectoryAtomically(const std::string& dir,
   return true;
 }
 
+// One row per sample: measured and each variant's predicted tensions; with a calibration
+// the held_out flag and gross_error_cables, the cables whose reading was a gross error
+// ("3", "1 4"; empty for none).
 std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluation>& variants,
-                         const std::vector<bool>& held_out) {
+                         const std::vector<bool>& held_out, const ReadingMask& excluded) {
   std::ostringstream out;
   out << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
-  out << "line,time_s,held_out";
+  out << "line,time_s,held_out,gross_error_cables";
   for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
   std::vector<std::string> tags;
   for (size_t v = 0; v < variants.size(); ++v) {
@@ -174,7 +177,12 @@ std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluatio
   for (size_t n = 0; n < data.samples.size(); ++n) {
     const Sample& s = data.samples[n];
     out << s.line << "," << FormatDouble(s.time_s) << ","
-        << (!held_out.empty() && held_out[n] ? 1 : 0);
+        << (!held_out.empty() && held_out[n] ? 1 : 0) << ",";
+    std::string gross;
+    for (int i = 0; n < excluded.size() && i < kNumCables; ++i) {
+      if (excluded[n][i]) gross += (gross.empty() ? "" : " ") + std::to_string(i + 1);
+    }
+    out << gross;
     for (double t : s.tension_n) out << "," << FormatDouble(t / kNPerKn);
     for (const VariantEvaluation& v : variants) {
       for (double t : v.predicted_n[n]) out << "," << FormatDouble(t / kNPerKn);
@@ -591,7 +599,7 @@ int RunCalibrate(int argc, char** argv) {
   const std::vector<std::pair<std::string, std::string>> files = {
       {"model_calibrated.yaml",
        CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))},
-      {"residuals.csv", ResidualsCsv(data, variants, result.held_out)}};
+      {"residuals.csv", ResidualsCsv(data, variants, result.held_out, result.excluded)}};
   if (!WriteOutDirectory(command, files, report)) return kExitUsage;
 
   std::cerr << CalibrationConsole(result, data, variants) << ChiSquareWarning(result);
@@ -652,7 +660,7 @@ int RunEvaluate(int argc, char** argv) {
     report.data = &data;
     report.variants = variants;
     report.evaluation_method = StaticsMethodName(method);
-    if (!WriteOutDirectory(command, {{"residuals.csv", ResidualsCsv(data, variants, {})}},
+    if (!WriteOutDirectory(command, {{"residuals.csv", ResidualsCsv(data, variants, {}, {})}},
                            report)) {
       return kExitUsage;
     }

@@ -658,6 +658,11 @@ TEST_F(CliTest, CalibrateNamesAGrossErrorByLineAndCable) {
   const std::string model = ReadFile(out + "/model_calibrated.yaml");
   EXPECT_NE(model.find("#   linear_density_kg_per_m = 11.7"), std::string::npos) << model;
   EXPECT_NE(model.find("# verdict: ok"), std::string::npos) << model;
+  // residuals.csv marks the reading; the other rows have the column empty.
+  const std::string residuals = ReadFile(out + "/residuals.csv");
+  EXPECT_NE(residuals.find("line,time_s,held_out,gross_error_cables,T1_kN"), std::string::npos);
+  EXPECT_NE(residuals.find("\n9,4,0,3,"), std::string::npos) << residuals.substr(0, 600);
+  EXPECT_NE(residuals.find("\n10,5,0,,"), std::string::npos);
 }
 
 // A fixed parameter with a prior is a consider parameter: its contribution to each
