@@ -127,6 +127,8 @@ BudgetInputs LinearBudgetInputs(const LinearFit& f) {
   in.rows_per_sample = 1;
   in.num_residuals = static_cast<int>(f.j.rows());
   in.chi_square = f.residuals.squaredNorm();
+  // The band of calibration.h: chi2/nu within 1 +- 3 sqrt(2 / nu) is noise.
+  in.misfit_threshold = 1.0 + 3.0 * std::sqrt(2.0 / (f.j.rows() - f.j.cols()));
   return in;
 }
 
@@ -167,12 +169,13 @@ TEST(UncertaintyBudgetTest, WhiteResidualsKeepTheFormalSigmaAndMisfitScalesIt) {
   LinearFit f = FitAr1Data(kSamples, 0.0, 0.0, &rng);
   UncertaintyBudget b;
   ASSERT_TRUE(ComputeUncertaintyBudget(LinearBudgetInputs(f), &b));
+  EXPECT_TRUE(b.correlation_measured);
+  EXPECT_FALSE(b.correlated);  // white: no long-run covariance, only its noise
+  EXPECT_EQ(b.misfit_factor, 1.0);
   for (const ParameterBudget& p : b.parameters) {
-    EXPECT_GE(p.statistical, p.formal);  // never narrower than the formal one
-    EXPECT_NEAR(p.statistical, p.formal, kRelTol * p.formal);
+    EXPECT_EQ(p.statistical, p.formal);
     EXPECT_EQ(p.systematic, 0.0);
   }
-  EXPECT_NEAR(b.tau, 1.0, 0.5);
   // Residuals three times the stated noise: chi2/nu ~ 9, sigma widened ~3x.
   f.residuals *= 3.0;
   ASSERT_TRUE(ComputeUncertaintyBudget(LinearBudgetInputs(f), &b));
@@ -180,6 +183,47 @@ TEST(UncertaintyBudgetTest, WhiteResidualsKeepTheFormalSigmaAndMisfitScalesIt) {
   for (const ParameterBudget& p : b.parameters) {
     EXPECT_NEAR(p.widening, 3.0, kRelTol * 3.0);
   }
+}
+
+// The misfit factor scales the data's information, not a prior's: a parameter held by a
+// tight prior keeps its prior sigma however badly the data fit; and the factor applies
+// only above the band the caller gives (the chi-square's own noise).
+TEST(UncertaintyBudgetTest, MisfitWidensTheDataNotThePriors) {
+  constexpr int kSamples = 1000;
+  constexpr double kPriorSigma = 1e-6, kRelTol = 1e-6;
+  std::mt19937_64 rng(23);
+  LinearFit f = FitAr1Data(kSamples, 0.0, 0.0, &rng);
+  f.residuals *= 3.0;
+  BudgetInputs in = LinearBudgetInputs(f);
+  in.prior_information = Eigen::VectorXd::Zero(3);
+  in.prior_information[0] = 1.0 / (kPriorSigma * kPriorSigma);
+  in.information.diagonal() += in.prior_information;
+  in.num_residuals += 1;
+  UncertaintyBudget b;
+  ASSERT_TRUE(ComputeUncertaintyBudget(in, &b));
+  EXPECT_GT(b.misfit_factor, 2.5);
+  EXPECT_LE(b.parameters[0].total, kPriorSigma * (1.0 + kRelTol));
+  EXPECT_GT(b.parameters[1].widening, 2.5);
+  // A chi2/nu of 1.05 inside a band up to 1.1: no factor.
+  f = FitAr1Data(kSamples, 0.0, 0.0, &rng);
+  in = LinearBudgetInputs(f);
+  in.chi_square = 1.05 * (kSamples - 3);
+  in.misfit_threshold = 1.1;
+  ASSERT_TRUE(ComputeUncertaintyBudget(in, &b));
+  EXPECT_EQ(b.misfit_factor, 1.0);
+  in.misfit_threshold = 1.0;
+  ASSERT_TRUE(ComputeUncertaintyBudget(in, &b));
+  EXPECT_NEAR(b.misfit_factor, std::sqrt(1.05), 1e-12);
+}
+
+// Too few samples to measure the residuals' memory: said so, nothing assumed.
+TEST(UncertaintyBudgetTest, ShortSeriesIsNotMeasured) {
+  std::mt19937_64 rng(29);
+  const LinearFit f = FitAr1Data(kMinSamplesForCorrelation - 1, 0.0, 0.0, &rng);
+  UncertaintyBudget b;
+  ASSERT_TRUE(ComputeUncertaintyBudget(LinearBudgetInputs(f), &b));
+  EXPECT_FALSE(b.correlation_measured);
+  EXPECT_FALSE(b.correlated);
 }
 
 // y = a x + c z + e with c held at c0 (consider, sigma_c): the sensitivity of the

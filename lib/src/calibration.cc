@@ -687,12 +687,22 @@ BudgetInputs MakeBudgetInputs(const Run& run, const internal::Linearisation& lin
     if (p.has_prior) in.prior_information[k] = 1.0 / (p.prior_sigma_si * p.prior_sigma_si);
   }
   in.information = lin.information;
+  if (run.loss != nullptr) {
+    // The exact Hessian of the robust cost, when it stays positive definite (a
+    // redescending loss can make it indefinite: then Gauss-Newton's, as the fit used).
+    const Eigen::MatrixXd exact = lin.information + lin.loss_curvature;
+    const Eigen::LLT<Eigen::MatrixXd> llt(exact +
+                                          Eigen::MatrixXd(in.prior_information.asDiagonal()));
+    if (llt.info() == Eigen::Success) in.information = exact;
+  }
   in.information.diagonal() += in.prior_information;
   in.scores = lin.scores;
   in.jacobians = lin.jacobians;
   in.rows_per_sample = kNumCables;
   in.num_residuals = run.result->num_residuals;
-  in.chi_square = lin.chi_square + PriorChiSquare(run);
+  in.chi_square = lin.raw_chi_square + PriorChiSquare(run);
+  in.robust_loss = run.loss != nullptr;
+  in.misfit_threshold = 1.0 + ReducedChiSquareBand(*run.result).half_width;
   std::vector<int> consider;
   for (size_t j = 0; j < candidates.size(); ++j) {
     if (candidates[j].has_prior) consider.push_back(static_cast<int>(j));
@@ -748,6 +758,7 @@ CalibrationStatus Linearise(Run& run, const std::vector<ParameterSpec>& candidat
   in.candidates = candidates;
   in.cross_validation_blocks = run.spec.cross_validation_blocks;
   in.num_threads = run.spec.num_threads;
+  in.max_candidate_samples = run.options.max_candidate_samples;
   std::string why;
   if (!internal::Linearise(in, lin, &why)) return run.Fail(CalibrationStatus::kSolverFailed, why);
   return CalibrationStatus::kOk;
@@ -770,6 +781,36 @@ void AnalyseAtSolution(Run& run, const internal::Linearisation& lin) {
 // Stage: diagnostics: what would explain the misfit, block cross-validation, the
 // residuals' memory, the worst readings.
 
+// Each candidate's score statistic against the residuals' own noise: the long-run
+// variance (overlapping batch means at the budget's bandwidth, in the candidate pass's
+// sample spacing) of its score projected off the free parameters,
+// g~_t = J_c,t^T r_t - (M^-1 J_x^T J_c)^T s_t. White, well-fitting residuals give
+// g^2 / A; correlated or misfitting ones a proportionally larger variance.
+Eigen::VectorXd ScoreStatistics(const Run& run, const internal::Linearisation& lin,
+                                const Eigen::MatrixXd& information) {
+  const int rows = static_cast<int>(lin.candidate_rows.size());
+  const int q = static_cast<int>(lin.cross.cols());
+  Eigen::VectorXd statistic = Eigen::VectorXd::Zero(q);
+  if (rows == 0) return statistic;
+  const Eigen::MatrixXd projection = information.ldlt().solve(lin.cross) / lin.candidate_scale;
+  Eigen::MatrixXd projected = lin.candidate_scores;
+  for (int k = 0; k < rows; ++k) {
+    projected.row(k) -= lin.scores.row(lin.candidate_rows[k]) * projection;
+  }
+  const UncertaintyBudget& b = run.result->budget;
+  const double stride = static_cast<double>(run.fit.size()) / rows;
+  const int bandwidth =
+      b.correlated ? std::max(1, static_cast<int>(std::lround(b.bandwidth / stride))) : 1;
+  const Eigen::VectorXd sum = projected.colwise().sum().transpose();
+  const Eigen::RowVectorXd mean = projected.colwise().mean();
+  projected.rowwise() -= mean;  // the signal's constant part is not noise
+  for (int j = 0; j < q; ++j) {
+    const double variance = LongRunCovarianceOfSum(projected.col(j), bandwidth)(0, 0);
+    statistic[j] = variance > 0.0 ? sum[j] * sum[j] / variance : 0.0;
+  }
+  return statistic;
+}
+
 void RankMisfit(Run& run, const internal::Linearisation& lin,
                 const std::vector<ParameterSpec>& candidates, const std::vector<double>& value_si,
                 const Eigen::MatrixXd& information) {
@@ -781,22 +822,51 @@ void RankMisfit(Run& run, const internal::Linearisation& lin,
     self[j] += w;
     gradient[j] += (value_si[j] - c.prior_mean_si) * w;
   }
-  const Eigen::VectorXd decrease = ScoreTestDecrease(information, lin.cross, self, gradient);
+  // Everything from the candidate pass's samples, so that the Schur complement's two
+  // terms (a small difference for a candidate near the free parameters' span) come from
+  // the same samples: its own J_x^T J_x (with the priors), and the candidates' gradient
+  // projected off the free parameters' gradient over those samples, which is not 0 as
+  // it is over all of them.
+  Eigen::MatrixXd same_samples = lin.candidate_information;
+  same_samples.diagonal() += information.diagonal() - lin.information.diagonal();
+  Eigen::VectorXd free_gradient = Eigen::VectorXd::Zero(run.n);
+  for (int row : lin.candidate_rows) free_gradient += lin.scores.row(row).transpose();
+  free_gradient *= lin.candidate_scale;
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    if (p.has_prior) {
+      free_gradient[k] += (run.theta[k] - p.prior_mean_si) / (p.prior_sigma_si * p.prior_sigma_si);
+    }
+  }
+  gradient -= lin.cross.transpose() * same_samples.ldlt().solve(free_gradient);
+  const Eigen::VectorXd decrease = ScoreTestDecrease(same_samples, lin.cross, self, gradient);
+  const Eigen::VectorXd statistic = ScoreStatistics(run, lin, same_samples);
+  const Eigen::MatrixXd inverse =
+      information.ldlt().solve(Eigen::MatrixXd::Identity(information.rows(), information.cols()));
   CalibrationResult& r = *run.result;
   std::vector<MisfitCandidate>& ranking = r.misfit_ranking;
   for (size_t j = 0; j < candidates.size(); ++j) {
-    if (std::isfinite(decrease[j])) ranking.push_back({candidates[j].name, decrease[j], false});
+    if (!std::isfinite(decrease[j])) continue;
+    const ParameterSpec& c = candidates[j];
+    MisfitCandidate m;
+    m.name = c.name;
+    m.unit = c.unit;
+    m.expected_decrease = decrease[j];
+    m.statistic = statistic[j];
+    // Freeing it, one Gauss-Newton step: dc = -g / A, d(theta) = M^-1 J_x^T J_c g / A,
+    // with A = g^2 / decrease.
+    const double a = gradient[j] * gradient[j] / decrease[j];
+    const double step = a > 0.0 ? gradient[j] / a : 0.0;
+    m.change = -step / c.to_si;
+    const Eigen::VectorXd shift = inverse * lin.cross.col(static_cast<int>(j)) * step;
+    for (int k = 0; k < run.n; ++k) m.shifts.push_back(shift[k] / run.Free(k).to_si);
+    ranking.push_back(std::move(m));
   }
   std::stable_sort(ranking.begin(), ranking.end(), [](const auto& a, const auto& b) {
     return a.expected_decrease > b.expected_decrease;
   });
-  const double misfit2 = r.budget.misfit_factor * r.budget.misfit_factor;
-  // A subsample's J_c^T r, scaled up, carries its noise scaled up as much.
-  const double subsample = static_cast<double>(run.fit.size()) / std::max(1, lin.candidate_samples);
-  r.misfit_threshold =
-      ChiSquare1Quantile(kMisfitFamilyError / std::max<size_t>(1, ranking.size())) * misfit2 *
-      subsample;
-  for (MisfitCandidate& c : ranking) c.significant = c.expected_decrease > r.misfit_threshold;
+  r.misfit_threshold = ChiSquare1Quantile(kMisfitFamilyError / std::max<size_t>(1, ranking.size()));
+  for (MisfitCandidate& c : ranking) c.significant = c.statistic > r.misfit_threshold;
 }
 
 // Each block predicted by the fit without it: theta + (M - M_k)^-1 J_k^T r_k, one
@@ -854,6 +924,10 @@ CalibrationStatus EstimateUncertaintyAndDiagnose(Run& run) {
     return s;
   }
   AnalyseAtSolution(run, lin);
+  // The least-squares chi-square of the kept readings (with a robust loss, twice the
+  // robust cost would be another number).
+  r.reduced_chi_square =
+      (lin.raw_chi_square + PriorChiSquare(run)) / std::max(1, r.num_residuals - run.n);
   const BudgetInputs inputs = MakeBudgetInputs(run, lin, candidates);
   r.covariance_ok = ComputeUncertaintyBudget(inputs, &r.budget);
   FillCorrelation(run);
@@ -972,7 +1046,7 @@ void DecideVerdict(Run& run) {
         "of it";
   }
   const UncertaintyBudget& b = r.budget;
-  if (r.covariance_ok && b.samples > 0 && !b.correlated) {
+  if (r.covariance_ok && b.correlation_measured && !b.correlated) {
     r.notes.push_back("residuals uncorrelated in time (largest autocorrelation time " +
                       Fixed("%.3g", b.tau) + " samples, not significantly above 1)");
   } else if (r.covariance_ok && b.correlated) {

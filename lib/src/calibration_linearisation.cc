@@ -51,8 +51,11 @@ TensionResidual ResidualOf(const LinearisationInputs& in, const CalibrationModel
 
 // Residuals and Jacobian (rows of excluded readings zero) of `f` at `theta`, and the
 // robust loss's IRLS weight sqrt(rho'(|r|^2)) (1 without a loss).
+// `curvature` (may be null) receives 2 rho'' for the loss's exact Hessian
+// rho' J^T J + 2 rho'' (J^T r)(J^T r)^T (0 without a loss).
 bool EvaluateSample(const TensionResidual& f, const double* theta, const ceres::LossFunction* loss,
-                    Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j, double* weight) {
+                    Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j, double* weight,
+                    double* curvature = nullptr) {
   const TensionCost cost(f);
   const double* parameters[1] = {theta};
   double* jacobians[1] = {j->data()};
@@ -61,10 +64,12 @@ bool EvaluateSample(const TensionResidual& f, const double* theta, const ceres::
     if (f.excluded[i]) j->row(i).setZero();  // r_i is 0 already
   }
   *weight = 1.0;
+  if (curvature != nullptr) *curvature = 0.0;
   if (loss != nullptr) {
     double rho[3];
     loss->Evaluate(r->squaredNorm(), rho);
     *weight = std::sqrt(std::max(rho[1], 0.0));
+    if (curvature != nullptr) *curvature = 2.0 * rho[2];
   }
   return true;
 }
@@ -73,14 +78,17 @@ bool EvaluateSample(const TensionResidual& f, const double* theta, const ceres::
 // The free pass.
 
 struct FreeSums {
-  Eigen::MatrixXd information, r_factor, pending;
+  Eigen::MatrixXd information, curvature, r_factor, pending;
   int pending_rows = 0;
-  double chi_square = 0.0;
+  double chi_square = 0.0, raw_chi_square = 0.0;
   int readings = 0;
   std::vector<FoldSums> folds;
 
   FreeSums(int n, int blocks)
-      : information(Eigen::MatrixXd::Zero(n, n)), pending(kQrChunkRows, n), folds(blocks) {
+      : information(Eigen::MatrixXd::Zero(n, n)),
+        curvature(Eigen::MatrixXd::Zero(n, n)),
+        pending(kQrChunkRows, n),
+        folds(blocks) {
     for (FoldSums& f : folds) {
       f.information = Eigen::MatrixXd::Zero(n, n);
       f.gradient = Eigen::VectorXd::Zero(n);
@@ -106,7 +114,9 @@ struct FreeSums {
     Flush();
     r_factor = FoldRows(r_factor, o.r_factor);
     information += o.information;
+    curvature += o.curvature;
     chi_square += o.chi_square;
+    raw_chi_square += o.raw_chi_square;
     readings += o.readings;
     for (size_t k = 0; k < folds.size(); ++k) {
       FoldSums& f = folds[k];
@@ -150,8 +160,8 @@ bool AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
   Eigen::Matrix<double, kNumCables, 1> r;
   for (int t = begin; t < end; ++t) {
     const TensionResidual f = ResidualOf(in, in.fitted, t);
-    double weight = 1.0;
-    if (!EvaluateSample(f, in.theta, in.loss, &r, &j, &weight)) {
+    double weight = 1.0, curvature = 0.0;
+    if (!EvaluateSample(f, in.theta, in.loss, &r, &j, &weight, &curvature)) {
       *failed = t;
       return false;
     }
@@ -163,8 +173,13 @@ bool AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
       out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
     }
     sums->information.noalias() += jw.transpose() * jw;
+    if (curvature != 0.0) {
+      const Eigen::VectorXd jr = j.transpose() * r;
+      sums->curvature.noalias() += curvature * jr * jr.transpose();
+    }
     sums->AddRows(jw);
     sums->chi_square += rw.squaredNorm();
+    sums->raw_chi_square += r.squaredNorm();
     for (bool e : f.excluded) sums->readings += !e;
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
     AddToFold(f, r, j, weight, &sums->folds[block]);
@@ -185,6 +200,7 @@ struct CandidatePass {
 struct CandidateSums {
   Eigen::MatrixXd cross;
   Eigen::VectorXd self, gradient;
+  Eigen::MatrixXd information;  // J_x^T J_x over the same samples
 };
 
 // Columns of `basis` (6 x K) summed into the parameters' columns.
@@ -197,7 +213,7 @@ Eigen::MatrixXd Combine(const RowMatrix& basis, const std::vector<std::vector<in
 }
 
 bool AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
-                          int end, CandidateSums* sums, int* failed) {
+                          int end, CandidateSums* sums, Eigen::MatrixXd* scores, int* failed) {
   RowMatrix b(kNumCables, pass.basis.num_free());
   Eigen::Matrix<double, kNumCables, 1> r;
   for (int k = begin; k < end; ++k) {
@@ -209,17 +225,20 @@ bool AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& sam
     }
     const Eigen::MatrixXd jx = weight * Combine(b, pass.free_columns);
     const Eigen::MatrixXd jc = weight * Combine(b, pass.candidate_columns);
+    const Eigen::VectorXd g = weight * (jc.transpose() * r);
     sums->cross.noalias() += jx.transpose() * jc;
     sums->self += jc.colwise().squaredNorm().transpose();
-    sums->gradient.noalias() += weight * (jc.transpose() * r);
+    sums->gradient += g;
+    sums->information.noalias() += jx.transpose() * jx;
+    scores->row(k) = g.transpose();
   }
   return true;
 }
 
-// Evenly spaced fitted samples, at most kMaxCandidateSamples of them.
-std::vector<int> CandidateSamples(int num_fit) {
+// Evenly spaced fitted samples, at most `budget` of them.
+std::vector<int> CandidateSamples(int num_fit, int budget) {
   std::vector<int> samples;
-  const int used = std::min(num_fit, kMaxCandidateSamples);
+  const int used = std::min(num_fit, std::max(1, budget));
   for (int k = 0; k < used; ++k) {
     samples.push_back(static_cast<int>(static_cast<long long>(k) * num_fit / used));
   }
@@ -254,8 +273,10 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   }
   sums[0].Flush();
   out->information = std::move(sums[0].information);
+  out->loss_curvature = std::move(sums[0].curvature);
   out->r_factor = std::move(sums[0].r_factor);
   out->chi_square = sums[0].chi_square;
+  out->raw_chi_square = sums[0].raw_chi_square;
   out->readings = sums[0].readings;
   out->folds = std::move(sums[0].folds);
   return true;
@@ -276,13 +297,15 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   for (const ParameterSpec& p : in.candidates) {
     pass.candidate_columns.push_back(BasisColumns(p, num_anchor_points));
   }
-  const std::vector<int> samples = CandidateSamples(static_cast<int>(in.fit.size()));
+  const std::vector<int> samples =
+      CandidateSamples(static_cast<int>(in.fit.size()), in.max_candidate_samples);
   const int threads = std::clamp(in.num_threads, 1, std::max(1, static_cast<int>(samples.size())));
-  std::vector<CandidateSums> sums(
-      threads, {Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q), Eigen::VectorXd::Zero(q)});
+  std::vector<CandidateSums> sums(threads, {Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q),
+                                            Eigen::VectorXd::Zero(q), Eigen::MatrixXd::Zero(n, n)});
   std::vector<int> failed(threads, -1);
+  out->candidate_scores = Eigen::MatrixXd::Zero(static_cast<int>(samples.size()), q);
   ParallelChunks(static_cast<int>(samples.size()), threads, [&](int w, int begin, int end) {
-    AccumulateCandidates(pass, samples, begin, end, &sums[w], &failed[w]);
+    AccumulateCandidates(pass, samples, begin, end, &sums[w], &out->candidate_scores, &failed[w]);
   });
   for (int w = 0; w < threads; ++w) {
     if (failed[w] >= 0) {
@@ -293,12 +316,16 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
     sums[0].cross += sums[w].cross;
     sums[0].self += sums[w].self;
     sums[0].gradient += sums[w].gradient;
+    sums[0].information += sums[w].information;
   }
   const double scale = static_cast<double>(in.fit.size()) / std::max<size_t>(1, samples.size());
   out->cross = scale * sums[0].cross;
   out->self = scale * sums[0].self;
   out->gradient = scale * sums[0].gradient;
   out->candidate_samples = static_cast<int>(samples.size());
+  out->candidate_rows = samples;
+  out->candidate_information = scale * sums[0].information;
+  out->candidate_scale = scale;
   return true;
 }
 

@@ -17,8 +17,6 @@ namespace {
 constexpr double kMadToSigma = 1.4826;
 // Sokal's window must end before this fraction of the series, or tau is unreliable.
 constexpr double kMaxWindowFraction = 0.25;
-// Fewer samples than this and the long-run covariance is not estimated.
-constexpr int kMinSamplesForCorrelation = 10;
 // How many of its standard deviations a tau must exceed 1 by to count as correlated: the
 // largest of n parameters' taus is judged, so a 3-sigma rule, not 2.
 constexpr double kTauSignificance = 3.0;
@@ -70,14 +68,21 @@ double SqrtNonNegative(double v) { return std::sqrt(std::max(v, 0.0)); }
 
 // The statistical covariance: P_data (or the formal one without scores), each variance
 // raised to the floor misfit^2 P_formal, the correlations of P_data kept.
-Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& formal, const Eigen::MatrixXd& data,
-                                      double misfit_factor) {
-  const int n = static_cast<int>(formal.rows());
+// The misfit floor: the data's information scaled by the Birge ratio, the priors' not
+// (a prior is not noisier because the data misfit), M^-1 (f^2 (M - Lambda) + Lambda) M^-1.
+Eigen::MatrixXd MisfitFloor(const BudgetInputs& in, const Eigen::MatrixXd& formal, double f) {
+  Eigen::MatrixXd meat = f * f * in.information;
+  meat.diagonal() -= (f * f - 1.0) * in.prior_information;
+  return formal * meat * formal;
+}
+
+// Each variance of `data` raised to the floor's, the correlations of `data` kept.
+Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& floor, const Eigen::MatrixXd& data) {
+  const int n = static_cast<int>(floor.rows());
   Eigen::VectorXd scale = Eigen::VectorXd::Ones(n);
   for (int k = 0; k < n; ++k) {
-    const double floor = misfit_factor * misfit_factor * formal(k, k);
-    if (!(data(k, k) > 0.0)) return misfit_factor * misfit_factor * formal;
-    if (data(k, k) < floor) scale[k] = std::sqrt(floor / data(k, k));
+    if (!(data(k, k) > 0.0)) return floor;
+    if (data(k, k) < floor(k, k)) scale[k] = std::sqrt(floor(k, k) / data(k, k));
   }
   return scale.asDiagonal() * data * scale.asDiagonal();
 }
@@ -114,6 +119,59 @@ Eigen::VectorXd CorrectionWithinLimit(const BudgetInputs& in, UncertaintyBudget*
   return c.cwiseMax(1.0);
 }
 
+// P_data at bandwidth L (the corrected overlapping batch means, with the priors).
+Eigen::MatrixXd DataCovarianceAt(const BudgetInputs& in, const Eigen::MatrixXd& formal,
+                                 const Eigen::VectorXd& correction, int bandwidth) {
+  const Eigen::VectorXd root_c = correction.cwiseMax(1.0).cwiseSqrt();
+  Eigen::MatrixXd meat =
+      root_c.asDiagonal() * LongRunCovarianceOfSum(in.scores, bandwidth) * root_c.asDiagonal();
+  meat.diagonal() += in.prior_information;
+  return formal * meat * formal;
+}
+
+// P_data, robust to a memory longer than the influence series' tau shows (the fit absorbs
+// slow errors, which shortens the residuals' apparent memory): the bandwidth is doubled
+// from L = 8 tau while the batch correction allows (kMaxBatchCorrection, and at most
+// kMaxBandwidthFraction of the samples). A parameter takes a wider bandwidth's variance
+// only when it exceeds the one it has by more than kGrowthSignificance of that
+// estimate's relative standard deviation, sqrt(4 L / (3 N)) (Bartlett/OBM): a variance
+// that keeps growing is a longer memory, not sampling noise. The correlations are those
+// of the first bandwidth. When a parameter's variance still grew at the widest
+// bandwidth, the memory may be longer than the data can measure: correlation_reliable is
+// false.
+Eigen::MatrixXd DataCovariance(const BudgetInputs& in, UncertaintyBudget* b) {
+  const int n = static_cast<int>(b->formal.rows());
+  const Eigen::MatrixXd first =
+      DataCovarianceAt(in, b->formal, CorrectionWithinLimit(in, b), b->bandwidth);
+  Eigen::VectorXd accepted = first.diagonal();
+  std::vector<int> accepted_at(n, b->bandwidth);
+  b->widest_bandwidth = b->bandwidth;
+  const int cap = static_cast<int>(kMaxBandwidthFraction * b->samples);
+  for (int l = 2 * b->bandwidth; l <= cap; l *= 2) {
+    const Eigen::VectorXd c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, l);
+    if (!(c.maxCoeff() <= kMaxBatchCorrection)) break;
+    const Eigen::MatrixXd p = DataCovarianceAt(in, b->formal, c, l);
+    const double noise = std::sqrt(4.0 * l / (3.0 * b->samples));
+    for (int k = 0; k < n; ++k) {
+      if (p(k, k) > accepted[k] * (1.0 + kGrowthSignificance * noise)) {
+        accepted[k] = p(k, k);
+        accepted_at[k] = l;
+      }
+    }
+    b->widest_bandwidth = l;
+  }
+  for (int k = 0; k < n; ++k) {
+    if (accepted_at[k] > b->bandwidth && accepted_at[k] == b->widest_bandwidth) {
+      b->correlation_reliable = false;
+    }
+  }
+  Eigen::VectorXd scale(n);
+  for (int k = 0; k < n; ++k) {
+    scale[k] = first(k, k) > 0.0 ? std::sqrt(accepted[k] / first(k, k)) : 1.0;
+  }
+  return scale.asDiagonal() * first * scale.asDiagonal();
+}
+
 }  // namespace
 
 RobustScale RobustScaleOf(std::vector<double> values) {
@@ -138,12 +196,12 @@ AutocorrelationTime IntegratedAutocorrelationTime(const Eigen::Ref<const Eigen::
   for (int w = 1; w <= max_window; ++w) {
     tau += 2.0 * c[w] / c[0];
     if (w >= window_factor * tau) {
-      a.tau = std::max(tau, 1.0 / n);
+      a.tau = std::max(tau, 1.0 / n);  // an anticorrelated series: below 1, never 0
       a.window = w;
       return a;
     }
   }
-  a.tau = std::max(tau, 1.0);
+  a.tau = std::max(tau, 1.0 / n);
   a.window = max_window;
   a.reliable = false;
   return a;
@@ -208,23 +266,25 @@ bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
   if (n == 0 || !InverseOfPositiveDefinite(in.information, &b->formal)) return false;
   const int dof = in.num_residuals - n;
   b->reduced_chi_square = dof > 0 ? in.chi_square / dof : std::numeric_limits<double>::quiet_NaN();
-  b->misfit_factor =
-      std::isfinite(b->reduced_chi_square) ? std::sqrt(std::max(1.0, b->reduced_chi_square)) : 1.0;
   b->samples = static_cast<int>(in.scores.rows());
+  if (in.robust_loss && b->samples > 0) {
+    // An M-estimator's covariance for white residuals: the sandwich
+    // H^-1 (sum_t psi_t psi_t^T + Lambda) H^-1 (the scores are psi, M is H); it carries
+    // the residuals' scale itself, so no misfit factor on top.
+    Eigen::MatrixXd meat = LongRunCovarianceOfSum(in.scores, 1);
+    meat.diagonal() += in.prior_information;
+    b->formal = b->formal * meat * b->formal;
+  } else if (std::isfinite(b->reduced_chi_square) && b->reduced_chi_square > in.misfit_threshold) {
+    b->misfit_factor = std::sqrt(std::max(1.0, b->reduced_chi_square));
+  }
   std::vector<double> tau(n, 1.0);
   Eigen::MatrixXd data = b->formal;
-  if (b->samples >= kMinSamplesForCorrelation && in.scores.cols() == n && dof > 0) {
-    ChooseBandwidth(in.scores * b->formal, b, &tau);
-  }
-  if (b->correlated) {
-    const Eigen::VectorXd root_c = CorrectionWithinLimit(in, b).cwiseSqrt();
-    Eigen::MatrixXd meat =
-        root_c.asDiagonal() * LongRunCovarianceOfSum(in.scores, b->bandwidth) * root_c.asDiagonal();
-    meat.diagonal() += in.prior_information;
-    data = b->formal * meat * b->formal;
-  }
+  b->correlation_measured =
+      b->samples >= kMinSamplesForCorrelation && in.scores.cols() == n && dof > 0;
+  if (b->correlation_measured) ChooseBandwidth(in.scores * b->formal, b, &tau);
+  if (b->correlated) data = DataCovariance(in, b);
   b->effective_samples = b->samples / b->tau;
-  b->statistical = StatisticalCovariance(b->formal, data, b->misfit_factor);
+  b->statistical = StatisticalCovariance(MisfitFloor(in, b->formal, b->misfit_factor), data);
 
   const int q = static_cast<int>(in.consider_sigma.size());
   const int groups = static_cast<int>(in.consider_groups.size());

@@ -78,6 +78,10 @@ struct CalibrationOptions {
   int max_passes = 4;
   // Readings listed as the worst fitted ones (largest |residual| / sigma).
   int worst_readings = 10;
+  // The misfit ranking and the consider parameters' sensitivities come from at most this
+  // many evenly spaced fitted samples, their sums scaled up (a 64-wide Jet through the
+  // statics costs ~25 us a sample): docs/calibration.md, "What would explain the misfit".
+  int max_candidate_samples = 20000;
 };
 
 // A direction in parameter space: weights on parameter names (unit vector in the
@@ -146,13 +150,21 @@ struct GrossErrorSummary {
   bool settled = true;  // the flagged set stopped changing before max_passes
 };
 
-// The chi-square decrease expected from freeing a fixed parameter (score test).
+// The chi-square decrease expected from freeing a fixed parameter (score test), with
+// what freeing it would do (one Gauss-Newton step: exact for a linear model).
 struct MisfitCandidate {
   std::string name;
+  std::string unit;
   double expected_decrease = 0.0;
-  // Above CalibrationResult::misfit_threshold: more than noise alone would give the
-  // largest of all the candidates.
+  // The score statistic against the noise the residuals actually have (their long-run
+  // variance, so time-correlated or misfitting residuals do not inflate it):
+  // chi-square with 1 degree of freedom when the parameter explains nothing.
+  double statistic = 0.0;
+  // statistic above CalibrationResult::misfit_threshold: more than noise alone would
+  // give the largest of all the candidates.
   bool significant = false;
+  double change = 0.0;         // of the parameter itself, in `unit`
+  std::vector<double> shifts;  // of each free parameter, in its unit, free order
 };
 
 // Block cross-validation (linearised: each block predicted by one Gauss-Newton step
@@ -189,10 +201,8 @@ struct CalibrationResult {
   // Every fixed parameter the model has, by the chi-square decrease expected from
   // freeing it, largest first (candidates already spanned by the free set left out).
   std::vector<MisfitCandidate> misfit_ranking;
-  // The decrease that freeing the best of q candidates reaches from white noise alone
-  // with probability 1% (chi-square with 1 degree of freedom at 1 - 0.01 / q), times
-  // max(1, chi2/nu). Time-correlated residuals inflate every candidate's decrease alike
-  // (by up to the widening squared), so then compare the candidates with each other.
+  // The statistic that the best of q candidates reaches from noise alone with
+  // probability 1% (chi-square with 1 degree of freedom at 1 - 0.01 / q).
   double misfit_threshold = 0.0;
   CrossValidation cross_validation;
   // Integrated autocorrelation time of each cable's whitened residuals (file order).

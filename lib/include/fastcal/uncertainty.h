@@ -36,10 +36,15 @@
 // add its own sampling noise (a third of the variance at 9 batches) and nothing else,
 // and the Birge ratio below already covers the misfit. L is halved while some c_k exceeds
 // kMaxBatchCorrection (the fit then absorbs most of a batch's slow error and the residuals
-// can no longer measure it: the budget says its widening is a lower bound). The
-// statistical variance is max(P_formal * max(1, chi2/nu), P_data) per parameter (the
-// Birge ratio as a floor): never narrower than the formal one, never narrower than the
-// misfit calls for.
+// can no longer measure it: the budget says its widening is a lower bound). From there
+// the bandwidth is doubled while the variance keeps growing beyond its own noise
+// (DataCovariance in uncertainty.cc). The statistical variance is, per parameter,
+//
+//   max(P_data, P_floor),  P_floor = M^-1 (f^2 J_x^T J_x + Lambda) M^-1,
+//   f^2 = chi2/nu when above its band (misfit_threshold), else 1
+//
+// (the Birge ratio as a floor, scaling the data's information, not the priors'): never
+// narrower than the formal one, never narrower than the misfit calls for.
 //
 // Systematic part from consider parameters (held fixed, uncertain with sigma_c; Tapley,
 // Schutz and Born, "Statistical Orbit Determination", ch. 6), with J_c their whitened
@@ -60,6 +65,9 @@
 #include <vector>
 
 namespace fastcal {
+
+// Fewer samples than this and the residuals' memory is not measured (no P_data).
+inline constexpr int kMinSamplesForCorrelation = 10;
 
 // Per-sample Jacobian rows, one sample per row (row-major, so a sample's rows are contiguous).
 using SampleJacobians = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
@@ -104,6 +112,12 @@ inline constexpr double kBandwidthPerTau = 8.0;
 // Largest batch correction c_k accepted before the bandwidth is halved: at 3 the fit has
 // absorbed two thirds of a batch's slow error.
 inline constexpr double kMaxBatchCorrection = 3.0;
+// Largest bandwidth tried, as a fraction of the samples (with fewer than ~4 batches the
+// estimate means little).
+inline constexpr double kMaxBandwidthFraction = 0.25;
+// A wider bandwidth's variance is taken when it exceeds the narrower one's by more than
+// this many of its relative standard deviations (one-sided, ~2.3% by chance per step).
+inline constexpr double kGrowthSignificance = 2.0;
 
 struct BudgetInputs {
   Eigen::MatrixXd information;        // M (n x n), data and priors
@@ -115,6 +129,13 @@ struct BudgetInputs {
   int rows_per_sample = 1;
   int num_residuals = 0;    // m: data and prior residuals
   double chi_square = 0.0;  // sum of squared whitened residuals at the solution
+  // The reduced chi-square above which the misfit factor applies (the top of its band,
+  // calibration.h's ReducedChiSquareBand; 1 when not given).
+  double misfit_threshold = 1.0;
+  // The fit used a robust loss: scores and M are its psi and H (the rows weighted by
+  // sqrt(rho')), and the formal covariance is the M-estimator's sandwich for white
+  // residuals (no misfit factor: the sandwich has the residuals' scale).
+  bool robust_loss = false;
   // Consider parameters (q of them): J_x^T J_c (n x q), their sigmas in the same units
   // as the Jacobian's columns, and the index of each one's group in `consider_groups`.
   Eigen::MatrixXd consider_cross;
@@ -142,13 +163,16 @@ struct UncertaintyBudget {
   Eigen::MatrixXd sensitivity;  // S (n x q)
   std::vector<std::string> consider_groups;
   double reduced_chi_square = 0.0;
-  double misfit_factor = 1.0;         // max(1, sqrt(chi2/nu)), the Birge ratio as applied
+  double misfit_factor = 1.0;         // sqrt(chi2/nu) when above misfit_threshold, else 1
   int samples = 0;                    // N (rows of scores)
   int bandwidth = 0;                  // L; 0 without scores
+  int widest_bandwidth = 0;           // the largest L tried (see P_data above)
   double max_batch_correction = 1.0;  // the largest c_k at L
   double tau = 1.0;                   // largest of the parameters' tau
   double effective_samples = 0.0;     // N / tau
-  // The residuals are correlated in time (some tau significantly above 1): P_data used.
+  // The residuals' memory was measured (at least kMinSamplesForCorrelation samples), and
+  // they are correlated in time (some tau significantly above 1): P_data used.
+  bool correlation_measured = false;
   bool correlated = false;
   bool correlation_reliable = true;  // false: the memory is too long to measure (cap hit)
   bool ok = false;                   // M was invertible

@@ -15,8 +15,8 @@
 // columns. One basis pass gives B_t (6 x K), so J_x = B_t A_x and J_c = B_t A_c (A: 0/1
 // maps), accumulated as J_x^T J_c, diag(J_c^T J_c) and J_c^T r. This pass costs ~25 us a
 // sample (a 64-wide Jet through the statics), so on long datasets it runs on at most
-// kMaxCandidateSamples evenly spaced samples and its sums are scaled by N / N_used:
-// J_x^T J_c and diag(J_c^T J_c) involve no noise and are smooth along the poses (a
+// LinearisationInputs::max_candidate_samples evenly spaced samples and its sums are scaled by N /
+// N_used: J_x^T J_c and diag(J_c^T J_c) involve no noise and are smooth along the poses (a
 // quadrature), while J_c^T r then carries N / N_used times its noise (the misfit
 // ranking's threshold is raised by that factor).
 //
@@ -43,9 +43,6 @@
 
 namespace fastcal::internal {
 
-// The candidate pass's sample budget (see above).
-inline constexpr int kMaxCandidateSamples = 20000;
-
 struct LinearisationInputs {
   const CalibrationModel* fitted = nullptr;  // the fit's model (its free set)
   const double* theta = nullptr;             // the solution
@@ -62,6 +59,7 @@ struct LinearisationInputs {
   std::vector<ParameterSpec> candidates;      // fixed parameters to differentiate against
   int cross_validation_blocks = 10;
   int num_threads = 1;
+  int max_candidate_samples = 20000;  // the candidate pass's sample budget (see above)
 };
 
 struct FoldSums {
@@ -75,19 +73,33 @@ struct FoldSums {
 };
 
 struct Linearisation {
-  Eigen::MatrixXd information;  // J_x^T J_x over the data (no priors)
+  Eigen::MatrixXd information;  // J_x^T J_x over the data (no priors; rows weighted)
+  // With a robust loss, sum 2 rho'' (J^T r)(J^T r)^T: added to `information` it makes
+  // the loss's exact Hessian (Triggs et al. 2000), which Gauss-Newton leaves out and
+  // which the M-estimator's sandwich needs. 0 without a loss.
+  Eigen::MatrixXd loss_curvature;
   Eigen::MatrixXd r_factor;     // upper triangular R, R^T R = J_x^T J_x
   Eigen::MatrixXd scores;       // s_t, one row per fitted sample
   SampleJacobians jacobians;    // J_t (6 x n, row after row), one row per fitted sample
   Eigen::MatrixXd residuals;    // r_t (fitted samples x 6); 0 where excluded
-  double chi_square = 0.0;      // sum r^2 over the data
+  double chi_square = 0.0;      // sum (w r)^2 over the data, w the robust loss's weight
+  double raw_chi_square = 0.0;  // sum r^2 over the data
   int readings = 0;             // readings not excluded
   std::vector<FoldSums> folds;
   // Candidates (scaled to all fitted samples).
-  Eigen::MatrixXd cross;      // J_x^T J_c
-  Eigen::VectorXd self;       // diag(J_c^T J_c)
-  Eigen::VectorXd gradient;   // J_c^T r
-  int candidate_samples = 0;  // N_used
+  Eigen::MatrixXd cross;         // J_x^T J_c
+  Eigen::VectorXd self;          // diag(J_c^T J_c)
+  Eigen::VectorXd gradient;      // J_c^T r
+  int candidate_samples = 0;     // N_used
+  double candidate_scale = 1.0;  // N / N_used, by which the sums above were scaled
+  // J_x^T J_x over the candidate pass's samples, scaled like the sums above: the score
+  // test's Schur complement is a small difference of large numbers for a candidate near
+  // the free parameters' span, so its two terms must come from the same samples.
+  Eigen::MatrixXd candidate_information;
+  // Per sample of the candidate pass (in time order): J_c,t^T r_t (unscaled), and the
+  // sample's row in `scores` (for the score test's long-run variance).
+  Eigen::MatrixXd candidate_scores;
+  std::vector<int> candidate_rows;
 };
 
 // The basis parameters, in order (all free, no initial: the model's values).
