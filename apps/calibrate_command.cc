@@ -404,10 +404,9 @@ std::string MisfitLine(const CalibrationResult& result) {
   if (result.misfit_ranking.empty()) return "";
   const MisfitCandidate& top = result.misfit_ranking.front();
   if (!top.significant) {
-    return "  freeing no fixed parameter would lower the chi-square by more than noise alone "
-           "(largest expected decrease " +
-           FormatDouble(top.expected_decrease, 3) + ", from " + top.name +
-           "; white noise alone reaches " + FormatDouble(result.misfit_threshold, 3) + ")\n";
+    return "  no fixed parameter explains the misfit beyond the residuals' own noise (largest "
+           "expected chi-square decrease " +
+           FormatDouble(top.expected_decrease, 3) + ", from " + top.name + ")\n";
   }
   std::string line = "  the misfit is best explained by freeing:";
   for (size_t k = 0; k < std::min(kShown, result.misfit_ranking.size()); ++k) {
@@ -416,8 +415,7 @@ std::string MisfitLine(const CalibrationResult& result) {
     line += std::string(k ? ", " : " ") + c.name + " (about " +
             FormatDouble(c.expected_decrease, 3) + ")";
   }
-  return line + "  [expected chi-square decrease; white noise alone reaches " +
-         FormatDouble(result.misfit_threshold, 3) + "]\n";
+  return line + "  [expected chi-square decrease; each beyond the residuals' own noise]\n";
 }
 
 std::string CrossValidationLine(const CalibrationResult& result) {
@@ -487,38 +485,6 @@ bool WriteOutDirectory(const char* command,
 
 }  // namespace
 
-// The RMS table's rows: the initial model at each attitude the data has, and the
-// calibrated one at the fit's attitude (exact statics; gross errors left out).
-bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec,
-                            const Dataset& data, const CalibrationResult& result,
-                            std::vector<VariantEvaluation>* variants, std::string* error) {
-  struct Variant {
-    std::string name;
-    const CableRobot* robot;
-    AttitudeSource attitude;
-  };
-  std::vector<Variant> list;
-  if (data.has_planned_attitude) {
-    list.push_back({"initial model, planned attitude", &model, AttitudeSource::kPlanned});
-  }
-  list.push_back({"initial model, measured attitude", &model, AttitudeSource::kMeasured});
-  list.push_back(
-      {std::string("calibrated model, ") + (spec.use_planned_attitude ? "planned" : "measured") +
-           " attitude",
-       &result.calibrated,
-       spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured});
-  for (const Variant& v : list) {
-    VariantEvaluation e;
-    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact, result.held_out,
-                         &e, error, result.excluded)) {
-      *error = v.name + ": " + *error;
-      return false;
-    }
-    variants->push_back(std::move(e));
-  }
-  return true;
-}
-
 int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
@@ -573,11 +539,7 @@ int RunCalibrate(int argc, char** argv) {
     return status == CalibrationStatus::kInvalidInput ? kExitUsage : kExitFailure;
   }
 
-  std::vector<VariantEvaluation> variants;
-  if (!EvaluateBeforeAndAfter(model, spec, data, result, &variants, &error)) {
-    PrintError(command, error);
-    return kExitFailure;
-  }
+  const std::vector<VariantEvaluation>& variants = result.variants;
 
   ReportInputs report;
   report.model_path = FLAGS_model;

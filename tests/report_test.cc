@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <random>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -472,7 +473,7 @@ TEST_F(ReportTest, DiagnosticSectionsNameTheirNumbers) {
   EXPECT_TRUE(Contains(md,
                        "**The misfit is best explained by freeing:** `sensor_gain[3]` "
                        "(about 410)."));
-  EXPECT_TRUE(Contains(md, "| 2 | `tower_offset_m[2].z` | 12 | no |"));
+  EXPECT_TRUE(Contains(md, "| 2 | `tower_offset_m[2].z` | 12 | 2 | no | 1 mm | - |"));
   EXPECT_TRUE(Contains(md, "| **calibrated, cross-validated** | 5.100 | 5.200 |"));
   const std::string json = SummaryJson(inputs_);
   EXPECT_TRUE(JsonChecker(json).Valid());
@@ -512,9 +513,41 @@ TEST_F(ReportTest, PlotsSuitTheDataAndLeaveGrossErrorsOut) {
   EXPECT_TRUE(Contains(svg, after + " stroke-width=\"3.6\" stroke-linecap=\"round\"")) << svg;
 }
 
+// "Nothing is poorly determined" only when no estimate leans on its prior either.
 TEST_F(ReportTest, SaysSoWhenNothingIsPoorlyDetermined) {
   result_.data_only.undetermined.clear();
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_),
+                       "No combination of parameters is poorly determined by the data alone, "
+                       "but 1 estimate(s) are set mostly by their prior"));
+  result_.parameters[2].note.clear();
   EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "Nothing is poorly determined"));
+}
+
+// A long set of samples that is not a trajectory is thinned evenly, not by min/max per
+// bucket (which keeps only each bucket's extremes of an unordered cloud: two false bands).
+TEST_F(ReportTest, UnorderedSamplesAreThinnedEvenly) {
+  constexpr int kLong = 5000;
+  Sample s = data_.samples.back();
+  data_.samples.clear();
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<double> angle(0.0, 2.0 * M_PI);
+  for (int n = 0; n < kLong; ++n) {
+    s.line = n + 2;
+    s.time_s = n;
+    const double a = angle(rng);
+    s.pose.position_m = Eigen::Vector3d(71.11 * std::cos(a), 71.11 * std::sin(a), 156.73);
+    data_.samples.push_back(s);
+  }
+  result_.held_out = held_out_ = HoldoutMask(kLong, 0.2, 1);
+  result_.excluded.clear();
+  result_.gross_errors.clear();
+  inputs_.variants[1] =
+      MakeVariant("nominal model, measured attitude", data_, held_out_, 20e3, 8e3);
+  inputs_.variants[2] =
+      MakeVariant("calibrated model, measured attitude", data_, held_out_, 1e3, 4e3);
+  const std::string html = ReportHtml(inputs_);
+  EXPECT_TRUE(Contains(html, "Thinned for drawing: one point in 3 of the 5000 samples, evenly"));
+  EXPECT_FALSE(Contains(html, "min/max per bucket"));
 }
 
 TEST_F(ReportTest, HtmlIsSelfContainedWithPlotsAndNoNonFiniteNumbers) {

@@ -82,6 +82,12 @@ struct Run {
   std::vector<std::array<double, kNumCables>> sigma_n;
   ReadingMask excluded;
   std::unique_ptr<ceres::Problem> problem;
+  // At the solution: the candidates of the misfit ranking (and consider parameters),
+  // the linearisation, and the normal matrix with the priors.
+  std::vector<ParameterSpec> candidates;
+  std::vector<double> candidate_value_si;
+  internal::Linearisation lin;
+  Eigen::MatrixXd information;
 
   Pose PoseOf(const Sample& s) const {
     Pose pose = s.pose;
@@ -914,29 +920,40 @@ void FindWorstReadings(Run& run) {
   run.result->worst_readings = std::move(all);
 }
 
-CalibrationStatus EstimateUncertaintyAndDiagnose(Run& run) {
-  CalibrationResult& r = *run.result;
+// Stage: the problem linearised at the solution (one pass for the free parameters, one
+// for the candidates).
+CalibrationStatus LineariseAtSolution(Run& run) {
   run.problem.reset();  // its residuals hold a copy of every warm start
-  std::vector<double> value_si;
-  const std::vector<ParameterSpec> candidates = Candidates(run, &value_si);
-  internal::Linearisation lin;
-  if (const CalibrationStatus s = Linearise(run, candidates, &lin); s != CalibrationStatus::kOk) {
-    return s;
-  }
-  AnalyseAtSolution(run, lin);
+  run.candidates = Candidates(run, &run.candidate_value_si);
+  return Linearise(run, run.candidates, &run.lin);
+}
+
+// Stage: identifiability at the solution, the least-squares chi-square, the budget.
+CalibrationStatus EstimateUncertainty(Run& run) {
+  CalibrationResult& r = *run.result;
+  AnalyseAtSolution(run, run.lin);
   // The least-squares chi-square of the kept readings (with a robust loss, twice the
   // robust cost would be another number).
   r.reduced_chi_square =
-      (lin.raw_chi_square + PriorChiSquare(run)) / std::max(1, r.num_residuals - run.n);
-  const BudgetInputs inputs = MakeBudgetInputs(run, lin, candidates);
+      (run.lin.raw_chi_square + PriorChiSquare(run)) / std::max(1, r.num_residuals - run.n);
+  const BudgetInputs inputs = MakeBudgetInputs(run, run.lin, run.candidates);
+  run.information = inputs.information;
   r.covariance_ok = ComputeUncertaintyBudget(inputs, &r.budget);
   FillCorrelation(run);
-  RankMisfit(run, lin, candidates, value_si, inputs.information);
-  CrossValidate(run, lin, inputs.information);
+  return CalibrationStatus::kOk;
+}
+
+// Stage: what would explain the misfit, block cross-validation, the residuals' memory,
+// the worst readings.
+CalibrationStatus Diagnose(Run& run) {
+  CalibrationResult& r = *run.result;
+  RankMisfit(run, run.lin, run.candidates, run.candidate_value_si, run.information);
+  CrossValidate(run, run.lin, run.information);
   for (int i = 0; i < kNumCables; ++i) {
-    r.residual_tau[i] = IntegratedAutocorrelationTime(lin.residuals.col(i)).tau;
+    r.residual_tau[i] = IntegratedAutocorrelationTime(run.lin.residuals.col(i)).tau;
   }
   FindWorstReadings(run);
+  run.lin = internal::Linearisation();  // the per-sample Jacobians: ~100 MB at 1e5 samples
   return CalibrationStatus::kOk;
 }
 
@@ -1024,8 +1041,9 @@ void DecideVerdict(Run& run) {
                   "): do not use the estimates"
             : chi_text + " is above " + Fixed("%g", run.options.failed_fit_reduced_chi_square) +
                   " (residuals about " + Fixed("%.1f", std::sqrt(chi)) +
-                  " times the stated noise): the model does not describe these data and its "
-                  "uncertainties mean nothing; do not use the estimates";
+                  " times the stated noise): the model does not describe these data, or the "
+                  "stated noise is far too small (noise in the spec); the linearised "
+                  "uncertainties mean nothing then; do not use the estimates as they are";
   } else if (band.within || band.degrees_of_freedom <= 0) {
     r.verdict = FitVerdict::kOk;
     r.verdict_text =
@@ -1045,6 +1063,41 @@ void DecideVerdict(Run& run) {
         "(sigma_total); the misfit ranking says which fixed parameter would explain most "
         "of it";
   }
+}
+
+// What the misfit ranking's significant candidates would move, in sigma_total: sigma_total
+// does not contain the error of a fixed parameter the data point at.
+void NoteWhatTheMisfitWouldMove(CalibrationResult* r) {
+  constexpr size_t kCandidates = 3;
+  constexpr double kWorthSaying = 1.0;  // sigma_total
+  size_t said = 0;
+  for (const MisfitCandidate& c : r->misfit_ranking) {
+    if (!c.significant || said == kCandidates) break;
+    const ParameterEstimate* worst = nullptr;
+    double worst_sigmas = 0.0, worst_shift = 0.0;
+    size_t k = 0;
+    for (const ParameterEstimate& e : r->parameters) {
+      if (!e.free) continue;
+      const double sigmas = e.sigma_total > 0 ? std::abs(c.shifts[k]) / e.sigma_total : 0.0;
+      if (sigmas > worst_sigmas) {
+        worst = &e;
+        worst_sigmas = sigmas;
+        worst_shift = c.shifts[k];
+      }
+      ++k;
+    }
+    ++said;
+    if (worst == nullptr || worst_sigmas < kWorthSaying) continue;
+    r->notes.push_back("freeing " + c.name + ", which the data point at, would move " +
+                       worst->name + " by " + Fixed("%+.3g", worst_shift) + " " + worst->unit +
+                       " (" + Fixed("%.1f", worst_sigmas) +
+                       " sigma_total): sigma_total does not include the error of a parameter "
+                       "held fixed at a wrong value");
+  }
+}
+
+void AddNotes(Run& run) {
+  CalibrationResult& r = *run.result;
   const UncertaintyBudget& b = r.budget;
   if (r.covariance_ok && b.correlation_measured && !b.correlated) {
     r.notes.push_back("residuals uncorrelated in time (largest autocorrelation time " +
@@ -1063,13 +1116,80 @@ void DecideVerdict(Run& run) {
     r.notes.push_back("the set of gross errors still changed after " +
                       std::to_string(run.options.max_passes) + " passes");
   }
+  std::string wider;
   for (const ParameterEstimate& e : r.parameters) {
+    if (e.free && e.has_prior && e.sigma_total > e.prior_sigma) {
+      wider += (wider.empty() ? "" : ", ") + e.name + " (" + Fixed("%.3g", e.sigma_total) +
+               " against " + Fixed("%.3g", e.prior_sigma) + ")";
+    }
     if (e.consider && std::abs(e.estimate - e.prior_mean) > 0.5 * e.prior_sigma) {
       r.notes.push_back(e.name + " is held at " + Fixed("%.6g", e.estimate) +
                         " but its prior's mean is " + Fixed("%.6g", e.prior_mean) +
                         ": the fit is conditional on a value the prior doubts");
     }
   }
+  if (!wider.empty()) {
+    r.notes.push_back("sigma_total exceeds the prior's sigma for " + wider +
+                      ": the data, weighted by the stated noise but noisier than stated, pull "
+                      "them further than their priors allow; stating the noise the residuals "
+                      "show (or fewer free parameters) would give the priors their due weight");
+  }
+  NoteWhatTheMisfitWouldMove(&r);
+}
+
+// ---------------------------------------------------------------------------------------
+// Stage: the model against the measurements before and after (the paper's Table 6):
+// the initial model at each attitude the data has and the calibrated one at the fit's,
+// exact statics, gross errors left out.
+CalibrationStatus Evaluate(Run& run) {
+  CalibrationResult& r = *run.result;
+  if (!run.options.evaluate) return CalibrationStatus::kOk;
+  struct Variant {
+    std::string name;
+    const CableRobot* robot;
+    AttitudeSource attitude;
+  };
+  std::vector<Variant> list;
+  if (run.data.has_planned_attitude) {
+    list.push_back({"initial model, planned attitude", &run.model, AttitudeSource::kPlanned});
+  }
+  list.push_back({"initial model, measured attitude", &run.model, AttitudeSource::kMeasured});
+  const bool planned = run.spec.use_planned_attitude;
+  list.push_back(
+      {std::string("calibrated model, ") + (planned ? "planned" : "measured") + " attitude",
+       &r.calibrated, planned ? AttitudeSource::kPlanned : AttitudeSource::kMeasured});
+  for (const Variant& v : list) {
+    VariantEvaluation e;
+    std::string why;
+    if (!EvaluateVariant(v.name, *v.robot, run.data, v.attitude, StaticsMethod::kExact, r.held_out,
+                         &e, &why, r.excluded)) {
+      return run.Fail(CalibrationStatus::kInfeasible, v.name + ": " + why);
+    }
+    r.variants.push_back(std::move(e));
+  }
+  return CalibrationStatus::kOk;
+}
+
+// Stage: the per-parameter table, the verdict and its notes.
+CalibrationStatus Conclude(Run& run) {
+  FillParameterTable(run);
+  DecideVerdict(run);
+  AddNotes(run);
+  return CalibrationStatus::kOk;
+}
+
+// Stage: the initial model's readings, screened for gross errors.
+CalibrationStatus PredictAndScreen(Run& run) {
+  const CalibrationStatus status = Predict(run);
+  if (status == CalibrationStatus::kOk) run.excluded = ScreenReadings(run);
+  return status;
+}
+
+// Stage: the problem with the initial weights, and the refusal of a free set the data
+// and priors cannot determine.
+CalibrationStatus BuildAndCheck(Run& run) {
+  BuildProblem(run);
+  return CheckIdentifiability(run);
 }
 
 }  // namespace
@@ -1120,27 +1240,17 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   *result = CalibrationResult();
   Run run(model, spec, data, options, result, error);
   using Stage = CalibrationStatus (*)(Run&);
-  const Stage stages[] = {
-      ValidateInputs,
-      MeasureForwardModelError,
-      [](Run& r) {  // the initial model's readings, screened for gross errors
-        const CalibrationStatus s = Predict(r);
-        if (s == CalibrationStatus::kOk) r.excluded = ScreenReadings(r);
-        return s;
-      },
-      [](Run& r) {
-        BuildProblem(r);
-        return CheckIdentifiability(r);
-      },
-      SolveAndReweight,
-      NameGrossErrors,
-      EstimateUncertaintyAndDiagnose,
-      [](Run& r) {
-        FillParameterTable(r);
-        DecideVerdict(r);
-        return CalibrationStatus::kOk;
-      },
-  };
+  const Stage stages[] = {ValidateInputs,
+                          MeasureForwardModelError,
+                          PredictAndScreen,
+                          BuildAndCheck,
+                          SolveAndReweight,
+                          NameGrossErrors,
+                          LineariseAtSolution,
+                          EstimateUncertainty,
+                          Diagnose,
+                          Conclude,
+                          Evaluate};
   for (const Stage stage : stages) {
     const CalibrationStatus status = stage(run);
     if (status != CalibrationStatus::kOk) return status;

@@ -436,9 +436,18 @@ void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* d
                             r.data_only.undetermined.empty() &&
                             r.data_only.poorly_determined.empty();
   if (nothing_weak) {
+    int prior_set = 0;
+    for (const ParameterEstimate& p : r.parameters) {
+      prior_set += p.note.find("set mostly by its prior") != std::string::npos;
+    }
     doc->Paragraph(
-        "Nothing is poorly determined: every free parameter is fixed by the data alone, "
-        "without help from a prior.");
+        prior_set == 0
+            ? "Nothing is poorly determined: every free parameter is fixed by the data alone, "
+              "without help from a prior."
+            : "No combination of parameters is poorly determined by the data alone, but " +
+                  Int(prior_set) +
+                  " estimate(s) are set mostly by their prior (see Estimates): the data "
+                  "inform them less than the prior does.");
   }
   doc->List(std::move(items));
   if (!r.strong_correlations.empty()) {
@@ -648,6 +657,18 @@ struct TimePlots {
   bool ordered = true;  // a trajectory: lines join the samples; else dots
   std::string not_drawn;
 
+  // Thins a series for drawing: min/max per bucket along a trajectory (peaks stay
+  // visible), every k-th point for unordered samples (extremes of an unordered cloud
+  // would draw false bands).
+  PlotSeries Thin(PlotSeries s, int* thinning) const {
+    if (!ordered) return internal::ThinEvenly(s, kMaxPlotPointsPerSeries, thinning);
+    return ::fastcal::Thin(std::move(s), thinning);
+  }
+  std::string ThinningNote(int thinning) const {
+    return ordered ? ::fastcal::ThinningNote(NumSamples(in), thinning)
+                   : internal::EvenThinningNote(NumSamples(in), thinning);
+  }
+
   TimePlots(const ReportInputs& inputs)  // NOLINT: a view of the inputs
       : in(inputs), d(*inputs.data), x(SampleAxis(d, &x_label)), shown(PlotVariants(inputs)) {
     holdout = NumHeldOut(in) > 0;
@@ -692,7 +713,7 @@ void AddTensionPlots(const TimePlots& t, Document* doc) {
       if (!HasPredictions(t.in, v)) continue;
       PlotSeries p = t.Model(v.name, k);
       for (const auto& predicted : v.predicted_n) p.y.push_back(predicted[i] / kNPerKn);
-      PutAt(&series, t.shown[k], Thin(std::move(p), &buckets));
+      PutAt(&series, t.shown[k], t.Thin(std::move(p), &buckets));
     }
     PlotSeries fitted{t.holdout ? "measured (fitted)" : "measured", {}, {}, false, true};
     PlotSeries held{"measured (held out)", {}, {}, false, true};
@@ -705,8 +726,8 @@ void AddTensionPlots(const TimePlots& t, Document* doc) {
     fitted.marker_radius_px = held.marker_radius_px = kMeasuredDotRadiusPx;
     fitted.opacity = kMeasuredDotOpacity;
     held.opacity = kHeldOutDotOpacity;
-    if (t.holdout) PutAt(&series, HeldOutSlot(t.in), Thin(std::move(held), &buckets));
-    PutAt(&series, MeasuredSlot(t.in), Thin(std::move(fitted), &buckets));
+    if (t.holdout) PutAt(&series, HeldOutSlot(t.in), t.Thin(std::move(held), &buckets));
+    PutAt(&series, MeasuredSlot(t.in), t.Thin(std::move(fitted), &buckets));
     svgs.push_back(SvgLinePlot(series, CablePlotOptions("Cable " + Int(i + 1) + ": tension",
                                                         t.x_label, "T" + Int(i + 1) + " [kN]")));
   }
@@ -716,8 +737,7 @@ void AddTensionPlots(const TimePlots& t, Document* doc) {
                   (t.ordered ? "predictions (lines on top; dashed: before calibration)"
                              : "predictions (dots on top: the samples are not a trajectory, so "
                                "nothing joins them)") +
-                  " against time, per cable [kN]." + t.not_drawn +
-                  ThinningNote(NumSamples(t.in), buckets));
+                  " against time, per cable [kN]." + t.not_drawn + t.ThinningNote(buckets));
 }
 
 // Residual distribution, all cables and samples pooled. False when no variant has
@@ -772,7 +792,7 @@ void AddResidualTimePlots(const TimePlots& t, Document* doc) {
   doc->Figure(std::move(svgs),
               "Model - measured against time, per cable [kN]: a pattern that repeats with "
               "the pose is model error; what remains after calibration should look like noise." +
-                  t.not_drawn + ThinningNote(NumSamples(t.in), buckets));
+                  t.not_drawn + t.ThinningNote(buckets));
 }
 
 void AddPlots(const ReportInputs& in, Document* doc) {

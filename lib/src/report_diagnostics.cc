@@ -81,6 +81,27 @@ std::string CorrelationSentence(const UncertaintyBudget& b) {
 
 }  // namespace
 
+PlotSeries ThinEvenly(const PlotSeries& series, int max_points, int* stride) {
+  const size_t n = std::min(series.x.size(), series.y.size());
+  const size_t k = max_points > 0 ? std::max<size_t>(1, (n + max_points - 1) / max_points) : 1;
+  *stride = std::max(*stride, static_cast<int>(k));
+  if (k == 1) return series;
+  PlotSeries thinned = series;
+  thinned.x.clear();
+  thinned.y.clear();
+  for (size_t t = 0; t < n; t += k) {
+    thinned.x.push_back(series.x[t]);
+    thinned.y.push_back(series.y[t]);
+  }
+  return thinned;
+}
+
+std::string EvenThinningNote(int num_samples, int stride) {
+  if (stride <= 1) return "";
+  return " Thinned for drawing: one point in " + Int(stride) + " of the " + Int(num_samples) +
+         " samples, evenly (the statistics use them all).";
+}
+
 bool IsTrajectory(const Dataset& data) {
   const size_t n = data.samples.size();
   if (n < 3) return true;
@@ -226,11 +247,14 @@ void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
   doc->Paragraph(
       "For every parameter held fixed (each group's common value and each cable's, every "
       "offset axis), the chi-square decrease expected from freeing it, from a score test "
-      "at the solution (no refit; exact for a linear model). White noise alone lets the "
-      "best of these reach about " +
+      "at the solution (no refit; exact for a linear model), and what freeing it would do. "
+      "Significant: its score is larger than the residuals' own noise (their long-run "
+      "variance, so time-correlated residuals do not count as evidence) would make the "
+      "largest of these, the statistic above " +
       Sig3(r.misfit_threshold) +
-      "; residuals correlated in time inflate them all alike, so compare them with each "
-      "other.");
+      " (chi-square of 1 degree of freedom, 1% for the family). Significant or not, a "
+      "single circle of poses often cannot tell some candidates apart (a gain from an "
+      "anchor offset): they are where to look, not a diagnosis.");
   if (r.misfit_ranking.empty()) {
     doc->Paragraph("No candidate: every parameter is free or spanned by the free ones.");
     return;
@@ -247,16 +271,36 @@ void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
         ". Free it (with a prior if the data alone cannot hold it) or give it a "
         "consider prior, and calibrate again.");
   } else {
-    lead.Plain("No fixed parameter explains more of the misfit than noise alone would.");
+    lead.Plain("No fixed parameter explains the misfit beyond the residuals' own noise.");
   }
   doc->Paragraph(lead);
+  const std::vector<const ParameterEstimate*> free = FreeEstimates(r);
   Table t;
-  t.header = {"Rank", "Parameter", "Expected χ² decrease", "Above the noise"};
-  t.right_align = {true, false, true, false};
+  t.header = {"Rank",
+              "Parameter",
+              "Expected χ² decrease",
+              "Statistic",
+              "Significant",
+              "Freeing it would move it by",
+              "and the estimate it moves most (in σ_total)"};
+  t.right_align = {true, false, true, true, false, true, false};
   for (size_t k = 0; k < std::min(kMisfitRows, r.misfit_ranking.size()); ++k) {
     const MisfitCandidate& c = r.misfit_ranking[k];
+    Text moved("-");
+    double most = 0.0;
+    for (size_t j = 0; j < free.size() && j < c.shifts.size(); ++j) {
+      const double sigmas =
+          free[j]->sigma_total > 0 ? std::abs(c.shifts[j]) / free[j]->sigma_total : 0.0;
+      if (sigmas <= most) continue;
+      most = sigmas;
+      moved = Text()
+                  .Code(free[j]->name)
+                  .Plain(" " + WithUnit(c.shifts[j], free[j]->unit) + " (" +
+                         Printf("%.2g", sigmas) + ")");
+    }
     t.rows.push_back({Int(static_cast<long long>(k + 1)), Text().Code(c.name),
-                      Sig3(c.expected_decrease), c.significant ? "yes" : "no"});
+                      Sig3(c.expected_decrease), Sig3(c.statistic), c.significant ? "yes" : "no",
+                      WithUnit(c.change, c.unit), moved});
   }
   doc->AddTable(std::move(t));
 }
@@ -294,7 +338,7 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
   const Dataset& d = *in.data;
   if (v.predicted_n.size() != d.samples.size()) return;
   std::vector<PlotSeries> zenith(kNumCables), azimuth(kNumCables), versus(kNumCables + 1);
-  int excluded = 0;
+  int excluded = 0, stride = 1;
   double lo = INFINITY, hi = -INFINITY;
   for (int i = 0; i < kNumCables; ++i) {
     for (PlotSeries* s : {&zenith[i], &azimuth[i], &versus[i]}) {
@@ -320,7 +364,7 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
       hi = std::max(hi, s.tension_n[i] / kNPerKn);
     }
     for (PlotSeries* s : {&zenith[i], &azimuth[i], &versus[i]}) {
-      *s = ThinMinMaxPerBucket(*s, kMaxScatterPoints);
+      *s = ThinEvenly(*s, kMaxScatterPoints, &stride);
     }
   }
   versus[kNumCables] = PlotSeries{"predicted = measured", {lo, hi}, {lo, hi}, true, false};
@@ -343,7 +387,8 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
               "angle and azimuth seen from the focal centre): a trend or a wave is model error "
               "that depends on the pose, not noise. Last: predicted against measured tension, "
               "with the diagonal." +
-                  (excluded > 0 ? " " + Int(excluded) + " gross errors are not drawn." : ""));
+                  (excluded > 0 ? " " + Int(excluded) + " gross errors are not drawn." : "") +
+                  EvenThinningNote(static_cast<int>(d.samples.size()), stride));
 }
 
 namespace {
@@ -410,11 +455,21 @@ void JsonMisfitAndValidation(const CalibrationResult& r, JsonWriter* w) {
     w->BeginObject();
     w->Key("name").String(c.name);
     w->Key("expected_chi_square_decrease").Number(c.expected_decrease);
+    w->Key("statistic").Number(c.statistic);
     w->Key("significant").Bool(c.significant);
+    w->Key("change").Number(c.change);
+    w->Key("unit").String(c.unit);
+    w->Key("shifts").BeginObject();
+    size_t k = 0;
+    for (const ParameterEstimate& e : r.parameters) {
+      if (!e.free || k >= c.shifts.size()) continue;
+      w->Key(e.name).Number(c.shifts[k++]);
+    }
+    w->EndObject();
     w->EndObject();
   }
   w->EndArray();
-  w->Key("misfit_noise_threshold").Number(r.misfit_threshold);
+  w->Key("misfit_significance_threshold").Number(r.misfit_threshold);
 
   const CrossValidation& cv = r.cross_validation;
   w->Key("cross_validation").BeginObject();

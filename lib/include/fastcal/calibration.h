@@ -82,6 +82,9 @@ struct CalibrationOptions {
   // many evenly spaced fitted samples, their sums scaled up (a 64-wide Jet through the
   // statics costs ~25 us a sample): docs/calibration.md, "What would explain the misfit".
   int max_candidate_samples = 20000;
+  // Evaluate the model before and after (CalibrationResult::variants), the paper's
+  // Table 6. Off, Calibrate skips those exact statics passes.
+  bool evaluate = true;
 };
 
 // A direction in parameter space: weights on parameter names (unit vector in the
@@ -205,6 +208,10 @@ struct CalibrationResult {
   // probability 1% (chi-square with 1 degree of freedom at 1 - 0.01 / q).
   double misfit_threshold = 0.0;
   CrossValidation cross_validation;
+  // The model against the measurements (exact statics, gross errors left out): the
+  // initial model at each attitude the data has, then the calibrated one at the fit's
+  // attitude (the last). Empty with CalibrationOptions::evaluate off.
+  std::vector<VariantEvaluation> variants;
   // Integrated autocorrelation time of each cable's whitened residuals (file order).
   std::array<double, kNumCables> residual_tau{};
   FitVerdict verdict = FitVerdict::kOk;

@@ -11,6 +11,7 @@
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/report_document.h"
 #include "fastcal/report.h"
+#include "fastcal/svg_plot.h"
 
 namespace fastcal::internal {
 
@@ -19,6 +20,15 @@ namespace fastcal::internal {
 // consecutive positions below kTrajectoryStepFraction of the positions' RMS spread.
 inline constexpr double kTrajectoryStepFraction = 0.2;
 bool IsTrajectory(const Dataset& data);
+
+// Every k-th point of a series with more than `max_points` (k the smallest that leaves
+// at most max_points; *stride receives k, 1 if nothing was thinned). For data that are not
+// a time series (scatter plots, unordered samples): min/max per bucket of consecutive
+// samples would keep only each bucket's extremes of an unordered cloud and draw two
+// false bands.
+PlotSeries ThinEvenly(const PlotSeries& series, int max_points, int* stride);
+// Says in a caption that series were thinned evenly (stride > 1).
+std::string EvenThinningNote(int num_samples, int stride);
 
 // Off-axis angle (deg, 0 at the bottom of the focal sphere) and azimuth (deg, [0, 360)
 // from +x toward +y) of a position seen from the focal centre (0, 0, 300) m.
