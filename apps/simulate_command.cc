@@ -210,11 +210,8 @@ bool ParseOneOrSix(const std::string& name, const std::string& text,
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    const char* begin = item.c_str();
-    char* end = nullptr;
-    const double v = std::strtod(begin, &end);
-    while (end != nullptr && (*end == ' ' || *end == '\t')) ++end;
-    if (end == begin || *end != '\0' || !std::isfinite(v)) {
+    double v = 0.0;
+    if (!ParseNumberItem(item, &v) || !std::isfinite(v)) {
       *error = "--" + name + ": '" + item + "' is not a finite number";
       return false;
     }

@@ -17,6 +17,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/internal/number_text.h"
+
 namespace fastcal {
 namespace {
 
@@ -583,6 +585,42 @@ TEST_F(DatasetTest, FileFnv1a64MatchesTheDefinition) {
   EXPECT_EQ(hex, "af63dc4c8601ec8c");
   EXPECT_FALSE(FileFnv1a64(PathOf("absent"), &hex, &error));
   EXPECT_TRUE(Contains(error, "absent: cannot open"));
+}
+
+// The readers' number parser accepts what strtod accepts in the "C" locale (the program
+// runs in it: setlocale is never called), with the same value, and refuses the rest;
+// the writers' formatter prints what printf prints there.
+TEST(NumberTextTest, ParsesAndFormatsLikeTheCLocale) {
+  for (const char* text :
+       {"1.5", "-2e-3", "+7", ".5", "5.", "1e308", "1e309", "-1e400", "1e-320", "1e-400", "-0",
+        "0x1.8p1", "-0X10", "inf", "-Infinity", "nan", "123456789012345678901234567890",
+        "0.000000000000000000000000000000000000000000000000000000000000000000000000000001"}) {
+    char* end = nullptr;
+    const double expected = std::strtod(text, &end);
+    ASSERT_EQ(*end, '\0') << text;
+    double parsed = 0.0;
+    ASSERT_TRUE(internal::ParseDouble(text, &parsed)) << text;
+    if (std::isnan(expected)) {
+      EXPECT_TRUE(std::isnan(parsed)) << text;
+    } else {
+      EXPECT_EQ(parsed, expected) << text;
+      EXPECT_EQ(std::signbit(parsed), std::signbit(expected)) << text;
+    }
+  }
+  for (const char* text :
+       {"", " 1", "1 ", "1,5", "1.5.2", "++1", "+-1", "e5", "1e", "0x", "1kN", "--1", "nanx"}) {
+    double parsed = 42.0;
+    EXPECT_FALSE(internal::ParseDouble(text, &parsed)) << "'" << text << "'";
+    EXPECT_EQ(parsed, 42.0) << text;
+  }
+  for (const char* format : {"%.3f", "%+.2f", "%.6g", "%g", "%.12g", "%.1e", "%+.3e", "%8.3f",
+                             "%-8.1fx", "%.0f%%", "T = %.3g kN"}) {
+    for (double v : {0.0, -0.0, 1.0, -1.5, 0.1234567, 158981.123456, 1e-7, -2.5e12, 1e300}) {
+      char expected[512];
+      std::snprintf(expected, sizeof(expected), format, v);
+      EXPECT_EQ(internal::FormatDouble(format, v), expected) << format << " " << v;
+    }
+  }
 }
 
 }  // namespace

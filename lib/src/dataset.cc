@@ -22,6 +22,7 @@
 
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/csv.h"
+#include "fastcal/internal/number_text.h"
 
 namespace fastcal {
 namespace {
@@ -111,18 +112,16 @@ std::string AcceptedColumns() {
   return list;
 }
 
-// Parses a whole trimmed field with std::strtod. Returns false when the field is not a
-// number (a message goes to *reason).
+// Parses a whole trimmed field (internal::ParseDouble: '.' in every locale). Returns false
+// when the field is not a finite number (a message goes to *reason).
 bool ParseNumber(std::string_view field, double* value, std::string* reason) {
   if (field.empty()) {
     *reason = "missing value";
     return false;
   }
-  const std::string text(field);
-  char* end = nullptr;
-  // ERANGE is no error here: an underflow reads as 0 or a subnormal, an overflow as inf.
-  const double v = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size()) {
+  // Beyond the range of a double reads as inf (refused below), below it as 0.
+  double v = 0.0;
+  if (!internal::ParseDouble(field, &v)) {
     *reason = Quoted(field) + " is not a number";
     return false;
   }
@@ -145,17 +144,22 @@ double ScaleByKilo(std::string_view field, double parsed_value) {
   if (e == std::string::npos) {
     shifted = text + "e" + std::to_string(kKilo);
   } else {
-    errno = 0;
-    const long exponent = std::strtol(text.c_str() + e + 1, nullptr, 10);
-    if (errno == ERANGE || std::labs(exponent) > kMaxShiftableExponent) {
+    std::string_view exponent_text = field.substr(e + 1);
+    if (!exponent_text.empty() && exponent_text.front() == '+') exponent_text.remove_prefix(1);
+    long exponent = 0;
+    const auto [ptr, ec] = std::from_chars(exponent_text.data(),
+                                           exponent_text.data() + exponent_text.size(), exponent);
+    if (ec != std::errc() || std::labs(exponent) > kMaxShiftableExponent) {
       return parsed_value * 1e3;
     }
     shifted = text.substr(0, e) + "e" + std::to_string(exponent + kKilo);
   }
-  return std::strtod(shifted.c_str(), nullptr);
+  double scaled = parsed_value * 1e3;
+  internal::ParseDouble(shifted, &scaled);
+  return scaled;
 }
 
-// The shortest decimal text that std::strtod reads back as value * 10^-shift exactly
+// The shortest decimal text that ParseNumber reads back as value * 10^-shift exactly
 // after the reader shifts it back (shift 0: plain shortest round-trip formatting). Plain
 // notation for moderate exponents, scientific otherwise. `value` must be finite.
 std::string FormatNumber(double value, int shift) {
