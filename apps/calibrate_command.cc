@@ -19,6 +19,7 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/file_digest.h"
 #include "fastcal/report.h"
 
 DECLARE_string(model);
@@ -256,7 +257,7 @@ std::string SkipHint() {
 
 std::string Digest(const std::string& path) {
   std::string hex, error;
-  return !path.empty() && FileFnv1a64(path, &hex, &error) ? hex : "";
+  return !path.empty() && FileSha256(path, &hex, &error) ? hex : "";
 }
 
 // The current date and time, UTC, ISO 8601 ("2026-11-22T15:04:05Z").
@@ -279,7 +280,7 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
               ".\n(report.md, Verdict)\n";
   }
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
-            "\n" + report.command_line + "\ndata " + report.data_path + " (fnv1a64 " +
+            "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
             report.data_digest + ")\nverdict: " + FitVerdictName(result.verdict) +
             "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
             "budget):";

@@ -5,6 +5,7 @@
 set -euo pipefail
 packages=(cmake g++ make libceres-dev libeigen3-dev libgflags-dev libgoogle-glog-dev
           libyaml-cpp-dev libgtest-dev libbenchmark-dev
+          libssl-dev  # libcrypto: SHA-256 of the input files (provenance)
           locales)  # de_DE.UTF-8: tests/calibration_test.cc, decimal comma
 missing=()
 for p in "${packages[@]}"; do

@@ -1,4 +1,4 @@
-// Tests of the measurement dataset CSV reader and writer and of the FNV-1a file digest
+// Tests of the measurement dataset CSV reader and writer
 // (fastcal/dataset.h, docs/data-format.md).
 #include "fastcal/dataset.h"
 
@@ -413,23 +413,23 @@ TEST_F(DatasetTest, WritesHeaderCommentReadableKilonewtonsAndRereadsTheSameFile)
       ParseOk(std::string(kHeader) + "0.5,1,2,140.25,0.1,0.2,0.3,159.17,151,152,153,154,155.5\n");
   const std::string path = PathOf("out.csv");
   std::string error;
-  ASSERT_TRUE(WriteDataset(path, dataset, "from telemetry.csv\n\nfnv1a64 0123", &error)) << error;
+  ASSERT_TRUE(WriteDataset(path, dataset, "from telemetry.csv\n\nsha256 0123", &error)) << error;
   std::ifstream in(path);
   std::stringstream contents;
   contents << in.rdbuf();
   EXPECT_EQ(contents.str(),
-            "# from telemetry.csv\n#\n# fnv1a64 0123\n"
+            "# from telemetry.csv\n#\n# sha256 0123\n"
             "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
             "0.5,1,2,140.25,0.1,0.2,0.3,159.17,151,152,153,154,155.5\n");
   // Writing what was read gives the same bytes.
   Dataset again;
   ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &again, &error)) << error;
   const std::string path2 = PathOf("out2.csv");
-  ASSERT_TRUE(WriteDataset(path2, again, "from telemetry.csv\n\nfnv1a64 0123", &error));
-  std::string digest1, digest2;
-  ASSERT_TRUE(FileFnv1a64(path, &digest1, &error)) << error;
-  ASSERT_TRUE(FileFnv1a64(path2, &digest2, &error)) << error;
-  EXPECT_EQ(digest1, digest2);
+  ASSERT_TRUE(WriteDataset(path2, again, "from telemetry.csv\n\nsha256 0123", &error));
+  std::ifstream in2(path2);
+  std::stringstream contents2;
+  contents2 << in2.rdbuf();
+  EXPECT_EQ(contents2.str(), contents.str());
 }
 
 TEST_F(DatasetTest, ExtremeTensionsRoundTripExactly) {
@@ -553,38 +553,6 @@ TEST_F(DatasetTest, ReadMissingFileFails) {
   std::string error;
   EXPECT_FALSE(ReadDataset(path, DatasetReadOptions(), &dataset, &error));
   EXPECT_TRUE(Contains(error, path + ": cannot open"));
-}
-
-// FNV-1a 64 straight from its definition, for comparison.
-std::string ReferenceFnv1a64(const std::string& bytes) {
-  std::uint64_t hash = 14695981039346656037ULL;  // offset basis
-  for (const unsigned char byte : bytes) {
-    hash ^= byte;
-    hash *= 1099511628211ULL;  // FNV prime 2^40 + 2^8 + 0xb3
-  }
-  char hex[17];
-  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
-}
-
-TEST_F(DatasetTest, FileFnv1a64MatchesTheDefinition) {
-  EXPECT_EQ(ReferenceFnv1a64(""), "cbf29ce484222325");  // published test vectors
-  EXPECT_EQ(ReferenceFnv1a64("a"), "af63dc4c8601ec8c");
-  const std::vector<std::string> contents = {
-      "", "a", "foobar", std::string("\0\xff\x80 binary\n", 11), std::string(200000, 'z')};
-  for (size_t k = 0; k < contents.size(); ++k) {
-    const std::string name = "file" + std::to_string(k);
-    WriteText(name, contents[k]);
-    std::string hex, error;
-    ASSERT_TRUE(FileFnv1a64(PathOf(name), &hex, &error)) << error;
-    EXPECT_EQ(hex, ReferenceFnv1a64(contents[k])) << k;
-  }
-  std::string hex, error;
-  WriteText("a.txt", "a");
-  ASSERT_TRUE(FileFnv1a64(PathOf("a.txt"), &hex, &error)) << error;
-  EXPECT_EQ(hex, "af63dc4c8601ec8c");
-  EXPECT_FALSE(FileFnv1a64(PathOf("absent"), &hex, &error));
-  EXPECT_TRUE(Contains(error, "absent: cannot open"));
 }
 
 // The readers' number parser accepts what strtod accepts in the "C" locale (the program

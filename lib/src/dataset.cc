@@ -1,5 +1,5 @@
-// Reader and writer of the measurement dataset CSV (docs/data-format.md) and the FNV-1a 64
-// file digest (declarations: dataset.h).
+// Reader and writer of the measurement dataset CSV (docs/data-format.md; declarations:
+// dataset.h).
 #include "fastcal/dataset.h"
 
 #include <fcntl.h>
@@ -66,9 +66,6 @@ constexpr long kMaxShiftableExponent = 100000;
 // WriteDataset refuses a pose.rotation farther than this (max |R^T R - I| entry) from a
 // rotation: it could not be written as angles or a quaternion.
 constexpr double kRotationTolerance = 1e-6;
-
-constexpr std::uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ULL;
-constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
 
 bool IsTension(int column) { return column >= kTension1 && column < kTension1 + kNumCables; }
 bool IsUnstretched(int column) {
@@ -197,30 +194,6 @@ std::string FormatNumber(double value, int shift) {
     out += "e" + std::to_string(exponent);
   }
   return out;
-}
-
-// Reads a whole file; false with a message (naming the file) on failure.
-bool ReadFileChunks(const std::string& path, const std::function<void(const char*, size_t)>& sink,
-                    std::string* error) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    *error = path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
-  char buffer[1 << 16];
-  while (true) {
-    const size_t n = std::fread(buffer, 1, sizeof(buffer), file);
-    if (n > 0) sink(buffer, n);
-    if (n < sizeof(buffer)) break;
-  }
-  const bool failed = std::ferror(file) != 0;
-  const int read_errno = errno;
-  std::fclose(file);
-  if (failed) {
-    *error = path + ": cannot read: " + std::strerror(read_errno);
-    return false;
-  }
-  return true;
 }
 
 // The header: which field holds each column (-1: absent).
@@ -578,7 +551,7 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   std::string message;
   bool ok = false;
   try {
-    ok = ReadFileChunks(
+    ok = internal::ReadFileChunks(
         path, [&text](const char* data, size_t size) { text.append(data, size); }, &message);
   } catch (const std::exception& e) {
     message = path + ": " + e.what();
@@ -603,34 +576,6 @@ bool WriteDataset(const std::string& path, const Dataset& dataset,
   }
   if (!ok && error != nullptr) *error = message;
   return ok;
-}
-
-bool FileFnv1a64(const std::string& path, std::string* hex, std::string* error) {
-  std::uint64_t hash = kFnvOffsetBasis;
-  std::string message;
-  bool ok = false;
-  try {
-    ok = ReadFileChunks(
-        path,
-        [&hash](const char* data, size_t size) {
-          for (size_t i = 0; i < size; ++i) {
-            hash ^= static_cast<unsigned char>(data[i]);
-            hash *= kFnvPrime;
-          }
-        },
-        &message);
-  } catch (const std::exception& e) {
-    message = path + ": " + e.what();
-    ok = false;
-  }
-  if (!ok) {
-    if (error != nullptr) *error = message;
-    return false;
-  }
-  char buffer[17];
-  std::snprintf(buffer, sizeof(buffer), "%016llx", static_cast<unsigned long long>(hash));
-  *hex = buffer;
-  return true;
 }
 
 }  // namespace fastcal
