@@ -21,6 +21,7 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/report.h"
+#include "fastcal/version.h"
 
 DECLARE_string(model);
 DECLARE_string(method);

@@ -22,6 +22,7 @@
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
+#include "fastcal/version.h"
 
 // Shared with solve (solve_command.cc) and calibrate (calibrate_command.cc): gflags flags
 // are process-global, so they are defined once and declared here.

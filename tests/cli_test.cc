@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/version.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -156,6 +158,9 @@ TEST_F(CliTest, SimulateCalibrateEvaluateRoundTrip) {
                 std::string::npos);
     }
   }
+  // The version from its one place, the CMake project version (fastcal/version.h).
+  EXPECT_NE(json.find("\"software_version\": \"" FASTCAL_VERSION "\""), std::string::npos);
+  EXPECT_EQ(Fastcal("--version").output, "fastcal " FASTCAL_VERSION "\n");
   EXPECT_NE(json.find("\"model\": {\n      \"path\": null,\n      \"sha256\": null"),
             std::string::npos)
       << "the built-in model has no file";

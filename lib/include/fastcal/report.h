@@ -49,7 +49,7 @@ struct ReportInputs {
   // FileSha256 of each file (64 hex digits, as sha256sum prints them), filled by the
   // caller; empty if not known.
   std::string model_digest, spec_digest, data_digest;
-  std::string software_version;  // FASTCAL_VERSION
+  std::string software_version;  // FASTCAL_VERSION (fastcal/version.h)
   std::string command_line;
   // When the run happened, UTC, e.g. "2026-11-22T15:04:05Z"; empty: not recorded.
   std::string run_utc;
