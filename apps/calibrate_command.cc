@@ -489,38 +489,6 @@ bool WriteOutDirectory(const char* command,
 
 }  // namespace
 
-// The RMS table's rows: the initial model at each attitude the data has, and the
-// calibrated one at the fit's attitude (exact statics; gross errors left out).
-bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec,
-                            const Dataset& data, const CalibrationResult& result,
-                            std::vector<VariantEvaluation>* variants, std::string* error) {
-  struct Variant {
-    std::string name;
-    const CableRobot* robot;
-    AttitudeSource attitude;
-  };
-  std::vector<Variant> list;
-  if (data.has_planned_attitude) {
-    list.push_back({"initial model, planned attitude", &model, AttitudeSource::kPlanned});
-  }
-  list.push_back({"initial model, measured attitude", &model, AttitudeSource::kMeasured});
-  list.push_back(
-      {std::string("calibrated model, ") + (spec.use_planned_attitude ? "planned" : "measured") +
-           " attitude",
-       &result.calibrated,
-       spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured});
-  for (const Variant& v : list) {
-    VariantEvaluation e;
-    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact, result.held_out,
-                         &e, error, result.excluded)) {
-      *error = v.name + ": " + *error;
-      return false;
-    }
-    variants->push_back(std::move(e));
-  }
-  return true;
-}
-
 int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
@@ -637,17 +605,9 @@ int RunEvaluate(int argc, char** argv) {
     return kExitFailure;
   }
   std::vector<VariantEvaluation> variants;
-  std::vector<std::pair<std::string, AttitudeSource>> list;
-  if (data.has_planned_attitude)
-    list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
-  list.emplace_back("model, measured attitude", AttitudeSource::kMeasured);
-  for (const auto& [name, attitude] : list) {
-    VariantEvaluation e;
-    if (!EvaluateVariant(name, model, data, attitude, method, {}, &e, &error)) {
-      PrintError(command, error + SkipHint());
-      return kExitFailure;
-    }
-    variants.push_back(std::move(e));
+  if (!EvaluateModel(model, data, method, &variants, &error)) {
+    PrintError(command, error + SkipHint());
+    return kExitFailure;
   }
   if (!FLAGS_out.empty()) {
     ReportInputs report;
