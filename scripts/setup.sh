@@ -6,6 +6,9 @@ set -euo pipefail
 packages=(cmake g++ make libceres-dev libeigen3-dev libgflags-dev libgoogle-glog-dev
           libyaml-cpp-dev libgtest-dev libbenchmark-dev
           libssl-dev  # libcrypto: SHA-256 of the input files (provenance)
+          # The Python module: pybind11's headers and CMake package, Python's headers,
+          # NumPy; pytest runs its tests, matplotlib the plot of docs/python.md.
+          pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
           locales)  # de_DE.UTF-8: tests/calibration_test.cc, decimal comma
 missing=()
 for p in "${packages[@]}"; do

@@ -2,7 +2,8 @@
 # against it, as a user of the installed package would: the README's main.cc and
 # CMakeLists.txt (the fenced blocks after "<!-- consumer: NAME -->"), find_package(fastcal
 # 0.2 CONFIG REQUIRED) with CMAKE_PREFIX_PATH set to the prefix only. Then runs the
-# program and the installed fastcal executable.
+# program, the installed fastcal executable and (-DPYTHON=... -DPYTHON_DIR=...) the
+# installed Python module.
 #
 #   cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DWORK_DIR=... [-DGENERATOR=...]
 #         -P install_consumer_test.cmake
@@ -87,6 +88,25 @@ if(EXISTS ${prefix}/bin/fastcal)
   run(COMMAND ${prefix}/bin/fastcal --version OUTPUT out)
   if(NOT out STREQUAL "fastcal ${version}\n")
     message(FATAL_ERROR "installed fastcal --version: ${out}")
+  endif()
+endif()
+# The installed Python module, imported from elsewhere than the build tree, with its
+# documentation.
+if(PYTHON)
+  set(ENV{PYTHONPATH} ${prefix}/${PYTHON_DIR})
+  file(WRITE ${consumer}/import_fastcal.py [[
+import pydoc
+import sys
+
+import fastcal
+
+assert fastcal.__file__.startswith(sys.argv[1]), fastcal.__file__
+assert "position_m" in pydoc.render_doc(fastcal.solve)
+print(fastcal.__version__)
+]])
+  run(COMMAND ${PYTHON} import_fastcal.py ${prefix}/ WORKING_DIRECTORY ${consumer} OUTPUT out)
+  if(NOT out STREQUAL "${version}\n")
+    message(FATAL_ERROR "installed fastcal.__version__: ${out}")
   endif()
 endif()
 file(REMOVE_RECURSE ${WORK_DIR})
