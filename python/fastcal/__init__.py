@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import warnings
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
@@ -415,10 +416,13 @@ class CalibrationResult:
         return f"<fastcal.CalibrationResult: {self.verdict}; {shown}>"
 
 
+_DICT_SPEC = "spec (dict)"
+
+
 def _spec_argument(spec: Union[PathLike, Mapping[str, Any]]) -> Tuple[str, bool, str]:
     """A spec file's path, or a dict as YAML text (JSON is YAML) with a name for messages."""
     if isinstance(spec, Mapping):
-        return json.dumps(spec, indent=1), True, "spec (dict)"
+        return json.dumps(spec), True, _DICT_SPEC
     return os.fspath(spec), False, os.fspath(spec)
 
 
@@ -458,7 +462,13 @@ def calibrate(
     if not isinstance(data, Dataset):
         data = read_dataset(data)
     spec_text, is_text, source = _spec_argument(spec)
-    result = CalibrationResult(_fastcal.calibrate(model, spec_text, is_text, source, data))
+    try:
+        raw = _fastcal.calibrate(model, spec_text, is_text, source, data)
+    except InputError as error:
+        # A dict has no lines: its messages name the key path alone.
+        message = re.sub(rf"^{re.escape(_DICT_SPEC)}:\d+: ", f"{_DICT_SPEC}: ", str(error))
+        raise InputError(message) from None
+    result = CalibrationResult(raw)
     if result.verdict == "failed":
         warnings.warn(f"the fit failed: {result.verdict_text}", RuntimeWarning, stacklevel=2)
     return result

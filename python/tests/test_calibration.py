@@ -157,7 +157,7 @@ def test_bad_spec_names_file_line_and_key_as_the_cli_does(
         )
         assert run.returncode == 2
         assert run.stderr.strip() == f"fastcal calibrate: {message}"
-    with pytest.raises(fastcal.InputError, match="spec \\(dict\\)"):
+    with pytest.raises(fastcal.InputError, match=r"^spec \(dict\): parameters\.mass: unknown"):
         fastcal.calibrate(
             {"format": "fastcal-calibration-spec-1", "parameters": {"mass": 1}}, circle
         )
