@@ -19,7 +19,9 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/file_digest.h"
 #include "fastcal/report.h"
+#include "fastcal/version.h"
 
 DECLARE_string(model);
 DECLARE_string(method);
@@ -256,7 +258,7 @@ std::string SkipHint() {
 
 std::string Digest(const std::string& path) {
   std::string hex, error;
-  return !path.empty() && FileFnv1a64(path, &hex, &error) ? hex : "";
+  return !path.empty() && FileSha256(path, &hex, &error) ? hex : "";
 }
 
 // The current date and time, UTC, ISO 8601 ("2026-11-22T15:04:05Z").
@@ -279,7 +281,7 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
               ".\n(report.md, Verdict)\n";
   }
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
-            "\n" + report.command_line + "\ndata " + report.data_path + " (fnv1a64 " +
+            "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
             report.data_digest + ")\nverdict: " + FitVerdictName(result.verdict) +
             "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
             "budget):";
@@ -597,17 +599,9 @@ int RunEvaluate(int argc, char** argv) {
     return kExitFailure;
   }
   std::vector<VariantEvaluation> variants;
-  std::vector<std::pair<std::string, AttitudeSource>> list;
-  if (data.has_planned_attitude)
-    list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
-  list.emplace_back("model, measured attitude", AttitudeSource::kMeasured);
-  for (const auto& [name, attitude] : list) {
-    VariantEvaluation e;
-    if (!EvaluateVariant(name, model, data, attitude, method, {}, &e, &error)) {
-      PrintError(command, error + SkipHint());
-      return kExitFailure;
-    }
-    variants.push_back(std::move(e));
+  if (!EvaluateModel(model, data, method, &variants, &error)) {
+    PrintError(command, error + SkipHint());
+    return kExitFailure;
   }
   if (!FLAGS_out.empty()) {
     ReportInputs report;

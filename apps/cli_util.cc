@@ -13,6 +13,7 @@
 #include <sstream>
 
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/number_text.h"
 
 namespace fastcal::cli {
 
@@ -213,6 +214,13 @@ bool CheckOutputDirectory(const std::string& dir, std::string* error) {
   return true;
 }
 
+bool ParseNumberItem(const std::string& item, double* value) {
+  const size_t begin = item.find_first_not_of(" \t");
+  if (begin == std::string::npos) return false;
+  const size_t end = item.find_last_not_of(" \t");
+  return internal::ParseDouble(std::string_view(item).substr(begin, end + 1 - begin), value);
+}
+
 namespace {
 bool ParseList(const std::string& name, const std::string& text, int n, double* out,
                std::string* error) {
@@ -221,11 +229,8 @@ bool ParseList(const std::string& name, const std::string& text, int n, double* 
   int count = 0;
   while (std::getline(ss, item, ',')) {
     if (count >= n) break;
-    const char* begin = item.c_str();
-    char* end = nullptr;
-    const double v = std::strtod(begin, &end);
-    while (end != nullptr && (*end == ' ' || *end == '\t')) ++end;
-    if (end == begin || *end != '\0') {
+    double v = 0.0;
+    if (!ParseNumberItem(item, &v)) {
       *error = "--" + name + ": '" + item + "' is not a number";
       return false;
     }

@@ -80,6 +80,10 @@ bool CheckCanWrite(const std::string& path, bool force, std::string* error);
 // message naming `dir` (a file, or a non-empty directory) otherwise.
 bool CheckOutputDirectory(const std::string& dir, std::string* error);
 
+// Parses one number of a comma-separated flag value: spaces and tabs around it are
+// ignored, '.' is the decimal point whatever the locale. False when `item` is not a number.
+bool ParseNumberItem(const std::string& item, double* value);
+
 // Parses "x,y,z" (three finite numbers) for flag `name`.
 bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vector3d* v,
                   std::string* error);

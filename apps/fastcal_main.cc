@@ -8,6 +8,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "fastcal/version.h"
 
 namespace fastcal::cli {
 

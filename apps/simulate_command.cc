@@ -22,6 +22,7 @@
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
+#include "fastcal/version.h"
 
 // Shared with solve (solve_command.cc) and calibrate (calibrate_command.cc): gflags flags
 // are process-global, so they are defined once and declared here.
@@ -210,11 +211,8 @@ bool ParseOneOrSix(const std::string& name, const std::string& text,
   std::stringstream ss(text);
   std::string item;
   while (std::getline(ss, item, ',')) {
-    const char* begin = item.c_str();
-    char* end = nullptr;
-    const double v = std::strtod(begin, &end);
-    while (end != nullptr && (*end == ' ' || *end == '\t')) ++end;
-    if (end == begin || *end != '\0' || !std::isfinite(v)) {
+    double v = 0.0;
+    if (!ParseNumberItem(item, &v) || !std::isfinite(v)) {
       *error = "--" + name + ": '" + item + "' is not a finite number";
       return false;
     }

@@ -1,5 +1,7 @@
 // Time per pose of the three statics methods (statics.h), cold and warm-started, at K2
-// and along the paper's 101-node line and half circle (focal attitude law).
+// and along the paper's 101-node line and half circle (focal attitude law); and the C++
+// side of the Python comparison (bench/python_statics_bench.py): 10000 poses spread over
+// the workspace, solved one after the other, as a C++ program would.
 // Run: build/bench/statics_bench --benchmark_min_time=0.2
 // items_per_second is poses per second; time per pose = 1 / items_per_second.
 #include <benchmark/benchmark.h>
@@ -8,6 +10,7 @@
 #include <vector>
 
 #include "fastcal/statics.h"
+#include "fastcal/trajectory.h"
 
 namespace fastcal {
 namespace {
@@ -89,7 +92,38 @@ void BM_PaperTrajectory(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * poses.size());
 }
 
+// The workspace the Python bench solves: kWorkspacePoses positions of
+// RandomWorkspacePositions (seed 1, defaults otherwise) with the focal attitude law.
+constexpr int kWorkspacePoses = 10000;
+
+// range(0): method. The poses are built before timing: a C++ caller has them.
+void BM_WorkspaceArray(benchmark::State& state) {
+  const CableRobot robot = CableRobot::NominalFast();
+  RandomWorkspaceSpec spec;
+  spec.samples = kWorkspacePoses;
+  spec.seed = 1;
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Pose> poses;
+  if (!RandomWorkspacePositions(spec, &positions, nullptr) ||
+      !PosesWithAttitudeLaw(positions, FocalAttitudeLaw(), &poses, nullptr)) {
+    state.SkipWithError("workspace poses");
+    return;
+  }
+  StaticsOptions options;
+  options.method = MethodOf(state.range(0));
+  StaticsSolution solution;
+  for (auto _ : state) {
+    for (const Pose& p : poses) {
+      SolveStatics(robot, p, options, &solution);
+      benchmark::DoNotOptimize(solution);
+    }
+  }
+  state.SetLabel(std::string(StaticsMethodName(options.method)) + " workspace cold");
+  state.SetItemsProcessed(state.iterations() * poses.size());
+}
+
 BENCHMARK(BM_SinglePoseCold)->DenseRange(0, 2);
+BENCHMARK(BM_WorkspaceArray)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SinglePoseColdAasForcesOnly);
 BENCHMARK(BM_PaperTrajectory)->ArgsProduct({{0, 1, 2}, {0, 1}, {0, 1}});
 

@@ -1,16 +1,25 @@
 // Tests of the calibration (calibration.h) on synthetic data made here with the exact
 // statics: recovery without noise, the problem's size, estimates and sigmas under noise
-// over several seeds, Jacobian against central differences, and refused free sets.
+// over several seeds, Jacobian against central differences, refused free sets, and the
+// same calibration from the bundled files under a locale whose decimal separator is a comma.
 #include "fastcal/calibration.h"
 
 #include <gtest/gtest.h>
 
+#include <clocale>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <locale>
 #include <random>
+#include <string>
+#include <vector>
 
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/report.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
 
@@ -732,6 +741,107 @@ TEST(CalibrationTest, ReducedChiSquareBand) {
   band = ReducedChiSquareBand(r);
   EXPECT_EQ(band.half_width, 0.0);
   EXPECT_FALSE(band.within);
+}
+
+// Sets the C and C++ global locales to the first installed one whose decimal separator is
+// a comma (scripts/setup.sh generates de_DE.UTF-8), as a GUI host or a Python session that
+// called setlocale(LC_ALL, "") would; restores both on destruction.
+class CommaDecimalLocale {
+ public:
+  CommaDecimalLocale() : saved_c_(std::setlocale(LC_ALL, nullptr)) {
+    for (const char* name : {"de_DE.UTF-8", "de_DE.utf8", "fr_FR.UTF-8", "fr_FR.utf8"}) {
+      if (std::setlocale(LC_ALL, name) == nullptr) continue;
+      if (std::string(std::localeconv()->decimal_point) == ",") {
+        std::locale::global(std::locale(name));
+        name_ = name;
+        return;
+      }
+    }
+    std::setlocale(LC_ALL, saved_c_.c_str());
+  }
+  ~CommaDecimalLocale() {
+    std::locale::global(saved_cpp_);
+    std::setlocale(LC_ALL, saved_c_.c_str());
+  }
+  const std::string& name() const { return name_; }  // empty: none installed
+
+ private:
+  std::string saved_c_;
+  std::locale saved_cpp_;
+  std::string name_;
+};
+
+// What a calibration from the bundled files gives, as a program embedding the library
+// would write it.
+struct BundledCalibration {
+  std::vector<double> estimates;
+  std::string model_yaml, summary_json, report_html;
+};
+
+BundledCalibration CalibrateBundledCircle() {
+  const char* dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR")
+                                                       : FASTCAL_TEST_SOURCE_DIR);
+  const std::string data_dir = std::string(dir) + "/calibration_data/";
+  BundledCalibration out;
+  CableRobot model;
+  CalibrationSpec spec;
+  Dataset data;
+  std::string error;
+  EXPECT_TRUE(LoadCableRobot(data_dir + "nominal_fast.yaml", &model, &error)) << error;
+  EXPECT_TRUE(LoadCalibrationSpec(data_dir + "spec_mass_centre_density.yaml",
+                                  static_cast<int>(model.anchor_points_cabin_m.size()), &spec,
+                                  &error))
+      << error;
+  EXPECT_TRUE(ReadDataset(data_dir + "circle_paper.csv", {}, &data, &error)) << error;
+  if (!error.empty()) return out;
+  CalibrationResult result;
+  EXPECT_EQ(Calibrate(model, spec, data, CalibrationOptions(), &result, &error),
+            CalibrationStatus::kOk)
+      << error;
+  for (const ParameterEstimate& p : result.parameters) out.estimates.push_back(p.estimate);
+  // Not ours to compare: the solve time, and Ceres' own report, which Ceres formats with
+  // printf in the current locale (the HTML report quotes it as it is).
+  result.seconds = 0.0;
+  result.ceres_full_report.clear();
+  result.ceres_brief_report.clear();
+  VariantEvaluation after;
+  EXPECT_TRUE(EvaluateVariant("calibrated", result.calibrated, data, AttitudeSource::kMeasured,
+                              StaticsMethod::kExact, result.held_out, &after, &error,
+                              result.excluded))
+      << error;
+  ReportInputs report;
+  report.spec_path = "spec.yaml";
+  report.data_path = "data.csv";
+  report.run_utc = "2026-11-22T15:04:05Z";
+  report.initial_model = &model;
+  report.spec = &spec;
+  report.data = &data;
+  report.result = &result;
+  report.variants = {after};
+  report.evaluation_method = "exact";
+  out.model_yaml = CableRobotToYaml(result.calibrated, "calibrated");
+  out.summary_json = SummaryJson(report);
+  out.report_html = ReportHtml(report);
+  return out;
+}
+
+// Numbers are read and written with '.' whatever the locale: under one whose decimal
+// separator is a comma, the bundled files read the same, the calibration gives the same
+// estimates to the bit, and the model file, summary.json and the report (tables, SVG
+// coordinates) are byte for byte the same.
+TEST(CalibrationTest, SameCalibrationUnderACommaDecimalLocale) {
+  const BundledCalibration reference = CalibrateBundledCircle();
+  ASSERT_FALSE(reference.estimates.empty());
+  CommaDecimalLocale comma;
+  if (comma.name().empty()) {
+    GTEST_SKIP() << "no locale with a decimal comma is installed (tried de_DE.UTF-8, "
+                    "fr_FR.UTF-8); scripts/setup.sh generates de_DE.UTF-8 when run as root";
+  }
+  const BundledCalibration under_comma = CalibrateBundledCircle();
+  EXPECT_EQ(under_comma.estimates, reference.estimates) << comma.name();
+  EXPECT_EQ(under_comma.model_yaml, reference.model_yaml);
+  EXPECT_EQ(under_comma.summary_json, reference.summary_json);
+  EXPECT_EQ(under_comma.report_html, reference.report_html);
 }
 
 }  // namespace

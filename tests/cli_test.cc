@@ -13,6 +13,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/version.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -32,9 +34,9 @@ std::string Source() {
   return dir ? dir : "";
 }
 
-CommandResult Fastcal(const std::string& args) {
+CommandResult Shell(const std::string& command_line) {
   CommandResult r;
-  const std::string command = Bin() + " " + args + " 2>&1";
+  const std::string command = command_line + " 2>&1";
   FILE* pipe = popen(command.c_str(), "r");
   if (pipe == nullptr) return r;
   char buf[4096];
@@ -43,6 +45,15 @@ CommandResult Fastcal(const std::string& args) {
   const int status = pclose(pipe);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+CommandResult Fastcal(const std::string& args) { return Shell(Bin() + " " + args); }
+
+std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 class CliTest : public ::testing::Test {
@@ -134,6 +145,25 @@ TEST_F(CliTest, SimulateCalibrateEvaluateRoundTrip) {
        {"model_calibrated.yaml", "report.html", "report.md", "summary.json", "residuals.csv"}) {
     EXPECT_TRUE(fs::exists(fs::path(out) / f)) << f;
   }
+  // Provenance anyone can check: the inputs' SHA-256 as sha256sum prints it.
+  const std::string json = ReadFile(out + "/summary.json");
+  for (const std::string& input :
+       {data, Source() + "/calibration_data/spec_mass_centre_density.yaml"}) {
+    const CommandResult sum = Shell("sha256sum '" + input + "'");
+    ASSERT_EQ(sum.code, 0) << sum.output;
+    const std::string sha256 = sum.output.substr(0, 64);
+    EXPECT_NE(json.find("\"sha256\": \"" + sha256 + "\""), std::string::npos) << input;
+    if (input == data) {
+      EXPECT_NE(ReadFile(out + "/model_calibrated.yaml").find("(sha256 " + sha256 + ")"),
+                std::string::npos);
+    }
+  }
+  // The version from its one place, the CMake project version (fastcal/version.h).
+  EXPECT_NE(json.find("\"software_version\": \"" FASTCAL_VERSION "\""), std::string::npos);
+  EXPECT_EQ(Fastcal("--version").output, "fastcal " FASTCAL_VERSION "\n");
+  EXPECT_NE(json.find("\"model\": {\n      \"path\": null,\n      \"sha256\": null"),
+            std::string::npos)
+      << "the built-in model has no file";
   const std::regex row("calibrated model, measured attitude\\s+([0-9. ]+)");
   std::smatch cal;
   ASSERT_TRUE(std::regex_search(r.output, cal, row)) << r.output;
@@ -201,13 +231,6 @@ TEST_F(CliTest, CalibrateBadInputLeavesNoOutput) {
   for (const auto& e : fs::directory_iterator(dir_))
     entries += e.path().filename().string()[0] == '.';
   EXPECT_EQ(entries, 0);
-}
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 // Generated trajectories fly the focal attitude law unless told otherwise; one --position

@@ -1,4 +1,4 @@
-// Tests of the measurement dataset CSV reader and writer and of the FNV-1a file digest
+// Tests of the measurement dataset CSV reader and writer
 // (fastcal/dataset.h, docs/data-format.md).
 #include "fastcal/dataset.h"
 
@@ -16,6 +16,8 @@
 #include <sstream>
 #include <string>
 #include <vector>
+
+#include "fastcal/internal/number_text.h"
 
 namespace fastcal {
 namespace {
@@ -411,23 +413,23 @@ TEST_F(DatasetTest, WritesHeaderCommentReadableKilonewtonsAndRereadsTheSameFile)
       ParseOk(std::string(kHeader) + "0.5,1,2,140.25,0.1,0.2,0.3,159.17,151,152,153,154,155.5\n");
   const std::string path = PathOf("out.csv");
   std::string error;
-  ASSERT_TRUE(WriteDataset(path, dataset, "from telemetry.csv\n\nfnv1a64 0123", &error)) << error;
+  ASSERT_TRUE(WriteDataset(path, dataset, "from telemetry.csv\n\nsha256 0123", &error)) << error;
   std::ifstream in(path);
   std::stringstream contents;
   contents << in.rdbuf();
   EXPECT_EQ(contents.str(),
-            "# from telemetry.csv\n#\n# fnv1a64 0123\n"
+            "# from telemetry.csv\n#\n# sha256 0123\n"
             "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
             "0.5,1,2,140.25,0.1,0.2,0.3,159.17,151,152,153,154,155.5\n");
   // Writing what was read gives the same bytes.
   Dataset again;
   ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &again, &error)) << error;
   const std::string path2 = PathOf("out2.csv");
-  ASSERT_TRUE(WriteDataset(path2, again, "from telemetry.csv\n\nfnv1a64 0123", &error));
-  std::string digest1, digest2;
-  ASSERT_TRUE(FileFnv1a64(path, &digest1, &error)) << error;
-  ASSERT_TRUE(FileFnv1a64(path2, &digest2, &error)) << error;
-  EXPECT_EQ(digest1, digest2);
+  ASSERT_TRUE(WriteDataset(path2, again, "from telemetry.csv\n\nsha256 0123", &error));
+  std::ifstream in2(path2);
+  std::stringstream contents2;
+  contents2 << in2.rdbuf();
+  EXPECT_EQ(contents2.str(), contents.str());
 }
 
 TEST_F(DatasetTest, ExtremeTensionsRoundTripExactly) {
@@ -553,36 +555,40 @@ TEST_F(DatasetTest, ReadMissingFileFails) {
   EXPECT_TRUE(Contains(error, path + ": cannot open"));
 }
 
-// FNV-1a 64 straight from its definition, for comparison.
-std::string ReferenceFnv1a64(const std::string& bytes) {
-  std::uint64_t hash = 14695981039346656037ULL;  // offset basis
-  for (const unsigned char byte : bytes) {
-    hash ^= byte;
-    hash *= 1099511628211ULL;  // FNV prime 2^40 + 2^8 + 0xb3
+// The readers' number parser accepts what strtod accepts in the "C" locale (the program
+// runs in it: setlocale is never called), with the same value, and refuses the rest;
+// the writers' formatter prints what printf prints there.
+TEST(NumberTextTest, ParsesAndFormatsLikeTheCLocale) {
+  for (const char* text :
+       {"1.5", "-2e-3", "+7", ".5", "5.", "1e308", "1e309", "-1e400", "1e-320", "1e-400", "-0",
+        "0x1.8p1", "-0X10", "inf", "-Infinity", "nan", "123456789012345678901234567890",
+        "0.000000000000000000000000000000000000000000000000000000000000000000000000000001"}) {
+    char* end = nullptr;
+    const double expected = std::strtod(text, &end);
+    ASSERT_EQ(*end, '\0') << text;
+    double parsed = 0.0;
+    ASSERT_TRUE(internal::ParseDouble(text, &parsed)) << text;
+    if (std::isnan(expected)) {
+      EXPECT_TRUE(std::isnan(parsed)) << text;
+    } else {
+      EXPECT_EQ(parsed, expected) << text;
+      EXPECT_EQ(std::signbit(parsed), std::signbit(expected)) << text;
+    }
   }
-  char hex[17];
-  std::snprintf(hex, sizeof(hex), "%016llx", static_cast<unsigned long long>(hash));
-  return hex;
-}
-
-TEST_F(DatasetTest, FileFnv1a64MatchesTheDefinition) {
-  EXPECT_EQ(ReferenceFnv1a64(""), "cbf29ce484222325");  // published test vectors
-  EXPECT_EQ(ReferenceFnv1a64("a"), "af63dc4c8601ec8c");
-  const std::vector<std::string> contents = {
-      "", "a", "foobar", std::string("\0\xff\x80 binary\n", 11), std::string(200000, 'z')};
-  for (size_t k = 0; k < contents.size(); ++k) {
-    const std::string name = "file" + std::to_string(k);
-    WriteText(name, contents[k]);
-    std::string hex, error;
-    ASSERT_TRUE(FileFnv1a64(PathOf(name), &hex, &error)) << error;
-    EXPECT_EQ(hex, ReferenceFnv1a64(contents[k])) << k;
+  for (const char* text :
+       {"", " 1", "1 ", "1,5", "1.5.2", "++1", "+-1", "e5", "1e", "0x", "1kN", "--1", "nanx"}) {
+    double parsed = 42.0;
+    EXPECT_FALSE(internal::ParseDouble(text, &parsed)) << "'" << text << "'";
+    EXPECT_EQ(parsed, 42.0) << text;
   }
-  std::string hex, error;
-  WriteText("a.txt", "a");
-  ASSERT_TRUE(FileFnv1a64(PathOf("a.txt"), &hex, &error)) << error;
-  EXPECT_EQ(hex, "af63dc4c8601ec8c");
-  EXPECT_FALSE(FileFnv1a64(PathOf("absent"), &hex, &error));
-  EXPECT_TRUE(Contains(error, "absent: cannot open"));
+  for (const char* format : {"%.3f", "%+.2f", "%.6g", "%g", "%.12g", "%.1e", "%+.3e", "%8.3f",
+                             "%-8.1fx", "%.0f%%", "T = %.3g kN"}) {
+    for (double v : {0.0, -0.0, 1.0, -1.5, 0.1234567, 158981.123456, 1e-7, -2.5e12, 1e300}) {
+      char expected[512];
+      std::snprintf(expected, sizeof(expected), format, v);
+      EXPECT_EQ(internal::FormatDouble(format, v), expected) << format << " " << v;
+    }
+  }
 }
 
 }  // namespace

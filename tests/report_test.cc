@@ -327,8 +327,8 @@ class ReportTest : public ::testing::Test {
     inputs_.model_path = "";
     inputs_.spec_path = "spec_mass_centre.yaml";
     inputs_.data_path = "circle.csv";
-    inputs_.spec_digest = "0123456789abcdef";
-    inputs_.data_digest = "fedcba9876543210";
+    inputs_.spec_digest = "0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef";
+    inputs_.data_digest = "fedcba9876543210fedcba9876543210fedcba9876543210fedcba9876543210";
     inputs_.software_version = "0.1.0";
     inputs_.command_line = "fastcal calibrate --spec=spec_mass_centre.yaml --data=circle.csv";
     inputs_.run_utc = "2026-11-22T15:04:05Z";
@@ -388,7 +388,9 @@ TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
   EXPECT_TRUE(Contains(md, "16 fitted, 4 held out (20 in the dataset)"));
   EXPECT_TRUE(Contains(md, "nominal FAST model (built in)"));
   EXPECT_TRUE(Contains(md, "| Run (UTC) | 2026-11-22T15:04:05Z |"));
-  EXPECT_TRUE(Contains(md, "`spec_mass_centre.yaml` (fnv1a64 `0123456789abcdef`)"));
+  EXPECT_TRUE(Contains(md,
+                       "`spec_mass_centre.yaml` (SHA-256 "
+                       "`0123456789abcdef0123456789abcdef0123456789abcdef0123456789abcdef`)"));
   EXPECT_TRUE(Contains(md, "max 0.021 %, RMS 0.008 %"));
   EXPECT_TRUE(Contains(md, "The data alone cannot determine `linear_density_kg_per_m (+1.00)`"));
   EXPECT_TRUE(Contains(md, "the prior holds it"));
@@ -675,7 +677,8 @@ TEST_F(ReportTest, JsonIsWellFormedWithTheSummary) {
   EXPECT_TRUE(JsonChecker(json).Valid()) << json;
   EXPECT_TRUE(Contains(json, "\"reduced_chi_square\": 0.98"));
   EXPECT_TRUE(Contains(json, "\"software_version\": \"0.1.0\""));
-  EXPECT_TRUE(Contains(json, "\"fnv1a64\": \"fedcba9876543210\""));
+  EXPECT_TRUE(Contains(
+      json, "\"sha256\": \"fedcba9876543210fedcba9876543210fedcba9876543210fedcba9876543210\""));
   EXPECT_TRUE(Contains(json, "\"spec_yaml\": \""));
   EXPECT_TRUE(Contains(json, "\"rms_kN\": [22.554, 17.517, 20.078, 18.687, 17.167, 18.19]"));
   EXPECT_TRUE(Contains(json, "\"prior\": null"));

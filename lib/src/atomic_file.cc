@@ -76,4 +76,27 @@ bool ReadTextFile(const std::string& path, std::string* text, std::string* error
   return true;
 }
 
+bool ReadFileChunks(const std::string& path, const std::function<void(const char*, size_t)>& sink,
+                    std::string* error) {
+  std::FILE* file = std::fopen(path.c_str(), "rb");
+  if (file == nullptr) {
+    *error = path + ": cannot open: " + std::strerror(errno);
+    return false;
+  }
+  char buffer[1 << 16];
+  while (true) {
+    const size_t n = std::fread(buffer, 1, sizeof(buffer), file);
+    if (n > 0) sink(buffer, n);
+    if (n < sizeof(buffer)) break;
+  }
+  const bool failed = std::ferror(file) != 0;
+  const int read_errno = errno;
+  std::fclose(file);
+  if (failed) {
+    *error = path + ": cannot read: " + std::strerror(read_errno);
+    return false;
+  }
+  return true;
+}
+
 }  // namespace fastcal::internal

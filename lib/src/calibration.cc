@@ -10,7 +10,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <memory>
 #include <sstream>
@@ -18,6 +17,7 @@
 #include "fastcal/gross_errors.h"
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/number_text.h"
 
 namespace fastcal {
 namespace {
@@ -131,12 +131,13 @@ class ProgressCallback : public ceres::IterationCallback {
  public:
   explicit ProgressCallback(const std::function<void(const std::string&)>& f) : f_(f) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary& s) override {
-    char line[200];
-    std::snprintf(line, sizeof(line),
-                  "iter %3d  cost %.6e  decrease %+.3e  |gradient| %.3e  |step| %.3e  %s",
-                  s.iteration, s.cost, s.cost_change, s.gradient_max_norm, s.step_norm,
-                  s.step_is_successful ? "" : "(rejected)");
-    f_(line);
+    using internal::FormatDouble;
+    std::string iteration = std::to_string(s.iteration);
+    iteration.insert(0, iteration.size() < 3 ? 3 - iteration.size() : 0, ' ');
+    f_("iter " + iteration + "  cost " + FormatDouble("%.6e", s.cost) + "  decrease " +
+       FormatDouble("%+.3e", s.cost_change) + "  |gradient| " +
+       FormatDouble("%.3e", s.gradient_max_norm) + "  |step| " + FormatDouble("%.3e", s.step_norm) +
+       "  " + (s.step_is_successful ? "" : "(rejected)"));
     return ceres::SOLVER_CONTINUE;
   }
 
@@ -216,17 +217,9 @@ bool JacobianR(ceres::Problem* problem, int num_threads, Eigen::MatrixXd* r) {
   return true;
 }
 
-std::string Fixed(const char* format, double v) {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, v);
-  return text;
-}
+std::string Fixed(const char* format, double v) { return internal::FormatDouble(format, v); }
 
-std::string RatioText(double ratio) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%.1e", ratio);
-  return text;
-}
+std::string RatioText(double ratio) { return internal::FormatDouble("%.1e", ratio); }
 
 std::unique_ptr<ceres::LossFunction> MakeLoss(const CalibrationSpec& spec) {
   if (spec.robust_loss == RobustLoss::kHuber) {
@@ -453,10 +446,9 @@ std::string DescribeRefusal(const Run& run) {
     if (!(sigma > limit)) continue;
     if (!any) refuse << "these would be determined only to (1 sigma, from the stated noise):\n";
     any = true;
-    char line[200];
-    std::snprintf(line, sizeof(line), "  - %s: +-%.3g %s (determined means +-%.3g %s or better)\n",
-                  p.name.c_str(), sigma / p.to_si, p.unit.c_str(), limit / p.to_si, p.unit.c_str());
-    refuse << line;
+    refuse << "  - " << p.name << ": +-" << Fixed("%.3g", sigma / p.to_si) << " " << p.unit
+           << " (determined means +-" << Fixed("%.3g", limit / p.to_si) << " " << p.unit
+           << " or better)\n";
   }
   if (!any) return "";
   if (!before.poorly_determined.empty()) refuse << "the weakest directions in parameter space:\n";
@@ -585,13 +577,11 @@ constexpr double kMostlyFarFraction = 0.5;
 
 std::string MostlyGrossErrorsMessage(const Run& run, int flagged, int readings, const char* how,
                                      double limit) {
-  char text[400];
-  std::snprintf(text, sizeof(text),
-                "%d of the %d fitted readings (%.0f%%) are %s, more than the %.0f%% allowed: "
-                "the data are mostly not what the model predicts. Check the export (units, "
-                "column order, a dead sensor), the model and the stated noise; ",
-                flagged, readings, 100.0 * flagged / std::max(1, readings), how, 100.0 * limit);
-  return text;
+  return std::to_string(flagged) + " of the " + std::to_string(readings) + " fitted readings (" +
+         Fixed("%.0f%%", 100.0 * flagged / std::max(1, readings)) + ") are " + how +
+         ", more than the " + Fixed("%.0f%%", 100.0 * limit) +
+         " allowed: the data are mostly not what the model predicts. Check the export (units, "
+         "column order, a dead sensor), the model and the stated noise; ";
 }
 
 CalibrationStatus NameGrossErrors(Run& run) {
@@ -738,9 +728,8 @@ void FillCorrelation(Run& run) {
       const double d = std::sqrt(cov(a, a) * cov(b, b));
       r.correlation(a, b) = d > 0 ? cov(a, b) / d : (a == b ? 1.0 : 0.0);
       if (b > a && std::abs(r.correlation(a, b)) >= run.options.strong_correlation) {
-        char c[32];
-        std::snprintf(c, sizeof(c), "%+.3f", r.correlation(a, b));
-        r.strong_correlations.push_back(r.free_names[a] + " ~ " + r.free_names[b] + ": " + c);
+        r.strong_correlations.push_back(r.free_names[a] + " ~ " + r.free_names[b] + ": " +
+                                        Fixed("%+.3f", r.correlation(a, b)));
       }
     }
   }
@@ -1144,28 +1133,9 @@ void AddNotes(Run& run) {
 CalibrationStatus Evaluate(Run& run) {
   CalibrationResult& r = *run.result;
   if (!run.options.evaluate) return CalibrationStatus::kOk;
-  struct Variant {
-    std::string name;
-    const CableRobot* robot;
-    AttitudeSource attitude;
-  };
-  std::vector<Variant> list;
-  if (run.data.has_planned_attitude) {
-    list.push_back({"initial model, planned attitude", &run.model, AttitudeSource::kPlanned});
-  }
-  list.push_back({"initial model, measured attitude", &run.model, AttitudeSource::kMeasured});
-  const bool planned = run.spec.use_planned_attitude;
-  list.push_back(
-      {std::string("calibrated model, ") + (planned ? "planned" : "measured") + " attitude",
-       &r.calibrated, planned ? AttitudeSource::kPlanned : AttitudeSource::kMeasured});
-  for (const Variant& v : list) {
-    VariantEvaluation e;
-    std::string why;
-    if (!EvaluateVariant(v.name, *v.robot, run.data, v.attitude, StaticsMethod::kExact, r.held_out,
-                         &e, &why, r.excluded)) {
-      return run.Fail(CalibrationStatus::kInfeasible, v.name + ": " + why);
-    }
-    r.variants.push_back(std::move(e));
+  std::string why;
+  if (!EvaluateBeforeAndAfter(run.model, run.spec, run.data, r, &r.variants, &why)) {
+    return run.Fail(CalibrationStatus::kInfeasible, why);
   }
   return CalibrationStatus::kOk;
 }
@@ -1197,9 +1167,8 @@ CalibrationStatus BuildAndCheck(Run& run) {
 std::string ParameterDirection::Describe() const {
   std::ostringstream s;
   for (size_t i = 0; i < weights.size(); ++i) {
-    char w[32];
-    std::snprintf(w, sizeof(w), "%+.2f", weights[i].second);
-    s << (i ? " ~ " : "") << weights[i].first << " (" << w << ")";
+    s << (i ? " ~ " : "") << weights[i].first << " ("
+      << internal::FormatDouble("%+.2f", weights[i].second) << ")";
   }
   return s.str();
 }

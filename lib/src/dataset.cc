@@ -1,5 +1,5 @@
-// Reader and writer of the measurement dataset CSV (docs/data-format.md) and the FNV-1a 64
-// file digest (declarations: dataset.h).
+// Reader and writer of the measurement dataset CSV (docs/data-format.md; declarations:
+// dataset.h).
 #include "fastcal/dataset.h"
 
 #include <fcntl.h>
@@ -22,6 +22,7 @@
 
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/csv.h"
+#include "fastcal/internal/number_text.h"
 
 namespace fastcal {
 namespace {
@@ -66,9 +67,6 @@ constexpr long kMaxShiftableExponent = 100000;
 // rotation: it could not be written as angles or a quaternion.
 constexpr double kRotationTolerance = 1e-6;
 
-constexpr std::uint64_t kFnvOffsetBasis = 0xcbf29ce484222325ULL;
-constexpr std::uint64_t kFnvPrime = 0x100000001b3ULL;
-
 bool IsTension(int column) { return column >= kTension1 && column < kTension1 + kNumCables; }
 bool IsUnstretched(int column) {
   return column >= kUnstretched1 && column < kUnstretched1 + kNumCables;
@@ -111,18 +109,16 @@ std::string AcceptedColumns() {
   return list;
 }
 
-// Parses a whole trimmed field with std::strtod. Returns false when the field is not a
-// number (a message goes to *reason).
+// Parses a whole trimmed field (internal::ParseDouble: '.' in every locale). Returns false
+// when the field is not a finite number (a message goes to *reason).
 bool ParseNumber(std::string_view field, double* value, std::string* reason) {
   if (field.empty()) {
     *reason = "missing value";
     return false;
   }
-  const std::string text(field);
-  char* end = nullptr;
-  // ERANGE is no error here: an underflow reads as 0 or a subnormal, an overflow as inf.
-  const double v = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size()) {
+  // Beyond the range of a double reads as inf (refused below), below it as 0.
+  double v = 0.0;
+  if (!internal::ParseDouble(field, &v)) {
     *reason = Quoted(field) + " is not a number";
     return false;
   }
@@ -145,17 +141,22 @@ double ScaleByKilo(std::string_view field, double parsed_value) {
   if (e == std::string::npos) {
     shifted = text + "e" + std::to_string(kKilo);
   } else {
-    errno = 0;
-    const long exponent = std::strtol(text.c_str() + e + 1, nullptr, 10);
-    if (errno == ERANGE || std::labs(exponent) > kMaxShiftableExponent) {
+    std::string_view exponent_text = field.substr(e + 1);
+    if (!exponent_text.empty() && exponent_text.front() == '+') exponent_text.remove_prefix(1);
+    long exponent = 0;
+    const auto [ptr, ec] = std::from_chars(exponent_text.data(),
+                                           exponent_text.data() + exponent_text.size(), exponent);
+    if (ec != std::errc() || std::labs(exponent) > kMaxShiftableExponent) {
       return parsed_value * 1e3;
     }
     shifted = text.substr(0, e) + "e" + std::to_string(exponent + kKilo);
   }
-  return std::strtod(shifted.c_str(), nullptr);
+  double scaled = parsed_value * 1e3;
+  internal::ParseDouble(shifted, &scaled);
+  return scaled;
 }
 
-// The shortest decimal text that std::strtod reads back as value * 10^-shift exactly
+// The shortest decimal text that ParseNumber reads back as value * 10^-shift exactly
 // after the reader shifts it back (shift 0: plain shortest round-trip formatting). Plain
 // notation for moderate exponents, scientific otherwise. `value` must be finite.
 std::string FormatNumber(double value, int shift) {
@@ -193,30 +194,6 @@ std::string FormatNumber(double value, int shift) {
     out += "e" + std::to_string(exponent);
   }
   return out;
-}
-
-// Reads a whole file; false with a message (naming the file) on failure.
-bool ReadFileChunks(const std::string& path, const std::function<void(const char*, size_t)>& sink,
-                    std::string* error) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    *error = path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
-  char buffer[1 << 16];
-  while (true) {
-    const size_t n = std::fread(buffer, 1, sizeof(buffer), file);
-    if (n > 0) sink(buffer, n);
-    if (n < sizeof(buffer)) break;
-  }
-  const bool failed = std::ferror(file) != 0;
-  const int read_errno = errno;
-  std::fclose(file);
-  if (failed) {
-    *error = path + ": cannot read: " + std::strerror(read_errno);
-    return false;
-  }
-  return true;
 }
 
 // The header: which field holds each column (-1: absent).
@@ -574,7 +551,7 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   std::string message;
   bool ok = false;
   try {
-    ok = ReadFileChunks(
+    ok = internal::ReadFileChunks(
         path, [&text](const char* data, size_t size) { text.append(data, size); }, &message);
   } catch (const std::exception& e) {
     message = path + ": " + e.what();
@@ -599,34 +576,6 @@ bool WriteDataset(const std::string& path, const Dataset& dataset,
   }
   if (!ok && error != nullptr) *error = message;
   return ok;
-}
-
-bool FileFnv1a64(const std::string& path, std::string* hex, std::string* error) {
-  std::uint64_t hash = kFnvOffsetBasis;
-  std::string message;
-  bool ok = false;
-  try {
-    ok = ReadFileChunks(
-        path,
-        [&hash](const char* data, size_t size) {
-          for (size_t i = 0; i < size; ++i) {
-            hash ^= static_cast<unsigned char>(data[i]);
-            hash *= kFnvPrime;
-          }
-        },
-        &message);
-  } catch (const std::exception& e) {
-    message = path + ": " + e.what();
-    ok = false;
-  }
-  if (!ok) {
-    if (error != nullptr) *error = message;
-    return false;
-  }
-  char buffer[17];
-  std::snprintf(buffer, sizeof(buffer), "%016llx", static_cast<unsigned long long>(hash));
-  *hex = buffer;
-  return true;
 }
 
 }  // namespace fastcal

@@ -132,6 +132,20 @@ bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dat
   return true;
 }
 
+bool EvaluateModel(const CableRobot& robot, const Dataset& data, StaticsMethod method,
+                   std::vector<VariantEvaluation>* variants, std::string* error) {
+  std::vector<std::pair<std::string, AttitudeSource>> list;
+  if (data.has_planned_attitude)
+    list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
+  list.emplace_back("model, measured attitude", AttitudeSource::kMeasured);
+  for (const auto& [name, attitude] : list) {
+    VariantEvaluation e;
+    if (!EvaluateVariant(name, robot, data, attitude, method, {}, &e, error)) return false;
+    variants->push_back(std::move(e));
+  }
+  return true;
+}
+
 int BlockOfSample(int sample, int num_samples, int blocks) {
   if (num_samples <= 0 || blocks <= 1) return 0;
   // The largest b whose start floor(b n / blocks) is <= sample.

@@ -143,7 +143,7 @@ Text FileText(const std::string& path, const std::string& digest, const char* ab
   Text t;
   if (path.empty()) return Text(absent);
   t.Code(path);
-  if (!digest.empty()) t.Plain(" (fnv1a64 ").Code(digest).Plain(")");
+  if (!digest.empty()) t.Plain(" (SHA-256 ").Code(digest).Plain(")");
   return t;
 }
 
@@ -1127,7 +1127,7 @@ void JsonFile(JsonWriter* w, const std::string& key, const std::string& path,
     w->Null();
   else
     w->String(path);
-  w->Key("fnv1a64");
+  w->Key("sha256");
   if (digest.empty())
     w->Null();
   else

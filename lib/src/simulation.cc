@@ -5,7 +5,8 @@
 #include <cmath>
 #include <exception>
 #include <random>
-#include <sstream>
+
+#include "fastcal/internal/number_text.h"
 
 namespace fastcal {
 namespace {
@@ -33,12 +34,7 @@ bool Fail(std::string* error, const std::string& message) {
   return false;
 }
 
-std::string Num(double value) {
-  std::ostringstream s;
-  s.precision(10);
-  s << value;
-  return s.str();
-}
+std::string Num(double value) { return internal::FormatDouble("%.10g", value); }
 
 // SplitMix64 finaliser: spreads (seed, stream) over the generator's seed space.
 std::uint64_t MixSeed(std::uint64_t seed, std::uint64_t stream) {

@@ -9,6 +9,8 @@
 #include <limits>
 #include <utility>
 
+#include "fastcal/internal/number_text.h"
+
 namespace fastcal {
 namespace {
 
@@ -33,27 +35,22 @@ const char* Colour(size_t index) { return kPalette[index % kPalette.size()]; }
 std::string Px(double v) {
   if (!std::isfinite(v)) return "0";
   v = std::clamp(v, -1e7, 1e7);
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.1f", v);
-  std::string s(buf);
+  std::string s = internal::FormatDouble("%.1f", v);
   if (s.size() > 2 && s.compare(s.size() - 2, 2, ".0") == 0) s.resize(s.size() - 2);
   if (s == "-0") s = "0";
   return s;
 }
 
 std::string Fixed(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", std::clamp(decimals, 0, 20), v);
-  std::string s(buf);
+  std::string s =
+      internal::FormatDouble("%." + std::to_string(std::clamp(decimals, 0, 20)) + "f", v);
   // "-0.00" -> "0.00".
   if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
   return s;
 }
 
 std::string Scientific(double v, int decimals) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*e", std::clamp(decimals, 0, 16), v);
-  return buf;
+  return internal::FormatDouble("%." + std::to_string(std::clamp(decimals, 0, 16)) + "e", v);
 }
 
 // Drops trailing zeros of the fraction (and a bare '.') in "12.50" or "1.20e+05".

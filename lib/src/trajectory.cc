@@ -8,11 +8,11 @@
 #include <fstream>
 #include <random>
 #include <set>
-#include <sstream>
 #include <string_view>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/csv.h"
+#include "fastcal/internal/number_text.h"
 
 namespace fastcal {
 namespace {
@@ -29,11 +29,7 @@ bool Fail(std::string* error, const std::string& message) {
   return false;
 }
 
-std::string Num(double value) {
-  std::ostringstream s;
-  s << value;
-  return s.str();
-}
+std::string Num(double value) { return internal::FormatDouble("%g", value); }
 
 bool IsPositiveFinite(double value) { return std::isfinite(value) && value > 0.0; }
 
@@ -99,16 +95,15 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
   }
 }
 
-// Parses a trimmed field; on failure *why says what is wrong with it.
+// Parses a trimmed field ('.' in every locale); on failure *why says what is wrong with it.
 bool ParseNumber(std::string_view field, double* value, std::string* why) {
   const std::string text(field);
   if (text.empty()) {
     *why = "empty field";
     return false;
   }
-  char* end = nullptr;
-  const double parsed = std::strtod(text.c_str(), &end);
-  if (end != text.c_str() + text.size()) {
+  double parsed = 0.0;
+  if (!internal::ParseDouble(text, &parsed)) {
     *why = "'" + text + "' is not a number";
     return false;
   }

@@ -1,6 +1,5 @@
 // The measurement dataset: a CSV telemetry export of measured cabin poses and measured
-// lower-end cable tensions (format: docs/data-format.md), its reader and writer, and a
-// file digest for provenance.
+// lower-end cable tensions (format: docs/data-format.md), its reader and writer.
 //
 // Files give tensions in kN (column names say so: T1_kN ... T6_kN); in memory they are in
 // N, like every other quantity in the library. The kN <-> N conversion is done on the
@@ -91,10 +90,6 @@ bool ParseDataset(const std::string& text, const std::string& source_name,
 // the same directory, then rename): a failure leaves no file behind.
 bool WriteDataset(const std::string& path, const Dataset& dataset,
                   const std::string& header_comment, std::string* error);
-
-// FNV-1a 64-bit hash of the file's bytes as 16 lowercase hex digits, for provenance
-// (not a cryptographic digest). The empty file gives "cbf29ce484222325".
-bool FileFnv1a64(const std::string& path, std::string* hex, std::string* error);
 
 }  // namespace fastcal
 

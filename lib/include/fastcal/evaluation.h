@@ -73,6 +73,12 @@ bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dat
                      const std::vector<bool>& held_out, VariantEvaluation* evaluation,
                      std::string* error, const ReadingMask& excluded = {});
 
+// The table of `fastcal evaluate`: `robot` against every sample at each attitude the data
+// has, "model, planned attitude" (when it has one) then "model, measured attitude", with
+// `method`. False, naming the file and line of a pose the model cannot hold, otherwise.
+bool EvaluateModel(const CableRobot& robot, const Dataset& data, StaticsMethod method,
+                   std::vector<VariantEvaluation>* variants, std::string* error);
+
 // Contiguous block b of n samples cut into `blocks` (b = 0 .. blocks - 1): samples
 // [b n / blocks, (b + 1) n / blocks).
 int BlockOfSample(int sample, int num_samples, int blocks);

@@ -10,7 +10,7 @@
 //                 tables, statistics and histogram use every sample
 //   summary.json  the numbers, for scripts (units in the key names: _kN, _percent)
 //
-// Sections: provenance (inputs with FNV-1a digests, software version, command line, the
+// Sections: provenance (inputs with SHA-256 digests, software version, command line, the
 // run's UTC date and time, forward model and its error against the exact statics,
 // evaluation method, noise model, robust loss, gross-error screen, hold-out and
 // cross-validation blocks, Ceres options, rows skipped); verdict (CalibrationResult's:
@@ -46,9 +46,10 @@ struct ReportInputs {
   // The input files as given on the command line; an empty model path means the built-in
   // nominal FAST model, an empty spec path an evaluation without calibration.
   std::string model_path, spec_path, data_path;
-  // FileFnv1a64 of each file (16 hex digits), filled by the caller; empty if not known.
+  // FileSha256 of each file (64 hex digits, as sha256sum prints them), filled by the
+  // caller; empty if not known.
   std::string model_digest, spec_digest, data_digest;
-  std::string software_version;  // FASTCAL_VERSION
+  std::string software_version;  // FASTCAL_VERSION (fastcal/version.h)
   std::string command_line;
   // When the run happened, UTC, e.g. "2026-11-22T15:04:05Z"; empty: not recorded.
   std::string run_utc;

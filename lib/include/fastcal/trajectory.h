@@ -126,8 +126,8 @@ bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
 // column number and listing the accepted names:
 //   "<path>:<line>: column <n> '<name>': unknown column name (accepted: x_m, ...)".
 // Every data row must have as many fields as the header; every used field must be a finite
-// number (std::strtod, so the decimal point of the current C locale, '.' by default; the
-// whole field consumed). There must be at least one data row.
+// number ('.' as the decimal point whatever the locale, as strtod reads it in the "C"
+// locale; the whole field consumed). There must be at least one data row.
 //
 // Errors read "<path>:<line>: column '<name>': <what>" (line 1-based in the file).
 // `times_s` may be null; otherwise it receives one time per pose, or is left empty when

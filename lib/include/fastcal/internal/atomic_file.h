@@ -4,6 +4,8 @@
 #ifndef FASTCAL_INTERNAL_ATOMIC_FILE_H_
 #define FASTCAL_INTERNAL_ATOMIC_FILE_H_
 
+#include <cstddef>
+#include <functional>
 #include <string>
 
 namespace fastcal::internal {
@@ -14,6 +16,11 @@ bool WriteFileAtomically(const std::string& path, const std::string& content, st
 // Reads a whole file; "<path>: cannot open" / "<path>: cannot read" on failure (a
 // directory cannot be opened).
 bool ReadTextFile(const std::string& path, std::string* text, std::string* error);
+
+// Reads a whole file in chunks handed to `sink` in order, for files too large to hold (a
+// digest); the same messages (error may not be null).
+bool ReadFileChunks(const std::string& path, const std::function<void(const char*, size_t)>& sink,
+                    std::string* error);
 
 }  // namespace fastcal::internal
 

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/internal/number_text.h"
+
 namespace fastcal {
 
 class JsonWriter {
@@ -36,9 +38,7 @@ class JsonWriter {
     if (!std::isfinite(value)) {
       out_ += "null";
     } else {
-      char buf[32];
-      std::snprintf(buf, sizeof(buf), "%.12g", value);
-      out_ += buf;
+      out_ += internal::FormatDouble("%.12g", value);
     }
     return *this;
   }

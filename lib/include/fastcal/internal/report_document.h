@@ -12,6 +12,8 @@
 #include <utility>
 #include <vector>
 
+#include "fastcal/internal/number_text.h"
+
 namespace fastcal::internal {
 
 inline constexpr double kReportNPerKn = 1000.0;
@@ -28,9 +30,7 @@ inline std::string DropSignOfZero(std::string s) {
 
 inline std::string Printf(const char* format, double v) {
   if (!std::isfinite(v)) return "n/a";
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), format, v);
-  return DropSignOfZero(buf);
+  return DropSignOfZero(internal::FormatDouble(format, v));
 }
 inline std::string Sig6(double v) { return Printf("%.6g", v); }
 inline std::string Sig3(double v) { return Printf("%.3g", v); }
@@ -47,9 +47,7 @@ inline std::string EstimateText(double value, double sigma) {
   if (!std::isfinite(value) || !std::isfinite(sigma) || sigma <= 0.0) return Sig6(value);
   const int decimals =
       std::clamp(2 - static_cast<int>(std::floor(std::log10(sigma))), 0, kMaxDecimals);
-  char buf[64];
-  std::snprintf(buf, sizeof(buf), "%.*f", decimals, value);
-  return DropSignOfZero(buf);
+  return DropSignOfZero(internal::FormatDouble("%." + std::to_string(decimals) + "f", value));
 }
 
 struct Span {

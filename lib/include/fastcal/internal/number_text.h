@@ -1,0 +1,30 @@
+// Numbers as text, the same in every locale. std::strtod and printf's %f/%e/%g follow the
+// C locale's LC_NUMERIC, so a program that calls setlocale(LC_ALL, "") under a German or
+// French locale (a GUI host, a Python session that did locale.setlocale) would read
+// "1.5" as 1 and write "1,5" into CSV, JSON, YAML and SVG. These use std::from_chars and
+// std::to_chars, which always use '.'.
+#ifndef FASTCAL_INTERNAL_NUMBER_TEXT_H_
+#define FASTCAL_INTERNAL_NUMBER_TEXT_H_
+
+#include <string>
+#include <string_view>
+
+namespace fastcal::internal {
+
+// Parses the whole of `text` as a number, as strtod does in the "C" locale: an optional
+// sign ('+' too), a decimal number with an optional exponent ("1.5", "-2e-3", ".5"), a
+// hexadecimal one ("0x1.8p1"), "inf", "infinity" or "nan" (any case; callers that need a
+// finite value check). A value beyond the range of a double reads as +-infinity, one
+// below the smallest subnormal as +-0. No white space is skipped. False (and *value
+// untouched) when the text is not entirely a number.
+bool ParseDouble(std::string_view text, double* value);
+
+// `value` formatted by a printf format with exactly one floating-point conversion,
+// %[+][width][.precision](f|e|g), and literal text around it ('%%' for a percent sign),
+// e.g. FormatDouble("%+.3f", x), FormatDouble("%.6g kN", t). Output as printf's in the
+// "C" locale, whatever the current one.
+std::string FormatDouble(std::string_view format, double value);
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_INTERNAL_NUMBER_TEXT_H_

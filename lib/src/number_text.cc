@@ -1,0 +1,134 @@
+// Locale-independent number text (declarations: internal/number_text.h).
+#include "fastcal/internal/number_text.h"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <system_error>
+
+namespace fastcal::internal {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+bool StartsWithNoCase(std::string_view text, std::string_view prefix) {
+  if (text.size() < prefix.size()) return false;
+  for (size_t i = 0; i < prefix.size(); ++i) {
+    if ((text[i] | 0x20) != prefix[i]) return false;
+  }
+  return true;
+}
+
+// For an unsigned number that std::from_chars found out of range: true when it is too
+// large, false when too small. Out of range means beyond 1.8e308 or below 4.9e-324, so
+// the decimal magnitude (where the first non-zero digit stands, plus the exponent)
+// decides. `exponent_chars` is "eE" for decimal text, "pP" for hexadecimal.
+bool TooLarge(std::string_view text, const char* exponent_chars, const char* nonzero_digits) {
+  long exponent = 0;
+  const size_t e = text.find_first_of(exponent_chars);
+  if (e != std::string_view::npos) {
+    std::string_view x = text.substr(e + 1);
+    const bool negative = !x.empty() && x.front() == '-';
+    if (!x.empty() && (x.front() == '+' || x.front() == '-')) x.remove_prefix(1);
+    long magnitude = 0;
+    const auto [ptr, ec] = std::from_chars(x.data(), x.data() + x.size(), magnitude);
+    if (ec == std::errc::result_out_of_range) return !negative;
+    exponent = negative ? -magnitude : magnitude;
+    text = text.substr(0, e);
+  }
+  const size_t point = std::min(text.find('.'), text.size());
+  const size_t first = text.find_first_of(nonzero_digits);
+  if (first == std::string_view::npos) return false;
+  const long lead =
+      first < point ? static_cast<long>(point - first) : -static_cast<long>(first - point - 1);
+  return lead + exponent > 0;
+}
+
+}  // namespace
+
+bool ParseDouble(std::string_view text, double* value) {
+  std::string_view t = text;
+  bool negative = false;
+  if (!t.empty() && (t.front() == '+' || t.front() == '-')) {
+    negative = t.front() == '-';
+    t.remove_prefix(1);
+  }
+  // from_chars takes no sign of its own here (the '-' it would take is handled above, so
+  // "+-1" and "--1" stay errors), and hexadecimal text without its "0x".
+  if (t.empty() || t.front() == '+' || t.front() == '-') return false;
+  std::chars_format format = std::chars_format::general;
+  const char* exponent_chars = "eE";
+  const char* nonzero_digits = "123456789";
+  if (StartsWithNoCase(t, "0x")) {
+    t.remove_prefix(2);
+    format = std::chars_format::hex;
+    exponent_chars = "pP";
+    nonzero_digits = "123456789abcdefABCDEF";
+  }
+  double parsed = 0.0;
+  const auto [ptr, ec] = std::from_chars(t.data(), t.data() + t.size(), parsed, format);
+  if (ptr != t.data() + t.size() || ptr == t.data()) return false;
+  if (ec == std::errc::result_out_of_range) {
+    parsed = TooLarge(t, exponent_chars, nonzero_digits) ? kInf : 0.0;
+  } else if (ec != std::errc()) {
+    return false;
+  }
+  *value = negative ? -parsed : parsed;
+  return true;
+}
+
+std::string FormatDouble(std::string_view format, double value) {
+  std::string out;
+  size_t i = 0;
+  bool converted = false;
+  while (i < format.size()) {
+    const char c = format[i++];
+    if (c != '%') {
+      out += c;
+      continue;
+    }
+    if (i < format.size() && format[i] == '%') {
+      out += '%';
+      ++i;
+      continue;
+    }
+    bool plus = false, left = false;
+    for (; i < format.size() && (format[i] == '+' || format[i] == '-'); ++i) {
+      (format[i] == '+' ? plus : left) = true;
+    }
+    size_t width = 0;
+    for (; i < format.size() && format[i] >= '0' && format[i] <= '9'; ++i) {
+      width = width * 10 + static_cast<size_t>(format[i] - '0');
+    }
+    int precision = 6;  // printf's default
+    if (i < format.size() && format[i] == '.') {
+      precision = 0;
+      for (++i; i < format.size() && format[i] >= '0' && format[i] <= '9'; ++i) {
+        precision = precision * 10 + (format[i] - '0');
+      }
+    }
+    const char conversion = i < format.size() ? format[i++] : 'g';
+    const std::chars_format chars = conversion == 'f'   ? std::chars_format::fixed
+                                    : conversion == 'e' ? std::chars_format::scientific
+                                                        : std::chars_format::general;
+    // Large enough for %.*f of the largest double with the precisions fastcal uses.
+    char buffer[400];
+    std::string number;
+    if (std::isnan(value)) {
+      number = std::signbit(value) ? "-nan" : "nan";  // to_chars' spelling of the sign varies
+    } else {
+      const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value, chars, precision);
+      number.assign(buffer, result.ec == std::errc() ? result.ptr : buffer);
+    }
+    if (plus && !number.empty() && number.front() != '-') number.insert(0, "+");
+    if (number.size() < width) {
+      const std::string pad(width - number.size(), ' ');
+      number = left ? number + pad : pad + number;
+    }
+    out += converted ? std::string() : number;  // a second conversion has no argument
+    converted = true;
+  }
+  return out;
+}
+
+}  // namespace fastcal::internal

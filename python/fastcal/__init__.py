@@ -1,0 +1,500 @@
+"""fastcal: statics and calibration of the FAST cable robot, from Python.
+
+The C++ library's statics (six sagging cables, elastic catenary) and its calibration
+against measured cable tensions, on numpy arrays. Guide: docs/python.md.
+
+    import fastcal
+    p = fastcal.arc(centre_m=(0, 0, 156.73), radius_m=71.11, nodes=360)
+    sol = fastcal.solve(p, quat=fastcal.focal_attitude(p))
+    sol.lower_tension_kN          # (360, 6), cable i in column i-1
+
+Units are in the names: SI inside (position_m, s0_m), kN for tensions and forces
+(lower_tension_kN, force_kN), degrees for roll/pitch/yaw (rpy_deg). Quaternions are
+(w, x, y, z). Bad input raises fastcal.InputError (a ValueError) with the message the
+command line prints: it names the file, line, column or parameter. A calibration the
+data cannot support raises fastcal.CalibrationError (a RuntimeError).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import warnings
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _fastcal
+from ._fastcal import CalibrationError, Dataset, Error, InputError, Model
+
+__version__: str = _fastcal.__version__
+
+__all__ = [
+    "CalibrationError",
+    "CalibrationResult",
+    "Dataset",
+    "Error",
+    "InputError",
+    "Model",
+    "StaticsResult",
+    "__version__",
+    "arc",
+    "calibrate",
+    "evaluate",
+    "focal_attitude",
+    "focal_grid",
+    "line",
+    "quat_from_rpy_deg",
+    "random_workspace",
+    "read_dataset",
+    "rpy_deg_from_quat",
+    "simulate",
+    "solve",
+]
+
+ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
+PathLike = Union[str, "os.PathLike[str]"]
+
+STATUS_NAMES: List[str] = _fastcal.statics_status_names()
+"""The statics status of a pose, by code: 'ok', 'invalid input', 'slack cable', ..."""
+_STATUS_NAMES_ARRAY = np.array(STATUS_NAMES, dtype=object)
+
+
+def _rows(value: ArrayLike, columns: int, name: str) -> Tuple[np.ndarray, bool]:
+    """`value` as an (n, columns) float array, and whether it was one row of shape (columns,)."""
+    array = np.asarray(value, dtype=np.float64)
+    if array.ndim == 1 and array.shape[0] == columns:
+        return array.reshape(1, columns), True
+    if array.ndim == 2 and array.shape[1] == columns:
+        return np.ascontiguousarray(array), False
+    raise InputError(f"{name} must have shape ({columns},) or (n, {columns}), got {array.shape}")
+
+
+def _attitude(
+    n: int, rpy_deg: Optional[ArrayLike], quat: Optional[ArrayLike]
+) -> Tuple[str, np.ndarray]:
+    """The attitude arguments as the core takes them: a kind and an (n, k) array."""
+    if rpy_deg is not None and quat is not None:
+        raise InputError("give rpy_deg or quat, not both")
+    if rpy_deg is None and quat is None:
+        return "none", np.zeros((0, 3))
+    kind, value, columns = ("rpy", rpy_deg, 3) if rpy_deg is not None else ("quat", quat, 4)
+    name = "rpy_deg" if kind == "rpy" else "quat"
+    array, _ = _rows(value, columns, name)
+    if array.shape[0] != n:
+        raise InputError(f"{name} has {array.shape[0]} rows for {n} positions")
+    return kind, array
+
+
+def _point(value: ArrayLike, name: str) -> np.ndarray:
+    array = np.asarray(value, dtype=np.float64)
+    if array.shape != (3,):
+        raise InputError(f"{name} must have shape (3,), got {array.shape}")
+    return array
+
+
+class StaticsResult:
+    """The statics of one pose or of n poses (fastcal.solve).
+
+    For n poses (positions of shape (n, 3)) each array has a leading axis of n; for one
+    pose (shape (3,)) it has none, and `status` and `ok` are scalars. Cable i is at index
+    i-1 of the cable axis.
+
+    Attributes:
+        lower_tension_kN: tension at the cabin end, (n, 6). What the cabin-side sensor
+            reads through its gain and bias (Model.sensor_gain, sensor_bias_n).
+        upper_tension_kN: tension at the tower end, (n, 6).
+        s0_m: unstretched cable lengths, (n, 6).
+        force_kN: force applied on each cable at its lower end by the cabin, global
+            frame, (n, 6, 3); the cabin feels its opposite.
+        chord_m: straight-line length from cabin anchor to tower top, (n, 6).
+        status: per pose 'ok' or why it failed ('slack cable', 'overstretched cable',
+            ...), an (n,) array of str.
+        ok: per pose whether status is 'ok', (n,) bool.
+        cable: per pose the 1-based cable a failure concerns, 0 when none, (n,) int.
+        messages: per failed pose index, the full account (the CLI's words).
+
+    A failed pose has zero forces and tensions, never NaN: check `ok`.
+    """
+
+    def __init__(self, raw: Dict[str, Any], single: bool) -> None:
+        codes = raw["status_code"]
+        status = _STATUS_NAMES_ARRAY[codes]
+        self.messages: Dict[int, str] = dict(raw["failures"])
+        self._single = single
+        pick = (lambda a: a[0]) if single else (lambda a: a)
+        self.lower_tension_kN: np.ndarray = pick(raw["lower_tension_kN"])
+        self.upper_tension_kN: np.ndarray = pick(raw["upper_tension_kN"])
+        self.s0_m: np.ndarray = pick(raw["s0_m"])
+        self.force_kN: np.ndarray = pick(raw["force_kN"])
+        self.chord_m: np.ndarray = pick(raw["chord_m"])
+        self.status = pick(status)
+        self.ok = pick(codes == 0)
+        self.cable = pick(raw["cable"] + 1)
+
+    def __len__(self) -> int:
+        return 1 if self._single else len(self.ok)
+
+    def __repr__(self) -> str:
+        n = len(self)
+        failed = n - int(np.sum(self.ok))
+        return f"<fastcal.StaticsResult: {n} pose{'s' if n != 1 else ''}, {failed} failed>"
+
+
+def solve(
+    position_m: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    method: str = "exact",
+    model: Optional[Model] = None,
+    *,
+    warm_start: bool = False,
+    refinement_steps: int = 1,
+    exact_relative_tolerance: float = 1e-12,
+    max_strain: float = 0.05,
+    max_length_ratio: float = 1.5,
+) -> StaticsResult:
+    """Cable forces, tensions and unstretched lengths at one pose or many.
+
+    Args:
+        position_m: position of the cabin-frame origin, global frame: (3,) or (n, 3).
+        rpy_deg: attitude as roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll):
+            (3,) or (n, 3). At most one of rpy_deg and quat; neither means R = I.
+        quat: attitude as unit quaternions (w, x, y, z): (4,) or (n, 4). E.g. the focal
+            law's, fastcal.focal_attitude(position_m).
+        method: 'exact' (Newton on all unknowns), 'aas-refined' (the paper's AAS with one
+            Newton step on its tangent, ~1e-7 of exact) or 'aas' (the paper's).
+        model: the model; None for Model.nominal().
+        warm_start: start each pose from the previous pose's solution (a trajectory);
+            off, each pose is solved on its own and the order does not matter.
+        refinement_steps: re-linearisations of 'aas-refined' (>= 1).
+        exact_relative_tolerance: where 'exact' stops.
+        max_strain: tensions above max_strain * EA are refused ('overstretched cable').
+        max_length_ratio: unstretched lengths above this times the chord are refused
+            ('slack cable').
+
+    Returns:
+        A StaticsResult: arrays with a leading axis of n for (n, 3) positions, none for
+        one (3,) position. Poses the cables cannot hold are marked in `status`/`ok`,
+        not raised. Solved in C++, without holding the GIL.
+
+    Raises:
+        InputError: a wrong shape, an unknown method, a non-unit quaternion (named by row).
+    """
+    positions, single = _rows(position_m, 3, "position_m")
+    kind, attitude = _attitude(positions.shape[0], rpy_deg, quat)
+    raw = _fastcal.solve(
+        model if model is not None else Model.nominal(),
+        positions,
+        kind,
+        attitude,
+        method,
+        warm_start,
+        refinement_steps,
+        exact_relative_tolerance,
+        max_strain,
+        max_length_ratio,
+    )
+    return StaticsResult(raw, single)
+
+
+def line(from_m: ArrayLike, to_m: ArrayLike, nodes: int = 101) -> np.ndarray:
+    """`nodes` evenly spaced positions from `from_m` to `to_m`, both included: (nodes, 3).
+
+    The paper's line G1 -> G2 is line((50, 0, 150), (-50, 0, 150)).
+    """
+    return _fastcal.line(_point(from_m, "from_m"), _point(to_m, "to_m"), nodes)
+
+
+def arc(
+    centre_m: ArrayLike = (0.0, 0.0, 150.0),
+    radius_m: float = 50.0,
+    start_deg: float = 0.0,
+    end_deg: float = 360.0,
+    nodes: int = 101,
+) -> np.ndarray:
+    """Positions on a horizontal circle or arc at the height of its centre: (nodes, 3).
+
+    Angles from +x toward +y; a 360 deg span is a full circle without a repeated node.
+    The paper's measured circle: arc(centre_m=(0, 0, 156.73), radius_m=71.11).
+    """
+    return _fastcal.arc(_point(centre_m, "centre_m"), radius_m, start_deg, end_deg, nodes)
+
+
+def focal_grid(
+    max_off_axis_deg: float = 40.0,
+    off_axis_step_deg: float = 5.0,
+    azimuth_step_deg: float = 15.0,
+    focal_centre_m: ArrayLike = (0.0, 0.0, 300.0),
+    focal_radius_m: float = 160.0,
+) -> np.ndarray:
+    """A regular grid on the lower cap of the focal sphere, axis point first: (n, 3)."""
+    return _fastcal.focal_grid(
+        max_off_axis_deg,
+        off_axis_step_deg,
+        azimuth_step_deg,
+        _point(focal_centre_m, "focal_centre_m"),
+        focal_radius_m,
+    )
+
+
+def random_workspace(
+    samples: int = 100,
+    max_off_axis_deg: float = 40.0,
+    radial_spread_m: float = 0.0,
+    seed: int = 0,
+    focal_centre_m: ArrayLike = (0.0, 0.0, 300.0),
+    focal_radius_m: float = 160.0,
+) -> np.ndarray:
+    """Positions spread uniformly over the focal sphere's lower cap: (samples, 3).
+
+    Each is moved along the sphere's normal by a uniform offset in +-radial_spread_m.
+    The same seed gives the same positions on every platform.
+    """
+    return _fastcal.random_workspace(
+        samples,
+        max_off_axis_deg,
+        radial_spread_m,
+        seed,
+        _point(focal_centre_m, "focal_centre_m"),
+        focal_radius_m,
+    )
+
+
+def focal_attitude(
+    position_m: ArrayLike,
+    tilt_fraction: float = 0.41,
+    focal_centre_m: ArrayLike = (0.0, 0.0, 300.0),
+) -> np.ndarray:
+    """The attitude the focal law prescribes at each position, as quaternions (w, x, y, z).
+
+    The cabin's z' axis is tilted toward the focal-sphere centre by tilt_fraction of the
+    off-axis angle (docs/model.md); with the defaults it reproduces the paper's Tables
+    3-5. Positions must lie below the focal centre. Shape (n, 4), or (4,) for one (3,)
+    position.
+    """
+    positions, single = _rows(position_m, 3, "position_m")
+    centre = _point(focal_centre_m, "focal_centre_m")
+    quat = _fastcal.focal_attitude(positions, tilt_fraction, centre)
+    return quat[0] if single else quat
+
+
+def rpy_deg_from_quat(quat: ArrayLike) -> np.ndarray:
+    """Roll, pitch, yaw in degrees (pitch in [-90, 90]) of unit quaternions (w, x, y, z)."""
+    rows, single = _rows(quat, 4, "quat")
+    rpy = _fastcal.rpy_deg_from_quat(rows)
+    return rpy[0] if single else rpy
+
+
+def quat_from_rpy_deg(rpy_deg: ArrayLike) -> np.ndarray:
+    """Unit quaternions (w, x, y, z; w >= 0) of roll, pitch, yaw in degrees."""
+    rows, single = _rows(rpy_deg, 3, "rpy_deg")
+    quat = _fastcal.quat_from_rpy_deg(rows)
+    return quat[0] if single else quat
+
+
+def read_dataset(path: PathLike, skip_invalid_rows: bool = False) -> Dataset:
+    """Reads a telemetry CSV (docs/data-format.md).
+
+    With skip_invalid_rows, a row with a bad value is left out and listed in
+    Dataset.skipped instead of raising. Raises InputError naming the file, line and
+    column, e.g. "data.csv:12: column 'T3_kN': 'abc' is not a number".
+    """
+    return _fastcal.read_dataset(os.fspath(path), skip_invalid_rows)
+
+
+def simulate(
+    position_m: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    model: Optional[Model] = None,
+    **options: Any,
+) -> Tuple[Dataset, Model, Dict[str, Any]]:
+    """Synthetic telemetry from a known ("truth") model at planned poses.
+
+    The planned poses are positions (n, 3) with an attitude as in solve(). Options are
+    the fields of the C++ SimulationOptions (simulation.h, docs/cli.md's `simulate`):
+    tension_noise_percent (3), tension_noise_kn, outlier_fraction,
+    outlier_scale_percent, attitude_control_sigma_deg, attitude_control_time_s,
+    attitude_measurement_sigma_deg, position_measurement_sigma_m,
+    tension_drift_percent, tension_drift_time_s, mass_centre_drift_m,
+    mass_centre_drift_time_s, sensor_gain_spread_percent, sensor_bias_spread_kn,
+    density_mismatch_percent, sample_interval_s (1), seed (1), method ('exact').
+
+    Returns:
+        (dataset, truth_used, summary): the telemetry, the truth model after the drawn
+        per-cable mismatches (the one the tensions come from), and what was added
+        (noise RMS per cable in kN, outliers, ...).
+    """
+    positions, _ = _rows(position_m, 3, "position_m")
+    kind, attitude = _attitude(positions.shape[0], rpy_deg, quat)
+    truth = model if model is not None else Model.nominal()
+    return _fastcal.simulate(truth, positions, kind, attitude, dict(options))
+
+
+class CalibrationResult:
+    """What fastcal.calibrate found (docs/calibration.md explains each part).
+
+    Attributes:
+        parameters: one dict per parameter the spec names, in spec order: name, unit,
+            free, consider, initial, estimate, sigma (formal: stated noise, independent
+            samples), sigma_total (the uncertainty to quote) with its parts
+            sigma_statistical (the formal one widened by misfit and time-correlated
+            residuals; widening = their ratio; tau) and sigma_systematic (from consider
+            parameters; systematic_by_group), prior_mean, prior_sigma (None without a
+            prior), note. Values in the spec's units (kN for sensor biases).
+        estimates: name -> estimate, every parameter the spec names.
+        sigma, sigma_total: name -> formal and total standard deviation, free ones.
+        free_names: the free parameters, in the order of `correlation`'s rows.
+        correlation: correlation matrix of the free estimates (total covariance), (k, k).
+        outliers: the gross errors kept out of the fit, in file order: dicts of line,
+            cable (1-6), measured_kN, predicted_kN, residual_sigma, held_out.
+        worst_readings: the fitted readings with the largest |residual| / sigma.
+        misfit_ranking: fixed parameters by the chi-square decrease freeing each would
+            bring (name, expected_chi_square_decrease, significant); misfit_threshold
+            is what white noise alone reaches.
+        rms_kN: variant -> RMS of model minus measured per cable, (6,), on the fitted
+            samples: the initial model at each attitude the data has, and the
+            calibrated one (the paper's Table 6). holdout_rms_kN: the same on the
+            held-out samples (variants with some). cross_validation_rms_kN: the block
+            cross-validation's, or None.
+        evaluation: variant -> the full statistics (fit, holdout: samples, rms_kN,
+            mean_kN, max_abs_kN, rms_percent, max_abs_percent) and predicted_kN (n, 6).
+        verdict: 'ok', 'noise overstated', 'misfit' or 'failed'; verdict_text says why.
+        reduced_chi_square, converged, iterations, termination, notes,
+        strong_correlations, budget (dict), seconds.
+        model: the calibrated Model.
+        held_out: per sample, held out of the fit (list of bool).
+        gross_error_mask: per sample and cable, a reading kept out, (n, 6) bool.
+    """
+
+    def __init__(self, raw: Dict[str, Any]) -> None:
+        self.parameters: List[Dict[str, Any]] = raw["parameters"]
+        self.estimates: Dict[str, float] = {p["name"]: p["estimate"] for p in self.parameters}
+        free = [p for p in self.parameters if p["free"]]
+        self.sigma: Dict[str, float] = {p["name"]: p["sigma"] for p in free}
+        self.sigma_total: Dict[str, float] = {p["name"]: p["sigma_total"] for p in free}
+        self.free_names: List[str] = raw["free_names"]
+        self.correlation: np.ndarray = raw["correlation"]
+        self.outliers: List[Dict[str, Any]] = raw["outliers"]
+        self.worst_readings: List[Dict[str, Any]] = raw["worst_readings"]
+        self.misfit_ranking: List[Dict[str, Any]] = raw["misfit_ranking"]
+        self.misfit_threshold: float = raw["misfit_threshold"]
+        self.evaluation: Dict[str, Dict[str, Any]] = raw["evaluation"]
+        self.rms_kN: Dict[str, np.ndarray] = {
+            name: v["fit"]["rms_kN"] for name, v in self.evaluation.items()
+        }
+        self.holdout_rms_kN: Dict[str, np.ndarray] = {
+            name: v["holdout"]["rms_kN"]
+            for name, v in self.evaluation.items()
+            if v["holdout"] is not None
+        }
+        self.cross_validation_rms_kN: Optional[np.ndarray] = raw["cross_validation_rms_kN"]
+        self.verdict: str = raw["verdict"]
+        self.verdict_text: str = raw["verdict_text"]
+        self.notes: List[str] = raw["notes"]
+        self.strong_correlations: List[str] = raw["strong_correlations"]
+        self.budget: Dict[str, Any] = raw["budget"]
+        self.model: Model = raw["model"]
+        self.held_out: List[bool] = raw["held_out"]
+        self.gross_error_mask: np.ndarray = raw["gross_error_mask"]
+        self.reduced_chi_square: float = raw["reduced_chi_square"]
+        self.converged: bool = raw["converged"]
+        self.iterations: int = raw["iterations"]
+        self.termination: str = raw["termination"]
+        self.num_residuals: int = raw["num_residuals"]
+        self.num_fit_samples: int = raw["num_fit_samples"]
+        self.seconds: float = raw["seconds"]
+        self.ceres_report: str = raw["ceres_report"]
+
+    def __repr__(self) -> str:
+        shown = ", ".join(
+            f"{name} = {self.estimates[name]:.6g} +- {self.sigma_total[name]:.2g}"
+            for name in self.free_names
+        )
+        return f"<fastcal.CalibrationResult: {self.verdict}; {shown}>"
+
+
+_DICT_SPEC = "spec (dict)"
+
+
+def _spec_argument(spec: Union[PathLike, Mapping[str, Any]]) -> Tuple[str, bool, str]:
+    """A spec file's path, or a dict as YAML text (JSON is YAML) with a name for messages."""
+    if isinstance(spec, Mapping):
+        return json.dumps(spec), True, _DICT_SPEC
+    return os.fspath(spec), False, os.fspath(spec)
+
+
+def calibrate(
+    spec: Union[PathLike, Mapping[str, Any]],
+    data: Union[Dataset, PathLike],
+    model: Optional[Union[Model, PathLike]] = None,
+) -> CalibrationResult:
+    """Estimates model parameters from measured poses and tensions (docs/calibration.md).
+
+    What `fastcal calibrate` does, without writing files: the fit, its uncertainty
+    budget, gross errors, the misfit ranking, and the RMS tables of the initial and the
+    calibrated model (exact statics).
+
+    Args:
+        spec: a calibration spec file, or the same content as a dict, e.g.
+            {"format": "fastcal-calibration-spec-1",
+             "parameters": {"mass_centre_m": {"x": {"free": True}, "y": {"free": True}}}}.
+        data: a Dataset, or the path of a telemetry CSV.
+        model: the starting model (a Model or a model file); None for Model.nominal().
+
+    Returns:
+        A CalibrationResult. A fit whose verdict is 'failed' is returned, with a
+        RuntimeWarning, as the command line writes it with a warning.
+
+    Raises:
+        InputError: a bad spec, dataset or model file (file, line, key named).
+        CalibrationError: refused or failed; `status` is 'undetermined' (the data cannot
+            determine the free set: the message names the combination), 'infeasible' (the
+            model cannot hold a sample's pose: the line is named), 'solver failed' or
+            'mostly gross errors'.
+    """
+    if model is None:
+        model = Model.nominal()
+    elif not isinstance(model, Model):
+        model = Model.load(os.fspath(model))
+    if not isinstance(data, Dataset):
+        data = read_dataset(data)
+    spec_text, is_text, source = _spec_argument(spec)
+    try:
+        raw = _fastcal.calibrate(model, spec_text, is_text, source, data)
+    except InputError as error:
+        # A dict has no lines: its messages name the key path alone.
+        message = re.sub(rf"^{re.escape(_DICT_SPEC)}:\d+: ", f"{_DICT_SPEC}: ", str(error))
+        raise InputError(message) from None
+    result = CalibrationResult(raw)
+    if result.verdict == "failed":
+        warnings.warn(f"the fit failed: {result.verdict_text}", RuntimeWarning, stacklevel=2)
+    return result
+
+
+def evaluate(
+    data: Union[Dataset, PathLike],
+    model: Optional[Union[Model, PathLike]] = None,
+    method: str = "exact",
+) -> Dict[str, Dict[str, Any]]:
+    """Model minus measured tension statistics per cable, as `fastcal evaluate` prints.
+
+    Returns:
+        variant -> statistics, for 'model, planned attitude' (when the data has it) and
+        'model, measured attitude': {'fit': {'samples', 'rms_kN', 'mean_kN',
+        'max_abs_kN', 'rms_percent', 'max_abs_percent', 'excluded'}, 'holdout': None,
+        'predicted_kN': (n, 6)}. The model's sensor gains and biases are applied.
+
+    Raises:
+        InputError: a bad file or method. CalibrationError ('infeasible'): the model
+        cannot hold a sample's pose (its line is named).
+    """
+    if model is None:
+        model = Model.nominal()
+    elif not isinstance(model, Model):
+        model = Model.load(os.fspath(model))
+    if not isinstance(data, Dataset):
+        data = read_dataset(data)
+    return _fastcal.evaluate(model, data, method)

@@ -1,0 +1,63 @@
+// The Python module fastcal._fastcal (pybind11): the library's models, statics,
+// trajectories, datasets, simulation, calibration and evaluation on numpy arrays. The
+// package fastcal (python/fastcal/__init__.py) is the documented interface on top: it
+// checks shapes, names arguments and wraps results; this layer converts and calls the
+// library with the GIL released. Tensions and forces cross in kN (the edge), everything
+// else in the library's SI units, each named with its unit.
+#ifndef FASTCAL_PYTHON_BINDINGS_H_
+#define FASTCAL_PYTHON_BINDINGS_H_
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "fastcal/pose.h"
+
+namespace fastcal::python {
+
+namespace py = pybind11;
+
+inline constexpr double kNPerKn = 1e3;
+
+// Bad input (a file, a spec, an argument): raised as fastcal.InputError, a ValueError,
+// with the library's message (the one the command line prints before exiting with 2).
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+// A calibration refused or failed (the command line's exit 1): fastcal.CalibrationError,
+// a RuntimeError, whose `status` says which ("undetermined", "infeasible", ...).
+struct CalibrationError : std::runtime_error {
+  CalibrationError(std::string status_name, const std::string& message)
+      : std::runtime_error(message), status(std::move(status_name)) {}
+  std::string status;
+};
+
+// A C-contiguous float64 array; anything numpy can convert is converted on the way in.
+using DoubleArray = py::array_t<double, py::array::c_style | py::array::forcecast>;
+
+// `array` as rows of `columns` numbers: shape (n, columns). InputError naming `name` and
+// the shape otherwise.
+void CheckRows(const DoubleArray& array, py::ssize_t columns, const char* name);
+
+// A new float64 array of the given shape (C order), zero-filled.
+DoubleArray NewArray(const std::vector<py::ssize_t>& shape);
+
+// Poses from positions (n, 3) and an attitude: kind "none" (R = I), "rpy" (n, 3 roll,
+// pitch, yaw in degrees) or "quat" (n, 4 unit quaternions w, x, y, z). InputError naming
+// the row of a non-unit quaternion.
+std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::string& attitude_kind,
+                                  const DoubleArray& attitude);
+
+void BindModel(py::module_& m);
+void BindStatics(py::module_& m);
+void BindData(py::module_& m);
+void BindCalibration(py::module_& m);
+
+}  // namespace fastcal::python
+
+#endif  // FASTCAL_PYTHON_BINDINGS_H_

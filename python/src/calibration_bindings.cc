@@ -1,0 +1,243 @@
+// Calibration and evaluation (calibration.h, evaluation.h): the result as plain Python
+// values and numpy arrays, in the units of the spec and the report (tensions in kN).
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+#include "fastcal/evaluation.h"
+
+namespace fastcal::python {
+namespace {
+
+template <typename Array>
+DoubleArray PerCableKn(const Array& values_n) {
+  DoubleArray out = NewArray({kNumCables});
+  for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = values_n[i] / kNPerKn;
+  return out;
+}
+
+template <typename Array>
+DoubleArray PerCable(const Array& values) {
+  DoubleArray out = NewArray({kNumCables});
+  for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = values[i];
+  return out;
+}
+
+DoubleArray Matrix(const Eigen::MatrixXd& m) {
+  DoubleArray out = NewArray({m.rows(), m.cols()});
+  for (Eigen::Index r = 0; r < m.rows(); ++r) {
+    for (Eigen::Index c = 0; c < m.cols(); ++c) out.mutable_data()[r * m.cols() + c] = m(r, c);
+  }
+  return out;
+}
+
+py::dict Stats(const CableErrorStats& s) {
+  py::dict d;
+  d["samples"] = s.samples;
+  d["rms_kN"] = PerCableKn(s.rms_n);
+  d["mean_kN"] = PerCableKn(s.mean_n);
+  d["max_abs_kN"] = PerCableKn(s.max_abs_n);
+  d["rms_percent"] = PerCable(s.rms_percent);
+  d["max_abs_percent"] = PerCable(s.max_abs_percent);
+  d["excluded"] = std::vector<int>(s.excluded.begin(), s.excluded.end());
+  return d;
+}
+
+py::dict Variant(const VariantEvaluation& v) {
+  py::dict d;
+  d["fit"] = Stats(v.fit);
+  d["holdout"] = v.holdout.samples > 0 ? py::object(Stats(v.holdout)) : py::object(py::none());
+  DoubleArray predicted = NewArray({static_cast<py::ssize_t>(v.predicted_n.size()), kNumCables});
+  for (size_t n = 0; n < v.predicted_n.size(); ++n) {
+    for (int i = 0; i < kNumCables; ++i) {
+      predicted.mutable_data()[n * kNumCables + i] = v.predicted_n[n][i] / kNPerKn;
+    }
+  }
+  d["predicted_kN"] = predicted;
+  return d;
+}
+
+py::dict Reading(const ReadingResidual& r) {
+  py::dict d;
+  d["line"] = r.line;
+  d["cable"] = r.cable;
+  d["measured_kN"] = r.measured_n / kNPerKn;
+  d["predicted_kN"] = r.predicted_n / kNPerKn;
+  d["residual_sigma"] = r.residual_sigma;
+  d["held_out"] = r.held_out;
+  return d;
+}
+
+py::dict Parameter(const ParameterEstimate& p, const std::vector<std::string>& groups) {
+  py::dict d;
+  d["name"] = p.name;
+  d["unit"] = p.unit;
+  d["free"] = p.free;
+  d["consider"] = p.consider;
+  d["initial"] = p.initial;
+  d["estimate"] = p.estimate;
+  d["sigma"] = p.sigma;
+  d["sigma_total"] = p.sigma_total;
+  d["sigma_statistical"] = p.sigma_statistical;
+  d["sigma_systematic"] = p.sigma_systematic;
+  d["widening"] = p.widening;
+  d["tau"] = p.tau;
+  py::dict by_group;
+  for (size_t g = 0; g < groups.size() && g < p.systematic_by_group.size(); ++g) {
+    by_group[py::str(groups[g])] = p.systematic_by_group[g];
+  }
+  d["systematic_by_group"] = by_group;
+  d["prior_mean"] = p.has_prior ? py::object(py::float_(p.prior_mean)) : py::object(py::none());
+  d["prior_sigma"] = p.has_prior ? py::object(py::float_(p.prior_sigma)) : py::object(py::none());
+  d["note"] = p.note;
+  return d;
+}
+
+py::dict ResultDict(const CalibrationResult& r) {
+  py::dict d;
+  py::list parameters;
+  for (const ParameterEstimate& p : r.parameters)
+    parameters.append(Parameter(p, r.budget.consider_groups));
+  d["parameters"] = parameters;
+  d["free_names"] = r.free_names;
+  d["correlation"] = Matrix(r.correlation);
+  d["covariance_ok"] = r.covariance_ok;
+  py::list outliers, worst, ranking;
+  for (const ReadingResidual& e : r.gross_errors) outliers.append(Reading(e));
+  for (const ReadingResidual& e : r.worst_readings) worst.append(Reading(e));
+  for (const MisfitCandidate& c : r.misfit_ranking) {
+    py::dict m;
+    m["name"] = c.name;
+    m["expected_chi_square_decrease"] = c.expected_decrease;
+    m["significant"] = c.significant;
+    ranking.append(m);
+  }
+  d["outliers"] = outliers;
+  d["worst_readings"] = worst;
+  d["misfit_ranking"] = ranking;
+  d["misfit_threshold"] = r.misfit_threshold;
+  py::dict evaluation;
+  for (const VariantEvaluation& v : r.variants) evaluation[py::str(v.name)] = Variant(v);
+  d["evaluation"] = evaluation;
+  d["cross_validation_rms_kN"] = r.cross_validation.folds_used > 0
+                                     ? py::object(PerCableKn(r.cross_validation.rms_n))
+                                     : py::object(py::none());
+  d["residual_tau"] = PerCable(r.residual_tau);
+  py::dict budget;
+  budget["reduced_chi_square"] = r.budget.reduced_chi_square;
+  budget["misfit_factor"] = r.budget.misfit_factor;
+  budget["autocorrelation_time_samples"] = r.budget.tau;
+  budget["batch_length_samples"] = r.budget.bandwidth;
+  budget["effective_samples"] = r.budget.effective_samples;
+  budget["residuals_correlated"] = r.budget.correlated;
+  budget["correlation_reliable"] = r.budget.correlation_reliable;
+  budget["consider_groups"] = r.budget.consider_groups;
+  d["budget"] = budget;
+  d["verdict"] = std::string(FitVerdictName(r.verdict));
+  d["verdict_text"] = r.verdict_text;
+  d["notes"] = r.notes;
+  d["strong_correlations"] = r.strong_correlations;
+  d["model"] = r.calibrated;
+  d["held_out"] = r.held_out;
+  py::array_t<bool> excluded(
+      {static_cast<py::ssize_t>(r.excluded.size()), static_cast<py::ssize_t>(kNumCables)});
+  for (size_t n = 0; n < r.excluded.size(); ++n) {
+    for (int i = 0; i < kNumCables; ++i)
+      excluded.mutable_data()[n * kNumCables + i] = r.excluded[n][i];
+  }
+  d["gross_error_mask"] = excluded;
+  d["num_fit_samples"] = r.num_fit_samples;
+  d["num_residuals"] = r.num_residuals;
+  d["num_free"] = r.num_free;
+  d["initial_cost"] = r.initial_cost;
+  d["final_cost"] = r.final_cost;
+  d["reduced_chi_square"] = r.reduced_chi_square;
+  d["iterations"] = r.iterations;
+  d["converged"] = r.converged;
+  d["termination"] = r.termination;
+  d["forward_model_max_rel_error"] = r.forward_model_max_rel_error;
+  d["seconds"] = r.seconds;
+  d["ceres_report"] = r.ceres_full_report;
+  return d;
+}
+
+const char* StatusName(CalibrationStatus status) {
+  switch (status) {
+    case CalibrationStatus::kOk:
+      return "ok";
+    case CalibrationStatus::kInvalidInput:
+      return "invalid input";
+    case CalibrationStatus::kUndetermined:
+      return "undetermined";
+    case CalibrationStatus::kInfeasible:
+      return "infeasible";
+    case CalibrationStatus::kSolverFailed:
+      return "solver failed";
+    case CalibrationStatus::kMostlyGrossErrors:
+      return "mostly gross errors";
+  }
+  return "unknown";
+}
+
+// The spec from a file, or from YAML text (the package turns a dict into it).
+CalibrationSpec Spec(const CableRobot& model, const std::string& path_or_text, bool is_text,
+                     const std::string& source_name) {
+  CalibrationSpec spec;
+  std::string error;
+  const int anchors = static_cast<int>(model.anchor_points_cabin_m.size());
+  const bool ok = is_text
+                      ? ParseCalibrationSpecYaml(path_or_text, source_name, anchors, &spec, &error)
+                      : LoadCalibrationSpec(path_or_text, anchors, &spec, &error);
+  if (!ok) throw InputError(error);
+  return spec;
+}
+
+py::dict Calibrate(const CableRobot& model, const std::string& spec_path_or_text, bool spec_is_text,
+                   const std::string& spec_source, const Dataset& data) {
+  const CalibrationSpec spec = Spec(model, spec_path_or_text, spec_is_text, spec_source);
+  CalibrationResult result;
+  std::string error;
+  CalibrationStatus status;
+  {
+    py::gil_scoped_release release;
+    // Calibrate's evaluation stage fills result.variants (the before/after table).
+    status = fastcal::Calibrate(model, spec, data, CalibrationOptions(), &result, &error);
+  }
+  if (status == CalibrationStatus::kInvalidInput) throw InputError(error);
+  if (status != CalibrationStatus::kOk) throw CalibrationError(StatusName(status), error);
+  return ResultDict(result);
+}
+
+py::dict Evaluate(const CableRobot& model, const Dataset& data, const std::string& method_name) {
+  StaticsMethod method;
+  if (!ParseStaticsMethod(method_name, &method)) {
+    throw InputError("method must be 'aas', 'aas-refined' or 'exact', got '" + method_name + "'");
+  }
+  std::vector<VariantEvaluation> variants;
+  std::string error;
+  bool ok = true;
+  {
+    py::gil_scoped_release release;
+    ok = EvaluateModel(model, data, method, &variants, &error);
+  }
+  if (!ok) throw CalibrationError("infeasible", error);
+  py::dict out;
+  for (const VariantEvaluation& v : variants) out[py::str(v.name)] = Variant(v);
+  return out;
+}
+
+}  // namespace
+
+void BindCalibration(py::module_& m) {
+  m.def("calibrate", &Calibrate, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
+        py::arg("spec_source"), py::arg("data"));
+  m.def("evaluate", &Evaluate, py::arg("model"), py::arg("data"), py::arg("method"));
+}
+
+}  // namespace fastcal::python

@@ -1,0 +1,221 @@
+// fastcal.Dataset (dataset.h): telemetry as numpy arrays, read, written and simulated
+// (simulation.h).
+#include <pybind11/stl.h>
+
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "fastcal/cable_robot.h"
+#include "fastcal/dataset.h"
+#include "fastcal/simulation.h"
+
+namespace fastcal::python {
+namespace {
+
+// One (n, columns) array of a per-sample quantity.
+template <typename Fill>
+DoubleArray PerSample(const Dataset& d, py::ssize_t columns, Fill fill) {
+  DoubleArray out = NewArray({static_cast<py::ssize_t>(d.samples.size()), columns});
+  for (size_t n = 0; n < d.samples.size(); ++n) {
+    fill(d.samples[n], out.mutable_data() + static_cast<py::ssize_t>(n) * columns);
+  }
+  return out;
+}
+
+// The measured attitude as roll/pitch/yaw: the file's numbers when it gave them.
+Eigen::Vector3d MeasuredRpyDeg(const Dataset& d, const Sample& s) {
+  return d.attitude_as_quaternion ? RpyDegFromRotation(s.pose.rotation) : s.measured_rpy_deg;
+}
+Eigen::Vector4d MeasuredQuat(const Dataset& d, const Sample& s) {
+  return d.attitude_as_quaternion ? s.measured_quaternion_wxyz
+                                  : QuaternionFromRotation(s.pose.rotation);
+}
+
+SimulationOptions MakeSimulationOptions(const py::dict& kwargs) {
+  SimulationOptions o;
+  const std::vector<std::pair<const char*, double*>> doubles = {
+      {"attitude_control_sigma_deg", &o.attitude_control_sigma_deg},
+      {"attitude_control_time_s", &o.attitude_control_time_s},
+      {"tension_drift_percent", &o.tension_drift_percent},
+      {"tension_drift_time_s", &o.tension_drift_time_s},
+      {"mass_centre_drift_m", &o.mass_centre_drift_m},
+      {"mass_centre_drift_time_s", &o.mass_centre_drift_time_s},
+      {"sensor_gain_spread_percent", &o.sensor_gain_spread_percent},
+      {"sensor_bias_spread_kn", &o.sensor_bias_spread_kn},
+      {"attitude_measurement_sigma_deg", &o.attitude_measurement_sigma_deg},
+      {"position_measurement_sigma_m", &o.position_measurement_sigma_m},
+      {"tension_noise_percent", &o.tension_noise_percent},
+      {"tension_noise_kn", &o.tension_noise_kn},
+      {"outlier_fraction", &o.outlier_fraction},
+      {"outlier_scale_percent", &o.outlier_scale_percent},
+      {"density_mismatch_percent", &o.density_mismatch_percent},
+      {"sample_interval_s", &o.sample_interval_s}};
+  for (const auto& [key, value] : kwargs) {
+    const std::string name = py::str(key);
+    bool known = false;
+    for (const auto& [field, target] : doubles) {
+      if (name == field) {
+        *target = value.cast<double>();
+        known = true;
+      }
+    }
+    if (name == "seed") {
+      o.seed = value.cast<std::uint64_t>();
+    } else if (name == "method") {
+      if (!ParseStaticsMethod(value.cast<std::string>(), &o.method)) {
+        throw InputError("method must be 'aas', 'aas-refined' or 'exact'");
+      }
+    } else if (!known) {
+      throw InputError("simulate: unknown option '" + name + "'");
+    }
+  }
+  std::string error;
+  if (!o.IsValid(&error)) throw InputError(error);
+  return o;
+}
+
+py::dict SummaryDict(const SimulationSummary& s) {
+  py::dict d;
+  DoubleArray rms_kn = NewArray({kNumCables}), rms_rel = NewArray({kNumCables}),
+              density = NewArray({kNumCables}), drift = NewArray({kNumCables});
+  py::array_t<int> outliers(kNumCables);
+  for (int i = 0; i < kNumCables; ++i) {
+    rms_kn.mutable_data()[i] = s.tension_noise_rms_n[i] / kNPerKn;
+    rms_rel.mutable_data()[i] = s.tension_noise_rms_relative[i];
+    density.mutable_data()[i] = s.density_factor[i];
+    drift.mutable_data()[i] = s.tension_drift_rms_relative[i];
+    outliers.mutable_data()[i] = s.outliers[i];
+  }
+  d["samples"] = s.samples;
+  d["tension_noise_rms_kN"] = rms_kn;
+  d["tension_noise_rms_relative"] = rms_rel;
+  d["outliers"] = outliers;
+  d["redrawn"] = s.redrawn;
+  d["attitude_control_rms_deg"] = s.attitude_control_rms_deg;
+  d["attitude_measurement_rms_deg"] = s.attitude_measurement_rms_deg;
+  d["position_measurement_rms_m"] = s.position_measurement_rms_m;
+  d["density_factor"] = density;
+  d["tension_drift_rms_relative"] = drift;
+  d["mass_centre_mean_m"] =
+      std::vector<double>(s.mass_centre_mean_m.data(), s.mass_centre_mean_m.data() + 3);
+  d["mass_centre_drift_rms_m"] = s.mass_centre_drift_rms_m;
+  return d;
+}
+
+Dataset ReadDatasetOrThrow(const std::string& path, bool skip_invalid_rows) {
+  DatasetReadOptions options;
+  options.skip_invalid_rows = skip_invalid_rows;
+  Dataset data;
+  std::string error;
+  bool ok = false;
+  {
+    py::gil_scoped_release release;
+    ok = ReadDataset(path, options, &data, &error);
+  }
+  if (!ok) throw InputError(error);
+  return data;
+}
+
+}  // namespace
+
+void BindData(py::module_& m) {
+  py::class_<Dataset>(m, "Dataset", R"(Measured telemetry (docs/data-format.md), one row per sample.
+
+Arrays are copies, in file order: time_s (n,), position_m (n, 3), rpy_deg (n, 3) and
+quat (n, 4) the measured attitude, tension_kN (n, 6), line (n,) the file's 1-based line
+of each sample; planned_rpy_deg (n, 3) and s0_m (n, 6) are None when the file lacks
+those columns. skipped lists the rows read_dataset(skip_invalid_rows=True) left out.
+)")
+      .def("__len__", [](const Dataset& d) { return d.samples.size(); })
+      .def_readonly("path", &Dataset::path)
+      .def_readonly("skipped", &Dataset::skipped)
+      .def_property_readonly("time_s",
+                             [](const Dataset& d) {
+                               return PerSample(d, 1,
+                                                [](const Sample& s, double* o) { *o = s.time_s; })
+                                   .attr("reshape")(-1);
+                             })
+      .def_property_readonly("line",
+                             [](const Dataset& d) {
+                               py::array_t<int> out(static_cast<py::ssize_t>(d.samples.size()));
+                               for (size_t n = 0; n < d.samples.size(); ++n) {
+                                 out.mutable_data()[n] = d.samples[n].line;
+                               }
+                               return out;
+                             })
+      .def_property_readonly("position_m",
+                             [](const Dataset& d) {
+                               return PerSample(d, 3, [](const Sample& s, double* o) {
+                                 for (int k = 0; k < 3; ++k) o[k] = s.pose.position_m[k];
+                               });
+                             })
+      .def_property_readonly("rpy_deg",
+                             [](const Dataset& d) {
+                               return PerSample(d, 3, [&d](const Sample& s, double* o) {
+                                 const Eigen::Vector3d a = MeasuredRpyDeg(d, s);
+                                 for (int k = 0; k < 3; ++k) o[k] = a[k];
+                               });
+                             })
+      .def_property_readonly("quat",
+                             [](const Dataset& d) {
+                               return PerSample(d, 4, [&d](const Sample& s, double* o) {
+                                 const Eigen::Vector4d q = MeasuredQuat(d, s);
+                                 for (int k = 0; k < 4; ++k) o[k] = q[k];
+                               });
+                             })
+      .def_property_readonly("tension_kN",
+                             [](const Dataset& d) {
+                               return PerSample(d, kNumCables, [](const Sample& s, double* o) {
+                                 for (int i = 0; i < kNumCables; ++i)
+                                   o[i] = s.tension_n[i] / kNPerKn;
+                               });
+                             })
+      .def_property_readonly("planned_rpy_deg",
+                             [](const Dataset& d) -> py::object {
+                               if (!d.has_planned_attitude) return py::none();
+                               return PerSample(d, 3, [](const Sample& s, double* o) {
+                                 for (int k = 0; k < 3; ++k) o[k] = s.planned_rpy_deg[k];
+                               });
+                             })
+      .def_property_readonly("s0_m",
+                             [](const Dataset& d) -> py::object {
+                               if (!d.has_unstretched_lengths) return py::none();
+                               return PerSample(d, kNumCables, [](const Sample& s, double* o) {
+                                 for (int i = 0; i < kNumCables; ++i)
+                                   o[i] = s.unstretched_length_m[i];
+                               });
+                             })
+      .def(
+          "save",
+          [](const Dataset& d, const std::string& path, const std::string& header_comment) {
+            std::string error;
+            if (!WriteDataset(path, d, header_comment, &error)) throw InputError(error);
+          },
+          py::arg("path"), py::arg("header_comment") = "",
+          "Writes the dataset file (atomically); read_dataset reads it back exactly.")
+      .def("__repr__", [](const Dataset& d) {
+        return "<fastcal.Dataset: " + std::to_string(d.samples.size()) + " samples from " +
+               (d.path.empty() ? std::string("memory") : d.path) + ">";
+      });
+  m.def("read_dataset", &ReadDatasetOrThrow, py::arg("path"), py::arg("skip_invalid_rows"));
+  m.def("simulate",
+        [](const CableRobot& truth, const DoubleArray& positions_m,
+           const std::string& attitude_kind, const DoubleArray& attitude, const py::dict& options) {
+          const SimulationOptions o = MakeSimulationOptions(options);
+          const std::vector<Pose> planned = PosesFromArrays(positions_m, attitude_kind, attitude);
+          Dataset data;
+          CableRobot truth_used;
+          SimulationSummary summary;
+          std::string error;
+          bool ok = false;
+          {
+            py::gil_scoped_release release;
+            ok = Simulate(truth, planned, o, &data, &truth_used, &summary, &error);
+          }
+          if (!ok) throw InputError(error);
+          return py::make_tuple(data, truth_used, SummaryDict(summary));
+        });
+}
+
+}  // namespace fastcal::python

@@ -1,0 +1,157 @@
+// fastcal.Model: the cable robot's parameters (cable_robot.h), its YAML file, and each
+// field as a number or a numpy array (per cable: shape (6,), per point: (n, 3)).
+#include <array>
+#include <string>
+
+#include "bindings.h"
+#include "fastcal/cable_robot.h"
+
+namespace fastcal::python {
+namespace {
+
+// A per-cable field of CableProperties as a (6,) array property, both ways.
+void PerCableProperty(py::class_<CableRobot>& model, const char* name,
+                      double CableProperties::*field, const char* doc) {
+  model.def_property(
+      name,
+      [field](const CableRobot& r) {
+        DoubleArray out = NewArray({kNumCables});
+        for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = r.cables[i].*field;
+        return out;
+      },
+      [field, name](CableRobot& r, const DoubleArray& values) {
+        if (values.ndim() != 1 || values.shape(0) != kNumCables) {
+          throw InputError(std::string(name) + " must have shape (6,): one value per cable");
+        }
+        for (int i = 0; i < kNumCables; ++i) r.cables[i].*field = values.data()[i];
+      },
+      doc);
+}
+
+DoubleArray Vector3(const Eigen::Vector3d& v) {
+  DoubleArray out = NewArray({3});
+  for (int k = 0; k < 3; ++k) out.mutable_data()[k] = v[k];
+  return out;
+}
+Eigen::Vector3d ToVector3(const DoubleArray& a, const char* name) {
+  if (a.ndim() != 1 || a.shape(0) != 3)
+    throw InputError(std::string(name) + " must have shape (3,)");
+  return Eigen::Vector3d(a.data()[0], a.data()[1], a.data()[2]);
+}
+
+CableRobot Load(const std::string& path) {
+  CableRobot robot;
+  std::string error;
+  if (!LoadCableRobot(path, &robot, &error)) throw InputError(error);
+  return robot;
+}
+
+}  // namespace
+
+void BindModel(py::module_& m) {
+  py::class_<CableRobot> model(m, "Model",
+                               R"(The cable robot's model parameters (docs/model-format.md).
+
+Model.nominal() is the paper's FAST; Model.load(path) reads a model file, e.g. the
+model_calibrated.yaml of a calibration. Fields are plain numbers or numpy arrays in SI
+units named with their unit; per-cable fields have shape (6,), cable i at index i-1.
+Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
+)");
+  model.def_static("nominal", &CableRobot::NominalFast, "The nominal FAST model (paper Table 1).")
+      .def_static("load", &Load, py::arg("path"),
+                  "Reads a model file. fastcal.InputError names the file, line and key.")
+      .def(
+          "save",
+          [](const CableRobot& r, const std::string& path, const std::string& header_comment) {
+            std::string error;
+            if (!SaveCableRobot(r, path, header_comment, &error)) throw InputError(error);
+          },
+          py::arg("path"), py::arg("header_comment") = "",
+          "Writes the model file (atomically: a failure leaves no partial file).")
+      .def("to_yaml", &CableRobotToYaml, py::arg("header_comment") = "", "The model file's text.")
+      .def(
+          "validate",
+          [](const CableRobot& r) {
+            std::string error;
+            if (!r.IsValid(&error)) throw InputError(error);
+          },
+          "Raises fastcal.InputError naming the key of a non-physical value.")
+      .def(
+          "copy", [](const CableRobot& r) { return CableRobot(r); }, "An independent copy.")
+      .def_readwrite("cabin_mass_kg", &CableRobot::cabin_mass_kg)
+      .def_readwrite("gravity_m_per_s2", &CableRobot::gravity_m_per_s2,
+                     "Gravitational acceleration along z (negative: z is up).")
+      .def_property(
+          "mass_centre_cabin_m", [](const CableRobot& r) { return Vector3(r.mass_centre_cabin_m); },
+          [](CableRobot& r, const DoubleArray& v) {
+            r.mass_centre_cabin_m = ToVector3(v, "mass_centre_cabin_m");
+          },
+          "Mass centre of the cabin in the cabin frame, shape (3,).")
+      .def_property(
+          "anchor_points_cabin_m",
+          [](const CableRobot& r) {
+            const auto n = static_cast<py::ssize_t>(r.anchor_points_cabin_m.size());
+            DoubleArray out = NewArray({n, 3});
+            for (py::ssize_t j = 0; j < n; ++j) {
+              for (int k = 0; k < 3; ++k)
+                out.mutable_data()[3 * j + k] = r.anchor_points_cabin_m[j][k];
+            }
+            return out;
+          },
+          [](CableRobot& r, const DoubleArray& v) {
+            CheckRows(v, 3, "anchor_points_cabin_m");
+            r.anchor_points_cabin_m.clear();
+            for (py::ssize_t j = 0; j < v.shape(0); ++j) {
+              r.anchor_points_cabin_m.emplace_back(v.data()[3 * j], v.data()[3 * j + 1],
+                                                   v.data()[3 * j + 2]);
+            }
+          },
+          "Cabin anchor points in the cabin frame, shape (n, 3).")
+      .def_property(
+          "tower_top_m",
+          [](const CableRobot& r) {
+            DoubleArray out = NewArray({kNumCables, 3});
+            for (int i = 0; i < kNumCables; ++i) {
+              for (int k = 0; k < 3; ++k)
+                out.mutable_data()[3 * i + k] = r.cables[i].tower_top_m[k];
+            }
+            return out;
+          },
+          [](CableRobot& r, const DoubleArray& v) {
+            CheckRows(v, 3, "tower_top_m");
+            if (v.shape(0) != kNumCables) throw InputError("tower_top_m must have shape (6, 3)");
+            for (int i = 0; i < kNumCables; ++i) {
+              r.cables[i].tower_top_m =
+                  Eigen::Vector3d(v.data()[3 * i], v.data()[3 * i + 1], v.data()[3 * i + 2]);
+            }
+          },
+          "Upper end of each cable (tower top), global frame, shape (6, 3).")
+      .def_property(
+          "anchor_index",
+          [](const CableRobot& r) {
+            py::array_t<int> out(kNumCables);
+            for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = r.cables[i].anchor_index;
+            return out;
+          },
+          [](CableRobot& r, const py::array_t<int, py::array::forcecast>& v) {
+            if (v.ndim() != 1 || v.shape(0) != kNumCables) {
+              throw InputError("anchor_index must have shape (6,)");
+            }
+            for (int i = 0; i < kNumCables; ++i) r.cables[i].anchor_index = v.data()[i];
+          },
+          "Index into anchor_points_cabin_m of each cable's cabin point (0-based), shape (6,).")
+      .def("__repr__", [](const CableRobot& r) {
+        return "<fastcal.Model: cabin " + std::to_string(r.cabin_mass_kg) + " kg, " +
+               std::to_string(r.anchor_points_cabin_m.size()) + " anchor points>";
+      });
+  PerCableProperty(model, "ea_n", &CableProperties::ea_n,
+                   "Axial stiffness E*A of each cable (N), shape (6,).");
+  PerCableProperty(model, "linear_density_kg_per_m", &CableProperties::linear_density_kg_per_m,
+                   "Mass per unit unstretched length of each cable, shape (6,).");
+  PerCableProperty(model, "sensor_gain", &CableProperties::sensor_gain,
+                   "Tension sensor gain per cable: reading = gain * tension + bias, shape (6,).");
+  PerCableProperty(model, "sensor_bias_n", &CableProperties::sensor_bias_n,
+                   "Tension sensor bias per cable (N), shape (6,).");
+}
+
+}  // namespace fastcal::python

@@ -1,0 +1,105 @@
+// fastcal._fastcal: the module's exceptions, shared conversions and its parts.
+#include <pybind11/pybind11.h>
+
+#include "bindings.h"
+#include "fastcal/version.h"
+
+namespace fastcal::python {
+
+void CheckRows(const DoubleArray& array, py::ssize_t columns, const char* name) {
+  if (array.ndim() != 2 || array.shape(1) != columns) {
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < array.ndim(); ++d) {
+      shape += (d ? ", " : "") + std::to_string(array.shape(d));
+    }
+    throw InputError(std::string(name) + " must have shape (n, " + std::to_string(columns) +
+                     "), got " + shape + (array.ndim() == 1 ? ",)" : ")"));
+  }
+}
+
+DoubleArray NewArray(const std::vector<py::ssize_t>& shape) {
+  DoubleArray array(shape);
+  std::fill(array.mutable_data(), array.mutable_data() + array.size(), 0.0);
+  return array;
+}
+
+std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::string& attitude_kind,
+                                  const DoubleArray& attitude) {
+  CheckRows(positions_m, 3, "position_m");
+  const py::ssize_t n = positions_m.shape(0);
+  const py::ssize_t columns = attitude_kind == "rpy" ? 3 : attitude_kind == "quat" ? 4 : 0;
+  const char* name = attitude_kind == "rpy" ? "rpy_deg" : "quat";
+  if (columns > 0) {
+    CheckRows(attitude, columns, name);
+    if (attitude.shape(0) != n) {
+      throw InputError(std::string(name) + " has " + std::to_string(attitude.shape(0)) +
+                       " rows for " + std::to_string(n) + " positions");
+    }
+  } else if (attitude_kind != "none") {
+    throw InputError("attitude kind must be none, rpy or quat, got '" + attitude_kind + "'");
+  }
+  std::vector<Pose> poses(static_cast<size_t>(n));
+  const double* p = positions_m.data();
+  const double* a = columns > 0 ? attitude.data() : nullptr;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    Pose& pose = poses[static_cast<size_t>(i)];
+    pose.position_m = Eigen::Vector3d(p[3 * i], p[3 * i + 1], p[3 * i + 2]);
+    if (columns == 3) {
+      pose.rotation = RotationFromRpyDeg(a[3 * i], a[3 * i + 1], a[3 * i + 2]);
+    } else if (columns == 4) {
+      std::string error;
+      if (!RotationFromQuaternion(a[4 * i], a[4 * i + 1], a[4 * i + 2], a[4 * i + 3],
+                                  &pose.rotation, &error)) {
+        throw InputError("quat[" + std::to_string(i) + "]: " + error);
+      }
+    }
+  }
+  return poses;
+}
+
+namespace {
+
+// fastcal.Error and its two kinds; each also derives from the built-in exception a Python
+// user would catch for it.
+void RegisterExceptions(py::module_& m) {
+  static PyObject* error = PyErr_NewExceptionWithDoc(
+      "fastcal.Error", "Base class of the errors fastcal raises.", PyExc_Exception, nullptr);
+  static PyObject* input_error = PyErr_NewExceptionWithDoc(
+      "fastcal.InputError",
+      "Bad input: a file, a spec or an argument. The message names the file, line, column\n"
+      "or parameter, as the command line's does (its exit code 2).",
+      py::make_tuple(py::handle(error), py::handle(PyExc_ValueError)).release().ptr(), nullptr);
+  static PyObject* calibration_error = PyErr_NewExceptionWithDoc(
+      "fastcal.CalibrationError",
+      "A calibration refused or failed (the command line's exit code 1). `status` says\n"
+      "which: 'undetermined', 'infeasible', 'solver failed' or 'mostly gross errors'.",
+      py::make_tuple(py::handle(error), py::handle(PyExc_RuntimeError)).release().ptr(), nullptr);
+  m.attr("Error") = py::handle(error);
+  m.attr("InputError") = py::handle(input_error);
+  m.attr("CalibrationError") = py::handle(calibration_error);
+  py::register_exception_translator([](std::exception_ptr thrown) {
+    try {
+      if (thrown) std::rethrow_exception(thrown);
+    } catch (const InputError& e) {
+      PyErr_SetString(input_error, e.what());
+    } catch (const CalibrationError& e) {
+      py::object instance = py::handle(calibration_error)(e.what());
+      instance.attr("status") = e.status;
+      PyErr_SetObject(calibration_error, instance.ptr());
+    }
+  });
+}
+
+}  // namespace
+}  // namespace fastcal::python
+
+PYBIND11_MODULE(_fastcal, m) {
+  using namespace fastcal::python;
+  m.doc() = "fastcal's C++ core; use the package fastcal, which documents it.";
+  m.attr("__version__") = FASTCAL_VERSION;
+  RegisterExceptions(m);
+  BindModel(m);
+  BindStatics(m);
+  BindData(m);
+  BindCalibration(m);
+}

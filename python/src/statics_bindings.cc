@@ -1,0 +1,210 @@
+// Statics of many poses in one call (the loop in C++, without the GIL), the trajectory
+// generators and the focal attitude law (statics.h, trajectory.h, pose.h).
+#include <string>
+#include <vector>
+
+#include "bindings.h"
+#include "fastcal/cable_robot.h"
+#include "fastcal/statics.h"
+#include "fastcal/trajectory.h"
+
+namespace fastcal::python {
+namespace {
+
+StaticsOptions MakeStaticsOptions(const std::string& method, bool warm_start, int refinement_steps,
+                                  double exact_relative_tolerance, double max_strain,
+                                  double max_length_ratio) {
+  StaticsOptions options;
+  if (!ParseStaticsMethod(method, &options.method)) {
+    throw InputError("method must be 'aas', 'aas-refined' or 'exact', got '" + method + "'");
+  }
+  options.warm_start = warm_start;
+  options.refinement_steps = refinement_steps;
+  options.exact_relative_tolerance = exact_relative_tolerance;
+  options.max_strain = max_strain;
+  options.max_length_ratio = max_length_ratio;
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  return options;
+}
+
+// Per-pose outputs, written straight into the arrays numpy will own.
+struct SolveOutputs {
+  DoubleArray lower_kn, upper_kn, s0_m, force_kn, chord_m;
+  py::array_t<int> status, cable;
+  py::dict failures;  // pose index -> DescribeStatus, for the failed poses only
+};
+
+py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
+               const std::string& attitude_kind, const DoubleArray& attitude,
+               const std::string& method, bool warm_start, int refinement_steps,
+               double exact_relative_tolerance, double max_strain, double max_length_ratio) {
+  const StaticsOptions options = MakeStaticsOptions(
+      method, warm_start, refinement_steps, exact_relative_tolerance, max_strain, max_length_ratio);
+  const std::vector<Pose> poses = PosesFromArrays(positions_m, attitude_kind, attitude);
+  const auto n = static_cast<py::ssize_t>(poses.size());
+  // Every element is written below: no zero-filling.
+  using Shape = std::vector<py::ssize_t>;
+  SolveOutputs out{DoubleArray(Shape{n, kNumCables}),
+                   DoubleArray(Shape{n, kNumCables}),
+                   DoubleArray(Shape{n, kNumCables}),
+                   DoubleArray(Shape{n, kNumCables, 3}),
+                   DoubleArray(Shape{n, kNumCables}),
+                   py::array_t<int>(n),
+                   py::array_t<int>(n),
+                   py::dict()};
+  double* lower = out.lower_kn.mutable_data();
+  double* upper = out.upper_kn.mutable_data();
+  double* s0 = out.s0_m.mutable_data();
+  double* force = out.force_kn.mutable_data();
+  double* chord = out.chord_m.mutable_data();
+  int* status = out.status.mutable_data();
+  int* cable = out.cable.mutable_data();
+  std::vector<std::pair<py::ssize_t, std::string>> failed;
+  {
+    py::gil_scoped_release release;
+    StaticsSolution solution;  // reused: no allocation per pose, and the warm start's source
+    for (py::ssize_t k = 0; k < n; ++k) {
+      const StaticsStatus s =
+          SolveStatics(robot, poses[static_cast<size_t>(k)], options, &solution);
+      status[k] = static_cast<int>(s);
+      cable[k] = solution.cable;
+      if (s != StaticsStatus::kOk) failed.emplace_back(k, DescribeStatus(solution));
+      for (int i = 0; i < kNumCables; ++i) {
+        const CableSolution& c = solution.cables[i];
+        const py::ssize_t at = k * kNumCables + i;
+        lower[at] = c.lower_tension_n / kNPerKn;
+        upper[at] = c.upper_tension_n / kNPerKn;
+        s0[at] = c.unstretched_length_m;
+        chord[at] = c.chord_length_m;
+        for (int d = 0; d < 3; ++d) force[3 * at + d] = c.force_n[d] / kNPerKn;
+      }
+    }
+  }
+  for (const auto& [k, text] : failed) out.failures[py::int_(k)] = text;
+  py::dict result;
+  result["lower_tension_kN"] = out.lower_kn;
+  result["upper_tension_kN"] = out.upper_kn;
+  result["s0_m"] = out.s0_m;
+  result["force_kN"] = out.force_kn;
+  result["chord_m"] = out.chord_m;
+  result["status_code"] = out.status;
+  result["cable"] = out.cable;
+  result["failures"] = out.failures;
+  return result;
+}
+
+DoubleArray PositionsArray(const std::vector<Eigen::Vector3d>& positions) {
+  DoubleArray out = NewArray({static_cast<py::ssize_t>(positions.size()), 3});
+  for (size_t j = 0; j < positions.size(); ++j) {
+    for (int k = 0; k < 3; ++k) out.mutable_data()[3 * j + k] = positions[j][k];
+  }
+  return out;
+}
+
+Eigen::Vector3d Point(const DoubleArray& a, const char* name) {
+  if (a.ndim() != 1 || a.shape(0) != 3)
+    throw InputError(std::string(name) + " must have shape (3,)");
+  return Eigen::Vector3d(a.data()[0], a.data()[1], a.data()[2]);
+}
+
+// The generator's positions, or InputError with its message (it names the parameter).
+template <typename Generate>
+DoubleArray Generated(Generate generate) {
+  std::vector<Eigen::Vector3d> positions;
+  std::string error;
+  if (!generate(&positions, &error)) throw InputError(error);
+  return PositionsArray(positions);
+}
+
+// The poses' attitudes as quaternions (w, x, y, z; w >= 0), shape (n, 4).
+DoubleArray QuaternionsOf(const std::vector<Pose>& poses) {
+  DoubleArray quat = NewArray({static_cast<py::ssize_t>(poses.size()), 4});
+  for (size_t j = 0; j < poses.size(); ++j) {
+    const Eigen::Vector4d q = QuaternionFromRotation(poses[j].rotation);
+    for (int k = 0; k < 4; ++k) quat.mutable_data()[4 * j + k] = q[k];
+  }
+  return quat;
+}
+
+}  // namespace
+
+void BindStatics(py::module_& m) {
+  m.def("statics_status_names", [] {
+    py::list names;
+    for (int s = 0; s <= static_cast<int>(StaticsStatus::kOverstretchedCable); ++s) {
+      names.append(StaticsStatusName(static_cast<StaticsStatus>(s)));
+    }
+    return names;
+  });
+  m.def("solve", &Solve, py::arg("model"), py::arg("position_m"), py::arg("attitude_kind"),
+        py::arg("attitude"), py::arg("method"), py::arg("warm_start"), py::arg("refinement_steps"),
+        py::arg("exact_relative_tolerance"), py::arg("max_strain"), py::arg("max_length_ratio"));
+  m.def("line", [](const DoubleArray& from_m, const DoubleArray& to_m, int nodes) {
+    return Generated([&](std::vector<Eigen::Vector3d>* p, std::string* e) {
+      return LinePositions(Point(from_m, "from_m"), Point(to_m, "to_m"), nodes, p, e);
+    });
+  });
+  m.def("arc", [](const DoubleArray& centre_m, double radius_m, double start_deg, double end_deg,
+                  int nodes) {
+    ArcSpec spec;
+    spec.centre_m = Point(centre_m, "centre_m");
+    spec.radius_m = radius_m;
+    spec.start_deg = start_deg;
+    spec.end_deg = end_deg;
+    spec.nodes = nodes;
+    return Generated([&](auto* p, auto* e) { return ArcPositions(spec, p, e); });
+  });
+  m.def("focal_grid", [](double max_off_axis_deg, double off_axis_step_deg, double azimuth_step_deg,
+                         const DoubleArray& focal_centre_m, double focal_radius_m) {
+    FocalGridSpec spec;
+    spec.max_off_axis_deg = max_off_axis_deg;
+    spec.off_axis_step_deg = off_axis_step_deg;
+    spec.azimuth_step_deg = azimuth_step_deg;
+    spec.focal_centre_m = Point(focal_centre_m, "focal_centre_m");
+    spec.focal_radius_m = focal_radius_m;
+    return Generated([&](auto* p, auto* e) { return FocalSpherePositions(spec, p, e); });
+  });
+  m.def("random_workspace",
+        [](int samples, double max_off_axis_deg, double radial_spread_m, std::uint64_t seed,
+           const DoubleArray& focal_centre_m, double focal_radius_m) {
+          RandomWorkspaceSpec spec;
+          spec.samples = samples;
+          spec.max_off_axis_deg = max_off_axis_deg;
+          spec.radial_spread_m = radial_spread_m;
+          spec.seed = seed;
+          spec.sphere.focal_centre_m = Point(focal_centre_m, "focal_centre_m");
+          spec.sphere.focal_radius_m = focal_radius_m;
+          return Generated([&](auto* p, auto* e) { return RandomWorkspacePositions(spec, p, e); });
+        });
+  m.def("focal_attitude", [](const DoubleArray& positions_m, double tilt_fraction,
+                             const DoubleArray& focal_centre_m) {
+    const std::vector<Pose> at = PosesFromArrays(positions_m, "none", positions_m);
+    std::vector<Eigen::Vector3d> positions;
+    for (const Pose& p : at) positions.push_back(p.position_m);
+    FocalAttitudeLaw law;
+    law.tilt_fraction = tilt_fraction;
+    law.focal_centre_m = Point(focal_centre_m, "focal_centre_m");
+    std::vector<Pose> poses;
+    std::string error;
+    if (!PosesWithAttitudeLaw(positions, law, &poses, &error)) throw InputError(error);
+    return QuaternionsOf(poses);
+  });
+  m.def("rpy_deg_from_quat", [](const DoubleArray& quat) {
+    const std::vector<Pose> poses =
+        PosesFromArrays(NewArray({quat.ndim() == 2 ? quat.shape(0) : 0, 3}), "quat", quat);
+    DoubleArray rpy = NewArray({static_cast<py::ssize_t>(poses.size()), 3});
+    for (size_t j = 0; j < poses.size(); ++j) {
+      const Eigen::Vector3d a = RpyDegFromRotation(poses[j].rotation);
+      for (int k = 0; k < 3; ++k) rpy.mutable_data()[3 * j + k] = a[k];
+    }
+    return rpy;
+  });
+  m.def("quat_from_rpy_deg", [](const DoubleArray& rpy_deg) {
+    const std::vector<Pose> poses =
+        PosesFromArrays(NewArray({rpy_deg.ndim() == 2 ? rpy_deg.shape(0) : 0, 3}), "rpy", rpy_deg);
+    return QuaternionsOf(poses);
+  });
+}
+
+}  // namespace fastcal::python

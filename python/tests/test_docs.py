@@ -1,0 +1,37 @@
+"""docs/python.md's worked example runs as written."""
+
+from __future__ import annotations
+
+import importlib.util
+import os
+import pathlib
+import re
+from typing import Dict
+
+import pytest
+
+
+def example_blocks(source_dir: pathlib.Path) -> Dict[str, str]:
+    """The fenced Python blocks after "<!-- example -->" / "<!-- example: NAME -->"."""
+    text = (source_dir / "docs" / "python.md").read_text()
+    blocks = re.findall(r"<!-- example(?:: (\w+))? -->\n```python\n(.*?)```", text, re.S)
+    return {name or "main": code for name, code in blocks}
+
+
+def test_worked_example(
+    source_dir: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    blocks = example_blocks(source_dir)
+    assert set(blocks) == {"main", "plot"}
+    # Run where the example expects to be: beside calibration_data/.
+    (tmp_path / "calibration_data").symlink_to(source_dir / "calibration_data")
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(blocks["main"], "docs/python.md (example)", "exec"), namespace)
+    assert namespace["result"].verdict == "ok"
+    assert namespace["predicted_kN"].shape == (360, 6)
+    if importlib.util.find_spec("matplotlib") is None:
+        pytest.skip("matplotlib (python3-matplotlib) is missing: the example ran, its plot did not")
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    exec(compile(blocks["plot"], "docs/python.md (plot)", "exec"), namespace)
+    assert (tmp_path / "tensions.png").stat().st_size > 0

@@ -1,0 +1,112 @@
+# Installs the build tree into a fresh prefix and builds the README's consumer example
+# against it, as a user of the installed package would: the README's main.cc and
+# CMakeLists.txt (the fenced blocks after "<!-- consumer: NAME -->"), find_package(fastcal
+# 0.2 CONFIG REQUIRED) with CMAKE_PREFIX_PATH set to the prefix only. Then runs the
+# program, the installed fastcal executable and (-DPYTHON=... -DPYTHON_DIR=...) the
+# installed Python module.
+#
+#   cmake -DSOURCE_DIR=... -DBUILD_DIR=... -DWORK_DIR=... [-DGENERATOR=...]
+#         -P install_consumer_test.cmake
+cmake_minimum_required(VERSION 3.18)
+
+function(run)
+  cmake_parse_arguments(RUN "" "WORKING_DIRECTORY;OUTPUT" "COMMAND" ${ARGN})
+  if(NOT RUN_WORKING_DIRECTORY)
+    set(RUN_WORKING_DIRECTORY ${WORK_DIR})
+  endif()
+  execute_process(COMMAND ${RUN_COMMAND} WORKING_DIRECTORY ${RUN_WORKING_DIRECTORY}
+    RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE out)
+  if(NOT code EQUAL 0)
+    string(REPLACE ";" " " shown "${RUN_COMMAND}")
+    message(FATAL_ERROR "failed (${code}): ${shown}\n${out}")
+  endif()
+  if(RUN_OUTPUT)
+    set(${RUN_OUTPUT} "${out}" PARENT_SCOPE)
+  endif()
+endfunction()
+
+# The fenced block that follows "<!-- consumer: NAME -->" in the README.
+function(readme_block readme name result)
+  string(FIND "${readme}" "<!-- consumer: ${name} -->" at)
+  if(at EQUAL -1)
+    message(FATAL_ERROR "README.md has no block marked <!-- consumer: ${name} -->")
+  endif()
+  string(SUBSTRING "${readme}" ${at} -1 rest)
+  string(REGEX MATCH "```[a-z]*\n(.*)" ignored "${rest}")
+  set(rest "${CMAKE_MATCH_1}")
+  string(FIND "${rest}" "```" end)
+  string(SUBSTRING "${rest}" 0 ${end} block)
+  set(${result} "${block}" PARENT_SCOPE)
+endfunction()
+
+set(prefix ${WORK_DIR}/prefix)
+set(consumer ${WORK_DIR}/consumer)
+file(REMOVE_RECURSE ${WORK_DIR})
+file(MAKE_DIRECTORY ${consumer})
+
+run(COMMAND ${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
+foreach(f lib/cmake/fastcal/fastcalConfig.cmake lib/cmake/fastcal/fastcalConfigVersion.cmake
+    include/fastcal/statics.h include/fastcal/version.h include/fastcal/internal/statics_core.h)
+  if(NOT EXISTS ${prefix}/${f})
+    message(FATAL_ERROR "not installed: ${f}")
+  endif()
+endforeach()
+
+file(READ ${SOURCE_DIR}/README.md readme)
+foreach(name main.cc CMakeLists.txt)
+  readme_block("${readme}" ${name} block)
+  file(WRITE ${consumer}/${name} "${block}")
+endforeach()
+
+set(generator_args)
+if(GENERATOR)
+  set(generator_args -G ${GENERATOR})
+endif()
+run(COMMAND ${CMAKE_COMMAND} -S ${consumer} -B ${consumer}/build ${generator_args}
+  -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
+run(COMMAND ${CMAKE_COMMAND} --build ${consumer}/build)
+
+# The example with the bundled nominal model: six tensions, and the version it was built
+# against.
+run(COMMAND ${consumer}/build/app ${SOURCE_DIR}/calibration_data/nominal_fast.yaml OUTPUT out)
+file(READ ${SOURCE_DIR}/CMakeLists.txt top)
+string(REGEX MATCH "project\\(fastcal VERSION ([0-9.]+)" ignored "${top}")
+set(version ${CMAKE_MATCH_1})
+if(NOT out MATCHES "^fastcal ${version}, exact statics\nT1 = [0-9]+\\.[0-9]+ kN\n.*T6 = ")
+  message(FATAL_ERROR "unexpected output of the consumer example:\n${out}")
+endif()
+message(STATUS "consumer example:\n${out}")
+
+# A bad model file: the library's message naming the file, and exit code 2.
+execute_process(COMMAND ${consumer}/build/app ${WORK_DIR}/absent.yaml
+  RESULT_VARIABLE code ERROR_VARIABLE err)
+if(NOT code EQUAL 2 OR NOT err MATCHES "absent.yaml")
+  message(FATAL_ERROR "a missing model file gave exit ${code}: ${err}")
+endif()
+
+if(EXISTS ${prefix}/bin/fastcal)
+  run(COMMAND ${prefix}/bin/fastcal --version OUTPUT out)
+  if(NOT out STREQUAL "fastcal ${version}\n")
+    message(FATAL_ERROR "installed fastcal --version: ${out}")
+  endif()
+endif()
+# The installed Python module, imported from elsewhere than the build tree, with its
+# documentation.
+if(PYTHON)
+  set(ENV{PYTHONPATH} ${prefix}/${PYTHON_DIR})
+  file(WRITE ${consumer}/import_fastcal.py [[
+import pydoc
+import sys
+
+import fastcal
+
+assert fastcal.__file__.startswith(sys.argv[1]), fastcal.__file__
+assert "position_m" in pydoc.render_doc(fastcal.solve)
+print(fastcal.__version__)
+]])
+  run(COMMAND ${PYTHON} import_fastcal.py ${prefix}/ WORKING_DIRECTORY ${consumer} OUTPUT out)
+  if(NOT out STREQUAL "${version}\n")
+    message(FATAL_ERROR "installed fastcal.__version__: ${out}")
+  endif()
+endif()
+file(REMOVE_RECURSE ${WORK_DIR})
