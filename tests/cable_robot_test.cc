@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -16,7 +17,10 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "bounded_process.h"
 
 namespace fastcal {
 namespace {
@@ -416,6 +420,35 @@ TEST(CableRobotYaml, SyntaxErrorNamesLine) {
   EXPECT_LE(line, 4) << error;
   const std::string error2 = ParseError("cabin:\n  mass_kg: 1\n mass_centre_m: [0, 0, 1]\n");
   EXPECT_EQ(error2.rfind("m.yaml:3: YAML syntax error", 0), 0u) << error2;
+}
+
+// yaml-cpp 0.7's LoadAll never returns on a stream it cannot advance through (a stray
+// top-level comma) and grows past 1 GB in 15 s; the reader must refuse it at once.
+TEST(CableRobotYaml, StrayTopLevelCommaIsASyntaxErrorNotAHang) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {",", "m.yaml:1: YAML syntax error: unexpected ',' at column 1"},
+      {"{format: fastcal-model-1, gravity_m_per_s2: -9.8},",
+       "m.yaml:1: YAML syntax error: unexpected ',' at column 50"},
+      {"{a: 1}, {b: 2}", "m.yaml:1: YAML syntax error: unexpected ',' at column 7"},
+      {"{cabin: {mass_kg: 1}}\n,\n", "m.yaml:2: YAML syntax error: unexpected ',' at column 1"}};
+  for (const auto& [text, expected] : cases) {
+    EXPECT_EXIT(
+        {
+          test::LimitThisProcess();
+          CableRobot robot;
+          std::string error;
+          const bool ok = ParseCableRobotYaml(text, "m.yaml", &robot, &error);
+          std::fprintf(stderr, "%s\n", error.c_str());
+          std::exit(ok ? 1 : 0);
+        },
+        ::testing::ExitedWithCode(0), expected)
+        << text;
+  }
+}
+
+TEST(CableRobotYaml, SecondDocumentIsAnErrorOnItsLine) {
+  const std::string error = ParseError("gravity_m_per_s2: -9.8\n---\ngravity_m_per_s2: -9.8\n");
+  EXPECT_EQ(error, "m.yaml:3: (top level): only one YAML document is allowed");
 }
 
 TEST(CableRobotYaml, FailedParseLeavesRobotUntouched) {

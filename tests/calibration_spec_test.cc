@@ -6,11 +6,15 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <utility>
 #include <vector>
+
+#include "bounded_process.h"
 
 namespace fastcal {
 namespace {
@@ -116,6 +120,28 @@ parameters:
     - {x: {free: true}, y: {free: false}}
     - {}
 )";
+
+// yaml-cpp 0.7's LoadAll never returns on a stray top-level comma (and grows without
+// bound): the spec reader must refuse it at once, naming line and column.
+TEST(CalibrationSpecTest, StrayTopLevelCommaIsASyntaxErrorNotAHang) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {",", "s.yaml:1: YAML syntax error: unexpected ',' at column 1"},
+      {"{format: fastcal-calibration-spec-1},", "s.yaml:1: YAML syntax error: unexpected ','"},
+      {"{a: 1}, {b: 2}", "s.yaml:1: YAML syntax error: unexpected ',' at column 7"}};
+  for (const auto& [text, expected] : cases) {
+    EXPECT_EXIT(
+        {
+          test::LimitThisProcess();
+          CalibrationSpec spec;
+          std::string error;
+          const bool ok = ParseCalibrationSpecYaml(text, "s.yaml", 3, &spec, &error);
+          std::fprintf(stderr, "%s\n", error.c_str());
+          std::exit(ok ? 1 : 0);
+        },
+        ::testing::ExitedWithCode(0), expected)
+        << text;
+  }
+}
 
 TEST(CalibrationSpecTest, EmptySpecHasTheDefaults) {
   const CalibrationSpec defaults;

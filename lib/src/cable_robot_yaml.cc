@@ -26,6 +26,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/atomic_file.h"
+#include "yaml_document.h"
 
 namespace fastcal {
 namespace {
@@ -342,13 +343,13 @@ bool ParseCableRobotYaml(const std::string& text, const std::string& source_name
   Parser parser(source_name);
   CableRobot parsed = CableRobot::NominalFast();
   try {
-    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
-    if (documents.size() > 1) {
-      parser.Fail(documents[1], kRootPath, "only one YAML document is allowed");
-    } else if (documents.empty() || documents[0].IsNull()) {
+    const internal::YamlDocuments documents = internal::LoadYamlDocuments(text);
+    if (documents.count > 1) {
+      parser.Fail(documents.second_line, kRootPath, "only one YAML document is allowed");
+    } else if (documents.first.IsNull()) {
       // Most likely a truncated or wrong file: the nominal model is had without one.
       parser.FailFile("empty model file: omit the model file for the nominal FAST layout");
-    } else if (parser.ReadRoot(documents[0], &parsed)) {
+    } else if (parser.ReadRoot(documents.first, &parsed)) {
       std::string why;
       if (!parsed.IsValid(&why)) parser.FailValidation(why);
     }

@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "fastcal/internal/atomic_file.h"
+#include "yaml_document.h"
 
 namespace fastcal {
 namespace {
@@ -905,11 +906,11 @@ bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source
   Reader reader(source_name, num_anchor_points);
   CalibrationSpec parsed;
   try {
-    const std::vector<YAML::Node> documents = YAML::LoadAll(text);
-    if (documents.size() > 1) {
-      reader.Fail(LineOf(documents[1]), kRootPath, "only one YAML document is allowed");
-    } else if (documents.empty() || documents[0].IsNull() ||  // empty file: all defaults
-               reader.ReadRoot(documents[0], &parsed)) {
+    const internal::YamlDocuments documents = internal::LoadYamlDocuments(text);
+    if (documents.count > 1) {
+      reader.Fail(documents.second_line, kRootPath, "only one YAML document is allowed");
+    } else if (documents.first.IsNull() ||  // empty file: all defaults
+               reader.ReadRoot(documents.first, &parsed)) {
       // The reader checked every value where it read it; this only guards the two
       // against drifting apart.
       std::string why;

@@ -1,0 +1,37 @@
+// The one YAML document of a model or spec file, read without yaml-cpp 0.7's hang.
+//
+// YAML::LoadAll in yaml-cpp 0.7 (Debian 12) never returns, and grows without bound, on a
+// stream the parser cannot advance through, e.g. a lone "," or "{a: 1}, {b: 2}": each
+// call of Parser::HandleNextDocument reports an empty document without consuming the
+// offending token, and LoadAll calls it again (upstream issue #1040, fixed by pull
+// request #1319 after 0.7). LoadYamlDocuments asks the parser for at most three
+// documents, notices a document that starts where the previous one started (the parser
+// made no progress) and reports the token there as a syntax error. Private to the
+// library: the header needs yaml-cpp, which is a private dependency.
+#ifndef FASTCAL_SRC_YAML_DOCUMENT_H_
+#define FASTCAL_SRC_YAML_DOCUMENT_H_
+
+#include <yaml-cpp/yaml.h>
+
+#include <string>
+
+namespace fastcal::internal {
+
+struct YamlDocuments {
+  // The first document (Null when the text has none: empty, or only comments).
+  YAML::Node first;
+  // 0, 1, or 2 meaning two or more.
+  int count = 0;
+  // 1-based line where the second document starts (when count == 2).
+  int second_line = 0;
+};
+
+// Reads `text`, as YAML::LoadAll would, but returns in bounded time and memory on any
+// input. Throws YAML::Exception (with the mark of the problem) on a syntax error,
+// including the text yaml-cpp 0.7 would loop on: "unexpected ',' after the end of the
+// document" at its line and column.
+YamlDocuments LoadYamlDocuments(const std::string& text);
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_SRC_YAML_DOCUMENT_H_
