@@ -465,7 +465,7 @@ TEST(CableRobotYaml, MissingFileCannotOpen) {
   CableRobot robot;
   std::string error;
   EXPECT_FALSE(LoadCableRobot(path, &robot, &error));
-  EXPECT_EQ(error, path + ": cannot open");
+  EXPECT_EQ(error, path + ": cannot open: No such file or directory");
 }
 
 TEST(CableRobotYaml, LoadReportsTheFileName) {

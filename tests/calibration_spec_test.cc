@@ -630,7 +630,7 @@ TEST(CalibrationSpecTest, MissingFileIsReported) {
   CalibrationSpec spec;
   std::string error;
   EXPECT_FALSE(LoadCalibrationSpec(path, kNumAnchors, &spec, &error));
-  EXPECT_EQ(error, path + ": cannot open");
+  EXPECT_EQ(error, path + ": cannot open: No such file or directory");
 }
 
 TEST(CalibrationSpecTest, LoadedFileErrorsNameThePath) {

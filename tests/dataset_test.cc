@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/stat.h>
 
 #include <Eigen/Geometry>
 #include <cmath>
@@ -17,6 +18,7 @@
 #include <string>
 #include <vector>
 
+#include "bounded_process.h"
 #include "fastcal/internal/number_text.h"
 
 namespace fastcal {
@@ -553,6 +555,49 @@ TEST_F(DatasetTest, ReadMissingFileFails) {
   std::string error;
   EXPECT_FALSE(ReadDataset(path, DatasetReadOptions(), &dataset, &error));
   EXPECT_TRUE(Contains(error, path + ": cannot open"));
+}
+
+// /dev/zero (any endless or huge non-regular file) was read until memory ran out: now it
+// is refused before reading. Run in a bounded child so that without the check the test
+// fails within seconds instead of taking the machine's memory.
+TEST_F(DatasetTest, NonRegularFilesAreRefusedBeforeReading) {
+  EXPECT_EXIT(
+      {
+        test::LimitThisProcess();
+        Dataset dataset;
+        std::string error;
+        const bool ok = ReadDataset("/dev/zero", DatasetReadOptions(), &dataset, &error);
+        std::fprintf(stderr, "%s\n", error.c_str());
+        std::exit(ok ? 1 : 0);
+      },
+      ::testing::ExitedWithCode(0),
+      "/dev/zero: not a regular file \\(a device, pipe or socket\\): a dataset file must be "
+      "a regular file");
+  // A pipe is refused without waiting for a writer.
+  const std::string fifo = PathOf("fifo.csv");
+  ASSERT_EQ(mkfifo(fifo.c_str(), 0600), 0);
+  Dataset dataset;
+  std::string error;
+  EXPECT_FALSE(ReadDataset(fifo, DatasetReadOptions(), &dataset, &error));
+  EXPECT_TRUE(Contains(error, fifo + ": not a regular file"));
+  EXPECT_FALSE(ReadDataset(dir_.string(), DatasetReadOptions(), &dataset, &error));
+  EXPECT_TRUE(Contains(error, dir_.string() + ": is a directory, not a dataset file"));
+}
+
+TEST_F(DatasetTest, FilesAboveTheSizeLimitAreRefusedBeforeReading) {
+  const std::string text = std::string(kHeader) + kRow + kRow;
+  WriteText("data.csv", text);
+  DatasetReadOptions options;
+  options.max_file_bytes = 100;
+  Dataset dataset;
+  std::string error;
+  EXPECT_FALSE(ReadDataset(PathOf("data.csv"), options, &dataset, &error));
+  EXPECT_EQ(error, PathOf("data.csv") + ": " + std::to_string(text.size()) +
+                       " bytes is larger than the limit for a dataset file, 100 bytes "
+                       "(docs/data-format.md, \"Limits\")");
+  options.max_file_bytes = static_cast<long long>(text.size());
+  EXPECT_TRUE(ReadDataset(PathOf("data.csv"), options, &dataset, &error)) << error;
+  EXPECT_EQ(DatasetReadOptions().max_file_bytes, 1LL << 30);  // as documented
 }
 
 // The readers' number parser accepts what strtod accepts in the "C" locale (the program

@@ -491,7 +491,7 @@ TEST(ReadPosesCsv, BadFilesReportFileLineAndColumn) {
   ExpectCsvError("trajectory_test_empty.csv", "", ": no header line");
   ExpectCsvError("trajectory_test_comments_only.csv", "# nothing\n\n", ": no header line");
   ExpectCsvError("trajectory_test_header_only.csv", "x_m,y_m,z_m\n# no rows\n", ": no data rows");
-  ExpectCsvError("trajectory_test_does_not_exist_dir/poses.csv", "", ": cannot open file");
+  ExpectCsvError("trajectory_test_does_not_exist_dir/poses.csv", "", ": cannot open: No such file or directory");
 }
 
 // A misspelt attitude column must not silently give R = I: every column is either used,

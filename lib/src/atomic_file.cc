@@ -2,15 +2,15 @@
 #include "fastcal/internal/atomic_file.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
+
+#include "fastcal/internal/quote.h"
 
 namespace fastcal::internal {
 
@@ -52,27 +52,62 @@ bool WriteFileAtomically(const std::string& path, const std::string& content, st
   return true;
 }
 
-bool ReadTextFile(const std::string& path, std::string* text, std::string* error) {
-  std::string ignored;
-  if (error == nullptr) error = &ignored;
-  try {
-    std::error_code ec;
-    std::ifstream in(path, std::ios::binary);
-    if (!in || std::filesystem::is_directory(path, ec)) {
-      *error = path + ": cannot open";
-      return false;
-    }
-    std::ostringstream contents;
-    contents << in.rdbuf();
-    if (in.bad()) {
-      *error = path + ": cannot read";
-      return false;
-    }
-    *text = contents.str();
-  } catch (const std::exception& e) {
-    *error = path + ": cannot read: " + e.what();
+namespace {
+
+// "1 GiB", "16 MiB", "100 bytes": a limit as docs/data-format.md states it.
+std::string ByteCount(long long bytes) {
+  const char* units[] = {"bytes", "KiB", "MiB", "GiB", "TiB"};
+  int unit = 0;
+  long long whole = bytes;
+  while (unit < 4 && whole >= 1024 && whole % 1024 == 0) {
+    whole /= 1024;
+    ++unit;
+  }
+  return std::to_string(whole) + " " + units[unit];
+}
+
+}  // namespace
+
+bool ReadRegularFile(const std::string& path, long long max_bytes, const std::string& what,
+                     std::string* text, std::string* error) {
+  const std::string name = Escape(path);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    *error = name + ": cannot open: " + std::strerror(errno);
     return false;
   }
+  struct stat st {};
+  const auto fail = [&](const std::string& why) {
+    ::close(fd);
+    *error = name + ": " + why;
+    return false;
+  };
+  if (::fstat(fd, &st) != 0) return fail(std::string("cannot read: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) return fail("is a directory, not a " + what + " file");
+  if (!S_ISREG(st.st_mode)) {
+    return fail("not a regular file (a device, pipe or socket): a " + what +
+                " file must be a regular file");
+  }
+  const std::string too_large = "larger than the limit for a " + what + " file, " +
+                                ByteCount(max_bytes) + " (docs/data-format.md, \"Limits\")";
+  if (st.st_size > max_bytes) {
+    return fail(std::to_string(static_cast<long long>(st.st_size)) + " bytes is " + too_large);
+  }
+  std::string contents;
+  contents.reserve(static_cast<size_t>(st.st_size));
+  char buffer[1 << 16];
+  while (true) {
+    const ssize_t n = ::read(fd, buffer, sizeof(buffer));
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return fail(std::string("cannot read: ") + std::strerror(errno));
+    if (n == 0) break;
+    if (static_cast<long long>(contents.size()) + n > max_bytes) {
+      return fail("grew while being read: " + too_large);
+    }
+    contents.append(buffer, static_cast<size_t>(n));
+  }
+  ::close(fd);
+  *text = std::move(contents);
   return true;
 }
 

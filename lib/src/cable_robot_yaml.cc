@@ -367,7 +367,11 @@ bool ParseCableRobotYaml(const std::string& text, const std::string& source_name
 
 bool LoadCableRobot(const std::string& path, CableRobot* robot, std::string* error) {
   std::string text;
-  if (!internal::ReadTextFile(path, &text, error)) return false;
+  std::string message;
+  if (!internal::ReadRegularFile(path, kMaxModelFileBytes, "model", &text, &message)) {
+    if (error != nullptr) *error = message;
+    return false;
+  }
   return ParseCableRobotYaml(text, path, robot, error);
 }
 

@@ -932,7 +932,11 @@ bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source
 bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
                          std::string* error) {
   std::string text;
-  if (!internal::ReadTextFile(path, &text, error)) return false;
+  std::string message;
+  if (!internal::ReadRegularFile(path, kMaxSpecFileBytes, "calibration spec", &text, &message)) {
+    if (error != nullptr) *error = message;
+    return false;
+  }
   return ParseCalibrationSpecYaml(text, path, num_anchor_points, spec, error);
 }
 

@@ -551,8 +551,7 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   std::string message;
   bool ok = false;
   try {
-    ok = internal::ReadFileChunks(
-        path, [&text](const char* data, size_t size) { text.append(data, size); }, &message);
+    ok = internal::ReadRegularFile(path, options.max_file_bytes, "dataset", &text, &message);
   } catch (const std::exception& e) {
     message = path + ": " + e.what();
     ok = false;

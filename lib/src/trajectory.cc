@@ -5,12 +5,13 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
-#include <fstream>
 #include <random>
 #include <set>
+#include <sstream>
 #include <string_view>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
 
@@ -295,11 +296,10 @@ bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
   return true;
 }
 
-bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
-                  std::string* error) {
+bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector<Pose>* poses,
+                   std::vector<double>* times_s, std::string* error) {
   if (poses == nullptr) return Fail(error, "poses must not be null");
-  std::ifstream in(path);
-  if (!in) return Fail(error, path + ": cannot open file");
+  std::istringstream in(text);
 
   std::array<int, kNumColumns> index;
   index.fill(-1);
@@ -395,13 +395,21 @@ bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector
     out_poses.push_back(pose);
     if (index[kTime] >= 0) out_times.push_back(values[kTime]);
   }
-  if (in.bad()) return Fail(error, path + ": read error");
   if (!has_header) return Fail(error, path + ": no header line (empty file)");
   if (out_poses.empty()) return Fail(error, path + ": no data rows");
 
   *poses = std::move(out_poses);
   if (times_s != nullptr) *times_s = std::move(out_times);
   return true;
+}
+
+bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
+                  std::string* error) {
+  std::string text, message;
+  if (!internal::ReadRegularFile(path, kMaxPoseFileBytes, "pose", &text, &message)) {
+    return Fail(error, message);
+  }
+  return ParsePosesCsv(text, path, poses, times_s, error);
 }
 
 }  // namespace fastcal

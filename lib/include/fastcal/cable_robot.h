@@ -71,12 +71,17 @@ struct CableRobot {
   bool IsValid(std::string* error) const;
 };
 
+// Largest model file LoadCableRobot reads: a model is about 2 KiB.
+inline constexpr long long kMaxModelFileBytes = 16LL << 20;  // 16 MiB
+
 // Loads a model from YAML (format in docs/model-format.md). Keys that are absent take
 // the nominal values, except that a file that gives `cables` must give all six. A file
 // with no document (empty, or only comments and white space) is an error: the nominal
 // model is CableRobot::NominalFast(), without a file.
 // Unknown keys, wrong types and non-physical values are errors; *error then names the
-// file, the key and (where yaml-cpp knows it) the line.
+// file, the key and (where yaml-cpp knows it) the line. Only a regular file of at most
+// kMaxModelFileBytes is read (a device such as /dev/zero, a pipe or a larger file is
+// refused before reading).
 bool LoadCableRobot(const std::string& path, CableRobot* robot, std::string* error);
 bool ParseCableRobotYaml(const std::string& text, const std::string& source_name, CableRobot* robot,
                          std::string* error);

@@ -100,8 +100,12 @@ struct CalibrationSpec {
   bool IsValid(std::string* error) const;
 };
 
+// Largest spec file LoadCalibrationSpec reads: a spec is a few KiB.
+inline constexpr long long kMaxSpecFileBytes = 16LL << 20;  // 16 MiB
+
 // Parses a spec. Errors name the file, the line and the key; unknown keys and unknown
-// parameter names are errors. `num_anchor_points` bounds anchor_offset_m[j].
+// parameter names are errors. `num_anchor_points` bounds anchor_offset_m[j]. Only a
+// regular file of at most kMaxSpecFileBytes is read (others are refused before reading).
 bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
                          std::string* error);
 bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,

@@ -64,6 +64,10 @@ struct DatasetReadOptions {
   // quaternion) is skipped and listed in Dataset::skipped instead of failing the read.
   // Header errors are never skipped, and a file whose rows are all skipped is an error.
   bool skip_invalid_rows = false;
+  // ReadDataset reads only a regular file of at most this many bytes, refusing a larger
+  // one, a device (/dev/zero), a pipe or a directory before reading (docs/data-format.md,
+  // "Limits"). 1 GiB is about 4 million rows of 24 columns, days of telemetry at 10 Hz.
+  long long max_file_bytes = 1LL << 30;
 };
 
 // Reads a dataset file. On failure returns false and sets *error to a message naming the

@@ -132,8 +132,16 @@ bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
 // Errors read "<path>:<line>: column '<name>': <what>" (line 1-based in the file).
 // `times_s` may be null; otherwise it receives one time per pose, or is left empty when
 // the file has no time_s column. Times are not checked for order.
+// Only a regular file of at most kMaxPoseFileBytes is read (a device, pipe or larger file
+// is refused before reading).
 bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
                   std::string* error);
+// Same, from the file's text; `source_name` stands for the file name in messages.
+bool ParsePosesCsv(const std::string& text, const std::string& source_name,
+                   std::vector<Pose>* poses, std::vector<double>* times_s, std::string* error);
+
+// Largest pose file ReadPosesCsv reads, as for a dataset (DatasetReadOptions).
+inline constexpr long long kMaxPoseFileBytes = 1LL << 30;  // 1 GiB
 
 }  // namespace fastcal
 

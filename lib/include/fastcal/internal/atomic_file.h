@@ -13,9 +13,13 @@ namespace fastcal::internal {
 // On failure returns false with "<path>: <what>: <strerror>" in *error (may be null).
 bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error);
 
-// Reads a whole file; "<path>: cannot open" / "<path>: cannot read" on failure (a
-// directory cannot be opened).
-bool ReadTextFile(const std::string& path, std::string* text, std::string* error);
+// Reads a whole regular file of at most `max_bytes` into *text, refusing before reading
+// anything else: a device, pipe or directory ("<path>: not a regular file ..."; /dev/zero
+// would be read until memory ran out) and a file larger than `max_bytes` ("<path>: 2.1 GB
+// is more than the <what> limit of 1 GiB"). `what` names the kind of file ("dataset").
+// A file that grows while it is read is refused the same way.
+bool ReadRegularFile(const std::string& path, long long max_bytes, const std::string& what,
+                     std::string* text, std::string* error);
 
 // Reads a whole file in chunks handed to `sink` in order, for files too large to hold (a
 // digest); the same messages (error may not be null).
