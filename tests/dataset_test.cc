@@ -20,6 +20,7 @@
 
 #include "bounded_process.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/quote.h"
 
 namespace fastcal {
 namespace {
@@ -277,16 +278,48 @@ TEST_F(DatasetTest, ErrorsNameFileLineAndColumn) {
        {"data.csv:5: column 'pitch_deg': missing value"}},
       {"too few fields",
        rows + "0,1,2,140,0,0,0,150,151,152,153,154\n",
-       {"data.csv:7: expected 13 fields, found 12"}},
+       {"data.csv:7: expected 13 fields (as in the header), found 12"}},
       {"too many fields",
        header + "0,1,2,140,0,0,0,150,151,152,153,154,155,\n",
-       {"data.csv:5: expected 13 fields, found 14"}},
-      {"zero tension",
-       header + "0,1,2,140,0,0,0,150,151,152,0,154,155\n",
-       {"data.csv:5: column 'T4_kN': tension must be > 0: a slack or failed sensor"}},
+       {"data.csv:5: expected 13 fields (as in the header), found 14 (a comma at the end?)"}},
+      {"decimal comma",
+       header + "0,1,2,140,0,0,0,150,151,152,153,154,155\n" +
+           "0,1,2,140,0,0,0,150,151,244,5,153,154,155\n",
+       {"data.csv:6: expected 13 fields (as in the header), found 14: a decimal comma? '244,5' "
+        "in column 'T3_kN' reads as two fields; numbers must use '.' as the decimal point"}},
+      {"hexadecimal",
+       header + "0,0x10,2,140,0,0,0,150,151,152,153,154,155\n",
+       {"data.csv:5: column 'x_m': '0x10' is not a decimal number (hexadecimal is not "
+        "accepted)"}},
       {"negative tension",
        header + "0,1,2,140,0,0,0,150,151,152,153,-154,155\n",
-       {"data.csv:5: column 'T5_kN': tension must be > 0"}},
+       {"data.csv:5: column 'T5_kN': -154 kN is negative: a tension reading is >= 0"}},
+      {"implausible tension",
+       header + "0,1,2,140,0,0,0,150,151,1e30,153,154,155\n",
+       {"data.csv:5: column 'T3_kN': 1e+30 kN is above the plausible maximum of 5000 kN"}},
+      {"tension near the largest double",
+       header + "0,1,2,140,0,0,0,150,151,1e308,153,154,155\n",
+       {"data.csv:5: column 'T3_kN': 1e+308 kN is above the plausible maximum of 5000 kN"}},
+      {"position below the reflector",
+       header + "0,0,0,-50,0,0,0,150,151,152,153,154,155\n",
+       {"data.csv:5: columns 'x_m,y_m,z_m': z = -50 m is below the reflector (z >= 0 m at 0 "
+        "m from the axis)"}},
+      {"position outside the towers",
+       header + "0,400,0,150,0,0,0,150,151,152,153,154,155\n",
+       {"data.csv:5: columns 'x_m,y_m,z_m': the position is 400 m from the axis, beyond the "
+        "ring of towers (at most 350 m)"}},
+      {"position above the towers",
+       header + "0,0,0,1e308,0,0,0,150,151,152,153,154,155\n",
+       {"data.csv:5: columns 'x_m,y_m,z_m': z = 1e+308 m is above the tower tops (at most 300 "
+        "m)"}},
+      {"implausible angle",
+       header + "0,1,2,140,0,0,1e300,150,151,152,153,154,155\n",
+       {"data.csv:5: column 'yaw_deg': 1e+300 deg is beyond the plausible +-360 deg"}},
+      {"control bytes and a long name in the header",
+       "time_s,x_m,\x1b[2J" + std::string(200, 'a') + "\n",
+       {"data.csv:1: unknown column '\\x1b[2J" + std::string(60, 'a') +
+        "'... (204 bytes) "
+        "(accepted:"}},
       {"non-unit quaternion",
        q_header + "0,1,2,140,1,0.1,0,0,1,2,3,4,5,6\n",
        {"data.csv:2: ", "qw,qx,qy,qz", "must be unit"}},
@@ -346,6 +379,32 @@ TEST_F(DatasetTest, ErrorsNameFileLineAndColumn) {
   }
 }
 
+// A dropout (0 kN, or nearly) is a possible reading, not a file error: the calibration
+// flags it as a gross error. It used to refuse the whole file.
+TEST_F(DatasetTest, DropoutReadingsOfZeroAreAccepted) {
+  const Dataset d = ParseOk(std::string(kHeader) + "0,1,2,140,0,0,0,150,0,152,1e-300,-0,155\n");
+  ASSERT_EQ(d.samples.size(), 1u);
+  EXPECT_EQ(d.samples[0].tension_n[1], 0.0);
+  EXPECT_EQ(d.samples[0].tension_n[3], 1e-297);
+  EXPECT_EQ(d.samples[0].tension_n[4], 0.0);
+}
+
+// User text in messages (internal/quote.h): control bytes escaped, invalid UTF-8 and C1
+// controls escaped, valid UTF-8 kept, long text cut at a character boundary.
+TEST(QuoteTest, EscapesControlBytesAndCapsTheLength) {
+  EXPECT_EQ(internal::Quote("T1_kN"), "'T1_kN'");
+  EXPECT_EQ(internal::Quote("a\x1b[2Jb\tc\n\x7f"), "'a\\x1b[2Jb\\tc\\n\\x7f'");
+  EXPECT_EQ(internal::Quote("it's \\"), "'it\\'s \\\\'");
+  EXPECT_EQ(internal::Quote("Zugkraft_\xc3\xa4"), "'Zugkraft_\xc3\xa4'");    // UTF-8 kept
+  EXPECT_EQ(internal::Quote("\xc2\x9b\xff\xc3"), "'\\xc2\\x9b\\xff\\xc3'");  // C1 CSI, invalid
+  const std::string long_text(10 << 20, 'x');
+  const std::string quoted = internal::Quote(long_text);
+  EXPECT_EQ(quoted, "'" + std::string(internal::kMaxQuotedBytes, 'x') + "'... (10485760 bytes)");
+  // A cut never splits a character: 63 bytes of 'x' and a 2-byte character.
+  EXPECT_EQ(internal::Quote(std::string(63, 'x') + "\xc3\xa4\xc3\xa4"),
+            "'" + std::string(63, 'x') + "'... (67 bytes)");
+}
+
 TEST_F(DatasetTest, NoDataRowsIsAnError) {
   EXPECT_EQ(ParseError(std::string("# nothing yet\n") + kHeader + "\n# end\n"),
             "data.csv: no data rows");
@@ -359,7 +418,7 @@ TEST_F(DatasetTest, SkipInvalidRowsSkipsAndListsThem) {
                            "1,1,2,140,0,0,0,150,151,abc,153,154,155\n"    // 4
                            "2,1,2,140,0,0,0,150,151,152\n"                // 5
                            "# a comment\n"                                // 6
-                           "3,1,2,140,0,0,0,150,151,152,153,0,155\n"      // 7
+                           "3,1,2,140,0,0,0,150,151,152,153,-1,155\n"     // 7
                            "4,1,2,140,0,0,0,150,151,152,153,154,155\n";   // 8
   EXPECT_TRUE(Contains(ParseError(text), "data.csv:4: column 'T3_kN'"));
   const Dataset d = ParseOk(text, /*skip=*/true);
@@ -369,8 +428,8 @@ TEST_F(DatasetTest, SkipInvalidRowsSkipsAndListsThem) {
   EXPECT_EQ(d.samples[1].time_s, 4.0);
   ASSERT_EQ(d.skipped.size(), 3u);
   EXPECT_EQ(d.skipped[0], "data.csv:4: column 'T3_kN': 'abc' is not a number");
-  EXPECT_EQ(d.skipped[1], "data.csv:5: expected 13 fields, found 10");
-  EXPECT_TRUE(Contains(d.skipped[2], "data.csv:7: column 'T5_kN': tension must be > 0"));
+  EXPECT_EQ(d.skipped[1], "data.csv:5: expected 13 fields (as in the header), found 10");
+  EXPECT_TRUE(Contains(d.skipped[2], "data.csv:7: column 'T5_kN': -1 kN is negative"));
 }
 
 TEST_F(DatasetTest, SkipInvalidRowsNeverSkipsHeaderErrorsOrEverything) {
@@ -435,14 +494,16 @@ TEST_F(DatasetTest, WritesHeaderCommentReadableKilonewtonsAndRereadsTheSameFile)
 }
 
 TEST_F(DatasetTest, ExtremeTensionsRoundTripExactly) {
-  const std::vector<double> values = {std::numeric_limits<double>::denorm_min(),
+  const PlausibilityLimits limits;
+  const std::vector<double> values = {0.0,
+                                      std::numeric_limits<double>::denorm_min(),
                                       std::numeric_limits<double>::min(),
                                       1e-7,
                                       0.1,
                                       1.0 / 3.0,
                                       159170.00000000003,
-                                      123456789.123,
-                                      std::numeric_limits<double>::max()};
+                                      4999999.999999999,
+                                      limits.max_tension_n};
   Dataset dataset;
   for (size_t start = 0; start < values.size(); ++start) {
     Sample s;
@@ -516,9 +577,14 @@ TEST_F(DatasetTest, WriteRefusesDataTheReaderWouldReject) {
   EXPECT_TRUE(Contains(error, "samples[1]: column 'T3_kN': value is not finite"));
 
   bad = good;
-  bad.samples[2].tension_n[0] = 0.0;
+  bad.samples[2].tension_n[0] = -1.0;
   EXPECT_FALSE(WriteDataset(path, bad, "", &error));
-  EXPECT_TRUE(Contains(error, "samples[2]: column 'T1_kN': tension must be > 0"));
+  EXPECT_TRUE(Contains(error, "samples[2]: column 'T1_kN': -0.001 kN is negative"));
+
+  bad = good;
+  bad.samples[2].tension_n[0] = 1e10;
+  EXPECT_FALSE(WriteDataset(path, bad, "", &error));
+  EXPECT_TRUE(Contains(error, "samples[2]: column 'T1_kN': 1e+07 kN is above the plausible"));
 
   bad = good;
   bad.samples[0].has_unstretched_lengths = false;

@@ -466,11 +466,19 @@ TEST(ReadPosesCsv, BadFilesReportFileLineAndColumn) {
   ExpectCsvError("trajectory_test_trailing.csv", "x_m,y_m,z_m\n1,2,150x\n",
                  ":2: column 'z_m': '150x' is not a number");
   ExpectCsvError("trajectory_test_nan.csv", "x_m,y_m,z_m\nnan,2,150\n",
-                 ":2: column 'x_m': 'nan' is not finite");
+                 ":2: column 'x_m': value is not finite");
   ExpectCsvError("trajectory_test_inf.csv", "x_m,y_m,z_m,time_s\n1,2,150,1e999\n",
-                 ":2: column 'time_s': '1e999' is not finite");
+                 ":2: column 'time_s': '1e999' is out of the range of a double");
   ExpectCsvError("trajectory_test_empty_field.csv", "x_m,y_m,z_m\n1,,150\n",
-                 ":2: column 'y_m': empty field");
+                 ":2: column 'y_m': missing value");
+  // The same number rules and plausibility limits as a dataset (plausibility.h).
+  ExpectCsvError("trajectory_test_hex.csv", "x_m,y_m,z_m\n0x10,2,150\n",
+                 ":2: column 'x_m': '0x10' is not a decimal number (hexadecimal is not accepted)");
+  ExpectCsvError("trajectory_test_below.csv", "x_m,y_m,z_m\n0,0,-50\n",
+                 ":2: columns 'x_m,y_m,z_m': z = -50 m is below the reflector");
+  ExpectCsvError("trajectory_test_angle.csv",
+                 "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n0,0,150,0,0,1e300\n",
+                 ":2: column 'yaw_deg': 1e+300 deg is beyond the plausible +-360 deg");
   ExpectCsvError("trajectory_test_both.csv",
                  "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,qw,qx,qy,qz\n1,2,3,0,0,0,1,0,0,0\n",
                  ":1: both roll/pitch/yaw and quaternion");
@@ -491,7 +499,8 @@ TEST(ReadPosesCsv, BadFilesReportFileLineAndColumn) {
   ExpectCsvError("trajectory_test_empty.csv", "", ": no header line");
   ExpectCsvError("trajectory_test_comments_only.csv", "# nothing\n\n", ": no header line");
   ExpectCsvError("trajectory_test_header_only.csv", "x_m,y_m,z_m\n# no rows\n", ": no data rows");
-  ExpectCsvError("trajectory_test_does_not_exist_dir/poses.csv", "", ": cannot open: No such file or directory");
+  ExpectCsvError("trajectory_test_does_not_exist_dir/poses.csv", "",
+                 ": cannot open: No such file or directory");
 }
 
 // A misspelt attitude column must not silently give R = I: every column is either used,

@@ -23,6 +23,8 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/quote.h"
+#include "fastcal/plausibility.h"
 
 namespace fastcal {
 namespace {
@@ -98,7 +100,13 @@ bool IsCommentOrBlank(std::string_view line) {
   return t.empty() || t.front() == '#';
 }
 
-std::string Quoted(std::string_view s) { return "'" + std::string(s) + "'"; }
+// User text in messages is escaped and capped (a binary file's header, a 10 MB line);
+// the names of our own columns are quoted the same way.
+std::string Quoted(std::string_view s) { return internal::Quote(s); }
+
+bool IsAngle(int column) {
+  return (column >= kRoll && column <= kYaw) || (column >= kPlannedRoll && column <= kPlannedYaw);
+}
 
 std::string AcceptedColumns() {
   std::string list;
@@ -109,25 +117,10 @@ std::string AcceptedColumns() {
   return list;
 }
 
-// Parses a whole trimmed field (internal::ParseDouble: '.' in every locale). Returns false
-// when the field is not a finite number (a message goes to *reason).
+// Parses a whole trimmed field (internal::ParseFiniteDecimal: decimal, '.' in every
+// locale, finite). Returns false with a message in *reason otherwise.
 bool ParseNumber(std::string_view field, double* value, std::string* reason) {
-  if (field.empty()) {
-    *reason = "missing value";
-    return false;
-  }
-  // Beyond the range of a double reads as inf (refused below), below it as 0.
-  double v = 0.0;
-  if (!internal::ParseDouble(field, &v)) {
-    *reason = Quoted(field) + " is not a number";
-    return false;
-  }
-  if (!std::isfinite(v)) {
-    *reason = "value is not finite";
-    return false;
-  }
-  *value = v;
-  return true;
+  return internal::ParseFiniteDecimal(field, value, reason);
 }
 
 // `field` (already accepted by ParseNumber) times 10^kKilo, computed by shifting the
@@ -291,14 +284,93 @@ bool ParseHeader(std::string_view line, const std::string& where, Header* header
 }
 
 // Parses one data row into *sample; on failure *reason says why (without file:line).
-bool ParseRow(std::string_view line, const Header& header, Sample* sample, std::string* reason) {
+// Checks a parsed value (kN for a tension) against the plausibility limits.
+bool CheckValue(int column, double value, const PlausibilityLimits& limits, std::string* why) {
+  if (IsTension(column)) {
+    // Compared in kN as read, so that 1e308 kN is called implausible, not "not finite"
+    // after the conversion to N.
+    const double max_kn = limits.max_tension_n / 1e3;
+    if (value > max_kn) {
+      *why = internal::FormatDouble("%.6g", value) + " kN is above the plausible maximum of " +
+             internal::FormatDouble("%.6g", max_kn) + " kN";
+      return false;
+    }
+    return CheckTensionN(value * 1e3, limits, why);
+  }
+  if (IsUnstretched(column)) return CheckUnstretchedLengthM(value, limits, why);
+  if (IsAngle(column)) return CheckAngleDeg(value, limits, why);
+  return true;
+}
+
+// The numbers of one row, by column (tensions in N; columns the file lacks stay 0).
+using FieldValues = std::array<double, kNumColumns>;
+
+// Parses one data row into *sample and *values; on failure *reason says why (without
+// file:line). `previous` (may be null): the last valid row, for the decimal-comma hint.
+bool ParseRow(std::string_view line, const Header& header, const PlausibilityLimits& limits,
+              const FieldValues* previous, Sample* sample, FieldValues* values,
+              std::string* reason);
+
+// The message for a row with one field more than the header. Most often a decimal comma
+// ("244,5" for 244.5, from a spreadsheet in a German or French locale) split one number
+// in two. Each place where a whole number is followed by a field of digits is tried as
+// one decimal number; of those that make the row valid, the one closest to the previous
+// row (telemetry changes little from one row to the next) is named with its column. No
+// previous row: named only when it is the only one.
+std::string TooManyFieldsMessage(const std::vector<std::string_view>& fields, const Header& header,
+                                 const PlausibilityLimits& limits, const FieldValues* previous) {
+  const size_t expected = header.column_of_field.size();
+  std::string message = "expected " + std::to_string(expected) +
+                        " fields (as in the header), found " + std::to_string(fields.size());
+  if (!fields.empty() && fields.back().empty()) return message + " (a comma at the end?)";
+  const auto digits = [](std::string_view s, bool sign) {
+    if (sign && !s.empty() && (s.front() == '-' || s.front() == '+')) s.remove_prefix(1);
+    return !s.empty() && s.find_first_not_of("0123456789") == std::string_view::npos;
+  };
+  int valid = 0;
+  size_t best = 0;
+  double best_distance = std::numeric_limits<double>::infinity();
+  for (size_t f = 0; fields.size() == expected + 1 && f + 1 < fields.size(); ++f) {
+    if (!digits(fields[f], true) || !digits(fields[f + 1], false)) continue;
+    std::string joined;
+    for (size_t k = 0; k < fields.size(); ++k) {
+      joined += std::string(k == 0 ? "" : k == f + 1 ? "." : ",") + std::string(fields[k]);
+    }
+    Sample ignored;
+    FieldValues values{};
+    std::string why;
+    if (!ParseRow(joined, header, limits, nullptr, &ignored, &values, &why)) continue;
+    double distance = 0.0;
+    for (int c = 0; previous != nullptr && c < kNumColumns; ++c) {
+      distance += std::abs(values[c] - (*previous)[c]);
+    }
+    if (valid++ == 0 || distance < best_distance) {
+      best = f;
+      best_distance = distance;
+    }
+  }
+  if (valid == 1 || (valid > 1 && previous != nullptr)) {
+    return message + ": a decimal comma? " +
+           Quoted(std::string(fields[best]) + "," + std::string(fields[best + 1])) + " in column " +
+           Quoted(kColumnNames[header.column_of_field[best]]) +
+           " reads as two fields; numbers must use '.' as the decimal point";
+  }
+  return message + " (fields cannot contain a comma; a decimal comma must be a '.')";
+}
+
+bool ParseRow(std::string_view line, const Header& header, const PlausibilityLimits& limits,
+              const FieldValues* previous, Sample* sample, FieldValues* values,
+              std::string* reason) {
   const std::vector<std::string_view> fields = SplitFields(line);
   if (fields.size() != header.column_of_field.size()) {
-    *reason = "expected " + std::to_string(header.column_of_field.size()) + " fields, found " +
-              std::to_string(fields.size());
+    *reason = fields.size() > header.column_of_field.size()
+                  ? TooManyFieldsMessage(fields, header, limits, previous)
+                  : "expected " + std::to_string(header.column_of_field.size()) +
+                        " fields (as in the header), found " + std::to_string(fields.size());
     return false;
   }
-  std::array<double, kNumColumns> value{};
+  FieldValues& value = *values;
+  value.fill(0.0);
   for (size_t f = 0; f < fields.size(); ++f) {
     const int column = header.column_of_field[f];
     const auto fail = [&](const std::string& why) {
@@ -307,16 +379,15 @@ bool ParseRow(std::string_view line, const Header& header, Sample* sample, std::
     };
     std::string why;
     if (!ParseNumber(fields[f], &value[column], &why)) return fail(why);
-    if (IsTension(column)) {
-      value[column] = ScaleByKilo(fields[f], value[column]);
-      if (!std::isfinite(value[column])) return fail("value is not finite in N");
-      if (!(value[column] > 0.0)) {
-        return fail("tension must be > 0: a slack or failed sensor (read " + Quoted(fields[f]) +
-                    ")");
-      }
-    }
-    if (IsUnstretched(column) && !(value[column] > 0.0)) {
-      return fail("unstretched length must be > 0 (read " + Quoted(fields[f]) + ")");
+    if (!CheckValue(column, value[column], limits, &why)) return fail(why);
+    if (IsTension(column)) value[column] = ScaleByKilo(fields[f], value[column]);
+  }
+  {
+    const Eigen::Vector3d position(value[kX], value[kY], value[kZ]);
+    std::string why;
+    if (!CheckPosition(position, limits, &why)) {
+      *reason = "columns 'x_m,y_m,z_m': " + why;
+      return false;
     }
   }
   sample->time_s = value[kTime];
@@ -358,6 +429,7 @@ bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
   Header header;
   bool have_header = false;
   int rows = 0;
+  FieldValues previous{};  // the last valid row
   std::string_view rest(text);
   if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // UTF-8 byte order mark
   for (int line_number = 1; !rest.empty(); ++line_number) {
@@ -375,8 +447,11 @@ bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
     Sample sample;
     sample.line = line_number;
     std::string reason;
-    if (ParseRow(line, header, &sample, &reason)) {
+    FieldValues values{};
+    if (ParseRow(line, header, options.limits, result.samples.empty() ? nullptr : &previous,
+                 &sample, &values, &reason)) {
       result.samples.push_back(std::move(sample));
+      previous = values;
     } else if (options.skip_invalid_rows) {
       result.skipped.push_back(where + reason);
     } else {
@@ -461,20 +536,25 @@ bool RowValues(const Dataset& dataset, const Sample& s, std::array<double, kNumC
     }
     for (int i = 0; i < kNumCables; ++i) v[kUnstretched1 + i] = s.unstretched_length_m[i];
   }
+  // What the reader would refuse, with its default limits.
+  const PlausibilityLimits limits;
   for (int c = 0; c < kNumColumns; ++c) {
     const std::string prefix = "column " + Quoted(kColumnNames[c]) + ": ";
     if (!std::isfinite(v[c])) {
       *reason = prefix + "value is not finite";
       return false;
     }
-    if (IsTension(c) && !(v[c] > 0.0)) {
-      *reason = prefix + "tension must be > 0";
+    const bool written = !(IsUnstretched(c) && !dataset.has_unstretched_lengths);
+    std::string why;
+    if (written && !CheckValue(c, IsTension(c) ? v[c] / 1e3 : v[c], limits, &why)) {
+      *reason = prefix + why;
       return false;
     }
-    if (IsUnstretched(c) && dataset.has_unstretched_lengths && !(v[c] > 0.0)) {
-      *reason = prefix + "unstretched length must be > 0";
-      return false;
-    }
+  }
+  std::string why;
+  if (!CheckPosition(s.pose.position_m, limits, &why)) {
+    *reason = "columns 'x_m,y_m,z_m': " + why;
+    return false;
   }
   return true;
 }

@@ -6,6 +6,8 @@
 #include <limits>
 #include <system_error>
 
+#include "fastcal/internal/quote.h"
+
 namespace fastcal::internal {
 namespace {
 
@@ -74,6 +76,60 @@ bool ParseDouble(std::string_view text, double* value) {
     return false;
   }
   *value = negative ? -parsed : parsed;
+  return true;
+}
+
+namespace {
+
+// Whether `text` is [+-](digits[.digits] | .digits)[(e|E)[+-]digits] exactly.
+bool IsDecimalText(std::string_view text) {
+  size_t i = 0;
+  const auto digits = [&] {
+    const size_t start = i;
+    while (i < text.size() && text[i] >= '0' && text[i] <= '9') ++i;
+    return i - start;
+  };
+  if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+  size_t mantissa = digits();
+  if (i < text.size() && text[i] == '.') {
+    ++i;
+    mantissa += digits();
+  }
+  if (mantissa == 0) return false;
+  if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
+    ++i;
+    if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
+    if (digits() == 0) return false;
+  }
+  return i == text.size();
+}
+
+}  // namespace
+
+bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why) {
+  if (text.empty()) {
+    *why = "missing value";
+    return false;
+  }
+  double parsed = 0.0;
+  const bool number = ParseDouble(text, &parsed);
+  if (number && !IsDecimalText(text)) {
+    if (std::isfinite(parsed)) {
+      *why = Quote(text) + " is not a decimal number (hexadecimal is not accepted)";
+    } else {
+      *why = "value is not finite";
+    }
+    return false;
+  }
+  if (!number) {
+    *why = Quote(text) + " is not a number";
+    return false;
+  }
+  if (!std::isfinite(parsed)) {
+    *why = Quote(text) + " is out of the range of a double";
+    return false;
+  }
+  *value = parsed;
   return true;
 }
 

@@ -14,6 +14,8 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/quote.h"
+#include "fastcal/plausibility.h"
 
 namespace fastcal {
 namespace {
@@ -96,24 +98,10 @@ std::vector<std::string_view> SplitFields(std::string_view line) {
   }
 }
 
-// Parses a trimmed field ('.' in every locale); on failure *why says what is wrong with it.
+// Parses a trimmed field as every fastcal file does (internal::ParseFiniteDecimal: decimal,
+// '.' in every locale, finite); on failure *why says what is wrong with it.
 bool ParseNumber(std::string_view field, double* value, std::string* why) {
-  const std::string text(field);
-  if (text.empty()) {
-    *why = "empty field";
-    return false;
-  }
-  double parsed = 0.0;
-  if (!internal::ParseDouble(text, &parsed)) {
-    *why = "'" + text + "' is not a number";
-    return false;
-  }
-  if (!std::isfinite(parsed)) {
-    *why = "'" + text + "' is not finite";
-    return false;
-  }
-  *value = parsed;
-  return true;
+  return internal::ParseFiniteDecimal(field, value, why);
 }
 
 enum Column { kX, kY, kZ, kRoll, kPitch, kYaw, kQw, kQx, kQy, kQz, kTime, kNumColumns };
@@ -300,6 +288,7 @@ bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector
                    std::vector<double>* times_s, std::string* error) {
   if (poses == nullptr) return Fail(error, "poses must not be null");
   std::istringstream in(text);
+  const PlausibilityLimits limits;  // as for a dataset, by default
 
   std::array<int, kNumColumns> index;
   index.fill(-1);
@@ -347,8 +336,8 @@ bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector
           known = true;
         }
         if (!known) {
-          return Fail(error, where + column + " '" + std::string(fields[i]) +
-                                 "': unknown column name (accepted: " + AcceptedColumns() + ")");
+          return Fail(error, where + column + " " + internal::Quote(fields[i]) +
+                                 ": unknown column name (accepted: " + AcceptedColumns() + ")");
         }
       }
       has_rpy = index[kRoll] >= 0 || index[kPitch] >= 0 || index[kYaw] >= 0;
@@ -377,12 +366,16 @@ bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector
     for (int c = 0; c < kNumColumns; ++c) {
       if (index[c] < 0) continue;
       std::string why;
-      if (!ParseNumber(fields[index[c]], &values[c], &why)) {
+      if (!ParseNumber(fields[index[c]], &values[c], &why) ||
+          (c >= kRoll && c <= kYaw && !CheckAngleDeg(values[c], limits, &why))) {
         return Fail(error, where + "column '" + kColumnNames[c] + "': " + why);
       }
     }
     Pose pose;
     pose.position_m = Eigen::Vector3d(values[kX], values[kY], values[kZ]);
+    if (std::string why; !CheckPosition(pose.position_m, limits, &why)) {
+      return Fail(error, where + "columns 'x_m,y_m,z_m': " + why);
+    }
     if (has_rpy) {
       pose.rotation = RotationFromRpyDeg(values[kRoll], values[kPitch], values[kYaw]);
     } else if (has_quaternion) {

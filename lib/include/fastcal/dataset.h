@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/plausibility.h"
 #include "fastcal/pose.h"
 
 namespace fastcal {
@@ -36,7 +37,8 @@ struct Sample {
   Eigen::Matrix3d planned_rotation = Eigen::Matrix3d::Identity();
   // As in the file; written when it reproduces planned_rotation exactly (as above).
   Eigen::Vector3d planned_rpy_deg = Eigen::Vector3d::Zero();
-  // Measured lower-end cable tensions, cable i at index i-1 (> 0).
+  // Measured lower-end cable tensions, cable i at index i-1 (>= 0: 0 is a dropout, which
+  // a calibration flags as a gross error; at most PlausibilityLimits::max_tension_n).
   std::array<double, kNumCables> tension_n{};
   // Commanded unstretched cable lengths, when the file has the s0_*_m columns (> 0).
   bool has_unstretched_lengths = false;
@@ -60,14 +62,19 @@ struct Dataset {
 
 struct DatasetReadOptions {
   // When true, a row with a problem in its values (wrong number of fields, a missing,
-  // non-numeric or non-finite value, a tension or unstretched length <= 0, a non-unit
-  // quaternion) is skipped and listed in Dataset::skipped instead of failing the read.
+  // non-numeric or non-finite value, a value beyond `limits` below, a non-unit quaternion)
+  // is skipped and listed in Dataset::skipped instead of failing the read.
   // Header errors are never skipped, and a file whose rows are all skipped is an error.
   bool skip_invalid_rows = false;
   // ReadDataset reads only a regular file of at most this many bytes, refusing a larger
   // one, a device (/dev/zero), a pipe or a directory before reading (docs/data-format.md,
   // "Limits"). 1 GiB is about 4 million rows of 24 columns, days of telemetry at 10 Hz.
   long long max_file_bytes = 1LL << 30;
+  // Values no real FAST file holds (a tension above 5000 kN or < 0, a position below the
+  // reflector or beyond the towers, an angle beyond one turn) are errors naming the line
+  // and column, or skipped rows under skip_invalid_rows. A reading of 0 kN (a dropout) is
+  // accepted: the calibration flags it as a gross error.
+  PlausibilityLimits limits;
 };
 
 // Reads a dataset file. On failure returns false and sets *error to a message naming the
@@ -89,7 +96,8 @@ bool ParseDataset(const std::string& text, const std::string& source_name,
 //   s0_1_m ... s0_6_m (if dataset.has_unstretched_lengths).
 // Numbers are written with the fewest significant digits (at most 17) that read back to
 // the same double, so Write then Read is exact. Refuses (returns false) data the reader
-// would reject: non-finite values, tensions or unstretched lengths <= 0, a sample lacking
+// would reject with its default options: non-finite values, values beyond the default
+// PlausibilityLimits, unstretched lengths <= 0, a sample lacking
 // a column group the dataset declares, no samples. Writes atomically (temporary file in
 // the same directory, then rename): a failure leaves no file behind.
 bool WriteDataset(const std::string& path, const Dataset& dataset,

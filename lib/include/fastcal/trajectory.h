@@ -126,8 +126,9 @@ bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
 // column number and listing the accepted names:
 //   "<path>:<line>: column <n> '<name>': unknown column name (accepted: x_m, ...)".
 // Every data row must have as many fields as the header; every used field must be a finite
-// number ('.' as the decimal point whatever the locale, as strtod reads it in the "C"
-// locale; the whole field consumed). There must be at least one data row.
+// decimal number ('.' as the decimal point whatever the locale; no hexadecimal; the whole
+// field consumed), and positions and angles within the default PlausibilityLimits
+// (plausibility.h), as in a dataset. There must be at least one data row.
 //
 // Errors read "<path>:<line>: column '<name>': <what>" (line 1-based in the file).
 // `times_s` may be null; otherwise it receives one time per pose, or is left empty when

@@ -19,6 +19,16 @@ namespace fastcal::internal {
 // untouched) when the text is not entirely a number.
 bool ParseDouble(std::string_view text, double* value);
 
+// Reads the whole of `text` as a number the way every fastcal file and flag does: a
+// decimal number with an optional sign and exponent ("1.5", "-2e-3", "+7", ".5", "5.").
+// Hexadecimal ("0x10", which strtod reads as 16), "inf", "nan", white space and anything
+// else is not a number. On success *value is finite; otherwise false with *why, e.g.
+//   "missing value", "'0x10' is not a decimal number (hexadecimal is not accepted)",
+//   "'abc' is not a number", "'1e999' is out of the range of a double",
+//   "value is not finite" (inf, nan).
+// User text in *why is quoted with internal::Quote (escaped, length capped).
+bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why);
+
 // `value` formatted by a printf format with exactly one floating-point conversion,
 // %[+][width][.precision](f|e|g), and literal text around it ('%%' for a percent sign),
 // e.g. FormatDouble("%+.3f", x), FormatDouble("%.6g kN", t). Output as printf's in the
