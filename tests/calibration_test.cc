@@ -6,13 +6,16 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <clocale>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <limits>
 #include <locale>
 #include <random>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "fastcal/calibration_spec.h"
@@ -403,6 +406,62 @@ TEST(CalibrationTest, GrossErrorsAreNamedAndDoNotMoveTheEstimates) {
   EXPECT_TRUE(fit_off.gross_errors.empty());
   EXPECT_GT(std::abs(fit_off.parameters[2].estimate - fit_clean.parameters[2].estimate),
             3.0 * fit_clean.parameters[2].sigma_total);
+}
+
+// Dropouts of exactly 0 kN reach the calibration through the file reader (which used to
+// refuse the whole file for them) and, with a glitch of 4 times the normal tension, are
+// flagged by the robust screen; the fit stays ok and near the truth, and no statistic
+// divides by a 0 kN reading.
+TEST(CalibrationTest, ZeroReadingsFromAFileAreGrossErrorsAndNothingIsInfinite) {
+  constexpr int kNodes = 120;
+  // Estimates within this many sigma_total of the truth (3: a seeded draw, not a search
+  // for a lucky one).
+  constexpr double kCoverageSigmas = 3.0;
+  Dataset simulated = CircleData(Truth(), kNodes, 0.03, 41);
+  const std::array<std::pair<int, int>, 3> dropouts = {{{15, 1}, {16, 1}, {70, 4}}};
+  for (const auto& [sample, cable] : dropouts) simulated.samples[sample].tension_n[cable] = 0.0;
+  const int glitch_sample = 93, glitch_cable = 0;
+  simulated.samples[glitch_sample].tension_n[glitch_cable] *= 4.0;
+  const std::string path = ::testing::TempDir() + "calibration_test_dropouts.csv";
+  std::string error;
+  ASSERT_TRUE(WriteDataset(path, simulated, "", &error)) << error;
+  Dataset data;
+  ASSERT_TRUE(ReadDataset(path, DatasetReadOptions(), &data, &error)) << error;
+  std::remove(path.c_str());
+  ASSERT_EQ(data.samples.size(), simulated.samples.size());
+
+  const CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+  CalibrationResult result;
+  ASSERT_TRUE(CalibrateNominal(spec, data, &result));
+  EXPECT_EQ(result.verdict, FitVerdict::kOk) << result.verdict_text;
+  ASSERT_EQ(result.gross_errors.size(), dropouts.size() + 1);
+  for (const auto& [sample, cable] : dropouts) {
+    EXPECT_TRUE(result.excluded[sample][cable]) << "sample " << sample << " cable " << cable;
+  }
+  EXPECT_TRUE(result.excluded[glitch_sample][glitch_cable]);
+  const double truth[] = {kTruthMassCentreM.x(), kTruthMassCentreM.y(), kTruthMassCentreM.z(),
+                          kTruthDensityKgPerM};
+  ASSERT_EQ(result.parameters.size(), std::size(truth));
+  for (size_t k = 0; k < std::size(truth); ++k) {
+    const ParameterEstimate& p = result.parameters[k];
+    EXPECT_LT(std::abs(p.estimate - truth[k]), kCoverageSigmas * p.sigma_total) << p.name;
+  }
+  // Every statistic finite: the calibration's variants, and a plain evaluation (no
+  // exclusions) of the dropouts, whose percents are of the model's reading.
+  std::vector<VariantEvaluation> evaluated;
+  ASSERT_TRUE(EvaluateModel(Truth(), data, StaticsMethod::kExact, &evaluated, &error)) << error;
+  for (const std::vector<VariantEvaluation>* set : {&result.variants, &evaluated}) {
+    for (const VariantEvaluation& v : *set) {
+      for (int i = 0; i < kNumCables; ++i) {
+        for (double x : {v.fit.rms_n[i], v.fit.mean_n[i], v.fit.max_abs_n[i], v.fit.rms_percent[i],
+                         v.fit.max_abs_percent[i]}) {
+          EXPECT_TRUE(std::isfinite(x)) << v.name << " cable " << i + 1;
+        }
+      }
+    }
+  }
+  // A 0 kN reading is 100% below the model's reading.
+  EXPECT_NEAR(evaluated.back().fit.max_abs_percent[1], 100.0, 1e-9);
 }
 
 TEST(CalibrationTest, DataThatAreMostlyGrossErrorsAreRefused) {

@@ -378,7 +378,7 @@ TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
                        "18.190 |"));
   EXPECT_TRUE(Contains(md, "RMS of model - measured [kN], fitted samples (n = 16)"));
   EXPECT_TRUE(Contains(md, "held-out samples (n = 4"));
-  EXPECT_TRUE(Contains(md, "RMS of 100 (model - measured) / measured [%]"));
+  EXPECT_TRUE(Contains(md, "RMS of 100 (model - measured) / model [%]"));
   EXPECT_TRUE(Contains(md, "Largest |model - measured| [kN]"));
   // Verdict, provenance, identifiability, calibrated model, Ceres report.
   EXPECT_TRUE(Contains(md, "**Converged** (termination: `CONVERGENCE`) after 7 iterations"));

@@ -90,6 +90,7 @@ CableErrorStats ErrorStats(const Dataset& data,
                            const ReadingMask& excluded) {
   CableErrorStats st;
   std::array<double, kNumCables> sum{}, sum2{}, sum2_pct{};
+  std::array<int, kNumCables> percent_readings{};
   for (size_t n = 0; n < data.samples.size(); ++n) {
     const bool h = !held_out.empty() && held_out[n];
     if (h != select_held_out) continue;
@@ -101,11 +102,16 @@ CableErrorStats ErrorStats(const Dataset& data,
       }
       const double measured = data.samples[n].tension_n[i];
       const double d = predicted[n][i] - measured;
-      const double pct = 100.0 * d / measured;
       sum[i] += d;
       sum2[i] += d * d;
-      sum2_pct[i] += pct * pct;
       st.max_abs_n[i] = std::max(st.max_abs_n[i], std::abs(d));
+      // Percent of the predicted reading, not of the measured one: a dropout reads 0 kN
+      // (100 d / 0 = inf), and the prediction of a pose the model holds is > 0. A
+      // prediction <= 0 (a negative sensor bias) leaves the reading out of the percents.
+      if (!(predicted[n][i] > 0.0)) continue;
+      const double pct = 100.0 * d / predicted[n][i];
+      sum2_pct[i] += pct * pct;
+      ++percent_readings[i];
       st.max_abs_percent[i] = std::max(st.max_abs_percent[i], std::abs(pct));
     }
   }
@@ -114,7 +120,7 @@ CableErrorStats ErrorStats(const Dataset& data,
     if (readings == 0) continue;
     st.mean_n[i] = sum[i] / readings;
     st.rms_n[i] = std::sqrt(sum2[i] / readings);
-    st.rms_percent[i] = std::sqrt(sum2_pct[i] / readings);
+    if (percent_readings[i] > 0) st.rms_percent[i] = std::sqrt(sum2_pct[i] / percent_readings[i]);
   }
   return st;
 }

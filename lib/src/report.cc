@@ -586,7 +586,7 @@ void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
     doc->Figure(std::move(svgs), "RMS of model - measured per cable for each variant [kN].");
   }
   const StatsRows rows = holdout ? StatsRows::kFitAndHeldOut : StatsRows::kFit;
-  doc->AddTable(StatsTable(in, "RMS of 100 (model - measured) / measured [%]",
+  doc->AddTable(StatsTable(in, "RMS of 100 (model - measured) / model [%]",
                            &CableErrorStats::rms_percent, false, rows, "%.2f"));
   doc->AddTable(StatsTable(in, "Mean of model - measured (bias) [kN]", &CableErrorStats::mean_n,
                            true, rows, nullptr));

@@ -24,10 +24,13 @@ struct CableErrorStats {
   // Readings left out per cable (gross errors, when the caller excludes them); the
   // statistics of cable i are over samples - excluded[i] readings.
   std::array<int, kNumCables> excluded{};
-  std::array<double, kNumCables> mean_n{};       // mean of model - measured
-  std::array<double, kNumCables> rms_n{};        // RMS of model - measured
-  std::array<double, kNumCables> max_abs_n{};    // largest |model - measured|
-  std::array<double, kNumCables> rms_percent{};  // RMS of 100 (model - measured)/measured
+  std::array<double, kNumCables> mean_n{};     // mean of model - measured
+  std::array<double, kNumCables> rms_n{};      // RMS of model - measured
+  std::array<double, kNumCables> max_abs_n{};  // largest |model - measured|
+  // RMS and largest |.| of 100 (model - measured) / model: percent of the predicted
+  // reading, which is > 0 wherever the model holds the pose, so a dropout reading of
+  // 0 kN cannot make it infinite (readings whose prediction is <= 0 are left out of these).
+  std::array<double, kNumCables> rms_percent{};
   std::array<double, kNumCables> max_abs_percent{};
 };
 
