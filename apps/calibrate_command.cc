@@ -128,24 +128,32 @@ bool WriteDirectoryAtomically(const std::string& dir,
                               const std::vector<std::pair<std::string, std::string>>& files,
                               const std::function<bool(const std::string&, std::string*)>& extra,
                               std::string* error) {
-  if (!CheckOutputDirectory(dir, error)) return false;
+  if (!CheckOutputDirectory("out", dir, error)) return false;
   std::error_code ec;
   const fs::path target(dir);
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::exists(parent, ec) && !fs::create_directories(parent, ec)) {
-    *error = parent.string() + ": cannot create: " + ec.message();
+    *error =
+        "--out=" + dir + ": cannot create its directory '" + parent.string() + "': " + ec.message();
     return false;
   }
   const fs::path tmp =
       parent / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
   fs::remove_all(tmp, ec);
+  // Failures name the user's --out, not the temporary sibling.
+  const std::string where = "--out=" + dir + ": ";
   if (!fs::create_directory(tmp, ec)) {
-    *error = tmp.string() + ": cannot create: " + ec.message();
+    *error =
+        where + "cannot create the temporary directory '" + tmp.string() + "': " + ec.message();
     return false;
   }
-  auto fail = [&](const std::string& why) {
+  auto fail = [&](std::string why) {
     fs::remove_all(tmp, ec);
-    *error = why;
+    for (size_t at = why.find(tmp.string()); at != std::string::npos;
+         at = why.find(tmp.string(), at + dir.size())) {
+      why.replace(at, tmp.string().size(), dir);
+    }
+    *error = why.rfind("--out=", 0) == 0 ? why : where + why;
     return false;
   };
   for (const auto& [name, content] : files) {
@@ -156,7 +164,7 @@ bool WriteDirectoryAtomically(const std::string& dir,
   if (extra && !extra(tmp.string(), &why)) return fail(why);
   if (fs::exists(target, ec)) fs::remove(target, ec);  // empty directory
   fs::rename(tmp, target, ec);
-  if (ec) return fail(dir + ": cannot move the results into place: " + ec.message());
+  if (ec) return fail("cannot move the results into place: " + ec.message());
   return true;
 }
 
@@ -504,10 +512,9 @@ int RunCalibrate(int argc, char** argv) {
   CableRobot model;
   Dataset data;
   CalibrationSpec spec;
-  if (!LoadInputs(&model, &data, &error) ||
+  if (!CheckOutputDirectory("out", FLAGS_out, &error) || !LoadInputs(&model, &data, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(model.anchor_points_cabin_m.size()), &spec,
-                           &error) ||
-      !CheckOutputDirectory(FLAGS_out, &error)) {
+                           &error)) {
     PrintError(command, error);
     return kExitUsage;
   }
@@ -585,8 +592,8 @@ int RunEvaluate(int argc, char** argv) {
   }
   CableRobot model;
   Dataset data;
-  if (!LoadInputs(&model, &data, &error) ||
-      (!FLAGS_out.empty() && !CheckOutputDirectory(FLAGS_out, &error))) {
+  if ((!FLAGS_out.empty() && !CheckOutputDirectory("out", FLAGS_out, &error)) ||
+      !LoadInputs(&model, &data, &error)) {
     PrintError(command, error);
     return kExitUsage;
   }

@@ -1,12 +1,17 @@
 #include "cli_util.h"
 
+#include <fcntl.h>
 #include <gflags/gflags.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cctype>
+#include <cerrno>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -14,6 +19,8 @@
 
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/quote.h"
+#include "fastcal/plausibility.h"
 
 namespace fastcal::cli {
 
@@ -63,23 +70,30 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
       const char* begin = value.c_str();
       char* end = nullptr;
       bool ok = true;
+      // The numbers of a flag are read as a file's are: whole decimal text (no hexadecimal,
+      // no trailing junk), finite, and in the range of the flag's type (no truncation).
       if (info.type == "int32" || info.type == "int64") {
-        std::strtoll(begin, &end, 10);
-        ok = !value.empty() && *end == '\0';
+        errno = 0;
+        const long long v = std::strtoll(begin, &end, 10);
+        ok = !value.empty() && *end == '\0' && errno == 0 &&
+             (info.type == "int64" || (v >= INT32_MIN && v <= INT32_MAX));
       } else if (info.type == "uint32" || info.type == "uint64") {
-        std::strtoull(begin, &end, 10);
-        ok = !value.empty() && value[0] != '-' && *end == '\0';
+        errno = 0;
+        const unsigned long long v = std::strtoull(begin, &end, 10);
+        ok = !value.empty() && value[0] != '-' && *end == '\0' && errno == 0 &&
+             (info.type == "uint64" || v <= UINT32_MAX);
       } else if (info.type == "double") {
-        const double v = std::strtod(begin, &end);
-        ok = !value.empty() && *end == '\0' && std::isfinite(v);
+        double v = 0.0;
+        std::string why;
+        ok = internal::ParseFiniteDecimal(value, &v, &why);
       } else if (info.type == "bool") {
         ok = value == "true" || value == "false" || value == "1" || value == "0";
       }
       if (!ok) {
-        *error = "--" + name + ": '" + value + "' is not a valid " +
+        *error = "--" + name + ": " + internal::Quote(value) + " is not a valid " +
                  (info.type == "bool"     ? std::string("true/false")
-                  : info.type == "double" ? std::string("finite number")
-                                          : std::string("whole number")) +
+                  : info.type == "double" ? std::string("finite decimal number")
+                                          : std::string("whole number in range")) +
                  " (see fastcal " + command + " --help)";
         return false;
       }
@@ -179,46 +193,95 @@ std::string WithFlagNames(const std::string& message,
   return out;
 }
 
-bool CheckCanWrite(const std::string& path, bool force, std::string* error) {
+namespace {
+
+// Whether a new file (or directory) can be made in `dir`: makes a uniquely named probe
+// and removes it. Asking access(2) is not enough: root passes it on /proc and on a
+// read-only mount. False with "cannot create a file in '<dir>': <why>".
+bool CanCreateIn(const std::filesystem::path& dir, bool directory, std::string* why) {
+  const std::filesystem::path probe = dir / (".fastcal-write-probe." + std::to_string(::getpid()));
+  const std::string shown = dir.empty() ? "." : dir.string();
+  if (directory ? ::mkdir(probe.c_str(), 0700) == 0 : [&] {
+        const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+        return fd >= 0 && ::close(fd) == 0;
+      }()) {
+    directory ? ::rmdir(probe.c_str()) : ::unlink(probe.c_str());
+    return true;
+  }
+  *why = std::string("cannot create a ") + (directory ? "directory" : "file") + " in '" +
+         internal::Escape(shown) + "': " + std::strerror(errno);
+  return false;
+}
+
+}  // namespace
+
+bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
+                   std::string* error) {
   if (path.empty() || path == "-") return true;
+  const std::string where = "--" + flag + "=" + internal::Escape(path) + ": ";
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
   if (std::filesystem::is_directory(status)) {
-    *error = path + ": is a directory (give a file name)";
+    *error = where + "is a directory (give a file name)";
     return false;
   }
   if (std::filesystem::exists(status) && !force) {
-    *error = path + ": exists; not overwritten (add --force to replace it, or choose another name)";
+    *error = where + "exists; not overwritten (add --force to replace it, or choose another name)";
     return false;
   }
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   if (!parent.empty() && !std::filesystem::is_directory(parent, ec)) {
-    *error = path + ": cannot write: directory '" + parent.string() + "' does not exist";
+    *error = where + "cannot write: directory '" + internal::Escape(parent.string()) +
+             "' does not exist";
+    return false;
+  }
+  std::string why;
+  if (!CanCreateIn(parent.empty() ? std::filesystem::path(".") : parent, false, &why)) {
+    *error = where + "cannot write: " + why;
     return false;
   }
   return true;
 }
 
-bool CheckOutputDirectory(const std::string& dir, std::string* error) {
+bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error) {
+  const std::string where = "--" + flag + "=" + internal::Escape(dir) + ": ";
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(dir, ec);
-  if (!std::filesystem::exists(status)) return true;
-  if (!std::filesystem::is_directory(status)) {
-    *error = dir + ": is a file, not a directory (--out names a new or empty directory)";
+  if (std::filesystem::exists(status) && !std::filesystem::is_directory(status)) {
+    *error = where + "is a file, not a directory (--" + flag + " names a new or empty directory)";
     return false;
   }
-  if (!std::filesystem::is_empty(dir, ec)) {
-    *error = dir + ": exists and is not an empty directory (choose a new --out)";
+  if (std::filesystem::exists(status) && !std::filesystem::is_empty(dir, ec)) {
+    *error = where + "exists and is not an empty directory (choose a new --" + flag + ")";
+    return false;
+  }
+  // The results are built in a sibling of `dir` and renamed into place, and missing
+  // parents are created: the nearest existing ancestor must take a new directory.
+  std::filesystem::path ancestor = std::filesystem::absolute(dir, ec).parent_path();
+  while (!ancestor.empty() && !std::filesystem::exists(ancestor, ec) &&
+         ancestor != ancestor.root_path()) {
+    ancestor = ancestor.parent_path();
+  }
+  if (!std::filesystem::is_directory(ancestor, ec)) {
+    *error =
+        where + "cannot write: '" + internal::Escape(ancestor.string()) + "' is not a directory";
+    return false;
+  }
+  std::string why;
+  if (!CanCreateIn(ancestor, true, &why)) {
+    *error = where + "cannot write: " + why;
     return false;
   }
   return true;
 }
 
-bool ParseNumberItem(const std::string& item, double* value) {
+bool ParseNumberItem(const std::string& item, double* value, std::string* why) {
   const size_t begin = item.find_first_not_of(" \t");
-  if (begin == std::string::npos) return false;
   const size_t end = item.find_last_not_of(" \t");
-  return internal::ParseDouble(std::string_view(item).substr(begin, end + 1 - begin), value);
+  const std::string_view trimmed = begin == std::string::npos
+                                       ? std::string_view()
+                                       : std::string_view(item).substr(begin, end + 1 - begin);
+  return internal::ParseFiniteDecimal(trimmed, value, why);
 }
 
 namespace {
@@ -230,19 +293,16 @@ bool ParseList(const std::string& name, const std::string& text, int n, double* 
   while (std::getline(ss, item, ',')) {
     if (count >= n) break;
     double v = 0.0;
-    if (!ParseNumberItem(item, &v)) {
-      *error = "--" + name + ": '" + item + "' is not a number";
-      return false;
-    }
-    if (!std::isfinite(v)) {
-      *error = "--" + name + ": '" + item + "' is not finite";
+    std::string why;
+    if (!ParseNumberItem(item, &v, &why)) {
+      *error = "--" + name + ": " + why;
       return false;
     }
     out[count++] = v;
   }
   if (count != n || ss.rdbuf()->in_avail() > 0 || (!text.empty() && text.back() == ',')) {
-    *error = "--" + name + " needs " + std::to_string(n) + " comma-separated numbers, got '" +
-             text + "'";
+    *error = "--" + name + " needs " + std::to_string(n) + " comma-separated numbers, got " +
+             internal::Quote(text);
     return false;
   }
   return true;
@@ -257,6 +317,29 @@ bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vecto
 bool ParseVector4(const std::string& name, const std::string& text, Eigen::Vector4d* v,
                   std::string* error) {
   return ParseList(name, text, 4, v->data(), error);
+}
+
+bool ParsePosition(const std::string& name, const std::string& text, Eigen::Vector3d* position_m,
+                   std::string* error) {
+  if (!ParseVector3(name, text, position_m, error)) return false;
+  std::string why;
+  if (CheckPosition(*position_m, PlausibilityLimits(), &why)) return true;
+  *error = "--" + name + "=" + internal::Escape(text) + ": " + why;
+  return false;
+}
+
+bool ParseRpyDeg(const std::string& name, const std::string& text, Eigen::Vector3d* rpy_deg,
+                 std::string* error) {
+  if (!ParseVector3(name, text, rpy_deg, error)) return false;
+  const char* names[] = {"roll", "pitch", "yaw"};
+  for (int k = 0; k < 3; ++k) {
+    std::string why;
+    if (!CheckAngleDeg((*rpy_deg)[k], PlausibilityLimits(), &why)) {
+      *error = "--" + name + "=" + internal::Escape(text) + ": " + names[k] + " " + why;
+      return false;
+    }
+  }
+  return true;
 }
 
 bool WriteOutput(const std::string& path, const std::string& content, std::string* error) {

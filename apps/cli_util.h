@@ -71,24 +71,38 @@ bool LoadModelFlag(const std::string& flag, const std::string& path, CableRobot*
 std::string WithFlagNames(const std::string& message,
                           const std::vector<std::pair<std::string, std::string>>& field_to_flag);
 
-// Refuses to replace an existing `path` unless `force`: false with a message naming the
-// file and --force. A directory is refused even with `force`, and so is a path whose
-// directory does not exist (named). "" and "-" (stdout) pass.
-bool CheckCanWrite(const std::string& path, bool force, std::string* error);
+// Checks, before any work, that output flag `flag` (e.g. "output") can write `path`:
+// refuses to replace an existing file unless `force` (naming the file and --force), a
+// directory even with `force`, a path whose directory does not exist, and a directory
+// where no file can be made (read-only, /proc: a probe file is made and removed), each
+// message starting "--<flag>=<path>: " and naming the directory. "" and "-" (stdout) pass.
+bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
+                   std::string* error);
 
-// An output directory (calibrate/evaluate --out) must be new or empty: false with a
-// message naming `dir` (a file, or a non-empty directory) otherwise.
-bool CheckOutputDirectory(const std::string& dir, std::string* error);
+// An output directory (calibrate/evaluate --out) must be new or empty, and creatable: its
+// nearest existing ancestor must take a new directory (a probe is made and removed).
+// False with a message starting "--<flag>=<dir>: " and naming the directory otherwise.
+bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error);
 
-// Parses one number of a comma-separated flag value: spaces and tabs around it are
-// ignored, '.' is the decimal point whatever the locale. False when `item` is not a number.
-bool ParseNumberItem(const std::string& item, double* value);
+// Parses one number of a comma-separated flag value by the rules of every fastcal file
+// (internal::ParseFiniteDecimal: decimal, '.' whatever the locale, finite; no hexadecimal);
+// spaces and tabs around it are ignored. False with the reason in *why otherwise.
+bool ParseNumberItem(const std::string& item, double* value, std::string* why);
 
 // Parses "x,y,z" (three finite numbers) for flag `name`.
 bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vector3d* v,
                   std::string* error);
 bool ParseVector4(const std::string& name, const std::string& text, Eigen::Vector4d* v,
                   std::string* error);
+
+// A cabin position (--position, --from, --to): ParseVector3, then the plausibility limits
+// a dataset's positions obey (plausibility.h): "--position=0,0,-50: z = -50 m is below the
+// reflector (...)".
+bool ParsePosition(const std::string& name, const std::string& text, Eigen::Vector3d* position_m,
+                   std::string* error);
+// Roll, pitch, yaw in degrees (--rpy), each within the plausible angle.
+bool ParseRpyDeg(const std::string& name, const std::string& text, Eigen::Vector3d* rpy_deg,
+                 std::string* error);
 
 // Writes `content` to `path` through a temporary file and a rename, so that a failure
 // leaves no partial file; path "" or "-" writes to stdout.

@@ -212,8 +212,9 @@ bool ParseOneOrSix(const std::string& name, const std::string& text,
   std::string item;
   while (std::getline(ss, item, ',')) {
     double v = 0.0;
-    if (!ParseNumberItem(item, &v) || !std::isfinite(v)) {
-      *error = "--" + name + ": '" + item + "' is not a finite number";
+    std::string why;
+    if (!ParseNumberItem(item, &v, &why)) {
+      *error = "--" + name + ": " + why;
       return false;
     }
     parsed.push_back(v);
@@ -490,8 +491,8 @@ int RunSimulate(int argc, char** argv) {
     return kExitUsage;
   }
   std::string error;
-  if (!CheckCanWrite(FLAGS_out, FLAGS_force, &error) ||
-      !CheckCanWrite(TruthPathFor(FLAGS_out), FLAGS_force, &error)) {
+  if (!CheckCanWrite("out", FLAGS_out, FLAGS_force, &error) ||
+      !CheckCanWrite("out", TruthPathFor(FLAGS_out), FLAGS_force, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

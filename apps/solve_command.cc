@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/json.h"
+#include "fastcal/plausibility.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
 
@@ -244,14 +245,16 @@ bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
   return false;
 }
 
-bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
-                                  std::vector<Eigen::Vector3d>* positions, bool* known,
-                                  std::string* error) {
+namespace {
+
+bool GenerateTrajectoryPositions(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
+                                 std::vector<Eigen::Vector3d>* positions, bool* known,
+                                 std::string* error) {
   *known = true;
   if (kind == "line") {
     Eigen::Vector3d from, to;
-    return ParseVector3("from", FLAGS_from, &from, error) &&
-           ParseVector3("to", FLAGS_to, &to, error) &&
+    return ParsePosition("from", FLAGS_from, &from, error) &&
+           ParsePosition("to", FLAGS_to, &to, error) &&
            LinePositions(from, to, FLAGS_nodes, positions, error);
   }
   if (kind == "arc") {
@@ -284,6 +287,25 @@ bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d
   }
   *known = false;
   return false;
+}
+
+}  // namespace
+
+bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
+                                  std::vector<Eigen::Vector3d>* positions, bool* known,
+                                  std::string* error) {
+  if (!GenerateTrajectoryPositions(kind, focal_centre_m, positions, known, error)) return false;
+  // Every node within the limits a dataset's positions obey (an arc of radius 1e6 m).
+  const PlausibilityLimits limits;
+  for (size_t n = 0; n < positions->size(); ++n) {
+    const Eigen::Vector3d& p = (*positions)[n];
+    if (std::string why; !CheckPosition(p, limits, &why)) {
+      *error = "node " + std::to_string(n) + " at position (" + FormatDouble(p[0]) + ", " +
+               FormatDouble(p[1]) + ", " + FormatDouble(p[2]) + ") m: " + why;
+      return false;
+    }
+  }
+  return true;
 }
 
 namespace {
@@ -352,13 +374,13 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
       *error = "give --position=x,y,z, a --trajectory or --poses (see fastcal solve --help)";
       return false;
     }
-    if (!ParseVector3("position", FLAGS_position, &position, error)) return false;
+    if (!ParsePosition("position", FLAGS_position, &position, error)) return false;
     Pose pose;
     pose.position_m = position;
     *attitude = "R = I (no attitude flag)";
     if (!FLAGS_rpy.empty()) {
       Eigen::Vector3d rpy;
-      if (!ParseVector3("rpy", FLAGS_rpy, &rpy, error)) return false;
+      if (!ParseRpyDeg("rpy", FLAGS_rpy, &rpy, error)) return false;
       pose.rotation = RotationFromRpyDeg(rpy[0], rpy[1], rpy[2]);
       *attitude = "--rpy=" + FLAGS_rpy + " deg";
     } else if (!FLAGS_quat.empty()) {
@@ -372,7 +394,12 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
       *attitude = "--quat=" + FLAGS_quat;
     } else if (!FLAGS_rotvec.empty()) {
       Eigen::Vector3d v;
+      std::string why;
       if (!ParseVector3("rotvec", FLAGS_rotvec, &v, error)) return false;
+      if (!CheckRotationVector(v, PlausibilityLimits(), &why)) {
+        *error = "--rotvec=" + FLAGS_rotvec + ": " + why;
+        return false;
+      }
       pose.rotation = RotationFromRotationVector(v);
       *attitude = "--rotvec=" + FLAGS_rotvec + " rad";
     } else if (focal) {
@@ -665,7 +692,7 @@ int RunSolve(int argc, char** argv) {
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
 
   std::string error;
-  if (!CheckCanWrite(FLAGS_output, FLAGS_force, &error)) {
+  if (!CheckCanWrite("output", FLAGS_output, FLAGS_force, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

@@ -349,7 +349,7 @@ TEST_F(CliTest, BadValuesNameTheFlagNotTheOptionField) {
       {"solve --trajectory=grid --focal-radius=0", "--focal-radius", "focal_radius_m"},
       {"solve --trajectory=random --samples=0", "--samples", ": samples must"},
       {"solve --trajectory=random --radial-spread=500", "--radial-spread", "radial_spread_m"},
-      {"solve --trajectory=line --from=0,0,400", "--focal-centre", "law.focal_centre_m"},
+      {"solve --trajectory=line --focal-centre=0,0,100", "--focal-centre", "law.focal_centre_m"},
       {sim + "--attitude-control-deg=-1", "--attitude-control-deg", "attitude_control_sigma_deg"},
       {sim + "--attitude-noise-deg=-1", "--attitude-noise-deg", "attitude_measurement_sigma_deg"},
       {sim + "--position-noise-m=-1", "--position-noise-m", "position_measurement_sigma_m"},
@@ -644,7 +644,7 @@ TEST_F(CliTest, SkipInvalidRowsSkipsPosesTheModelCannotSolve) {
 // A mistyped reading (T3_kN = 99999 on line 9) is named by line and cable on the
 // console and in summary.json, kept out of the fit, and the estimates stay sane.
 TEST_F(CliTest, CalibrateNamesAGrossErrorByLineAndCable) {
-  // Line 9 of the bundled circle with its T3_kN replaced by 99999.
+  // Line 9 of the bundled circle with its T3_kN replaced by 4999.
   std::ifstream in(Source() + "/calibration_data/circle_paper.csv");
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
@@ -739,6 +739,91 @@ TEST_F(CliTest, FailedFitIsMarkedInTheModelFile) {
   const std::string model = ReadFile(out + "/model_calibrated.yaml");
   EXPECT_EQ(model.rfind("# WARNING: THIS CALIBRATION FAILED; DO NOT USE THIS MODEL.", 0), 0u)
       << model;
+}
+
+// The first rows of the bundled circle (header on line 4) with field `column` of data row
+// `row` (0-based) replaced by `value`.
+std::string CircleWith(const std::string& column, int row, const std::string& value) {
+  std::ifstream in(Source() + "/calibration_data/circle_paper.csv");
+  std::string text, line, header;
+  int data_row = -1;
+  while (std::getline(in, line) && data_row < 20) {
+    if (!line.empty() && line[0] != '#' && header.empty()) {
+      header = line;
+    } else if (!line.empty() && line[0] != '#' && ++data_row == row) {
+      std::vector<std::string> names, fields;
+      std::stringstream h(header), r(line);
+      for (std::string f; std::getline(h, f, ',');) names.push_back(f);
+      for (std::string f; std::getline(r, f, ',');) fields.push_back(f);
+      fields[std::find(names.begin(), names.end(), column) - names.begin()] = value;
+      line.clear();
+      for (size_t k = 0; k < fields.size(); ++k) line += (k ? "," : "") + fields[k];
+    }
+    text += line + "\n";
+  }
+  return text;
+}
+
+// Each command of the hardening issue's list, as a new user would type it: a clear
+// message and a non-zero exit, or success where the input is possible. Run under a
+// memory and time limit, so that a regression (a hang, reading /dev/zero) fails the test
+// instead of the machine.
+TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
+  const std::string limit = "ulimit -v 4000000; timeout 60 ";
+  const auto run = [&](const std::string& args) { return Shell(limit + Bin() + " " + args); };
+  const std::string data = " --data=" + Source() + "/calibration_data/circle_paper.csv";
+  const std::string spec = " --spec=" + Source() + "/calibration_data/spec_mass_centre.yaml";
+  struct Case {
+    std::string args;
+    int code;
+    std::string expected;
+  };
+  Write("comma.yaml", "{format: fastcal-model-1, gravity_m_per_s2: -9.8},");
+  Write("t3.csv", CircleWith("T3_kN", 2, "1e30"));
+  Write("t3max.csv", CircleWith("T3_kN", 2, "1e308"));
+  Write("t1tiny.csv", CircleWith("T1_kN", 2, "1e-300"));
+  Write("zero.csv", CircleWith("T2_kN", 3, "0"));
+  Write("comma.csv", CircleWith("T3_kN", 4, "244,5"));
+  Write("binary.csv", "time_s,x_m,\x1b]0;owned\x07" + std::string(1 << 20, 'A') + "\n1,2,3\n");
+  const std::string comma = Path("comma.yaml");
+  const std::vector<Case> cases = {
+      {"solve --position=0,0,140 --model=" + comma, 2,
+       "comma.yaml:1: YAML syntax error: unexpected ',' at column 50"},
+      {"evaluate --model=" + comma + data, 2, "unexpected ','"},
+      {"calibrate --spec=" + comma + data + " --out=" + Path("o1"), 2, "unexpected ','"},
+      {"evaluate --data=/dev/zero", 2, "/dev/zero: not a regular file"},
+      {"calibrate" + spec + data + " --out=/proc/x", 2,
+       "--out=/proc/x: cannot write: cannot create a directory in '/proc'"},
+      {"evaluate --data=" + Path("binary.csv"), 2, "unknown column '\\x1b]0;owned\\x07AAA"},
+      {"evaluate --data=" + Path("t3.csv"), 2,
+       "t3.csv:7: column 'T3_kN': 1e+30 kN is above the plausible maximum of 5000 kN"},
+      {"evaluate --data=" + Path("t3max.csv"), 2, "1e+308 kN is above the plausible maximum"},
+      {"evaluate --data=" + Path("comma.csv"), 2,
+       "comma.csv:9: expected 22 fields (as in the header), found 23: a decimal comma? '244,5' "
+       "in column 'T3_kN'"},
+      {"solve --position=0,0,-50", 2, "--position=0,0,-50: z = -50 m is below the reflector"},
+      {"solve --position=0x10,0,140", 2, "--position: '0x10' is not a decimal number"},
+      {"solve --position=0,0,1e308", 2, "z = 1e+308 m is above the tower tops"},
+      {"solve --position=0,0,140 --rpy=0,0,1e300", 2, "yaw 1e+300 deg is beyond the plausible"},
+      {"evaluate --data=" + Path("t1tiny.csv"), 0, "RMS (%)"},
+      {"evaluate --data=" + Path("zero.csv"), 0, "RMS (%)"},
+      {"--help", 0, "solve"},
+      {"solve --bogus=1", 2, "unknown flag --bogus"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = run(c.args);
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output.substr(0, 2000);
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args << "\n"
+                                                            << r.output.substr(0, 2000);
+    // Never a raw control byte from the input, never a message the size of the input, never
+    // an infinite or undefined number where an error or a value belongs.
+    EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << c.args;
+    EXPECT_LT(r.output.size(), 20000u) << c.args;
+    for (const char* bad : {" inf", " nan", "-nan", " -inf"}) {
+      EXPECT_EQ(r.output.find(bad), std::string::npos) << c.args << ": " << bad << "\n" << r.output;
+    }
+  }
+  EXPECT_FALSE(fs::exists(Path("o1")));
 }
 
 }  // namespace
