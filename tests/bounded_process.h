@@ -16,18 +16,27 @@ inline constexpr unsigned kBoundedSeconds = 20;
 // shadow memory, so there only the time limit applies).
 inline constexpr rlim_t kBoundedAddressSpaceBytes = rlim_t{4} << 30;
 
-inline void LimitThisProcess() {
-#if !defined(__SANITIZE_ADDRESS__) && !defined(__has_feature)
-#define FASTCAL_LIMIT_ADDRESS_SPACE 1
+// Whether this build runs under AddressSanitizer (gcc defines __SANITIZE_ADDRESS__, clang
+// has __has_feature).
+#if defined(__SANITIZE_ADDRESS__)
+inline constexpr bool kUnderAddressSanitizer = true;
 #elif defined(__has_feature)
-#if !__has_feature(address_sanitizer) && !defined(__SANITIZE_ADDRESS__)
-#define FASTCAL_LIMIT_ADDRESS_SPACE 1
+#if __has_feature(address_sanitizer)
+inline constexpr bool kUnderAddressSanitizer = true;
+#else
+inline constexpr bool kUnderAddressSanitizer = false;
 #endif
+#else
+inline constexpr bool kUnderAddressSanitizer = false;
 #endif
-#ifdef FASTCAL_LIMIT_ADDRESS_SPACE
-  const rlimit limit{kBoundedAddressSpaceBytes, kBoundedAddressSpaceBytes};
-  setrlimit(RLIMIT_AS, &limit);
-#endif
+
+// Limits this process: SIGALRM after kBoundedSeconds and, without a sanitizer, at most
+// kBoundedAddressSpaceBytes of address space (beyond it allocation throws bad_alloc).
+inline void LimitThisProcess() {
+  if (!kUnderAddressSanitizer) {
+    const rlimit limit{kBoundedAddressSpaceBytes, kBoundedAddressSpaceBytes};
+    setrlimit(RLIMIT_AS, &limit);
+  }
   alarm(kBoundedSeconds);
 }
 

@@ -136,6 +136,16 @@ def test_undetermined_free_set_is_refused_with_the_combination(circle: fastcal.D
     assert isinstance(raised.value, RuntimeError)
 
 
+def test_spec_with_a_stray_comma_is_a_syntax_error_not_a_hang(
+    tmp_path: pathlib.Path, circle: fastcal.Dataset
+) -> None:
+    # yaml-cpp 0.7's LoadAll looped without end on this (docs/hardening.md).
+    path = tmp_path / "spec.yaml"
+    path.write_text("{format: fastcal-calibration-spec-1},")
+    with pytest.raises(fastcal.InputError, match=r"spec\.yaml:1: YAML syntax error: unexpected ','"):
+        fastcal.calibrate(path, circle)
+
+
 def test_bad_spec_names_file_line_and_key_as_the_cli_does(
     tmp_path: pathlib.Path, data_dir: pathlib.Path, circle: fastcal.Dataset, cli: Optional[str]
 ) -> None:

@@ -63,6 +63,15 @@ def test_bad_model_file_names_file_and_key(tmp_path: pathlib.Path) -> None:
         fastcal.Model.load(str(tmp_path / "absent.yaml"))
 
 
+def test_stray_comma_is_a_syntax_error_not_a_hang(tmp_path: pathlib.Path) -> None:
+    # yaml-cpp 0.7's LoadAll looped without end on this (docs/hardening.md); the module
+    # reads through the same guarded reader as the command line.
+    path = tmp_path / "comma.yaml"
+    path.write_text("{format: fastcal-model-1, gravity_m_per_s2: -9.8},")
+    with pytest.raises(fastcal.InputError, match=r"comma\.yaml:1: YAML syntax error: unexpected ','"):
+        fastcal.Model.load(str(path))
+
+
 def test_validate_names_the_key() -> None:
     model = fastcal.Model.nominal()
     model.ea_n = [2.4656e7, 2.4656e7, -1.0, 2.4656e7, 2.4656e7, 2.4656e7]
