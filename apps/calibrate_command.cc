@@ -20,6 +20,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/file_digest.h"
+#include "fastcal/internal/quote.h"
 #include "fastcal/report.h"
 #include "fastcal/version.h"
 
@@ -587,7 +588,8 @@ int RunEvaluate(int argc, char** argv) {
   std::string error;
   StaticsMethod method = StaticsMethod::kExact;
   if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &method)) {
-    PrintError(command, "--method must be aas, aas-refined or exact, got '" + FLAGS_method + "'");
+    PrintError(command,
+               "--method must be aas, aas-refined or exact, got " + internal::Quote(FLAGS_method));
     return kExitUsage;
   }
   CableRobot model;

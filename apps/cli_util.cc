@@ -40,8 +40,8 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
   for (int i = first; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg.size() < 3 || arg[0] != '-') {
-      *error = "unexpected argument '" + arg + "' (flags are --name=value; see fastcal " + command +
-               " --help)";
+      *error = "unexpected argument " + internal::Quote(arg) +
+               " (flags are --name=value; see fastcal " + command + " --help)";
       return false;
     }
     const size_t start = arg[1] == '-' ? 2 : 1;
@@ -56,7 +56,8 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
       if (c == '-') c = '_';
     }
     if (!allowed.count(bare)) {
-      *error = "unknown flag --" + name + " (see fastcal " + command + " --help)";
+      *error = "unknown flag --" + internal::Escape(name.substr(0, internal::kMaxQuotedBytes)) +
+               " (see fastcal " + command + " --help)";
       return false;
     }
     if (!seen.insert(bare).second) {

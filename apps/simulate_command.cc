@@ -19,6 +19,7 @@
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/dataset.h"
+#include "fastcal/internal/quote.h"
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
@@ -220,7 +221,8 @@ bool ParseOneOrSix(const std::string& name, const std::string& text,
     parsed.push_back(v);
   }
   if ((parsed.size() != 1 && parsed.size() != kNumCables) || text.back() == ',') {
-    *error = "--" + name + " needs one value or six comma-separated values, got '" + text + "'";
+    *error = "--" + name + " needs one value or six comma-separated values, got " +
+             internal::Quote(text);
     return false;
   }
   for (int i = 0; i < kNumCables; ++i) (*values)[i] = parsed[parsed.size() == 1 ? 0 : i];
@@ -277,7 +279,7 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->sample_interval_s = FLAGS_interval_s;
   options->method = StaticsMethod::kExact;
   if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &options->method)) {
-    *error = "--method must be exact, aas-refined or aas, got '" + FLAGS_method + "'";
+    *error = "--method must be exact, aas-refined or aas, got " + internal::Quote(FLAGS_method);
     return false;
   }
   std::string why;
@@ -339,7 +341,7 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     return false;
   }
   if (FlagGiven("attitude-law") && FLAGS_attitude_law != "focal" && FLAGS_attitude_law != "none") {
-    *error = "--attitude-law must be 'focal' or 'none', got '" + FLAGS_attitude_law + "'";
+    *error = "--attitude-law must be 'focal' or 'none', got " + internal::Quote(FLAGS_attitude_law);
     return false;
   }
   std::string trajectory = FlagGiven("trajectory") ? FLAGS_trajectory : "circle";
@@ -377,8 +379,8 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     bool known = false;
     ok = TrajectoryPositionsFromFlags(trajectory, law.focal_centre_m, &positions, &known, error);
     if (!known) {
-      *error =
-          "--trajectory must be circle, line, arc, grid, random or poses, got '" + trajectory + "'";
+      *error = "--trajectory must be circle, line, arc, grid, random or poses, got " +
+               internal::Quote(trajectory);
       return false;
     }
   }

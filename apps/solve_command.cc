@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/json.h"
+#include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
@@ -329,7 +330,7 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
   }
   if (!FLAGS_attitude_law.empty() && FLAGS_attitude_law != "focal" &&
       FLAGS_attitude_law != "none") {
-    *error = "--attitude-law must be 'focal' or 'none', got '" + FLAGS_attitude_law + "'";
+    *error = "--attitude-law must be 'focal' or 'none', got " + internal::Quote(FLAGS_attitude_law);
     return false;
   }
   const int constant_attitudes = !FLAGS_rpy.empty() + !FLAGS_quat.empty() + !FLAGS_rotvec.empty() +
@@ -427,8 +428,8 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
   const bool ok =
       TrajectoryPositionsFromFlags(FLAGS_trajectory, law.focal_centre_m, &positions, &known, error);
   if (!known) {
-    *error =
-        "--trajectory must be point, line, arc, grid or random, got '" + FLAGS_trajectory + "'";
+    *error = "--trajectory must be point, line, arc, grid or random, got " +
+             internal::Quote(FLAGS_trajectory);
     return false;
   }
   if (!ok) {
@@ -473,7 +474,8 @@ bool CheckFlagsApplyToMode(std::string* error) {
 bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* error) {
   *compare = FLAGS_method == "compare";
   if (!*compare && !ParseStaticsMethod(FLAGS_method, &options->method)) {
-    *error = "--method must be aas, aas-refined, exact or compare, got '" + FLAGS_method + "'";
+    *error =
+        "--method must be aas, aas-refined, exact or compare, got " + internal::Quote(FLAGS_method);
     return false;
   }
   options->secant_low_fraction = FLAGS_secant_low;
@@ -488,7 +490,7 @@ bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* er
     return false;
   }
   if (FLAGS_format != "csv" && FLAGS_format != "json") {
-    *error = "--format must be csv or json, got '" + FLAGS_format + "'";
+    *error = "--format must be csv or json, got " + internal::Quote(FLAGS_format);
     return false;
   }
   return true;

@@ -446,6 +446,18 @@ TEST(CableRobotYaml, StrayTopLevelCommaIsASyntaxErrorNotAHang) {
   }
 }
 
+// Text from the file in a message is escaped and capped (internal/quote.h): YAML's "\e"
+// is an escape byte, which must not reach the terminal.
+TEST(CableRobotYaml, MessagesQuoteTheFilesTextSafely) {
+  const std::string error =
+      ParseError("cabin:\n  mass_kg: \"\\e[2J" + std::string(500, 'x') + "\"\n");
+  EXPECT_EQ(error.find('\x1b'), std::string::npos) << error;
+  EXPECT_NE(error.find("cabin.mass_kg: expected a number, got the quoted text '\\x1b[2Jxxx"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("'... (504 bytes)"), std::string::npos) << error;
+}
+
 TEST(CableRobotYaml, SecondDocumentIsAnErrorOnItsLine) {
   const std::string error = ParseError("gravity_m_per_s2: -9.8\n---\ngravity_m_per_s2: -9.8\n");
   EXPECT_EQ(error, "m.yaml:3: (top level): only one YAML document is allowed");

@@ -813,6 +813,8 @@ TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
       {"evaluate --data=" + Path("zero.csv"), 0, "RMS (%)"},
       {"--help", 0, "solve"},
       {"solve --bogus=1", 2, "unknown flag --bogus"},
+      {"solve --position=0,0,140 --method=\"$(printf '\\033')[2J\"", 2,
+       "--method must be aas, aas-refined, exact or compare, got '\\x1b[2J'"},
   };
   for (const Case& c : cases) {
     const CommandResult r = run(c.args);

@@ -26,6 +26,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/quote.h"
 #include "yaml_document.h"
 
 namespace fastcal {
@@ -64,7 +65,8 @@ class Parser {
   bool Fail(int line, const std::string& path, const std::string& what) {
     error_ = source_;
     if (line > 0) error_ += ":" + std::to_string(line);
-    error_ += ": " + path + ": " + what;
+    // Key names come from the file: escaped like the values (internal/quote.h).
+    error_ += ": " + internal::Escape(path) + ": " + what;
     return false;
   }
   // Records "<source>: <what>": a problem of the whole file.
@@ -114,7 +116,8 @@ class Parser {
     if (node.IsNull()) return Fail(line, path, "has no value (expected a number)");
     if (!node.IsScalar()) return Fail(line, path, "expected a number");
     if (node.Tag() == "!") {
-      return Fail(line, path, "expected a number, got the quoted text \"" + node.Scalar() + "\"");
+      return Fail(line, path,
+                  "expected a number, got the quoted text " + internal::Quote(node.Scalar()));
     }
     const std::string& text = node.Scalar();
     const std::string lower = ToLower(text);
@@ -129,7 +132,7 @@ class Parser {
     const auto [ptr, ec] = std::from_chars(begin, end, parsed);
     if (ec == std::errc::result_out_of_range) return Fail(line, path, "out of range: " + text);
     if (ec != std::errc() || ptr != end || begin == end) {
-      return Fail(line, path, "expected a number, got \"" + text + "\"");
+      return Fail(line, path, "expected a number, got " + internal::Quote(text));
     }
     if (!std::isfinite(parsed)) return Fail(line, path, "must be finite, got " + text);
     *value = parsed;
@@ -143,7 +146,7 @@ class Parser {
     int parsed = 0;
     const auto [ptr, ec] = std::from_chars(text.data(), text.data() + text.size(), parsed);
     if (ec != std::errc() || ptr != text.data() + text.size() || text.empty()) {
-      return Fail(line, path, "expected an integer, got \"" + text + "\"");
+      return Fail(line, path, "expected an integer, got " + internal::Quote(text));
     }
     *value = parsed;
     return true;

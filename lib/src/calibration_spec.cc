@@ -31,6 +31,7 @@
 #include <vector>
 
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/quote.h"
 #include "yaml_document.h"
 
 namespace fastcal {
@@ -256,7 +257,8 @@ class Reader {
   bool Fail(int line, const std::string& path, const std::string& what) {
     error_ = source_;
     if (line > 0) error_ += ":" + std::to_string(line);
-    error_ += ": " + path + ": " + what;
+    // Key names come from the file: escaped like the values (internal/quote.h).
+    error_ += ": " + internal::Escape(path) + ": " + what;
     return false;
   }
 
@@ -377,7 +379,7 @@ class Reader {
     if (!node.IsScalar()) return Fail(kv.line, path, "expected a number");
     const std::string& text = node.Scalar();
     if (node.Tag() == "!") {
-      return Fail(kv.line, path, "expected a number, got the quoted text \"" + text + "\"");
+      return Fail(kv.line, path, "expected a number, got the quoted text " + internal::Quote(text));
     }
     for (const char* special : {".nan", ".NaN", ".NAN", ".inf", ".Inf", ".INF", "+.inf", "+.Inf",
                                 "+.INF", "-.inf", "-.Inf", "-.INF"}) {
@@ -390,7 +392,7 @@ class Reader {
     const auto [ptr, ec] = std::from_chars(begin, end, parsed);
     if (ec == std::errc::result_out_of_range) return Fail(kv.line, path, "out of range: " + text);
     if (ec != std::errc() || ptr != end || begin == end) {
-      return Fail(kv.line, path, "expected a number, got \"" + text + "\"");
+      return Fail(kv.line, path, "expected a number, got " + internal::Quote(text));
     }
     if (!std::isfinite(parsed)) return Fail(kv.line, path, "must be finite, got " + text);
     *value = parsed;
@@ -408,8 +410,8 @@ class Reader {
     if (ec != std::errc() || ptr != text.data() + text.size() || text.empty()) {
       return Fail(kv.line, path,
                   std::string("expected ") +
-                      (std::is_signed<Int>::value ? "an integer" : "an integer >= 0") + ", got \"" +
-                      text + "\"");
+                      (std::is_signed<Int>::value ? "an integer" : "an integer >= 0") + ", got " +
+                      internal::Quote(text));
     }
     *value = parsed;
     return true;
@@ -428,7 +430,7 @@ class Reader {
     }
     return Fail(kv.line, path,
                 "expected true or false" +
-                    (node.IsScalar() ? ", got \"" + node.Scalar() + "\"" : std::string()));
+                    (node.IsScalar() ? ", got " + internal::Quote(node.Scalar()) : std::string()));
   }
 
   // Fails with `what` unless it is empty.
