@@ -351,10 +351,12 @@ std::vector<int> BasisColumns(const ParameterSpec& p, int num_anchor_points) {
 }
 
 Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows) {
-  const int n = static_cast<int>(rows.cols());
+  // A fold with nothing yet has a 0 x 0 R factor, not 0 x n: Eigen's assert (on in the
+  // sanitizer build) refuses assigning it to a 0 x n block, so empty parts are skipped.
+  const int n = static_cast<int>(std::max(top.cols(), rows.cols()));
   Eigen::MatrixXd m(top.rows() + rows.rows(), n);
-  m.topRows(top.rows()) = top;
-  m.bottomRows(rows.rows()) = rows;
+  if (top.rows() > 0) m.topRows(top.rows()) = top;
+  if (rows.rows() > 0) m.bottomRows(rows.rows()) = rows;
   if (m.rows() == 0) return Eigen::MatrixXd::Zero(n, n);
   const Eigen::HouseholderQR<Eigen::MatrixXd> qr(m);
   Eigen::MatrixXd r = Eigen::MatrixXd::Zero(n, n);
