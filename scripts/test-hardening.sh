@@ -1,0 +1,76 @@
+#!/usr/bin/env bash
+# The hardening job (docs/hardening.md), run by .ci/run after scripts/test.sh:
+#  1. the whole test suite built with g++ under AddressSanitizer + UndefinedBehaviorSanitizer,
+#     stopping at the first report (build-asan/);
+#  2. the four libFuzzer targets of tests/fuzz built with clang (build-fuzz/), each run for
+#     FASTCAL_FUZZ_SECONDS (default 60) from the seed corpus and the regression inputs.
+# Usage: scripts/test-hardening.sh [--sanitizers-only | --fuzz-only]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+mode=${1:-all}
+case "$mode" in all | --sanitizers-only | --fuzz-only) ;; *)
+  echo "usage: $0 [--sanitizers-only | --fuzz-only]" >&2
+  exit 2
+  ;;
+esac
+"$root/scripts/setup.sh"
+"$root/scripts/setup-hardening.sh"
+jobs=$(nproc 2>/dev/null || echo 2)
+fuzz_seconds=${FASTCAL_FUZZ_SECONDS:-60}
+# Debian's libceres is built without sanitizers: Eigen's own aligned allocation in our
+# code and the plain free in the library disagree, and ASan reports a bad free inside
+# Eigen's SVD (Ceres' covariance). With this, Eigen uses malloc/free everywhere.
+eigen_flags=-DEIGEN_MALLOC_ALREADY_ALIGNED=1
+export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1
+export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
+start=$SECONDS
+
+if [ "$mode" != --fuzz-only ]; then
+  sanitize="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+  # No Python module (the interpreter is not built with ASan and cannot load an ASan
+  # module without LD_PRELOAD), no install test (its consumer would need the same
+  # flags), no benchmarks.
+  # -O1 -g1: quick to build, readable stacks; no NDEBUG, so Eigen's and our asserts run.
+  cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=Sanitize \
+    -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" \
+    -DCMAKE_CXX_FLAGS="$sanitize $eigen_flags" -DCMAKE_EXE_LINKER_FLAGS="$sanitize" \
+    -DCMAKE_SHARED_LINKER_FLAGS="$sanitize" -DFASTCAL_BUILD_PYTHON=OFF \
+    -DFASTCAL_BUILD_BENCHMARKS=OFF -DFASTCAL_INSTALL=OFF >/dev/null
+  cmake --build "$root/build-asan" -j "$jobs"
+  (cd "$root/build-asan" && ctest --output-on-failure -j "$jobs" --timeout 900)
+  echo "hardening: sanitizer suite passed ($((SECONDS - start)) s so far)"
+fi
+
+if [ "$mode" != --sanitizers-only ]; then
+  fuzz_flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
+  cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_CXX_COMPILER=clang++ \
+    -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" \
+    -DCMAKE_CXX_FLAGS="$fuzz_flags $eigen_flags" \
+    -DFASTCAL_BUILD_FUZZERS=ON -DFASTCAL_BUILD_APPS=OFF -DFASTCAL_BUILD_TESTS=OFF \
+    -DFASTCAL_BUILD_BENCHMARKS=OFF -DFASTCAL_BUILD_PYTHON=OFF -DFASTCAL_INSTALL=OFF >/dev/null
+  cmake --build "$root/build-fuzz" -j "$jobs"
+  summary=()
+  for target in dataset_csv pose_csv model_yaml spec_yaml; do
+    work="$root/build-fuzz/fuzz-work/$target"
+    artifacts="$root/build-fuzz/fuzz-artifacts"
+    mkdir -p "$work" "$artifacts"
+    log="$root/build-fuzz/fuzz-$target.log"
+    inputs=("$work")
+    for kind in corpus regressions; do
+      [ -d "$root/tests/fuzz/$kind/$target" ] && inputs+=("$root/tests/fuzz/$kind/$target")
+    done
+    # New inputs go to the work folder (first), never into the tree's corpus. A hang
+    # beyond 10 s or 2 GB of memory is a finding like a crash.
+    if ! "$root/build-fuzz/fuzz/fuzz_$target" -max_total_time="$fuzz_seconds" -timeout=10 \
+      -rss_limit_mb=2048 -print_final_stats=1 -artifact_prefix="$artifacts/$target-" \
+      "${inputs[@]}" >"$log" 2>&1; then
+      tail -n 60 "$log" >&2
+      echo "hardening: fuzz_$target found a problem; the input is in $artifacts/" >&2
+      exit 1
+    fi
+    execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log")
+    summary+=("fuzz_$target: $execs executions in ${fuzz_seconds} s, no finding")
+  done
+  printf 'hardening: %s\n' "${summary[@]}"
+fi
+echo "hardening: done in $((SECONDS - start)) s"
