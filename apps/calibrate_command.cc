@@ -58,7 +58,7 @@ Usage:
   --out=DIR           output directory; must not exist or be empty. Written only when the
                       calibration succeeded: nothing is left behind on failure.
   --skip-invalid-rows skip rows that are malformed (a missing, non-numeric or non-finite
-                      value, a tension <= 0...) or whose pose the initial model cannot
+                      value, an implausible one...) or whose pose the initial model cannot
                       solve (e.g. outside the workspace), instead of failing; each is
                       listed with its line on stderr, in the report and in summary.json
   --quiet             no per-iteration solver progress
