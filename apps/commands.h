@@ -9,6 +9,7 @@
 
 #include "cli_util.h"
 #include "fastcal/pose.h"
+#include "fastcal/statics.h"
 
 namespace fastcal::cli {
 
@@ -39,6 +40,10 @@ std::string WithTrajectoryFlagNames(const std::string& message);
 bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
                                 const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                                 std::string* error);
+
+// Sets the model-range limits of `options` from --max-strain, --max-length-ratio and
+// --reflector-clearance (solve, workspace); false with the flags named when invalid.
+bool ModelRangeFromFlags(StaticsOptions* options, std::string* error);
 
 }  // namespace fastcal::cli
 

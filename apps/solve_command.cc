@@ -16,7 +16,7 @@
 #include "fastcal/trajectory.h"
 
 DEFINE_string(model, "", "Model YAML (docs/model-format.md); empty = nominal FAST.");
-DEFINE_string(method, "aas-refined", "aas | aas-refined | exact | compare");
+DEFINE_string(method, "exact", "exact | aas | aas-refined | compare");
 DEFINE_string(position, "", "Single pose: x,y,z of the cabin frame origin (m).");
 DEFINE_string(rpy, "", "Attitude roll,pitch,yaw (deg), R = Rz(yaw) Ry(pitch) Rx(roll).");
 DEFINE_string(quat, "", "Attitude as unit quaternion w,x,y,z.");
@@ -47,8 +47,16 @@ DEFINE_string(output, "", "Output file; empty or - = stdout. Written only on suc
 DEFINE_bool(force, false, "Replace an existing output file (solve --output, simulate --out).");
 DEFINE_double(secant_low, 0.99, "AAS: low secant length as a fraction of the chord.");
 DEFINE_double(secant_high, 1.01, "AAS: high secant length as a fraction of the chord.");
-DEFINE_int32(refinement_steps, 1, "aas-refined: re-linearisation steps.");
-DEFINE_double(exact_tolerance, 1e-12, "exact: relative tolerance on the forces.");
+DEFINE_int32(max_refinement_steps, 8, "aas-refined: at most this many tangent steps.");
+DEFINE_double(refined_tolerance, 1e-6,
+              "aas-refined: steps stop when its tension error estimate is below this.");
+DEFINE_double(aas_max_error, 0.01,
+              "aas, compare: aas is ok only when its tension error estimate is at most this.");
+DEFINE_double(exact_tolerance, 1e-12, "exact: relative tolerance on the tensions.");
+DEFINE_double(max_strain, 0.05, "Model range: largest cable strain (tension / EA).");
+DEFINE_double(max_length_ratio, 1.5, "Model range: largest unstretched length / chord, s0/k.");
+DEFINE_double(reflector_clearance, 0.0,
+              "Smallest clearance (m) of a cable from the model's reflector surface.");
 DEFINE_bool(warm_start, true, "Start each trajectory node from the previous solution.");
 DEFINE_bool(keep_going, false,
             "Write infeasible poses as rows with their status instead of failing.");
@@ -68,9 +76,9 @@ Usage:
   fastcal solve --poses=FILE.csv [options]
 
 Each flag belongs to a mode: a flag given for another one (--nodes with --position,
---radius with --trajectory=grid, --tilt-fraction without the focal law, --refinement-steps
-with --method=exact, --force without --output) is an error naming it and where it
-belongs (exit 2), never silently ignored; so is a flag given twice.
+--radius with --trajectory=grid, --tilt-fraction without the focal law,
+--max-refinement-steps with --method=exact, --force without --output) is an error naming
+it and where it belongs (exit 2), never silently ignored; so is a flag given twice.
 
 Attitude (at most one):
   --rpy=r,p,y            roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll)
@@ -98,14 +106,22 @@ Trajectories:
           ignored, so a calibration dataset works; any other column is an error
 
 Method (--method):
-  aas          the paper's approximately analytical solution (secants at 0.99k, 1.01k)
-  aas-refined  AAS re-linearised on the exact Fz(Fl) tangent (default; ~1e-7 of exact)
-  exact        full coupled Newton solution to --exact-tolerance
+  exact        (default) the coupled Newton solution to --exact-tolerance=1e-12; where its
+               start from AAS fails it follows the equilibrium from the home pose, so it
+               finds it wherever one exists, and says when none does
+  aas          the paper's approximately analytical solution (secants at 0.99k, 1.01k);
+               ok only when its own error estimate is at most --aas-max-error=0.01 (1%)
+  aas-refined  AAS re-linearised on the exact Fz(Fl) tangent, step after step until its
+               error estimate is below --refined-tolerance=1e-6, at most
+               --max-refinement-steps=8 (one step where the cables are taut)
   compare      AAS and exact side by side with per-cable relative errors and their
                maxima over the trajectory (printed on stderr; in JSON as a field)
   --secant-low=0.99 --secant-high=1.01 (every method: exact starts from AAS)
-  --refinement-steps=1 (aas-refined only) --exact-tolerance=1e-12 (exact, compare)
   --warm-start (default true): each trajectory node starts from the previous solution
+Every solution is checked before it is ok: each catenary's end conditions and the
+cabin's equilibrium, from which the method's error estimate comes. Then the model's range: --max-strain=0.05 (tension / EA),
+--max-length-ratio=1.5 (s0 / chord) and --reflector-clearance=0 (m, how close a cable
+may come to the model's reflector).
 
 Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model. solve
 reports the model's true cable tensions: a model's sensor_gain and sensor_bias_kN are
@@ -125,10 +141,11 @@ CSV columns, units in the names:
 A summary line on stderr names the model (its file, or "nominal FAST"), the attitude
 used and the time per pose.
 
-A pose the cables cannot hold (a slack cable), a vertical cable or a solver failure is
-an error naming the node and cable (exit 1, no output) unless --keep-going, which writes
-the row with its status and empty numbers and exits 0; the summary then says how many
-poses failed, as in 289 poses (69 failed), and names the first.
+A pose the cables cannot hold (no equilibrium, or one outside the model's range), a
+vertical cable or a solver failure is an error naming the node, the cable and the
+numbers (exit 1, no output) unless --keep-going, which writes the row with its status
+and empty numbers and exits 0; the summary then says how many poses failed, as in
+289 poses (69 failed), and names the first.
 
 Examples:
   fastcal solve --position=0,0,140 --method=compare
@@ -166,8 +183,13 @@ const std::set<std::string> kFlags = {"model",
                                       "force",
                                       "secant-low",
                                       "secant-high",
-                                      "refinement-steps",
+                                      "max-refinement-steps",
+                                      "refined-tolerance",
+                                      "aas-max-error",
                                       "exact-tolerance",
+                                      "max-strain",
+                                      "max-length-ratio",
+                                      "reflector-clearance",
                                       "warm-start",
                                       "keep-going"};
 
@@ -433,10 +455,13 @@ bool CheckFlagsApplyToMode(std::string* error) {
                      : kind == "poses" ? "--poses"
                                        : "--trajectory=" + kind;
   if (FlagGiven("attitude-law")) mode += " with --attitude-law=" + FLAGS_attitude_law;
+  const bool exact = FLAGS_method == "exact" || FLAGS_method == "compare";
   const std::vector<FlagScope> method_scopes = {
-      {"refinement-steps", FLAGS_method == "aas-refined", "--method=aas-refined (the default)"},
-      {"exact-tolerance", FLAGS_method == "exact" || FLAGS_method == "compare",
-       "--method=exact or compare"}};
+      {"max-refinement-steps", FLAGS_method == "aas-refined", "--method=aas-refined"},
+      {"refined-tolerance", FLAGS_method == "aas-refined", "--method=aas-refined"},
+      {"aas-max-error", FLAGS_method == "aas" || FLAGS_method == "compare",
+       "--method=aas or compare"},
+      {"exact-tolerance", exact, "--method=exact (the default) or compare"}};
   const bool to_file = !FLAGS_output.empty() && FLAGS_output != "-";
   return CheckFlagsApply(scopes, mode, error) &&
          CheckFlagsApply(method_scopes, "--method=" + FLAGS_method, error) &&
@@ -451,21 +476,41 @@ bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* er
   }
   options->secant_low_fraction = FLAGS_secant_low;
   options->secant_high_fraction = FLAGS_secant_high;
-  options->refinement_steps = FLAGS_refinement_steps;
+  options->max_refinement_steps = FLAGS_max_refinement_steps;
+  options->refined_relative_tolerance = FLAGS_refined_tolerance;
+  options->aas_max_relative_error = FLAGS_aas_max_error;
   options->exact_relative_tolerance = FLAGS_exact_tolerance;
   options->warm_start = FLAGS_warm_start;
   if (!options->IsValid(error)) {
     *error = WithFlagNames(*error, {{"secant fractions", "--secant-low and --secant-high"},
-                                    {"refinement_steps", "--refinement-steps"},
+                                    {"max_refinement_steps", "--max-refinement-steps"},
+                                    {"refined_relative_tolerance", "--refined-tolerance"},
+                                    {"aas_max_relative_error", "--aas-max-error"},
                                     {"exact_relative_tolerance", "--exact-tolerance"}});
     return false;
   }
+  if (!ModelRangeFromFlags(options, error)) return false;
   if (FLAGS_format != "csv" && FLAGS_format != "json") {
     *error = "--format must be csv or json, got '" + FLAGS_format + "'";
     return false;
   }
   return true;
 }
+
+}  // namespace
+
+bool ModelRangeFromFlags(StaticsOptions* options, std::string* error) {
+  options->max_strain = FLAGS_max_strain;
+  options->max_length_ratio = FLAGS_max_length_ratio;
+  options->min_reflector_clearance_m = FLAGS_reflector_clearance;
+  if (options->IsValid(error)) return true;
+  *error = WithFlagNames(*error, {{"max_strain", "--max-strain"},
+                                  {"max_length_ratio", "--max-length-ratio"},
+                                  {"min_reflector_clearance_m", "--reflector-clearance"}});
+  return false;
+}
+
+namespace {
 
 struct Run {
   std::vector<StaticsSolution> solutions;

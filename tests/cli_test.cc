@@ -98,11 +98,12 @@ TEST_F(CliTest, SolveBadInputExitsNonZeroAndNamesTheProblem) {
   r = Fastcal("solve --position=0,0,140 --quat=1,1,0,0");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("unit"), std::string::npos) << r.output;
-  // A pose the cables cannot hold: exit 1, the cable named, no output file.
+  // A pose the cables cannot hold: exit 1, the reason named, no output file.
   const std::string out = Path("never.csv");
   r = Fastcal("solve --position=330,0,150 --output=" + out);
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.output.find("slack"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no equilibrium with positive cable forces"), std::string::npos)
+      << r.output;
   EXPECT_FALSE(fs::exists(out));
   // Malformed model YAML: file and line named.
   Write("bad.yaml", "cabin:\n  mass_kg: heavy\n");
@@ -315,7 +316,13 @@ TEST_F(CliTest, BadValuesNameTheFlagNotTheOptionField) {
   const std::vector<Case> cases = {
       {"solve --position=0,0,140 --exact-tolerance=0", "--exact-tolerance",
        "exact_relative_tolerance"},
-      {"solve --position=0,0,140 --refinement-steps=0", "--refinement-steps", "refinement_steps"},
+      {"solve --position=0,0,140 --method=aas-refined --max-refinement-steps=0",
+       "--max-refinement-steps", "max_refinement_steps"},
+      {"solve --position=0,0,140 --method=aas --aas-max-error=0", "--aas-max-error",
+       "aas_max_relative_error"},
+      {"solve --position=0,0,140 --max-length-ratio=1", "--max-length-ratio", "max_length_ratio"},
+      {"solve --position=0,0,140 --reflector-clearance=nan", "--reflector-clearance",
+       "min_reflector_clearance_m"},
       {"solve --position=0,0,140 --secant-low=2", "--secant-low", "secant fractions"},
       {"solve --trajectory=line --nodes=1", "--nodes", ": nodes must"},
       {"solve --trajectory=arc --radius=0", "--radius", "radius_m"},
@@ -395,10 +402,13 @@ TEST_F(CliTest, FlagsOfAnotherModeAreRefused) {
        "--tilt-fraction applies to the focal attitude law"},
       {"solve --trajectory=line --attitude-law=none --focal-centre=0,0,290",
        "not to --trajectory=line with --attitude-law=none"},
-      {"solve --position=0,0,140 --method=exact --refinement-steps=2",
-       "--refinement-steps applies to --method=aas-refined (the default), not to --method=exact"},
-      {"solve --position=0,0,140 --exact-tolerance=1e-9",
-       "--exact-tolerance applies to --method=exact or compare, not to --method=aas-refined"},
+      {"solve --position=0,0,140 --max-refinement-steps=2",
+       "--max-refinement-steps applies to --method=aas-refined, not to --method=exact"},
+      {"solve --position=0,0,140 --method=aas --exact-tolerance=1e-9",
+       "--exact-tolerance applies to --method=exact (the default) or compare, not to "
+       "--method=aas"},
+      {"solve --position=0,0,140 --method=exact --aas-max-error=0.02",
+       "--aas-max-error applies to --method=aas or compare, not to --method=exact"},
       {"solve --position=0,0,140 --force", "--force applies to --output=FILE"},
       {sim + "--trajectory=grid --nodes=3",
        "--nodes applies to --trajectory=line, arc or circle, not to --trajectory=grid"},
@@ -419,7 +429,9 @@ TEST_F(CliTest, FlagsOfAnotherModeAreRefused) {
                                 "--attitude-law=none --max-off-axis-deg=10",
                                 "solve --position=0,0,140 --attitude-law=focal --tilt-fraction=0.3",
                                 "solve --position=0,0,140 --method=compare --exact-tolerance=1e-9",
-                                "solve --position=0,0,140 --refinement-steps=2",
+                                "solve --position=0,0,140 --method=aas-refined "
+                                "--max-refinement-steps=2 --refined-tolerance=1e-9",
+                                "solve --position=0,0,140 --exact-tolerance=1e-9",
                                 "simulate --nodes=4 --out=" + Path("circle.csv")}) {
     const CommandResult r = Fastcal(args);
     EXPECT_EQ(r.code, 0) << args << ": " << r.output;

@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/catenary.h"
@@ -37,6 +38,8 @@ struct StaticsParameters {
   T cabin_mass_kg;
   Vector3T<T> mass_centre_cabin_m;
   double gravity_m_per_s2 = -9.8;
+  // Only checked against (in double), never differentiated; none unless set.
+  std::optional<Reflector> reflector;
 };
 
 StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot);
@@ -55,6 +58,7 @@ StaticsParameters<double> ScalarParameters(const StaticsParameters<T>& p) {
   d.cabin_mass_kg = ScalarValue(p.cabin_mass_kg);
   for (int j = 0; j < 3; ++j) d.mass_centre_cabin_m[j] = ScalarValue(p.mass_centre_cabin_m[j]);
   d.gravity_m_per_s2 = p.gravity_m_per_s2;
+  d.reflector = p.reflector;
   return d;
 }
 
@@ -94,11 +98,23 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
   return StaticsStatus::kOk;
 }
 
+// How the solution Fl of the 6x6 equilibrium system moves when the right-hand sides of
+// its vertical-force row and its two tilting-moment rows (rows 2, 3, 4; statics.h) move:
+// dFl = response * (d rhs2, d rhs3, d rhs4). A cable's Fz off its curve by d shifts just
+// those rows (by -d, -r_y d, -r_x d), so the error estimates need only this, not the
+// matrix's factors; SolveEquilibrium computes it alongside Fl, off the critical path.
+// The fourth column is padding: rows of four doubles are one vector operation each.
+using EquilibriumResponse = Eigen::Matrix<double, 6, 4, Eigen::RowMajor>;
+
 // Solves the six equilibrium rows for Fl given Fz_i = a_i Fl_i + b_i (statics.h).
-// Returns false when the matrix is singular to working precision.
-template <typename T>
+// Returns false when the matrix is singular to working precision. With kResponse (double
+// only) *response receives the system's EquilibriumResponse; a separate instantiation, so
+// that the plain solve stays as fast as without it.
+template <typename T, bool kResponse = false>
 bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>& a,
-                      const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl) {
+                      const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl,
+                      EquilibriumResponse* response = nullptr) {
+  static_assert(!kResponse || kIsDouble<T>, "the response is kept for double only");
   // Smallest/largest pivot below which the 6x6 system counts as singular.
   constexpr double kMinReciprocalCondition = 1e-13;
   // Row-major, and for double full-length row operations below: fixed trip counts the
@@ -119,10 +135,17 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
     rhs[4] -= r[0] * b[i];
   }
   // Gaussian elimination with partial pivoting, written out: for a fixed 6x6 it is several
-  // times faster than Eigen's blocked PartialPivLU plus its rcond() estimate.
+  // times faster than Eigen's blocked PartialPivLU plus its rcond() estimate. With
+  // `factors` (double only) the multipliers and the row order are recorded as they go.
   using std::abs;
   double max_pivot = 0.0, min_pivot = std::numeric_limits<double>::infinity();
   std::array<T, 6> inv_pivot;
+  // With kResponse, three more right-hand sides: the unit vectors of rows 2, 3 and 4.
+  EquilibriumResponse unit;
+  if constexpr (kResponse) {
+    unit.setZero();
+    unit(2, 0) = unit(3, 1) = unit(4, 2) = 1.0;
+  }
 #pragma GCC unroll 6
   for (int c = 0; c < 6; ++c) {
     int p = c;
@@ -132,6 +155,7 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
     if (p != c) {
       m.row(p).swap(m.row(c));
       std::swap(rhs[p], rhs[c]);
+      if constexpr (kResponse) unit.row(p).swap(unit.row(c));
     }
     const double pivot = abs(ScalarValue(m(c, c)));
     max_pivot = std::max(max_pivot, pivot);
@@ -141,6 +165,7 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
 #pragma GCC unroll 6
     for (int r = c + 1; r < 6; ++r) {
       const T f = m(r, c) * inv_pivot[c];
+      if constexpr (kResponse) unit.row(r) -= f * unit.row(c);
 #pragma GCC unroll 6
       for (int k = kIsDouble<T> ? 0 : c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
       rhs[r] -= f * rhs[c];
@@ -155,6 +180,13 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
     x[r] = acc * inv_pivot[r];
   }
   for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
+  if constexpr (kResponse) {
+    for (int r = 5; r >= 0; --r) {
+      Eigen::Matrix<double, 1, 4> acc = unit.row(r);
+      for (int k = r + 1; k < 6; ++k) acc -= m(r, k) * response->row(k);
+      response->row(r) = acc * inv_pivot[r];
+    }
+  }
   return true;
 }
 
@@ -257,7 +289,7 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
 }
 
 // Puts each cable on its exact Fz(Fl) curve at the current Fl (solves Fz, s0). `guess`
-// (double) starts each solve.
+// (double) starts each solve. kNoEquilibrium when a cable has Fl <= 0.
 template <typename T>
 StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                               const StaticsOptions& o,
@@ -267,7 +299,7 @@ StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<
   for (int i = 0; i < kNumCables; ++i) {
     if (!(ScalarValue((*state)[i].fl) > 0.0)) {
       *cable = i;
-      return StaticsStatus::kSlackCable;
+      return StaticsStatus::kNoEquilibrium;
     }
   }
   if constexpr (kIsDouble<T>) {
@@ -305,45 +337,74 @@ StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<
   return StaticsStatus::kOk;
 }
 
-// One Newton step on all 18 unknowns: each catenary linearised in (Fl, Fz, s0), ds0
-// eliminated with the normal n = (dZ/ds0, -dL/ds0), giving Fz = a Fl + b; then the 6x6
-// equilibrium solve, and ds0 from the linearisation. Writes the largest |dFl| relative to
-// the largest Fl and the largest end-point residual relative to the chord (before the
-// step) when those pointers are not null.
+// Each cable linearised at its state (Fl, Fz, s0): the end conditions' residual and,
+// with ds0 eliminated by the normal n = (dZ/ds0, -dL/ds0), the line Fz = a Fl + b on
+// which the linearised end conditions hold. Where the state meets them, a is the tangent
+// of the cable's Fz(Fl) curve; b - (Fz - a Fl) is how far its Fz misses the curve.
 template <typename T>
-StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
-                                std::array<CableState<T>, kNumCables>* state, int* cable,
-                                double* relative_step, double* relative_residual) {
-  std::array<T, kNumCables> a, b, fl_new;
+struct CableLinearisation {
+  std::array<T, kNumCables> a, b;
+  std::array<T, kNumCables> inv_qq;  // 1 / (n . d(L, Z)/dFz): a miss in Fz per residual
+  std::array<T, kNumCables> g0, g1;  // end residuals: span, rise (m)
   std::array<CatenaryEnd<T>, kNumCables> ends;
-  std::array<T, kNumCables> g0, g1;
+  double max_relative_residual = 0.0;  // largest |g0|, |g1| relative to the chord
+};
+
+template <typename T>
+void LineariseCables(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
+                     const std::array<CableState<T>, kNumCables>& state,
+                     CableLinearisation<T>* lin) {
   double max_residual = 0.0;
   for (int i = 0; i < kNumCables; ++i) {
-    const CableState<T>& c = (*state)[i];
+    const CableState<T>& c = state[i];
     const CatenaryEnd<T> e = CatenaryEndpoint(c.fl, c.fz, c.s0, p.ea_n[i], g.w[i]);
-    g0[i] = e.span_m - g.span[i];
-    g1[i] = e.rise_m - g.rise[i];
+    const T g0 = e.span_m - g.span[i];
+    const T g1 = e.rise_m - g.rise[i];
     const double chord = ScalarValue(g.chord[i]);
-    max_residual = std::max(
-        max_residual, std::max(std::abs(ScalarValue(g0[i])), std::abs(ScalarValue(g1[i]))) / chord);
+    max_residual = std::max(max_residual,
+                            std::max(std::abs(ScalarValue(g0)), std::abs(ScalarValue(g1))) / chord);
     const T n0 = e.drise[2], n1 = -e.dspan[2];
-    const T cc = n0 * g0[i] + n1 * g1[i];
+    const T cc = n0 * g0 + n1 * g1;
     const T pp = n0 * e.dspan[0] + n1 * e.drise[0];
-    const T qq = n0 * e.dspan[1] + n1 * e.drise[1];
-    a[i] = -pp / qq;
-    b[i] = c.fz - cc / qq - a[i] * c.fl;
-    ends[i] = e;
+    const T inv_qq = T(1) / (n0 * e.dspan[1] + n1 * e.drise[1]);  // one division, not two
+    lin->a[i] = -pp * inv_qq;
+    lin->b[i] = c.fz - cc * inv_qq - lin->a[i] * c.fl;
+    lin->inv_qq[i] = inv_qq;
+    lin->g0[i] = g0;
+    lin->g1[i] = g1;
+    lin->ends[i] = e;
   }
-  if (!SolveEquilibrium(g, a, b, &fl_new)) return StaticsStatus::kSingular;
+  lin->max_relative_residual = max_residual;
+}
+
+// The Newton step from a linearisation: the 6x6 equilibrium solve for Fl, then Fz on each
+// cable's line and ds0 from its linearisation. Writes the largest |dFl| relative to the
+// largest Fl when relative_step is not null, and for double the system's
+// EquilibriumResponse when `response` is not null. Returns kNoEquilibrium when the step
+// leaves a cable with Fl <= 0 or s0 <= 0 (the caller says what that means for its method).
+template <typename T>
+StaticsStatus StepFromLinearisation(const PoseGeometry<T>& g, const CableLinearisation<T>& lin,
+                                    std::array<CableState<T>, kNumCables>* state, int* cable,
+                                    double* relative_step,
+                                    EquilibriumResponse* response = nullptr) {
+  std::array<T, kNumCables> fl_new;
+  bool solved;
+  if constexpr (kIsDouble<T>) {
+    solved = response != nullptr ? SolveEquilibrium<T, true>(g, lin.a, lin.b, &fl_new, response)
+                                 : SolveEquilibrium(g, lin.a, lin.b, &fl_new);
+  } else {
+    solved = SolveEquilibrium(g, lin.a, lin.b, &fl_new);
+  }
+  if (!solved) return StaticsStatus::kSingular;
   double max_fl = 0.0, max_step = 0.0;
   for (int i = 0; i < kNumCables; ++i) {
     CableState<T>& c = (*state)[i];
-    const CatenaryEnd<T>& e = ends[i];
+    const CatenaryEnd<T>& e = lin.ends[i];
     const T dfl = fl_new[i] - c.fl;
-    const T fz_new = a[i] * fl_new[i] + b[i];
+    const T fz_new = lin.a[i] * fl_new[i] + lin.b[i];
     const T dfz = fz_new - c.fz;
-    const T res0 = g0[i] + e.dspan[0] * dfl + e.dspan[1] * dfz;
-    const T res1 = g1[i] + e.drise[0] * dfl + e.drise[1] * dfz;
+    const T res0 = lin.g0[i] + e.dspan[0] * dfl + e.dspan[1] * dfz;
+    const T res1 = lin.g1[i] + e.drise[0] * dfl + e.drise[1] * dfz;
     const T ds = -(e.dspan[2] * res0 + e.drise[2] * res1) /
                  (e.dspan[2] * e.dspan[2] + e.drise[2] * e.drise[2]);
     max_step = std::max(max_step, std::abs(ScalarValue(dfl)));
@@ -353,14 +414,26 @@ StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometr
     c.s0 = c.s0 + ds;
   }
   for (int i = 0; i < kNumCables; ++i) {
-    if (!(ScalarValue((*state)[i].fl) > 0.0)) {
+    if (!(ScalarValue((*state)[i].fl) > 0.0) || !(ScalarValue((*state)[i].s0) > 0.0)) {
       *cable = i;
-      return StaticsStatus::kSlackCable;
+      return StaticsStatus::kNoEquilibrium;
     }
   }
   if (relative_step != nullptr) *relative_step = max_step / max_fl;
-  if (relative_residual != nullptr) *relative_residual = max_residual;
   return StaticsStatus::kOk;
+}
+
+// One Newton step on all 18 unknowns (LineariseCables, then StepFromLinearisation).
+// Writes the largest end-point residual relative to the chord before the step when
+// relative_residual is not null.
+template <typename T>
+StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
+                                std::array<CableState<T>, kNumCables>* state, int* cable,
+                                double* relative_step, double* relative_residual) {
+  CableLinearisation<T> lin;
+  LineariseCables(p, g, *state, &lin);
+  if (relative_residual != nullptr) *relative_residual = lin.max_relative_residual;
+  return StepFromLinearisation(g, lin, state, cable, relative_step);
 }
 
 // Guess for cable i's curve point at Fl from its secant data. Linear: s0 interpolated
