@@ -11,6 +11,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "fastcal/cable_robot.h"
+#include "fastcal/internal/csv.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
@@ -118,8 +119,9 @@ Method (--method):
                maxima over the trajectory (printed on stderr; in JSON as a field)
   --secant-low=0.99 --secant-high=1.01 (every method: exact starts from AAS)
   --warm-start (default true): each trajectory node starts from the previous solution
-Every solution is checked before it is ok: each catenary's end conditions and the
-cabin's equilibrium, from which the method's error estimate comes. Then the model's range: --max-strain=0.05 (tension / EA),
+Every solution is checked before it is ok: each catenary's end conditions (the residual
+is end_residual_m) and the cabin's equilibrium; the method's error estimate comes from
+them (error_estimate_pct). Then the model's range: --max-strain=0.05 (tension / EA),
 --max-length-ratio=1.5 (s0 / chord) and --reflector-clearance=0 (m, how close a cable
 may come to the model's reflector).
 
@@ -137,15 +139,23 @@ CSV columns, units in the names:
   F1x_kN,F1y_kN,F1z_kN..  force on each cable at its lower end, global frame (the cabin
                           feels the opposite)
   force_residual_N,moment_residual_Nm   equilibrium residual of the returned forces
-  compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact.
+  end_residual_m          largest distance between a cable's computed upper end and its
+                          tower top (the catenaries' end conditions)
+  error_estimate_pct      the method's estimate of its largest tension error, %
+  message                 why a pose failed, in double quotes ("" when ok)
+  status is a short code: ok, no_equilibrium, sagging_cable, overstretched_cable,
+  reflector_contact, not_converged, inaccurate, vertical_cable, singular,
+  catenary_failed, invalid_input (docs/cli.md).
+  compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact,
+  aas_error_estimate_pct, message.
 A summary line on stderr names the model (its file, or "nominal FAST"), the attitude
 used and the time per pose.
 
 A pose the cables cannot hold (no equilibrium, or one outside the model's range), a
 vertical cable or a solver failure is an error naming the node, the cable and the
-numbers (exit 1, no output) unless --keep-going, which writes the row with its status
-and empty numbers and exits 0; the summary then says how many poses failed, as in
-289 poses (69 failed), and names the first.
+numbers (exit 1, no output) unless --keep-going, which writes the row with its status,
+its message and empty numbers and exits 0; the summary then says how many poses failed,
+as in 289 poses (69 failed), and names the first.
 
 Examples:
   fastcal solve --position=0,0,140 --method=compare
@@ -548,6 +558,15 @@ bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
   return true;
 }
 
+// The status code and the message of a row: "ok" and "" on success; for compare the
+// message names the method that failed.
+std::pair<std::string, std::string> StatusAndMessage(const StaticsSolution& s,
+                                                     const char* method = nullptr) {
+  if (s.status == StaticsStatus::kOk) return {"ok", ""};
+  return {StaticsStatusName(s.status),
+          (method != nullptr ? std::string(method) + ": " : "") + DescribeStatus(s)};
+}
+
 std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run* aas,
                     const Run* exact) {
   std::ostringstream out;
@@ -558,21 +577,24 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
     for (int i = 1; i <= kNumCables; ++i) out << ",s0_" << i << "_m";
     for (int i = 1; i <= kNumCables; ++i)
       out << ",F" << i << "x_kN,F" << i << "y_kN,F" << i << "z_kN";
-    out << ",force_residual_N,moment_residual_Nm";
+    out << ",force_residual_N,moment_residual_Nm,end_residual_m,error_estimate_pct";
   } else {
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_aas_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_exact_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",err" << i << "_pct";
+    out << ",aas_error_estimate_pct";
   }
-  out << "\n";
+  out << ",message\n";
   for (size_t n = 0; n < poses.size(); ++n) {
     const Eigen::Vector3d rpy = RpyDegFromRotation(poses[n].rotation);
     out << n;
     for (int j = 0; j < 3; ++j) out << "," << FormatDouble(poses[n].position_m[j]);
     for (int j = 0; j < 3; ++j) out << "," << FormatDouble(rpy[j]);
+    std::pair<std::string, std::string> status;
     if (single != nullptr) {
       const StaticsSolution& s = single->solutions[n];
-      out << "," << (s.status == StaticsStatus::kOk ? "ok" : DescribeStatus(s));
+      status = StatusAndMessage(s);
+      out << "," << status.first;
       const bool ok = s.status == StaticsStatus::kOk;
       auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
       for (const CableSolution& c : s.cables) put(c.lower_tension_n / kNPerKn);
@@ -583,19 +605,24 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
       }
       put(s.force_residual_n);
       put(s.moment_residual_nm);
+      put(s.end_residual_m);
+      put(100.0 * s.error_estimate);
     } else {
       const StaticsSolution& a = aas->solutions[n];
       const StaticsSolution& e = exact->solutions[n];
       const bool ok = a.status == StaticsStatus::kOk && e.status == StaticsStatus::kOk;
-      out << "," << (ok ? "ok" : DescribeStatus(a.status != StaticsStatus::kOk ? a : e));
+      status = a.status != StaticsStatus::kOk ? StatusAndMessage(a, "aas")
+                                              : StatusAndMessage(e, "exact");
+      out << "," << status.first;
       auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
       for (const CableSolution& c : a.cables) put(c.lower_tension_n / kNPerKn);
       for (const CableSolution& c : e.cables) put(c.lower_tension_n / kNPerKn);
       for (int i = 0; i < kNumCables; ++i) {
         put(ok ? 100.0 * (a.cables[i].lower_tension_n / e.cables[i].lower_tension_n - 1.0) : 0.0);
       }
+      put(100.0 * a.error_estimate);
     }
-    out << "\n";
+    out << "," << internal::QuotedCsvField(status.second) << "\n";
   }
   return out.str();
 }
@@ -618,8 +645,13 @@ std::array<double, kNumCables> MaxAbsErrorPct(const Run& aas, const Run& exact) 
 }
 
 void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
-  j->Key("status").String(s.status == StaticsStatus::kOk ? "ok" : DescribeStatus(s));
-  if (s.status != StaticsStatus::kOk) return;
+  const auto [status, message] = StatusAndMessage(s);
+  j->Key("status").String(status);
+  if (s.status != StaticsStatus::kOk) {
+    j->Key("message").String(message);
+    if (s.cable >= 0) j->Key("cable").Int(s.cable + 1);
+    return;
+  }
   j->Key("cables").BeginArray();
   for (const CableSolution& c : s.cables) {
     j->BeginObject();
@@ -627,6 +659,7 @@ void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
     j->Key("upper_tension_kN").Number(c.upper_tension_n / kNPerKn);
     j->Key("unstretched_length_m").Number(c.unstretched_length_m);
     j->Key("chord_length_m").Number(c.chord_length_m);
+    j->Key("end_residual_m").Number(c.end_residual_m);
     j->Key("force_kN")
         .NumberArray(std::array<double, 3>{c.force_n[0] / kNPerKn, c.force_n[1] / kNPerKn,
                                            c.force_n[2] / kNPerKn});
@@ -635,6 +668,8 @@ void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
   j->EndArray();
   j->Key("force_residual_N").Number(s.force_residual_n);
   j->Key("moment_residual_Nm").Number(s.moment_residual_nm);
+  j->Key("end_residual_m").Number(s.end_residual_m);
+  j->Key("error_estimate").Number(s.error_estimate);
   j->Key("outer_iterations").Int(s.outer_iterations);
 }
 
@@ -777,7 +812,8 @@ int RunSolve(int argc, char** argv) {
             << timing.str() << std::endl;
   if (failures.count > 0) {
     std::cerr << "fastcal solve: " << failures.count << " of " << poses.size()
-              << " poses failed; --keep-going wrote them with their status and empty numbers "
+              << " poses failed; --keep-going wrote them with their status, message and empty "
+                 "numbers "
                  "(exit 0). First: "
               << failures.first << std::endl;
   }

@@ -4,10 +4,12 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -474,6 +476,65 @@ TEST_F(CliTest, KeepGoingSummarySaysHowManyPosesFailed) {
   r = Fastcal("solve --trajectory=grid --keep-going");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output.find("failed"), std::string::npos) << r.output.substr(r.output.size() - 500);
+}
+
+// Splits one CSV line into fields as RFC 4180 readers do (pandas, Python's csv): a field in
+// double quotes may hold commas, and "" inside it is one quote.
+std::vector<std::string> CsvFields(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (size_t k = 0; k < line.size(); ++k) {
+    const char c = line[k];
+    if (quoted && c == '"' && k + 1 < line.size() && line[k + 1] == '"') {
+      fields.back() += '"';
+      ++k;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+// With --keep-going the CSV stays a CSV: status is a short code, the message (which has
+// commas) is its own quoted column, and every row has the header's fields.
+TEST_F(CliTest, KeepGoingCsvHasStatusCodesAndQuotedMessages) {
+  const std::string out = Path("grid.csv");
+  for (const char* method : {"exact", "compare"}) {
+    const CommandResult r = Fastcal(
+        "solve --trajectory=grid --max-off-axis-deg=60 --keep-going "
+        "--force --output=" +
+        out + " --method=" + method);
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::ifstream in(out);
+    std::string line;
+    std::getline(in, line);
+    const std::vector<std::string> header = CsvFields(line);
+    const size_t status = std::find(header.begin(), header.end(), "status") - header.begin();
+    ASSERT_LT(status, header.size());
+    ASSERT_EQ(header.back(), "message");
+    std::map<std::string, int> codes;
+    while (std::getline(in, line)) {
+      const std::vector<std::string> fields = CsvFields(line);
+      ASSERT_EQ(fields.size(), header.size()) << line;
+      ++codes[fields[status]];
+      EXPECT_EQ(fields[status] == "ok", fields.back().empty()) << line;
+      EXPECT_EQ(line.back(), '"') << line;  // the message column is always quoted
+    }
+    EXPECT_GT(codes["ok"], 0) << method;
+    // compare names aas's failure first where both fail.
+    for (const char* code : std::string(method) == "exact"
+                                ? std::vector<const char*>{"no_equilibrium", "sagging_cable"}
+                                : std::vector<const char*>{"inaccurate"}) {
+      EXPECT_GT(codes[code], 0) << method << " " << code;
+    }
+    for (const auto& [code, count] : codes) {
+      EXPECT_EQ(code.find_first_not_of("abcdefghijklmnopqrstuvwxyz_"), std::string::npos) << code;
+    }
+  }
 }
 
 // A reduced chi-square far outside its band is a warning on stderr and a failure in the
