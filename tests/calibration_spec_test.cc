@@ -117,7 +117,7 @@ TEST(CalibrationSpecTest, EmptySpecHasTheDefaults) {
     const CalibrationSpec spec = ParseOk(text);
     ExpectSameSpec(spec, defaults);
   }
-  EXPECT_EQ(defaults.forward_model, StaticsMethod::kAasRefined);
+  EXPECT_EQ(defaults.forward_model, StaticsMethod::kExact);
   EXPECT_EQ(defaults.tension_sigma_percent, 3.0);
   EXPECT_TRUE(defaults.IsValid(nullptr));
 }
@@ -665,7 +665,8 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
         << error;
     EXPECT_EQ(CountFree(spec), e.num_free);
     EXPECT_TRUE(spec.IsValid(&error)) << error;
-    // Every example states its own (default) statistics explicitly.
+    // Every example states its statistics explicitly, the forward model included (they
+    // were made with aas-refined, the default then).
     EXPECT_EQ(spec.forward_model, StaticsMethod::kAasRefined);
   }
 }
