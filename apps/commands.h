@@ -17,6 +17,7 @@ int RunSolve(int argc, char** argv);
 int RunCalibrate(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
+int RunWorkspace(int argc, char** argv);
 
 // Positions of the trajectory `kind` (line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.

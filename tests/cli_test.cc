@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <regex>
 #include <sstream>
@@ -535,6 +536,54 @@ TEST_F(CliTest, KeepGoingCsvHasStatusCodesAndQuotedMessages) {
       EXPECT_EQ(code.find_first_not_of("abcdefghijklmnopqrstuvwxyz_"), std::string::npos) << code;
     }
   }
+}
+
+// fastcal workspace: the paper's cap is all feasible, 113 to 316 kN on this coarser grid
+// (112 to 316 kN at its default 1 x 5 deg, workspace_test.cc); with limits
+// the CSV names the reasons; both files written together, an existing one only with
+// --force; bad values exit 2 naming the flag.
+TEST_F(CliTest, WorkspaceWritesCsvAndHtmlAndNamesBadFlags) {
+  CommandResult r = Fastcal("workspace --help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.output.find("--min-tension-kn"), std::string::npos);
+  r = Fastcal("workspace --off-axis-step-deg=5 --azimuth-step-deg=15");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("193 of 193 feasible, lower-end tensions 113.2 to 316 kN"),
+            std::string::npos)
+      << r.output;
+  const std::string csv = Path("ws.csv"), html = Path("ws.html");
+  const std::string limits =
+      "workspace --off-axis-step-deg=5 --azimuth-step-deg=15 --max-off-axis-deg=45 "
+      "--min-tension-kn=130 --max-tension-kn=300 --output=" +
+      csv + " --html=" + html;
+  r = Fastcal(limits);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(csv);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(",below_min_tension,"), std::string::npos);
+  EXPECT_NE(text.find(",above_max_tension,"), std::string::npos);
+  EXPECT_NE(text.find(",sagging_cable,"), std::string::npos);
+  EXPECT_TRUE(fs::exists(html));
+  r = Fastcal(limits);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
+  EXPECT_EQ(Fastcal(limits + " --force").code, 0);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"workspace --min-tension-kn=-5", "--min-tension-kn"},
+      {"workspace --min-tension-kn=200 --max-tension-kn=100", "--max-tension-kn"},
+      {"workspace --radial-offset=-1", "--radial-offset"},
+      {"workspace --off-axis-step-deg=0", "--off-axis-step-deg"},
+      {"workspace --max-length-ratio=0.5", "--max-length-ratio"},
+      {"workspace --method=fast", "--method"},
+      {"workspace --nodes=3", "--nodes"},
+  };
+  for (const auto& [args, flag] : bad) {
+    r = Fastcal(args + " --output=" + Path("never.csv") + " --html=" + Path("never.html"));
+    EXPECT_EQ(r.code, 2) << args << ": " << r.output;
+    EXPECT_NE(r.output.find(flag), std::string::npos) << args << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(Path("never.csv")));
+  EXPECT_FALSE(fs::exists(Path("never.html")));
 }
 
 // A reduced chi-square far outside its band is a warning on stderr and a failure in the
