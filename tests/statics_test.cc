@@ -491,6 +491,34 @@ TEST(StaticsTest, WarmStartGivesTheColdSolution) {
   }
 }
 
+// Along the paper's line (nodes 1 m apart) exact starts each node from the last two
+// solutions extrapolated: two Newton steps from the third node on (three from the last
+// one alone, as at the second). A pose off the path's line, or back at its start, is
+// started from the last solution alone, and still gives the cold solution.
+TEST(StaticsTest, WarmStartExtrapolatesAlongThePath) {
+  constexpr double kConvergedRelTol = 1e-9;
+  const CableRobot robot = CableRobot::NominalFast();
+  StaticsOptions warm;
+  warm.warm_start = true;
+  StaticsSolution w;
+  for (int n = 0; n <= 20; ++n) {
+    ASSERT_EQ(SolveStatics(robot, FocalPose(Eigen::Vector3d(50 - n, 0, 150)), warm, &w),
+              StaticsStatus::kOk);
+    EXPECT_EQ(w.has_previous, n >= 1);
+    if (n >= 2) {
+      EXPECT_EQ(w.outer_iterations, 2) << n;
+    }
+  }
+  for (const Eigen::Vector3d& p : {Eigen::Vector3d(20, 20, 150), Eigen::Vector3d(50, 0, 150)}) {
+    ASSERT_EQ(SolveStatics(robot, FocalPose(p), warm, &w), StaticsStatus::kOk);
+    const StaticsSolution c = Solve(robot, FocalPose(p), StaticsMethod::kExact);
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_NEAR(w.cables[i].lower_tension_n, c.cables[i].lower_tension_n,
+                  kConvergedRelTol * c.cables[i].lower_tension_n);
+    }
+  }
+}
+
 // Solutions of the equations that describe no cable are refused (StaticsOptions'
 // max_strain, max_length_ratio), for every method and also after a warm start.
 TEST(StaticsTest, SolutionsOutsideTheModelsRangeAreRefused) {

@@ -283,9 +283,12 @@ struct CatenaryLengthProblem {  // SolveCatenaryLengthDouble's arguments
   double span_m = 0.0, rise_m = 0.0, fl_n = 0.0, ea_n = 0.0, w_n_per_m = 0.0;
   const CatenaryCurvePoint* guess = nullptr;
 };
+// jacobians (may be null): d(span, rise)/d(Fz, s0), row-major, at each solve's last
+// evaluation (the returned point, or one final Newton step before it), where ok.
 void SolveCatenaryLengthBatch(int n, const CatenaryLengthProblem* problems,
                               const CatenarySolverOptions& options, CatenaryCurvePoint* points,
-                              CatenaryStatus* statuses, int* iterations);
+                              CatenaryStatus* statuses, int* iterations,
+                              double (*jacobians)[4] = nullptr);
 
 // A point of the cable's shape (eqs. 11-13, in the cable plane) with the tension there.
 struct CatenaryPoint {

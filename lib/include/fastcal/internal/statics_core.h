@@ -89,8 +89,9 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
       *cable = i;
       return StaticsStatus::kVerticalCable;
     }
-    g->ux[i] = c[0] / g->span[i];
-    g->uy[i] = c[1] / g->span[i];
+    const T inv_span = T(1) / g->span[i];  // one division, not two
+    g->ux[i] = c[0] * inv_span;
+    g->uy[i] = c[1] * inv_span;
     g->w[i] = p.linear_density_kg_per_m[i] * p.gravity_m_per_s2;
   }
   g->e = rotation * p.mass_centre_cabin_m;
@@ -289,13 +290,14 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
 }
 
 // Puts each cable on its exact Fz(Fl) curve at the current Fl (solves Fz, s0). `guess`
-// (double) starts each solve. kNoEquilibrium when a cable has Fl <= 0.
+// (double) starts each solve. kNoEquilibrium when a cable has Fl <= 0. For double,
+// `jacobians` (may be null) as SolveCatenaryLengthBatch's.
 template <typename T>
 StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                               const StaticsOptions& o,
                               const std::array<CatenaryCurvePoint, kNumCables>& guess,
                               std::array<CableState<T>, kNumCables>* state, int* cable,
-                              int* iterations) {
+                              int* iterations, double (*jacobians)[4] = nullptr) {
   for (int i = 0; i < kNumCables; ++i) {
     if (!(ScalarValue((*state)[i].fl) > 0.0)) {
       *cable = i;
@@ -311,7 +313,7 @@ StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<
     for (int i = 0; i < kNumCables; ++i) {
       problems[i] = {g.span[i], g.rise[i], (*state)[i].fl, p.ea_n[i], g.w[i], &guess[i]};
     }
-    SolveCatenaryLengthBatch(kNumCables, problems, o.catenary, points, statuses, its);
+    SolveCatenaryLengthBatch(kNumCables, problems, o.catenary, points, statuses, its, jacobians);
     for (int i = 0; i < kNumCables; ++i) {
       *iterations += its[i];
       if (statuses[i] != CatenaryStatus::kOk) {
