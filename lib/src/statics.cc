@@ -822,6 +822,7 @@ StaticsOptions ModelFitStaticsOptions(StaticsMethod method) {
   o.method = method;
   o.aas_secant_tolerance = o.catenary.relative_tolerance;
   o.aas_length_tolerance = o.catenary.relative_tolerance;
+  o.aas_max_relative_error = std::numeric_limits<double>::infinity();
   return o;
 }
 
