@@ -31,6 +31,18 @@ using State = std::array<CableState<double>, kNumCables>;
 // Equilibrium residuals above this fraction of the largest force (N), or of it times the
 // largest lever arm (N m), mean the 6x6 solve failed: it meets them to rounding, ~1e-14.
 constexpr double kMaxRelativeEquilibriumResidual = 1e-9;
+// Whether the error estimate after a Newton step of relative size `step` can be trusted:
+// it uses the partials from before the step (CheckAfterStep), so only after a small step
+// (after larger ones, where a cable sags, it was measured 100 times too small), and only
+// while Newton is seen to converge, the error left a tenth of the step or less (or at the
+// rounding floor): aas-refined can stall near a fold of the equations with a small step
+// and a small residual 27% from the solution, where its steps then diverge.
+bool Contracting(double step, double estimate) {
+  constexpr double kTrustedStep = 1e-2;
+  constexpr double kMaxContraction = 0.1;
+  constexpr double kRoundingFloor = 1e-12;
+  return step <= kTrustedStep && (estimate <= kMaxContraction * step || estimate <= kRoundingFloor);
+}
 // A point of exact's continuation counts as solved once its Newton step is below this
 // fraction of the forces: it only starts the next point (the last one is then polished to
 // exact_relative_tolerance), and at 1e-6 the next point's start is as good as exact.
@@ -237,12 +249,16 @@ StaticsStatus SolveAasRefined(Context* c, const Geometry& g, bool warm, State* s
     CableLinearisation<double> lin;
     internal::LineariseCables(c->p, g, *st, &lin);
     EquilibriumResponse response;
-    status = internal::StepFromLinearisation(g, lin, st, &c->sol->cable, nullptr, &response);
+    double relative_step = 0.0;
+    status = internal::StepFromLinearisation(g, lin, st, &c->sol->cable, &relative_step, &response);
     ++c->sol->outer_iterations;
     if (status == StaticsStatus::kNoEquilibrium) return StaticsStatus::kNotConverged;
     if (status != StaticsStatus::kOk) return status;
     *check = CheckAfterStep(c->p, g, *st, lin, response);
-    if (check->error_estimate <= c->o.refined_relative_tolerance) return StaticsStatus::kOk;
+    if (check->error_estimate <= c->o.refined_relative_tolerance &&
+        Contracting(relative_step, check->error_estimate)) {
+      return StaticsStatus::kOk;
+    }
   }
   c->sol->cable = -1;
   c->sol->limit_value = check->error_estimate;
