@@ -99,14 +99,9 @@ void BM_PaperTrajectory(benchmark::State& state) {
 void BM_EdgeSweepCold(benchmark::State& state) {
   constexpr int kPoses = 2000;
   const CableRobot robot = CableRobot::NominalFast();
-  RandomPoseSpec spec;
-  spec.positions.samples = kPoses;
-  spec.positions.max_off_axis_deg = 45.0;
-  spec.positions.radial_spread_m = 5.0;
-  spec.positions.seed = 20260101;
   std::vector<Pose> poses;
   std::string error;
-  if (!RandomPosesAroundFocalLaw(spec, &poses, &error)) {
+  if (!RandomPosesAroundFocalLaw(EdgeSweepSpec(kPoses, 20260101), &poses, &error)) {
     state.SkipWithError(error.c_str());
     return;
   }

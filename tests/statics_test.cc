@@ -784,14 +784,9 @@ TEST(StaticsTest, ErrorEstimateMatchesTheActualError) {
 // cap's area), +-5 m off the focal sphere, the focal law times an extra rotation whose
 // amplitude per axis is drawn in [2, 5] deg (trajectory.h, RandomPosesAroundFocalLaw).
 std::vector<Pose> Issue9SweepPoses(int count, std::uint64_t seed) {
-  RandomPoseSpec spec;
-  spec.positions.samples = count;
-  spec.positions.max_off_axis_deg = 45.0;
-  spec.positions.radial_spread_m = 5.0;
-  spec.positions.seed = seed;
   std::vector<Pose> poses;
   std::string error;
-  EXPECT_TRUE(RandomPosesAroundFocalLaw(spec, &poses, &error)) << error;
+  EXPECT_TRUE(RandomPosesAroundFocalLaw(EdgeSweepSpec(count, seed), &poses, &error)) << error;
   return poses;
 }
 

@@ -106,7 +106,7 @@ double EstimateError(const Geometry& g, const State& st,
                      const std::array<double, kNumCables>& slope,
                      const std::array<double, kNumCables>& miss,
                      const EquilibriumResponse& response) {
-  Eigen::Vector4d rhs = Eigen::Vector4d::Zero();  // rows 2, 3, 4 (and padding)
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();  // rows 2, 3, 4
   for (int i = 0; i < kNumCables; ++i) {
     rhs[0] -= miss[i];
     rhs[1] -= g.r[i][1] * miss[i];
@@ -252,7 +252,12 @@ StaticsStatus SolveAasRefined(Context* c, const Geometry& g, bool warm, State* s
     double relative_step = 0.0;
     status = internal::StepFromLinearisation(g, lin, st, &c->sol->cable, &relative_step, &response);
     ++c->sol->outer_iterations;
-    if (status == StaticsStatus::kNoEquilibrium) return StaticsStatus::kNotConverged;
+    // A step that leaves Fl > 0 or meets a singular system (near a fold, where cables
+    // sag): aas-refined cannot go on, which says nothing about the pose.
+    if (status == StaticsStatus::kSingular) c->sol->cable = -1;
+    if (status == StaticsStatus::kNoEquilibrium || status == StaticsStatus::kSingular) {
+      return StaticsStatus::kNotConverged;
+    }
     if (status != StaticsStatus::kOk) return status;
     *check = CheckAfterStep(c->p, g, *st, lin, response);
     if (check->error_estimate <= c->o.refined_relative_tolerance &&
@@ -935,6 +940,10 @@ std::string DescribeNotConverged(const StaticsSolution& solution) {
            " > " + Sig(solution.limit) +
            " (StaticsOptions::refined_relative_tolerance) after max_refinement_steps steps; "
            "use exact";
+  }
+  if (solution.cable < 0) {
+    return "aas-refined: a step met a singular equilibrium system, so it cannot go on; use "
+           "exact, which also says whether the pose can be held";
   }
   return "aas-refined: its AAS start or a step gives cable " + std::to_string(c) +
          " a horizontal force or length <= 0, so it cannot go on; use exact, which also says "

@@ -299,6 +299,15 @@ bool RandomPosesAroundFocalLaw(const RandomPoseSpec& spec, std::vector<Pose>* po
   return true;
 }
 
+RandomPoseSpec EdgeSweepSpec(int samples, std::uint64_t seed) {
+  RandomPoseSpec spec;
+  spec.positions.samples = samples;
+  spec.positions.max_off_axis_deg = 45.0;
+  spec.positions.radial_spread_m = 5.0;
+  spec.positions.seed = seed;
+  return spec;
+}
+
 bool PosesWithAttitudeLaw(const std::vector<Eigen::Vector3d>& positions,
                           const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                           std::string* error) {

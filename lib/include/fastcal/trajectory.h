@@ -120,6 +120,11 @@ struct RandomPoseSpec {
 bool RandomPosesAroundFocalLaw(const RandomPoseSpec& spec, std::vector<Pose>* poses,
                                std::string* error);
 
+// The sweep of the workspace's edge of issue 9: `samples` poses up to 45 deg off axis,
+// +-5 m off the focal sphere, extra rotations of 2 to 5 deg per axis, `seed`; the other
+// fields at their defaults (the paper's focal law and sphere).
+RandomPoseSpec EdgeSweepSpec(int samples, std::uint64_t seed);
+
 // Poses at finite `positions` with the neutral attitude R = I.
 bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
                                std::vector<Pose>* poses, std::string* error);

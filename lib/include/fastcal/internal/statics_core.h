@@ -71,7 +71,96 @@ struct PoseGeometry {
   std::array<T, kNumCables> span, rise, chord, ux, uy, w;
   Vector3T<T> e;  // R r_e
   T weight_n;     // m g (negative)
+  // double only (ComputeGeometry): three of the six equilibrium rows (0, 1, 5: the
+  // horizontal forces and the moment about z) hold no Fz, so they are the same for every
+  // solve at this pose: the Fl that meet them are null_basis * c, c in R^3
+  // (EquilibriumNullBasis), and its solved block's reciprocal condition squared (det^2
+  // over Hadamard's bound squared), for the singularity test.
+  Eigen::Matrix<double, 6, 3> null_basis;
+  double basis_reciprocal_condition2 = 0.0;
 };
+
+// The adjugate of a 3x3 matrix (its inverse times the determinant) and the determinant,
+// and Hadamard's bound on that (the product of the rows' lengths, squared), whose ratio
+// to det^2 serves as the reciprocal condition: no division, no branch.
+struct Adjugate3 {
+  Eigen::Matrix3d adjugate;
+  double det, hadamard2;
+  explicit Adjugate3(const Eigen::Matrix3d& m) {
+    auto col = [&m](int a, int b) {  // row a x row b, as a column
+      return Eigen::Vector3d(m(a, 1) * m(b, 2) - m(a, 2) * m(b, 1),
+                             m(a, 2) * m(b, 0) - m(a, 0) * m(b, 2),
+                             m(a, 0) * m(b, 1) - m(a, 1) * m(b, 0));
+    };
+    adjugate.col(0) = col(1, 2);
+    adjugate.col(1) = col(2, 0);
+    adjugate.col(2) = col(0, 1);
+    det = m.row(0).dot(adjugate.col(0).transpose());
+    hadamard2 = m.row(0).squaredNorm() * m.row(1).squaredNorm() * m.row(2).squaredNorm();
+  }
+  // |det| >= ratio times Hadamard's bound.
+  bool ConditionedBetterThan(double ratio) const { return det * det >= ratio * ratio * hadamard2; }
+};
+
+// The null space of the equilibrium rows without Fz (rows 0, 1, 5 of SolveEquilibrium's
+// matrix, H: ux_i, uy_i, r_y,i ux_i - r_x,i uy_i): three columns of H are solved for
+// (H_p X = -H_f, by the adjugate), the other three are free (identity). First with
+// cables 1, 3, 5, one per anchor and 120 deg apart on FAST, which makes H_p well
+// conditioned without a search; only if it is not (reciprocal condition, as Hadamard's
+// ratio, below kWellConditioned), with the columns of complete pivoting.
+inline void EquilibriumNullBasis(PoseGeometry<double>* g) {
+  constexpr double kWellConditioned = 1e-3;
+  double h[3][kNumCables];
+  for (int i = 0; i < kNumCables; ++i) {
+    h[0][i] = g->ux[i];
+    h[1][i] = g->uy[i];
+    h[2][i] = g->r[i][1] * g->ux[i] - g->r[i][0] * g->uy[i];
+  }
+  auto solve_for = [&](const int* pivots, const int* free) {
+    Eigen::Matrix3d hp, hf;
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 3; ++k) {
+        hp(r, k) = h[r][pivots[k]];
+        hf(r, k) = h[r][free[k]];
+      }
+    }
+    const Adjugate3 a(hp);
+    const Eigen::Matrix3d x = -(a.adjugate / a.det) * hf;
+    g->null_basis.setZero();
+    for (int k = 0; k < 3; ++k) {
+      g->null_basis.row(pivots[k]) = x.row(k);
+      g->null_basis(free[k], k) = 1.0;
+    }
+    g->basis_reciprocal_condition2 = a.det * a.det / a.hadamard2;
+    return a.ConditionedBetterThan(kWellConditioned);
+  };
+  const int odd[3] = {0, 2, 4}, even[3] = {1, 3, 5};
+  if (solve_for(odd, even)) return;
+  // Complete pivoting on a copy, for its choice of columns only.
+  double e[3][kNumCables];
+  std::copy(&h[0][0], &h[0][0] + 3 * kNumCables, &e[0][0]);
+  int col[kNumCables] = {0, 1, 2, 3, 4, 5};
+  for (int k = 0; k < 3; ++k) {
+    int pr = k, pc = k;
+    for (int r = k; r < 3; ++r) {
+      for (int c = k; c < kNumCables; ++c) {
+        if (std::abs(e[r][col[c]]) > std::abs(e[pr][col[pc]])) {
+          pr = r;
+          pc = c;
+        }
+      }
+    }
+    for (int c = 0; c < kNumCables; ++c) std::swap(e[k][c], e[pr][c]);
+    std::swap(col[k], col[pc]);
+    const double pivot = e[k][col[k]];
+    if (!(std::abs(pivot) > 0.0)) break;  // rank < 3: the ratio below says singular
+    for (int r = k + 1; r < 3; ++r) {
+      const double f = e[r][col[k]] / pivot;
+      for (int c = 0; c < kNumCables; ++c) e[r][c] -= f * e[k][c];
+    }
+  }
+  solve_for(col, col + 3);
+}
 
 template <typename T>
 StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
@@ -96,6 +185,7 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
   }
   g->e = rotation * p.mass_centre_cabin_m;
   g->weight_n = p.cabin_mass_kg * p.gravity_m_per_s2;
+  if constexpr (kIsDouble<T>) EquilibriumNullBasis(g);
   return StaticsStatus::kOk;
 }
 
@@ -104,91 +194,95 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
 // dFl = response * (d rhs2, d rhs3, d rhs4). A cable's Fz off its curve by d shifts just
 // those rows (by -d, -r_y d, -r_x d), so the error estimates need only this, not the
 // matrix's factors; SolveEquilibrium computes it alongside Fl, off the critical path.
-// The fourth column is padding: rows of four doubles are one vector operation each.
-using EquilibriumResponse = Eigen::Matrix<double, 6, 4, Eigen::RowMajor>;
+using EquilibriumResponse = Eigen::Matrix<double, 6, 3>;
 
 // Solves the six equilibrium rows for Fl given Fz_i = a_i Fl_i + b_i (statics.h).
 // Returns false when the matrix is singular to working precision. With kResponse (double
-// only) *response receives the system's EquilibriumResponse; a separate instantiation, so
-// that the plain solve stays as fast as without it.
+// only) *response receives the system's EquilibriumResponse.
 template <typename T, bool kResponse = false>
 bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>& a,
                       const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl,
                       EquilibriumResponse* response = nullptr) {
   static_assert(!kResponse || kIsDouble<T>, "the response is kept for double only");
-  // Smallest/largest pivot below which the 6x6 system counts as singular.
+  // Reciprocal condition below which the system counts as singular.
   constexpr double kMinReciprocalCondition = 1e-13;
-  // Row-major, and for double full-length row operations below: fixed trip counts the
-  // compiler unrolls and vectorises (entries left of the pivot go stale, never read).
-  Eigen::Matrix<T, 6, 6, Eigen::RowMajor> m;
-  Eigen::Matrix<T, 6, 1> rhs;
-  rhs << T(0), T(0), g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n, T(0);
-  for (int i = 0; i < kNumCables; ++i) {
-    const Vector3T<T>& r = g.r[i];
-    m(0, i) = g.ux[i];
-    m(1, i) = g.uy[i];
-    m(2, i) = a[i];
-    m(3, i) = r[1] * a[i] + r[2] * g.uy[i];
-    m(4, i) = r[0] * a[i] + r[2] * g.ux[i];
-    m(5, i) = r[1] * g.ux[i] - r[0] * g.uy[i];
-    rhs[2] -= b[i];
-    rhs[3] -= r[1] * b[i];
-    rhs[4] -= r[0] * b[i];
-  }
-  // Gaussian elimination with partial pivoting, written out: for a fixed 6x6 it is several
-  // times faster than Eigen's blocked PartialPivLU plus its rcond() estimate. With
-  // `factors` (double only) the multipliers and the row order are recorded as they go.
-  using std::abs;
-  double max_pivot = 0.0, min_pivot = std::numeric_limits<double>::infinity();
-  std::array<T, 6> inv_pivot;
-  // With kResponse, three more right-hand sides: the unit vectors of rows 2, 3 and 4.
-  EquilibriumResponse unit;
-  if constexpr (kResponse) {
-    unit.setZero();
-    unit(2, 0) = unit(3, 1) = unit(4, 2) = 1.0;
-  }
-#pragma GCC unroll 6
-  for (int c = 0; c < 6; ++c) {
-    int p = c;
-    for (int r = c + 1; r < 6; ++r) {
-      if (abs(ScalarValue(m(r, c))) > abs(ScalarValue(m(p, c)))) p = r;
+  if constexpr (kIsDouble<T>) {
+    // Fl = N c (PoseGeometry::null_basis) meets rows 0, 1, 5; rows 2, 3, 4 are then the
+    // 3x3 system (V N) c = rhs, solved by its adjugate: one division and no branches,
+    // where the 6x6 elimination's pivot search and six divisions made a long dependent
+    // chain (the largest single cost of a solve). The response is then N (V N)^-1.
+    const Eigen::Matrix<double, 6, 3>& n = g.null_basis;
+    Eigen::Matrix3d vn = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d rhs(g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n);
+    for (int i = 0; i < kNumCables; ++i) {
+      const Vector3T<double>& r = g.r[i];
+      const Eigen::Vector3d v(a[i], r[1] * a[i] + r[2] * g.uy[i], r[0] * a[i] + r[2] * g.ux[i]);
+      vn += v * n.row(i);
+      rhs -= b[i] * Eigen::Vector3d(1.0, r[1], r[0]);
     }
-    if (p != c) {
-      m.row(p).swap(m.row(c));
-      std::swap(rhs[p], rhs[c]);
-      if constexpr (kResponse) unit.row(p).swap(unit.row(c));
+    const Adjugate3 adj(vn);
+    if (!adj.ConditionedBetterThan(kMinReciprocalCondition) ||
+        !(g.basis_reciprocal_condition2 > kMinReciprocalCondition * kMinReciprocalCondition)) {
+      return false;
     }
-    const double pivot = abs(ScalarValue(m(c, c)));
-    max_pivot = std::max(max_pivot, pivot);
-    min_pivot = std::min(min_pivot, pivot);
-    if (!(pivot > 0.0)) return false;
-    inv_pivot[c] = T(1) / m(c, c);
-#pragma GCC unroll 6
-    for (int r = c + 1; r < 6; ++r) {
-      const T f = m(r, c) * inv_pivot[c];
-      if constexpr (kResponse) unit.row(r) -= f * unit.row(c);
-#pragma GCC unroll 6
-      for (int k = kIsDouble<T> ? 0 : c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
-      rhs[r] -= f * rhs[c];
+    const Eigen::Matrix3d inverse = adj.adjugate / adj.det;
+    const Eigen::Matrix<double, 6, 1> x = n * (inverse * rhs);
+    for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
+    if constexpr (kResponse) *response = n * inverse;
+    return true;
+  } else {
+    // Jet (the calibration's derivatives): the whole 6x6 system, Gaussian elimination
+    // with partial pivoting written out (several times faster than Eigen's blocked
+    // PartialPivLU plus its rcond() estimate), the pivot ratio as the singularity test
+    // (columns are scaled alike: forces in N).
+    Eigen::Matrix<T, 6, 6, Eigen::RowMajor> m;
+    Eigen::Matrix<T, 6, 1> rhs;
+    rhs << T(0), T(0), g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n, T(0);
+    for (int i = 0; i < kNumCables; ++i) {
+      const Vector3T<T>& r = g.r[i];
+      m(0, i) = g.ux[i];
+      m(1, i) = g.uy[i];
+      m(2, i) = a[i];
+      m(3, i) = r[1] * a[i] + r[2] * g.uy[i];
+      m(4, i) = r[0] * a[i] + r[2] * g.ux[i];
+      m(5, i) = r[1] * g.ux[i] - r[0] * g.uy[i];
+      rhs[2] -= b[i];
+      rhs[3] -= r[1] * b[i];
+      rhs[4] -= r[0] * b[i];
     }
-  }
-  // Pivot ratio as a cheap singularity test (columns are scaled alike: forces in N).
-  if (!(min_pivot > kMinReciprocalCondition * max_pivot)) return false;
-  Eigen::Matrix<T, 6, 1> x;
-  for (int r = 5; r >= 0; --r) {
-    T acc = rhs[r];
-    for (int k = r + 1; k < 6; ++k) acc -= m(r, k) * x[k];
-    x[r] = acc * inv_pivot[r];
-  }
-  for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
-  if constexpr (kResponse) {
+    using std::abs;
+    double max_pivot = 0.0, min_pivot = std::numeric_limits<double>::infinity();
+    std::array<T, 6> inv_pivot;
+    for (int c = 0; c < 6; ++c) {
+      int p = c;
+      for (int r = c + 1; r < 6; ++r) {
+        if (abs(ScalarValue(m(r, c))) > abs(ScalarValue(m(p, c)))) p = r;
+      }
+      if (p != c) {
+        m.row(p).swap(m.row(c));
+        std::swap(rhs[p], rhs[c]);
+      }
+      const double pivot = abs(ScalarValue(m(c, c)));
+      max_pivot = std::max(max_pivot, pivot);
+      min_pivot = std::min(min_pivot, pivot);
+      if (!(pivot > 0.0)) return false;
+      inv_pivot[c] = T(1) / m(c, c);
+      for (int r = c + 1; r < 6; ++r) {
+        const T f = m(r, c) * inv_pivot[c];
+        for (int k = c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
+        rhs[r] -= f * rhs[c];
+      }
+    }
+    if (!(min_pivot > kMinReciprocalCondition * max_pivot)) return false;
+    Eigen::Matrix<T, 6, 1> x;
     for (int r = 5; r >= 0; --r) {
-      Eigen::Matrix<double, 1, 4> acc = unit.row(r);
-      for (int k = r + 1; k < 6; ++k) acc -= m(r, k) * response->row(k);
-      response->row(r) = acc * inv_pivot[r];
+      T acc = rhs[r];
+      for (int k = r + 1; k < 6; ++k) acc -= m(r, k) * x[k];
+      x[r] = acc * inv_pivot[r];
     }
+    for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
+    return true;
   }
-  return true;
 }
 
 template <typename T>
