@@ -18,7 +18,7 @@ Usage: fastcal <command> [--flag=value ...]
 
 Commands:
   solve      cable forces, tensions and unstretched lengths at a pose or along a trajectory
-             (AAS, refined AAS, exact, or AAS against exact)
+             (exact, AAS, refined AAS, or AAS against exact), every answer checked
   calibrate  estimate mass centre, cable density, offsets, sensor gains... from measured
              poses and tensions; refuse free sets the data cannot determine; report
   evaluate   RMS of model minus measured tensions per cable, for any model file

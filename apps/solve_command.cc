@@ -109,7 +109,7 @@ Trajectories:
 Method (--method):
   exact        (default) the coupled Newton solution to --exact-tolerance=1e-12; where its
                start from AAS fails it follows the equilibrium from the home pose, so it
-               finds it wherever one exists, and says when none does
+               finds the one the cabin reaches from there, and says when there is none
   aas          the paper's approximately analytical solution (secants at 0.99k, 1.01k);
                ok only when its own error estimate is at most --aas-max-error=0.01 (1%)
   aas-refined  AAS re-linearised on the exact Fz(Fl) tangent, step after step until its
