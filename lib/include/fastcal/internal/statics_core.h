@@ -196,6 +196,99 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
 // matrix's factors; SolveEquilibrium computes it alongside Fl, off the critical path.
 using EquilibriumResponse = Eigen::Matrix<double, 6, 3>;
 
+// Reciprocal condition below which the equilibrium system counts as singular.
+inline constexpr double kMinEquilibriumReciprocalCondition = 1e-13;
+
+// SolveEquilibrium for double: three unknowns through PoseGeometry::null_basis.
+template <bool kResponse>
+bool SolveEquilibriumReduced(const PoseGeometry<double>& g, const std::array<double, kNumCables>& a,
+                             const std::array<double, kNumCables>& b,
+                             std::array<double, kNumCables>* fl, EquilibriumResponse* response) {
+  constexpr double kMinReciprocalCondition = kMinEquilibriumReciprocalCondition;
+  // Fl = N c (PoseGeometry::null_basis) meets rows 0, 1, 5; rows 2, 3, 4 are then the
+  // 3x3 system (V N) c = rhs, solved by its adjugate: one division and no branches,
+  // where the 6x6 elimination's pivot search and six divisions made a long dependent
+  // chain (the largest single cost of a solve). The response is then N (V N)^-1.
+  const Eigen::Matrix<double, 6, 3>& n = g.null_basis;
+  Eigen::Matrix3d vn = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs(g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n);
+  for (int i = 0; i < kNumCables; ++i) {
+    const Vector3T<double>& r = g.r[i];
+    const Eigen::Vector3d v(a[i], r[1] * a[i] + r[2] * g.uy[i], r[0] * a[i] + r[2] * g.ux[i]);
+    vn += v * n.row(i);
+    rhs -= b[i] * Eigen::Vector3d(1.0, r[1], r[0]);
+  }
+  const Adjugate3 adj(vn);
+  if (!adj.ConditionedBetterThan(kMinReciprocalCondition) ||
+      !(g.basis_reciprocal_condition2 > kMinReciprocalCondition * kMinReciprocalCondition)) {
+    return false;
+  }
+  const Eigen::Matrix3d inverse = adj.adjugate / adj.det;
+  const Eigen::Matrix<double, 6, 1> x = n * (inverse * rhs);
+  for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
+  if constexpr (kResponse) *response = n * inverse;
+  return true;
+}
+
+// SolveEquilibrium for a Jet (the calibration's derivatives): the whole 6x6 system.
+template <typename T>
+bool SolveEquilibrium6x6(const PoseGeometry<T>& g, const std::array<T, kNumCables>& a,
+                         const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl) {
+  constexpr double kMinReciprocalCondition = kMinEquilibriumReciprocalCondition;
+  // Gaussian elimination with partial pivoting written out (several times faster than
+  // Eigen's blocked PartialPivLU plus its rcond() estimate), the pivot ratio as the
+  // singularity test (columns are scaled alike: forces in N). The Jets keep the full
+  // system: the null basis is built for double only, and this path's speed is the
+  // calibration's, measured by calibration_bench.
+  Eigen::Matrix<T, 6, 6, Eigen::RowMajor> m;
+  Eigen::Matrix<T, 6, 1> rhs;
+  rhs << T(0), T(0), g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n, T(0);
+  for (int i = 0; i < kNumCables; ++i) {
+    const Vector3T<T>& r = g.r[i];
+    m(0, i) = g.ux[i];
+    m(1, i) = g.uy[i];
+    m(2, i) = a[i];
+    m(3, i) = r[1] * a[i] + r[2] * g.uy[i];
+    m(4, i) = r[0] * a[i] + r[2] * g.ux[i];
+    m(5, i) = r[1] * g.ux[i] - r[0] * g.uy[i];
+    rhs[2] -= b[i];
+    rhs[3] -= r[1] * b[i];
+    rhs[4] -= r[0] * b[i];
+  }
+  using std::abs;
+  double max_pivot = 0.0, min_pivot = std::numeric_limits<double>::infinity();
+  std::array<T, 6> inv_pivot;
+  for (int c = 0; c < 6; ++c) {
+    int p = c;
+    for (int r = c + 1; r < 6; ++r) {
+      if (abs(ScalarValue(m(r, c))) > abs(ScalarValue(m(p, c)))) p = r;
+    }
+    if (p != c) {
+      m.row(p).swap(m.row(c));
+      std::swap(rhs[p], rhs[c]);
+    }
+    const double pivot = abs(ScalarValue(m(c, c)));
+    max_pivot = std::max(max_pivot, pivot);
+    min_pivot = std::min(min_pivot, pivot);
+    if (!(pivot > 0.0)) return false;
+    inv_pivot[c] = T(1) / m(c, c);
+    for (int r = c + 1; r < 6; ++r) {
+      const T f = m(r, c) * inv_pivot[c];
+      for (int k = c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
+      rhs[r] -= f * rhs[c];
+    }
+  }
+  if (!(min_pivot > kMinReciprocalCondition * max_pivot)) return false;
+  Eigen::Matrix<T, 6, 1> x;
+  for (int r = 5; r >= 0; --r) {
+    T acc = rhs[r];
+    for (int k = r + 1; k < 6; ++k) acc -= m(r, k) * x[k];
+    x[r] = acc * inv_pivot[r];
+  }
+  for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
+  return true;
+}
+
 // Solves the six equilibrium rows for Fl given Fz_i = a_i Fl_i + b_i (statics.h).
 // Returns false when the matrix is singular to working precision. With kResponse (double
 // only) *response receives the system's EquilibriumResponse.
@@ -204,84 +297,10 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
                       const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl,
                       EquilibriumResponse* response = nullptr) {
   static_assert(!kResponse || kIsDouble<T>, "the response is kept for double only");
-  // Reciprocal condition below which the system counts as singular.
-  constexpr double kMinReciprocalCondition = 1e-13;
   if constexpr (kIsDouble<T>) {
-    // Fl = N c (PoseGeometry::null_basis) meets rows 0, 1, 5; rows 2, 3, 4 are then the
-    // 3x3 system (V N) c = rhs, solved by its adjugate: one division and no branches,
-    // where the 6x6 elimination's pivot search and six divisions made a long dependent
-    // chain (the largest single cost of a solve). The response is then N (V N)^-1.
-    const Eigen::Matrix<double, 6, 3>& n = g.null_basis;
-    Eigen::Matrix3d vn = Eigen::Matrix3d::Zero();
-    Eigen::Vector3d rhs(g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n);
-    for (int i = 0; i < kNumCables; ++i) {
-      const Vector3T<double>& r = g.r[i];
-      const Eigen::Vector3d v(a[i], r[1] * a[i] + r[2] * g.uy[i], r[0] * a[i] + r[2] * g.ux[i]);
-      vn += v * n.row(i);
-      rhs -= b[i] * Eigen::Vector3d(1.0, r[1], r[0]);
-    }
-    const Adjugate3 adj(vn);
-    if (!adj.ConditionedBetterThan(kMinReciprocalCondition) ||
-        !(g.basis_reciprocal_condition2 > kMinReciprocalCondition * kMinReciprocalCondition)) {
-      return false;
-    }
-    const Eigen::Matrix3d inverse = adj.adjugate / adj.det;
-    const Eigen::Matrix<double, 6, 1> x = n * (inverse * rhs);
-    for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
-    if constexpr (kResponse) *response = n * inverse;
-    return true;
+    return SolveEquilibriumReduced<kResponse>(g, a, b, fl, response);
   } else {
-    // Jet (the calibration's derivatives): the whole 6x6 system, Gaussian elimination
-    // with partial pivoting written out (several times faster than Eigen's blocked
-    // PartialPivLU plus its rcond() estimate), the pivot ratio as the singularity test
-    // (columns are scaled alike: forces in N).
-    Eigen::Matrix<T, 6, 6, Eigen::RowMajor> m;
-    Eigen::Matrix<T, 6, 1> rhs;
-    rhs << T(0), T(0), g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n, T(0);
-    for (int i = 0; i < kNumCables; ++i) {
-      const Vector3T<T>& r = g.r[i];
-      m(0, i) = g.ux[i];
-      m(1, i) = g.uy[i];
-      m(2, i) = a[i];
-      m(3, i) = r[1] * a[i] + r[2] * g.uy[i];
-      m(4, i) = r[0] * a[i] + r[2] * g.ux[i];
-      m(5, i) = r[1] * g.ux[i] - r[0] * g.uy[i];
-      rhs[2] -= b[i];
-      rhs[3] -= r[1] * b[i];
-      rhs[4] -= r[0] * b[i];
-    }
-    using std::abs;
-    double max_pivot = 0.0, min_pivot = std::numeric_limits<double>::infinity();
-    std::array<T, 6> inv_pivot;
-    for (int c = 0; c < 6; ++c) {
-      int p = c;
-      for (int r = c + 1; r < 6; ++r) {
-        if (abs(ScalarValue(m(r, c))) > abs(ScalarValue(m(p, c)))) p = r;
-      }
-      if (p != c) {
-        m.row(p).swap(m.row(c));
-        std::swap(rhs[p], rhs[c]);
-      }
-      const double pivot = abs(ScalarValue(m(c, c)));
-      max_pivot = std::max(max_pivot, pivot);
-      min_pivot = std::min(min_pivot, pivot);
-      if (!(pivot > 0.0)) return false;
-      inv_pivot[c] = T(1) / m(c, c);
-      for (int r = c + 1; r < 6; ++r) {
-        const T f = m(r, c) * inv_pivot[c];
-        for (int k = c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
-        rhs[r] -= f * rhs[c];
-      }
-    }
-    if (!(min_pivot > kMinReciprocalCondition * max_pivot)) return false;
-    Eigen::Matrix<T, 6, 1> x;
-    for (int r = 5; r >= 0; --r) {
-      T acc = rhs[r];
-      for (int k = r + 1; k < 6; ++k) acc -= m(r, k) * x[k];
-      x[r] = acc * inv_pivot[r];
-    }
-    for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
-    return true;
+    return SolveEquilibrium6x6(g, a, b, fl);
   }
 }
 
