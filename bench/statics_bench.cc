@@ -56,9 +56,8 @@ void BM_SinglePoseCold(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations());
 }
 
-// AAS with compute_unstretched_lengths = false, which used to skip the s0 solves (the
-// paper's AAS returns forces only). No longer: aas's check needs the curve points they
-// give, so this costs what aas costs (docs/model.md, "Speed").
+// AAS with compute_unstretched_lengths = false (forces only, as in a fit): no s0 solves;
+// its check uses the model-corrected guesses of the curve points instead.
 void BM_SinglePoseColdAasForcesOnly(benchmark::State& state) {
   const CableRobot robot = CableRobot::NominalFast();
   const Pose pose = K2Pose();

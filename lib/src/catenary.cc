@@ -434,8 +434,8 @@ void SolveBatchInto(int n, const Spec* problems, const CatenarySolverOptions& op
 
 void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
                               const CatenarySolverOptions& options, CatenaryForces* forces,
-                              CatenaryStatus* statuses, int* iterations) {
-  SolveBatchInto(n, problems, options, forces, statuses, iterations);
+                              CatenaryStatus* statuses, int* iterations, double (*jacobians)[4]) {
+  SolveBatchInto(n, problems, options, forces, statuses, iterations, jacobians);
 }
 
 void SolveCatenaryLengthBatch(int n, const CatenaryLengthProblem* problems,

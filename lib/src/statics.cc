@@ -150,11 +150,13 @@ struct Context {
 // the lines; *slope receives the lines' slopes. kNoEquilibrium (cable set) when AAS gives
 // a cable Fl <= 0: AAS then says nothing about the pose.
 StaticsStatus AasStart(Context* c, const Geometry& g, bool use_guess, State* st,
-                       std::array<double, kNumCables>* slope, EquilibriumResponse* response) {
+                       std::array<double, kNumCables>* slope, EquilibriumResponse* response,
+                       double (*secant_jacobians)[4] = nullptr) {
   std::array<double, kNumCables> b, fl;
   int* cable = &c->sol->cable;
-  const StaticsStatus status = internal::AasLines(c->p, g, c->o, use_guess, &c->low, &c->high,
-                                                  slope, &b, cable, &c->sol->catenary_iterations);
+  const StaticsStatus status =
+      internal::AasLines(c->p, g, c->o, use_guess, &c->low, &c->high, slope, &b, cable,
+                         &c->sol->catenary_iterations, secant_jacobians);
   if (status != StaticsStatus::kOk) return status;
   const bool solved = response != nullptr
                           ? internal::SolveEquilibrium<double, true>(g, *slope, b, &fl, response)
@@ -202,27 +204,67 @@ StaticsStatus ExactStart(Context* c, const Geometry& g, State* st) {
   return StaticsStatus::kOk;
 }
 
-// The paper's AAS, with s0 from the curves at its Fl and the checks. Its Fz misses each
-// curve by exactly the projection's Fz minus its own, d; at the same Fl and s0 its end
-// point therefore misses the tower by d(L, Z)/dFz d, to first order (the second order is
-// d/T, below 1% of it where aas is ok): the end residual without another evaluation.
-StaticsStatus SolveAas(Context* c, const Geometry& g, bool warm, State* st, Check* check) {
-  std::array<double, kNumCables> slope;
-  EquilibriumResponse response;
-  StaticsStatus status = AasStart(c, g, warm, st, &slope, &response);
-  if (status == StaticsStatus::kNoEquilibrium) return StaticsStatus::kInaccurate;
-  if (status != StaticsStatus::kOk) return status;
+// aas's curve points: each cable's curve point at its AAS Fl, solved (one Newton step from
+// the model-corrected guess): s0 into *st and the Fz miss d, the curve's Fz minus AAS's,
+// into *miss. At the same Fl and s0 AAS's end point misses the tower by d(L, Z)/dFz d, to
+// first order (the second order is d/T, below 1% of it where aas is ok): the end
+// residual without another evaluation.
+StaticsStatus AasCurvePointsSolved(Context* c, const Geometry& g, State* st,
+                                   std::array<double, kNumCables>* miss, Check* check) {
   State projected;
   double jacobians[kNumCables][4] = {};  // written where the solves are ok
-  status = Project(c, g, *st, /*from_state=*/false, &projected, jacobians);
+  const StaticsStatus status = Project(c, g, *st, /*from_state=*/false, &projected, jacobians);
   if (status != StaticsStatus::kOk) return status;
-  std::array<double, kNumCables> miss;
+  for (int i = 0; i < kNumCables; ++i) {
+    (*st)[i].s0 = projected[i].s0;
+    (*miss)[i] = projected[i].fz - (*st)[i].fz;
+    const double* j = jacobians[i];  // rows: span, rise; columns: Fz, s0
+    check->end_residual_m[i] = std::abs((*miss)[i]) * std::sqrt(j[0] * j[0] + j[2] * j[2]);
+  }
+  return StaticsStatus::kOk;
+}
+
+// The same for forces only (StaticsOptions::compute_unstretched_lengths off), without a
+// catenary evaluation: the curve point is the model-corrected guess, and d(L, Z)/dFz is
+// interpolated in Fl between the secant solves' (columns Fz of `secant_jacobians`), as
+// the guess is.
+void AasCurvePointsGuessed(Context* c, const Geometry& g, const double (*secant_jacobians)[4],
+                           State* st, std::array<double, kNumCables>* miss, Check* check) {
   for (int i = 0; i < kNumCables; ++i) {
     CableState<double>& x = (*st)[i];
-    x.s0 = projected[i].s0;
-    miss[i] = projected[i].fz - x.fz;
-    const double* j = jacobians[i];  // rows: span, rise; columns: Fz, s0
-    check->end_residual_m[i] = std::abs(miss[i]) * std::sqrt(j[0] * j[0] + j[2] * j[2]);
+    const CatenaryForces &low = c->low[i], &high = c->high[i];
+    const CatenaryCurvePoint guess =
+        internal::CurveGuess(x.fl, g, i, c->p.ea_n[i], low, high, c->o, /*model_corrected=*/true);
+    x.s0 = guess.s0_m;
+    (*miss)[i] = guess.fz_n - x.fz;
+    const double t = (x.fl - low.fl_n) / (high.fl_n - low.fl_n);
+    const double* jl = secant_jacobians[i];  // rows: span, rise; columns: Fl, Fz
+    const double* jh = secant_jacobians[i + kNumCables];
+    const double dspan = jl[1] + t * (jh[1] - jl[1]), drise = jl[3] + t * (jh[3] - jl[3]);
+    check->end_residual_m[i] = std::abs((*miss)[i]) * std::sqrt(dspan * dspan + drise * drise);
+  }
+}
+
+// The paper's AAS, with s0 from the curves at its Fl and the checks (the curve points
+// above, the tensions, the error estimate through AAS's own equilibrium response).
+StaticsStatus SolveAas(Context* c, const Geometry& g, bool warm, State* st, Check* check) {
+  const bool solve_points = c->o.compute_unstretched_lengths;
+  std::array<double, kNumCables> slope;
+  EquilibriumResponse response;
+  double secant_jacobians[2 * kNumCables][4] = {};  // written where the solves are ok
+  StaticsStatus status =
+      AasStart(c, g, warm, st, &slope, &response, solve_points ? nullptr : secant_jacobians);
+  if (status == StaticsStatus::kNoEquilibrium) return StaticsStatus::kInaccurate;
+  if (status != StaticsStatus::kOk) return status;
+  std::array<double, kNumCables> miss;
+  if (solve_points) {
+    status = AasCurvePointsSolved(c, g, st, &miss, check);
+    if (status != StaticsStatus::kOk) return status;
+  } else {
+    AasCurvePointsGuessed(c, g, secant_jacobians, st, &miss, check);
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableState<double>& x = (*st)[i];
     check->lower_n[i] = std::sqrt(x.fl * x.fl + x.fz * x.fz);
     check->upper_n[i] = CatenaryTension(x.fl, x.fz, x.s0, g.w[i]);
   }
@@ -844,6 +886,7 @@ StaticsOptions ModelFitStaticsOptions(StaticsMethod method) {
   o.aas_secant_tolerance = o.catenary.relative_tolerance;
   o.aas_length_tolerance = o.catenary.relative_tolerance;
   o.aas_max_relative_error = std::numeric_limits<double>::infinity();
+  o.compute_unstretched_lengths = false;
   return o;
 }
 

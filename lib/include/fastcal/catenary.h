@@ -276,9 +276,12 @@ struct CatenaryProblem {  // SolveCatenaryForcesDouble's arguments
   double span_m = 0.0, rise_m = 0.0, s0_m = 0.0, ea_n = 0.0, w_n_per_m = 0.0;
   const CatenaryForces* guess = nullptr;
 };
+// jacobians (may be null): d(span, rise)/d(Fl, Fz), row-major, at each solve's last
+// evaluation (the returned forces, or one final Newton step before them), where ok.
 void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
                               const CatenarySolverOptions& options, CatenaryForces* forces,
-                              CatenaryStatus* statuses, int* iterations);
+                              CatenaryStatus* statuses, int* iterations,
+                              double (*jacobians)[4] = nullptr);
 struct CatenaryLengthProblem {  // SolveCatenaryLengthDouble's arguments
   double span_m = 0.0, rise_m = 0.0, fl_n = 0.0, ea_n = 0.0, w_n_per_m = 0.0;
   const CatenaryCurvePoint* guess = nullptr;

@@ -96,9 +96,13 @@ struct StaticsOptions {
   // model-corrected guess ~1e-5 off, so at 1e-8 one Newton step ends them, leaving s0
   // within ~1e-8 relative (3 um on a 300 m cable).
   double aas_length_tolerance = 1e-8;
-  // No longer has an effect: every method computes s0, because its solution is checked
-  // against the catenaries' end conditions, which need it. Kept so that code setting it
-  // still compiles.
+  // kAas only: solve each cable's curve point at AAS's Fl (one 2x2 Newton per cable),
+  // for s0 and the check's exact Fz miss. Off (forces only: a fit's inner loop,
+  // ModelFitStaticsOptions), s0 and the Fz miss come from the model-corrected guess of
+  // that point (6.7e-5 in s0, 1.4e-5 of the tension in Fz over the workspace cap) and
+  // d(L, Z)/dFz from the secant solves, with no catenary evaluation: the same forces, but
+  // a rougher check, since aas's own Fz miss is only a few N there: error estimate 0.76
+  // to 1.10 times the solved one, end residual 1.06 to 1.71 times (tests/statics_test.cc).
   bool compute_unstretched_lengths = true;
   // Limits of the model's range, checked on every solution. A cable whose tension
   // exceeds max_strain EA (or whose s0 <= 0) is refused as kOverstretchedCable: a linear
@@ -137,6 +141,8 @@ struct StaticsOptions {
 // a bias that calibrate measures against exact and reports, and refusing the samples
 // where a trial parameter set takes it over 1% made Ceres fail or crawl (a mass centre
 // 0.5 m off takes it to 3% at the cap's edge; calibration_bench: 111 iterations, not 6).
+// Its curve points are not solved (compute_unstretched_lengths off): the fit needs only
+// the forces, and the solves made an aas calibration 20% slower (calibration_bench).
 StaticsOptions ModelFitStaticsOptions(StaticsMethod method);
 
 enum class StaticsStatus {

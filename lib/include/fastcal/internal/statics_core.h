@@ -331,14 +331,17 @@ inline StaticsOptions AasLengthStageOptions(const StaticsOptions& o) {
   return so;
 }
 
-// AAS secant lines Fz = a Fl + b. `secant` in/out: double solutions used as guesses when
-// `use_guess` and written back.
+// AAS secant lines Fz = a Fl + b. `low`, `high` in/out: double solutions used as guesses
+// when `use_guess` and written back. For double, `jacobians` (may be null) receives each
+// secant solve's last d(L, Z)/d(Fl, Fz) (SolveCatenaryForcesBatch's; low lengths at i,
+// high at i + kNumCables).
 template <typename T>
 StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                        const StaticsOptions& o, bool use_guess,
                        std::array<CatenaryForces, kNumCables>* low,
                        std::array<CatenaryForces, kNumCables>* high, std::array<T, kNumCables>* a,
-                       std::array<T, kNumCables>* b, int* cable, int* iterations) {
+                       std::array<T, kNumCables>* b, int* cable, int* iterations,
+                       double (*jacobians)[4] = nullptr) {
   const CatenarySolverOptions secant_options = AasSecantSolverOptions(o);
   if constexpr (kIsDouble<T>) {
     // All twelve solves at once (low lengths, then high): same results, overlapped.
@@ -357,7 +360,8 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
         c.guess = use_guess ? (h == 0 ? &(*low)[i] : &(*high)[i]) : nullptr;
       }
     }
-    SolveCatenaryForcesBatch(2 * kNumCables, problems, secant_options, solved, statuses, its);
+    SolveCatenaryForcesBatch(2 * kNumCables, problems, secant_options, solved, statuses, its,
+                             jacobians);
     for (int i = 0; i < kNumCables; ++i) {
       *iterations += its[i] + its[i + kNumCables];
       for (CatenaryStatus s : {statuses[i], statuses[i + kNumCables]}) {
