@@ -1041,8 +1041,8 @@ void DrawPolarGrid(std::string* out, const PolarLayout& l, double radius_max,
     Line(out, l.cx, l.cy, l.cx + l.radius_px * c, l.cy - l.radius_px * s, "#ffffff", 0.6,
          "stroke-opacity=\"0.5\"");
     // A rim label (a tower) says the direction there; its degrees would collide with it.
-    const bool labelled = std::any_of(
-        options.rim_labels.begin(), options.rim_labels.end(), [deg](const auto& label) {
+    const bool labelled =
+        std::any_of(options.rim_labels.begin(), options.rim_labels.end(), [deg](const auto& label) {
           return std::abs(std::remainder(label.first - deg, 360.0)) < 10.0;
         });
     if (labelled) continue;
