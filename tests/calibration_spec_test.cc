@@ -124,7 +124,7 @@ TEST(CalibrationSpecTest, EmptySpecHasTheDefaults) {
     const CalibrationSpec spec = ParseOk(text);
     ExpectSameSpec(spec, defaults);
   }
-  EXPECT_EQ(defaults.forward_model, StaticsMethod::kAasRefined);
+  EXPECT_EQ(defaults.forward_model, StaticsMethod::kExact);
   EXPECT_EQ(defaults.tension_sigma_percent, 3.0);
   // Gross errors screened by default, at 5 robust sigmas; hold-out and cross-validation
   // by 10 contiguous blocks.
@@ -727,7 +727,8 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
         << error;
     EXPECT_EQ(CountFree(spec), e.num_free);
     EXPECT_TRUE(spec.IsValid(&error)) << error;
-    // Every example states its own (default) statistics explicitly.
+    // Every example states its statistics explicitly, the forward model included (they
+    // were made with aas-refined, the default then).
     EXPECT_EQ(spec.forward_model, StaticsMethod::kAasRefined);
   }
 }
