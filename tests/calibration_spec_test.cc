@@ -717,6 +717,7 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
       {"spec_mass_centre.yaml", 2},
       {"spec_mass_centre_density.yaml", 4},
       {"spec_wide.yaml", 3 + 1 + 1 + 6 + 9},
+      {"spec_realistic.yaml", 3 + 6 + 6 + 6},
   };
   for (const Example& e : kExamples) {
     SCOPED_TRACE(e.file);
@@ -727,9 +728,9 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
         << error;
     EXPECT_EQ(CountFree(spec), e.num_free);
     EXPECT_TRUE(spec.IsValid(&error)) << error;
-    // Every example states its statistics explicitly, the forward model included (they
-    // were made with aas-refined, the default then).
-    EXPECT_EQ(spec.forward_model, StaticsMethod::kAasRefined);
+    // Every example states its forward model, and it is exact: right wherever it answers
+    // (docs/model.md), and no slower than aas-refined.
+    EXPECT_EQ(spec.forward_model, StaticsMethod::kExact);
   }
 }
 
