@@ -302,12 +302,6 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
   return header;
 }
 
-std::string CommandLine(int argc, char** argv) {
-  std::string s = "fastcal";
-  for (int i = 1; i < argc; ++i) s += std::string(" ") + argv[i];
-  return s;
-}
-
 // The verdict as a last stderr line when it is not plain ok: a failed fit is a
 // warning ("do not use"), a misfit scaled into the sigmas a note; "" when ok.
 std::string ChiSquareWarning(const CalibrationResult& result) {

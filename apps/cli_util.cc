@@ -351,8 +351,45 @@ bool WriteOutput(const std::string& path, const std::string& content, std::strin
   return internal::WriteFileAtomically(path, content, error);
 }
 
+bool WriteOutputsTogether(const std::vector<std::pair<std::string, std::string>>& files,
+                          std::string* error) {
+  const std::string suffix = ".tmp." + std::to_string(::getpid());
+  std::vector<std::string> written;
+  auto undo = [&written] {
+    for (const std::string& path : written) std::remove(path.c_str());
+  };
+  for (const auto& [path, content] : files) {
+    if (!internal::WriteFileAtomically(path + suffix, content, error)) {
+      undo();
+      return false;
+    }
+    written.push_back(path + suffix);
+  }
+  for (const auto& [path, content] : files) {
+    if (std::rename((path + suffix).c_str(), path.c_str()) != 0) {
+      undo();
+      *error = path + ": cannot rename the temporary file into place";
+      return false;
+    }
+  }
+  return true;
+}
+
 void PrintError(const std::string& command, const std::string& message) {
   std::cerr << "fastcal " << command << ": " << message << std::endl;
+}
+
+std::string CommandLine(int argc, char** argv, const std::vector<std::string>& omit) {
+  std::string s = "fastcal";
+  for (int i = 1; i < argc; ++i) {
+    std::string name = argv[i];
+    name = name.substr(0, name.find('='));
+    name.erase(0, name.find_first_not_of('-'));
+    bool skip = false;
+    for (const std::string& o : omit) skip = skip || name == o || name == "no" + o;
+    if (!skip) s += std::string(" ") + argv[i];
+  }
+  return s;
 }
 
 std::string FormatDouble(double value, int significant_digits) {

@@ -108,10 +108,22 @@ bool ParseRpyDeg(const std::string& name, const std::string& text, Eigen::Vector
 // leaves no partial file; path "" or "-" writes to stdout.
 bool WriteOutput(const std::string& path, const std::string& content, std::string* error);
 
+// Writes every (path, content) to a temporary file beside it, and renames them into place
+// only once all were written: a failure to write (disk full, no permission) leaves none
+// of the paths changed. On failure removes its temporary files and returns false with the
+// path named in *error. (A rename that fails after others succeeded, which needs the
+// directory to change under us, leaves those in place.)
+bool WriteOutputsTogether(const std::vector<std::pair<std::string, std::string>>& files,
+                          std::string* error);
+
 // "fastcal <command>: <message>" on stderr.
 void PrintError(const std::string& command, const std::string& message);
 
 std::string FormatDouble(double value, int significant_digits = 10);
+
+// "fastcal <arguments>" as typed, for the headers of written files; the flags named in
+// `omit` (without dashes, e.g. "force") left out, with their "no" forms.
+std::string CommandLine(int argc, char** argv, const std::vector<std::string>& omit = {});
 
 }  // namespace fastcal::cli
 

@@ -9,6 +9,7 @@
 
 #include "cli_util.h"
 #include "fastcal/pose.h"
+#include "fastcal/statics.h"
 
 namespace fastcal::cli {
 
@@ -16,6 +17,7 @@ int RunSolve(int argc, char** argv);
 int RunCalibrate(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
+int RunWorkspace(int argc, char** argv);
 
 // Positions of the trajectory `kind` (line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.
@@ -39,6 +41,10 @@ std::string WithTrajectoryFlagNames(const std::string& message);
 bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
                                 const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                                 std::string* error);
+
+// Sets the model-range limits of `options` from --max-strain, --max-length-ratio and
+// --reflector-clearance (solve, workspace); false with the flags named when invalid.
+bool ModelRangeFromFlags(StaticsOptions* options, std::string* error);
 
 }  // namespace fastcal::cli
 

@@ -19,11 +19,13 @@ Usage: fastcal <command> [--flag=value ...]
 
 Commands:
   solve      cable forces, tensions and unstretched lengths at a pose or along a trajectory
-             (AAS, refined AAS, exact, or AAS against exact)
+             (exact, AAS, refined AAS, or AAS against exact), every answer checked
   calibrate  estimate mass centre, cable density, offsets, sensor gains... from measured
              poses and tensions; refuse free sets the data cannot determine; report
   evaluate   RMS of model minus measured tensions per cable, for any model file
   simulate   synthetic telemetry from a "truth" model along a trajectory, with noise
+  workspace  where the cabin can go with every cable within tension limits: CSV and an
+             HTML map of the focal-sphere cap
 
 Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
 )";
@@ -48,6 +50,7 @@ int main(int argc, char** argv) {
   if (command == "calibrate") return RunCalibrate(argc, argv);
   if (command == "evaluate") return RunEvaluate(argc, argv);
   if (command == "simulate") return RunSimulate(argc, argv);
+  if (command == "workspace") return RunWorkspace(argc, argv);
   std::cerr << "fastcal: unknown command '" << command << "'\n\n" << kUsage;
   return kExitUsage;
 }

@@ -392,21 +392,6 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
                                       : PosesWithFocalLawFromFlags(positions, law, poses, error);
 }
 
-// The command line for the files' headers, without --force (it changes nothing in the
-// files, so a dataset regenerated with it is the same bit for bit).
-std::string CommandLine(int argc, char** argv) {
-  std::string s = "fastcal";
-  for (int i = 1; i < argc; ++i) {
-    std::string name = argv[i];
-    name = name.substr(0, name.find('='));
-    if (name == "--force" || name == "-force" || name == "--noforce" || name == "-noforce") {
-      continue;
-    }
-    s += std::string(" ") + argv[i];
-  }
-  return s;
-}
-
 // FILE.csv -> FILE.truth.yaml; any other name gets ".truth.yaml" appended.
 std::string TruthPathFor(const std::string& csv_path) {
   const std::string suffix = ".csv";
@@ -521,7 +506,9 @@ int RunSimulate(int argc, char** argv) {
 
   const std::string csv_path = FLAGS_out;
   const std::string yaml_path = TruthPathFor(csv_path);
-  const std::string command = CommandLine(argc, argv);
+  // Without --force: it changes nothing in the files, so a dataset regenerated with it
+  // is the same bit for bit.
+  const std::string command = CommandLine(argc, argv, {"force"});
   const std::string version = FASTCAL_VERSION;
   const std::string csv_header =
       "Simulated by fastcal " + version + "\n" + command + "\nTruth model: " + yaml_path;

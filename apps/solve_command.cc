@@ -11,6 +11,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "fastcal/cable_robot.h"
+#include "fastcal/internal/csv.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
@@ -18,7 +19,7 @@
 #include "fastcal/trajectory.h"
 
 DEFINE_string(model, "", "Model YAML (docs/model-format.md); empty = nominal FAST.");
-DEFINE_string(method, "aas-refined", "aas | aas-refined | exact | compare");
+DEFINE_string(method, "exact", "exact | aas | aas-refined | compare");
 DEFINE_string(position, "", "Single pose: x,y,z of the cabin frame origin (m).");
 DEFINE_string(rpy, "", "Attitude roll,pitch,yaw (deg), R = Rz(yaw) Ry(pitch) Rx(roll).");
 DEFINE_string(quat, "", "Attitude as unit quaternion w,x,y,z.");
@@ -49,8 +50,16 @@ DEFINE_string(output, "", "Output file; empty or - = stdout. Written only on suc
 DEFINE_bool(force, false, "Replace an existing output file (solve --output, simulate --out).");
 DEFINE_double(secant_low, 0.99, "AAS: low secant length as a fraction of the chord.");
 DEFINE_double(secant_high, 1.01, "AAS: high secant length as a fraction of the chord.");
-DEFINE_int32(refinement_steps, 1, "aas-refined: re-linearisation steps.");
-DEFINE_double(exact_tolerance, 1e-12, "exact: relative tolerance on the forces.");
+DEFINE_int32(max_refinement_steps, 8, "aas-refined: at most this many tangent steps.");
+DEFINE_double(refined_tolerance, 1e-6,
+              "aas-refined: steps stop when its tension error estimate is below this.");
+DEFINE_double(aas_max_error, 0.01,
+              "aas, compare: aas is ok only when its tension error estimate is at most this.");
+DEFINE_double(exact_tolerance, 1e-12, "exact: relative tolerance on the tensions.");
+DEFINE_double(max_strain, 0.05, "Model range: largest cable strain (tension / EA).");
+DEFINE_double(max_length_ratio, 1.5, "Model range: largest unstretched length / chord, s0/k.");
+DEFINE_double(reflector_clearance, 0.0,
+              "Smallest clearance (m) of a cable from the model's reflector surface.");
 DEFINE_bool(warm_start, true, "Start each trajectory node from the previous solution.");
 DEFINE_bool(keep_going, false,
             "Write infeasible poses as rows with their status instead of failing.");
@@ -70,9 +79,9 @@ Usage:
   fastcal solve --poses=FILE.csv [options]
 
 Each flag belongs to a mode: a flag given for another one (--nodes with --position,
---radius with --trajectory=grid, --tilt-fraction without the focal law, --refinement-steps
-with --method=exact, --force without --output) is an error naming it and where it
-belongs (exit 2), never silently ignored; so is a flag given twice.
+--radius with --trajectory=grid, --tilt-fraction without the focal law,
+--max-refinement-steps with --method=exact, --force without --output) is an error naming
+it and where it belongs (exit 2), never silently ignored; so is a flag given twice.
 
 Attitude (at most one):
   --rpy=r,p,y            roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll)
@@ -100,14 +109,23 @@ Trajectories:
           ignored, so a calibration dataset works; any other column is an error
 
 Method (--method):
-  aas          the paper's approximately analytical solution (secants at 0.99k, 1.01k)
-  aas-refined  AAS re-linearised on the exact Fz(Fl) tangent (default; ~1e-7 of exact)
-  exact        full coupled Newton solution to --exact-tolerance
+  exact        (default) the coupled Newton solution to --exact-tolerance=1e-12; where its
+               start from AAS fails it follows the equilibrium from the home pose, so it
+               finds the one the cabin reaches from there, and says when there is none
+  aas          the paper's approximately analytical solution (secants at 0.99k, 1.01k);
+               ok only when its own error estimate is at most --aas-max-error=0.01 (1%)
+  aas-refined  AAS re-linearised on the exact Fz(Fl) tangent, step after step until its
+               error estimate is below --refined-tolerance=1e-6, at most
+               --max-refinement-steps=8 (one step where the cables are taut)
   compare      AAS and exact side by side with per-cable relative errors and their
                maxima over the trajectory (printed on stderr; in JSON as a field)
   --secant-low=0.99 --secant-high=1.01 (every method: exact starts from AAS)
-  --refinement-steps=1 (aas-refined only) --exact-tolerance=1e-12 (exact, compare)
   --warm-start (default true): each trajectory node starts from the previous solution
+Every solution is checked before it is ok: each catenary's end conditions (the residual
+is end_residual_m) and the cabin's equilibrium; the method's error estimate comes from
+them (error_estimate_pct). Then the model's range: --max-strain=0.05 (tension / EA),
+--max-length-ratio=1.5 (s0 / chord) and --reflector-clearance=0 (m, how close a cable
+may come to the model's reflector).
 
 Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model. solve
 reports the model's true cable tensions: a model's sensor_gain and sensor_bias_kN are
@@ -123,14 +141,23 @@ CSV columns, units in the names:
   F1x_kN,F1y_kN,F1z_kN..  force on each cable at its lower end, global frame (the cabin
                           feels the opposite)
   force_residual_N,moment_residual_Nm   equilibrium residual of the returned forces
-  compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact.
+  end_residual_m          largest distance between a cable's computed upper end and its
+                          tower top (the catenaries' end conditions)
+  error_estimate_pct      the method's estimate of its largest tension error, %
+  message                 why a pose failed, in double quotes ("" when ok)
+  status is a short code: ok, no_equilibrium, sagging_cable, overstretched_cable,
+  reflector_contact, not_converged, inaccurate, vertical_cable, singular,
+  catenary_failed, invalid_input (docs/cli.md).
+  compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact,
+  aas_error_estimate_pct, message.
 A summary line on stderr names the model (its file, or "nominal FAST"), the attitude
 used and the time per pose.
 
-A pose the cables cannot hold (a slack cable), a vertical cable or a solver failure is
-an error naming the node and cable (exit 1, no output) unless --keep-going, which writes
-the row with its status and empty numbers and exits 0; the summary then says how many
-poses failed, as in 289 poses (69 failed), and names the first.
+A pose the cables cannot hold (no equilibrium, or one outside the model's range), a
+vertical cable or a solver failure is an error naming the node, the cable and the
+numbers (exit 1, no output) unless --keep-going, which writes the row with its status,
+its message and empty numbers and exits 0; the summary then says how many poses failed,
+as in 289 poses (69 failed), and names the first.
 
 Examples:
   fastcal solve --position=0,0,140 --method=compare
@@ -168,8 +195,13 @@ const std::set<std::string> kFlags = {"model",
                                       "force",
                                       "secant-low",
                                       "secant-high",
-                                      "refinement-steps",
+                                      "max-refinement-steps",
+                                      "refined-tolerance",
+                                      "aas-max-error",
                                       "exact-tolerance",
+                                      "max-strain",
+                                      "max-length-ratio",
+                                      "reflector-clearance",
                                       "warm-start",
                                       "keep-going"};
 
@@ -461,10 +493,13 @@ bool CheckFlagsApplyToMode(std::string* error) {
                      : kind == "poses" ? "--poses"
                                        : "--trajectory=" + kind;
   if (FlagGiven("attitude-law")) mode += " with --attitude-law=" + FLAGS_attitude_law;
+  const bool exact = FLAGS_method == "exact" || FLAGS_method == "compare";
   const std::vector<FlagScope> method_scopes = {
-      {"refinement-steps", FLAGS_method == "aas-refined", "--method=aas-refined (the default)"},
-      {"exact-tolerance", FLAGS_method == "exact" || FLAGS_method == "compare",
-       "--method=exact or compare"}};
+      {"max-refinement-steps", FLAGS_method == "aas-refined", "--method=aas-refined"},
+      {"refined-tolerance", FLAGS_method == "aas-refined", "--method=aas-refined"},
+      {"aas-max-error", FLAGS_method == "aas" || FLAGS_method == "compare",
+       "--method=aas or compare"},
+      {"exact-tolerance", exact, "--method=exact (the default) or compare"}};
   const bool to_file = !FLAGS_output.empty() && FLAGS_output != "-";
   return CheckFlagsApply(scopes, mode, error) &&
          CheckFlagsApply(method_scopes, "--method=" + FLAGS_method, error) &&
@@ -480,21 +515,41 @@ bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* er
   }
   options->secant_low_fraction = FLAGS_secant_low;
   options->secant_high_fraction = FLAGS_secant_high;
-  options->refinement_steps = FLAGS_refinement_steps;
+  options->max_refinement_steps = FLAGS_max_refinement_steps;
+  options->refined_relative_tolerance = FLAGS_refined_tolerance;
+  options->aas_max_relative_error = FLAGS_aas_max_error;
   options->exact_relative_tolerance = FLAGS_exact_tolerance;
   options->warm_start = FLAGS_warm_start;
   if (!options->IsValid(error)) {
     *error = WithFlagNames(*error, {{"secant fractions", "--secant-low and --secant-high"},
-                                    {"refinement_steps", "--refinement-steps"},
+                                    {"max_refinement_steps", "--max-refinement-steps"},
+                                    {"refined_relative_tolerance", "--refined-tolerance"},
+                                    {"aas_max_relative_error", "--aas-max-error"},
                                     {"exact_relative_tolerance", "--exact-tolerance"}});
     return false;
   }
+  if (!ModelRangeFromFlags(options, error)) return false;
   if (FLAGS_format != "csv" && FLAGS_format != "json") {
     *error = "--format must be csv or json, got " + internal::Quote(FLAGS_format);
     return false;
   }
   return true;
 }
+
+}  // namespace
+
+bool ModelRangeFromFlags(StaticsOptions* options, std::string* error) {
+  options->max_strain = FLAGS_max_strain;
+  options->max_length_ratio = FLAGS_max_length_ratio;
+  options->min_reflector_clearance_m = FLAGS_reflector_clearance;
+  if (options->IsValid(error)) return true;
+  *error = WithFlagNames(*error, {{"max_strain", "--max-strain"},
+                                  {"max_length_ratio", "--max-length-ratio"},
+                                  {"min_reflector_clearance_m", "--reflector-clearance"}});
+  return false;
+}
+
+namespace {
 
 struct Run {
   std::vector<StaticsSolution> solutions;
@@ -532,6 +587,15 @@ bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
   return true;
 }
 
+// The status code and the message of a row: "ok" and "" on success; for compare the
+// message names the method that failed.
+std::pair<std::string, std::string> StatusAndMessage(const StaticsSolution& s,
+                                                     const char* method = nullptr) {
+  if (s.status == StaticsStatus::kOk) return {"ok", ""};
+  return {StaticsStatusName(s.status),
+          (method != nullptr ? std::string(method) + ": " : "") + DescribeStatus(s)};
+}
+
 std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run* aas,
                     const Run* exact) {
   std::ostringstream out;
@@ -542,21 +606,24 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
     for (int i = 1; i <= kNumCables; ++i) out << ",s0_" << i << "_m";
     for (int i = 1; i <= kNumCables; ++i)
       out << ",F" << i << "x_kN,F" << i << "y_kN,F" << i << "z_kN";
-    out << ",force_residual_N,moment_residual_Nm";
+    out << ",force_residual_N,moment_residual_Nm,end_residual_m,error_estimate_pct";
   } else {
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_aas_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_exact_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",err" << i << "_pct";
+    out << ",aas_error_estimate_pct";
   }
-  out << "\n";
+  out << ",message\n";
   for (size_t n = 0; n < poses.size(); ++n) {
     const Eigen::Vector3d rpy = RpyDegFromRotation(poses[n].rotation);
     out << n;
     for (int j = 0; j < 3; ++j) out << "," << FormatDouble(poses[n].position_m[j]);
     for (int j = 0; j < 3; ++j) out << "," << FormatDouble(rpy[j]);
+    std::pair<std::string, std::string> status;
     if (single != nullptr) {
       const StaticsSolution& s = single->solutions[n];
-      out << "," << (s.status == StaticsStatus::kOk ? "ok" : DescribeStatus(s));
+      status = StatusAndMessage(s);
+      out << "," << status.first;
       const bool ok = s.status == StaticsStatus::kOk;
       auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
       for (const CableSolution& c : s.cables) put(c.lower_tension_n / kNPerKn);
@@ -567,19 +634,24 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
       }
       put(s.force_residual_n);
       put(s.moment_residual_nm);
+      put(s.end_residual_m);
+      put(100.0 * s.error_estimate);
     } else {
       const StaticsSolution& a = aas->solutions[n];
       const StaticsSolution& e = exact->solutions[n];
       const bool ok = a.status == StaticsStatus::kOk && e.status == StaticsStatus::kOk;
-      out << "," << (ok ? "ok" : DescribeStatus(a.status != StaticsStatus::kOk ? a : e));
+      status = a.status != StaticsStatus::kOk ? StatusAndMessage(a, "aas")
+                                              : StatusAndMessage(e, "exact");
+      out << "," << status.first;
       auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
       for (const CableSolution& c : a.cables) put(c.lower_tension_n / kNPerKn);
       for (const CableSolution& c : e.cables) put(c.lower_tension_n / kNPerKn);
       for (int i = 0; i < kNumCables; ++i) {
         put(ok ? 100.0 * (a.cables[i].lower_tension_n / e.cables[i].lower_tension_n - 1.0) : 0.0);
       }
+      put(100.0 * a.error_estimate);
     }
-    out << "\n";
+    out << "," << internal::QuotedCsvField(status.second) << "\n";
   }
   return out.str();
 }
@@ -602,8 +674,13 @@ std::array<double, kNumCables> MaxAbsErrorPct(const Run& aas, const Run& exact) 
 }
 
 void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
-  j->Key("status").String(s.status == StaticsStatus::kOk ? "ok" : DescribeStatus(s));
-  if (s.status != StaticsStatus::kOk) return;
+  const auto [status, message] = StatusAndMessage(s);
+  j->Key("status").String(status);
+  if (s.status != StaticsStatus::kOk) {
+    j->Key("message").String(message);
+    if (s.cable >= 0) j->Key("cable").Int(s.cable + 1);
+    return;
+  }
   j->Key("cables").BeginArray();
   for (const CableSolution& c : s.cables) {
     j->BeginObject();
@@ -611,6 +688,7 @@ void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
     j->Key("upper_tension_kN").Number(c.upper_tension_n / kNPerKn);
     j->Key("unstretched_length_m").Number(c.unstretched_length_m);
     j->Key("chord_length_m").Number(c.chord_length_m);
+    j->Key("end_residual_m").Number(c.end_residual_m);
     j->Key("force_kN")
         .NumberArray(std::array<double, 3>{c.force_n[0] / kNPerKn, c.force_n[1] / kNPerKn,
                                            c.force_n[2] / kNPerKn});
@@ -619,6 +697,8 @@ void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
   j->EndArray();
   j->Key("force_residual_N").Number(s.force_residual_n);
   j->Key("moment_residual_Nm").Number(s.moment_residual_nm);
+  j->Key("end_residual_m").Number(s.end_residual_m);
+  j->Key("error_estimate").Number(s.error_estimate);
   j->Key("outer_iterations").Int(s.outer_iterations);
 }
 
@@ -761,7 +841,8 @@ int RunSolve(int argc, char** argv) {
             << timing.str() << std::endl;
   if (failures.count > 0) {
     std::cerr << "fastcal solve: " << failures.count << " of " << poses.size()
-              << " poses failed; --keep-going wrote them with their status and empty numbers "
+              << " poses failed; --keep-going wrote them with their status, message and empty "
+                 "numbers "
                  "(exit 0). First: "
               << failures.first << std::endl;
   }

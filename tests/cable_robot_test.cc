@@ -55,6 +55,12 @@ void ExpectIdentical(const CableRobot& a, const CableRobot& b) {
   EXPECT_EQ(a.cabin_mass_kg, b.cabin_mass_kg);
   for (int k = 0; k < 3; ++k) EXPECT_EQ(a.mass_centre_cabin_m[k], b.mass_centre_cabin_m[k]);
   EXPECT_EQ(a.gravity_m_per_s2, b.gravity_m_per_s2);
+  ASSERT_EQ(a.reflector.has_value(), b.reflector.has_value());
+  if (a.reflector.has_value()) {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(a.reflector->centre_m[k], b.reflector->centre_m[k]);
+    EXPECT_EQ(a.reflector->radius_m, b.reflector->radius_m);
+    EXPECT_EQ(a.reflector->aperture_m, b.reflector->aperture_m);
+  }
 }
 
 // A fresh empty directory, removed (with its contents) at the end of the test.
@@ -560,6 +566,43 @@ TEST(CableRobotYaml, SensorGainAndBiasRoundTripAndValidate) {
   robot.cables[1].sensor_gain = 0.0;
   EXPECT_FALSE(robot.IsValid(&error));
   EXPECT_NE(error.find("cables[1].sensor_gain"), std::string::npos) << error;
+}
+
+// The reflector is optional model data: FAST's in the nominal model (design notes: a
+// sphere of radius 300 m about (0, 0, 300) m, aperture 500 m), `reflector: none` for a
+// model without it, partial keys keep the nominal values, and it round-trips.
+TEST(CableRobotYaml, ReflectorIsOptionalModelData) {
+  const CableRobot nominal = CableRobot::NominalFast();
+  ASSERT_TRUE(nominal.reflector.has_value());
+  EXPECT_EQ(nominal.reflector->centre_m, Eigen::Vector3d(0, 0, 300));
+  EXPECT_EQ(nominal.reflector->radius_m, 300.0);
+  EXPECT_EQ(nominal.reflector->aperture_m, 500.0);
+  EXPECT_FALSE(CableRobot().reflector.has_value());
+  CableRobot robot;
+  std::string error;
+  ASSERT_TRUE(ParseCableRobotYaml("reflector: none\n", "m.yaml", &robot, &error)) << error;
+  EXPECT_FALSE(robot.reflector.has_value());
+  CableRobot back;
+  ASSERT_TRUE(ParseCableRobotYaml(CableRobotToYaml(robot, ""), "m.yaml", &back, &error)) << error;
+  ExpectIdentical(back, robot);
+  ASSERT_TRUE(ParseCableRobotYaml("reflector:\n  radius_m: 310\n", "m.yaml", &robot, &error))
+      << error;
+  ASSERT_TRUE(robot.reflector.has_value());
+  EXPECT_EQ(robot.reflector->radius_m, 310.0);
+  EXPECT_EQ(robot.reflector->aperture_m, 500.0);
+  ASSERT_TRUE(ParseCableRobotYaml(CableRobotToYaml(robot, ""), "m.yaml", &back, &error)) << error;
+  ExpectIdentical(back, robot);
+  const std::pair<const char*, const char*> bad[] = {
+      {"reflector: nothing\n", "reflector: expected a mapping"},
+      {"reflector:\n  radius: 300\n", "reflector.radius: unknown key"},
+      {"reflector:\n  radius_m: -1\n", "reflector.radius_m: must be > 0"},
+      {"reflector:\n  aperture_m: 700\n", "reflector.aperture_m: must be > 0 and at most 2"},
+      {"reflector:\n  centre_m: [0, 0]\n", "reflector.centre_m: expected a list of 3"},
+  };
+  for (const auto& [text, message] : bad) {
+    EXPECT_FALSE(ParseCableRobotYaml(text, "m.yaml", &robot, &error)) << text;
+    EXPECT_NE(error.find(message), std::string::npos) << text << ": " << error;
+  }
 }
 
 }  // namespace

@@ -150,7 +150,7 @@ TEST(CalibrationSpecTest, EmptySpecHasTheDefaults) {
     const CalibrationSpec spec = ParseOk(text);
     ExpectSameSpec(spec, defaults);
   }
-  EXPECT_EQ(defaults.forward_model, StaticsMethod::kAasRefined);
+  EXPECT_EQ(defaults.forward_model, StaticsMethod::kExact);
   EXPECT_EQ(defaults.tension_sigma_percent, 3.0);
   // Gross errors screened by default, at 5 robust sigmas; hold-out and cross-validation
   // by 10 contiguous blocks.
@@ -743,6 +743,7 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
       {"spec_mass_centre.yaml", 2},
       {"spec_mass_centre_density.yaml", 4},
       {"spec_wide.yaml", 3 + 1 + 1 + 6 + 9},
+      {"spec_realistic.yaml", 3 + 6 + 6 + 6},
   };
   for (const Example& e : kExamples) {
     SCOPED_TRACE(e.file);
@@ -753,8 +754,9 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
         << error;
     EXPECT_EQ(CountFree(spec), e.num_free);
     EXPECT_TRUE(spec.IsValid(&error)) << error;
-    // Every example states its own (default) statistics explicitly.
-    EXPECT_EQ(spec.forward_model, StaticsMethod::kAasRefined);
+    // Every example states its forward model, and it is exact: right wherever it answers
+    // (docs/model.md), and no slower than aas-refined.
+    EXPECT_EQ(spec.forward_model, StaticsMethod::kExact);
   }
 }
 

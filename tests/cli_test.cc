@@ -4,10 +4,13 @@
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <map>
 #include <regex>
 #include <sstream>
 #include <string>
@@ -110,11 +113,12 @@ TEST_F(CliTest, SolveBadInputExitsNonZeroAndNamesTheProblem) {
   r = Fastcal("solve --position=0,0,140 --quat=1,1,0,0");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("unit"), std::string::npos) << r.output;
-  // A pose the cables cannot hold: exit 1, the cable named, no output file.
+  // A pose the cables cannot hold: exit 1, the reason named, no output file.
   const std::string out = Path("never.csv");
   r = Fastcal("solve --position=330,0,150 --output=" + out);
   EXPECT_EQ(r.code, 1);
-  EXPECT_NE(r.output.find("slack"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no equilibrium with positive cable forces"), std::string::npos)
+      << r.output;
   EXPECT_FALSE(fs::exists(out));
   // Malformed model YAML: file and line named.
   Write("bad.yaml", "cabin:\n  mass_kg: heavy\n");
@@ -339,7 +343,13 @@ TEST_F(CliTest, BadValuesNameTheFlagNotTheOptionField) {
   const std::vector<Case> cases = {
       {"solve --position=0,0,140 --exact-tolerance=0", "--exact-tolerance",
        "exact_relative_tolerance"},
-      {"solve --position=0,0,140 --refinement-steps=0", "--refinement-steps", "refinement_steps"},
+      {"solve --position=0,0,140 --method=aas-refined --max-refinement-steps=0",
+       "--max-refinement-steps", "max_refinement_steps"},
+      {"solve --position=0,0,140 --method=aas --aas-max-error=0", "--aas-max-error",
+       "aas_max_relative_error"},
+      {"solve --position=0,0,140 --max-length-ratio=1", "--max-length-ratio", "max_length_ratio"},
+      {"solve --position=0,0,140 --reflector-clearance=nan", "--reflector-clearance",
+       "min_reflector_clearance_m"},
       {"solve --position=0,0,140 --secant-low=2", "--secant-low", "secant fractions"},
       {"solve --trajectory=line --nodes=1", "--nodes", ": nodes must"},
       {"solve --trajectory=arc --radius=0", "--radius", "radius_m"},
@@ -419,10 +429,13 @@ TEST_F(CliTest, FlagsOfAnotherModeAreRefused) {
        "--tilt-fraction applies to the focal attitude law"},
       {"solve --trajectory=line --attitude-law=none --focal-centre=0,0,290",
        "not to --trajectory=line with --attitude-law=none"},
-      {"solve --position=0,0,140 --method=exact --refinement-steps=2",
-       "--refinement-steps applies to --method=aas-refined (the default), not to --method=exact"},
-      {"solve --position=0,0,140 --exact-tolerance=1e-9",
-       "--exact-tolerance applies to --method=exact or compare, not to --method=aas-refined"},
+      {"solve --position=0,0,140 --max-refinement-steps=2",
+       "--max-refinement-steps applies to --method=aas-refined, not to --method=exact"},
+      {"solve --position=0,0,140 --method=aas --exact-tolerance=1e-9",
+       "--exact-tolerance applies to --method=exact (the default) or compare, not to "
+       "--method=aas"},
+      {"solve --position=0,0,140 --method=exact --aas-max-error=0.02",
+       "--aas-max-error applies to --method=aas or compare, not to --method=exact"},
       {"solve --position=0,0,140 --force", "--force applies to --output=FILE"},
       {sim + "--trajectory=grid --nodes=3",
        "--nodes applies to --trajectory=line, arc or circle, not to --trajectory=grid"},
@@ -443,7 +456,9 @@ TEST_F(CliTest, FlagsOfAnotherModeAreRefused) {
                                 "--attitude-law=none --max-off-axis-deg=10",
                                 "solve --position=0,0,140 --attitude-law=focal --tilt-fraction=0.3",
                                 "solve --position=0,0,140 --method=compare --exact-tolerance=1e-9",
-                                "solve --position=0,0,140 --refinement-steps=2",
+                                "solve --position=0,0,140 --method=aas-refined "
+                                "--max-refinement-steps=2 --refined-tolerance=1e-9",
+                                "solve --position=0,0,140 --exact-tolerance=1e-9",
                                 "simulate --nodes=4 --out=" + Path("circle.csv")}) {
     const CommandResult r = Fastcal(args);
     EXPECT_EQ(r.code, 0) << args << ": " << r.output;
@@ -486,6 +501,113 @@ TEST_F(CliTest, KeepGoingSummarySaysHowManyPosesFailed) {
   r = Fastcal("solve --trajectory=grid --keep-going");
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_EQ(r.output.find("failed"), std::string::npos) << r.output.substr(r.output.size() - 500);
+}
+
+// Splits one CSV line into fields as RFC 4180 readers do (pandas, Python's csv): a field in
+// double quotes may hold commas, and "" inside it is one quote.
+std::vector<std::string> CsvFields(const std::string& line) {
+  std::vector<std::string> fields(1);
+  bool quoted = false;
+  for (size_t k = 0; k < line.size(); ++k) {
+    const char c = line[k];
+    if (quoted && c == '"' && k + 1 < line.size() && line[k + 1] == '"') {
+      fields.back() += '"';
+      ++k;
+    } else if (c == '"') {
+      quoted = !quoted;
+    } else if (c == ',' && !quoted) {
+      fields.emplace_back();
+    } else {
+      fields.back() += c;
+    }
+  }
+  return fields;
+}
+
+// With --keep-going the CSV stays a CSV: status is a short code, the message (which has
+// commas) is its own quoted column, and every row has the header's fields.
+TEST_F(CliTest, KeepGoingCsvHasStatusCodesAndQuotedMessages) {
+  const std::string out = Path("grid.csv");
+  for (const char* method : {"exact", "compare"}) {
+    const CommandResult r = Fastcal(
+        "solve --trajectory=grid --max-off-axis-deg=60 --keep-going "
+        "--force --output=" +
+        out + " --method=" + method);
+    ASSERT_EQ(r.code, 0) << r.output;
+    std::ifstream in(out);
+    std::string line;
+    std::getline(in, line);
+    const std::vector<std::string> header = CsvFields(line);
+    const size_t status = std::find(header.begin(), header.end(), "status") - header.begin();
+    ASSERT_LT(status, header.size());
+    ASSERT_EQ(header.back(), "message");
+    std::map<std::string, int> codes;
+    while (std::getline(in, line)) {
+      const std::vector<std::string> fields = CsvFields(line);
+      ASSERT_EQ(fields.size(), header.size()) << line;
+      ++codes[fields[status]];
+      EXPECT_EQ(fields[status] == "ok", fields.back().empty()) << line;
+      EXPECT_EQ(line.back(), '"') << line;  // the message column is always quoted
+    }
+    EXPECT_GT(codes["ok"], 0) << method;
+    // compare names aas's failure first where both fail.
+    for (const char* code : std::string(method) == "exact"
+                                ? std::vector<const char*>{"no_equilibrium", "sagging_cable"}
+                                : std::vector<const char*>{"inaccurate"}) {
+      EXPECT_GT(codes[code], 0) << method << " " << code;
+    }
+    for (const auto& [code, count] : codes) {
+      EXPECT_EQ(code.find_first_not_of("abcdefghijklmnopqrstuvwxyz_"), std::string::npos) << code;
+    }
+  }
+}
+
+// fastcal workspace: the paper's cap is all feasible, 113 to 316 kN on this coarser grid
+// (112 to 316 kN at its default 1 x 5 deg, workspace_test.cc); with limits
+// the CSV names the reasons; both files written together, an existing one only with
+// --force; bad values exit 2 naming the flag.
+TEST_F(CliTest, WorkspaceWritesCsvAndHtmlAndNamesBadFlags) {
+  CommandResult r = Fastcal("workspace --help");
+  EXPECT_EQ(r.code, 0);
+  EXPECT_NE(r.output.find("--min-tension-kn"), std::string::npos);
+  r = Fastcal("workspace --off-axis-step-deg=5 --azimuth-step-deg=15");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("193 of 193 feasible, lower-end tensions 113.2 to 316 kN"),
+            std::string::npos)
+      << r.output;
+  const std::string csv = Path("ws.csv"), html = Path("ws.html");
+  const std::string limits =
+      "workspace --off-axis-step-deg=5 --azimuth-step-deg=15 --max-off-axis-deg=45 "
+      "--min-tension-kn=130 --max-tension-kn=300 --output=" +
+      csv + " --html=" + html;
+  r = Fastcal(limits);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::ifstream in(csv);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find(",below_min_tension,"), std::string::npos);
+  EXPECT_NE(text.find(",above_max_tension,"), std::string::npos);
+  EXPECT_NE(text.find(",sagging_cable,"), std::string::npos);
+  EXPECT_TRUE(fs::exists(html));
+  r = Fastcal(limits);
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
+  EXPECT_EQ(Fastcal(limits + " --force").code, 0);
+  const std::vector<std::pair<std::string, std::string>> bad = {
+      {"workspace --min-tension-kn=-5", "--min-tension-kn"},
+      {"workspace --min-tension-kn=200 --max-tension-kn=100", "--max-tension-kn"},
+      {"workspace --radial-offset=-1", "--radial-offset"},
+      {"workspace --off-axis-step-deg=0", "--off-axis-step-deg"},
+      {"workspace --max-length-ratio=0.5", "--max-length-ratio"},
+      {"workspace --method=fast", "--method"},
+      {"workspace --nodes=3", "--nodes"},
+  };
+  for (const auto& [args, flag] : bad) {
+    r = Fastcal(args + " --output=" + Path("never.csv") + " --html=" + Path("never.html"));
+    EXPECT_EQ(r.code, 2) << args << ": " << r.output;
+    EXPECT_NE(r.output.find(flag), std::string::npos) << args << ": " << r.output;
+  }
+  EXPECT_FALSE(fs::exists(Path("never.csv")));
+  EXPECT_FALSE(fs::exists(Path("never.html")));
 }
 
 // A reduced chi-square far outside its band is a warning on stderr and a failure in the

@@ -562,6 +562,47 @@ TEST(SvgMatrixHeatmap, EmptyOrNonSquareSaysNoData) {
   EXPECT_EQ(Count(svg, "class=\"cell\""), 0);
 }
 
+// A polar map: one cell path per cell with its value (n/a without one, grey), the colour
+// scale's range from the cells or the options, a mark per marked cell with the legend's
+// labels, the rim labels, and the azimuth labels only where no rim label is near.
+TEST(SvgPolarMap, CellsMarksScaleAndLabels) {
+  std::vector<PolarCell> cells;
+  cells.push_back({0.0, 0.5, 0.0, 360.0, 150.0, -1, "axis"});  // the centre disc
+  for (int k = 0; k < 12; ++k) {
+    const double a = 30.0 * k;
+    cells.push_back({0.5, 1.5, a - 15.0, a + 15.0, k == 3 ? kNaN : 100.0 + k, k % 4 == 0 ? 1 : -1,
+                     "cell <" + std::to_string(k) + ">"});
+  }
+  PolarMapOptions options;
+  options.plot.title = "cap";
+  options.value_label = "T [kN]";
+  options.radius_label = "off-axis angle [deg]";
+  options.marks = {{"", MarkShape::kCross}, {"below the minimum (3)", MarkShape::kTriangleDown}};
+  options.rim_labels = {{0.0, "T1"}, {120.0, "T3"}};
+  std::string svg = SvgPolarMap(cells, options);
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Count(svg, "<path class=\"cell\""), 13);
+  const std::vector<std::string> values = Attribute(svg, "<path class=\"cell\"", "data-value");
+  EXPECT_EQ(values[0], "150");
+  EXPECT_EQ(Count(svg, "data-value=\"n/a\""), 1);
+  EXPECT_EQ(Count(svg, "class=\"mark\" data-mark=\"1\""), 3);
+  EXPECT_NE(svg.find("below the minimum (3)"), std::string::npos);
+  EXPECT_NE(svg.find("cell &lt;4&gt;"), std::string::npos);  // tooltips escaped
+  EXPECT_NE(svg.find(">T1<"), std::string::npos);
+  EXPECT_NE(svg.find(">T3<"), std::string::npos);
+  EXPECT_EQ(svg.find(">120\u00b0<"), std::string::npos);  // T3 is there
+  EXPECT_NE(svg.find(">90\u00b0<"), std::string::npos);
+  EXPECT_NE(svg.find("T [kN]"), std::string::npos);
+  EXPECT_EQ(Lower(svg).find("nan"), std::string::npos);
+  // The scale from the cells spans 100 to 150 kN; a shared one from the options.
+  EXPECT_NE(svg.find(">110<"), std::string::npos);
+  options.value_lo = 0.0;
+  options.value_hi = 500.0;
+  svg = SvgPolarMap(cells, options);
+  EXPECT_NE(svg.find(">400<"), std::string::npos);
+  EXPECT_NE(SvgPolarMap({}, options).find("no data"), std::string::npos);
+}
+
 TEST(XmlProblem, DetectsMalformedMarkup) {
   EXPECT_EQ(XmlProblem("<svg><g></g></svg>"), "");
   EXPECT_NE(XmlProblem("<svg><g></svg>"), "");

@@ -241,6 +241,38 @@ TEST(RandomWorkspacePositions, RadialSpreadMovesOnlyAlongTheNormal) {
 
 // ---- Poses ----
 
+// Around the focal law: the positions are RandomWorkspacePositions' own, each attitude
+// the law's times a rotation of at most the amplitude per axis (so at most sqrt(3) times
+// it in all), not all small; the same spec gives the same poses; bad amplitudes are named.
+TEST(RandomPosesAroundFocalLaw, FocalLawTimesABoundedExtraRotation) {
+  constexpr int kSamples = 500;
+  constexpr double kMaxDeg = 5.0, kMinDeg = 2.0;
+  RandomPoseSpec spec;
+  spec.positions = RandomSpec(kSamples, 7);
+  std::vector<Pose> poses, again;
+  std::vector<Eigen::Vector3d> positions;
+  std::string error;
+  ASSERT_TRUE(RandomPosesAroundFocalLaw(spec, &poses, &error)) << error;
+  ASSERT_TRUE(RandomPosesAroundFocalLaw(spec, &again, &error)) << error;
+  ASSERT_TRUE(RandomWorkspacePositions(spec.positions, &positions, &error)) << error;
+  ASSERT_EQ(poses.size(), static_cast<size_t>(kSamples));
+  double largest_deg = 0.0;
+  for (int n = 0; n < kSamples; ++n) {
+    EXPECT_EQ(poses[n].position_m, positions[n]);
+    EXPECT_EQ(poses[n].rotation, again[n].rotation);
+    const Eigen::Matrix3d extra =
+        FocalAttitude(positions[n], spec.law).transpose() * poses[n].rotation;
+    const double angle_deg = Eigen::AngleAxisd(extra).angle() * 180.0 / M_PI;
+    EXPECT_LE(angle_deg, std::sqrt(3.0) * kMaxDeg + 1e-9);
+    largest_deg = std::max(largest_deg, angle_deg);
+  }
+  EXPECT_GT(largest_deg, kMaxDeg);  // the three axes add up
+  spec.min_extra_rotation_deg = kMaxDeg;
+  spec.max_extra_rotation_deg = kMinDeg;
+  EXPECT_FALSE(RandomPosesAroundFocalLaw(spec, &poses, &error));
+  EXPECT_NE(error.find("min_extra_rotation_deg"), std::string::npos) << error;
+}
+
 TEST(PosesWithAttitudeLaw, MatchesFocalAttitude) {
   std::vector<Eigen::Vector3d> positions;
   ASSERT_TRUE(FocalSpherePositions(FocalGridSpec(), &positions, nullptr));

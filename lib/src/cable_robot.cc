@@ -32,6 +32,7 @@ CableRobot CableRobot::NominalFast() {
   robot.cabin_mass_kg = 30000.0;
   robot.mass_centre_cabin_m = Eigen::Vector3d(0.0, 0.0, 0.5);
   robot.gravity_m_per_s2 = -9.8;
+  robot.reflector = Reflector();
   return robot;
 }
 
@@ -78,6 +79,15 @@ bool CableRobot::IsValid(std::string* error) const {
     return fail("cabin_mass_kg", "must be > 0");
   }
   if (!mass_centre_cabin_m.allFinite()) return fail("mass_centre_cabin_m", "must be finite");
+  if (reflector.has_value()) {
+    if (!reflector->centre_m.allFinite()) return fail("reflector.centre_m", "must be finite");
+    if (!(reflector->radius_m > 0.0) || !std::isfinite(reflector->radius_m)) {
+      return fail("reflector.radius_m", "must be > 0");
+    }
+    if (!(reflector->aperture_m > 0.0) || !(reflector->aperture_m <= 2.0 * reflector->radius_m)) {
+      return fail("reflector.aperture_m", "must be > 0 and at most 2 radius_m");
+    }
+  }
   if (!(gravity_m_per_s2 < 0.0) || !std::isfinite(gravity_m_per_s2)) {
     return fail("gravity_m_per_s2", "must be < 0 (z is up)");
   }

@@ -266,10 +266,43 @@ class Parser {
     return true;
   }
 
+  // `reflector: none`, or a mapping whose absent keys keep the nominal values.
+  bool ReadReflector(const Entry& entry, CableRobot* robot) {
+    const std::string path = "reflector";
+    const YAML::Node& node = entry.value;
+    const int line = LineOf(entry.key);
+    if (node.IsScalar() && node.Tag() != "!" && node.Scalar() == "none") {
+      robot->reflector.reset();
+      return true;
+    }
+    if (!node.IsMap()) {
+      return Fail(line, path, "expected a mapping (centre_m, radius_m, aperture_m) or none");
+    }
+    std::map<std::string, Entry> keys;
+    if (!ReadMap(node, line, path, {"centre_m", "radius_m", "aperture_m"}, &keys)) return false;
+    Reflector reflector;
+    if (const auto it = keys.find("centre_m"); it != keys.end()) {
+      if (!ReadVector3(it->second.value, LineOf(it->second.key), Join(path, "centre_m"),
+                       &reflector.centre_m)) {
+        return false;
+      }
+    }
+    for (const auto& [name, value] : {std::pair{"radius_m", &reflector.radius_m},
+                                      std::pair{"aperture_m", &reflector.aperture_m}}) {
+      if (const auto it = keys.find(name); it != keys.end()) {
+        if (!ReadDouble(it->second.value, LineOf(it->second.key), Join(path, name), value)) {
+          return false;
+        }
+      }
+    }
+    robot->reflector = reflector;
+    return true;
+  }
+
   bool ReadRoot(const YAML::Node& root, CableRobot* robot) {
     std::map<std::string, Entry> keys;
-    if (!ReadMap(root, LineOf(root), kRootPath, {"format", "gravity_m_per_s2", "cabin", "cables"},
-                 &keys)) {
+    if (!ReadMap(root, LineOf(root), kRootPath,
+                 {"format", "gravity_m_per_s2", "cabin", "cables", "reflector"}, &keys)) {
       return false;
     }
     if (const auto it = keys.find("format"); it != keys.end()) {
@@ -291,6 +324,9 @@ class Parser {
     }
     if (const auto it = keys.find("cables"); it != keys.end()) {
       if (!ReadCables(it->second, robot)) return false;
+    }
+    if (const auto it = keys.find("reflector"); it != keys.end()) {
+      if (!ReadReflector(it->second, robot)) return false;
     }
     return true;
   }
@@ -404,6 +440,14 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
       out << "    sensor_gain: " << Num(c.sensor_gain) << "  # reading = gain * tension + bias\n";
       out << "    sensor_bias_kN: " << Num(c.sensor_bias_n / 1e3) << "\n";
     }
+  }
+  if (robot.reflector.has_value()) {
+    out << "reflector:  # lower cap of a sphere, global frame, m\n";
+    out << "  centre_m: " << Vec(robot.reflector->centre_m) << "\n";
+    out << "  radius_m: " << Num(robot.reflector->radius_m) << "\n";
+    out << "  aperture_m: " << Num(robot.reflector->aperture_m) << "  # rim diameter\n";
+  } else {
+    out << "reflector: none  # not modelled: no contact check\n";
   }
   return out.str();
 }

@@ -337,10 +337,11 @@ CatenaryStatus Start(const CatenaryLengthProblem& c, double chord_m,
 // Newton on n independent problems in lockstep: each takes exactly the iterations it
 // would take alone (anything off the plain full-step path continues in NewtonFrom from
 // that point), but each loop below runs over independent problems, so no iteration
-// waits on another's square roots, divisions and logarithm. u[j] receives the solution.
+// waits on another's square roots, divisions and logarithm. u[j] receives the solution
+// and, when `jacobians` is not null, jacobians[j] its last evaluation's Jacobian.
 template <typename Spec>
 void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, double (*u)[2],
-                CatenaryStatus* statuses, int* iterations) {
+                CatenaryStatus* statuses, int* iterations, double (*jacobians)[4]) {
   using P = decltype(MakeProblem(specs[0]));
   struct State {
     P problem;
@@ -409,6 +410,9 @@ void SolveBatch(int n, const Spec* specs, const CatenarySolverOptions& options, 
       }
     }
   }
+  for (int j = 0; j < n && jacobians != nullptr; ++j) {
+    if (statuses[j] == CatenaryStatus::kOk) std::copy(st[j].jac, st[j].jac + 4, jacobians[j]);
+  }
 }
 
 }  // namespace
@@ -418,9 +422,9 @@ namespace {
 // SolveBatch with each solution converted to its public type, written where ok.
 template <typename Spec, typename Out>
 void SolveBatchInto(int n, const Spec* problems, const CatenarySolverOptions& options, Out* out,
-                    CatenaryStatus* statuses, int* iterations) {
+                    CatenaryStatus* statuses, int* iterations, double (*jacobians)[4] = nullptr) {
   double u[kMaxCatenaryBatch][2];
-  SolveBatch(n, problems, options, u, statuses, iterations);
+  SolveBatch(n, problems, options, u, statuses, iterations, jacobians);
   for (int j = 0; j < std::min(n, kMaxCatenaryBatch); ++j) {
     if (statuses[j] == CatenaryStatus::kOk) out[j] = Out{u[j][0], u[j][1]};
   }
@@ -430,14 +434,14 @@ void SolveBatchInto(int n, const Spec* problems, const CatenarySolverOptions& op
 
 void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
                               const CatenarySolverOptions& options, CatenaryForces* forces,
-                              CatenaryStatus* statuses, int* iterations) {
-  SolveBatchInto(n, problems, options, forces, statuses, iterations);
+                              CatenaryStatus* statuses, int* iterations, double (*jacobians)[4]) {
+  SolveBatchInto(n, problems, options, forces, statuses, iterations, jacobians);
 }
 
 void SolveCatenaryLengthBatch(int n, const CatenaryLengthProblem* problems,
                               const CatenarySolverOptions& options, CatenaryCurvePoint* points,
-                              CatenaryStatus* statuses, int* iterations) {
-  SolveBatchInto(n, problems, options, points, statuses, iterations);
+                              CatenaryStatus* statuses, int* iterations, double (*jacobians)[4]) {
+  SolveBatchInto(n, problems, options, points, statuses, iterations, jacobians);
 }
 
 CatenaryStatus SolveCatenaryForcesDouble(double span_m, double rise_m, double s0_m, double ea_n,

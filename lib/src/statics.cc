@@ -1,13 +1,67 @@
-// The double-precision statics solvers (equations and methods: statics.h).
+// The double-precision statics solvers (equations and methods: statics.h): AAS, refined
+// AAS and exact, the continuation from the home pose that exact falls back on where its
+// start fails, and the checks every solution passes before it is ok (docs/model.md,
+// "Checking every solution"):
+//   end conditions   g_i = (L, Z)(Fl_i, Fz_i, s0_i) - (L_i, Z_i)   (eqs. 14-16, m)
+//   error estimate   the Newton step they imply: per cable the Fz miss at its Fl,
+//                    d_i = -(n . g_i)/(n . dg/dFz) (ds0 eliminated by n), moved through the
+//                    equilibrium, M dFl = -(0, 0, sum d, sum r_y d, sum r_x d, 0), with M
+//                    the last 6x6 matrix (statics.h), dFz_i = a_i dFl_i + d_i; the estimate is
+//                    max_i |dT_i| / T_i, dT = (Fl dFl + Fz dFz)/T (first order in the error;
+//                    for aas, d_i is exactly its Fz minus the curve's at its Fl)
+//   equilibrium      sum(-F_i) + W and sum r_i x (-F_i) + e x W of the returned forces
+//   model range      strain, s0/k, and each cable's clearance from the reflector.
 #include "fastcal/statics.h"
 
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 #include <sstream>
 
 namespace fastcal {
 namespace {
+
+using internal::CableLinearisation;
+using internal::CableState;
+using internal::EquilibriumResponse;
+using Geometry = internal::PoseGeometry<double>;
+using State = std::array<CableState<double>, kNumCables>;
+
+// Equilibrium residuals above this fraction of the largest force (N), or of it times the
+// largest lever arm (N m), mean the 6x6 solve failed: it meets them to rounding, ~1e-14.
+constexpr double kMaxRelativeEquilibriumResidual = 1e-9;
+// Whether the error estimate after a Newton step of relative size `step` can be trusted:
+// it uses the partials from before the step (CheckAfterStep), so only after a small step
+// (after larger ones, where a cable sags, it was measured 100 times too small), and only
+// while Newton is seen to converge, the error left a tenth of the step or less (or at the
+// rounding floor): aas-refined can stall near a fold of the equations with a small step
+// and a small residual 27% from the solution, where its steps then diverge.
+bool Contracting(double step, double estimate) {
+  constexpr double kTrustedStep = 1e-2;
+  constexpr double kMaxContraction = 0.1;
+  constexpr double kRoundingFloor = 1e-12;
+  return step <= kTrustedStep && (estimate <= kMaxContraction * step || estimate <= kRoundingFloor);
+}
+// A point of exact's continuation counts as solved once its Newton step is below this
+// fraction of the forces: it only starts the next point (the last one is then polished to
+// exact_relative_tolerance), and at 1e-6 the next point's start is as good as exact.
+constexpr double kPathPointTolerance = 1e-6;
+// Newton iterations per path point before the step along the path is halved: from the
+// previous point extrapolated, a point 1/8 of the way on takes 2-3 where the path is easy.
+constexpr int kPathPointIterations = 6;
+// The continuation's first step, as a fraction of the path; successful steps double.
+constexpr double kFirstPathStep = 0.5;
+// A step along the path halved below this fraction means the equilibrium ends before the
+// pose (a fold of the solution path, or a cable's Fl reaching 0): no equilibrium. Over
+// the seeded 10,000-pose sweep (tests/statics_test.cc) no pose that has an in-range
+// equilibrium needed steps below 1e-2.
+constexpr double kMinPathStep = 1e-3;
+// The home pose the continuation starts from: level (R = I), below the centroid of the
+// tower tops by this fraction of their mean horizontal distance from it. For FAST that is
+// K1 = (0, 0, 140) m (130 m below 270 m tower tops at 300 m), where all cables are taut.
+constexpr double kHomeDepthPerTowerRadius = 130.0 / 300.0;
 
 bool ParametersUsable(const StaticsParameters<double>& p) {
   for (int i = 0; i < kNumCables; ++i) {
@@ -22,170 +76,668 @@ bool ParametersUsable(const StaticsParameters<double>& p) {
          std::isfinite(p.gravity_m_per_s2);
 }
 
-// Tensions of each cable's ends (CheckModelRange computes them, FillSolution reports them).
-struct EndTensions {
-  std::array<double, kNumCables> lower_n, upper_n;
+// What the checks found at a solution, with its end tensions (T0, T1 of eqs. 6, computed
+// by the same evaluation).
+struct Check {
+  std::array<double, kNumCables> end_residual_m{}, lower_n{}, upper_n{};
+  double error_estimate = 0.0;
 };
 
-void FillSolution(const internal::PoseGeometry<double>& g,
-                  const std::array<internal::CableState<double>, kNumCables>& st,
-                  const EndTensions& tensions, const std::array<CatenaryForces, kNumCables>& low,
-                  const std::array<CatenaryForces, kNumCables>& high, StaticsSolution* sol) {
-  Eigen::Vector3d force_sum = Eigen::Vector3d::Zero(), moment_sum = Eigen::Vector3d::Zero();
+// Evaluates every cable's end point at `st` (values only): the end residuals and tensions
+// into *check and, through `lin` (the linearisation of the last step, whose partials are
+// good to first order here), each cable's Fz miss through its normal n,
+// d = -(n . g)/(n . dg/dFz), into *miss.
+void EvaluateEnds(const StaticsParameters<double>& p, const Geometry& g, const State& st,
+                  const CableLinearisation<double>& lin, std::array<double, kNumCables>* miss,
+                  Check* check) {
   for (int i = 0; i < kNumCables; ++i) {
-    CableSolution& c = sol->cables[i];
-    c.horizontal_force_n = st[i].fl;
-    c.force_n = Eigen::Vector3d(-g.ux[i] * st[i].fl, -g.uy[i] * st[i].fl, st[i].fz);
-    c.lower_tension_n = tensions.lower_n[i];
-    c.unstretched_length_m = st[i].s0;
-    c.upper_tension_n = tensions.upper_n[i];
-    c.chord_length_m = g.chord[i];
-    c.secant_low = low[i];
-    c.secant_high = high[i];
-    force_sum -= c.force_n;
-    moment_sum -= g.r[i].cross(c.force_n);
+    const CatenaryEnd<double> e = CatenaryEndpoint(st[i].fl, st[i].fz, st[i].s0, p.ea_n[i], g.w[i]);
+    const double g0 = e.span_m - g.span[i], g1 = e.rise_m - g.rise[i];
+    check->end_residual_m[i] = std::sqrt(g0 * g0 + g1 * g1);
+    check->lower_n[i] = e.lower_tension_n;
+    check->upper_n[i] = e.upper_tension_n;
+    const CatenaryEnd<double>& d = lin.ends[i];
+    (*miss)[i] = -(d.drise[2] * g0 - d.dspan[2] * g1) * lin.inv_qq[i];
+  }
+}
+
+// max_i |dT_i| / T_i for the correction of each cable's Fz by `miss` at its Fl, moved
+// through the equilibrium with `response` (the file comment's error estimate).
+double EstimateError(const Geometry& g, const State& st,
+                     const std::array<double, kNumCables>& slope,
+                     const std::array<double, kNumCables>& miss,
+                     const EquilibriumResponse& response) {
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();  // rows 2, 3, 4
+  for (int i = 0; i < kNumCables; ++i) {
+    rhs[0] -= miss[i];
+    rhs[1] -= g.r[i][1] * miss[i];
+    rhs[2] -= g.r[i][0] * miss[i];
+  }
+  const Eigen::Matrix<double, 6, 1> dfl = response * rhs;
+  // The largest |T dT| / T^2, compared as fractions: one division instead of six.
+  double worst_num = 0.0, worst_den = 1.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    const double dfz = slope[i] * dfl[i] + miss[i];
+    const double num = std::abs(st[i].fl * dfl[i] + st[i].fz * dfz);
+    const double den = st[i].fl * st[i].fl + st[i].fz * st[i].fz;
+    if (!(num * worst_den <= worst_num * den)) {  // NaN propagates as the worst
+      worst_num = num;
+      worst_den = den;
+    }
+  }
+  return worst_num / worst_den;
+}
+
+// The checks at `st` after a step from the linearisation `lin` whose equilibrium system
+// had `response` (EvaluateEnds, then the error estimate).
+Check CheckAfterStep(const StaticsParameters<double>& p, const Geometry& g, const State& st,
+                     const CableLinearisation<double>& lin, const EquilibriumResponse& response) {
+  Check c;
+  std::array<double, kNumCables> miss;
+  EvaluateEnds(p, g, st, lin, &miss, &c);
+  c.error_estimate = EstimateError(g, st, lin.a, miss, response);
+  return c;
+}
+
+// Shared by the stages of one solve.
+struct Context {
+  const StaticsParameters<double>& p;
+  const StaticsOptions& o;
+  StaticsSolution* sol;
+  std::array<CatenaryForces, kNumCables> low{}, high{};  // AAS secants (warm starts)
+};
+
+// AAS at the pose of `g`: the secant lines, the 6x6 solve (its response kept), Fl and Fz on
+// the lines; *slope receives the lines' slopes. kNoEquilibrium (cable set) when AAS gives
+// a cable Fl <= 0: AAS then says nothing about the pose.
+StaticsStatus AasStart(Context* c, const Geometry& g, bool use_guess, State* st,
+                       std::array<double, kNumCables>* slope, EquilibriumResponse* response,
+                       double (*secant_jacobians)[4] = nullptr) {
+  std::array<double, kNumCables> b, fl;
+  int* cable = &c->sol->cable;
+  const StaticsStatus status =
+      internal::AasLines(c->p, g, c->o, use_guess, &c->low, &c->high, slope, &b, cable,
+                         &c->sol->catenary_iterations, secant_jacobians);
+  if (status != StaticsStatus::kOk) return status;
+  const bool solved = response != nullptr
+                          ? internal::SolveEquilibrium<double, true>(g, *slope, b, &fl, response)
+                          : internal::SolveEquilibrium(g, *slope, b, &fl);
+  if (!solved) return StaticsStatus::kSingular;
+  for (int i = 0; i < kNumCables; ++i) {
+    if (!(fl[i] > 0.0)) {
+      *cable = i;
+      return StaticsStatus::kNoEquilibrium;
+    }
+    (*st)[i] = {fl[i], (*slope)[i] * fl[i] + b[i], 0.0};
+  }
+  return StaticsStatus::kOk;
+}
+
+// Each cable on its Fz(Fl) curve at its Fl: *projected gets Fz and s0. The start is the
+// secant data's model-corrected CurveGuess, or with `from_state` the state's own Fz and s0.
+// `jacobians` (may be null): each solve's last d(L, Z)/d(Fz, s0) (ProjectOnCurves).
+StaticsStatus Project(Context* c, const Geometry& g, const State& st, bool from_state,
+                      State* projected, double (*jacobians)[4] = nullptr) {
+  std::array<CatenaryCurvePoint, kNumCables> guess;
+  for (int i = 0; i < kNumCables; ++i) {
+    guess[i] = from_state ? CatenaryCurvePoint{st[i].fz, st[i].s0}
+                          : internal::CurveGuess(st[i].fl, g, i, c->p.ea_n[i], c->low[i],
+                                                 c->high[i], c->o, /*model_corrected=*/true);
+  }
+  *projected = st;
+  return internal::ProjectOnCurves(c->p, g, internal::AasLengthStageOptions(c->o), guess, projected,
+                                   &c->sol->cable, &c->sol->catenary_iterations, jacobians);
+}
+
+// exact's start at the pose of `g`: AAS's Fl and each cable's Fz and s0 from the secant
+// data's model-corrected guess of its curve point there (internal::CurveGuess, ~1e-5
+// off), as good as solving for the point, since the AAS Fl is itself ~1e-3 off.
+StaticsStatus ExactStart(Context* c, const Geometry& g, State* st) {
+  std::array<double, kNumCables> slope;
+  const StaticsStatus status = AasStart(c, g, /*use_guess=*/false, st, &slope, nullptr);
+  if (status != StaticsStatus::kOk) return status;
+  for (int i = 0; i < kNumCables; ++i) {
+    const CatenaryCurvePoint guess =
+        internal::CurveGuess((*st)[i].fl, g, i, c->p.ea_n[i], c->low[i], c->high[i], c->o, true);
+    (*st)[i].fz = guess.fz_n;
+    (*st)[i].s0 = guess.s0_m;
+  }
+  return StaticsStatus::kOk;
+}
+
+// aas's curve points: each cable's curve point at its AAS Fl, solved (one Newton step from
+// the model-corrected guess): s0 into *st and the Fz miss d, the curve's Fz minus AAS's,
+// into *miss. At the same Fl and s0 AAS's end point misses the tower by d(L, Z)/dFz d, to
+// first order (the second order is d/T, below 1% of it where aas is ok): the end
+// residual without another evaluation.
+StaticsStatus AasCurvePointsSolved(Context* c, const Geometry& g, State* st,
+                                   std::array<double, kNumCables>* miss, Check* check) {
+  State projected;
+  double jacobians[kNumCables][4] = {};  // written where the solves are ok
+  const StaticsStatus status = Project(c, g, *st, /*from_state=*/false, &projected, jacobians);
+  if (status != StaticsStatus::kOk) return status;
+  for (int i = 0; i < kNumCables; ++i) {
+    (*st)[i].s0 = projected[i].s0;
+    (*miss)[i] = projected[i].fz - (*st)[i].fz;
+    const double* j = jacobians[i];  // rows: span, rise; columns: Fz, s0
+    check->end_residual_m[i] = std::abs((*miss)[i]) * std::sqrt(j[0] * j[0] + j[2] * j[2]);
+  }
+  return StaticsStatus::kOk;
+}
+
+// The same for forces only (StaticsOptions::compute_unstretched_lengths off), without a
+// catenary evaluation: the curve point is the model-corrected guess, and d(L, Z)/dFz is
+// interpolated in Fl between the secant solves' (columns Fz of `secant_jacobians`), as
+// the guess is.
+void AasCurvePointsGuessed(Context* c, const Geometry& g, const double (*secant_jacobians)[4],
+                           State* st, std::array<double, kNumCables>* miss, Check* check) {
+  for (int i = 0; i < kNumCables; ++i) {
+    CableState<double>& x = (*st)[i];
+    const CatenaryForces &low = c->low[i], &high = c->high[i];
+    const CatenaryCurvePoint guess =
+        internal::CurveGuess(x.fl, g, i, c->p.ea_n[i], low, high, c->o, /*model_corrected=*/true);
+    x.s0 = guess.s0_m;
+    (*miss)[i] = guess.fz_n - x.fz;
+    const double t = (x.fl - low.fl_n) / (high.fl_n - low.fl_n);
+    const double* jl = secant_jacobians[i];  // rows: span, rise; columns: Fl, Fz
+    const double* jh = secant_jacobians[i + kNumCables];
+    const double dspan = jl[1] + t * (jh[1] - jl[1]), drise = jl[3] + t * (jh[3] - jl[3]);
+    check->end_residual_m[i] = std::abs((*miss)[i]) * std::sqrt(dspan * dspan + drise * drise);
+  }
+}
+
+// The paper's AAS, with s0 from the curves at its Fl and the checks (the curve points
+// above, the tensions, the error estimate through AAS's own equilibrium response).
+StaticsStatus SolveAas(Context* c, const Geometry& g, bool warm, State* st, Check* check) {
+  const bool solve_points = c->o.compute_unstretched_lengths;
+  std::array<double, kNumCables> slope;
+  EquilibriumResponse response;
+  double secant_jacobians[2 * kNumCables][4] = {};  // written where the solves are ok
+  StaticsStatus status =
+      AasStart(c, g, warm, st, &slope, &response, solve_points ? nullptr : secant_jacobians);
+  if (status == StaticsStatus::kNoEquilibrium) return StaticsStatus::kInaccurate;
+  if (status != StaticsStatus::kOk) return status;
+  std::array<double, kNumCables> miss;
+  if (solve_points) {
+    status = AasCurvePointsSolved(c, g, st, &miss, check);
+    if (status != StaticsStatus::kOk) return status;
+  } else {
+    AasCurvePointsGuessed(c, g, secant_jacobians, st, &miss, check);
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableState<double>& x = (*st)[i];
+    check->lower_n[i] = std::sqrt(x.fl * x.fl + x.fz * x.fz);
+    check->upper_n[i] = CatenaryTension(x.fl, x.fz, x.s0, g.w[i]);
+  }
+  check->error_estimate = EstimateError(g, *st, slope, miss, response);
+  if (!(check->error_estimate <= c->o.aas_max_relative_error)) {
+    c->sol->limit_value = check->error_estimate;
+    c->sol->limit = c->o.aas_max_relative_error;
+    return StaticsStatus::kInaccurate;
+  }
+  return StaticsStatus::kOk;
+}
+
+// AAS, then steps (each: onto the curves, tangent step, checks) until the error estimate
+// is below refined_relative_tolerance.
+StaticsStatus SolveAasRefined(Context* c, const Geometry& g, bool warm, State* st, Check* check) {
+  std::array<double, kNumCables> slope;
+  StaticsStatus status = AasStart(c, g, warm, st, &slope, nullptr);
+  if (status == StaticsStatus::kNoEquilibrium) return StaticsStatus::kNotConverged;
+  if (status != StaticsStatus::kOk) return status;
+  for (int step = 0; step < c->o.max_refinement_steps; ++step) {
+    status = Project(c, g, *st, /*from_state=*/step > 0, st);
+    if (status == StaticsStatus::kNoEquilibrium) return StaticsStatus::kNotConverged;
+    if (status != StaticsStatus::kOk) return status;
+    CableLinearisation<double> lin;
+    internal::LineariseCables(c->p, g, *st, &lin);
+    EquilibriumResponse response;
+    double relative_step = 0.0;
+    status = internal::StepFromLinearisation(g, lin, st, &c->sol->cable, &relative_step, &response);
+    ++c->sol->outer_iterations;
+    // A step that leaves Fl > 0 or meets a singular system (near a fold, where cables
+    // sag): aas-refined cannot go on, which says nothing about the pose.
+    if (status == StaticsStatus::kSingular) c->sol->cable = -1;
+    if (status == StaticsStatus::kNoEquilibrium || status == StaticsStatus::kSingular) {
+      return StaticsStatus::kNotConverged;
+    }
+    if (status != StaticsStatus::kOk) return status;
+    *check = CheckAfterStep(c->p, g, *st, lin, response);
+    if (check->error_estimate <= c->o.refined_relative_tolerance &&
+        Contracting(relative_step, check->error_estimate)) {
+      return StaticsStatus::kOk;
+    }
+  }
+  c->sol->cable = -1;
+  c->sol->limit_value = check->error_estimate;
+  c->sol->limit = c->o.refined_relative_tolerance;
+  return StaticsStatus::kNotConverged;
+}
+
+// Newton on the reduced system from *st at the pose of `g`, at most max_steps steps, until
+// the error estimate is <= tolerance; then *check holds the checks of *st. Otherwise
+// kNotConverged, or a step's failure (kNoEquilibrium: a step left Fl > 0 or s0 > 0;
+// kSingular), with *st the last iterate.
+StaticsStatus Newton(Context* c, const Geometry& g, int max_steps, double tolerance, State* st,
+                     Check* check) {
+  // Newton's error after a step of relative size d is ~C d^2, C ~ 1 where the cables are
+  // taut (0.06-1.2 measured; larger where they sag): the new iterate is checked once d^2
+  // is below the tolerance. A check that cannot pass would cost six catenary evaluations
+  // for nothing, one that could have passed a step.
+  //
+  // The check's estimate uses the equilibrium response of the step before it. Computing
+  // it costs half a 6x6 solve, so a step computes it only if it may be the last: the
+  // first when the start's end residual is below kFirstStepKeepResidual (a start next to
+  // the solution: a warm start in a calibration), a later one when the step before it
+  // was small enough that this one may pass the check (d_next >= 0.05 d^2 in practice, so
+  // d^4 <= 400 tolerance). A check without it solves the step's system again.
+  constexpr double kFirstStepKeepResidual = 1e-7;
+  constexpr double kSmallestContraction = 5e-2;
+  CableLinearisation<double> lin;
+  EquilibriumResponse response;
+  internal::LineariseCables(c->p, g, *st, &lin);
+  double previous_step = std::numeric_limits<double>::infinity();
+  for (int step = 0; step < max_steps; ++step) {
+    const double predicted = kSmallestContraction * previous_step * previous_step;
+    const bool keep = step == 0 ? lin.max_relative_residual <= kFirstStepKeepResidual
+                                : predicted * predicted <= tolerance;
+    double relative_step = 0.0;
+    const StaticsStatus status = internal::StepFromLinearisation(
+        g, lin, st, &c->sol->cable, &relative_step, keep ? &response : nullptr);
+    ++c->sol->outer_iterations;
+    if (status != StaticsStatus::kOk) return status;
+    if (relative_step * relative_step <= tolerance) {
+      if (!keep) {
+        std::array<double, kNumCables> unused;
+        internal::SolveEquilibrium<double, true>(g, lin.a, lin.b, &unused, &response);
+      }
+      *check = CheckAfterStep(c->p, g, *st, lin, response);
+      if (check->error_estimate <= tolerance) return StaticsStatus::kOk;
+    }
+    internal::LineariseCables(c->p, g, *st, &lin);
+    previous_step = relative_step;
+  }
+  return StaticsStatus::kNotConverged;
+}
+
+// The home pose of the continuation (kHomeDepthPerTowerRadius).
+Pose HomePose(const StaticsParameters<double>& p) {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& t : p.tower_top_m) centroid += t / kNumCables;
+  double radius_m = 0.0;
+  for (const Eigen::Vector3d& t : p.tower_top_m) {
+    radius_m += (t - centroid).head<2>().norm() / kNumCables;
+  }
+  Pose home;
+  home.position_m = centroid - Eigen::Vector3d(0.0, 0.0, kHomeDepthPerTowerRadius * radius_m);
+  return home;
+}
+
+Pose PoseOnPath(const Pose& from, const Pose& to, double t) {
+  Pose p;
+  p.position_m = (1.0 - t) * from.position_m + t * to.position_m;
+  p.rotation = Eigen::Quaterniond(from.rotation)
+                   .slerp(t, Eigen::Quaterniond(to.rotation))
+                   .toRotationMatrix();
+  return p;
+}
+
+// The largest s0/k of a state and its cable.
+double LargestLengthRatio(const Geometry& g, const State& st, int* cable) {
+  double worst = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    if (st[i].s0 / g.chord[i] > worst) {
+      worst = st[i].s0 / g.chord[i];
+      *cable = i;
+    }
+  }
+  return worst;
+}
+
+// exact's fallback: the equilibrium followed from the home pose to `pose` in steps along
+// a straight path (position, and attitude by slerp), each point solved by Newton from
+// the previous ones extrapolated; a failed step is halved, a good one doubled. kOk with
+// *st solved (to kPathPointTolerance) at `pose`; kNoEquilibrium when the steps shrink
+// below kMinPathStep (sol->cable: the slackest cable there, limit_value its s0/k);
+// kNotConverged when *budget Newton steps run out or the home pose has no solution.
+StaticsStatus FollowFromHome(Context* c, const Pose& pose, int* budget, State* st) {
+  const Pose home = HomePose(c->p);
+  Geometry g;
+  Check check;
+  int* cable = &c->sol->cable;
+  const int start_iterations = c->sol->outer_iterations;
+  if (internal::ComputeGeometry(c->p, home, c->o.catenary.vertical_span_fraction, &g, cable) !=
+          StaticsStatus::kOk ||
+      ExactStart(c, g, st) != StaticsStatus::kOk ||
+      Newton(c, g, kPathPointIterations, kPathPointTolerance, st, &check) != StaticsStatus::kOk) {
+    return StaticsStatus::kNotConverged;
+  }
+  int used = c->sol->outer_iterations - start_iterations;
+  State previous = *st;
+  double t = 0.0, t_previous = -1.0, dt = kFirstPathStep;
+  while (t < 1.0) {
+    if (used >= *budget) {
+      c->sol->cable = -1;
+      return StaticsStatus::kNotConverged;
+    }
+    const double t_next = std::min(1.0, t + dt);
+    State trial = *st;
+    if (t_previous >= 0.0) {
+      const double f = (t_next - t) / (t - t_previous);
+      for (int i = 0; i < kNumCables; ++i) {
+        const CableState<double> x = {(*st)[i].fl + f * ((*st)[i].fl - previous[i].fl),
+                                      (*st)[i].fz + f * ((*st)[i].fz - previous[i].fz),
+                                      (*st)[i].s0 + f * ((*st)[i].s0 - previous[i].s0)};
+        if (x.fl > 0.0 && x.s0 > 0.0) trial[i] = x;
+      }
+    }
+    const int before = c->sol->outer_iterations;
+    const bool solved = internal::ComputeGeometry(c->p, PoseOnPath(home, pose, t_next),
+                                                  c->o.catenary.vertical_span_fraction, &g,
+                                                  cable) == StaticsStatus::kOk &&
+                        Newton(c, g, std::min(kPathPointIterations, *budget - used),
+                               kPathPointTolerance, &trial, &check) == StaticsStatus::kOk;
+    used += c->sol->outer_iterations - before;
+    if (solved) {
+      previous = *st;
+      *st = trial;
+      t_previous = t;
+      t = t_next;
+      dt *= 2.0;
+    } else if ((dt *= 0.5) < kMinPathStep) {
+      internal::ComputeGeometry(c->p, PoseOnPath(home, pose, t),
+                                c->o.catenary.vertical_span_fraction, &g, cable);
+      c->sol->limit_value = LargestLengthRatio(g, *st, cable);
+      *budget -= used;
+      return StaticsStatus::kNoEquilibrium;
+    }
+  }
+  *budget -= used;
+  return StaticsStatus::kOk;
+}
+
+// The clearance of cable i from the reflector: the sphere's radius minus the largest
+// distance from its centre of a cable point over the reflector (below the centre, within
+// the aperture's circle); negative: the cable passes through it. +infinity without a
+// reflector, or for a cable that cannot reach it: one rising from its cabin anchor
+// (Fz <= 0) where that lies above the rim's plane stays above the plane, and every point
+// over the aperture above the rim's plane is inside the sphere. Others (only cables that
+// dip below their anchor, in practice) are sampled at kSamples points, the best refined by
+// golden section: eqs. 11-13 give the points. rim2: the rim's radius squared, rim_z: its
+// height.
+double CableReflectorClearanceM(const StaticsParameters<double>& p, const Geometry& g,
+                                const State& st, int i, double rim2, double rim_z) {
+  constexpr int kSamples = 32;
+  constexpr int kRefinements = 30;  // brackets shrink to 1e-6 of s0 / kSamples
+  const Reflector& r = *p.reflector;
+  const double anchor_z = p.tower_top_m[i].z() - g.rise[i];
+  if (st[i].fz <= 0.0 && anchor_z >= rim_z) return std::numeric_limits<double>::infinity();
+  const Eigen::Vector3d anchor =
+      p.tower_top_m[i] - Eigen::Vector3d(g.ux[i] * g.span[i], g.uy[i] * g.span[i], g.rise[i]);
+  auto distance2 = [&](double s_m) {  // -1 where the point is not over the reflector
+    const CatenaryEnd<double> e = CatenaryEndpoint(st[i].fl, st[i].fz, s_m, p.ea_n[i], g.w[i]);
+    const Eigen::Vector3d d =
+        anchor + Eigen::Vector3d(g.ux[i] * e.span_m, g.uy[i] * e.span_m, e.rise_m) - r.centre_m;
+    return d.z() > 0.0 || d.head<2>().squaredNorm() > rim2 ? -1.0 : d.squaredNorm();
+  };
+  const double ds = st[i].s0 / kSamples;
+  int best = 0;
+  double best2 = (anchor - r.centre_m).squaredNorm();
+  for (int k = 1; k <= kSamples; ++k) {
+    const double d2 = distance2(k * ds);
+    if (d2 > best2) {
+      best2 = d2;
+      best = k;
+    }
+  }
+  const double kGolden = 0.5 * (std::sqrt(5.0) - 1.0);
+  double lo = std::max(0.0, (best - 1) * ds), hi = std::min(st[i].s0, (best + 1) * ds);
+  for (int it = 0; it < kRefinements; ++it) {
+    const double a = hi - kGolden * (hi - lo), b = lo + kGolden * (hi - lo);
+    const double da = distance2(a), db = distance2(b);
+    best2 = std::max(best2, std::max(da, db));
+    if (da > db) {
+      hi = b;
+    } else {
+      lo = a;
+    }
+  }
+  return r.radius_m - std::sqrt(best2);
+}
+
+// The smallest clearance from the reflector over the cables (CableReflectorClearanceM).
+double ReflectorClearanceM(const StaticsParameters<double>& p, const Geometry& g, const State& st,
+                           int* cable) {
+  double smallest = std::numeric_limits<double>::infinity();
+  if (!p.reflector.has_value()) return smallest;
+  const Reflector& r = *p.reflector;
+  const double rim2 = 0.25 * r.aperture_m * r.aperture_m;
+  const double rim_z = r.centre_m.z() - std::sqrt(r.radius_m * r.radius_m - rim2);
+  for (int i = 0; i < kNumCables; ++i) {
+    const double clearance_m = CableReflectorClearanceM(p, g, st, i, rim2, rim_z);
+    if (clearance_m < smallest) {
+      smallest = clearance_m;
+      *cable = i;
+    }
+  }
+  return smallest;
+}
+
+// The model-range limits of StaticsOptions on a solution, the worst cable of the first
+// limit broken, in this order: s0 <= 0 or strain over max_strain (kOverstretchedCable),
+// s0/k over max_length_ratio (kSaggingCable), a lowest point closer to the reflector than
+// min_reflector_clearance_m (kReflectorContact). Writes the smallest clearance whatever
+// the outcome.
+StaticsStatus CheckModelRange(Context* c, const Geometry& g, const State& st, const Check& check) {
+  StaticsSolution* sol = c->sol;
+  const StaticsOptions& o = c->o;
+  int too_short = -1, stretched = -1, sagging = -1, nearest = -1;
+  double strain = 0.0, ratio = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    // Divisions only where a limit is broken: this runs on every solution.
+    const double highest_n = std::max(check.lower_n[i], check.upper_n[i]);
+    if (!(st[i].s0 > 0.0)) {
+      too_short = i;
+    } else if (!(highest_n <= o.max_strain * c->p.ea_n[i]) && highest_n / c->p.ea_n[i] > strain) {
+      stretched = i;
+      strain = highest_n / c->p.ea_n[i];
+    }
+    if (st[i].s0 > o.max_length_ratio * g.chord[i] && st[i].s0 / g.chord[i] > ratio) {
+      sagging = i;
+      ratio = st[i].s0 / g.chord[i];
+    }
+  }
+  sol->reflector_clearance_m = ReflectorClearanceM(c->p, g, st, &nearest);
+  if (too_short >= 0 || stretched >= 0) {
+    sol->cable = too_short >= 0 ? too_short : stretched;
+    sol->limit_value = too_short >= 0 ? st[too_short].s0 / g.chord[too_short] : strain;
+    sol->limit = too_short >= 0 ? 0.0 : o.max_strain;
+    return StaticsStatus::kOverstretchedCable;
+  }
+  if (sagging >= 0) {
+    sol->cable = sagging;
+    sol->limit_value = ratio;
+    sol->limit = o.max_length_ratio;
+    return StaticsStatus::kSaggingCable;
+  }
+  if (sol->reflector_clearance_m < o.min_reflector_clearance_m) {
+    sol->cable = nearest;
+    sol->limit_value = sol->reflector_clearance_m;
+    sol->limit = o.min_reflector_clearance_m;
+    return StaticsStatus::kReflectorContact;
+  }
+  return StaticsStatus::kOk;
+}
+
+// Writes a checked solution into *sol; kSingular if its equilibrium residuals show that
+// the 6x6 solve failed (kMaxRelativeEquilibriumResidual).
+StaticsStatus FillSolution(Context* c, const Geometry& g, const State& st, const Check& check) {
+  StaticsSolution* sol = c->sol;
+  Eigen::Vector3d force_sum = Eigen::Vector3d::Zero(), moment_sum = Eigen::Vector3d::Zero();
+  double force_scale = std::abs(g.weight_n), lever2_m2 = 1.0;
+  sol->end_residual_m = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    CableSolution& cs = sol->cables[i];
+    cs.horizontal_force_n = st[i].fl;
+    cs.force_n = Eigen::Vector3d(-g.ux[i] * st[i].fl, -g.uy[i] * st[i].fl, st[i].fz);
+    cs.lower_tension_n = check.lower_n[i];
+    cs.unstretched_length_m = st[i].s0;
+    cs.upper_tension_n = check.upper_n[i];
+    cs.chord_length_m = g.chord[i];
+    cs.end_residual_m = check.end_residual_m[i];
+    cs.secant_low = c->low[i];
+    cs.secant_high = c->high[i];
+    sol->end_residual_m = std::max(sol->end_residual_m, cs.end_residual_m);
+    force_sum -= cs.force_n;
+    moment_sum -= g.r[i].cross(cs.force_n);
+    force_scale = std::max(force_scale, cs.lower_tension_n);
+    lever2_m2 = std::max(lever2_m2, g.r[i].squaredNorm());
   }
   const Eigen::Vector3d weight(0.0, 0.0, g.weight_n);
   force_sum += weight;
   moment_sum += g.e.cross(weight);
   sol->force_residual_n = force_sum.norm();
   sol->moment_residual_nm = moment_sum.norm();
-}
-
-// The model-range limits of StaticsOptions, on the finished solution: s0 in
-// (0, max_length_ratio k] (when computed: AAS may skip it), then every cable's lower and
-// upper tension within max_strain EA. Writes the tensions (upper 0 without s0).
-StaticsStatus CheckModelRange(const StaticsParameters<double>& p,
-                              const internal::PoseGeometry<double>& g,
-                              const std::array<internal::CableState<double>, kNumCables>& st,
-                              bool have_lengths, const StaticsOptions& o, EndTensions* tensions,
-                              int* cable) {
-  for (int i = 0; i < kNumCables; ++i) {
-    const double lower_n = std::sqrt(st[i].fl * st[i].fl + st[i].fz * st[i].fz);
-    double upper_n = lower_n;
-    tensions->lower_n[i] = lower_n;
-    tensions->upper_n[i] = 0.0;
-    if (have_lengths) {
-      const double s0_m = st[i].s0;
-      if (s0_m > o.max_length_ratio * g.chord[i]) {
-        *cable = i;
-        return StaticsStatus::kSlackCable;
-      }
-      if (!(s0_m > 0.0)) {
-        *cable = i;
-        return StaticsStatus::kOverstretchedCable;
-      }
-      upper_n = CatenaryTension(st[i].fl, st[i].fz, s0_m, g.w[i]);
-      tensions->upper_n[i] = upper_n;
-    }
-    if (!(std::max(lower_n, upper_n) <= o.max_strain * p.ea_n[i])) {
-      *cable = i;
-      return StaticsStatus::kOverstretchedCable;
-    }
+  sol->error_estimate = check.error_estimate;
+  const double tolerance_n = kMaxRelativeEquilibriumResidual * force_scale;
+  if (!(sol->force_residual_n <= tolerance_n) ||
+      !(sol->moment_residual_nm <= tolerance_n * std::sqrt(lever2_m2))) {
+    return StaticsStatus::kSingular;
   }
   return StaticsStatus::kOk;
 }
 
+// A solution that passed the method's checks: the model range, then FillSolution.
+StaticsStatus Finish(Context* c, const Geometry& g, const State& st, const Check& check) {
+  const StaticsStatus status = CheckModelRange(c, g, st, check);
+  if (status != StaticsStatus::kOk) return status;
+  return FillSolution(c, g, st, check);
+}
+
+// How far apart two poses are, as a vector: the position and the rotation matrix's change
+// scaled by the cabin's size (an anchor's move), so that turning counts like moving.
+Eigen::Matrix<double, 12, 1> PoseStep(const Pose& from, const Pose& to, double size_m) {
+  Eigen::Matrix<double, 12, 1> d;
+  d.head<3>() = to.position_m - from.position_m;
+  d.tail<9>() = size_m * (to.rotation - from.rotation).reshaped();
+  return d;
+}
+
+// exact's warm start at `pose` from the previous solution: its state, extrapolated
+// linearly along the path when it was itself warm-started and the poses go on in about
+// the same direction (the new step at least half along the last one).
+void WarmStart(const StaticsParameters<double>& p, const StaticsSolution& previous,
+               const Pose& pose, State* st) {
+  // Accept the extrapolation only while the new step is this close to the last one's line.
+  constexpr double kMaxOffLine = 0.5;
+  // and stretches it by at most this (a stop and go, or a jump, are no path).
+  constexpr double kMaxStretch = 2.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableSolution& c = previous.cables[i];
+    (*st)[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
+  }
+  if (!previous.has_previous) return;
+  double size_m = 0.0;
+  for (const Eigen::Vector3d& a : p.anchor_cabin_m) size_m = std::max(size_m, a.norm());
+  const Eigen::Matrix<double, 12, 1> last = PoseStep(previous.previous_pose, previous.pose, size_m);
+  const Eigen::Matrix<double, 12, 1> next = PoseStep(previous.pose, pose, size_m);
+  if (!(last.squaredNorm() > 0.0)) return;
+  const double f = next.dot(last) / last.squaredNorm();
+  if (!(f > 0.0 && f <= kMaxStretch) || (next - f * last).norm() > kMaxOffLine * next.norm()) {
+    return;
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const std::array<double, 3>& b = previous.previous_state[i];
+    const CableState<double> x = {(*st)[i].fl + f * ((*st)[i].fl - b[0]),
+                                  (*st)[i].fz + f * ((*st)[i].fz - b[1]),
+                                  (*st)[i].s0 + f * ((*st)[i].s0 - b[2])};
+    if (x.fl > 0.0 && x.s0 > 0.0) (*st)[i] = x;
+  }
+}
+
+// exact: Newton from the previous solution (warm) or from AAS; where that fails or ends
+// outside the model's range, and `may_follow`, the continuation from the home pose decides.
+StaticsStatus SolveExact(Context* c, const Geometry& g, const Pose& pose,
+                         const StaticsSolution* previous, bool may_follow) {
+  const StaticsOptions& o = c->o;
+  StaticsSolution* sol = c->sol;
+  State st;
+  Check check;
+  StaticsStatus status = StaticsStatus::kOk;
+  if (previous != nullptr) {
+    WarmStart(c->p, *previous, pose, &st);
+  } else {
+    status = ExactStart(c, g, &st);
+  }
+  if (status == StaticsStatus::kOk) {
+    status = Newton(c, g, o.exact_max_iterations, o.exact_relative_tolerance, &st, &check);
+  }
+  // A converged solution outside the model's range is kept in case the continuation
+  // finds none: it is an equilibrium, and its range status the answer.
+  const bool converged = status == StaticsStatus::kOk;
+  const State direct = st;
+  const Check direct_check = check;
+  if (converged) {
+    status = Finish(c, g, st, check);
+    if (status == StaticsStatus::kOk || !may_follow) return status;
+  }
+  if (!may_follow) return StaticsStatus::kNotConverged;
+  sol->continuation = true;
+  sol->cable = -1;
+  sol->limit_value = sol->limit = 0.0;
+  int budget = o.exact_max_continuation_iterations;
+  status = FollowFromHome(c, pose, &budget, &st);
+  if (status == StaticsStatus::kOk) {
+    status = Newton(c, g, std::min(o.exact_max_iterations, std::max(budget, 1)),
+                    o.exact_relative_tolerance, &st, &check);
+    if (status == StaticsStatus::kOk) return Finish(c, g, st, check);
+    if (status == StaticsStatus::kNoEquilibrium) status = StaticsStatus::kNotConverged;
+  }
+  if (converged) {  // the continuation found no equilibrium, or ran out of iterations
+    sol->limit_value = sol->limit = 0.0;
+    return Finish(c, g, direct, direct_check);
+  }
+  return status;
+}
+
 StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, const StaticsOptions& o,
-                      const StaticsSolution* previous, StaticsSolution* sol) {
-  using internal::CableState;
+                      const StaticsSolution* previous, bool may_follow, StaticsSolution* sol) {
   // sol->cables is left as it is: FillSolution writes all of it on success, and
   // SolveStaticsWithParameters zeroes it on failure.
+  sol->method = o.method;
   sol->cable = -1;
   sol->outer_iterations = 0;
   sol->catenary_iterations = 0;
+  sol->continuation = false;
   sol->force_residual_n = 0.0;
   sol->moment_residual_nm = 0.0;
+  sol->end_residual_m = 0.0;
+  sol->error_estimate = 0.0;
+  sol->limit_value = sol->limit = 0.0;
+  sol->reflector_clearance_m = std::numeric_limits<double>::infinity();
   if (!IsFinite(pose) || !ParametersUsable(p)) return StaticsStatus::kInvalidInput;
 
-  internal::PoseGeometry<double> g;
+  Geometry g;
   StaticsStatus status =
       internal::ComputeGeometry(p, pose, o.catenary.vertical_span_fraction, &g, &sol->cable);
   if (status != StaticsStatus::kOk) return status;
 
-  std::array<CatenaryForces, kNumCables> low{}, high{};
-  std::array<CableState<double>, kNumCables> st;
-  bool have_state = false;
+  Context c{p, o, sol};
   if (previous != nullptr) {
     for (int i = 0; i < kNumCables; ++i) {
-      low[i] = previous->cables[i].secant_low;
-      high[i] = previous->cables[i].secant_high;
-    }
-    if (o.method == StaticsMethod::kExact) {
-      for (int i = 0; i < kNumCables; ++i) {
-        const CableSolution& c = previous->cables[i];
-        st[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
-      }
-      have_state = true;
+      c.low[i] = previous->cables[i].secant_low;
+      c.high[i] = previous->cables[i].secant_high;
     }
   }
-
-  int* cable = &sol->cable;
-  int* its = &sol->catenary_iterations;
-  if (!have_state) {
-    const StaticsOptions so = internal::AasLengthStageOptions(o);
-    std::array<double, kNumCables> a, b, fl;
-    status = internal::AasLines(p, g, o, previous != nullptr, &low, &high, &a, &b, cable, its);
-    if (status != StaticsStatus::kOk) return status;
-    if (!internal::SolveEquilibrium(g, a, b, &fl)) return StaticsStatus::kSingular;
-    for (int i = 0; i < kNumCables; ++i) {
-      if (!(fl[i] > 0.0)) {
-        *cable = i;
-        return StaticsStatus::kSlackCable;
-      }
-      st[i] = {fl[i], a[i] * fl[i] + b[i], 0.0};
-    }
-    const int projections = o.method == StaticsMethod::kAasRefined ? o.refinement_steps
-                            : o.method == StaticsMethod::kExact    ? 1
-                            : o.compute_unstretched_lengths        ? 1
-                                                                   : 0;
-    for (int step = 0; step < projections; ++step) {
-      std::array<CatenaryCurvePoint, kNumCables> guess;
-      for (int i = 0; i < kNumCables; ++i) {
-        guess[i] = internal::CurveGuess(st[i].fl, g, i, p.ea_n[i], low[i], high[i], o,
-                                        /*model_corrected=*/o.method != StaticsMethod::kExact);
-      }
-      std::array<CableState<double>, kNumCables> projected = st;
-      status = internal::ProjectOnCurves(p, g, so, guess, &projected, cable, its);
-      if (status != StaticsStatus::kOk) return status;
-      if (o.method == StaticsMethod::kAas) {
-        // AAS keeps Fz on its secant line (which satisfies equilibrium); s0 is the length
-        // that yields Fl.
-        for (int i = 0; i < kNumCables; ++i) st[i].s0 = projected[i].s0;
-      } else {
-        st = projected;
-      }
-      if (o.method == StaticsMethod::kAasRefined) {
-        status = internal::ReducedNewtonStep(p, g, &st, cable, nullptr, nullptr);
-        if (status != StaticsStatus::kOk) return status;
-        ++sol->outer_iterations;
-      }
-    }
-  }
-
-  if (o.method == StaticsMethod::kExact) {
-    bool converged = false;
-    for (int it = 0; it < o.exact_max_iterations && !converged; ++it) {
-      double relative_step = 0.0, relative_residual = 0.0;
-      status = internal::ReducedNewtonStep(p, g, &st, cable, &relative_step, &relative_residual);
-      if (status != StaticsStatus::kOk) return status;
-      ++sol->outer_iterations;
-      // Newton converges quadratically: a step of relative size d leaves an error of
-      // order d^2, so the tolerance is met once d <= sqrt(tolerance) and the end
-      // conditions held to the same order before the step.
-      const double step_bound = std::sqrt(o.exact_relative_tolerance);
-      converged = relative_step <= step_bound && relative_residual <= step_bound;
-    }
-    if (!converged) return StaticsStatus::kNotConverged;
-  }
-  const bool have_lengths = o.method != StaticsMethod::kAas || o.compute_unstretched_lengths;
-  EndTensions tensions;
-  status = CheckModelRange(p, g, st, have_lengths, o, &tensions, cable);
+  if (o.method == StaticsMethod::kExact) return SolveExact(&c, g, pose, previous, may_follow);
+  State st;
+  Check check;
+  status = o.method == StaticsMethod::kAas
+               ? SolveAas(&c, g, previous != nullptr, &st, &check)
+               : SolveAasRefined(&c, g, previous != nullptr, &st, &check);
   if (status != StaticsStatus::kOk) return status;
-  FillSolution(g, st, tensions, low, high, sol);
-  return StaticsStatus::kOk;
+  return Finish(&c, g, st, check);
 }
-
 }  // namespace
 
 const char* StaticsMethodName(StaticsMethod method) {
@@ -215,19 +767,25 @@ const char* StaticsStatusName(StaticsStatus status) {
     case StaticsStatus::kOk:
       return "ok";
     case StaticsStatus::kInvalidInput:
-      return "invalid input";
+      return "invalid_input";
     case StaticsStatus::kVerticalCable:
-      return "vertical cable";
-    case StaticsStatus::kSlackCable:
-      return "slack cable";
+      return "vertical_cable";
+    case StaticsStatus::kNoEquilibrium:
+      return "no_equilibrium";
+    case StaticsStatus::kSaggingCable:
+      return "sagging_cable";
+    case StaticsStatus::kOverstretchedCable:
+      return "overstretched_cable";
+    case StaticsStatus::kReflectorContact:
+      return "reflector_contact";
     case StaticsStatus::kSingular:
       return "singular";
     case StaticsStatus::kCatenaryFailed:
-      return "catenary not converged";
+      return "catenary_failed";
     case StaticsStatus::kNotConverged:
-      return "not converged";
-    case StaticsStatus::kOverstretchedCable:
-      return "overstretched cable";
+      return "not_converged";
+    case StaticsStatus::kInaccurate:
+      return "inaccurate";
   }
   return "unknown";
 }
@@ -239,10 +797,12 @@ namespace {
 enum class OptionsRule {
   kNone,
   kSecants,
-  kRefinementSteps,
+  kRefinement,
+  kAasMaxError,
   kExactTolerance,
   kStartTolerance,
   kModelRange,
+  kReflectorClearance,
   kExactIterations,
   kCatenary
 };
@@ -252,14 +812,20 @@ OptionsRule BrokenRule(const StaticsOptions& o) {
       !std::isfinite(o.secant_high_fraction)) {
     return OptionsRule::kSecants;
   }
-  if (o.refinement_steps < 1) return OptionsRule::kRefinementSteps;
+  if (o.max_refinement_steps < 1 || !(o.refined_relative_tolerance > 0.0)) {
+    return OptionsRule::kRefinement;
+  }
+  if (!(o.aas_max_relative_error > 0.0)) return OptionsRule::kAasMaxError;
   if (!(o.exact_relative_tolerance > 0.0)) return OptionsRule::kExactTolerance;
   if (!(o.exact_start_catenary_tolerance > 0.0) || !(o.aas_secant_tolerance > 0.0) ||
       !(o.aas_length_tolerance > 0.0)) {
     return OptionsRule::kStartTolerance;
   }
   if (!(o.max_strain > 0.0) || !(o.max_length_ratio > 1.0)) return OptionsRule::kModelRange;
-  if (o.exact_max_iterations < 1) return OptionsRule::kExactIterations;
+  if (!std::isfinite(o.min_reflector_clearance_m)) return OptionsRule::kReflectorClearance;
+  if (o.exact_max_iterations < 1 || o.exact_max_continuation_iterations < 1) {
+    return OptionsRule::kExactIterations;
+  }
   if (!(o.catenary.relative_tolerance > 0.0) || o.catenary.max_iterations < 1) {
     return OptionsRule::kCatenary;
   }
@@ -280,8 +846,12 @@ bool StaticsOptions::IsValid(std::string* error) const {
       e << "secant fractions must satisfy 0 < low < high (got " << secant_low_fraction << ", "
         << secant_high_fraction << ")";
       break;
-    case OptionsRule::kRefinementSteps:
-      e << "refinement_steps must be >= 1 (got " << refinement_steps << ")";
+    case OptionsRule::kRefinement:
+      e << "max_refinement_steps must be >= 1 and refined_relative_tolerance > 0 (got "
+        << max_refinement_steps << ", " << refined_relative_tolerance << ")";
+      break;
+    case OptionsRule::kAasMaxError:
+      e << "aas_max_relative_error must be > 0 (got " << aas_max_relative_error << ")";
       break;
     case OptionsRule::kExactTolerance:
       e << "exact_relative_tolerance must be > 0 (got " << exact_relative_tolerance << ")";
@@ -296,8 +866,12 @@ bool StaticsOptions::IsValid(std::string* error) const {
       e << "max_strain must be > 0 and max_length_ratio > 1 (got " << max_strain << ", "
         << max_length_ratio << ")";
       break;
+    case OptionsRule::kReflectorClearance:
+      e << "min_reflector_clearance_m must be finite (got " << min_reflector_clearance_m << ")";
+      break;
     case OptionsRule::kExactIterations:
-      e << "exact_max_iterations must be >= 1 (got " << exact_max_iterations << ")";
+      e << "exact_max_iterations and exact_max_continuation_iterations must be >= 1 (got "
+        << exact_max_iterations << ", " << exact_max_continuation_iterations << ")";
       break;
     case OptionsRule::kCatenary:
       e << "catenary solver options must have relative_tolerance > 0 and max_iterations >= 1";
@@ -310,9 +884,10 @@ bool StaticsOptions::IsValid(std::string* error) const {
 StaticsOptions ModelFitStaticsOptions(StaticsMethod method) {
   StaticsOptions o;
   o.method = method;
-  o.compute_unstretched_lengths = false;
   o.aas_secant_tolerance = o.catenary.relative_tolerance;
   o.aas_length_tolerance = o.catenary.relative_tolerance;
+  o.aas_max_relative_error = std::numeric_limits<double>::infinity();
+  o.compute_unstretched_lengths = false;
   return o;
 }
 
@@ -327,6 +902,7 @@ StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot) {
   p.cabin_mass_kg = robot.cabin_mass_kg;
   p.mass_centre_cabin_m = robot.mass_centre_cabin_m;
   p.gravity_m_per_s2 = robot.gravity_m_per_s2;
+  p.reflector = robot.reflector;
   return p;
 }
 
@@ -336,21 +912,38 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   if (BrokenRule(options) != OptionsRule::kNone) {
     // Invalid options are invalid input (StaticsOptions::IsValid says which).
     const StaticsStatus status = solution->status = StaticsStatus::kInvalidInput;
+    solution->method = options.method;
     solution->cables = {};
     solution->cable = -1;
     return status;
   }
   const bool warm = options.warm_start && solution->status == StaticsStatus::kOk;
-  StaticsSolution previous;
+  // Constructed only when warm: a cold solve at 1.4 us would spend 1-2% on it.
+  std::optional<StaticsSolution> previous;
   if (warm) previous = *solution;
-  StaticsStatus status = Attempt(parameters, pose, options, warm ? &previous : nullptr, solution);
+  // A warm attempt that fails is retried cold; only the cold one may take exact's
+  // continuation, so that it runs at most once.
+  StaticsStatus status = Attempt(parameters, pose, options, warm ? &*previous : nullptr,
+                                 /*may_follow=*/!warm, solution);
+  const bool warm_worked = warm && status == StaticsStatus::kOk;
   if (status != StaticsStatus::kOk && warm) {
-    status = Attempt(parameters, pose, options, nullptr, solution);
+    status = Attempt(parameters, pose, options, nullptr, /*may_follow=*/true, solution);
+  }
+  solution->pose = pose;
+  solution->has_previous = warm_worked;
+  if (solution->has_previous) {
+    solution->previous_pose = previous->pose;
+    for (int i = 0; i < kNumCables; ++i) {
+      const CableSolution& c = previous->cables[i];
+      solution->previous_state[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
+    }
   }
   if (status != StaticsStatus::kOk) {
-    const int cable = solution->cable;
+    // No numbers where an error belongs: only the failure's own (cable, limit_value,
+    // limit) and the iteration counts stay.
     solution->cables = {};
-    solution->cable = cable;
+    solution->force_residual_n = solution->moment_residual_nm = 0.0;
+    solution->end_residual_m = solution->error_estimate = 0.0;
   }
   solution->status = status;
   return status;
@@ -371,6 +964,80 @@ StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const Stat
   return SolveStaticsWithParameters(MakeStaticsParameters(robot), pose, options, solution);
 }
 
+namespace {
+
+// `value` with `digits` significant digits, for messages.
+std::string Sig(double value, int digits = 3) {
+  std::ostringstream s;
+  s.precision(digits);
+  s << value;
+  return s.str();
+}
+
+std::string DescribeNotConverged(const StaticsSolution& solution) {
+  const int c = solution.cable + 1;
+  if (solution.method == StaticsMethod::kExact) {
+    return "the exact solver did not converge within its iteration limits "
+           "(StaticsOptions::exact_max_iterations, exact_max_continuation_iterations)";
+  }
+  if (solution.limit > 0.0) {
+    return "aas-refined did not reach its tolerance: error estimate " + Sig(solution.limit_value) +
+           " > " + Sig(solution.limit) +
+           " (StaticsOptions::refined_relative_tolerance) after max_refinement_steps steps; "
+           "use exact";
+  }
+  if (solution.cable < 0) {
+    return "aas-refined: a step met a singular equilibrium system, so it cannot go on; use "
+           "exact, which also says whether the pose can be held";
+  }
+  return "aas-refined: its AAS start or a step gives cable " + std::to_string(c) +
+         " a horizontal force or length <= 0, so it cannot go on; use exact, which also says "
+         "whether the pose can be held";
+}
+
+std::string DescribeModelRange(const StaticsSolution& solution) {
+  const int c = solution.cable + 1;
+  std::ostringstream s;
+  switch (solution.status) {
+    case StaticsStatus::kSaggingCable:
+      s << "cable " << c << " hangs beyond the model's range: s0/k = " << Sig(solution.limit_value)
+        << " > " << Sig(solution.limit)
+        << " (StaticsOptions::max_length_ratio); the equilibrium has it in a deep loop";
+      if (solution.reflector_clearance_m < 0.0) {
+        s << ", and a cable would pass " << Sig(-solution.reflector_clearance_m)
+          << " m below the reflector's surface";
+      }
+      break;
+    case StaticsStatus::kOverstretchedCable:
+      if (solution.limit > 0.0) {
+        s << "cable " << c << " would be stretched beyond the model's elastic range: strain "
+          << Sig(100.0 * solution.limit_value) << "% > " << Sig(100.0 * solution.limit)
+          << "% (StaticsOptions::max_strain): the pose cannot be held as modelled";
+      } else {
+        s << "cable " << c
+          << "'s equilibrium has an unstretched length <= 0 (s0/k = " << Sig(solution.limit_value)
+          << "): no physical cable";
+      }
+      break;
+    case StaticsStatus::kReflectorContact:
+      if (solution.limit_value < 0.0) {
+        s << "cable " << c << " would pass through the reflector: its loop reaches "
+          << Sig(-solution.limit_value) << " m below the reflector's surface";
+      } else {
+        s << "cable " << c << " would come within " << Sig(solution.limit_value)
+          << " m of the reflector's surface, closer than "
+             "StaticsOptions::min_reflector_clearance_m = "
+          << Sig(solution.limit) << " m";
+      }
+      break;
+    default:
+      break;
+  }
+  return s.str();
+}
+
+}  // namespace
+
 std::string DescribeStatus(const StaticsSolution& solution) {
   std::ostringstream s;
   const int c = solution.cable + 1;
@@ -385,11 +1052,18 @@ std::string DescribeStatus(const StaticsSolution& solution) {
     case StaticsStatus::kVerticalCable:
       s << "cable " << c << " is vertical: its horizontal force direction is undefined";
       break;
-    case StaticsStatus::kSlackCable:
-      s << "cable " << c
-        << " would be slack (horizontal force <= 0, or an unstretched length over 1.5 times "
-           "its chord, StaticsOptions::max_length_ratio): the pose cannot be held with taut "
-           "cables";
+    case StaticsStatus::kNoEquilibrium:
+      s << "no equilibrium with positive cable forces: the cables cannot hold the cabin here "
+           "(followed from the home pose, the equilibrium ends before this pose";
+      if (solution.cable >= 0 && solution.limit_value > 1.05) {
+        s << "; cable " << c << " then hung in a loop, s0/k = " << Sig(solution.limit_value);
+      }
+      s << ")";
+      break;
+    case StaticsStatus::kSaggingCable:
+    case StaticsStatus::kOverstretchedCable:
+    case StaticsStatus::kReflectorContact:
+      s << DescribeModelRange(solution);
       break;
     case StaticsStatus::kSingular:
       s << "the equilibrium equations are singular at this pose";
@@ -398,13 +1072,21 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       s << "the catenary of cable " << c << " did not converge";
       break;
     case StaticsStatus::kNotConverged:
-      s << "the exact solver did not converge";
+      s << DescribeNotConverged(solution);
       break;
-    case StaticsStatus::kOverstretchedCable:
-      s << "cable " << c
-        << " would be stretched beyond the model's elastic range (strain over 5%, "
-           "StaticsOptions::max_strain, or an unstretched length <= 0): the pose cannot be held "
-           "as modelled";
+    case StaticsStatus::kInaccurate:
+      if (solution.limit > 0.0) {
+        s << "aas's error estimate "
+          << (solution.limit_value > 1.0 ? "is over 100%"
+                                         : Sig(100.0 * solution.limit_value) + "% exceeds")
+          << " its limit " << Sig(100.0 * solution.limit)
+          << "% (StaticsOptions::aas_max_relative_error): its secant lines are far from the "
+             "catenaries here; use exact";
+      } else {
+        s << "aas gives cable " << c
+          << " a horizontal force <= 0: its secant lines are far from the catenaries here, "
+             "which says nothing about whether the pose can be held; use exact";
+      }
       break;
   }
   return s.str();

@@ -229,14 +229,58 @@ std::string NoDataSvg(const PlotOptions& options, const std::string& message) {
 
 // ---- Legend ---------------------------------------------------------------------------
 
-enum class Swatch { kLine, kDashed, kMarker, kBox, kSolidBox };
+enum class Swatch { kLine, kDashed, kMarker, kBox, kSolidBox, kMark };
 
 struct LegendItem {
   std::string label;
   const char* colour;
   Swatch swatch;
-  double opacity = 1.0;  // kMarker: of the dot, as drawn in the chart.
+  double opacity = 1.0;                 // kMarker: of the dot, as drawn in the chart.
+  MarkShape shape = MarkShape::kCross;  // kMark: as drawn in the chart.
 };
+
+constexpr const char* kMarkColour = "#111111";
+
+// Path data of a mark of half-size r centred at (x, y).
+std::string MarkPath(MarkShape shape, double x, double y, double r) {
+  const std::string X = Px(x), Y = Px(y);
+  auto at = [](double a, double b) { return Px(a) + " " + Px(b); };
+  switch (shape) {
+    case MarkShape::kCross:
+      return "M" + at(x - r, y - r) + "L" + at(x + r, y + r) + "M" + at(x - r, y + r) + "L" +
+             at(x + r, y - r);
+    case MarkShape::kPlus:
+      return "M" + at(x - r, y) + "L" + at(x + r, y) + "M" + at(x, y - r) + "L" + at(x, y + r);
+    case MarkShape::kTriangleUp:
+      return "M" + at(x, y - r) + "L" + at(x + 0.87 * r, y + 0.5 * r) + "L" +
+             at(x - 0.87 * r, y + 0.5 * r) + "Z";
+    case MarkShape::kTriangleDown:
+      return "M" + at(x, y + r) + "L" + at(x + 0.87 * r, y - 0.5 * r) + "L" +
+             at(x - 0.87 * r, y - 0.5 * r) + "Z";
+    case MarkShape::kSquare:
+      return "M" + at(x - 0.75 * r, y - 0.75 * r) + "h" + Px(1.5 * r) + "v" + Px(1.5 * r) + "h" +
+             Px(-1.5 * r) + "Z";
+    case MarkShape::kDiamond:
+      return "M" + at(x, y - r) + "L" + at(x + r, y) + "L" + at(x, y + r) + "L" + at(x - r, y) +
+             "Z";
+    case MarkShape::kCircle:
+      return "M" + at(x - 0.8 * r, y) + "a" + Px(0.8 * r) + " " + Px(0.8 * r) + " 0 1 0 " +
+             Px(1.6 * r) + " 0a" + Px(0.8 * r) + " " + Px(0.8 * r) + " 0 1 0 " + Px(-1.6 * r) +
+             " 0Z";
+  }
+  return "";
+}
+
+// A mark drawn on a white halo, so that it reads on light and dark cells alike.
+void DrawMark(std::string* out, MarkShape shape, double x, double y, double r,
+              const std::string& extra = "") {
+  const std::string d = MarkPath(shape, x, y, r);
+  const bool closed = shape != MarkShape::kCross && shape != MarkShape::kPlus;
+  *out += "<path" + (extra.empty() ? "" : " " + extra) + " d=\"" + d + "\" fill=\"" +
+          (closed ? "#ffffff" : "none") + "\" stroke=\"#ffffff\" stroke-width=\"3.2\"/>\n";
+  *out += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + kMarkColour +
+          "\" stroke-width=\"1.3\" stroke-linejoin=\"round\"/>\n";
+}
 
 double LegendItemWidth(const LegendItem& item) {
   return kLegendSwatchPx + 5.0 + TextWidth(item.label, kFontPx);
@@ -281,6 +325,9 @@ void DrawLegend(std::string* out, const std::vector<LegendItem>& items,
                   "\" r=\"3.5\" fill=\"" + item.colour + "\"" +
                   (item.opacity < 1.0 ? " fill-opacity=\"" + Compact(item.opacity, 2) + "\"" : "") +
                   "/>\n";
+          break;
+        case Swatch::kMark:
+          DrawMark(out, item.shape, x + kLegendSwatchPx / 2, mid, 4.5);
           break;
         case Swatch::kBox:
         case Swatch::kSolidBox:
@@ -875,6 +922,230 @@ std::string SvgMatrixHeatmap(const std::vector<std::string>& labels,
     Line(&out, bar_x + bar_w, y, bar_x + bar_w + 3.0, y, kAxisColour);
     Text(&out, bar_x + bar_w + 5.0, y + 4.0, Fixed(v, 1), "", kTickFontPx);
   }
+  CloseSvg(&out);
+  return out;
+}
+
+namespace {
+
+// A perceptually uniform sequential scale (viridis' end and seven inner colours), t in
+// [0, 1]: dark purple for the smallest values, yellow for the largest.
+std::string SequentialColour(double t) {
+  constexpr int kStops = 9;
+  constexpr double kRgb[kStops][3] = {{68, 1, 84},    {71, 45, 123},  {59, 82, 139},
+                                      {44, 114, 142}, {33, 145, 140}, {40, 174, 128},
+                                      {94, 201, 98},  {173, 220, 48}, {253, 231, 37}};
+  const double x = std::clamp(t, 0.0, 1.0) * (kStops - 1);
+  const int k = std::min(static_cast<int>(x), kStops - 2);
+  const double f = x - k;
+  char buf[8];
+  int rgb[3];
+  for (int i = 0; i < 3; ++i) {
+    rgb[i] = static_cast<int>(std::lround(kRgb[k][i] + (kRgb[k + 1][i] - kRgb[k][i]) * f));
+  }
+  std::snprintf(buf, sizeof buf, "#%02x%02x%02x", rgb[0], rgb[1], rgb[2]);
+  return buf;
+}
+
+constexpr const char* kNoValueColour = "#d4d4d4";
+
+// Where a polar map's disc and its colour bar go.
+struct PolarLayout {
+  Size size{0, 0};
+  double cx = 0, cy = 0, radius_px = 0;    // the disc
+  double bar_x = 0, bar_y = 0, bar_w = 0;  // the colour bar, under the disc
+  std::vector<LegendItem> legend;
+  std::vector<std::vector<size_t>> legend_rows;
+  double legend_top = 0;
+};
+
+constexpr double kRimLabelsPx = 30.0;  // azimuth and rim labels, outside the disc
+constexpr double kBarHeightPx = 12.0;
+constexpr double kBarBlockPx = 66.0;  // bar, its tick labels, its label, the rings' label
+
+PolarLayout LayOutPolarMap(const PolarMapOptions& options) {
+  PolarLayout l;
+  l.size = ClampedSize(options.plot);
+  for (const PolarMark& m : options.marks) {
+    if (!m.label.empty()) l.legend.push_back({m.label, kMarkColour, Swatch::kMark, 1.0, m.shape});
+  }
+  l.legend_rows = LegendRows(l.legend, l.size.w - 16.0);
+  const double legend_h = kLegendRowPx * static_cast<double>(l.legend_rows.size());
+  const double top = TitleBottom(options.plot) + kRimLabelsPx;
+  const double bottom = kRimLabelsPx + kBarBlockPx + legend_h + 8.0;
+  l.radius_px = std::max(
+      20.0, std::min(0.5 * l.size.w - kRimLabelsPx - 8.0, 0.5 * (l.size.h - top - bottom)));
+  l.cx = 0.5 * l.size.w;
+  l.cy = top + l.radius_px;
+  l.bar_w = std::min(360.0, l.size.w - 80.0);
+  l.bar_x = l.cx - 0.5 * l.bar_w;
+  l.bar_y = l.cy + l.radius_px + kRimLabelsPx;
+  l.legend_top = l.bar_y + kBarBlockPx;
+  return l;
+}
+
+// The point at radius r_px and angle a_deg (counter-clockwise from +x, +y up the page).
+std::string PolarPoint(const PolarLayout& l, double r_px, double a_deg) {
+  const double a = a_deg * M_PI / 180.0;
+  return Px(l.cx + r_px * std::cos(a)) + " " + Px(l.cy - r_px * std::sin(a));
+}
+
+// Path data of an annular sector; a full turn gives a disc or a ring (two half arcs each).
+std::string SectorPath(const PolarLayout& l, double r0, double r1, double a0, double a1) {
+  const std::string R0 = Px(r0), R1 = Px(r1);
+  if (a1 - a0 >= 360.0 - 1e-9) {
+    std::string d = "M" + PolarPoint(l, r1, 0) + "A" + R1 + " " + R1 + " 0 1 0 " +
+                    PolarPoint(l, r1, 180) + "A" + R1 + " " + R1 + " 0 1 0 " +
+                    PolarPoint(l, r1, 0) + "Z";
+    if (r0 > 0.0) {
+      d += "M" + PolarPoint(l, r0, 0) + "A" + R0 + " " + R0 + " 0 1 1 " + PolarPoint(l, r0, 180) +
+           "A" + R0 + " " + R0 + " 0 1 1 " + PolarPoint(l, r0, 0) + "Z";
+    }
+    return d;
+  }
+  const char* large = a1 - a0 > 180.0 ? "1" : "0";
+  // Counter-clockwise on the page is SVG's negative sweep (its y axis points down).
+  std::string d = "M" + PolarPoint(l, r1, a0) + "A" + R1 + " " + R1 + " 0 " + large + " 0 " +
+                  PolarPoint(l, r1, a1);
+  if (r0 > 0.0) {
+    d += "L" + PolarPoint(l, r0, a1) + "A" + R0 + " " + R0 + " 0 " + large + " 1 " +
+         PolarPoint(l, r0, a0);
+  } else {
+    d += "L" + Px(l.cx) + " " + Px(l.cy);
+  }
+  return d + "Z";
+}
+
+// Rings every nice step of the radius (labelled along the 80 deg spoke, between the
+// usual tower directions), spokes every 30 deg with their azimuth where no rim label is
+// within 10 deg, the rim labels.
+void DrawPolarGrid(std::string* out, const PolarLayout& l, double radius_max,
+                   const PolarMapOptions& options) {
+  const std::vector<double> ticks = NiceTicks(0.0, radius_max, 4);
+  const std::vector<std::string> labels = TickLabels(ticks);
+  for (size_t k = 0; k < ticks.size(); ++k) {
+    if (ticks[k] <= 0.0 || ticks[k] > radius_max * (1.0 + 1e-9)) continue;
+    const double r = l.radius_px * ticks[k] / radius_max;
+    *out += "<circle cx=\"" + Px(l.cx) + "\" cy=\"" + Px(l.cy) + "\" r=\"" + Px(r) +
+            "\" fill=\"none\" stroke=\"#ffffff\" stroke-opacity=\"0.7\" stroke-width=\"0.8\"/>\n";
+    const double a = 80.0 * M_PI / 180.0;
+    Text(out, l.cx + r * std::cos(a) + 3.0, l.cy - r * std::sin(a) - 3.0, labels[k], "",
+         kTickFontPx,
+         "fill=\"#333333\" stroke=\"#ffffff\" stroke-width=\"2.5\" paint-order=\"stroke\"");
+  }
+  for (int deg = 0; deg < 360; deg += 30) {
+    const double a = deg * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
+    Line(out, l.cx, l.cy, l.cx + l.radius_px * c, l.cy - l.radius_px * s, "#ffffff", 0.6,
+         "stroke-opacity=\"0.5\"");
+    // A rim label (a tower) says the direction there; its degrees would collide with it.
+    const bool labelled =
+        std::any_of(options.rim_labels.begin(), options.rim_labels.end(), [deg](const auto& label) {
+          return std::abs(std::remainder(label.first - deg, 360.0)) < 10.0;
+        });
+    if (labelled) continue;
+    const double r = l.radius_px + 11.0;
+    const char* anchor = c > 0.3 ? "start" : c < -0.3 ? "end" : "middle";
+    Text(out, l.cx + r * c, l.cy - r * s + 4.0 - 4.0 * s, std::to_string(deg) + "\u00b0", anchor,
+         10.0, "fill=\"#777777\"");
+  }
+  *out += "<circle cx=\"" + Px(l.cx) + "\" cy=\"" + Px(l.cy) + "\" r=\"" + Px(l.radius_px) +
+          "\" fill=\"none\" stroke=\"" + kAxisColour + "\"/>\n";
+  for (const auto& [deg, text] : options.rim_labels) {
+    const double a = deg * M_PI / 180.0, c = std::cos(a), s = std::sin(a);
+    const double r = l.radius_px + 12.0;
+    const char* anchor = c > 0.3 ? "start" : c < -0.3 ? "end" : "middle";
+    Text(out, l.cx + r * c, l.cy - r * s + 4.0 - 4.0 * s, text, anchor, kFontPx,
+         "font-weight=\"bold\"");
+  }
+}
+
+// The colour bar for values in [lo, hi] and its label, then the radial axis' label.
+void DrawColourBar(std::string* out, const PolarLayout& l, double lo, double hi,
+                   const PolarMapOptions& options) {
+  constexpr int kBands = 60;
+  const double band = l.bar_w / kBands;
+  for (int b = 0; b < kBands; ++b) {
+    *out += "<rect x=\"" + Px(l.bar_x + b * band) + "\" y=\"" + Px(l.bar_y) + "\" width=\"" +
+            Px(band + 0.5) + "\" height=\"" + Px(kBarHeightPx) + "\" fill=\"" +
+            SequentialColour((b + 0.5) / kBands) + "\"/>\n";
+  }
+  *out += "<rect x=\"" + Px(l.bar_x) + "\" y=\"" + Px(l.bar_y) + "\" width=\"" + Px(l.bar_w) +
+          "\" height=\"" + Px(kBarHeightPx) + "\" fill=\"none\" stroke=\"" + kAxisColour + "\"/>\n";
+  std::vector<double> ticks;
+  for (double t : NiceTicks(lo, hi, 5)) {
+    if (t >= lo - 1e-9 * (hi - lo) && t <= hi + 1e-9 * (hi - lo)) ticks.push_back(t);
+  }
+  if (ticks.size() < 2) ticks = {lo, hi};
+  const std::vector<std::string> labels = TickLabels(ticks);
+  for (size_t k = 0; k < ticks.size(); ++k) {
+    const double x = hi > lo ? l.bar_x + l.bar_w * (ticks[k] - lo) / (hi - lo) : l.cx;
+    Line(out, x, l.bar_y + kBarHeightPx, x, l.bar_y + kBarHeightPx + kTickLenPx, kAxisColour);
+    Text(out, x, l.bar_y + kBarHeightPx + 15.0, labels[k], "middle", kTickFontPx);
+  }
+  Text(out, l.cx, l.bar_y + kBarHeightPx + 31.0, options.value_label, "middle", kFontPx);
+  if (!options.radius_label.empty()) {
+    Text(out, l.cx, l.bar_y + kBarHeightPx + 46.0, "rings: " + options.radius_label, "middle",
+         kTickFontPx, "fill=\"#555555\"");
+  }
+}
+
+}  // namespace
+
+std::string SvgPolarMap(const std::vector<PolarCell>& cells, const PolarMapOptions& options) {
+  double radius_max = options.radius_max, lo = HUGE_VAL, hi = -HUGE_VAL;
+  bool any = false;
+  for (const PolarCell& c : cells) {
+    if (!(c.radius_hi > c.radius_lo) || !(c.angle_hi_deg > c.angle_lo_deg)) continue;
+    any = true;
+    if (options.radius_max <= 0.0) radius_max = std::max(radius_max, c.radius_hi);
+    if (std::isfinite(c.value)) {
+      lo = std::min(lo, c.value);
+      hi = std::max(hi, c.value);
+    }
+  }
+  if (!any || !(radius_max > 0.0) || !std::isfinite(radius_max)) {
+    return NoDataSvg(options.plot, "no data");
+  }
+  if (options.value_lo < options.value_hi) {
+    lo = options.value_lo;
+    hi = options.value_hi;
+  }
+  if (lo > hi) lo = hi = 0.0;  // no values: every cell grey, the bar still drawn
+  const PolarLayout l = LayOutPolarMap(options);
+  std::string out;
+  OpenSvg(&out, l.size, options.plot.title);
+  const double scale = l.radius_px / radius_max;
+  for (const PolarCell& c : cells) {
+    if (!(c.radius_hi > c.radius_lo) || !(c.angle_hi_deg > c.angle_lo_deg)) continue;
+    const bool has_value = std::isfinite(c.value);
+    const double t = hi > lo ? (c.value - lo) / (hi - lo) : 0.5;
+    out += "<path class=\"cell\" data-value=\"" + (has_value ? Compact(c.value, 6) : "n/a") +
+           "\" d=\"" +
+           SectorPath(l, std::min(c.radius_lo, radius_max) * scale,
+                      std::min(c.radius_hi, radius_max) * scale, c.angle_lo_deg, c.angle_hi_deg) +
+           "\" fill=\"" + (has_value ? SequentialColour(t) : std::string(kNoValueColour)) +
+           "\" fill-rule=\"evenodd\" stroke=\"" +
+           (has_value ? SequentialColour(t) : kNoValueColour) + "\" stroke-width=\"0.3\">";
+    if (!c.tooltip.empty()) out += "<title>" + XmlEscape(c.tooltip) + "</title>";
+    out += "</path>\n";
+  }
+  DrawPolarGrid(&out, l, radius_max, options);
+  for (const PolarCell& c : cells) {
+    if (c.mark < 0 || c.mark >= static_cast<int>(options.marks.size())) continue;
+    if (!(c.radius_hi > c.radius_lo) || !(c.angle_hi_deg > c.angle_lo_deg)) continue;
+    const bool disc = c.angle_hi_deg - c.angle_lo_deg >= 360.0 - 1e-9 && c.radius_lo <= 0.0;
+    const double r_mid = disc ? 0.0 : 0.5 * (c.radius_lo + c.radius_hi) * scale;
+    const double a_mid = 0.5 * (c.angle_lo_deg + c.angle_hi_deg);
+    const double arc_px = r_mid * (c.angle_hi_deg - c.angle_lo_deg) * M_PI / 180.0;
+    const double size_px = std::clamp(
+        0.45 * std::min((c.radius_hi - c.radius_lo) * scale, disc ? 1e9 : arc_px), 3.0, 7.0);
+    const double a = a_mid * M_PI / 180.0;
+    DrawMark(&out, options.marks[c.mark].shape, l.cx + r_mid * std::cos(a),
+             l.cy - r_mid * std::sin(a), size_px,
+             "class=\"mark\" data-mark=\"" + std::to_string(c.mark) + "\"");
+  }
+  DrawColourBar(&out, l, lo, hi, options);
+  DrawLegend(&out, l.legend, l.legend_rows, l.size.w, l.legend_top);
   CloseSvg(&out);
   return out;
 }

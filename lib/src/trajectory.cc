@@ -253,6 +253,45 @@ bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
   return true;
 }
 
+bool RandomPosesAroundFocalLaw(const RandomPoseSpec& spec, std::vector<Pose>* poses,
+                               std::string* error) {
+  if (poses == nullptr) return Fail(error, "poses must not be null");
+  if (!(spec.min_extra_rotation_deg >= 0.0) ||
+      !(spec.max_extra_rotation_deg >= spec.min_extra_rotation_deg) ||
+      !std::isfinite(spec.max_extra_rotation_deg)) {
+    return Fail(error,
+                "min_extra_rotation_deg and max_extra_rotation_deg must satisfy 0 <= min "
+                "<= max, finite (got " +
+                    Num(spec.min_extra_rotation_deg) + ", " + Num(spec.max_extra_rotation_deg) +
+                    ")");
+  }
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Pose> out;
+  if (!RandomWorkspacePositions(spec.positions, &positions, error) ||
+      !PosesWithAttitudeLaw(positions, spec.law, &out, error)) {
+    return false;
+  }
+  std::mt19937_64 rng(spec.positions.seed + 1);
+  const double span_deg = spec.max_extra_rotation_deg - spec.min_extra_rotation_deg;
+  for (Pose& p : out) {
+    const double amplitude_deg = spec.min_extra_rotation_deg + span_deg * Uniform01(rng);
+    double rpy_deg[3];
+    for (double& a : rpy_deg) a = amplitude_deg * (2.0 * Uniform01(rng) - 1.0);
+    p.rotation = p.rotation * RotationFromRpyDeg(rpy_deg[0], rpy_deg[1], rpy_deg[2]);
+  }
+  *poses = std::move(out);
+  return true;
+}
+
+RandomPoseSpec EdgeSweepSpec(int samples, std::uint64_t seed) {
+  RandomPoseSpec spec;
+  spec.positions.samples = samples;
+  spec.positions.max_off_axis_deg = 45.0;
+  spec.positions.radial_spread_m = 5.0;
+  spec.positions.seed = seed;
+  return spec;
+}
+
 bool PosesWithAttitudeLaw(const std::vector<Eigen::Vector3d>& positions,
                           const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                           std::string* error) {

@@ -57,7 +57,9 @@ ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
 PathLike = Union[str, "os.PathLike[str]"]
 
 STATUS_NAMES: List[str] = _fastcal.statics_status_names()
-"""The statics status of a pose, by code: 'ok', 'invalid input', 'slack cable', ..."""
+"""The statics status of a pose, by code: 'ok', 'invalid_input', 'vertical_cable',
+'no_equilibrium', 'sagging_cable', 'overstretched_cable', 'reflector_contact', ... (the
+short codes of `fastcal solve`'s status column)."""
 _STATUS_NAMES_ARRAY = np.array(STATUS_NAMES, dtype=object)
 
 
@@ -109,11 +111,15 @@ class StaticsResult:
         force_kN: force applied on each cable at its lower end by the cabin, global
             frame, (n, 6, 3); the cabin feels its opposite.
         chord_m: straight-line length from cabin anchor to tower top, (n, 6).
-        status: per pose 'ok' or why it failed ('slack cable', 'overstretched cable',
-            ...), an (n,) array of str.
+        status: per pose 'ok' or why it failed ('no_equilibrium', 'sagging_cable',
+            'reflector_contact', 'not_converged', ...; STATUS_NAMES), an (n,) array of str.
         ok: per pose whether status is 'ok', (n,) bool.
         cable: per pose the 1-based cable a failure concerns, 0 when none, (n,) int.
         messages: per failed pose index, the full account (the CLI's words).
+        end_residual_m: per pose, how far the returned state misses the catenaries' end
+            conditions (largest over the cables), (n,); ~0 for 'exact'.
+        error_estimate: per pose, the relative tension error those misses imply, (n,):
+            the check behind every 'ok' (docs/model.md, "Checks and statuses").
 
     A failed pose has zero forces and tensions, never NaN: check `ok`.
     """
@@ -129,6 +135,8 @@ class StaticsResult:
         self.s0_m: np.ndarray = pick(raw["s0_m"])
         self.force_kN: np.ndarray = pick(raw["force_kN"])
         self.chord_m: np.ndarray = pick(raw["chord_m"])
+        self.end_residual_m = pick(raw["end_residual_m"])
+        self.error_estimate = pick(raw["error_estimate"])
         self.status = pick(status)
         self.ok = pick(codes == 0)
         self.cable = pick(raw["cable"] + 1)
@@ -150,10 +158,13 @@ def solve(
     model: Optional[Model] = None,
     *,
     warm_start: bool = False,
-    refinement_steps: int = 1,
+    max_refinement_steps: int = 8,
+    refined_relative_tolerance: float = 1e-6,
+    aas_max_relative_error: float = 1e-2,
     exact_relative_tolerance: float = 1e-12,
     max_strain: float = 0.05,
     max_length_ratio: float = 1.5,
+    min_reflector_clearance_m: float = 0.0,
 ) -> StaticsResult:
     """Cable forces, tensions and unstretched lengths at one pose or many.
 
@@ -163,16 +174,24 @@ def solve(
             (3,) or (n, 3). At most one of rpy_deg and quat; neither means R = I.
         quat: attitude as unit quaternions (w, x, y, z): (4,) or (n, 4). E.g. the focal
             law's, fastcal.focal_attitude(position_m).
-        method: 'exact' (Newton on all unknowns), 'aas-refined' (the paper's AAS with one
-            Newton step on its tangent, ~1e-7 of exact) or 'aas' (the paper's).
+        method: 'exact' (Newton on all unknowns; where its start fails it follows the
+            equilibrium from the home pose), 'aas-refined' (the paper's AAS refined by
+            Newton steps on its tangent until its error estimate is below
+            refined_relative_tolerance) or 'aas' (the paper's; 'inaccurate' when its
+            error estimate exceeds aas_max_relative_error).
         model: the model; None for Model.nominal().
         warm_start: start each pose from the previous pose's solution (a trajectory);
             off, each pose is solved on its own and the order does not matter.
-        refinement_steps: re-linearisations of 'aas-refined' (>= 1).
+        max_refinement_steps: at most this many steps of 'aas-refined' (>= 1), then
+            'not_converged'.
+        refined_relative_tolerance: where 'aas-refined' stops.
+        aas_max_relative_error: the largest error estimate 'aas' calls 'ok'.
         exact_relative_tolerance: where 'exact' stops.
-        max_strain: tensions above max_strain * EA are refused ('overstretched cable').
+        max_strain: tensions above max_strain * EA are refused ('overstretched_cable').
         max_length_ratio: unstretched lengths above this times the chord are refused
-            ('slack cable').
+            ('sagging_cable').
+        min_reflector_clearance_m: with a reflector in the model, a cable closer to its
+            surface than this is refused ('reflector_contact').
 
     Returns:
         A StaticsResult: arrays with a leading axis of n for (n, 3) positions, none for
@@ -190,11 +209,16 @@ def solve(
         kind,
         attitude,
         method,
-        warm_start,
-        refinement_steps,
-        exact_relative_tolerance,
-        max_strain,
-        max_length_ratio,
+        {
+            "warm_start": warm_start,
+            "max_refinement_steps": max_refinement_steps,
+            "refined_relative_tolerance": refined_relative_tolerance,
+            "aas_max_relative_error": aas_max_relative_error,
+            "exact_relative_tolerance": exact_relative_tolerance,
+            "max_strain": max_strain,
+            "max_length_ratio": max_length_ratio,
+            "min_reflector_clearance_m": min_reflector_clearance_m,
+        },
     )
     return StaticsResult(raw, single)
 

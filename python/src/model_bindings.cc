@@ -88,6 +88,41 @@ Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
           },
           "Mass centre of the cabin in the cabin frame, shape (3,).")
       .def_property(
+          "reflector",
+          [](const CableRobot& r) -> py::object {
+            if (!r.reflector) return py::none();
+            py::dict d;
+            d["centre_m"] = Vector3(r.reflector->centre_m);
+            d["radius_m"] = r.reflector->radius_m;
+            d["aperture_m"] = r.reflector->aperture_m;
+            return std::move(d);
+          },
+          [](CableRobot& r, const py::object& v) {
+            if (v.is_none()) {
+              r.reflector.reset();
+              return;
+            }
+            const py::dict d = v.cast<py::dict>();
+            Reflector reflector;
+            for (const auto& [key, value] : d) {
+              const std::string name = py::str(key);
+              if (name == "centre_m") {
+                reflector.centre_m = ToVector3(value.cast<DoubleArray>(), "reflector centre_m");
+              } else if (name == "radius_m") {
+                reflector.radius_m = value.cast<double>();
+              } else if (name == "aperture_m") {
+                reflector.aperture_m = value.cast<double>();
+              } else {
+                throw InputError("reflector: unknown key '" + name +
+                                 "' (accepted: centre_m, radius_m, aperture_m)");
+              }
+            }
+            r.reflector = reflector;
+          },
+          "The reflector cables are checked against: None, or a dict {centre_m (3,), "
+          "radius_m, aperture_m} (a sphere's lower cap; docs/model-format.md). Assign a "
+          "whole dict; keys left out keep FAST's values.")
+      .def_property(
           "anchor_points_cabin_m",
           [](const CableRobot& r) {
             const auto n = static_cast<py::ssize_t>(r.anchor_points_cabin_m.size());

@@ -1,6 +1,7 @@
 // Statics of many poses in one call (the loop in C++, without the GIL), the trajectory
 // generators and the focal attitude law (statics.h, trajectory.h, pose.h).
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "bindings.h"
@@ -11,18 +12,26 @@
 namespace fastcal::python {
 namespace {
 
-StaticsOptions MakeStaticsOptions(const std::string& method, bool warm_start, int refinement_steps,
-                                  double exact_relative_tolerance, double max_strain,
-                                  double max_length_ratio) {
+// `settings`: the keyword arguments of fastcal.solve that set StaticsOptions (their
+// names are the fields'; fastcal/__init__.py passes every one).
+StaticsOptions MakeStaticsOptions(const std::string& method, const py::dict& settings) {
   StaticsOptions options;
   if (!ParseStaticsMethod(method, &options.method)) {
     throw InputError("method must be 'aas', 'aas-refined' or 'exact', got '" + method + "'");
   }
-  options.warm_start = warm_start;
-  options.refinement_steps = refinement_steps;
-  options.exact_relative_tolerance = exact_relative_tolerance;
-  options.max_strain = max_strain;
-  options.max_length_ratio = max_length_ratio;
+  const auto get = [&settings](const char* name, auto* field) {
+    if (settings.contains(name)) {
+      *field = settings[name].cast<std::remove_pointer_t<decltype(field)>>();
+    }
+  };
+  get("warm_start", &options.warm_start);
+  get("max_refinement_steps", &options.max_refinement_steps);
+  get("refined_relative_tolerance", &options.refined_relative_tolerance);
+  get("aas_max_relative_error", &options.aas_max_relative_error);
+  get("exact_relative_tolerance", &options.exact_relative_tolerance);
+  get("max_strain", &options.max_strain);
+  get("max_length_ratio", &options.max_length_ratio);
+  get("min_reflector_clearance_m", &options.min_reflector_clearance_m);
   std::string error;
   if (!options.IsValid(&error)) throw InputError(error);
   return options;
@@ -30,17 +39,15 @@ StaticsOptions MakeStaticsOptions(const std::string& method, bool warm_start, in
 
 // Per-pose outputs, written straight into the arrays numpy will own.
 struct SolveOutputs {
-  DoubleArray lower_kn, upper_kn, s0_m, force_kn, chord_m;
+  DoubleArray lower_kn, upper_kn, s0_m, force_kn, chord_m, end_residual_m, error_estimate;
   py::array_t<int> status, cable;
   py::dict failures;  // pose index -> DescribeStatus, for the failed poses only
 };
 
 py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
                const std::string& attitude_kind, const DoubleArray& attitude,
-               const std::string& method, bool warm_start, int refinement_steps,
-               double exact_relative_tolerance, double max_strain, double max_length_ratio) {
-  const StaticsOptions options = MakeStaticsOptions(
-      method, warm_start, refinement_steps, exact_relative_tolerance, max_strain, max_length_ratio);
+               const std::string& method, const py::dict& settings) {
+  const StaticsOptions options = MakeStaticsOptions(method, settings);
   const std::vector<Pose> poses = PosesFromArrays(positions_m, attitude_kind, attitude);
   const auto n = static_cast<py::ssize_t>(poses.size());
   // Every element is written below: no zero-filling.
@@ -50,6 +57,8 @@ py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
                    DoubleArray(Shape{n, kNumCables}),
                    DoubleArray(Shape{n, kNumCables, 3}),
                    DoubleArray(Shape{n, kNumCables}),
+                   DoubleArray(Shape{n}),
+                   DoubleArray(Shape{n}),
                    py::array_t<int>(n),
                    py::array_t<int>(n),
                    py::dict()};
@@ -58,6 +67,8 @@ py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
   double* s0 = out.s0_m.mutable_data();
   double* force = out.force_kn.mutable_data();
   double* chord = out.chord_m.mutable_data();
+  double* end_residual = out.end_residual_m.mutable_data();
+  double* error_estimate = out.error_estimate.mutable_data();
   int* status = out.status.mutable_data();
   int* cable = out.cable.mutable_data();
   std::vector<std::pair<py::ssize_t, std::string>> failed;
@@ -69,6 +80,8 @@ py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
           SolveStatics(robot, poses[static_cast<size_t>(k)], options, &solution);
       status[k] = static_cast<int>(s);
       cable[k] = solution.cable;
+      end_residual[k] = solution.end_residual_m;
+      error_estimate[k] = solution.error_estimate;
       if (s != StaticsStatus::kOk) failed.emplace_back(k, DescribeStatus(solution));
       for (int i = 0; i < kNumCables; ++i) {
         const CableSolution& c = solution.cables[i];
@@ -88,6 +101,8 @@ py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
   result["s0_m"] = out.s0_m;
   result["force_kN"] = out.force_kn;
   result["chord_m"] = out.chord_m;
+  result["end_residual_m"] = out.end_residual_m;
+  result["error_estimate"] = out.error_estimate;
   result["status_code"] = out.status;
   result["cable"] = out.cable;
   result["failures"] = out.failures;
@@ -132,14 +147,14 @@ DoubleArray QuaternionsOf(const std::vector<Pose>& poses) {
 void BindStatics(py::module_& m) {
   m.def("statics_status_names", [] {
     py::list names;
-    for (int s = 0; s <= static_cast<int>(StaticsStatus::kOverstretchedCable); ++s) {
+    // kInaccurate is the enum's last status.
+    for (int s = 0; s <= static_cast<int>(StaticsStatus::kInaccurate); ++s) {
       names.append(StaticsStatusName(static_cast<StaticsStatus>(s)));
     }
     return names;
   });
   m.def("solve", &Solve, py::arg("model"), py::arg("position_m"), py::arg("attitude_kind"),
-        py::arg("attitude"), py::arg("method"), py::arg("warm_start"), py::arg("refinement_steps"),
-        py::arg("exact_relative_tolerance"), py::arg("max_strain"), py::arg("max_length_ratio"));
+        py::arg("attitude"), py::arg("method"), py::arg("settings"));
   m.def("line", [](const DoubleArray& from_m, const DoubleArray& to_m, int nodes) {
     return Generated([&](std::vector<Eigen::Vector3d>* p, std::string* e) {
       return LinePositions(Point(from_m, "from_m"), Point(to_m, "to_m"), nodes, p, e);

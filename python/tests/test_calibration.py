@@ -19,7 +19,7 @@ COVERAGE_SIGMAS = 4.0
 
 SPEC_DICT = {
     "format": "fastcal-calibration-spec-1",
-    "forward_model": "aas-refined",
+    "forward_model": "exact",
     "noise": {"tension_sigma_kN": 0, "tension_sigma_percent": 3},
     "parameters": {
         "mass_centre_m": {"x": {"free": True}, "y": {"free": True}, "z": {"free": True}},

@@ -16,6 +16,8 @@ K1_AAS_T1_KN = 158.9811
 PAPER_DIGITS_KN = 5e-5  # the table's last digit
 # Refined AAS is within 7.2e-8 of exact over the workspace (README).
 REFINED_RELATIVE = 1e-7
+EXACT_CHECK_RELATIVE = 1e-10  # exact stops at 1e-12; its rounding floor is ~1e-14
+EXACT_END_RESIDUAL_M = 1e-6  # a micrometre on 300 m cables
 
 
 def test_k1_matches_the_paper() -> None:
@@ -64,6 +66,21 @@ def test_a_pose_the_cables_cannot_hold_is_a_status_not_nan() -> None:
     np.testing.assert_array_equal(result.lower_tension_kN[1], np.zeros(6))
     assert set(result.messages) == {1, 2}
     assert result.status[2] in result.messages[2] or "cable" in result.messages[2]
+    assert set(result.status) <= set(fastcal.STATUS_NAMES)
+    # The check behind the ok: exact meets the end conditions to rounding.
+    assert result.error_estimate[0] < EXACT_CHECK_RELATIVE
+    assert result.end_residual_m[0] < EXACT_END_RESIDUAL_M
+
+
+def test_the_issue_9_pose_touches_the_reflector() -> None:
+    # A cable of the nominal model passes 2.4 m below the reflector's surface here
+    # (tests/statics_test.cc has the numbers).
+    result = fastcal.solve(
+        [52.483144870, 85.317743916, 179.260329188],
+        rpy_deg=[14.724046077086, -5.261549746844, 2.681403711399],
+    )
+    assert result.status == "reflector_contact" and result.cable == 5
+    assert "reflector" in result.messages[0]
 
 
 def test_wrong_arguments_are_input_errors_naming_them() -> None:
@@ -77,8 +94,8 @@ def test_wrong_arguments_are_input_errors_naming_them() -> None:
         fastcal.solve([[0, 0, 140], [0, 0, 150]], quat=[[1, 0, 0, 0], [2, 0, 0, 0]])
     with pytest.raises(ValueError, match="method must be 'aas', 'aas-refined' or 'exact'"):
         fastcal.solve([0, 0, 140], method="newton")
-    with pytest.raises(fastcal.InputError, match="refinement_steps"):
-        fastcal.solve([0, 0, 140], method="aas-refined", refinement_steps=0)
+    with pytest.raises(fastcal.InputError, match="max_refinement_steps"):
+        fastcal.solve([0, 0, 140], method="aas-refined", max_refinement_steps=0)
 
 
 def test_trajectories() -> None:
@@ -114,7 +131,7 @@ def test_solve_releases_the_gil() -> None:
     try:
         time.sleep(0.01)  # the counter is running
         start = time.perf_counter()
-        fastcal._fastcal.solve(model, positions, "quat", quat, "exact", False, 1, 1e-12, 0.05, 1.5)
+        fastcal._fastcal.solve(model, positions, "quat", quat, "exact", {})
         end = time.perf_counter()
     finally:
         done.set()
@@ -127,3 +144,18 @@ def test_solve_releases_the_gil() -> None:
     inside = [t for t in tick_times if start + edge_s < t < middle]
     assert middle - start > 3 * edge_s, "the solve was too short to tell"
     assert len(inside) > 100
+
+
+def test_without_the_reflector_the_issue_9_pose_is_held() -> None:
+    model = fastcal.Model.nominal()
+    assert model.reflector["radius_m"] == 300.0
+    model.reflector = None
+    result = fastcal.solve(
+        [52.483144870, 85.317743916, 179.260329188],
+        rpy_deg=[14.724046077086, -5.261549746844, 2.681403711399],
+        model=model,
+    )
+    # The issue's equilibrium: T5 = 31.98 kN.
+    assert result.ok and abs(result.lower_tension_kN[4] - 31.98) < 0.005
+    with pytest.raises(fastcal.InputError, match="reflector: unknown key 'radius'"):
+        model.reflector = {"radius": 300.0}

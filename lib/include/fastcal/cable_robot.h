@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -46,6 +47,16 @@ struct CableProperties {
   double SensorReadingN(double tension_n) const { return sensor_gain * tension_n + sensor_bias_n; }
 };
 
+// The reflector: the lower cap of a sphere, within a circle of diameter aperture_m seen
+// from above (FAST: radius 300 m about (0, 0, 300) m, aperture 500 m; design notes). Only
+// used to check that no cable's lowest point passes through it
+// (StaticsOptions::min_reflector_clearance_m).
+struct Reflector {
+  Eigen::Vector3d centre_m = Eigen::Vector3d(0.0, 0.0, 300.0);  // sphere centre, global frame
+  double radius_m = 300.0;
+  double aperture_m = 500.0;  // in (0, 2 radius_m]
+};
+
 struct CableRobot {
   // Cabin anchor points in the cabin frame (several cables may share one).
   std::vector<Eigen::Vector3d> anchor_points_cabin_m;
@@ -55,6 +66,9 @@ struct CableRobot {
   Eigen::Vector3d mass_centre_cabin_m = Eigen::Vector3d(0.0, 0.0, 0.5);
   // Gravitational acceleration along z (negative: z is up).
   double gravity_m_per_s2 = -9.8;
+  // Optional model data: FAST's reflector in NominalFast(), none in a default-constructed
+  // robot. Without it no cable is checked against the reflector.
+  std::optional<Reflector> reflector;
 
   // The nominal FAST layout and parameters of the paper's Table 1.
   static CableRobot NominalFast();
@@ -65,9 +79,9 @@ struct CableRobot {
   }
 
   // Checks physical sense: EA > 0, density > 0, mass > 0, g < 0, finite coordinates,
-  // anchor indices in range, no two tower tops coincident, no two distinct anchor points
-  // coincident. On failure returns false and names the offending key in *error (YAML key
-  // path, e.g. "cables[2].ea_n").
+  // a reflector (if any) with radius > 0 and aperture in (0, 2 radius], anchor indices in range, no
+  // two tower tops coincident, no two distinct anchor points coincident. On failure returns false
+  // and names the offending key in *error (YAML key path, e.g. "cables[2].ea_n").
   bool IsValid(std::string* error) const;
 };
 

@@ -62,9 +62,10 @@ struct CalibrationSpec {
   // the list in the file header above). Parameters the spec does not name are fixed at
   // the model's values and not listed.
   std::vector<ParameterSpec> parameters;
-  // Statics model inside the residuals. aas-refined by default: plain AAS's own 0.1-0.3%
-  // error is a bias, not noise, and would shift the estimates (docs/calibration.md).
-  StaticsMethod forward_model = StaticsMethod::kAasRefined;
+  // Statics model inside the residuals. exact by default: as fast as aas-refined and
+  // right wherever it answers; plain AAS's own 0.1-0.3% error is a bias, not noise, and
+  // would shift the estimates (docs/calibration.md).
+  StaticsMethod forward_model = StaticsMethod::kExact;
   // Tension noise: sigma_i^2 = sigma_abs^2 + (percent/100 * predicted_i)^2, predicted_i
   // the model's reading (docs/calibration.md: why not the measured one).
   double tension_sigma_n = 0.0;

@@ -66,8 +66,10 @@ template <typename T>
 struct CatenaryEnd {
   T span_m;
   T rise_m;
-  T dspan[3];  // d span / d(Fl, Fz, s0)
-  T drise[3];  // d rise / d(Fl, Fz, s0)
+  T dspan[3];         // d span / d(Fl, Fz, s0)
+  T drise[3];         // d rise / d(Fl, Fz, s0)
+  T lower_tension_n;  // T0, computed on the way (free where a caller needs it)
+  T upper_tension_n;  // T1
 };
 
 // Forward map (eqs. 14-16 in the cable plane). Requires fl > 0, s0 > 0, ea > 0, w != 0.
@@ -98,6 +100,8 @@ FASTCAL_ALWAYS_INLINE CatenaryEnd<T> CatenaryEndpoint(const T& fl_n, const T& fz
   const T cross = s0_m * two_fz_ws * inv_s_t0t1;
   const T s0_q_t0t1 = s0_m * q * inv_t0t1;
   CatenaryEnd<T> end;
+  end.lower_tension_n = t0;
+  end.upper_tension_n = t1;
   end.span_m = (fl_n * s0_m) * inv_ea + fl_n * d_over_w;
   end.rise_m = -(fz_n + T(0.5) * ws) * s0_m * inv_ea - s0_m * two_fz_ws * inv_s;
   end.dspan[0] = s0_m * inv_ea + d_over_w - s0_q_t0t1;
@@ -272,16 +276,22 @@ struct CatenaryProblem {  // SolveCatenaryForcesDouble's arguments
   double span_m = 0.0, rise_m = 0.0, s0_m = 0.0, ea_n = 0.0, w_n_per_m = 0.0;
   const CatenaryForces* guess = nullptr;
 };
+// jacobians (may be null): d(span, rise)/d(Fl, Fz), row-major, at each solve's last
+// evaluation (the returned forces, or one final Newton step before them), where ok.
 void SolveCatenaryForcesBatch(int n, const CatenaryProblem* problems,
                               const CatenarySolverOptions& options, CatenaryForces* forces,
-                              CatenaryStatus* statuses, int* iterations);
+                              CatenaryStatus* statuses, int* iterations,
+                              double (*jacobians)[4] = nullptr);
 struct CatenaryLengthProblem {  // SolveCatenaryLengthDouble's arguments
   double span_m = 0.0, rise_m = 0.0, fl_n = 0.0, ea_n = 0.0, w_n_per_m = 0.0;
   const CatenaryCurvePoint* guess = nullptr;
 };
+// jacobians (may be null): d(span, rise)/d(Fz, s0), row-major, at each solve's last
+// evaluation (the returned point, or one final Newton step before it), where ok.
 void SolveCatenaryLengthBatch(int n, const CatenaryLengthProblem* problems,
                               const CatenarySolverOptions& options, CatenaryCurvePoint* points,
-                              CatenaryStatus* statuses, int* iterations);
+                              CatenaryStatus* statuses, int* iterations,
+                              double (*jacobians)[4] = nullptr);
 
 // A point of the cable's shape (eqs. 11-13, in the cable plane) with the tension there.
 struct CatenaryPoint {

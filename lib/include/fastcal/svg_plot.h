@@ -1,5 +1,6 @@
-// Dependency-free SVG chart writer for the self-contained HTML calibration report: line
-// plots, overlaid histograms, grouped bars and correlation heatmaps, each returned as one
+// Dependency-free SVG chart writer for the self-contained HTML calibration report and
+// workspace map: line plots, overlaid histograms, grouped bars, correlation heatmaps and
+// polar maps, each returned as one
 // <svg> element to inline in HTML (no JavaScript, no CSS, no external fonts, no element
 // ids, so several charts can share a page).
 //
@@ -17,6 +18,7 @@
 #define FASTCAL_SVG_PLOT_H_
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace fastcal {
@@ -94,6 +96,46 @@ std::string SvgGroupedBars(const std::vector<BarGroup>& groups,
 std::string SvgMatrixHeatmap(const std::vector<std::string>& labels,
                              const std::vector<std::vector<double>>& matrix,
                              const PlotOptions& options);
+
+// Shapes of the marks a polar map puts on its cells (e.g. why a workspace node fails).
+enum class MarkShape { kCross, kTriangleUp, kTriangleDown, kSquare, kDiamond, kCircle, kPlus };
+
+struct PolarMark {
+  std::string label;  // legend text; empty leaves the mark out of the legend
+  MarkShape shape = MarkShape::kCross;
+};
+
+// One cell of a polar map: an annular sector, angles from +x toward +y (counter-clockwise
+// seen from above, +y up on the page), radii in the map's radial unit.
+struct PolarCell {
+  double radius_lo = 0.0, radius_hi = 0.0;        // >= 0
+  double angle_lo_deg = 0.0, angle_hi_deg = 0.0;  // a full turn (360) gives a disc or ring
+  // Its colour on the map's sequential scale; non-finite: light grey, no value.
+  double value = 0.0;
+  int mark = -1;        // index into PolarMapOptions::marks, drawn at its centre; -1: none
+  std::string tooltip;  // shown on hover (an SVG <title> inside the cell)
+};
+
+struct PolarMapOptions {
+  PlotOptions plot;          // title, size (x_label and y_label are not used)
+  std::string radius_label;  // what the rings measure, e.g. "off-axis angle [deg]"
+  std::string value_label;   // the colour bar's label, with its unit, e.g. "T [kN]"
+  double radius_max = 0.0;   // the outer ring; <= 0: the cells' largest radius
+  // The colour scale's range; value_lo >= value_hi: the cells' values' range. Several
+  // maps meant to be compared should share one.
+  double value_lo = 0.0, value_hi = 0.0;
+  std::vector<PolarMark> marks;
+  // Labels outside the outer ring at these angles (deg), e.g. the towers.
+  std::vector<std::pair<double, std::string>> rim_labels;
+};
+
+// A polar map: each cell filled by its value on a sequential (viridis-like) scale with a
+// colour bar, light grey where it has none, and its mark; rings every nice step of the
+// radius, labelled, spokes and azimuth labels every 30 deg. Each cell is one
+// <path class="cell" data-value="..."> (data-value "n/a" without one) holding its
+// <title>; each mark one <path class="mark" data-mark="k">. The legend lists the marks,
+// each with its label. No cells with a positive extent: a "no data" SVG.
+std::string SvgPolarMap(const std::vector<PolarCell>& cells, const PolarMapOptions& options);
 
 // Escapes & < > " ' for XML text and attribute values; drops control characters that
 // XML 1.0 forbids (all below 0x20 except tab, newline and carriage return).

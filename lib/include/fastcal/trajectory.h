@@ -104,6 +104,27 @@ bool PosesWithAttitudeLaw(const std::vector<Eigen::Vector3d>& positions,
                           const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                           std::string* error);
 
+// Random poses around the focal attitude law, for sweeps of the workspace's edge (issue 9's:
+// 45 deg off axis, +-5 m, 2 to 5 deg): positions as RandomWorkspacePositions(positions),
+// each attitude the focal law's times an extra rotation Rz(c) Ry(b) Rx(a), whose amplitude
+// A is drawn per pose uniform in [min_extra_rotation_deg, max_extra_rotation_deg] and a, b,
+// c uniform in [-A, A]. The rotations come from a second generator seeded with
+// positions.seed + 1, so the positions are RandomWorkspacePositions' own; the same spec
+// gives the same poses on every platform.
+struct RandomPoseSpec {
+  RandomWorkspaceSpec positions;
+  FocalAttitudeLaw law;
+  double min_extra_rotation_deg = 2.0;  // 0 <= min <= max, finite
+  double max_extra_rotation_deg = 5.0;
+};
+bool RandomPosesAroundFocalLaw(const RandomPoseSpec& spec, std::vector<Pose>* poses,
+                               std::string* error);
+
+// The sweep of the workspace's edge of issue 9: `samples` poses up to 45 deg off axis,
+// +-5 m off the focal sphere, extra rotations of 2 to 5 deg per axis, `seed`; the other
+// fields at their defaults (the paper's focal law and sphere).
+RandomPoseSpec EdgeSweepSpec(int samples, std::uint64_t seed);
+
 // Poses at finite `positions` with the neutral attitude R = I.
 bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
                                std::vector<Pose>* poses, std::string* error);

@@ -1,4 +1,5 @@
-// Helpers shared by the CSV readers (dataset.cc, trajectory.cc).
+// Helpers shared by the CSV readers (dataset.cc, trajectory.cc) and writers (workspace.cc,
+// the command line).
 #ifndef FASTCAL_INTERNAL_CSV_H_
 #define FASTCAL_INTERNAL_CSV_H_
 
@@ -17,6 +18,18 @@ inline std::string WrongSeparatorMessage(std::string_view header) {
   if (separator == nullptr) return "";
   return std::string("the header is separated by ") + separator +
          ": fields must be separated by commas";
+}
+
+// `text` as one CSV field in double quotes, inner quotes doubled (RFC 4180), so that
+// commas, quotes and line breaks in a message stay inside its column for any CSV reader
+// (pandas, Python's csv). Messages are always quoted, so that a column reads alike.
+inline std::string QuotedCsvField(std::string_view text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"') out += '"';
+    out += c;
+  }
+  return out + "\"";
 }
 
 }  // namespace fastcal::internal

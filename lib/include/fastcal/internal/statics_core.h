@@ -16,6 +16,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/catenary.h"
@@ -37,6 +38,8 @@ struct StaticsParameters {
   T cabin_mass_kg;
   Vector3T<T> mass_centre_cabin_m;
   double gravity_m_per_s2 = -9.8;
+  // Only checked against (in double), never differentiated; none unless set.
+  std::optional<Reflector> reflector;
 };
 
 StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot);
@@ -55,6 +58,7 @@ StaticsParameters<double> ScalarParameters(const StaticsParameters<T>& p) {
   d.cabin_mass_kg = ScalarValue(p.cabin_mass_kg);
   for (int j = 0; j < 3; ++j) d.mass_centre_cabin_m[j] = ScalarValue(p.mass_centre_cabin_m[j]);
   d.gravity_m_per_s2 = p.gravity_m_per_s2;
+  d.reflector = p.reflector;
   return d;
 }
 
@@ -67,7 +71,96 @@ struct PoseGeometry {
   std::array<T, kNumCables> span, rise, chord, ux, uy, w;
   Vector3T<T> e;  // R r_e
   T weight_n;     // m g (negative)
+  // double only (ComputeGeometry): three of the six equilibrium rows (0, 1, 5: the
+  // horizontal forces and the moment about z) hold no Fz, so they are the same for every
+  // solve at this pose: the Fl that meet them are null_basis * c, c in R^3
+  // (EquilibriumNullBasis), and its solved block's reciprocal condition squared (det^2
+  // over Hadamard's bound squared), for the singularity test.
+  Eigen::Matrix<double, 6, 3> null_basis;
+  double basis_reciprocal_condition2 = 0.0;
 };
+
+// The adjugate of a 3x3 matrix (its inverse times the determinant) and the determinant,
+// and Hadamard's bound on that (the product of the rows' lengths, squared), whose ratio
+// to det^2 serves as the reciprocal condition: no division, no branch.
+struct Adjugate3 {
+  Eigen::Matrix3d adjugate;
+  double det, hadamard2;
+  explicit Adjugate3(const Eigen::Matrix3d& m) {
+    auto col = [&m](int a, int b) {  // row a x row b, as a column
+      return Eigen::Vector3d(m(a, 1) * m(b, 2) - m(a, 2) * m(b, 1),
+                             m(a, 2) * m(b, 0) - m(a, 0) * m(b, 2),
+                             m(a, 0) * m(b, 1) - m(a, 1) * m(b, 0));
+    };
+    adjugate.col(0) = col(1, 2);
+    adjugate.col(1) = col(2, 0);
+    adjugate.col(2) = col(0, 1);
+    det = m.row(0).dot(adjugate.col(0).transpose());
+    hadamard2 = m.row(0).squaredNorm() * m.row(1).squaredNorm() * m.row(2).squaredNorm();
+  }
+  // |det| >= ratio times Hadamard's bound.
+  bool ConditionedBetterThan(double ratio) const { return det * det >= ratio * ratio * hadamard2; }
+};
+
+// The null space of the equilibrium rows without Fz (rows 0, 1, 5 of SolveEquilibrium's
+// matrix, H: ux_i, uy_i, r_y,i ux_i - r_x,i uy_i): three columns of H are solved for
+// (H_p X = -H_f, by the adjugate), the other three are free (identity). First with
+// cables 1, 3, 5, one per anchor and 120 deg apart on FAST, which makes H_p well
+// conditioned without a search; only if it is not (reciprocal condition, as Hadamard's
+// ratio, below kWellConditioned), with the columns of complete pivoting.
+inline void EquilibriumNullBasis(PoseGeometry<double>* g) {
+  constexpr double kWellConditioned = 1e-3;
+  double h[3][kNumCables];
+  for (int i = 0; i < kNumCables; ++i) {
+    h[0][i] = g->ux[i];
+    h[1][i] = g->uy[i];
+    h[2][i] = g->r[i][1] * g->ux[i] - g->r[i][0] * g->uy[i];
+  }
+  auto solve_for = [&](const int* pivots, const int* free) {
+    Eigen::Matrix3d hp, hf;
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 3; ++k) {
+        hp(r, k) = h[r][pivots[k]];
+        hf(r, k) = h[r][free[k]];
+      }
+    }
+    const Adjugate3 a(hp);
+    const Eigen::Matrix3d x = -(a.adjugate / a.det) * hf;
+    g->null_basis.setZero();
+    for (int k = 0; k < 3; ++k) {
+      g->null_basis.row(pivots[k]) = x.row(k);
+      g->null_basis(free[k], k) = 1.0;
+    }
+    g->basis_reciprocal_condition2 = a.det * a.det / a.hadamard2;
+    return a.ConditionedBetterThan(kWellConditioned);
+  };
+  const int odd[3] = {0, 2, 4}, even[3] = {1, 3, 5};
+  if (solve_for(odd, even)) return;
+  // Complete pivoting on a copy, for its choice of columns only.
+  double e[3][kNumCables];
+  std::copy(&h[0][0], &h[0][0] + 3 * kNumCables, &e[0][0]);
+  int col[kNumCables] = {0, 1, 2, 3, 4, 5};
+  for (int k = 0; k < 3; ++k) {
+    int pr = k, pc = k;
+    for (int r = k; r < 3; ++r) {
+      for (int c = k; c < kNumCables; ++c) {
+        if (std::abs(e[r][col[c]]) > std::abs(e[pr][col[pc]])) {
+          pr = r;
+          pc = c;
+        }
+      }
+    }
+    for (int c = 0; c < kNumCables; ++c) std::swap(e[k][c], e[pr][c]);
+    std::swap(col[k], col[pc]);
+    const double pivot = e[k][col[k]];
+    if (!(std::abs(pivot) > 0.0)) break;  // rank < 3: the ratio below says singular
+    for (int r = k + 1; r < 3; ++r) {
+      const double f = e[r][col[k]] / pivot;
+      for (int c = 0; c < kNumCables; ++c) e[r][c] -= f * e[k][c];
+    }
+  }
+  solve_for(col, col + 3);
+}
 
 template <typename T>
 StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
@@ -85,24 +178,68 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
       *cable = i;
       return StaticsStatus::kVerticalCable;
     }
-    g->ux[i] = c[0] / g->span[i];
-    g->uy[i] = c[1] / g->span[i];
+    const T inv_span = T(1) / g->span[i];  // one division, not two
+    g->ux[i] = c[0] * inv_span;
+    g->uy[i] = c[1] * inv_span;
     g->w[i] = p.linear_density_kg_per_m[i] * p.gravity_m_per_s2;
   }
   g->e = rotation * p.mass_centre_cabin_m;
   g->weight_n = p.cabin_mass_kg * p.gravity_m_per_s2;
+  if constexpr (kIsDouble<T>) EquilibriumNullBasis(g);
   return StaticsStatus::kOk;
 }
 
-// Solves the six equilibrium rows for Fl given Fz_i = a_i Fl_i + b_i (statics.h).
-// Returns false when the matrix is singular to working precision.
+// How the solution Fl of the 6x6 equilibrium system moves when the right-hand sides of
+// its vertical-force row and its two tilting-moment rows (rows 2, 3, 4; statics.h) move:
+// dFl = response * (d rhs2, d rhs3, d rhs4). A cable's Fz off its curve by d shifts just
+// those rows (by -d, -r_y d, -r_x d), so the error estimates need only this, not the
+// matrix's factors; SolveEquilibrium computes it alongside Fl, off the critical path.
+using EquilibriumResponse = Eigen::Matrix<double, 6, 3>;
+
+// Reciprocal condition below which the equilibrium system counts as singular.
+inline constexpr double kMinEquilibriumReciprocalCondition = 1e-13;
+
+// SolveEquilibrium for double: three unknowns through PoseGeometry::null_basis.
+template <bool kResponse>
+bool SolveEquilibriumReduced(const PoseGeometry<double>& g, const std::array<double, kNumCables>& a,
+                             const std::array<double, kNumCables>& b,
+                             std::array<double, kNumCables>* fl, EquilibriumResponse* response) {
+  constexpr double kMinReciprocalCondition = kMinEquilibriumReciprocalCondition;
+  // Fl = N c (PoseGeometry::null_basis) meets rows 0, 1, 5; rows 2, 3, 4 are then the
+  // 3x3 system (V N) c = rhs, solved by its adjugate: one division and no branches,
+  // where the 6x6 elimination's pivot search and six divisions made a long dependent
+  // chain (the largest single cost of a solve). The response is then N (V N)^-1.
+  const Eigen::Matrix<double, 6, 3>& n = g.null_basis;
+  Eigen::Matrix3d vn = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs(g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n);
+  for (int i = 0; i < kNumCables; ++i) {
+    const Vector3T<double>& r = g.r[i];
+    const Eigen::Vector3d v(a[i], r[1] * a[i] + r[2] * g.uy[i], r[0] * a[i] + r[2] * g.ux[i]);
+    vn += v * n.row(i);
+    rhs -= b[i] * Eigen::Vector3d(1.0, r[1], r[0]);
+  }
+  const Adjugate3 adj(vn);
+  if (!adj.ConditionedBetterThan(kMinReciprocalCondition) ||
+      !(g.basis_reciprocal_condition2 > kMinReciprocalCondition * kMinReciprocalCondition)) {
+    return false;
+  }
+  const Eigen::Matrix3d inverse = adj.adjugate / adj.det;
+  const Eigen::Matrix<double, 6, 1> x = n * (inverse * rhs);
+  for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
+  if constexpr (kResponse) *response = n * inverse;
+  return true;
+}
+
+// SolveEquilibrium for a Jet (the calibration's derivatives): the whole 6x6 system.
 template <typename T>
-bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>& a,
-                      const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl) {
-  // Smallest/largest pivot below which the 6x6 system counts as singular.
-  constexpr double kMinReciprocalCondition = 1e-13;
-  // Row-major, and for double full-length row operations below: fixed trip counts the
-  // compiler unrolls and vectorises (entries left of the pivot go stale, never read).
+bool SolveEquilibrium6x6(const PoseGeometry<T>& g, const std::array<T, kNumCables>& a,
+                         const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl) {
+  constexpr double kMinReciprocalCondition = kMinEquilibriumReciprocalCondition;
+  // Gaussian elimination with partial pivoting written out (several times faster than
+  // Eigen's blocked PartialPivLU plus its rcond() estimate), the pivot ratio as the
+  // singularity test (columns are scaled alike: forces in N). The Jets keep the full
+  // system: the null basis is built for double only, and this path's speed is the
+  // calibration's, measured by calibration_bench.
   Eigen::Matrix<T, 6, 6, Eigen::RowMajor> m;
   Eigen::Matrix<T, 6, 1> rhs;
   rhs << T(0), T(0), g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n, T(0);
@@ -118,12 +255,9 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
     rhs[3] -= r[1] * b[i];
     rhs[4] -= r[0] * b[i];
   }
-  // Gaussian elimination with partial pivoting, written out: for a fixed 6x6 it is several
-  // times faster than Eigen's blocked PartialPivLU plus its rcond() estimate.
   using std::abs;
   double max_pivot = 0.0, min_pivot = std::numeric_limits<double>::infinity();
   std::array<T, 6> inv_pivot;
-#pragma GCC unroll 6
   for (int c = 0; c < 6; ++c) {
     int p = c;
     for (int r = c + 1; r < 6; ++r) {
@@ -138,15 +272,12 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
     min_pivot = std::min(min_pivot, pivot);
     if (!(pivot > 0.0)) return false;
     inv_pivot[c] = T(1) / m(c, c);
-#pragma GCC unroll 6
     for (int r = c + 1; r < 6; ++r) {
       const T f = m(r, c) * inv_pivot[c];
-#pragma GCC unroll 6
-      for (int k = kIsDouble<T> ? 0 : c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
+      for (int k = c + 1; k < 6; ++k) m(r, k) -= f * m(c, k);
       rhs[r] -= f * rhs[c];
     }
   }
-  // Pivot ratio as a cheap singularity test (columns are scaled alike: forces in N).
   if (!(min_pivot > kMinReciprocalCondition * max_pivot)) return false;
   Eigen::Matrix<T, 6, 1> x;
   for (int r = 5; r >= 0; --r) {
@@ -156,6 +287,21 @@ bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>&
   }
   for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
   return true;
+}
+
+// Solves the six equilibrium rows for Fl given Fz_i = a_i Fl_i + b_i (statics.h).
+// Returns false when the matrix is singular to working precision. With kResponse (double
+// only) *response receives the system's EquilibriumResponse.
+template <typename T, bool kResponse = false>
+bool SolveEquilibrium(const PoseGeometry<T>& g, const std::array<T, kNumCables>& a,
+                      const std::array<T, kNumCables>& b, std::array<T, kNumCables>* fl,
+                      EquilibriumResponse* response = nullptr) {
+  static_assert(!kResponse || kIsDouble<T>, "the response is kept for double only");
+  if constexpr (kIsDouble<T>) {
+    return SolveEquilibriumReduced<kResponse>(g, a, b, fl, response);
+  } else {
+    return SolveEquilibrium6x6(g, a, b, fl);
+  }
 }
 
 template <typename T>
@@ -185,14 +331,17 @@ inline StaticsOptions AasLengthStageOptions(const StaticsOptions& o) {
   return so;
 }
 
-// AAS secant lines Fz = a Fl + b. `secant` in/out: double solutions used as guesses when
-// `use_guess` and written back.
+// AAS secant lines Fz = a Fl + b. `low`, `high` in/out: double solutions used as guesses
+// when `use_guess` and written back. For double, `jacobians` (may be null) receives each
+// secant solve's last d(L, Z)/d(Fl, Fz) (SolveCatenaryForcesBatch's; low lengths at i,
+// high at i + kNumCables).
 template <typename T>
 StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                        const StaticsOptions& o, bool use_guess,
                        std::array<CatenaryForces, kNumCables>* low,
                        std::array<CatenaryForces, kNumCables>* high, std::array<T, kNumCables>* a,
-                       std::array<T, kNumCables>* b, int* cable, int* iterations) {
+                       std::array<T, kNumCables>* b, int* cable, int* iterations,
+                       double (*jacobians)[4] = nullptr) {
   const CatenarySolverOptions secant_options = AasSecantSolverOptions(o);
   if constexpr (kIsDouble<T>) {
     // All twelve solves at once (low lengths, then high): same results, overlapped.
@@ -211,7 +360,8 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
         c.guess = use_guess ? (h == 0 ? &(*low)[i] : &(*high)[i]) : nullptr;
       }
     }
-    SolveCatenaryForcesBatch(2 * kNumCables, problems, secant_options, solved, statuses, its);
+    SolveCatenaryForcesBatch(2 * kNumCables, problems, secant_options, solved, statuses, its,
+                             jacobians);
     for (int i = 0; i < kNumCables; ++i) {
       *iterations += its[i] + its[i + kNumCables];
       for (CatenaryStatus s : {statuses[i], statuses[i + kNumCables]}) {
@@ -257,17 +407,18 @@ StaticsStatus AasLines(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
 }
 
 // Puts each cable on its exact Fz(Fl) curve at the current Fl (solves Fz, s0). `guess`
-// (double) starts each solve.
+// (double) starts each solve. kNoEquilibrium when a cable has Fl <= 0. For double,
+// `jacobians` (may be null) as SolveCatenaryLengthBatch's.
 template <typename T>
 StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
                               const StaticsOptions& o,
                               const std::array<CatenaryCurvePoint, kNumCables>& guess,
                               std::array<CableState<T>, kNumCables>* state, int* cable,
-                              int* iterations) {
+                              int* iterations, double (*jacobians)[4] = nullptr) {
   for (int i = 0; i < kNumCables; ++i) {
     if (!(ScalarValue((*state)[i].fl) > 0.0)) {
       *cable = i;
-      return StaticsStatus::kSlackCable;
+      return StaticsStatus::kNoEquilibrium;
     }
   }
   if constexpr (kIsDouble<T>) {
@@ -279,7 +430,7 @@ StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<
     for (int i = 0; i < kNumCables; ++i) {
       problems[i] = {g.span[i], g.rise[i], (*state)[i].fl, p.ea_n[i], g.w[i], &guess[i]};
     }
-    SolveCatenaryLengthBatch(kNumCables, problems, o.catenary, points, statuses, its);
+    SolveCatenaryLengthBatch(kNumCables, problems, o.catenary, points, statuses, its, jacobians);
     for (int i = 0; i < kNumCables; ++i) {
       *iterations += its[i];
       if (statuses[i] != CatenaryStatus::kOk) {
@@ -305,45 +456,74 @@ StaticsStatus ProjectOnCurves(const StaticsParameters<T>& p, const PoseGeometry<
   return StaticsStatus::kOk;
 }
 
-// One Newton step on all 18 unknowns: each catenary linearised in (Fl, Fz, s0), ds0
-// eliminated with the normal n = (dZ/ds0, -dL/ds0), giving Fz = a Fl + b; then the 6x6
-// equilibrium solve, and ds0 from the linearisation. Writes the largest |dFl| relative to
-// the largest Fl and the largest end-point residual relative to the chord (before the
-// step) when those pointers are not null.
+// Each cable linearised at its state (Fl, Fz, s0): the end conditions' residual and,
+// with ds0 eliminated by the normal n = (dZ/ds0, -dL/ds0), the line Fz = a Fl + b on
+// which the linearised end conditions hold. Where the state meets them, a is the tangent
+// of the cable's Fz(Fl) curve; b - (Fz - a Fl) is how far its Fz misses the curve.
 template <typename T>
-StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
-                                std::array<CableState<T>, kNumCables>* state, int* cable,
-                                double* relative_step, double* relative_residual) {
-  std::array<T, kNumCables> a, b, fl_new;
+struct CableLinearisation {
+  std::array<T, kNumCables> a, b;
+  std::array<T, kNumCables> inv_qq;  // 1 / (n . d(L, Z)/dFz): a miss in Fz per residual
+  std::array<T, kNumCables> g0, g1;  // end residuals: span, rise (m)
   std::array<CatenaryEnd<T>, kNumCables> ends;
-  std::array<T, kNumCables> g0, g1;
+  double max_relative_residual = 0.0;  // largest |g0|, |g1| relative to the chord
+};
+
+template <typename T>
+void LineariseCables(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
+                     const std::array<CableState<T>, kNumCables>& state,
+                     CableLinearisation<T>* lin) {
   double max_residual = 0.0;
   for (int i = 0; i < kNumCables; ++i) {
-    const CableState<T>& c = (*state)[i];
+    const CableState<T>& c = state[i];
     const CatenaryEnd<T> e = CatenaryEndpoint(c.fl, c.fz, c.s0, p.ea_n[i], g.w[i]);
-    g0[i] = e.span_m - g.span[i];
-    g1[i] = e.rise_m - g.rise[i];
+    const T g0 = e.span_m - g.span[i];
+    const T g1 = e.rise_m - g.rise[i];
     const double chord = ScalarValue(g.chord[i]);
-    max_residual = std::max(
-        max_residual, std::max(std::abs(ScalarValue(g0[i])), std::abs(ScalarValue(g1[i]))) / chord);
+    max_residual = std::max(max_residual,
+                            std::max(std::abs(ScalarValue(g0)), std::abs(ScalarValue(g1))) / chord);
     const T n0 = e.drise[2], n1 = -e.dspan[2];
-    const T cc = n0 * g0[i] + n1 * g1[i];
+    const T cc = n0 * g0 + n1 * g1;
     const T pp = n0 * e.dspan[0] + n1 * e.drise[0];
-    const T qq = n0 * e.dspan[1] + n1 * e.drise[1];
-    a[i] = -pp / qq;
-    b[i] = c.fz - cc / qq - a[i] * c.fl;
-    ends[i] = e;
+    const T inv_qq = T(1) / (n0 * e.dspan[1] + n1 * e.drise[1]);  // one division, not two
+    lin->a[i] = -pp * inv_qq;
+    lin->b[i] = c.fz - cc * inv_qq - lin->a[i] * c.fl;
+    lin->inv_qq[i] = inv_qq;
+    lin->g0[i] = g0;
+    lin->g1[i] = g1;
+    lin->ends[i] = e;
   }
-  if (!SolveEquilibrium(g, a, b, &fl_new)) return StaticsStatus::kSingular;
+  lin->max_relative_residual = max_residual;
+}
+
+// The Newton step from a linearisation: the 6x6 equilibrium solve for Fl, then Fz on each
+// cable's line and ds0 from its linearisation. Writes the largest |dFl| relative to the
+// largest Fl when relative_step is not null, and for double the system's
+// EquilibriumResponse when `response` is not null. Returns kNoEquilibrium when the step
+// leaves a cable with Fl <= 0 or s0 <= 0 (the caller says what that means for its method).
+template <typename T>
+StaticsStatus StepFromLinearisation(const PoseGeometry<T>& g, const CableLinearisation<T>& lin,
+                                    std::array<CableState<T>, kNumCables>* state, int* cable,
+                                    double* relative_step,
+                                    EquilibriumResponse* response = nullptr) {
+  std::array<T, kNumCables> fl_new;
+  bool solved;
+  if constexpr (kIsDouble<T>) {
+    solved = response != nullptr ? SolveEquilibrium<T, true>(g, lin.a, lin.b, &fl_new, response)
+                                 : SolveEquilibrium(g, lin.a, lin.b, &fl_new);
+  } else {
+    solved = SolveEquilibrium(g, lin.a, lin.b, &fl_new);
+  }
+  if (!solved) return StaticsStatus::kSingular;
   double max_fl = 0.0, max_step = 0.0;
   for (int i = 0; i < kNumCables; ++i) {
     CableState<T>& c = (*state)[i];
-    const CatenaryEnd<T>& e = ends[i];
+    const CatenaryEnd<T>& e = lin.ends[i];
     const T dfl = fl_new[i] - c.fl;
-    const T fz_new = a[i] * fl_new[i] + b[i];
+    const T fz_new = lin.a[i] * fl_new[i] + lin.b[i];
     const T dfz = fz_new - c.fz;
-    const T res0 = g0[i] + e.dspan[0] * dfl + e.dspan[1] * dfz;
-    const T res1 = g1[i] + e.drise[0] * dfl + e.drise[1] * dfz;
+    const T res0 = lin.g0[i] + e.dspan[0] * dfl + e.dspan[1] * dfz;
+    const T res1 = lin.g1[i] + e.drise[0] * dfl + e.drise[1] * dfz;
     const T ds = -(e.dspan[2] * res0 + e.drise[2] * res1) /
                  (e.dspan[2] * e.dspan[2] + e.drise[2] * e.drise[2]);
     max_step = std::max(max_step, std::abs(ScalarValue(dfl)));
@@ -353,14 +533,26 @@ StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometr
     c.s0 = c.s0 + ds;
   }
   for (int i = 0; i < kNumCables; ++i) {
-    if (!(ScalarValue((*state)[i].fl) > 0.0)) {
+    if (!(ScalarValue((*state)[i].fl) > 0.0) || !(ScalarValue((*state)[i].s0) > 0.0)) {
       *cable = i;
-      return StaticsStatus::kSlackCable;
+      return StaticsStatus::kNoEquilibrium;
     }
   }
   if (relative_step != nullptr) *relative_step = max_step / max_fl;
-  if (relative_residual != nullptr) *relative_residual = max_residual;
   return StaticsStatus::kOk;
+}
+
+// One Newton step on all 18 unknowns (LineariseCables, then StepFromLinearisation).
+// Writes the largest end-point residual relative to the chord before the step when
+// relative_residual is not null.
+template <typename T>
+StaticsStatus ReducedNewtonStep(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
+                                std::array<CableState<T>, kNumCables>* state, int* cable,
+                                double* relative_step, double* relative_residual) {
+  CableLinearisation<T> lin;
+  LineariseCables(p, g, *state, &lin);
+  if (relative_residual != nullptr) *relative_residual = lin.max_relative_residual;
+  return StepFromLinearisation(g, lin, state, cable, relative_step);
 }
 
 // Guess for cable i's curve point at Fl from its secant data. Linear: s0 interpolated

@@ -60,7 +60,8 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
         const StaticsParameters<double> pd = ScalarParameters(p);
         internal::PoseGeometry<double> gd;
         internal::ComputeGeometry(pd, pose, options.catenary.vertical_span_fraction, &gd, &cable);
-        for (int step = 0; step < options.refinement_steps; ++step) {
+        // The double solve's steps, as many as it took to meet its tolerance.
+        for (int step = 0; step < sol->outer_iterations; ++step) {
           std::array<CatenaryCurvePoint, kNumCables> guess;
           for (int i = 0; i < kNumCables; ++i) {
             guess[i] = internal::CurveGuess(ScalarValue(st[i].fl), gd, i, pd.ea_n[i], low[i],

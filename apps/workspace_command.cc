@@ -1,0 +1,222 @@
+// `fastcal workspace`: the feasible workspace over the focal-sphere cap for the focal
+// attitude law and the limits given (workspace.h), as CSV and as an HTML map.
+#include <gflags/gflags.h>
+
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <sstream>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "fastcal/version.h"
+#include "fastcal/workspace.h"
+
+// Shared with solve (solve_command.cc).
+DECLARE_string(model);
+DECLARE_string(method);
+DECLARE_double(tilt_fraction);
+DECLARE_string(focal_centre);
+DECLARE_double(max_off_axis_deg);
+DECLARE_double(off_axis_step_deg);
+DECLARE_double(azimuth_step_deg);
+DECLARE_double(focal_radius);
+DECLARE_string(output);
+DECLARE_bool(force);
+
+DEFINE_double(radial_offset, 0.0,
+              "workspace: > 0 adds the grid this far (m) inside and outside the focal sphere.");
+DEFINE_double(min_tension_kn, 0.0, "workspace: smallest lower-end tension allowed (kN).");
+DEFINE_double(max_tension_kn, std::numeric_limits<double>::infinity(),
+              "workspace: largest lower-end tension allowed (kN); inf: none.");
+DEFINE_string(html, "", "workspace: also write the map as a self-contained HTML file.");
+
+namespace fastcal::cli {
+namespace {
+
+constexpr char kCommand[] = "workspace";
+constexpr double kNPerKn = 1e3;
+// Its grid defaults, finer than solve's --trajectory=grid (the flags are shared).
+constexpr double kOffAxisStepDeg = 1.0, kAzimuthStepDeg = 5.0;
+
+const char kHelp[] =
+    R"(fastcal workspace: where the cabin can go with every cable within limits.
+
+Usage:
+  fastcal workspace [--min-tension-kn=50 --max-tension-kn=500] [--output=ws.csv]
+                    [--html=ws.html] [options]
+
+Solves every node of a grid on the focal-sphere cap at the focal attitude law and says
+per node whether it is feasible: the statics hold the cabin there within the model's
+range, clear of the reflector, with every cable's lower-end tension (what the cabin-side
+sensors read, solve's T<i>_kN) within the limits. Otherwise the reason and the cable.
+
+Grid (the focal-sphere cap, as solve --trajectory=grid, with finer defaults):
+  --max-off-axis-deg=40 --off-axis-step-deg=1 --azimuth-step-deg=5 --focal-radius=160
+  --focal-centre=0,0,300 (also the focal law's centre)
+  --radial-offset=0       m; > 0 adds the same grid this far inside and outside the sphere
+Attitude: the focal law, --tilt-fraction=0.41 (docs/model.md).
+Limits:
+  --min-tension-kn=0 --max-tension-kn=inf   lower-end tension, kN
+  --max-strain=0.05 --max-length-ratio=1.5  the model's range (tension / EA, s0 / chord)
+  --reflector-clearance=0                   m, how close a cable may come to the reflector
+Statics: --method=exact (default), aas-refined or aas. Model: --model=FILE.yaml (default
+the nominal FAST model, whose reflector is checked; docs/model-format.md).
+
+Output: CSV to stdout or --output=FILE.csv, one row per node: radial_offset_m,
+off_axis_deg, azimuth_deg, x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg, status (feasible,
+below_min_tension, above_max_tension, or the statics' code: no_equilibrium,
+sagging_cable, overstretched_cable, reflector_contact, ...), cable (1-based),
+min_tension_kN, min_tension_cable, max_tension_kN, max_tension_cable,
+max_upper_tension_kN (the tower end), message (quoted). --html=FILE.html writes the map:
+a polar plot of the cap per layer, colour = the smallest lower-end tension, a mark per
+infeasible node for its reason. Files are written only when everything succeeded; an
+existing one only with --force. A summary on stderr.
+
+Examples:
+  fastcal workspace --min-tension-kn=50 --max-tension-kn=500 --html=ws.html --output=ws.csv
+  fastcal workspace --max-off-axis-deg=45 --radial-offset=5 --html=edge.html --output=edge.csv
+)";
+
+const std::set<std::string> kFlags = {"model",
+                                      "method",
+                                      "tilt-fraction",
+                                      "focal-centre",
+                                      "max-off-axis-deg",
+                                      "off-axis-step-deg",
+                                      "azimuth-step-deg",
+                                      "focal-radius",
+                                      "radial-offset",
+                                      "min-tension-kn",
+                                      "max-tension-kn",
+                                      "max-strain",
+                                      "max-length-ratio",
+                                      "reflector-clearance",
+                                      "output",
+                                      "html",
+                                      "force"};
+
+bool SetOptionsFromFlags(WorkspaceOptions* o, std::string* error) {
+  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &o->grid.focal_centre_m, error)) {
+    return false;
+  }
+  o->grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
+  o->grid.off_axis_step_deg =
+      FlagGiven("off-axis-step-deg") ? FLAGS_off_axis_step_deg : kOffAxisStepDeg;
+  o->grid.azimuth_step_deg =
+      FlagGiven("azimuth-step-deg") ? FLAGS_azimuth_step_deg : kAzimuthStepDeg;
+  o->grid.focal_radius_m = FLAGS_focal_radius;
+  o->attitude_law.focal_centre_m = o->grid.focal_centre_m;
+  o->attitude_law.tilt_fraction = FLAGS_tilt_fraction;
+  o->radial_offset_m = FLAGS_radial_offset;
+  // Checked here too, so that the message gives the flags' own numbers (kN).
+  if (!(FLAGS_min_tension_kn >= 0.0) || !std::isfinite(FLAGS_min_tension_kn)) {
+    *error =
+        "--min-tension-kn must be >= 0 and finite (got " + FormatDouble(FLAGS_min_tension_kn) + ")";
+    return false;
+  }
+  if (!(FLAGS_max_tension_kn > FLAGS_min_tension_kn)) {
+    *error = "--max-tension-kn must be above --min-tension-kn (got " +
+             FormatDouble(FLAGS_max_tension_kn) + " <= " + FormatDouble(FLAGS_min_tension_kn) + ")";
+    return false;
+  }
+  o->min_tension_n = FLAGS_min_tension_kn * kNPerKn;
+  o->max_tension_n = FLAGS_max_tension_kn * kNPerKn;
+  if (!ParseStaticsMethod(FLAGS_method, &o->statics.method)) {
+    *error = "--method must be exact, aas-refined or aas, got '" + FLAGS_method + "'";
+    return false;
+  }
+  if (!ModelRangeFromFlags(&o->statics, error)) return false;
+  if (o->IsValid(error)) return true;
+  *error = WithFlagNames(WithTrajectoryFlagNames(*error),
+                         {{"grid.max_off_axis_deg", "--max-off-axis-deg"},
+                          {"grid.off_axis_step_deg", "--off-axis-step-deg"},
+                          {"grid.azimuth_step_deg", "--azimuth-step-deg"},
+                          {"grid.focal_radius_m", "--focal-radius"},
+                          {"grid.focal_centre_m", "--focal-centre"},
+                          {"radial_offset_m", "--radial-offset"},
+                          {"min_tension_n", "--min-tension-kn"},
+                          {"max_tension_n", "--max-tension-kn"},
+                          {"attitude_law.focal_centre_m", "--focal-centre"},
+                          {"attitude_law.tilt_fraction", "--tilt-fraction"}});
+  return false;
+}
+
+// "2881 nodes on the focal sphere: 2881 feasible, lower-end tensions 112.3 to 316 kN".
+std::string Summary(const WorkspaceMap& map) {
+  std::ostringstream s;
+  s << "fastcal workspace: " << map.nodes.size() << " nodes";
+  for (double offset_m : map.layers_m) {
+    int nodes = 0, feasible = 0;
+    double lo = HUGE_VAL, hi = 0.0;
+    std::map<std::string, int> reasons;
+    for (const WorkspaceNode& n : map.nodes) {
+      if (n.radial_offset_m != offset_m) continue;
+      ++nodes;
+      if (n.verdict != WorkspaceVerdict::kFeasible) {
+        ++reasons[WorkspaceNodeCode(n)];
+        continue;
+      }
+      ++feasible;
+      lo = std::min(lo, n.min_tension_n);
+      hi = std::max(hi, n.max_tension_n);
+    }
+    s << "\n  " << (offset_m == 0.0 ? "on the sphere" : FormatDouble(offset_m) + " m off it")
+      << ": " << feasible << " of " << nodes << " feasible";
+    if (feasible > 0) {
+      s << ", lower-end tensions " << FormatDouble(lo / kNPerKn, 4) << " to "
+        << FormatDouble(hi / kNPerKn, 4) << " kN";
+    }
+    for (const auto& [code, count] : reasons) s << "; " << code << " " << count;
+  }
+  return s.str();
+}
+
+}  // namespace
+
+int RunWorkspace(int argc, char** argv) {
+  int exit_code = 0;
+  if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+  std::string error;
+  const bool to_file = !FLAGS_output.empty() && FLAGS_output != "-";
+  if (FLAGS_force && !to_file && FLAGS_html.empty()) {
+    PrintError(kCommand, "--force applies to --output=FILE or --html=FILE");
+    return kExitUsage;
+  }
+  if ((to_file && !CheckCanWrite("output", FLAGS_output, FLAGS_force, &error)) ||
+      (!FLAGS_html.empty() && !CheckCanWrite("html", FLAGS_html, FLAGS_force, &error))) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  CableRobot robot;
+  WorkspaceOptions options;
+  if (!LoadModelFlag("model", FLAGS_model, &robot, &error) ||
+      !SetOptionsFromFlags(&options, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  WorkspaceMap map;
+  if (!ComputeWorkspace(robot, options, &map, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  const std::string command = CommandLine(argc, argv);
+  std::vector<std::pair<std::string, std::string>> files;
+  if (to_file) files.push_back({FLAGS_output, WorkspaceCsv(map)});
+  if (!FLAGS_html.empty()) {
+    files.push_back({FLAGS_html, WorkspaceHtml(map, robot, ModelName(FLAGS_model),
+                                               "Made by fastcal " + std::string(FASTCAL_VERSION) +
+                                                   ": " + command)});
+  }
+  if (!WriteOutputsTogether(files, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  if (!to_file) std::cout << WorkspaceCsv(map) << std::flush;
+  std::cerr << Summary(map) << std::endl;
+  return 0;
+}
+
+}  // namespace fastcal::cli
