@@ -642,9 +642,10 @@ TEST(CalibrationTest, SigmaTotalCoversTheTruthOnRealisticData) {
     }
   }
   // The figures docs/calibration.md quotes.
-  std::printf("coverage within 2 sigma_total %d/%d, within 2 formal sigma %d/%d, "
-              "mean z^2 %.2f, ranking false alarms %d/%d\n",
-              covered, count, covered_formal, count, z2 / count, flagged, kSeeds);
+  std::printf(
+      "coverage within 2 sigma_total %d/%d, within 2 formal sigma %d/%d, "
+      "mean z^2 %.2f, ranking false alarms %d/%d\n",
+      covered, count, covered_formal, count, z2 / count, flagged, kSeeds);
   EXPECT_GE(covered, kMinCoverage * count);
   EXPECT_LE(covered_formal, kMaxFormalCoverage * count);
   EXPECT_GT(z2 / count, kMinMeanZ2);
