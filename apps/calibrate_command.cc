@@ -131,18 +131,18 @@ bool WriteDirectoryAtomically(const std::string& dir,
                               std::string* error) {
   if (!CheckOutputDirectory("out", dir, error)) return false;
   std::error_code ec;
-  const fs::path target(dir);
+  const fs::path target = ResolveOutputPath(dir);
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
   if (!fs::exists(parent, ec) && !fs::create_directories(parent, ec)) {
-    *error =
-        "--out=" + dir + ": cannot create its directory '" + parent.string() + "': " + ec.message();
+    *error = "--out=" + internal::Escape(dir) + ": cannot create its directory '" +
+             internal::Escape(parent.string()) + "': " + ec.message();
     return false;
   }
   const fs::path tmp =
       parent / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
   fs::remove_all(tmp, ec);
   // Failures name the user's --out, not the temporary sibling.
-  const std::string where = "--out=" + dir + ": ";
+  const std::string where = "--out=" + internal::Escape(dir) + ": ";
   if (!fs::create_directory(tmp, ec)) {
     *error =
         where + "cannot create the temporary directory '" + tmp.string() + "': " + ec.message();
@@ -530,8 +530,9 @@ int RunCalibrate(int argc, char** argv) {
     return kExitFailure;
   }
   std::cerr << "fastcal calibrate: " << data.samples.size()
-            << (data.samples.size() == 1 ? " sample from " : " samples from ") << data.path
-            << SkippedNote(data) << ", model " << ModelName(FLAGS_model) << ", forward model "
+            << (data.samples.size() == 1 ? " sample from " : " samples from ")
+            << internal::Escape(data.path) << SkippedNote(data) << ", model "
+            << internal::Escape(ModelName(FLAGS_model)) << ", forward model "
             << StaticsMethodName(spec.forward_model) << "\n";
   CalibrationOptions options;
   if (!FLAGS_quiet)
@@ -627,7 +628,8 @@ int RunEvaluate(int argc, char** argv) {
   std::ostringstream s;
   s << "fastcal evaluate: " << data.samples.size() << " samples";
   s << SkippedNote(data);
-  s << ", model " << ModelName(FLAGS_model) << ", method " << StaticsMethodName(method) << "\n\n"
+  s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
+    << StaticsMethodName(method) << "\n\n"
     << RmsTable(variants);
   char buf[160];
   for (const VariantEvaluation& v : variants) {

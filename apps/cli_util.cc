@@ -66,6 +66,12 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
     }
     // Check the value's type here: gflags would exit 1 with its own message.
     gflags::CommandLineFlagInfo info;
+    if (eq == std::string::npos && gflags::GetCommandLineFlagInfo(underscored.c_str(), &info) &&
+        info.type != "bool") {
+      *error =
+          "--" + name + " needs a value: --" + name + "=... (see fastcal " + command + " --help)";
+      return false;
+    }
     if (eq != std::string::npos && gflags::GetCommandLineFlagInfo(underscored.c_str(), &info)) {
       const std::string value = arg.substr(eq + 1);
       const char* begin = value.c_str();
@@ -226,6 +232,16 @@ bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
     *error = where + "is a directory (give a file name)";
     return false;
   }
+  // The output is written beside the path and renamed over it: that would replace a
+  // device, a pipe or a link (with --force, /dev/null itself) instead of writing to it.
+  const std::filesystem::file_status link = std::filesystem::symlink_status(path, ec);
+  if (std::filesystem::exists(link) && !std::filesystem::is_regular_file(link)) {
+    *error = where + "is not a regular file (a " +
+             (std::filesystem::is_symlink(link) ? "symbolic link" : "device, pipe or socket") +
+             "): not replaced; give a new file name (--" + flag +
+             "=- writes to standard output where the command allows it)";
+    return false;
+  }
   if (std::filesystem::exists(status) && !force) {
     *error = where + "exists; not overwritten (add --force to replace it, or choose another name)";
     return false;
@@ -247,6 +263,11 @@ bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
 bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error) {
   const std::string where = "--" + flag + "=" + internal::Escape(dir) + ": ";
   std::error_code ec;
+  if (std::filesystem::is_symlink(std::filesystem::symlink_status(dir, ec)) &&
+      !std::filesystem::exists(dir, ec)) {
+    *error = where + "is a symbolic link to nothing (give a directory)";
+    return false;
+  }
   const std::filesystem::file_status status = std::filesystem::status(dir, ec);
   if (std::filesystem::exists(status) && !std::filesystem::is_directory(status)) {
     *error = where + "is a file, not a directory (--" + flag + " names a new or empty directory)";
@@ -276,6 +297,21 @@ bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::
   return true;
 }
 
+std::filesystem::path ResolveOutputPath(const std::string& dir) {
+  std::string text = dir;
+  while (text.size() > 1 && text.back() == '/') text.pop_back();
+  std::error_code ec;
+  const std::filesystem::path absolute = std::filesystem::absolute(text, ec);
+  if (ec) return std::filesystem::path(text).lexically_normal();
+  std::filesystem::path resolved = std::filesystem::weakly_canonical(absolute, ec);
+  if (ec) resolved = absolute.lexically_normal();
+  // lexically_normal keeps a trailing separator ("a/b/" for "a/b/."): drop it.
+  if (!resolved.has_filename() && resolved.has_parent_path() && resolved != resolved.root_path()) {
+    resolved = resolved.parent_path();
+  }
+  return resolved;
+}
+
 bool ParseNumberItem(const std::string& item, double* value, std::string* why) {
   const size_t begin = item.find_first_not_of(" \t");
   const size_t end = item.find_last_not_of(" \t");
@@ -288,23 +324,26 @@ bool ParseNumberItem(const std::string& item, double* value, std::string* why) {
 namespace {
 bool ParseList(const std::string& name, const std::string& text, int n, double* out,
                std::string* error) {
-  std::stringstream ss(text);
-  std::string item;
-  int count = 0;
-  while (std::getline(ss, item, ',')) {
-    if (count >= n) break;
-    double v = 0.0;
-    std::string why;
-    if (!ParseNumberItem(item, &v, &why)) {
-      *error = "--" + name + ": " + why;
-      return false;
+  // Every item counts, an empty last one too: "0,0,140,5" and "0,0,140," are not 3 numbers.
+  std::vector<std::string> items(1);
+  for (char ch : text) {
+    if (ch == ',') {
+      items.emplace_back();
+    } else {
+      items.back() += ch;
     }
-    out[count++] = v;
   }
-  if (count != n || ss.rdbuf()->in_avail() > 0 || (!text.empty() && text.back() == ',')) {
+  if (static_cast<int>(items.size()) != n) {
     *error = "--" + name + " needs " + std::to_string(n) + " comma-separated numbers, got " +
              internal::Quote(text);
     return false;
+  }
+  for (int k = 0; k < n; ++k) {
+    std::string why;
+    if (!ParseNumberItem(items[k], &out[k], &why)) {
+      *error = "--" + name + ": " + why;
+      return false;
+    }
   }
   return true;
 }

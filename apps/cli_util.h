@@ -3,6 +3,7 @@
 #define FASTCAL_APPS_CLI_UTIL_H_
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <set>
 #include <string>
 #include <utility>
@@ -83,6 +84,12 @@ bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
 // nearest existing ancestor must take a new directory (a probe is made and removed).
 // False with a message starting "--<flag>=<dir>: " and naming the directory otherwise.
 bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error);
+
+// Where an output path really is: absolute, without a trailing '/', '.' or '..', and
+// through symbolic links, so that `--out=dir/`, `--out=.` and a link to an empty directory
+// put the results in that directory (a temporary sibling renamed over it), and so that two
+// flags naming one file can be told.
+std::filesystem::path ResolveOutputPath(const std::string& dir);
 
 // Parses one number of a comma-separated flag value by the rules of every fastcal file
 // (internal::ParseFiniteDecimal: decimal, '.' whatever the locale, finite; no hexadecimal);

@@ -4,10 +4,12 @@
 
 #include <cstring>
 #include <iostream>
+#include <new>
 #include <string>
 
 #include "cli_util.h"
 #include "commands.h"
+#include "fastcal/internal/quote.h"
 #include "fastcal/version.h"
 
 namespace fastcal::cli {
@@ -38,7 +40,8 @@ int main(int argc, char** argv) {
   FLAGS_logtostderr = true;
   if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
       !std::strcmp(argv[1], "help")) {
-    std::cout << kUsage;
+    // Asked for: the usage on stdout, exit 0; no command at all is a usage error.
+    (argc < 2 ? std::cerr : std::cout) << kUsage;
     return argc < 2 ? kExitUsage : 0;
   }
   if (!std::strcmp(argv[1], "--version")) {
@@ -46,11 +49,18 @@ int main(int argc, char** argv) {
     return 0;
   }
   const std::string command = argv[1];
-  if (command == "solve") return RunSolve(argc, argv);
-  if (command == "calibrate") return RunCalibrate(argc, argv);
-  if (command == "evaluate") return RunEvaluate(argc, argv);
-  if (command == "simulate") return RunSimulate(argc, argv);
-  if (command == "workspace") return RunWorkspace(argc, argv);
-  std::cerr << "fastcal: unknown command '" << command << "'\n\n" << kUsage;
+  try {
+    if (command == "solve") return RunSolve(argc, argv);
+    if (command == "calibrate") return RunCalibrate(argc, argv);
+    if (command == "evaluate") return RunEvaluate(argc, argv);
+    if (command == "simulate") return RunSimulate(argc, argv);
+    if (command == "workspace") return RunWorkspace(argc, argv);
+  } catch (const std::bad_alloc&) {
+    // Outputs are written last and atomically: nothing is left behind.
+    std::cerr << "fastcal " << command
+              << ": out of memory: the input or the flags ask for more than this machine has\n";
+    return kExitFailure;
+  }
+  std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command) << "\n\n" << kUsage;
   return kExitUsage;
 }

@@ -336,8 +336,8 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
   FocalAttitudeLaw law;
   law.tilt_fraction = FLAGS_tilt_fraction;
   if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
-  if (!std::isfinite(law.tilt_fraction)) {
-    *error = "--tilt-fraction must be finite";
+  if (!(law.tilt_fraction >= 0.0 && law.tilt_fraction <= 1.0)) {
+    *error = "--tilt-fraction must be in [0, 1] (got " + FormatDouble(law.tilt_fraction) + ")";
     return false;
   }
   if (FlagGiven("attitude-law") && FLAGS_attitude_law != "focal" && FLAGS_attitude_law != "none") {
@@ -437,8 +437,9 @@ bool WriteBoth(const std::string& csv_path, const Dataset& dataset, const std::s
 std::string Summary(const SimulationSummary& s, const SimulationOptions& options,
                     const std::string& csv_path, const std::string& yaml_path) {
   std::ostringstream out;
-  out << "fastcal simulate: " << s.samples << " samples -> " << csv_path << ", truth model -> "
-      << yaml_path << "\n  tension noise added, RMS per cable (kN):";
+  out << "fastcal simulate: " << s.samples << " samples -> " << internal::Escape(csv_path)
+      << ", truth model -> " << internal::Escape(yaml_path)
+      << "\n  tension noise added, RMS per cable (kN):";
   for (double v : s.tension_noise_rms_n) out << " " << FormatDouble(v / kNPerKn, 4);
   out << "\n  tension noise added, RMS per cable (%):";
   for (double v : s.tension_noise_rms_relative) out << " " << FormatDouble(100.0 * v, 4);

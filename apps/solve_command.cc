@@ -837,8 +837,9 @@ int RunSolve(int argc, char** argv) {
   }
   std::cerr << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose" : " poses");
   if (failures.count > 0) std::cerr << " (" << failures.count << " failed)";
-  std::cerr << ", model " << ModelName(FLAGS_model) << ", attitude " << attitude << "; "
-            << timing.str() << std::endl;
+  // Paths and flag text on the terminal: control bytes escaped.
+  std::cerr << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", attitude "
+            << internal::Escape(attitude) << "; " << timing.str() << std::endl;
   if (failures.count > 0) {
     std::cerr << "fastcal solve: " << failures.count << " of " << poses.size()
               << " poses failed; --keep-going wrote them with their status, message and empty "

@@ -11,6 +11,8 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "fastcal/plausibility.h"
+#include "fastcal/trajectory.h"
 #include "fastcal/version.h"
 #include "fastcal/workspace.h"
 
@@ -45,7 +47,7 @@ const char kHelp[] =
     R"(fastcal workspace: where the cabin can go with every cable within limits.
 
 Usage:
-  fastcal workspace [--min-tension-kn=50 --max-tension-kn=500] [--output=ws.csv]
+  fastcal workspace [--min-tension-kn=KN] [--max-tension-kn=KN] [--output=ws.csv]
                     [--html=ws.html] [options]
 
 Solves every node of a grid on the focal-sphere cap at the focal attitude law and says
@@ -144,6 +146,30 @@ bool SetOptionsFromFlags(WorkspaceOptions* o, std::string* error) {
   return false;
 }
 
+// Every node, on each layer, where the cabin can be (the limits of solve's trajectories
+// and of the data files): a focal radius of 1e6 m is a typo, not a map.
+bool CheckGridPlausible(const WorkspaceOptions& o, std::string* error) {
+  std::vector<Eigen::Vector3d> positions;
+  if (!FocalSpherePositions(o.grid, &positions, error)) return true;  // IsValid said why
+  const PlausibilityLimits limits;
+  const double radius_m = o.grid.focal_radius_m;
+  for (const Eigen::Vector3d& p : positions) {
+    for (double offset_m : {-o.radial_offset_m, 0.0, o.radial_offset_m}) {
+      const Eigen::Vector3d q =
+          o.grid.focal_centre_m + (p - o.grid.focal_centre_m) * ((radius_m + offset_m) / radius_m);
+      if (std::string why; !CheckPosition(q, limits, &why)) {
+        *error =
+            "--focal-radius, --focal-centre, --max-off-axis-deg and --radial-offset put a "
+            "node at (" +
+            FormatDouble(q[0]) + ", " + FormatDouble(q[1]) + ", " + FormatDouble(q[2]) +
+            ") m: " + why;
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 // "2881 nodes on the focal sphere: 2881 feasible, lower-end tensions 112.3 to 316 kN".
 std::string Summary(const WorkspaceMap& map) {
   std::ostringstream s;
@@ -185,6 +211,17 @@ int RunWorkspace(int argc, char** argv) {
     PrintError(kCommand, "--force applies to --output=FILE or --html=FILE");
     return kExitUsage;
   }
+  if (FLAGS_html == "-") {
+    PrintError(kCommand,
+               "--html=-: the map goes to a file; give its name (--output=- is the CSV "
+               "on standard output)");
+    return kExitUsage;
+  }
+  if (to_file && !FLAGS_html.empty() &&
+      ResolveOutputPath(FLAGS_output) == ResolveOutputPath(FLAGS_html)) {
+    PrintError(kCommand, "--output and --html name the same file; give two names");
+    return kExitUsage;
+  }
   if ((to_file && !CheckCanWrite("output", FLAGS_output, FLAGS_force, &error)) ||
       (!FLAGS_html.empty() && !CheckCanWrite("html", FLAGS_html, FLAGS_force, &error))) {
     PrintError(kCommand, error);
@@ -193,7 +230,7 @@ int RunWorkspace(int argc, char** argv) {
   CableRobot robot;
   WorkspaceOptions options;
   if (!LoadModelFlag("model", FLAGS_model, &robot, &error) ||
-      !SetOptionsFromFlags(&options, &error)) {
+      !SetOptionsFromFlags(&options, &error) || !CheckGridPlausible(options, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

@@ -2,6 +2,7 @@
 // that name the file, line, column or flag, no output left behind on failure, and the
 // calibrate -> evaluate round trip. The binary comes from $FASTCAL_BIN (set by CTest).
 #include <gtest/gtest.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 
 #include <algorithm>
@@ -956,6 +957,60 @@ TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
     }
   }
   EXPECT_FALSE(fs::exists(Path("o1")));
+}
+
+// What a fresh-eyes review of the hardened CLI found: each case failed before its fix.
+TEST_F(CliTest, FlagsAndOutputsFromTheReviewGiveClearMessages) {
+  struct Case {
+    std::string args;
+    int code;
+    std::string expected;
+  };
+  ASSERT_EQ(::mkfifo(Path("fifo").c_str(), 0600), 0);
+  Write("target.csv", "keep\n");
+  fs::create_symlink(Path("target.csv"), Path("link.csv"));
+  const std::vector<Case> cases = {
+      // A vector flag with one value too many (or a trailing comma) is not a vector.
+      {"solve --position=0,0,140,5", 2, "--position needs 3 comma-separated numbers"},
+      {"solve --position=0,0,140,", 2, "--position needs 3 comma-separated numbers"},
+      {"solve --position=0,0,140 --rpy=1,2,3,4", 2, "--rpy needs 3 comma-separated numbers"},
+      // A flag without its value: a fastcal message and exit 2, not gflags' exit 1.
+      {"solve --position", 2, "--position needs a value"},
+      // --force never replaces a pipe or a link with a plain file.
+      {"solve --position=0,0,140 --force --output=" + Path("fifo"), 2, "is not a regular file"},
+      {"solve --position=0,0,140 --force --output=" + Path("link.csv"), 2, "symbolic link"},
+      // Counts that would exhaust memory are refused by name.
+      {"solve --trajectory=line --nodes=100000000", 2, "nodes must be at most 10000000"},
+      {"solve --position=50,0,150 --attitude-law=focal --tilt-fraction=1.5", 2,
+       "--tilt-fraction must be in [0, 1]"},
+      {"workspace --output=" + Path("same.x") + " --html=" + Path("same.x"), 2,
+       "--output and --html name the same file"},
+      {"workspace --focal-radius=1e6", 2, "put a node at"},
+      {"workspace --html=-", 2, "--html=-: the map goes to a file"},
+  };
+  for (const Case& c : cases) {
+    const CommandResult r = Shell("timeout 60 " + Bin() + " " + c.args);
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output.substr(0, 2000);
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args << "\n"
+                                                            << r.output.substr(0, 2000);
+  }
+  EXPECT_TRUE(fs::is_symlink(Path("link.csv")));
+  EXPECT_EQ(fs::status(Path("fifo")).type(), fs::file_type::fifo);
+  EXPECT_FALSE(fs::exists(Path("same.x")));
+  EXPECT_FALSE(fs::exists("-"));
+
+  // --out with a trailing slash, or a link to an empty directory, fills that directory.
+  const std::string data = " --data=" + Source() + "/calibration_data/circle_paper.csv";
+  fs::create_directory(Path("empty"));
+  fs::create_directory(Path("real"));
+  fs::create_directory_symlink(Path("real"), Path("to_real"));
+  for (const std::string& out : {Path("empty") + "/", Path("to_real")}) {
+    const CommandResult r = Shell(Bin() + " evaluate" + data + " --out=" + out);
+    EXPECT_EQ(r.code, 0) << out << "\n" << r.output;
+  }
+  EXPECT_TRUE(fs::exists(Path("empty") + "/report.html"));
+  EXPECT_TRUE(fs::exists(Path("real") + "/report.html"));
+  EXPECT_TRUE(fs::is_symlink(Path("to_real")));
 }
 
 }  // namespace

@@ -71,5 +71,17 @@ TEST(PlausibilityTest, TensionsAnglesAndLengths) {
   EXPECT_EQ(why, "1e+06 m is above the plausible maximum of 1000 m");
 }
 
+// A value just beyond a limit is shown with the digits that make it differ from it.
+TEST(PlausibilityTest, ValuesJustBeyondALimitAreShownBeyondIt) {
+  const PlausibilityLimits limits;
+  std::string why;
+  EXPECT_FALSE(CheckPosition({0.0, 0.0, 300.00001}, limits, &why));
+  EXPECT_EQ(why, "z = 300.00001 m is above the tower tops (at most 300 m)");
+  EXPECT_FALSE(CheckTensionN(5000.0001e3, limits, &why));
+  EXPECT_EQ(why, "5000.0001 kN is above the plausible maximum of 5000 kN");
+  EXPECT_FALSE(CheckAngleDeg(-360.0000001, limits, &why));
+  EXPECT_EQ(why, "-360.0000001 deg is beyond the plausible +-360 deg");
+}
+
 }  // namespace
 }  // namespace fastcal

@@ -406,9 +406,11 @@ TEST(TrajectoryArguments, PoseErrorsNameTheParameter) {
   ExpectError(PosesWithIdentityAttitude(bad, &poses, &error), error, "positions[1]");
   const std::vector<Eigen::Vector3d> at_centre = {Eigen::Vector3d(0, 0, 150), kFocalCentre_m};
   ExpectError(PosesWithAttitudeLaw(at_centre, law, &poses, &error), error, "positions[1]");
-  law.tilt_fraction = NAN;
-  ExpectError(PosesWithAttitudeLaw({Eigen::Vector3d(0, 0, 150)}, law, &poses, &error), error,
-              "law.tilt_fraction");
+  for (double fraction : {static_cast<double>(NAN), -0.1, 1.5}) {
+    law.tilt_fraction = fraction;
+    ExpectError(PosesWithAttitudeLaw({Eigen::Vector3d(0, 0, 150)}, law, &poses, &error), error,
+                "law.tilt_fraction must be in [0, 1]");
+  }
   EXPECT_TRUE(poses.empty());
 }
 

@@ -24,8 +24,15 @@ constexpr double kDegToRad = M_PI / 180.0;
 // Tolerance, in degrees or in steps, when deciding whether an angle is a whole turn or a
 // whole number of steps.
 constexpr double kAngleTolerance = 1e-9;
-// Largest grid FocalSpherePositions builds: guards against a step typed too small.
+// Most positions one trajectory builds (grid, line, arc, random): guards against a step
+// or a count typed too large, which would exhaust memory (1e7 poses solve in ~15 s).
 constexpr double kMaxGridPositions = 1e7;
+constexpr int kMaxPositions = 10000000;
+
+std::string TooMany(const std::string& what, int count) {
+  return what + " must be at most " + std::to_string(kMaxPositions) + " (got " +
+         std::to_string(count) + ")";
+}
 
 bool Fail(std::string* error, const std::string& message) {
   if (error != nullptr) *error = message;
@@ -138,6 +145,7 @@ bool LinePositions(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, i
                    std::vector<Eigen::Vector3d>* positions, std::string* error) {
   if (positions == nullptr) return Fail(error, "positions must not be null");
   if (nodes < 2) return Fail(error, "nodes must be >= 2 (got " + std::to_string(nodes) + ")");
+  if (nodes > kMaxPositions) return Fail(error, TooMany("nodes", nodes));
   if (!from_m.allFinite()) return Fail(error, "from_m must be finite");
   if (!to_m.allFinite()) return Fail(error, "to_m must be finite");
   std::vector<Eigen::Vector3d> out;
@@ -159,6 +167,7 @@ bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions,
   }
   if (!std::isfinite(spec.start_deg)) return Fail(error, "start_deg must be finite");
   if (!std::isfinite(spec.end_deg)) return Fail(error, "end_deg must be finite");
+  if (spec.nodes > kMaxPositions) return Fail(error, TooMany("nodes", spec.nodes));
   if (spec.nodes < 2) {
     return Fail(error, "nodes must be >= 2 (got " + std::to_string(spec.nodes) + ")");
   }
@@ -226,6 +235,7 @@ bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d
 bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
                               std::vector<Eigen::Vector3d>* positions, std::string* error) {
   if (positions == nullptr) return Fail(error, "positions must not be null");
+  if (spec.samples > kMaxPositions) return Fail(error, TooMany("samples", spec.samples));
   if (spec.samples < 1) {
     return Fail(error, "samples must be >= 1 (got " + std::to_string(spec.samples) + ")");
   }
@@ -296,7 +306,9 @@ bool PosesWithAttitudeLaw(const std::vector<Eigen::Vector3d>& positions,
                           const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                           std::string* error) {
   if (poses == nullptr) return Fail(error, "poses must not be null");
-  if (!std::isfinite(law.tilt_fraction)) return Fail(error, "law.tilt_fraction must be finite");
+  if (!(law.tilt_fraction >= 0.0 && law.tilt_fraction <= 1.0)) {
+    return Fail(error, "law.tilt_fraction must be in [0, 1] (got " + Num(law.tilt_fraction) + ")");
+  }
   if (!law.focal_centre_m.allFinite()) return Fail(error, "law.focal_centre_m must be finite");
   if (!CheckPositions(positions, error)) return false;
   std::vector<Pose> out(positions.size());

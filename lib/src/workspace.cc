@@ -106,8 +106,12 @@ bool WorkspaceOptions::IsValid(std::string* error) const {
     return fail("max_tension_n must be above min_tension_n (got " + Num(max_tension_n) +
                 " <= " + Num(min_tension_n) + ")");
   }
-  if (!attitude_law.focal_centre_m.allFinite() || !std::isfinite(attitude_law.tilt_fraction)) {
-    return fail("attitude_law.focal_centre_m and attitude_law.tilt_fraction must be finite");
+  if (!attitude_law.focal_centre_m.allFinite()) {
+    return fail("attitude_law.focal_centre_m must be finite");
+  }
+  if (!(attitude_law.tilt_fraction >= 0.0 && attitude_law.tilt_fraction <= 1.0)) {
+    return fail("attitude_law.tilt_fraction must be in [0, 1] (got " +
+                Num(attitude_law.tilt_fraction) + ")");
   }
   if (!statics.IsValid(&why)) return fail("statics: " + why);
   return true;

@@ -40,7 +40,8 @@ Eigen::Vector4d QuaternionFromRotation(const Eigen::Matrix3d& rotation);  // (w,
 Eigen::Matrix3d RotationFromRotationVector(const Eigen::Vector3d& rotation_vector_rad);
 
 struct FocalAttitudeLaw {
-  // Fraction of the off-axis angle by which z' is tilted toward the focal-sphere centre.
+  // Fraction of the off-axis angle by which z' is tilted toward the focal-sphere centre,
+  // in [0, 1]: 0 keeps the cabin level, 1 points z' at the centre.
   double tilt_fraction = 0.41;
   // Centre of the focal sphere, global frame.
   Eigen::Vector3d focal_centre_m = Eigen::Vector3d(0.0, 0.0, 300.0);

@@ -27,7 +27,7 @@
 namespace fastcal {
 
 // `nodes` evenly spaced points from `from_m` to `to_m`, both ends included (exactly).
-// Requires nodes >= 2 and finite end points; equal end points give a stationary sequence.
+// Requires 2 <= nodes <= 1e7 and finite end points; equal end points give a stationary sequence.
 bool LinePositions(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, int nodes,
                    std::vector<Eigen::Vector3d>* positions, std::string* error);
 
@@ -41,7 +41,7 @@ struct ArcSpec {
   // seen from above); end_deg < start_deg runs clockwise. 0 < |end_deg - start_deg| <= 360.
   double start_deg = 0.0;
   double end_deg = 360.0;
-  // Number of nodes, >= 2.
+  // Number of nodes, 2 to 1e7.
   int nodes = 101;
 };
 
@@ -77,7 +77,7 @@ bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d
 
 // Random positions spread uniformly over the area of the focal sphere's lower cap.
 struct RandomWorkspaceSpec {
-  // Number of positions, >= 1.
+  // Number of positions, 1 to 1e7.
   int samples = 100;
   // Largest off-axis angle, in [0, 90]; sphere.max_off_axis_deg is not used.
   double max_off_axis_deg = 40.0;
