@@ -315,6 +315,9 @@ TEST(TrajectoryArguments, LineErrorsNameTheParameter) {
   std::vector<Eigen::Vector3d> p = {Eigen::Vector3d(9, 9, 9)};
   std::string error;
   ExpectError(LinePositions(a, b, 1, &p, &error), error, "nodes must be >= 2 (got 1)");
+  // A count that would exhaust memory is refused before anything is allocated.
+  constexpr int kTooMany = 10000001;
+  ExpectError(LinePositions(a, b, kTooMany, &p, &error), error, "nodes must be at most 10000000");
   ExpectError(LinePositions(Eigen::Vector3d(NAN, 0, 0), b, 5, &p, &error), error, "from_m");
   ExpectError(LinePositions(a, Eigen::Vector3d(0, INFINITY, 0), 5, &p, &error), error, "to_m");
   ExpectError(LinePositions(a, b, 5, nullptr, &error), error, "positions");
@@ -337,6 +340,8 @@ TEST(TrajectoryArguments, ArcErrorsNameTheParameter) {
   s = good;
   s.nodes = 1;
   ExpectError(ArcPositions(s, &p, &error), error, "nodes must be >= 2 (got 1)");
+  s.nodes = 10000001;
+  ExpectError(ArcPositions(s, &p, &error), error, "nodes must be at most 10000000");
   s = good;
   s.centre_m.x() = NAN;
   ExpectError(ArcPositions(s, &p, &error), error, "centre_m");
@@ -382,6 +387,8 @@ TEST(TrajectoryArguments, RandomErrorsNameTheParameter) {
   std::string error;
   RandomWorkspaceSpec s = RandomSpec(0, 1);
   ExpectError(RandomWorkspacePositions(s, &p, &error), error, "samples must be >= 1 (got 0)");
+  s = RandomSpec(10000001, 1);
+  ExpectError(RandomWorkspacePositions(s, &p, &error), error, "samples must be at most 10000000");
   s = RandomSpec(10, 1);
   s.max_off_axis_deg = -1.0;
   ExpectError(RandomWorkspacePositions(s, &p, &error), error, "max_off_axis_deg");
