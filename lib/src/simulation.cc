@@ -163,9 +163,8 @@ std::string Vec(const Eigen::Vector3d& v) {
   return "(" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + ")";
 }
 
-bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
-                  const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
-                  SimulationSummary* summary, std::string* error) {
+bool CheckInputs(const CableRobot& truth, const std::vector<Pose>& planned,
+                 const SimulationOptions& options, std::string* error) {
   if (!options.IsValid(error)) return false;
   std::string why;
   if (!truth.IsValid(&why)) return Fail(error, "truth model: " + why);
@@ -175,30 +174,141 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
       return Fail(error, "planned pose of node " + std::to_string(n) + " is not finite");
     }
   }
+  return true;
+}
 
+// The random processes along the run, one independent stream each (so that turning one
+// on leaves the others' draws unchanged), and the sums of squares the summary reports.
+struct Processes {
+  explicit Processes(const SimulationOptions& o)
+      : control_rng(o.seed, kAttitudeControlStream),
+        attitude_rng(o.seed, kAttitudeMeasurementStream),
+        position_rng(o.seed, kPositionStream),
+        tension_rng(o.seed, kTensionNoiseStream),
+        outlier_rng(o.seed, kOutlierStream),
+        drift_rng(o.seed, kTensionDriftStream),
+        mass_centre_rng(o.seed, kMassCentreDriftStream),
+        control(o.attitude_control_sigma_deg, o.attitude_control_time_s, o.sample_interval_s),
+        mass_centre_drift(o.mass_centre_drift_m, o.mass_centre_drift_time_s, o.sample_interval_s),
+        tension_drift(kNumCables, Ar1(o.tension_drift_percent / 100.0, o.tension_drift_time_s,
+                                      o.sample_interval_s)) {}
+  Random control_rng, attitude_rng, position_rng, tension_rng, outlier_rng, drift_rng,
+      mass_centre_rng;
+  Ar1Vector control, mass_centre_drift;
+  std::vector<Ar1> tension_drift;
+  // Sums over the samples.
+  Eigen::Vector3d mass_centre_sum = Eigen::Vector3d::Zero();
+  double mass_centre_sq = 0.0, control_sq = 0.0, attitude_sq = 0.0, position_sq = 0.0;
+  std::array<double, kNumCables> drift_sq{}, noise_sq{}, relative_sq{};
+};
+
+// The actual pose of sample n (the planned one with the control error) and its statics
+// with the model's mass centre drifted; *actual_rpy_deg for the measurement.
+bool SolveActual(size_t n, const Pose& planned_pose, const Eigen::Vector3d& planned_rpy_deg,
+                 const SimulationOptions& options, const Eigen::Vector3d& mass_centre_m,
+                 const StaticsOptions& statics, Processes* p, CableRobot* model,
+                 Eigen::Vector3d* actual_rpy_deg, StaticsSolution* solution, std::string* error) {
+  const Eigen::Vector3d control_deg = p->control.Next(&p->control_rng);
+  const Eigen::Vector3d drift_m = p->mass_centre_drift.Next(&p->mass_centre_rng);
+  model->mass_centre_cabin_m = mass_centre_m + drift_m;
+  p->mass_centre_sum += model->mass_centre_cabin_m;
+  p->mass_centre_sq += drift_m.squaredNorm();
+  p->control_sq += control_deg.squaredNorm();
+  *actual_rpy_deg = NoNegativeZero(planned_rpy_deg + control_deg);
+  Pose actual;
+  actual.position_m = planned_pose.position_m;
+  actual.rotation =
+      RotationFromRpyDeg((*actual_rpy_deg)[0], (*actual_rpy_deg)[1], (*actual_rpy_deg)[2]);
+  if (SolveStatics(*model, actual, statics, solution) == StaticsStatus::kOk) return true;
+  std::string message =
+      "node " + std::to_string(n) + " at position " + Vec(actual.position_m) + " m";
+  if (options.attitude_control_sigma_deg > 0.0) {
+    message += ", actual attitude rpy " + Vec(*actual_rpy_deg) + " deg";
+  }
+  return Fail(error, message + ": " + DescribeStatus(*solution) + " [truth model, method " +
+                         StaticsMethodName(options.method) + "]");
+}
+
+// The measured pose: the actual one with attitude and position noise.
+void MeasurePose(const Eigen::Vector3d& position_m, const Eigen::Vector3d& actual_rpy_deg,
+                 const SimulationOptions& options, Processes* p, Sample* s) {
+  const Eigen::Vector3d attitude_noise_deg =
+      options.attitude_measurement_sigma_deg * p->attitude_rng.Normal3();
+  s->measured_rpy_deg = NoNegativeZero(actual_rpy_deg + attitude_noise_deg);
+  s->pose.rotation =
+      RotationFromRpyDeg(s->measured_rpy_deg[0], s->measured_rpy_deg[1], s->measured_rpy_deg[2]);
+  const Eigen::Vector3d position_noise_m =
+      options.position_measurement_sigma_m * p->position_rng.Normal3();
+  s->pose.position_m = NoNegativeZero(position_m + position_noise_m);
+  p->attitude_sq += attitude_noise_deg.squaredNorm();
+  p->position_sq += position_noise_m.squaredNorm();
+}
+
+// The six readings of sample n: the sensor's reading of the true tension, with the slow
+// drift and the noise, or an outlier; the commanded s0 alongside.
+bool MeasureTensions(size_t n, const CableRobot& model, const StaticsSolution& solution,
+                     const SimulationOptions& options, Processes* p, SimulationSummary* stats,
+                     Sample* s, std::string* error) {
+  s->has_unstretched_lengths = true;
+  for (int i = 0; i < kNumCables; ++i) {
+    const double reading_n = model.cables[i].SensorReadingN(solution.cables[i].lower_tension_n);
+    if (!(reading_n > 0.0)) {
+      return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
+                             ": sensor reading gain * tension + bias = " +
+                             Num(reading_n / kNPerKn) + " kN is not > 0 (check the bias)");
+    }
+    const double drift = p->tension_drift[i].Next(&p->drift_rng);
+    p->drift_sq[i] += drift * drift;
+    // Both draws are made for every reading, outlier or not, to keep streams aligned.
+    const bool outlier = p->outlier_rng.Uniform01() < options.outlier_fraction;
+    const double outlier_u = 2.0 * p->outlier_rng.Uniform01() - 1.0;
+    double measured_n = 0.0;
+    for (int attempt = 0; !(measured_n > 0.0); ++attempt) {
+      if (attempt == kMaxRedraws) {
+        return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
+                               ": the tension noise keeps making the reading <= 0");
+      }
+      if (attempt > 0) ++stats->redrawn;
+      const double relative = options.tension_noise_percent / 100.0 * p->tension_rng.Normal();
+      const double absolute_n = options.tension_noise_kn * kNPerKn * p->tension_rng.Normal();
+      measured_n = outlier ? reading_n * (1.0 + options.outlier_scale_percent / 100.0 * outlier_u)
+                           : reading_n * (1.0 + relative + drift) + absolute_n;
+    }
+    s->tension_n[i] = measured_n;
+    s->unstretched_length_m[i] = solution.cables[i].unstretched_length_m;
+    stats->outliers[i] += outlier ? 1 : 0;
+    p->noise_sq[i] += (measured_n - reading_n) * (measured_n - reading_n);
+    p->relative_sq[i] += (measured_n / reading_n - 1.0) * (measured_n / reading_n - 1.0);
+  }
+  return true;
+}
+
+// The RMS figures of the summary from the sums over `count` samples.
+void Summarise(const Processes& p, double count, SimulationSummary* stats) {
+  for (int i = 0; i < kNumCables; ++i) {
+    stats->tension_noise_rms_n[i] = std::sqrt(p.noise_sq[i] / count);
+    stats->tension_noise_rms_relative[i] = std::sqrt(p.relative_sq[i] / count);
+    stats->tension_drift_rms_relative[i] = std::sqrt(p.drift_sq[i] / count);
+  }
+  stats->mass_centre_mean_m = p.mass_centre_sum / count;
+  stats->mass_centre_drift_rms_m = std::sqrt(p.mass_centre_sq / (3.0 * count));
+  stats->attitude_control_rms_deg = std::sqrt(p.control_sq / (3.0 * count));
+  stats->attitude_measurement_rms_deg = std::sqrt(p.attitude_sq / (3.0 * count));
+  stats->position_measurement_rms_m = std::sqrt(p.position_sq / (3.0 * count));
+}
+
+// Stages: check the inputs, draw the truth model, then per planned pose the actual pose
+// and its statics, the measured pose and the readings; last the summary.
+bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
+                  const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
+                  SimulationSummary* summary, std::string* error) {
+  if (!CheckInputs(truth, planned, options, error)) return false;
   SimulationSummary stats;
   stats.samples = static_cast<int>(planned.size());
-
-  // The truth model with what is drawn once.
   CableRobot model = truth;
   if (!DrawTruthModel(options, &model, &stats, error)) return false;
   const Eigen::Vector3d mass_centre_m = model.mass_centre_cabin_m;
-
-  Random control_rng(options.seed, kAttitudeControlStream);
-  Random attitude_rng(options.seed, kAttitudeMeasurementStream);
-  Random position_rng(options.seed, kPositionStream);
-  Random tension_rng(options.seed, kTensionNoiseStream);
-  Random outlier_rng(options.seed, kOutlierStream);
-  Random drift_rng(options.seed, kTensionDriftStream);
-  Random mass_centre_rng(options.seed, kMassCentreDriftStream);
-  const double dt = options.sample_interval_s;
-  Ar1Vector control(options.attitude_control_sigma_deg, options.attitude_control_time_s, dt);
-  Ar1Vector mass_centre_drift(options.mass_centre_drift_m, options.mass_centre_drift_time_s, dt);
-  std::vector<Ar1> tension_drift(
-      kNumCables, Ar1(options.tension_drift_percent / 100.0, options.tension_drift_time_s, dt));
-  Eigen::Vector3d mass_centre_sum = Eigen::Vector3d::Zero();
-  double mass_centre_sq = 0.0;
-  std::array<double, kNumCables> drift_sq{};
+  Processes processes(options);
 
   // Synthetic truth: converged per-cable solves, as a fit uses, plus s0.
   StaticsOptions statics = ModelFitStaticsOptions(options.method);
@@ -213,9 +323,6 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
   out.has_unstretched_lengths = true;
   out.attitude_as_quaternion = false;
   out.samples.resize(planned.size());
-
-  double control_sq = 0.0, attitude_sq = 0.0, position_sq = 0.0;
-  std::array<double, kNumCables> noise_sq{}, relative_sq{};
   for (size_t n = 0; n < planned.size(); ++n) {
     Sample& s = out.samples[n];
     s.time_s = static_cast<double>(n) * options.sample_interval_s;
@@ -223,84 +330,16 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
     s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned[n].rotation));
     s.planned_rotation =
         RotationFromRpyDeg(s.planned_rpy_deg[0], s.planned_rpy_deg[1], s.planned_rpy_deg[2]);
-
-    const Eigen::Vector3d control_deg = control.Next(&control_rng);
-    const Eigen::Vector3d drift_m = mass_centre_drift.Next(&mass_centre_rng);
-    model.mass_centre_cabin_m = mass_centre_m + drift_m;
-    mass_centre_sum += model.mass_centre_cabin_m;
-    mass_centre_sq += drift_m.squaredNorm();
-    const Eigen::Vector3d actual_rpy_deg = NoNegativeZero(s.planned_rpy_deg + control_deg);
-    Pose actual;
-    actual.position_m = planned[n].position_m;
-    actual.rotation = RotationFromRpyDeg(actual_rpy_deg[0], actual_rpy_deg[1], actual_rpy_deg[2]);
-    if (SolveStatics(model, actual, statics, &solution) != StaticsStatus::kOk) {
-      std::string message =
-          "node " + std::to_string(n) + " at position " + Vec(actual.position_m) + " m";
-      if (options.attitude_control_sigma_deg > 0.0) {
-        message += ", actual attitude rpy " + Vec(actual_rpy_deg) + " deg";
-      }
-      return Fail(error, message + ": " + DescribeStatus(solution) + " [truth model, method " +
-                             StaticsMethodName(options.method) + "]");
+    Eigen::Vector3d actual_rpy_deg;
+    if (!SolveActual(n, planned[n], s.planned_rpy_deg, options, mass_centre_m, statics, &processes,
+                     &model, &actual_rpy_deg, &solution, error)) {
+      return false;
     }
-
-    const Eigen::Vector3d attitude_noise_deg =
-        options.attitude_measurement_sigma_deg * attitude_rng.Normal3();
-    s.measured_rpy_deg = NoNegativeZero(actual_rpy_deg + attitude_noise_deg);
-    s.pose.rotation =
-        RotationFromRpyDeg(s.measured_rpy_deg[0], s.measured_rpy_deg[1], s.measured_rpy_deg[2]);
-    const Eigen::Vector3d position_noise_m =
-        options.position_measurement_sigma_m * position_rng.Normal3();
-    s.pose.position_m = NoNegativeZero(actual.position_m + position_noise_m);
-    control_sq += control_deg.squaredNorm();
-    attitude_sq += attitude_noise_deg.squaredNorm();
-    position_sq += position_noise_m.squaredNorm();
-
-    s.has_unstretched_lengths = true;
-    for (int i = 0; i < kNumCables; ++i) {
-      const CableProperties& cable = model.cables[i];
-      const double reading_n = cable.SensorReadingN(solution.cables[i].lower_tension_n);
-      if (!(reading_n > 0.0)) {
-        return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
-                               ": sensor reading gain * tension + bias = " +
-                               Num(reading_n / kNPerKn) + " kN is not > 0 (check the bias)");
-      }
-      const double drift = tension_drift[i].Next(&drift_rng);
-      drift_sq[i] += drift * drift;
-      // Both draws are made for every reading, outlier or not, to keep streams aligned.
-      const bool outlier = outlier_rng.Uniform01() < options.outlier_fraction;
-      const double outlier_u = 2.0 * outlier_rng.Uniform01() - 1.0;
-      double measured_n = 0.0;
-      for (int attempt = 0; !(measured_n > 0.0); ++attempt) {
-        if (attempt == kMaxRedraws) {
-          return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
-                                 ": the tension noise keeps making the reading <= 0");
-        }
-        if (attempt > 0) ++stats.redrawn;
-        const double relative = options.tension_noise_percent / 100.0 * tension_rng.Normal();
-        const double absolute_n = options.tension_noise_kn * kNPerKn * tension_rng.Normal();
-        measured_n = outlier ? reading_n * (1.0 + options.outlier_scale_percent / 100.0 * outlier_u)
-                             : reading_n * (1.0 + relative + drift) + absolute_n;
-      }
-      s.tension_n[i] = measured_n;
-      s.unstretched_length_m[i] = solution.cables[i].unstretched_length_m;
-      stats.outliers[i] += outlier ? 1 : 0;
-      noise_sq[i] += (measured_n - reading_n) * (measured_n - reading_n);
-      relative_sq[i] += (measured_n / reading_n - 1.0) * (measured_n / reading_n - 1.0);
-    }
+    MeasurePose(planned[n].position_m, actual_rpy_deg, options, &processes, &s);
+    if (!MeasureTensions(n, model, solution, options, &processes, &stats, &s, error)) return false;
   }
-
-  const double count = static_cast<double>(planned.size());
-  for (int i = 0; i < kNumCables; ++i) {
-    stats.tension_noise_rms_n[i] = std::sqrt(noise_sq[i] / count);
-    stats.tension_noise_rms_relative[i] = std::sqrt(relative_sq[i] / count);
-    stats.tension_drift_rms_relative[i] = std::sqrt(drift_sq[i] / count);
-  }
-  stats.mass_centre_mean_m = mass_centre_sum / count;
-  stats.mass_centre_drift_rms_m = std::sqrt(mass_centre_sq / (3.0 * count));
+  Summarise(processes, static_cast<double>(planned.size()), &stats);
   model.mass_centre_cabin_m = mass_centre_m;  // the truth written out: the mean
-  stats.attitude_control_rms_deg = std::sqrt(control_sq / (3.0 * count));
-  stats.attitude_measurement_rms_deg = std::sqrt(attitude_sq / (3.0 * count));
-  stats.position_measurement_rms_m = std::sqrt(position_sq / (3.0 * count));
 
   if (dataset != nullptr) *dataset = std::move(out);
   if (truth_used != nullptr) *truth_used = std::move(model);
