@@ -350,13 +350,12 @@ std::string FocalLawDescription(const FocalAttitudeLaw& law) {
          FormatDouble(c[0]) + "," + FormatDouble(c[1]) + "," + FormatDouble(c[2]) + " m)";
 }
 
-// The poses to solve from the pose, trajectory and attitude flags; *attitude says in words
-// which attitude they have (for the summary line).
-bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* error) {
-  FocalAttitudeLaw law;
-  law.tilt_fraction = FLAGS_tilt_fraction;
-  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
-  if (!std::isfinite(law.tilt_fraction)) {
+// The attitude flags shared by every kind of pose: the focal law's parameters, and at
+// most one of --rpy, --quat, --rotvec, --attitude-law.
+bool AttitudeLawFromFlags(FocalAttitudeLaw* law, std::string* error) {
+  law->tilt_fraction = FLAGS_tilt_fraction;
+  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law->focal_centre_m, error)) return false;
+  if (!std::isfinite(law->tilt_fraction)) {
     *error = "--tilt-fraction must be finite";
     return false;
   }
@@ -371,81 +370,93 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
     *error = "give at most one of --rpy, --quat, --rotvec, --attitude-law";
     return false;
   }
-  const bool focal = FLAGS_attitude_law == "focal";
-  const bool none = FLAGS_attitude_law == "none";
-  const std::string identity = "R = I (--attitude-law=none)";
+  return true;
+}
 
-  std::vector<Eigen::Vector3d> positions;
-  if (!FLAGS_poses.empty()) {
-    if (FLAGS_trajectory != "point" || !FLAGS_position.empty()) {
-      *error = "--poses cannot be combined with --position or --trajectory";
+constexpr char kIdentityByFlag[] = "R = I (--attitude-law=none)";
+
+// --poses=FILE: its poses, their attitudes replaced only by --attitude-law.
+bool PosesFromFile(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::string* attitude,
+                   std::string* error) {
+  if (FLAGS_trajectory != "point" || !FLAGS_position.empty()) {
+    *error = "--poses cannot be combined with --position or --trajectory";
+    return false;
+  }
+  if (!FLAGS_rpy.empty() || !FLAGS_quat.empty() || !FLAGS_rotvec.empty()) {
+    *error = "--poses brings its own attitudes; only --attitude-law=focal|none may override them";
+    return false;
+  }
+  if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
+  if (FLAGS_attitude_law == "focal") {
+    std::vector<Eigen::Vector3d> positions;
+    for (const Pose& p : *poses) positions.push_back(p.position_m);
+    *attitude = FocalLawDescription(law);
+    return PosesWithFocalLawFromFlags(positions, law, poses, error);
+  }
+  if (FLAGS_attitude_law == "none") {
+    for (Pose& p : *poses) p.rotation.setIdentity();
+    *attitude = kIdentityByFlag;
+  } else {
+    *attitude = "as in " + FLAGS_poses + " (R = I if it has no attitude columns)";
+  }
+  return true;
+}
+
+// The rotation of a single --position from --rpy, --quat or --rotvec; false with
+// *attitude untouched when none of them is given.
+bool ConstantRotationFromFlags(Eigen::Matrix3d* rotation, std::string* attitude,
+                               std::string* error) {
+  if (!FLAGS_rpy.empty()) {
+    Eigen::Vector3d rpy;
+    if (!ParseRpyDeg("rpy", FLAGS_rpy, &rpy, error)) return false;
+    *rotation = RotationFromRpyDeg(rpy[0], rpy[1], rpy[2]);
+    *attitude = "--rpy=" + FLAGS_rpy + " deg";
+  } else if (!FLAGS_quat.empty()) {
+    Eigen::Vector4d q;
+    if (!ParseVector4("quat", FLAGS_quat, &q, error)) return false;
+    std::string why;
+    if (!RotationFromQuaternion(q[0], q[1], q[2], q[3], rotation, &why)) {
+      *error = "--quat: " + why;
       return false;
     }
-    if (!FLAGS_rpy.empty() || !FLAGS_quat.empty() || !FLAGS_rotvec.empty()) {
-      *error = "--poses brings its own attitudes; only --attitude-law=focal|none may override them";
+    *attitude = "--quat=" + FLAGS_quat;
+  } else if (!FLAGS_rotvec.empty()) {
+    Eigen::Vector3d v;
+    std::string why;
+    if (!ParseVector3("rotvec", FLAGS_rotvec, &v, error)) return false;
+    if (!CheckRotationVector(v, PlausibilityLimits(), &why)) {
+      *error = "--rotvec=" + FLAGS_rotvec + ": " + why;
       return false;
     }
-    if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
-    if (focal) {
-      positions.clear();
-      for (const Pose& p : *poses) positions.push_back(p.position_m);
-      *attitude = FocalLawDescription(law);
-      return PosesWithFocalLawFromFlags(positions, law, poses, error);
-    }
-    if (none) {
-      for (Pose& p : *poses) p.rotation.setIdentity();
-      *attitude = identity;
-    } else {
-      *attitude = "as in " + FLAGS_poses + " (R = I if it has no attitude columns)";
-    }
+    *rotation = RotationFromRotationVector(v);
+    *attitude = "--rotvec=" + FLAGS_rotvec + " rad";
+  }
+  return true;
+}
+
+// --position=x,y,z with its attitude flag (R = I without one).
+bool SinglePose(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::string* attitude,
+                std::string* error) {
+  if (FLAGS_position.empty()) {
+    *error = "give --position=x,y,z, a --trajectory or --poses (see fastcal solve --help)";
+    return false;
+  }
+  Pose pose;
+  if (!ParsePosition("position", FLAGS_position, &pose.position_m, error)) return false;
+  if (FLAGS_attitude_law == "focal") {
+    if (!PosesWithFocalLawFromFlags({pose.position_m}, law, poses, error)) return false;
+    *attitude = FocalLawDescription(law);
     return true;
   }
+  *attitude = FLAGS_attitude_law == "none" ? kIdentityByFlag : "R = I (no attitude flag)";
+  if (!ConstantRotationFromFlags(&pose.rotation, attitude, error)) return false;
+  poses->assign(1, pose);
+  return true;
+}
 
-  if (FLAGS_trajectory == "point") {
-    Eigen::Vector3d position;
-    if (FLAGS_position.empty()) {
-      *error = "give --position=x,y,z, a --trajectory or --poses (see fastcal solve --help)";
-      return false;
-    }
-    if (!ParsePosition("position", FLAGS_position, &position, error)) return false;
-    Pose pose;
-    pose.position_m = position;
-    *attitude = "R = I (no attitude flag)";
-    if (!FLAGS_rpy.empty()) {
-      Eigen::Vector3d rpy;
-      if (!ParseRpyDeg("rpy", FLAGS_rpy, &rpy, error)) return false;
-      pose.rotation = RotationFromRpyDeg(rpy[0], rpy[1], rpy[2]);
-      *attitude = "--rpy=" + FLAGS_rpy + " deg";
-    } else if (!FLAGS_quat.empty()) {
-      Eigen::Vector4d q;
-      if (!ParseVector4("quat", FLAGS_quat, &q, error)) return false;
-      std::string why;
-      if (!RotationFromQuaternion(q[0], q[1], q[2], q[3], &pose.rotation, &why)) {
-        *error = "--quat: " + why;
-        return false;
-      }
-      *attitude = "--quat=" + FLAGS_quat;
-    } else if (!FLAGS_rotvec.empty()) {
-      Eigen::Vector3d v;
-      std::string why;
-      if (!ParseVector3("rotvec", FLAGS_rotvec, &v, error)) return false;
-      if (!CheckRotationVector(v, PlausibilityLimits(), &why)) {
-        *error = "--rotvec=" + FLAGS_rotvec + ": " + why;
-        return false;
-      }
-      pose.rotation = RotationFromRotationVector(v);
-      *attitude = "--rotvec=" + FLAGS_rotvec + " rad";
-    } else if (focal) {
-      if (!PosesWithFocalLawFromFlags({position}, law, poses, error)) return false;
-      *attitude = FocalLawDescription(law);
-      return true;
-    } else if (none) {
-      *attitude = identity;
-    }
-    poses->assign(1, pose);
-    return true;
-  }
-
+// --trajectory=line|arc|grid|random, flying the focal law unless --attitude-law=none.
+bool TrajectoryPoses(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::string* attitude,
+                     std::string* error) {
   if (!FLAGS_position.empty()) {
     *error = "--position is for a single pose; drop it or --trajectory";
     return false;
@@ -456,6 +467,7 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
         "attitude law (the default) or, with --attitude-law=none, R = I";
     return false;
   }
+  std::vector<Eigen::Vector3d> positions;
   bool known = false;
   const bool ok =
       TrajectoryPositionsFromFlags(FLAGS_trajectory, law.focal_centre_m, &positions, &known, error);
@@ -470,12 +482,23 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
   }
   // Trajectories fly the focal law unless told otherwise: that is how the telescope
   // moves, and what the paper's Tables 4 and 5 use.
-  if (none) {
-    *attitude = identity;
+  if (FLAGS_attitude_law == "none") {
+    *attitude = kIdentityByFlag;
     return PosesWithIdentityAttitude(positions, poses, error);
   }
-  *attitude = FocalLawDescription(law) + (focal ? "" : ", the default for trajectories");
+  *attitude = FocalLawDescription(law) +
+              (FLAGS_attitude_law == "focal" ? "" : ", the default for trajectories");
   return PosesWithFocalLawFromFlags(positions, law, poses, error);
+}
+
+// The poses to solve from the pose, trajectory and attitude flags; *attitude says in words
+// which attitude they have (for the summary line).
+bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* error) {
+  FocalAttitudeLaw law;
+  if (!AttitudeLawFromFlags(&law, error)) return false;
+  if (!FLAGS_poses.empty()) return PosesFromFile(law, poses, attitude, error);
+  if (FLAGS_trajectory == "point") return SinglePose(law, poses, attitude, error);
+  return TrajectoryPoses(law, poses, attitude, error);
 }
 
 // Refuses a flag given for another mode than this command line's (a trajectory's
