@@ -335,21 +335,109 @@ bool PosesWithIdentityAttitude(const std::vector<Eigen::Vector3d>& positions,
   return true;
 }
 
+// Where each known column stands in a pose file, and which attitude it gives.
+struct PoseColumns {
+  std::array<int, kNumColumns> index;
+  size_t num_fields = 0;
+  bool has_rpy = false;
+  bool has_quaternion = false;
+};
+
+// The header line: known or ignored (dataset) columns, each once; x, y, z and at most one
+// complete attitude group. `where` is "path:line: ".
+bool ParsePoseHeader(const std::string& line, const std::vector<std::string_view>& fields,
+                     const std::string& where, PoseColumns* columns, std::string* error) {
+  const std::string separator_error = internal::WrongSeparatorMessage(line);
+  if (!separator_error.empty()) return Fail(error, where + separator_error);
+  std::array<int, kNumColumns>& index = columns->index;
+  index.fill(-1);
+  columns->num_fields = fields.size();
+  const std::vector<std::string> ignored = IgnoredDatasetColumns();
+  std::set<std::string_view> seen_ignored;
+  for (size_t i = 0; i < fields.size(); ++i) {
+    const std::string column = "column " + std::to_string(i + 1);
+    if (fields[i].empty()) return Fail(error, where + column + ": empty column name");
+    bool known = false;
+    for (int c = 0; c < kNumColumns; ++c) {
+      if (fields[i] != kColumnNames[c]) continue;
+      if (index[c] >= 0) return Fail(error, where + "duplicate column '" + kColumnNames[c] + "'");
+      index[c] = static_cast<int>(i);
+      known = true;
+    }
+    for (const std::string& name : ignored) {
+      if (fields[i] != name) continue;
+      if (!seen_ignored.insert(fields[i]).second) {
+        return Fail(error, where + "duplicate column '" + name + "'");
+      }
+      known = true;
+    }
+    if (!known) {
+      return Fail(error, where + column + " " + internal::Quote(fields[i]) +
+                             ": unknown column name (accepted: " + AcceptedColumns() + ")");
+    }
+  }
+  columns->has_rpy = index[kRoll] >= 0 || index[kPitch] >= 0 || index[kYaw] >= 0;
+  columns->has_quaternion =
+      index[kQw] >= 0 || index[kQx] >= 0 || index[kQy] >= 0 || index[kQz] >= 0;
+  if (columns->has_rpy && columns->has_quaternion) {
+    return Fail(error, where +
+                           "both roll/pitch/yaw and quaternion (qw,qx,qy,qz) columns; give "
+                           "one attitude");
+  }
+  std::vector<int> required = {kX, kY, kZ};
+  if (columns->has_rpy) required.insert(required.end(), {kRoll, kPitch, kYaw});
+  if (columns->has_quaternion) required.insert(required.end(), {kQw, kQx, kQy, kQz});
+  for (int c : required) {
+    if (index[c] < 0) return Fail(error, where + "missing column '" + kColumnNames[c] + "'");
+  }
+  return true;
+}
+
+// One data row: numbers, plausible angles and position, a unit quaternion; *time_s is
+// set when the file has time_s.
+bool ParsePoseRow(const std::vector<std::string_view>& fields, const std::string& where,
+                  const PoseColumns& columns, const PlausibilityLimits& limits, Pose* pose,
+                  double* time_s, std::string* error) {
+  if (fields.size() != columns.num_fields) {
+    return Fail(error, where + "expected " + std::to_string(columns.num_fields) +
+                           " fields (as in the header), got " + std::to_string(fields.size()));
+  }
+  const std::array<int, kNumColumns>& index = columns.index;
+  std::array<double, kNumColumns> values{};
+  for (int c = 0; c < kNumColumns; ++c) {
+    if (index[c] < 0) continue;
+    std::string why;
+    if (!ParseNumber(fields[index[c]], &values[c], &why) ||
+        (c >= kRoll && c <= kYaw && !CheckAngleDeg(values[c], limits, &why))) {
+      return Fail(error, where + "column '" + kColumnNames[c] + "': " + why);
+    }
+  }
+  pose->position_m = Eigen::Vector3d(values[kX], values[kY], values[kZ]);
+  if (std::string why; !CheckPosition(pose->position_m, limits, &why)) {
+    return Fail(error, where + "columns 'x_m,y_m,z_m': " + why);
+  }
+  if (columns.has_rpy) {
+    pose->rotation = RotationFromRpyDeg(values[kRoll], values[kPitch], values[kYaw]);
+  } else if (columns.has_quaternion) {
+    std::string why;
+    if (!RotationFromQuaternion(values[kQw], values[kQx], values[kQy], values[kQz], &pose->rotation,
+                                &why)) {
+      return Fail(error, where + "columns 'qw,qx,qy,qz': " + why);
+    }
+  }
+  *time_s = values[kTime];
+  return true;
+}
+
 bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector<Pose>* poses,
                    std::vector<double>* times_s, std::string* error) {
   if (poses == nullptr) return Fail(error, "poses must not be null");
   std::istringstream in(text);
   const PlausibilityLimits limits;  // as for a dataset, by default
-
-  std::array<int, kNumColumns> index;
-  index.fill(-1);
-  size_t num_fields = 0;
+  PoseColumns columns;
   bool has_header = false;
-  bool has_rpy = false;
-  bool has_quaternion = false;
   std::vector<Pose> out_poses;
   std::vector<double> out_times;
-
   std::string line;
   long line_number = 0;
   while (std::getline(in, line)) {
@@ -359,85 +447,16 @@ bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector
     if (IsSkipped(line)) continue;
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
     const std::vector<std::string_view> fields = SplitFields(line);
-
     if (!has_header) {
-      const std::string separator_error = internal::WrongSeparatorMessage(line);
-      if (!separator_error.empty()) return Fail(error, where + separator_error);
+      if (!ParsePoseHeader(line, fields, where, &columns, error)) return false;
       has_header = true;
-      num_fields = fields.size();
-      const std::vector<std::string> ignored = IgnoredDatasetColumns();
-      std::set<std::string_view> seen_ignored;
-      for (size_t i = 0; i < fields.size(); ++i) {
-        const std::string column = "column " + std::to_string(i + 1);
-        if (fields[i].empty()) return Fail(error, where + column + ": empty column name");
-        bool known = false;
-        for (int c = 0; c < kNumColumns; ++c) {
-          if (fields[i] != kColumnNames[c]) continue;
-          if (index[c] >= 0) {
-            return Fail(error, where + "duplicate column '" + kColumnNames[c] + "'");
-          }
-          index[c] = static_cast<int>(i);
-          known = true;
-        }
-        for (const std::string& name : ignored) {
-          if (fields[i] != name) continue;
-          if (!seen_ignored.insert(fields[i]).second) {
-            return Fail(error, where + "duplicate column '" + name + "'");
-          }
-          known = true;
-        }
-        if (!known) {
-          return Fail(error, where + column + " " + internal::Quote(fields[i]) +
-                                 ": unknown column name (accepted: " + AcceptedColumns() + ")");
-        }
-      }
-      has_rpy = index[kRoll] >= 0 || index[kPitch] >= 0 || index[kYaw] >= 0;
-      has_quaternion = index[kQw] >= 0 || index[kQx] >= 0 || index[kQy] >= 0 || index[kQz] >= 0;
-      if (has_rpy && has_quaternion) {
-        return Fail(error, where +
-                               "both roll/pitch/yaw and quaternion (qw,qx,qy,qz) columns; give "
-                               "one attitude");
-      }
-      std::vector<int> required = {kX, kY, kZ};
-      if (has_rpy) required.insert(required.end(), {kRoll, kPitch, kYaw});
-      if (has_quaternion) required.insert(required.end(), {kQw, kQx, kQy, kQz});
-      for (int c : required) {
-        if (index[c] < 0) {
-          return Fail(error, where + "missing column '" + kColumnNames[c] + "'");
-        }
-      }
       continue;
     }
-
-    if (fields.size() != num_fields) {
-      return Fail(error, where + "expected " + std::to_string(num_fields) +
-                             " fields (as in the header), got " + std::to_string(fields.size()));
-    }
-    std::array<double, kNumColumns> values{};
-    for (int c = 0; c < kNumColumns; ++c) {
-      if (index[c] < 0) continue;
-      std::string why;
-      if (!ParseNumber(fields[index[c]], &values[c], &why) ||
-          (c >= kRoll && c <= kYaw && !CheckAngleDeg(values[c], limits, &why))) {
-        return Fail(error, where + "column '" + kColumnNames[c] + "': " + why);
-      }
-    }
     Pose pose;
-    pose.position_m = Eigen::Vector3d(values[kX], values[kY], values[kZ]);
-    if (std::string why; !CheckPosition(pose.position_m, limits, &why)) {
-      return Fail(error, where + "columns 'x_m,y_m,z_m': " + why);
-    }
-    if (has_rpy) {
-      pose.rotation = RotationFromRpyDeg(values[kRoll], values[kPitch], values[kYaw]);
-    } else if (has_quaternion) {
-      std::string why;
-      if (!RotationFromQuaternion(values[kQw], values[kQx], values[kQy], values[kQz],
-                                  &pose.rotation, &why)) {
-        return Fail(error, where + "columns 'qw,qx,qy,qz': " + why);
-      }
-    }
+    double time_s = 0.0;
+    if (!ParsePoseRow(fields, where, columns, limits, &pose, &time_s, error)) return false;
     out_poses.push_back(pose);
-    if (index[kTime] >= 0) out_times.push_back(values[kTime]);
+    if (columns.index[kTime] >= 0) out_times.push_back(time_s);
   }
   if (!has_header) return Fail(error, path + ": no header line (empty file)");
   if (out_poses.empty()) return Fail(error, path + ": no data rows");
