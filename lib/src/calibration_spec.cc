@@ -798,94 +798,89 @@ std::vector<std::string> AxisLines(const CalibrationSpec& spec, const GroupInfo&
 
 }  // namespace
 
+namespace {
+
+// The first problem with the spec's options (everything but the parameters), as
+// "field: why"; empty when there is none.
+std::string OptionsProblem(const CalibrationSpec& s) {
+  if (!IsKnownMethod(s.forward_model)) return "forward_model: unknown statics method";
+  const bool known_loss = s.robust_loss == RobustLoss::kNone ||
+                          s.robust_loss == RobustLoss::kHuber ||
+                          s.robust_loss == RobustLoss::kCauchy;
+  // In the order of the spec file's documentation; each check gives "" or why.
+  const std::pair<const char*, std::string> checks[] = {
+      {"tension_sigma_n", CheckNonNegative(s.tension_sigma_n)},
+      {"tension_sigma_percent", CheckNonNegative(s.tension_sigma_percent)},
+      {"noise", s.tension_sigma_n == 0.0 && s.tension_sigma_percent == 0.0 ? kBothNoiseZero : ""},
+      {"robust_loss", known_loss ? "" : "unknown loss"},
+      {"robust_loss_scale", CheckPositive(s.robust_loss_scale)},
+      {"holdout_fraction", CheckHoldoutFraction(s.holdout_fraction)},
+      {"holdout_blocks", CheckAtLeastTwo(s.holdout_blocks)},
+      {"cross_validation_blocks", CheckAtLeastTwo(s.cross_validation_blocks)},
+      {"gross_error_threshold_sigmas", CheckPositive(s.gross_error_threshold_sigmas)},
+      {"max_gross_error_fraction", CheckFraction(s.max_gross_error_fraction)},
+      {"max_iterations", CheckAtLeastOne(s.max_iterations)},
+      {"num_threads", CheckAtLeastOne(s.num_threads)},
+      {"function_tolerance", CheckPositive(s.function_tolerance)},
+      {"gradient_tolerance", CheckPositive(s.gradient_tolerance)},
+      {"parameter_tolerance", CheckPositive(s.parameter_tolerance)},
+  };
+  for (const auto& [name, why] : checks) {
+    if (!why.empty()) return std::string(name) + ": " + why;
+  }
+  return "";
+}
+
+// The first problem with one listed parameter on its own (kind, index, component, initial
+// value, prior), as "label: why"; empty when there is none.
+std::string ParameterProblem(const ParameterSpec& p, const std::string& label) {
+  if (InfoOf(p.kind) == nullptr) return label + ": unknown parameter kind";
+  if (p.name.empty()) return label + ": has no name";
+  if (IsVector(p.kind) && (p.component < 0 || p.component > 2)) {
+    return label + ": component must be 0, 1 or 2 (x, y, z)";
+  }
+  if (IsPerCableCapable(p.kind) && (p.index < -1 || p.index >= kNumCables)) {
+    return label + ": index must be -1 (all cables) or a cable 0..5";
+  }
+  if (p.kind == ParameterKind::kAnchorOffset && p.index < 0) {
+    return label + ": index must be an anchor point >= 0";
+  }
+  if (p.kind == ParameterKind::kTowerOffset && (p.index < 0 || p.index >= kNumCables)) {
+    return label + ": index must be a tower 0..5";
+  }
+  if (!(std::isfinite(p.to_si) && p.to_si > 0.0)) return label + ": to_si must be > 0";
+  if (p.has_initial) {
+    if (const std::string w = CheckInitial(p.kind, p.initial_si); !w.empty()) {
+      return label + ".initial: " + w;
+    }
+  }
+  if (p.has_prior) {
+    if (const std::string w = CheckPriorMean(p.prior_mean_si); !w.empty()) {
+      return label + ".prior.mean: " + w;
+    }
+    if (const std::string w = CheckPositive(p.prior_sigma_si); !w.empty()) {
+      return label + ".prior.sigma: " + w;
+    }
+  }
+  return "";
+}
+
+}  // namespace
+
 bool CalibrationSpec::IsValid(std::string* error) const {
   auto fail = [error](const std::string& what) {
     if (error != nullptr) *error = what;
     return false;
   };
-  if (!IsKnownMethod(forward_model)) return fail("forward_model: unknown statics method");
-  if (const std::string w = CheckNonNegative(tension_sigma_n); !w.empty()) {
-    return fail("tension_sigma_n: " + w);
-  }
-  if (const std::string w = CheckNonNegative(tension_sigma_percent); !w.empty()) {
-    return fail("tension_sigma_percent: " + w);
-  }
-  if (tension_sigma_n == 0.0 && tension_sigma_percent == 0.0) {
-    return fail(std::string("noise: ") + kBothNoiseZero);
-  }
-  if (robust_loss != RobustLoss::kNone && robust_loss != RobustLoss::kHuber &&
-      robust_loss != RobustLoss::kCauchy) {
-    return fail("robust_loss: unknown loss");
-  }
-  if (const std::string w = CheckPositive(robust_loss_scale); !w.empty()) {
-    return fail("robust_loss_scale: " + w);
-  }
-  if (const std::string w = CheckHoldoutFraction(holdout_fraction); !w.empty()) {
-    return fail("holdout_fraction: " + w);
-  }
-  if (const std::string w = CheckAtLeastTwo(holdout_blocks); !w.empty()) {
-    return fail("holdout_blocks: " + w);
-  }
-  if (const std::string w = CheckAtLeastTwo(cross_validation_blocks); !w.empty()) {
-    return fail("cross_validation_blocks: " + w);
-  }
-  if (const std::string w = CheckPositive(gross_error_threshold_sigmas); !w.empty()) {
-    return fail("gross_error_threshold_sigmas: " + w);
-  }
-  if (const std::string w = CheckFraction(max_gross_error_fraction); !w.empty()) {
-    return fail("max_gross_error_fraction: " + w);
-  }
-  if (const std::string w = CheckAtLeastOne(max_iterations); !w.empty()) {
-    return fail("max_iterations: " + w);
-  }
-  if (const std::string w = CheckAtLeastOne(num_threads); !w.empty()) {
-    return fail("num_threads: " + w);
-  }
-  const std::pair<const char*, double> kTolerances[] = {
-      {"function_tolerance", function_tolerance},
-      {"gradient_tolerance", gradient_tolerance},
-      {"parameter_tolerance", parameter_tolerance}};
-  for (const auto& [name, value] : kTolerances) {
-    if (const std::string w = CheckPositive(value); !w.empty()) {
-      return fail(std::string(name) + ": " + w);
-    }
-  }
-
-  // (kind, index, component) with the fields that do not apply set to -1.
+  if (const std::string w = OptionsProblem(*this); !w.empty()) return fail(w);
+  // Across parameters: none listed twice, as (kind, index, component) with the fields that
+  // do not apply set to -1, and no group both common and per cable.
   std::set<std::tuple<int, int, int>> seen;
   std::set<int> kinds_common, kinds_per_cable;
   for (size_t k = 0; k < parameters.size(); ++k) {
     const ParameterSpec& p = parameters[k];
     const std::string label = p.name.empty() ? "parameters[" + std::to_string(k) + "]" : p.name;
-    const GroupInfo* g = InfoOf(p.kind);
-    if (g == nullptr) return fail(label + ": unknown parameter kind");
-    if (p.name.empty()) return fail(label + ": has no name");
-    if (IsVector(p.kind) && (p.component < 0 || p.component > 2)) {
-      return fail(label + ": component must be 0, 1 or 2 (x, y, z)");
-    }
-    if (IsPerCableCapable(p.kind) && (p.index < -1 || p.index >= kNumCables)) {
-      return fail(label + ": index must be -1 (all cables) or a cable 0..5");
-    }
-    if (p.kind == ParameterKind::kAnchorOffset && p.index < 0) {
-      return fail(label + ": index must be an anchor point >= 0");
-    }
-    if (p.kind == ParameterKind::kTowerOffset && (p.index < 0 || p.index >= kNumCables)) {
-      return fail(label + ": index must be a tower 0..5");
-    }
-    if (!(std::isfinite(p.to_si) && p.to_si > 0.0)) return fail(label + ": to_si must be > 0");
-    if (p.has_initial) {
-      if (const std::string w = CheckInitial(p.kind, p.initial_si); !w.empty()) {
-        return fail(label + ".initial: " + w);
-      }
-    }
-    if (p.has_prior) {
-      if (const std::string w = CheckPriorMean(p.prior_mean_si); !w.empty()) {
-        return fail(label + ".prior.mean: " + w);
-      }
-      if (const std::string w = CheckPositive(p.prior_sigma_si); !w.empty()) {
-        return fail(label + ".prior.sigma: " + w);
-      }
-    }
+    if (const std::string w = ParameterProblem(p, label); !w.empty()) return fail(w);
     const bool indexed =
         p.kind != ParameterKind::kMassCentre && p.kind != ParameterKind::kCabinMass;
     const auto key = std::make_tuple(static_cast<int>(p.kind), indexed ? p.index : -1,
@@ -895,7 +890,7 @@ bool CalibrationSpec::IsValid(std::string* error) const {
       (p.index < 0 ? kinds_common : kinds_per_cable).insert(static_cast<int>(p.kind));
       if (kinds_common.count(static_cast<int>(p.kind)) != 0 &&
           kinds_per_cable.count(static_cast<int>(p.kind)) != 0) {
-        return fail(label + ": " + g->key +
+        return fail(label + ": " + InfoOf(p.kind)->key +
                     " is listed both for all cables (common) and per cable; choose one mode");
       }
     }
