@@ -387,33 +387,29 @@ bool CorrelationUsable(const CalibrationResult& r) {
   return r.covariance_ok && n > 0 && r.correlation.rows() == n && r.correlation.cols() == n;
 }
 
-void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* doc) {
-  doc->Heading(2, "Identifiability");
-  doc->Paragraph(
-      "Singular values s of the whitened Jacobian (data and prior rows) with unit-norm "
-      "columns, relative to the largest (s/s1). A small ratio is a combination of parameters "
-      "the measurements barely change: below " +
-      Sig3(kDefaultPoorlyDeterminedRatio) + " it is reported as poorly determined, below " +
-      Sig3(kDefaultUndeterminedRatio) +
-      " as undetermined (default thresholds). \"Data alone\" leaves the priors out.");
+// The singular-value ratios before, after, and of the data alone, side by side.
+void AddSingularValueTable(const CalibrationResult& r, Document* doc) {
   const size_t rows =
       std::max({r.before.singular_value_ratios.size(), r.after.singular_value_ratios.size(),
                 r.data_only.singular_value_ratios.size()});
-  if (rows > 0) {
-    Table t;
-    t.header = {"k", "s/s1 before (with priors)", "s/s1 after (with priors)",
-                "s/s1 after (data alone)"};
-    t.right_align = {true, true, true, true};
-    auto cell = [](const std::vector<double>& v, size_t k) -> Text {
-      return k < v.size() ? Text(Printf("%.3g", v[k])) : Text("-");
-    };
-    for (size_t k = 0; k < rows; ++k) {
-      t.rows.push_back({Int(static_cast<long long>(k + 1)), cell(r.before.singular_value_ratios, k),
-                        cell(r.after.singular_value_ratios, k),
-                        cell(r.data_only.singular_value_ratios, k)});
-    }
-    doc->AddTable(std::move(t));
+  if (rows == 0) return;
+  Table t;
+  t.header = {"k", "s/s1 before (with priors)", "s/s1 after (with priors)",
+              "s/s1 after (data alone)"};
+  t.right_align = {true, true, true, true};
+  auto cell = [](const std::vector<double>& v, size_t k) -> Text {
+    return k < v.size() ? Text(Printf("%.3g", v[k])) : Text("-");
+  };
+  for (size_t k = 0; k < rows; ++k) {
+    t.rows.push_back({Int(static_cast<long long>(k + 1)), cell(r.before.singular_value_ratios, k),
+                      cell(r.after.singular_value_ratios, k),
+                      cell(r.data_only.singular_value_ratios, k)});
   }
+  doc->AddTable(std::move(t));
+}
+
+// The undetermined and poorly determined directions, or that there are none.
+void AddWeakDirections(const CalibrationResult& r, Document* doc) {
   // One item per direction: lead, the direction, its ratio in parentheses, the tail.
   std::vector<Text> items;
   auto add = [&items](const std::vector<ParameterDirection>& directions, const Text& lead,
@@ -450,6 +446,11 @@ void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* d
                   "inform them less than the prior does.");
   }
   doc->List(std::move(items));
+}
+
+// Strongly correlated pairs, and the correlation matrix (a table in Markdown, a heatmap
+// in HTML).
+void AddCorrelations(const CalibrationResult& r, bool with_plots, Document* doc) {
   if (!r.strong_correlations.empty()) {
     std::vector<Text> pairs;
     for (const std::string& c : r.strong_correlations) pairs.push_back(Text().Code(c));
@@ -463,7 +464,6 @@ void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* d
   }
   if (!CorrelationUsable(r)) return;
   const std::vector<std::vector<double>> m = CorrelationRows(r);
-  // Markdown: the matrix as a table; HTML: a heatmap.
   Table t;
   t.caption = "Correlation of the estimates";
   t.header.push_back("");
@@ -488,6 +488,20 @@ void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* d
                 "Correlation of the free parameters' estimates (1: move together, -1: "
                 "opposite, 0: independent).");
   }
+}
+
+void AddIdentifiability(const CalibrationResult& r, bool with_plots, Document* doc) {
+  doc->Heading(2, "Identifiability");
+  doc->Paragraph(
+      "Singular values s of the whitened Jacobian (data and prior rows) with unit-norm "
+      "columns, relative to the largest (s/s1). A small ratio is a combination of parameters "
+      "the measurements barely change: below " +
+      Sig3(kDefaultPoorlyDeterminedRatio) + " it is reported as poorly determined, below " +
+      Sig3(kDefaultUndeterminedRatio) +
+      " as undetermined (default thresholds). \"Data alone\" leaves the priors out.");
+  AddSingularValueTable(r, doc);
+  AddWeakDirections(r, doc);
+  AddCorrelations(r, with_plots, doc);
 }
 
 // Which rows a statistics table has: each variant's statistics on the fitted (or all)
