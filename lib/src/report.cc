@@ -1022,6 +1022,7 @@ code { background: #f0f1f3; padding: 0 3px; border-radius: 3px; overflow-wrap: a
 td code, th code { overflow-wrap: normal; }  /* names whole; long commands wrap at spaces */
 pre { background: #f6f7f9; border: 1px solid #e1e4e8; padding: 10px 12px; overflow-x: auto; }
 table { border-collapse: collapse; margin: 8px 0 18px; font-variant-numeric: tabular-nums; }
+.table-scroll { max-width: 100%; overflow-x: auto; }
 caption { caption-side: top; text-align: left; font-weight: bold; padding: 4px 0; }
 th, td { border: 1px solid #d7dbe0; padding: 3px 9px; vertical-align: top; }
 th { background: #eef0f3; text-align: left; font-weight: 600; }
@@ -1041,6 +1042,7 @@ summary { cursor: pointer; font-weight: 600; }
   details > * { display: block; }
   pre, code { white-space: pre-wrap; overflow-wrap: anywhere; }
   table, figure, pre { break-inside: avoid; }
+  .table-scroll { overflow-x: visible; }
   h2 { break-after: avoid; }
 }
 )";
@@ -1092,7 +1094,9 @@ std::string RenderHtml(const Document& doc) {
         auto cls = [&t](size_t c) {
           return c < t.right_align.size() && t.right_align[c] ? " class=\"num\"" : "";
         };
-        out += "<table>\n";
+        // Wide tables (the budget's columns per consider group) scroll inside the page on a
+        // narrow window instead of running past it.
+        out += "<div class=\"table-scroll\">\n<table>\n";
         if (!t.caption.spans().empty()) out += "<caption>" + HtmlInline(t.caption) + "</caption>\n";
         out += "<thead><tr>";
         for (size_t c = 0; c < t.header.size(); ++c) {
@@ -1106,7 +1110,7 @@ std::string RenderHtml(const Document& doc) {
           }
           out += "</tr>\n";
         }
-        out += "</tbody>\n</table>\n";
+        out += "</tbody>\n</table>\n</div>\n";
         break;
       }
       case Block::kPre:
