@@ -42,6 +42,12 @@ bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
                                 const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                                 std::string* error);
 
+// The poses of --poses=FILE (solve, simulate) under --attitude-law: "focal" replaces the
+// file's attitudes by the law's, "none" by R = I, "" keeps them.
+bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitude_law,
+                              const FocalAttitudeLaw& law, std::vector<Pose>* poses,
+                              std::string* error);
+
 // Sets the model-range limits of `options` from --max-strain, --max-length-ratio and
 // --reflector-clearance (solve, workspace); false with the flags named when invalid.
 bool ModelRangeFromFlags(StaticsOptions* options, std::string* error);

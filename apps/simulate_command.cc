@@ -353,16 +353,7 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
   if (!CheckFlagsApplyToTrajectory(trajectory, error)) return false;
 
   if (trajectory == "poses") {
-    if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
-    if (FLAGS_attitude_law == "focal") {
-      std::vector<Eigen::Vector3d> positions;
-      for (const Pose& p : *poses) positions.push_back(p.position_m);
-      return PosesWithFocalLawFromFlags(positions, law, poses, error);
-    }
-    if (FLAGS_attitude_law == "none") {
-      for (Pose& p : *poses) p.rotation.setIdentity();
-    }
-    return true;
+    return ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, poses, error);
   }
 
   std::vector<Eigen::Vector3d> positions;

@@ -278,6 +278,21 @@ bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
   return false;
 }
 
+bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitude_law,
+                              const FocalAttitudeLaw& law, std::vector<Pose>* poses,
+                              std::string* error) {
+  if (!ReadPosesCsv(path, poses, nullptr, error)) return false;
+  if (attitude_law == "focal") {
+    std::vector<Eigen::Vector3d> positions;
+    for (const Pose& p : *poses) positions.push_back(p.position_m);
+    return PosesWithFocalLawFromFlags(positions, law, poses, error);
+  }
+  if (attitude_law == "none") {
+    for (Pose& p : *poses) p.rotation.setIdentity();
+  }
+  return true;
+}
+
 namespace {
 
 bool GenerateTrajectoryPositions(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
@@ -386,20 +401,11 @@ bool PosesFromFile(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::s
     *error = "--poses brings its own attitudes; only --attitude-law=focal|none may override them";
     return false;
   }
-  if (!ReadPosesCsv(FLAGS_poses, poses, nullptr, error)) return false;
-  if (FLAGS_attitude_law == "focal") {
-    std::vector<Eigen::Vector3d> positions;
-    for (const Pose& p : *poses) positions.push_back(p.position_m);
-    *attitude = FocalLawDescription(law);
-    return PosesWithFocalLawFromFlags(positions, law, poses, error);
-  }
-  if (FLAGS_attitude_law == "none") {
-    for (Pose& p : *poses) p.rotation.setIdentity();
-    *attitude = kIdentityByFlag;
-  } else {
-    *attitude = "as in " + FLAGS_poses + " (R = I if it has no attitude columns)";
-  }
-  return true;
+  *attitude = FLAGS_attitude_law == "focal" ? FocalLawDescription(law)
+              : FLAGS_attitude_law == "none"
+                  ? std::string(kIdentityByFlag)
+                  : "as in " + FLAGS_poses + " (R = I if it has no attitude columns)";
+  return ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, poses, error);
 }
 
 // The rotation of a single --position from --rpy, --quat or --rotvec; false with
