@@ -117,9 +117,7 @@ Dataset ReadDatasetOrThrow(const std::string& path, bool skip_invalid_rows) {
   return data;
 }
 
-}  // namespace
-
-void BindData(py::module_& m) {
+void BindDatasetClass(py::module_& m) {
   py::class_<Dataset>(m, "Dataset", R"(Measured telemetry (docs/data-format.md), one row per sample.
 
 Arrays are copies, in file order: time_s (n,), position_m (n, 3), rpy_deg (n, 3) and
@@ -198,24 +196,34 @@ those columns. skipped lists the rows read_dataset(skip_invalid_rows=True) left 
         return "<fastcal.Dataset: " + std::to_string(d.samples.size()) + " samples from " +
                (d.path.empty() ? std::string("memory") : d.path) + ">";
       });
+}
+
+// simulate(truth, positions, attitude kind and values, options) -> (dataset, truth used,
+// summary dict); the simulation runs without the GIL.
+py::tuple SimulateFromArrays(const CableRobot& truth, const DoubleArray& positions_m,
+                             const std::string& attitude_kind, const DoubleArray& attitude,
+                             const py::dict& options) {
+  const SimulationOptions o = MakeSimulationOptions(options);
+  const std::vector<Pose> planned = PosesFromArrays(positions_m, attitude_kind, attitude);
+  Dataset data;
+  CableRobot truth_used;
+  SimulationSummary summary;
+  std::string error;
+  bool ok = false;
+  {
+    py::gil_scoped_release release;
+    ok = Simulate(truth, planned, o, &data, &truth_used, &summary, &error);
+  }
+  if (!ok) throw InputError(error);
+  return py::make_tuple(data, truth_used, SummaryDict(summary));
+}
+
+}  // namespace
+
+void BindData(py::module_& m) {
+  BindDatasetClass(m);
   m.def("read_dataset", &ReadDatasetOrThrow, py::arg("path"), py::arg("skip_invalid_rows"));
-  m.def("simulate",
-        [](const CableRobot& truth, const DoubleArray& positions_m,
-           const std::string& attitude_kind, const DoubleArray& attitude, const py::dict& options) {
-          const SimulationOptions o = MakeSimulationOptions(options);
-          const std::vector<Pose> planned = PosesFromArrays(positions_m, attitude_kind, attitude);
-          Dataset data;
-          CableRobot truth_used;
-          SimulationSummary summary;
-          std::string error;
-          bool ok = false;
-          {
-            py::gil_scoped_release release;
-            ok = Simulate(truth, planned, o, &data, &truth_used, &summary, &error);
-          }
-          if (!ok) throw InputError(error);
-          return py::make_tuple(data, truth_used, SummaryDict(summary));
-        });
+  m.def("simulate", &SimulateFromArrays);
 }
 
 }  // namespace fastcal::python

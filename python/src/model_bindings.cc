@@ -46,6 +46,87 @@ CableRobot Load(const std::string& path) {
   return robot;
 }
 
+// Model's array and dict properties: numpy arrays and a dict in, copies out.
+
+py::object GetReflector(const CableRobot& r) {
+  if (!r.reflector) return py::none();
+  py::dict d;
+  d["centre_m"] = Vector3(r.reflector->centre_m);
+  d["radius_m"] = r.reflector->radius_m;
+  d["aperture_m"] = r.reflector->aperture_m;
+  return std::move(d);
+}
+
+void SetReflector(CableRobot& r, const py::object& v) {
+  if (v.is_none()) {
+    r.reflector.reset();
+    return;
+  }
+  const py::dict d = v.cast<py::dict>();
+  Reflector reflector;
+  for (const auto& [key, value] : d) {
+    const std::string name = py::str(key);
+    if (name == "centre_m") {
+      reflector.centre_m = ToVector3(value.cast<DoubleArray>(), "reflector centre_m");
+    } else if (name == "radius_m") {
+      reflector.radius_m = value.cast<double>();
+    } else if (name == "aperture_m") {
+      reflector.aperture_m = value.cast<double>();
+    } else {
+      throw InputError("reflector: unknown key '" + name +
+                       "' (accepted: centre_m, radius_m, aperture_m)");
+    }
+  }
+  r.reflector = reflector;
+}
+
+DoubleArray GetAnchorPoints(const CableRobot& r) {
+  const auto n = static_cast<py::ssize_t>(r.anchor_points_cabin_m.size());
+  DoubleArray out = NewArray({n, 3});
+  for (py::ssize_t j = 0; j < n; ++j) {
+    for (int k = 0; k < 3; ++k) out.mutable_data()[3 * j + k] = r.anchor_points_cabin_m[j][k];
+  }
+  return out;
+}
+
+void SetAnchorPoints(CableRobot& r, const DoubleArray& v) {
+  CheckRows(v, 3, "anchor_points_cabin_m");
+  r.anchor_points_cabin_m.clear();
+  for (py::ssize_t j = 0; j < v.shape(0); ++j) {
+    r.anchor_points_cabin_m.emplace_back(v.data()[3 * j], v.data()[3 * j + 1], v.data()[3 * j + 2]);
+  }
+}
+
+DoubleArray GetTowerTops(const CableRobot& r) {
+  DoubleArray out = NewArray({kNumCables, 3});
+  for (int i = 0; i < kNumCables; ++i) {
+    for (int k = 0; k < 3; ++k) out.mutable_data()[3 * i + k] = r.cables[i].tower_top_m[k];
+  }
+  return out;
+}
+
+void SetTowerTops(CableRobot& r, const DoubleArray& v) {
+  CheckRows(v, 3, "tower_top_m");
+  if (v.shape(0) != kNumCables) throw InputError("tower_top_m must have shape (6, 3)");
+  for (int i = 0; i < kNumCables; ++i) {
+    r.cables[i].tower_top_m =
+        Eigen::Vector3d(v.data()[3 * i], v.data()[3 * i + 1], v.data()[3 * i + 2]);
+  }
+}
+
+py::array_t<int> GetAnchorIndex(const CableRobot& r) {
+  py::array_t<int> out(kNumCables);
+  for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = r.cables[i].anchor_index;
+  return out;
+}
+
+void SetAnchorIndex(CableRobot& r, const py::array_t<int, py::array::forcecast>& v) {
+  if (v.ndim() != 1 || v.shape(0) != kNumCables) {
+    throw InputError("anchor_index must have shape (6,)");
+  }
+  for (int i = 0; i < kNumCables; ++i) r.cables[i].anchor_index = v.data()[i];
+}
+
 }  // namespace
 
 void BindModel(py::module_& m) {
@@ -87,93 +168,16 @@ Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
             r.mass_centre_cabin_m = ToVector3(v, "mass_centre_cabin_m");
           },
           "Mass centre of the cabin in the cabin frame, shape (3,).")
+      .def_property("reflector", &GetReflector, &SetReflector,
+                    "The reflector cables are checked against: None, or a dict {centre_m (3,), "
+                    "radius_m, aperture_m} (a sphere's lower cap; docs/model-format.md). Assign a "
+                    "whole dict; keys left out keep FAST's values.")
+      .def_property("anchor_points_cabin_m", &GetAnchorPoints, &SetAnchorPoints,
+                    "Cabin anchor points in the cabin frame, shape (n, 3).")
+      .def_property("tower_top_m", &GetTowerTops, &SetTowerTops,
+                    "Upper end of each cable (tower top), global frame, shape (6, 3).")
       .def_property(
-          "reflector",
-          [](const CableRobot& r) -> py::object {
-            if (!r.reflector) return py::none();
-            py::dict d;
-            d["centre_m"] = Vector3(r.reflector->centre_m);
-            d["radius_m"] = r.reflector->radius_m;
-            d["aperture_m"] = r.reflector->aperture_m;
-            return std::move(d);
-          },
-          [](CableRobot& r, const py::object& v) {
-            if (v.is_none()) {
-              r.reflector.reset();
-              return;
-            }
-            const py::dict d = v.cast<py::dict>();
-            Reflector reflector;
-            for (const auto& [key, value] : d) {
-              const std::string name = py::str(key);
-              if (name == "centre_m") {
-                reflector.centre_m = ToVector3(value.cast<DoubleArray>(), "reflector centre_m");
-              } else if (name == "radius_m") {
-                reflector.radius_m = value.cast<double>();
-              } else if (name == "aperture_m") {
-                reflector.aperture_m = value.cast<double>();
-              } else {
-                throw InputError("reflector: unknown key '" + name +
-                                 "' (accepted: centre_m, radius_m, aperture_m)");
-              }
-            }
-            r.reflector = reflector;
-          },
-          "The reflector cables are checked against: None, or a dict {centre_m (3,), "
-          "radius_m, aperture_m} (a sphere's lower cap; docs/model-format.md). Assign a "
-          "whole dict; keys left out keep FAST's values.")
-      .def_property(
-          "anchor_points_cabin_m",
-          [](const CableRobot& r) {
-            const auto n = static_cast<py::ssize_t>(r.anchor_points_cabin_m.size());
-            DoubleArray out = NewArray({n, 3});
-            for (py::ssize_t j = 0; j < n; ++j) {
-              for (int k = 0; k < 3; ++k)
-                out.mutable_data()[3 * j + k] = r.anchor_points_cabin_m[j][k];
-            }
-            return out;
-          },
-          [](CableRobot& r, const DoubleArray& v) {
-            CheckRows(v, 3, "anchor_points_cabin_m");
-            r.anchor_points_cabin_m.clear();
-            for (py::ssize_t j = 0; j < v.shape(0); ++j) {
-              r.anchor_points_cabin_m.emplace_back(v.data()[3 * j], v.data()[3 * j + 1],
-                                                   v.data()[3 * j + 2]);
-            }
-          },
-          "Cabin anchor points in the cabin frame, shape (n, 3).")
-      .def_property(
-          "tower_top_m",
-          [](const CableRobot& r) {
-            DoubleArray out = NewArray({kNumCables, 3});
-            for (int i = 0; i < kNumCables; ++i) {
-              for (int k = 0; k < 3; ++k)
-                out.mutable_data()[3 * i + k] = r.cables[i].tower_top_m[k];
-            }
-            return out;
-          },
-          [](CableRobot& r, const DoubleArray& v) {
-            CheckRows(v, 3, "tower_top_m");
-            if (v.shape(0) != kNumCables) throw InputError("tower_top_m must have shape (6, 3)");
-            for (int i = 0; i < kNumCables; ++i) {
-              r.cables[i].tower_top_m =
-                  Eigen::Vector3d(v.data()[3 * i], v.data()[3 * i + 1], v.data()[3 * i + 2]);
-            }
-          },
-          "Upper end of each cable (tower top), global frame, shape (6, 3).")
-      .def_property(
-          "anchor_index",
-          [](const CableRobot& r) {
-            py::array_t<int> out(kNumCables);
-            for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = r.cables[i].anchor_index;
-            return out;
-          },
-          [](CableRobot& r, const py::array_t<int, py::array::forcecast>& v) {
-            if (v.ndim() != 1 || v.shape(0) != kNumCables) {
-              throw InputError("anchor_index must have shape (6,)");
-            }
-            for (int i = 0; i < kNumCables; ++i) r.cables[i].anchor_index = v.data()[i];
-          },
+          "anchor_index", &GetAnchorIndex, &SetAnchorIndex,
           "Index into anchor_points_cabin_m of each cable's cabin point (0-based), shape (6,).")
       .def("__repr__", [](const CableRobot& r) {
         return "<fastcal.Model: cabin " + std::to_string(r.cabin_mass_kg) + " kg, " +
