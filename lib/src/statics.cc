@@ -113,7 +113,7 @@ double EstimateError(const Geometry& g, const State& st,
     rhs[1] -= g.r[i][1] * miss[i];
     rhs[2] -= g.r[i][0] * miss[i];
   }
-  const Eigen::Matrix<double, 6, 1> dfl = response * rhs;
+  const Eigen::Matrix<double, 6, 1> dfl = g.null_basis * (response * rhs);
   // The largest |T dT| / T^2, compared as fractions: one division instead of six.
   double worst_num = 0.0, worst_den = 1.0;
   for (int i = 0; i < kNumCables; ++i) {
@@ -138,6 +138,32 @@ Check CheckAfterStep(const StaticsParameters<double>& p, const Geometry& g, cons
   c.error_estimate = EstimateError(g, st, lin.a, miss, response);
   return c;
 }
+
+// What a warm start takes from the solution before (StaticsOptions::warm_start): only
+// this is copied, not the whole StaticsSolution, which the solve then overwrites.
+struct PreviousSolve {
+  std::array<CatenaryForces, kNumCables> low, high;     // AAS secants
+  std::array<std::array<double, 3>, kNumCables> state;  // each cable's (Fl, Fz, s0)
+  Pose pose;
+  // exact only (its WarmStart's extrapolation): the solve before that one.
+  bool has_previous = false;
+  Pose previous_pose;
+  std::array<std::array<double, 3>, kNumCables> previous_state;
+
+  PreviousSolve(const StaticsSolution& s, bool exact) {
+    for (int i = 0; i < kNumCables; ++i) {
+      const CableSolution& c = s.cables[i];
+      low[i] = c.secant_low;
+      high[i] = c.secant_high;
+      state[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
+    }
+    pose = s.pose;
+    if (!exact) return;
+    has_previous = s.has_previous;
+    previous_pose = s.previous_pose;
+    previous_state = s.previous_state;
+  }
+};
 
 // Shared by the stages of one solve.
 struct Context {
@@ -626,15 +652,15 @@ Eigen::Matrix<double, 12, 1> PoseStep(const Pose& from, const Pose& to, double s
 // exact's warm start at `pose` from the previous solution: its state, extrapolated
 // linearly along the path when it was itself warm-started and the poses go on in about
 // the same direction (the new step at least half along the last one).
-void WarmStart(const StaticsParameters<double>& p, const StaticsSolution& previous,
-               const Pose& pose, State* st) {
+void WarmStart(const StaticsParameters<double>& p, const PreviousSolve& previous, const Pose& pose,
+               State* st) {
   // Accept the extrapolation only while the new step is this close to the last one's line.
   constexpr double kMaxOffLine = 0.5;
   // and stretches it by at most this (a stop and go, or a jump, are no path).
   constexpr double kMaxStretch = 2.0;
   for (int i = 0; i < kNumCables; ++i) {
-    const CableSolution& c = previous.cables[i];
-    (*st)[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
+    const std::array<double, 3>& c = previous.state[i];
+    (*st)[i] = {c[0], c[1], c[2]};
   }
   if (!previous.has_previous) return;
   double size_m = 0.0;
@@ -658,7 +684,7 @@ void WarmStart(const StaticsParameters<double>& p, const StaticsSolution& previo
 // exact: Newton from the previous solution (warm) or from AAS; where that fails or ends
 // outside the model's range, and `may_follow`, the continuation from the home pose decides.
 StaticsStatus SolveExact(Context* c, const Geometry& g, const Pose& pose,
-                         const StaticsSolution* previous, bool may_follow) {
+                         const PreviousSolve* previous, bool may_follow) {
   const StaticsOptions& o = c->o;
   StaticsSolution* sol = c->sol;
   State st;
@@ -701,7 +727,7 @@ StaticsStatus SolveExact(Context* c, const Geometry& g, const Pose& pose,
 }
 
 StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, const StaticsOptions& o,
-                      const StaticsSolution* previous, bool may_follow, StaticsSolution* sol) {
+                      const PreviousSolve* previous, bool may_follow, StaticsSolution* sol) {
   // sol->cables is left as it is: FillSolution writes all of it on success, and
   // SolveStaticsWithParameters zeroes it on failure.
   sol->method = o.method;
@@ -724,10 +750,8 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
 
   Context c{p, o, sol};
   if (previous != nullptr) {
-    for (int i = 0; i < kNumCables; ++i) {
-      c.low[i] = previous->cables[i].secant_low;
-      c.high[i] = previous->cables[i].secant_high;
-    }
+    c.low = previous->low;
+    c.high = previous->high;
   }
   if (o.method == StaticsMethod::kExact) return SolveExact(&c, g, pose, previous, may_follow);
   State st;
@@ -919,8 +943,8 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   }
   const bool warm = options.warm_start && solution->status == StaticsStatus::kOk;
   // Constructed only when warm: a cold solve at 1.4 us would spend 1-2% on it.
-  std::optional<StaticsSolution> previous;
-  if (warm) previous = *solution;
+  std::optional<PreviousSolve> previous;
+  if (warm) previous.emplace(*solution, options.method == StaticsMethod::kExact);
   // A warm attempt that fails is retried cold; only the cold one may take exact's
   // continuation, so that it runs at most once.
   StaticsStatus status = Attempt(parameters, pose, options, warm ? &*previous : nullptr,
@@ -933,10 +957,7 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   solution->has_previous = warm_worked;
   if (solution->has_previous) {
     solution->previous_pose = previous->pose;
-    for (int i = 0; i < kNumCables; ++i) {
-      const CableSolution& c = previous->cables[i];
-      solution->previous_state[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
-    }
+    solution->previous_state = previous->state;
   }
   if (status != StaticsStatus::kOk) {
     // No numbers where an error belongs: only the failure's own (cable, limit_value,

@@ -79,6 +79,9 @@ template <typename T>
 FASTCAL_ALWAYS_INLINE CatenaryEnd<T> CatenaryEndpoint(const T& fl_n, const T& fz_n, const T& s0_m,
                                                       const T& ea_n, const T& w_n_per_m) {
   using std::sqrt;
+  // 1/w first, off the critical path: D comes from a logarithm, and a division after it
+  // would add its latency to every evaluation.
+  const T inv_w = T(1) / w_n_per_m;
   const T ws = w_n_per_m * s0_m;
   const T fz1 = fz_n + ws;
   const T fl2 = fl_n * fl_n;
@@ -96,7 +99,7 @@ FASTCAL_ALWAYS_INLINE CatenaryEnd<T> CatenaryEndpoint(const T& fl_n, const T& fz
   const T p = fz_n * two_fz_ws * inv_s;
   const T q = t0 - p;
   const T d = CatenaryAngleDifference(fz_n, fz1, t0, t1, ws, q, fl2);
-  const T d_over_w = d / w_n_per_m;
+  const T d_over_w = d * inv_w;
   const T cross = s0_m * two_fz_ws * inv_s_t0t1;
   const T s0_q_t0t1 = s0_m * q * inv_t0t1;
   CatenaryEnd<T> end;
@@ -190,18 +193,30 @@ inline double StartCoth(double lambda, double inv_lambda) {
 class ParabolicCatenaryModel {
  public:
   ParabolicCatenaryModel(double span_m, double rise_m, double ea_n, double w_n_per_m)
-      : k_(std::sqrt(span_m * span_m + rise_m * rise_m)),
-        c_(k_ / (span_m * ea_n)),
+      : ParabolicCatenaryModel(span_m, rise_m, std::sqrt(span_m * span_m + rise_m * rise_m), ea_n,
+                               w_n_per_m) {}
+  // With the chord k = sqrt(span^2 + rise^2) already known.
+  ParabolicCatenaryModel(double span_m, double rise_m, double chord_m, double ea_n,
+                         double w_n_per_m)
+      : k_(chord_m),
         b_(w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0),
         half_w_(0.5 * w_n_per_m),
         half_abs_w_(0.5 * std::abs(w_n_per_m)),
         rise_m_(rise_m),
-        lambda_h_(half_abs_w_ * span_m),
-        inv_lambda_h_(1.0 / lambda_h_) {}
+        lambda_h_(half_abs_w_ * span_m) {
+    // c = k/(L EA) and 1/lambda_h from one division (the statics evaluate this model
+    // three times per cable and pose, side by side: divisions are what it costs).
+    const double inv = 1.0 / (span_m * ea_n * lambda_h_);
+    c_ = k_ * lambda_h_ * inv;
+    inv_lambda_h_ = span_m * ea_n * inv;
+  }
 
   CatenaryCurvePoint AtHorizontalForce(double fl_n) const {
-    const double inv_fl = 1.0 / fl_n;
-    const double s0_m = std::sqrt(k_ * k_ + b_ * inv_fl * inv_fl) / (1.0 + c_ * fl_n);
+    // 1/Fl and 1/(1 + c Fl) from one division; s0 = sqrt(k^2 + b/Fl^2)/(1 + c Fl).
+    const double q = 1.0 + c_ * fl_n;
+    const double inv_fl_q = 1.0 / (fl_n * q);
+    const double inv_fl = q * inv_fl_q;
+    const double s0_m = std::sqrt(k_ * k_ * (fl_n * fl_n) + b_) * inv_fl_q;
     // Fz of CatenaryInitialGuess (the inextensible catenary), lambda = lambda_h / H.
     const double coth = StartCoth(lambda_h_ * inv_fl, fl_n * inv_lambda_h_);
     return CatenaryCurvePoint{-half_w_ * s0_m - half_abs_w_ * rise_m_ * coth, s0_m};

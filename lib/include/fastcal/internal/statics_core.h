@@ -191,10 +191,12 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
 
 // How the solution Fl of the 6x6 equilibrium system moves when the right-hand sides of
 // its vertical-force row and its two tilting-moment rows (rows 2, 3, 4; statics.h) move:
-// dFl = response * (d rhs2, d rhs3, d rhs4). A cable's Fz off its curve by d shifts just
-// those rows (by -d, -r_y d, -r_x d), so the error estimates need only this, not the
-// matrix's factors; SolveEquilibrium computes it alongside Fl, off the critical path.
-using EquilibriumResponse = Eigen::Matrix<double, 6, 3>;
+// dFl = null_basis * response * (d rhs2, d rhs3, d rhs4), with response = (V N)^-1, the
+// inverse of SolveEquilibriumReduced's 3x3 system (PoseGeometry::null_basis: N). A
+// cable's Fz off its curve by d shifts just those rows (by -d, -r_y d, -r_x d), so the
+// error estimates need only this, not the matrix's factors; SolveEquilibrium keeps it
+// alongside Fl (a copy: the product with N is left to the one use of each).
+using EquilibriumResponse = Eigen::Matrix3d;
 
 // Reciprocal condition below which the equilibrium system counts as singular.
 inline constexpr double kMinEquilibriumReciprocalCondition = 1e-13;
@@ -208,7 +210,7 @@ bool SolveEquilibriumReduced(const PoseGeometry<double>& g, const std::array<dou
   // Fl = N c (PoseGeometry::null_basis) meets rows 0, 1, 5; rows 2, 3, 4 are then the
   // 3x3 system (V N) c = rhs, solved by its adjugate: one division and no branches,
   // where the 6x6 elimination's pivot search and six divisions made a long dependent
-  // chain (the largest single cost of a solve). The response is then N (V N)^-1.
+  // chain (the largest single cost of a solve). The response is then (V N)^-1.
   const Eigen::Matrix<double, 6, 3>& n = g.null_basis;
   Eigen::Matrix3d vn = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs(g.weight_n, g.e[1] * g.weight_n, g.e[0] * g.weight_n);
@@ -226,7 +228,7 @@ bool SolveEquilibriumReduced(const PoseGeometry<double>& g, const std::array<dou
   const Eigen::Matrix3d inverse = adj.adjugate / adj.det;
   const Eigen::Matrix<double, 6, 1> x = n * (inverse * rhs);
   for (int i = 0; i < kNumCables; ++i) (*fl)[i] = x[i];
-  if constexpr (kResponse) *response = n * inverse;
+  if constexpr (kResponse) *response = inverse;
   return true;
 }
 
@@ -568,7 +570,7 @@ inline CatenaryCurvePoint CurveGuess(double fl, const PoseGeometry<double>& g, i
   const double s_high = o.secant_high_fraction * g.chord[i];
   CatenaryCurvePoint c;
   if (model_corrected) {
-    const ParabolicCatenaryModel model(g.span[i], g.rise[i], ea_n, g.w[i]);
+    const ParabolicCatenaryModel model(g.span[i], g.rise[i], g.chord[i], ea_n, g.w[i]);
     const CatenaryCurvePoint m = model.AtHorizontalForce(fl);
     const CatenaryCurvePoint m_low = model.AtHorizontalForce(low.fl_n);
     const CatenaryCurvePoint m_high = model.AtHorizontalForce(high.fl_n);
