@@ -600,12 +600,14 @@ StaticsStatus CheckModelRange(Context* c, const Geometry& g, const State& st, co
 StaticsStatus FillSolution(Context* c, const Geometry& g, const State& st, const Check& check) {
   StaticsSolution* sol = c->sol;
   Eigen::Vector3d force_sum = Eigen::Vector3d::Zero(), moment_sum = Eigen::Vector3d::Zero();
-  double force_scale = std::abs(g.weight_n), lever2_m2 = 1.0;
-  sol->end_residual_m = 0.0;
+  double force_scale = std::abs(g.weight_n), lever2_m2 = 1.0, end_residual_m = 0.0;
   for (int i = 0; i < kNumCables; ++i) {
     CableSolution& cs = sol->cables[i];
     cs.horizontal_force_n = st[i].fl;
-    cs.force_n = Eigen::Vector3d(-g.ux[i] * st[i].fl, -g.uy[i] * st[i].fl, st[i].fz);
+    // The sums below use this local, not cs.force_n read back: a load spanning the
+    // stores just made of it cannot be forwarded and stalled each cable (~15 cycles).
+    const Eigen::Vector3d force_n(-g.ux[i] * st[i].fl, -g.uy[i] * st[i].fl, st[i].fz);
+    cs.force_n = force_n;
     cs.lower_tension_n = check.lower_n[i];
     cs.unstretched_length_m = st[i].s0;
     cs.upper_tension_n = check.upper_n[i];
@@ -613,12 +615,13 @@ StaticsStatus FillSolution(Context* c, const Geometry& g, const State& st, const
     cs.end_residual_m = check.end_residual_m[i];
     cs.secant_low = c->low[i];
     cs.secant_high = c->high[i];
-    sol->end_residual_m = std::max(sol->end_residual_m, cs.end_residual_m);
-    force_sum -= cs.force_n;
-    moment_sum -= g.r[i].cross(cs.force_n);
-    force_scale = std::max(force_scale, cs.lower_tension_n);
+    end_residual_m = std::max(end_residual_m, check.end_residual_m[i]);
+    force_sum -= force_n;
+    moment_sum -= g.r[i].cross(force_n);
+    force_scale = std::max(force_scale, check.lower_n[i]);
     lever2_m2 = std::max(lever2_m2, g.r[i].squaredNorm());
   }
+  sol->end_residual_m = end_residual_m;
   const Eigen::Vector3d weight(0.0, 0.0, g.weight_n);
   force_sum += weight;
   moment_sum += g.e.cross(weight);
