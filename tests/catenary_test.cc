@@ -140,6 +140,37 @@ TEST(CatenaryTest, InitialGuessIsCloseOverWorkspaceLengthRange) {
   }
 }
 
+// ParabolicCatenaryModel's point at H = Fl meets the relation it is defined by
+// (catenary.h: s0^2 (1 + c H)^2 - k^2 = b / H^2, c = k/(L EA), b = w^2 L^4 / 12) and the
+// inextensible catenary's Fz, computed here with std::tanh; with the chord given it is
+// the same model; with an absurd EA (its merged division out of range) it is still the
+// inextensible limit, not NaN.
+TEST(CatenaryTest, ParabolicModelMeetsItsRelation) {
+  constexpr double kRelationRelTol = 1e-13;  // rounding of a few operations
+  constexpr double kCothRelTol = 1e-6;       // StartCoth's series (catenary.h)
+  constexpr double kMinFlN = 5e4, kMaxFlN = 6e5;
+  std::mt19937_64 rng(kSeed);
+  std::uniform_real_distribution<double> fl_dist(kMinFlN, kMaxFlN);
+  for (const Chord& c : RandomChords(500, 1.0, 1.0)) {
+    const double k = std::hypot(c.span_m, c.rise_m), h = fl_dist(rng);
+    for (const double ea_n : {kEaN, 1e306}) {  // 1e306: L EA lambda_h overflows
+      const ParabolicCatenaryModel model(c.span_m, c.rise_m, ea_n, kWNPerM);
+      const CatenaryCurvePoint p = model.AtHorizontalForce(h);
+      const double cc = k / (c.span_m * ea_n);
+      const double b = kWNPerM * kWNPerM * std::pow(c.span_m, 4) / 12.0;
+      const double lhs = p.s0_m * p.s0_m * (1.0 + cc * h) * (1.0 + cc * h) - k * k;
+      EXPECT_NEAR(lhs, b / (h * h), kRelationRelTol * k * k) << "EA " << ea_n << " H " << h;
+      const double lambda = std::abs(kWNPerM) * c.span_m / (2.0 * h);
+      const double coth_term = 0.5 * std::abs(kWNPerM) * c.rise_m / std::tanh(lambda);
+      EXPECT_NEAR(p.fz_n, -0.5 * kWNPerM * p.s0_m - coth_term, kCothRelTol * coth_term);
+      const CatenaryCurvePoint q =
+          ParabolicCatenaryModel(c.span_m, c.rise_m, k, ea_n, kWNPerM).AtHorizontalForce(h);
+      EXPECT_NEAR(q.s0_m, p.s0_m, kRelationRelTol * p.s0_m);
+      EXPECT_NEAR(q.fz_n, p.fz_n, kRelationRelTol * std::abs(p.fz_n));
+    }
+  }
+}
+
 // Asinh (scalar.h) takes the log form above kAsinhLogFormMin and glibc's below: both
 // sides of the switch, signs and large arguments agree with std::asinh to a few ulp.
 TEST(CatenaryTest, AsinhMatchesStdAsinhOnBothSidesOfItsSwitch) {

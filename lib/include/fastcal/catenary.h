@@ -205,10 +205,16 @@ class ParabolicCatenaryModel {
         rise_m_(rise_m),
         lambda_h_(half_abs_w_ * span_m) {
     // c = k/(L EA) and 1/lambda_h from one division (the statics evaluate this model
-    // three times per cable and pose, side by side: divisions are what it costs).
+    // three times per cable and pose, side by side: divisions are what it costs), unless
+    // the product leaves double's normal range (an absurd EA): then one each.
     const double inv = 1.0 / (span_m * ea_n * lambda_h_);
-    c_ = k_ * lambda_h_ * inv;
-    inv_lambda_h_ = span_m * ea_n * inv;
+    if (std::isnormal(inv)) {
+      c_ = k_ * lambda_h_ * inv;
+      inv_lambda_h_ = span_m * ea_n * inv;
+    } else {
+      c_ = k_ / (span_m * ea_n);
+      inv_lambda_h_ = 1.0 / lambda_h_;
+    }
   }
 
   CatenaryCurvePoint AtHorizontalForce(double fl_n) const {
