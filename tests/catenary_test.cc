@@ -143,8 +143,8 @@ TEST(CatenaryTest, InitialGuessIsCloseOverWorkspaceLengthRange) {
 // ParabolicCatenaryModel's point at H = Fl meets the relation it is defined by
 // (catenary.h: s0^2 (1 + c H)^2 - k^2 = b / H^2, c = k/(L EA), b = w^2 L^4 / 12) and the
 // inextensible catenary's Fz, computed here with std::tanh; with the chord given it is
-// the same model; with an absurd EA (its merged division out of range) it is still the
-// inextensible limit, not NaN.
+// the same model; with an absurd EA (L EA lambda_h beyond double's range, which a merged
+// division of its constants would meet) it is still the inextensible limit, not NaN.
 TEST(CatenaryTest, ParabolicModelMeetsItsRelation) {
   constexpr double kRelationRelTol = 1e-13;  // rounding of a few operations
   constexpr double kCothRelTol = 1e-6;       // StartCoth's series (catenary.h)

@@ -199,23 +199,13 @@ class ParabolicCatenaryModel {
   ParabolicCatenaryModel(double span_m, double rise_m, double chord_m, double ea_n,
                          double w_n_per_m)
       : k_(chord_m),
+        c_(k_ / (span_m * ea_n)),
         b_(w_n_per_m * w_n_per_m * (span_m * span_m) * (span_m * span_m) / 12.0),
         half_w_(0.5 * w_n_per_m),
         half_abs_w_(0.5 * std::abs(w_n_per_m)),
         rise_m_(rise_m),
-        lambda_h_(half_abs_w_ * span_m) {
-    // c = k/(L EA) and 1/lambda_h from one division (the statics evaluate this model
-    // three times per cable and pose, side by side: divisions are what it costs), unless
-    // the product leaves double's normal range (an absurd EA): then one each.
-    const double inv = 1.0 / (span_m * ea_n * lambda_h_);
-    if (std::isnormal(inv)) {
-      c_ = k_ * lambda_h_ * inv;
-      inv_lambda_h_ = span_m * ea_n * inv;
-    } else {
-      c_ = k_ / (span_m * ea_n);
-      inv_lambda_h_ = 1.0 / lambda_h_;
-    }
-  }
+        lambda_h_(half_abs_w_ * span_m),
+        inv_lambda_h_(1.0 / lambda_h_) {}
 
   CatenaryCurvePoint AtHorizontalForce(double fl_n) const {
     // 1/Fl and 1/(1 + c Fl) from one division; s0 = sqrt(k^2 + b/Fl^2)/(1 + c Fl).
