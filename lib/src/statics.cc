@@ -145,23 +145,25 @@ struct PreviousSolve {
   std::array<CatenaryForces, kNumCables> low, high;     // AAS secants
   std::array<std::array<double, 3>, kNumCables> state;  // each cable's (Fl, Fz, s0)
   Pose pose;
-  // exact only (its WarmStart's extrapolation): the solve before that one.
+  // For the extrapolation along the path (PathFactor): the solve before that one.
   bool has_previous = false;
   Pose previous_pose;
   std::array<std::array<double, 3>, kNumCables> previous_state;
+  std::array<CatenaryForces, kNumCables> previous_low, previous_high;
 
-  PreviousSolve(const StaticsSolution& s, bool exact) {
+  explicit PreviousSolve(const StaticsSolution& s)
+      : pose(s.pose),
+        has_previous(s.has_previous),
+        previous_pose(s.previous_pose),
+        previous_state(s.previous_state),
+        previous_low(s.previous_secant_low),
+        previous_high(s.previous_secant_high) {
     for (int i = 0; i < kNumCables; ++i) {
       const CableSolution& c = s.cables[i];
       low[i] = c.secant_low;
       high[i] = c.secant_high;
       state[i] = {c.horizontal_force_n, c.force_n[2], c.unstretched_length_m};
     }
-    pose = s.pose;
-    if (!exact) return;
-    has_previous = s.has_previous;
-    previous_pose = s.previous_pose;
-    previous_state = s.previous_state;
   }
 };
 
@@ -652,29 +654,59 @@ Eigen::Matrix<double, 12, 1> PoseStep(const Pose& from, const Pose& to, double s
   return d;
 }
 
-// exact's warm start at `pose` from the previous solution: its state, extrapolated
-// linearly along the path when it was itself warm-started and the poses go on in about
-// the same direction (the new step at least half along the last one).
-void WarmStart(const StaticsParameters<double>& p, const PreviousSolve& previous, const Pose& pose,
-               State* st) {
+// How far to extrapolate a warm start from the previous solution along the poses' path:
+// f with next step = f * last step, when the previous solution was itself warm-started
+// and the poses go on in about the same direction; else 0 (start from the previous
+// solution as it is).
+double PathFactor(const StaticsParameters<double>& p, const PreviousSolve& previous,
+                  const Pose& pose) {
   // Accept the extrapolation only while the new step is this close to the last one's line.
   constexpr double kMaxOffLine = 0.5;
   // and stretches it by at most this (a stop and go, or a jump, are no path).
   constexpr double kMaxStretch = 2.0;
-  for (int i = 0; i < kNumCables; ++i) {
-    const std::array<double, 3>& c = previous.state[i];
-    (*st)[i] = {c[0], c[1], c[2]};
-  }
-  if (!previous.has_previous) return;
+  if (!previous.has_previous) return 0.0;
   double size_m = 0.0;
   for (const Eigen::Vector3d& a : p.anchor_cabin_m) size_m = std::max(size_m, a.norm());
   const Eigen::Matrix<double, 12, 1> last = PoseStep(previous.previous_pose, previous.pose, size_m);
   const Eigen::Matrix<double, 12, 1> next = PoseStep(previous.pose, pose, size_m);
-  if (!(last.squaredNorm() > 0.0)) return;
+  if (!(last.squaredNorm() > 0.0)) return 0.0;
   const double f = next.dot(last) / last.squaredNorm();
   if (!(f > 0.0 && f <= kMaxStretch) || (next - f * last).norm() > kMaxOffLine * next.norm()) {
-    return;
+    return 0.0;
   }
+  return f;
+}
+
+// The starts of aas's secant solves at `pose`: the previous solution's secants,
+// extrapolated along the path as PathFactor says (each where it keeps Fl > 0).
+void WarmSecants(const StaticsParameters<double>& p, const PreviousSolve& previous,
+                 const Pose& pose, Context* c) {
+  c->low = previous.low;
+  c->high = previous.high;
+  const double f = PathFactor(p, previous, pose);
+  if (!(f > 0.0)) return;
+  auto extrapolate = [f](const CatenaryForces& now, const CatenaryForces& before,
+                         CatenaryForces* start) {
+    const CatenaryForces x{now.fl_n + f * (now.fl_n - before.fl_n),
+                           now.fz_n + f * (now.fz_n - before.fz_n)};
+    if (x.fl_n > 0.0) *start = x;
+  };
+  for (int i = 0; i < kNumCables; ++i) {
+    extrapolate(previous.low[i], previous.previous_low[i], &c->low[i]);
+    extrapolate(previous.high[i], previous.previous_high[i], &c->high[i]);
+  }
+}
+
+// exact's warm start at `pose` from the previous solution: its state, extrapolated
+// linearly along the path (PathFactor).
+void WarmStart(const StaticsParameters<double>& p, const PreviousSolve& previous, const Pose& pose,
+               State* st) {
+  for (int i = 0; i < kNumCables; ++i) {
+    const std::array<double, 3>& c = previous.state[i];
+    (*st)[i] = {c[0], c[1], c[2]};
+  }
+  const double f = PathFactor(p, previous, pose);
+  if (!(f > 0.0)) return;
   for (int i = 0; i < kNumCables; ++i) {
     const std::array<double, 3>& b = previous.previous_state[i];
     const CableState<double> x = {(*st)[i].fl + f * ((*st)[i].fl - b[0]),
@@ -753,8 +785,12 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
 
   Context c{p, o, sol};
   if (previous != nullptr) {
-    c.low = previous->low;
-    c.high = previous->high;
+    if (o.method == StaticsMethod::kExact) {
+      c.low = previous->low;  // only kept: exact's Newton starts from the state
+      c.high = previous->high;
+    } else {
+      WarmSecants(p, *previous, pose, &c);
+    }
   }
   if (o.method == StaticsMethod::kExact) return SolveExact(&c, g, pose, previous, may_follow);
   State st;
@@ -947,7 +983,7 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   const bool warm = options.warm_start && solution->status == StaticsStatus::kOk;
   // Constructed only when warm: a cold solve at 1.4 us would spend 1-2% on it.
   std::optional<PreviousSolve> previous;
-  if (warm) previous.emplace(*solution, options.method == StaticsMethod::kExact);
+  if (warm) previous.emplace(*solution);
   // A warm attempt that fails is retried cold; only the cold one may take exact's
   // continuation, so that it runs at most once.
   StaticsStatus status = Attempt(parameters, pose, options, warm ? &*previous : nullptr,
@@ -961,6 +997,8 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   if (solution->has_previous) {
     solution->previous_pose = previous->pose;
     solution->previous_state = previous->state;
+    solution->previous_secant_low = previous->low;
+    solution->previous_secant_high = previous->high;
   }
   if (status != StaticsStatus::kOk) {
     // No numbers where an error belongs: only the failure's own (cable, limit_value,

@@ -89,7 +89,9 @@ struct StaticsOptions {
   // catenary.relative_tolerance). The secants only define AAS's straight lines, whose own
   // error is ~1e-3; at 1e-6 each solve ends after one Newton step instead of two, and the
   // AAS forces differ from fully converged secants' by at most 2.9e-7 relative over the
-  // workspace cap (s0 by 2 um; tests/statics_test.cc).
+  // workspace cap (s0 by 2 um; tests/statics_test.cc); warm-started along a path, where
+  // an extrapolated start may meet the tolerance as it is and end without a step, by up
+  // to ~1.5e-6.
   double aas_secant_tolerance = 1e-6;
   // aas and aas-refined: tolerance of the per-cable solves for s0 at the AAS horizontal
   // forces (the looser of this and catenary.relative_tolerance). They start from a
@@ -216,11 +218,14 @@ struct StaticsSolution {
   // solution was itself warm-started, the pose and each cable's (Fl, Fz, s0) of the one
   // before. exact starts the next pose from the two, extrapolated along the poses' path:
   // ~1e-4 from the solution on the paper's trajectories, against ~7e-3 for the last alone,
-  // which saves a Newton step.
+  // which saves a Newton step. aas and aas-refined extrapolate the starts of their secant
+  // solves the same way, from the secants of the one before: along the paper's line 18
+  // catenary evaluations a pose instead of 22.5 from the last secants alone.
   Pose pose;
   bool has_previous = false;
   Pose previous_pose;
   std::array<std::array<double, 3>, kNumCables> previous_state{};
+  std::array<CatenaryForces, kNumCables> previous_secant_low{}, previous_secant_high{};
 };
 
 // Solves the statics of `pose`. Returns solution->status: kInvalidInput also for options
