@@ -526,8 +526,9 @@ TEST(StaticsTest, WarmStartExtrapolatesAlongThePath) {
 // 12 secant and 6 curve-point solves ends after at most one evaluation (cold: exactly one;
 // from the last secants alone 23 a node), and the forces are the cold ones to within the
 // secants' tolerance. An extrapolated start can meet that tolerance (1e-6 of the chord)
-// as it is and end without a Newton step, so the forces differ by up to ~1.5e-6 relative
-// where a cold solve, which always takes its step, ends within 3e-7 of converged secants.
+// as it is and end without a Newton step, so on this line the forces differ by up to
+// ~1.5e-6 relative (statics.h: aas_secant_tolerance), where a cold solve, which always
+// takes its step, ends within 3e-7 of converged secants.
 TEST(StaticsTest, WarmAasExtrapolatesItsSecantsAlongThePath) {
   constexpr int kColdEvaluations = 2 * kNumCables + kNumCables;
   constexpr double kAasRelTol = 2e-6;
@@ -547,6 +548,27 @@ TEST(StaticsTest, WarmAasExtrapolatesItsSecantsAlongThePath) {
       for (int i = 0; i < kNumCables; ++i) {
         EXPECT_NEAR(w.cables[i].lower_tension_n, c.cables[i].lower_tension_n,
                     kAasRelTol * c.cables[i].lower_tension_n);
+      }
+    }
+  }
+  // After exact (whose solutions carry no secants of their own pose) the first aas solve
+  // starts from old secants and the second from its predecessor's alone: no
+  // extrapolation from old ones (that took 77 evaluations), and back to one evaluation
+  // per solve from the third.
+  {
+    constexpr int kFromLastSecants = 24;  // 23 measured along the line
+    StaticsOptions switching;
+    switching.warm_start = true;
+    StaticsSolution s;
+    for (int n = 0; n <= 15; ++n) {
+      switching.method = n < 10 ? StaticsMethod::kExact : StaticsMethod::kAas;
+      ASSERT_EQ(SolveStatics(robot, FocalPose(Eigen::Vector3d(50 - n, 0, 150)), switching, &s),
+                StaticsStatus::kOk);
+      if (n == 11) {
+        EXPECT_LE(s.catenary_iterations, kFromLastSecants);
+      }
+      if (n >= 12) {
+        EXPECT_LE(s.catenary_iterations, kColdEvaluations) << n;
       }
     }
   }

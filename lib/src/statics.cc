@@ -145,6 +145,9 @@ struct PreviousSolve {
   std::array<CatenaryForces, kNumCables> low, high;     // AAS secants
   std::array<std::array<double, 3>, kNumCables> state;  // each cable's (Fl, Fz, s0)
   Pose pose;
+  // Whether low and high were solved at `pose` by aas or aas-refined (StaticsSolution:
+  // exact's carry older secants, or its AAS start's loose ones).
+  bool secants_at_pose = false;
   // For the extrapolation along the path (PathFactor): the solve before that one.
   bool has_previous = false;
   Pose previous_pose;
@@ -153,6 +156,7 @@ struct PreviousSolve {
 
   explicit PreviousSolve(const StaticsSolution& s)
       : pose(s.pose),
+        secants_at_pose(s.method != StaticsMethod::kExact),
         has_previous(s.has_previous),
         previous_pose(s.previous_pose),
         previous_state(s.previous_state),
@@ -678,15 +682,18 @@ double PathFactor(const StaticsParameters<double>& p, const PreviousSolve& previ
 }
 
 // The starts of aas's secant solves at `pose`: the previous solution's secants,
-// extrapolated along the path as PathFactor says (each where it keeps Fl > 0).
+// extrapolated along the path as PathFactor says where both it and the one before solved
+// theirs at their poses (before.fl_n > 0: StaticsSolution::previous_secant_low), and
+// where that keeps Fl > 0.
 void WarmSecants(const StaticsParameters<double>& p, const PreviousSolve& previous,
                  const Pose& pose, Context* c) {
   c->low = previous.low;
   c->high = previous.high;
-  const double f = PathFactor(p, previous, pose);
+  const double f = previous.secants_at_pose ? PathFactor(p, previous, pose) : 0.0;
   if (!(f > 0.0)) return;
   auto extrapolate = [f](const CatenaryForces& now, const CatenaryForces& before,
                          CatenaryForces* start) {
+    if (!(before.fl_n > 0.0)) return;
     const CatenaryForces x{now.fl_n + f * (now.fl_n - before.fl_n),
                            now.fz_n + f * (now.fz_n - before.fz_n)};
     if (x.fl_n > 0.0) *start = x;
@@ -997,8 +1004,13 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   if (solution->has_previous) {
     solution->previous_pose = previous->pose;
     solution->previous_state = previous->state;
-    solution->previous_secant_low = previous->low;
-    solution->previous_secant_high = previous->high;
+    if (previous->secants_at_pose) {
+      solution->previous_secant_low = previous->low;
+      solution->previous_secant_high = previous->high;
+    } else {
+      solution->previous_secant_low = {};  // none to extrapolate from (statics.h)
+      solution->previous_secant_high = {};
+    }
   }
   if (status != StaticsStatus::kOk) {
     // No numbers where an error belongs: only the failure's own (cable, limit_value,

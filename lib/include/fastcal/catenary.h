@@ -207,6 +207,8 @@ class ParabolicCatenaryModel {
         lambda_h_(half_abs_w_ * span_m),
         inv_lambda_h_(1.0 / lambda_h_) {}
 
+  // For 0 < Fl below ~1e150 N (k Fl and Fl (1 + c Fl) must stay within double's range;
+  // beyond that s0 is not finite): far above any cable's force.
   CatenaryCurvePoint AtHorizontalForce(double fl_n) const {
     // 1/Fl and 1/(1 + c Fl) from one division; s0 = sqrt(k^2 + b/Fl^2)/(1 + c Fl).
     const double q = 1.0 + c_ * fl_n;

@@ -89,9 +89,9 @@ struct StaticsOptions {
   // catenary.relative_tolerance). The secants only define AAS's straight lines, whose own
   // error is ~1e-3; at 1e-6 each solve ends after one Newton step instead of two, and the
   // AAS forces differ from fully converged secants' by at most 2.9e-7 relative over the
-  // workspace cap (s0 by 2 um; tests/statics_test.cc); warm-started along a path, where
-  // an extrapolated start may meet the tolerance as it is and end without a step, by up
-  // to ~1.5e-6.
+  // workspace cap (s0 by 2 um; tests/statics_test.cc). Warm-started, a start may meet the
+  // tolerance as it is and end without a step: then by up to ~1.2e-5 (2000 random
+  // 15-node paths; 7e-6 before the secant starts were extrapolated along the path).
   double aas_secant_tolerance = 1e-6;
   // aas and aas-refined: tolerance of the per-cable solves for s0 at the AAS horizontal
   // forces (the looser of this and catenary.relative_tolerance). They start from a
@@ -219,8 +219,11 @@ struct StaticsSolution {
   // before. exact starts the next pose from the two, extrapolated along the poses' path:
   // ~1e-4 from the solution on the paper's trajectories, against ~7e-3 for the last alone,
   // which saves a Newton step. aas and aas-refined extrapolate the starts of their secant
-  // solves the same way, from the secants of the one before: along the paper's line 18
-  // catenary evaluations a pose instead of 22.5 from the last secants alone.
+  // solves the same way, from the secants of the one before: along the paper's line 15-18
+  // catenary evaluations a pose instead of 23 from the last secants alone. Only secants
+  // that aas or aas-refined solved at their own pose count: previous_secant_* are zero
+  // where the one before was exact's (it carries older secants, or loose ones of its
+  // AAS start), and then the next solve starts from the last secants alone.
   Pose pose;
   bool has_previous = false;
   Pose previous_pose;
