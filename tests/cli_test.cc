@@ -76,6 +76,25 @@ class CliTest : public ::testing::Test {
   void Write(const std::string& name, const std::string& text) const {
     std::ofstream(Path(name)) << text;
   }
+  // A command line, its exit code and a text its output must contain.
+  struct ExpectedRun {
+    std::string args;
+    int code;
+    std::string expected;
+  };
+  // Runs `fastcal c.args` bounded (a regression of a limit must fail, not exhaust the
+  // machine: 60 s, and 4 GB of address space except under a sanitizer, which reserves
+  // terabytes) and checks its exit code and output; returns the result for more checks.
+  CommandResult RunBoundedAndExpect(const ExpectedRun& c) const {
+    const std::string limit =
+        std::string(fastcal::test::kUnderAddressSanitizer ? "" : "ulimit -v 4000000; ") +
+        "timeout 60 ";
+    const CommandResult r = Shell(limit + Bin() + " " + c.args);
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output.substr(0, 2000);
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args << "\n"
+                                                            << r.output.substr(0, 2000);
+    return r;
+  }
   fs::path dir_;
 };
 
@@ -893,18 +912,8 @@ std::string CircleWith(const std::string& column, int row, const std::string& va
 // memory and time limit, so that a regression (a hang, reading /dev/zero) fails the test
 // instead of the machine.
 TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
-  // (A sanitizer reserves terabytes of address space: there only the time limit.)
-  const std::string limit =
-      std::string(fastcal::test::kUnderAddressSanitizer ? "" : "ulimit -v 4000000; ") +
-      "timeout 60 ";
-  const auto run = [&](const std::string& args) { return Shell(limit + Bin() + " " + args); };
   const std::string data = " --data=" + Source() + "/calibration_data/circle_paper.csv";
   const std::string spec = " --spec=" + Source() + "/calibration_data/spec_mass_centre.yaml";
-  struct Case {
-    std::string args;
-    int code;
-    std::string expected;
-  };
   Write("comma.yaml", "{format: fastcal-model-1, gravity_m_per_s2: -9.8},");
   Write("t3.csv", CircleWith("T3_kN", 2, "1e30"));
   Write("t3max.csv", CircleWith("T3_kN", 2, "1e308"));
@@ -913,7 +922,7 @@ TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
   Write("comma.csv", CircleWith("T3_kN", 4, "244,5"));
   Write("binary.csv", "time_s,x_m,\x1b]0;owned\x07" + std::string(1 << 20, 'A') + "\n1,2,3\n");
   const std::string comma = Path("comma.yaml");
-  const std::vector<Case> cases = {
+  const std::vector<ExpectedRun> cases = {
       {"solve --position=0,0,140 --model=" + comma, 2,
        "comma.yaml:1: YAML syntax error: unexpected ',' at column 50"},
       {"evaluate --model=" + comma + data, 2, "unexpected ','"},
@@ -943,11 +952,8 @@ TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
       {"solve --position=0,0,140 --method=\"$(printf '\\033')[2J\"", 2,
        "--method must be aas, aas-refined, exact or compare, got '\\x1b[2J'"},
   };
-  for (const Case& c : cases) {
-    const CommandResult r = run(c.args);
-    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output.substr(0, 2000);
-    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args << "\n"
-                                                            << r.output.substr(0, 2000);
+  for (const ExpectedRun& c : cases) {
+    const CommandResult r = RunBoundedAndExpect(c);
     // Never a raw control byte from the input, never a message the size of the input, never
     // an infinite or undefined number where an error or a value belongs.
     EXPECT_EQ(r.output.find('\x1b'), std::string::npos) << c.args;
@@ -961,15 +967,10 @@ TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
 
 // What a fresh-eyes review of the hardened CLI found: each case failed before its fix.
 TEST_F(CliTest, FlagsAndOutputsFromTheReviewGiveClearMessages) {
-  struct Case {
-    std::string args;
-    int code;
-    std::string expected;
-  };
   ASSERT_EQ(::mkfifo(Path("fifo").c_str(), 0600), 0);
   Write("target.csv", "keep\n");
   fs::create_symlink(Path("target.csv"), Path("link.csv"));
-  const std::vector<Case> cases = {
+  const std::vector<ExpectedRun> cases = {
       // A vector flag with one value too many (or a trailing comma) is not a vector.
       {"solve --position=0,0,140,5", 2, "--position needs 3 comma-separated numbers"},
       {"solve --position=0,0,140,", 2, "--position needs 3 comma-separated numbers"},
@@ -988,17 +989,7 @@ TEST_F(CliTest, FlagsAndOutputsFromTheReviewGiveClearMessages) {
       {"workspace --focal-radius=1e6", 2, "put a node at"},
       {"workspace --html=-", 2, "--html=-: the map goes to a file"},
   };
-  // A regression of a limit must fail, not exhaust the machine (no limit under ASan,
-  // which reserves terabytes of address space).
-  const std::string limit =
-      std::string(fastcal::test::kUnderAddressSanitizer ? "" : "ulimit -v 4000000; ") +
-      "timeout 60 ";
-  for (const Case& c : cases) {
-    const CommandResult r = Shell(limit + Bin() + " " + c.args);
-    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output.substr(0, 2000);
-    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args << "\n"
-                                                            << r.output.substr(0, 2000);
-  }
+  for (const ExpectedRun& c : cases) RunBoundedAndExpect(c);
   EXPECT_TRUE(fs::is_symlink(Path("link.csv")));
   EXPECT_EQ(fs::status(Path("fifo")).type(), fs::file_type::fifo);
   EXPECT_FALSE(fs::exists(Path("same.x")));
