@@ -490,6 +490,38 @@ bool WriteOutDirectory(const char* command,
 
 }  // namespace
 
+// The report's provenance, common to calibrate and evaluate: the input files (the spec's
+// only when there is one), their digests, the software, the command line and the time.
+ReportInputs ReportProvenance(int argc, char** argv, bool with_spec) {
+  ReportInputs report;
+  report.model_path = FLAGS_model;
+  report.data_path = FLAGS_data;
+  report.model_digest = Digest(FLAGS_model);
+  report.data_digest = Digest(FLAGS_data);
+  if (with_spec) {
+    report.spec_path = FLAGS_spec;
+    report.spec_digest = Digest(FLAGS_spec);
+  }
+  report.software_version = FASTCAL_VERSION;
+  report.command_line = CommandLine(argc, argv);
+  report.run_utc = UtcNow();
+  return report;
+}
+
+// --skip-invalid-rows for calibrate: what must solve are the "initial model" rows of the
+// table (exact, every attitude the data has) and the fit's start, the spec's initial
+// values (its forward model and exact, at the fit's attitude).
+void SkipSamplesTheCalibrationCannotSolve(const CableRobot& model, const CalibrationSpec& spec,
+                                          Dataset* data) {
+  const AttitudeSource fit_attitude =
+      spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured;
+  const std::string name = "the initial model";
+  SkipUnsolvableSamples(model, name, {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
+                        {StaticsMethod::kExact}, data);
+  SkipUnsolvableSamples(InitialCalibrationModel(model, spec), name, {fit_attitude},
+                        {spec.forward_model, StaticsMethod::kExact}, data);
+}
+
 int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
@@ -513,18 +545,7 @@ int RunCalibrate(int argc, char** argv) {
     PrintError(command, error);
     return kExitUsage;
   }
-  const AttitudeSource fit_attitude =
-      spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured;
-  if (FLAGS_skip_invalid_rows) {
-    // What must solve: the "initial model" rows of the table (exact, every attitude the
-    // data has), and the fit's start, the spec's initial values (its forward model and
-    // exact, at the fit's attitude).
-    const std::string name = "the initial model";
-    SkipUnsolvableSamples(model, name, {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
-                          {StaticsMethod::kExact}, &data);
-    SkipUnsolvableSamples(InitialCalibrationModel(model, spec), name, {fit_attitude},
-                          {spec.forward_model, StaticsMethod::kExact}, &data);
-  }
+  if (FLAGS_skip_invalid_rows) SkipSamplesTheCalibrationCannotSolve(model, spec, &data);
   if (!ReportSkipped(command, data, &error)) {
     PrintError(command, error);
     return kExitFailure;
@@ -546,16 +567,7 @@ int RunCalibrate(int argc, char** argv) {
 
   const std::vector<VariantEvaluation>& variants = result.variants;
 
-  ReportInputs report;
-  report.model_path = FLAGS_model;
-  report.spec_path = FLAGS_spec;
-  report.data_path = FLAGS_data;
-  report.model_digest = Digest(FLAGS_model);
-  report.spec_digest = Digest(FLAGS_spec);
-  report.data_digest = Digest(FLAGS_data);
-  report.software_version = FASTCAL_VERSION;
-  report.command_line = CommandLine(argc, argv);
-  report.run_utc = UtcNow();
+  ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/true);
   report.initial_model = &model;
   report.spec = &spec;
   report.data = &data;
@@ -571,6 +583,37 @@ int RunCalibrate(int argc, char** argv) {
 
   std::cerr << CalibrationConsole(result, data, variants) << ChiSquareWarning(result);
   return 0;
+}
+
+// evaluate's console: the RMS table, then per variant the RMS (%), mean and largest
+// error (kN) per cable.
+std::string EvaluationConsole(const Dataset& data, StaticsMethod method,
+                              const std::vector<VariantEvaluation>& variants) {
+  std::ostringstream s;
+  s << "fastcal evaluate: " << data.samples.size() << " samples";
+  s << SkippedNote(data);
+  s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
+    << StaticsMethodName(method) << "\n\n"
+    << RmsTable(variants);
+  char buf[160];
+  auto row = [&](const char* label, const auto& values, double scale) {
+    std::snprintf(buf, sizeof(buf), "    %-22s", label);
+    s << buf;
+    for (double v : values) {
+      std::snprintf(buf, sizeof(buf), " %8.3f", v * scale);
+      s << buf;
+    }
+    s << "\n";
+  };
+  for (const VariantEvaluation& v : variants) {
+    s << "\n  " << v.name << ":\n";
+    row("RMS (%)", v.fit.rms_percent, 1.0);
+    row("mean (kN)", v.fit.mean_n, 1.0 / kNPerKn);
+    row("max |error| (kN)", v.fit.max_abs_n, 1.0 / kNPerKn);
+  }
+  if (!FLAGS_out.empty())
+    s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";
+  return s.str();
 }
 
 int RunEvaluate(int argc, char** argv) {
@@ -608,14 +651,7 @@ int RunEvaluate(int argc, char** argv) {
     return kExitFailure;
   }
   if (!FLAGS_out.empty()) {
-    ReportInputs report;
-    report.model_path = FLAGS_model;
-    report.data_path = FLAGS_data;
-    report.model_digest = Digest(FLAGS_model);
-    report.data_digest = Digest(FLAGS_data);
-    report.software_version = FASTCAL_VERSION;
-    report.command_line = CommandLine(argc, argv);
-    report.run_utc = UtcNow();
+    ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/false);
     report.initial_model = &model;
     report.data = &data;
     report.variants = variants;
@@ -625,38 +661,7 @@ int RunEvaluate(int argc, char** argv) {
       return kExitUsage;
     }
   }
-  std::ostringstream s;
-  s << "fastcal evaluate: " << data.samples.size() << " samples";
-  s << SkippedNote(data);
-  s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
-    << StaticsMethodName(method) << "\n\n"
-    << RmsTable(variants);
-  char buf[160];
-  for (const VariantEvaluation& v : variants) {
-    s << "\n  " << v.name << ":\n";
-    std::snprintf(buf, sizeof(buf), "    %-22s", "RMS (%)");
-    s << buf;
-    for (double r : v.fit.rms_percent) {
-      std::snprintf(buf, sizeof(buf), " %8.3f", r);
-      s << buf;
-    }
-    std::snprintf(buf, sizeof(buf), "\n    %-22s", "mean (kN)");
-    s << buf;
-    for (double r : v.fit.mean_n) {
-      std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
-      s << buf;
-    }
-    std::snprintf(buf, sizeof(buf), "\n    %-22s", "max |error| (kN)");
-    s << buf;
-    for (double r : v.fit.max_abs_n) {
-      std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
-      s << buf;
-    }
-    s << "\n";
-  }
-  if (!FLAGS_out.empty())
-    s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";
-  std::cout << s.str();
+  std::cout << EvaluationConsole(data, method, variants);
   return 0;
 }
 
