@@ -144,7 +144,56 @@ void BM_EdgeSweepCold(benchmark::State& state) {
   SolveEachCold(state, poses, "edge sweep");
 }
 
+// Cables as built (issue 18): exact with two attachments per cable (a point mass 2-6 m up
+// and hung lines over the lowest 120-200 m), against the same solve with uniform cables
+// (argument 0: uniform, 1: two attachments per cable); cold at K2, and warm along the
+// paper's half circle.
+CableRobot AsBuiltRobot(bool attachments) {
+  CableRobot robot = CableRobot::NominalFast();
+  if (!attachments) return robot;
+  for (int i = 0; i < kNumCables; ++i) {
+    CableAttachment point, lines;
+    point.at_m = 2.0 + 0.8 * i;
+    point.mass_kg = 250.0 + 80.0 * i;
+    lines.kind = AttachmentKind::kAddedDensity;
+    lines.to_m = 120.0 + 16.0 * i;
+    lines.added_density_kg_per_m = 0.6 + 0.2 * i;
+    robot.cables[i].attachments = {point, lines};
+  }
+  return robot;
+}
+
+void BM_AttachmentsExactCold(benchmark::State& state) {
+  const CableRobot robot = AsBuiltRobot(state.range(0) != 0);
+  const Pose pose = K2Pose();
+  StaticsOptions options;
+  StaticsSolution solution;
+  for (auto _ : state) {
+    SolveStatics(robot, pose, options, &solution);
+    benchmark::DoNotOptimize(solution);
+  }
+  state.SetLabel(state.range(0) != 0 ? "two attachments per cable" : "uniform cables");
+  state.SetItemsProcessed(state.iterations());
+}
+
+void BM_AttachmentsExactWarmCircle(benchmark::State& state) {
+  const CableRobot robot = AsBuiltRobot(state.range(0) != 0);
+  const std::vector<Pose> poses = PaperTrajectory(/*circle=*/true);
+  StaticsOptions options;
+  options.warm_start = true;
+  StaticsSolution solution;
+  for (auto _ : state) {
+    solution.status = StaticsStatus::kInvalidInput;  // each pass starts cold
+    for (const Pose& pose : poses) SolveStatics(robot, pose, options, &solution);
+    benchmark::DoNotOptimize(solution);
+  }
+  state.SetLabel(state.range(0) != 0 ? "two attachments per cable" : "uniform cables");
+  state.SetItemsProcessed(state.iterations() * static_cast<int64_t>(poses.size()));
+}
+
 BENCHMARK(BM_SinglePoseCold)->DenseRange(0, 2);
+BENCHMARK(BM_AttachmentsExactCold)->DenseRange(0, 1);
+BENCHMARK(BM_AttachmentsExactWarmCircle)->DenseRange(0, 1);
 BENCHMARK(BM_WorkspaceArray)->DenseRange(0, 2)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_SinglePoseColdAasForcesOnly);
 BENCHMARK(BM_PaperTrajectory)->ArgsProduct({{0, 1, 2}, {0, 1}, {0, 1}});

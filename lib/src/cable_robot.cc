@@ -74,6 +74,18 @@ bool CableRobot::IsValid(std::string* error) const {
       return fail(key + ".sensor_gain", "must be > 0");
     }
     if (!std::isfinite(c.sensor_bias_n)) return fail(key + ".sensor_bias_kN", "must be finite");
+    if (c.attachments.size() > static_cast<size_t>(kMaxAttachmentsPerCable)) {
+      return fail(key + ".attachments",
+                  "has " + std::to_string(c.attachments.size()) + " entries; at most " +
+                      std::to_string(kMaxAttachmentsPerCable) + " per cable are supported");
+    }
+    for (size_t j = 0; j < c.attachments.size(); ++j) {
+      std::string why;
+      if (!c.attachments[j].IsValid(&why)) {
+        return fail(key + ".attachments[" + std::to_string(j) + "]." + why.substr(0, why.find(':')),
+                    why.substr(why.find(": ") + 2));
+      }
+    }
   }
   if (!(cabin_mass_kg > 0.0) || !std::isfinite(cabin_mass_kg)) {
     return fail("cabin_mass_kg", "must be > 0");
@@ -90,6 +102,27 @@ bool CableRobot::IsValid(std::string* error) const {
   }
   if (!(gravity_m_per_s2 < 0.0) || !std::isfinite(gravity_m_per_s2)) {
     return fail("gravity_m_per_s2", "must be < 0 (z is up)");
+  }
+  return true;
+}
+
+bool CableAttachment::IsValid(std::string* error) const {
+  auto fail = [&](const char* key, const std::string& why) {
+    if (error != nullptr) *error = std::string(key) + ": " + why;
+    return false;
+  };
+  if (kind == AttachmentKind::kPointMass) {
+    if (!(at_m >= 0.0) || !std::isfinite(at_m))
+      return fail("at_m", "must be >= 0 (m from the lower end)");
+    if (!(mass_kg >= 0.0) || !std::isfinite(mass_kg)) return fail("mass_kg", "must be >= 0");
+    return true;
+  }
+  if (!(from_m >= 0.0) || !std::isfinite(from_m)) {
+    return fail("from_m", "must be >= 0 (m from the lower end)");
+  }
+  if (!(to_m > from_m) || !std::isfinite(to_m)) return fail("to_m", "must be > from_m");
+  if (!(added_density_kg_per_m >= 0.0) || !std::isfinite(added_density_kg_per_m)) {
+    return fail("added_density_kg_per_m", "must be >= 0");
   }
   return true;
 }

@@ -225,6 +225,7 @@ class Parser {
       std::vector<std::string> allowed = required;
       allowed.push_back("sensor_gain");     // optional, default 1
       allowed.push_back("sensor_bias_kN");  // optional, default 0
+      allowed.push_back("attachments");     // optional, default none
       std::map<std::string, Entry> keys;
       if (!ReadMap(list[i], cable_line, cable_path, allowed, &keys)) return false;
       for (const std::string& name : required) {
@@ -262,6 +263,65 @@ class Parser {
         }
         c.sensor_bias_n = bias_kn * 1e3;
       }
+      c.attachments.clear();
+      if (keys.count("attachments") &&
+          !ReadAttachments(keys["attachments"], Join(cable_path, "attachments"), &c.attachments)) {
+        return false;
+      }
+    }
+    return true;
+  }
+
+  // A list of {at_m, mass_kg} (point masses) and {from_m, to_m, added_density_kg_per_m}
+  // (added weight over a range), each with all of its keys (cable_attachment.h).
+  bool ReadAttachments(const Entry& entry, const std::string& path,
+                       std::vector<CableAttachment>* out) {
+    const YAML::Node& list = entry.value;
+    const int line = LineOf(entry.key);
+    if (list.IsNull()) return true;  // `attachments:` with nothing: none
+    if (!list.IsSequence()) {
+      return Fail(line, path,
+                  "expected a list of {at_m, mass_kg} and {from_m, to_m, "
+                  "added_density_kg_per_m} entries");
+    }
+    for (size_t j = 0; j < list.size(); ++j) {
+      const std::string item_path = Index(path, j);
+      const int item_line = LineOf(list[j]) > 0 ? LineOf(list[j]) : line;
+      lines_[item_path] = item_line;
+      std::map<std::string, Entry> keys;
+      if (!ReadMap(list[j], item_line, item_path,
+                   {"at_m", "mass_kg", "from_m", "to_m", "added_density_kg_per_m"}, &keys)) {
+        return false;
+      }
+      CableAttachment a;
+      const bool point = keys.count("at_m") || keys.count("mass_kg");
+      a.kind = point ? AttachmentKind::kPointMass : AttachmentKind::kAddedDensity;
+      const std::vector<std::pair<const char*, double*>> fields =
+          point ? std::vector<std::pair<const char*, double*>>{{"at_m", &a.at_m},
+                                                               {"mass_kg", &a.mass_kg}}
+                : std::vector<std::pair<const char*, double*>>{
+                      {"from_m", &a.from_m},
+                      {"to_m", &a.to_m},
+                      {"added_density_kg_per_m", &a.added_density_kg_per_m}};
+      if (keys.size() != fields.size()) {
+        return Fail(item_line, item_path,
+                    point ? "a point mass has exactly the keys at_m and mass_kg"
+                          : "added weight has exactly the keys from_m, to_m and "
+                            "added_density_kg_per_m");
+      }
+      for (const auto& [name, value] : fields) {
+        const auto it = keys.find(name);
+        if (it == keys.end()) {
+          return Fail(item_line, Join(item_path, name),
+                      point ? "missing (a point mass gives at_m and mass_kg)"
+                            : "missing (added weight gives from_m, to_m and "
+                              "added_density_kg_per_m)");
+        }
+        if (!ReadDouble(it->second.value, LineOf(it->second.key), Join(item_path, name), value)) {
+          return false;
+        }
+      }
+      out->push_back(a);
     }
     return true;
   }
@@ -439,6 +499,17 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
     if (c.sensor_gain != 1.0 || c.sensor_bias_n != 0.0) {
       out << "    sensor_gain: " << Num(c.sensor_gain) << "  # reading = gain * tension + bias\n";
       out << "    sensor_bias_kN: " << Num(c.sensor_bias_n / 1e3) << "\n";
+    }
+    if (!c.attachments.empty()) {
+      out << "    attachments:  # arc length from the lower (cabin) end, unstretched, m\n";
+      for (const CableAttachment& a : c.attachments) {
+        if (a.kind == AttachmentKind::kPointMass) {
+          out << "      - {at_m: " << Num(a.at_m) << ", mass_kg: " << Num(a.mass_kg) << "}\n";
+        } else {
+          out << "      - {from_m: " << Num(a.from_m) << ", to_m: " << Num(a.to_m)
+              << ", added_density_kg_per_m: " << Num(a.added_density_kg_per_m) << "}\n";
+        }
+      }
     }
   }
   if (robot.reflector.has_value()) {

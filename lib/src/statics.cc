@@ -70,6 +70,12 @@ bool ParametersUsable(const StaticsParameters<double>& p) {
     if (!(p.linear_density_kg_per_m[i] > 0.0) || !std::isfinite(p.linear_density_kg_per_m[i])) {
       return false;
     }
+    for (int j = 0; j < p.chain[i].num_attachments; ++j) {
+      if (!(p.chain[i].value[j] >= 0.0) || !std::isfinite(p.chain[i].value[j])) return false;
+    }
+    for (int k = 0; k < p.chain[i].num_cuts; ++k) {
+      if (!(p.chain[i].cuts[k].s_m >= 0.0) || !std::isfinite(p.chain[i].cuts[k].s_m)) return false;
+    }
   }
   return p.cabin_mass_kg > 0.0 && std::isfinite(p.cabin_mass_kg) &&
          p.mass_centre_cabin_m.allFinite() && p.gravity_m_per_s2 < 0.0 &&
@@ -91,7 +97,8 @@ void EvaluateEnds(const StaticsParameters<double>& p, const Geometry& g, const S
                   const CableLinearisation<double>& lin, std::array<double, kNumCables>* miss,
                   Check* check) {
   for (int i = 0; i < kNumCables; ++i) {
-    const CatenaryEnd<double> e = CatenaryEndpoint(st[i].fl, st[i].fz, st[i].s0, p.ea_n[i], g.w[i]);
+    const CatenaryEnd<double> e =
+        internal::CableEndpoint(p, i, st[i].fl, st[i].fz, st[i].s0, g.w[i]);
     const double g0 = e.span_m - g.span[i], g1 = e.rise_m - g.rise[i];
     check->end_residual_m[i] = std::sqrt(g0 * g0 + g1 * g1);
     check->lower_n[i] = e.lower_tension_n;
@@ -191,6 +198,13 @@ StaticsStatus AasStart(Context* c, const Geometry& g, bool use_guess, State* st,
       internal::AasLines(c->p, g, c->o, use_guess, &c->low, &c->high, slope, &b, cable,
                          &c->sol->catenary_iterations, secant_jacobians);
   if (status != StaticsStatus::kOk) return status;
+  // Cables with attachments (exact's start only: aas refuses them): the uniform cable's
+  // line, moved by the share of the attachments' weight its lower end carries.
+  for (int i = 0; i < kNumCables; ++i) {
+    if (!c->p.chain[i].empty()) {
+      b[i] += CatenaryChainLowerShareN(c->p.chain[i], g.chord[i], c->p.gravity_m_per_s2);
+    }
+  }
   const bool solved = response != nullptr
                           ? internal::SolveEquilibrium<double, true>(g, *slope, b, &fl, response)
                           : internal::SolveEquilibrium(g, *slope, b, &fl);
@@ -231,7 +245,11 @@ StaticsStatus ExactStart(Context* c, const Geometry& g, State* st) {
   for (int i = 0; i < kNumCables; ++i) {
     const CatenaryCurvePoint guess =
         internal::CurveGuess((*st)[i].fl, g, i, c->p.ea_n[i], c->low[i], c->high[i], c->o, true);
-    (*st)[i].fz = guess.fz_n;
+    // A cable with attachments: the uniform cable's point, Fz moved as in AasStart.
+    (*st)[i].fz =
+        guess.fz_n + (c->p.chain[i].empty() ? 0.0
+                                            : CatenaryChainLowerShareN(c->p.chain[i], g.chord[i],
+                                                                       c->p.gravity_m_per_s2));
     (*st)[i].s0 = guess.s0_m;
   }
   return StaticsStatus::kOk;
@@ -507,7 +525,7 @@ double CableReflectorClearanceM(const StaticsParameters<double>& p, const Geomet
   const Eigen::Vector3d anchor =
       p.tower_top_m[i] - Eigen::Vector3d(g.ux[i] * g.span[i], g.uy[i] * g.span[i], g.rise[i]);
   auto distance2 = [&](double s_m) {  // -1 where the point is not over the reflector
-    const CatenaryEnd<double> e = CatenaryEndpoint(st[i].fl, st[i].fz, s_m, p.ea_n[i], g.w[i]);
+    const CatenaryEnd<double> e = internal::CableEndpoint(p, i, st[i].fl, st[i].fz, s_m, g.w[i]);
     const Eigen::Vector3d d =
         anchor + Eigen::Vector3d(g.ux[i] * e.span_m, g.uy[i] * e.span_m, e.rise_m) - r.centre_m;
     return d.z() > 0.0 || d.head<2>().squaredNorm() > rim2 ? -1.0 : d.squaredNorm();
@@ -556,10 +574,11 @@ double ReflectorClearanceM(const StaticsParameters<double>& p, const Geometry& g
 }
 
 // The model-range limits of StaticsOptions on a solution, the worst cable of the first
-// limit broken, in this order: s0 <= 0 or strain over max_strain (kOverstretchedCable),
-// s0/k over max_length_ratio (kSaggingCable), a lowest point closer to the reflector than
-// min_reflector_clearance_m (kReflectorContact). Writes the smallest clearance whatever
-// the outcome.
+// limit broken, in this order: an attachment that starts beyond its cable's unstretched
+// length (kAttachmentBeyondCable, the first such cable), s0 <= 0 or strain over max_strain
+// (kOverstretchedCable), s0/k over max_length_ratio (kSaggingCable), a lowest point closer to the
+// reflector than min_reflector_clearance_m (kReflectorContact). Writes the smallest clearance
+// whatever the outcome.
 StaticsStatus CheckModelRange(Context* c, const Geometry& g, const State& st, const Check& check) {
   StaticsSolution* sol = c->sol;
   const StaticsOptions& o = c->o;
@@ -580,6 +599,16 @@ StaticsStatus CheckModelRange(Context* c, const Geometry& g, const State& st, co
     }
   }
   sol->reflector_clearance_m = ReflectorClearanceM(c->p, g, st, &nearest);
+  for (int i = 0; i < kNumCables; ++i) {
+    double start_m = 0.0;
+    if (!c->p.chain[i].empty() && st[i].s0 > 0.0 &&
+        CatenaryChainBeyond(c->p.chain[i], st[i].s0, &start_m) >= 0) {
+      sol->cable = i;
+      sol->limit_value = start_m;
+      sol->limit = st[i].s0;
+      return StaticsStatus::kAttachmentBeyondCable;
+    }
+  }
   if (too_short >= 0 || stretched >= 0) {
     sol->cable = too_short >= 0 ? too_short : stretched;
     sol->limit_value = too_short >= 0 ? st[too_short].s0 / g.chord[too_short] : strain;
@@ -790,6 +819,15 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
       internal::ComputeGeometry(p, pose, o.catenary.vertical_span_fraction, &g, &sol->cable);
   if (status != StaticsStatus::kOk) return status;
 
+  if (o.method != StaticsMethod::kExact) {
+    for (int i = 0; i < kNumCables; ++i) {
+      if (!p.chain[i].empty()) {
+        sol->cable = i;
+        return StaticsStatus::kUnsupportedModel;
+      }
+    }
+  }
+
   Context c{p, o, sol};
   if (previous != nullptr) {
     if (o.method == StaticsMethod::kExact) {
@@ -856,6 +894,10 @@ const char* StaticsStatusName(StaticsStatus status) {
       return "not_converged";
     case StaticsStatus::kInaccurate:
       return "inaccurate";
+    case StaticsStatus::kAttachmentBeyondCable:
+      return "attachment_beyond_cable";
+    case StaticsStatus::kUnsupportedModel:
+      return "unsupported_model";
   }
   return "unknown";
 }
@@ -968,6 +1010,7 @@ StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot) {
     p.anchor_cabin_m[i] = robot.AnchorOfCable(i);
     p.ea_n[i] = robot.cables[i].ea_n;
     p.linear_density_kg_per_m[i] = robot.cables[i].linear_density_kg_per_m;
+    p.chain[i] = MakeCatenaryChain(robot.cables[i].attachments);
   }
   p.cabin_mass_kg = robot.cabin_mass_kg;
   p.mass_centre_cabin_m = robot.mass_centre_cabin_m;
@@ -1161,6 +1204,16 @@ std::string DescribeStatus(const StaticsSolution& solution) {
           << " a horizontal force <= 0: its secant lines are far from the catenaries here, "
              "which says nothing about whether the pose can be held; use exact";
       }
+      break;
+    case StaticsStatus::kAttachmentBeyondCable:
+      s << "an attachment of cable " << c << " starts " << Sig(solution.limit_value, 6)
+        << " m from its lower end, at or beyond the cable's unstretched length here ("
+        << Sig(solution.limit, 6) << " m): it is not on the cable (check the model's "
+        << "cables[" << solution.cable << "].attachments)";
+      break;
+    case StaticsStatus::kUnsupportedModel:
+      s << "cable " << c << " carries attachments (sensors, hung lines), which aas and "
+        << "aas-refined do not model (their secant lines are the uniform cable's); use exact";
       break;
   }
   return s.str();

@@ -147,8 +147,8 @@ DoubleArray QuaternionsOf(const std::vector<Pose>& poses) {
 void BindStatics(py::module_& m) {
   m.def("statics_status_names", [] {
     py::list names;
-    // kInaccurate is the enum's last status.
-    for (int s = 0; s <= static_cast<int>(StaticsStatus::kInaccurate); ++s) {
+    // kUnsupportedModel is the enum's last status.
+    for (int s = 0; s <= static_cast<int>(StaticsStatus::kUnsupportedModel); ++s) {
       names.append(StaticsStatusName(static_cast<StaticsStatus>(s)));
     }
     return names;

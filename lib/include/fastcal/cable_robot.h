@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/cable_attachment.h"
+
 namespace fastcal {
 
 // FAST has six cables and six degrees of freedom; fixed-size arrays keep the per-pose
@@ -41,6 +43,9 @@ struct CableProperties {
   // sensor_bias_kN, optional).
   double sensor_gain = 1.0;
   double sensor_bias_n = 0.0;
+  // Sensors, connectors and hung lines the cable carries (cable_attachment.h), in the
+  // model file's order; none for a uniform cable. At most kMaxAttachmentsPerCable.
+  std::vector<CableAttachment> attachments;
 
   // What this cable's sensor reads when the cable's lower-end tension is `tension_n`
   // (e.g. StaticsSolution's lower_tension_n, which is the true tension).
@@ -78,7 +83,16 @@ struct CableRobot {
     return anchor_points_cabin_m[cables[i].anchor_index];
   }
 
+  // Whether any cable carries attachments (the statics then need exact: statics.h).
+  bool HasAttachments() const {
+    for (const CableProperties& c : cables) {
+      if (!c.attachments.empty()) return true;
+    }
+    return false;
+  }
+
   // Checks physical sense: EA > 0, density > 0, mass > 0, g < 0, finite coordinates,
+  // attachments valid (CableAttachment::IsValid) and at most kMaxAttachmentsPerCable,
   // a reflector (if any) with radius > 0 and aperture in (0, 2 radius], anchor indices in range, no
   // two tower tops coincident, no two distinct anchor points coincident. On failure returns false
   // and names the offending key in *error (YAML key path, e.g. "cables[2].ea_n").

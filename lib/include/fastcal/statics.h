@@ -149,24 +149,29 @@ StaticsOptions ModelFitStaticsOptions(StaticsMethod method);
 
 enum class StaticsStatus {
   kOk = 0,
-  kInvalidInput,        // non-finite pose or parameters, or invalid options
-  kVerticalCable,       // a chord is vertical: Fl's direction is undefined
-  kNoEquilibrium,       // exact: no equilibrium with positive cable forces (Fl_i > 0)
-  kSaggingCable,        // an equilibrium, but cable `cable` has s0/k = limit_value > limit
-  kOverstretchedCable,  // an equilibrium, but cable `cable` has strain limit_value > limit
-                        // (tension over max_strain EA), or s0 <= 0 (limit_value = s0/k)
-  kReflectorContact,    // an equilibrium, but cable `cable`'s lowest point is closer to
-                        // the reflector than limit (m): clearance limit_value
-  kSingular,            // the 6x6 equilibrium matrix is singular
-  kCatenaryFailed,      // a per-cable solve did not converge
-  kNotConverged,        // exact or aas-refined did not reach its tolerance within its
-                        // iteration limits: error estimate limit_value > limit
-  kInaccurate,          // aas: error estimate limit_value > aas_max_relative_error, or
-                        // (limit_value 0) AAS gave cable `cable` Fl <= 0
+  kInvalidInput,           // non-finite pose or parameters, or invalid options
+  kVerticalCable,          // a chord is vertical: Fl's direction is undefined
+  kNoEquilibrium,          // exact: no equilibrium with positive cable forces (Fl_i > 0)
+  kSaggingCable,           // an equilibrium, but cable `cable` has s0/k = limit_value > limit
+  kOverstretchedCable,     // an equilibrium, but cable `cable` has strain limit_value > limit
+                           // (tension over max_strain EA), or s0 <= 0 (limit_value = s0/k)
+  kReflectorContact,       // an equilibrium, but cable `cable`'s lowest point is closer to
+                           // the reflector than limit (m): clearance limit_value
+  kSingular,               // the 6x6 equilibrium matrix is singular
+  kCatenaryFailed,         // a per-cable solve did not converge
+  kNotConverged,           // exact or aas-refined did not reach its tolerance within its
+                           // iteration limits: error estimate limit_value > limit
+  kInaccurate,             // aas: error estimate limit_value > aas_max_relative_error, or
+                           // (limit_value 0) AAS gave cable `cable` Fl <= 0
+  kAttachmentBeyondCable,  // an equilibrium, but an attachment of cable `cable` starts at
+                           // limit_value (m), at or beyond its unstretched length limit (m)
+  kUnsupportedModel,       // aas, aas-refined: cable `cable` carries attachments, which the
+                           // paper's secant lines do not describe (use exact)
 };
 // Short code for files and scripts: "ok", "invalid_input", "vertical_cable",
 // "no_equilibrium", "sagging_cable", "overstretched_cable", "reflector_contact",
-// "singular", "catenary_failed", "not_converged", "inaccurate".
+// "singular", "catenary_failed", "not_converged", "inaccurate", "attachment_beyond_cable",
+// "unsupported_model".
 const char* StaticsStatusName(StaticsStatus status);
 
 struct CableSolution {

@@ -20,6 +20,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/catenary.h"
+#include "fastcal/catenary_chain.h"
 #include "fastcal/pose.h"
 #include "fastcal/scalar.h"
 
@@ -35,6 +36,8 @@ struct StaticsParameters {
   std::array<Vector3T<T>, kNumCables> anchor_cabin_m;  // cabin frame
   std::array<T, kNumCables> ea_n;
   std::array<T, kNumCables> linear_density_kg_per_m;
+  // Each cable's attachments (catenary_chain.h); empty for a uniform cable.
+  std::array<CatenaryChain<T>, kNumCables> chain;
   T cabin_mass_kg;
   Vector3T<T> mass_centre_cabin_m;
   double gravity_m_per_s2 = -9.8;
@@ -54,6 +57,7 @@ StaticsParameters<double> ScalarParameters(const StaticsParameters<T>& p) {
     }
     d.ea_n[i] = ScalarValue(p.ea_n[i]);
     d.linear_density_kg_per_m[i] = ScalarValue(p.linear_density_kg_per_m[i]);
+    d.chain[i] = ScalarChain(p.chain[i]);
   }
   d.cabin_mass_kg = ScalarValue(p.cabin_mass_kg);
   for (int j = 0; j < 3; ++j) d.mass_centre_cabin_m[j] = ScalarValue(p.mass_centre_cabin_m[j]);
@@ -63,6 +67,18 @@ StaticsParameters<double> ScalarParameters(const StaticsParameters<T>& p) {
 }
 
 namespace internal {
+
+// The end point of cable i at (Fl, Fz, s0) with weight per length w: the uniform
+// catenary's (catenary.h) or, where the cable carries attachments, the chain's
+// (catenary_chain.h). A uniform cable pays one predictable branch.
+template <typename T>
+FASTCAL_ALWAYS_INLINE CatenaryEnd<T> CableEndpoint(const StaticsParameters<T>& p, int i,
+                                                   const T& fl_n, const T& fz_n, const T& s0_m,
+                                                   const T& w_n_per_m) {
+  if (p.chain[i].empty()) return CatenaryEndpoint(fl_n, fz_n, s0_m, p.ea_n[i], w_n_per_m);
+  return CatenaryChainEndpoint(fl_n, fz_n, s0_m, p.ea_n[i], w_n_per_m, p.chain[i],
+                               p.gravity_m_per_s2);
+}
 
 // Cable chords and lever arms at one pose.
 template <typename T>
@@ -478,7 +494,7 @@ void LineariseCables(const StaticsParameters<T>& p, const PoseGeometry<T>& g,
   double max_residual = 0.0;
   for (int i = 0; i < kNumCables; ++i) {
     const CableState<T>& c = state[i];
-    const CatenaryEnd<T> e = CatenaryEndpoint(c.fl, c.fz, c.s0, p.ea_n[i], g.w[i]);
+    const CatenaryEnd<T> e = CableEndpoint(p, i, c.fl, c.fz, c.s0, g.w[i]);
     const T g0 = e.span_m - g.span[i];
     const T g1 = e.rise_m - g.rise[i];
     const double chord = ScalarValue(g.chord[i]);
