@@ -288,6 +288,9 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
   if (result.verdict == FitVerdict::kFailed) {
     header += "WARNING: THIS CALIBRATION FAILED; DO NOT USE THIS MODEL.\n" + result.verdict_text +
               ".\n(report.md, Verdict)\n";
+  } else if (result.verdict == FitVerdict::kModelIncomplete) {
+    header += "WARNING: THE MODEL IS INCOMPLETE; ESTIMATES MARKED BELOW ARE NOT SOUND.\n" +
+              result.verdict_text + ".\n(report.md, Verdict)\n";
   }
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
             "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
@@ -298,6 +301,7 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
     if (!p.free) continue;
     header += "\n  " + p.name + " = " + FormatDouble(p.estimate, 8) + " +- " +
               FormatDouble(p.sigma_total, 3) + (p.unit == "1" ? "" : " " + p.unit);
+    if (!p.moved_by.empty()) header += "  NOT SOUND: freeing " + p.moved_by + " would move it";
   }
   return header;
 }
@@ -316,6 +320,9 @@ std::string ChiSquareWarning(const CalibrationResult& result) {
              " (report.md, Verdict)\n";
     case FitVerdict::kNoiseOverstated:
       return "fastcal calibrate: note: noise overstated: " + result.verdict_text + "\n";
+    case FitVerdict::kModelIncomplete:
+      return "fastcal calibrate: warning: model incomplete: " + result.verdict_text +
+             " (report.md, Verdict)\n";
   }
   return "";
 }
@@ -345,6 +352,10 @@ std::string EstimatesTable(const CalibrationResult& result) {
       flags += "weak in data ";
     }
     if (p.consider) flags += "consider (fixed, prior sigma) ";
+    if (!p.moved_by.empty()) {
+      flags += "NOT SOUND: " + p.moved_by + " would move it " + FormatDouble(p.moved_by_sigmas, 2) +
+               " sigma ";
+    }
     const std::string total = p.free || p.consider ? FormatDouble(p.sigma_total, 3) : "fixed";
     std::snprintf(buf, sizeof(buf), "  %-28.28s %6s %14.6g %14.6g %11s %11s %8s %11s  %s\n",
                   p.name.c_str(), p.unit.c_str(), p.initial, p.estimate, total.c_str(),
@@ -540,8 +551,7 @@ int RunCalibrate(int argc, char** argv) {
   Dataset data;
   CalibrationSpec spec;
   if (!CheckOutputDirectory("out", FLAGS_out, &error) || !LoadInputs(&model, &data, &error) ||
-      !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(model.anchor_points_cabin_m.size()), &spec,
-                           &error)) {
+      !LoadCalibrationSpec(FLAGS_spec, model, &spec, &error)) {
     PrintError(command, error);
     return kExitUsage;
   }

@@ -632,6 +632,9 @@ TEST_F(CliTest, WorkspaceWritesCsvAndHtmlAndNamesBadFlags) {
 
 // A reduced chi-square far outside its band is a warning on stderr and a failure in the
 // report's verdict, not silence. The dataset is the example of docs/data-format.md.
+// Two samples of a far-off model: the chi-square is far above its band, and fixed
+// parameters the data point at would move the mass centre by many sigma_total: the
+// verdict says the model is incomplete (issue 18), not merely "misfit scaled".
 TEST_F(CliTest, CalibratePoorFitWarns) {
   Write("example.csv",
         "# FAST telemetry export, 2024-05-01, circle of radius 71.11 m\n"
@@ -644,13 +647,13 @@ TEST_F(CliTest, CalibratePoorFitWarns) {
       "/calibration_data/spec_mass_centre.yaml --data=" + Path("example.csv") + " --out=" + out);
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(std::regex_search(
-      r.output, std::regex("fastcal calibrate: note: misfit scaled into sigma_total: reduced "
-                           "chi-square [0-9.]+ is above 1 \\+ 1.34: the residuals are [0-9.]+ "
-                           "times the stated noise")))
+      r.output, std::regex("fastcal calibrate: warning: model incomplete: freeing [a-z_]+\\[[0-9]\\]"
+                           "\\.[xyz], which the data point at beyond their noise, would move "
+                           "mass_centre_m\\.[xy] by .*; reduced chi-square [0-9.]+ is above 1 "
+                           "\\+ 1.34: the residuals are [0-9.]+ times the stated noise")))
       << r.output;
   EXPECT_NE(ReadFile(out + "/report.md")
-                .find("## Verdict\n\n**Misfit, scaled into the "
-                      "uncertainties:** reduced chi-square"),
+                .find("## Verdict\n\n**Model incomplete:** freeing "),
             std::string::npos);
   EXPECT_NE(ReadFile(out + "/summary.json").find("\"reduced_chi_square_within_band\": false"),
             std::string::npos);

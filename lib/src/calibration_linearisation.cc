@@ -285,17 +285,17 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
 bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std::string* error) {
   const int n = in.fitted->num_free();
   const int q = static_cast<int>(in.candidates.size());
-  const int num_anchor_points = static_cast<int>(in.fitted->robot().anchor_points_cabin_m.size());
+  const CableRobot& model = in.fitted->robot();
   CalibrationSpec basis_spec;
-  basis_spec.parameters = BasisParameters(num_anchor_points);
+  basis_spec.parameters = BasisParameters(model);
   CandidatePass pass{in, CalibrationModel(in.fitted->ToRobot(in.theta), basis_spec), {}, {}, {}};
   pass.theta = pass.basis.InitialTheta();
   for (int k = 0; k < n; ++k) {
     const ParameterSpec& p = in.fitted->spec().parameters[in.fitted->spec_index(k)];
-    pass.free_columns.push_back(BasisColumns(p, num_anchor_points));
+    pass.free_columns.push_back(BasisColumns(p, model));
   }
   for (const ParameterSpec& p : in.candidates) {
-    pass.candidate_columns.push_back(BasisColumns(p, num_anchor_points));
+    pass.candidate_columns.push_back(BasisColumns(p, model));
   }
   const std::vector<int> samples =
       CandidateSamples(static_cast<int>(in.fit.size()), in.max_candidate_samples);
@@ -331,9 +331,9 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
 
 }  // namespace
 
-std::vector<ParameterSpec> BasisParameters(int num_anchor_points) {
+std::vector<ParameterSpec> BasisParameters(const CableRobot& model) {
   std::vector<ParameterSpec> basis;
-  for (ParameterSpec p : AllModelParameters(num_anchor_points)) {
+  for (ParameterSpec p : AllModelParameters(model)) {
     if (IsPerCableGroup(p.kind) && p.index < 0) continue;
     p.free = true;
     basis.push_back(p);
@@ -341,8 +341,8 @@ std::vector<ParameterSpec> BasisParameters(int num_anchor_points) {
   return basis;
 }
 
-std::vector<int> BasisColumns(const ParameterSpec& p, int num_anchor_points) {
-  const std::vector<ParameterSpec> basis = BasisParameters(num_anchor_points);
+std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model) {
+  const std::vector<ParameterSpec> basis = BasisParameters(model);
   std::vector<int> columns;
   for (size_t c = 0; c < basis.size(); ++c) {
     if (Covers(p, basis[c])) columns.push_back(static_cast<int>(c));

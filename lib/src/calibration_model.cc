@@ -48,6 +48,10 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
         case ParameterKind::kSensorBias:
           if (cable) base_bias_n_[i] = v;
           break;
+        case ParameterKind::kAttachmentMass:
+        case ParameterKind::kAttachmentDensity:
+          if (i == s.index) base_.chain[i].value[s.component] = v;
+          break;
       }
     }
   }
@@ -87,6 +91,9 @@ double CalibrationModel::BaseValue(const ParameterSpec& s) const {
       for (double d : base_bias_n_) sum += d;
       return sum / kNumCables;
     }
+    case ParameterKind::kAttachmentMass:
+    case ParameterKind::kAttachmentDensity:
+      return base_.chain[c].value[s.component];
   }
   return 0.0;
 }
@@ -122,6 +129,8 @@ CableRobot CalibrationModel::ToRobot(const double* theta) const {
     c.linear_density_kg_per_m = p.linear_density_kg_per_m[i];
     c.sensor_gain = gain[i];
     c.sensor_bias_n = bias[i];
+    for (size_t j = 0; j < c.attachments.size(); ++j)
+      c.attachments[j].SetValue(p.chain[i].value[j]);
   }
   out.cabin_mass_kg = p.cabin_mass_kg;
   out.mass_centre_cabin_m = p.mass_centre_cabin_m;
@@ -147,7 +156,7 @@ TensionCost::TensionCost(const TensionResidual& functor)
 template <int N>
 bool TensionCost::EvaluateJet(const double* theta, double* residuals, double* jacobian) const {
   using Jet = ceres::Jet<double, N>;
-  std::array<Jet, kMaxFreeParameters> t;
+  std::array<Jet, N> t;
   for (int k = 0; k < n_; ++k) t[k] = Jet(theta[k], k);
   std::array<Jet, kNumCables> r;
   if (!functor_(t.data(), r.data())) return false;
@@ -169,6 +178,7 @@ bool TensionCost::Evaluate(double const* const* parameters, double* residuals,
   if (n_ <= 8) return EvaluateJet<8>(theta, residuals, j);
   if (n_ <= 16) return EvaluateJet<16>(theta, residuals, j);
   if (n_ <= 32) return EvaluateJet<32>(theta, residuals, j);
+  if (n_ <= 64) return EvaluateJet<64>(theta, residuals, j);
   return EvaluateJet<kMaxFreeParameters>(theta, residuals, j);
 }
 

@@ -61,7 +61,29 @@ constexpr GroupInfo kGroups[] = {
     {ParameterKind::kTowerOffset, "tower_offset_m", "m", 1.0},
     {ParameterKind::kSensorGain, "sensor_gain", "1", 1.0},
     {ParameterKind::kSensorBias, "sensor_bias_kN", "kN", kNewtonsPerKilonewton},
+    {ParameterKind::kAttachmentMass, "attachment_mass_kg", "kg", 1.0},
+    {ParameterKind::kAttachmentDensity, "attachment_density_kg_per_m", "kg/m", 1.0},
 };
+
+bool IsAttachment(ParameterKind kind) {
+  return kind == ParameterKind::kAttachmentMass || kind == ParameterKind::kAttachmentDensity;
+}
+
+AttachmentKind AttachmentKindOf(ParameterKind kind) {
+  return kind == ParameterKind::kAttachmentMass ? AttachmentKind::kPointMass
+                                                : AttachmentKind::kAddedDensity;
+}
+
+// What the model's cables carry, as the spec reader needs it: each cable's attachment kinds.
+using AttachmentShape = std::array<std::vector<AttachmentKind>, kNumCables>;
+
+AttachmentShape ShapeOf(const CableRobot& model) {
+  AttachmentShape shape;
+  for (int i = 0; i < kNumCables; ++i) {
+    for (const CableAttachment& a : model.cables[i].attachments) shape[i].push_back(a.kind);
+  }
+  return shape;
+}
 
 // Null for a kind outside the enum (a spec built in code from a bad cast).
 const GroupInfo* InfoOf(ParameterKind kind) {
@@ -82,9 +104,13 @@ bool IsVector(ParameterKind kind) {
          kind == ParameterKind::kTowerOffset;
 }
 
-// "mass_centre_m.x", "cabin_mass_kg", "ea_n[3]", "anchor_offset_m[2].z" (1-based).
+// "mass_centre_m.x", "cabin_mass_kg", "ea_n[3]", "anchor_offset_m[2].z",
+// "attachment_mass_kg[3][1]" (1-based).
 std::string ParameterName(const GroupInfo& g, int index, int component) {
   std::string name = g.key;
+  if (IsAttachment(g.kind)) {
+    return name + "[" + std::to_string(index + 1) + "][" + std::to_string(component + 1) + "]";
+  }
   if (index >= 0) name += "[" + std::to_string(index + 1) + "]";
   if (component >= 0 && component < 3) name += std::string(".") + kAxes[component];
   return name;
@@ -115,6 +141,9 @@ std::string CheckInitial(ParameterKind kind, double initial_si) {
   }
   if (what != nullptr && !(initial_si > 0.0)) {
     return std::string("must be > 0 (") + what + " is positive)";
+  }
+  if (IsAttachment(kind) && !(initial_si >= 0.0)) {
+    return "must be >= 0 (an attachment adds weight)";
   }
   return "";
 }
@@ -248,8 +277,10 @@ ParameterSpec MakeParameter(const GroupInfo& g, int index, int component, const 
 
 class Reader {
  public:
-  Reader(const std::string& source, int num_anchor_points)
-      : source_(source), num_anchor_points_(num_anchor_points) {}
+  Reader(const std::string& source, int num_anchor_points, AttachmentShape attachments)
+      : source_(source),
+        num_anchor_points_(num_anchor_points),
+        attachments_(std::move(attachments)) {}
 
   const std::string& error() const { return error_; }
 
@@ -731,6 +762,88 @@ class Reader {
     return true;
   }
 
+  // {all: entry} (every attachment of the group's kind on every cable), or a list of
+  // entries each naming its `cable` (1..6) and `attachment` (1.., its position in the
+  // model's cables[cable - 1].attachments).
+  bool ReadAttachments(const KeyValue& group, const GroupInfo& g, const std::string& path,
+                       std::vector<ParameterSpec>* out) {
+    const AttachmentKind kind = AttachmentKindOf(g.kind);
+    const char* what = kind == AttachmentKind::kPointMass ? "point mass" : "added density";
+    if (group.value.IsSequence()) {
+      const YAML::Node& list = group.value;
+      std::vector<ParameterSpec> listed;
+      for (size_t k = 0; k < list.size(); ++k) {
+        const std::string item = Element(path, k);
+        const int line = LineOf(list[k]) > 0 ? LineOf(list[k]) : group.line;
+        KeyMap keys;
+        if (!ReadMap(list[k], line, item, {"cable", "attachment", "free", "initial", "prior"},
+                     &keys)) {
+          return false;
+        }
+        int cable = 0, attachment = 0;
+        for (const auto& [name, field] :
+             {std::pair{"cable", &cable}, std::pair{"attachment", &attachment}}) {
+          const KeyValue* kv = Find(keys, name);
+          if (kv == nullptr) {
+            return Fail(line, Join(item, name),
+                        "missing (each entry names its cable and attachment)");
+          }
+          if (!ReadInteger(*kv, Join(item, name), field)) return false;
+        }
+        if (cable < 1 || cable > kNumCables) {
+          return Fail(keys.at("cable").line, Join(item, "cable"), "must be a cable 1..6");
+        }
+        const std::vector<AttachmentKind>& on = attachments_[cable - 1];
+        if (attachment < 1 || attachment > static_cast<int>(on.size()) ||
+            on[attachment - 1] != kind) {
+          return Fail(keys.at("attachment").line, Join(item, "attachment"),
+                      "cable " + std::to_string(cable) + " has no " + what + " at position " +
+                          std::to_string(attachment) + " of its attachments in the model (" +
+                          std::to_string(on.size()) + " attachments; give the model with --model)");
+        }
+        EntryText entry;
+        if (!ReadEntryKeys(keys, g, item, &entry)) return false;
+        const ParameterSpec p = MakeParameter(g, cable - 1, attachment - 1, entry);
+        for (const ParameterSpec& q : listed) {
+          if (q.index == p.index && q.component == p.component) {
+            return Fail(line, item, p.name + " is listed twice");
+          }
+        }
+        listed.push_back(p);
+      }
+      // Canonical order: cable by cable, attachment by attachment.
+      std::sort(listed.begin(), listed.end(), [](const ParameterSpec& a, const ParameterSpec& b) {
+        return std::make_pair(a.index, a.component) < std::make_pair(b.index, b.component);
+      });
+      out->insert(out->end(), listed.begin(), listed.end());
+      return true;
+    }
+    if (!group.value.IsNull() && !group.value.IsMap()) {
+      return Fail(group.line, path,
+                  "expected {all: entry} or a list of entries with cable and attachment");
+    }
+    KeyMap keys;
+    if (!ReadMap(group, path, {"all"}, &keys)) return false;
+    if (const KeyValue* kv = Find(keys, "all")) {
+      EntryText entry;
+      if (!ReadEntry(kv->value, kv->line, g, Join(path, "all"), &entry)) return false;
+      const size_t before = out->size();
+      for (int i = 0; i < kNumCables; ++i) {
+        for (size_t j = 0; j < attachments_[i].size(); ++j) {
+          if (attachments_[i][j] == kind) {
+            out->push_back(MakeParameter(g, i, static_cast<int>(j), entry));
+          }
+        }
+      }
+      if (out->size() == before) {
+        return Fail(kv->line, Join(path, "all"),
+                    std::string("the model's cables carry no ") + what +
+                        " (cables[i].attachments in the model file, given with --model)");
+      }
+    }
+    return true;
+  }
+
   bool ReadParameters(const KeyValue& parameters, CalibrationSpec* spec) {
     std::vector<std::string> accepted;
     for (const GroupInfo& g : kGroups) accepted.push_back(g.key);
@@ -753,6 +866,8 @@ class Reader {
         if (ok) out.push_back(MakeParameter(g, -1, -1, entry));
       } else if (IsPerCableCapable(g.kind)) {
         ok = ReadPerCableGroup(*kv, g, path, &out);
+      } else if (IsAttachment(g.kind)) {
+        ok = ReadAttachments(*kv, g, path, &out);
       } else {
         ok = ReadOffsets(*kv, g, path, &out);
       }
@@ -764,6 +879,7 @@ class Reader {
 
   std::string source_;
   int num_anchor_points_;
+  AttachmentShape attachments_;
   std::string error_;
 };
 
@@ -848,6 +964,10 @@ std::string ParameterProblem(const ParameterSpec& p, const std::string& label) {
   if (p.kind == ParameterKind::kTowerOffset && (p.index < 0 || p.index >= kNumCables)) {
     return label + ": index must be a tower 0..5";
   }
+  if (IsAttachment(p.kind) && (p.index < 0 || p.index >= kNumCables || p.component < 0 ||
+                               p.component >= kMaxAttachmentsPerCable)) {
+    return label + ": index must be a cable 0..5 and component an attachment 0..7";
+  }
   if (!(std::isfinite(p.to_si) && p.to_si > 0.0)) return label + ": to_si must be > 0";
   if (p.has_initial) {
     if (const std::string w = CheckInitial(p.kind, p.initial_si); !w.empty()) {
@@ -884,7 +1004,7 @@ bool CalibrationSpec::IsValid(std::string* error) const {
     const bool indexed =
         p.kind != ParameterKind::kMassCentre && p.kind != ParameterKind::kCabinMass;
     const auto key = std::make_tuple(static_cast<int>(p.kind), indexed ? p.index : -1,
-                                     IsVector(p.kind) ? p.component : -1);
+                                     IsVector(p.kind) || IsAttachment(p.kind) ? p.component : -1);
     if (!seen.insert(key).second) return fail(label + ": listed twice");
     if (IsPerCableCapable(p.kind)) {
       (p.index < 0 ? kinds_common : kinds_per_cable).insert(static_cast<int>(p.kind));
@@ -898,9 +1018,11 @@ bool CalibrationSpec::IsValid(std::string* error) const {
   return true;
 }
 
-bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
-                              int num_anchor_points, CalibrationSpec* spec, std::string* error) {
-  Reader reader(source_name, num_anchor_points);
+namespace {
+
+bool ParseSpec(const std::string& text, const std::string& source_name, int num_anchor_points,
+               const AttachmentShape& attachments, CalibrationSpec* spec, std::string* error) {
+  Reader reader(source_name, num_anchor_points, attachments);
   CalibrationSpec parsed;
   try {
     const internal::YamlDocuments documents = internal::LoadYamlDocuments(text);
@@ -926,15 +1048,39 @@ bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source
   return true;
 }
 
-bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
-                         std::string* error) {
+bool LoadSpec(const std::string& path, int num_anchor_points, const AttachmentShape& attachments,
+              CalibrationSpec* spec, std::string* error) {
   std::string text;
   std::string message;
   if (!internal::ReadRegularFile(path, kMaxSpecFileBytes, "calibration spec", &text, &message)) {
     if (error != nullptr) *error = message;
     return false;
   }
-  return ParseCalibrationSpecYaml(text, path, num_anchor_points, spec, error);
+  return ParseSpec(text, path, num_anchor_points, attachments, spec, error);
+}
+
+}  // namespace
+
+bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
+                              const CableRobot& model, CalibrationSpec* spec, std::string* error) {
+  return ParseSpec(text, source_name, static_cast<int>(model.anchor_points_cabin_m.size()),
+                   ShapeOf(model), spec, error);
+}
+
+bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
+                              int num_anchor_points, CalibrationSpec* spec, std::string* error) {
+  return ParseSpec(text, source_name, num_anchor_points, AttachmentShape(), spec, error);
+}
+
+bool LoadCalibrationSpec(const std::string& path, const CableRobot& model, CalibrationSpec* spec,
+                         std::string* error) {
+  return LoadSpec(path, static_cast<int>(model.anchor_points_cabin_m.size()), ShapeOf(model), spec,
+                  error);
+}
+
+bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
+                         std::string* error) {
+  return LoadSpec(path, num_anchor_points, AttachmentShape(), spec, error);
 }
 
 std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
@@ -991,6 +1137,13 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
           out << "      - " << EntryYaml(*p, g) << "  # cable " << i + 1 << "\n";
         }
       }
+    } else if (IsAttachment(g.kind)) {  // one entry per listed attachment
+      out << "\n";
+      for (const ParameterSpec* p : group) {
+        const std::string entry = EntryYaml(*p, g);
+        out << "    - {cable: " << p->index + 1 << ", attachment: " << p->component + 1 << ", "
+            << entry.substr(1) << "\n";
+      }
     } else {  // offsets: one list element per point up to the last one listed
       int last = -1;
       for (const ParameterSpec* p : group) last = std::max(last, p->index);
@@ -1020,6 +1173,7 @@ std::vector<ParameterSpec> AllModelParameters(int num_anchor_points) {
     } else if (IsPerCableCapable(g.kind)) {
       for (int i = -1; i < kNumCables; ++i) all.push_back(MakeParameter(g, i, -1, fixed));
     } else {
+      if (IsAttachment(g.kind)) continue;  // none without a model (the overload below)
       const int count = g.kind == ParameterKind::kAnchorOffset ? num_anchor_points : kNumCables;
       for (int j = 0; j < count; ++j) {
         for (int c = 0; c < 3; ++c) all.push_back(MakeParameter(g, j, c, fixed));
@@ -1027,6 +1181,47 @@ std::vector<ParameterSpec> AllModelParameters(int num_anchor_points) {
     }
   }
   return all;
+}
+
+std::vector<ParameterSpec> AllModelParameters(const CableRobot& model) {
+  std::vector<ParameterSpec> all =
+      AllModelParameters(static_cast<int>(model.anchor_points_cabin_m.size()));
+  const EntryText fixed;
+  for (const GroupInfo& g : kGroups) {
+    if (!IsAttachment(g.kind)) continue;
+    for (int i = 0; i < kNumCables; ++i) {
+      const std::vector<CableAttachment>& on = model.cables[i].attachments;
+      for (size_t j = 0; j < on.size(); ++j) {
+        if (on[j].kind == AttachmentKindOf(g.kind)) {
+          all.push_back(MakeParameter(g, i, static_cast<int>(j), fixed));
+        }
+      }
+    }
+  }
+  return all;
+}
+
+bool ParameterFitsModel(const ParameterSpec& p, const CableRobot& model, std::string* error) {
+  auto fail = [&](const std::string& why) {
+    if (error != nullptr) *error = p.name + ": " + why;
+    return false;
+  };
+  if (p.kind == ParameterKind::kAnchorOffset &&
+      p.index >= static_cast<int>(model.anchor_points_cabin_m.size())) {
+    return fail("the model has " + std::to_string(model.anchor_points_cabin_m.size()) +
+                " anchor points");
+  }
+  if (IsAttachment(p.kind)) {
+    const bool on_cable = p.index >= 0 && p.index < kNumCables && p.component >= 0 &&
+                          p.component < static_cast<int>(model.cables[p.index].attachments.size());
+    if (!on_cable ||
+        model.cables[p.index].attachments[p.component].kind != AttachmentKindOf(p.kind)) {
+      return fail(std::string("the model has no ") +
+                  (p.kind == ParameterKind::kAttachmentMass ? "point mass" : "added density") +
+                  " there (cables[i].attachments in the model file)");
+    }
+  }
+  return true;
 }
 
 bool SameParameter(const ParameterSpec& a, const ParameterSpec& b) {
@@ -1038,6 +1233,8 @@ bool SameParameter(const ParameterSpec& a, const ParameterSpec& b) {
       return true;
     case ParameterKind::kAnchorOffset:
     case ParameterKind::kTowerOffset:
+    case ParameterKind::kAttachmentMass:
+    case ParameterKind::kAttachmentDensity:
       return a.index == b.index && a.component == b.component;
     default:
       return a.index == b.index;

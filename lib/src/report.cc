@@ -263,6 +263,9 @@ void AddVerdictLead(const CalibrationResult& r, Document* doc) {
     case FitVerdict::kFailed:
       lead = "The fit failed:";
       break;
+    case FitVerdict::kModelIncomplete:
+      lead = "Model incomplete:";
+      break;
   }
   doc->Paragraph(Text().Bold(lead).Plain(" " + r.verdict_text + "."));
   std::vector<Text> notes;
@@ -359,11 +362,21 @@ void AddEstimates(const CalibrationResult& r, Document* doc) {
       widening = r.covariance_ok ? "× " + Printf("%.3g", p.widening) : "";
     }
     const std::string prior = p.has_prior ? Sig6(p.prior_mean) + " ± " + Sig3(p.prior_sigma) : "-";
+    Text note(p.note);
+    if (!p.moved_by.empty()) {
+      note = Text()
+                 .Bold("Not sound:")
+                 .Plain(" freeing ")
+                 .Code(p.moved_by)
+                 .Plain(" would move it by " + Sig3(p.moved_by_shift) + " " + p.unit + " (" +
+                        Printf("%.1f", p.moved_by_sigmas) + " σ_total)" +
+                        (p.note.empty() ? "" : "; " + p.note));
+    }
     t.rows.push_back(
         {Text().Code(p.name), p.unit, Sig6(p.initial),
          p.free ? Text().Bold(EstimateText(p.estimate, r.covariance_ok ? p.sigma_total : 0.0))
                 : Text(Sig6(p.estimate)),
-         p.free ? Text().Bold(total) : Text(total), formal, widening, prior, p.note});
+         p.free ? Text().Bold(total) : Text(total), formal, widening, prior, note});
   }
   if (t.rows.empty()) {
     doc->Paragraph("The spec names no parameter.");
@@ -1327,6 +1340,11 @@ void JsonParameters(const ReportInputs& in, JsonWriter* w) {
       ObjectOrNull(w, "prior", p.has_prior, [&] {
         w->Key("mean").Number(p.prior_mean);
         w->Key("sigma").Number(p.prior_sigma);
+      });
+      ObjectOrNull(w, "not_sound", !p.moved_by.empty(), [&] {
+        w->Key("candidate").String(p.moved_by);
+        w->Key("shift").Number(p.moved_by_shift);
+        w->Key("sigma_total_multiples").Number(p.moved_by_sigmas);
       });
       w->Key("note").String(p.note);
       w->EndObject();

@@ -190,10 +190,9 @@ CalibrationSpec Spec(const CableRobot& model, const std::string& path_or_text, b
                      const std::string& source_name) {
   CalibrationSpec spec;
   std::string error;
-  const int anchors = static_cast<int>(model.anchor_points_cabin_m.size());
   const bool ok = is_text
-                      ? ParseCalibrationSpecYaml(path_or_text, source_name, anchors, &spec, &error)
-                      : LoadCalibrationSpec(path_or_text, anchors, &spec, &error);
+                      ? ParseCalibrationSpecYaml(path_or_text, source_name, model, &spec, &error)
+                      : LoadCalibrationSpec(path_or_text, model, &spec, &error);
   if (!ok) throw InputError(error);
   return spec;
 }

@@ -67,12 +67,23 @@ struct CalibrationOptions {
   double max_sigma_tower_offset_m = 0.2;
   double max_sigma_sensor_gain = 0.05;
   double max_sigma_sensor_bias_n = 5e3;
+  // Attachments (cable_attachment.h): FAST's sensor assemblies weigh 250-650 kg, its
+  // hung lines 0.6-1.6 kg/m; an estimate this uncertain says little about either.
+  double max_sigma_attachment_mass_kg = 100.0;
+  double max_sigma_attachment_density_kg_per_m = 0.5;
   // A reduced chi-square above this is a fit that failed (the typical residual 5 times
   // the stated noise): the model does not describe the data, and the linearised
   // uncertainties no longer mean anything. Between the band and this the misfit is
   // scaled into the uncertainties (the paper's own fit, 10-20 kN RMS against ~5 kN of
   // sensor noise, is a chi^2/nu of about 4-16: usable, with wider sigmas).
   double failed_fit_reduced_chi_square = 25.0;
+  // The verdict is kModelIncomplete when a significant candidate of the misfit ranking
+  // (a fixed parameter the data point at beyond noise, CalibrationResult::misfit_ranking)
+  // would move a free estimate by more than this many times the uncertainty it would
+  // have with the candidate freed (sigma_total widened by the move's own uncertainty):
+  // sigma_total cannot contain that error, so neither "ok" nor "misfit scaled" would be
+  // honest (docs/calibration.md, "Model incomplete").
+  double incomplete_model_sigmas = 3.0;
   // Least-squares passes at most: 2 when nothing changes (weights from the initial
   // model, then from the first fit), more while the set of gross errors still changes.
   int max_passes = 4;
@@ -102,6 +113,11 @@ struct Identifiability {
   std::vector<double> sigma_si;
   std::vector<ParameterDirection> undetermined;  // ratio < undetermined_ratio
   std::vector<ParameterDirection> poorly_determined;
+  // For each free parameter, the one its estimate is most correlated with (index into
+  // the free parameters; -1 with a single free parameter or an undetermined direction)
+  // and that correlation: what the data cannot separate it from.
+  std::vector<int> partner;
+  std::vector<double> partner_correlation;
 };
 
 struct ParameterEstimate {
@@ -127,6 +143,13 @@ struct ParameterEstimate {
   double prior_mean = 0.0;
   double prior_sigma = 0.0;
   std::string note;  // e.g. "set mostly by its prior"
+  // Free estimates only: the misfit ranking's significant candidate that would move this
+  // estimate most, when by more than CalibrationOptions::incomplete_model_sigmas, and by
+  // how much (in `unit`, and in sigma_total); empty otherwise. Such an estimate is not
+  // sound as it stands (FitVerdict::kModelIncomplete).
+  std::string moved_by;
+  double moved_by_shift = 0.0;
+  double moved_by_sigmas = 0.0;
 };
 
 // One tension reading: a gross error, or one of the worst fitted readings.
@@ -184,8 +207,13 @@ enum class FitVerdict {
   kNoiseOverstated,  // below the band: the sigmas are pessimistic
   kMisfit,           // above the band: the misfit is scaled into sigma_total
   kFailed,           // not converged, or chi^2/nu above failed_fit_reduced_chi_square
+  // A fixed parameter the data point at would move a free estimate by more than
+  // CalibrationOptions::incomplete_model_sigmas sigma_total (ParameterEstimate::moved_by):
+  // the model lacks what the data show, whatever the chi-square says.
+  kModelIncomplete,
 };
-const char* FitVerdictName(FitVerdict verdict);  // "ok", "noise overstated", ...
+// "ok", "noise overstated", "misfit scaled", "failed", "model incomplete".
+const char* FitVerdictName(FitVerdict verdict);
 
 struct CalibrationResult {
   std::vector<ParameterEstimate> parameters;  // every parameter the spec names

@@ -11,6 +11,9 @@
 //   tower_offset_m[i].{x,y,z}       m     added to tower top i = 1..6 (global frame)
 //   sensor_gain / sensor_gain[i]    1     measured = gain * model + bias
 //   sensor_bias_kN / sensor_bias_kN[i]  kN
+//   attachment_mass_kg[i][j]        kg    point mass j of cable i (cable_attachment.h;
+//   attachment_density_kg_per_m[i][j] kg/m  added density j of cable i; j = 1.. counts
+//                                         the cable's attachments in the model file)
 // Values in the file are in the unit the name carries (kN for the bias); inside
 // everything is SI (ParameterSpec::to_si converts).
 #ifndef FASTCAL_CALIBRATION_SPEC_H_
@@ -32,6 +35,10 @@ enum class ParameterKind {
   kTowerOffset,    // index = cable/tower, component = axis
   kSensorGain,     // cable = 0..5, or -1 for common
   kSensorBias,     // cable = 0..5, or -1 for common
+  // index = cable 0..5, component = the attachment's 0-based position in the model's
+  // cables[index].attachments (of the matching kind).
+  kAttachmentMass,
+  kAttachmentDensity,
 };
 
 struct ParameterSpec {
@@ -104,9 +111,16 @@ struct CalibrationSpec {
 // Largest spec file LoadCalibrationSpec reads: a spec is a few KiB.
 inline constexpr long long kMaxSpecFileBytes = 16LL << 20;  // 16 MiB
 
-// Parses a spec. Errors name the file, the line and the key; unknown keys and unknown
-// parameter names are errors. `num_anchor_points` bounds anchor_offset_m[j]. Only a
-// regular file of at most kMaxSpecFileBytes is read (others are refused before reading).
+// Parses a spec for `model`. Errors name the file, the line and the key; unknown keys and
+// unknown parameter names are errors. The model's anchor points bound anchor_offset_m[j],
+// its cables' attachments the attachment groups. Only a regular file of at most
+// kMaxSpecFileBytes is read (others are refused before reading).
+bool LoadCalibrationSpec(const std::string& path, const CableRobot& model, CalibrationSpec* spec,
+                         std::string* error);
+bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
+                              const CableRobot& model, CalibrationSpec* spec, std::string* error);
+// The same for a model of `num_anchor_points` anchor points whose cables carry no
+// attachments.
 bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
                          std::string* error);
 bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
@@ -119,6 +133,12 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec);
 // Names, units and to_si as the reader gives them; all fixed, without initial or prior.
 // (The candidates of the calibration's misfit ranking.)
 std::vector<ParameterSpec> AllModelParameters(int num_anchor_points);
+// The same for `model`, its attachments' masses and densities included.
+std::vector<ParameterSpec> AllModelParameters(const CableRobot& model);
+
+// Whether `p` names something `model` has: an anchor point it has, and for an attachment
+// parameter an attachment of that kind at that position. On failure says why in *error.
+bool ParameterFitsModel(const ParameterSpec& p, const CableRobot& model, std::string* error);
 
 // Whether two specs name the same parameter: same kind, and the same axis, cable, anchor
 // point or tower where the kind has one (a per-cable group's common parameter, index -1,

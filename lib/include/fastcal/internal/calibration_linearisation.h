@@ -10,11 +10,12 @@
 //
 // Candidates (every fixed parameter the model has): every parameter a spec can name is a
 // sum of "basis" parameters (mass centre x, y, z, cabin mass, per cable i density_i,
-// EA_i, gain_i, bias_i, every anchor and tower offset axis: 3 + 1 + 24 + 3 * anchor
-// points + 18 <= 64, one Jet); a common group's parameter is the sum of its six per-cable
+// EA_i, gain_i, bias_i, every anchor and tower offset axis, every attachment's mass or
+// density: 3 + 1 + 24 + 3 * anchor points + 18 + attachments <= kMaxFreeParameters, one
+// Jet); a common group's parameter is the sum of its six per-cable
 // columns. One basis pass gives B_t (6 x K), so J_x = B_t A_x and J_c = B_t A_c (A: 0/1
 // maps), accumulated as J_x^T J_c, diag(J_c^T J_c) and J_c^T r. This pass costs ~25 us a
-// sample (a 64-wide Jet through the statics), so on long datasets it runs on at most
+// sample (a 64-wide Jet through the statics; twice that with attachments, 128 wide), so on long datasets it runs on at most
 // LinearisationInputs::max_candidate_samples evenly spaced samples and its sums are scaled by N /
 // N_used: J_x^T J_c and diag(J_c^T J_c) involve no noise and are smooth along the poses (a
 // quadrature), while J_c^T r then carries N / N_used times its noise (the misfit
@@ -103,9 +104,9 @@ struct Linearisation {
 };
 
 // The basis parameters, in order (all free, no initial: the model's values).
-std::vector<ParameterSpec> BasisParameters(int num_anchor_points);
+std::vector<ParameterSpec> BasisParameters(const CableRobot& model);
 // The basis columns a parameter (of a spec or a candidate) is the sum of.
-std::vector<int> BasisColumns(const ParameterSpec& p, int num_anchor_points);
+std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model);
 
 // Both passes. False, with *error naming the sample's line, when the statics fail there.
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error);

@@ -24,8 +24,10 @@
 
 namespace fastcal::internal {
 
-// Largest number of free parameters one cost evaluation handles (Jet size).
-inline constexpr int kMaxFreeParameters = 64;
+// Largest number of free parameters one cost evaluation handles (Jet size). The
+// linearisation's basis (every parameter the model has) needs 55 for FAST's layout, plus
+// one per attachment.
+inline constexpr int kMaxFreeParameters = 128;
 
 class CalibrationModel {
  public:
@@ -53,6 +55,11 @@ class CalibrationModel {
       p->anchor_cabin_m[i] = base_.anchor_cabin_m[i].cast<T>();
       p->ea_n[i] = T(base_.ea_n[i]);
       p->linear_density_kg_per_m[i] = T(base_.linear_density_kg_per_m[i]);
+      const CatenaryChain<double>& chain = base_.chain[i];
+      p->chain[i].num_cuts = chain.num_cuts;
+      p->chain[i].num_attachments = chain.num_attachments;
+      p->chain[i].cuts = chain.cuts;
+      for (int j = 0; j < chain.num_attachments; ++j) p->chain[i].value[j] = T(chain.value[j]);
       (*gain)[i] = T(base_gain_[i]);
       (*bias)[i] = T(base_bias_n_[i]);
     }
@@ -96,6 +103,10 @@ class CalibrationModel {
           for (int i = 0; i < kNumCables; ++i) {
             if (s.index < 0 || s.index == i) (*bias)[i] = v;
           }
+          break;
+        case ParameterKind::kAttachmentMass:
+        case ParameterKind::kAttachmentDensity:
+          p->chain[s.index].value[s.component] = v;
           break;
       }
     }
