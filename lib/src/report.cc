@@ -838,6 +838,43 @@ void AddPlots(const ReportInputs& in, Document* doc) {
   if (in.result) internal::AddDiagnosticPlots(in, doc);
 }
 
+// Each cable's attachments (cable_attachment.h) as the model describes them, and as
+// calibrated where the spec estimated them; nothing for uniform cables.
+void AddCablesAsBuilt(const ReportInputs& in, Document* doc) {
+  const CableRobot* model = in.initial_model;
+  const CableRobot* calibrated = in.result ? &in.result->calibrated : nullptr;
+  const CableRobot* any = model != nullptr ? model : calibrated;
+  if (any == nullptr || !any->HasAttachments()) return;
+  doc->Heading(2, "Cables as built");
+  doc->Paragraph(
+      "What each cable carries besides its own weight, by unstretched arc length from its "
+      "lower (cabin) end: point masses (sensor and connector assemblies, clamps) and added "
+      "weight per length (hung lines). The tension sensor sits below all of them. The "
+      "statics solve such a cable as a chain of catenary segments (docs/model.md).");
+  Table t;
+  t.header = {
+      "Cable", "#", "What", "Where (m)", "Model", "Calibrated", "Added mass in the model (kg)"};
+  t.right_align = {true, true, false, true, true, true, true};
+  for (int i = 0; i < kNumCables; ++i) {
+    const std::vector<CableAttachment>& on = any->cables[i].attachments;
+    for (size_t j = 0; j < on.size(); ++j) {
+      const CableAttachment& a = on[j];
+      const bool point = a.kind == AttachmentKind::kPointMass;
+      const std::string unit = point ? " kg" : " kg/m";
+      std::string after = "-";
+      if (calibrated != nullptr && j < calibrated->cables[i].attachments.size() &&
+          calibrated->cables[i].attachments[j].Value() != a.Value()) {
+        after = Sig6(calibrated->cables[i].attachments[j].Value()) + unit;
+      }
+      t.rows.push_back({Int(i + 1), Int(static_cast<long long>(j + 1)),
+                        point ? "point mass" : "added density",
+                        point ? Sig6(a.at_m) : Sig6(a.from_m) + " – " + Sig6(a.to_m),
+                        Sig6(a.Value()) + unit, after, Sig6(a.TotalMassKg())});
+    }
+  }
+  doc->AddTable(std::move(t));
+}
+
 void AddCalibratedModel(const ReportInputs& in, Document* doc) {
   doc->Heading(2, "The calibrated model");
   doc->Paragraph(Text("The calibrated model is ")
@@ -885,11 +922,13 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
   AddVerdict(in, &doc);
   if (in.result) {
     AddEstimates(*in.result, &doc);
+    AddCablesAsBuilt(in, &doc);
     internal::AddUncertaintyBudget(*in.result, &doc);
     internal::AddGrossErrors(in, &doc);
     internal::AddMisfitRanking(*in.result, &doc);
     AddIdentifiability(*in.result, with_plots, &doc);
   }
+  if (!in.result) AddCablesAsBuilt(in, &doc);
   AddRmsTables(in, with_plots, &doc);
   if (in.result) internal::AddCrossValidation(*in.result, &doc);
   if (with_plots) {

@@ -2,6 +2,8 @@
 // field as a number or a numpy array (per cable: shape (6,), per point: (n, 3)).
 #include <array>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "bindings.h"
 #include "fastcal/cable_robot.h"
@@ -10,6 +12,72 @@ namespace fastcal::python {
 namespace {
 
 // A per-cable field of CableProperties as a (6,) array property, both ways.
+
+// cables[i].attachments as a list of six lists of dicts (docs/model-format.md): a point
+// mass {at_m, mass_kg}, added weight {from_m, to_m, added_density_kg_per_m}.
+py::list GetAttachments(const CableRobot& r) {
+  py::list cables;
+  for (const CableProperties& c : r.cables) {
+    py::list on;
+    for (const CableAttachment& a : c.attachments) {
+      py::dict d;
+      if (a.kind == AttachmentKind::kPointMass) {
+        d["at_m"] = a.at_m;
+        d["mass_kg"] = a.mass_kg;
+      } else {
+        d["from_m"] = a.from_m;
+        d["to_m"] = a.to_m;
+        d["added_density_kg_per_m"] = a.added_density_kg_per_m;
+      }
+      on.append(d);
+    }
+    cables.append(on);
+  }
+  return cables;
+}
+
+void SetAttachments(CableRobot& r, const py::sequence& cables) {
+  if (py::len(cables) != kNumCables) {
+    throw InputError("attachments: expected a list of 6 lists (cable 1 first), got " +
+                     std::to_string(py::len(cables)));
+  }
+  std::array<std::vector<CableAttachment>, kNumCables> all;
+  for (int i = 0; i < kNumCables; ++i) {
+    const py::sequence on = py::reinterpret_borrow<py::sequence>(cables[i]);
+    for (size_t j = 0; j < py::len(on); ++j) {
+      const std::string where = "attachments[" + std::to_string(i) + "][" + std::to_string(j) + "]";
+      const py::dict d = py::reinterpret_borrow<py::dict>(on[j]);
+      CableAttachment a;
+      const bool point = d.contains("at_m") || d.contains("mass_kg");
+      a.kind = point ? AttachmentKind::kPointMass : AttachmentKind::kAddedDensity;
+      const std::vector<std::pair<const char*, double*>> fields =
+          point ? std::vector<std::pair<const char*, double*>>{{"at_m", &a.at_m},
+                                                               {"mass_kg", &a.mass_kg}}
+                : std::vector<std::pair<const char*, double*>>{
+                      {"from_m", &a.from_m},
+                      {"to_m", &a.to_m},
+                      {"added_density_kg_per_m", &a.added_density_kg_per_m}};
+      if (py::len(d) != fields.size()) {
+        throw InputError(where +
+                         ": a point mass has exactly the keys at_m and mass_kg, added "
+                         "weight from_m, to_m and added_density_kg_per_m");
+      }
+      for (const auto& [key, value] : fields) {
+        if (!d.contains(key)) throw InputError(where + "." + key + ": missing");
+        *value = d[key].cast<double>();
+      }
+      std::string why;
+      if (!a.IsValid(&why)) throw InputError(where + "." + why);
+      all[i].push_back(a);
+    }
+    if (all[i].size() > static_cast<size_t>(kMaxAttachmentsPerCable)) {
+      throw InputError("attachments[" + std::to_string(i) + "]: at most " +
+                       std::to_string(kMaxAttachmentsPerCable) + " per cable");
+    }
+  }
+  for (int i = 0; i < kNumCables; ++i) r.cables[i].attachments = std::move(all[i]);
+}
+
 void PerCableProperty(py::class_<CableRobot>& model, const char* name,
                       double CableProperties::*field, const char* doc) {
   model.def_property(
@@ -174,6 +242,12 @@ Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
                     "whole dict; keys left out keep FAST's values.")
       .def_property("anchor_points_cabin_m", &GetAnchorPoints, &SetAnchorPoints,
                     "Cabin anchor points in the cabin frame, shape (n, 3).")
+      .def_property("attachments", &GetAttachments, &SetAttachments,
+                    "What each cable carries (docs/model-format.md): a list of 6 lists (cable "
+                    "1 first) of dicts, {at_m, mass_kg} for a point mass, {from_m, to_m, "
+                    "added_density_kg_per_m} for added weight; arc lengths in m from the lower "
+                    "(cabin) end, unstretched. Assign a whole list; fastcal.InputError names a "
+                    "bad entry.")
       .def_property("tower_top_m", &GetTowerTops, &SetTowerTops,
                     "Upper end of each cable (tower top), global frame, shape (6, 3).")
       .def_property(

@@ -77,3 +77,20 @@ def test_validate_names_the_key() -> None:
     model.ea_n = [2.4656e7, 2.4656e7, -1.0, 2.4656e7, 2.4656e7, 2.4656e7]
     with pytest.raises(fastcal.InputError, match=r"cables\[2\]\.ea_n"):
         model.validate()
+
+
+def test_attachments_round_trip_and_change_the_tensions(tmp_path: pathlib.Path) -> None:
+    model = fastcal.Model.nominal()
+    assert model.attachments == [[], [], [], [], [], []]
+    built = [[{"at_m": 4.0, "mass_kg": 450.0},
+              {"from_m": 0.0, "to_m": 160.0, "added_density_kg_per_m": 1.0}]] + [[]] * 5
+    model.attachments = built
+    assert model.attachments == built
+    path = tmp_path / "built.yaml"
+    model.save(str(path))
+    assert fastcal.Model.load(str(path)).attachments == built
+    with pytest.raises(fastcal.InputError, match=r"attachments\[0\]\[0\]\.mass_kg"):
+        model.attachments = [[{"at_m": 1.0, "mass_kg": -5.0}]] + [[]] * 5
+    with pytest.raises(fastcal.InputError, match="exactly the keys"):
+        model.attachments = [[{"at_m": 1.0}]] + [[]] * 5
+    assert model.attachments == built  # a refused assignment changes nothing
