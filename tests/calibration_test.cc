@@ -561,6 +561,31 @@ TEST(CalibrationTest, MisfitRankingNamesTheMissingParameterAndPredictsItsDecreas
   }
 }
 
+// A prior the data disagree with beyond their noise is a candidate too ("prior of ..."):
+// a sensor reading 5% high held at 1 +- 0.5% by its prior is a model incomplete, and the
+// gain is marked; with the prior widened to its real tolerance the verdict is ok.
+TEST(CalibrationTest, ADoubtedPriorIsAModelIncomplete) {
+  Dataset data = CircleData(Truth(), 180, 0.02, 41);
+  for (Sample& s : data.samples) s.tension_n[2] *= 1.05;  // cable 3's sensor reads 5% high
+  CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+  spec.tension_sigma_percent = 2.0;
+  ParameterSpec gain = Free(ParameterKind::kSensorGain, 2, -1, "sensor_gain[3]");
+  gain.has_prior = true;
+  gain.prior_mean_si = 1.0;
+  gain.prior_sigma_si = 0.005;
+  spec.parameters.push_back(gain);
+  CalibrationResult tight, wide;
+  ASSERT_TRUE(CalibrateNominal(spec, data, &tight));
+  EXPECT_EQ(tight.verdict, FitVerdict::kModelIncomplete) << tight.verdict_text;
+  EXPECT_EQ(tight.verdict_text.rfind("releasing the prior of sensor_gain[3]", 0), 0u)
+      << tight.verdict_text;
+  EXPECT_EQ(tight.parameters.back().moved_by, "prior of sensor_gain[3]");
+  spec.parameters.back().prior_sigma_si = 0.1;
+  ASSERT_TRUE(CalibrateNominal(spec, data, &wide));
+  EXPECT_NE(wide.verdict, FitVerdict::kModelIncomplete) << wide.verdict_text;
+  EXPECT_NEAR(wide.parameters.back().estimate, 1.05, 3 * wide.parameters.back().sigma_total);
+}
+
 // The realistic telemetry of simulation.h (slow tension error, drifting mass centre,
 // smooth attitude control error, per-cable densities, gains and biases) fitted with a
 // spec that frees the per-cable parameters with priors: over 20 seeds, sigma_total

@@ -837,6 +837,58 @@ Eigen::VectorXd ScoreStatistics(const Run& run, const internal::Linearisation& l
   return statistic;
 }
 
+// The free parameters' priors as candidates of the misfit ranking ("prior of NAME"): what
+// releasing prior k (the others kept) would do. At the solution the data's gradient is
+// -Lambda_k d e_k (d = estimate - prior mean), so one Newton step without the prior moves
+// the estimates by (M - Lambda_k e_k e_k^T)^-1 Lambda_k d e_k. Its statistic is the
+// prior's normalised residual, d^2 / (sigma_k^2 - P_kk) (the data's share of the
+// disagreement's variance, P = M^-1), against the noise the residuals have (divided by
+// the parameter's widening squared); its expected decrease that of the data's
+// chi-square, d^2 P_kk / (sigma_k^2 (sigma_k^2 - P_kk)). A prior the data barely inform
+// (P_kk > 99% of sigma_k^2) cannot disagree with them and is left out, as is one the
+// data cannot do without (M singular without it).
+void RankPriors(const Run& run, const Eigen::MatrixXd& information,
+                std::vector<MisfitCandidate>* ranking) {
+  constexpr double kMinDataShare = 0.01;
+  if (run.loss != nullptr) return;  // M^-1 is then not the covariance (a sandwich)
+  const Eigen::MatrixXd covariance =
+      information.ldlt().solve(Eigen::MatrixXd::Identity(run.n, run.n));
+  const UncertaintyBudget& b = run.result->budget;
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    if (!p.has_prior) continue;
+    const double prior_var = p.prior_sigma_si * p.prior_sigma_si;
+    const double data_var = prior_var - covariance(k, k);
+    if (!(data_var > kMinDataShare * prior_var)) continue;
+    Eigen::MatrixXd without = information;
+    without(k, k) -= 1.0 / prior_var;
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(without);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) continue;
+    const double d = run.theta[k] - p.prior_mean_si;
+    Eigen::VectorXd unit = Eigen::VectorXd::Zero(run.n);
+    unit[k] = d / prior_var;
+    const Eigen::VectorXd shift = ldlt.solve(unit);
+    if (!shift.allFinite()) continue;
+    // The data's share of d is widened like a data-only estimate would be: by the misfit
+    // factor and the autocorrelation time of the parameter's influence series. (Its
+    // posterior widening is diluted by the prior, which is not widened.)
+    double widening2 = 1.0;
+    if (k < static_cast<int>(b.parameters.size())) {
+      const ParameterBudget& pb = b.parameters[k];
+      widening2 = std::max({1.0, pb.widening * pb.widening,
+                            b.misfit_factor * b.misfit_factor * std::max(1.0, pb.tau)});
+    }
+    MisfitCandidate m;
+    m.name = "prior of " + p.name;
+    m.unit = p.unit;
+    m.expected_decrease = d * d * covariance(k, k) / (prior_var * data_var);
+    m.statistic = d * d / data_var / widening2;
+    m.change = shift[k] / p.to_si;
+    for (int j = 0; j < run.n; ++j) m.shifts.push_back(shift[j] / run.Free(j).to_si);
+    ranking->push_back(std::move(m));
+  }
+}
+
 void RankMisfit(Run& run, const internal::Linearisation& lin,
                 const std::vector<ParameterSpec>& candidates, const std::vector<double>& value_si,
                 const Eigen::MatrixXd& information) {
@@ -888,6 +940,7 @@ void RankMisfit(Run& run, const internal::Linearisation& lin,
     for (int k = 0; k < run.n; ++k) m.shifts.push_back(shift[k] / run.Free(k).to_si);
     ranking.push_back(std::move(m));
   }
+  RankPriors(run, information, &ranking);
   std::stable_sort(ranking.begin(), ranking.end(), [](const auto& a, const auto& b) {
     return a.expected_decrease > b.expected_decrease;
   });
@@ -1123,15 +1176,19 @@ void JudgeCompleteness(Run& run) {
   }
   if (worst == nullptr) return;
   r.verdict = FitVerdict::kModelIncomplete;
-  r.verdict_text = "freeing " + worst->moved_by + ", which the data point at beyond their " +
-                   "noise, would move " + worst->name + " by " +
-                   Fixed("%+.3g", worst->moved_by_shift) + " " + worst->unit + " (" +
+  // A prior's candidate is released, a fixed parameter's freed.
+  const bool prior = worst->moved_by.rfind("prior of ", 0) == 0;
+  r.verdict_text = (prior ? "releasing the " : "freeing ") + worst->moved_by +
+                   ", which the data point at beyond their " + "noise, would move " + worst->name +
+                   " by " + Fixed("%+.3g", worst->moved_by_shift) + " " + worst->unit + " (" +
                    Fixed("%.1f", worst->moved_by_sigmas) +
                    " sigma_total): the model lacks something the data show, and sigma_total " +
                    "cannot contain that error. Not sound as they stand: " + marked +
-                   ". Free the candidate (with a prior), or model what it stands for (a " +
-                   "sensor's gain, cable attachments: docs/calibration.md, \"Model " +
-                   "incomplete\"); " + r.verdict_text;
+                   (prior ? ". Check the prior, or free what explains the data's disagreement"
+                          : ". Free the candidate (with a prior)") +
+                   ", or model what it stands for (a sensor's gain, cable attachments: "
+                   "docs/calibration.md, \"Model incomplete\"); " +
+                   r.verdict_text;
 }
 
 // What the misfit ranking's significant candidates would move, in sigma_total: sigma_total
