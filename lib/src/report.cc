@@ -366,7 +366,7 @@ void AddEstimates(const CalibrationResult& r, Document* doc) {
     if (!p.moved_by.empty()) {
       note = Text()
                  .Bold("Not sound:")
-                 .Plain(" freeing ")
+                 .Plain(p.moved_by.rfind("prior of ", 0) == 0 ? " releasing the " : " freeing ")
                  .Code(p.moved_by)
                  .Plain(" would move it by " + Sig3(p.moved_by_shift) + " " + p.unit + " (" +
                         Printf("%.1f", p.moved_by_sigmas) + " σ_total)" +
