@@ -152,13 +152,9 @@ CableRobot AsBuiltRobot(bool attachments) {
   CableRobot robot = CableRobot::NominalFast();
   if (!attachments) return robot;
   for (int i = 0; i < kNumCables; ++i) {
-    CableAttachment point, lines;
-    point.at_m = 2.0 + 0.8 * i;
-    point.mass_kg = 250.0 + 80.0 * i;
-    lines.kind = AttachmentKind::kAddedDensity;
-    lines.to_m = 120.0 + 16.0 * i;
-    lines.added_density_kg_per_m = 0.6 + 0.2 * i;
-    robot.cables[i].attachments = {point, lines};
+    robot.cables[i].attachments = {
+        CableAttachment::PointMass(2.0 + 0.8 * i, 250.0 + 80.0 * i),
+        CableAttachment::AddedDensity(0.0, 120.0 + 16.0 * i, 0.6 + 0.2 * i)};
   }
   return robot;
 }

@@ -19,20 +19,11 @@ namespace fastcal {
 namespace {
 
 CableAttachment Point(double at_m, double mass_kg) {
-  CableAttachment a;
-  a.kind = AttachmentKind::kPointMass;
-  a.at_m = at_m;
-  a.mass_kg = mass_kg;
-  return a;
+  return CableAttachment::PointMass(at_m, mass_kg);
 }
 
 CableAttachment Range(double from_m, double to_m, double density) {
-  CableAttachment a;
-  a.kind = AttachmentKind::kAddedDensity;
-  a.from_m = from_m;
-  a.to_m = to_m;
-  a.added_density_kg_per_m = density;
-  return a;
+  return CableAttachment::AddedDensity(from_m, to_m, density);
 }
 
 // The cables: a 250-650 kg assembly 2-6 m up, 0.6-1.6 kg/m over the lowest

@@ -26,20 +26,11 @@ constexpr double kFl = 1.0e5, kFz = -1.2e5, kS0 = 300.0;
 constexpr double kRoundingTol = 1e-12;
 
 CableAttachment Point(double at_m, double mass_kg) {
-  CableAttachment a;
-  a.kind = AttachmentKind::kPointMass;
-  a.at_m = at_m;
-  a.mass_kg = mass_kg;
-  return a;
+  return CableAttachment::PointMass(at_m, mass_kg);
 }
 
 CableAttachment Range(double from_m, double to_m, double density) {
-  CableAttachment a;
-  a.kind = AttachmentKind::kAddedDensity;
-  a.from_m = from_m;
-  a.to_m = to_m;
-  a.added_density_kg_per_m = density;
-  return a;
+  return CableAttachment::AddedDensity(from_m, to_m, density);
 }
 
 CatenaryEnd<double> Chain(const std::vector<CableAttachment>& attachments, double fl = kFl,

@@ -23,20 +23,11 @@ namespace {
 constexpr double kSolveTol = 1e-9;
 
 CableAttachment Point(double at_m, double mass_kg) {
-  CableAttachment a;
-  a.kind = AttachmentKind::kPointMass;
-  a.at_m = at_m;
-  a.mass_kg = mass_kg;
-  return a;
+  return CableAttachment::PointMass(at_m, mass_kg);
 }
 
 CableAttachment Range(double from_m, double to_m, double density) {
-  CableAttachment a;
-  a.kind = AttachmentKind::kAddedDensity;
-  a.from_m = from_m;
-  a.to_m = to_m;
-  a.added_density_kg_per_m = density;
-  return a;
+  return CableAttachment::AddedDensity(from_m, to_m, density);
 }
 
 Pose FocalPose(const Eigen::Vector3d& position_m) {

@@ -296,18 +296,9 @@ class Parser {
       CableAttachment a;
       const bool point = keys.count("at_m") || keys.count("mass_kg");
       a.kind = point ? AttachmentKind::kPointMass : AttachmentKind::kAddedDensity;
-      const std::vector<std::pair<const char*, double*>> fields =
-          point ? std::vector<std::pair<const char*, double*>>{{"at_m", &a.at_m},
-                                                               {"mass_kg", &a.mass_kg}}
-                : std::vector<std::pair<const char*, double*>>{
-                      {"from_m", &a.from_m},
-                      {"to_m", &a.to_m},
-                      {"added_density_kg_per_m", &a.added_density_kg_per_m}};
+      const std::vector<std::pair<const char*, double*>> fields = a.Fields();
       if (keys.size() != fields.size()) {
-        return Fail(item_line, item_path,
-                    point ? "a point mass has exactly the keys at_m and mass_kg"
-                          : "added weight has exactly the keys from_m, to_m and "
-                            "added_density_kg_per_m");
+        return Fail(item_line, item_path, CableAttachment::KeysText(a.kind));
       }
       for (const auto& [name, value] : fields) {
         const auto it = keys.find(name);

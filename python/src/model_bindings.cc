@@ -50,17 +50,9 @@ void SetAttachments(CableRobot& r, const py::sequence& cables) {
       CableAttachment a;
       const bool point = d.contains("at_m") || d.contains("mass_kg");
       a.kind = point ? AttachmentKind::kPointMass : AttachmentKind::kAddedDensity;
-      const std::vector<std::pair<const char*, double*>> fields =
-          point ? std::vector<std::pair<const char*, double*>>{{"at_m", &a.at_m},
-                                                               {"mass_kg", &a.mass_kg}}
-                : std::vector<std::pair<const char*, double*>>{
-                      {"from_m", &a.from_m},
-                      {"to_m", &a.to_m},
-                      {"added_density_kg_per_m", &a.added_density_kg_per_m}};
+      const std::vector<std::pair<const char*, double*>> fields = a.Fields();
       if (py::len(d) != fields.size()) {
-        throw InputError(where +
-                         ": a point mass has exactly the keys at_m and mass_kg, added "
-                         "weight from_m, to_m and added_density_kg_per_m");
+        throw InputError(where + ": " + CableAttachment::KeysText(a.kind));
       }
       for (const auto& [key, value] : fields) {
         if (!d.contains(key)) throw InputError(where + "." + key + ": missing");

@@ -12,6 +12,8 @@
 #define FASTCAL_CABLE_ATTACHMENT_H_
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace fastcal {
 
@@ -25,6 +27,21 @@ enum class AttachmentKind {
 };
 
 struct CableAttachment {
+  static CableAttachment PointMass(double at_m, double mass_kg) {
+    CableAttachment a;
+    a.at_m = at_m;
+    a.mass_kg = mass_kg;
+    return a;
+  }
+  static CableAttachment AddedDensity(double from_m, double to_m, double density_kg_per_m) {
+    CableAttachment a;
+    a.kind = AttachmentKind::kAddedDensity;
+    a.from_m = from_m;
+    a.to_m = to_m;
+    a.added_density_kg_per_m = density_kg_per_m;
+    return a;
+  }
+
   AttachmentKind kind = AttachmentKind::kPointMass;
   // kPointMass: unstretched arc length from the lower end (m), >= 0. At 0 the mass hangs
   // just above the sensor: the cabin carries it, the sensor does not read it.
@@ -52,6 +69,20 @@ struct CableAttachment {
   // Its added weight (kg): the mass, or the density times the range's length.
   double TotalMassKg() const {
     return kind == AttachmentKind::kPointMass ? mass_kg : added_density_kg_per_m * (to_m - from_m);
+  }
+
+  // The model file's keys of an attachment of `kind` (docs/model-format.md) with the
+  // fields they fill: at_m, mass_kg; or from_m, to_m, added_density_kg_per_m.
+  std::vector<std::pair<const char*, double*>> Fields() {
+    if (kind == AttachmentKind::kPointMass) return {{"at_m", &at_m}, {"mass_kg", &mass_kg}};
+    return {
+        {"from_m", &from_m}, {"to_m", &to_m}, {"added_density_kg_per_m", &added_density_kg_per_m}};
+  }
+  // What an attachment of `kind` must give, for messages.
+  static const char* KeysText(AttachmentKind kind) {
+    return kind == AttachmentKind::kPointMass
+               ? "a point mass has exactly the keys at_m and mass_kg"
+               : "added weight has exactly the keys from_m, to_m and added_density_kg_per_m";
   }
 
   // Checks the rules above; on failure names the offending key relative to the
