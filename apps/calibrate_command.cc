@@ -21,6 +21,7 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/version.h"
 
@@ -263,6 +264,20 @@ std::string SkippedNote(const Dataset& data) {
 // What to add to the message of a pose the model cannot solve.
 std::string SkipHint() {
   return FLAGS_skip_invalid_rows ? "" : " (--skip-invalid-rows skips such rows, and lists them)";
+}
+
+// When `model` cannot solve at least two rows and the nominal FAST model solves most of
+// them, the model or spec, not the data, is the likely cause: the message that says so,
+// naming the values furthest from nominal; "" otherwise (model_plausibility.h).
+std::string BlameTheModel(const CableRobot& model, const std::string& model_name,
+                          const Dataset& data, const std::vector<StaticsMethod>& methods) {
+  const UnsolvableRows d = DiagnoseUnsolvableRows(
+      model, model_name, data, {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, methods);
+  if (!d.model_likely) return "";
+  return DescribeUnsolvableRows(d, model_name) +
+         (FLAGS_skip_invalid_rows ? " (not skipped: --skip-invalid-rows is for bad rows, and "
+                                    "would fit the rest with this model)"
+                                  : "");
 }
 
 std::string Digest(const std::string& path) {
@@ -545,7 +560,16 @@ int RunCalibrate(int argc, char** argv) {
     PrintError(command, error);
     return kExitUsage;
   }
-  if (FLAGS_skip_invalid_rows) SkipSamplesTheCalibrationCannotSolve(model, spec, &data);
+  const CableRobot initial = InitialCalibrationModel(model, spec);
+  const std::vector<StaticsMethod> methods = {StaticsMethod::kExact, spec.forward_model};
+  if (FLAGS_skip_invalid_rows) {
+    if (const std::string blame = BlameTheModel(initial, "the initial model", data, methods);
+        !blame.empty()) {
+      PrintError(command, blame);
+      return kExitFailure;
+    }
+    SkipSamplesTheCalibrationCannotSolve(model, spec, &data);
+  }
   if (!ReportSkipped(command, data, &error)) {
     PrintError(command, error);
     return kExitFailure;
@@ -560,6 +584,13 @@ int RunCalibrate(int argc, char** argv) {
     options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
   CalibrationResult result;
   const CalibrationStatus status = Calibrate(model, spec, data, options, &result, &error);
+  if (status == CalibrationStatus::kInfeasible) {
+    if (const std::string blame = BlameTheModel(initial, "the initial model", data, methods);
+        !blame.empty()) {
+      PrintError(command, blame);
+      return kExitFailure;
+    }
+  }
   if (status != CalibrationStatus::kOk) {
     PrintError(command, error + (status == CalibrationStatus::kInfeasible ? SkipHint() : ""));
     return status == CalibrationStatus::kInvalidInput ? kExitUsage : kExitFailure;
@@ -637,6 +668,12 @@ int RunEvaluate(int argc, char** argv) {
     PrintError(command, error);
     return kExitUsage;
   }
+  if (const std::string blame =
+          FLAGS_skip_invalid_rows ? BlameTheModel(model, "the model", data, {method}) : "";
+      !blame.empty()) {
+    PrintError(command, blame);
+    return kExitFailure;
+  }
   if (FLAGS_skip_invalid_rows) {
     SkipUnsolvableSamples(model, "the model", {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
                           {method}, &data);
@@ -647,6 +684,11 @@ int RunEvaluate(int argc, char** argv) {
   }
   std::vector<VariantEvaluation> variants;
   if (!EvaluateModel(model, data, method, &variants, &error)) {
+    if (const std::string blame = BlameTheModel(model, "the model", data, {method});
+        !blame.empty()) {
+      PrintError(command, blame);
+      return kExitFailure;
+    }
     PrintError(command, error + SkipHint());
     return kExitFailure;
   }

@@ -784,6 +784,43 @@ TEST_F(CliTest, SkipInvalidRowsSkipsPosesTheModelCannotSolve) {
   EXPECT_NE(md.find(where + "the initial model cannot solve this pose"), std::string::npos);
 }
 
+// Unit and magnitude slips in a spec or model (issue 17) are refused where they are
+// written, not blamed on a data row; a plausible model that cannot solve the rows the
+// nominal model solves is named as the likely cause, and --skip-invalid-rows does not
+// skip its way round it.
+TEST_F(CliTest, UnitSlipsAreCaughtInTheSpecOrModelNotBlamedOnTheData) {
+  const std::string data = " --data=" + Source() + "/calibration_data/circle_paper.csv";
+  const std::string spec_text = ReadFile(Source() + "/calibration_data/spec_mass_centre.yaml");
+  Write("mass30.yaml", spec_text + "  cabin_mass_kg: {initial: 30}\n");
+  std::string noise = spec_text;
+  noise.replace(noise.find("tension_sigma_kN: 0"), 19, "tension_sigma_kN: 3000");
+  Write("noise.yaml", noise);
+  std::string model = ReadFile(Source() + "/calibration_data/nominal_fast.yaml");
+  model.replace(model.find("mass_centre_m: [0, 0, 0.5]"), 26, "mass_centre_m: [4, 0, 0.5]");
+  Write("mc4.yaml", model);
+  const ExpectedRun kRuns[] = {
+      {"calibrate --spec=" + Path("mass30.yaml") + data + " --out=" + Path("o1"), 2,
+       "parameters.cabin_mass_kg.initial: 30 kg is below the plausible minimum of 10000 kg "
+       "(nominal FAST: 30000 kg; tonnes written as kg?)"},
+      {"calibrate --spec=" + Path("noise.yaml") + data + " --out=" + Path("o1"), 2,
+       "noise.tension_sigma_kN: 3000 kN is above the plausible maximum of 50 kN (N written as "
+       "kN?)"},
+      {"evaluate --model=" + Path("mc4.yaml") + data, 1,
+       "fastcal evaluate: the model cannot solve 360 of 360 rows (the nominal FAST model solves "
+       "360 of them): the model or the spec is the likely cause, not the data; furthest from "
+       "nominal: cabin.mass_centre_m.x = 4 m (nominal 0 m). First: "},
+      {"calibrate --skip-invalid-rows --spec=" + Source() +
+           "/calibration_data/spec_mass_centre.yaml --model=" + Path("mc4.yaml") + data +
+           " --out=" + Path("o1"),
+       1, "the initial model cannot solve 360 of 360 rows"},
+  };
+  for (const ExpectedRun& run : kRuns) {
+    const CommandResult r = RunBoundedAndExpect(run);
+    EXPECT_EQ(r.output.find("--skip-invalid-rows skips such rows"), std::string::npos) << r.output;
+  }
+  EXPECT_FALSE(fs::exists(Path("o1")));
+}
+
 // A mistyped reading (T3_kN = 99999 on line 9) is named by line and cable on the
 // console and in summary.json, kept out of the fit, and the estimates stay sane.
 TEST_F(CliTest, CalibrateNamesAGrossErrorByLineAndCable) {
