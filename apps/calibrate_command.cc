@@ -10,6 +10,7 @@
 #include <ctime>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "cli_util.h"
@@ -21,6 +22,7 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/internal/report_document.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/version.h"
@@ -208,27 +210,39 @@ std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluatio
   return legend.str() + out.str();
 }
 
-std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
-  std::ostringstream s;
+// The per-cable tables of calibrate's and evaluate's consoles share one layout: a label
+// column, then T1..T6, so that every row lines up under its header.
+constexpr int kLabelWidth = 40;
+
+std::string CableHeader(const std::string& title) {
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "  %-46s %8s %8s %8s %8s %8s %8s\n", "RMS model - measured (kN)",
+  std::snprintf(buf, sizeof(buf), "  %-*s %8s %8s %8s %8s %8s %8s\n", kLabelWidth, title.c_str(),
                 "T1", "T2", "T3", "T4", "T5", "T6");
-  s << buf;
+  return buf;
+}
+
+std::string CableRow(const std::string& label, const std::array<double, kNumCables>& values,
+                     double scale) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "  %-*.*s", kLabelWidth, kLabelWidth, label.c_str());
+  std::string row = buf;
+  for (double v : values) {
+    std::snprintf(buf, sizeof(buf), " %8.3f", v * scale + 0.0);  // + 0.0: no "-0.000"
+    row += std::string(buf) == " -0.000" ? "    0.000" : buf;
+  }
+  return row + "\n";
+}
+
+std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
+  std::string s = CableHeader("RMS model - measured (kN)");
   for (const VariantEvaluation& v : variants) {
     for (int part = 0; part < 2; ++part) {
       const CableErrorStats& st = part == 0 ? v.fit : v.holdout;
       if (st.samples == 0) continue;
-      std::string name = v.name + (part == 1 ? " [hold-out]" : "");
-      std::snprintf(buf, sizeof(buf), "  %-46.46s", name.c_str());
-      s << buf;
-      for (double r : st.rms_n) {
-        std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
-        s << buf;
-      }
-      s << "\n";
+      s += CableRow(v.name + (part == 1 ? " [hold-out]" : ""), st.rms_n, 1.0 / kNPerKn);
     }
   }
-  return s.str();
+  return s;
 }
 
 bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
@@ -342,31 +356,125 @@ std::string SigmaText(double sigma, const std::string& unit) {
   return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
 }
 
-// The estimates: value +- sigma_total first, then its parts.
-std::string EstimatesTable(const CalibrationResult& result) {
-  std::ostringstream s;
-  char buf[260];
-  std::snprintf(buf, sizeof(buf), "  %-28s %6s %14s %14s %11s %11s %8s %11s  %s\n", "parameter",
-                "unit", "initial", "estimate", "sigma_total", "formal", "widening", "systematic",
-                "note");
-  s << buf;
-  for (const ParameterEstimate& p : result.parameters) {
-    // Short flags here; the full notes are in the report.
-    std::string flags;
-    if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
-    if (p.note.find("not determined by the data alone") != std::string::npos) {
-      flags += "data cannot determine ";
-    } else if (p.note.find("poorly determined") != std::string::npos) {
-      flags += "weak in data ";
+// "0.192 +- 0.034 m": the estimate to the precision its sigma_total supports (a tiny
+// estimate beside a large sigma is "0.000 +- 0.010", not "1.2e-09"); no unit for "1".
+std::string ValueWithSigma(double estimate, double sigma, const std::string& unit) {
+  const std::string shown_unit = unit == "1" ? "" : " " + unit;
+  if (!(sigma > 0.0)) return internal::EstimateText(estimate, sigma) + shown_unit;
+  return internal::EstimateText(estimate, sigma) + " +- " + internal::EstimateText(sigma, sigma) +
+         shown_unit;
+}
+
+// The console is one screen: at most kConsoleWidth columns, long notes cut to
+// kNoteLines lines (the report has them whole).
+constexpr size_t kConsoleWidth = 100;
+constexpr size_t kNoteLines = 2;
+constexpr size_t kEstimateRows = 14;
+
+// `text` wrapped at kConsoleWidth, each line after the first indented by `indent`; cut
+// after `max_lines` lines with "... (report.md)".
+std::string Wrapped(const std::string& text, const std::string& first_indent,
+                    const std::string& indent, size_t max_lines) {
+  std::istringstream words(text);
+  std::vector<std::string> lines = {first_indent};
+  std::string word;
+  while (words >> word) {
+    std::string& line = lines.back();
+    const bool starts = line.size() == (lines.size() == 1 ? first_indent : indent).size();
+    if (!starts && line.size() + 1 + word.size() > kConsoleWidth) {
+      lines.push_back(indent + word);
+    } else {
+      line += (starts ? "" : " ") + word;
     }
-    if (p.consider) flags += "consider (fixed, prior sigma) ";
-    const std::string total = p.free || p.consider ? FormatDouble(p.sigma_total, 3) : "fixed";
-    std::snprintf(buf, sizeof(buf), "  %-28.28s %6s %14.6g %14.6g %11s %11s %8s %11s  %s\n",
-                  p.name.c_str(), p.unit.c_str(), p.initial, p.estimate, total.c_str(),
-                  p.free ? FormatDouble(p.sigma, 3).c_str() : "",
-                  p.free ? ("x" + FormatDouble(p.widening, 3)).c_str() : "",
-                  p.free ? FormatDouble(p.sigma_systematic, 3).c_str() : "", flags.c_str());
-    s << buf;
+  }
+  const char kCut[] = " ... (report.md)";
+  if (lines.size() > max_lines) {
+    lines.resize(max_lines);
+    std::string& last = lines.back();
+    if (last.size() + sizeof(kCut) - 1 > kConsoleWidth)
+      last.resize(kConsoleWidth - sizeof(kCut) + 1);
+    last += kCut;
+  }
+  std::string out;
+  for (const std::string& line : lines) out += line + "\n";
+  return out;
+}
+
+// Short flags of an estimate's note; the full notes are in the report.
+std::string EstimateFlags(const ParameterEstimate& p) {
+  std::string flags;
+  if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
+  if (p.note.find("not determined by the data alone") != std::string::npos) {
+    flags += "data cannot determine ";
+  } else if (p.note.find("poorly determined") != std::string::npos) {
+    flags += "weak in data ";
+  }
+  return flags;
+}
+
+// The free estimates: value +- sigma_total, the formal sigma and the widening. A group of
+// more than three per-cable or per-point parameters (sensor_gain[1..6]) is one row: the
+// range of its estimates and of their sigma_total. At most kEstimateRows rows; the fixed
+// and consider parameters and every part of the budget are in the report.
+std::string EstimatesTable(const CalibrationResult& result) {
+  constexpr size_t kGroupedFrom = 4;
+  std::map<std::string, std::vector<const ParameterEstimate*>> groups;
+  std::vector<std::string> order;
+  for (const ParameterEstimate& p : result.parameters) {
+    if (!p.free) continue;
+    const std::string key = p.name.substr(0, p.name.find('['));
+    if (!groups.count(key)) order.push_back(key);
+    groups[key].push_back(&p);
+  }
+  std::vector<std::string> rows;
+  char buf[200];
+  for (const std::string& key : order) {
+    const std::vector<const ParameterEstimate*>& g = groups[key];
+    if (g.size() < kGroupedFrom) {
+      for (const ParameterEstimate* p : g) {
+        std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", p->name.c_str(),
+                      ValueWithSigma(p->estimate, p->sigma_total, p->unit).c_str(),
+                      SigmaText(p->sigma, p->unit).c_str(),
+                      ("x" + FormatDouble(p->widening, 2)).c_str(), EstimateFlags(*p).c_str());
+        rows.push_back(buf);
+      }
+      continue;
+    }
+    double lo = HUGE_VAL, hi = -HUGE_VAL, sigma_lo = HUGE_VAL, sigma_hi = 0.0, widest = 0.0;
+    std::string flags;
+    for (const ParameterEstimate* p : g) {
+      lo = std::min(lo, p->estimate);
+      hi = std::max(hi, p->estimate);
+      sigma_lo = std::min(sigma_lo, p->sigma_total);
+      sigma_hi = std::max(sigma_hi, p->sigma_total);
+      widest = std::max(widest, p->widening);
+      if (flags.empty()) flags = EstimateFlags(*p);
+    }
+    // "sensor_gain[1..6]": the first and the last index of the group.
+    auto index_of = [](const std::string& name) {
+      const size_t open = name.find('['), close = name.find(']');
+      return name.substr(open + 1, close - open - 1);
+    };
+    const std::string label =
+        key + "[" + index_of(g.front()->name) + ".." + index_of(g.back()->name) + "]";
+    const std::string unit = g.front()->unit == "1" ? "" : " " + g.front()->unit;
+    const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + unit + " +- " +
+                              FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2);
+    std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", label.c_str(), range.c_str(),
+                  "", ("<= x" + FormatDouble(widest, 2)).c_str(), flags.c_str());
+    rows.push_back(buf);
+  }
+  std::ostringstream s;
+  std::snprintf(buf, sizeof(buf), "  %-29s %-31s %9s %8s  %s\n", "free parameter",
+                "estimate +- sigma_total", "formal", "widening", "note");
+  s << buf;
+  for (size_t k = 0; k < rows.size() && k < kEstimateRows; ++k) {
+    std::string row = rows[k];
+    while (!row.empty() && row.back() == ' ') row.pop_back();
+    s << row << "\n";
+  }
+  if (rows.size() > kEstimateRows) {
+    s << "  ... " << rows.size() - kEstimateRows << " more rows (report.md, Estimates)\n";
   }
   return s.str();
 }
@@ -391,8 +499,8 @@ std::string ConsiderLines(const CalibrationResult& result) {
       line += (k ? ", " : "") + SigmaText(on[k]->systematic_by_group[g], on[k]->unit) + " on " +
               on[k]->name;
     }
-    if (on.size() > kShown) line += ", ... (report.md, Uncertainty budget)";
-    s << "  systematic, from " << groups[g] << ": " << line << "\n";
+    if (on.size() > kShown) line += ", ...";
+    s << Wrapped("systematic, from " + groups[g] + ": " + line, "  ", "    ", kNoteLines);
   }
   return s.str();
 }
@@ -405,7 +513,7 @@ std::string GrossErrorLines(const CalibrationResult& result) {
   s << "  gross errors (more than " << FormatDouble(g.threshold_sigmas, 3)
     << " robust sigmas from the model): " << count << (count == 1 ? " reading" : " readings")
     << ", kept out of the fit\n";
-  constexpr size_t kShown = 10;
+  constexpr size_t kShown = 5;
   for (size_t k = 0; k < std::min(count, kShown); ++k) {
     const ReadingResidual& e = result.gross_errors[k];
     char buf[200];
@@ -424,9 +532,11 @@ std::string MisfitLine(const CalibrationResult& result) {
   if (result.misfit_ranking.empty()) return "";
   const MisfitCandidate& top = result.misfit_ranking.front();
   if (!top.significant) {
-    return "  no fixed parameter explains the misfit beyond the residuals' own noise (largest "
-           "expected chi-square decrease " +
-           FormatDouble(top.expected_decrease, 3) + ", from " + top.name + ")\n";
+    return Wrapped(
+        "no fixed parameter explains the misfit beyond the residuals' own noise (largest "
+        "expected chi-square decrease " +
+            FormatDouble(top.expected_decrease, 3) + ", from " + top.name + ")",
+        "  ", "    ", kNoteLines);
   }
   std::string line = "  the misfit is best explained by freeing:";
   for (size_t k = 0; k < std::min(kShown, result.misfit_ranking.size()); ++k) {
@@ -435,49 +545,47 @@ std::string MisfitLine(const CalibrationResult& result) {
     line += std::string(k ? ", " : " ") + c.name + " (about " +
             FormatDouble(c.expected_decrease, 3) + ")";
   }
-  return line + "  [expected chi-square decrease; each beyond the residuals' own noise]\n";
+  return Wrapped(line + " [expected chi-square decrease; each beyond the residuals' own noise]", "",
+                 "    ", kNoteLines);
 }
 
 std::string CrossValidationLine(const CalibrationResult& result) {
   const CrossValidation& cv = result.cross_validation;
   if (cv.folds_used == 0) return "";
-  std::ostringstream s;
-  char buf[200];
-  std::snprintf(
-      buf, sizeof(buf), "  %-46.46s",
-      ("calibrated, block cross-validation (" + std::to_string(cv.folds_used) + " blocks)")
-          .c_str());
-  s << buf;
-  for (double r : cv.rms_n) {
-    std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
-    s << buf;
-  }
-  return s.str() + "\n";
+  return CableRow("calibrated, cross-validated (" + std::to_string(cv.folds_used) + " blocks)",
+                  cv.rms_n, 1.0 / kNPerKn);
 }
 
 std::string CalibrationConsole(const CalibrationResult& result, const Dataset& data,
                                const std::vector<VariantEvaluation>& variants) {
   std::ostringstream s;
-  s << "\n" << result.ceres_brief_report << "\n";
   char buf[300];
   const ChiSquareBand band = ReducedChiSquareBand(result);
   std::snprintf(buf, sizeof(buf),
-                "reduced chi-square %.3f (expected 1 +- %.3g) over %d residuals; %d samples "
-                "fitted, %d held out; %.2f s\n",
+                "reduced chi-square %.3f (expected 1 +- %.3g) over %d residuals\n"
+                "%d samples fitted, %d held out; %.2f s\n",
                 result.reduced_chi_square, band.half_width, result.num_residuals,
                 result.num_fit_samples,
                 static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
-  s << buf << "verdict: " << FitVerdictName(result.verdict) << ": " << result.verdict_text << "\n\n"
+  s << buf
+    << Wrapped(
+           std::string("verdict: ") + FitVerdictName(result.verdict) + ": " + result.verdict_text,
+           "", "  ", 2 * kNoteLines)
+    << "\n"
     << EstimatesTable(result) << ConsiderLines(result);
-  for (const std::string& note : result.notes) s << "  " << note << "\n";
+  for (const std::string& note : result.notes) s << Wrapped(note, "  ", "    ", kNoteLines);
   for (const ParameterDirection& d : result.data_only.undetermined) {
-    s << "  the data alone cannot determine (a prior holds it): " << d.Describe() << "\n";
+    s << Wrapped("the data alone cannot determine (a prior holds it): " + d.Describe(), "  ",
+                 "    ", kNoteLines);
   }
   for (const ParameterDirection& d : result.data_only.poorly_determined) {
-    s << "  weak direction in the data alone: " << d.Describe() << "\n";
+    s << Wrapped("weak direction in the data alone: " + d.Describe(), "  ", "    ", kNoteLines);
   }
-  for (const std::string& c : result.strong_correlations) {
-    s << "  strongly correlated: " << c << "\n";
+  if (!result.strong_correlations.empty()) {
+    std::string pairs;
+    for (const std::string& c : result.strong_correlations)
+      pairs += (pairs.empty() ? "" : "; ") + c;
+    s << Wrapped("strongly correlated: " + pairs, "  ", "    ", kNoteLines);
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
     << RmsTable(variants) << CrossValidationLine(result) << "\nwrote " << FLAGS_out
@@ -612,7 +720,10 @@ int RunCalibrate(int argc, char** argv) {
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out, result.excluded)}};
   if (!WriteOutDirectory(command, files, report)) return kExitUsage;
 
-  std::cerr << CalibrationConsole(result, data, variants) << ChiSquareWarning(result);
+  // Results on stdout, progress and diagnostics on stderr (docs/cli.md, "Output streams").
+  if (!FLAGS_quiet) std::cerr << result.ceres_brief_report << "\n";
+  std::cout << CalibrationConsole(result, data, variants) << std::flush;
+  std::cerr << ChiSquareWarning(result);
   return 0;
 }
 
@@ -626,21 +737,11 @@ std::string EvaluationConsole(const Dataset& data, StaticsMethod method,
   s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
     << StaticsMethodName(method) << "\n\n"
     << RmsTable(variants);
-  char buf[160];
-  auto row = [&](const char* label, const auto& values, double scale) {
-    std::snprintf(buf, sizeof(buf), "    %-22s", label);
-    s << buf;
-    for (double v : values) {
-      std::snprintf(buf, sizeof(buf), " %8.3f", v * scale);
-      s << buf;
-    }
-    s << "\n";
-  };
   for (const VariantEvaluation& v : variants) {
-    s << "\n  " << v.name << ":\n";
-    row("RMS (%)", v.fit.rms_percent, 1.0);
-    row("mean (kN)", v.fit.mean_n, 1.0 / kNPerKn);
-    row("max |error| (kN)", v.fit.max_abs_n, 1.0 / kNPerKn);
+    s << "\n" << CableHeader(v.name + ":");
+    s << CableRow("  RMS (%)", v.fit.rms_percent, 1.0);
+    s << CableRow("  mean (kN)", v.fit.mean_n, 1.0 / kNPerKn);
+    s << CableRow("  max |error| (kN)", v.fit.max_abs_n, 1.0 / kNPerKn);
   }
   if (!FLAGS_out.empty())
     s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";

@@ -518,7 +518,8 @@ int RunSimulate(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  std::cerr << Summary(summary, options, csv_path, yaml_path) << std::endl;
+  // The summary of what was written is the result: stdout (docs/cli.md, "Output streams").
+  std::cout << Summary(summary, options, csv_path, yaml_path) << std::endl;
   return 0;
 }
 
