@@ -191,6 +191,7 @@ CalibrationSpec Spec(const CableRobot& model, const std::string& path_or_text, b
   CalibrationSpec spec;
   std::string error;
   const int anchors = static_cast<int>(model.anchor_points_cabin_m.size());
+  if (!is_text) RequireExistingFile(path_or_text, "spec");
   const bool ok = is_text
                       ? ParseCalibrationSpecYaml(path_or_text, source_name, anchors, &spec, &error)
                       : LoadCalibrationSpec(path_or_text, anchors, &spec, &error);
