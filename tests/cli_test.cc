@@ -815,6 +815,34 @@ TEST_F(CliTest, ResultsOnStdoutProgressOnStderrForEveryCommand) {
     EXPECT_LE(line.size(), kScreenColumns) << line;
   }
   EXPECT_LE(count, kScreenLines) << out;
+  // The misfit ranking's change column (issue 17, item 3): a one-step extrapolation that
+  // lands outside the parameter's plausible range is "beyond the linear range", never a
+  // negative or tenfold EA; lengths in one unit (mm).
+  const std::string md = ReadFile(Path("cal") + "/report.md");
+  std::istringstream rows(md.substr(md.find("| Rank | Parameter |")));
+  int beyond = 0, numbers = 0;
+  for (std::string row; std::getline(rows, row) && row.rfind("|", 0) == 0;) {
+    std::vector<std::string> cells;
+    std::stringstream split(row);
+    for (std::string cell; std::getline(split, cell, '|');) cells.push_back(cell);
+    if (cells.size() < 7 || cells[1].find("Rank") != std::string::npos ||
+        cells[1].find("---") != std::string::npos) {
+      continue;
+    }
+    const std::string change = cells[6];
+    EXPECT_EQ(change.find(" m "), std::string::npos) << row;  // lengths in mm
+    EXPECT_EQ(change.find("e+"), std::string::npos) << row;
+    if (change.find("beyond the linear range") != std::string::npos) {
+      ++beyond;
+    } else if (cells[2].find("`ea_n[") != std::string::npos) {
+      ++numbers;
+      const double ea_n = 2.4656e7 + std::stod(change);
+      EXPECT_TRUE(ea_n >= 5e6 && ea_n <= 1.25e8) << row;
+    }
+  }
+  EXPECT_GT(beyond, 0) << md;
+  EXPECT_NE(ReadFile(Path("cal") + "/summary.json").find("\"beyond_linear_range\": true"),
+            std::string::npos);
   std::tie(out, err) = run("evaluate --data=" + data_dir + "circle_paper.csv");
   EXPECT_NE(out.find("RMS model - measured (kN)"), std::string::npos) << out;
   EXPECT_EQ(err, "");
@@ -843,6 +871,28 @@ TEST_F(CliTest, ResultsOnStdoutProgressOnStderrForEveryCommand) {
       run("workspace --off-axis-step-deg=10 --azimuth-step-deg=60 --output=" + Path("ws.csv"));
   EXPECT_EQ(out.rfind("fastcal workspace: ", 0), 0u) << out;
   EXPECT_EQ(err, "");
+}
+
+// A dimensionless value has no unit after it (issue 17, item 7): "+-0.72", never
+// "+-0.72 1", which reads as a unit called "1".
+TEST_F(CliTest, DimensionlessValuesCarryNoUnitOfOne) {
+  std::istringstream circle(ReadFile(Source() + "/calibration_data/circle_paper.csv"));
+  std::string text, line;
+  for (int n = 0; n < 12 && std::getline(circle, line); ++n) text += line + "\n";
+  Write("eight.csv", text);  // 8 samples: per-cable gains and biases undetermined
+  Write("gains.yaml",
+        "parameters:\n  sensor_gain: {mode: per_cable, free: true}\n"
+        "  sensor_bias_kN: {mode: per_cable, free: true}\n");
+  const CommandResult r =
+      RunBoundedAndExpect({"calibrate --quiet --spec=" + Path("gains.yaml") +
+                               " --data=" + Path("eight.csv") + " --out=" + Path("o"),
+                           1, "  - sensor_gain[1]: +-"});
+  EXPECT_TRUE(
+      std::regex_search(r.output, std::regex("sensor_gain\\[1\\]: \\+-[0-9.]+ \\(determined "
+                                             "means \\+-0.05 or better\\)")))
+      << r.output;
+  EXPECT_EQ(r.output.find(" 1 (determined"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("kN (determined means +-5 kN or better)"), std::string::npos);
 }
 
 // Unit and magnitude slips in a spec or model (issue 17) are refused where they are

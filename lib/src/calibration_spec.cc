@@ -33,6 +33,7 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/model_plausibility.h"
 #include "fastcal/plausibility.h"
 #include "yaml_document.h"
 
@@ -96,35 +97,10 @@ std::string ParameterName(const GroupInfo& g, int index, int component) {
 // Checks shared by the reader and CalibrationSpec::IsValid. Each returns what is wrong,
 // or an empty string.
 
-// The plausibility.h quantity of a parameter kind's values; none for kinds without one.
-std::optional<ModelQuantity> QuantityOf(ParameterKind kind) {
-  switch (kind) {
-    case ParameterKind::kMassCentre:
-      return ModelQuantity::kMassCentreM;
-    case ParameterKind::kCabinMass:
-      return ModelQuantity::kCabinMassKg;
-    case ParameterKind::kLinearDensity:
-      return ModelQuantity::kLinearDensityKgPerM;
-    case ParameterKind::kEa:
-      return ModelQuantity::kEaN;
-    case ParameterKind::kAnchorOffset:
-    case ParameterKind::kTowerOffset:
-      return ModelQuantity::kOffsetM;
-    case ParameterKind::kSensorGain:
-      return ModelQuantity::kSensorGain;
-    case ParameterKind::kSensorBias:
-      return ModelQuantity::kSensorBiasN;
-    default:
-      return std::nullopt;
-  }
-}
-
 // "" for a value within the plausible range of its kind (plausibility.h), else why not.
 std::string CheckPlausible(ParameterKind kind, double value_si) {
-  const std::optional<ModelQuantity> quantity = QuantityOf(kind);
   std::string why;
-  if (!quantity || CheckQuantity(*quantity, value_si, PlausibilityLimits(), &why)) return "";
-  return why;
+  return CheckParameterValue(kind, value_si, PlausibilityLimits(), &why) ? "" : why;
 }
 
 std::string CheckInitial(ParameterKind kind, double initial_si) {
@@ -160,9 +136,9 @@ std::string CheckPriorMean(ParameterKind kind, double mean) {
 // 2000 on sensor_bias_kN is 2000 N written as kN).
 std::string CheckPriorSigma(ParameterKind kind, double sigma_si) {
   if (!(std::isfinite(sigma_si) && sigma_si > 0.0)) return "must be > 0";
-  const std::optional<ModelQuantity> quantity = QuantityOf(kind);
-  if (!quantity) return "";
-  const QuantityRange range = PlausibleRange(*quantity, PlausibilityLimits());
+  ModelQuantity quantity;
+  if (!QuantityOfParameter(kind, &quantity)) return "";
+  const QuantityRange range = PlausibleRange(quantity, PlausibilityLimits());
   const double width = range.max - range.min;
   if (sigma_si <= width) return "";
   const std::string unit = range.file_unit;

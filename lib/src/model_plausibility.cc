@@ -77,6 +77,41 @@ std::string InFileUnit(double value_si, const QuantityRange& range) {
 
 }  // namespace
 
+bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity) {
+  switch (kind) {
+    case ParameterKind::kMassCentre:
+      *quantity = ModelQuantity::kMassCentreM;
+      return true;
+    case ParameterKind::kCabinMass:
+      *quantity = ModelQuantity::kCabinMassKg;
+      return true;
+    case ParameterKind::kLinearDensity:
+      *quantity = ModelQuantity::kLinearDensityKgPerM;
+      return true;
+    case ParameterKind::kEa:
+      *quantity = ModelQuantity::kEaN;
+      return true;
+    case ParameterKind::kAnchorOffset:
+    case ParameterKind::kTowerOffset:
+      *quantity = ModelQuantity::kOffsetM;
+      return true;
+    case ParameterKind::kSensorGain:
+      *quantity = ModelQuantity::kSensorGain;
+      return true;
+    case ParameterKind::kSensorBias:
+      *quantity = ModelQuantity::kSensorBiasN;
+      return true;
+    default:
+      return false;
+  }
+}
+
+bool CheckParameterValue(ParameterKind kind, double value_si, const PlausibilityLimits& limits,
+                         std::string* why) {
+  ModelQuantity quantity;
+  return !QuantityOfParameter(kind, &quantity) || CheckQuantity(quantity, value_si, limits, why);
+}
+
 bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limits,
                          std::string* why) {
   std::string what;

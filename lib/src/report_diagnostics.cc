@@ -33,6 +33,21 @@ std::string WithUnit(double v, const std::string& unit) {
   return Printf("%.2g", v) + (unit == "1" ? "" : " " + unit);
 }
 
+// A value of the misfit table, one unit per quantity (lengths always in mm, so that a
+// column never has "1.6 m" beside "7.5e+02 mm"), 2 significant digits, no exponent
+// between 0.001 and 1e6.
+std::string MisfitValue(double v, const std::string& unit) {
+  const bool length = unit == "m";
+  const double shown = length ? v * 1e3 : v;
+  const double magnitude = std::abs(shown);
+  std::string text = Printf("%.2g", shown);
+  if (magnitude >= 1e2 && magnitude < 1e6) {  // 2 significant digits, written out
+    const double step = std::pow(10.0, std::floor(std::log10(magnitude)) - 1.0);
+    text = Printf("%.0f", std::round(shown / step) * step);
+  }
+  return text + (length ? " mm" : unit == "1" ? "" : " " + unit);
+}
+
 std::vector<const ParameterEstimate*> FreeEstimates(const CalibrationResult& r) {
   std::vector<const ParameterEstimate*> free;
   for (const ParameterEstimate& p : r.parameters) {
@@ -288,19 +303,20 @@ void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
     const MisfitCandidate& c = r.misfit_ranking[k];
     Text moved("-");
     double most = 0.0;
-    for (size_t j = 0; j < free.size() && j < c.shifts.size(); ++j) {
+    for (size_t j = 0; !c.beyond_linear_range && j < free.size() && j < c.shifts.size(); ++j) {
       const double sigmas =
           free[j]->sigma_total > 0 ? std::abs(c.shifts[j]) / free[j]->sigma_total : 0.0;
       if (sigmas <= most) continue;
       most = sigmas;
       moved = Text()
                   .Code(free[j]->name)
-                  .Plain(" " + WithUnit(c.shifts[j], free[j]->unit) + " (" +
+                  .Plain(" " + MisfitValue(c.shifts[j], free[j]->unit) + " (" +
                          Printf("%.2g", sigmas) + ")");
     }
-    t.rows.push_back({Int(static_cast<long long>(k + 1)), Text().Code(c.name),
-                      Sig3(c.expected_decrease), Sig3(c.statistic), c.significant ? "yes" : "no",
-                      WithUnit(c.change, c.unit), moved});
+    t.rows.push_back(
+        {Int(static_cast<long long>(k + 1)), Text().Code(c.name), Sig3(c.expected_decrease),
+         Sig3(c.statistic), c.significant ? "yes" : "no",
+         c.beyond_linear_range ? "beyond the linear range" : MisfitValue(c.change, c.unit), moved});
   }
   doc->AddTable(std::move(t));
 }
@@ -458,6 +474,7 @@ void JsonMisfitAndValidation(const CalibrationResult& r, JsonWriter* w) {
     w->Key("statistic").Number(c.statistic);
     w->Key("significant").Bool(c.significant);
     w->Key("change").Number(c.change);
+    w->Key("beyond_linear_range").Bool(c.beyond_linear_range);
     w->Key("unit").String(c.unit);
     w->Key("shifts").BeginObject();
     size_t k = 0;

@@ -116,6 +116,9 @@ py::dict ResultDict(const CalibrationResult& r) {
     m["name"] = c.name;
     m["expected_chi_square_decrease"] = c.expected_decrease;
     m["significant"] = c.significant;
+    m["change"] = c.change;  // in `unit`; not meaningful when beyond_linear_range
+    m["unit"] = c.unit;
+    m["beyond_linear_range"] = c.beyond_linear_range;
     ranking.append(m);
   }
   d["outliers"] = outliers;

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/plausibility.h"
@@ -22,6 +23,14 @@ namespace fastcal {
 //   "cables[2].ea_n: 24656 N is below the plausible minimum of 5000000 N (...)".
 // Tower tops are checked as positions (CheckPosition).
 bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limits,
+                         std::string* why);
+
+// The plausibility.h quantity of a calibration parameter kind's values; false for a kind
+// without one.
+bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity);
+// True when `value_si` is plausible for a parameter of `kind` (or the kind has no range);
+// otherwise false and *why as CheckQuantity says it.
+bool CheckParameterValue(ParameterKind kind, double value_si, const PlausibilityLimits& limits,
                          std::string* why);
 
 // The values of `robot` furthest from the nominal FAST model, furthest first, at most
