@@ -29,6 +29,7 @@
 
 DECLARE_string(model);
 DECLARE_string(method);
+DECLARE_bool(force);
 DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
 DEFINE_string(data, "", "Measurement CSV (docs/data-format.md).");
 DEFINE_string(out, "", "Output directory (must not exist, or be empty).");
@@ -47,7 +48,7 @@ const char kCalibrateHelp[] =
     R"(fastcal calibrate: estimate model parameters from measured cabin poses and cable tensions.
 
 Usage:
-  fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml]
+  fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml] [--force]
 
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
   --spec=FILE         which parameters are free, initial values, priors (a fixed
@@ -60,6 +61,8 @@ Usage:
                       (docs/data-format.md)
   --out=DIR           output directory; must not exist or be empty. Written only when the
                       calibration succeeded: nothing is left behind on failure.
+  --force             let --out be a previous run's results (only the files listed under
+                      Outputs), replaced when the new ones are complete
   --skip-invalid-rows skip rows that are malformed (a missing, non-numeric or non-finite
                       value, an implausible one...) or whose pose the initial model cannot
                       solve (e.g. outside the workspace), instead of failing; each is
@@ -117,6 +120,7 @@ Usage:
   --data=FILE    telemetry export (docs/data-format.md)
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
+  --force        let --out be a previous evaluate's results, replaced when complete
   --skip-invalid-rows   skip rows that are malformed or whose pose the model cannot solve
                  (with --method, at each attitude) instead of failing; each is listed
                  with its line on stderr and, with --out, in the report and summary.json
@@ -128,11 +132,23 @@ bias (if any) are applied: predicted reading = gain * tension + bias.
 
 // Writes the given files into a fresh temporary sibling of `dir`, then renames it to
 // `dir`; on any failure removes the temporary directory.
+// The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
+// replace there.
+const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "report.html",
+                                                    "report.md", "summary.json", "residuals.csv"};
+const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
+                                                   "residuals.csv"};
+
+// CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
+bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
+  return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
+}
+
 bool WriteDirectoryAtomically(const std::string& dir,
                               const std::vector<std::pair<std::string, std::string>>& files,
                               const std::function<bool(const std::string&, std::string*)>& extra,
-                              std::string* error) {
-  if (!CheckOutputDirectory("out", dir, error)) return false;
+                              const std::vector<std::string>& outputs, std::string* error) {
+  if (!CheckOutputDirectory("out", dir, error, FLAGS_force ? &outputs : nullptr)) return false;
   std::error_code ec;
   const fs::path target = ResolveOutputPath(dir);
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -166,9 +182,22 @@ bool WriteDirectoryAtomically(const std::string& dir,
   }
   std::string why;
   if (extra && !extra(tmp.string(), &why)) return fail(why);
-  if (fs::exists(target, ec)) fs::remove(target, ec);  // empty directory
+  // An existing target is empty, or (--force) a previous run's results: moved aside,
+  // and removed only once the new results are in place.
+  const fs::path previous =
+      parent / ("." + target.filename().string() + ".old." + std::to_string(::getpid()));
+  const bool replacing = fs::exists(target, ec);
+  if (replacing) {
+    fs::remove_all(previous, ec);
+    fs::rename(target, previous, ec);
+    if (ec) return fail("cannot move the previous results aside: " + ec.message());
+  }
   fs::rename(tmp, target, ec);
-  if (ec) return fail("cannot move the results into place: " + ec.message());
+  if (ec) {
+    if (replacing) fs::rename(previous, target, ec);
+    return fail("cannot move the results into place: " + ec.message());
+  }
+  if (replacing) fs::remove_all(previous, ec);
   return true;
 }
 
@@ -597,14 +626,14 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
 // sibling and renamed into place). False, with the error printed, on failure.
 bool WriteOutDirectory(const char* command,
                        const std::vector<std::pair<std::string, std::string>>& files,
-                       const ReportInputs& report) {
+                       const ReportInputs& report, const std::vector<std::string>& outputs) {
   std::string error;
   if (WriteDirectoryAtomically(
           FLAGS_out, files,
           [&](const std::string& dir, std::string* why) {
             return WriteReportFiles(dir, report, why);
           },
-          &error)) {
+          outputs, &error)) {
     return true;
   }
   PrintError(command, error);
@@ -649,7 +678,8 @@ int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kCalibrateHelp,
-                    {"model", "spec", "data", "out", "skip-invalid-rows", "quiet"}, &exit_code)) {
+                    {"model", "spec", "data", "out", "skip-invalid-rows", "quiet", "force"},
+                    &exit_code)) {
     return exit_code;
   }
   std::string error;
@@ -662,7 +692,7 @@ int RunCalibrate(int argc, char** argv) {
   CableRobot model;
   Dataset data;
   CalibrationSpec spec;
-  if (!CheckOutputDirectory("out", FLAGS_out, &error) || !LoadInputs(&model, &data, &error) ||
+  if (!CheckOutFlag(kCalibrateOutputs, &error) || !LoadInputs(&model, &data, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(model.anchor_points_cabin_m.size()), &spec,
                            &error)) {
     PrintError(command, error);
@@ -718,7 +748,7 @@ int RunCalibrate(int argc, char** argv) {
       {"model_calibrated.yaml",
        CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))},
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out, result.excluded)}};
-  if (!WriteOutDirectory(command, files, report)) return kExitUsage;
+  if (!WriteOutDirectory(command, files, report, kCalibrateOutputs)) return kExitUsage;
 
   // Results on stdout, progress and diagnostics on stderr (docs/cli.md, "Output streams").
   if (!FLAGS_quiet) std::cerr << result.ceres_brief_report << "\n";
@@ -752,7 +782,7 @@ int RunEvaluate(int argc, char** argv) {
   const char* command = "evaluate";
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kEvaluateHelp,
-                    {"model", "data", "out", "method", "skip-invalid-rows"}, &exit_code)) {
+                    {"model", "data", "out", "method", "skip-invalid-rows", "force"}, &exit_code)) {
     return exit_code;
   }
   std::string error;
@@ -764,7 +794,7 @@ int RunEvaluate(int argc, char** argv) {
   }
   CableRobot model;
   Dataset data;
-  if ((!FLAGS_out.empty() && !CheckOutputDirectory("out", FLAGS_out, &error)) ||
+  if ((!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error)) ||
       !LoadInputs(&model, &data, &error)) {
     PrintError(command, error);
     return kExitUsage;
@@ -800,7 +830,7 @@ int RunEvaluate(int argc, char** argv) {
     report.variants = variants;
     report.evaluation_method = StaticsMethodName(method);
     if (!WriteOutDirectory(command, {{"residuals.csv", ResidualsCsv(data, variants, {}, {})}},
-                           report)) {
+                           report, kEvaluateOutputs)) {
       return kExitUsage;
     }
   }

@@ -873,6 +873,34 @@ TEST_F(CliTest, ResultsOnStdoutProgressOnStderrForEveryCommand) {
   EXPECT_EQ(err, "");
 }
 
+// calibrate --force reruns into the same folder (issue 17, item 7), replacing a previous
+// run's results and nothing else.
+TEST_F(CliTest, CalibrateForceReplacesAPreviousRunOnly) {
+  const std::string args = "calibrate --quiet --spec=" + Source() +
+                           "/calibration_data/spec_mass_centre.yaml --data=" + Source() +
+                           "/calibration_data/circle_paper.csv --out=" + Path("run");
+  ASSERT_EQ(Fastcal(args).code, 0);
+  RunBoundedAndExpect({args, 2,
+                       "exists and is not an empty directory (choose a new --out, or "
+                       "--force to replace a previous run's results)"});
+  std::ofstream(Path("run") + "/residuals.csv") << "stale\n";
+  RunBoundedAndExpect({args + " --force", 0, "wrote "});
+  EXPECT_NE(ReadFile(Path("run") + "/residuals.csv"), "stale\n");
+  std::vector<std::string> entries;
+  for (const auto& e : fs::directory_iterator(dir_)) entries.push_back(e.path().filename());
+  EXPECT_EQ(entries, std::vector<std::string>{"run"});  // nothing left aside
+  // Anything else in the folder: refused, untouched.
+  std::ofstream(Path("run") + "/notes.txt") << "mine\n";
+  RunBoundedAndExpect({args + " --force", 2,
+                       "holds 'notes.txt', which is not a fastcal result: --force replaces "
+                       "only a previous run's results"});
+  EXPECT_EQ(ReadFile(Path("run") + "/notes.txt"), "mine\n");
+  // evaluate --force does not take over a calibration's folder (its model would be lost).
+  RunBoundedAndExpect({"evaluate --force --data=" + Source() +
+                           "/calibration_data/circle_paper.csv --out=" + Path("run"),
+                       2, "holds '"});
+}
+
 // A dimensionless value has no unit after it (issue 17, item 7): "+-0.72", never
 // "+-0.72 1", which reads as a unit called "1".
 TEST_F(CliTest, DimensionlessValuesCarryNoUnitOfOne) {
