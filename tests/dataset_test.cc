@@ -442,6 +442,19 @@ TEST_F(DatasetTest, AttitudesInRadiansUnderDegreeColumnsAreRefused) {
           kRow + kRow);
 }
 
+// "-0" is written as "0" (issue 17, item 7): the same value, and a reader wonders.
+TEST_F(DatasetTest, NegativeZeroIsWrittenAsZero) {
+  const Dataset d =
+      ParseOk(std::string(kHeader) + "0.5,-0,2,140,-0,0.2,-0.0,150,151,152,153,154,0\n");
+  const std::string path = PathOf("zero.csv");
+  std::string error;
+  ASSERT_TRUE(WriteDataset(path, d, "", &error)) << error;
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("-0,"), std::string::npos) << text;
+  EXPECT_NE(text.find("0.5,0,2,140,0,0.2,0,"), std::string::npos) << text;
+}
+
 TEST_F(DatasetTest, DropoutReadingsOfZeroAreAccepted) {
   const Dataset d = ParseOk(std::string(kHeader) + "0,1,2,140,0,0,0,150,0,152,1e-300,-0,155\n");
   ASSERT_EQ(d.samples.size(), 1u);

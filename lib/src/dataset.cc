@@ -155,7 +155,7 @@ double ScaleByKilo(std::string_view field, double parsed_value) {
 // after the reader shifts it back (shift 0: plain shortest round-trip formatting). Plain
 // notation for moderate exponents, scientific otherwise. `value` must be finite.
 std::string FormatNumber(double value, int shift) {
-  if (value == 0.0) return std::signbit(value) ? "-0" : "0";
+  if (value == 0.0) return "0";  // -0 too: the same reading, and "-0" puzzles a reader
   char buffer[64];
   const std::to_chars_result result =
       std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::scientific);
