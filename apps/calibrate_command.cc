@@ -5,10 +5,12 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -640,6 +642,32 @@ bool WriteOutDirectory(const char* command,
   return false;
 }
 
+// A dataset beside `data_path` to check a calibrated model on: the first other .csv file
+// of its directory (by name) whose header is a dataset's; "" when there is none.
+std::string OtherDataset(const std::string& data_path) {
+  std::error_code ec;
+  const fs::path data = fs::path(data_path);
+  const fs::path dir = data.has_parent_path() ? data.parent_path() : fs::path(".");
+  std::vector<fs::path> candidates;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (entry.path().extension() == ".csv" && entry.is_regular_file(ec) &&
+        !fs::equivalent(entry.path(), data, ec)) {
+      candidates.push_back(entry.path());
+    }
+  }
+  std::sort(candidates.begin(), candidates.end());
+  for (const fs::path& candidate : candidates) {
+    std::ifstream in(candidate);
+    std::string line;
+    while (std::getline(in, line) && (line.empty() || line[0] == '#')) {
+    }
+    if (line.find("T1_kN") != std::string::npos && line.find("x_m") != std::string::npos) {
+      return (data.has_parent_path() ? dir / candidate.filename() : candidate.filename()).string();
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 // The report's provenance, common to calibrate and evaluate: the input files (the spec's
@@ -743,6 +771,8 @@ int RunCalibrate(int argc, char** argv) {
   report.result = &result;
   report.variants = variants;
   report.evaluation_method = "exact";
+  report.out_dir = FLAGS_out;
+  report.other_data_path = OtherDataset(FLAGS_data);
 
   const std::vector<std::pair<std::string, std::string>> files = {
       {"model_calibrated.yaml",

@@ -240,10 +240,17 @@ void AddGrossErrors(const ReportInputs& in, Document* doc) {
     t.header = {"Line",    "Cable", "Measured [kN]", "Predicted [kN]", "(model - measured) / σ",
                 "Held out"};
     t.right_align = {true, true, true, true, true, false};
+    bool any_held_out = false;
     for (size_t k = 0; k < std::min(list.size(), kMaxReadingRows); ++k) {
       const ReadingResidual& e = list[k];
+      any_held_out = any_held_out || e.held_out;
       t.rows.push_back({Int(e.line), Int(e.cable), Kn3(e.measured_n), Kn3(e.predicted_n),
                         Printf("%+.1f", e.residual_sigma), e.held_out ? "yes" : ""});
+    }
+    if (!any_held_out) {  // an empty column is not drawn
+      t.header.pop_back();
+      t.right_align.pop_back();
+      for (std::vector<Text>& row : t.rows) row.pop_back();
     }
     doc->AddTable(std::move(t));
     if (list.size() > kMaxReadingRows) {
@@ -269,7 +276,10 @@ void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
       Sig3(r.misfit_threshold) +
       " (chi-square of 1 degree of freedom, 1% for the family). Significant or not, a "
       "single circle of poses often cannot tell some candidates apart (a gain from an "
-      "anchor offset): they are where to look, not a diagnosis.");
+      "anchor offset): they are where to look, not a diagnosis. Freed, moves: the change "
+      "of the parameter itself, one Gauss-Newton step (\"beyond the linear range\" when "
+      "that would leave its plausible range); moves most: the estimate it would shift most, "
+      "in units of that estimate's σ_total.");
   if (r.misfit_ranking.empty()) {
     doc->Paragraph("No candidate: every parameter is free or spanned by the free ones.");
     return;
@@ -291,13 +301,9 @@ void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
   doc->Paragraph(lead);
   const std::vector<const ParameterEstimate*> free = FreeEstimates(r);
   Table t;
-  t.header = {"Rank",
-              "Parameter",
-              "Expected χ² decrease",
-              "Statistic",
-              "Significant",
-              "Freeing it would move it by",
-              "and the estimate it moves most (in σ_total)"};
+  // Short headers: the table fits a 900 px window (the paragraph above explains them).
+  t.header = {"#",           "Parameter",    "Expected χ² decrease", "Statistic",
+              "Significant", "Freed, moves", "Moves most (σ_total)"};
   t.right_align = {true, false, true, true, false, true, false};
   for (size_t k = 0; k < std::min(kMisfitRows, r.misfit_ranking.size()); ++k) {
     const MisfitCandidate& c = r.misfit_ranking[k];
@@ -388,21 +394,42 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
   o.width_px = kScatterWidthPx;
   o.height_px = kScatterHeightPx;
   o.y_label = "model - measured [kN]";
-  o.title = "Residual against off-axis angle";
-  o.x_label = "off-axis angle from the focal centre [deg]";
-  const std::string a = SvgLinePlot(zenith, o);
-  o.title = "Residual against azimuth";
-  o.x_label = "azimuth [deg]";
-  const std::string b = SvgLinePlot(azimuth, o);
+  // A pose axis the trajectory barely moves along (a circle keeps its off-axis angle,
+  // 26.39-26.41 deg) would show the residuals' scatter stretched over rounding: left
+  // out, and the caption says why.
+  constexpr double kFlatAxisDeg = 1.0;
+  std::vector<std::string> plots;
+  std::string flat;
+  auto against = [&](const std::vector<PlotSeries>& series, const std::string& title,
+                     const std::string& axis) {
+    double axis_lo = INFINITY, axis_hi = -INFINITY;
+    for (const PlotSeries& p : series) {
+      for (double x : p.x) {
+        axis_lo = std::min(axis_lo, x);
+        axis_hi = std::max(axis_hi, x);
+      }
+    }
+    if (axis_hi - axis_lo < kFlatAxisDeg) {
+      flat += " Not drawn against the " + axis + ": the data span only " + Printf("%.4g", axis_lo) +
+              " to " + Printf("%.4g", axis_hi) + " deg of it.";
+      return;
+    }
+    o.title = "Residual against " + title;
+    o.x_label = axis + " [deg]";
+    plots.push_back(SvgLinePlot(series, o));
+  };
+  against(zenith, "off-axis angle", "off-axis angle from the focal centre");
+  against(azimuth, "azimuth", "azimuth");
   o.title = "Predicted against measured";
   o.x_label = "measured [kN]";
   o.y_label = "predicted by the calibrated model [kN]";
-  const std::string c = SvgLinePlot(versus, o);
-  doc->Figure({a, b, c},
+  plots.push_back(SvgLinePlot(versus, o));
+  doc->Figure(plots,
               "The calibrated model's residuals per cable against where the cabin was (off-axis "
               "angle and azimuth seen from the focal centre): a trend or a wave is model error "
               "that depends on the pose, not noise. Last: predicted against measured tension, "
               "with the diagonal." +
+                  flat +
                   (excluded > 0 ? " " + Int(excluded) + " gross errors are not drawn." : "") +
                   EvenThinningNote(static_cast<int>(d.samples.size()), stride));
 }
