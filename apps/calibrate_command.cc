@@ -340,6 +340,15 @@ std::string UtcNow() {
   return text;
 }
 
+// "0.192 +- 0.034 m": the estimate to the precision its sigma_total supports (a tiny
+// estimate beside a large sigma is "0.000 +- 0.010", not "1.2e-09"); no unit for "1".
+std::string ValueWithSigma(double estimate, double sigma, const std::string& unit) {
+  const std::string shown_unit = unit == "1" ? "" : " " + unit;
+  if (!(sigma > 0.0)) return internal::EstimateText(estimate, sigma) + shown_unit;
+  return internal::EstimateText(estimate, sigma) + " +- " + internal::EstimateText(sigma, sigma) +
+         shown_unit;
+}
+
 // The comment lines at the top of model_calibrated.yaml: provenance, a warning when the
 // fit failed (the file is still written, as a record), and each free estimate with its
 // sigma_total (the file's values have no room for uncertainties).
@@ -356,8 +365,7 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
             "budget):";
   for (const ParameterEstimate& p : result.parameters) {
     if (!p.free) continue;
-    header += "\n  " + p.name + " = " + FormatDouble(p.estimate, 8) + " +- " +
-              FormatDouble(p.sigma_total, 3) + (p.unit == "1" ? "" : " " + p.unit);
+    header += "\n  " + p.name + " = " + ValueWithSigma(p.estimate, p.sigma_total, p.unit);
   }
   return header;
 }
@@ -385,15 +393,6 @@ std::string ChiSquareWarning(const CalibrationResult& result) {
 std::string SigmaText(double sigma, const std::string& unit) {
   if (unit == "m" && std::abs(sigma) < 1.0) return FormatDouble(sigma * 1e3, 2) + " mm";
   return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
-}
-
-// "0.192 +- 0.034 m": the estimate to the precision its sigma_total supports (a tiny
-// estimate beside a large sigma is "0.000 +- 0.010", not "1.2e-09"); no unit for "1".
-std::string ValueWithSigma(double estimate, double sigma, const std::string& unit) {
-  const std::string shown_unit = unit == "1" ? "" : " " + unit;
-  if (!(sigma > 0.0)) return internal::EstimateText(estimate, sigma) + shown_unit;
-  return internal::EstimateText(estimate, sigma) + " +- " + internal::EstimateText(sigma, sigma) +
-         shown_unit;
 }
 
 // The console is one screen: at most kConsoleWidth columns, long notes cut to
