@@ -104,6 +104,9 @@ the residuals 5 times the stated noise, or no convergence: "warning: the fit fai
 ends stderr and model_calibrated.yaml opens with a warning). The exit code stays 0 for
 all four: the outputs are written, as a record.
 
+Streams: the one-screen summary (verdict, free estimates, gross errors, RMS table) on
+stdout; progress, skipped rows, notes and warnings on stderr.
+
 Exit codes: 0 the outputs were written (see the verdict), 1 the calibration failed or was
 refused, or a row's pose cannot be solved (without --skip-invalid-rows), 2 bad input.
 
