@@ -5,11 +5,14 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "cli_util.h"
@@ -21,11 +24,14 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/internal/report_document.h"
+#include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/version.h"
 
 DECLARE_string(model);
 DECLARE_string(method);
+DECLARE_bool(force);
 DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
 DEFINE_string(data, "", "Measurement CSV (docs/data-format.md).");
 DEFINE_string(out, "", "Output directory (must not exist, or be empty).");
@@ -44,7 +50,7 @@ const char kCalibrateHelp[] =
     R"(fastcal calibrate: estimate model parameters from measured cabin poses and cable tensions.
 
 Usage:
-  fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml]
+  fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml] [--force]
 
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
   --spec=FILE         which parameters are free, initial values, priors (a fixed
@@ -57,6 +63,8 @@ Usage:
                       (docs/data-format.md)
   --out=DIR           output directory; must not exist or be empty. Written only when the
                       calibration succeeded: nothing is left behind on failure.
+  --force             let --out be a previous run's results (only the files listed under
+                      Outputs), replaced when the new ones are complete
   --skip-invalid-rows skip rows that are malformed (a missing, non-numeric or non-finite
                       value, an implausible one...) or whose pose the initial model cannot
                       solve (e.g. outside the workspace), instead of failing; each is
@@ -96,6 +104,9 @@ the residuals 5 times the stated noise, or no convergence: "warning: the fit fai
 ends stderr and model_calibrated.yaml opens with a warning). The exit code stays 0 for
 all four: the outputs are written, as a record.
 
+Streams: the one-screen summary (verdict, free estimates, gross errors, RMS table) on
+stdout; progress, skipped rows, notes and warnings on stderr.
+
 Exit codes: 0 the outputs were written (see the verdict), 1 the calibration failed or was
 refused, or a row's pose cannot be solved (without --skip-invalid-rows), 2 bad input.
 
@@ -114,6 +125,7 @@ Usage:
   --data=FILE    telemetry export (docs/data-format.md)
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
+  --force        let --out be a previous evaluate's results, replaced when complete
   --skip-invalid-rows   skip rows that are malformed or whose pose the model cannot solve
                  (with --method, at each attitude) instead of failing; each is listed
                  with its line on stderr and, with --out, in the report and summary.json
@@ -125,11 +137,23 @@ bias (if any) are applied: predicted reading = gain * tension + bias.
 
 // Writes the given files into a fresh temporary sibling of `dir`, then renames it to
 // `dir`; on any failure removes the temporary directory.
+// The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
+// replace there.
+const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "report.html",
+                                                    "report.md", "summary.json", "residuals.csv"};
+const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
+                                                   "residuals.csv"};
+
+// CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
+bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
+  return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
+}
+
 bool WriteDirectoryAtomically(const std::string& dir,
                               const std::vector<std::pair<std::string, std::string>>& files,
                               const std::function<bool(const std::string&, std::string*)>& extra,
-                              std::string* error) {
-  if (!CheckOutputDirectory("out", dir, error)) return false;
+                              const std::vector<std::string>& outputs, std::string* error) {
+  if (!CheckOutputDirectory("out", dir, error, FLAGS_force ? &outputs : nullptr)) return false;
   std::error_code ec;
   const fs::path target = ResolveOutputPath(dir);
   const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
@@ -163,9 +187,22 @@ bool WriteDirectoryAtomically(const std::string& dir,
   }
   std::string why;
   if (extra && !extra(tmp.string(), &why)) return fail(why);
-  if (fs::exists(target, ec)) fs::remove(target, ec);  // empty directory
+  // An existing target is empty, or (--force) a previous run's results: moved aside,
+  // and removed only once the new results are in place.
+  const fs::path previous =
+      parent / ("." + target.filename().string() + ".old." + std::to_string(::getpid()));
+  const bool replacing = fs::exists(target, ec);
+  if (replacing) {
+    fs::remove_all(previous, ec);
+    fs::rename(target, previous, ec);
+    if (ec) return fail("cannot move the previous results aside: " + ec.message());
+  }
   fs::rename(tmp, target, ec);
-  if (ec) return fail("cannot move the results into place: " + ec.message());
+  if (ec) {
+    if (replacing) fs::rename(previous, target, ec);
+    return fail("cannot move the results into place: " + ec.message());
+  }
+  if (replacing) fs::remove_all(previous, ec);
   return true;
 }
 
@@ -207,27 +244,39 @@ std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluatio
   return legend.str() + out.str();
 }
 
-std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
-  std::ostringstream s;
+// The per-cable tables of calibrate's and evaluate's consoles share one layout: a label
+// column, then T1..T6, so that every row lines up under its header.
+constexpr int kLabelWidth = 40;
+
+std::string CableHeader(const std::string& title) {
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "  %-46s %8s %8s %8s %8s %8s %8s\n", "RMS model - measured (kN)",
+  std::snprintf(buf, sizeof(buf), "  %-*s %8s %8s %8s %8s %8s %8s\n", kLabelWidth, title.c_str(),
                 "T1", "T2", "T3", "T4", "T5", "T6");
-  s << buf;
+  return buf;
+}
+
+std::string CableRow(const std::string& label, const std::array<double, kNumCables>& values,
+                     double scale) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "  %-*.*s", kLabelWidth, kLabelWidth, label.c_str());
+  std::string row = buf;
+  for (double v : values) {
+    std::snprintf(buf, sizeof(buf), " %8.3f", v * scale + 0.0);  // + 0.0: no "-0.000"
+    row += std::string(buf) == " -0.000" ? "    0.000" : buf;
+  }
+  return row + "\n";
+}
+
+std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
+  std::string s = CableHeader("RMS model - measured (kN)");
   for (const VariantEvaluation& v : variants) {
     for (int part = 0; part < 2; ++part) {
       const CableErrorStats& st = part == 0 ? v.fit : v.holdout;
       if (st.samples == 0) continue;
-      std::string name = v.name + (part == 1 ? " [hold-out]" : "");
-      std::snprintf(buf, sizeof(buf), "  %-46.46s", name.c_str());
-      s << buf;
-      for (double r : st.rms_n) {
-        std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
-        s << buf;
-      }
-      s << "\n";
+      s += CableRow(v.name + (part == 1 ? " [hold-out]" : ""), st.rms_n, 1.0 / kNPerKn);
     }
   }
-  return s.str();
+  return s;
 }
 
 bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
@@ -265,6 +314,20 @@ std::string SkipHint() {
   return FLAGS_skip_invalid_rows ? "" : " (--skip-invalid-rows skips such rows, and lists them)";
 }
 
+// When `model` cannot solve at least two rows and the nominal FAST model solves most of
+// them, the model or spec, not the data, is the likely cause: the message that says so,
+// naming the values furthest from nominal; "" otherwise (model_plausibility.h).
+std::string BlameTheModel(const CableRobot& model, const std::string& model_name,
+                          const Dataset& data, const std::vector<StaticsMethod>& methods) {
+  const UnsolvableRows d = DiagnoseUnsolvableRows(
+      model, model_name, data, {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, methods);
+  if (!d.model_likely) return "";
+  return DescribeUnsolvableRows(d, model_name) +
+         (FLAGS_skip_invalid_rows ? " (not skipped: --skip-invalid-rows is for bad rows, and "
+                                    "would fit the rest with this model)"
+                                  : "");
+}
+
 std::string Digest(const std::string& path) {
   std::string hex, error;
   return !path.empty() && FileSha256(path, &hex, &error) ? hex : "";
@@ -278,6 +341,15 @@ std::string UtcNow() {
   char text[32];
   std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
   return text;
+}
+
+// "0.192 +- 0.034 m": the estimate to the precision its sigma_total supports (a tiny
+// estimate beside a large sigma is "0.000 +- 0.010", not "1.2e-09"); no unit for "1".
+std::string ValueWithSigma(double estimate, double sigma, const std::string& unit) {
+  const std::string shown_unit = unit == "1" ? "" : " " + unit;
+  if (!(sigma > 0.0)) return internal::EstimateText(estimate, sigma) + shown_unit;
+  return internal::EstimateText(estimate, sigma) + " +- " + internal::EstimateText(sigma, sigma) +
+         shown_unit;
 }
 
 // The comment lines at the top of model_calibrated.yaml: provenance, a warning when the
@@ -299,8 +371,7 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
             "budget):";
   for (const ParameterEstimate& p : result.parameters) {
     if (!p.free) continue;
-    header += "\n  " + p.name + " = " + FormatDouble(p.estimate, 8) + " +- " +
-              FormatDouble(p.sigma_total, 3) + (p.unit == "1" ? "" : " " + p.unit);
+    header += "\n  " + p.name + " = " + ValueWithSigma(p.estimate, p.sigma_total, p.unit);
     if (!p.moved_by.empty()) header += "  NOT SOUND: freeing " + p.moved_by + " would move it";
   }
   return header;
@@ -334,35 +405,128 @@ std::string SigmaText(double sigma, const std::string& unit) {
   return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
 }
 
-// The estimates: value +- sigma_total first, then its parts.
+// The console is one screen: at most kConsoleWidth columns, long notes cut to
+// kNoteLines lines (the report has them whole).
+constexpr size_t kConsoleWidth = 100;
+constexpr size_t kNoteLines = 2;
+constexpr size_t kEstimateRows = 14;
+
+// `text` wrapped at kConsoleWidth, each line after the first indented by `indent`; cut
+// after `max_lines` lines with "... (report.md)".
+std::string Wrapped(const std::string& text, const std::string& first_indent,
+                    const std::string& indent, size_t max_lines) {
+  std::istringstream words(text);
+  std::vector<std::string> lines = {first_indent};
+  std::string word;
+  while (words >> word) {
+    std::string& line = lines.back();
+    const bool starts = line.size() == (lines.size() == 1 ? first_indent : indent).size();
+    if (!starts && line.size() + 1 + word.size() > kConsoleWidth) {
+      lines.push_back(indent + word);
+    } else {
+      line += (starts ? "" : " ") + word;
+    }
+  }
+  const char kCut[] = " ... (report.md)";
+  if (lines.size() > max_lines) {
+    lines.resize(max_lines);
+    std::string& last = lines.back();
+    if (last.size() + sizeof(kCut) - 1 > kConsoleWidth)
+      last.resize(kConsoleWidth - sizeof(kCut) + 1);
+    last += kCut;
+  }
+  std::string out;
+  for (const std::string& line : lines) out += line + "\n";
+  return out;
+}
+
+// Short flags of an estimate's note; the full notes are in the report.
+std::string EstimateFlags(const ParameterEstimate& p) {
+  std::string flags;
+  // Model incomplete (calibration.h): the report says which candidate and by how much.
+  if (!p.moved_by.empty()) {
+    flags += "NOT SOUND: " + p.moved_by + " would move it " + FormatDouble(p.moved_by_sigmas, 2) +
+             " sigma ";
+  }
+  if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
+  if (p.note.find("not determined by the data alone") != std::string::npos) {
+    flags += "data cannot determine ";
+  } else if (p.note.find("poorly determined") != std::string::npos) {
+    flags += "weak in data ";
+  }
+  return flags;
+}
+
+// The free estimates: value +- sigma_total, the formal sigma and the widening. A group of
+// more than three per-cable or per-point parameters (sensor_gain[1..6]) is one row: the
+// range of its estimates and of their sigma_total. At most kEstimateRows rows; the fixed
+// and consider parameters and every part of the budget are in the report.
 std::string EstimatesTable(const CalibrationResult& result) {
-  std::ostringstream s;
-  char buf[260];
-  std::snprintf(buf, sizeof(buf), "  %-28s %6s %14s %14s %11s %11s %8s %11s  %s\n", "parameter",
-                "unit", "initial", "estimate", "sigma_total", "formal", "widening", "systematic",
-                "note");
-  s << buf;
+  constexpr size_t kGroupedFrom = 4;
+  std::map<std::string, std::vector<const ParameterEstimate*>> groups;
+  std::vector<std::string> order;
   for (const ParameterEstimate& p : result.parameters) {
-    // Short flags here; the full notes are in the report.
+    if (!p.free) continue;
+    const std::string key = p.name.substr(0, p.name.find('['));
+    if (!groups.count(key)) order.push_back(key);
+    groups[key].push_back(&p);
+  }
+  std::vector<std::string> rows;
+  char buf[200];
+  for (const std::string& key : order) {
+    const std::vector<const ParameterEstimate*>& g = groups[key];
+    if (g.size() < kGroupedFrom) {
+      for (const ParameterEstimate* p : g) {
+        std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", p->name.c_str(),
+                      ValueWithSigma(p->estimate, p->sigma_total, p->unit).c_str(),
+                      SigmaText(p->sigma, p->unit).c_str(),
+                      ("x" + FormatDouble(p->widening, 2)).c_str(), EstimateFlags(*p).c_str());
+        rows.push_back(buf);
+      }
+      continue;
+    }
+    double lo = HUGE_VAL, hi = -HUGE_VAL, sigma_lo = HUGE_VAL, sigma_hi = 0.0, widest = 0.0;
+    int marked = 0;
     std::string flags;
-    if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
-    if (p.note.find("not determined by the data alone") != std::string::npos) {
-      flags += "data cannot determine ";
-    } else if (p.note.find("poorly determined") != std::string::npos) {
-      flags += "weak in data ";
+    for (const ParameterEstimate* p : g) {
+      lo = std::min(lo, p->estimate);
+      hi = std::max(hi, p->estimate);
+      sigma_lo = std::min(sigma_lo, p->sigma_total);
+      sigma_hi = std::max(sigma_hi, p->sigma_total);
+      widest = std::max(widest, p->widening);
+      if (flags.empty()) flags = EstimateFlags(*p);
+      marked += !p->moved_by.empty();
     }
-    if (p.consider) flags += "consider (fixed, prior sigma) ";
-    if (!p.moved_by.empty()) {
-      flags += "NOT SOUND: " + p.moved_by + " would move it " + FormatDouble(p.moved_by_sigmas, 2) +
-               " sigma ";
+    if (marked > 0) {
+      flags = "NOT SOUND: " + std::to_string(marked) + " of " + std::to_string(g.size()) +
+              " (report.md) " +
+              flags.substr(flags.rfind("NOT SOUND", 0) == 0 ? flags.find(" sigma ") + 7 : 0);
     }
-    const std::string total = p.free || p.consider ? FormatDouble(p.sigma_total, 3) : "fixed";
-    std::snprintf(buf, sizeof(buf), "  %-28.28s %6s %14.6g %14.6g %11s %11s %8s %11s  %s\n",
-                  p.name.c_str(), p.unit.c_str(), p.initial, p.estimate, total.c_str(),
-                  p.free ? FormatDouble(p.sigma, 3).c_str() : "",
-                  p.free ? ("x" + FormatDouble(p.widening, 3)).c_str() : "",
-                  p.free ? FormatDouble(p.sigma_systematic, 3).c_str() : "", flags.c_str());
-    s << buf;
+    // "sensor_gain[1..6]": the first and the last index of the group.
+    auto index_of = [](const std::string& name) {
+      const size_t open = name.find('['), close = name.find(']');
+      return name.substr(open + 1, close - open - 1);
+    };
+    const std::string label =
+        key + "[" + index_of(g.front()->name) + ".." + index_of(g.back()->name) + "]";
+    const std::string unit = g.front()->unit == "1" ? "" : " " + g.front()->unit;
+    const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + unit + " +- " +
+                              FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2);
+    std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", label.c_str(), range.c_str(),
+                  "", ("<= x" + FormatDouble(widest, 2)).c_str(), flags.c_str());
+    rows.push_back(buf);
+  }
+  std::ostringstream s;
+  std::snprintf(buf, sizeof(buf), "  %-29s %-31s %9s %8s  %s\n", "free parameter",
+                "estimate +- sigma_total", "formal", "widening", "note");
+  s << buf;
+  for (size_t k = 0; k < rows.size() && k < kEstimateRows; ++k) {
+    std::string row = rows[k];
+    while (!row.empty() && row.back() == ' ') row.pop_back();
+    s << row << "\n";
+  }
+  if (rows.size() > kEstimateRows) {
+    s << "  ... " << rows.size() - kEstimateRows << " more rows (report.md, Estimates)\n";
   }
   return s.str();
 }
@@ -387,8 +551,8 @@ std::string ConsiderLines(const CalibrationResult& result) {
       line += (k ? ", " : "") + SigmaText(on[k]->systematic_by_group[g], on[k]->unit) + " on " +
               on[k]->name;
     }
-    if (on.size() > kShown) line += ", ... (report.md, Uncertainty budget)";
-    s << "  systematic, from " << groups[g] << ": " << line << "\n";
+    if (on.size() > kShown) line += ", ...";
+    s << Wrapped("systematic, from " + groups[g] + ": " + line, "  ", "    ", kNoteLines);
   }
   return s.str();
 }
@@ -401,7 +565,7 @@ std::string GrossErrorLines(const CalibrationResult& result) {
   s << "  gross errors (more than " << FormatDouble(g.threshold_sigmas, 3)
     << " robust sigmas from the model): " << count << (count == 1 ? " reading" : " readings")
     << ", kept out of the fit\n";
-  constexpr size_t kShown = 10;
+  constexpr size_t kShown = 5;
   for (size_t k = 0; k < std::min(count, kShown); ++k) {
     const ReadingResidual& e = result.gross_errors[k];
     char buf[200];
@@ -420,9 +584,11 @@ std::string MisfitLine(const CalibrationResult& result) {
   if (result.misfit_ranking.empty()) return "";
   const MisfitCandidate& top = result.misfit_ranking.front();
   if (!top.significant) {
-    return "  no fixed parameter explains the misfit beyond the residuals' own noise (largest "
-           "expected chi-square decrease " +
-           FormatDouble(top.expected_decrease, 3) + ", from " + top.name + ")\n";
+    return Wrapped(
+        "no fixed parameter explains the misfit beyond the residuals' own noise (largest "
+        "expected chi-square decrease " +
+            FormatDouble(top.expected_decrease, 3) + ", from " + top.name + ")",
+        "  ", "    ", kNoteLines);
   }
   std::string line = "  the misfit is best explained by freeing:";
   for (size_t k = 0; k < std::min(kShown, result.misfit_ranking.size()); ++k) {
@@ -431,49 +597,47 @@ std::string MisfitLine(const CalibrationResult& result) {
     line += std::string(k ? ", " : " ") + c.name + " (about " +
             FormatDouble(c.expected_decrease, 3) + ")";
   }
-  return line + "  [expected chi-square decrease; each beyond the residuals' own noise]\n";
+  return Wrapped(line + " [expected chi-square decrease; each beyond the residuals' own noise]", "",
+                 "    ", kNoteLines);
 }
 
 std::string CrossValidationLine(const CalibrationResult& result) {
   const CrossValidation& cv = result.cross_validation;
   if (cv.folds_used == 0) return "";
-  std::ostringstream s;
-  char buf[200];
-  std::snprintf(
-      buf, sizeof(buf), "  %-46.46s",
-      ("calibrated, block cross-validation (" + std::to_string(cv.folds_used) + " blocks)")
-          .c_str());
-  s << buf;
-  for (double r : cv.rms_n) {
-    std::snprintf(buf, sizeof(buf), " %8.3f", r / kNPerKn);
-    s << buf;
-  }
-  return s.str() + "\n";
+  return CableRow("calibrated, cross-validated (" + std::to_string(cv.folds_used) + " blocks)",
+                  cv.rms_n, 1.0 / kNPerKn);
 }
 
 std::string CalibrationConsole(const CalibrationResult& result, const Dataset& data,
                                const std::vector<VariantEvaluation>& variants) {
   std::ostringstream s;
-  s << "\n" << result.ceres_brief_report << "\n";
   char buf[300];
   const ChiSquareBand band = ReducedChiSquareBand(result);
   std::snprintf(buf, sizeof(buf),
-                "reduced chi-square %.3f (expected 1 +- %.3g) over %d residuals; %d samples "
-                "fitted, %d held out; %.2f s\n",
+                "reduced chi-square %.3f (expected 1 +- %.3g) over %d residuals\n"
+                "%d samples fitted, %d held out; %.2f s\n",
                 result.reduced_chi_square, band.half_width, result.num_residuals,
                 result.num_fit_samples,
                 static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
-  s << buf << "verdict: " << FitVerdictName(result.verdict) << ": " << result.verdict_text << "\n\n"
+  s << buf
+    << Wrapped(
+           std::string("verdict: ") + FitVerdictName(result.verdict) + ": " + result.verdict_text,
+           "", "  ", 2 * kNoteLines)
+    << "\n"
     << EstimatesTable(result) << ConsiderLines(result);
-  for (const std::string& note : result.notes) s << "  " << note << "\n";
+  for (const std::string& note : result.notes) s << Wrapped(note, "  ", "    ", kNoteLines);
   for (const ParameterDirection& d : result.data_only.undetermined) {
-    s << "  the data alone cannot determine (a prior holds it): " << d.Describe() << "\n";
+    s << Wrapped("the data alone cannot determine (a prior holds it): " + d.Describe(), "  ",
+                 "    ", kNoteLines);
   }
   for (const ParameterDirection& d : result.data_only.poorly_determined) {
-    s << "  weak direction in the data alone: " << d.Describe() << "\n";
+    s << Wrapped("weak direction in the data alone: " + d.Describe(), "  ", "    ", kNoteLines);
   }
-  for (const std::string& c : result.strong_correlations) {
-    s << "  strongly correlated: " << c << "\n";
+  if (!result.strong_correlations.empty()) {
+    std::string pairs;
+    for (const std::string& c : result.strong_correlations)
+      pairs += (pairs.empty() ? "" : "; ") + c;
+    s << Wrapped("strongly correlated: " + pairs, "  ", "    ", kNoteLines);
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
     << RmsTable(variants) << CrossValidationLine(result) << "\nwrote " << FLAGS_out
@@ -485,18 +649,44 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
 // sibling and renamed into place). False, with the error printed, on failure.
 bool WriteOutDirectory(const char* command,
                        const std::vector<std::pair<std::string, std::string>>& files,
-                       const ReportInputs& report) {
+                       const ReportInputs& report, const std::vector<std::string>& outputs) {
   std::string error;
   if (WriteDirectoryAtomically(
           FLAGS_out, files,
           [&](const std::string& dir, std::string* why) {
             return WriteReportFiles(dir, report, why);
           },
-          &error)) {
+          outputs, &error)) {
     return true;
   }
   PrintError(command, error);
   return false;
+}
+
+// A dataset beside `data_path` to check a calibrated model on: the first other .csv file
+// of its directory (by name) whose header is a dataset's; "" when there is none.
+std::string OtherDataset(const std::string& data_path) {
+  std::error_code ec;
+  const fs::path data = fs::path(data_path);
+  const fs::path dir = data.has_parent_path() ? data.parent_path() : fs::path(".");
+  std::vector<fs::path> candidates;
+  for (const auto& entry : fs::directory_iterator(dir, ec)) {
+    if (entry.path().extension() == ".csv" && entry.is_regular_file(ec) &&
+        !fs::equivalent(entry.path(), data, ec)) {
+      candidates.push_back(entry.path());
+    }
+  }
+  std::sort(candidates.begin(), candidates.end());
+  for (const fs::path& candidate : candidates) {
+    std::ifstream in(candidate);
+    std::string line;
+    while (std::getline(in, line) && (line.empty() || line[0] == '#')) {
+    }
+    if (line.find("T1_kN") != std::string::npos && line.find("x_m") != std::string::npos) {
+      return (data.has_parent_path() ? dir / candidate.filename() : candidate.filename()).string();
+    }
+  }
+  return "";
 }
 
 }  // namespace
@@ -537,7 +727,8 @@ int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kCalibrateHelp,
-                    {"model", "spec", "data", "out", "skip-invalid-rows", "quiet"}, &exit_code)) {
+                    {"model", "spec", "data", "out", "skip-invalid-rows", "quiet", "force"},
+                    &exit_code)) {
     return exit_code;
   }
   std::string error;
@@ -550,12 +741,21 @@ int RunCalibrate(int argc, char** argv) {
   CableRobot model;
   Dataset data;
   CalibrationSpec spec;
-  if (!CheckOutputDirectory("out", FLAGS_out, &error) || !LoadInputs(&model, &data, &error) ||
+  if (!CheckOutFlag(kCalibrateOutputs, &error) || !LoadInputs(&model, &data, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, model, &spec, &error)) {
     PrintError(command, error);
     return kExitUsage;
   }
-  if (FLAGS_skip_invalid_rows) SkipSamplesTheCalibrationCannotSolve(model, spec, &data);
+  const CableRobot initial = InitialCalibrationModel(model, spec);
+  const std::vector<StaticsMethod> methods = {StaticsMethod::kExact, spec.forward_model};
+  if (FLAGS_skip_invalid_rows) {
+    if (const std::string blame = BlameTheModel(initial, "the initial model", data, methods);
+        !blame.empty()) {
+      PrintError(command, blame);
+      return kExitFailure;
+    }
+    SkipSamplesTheCalibrationCannotSolve(model, spec, &data);
+  }
   if (!ReportSkipped(command, data, &error)) {
     PrintError(command, error);
     return kExitFailure;
@@ -570,6 +770,13 @@ int RunCalibrate(int argc, char** argv) {
     options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
   CalibrationResult result;
   const CalibrationStatus status = Calibrate(model, spec, data, options, &result, &error);
+  if (status == CalibrationStatus::kInfeasible) {
+    if (const std::string blame = BlameTheModel(initial, "the initial model", data, methods);
+        !blame.empty()) {
+      PrintError(command, blame);
+      return kExitFailure;
+    }
+  }
   if (status != CalibrationStatus::kOk) {
     PrintError(command, error + (status == CalibrationStatus::kInfeasible ? SkipHint() : ""));
     return status == CalibrationStatus::kInvalidInput ? kExitUsage : kExitFailure;
@@ -584,14 +791,19 @@ int RunCalibrate(int argc, char** argv) {
   report.result = &result;
   report.variants = variants;
   report.evaluation_method = "exact";
+  report.out_dir = FLAGS_out;
+  report.other_data_path = OtherDataset(FLAGS_data);
 
   const std::vector<std::pair<std::string, std::string>> files = {
       {"model_calibrated.yaml",
        CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))},
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out, result.excluded)}};
-  if (!WriteOutDirectory(command, files, report)) return kExitUsage;
+  if (!WriteOutDirectory(command, files, report, kCalibrateOutputs)) return kExitUsage;
 
-  std::cerr << CalibrationConsole(result, data, variants) << ChiSquareWarning(result);
+  // Results on stdout, progress and diagnostics on stderr (docs/cli.md, "Output streams").
+  if (!FLAGS_quiet) std::cerr << result.ceres_brief_report << "\n";
+  std::cout << CalibrationConsole(result, data, variants) << std::flush;
+  std::cerr << ChiSquareWarning(result);
   return 0;
 }
 
@@ -605,21 +817,11 @@ std::string EvaluationConsole(const Dataset& data, StaticsMethod method,
   s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
     << StaticsMethodName(method) << "\n\n"
     << RmsTable(variants);
-  char buf[160];
-  auto row = [&](const char* label, const auto& values, double scale) {
-    std::snprintf(buf, sizeof(buf), "    %-22s", label);
-    s << buf;
-    for (double v : values) {
-      std::snprintf(buf, sizeof(buf), " %8.3f", v * scale);
-      s << buf;
-    }
-    s << "\n";
-  };
   for (const VariantEvaluation& v : variants) {
-    s << "\n  " << v.name << ":\n";
-    row("RMS (%)", v.fit.rms_percent, 1.0);
-    row("mean (kN)", v.fit.mean_n, 1.0 / kNPerKn);
-    row("max |error| (kN)", v.fit.max_abs_n, 1.0 / kNPerKn);
+    s << "\n" << CableHeader(v.name + ":");
+    s << CableRow("  RMS (%)", v.fit.rms_percent, 1.0);
+    s << CableRow("  mean (kN)", v.fit.mean_n, 1.0 / kNPerKn);
+    s << CableRow("  max |error| (kN)", v.fit.max_abs_n, 1.0 / kNPerKn);
   }
   if (!FLAGS_out.empty())
     s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";
@@ -630,7 +832,7 @@ int RunEvaluate(int argc, char** argv) {
   const char* command = "evaluate";
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kEvaluateHelp,
-                    {"model", "data", "out", "method", "skip-invalid-rows"}, &exit_code)) {
+                    {"model", "data", "out", "method", "skip-invalid-rows", "force"}, &exit_code)) {
     return exit_code;
   }
   std::string error;
@@ -642,10 +844,16 @@ int RunEvaluate(int argc, char** argv) {
   }
   CableRobot model;
   Dataset data;
-  if ((!FLAGS_out.empty() && !CheckOutputDirectory("out", FLAGS_out, &error)) ||
+  if ((!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error)) ||
       !LoadInputs(&model, &data, &error)) {
     PrintError(command, error);
     return kExitUsage;
+  }
+  if (const std::string blame =
+          FLAGS_skip_invalid_rows ? BlameTheModel(model, "the model", data, {method}) : "";
+      !blame.empty()) {
+    PrintError(command, blame);
+    return kExitFailure;
   }
   if (FLAGS_skip_invalid_rows) {
     SkipUnsolvableSamples(model, "the model", {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
@@ -657,6 +865,11 @@ int RunEvaluate(int argc, char** argv) {
   }
   std::vector<VariantEvaluation> variants;
   if (!EvaluateModel(model, data, method, &variants, &error)) {
+    if (const std::string blame = BlameTheModel(model, "the model", data, {method});
+        !blame.empty()) {
+      PrintError(command, blame);
+      return kExitFailure;
+    }
     PrintError(command, error + SkipHint());
     return kExitFailure;
   }
@@ -667,7 +880,7 @@ int RunEvaluate(int argc, char** argv) {
     report.variants = variants;
     report.evaluation_method = StaticsMethodName(method);
     if (!WriteOutDirectory(command, {{"residuals.csv", ResidualsCsv(data, variants, {}, {})}},
-                           report)) {
+                           report, kEvaluateOutputs)) {
       return kExitUsage;
     }
   }

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -260,7 +261,8 @@ bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
   return true;
 }
 
-bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error) {
+bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error,
+                          const std::vector<std::string>* replaceable) {
   const std::string where = "--" + flag + "=" + internal::Escape(dir) + ": ";
   std::error_code ec;
   if (std::filesystem::is_symlink(std::filesystem::symlink_status(dir, ec)) &&
@@ -274,8 +276,23 @@ bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::
     return false;
   }
   if (std::filesystem::exists(status) && !std::filesystem::is_empty(dir, ec)) {
-    *error = where + "exists and is not an empty directory (choose a new --" + flag + ")";
-    return false;
+    if (replaceable == nullptr) {
+      *error = where + "exists and is not an empty directory (choose a new --" + flag +
+               ", or --force to replace a previous run's results)";
+      return false;
+    }
+    // --force replaces a previous run's results, never anything else.
+    for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
+      const std::string name = entry.path().filename().string();
+      if (std::find(replaceable->begin(), replaceable->end(), name) == replaceable->end() ||
+          !entry.is_regular_file(ec)) {
+        *error = where + "holds '" + internal::Escape(name) +
+                 "', which is not a fastcal result: --force replaces only a previous run's "
+                 "results (choose a new --" +
+                 flag + ")";
+        return false;
+      }
+    }
   }
   // The results are built in a sibling of `dir` and renamed into place, and missing
   // parents are created: the nearest existing ancestor must take a new directory.

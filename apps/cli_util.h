@@ -82,8 +82,11 @@ bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
 
 // An output directory (calibrate/evaluate --out) must be new or empty, and creatable: its
 // nearest existing ancestor must take a new directory (a probe is made and removed).
-// False with a message starting "--<flag>=<dir>: " and naming the directory otherwise.
-bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error);
+// With `replaceable` (--force), a directory holding only regular files of those names (a
+// previous run's results) is accepted too. False with a message starting
+// "--<flag>=<dir>: " and naming the directory otherwise.
+bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error,
+                          const std::vector<std::string>* replaceable = nullptr);
 
 // Where an output path really is: absolute, without a trailing '/', '.' or '..', and
 // through symbolic links, so that `--out=dir/`, `--out=.` and a link to an empty directory

@@ -182,11 +182,13 @@ Examples (the bundled datasets):
   # realistic telemetry: rings over the cap, smooth control error, slow tension error,
   # drifting mass centre, per-cable densities, gains and biases (calibration_data/README.md)
   fastcal simulate --trajectory=grid --max-off-axis-deg=40 --off-axis-step-deg=5 \
-    --azimuth-step-deg=1 --mass-centre=0.22,0.11,0.5 --attitude-control-deg=0.2 \
-    --attitude-control-time-s=60 --attitude-noise-deg=0.02 --position-noise-m=0.01 \
-    --tension-noise-pct=3 --tension-drift-pct=2 --tension-drift-time-s=120 \
-    --mass-centre-drift-m=0.02 --mass-centre-drift-time-s=1800 --density-mismatch-pct=1.5 \
-    --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=2 --seed=5 --out=realistic.csv
+    --azimuth-step-deg=2 --interval-s=2 --mass-centre=0.22,0.11,0.5 \
+    --attitude-control-deg=0.2 --attitude-control-time-s=60 --attitude-noise-deg=0.02 \
+    --position-noise-m=0.01 --tension-noise-pct=3 --tension-drift-pct=2 \
+    --tension-drift-time-s=120 --mass-centre-drift-m=0.01 --mass-centre-drift-time-s=600 \
+    --density-mismatch-pct=1.5 --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=2 \
+    --outlier-fraction=0.002 --outlier-scale-pct=90 --seed=5 --force \
+    --out=calibration_data/realistic_survey.csv
   # sensor gain errors and 2% outliers on a straight line
   fastcal simulate --trajectory=line --sensor-gain=1.02,0.98,1,1,1.01,0.99 \
     --outlier-fraction=0.02 --out=line.csv
@@ -518,7 +520,8 @@ int RunSimulate(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  std::cerr << Summary(summary, options, csv_path, yaml_path) << std::endl;
+  // The summary of what was written is the result: stdout (docs/cli.md, "Output streams").
+  std::cout << Summary(summary, options, csv_path, yaml_path) << std::endl;
   return 0;
 }
 

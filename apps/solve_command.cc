@@ -864,11 +864,14 @@ int RunSolve(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  std::cerr << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose" : " poses");
-  if (failures.count > 0) std::cerr << " (" << failures.count << " failed)";
+  // stdout carries the result: the table itself, else (--output=FILE) this summary of
+  // it (docs/cli.md, "Output streams").
+  std::ostream& summary = FLAGS_output.empty() || FLAGS_output == "-" ? std::cerr : std::cout;
+  summary << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose" : " poses");
+  if (failures.count > 0) summary << " (" << failures.count << " failed)";
   // Paths and flag text on the terminal: control bytes escaped.
-  std::cerr << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", attitude "
-            << internal::Escape(attitude) << "; " << timing.str() << std::endl;
+  summary << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", attitude "
+          << internal::Escape(attitude) << "; " << timing.str() << std::endl;
   if (failures.count > 0) {
     std::cerr << "fastcal solve: " << failures.count << " of " << poses.size()
               << " poses failed; --keep-going wrote them with their status, message and empty "

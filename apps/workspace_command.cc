@@ -251,8 +251,10 @@ int RunWorkspace(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
+  // stdout carries the result: the CSV itself, else the summary of what was written
+  // (docs/cli.md, "Output streams").
   if (!to_file) std::cout << WorkspaceCsv(map) << std::flush;
-  std::cerr << Summary(map) << std::endl;
+  (to_file ? std::cout : std::cerr) << Summary(map) << std::endl;
   return 0;
 }
 

@@ -134,6 +134,28 @@ std::string ParseError(const std::string& text) {
   return error;
 }
 
+// Unit and magnitude slips in a model file (issue 17) are refused at the key, with the
+// nominal value and the likely slip, before any statics can fail on them.
+TEST(CableRobotYaml, ImplausibleValuesAreRefusedAtTheirKeyWithTheLikelySlip) {
+  EXPECT_EQ(ParseError("cabin:\n  mass_kg: 30\n"),
+            "m.yaml:2: cabin.mass_kg: 30 kg is below the plausible minimum of 10000 kg (nominal "
+            "FAST: 30000 kg; tonnes written as kg?)");
+  EXPECT_EQ(ParseError("cabin:\n  mass_centre_m: [0, 0, 500]\n"),
+            "m.yaml:2: cabin.mass_centre_m.z: 500 m is beyond the plausible +-5 m (mm written "
+            "as m?)");
+  std::string cables = "cables:\n";
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableProperties& c = CableRobot::NominalFast().cables[i];
+    cables += "  - {tower_top_m: [" + std::to_string(c.tower_top_m.x()) + ", " +
+              std::to_string(c.tower_top_m.y()) +
+              ", 270], anchor: " + std::to_string(c.anchor_index) +
+              ", ea_n: " + (i == 2 ? "24656" : "2.4656e7") + ", linear_density_kg_per_m: 11.718}\n";
+  }
+  EXPECT_EQ(ParseError(cables),
+            "m.yaml:4: cables[2].ea_n: 24656 N is below the plausible minimum of 5e+06 N "
+            "(nominal FAST: 2.4656e+07 N; kN written as N?)");
+}
+
 TEST(NominalFast, TowersFollowModelFormula) {
   constexpr double kTowerRadiusM = 300.0, kTowerHeightM = 270.0;
   const CableRobot robot = CableRobot::NominalFast();
@@ -256,7 +278,9 @@ TEST(CableRobotYaml, PerturbedModelSaveLoadRoundTripIsExact) {
   robot.cabin_mass_kg *= factor(rng);
   robot.mass_centre_cabin_m = Eigen::Vector3d(offset_m(rng), 1e-300, -0.0);  // extreme values
   robot.gravity_m_per_s2 = -9.80665 * factor(rng);
-  robot.cables[3].ea_n = 3.0e-310;  // subnormal: must survive the text round trip too
+  // Subnormal: must survive the text round trip too (on a coordinate: an EA that small
+  // is refused as implausible).
+  robot.anchor_points_cabin_m[0].z() = 3.0e-310;
   std::string error;
   ASSERT_TRUE(robot.IsValid(&error)) << error;
 

@@ -544,6 +544,26 @@ const ErrorCase kErrorCases[] = {
      "parameters.sensor_gain.prior.sigma", "> 0"},
     {"parameters:\n  sensor_gain:\n    prior:\n      mean: .inf\n      sigma: 1\n", 4,
      "parameters.sensor_gain.prior.mean", "finite"},
+    // Unit and magnitude slips (issue 17): refused where they are written, the likely
+    // slip named.
+    {"parameters:\n  cabin_mass_kg: {initial: 30}\n", 2, "parameters.cabin_mass_kg.initial",
+     "30 kg is below the plausible minimum of 10000 kg (nominal FAST: 30000 kg; tonnes written "
+     "as kg?)"},
+    {"parameters:\n  ea_n: {initial: 24656}\n", 2, "parameters.ea_n.initial",
+     "24656 N is below the plausible minimum of 5e+06 N (nominal FAST: 2.4656e+07 N; kN "
+     "written as N?)"},
+    {"parameters:\n  mass_centre_m:\n    x: {initial: 150}\n", 3,
+     "parameters.mass_centre_m.x.initial",
+     "150 m is beyond the plausible +-5 m (mm written as m?)"},
+    {"noise: {tension_sigma_kN: 3000}\n", 1, "noise.tension_sigma_kN",
+     "3000 kN is above the plausible maximum of 50 kN (N written as kN?)"},
+    {"noise: {tension_sigma_percent: 300}\n", 1, "noise.tension_sigma_percent",
+     "300% is above the plausible maximum of 50%"},
+    {"parameters:\n  sensor_bias_kN: {prior: {mean: 0, sigma: 2000}}\n", 2,
+     "parameters.sensor_bias_kN.prior.sigma",
+     "2000 kN is wider than the whole plausible range of the parameter (-100 kN to 100 kN)"},
+    {"parameters:\n  tower_offset_m: {all: {prior: {mean: 10, sigma: 0.01}}}\n", 2,
+     "parameters.tower_offset_m.all.prior.mean", "10 m is beyond the plausible +-1 m"},
     {"parameters:\n  sensor_bias_kN:\n    mode: each\n", 3, "parameters.sensor_bias_kN.mode",
      "per_cable"},
     {"parameters:\n  sensor_bias_kN:\n    cables: [{}, {}, {}, {}, {}, {}]\n", 3,
@@ -681,7 +701,22 @@ TEST(CalibrationSpecTest, IsValidRejectsEachImpossibleValue) {
       {"sensor_gain.prior.sigma",
        [](CalibrationSpec* s) {
          s->parameters[0].has_prior = true;
+         s->parameters[0].prior_mean_si = 1;  // a plausible gain: the sigma is what fails
          s->parameters[0].prior_sigma_si = 0;
+       }},
+      {"sensor_gain.prior.mean: 0 is below the plausible minimum of 0.5",
+       [](CalibrationSpec* s) {
+         s->parameters[0].has_prior = true;
+         s->parameters[0].prior_sigma_si = 0.01;
+       }},
+      {"tension_sigma_n: 3000 kN is above the plausible maximum of 50 kN (N written as kN?)",
+       [](CalibrationSpec* s) { s->tension_sigma_n = 3e6; }},
+      {"initial: 30 kg is below the plausible minimum of 10000 kg (nominal FAST: 30000 kg; "
+       "tonnes written as kg?)",
+       [](CalibrationSpec* s) {
+         s->parameters[0].kind = ParameterKind::kCabinMass;
+         s->parameters[0].has_initial = true;
+         s->parameters[0].initial_si = 30;
        }},
       {"sensor_gain: index", [](CalibrationSpec* s) { s->parameters[0].index = kNumCables; }},
       {"sensor_gain: to_si", [](CalibrationSpec* s) { s->parameters[0].to_si = 0; }},

@@ -12,6 +12,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <limits>
 #include <random>
 #include <sstream>
@@ -381,6 +382,79 @@ TEST_F(DatasetTest, ErrorsNameFileLineAndColumn) {
 
 // A dropout (0 kN, or nearly) is a possible reading, not a file error: the calibration
 // flags it as a gross error. It used to refuse the whole file.
+// The bundled circle with `transform` applied to each data row's fields (the header
+// given to it too, as row -1), as text.
+std::string CircleWith(
+    const std::function<void(int row, std::vector<std::string>* fields)>& transform) {
+  std::ifstream in(std::string(FASTCAL_TEST_SOURCE_DIR) + "/calibration_data/circle_paper.csv");
+  std::string line, text;
+  int row = -1;
+  while (std::getline(in, line)) {
+    if (line.empty() || line[0] == '#') {
+      text += line + "\n";
+      continue;
+    }
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    for (std::string f; std::getline(split, f, ',');) fields.push_back(f);
+    transform(row++, &fields);
+    for (size_t k = 0; k < fields.size(); ++k) text += (k ? "," : "") + fields[k];
+    text += "\n";
+  }
+  return text;
+}
+
+// Radians under *_deg columns (issue 17): per value they are plausible angles, so the
+// whole file is checked, and the message says what was seen and how to fix it.
+TEST_F(DatasetTest, AttitudesInRadiansUnderDegreeColumnsAreRefused) {
+  constexpr double kRadPerDeg = M_PI / 180.0;
+  // Columns 4-6: roll, pitch, yaw (measured); 7-9 planned.
+  auto to_radians = [&](int first, int row, std::vector<std::string>* f) {
+    if (row < 0) return;
+    for (int c = first; c < first + 3; ++c) {
+      (*f)[c] = internal::FormatDouble("%.17g", std::stod((*f)[c]) * kRadPerDeg);
+    }
+  };
+  const std::string measured =
+      ParseError(CircleWith([&](int row, std::vector<std::string>* f) { to_radians(4, row, f); }));
+  EXPECT_TRUE(Contains(measured,
+                       "data.csv: roll_deg, pitch_deg, yaw_deg look like radians: the "
+                       "planned_*_deg angles are 57."));
+  EXPECT_TRUE(Contains(measured, "write degrees (radians x 57.2958)"));
+  // Both in radians, or no planned columns: every angle below 1 deg where the focal law
+  // tilts the cabin by 10.8 deg (0.41 of the circle's 26.4 deg off axis).
+  const std::string both = ParseError(CircleWith([&](int row, std::vector<std::string>* f) {
+    to_radians(4, row, f);
+    to_radians(7, row, f);
+  }));
+  EXPECT_TRUE(Contains(both, "every angle is below 1 deg (largest 0."));
+  EXPECT_TRUE(Contains(both, "while the focal attitude law tilts the cabin by up to 10.8 deg"));
+  const std::string unplanned = ParseError(CircleWith([&](int row, std::vector<std::string>* f) {
+    to_radians(4, row, f);
+    f->erase(f->begin() + 7, f->begin() + 10);
+  }));
+  EXPECT_TRUE(Contains(unplanned, "every angle is below 1 deg"));
+  // Degrees pass, planned or not; so does a level cabin near the axis (kRow).
+  ParseOk(CircleWith([](int, std::vector<std::string>*) {}));
+  ParseOk(CircleWith(
+      [](int, std::vector<std::string>* f) { f->erase(f->begin() + 7, f->begin() + 10); }));
+  ParseOk(std::string(kHeader) + kRow + kRow + kRow + kRow + kRow + kRow + kRow + kRow + kRow +
+          kRow + kRow);
+}
+
+// "-0" is written as "0" (issue 17, item 7): the same value, and a reader wonders.
+TEST_F(DatasetTest, NegativeZeroIsWrittenAsZero) {
+  const Dataset d =
+      ParseOk(std::string(kHeader) + "0.5,-0,2,140,-0,0.2,-0.0,150,151,152,153,154,0\n");
+  const std::string path = PathOf("zero.csv");
+  std::string error;
+  ASSERT_TRUE(WriteDataset(path, d, "", &error)) << error;
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find("-0,"), std::string::npos) << text;
+  EXPECT_NE(text.find("0.5,0,2,140,0,0.2,0,"), std::string::npos) << text;
+}
+
 TEST_F(DatasetTest, DropoutReadingsOfZeroAreAccepted) {
   const Dataset d = ParseOk(std::string(kHeader) + "0,1,2,140,0,0,0,150,0,152,1e-300,-0,155\n");
   ASSERT_EQ(d.samples.size(), 1u);

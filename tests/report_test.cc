@@ -396,7 +396,8 @@ TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
   EXPECT_TRUE(Contains(md, "the prior holds it"));
   EXPECT_TRUE(Contains(md, "`mass_centre_m.x ~ linear_density_kg_per_m: +0.95`"));
   EXPECT_TRUE(Contains(md, "| `mass_centre_m.x` | +1.00 | +0.95 |"));
-  EXPECT_TRUE(Contains(md, "fastcal evaluate --model=DIR/model_calibrated.yaml --data=circle.csv"));
+  EXPECT_TRUE(
+      Contains(md, "fastcal evaluate --model=DIR/model_calibrated.yaml --data=OTHER_DATA.csv"));
   EXPECT_TRUE(Contains(md, "```\nSolver Summary (v 2.1.0-eigen)\n  <Residual blocks> & more\n```"));
   EXPECT_TRUE(NonFiniteWords(md).empty()) << NonFiniteWords(md).front();
   EXPECT_TRUE(Contains(md, "n/a"));
@@ -470,7 +471,7 @@ TEST_F(ReportTest, DiagnosticSectionsNameTheirNumbers) {
                        "`linear_density_kg_per_m`"));
   EXPECT_TRUE(Contains(md, "carry about 6.4 independent pieces of information"));
   EXPECT_TRUE(Contains(md, "## Gross errors and worst readings"));
-  EXPECT_TRUE(Contains(md, "| 9 | 3 | 99999.000 | 154.342 | -21563.5 |  |"));
+  EXPECT_TRUE(Contains(md, "| 9 | 3 | 99999.000 | 154.342 | -21563.5 |\n"));  // none held out
   EXPECT_TRUE(Contains(md, "| gross errors | 0 | 0 | 1 | 0 | 0 | 0 |"));
   EXPECT_TRUE(Contains(md,
                        "**The misfit is best explained by freeing:** `sensor_gain[3]` "
@@ -498,7 +499,11 @@ TEST_F(ReportTest, DiagnosticSectionsNameTheirNumbers) {
 TEST_F(ReportTest, PlotsSuitTheDataAndLeaveGrossErrorsOut) {
   std::string html = ReportHtml(inputs_);
   EXPECT_TRUE(Contains(html, "Gross errors are not drawn."));
-  EXPECT_TRUE(Contains(html, "<title>Residual against off-axis angle</title>"));
+  // A circle keeps its off-axis angle (issue 17): that plot is left out, and said so.
+  EXPECT_FALSE(Contains(html, "<title>Residual against off-axis angle</title>"));
+  EXPECT_TRUE(Contains(html,
+                       "Not drawn against the off-axis angle from the focal centre: the "
+                       "data span only 26.4"));
   EXPECT_TRUE(Contains(html, "<title>Residual against azimuth</title>"));
   EXPECT_TRUE(Contains(html, "<title>Predicted against measured</title>"));
   EXPECT_TRUE(Contains(html, "@media print"));
@@ -513,6 +518,42 @@ TEST_F(ReportTest, PlotsSuitTheDataAndLeaveGrossErrorsOut) {
   const std::string svg = SvgTitled(html, "Cable 1: tension");
   const std::string after = "stroke=\"" + PlotSeriesColour(2) + "\"";
   EXPECT_TRUE(Contains(svg, after + " stroke-width=\"3.6\" stroke-linecap=\"round\"")) << svg;
+}
+
+// A pose axis the data move along is plotted (a spiral: the off-axis angle varies).
+TEST_F(ReportTest, APlotAgainstAnAxisThatVariesIsDrawn) {
+  for (size_t n = 0; n < data_.samples.size(); ++n) data_.samples[n].pose.position_m.z() += 3.0 * n;
+  const std::string html = ReportHtml(inputs_);
+  EXPECT_TRUE(Contains(html, "<title>Residual against off-axis angle</title>"));
+  EXPECT_FALSE(Contains(html, "Not drawn against"));
+}
+
+// The "check it on other data" commands name this run's directory and another dataset,
+// never the fitted file and a literal DIR (issue 17); an empty column is not drawn, and
+// the misfit table's headers are short enough for a 900 px window.
+TEST_F(ReportTest, CalibratedModelCommandsNameRealFilesAndTablesStayNarrow) {
+  std::string md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md, "--data=OTHER_DATA.csv"));
+  EXPECT_TRUE(Contains(md, "stands for such a file"));
+  EXPECT_FALSE(Contains(md, "--data=circle.csv\n"));
+  inputs_.out_dir = "out/circle";
+  inputs_.other_data_path = "calibration_data/workspace_multi_zenith.csv";
+  md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md,
+                       "fastcal evaluate --model=out/circle/model_calibrated.yaml "
+                       "--data=calibration_data/workspace_multi_zenith.csv"));
+  EXPECT_FALSE(Contains(md, "DIR/"));
+  // No listed reading is held out here: no "Held out" column.
+  for (ReadingResidual& e : result_.worst_readings) e.held_out = false;
+  for (ReadingResidual& e : result_.gross_errors) e.held_out = false;
+  md = ReportMarkdown(inputs_);
+  EXPECT_FALSE(Contains(md, "| Held out |"));
+  ASSERT_FALSE(result_.gross_errors.empty());
+  result_.gross_errors.front().held_out = true;
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "| Held out |"));
+  EXPECT_TRUE(Contains(md,
+                       "| # | Parameter | Expected χ² decrease | Statistic | Significant | "
+                       "Freed, moves | Moves most (σ\\_total) |"));
 }
 
 // "Nothing is poorly determined" only when no estimate leans on its prior either.
@@ -558,9 +599,10 @@ TEST_F(ReportTest, HtmlIsSelfContainedWithPlotsAndNoNonFiniteNumbers) {
   EXPECT_TRUE(Contains(html, "<meta charset=\"utf-8\">"));
   EXPECT_TRUE(Contains(html, "</html>"));
   // Heatmap, RMS bars (fitted and held out), tension per cable, histogram, residual per
-  // cable, residual against off-axis angle and azimuth, predicted against measured.
+  // cable, residual against azimuth, predicted against measured (not against the
+  // off-axis angle, which a circle keeps).
   EXPECT_GE(Count(html, "<svg"), 4);
-  EXPECT_EQ(Count(html, "<svg"), 1 + 2 + 6 + 1 + 6 + 3);
+  EXPECT_EQ(Count(html, "<svg"), 1 + 2 + 6 + 1 + 6 + 2);
   EXPECT_TRUE(Contains(html, "<details>\n<summary>Ceres full report</summary>"));
   EXPECT_TRUE(Contains(html, "&lt;Residual blocks&gt; &amp; more"));
   EXPECT_TRUE(Contains(html, "<td class=\"num\">22.554</td>"));

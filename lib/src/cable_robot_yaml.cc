@@ -27,6 +27,7 @@
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/model_plausibility.h"
 #include "yaml_document.h"
 
 namespace fastcal {
@@ -441,7 +442,9 @@ bool ParseCableRobotYaml(const std::string& text, const std::string& source_name
       parser.FailFile("empty model file: omit the model file for the nominal FAST layout");
     } else if (parser.ReadRoot(documents.first, &parsed)) {
       std::string why;
-      if (!parsed.IsValid(&why)) parser.FailValidation(why);
+      if (!parsed.IsValid(&why) || !CheckModelPlausible(parsed, PlausibilityLimits(), &why)) {
+        parser.FailValidation(why);
+      }
     }
   } catch (const YAML::Exception& e) {
     const int line = e.mark.line < 0 ? 0 : e.mark.line + 1;

@@ -18,6 +18,7 @@
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/model_plausibility.h"
 
 namespace fastcal {
 namespace {
@@ -241,6 +242,9 @@ bool JacobianR(ceres::Problem* problem, int num_threads, Eigen::MatrixXd* r) {
 std::string Fixed(const char* format, double v) { return internal::FormatDouble(format, v); }
 
 std::string RatioText(double ratio) { return internal::FormatDouble("%.1e", ratio); }
+
+// " kg/m" after a value; nothing for a dimensionless one ("+-0.0879", not "+-0.0879 1").
+std::string UnitAfter(const std::string& unit) { return unit == "1" ? "" : " " + unit; }
 
 std::unique_ptr<ceres::LossFunction> MakeLoss(const CalibrationSpec& spec) {
   if (spec.robust_loss == RobustLoss::kHuber) {
@@ -470,8 +474,8 @@ std::string DescribeRefusal(const Run& run) {
     if (!(sigma > limit)) continue;
     if (!any) refuse << "these would be determined only to (1 sigma, from the stated noise):\n";
     any = true;
-    refuse << "  - " << p.name << ": +-" << Fixed("%.3g", sigma / p.to_si) << " " << p.unit
-           << " (determined means +-" << Fixed("%.3g", limit / p.to_si) << " " << p.unit
+    refuse << "  - " << p.name << ": +-" << Fixed("%.3g", sigma / p.to_si) << UnitAfter(p.unit)
+           << " (determined means +-" << Fixed("%.3g", limit / p.to_si) << UnitAfter(p.unit)
            << " or better)";
     // What it cannot be told apart from, where the correlation says so.
     constexpr double kNamedCorrelation = 0.5;
@@ -936,6 +940,8 @@ void RankMisfit(Run& run, const internal::Linearisation& lin,
     const double a = gradient[j] * gradient[j] / decrease[j];
     const double step = a > 0.0 ? gradient[j] / a : 0.0;
     m.change = -step / c.to_si;
+    m.beyond_linear_range =
+        !CheckParameterValue(c.kind, value_si[j] - step, PlausibilityLimits(), nullptr);
     const Eigen::VectorXd shift = inverse * lin.cross.col(static_cast<int>(j)) * step;
     for (int k = 0; k < run.n; ++k) m.shifts.push_back(shift[k] / run.Free(k).to_si);
     ranking.push_back(std::move(m));
@@ -1215,7 +1221,7 @@ void NoteWhatTheMisfitWouldMove(CalibrationResult* r) {
     ++said;
     if (worst == nullptr || worst_sigmas < kWorthSaying) continue;
     r->notes.push_back("freeing " + c.name + ", which the data point at, would move " +
-                       worst->name + " by " + Fixed("%+.3g", worst_shift) + " " + worst->unit +
+                       worst->name + " by " + Fixed("%+.3g", worst_shift) + UnitAfter(worst->unit) +
                        " (" + Fixed("%.1f", worst_sigmas) +
                        " sigma_total): sigma_total does not include the error of a parameter "
                        "held fixed at a wrong value");

@@ -31,7 +31,10 @@
 #include <vector>
 
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/model_plausibility.h"
+#include "fastcal/plausibility.h"
 #include "yaml_document.h"
 
 namespace fastcal {
@@ -120,6 +123,12 @@ std::string ParameterName(const GroupInfo& g, int index, int component) {
 // Checks shared by the reader and CalibrationSpec::IsValid. Each returns what is wrong,
 // or an empty string.
 
+// "" for a value within the plausible range of its kind (plausibility.h), else why not.
+std::string CheckPlausible(ParameterKind kind, double value_si) {
+  std::string why;
+  return CheckParameterValue(kind, value_si, PlausibilityLimits(), &why) ? "" : why;
+}
+
 std::string CheckInitial(ParameterKind kind, double initial_si) {
   if (!std::isfinite(initial_si)) return "must be finite";
   const char* what = nullptr;
@@ -145,17 +154,40 @@ std::string CheckInitial(ParameterKind kind, double initial_si) {
   if (IsAttachment(kind) && !(initial_si >= 0.0)) {
     return "must be >= 0 (an attachment adds weight)";
   }
-  return "";
+  return CheckPlausible(kind, initial_si);
 }
 
-std::string CheckPriorMean(double mean) { return std::isfinite(mean) ? "" : "must be finite"; }
+std::string CheckPriorMean(ParameterKind kind, double mean) {
+  return std::isfinite(mean) ? CheckPlausible(kind, mean) : "must be finite";
+}
+
+// A prior's sigma: > 0, and not wider than the parameter's plausible range (a sigma of
+// 2000 on sensor_bias_kN is 2000 N written as kN).
+std::string CheckPriorSigma(ParameterKind kind, double sigma_si) {
+  if (!(std::isfinite(sigma_si) && sigma_si > 0.0)) return "must be > 0";
+  ModelQuantity quantity;
+  if (!QuantityOfParameter(kind, &quantity)) return "";
+  const QuantityRange range = PlausibleRange(quantity, PlausibilityLimits());
+  const double width = range.max - range.min;
+  if (sigma_si <= width) return "";
+  const std::string unit = range.file_unit;
+  auto shown = [&](double v) {
+    return internal::FormatDouble("%.6g", v / range.si_per_file_unit) +
+           (unit.empty() ? "" : " " + unit);
+  };
+  return shown(sigma_si) + " is wider than the whole plausible range of the parameter (" +
+         shown(range.min) + " to " + shown(range.max) + ")";
+}
+
+// The noise's sigmas: >= 0 and plausible (a tension sigma of 3000 kN is 3000 N).
+std::string CheckNoiseSigma(ModelQuantity quantity, double value_si) {
+  if (!(std::isfinite(value_si) && value_si >= 0.0)) return "must be >= 0";
+  std::string why;
+  return CheckQuantity(quantity, value_si, PlausibilityLimits(), &why) ? "" : why;
+}
 
 std::string CheckPositive(double value) {
   return std::isfinite(value) && value > 0.0 ? "" : "must be > 0";
-}
-
-std::string CheckNonNegative(double value) {
-  return std::isfinite(value) && value >= 0.0 ? "" : "must be >= 0";
 }
 
 constexpr char kBothNoiseZero[] =
@@ -477,7 +509,9 @@ class Reader {
     if (const KeyValue* kv = Find(keys, "tension_sigma_kN")) {
       const std::string path = "noise.tension_sigma_kN";
       double kn = 0.0;
-      if (!ReadDouble(*kv, path, &kn) || !Check(CheckNonNegative(kn), kv->line, path)) {
+      if (!ReadDouble(*kv, path, &kn) ||
+          !Check(CheckNoiseSigma(ModelQuantity::kTensionSigmaN, kn * kNewtonsPerKilonewton),
+                 kv->line, path)) {
         return false;
       }
       spec->tension_sigma_n = kn * kNewtonsPerKilonewton;
@@ -485,7 +519,8 @@ class Reader {
     if (const KeyValue* kv = Find(keys, "tension_sigma_percent")) {
       const std::string path = "noise.tension_sigma_percent";
       if (!ReadDouble(*kv, path, &spec->tension_sigma_percent) ||
-          !Check(CheckNonNegative(spec->tension_sigma_percent), kv->line, path)) {
+          !Check(CheckNoiseSigma(ModelQuantity::kTensionSigmaPercent, spec->tension_sigma_percent),
+                 kv->line, path)) {
         return false;
       }
     }
@@ -646,9 +681,9 @@ class Reader {
       const std::string mean_path = Join(prior_path, "mean");
       const std::string sigma_path = Join(prior_path, "sigma");
       if (!ReadDouble(mean_kv, mean_path, &mean) ||
-          !Check(CheckPriorMean(mean * g.to_si), mean_kv.line, mean_path) ||
+          !Check(CheckPriorMean(g.kind, mean * g.to_si), mean_kv.line, mean_path) ||
           !ReadDouble(sigma_kv, sigma_path, &sigma) ||
-          !Check(CheckPositive(sigma * g.to_si), sigma_kv.line, sigma_path)) {
+          !Check(CheckPriorSigma(g.kind, sigma * g.to_si), sigma_kv.line, sigma_path)) {
         return false;
       }
       entry->prior = std::make_pair(mean, sigma);
@@ -925,8 +960,9 @@ std::string OptionsProblem(const CalibrationSpec& s) {
                           s.robust_loss == RobustLoss::kCauchy;
   // In the order of the spec file's documentation; each check gives "" or why.
   const std::pair<const char*, std::string> checks[] = {
-      {"tension_sigma_n", CheckNonNegative(s.tension_sigma_n)},
-      {"tension_sigma_percent", CheckNonNegative(s.tension_sigma_percent)},
+      {"tension_sigma_n", CheckNoiseSigma(ModelQuantity::kTensionSigmaN, s.tension_sigma_n)},
+      {"tension_sigma_percent",
+       CheckNoiseSigma(ModelQuantity::kTensionSigmaPercent, s.tension_sigma_percent)},
       {"noise", s.tension_sigma_n == 0.0 && s.tension_sigma_percent == 0.0 ? kBothNoiseZero : ""},
       {"robust_loss", known_loss ? "" : "unknown loss"},
       {"robust_loss_scale", CheckPositive(s.robust_loss_scale)},
@@ -975,10 +1011,10 @@ std::string ParameterProblem(const ParameterSpec& p, const std::string& label) {
     }
   }
   if (p.has_prior) {
-    if (const std::string w = CheckPriorMean(p.prior_mean_si); !w.empty()) {
+    if (const std::string w = CheckPriorMean(p.kind, p.prior_mean_si); !w.empty()) {
       return label + ".prior.mean: " + w;
     }
-    if (const std::string w = CheckPositive(p.prior_sigma_si); !w.empty()) {
+    if (const std::string w = CheckPriorSigma(p.kind, p.prior_sigma_si); !w.empty()) {
       return label + ".prior.sigma: " + w;
     }
   }

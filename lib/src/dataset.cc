@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 #include <algorithm>
 #include <atomic>
@@ -25,6 +26,7 @@
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
+#include "fastcal/pose.h"
 
 namespace fastcal {
 namespace {
@@ -153,7 +155,7 @@ double ScaleByKilo(std::string_view field, double parsed_value) {
 // after the reader shifts it back (shift 0: plain shortest round-trip formatting). Plain
 // notation for moderate exponents, scientific otherwise. `value` must be finite.
 std::string FormatNumber(double value, int shift) {
-  if (value == 0.0) return std::signbit(value) ? "-0" : "0";
+  if (value == 0.0) return "0";  // -0 too: the same reading, and "-0" puzzles a reader
   char buffer[64];
   const std::to_chars_result result =
       std::to_chars(buffer, buffer + sizeof(buffer), value, std::chars_format::scientific);
@@ -422,6 +424,61 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
   return true;
 }
 
+// Attitudes written in radians under *_deg columns: a unit slip the per-value limits
+// cannot see (0.3 rad is a plausible 0.3 deg). Two signs, on the whole file: the planned
+// angles (in degrees, written by the planner) are about 57.3 times the measured ones; or
+// every angle of the file is below 1 deg where the focal attitude law (how FAST flies)
+// tilts the cabin by several degrees on most samples. Returns the
+// message, or "" when neither holds.
+std::string AttitudeInRadiansProblem(const Dataset& d) {
+  constexpr double kDegPerRad = 57.29577951308232;
+  constexpr double kFactorTolerance = 0.25;       // of kDegPerRad: 43 to 72
+  constexpr double kSignificantPlannedDeg = 1.0;  // planned angles compared from here
+  constexpr int kFewestAngles = 10;
+  constexpr double kLevelBelowDeg = 1.0;
+  constexpr double kFocalTiltDeg = 5.0;  // "several degrees" of the focal law
+  if (d.attitude_as_quaternion || d.samples.empty()) return "";
+  const std::string columns = d.path + ": roll_deg, pitch_deg, yaw_deg look like radians: ";
+  const std::string fix = "; write degrees (radians x 57.2958)";
+  if (d.has_planned_attitude) {
+    double pm = 0.0, mm = 0.0;
+    int angles = 0;
+    for (const Sample& s : d.samples) {
+      for (int a = 0; a < 3; ++a) {
+        if (std::abs(s.planned_rpy_deg[a]) < kSignificantPlannedDeg) continue;
+        pm += s.planned_rpy_deg[a] * s.measured_rpy_deg[a];
+        mm += s.measured_rpy_deg[a] * s.measured_rpy_deg[a];
+        ++angles;
+      }
+    }
+    const double factor = mm > 0.0 ? pm / mm : 0.0;
+    if (angles >= kFewestAngles && std::abs(factor / kDegPerRad - 1.0) <= kFactorTolerance) {
+      return columns + "the planned_*_deg angles are " + internal::FormatDouble("%.3g", factor) +
+             " times the measured ones (least squares over " + std::to_string(angles) +
+             " angles above 1 deg)" + fix;
+    }
+  }
+  // Measured (and planned, when given) angles all below 1 deg where FAST tilts.
+  double largest_deg = 0.0, largest_focal_deg = 0.0;
+  int tilted = 0;
+  for (const Sample& s : d.samples) {
+    largest_deg = std::max(largest_deg, s.measured_rpy_deg.cwiseAbs().maxCoeff());
+    if (d.has_planned_attitude) {
+      largest_deg = std::max(largest_deg, s.planned_rpy_deg.cwiseAbs().maxCoeff());
+    }
+    const Eigen::AngleAxisd focal(FocalAttitude(s.pose.position_m, FocalAttitudeLaw()));
+    const double focal_deg = std::abs(focal.angle()) * kDegPerRad;
+    largest_focal_deg = std::max(largest_focal_deg, focal_deg);
+    if (focal_deg > kFocalTiltDeg) ++tilted;
+  }
+  const int n = static_cast<int>(d.samples.size());
+  if (n < kFewestAngles || largest_deg >= kLevelBelowDeg || 2 * tilted < n) return "";
+  return columns + "every angle is below 1 deg (largest " +
+         internal::FormatDouble("%.3g", largest_deg) +
+         " deg), while the focal attitude law tilts the cabin by up to " +
+         internal::FormatDouble("%.3g", largest_focal_deg) + " deg at these positions" + fix;
+}
+
 bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
                       const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
   Dataset result;
@@ -475,6 +532,10 @@ bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
   result.has_planned_attitude = header.planned;
   result.has_unstretched_lengths = header.unstretched;
   result.attitude_as_quaternion = header.quaternion;
+  if (const std::string why = AttitudeInRadiansProblem(result); !why.empty()) {
+    *error = why;
+    return false;
+  }
   *dataset = std::move(result);
   return true;
 }

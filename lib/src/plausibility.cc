@@ -38,7 +38,24 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
       {"below_reflector_margin_m", below_reflector_margin_m},
       {"max_abs_angle_deg", max_abs_angle_deg},
       {"max_rotation_vector_rad", max_rotation_vector_rad},
-      {"max_unstretched_length_m", max_unstretched_length_m}};
+      {"max_unstretched_length_m", max_unstretched_length_m},
+      {"min_cabin_mass_kg", min_cabin_mass_kg},
+      {"max_cabin_mass_kg", max_cabin_mass_kg},
+      {"max_abs_mass_centre_m", max_abs_mass_centre_m},
+      {"max_abs_anchor_point_m", max_abs_anchor_point_m},
+      {"min_linear_density_kg_per_m", min_linear_density_kg_per_m},
+      {"max_linear_density_kg_per_m", max_linear_density_kg_per_m},
+      {"min_ea_n", min_ea_n},
+      {"max_ea_n", max_ea_n},
+      {"max_abs_offset_m", max_abs_offset_m},
+      {"min_sensor_gain", min_sensor_gain},
+      {"max_sensor_gain", max_sensor_gain},
+      {"max_abs_sensor_bias_n", max_abs_sensor_bias_n},
+      {"max_tension_sigma_n", max_tension_sigma_n},
+      {"max_tension_sigma_percent", max_tension_sigma_percent},
+      {"max_attachment_mass_kg", max_attachment_mass_kg},
+      {"max_attachment_density_kg_per_m", max_attachment_density_kg_per_m},
+      {"max_attachment_position_m", max_attachment_position_m}};
   for (const auto& [name, value] : fields) {
     if (!(std::isfinite(value) && value > 0.0)) {
       return Fail(error, std::string(name) + ": must be > 0 and finite (got " + Num(value) + ")");
@@ -47,7 +64,122 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
   if (reflector_aperture_radius_m > reflector_radius_m) {
     return Fail(error, "reflector_aperture_radius_m: must be <= reflector_radius_m");
   }
+  const std::pair<const char*, std::pair<double, double>> ranges[] = {
+      {"cabin_mass_kg", {min_cabin_mass_kg, max_cabin_mass_kg}},
+      {"linear_density_kg_per_m", {min_linear_density_kg_per_m, max_linear_density_kg_per_m}},
+      {"ea_n", {min_ea_n, max_ea_n}},
+      {"sensor_gain", {min_sensor_gain, max_sensor_gain}}};
+  for (const auto& [name, range] : ranges) {
+    if (range.first > range.second) {
+      return Fail(error, std::string("min_") + name + ": must be <= max_" + name);
+    }
+  }
   return true;
+}
+
+QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& limits) {
+  // Nominal FAST values: docs/model.md, Table 1 (CableRobot::NominalFast()).
+  constexpr double kNominalMassKg = 30000.0, kNominalDensity = 11.718, kNominalEaN = 2.4656e7;
+  switch (quantity) {
+    case ModelQuantity::kCabinMassKg:
+      return {limits.min_cabin_mass_kg, limits.max_cabin_mass_kg, kNominalMassKg, "kg", 1.0};
+    case ModelQuantity::kMassCentreM:
+      return {-limits.max_abs_mass_centre_m, limits.max_abs_mass_centre_m, 0.0, "m", 1.0};
+    case ModelQuantity::kAnchorPointM:
+      return {-limits.max_abs_anchor_point_m, limits.max_abs_anchor_point_m, 0.0, "m", 1.0};
+    case ModelQuantity::kLinearDensityKgPerM:
+      return {limits.min_linear_density_kg_per_m, limits.max_linear_density_kg_per_m,
+              kNominalDensity, "kg/m", 1.0};
+    case ModelQuantity::kEaN:
+      return {limits.min_ea_n, limits.max_ea_n, kNominalEaN, "N", 1.0};
+    case ModelQuantity::kOffsetM:
+      return {-limits.max_abs_offset_m, limits.max_abs_offset_m, 0.0, "m", 1.0};
+    case ModelQuantity::kSensorGain:
+      return {limits.min_sensor_gain, limits.max_sensor_gain, 1.0, "", 1.0};
+    case ModelQuantity::kSensorBiasN:
+      return {-limits.max_abs_sensor_bias_n, limits.max_abs_sensor_bias_n, 0.0, "kN", 1e3};
+    case ModelQuantity::kTensionSigmaN:
+      return {0.0, limits.max_tension_sigma_n, 0.0, "kN", 1e3};
+    case ModelQuantity::kTensionSigmaPercent:
+      return {0.0, limits.max_tension_sigma_percent, 3.0, "%", 1.0};
+    case ModelQuantity::kAttachmentMassKg:
+      return {0.0, limits.max_attachment_mass_kg, 0.0, "kg", 1.0};
+    case ModelQuantity::kAttachmentDensityKgPerM:
+      return {0.0, limits.max_attachment_density_kg_per_m, 0.0, "kg/m", 1.0};
+    case ModelQuantity::kAttachmentPositionM:
+      return {0.0, limits.max_attachment_position_m, 0.0, "m", 1.0};
+  }
+  return {};
+}
+
+namespace {
+
+// The unit slip that makes a value 1000 times too small (`smaller`) or too large.
+struct SlipHints {
+  const char* smaller;
+  const char* larger;
+};
+SlipHints SlipHintsOf(ModelQuantity quantity) {
+  switch (quantity) {
+    case ModelQuantity::kCabinMassKg:
+      return {"tonnes written as kg?", "grams written as kg?"};
+    case ModelQuantity::kMassCentreM:
+    case ModelQuantity::kAnchorPointM:
+    case ModelQuantity::kOffsetM:
+      return {nullptr, "mm written as m?"};
+    case ModelQuantity::kLinearDensityKgPerM:
+    case ModelQuantity::kAttachmentDensityKgPerM:
+      return {nullptr, "g/m written as kg/m?"};
+    case ModelQuantity::kAttachmentMassKg:
+      return {nullptr, "grams written as kg?"};
+    case ModelQuantity::kAttachmentPositionM:
+      return {nullptr, "mm written as m?"};
+    case ModelQuantity::kEaN:
+      return {"kN written as N?", nullptr};
+    case ModelQuantity::kSensorBiasN:
+    case ModelQuantity::kTensionSigmaN:
+      return {nullptr, "N written as kN?"};
+    default:
+      return {nullptr, nullptr};
+  }
+}
+
+std::string WithFileUnit(double value, const char* unit) {
+  return *unit == '\0' ? Num(value) : Num(value) + (std::string(unit) == "%" ? "" : " ") + unit;
+}
+
+}  // namespace
+
+bool CheckQuantity(ModelQuantity quantity, double value_si, const PlausibilityLimits& limits,
+                   std::string* why) {
+  const QuantityRange range = PlausibleRange(quantity, limits);
+  if (value_si >= range.min && value_si <= range.max) return true;
+  const double k = range.si_per_file_unit;
+  std::string message;
+  if (!std::isfinite(value_si)) {
+    message = "must be finite";
+  } else if (range.min == -range.max) {
+    message = WithFileUnit(value_si / k, range.file_unit) + " is beyond the plausible +-" +
+              WithFileUnit(range.max / k, range.file_unit);
+  } else if (value_si < range.min) {
+    message = WithFileUnit(value_si / k, range.file_unit) + " is below the plausible minimum of " +
+              WithFileUnit(range.min / k, range.file_unit);
+  } else {
+    message = WithFileUnit(value_si / k, range.file_unit) + " is above the plausible maximum of " +
+              WithFileUnit(range.max / k, range.file_unit);
+  }
+  std::string context;
+  if (range.nominal != 0.0) {
+    context = "nominal FAST: " + WithFileUnit(range.nominal / k, range.file_unit);
+  }
+  const SlipHints hints = SlipHintsOf(quantity);
+  auto plausible = [&](double v) { return v >= range.min && v <= range.max; };
+  const char* hint = nullptr;
+  if (hints.smaller != nullptr && plausible(value_si * 1e3)) hint = hints.smaller;
+  if (hints.larger != nullptr && plausible(value_si / 1e3)) hint = hints.larger;
+  if (hint != nullptr) context += (context.empty() ? "" : "; ") + std::string(hint);
+  if (std::isfinite(value_si) && !context.empty()) message += " (" + context + ")";
+  return Fail(why, message);
 }
 
 double LowestPlausibleZ(double horizontal_radius_m, const PlausibilityLimits& limits) {

@@ -877,18 +877,24 @@ void AddCablesAsBuilt(const ReportInputs& in, Document* doc) {
 
 void AddCalibratedModel(const ReportInputs& in, Document* doc) {
   doc->Heading(2, "The calibrated model");
+  // The commands name this run's directory and a dataset the model was not fitted to:
+  // evaluating on the fitted data again would only repeat the fit's own RMS.
+  const std::string dir = in.out_dir.empty() ? "DIR" : in.out_dir;
+  const std::string other = in.other_data_path.empty() ? "OTHER_DATA.csv" : in.other_data_path;
   doc->Paragraph(Text("The calibrated model is ")
-                     .Code("model_calibrated.yaml")
-                     .Plain(" in the directory of this report (DIR below), in the same format as "
-                            "the input model; parameters the spec does not name keep their input "
-                            "values, and the estimated sensor gains and biases are in it. Check it "
-                            "on data it was not fitted to (another trajectory, another day), then "
-                            "use it like any model file:"));
-  const std::string data = in.data_path.empty() ? "OTHER_DATA.csv" : in.data_path;
+                     .Code(dir + "/model_calibrated.yaml")
+                     .Plain(", in the same format as the input model; parameters the spec does "
+                            "not name keep their input values, and the estimated sensor gains and "
+                            "biases are in it. Check it on data it was not fitted to (another "
+                            "trajectory, another day: " +
+                            std::string(in.other_data_path.empty()
+                                            ? "OTHER_DATA.csv stands for such a file"
+                                            : "here another file beside the fitted one") +
+                            "), then use it like any model file:"));
   doc->Pre("",
-           "fastcal evaluate --model=DIR/model_calibrated.yaml --data=" + data +
-               "\nfastcal solve --model=DIR/model_calibrated.yaml --position=0,0,140 "
-               "--method=exact",
+           "fastcal evaluate --model=" + dir + "/model_calibrated.yaml --data=" + other +
+               "\nfastcal solve --model=" + dir +
+               "/model_calibrated.yaml --position=0,0,140 --method=exact",
            false);
 }
 

@@ -33,6 +33,21 @@ std::string WithUnit(double v, const std::string& unit) {
   return Printf("%.2g", v) + (unit == "1" ? "" : " " + unit);
 }
 
+// A value of the misfit table, one unit per quantity (lengths always in mm, so that a
+// column never has "1.6 m" beside "7.5e+02 mm"), 2 significant digits, no exponent
+// between 0.001 and 1e6.
+std::string MisfitValue(double v, const std::string& unit) {
+  const bool length = unit == "m";
+  const double shown = length ? v * 1e3 : v;
+  const double magnitude = std::abs(shown);
+  std::string text = Printf("%.2g", shown);
+  if (magnitude >= 1e2 && magnitude < 1e6) {  // 2 significant digits, written out
+    const double step = std::pow(10.0, std::floor(std::log10(magnitude)) - 1.0);
+    text = Printf("%.0f", std::round(shown / step) * step);
+  }
+  return text + (length ? " mm" : unit == "1" ? "" : " " + unit);
+}
+
 std::vector<const ParameterEstimate*> FreeEstimates(const CalibrationResult& r) {
   std::vector<const ParameterEstimate*> free;
   for (const ParameterEstimate& p : r.parameters) {
@@ -225,10 +240,17 @@ void AddGrossErrors(const ReportInputs& in, Document* doc) {
     t.header = {"Line",    "Cable", "Measured [kN]", "Predicted [kN]", "(model - measured) / σ",
                 "Held out"};
     t.right_align = {true, true, true, true, true, false};
+    bool any_held_out = false;
     for (size_t k = 0; k < std::min(list.size(), kMaxReadingRows); ++k) {
       const ReadingResidual& e = list[k];
+      any_held_out = any_held_out || e.held_out;
       t.rows.push_back({Int(e.line), Int(e.cable), Kn3(e.measured_n), Kn3(e.predicted_n),
                         Printf("%+.1f", e.residual_sigma), e.held_out ? "yes" : ""});
+    }
+    if (!any_held_out) {  // an empty column is not drawn
+      t.header.pop_back();
+      t.right_align.pop_back();
+      for (std::vector<Text>& row : t.rows) row.pop_back();
     }
     doc->AddTable(std::move(t));
     if (list.size() > kMaxReadingRows) {
@@ -254,7 +276,10 @@ void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
       Sig3(r.misfit_threshold) +
       " (chi-square of 1 degree of freedom, 1% for the family). Significant or not, a "
       "single circle of poses often cannot tell some candidates apart (a gain from an "
-      "anchor offset): they are where to look, not a diagnosis.");
+      "anchor offset): they are where to look, not a diagnosis. Freed, moves: the change "
+      "of the parameter itself, one Gauss-Newton step (\"beyond the linear range\" when "
+      "that would leave its plausible range); moves most: the estimate it would shift most, "
+      "in units of that estimate's σ_total.");
   if (r.misfit_ranking.empty()) {
     doc->Paragraph("No candidate: every parameter is free or spanned by the free ones.");
     return;
@@ -276,31 +301,28 @@ void AddMisfitRanking(const CalibrationResult& r, Document* doc) {
   doc->Paragraph(lead);
   const std::vector<const ParameterEstimate*> free = FreeEstimates(r);
   Table t;
-  t.header = {"Rank",
-              "Parameter",
-              "Expected χ² decrease",
-              "Statistic",
-              "Significant",
-              "Freeing it would move it by",
-              "and the estimate it moves most (in σ_total)"};
+  // Short headers: the table fits a 900 px window (the paragraph above explains them).
+  t.header = {"#",           "Parameter",    "Expected χ² decrease", "Statistic",
+              "Significant", "Freed, moves", "Moves most (σ_total)"};
   t.right_align = {true, false, true, true, false, true, false};
   for (size_t k = 0; k < std::min(kMisfitRows, r.misfit_ranking.size()); ++k) {
     const MisfitCandidate& c = r.misfit_ranking[k];
     Text moved("-");
     double most = 0.0;
-    for (size_t j = 0; j < free.size() && j < c.shifts.size(); ++j) {
+    for (size_t j = 0; !c.beyond_linear_range && j < free.size() && j < c.shifts.size(); ++j) {
       const double sigmas =
           free[j]->sigma_total > 0 ? std::abs(c.shifts[j]) / free[j]->sigma_total : 0.0;
       if (sigmas <= most) continue;
       most = sigmas;
       moved = Text()
                   .Code(free[j]->name)
-                  .Plain(" " + WithUnit(c.shifts[j], free[j]->unit) + " (" +
+                  .Plain(" " + MisfitValue(c.shifts[j], free[j]->unit) + " (" +
                          Printf("%.2g", sigmas) + ")");
     }
-    t.rows.push_back({Int(static_cast<long long>(k + 1)), Text().Code(c.name),
-                      Sig3(c.expected_decrease), Sig3(c.statistic), c.significant ? "yes" : "no",
-                      WithUnit(c.change, c.unit), moved});
+    t.rows.push_back(
+        {Int(static_cast<long long>(k + 1)), Text().Code(c.name), Sig3(c.expected_decrease),
+         Sig3(c.statistic), c.significant ? "yes" : "no",
+         c.beyond_linear_range ? "beyond the linear range" : MisfitValue(c.change, c.unit), moved});
   }
   doc->AddTable(std::move(t));
 }
@@ -372,21 +394,42 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
   o.width_px = kScatterWidthPx;
   o.height_px = kScatterHeightPx;
   o.y_label = "model - measured [kN]";
-  o.title = "Residual against off-axis angle";
-  o.x_label = "off-axis angle from the focal centre [deg]";
-  const std::string a = SvgLinePlot(zenith, o);
-  o.title = "Residual against azimuth";
-  o.x_label = "azimuth [deg]";
-  const std::string b = SvgLinePlot(azimuth, o);
+  // A pose axis the trajectory barely moves along (a circle keeps its off-axis angle,
+  // 26.39-26.41 deg) would show the residuals' scatter stretched over rounding: left
+  // out, and the caption says why.
+  constexpr double kFlatAxisDeg = 1.0;
+  std::vector<std::string> plots;
+  std::string flat;
+  auto against = [&](const std::vector<PlotSeries>& series, const std::string& title,
+                     const std::string& axis) {
+    double axis_lo = INFINITY, axis_hi = -INFINITY;
+    for (const PlotSeries& p : series) {
+      for (double x : p.x) {
+        axis_lo = std::min(axis_lo, x);
+        axis_hi = std::max(axis_hi, x);
+      }
+    }
+    if (axis_hi - axis_lo < kFlatAxisDeg) {
+      flat += " Not drawn against the " + axis + ": the data span only " + Printf("%.4g", axis_lo) +
+              " to " + Printf("%.4g", axis_hi) + " deg of it.";
+      return;
+    }
+    o.title = "Residual against " + title;
+    o.x_label = axis + " [deg]";
+    plots.push_back(SvgLinePlot(series, o));
+  };
+  against(zenith, "off-axis angle", "off-axis angle from the focal centre");
+  against(azimuth, "azimuth", "azimuth");
   o.title = "Predicted against measured";
   o.x_label = "measured [kN]";
   o.y_label = "predicted by the calibrated model [kN]";
-  const std::string c = SvgLinePlot(versus, o);
-  doc->Figure({a, b, c},
+  plots.push_back(SvgLinePlot(versus, o));
+  doc->Figure(plots,
               "The calibrated model's residuals per cable against where the cabin was (off-axis "
               "angle and azimuth seen from the focal centre): a trend or a wave is model error "
               "that depends on the pose, not noise. Last: predicted against measured tension, "
               "with the diagonal." +
+                  flat +
                   (excluded > 0 ? " " + Int(excluded) + " gross errors are not drawn." : "") +
                   EvenThinningNote(static_cast<int>(d.samples.size()), stride));
 }
@@ -458,6 +501,7 @@ void JsonMisfitAndValidation(const CalibrationResult& r, JsonWriter* w) {
     w->Key("statistic").Number(c.statistic);
     w->Key("significant").Bool(c.significant);
     w->Key("change").Number(c.change);
+    w->Key("beyond_linear_range").Bool(c.beyond_linear_range);
     w->Key("unit").String(c.unit);
     w->Key("shifts").BeginObject();
     size_t k = 0;

@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "fastcal/internal/csv.h"
+#include "fastcal/internal/number_text.h"
 #include "fastcal/svg_plot.h"
 
 namespace fastcal {
@@ -21,9 +22,8 @@ constexpr double kRadToDeg = 180.0 / M_PI;
 
 // `value` with `digits` significant digits (no trailing zeros), for files and text.
 std::string Num(double value, int digits = 10) {
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
-  return buf;
+  if (value == 0.0) return "0";  // never "-0" in a table
+  return internal::FormatDouble("%." + std::to_string(digits) + "g", value);
 }
 
 std::string CableName(int cable) { return "cable " + std::to_string(cable + 1); }

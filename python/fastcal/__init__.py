@@ -10,9 +10,11 @@ against measured cable tensions, on numpy arrays. Guide: docs/python.md.
 
 Units are in the names: SI inside (position_m, s0_m), kN for tensions and forces
 (lower_tension_kN, force_kN), degrees for roll/pitch/yaw (rpy_deg). Quaternions are
-(w, x, y, z). Bad input raises fastcal.InputError (a ValueError) with the message the
-command line prints: it names the file, line, column or parameter. A calibration the
-data cannot support raises fastcal.CalibrationError (a RuntimeError).
+(w, x, y, z). A sensor bias is in kN too (Model.sensor_bias_kN). A missing input file
+raises FileNotFoundError (an OSError), as open() does; other bad input raises
+fastcal.InputError (a ValueError) with the message the command line prints: it names the
+file, line, column or parameter. A calibration the data cannot support raises
+fastcal.CalibrationError (a RuntimeError).
 """
 
 from __future__ import annotations
@@ -23,9 +25,20 @@ import re
 import warnings
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-import numpy as np
+try:
+    import numpy as np
 
-from . import _fastcal
+    from . import _fastcal
+except ImportError as _error:  # another interpreter than the build's: say which to use
+    try:
+        from ._build import PYTHON as _BUILT_FOR
+    except ImportError:  # an installed package: no build tree
+        raise _error from None
+    raise ImportError(
+        f"fastcal was built for {_BUILT_FOR}; this is another Python interpreter "
+        f"({_error}). Run it with {_BUILT_FOR}, or build/python/python3 in the build tree "
+        "(docs/python.md)"
+    ) from _error
 from ._fastcal import CalibrationError, Dataset, Error, InputError, Model
 
 __version__: str = _fastcal.__version__
@@ -105,7 +118,7 @@ class StaticsResult:
 
     Attributes:
         lower_tension_kN: tension at the cabin end, (n, 6). What the cabin-side sensor
-            reads through its gain and bias (Model.sensor_gain, sensor_bias_n).
+            reads through its gain and bias (Model.sensor_gain, sensor_bias_kN).
         upper_tension_kN: tension at the tower end, (n, 6).
         s0_m: unstretched cable lengths, (n, 6).
         force_kN: force applied on each cable at its lower end by the cabin, global
@@ -121,7 +134,9 @@ class StaticsResult:
         error_estimate: per pose, the relative tension error those misses imply, (n,):
             the check behind every 'ok' (docs/model.md, "Checks and statuses").
 
-    A failed pose has zero forces and tensions, never NaN: check `ok`.
+    A failed pose has NaN tensions, forces and unstretched lengths (its chord is
+    geometry and stays), with `status` saying why: np.nanmean skips it, a plain mean
+    shows it.
     """
 
     def __init__(self, raw: Dict[str, Any], single: bool) -> None:

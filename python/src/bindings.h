@@ -11,8 +11,11 @@
 #include <pybind11/pybind11.h>
 
 #include <Eigen/Core>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <system_error>
+#include <utility>
 #include <vector>
 
 #include "fastcal/pose.h"
@@ -28,6 +31,23 @@ inline constexpr double kNPerKn = 1e3;
 struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
+
+// An input file that does not exist: raised as FileNotFoundError (an OSError, what
+// open() raises), with errno ENOENT, the library's message and the file name.
+struct MissingFileError : std::runtime_error {
+  MissingFileError(std::string file, const std::string& message)
+      : std::runtime_error(message), path(std::move(file)) {}
+  std::string path;
+};
+
+// Throws MissingFileError when nothing exists at `path` (other problems, a directory or
+// an unreadable file, are the reader's InputError with its message).
+inline void RequireExistingFile(const std::string& path, const std::string& what) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) {
+    throw MissingFileError(path, path + ": no such " + what + " file");
+  }
+}
 
 // A calibration refused or failed (the command line's exit 1): fastcal.CalibrationError,
 // a RuntimeError, whose `status` says which ("undetermined", "infeasible", ...).

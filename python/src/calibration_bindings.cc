@@ -116,6 +116,9 @@ py::dict ResultDict(const CalibrationResult& r) {
     m["name"] = c.name;
     m["expected_chi_square_decrease"] = c.expected_decrease;
     m["significant"] = c.significant;
+    m["change"] = c.change;  // in `unit`; not meaningful when beyond_linear_range
+    m["unit"] = c.unit;
+    m["beyond_linear_range"] = c.beyond_linear_range;
     ranking.append(m);
   }
   d["outliers"] = outliers;
@@ -190,6 +193,7 @@ CalibrationSpec Spec(const CableRobot& model, const std::string& path_or_text, b
                      const std::string& source_name) {
   CalibrationSpec spec;
   std::string error;
+  if (!is_text) RequireExistingFile(path_or_text, "spec");
   const bool ok = is_text
                       ? ParseCalibrationSpecYaml(path_or_text, source_name, model, &spec, &error)
                       : LoadCalibrationSpec(path_or_text, model, &spec, &error);

@@ -109,6 +109,7 @@ Dataset ReadDatasetOrThrow(const std::string& path, bool skip_invalid_rows) {
   Dataset data;
   std::string error;
   bool ok = false;
+  RequireExistingFile(path, "dataset");
   {
     py::gil_scoped_release release;
     ok = ReadDataset(path, options, &data, &error);

@@ -102,6 +102,7 @@ Eigen::Vector3d ToVector3(const DoubleArray& a, const char* name) {
 CableRobot Load(const std::string& path) {
   CableRobot robot;
   std::string error;
+  RequireExistingFile(path, "model");
   if (!LoadCableRobot(path, &robot, &error)) throw InputError(error);
   return robot;
 }
@@ -255,8 +256,34 @@ Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
                    "Mass per unit unstretched length of each cable, shape (6,).");
   PerCableProperty(model, "sensor_gain", &CableProperties::sensor_gain,
                    "Tension sensor gain per cable: reading = gain * tension + bias, shape (6,).");
-  PerCableProperty(model, "sensor_bias_n", &CableProperties::sensor_bias_n,
-                   "Tension sensor bias per cable (N), shape (6,).");
+  // The bias in kN, as every tension of the module and the model file's key
+  // (sensor_bias_kN); formerly sensor_bias_n, in N (docs/python.md, Decisions).
+  model.def_property(
+      "sensor_bias_kN",
+      [](const CableRobot& r) {
+        DoubleArray out = NewArray({kNumCables});
+        for (int i = 0; i < kNumCables; ++i) {
+          out.mutable_data()[i] = r.cables[i].sensor_bias_n / kNPerKn;
+        }
+        return out;
+      },
+      [](CableRobot& r, const DoubleArray& values) {
+        if (values.ndim() != 1 || values.shape(0) != kNumCables) {
+          throw InputError("sensor_bias_kN must have shape (6,): one value per cable");
+        }
+        for (int i = 0; i < kNumCables; ++i) r.cables[i].sensor_bias_n = values.data()[i] * kNPerKn;
+      },
+      "Tension sensor bias per cable (kN, as every tension), shape (6,).");
+  // The old name, in N, is refused with the new one rather than kept: two units for one
+  // quantity is what the rename removes.
+  auto renamed = [](const py::object&) -> py::object {
+    throw py::attribute_error(
+        "Model.sensor_bias_n (N) is now Model.sensor_bias_kN (kN, as every tension)");
+  };
+  model.def_property(
+      "sensor_bias_n", renamed,
+      [renamed](const py::object& self, const py::object&) { renamed(self); },
+      "Renamed: use sensor_bias_kN (kN).");
 }
 
 }  // namespace fastcal::python

@@ -1,6 +1,8 @@
 // fastcal._fastcal: the module's exceptions, shared conversions and its parts.
 #include <pybind11/pybind11.h>
 
+#include <cerrno>
+
 #include "bindings.h"
 #include "fastcal/version.h"
 
@@ -82,6 +84,9 @@ void RegisterExceptions(py::module_& m) {
       if (thrown) std::rethrow_exception(thrown);
     } catch (const InputError& e) {
       PyErr_SetString(input_error, e.what());
+    } catch (const MissingFileError& e) {
+      PyErr_SetObject(PyExc_FileNotFoundError,
+                      py::make_tuple(ENOENT, std::string(e.what()), e.path).ptr());
     } catch (const CalibrationError& e) {
       py::object instance = py::handle(calibration_error)(e.what());
       instance.attr("status") = e.status;

@@ -1,5 +1,6 @@
 // Statics of many poses in one call (the loop in C++, without the GIL), the trajectory
 // generators and the focal attitude law (statics.h, trajectory.h, pose.h).
+#include <cmath>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -83,14 +84,17 @@ py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
       end_residual[k] = solution.end_residual_m;
       error_estimate[k] = solution.error_estimate;
       if (s != StaticsStatus::kOk) failed.emplace_back(k, DescribeStatus(solution));
+      // A pose the cables cannot hold has no tensions: NaN, so that a mean or a plot
+      // over the poses shows the gap instead of averaging in a 0 (its status says why).
+      const double none = s == StaticsStatus::kOk ? 1.0 : std::nan("");
       for (int i = 0; i < kNumCables; ++i) {
         const CableSolution& c = solution.cables[i];
         const py::ssize_t at = k * kNumCables + i;
-        lower[at] = c.lower_tension_n / kNPerKn;
-        upper[at] = c.upper_tension_n / kNPerKn;
-        s0[at] = c.unstretched_length_m;
+        lower[at] = none * c.lower_tension_n / kNPerKn;
+        upper[at] = none * c.upper_tension_n / kNPerKn;
+        s0[at] = none * c.unstretched_length_m;
         chord[at] = c.chord_length_m;
-        for (int d = 0; d < 3; ++d) force[3 * at + d] = c.force_n[d] / kNPerKn;
+        for (int d = 0; d < 3; ++d) force[3 * at + d] = none * c.force_n[d] / kNPerKn;
       }
     }
   }

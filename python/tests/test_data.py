@@ -58,6 +58,27 @@ def test_bad_value_names_file_line_and_column_as_the_cli_does(
     assert len(skipped) == 3 and len(skipped.skipped) == 1
 
 
+def test_attitudes_in_radians_are_refused_as_the_cli_does(
+    tmp_path: pathlib.Path, data_dir: pathlib.Path, cli: Optional[str]
+) -> None:
+    rows = []
+    for row in (data_dir / "circle_paper.csv").read_text().splitlines():
+        fields = row.split(",")
+        if not row.startswith(("#", "time_s")):  # radians under roll_deg, pitch_deg, yaw_deg
+            fields[4:7] = [repr(float(np.radians(float(v)))) for v in fields[4:7]]
+        rows.append(",".join(fields))
+    path = tmp_path / "radians.csv"
+    path.write_text("\n".join(rows) + "\n")
+    with pytest.raises(fastcal.InputError) as raised:
+        fastcal.read_dataset(path)
+    message = str(raised.value)
+    assert message.startswith(f"{path}: roll_deg, pitch_deg, yaw_deg look like radians: ")
+    assert message.endswith("write degrees (radians x 57.2958)")
+    expected = cli_error(cli, ["evaluate", f"--data={path}"])
+    if expected is not None:
+        assert message == expected
+
+
 def test_simulate_is_reproducible_and_round_trips(tmp_path: pathlib.Path) -> None:
     truth = fastcal.Model.nominal()
     truth.mass_centre_cabin_m = [0.22, 0.11, 0.5]

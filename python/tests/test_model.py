@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import os
 import pathlib
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -27,7 +30,57 @@ def test_nominal_fields_are_numbers_and_arrays() -> None:
     np.testing.assert_array_equal(model.ea_n, np.full(6, 2.4656e7))
     np.testing.assert_array_equal(model.linear_density_kg_per_m, np.full(6, 11.718))
     np.testing.assert_array_equal(model.sensor_gain, np.ones(6))
-    np.testing.assert_array_equal(model.sensor_bias_n, np.zeros(6))
+    np.testing.assert_array_equal(model.sensor_bias_kN, np.zeros(6))
+
+
+def test_sensor_bias_is_in_kn_like_every_tension_and_the_old_name_says_so(
+    tmp_path: pathlib.Path,
+) -> None:
+    model = fastcal.Model.nominal()
+    model.sensor_bias_kN = [1.5, 0, 0, 0, 0, -2]
+    path = tmp_path / "model.yaml"
+    model.save(str(path), "biased")
+    assert "sensor_bias_kN: 1.5\n" in path.read_text()  # the file's key and unit
+    np.testing.assert_array_equal(fastcal.Model.load(str(path)).sensor_bias_kN, model.sensor_bias_kN)
+    with pytest.raises(AttributeError, match="now Model.sensor_bias_kN"):
+        model.sensor_bias_n
+    with pytest.raises(AttributeError, match="now Model.sensor_bias_kN"):
+        model.sensor_bias_n = np.zeros(6)
+
+
+def test_the_build_names_its_interpreter_and_runs_it() -> None:
+    """build/python/python3 runs the interpreter the module was built for (docs/python.md)."""
+    from fastcal import _build  # the build tree's record; not installed
+
+    assert os.path.samefile(_build.PYTHON, sys.executable)
+    runner = pathlib.Path(fastcal.__file__).parents[1] / "python3"
+    out = subprocess.run(
+        [str(runner), "-c", "import fastcal; print(fastcal.Model.nominal().sensor_bias_kN.sum())"],
+        env={"PATH": "/nonexistent"},  # whatever python3 is on PATH does not matter
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    assert out.stdout == "0.0\n"
+
+
+def test_a_missing_file_is_file_not_found_as_open_raises(
+    tmp_path: pathlib.Path, data_dir: pathlib.Path
+) -> None:
+    missing = tmp_path / "nowhere.yaml"
+    with pytest.raises(FileNotFoundError) as raised:
+        fastcal.Model.load(str(missing))
+    assert isinstance(raised.value, OSError)
+    assert raised.value.filename == str(missing)
+    with pytest.raises(FileNotFoundError, match="no such dataset file"):
+        fastcal.read_dataset(tmp_path / "nowhere.csv")
+    with pytest.raises(FileNotFoundError, match="no such spec file"):
+        fastcal.calibrate(missing, data_dir / "circle_paper.csv")
+    # A file that exists but is wrong stays an InputError (a ValueError).
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("cabin:\n  mass_kg: 30\n")
+    with pytest.raises(fastcal.InputError, match="tonnes written as kg"):
+        fastcal.Model.load(str(bad))
 
 
 def test_fields_are_set_by_whole_arrays(tmp_path: pathlib.Path) -> None:
@@ -59,7 +112,7 @@ def test_bad_model_file_names_file_and_key(tmp_path: pathlib.Path) -> None:
         fastcal.Model.load(str(path))
     assert "mass_kg" in str(raised.value)
     assert isinstance(raised.value, fastcal.Error)
-    with pytest.raises(fastcal.InputError, match="absent.yaml"):
+    with pytest.raises(FileNotFoundError, match="absent.yaml"):  # as open() raises
         fastcal.Model.load(str(tmp_path / "absent.yaml"))
 
 

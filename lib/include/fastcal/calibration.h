@@ -189,7 +189,11 @@ struct MisfitCandidate {
   // statistic above CalibrationResult::misfit_threshold: more than noise alone would
   // give the largest of all the candidates.
   bool significant = false;
-  double change = 0.0;         // of the parameter itself, in `unit`
+  double change = 0.0;  // of the parameter itself, in `unit`
+  // value + change is outside the parameter's plausible range (plausibility.h: a negative
+  // or tenfold EA, a tower a metre off): the one-step linear extrapolation behind change
+  // and shifts is far beyond where it holds. Reports show "beyond the linear range".
+  bool beyond_linear_range = false;
   std::vector<double> shifts;  // of each free parameter, in its unit, free order
 };
 

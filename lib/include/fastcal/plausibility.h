@@ -43,6 +43,43 @@ struct PlausibilityLimits {
   // the workspace is under 700 m.
   double max_unstretched_length_m = 1000.0;
 
+  // Model and calibration-spec values (model_plausibility.h checks model files with them,
+  // calibration_spec.h initial values, priors and noise): wide enough for any real FAST
+  // cabin, cable and sensor, narrow enough that a factor of 1000 (tonnes typed as kg, kN
+  // as N, mm as m) always falls outside. Nominal values: docs/model.md, Table 1.
+  // Cabin mass, kg: nominal 30 t; a third to three times it.
+  double min_cabin_mass_kg = 1.0e4;
+  double max_cabin_mass_kg = 1.0e5;
+  // Largest |component| of the mass centre in the cabin frame, m: the cabin's anchor
+  // points are 7.5 m from its origin.
+  double max_abs_mass_centre_m = 5.0;
+  // Largest |component| of a cabin anchor point, m: the cabin is about 15 m across.
+  double max_abs_anchor_point_m = 20.0;
+  // Cable linear density, kg/m: nominal 11.718; a fifth to five times it.
+  double min_linear_density_kg_per_m = 2.0;
+  double max_linear_density_kg_per_m = 60.0;
+  // Cable axial stiffness EA, N: nominal 2.4656e7 N; a fifth to five times it.
+  double min_ea_n = 5.0e6;
+  double max_ea_n = 1.25e8;
+  // Largest |component| of a calibration's anchor or tower offset, m: the points are
+  // surveyed to about a centimetre; a metre off is a survey blunder, not a calibration.
+  double max_abs_offset_m = 1.0;
+  // Tension sensor: reading = gain * tension + bias.
+  double min_sensor_gain = 0.5;
+  double max_sensor_gain = 2.0;
+  // Largest |bias|, N: half the working tension of about 200 kN.
+  double max_abs_sensor_bias_n = 1.0e5;
+  // Stated tension noise: beyond a quarter of the working tension (50 kN) or 50% the
+  // readings would carry no information.
+  double max_tension_sigma_n = 5.0e4;
+  double max_tension_sigma_percent = 50.0;
+  // A cable's attachments (cable_attachment.h): FAST's sensor assemblies weigh 250-650 kg
+  // and its hung lines 0.6-1.6 kg/m; 5 t on one cable, 50 kg/m (four times the cable) or
+  // a position 2 km up a ~300 m cable is a slip.
+  double max_attachment_mass_kg = 5000.0;
+  double max_attachment_density_kg_per_m = 50.0;
+  double max_attachment_position_m = 2000.0;
+
   // False, naming the field, when a limit is not finite or not > 0.
   bool IsValid(std::string* error) const;
 };
@@ -59,6 +96,42 @@ bool CheckAngleDeg(double angle_deg, const PlausibilityLimits& limits, std::stri
 bool CheckRotationVector(const Eigen::Vector3d& rotation_vector_rad,
                          const PlausibilityLimits& limits, std::string* why);
 bool CheckUnstretchedLengthM(double length_m, const PlausibilityLimits& limits, std::string* why);
+
+// The model and spec quantities with a plausible range (PlausibilityLimits above).
+enum class ModelQuantity {
+  kCabinMassKg,
+  kMassCentreM,   // one component, cabin frame
+  kAnchorPointM,  // one component, cabin frame
+  kLinearDensityKgPerM,
+  kEaN,
+  kOffsetM,  // one component of an anchor or tower offset
+  kSensorGain,
+  kSensorBiasN,
+  kTensionSigmaN,
+  kTensionSigmaPercent,
+  kAttachmentMassKg,
+  kAttachmentDensityKgPerM,
+  kAttachmentPositionM,  // at_m, from_m, to_m
+};
+
+// A quantity's plausible range and its nominal FAST value, SI (percent for
+// kTensionSigmaPercent), and how the files write it: file value = SI / si_per_file_unit.
+struct QuantityRange {
+  double min = 0.0;
+  double max = 0.0;
+  double nominal = 0.0;
+  const char* file_unit = "";
+  double si_per_file_unit = 1.0;
+};
+QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& limits);
+
+// True for a value within its plausible range; otherwise false and *why says so in the
+// file's unit, with the nominal value and, when the value times or over 1000 would be
+// plausible, the likely unit slip:
+//   "30 kg is below the plausible minimum of 10000 kg (nominal FAST: 30000 kg; tonnes
+//    written as kg?)"
+bool CheckQuantity(ModelQuantity quantity, double value_si, const PlausibilityLimits& limits,
+                   std::string* why);
 
 // Lowest plausible z at `horizontal_radius_m` from the axis (PlausibilityLimits above).
 double LowestPlausibleZ(double horizontal_radius_m, const PlausibilityLimits& limits);

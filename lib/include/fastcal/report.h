@@ -67,6 +67,11 @@ struct ReportInputs {
   std::vector<VariantEvaluation> variants;
   // Statics method of the evaluation, e.g. "exact".
   std::string evaluation_method;
+  // For the calibrated model's "check it on other data" commands: the output directory
+  // as given (--out; empty: "DIR"), and a dataset it was not fitted to, e.g. another
+  // file beside the data (empty: "OTHER_DATA.csv", said to be one).
+  std::string out_dir;
+  std::string other_data_path;
 };
 
 // The report as Markdown, HTML and JSON. Each is deterministic (its only date is

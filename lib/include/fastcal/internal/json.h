@@ -38,7 +38,7 @@ class JsonWriter {
     if (!std::isfinite(value)) {
       out_ += "null";
     } else {
-      out_ += internal::FormatDouble("%.12g", value);
+      out_ += value == 0.0 ? "0" : internal::FormatDouble("%.12g", value);  // never "-0"
     }
     return *this;
   }

@@ -1,0 +1,224 @@
+// Plausibility of a whole model, and the diagnosis of a model that cannot solve many rows
+// (model_plausibility.h).
+#include "fastcal/model_plausibility.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <utility>
+
+#include "fastcal/internal/number_text.h"
+
+namespace fastcal {
+namespace {
+
+std::string Num(double value) { return internal::FormatDouble("%.6g", value); }
+
+std::string Vec(const Eigen::Vector3d& v) {
+  return "(" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + ")";
+}
+
+// One value of a model with its key path, quantity and nominal value.
+struct ModelValue {
+  std::string path;
+  ModelQuantity quantity;
+  double value_si;
+  double nominal_si;
+};
+
+// Every scalar value of `robot` that has a plausible range, with the nominal FAST
+// model's value beside it (components of vectors each on their own).
+std::vector<ModelValue> ModelValues(const CableRobot& robot) {
+  static const CableRobot nominal = CableRobot::NominalFast();
+  static const char kAxes[] = "xyz";
+  std::vector<ModelValue> values;
+  values.push_back(
+      {"cabin.mass_kg", ModelQuantity::kCabinMassKg, robot.cabin_mass_kg, nominal.cabin_mass_kg});
+  for (int a = 0; a < 3; ++a) {
+    values.push_back({std::string("cabin.mass_centre_m.") + kAxes[a], ModelQuantity::kMassCentreM,
+                      robot.mass_centre_cabin_m[a], nominal.mass_centre_cabin_m[a]});
+  }
+  for (size_t j = 0; j < robot.anchor_points_cabin_m.size(); ++j) {
+    const Eigen::Vector3d nominal_point = j < nominal.anchor_points_cabin_m.size()
+                                              ? nominal.anchor_points_cabin_m[j]
+                                              : robot.anchor_points_cabin_m[j];
+    for (int a = 0; a < 3; ++a) {
+      values.push_back({"cabin.anchor_points_m[" + std::to_string(j) + "]." + kAxes[a],
+                        ModelQuantity::kAnchorPointM, robot.anchor_points_cabin_m[j][a],
+                        nominal_point[a]});
+    }
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableProperties& c = robot.cables[i];
+    const CableProperties& n = nominal.cables[i];
+    const std::string key = "cables[" + std::to_string(i) + "].";
+    values.push_back({key + "ea_n", ModelQuantity::kEaN, c.ea_n, n.ea_n});
+    values.push_back({key + "linear_density_kg_per_m", ModelQuantity::kLinearDensityKgPerM,
+                      c.linear_density_kg_per_m, n.linear_density_kg_per_m});
+    values.push_back({key + "sensor_gain", ModelQuantity::kSensorGain, c.sensor_gain, 1.0});
+    values.push_back({key + "sensor_bias_kN", ModelQuantity::kSensorBiasN, c.sensor_bias_n, 0.0});
+    for (size_t j = 0; j < c.attachments.size(); ++j) {
+      CableAttachment a = c.attachments[j];
+      const std::string at = key + "attachments[" + std::to_string(j) + "].";
+      for (const auto& [name, value] : a.Fields()) {
+        const std::string field = name;
+        const ModelQuantity q = field == "mass_kg" ? ModelQuantity::kAttachmentMassKg
+                                : field == "added_density_kg_per_m"
+                                    ? ModelQuantity::kAttachmentDensityKgPerM
+                                    : ModelQuantity::kAttachmentPositionM;
+        values.push_back({at + field, q, *value, *value});  // no nominal: its own value
+      }
+    }
+  }
+  return values;
+}
+
+// How far a value is from nominal, in units of its plausible range (model_plausibility.h).
+double Departure(const ModelValue& v, const PlausibilityLimits& limits) {
+  const QuantityRange range = PlausibleRange(v.quantity, limits);
+  if (range.min > 0.0 && v.value_si > 0.0 && v.nominal_si > 0.0) {
+    return std::abs(std::log(v.value_si / v.nominal_si)) / std::log(range.max / range.nominal);
+  }
+  return std::abs(v.value_si - v.nominal_si) / range.max;
+}
+
+std::string InFileUnit(double value_si, const QuantityRange& range) {
+  const std::string unit = range.file_unit;
+  return Num(value_si / range.si_per_file_unit) + (unit.empty() ? "" : " " + unit);
+}
+
+}  // namespace
+
+bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity) {
+  switch (kind) {
+    case ParameterKind::kMassCentre:
+      *quantity = ModelQuantity::kMassCentreM;
+      return true;
+    case ParameterKind::kCabinMass:
+      *quantity = ModelQuantity::kCabinMassKg;
+      return true;
+    case ParameterKind::kLinearDensity:
+      *quantity = ModelQuantity::kLinearDensityKgPerM;
+      return true;
+    case ParameterKind::kEa:
+      *quantity = ModelQuantity::kEaN;
+      return true;
+    case ParameterKind::kAnchorOffset:
+    case ParameterKind::kTowerOffset:
+      *quantity = ModelQuantity::kOffsetM;
+      return true;
+    case ParameterKind::kSensorGain:
+      *quantity = ModelQuantity::kSensorGain;
+      return true;
+    case ParameterKind::kSensorBias:
+      *quantity = ModelQuantity::kSensorBiasN;
+      return true;
+    case ParameterKind::kAttachmentMass:
+      *quantity = ModelQuantity::kAttachmentMassKg;
+      return true;
+    case ParameterKind::kAttachmentDensity:
+      *quantity = ModelQuantity::kAttachmentDensityKgPerM;
+      return true;
+    default:
+      return false;
+  }
+}
+
+bool CheckParameterValue(ParameterKind kind, double value_si, const PlausibilityLimits& limits,
+                         std::string* why) {
+  ModelQuantity quantity;
+  return !QuantityOfParameter(kind, &quantity) || CheckQuantity(quantity, value_si, limits, why);
+}
+
+bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limits,
+                         std::string* why) {
+  std::string what;
+  for (const ModelValue& v : ModelValues(robot)) {
+    if (!CheckQuantity(v.quantity, v.value_si, limits, &what)) {
+      if (why != nullptr) *why = v.path + ": " + what;
+      return false;
+    }
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    if (!CheckPosition(robot.cables[i].tower_top_m, limits, &what)) {
+      if (why != nullptr) *why = "cables[" + std::to_string(i) + "].tower_top_m: " + what;
+      return false;
+    }
+  }
+  return true;
+}
+
+std::vector<std::string> FurthestFromNominal(const CableRobot& robot,
+                                             const PlausibilityLimits& limits, size_t count) {
+  // Below this share of its plausible range a departure is a calibration, not a slip.
+  constexpr double kNegligibleDeparture = 0.01;
+  // Tower tops: a metre is far (they are surveyed to a centimetre).
+  constexpr double kTowerTopScaleM = 1.0;
+  static const CableRobot nominal = CableRobot::NominalFast();
+  std::vector<std::pair<double, std::string>> found;
+  for (const ModelValue& v : ModelValues(robot)) {
+    const double d = Departure(v, limits);
+    if (!(d > kNegligibleDeparture)) continue;
+    const QuantityRange range = PlausibleRange(v.quantity, limits);
+    found.emplace_back(d, v.path + " = " + InFileUnit(v.value_si, range) + " (nominal " +
+                              InFileUnit(v.nominal_si, range) + ")");
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const Eigen::Vector3d& top = robot.cables[i].tower_top_m;
+    const Eigen::Vector3d& nominal_top = nominal.cables[i].tower_top_m;
+    const double d = (top - nominal_top).norm() / kTowerTopScaleM;
+    if (!(d > kNegligibleDeparture)) continue;
+    found.emplace_back(d, "cables[" + std::to_string(i) + "].tower_top_m = " + Vec(top) +
+                              " m (nominal " + Vec(nominal_top) + " m)");
+  }
+  std::stable_sort(found.begin(), found.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  std::vector<std::string> names;
+  for (size_t k = 0; k < std::min(count, found.size()); ++k) names.push_back(found[k].second);
+  return names;
+}
+
+UnsolvableRows DiagnoseUnsolvableRows(const CableRobot& model, const std::string& model_name,
+                                      const Dataset& data,
+                                      const std::vector<AttitudeSource>& attitudes,
+                                      const std::vector<StaticsMethod>& methods) {
+  constexpr size_t kNamed = 3;
+  constexpr int kFewestForNominalTest = 2;
+  UnsolvableRows d;
+  d.rows = static_cast<int>(data.samples.size());
+  Dataset kept = data;
+  const size_t skipped_before = kept.skipped.size();
+  d.failed = SkipUnsolvableSamples(model, model_name, attitudes, methods, &kept);
+  if (d.failed == 0) return d;
+  d.first = kept.skipped[skipped_before];
+  // The failed rows alone, tried with the nominal model.
+  std::set<int> kept_lines;
+  for (const Sample& s : kept.samples) kept_lines.insert(s.line);
+  Dataset failed = data;
+  failed.samples.clear();
+  for (const Sample& s : data.samples) {
+    if (!kept_lines.count(s.line)) failed.samples.push_back(s);
+  }
+  d.solved_by_nominal =
+      d.failed - SkipUnsolvableSamples(CableRobot::NominalFast(), "the nominal FAST model",
+                                       attitudes, methods, &failed);
+  d.model_likely = d.failed >= kFewestForNominalTest && 2 * d.solved_by_nominal >= d.failed;
+  d.furthest_from_nominal = FurthestFromNominal(model, PlausibilityLimits(), kNamed);
+  return d;
+}
+
+std::string DescribeUnsolvableRows(const UnsolvableRows& d, const std::string& model_name) {
+  std::string text = model_name + " cannot solve " + std::to_string(d.failed) + " of " +
+                     std::to_string(d.rows) + " rows (the nominal FAST model solves " +
+                     std::to_string(d.solved_by_nominal) +
+                     " of them): the model or the spec is the likely cause, not the data";
+  if (!d.furthest_from_nominal.empty()) {
+    text += "; furthest from nominal: ";
+    for (size_t k = 0; k < d.furthest_from_nominal.size(); ++k) {
+      text += (k ? ", " : "") + d.furthest_from_nominal[k];
+    }
+  }
+  return text + ". First: " + d.first;
+}
+
+}  // namespace fastcal
