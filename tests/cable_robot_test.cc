@@ -144,8 +144,9 @@ TEST(CableRobotYaml, ImplausibleValuesAreRefusedAtTheirKeyWithTheLikelySlip) {
             "m.yaml:2: cabin.mass_centre_m.z: 500 m is beyond the plausible +-5 m (mm written "
             "as m?)");
   std::string cables = "cables:\n";
+  const CableRobot nominal = CableRobot::NominalFast();  // outlives the references below
   for (int i = 0; i < kNumCables; ++i) {
-    const CableProperties& c = CableRobot::NominalFast().cables[i];
+    const CableProperties& c = nominal.cables[i];
     cables += "  - {tower_top_m: [" + std::to_string(c.tower_top_m.x()) + ", " +
               std::to_string(c.tower_top_m.y()) +
               ", 270], anchor: " + std::to_string(c.anchor_index) +

@@ -889,8 +889,9 @@ TEST_F(CliTest, ResultsOnStdoutProgressOnStderrForEveryCommand) {
   // estimate beside a large sigma is "0.00 +- 2.1 kN", never "1.2e-09 +- 2.1 kN".
   std::istringstream header(ReadFile(Path("cal") + "/model_calibrated.yaml"));
   for (std::string line; std::getline(header, line) && line.rfind("#", 0) == 0;) {
-    if (line.find(" = ") != std::string::npos)
+    if (line.find(" = ") != std::string::npos) {
       EXPECT_EQ(line.find("e-"), std::string::npos) << line;
+    }
   }
   // The "check it on other data" command names this run's folder and another bundled
   // dataset, not the fitted one (issue 17, item 6).

@@ -263,8 +263,8 @@ class ReportTest : public ::testing::Test {
     r.budget.effective_samples = 6.4;
     r.verdict = FitVerdict::kOk;
     r.verdict_text = "reduced chi-square 0.98 agrees with the stated noise (1 +- 0.435)";
-    r.misfit_ranking = {{"sensor_gain[3]", "1", 410.0, 80.0, true, 0.03, {}},
-                        {"tower_offset_m[2].z", "m", 12.0, 2.0, false, 0.001, {}}};
+    r.misfit_ranking = {{"sensor_gain[3]", "1", 410.0, 80.0, true, 0.03, false, {}},
+                        {"tower_offset_m[2].z", "m", 12.0, 2.0, false, 0.001, false, {}}};
     r.misfit_threshold = 15.1;
     r.excluded.assign(kNumSamples, {});
     r.excluded[7][2] = true;

@@ -1152,7 +1152,9 @@ void JudgeCompleteness(Run& run) {
   if (r.verdict == FitVerdict::kFailed || !r.covariance_ok) return;
   const double limit = run.options.incomplete_model_sigmas;
   for (const MisfitCandidate& c : r.misfit_ranking) {
-    if (!c.significant) continue;
+    // A change beyond the parameter's plausible range leaves the linearisation: its
+    // shifts say nothing reliable (the ranking shows no shift for it either).
+    if (!c.significant || c.beyond_linear_range) continue;
     size_t k = 0;
     for (ParameterEstimate& e : r.parameters) {
       if (!e.free) continue;
@@ -1205,6 +1207,7 @@ void NoteWhatTheMisfitWouldMove(CalibrationResult* r) {
   size_t said = 0;
   for (const MisfitCandidate& c : r->misfit_ranking) {
     if (!c.significant || said == kCandidates) break;
+    if (c.beyond_linear_range) continue;
     const ParameterEstimate* worst = nullptr;
     double worst_sigmas = 0.0, worst_shift = 0.0;
     size_t k = 0;
