@@ -123,52 +123,6 @@ attitude and, when the data has it, the planned attitude. The model's sensor gai
 bias (if any) are applied: predicted reading = gain * tension + bias.
 )";
 
-// Writes the given files into a fresh temporary sibling of `dir`, then renames it to
-// `dir`; on any failure removes the temporary directory.
-bool WriteDirectoryAtomically(const std::string& dir,
-                              const std::vector<std::pair<std::string, std::string>>& files,
-                              const std::function<bool(const std::string&, std::string*)>& extra,
-                              std::string* error) {
-  if (!CheckOutputDirectory("out", dir, error)) return false;
-  std::error_code ec;
-  const fs::path target = ResolveOutputPath(dir);
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::exists(parent, ec) && !fs::create_directories(parent, ec)) {
-    *error = "--out=" + internal::Escape(dir) + ": cannot create its directory '" +
-             internal::Escape(parent.string()) + "': " + ec.message();
-    return false;
-  }
-  const fs::path tmp =
-      parent / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
-  fs::remove_all(tmp, ec);
-  // Failures name the user's --out, not the temporary sibling.
-  const std::string where = "--out=" + internal::Escape(dir) + ": ";
-  if (!fs::create_directory(tmp, ec)) {
-    *error =
-        where + "cannot create the temporary directory '" + tmp.string() + "': " + ec.message();
-    return false;
-  }
-  auto fail = [&](std::string why) {
-    fs::remove_all(tmp, ec);
-    for (size_t at = why.find(tmp.string()); at != std::string::npos;
-         at = why.find(tmp.string(), at + dir.size())) {
-      why.replace(at, tmp.string().size(), dir);
-    }
-    *error = why.rfind("--out=", 0) == 0 ? why : where + why;
-    return false;
-  };
-  for (const auto& [name, content] : files) {
-    std::string why;
-    if (!WriteOutput((tmp / name).string(), content, &why)) return fail(why);
-  }
-  std::string why;
-  if (extra && !extra(tmp.string(), &why)) return fail(why);
-  if (fs::exists(target, ec)) fs::remove(target, ec);  // empty directory
-  fs::rename(tmp, target, ec);
-  if (ec) return fail("cannot move the results into place: " + ec.message());
-  return true;
-}
-
 // One row per sample: measured and each variant's predicted tensions; with a calibration
 // the held_out flag and gross_error_cables, the cables whose reading was a gross error
 // ("3", "1 4"; empty for none).

@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <string>
 #include <utility>
@@ -123,6 +124,14 @@ bool WriteOutput(const std::string& path, const std::string& content, std::strin
 bool WriteOutputsTogether(const std::vector<std::pair<std::string, std::string>>& files,
                           std::string* error);
 
+// Writes the given (name, content) files and then `extra` (may be empty; it writes into
+// the directory it is given) into a fresh temporary sibling of `dir`, then renames it to
+// `dir` (calibrate, evaluate, design --out); on any failure removes the temporary
+// directory and names --out=<dir> in *error. `dir` must pass CheckOutputDirectory.
+bool WriteDirectoryAtomically(const std::string& dir,
+                              const std::vector<std::pair<std::string, std::string>>& files,
+                              const std::function<bool(const std::string&, std::string*)>& extra,
+                              std::string* error);
 // "fastcal <command>: <message>" on stderr.
 void PrintError(const std::string& command, const std::string& message);
 
