@@ -67,8 +67,9 @@ draws the random survey compared against).
                          its least useful stops (their samples dwell at the others)
 Grid and limits, as fastcal workspace: --max-off-axis-deg=40 --off-axis-step-deg=1
   --azimuth-step-deg=5 --focal-radius=160 --focal-centre=0,0,300 --tilt-fraction=0.41
-  --min-tension-kn=0 --max-tension-kn=inf --max-strain=0.05 --max-length-ratio=1.5
-  --reflector-clearance=0
+  --max-tension-kn=inf --max-strain=0.05 --max-length-ratio=1.5, and with the design's
+  own margins (the optimum lies on the workspace's edge, where cables near slack sag by
+  metres for a small error of the model): --min-tension-kn=50 --reflector-clearance=5
 
 Outputs (written only when everything succeeded):
   poses.csv    x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg, one row per sample in flight
@@ -110,6 +111,11 @@ const std::set<std::string> kFlags = {"spec",
 bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   // The candidates' grid and limits exactly as `fastcal workspace` reads them.
   if (!WorkspaceOptionsFromFlags(&o->workspace, error)) return false;
+  // The design's margins unless given (design.h: the optimum lies on the edge).
+  if (!FlagGiven("reflector-clearance")) {
+    o->workspace.statics.min_reflector_clearance_m = kDesignReflectorClearanceM;
+  }
+  if (!FlagGiven("min-tension-kn")) o->workspace.min_tension_n = kDesignMinTensionN;
   o->max_extra_tilt_deg = FLAGS_max_extra_tilt_deg;
   o->max_extra_yaw_deg = FLAGS_max_extra_yaw_deg;
   o->samples = FLAGS_samples;

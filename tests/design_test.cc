@@ -183,7 +183,8 @@ parameters:
   // The calibration's sigma_total is at the solution, the prediction at the start.
   constexpr double kSigmaRelativeTolerance = 0.2;
   double sum_z2 = 0.0;
-  int count = 0;
+  int count = 0, correlated = 0;
+  constexpr int kMaxFalseCorrelation = 2;
   std::mt19937_64 rng(11);
   std::normal_distribution<double> normal;
   for (int seed = 1; seed <= kSeeds; ++seed) {
@@ -201,15 +202,21 @@ parameters:
     ASSERT_EQ(Calibrate(nominal, spec, data, CalibrationOptions(), &r, &error),
               CalibrationStatus::kOk)
         << error;
+    // The prediction is for white residuals; the calibration widens its sigma when its
+    // test finds them correlated in time, by chance now and then (seed 5 here).
+    correlated += r.budget.correlated;
     for (int k = 0; k < 3; ++k) {
       const double predicted = d.design.budget.parameters[k].total;
       const ParameterEstimate& e = r.parameters[k];
-      EXPECT_NEAR(e.sigma_total, predicted, kSigmaRelativeTolerance * predicted) << e.name;
+      if (!r.budget.correlated) {
+        EXPECT_NEAR(e.sigma_total, predicted, kSigmaRelativeTolerance * predicted) << e.name;
+      }
       const double z = (e.estimate - truth.mass_centre_cabin_m[k]) / predicted;
       sum_z2 += z * z;
       ++count;
     }
   }
+  EXPECT_LE(correlated, kMaxFalseCorrelation);
   EXPECT_GT(sum_z2 / count, kMeanZ2Low);
   EXPECT_LT(sum_z2 / count, kMeanZ2High);
 }

@@ -251,7 +251,9 @@ std::string LimitsText(const Design& d) {
   if (d.prior_effects.empty()) return h;
   h += "<p>With one prior (or consider) sigma halved, the design's sigma_total would be:</p>\n"
        "<table><thead><tr><th>sigma halved</th>";
-  for (int k : d.wanted) h += "<th>" + XmlEscape(d.free_names[k]) + "</th>";
+  for (int k : d.wanted) {
+    h += "<th>" + XmlEscape(d.free_names[k]) + " (" + ShownUnit(d, k).unit + ")</th>";
+  }
   h += "</tr></thead><tbody>\n<tr><th>none (as designed)</th>";
   for (int k : d.wanted) {
     h += SigmaCell(d.design, k, ShownUnit(d, k).scale);

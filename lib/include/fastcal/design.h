@@ -63,12 +63,29 @@ enum class DesignCriterion {
 };
 const char* DesignCriterionName(DesignCriterion criterion);  // "A", "D"
 
+// Default margins of a designed pose: every cable's lower-end tension (N) and its
+// clearance from the reflector (m).
+inline constexpr double kDesignMinTensionN = 50e3;
+inline constexpr double kDesignReflectorClearanceM = 5.0;
+
 struct DesignOptions {
   // Where the cabin may go: the workspace's grid (1 deg off axis up to 40 deg, every 5 deg
   // of azimuth: 2881 positions), its focal attitude law, tension limits (none by default)
   // and statics checks (reflector clearance, model range), as `fastcal workspace`. The
-  // radial offset is not used (candidates are on the focal sphere).
-  WorkspaceOptions workspace;
+  // radial offset is not used (candidates are on the focal sphere). Two differences,
+  // margins: every lower-end tension at least kDesignMinTensionN and every cable
+  // kDesignReflectorClearanceM clear of the reflector. The optimum lies on the feasible
+  // set's edge, and the information there comes from cables near slack, whose sag moves
+  // by metres with a small error of the model: a design without them put a tilted pose
+  // with cable 1 at 27 kN, which a truth 1.5% heavier per cable took 0.6 m into the
+  // reflector; with 30 kN the simulation of a drawn truth still failed, with 50 kN none
+  // of 10 did (docs/design.md).
+  WorkspaceOptions workspace = [] {
+    WorkspaceOptions w;
+    w.min_tension_n = kDesignMinTensionN;
+    w.statics.min_reflector_clearance_m = kDesignReflectorClearanceM;
+    return w;
+  }();
   // Largest extra tilt of z' off the focal law (deg, in [0, 30]); 0: the law alone.
   double max_extra_tilt_deg = 0.0;
   // Number of tilt directions, evenly spaced about z' (>= 1); used when tilting.
