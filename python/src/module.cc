@@ -102,4 +102,5 @@ PYBIND11_MODULE(_fastcal, m) {
   BindStatics(m);
   BindData(m);
   BindCalibration(m);
+  BindDesign(m);
 }
