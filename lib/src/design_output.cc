@@ -246,8 +246,8 @@ std::string LimitsText(const Design& d) {
   std::string h =
       "<h2>What limits the design</h2>\n<p>The largest part of the wanted "
       "parameters' summed variance is <b>" +
-      XmlEscape(d.limiting_part) + "</b>: " + Fmt("%.0f", 100.0 * d.limiting_share) +
-      "% of it.</p>\n";
+      XmlEscape(d.limiting_part == "noise" ? "the tension noise of the data" : d.limiting_part) +
+      "</b>: " + Fmt("%.0f", 100.0 * d.limiting_share) + "% of it.</p>\n";
   if (d.prior_effects.empty()) return h;
   h += "<p>With one prior (or consider) sigma halved, the design's sigma_total would be:</p>\n"
        "<table><thead><tr><th>sigma halved</th>";
