@@ -9,6 +9,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <thread>
 
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/statics.h"
@@ -206,21 +207,36 @@ bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::V
   const Eigen::MatrixXd g = kwk + k * w * q + q * w * k;
   const Eigen::MatrixXd h = pr.consider_variance.asDiagonal() * kc.transpose() * w * k;
   // Per row: -x G x^T + 2 z H x^T; per candidate: the sum over its six rows. In chunks,
-  // so that the temporaries stay small (the rows of 40 000 candidates are ~40 MB).
+  // so that the temporaries stay small (the rows of 40 000 candidates are ~40 MB), the
+  // chunks shared by two threads (the gradient is most of a design's time).
   constexpr int kChunkCandidates = 512;
+  constexpr int kThreads = 2;
   gradient->resize(pr.candidates());
-  Eigen::MatrixXd xg, zh;
-  for (int c0 = 0; c0 < pr.candidates(); c0 += kChunkCandidates) {
-    const int count = std::min(kChunkCandidates, pr.candidates() - c0);
-    const auto x = pr.x_rows.middleRows(kRows * c0, kRows * count);
-    xg.noalias() = x * g;
-    Eigen::VectorXd per_row = -(xg.cwiseProduct(x)).rowwise().sum();
-    if (pr.q > 0) {
-      zh.noalias() = pr.z_rows.middleRows(kRows * c0, kRows * count) * h;
-      per_row += 2.0 * (zh.cwiseProduct(x)).rowwise().sum();
+  const int chunks = (pr.candidates() + kChunkCandidates - 1) / kChunkCandidates;
+  auto work = [&](int first_chunk) {
+    Eigen::MatrixXd xg, zh;
+    for (int chunk = first_chunk; chunk < chunks; chunk += kThreads) {
+      const int c0 = chunk * kChunkCandidates;
+      const int count = std::min(kChunkCandidates, pr.candidates() - c0);
+      const auto x = pr.x_rows.middleRows(kRows * c0, kRows * count);
+      xg.noalias() = x * g;
+      Eigen::VectorXd per_row = -(xg.cwiseProduct(x)).rowwise().sum();
+      if (pr.q > 0) {
+        zh.noalias() = pr.z_rows.middleRows(kRows * c0, kRows * count) * h;
+        per_row += 2.0 * (zh.cwiseProduct(x)).rowwise().sum();
+      }
+      for (int c = 0; c < count; ++c) {
+        (*gradient)[c0 + c] = per_row.segment(kRows * c, kRows).sum();
+      }
     }
-    for (int c = 0; c < count; ++c) (*gradient)[c0 + c] = per_row.segment(kRows * c, kRows).sum();
+  };
+  if (chunks < kThreads) {
+    work(0);
+    return true;
   }
+  std::thread other(work, 1);
+  work(0);
+  other.join();
   return true;
 }
 
