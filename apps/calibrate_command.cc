@@ -135,8 +135,6 @@ attitude and, when the data has it, the planned attitude. The model's sensor gai
 bias (if any) are applied: predicted reading = gain * tension + bias.
 )";
 
-// Writes the given files into a fresh temporary sibling of `dir`, then renames it to
-// `dir`; on any failure removes the temporary directory.
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
 // replace there.
 const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "report.html",
@@ -147,63 +145,6 @@ const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "
 // CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
 bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
   return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
-}
-
-bool WriteDirectoryAtomically(const std::string& dir,
-                              const std::vector<std::pair<std::string, std::string>>& files,
-                              const std::function<bool(const std::string&, std::string*)>& extra,
-                              const std::vector<std::string>& outputs, std::string* error) {
-  if (!CheckOutputDirectory("out", dir, error, FLAGS_force ? &outputs : nullptr)) return false;
-  std::error_code ec;
-  const fs::path target = ResolveOutputPath(dir);
-  const fs::path parent = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  if (!fs::exists(parent, ec) && !fs::create_directories(parent, ec)) {
-    *error = "--out=" + internal::Escape(dir) + ": cannot create its directory '" +
-             internal::Escape(parent.string()) + "': " + ec.message();
-    return false;
-  }
-  const fs::path tmp =
-      parent / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
-  fs::remove_all(tmp, ec);
-  // Failures name the user's --out, not the temporary sibling.
-  const std::string where = "--out=" + internal::Escape(dir) + ": ";
-  if (!fs::create_directory(tmp, ec)) {
-    *error =
-        where + "cannot create the temporary directory '" + tmp.string() + "': " + ec.message();
-    return false;
-  }
-  auto fail = [&](std::string why) {
-    fs::remove_all(tmp, ec);
-    for (size_t at = why.find(tmp.string()); at != std::string::npos;
-         at = why.find(tmp.string(), at + dir.size())) {
-      why.replace(at, tmp.string().size(), dir);
-    }
-    *error = why.rfind("--out=", 0) == 0 ? why : where + why;
-    return false;
-  };
-  for (const auto& [name, content] : files) {
-    std::string why;
-    if (!WriteOutput((tmp / name).string(), content, &why)) return fail(why);
-  }
-  std::string why;
-  if (extra && !extra(tmp.string(), &why)) return fail(why);
-  // An existing target is empty, or (--force) a previous run's results: moved aside,
-  // and removed only once the new results are in place.
-  const fs::path previous =
-      parent / ("." + target.filename().string() + ".old." + std::to_string(::getpid()));
-  const bool replacing = fs::exists(target, ec);
-  if (replacing) {
-    fs::remove_all(previous, ec);
-    fs::rename(target, previous, ec);
-    if (ec) return fail("cannot move the previous results aside: " + ec.message());
-  }
-  fs::rename(tmp, target, ec);
-  if (ec) {
-    if (replacing) fs::rename(previous, target, ec);
-    return fail("cannot move the results into place: " + ec.message());
-  }
-  if (replacing) fs::remove_all(previous, ec);
-  return true;
 }
 
 // One row per sample: measured and each variant's predicted tensions; with a calibration
@@ -656,7 +597,7 @@ bool WriteOutDirectory(const char* command,
           [&](const std::string& dir, std::string* why) {
             return WriteReportFiles(dir, report, why);
           },
-          outputs, &error)) {
+          FLAGS_force ? &outputs : nullptr, &error)) {
     return true;
   }
   PrintError(command, error);

@@ -15,6 +15,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <sstream>
 
@@ -453,6 +454,66 @@ std::string FormatDouble(double value, int significant_digits) {
   char buf[48];
   std::snprintf(buf, sizeof(buf), "%.*g", significant_digits, value);
   return buf;
+}
+
+// Writes the given files into a fresh temporary sibling of `dir`, then renames it to
+// `dir`; on any failure removes the temporary directory.
+bool WriteDirectoryAtomically(const std::string& dir,
+                              const std::vector<std::pair<std::string, std::string>>& files,
+                              const std::function<bool(const std::string&, std::string*)>& extra,
+                              const std::vector<std::string>* replaceable, std::string* error) {
+  if (!CheckOutputDirectory("out", dir, error, replaceable)) return false;
+  std::error_code ec;
+  const std::filesystem::path target = ResolveOutputPath(dir);
+  const std::filesystem::path parent =
+      target.has_parent_path() ? target.parent_path() : std::filesystem::path(".");
+  if (!std::filesystem::exists(parent, ec) && !std::filesystem::create_directories(parent, ec)) {
+    *error = "--out=" + internal::Escape(dir) + ": cannot create its directory '" +
+             internal::Escape(parent.string()) + "': " + ec.message();
+    return false;
+  }
+  const std::filesystem::path tmp =
+      parent / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
+  std::filesystem::remove_all(tmp, ec);
+  // Failures name the user's --out, not the temporary sibling.
+  const std::string where = "--out=" + internal::Escape(dir) + ": ";
+  if (!std::filesystem::create_directory(tmp, ec)) {
+    *error =
+        where + "cannot create the temporary directory '" + tmp.string() + "': " + ec.message();
+    return false;
+  }
+  auto fail = [&](std::string why) {
+    std::filesystem::remove_all(tmp, ec);
+    for (size_t at = why.find(tmp.string()); at != std::string::npos;
+         at = why.find(tmp.string(), at + dir.size())) {
+      why.replace(at, tmp.string().size(), dir);
+    }
+    *error = why.rfind("--out=", 0) == 0 ? why : where + why;
+    return false;
+  };
+  for (const auto& [name, content] : files) {
+    std::string why;
+    if (!WriteOutput((tmp / name).string(), content, &why)) return fail(why);
+  }
+  std::string why;
+  if (extra && !extra(tmp.string(), &why)) return fail(why);
+  // An existing target is empty, or (--force) a previous run's results: moved aside,
+  // and removed only once the new results are in place.
+  const std::filesystem::path previous =
+      parent / ("." + target.filename().string() + ".old." + std::to_string(::getpid()));
+  const bool replacing = std::filesystem::exists(target, ec);
+  if (replacing) {
+    std::filesystem::remove_all(previous, ec);
+    std::filesystem::rename(target, previous, ec);
+    if (ec) return fail("cannot move the previous results aside: " + ec.message());
+  }
+  std::filesystem::rename(tmp, target, ec);
+  if (ec) {
+    if (replacing) std::filesystem::rename(previous, target, ec);
+    return fail("cannot move the results into place: " + ec.message());
+  }
+  if (replacing) std::filesystem::remove_all(previous, ec);
+  return true;
 }
 
 }  // namespace fastcal::cli

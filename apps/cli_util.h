@@ -4,6 +4,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <set>
 #include <string>
 #include <utility>
@@ -126,6 +127,16 @@ bool WriteOutput(const std::string& path, const std::string& content, std::strin
 bool WriteOutputsTogether(const std::vector<std::pair<std::string, std::string>>& files,
                           std::string* error);
 
+// Writes the given (name, content) files and then `extra` (may be empty; it writes into
+// the directory it is given) into a fresh temporary sibling of `dir`, then renames it to
+// `dir` (calibrate, evaluate, design --out); on any failure removes the temporary
+// directory and names --out=<dir> in *error. `dir` must pass CheckOutputDirectory, with
+// `replaceable` (may be null) the files a previous run may have left there (--force):
+// that run's directory is then moved aside and removed once the new one is in place.
+bool WriteDirectoryAtomically(const std::string& dir,
+                              const std::vector<std::pair<std::string, std::string>>& files,
+                              const std::function<bool(const std::string&, std::string*)>& extra,
+                              const std::vector<std::string>* replaceable, std::string* error);
 // "fastcal <command>: <message>" on stderr.
 void PrintError(const std::string& command, const std::string& message);
 

@@ -10,6 +10,7 @@
 #include "cli_util.h"
 #include "fastcal/pose.h"
 #include "fastcal/statics.h"
+#include "fastcal/workspace.h"
 
 namespace fastcal::cli {
 
@@ -18,6 +19,7 @@ int RunCalibrate(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
 int RunWorkspace(int argc, char** argv);
+int RunDesign(int argc, char** argv);
 
 // Positions of the trajectory `kind` (line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.
@@ -47,6 +49,10 @@ bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
 bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitude_law,
                               const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                               std::string* error);
+
+// The workspace's grid, focal law, tension limits and statics checks from its flags
+// (workspace, design); false with the flags named when invalid.
+bool WorkspaceOptionsFromFlags(WorkspaceOptions* options, std::string* error);
 
 // Sets the model-range limits of `options` from --max-strain, --max-length-ratio and
 // --reflector-clearance (solve, workspace); false with the flags named when invalid.

@@ -28,6 +28,8 @@ Commands:
   simulate   synthetic telemetry from a "truth" model along a trajectory, with noise
   workspace  where the cabin can go with every cable within tension limits: CSV and an
              HTML map of the focal-sphere cap
+  design     the calibration survey that determines the wanted parameters best: poses,
+             samples per pose and flight order, with predicted sigma_total
 
 Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
 )";
@@ -55,6 +57,7 @@ int main(int argc, char** argv) {
     if (command == "evaluate") return RunEvaluate(argc, argv);
     if (command == "simulate") return RunSimulate(argc, argv);
     if (command == "workspace") return RunWorkspace(argc, argv);
+    if (command == "design") return RunDesign(argc, argv);
   } catch (const std::bad_alloc&) {
     // Outputs are written last and atomically: nothing is left behind.
     std::cerr << "fastcal " << command

@@ -100,52 +100,6 @@ const std::set<std::string> kFlags = {"model",
                                       "html",
                                       "force"};
 
-bool SetOptionsFromFlags(WorkspaceOptions* o, std::string* error) {
-  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &o->grid.focal_centre_m, error)) {
-    return false;
-  }
-  o->grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
-  o->grid.off_axis_step_deg =
-      FlagGiven("off-axis-step-deg") ? FLAGS_off_axis_step_deg : kOffAxisStepDeg;
-  o->grid.azimuth_step_deg =
-      FlagGiven("azimuth-step-deg") ? FLAGS_azimuth_step_deg : kAzimuthStepDeg;
-  o->grid.focal_radius_m = FLAGS_focal_radius;
-  o->attitude_law.focal_centre_m = o->grid.focal_centre_m;
-  o->attitude_law.tilt_fraction = FLAGS_tilt_fraction;
-  o->radial_offset_m = FLAGS_radial_offset;
-  // Checked here too, so that the message gives the flags' own numbers (kN).
-  if (!(FLAGS_min_tension_kn >= 0.0) || !std::isfinite(FLAGS_min_tension_kn)) {
-    *error =
-        "--min-tension-kn must be >= 0 and finite (got " + FormatDouble(FLAGS_min_tension_kn) + ")";
-    return false;
-  }
-  if (!(FLAGS_max_tension_kn > FLAGS_min_tension_kn)) {
-    *error = "--max-tension-kn must be above --min-tension-kn (got " +
-             FormatDouble(FLAGS_max_tension_kn) + " <= " + FormatDouble(FLAGS_min_tension_kn) + ")";
-    return false;
-  }
-  o->min_tension_n = FLAGS_min_tension_kn * kNPerKn;
-  o->max_tension_n = FLAGS_max_tension_kn * kNPerKn;
-  if (!ParseStaticsMethod(FLAGS_method, &o->statics.method)) {
-    *error = "--method must be exact, aas-refined or aas, got '" + FLAGS_method + "'";
-    return false;
-  }
-  if (!ModelRangeFromFlags(&o->statics, error)) return false;
-  if (o->IsValid(error)) return true;
-  *error = WithFlagNames(WithTrajectoryFlagNames(*error),
-                         {{"grid.max_off_axis_deg", "--max-off-axis-deg"},
-                          {"grid.off_axis_step_deg", "--off-axis-step-deg"},
-                          {"grid.azimuth_step_deg", "--azimuth-step-deg"},
-                          {"grid.focal_radius_m", "--focal-radius"},
-                          {"grid.focal_centre_m", "--focal-centre"},
-                          {"radial_offset_m", "--radial-offset"},
-                          {"min_tension_n", "--min-tension-kn"},
-                          {"max_tension_n", "--max-tension-kn"},
-                          {"attitude_law.focal_centre_m", "--focal-centre"},
-                          {"attitude_law.tilt_fraction", "--tilt-fraction"}});
-  return false;
-}
-
 // Every node, on each layer, where the cabin can be (the limits of solve's trajectories
 // and of the data files): a focal radius of 1e6 m is a typo, not a map.
 bool CheckGridPlausible(const WorkspaceOptions& o, std::string* error) {
@@ -202,6 +156,52 @@ std::string Summary(const WorkspaceMap& map) {
 
 }  // namespace
 
+bool WorkspaceOptionsFromFlags(WorkspaceOptions* o, std::string* error) {
+  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &o->grid.focal_centre_m, error)) {
+    return false;
+  }
+  o->grid.max_off_axis_deg = FLAGS_max_off_axis_deg;
+  o->grid.off_axis_step_deg =
+      FlagGiven("off-axis-step-deg") ? FLAGS_off_axis_step_deg : kOffAxisStepDeg;
+  o->grid.azimuth_step_deg =
+      FlagGiven("azimuth-step-deg") ? FLAGS_azimuth_step_deg : kAzimuthStepDeg;
+  o->grid.focal_radius_m = FLAGS_focal_radius;
+  o->attitude_law.focal_centre_m = o->grid.focal_centre_m;
+  o->attitude_law.tilt_fraction = FLAGS_tilt_fraction;
+  o->radial_offset_m = FLAGS_radial_offset;
+  // Checked here too, so that the message gives the flags' own numbers (kN).
+  if (!(FLAGS_min_tension_kn >= 0.0) || !std::isfinite(FLAGS_min_tension_kn)) {
+    *error =
+        "--min-tension-kn must be >= 0 and finite (got " + FormatDouble(FLAGS_min_tension_kn) + ")";
+    return false;
+  }
+  if (!(FLAGS_max_tension_kn > FLAGS_min_tension_kn)) {
+    *error = "--max-tension-kn must be above --min-tension-kn (got " +
+             FormatDouble(FLAGS_max_tension_kn) + " <= " + FormatDouble(FLAGS_min_tension_kn) + ")";
+    return false;
+  }
+  o->min_tension_n = FLAGS_min_tension_kn * kNPerKn;
+  o->max_tension_n = FLAGS_max_tension_kn * kNPerKn;
+  if (!ParseStaticsMethod(FLAGS_method, &o->statics.method)) {
+    *error = "--method must be exact, aas-refined or aas, got '" + FLAGS_method + "'";
+    return false;
+  }
+  if (!ModelRangeFromFlags(&o->statics, error)) return false;
+  if (o->IsValid(error)) return true;
+  *error = WithFlagNames(WithTrajectoryFlagNames(*error),
+                         {{"grid.max_off_axis_deg", "--max-off-axis-deg"},
+                          {"grid.off_axis_step_deg", "--off-axis-step-deg"},
+                          {"grid.azimuth_step_deg", "--azimuth-step-deg"},
+                          {"grid.focal_radius_m", "--focal-radius"},
+                          {"grid.focal_centre_m", "--focal-centre"},
+                          {"radial_offset_m", "--radial-offset"},
+                          {"min_tension_n", "--min-tension-kn"},
+                          {"max_tension_n", "--max-tension-kn"},
+                          {"attitude_law.focal_centre_m", "--focal-centre"},
+                          {"attitude_law.tilt_fraction", "--tilt-fraction"}});
+  return false;
+}
+
 int RunWorkspace(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
@@ -230,7 +230,7 @@ int RunWorkspace(int argc, char** argv) {
   CableRobot robot;
   WorkspaceOptions options;
   if (!LoadModelFlag("model", FLAGS_model, &robot, &error) ||
-      !SetOptionsFromFlags(&options, &error) || !CheckGridPlausible(options, &error)) {
+      !WorkspaceOptionsFromFlags(&options, &error) || !CheckGridPlausible(options, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

@@ -447,7 +447,7 @@ TEST_F(CliTest, BadValuesNameTheFlagNotTheOptionField) {
 
 // Every command starts the same way: --help, then the flag allow-list.
 TEST_F(CliTest, EveryCommandHasHelpAndRejectsUnknownFlags) {
-  for (const char* command : {"solve", "calibrate", "evaluate", "simulate"}) {
+  for (const char* command : {"solve", "calibrate", "evaluate", "simulate", "design"}) {
     CommandResult r = Fastcal(std::string(command) + " --help");
     EXPECT_EQ(r.code, 0) << command;
     EXPECT_NE(r.output.find(std::string("fastcal ") + command + ":"), std::string::npos)
@@ -1328,6 +1328,49 @@ TEST_F(CliTest, FlagsAndOutputsFromTheReviewGiveClearMessages) {
   EXPECT_TRUE(fs::exists(Path("empty") + "/report.html"));
   EXPECT_TRUE(fs::exists(Path("real") + "/report.html"));
   EXPECT_TRUE(fs::is_symlink(Path("to_real")));
+}
+
+// fastcal design writes poses that simulate reads, and refuses bad input with a message
+// and no output (issue 21).
+TEST_F(CliTest, DesignWritesPosesSimulateReadsAndRefusesBadInput) {
+  const std::string spec = Source() + "/calibration_data/spec_mass_centre_density.yaml";
+  const std::string grid = " --off-axis-step-deg=10 --azimuth-step-deg=30";
+  const std::string out = Path("design");
+  CommandResult r = Fastcal("design --spec=" + spec + " --samples=40 --max-extra-tilt-deg=5" +
+                            grid + " --speed-m-per-s=0.5 --out=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("predicted sigma_total (design | paper's circle | random survey)"),
+            std::string::npos)
+      << r.output;
+  for (const char* file : {"poses.csv", "design.json", "design.html"}) {
+    EXPECT_TRUE(fs::exists(out + "/" + file)) << file;
+  }
+  EXPECT_NE(ReadFile(out + "/design.json").find("\"sigma_total\""), std::string::npos);
+  r = Fastcal("simulate --poses=" + out + "/poses.csv --out=" + Path("sim.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = Fastcal("solve --poses=" + out + "/poses.csv --output=" + Path("solve.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::vector<ExpectedRun> bad = {
+      {"design --spec=" + spec + " --samples=3" + grid + " --out=" + Path("never"), 2,
+       "3 samples cannot determine the spec's 4 free parameters"},
+      {"design --spec=" + spec + " --samples=40" + grid + " --minutes=0.5 --speed-m-per-s=1" +
+           " --out=" + Path("never"),
+       2, "infeasible time budget"},
+      {"design --spec=" + spec + " --samples=40" + grid + " --minutes=5 --out=" + Path("never"), 2,
+       "--minutes needs --speed-m-per-s"},
+      {"design --spec=" + spec + " --samples=40" + grid + " --criterion=E --out=" + Path("never"),
+       2, "--criterion must be A or D"},
+      {"design --spec=" + spec + " --samples=40" + grid +
+           " --parameters=cabin_mass_kg --out=" + Path("never"),
+       2, "'cabin_mass_kg' is not a free parameter"},
+      {"design --spec=" + spec + " --out=" + Path("never"), 2, "--samples=N"},
+  };
+  for (const ExpectedRun& c : bad) RunBoundedAndExpect(c);
+  Write("nothing_free.yaml", "parameters:\n  mass_centre_m: {x: {free: false}}\n");
+  RunBoundedAndExpect({"design --spec=" + Path("nothing_free.yaml") + " --samples=40" + grid +
+                           " --out=" + Path("never"),
+                       2, "frees no parameter"});
+  EXPECT_FALSE(fs::exists(Path("never")));
 }
 
 }  // namespace

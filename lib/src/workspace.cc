@@ -147,6 +147,14 @@ bool ComputeWorkspace(const CableRobot& robot, const WorkspaceOptions& options, 
   return true;
 }
 
+void JudgeWorkspacePose(const CableRobot& robot, const Pose& pose, const WorkspaceOptions& options,
+                        StaticsSolution* solution, WorkspaceNode* node) {
+  *node = WorkspaceNode();
+  node->pose = pose;
+  SolveStatics(robot, pose, options.statics, solution);
+  Judge(*solution, options, node);
+}
+
 std::string WorkspaceNodeCode(const WorkspaceNode& node) {
   switch (node.verdict) {
     case WorkspaceVerdict::kFeasible:

@@ -54,6 +54,7 @@ __all__ = [
     "__version__",
     "arc",
     "calibrate",
+    "design",
     "evaluate",
     "focal_attitude",
     "focal_grid",
@@ -537,3 +538,86 @@ def evaluate(
     if not isinstance(data, Dataset):
         data = read_dataset(data)
     return _fastcal.evaluate(model, data, method)
+
+
+def design(
+    spec: Union[PathLike, Mapping[str, Any]],
+    samples: int,
+    model: Optional[Union[Model, PathLike]] = None,
+    *,
+    max_extra_tilt_deg: float = 0.0,
+    max_extra_yaw_deg: float = 0.0,
+    criterion: str = "A",
+    parameters: Sequence[str] = (),
+    seed: int = 1,
+    speed_m_per_s: float = 0.0,
+    sample_interval_s: float = 1.0,
+    minutes: float = 0.0,
+    min_tension_kN: Optional[float] = None,
+    max_tension_kN: Optional[float] = None,
+    reflector_clearance_m: Optional[float] = None,
+    max_off_axis_deg: Optional[float] = None,
+    off_axis_step_deg: Optional[float] = None,
+    azimuth_step_deg: Optional[float] = None,
+) -> Dict[str, Any]:
+    """Designs a calibration survey, as `fastcal design` does without writing files.
+
+    Chooses `samples` samples among the feasible poses of the focal-sphere cap (with
+    attitudes up to max_extra_tilt_deg tilted and max_extra_yaw_deg turned off the focal
+    law) so that a calibration with `spec` determines the wanted parameters best, and
+    orders them into a short path (docs/design.md).
+
+    Args:
+        spec: a calibration spec file, or the same content as a dict (see calibrate).
+        samples: the survey's samples (at least the spec's free parameters).
+        model: the model (a Model or a model file); None for Model.nominal().
+        criterion: 'A' (sum of the wanted variances) or 'D' (their log-determinant).
+        parameters: the wanted parameters; empty: the free ones without a prior.
+        seed: draws the random survey the design is compared with.
+        speed_m_per_s, sample_interval_s: the path's duration; minutes: a time budget
+            (needs a speed).
+        min_tension_kN, max_tension_kN, reflector_clearance_m: the candidates' limits;
+            None: the design's defaults (50 kN, none, 5 m).
+        max_off_axis_deg, off_axis_step_deg, azimuth_step_deg: the grid; None: the
+            workspace's (40, 1, 5 deg).
+
+    Returns:
+        A dict: 'poses', a (samples, 6) array of x_m, y_m, z_m, roll_deg, pitch_deg,
+        yaw_deg in flight order (what poses.csv holds); 'stops' (dicts: samples,
+        position_m, extra_tilt_deg, tilt_direction_deg, extra_yaw_deg); 'wanted';
+        'design', 'circle', 'random': {'ok', 'note', 'criterion', 'sigma_total':
+        {name: SI value}}; 'path_length_m', 'duration_s' (nan without a speed),
+        'candidates', 'rejected_candidates', 'limiting_part', 'limiting_share',
+        'prior_halved' ({group: {wanted name: sigma_total with its sigma halved}}).
+
+    Raises:
+        InputError: a bad spec or option, nothing free, fewer samples than free
+            parameters, no feasible candidate, an infeasible time budget.
+    """
+    if model is None:
+        model = Model.nominal()
+    elif not isinstance(model, Model):
+        model = Model.load(os.fspath(model))
+    spec_text, is_text, source = _spec_argument(spec)
+    options = {
+        "samples": int(samples),
+        "max_extra_tilt_deg": float(max_extra_tilt_deg),
+        "max_extra_yaw_deg": float(max_extra_yaw_deg),
+        "criterion": str(criterion).upper(),
+        "parameters": [str(p) for p in parameters],
+        "seed": int(seed),
+        "speed_m_per_s": float(speed_m_per_s),
+        "sample_interval_s": float(sample_interval_s),
+        "time_budget_s": 60.0 * float(minutes),
+        "min_tension_kN": min_tension_kN,
+        "max_tension_kN": max_tension_kN,
+        "reflector_clearance_m": reflector_clearance_m,
+        "max_off_axis_deg": max_off_axis_deg,
+        "off_axis_step_deg": off_axis_step_deg,
+        "azimuth_step_deg": azimuth_step_deg,
+    }
+    try:
+        return _fastcal.design(model, spec_text, is_text, source, options)
+    except InputError as error:
+        message = re.sub(rf"^{re.escape(_DICT_SPEC)}:\d+: ", f"{_DICT_SPEC}: ", str(error))
+        raise InputError(message) from None

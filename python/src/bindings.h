@@ -77,6 +77,7 @@ void BindModel(py::module_& m);
 void BindStatics(py::module_& m);
 void BindData(py::module_& m);
 void BindCalibration(py::module_& m);
+void BindDesign(py::module_& m);
 
 }  // namespace fastcal::python
 

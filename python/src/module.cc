@@ -107,4 +107,5 @@ PYBIND11_MODULE(_fastcal, m) {
   BindStatics(m);
   BindData(m);
   BindCalibration(m);
+  BindDesign(m);
 }

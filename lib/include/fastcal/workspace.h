@@ -89,6 +89,11 @@ struct WorkspaceMap {
 bool ComputeWorkspace(const CableRobot& robot, const WorkspaceOptions& options, WorkspaceMap* map,
                       std::string* error);
 
+// Solves and judges one pose as ComputeWorkspace judges a node (statics ok, tensions
+// within the limits); `solution` is the warm start in and the solution out. The node's
+// grid angles and radial offset are left at 0 (design.h judges tilted poses with it).
+void JudgeWorkspacePose(const CableRobot& robot, const Pose& pose, const WorkspaceOptions& options,
+                        StaticsSolution* solution, WorkspaceNode* node);
 // A node's short code: "feasible", "below_min_tension", "above_max_tension", or the
 // statics' status code (StaticsStatusName).
 std::string WorkspaceNodeCode(const WorkspaceNode& node);

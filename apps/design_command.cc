@@ -1,0 +1,216 @@
+// `fastcal design`: where to put the cabin, how many samples at each stop and in what
+// order, for a calibration with a given spec to learn the most (design.h).
+#include <gflags/gflags.h>
+
+#include <cmath>
+#include <iostream>
+#include <limits>
+#include <sstream>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/design.h"
+#include "fastcal/internal/quote.h"
+#include "fastcal/version.h"
+
+// Shared with the other commands.
+DECLARE_string(spec);
+DECLARE_string(out);
+DECLARE_string(model);
+DECLARE_int32(samples);
+DECLARE_uint64(seed);
+DECLARE_double(interval_s);
+
+DEFINE_double(max_extra_tilt_deg, 0.0, "design: largest tilt of z' off the focal law (deg).");
+DEFINE_double(max_extra_yaw_deg, 0.0, "design: largest turn about z' off the focal law (deg).");
+DEFINE_double(speed_m_per_s, 0.0, "design: cabin speed between stops (m/s); 0: no duration.");
+DEFINE_double(minutes, 0.0, "design: time budget of the survey (min); 0: none.");
+DEFINE_string(criterion, "A", "design: A (sum of variances) or D (log-determinant).");
+DEFINE_string(parameters, "", "design: wanted parameters, comma-separated; default: see --help.");
+
+namespace fastcal::cli {
+namespace {
+
+constexpr char kCommand[] = "design";
+constexpr double kSecondsPerMinute = 60.0;
+
+const char kHelp[] =
+    R"(fastcal design: the calibration survey that determines the wanted parameters best.
+
+Usage:
+  fastcal design --spec=SPEC.yaml --samples=N --out=DIR [--model=MODEL.yaml]
+                 [--max-extra-tilt-deg=A] [--max-extra-yaw-deg=B] [--criterion=A|D]
+                 [--parameters=NAME,...] [--seed=1] [--speed-m-per-s=V] [--minutes=T]
+
+Chooses N samples among candidate poses (the workspace grid of the focal-sphere cap at
+the focal attitude law, and with --max-extra-tilt-deg / --max-extra-yaw-deg also tilted
+up to A and turned up to B degrees off the law; each checked as `fastcal workspace`
+checks a node) to minimise the predicted uncertainty of the wanted parameters, from the
+calibration's own linearisation and noise model (the spec's noise, priors, free
+nuisance parameters marginalised, consider parameters included), then orders the stops
+into a short path (nearest neighbour + 2-opt). Deterministic for a given --seed (which
+draws the random survey compared against).
+
+  --spec=SPEC.yaml       the calibration spec the survey is for (docs/calibration.md)
+  --samples=N            samples in the survey (>= the spec's free parameters)
+  --out=DIR              new or empty directory: poses.csv, design.json, design.html
+  --model=MODEL.yaml     default: the nominal FAST model
+  --criterion=A          A: sum of the wanted variances; D: their log-determinant
+  --parameters=...       wanted parameters, e.g. mass_centre_m.x,mass_centre_m.z;
+                         default: the free parameters without a prior (those with a
+                         prior are nuisance), or all free ones when all have priors
+  --max-extra-tilt-deg=0 --max-extra-yaw-deg=0   attitudes off the focal law
+  --speed-m-per-s=0      cabin speed between stops; gives the survey's duration
+  --interval-s=1         time per sample (s)
+  --minutes=0            time budget; needs --speed-m-per-s. Over it, the design drops
+                         its least useful stops (their samples dwell at the others)
+Grid and limits, as fastcal workspace: --max-off-axis-deg=40 --off-axis-step-deg=1
+  --azimuth-step-deg=5 --focal-radius=160 --focal-centre=0,0,300 --tilt-fraction=0.41
+  --max-tension-kn=inf --max-strain=0.05 --max-length-ratio=1.5, and with the design's
+  own margins (the optimum lies on the workspace's edge, where cables near slack sag by
+  metres for a small error of the model): --min-tension-kn=50 --reflector-clearance=5
+
+Outputs (written only when everything succeeded):
+  poses.csv    x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg, one row per sample in flight
+               order: read by `fastcal simulate --poses` and `fastcal solve --poses`
+  design.json  the stops, the path, and parameters[]: {name, sigma_total} predicted for
+               the design, the paper's circle and a random survey of N samples
+  design.html  the stops and path on the cap, the predicted sigmas side by side, what
+               limits the design and what a better prior would buy
+
+Example:
+  fastcal design --spec=calibration_data/spec_realistic.yaml --samples=360 \
+      --max-extra-tilt-deg=5 --max-extra-yaw-deg=10 --speed-m-per-s=0.5 --out=out/design
+)";
+
+const std::set<std::string> kFlags = {"spec",
+                                      "out",
+                                      "model",
+                                      "samples",
+                                      "seed",
+                                      "tilt-fraction",
+                                      "focal-centre",
+                                      "max-off-axis-deg",
+                                      "off-axis-step-deg",
+                                      "azimuth-step-deg",
+                                      "focal-radius",
+                                      "min-tension-kn",
+                                      "max-tension-kn",
+                                      "interval-s",
+                                      "max-extra-tilt-deg",
+                                      "max-extra-yaw-deg",
+                                      "speed-m-per-s",
+                                      "minutes",
+                                      "criterion",
+                                      "parameters",
+                                      "max-strain",
+                                      "max-length-ratio",
+                                      "reflector-clearance"};
+
+bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
+  // The candidates' grid and limits exactly as `fastcal workspace` reads them.
+  if (!WorkspaceOptionsFromFlags(&o->workspace, error)) return false;
+  // The design's margins unless given (design.h: the optimum lies on the edge).
+  if (!FlagGiven("reflector-clearance")) {
+    o->workspace.statics.min_reflector_clearance_m = kDesignReflectorClearanceM;
+  }
+  if (!FlagGiven("min-tension-kn")) o->workspace.min_tension_n = kDesignMinTensionN;
+  o->max_extra_tilt_deg = FLAGS_max_extra_tilt_deg;
+  o->max_extra_yaw_deg = FLAGS_max_extra_yaw_deg;
+  o->samples = FLAGS_samples;
+  o->seed = FLAGS_seed;
+  o->speed_m_per_s = FLAGS_speed_m_per_s;
+  o->sample_interval_s = FLAGS_interval_s;
+  if (!(FLAGS_minutes >= 0.0) || !std::isfinite(FLAGS_minutes)) {
+    *error = "--minutes must be >= 0 and finite (got " + FormatDouble(FLAGS_minutes) + ")";
+    return false;
+  }
+  o->time_budget_s = FLAGS_minutes * kSecondsPerMinute;
+  if (FLAGS_criterion == "A" || FLAGS_criterion == "a") {
+    o->criterion = DesignCriterion::kA;
+  } else if (FLAGS_criterion == "D" || FLAGS_criterion == "d") {
+    o->criterion = DesignCriterion::kD;
+  } else {
+    *error = "--criterion must be A or D, got " + internal::Quote(FLAGS_criterion);
+    return false;
+  }
+  std::stringstream names(FLAGS_parameters);
+  for (std::string name; std::getline(names, name, ',');) {
+    if (!name.empty()) o->wanted.push_back(name);
+  }
+  if (o->IsValid(error)) return true;
+  *error = WithFlagNames(WithTrajectoryFlagNames(*error),
+                         {{"max_extra_tilt_deg", "--max-extra-tilt-deg"},
+                          {"max_extra_yaw_deg", "--max-extra-yaw-deg"},
+                          {"samples", "--samples"},
+                          {"speed_m_per_s", "--speed-m-per-s"},
+                          {"sample_interval_s", "--interval-s"},
+                          {"time_budget_s", "--minutes"}});
+  return false;
+}
+
+std::string Summary(const Design& d) {
+  std::ostringstream s;
+  s << "fastcal design: " << d.options.samples << " samples at " << d.stops.size() << " stops from "
+    << d.candidates.size() << " feasible candidates (" << d.rejected_candidates
+    << " infeasible); path " << FormatDouble(d.path_length_m, 5) << " m";
+  if (d.options.speed_m_per_s > 0.0) {
+    s << ", " << FormatDouble(d.duration_s / kSecondsPerMinute, 4) << " min";
+  }
+  s << "\n  predicted sigma_total (design | paper's circle | random survey):";
+  for (int k : d.wanted) {
+    auto sig = [k](const DesignPrediction& p) {
+      return p.ok ? FormatDouble(p.budget.parameters[k].total, 4) : std::string("n/a");
+    };
+    s << "\n    " << d.free_names[k] << ": " << sig(d.design) << " | " << sig(d.circle) << " | "
+      << sig(d.random);
+  }
+  s << "\n  limited by " << d.limiting_part << " (" << FormatDouble(100.0 * d.limiting_share, 3)
+    << "% of the wanted variance)";
+  return s.str();
+}
+
+}  // namespace
+
+int RunDesign(int argc, char** argv) {
+  int exit_code = 0;
+  if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+  std::string error;
+  if (FLAGS_spec.empty() || FLAGS_out.empty() || !FlagGiven("samples")) {
+    PrintError(kCommand,
+               "--spec=SPEC.yaml, --samples=N and --out=DIR are required (see "
+               "fastcal design --help)");
+    return kExitUsage;
+  }
+  CableRobot robot;
+  CalibrationSpec spec;
+  DesignOptions options;
+  if (!CheckOutputDirectory("out", FLAGS_out, &error) ||
+      !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
+      !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(robot.anchor_points_cabin_m.size()), &spec,
+                           &error) ||
+      !SetOptionsFromFlags(&options, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  Design design;
+  if (!DesignSurvey(robot, spec, options, &design, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  const std::string provenance = CommandLine(argc, argv) + "\nfastcal " + FASTCAL_VERSION +
+                                 ", model " + ModelName(FLAGS_model);
+  if (!WriteDirectoryAtomically(FLAGS_out,
+                                {{"poses.csv", DesignPosesCsv(design, provenance)},
+                                 {"design.json", DesignJson(design, provenance)},
+                                 {"design.html", DesignHtml(design, robot, provenance)}},
+                                {}, nullptr, &error)) {
+    PrintError(kCommand, error);
+    return kExitFailure;
+  }
+  std::cerr << Summary(design) << "\n";
+  return 0;
+}
+
+}  // namespace fastcal::cli

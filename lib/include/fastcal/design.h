@@ -1,0 +1,210 @@
+// Design of a calibration survey (optimal experimental design): which poses, how many
+// samples at each, and in what order to fly them, so that a calibration with a given spec
+// determines the wanted parameters best.
+//
+// Information of a candidate pose i (docs/design.md; Fedorov 1972, Atkinson, Donev and
+// Tobias 2007 ch. 9-12): J_i = [J_x,i  J_c,i], the whitened Jacobian (6 rows: the six
+// readings over the spec's noise sigma at the initial model's predicted reading) with
+// respect to the n free parameters x and the q consider parameters c, from the very
+// residual the calibration fits (internal/calibration_model.h, TensionResidual). A design
+// with n_i samples at candidate i has
+//
+//   M = sum_i n_i J_x,i^T J_x,i + Lambda       (Lambda: the free parameters' priors)
+//   C = sum_i n_i J_x,i^T J_c,i
+//   P_total = M^-1 + M^-1 C diag(sigma_c^2) C^T M^-1
+//
+// the calibration's uncertainty budget (uncertainty.h) for white residuals at the stated
+// noise (misfit factor 1, no correlation widening): nuisance parameters marginalised (the
+// wanted block of the full inverse), priors as information, consider parameters' part
+// included. Criterion on the wanted block P_w: A-optimal tr(P_w) (each variance divided
+// by its reference value when the wanted parameters' units differ), D-optimal
+// log det(P_w). Its gradient in n_i is
+//
+//   df/dn_i = -tr(J_x,i G J_x,i^T) + 2 tr(J_c,i H J_x,i^T),
+//   G = K W K + K W Q + Q W K,  H = Sigma_c C^T K W K,  K = M^-1,  Q = K C Sigma_c C^T K
+//
+// with W the criterion's weight on P (A: diag of the wanted weights; D: P_w^-1 embedded).
+// Optimisation: Frank-Wolfe (the vertex-direction method of Fedorov and Wynn, with a
+// line search) on the approximate design's weights, rounded to N samples, then a
+// Fedorov exchange of single samples (the best gradient's additions against the
+// smallest losses' removals, each swap judged by the exact criterion) until no swap
+// improves it. Deterministic; the seed draws only the random survey compared against.
+//
+// Candidates: the workspace grid of the focal-sphere cap (workspace.h) at the focal
+// attitude law, and with max_extra_tilt_deg A > 0 also each attitude tilted by A about
+// tilt_directions horizontal cabin axes, and with max_extra_yaw_deg B > 0 turned by +-B
+// about the cabin's z' axis: R = R_law Rtilt(A, phi) Rz(psi). Every candidate is judged
+// as `fastcal workspace` judges a node: statics ok (model range, reflector clearance)
+// and every lower-end tension within the limits.
+//
+// A time budget: flying the stops in order takes path_length / speed plus N samples
+// times the sample interval. When that is over the budget the design drops its least
+// useful stops one at a time (their samples go to the others: dwell) until it fits.
+#ifndef FASTCAL_DESIGN_H_
+#define FASTCAL_DESIGN_H_
+
+#include <Eigen/Core>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/pose.h"
+#include "fastcal/trajectory.h"
+#include "fastcal/uncertainty.h"
+#include "fastcal/workspace.h"
+
+namespace fastcal {
+
+enum class DesignCriterion {
+  kA,  // sum of the wanted parameters' variances
+  kD,  // log-determinant of their covariance
+};
+const char* DesignCriterionName(DesignCriterion criterion);  // "A", "D"
+
+// Default margins of a designed pose: every cable's lower-end tension (N) and its
+// clearance from the reflector (m).
+inline constexpr double kDesignMinTensionN = 50e3;
+inline constexpr double kDesignReflectorClearanceM = 5.0;
+
+struct DesignOptions {
+  // Where the cabin may go: the workspace's grid (1 deg off axis up to 40 deg, every 5 deg
+  // of azimuth: 2881 positions), its focal attitude law, tension limits (none by default)
+  // and statics checks (reflector clearance, model range), as `fastcal workspace`. The
+  // radial offset is not used (candidates are on the focal sphere). Two differences,
+  // margins: every lower-end tension at least kDesignMinTensionN and every cable
+  // kDesignReflectorClearanceM clear of the reflector. The optimum lies on the feasible
+  // set's edge, and the information there comes from cables near slack, whose sag moves
+  // by metres with a small error of the model: a design without them put a tilted pose
+  // with cable 1 at 27 kN, which a truth 1.5% heavier per cable took 0.6 m into the
+  // reflector; with 30 kN the simulation of a drawn truth still failed, with 50 kN none
+  // of 10 did (docs/design.md).
+  WorkspaceOptions workspace = [] {
+    WorkspaceOptions w;
+    w.min_tension_n = kDesignMinTensionN;
+    w.statics.min_reflector_clearance_m = kDesignReflectorClearanceM;
+    return w;
+  }();
+  // Largest extra tilt of z' off the focal law (deg, in [0, 30]); 0: the law alone.
+  double max_extra_tilt_deg = 0.0;
+  // Number of tilt directions, evenly spaced about z' (>= 1); used when tilting.
+  int tilt_directions = 4;
+  // Largest extra turn about z' off the law (deg, in [0, 90]); 0: none.
+  double max_extra_yaw_deg = 0.0;
+  // Samples in the survey (>= the number of free parameters).
+  int samples = 360;
+  DesignCriterion criterion = DesignCriterion::kA;
+  // Names of the wanted parameters (free ones of the spec); empty: the free parameters
+  // without a prior (those known beforehand only to a tolerance, given a prior, are the
+  // nuisance), or every free parameter when all have priors.
+  std::vector<std::string> wanted;
+  // Seed of the random survey the design is compared with.
+  std::uint64_t seed = 1;
+  // Frank-Wolfe iterations on the approximate design, and exchange iterations after
+  // rounding (each an accepted swap of one sample).
+  int approximate_iterations = 300;
+  int exchange_iterations = 2000;
+  // Additions and removals tried per exchange iteration (the best by the gradient).
+  int exchange_width = 8;
+  // Path: cabin speed between stops (m/s; 0: no duration), time per sample (s, > 0),
+  // time budget (s; 0: none, else needs a speed).
+  double speed_m_per_s = 0.0;
+  double sample_interval_s = 1.0;
+  double time_budget_s = 0.0;
+  // The paper's measured circle, compared with: radius 71.11 m about (0, 0, 156.73) m,
+  // N samples evenly spaced on one turn, attitude by the focal law.
+  Eigen::Vector3d circle_centre_m = Eigen::Vector3d(0.0, 0.0, 156.73);
+  double circle_radius_m = 71.11;
+  // False with *error naming the field when an option is invalid.
+  bool IsValid(std::string* error) const;
+};
+
+// One candidate pose.
+struct DesignCandidate {
+  Pose pose;
+  double off_axis_deg = 0.0, azimuth_deg = 0.0;  // its grid node
+  double extra_tilt_deg = 0.0;                   // 0 or max_extra_tilt_deg
+  double tilt_direction_deg = 0.0;               // about z', from x'
+  double extra_yaw_deg = 0.0;                    // 0 or +-max_extra_yaw_deg
+};
+
+// The predicted uncertainty of a survey.
+struct DesignPrediction {
+  bool ok = false;  // false: the survey could not be predicted (`note` says why)
+  std::string note;
+  int samples = 0;
+  double criterion = 0.0;
+  // Per free parameter (spec order): the calibration's budget for white residuals.
+  UncertaintyBudget budget;
+  // Per free parameter: variance from the data's noise, from each prior group (free
+  // parameters with a prior) and each consider group: they add up to sigma_total^2.
+  std::vector<double> noise_variance;
+  std::vector<std::string> parts;                  // prior and consider group names
+  std::vector<std::vector<double>> part_variance;  // [part][free parameter]
+};
+
+// What a better prior would buy: a prior or consider group's sigma halved.
+struct DesignPriorEffect {
+  std::string group;
+  bool consider = false;
+  std::vector<double> sigma_total;  // of each wanted parameter with that prior halved
+};
+
+struct DesignStop {
+  int candidate = 0;  // index into Design::candidates
+  int samples = 0;    // samples taken there (dwell = samples x sample interval)
+};
+
+struct Design {
+  DesignOptions options;
+  std::vector<DesignCandidate> candidates;  // the feasible ones
+  int rejected_candidates = 0;              // infeasible ones
+  std::vector<std::string> free_names;      // spec order
+  std::vector<std::string> free_units;      // their units in files (the spec's)
+  std::vector<double> free_to_si;           // SI value = file value * to_si
+  std::vector<int> wanted;                  // indices into free_names
+  std::vector<DesignStop> stops;            // in flight order
+  std::vector<Pose> poses;                  // one per sample, in flight order
+  double path_length_m = 0.0;
+  double travel_s = 0.0, dwell_s = 0.0, duration_s = 0.0;  // 0 without a speed
+  // Distinct stops the optimum had before the time budget dropped some (= stops.size()
+  // without a budget).
+  int unconstrained_stops = 0;
+  DesignPrediction design, circle, random;
+  // The largest part of the wanted parameters' summed variance in the design:
+  // "noise" or a group name, and its share of the sum.
+  std::string limiting_part;
+  double limiting_share = 0.0;
+  std::vector<DesignPriorEffect> prior_effects;
+};
+
+// Designs the survey. False with *error for invalid options, a spec with nothing free,
+// more free plus consider parameters than the calibration handles, fewer samples than
+// free parameters, unknown wanted names, no feasible candidate, a design that cannot
+// determine the parameters, or a time budget shorter than the samples alone take.
+bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
+                  const DesignOptions& options, Design* design, std::string* error);
+
+// The prediction for any survey (one sample per pose), with the design's criterion and
+// wanted parameters. False with *error when the statics fail at a pose.
+bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
+                   const DesignOptions& options, const std::vector<Pose>& poses,
+                   DesignPrediction* prediction, std::string* error);
+
+// The design's outputs (design_output.cc). Poses, one row per sample in flight order:
+// x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg (the format ReadPosesCsv reads), after
+// '#' comment lines with `provenance`.
+std::string DesignPosesCsv(const Design& design, const std::string& provenance);
+// design.json: options, stops, path, and for the design, the circle and the random
+// survey `parameters[]: {name, wanted, sigma_total, formal, systematic}`, the budget's
+// parts, what limits the design and what a better prior would buy.
+std::string DesignJson(const Design& design, const std::string& provenance);
+// A self-contained HTML page: the stops and the path on the cap seen from above (with
+// the circle), the predicted sigma_total side by side, the limits and prior effects.
+std::string DesignHtml(const Design& design, const CableRobot& robot,
+                       const std::string& provenance);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_DESIGN_H_

@@ -1,0 +1,243 @@
+// A survey design's information and criterion (internal/design_information.h; formulas in
+// design.h). The Jacobian comes from the calibration's own residual, TensionResidual
+// through TensionCost, with the consider parameters freed so that one Jet pass gives
+// both [J_x J_c]: the same derivatives the calibration's budget uses.
+#include "fastcal/internal/design_information.h"
+
+#include <Eigen/Cholesky>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <thread>
+
+#include "fastcal/internal/calibration_model.h"
+#include "fastcal/statics.h"
+
+namespace fastcal::internal {
+namespace {
+
+constexpr int kRows = kNumCables;  // readings per sample
+
+// P_w^-1 (D) or diag(weights) (A), embedded in n x n: the criterion's weight on P.
+bool CriterionWeight(const DesignProblem& pr, const Eigen::MatrixXd& total, Eigen::MatrixXd* w) {
+  const int n = pr.n;
+  w->setZero(n, n);
+  if (pr.criterion == DesignCriterion::kA) {
+    w->diagonal() = pr.wanted_weight;
+    return true;
+  }
+  const int m = static_cast<int>(pr.wanted.size());
+  Eigen::MatrixXd block(m, m);
+  for (int a = 0; a < m; ++a) {
+    for (int b = 0; b < m; ++b) block(a, b) = total(pr.wanted[a], pr.wanted[b]);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(block);
+  if (llt.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(m, m));
+  for (int a = 0; a < m; ++a) {
+    for (int b = 0; b < m; ++b) (*w)(pr.wanted[a], pr.wanted[b]) = inverse(a, b);
+  }
+  return true;
+}
+
+}  // namespace
+
+bool SetUpDesignProblem(const CalibrationSpec& spec, DesignProblem* problem, std::string* error) {
+  DesignProblem& pr = *problem;
+  pr = DesignProblem();
+  for (size_t j = 0; j < spec.parameters.size(); ++j) {
+    const ParameterSpec& p = spec.parameters[j];
+    if (p.free) pr.free_spec.push_back(static_cast<int>(j));
+    if (p.IsConsider()) pr.consider_spec.push_back(static_cast<int>(j));
+  }
+  pr.n = static_cast<int>(pr.free_spec.size());
+  pr.q = static_cast<int>(pr.consider_spec.size());
+  if (pr.n == 0) {
+    *error = "the spec frees no parameter: there is nothing to calibrate, so nothing to design for";
+    return false;
+  }
+  if (pr.n + pr.q > kMaxFreeParameters) {
+    *error = "the spec has " + std::to_string(pr.n) + " free and " + std::to_string(pr.q) +
+             " consider parameters; the design handles at most " +
+             std::to_string(kMaxFreeParameters) + " together";
+    return false;
+  }
+  pr.prior_information = Eigen::VectorXd::Zero(pr.n);
+  for (int k = 0; k < pr.n; ++k) {
+    const ParameterSpec& p = spec.parameters[pr.free_spec[k]];
+    if (p.has_prior) pr.prior_information[k] = 1.0 / (p.prior_sigma_si * p.prior_sigma_si);
+  }
+  pr.consider_variance.resize(pr.q);
+  for (int c = 0; c < pr.q; ++c) {
+    const ParameterSpec& p = spec.parameters[pr.consider_spec[c]];
+    pr.consider_variance[c] = p.prior_sigma_si * p.prior_sigma_si;
+    const std::string group = ParameterGroupName(p.kind);
+    int g = 0;
+    while (g < static_cast<int>(pr.consider_groups.size()) && pr.consider_groups[g] != group) ++g;
+    if (g == static_cast<int>(pr.consider_groups.size())) pr.consider_groups.push_back(group);
+    pr.consider_group.push_back(g);
+  }
+  pr.x_rows.resize(0, pr.n);
+  pr.z_rows.resize(0, pr.q);
+  pr.wanted_weight = Eigen::VectorXd::Zero(pr.n);
+  return true;
+}
+
+bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
+                 const std::vector<Pose>& poses, DesignProblem* problem, std::string* error) {
+  DesignProblem& pr = *problem;
+  // The consider parameters freed: one Jet pass differentiates against both kinds.
+  CalibrationSpec both = spec;
+  for (int j : pr.consider_spec) both.parameters[j].free = true;
+  const CalibrationModel model(robot, both);
+  const std::vector<double> theta = model.InitialTheta();
+  std::vector<int> column(model.num_free());  // x columns first, then z (+ n)
+  {
+    int x = 0, z = 0;
+    for (int k = 0; k < model.num_free(); ++k) {
+      column[k] = spec.parameters[model.spec_index(k)].free ? x++ : pr.n + z++;
+    }
+  }
+  TensionResidual f{&model,           Pose(), {}, {}, ModelFitStaticsOptions(spec.forward_model),
+                    StaticsSolution()};
+  f.sigma_n.fill(1.0);  // residual = reading; whitened below
+  const int first = static_cast<int>(pr.x_rows.rows());
+  pr.x_rows.conservativeResize(first + kRows * static_cast<int>(poses.size()), pr.n);
+  pr.z_rows.conservativeResize(first + kRows * static_cast<int>(poses.size()), pr.q);
+  Eigen::Matrix<double, kRows, Eigen::Dynamic, Eigen::RowMajor> jac(kRows, model.num_free());
+  std::array<double, kRows> reading{};
+  for (size_t t = 0; t < poses.size(); ++t) {
+    f.pose = poses[t];
+    const TensionCost cost(f);
+    const double* parameters[1] = {theta.data()};
+    double* jacobians[1] = {jac.data()};
+    if (!cost.Evaluate(parameters, reading.data(), jacobians)) {
+      const Eigen::Vector3d& p = poses[t].position_m;
+      *error = "pose " + std::to_string(t + 1) + " at (" + std::to_string(p[0]) + ", " +
+               std::to_string(p[1]) + ", " + std::to_string(p[2]) +
+               ") m: the statics of the spec's initial model fail there";
+      pr.x_rows.conservativeResize(first, pr.n);
+      pr.z_rows.conservativeResize(first, pr.q);
+      return false;
+    }
+    const std::array<double, kRows> sigma =
+        TensionSigmas(reading, spec.tension_sigma_n, spec.tension_sigma_percent);
+    for (int i = 0; i < kRows; ++i) {
+      const int row = first + kRows * static_cast<int>(t) + i;
+      for (int k = 0; k < model.num_free(); ++k) {
+        const double v = jac(i, k) / sigma[i];
+        if (column[k] < pr.n) {
+          pr.x_rows(row, column[k]) = v;
+        } else {
+          pr.z_rows(row, column[k] - pr.n) = v;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+DesignSums SumsOf(const DesignProblem& pr, const Eigen::VectorXd& weights) {
+  DesignSums s;
+  s.m = Eigen::MatrixXd::Zero(pr.n, pr.n);
+  s.c = Eigen::MatrixXd::Zero(pr.n, pr.q);
+  for (int k = 0; k < pr.candidates(); ++k) {
+    if (!(weights[k] > 0.0)) continue;
+    const auto x = pr.x_rows.middleRows(kRows * k, kRows);
+    s.m.noalias() += weights[k] * (x.transpose() * x);
+    if (pr.q > 0)
+      s.c.noalias() += weights[k] * (x.transpose() * pr.z_rows.middleRows(kRows * k, kRows));
+  }
+  return s;
+}
+
+DesignSums SumsOfCandidate(const DesignProblem& pr, int k) {
+  const auto x = pr.x_rows.middleRows(kRows * k, kRows);
+  DesignSums s;
+  s.m = x.transpose() * x;
+  s.c = x.transpose() * pr.z_rows.middleRows(kRows * k, kRows);
+  return s;
+}
+
+bool CovarianceOf(const DesignProblem& pr, const DesignSums& sums, DesignCovariance* out) {
+  Eigen::MatrixXd m = sums.m;
+  m.diagonal() += pr.prior_information;
+  const Eigen::LLT<Eigen::MatrixXd> llt(m);
+  if (llt.info() != Eigen::Success) return false;
+  out->k = llt.solve(Eigen::MatrixXd::Identity(pr.n, pr.n));
+  // An information matrix that is positive definite only by rounding: refuse, as the
+  // calibration's identifiability check would (its 1e-8 singular-value ratio, squared).
+  const Eigen::VectorXd scale = m.diagonal().cwiseSqrt();
+  const Eigen::MatrixXd normalised = scale.asDiagonal() * out->k * scale.asDiagonal();
+  if (!(normalised.diagonal().maxCoeff() < 1e16) || !out->k.allFinite()) return false;
+  const Eigen::MatrixXd kc = out->k * sums.c;
+  out->total = out->k + kc * pr.consider_variance.asDiagonal() * kc.transpose();
+  return true;
+}
+
+double CriterionOf(const DesignProblem& pr, const DesignSums& sums) {
+  constexpr double kInfinity = std::numeric_limits<double>::infinity();
+  DesignCovariance cov;
+  if (!CovarianceOf(pr, sums, &cov)) return kInfinity;
+  if (pr.criterion == DesignCriterion::kA) {
+    double f = 0.0;
+    for (int j : pr.wanted) f += pr.wanted_weight[j] * cov.total(j, j);
+    return f;
+  }
+  const int m = static_cast<int>(pr.wanted.size());
+  Eigen::MatrixXd block(m, m);
+  for (int a = 0; a < m; ++a) {
+    for (int b = 0; b < m; ++b) block(a, b) = cov.total(pr.wanted[a], pr.wanted[b]);
+  }
+  const Eigen::LLT<Eigen::MatrixXd> llt(block);
+  if (llt.info() != Eigen::Success) return kInfinity;
+  return 2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
+}
+
+bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::VectorXd* gradient) {
+  DesignCovariance cov;
+  if (!CovarianceOf(pr, sums, &cov)) return false;
+  Eigen::MatrixXd w;
+  if (!CriterionWeight(pr, cov.total, &w)) return false;
+  const Eigen::MatrixXd& k = cov.k;
+  const Eigen::MatrixXd kc = k * sums.c;
+  const Eigen::MatrixXd q = kc * pr.consider_variance.asDiagonal() * kc.transpose();
+  const Eigen::MatrixXd kwk = k * w * k;
+  const Eigen::MatrixXd g = kwk + k * w * q + q * w * k;
+  const Eigen::MatrixXd h = pr.consider_variance.asDiagonal() * kc.transpose() * w * k;
+  // Per row: -x G x^T + 2 z H x^T; per candidate: the sum over its six rows. In chunks,
+  // so that the temporaries stay small (the rows of 40 000 candidates are ~40 MB), the
+  // chunks shared by two threads (the gradient is most of a design's time).
+  constexpr int kChunkCandidates = 512;
+  constexpr int kThreads = 2;
+  gradient->resize(pr.candidates());
+  const int chunks = (pr.candidates() + kChunkCandidates - 1) / kChunkCandidates;
+  auto work = [&](int first_chunk) {
+    Eigen::MatrixXd xg, zh;
+    for (int chunk = first_chunk; chunk < chunks; chunk += kThreads) {
+      const int c0 = chunk * kChunkCandidates;
+      const int count = std::min(kChunkCandidates, pr.candidates() - c0);
+      const auto x = pr.x_rows.middleRows(kRows * c0, kRows * count);
+      xg.noalias() = x * g;
+      Eigen::VectorXd per_row = -(xg.cwiseProduct(x)).rowwise().sum();
+      if (pr.q > 0) {
+        zh.noalias() = pr.z_rows.middleRows(kRows * c0, kRows * count) * h;
+        per_row += 2.0 * (zh.cwiseProduct(x)).rowwise().sum();
+      }
+      for (int c = 0; c < count; ++c) {
+        (*gradient)[c0 + c] = per_row.segment(kRows * c, kRows).sum();
+      }
+    }
+  };
+  if (chunks < kThreads) {
+    work(0);
+    return true;
+  }
+  std::thread other(work, 1);
+  work(0);
+  other.join();
+  return true;
+}
+
+}  // namespace fastcal::internal
