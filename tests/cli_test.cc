@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -66,9 +67,11 @@ class CliTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (Bin().empty() || Source().empty()) GTEST_SKIP() << "FASTCAL_BIN / FASTCAL_SOURCE_DIR unset";
+    // The process id keeps two suites run at once (two checkouts on one machine) apart.
     dir_ = fs::path(::testing::TempDir()) /
            ("fastcal_cli_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
