@@ -208,6 +208,44 @@ TEST_F(CliTest, SimulateCalibrateEvaluateRoundTrip) {
   EXPECT_NE(r.output.find("not an empty directory"), std::string::npos) << r.output;
 }
 
+TEST_F(CliTest, TwoSurveysAsTwoFilesAreFittedJointly) {
+  // Two circles, the second with the mass centre moved by 5 cm in x; --data=a.csv,b.csv
+  // is one session each, labelled a and b; the mass centre is separate, nothing else free.
+  ASSERT_EQ(
+      Fastcal("simulate --mass-centre=0.2,0,0.5 --nodes=48 --seed=3 --out=" + Path("a.csv")).code,
+      0);
+  ASSERT_EQ(
+      Fastcal("simulate --mass-centre=0.25,0,0.5 --nodes=48 --seed=4 --out=" + Path("b.csv")).code,
+      0);
+  Write("spec.yaml",
+        "parameters:\n  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}\n"
+        "sessions: {separate: [mass_centre_m]}\n");
+  const std::string out = Path("joint");
+  CommandResult r = Fastcal("calibrate --quiet --spec=" + Path("spec.yaml") +
+                            " --data=" + Path("a.csv") + "," + Path("b.csv") + " --out=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* f :
+       {"model_calibrated.yaml", "model_calibrated@a.yaml", "model_calibrated@b.yaml"}) {
+    EXPECT_TRUE(fs::exists(fs::path(out) / f)) << f;
+  }
+  EXPECT_NE(r.output.find("mass_centre_m.x@b"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("from session a to b: moved mass_centre_m.x"), std::string::npos)
+      << r.output;
+  const std::string json = ReadFile(out + "/summary.json");
+  EXPECT_NE(json.find("\"session_differences\": [\n    {\n      \"name\": \"mass_centre_m.x\""),
+            std::string::npos)
+      << json.substr(0, 3000);
+  // Each session's model evaluates on its own survey.
+  r = Fastcal("evaluate --model=" + out + "/model_calibrated@b.yaml --data=" + Path("b.csv"));
+  EXPECT_EQ(r.code, 0) << r.output;
+  // The same file twice is one label twice: refused, naming both.
+  r = Fastcal("calibrate --quiet --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") + "," +
+              Path("a.csv") + " --out=" + Path("twice"));
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("session 'a' is in both"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(Path("twice")));
+}
+
 TEST_F(CliTest, CalibrateBadInputLeavesNoOutput) {
   const std::string spec = Source() + "/calibration_data/spec_mass_centre_density.yaml";
   const std::string out = Path("never");

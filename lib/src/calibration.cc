@@ -347,9 +347,14 @@ CalibrationStatus MeasureForwardModelError(Run& run) {
 // depends on the parameters, hence the passes (iteratively reweighted least squares).
 
 CalibrationStatus Predict(Run& run) {
-  StaticsParameters<double> params;
-  std::array<double, kNumCables> gain, bias;
-  run.cm->Assemble(run.theta.data(), &params, &gain, &bias);
+  // One model per session (a single one without sessions).
+  const size_t sessions = std::max<size_t>(1, run.data.session_labels.size());
+  std::vector<StaticsParameters<double>> session_params(sessions);
+  std::vector<std::array<double, kNumCables>> session_gain(sessions), session_bias(sessions);
+  for (size_t k = 0; k < sessions; ++k) {
+    run.cm->Assemble(run.theta.data(), &session_params[k], &session_gain[k], &session_bias[k],
+                     static_cast<int>(k));
+  }
   const size_t num_samples = run.data.samples.size();
   Prediction& at = run.at;
   at.reading_n.assign(num_samples, {});
@@ -358,6 +363,9 @@ CalibrationStatus Predict(Run& run) {
   at.starts.assign(num_samples, StaticsSolution());
   for (size_t t = 0; t < num_samples; ++t) {
     const Sample& sample = run.data.samples[t];
+    const StaticsParameters<double>& params = session_params[sample.session];
+    const std::array<double, kNumCables>& gain = session_gain[sample.session];
+    const std::array<double, kNumCables>& bias = session_bias[sample.session];
     if (SolveStaticsWithParameters(params, run.PoseOf(sample), run.statics, &at.starts[t]) !=
         StaticsStatus::kOk) {
       return run.Fail(CalibrationStatus::kInfeasible,
@@ -412,6 +420,7 @@ void BuildProblem(Run& run) {
     f.statics = run.statics;
     f.start = run.at.starts[t];
     if (!run.excluded.empty()) f.excluded = run.excluded[t];
+    f.session = sample.session;
     run.problem->AddResidualBlock(new internal::TensionCost(f), loss, run.theta.data());
   }
   for (int k = 0; k < run.n; ++k) {
@@ -1140,11 +1149,30 @@ CalibrationStatus Evaluate(Run& run) {
   return CalibrationStatus::kOk;
 }
 
+// A joint fit's per-session models, the differences between sessions and what they say
+// (sessions.h); nothing without separate parameters.
+void ConcludeSessions(Run& run) {
+  CalibrationResult& r = *run.result;
+  std::vector<ParameterSpec> free;
+  for (int k = 0; k < run.n; ++k) free.push_back(run.Free(k));
+  if (std::none_of(free.begin(), free.end(), [](const auto& p) { return p.session >= 0; })) {
+    return;
+  }
+  r.session_labels = run.data.session_labels;
+  for (size_t s = 0; s < r.session_labels.size(); ++s) {
+    r.session_models.push_back(run.cm->ToRobot(run.theta.data(), static_cast<int>(s)));
+  }
+  r.session_differences = ConsecutiveSessionDifferences(
+      free, run.theta, r.covariance_ok ? r.budget.total : Eigen::MatrixXd(), r.session_labels);
+  r.verdict_text += "; " + SessionVerdict(r.session_differences);
+}
+
 // Stage: the per-parameter table, the verdict and its notes.
 CalibrationStatus Conclude(Run& run) {
   FillParameterTable(run);
   DecideVerdict(run);
   AddNotes(run);
+  ConcludeSessions(run);
   return CalibrationStatus::kOk;
 }
 
@@ -1207,7 +1235,10 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
                             CalibrationResult* result, std::string* error) {
   const auto t0 = std::chrono::steady_clock::now();
   *result = CalibrationResult();
-  Run run(model, spec, data, options, result, error);
+  if (!CheckSessions(data, error)) return CalibrationStatus::kInvalidInput;
+  // A joint fit of several sessions: the separate groups' copies (sessions.h).
+  const CalibrationSpec joint = SeparateSessionParameters(spec, data.session_labels);
+  Run run(model, joint, data, options, result, error);
   using Stage = CalibrationStatus (*)(Run&);
   const Stage stages[] = {ValidateInputs,
                           MeasureForwardModelError,

@@ -872,6 +872,7 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
   AddVerdict(in, &doc);
   if (in.result) {
     AddEstimates(*in.result, &doc);
+    internal::AddSessions(*in.result, with_plots, &doc);
     internal::AddUncertaintyBudget(*in.result, &doc);
     internal::AddGrossErrors(in, &doc);
     internal::AddMisfitRanking(*in.result, &doc);
@@ -1352,6 +1353,7 @@ void JsonCorrelations(const ReportInputs& in, JsonWriter* w) {
   }
   w->EndArray();
   if (r) internal::WriteDiagnosticsJson(*r, w);
+  if (r) internal::WriteSessionsJson(*r, w);
   ObjectOrNull(w, "identifiability", r != nullptr, [&] {
     JsonIdentifiability(w, "before", r->before);
     JsonIdentifiability(w, "after", r->after);

@@ -39,6 +39,7 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/sessions.h"
 #include "fastcal/uncertainty.h"
 
 namespace fastcal {
@@ -221,6 +222,13 @@ struct CalibrationResult {
   // With priors, before and after solving; and from the data alone after solving.
   Identifiability before, after, data_only;
   CableRobot calibrated;
+  // A joint fit of several sessions (spec sessions.separate, data with two or more
+  // sessions: sessions.h); else all empty. The labels (Dataset::session_labels), the
+  // calibrated model of each session (`calibrated` is the first's), and each separate
+  // parameter's difference between consecutive sessions.
+  std::vector<std::string> session_labels;
+  std::vector<CableRobot> session_models;
+  std::vector<SessionDifference> session_differences;
   std::vector<bool> held_out;  // per dataset sample
   int num_fit_samples = 0;
   int num_residuals = 0;
