@@ -246,6 +246,29 @@ TEST_F(CliTest, TwoSurveysAsTwoFilesAreFittedJointly) {
   EXPECT_FALSE(fs::exists(Path("twice")));
 }
 
+TEST_F(CliTest, ChangeScanFindsAStepAndSummaryJsonListsIt) {
+  // A circle of 240 nodes, the mass centre stepping by 8 cm in x at t = 120 s.
+  ASSERT_EQ(Fastcal("simulate --mass-centre=0.2,0,0.5 --nodes=240 --seed=5 "
+                    "--mass-centre-step=120:0.08,0,0 --out=" +
+                    Path("step.csv"))
+                .code,
+            0);
+  Write("spec.yaml",
+        "parameters:\n  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}\n"
+        "change_scan: {parameters: [mass_centre_m], min_segment_samples: 40}\n");
+  const std::string out = Path("scan");
+  const CommandResult r = Fastcal("calibrate --quiet --spec=" + Path("spec.yaml") +
+                                  " --data=" + Path("step.csv") + " --out=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("a change at t = "), std::string::npos) << r.output;
+  const std::string json = ReadFile(out + "/summary.json");
+  const std::regex change("\"changes\": \\[\n    \\{\n      \"time_s\": ([0-9.]+),");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(json, m, change)) << json.substr(json.find("\"changes\""), 500);
+  EXPECT_NEAR(std::stod(m[1].str()), 120.0, 10.0);
+  EXPECT_NE(ReadFile(out + "/report.html").find("<h2>Change scan</h2>"), std::string::npos);
+}
+
 TEST_F(CliTest, CalibrateBadInputLeavesNoOutput) {
   const std::string spec = Source() + "/calibration_data/spec_mass_centre_density.yaml";
   const std::string out = Path("never");

@@ -941,6 +941,73 @@ CalibrationStatus EstimateUncertainty(Run& run) {
   return CalibrationStatus::kOk;
 }
 
+// Stage: the scan for a step of the spec's change_scan groups within the survey
+// (change_scan.h), on the linearisation and with the budget's widening.
+CalibrationStatus ScanChanges(Run& run) {
+  CalibrationResult& r = *run.result;
+  ChangeScanResult& scan = r.change_scan;
+  if (run.spec.change_scan_groups.empty()) return CalibrationStatus::kOk;
+  scan.enabled = true;
+  scan.groups = run.spec.change_scan_groups;
+  scan.significance = run.spec.change_scan_significance;
+  scan.min_segment = run.spec.change_scan_min_segment;
+  scan.replicates = run.options.change_scan_replicates;
+  ChangeScanInputs in;
+  in.residuals = &run.lin.residuals;
+  in.jacobians = &run.lin.jacobians;
+  in.num_free = run.n;
+  in.prior_information = Eigen::VectorXd::Zero(run.n);
+  in.prior_gradient = Eigen::VectorXd::Zero(run.n);
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    const std::string group = ParameterGroupName(p.kind);
+    if (std::count(scan.groups.begin(), scan.groups.end(), group) != 0) {
+      if (p.session >= 0) {
+        return run.Fail(CalibrationStatus::kInvalidInput,
+                        "spec: change_scan and sessions.separate both name " + group +
+                            ": scan each session on its own, or scan another group");
+      }
+      in.scanned.push_back(k);
+      scan.parameters.push_back(p.name);
+      scan.units.push_back(p.unit);
+    }
+    if (!p.has_prior) continue;
+    in.prior_information[k] = 1.0 / (p.prior_sigma_si * p.prior_sigma_si);
+    in.prior_gradient[k] = (run.theta[k] - p.prior_mean_si) * in.prior_information[k];
+  }
+  in.bandwidth = r.covariance_ok && r.budget.correlated ? r.budget.bandwidth : 1;
+  in.min_segment = run.spec.change_scan_min_segment;
+  in.significance = run.spec.change_scan_significance;
+  in.max_changes = run.spec.change_scan_max_changes;
+  in.replicates = run.options.change_scan_replicates;
+  in.seed = run.options.change_scan_seed;
+  ChangeScanOutput out;
+  std::string why;
+  if (!ScanForChanges(in, &out, &why)) return run.Fail(CalibrationStatus::kSolverFailed, why);
+  scan.threshold = out.threshold;
+  scan.widening = out.widening;
+  scan.unit_samples = out.unit_samples;
+  for (size_t k = 0; k < out.splits.size(); ++k) {
+    scan.time_s.push_back(run.data.samples[run.fit[out.splits[k]]].time_s);
+    scan.statistic.push_back(out.statistic[k]);
+  }
+  for (const DetectedChange& c : out.changes) {
+    FoundChange f;
+    f.sample = run.fit[c.split];
+    f.time_s = run.data.samples[f.sample].time_s;
+    f.line = run.data.samples[f.sample].line;
+    f.statistic = c.statistic;
+    f.p_value = c.p_value;
+    for (size_t j = 0; j < in.scanned.size(); ++j) {
+      const double to_si = run.Free(in.scanned[j]).to_si;
+      f.shift.push_back(c.shift[j] / to_si);
+      f.shift_sigma.push_back(c.shift_sigma[j] / to_si);
+    }
+    scan.changes.push_back(std::move(f));
+  }
+  return CalibrationStatus::kOk;
+}
+
 // Stage: what would explain the misfit, block cross-validation, the residuals' memory,
 // the worst readings.
 CalibrationStatus Diagnose(Run& run) {
@@ -1173,6 +1240,9 @@ CalibrationStatus Conclude(Run& run) {
   DecideVerdict(run);
   AddNotes(run);
   ConcludeSessions(run);
+  if (run.result->change_scan.enabled) {
+    run.result->verdict_text += "; " + ChangeScanVerdict(run.result->change_scan);
+  }
   return CalibrationStatus::kOk;
 }
 
@@ -1248,6 +1318,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
                           NameGrossErrors,
                           LineariseAtSolution,
                           EstimateUncertainty,
+                          ScanChanges,
                           Diagnose,
                           Conclude,
                           Evaluate};

@@ -873,6 +873,7 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
   if (in.result) {
     AddEstimates(*in.result, &doc);
     internal::AddSessions(*in.result, with_plots, &doc);
+    internal::AddChangeScan(*in.result, with_plots, &doc);
     internal::AddUncertaintyBudget(*in.result, &doc);
     internal::AddGrossErrors(in, &doc);
     internal::AddMisfitRanking(*in.result, &doc);
@@ -1354,6 +1355,7 @@ void JsonCorrelations(const ReportInputs& in, JsonWriter* w) {
   w->EndArray();
   if (r) internal::WriteDiagnosticsJson(*r, w);
   if (r) internal::WriteSessionsJson(*r, w);
+  if (r) internal::WriteChangeScanJson(*r, w);
   ObjectOrNull(w, "identifiability", r != nullptr, [&] {
     JsonIdentifiability(w, "before", r->before);
     JsonIdentifiability(w, "after", r->after);

@@ -31,12 +31,14 @@
 #define FASTCAL_CALIBRATION_H_
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/change_scan.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/sessions.h"
@@ -83,6 +85,10 @@ struct CalibrationOptions {
   // many evenly spaced fitted samples, their sums scaled up (a 64-wide Jet through the
   // statics costs ~25 us a sample): docs/calibration.md, "What would explain the misfit".
   int max_candidate_samples = 20000;
+  // The change scan's null draws per round (change_scan.h) and their seed: 1000 place
+  // a 1% threshold to about +-0.3% in probability.
+  int change_scan_replicates = 1000;
+  std::uint64_t change_scan_seed = 1;
   // Evaluate the model before and after (CalibrationResult::variants), the paper's
   // Table 6. Off, Calibrate skips those exact statics passes.
   bool evaluate = true;
@@ -229,6 +235,8 @@ struct CalibrationResult {
   std::vector<std::string> session_labels;
   std::vector<CableRobot> session_models;
   std::vector<SessionDifference> session_differences;
+  // The scan for a change within the survey (spec change_scan; change_scan.h).
+  ChangeScanResult change_scan;
   std::vector<bool> held_out;  // per dataset sample
   int num_fit_samples = 0;
   int num_residuals = 0;

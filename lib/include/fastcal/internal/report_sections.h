@@ -51,6 +51,11 @@ void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w);
 void AddSessions(const CalibrationResult& r, bool with_plots, Document* doc);
 // summary.json's `sessions` (labels) and `session_differences` (empty without sessions).
 void WriteSessionsJson(const CalibrationResult& r, JsonWriter* w);
+// The change scan (report_sessions.cc): the changes found, the statistic over time with
+// its threshold and the changes marked. Nothing without a scan.
+void AddChangeScan(const CalibrationResult& r, bool with_plots, Document* doc);
+// summary.json's `change_scan` (null without a scan) and `changes` (empty when none).
+void WriteChangeScanJson(const CalibrationResult& r, JsonWriter* w);
 
 }  // namespace fastcal::internal
 
