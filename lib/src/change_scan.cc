@@ -13,6 +13,10 @@
 namespace fastcal {
 namespace {
 
+// An integrated autocorrelation time up to this counts as white (a white series of a
+// thousand samples gives 1 +- ~0.2 by Sokal's window).
+constexpr double kWhiteTau = 1.5;
+
 // A group of consecutive fitted samples: splits fall between groups.
 struct Unit {
   int first = 0;          // first row
@@ -244,7 +248,7 @@ double MeasuredWidening(const ChangeScanInputs& in, const std::vector<Unit>& uni
                         const std::vector<int>& steps, const Eigen::VectorXd& beta) {
   const int rows = static_cast<int>(in.residuals->rows());
   const int n = in.num_free, m = in.rows_per_sample, p = static_cast<int>(in.scanned.size());
-  const int bandwidth = std::clamp(in.bandwidth, 1, std::max(1, rows));
+  const int bandwidth = std::max(1, in.bandwidth);
   Eigen::MatrixXd scores(rows, p);
   Eigen::VectorXd white = Eigen::VectorXd::Zero(p);
   Eigen::MatrixXd j(m, n);
@@ -263,16 +267,37 @@ double MeasuredWidening(const ChangeScanInputs& in, const std::vector<Unit>& uni
   }
   double ratio = 1.0;
   for (int g = 0; g < p; ++g) {
-    double sum = 0.0, window = 0.0;
-    for (int t = 0; t < rows; ++t) {
-      window += scores(t, g);
-      if (t >= bandwidth) window -= scores(t - bandwidth, g);
-      if (t >= bandwidth - 1) sum += window * window;
-    }
-    const double omega = static_cast<double>(rows) / ((rows - bandwidth + 1.0) * bandwidth) * sum;
+    // The batch length: the budget's, or longer for this score's own memory (the budget
+    // judges its influence series, in which a slow error may not stand out while it
+    // still moves the scan's partial sums).
+    const double tau =
+        rows >= kMinSamplesForCorrelation ? IntegratedAutocorrelationTime(scores.col(g)).tau : 1.0;
+    const int own = static_cast<int>(std::ceil(kBandwidthPerTau * std::max(1.0, tau)));
+    const int length = std::clamp(std::max(bandwidth, tau > kWhiteTau ? own : 1), 1,
+                                  std::max(1, static_cast<int>(kMaxBandwidthFraction * rows)));
+    const double omega = LongRunCovarianceOfSum(scores.col(g), length)(0, 0);
     if (white[g] > 0.0) ratio = std::max(ratio, omega / white[g]);
   }
   return std::sqrt(ratio);
+}
+
+// The changes plus the best remaining splits, one at a time by the raw statistic, up to
+// max_changes in all: the alternative with every step the scan may still report, whose
+// residuals measure w. With one step fitted, a second would count as the residuals'
+// memory and hide both.
+std::vector<int> GreedySteps(const ChangeScanInputs& in, const std::vector<Unit>& units,
+                             const std::vector<Eigen::MatrixXd>& info_from,
+                             const std::vector<Eigen::VectorXd>& score_from,
+                             std::vector<int> steps) {
+  while (static_cast<int>(steps.size()) < in.max_changes) {
+    const Round r(in, units, info_from, score_from, steps);
+    if (r.splits().empty()) break;
+    const auto best = std::max_element(r.splits().begin(), r.splits().end(),
+                                       [](const auto& a, const auto& b) { return a.raw < b.raw; });
+    steps.push_back(best->unit);
+    std::sort(steps.begin(), steps.end());
+  }
+  return steps;
 }
 
 double PValue(const std::vector<double>& null_maxima, double observed) {
@@ -334,15 +359,10 @@ bool ScanForChanges(const ChangeScanInputs& in, ChangeScanOutput* out, std::stri
   for (int round = 0; round <= in.max_changes; ++round) {
     Round r(in, units, info_from, score_from, changes);
     if (r.splits().empty()) break;
-    // w: fixed, or measured with the round's best split in the fit.
+    // w: fixed, or measured with as many steps fitted as the scan may still find.
     double w = in.widening;
     if (!(w > 0.0)) {
-      const auto best =
-          std::max_element(r.splits().begin(), r.splits().end(),
-                           [](const auto& a, const auto& b) { return a.raw < b.raw; });
-      std::vector<int> steps = changes;
-      steps.push_back(best->unit);
-      std::sort(steps.begin(), steps.end());
+      const std::vector<int> steps = GreedySteps(in, units, info_from, score_from, changes);
       w = MeasuredWidening(in, units, steps,
                            Round(in, units, info_from, score_from, steps, false).Fit());
     }
