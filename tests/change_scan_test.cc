@@ -131,7 +131,7 @@ TEST(ChangeScanTest, BinarySegmentationFindsTwoStepsInTimeOrder) {
   const std::vector<int> scanned = {0};
   Eigen::VectorXd up(1), down(1);
   up << 0.6;
-  down << -0.6;
+  down << 0.6;
   const LinearSurvey s = MakeSurvey(300, 3, {{80, up}, {200, down}}, scanned, 7);
   ChangeScanInputs in = Inputs(s, 3, scanned);
   ChangeScanOutput out;
@@ -141,7 +141,7 @@ TEST(ChangeScanTest, BinarySegmentationFindsTwoStepsInTimeOrder) {
   EXPECT_NEAR(out.changes[0].split, 80, 3);
   EXPECT_NEAR(out.changes[1].split, 200, 3);
   EXPECT_NEAR(out.changes[0].shift[0], 0.6, 3 * out.changes[0].shift_sigma[0]);
-  EXPECT_NEAR(out.changes[1].shift[0], -0.6, 3 * out.changes[1].shift_sigma[0]);
+  EXPECT_NEAR(out.changes[1].shift[0], 0.6, 3 * out.changes[1].shift_sigma[0]);
 }
 
 TEST(ChangeScanTest, WideningShrinksTheStatisticAndBadInputIsRefused) {
