@@ -1223,6 +1223,12 @@ void ConcludeSessions(Run& run) {
   std::vector<ParameterSpec> free;
   for (int k = 0; k < run.n; ++k) free.push_back(run.Free(k));
   if (std::none_of(free.begin(), free.end(), [](const auto& p) { return p.session >= 0; })) {
+    if (!run.spec.separate_groups.empty()) {
+      r.notes.push_back("sessions.separate has no effect: the data have " +
+                        std::to_string(run.data.session_labels.size()) +
+                        " session labels (two or more are needed: a session column, or "
+                        "--data=a.csv,b.csv)");
+    }
     return;
   }
   r.session_labels = run.data.session_labels;
