@@ -89,6 +89,10 @@ TEST(SessionsTest, MergedFilesAreOneSessionEachLabelledByStem) {
   EXPECT_EQ(merged.samples[5].session, 3);
   EXPECT_EQ(merged.samples[2].line, 2);  // its own file's line
   EXPECT_EQ(merged.path, "dir/day-1.csv,other/day_2.csv,c.csv");
+  // Messages name a sample's own file and line.
+  EXPECT_EQ(SampleWhere(merged, merged.samples[2]), "other/day_2.csv:2");
+  EXPECT_EQ(SampleWhere(merged, merged.samples[5]), "c.csv:3");
+  EXPECT_EQ(SampleWhere(a, a.samples[1]), "dir/day-1.csv:3");
   // The same stem twice: an error naming both files.
   Dataset a2 = a;
   a2.path = "elsewhere/day-1.csv";

@@ -325,7 +325,7 @@ CalibrationStatus MeasureForwardModelError(Run& run) {
       StaticsSolution sol;
       SolveStatics(run.cm->ToRobot(run.theta.data()), pose, exact, &sol);
       return run.Fail(CalibrationStatus::kInfeasible,
-                      run.data.path + ":" + std::to_string(s.line) +
+                      SampleWhere(run.data, s) +
                           ": the initial model cannot solve this pose: " + DescribeStatus(sol));
     }
     for (int i = 0; i < kNumCables; ++i) {
@@ -369,7 +369,7 @@ CalibrationStatus Predict(Run& run) {
     if (SolveStaticsWithParameters(params, run.PoseOf(sample), run.statics, &at.starts[t]) !=
         StaticsStatus::kOk) {
       return run.Fail(CalibrationStatus::kInfeasible,
-                      run.data.path + ":" + std::to_string(sample.line) +
+                      SampleWhere(run.data, sample) +
                           ": the model cannot solve this pose: " + DescribeStatus(at.starts[t]));
     }
     for (int i = 0; i < kNumCables; ++i) {
@@ -639,8 +639,9 @@ CalibrationStatus NameGrossErrors(Run& run) {
   }
   const ReadingResidual& first = r.gross_errors.front();
   return run.Fail(CalibrationStatus::kMostlyGrossErrors,
-                  message + "the first is " + run.data.path + ":" + std::to_string(first.line) +
-                      " cable " + std::to_string(first.cable));
+                  message + "the first is " +
+                      SampleWhere(run.data, run.data.samples[first.sample]) + " cable " +
+                      std::to_string(first.cable));
 }
 
 // ---------------------------------------------------------------------------------------

@@ -255,8 +255,7 @@ std::vector<int> CandidateSamples(int num_fit, int budget) {
 
 std::string CannotSolve(const LinearisationInputs& in, int fitted_sample) {
   const Sample& s = in.data->samples[in.fit[fitted_sample]];
-  return in.data->path + ":" + std::to_string(s.line) +
-         ": the calibrated model cannot solve this pose";
+  return SampleWhere(*in.data, s) + ": the calibrated model cannot solve this pose";
 }
 
 bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::string* error) {

@@ -694,6 +694,13 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   return ParseDataset(text, path, options, dataset, error);
 }
 
+std::string SampleWhere(const Dataset& data, const Sample& sample) {
+  const bool merged =
+      sample.session >= 0 && sample.session < static_cast<int>(data.session_paths.size());
+  return (merged ? data.session_paths[sample.session] : data.path) + ":" +
+         std::to_string(sample.line);
+}
+
 bool IsValidSessionLabel(const std::string& label) {
   if (label.empty() || label.size() > static_cast<size_t>(kMaxSessionLabelLength)) return false;
   for (char c : label) {

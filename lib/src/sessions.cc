@@ -48,6 +48,7 @@ bool AppendFile(const std::vector<Dataset>& files, size_t index, Dataset* merged
     }
     map.push_back(static_cast<int>(merged->session_labels.size()));
     merged->session_labels.push_back(label);
+    merged->session_paths.push_back(file.path);
     owner->push_back(index);
   }
   for (Sample s : file.samples) {

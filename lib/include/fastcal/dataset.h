@@ -67,6 +67,9 @@ struct Dataset {
   // from the file's `session` column, or one per file when several files are merged
   // (sessions.h). Empty: no session column, one survey.
   std::vector<std::string> session_labels;
+  // With files merged (sessions.h): the file each session came from, parallel to
+  // session_labels; empty otherwise.
+  std::vector<std::string> session_paths;
   // One message per row skipped under DatasetReadOptions::skip_invalid_rows, in file
   // order, formatted like the error the row would otherwise have caused ("file:line: ...");
   // then those of samples removed by SkipUnsolvableSamples (evaluation.h).
@@ -89,6 +92,10 @@ struct DatasetReadOptions {
   // accepted: the calibration flags it as a gross error.
   PlausibilityLimits limits;
 };
+
+// "<file>:<line>" of a sample, for messages: the file of its session when the dataset was
+// merged from several (Dataset::session_paths), else Dataset::path.
+std::string SampleWhere(const Dataset& data, const Sample& sample);
 
 // Reads a dataset file. On failure returns false and sets *error to a message naming the
 // file, the 1-based line and, where there is one, the column, e.g.
