@@ -212,6 +212,15 @@ TEST(ChangeScanTest, CalibrateFindsAMassCentreStepInSimulatedTelemetry) {
   }
   EXPECT_NE(r.verdict_text.find("sessions: {separate: [mass_centre_m]}"), std::string::npos)
       << r.verdict_text;
+  // Rows out of time order: the scan says so.
+  std::swap(data.samples[10].time_s, data.samples[11].time_s);
+  ASSERT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, options, &r, &error),
+            CalibrationStatus::kOk)
+      << error;
+  bool noted = false;
+  for (const std::string& note : r.notes)
+    noted |= note.find("time_s decreases at") != std::string::npos;
+  EXPECT_TRUE(noted);
   // Scanning a group the fit separates per session is refused.
   spec.separate_groups = {"mass_centre_m"};
   data.session_labels = {"a", "b"};

@@ -987,6 +987,16 @@ CalibrationStatus ScanChanges(Run& run) {
   if (!ScanForChanges(in, &out, &why)) return run.Fail(CalibrationStatus::kSolverFailed, why);
   scan.threshold = out.threshold;
   scan.widening = out.widening;
+  for (size_t j = 1; j < run.fit.size(); ++j) {
+    const Sample& now = run.data.samples[run.fit[j]];
+    if (now.time_s >= run.data.samples[run.fit[j - 1]].time_s) continue;
+    r.notes.push_back(
+        "the change scan takes the rows in file order as time order, but time_s "
+        "decreases at " +
+        SampleWhere(run.data, now) +
+        ": sort the export by time for the scan's times to mean anything");
+    break;
+  }
   scan.unit_samples = out.unit_samples;
   for (size_t k = 0; k < out.splits.size(); ++k) {
     scan.time_s.push_back(run.data.samples[run.fit[out.splits[k]]].time_s);
