@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -260,7 +261,13 @@ bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   }
   DatasetReadOptions read;
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
-  return ReadSessionDatasets(DataPaths(), read, data, error);
+  const std::vector<std::string> paths = DataPaths();
+  if (std::find(paths.begin(), paths.end(), "") != paths.end()) {
+    *error = "--data=" + internal::Quote(FLAGS_data) +
+             " has an empty file name (a stray comma?); several files are FILE.csv,FILE.csv";
+    return false;
+  }
+  return ReadSessionDatasets(paths, read, data, error);
 }
 
 // Lists the rows --skip-invalid-rows skipped (malformed, or a pose the model cannot solve)

@@ -244,6 +244,10 @@ TEST_F(CliTest, TwoSurveysAsTwoFilesAreFittedJointly) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("session 'a' is in both"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(Path("twice")));
+  r = Fastcal("calibrate --quiet --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") +
+              ", --out=" + Path("comma"));
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("has an empty file name"), std::string::npos) << r.output;
 }
 
 TEST_F(CliTest, ChangeScanFindsAStepAndSummaryJsonListsIt) {
