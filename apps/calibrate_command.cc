@@ -119,7 +119,8 @@ Usage:
 
   --model=FILE   model to evaluate (e.g. DIR/model_calibrated.yaml from calibrate);
                  default the nominal FAST model
-  --data=FILE    telemetry export (docs/data-format.md)
+  --data=FILE    telemetry export (docs/data-format.md); several, comma-separated, are
+                 read together (one session each)
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
   --skip-invalid-rows   skip rows that are malformed or whose pose the model cannot solve
