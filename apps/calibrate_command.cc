@@ -27,13 +27,16 @@
 #include "fastcal/internal/report_document.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
+#include "fastcal/sessions.h"
 #include "fastcal/version.h"
 
 DECLARE_string(model);
 DECLARE_string(method);
 DECLARE_bool(force);
 DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
-DEFINE_string(data, "", "Measurement CSV (docs/data-format.md).");
+DEFINE_string(data, "",
+              "Measurement CSV (docs/data-format.md); several, comma-separated, are one "
+              "session each, labelled by file name.");
 DEFINE_string(out, "", "Output directory (must not exist, or be empty).");
 DEFINE_bool(skip_invalid_rows, false,
             "Skip dataset rows that are malformed or whose pose the model cannot solve "
@@ -59,8 +62,9 @@ Usage:
                       (docs/calibration.md; calibration_data/spec_realistic.yaml is the
                       one recommended for real telemetry)
   --data=FILE         telemetry export: time_s, x_m,y_m,z_m, roll_deg,pitch_deg,yaw_deg (or
-                      qw,qx,qy,qz), T1_kN..T6_kN, optional planned_*_deg and s0_*_m
-                      (docs/data-format.md)
+                      qw,qx,qy,qz), T1_kN..T6_kN, optional planned_*_deg, s0_*_m and
+                      session (docs/data-format.md). --data=a.csv,b.csv: several
+                      surveys, one session each, labelled by file name ("a", "b")
   --out=DIR           output directory; must not exist or be empty. Written only when the
                       calibration succeeded: nothing is left behind on failure.
   --force             let --out be a previous run's results (only the files listed under
@@ -95,6 +99,9 @@ Outputs in DIR:
                           cross-validation, plots
   summary.json            the same, machine-readable (outliers: line, cable, measured_kN,
                           predicted_kN, residual_sigma), with provenance and the UTC time
+  model_calibrated@LABEL.yaml  with sessions: {separate: [...]} in the spec and data of
+                          two or more sessions, the calibrated model of each session
+                          (model_calibrated.yaml is the first's)
   residuals.csv           per sample: measured, nominal and calibrated tensions (kN)
 
 Verdict, from the reduced chi-square against its band 1 +- 3 sqrt(2/nu) (nu: residuals
@@ -122,7 +129,8 @@ Usage:
 
   --model=FILE   model to evaluate (e.g. DIR/model_calibrated.yaml from calibrate);
                  default the nominal FAST model
-  --data=FILE    telemetry export (docs/data-format.md)
+  --data=FILE    telemetry export (docs/data-format.md); several, comma-separated, are
+                 read together (one session each)
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
   --force        let --out be a previous evaluate's results, replaced when complete
@@ -220,6 +228,21 @@ std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
   return s;
 }
 
+// --data's files: split at ',' (one session each, sessions.h), unless the whole value names
+// an existing file.
+std::vector<std::string> DataPaths() {
+  std::error_code ec;
+  if (fs::exists(FLAGS_data, ec)) return {FLAGS_data};
+  std::vector<std::string> paths;
+  std::string_view rest(FLAGS_data);
+  while (true) {
+    const size_t comma = rest.find(',');
+    paths.emplace_back(rest.substr(0, comma));
+    if (comma == std::string_view::npos) return paths;
+    rest.remove_prefix(comma + 1);
+  }
+}
+
 bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   if (!LoadModelFlag("model", FLAGS_model, robot, error)) return false;
   if (FLAGS_data.empty()) {
@@ -228,7 +251,13 @@ bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   }
   DatasetReadOptions read;
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
-  return ReadDataset(FLAGS_data, read, data, error);
+  const std::vector<std::string> paths = DataPaths();
+  if (std::find(paths.begin(), paths.end(), "") != paths.end()) {
+    *error = "--data=" + internal::Quote(FLAGS_data) +
+             " has an empty file name (a stray comma?); several files are FILE.csv,FILE.csv";
+    return false;
+  }
+  return ReadSessionDatasets(paths, read, data, error);
 }
 
 // Lists the rows --skip-invalid-rows skipped (malformed, or a pose the model cannot solve)
@@ -272,6 +301,14 @@ std::string BlameTheModel(const CableRobot& model, const std::string& model_name
 std::string Digest(const std::string& path) {
   std::string hex, error;
   return !path.empty() && FileSha256(path, &hex, &error) ? hex : "";
+}
+
+// The digests of --data's files, joined by ',' like the names.
+std::string DataDigest() {
+  std::string digests;
+  const std::vector<std::string> paths = DataPaths();
+  for (size_t k = 0; k < paths.size(); ++k) digests += (k ? "," : "") + Digest(paths[k]);
+  return digests;
 }
 
 // The current date and time, UTC, ISO 8601 ("2026-11-22T15:04:05Z").
@@ -549,6 +586,21 @@ std::string CrossValidationLine(const CalibrationResult& result) {
                   cv.rms_n, 1.0 / kNPerKn);
 }
 
+// A joint fit's differences between consecutive sessions ("" without sessions).
+std::string SessionLines(const CalibrationResult& result) {
+  if (result.session_differences.empty()) return "";
+  std::ostringstream s;
+  s << "\n  between sessions (later minus earlier, +- sigma_total from the full covariance):\n";
+  char buf[200];
+  for (const SessionDifference& d : result.session_differences) {
+    std::snprintf(buf, sizeof(buf), "    %-24s %s -> %s  %+.4g +- %.3g %s  (%.1f sigma)\n",
+                  d.name.c_str(), d.from.c_str(), d.to.c_str(), d.difference, d.sigma_total,
+                  d.unit.c_str(), d.Sigmas());
+    s << buf;
+  }
+  return s.str();
+}
+
 std::string CalibrationConsole(const CalibrationResult& result, const Dataset& data,
                                const std::vector<VariantEvaluation>& variants) {
   std::ostringstream s;
@@ -565,7 +617,7 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
            std::string("verdict: ") + FitVerdictName(result.verdict) + ": " + result.verdict_text,
            "", "  ", 2 * kNoteLines)
     << "\n"
-    << EstimatesTable(result) << ConsiderLines(result);
+    << EstimatesTable(result) << ConsiderLines(result) << SessionLines(result);
   for (const std::string& note : result.notes) s << Wrapped(note, "  ", "    ", kNoteLines);
   for (const ParameterDirection& d : result.data_only.undetermined) {
     s << Wrapped("the data alone cannot determine (a prior holds it): " + d.Describe(), "  ",
@@ -639,7 +691,7 @@ ReportInputs ReportProvenance(int argc, char** argv, bool with_spec) {
   report.model_path = FLAGS_model;
   report.data_path = FLAGS_data;
   report.model_digest = Digest(FLAGS_model);
-  report.data_digest = Digest(FLAGS_data);
+  report.data_digest = DataDigest();
   if (with_spec) {
     report.spec_path = FLAGS_spec;
     report.spec_digest = Digest(FLAGS_spec);
@@ -735,11 +787,19 @@ int RunCalibrate(int argc, char** argv) {
   report.out_dir = FLAGS_out;
   report.other_data_path = OtherDataset(FLAGS_data);
 
-  const std::vector<std::pair<std::string, std::string>> files = {
+  std::vector<std::pair<std::string, std::string>> files = {
       {"model_calibrated.yaml",
        CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))},
       {"residuals.csv", ResidualsCsv(data, variants, result.held_out, result.excluded)}};
-  if (!WriteOutDirectory(command, files, report, kCalibrateOutputs)) return kExitUsage;
+  std::vector<std::string> outputs = kCalibrateOutputs;
+  for (size_t s = 0; s < result.session_models.size(); ++s) {
+    const std::string name = "model_calibrated@" + result.session_labels[s] + ".yaml";
+    files.push_back({name, CableRobotToYaml(result.session_models[s],
+                                            "session " + result.session_labels[s] + "\n" +
+                                                CalibratedModelHeader(result, report))});
+    outputs.push_back(name);  // --force may replace a previous run's
+  }
+  if (!WriteOutDirectory(command, files, report, outputs)) return kExitUsage;
 
   // Results on stdout, progress and diagnostics on stderr (docs/cli.md, "Output streams").
   if (!FLAGS_quiet) std::cerr << result.ceres_brief_report << "\n";

@@ -71,6 +71,11 @@ DEFINE_double(mass_centre_drift_m, 0.0, "simulate: mass-centre drift sigma per a
 DEFINE_double(mass_centre_drift_time_s, 0.0, "simulate: its correlation time (s).");
 DEFINE_double(sensor_gain_spread_pct, 0.0, "simulate: per-cable gain spread drawn once (%).");
 DEFINE_double(sensor_bias_spread_kn, 0.0, "simulate: per-cable bias spread drawn once (kN).");
+DEFINE_int32(sessions, 1, "simulate: consecutive sessions (session column 1..N).");
+DEFINE_string(session_shift_m, "",
+              "simulate: mass centre moved by dx,dy,dz (m) at each new session.");
+DEFINE_string(mass_centre_step, "",
+              "simulate: mass centre steps T:dx,dy,dz (s: m), several joined by ';'.");
 
 namespace fastcal::cli {
 namespace {
@@ -162,6 +167,15 @@ source with its own generator, so changing one sigma leaves the others' numbers 
   --outlier-scale-pct=30     outlier half-width (%), in [0, 100)
 A noise draw that would make a reading <= 0 is redrawn (counted in the summary).
 
+Sessions and steps of the mass centre (the cabin's structure changed):
+  --sessions=1               cut the samples into N consecutive sessions of equal length,
+                             labelled 1..N in a session column (docs/data-format.md)
+  --session-shift-m=dx,dy,dz the mass centre moves by this at the first sample of each
+                             session after the first (needs --sessions >= 2)
+  --mass-centre-step=T:dx,dy,dz  the mass centre moves by this at time T (s) and stays;
+                             several joined by ';' (steps add up)
+The truth model written out has the mass centre before any step; its header lists them.
+
 Output: --out=FILE.csv (required), --force to replace existing files, --interval-s=1
 between samples. A summary on stderr:
 samples, RMS of the noise added per cable (kN and %), outliers, pose-error RMS.
@@ -204,7 +218,7 @@ const std::set<std::string> kFlags = {
     "tension-noise-kn", "outlier-fraction", "outlier-scale-pct", "seed", "interval-s", "out",
     "force", "attitude-control-time-s", "tension-drift-pct", "tension-drift-time-s",
     "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-pct",
-    "sensor-bias-spread-kn"};
+    "sensor-bias-spread-kn", "sessions", "session-shift-m", "mass-centre-step"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -261,6 +275,48 @@ bool LoadTruth(CableRobot* truth, std::string* error) {
   return true;
 }
 
+// --mass-centre-step (T:dx,dy,dz;...) and --session-shift-m (a step at the first sample
+// of each session after the first; needs --sessions and the trajectory's length, so its
+// times are set in RunSimulate: StepsAtSessions).
+bool SetStepsFromFlags(SimulationOptions* options, std::string* error) {
+  std::stringstream list(FLAGS_mass_centre_step);
+  std::string item;
+  while (!FLAGS_mass_centre_step.empty() && std::getline(list, item, ';')) {
+    const size_t colon = item.find(':');
+    MassCentreStep step;
+    std::string why;
+    if (colon == std::string::npos || !ParseNumberItem(item.substr(0, colon), &step.time_s, &why) ||
+        !ParseVector3("mass-centre-step", item.substr(colon + 1), &step.shift_m, error)) {
+      *error =
+          "--mass-centre-step needs T:dx,dy,dz (time in s, shift in m), several joined by "
+          "';', got " +
+          internal::Quote(item) + (why.empty() ? "" : ": " + why);
+      return false;
+    }
+    options->mass_centre_steps.push_back(step);
+  }
+  if (!FLAGS_session_shift_m.empty() && FLAGS_sessions < 2) {
+    *error = "--session-shift-m needs --sessions=N with N >= 2";
+    return false;
+  }
+  return true;
+}
+
+// The steps of --session-shift-m: one at the first sample of each session after the first.
+bool StepsAtSessions(int samples, SimulationOptions* options, std::string* error) {
+  if (FLAGS_session_shift_m.empty()) return true;
+  Eigen::Vector3d shift;
+  if (!ParseVector3("session-shift-m", FLAGS_session_shift_m, &shift, error)) return false;
+  for (int k = 1; k < options->sessions; ++k) {
+    // The first sample t with t * sessions / samples == k (LabelSessions' rule).
+    const long long first =
+        (static_cast<long long>(k) * samples + options->sessions - 1) / options->sessions;
+    options->mass_centre_steps.push_back(
+        {static_cast<double>(first) * options->sample_interval_s, shift});
+  }
+  return true;
+}
+
 bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->attitude_control_sigma_deg = FLAGS_attitude_control_deg;
   options->attitude_measurement_sigma_deg = FLAGS_attitude_noise_deg;
@@ -279,6 +335,8 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->sensor_bias_spread_kn = FLAGS_sensor_bias_spread_kn;
   options->seed = FLAGS_seed;
   options->sample_interval_s = FLAGS_interval_s;
+  options->sessions = FLAGS_sessions;
+  if (!SetStepsFromFlags(options, error)) return false;
   options->method = StaticsMethod::kExact;
   if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &options->method)) {
     *error = "--method must be exact, aas-refined or aas, got " + internal::Quote(FLAGS_method);
@@ -301,7 +359,8 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
                                  {"mass_centre_drift_time_s", "--mass-centre-drift-time-s"},
                                  {"sensor_gain_spread_percent", "--sensor-gain-spread-pct"},
                                  {"sensor_bias_spread_kn", "--sensor-bias-spread-kn"},
-                                 {"sample_interval_s", "--interval-s"}});
+                                 {"sample_interval_s", "--interval-s"},
+                                 {"sessions", "--sessions"}});
     return false;
   }
   return true;
@@ -489,6 +548,10 @@ int RunSimulate(int argc, char** argv) {
     PrintError(kCommand, "no poses to simulate");
     return kExitUsage;
   }
+  if (!StepsAtSessions(static_cast<int>(poses.size()), &options, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
 
   Dataset dataset;
   CableRobot truth_used;
@@ -515,6 +578,12 @@ int RunSimulate(int argc, char** argv) {
                    FormatDouble(options.mass_centre_drift_time_s) +
                    " s); its average over the samples was (" + FormatDouble(m.x(), 6) + ", " +
                    FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
+  }
+  for (const MassCentreStep& step : options.mass_centre_steps) {
+    yaml_header += "\nAt t = " + FormatDouble(step.time_s) + " s the mass centre moved by (" +
+                   FormatDouble(step.shift_m.x()) + ", " + FormatDouble(step.shift_m.y()) + ", " +
+                   FormatDouble(step.shift_m.z()) +
+                   ") m from mass_centre_m below (before any step).";
   }
   if (!WriteBoth(csv_path, dataset, csv_header, yaml_path, truth_used, yaml_header, &error)) {
     PrintError(kCommand, error);

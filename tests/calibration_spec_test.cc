@@ -780,6 +780,8 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
       {"spec_mass_centre_density.yaml", 4},
       {"spec_wide.yaml", 3 + 1 + 1 + 6 + 9},
       {"spec_realistic.yaml", 3 + 6 + 6 + 6},
+      {"spec_sessions.yaml", 3 + 6 + 6 + 6},
+      {"spec_change_scan.yaml", 3 + 6 + 6 + 6},
   };
   for (const Example& e : kExamples) {
     SCOPED_TRACE(e.file);

@@ -542,5 +542,44 @@ TEST(SimulationTest, DatasetSurvivesWriteAndRead) {
   fs::remove_all(dir, ignored);
 }
 
+TEST(SimulationTest, MassCentreStepsAndSessions) {
+  // Noise-free: before the step the tensions are the truth's, from the step's time on
+  // those of the truth with the mass centre moved; the sessions cut the samples in
+  // equal consecutive parts, labelled 1..N.
+  const std::vector<Pose> poses = Circle(10);
+  ASSERT_EQ(poses.size(), 10u);
+  const CableRobot truth = CableRobot::NominalFast();
+  SimulationOptions o = NoNoise();
+  o.sample_interval_s = 2.0;
+  o.mass_centre_steps.push_back({8.0, Eigen::Vector3d(0.3, -0.2, 0.1)});
+  o.sessions = 3;
+  Dataset d;
+  CableRobot used;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, poses, o, &d, &used, nullptr, &error)) << error;
+  EXPECT_EQ(used.mass_centre_cabin_m, truth.mass_centre_cabin_m);  // before the step
+  CableRobot moved = truth;
+  moved.mass_centre_cabin_m += Eigen::Vector3d(0.3, -0.2, 0.1);
+  for (size_t n = 0; n < poses.size(); ++n) {
+    const StaticsSolution expected = ExactAt(d.samples[n].time_s >= 8.0 ? moved : truth, poses[n]);
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_NEAR(d.samples[n].tension_n[i] / expected.cables[i].lower_tension_n, 1.0,
+                  kTensionRelTolerance)
+          << "sample " << n << " cable " << i + 1;
+    }
+  }
+  EXPECT_EQ(d.session_labels, (std::vector<std::string>{"1", "2", "3"}));
+  const int expected_session[10] = {0, 0, 0, 0, 1, 1, 1, 2, 2, 2};
+  for (size_t n = 0; n < poses.size(); ++n) EXPECT_EQ(d.samples[n].session, expected_session[n]);
+  // More sessions than poses, and a non-finite step, are refused.
+  o.sessions = 11;
+  EXPECT_FALSE(Simulate(truth, poses, o, &d, nullptr, nullptr, &error));
+  EXPECT_NE(error.find("11 sessions for 10 poses"), std::string::npos) << error;
+  o.sessions = 1;
+  o.mass_centre_steps[0].time_s = std::nan("");
+  EXPECT_FALSE(Simulate(truth, poses, o, &d, nullptr, nullptr, &error));
+  EXPECT_NE(error.find("mass_centre_steps"), std::string::npos) << error;
+}
+
 }  // namespace
 }  // namespace fastcal

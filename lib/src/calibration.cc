@@ -353,7 +353,7 @@ CalibrationStatus MeasureForwardModelError(Run& run) {
       StaticsSolution sol;
       SolveStatics(run.cm->ToRobot(run.theta.data()), pose, exact, &sol);
       return run.Fail(CalibrationStatus::kInfeasible,
-                      run.data.path + ":" + std::to_string(s.line) +
+                      SampleWhere(run.data, s) +
                           ": the initial model cannot solve this pose: " + DescribeStatus(sol));
     }
     for (int i = 0; i < kNumCables; ++i) {
@@ -375,9 +375,14 @@ CalibrationStatus MeasureForwardModelError(Run& run) {
 // depends on the parameters, hence the passes (iteratively reweighted least squares).
 
 CalibrationStatus Predict(Run& run) {
-  StaticsParameters<double> params;
-  std::array<double, kNumCables> gain, bias;
-  run.cm->Assemble(run.theta.data(), &params, &gain, &bias);
+  // One model per session (a single one without sessions).
+  const size_t sessions = std::max<size_t>(1, run.data.session_labels.size());
+  std::vector<StaticsParameters<double>> session_params(sessions);
+  std::vector<std::array<double, kNumCables>> session_gain(sessions), session_bias(sessions);
+  for (size_t k = 0; k < sessions; ++k) {
+    run.cm->Assemble(run.theta.data(), &session_params[k], &session_gain[k], &session_bias[k],
+                     static_cast<int>(k));
+  }
   const size_t num_samples = run.data.samples.size();
   Prediction& at = run.at;
   at.reading_n.assign(num_samples, {});
@@ -386,10 +391,13 @@ CalibrationStatus Predict(Run& run) {
   at.starts.assign(num_samples, StaticsSolution());
   for (size_t t = 0; t < num_samples; ++t) {
     const Sample& sample = run.data.samples[t];
+    const StaticsParameters<double>& params = session_params[sample.session];
+    const std::array<double, kNumCables>& gain = session_gain[sample.session];
+    const std::array<double, kNumCables>& bias = session_bias[sample.session];
     if (SolveStaticsWithParameters(params, run.PoseOf(sample), run.statics, &at.starts[t]) !=
         StaticsStatus::kOk) {
       return run.Fail(CalibrationStatus::kInfeasible,
-                      run.data.path + ":" + std::to_string(sample.line) +
+                      SampleWhere(run.data, sample) +
                           ": the model cannot solve this pose: " + DescribeStatus(at.starts[t]));
     }
     for (int i = 0; i < kNumCables; ++i) {
@@ -440,6 +448,7 @@ void BuildProblem(Run& run) {
     f.statics = run.statics;
     f.start = run.at.starts[t];
     if (!run.excluded.empty()) f.excluded = run.excluded[t];
+    f.session = sample.session;
     run.problem->AddResidualBlock(new internal::TensionCost(f), loss, run.theta.data());
   }
   for (int k = 0; k < run.n; ++k) {
@@ -666,8 +675,9 @@ CalibrationStatus NameGrossErrors(Run& run) {
   }
   const ReadingResidual& first = r.gross_errors.front();
   return run.Fail(CalibrationStatus::kMostlyGrossErrors,
-                  message + "the first is " + run.data.path + ":" + std::to_string(first.line) +
-                      " cable " + std::to_string(first.cable));
+                  message + "the first is " +
+                      SampleWhere(run.data, run.data.samples[first.sample]) + " cable " +
+                      std::to_string(first.cable));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -1022,6 +1032,83 @@ CalibrationStatus EstimateUncertainty(Run& run) {
   return CalibrationStatus::kOk;
 }
 
+// Stage: the scan for a step of the spec's change_scan groups within the survey
+// (change_scan.h), on the linearisation and with the budget's widening.
+CalibrationStatus ScanChanges(Run& run) {
+  CalibrationResult& r = *run.result;
+  ChangeScanResult& scan = r.change_scan;
+  if (run.spec.change_scan_groups.empty()) return CalibrationStatus::kOk;
+  scan.enabled = true;
+  scan.groups = run.spec.change_scan_groups;
+  scan.significance = run.spec.change_scan_significance;
+  scan.min_segment = run.spec.change_scan_min_segment;
+  scan.replicates = run.options.change_scan_replicates;
+  ChangeScanInputs in;
+  in.residuals = &run.lin.residuals;
+  in.jacobians = &run.lin.jacobians;
+  in.num_free = run.n;
+  in.prior_information = Eigen::VectorXd::Zero(run.n);
+  in.prior_gradient = Eigen::VectorXd::Zero(run.n);
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    const std::string group = ParameterGroupName(p.kind);
+    if (std::count(scan.groups.begin(), scan.groups.end(), group) != 0) {
+      if (p.session >= 0) {
+        return run.Fail(CalibrationStatus::kInvalidInput,
+                        "spec: change_scan and sessions.separate both name " + group +
+                            ": scan each session on its own, or scan another group");
+      }
+      in.scanned.push_back(k);
+      scan.parameters.push_back(p.name);
+      scan.units.push_back(p.unit);
+    }
+    if (!p.has_prior) continue;
+    in.prior_information[k] = 1.0 / (p.prior_sigma_si * p.prior_sigma_si);
+    in.prior_gradient[k] = (run.theta[k] - p.prior_mean_si) * in.prior_information[k];
+  }
+  in.bandwidth = r.covariance_ok && r.budget.correlated ? r.budget.bandwidth : 1;
+  in.min_segment = run.spec.change_scan_min_segment;
+  in.significance = run.spec.change_scan_significance;
+  in.max_changes = run.spec.change_scan_max_changes;
+  in.replicates = run.options.change_scan_replicates;
+  in.seed = run.options.change_scan_seed;
+  ChangeScanOutput out;
+  std::string why;
+  if (!ScanForChanges(in, &out, &why)) return run.Fail(CalibrationStatus::kSolverFailed, why);
+  scan.threshold = out.threshold;
+  scan.widening = out.widening;
+  for (size_t j = 1; j < run.fit.size(); ++j) {
+    const Sample& now = run.data.samples[run.fit[j]];
+    if (now.time_s >= run.data.samples[run.fit[j - 1]].time_s) continue;
+    r.notes.push_back(
+        "the change scan takes the rows in file order as time order, but time_s "
+        "decreases at " +
+        SampleWhere(run.data, now) +
+        ": sort the export by time for the scan's times to mean anything");
+    break;
+  }
+  scan.unit_samples = out.unit_samples;
+  for (size_t k = 0; k < out.splits.size(); ++k) {
+    scan.time_s.push_back(run.data.samples[run.fit[out.splits[k]]].time_s);
+    scan.statistic.push_back(out.statistic[k]);
+  }
+  for (const DetectedChange& c : out.changes) {
+    FoundChange f;
+    f.sample = run.fit[c.split];
+    f.time_s = run.data.samples[f.sample].time_s;
+    f.line = run.data.samples[f.sample].line;
+    f.statistic = c.statistic;
+    f.p_value = c.p_value;
+    for (size_t j = 0; j < in.scanned.size(); ++j) {
+      const double to_si = run.Free(in.scanned[j]).to_si;
+      f.shift.push_back(c.shift[j] / to_si);
+      f.shift_sigma.push_back(c.shift_sigma[j] / to_si);
+    }
+    scan.changes.push_back(std::move(f));
+  }
+  return CalibrationStatus::kOk;
+}
+
 // Stage: what would explain the misfit, block cross-validation, the residuals' memory,
 // the worst readings.
 CalibrationStatus Diagnose(Run& run) {
@@ -1286,12 +1373,40 @@ CalibrationStatus Evaluate(Run& run) {
   return CalibrationStatus::kOk;
 }
 
+// A joint fit's per-session models, the differences between sessions and what they say
+// (sessions.h); nothing without separate parameters.
+void ConcludeSessions(Run& run) {
+  CalibrationResult& r = *run.result;
+  std::vector<ParameterSpec> free;
+  for (int k = 0; k < run.n; ++k) free.push_back(run.Free(k));
+  if (std::none_of(free.begin(), free.end(), [](const auto& p) { return p.session >= 0; })) {
+    if (!run.spec.separate_groups.empty()) {
+      r.notes.push_back("sessions.separate has no effect: the data have " +
+                        std::to_string(run.data.session_labels.size()) +
+                        " session labels (two or more are needed: a session column, or "
+                        "--data=a.csv,b.csv)");
+    }
+    return;
+  }
+  r.session_labels = run.data.session_labels;
+  for (size_t s = 0; s < r.session_labels.size(); ++s) {
+    r.session_models.push_back(run.cm->ToRobot(run.theta.data(), static_cast<int>(s)));
+  }
+  r.session_differences = ConsecutiveSessionDifferences(
+      free, run.theta, r.covariance_ok ? r.budget.total : Eigen::MatrixXd(), r.session_labels);
+  r.verdict_text += "; " + SessionVerdict(r.session_differences);
+}
+
 // Stage: the per-parameter table, the verdict and its notes.
 CalibrationStatus Conclude(Run& run) {
   FillParameterTable(run);
   DecideVerdict(run);
   JudgeCompleteness(run);
   AddNotes(run);
+  ConcludeSessions(run);
+  if (run.result->change_scan.enabled) {
+    run.result->verdict_text += "; " + ChangeScanVerdict(run.result->change_scan);
+  }
   return CalibrationStatus::kOk;
 }
 
@@ -1356,7 +1471,10 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
                             CalibrationResult* result, std::string* error) {
   const auto t0 = std::chrono::steady_clock::now();
   *result = CalibrationResult();
-  Run run(model, spec, data, options, result, error);
+  if (!CheckSessions(data, error)) return CalibrationStatus::kInvalidInput;
+  // A joint fit of several sessions: the separate groups' copies (sessions.h).
+  const CalibrationSpec joint = SeparateSessionParameters(spec, data.session_labels);
+  Run run(model, joint, data, options, result, error);
   using Stage = CalibrationStatus (*)(Run&);
   const Stage stages[] = {ValidateInputs,
                           MeasureForwardModelError,
@@ -1366,6 +1484,7 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
                           NameGrossErrors,
                           LineariseAtSolution,
                           EstimateUncertainty,
+                          ScanChanges,
                           Diagnose,
                           Conclude,
                           Evaluate};

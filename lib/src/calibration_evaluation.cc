@@ -4,6 +4,7 @@
 
 #include "fastcal/calibration.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/sessions.h"
 
 namespace fastcal {
 
@@ -27,8 +28,13 @@ bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec
        spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured});
   for (const Variant& v : list) {
     VariantEvaluation e;
-    if (!EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact, result.held_out,
-                         &e, error, result.excluded)) {
+    // A joint fit's calibrated model is one per session (sessions.h).
+    const bool per_session = v.robot == &result.calibrated && result.session_models.size() > 1;
+    if (per_session ? !EvaluateSessionModels(v.name, result.session_models, data, v.attitude,
+                                             StaticsMethod::kExact, result.held_out,
+                                             result.excluded, &e, error)
+                    : !EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact,
+                                       result.held_out, &e, error, result.excluded)) {
       *error = v.name + ": " + *error;
       return false;
     }

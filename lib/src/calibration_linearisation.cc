@@ -46,6 +46,7 @@ TensionResidual ResidualOf(const LinearisationInputs& in, const CalibrationModel
       in.sigma_n[j], in.statics,  in.starts.empty() ? StaticsSolution() : in.starts[j]};
   if (in.use_planned_attitude) f.pose.rotation = sample.planned_rotation;
   if (!in.excluded.empty()) f.excluded = in.excluded[in.fit[j]];
+  f.session = sample.session;
   return f;
 }
 
@@ -192,9 +193,11 @@ bool AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
 
 struct CandidatePass {
   const LinearisationInputs& in;
-  CalibrationModel basis;
-  std::vector<double> theta;
+  // The basis at the calibrated model of each session (one without sessions).
+  std::vector<CalibrationModel> basis;
+  std::vector<std::vector<double>> theta;  // each basis's own values
   std::vector<std::vector<int>> free_columns, candidate_columns;
+  std::vector<int> free_session;  // of each free parameter (ParameterSpec::session)
 };
 
 struct CandidateSums {
@@ -214,16 +217,21 @@ Eigen::MatrixXd Combine(const RowMatrix& basis, const std::vector<std::vector<in
 
 bool AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
                           int end, CandidateSums* sums, Eigen::MatrixXd* scores, int* failed) {
-  RowMatrix b(kNumCables, pass.basis.num_free());
+  RowMatrix b(kNumCables, pass.basis.front().num_free());
   Eigen::Matrix<double, kNumCables, 1> r;
   for (int k = begin; k < end; ++k) {
-    const TensionResidual f = ResidualOf(pass.in, &pass.basis, samples[k]);
+    const int session = pass.in.data->samples[pass.in.fit[samples[k]]].session;
+    const TensionResidual f = ResidualOf(pass.in, &pass.basis[session], samples[k]);
     double weight = 1.0;
-    if (!EvaluateSample(f, pass.theta.data(), pass.in.loss, &r, &b, &weight)) {
+    if (!EvaluateSample(f, pass.theta[session].data(), pass.in.loss, &r, &b, &weight)) {
       *failed = samples[k];
       return false;
     }
-    const Eigen::MatrixXd jx = weight * Combine(b, pass.free_columns);
+    Eigen::MatrixXd jx = weight * Combine(b, pass.free_columns);
+    for (size_t c = 0; c < pass.free_session.size(); ++c) {
+      // Another session's copy: no effect on this sample.
+      if (pass.free_session[c] >= 0 && pass.free_session[c] != session) jx.col(c).setZero();
+    }
     const Eigen::MatrixXd jc = weight * Combine(b, pass.candidate_columns);
     const Eigen::VectorXd g = weight * (jc.transpose() * r);
     sums->cross.noalias() += jx.transpose() * jc;
@@ -247,8 +255,7 @@ std::vector<int> CandidateSamples(int num_fit, int budget) {
 
 std::string CannotSolve(const LinearisationInputs& in, int fitted_sample) {
   const Sample& s = in.data->samples[in.fit[fitted_sample]];
-  return in.data->path + ":" + std::to_string(s.line) +
-         ": the calibrated model cannot solve this pose";
+  return SampleWhere(*in.data, s) + ": the calibrated model cannot solve this pose";
 }
 
 bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::string* error) {
@@ -288,11 +295,16 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   const CableRobot& model = in.fitted->robot();
   CalibrationSpec basis_spec;
   basis_spec.parameters = BasisParameters(model);
-  CandidatePass pass{in, CalibrationModel(in.fitted->ToRobot(in.theta), basis_spec), {}, {}, {}};
-  pass.theta = pass.basis.InitialTheta();
+  CandidatePass pass{in, {}, {}, {}, {}, {}};
+  const int sessions = std::max<int>(1, static_cast<int>(in.data->session_labels.size()));
+  for (int s = 0; s < sessions; ++s) {
+    pass.basis.emplace_back(in.fitted->ToRobot(in.theta, s), basis_spec);
+    pass.theta.push_back(pass.basis.back().InitialTheta());
+  }
   for (int k = 0; k < n; ++k) {
     const ParameterSpec& p = in.fitted->spec().parameters[in.fitted->spec_index(k)];
     pass.free_columns.push_back(BasisColumns(p, model));
+    pass.free_session.push_back(p.session);
   }
   for (const ParameterSpec& p : in.candidates) {
     pass.candidate_columns.push_back(BasisColumns(p, model));

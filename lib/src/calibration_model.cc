@@ -107,10 +107,10 @@ std::vector<double> CalibrationModel::InitialTheta() const {
   return theta;
 }
 
-CableRobot CalibrationModel::ToRobot(const double* theta) const {
+CableRobot CalibrationModel::ToRobot(const double* theta, int session) const {
   StaticsParameters<double> p;
   std::array<double, kNumCables> gain, bias;
-  Assemble(theta, &p, &gain, &bias);
+  Assemble(theta, &p, &gain, &bias, session);
   CableRobot out = robot_;
   // Anchor points: the offset of the first cable tied to each point (all its cables
   // carry the same offset by construction).

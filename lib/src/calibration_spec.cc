@@ -202,6 +202,21 @@ std::string CheckAtLeastOne(int value) { return value >= 1 ? "" : "must be >= 1"
 
 std::string CheckAtLeastTwo(int value) { return value >= 2 ? "" : "must be >= 2"; }
 
+// The change scan's family-wise false-alarm probability: strictly between 0 and 0.5
+// (its critical values are tabulated down to 1e-4: change_scan.cc).
+std::string CheckSignificance(double p) {
+  return p >= 1e-4 && p <= 0.5 ? "" : "must be between 0.0001 and 0.5";
+}
+
+// A group named by sessions.separate or change_scan.parameters must have a free
+// parameter: only free parameters can differ between sessions or step.
+std::string GroupWithoutFreeParameter(const CalibrationSpec& spec, const std::string& group) {
+  for (const ParameterSpec& p : spec.parameters) {
+    if (p.free && group == ParameterGroupName(p.kind)) return "";
+  }
+  return group + " has no free parameter in this spec (free: true under parameters)";
+}
+
 std::string CheckFraction(double fraction) {
   return std::isfinite(fraction) && fraction > 0.0 && fraction <= 1.0 ? "" : "must be in (0, 1]";
 }
@@ -327,10 +342,11 @@ class Reader {
 
   bool ReadRoot(const YAML::Node& root, CalibrationSpec* spec) {
     KeyMap keys;
-    if (!ReadMap(root, LineOf(root), kRootPath,
-                 {"format", "forward_model", "noise", "robust_loss", "gross_errors", "holdout",
-                  "cross_validation", "attitude", "solver", "parameters"},
-                 &keys)) {
+    if (!ReadMap(
+            root, LineOf(root), kRootPath,
+            {"format", "forward_model", "noise", "robust_loss", "gross_errors", "holdout",
+             "cross_validation", "attitude", "solver", "parameters", "sessions", "change_scan"},
+            &keys)) {
       return false;
     }
     if (const KeyValue* kv = Find(keys, "format")) {
@@ -377,6 +393,14 @@ class Reader {
     }
     if (const KeyValue* kv = Find(keys, "parameters");
         kv != nullptr && !ReadParameters(*kv, spec)) {
+      return false;
+    }
+    // After the parameters: a group named here must have a free parameter.
+    if (const KeyValue* kv = Find(keys, "sessions"); kv != nullptr && !ReadSessions(*kv, spec)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "change_scan");
+        kv != nullptr && !ReadChangeScan(*kv, spec)) {
       return false;
     }
     return true;
@@ -610,6 +634,77 @@ class Reader {
       if (!ReadInteger(*kv, "holdout.seed", &spec->holdout_seed)) return false;
     }
     return true;
+  }
+
+  // A list of parameter groups (`[mass_centre_m, sensor_gain]`), each with a free
+  // parameter in `spec`, none twice.
+  bool ReadGroupList(const KeyValue& kv, const std::string& path, const CalibrationSpec& spec,
+                     std::vector<std::string>* groups) {
+    if (!kv.value.IsSequence()) return Fail(kv.line, path, "expected a list of parameter groups");
+    std::vector<std::string> keys;
+    for (const GroupInfo& g : kGroups) keys.push_back(g.key);
+    for (const YAML::Node& item : kv.value) {
+      const int line = LineOf(item) > 0 ? LineOf(item) : kv.line;
+      if (!item.IsScalar()) return Fail(line, path, "expected a parameter group name");
+      const std::string name = item.Scalar();
+      if (std::find(keys.begin(), keys.end(), name) == keys.end()) {
+        return Fail(line, path,
+                    "unknown parameter group " + internal::Quote(name) +
+                        " (accepted: " + ListOf(keys) + ")");
+      }
+      if (std::find(groups->begin(), groups->end(), name) != groups->end()) {
+        return Fail(line, path, name + " is listed twice");
+      }
+      if (const std::string w = GroupWithoutFreeParameter(spec, name); !w.empty()) {
+        return Fail(line, path, w);
+      }
+      groups->push_back(name);
+    }
+    return true;
+  }
+
+  bool ReadSessions(const KeyValue& sessions, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(sessions, "sessions", {"separate"}, &keys)) return false;
+    if (const KeyValue* kv = Find(keys, "separate")) {
+      return ReadGroupList(*kv, "sessions.separate", *spec, &spec->separate_groups);
+    }
+    return true;
+  }
+
+  bool ReadChangeScan(const KeyValue& scan, CalibrationSpec* spec) {
+    KeyMap keys;
+    if (!ReadMap(scan, "change_scan",
+                 {"parameters", "min_segment_samples", "significance", "max_changes"}, &keys)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "min_segment_samples")) {
+      const std::string path = "change_scan.min_segment_samples";
+      if (!ReadInteger(*kv, path, &spec->change_scan_min_segment) ||
+          !Check(CheckAtLeastTwo(spec->change_scan_min_segment), kv->line, path)) {
+        return false;
+      }
+    }
+    if (const KeyValue* kv = Find(keys, "significance")) {
+      const std::string path = "change_scan.significance";
+      if (!ReadDouble(*kv, path, &spec->change_scan_significance) ||
+          !Check(CheckSignificance(spec->change_scan_significance), kv->line, path)) {
+        return false;
+      }
+    }
+    if (const KeyValue* kv = Find(keys, "max_changes")) {
+      const std::string path = "change_scan.max_changes";
+      if (!ReadInteger(*kv, path, &spec->change_scan_max_changes) ||
+          !Check(CheckAtLeastOne(spec->change_scan_max_changes), kv->line, path)) {
+        return false;
+      }
+    }
+    const KeyValue* kv = Find(keys, "parameters");
+    if (kv == nullptr) {
+      return Fail(LineOf(scan.value) > 0 ? LineOf(scan.value) : scan.line, "change_scan",
+                  "needs parameters: [group, ...], the groups whose step is searched for");
+    }
+    return ReadGroupList(*kv, "change_scan.parameters", *spec, &spec->change_scan_groups);
   }
 
   bool ReadSolver(const KeyValue& solver, CalibrationSpec* spec) {
@@ -1029,9 +1124,27 @@ bool CalibrationSpec::IsValid(std::string* error) const {
     return false;
   };
   if (const std::string w = OptionsProblem(*this); !w.empty()) return fail(w);
+  for (const auto* list : {&separate_groups, &change_scan_groups}) {
+    for (const std::string& group : *list) {
+      const std::string w = GroupWithoutFreeParameter(*this, group);
+      if (!w.empty())
+        return fail((list == &separate_groups ? "sessions.separate: " : "change_scan: ") + w);
+    }
+  }
+  if (!change_scan_groups.empty()) {
+    if (const std::string w = CheckAtLeastTwo(change_scan_min_segment); !w.empty()) {
+      return fail("change_scan_min_segment: " + w);
+    }
+    if (const std::string w = CheckSignificance(change_scan_significance); !w.empty()) {
+      return fail("change_scan_significance: " + w);
+    }
+    if (const std::string w = CheckAtLeastOne(change_scan_max_changes); !w.empty()) {
+      return fail("change_scan_max_changes: " + w);
+    }
+  }
   // Across parameters: none listed twice, as (kind, index, component) with the fields that
   // do not apply set to -1, and no group both common and per cable.
-  std::set<std::tuple<int, int, int>> seen;
+  std::set<std::tuple<int, int, int, int>> seen;
   std::set<int> kinds_common, kinds_per_cable;
   for (size_t k = 0; k < parameters.size(); ++k) {
     const ParameterSpec& p = parameters[k];
@@ -1039,8 +1152,9 @@ bool CalibrationSpec::IsValid(std::string* error) const {
     if (const std::string w = ParameterProblem(p, label); !w.empty()) return fail(w);
     const bool indexed =
         p.kind != ParameterKind::kMassCentre && p.kind != ParameterKind::kCabinMass;
-    const auto key = std::make_tuple(static_cast<int>(p.kind), indexed ? p.index : -1,
-                                     IsVector(p.kind) || IsAttachment(p.kind) ? p.component : -1);
+    const auto key =
+        std::make_tuple(static_cast<int>(p.kind), indexed ? p.index : -1,
+                        IsVector(p.kind) || IsAttachment(p.kind) ? p.component : -1, p.session);
     if (!seen.insert(key).second) return fail(label + ": listed twice");
     if (IsPerCableCapable(p.kind)) {
       (p.index < 0 ? kinds_common : kinds_per_cable).insert(static_cast<int>(p.kind));
@@ -1119,6 +1233,30 @@ bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, Calibra
   return LoadSpec(path, num_anchor_points, AttachmentShape(), spec, error);
 }
 
+namespace {
+
+// The spec's sessions and change_scan blocks ("" when it has neither).
+std::string SessionsYaml(const CalibrationSpec& spec) {
+  const auto list = [](const std::vector<std::string>& groups) {
+    std::string text;
+    for (const std::string& g : groups) text += (text.empty() ? "" : ", ") + g;
+    return "[" + text + "]";
+  };
+  std::ostringstream out;
+  if (!spec.separate_groups.empty()) {
+    out << "sessions: {separate: " << list(spec.separate_groups) << "}\n";
+  }
+  if (!spec.change_scan_groups.empty()) {
+    out << "change_scan: {parameters: " << list(spec.change_scan_groups)
+        << ", min_segment_samples: " << spec.change_scan_min_segment
+        << ", significance: " << Num(spec.change_scan_significance)
+        << ", max_changes: " << spec.change_scan_max_changes << "}\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
 std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
   std::ostringstream out;
   out << "format: " << kFormatName << "\n";
@@ -1195,6 +1333,7 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
       }
     }
   }
+  out << SessionsYaml(spec);
   return out.str();
 }
 

@@ -62,6 +62,11 @@ constexpr const char* kColumnNames[kNumColumns] = {
     "s0_1_m", "s0_2_m", "s0_3_m", "s0_4_m", "s0_5_m", "s0_6_m"};
 // clang-format on
 
+// The optional label column (docs/data-format.md, "Sessions"): text, not a number, so it
+// has no Column; its field maps to this.
+constexpr char kSessionColumn[] = "session";
+constexpr int kSessionField = -1;
+
 // Files hold tensions in kN, memory in N: the decimal exponent shifts by this much.
 constexpr int kKilo = 3;
 // Exponents beyond this (e.g. "0e999999") are converted by multiplication instead of by
@@ -198,6 +203,7 @@ struct Header {
   bool quaternion = false;
   bool planned = false;
   bool unstretched = false;
+  int session_field = -1;  // the field holding the session label, or -1
 };
 
 // Checks that a group of columns is all present or all absent; on a partial group names
@@ -231,6 +237,16 @@ bool ParseHeader(std::string_view line, const std::string& where, Header* header
     if (name.empty()) {
       *error = where + "empty column name in field " + std::to_string(f + 1);
       return false;
+    }
+    if (name == kSessionColumn) {
+      if (header->session_field >= 0) {
+        *error = where + "duplicate column " + Quoted(kSessionColumn) + " (fields " +
+                 std::to_string(header->session_field + 1) + " and " + std::to_string(f + 1) + ")";
+        return false;
+      }
+      header->session_field = static_cast<int>(f);
+      header->column_of_field.push_back(kSessionField);
+      continue;
     }
     int column = -1;
     for (int c = 0; c < kNumColumns; ++c) {
@@ -333,6 +349,7 @@ std::string TooManyFieldsMessage(const std::vector<std::string_view>& fields, co
   size_t best = 0;
   double best_distance = std::numeric_limits<double>::infinity();
   for (size_t f = 0; fields.size() == expected + 1 && f + 1 < fields.size(); ++f) {
+    if (header.column_of_field[f] == kSessionField) continue;
     if (!digits(fields[f], true) || !digits(fields[f + 1], false)) continue;
     std::string joined;
     for (size_t k = 0; k < fields.size(); ++k) {
@@ -375,6 +392,15 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
   value.fill(0.0);
   for (size_t f = 0; f < fields.size(); ++f) {
     const int column = header.column_of_field[f];
+    if (column == kSessionField) {
+      if (!IsValidSessionLabel(std::string(fields[f]))) {
+        *reason = "column " + Quoted(kSessionColumn) + ": " + Quoted(std::string(fields[f])) +
+                  " is not a session label (letters, digits, '-' and '_', at most " +
+                  std::to_string(kMaxSessionLabelLength) + ")";
+        return false;
+      }
+      continue;
+    }
     const auto fail = [&](const std::string& why) {
       *reason = "column " + Quoted(kColumnNames[column]) + ": " + why;
       return false;
@@ -479,6 +505,16 @@ std::string AttitudeInRadiansProblem(const Dataset& d) {
          internal::FormatDouble("%.3g", largest_focal_deg) + " deg at these positions" + fix;
 }
 
+// The index of `label` in dataset->session_labels, appended when new.
+int SessionIndex(std::string_view label, Dataset* dataset) {
+  std::vector<std::string>& labels = dataset->session_labels;
+  for (size_t k = 0; k < labels.size(); ++k) {
+    if (labels[k] == label) return static_cast<int>(k);
+  }
+  labels.emplace_back(label);
+  return static_cast<int>(labels.size()) - 1;
+}
+
 bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
                       const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
   Dataset result;
@@ -507,6 +543,9 @@ bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
     FieldValues values{};
     if (ParseRow(line, header, options.limits, result.samples.empty() ? nullptr : &previous,
                  &sample, &values, &reason)) {
+      if (header.session_field >= 0) {
+        sample.session = SessionIndex(SplitFields(line)[header.session_field], &result);
+      }
       result.samples.push_back(std::move(sample));
       previous = values;
     } else if (options.skip_invalid_rows) {
@@ -652,6 +691,8 @@ bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
   for (size_t k = 0; k < columns.size(); ++k) {
     text += (k > 0 ? "," : "") + std::string(kColumnNames[columns[k]]);
   }
+  const bool sessions = !dataset.session_labels.empty();
+  if (sessions) text += std::string(",") + kSessionColumn;
   text += "\n";
   for (size_t i = 0; i < dataset.samples.size(); ++i) {
     std::array<double, kNumColumns> value{};
@@ -664,6 +705,16 @@ bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
       const int c = columns[k];
       if (k > 0) text += ",";
       text += FormatNumber(value[c], IsTension(c) ? kKilo : 0);
+    }
+    if (sessions) {
+      const int session = dataset.samples[i].session;
+      if (session < 0 || session >= static_cast<int>(dataset.session_labels.size()) ||
+          !IsValidSessionLabel(dataset.session_labels[session])) {
+        *error = path + ": samples[" + std::to_string(i) + "]: session " + std::to_string(session) +
+                 " has no valid label in session_labels";
+        return false;
+      }
+      text += "," + dataset.session_labels[session];
     }
     text += "\n";
   }
@@ -702,6 +753,23 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
     return false;
   }
   return ParseDataset(text, path, options, dataset, error);
+}
+
+std::string SampleWhere(const Dataset& data, const Sample& sample) {
+  const bool merged =
+      sample.session >= 0 && sample.session < static_cast<int>(data.session_paths.size());
+  return (merged ? data.session_paths[sample.session] : data.path) + ":" +
+         std::to_string(sample.line);
+}
+
+bool IsValidSessionLabel(const std::string& label) {
+  if (label.empty() || label.size() > static_cast<size_t>(kMaxSessionLabelLength)) return false;
+  for (char c : label) {
+    const bool ok = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                    c == '-' || c == '_';
+    if (!ok) return false;
+  }
+  return true;
 }
 
 bool WriteDataset(const std::string& path, const Dataset& dataset,

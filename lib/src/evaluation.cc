@@ -18,8 +18,8 @@ Pose PoseOf(const Sample& sample, AttitudeSource attitude) {
 // "<file>:<line>: <model> cannot solve this pose<detail>: <why>".
 std::string CannotSolve(const Dataset& data, const Sample& sample, const std::string& model,
                         const std::string& detail, const StaticsSolution& solution) {
-  return data.path + ":" + std::to_string(sample.line) + ": " + model + " cannot solve this pose" +
-         detail + ": " + DescribeStatus(solution);
+  return SampleWhere(data, sample) + ": " + model + " cannot solve this pose" + detail + ": " +
+         DescribeStatus(solution);
 }
 
 }  // namespace

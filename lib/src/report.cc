@@ -929,6 +929,8 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
   if (in.result) {
     AddEstimates(*in.result, &doc);
     AddCablesAsBuilt(in, &doc);
+    internal::AddSessions(*in.result, with_plots, &doc);
+    internal::AddChangeScan(*in.result, with_plots, &doc);
     internal::AddUncertaintyBudget(*in.result, &doc);
     internal::AddGrossErrors(in, &doc);
     internal::AddMisfitRanking(*in.result, &doc);
@@ -1415,6 +1417,8 @@ void JsonCorrelations(const ReportInputs& in, JsonWriter* w) {
   }
   w->EndArray();
   if (r) internal::WriteDiagnosticsJson(*r, w);
+  if (r) internal::WriteSessionsJson(*r, w);
+  if (r) internal::WriteChangeScanJson(*r, w);
   ObjectOrNull(w, "identifiability", r != nullptr, [&] {
     JsonIdentifiability(w, "before", r->before);
     JsonIdentifiability(w, "after", r->after);

@@ -169,6 +169,10 @@ bool CheckInputs(const CableRobot& truth, const std::vector<Pose>& planned,
   std::string why;
   if (!truth.IsValid(&why)) return Fail(error, "truth model: " + why);
   if (planned.empty()) return Fail(error, "no planned poses");
+  if (static_cast<size_t>(options.sessions) > planned.size()) {
+    return Fail(error, std::to_string(options.sessions) + " sessions for " +
+                           std::to_string(planned.size()) + " poses: at most one per pose");
+  }
   for (size_t n = 0; n < planned.size(); ++n) {
     if (!IsFinite(planned[n])) {
       return Fail(error, "planned pose of node " + std::to_string(n) + " is not finite");
@@ -297,6 +301,25 @@ void Summarise(const Processes& p, double count, SimulationSummary* stats) {
   stats->position_measurement_rms_m = std::sqrt(p.position_sq / (3.0 * count));
 }
 
+// The sum of the mass-centre steps at or before time t.
+Eigen::Vector3d StepShiftAt(const SimulationOptions& options, double t) {
+  Eigen::Vector3d shift = Eigen::Vector3d::Zero();
+  for (const MassCentreStep& step : options.mass_centre_steps) {
+    if (step.time_s <= t) shift += step.shift_m;
+  }
+  return shift;
+}
+
+// Cuts the samples into `sessions` consecutive sessions labelled "1" .. "N".
+void LabelSessions(int sessions, Dataset* out) {
+  if (sessions <= 1) return;
+  const long long n = static_cast<long long>(out->samples.size());
+  for (int k = 0; k < sessions; ++k) out->session_labels.push_back(std::to_string(k + 1));
+  for (long long t = 0; t < n; ++t) {
+    out->samples[t].session = static_cast<int>(t * sessions / n);
+  }
+}
+
 // Stages: check the inputs, draw the truth model, then per planned pose the actual pose
 // and its statics, the measured pose and the readings; last the summary.
 bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
@@ -331,8 +354,9 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
     s.planned_rotation =
         RotationFromRpyDeg(s.planned_rpy_deg[0], s.planned_rpy_deg[1], s.planned_rpy_deg[2]);
     Eigen::Vector3d actual_rpy_deg;
-    if (!SolveActual(n, planned[n], s.planned_rpy_deg, options, mass_centre_m, statics, &processes,
-                     &model, &actual_rpy_deg, &solution, error)) {
+    if (!SolveActual(n, planned[n], s.planned_rpy_deg, options,
+                     mass_centre_m + StepShiftAt(options, s.time_s), statics, &processes, &model,
+                     &actual_rpy_deg, &solution, error)) {
       return false;
     }
     MeasurePose(planned[n].position_m, actual_rpy_deg, options, &processes, &s);
@@ -340,6 +364,7 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
   }
   Summarise(processes, static_cast<double>(planned.size()), &stats);
   model.mass_centre_cabin_m = mass_centre_m;  // the truth written out: the mean
+  LabelSessions(options.sessions, &out);
 
   if (dataset != nullptr) *dataset = std::move(out);
   if (truth_used != nullptr) *truth_used = std::move(model);
@@ -381,6 +406,13 @@ bool SimulationOptions::IsValid(std::string* error) const {
     return Fail(error, "outlier_scale_percent must be in [0, 100) (got " +
                            Num(outlier_scale_percent) + ")");
   }
+  for (const MassCentreStep& step : mass_centre_steps) {
+    if (!std::isfinite(step.time_s) || !step.shift_m.allFinite()) {
+      return Fail(error, "mass_centre_steps: a step's time and shift must be finite");
+    }
+  }
+  if (sessions < 1)
+    return Fail(error, "sessions must be >= 1 (got " + std::to_string(sessions) + ")");
   if (!(std::isfinite(sample_interval_s) && sample_interval_s > 0.0)) {
     return Fail(error,
                 "sample_interval_s must be finite and > 0 (got " + Num(sample_interval_s) + ")");

@@ -334,14 +334,24 @@ def quat_from_rpy_deg(rpy_deg: ArrayLike) -> np.ndarray:
     return quat[0] if single else quat
 
 
-def read_dataset(path: PathLike, skip_invalid_rows: bool = False) -> Dataset:
-    """Reads a telemetry CSV (docs/data-format.md).
+def read_dataset(
+    path: Union[PathLike, Sequence[PathLike]], skip_invalid_rows: bool = False
+) -> Dataset:
+    """Reads a telemetry CSV (docs/data-format.md), or several as one session each.
 
+    With a list of paths, the files are merged, one session per file labelled by its
+    name without directory and extension (a file with a `session` column keeps its
+    labels); Dataset.session_labels and Dataset.session say which sample is whose.
     With skip_invalid_rows, a row with a bad value is left out and listed in
     Dataset.skipped instead of raising. Raises InputError naming the file, line and
-    column, e.g. "data.csv:12: column 'T3_kN': 'abc' is not a number".
+    column, e.g. "data.csv:12: column 'T3_kN': 'abc' is not a number", or two files
+    with the same label.
     """
-    return _fastcal.read_dataset(os.fspath(path), skip_invalid_rows)
+    if isinstance(path, (str, bytes, os.PathLike)):
+        paths = [os.fspath(path)]
+    else:
+        paths = [os.fspath(p) for p in path]
+    return _fastcal.read_dataset(paths, skip_invalid_rows)
 
 
 def simulate(
@@ -360,7 +370,10 @@ def simulate(
     attitude_measurement_sigma_deg, position_measurement_sigma_m,
     tension_drift_percent, tension_drift_time_s, mass_centre_drift_m,
     mass_centre_drift_time_s, sensor_gain_spread_percent, sensor_bias_spread_kn,
-    density_mismatch_percent, sample_interval_s (1), seed (1), method ('exact').
+    density_mismatch_percent, sample_interval_s (1), seed (1), method ('exact'),
+    sessions (1: the samples cut into that many consecutive sessions, labelled 1..N),
+    mass_centre_steps ([(time_s, (dx, dy, dz)), ...]: the mass centre moves by the shift
+    at that time and stays).
 
     Returns:
         (dataset, truth_used, summary): the telemetry, the truth model after the drawn
@@ -407,6 +420,14 @@ class CalibrationResult:
         model: the calibrated Model.
         held_out: per sample, held out of the fit (list of bool).
         gross_error_mask: per sample and cable, a reading kept out, (n, 6) bool.
+        sessions: a joint fit's session labels (spec sessions.separate), else empty;
+            session_models: label -> the calibrated Model of that session;
+            session_differences: each separate parameter's change between consecutive
+            sessions, dicts of name, unit, from, to, difference, sigma_total.
+        change_scan: the scan (spec change_scan) as a dict (parameters, time_s,
+            statistic, threshold, significance, widening, min_segment_samples), or None;
+            changes: the changes found, dicts of time_s, line, sample, statistic,
+            p_value, shifts and shift_sigmas (name -> value, later minus earlier).
     """
 
     def __init__(self, raw: Dict[str, Any]) -> None:
@@ -447,6 +468,11 @@ class CalibrationResult:
         self.num_fit_samples: int = raw["num_fit_samples"]
         self.seconds: float = raw["seconds"]
         self.ceres_report: str = raw["ceres_report"]
+        self.sessions: List[str] = raw["sessions"]
+        self.session_models: Dict[str, Model] = raw["session_models"]
+        self.session_differences: List[Dict[str, Any]] = raw["session_differences"]
+        self.change_scan: Optional[Dict[str, Any]] = raw["change_scan"]
+        self.changes: List[Dict[str, Any]] = raw["changes"]
 
     def __repr__(self) -> str:
         shown = ", ".join(

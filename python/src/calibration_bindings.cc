@@ -99,6 +99,59 @@ py::dict Parameter(const ParameterEstimate& p, const std::vector<std::string>& g
   return d;
 }
 
+// The sessions of a joint fit and the change scan (sessions.h, change_scan.h).
+void AddSessionsAndChanges(const CalibrationResult& r, py::dict* d) {
+  (*d)["sessions"] = r.session_labels;
+  py::dict models;
+  for (size_t s = 0; s < r.session_models.size(); ++s) {
+    models[py::str(r.session_labels[s])] = r.session_models[s];
+  }
+  (*d)["session_models"] = models;
+  py::list differences;
+  for (const SessionDifference& x : r.session_differences) {
+    py::dict e;
+    e["name"] = x.name;
+    e["unit"] = x.unit;
+    e["from"] = x.from;
+    e["to"] = x.to;
+    e["difference"] = x.difference;
+    e["sigma_total"] = x.sigma_total;
+    differences.append(e);
+  }
+  (*d)["session_differences"] = differences;
+  const ChangeScanResult& scan = r.change_scan;
+  py::list changes;
+  for (const FoundChange& c : scan.changes) {
+    py::dict e, shifts, sigmas;
+    e["time_s"] = c.time_s;
+    e["line"] = c.line;
+    e["sample"] = c.sample;
+    e["statistic"] = c.statistic;
+    e["p_value"] = c.p_value;
+    for (size_t k = 0; k < c.shift.size(); ++k) {
+      shifts[py::str(scan.parameters[k])] = c.shift[k];
+      sigmas[py::str(scan.parameters[k])] = c.shift_sigma[k];
+    }
+    e["shifts"] = shifts;
+    e["shift_sigmas"] = sigmas;
+    changes.append(e);
+  }
+  (*d)["changes"] = changes;
+  if (!scan.enabled) {
+    (*d)["change_scan"] = py::none();
+    return;
+  }
+  py::dict s;
+  s["parameters"] = scan.parameters;
+  s["time_s"] = scan.time_s;
+  s["statistic"] = scan.statistic;
+  s["threshold"] = scan.threshold;
+  s["significance"] = scan.significance;
+  s["widening"] = scan.widening;
+  s["min_segment_samples"] = scan.min_segment;
+  (*d)["change_scan"] = s;
+}
+
 py::dict ResultDict(const CalibrationResult& r) {
   py::dict d;
   py::list parameters;
@@ -167,6 +220,7 @@ py::dict ResultDict(const CalibrationResult& r) {
   d["forward_model_max_rel_error"] = r.forward_model_max_rel_error;
   d["seconds"] = r.seconds;
   d["ceres_report"] = r.ceres_full_report;
+  AddSessionsAndChanges(r, &d);
   return d;
 }
 

@@ -8,6 +8,7 @@
 #include "bindings.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/dataset.h"
+#include "fastcal/sessions.h"
 #include "fastcal/simulation.h"
 
 namespace fastcal::python {
@@ -62,6 +63,18 @@ SimulationOptions MakeSimulationOptions(const py::dict& kwargs) {
     }
     if (name == "seed") {
       o.seed = value.cast<std::uint64_t>();
+    } else if (name == "sessions") {
+      o.sessions = value.cast<int>();
+    } else if (name == "mass_centre_steps") {
+      // [(time_s, (dx, dy, dz)), ...]
+      for (const py::handle step : value) {
+        const auto pair = step.cast<std::pair<double, std::vector<double>>>();
+        if (pair.second.size() != 3) {
+          throw InputError("simulate: each of mass_centre_steps is (time_s, (dx, dy, dz))");
+        }
+        o.mass_centre_steps.push_back(
+            {pair.first, Eigen::Vector3d(pair.second[0], pair.second[1], pair.second[2])});
+      }
     } else if (name == "method") {
       if (!ParseStaticsMethod(value.cast<std::string>(), &o.method)) {
         throw InputError("method must be 'aas', 'aas-refined' or 'exact'");
@@ -103,16 +116,17 @@ py::dict SummaryDict(const SimulationSummary& s) {
   return d;
 }
 
-Dataset ReadDatasetOrThrow(const std::string& path, bool skip_invalid_rows) {
+// One file, or several merged as one session each (sessions.h).
+Dataset ReadDatasetOrThrow(const std::vector<std::string>& paths, bool skip_invalid_rows) {
   DatasetReadOptions options;
   options.skip_invalid_rows = skip_invalid_rows;
   Dataset data;
   std::string error;
   bool ok = false;
-  RequireExistingFile(path, "dataset");
+  for (const std::string& path : paths) RequireExistingFile(path, "dataset");
   {
     py::gil_scoped_release release;
-    ok = ReadDataset(path, options, &data, &error);
+    ok = ReadSessionDatasets(paths, options, &data, &error);
   }
   if (!ok) throw InputError(error);
   return data;
@@ -125,10 +139,21 @@ Arrays are copies, in file order: time_s (n,), position_m (n, 3), rpy_deg (n, 3)
 quat (n, 4) the measured attitude, tension_kN (n, 6), line (n,) the file's 1-based line
 of each sample; planned_rpy_deg (n, 3) and s0_m (n, 6) are None when the file lacks
 those columns. skipped lists the rows read_dataset(skip_invalid_rows=True) left out.
+session_labels lists the sessions (a session column, or one per file read together) in
+the order of their first sample, empty without; session (n,) each sample's index into it.
 )")
       .def("__len__", [](const Dataset& d) { return d.samples.size(); })
       .def_readonly("path", &Dataset::path)
       .def_readonly("skipped", &Dataset::skipped)
+      .def_readonly("session_labels", &Dataset::session_labels)
+      .def_property_readonly("session",
+                             [](const Dataset& d) {
+                               py::array_t<int> out(static_cast<py::ssize_t>(d.samples.size()));
+                               for (size_t n = 0; n < d.samples.size(); ++n) {
+                                 out.mutable_data()[n] = d.samples[n].session;
+                               }
+                               return out;
+                             })
       .def_property_readonly("time_s",
                              [](const Dataset& d) {
                                return PerSample(d, 1,
@@ -223,7 +248,7 @@ py::tuple SimulateFromArrays(const CableRobot& truth, const DoubleArray& positio
 
 void BindData(py::module_& m) {
   BindDatasetClass(m);
-  m.def("read_dataset", &ReadDatasetOrThrow, py::arg("path"), py::arg("skip_invalid_rows"));
+  m.def("read_dataset", &ReadDatasetOrThrow, py::arg("paths"), py::arg("skip_invalid_rows"));
   m.def("simulate", &SimulateFromArrays);
 }
 

@@ -31,14 +31,17 @@
 #define FASTCAL_CALIBRATION_H_
 
 #include <Eigen/Core>
+#include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/change_scan.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/sessions.h"
 #include "fastcal/uncertainty.h"
 
 namespace fastcal {
@@ -93,6 +96,10 @@ struct CalibrationOptions {
   // many evenly spaced fitted samples, their sums scaled up (a 64-wide Jet through the
   // statics costs ~25 us a sample): docs/calibration.md, "What would explain the misfit".
   int max_candidate_samples = 20000;
+  // The change scan's null draws per round (change_scan.h) and their seed: 1000 place
+  // a 1% threshold to about +-0.3% in probability.
+  int change_scan_replicates = 1000;
+  std::uint64_t change_scan_seed = 1;
   // Evaluate the model before and after (CalibrationResult::variants), the paper's
   // Table 6. Off, Calibrate skips those exact statics passes.
   bool evaluate = true;
@@ -253,6 +260,15 @@ struct CalibrationResult {
   // With priors, before and after solving; and from the data alone after solving.
   Identifiability before, after, data_only;
   CableRobot calibrated;
+  // A joint fit of several sessions (spec sessions.separate, data with two or more
+  // sessions: sessions.h); else all empty. The labels (Dataset::session_labels), the
+  // calibrated model of each session (`calibrated` is the first's), and each separate
+  // parameter's difference between consecutive sessions.
+  std::vector<std::string> session_labels;
+  std::vector<CableRobot> session_models;
+  std::vector<SessionDifference> session_differences;
+  // The scan for a change within the survey (spec change_scan; change_scan.h).
+  ChangeScanResult change_scan;
   std::vector<bool> held_out;  // per dataset sample
   int num_fit_samples = 0;
   int num_residuals = 0;

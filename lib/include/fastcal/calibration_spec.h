@@ -57,6 +57,10 @@ struct ParameterSpec {
   bool has_prior = false;
   double prior_mean_si = 0.0;
   double prior_sigma_si = 0.0;
+  // The session this parameter belongs to (an index into Dataset::session_labels), or -1:
+  // one value shared by every session. Only a joint fit's expanded spec has sessions
+  // (sessions.h: SeparateSessionParameters); its name then ends in "@LABEL".
+  int session = -1;
 
   bool IsConsider() const { return !free && has_prior; }
 };
@@ -104,6 +108,22 @@ struct CalibrationSpec {
   double gradient_tolerance = 1e-12;
   double parameter_tolerance = 1e-12;
   int num_threads = 2;
+  // Joint fit of several sessions (`sessions: {separate: [...]}`, sessions.h): the free
+  // parameters of these groups ("mass_centre_m", ParameterGroupName) get one value per
+  // session of the data; every other parameter is shared by all sessions. Empty: the
+  // sessions are fitted as one survey.
+  std::vector<std::string> separate_groups;
+  // The change scan (`change_scan: {...}`, change_scan.h): is there a time at which the
+  // free parameters of these groups stepped? Empty: no scan.
+  std::vector<std::string> change_scan_groups;
+  // Shortest segment on either side of a change, in fitted samples (>= 2 x the free
+  // parameters is needed to refit a side; the scan's null distribution depends on it
+  // through the trimming fraction).
+  int change_scan_min_segment = 50;
+  // Family-wise false-alarm probability of each test of binary segmentation.
+  double change_scan_significance = 0.01;
+  // At most this many changes are reported.
+  int change_scan_max_changes = 3;
 
   bool IsValid(std::string* error) const;
 };

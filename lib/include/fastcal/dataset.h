@@ -43,7 +43,16 @@ struct Sample {
   // Commanded unstretched cable lengths, when the file has the s0_*_m columns (> 0).
   bool has_unstretched_lengths = false;
   std::array<double, kNumCables> unstretched_length_m{};
+  // The survey (session) the sample belongs to: an index into Dataset::session_labels,
+  // 0 when the dataset has no sessions.
+  int session = 0;
 };
+
+// A session label (the `session` column, or a file's stem): 1 to kMaxSessionLabelLength
+// letters, digits, '-' and '_', so that it can end a parameter name (NAME@LABEL) and a
+// file name (model_calibrated@LABEL.yaml) unquoted.
+inline constexpr int kMaxSessionLabelLength = 64;
+bool IsValidSessionLabel(const std::string& label);
 
 struct Dataset {
   // The file (or source name) the dataset was read from; used in messages.
@@ -54,6 +63,13 @@ struct Dataset {
   bool has_unstretched_lengths = false;
   // Measured attitude given as qw,qx,qy,qz (true) or roll_deg,pitch_deg,yaw_deg (false).
   bool attitude_as_quaternion = false;
+  // The sessions, in the order of their first sample (docs/data-format.md, "Sessions"):
+  // from the file's `session` column, or one per file when several files are merged
+  // (sessions.h). Empty: no session column, one survey.
+  std::vector<std::string> session_labels;
+  // With files merged (sessions.h): the file each session came from, parallel to
+  // session_labels; empty otherwise.
+  std::vector<std::string> session_paths;
   // One message per row skipped under DatasetReadOptions::skip_invalid_rows, in file
   // order, formatted like the error the row would otherwise have caused ("file:line: ...");
   // then those of samples removed by SkipUnsolvableSamples (evaluation.h).
@@ -77,6 +93,10 @@ struct DatasetReadOptions {
   PlausibilityLimits limits;
 };
 
+// "<file>:<line>" of a sample, for messages: the file of its session when the dataset was
+// merged from several (Dataset::session_paths), else Dataset::path.
+std::string SampleWhere(const Dataset& data, const Sample& sample);
+
 // Reads a dataset file. On failure returns false and sets *error to a message naming the
 // file, the 1-based line and, where there is one, the column, e.g.
 //   data.csv:12: column 'T3_kN': 'abc' is not a number
@@ -93,7 +113,8 @@ bool ParseDataset(const std::string& text, const std::string& source_name,
 //   time_s, x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg (or qw, qx, qy, qz when
 //   dataset.attitude_as_quaternion), planned_roll_deg, planned_pitch_deg,
 //   planned_yaw_deg (if dataset.has_planned_attitude), T1_kN ... T6_kN,
-//   s0_1_m ... s0_6_m (if dataset.has_unstretched_lengths).
+//   s0_1_m ... s0_6_m (if dataset.has_unstretched_lengths), session (if
+//   dataset.session_labels is not empty: the label of each sample's session).
 // Numbers are written with the fewest significant digits (at most 17) that read back to
 // the same double, so Write then Read is exact. Refuses (returns false) data the reader
 // would reject with its default options: non-finite values, values beyond the default

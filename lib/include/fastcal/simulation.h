@@ -6,8 +6,10 @@
 //                                angle AR(1) with sigma attitude_control_sigma_deg and
 //                                correlation time attitude_control_time_s (0: white)
 //   actual position     p_act  = p                        (the position is held exactly)
-//   mass centre         e_n    = e + d_n, d per axis AR(1) with sigma mass_centre_drift_m
-//                                and correlation time mass_centre_drift_time_s
+//   mass centre         e_n    = e + d_n + sum_{k: t_k <= t_n} s_k, d per axis AR(1) with
+//                                sigma mass_centre_drift_m and correlation time
+//                                mass_centre_drift_time_s; s_k the steps at times t_k
+//                                (mass_centre_steps: the structure changed)
 //   truth statics       T_i, s0_i = SolveStatics(truth with e_n, (p_act, R(a_act)))
 //   sensor reading      y_i    = sensor_gain_i T_i + sensor_bias_n_i
 //   measured tension    m_i    = y_i (1 + N(0, tension_noise_percent / 100) + u_i,n)
@@ -45,6 +47,12 @@
 #include "fastcal/statics.h"
 
 namespace fastcal {
+
+// The mass centre moves by shift_m (cabin frame) at time_s and stays there.
+struct MassCentreStep {
+  double time_s = 0.0;
+  Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();
+};
 
 struct SimulationOptions {
   // Attitude control error: standard deviation of the actual minus the planned roll,
@@ -93,6 +101,14 @@ struct SimulationOptions {
   StaticsMethod method = StaticsMethod::kExact;
   // Time between samples (s): sample n has time_s = n * sample_interval_s. > 0; default 1.
   double sample_interval_s = 1.0;
+  // Steps of the mass centre: from the first sample at or after each time on, the mass
+  // centre is moved by the step's shift (steps add up). Finite; default none. The truth
+  // model written out keeps the mass centre before the first step.
+  std::vector<MassCentreStep> mass_centre_steps;
+  // The samples cut into this many consecutive sessions of equal length (the first ones
+  // one sample longer when it does not divide), labelled "1" .. "N" in the dataset's
+  // session column (docs/data-format.md, "Sessions"). >= 1; 1: no session column.
+  int sessions = 1;
 
   // False, with the offending field named in *error (may be null), for a value out of range.
   bool IsValid(std::string* error) const;

@@ -44,12 +44,15 @@ class CalibrationModel {
   std::vector<double> InitialTheta() const;
   // The value parameter `p` has in the base model (after fixed overrides), SI.
   double BaseValue(const ParameterSpec& p) const;
-  // The calibrated model: the input robot with the parameters set to theta.
-  CableRobot ToRobot(const double* theta) const;
+  // The calibrated model: the input robot with the parameters set to theta (those of
+  // `session` where a parameter has one copy per session: sessions.h).
+  CableRobot ToRobot(const double* theta, int session = 0) const;
 
+  // The statics parameters and sensor model at theta for a sample of `session`: a
+  // parameter of another session (ParameterSpec::session) does not apply.
   template <typename T>
   void Assemble(const T* theta, StaticsParameters<T>* p, std::array<T, kNumCables>* gain,
-                std::array<T, kNumCables>* bias) const {
+                std::array<T, kNumCables>* bias, int session = 0) const {
     for (int i = 0; i < kNumCables; ++i) {
       p->tower_top_m[i] = base_.tower_top_m[i].cast<T>();
       p->anchor_cabin_m[i] = base_.anchor_cabin_m[i].cast<T>();
@@ -68,6 +71,7 @@ class CalibrationModel {
     p->gravity_m_per_s2 = base_.gravity_m_per_s2;
     for (int k = 0; k < num_free(); ++k) {
       const ParameterSpec& s = spec_.parameters[free_[k]];
+      if (s.session >= 0 && s.session != session) continue;
       const T& v = theta[k];
       switch (s.kind) {
         case ParameterKind::kMassCentre:
@@ -137,12 +141,13 @@ struct TensionResidual {
   StaticsSolution start;
   // Readings kept out of the fit: their residual is 0, whatever the parameters.
   std::array<bool, kNumCables> excluded{};
+  int session = 0;  // the sample's (Sample::session)
 
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
     StaticsParameters<T> p;
     std::array<T, kNumCables> gain, bias, tension;
-    model->Assemble(theta, &p, &gain, &bias);
+    model->Assemble(theta, &p, &gain, &bias, session);
     // Physical limits: a non-positive gain here, and non-positive mass, density or EA in
     // the statics, make the evaluation fail, which Ceres treats as an infeasible step.
     for (const T& g : gain) {

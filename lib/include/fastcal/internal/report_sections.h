@@ -45,6 +45,18 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc);
 // worst_readings, misfit_ranking, cross_validation, residual_autocorrelation_time.
 void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w);
 
+// A joint fit's sessions (report_sessions.cc): the separate parameters per session with
+// sigma_total, the differences between consecutive sessions, and a plot per parameter.
+// Nothing without sessions.
+void AddSessions(const CalibrationResult& r, bool with_plots, Document* doc);
+// summary.json's `sessions` (labels) and `session_differences` (empty without sessions).
+void WriteSessionsJson(const CalibrationResult& r, JsonWriter* w);
+// The change scan (report_sessions.cc): the changes found, the statistic over time with
+// its threshold and the changes marked. Nothing without a scan.
+void AddChangeScan(const CalibrationResult& r, bool with_plots, Document* doc);
+// summary.json's `change_scan` (null without a scan) and `changes` (empty when none).
+void WriteChangeScanJson(const CalibrationResult& r, JsonWriter* w);
+
 }  // namespace fastcal::internal
 
 #endif  // FASTCAL_INTERNAL_REPORT_SECTIONS_H_
