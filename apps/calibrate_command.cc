@@ -22,6 +22,7 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/evaluation_screen.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/internal/report_document.h"
@@ -42,6 +43,8 @@ DEFINE_bool(skip_invalid_rows, false,
             "Skip dataset rows that are malformed or whose pose the model cannot solve "
             "(listed on stderr and in the report) instead of failing.");
 DEFINE_bool(quiet, false, "calibrate: no per-iteration progress.");
+DEFINE_int32(residuals_every, 1,
+             "calibrate, evaluate: residuals.csv keeps every K-th sample (1: all; 0: no file).");
 
 namespace fastcal::cli {
 namespace {
@@ -69,6 +72,8 @@ Usage:
                       calibration succeeded: nothing is left behind on failure.
   --force             let --out be a previous run's results (only the files listed under
                       Outputs), replaced when the new ones are complete
+  --residuals-every=K residuals.csv keeps one sample in K (default 1: every sample;
+                      0: no residuals.csv). At 10^6 samples the full file is ~300 MB.
   --skip-invalid-rows skip rows that are malformed (a missing, non-numeric or non-finite
                       value, an implausible one...) or whose pose the initial model cannot
                       solve (e.g. outside the workspace), instead of failing; each is
@@ -80,8 +85,10 @@ e.g. cabin mass together with a common sensor gain, or tower offsets from one ci
 the calibration is refused with the combination named and what to fix (exit 1).
 
 Gross errors: a reading more than 5 robust sigmas from the model (the spec's
-gross_errors) is kept out of the fit and named by file line and cable; a dataset
-mostly made of them is refused (exit 1).
+gross_errors.threshold_sigmas; more on a long dataset: the threshold at which Gaussian
+noise has a 1% chance of naming any reading, 5.64 at 10^5 samples, 6.03 at 10^6) is kept
+out of the fit and named by file line and cable; a dataset mostly made of them is
+refused (exit 1).
 
 Each estimate comes with sigma_total, the uncertainty to quote: the formal sigma (stated
 noise, independent samples) widened by the misfit and by residuals correlated in time,
@@ -134,12 +141,16 @@ Usage:
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
   --force        let --out be a previous evaluate's results, replaced when complete
+  --residuals-every=K   residuals.csv keeps one sample in K (1: all, the default; 0: none)
   --skip-invalid-rows   skip rows that are malformed or whose pose the model cannot solve
                  (with --method, at each attitude) instead of failing; each is listed
                  with its line on stderr and, with --out, in the report and summary.json
 
 Prints RMS, mean and max |model - measured| per cable in kN and percent, with the measured
-attitude and, when the data has it, the planned attitude. The model's sensor gain and
+attitude and, when the data has it, the planned attitude. Gross errors are screened as calibrate
+screens them (against the measured attitude's predictions, with the default noise model
+of 3 % of the reading and a threshold that grows with the number of readings), named by
+line and cable, and each row of the RMS table is repeated without them. The model's sensor gain and
 bias (if any) are applied: predicted reading = gain * tension + bias.
 )";
 
@@ -149,6 +160,14 @@ const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "re
                                                     "report.md", "summary.json", "residuals.csv"};
 const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
                                                    "residuals.csv"};
+
+// --residuals-every must be >= 0 (0: no residuals.csv).
+bool CheckResidualsEvery(std::string* error) {
+  if (FLAGS_residuals_every >= 0) return true;
+  *error = "--residuals-every=" + std::to_string(FLAGS_residuals_every) +
+           ": must be 0 (no residuals.csv), 1 (every sample) or more (one sample in K)";
+  return false;
+}
 
 // CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
 bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
@@ -160,37 +179,49 @@ bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
 // ("3", "1 4"; empty for none).
 std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluation>& variants,
                          const std::vector<bool>& held_out, const ReadingMask& excluded) {
-  std::ostringstream out;
-  out << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
-  out << "line,time_s,held_out,gross_error_cables";
-  for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
-  std::vector<std::string> tags;
+  // One string, appended to in place (not a stream copied out and concatenated): at 10^6
+  // samples the file is ~300 MB, and each copy of it was another 300 MB of peak memory.
+  const size_t every = static_cast<size_t>(std::max(1, FLAGS_residuals_every));
+  std::ostringstream head;
+  std::vector<const VariantEvaluation*> drawn;  // variants with predictions (columns)
   for (size_t v = 0; v < variants.size(); ++v) {
-    std::string tag = "v" + std::to_string(v + 1);
-    tags.push_back(tag);
-    for (int i = 1; i <= kNumCables; ++i) out << "," << tag << "_T" << i << "_kN";
+    if (variants[v].predicted_n.empty()) continue;  // a row of statistics only
+    drawn.push_back(&variants[v]);
+    head << "# v" << v + 1 << " = " << variants[v].name << "\n";
   }
-  out << "\n";
-  for (size_t n = 0; n < data.samples.size(); ++n) {
+  head << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
+  if (every > 1) {
+    head << "# one sample in " << every << " of the " << data.samples.size()
+         << " (--residuals-every=" << every << "), from the first\n";
+  }
+  head << "line,time_s,held_out,gross_error_cables";
+  for (int i = 1; i <= kNumCables; ++i) head << ",T" << i << "_kN";
+  for (size_t v = 0; v < variants.size(); ++v) {
+    if (variants[v].predicted_n.empty()) continue;
+    for (int i = 1; i <= kNumCables; ++i) head << ",v" << v + 1 << "_T" << i << "_kN";
+  }
+  head << "\n";
+  std::string out = head.str();
+  constexpr size_t kBytesPerNumber = 12;  // a guess for reserve(), not a limit
+  const size_t rows = (data.samples.size() + every - 1) / every;
+  out.reserve(out.size() + rows * kBytesPerNumber * (3 + kNumCables * (1 + drawn.size())));
+  for (size_t n = 0; n < data.samples.size(); n += every) {
     const Sample& s = data.samples[n];
-    out << s.line << "," << FormatDouble(s.time_s) << ","
-        << (!held_out.empty() && held_out[n] ? 1 : 0) << ",";
-    std::string gross;
+    out += std::to_string(s.line) + "," + FormatDouble(s.time_s) + "," +
+           (!held_out.empty() && held_out[n] ? "1" : "0") + ",";
+    bool first = true;
     for (int i = 0; n < excluded.size() && i < kNumCables; ++i) {
-      if (excluded[n][i]) gross += (gross.empty() ? "" : " ") + std::to_string(i + 1);
+      if (!excluded[n][i]) continue;
+      out += (first ? "" : " ") + std::to_string(i + 1);
+      first = false;
     }
-    out << gross;
-    for (double t : s.tension_n) out << "," << FormatDouble(t / kNPerKn);
-    for (const VariantEvaluation& v : variants) {
-      for (double t : v.predicted_n[n]) out << "," << FormatDouble(t / kNPerKn);
+    for (double t : s.tension_n) out += "," + FormatDouble(t / kNPerKn);
+    for (const VariantEvaluation* v : drawn) {
+      for (double t : v->predicted_n[n]) out += "," + FormatDouble(t / kNPerKn);
     }
-    out << "\n";
+    out += "\n";
   }
-  std::ostringstream legend;
-  for (size_t v = 0; v < variants.size(); ++v) {
-    legend << "# " << tags[v] << " = " << variants[v].name << "\n";
-  }
-  return legend.str() + out.str();
+  return out;
 }
 
 // The per-cable tables of calibrate's and evaluate's consoles share one layout: a label
@@ -535,6 +566,36 @@ std::string ConsiderLines(const CalibrationResult& result) {
   return s.str();
 }
 
+// Which threshold the gross-error screen used, one console line (the report and
+// summary.json have the sentence, DescribeGrossErrorThreshold).
+std::string ThresholdLine(const std::string& indent, const GrossErrorThreshold& t) {
+  char buf[200];
+  std::snprintf(buf, sizeof(buf),
+                "%sthreshold: %s (floor %.3g, family-wise %.3g for %lld readings)\n",
+                indent.c_str(), t.family_wise_decides() ? "family-wise" : "the floor",
+                t.floor_sigmas, t.family_wise_sigmas, t.readings);
+  return buf;
+}
+
+// The first few readings of `list`, one line each, then how many more.
+std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::string& indent) {
+  constexpr size_t kShown = 5;
+  std::ostringstream s;
+  for (size_t k = 0; k < std::min(list.size(), kShown); ++k) {
+    const ReadingResidual& e = list[k];
+    char buf[200];
+    std::snprintf(buf, sizeof(buf),
+                  "%sline %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
+                  indent.c_str(), e.line, e.cable, e.measured_n / kNPerKn, e.predicted_n / kNPerKn,
+                  e.residual_sigma, e.held_out ? " (held out)" : "");
+    s << buf;
+  }
+  if (list.size() > kShown) {
+    s << indent << "... " << list.size() - kShown << " more in summary.json (outliers)\n";
+  }
+  return s.str();
+}
+
 std::string GrossErrorLines(const CalibrationResult& result) {
   const GrossErrorSummary& g = result.gross_error_summary;
   if (!g.enabled) return "  gross errors: not screened (gross_errors.detect: false)\n";
@@ -542,18 +603,9 @@ std::string GrossErrorLines(const CalibrationResult& result) {
   const size_t count = result.gross_errors.size();
   s << "  gross errors (more than " << FormatDouble(g.threshold_sigmas, 3)
     << " robust sigmas from the model): " << count << (count == 1 ? " reading" : " readings")
-    << ", kept out of the fit\n";
-  constexpr size_t kShown = 5;
-  for (size_t k = 0; k < std::min(count, kShown); ++k) {
-    const ReadingResidual& e = result.gross_errors[k];
-    char buf[200];
-    std::snprintf(buf, sizeof(buf),
-                  "    line %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
-                  e.line, e.cable, e.measured_n / kNPerKn, e.predicted_n / kNPerKn,
-                  e.residual_sigma, e.held_out ? " (held out)" : "");
-    s << buf;
-  }
-  if (count > kShown) s << "    ... " << count - kShown << " more in summary.json (outliers)\n";
+    << ", kept out of the fit\n"
+    << ThresholdLine("    ", g.threshold);
+  s << ReadingLines(result.gross_errors, "    ");
   return s.str();
 }
 
@@ -634,7 +686,8 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
     << RmsTable(variants) << CrossValidationLine(result) << "\nwrote " << FLAGS_out
-    << "/{model_calibrated.yaml, report.html, report.md, summary.json, residuals.csv}\n";
+    << "/{model_calibrated.yaml, report.html, report.md, summary.json"
+    << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
 }
 
@@ -720,7 +773,8 @@ int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kCalibrateHelp,
-                    {"model", "spec", "data", "out", "skip-invalid-rows", "quiet", "force"},
+                    {"model", "spec", "data", "out", "skip-invalid-rows", "quiet", "force",
+                     "residuals-every"},
                     &exit_code)) {
     return exit_code;
   }
@@ -734,7 +788,8 @@ int RunCalibrate(int argc, char** argv) {
   CableRobot model;
   Dataset data;
   CalibrationSpec spec;
-  if (!CheckOutFlag(kCalibrateOutputs, &error) || !LoadInputs(&model, &data, &error) ||
+  if (!CheckResidualsEvery(&error) || !CheckOutFlag(kCalibrateOutputs, &error) ||
+      !LoadInputs(&model, &data, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, model, &spec, &error)) {
     PrintError(command, error);
     return kExitUsage;
@@ -789,8 +844,11 @@ int RunCalibrate(int argc, char** argv) {
 
   std::vector<std::pair<std::string, std::string>> files = {
       {"model_calibrated.yaml",
-       CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))},
-      {"residuals.csv", ResidualsCsv(data, variants, result.held_out, result.excluded)}};
+       CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))}};
+  if (FLAGS_residuals_every > 0) {
+    files.emplace_back("residuals.csv",
+                       ResidualsCsv(data, variants, result.held_out, result.excluded));
+  }
   std::vector<std::string> outputs = kCalibrateOutputs;
   for (size_t s = 0; s < result.session_models.size(); ++s) {
     const std::string name = "model_calibrated@" + result.session_labels[s] + ".yaml";
@@ -808,10 +866,23 @@ int RunCalibrate(int argc, char** argv) {
   return 0;
 }
 
+// evaluate's gross errors: how many, the threshold and why, the first few by line and cable.
+std::string EvaluationGrossErrorLines(const EvaluationScreen& screen) {
+  std::ostringstream s;
+  const size_t count = screen.gross_errors.size();
+  s << "gross errors (against \"" << screen.variant << "\"): " << count
+    << (count == 1 ? " reading" : " readings")
+    << (count > 0 ? ", left out of the rows \"... - gross errors\"" : "") << "\n"
+    << ThresholdLine("  ", screen.threshold);
+  s << ReadingLines(screen.gross_errors, "  ");
+  return s.str();
+}
+
 // evaluate's console: the RMS table, then per variant the RMS (%), mean and largest
-// error (kN) per cable.
+// error (kN) per cable, then the gross errors.
 std::string EvaluationConsole(const Dataset& data, StaticsMethod method,
-                              const std::vector<VariantEvaluation>& variants) {
+                              const std::vector<VariantEvaluation>& variants,
+                              const EvaluationScreen& screen) {
   std::ostringstream s;
   s << "fastcal evaluate: " << data.samples.size() << " samples";
   s << SkippedNote(data);
@@ -824,16 +895,20 @@ std::string EvaluationConsole(const Dataset& data, StaticsMethod method,
     s << CableRow("  mean (kN)", v.fit.mean_n, 1.0 / kNPerKn);
     s << CableRow("  max |error| (kN)", v.fit.max_abs_n, 1.0 / kNPerKn);
   }
+  s << "\n" << EvaluationGrossErrorLines(screen);
   if (!FLAGS_out.empty())
-    s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json, residuals.csv}\n";
+    s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json"
+      << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
 }
 
 int RunEvaluate(int argc, char** argv) {
   const char* command = "evaluate";
   int exit_code = 0;
-  if (!StartCommand(argc, argv, command, kEvaluateHelp,
-                    {"model", "data", "out", "method", "skip-invalid-rows", "force"}, &exit_code)) {
+  if (!StartCommand(
+          argc, argv, command, kEvaluateHelp,
+          {"model", "data", "out", "method", "skip-invalid-rows", "force", "residuals-every"},
+          &exit_code)) {
     return exit_code;
   }
   std::string error;
@@ -845,7 +920,8 @@ int RunEvaluate(int argc, char** argv) {
   }
   CableRobot model;
   Dataset data;
-  if ((!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error)) ||
+  if (!CheckResidualsEvery(&error) ||
+      (!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error)) ||
       !LoadInputs(&model, &data, &error)) {
     PrintError(command, error);
     return kExitUsage;
@@ -874,18 +950,30 @@ int RunEvaluate(int argc, char** argv) {
     PrintError(command, error + SkipHint());
     return kExitFailure;
   }
+  // The screen calibrate applies, against the last variant (the measured attitude, which
+  // every dataset has); the RMS table gains each row again without what it names.
+  const EvaluationScreen screen = ScreenEvaluation(data, variants.back());
+  if (!screen.gross_errors.empty()) {
+    for (VariantEvaluation& v : WithoutGrossErrors(data, variants, screen.excluded)) {
+      variants.push_back(std::move(v));
+    }
+  }
   if (!FLAGS_out.empty()) {
     ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/false);
     report.initial_model = &model;
     report.data = &data;
     report.variants = variants;
     report.evaluation_method = StaticsMethodName(method);
-    if (!WriteOutDirectory(command, {{"residuals.csv", ResidualsCsv(data, variants, {}, {})}},
-                           report, kEvaluateOutputs)) {
+    report.evaluation_screen = &screen;
+    std::vector<std::pair<std::string, std::string>> files;
+    if (FLAGS_residuals_every > 0) {
+      files.emplace_back("residuals.csv", ResidualsCsv(data, variants, {}, screen.excluded));
+    }
+    if (!WriteOutDirectory(command, files, report, kEvaluateOutputs)) {
       return kExitUsage;
     }
   }
-  std::cout << EvaluationConsole(data, method, variants);
+  std::cout << EvaluationConsole(data, method, variants, screen);
   return 0;
 }
 

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <functional>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -454,19 +455,39 @@ std::string TruthPathFor(const std::string& csv_path) {
          ".truth.yaml";
 }
 
-// Writes both files to temporaries, then renames them into place; on failure removes
-// whatever it wrote, so that neither file is left.
-bool WriteBoth(const std::string& csv_path, const Dataset& dataset, const std::string& csv_header,
-               const std::string& yaml_path, const CableRobot& truth,
-               const std::string& yaml_header, std::string* error) {
+// Streams the simulation into a temporary beside csv_path (memory independent of the
+// number of samples), then writes the truth model (known only at the end: the
+// mass centre's average) to a temporary beside yaml_path and renames both into place;
+// on failure removes whatever it wrote, so that neither file is left. *simulation_failed
+// tells a failed simulation (exit 1) from a failed write (exit 2).
+bool SimulateAndWrite(const CableRobot& truth, const std::vector<Pose>& poses,
+                      const SimulationOptions& options, const std::string& csv_path,
+                      const std::string& csv_header, const std::string& yaml_path,
+                      const std::function<std::string(const SimulationSummary&)>& yaml_header,
+                      SimulationSummary* summary, bool* simulation_failed, std::string* error) {
   const std::string tmp = ".tmp." + std::to_string(::getpid());
   const std::string csv_tmp = csv_path + tmp;
   const std::string yaml_tmp = yaml_path + tmp;
-  if (!WriteDataset(csv_tmp, dataset, csv_header, error)) {
+  *simulation_failed = false;
+  DatasetWriter writer;
+  if (!writer.Open(csv_tmp, SimulatedDatasetLayout(options.sessions), csv_header, error)) {
     *error = "writing " + csv_path + ": " + *error;
     return false;
   }
-  if (!SaveCableRobot(truth, yaml_tmp, yaml_header, error)) {
+  bool write_failed = false;
+  const SampleSink sink = [&](const Sample& sample, std::string* why) {
+    write_failed = !writer.Write(sample, why);
+    return !write_failed;
+  };
+  CableRobot truth_used;
+  const bool simulated = SimulateStream(truth, poses, options, sink, &truth_used, summary, error);
+  if (!simulated || !writer.Close(error)) {
+    *simulation_failed = !simulated && !write_failed;
+    std::remove(csv_tmp.c_str());
+    if (!*simulation_failed) *error = "writing " + csv_path + ": " + *error;
+    return false;
+  }
+  if (!SaveCableRobot(truth_used, yaml_tmp, yaml_header(*summary), error)) {
     std::remove(csv_tmp.c_str());
     *error = "writing " + yaml_path + ": " + *error;
     return false;
@@ -553,14 +574,6 @@ int RunSimulate(int argc, char** argv) {
     return kExitUsage;
   }
 
-  Dataset dataset;
-  CableRobot truth_used;
-  SimulationSummary summary;
-  if (!Simulate(truth, poses, options, &dataset, &truth_used, &summary, &error)) {
-    PrintError(kCommand, error);
-    return kExitFailure;
-  }
-
   const std::string csv_path = FLAGS_out;
   const std::string yaml_path = TruthPathFor(csv_path);
   // Without --force: it changes nothing in the files, so a dataset regenerated with it
@@ -569,25 +582,25 @@ int RunSimulate(int argc, char** argv) {
   const std::string version = FASTCAL_VERSION;
   const std::string csv_header =
       "Simulated by fastcal " + version + "\n" + command + "\nTruth model: " + yaml_path;
-  std::string yaml_header =
-      "Truth model of " + csv_path + ", simulated by fastcal " + version + "\n" + command;
-  if (options.mass_centre_drift_m > 0.0) {
-    const Eigen::Vector3d& m = summary.mass_centre_mean_m;
-    yaml_header += "\nThe mass centre drifted about mass_centre_m below (AR(1), sigma " +
-                   FormatDouble(options.mass_centre_drift_m) + " m per axis, correlation time " +
-                   FormatDouble(options.mass_centre_drift_time_s) +
-                   " s); its average over the samples was (" + FormatDouble(m.x(), 6) + ", " +
-                   FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
-  }
-  for (const MassCentreStep& step : options.mass_centre_steps) {
-    yaml_header += "\nAt t = " + FormatDouble(step.time_s) + " s the mass centre moved by (" +
-                   FormatDouble(step.shift_m.x()) + ", " + FormatDouble(step.shift_m.y()) + ", " +
-                   FormatDouble(step.shift_m.z()) +
-                   ") m from mass_centre_m below (before any step).";
-  }
-  if (!WriteBoth(csv_path, dataset, csv_header, yaml_path, truth_used, yaml_header, &error)) {
+  auto yaml_header = [&](const SimulationSummary& summary) {
+    std::string header =
+        "Truth model of " + csv_path + ", simulated by fastcal " + version + "\n" + command;
+    if (options.mass_centre_drift_m > 0.0) {
+      const Eigen::Vector3d& m = summary.mass_centre_mean_m;
+      header += "\nThe mass centre drifted about mass_centre_m below (AR(1), sigma " +
+                FormatDouble(options.mass_centre_drift_m) + " m per axis, correlation time " +
+                FormatDouble(options.mass_centre_drift_time_s) +
+                " s); its average over the samples was (" + FormatDouble(m.x(), 6) + ", " +
+                FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
+    }
+    return header;
+  };
+  SimulationSummary summary;
+  bool simulation_failed = false;
+  if (!SimulateAndWrite(truth, poses, options, csv_path, csv_header, yaml_path, yaml_header,
+                        &summary, &simulation_failed, &error)) {
     PrintError(kCommand, error);
-    return kExitUsage;
+    return simulation_failed ? kExitFailure : kExitUsage;
   }
   // The summary of what was written is the result: stdout (docs/cli.md, "Output streams").
   std::cout << Summary(summary, options, csv_path, yaml_path) << std::endl;

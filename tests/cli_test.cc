@@ -1336,8 +1336,9 @@ TEST_F(CliTest, HardeningCommandsFromTheIssueGiveClearMessages) {
       {"solve --position=0x10,0,140", 2, "--position: '0x10' is not a decimal number"},
       {"solve --position=0,0,1e308", 2, "z = 1e+308 m is above the tower tops"},
       {"solve --position=0,0,140 --rpy=0,0,1e300", 2, "yaw 1e+300 deg is beyond the plausible"},
-      {"evaluate --data=" + Path("t1tiny.csv"), 0, "RMS (%)"},
-      {"evaluate --data=" + Path("zero.csv"), 0, "RMS (%)"},
+      // evaluate names a dropout (screened as calibrate screens) instead of folding it in.
+      {"evaluate --data=" + Path("t1tiny.csv"), 0, "cable 1: measured 0.000 kN"},
+      {"evaluate --data=" + Path("zero.csv"), 0, "cable 2: measured 0.000 kN"},
       {"--help", 0, "solve"},
       {"solve --bogus=1", 2, "unknown flag --bogus"},
       {"solve --position=0,0,140 --method=\"$(printf '\\033')[2J\"", 2,
@@ -1441,6 +1442,39 @@ TEST_F(CliTest, DesignWritesPosesSimulateReadsAndRefusesBadInput) {
                            " --out=" + Path("never"),
                        2, "frees no parameter"});
   EXPECT_FALSE(fs::exists(Path("never")));
+}
+
+// evaluate screens gross errors as calibrate does (issue 20): a 0 kN dropout is named in
+// summary.json and residuals.csv; --residuals-every thins residuals.csv (0: none, < 0
+// refused).
+TEST_F(CliTest, EvaluateNamesADropoutAndResidualsCanBeThinned) {
+  Write("dropout.csv", CircleWith("T2_kN", 0, "0"));  // data row 0: line 5
+  CommandResult r = Fastcal("evaluate --data=" + Path("dropout.csv") + " --out=" + Path("ev10") +
+                            " --residuals-every=10");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("line 5, cable 2: measured 0.000 kN"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("model, measured attitude - gross errors"), std::string::npos)
+      << r.output;
+  const std::string json = ReadFile(Path("ev10") + "/summary.json");
+  EXPECT_NE(json.find("\"outliers\": [\n    {\n      \"line\": 5,\n      \"cable\": 2,"),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"threshold_rule\": \"spec floor\""), std::string::npos) << json;
+  const std::string residuals = ReadFile(Path("ev10") + "/residuals.csv");
+  EXPECT_NE(residuals.find("# one sample in 10 of the 21 (--residuals-every=10)"),
+            std::string::npos)
+      << residuals;
+  EXPECT_NE(residuals.find("\n5,0,0,2,"), std::string::npos) << residuals;  // line 5, cable 2
+  EXPECT_NE(residuals.find("\n15,10,0,,"), std::string::npos) << residuals;
+  EXPECT_EQ(residuals.find("\n6,1,"), std::string::npos) << residuals;  // thinned out
+  r = Fastcal("evaluate --data=" + Path("dropout.csv") + " --out=" + Path("ev0") +
+              " --residuals-every=0");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_TRUE(fs::exists(Path("ev0") + "/report.html"));
+  EXPECT_FALSE(fs::exists(Path("ev0") + "/residuals.csv"));
+  r = Fastcal("evaluate --data=" + Path("dropout.csv") + " --residuals-every=-1");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("--residuals-every=-1: must be 0"), std::string::npos) << r.output;
 }
 
 }  // namespace

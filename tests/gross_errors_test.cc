@@ -7,8 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
+
+#include "fastcal/evaluation_screen.h"
 
 namespace fastcal {
 namespace {
@@ -83,6 +87,83 @@ TEST(GrossErrorScreenTest, UnjudgedSamplesAreFlaggedAgainstTheJudgedScales) {
   EXPECT_EQ(s.count, 0);      // among the judged samples
   EXPECT_EQ(s.count_all, 2);  // among all
   EXPECT_EQ(s.judged, 101 * kNumCables);
+}
+
+// The family-wise threshold z_N solves erfc(z_N / sqrt 2) = alpha / N (the definition),
+// and the spec's value is the floor: it decides on a short dataset, z_N on a long one.
+TEST(GrossErrorThresholdTest, FamilyWiseQuantileAndTheSpecsFloor) {
+  constexpr double kQuantileTol = 1e-12;  // relative, of the tail probability
+  for (long long n : {6LL, 17443LL, 600000LL, 6000000LL}) {
+    const GrossErrorThreshold t = ChooseGrossErrorThreshold(n, kThreshold);
+    const double tail = std::erfc(t.family_wise_sigmas / std::sqrt(2.0));
+    EXPECT_NEAR(tail / (kGrossErrorFamilyFalseAlarm / n), 1.0, kQuantileTol) << n;
+    EXPECT_EQ(t.sigmas, std::max(kThreshold, t.family_wise_sigmas)) << n;
+    EXPECT_EQ(t.readings, n);
+  }
+  // Reference values (Phi^-1(1 - 0.01 / (2 N)), e.g. scipy.stats.norm.isf(0.005 / N)).
+  constexpr double kReferenceTol = 1e-6;
+  EXPECT_NEAR(ChooseGrossErrorThreshold(6, kThreshold).family_wise_sigmas, 3.1439803,
+              kReferenceTol);
+  EXPECT_EQ(ChooseGrossErrorThreshold(6, kThreshold).sigmas, kThreshold);
+  EXPECT_FALSE(ChooseGrossErrorThreshold(6, kThreshold).family_wise_decides());
+  EXPECT_NEAR(ChooseGrossErrorThreshold(600000, kThreshold).sigmas, 5.6434596, kReferenceTol);
+  EXPECT_NEAR(ChooseGrossErrorThreshold(6000000, kThreshold).sigmas, 6.0273531, kReferenceTol);
+  EXPECT_TRUE(ChooseGrossErrorThreshold(600000, kThreshold).family_wise_decides());
+  EXPECT_EQ(ChooseGrossErrorThreshold(600000, 8.0).sigmas, 8.0);  // a stricter spec stands
+}
+
+// Pure Gaussian noise of 10^5 samples (6 x 10^5 readings) is accused of nothing at the
+// threshold for its length (a 1% chance per seed; this seed is one of the 99%), while a
+// planted dropout in the same noise is still named.
+TEST(GrossErrorThresholdTest, GaussianNoiseOfAHundredThousandSamplesNamesNothing) {
+  constexpr int kSamples = 100000;
+  std::mt19937_64 rng(20);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  Rows rows(kSamples);
+  for (auto& row : rows) {
+    for (double& r : row) r = noise(rng);
+  }
+  const GrossErrorThreshold t =
+      ChooseGrossErrorThreshold(static_cast<long long>(kNumCables) * kSamples, kThreshold);
+  EXPECT_EQ(ScreenGrossErrors(rows, {}, t.sigmas).count, 0);
+  rows[kSamples / 2][3] = -1.0 / 0.03;  // a 0 reading, at 3 % noise of the prediction
+  const GrossErrorScreen s = ScreenGrossErrors(rows, {}, t.sigmas);
+  EXPECT_EQ(s.count, 1);
+  EXPECT_TRUE(s.flagged[kSamples / 2][3]);
+}
+
+// evaluate's screen: a 0 kN dropout among readings with 1% noise is named by line and
+// cable, with its prediction; nothing else is, and the RMS without it is the noise's.
+TEST(EvaluationScreenTest, NamesADropoutByLineAndCable) {
+  constexpr int kSamples = 2000;
+  constexpr double kPredictedN = 500e3;
+  constexpr double kNoise = 0.01;  // relative, within the default 3 % noise model
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> noise(0.0, kNoise);
+  Dataset data;
+  VariantEvaluation v;
+  v.name = "model, measured attitude";
+  for (int t = 0; t < kSamples; ++t) {
+    Sample s;
+    s.line = t + 2;
+    for (int i = 0; i < kNumCables; ++i) s.tension_n[i] = kPredictedN * (1.0 + noise(rng));
+    data.samples.push_back(s);
+    v.predicted_n.push_back({});
+    v.predicted_n.back().fill(kPredictedN);
+  }
+  data.samples[1234].tension_n[4] = 1e-300;  // the dropout of the issue
+  const EvaluationScreen e = ScreenEvaluation(data, v);
+  ASSERT_EQ(e.gross_errors.size(), 1u);
+  EXPECT_EQ(e.gross_errors[0].line, 1236);
+  EXPECT_EQ(e.gross_errors[0].cable, 5);
+  EXPECT_EQ(e.gross_errors[0].predicted_n, kPredictedN);
+  EXPECT_EQ(e.variant, v.name);
+  const std::vector<VariantEvaluation> without = WithoutGrossErrors(data, {v}, e.excluded);
+  ASSERT_EQ(without.size(), 1u);
+  EXPECT_EQ(without[0].fit.excluded[4], 1);
+  constexpr double kRmsTol = 0.1;  // relative, of the noise's RMS over 2000 readings
+  EXPECT_NEAR(without[0].fit.rms_n[4] / (kNoise * kPredictedN), 1.0, kRmsTol);
+  EXPECT_GT(ErrorStats(data, v.predicted_n, {}, false).rms_n[4], 2.0 * kNoise * kPredictedN);
 }
 
 }  // namespace

@@ -7,6 +7,8 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 #include <vector>
 
@@ -579,6 +581,65 @@ TEST(SimulationTest, MassCentreStepsAndSessions) {
   o.mass_centre_steps[0].time_s = std::nan("");
   EXPECT_FALSE(Simulate(truth, poses, o, &d, nullptr, nullptr, &error));
   EXPECT_NE(error.find("mass_centre_steps"), std::string::npos) << error;
+}
+
+std::string FileText(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// fastcal simulate streams (issue 20): SimulateStream into a DatasetWriter writes the
+// same bytes as Simulate then WriteDataset, with the same truth model and summary; the
+// writer refuses an existing file, a file of no rows and a row the reader would refuse.
+TEST(SimulationTest, StreamedSimulationWritesTheSameFile) {
+  std::string pattern = ::testing::TempDir() + "simulation_stream_XXXXXX";
+  ASSERT_NE(mkdtemp(pattern.data()), nullptr);
+  const fs::path dir = pattern;
+  const std::string whole = (dir / "whole.csv").string();
+  const std::string streamed = (dir / "streamed.csv").string();
+  SimulationOptions options;
+  options.attitude_control_sigma_deg = 0.2;
+  options.tension_drift_percent = 1.0;
+  options.mass_centre_drift_m = 0.05;
+  options.outlier_fraction = 0.05;
+  const std::vector<Pose> planned = Circle(72);
+  Dataset data;
+  CableRobot used_whole, used_streamed;
+  SimulationSummary summary_whole, summary_streamed;
+  std::string error;
+  ASSERT_TRUE(Simulate(CableRobot::NominalFast(), planned, options, &data, &used_whole,
+                       &summary_whole, &error))
+      << error;
+  ASSERT_TRUE(WriteDataset(whole, data, "simulated\ntwo lines", &error)) << error;
+
+  DatasetWriter writer;
+  ASSERT_TRUE(writer.Open(streamed, SimulatedDatasetLayout(), "simulated\ntwo lines", &error))
+      << error;
+  const SampleSink sink = [&](const Sample& s, std::string* why) { return writer.Write(s, why); };
+  ASSERT_TRUE(SimulateStream(CableRobot::NominalFast(), planned, options, sink, &used_streamed,
+                             &summary_streamed, &error))
+      << error;
+  ASSERT_TRUE(writer.Close(&error)) << error;
+  EXPECT_EQ(FileText(streamed), FileText(whole));
+  EXPECT_EQ(used_streamed.mass_centre_cabin_m, used_whole.mass_centre_cabin_m);
+  EXPECT_EQ(summary_streamed.tension_noise_rms_n, summary_whole.tension_noise_rms_n);
+  EXPECT_EQ(summary_streamed.samples, summary_whole.samples);
+
+  DatasetWriter again;
+  EXPECT_FALSE(again.Open(streamed, SimulatedDatasetLayout(), "", &error));
+  EXPECT_NE(error.find("streamed.csv: cannot create"), std::string::npos) << error;
+  DatasetWriter empty;
+  ASSERT_TRUE(empty.Open((dir / "empty.csv").string(), SimulatedDatasetLayout(), "", &error));
+  EXPECT_FALSE(empty.Close(&error));
+  EXPECT_NE(error.find("no samples to write"), std::string::npos) << error;
+  DatasetWriter bad;
+  ASSERT_TRUE(bad.Open((dir / "bad.csv").string(), SimulatedDatasetLayout(), "", &error));
+  Sample nan = data.samples.front();
+  nan.tension_n[2] = std::nan("");
+  EXPECT_FALSE(bad.Write(nan, &error));
+  EXPECT_NE(error.find("samples[0]"), std::string::npos) << error;
+  std::error_code ignored;
+  fs::remove_all(dir, ignored);
 }
 
 }  // namespace

@@ -37,14 +37,10 @@ constexpr double kNPerKn = 1e3;
 // Chance that noise alone makes some candidate of the misfit ranking "significant".
 constexpr double kMisfitFamilyError = 0.01;
 
-// x with P(chi-square(1 dof) > x) = tail, i.e. erfc(sqrt(x / 2)) = tail, by bisection.
+// x with P(chi-square(1 dof) > x) = tail: the square of the two-sided normal quantile.
 double ChiSquare1Quantile(double tail) {
-  double lo = 0.0, hi = 1e3;
-  for (int i = 0; i < 200; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (std::erfc(std::sqrt(0.5 * mid)) > tail ? lo : hi) = mid;
-  }
-  return 0.5 * (lo + hi);
+  const double z = TwoSidedNormalQuantile(tail);
+  return z * z;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -412,11 +408,18 @@ CalibrationStatus Predict(Run& run) {
   return CalibrationStatus::kOk;
 }
 
+// The screen's threshold: the spec's as a floor, raised with the number of readings
+// screened (all samples') so that noise alone names none (gross_errors.h).
+GrossErrorThreshold ScreenThreshold(const Run& run) {
+  return ChooseGrossErrorThreshold(static_cast<long long>(kNumCables) * run.data.samples.size(),
+                                   run.spec.gross_error_threshold_sigmas);
+}
+
 // Stage helper: the gross errors at the current prediction, judged by the fitted samples.
 ReadingMask ScreenReadings(Run& run) {
   if (!run.spec.detect_gross_errors) return {};
   GrossErrorScreen screen =
-      ScreenGrossErrors(run.at.whitened, run.is_fit, run.spec.gross_error_threshold_sigmas);
+      ScreenGrossErrors(run.at.whitened, run.is_fit, ScreenThreshold(run).sigmas);
   GrossErrorSummary& g = run.result->gross_error_summary;
   for (int i = 0; i < kNumCables; ++i) {
     g.centre[i] = screen.cables[i].centre;
@@ -633,7 +636,8 @@ CalibrationStatus NameGrossErrors(Run& run) {
   CalibrationResult& r = *run.result;
   GrossErrorSummary& g = r.gross_error_summary;
   g.enabled = run.spec.detect_gross_errors;
-  g.threshold_sigmas = run.spec.gross_error_threshold_sigmas;
+  g.threshold = ScreenThreshold(run);
+  g.threshold_sigmas = g.threshold.sigmas;
   g.fitted_readings = kNumCables * r.num_fit_samples;
   r.excluded = run.excluded;
   if (!g.enabled) return CalibrationStatus::kOk;

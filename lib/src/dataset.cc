@@ -659,64 +659,79 @@ bool RowValues(const Dataset& dataset, const Sample& s, std::array<double, kNumC
   return true;
 }
 
+// The columns a dataset with `layout`'s flags has, in file order.
+std::vector<int> ColumnsOf(const Dataset& layout) {
+  std::vector<int> columns;
+  for (int c = 0; c < kNumColumns; ++c) {
+    const bool rpy = c >= kRoll && c <= kYaw;
+    const bool quaternion = c >= kQw && c <= kQz;
+    const bool planned = c >= kPlannedRoll && c <= kPlannedYaw;
+    if ((rpy && layout.attitude_as_quaternion) || (quaternion && !layout.attitude_as_quaternion) ||
+        (planned && !layout.has_planned_attitude) ||
+        (IsUnstretched(c) && !layout.has_unstretched_lengths)) {
+      continue;
+    }
+    columns.push_back(c);
+  }
+  return columns;
+}
+
+// The header comment as '# ' lines, then the column names (and the session column when
+// `sessions`).
+std::string HeaderText(const std::vector<int>& columns, const std::string& header_comment,
+                       bool sessions) {
+  std::string text;
+  std::string_view rest(header_comment);
+  while (!rest.empty()) {
+    const size_t newline = rest.find('\n');
+    const std::string_view line = rest.substr(0, newline);
+    text += line.empty() ? "#\n" : "# " + std::string(line) + "\n";
+    rest.remove_prefix(newline == std::string_view::npos ? rest.size() : newline + 1);
+  }
+  for (size_t k = 0; k < columns.size(); ++k) {
+    text += (k > 0 ? "," : "") + std::string(kColumnNames[columns[k]]);
+  }
+  if (sessions) text += std::string(",") + kSessionColumn;
+  return text + "\n";
+}
+
+// Appends sample `s`'s row to *text; false with *reason when the reader would refuse it.
+bool AppendRow(const Dataset& layout, const std::vector<int>& columns, const Sample& s,
+               std::string* text, std::string* reason) {
+  std::array<double, kNumColumns> value{};
+  if (!RowValues(layout, s, &value, reason)) return false;
+  std::string label;
+  if (!layout.session_labels.empty()) {
+    if (s.session < 0 || s.session >= static_cast<int>(layout.session_labels.size()) ||
+        !IsValidSessionLabel(layout.session_labels[s.session])) {
+      *reason = "session " + std::to_string(s.session) + " has no valid label in session_labels";
+      return false;
+    }
+    label = "," + layout.session_labels[s.session];
+  }
+  for (size_t k = 0; k < columns.size(); ++k) {
+    const int c = columns[k];
+    if (k > 0) *text += ",";
+    *text += FormatNumber(value[c], IsTension(c) ? kKilo : 0);
+  }
+  *text += label + "\n";
+  return true;
+}
+
 bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
                       const std::string& header_comment, std::string* error) {
   if (dataset.samples.empty()) {
     *error = path + ": no samples to write";
     return false;
   }
-  std::vector<int> columns;
-  for (int c = 0; c < kNumColumns; ++c) {
-    const bool rpy = c >= kRoll && c <= kYaw;
-    const bool quaternion = c >= kQw && c <= kQz;
-    const bool planned = c >= kPlannedRoll && c <= kPlannedYaw;
-    if ((rpy && dataset.attitude_as_quaternion) ||
-        (quaternion && !dataset.attitude_as_quaternion) ||
-        (planned && !dataset.has_planned_attitude) ||
-        (IsUnstretched(c) && !dataset.has_unstretched_lengths)) {
-      continue;
-    }
-    columns.push_back(c);
-  }
-  std::string text;
-  if (!header_comment.empty()) {
-    std::string_view rest(header_comment);
-    while (!rest.empty()) {
-      const size_t newline = rest.find('\n');
-      const std::string_view line = rest.substr(0, newline);
-      text += line.empty() ? "#\n" : "# " + std::string(line) + "\n";
-      rest.remove_prefix(newline == std::string_view::npos ? rest.size() : newline + 1);
-    }
-  }
-  for (size_t k = 0; k < columns.size(); ++k) {
-    text += (k > 0 ? "," : "") + std::string(kColumnNames[columns[k]]);
-  }
-  const bool sessions = !dataset.session_labels.empty();
-  if (sessions) text += std::string(",") + kSessionColumn;
-  text += "\n";
+  const std::vector<int> columns = ColumnsOf(dataset);
+  std::string text = HeaderText(columns, header_comment, !dataset.session_labels.empty());
   for (size_t i = 0; i < dataset.samples.size(); ++i) {
-    std::array<double, kNumColumns> value{};
     std::string reason;
-    if (!RowValues(dataset, dataset.samples[i], &value, &reason)) {
+    if (!AppendRow(dataset, columns, dataset.samples[i], &text, &reason)) {
       *error = path + ": samples[" + std::to_string(i) + "]: " + reason;
       return false;
     }
-    for (size_t k = 0; k < columns.size(); ++k) {
-      const int c = columns[k];
-      if (k > 0) text += ",";
-      text += FormatNumber(value[c], IsTension(c) ? kKilo : 0);
-    }
-    if (sessions) {
-      const int session = dataset.samples[i].session;
-      if (session < 0 || session >= static_cast<int>(dataset.session_labels.size()) ||
-          !IsValidSessionLabel(dataset.session_labels[session])) {
-        *error = path + ": samples[" + std::to_string(i) + "]: session " + std::to_string(session) +
-                 " has no valid label in session_labels";
-        return false;
-      }
-      text += "," + dataset.session_labels[session];
-    }
-    text += "\n";
   }
   return internal::WriteFileAtomically(path, text, error);
 }
@@ -784,6 +799,75 @@ bool WriteDataset(const std::string& path, const Dataset& dataset,
   }
   if (!ok && error != nullptr) *error = message;
   return ok;
+}
+
+DatasetWriter::~DatasetWriter() {
+  if (file_ != nullptr) std::fclose(file_);
+}
+
+bool DatasetWriter::Open(const std::string& path, const Dataset& layout,
+                         const std::string& header_comment, std::string* error) {
+  path_ = path;
+  layout_ = Dataset();
+  layout_.attitude_as_quaternion = layout.attitude_as_quaternion;
+  layout_.has_planned_attitude = layout.has_planned_attitude;
+  layout_.has_unstretched_lengths = layout.has_unstretched_lengths;
+  layout_.session_labels = layout.session_labels;
+  columns_ = ColumnsOf(layout_);
+  rows_ = 0;
+  file_ = std::fopen(path.c_str(), "wbx");  // x: never over an existing file
+  if (file_ == nullptr) {
+    *error = path + ": cannot create: " + std::strerror(errno);
+    return false;
+  }
+  buffer_ = HeaderText(columns_, header_comment, !layout_.session_labels.empty());
+  return Flush(error);
+}
+
+bool DatasetWriter::Write(const Sample& sample, std::string* error) {
+  std::string reason;
+  if (file_ == nullptr) {
+    *error = path_ + ": not open";
+    return false;
+  }
+  if (!AppendRow(layout_, columns_, sample, &buffer_, &reason)) {
+    *error = path_ + ": samples[" + std::to_string(rows_) + "]: " + reason;
+    return false;
+  }
+  ++rows_;
+  constexpr size_t kFlushBytes = 1 << 20;  // a few thousand rows per write
+  return buffer_.size() < kFlushBytes || Flush(error);
+}
+
+bool DatasetWriter::Close(std::string* error) {
+  if (file_ == nullptr) {
+    *error = path_ + ": not open";
+    return false;
+  }
+  bool ok = Flush(error);
+  if (ok && rows_ == 0) {
+    *error = path_ + ": no samples to write";
+    ok = false;
+  }
+  if (ok && (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0)) {
+    *error = path_ + ": cannot write: " + std::strerror(errno);
+    ok = false;
+  }
+  if (std::fclose(file_) != 0 && ok) {
+    *error = path_ + ": cannot write: " + std::strerror(errno);
+    ok = false;
+  }
+  file_ = nullptr;
+  return ok;
+}
+
+bool DatasetWriter::Flush(std::string* error) {
+  if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
+    *error = path_ + ": cannot write: " + std::strerror(errno);
+    return false;
+  }
+  buffer_.clear();
+  return true;
 }
 
 }  // namespace fastcal

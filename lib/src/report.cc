@@ -208,7 +208,8 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
     row("Attitude in the fit", s.use_planned_attitude ? "planned" : "measured");
     row("Gross errors", s.detect_gross_errors
                             ? "readings more than " + Sig3(s.gross_error_threshold_sigmas) +
-                                  " robust σ from the model are kept out; refused above " +
+                                  " robust σ from the model (more on a long dataset, see Gross "
+                                  "errors) are kept out; refused above " +
                                   Sig3(100.0 * s.max_gross_error_fraction) + " % of them"
                             : std::string("not screened"));
     Text holdout("none: every sample is fitted");
@@ -700,7 +701,10 @@ struct TimePlots {
       : in(inputs), d(*inputs.data), x(SampleAxis(d, &x_label)), shown(PlotVariants(inputs)) {
     holdout = NumHeldOut(in) > 0;
     ordered = internal::IsTrajectory(d);
-    if (in.result && !in.result->gross_errors.empty()) not_drawn = " Gross errors are not drawn.";
+    if ((in.result && !in.result->gross_errors.empty()) ||
+        (in.evaluation_screen && !in.evaluation_screen->gross_errors.empty())) {
+      not_drawn = " Gross errors are not drawn.";
+    }
   }
   // With a calibration the "before" variant is dashed, the calibrated one solid.
   PlotSeries Model(const std::string& name, size_t k) const {
@@ -710,7 +714,10 @@ struct TimePlots {
   }
   // Gross errors are not drawn: one 99999 kN reading would flatten every other point.
   bool Drawn(size_t n, int i) const {
-    return !in.result || n >= in.result->excluded.size() || !in.result->excluded[n][i];
+    const ReadingMask* gross = in.result              ? &in.result->excluded
+                               : in.evaluation_screen ? &in.evaluation_screen->excluded
+                                                      : nullptr;
+    return gross == nullptr || n >= gross->size() || !(*gross)[n][i];
   }
   double ResidualKn(const VariantEvaluation& v, size_t n, int i) const {
     return (v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn;
@@ -937,6 +944,7 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
     AddIdentifiability(*in.result, with_plots, &doc);
   }
   if (!in.result) AddCablesAsBuilt(in, &doc);
+  if (!in.result) internal::AddEvaluationGrossErrors(in, &doc);
   AddRmsTables(in, with_plots, &doc);
   if (in.result) internal::AddCrossValidation(*in.result, &doc);
   if (with_plots) {
@@ -1442,6 +1450,7 @@ void JsonEvaluation(const ReportInputs& in, JsonWriter* w) {
     w->EndObject();
   }
   w->EndArray();
+  internal::WriteEvaluationGrossErrorsJson(in, w);  // evaluate's screen, when it has one
 }
 
 // How many samples, fitted, held out and skipped.

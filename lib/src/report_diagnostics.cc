@@ -205,6 +205,56 @@ void AddUncertaintyBudget(const CalibrationResult& r, Document* doc) {
   }
 }
 
+namespace {
+
+// A table of readings (line, cable, measured, predicted, whitened residual; held out
+// only when one is), the first kMaxReadingRows of them.
+void AddReadingsTable(const std::vector<ReadingResidual>& list, const Text& caption,
+                      Document* doc) {
+  Table t;
+  t.caption = caption;
+  t.header = {"Line",    "Cable", "Measured [kN]", "Predicted [kN]", "(model - measured) / σ",
+              "Held out"};
+  t.right_align = {true, true, true, true, true, false};
+  bool any_held_out = false;
+  for (size_t k = 0; k < std::min(list.size(), kMaxReadingRows); ++k) {
+    const ReadingResidual& e = list[k];
+    any_held_out = any_held_out || e.held_out;
+    t.rows.push_back({Int(e.line), Int(e.cable), Kn3(e.measured_n), Kn3(e.predicted_n),
+                      Printf("%+.1f", e.residual_sigma), e.held_out ? "yes" : ""});
+  }
+  if (!any_held_out) {  // an empty column is not drawn
+    t.header.pop_back();
+    t.right_align.pop_back();
+    for (std::vector<Text>& row : t.rows) row.pop_back();
+  }
+  doc->AddTable(std::move(t));
+  if (list.size() > kMaxReadingRows) {
+    doc->Paragraph("... and " + Int(static_cast<long long>(list.size() - kMaxReadingRows)) +
+                   " more, all in summary.json.");
+  }
+}
+
+// The screen per cable: readings flagged, median and robust scale of the residuals.
+void AddPerCableScreen(const std::array<int, kNumCables>& counts,
+                       const std::array<RobustScale, kNumCables>& scales, Document* doc) {
+  Table s;
+  s.caption = "Per cable";
+  s.header = {"", "T1", "T2", "T3", "T4", "T5", "T6"};
+  s.right_align = {false, true, true, true, true, true, true};
+  std::vector<Text> count = {"gross errors"}, centre = {"median residual [σ]"},
+                    scale = {"robust scale [σ]"};
+  for (int i = 0; i < kNumCables; ++i) {
+    count.push_back(Int(counts[i]));
+    centre.push_back(Printf("%+.2f", scales[i].centre));
+    scale.push_back(Printf("%.2f", scales[i].scale));
+  }
+  s.rows = {count, centre, scale};
+  doc->AddTable(std::move(s));
+}
+
+}  // namespace
+
 void AddGrossErrors(const ReportInputs& in, Document* doc) {
   const CalibrationResult& r = *in.result;
   const GrossErrorSummary& g = r.gross_error_summary;
@@ -219,48 +269,38 @@ void AddGrossErrors(const ReportInputs& in, Document* doc) {
         "the statistics, and re-judged after every pass so that gross errors cannot hide "
         "each other. " +
         Int(static_cast<long long>(r.gross_errors.size())) +
-        (r.gross_errors.size() == 1 ? " reading was" : " readings were") + " flagged.");
-    Table s;
-    s.caption = "Per cable";
-    s.header = {"", "T1", "T2", "T3", "T4", "T5", "T6"};
-    s.right_align = {false, true, true, true, true, true, true};
-    std::vector<Text> count = {"gross errors"}, centre = {"median residual [σ]"},
-                      scale = {"robust scale [σ]"};
-    for (int i = 0; i < kNumCables; ++i) {
-      count.push_back(Int(g.count[i]));
-      centre.push_back(Printf("%+.2f", g.centre[i]));
-      scale.push_back(Printf("%.2f", g.scale[i]));
-    }
-    s.rows = {count, centre, scale};
-    doc->AddTable(std::move(s));
+        (r.gross_errors.size() == 1 ? " reading was" : " readings were") + " flagged. Threshold " +
+        DescribeGrossErrorThreshold(g.threshold) + ".");
+    std::array<RobustScale, kNumCables> scales;
+    for (int i = 0; i < kNumCables; ++i) scales[i] = {g.centre[i], g.scale[i]};
+    AddPerCableScreen(g.count, scales, doc);
   }
-  auto readings = [&](const std::vector<ReadingResidual>& list, const Text& caption) {
-    Table t;
-    t.caption = caption;
-    t.header = {"Line",    "Cable", "Measured [kN]", "Predicted [kN]", "(model - measured) / σ",
-                "Held out"};
-    t.right_align = {true, true, true, true, true, false};
-    bool any_held_out = false;
-    for (size_t k = 0; k < std::min(list.size(), kMaxReadingRows); ++k) {
-      const ReadingResidual& e = list[k];
-      any_held_out = any_held_out || e.held_out;
-      t.rows.push_back({Int(e.line), Int(e.cable), Kn3(e.measured_n), Kn3(e.predicted_n),
-                        Printf("%+.1f", e.residual_sigma), e.held_out ? "yes" : ""});
-    }
-    if (!any_held_out) {  // an empty column is not drawn
-      t.header.pop_back();
-      t.right_align.pop_back();
-      for (std::vector<Text>& row : t.rows) row.pop_back();
-    }
-    doc->AddTable(std::move(t));
-    if (list.size() > kMaxReadingRows) {
-      doc->Paragraph("... and " + Int(static_cast<long long>(list.size() - kMaxReadingRows)) +
-                     " more, all in summary.json.");
-    }
-  };
-  if (!r.gross_errors.empty()) readings(r.gross_errors, "Gross errors (line in the data file)");
+  if (!r.gross_errors.empty())
+    AddReadingsTable(r.gross_errors, "Gross errors (line in the data file)", doc);
   if (!r.worst_readings.empty()) {
-    readings(r.worst_readings, "The worst fitted readings (largest |model - measured| / σ)");
+    AddReadingsTable(r.worst_readings, "The worst fitted readings (largest |model - measured| / σ)",
+                     doc);
+  }
+}
+
+void AddEvaluationGrossErrors(const ReportInputs& in, Document* doc) {
+  if (in.evaluation_screen == nullptr) return;
+  const EvaluationScreen& e = *in.evaluation_screen;
+  doc->Heading(2, "Gross errors");
+  doc->Paragraph(
+      "The readings screened as calibrate screens them, against the predictions of \"" + e.variant +
+      "\": a reading more than the threshold in robust σ (the median and 1.4826 × MAD of "
+      "its cable's residuals whitened by the default noise model, 3 % of the reading, at "
+      "least that noise) is a gross error, named here and left out of the rows \"... - "
+      "gross errors\" of the RMS table. " +
+      Int(static_cast<long long>(e.gross_errors.size())) +
+      (e.gross_errors.size() == 1 ? " reading was" : " readings were") + " flagged. Threshold " +
+      DescribeGrossErrorThreshold(e.threshold) + ".");
+  std::array<int, kNumCables> counts{};
+  for (const ReadingResidual& g : e.gross_errors) ++counts[g.cable - 1];
+  AddPerCableScreen(counts, e.cables, doc);
+  if (!e.gross_errors.empty()) {
+    AddReadingsTable(e.gross_errors, "Gross errors (line in the data file)", doc);
   }
 }
 
@@ -476,11 +516,23 @@ void JsonReadings(const char* key, const std::vector<ReadingResidual>& list, Jso
   w->EndArray();
 }
 
+// Why the threshold is what it is: the spec's floor, the family-wise value for the
+// readings screened, and which of the two decided.
+void JsonGrossErrorThreshold(const GrossErrorThreshold& t, JsonWriter* w) {
+  w->Key("threshold_floor_sigmas").Number(t.floor_sigmas);
+  w->Key("threshold_family_wise_sigmas").Number(t.family_wise_sigmas);
+  w->Key("family_false_alarm").Number(kGrossErrorFamilyFalseAlarm);
+  w->Key("screened_readings").Int(t.readings);
+  w->Key("threshold_rule").String(t.family_wise_decides() ? "family-wise" : "spec floor");
+  w->Key("threshold_why").String(DescribeGrossErrorThreshold(t));
+}
+
 void JsonGrossErrors(const CalibrationResult& r, JsonWriter* w) {
   const GrossErrorSummary& g = r.gross_error_summary;
   w->Key("gross_errors").BeginObject();
   w->Key("detect").Bool(g.enabled);
   w->Key("threshold_sigmas").Number(g.threshold_sigmas);
+  JsonGrossErrorThreshold(g.threshold, w);
   w->Key("count_per_cable").NumberArray(std::vector<double>(g.count.begin(), g.count.end()));
   w->Key("robust_centre_sigma").NumberArray(g.centre);
   w->Key("robust_scale_sigma").NumberArray(g.scale);
@@ -531,6 +583,27 @@ void JsonMisfitAndValidation(const CalibrationResult& r, JsonWriter* w) {
 }
 
 }  // namespace
+
+void WriteEvaluationGrossErrorsJson(const ReportInputs& in, JsonWriter* w) {
+  if (in.evaluation_screen == nullptr) return;
+  const EvaluationScreen& e = *in.evaluation_screen;
+  w->Key("gross_errors").BeginObject();
+  w->Key("detect").Bool(true);
+  w->Key("variant").String(e.variant);
+  w->Key("threshold_sigmas").Number(e.threshold.sigmas);
+  JsonGrossErrorThreshold(e.threshold, w);
+  std::vector<double> counts(kNumCables, 0.0), centre, scale;
+  for (const ReadingResidual& g : e.gross_errors) ++counts[g.cable - 1];
+  for (const RobustScale& c : e.cables) {
+    centre.push_back(c.centre);
+    scale.push_back(c.scale);
+  }
+  w->Key("count_per_cable").NumberArray(counts);
+  w->Key("robust_centre_sigma").NumberArray(centre);
+  w->Key("robust_scale_sigma").NumberArray(scale);
+  w->EndObject();
+  JsonReadings("outliers", e.gross_errors, w);
+}
 
 void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
   JsonVerdictAndBudget(r, w);

@@ -310,20 +310,10 @@ Eigen::Vector3d StepShiftAt(const SimulationOptions& options, double t) {
   return shift;
 }
 
-// Cuts the samples into `sessions` consecutive sessions labelled "1" .. "N".
-void LabelSessions(int sessions, Dataset* out) {
-  if (sessions <= 1) return;
-  const long long n = static_cast<long long>(out->samples.size());
-  for (int k = 0; k < sessions; ++k) out->session_labels.push_back(std::to_string(k + 1));
-  for (long long t = 0; t < n; ++t) {
-    out->samples[t].session = static_cast<int>(t * sessions / n);
-  }
-}
-
 // Stages: check the inputs, draw the truth model, then per planned pose the actual pose
 // and its statics, the measured pose and the readings; last the summary.
 bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
-                  const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
+                  const SimulationOptions& options, const SampleSink& sink, CableRobot* truth_used,
                   SimulationSummary* summary, std::string* error) {
   if (!CheckInputs(truth, planned, options, error)) return false;
   SimulationSummary stats;
@@ -340,14 +330,8 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
   statics.warm_start = true;
   StaticsSolution solution;
 
-  Dataset out;
-  out.path = "simulation";
-  out.has_planned_attitude = true;
-  out.has_unstretched_lengths = true;
-  out.attitude_as_quaternion = false;
-  out.samples.resize(planned.size());
   for (size_t n = 0; n < planned.size(); ++n) {
-    Sample& s = out.samples[n];
+    Sample s;
     s.time_s = static_cast<double>(n) * options.sample_interval_s;
     s.has_planned_attitude = true;
     s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned[n].rotation));
@@ -361,12 +345,16 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
     }
     MeasurePose(planned[n].position_m, actual_rpy_deg, options, &processes, &s);
     if (!MeasureTensions(n, model, solution, options, &processes, &stats, &s, error)) return false;
+    // Consecutive equal sessions, labelled "1" .. "N" (SimulatedDatasetLayout).
+    if (options.sessions > 1) {
+      s.session = static_cast<int>(static_cast<long long>(n) * options.sessions /
+                                   static_cast<long long>(planned.size()));
+    }
+    if (!sink(s, error)) return false;
   }
   Summarise(processes, static_cast<double>(planned.size()), &stats);
   model.mass_centre_cabin_m = mass_centre_m;  // the truth written out: the mean
-  LabelSessions(options.sessions, &out);
 
-  if (dataset != nullptr) *dataset = std::move(out);
   if (truth_used != nullptr) *truth_used = std::move(model);
   if (summary != nullptr) *summary = stats;
   return true;
@@ -420,14 +408,42 @@ bool SimulationOptions::IsValid(std::string* error) const {
   return true;
 }
 
+Dataset SimulatedDatasetLayout(int sessions) {
+  Dataset layout;
+  for (int k = 1; sessions > 1 && k <= sessions; ++k) {
+    layout.session_labels.push_back(std::to_string(k));
+  }
+  layout.path = "simulation";
+  layout.has_planned_attitude = true;
+  layout.has_unstretched_lengths = true;
+  layout.attitude_as_quaternion = false;
+  return layout;
+}
+
+bool SimulateStream(const CableRobot& truth, const std::vector<Pose>& planned,
+                    const SimulationOptions& options, const SampleSink& sink,
+                    CableRobot* truth_used, SimulationSummary* summary, std::string* error) {
+  std::string message;
+  try {
+    if (SimulateImpl(truth, planned, options, sink, truth_used, summary, &message)) return true;
+  } catch (const std::exception& e) {
+    message = std::string("simulation failed: ") + e.what();
+  }
+  return Fail(error, message);
+}
+
 bool Simulate(const CableRobot& truth, const std::vector<Pose>& planned,
               const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
               SimulationSummary* summary, std::string* error) {
-  try {
-    return SimulateImpl(truth, planned, options, dataset, truth_used, summary, error);
-  } catch (const std::exception& e) {
-    return Fail(error, std::string("simulation failed: ") + e.what());
-  }
+  Dataset out = SimulatedDatasetLayout(options.sessions);
+  out.samples.reserve(planned.size());
+  const SampleSink keep = [&out](const Sample& s, std::string*) {
+    out.samples.push_back(s);
+    return true;
+  };
+  if (!SimulateStream(truth, planned, options, keep, truth_used, summary, error)) return false;
+  if (dataset != nullptr) *dataset = std::move(out);
+  return true;
 }
 
 }  // namespace fastcal

@@ -42,6 +42,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/sessions.h"
+#include "fastcal/gross_errors.h"
 #include "fastcal/uncertainty.h"
 
 namespace fastcal {
@@ -172,7 +173,10 @@ struct ReadingResidual {
 
 struct GrossErrorSummary {
   bool enabled = false;
+  // The threshold used (robust sigmas), the larger of the spec's threshold_sigmas (the
+  // floor) and the family-wise one for the readings screened (gross_errors.h).
   double threshold_sigmas = 0.0;
+  GrossErrorThreshold threshold;  // how it was chosen; N: every sample's readings
   // Per cable, of the fitted readings' whitened residuals at the solution: median and
   // robust scale (1.4826 MAD, at least 1), and readings flagged (fitted and held out).
   std::array<double, kNumCables> centre{};

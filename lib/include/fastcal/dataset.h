@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -123,6 +124,35 @@ bool ParseDataset(const std::string& text, const std::string& source_name,
 // the same directory, then rename): a failure leaves no file behind.
 bool WriteDataset(const std::string& path, const Dataset& dataset,
                   const std::string& header_comment, std::string* error);
+
+// The same file written row by row, for data too long to hold (fastcal simulate at 10^6
+// samples): memory independent of the number of rows. Open creates `path` (refusing an
+// existing file) and writes the header comment and the column line of `layout`'s column
+// groups (its flags; its samples are not read); Write appends one sample's row, refusing
+// what WriteDataset refuses; Close flushes, syncs and closes, and refuses a file of no
+// rows. Not atomic: write to a temporary name and rename (and remove it on failure).
+class DatasetWriter {
+ public:
+  DatasetWriter() = default;
+  DatasetWriter(const DatasetWriter&) = delete;
+  DatasetWriter& operator=(const DatasetWriter&) = delete;
+  ~DatasetWriter();  // closes the file if still open (it is left as written so far)
+
+  bool Open(const std::string& path, const Dataset& layout, const std::string& header_comment,
+            std::string* error);
+  bool Write(const Sample& sample, std::string* error);
+  bool Close(std::string* error);
+
+ private:
+  bool Flush(std::string* error);
+
+  std::string path_;
+  Dataset layout_;
+  std::vector<int> columns_;
+  std::string buffer_;
+  size_t rows_ = 0;
+  std::FILE* file_ = nullptr;
+};
 
 }  // namespace fastcal
 

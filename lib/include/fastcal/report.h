@@ -39,6 +39,7 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/evaluation_screen.h"
 
 namespace fastcal {
 
@@ -72,6 +73,9 @@ struct ReportInputs {
   // file beside the data (empty: "OTHER_DATA.csv", said to be one).
   std::string out_dir;
   std::string other_data_path;
+  // For an evaluation-only report: the gross-error screen of the readings (not owned;
+  // null: not screened).
+  const EvaluationScreen* evaluation_screen = nullptr;
 };
 
 // The report as Markdown, HTML and JSON. Each is deterministic (its only date is

@@ -38,6 +38,7 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -157,6 +158,22 @@ struct SimulationSummary {
 bool Simulate(const CableRobot& truth, const std::vector<Pose>& planned,
               const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
               SimulationSummary* summary, std::string* error);
+
+// The same simulation handing each sample to `sink` as it is made, in order, instead of
+// keeping them: memory independent of the number of samples (fastcal simulate streams
+// them into a DatasetWriter). The samples, *truth_used and *summary are those Simulate
+// gives. `sink` returning false stops the simulation with its *error. Samples already
+// handed over stay with the sink when a later pose fails.
+using SampleSink = std::function<bool(const Sample& sample, std::string* error)>;
+bool SimulateStream(const CableRobot& truth, const std::vector<Pose>& planned,
+                    const SimulationOptions& options, const SampleSink& sink,
+                    CableRobot* truth_used, SimulationSummary* summary, std::string* error);
+
+// The column groups of a simulated dataset (planned attitude, unstretched lengths,
+// roll/pitch/yaw) and, for more than one session, the session labels "1" .. "N"
+// (SimulationOptions::sessions), with no samples: the layout a DatasetWriter of
+// SimulateStream needs.
+Dataset SimulatedDatasetLayout(int sessions = 1);
 
 }  // namespace fastcal
 

@@ -37,6 +37,9 @@ double AzimuthDeg(const Eigen::Vector3d& position_m);
 
 void AddUncertaintyBudget(const CalibrationResult& r, Document* doc);
 void AddGrossErrors(const ReportInputs& in, Document* doc);
+// evaluate's: the screen of the readings against the model (in.evaluation_screen).
+void AddEvaluationGrossErrors(const ReportInputs& in, Document* doc);
+void WriteEvaluationGrossErrorsJson(const ReportInputs& in, JsonWriter* w);
 void AddMisfitRanking(const CalibrationResult& r, Document* doc);
 void AddCrossValidation(const CalibrationResult& r, Document* doc);
 void AddDiagnosticPlots(const ReportInputs& in, Document* doc);
