@@ -60,6 +60,16 @@ void AddChangeScan(const CalibrationResult& r, bool with_plots, Document* doc);
 // summary.json's `change_scan` (null without a scan) and `changes` (empty when none).
 void WriteChangeScanJson(const CalibrationResult& r, JsonWriter* w);
 
+// summary.json (report_json.cc), and the facts it shares with the document: the RMS over
+// the six cables of per-cable RMS values, the dataset's samples and those held out.
+std::string RenderJson(const ReportInputs& in);
+double RmsAllCables(const std::array<double, kNumCables>& rms);
+int NumSamples(const ReportInputs& in);
+int NumHeldOut(const ReportInputs& in);
+// The correlation matrix of the free estimates as rows, and whether it can be shown.
+std::vector<std::vector<double>> CorrelationRows(const CalibrationResult& r);
+bool CorrelationUsable(const CalibrationResult& r);
+
 }  // namespace fastcal::internal
 
 #endif  // FASTCAL_INTERNAL_REPORT_SECTIONS_H_
