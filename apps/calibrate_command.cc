@@ -769,6 +769,41 @@ void SkipSamplesTheCalibrationCannotSolve(const CableRobot& model, const Calibra
                         {spec.forward_model, StaticsMethod::kExact}, data);
 }
 
+// calibrate's --out: the calibrated model (one per session too), residuals.csv (unless
+// --residuals-every=0) and the report files. False, with the error printed, on failure.
+bool WriteCalibrationOutputs(int argc, char** argv, const CableRobot& model,
+                             const CalibrationSpec& spec, const Dataset& data,
+                             const CalibrationResult& result) {
+  const std::vector<VariantEvaluation>& variants = result.variants;
+
+  ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/true);
+  report.initial_model = &model;
+  report.spec = &spec;
+  report.data = &data;
+  report.result = &result;
+  report.variants = variants;
+  report.evaluation_method = "exact";
+  report.out_dir = FLAGS_out;
+  report.other_data_path = OtherDataset(FLAGS_data);
+
+  std::vector<std::pair<std::string, std::string>> files = {
+      {"model_calibrated.yaml",
+       CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))}};
+  if (FLAGS_residuals_every > 0) {
+    files.emplace_back("residuals.csv",
+                       ResidualsCsv(data, variants, result.held_out, result.excluded));
+  }
+  std::vector<std::string> outputs = kCalibrateOutputs;
+  for (size_t s = 0; s < result.session_models.size(); ++s) {
+    const std::string name = "model_calibrated@" + result.session_labels[s] + ".yaml";
+    files.push_back({name, CableRobotToYaml(result.session_models[s],
+                                            "session " + result.session_labels[s] + "\n" +
+                                                CalibratedModelHeader(result, report))});
+    outputs.push_back(name);  // --force may replace a previous run's
+  }
+  return WriteOutDirectory("calibrate", files, report, outputs);
+}
+
 int RunCalibrate(int argc, char** argv) {
   const char* command = "calibrate";
   int exit_code = 0;
@@ -830,38 +865,11 @@ int RunCalibrate(int argc, char** argv) {
     return status == CalibrationStatus::kInvalidInput ? kExitUsage : kExitFailure;
   }
 
-  const std::vector<VariantEvaluation>& variants = result.variants;
-
-  ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/true);
-  report.initial_model = &model;
-  report.spec = &spec;
-  report.data = &data;
-  report.result = &result;
-  report.variants = variants;
-  report.evaluation_method = "exact";
-  report.out_dir = FLAGS_out;
-  report.other_data_path = OtherDataset(FLAGS_data);
-
-  std::vector<std::pair<std::string, std::string>> files = {
-      {"model_calibrated.yaml",
-       CableRobotToYaml(result.calibrated, CalibratedModelHeader(result, report))}};
-  if (FLAGS_residuals_every > 0) {
-    files.emplace_back("residuals.csv",
-                       ResidualsCsv(data, variants, result.held_out, result.excluded));
-  }
-  std::vector<std::string> outputs = kCalibrateOutputs;
-  for (size_t s = 0; s < result.session_models.size(); ++s) {
-    const std::string name = "model_calibrated@" + result.session_labels[s] + ".yaml";
-    files.push_back({name, CableRobotToYaml(result.session_models[s],
-                                            "session " + result.session_labels[s] + "\n" +
-                                                CalibratedModelHeader(result, report))});
-    outputs.push_back(name);  // --force may replace a previous run's
-  }
-  if (!WriteOutDirectory(command, files, report, outputs)) return kExitUsage;
+  if (!WriteCalibrationOutputs(argc, argv, model, spec, data, result)) return kExitUsage;
 
   // Results on stdout, progress and diagnostics on stderr (docs/cli.md, "Output streams").
   if (!FLAGS_quiet) std::cerr << result.ceres_brief_report << "\n";
-  std::cout << CalibrationConsole(result, data, variants) << std::flush;
+  std::cout << CalibrationConsole(result, data, result.variants) << std::flush;
   std::cerr << ChiSquareWarning(result);
   return 0;
 }
