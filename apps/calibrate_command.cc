@@ -115,8 +115,12 @@ Verdict, from the reduced chi-square against its band 1 +- 3 sqrt(2/nu) (nu: res
 minus free parameters): ok; noise overstated (below; the sigmas are pessimistic);
 misfit (above: scaled into sigma_total, a note ends stderr); failed (chi^2/nu above 25,
 the residuals 5 times the stated noise, or no convergence: "warning: the fit failed"
-ends stderr and model_calibrated.yaml opens with a warning). The exit code stays 0 for
-all four: the outputs are written, as a record.
+ends stderr and model_calibrated.yaml opens with a warning); model incomplete (a fixed
+parameter or a prior the data point at would move an estimate by more than 3 times its
+uncertainty: "warning: model incomplete" ends stderr, the estimates concerned are marked
+NOT SOUND; docs/calibration.md, "Model incomplete"). The exit code stays 0 for all five:
+the outputs are written, as a record. A model whose cables carry attachments
+(docs/model-format.md) needs forward_model: exact.
 
 Streams: the one-screen summary (verdict, free estimates, gross errors, RMS table) on
 stdout; progress, skipped rows, notes and warnings on stderr.
