@@ -253,20 +253,7 @@ TEST(StaticsAttachmentsTest, JetTensionsMatchCentralDifferencesThroughTheChain) 
   const double steps[3] = {1.0, 1e-2, 1e-3};  // kg, kg/m, m
   constexpr double kTol = 1e-5;
   StaticsParameters<Jet> pj;
-  for (int i = 0; i < kNumCables; ++i) {
-    pj.tower_top_m[i] = p0.tower_top_m[i].cast<Jet>();
-    pj.anchor_cabin_m[i] = p0.anchor_cabin_m[i].cast<Jet>();
-    pj.ea_n[i] = Jet(p0.ea_n[i]);
-    pj.linear_density_kg_per_m[i] = Jet(p0.linear_density_kg_per_m[i]);
-    pj.chain[i].num_cuts = p0.chain[i].num_cuts;
-    pj.chain[i].cuts = p0.chain[i].cuts;
-    pj.chain[i].num_attachments = p0.chain[i].num_attachments;
-    for (int j = 0; j < p0.chain[i].num_attachments; ++j)
-      pj.chain[i].value[j] = Jet(p0.chain[i].value[j]);
-  }
-  pj.cabin_mass_kg = Jet(p0.cabin_mass_kg);
-  pj.mass_centre_cabin_m = p0.mass_centre_cabin_m.cast<Jet>();
-  pj.gravity_m_per_s2 = p0.gravity_m_per_s2;
+  CastParametersInto(p0, &pj);
   // Parameters: cable 2's point mass, cable 5's added density, the mass centre's z.
   pj.chain[1].value[0].v[0] = 1.0;
   pj.chain[4].value[1].v[1] = 1.0;

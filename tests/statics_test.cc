@@ -708,15 +708,7 @@ TEST(StaticsTest, JetTensionsMatchCentralDifferences) {
     StaticsOptions options;
     options.method = m;
     StaticsParameters<Jet> pj;
-    for (int i = 0; i < kNumCables; ++i) {
-      pj.tower_top_m[i] = p0.tower_top_m[i].cast<Jet>();
-      pj.anchor_cabin_m[i] = p0.anchor_cabin_m[i].cast<Jet>();
-      pj.ea_n[i] = Jet(p0.ea_n[i]);
-      pj.linear_density_kg_per_m[i] = Jet(p0.linear_density_kg_per_m[i]);
-    }
-    pj.cabin_mass_kg = Jet(p0.cabin_mass_kg);
-    pj.mass_centre_cabin_m = p0.mass_centre_cabin_m.cast<Jet>();
-    pj.gravity_m_per_s2 = p0.gravity_m_per_s2;
+    CastParametersInto(p0, &pj);
     for (int k = 0; k < 6; ++k) {
       Jet unit(0.0, k);
       perturb(pj, k, unit);

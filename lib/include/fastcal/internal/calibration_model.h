@@ -53,22 +53,11 @@ class CalibrationModel {
   template <typename T>
   void Assemble(const T* theta, StaticsParameters<T>* p, std::array<T, kNumCables>* gain,
                 std::array<T, kNumCables>* bias, int session = 0) const {
+    CastParametersInto(base_, p);
     for (int i = 0; i < kNumCables; ++i) {
-      p->tower_top_m[i] = base_.tower_top_m[i].cast<T>();
-      p->anchor_cabin_m[i] = base_.anchor_cabin_m[i].cast<T>();
-      p->ea_n[i] = T(base_.ea_n[i]);
-      p->linear_density_kg_per_m[i] = T(base_.linear_density_kg_per_m[i]);
-      const CatenaryChain<double>& chain = base_.chain[i];
-      p->chain[i].num_cuts = chain.num_cuts;
-      p->chain[i].num_attachments = chain.num_attachments;
-      p->chain[i].cuts = chain.cuts;
-      for (int j = 0; j < chain.num_attachments; ++j) p->chain[i].value[j] = T(chain.value[j]);
       (*gain)[i] = T(base_gain_[i]);
       (*bias)[i] = T(base_bias_n_[i]);
     }
-    p->cabin_mass_kg = T(base_.cabin_mass_kg);
-    p->mass_centre_cabin_m = base_.mass_centre_cabin_m.cast<T>();
-    p->gravity_m_per_s2 = base_.gravity_m_per_s2;
     for (int k = 0; k < num_free(); ++k) {
       const ParameterSpec& s = spec_.parameters[free_[k]];
       if (s.session >= 0 && s.session != session) continue;

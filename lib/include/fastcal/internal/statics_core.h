@@ -66,6 +66,26 @@ StaticsParameters<double> ScalarParameters(const StaticsParameters<T>& p) {
   return d;
 }
 
+// The other way: `d` in scalar T (constants, no derivative), into *p. The reflector, only
+// ever checked in double, is not copied (the Jet path solves with ScalarParameters of *p).
+template <typename T>
+void CastParametersInto(const StaticsParameters<double>& d, StaticsParameters<T>* p) {
+  for (int i = 0; i < kNumCables; ++i) {
+    p->tower_top_m[i] = d.tower_top_m[i].cast<T>();
+    p->anchor_cabin_m[i] = d.anchor_cabin_m[i].cast<T>();
+    p->ea_n[i] = T(d.ea_n[i]);
+    p->linear_density_kg_per_m[i] = T(d.linear_density_kg_per_m[i]);
+    const CatenaryChain<double>& chain = d.chain[i];
+    p->chain[i].num_cuts = chain.num_cuts;
+    p->chain[i].num_attachments = chain.num_attachments;
+    p->chain[i].cuts = chain.cuts;
+    for (int j = 0; j < chain.num_attachments; ++j) p->chain[i].value[j] = T(chain.value[j]);
+  }
+  p->cabin_mass_kg = T(d.cabin_mass_kg);
+  p->mass_centre_cabin_m = d.mass_centre_cabin_m.cast<T>();
+  p->gravity_m_per_s2 = d.gravity_m_per_s2;
+}
+
 namespace internal {
 
 // The end point of cable i at (Fl, Fz, s0) with weight per length w: the uniform
