@@ -281,7 +281,12 @@ std::string DesignHtml(const Design& d, const CableRobot& robot, const std::stri
       "3px 8px;text-align:left}td.num{text-align:right;font-variant-numeric:tabular-nums}"
       "tr.wanted th{color:#0072B2}.wrap{overflow-x:auto}code{background:#f3f3f3}</style>"
       "</head><body>\n<h1>Calibration survey design</h1>\n";
-  h += "<p><code>" + XmlEscape(provenance) + "</code></p>\n";
+  // One line of the provenance per line of the page (command line, then version and model).
+  std::string lines = XmlEscape(provenance);
+  for (size_t at = lines.find('\n'); at != std::string::npos; at = lines.find('\n', at + 6)) {
+    lines.replace(at, 1, "<br>\n");
+  }
+  h += "<p><code>" + lines + "</code></p>\n";
   h += "<p>" + std::to_string(o.samples) + " samples at " + std::to_string(d.stops.size()) +
        " stops, chosen " + DesignCriterionName(o.criterion) + "-optimally from " +
        std::to_string(d.candidates.size()) + " feasible candidate poses (" +
