@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -43,6 +44,9 @@ DEFINE_bool(skip_invalid_rows, false,
             "Skip dataset rows that are malformed or whose pose the model cannot solve "
             "(listed on stderr and in the report) instead of failing.");
 DEFINE_bool(quiet, false, "calibrate: no per-iteration progress.");
+DEFINE_bool(timings, false,
+            "calibrate: print the wall time of reading, of each stage of the fit and of "
+            "writing, on stderr.");
 DEFINE_int32(residuals_every, 1,
              "calibrate, evaluate: residuals.csv keeps every K-th sample (1: all; 0: no file).");
 
@@ -79,6 +83,8 @@ Usage:
                       solve (e.g. outside the workspace), instead of failing; each is
                       listed with its line on stderr, in the report and in summary.json
   --quiet             no per-iteration solver progress
+  --timings           after the run, the wall time of reading, of each stage of the
+                      fit and of writing (stderr)
 
 Before solving, the free set is checked: if the data (and priors) cannot determine it --
 e.g. cabin mass together with a common sensor gain, or tower offsets from one circle --
@@ -657,6 +663,38 @@ std::string SessionLines(const CalibrationResult& result) {
   return s.str();
 }
 
+// Wall time of a command's phases.
+class Stopwatch {
+ public:
+  // Seconds since the last lap (or construction).
+  double Lap() {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - last_).count();
+    last_ = now;
+    return s;
+  }
+
+ private:
+  std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
+};
+
+// --timings: read, the fit's stages, write (stderr).
+std::string TimingLines(double read_s, double fit_s, double write_s,
+                        const std::vector<std::pair<std::string, double>>& stages) {
+  std::ostringstream s;
+  char buf[120];
+  const auto line = [&](const std::string& name, double seconds) {
+    std::snprintf(buf, sizeof(buf), "  %-24s %8.3f s\n", name.c_str(), seconds);
+    s << buf;
+  };
+  s << "timings (wall):\n";
+  line("read inputs", read_s);
+  line("fit", fit_s);
+  for (const auto& [name, seconds] : stages) line("  " + name, seconds);
+  line("write outputs", write_s);
+  return s.str();
+}
+
 std::string CalibrationConsole(const CalibrationResult& result, const Dataset& data,
                                const std::vector<VariantEvaluation>& variants) {
   std::ostringstream s;
@@ -813,7 +851,7 @@ int RunCalibrate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kCalibrateHelp,
                     {"model", "spec", "data", "out", "skip-invalid-rows", "quiet", "force",
-                     "residuals-every"},
+                     "residuals-every", "timings"},
                     &exit_code)) {
     return exit_code;
   }
@@ -827,12 +865,14 @@ int RunCalibrate(int argc, char** argv) {
   CableRobot model;
   Dataset data;
   CalibrationSpec spec;
+  Stopwatch watch;
   if (!CheckResidualsEvery(&error) || !CheckOutFlag(kCalibrateOutputs, &error) ||
       !LoadInputs(&model, &data, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, model, &spec, &error)) {
     PrintError(command, error);
     return kExitUsage;
   }
+  const double read_s = watch.Lap();
   const CableRobot initial = InitialCalibrationModel(model, spec);
   const std::vector<StaticsMethod> methods = {StaticsMethod::kExact, spec.forward_model};
   if (FLAGS_skip_invalid_rows) {
@@ -856,7 +896,9 @@ int RunCalibrate(int argc, char** argv) {
   if (!FLAGS_quiet)
     options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
   CalibrationResult result;
+  watch.Lap();
   const CalibrationStatus status = Calibrate(model, spec, data, options, &result, &error);
+  const double fit_s = watch.Lap();
   if (status == CalibrationStatus::kInfeasible) {
     if (const std::string blame = BlameTheModel(initial, "the initial model", data, methods);
         !blame.empty()) {
@@ -870,6 +912,7 @@ int RunCalibrate(int argc, char** argv) {
   }
 
   if (!WriteCalibrationOutputs(argc, argv, model, spec, data, result)) return kExitUsage;
+  if (FLAGS_timings) std::cerr << TimingLines(read_s, fit_s, watch.Lap(), result.stage_seconds);
 
   // Results on stdout, progress and diagnostics on stderr (docs/cli.md, "Output streams").
   if (!FLAGS_quiet) std::cerr << result.ceres_brief_report << "\n";

@@ -1477,4 +1477,16 @@ TEST_F(CliTest, EvaluateNamesADropoutAndResidualsCanBeThinned) {
   EXPECT_NE(r.output.find("--residuals-every=-1: must be 0"), std::string::npos) << r.output;
 }
 
+// --timings names each stage of the fit with its wall time, on stderr after the run.
+TEST_F(CliTest, CalibrateTimingsNameEachStage) {
+  const CommandResult r = Fastcal("calibrate --quiet --timings --spec=" + Source() +
+                                  "/calibration_data/spec_mass_centre.yaml --data=" + Source() +
+                                  "/calibration_data/circle_paper.csv --out=" + Path("timed"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  for (const char* stage :
+       {"read inputs", "solve and reweight", "linearise", "evaluate", "write outputs"}) {
+    EXPECT_NE(r.output.find(std::string("  ") + stage), std::string::npos) << stage << r.output;
+  }
+}
+
 }  // namespace

@@ -1480,20 +1480,27 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   const CalibrationSpec joint = SeparateSessionParameters(spec, data.session_labels);
   Run run(model, joint, data, options, result, error);
   using Stage = CalibrationStatus (*)(Run&);
-  const Stage stages[] = {ValidateInputs,
-                          MeasureForwardModelError,
-                          PredictAndScreen,
-                          BuildAndCheck,
-                          SolveAndReweight,
-                          NameGrossErrors,
-                          LineariseAtSolution,
-                          EstimateUncertainty,
-                          ScanChanges,
-                          Diagnose,
-                          Conclude,
-                          Evaluate};
-  for (const Stage stage : stages) {
-    const CalibrationStatus status = stage(run);
+  struct NamedStage {
+    const char* name;
+    Stage stage;
+  };
+  const NamedStage stages[] = {{"validate", ValidateInputs},
+                               {"forward model error", MeasureForwardModelError},
+                               {"predict and screen", PredictAndScreen},
+                               {"build and check", BuildAndCheck},
+                               {"solve and reweight", SolveAndReweight},
+                               {"name gross errors", NameGrossErrors},
+                               {"linearise", LineariseAtSolution},
+                               {"uncertainty", EstimateUncertainty},
+                               {"change scan", ScanChanges},
+                               {"diagnose", Diagnose},
+                               {"conclude", Conclude},
+                               {"evaluate", Evaluate}};
+  for (const NamedStage& s : stages) {
+    const auto start = std::chrono::steady_clock::now();
+    const CalibrationStatus status = s.stage(run);
+    result->stage_seconds.emplace_back(
+        s.name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (status != CalibrationStatus::kOk) return status;
   }
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

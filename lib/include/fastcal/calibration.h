@@ -290,6 +290,9 @@ struct CalibrationResult {
   double forward_model_max_rel_error = 0.0;
   double forward_model_rms_rel_error = 0.0;
   double seconds = 0.0;
+  // Wall time of each stage of the pipeline, in order (name, s): where a long dataset's
+  // time goes (printed by `fastcal calibrate --timings`).
+  std::vector<std::pair<std::string, double>> stage_seconds;
 };
 
 // Whether the reduced chi-square agrees with the stated noise. For a correct noise model
