@@ -678,20 +678,28 @@ class Stopwatch {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
-// --timings: read, the fit's stages, write (stderr).
+// --timings: read, the fit's stages, write (stderr), with the peak resident memory at
+// the end of each.
 std::string TimingLines(double read_s, double fit_s, double write_s,
-                        const std::vector<std::pair<std::string, double>>& stages) {
+                        const std::vector<CalibrationResult::Stage>& stages) {
   std::ostringstream s;
   char buf[120];
-  const auto line = [&](const std::string& name, double seconds) {
-    std::snprintf(buf, sizeof(buf), "  %-24s %8.3f s\n", name.c_str(), seconds);
+  const auto line = [&](const std::string& name, double seconds, double peak_mb) {
+    std::snprintf(buf, sizeof(buf), "  %-24s %8.3f s", name.c_str(), seconds);
     s << buf;
+    if (peak_mb > 0.0) {
+      std::snprintf(buf, sizeof(buf), "  %8.0f MB", peak_mb);
+      s << buf;
+    }
+    s << "\n";
   };
-  s << "timings (wall):\n";
-  line("read inputs", read_s);
-  line("fit", fit_s);
-  for (const auto& [name, seconds] : stages) line("  " + name, seconds);
-  line("write outputs", write_s);
+  s << "timings (wall; peak resident memory so far):\n";
+  line("read inputs", read_s, 0.0);
+  line("fit", fit_s, 0.0);
+  for (const CalibrationResult::Stage& stage : stages) {
+    line("  " + stage.name, stage.seconds, stage.peak_resident_mb);
+  }
+  line("write outputs", write_s, 0.0);
   return s.str();
 }
 
@@ -912,7 +920,7 @@ int RunCalibrate(int argc, char** argv) {
   }
 
   if (!WriteCalibrationOutputs(argc, argv, model, spec, data, result)) return kExitUsage;
-  if (FLAGS_timings) std::cerr << TimingLines(read_s, fit_s, watch.Lap(), result.stage_seconds);
+  if (FLAGS_timings) std::cerr << TimingLines(read_s, fit_s, watch.Lap(), result.stages);
 
   // Results on stdout, progress and diagnostics on stderr (docs/cli.md, "Output streams").
   if (!FLAGS_quiet) std::cerr << result.ceres_brief_report << "\n";

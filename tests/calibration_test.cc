@@ -756,24 +756,42 @@ TEST(CalibrationTest, BlockCrossValidationMatchesRefitsWithoutEachBlock) {
   EXPECT_GT(cv, fitted);  // predicted without its own block, the data fit worse
 }
 
-// One thread or two: the same estimates and budget (sums in another order).
+// One thread or more: the same numbers, to the last bit (issue 20).
 TEST(CalibrationTest, ThreadsDoNotChangeTheResult) {
-  constexpr double kRelTol = 1e-9;
-  const Dataset data = CircleData(Truth(), 90, 0.03, 33);
+  // Three chunks of samples (internal/sample_chunks.h), a robust loss and a hold-out:
+  // every number the outputs print is the same bits on 1, 2 and 3 threads.
+  const Dataset data = CircleData(Truth(), 2600, 0.03, 33);
   CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
-  CalibrationResult one, two;
-  spec.num_threads = 1;
-  ASSERT_TRUE(CalibrateNominal(spec, data, &one));
-  spec.num_threads = 2;
-  ASSERT_TRUE(CalibrateNominal(spec, data, &two));
-  for (size_t k = 0; k < one.parameters.size(); ++k) {
-    const ParameterEstimate& a = one.parameters[k];
-    const ParameterEstimate& b = two.parameters[k];
-    EXPECT_NEAR(a.estimate, b.estimate, kRelTol * std::abs(a.estimate)) << a.name;
-    EXPECT_NEAR(a.sigma_total, b.sigma_total, kRelTol * a.sigma_total) << a.name;
+  spec.robust_loss = RobustLoss::kHuber;
+  spec.robust_loss_scale = 2.0;
+  spec.holdout_fraction = 0.2;
+  CalibrationResult results[3];
+  for (int k = 0; k < 3; ++k) {
+    spec.num_threads = k + 1;
+    ASSERT_TRUE(CalibrateNominal(spec, data, &results[k]));
   }
-  ASSERT_EQ(one.misfit_ranking.size(), two.misfit_ranking.size());
-  EXPECT_EQ(one.misfit_ranking.front().name, two.misfit_ranking.front().name);
+  for (int k = 1; k < 3; ++k) {
+    const CalibrationResult& a = results[0];
+    const CalibrationResult& b = results[k];
+    SCOPED_TRACE(std::to_string(k + 1) + " threads");
+    EXPECT_EQ(a.final_cost, b.final_cost);
+    EXPECT_EQ(a.reduced_chi_square, b.reduced_chi_square);
+    EXPECT_EQ(a.iterations, b.iterations);
+    for (size_t p = 0; p < a.parameters.size(); ++p) {
+      EXPECT_EQ(a.parameters[p].estimate, b.parameters[p].estimate) << a.parameters[p].name;
+      EXPECT_EQ(a.parameters[p].sigma_total, b.parameters[p].sigma_total) << a.parameters[p].name;
+    }
+    ASSERT_EQ(a.variants.size(), b.variants.size());
+    for (size_t v = 0; v < a.variants.size(); ++v) {
+      EXPECT_EQ(a.variants[v].fit.rms_n, b.variants[v].fit.rms_n) << a.variants[v].name;
+      EXPECT_EQ(a.variants[v].holdout.rms_n, b.variants[v].holdout.rms_n) << a.variants[v].name;
+    }
+    EXPECT_EQ(a.cross_validation.rms_n, b.cross_validation.rms_n);
+    ASSERT_EQ(a.misfit_ranking.size(), b.misfit_ranking.size());
+    for (size_t c = 0; c < a.misfit_ranking.size(); ++c) {
+      EXPECT_EQ(a.misfit_ranking[c].expected_decrease, b.misfit_ranking[c].expected_decrease);
+    }
+  }
 }
 
 // On long data the candidates come from an evenly spaced subsample (the option): the

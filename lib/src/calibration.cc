@@ -5,6 +5,7 @@
 #include "fastcal/calibration.h"
 
 #include <ceres/ceres.h>
+#include <sys/resource.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -17,7 +18,9 @@
 #include "fastcal/gross_errors.h"
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/folded_cost.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/model_plausibility.h"
 
 namespace fastcal {
@@ -37,6 +40,13 @@ constexpr double kNPerKn = 1e3;
 // Chance that noise alone makes some candidate of the misfit ranking "significant".
 constexpr double kMisfitFamilyError = 0.01;
 
+// The process's peak resident memory so far (MB), 0 where getrusage does not say.
+double PeakResidentMb() {
+  rusage usage;
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
+  return usage.ru_maxrss / 1024.0;  // kB on Linux
+}
+
 // x with P(chi-square(1 dof) > x) = tail: the square of the two-sided normal quantile.
 double ChiSquare1Quantile(double tail) {
   const double z = TwoSidedNormalQuantile(tail);
@@ -51,7 +61,7 @@ struct Prediction {
   std::vector<std::array<double, kNumCables>> reading_n;  // gain T + bias
   std::vector<std::array<double, kNumCables>> sigma_n;    // whitening sigma from the reading
   std::vector<std::array<double, kNumCables>> whitened;   // (reading - measured) / sigma
-  std::vector<StaticsSolution> starts;                    // the statics there (warm starts)
+  std::vector<internal::CompactStart> starts;             // the statics there (warm starts)
 };
 
 struct Run {
@@ -92,6 +102,19 @@ struct Run {
     return pose;
   }
   const ParameterSpec& Free(int k) const { return spec.parameters[cm->spec_index(k)]; }
+  // The fitted samples with the current weights, warm starts and exclusions.
+  internal::FittedSamples Samples() const {
+    internal::FittedSamples s;
+    s.model = cm.get();
+    s.data = &data;
+    s.fit = &fit;
+    s.sigma_n = &sigma_n;
+    s.starts = &at.starts;
+    s.excluded = &excluded;
+    s.use_planned_attitude = spec.use_planned_attitude;
+    s.statics = statics;
+    return s;
+  }
   CalibrationStatus Fail(CalibrationStatus status, const std::string& why) const {
     *error = why;
     return status;
@@ -379,31 +402,47 @@ CalibrationStatus Predict(Run& run) {
     run.cm->Assemble(run.theta.data(), &session_params[k], &session_gain[k], &session_bias[k],
                      static_cast<int>(k));
   }
-  const size_t num_samples = run.data.samples.size();
+  const int num_samples = static_cast<int>(run.data.samples.size());
   Prediction& at = run.at;
-  at.reading_n.assign(num_samples, {});
-  at.sigma_n.assign(num_samples, {});
-  at.whitened.assign(num_samples, {});
-  at.starts.assign(num_samples, StaticsSolution());
-  for (size_t t = 0; t < num_samples; ++t) {
+  at.reading_n.resize(num_samples);
+  at.sigma_n.resize(num_samples);
+  at.whitened.resize(num_samples);
+  // Each sample starts from its statics at the previous parameters, when there are any.
+  at.starts.resize(num_samples);
+  StaticsOptions options = run.statics;
+  options.warm_start = true;
+  const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& sample = run.data.samples[t];
-    const StaticsParameters<double>& params = session_params[sample.session];
-    const std::array<double, kNumCables>& gain = session_gain[sample.session];
-    const std::array<double, kNumCables>& bias = session_bias[sample.session];
-    if (SolveStaticsWithParameters(params, run.PoseOf(sample), run.statics, &at.starts[t]) !=
-        StaticsStatus::kOk) {
-      return run.Fail(CalibrationStatus::kInfeasible,
-                      SampleWhere(run.data, sample) +
-                          ": the model cannot solve this pose: " + DescribeStatus(at.starts[t]));
-    }
-    for (int i = 0; i < kNumCables; ++i) {
-      at.reading_n[t][i] = gain[i] * at.starts[t].cables[i].lower_tension_n + bias[i];
-    }
-    at.sigma_n[t] = internal::TensionSigmas(at.reading_n[t], run.spec.tension_sigma_n,
-                                            run.spec.tension_sigma_percent);
-    for (int i = 0; i < kNumCables; ++i) {
-      at.whitened[t][i] = (at.reading_n[t][i] - sample.tension_n[i]) / at.sigma_n[t][i];
-    }
+    at.starts[t].Restore(run.PoseOf(sample), options.method, solution);
+    return SolveStaticsWithParameters(session_params[sample.session], run.PoseOf(sample), options,
+                                      solution);
+  };
+  const int failed =
+      internal::ForEachChunk(num_samples, run.spec.num_threads, [&](int begin, int end) {
+        StaticsSolution solution;
+        for (int t = begin; t < end; ++t) {
+          const Sample& sample = run.data.samples[t];
+          if (solve(t, &solution) != StaticsStatus::kOk) return t;
+          at.starts[t] = internal::CompactStart::Of(solution);
+          const std::array<double, kNumCables>& gain = session_gain[sample.session];
+          const std::array<double, kNumCables>& bias = session_bias[sample.session];
+          for (int i = 0; i < kNumCables; ++i) {
+            at.reading_n[t][i] = gain[i] * solution.cables[i].lower_tension_n + bias[i];
+          }
+          at.sigma_n[t] = internal::TensionSigmas(at.reading_n[t], run.spec.tension_sigma_n,
+                                                  run.spec.tension_sigma_percent);
+          for (int i = 0; i < kNumCables; ++i) {
+            at.whitened[t][i] = (at.reading_n[t][i] - sample.tension_n[i]) / at.sigma_n[t][i];
+          }
+        }
+        return -1;
+      });
+  if (failed >= 0) {
+    StaticsSolution solution;  // the first failure again, for its message
+    solve(failed, &solution);
+    return run.Fail(CalibrationStatus::kInfeasible,
+                    SampleWhere(run.data, run.data.samples[failed]) +
+                        ": the model cannot solve this pose: " + DescribeStatus(solution));
   }
   return CalibrationStatus::kOk;
 }
@@ -435,25 +474,13 @@ ReadingMask ScreenReadings(Run& run) {
 // (Ceres owns the cost and loss objects it is given).
 
 void BuildProblem(Run& run) {
-  run.problem.reset();  // one problem in memory at a time (~300 MB at 1e5 samples)
-  ceres::Problem::Options po;
-  run.problem = std::make_unique<ceres::Problem>(po);
-  ceres::LossFunction* loss = MakeLoss(run.spec).release();
-  run.sigma_n.assign(run.fit.size(), {});
-  for (size_t j = 0; j < run.fit.size(); ++j) {
-    const int t = run.fit[j];
-    const Sample& sample = run.data.samples[t];
-    internal::TensionResidual f;
-    f.model = run.cm.get();
-    f.pose = run.PoseOf(sample);
-    f.measured_n = sample.tension_n;
-    f.sigma_n = run.sigma_n[j] = run.at.sigma_n[t];
-    f.statics = run.statics;
-    f.start = run.at.starts[t];
-    if (!run.excluded.empty()) f.excluded = run.excluded[t];
-    f.session = sample.session;
-    run.problem->AddResidualBlock(new internal::TensionCost(f), loss, run.theta.data());
-  }
+  run.problem.reset();
+  run.problem = std::make_unique<ceres::Problem>();
+  run.sigma_n.resize(run.fit.size());
+  for (size_t j = 0; j < run.fit.size(); ++j) run.sigma_n[j] = run.at.sigma_n[run.fit[j]];
+  run.problem->AddResidualBlock(
+      new internal::FoldedTensionCost(run.Samples(), run.loss.get(), run.spec.num_threads), nullptr,
+      run.theta.data());
   for (int k = 0; k < run.n; ++k) {
     const ParameterSpec& p = run.Free(k);
     if (p.has_prior) {
@@ -723,7 +750,9 @@ double PriorChiSquare(const Run& run) {
   return chi;
 }
 
-BudgetInputs MakeBudgetInputs(const Run& run, const internal::Linearisation& lin,
+// The budget's inputs. The linearisation's per-sample scores and Jacobians are moved
+// in, not copied (~130 MB at 10^6 samples): ReturnSeries gives them back.
+BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
                               const std::vector<ParameterSpec>& candidates) {
   BudgetInputs in;
   in.prior_information = Eigen::VectorXd::Zero(run.n);
@@ -741,8 +770,8 @@ BudgetInputs MakeBudgetInputs(const Run& run, const internal::Linearisation& lin
     if (llt.info() == Eigen::Success) in.information = exact;
   }
   in.information.diagonal() += in.prior_information;
-  in.scores = lin.scores;
-  in.jacobians = lin.jacobians;
+  in.scores = std::move(lin.scores);
+  in.jacobians = std::move(lin.jacobians);
   in.rows_per_sample = kNumCables;
   in.num_residuals = run.result->num_residuals;
   in.chi_square = lin.raw_chi_square + PriorChiSquare(run);
@@ -787,17 +816,8 @@ void FillCorrelation(Run& run) {
 CalibrationStatus Linearise(Run& run, const std::vector<ParameterSpec>& candidates,
                             internal::Linearisation* lin) {
   internal::LinearisationInputs in;
-  in.fitted = run.cm.get();
+  in.samples = run.Samples();
   in.theta = run.theta.data();
-  in.data = &run.data;
-  in.fit = run.fit;
-  in.sigma_n = run.sigma_n;
-  in.starts.reserve(run.fit.size());
-  for (int t : run.fit) in.starts.push_back(std::move(run.at.starts[t]));
-  run.at.starts = std::vector<StaticsSolution>();  // ~70 MB at 1e5 samples
-  in.excluded = run.excluded;
-  in.use_planned_attitude = run.spec.use_planned_attitude;
-  in.statics = run.statics;
   in.loss = run.loss.get();
   in.candidates = candidates;
   in.cross_validation_blocks = run.spec.cross_validation_blocks;
@@ -996,29 +1016,48 @@ void CrossValidate(Run& run, const internal::Linearisation& lin,
   }
 }
 
+// The fitted readings farthest from the model in stated sigmas (options.worst_readings),
+// through a bounded heap: memory independent of the number of samples. Ties go to the
+// earlier reading.
 void FindWorstReadings(Run& run) {
-  std::vector<ReadingResidual> all;
+  struct Entry {
+    double size;
+    int t, i;
+  };
+  const auto worse = [](const Entry& a, const Entry& b) {
+    if (a.size != b.size) return a.size > b.size;
+    return a.t != b.t ? a.t < b.t : a.i < b.i;
+  };
+  const size_t keep = static_cast<size_t>(std::max(0, run.options.worst_readings));
+  std::vector<Entry> heap;  // the best of the worst on top (a heap under `worse`)
   for (int t : run.fit) {
-    for (int i = 0; i < kNumCables; ++i) {
+    for (int i = 0; i < kNumCables && keep > 0; ++i) {
       if (!run.excluded.empty() && run.excluded[t][i]) continue;
-      all.push_back(ReadingAt(run, t, i));
+      const Entry e{std::abs(run.at.whitened[t][i]), t, i};
+      if (heap.size() < keep) {
+        heap.push_back(e);
+        std::push_heap(heap.begin(), heap.end(), worse);
+      } else if (worse(e, heap.front())) {
+        std::pop_heap(heap.begin(), heap.end(), worse);
+        heap.back() = e;
+        std::push_heap(heap.begin(), heap.end(), worse);
+      }
     }
   }
-  const size_t keep =
-      std::min(all.size(), static_cast<size_t>(std::max(0, run.options.worst_readings)));
-  std::partial_sort(all.begin(), all.begin() + keep, all.end(), [](const auto& a, const auto& b) {
-    return std::abs(a.residual_sigma) > std::abs(b.residual_sigma);
-  });
-  all.resize(keep);
-  run.result->worst_readings = std::move(all);
+  std::sort(heap.begin(), heap.end(), worse);
+  std::vector<ReadingResidual>& worst = run.result->worst_readings;
+  worst.clear();
+  for (const Entry& e : heap) worst.push_back(ReadingAt(run, e.t, e.i));
 }
 
 // Stage: the problem linearised at the solution (one pass for the free parameters, one
 // for the candidates).
 CalibrationStatus LineariseAtSolution(Run& run) {
-  run.problem.reset();  // its residuals hold a copy of every warm start
+  run.problem.reset();
   run.candidates = Candidates(run, &run.candidate_value_si);
-  return Linearise(run, run.candidates, &run.lin);
+  const CalibrationStatus status = Linearise(run, run.candidates, &run.lin);
+  run.at.starts = std::vector<internal::CompactStart>();  // the last use (~190 MB at 10^6)
+  return status;
 }
 
 // Stage: identifiability at the solution, the least-squares chi-square, the budget.
@@ -1029,9 +1068,11 @@ CalibrationStatus EstimateUncertainty(Run& run) {
   // robust cost would be another number).
   r.reduced_chi_square =
       (run.lin.raw_chi_square + PriorChiSquare(run)) / std::max(1, r.num_residuals - run.n);
-  const BudgetInputs inputs = MakeBudgetInputs(run, run.lin, run.candidates);
+  BudgetInputs inputs = MakeBudgetInputs(run, run.lin, run.candidates);
   run.information = inputs.information;
   r.covariance_ok = ComputeUncertaintyBudget(inputs, &r.budget);
+  run.lin.scores = std::move(inputs.scores);
+  run.lin.jacobians = std::move(inputs.jacobians);
   FillCorrelation(run);
   return CalibrationStatus::kOk;
 }
@@ -1370,8 +1411,13 @@ void AddNotes(Run& run) {
 CalibrationStatus Evaluate(Run& run) {
   CalibrationResult& r = *run.result;
   if (!run.options.evaluate) return CalibrationStatus::kOk;
+  // With exact statics the last prediction is the calibrated model's row already.
+  std::vector<std::array<double, kNumCables>> calibrated;
+  if (run.spec.forward_model == StaticsMethod::kExact) calibrated = std::move(run.at.reading_n);
+  run.at = Prediction();  // the fit's last use of it was the diagnostics
   std::string why;
-  if (!EvaluateBeforeAndAfter(run.model, run.spec, run.data, r, &r.variants, &why)) {
+  if (!EvaluateBeforeAndAfter(run.model, run.spec, run.data, r, &r.variants, &why,
+                              calibrated.empty() ? nullptr : &calibrated)) {
     return run.Fail(CalibrationStatus::kInfeasible, why);
   }
   return CalibrationStatus::kOk;
@@ -1499,8 +1545,9 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   for (const NamedStage& s : stages) {
     const auto start = std::chrono::steady_clock::now();
     const CalibrationStatus status = s.stage(run);
-    result->stage_seconds.emplace_back(
-        s.name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    result->stages.push_back(
+        {s.name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+         PeakResidentMb()});
     if (status != CalibrationStatus::kOk) return status;
   }
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -1,16 +1,63 @@
 // The before/after RMS table of a calibration (declaration: calibration.h).
+//
+// Each variant's readings are predicted with exact statics in chunks of samples on the
+// spec's threads (internal/sample_chunks.h): each chunk warm-starts along its own
+// samples from a cold first one, so the numbers do not depend on the number of threads.
 #include <string>
 #include <vector>
 
 #include "fastcal/calibration.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/sessions.h"
 
 namespace fastcal {
+namespace {
+
+// Every sample's reading predicted by models[sample.session] (models[0] for all when
+// there is one). False, naming the first sample a model cannot hold.
+bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset& data,
+                     AttitudeSource attitude, int threads,
+                     std::vector<std::array<double, kNumCables>>* predicted, std::string* error) {
+  StaticsOptions options = ModelFitStaticsOptions(StaticsMethod::kExact);
+  const auto pose_of = [&](const Sample& s) {
+    Pose pose = s.pose;
+    if (attitude == AttitudeSource::kPlanned) pose.rotation = s.planned_rotation;
+    return pose;
+  };
+  const auto model_of = [&](const Sample& s) -> const CableRobot& {
+    return *models[models.size() > 1 ? s.session : 0];
+  };
+  predicted->resize(data.samples.size());
+  const int failed = internal::ForEachChunk(
+      static_cast<int>(data.samples.size()), threads, [&](int begin, int end) {
+        StaticsOptions warm = options;
+        warm.warm_start = true;  // consecutive telemetry samples are close
+        StaticsSolution solution;
+        for (int t = begin; t < end; ++t) {
+          const Sample& s = data.samples[t];
+          const CableRobot& robot = model_of(s);
+          if (SolveStatics(robot, pose_of(s), warm, &solution) != StaticsStatus::kOk) return t;
+          for (int i = 0; i < kNumCables; ++i) {
+            (*predicted)[t][i] = robot.cables[i].SensorReadingN(solution.cables[i].lower_tension_n);
+          }
+        }
+        return -1;
+      });
+  if (failed < 0) return true;
+  const Sample& s = data.samples[failed];
+  StaticsSolution solution;  // cold, as the failed warm solve's retry was
+  SolveStatics(model_of(s), pose_of(s), options, &solution);
+  *error = SampleWhere(data, s) + ": the model cannot solve this pose: " + DescribeStatus(solution);
+  return false;
+}
+
+}  // namespace
 
 bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec,
                             const Dataset& data, const CalibrationResult& result,
-                            std::vector<VariantEvaluation>* variants, std::string* error) {
+                            std::vector<VariantEvaluation>* variants, std::string* error,
+                            std::vector<std::array<double, kNumCables>>* calibrated_readings) {
   struct Variant {
     std::string name;
     const CableRobot* robot;
@@ -28,16 +75,27 @@ bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec
        spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured});
   for (const Variant& v : list) {
     VariantEvaluation e;
+    e.name = v.name;
     // A joint fit's calibrated model is one per session (sessions.h).
-    const bool per_session = v.robot == &result.calibrated && result.session_models.size() > 1;
-    if (per_session ? !EvaluateSessionModels(v.name, result.session_models, data, v.attitude,
-                                             StaticsMethod::kExact, result.held_out,
-                                             result.excluded, &e, error)
-                    : !EvaluateVariant(v.name, *v.robot, data, v.attitude, StaticsMethod::kExact,
-                                       result.held_out, &e, error, result.excluded)) {
+    std::vector<const CableRobot*> models = {v.robot};
+    if (v.robot == &result.calibrated && result.session_models.size() > 1) {
+      models.clear();
+      for (const CableRobot& m : result.session_models) models.push_back(&m);
+    }
+    if (v.attitude == AttitudeSource::kPlanned && !data.has_planned_attitude) {
+      *error = v.name + ": " + data.path + ": no planned attitude columns (planned_roll_deg, ...)";
+      return false;
+    }
+    if (v.robot == &result.calibrated && calibrated_readings != nullptr &&
+        calibrated_readings->size() == data.samples.size()) {
+      e.predicted_n = std::move(*calibrated_readings);
+    } else if (!PredictReadings(models, data, v.attitude, spec.num_threads, &e.predicted_n,
+                                error)) {
       *error = v.name + ": " + *error;
       return false;
     }
+    e.fit = ErrorStats(data, e.predicted_n, result.held_out, false, result.excluded);
+    e.holdout = ErrorStats(data, e.predicted_n, result.held_out, true, result.excluded);
     variants->push_back(std::move(e));
   }
   return true;

@@ -6,6 +6,8 @@
 #include <cmath>
 #include <thread>
 
+#include "fastcal/internal/sample_chunks.h"
+
 namespace fastcal::internal {
 namespace {
 
@@ -23,31 +25,6 @@ bool IsPerCableGroup(ParameterKind kind) {
 // per-cable group's common parameter.
 bool Covers(const ParameterSpec& p, const ParameterSpec& b) {
   return SameParameter(p, b) || (p.kind == b.kind && IsPerCableGroup(p.kind) && p.index < 0);
-}
-
-// Calls fn(thread, begin, end) on `threads` contiguous chunks of [0, count), in parallel.
-template <typename Fn>
-void ParallelChunks(int count, int threads, const Fn& fn) {
-  threads = std::clamp(threads, 1, std::max(1, count));
-  std::vector<std::thread> workers;
-  for (int w = 0; w < threads; ++w) {
-    const int begin = static_cast<int>(static_cast<long long>(count) * w / threads);
-    const int end = static_cast<int>(static_cast<long long>(count) * (w + 1) / threads);
-    workers.emplace_back([&fn, w, begin, end] { fn(w, begin, end); });
-  }
-  for (std::thread& t : workers) t.join();
-}
-
-// The fit's residual of fitted sample j, through `model`.
-TensionResidual ResidualOf(const LinearisationInputs& in, const CalibrationModel* model, int j) {
-  const Sample& sample = in.data->samples[in.fit[j]];
-  TensionResidual f{
-      model,         sample.pose, sample.tension_n,
-      in.sigma_n[j], in.statics,  in.starts.empty() ? StaticsSolution() : in.starts[j]};
-  if (in.use_planned_attitude) f.pose.rotation = sample.planned_rotation;
-  if (!in.excluded.empty()) f.excluded = in.excluded[in.fit[j]];
-  f.session = sample.session;
-  return f;
 }
 
 // Residuals and Jacobian (rows of excluded readings zero) of `f` at `theta`, and the
@@ -153,19 +130,17 @@ void AddToFold(const TensionResidual& f, const Eigen::Matrix<double, kNumCables,
   }
 }
 
-bool AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisation* out,
-                    FreeSums* sums, int* failed) {
-  const int n = in.fitted->num_free();
-  const int num_fit = static_cast<int>(in.fit.size());
+// Fitted samples [begin, end) into `sums`; the first that fails, or -1.
+int AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisation* out,
+                   FreeSums* sums) {
+  const int n = in.samples.model->num_free();
+  const int num_fit = in.samples.size();
   RowMatrix j(kNumCables, n);
   Eigen::Matrix<double, kNumCables, 1> r;
   for (int t = begin; t < end; ++t) {
-    const TensionResidual f = ResidualOf(in, in.fitted, t);
+    const TensionResidual f = in.samples.At(t);
     double weight = 1.0, curvature = 0.0;
-    if (!EvaluateSample(f, in.theta, in.loss, &r, &j, &weight, &curvature)) {
-      *failed = t;
-      return false;
-    }
+    if (!EvaluateSample(f, in.theta, in.loss, &r, &j, &weight, &curvature)) return t;
     const Eigen::MatrixXd jw = weight * j;
     const Eigen::VectorXd rw = weight * r;
     out->residuals.row(t) = r.transpose();
@@ -185,7 +160,8 @@ bool AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
     AddToFold(f, r, j, weight, &sums->folds[block]);
   }
-  return true;
+  sums->Flush();
+  return -1;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -215,17 +191,19 @@ Eigen::MatrixXd Combine(const RowMatrix& basis, const std::vector<std::vector<in
   return j;
 }
 
-bool AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
-                          int end, CandidateSums* sums, Eigen::MatrixXd* scores, int* failed) {
+// The candidate pass's samples [begin, end) into `sums`; the first that fails (a fitted
+// sample), or -1.
+int AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
+                         int end, CandidateSums* sums, Eigen::MatrixXd* scores) {
+  const FittedSamples& in = pass.in.samples;
   RowMatrix b(kNumCables, pass.basis.front().num_free());
   Eigen::Matrix<double, kNumCables, 1> r;
   for (int k = begin; k < end; ++k) {
-    const int session = pass.in.data->samples[pass.in.fit[samples[k]]].session;
-    const TensionResidual f = ResidualOf(pass.in, &pass.basis[session], samples[k]);
+    const int session = in.data->samples[(*in.fit)[samples[k]]].session;
+    const TensionResidual f = in.At(samples[k], &pass.basis[session]);
     double weight = 1.0;
     if (!EvaluateSample(f, pass.theta[session].data(), pass.in.loss, &r, &b, &weight)) {
-      *failed = samples[k];
-      return false;
+      return samples[k];
     }
     Eigen::MatrixXd jx = weight * Combine(b, pass.free_columns);
     for (size_t c = 0; c < pass.free_session.size(); ++c) {
@@ -240,7 +218,7 @@ bool AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& sam
     sums->information.noalias() += jx.transpose() * jx;
     scores->row(k) = g.transpose();
   }
-  return true;
+  return -1;
 }
 
 // Evenly spaced fitted samples, at most `budget` of them.
@@ -254,89 +232,88 @@ std::vector<int> CandidateSamples(int num_fit, int budget) {
 }
 
 std::string CannotSolve(const LinearisationInputs& in, int fitted_sample) {
-  const Sample& s = in.data->samples[in.fit[fitted_sample]];
-  return SampleWhere(*in.data, s) + ": the calibrated model cannot solve this pose";
+  const Dataset& data = *in.samples.data;
+  const Sample& s = data.samples[(*in.samples.fit)[fitted_sample]];
+  return SampleWhere(data, s) + ": the calibrated model cannot solve this pose";
 }
 
 bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::string* error) {
-  const int n = in.fitted->num_free();
-  const int num_fit = static_cast<int>(in.fit.size());
+  const int n = in.samples.model->num_free();
+  const int num_fit = in.samples.size();
   const int blocks = std::clamp(in.cross_validation_blocks, 1, std::max(1, num_fit));
   out->scores = Eigen::MatrixXd::Zero(num_fit, n);
   out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
   out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
-  const int threads = std::clamp(in.num_threads, 1, std::max(1, num_fit));
-  std::vector<FreeSums> sums(threads, FreeSums(n, blocks));
-  std::vector<int> failed(threads, -1);
-  ParallelChunks(num_fit, threads, [&](int w, int begin, int end) {
-    AccumulateFree(in, begin, end, out, &sums[w], &failed[w]);
-  });
-  for (int w = 0; w < threads; ++w) {
-    if (failed[w] >= 0) {
-      *error = CannotSolve(in, failed[w]);
-      return false;
-    }
-    if (w > 0) sums[0].Add(sums[w]);
+  FreeSums total(n, blocks);
+  const int failed = ReduceChunks<FreeSums>(
+      num_fit, in.num_threads, [&] { return FreeSums(n, blocks); },
+      [&](int begin, int end, FreeSums* sums) { return AccumulateFree(in, begin, end, out, sums); },
+      [&](FreeSums& sums) { total.Add(sums); });
+  if (failed >= 0) {
+    *error = CannotSolve(in, failed);
+    return false;
   }
-  sums[0].Flush();
-  out->information = std::move(sums[0].information);
-  out->loss_curvature = std::move(sums[0].curvature);
-  out->r_factor = std::move(sums[0].r_factor);
-  out->chi_square = sums[0].chi_square;
-  out->raw_chi_square = sums[0].raw_chi_square;
-  out->readings = sums[0].readings;
-  out->folds = std::move(sums[0].folds);
+  total.Flush();
+  out->information = std::move(total.information);
+  out->loss_curvature = std::move(total.curvature);
+  out->r_factor = std::move(total.r_factor);
+  out->chi_square = total.chi_square;
+  out->raw_chi_square = total.raw_chi_square;
+  out->readings = total.readings;
+  out->folds = std::move(total.folds);
   return true;
 }
 
 bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std::string* error) {
-  const int n = in.fitted->num_free();
+  const CalibrationModel& fitted = *in.samples.model;
+  const int n = fitted.num_free();
   const int q = static_cast<int>(in.candidates.size());
-  const CableRobot& model = in.fitted->robot();
+  const CableRobot& model = fitted.robot();
   CalibrationSpec basis_spec;
   basis_spec.parameters = BasisParameters(model);
   CandidatePass pass{in, {}, {}, {}, {}, {}};
-  const int sessions = std::max<int>(1, static_cast<int>(in.data->session_labels.size()));
+  const int sessions = std::max<int>(1, static_cast<int>(in.samples.data->session_labels.size()));
   for (int s = 0; s < sessions; ++s) {
-    pass.basis.emplace_back(in.fitted->ToRobot(in.theta, s), basis_spec);
+    pass.basis.emplace_back(fitted.ToRobot(in.theta, s), basis_spec);
     pass.theta.push_back(pass.basis.back().InitialTheta());
   }
   for (int k = 0; k < n; ++k) {
-    const ParameterSpec& p = in.fitted->spec().parameters[in.fitted->spec_index(k)];
+    const ParameterSpec& p = fitted.spec().parameters[fitted.spec_index(k)];
     pass.free_columns.push_back(BasisColumns(p, model));
     pass.free_session.push_back(p.session);
   }
   for (const ParameterSpec& p : in.candidates) {
     pass.candidate_columns.push_back(BasisColumns(p, model));
   }
-  const std::vector<int> samples =
-      CandidateSamples(static_cast<int>(in.fit.size()), in.max_candidate_samples);
-  const int threads = std::clamp(in.num_threads, 1, std::max(1, static_cast<int>(samples.size())));
-  std::vector<CandidateSums> sums(threads, {Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q),
-                                            Eigen::VectorXd::Zero(q), Eigen::MatrixXd::Zero(n, n)});
-  std::vector<int> failed(threads, -1);
+  const std::vector<int> samples = CandidateSamples(in.samples.size(), in.max_candidate_samples);
+  const auto zero = [&] {
+    return CandidateSums{Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q),
+                         Eigen::VectorXd::Zero(q), Eigen::MatrixXd::Zero(n, n)};
+  };
+  CandidateSums total = zero();
   out->candidate_scores = Eigen::MatrixXd::Zero(static_cast<int>(samples.size()), q);
-  ParallelChunks(static_cast<int>(samples.size()), threads, [&](int w, int begin, int end) {
-    AccumulateCandidates(pass, samples, begin, end, &sums[w], &out->candidate_scores, &failed[w]);
-  });
-  for (int w = 0; w < threads; ++w) {
-    if (failed[w] >= 0) {
-      *error = CannotSolve(in, failed[w]);
-      return false;
-    }
-    if (w == 0) continue;
-    sums[0].cross += sums[w].cross;
-    sums[0].self += sums[w].self;
-    sums[0].gradient += sums[w].gradient;
-    sums[0].information += sums[w].information;
+  const int failed = ReduceChunks<CandidateSums>(
+      static_cast<int>(samples.size()), in.num_threads, zero,
+      [&](int begin, int end, CandidateSums* sums) {
+        return AccumulateCandidates(pass, samples, begin, end, sums, &out->candidate_scores);
+      },
+      [&](const CandidateSums& sums) {
+        total.cross += sums.cross;
+        total.self += sums.self;
+        total.gradient += sums.gradient;
+        total.information += sums.information;
+      });
+  if (failed >= 0) {
+    *error = CannotSolve(in, failed);
+    return false;
   }
-  const double scale = static_cast<double>(in.fit.size()) / std::max<size_t>(1, samples.size());
-  out->cross = scale * sums[0].cross;
-  out->self = scale * sums[0].self;
-  out->gradient = scale * sums[0].gradient;
+  const double scale = static_cast<double>(in.samples.size()) / std::max<size_t>(1, samples.size());
+  out->cross = scale * total.cross;
+  out->self = scale * total.self;
+  out->gradient = scale * total.gradient;
   out->candidate_samples = static_cast<int>(samples.size());
   out->candidate_rows = samples;
-  out->candidate_information = scale * sums[0].information;
+  out->candidate_information = scale * total.information;
   out->candidate_scale = scale;
   return true;
 }

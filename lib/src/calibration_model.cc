@@ -147,6 +147,22 @@ std::array<double, kNumCables> TensionSigmas(const std::array<double, kNumCables
   return s;
 }
 
+TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const {
+  const int t = (*fit)[j];
+  const Sample& sample = data->samples[t];
+  TensionResidual f;
+  f.model = through != nullptr ? through : model;
+  f.pose = sample.pose;
+  if (use_planned_attitude) f.pose.rotation = sample.planned_rotation;
+  f.measured_n = sample.tension_n;
+  f.sigma_n = (*sigma_n)[j];
+  f.statics = statics;
+  if (starts != nullptr && !starts->empty()) f.start = (*starts)[t];
+  if (excluded != nullptr && !excluded->empty()) f.excluded = (*excluded)[t];
+  f.session = sample.session;
+  return f;
+}
+
 TensionCost::TensionCost(const TensionResidual& functor)
     : functor_(functor), n_(functor.model->num_free()) {
   set_num_residuals(kNumCables);

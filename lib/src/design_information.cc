@@ -99,8 +99,8 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
       column[k] = spec.parameters[model.spec_index(k)].free ? x++ : pr.n + z++;
     }
   }
-  TensionResidual f{&model,           Pose(), {}, {}, ModelFitStaticsOptions(spec.forward_model),
-                    StaticsSolution()};
+  TensionResidual f{&model,        Pose(), {}, {}, ModelFitStaticsOptions(spec.forward_model),
+                    CompactStart()};
   f.sigma_n.fill(1.0);  // residual = reading; whitened below
   const int first = static_cast<int>(pr.x_rows.rows());
   pr.x_rows.conservativeResize(first + kRows * static_cast<int>(poses.size()), pr.n);

@@ -210,29 +210,4 @@ bool CheckSessions(const Dataset& data, std::string* error) {
   return true;
 }
 
-bool EvaluateSessionModels(const std::string& name, const std::vector<CableRobot>& models,
-                           const Dataset& data, AttitudeSource attitude, StaticsMethod method,
-                           const std::vector<bool>& held_out, const ReadingMask& excluded,
-                           VariantEvaluation* evaluation, std::string* error) {
-  evaluation->name = name;
-  evaluation->predicted_n.assign(data.samples.size(), {});
-  for (size_t s = 0; s < models.size(); ++s) {
-    Dataset part = data;
-    part.samples.clear();
-    std::vector<size_t> index;
-    for (size_t t = 0; t < data.samples.size(); ++t) {
-      if (data.samples[t].session != static_cast<int>(s)) continue;
-      part.samples.push_back(data.samples[t]);
-      index.push_back(t);
-    }
-    if (part.samples.empty()) continue;
-    std::vector<std::array<double, kNumCables>> predicted;
-    if (!PredictTensions(models[s], part, attitude, method, &predicted, error)) return false;
-    for (size_t k = 0; k < index.size(); ++k) evaluation->predicted_n[index[k]] = predicted[k];
-  }
-  evaluation->fit = ErrorStats(data, evaluation->predicted_n, held_out, false, excluded);
-  evaluation->holdout = ErrorStats(data, evaluation->predicted_n, held_out, true, excluded);
-  return true;
-}
-
 }  // namespace fastcal

@@ -41,8 +41,8 @@
 #include "fastcal/change_scan.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
-#include "fastcal/sessions.h"
 #include "fastcal/gross_errors.h"
+#include "fastcal/sessions.h"
 #include "fastcal/uncertainty.h"
 
 namespace fastcal {
@@ -290,9 +290,15 @@ struct CalibrationResult {
   double forward_model_max_rel_error = 0.0;
   double forward_model_rms_rel_error = 0.0;
   double seconds = 0.0;
-  // Wall time of each stage of the pipeline, in order (name, s): where a long dataset's
-  // time goes (printed by `fastcal calibrate --timings`).
-  std::vector<std::pair<std::string, double>> stage_seconds;
+  // Each stage of the pipeline, in order: its wall time and the process's peak resident
+  // memory at its end (getrusage; 0 where unavailable): where a long dataset's time and
+  // memory go (printed by `fastcal calibrate --timings`).
+  struct Stage {
+    std::string name;
+    double seconds = 0.0;
+    double peak_resident_mb = 0.0;
+  };
+  std::vector<Stage> stages;
 };
 
 // Whether the reduced chi-square agrees with the stated noise. For a correct noise model
@@ -334,10 +340,14 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
 // "initial model, measured attitude") and the calibrated one at the fit's attitude
 // ("calibrated model, measured attitude"), exact statics, on the fitted and the held-out
 // samples, gross errors left out. False, naming the variant and the sample's line, when
-// a model cannot hold a pose.
-bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec,
-                            const Dataset& data, const CalibrationResult& result,
-                            std::vector<VariantEvaluation>* variants, std::string* error);
+// a model cannot hold a pose. `calibrated_readings` (may be null): the calibrated model's
+// readings of every sample, when already predicted with exact statics at the fit's
+// attitude (moved from; saves a pass over the data). Predictions run on spec.num_threads
+// threads, with the same numbers on any number.
+bool EvaluateBeforeAndAfter(
+    const CableRobot& model, const CalibrationSpec& spec, const Dataset& data,
+    const CalibrationResult& result, std::vector<VariantEvaluation>* variants, std::string* error,
+    std::vector<std::array<double, kNumCables>>* calibrated_readings = nullptr);
 
 }  // namespace fastcal
 

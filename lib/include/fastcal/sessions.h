@@ -87,13 +87,6 @@ std::string SessionVerdict(const std::vector<SessionDifference>& differences);
 // naming the first sample that is not, otherwise.
 bool CheckSessions(const Dataset& data, std::string* error);
 
-// EvaluateVariant (evaluation.h) with each sample predicted by the model of its session
-// (models[sample.session]).
-bool EvaluateSessionModels(const std::string& name, const std::vector<CableRobot>& models,
-                           const Dataset& data, AttitudeSource attitude, StaticsMethod method,
-                           const std::vector<bool>& held_out, const ReadingMask& excluded,
-                           VariantEvaluation* evaluation, std::string* error);
-
 }  // namespace fastcal
 
 #endif  // FASTCAL_SESSIONS_H_

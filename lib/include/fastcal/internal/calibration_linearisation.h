@@ -15,10 +15,10 @@
 // Jet); a common group's parameter is the sum of its six per-cable
 // columns. One basis pass gives B_t (6 x K), so J_x = B_t A_x and J_c = B_t A_c (A: 0/1
 // maps), accumulated as J_x^T J_c, diag(J_c^T J_c) and J_c^T r. This pass costs ~25 us a
-// sample (a 64-wide Jet through the statics; twice that with attachments, 128 wide), so on long datasets it runs on at most
-// LinearisationInputs::max_candidate_samples evenly spaced samples and its sums are scaled by N /
-// N_used: J_x^T J_c and diag(J_c^T J_c) involve no noise and are smooth along the poses (a
-// quadrature), while J_c^T r then carries N / N_used times its noise (the misfit
+// sample (a 64-wide Jet through the statics; twice that with attachments, 128 wide), so on long
+// datasets it runs on at most LinearisationInputs::max_candidate_samples evenly spaced samples and
+// its sums are scaled by N / N_used: J_x^T J_c and diag(J_c^T J_c) involve no noise and are smooth
+// along the poses (a quadrature), while J_c^T r then carries N / N_used times its noise (the misfit
 // ranking's threshold is raised by that factor).
 //
 // Readings kept out of the fit (gross errors) have r = 0 and J = 0. With a robust loss,
@@ -45,20 +45,14 @@
 namespace fastcal::internal {
 
 struct LinearisationInputs {
-  const CalibrationModel* fitted = nullptr;  // the fit's model (its free set)
-  const double* theta = nullptr;             // the solution
-  const Dataset* data = nullptr;
-  std::vector<int> fit;  // fitted samples, dataset indices in file order
-  // Per fitted sample: the fit's whitening sigmas, and the statics at the solution
-  // (warm starts; status other than ok starts cold).
-  std::vector<std::array<double, kNumCables>> sigma_n;
-  std::vector<StaticsSolution> starts;
-  ReadingMask excluded;  // per dataset sample; may be empty
-  bool use_planned_attitude = false;
-  StaticsOptions statics;
+  // The fitted samples with the fit's whitening sigmas, exclusions and warm starts (the
+  // statics at the solution), through the fit's model (its free set).
+  FittedSamples samples;
+  const double* theta = nullptr;              // the solution
   const ceres::LossFunction* loss = nullptr;  // the fit's robust loss, or null
   std::vector<ParameterSpec> candidates;      // fixed parameters to differentiate against
   int cross_validation_blocks = 10;
+  // Threads of both passes: the results do not depend on it (sample_chunks.h).
   int num_threads = 1;
   int max_candidate_samples = 20000;  // the candidate pass's sample budget (see above)
 };

@@ -20,6 +20,9 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+#include "fastcal/evaluation.h"
+#include "fastcal/internal/compact_start.h"
 #include "fastcal/statics.h"
 
 namespace fastcal::internal {
@@ -124,10 +127,10 @@ struct TensionResidual {
   std::array<double, kNumCables> measured_n;
   std::array<double, kNumCables> sigma_n;
   StaticsOptions statics;
-  // The statics solution at the initial parameters (status ok), a constant starting
-  // point: each evaluation warm-starts from a copy of it, since the parameters move
-  // little. With a status other than ok every evaluation starts cold.
-  StaticsSolution start;
+  // The statics at the initial parameters, a constant starting point: each evaluation
+  // warm-starts from it, since the parameters move little. Without one (the default)
+  // every evaluation starts cold.
+  CompactStart start;
   // Readings kept out of the fit: their residual is 0, whatever the parameters.
   std::array<bool, kNumCables> excluded{};
   int session = 0;  // the sample's (Sample::session)
@@ -142,7 +145,8 @@ struct TensionResidual {
     for (const T& g : gain) {
       if (!(ScalarValue(g) > 0.0)) return false;
     }
-    StaticsSolution solution = start;
+    StaticsSolution solution;
+    start.Restore(pose, statics.method, &solution);
     StaticsOptions options = statics;
     options.warm_start = true;
     if (ModelLowerTensions(p, pose, options, &tension, &solution) != StaticsStatus::kOk) {
@@ -154,6 +158,26 @@ struct TensionResidual {
     }
     return true;
   }
+};
+
+// The fitted samples of one problem, by reference: nothing per sample is copied (at 10^6
+// samples every copy is ~50 MB). The residual of fitted sample j is At(j).
+struct FittedSamples {
+  const CalibrationModel* model = nullptr;
+  const Dataset* data = nullptr;
+  const std::vector<int>* fit = nullptr;  // dataset indices, file order
+  // Per fitted sample: the whitening sigmas.
+  const std::vector<std::array<double, kNumCables>>* sigma_n = nullptr;
+  // Per dataset sample: warm starts (may be null or empty: cold starts).
+  const std::vector<CompactStart>* starts = nullptr;
+  // Per dataset sample: readings kept out of the fit (may be null or empty).
+  const ReadingMask* excluded = nullptr;
+  bool use_planned_attitude = false;
+  StaticsOptions statics;
+
+  int size() const { return static_cast<int>(fit->size()); }
+  // Fitted sample j's residual through `through` (default: model).
+  TensionResidual At(int j, const CalibrationModel* through = nullptr) const;
 };
 
 // ceres::CostFunction over one parameter block (theta) of size num_free <= 64.

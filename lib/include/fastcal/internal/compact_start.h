@@ -1,0 +1,68 @@
+// A statics warm start small enough to keep one per sample (issue 20: the calibration
+// kept a whole StaticsSolution, 1240 bytes, per sample as its warm start: 1.2 GB at 10^6).
+//
+// What a warm start at the same pose reads from the solution before (statics.cc,
+// PreviousSolve): exact, each cable's state (Fl, Fz, s0); aas and aas-refined, each
+// cable's secant forces (Fl, Fz at the low and the high secant). Four numbers a cable:
+// 192 bytes. Doubles, not floats: aas's secant solves stop at a tolerance, so their
+// result moves with the start; from a float-rounded start the fit's cost became rough at
+// that level and Levenberg-Marquardt took 11 iterations on a circle where exact takes 6
+// (CalibrationTest.AasForwardModelConvergesLikeExact). Path extrapolation (has_previous)
+// is not kept: the calibration restarts each sample at its own pose.
+#ifndef FASTCAL_INTERNAL_COMPACT_START_H_
+#define FASTCAL_INTERNAL_COMPACT_START_H_
+
+#include <array>
+
+#include "fastcal/statics.h"
+
+namespace fastcal::internal {
+
+struct CompactStart {
+  // Per cable: exact (Fl, Fz, s0, 0); aas, aas-refined (low Fl, low Fz, high Fl, high Fz).
+  // All zero: no start (the solve starts cold).
+  std::array<std::array<double, 4>, kNumCables> v{};
+
+  bool has_start() const { return v[0][0] > 0.0; }
+
+  // From a solution of `method` (none when it did not succeed).
+  static CompactStart Of(const StaticsSolution& s) {
+    CompactStart c;
+    if (s.status != StaticsStatus::kOk) return c;
+    for (int i = 0; i < kNumCables; ++i) {
+      const CableSolution& k = s.cables[i];
+      if (s.method == StaticsMethod::kExact) {
+        c.v[i] = {static_cast<double>(k.horizontal_force_n), static_cast<double>(k.force_n[2]),
+                  static_cast<double>(k.unstretched_length_m), 0.0};
+      } else {
+        c.v[i] = {static_cast<double>(k.secant_low.fl_n), static_cast<double>(k.secant_low.fz_n),
+                  static_cast<double>(k.secant_high.fl_n), static_cast<double>(k.secant_high.fz_n)};
+      }
+    }
+    return c;
+  }
+
+  // Makes `s` a warm start for `method` at `pose` (status ok), or a cold one without a
+  // start (status other than ok).
+  void Restore(const Pose& pose, StaticsMethod method, StaticsSolution* s) const {
+    s->status = has_start() ? StaticsStatus::kOk : StaticsStatus::kInvalidInput;
+    s->method = method;
+    s->pose = pose;
+    s->has_previous = false;
+    for (int i = 0; i < kNumCables; ++i) {
+      CableSolution& k = s->cables[i];
+      if (method == StaticsMethod::kExact) {
+        k.horizontal_force_n = v[i][0];
+        k.force_n[2] = v[i][1];
+        k.unstretched_length_m = v[i][2];
+      } else {
+        k.secant_low = {v[i][0], v[i][1]};
+        k.secant_high = {v[i][2], v[i][3]};
+      }
+    }
+  }
+};
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_INTERNAL_COMPACT_START_H_

@@ -1,0 +1,129 @@
+// The fit's data term folded into one residual block (internal/folded_cost.h).
+#include "fastcal/internal/folded_cost.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "fastcal/internal/calibration_linearisation.h"
+#include "fastcal/internal/sample_chunks.h"
+
+namespace fastcal::internal {
+
+double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n) {
+  double sq_norm = 0.0;
+  for (int i = 0; i < kNumCables; ++i) sq_norm += residuals[i] * residuals[i];
+  if (loss == nullptr) return sq_norm;
+  double rho[3];
+  loss->Evaluate(sq_norm, rho);
+  const double sqrt_rho1 = std::sqrt(std::max(rho[1], 0.0));
+  double residual_scaling = sqrt_rho1, alpha_sq_norm = 0.0;
+  if (sq_norm > 0.0 && rho[2] > 0.0 && rho[1] > 0.0) {
+    const double alpha = 1.0 - std::sqrt(1.0 + 2.0 * sq_norm * rho[2] / rho[1]);
+    residual_scaling = sqrt_rho1 / (1.0 - alpha);
+    alpha_sq_norm = alpha / sq_norm;
+  }
+  if (jacobian != nullptr) {
+    for (int k = 0; k < n; ++k) {
+      double r_dot_j = 0.0;  // (r^T J)_k
+      for (int i = 0; i < kNumCables; ++i) r_dot_j += residuals[i] * jacobian[i * n + k];
+      for (int i = 0; i < kNumCables; ++i) {
+        jacobian[i * n + k] =
+            sqrt_rho1 * (jacobian[i * n + k] - alpha_sq_norm * residuals[i] * r_dot_j);
+      }
+    }
+  }
+  for (int i = 0; i < kNumCables; ++i) residuals[i] *= residual_scaling;
+  return rho[0];
+}
+
+FoldedTensionCost::FoldedTensionCost(const FittedSamples& samples, const ceres::LossFunction* loss,
+                                     int threads)
+    : samples_(samples), loss_(loss), threads_(threads), n_(samples.model->num_free()) {
+  set_num_residuals(n_ + 1);
+  mutable_parameter_block_sizes()->push_back(n_);
+}
+
+bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const {
+  struct Part {
+    Eigen::MatrixXd r;  // (n + 1) x (n + 1), upper triangular
+    double rho = 0.0;
+  };
+  const int n = n_;
+  *r_aug = Eigen::MatrixXd();
+  *rho_sum = 0.0;
+  const int failed = ReduceChunks<Part>(
+      samples_.size(), threads_, [] { return Part(); },
+      [&](int begin, int end, Part* part) {
+        using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+        Eigen::MatrixXd rows(kNumCables * (end - begin), n + 1);
+        RowMatrix j(kNumCables, n);
+        double r[kNumCables];
+        for (int t = begin; t < end; ++t) {
+          const TensionCost cost(samples_.At(t));
+          const double* parameters[1] = {theta};
+          double* jacobians[1] = {j.data()};
+          if (!cost.Evaluate(parameters, r, jacobians)) return t;
+          part->rho += CorrectForLoss(loss_, r, j.data(), n);
+          const int row = kNumCables * (t - begin);
+          rows.block(row, 0, kNumCables, n) = j;
+          for (int i = 0; i < kNumCables; ++i) rows(row + i, n) = r[i];
+        }
+        part->r = FoldRows(part->r, rows);
+        return -1;
+      },
+      [&](const Part& part) {
+        *r_aug = FoldRows(*r_aug, part.r);
+        *rho_sum += part.rho;
+      });
+  return failed < 0;
+}
+
+double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
+  double total = 0.0;
+  const int failed = ReduceChunks<double>(
+      samples_.size(), threads_, [] { return 0.0; },
+      [&](int begin, int end, double* sum) {
+        double r[kNumCables];
+        for (int j = begin; j < end; ++j) {
+          if (!samples_.At(j)(theta, r)) return j;
+          *sum += CorrectForLoss(loss_, r, nullptr, n_);
+        }
+        return -1;
+      },
+      [&](const double& sum) { total += sum; });
+  *ok = failed < 0;
+  return total;
+}
+
+bool FoldedTensionCost::Evaluate(double const* const* parameters, double* residuals,
+                                 double** jacobians) const {
+  const double* theta = parameters[0];
+  const int n = n_;
+  if (jacobians == nullptr || jacobians[0] == nullptr) {
+    bool ok = false;
+    const double s = Cost(theta, &ok);
+    if (!ok) return false;
+    std::fill(residuals, residuals + n, 0.0);
+    residuals[n] = std::sqrt(s);
+    return true;
+  }
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (memo_theta_.empty() || !std::equal(theta, theta + n, memo_theta_.begin())) {
+    memo_theta_.assign(theta, theta + n);
+    memo_ok_ = Fold(theta, &memo_r_aug_, &memo_rho_sum_);
+  }
+  if (!memo_ok_) return false;
+  const Eigen::VectorXd z = memo_r_aug_.col(n).head(n);
+  for (int k = 0; k < n; ++k) residuals[k] = z[k];
+  residuals[n] = std::sqrt(std::max(0.0, memo_rho_sum_ - z.squaredNorm()));
+  // Row-major (n + 1) x n: R, then a row of zeros.
+  double* jac = jacobians[0];
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < n; ++k) jac[i * n + k] = memo_r_aug_(i, k);
+  }
+  std::fill(jac + n * n, jac + (n + 1) * n, 0.0);
+  return true;
+}
+
+}  // namespace fastcal::internal

@@ -1,0 +1,261 @@
+// The fit's folded data term (internal/folded_cost.h) against Ceres's own per-sample
+// residual blocks, and the deterministic chunked passes it runs on
+// (internal/sample_chunks.h).
+#include "fastcal/internal/folded_cost.h"
+
+#include <ceres/ceres.h>
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+#include <memory>
+#include <random>
+#include <vector>
+
+#include "fastcal/internal/sample_chunks.h"
+#include "fastcal/trajectory.h"
+
+namespace fastcal::internal {
+namespace {
+
+// Folded and per-block evaluations differ by rounding only (a QR against sums).
+constexpr double kRelTol = 1e-9;
+
+// Random poses over the cap with seeded 3% noise around a shifted mass centre: residuals
+// of a few sigma, so that a robust loss with scale 1 acts on some of them.
+Dataset RandomData(int samples) {
+  CableRobot truth = CableRobot::NominalFast();
+  truth.mass_centre_cabin_m = Eigen::Vector3d(0.22, 0.11, 0.5);
+  RandomWorkspaceSpec spec;
+  spec.samples = samples;
+  spec.seed = 3;
+  std::vector<Eigen::Vector3d> positions;
+  std::vector<Pose> poses;
+  std::string error;
+  EXPECT_TRUE(RandomWorkspacePositions(spec, &positions, &error)) << error;
+  EXPECT_TRUE(PosesWithAttitudeLaw(positions, FocalAttitudeLaw(), &poses, &error)) << error;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal;
+  StaticsOptions exact;
+  Dataset d;
+  d.path = "random";
+  for (const Pose& pose : poses) {
+    StaticsSolution s;
+    EXPECT_EQ(SolveStatics(truth, pose, exact, &s), StaticsStatus::kOk);
+    Sample sample;
+    sample.line = static_cast<int>(d.samples.size()) + 2;
+    sample.pose = pose;
+    for (int i = 0; i < kNumCables; ++i) {
+      sample.tension_n[i] = s.cables[i].lower_tension_n * (1.0 + 0.03 * normal(rng));
+    }
+    d.samples.push_back(sample);
+  }
+  return d;
+}
+
+CalibrationSpec MassCentreSpec() {
+  CalibrationSpec spec;
+  for (int c = 0; c < 3; ++c) {
+    ParameterSpec p;
+    p.kind = ParameterKind::kMassCentre;
+    p.component = c;
+    p.name = std::string("mass_centre_m.") + "xyz"[c];
+    p.free = true;
+    spec.parameters.push_back(p);
+  }
+  ParameterSpec density;
+  density.kind = ParameterKind::kLinearDensity;
+  density.name = "linear_density_kg_per_m";
+  density.free = true;
+  spec.parameters.push_back(density);
+  return spec;
+}
+
+// The problem's inputs, owned here (FittedSamples points into them).
+struct Fixture {
+  Dataset data;
+  CalibrationSpec spec = MassCentreSpec();
+  CalibrationModel model{CableRobot::NominalFast(), spec};
+  std::vector<int> fit;
+  std::vector<std::array<double, kNumCables>> sigma_n;
+  ReadingMask excluded;
+
+  explicit Fixture(int samples) : data(RandomData(samples)) {
+    for (size_t t = 0; t < data.samples.size(); ++t) {
+      fit.push_back(static_cast<int>(t));
+      sigma_n.push_back(TensionSigmas(data.samples[t].tension_n, 0.0, 3.0));
+    }
+    excluded.assign(data.samples.size(), {});
+    excluded[7][2] = true;  // a reading kept out: residual 0 whatever theta
+  }
+  FittedSamples Samples() const {
+    FittedSamples s;
+    s.model = &model;
+    s.data = &data;
+    s.fit = &fit;
+    s.sigma_n = &sigma_n;
+    s.excluded = &excluded;
+    s.statics = ModelFitStaticsOptions(StaticsMethod::kExact);
+    return s;
+  }
+};
+
+struct Evaluation {
+  double cost = 0.0;
+  Eigen::VectorXd gradient;
+  Eigen::MatrixXd normal;  // J^T J
+};
+
+Evaluation Evaluate(ceres::Problem* problem) {
+  double cost = 0.0;
+  std::vector<double> gradient;
+  ceres::CRSMatrix j;
+  EXPECT_TRUE(problem->Evaluate(ceres::Problem::EvaluateOptions(), &cost, nullptr, &gradient, &j));
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(j.num_rows, j.num_cols);
+  for (int r = 0; r < j.num_rows; ++r) {
+    for (int p = j.rows[r]; p < j.rows[r + 1]; ++p) dense(r, j.cols[p]) = j.values[p];
+  }
+  return {cost, Eigen::Map<Eigen::VectorXd>(gradient.data(), gradient.size()),
+          dense.transpose() * dense};
+}
+
+// rho(s) = s + s^2 / 100: rho'' > 0, the corrector's alpha branch (Huber and Cauchy have
+// rho'' <= 0).
+class ConvexLoss : public ceres::LossFunction {
+ public:
+  void Evaluate(double s, double rho[3]) const override {
+    rho[0] = s + 0.01 * s * s;
+    rho[1] = 1.0 + 0.02 * s;
+    rho[2] = 0.02;
+  }
+};
+
+std::unique_ptr<ceres::LossFunction> Loss(int kind) {
+  if (kind == 1) return std::make_unique<ceres::HuberLoss>(1.0);
+  if (kind == 2) return std::make_unique<ceres::CauchyLoss>(1.0);
+  if (kind == 3) return std::make_unique<ConvexLoss>();
+  return nullptr;
+}
+
+// Cost, gradient and Gauss-Newton matrix of the folded block are those of one Ceres
+// residual block per sample with the loss attached (Ceres's own corrector is the
+// reference), without a loss, with Huber, Cauchy and a convex loss, on more samples than
+// a chunk.
+TEST(FoldedCostTest, MatchesOneCeresBlockPerSample) {
+  const Fixture f(2 * kSampleChunk + 100);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[2] += 0.4;  // z off the truth: residuals of a few sigma
+  for (int kind = 0; kind < 4; ++kind) {
+    const std::unique_ptr<ceres::LossFunction> loss = Loss(kind);
+    ceres::Problem::Options borrowed;
+    borrowed.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+    ceres::Problem blocks(borrowed), folded(borrowed);
+    const FittedSamples samples = f.Samples();
+    for (int j = 0; j < samples.size(); ++j) {
+      blocks.AddResidualBlock(new TensionCost(samples.At(j)), loss.get(), theta.data());
+    }
+    folded.AddResidualBlock(new FoldedTensionCost(samples, loss.get(), 2), nullptr, theta.data());
+    const Evaluation a = Evaluate(&blocks);
+    const Evaluation b = Evaluate(&folded);
+    EXPECT_NEAR(b.cost, a.cost, kRelTol * a.cost) << "loss " << kind;
+    EXPECT_LT((b.gradient - a.gradient).norm(), kRelTol * a.gradient.norm()) << "loss " << kind;
+    EXPECT_LT((b.normal - a.normal).norm(), kRelTol * a.normal.norm()) << "loss " << kind;
+    // A trial step's cost, without Jacobians: the same number.
+    double cost_only = 0.0;
+    ASSERT_TRUE(
+        folded.Evaluate(ceres::Problem::EvaluateOptions(), &cost_only, nullptr, nullptr, nullptr));
+    EXPECT_NEAR(cost_only, a.cost, kRelTol * a.cost) << "loss " << kind;
+  }
+}
+
+// One thread or three: the same bits.
+TEST(FoldedCostTest, ThreadsGiveTheSameBits) {
+  const Fixture f(3 * kSampleChunk + 7);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[0] += 0.1;
+  const ceres::HuberLoss huber(1.0);
+  std::vector<double> residuals[2], jacobian[2];
+  const int threads[2] = {1, 3};
+  for (int k = 0; k < 2; ++k) {
+    const FoldedTensionCost cost(f.Samples(), &huber, threads[k]);
+    residuals[k].resize(cost.num_residuals());
+    jacobian[k].resize(cost.num_residuals() * theta.size());
+    const double* parameters[1] = {theta.data()};
+    double* jacobians[1] = {jacobian[k].data()};
+    ASSERT_TRUE(cost.Evaluate(parameters, residuals[k].data(), jacobians));
+  }
+  EXPECT_EQ(residuals[0], residuals[1]);
+  EXPECT_EQ(jacobian[0], jacobian[1]);
+}
+
+// A sample the statics cannot solve (a non-positive density) fails the evaluation, as one
+// per-sample block would: Ceres then rejects the step.
+TEST(FoldedCostTest, AnUnsolvableSampleFailsTheEvaluation) {
+  const Fixture f(50);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[3] = -1.0;  // linear density
+  const FoldedTensionCost cost(f.Samples(), nullptr, 2);
+  std::vector<double> residuals(cost.num_residuals()), jacobian(cost.num_residuals() * 4);
+  const double* parameters[1] = {theta.data()};
+  double* jacobians[1] = {jacobian.data()};
+  EXPECT_FALSE(cost.Evaluate(parameters, residuals.data(), jacobians));
+  EXPECT_FALSE(cost.Evaluate(parameters, residuals.data(), nullptr));
+}
+
+// Sums merged in chunk order: a sum whose value depends on the order of its terms comes
+// out the same on 1, 2 and 4 threads, and equals the serial sum of the chunks' sums.
+TEST(SampleChunksTest, SumsDoNotDependOnThreads) {
+  constexpr int kCount = 10000, kChunk = 64;
+  std::mt19937_64 rng(9);
+  std::uniform_real_distribution<double> exponent(-20.0, 20.0);
+  std::vector<double> values(kCount);
+  for (double& v : values) v = std::pow(10.0, exponent(rng)) * (rng() % 2 ? 1 : -1);
+  double serial = 0.0;
+  for (int begin = 0; begin < kCount; begin += kChunk) {
+    double chunk = 0.0;
+    for (int t = begin; t < std::min(kCount, begin + kChunk); ++t) chunk += values[t];
+    serial += chunk;
+  }
+  for (int threads : {1, 2, 4}) {
+    double total = 0.0;
+    const int failed = ReduceChunks<double>(
+        kCount, threads, [] { return 0.0; },
+        [&](int begin, int end, double* sum) {
+          for (int t = begin; t < end; ++t) *sum += values[t];
+          return -1;
+        },
+        [&](const double& sum) { total += sum; }, kChunk);
+    EXPECT_EQ(failed, -1);
+    EXPECT_EQ(total, serial) << threads << " threads";
+  }
+}
+
+// The first failing item is named, whatever the threads and whichever chunk failed first
+// in time.
+TEST(SampleChunksTest, TheFirstFailureIsNamed) {
+  constexpr int kCount = 5000, kChunk = 100;
+  for (int threads : {1, 2, 4}) {
+    const int failed = ForEachChunk(
+        kCount, threads,
+        [](int begin, int end) {
+          for (int t = begin; t < end; ++t) {
+            if (t == 1234 || t == 4321) return t;
+          }
+          return -1;
+        },
+        kChunk);
+    EXPECT_EQ(failed, 1234) << threads << " threads";
+    const int reduced = ReduceChunks<int>(
+        kCount, threads, [] { return 0; },
+        [](int begin, int end, int*) {
+          for (int t = begin; t < end; ++t) {
+            if (t == 4321 || t == 777) return t;
+          }
+          return -1;
+        },
+        [](const int&) {}, kChunk);
+    EXPECT_EQ(reduced, 777) << threads << " threads";
+  }
+}
+
+}  // namespace
+}  // namespace fastcal::internal
