@@ -17,6 +17,8 @@ namespace {
 constexpr double kMadToSigma = 1.4826;
 // Sokal's window must end before this fraction of the series, or tau is unreliable.
 constexpr double kMaxWindowFraction = 0.25;
+// Lags of the autocovariance summed directly before the FFT is used.
+constexpr int kDirectLags = 64;
 // How many of its standard deviations a tau must exceed 1 by to count as correlated: the
 // largest of n parameters' taus is judged, so a 3-sigma rule, not 2.
 constexpr double kTauSignificance = 3.0;
@@ -172,6 +174,24 @@ Eigen::MatrixXd DataCovariance(const BudgetInputs& in, UncertaintyBudget* b) {
   return scale.asDiagonal() * first * scale.asDiagonal();
 }
 
+// Sokal's window over autocovariances c_0 .. c_last: true, with tau and the window in
+// *a, when some W <= last has W >= window_factor * tau(W); otherwise *a holds tau(last).
+bool SokalWindow(const std::vector<double>& c, int last, double window_factor, int n,
+                 AutocorrelationTime* a) {
+  double tau = 1.0;
+  for (int w = 1; w <= last; ++w) {
+    tau += 2.0 * c[w] / c[0];
+    if (w >= window_factor * tau) {
+      a->tau = std::max(tau, 1.0 / n);  // an anticorrelated series: below 1, never 0
+      a->window = w;
+      return true;
+    }
+  }
+  a->tau = std::max(tau, 1.0 / n);
+  a->window = last;
+  return false;
+}
+
 }  // namespace
 
 RobustScale RobustScaleOf(std::vector<double> values) {
@@ -190,19 +210,18 @@ AutocorrelationTime IntegratedAutocorrelationTime(const Eigen::Ref<const Eigen::
   if (n < 2) return a;
   const Eigen::VectorXd x = series.array() - series.mean();
   const int max_window = std::max(1, static_cast<int>(kMaxWindowFraction * n));
-  const std::vector<double> c = Autocovariance(x, max_window);
+  // The first lags summed directly: a series with a short memory (residuals, most
+  // influence series) meets the window within them, at ~1/20 of the FFT's cost on 10^6
+  // samples. A longer memory takes the FFT over all lags.
+  const int direct = std::min(max_window, kDirectLags);
+  std::vector<double> c(direct + 1);
+  for (int k = 0; k <= direct; ++k) c[k] = x.head(n - k).dot(x.tail(n - k)) / n;
   if (!(c[0] > 0.0)) return a;  // a constant series: no information about its memory
-  double tau = 1.0;
-  for (int w = 1; w <= max_window; ++w) {
-    tau += 2.0 * c[w] / c[0];
-    if (w >= window_factor * tau) {
-      a.tau = std::max(tau, 1.0 / n);  // an anticorrelated series: below 1, never 0
-      a.window = w;
-      return a;
-    }
+  if (SokalWindow(c, direct, window_factor, n, &a)) return a;
+  if (direct < max_window) {
+    c = Autocovariance(x, max_window);
+    if (SokalWindow(c, max_window, window_factor, n, &a)) return a;
   }
-  a.tau = std::max(tau, 1.0 / n);
-  a.window = max_window;
   a.reliable = false;
   return a;
 }
@@ -213,14 +232,20 @@ Eigen::MatrixXd LongRunCovarianceOfSum(const Eigen::MatrixXd& scores, int bandwi
   if (n_samples < 1) return Eigen::MatrixXd::Zero(n, n);
   const int l = std::clamp(bandwidth, 1, n_samples);
   const int batches = n_samples - l + 1;
-  Eigen::MatrixXd windows(batches, n);
-  Eigen::RowVectorXd window = scores.topRows(l).colwise().sum();
-  for (int j = 0; j < batches; ++j) {
-    if (j > 0) window += scores.row(j + l - 1) - scores.row(j - 1);
-    windows.row(j) = window;
-  }
+  // The window sums in blocks of rows: memory independent of the number of samples.
+  constexpr int kBlock = 4096;
+  Eigen::MatrixXd windows(std::min(kBlock, batches), n);
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n, n);
-  sum.selfadjointView<Eigen::Lower>().rankUpdate(windows.transpose());
+  Eigen::RowVectorXd window = scores.topRows(l).colwise().sum();
+  for (int first = 0; first < batches; first += kBlock) {
+    const int rows = std::min(kBlock, batches - first);
+    for (int k = 0; k < rows; ++k) {
+      const int j = first + k;
+      if (j > 0) window += scores.row(j + l - 1) - scores.row(j - 1);
+      windows.row(k) = window;
+    }
+    sum.selfadjointView<Eigen::Lower>().rankUpdate(windows.topRows(rows).transpose());
+  }
   sum = sum.selfadjointView<Eigen::Lower>();
   return static_cast<double>(n_samples) / (static_cast<double>(batches) * l) * sum;
 }
@@ -237,17 +262,21 @@ Eigen::VectorXd BatchCorrection(const SampleJacobians& jacobians, int rows_per_s
   const int stride = std::max(1, l / 16);
   // Per sample J_t^T J_t, added to and removed from the running window sum.
   using Rows = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-  auto information = [&](int t) {
-    const Eigen::MatrixXd j =
-        Eigen::Map<const Rows>(jacobians.row(t).data(), rows_per_sample, n).cast<double>();
-    return Eigen::MatrixXd(j.transpose() * j);
-  };
+  // Without allocation per sample (10^6 of them).
+  Eigen::MatrixXd j(rows_per_sample, n);
   Eigen::MatrixXd window = Eigen::MatrixXd::Zero(n, n);
-  for (int t = 0; t < l; ++t) window += information(t);
+  auto add = [&](int t, double sign) {
+    j = Eigen::Map<const Rows>(jacobians.row(t).data(), rows_per_sample, n).cast<double>();
+    window.noalias() += sign * (j.transpose() * j);
+  };
+  for (int t = 0; t < l; ++t) add(t, 1.0);
   Eigen::VectorXd kept = Eigen::VectorXd::Zero(n), all = Eigen::VectorXd::Zero(n);
-  for (int j = 0; j < batches; ++j) {
-    if (j > 0) window += information(j + l - 1) - information(j - 1);
-    if (j % stride != 0) continue;
+  for (int b = 0; b < batches; ++b) {
+    if (b > 0) {
+      add(b + l - 1, 1.0);
+      add(b - 1, -1.0);
+    }
+    if (b % stride != 0) continue;
     const Eigen::MatrixXd absorbed = window * inverse_information * window;
     all += window.diagonal();
     kept += window.diagonal() - absorbed.diagonal();
