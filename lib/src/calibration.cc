@@ -16,6 +16,7 @@
 #include <sstream>
 
 #include "fastcal/gross_errors.h"
+#include "fastcal/internal/calibration_evaluation.h"
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/folded_cost.h"
@@ -1059,9 +1060,7 @@ CalibrationStatus FindWorstReadings(Run& run) {
 CalibrationStatus LineariseAtSolution(Run& run) {
   run.problem.reset();
   run.candidates = Candidates(run, &run.candidate_value_si);
-  const CalibrationStatus status = Linearise(run, run.candidates, &run.lin);
-  run.at.starts = std::vector<internal::CompactStart>();  // the last use (~190 MB at 10^6)
-  return status;
+  return Linearise(run, run.candidates, &run.lin);
 }
 
 // Stage: identifiability at the solution, the least-squares chi-square, the budget.
@@ -1414,13 +1413,20 @@ void AddNotes(Run& run) {
 CalibrationStatus Evaluate(Run& run) {
   CalibrationResult& r = *run.result;
   if (!run.options.evaluate) return CalibrationStatus::kOk;
-  // With exact statics the last prediction is the calibrated model's row already.
+  // With exact statics the last prediction is the calibrated model's row already, and
+  // its statics each sample's warm start for the other rows.
+  internal::RmsTableInputs inputs;
   std::vector<std::array<double, kNumCables>> calibrated;
-  if (run.spec.forward_model == StaticsMethod::kExact) calibrated = std::move(run.at.reading_n);
-  run.at = Prediction();  // the fit's last use of it was the diagnostics
+  if (run.spec.forward_model == StaticsMethod::kExact) {
+    calibrated = std::move(run.at.reading_n);
+    inputs.calibrated_readings = &calibrated;
+    inputs.starts = &run.at.starts;
+  }
   std::string why;
-  if (!EvaluateBeforeAndAfter(run.model, run.spec, run.data, r, &r.variants, &why,
-                              calibrated.empty() ? nullptr : &calibrated)) {
+  const bool ok =
+      internal::EvaluateBeforeAndAfter(run.model, run.spec, run.data, r, inputs, &r.variants, &why);
+  run.at = Prediction();
+  if (!ok) {
     return run.Fail(CalibrationStatus::kInfeasible, why);
   }
   return CalibrationStatus::kOk;

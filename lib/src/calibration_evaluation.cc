@@ -1,43 +1,51 @@
-// The before/after RMS table of a calibration (declaration: calibration.h).
+// The before/after RMS table of a calibration (internal/calibration_evaluation.h).
 //
-// Each variant's readings are predicted with exact statics in chunks of samples on the
-// spec's threads (internal/sample_chunks.h): each chunk warm-starts along its own
-// samples from a cold first one, so the numbers do not depend on the number of threads.
+// Each variant's readings are predicted with exact statics, each sample from its own warm
+// start (or cold), in chunks on the spec's threads (internal/sample_chunks.h).
+#include "fastcal/internal/calibration_evaluation.h"
+
 #include <string>
 #include <vector>
 
-#include "fastcal/calibration.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/sample_chunks.h"
-#include "fastcal/sessions.h"
+#include "fastcal/internal/statics_core.h"
 
-namespace fastcal {
+namespace fastcal::internal {
 namespace {
 
 // Every sample's reading predicted by models[sample.session] (models[0] for all when
 // there is one). False, naming the first sample a model cannot hold.
 bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset& data,
-                     AttitudeSource attitude, int threads,
+                     AttitudeSource attitude, int threads, const std::vector<CompactStart>* starts,
                      std::vector<std::array<double, kNumCables>>* predicted, std::string* error) {
   StaticsOptions options = ModelFitStaticsOptions(StaticsMethod::kExact);
+  options.warm_start = true;
+  std::vector<StaticsParameters<double>> parameters;
+  for (const CableRobot* m : models) parameters.push_back(MakeStaticsParameters(*m));
   const auto pose_of = [&](const Sample& s) {
     Pose pose = s.pose;
     if (attitude == AttitudeSource::kPlanned) pose.rotation = s.planned_rotation;
     return pose;
   };
-  const auto model_of = [&](const Sample& s) -> const CableRobot& {
-    return *models[models.size() > 1 ? s.session : 0];
+  const auto model_of = [&](const Sample& s) { return models.size() > 1 ? s.session : 0; };
+  const auto solve = [&](int t, StaticsSolution* solution) {
+    const Sample& s = data.samples[t];
+    const Pose pose = pose_of(s);
+    if (starts != nullptr && !starts->empty()) {
+      (*starts)[t].Restore(pose, StaticsMethod::kExact, solution);
+    } else {
+      solution->status = StaticsStatus::kInvalidInput;  // no start: cold
+    }
+    return SolveStaticsWithParameters(parameters[model_of(s)], pose, options, solution);
   };
   predicted->resize(data.samples.size());
-  const int failed = internal::ForEachChunk(
-      static_cast<int>(data.samples.size()), threads, [&](int begin, int end) {
-        StaticsOptions warm = options;
-        warm.warm_start = true;  // consecutive telemetry samples are close
+  const int failed =
+      ForEachChunk(static_cast<int>(data.samples.size()), threads, [&](int begin, int end) {
         StaticsSolution solution;
         for (int t = begin; t < end; ++t) {
-          const Sample& s = data.samples[t];
-          const CableRobot& robot = model_of(s);
-          if (SolveStatics(robot, pose_of(s), warm, &solution) != StaticsStatus::kOk) return t;
+          if (solve(t, &solution) != StaticsStatus::kOk) return t;
+          const CableRobot& robot = *models[model_of(data.samples[t])];
           for (int i = 0; i < kNumCables; ++i) {
             (*predicted)[t][i] = robot.cables[i].SensorReadingN(solution.cables[i].lower_tension_n);
           }
@@ -45,10 +53,10 @@ bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset
         return -1;
       });
   if (failed < 0) return true;
-  const Sample& s = data.samples[failed];
-  StaticsSolution solution;  // cold, as the failed warm solve's retry was
-  SolveStatics(model_of(s), pose_of(s), options, &solution);
-  *error = SampleWhere(data, s) + ": the model cannot solve this pose: " + DescribeStatus(solution);
+  StaticsSolution solution;  // the failure again, for its message
+  solve(failed, &solution);
+  *error = SampleWhere(data, data.samples[failed]) +
+           ": the model cannot solve this pose: " + DescribeStatus(solution);
   return false;
 }
 
@@ -56,8 +64,9 @@ bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset
 
 bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec,
                             const Dataset& data, const CalibrationResult& result,
-                            std::vector<VariantEvaluation>* variants, std::string* error,
-                            std::vector<std::array<double, kNumCables>>* calibrated_readings) {
+                            const RmsTableInputs& inputs, std::vector<VariantEvaluation>* variants,
+                            std::string* error) {
+  std::vector<std::array<double, kNumCables>>* calibrated_readings = inputs.calibrated_readings;
   struct Variant {
     std::string name;
     const CableRobot* robot;
@@ -89,8 +98,8 @@ bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec
     if (v.robot == &result.calibrated && calibrated_readings != nullptr &&
         calibrated_readings->size() == data.samples.size()) {
       e.predicted_n = std::move(*calibrated_readings);
-    } else if (!PredictReadings(models, data, v.attitude, spec.num_threads, &e.predicted_n,
-                                error)) {
+    } else if (!PredictReadings(models, data, v.attitude, spec.num_threads, inputs.starts,
+                                &e.predicted_n, error)) {
       *error = v.name + ": " + *error;
       return false;
     }
@@ -101,4 +110,4 @@ bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec
   return true;
 }
 
-}  // namespace fastcal
+}  // namespace fastcal::internal

@@ -335,20 +335,6 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
                             const Dataset& data, const CalibrationOptions& options,
                             CalibrationResult* result, std::string* error);
 
-// The RMS table of a calibration (the paper's Table 6; the CLI's and the report's): the
-// initial `model` at each attitude the data has ("initial model, planned attitude",
-// "initial model, measured attitude") and the calibrated one at the fit's attitude
-// ("calibrated model, measured attitude"), exact statics, on the fitted and the held-out
-// samples, gross errors left out. False, naming the variant and the sample's line, when
-// a model cannot hold a pose. `calibrated_readings` (may be null): the calibrated model's
-// readings of every sample, when already predicted with exact statics at the fit's
-// attitude (moved from; saves a pass over the data). Predictions run on spec.num_threads
-// threads, with the same numbers on any number.
-bool EvaluateBeforeAndAfter(
-    const CableRobot& model, const CalibrationSpec& spec, const Dataset& data,
-    const CalibrationResult& result, std::vector<VariantEvaluation>* variants, std::string* error,
-    std::vector<std::array<double, kNumCables>>* calibrated_readings = nullptr);
-
 }  // namespace fastcal
 
 #endif  // FASTCAL_CALIBRATION_H_
