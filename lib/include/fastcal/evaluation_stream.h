@@ -1,0 +1,185 @@
+// `fastcal evaluate` on a file too long to hold (10^6 samples and more): the statistics of
+// evaluation.h and the gross-error screen of evaluation_screen.h, computed with memory
+// independent of the number of samples, and the same numbers, bit for bit, as the
+// whole-file path (EvaluateModel, ScreenEvaluation, WithoutGrossErrors).
+//
+// Pass 1 reads the file a chunk at a time (DatasetChunkReader), predicts each sample
+// (TensionPredictor: exact statics warm started from the sample before, across chunks),
+// accumulates the per-cable statistics (ErrorStatsAccumulator) and appends one fixed-size
+// binary record per sample (line, time, session, position, measured and predicted
+// readings: 8 (12 + 6 V) bytes for V variants, 144 or 192 bytes) to an unnamed temporary
+// file (std::tmpfile: on disk, deleted when closed), which the later passes read back.
+//
+// The robust centre and scale of the screen (gross_errors.h: median and 1.4826 MAD of
+// each cable's whitened residuals) are exact: each median is found by selection passes
+// over the temporary file (ExactSelection below: a histogram of 4096 bins narrows the
+// rank to one bin until at most 65536 values remain, which are sorted), 4 to 6 passes.
+// The same for the report's trajectory test (the median step between samples).
+#ifndef FASTCAL_EVALUATION_STREAM_H_
+#define FASTCAL_EVALUATION_STREAM_H_
+
+#include <Eigen/Core>
+#include <array>
+#include <cstdio>
+#include <functional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+#include "fastcal/evaluation.h"
+#include "fastcal/evaluation_screen.h"
+#include "fastcal/model_plausibility.h"
+#include "fastcal/statics.h"
+
+namespace fastcal {
+
+// The k-th smallest values (0-based rank) of several streams of values, exactly, in
+// memory independent of their length: the caller feeds every value of every stream in
+// each pass (Begin, Add..., End) until done(). A pass either counts and, when at most
+// kMaxKept values are left in the target's range, keeps them (then sorts: done), or
+// bins the range into kBins bins and narrows it to the bin holding the rank.
+class ExactSelection {
+ public:
+  static constexpr int kBins = 4096;
+  static constexpr size_t kMaxKept = 65536;
+  // targets[t] = {stream, rank}; a rank outside [0, count of the stream) gives NaN.
+  explicit ExactSelection(std::vector<std::pair<int, long long>> targets);
+  bool done() const;
+  void Begin();
+  void Add(int stream, double value);
+  void End();
+  double Result(size_t target) const { return targets_[target].result; }
+
+ private:
+  struct Level {
+    double min = 0.0, width = 0.0;
+    int bin = 0;
+  };
+  struct Target {
+    int stream = 0;
+    long long rank = 0;
+    bool done = false;
+    double result = 0.0;
+    std::vector<Level> levels;  // the range: the values in bin `bin` of every level
+    long long below = 0;        // values below the range
+    bool binning = false;       // this pass bins (else counts and keeps)
+    long long count = 0;
+    double min = 0.0, max = 0.0;
+    std::vector<double> kept;
+    std::vector<long long> bins;
+  };
+  static int BinOf(const Level& level, double value);
+  static bool InRange(const Target& t, double value);
+  std::vector<Target> targets_;
+  std::vector<std::vector<size_t>> by_stream_;  // targets of each stream
+};
+
+// One evaluated sample as the temporary file holds it.
+struct EvaluatedSample {
+  long long index = 0;  // 0-based, among the samples kept
+  int line = 0;
+  double time_s = 0.0;
+  int session = 0;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();
+  std::array<double, kNumCables> measured_n{};
+  // Per variant of StreamedEvaluation::variants that has predictions (the first ones).
+  std::vector<std::array<double, kNumCables>> predicted_n;
+  std::array<bool, kNumCables> gross{};  // the screen's gross errors (after Run)
+};
+
+struct EvaluationStreamOptions {
+  StaticsMethod method = StaticsMethod::kExact;
+  // skip_invalid_rows also removes the samples the model cannot solve (as
+  // SkipUnsolvableSamples, at each attitude with `method`), listed after the rows the
+  // reader skipped.
+  DatasetReadOptions read;
+  // Samples read, predicted and written at a time; bounds the memory of pass 1.
+  size_t chunk_samples = 8192;
+  // The screen's noise model and threshold floor (ScreenEvaluation's).
+  CalibrationSpec spec;
+  // Gross errors named in screen.gross_errors, the first in file order; the counts
+  // (screen.count, count_per_cable) are exact however many there are.
+  size_t max_named_gross_errors = 10000;
+};
+
+enum class EvaluationStreamStatus {
+  kOk,
+  kInvalidInput,  // the file: unreadable, a bad header or row (ReadDataset's messages)
+  kUnsolvable,    // a pose the model cannot hold (without skip_invalid_rows), or every
+                  // sample skipped, or the model likely wrong (see `diagnosis`)
+};
+
+class StreamedEvaluation {
+ public:
+  StreamedEvaluation() = default;
+  StreamedEvaluation(const StreamedEvaluation&) = delete;
+  StreamedEvaluation& operator=(const StreamedEvaluation&) = delete;
+  ~StreamedEvaluation();
+
+  // Evaluates `robot` on the file at `path`: the variants of EvaluateModel ("model, planned
+  // attitude" when the file has it, then "model, measured attitude"), the screen against
+  // the last, and the rows "... - gross errors" (when the screen names any).
+  EvaluationStreamStatus Run(const CableRobot& robot, const std::string& path,
+                             const EvaluationStreamOptions& options, std::string* error);
+
+  // Calls `visit` with every kept sample, in file order (reading the temporary file).
+  bool ForEach(const std::function<void(const EvaluatedSample&)>& visit, std::string* error) const;
+
+  // The path, column flags, session labels and skipped rows (no samples).
+  const Dataset& layout() const { return layout_; }
+  long long samples() const { return samples_; }
+  double time_min_s() const { return time_min_s_; }
+  double time_max_s() const { return time_max_s_; }
+  // The median distance between consecutive positions and the RMS distance of the
+  // positions from their mean (internal::IsTrajectory's two numbers), exact.
+  double median_step_m() const { return median_step_m_; }
+  double position_spread_m() const { return position_spread_m_; }
+  // As EvaluateModel then WithoutGrossErrors; predicted_n left empty.
+  const std::vector<VariantEvaluation>& variants() const { return variants_; }
+  // How many of variants() have predictions (in EvaluatedSample::predicted_n).
+  int predicted_variants() const { return predicted_variants_; }
+  // As ScreenEvaluation, without `excluded` (EvaluatedSample::gross holds it).
+  const EvaluationScreen& screen() const { return screen_; }
+  // With skip_invalid_rows: DiagnoseUnsolvableRows over every valid row (the model's
+  // failures and whether the nominal model solves them); otherwise filled only when
+  // Run failed on a pose (kUnsolvable), over every row of the file.
+  const UnsolvableRows& diagnosis() const { return diagnosis_; }
+
+ private:
+  struct Pass1;
+  bool ReadRecord(std::FILE* file, EvaluatedSample* s) const;
+  // The whitened residuals of the screened (last predicted) variant.
+  std::array<double, kNumCables> Whitened(const EvaluatedSample& s) const;
+  // Selection passes over the temporary file: `feed` gives each sample's values to the
+  // selection; `first_pass`, if given, sees every sample of the first pass too.
+  bool Select(ExactSelection* selection,
+              const std::function<void(const EvaluatedSample&, ExactSelection*)>& feed,
+              std::string* error) const;
+  EvaluationStreamStatus Failure(const CableRobot& robot, const std::string& path,
+                                 const EvaluationStreamOptions& options, std::string* error);
+  bool Append(const Sample& s, const std::vector<std::array<double, kNumCables>>& predicted,
+              Pass1* p, std::string* error);
+  bool Screen(const EvaluationStreamOptions& options, std::string* error);
+  bool Trajectory(std::string* error);
+  bool GrossErrorRows(const EvaluationStreamOptions& options, std::string* error);
+
+  Dataset layout_;
+  long long samples_ = 0;
+  double time_min_s_ = 0.0, time_max_s_ = 0.0;
+  Eigen::Vector3d position_sum_m_ = Eigen::Vector3d::Zero();
+  double median_step_m_ = 0.0, position_spread_m_ = 0.0;
+  std::vector<VariantEvaluation> variants_;
+  int predicted_variants_ = 0;
+  EvaluationScreen screen_;
+  UnsolvableRows diagnosis_;
+  double sigma_abs_n_ = 0.0, sigma_percent_ = 0.0;  // the screen's noise model
+  std::array<long long, kNumCables> finite_{};      // finite whitened residuals per cable
+  std::FILE* spill_ = nullptr;
+};
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_EVALUATION_STREAM_H_

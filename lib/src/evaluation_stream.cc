@@ -1,0 +1,477 @@
+// `fastcal evaluate` on a file too long to hold (evaluation_stream.h).
+#include "fastcal/evaluation_stream.h"
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "fastcal/gross_errors.h"
+#include "fastcal/internal/calibration_model.h"
+
+namespace fastcal {
+namespace {
+
+// As RobustScaleOf (uncertainty.h): the standard deviation of a normal sample per MAD.
+constexpr double kMadToSigma = 1.4826;
+const char* const kVariantNames[] = {"model, planned attitude", "model, measured attitude"};
+
+std::vector<AttitudeSource> Attitudes(bool planned) {
+  if (planned) return {AttitudeSource::kPlanned, AttitudeSource::kMeasured};
+  return {AttitudeSource::kMeasured};
+}
+
+// DiagnoseUnsolvableRows of two parts of one dataset, as if of the whole (its rule:
+// at least two failures, the nominal model solving at least half of them).
+void AddDiagnosis(const UnsolvableRows& part, UnsolvableRows* total) {
+  constexpr int kFewestForNominalTest = 2;
+  total->rows += part.rows;
+  if (part.failed == 0) return;
+  if (total->failed == 0) {
+    total->first = part.first;
+    total->furthest_from_nominal = part.furthest_from_nominal;
+  }
+  total->failed += part.failed;
+  total->solved_by_nominal += part.solved_by_nominal;
+  total->model_likely =
+      total->failed >= kFewestForNominalTest && 2 * total->solved_by_nominal >= total->failed;
+}
+
+// The median of a stream's n values from its selected ranks n / 2 (and n / 2 - 1 when n is
+// even), as Median (uncertainty.cc) computes it: 0.5 (upper + lower).
+std::vector<std::pair<int, long long>> MedianRanks(const std::array<long long, kNumCables>& n) {
+  std::vector<std::pair<int, long long>> targets;
+  for (int i = 0; i < kNumCables; ++i) {
+    targets.emplace_back(i, n[i] / 2);
+    targets.emplace_back(i, n[i] % 2 == 0 ? n[i] / 2 - 1 : n[i] / 2);
+  }
+  return targets;
+}
+double MedianOf(const ExactSelection& s, int cable, long long n) {
+  if (n == 0) return 0.0;
+  const double upper = s.Result(2 * cable), lower = s.Result(2 * cable + 1);
+  return n % 2 == 1 ? upper : 0.5 * (upper + lower);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------
+// ExactSelection
+
+ExactSelection::ExactSelection(std::vector<std::pair<int, long long>> targets) {
+  for (const auto& [stream, rank] : targets) {
+    Target t;
+    t.stream = stream;
+    t.rank = rank;
+    if (by_stream_.size() <= static_cast<size_t>(stream)) by_stream_.resize(stream + 1);
+    by_stream_[stream].push_back(targets_.size());
+    targets_.push_back(std::move(t));
+  }
+}
+
+bool ExactSelection::done() const {
+  return std::all_of(targets_.begin(), targets_.end(), [](const Target& t) { return t.done; });
+}
+
+int ExactSelection::BinOf(const Level& level, double value) {
+  const double b = std::floor((value - level.min) / level.width);
+  return static_cast<int>(std::clamp(b, 0.0, static_cast<double>(kBins - 1)));
+}
+
+bool ExactSelection::InRange(const Target& t, double value) {
+  // While binning, the last level is the one being binned: its bin is not chosen yet.
+  const size_t levels = t.levels.size() - (t.binning ? 1 : 0);
+  for (size_t l = 0; l < levels; ++l) {
+    const Level& level = t.levels[l];
+    if (value < level.min || BinOf(level, value) != level.bin) return false;
+  }
+  return true;
+}
+
+void ExactSelection::Begin() {
+  for (Target& t : targets_) {
+    t.count = 0;
+    t.min = std::numeric_limits<double>::infinity();
+    t.max = -t.min;
+    t.kept.clear();
+    if (t.binning) t.bins.assign(kBins, 0);
+  }
+}
+
+void ExactSelection::Add(int stream, double value) {
+  if (stream < 0 || static_cast<size_t>(stream) >= by_stream_.size()) return;
+  for (size_t k : by_stream_[stream]) {
+    Target& t = targets_[k];
+    if (t.done || !InRange(t, value)) continue;
+    if (t.binning) {
+      ++t.bins[BinOf(t.levels.back(), value)];
+      continue;
+    }
+    ++t.count;
+    t.min = std::min(t.min, value);
+    t.max = std::max(t.max, value);
+    if (t.kept.size() < kMaxKept) t.kept.push_back(value);
+  }
+}
+
+void ExactSelection::End() {
+  for (Target& t : targets_) {
+    if (t.done) continue;
+    const long long rank = t.rank - t.below;
+    if (t.binning) {
+      // Narrow the range to the bin that holds the rank.
+      long long before = 0;
+      int b = 0;
+      while (b < kBins - 1 && before + t.bins[b] <= rank) before += t.bins[b++];
+      t.below += before;
+      t.levels.back().bin = b;
+      t.binning = false;
+      t.bins.clear();
+      continue;
+    }
+    if (rank < 0 || rank >= t.count) {  // no such rank (or an empty stream)
+      t.result = std::numeric_limits<double>::quiet_NaN();
+      t.done = true;
+    } else if (t.count <= static_cast<long long>(kMaxKept)) {
+      std::nth_element(t.kept.begin(), t.kept.begin() + rank, t.kept.end());
+      t.result = t.kept[rank];
+      t.done = true;
+    } else if (t.min == t.max) {
+      t.result = t.min;
+      t.done = true;
+    } else {
+      // (max - min) / kBins underflows only for a subnormal range: then two bins.
+      const double width = (t.max - t.min) / kBins;
+      t.levels.push_back({t.min, width > 0.0 ? width : t.max - t.min, 0});
+      t.binning = true;
+    }
+    t.kept.clear();
+    t.kept.shrink_to_fit();
+  }
+}
+
+// ---------------------------------------------------------------------------------------
+// StreamedEvaluation
+
+StreamedEvaluation::~StreamedEvaluation() {
+  if (spill_ != nullptr) std::fclose(spill_);
+}
+
+// Pass 1's state: a predictor and the statistics of each variant, the whitened residuals'
+// counts, the rows the model cannot solve.
+struct StreamedEvaluation::Pass1 {
+  std::vector<TensionPredictor> predictors;
+  std::vector<ErrorStatsAccumulator> stats;
+  std::array<long long, kNumCables> finite{};  // finite whitened residuals per cable
+  std::vector<std::string> unsolvable;         // messages, listed after the reader's
+  std::vector<double> record;
+};
+
+bool StreamedEvaluation::ReadRecord(std::FILE* file, EvaluatedSample* s) const {
+  const size_t size = 12 + kNumCables * static_cast<size_t>(predicted_variants_);
+  double r[12 + kNumCables * 2];
+  if (std::fread(r, sizeof(double), size, file) != size) return false;
+  s->line = static_cast<int>(r[0]);
+  s->time_s = r[1];
+  s->session = static_cast<int>(r[2]);
+  s->position_m = Eigen::Vector3d(r[3], r[4], r[5]);
+  std::copy(r + 6, r + 12, s->measured_n.begin());
+  s->predicted_n.resize(predicted_variants_);
+  for (int v = 0; v < predicted_variants_; ++v) {
+    std::copy(r + 12 + kNumCables * v, r + 12 + kNumCables * (v + 1), s->predicted_n[v].begin());
+  }
+  return true;
+}
+
+bool StreamedEvaluation::ForEach(const std::function<void(const EvaluatedSample&)>& visit,
+                                 std::string* error) const {
+  if (spill_ == nullptr || samples_ == 0) return true;
+  std::rewind(spill_);
+  EvaluatedSample s;
+  const bool screened = screen_.threshold.readings > 0;
+  for (long long t = 0; t < samples_; ++t) {
+    if (!ReadRecord(spill_, &s)) {
+      *error =
+          "evaluation: cannot read back the temporary file: " + std::string(std::strerror(errno));
+      return false;
+    }
+    s.index = t;
+    s.gross.fill(false);
+    if (screened) {
+      const std::array<double, kNumCables> w = Whitened(s);
+      for (int i = 0; i < kNumCables; ++i) {
+        const double d = std::abs(w[i] - screen_.cables[i].centre);
+        // A non-finite residual (a reading the model cannot predict) is a gross error too.
+        s.gross[i] = !(d <= screen_.threshold.sigmas * screen_.cables[i].scale);
+      }
+    }
+    visit(s);
+  }
+  return true;
+}
+
+std::array<double, kNumCables> StreamedEvaluation::Whitened(const EvaluatedSample& s) const {
+  const std::array<double, kNumCables>& p = s.predicted_n.back();
+  const std::array<double, kNumCables> sigma_n =
+      internal::TensionSigmas(p, sigma_abs_n_, sigma_percent_);
+  std::array<double, kNumCables> w;
+  for (int i = 0; i < kNumCables; ++i) w[i] = (p[i] - s.measured_n[i]) / sigma_n[i];
+  return w;
+}
+
+bool StreamedEvaluation::Select(
+    ExactSelection* selection,
+    const std::function<void(const EvaluatedSample&, ExactSelection*)>& feed,
+    std::string* error) const {
+  while (!selection->done()) {
+    selection->Begin();
+    if (!ForEach([&](const EvaluatedSample& s) { feed(s, selection); }, error)) return false;
+    selection->End();
+  }
+  return true;
+}
+
+EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot, const std::string& path,
+                                               const EvaluationStreamOptions& options,
+                                               std::string* error) {
+  sigma_abs_n_ = options.spec.tension_sigma_n;
+  sigma_percent_ = options.spec.tension_sigma_percent;
+  DatasetChunkReader reader;
+  if (!reader.Open(path, options.read, error)) return EvaluationStreamStatus::kInvalidInput;
+  spill_ = std::tmpfile();
+  if (spill_ == nullptr) {
+    *error = "evaluation: cannot create a temporary file: " + std::string(std::strerror(errno));
+    return EvaluationStreamStatus::kInvalidInput;
+  }
+  const bool skip = options.read.skip_invalid_rows;
+  Pass1 p;
+  Dataset chunk;
+  for (bool done = false; !done;) {
+    if (!reader.Next(options.chunk_samples, &chunk, &done, error)) {
+      return EvaluationStreamStatus::kInvalidInput;
+    }
+    for (std::string& why : chunk.skipped) layout_.skipped.push_back(std::move(why));
+    chunk.skipped.clear();
+    if (chunk.samples.empty()) continue;
+    const std::vector<AttitudeSource> attitudes = Attitudes(chunk.has_planned_attitude);
+    if (p.predictors.empty()) {
+      for (AttitudeSource a : attitudes) {
+        p.predictors.emplace_back(robot, a, options.method);
+        p.stats.emplace_back();
+      }
+      predicted_variants_ = static_cast<int>(attitudes.size());
+    }
+    if (skip) {
+      // As fastcal evaluate --skip-invalid-rows: the diagnosis over every valid row, then
+      // the rows the model cannot solve removed (listed after the reader's).
+      AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", chunk,
+                                          {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
+                                          {options.method}),
+                   &diagnosis_);
+      SkipUnsolvableSamples(robot, "the model",
+                            {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, {options.method},
+                            &chunk);
+      for (std::string& why : chunk.skipped) p.unsolvable.push_back(std::move(why));
+      chunk.skipped.clear();
+    }
+    std::vector<std::array<double, kNumCables>> predicted(p.predictors.size());
+    for (const Sample& s : chunk.samples) {
+      for (size_t v = 0; v < p.predictors.size(); ++v) {
+        if (!p.predictors[v].Predict(chunk, s, &predicted[v], error)) {
+          return Failure(robot, path, options, error);
+        }
+        p.stats[v].Add(predicted[v], s.tension_n);
+      }
+      if (!Append(s, predicted, &p, error)) return EvaluationStreamStatus::kInvalidInput;
+    }
+  }
+  layout_.path = chunk.path;
+  layout_.has_planned_attitude = chunk.has_planned_attitude;
+  layout_.has_unstretched_lengths = chunk.has_unstretched_lengths;
+  layout_.attitude_as_quaternion = chunk.attitude_as_quaternion;
+  layout_.session_labels = chunk.session_labels;
+  for (std::string& why : p.unsolvable) layout_.skipped.push_back(std::move(why));
+  if (std::fflush(spill_) != 0) {
+    *error = "evaluation: cannot write the temporary file: " + std::string(std::strerror(errno));
+    return EvaluationStreamStatus::kInvalidInput;
+  }
+  for (size_t v = 0; v < p.stats.size(); ++v) {
+    VariantEvaluation e;
+    e.name = kVariantNames[p.stats.size() == 2 ? v : 1];
+    e.fit = p.stats[v].Finish();
+    variants_.push_back(std::move(e));
+  }
+  finite_ = p.finite;
+  if (samples_ == 0) return EvaluationStreamStatus::kOk;  // the caller says no sample is left
+  if (!Screen(options, error) || !Trajectory(error) || !GrossErrorRows(options, error)) {
+    return EvaluationStreamStatus::kInvalidInput;
+  }
+  return EvaluationStreamStatus::kOk;
+}
+
+bool StreamedEvaluation::Append(const Sample& s,
+                                const std::vector<std::array<double, kNumCables>>& predicted,
+                                Pass1* p, std::string* error) {
+  if (samples_ == 0) {
+    time_min_s_ = time_max_s_ = s.time_s;
+  }
+  time_min_s_ = std::min(time_min_s_, s.time_s);
+  time_max_s_ = std::max(time_max_s_, s.time_s);
+  position_sum_m_ += s.pose.position_m;
+  ++samples_;
+  std::vector<double>& r = p->record;
+  r.assign({static_cast<double>(s.line), s.time_s, static_cast<double>(s.session),
+            s.pose.position_m.x(), s.pose.position_m.y(), s.pose.position_m.z()});
+  r.insert(r.end(), s.tension_n.begin(), s.tension_n.end());
+  for (const auto& v : predicted) r.insert(r.end(), v.begin(), v.end());
+  EvaluatedSample e;
+  e.measured_n = s.tension_n;
+  e.predicted_n = predicted;
+  const std::array<double, kNumCables> w = Whitened(e);
+  for (int i = 0; i < kNumCables; ++i) p->finite[i] += std::isfinite(w[i]);
+  if (std::fwrite(r.data(), sizeof(double), r.size(), spill_) != r.size()) {
+    *error = "evaluation: cannot write the temporary file: " + std::string(std::strerror(errno));
+    return false;
+  }
+  return true;
+}
+
+// A pose the model cannot hold (without --skip-invalid-rows, or one a warm start fails):
+// the message and diagnosis the whole-file path gives, from a second reading of the file:
+// each variant predicted again (the same warm starts) to its first failure, the first
+// variant's failure named, and DiagnoseUnsolvableRows over every row.
+EvaluationStreamStatus StreamedEvaluation::Failure(const CableRobot& robot, const std::string& path,
+                                                   const EvaluationStreamOptions& options,
+                                                   std::string* error) {
+  diagnosis_ = UnsolvableRows();
+  DatasetChunkReader reader;
+  if (!reader.Open(path, options.read, error)) return EvaluationStreamStatus::kInvalidInput;
+  std::vector<TensionPredictor> predictors;
+  std::vector<std::string> failures;
+  Dataset chunk;
+  for (bool done = false; !done;) {
+    if (!reader.Next(options.chunk_samples, &chunk, &done, error)) {
+      return EvaluationStreamStatus::kInvalidInput;
+    }
+    if (chunk.samples.empty()) continue;
+    if (predictors.empty()) {
+      for (AttitudeSource a : Attitudes(chunk.has_planned_attitude)) {
+        predictors.emplace_back(robot, a, options.method);
+      }
+      failures.resize(predictors.size());
+    }
+    if (options.read.skip_invalid_rows) {
+      SkipUnsolvableSamples(robot, "the model",
+                            {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, {options.method},
+                            &chunk);
+    }
+    AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", chunk,
+                                        {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
+                                        {options.method}),
+                 &diagnosis_);
+    std::array<double, kNumCables> unused;
+    for (size_t v = 0; v < predictors.size(); ++v) {
+      for (const Sample& s : chunk.samples) {
+        if (!failures[v].empty()) break;
+        predictors[v].Predict(chunk, s, &unused, &failures[v]);
+      }
+    }
+  }
+  for (const std::string& f : failures) {
+    if (!f.empty()) {
+      *error = f;
+      break;
+    }
+  }
+  return EvaluationStreamStatus::kUnsolvable;
+}
+
+bool StreamedEvaluation::Screen(const EvaluationStreamOptions& options, std::string* error) {
+  screen_.variant = variants_.back().name;
+  // Centre: the median of each cable's finite whitened residuals.
+  ExactSelection centre(MedianRanks(finite_));
+  const auto feed_residuals = [this](const EvaluatedSample& s, ExactSelection* sel) {
+    const std::array<double, kNumCables> w = Whitened(s);
+    for (int i = 0; i < kNumCables; ++i) {
+      if (std::isfinite(w[i])) sel->Add(i, w[i]);
+    }
+  };
+  if (!Select(&centre, feed_residuals, error)) return false;
+  for (int i = 0; i < kNumCables; ++i) screen_.cables[i].centre = MedianOf(centre, i, finite_[i]);
+  // Scale: 1.4826 times the median absolute deviation from it, at least 1.
+  ExactSelection mad(MedianRanks(finite_));
+  const auto feed_deviations = [this](const EvaluatedSample& s, ExactSelection* sel) {
+    const std::array<double, kNumCables> w = Whitened(s);
+    for (int i = 0; i < kNumCables; ++i) {
+      if (std::isfinite(w[i])) sel->Add(i, std::abs(w[i] - screen_.cables[i].centre));
+    }
+  };
+  if (!Select(&mad, feed_deviations, error)) return false;
+  for (int i = 0; i < kNumCables; ++i) {
+    screen_.cables[i].scale = std::max(1.0, kMadToSigma * MedianOf(mad, i, finite_[i]));
+  }
+  screen_.threshold = ChooseGrossErrorThreshold(static_cast<long long>(kNumCables) * samples_,
+                                                options.spec.gross_error_threshold_sigmas);
+  return true;
+}
+
+bool StreamedEvaluation::Trajectory(std::string* error) {
+  if (samples_ < 3) return true;
+  const Eigen::Vector3d mean = position_sum_m_ / static_cast<double>(samples_);
+  double spread2 = 0.0;
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+  ExactSelection median({{0, (samples_ - 1) / 2}});
+  bool first_pass = true;
+  if (!Select(
+          &median,
+          [&](const EvaluatedSample& s, ExactSelection* sel) {
+            if (first_pass) spread2 += (s.position_m - mean).squaredNorm();
+            if (s.index > 0) sel->Add(0, (s.position_m - previous).norm());
+            previous = s.position_m;
+            if (s.index + 1 == samples_) first_pass = false;
+          },
+          error)) {
+    return false;
+  }
+  median_step_m_ = median.Result(0);
+  position_spread_m_ = std::sqrt(spread2 / samples_);
+  return true;
+}
+
+bool StreamedEvaluation::GrossErrorRows(const EvaluationStreamOptions& options,
+                                        std::string* error) {
+  std::vector<ErrorStatsAccumulator> without(predicted_variants_);
+  const bool ok = ForEach(
+      [&](const EvaluatedSample& s) {
+        for (int v = 0; v < predicted_variants_; ++v)
+          without[v].Add(s.predicted_n[v], s.measured_n, &s.gross);
+        const std::array<double, kNumCables> w = Whitened(s);
+        for (int i = 0; i < kNumCables; ++i) {
+          if (!s.gross[i]) continue;
+          ++screen_.count;
+          ++screen_.count_per_cable[i];
+          if (screen_.gross_errors.size() >= options.max_named_gross_errors) continue;
+          ReadingResidual g;
+          g.sample = static_cast<int>(s.index);
+          g.line = s.line;
+          g.cable = i + 1;
+          g.measured_n = s.measured_n[i];
+          g.predicted_n = s.predicted_n.back()[i];
+          g.residual_sigma = w[i];
+          screen_.gross_errors.push_back(g);
+        }
+      },
+      error);
+  if (!ok) return false;
+  if (screen_.count == 0) return true;
+  for (int v = 0; v < predicted_variants_; ++v) {
+    VariantEvaluation w;
+    w.name = variants_[v].name + " - gross errors";
+    w.fit = without[v].Finish();
+    variants_.push_back(std::move(w));
+  }
+  return true;
+}
+
+}  // namespace fastcal
