@@ -20,6 +20,7 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/model_plausibility.h"
+#include "fastcal/report.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
 
@@ -168,7 +169,7 @@ WholeFile EvaluateWhole(const std::string& path, bool skip) {
 // (31 chunks, warm starts carried across them) give the whole-file path's RMS table,
 // screen and gross errors bit for bit, and the same predictions sample by sample; with
 // --skip-invalid-rows, the same rows skipped (malformed, and a pose the model cannot
-// hold) in the same order.
+// hold) in the same order; and the same report.
 TEST_F(EvaluationStreamTest, ChunksGiveTheWholeFilesNumbers) {
   for (bool skip : {false, true}) {
     SCOPED_TRACE(skip ? "skip invalid rows" : "all rows valid");
@@ -223,6 +224,25 @@ TEST_F(EvaluationStreamTest, ChunksGiveTheWholeFilesNumbers) {
         &error))
         << error;
     EXPECT_EQ(n, streamed.samples());
+
+    // The report from the replayed samples is the whole dataset's, plots (thinned: 3000
+    // samples is more than a series draws) and histogram included.
+    ReportInputs in_memory;
+    in_memory.data = &whole.data;
+    in_memory.variants = whole.variants;
+    in_memory.evaluation_screen = &whole.screen;
+    in_memory.evaluation_method = "exact";
+    ReportInputs replayed = in_memory;
+    replayed.data = &streamed.layout();
+    replayed.variants = streamed.variants();
+    replayed.evaluation_screen = &streamed.screen();
+    const ReportSampleStream samples = ReportSamplesOf(streamed);
+    replayed.sample_stream = &samples;
+    const std::string html = ReportHtml(in_memory);
+    EXPECT_NE(html.find("Thinned for drawing"), std::string::npos);
+    EXPECT_EQ(ReportHtml(replayed), html);
+    EXPECT_EQ(ReportMarkdown(replayed), ReportMarkdown(in_memory));
+    EXPECT_EQ(SummaryJson(replayed), SummaryJson(in_memory));
   }
 }
 
