@@ -313,20 +313,27 @@ std::vector<std::string> DataPaths() {
   }
 }
 
-bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
+// --model's model and --data's files (checked: given, no empty name).
+bool LoadModelAndDataPaths(CableRobot* robot, std::vector<std::string>* paths, std::string* error) {
   if (!LoadModelFlag("model", FLAGS_model, robot, error)) return false;
   if (FLAGS_data.empty()) {
     *error = "--data=FILE.csv is required";
     return false;
   }
-  DatasetReadOptions read;
-  read.skip_invalid_rows = FLAGS_skip_invalid_rows;
-  const std::vector<std::string> paths = DataPaths();
-  if (std::find(paths.begin(), paths.end(), "") != paths.end()) {
+  *paths = DataPaths();
+  if (std::find(paths->begin(), paths->end(), "") != paths->end()) {
     *error = "--data=" + internal::Quote(FLAGS_data) +
              " has an empty file name (a stray comma?); several files are FILE.csv,FILE.csv";
     return false;
   }
+  return true;
+}
+
+bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
+  std::vector<std::string> paths;
+  if (!LoadModelAndDataPaths(robot, &paths, error)) return false;
+  DatasetReadOptions read;
+  read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   return ReadSessionDatasets(paths, read, data, error);
 }
 
@@ -1041,16 +1048,17 @@ bool WriteStreamedResiduals(const std::string& dir, const StreamedEvaluation& ev
   return true;
 }
 
-// evaluate on one file: read, predicted and screened a chunk at a time
-// (evaluation_stream.h), so that memory does not grow with the number of samples.
-int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model, StaticsMethod method) {
+// evaluate: the data read, predicted and screened a chunk at a time (evaluation_stream.h),
+// so that memory does not grow with the number of samples.
+int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
+                        const std::vector<std::string>& paths, StaticsMethod method) {
   const char* command = "evaluate";
   std::string error;
   EvaluationStreamOptions options;
   options.method = method;
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   StreamedEvaluation evaluation;
-  const EvaluationStreamStatus status = evaluation.Run(model, FLAGS_data, options, &error);
+  const EvaluationStreamStatus status = evaluation.Run(model, paths, options, &error);
   if (status == EvaluationStreamStatus::kInvalidInput) {
     PrintError(command, error);
     return kExitUsage;
@@ -1104,74 +1112,14 @@ int RunEvaluate(int argc, char** argv) {
     return kExitUsage;
   }
   CableRobot model;
-  Dataset data;
+  std::vector<std::string> paths;
   if (!CheckResidualsEvery(&error) ||
-      (!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error))) {
+      (!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error)) ||
+      !LoadModelAndDataPaths(&model, &paths, &error)) {
     PrintError(command, error);
     return kExitUsage;
   }
-  // One file streams; several (sessions) are read whole and merged.
-  if (!FLAGS_data.empty() && DataPaths().size() == 1) {
-    if (!LoadModelFlag("model", FLAGS_model, &model, &error)) {
-      PrintError(command, error);
-      return kExitUsage;
-    }
-    return RunEvaluateStreamed(argc, argv, model, method);
-  }
-  if (!LoadInputs(&model, &data, &error)) {
-    PrintError(command, error);
-    return kExitUsage;
-  }
-  if (const std::string blame =
-          FLAGS_skip_invalid_rows ? BlameTheModel(model, "the model", data, {method}) : "";
-      !blame.empty()) {
-    PrintError(command, blame);
-    return kExitFailure;
-  }
-  if (FLAGS_skip_invalid_rows) {
-    SkipUnsolvableSamples(model, "the model", {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
-                          {method}, &data);
-  }
-  if (!ReportSkipped(command, data, &error)) {
-    PrintError(command, error);
-    return kExitFailure;
-  }
-  std::vector<VariantEvaluation> variants;
-  if (!EvaluateModel(model, data, method, &variants, &error)) {
-    if (const std::string blame = BlameTheModel(model, "the model", data, {method});
-        !blame.empty()) {
-      PrintError(command, blame);
-      return kExitFailure;
-    }
-    PrintError(command, error + SkipHint());
-    return kExitFailure;
-  }
-  // The screen calibrate applies, against the last variant (the measured attitude, which
-  // every dataset has); the RMS table gains each row again without what it names.
-  const EvaluationScreen screen = ScreenEvaluation(data, variants.back());
-  if (!screen.gross_errors.empty()) {
-    for (VariantEvaluation& v : WithoutGrossErrors(data, variants, screen.excluded)) {
-      variants.push_back(std::move(v));
-    }
-  }
-  if (!FLAGS_out.empty()) {
-    ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/false);
-    report.initial_model = &model;
-    report.data = &data;
-    report.variants = variants;
-    report.evaluation_method = StaticsMethodName(method);
-    report.evaluation_screen = &screen;
-    std::vector<std::pair<std::string, std::string>> files;
-    if (FLAGS_residuals_every > 0) {
-      files.emplace_back("residuals.csv", ResidualsCsv(data, variants, {}, screen.excluded));
-    }
-    if (!WriteOutDirectory(command, files, report, kEvaluateOutputs)) {
-      return kExitUsage;
-    }
-  }
-  std::cout << EvaluationConsole(data, static_cast<long long>(data.samples.size()), method,
-                                 variants, screen);
-  return 0;
+  return RunEvaluateStreamed(argc, argv, model, paths, method);
 }
 
 }  // namespace fastcal::cli

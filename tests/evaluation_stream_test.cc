@@ -21,6 +21,7 @@
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
+#include "fastcal/sessions.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
 
@@ -184,12 +185,14 @@ TEST_F(EvaluationStreamTest, ChunksGiveTheWholeFilesNumbers) {
     options.read.skip_invalid_rows = skip;
     StreamedEvaluation streamed;
     std::string error;
-    ASSERT_EQ(streamed.Run(CableRobot::NominalFast(), path, options, &error),
+    ASSERT_EQ(streamed.Run(CableRobot::NominalFast(), {path}, options, &error),
               EvaluationStreamStatus::kOk)
         << error;
     ASSERT_EQ(streamed.samples(), static_cast<long long>(whole.data.samples.size()));
     EXPECT_EQ(streamed.layout().skipped, whole.data.skipped);
-    if (skip) EXPECT_EQ(whole.data.skipped.size(), 2u);
+    if (skip) {
+      EXPECT_EQ(whole.data.skipped.size(), 2u);
+    }
     ASSERT_EQ(streamed.variants().size(), whole.variants.size());
     for (size_t v = 0; v < whole.variants.size(); ++v) {
       EXPECT_EQ(streamed.variants()[v].name, whole.variants[v].name);
@@ -246,6 +249,47 @@ TEST_F(EvaluationStreamTest, ChunksGiveTheWholeFilesNumbers) {
   }
 }
 
+// Several files are one session each, merged as ReadSessionDatasets merges them: the same
+// labels, paths, sessions and statistics, streamed file after file.
+TEST_F(EvaluationStreamTest, SeveralFilesAreMergedAsSessions) {
+  const std::string first = Survey(700, [](std::vector<std::string>*) {});
+  const std::string second = (dir_ / "day-2.csv").string();
+  fs::copy_file(first, second);
+  const std::string third = Survey(500, [](std::vector<std::string>*) {});  // survey.csv again
+  fs::rename(third, dir_ / "day-3.csv");
+  const std::vector<std::string> paths = {second, (dir_ / "day-3.csv").string()};
+  Dataset whole;
+  std::string error;
+  ASSERT_TRUE(ReadSessionDatasets(paths, DatasetReadOptions(), &whole, &error)) << error;
+  std::vector<VariantEvaluation> variants;
+  ASSERT_TRUE(
+      EvaluateModel(CableRobot::NominalFast(), whole, StaticsMethod::kExact, &variants, &error));
+  EvaluationStreamOptions options;
+  options.chunk_samples = 64;
+  StreamedEvaluation streamed;
+  ASSERT_EQ(streamed.Run(CableRobot::NominalFast(), paths, options, &error),
+            EvaluationStreamStatus::kOk)
+      << error;
+  EXPECT_EQ(streamed.layout().path, whole.path);
+  EXPECT_EQ(streamed.layout().session_labels, whole.session_labels);
+  EXPECT_EQ(streamed.layout().session_paths, whole.session_paths);
+  ASSERT_EQ(streamed.samples(), static_cast<long long>(whole.samples.size()));
+  for (size_t v = 0; v < variants.size(); ++v) {
+    ExpectStatsEqual(streamed.variants()[v].fit, variants[v].fit);
+  }
+  std::vector<int> sessions;
+  ASSERT_TRUE(
+      streamed.ForEach([&](const EvaluatedSample& e) { sessions.push_back(e.session); }, &error));
+  for (size_t t = 0; t < sessions.size(); ++t) EXPECT_EQ(sessions[t], whole.samples[t].session);
+  // A label in two files: MergeSessionFiles' message.
+  std::string expected;
+  ASSERT_FALSE(ReadSessionDatasets({second, second}, DatasetReadOptions(), &whole, &expected));
+  StreamedEvaluation twice;
+  EXPECT_EQ(twice.Run(CableRobot::NominalFast(), {second, second}, options, &error),
+            EvaluationStreamStatus::kInvalidInput);
+  EXPECT_EQ(error, expected);
+}
+
 // Bad input met in a late chunk fails with ReadDataset's message; a pose the model cannot
 // hold (without --skip-invalid-rows) with EvaluateModel's.
 TEST_F(EvaluationStreamTest, LateBadRowsGiveTheWholeFilesMessages) {
@@ -258,7 +302,7 @@ TEST_F(EvaluationStreamTest, LateBadRowsGiveTheWholeFilesMessages) {
   EvaluationStreamOptions options;
   options.chunk_samples = 50;
   StreamedEvaluation bad_row;
-  EXPECT_EQ(bad_row.Run(CableRobot::NominalFast(), path, options, &error),
+  EXPECT_EQ(bad_row.Run(CableRobot::NominalFast(), {path}, options, &error),
             EvaluationStreamStatus::kInvalidInput);
   EXPECT_EQ(error, expected);
 
@@ -270,7 +314,7 @@ TEST_F(EvaluationStreamTest, LateBadRowsGiveTheWholeFilesMessages) {
   ASSERT_FALSE(
       EvaluateModel(CableRobot::NominalFast(), data, StaticsMethod::kExact, &variants, &expected));
   StreamedEvaluation pose;
-  EXPECT_EQ(pose.Run(CableRobot::NominalFast(), unsolvable, options, &error),
+  EXPECT_EQ(pose.Run(CableRobot::NominalFast(), {unsolvable}, options, &error),
             EvaluationStreamStatus::kUnsolvable);
   EXPECT_EQ(error, expected);
   const UnsolvableRows d = DiagnoseUnsolvableRows(

@@ -9,6 +9,7 @@
 
 #include "fastcal/gross_errors.h"
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/sessions.h"
 
 namespace fastcal {
 namespace {
@@ -232,13 +233,81 @@ bool StreamedEvaluation::Select(
   return true;
 }
 
-EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot, const std::string& path,
+bool StreamedEvaluation::Prepare(const std::vector<std::string>& paths,
+                                 const EvaluationStreamOptions& options, std::string* error) {
+  if (paths.size() < 2) return true;
+  // Several files: each read through once (its errors first, in file order, as
+  // ReadSessionDatasets reads them), then merged without samples for MergeSessionFiles'
+  // checks, messages and session labels.
+  std::vector<Dataset> files;
+  for (const std::string& path : paths) {
+    DatasetChunkReader reader;
+    if (!reader.Open(path, options.read, error)) return false;
+    Dataset chunk;
+    for (bool done = false; !done;) {
+      if (!reader.Next(options.chunk_samples, &chunk, &done, error)) return false;
+    }
+    chunk.samples.clear();
+    chunk.skipped.clear();
+    files.push_back(std::move(chunk));
+  }
+  if (!MergeSessionFiles(files, &merged_, error)) return false;
+  for (const Dataset& file : files) {
+    std::vector<std::string> labels = file.session_labels;
+    if (labels.empty()) labels.push_back(SessionLabelOfPath(file.path));
+    std::vector<int> map;
+    for (const std::string& label : labels) {
+      const auto at =
+          std::find(merged_.session_labels.begin(), merged_.session_labels.end(), label);
+      map.push_back(static_cast<int>(at - merged_.session_labels.begin()));
+    }
+    session_maps_.push_back(std::move(map));
+  }
+  return true;
+}
+
+bool StreamedEvaluation::Chunks(const std::vector<std::string>& paths,
+                                const EvaluationStreamOptions& options,
+                                const std::function<bool(Dataset*)>& visit, bool* stopped,
+                                std::string* error) {
+  *stopped = false;
+  Dataset chunk;
+  for (size_t f = 0; f < paths.size(); ++f) {
+    DatasetChunkReader reader;
+    if (!reader.Open(paths[f], options.read, error)) return false;
+    for (bool done = false; !done;) {
+      if (!reader.Next(options.chunk_samples, &chunk, &done, error)) return false;
+      if (f < session_maps_.size()) {
+        // The merged dataset's sessions and column groups (its planned attitude only
+        // when every file has one).
+        for (Sample& s : chunk.samples) {
+          s.session = session_maps_[f][chunk.session_labels.empty() ? 0 : s.session];
+        }
+        chunk.has_planned_attitude = merged_.has_planned_attitude;
+      }
+      if (!visit(&chunk)) {
+        *stopped = true;
+        return true;
+      }
+    }
+  }
+  if (session_maps_.empty()) {
+    merged_.path = chunk.path;
+    merged_.has_planned_attitude = chunk.has_planned_attitude;
+    merged_.has_unstretched_lengths = chunk.has_unstretched_lengths;
+    merged_.attitude_as_quaternion = chunk.attitude_as_quaternion;
+    merged_.session_labels = chunk.session_labels;
+  }
+  return true;
+}
+
+EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
+                                               const std::vector<std::string>& paths,
                                                const EvaluationStreamOptions& options,
                                                std::string* error) {
   sigma_abs_n_ = options.spec.tension_sigma_n;
   sigma_percent_ = options.spec.tension_sigma_percent;
-  DatasetChunkReader reader;
-  if (!reader.Open(path, options.read, error)) return EvaluationStreamStatus::kInvalidInput;
+  if (!Prepare(paths, options, error)) return EvaluationStreamStatus::kInvalidInput;
   spill_ = std::tmpfile();
   if (spill_ == nullptr) {
     *error = "evaluation: cannot create a temporary file: " + std::string(std::strerror(errno));
@@ -246,51 +315,53 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot, const st
   }
   const bool skip = options.read.skip_invalid_rows;
   Pass1 p;
-  Dataset chunk;
-  for (bool done = false; !done;) {
-    if (!reader.Next(options.chunk_samples, &chunk, &done, error)) {
-      return EvaluationStreamStatus::kInvalidInput;
-    }
-    for (std::string& why : chunk.skipped) layout_.skipped.push_back(std::move(why));
-    chunk.skipped.clear();
-    if (chunk.samples.empty()) continue;
-    const std::vector<AttitudeSource> attitudes = Attitudes(chunk.has_planned_attitude);
+  bool failed = false, write_failed = false;
+  std::vector<std::array<double, kNumCables>> predicted;
+  const auto pass1 = [&](Dataset* chunk) {
+    for (std::string& why : chunk->skipped) layout_.skipped.push_back(std::move(why));
+    chunk->skipped.clear();
+    if (chunk->samples.empty()) return true;
     if (p.predictors.empty()) {
-      for (AttitudeSource a : attitudes) {
+      for (AttitudeSource a : Attitudes(chunk->has_planned_attitude)) {
         p.predictors.emplace_back(robot, a, options.method);
         p.stats.emplace_back();
       }
-      predicted_variants_ = static_cast<int>(attitudes.size());
+      predicted_variants_ = static_cast<int>(p.predictors.size());
+      predicted.resize(p.predictors.size());
     }
     if (skip) {
       // As fastcal evaluate --skip-invalid-rows: the diagnosis over every valid row, then
       // the rows the model cannot solve removed (listed after the reader's).
-      AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", chunk,
+      AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", *chunk,
                                           {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
                                           {options.method}),
                    &diagnosis_);
       SkipUnsolvableSamples(robot, "the model",
                             {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, {options.method},
-                            &chunk);
-      for (std::string& why : chunk.skipped) p.unsolvable.push_back(std::move(why));
-      chunk.skipped.clear();
+                            chunk);
+      for (std::string& why : chunk->skipped) p.unsolvable.push_back(std::move(why));
+      chunk->skipped.clear();
     }
-    std::vector<std::array<double, kNumCables>> predicted(p.predictors.size());
-    for (const Sample& s : chunk.samples) {
+    for (const Sample& s : chunk->samples) {
       for (size_t v = 0; v < p.predictors.size(); ++v) {
-        if (!p.predictors[v].Predict(chunk, s, &predicted[v], error)) {
-          return Failure(robot, path, options, error);
-        }
+        if (!p.predictors[v].Predict(*chunk, s, &predicted[v], error)) return !(failed = true);
         p.stats[v].Add(predicted[v], s.tension_n);
       }
-      if (!Append(s, predicted, &p, error)) return EvaluationStreamStatus::kInvalidInput;
+      if (!Append(s, predicted, &p, error)) return !(write_failed = true);
     }
+    return true;
+  };
+  bool stopped = false;
+  if (!Chunks(paths, options, pass1, &stopped, error) || write_failed) {
+    return EvaluationStreamStatus::kInvalidInput;
   }
-  layout_.path = chunk.path;
-  layout_.has_planned_attitude = chunk.has_planned_attitude;
-  layout_.has_unstretched_lengths = chunk.has_unstretched_lengths;
-  layout_.attitude_as_quaternion = chunk.attitude_as_quaternion;
-  layout_.session_labels = chunk.session_labels;
+  if (failed) return Failure(robot, paths, options, error);
+  layout_.path = merged_.path;
+  layout_.has_planned_attitude = merged_.has_planned_attitude;
+  layout_.has_unstretched_lengths = merged_.has_unstretched_lengths;
+  layout_.attitude_as_quaternion = merged_.attitude_as_quaternion;
+  layout_.session_labels = merged_.session_labels;
+  layout_.session_paths = merged_.session_paths;
   for (std::string& why : p.unsolvable) layout_.skipped.push_back(std::move(why));
   if (std::fflush(spill_) != 0) {
     *error = "evaluation: cannot write the temporary file: " + std::string(std::strerror(errno));
@@ -341,22 +412,17 @@ bool StreamedEvaluation::Append(const Sample& s,
 // the message and diagnosis the whole-file path gives, from a second reading of the file:
 // each variant predicted again (the same warm starts) to its first failure, the first
 // variant's failure named, and DiagnoseUnsolvableRows over every row.
-EvaluationStreamStatus StreamedEvaluation::Failure(const CableRobot& robot, const std::string& path,
+EvaluationStreamStatus StreamedEvaluation::Failure(const CableRobot& robot,
+                                                   const std::vector<std::string>& paths,
                                                    const EvaluationStreamOptions& options,
                                                    std::string* error) {
   diagnosis_ = UnsolvableRows();
-  DatasetChunkReader reader;
-  if (!reader.Open(path, options.read, error)) return EvaluationStreamStatus::kInvalidInput;
   std::vector<TensionPredictor> predictors;
   std::vector<std::string> failures;
-  Dataset chunk;
-  for (bool done = false; !done;) {
-    if (!reader.Next(options.chunk_samples, &chunk, &done, error)) {
-      return EvaluationStreamStatus::kInvalidInput;
-    }
-    if (chunk.samples.empty()) continue;
+  const auto again = [&](Dataset* chunk) {
+    if (chunk->samples.empty()) return true;
     if (predictors.empty()) {
-      for (AttitudeSource a : Attitudes(chunk.has_planned_attitude)) {
+      for (AttitudeSource a : Attitudes(chunk->has_planned_attitude)) {
         predictors.emplace_back(robot, a, options.method);
       }
       failures.resize(predictors.size());
@@ -364,19 +430,24 @@ EvaluationStreamStatus StreamedEvaluation::Failure(const CableRobot& robot, cons
     if (options.read.skip_invalid_rows) {
       SkipUnsolvableSamples(robot, "the model",
                             {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, {options.method},
-                            &chunk);
+                            chunk);
     }
-    AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", chunk,
+    AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", *chunk,
                                         {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
                                         {options.method}),
                  &diagnosis_);
     std::array<double, kNumCables> unused;
     for (size_t v = 0; v < predictors.size(); ++v) {
-      for (const Sample& s : chunk.samples) {
+      for (const Sample& s : chunk->samples) {
         if (!failures[v].empty()) break;
-        predictors[v].Predict(chunk, s, &unused, &failures[v]);
+        predictors[v].Predict(*chunk, s, &unused, &failures[v]);
       }
     }
+    return true;
+  };
+  bool stopped = false;
+  if (!Chunks(paths, options, again, &stopped, error)) {
+    return EvaluationStreamStatus::kInvalidInput;
   }
   for (const std::string& f : failures) {
     if (!f.empty()) {

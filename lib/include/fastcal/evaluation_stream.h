@@ -119,10 +119,12 @@ class StreamedEvaluation {
   StreamedEvaluation& operator=(const StreamedEvaluation&) = delete;
   ~StreamedEvaluation();
 
-  // Evaluates `robot` on the file at `path`: the variants of EvaluateModel ("model, planned
-  // attitude" when the file has it, then "model, measured attitude"), the screen against
-  // the last, and the rows "... - gross errors" (when the screen names any).
-  EvaluationStreamStatus Run(const CableRobot& robot, const std::string& path,
+  // Evaluates `robot` on the file at `paths` (several: one session each, merged as
+  // ReadSessionDatasets merges them, with its messages; each file is then read twice,
+  // once to check it and learn its sessions): the variants of EvaluateModel ("model,
+  // planned attitude" when the data has it, then "model, measured attitude"), the screen
+  // against the last, and the rows "... - gross errors" (when the screen names any).
+  EvaluationStreamStatus Run(const CableRobot& robot, const std::vector<std::string>& paths,
                              const EvaluationStreamOptions& options, std::string* error);
 
   // Calls `visit` with every kept sample, in file order (reading the temporary file).
@@ -158,8 +160,16 @@ class StreamedEvaluation {
   bool Select(ExactSelection* selection,
               const std::function<void(const EvaluatedSample&, ExactSelection*)>& feed,
               std::string* error) const;
-  EvaluationStreamStatus Failure(const CableRobot& robot, const std::string& path,
+  EvaluationStreamStatus Failure(const CableRobot& robot, const std::vector<std::string>& paths,
                                  const EvaluationStreamOptions& options, std::string* error);
+  // Several files: checks them and merges their sessions (merged_, session_maps_).
+  bool Prepare(const std::vector<std::string>& paths, const EvaluationStreamOptions& options,
+               std::string* error);
+  // The files' chunks in order, as one dataset's (merged sessions and planned flag);
+  // `visit` returning false stops (*stopped). False, with ReadDataset's message, on a
+  // read error.
+  bool Chunks(const std::vector<std::string>& paths, const EvaluationStreamOptions& options,
+              const std::function<bool(Dataset*)>& visit, bool* stopped, std::string* error);
   bool Append(const Sample& s, const std::vector<std::array<double, kNumCables>>& predicted,
               Pass1* p, std::string* error);
   bool Screen(const EvaluationStreamOptions& options, std::string* error);
@@ -167,6 +177,8 @@ class StreamedEvaluation {
   bool GrossErrorRows(const EvaluationStreamOptions& options, std::string* error);
 
   Dataset layout_;
+  Dataset merged_;  // path, column groups and sessions of the data (no samples)
+  std::vector<std::vector<int>> session_maps_;  // several files: file's session -> merged
   long long samples_ = 0;
   double time_min_s_ = 0.0, time_max_s_ = 0.0;
   Eigen::Vector3d position_sum_m_ = Eigen::Vector3d::Zero();
