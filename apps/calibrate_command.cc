@@ -166,6 +166,9 @@ screens them (against the measured attitude's predictions, with the default nois
 of 3 % of the reading and a threshold that grows with the number of readings), named by
 line and cable, and each row of the RMS table is repeated without them. The model's sensor gain and
 bias (if any) are applied: predicted reading = gain * tension + bias.
+
+The data is read in chunks, so memory does not grow with it (about 20 MB at 10^6 samples);
+each sample is kept meanwhile in a temporary file in /tmp (about 200 bytes a sample).
 )";
 
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
