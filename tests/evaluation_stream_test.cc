@@ -19,6 +19,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
+#include "fastcal/internal/exact_selection.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/sessions.h"
@@ -29,6 +30,7 @@ namespace fastcal {
 namespace {
 
 namespace fs = std::filesystem;
+using internal::ExactSelection;
 
 // Runs `selection` to the end over `streams` (value v of stream s fed in each pass).
 void RunSelection(const std::vector<std::vector<double>>& streams, ExactSelection* selection) {

@@ -158,15 +158,22 @@ bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dat
   return true;
 }
 
+std::string EvaluationVariantName(AttitudeSource attitude) {
+  return attitude == AttitudeSource::kPlanned ? "model, planned attitude"
+                                              : "model, measured attitude";
+}
+
 bool EvaluateModel(const CableRobot& robot, const Dataset& data, StaticsMethod method,
                    std::vector<VariantEvaluation>* variants, std::string* error) {
-  std::vector<std::pair<std::string, AttitudeSource>> list;
-  if (data.has_planned_attitude)
-    list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
-  list.emplace_back("model, measured attitude", AttitudeSource::kMeasured);
-  for (const auto& [name, attitude] : list) {
+  std::vector<AttitudeSource> list;
+  if (data.has_planned_attitude) list.push_back(AttitudeSource::kPlanned);
+  list.push_back(AttitudeSource::kMeasured);
+  for (AttitudeSource attitude : list) {
     VariantEvaluation e;
-    if (!EvaluateVariant(name, robot, data, attitude, method, {}, &e, error)) return false;
+    if (!EvaluateVariant(EvaluationVariantName(attitude), robot, data, attitude, method, {}, &e,
+                         error)) {
+      return false;
+    }
     variants->push_back(std::move(e));
   }
   return true;

@@ -14,9 +14,10 @@
 namespace fastcal {
 namespace {
 
+using internal::ExactSelection;
+
 // As RobustScaleOf (uncertainty.h): the standard deviation of a normal sample per MAD.
 constexpr double kMadToSigma = 1.4826;
-const char* const kVariantNames[] = {"model, planned attitude", "model, measured attitude"};
 
 std::vector<AttitudeSource> Attitudes(bool planned) {
   if (planned) return {AttitudeSource::kPlanned, AttitudeSource::kMeasured};
@@ -58,101 +59,6 @@ double MedianOf(const ExactSelection& s, int cable, long long n) {
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
-// ExactSelection
-
-ExactSelection::ExactSelection(std::vector<std::pair<int, long long>> targets) {
-  for (const auto& [stream, rank] : targets) {
-    Target t;
-    t.stream = stream;
-    t.rank = rank;
-    if (by_stream_.size() <= static_cast<size_t>(stream)) by_stream_.resize(stream + 1);
-    by_stream_[stream].push_back(targets_.size());
-    targets_.push_back(std::move(t));
-  }
-}
-
-bool ExactSelection::done() const {
-  return std::all_of(targets_.begin(), targets_.end(), [](const Target& t) { return t.done; });
-}
-
-int ExactSelection::BinOf(const Level& level, double value) {
-  const double b = std::floor((value - level.min) / level.width);
-  return static_cast<int>(std::clamp(b, 0.0, static_cast<double>(kBins - 1)));
-}
-
-bool ExactSelection::InRange(const Target& t, double value) {
-  // While binning, the last level is the one being binned: its bin is not chosen yet.
-  const size_t levels = t.levels.size() - (t.binning ? 1 : 0);
-  for (size_t l = 0; l < levels; ++l) {
-    const Level& level = t.levels[l];
-    if (value < level.min || BinOf(level, value) != level.bin) return false;
-  }
-  return true;
-}
-
-void ExactSelection::Begin() {
-  for (Target& t : targets_) {
-    t.count = 0;
-    t.min = std::numeric_limits<double>::infinity();
-    t.max = -t.min;
-    t.kept.clear();
-    if (t.binning) t.bins.assign(kBins, 0);
-  }
-}
-
-void ExactSelection::Add(int stream, double value) {
-  if (stream < 0 || static_cast<size_t>(stream) >= by_stream_.size()) return;
-  for (size_t k : by_stream_[stream]) {
-    Target& t = targets_[k];
-    if (t.done || !InRange(t, value)) continue;
-    if (t.binning) {
-      ++t.bins[BinOf(t.levels.back(), value)];
-      continue;
-    }
-    ++t.count;
-    t.min = std::min(t.min, value);
-    t.max = std::max(t.max, value);
-    if (t.kept.size() < kMaxKept) t.kept.push_back(value);
-  }
-}
-
-void ExactSelection::End() {
-  for (Target& t : targets_) {
-    if (t.done) continue;
-    const long long rank = t.rank - t.below;
-    if (t.binning) {
-      // Narrow the range to the bin that holds the rank.
-      long long before = 0;
-      int b = 0;
-      while (b < kBins - 1 && before + t.bins[b] <= rank) before += t.bins[b++];
-      t.below += before;
-      t.levels.back().bin = b;
-      t.binning = false;
-      t.bins.clear();
-      continue;
-    }
-    if (rank < 0 || rank >= t.count) {  // no such rank (or an empty stream)
-      t.result = std::numeric_limits<double>::quiet_NaN();
-      t.done = true;
-    } else if (t.count <= static_cast<long long>(kMaxKept)) {
-      std::nth_element(t.kept.begin(), t.kept.begin() + rank, t.kept.end());
-      t.result = t.kept[rank];
-      t.done = true;
-    } else if (t.min == t.max) {
-      t.result = t.min;
-      t.done = true;
-    } else {
-      // (max - min) / kBins underflows only for a subnormal range: then two bins.
-      const double width = (t.max - t.min) / kBins;
-      t.levels.push_back({t.min, width > 0.0 ? width : t.max - t.min, 0});
-      t.binning = true;
-    }
-    t.kept.clear();
-    t.kept.shrink_to_fit();
-  }
-}
-
-// ---------------------------------------------------------------------------------------
 // StreamedEvaluation
 
 StreamedEvaluation::~StreamedEvaluation() {
@@ -164,8 +70,9 @@ StreamedEvaluation::~StreamedEvaluation() {
 struct StreamedEvaluation::Pass1 {
   std::vector<TensionPredictor> predictors;
   std::vector<ErrorStatsAccumulator> stats;
-  std::array<long long, kNumCables> finite{};  // finite whitened residuals per cable
-  std::vector<std::string> unsolvable;         // messages, listed after the reader's
+  std::array<long long, kNumCables> finite{};             // finite whitened residuals per cable
+  std::vector<std::string> unsolvable;                    // messages, listed after the reader's
+  std::vector<std::array<double, kNumCables>> predicted;  // the sample's, per variant
   std::vector<double> record;
 };
 
@@ -200,7 +107,7 @@ bool StreamedEvaluation::ForEach(const std::function<void(const EvaluatedSample&
     s.index = t;
     s.gross.fill(false);
     if (screened) {
-      const std::array<double, kNumCables> w = Whitened(s);
+      const std::array<double, kNumCables> w = Whitened(s.predicted_n.back(), s.measured_n);
       for (int i = 0; i < kNumCables; ++i) {
         const double d = std::abs(w[i] - screen_.cables[i].centre);
         // A non-finite residual (a reading the model cannot predict) is a gross error too.
@@ -212,12 +119,13 @@ bool StreamedEvaluation::ForEach(const std::function<void(const EvaluatedSample&
   return true;
 }
 
-std::array<double, kNumCables> StreamedEvaluation::Whitened(const EvaluatedSample& s) const {
-  const std::array<double, kNumCables>& p = s.predicted_n.back();
+std::array<double, kNumCables> StreamedEvaluation::Whitened(
+    const std::array<double, kNumCables>& predicted_n,
+    const std::array<double, kNumCables>& measured_n) const {
   const std::array<double, kNumCables> sigma_n =
-      internal::TensionSigmas(p, sigma_abs_n_, sigma_percent_);
+      internal::TensionSigmas(predicted_n, sigma_abs_n_, sigma_percent_);
   std::array<double, kNumCables> w;
-  for (int i = 0; i < kNumCables; ++i) w[i] = (p[i] - s.measured_n[i]) / sigma_n[i];
+  for (int i = 0; i < kNumCables; ++i) w[i] = (predicted_n[i] - measured_n[i]) / sigma_n[i];
   return w;
 }
 
@@ -268,9 +176,7 @@ bool StreamedEvaluation::Prepare(const std::vector<std::string>& paths,
 
 bool StreamedEvaluation::Chunks(const std::vector<std::string>& paths,
                                 const EvaluationStreamOptions& options,
-                                const std::function<bool(Dataset*)>& visit, bool* stopped,
-                                std::string* error) {
-  *stopped = false;
+                                const std::function<bool(Dataset*)>& visit, std::string* error) {
   Dataset chunk;
   for (size_t f = 0; f < paths.size(); ++f) {
     DatasetChunkReader reader;
@@ -285,10 +191,7 @@ bool StreamedEvaluation::Chunks(const std::vector<std::string>& paths,
         }
         chunk.has_planned_attitude = merged_.has_planned_attitude;
       }
-      if (!visit(&chunk)) {
-        *stopped = true;
-        return true;
-      }
+      if (!visit(&chunk)) return true;
     }
   }
   if (session_maps_.empty()) {
@@ -313,49 +216,17 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
     *error = "evaluation: cannot create a temporary file: " + std::string(std::strerror(errno));
     return EvaluationStreamStatus::kInvalidInput;
   }
-  const bool skip = options.read.skip_invalid_rows;
   Pass1 p;
-  bool failed = false, write_failed = false;
-  std::vector<std::array<double, kNumCables>> predicted;
+  bool unsolvable = false, write_failed = false;
   const auto pass1 = [&](Dataset* chunk) {
-    for (std::string& why : chunk->skipped) layout_.skipped.push_back(std::move(why));
-    chunk->skipped.clear();
-    if (chunk->samples.empty()) return true;
-    if (p.predictors.empty()) {
-      for (AttitudeSource a : Attitudes(chunk->has_planned_attitude)) {
-        p.predictors.emplace_back(robot, a, options.method);
-        p.stats.emplace_back();
-      }
-      predicted_variants_ = static_cast<int>(p.predictors.size());
-      predicted.resize(p.predictors.size());
-    }
-    if (skip) {
-      // As fastcal evaluate --skip-invalid-rows: the diagnosis over every valid row, then
-      // the rows the model cannot solve removed (listed after the reader's).
-      AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", *chunk,
-                                          {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
-                                          {options.method}),
-                   &diagnosis_);
-      SkipUnsolvableSamples(robot, "the model",
-                            {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, {options.method},
-                            chunk);
-      for (std::string& why : chunk->skipped) p.unsolvable.push_back(std::move(why));
-      chunk->skipped.clear();
-    }
-    for (const Sample& s : chunk->samples) {
-      for (size_t v = 0; v < p.predictors.size(); ++v) {
-        if (!p.predictors[v].Predict(*chunk, s, &predicted[v], error)) return !(failed = true);
-        p.stats[v].Add(predicted[v], s.tension_n);
-      }
-      if (!Append(s, predicted, &p, error)) return !(write_failed = true);
-    }
-    return true;
+    if (PassOneChunk(robot, options, chunk, &p, &unsolvable, error)) return true;
+    write_failed = !unsolvable;
+    return false;
   };
-  bool stopped = false;
-  if (!Chunks(paths, options, pass1, &stopped, error) || write_failed) {
+  if (!Chunks(paths, options, pass1, error) || write_failed) {
     return EvaluationStreamStatus::kInvalidInput;
   }
-  if (failed) return Failure(robot, paths, options, error);
+  if (unsolvable) return Failure(robot, paths, options, error);
   layout_.path = merged_.path;
   layout_.has_planned_attitude = merged_.has_planned_attitude;
   layout_.has_unstretched_lengths = merged_.has_unstretched_lengths;
@@ -369,7 +240,7 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
   }
   for (size_t v = 0; v < p.stats.size(); ++v) {
     VariantEvaluation e;
-    e.name = kVariantNames[p.stats.size() == 2 ? v : 1];
+    e.name = EvaluationVariantName(Attitudes(predicted_variants_ == 2)[v]);
     e.fit = p.stats[v].Finish();
     variants_.push_back(std::move(e));
   }
@@ -379,6 +250,45 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
     return EvaluationStreamStatus::kInvalidInput;
   }
   return EvaluationStreamStatus::kOk;
+}
+
+bool StreamedEvaluation::PassOneChunk(const CableRobot& robot,
+                                      const EvaluationStreamOptions& options, Dataset* chunk,
+                                      Pass1* p, bool* unsolvable, std::string* error) {
+  for (std::string& why : chunk->skipped) layout_.skipped.push_back(std::move(why));
+  chunk->skipped.clear();
+  if (chunk->samples.empty()) return true;
+  if (p->predictors.empty()) {
+    for (AttitudeSource a : Attitudes(chunk->has_planned_attitude)) {
+      p->predictors.emplace_back(robot, a, options.method);
+      p->stats.emplace_back();
+    }
+    predicted_variants_ = static_cast<int>(p->predictors.size());
+    p->predicted.resize(p->predictors.size());
+  }
+  if (options.read.skip_invalid_rows) {
+    // As fastcal evaluate --skip-invalid-rows: the diagnosis over every valid row, then
+    // the rows the model cannot solve removed (listed after the reader's).
+    AddDiagnosis(DiagnoseUnsolvableRows(robot, "the model", *chunk,
+                                        {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
+                                        {options.method}),
+                 &diagnosis_);
+    SkipUnsolvableSamples(robot, "the model", {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
+                          {options.method}, chunk);
+    for (std::string& why : chunk->skipped) p->unsolvable.push_back(std::move(why));
+    chunk->skipped.clear();
+  }
+  for (const Sample& s : chunk->samples) {
+    for (size_t v = 0; v < p->predictors.size(); ++v) {
+      if (!p->predictors[v].Predict(*chunk, s, &p->predicted[v], error)) {
+        *unsolvable = true;
+        return false;
+      }
+      p->stats[v].Add(p->predicted[v], s.tension_n);
+    }
+    if (!Append(s, p->predicted, p, error)) return false;
+  }
+  return true;
 }
 
 bool StreamedEvaluation::Append(const Sample& s,
@@ -396,10 +306,7 @@ bool StreamedEvaluation::Append(const Sample& s,
             s.pose.position_m.x(), s.pose.position_m.y(), s.pose.position_m.z()});
   r.insert(r.end(), s.tension_n.begin(), s.tension_n.end());
   for (const auto& v : predicted) r.insert(r.end(), v.begin(), v.end());
-  EvaluatedSample e;
-  e.measured_n = s.tension_n;
-  e.predicted_n = predicted;
-  const std::array<double, kNumCables> w = Whitened(e);
+  const std::array<double, kNumCables> w = Whitened(predicted.back(), s.tension_n);
   for (int i = 0; i < kNumCables; ++i) p->finite[i] += std::isfinite(w[i]);
   if (std::fwrite(r.data(), sizeof(double), r.size(), spill_) != r.size()) {
     *error = "evaluation: cannot write the temporary file: " + std::string(std::strerror(errno));
@@ -445,8 +352,7 @@ EvaluationStreamStatus StreamedEvaluation::Failure(const CableRobot& robot,
     }
     return true;
   };
-  bool stopped = false;
-  if (!Chunks(paths, options, again, &stopped, error)) {
+  if (!Chunks(paths, options, again, error)) {
     return EvaluationStreamStatus::kInvalidInput;
   }
   for (const std::string& f : failures) {
@@ -463,7 +369,7 @@ bool StreamedEvaluation::Screen(const EvaluationStreamOptions& options, std::str
   // Centre: the median of each cable's finite whitened residuals.
   ExactSelection centre(MedianRanks(finite_));
   const auto feed_residuals = [this](const EvaluatedSample& s, ExactSelection* sel) {
-    const std::array<double, kNumCables> w = Whitened(s);
+    const std::array<double, kNumCables> w = Whitened(s.predicted_n.back(), s.measured_n);
     for (int i = 0; i < kNumCables; ++i) {
       if (std::isfinite(w[i])) sel->Add(i, w[i]);
     }
@@ -473,7 +379,7 @@ bool StreamedEvaluation::Screen(const EvaluationStreamOptions& options, std::str
   // Scale: 1.4826 times the median absolute deviation from it, at least 1.
   ExactSelection mad(MedianRanks(finite_));
   const auto feed_deviations = [this](const EvaluatedSample& s, ExactSelection* sel) {
-    const std::array<double, kNumCables> w = Whitened(s);
+    const std::array<double, kNumCables> w = Whitened(s.predicted_n.back(), s.measured_n);
     for (int i = 0; i < kNumCables; ++i) {
       if (std::isfinite(w[i])) sel->Add(i, std::abs(w[i] - screen_.cables[i].centre));
     }
@@ -517,7 +423,7 @@ bool StreamedEvaluation::GrossErrorRows(const EvaluationStreamOptions& options,
       [&](const EvaluatedSample& s) {
         for (int v = 0; v < predicted_variants_; ++v)
           without[v].Add(s.predicted_n[v], s.measured_n, &s.gross);
-        const std::array<double, kNumCables> w = Whitened(s);
+        const std::array<double, kNumCables> w = Whitened(s.predicted_n.back(), s.measured_n);
         for (int i = 0; i < kNumCables; ++i) {
           if (!s.gross[i]) continue;
           ++screen_.count;

@@ -110,6 +110,10 @@ bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dat
                      const std::vector<bool>& held_out, VariantEvaluation* evaluation,
                      std::string* error, const ReadingMask& excluded = {});
 
+// The name of the row of `fastcal evaluate`'s table for an attitude source: "model,
+// planned attitude" or "model, measured attitude".
+std::string EvaluationVariantName(AttitudeSource attitude);
+
 // The table of `fastcal evaluate`: `robot` against every sample at each attitude the data
 // has, "model, planned attitude" (when it has one) then "model, measured attitude", with
 // `method`. False, naming the file and line of a pose the model cannot hold, otherwise.

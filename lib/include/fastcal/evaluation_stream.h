@@ -12,9 +12,9 @@
 //
 // The robust centre and scale of the screen (gross_errors.h: median and 1.4826 MAD of
 // each cable's whitened residuals) are exact: each median is found by selection passes
-// over the temporary file (ExactSelection below: a histogram of 4096 bins narrows the
-// rank to one bin until at most 65536 values remain, which are sorted), 4 to 6 passes.
-// The same for the report's trajectory test (the median step between samples).
+// over the temporary file (internal::ExactSelection, internal/exact_selection.h: a histogram of
+// 4096 bins narrows the rank to one bin until at most 65536 values remain, which are sorted), 4 to
+// 6 passes. The same for the report's trajectory test (the median step between samples).
 #ifndef FASTCAL_EVALUATION_STREAM_H_
 #define FASTCAL_EVALUATION_STREAM_H_
 
@@ -31,51 +31,11 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
+#include "fastcal/internal/exact_selection.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/statics.h"
 
 namespace fastcal {
-
-// The k-th smallest values (0-based rank) of several streams of values, exactly, in
-// memory independent of their length: the caller feeds every value of every stream in
-// each pass (Begin, Add..., End) until done(). A pass either counts and, when at most
-// kMaxKept values are left in the target's range, keeps them (then sorts: done), or
-// bins the range into kBins bins and narrows it to the bin holding the rank.
-class ExactSelection {
- public:
-  static constexpr int kBins = 4096;
-  static constexpr size_t kMaxKept = 65536;
-  // targets[t] = {stream, rank}; a rank outside [0, count of the stream) gives NaN.
-  explicit ExactSelection(std::vector<std::pair<int, long long>> targets);
-  bool done() const;
-  void Begin();
-  void Add(int stream, double value);
-  void End();
-  double Result(size_t target) const { return targets_[target].result; }
-
- private:
-  struct Level {
-    double min = 0.0, width = 0.0;
-    int bin = 0;
-  };
-  struct Target {
-    int stream = 0;
-    long long rank = 0;
-    bool done = false;
-    double result = 0.0;
-    std::vector<Level> levels;  // the range: the values in bin `bin` of every level
-    long long below = 0;        // values below the range
-    bool binning = false;       // this pass bins (else counts and keeps)
-    long long count = 0;
-    double min = 0.0, max = 0.0;
-    std::vector<double> kept;
-    std::vector<long long> bins;
-  };
-  static int BinOf(const Level& level, double value);
-  static bool InRange(const Target& t, double value);
-  std::vector<Target> targets_;
-  std::vector<std::vector<size_t>> by_stream_;  // targets of each stream
-};
 
 // One evaluated sample as the temporary file holds it.
 struct EvaluatedSample {
@@ -153,23 +113,28 @@ class StreamedEvaluation {
  private:
   struct Pass1;
   bool ReadRecord(std::FILE* file, EvaluatedSample* s) const;
-  // The whitened residuals of the screened (last predicted) variant.
-  std::array<double, kNumCables> Whitened(const EvaluatedSample& s) const;
+  // The whitened residuals of the screened (last predicted) variant's readings.
+  std::array<double, kNumCables> Whitened(const std::array<double, kNumCables>& predicted_n,
+                                          const std::array<double, kNumCables>& measured_n) const;
   // Selection passes over the temporary file: `feed` gives each sample's values to the
   // selection; `first_pass`, if given, sees every sample of the first pass too.
-  bool Select(ExactSelection* selection,
-              const std::function<void(const EvaluatedSample&, ExactSelection*)>& feed,
+  bool Select(internal::ExactSelection* selection,
+              const std::function<void(const EvaluatedSample&, internal::ExactSelection*)>& feed,
               std::string* error) const;
+  // Pass 1 on one chunk: skip (with skip_invalid_rows), predict, sum, spill. False when
+  // a pose cannot be solved (*unsolvable) or the temporary file cannot be written.
+  bool PassOneChunk(const CableRobot& robot, const EvaluationStreamOptions& options, Dataset* chunk,
+                    Pass1* p, bool* unsolvable, std::string* error);
   EvaluationStreamStatus Failure(const CableRobot& robot, const std::vector<std::string>& paths,
                                  const EvaluationStreamOptions& options, std::string* error);
   // Several files: checks them and merges their sessions (merged_, session_maps_).
   bool Prepare(const std::vector<std::string>& paths, const EvaluationStreamOptions& options,
                std::string* error);
   // The files' chunks in order, as one dataset's (merged sessions and planned flag);
-  // `visit` returning false stops (*stopped). False, with ReadDataset's message, on a
-  // read error.
+  // `visit` returning false stops them. False, with ReadDataset's message, on a read
+  // error.
   bool Chunks(const std::vector<std::string>& paths, const EvaluationStreamOptions& options,
-              const std::function<bool(Dataset*)>& visit, bool* stopped, std::string* error);
+              const std::function<bool(Dataset*)>& visit, std::string* error);
   bool Append(const Sample& s, const std::vector<std::array<double, kNumCables>>& predicted,
               Pass1* p, std::string* error);
   bool Screen(const EvaluationStreamOptions& options, std::string* error);
