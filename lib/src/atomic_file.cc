@@ -101,6 +101,7 @@ bool RegularFileReader::Open(const std::string& path, long long max_bytes, const
   }
   too_large_ = "larger than the limit for a " + what + " file, " + ByteCount(max_bytes) +
                " (docs/data-format.md, \"Limits\")";
+  size_ = static_cast<long long>(st.st_size);
   if (st.st_size > max_bytes) {
     return Fail(std::to_string(static_cast<long long>(st.st_size)) + " bytes is " + too_large_,
                 error);
@@ -134,6 +135,9 @@ bool ReadRegularFile(const std::string& path, long long max_bytes, const std::st
   RegularFileReader reader;
   if (!reader.Open(path, max_bytes, what, error)) return false;
   std::string contents;
+  // One allocation of the file's size: growing by doubling would peak at twice it (a
+  // 250 MB dataset of 10^6 samples read whole by calibrate).
+  contents.reserve(static_cast<size_t>(reader.size()));
   for (bool end = false; !end;) {
     if (!reader.Read(static_cast<size_t>(1) << 20, &contents, &end, error)) return false;
   }

@@ -34,12 +34,14 @@ class RegularFileReader {
   bool Open(const std::string& path, long long max_bytes, const std::string& what,
             std::string* error);
   bool Read(size_t max, std::string* text, bool* end, std::string* error);
+  // The file's size when opened (bytes).
+  long long size() const { return size_; }
 
  private:
   bool Fail(const std::string& why, std::string* error);
   int fd_ = -1;
   std::string name_, too_large_;
-  long long max_bytes_ = 0, read_bytes_ = 0;
+  long long max_bytes_ = 0, read_bytes_ = 0, size_ = 0;
 };
 
 // Reads a whole file in chunks handed to `sink` in order, for files too large to hold (a
