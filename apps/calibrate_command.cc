@@ -6,12 +6,15 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <map>
 #include <sstream>
@@ -24,6 +27,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
+#include "fastcal/evaluation_stream.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/internal/report_document.h"
@@ -162,6 +166,9 @@ screens them (against the measured attitude's predictions, with the default nois
 of 3 % of the reading and a threshold that grows with the number of readings), named by
 line and cable, and each row of the RMS table is repeated without them. The model's sensor gain and
 bias (if any) are applied: predicted reading = gain * tension + bias.
+
+The data is read in chunks, so memory does not grow with it (about 20 MB at 10^6 samples);
+each sample is kept meanwhile in a temporary file in /tmp (about 200 bytes a sample).
 )";
 
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
@@ -184,52 +191,77 @@ bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
   return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
 }
 
+// residuals.csv's comment lines and column line: `variants` are the RMS table's rows, of
+// which those with predictions (`predicted[v]`) get columns; `samples` how many the file
+// is one in K of.
+std::string ResidualsHeader(const std::vector<VariantEvaluation>& variants,
+                            const std::vector<bool>& predicted, size_t samples) {
+  const size_t every = static_cast<size_t>(std::max(1, FLAGS_residuals_every));
+  std::ostringstream head;
+  for (size_t v = 0; v < variants.size(); ++v) {
+    if (predicted[v]) head << "# v" << v + 1 << " = " << variants[v].name << "\n";
+  }
+  head << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
+  if (every > 1) {
+    head << "# one sample in " << every << " of the " << samples << " (--residuals-every=" << every
+         << "), from the first\n";
+  }
+  head << "line,time_s,held_out,gross_error_cables";
+  for (int i = 1; i <= kNumCables; ++i) head << ",T" << i << "_kN";
+  for (size_t v = 0; v < variants.size(); ++v) {
+    if (!predicted[v]) continue;
+    for (int i = 1; i <= kNumCables; ++i) head << ",v" << v + 1 << "_T" << i << "_kN";
+  }
+  head << "\n";
+  return head.str();
+}
+
+// One row of residuals.csv: the sample's line and time, whether it was held out, the
+// cables whose reading was a gross error ("3", "1 4"; empty for none), the measured and
+// each drawn variant's predicted tensions.
+void AppendResidualsRow(int line, double time_s, bool held_out,
+                        const std::array<bool, kNumCables>* gross,
+                        const std::array<double, kNumCables>& measured_n,
+                        const std::vector<const std::array<double, kNumCables>*>& predicted_n,
+                        std::string* out) {
+  *out += std::to_string(line) + "," + FormatDouble(time_s) + "," + (held_out ? "1" : "0") + ",";
+  bool first = true;
+  for (int i = 0; gross != nullptr && i < kNumCables; ++i) {
+    if (!(*gross)[i]) continue;
+    *out += (first ? "" : " ") + std::to_string(i + 1);
+    first = false;
+  }
+  for (double t : measured_n) *out += "," + FormatDouble(t / kNPerKn);
+  for (const std::array<double, kNumCables>* p : predicted_n) {
+    for (double t : *p) *out += "," + FormatDouble(t / kNPerKn);
+  }
+  *out += "\n";
+}
+
 // One row per sample: measured and each variant's predicted tensions; with a calibration
-// the held_out flag and gross_error_cables, the cables whose reading was a gross error
-// ("3", "1 4"; empty for none).
+// the held_out flag, and the gross errors (`excluded`).
 std::string ResidualsCsv(const Dataset& data, const std::vector<VariantEvaluation>& variants,
                          const std::vector<bool>& held_out, const ReadingMask& excluded) {
   // One string, appended to in place (not a stream copied out and concatenated): at 10^6
   // samples the file is ~300 MB, and each copy of it was another 300 MB of peak memory.
   const size_t every = static_cast<size_t>(std::max(1, FLAGS_residuals_every));
-  std::ostringstream head;
-  std::vector<const VariantEvaluation*> drawn;  // variants with predictions (columns)
-  for (size_t v = 0; v < variants.size(); ++v) {
-    if (variants[v].predicted_n.empty()) continue;  // a row of statistics only
-    drawn.push_back(&variants[v]);
-    head << "# v" << v + 1 << " = " << variants[v].name << "\n";
-  }
-  head << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
-  if (every > 1) {
-    head << "# one sample in " << every << " of the " << data.samples.size()
-         << " (--residuals-every=" << every << "), from the first\n";
-  }
-  head << "line,time_s,held_out,gross_error_cables";
-  for (int i = 1; i <= kNumCables; ++i) head << ",T" << i << "_kN";
-  for (size_t v = 0; v < variants.size(); ++v) {
-    if (variants[v].predicted_n.empty()) continue;
-    for (int i = 1; i <= kNumCables; ++i) head << ",v" << v + 1 << "_T" << i << "_kN";
-  }
-  head << "\n";
-  std::string out = head.str();
+  std::vector<bool> predicted;
+  for (const VariantEvaluation& v : variants) predicted.push_back(!v.predicted_n.empty());
+  std::string out = ResidualsHeader(variants, predicted, data.samples.size());
   constexpr size_t kBytesPerNumber = 12;  // a guess for reserve(), not a limit
   const size_t rows = (data.samples.size() + every - 1) / every;
-  out.reserve(out.size() + rows * kBytesPerNumber * (3 + kNumCables * (1 + drawn.size())));
+  const size_t drawn = static_cast<size_t>(std::count(predicted.begin(), predicted.end(), true));
+  out.reserve(out.size() + rows * kBytesPerNumber * (3 + kNumCables * (1 + drawn)));
+  std::vector<const std::array<double, kNumCables>*> row_predicted;
   for (size_t n = 0; n < data.samples.size(); n += every) {
     const Sample& s = data.samples[n];
-    out += std::to_string(s.line) + "," + FormatDouble(s.time_s) + "," +
-           (!held_out.empty() && held_out[n] ? "1" : "0") + ",";
-    bool first = true;
-    for (int i = 0; n < excluded.size() && i < kNumCables; ++i) {
-      if (!excluded[n][i]) continue;
-      out += (first ? "" : " ") + std::to_string(i + 1);
-      first = false;
+    row_predicted.clear();
+    for (const VariantEvaluation& v : variants) {
+      if (!v.predicted_n.empty()) row_predicted.push_back(&v.predicted_n[n]);
     }
-    for (double t : s.tension_n) out += "," + FormatDouble(t / kNPerKn);
-    for (const VariantEvaluation* v : drawn) {
-      for (double t : v->predicted_n[n]) out += "," + FormatDouble(t / kNPerKn);
-    }
-    out += "\n";
+    AppendResidualsRow(s.line, s.time_s, !held_out.empty() && held_out[n],
+                       n < excluded.size() ? &excluded[n] : nullptr, s.tension_n, row_predicted,
+                       &out);
   }
   return out;
 }
@@ -284,34 +316,46 @@ std::vector<std::string> DataPaths() {
   }
 }
 
-bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
+// --model's model and --data's files (checked: given, no empty name).
+bool LoadModelAndDataPaths(CableRobot* robot, std::vector<std::string>* paths, std::string* error) {
   if (!LoadModelFlag("model", FLAGS_model, robot, error)) return false;
   if (FLAGS_data.empty()) {
     *error = "--data=FILE.csv is required";
     return false;
   }
-  DatasetReadOptions read;
-  read.skip_invalid_rows = FLAGS_skip_invalid_rows;
-  const std::vector<std::string> paths = DataPaths();
-  if (std::find(paths.begin(), paths.end(), "") != paths.end()) {
+  *paths = DataPaths();
+  if (std::find(paths->begin(), paths->end(), "") != paths->end()) {
     *error = "--data=" + internal::Quote(FLAGS_data) +
              " has an empty file name (a stray comma?); several files are FILE.csv,FILE.csv";
     return false;
   }
+  return true;
+}
+
+bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
+  std::vector<std::string> paths;
+  if (!LoadModelAndDataPaths(robot, &paths, error)) return false;
+  DatasetReadOptions read;
+  read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   return ReadSessionDatasets(paths, read, data, error);
 }
 
 // Lists the rows --skip-invalid-rows skipped (malformed, or a pose the model cannot solve)
 // on stderr. False, with the message, when no sample is left.
-bool ReportSkipped(const char* command, const Dataset& data, std::string* error) {
+// `samples`: how many are left (data.samples.size() unless streamed).
+bool ReportSkipped(const char* command, const Dataset& data, long long samples,
+                   std::string* error) {
   if (data.skipped.empty()) return true;
   std::cerr << "fastcal " << command << ": --skip-invalid-rows skipped " << data.skipped.size()
             << (data.skipped.size() == 1 ? " row" : " rows") << " of " << data.path << ", "
-            << data.samples.size() << " left:\n";
+            << samples << " left:\n";
   for (const std::string& s : data.skipped) std::cerr << "  " << s << "\n";
-  if (!data.samples.empty()) return true;
+  if (samples > 0) return true;
   *error = data.path + ": no sample left: the model cannot solve any valid row";
   return false;
+}
+bool ReportSkipped(const char* command, const Dataset& data, std::string* error) {
+  return ReportSkipped(command, data, static_cast<long long>(data.samples.size()), error);
 }
 
 // " (3 rows skipped)" for the summary line; "" when none was.
@@ -328,15 +372,19 @@ std::string SkipHint() {
 // When `model` cannot solve at least two rows and the nominal FAST model solves most of
 // them, the model or spec, not the data, is the likely cause: the message that says so,
 // naming the values furthest from nominal; "" otherwise (model_plausibility.h).
-std::string BlameTheModel(const CableRobot& model, const std::string& model_name,
-                          const Dataset& data, const std::vector<StaticsMethod>& methods) {
-  const UnsolvableRows d = DiagnoseUnsolvableRows(
-      model, model_name, data, {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, methods);
+std::string BlameText(const UnsolvableRows& d, const std::string& model_name) {
   if (!d.model_likely) return "";
   return DescribeUnsolvableRows(d, model_name) +
          (FLAGS_skip_invalid_rows ? " (not skipped: --skip-invalid-rows is for bad rows, and "
                                     "would fit the rest with this model)"
                                   : "");
+}
+std::string BlameTheModel(const CableRobot& model, const std::string& model_name,
+                          const Dataset& data, const std::vector<StaticsMethod>& methods) {
+  return BlameText(
+      DiagnoseUnsolvableRows(model, model_name, data,
+                             {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, methods),
+      model_name);
 }
 
 std::string Digest(const std::string& path) {
@@ -743,14 +791,16 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
 
 // Writes `files` and the report files into --out as one directory (built as a hidden
 // sibling and renamed into place). False, with the error printed, on failure.
-bool WriteOutDirectory(const char* command,
-                       const std::vector<std::pair<std::string, std::string>>& files,
-                       const ReportInputs& report, const std::vector<std::string>& outputs) {
+// `more` (may be null) writes further files into the directory being built.
+bool WriteOutDirectory(
+    const char* command, const std::vector<std::pair<std::string, std::string>>& files,
+    const ReportInputs& report, const std::vector<std::string>& outputs,
+    const std::function<bool(const std::string&, std::string*)>& more = nullptr) {
   std::string error;
   if (WriteDirectoryAtomically(
           FLAGS_out, files,
           [&](const std::string& dir, std::string* why) {
-            return WriteReportFiles(dir, report, why);
+            return WriteReportFiles(dir, report, why) && (!more || more(dir, why));
           },
           FLAGS_force ? &outputs : nullptr, &error)) {
     return true;
@@ -935,22 +985,26 @@ int RunCalibrate(int argc, char** argv) {
 // evaluate's gross errors: how many, the threshold and why, the first few by line and cable.
 std::string EvaluationGrossErrorLines(const EvaluationScreen& screen) {
   std::ostringstream s;
-  const size_t count = screen.gross_errors.size();
+  const long long count = screen.count;
   s << "gross errors (against \"" << screen.variant << "\"): " << count
     << (count == 1 ? " reading" : " readings")
     << (count > 0 ? ", left out of the rows \"... - gross errors\"" : "") << "\n"
     << ThresholdLine("  ", screen.threshold);
   s << ReadingLines(screen.gross_errors, "  ");
+  if (count > static_cast<long long>(screen.gross_errors.size())) {
+    s << "  (" << screen.gross_errors.size() << " of the " << count
+      << " named in summary.json: the first in file order)\n";
+  }
   return s.str();
 }
 
 // evaluate's console: the RMS table, then per variant the RMS (%), mean and largest
 // error (kN) per cable, then the gross errors.
-std::string EvaluationConsole(const Dataset& data, StaticsMethod method,
+std::string EvaluationConsole(const Dataset& data, long long samples, StaticsMethod method,
                               const std::vector<VariantEvaluation>& variants,
                               const EvaluationScreen& screen) {
   std::ostringstream s;
-  s << "fastcal evaluate: " << data.samples.size() << " samples";
+  s << "fastcal evaluate: " << samples << " samples";
   s << SkippedNote(data);
   s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
     << StaticsMethodName(method) << "\n\n"
@@ -966,6 +1020,93 @@ std::string EvaluationConsole(const Dataset& data, StaticsMethod method,
     s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json"
       << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
+}
+
+// residuals.csv of a streamed evaluation, written into `dir` a sample at a time (the
+// same bytes ResidualsCsv gives for the same samples).
+bool WriteStreamedResiduals(const std::string& dir, const StreamedEvaluation& evaluation,
+                            std::string* error) {
+  constexpr size_t kFlushBytes = 1 << 20;
+  const std::string path = dir + "/residuals.csv";
+  std::FILE* file = std::fopen(path.c_str(), "wbx");
+  if (file == nullptr) {
+    *error = path + ": cannot create: " + std::strerror(errno);
+    return false;
+  }
+  const std::vector<VariantEvaluation>& variants = evaluation.variants();
+  std::vector<bool> predicted(variants.size(), false);
+  for (int v = 0; v < evaluation.predicted_variants(); ++v) predicted[v] = true;
+  std::string buffer = ResidualsHeader(variants, predicted, evaluation.samples());
+  const long long every = std::max(1, FLAGS_residuals_every);
+  bool written = true;
+  std::vector<const std::array<double, kNumCables>*> row_predicted;
+  const bool read = evaluation.ForEach(
+      [&](const EvaluatedSample& s) {
+        if (s.index % every != 0) return;
+        row_predicted.clear();
+        for (const auto& p : s.predicted_n) row_predicted.push_back(&p);
+        AppendResidualsRow(s.line, s.time_s, false, &s.gross, s.measured_n, row_predicted, &buffer);
+        if (buffer.size() < kFlushBytes) return;
+        written = written && std::fwrite(buffer.data(), 1, buffer.size(), file) == buffer.size();
+        buffer.clear();
+      },
+      error);
+  written = written && std::fwrite(buffer.data(), 1, buffer.size(), file) == buffer.size() &&
+            std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
+  const bool closed = std::fclose(file) == 0;
+  if (!read) return false;
+  if (!written || !closed) {
+    *error = path + ": cannot write: " + std::strerror(errno);
+    return false;
+  }
+  return true;
+}
+
+// evaluate: the data read, predicted and screened a chunk at a time (evaluation_stream.h),
+// so that memory does not grow with the number of samples.
+int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
+                        const std::vector<std::string>& paths, StaticsMethod method) {
+  const char* command = "evaluate";
+  std::string error;
+  EvaluationStreamOptions options;
+  options.method = method;
+  options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
+  StreamedEvaluation evaluation;
+  const EvaluationStreamStatus status = evaluation.Run(model, paths, options, &error);
+  if (status == EvaluationStreamStatus::kInvalidInput) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
+  if (const std::string blame = BlameText(evaluation.diagnosis(), "the model"); !blame.empty()) {
+    PrintError(command, blame);
+    return kExitFailure;
+  }
+  if (status == EvaluationStreamStatus::kUnsolvable) {
+    PrintError(command, error + SkipHint());
+    return kExitFailure;
+  }
+  const Dataset& data = evaluation.layout();
+  if (!ReportSkipped(command, data, evaluation.samples(), &error)) {
+    PrintError(command, error);
+    return kExitFailure;
+  }
+  if (!FLAGS_out.empty()) {
+    ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/false);
+    report.initial_model = &model;
+    report.data = &data;
+    report.variants = evaluation.variants();
+    report.evaluation_method = StaticsMethodName(method);
+    report.evaluation_screen = &evaluation.screen();
+    const ReportSampleStream samples = ReportSamplesOf(evaluation);
+    report.sample_stream = &samples;
+    const auto residuals = [&evaluation](const std::string& dir, std::string* why) {
+      return FLAGS_residuals_every <= 0 || WriteStreamedResiduals(dir, evaluation, why);
+    };
+    if (!WriteOutDirectory(command, {}, report, kEvaluateOutputs, residuals)) return kExitUsage;
+  }
+  std::cout << EvaluationConsole(data, evaluation.samples(), method, evaluation.variants(),
+                                 evaluation.screen());
+  return 0;
 }
 
 int RunEvaluate(int argc, char** argv) {
@@ -985,62 +1126,14 @@ int RunEvaluate(int argc, char** argv) {
     return kExitUsage;
   }
   CableRobot model;
-  Dataset data;
+  std::vector<std::string> paths;
   if (!CheckResidualsEvery(&error) ||
       (!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error)) ||
-      !LoadInputs(&model, &data, &error)) {
+      !LoadModelAndDataPaths(&model, &paths, &error)) {
     PrintError(command, error);
     return kExitUsage;
   }
-  if (const std::string blame =
-          FLAGS_skip_invalid_rows ? BlameTheModel(model, "the model", data, {method}) : "";
-      !blame.empty()) {
-    PrintError(command, blame);
-    return kExitFailure;
-  }
-  if (FLAGS_skip_invalid_rows) {
-    SkipUnsolvableSamples(model, "the model", {AttitudeSource::kPlanned, AttitudeSource::kMeasured},
-                          {method}, &data);
-  }
-  if (!ReportSkipped(command, data, &error)) {
-    PrintError(command, error);
-    return kExitFailure;
-  }
-  std::vector<VariantEvaluation> variants;
-  if (!EvaluateModel(model, data, method, &variants, &error)) {
-    if (const std::string blame = BlameTheModel(model, "the model", data, {method});
-        !blame.empty()) {
-      PrintError(command, blame);
-      return kExitFailure;
-    }
-    PrintError(command, error + SkipHint());
-    return kExitFailure;
-  }
-  // The screen calibrate applies, against the last variant (the measured attitude, which
-  // every dataset has); the RMS table gains each row again without what it names.
-  const EvaluationScreen screen = ScreenEvaluation(data, variants.back());
-  if (!screen.gross_errors.empty()) {
-    for (VariantEvaluation& v : WithoutGrossErrors(data, variants, screen.excluded)) {
-      variants.push_back(std::move(v));
-    }
-  }
-  if (!FLAGS_out.empty()) {
-    ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/false);
-    report.initial_model = &model;
-    report.data = &data;
-    report.variants = variants;
-    report.evaluation_method = StaticsMethodName(method);
-    report.evaluation_screen = &screen;
-    std::vector<std::pair<std::string, std::string>> files;
-    if (FLAGS_residuals_every > 0) {
-      files.emplace_back("residuals.csv", ResidualsCsv(data, variants, {}, screen.excluded));
-    }
-    if (!WriteOutDirectory(command, files, report, kEvaluateOutputs)) {
-      return kExitUsage;
-    }
-  }
-  std::cout << EvaluationConsole(data, method, variants, screen);
-  return 0;
+  return RunEvaluateStreamed(argc, argv, model, paths, method);
 }
 
 }  // namespace fastcal::cli

@@ -10,6 +10,7 @@
 #include "cli_util.h"
 #include "fastcal/pose.h"
 #include "fastcal/statics.h"
+#include "fastcal/trajectory.h"
 #include "fastcal/workspace.h"
 
 namespace fastcal::cli {
@@ -26,6 +27,12 @@ int RunDesign(int argc, char** argv);
 bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
                                   std::vector<Eigen::Vector3d>* positions, bool* known,
                                   std::string* error);
+// The same positions as a stream (trajectory.h), checked the same way (every node is
+// generated once to check it, not kept): simulate's memory does not grow with --samples.
+// The grid (at most kMaxGridPositions) is held and handed out from memory.
+bool TrajectoryPositionStreamFromFlags(const std::string& kind,
+                                       const Eigen::Vector3d& focal_centre_m,
+                                       PositionStream* stream, bool* known, std::string* error);
 
 // The scopes of the trajectory flags (cli_util.h) for trajectory `kind` (line, arc, grid,
 // random, circle with `with_circle` (simulate's, which takes --nodes), or another mode:

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <set>
 #include <sstream>
 #include <string>
@@ -394,7 +395,43 @@ bool CheckFlagsApplyToTrajectory(const std::string& trajectory, std::string* err
   return CheckFlagsApply(scopes, mode, error);
 }
 
-bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
+// Poses held in memory (a --poses file: bounded by its size), as a stream.
+PoseStream StreamOf(std::vector<Pose> poses) {
+  auto held = std::make_shared<std::vector<Pose>>(std::move(poses));
+  PoseStream stream;
+  stream.count = static_cast<long long>(held->size());
+  stream.next = [held, n = size_t{0}]() mutable { return (*held)[n++]; };
+  return stream;
+}
+
+// The poses of a generated trajectory, made as they are used: the positions' stream with
+// the attitude law applied to each. Checked first on a copy of the stream (no pose kept);
+// a position the law cannot take is named as PosesWithFocalLawFromFlags names it, from
+// the whole list, made only then.
+bool PosesFromPositions(const PositionStream& positions, bool focal, const FocalAttitudeLaw& law,
+                        PoseStream* poses, std::string* error) {
+  if (focal) {
+    PositionStream check = positions;
+    std::vector<Pose> one;
+    for (long long n = 0; n < check.count; ++n) {
+      if (PosesWithFocalLawFromFlags({check.next()}, law, &one, error)) continue;
+      std::vector<Eigen::Vector3d> all;
+      PositionStream again = positions;
+      for (long long k = 0; k < again.count; ++k) all.push_back(again.next());
+      return PosesWithFocalLawFromFlags(all, law, &one, error);
+    }
+  }
+  poses->count = positions.count;
+  poses->next = [positions, focal, law]() mutable {
+    Pose pose;
+    pose.position_m = positions.next();
+    pose.rotation = focal ? FocalAttitude(pose.position_m, law) : Eigen::Matrix3d::Identity();
+    return pose;
+  };
+  return true;
+}
+
+bool BuildPoses(PoseStream* poses, std::string* error) {
   FocalAttitudeLaw law;
   law.tilt_fraction = FLAGS_tilt_fraction;
   if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
@@ -415,10 +452,15 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
   if (!CheckFlagsApplyToTrajectory(trajectory, error)) return false;
 
   if (trajectory == "poses") {
-    return ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, poses, error);
+    std::vector<Pose> from_file;
+    if (!ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, &from_file, error)) {
+      return false;
+    }
+    *poses = StreamOf(std::move(from_file));
+    return true;
   }
 
-  std::vector<Eigen::Vector3d> positions;
+  PositionStream positions;
   bool ok = false;
   if (trajectory == "circle") {
     ArcSpec arc;
@@ -427,10 +469,11 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     arc.start_deg = 0.0;
     arc.end_deg = 360.0;
     arc.nodes = FlagGiven("nodes") ? FLAGS_nodes : kCircleNodes;
-    ok = ArcPositions(arc, &positions, error);
+    ok = ArcPositionStream(arc, &positions, error);
   } else {
     bool known = false;
-    ok = TrajectoryPositionsFromFlags(trajectory, law.focal_centre_m, &positions, &known, error);
+    ok = TrajectoryPositionStreamFromFlags(trajectory, law.focal_centre_m, &positions, &known,
+                                           error);
     if (!known) {
       *error = "--trajectory must be circle, line, arc, grid, random or poses, got " +
                internal::Quote(trajectory);
@@ -441,8 +484,7 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* error) {
     *error = "--trajectory=" + trajectory + ": " + WithTrajectoryFlagNames(*error);
     return false;
   }
-  return FLAGS_attitude_law == "none" ? PosesWithIdentityAttitude(positions, poses, error)
-                                      : PosesWithFocalLawFromFlags(positions, law, poses, error);
+  return PosesFromPositions(positions, FLAGS_attitude_law != "none", law, poses, error);
 }
 
 // FILE.csv -> FILE.truth.yaml; any other name gets ".truth.yaml" appended.
@@ -460,7 +502,7 @@ std::string TruthPathFor(const std::string& csv_path) {
 // mass centre's average) to a temporary beside yaml_path and renames both into place;
 // on failure removes whatever it wrote, so that neither file is left. *simulation_failed
 // tells a failed simulation (exit 1) from a failed write (exit 2).
-bool SimulateAndWrite(const CableRobot& truth, const std::vector<Pose>& poses,
+bool SimulateAndWrite(const CableRobot& truth, const PoseStream& poses,
                       const SimulationOptions& options, const std::string& csv_path,
                       const std::string& csv_header, const std::string& yaml_path,
                       const std::function<std::string(const SimulationSummary&)>& yaml_header,
@@ -559,17 +601,17 @@ int RunSimulate(int argc, char** argv) {
   }
   CableRobot truth;
   SimulationOptions options;
-  std::vector<Pose> poses;
+  PoseStream poses;
   if (!LoadTruth(&truth, &error) || !SetOptionsFromFlags(&options, &error) ||
       !BuildPoses(&poses, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  if (poses.empty()) {
+  if (poses.count == 0) {
     PrintError(kCommand, "no poses to simulate");
     return kExitUsage;
   }
-  if (!StepsAtSessions(static_cast<int>(poses.size()), &options, &error)) {
+  if (!StepsAtSessions(static_cast<int>(poses.count), &options, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

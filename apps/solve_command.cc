@@ -5,6 +5,7 @@
 
 #include <chrono>
 #include <iostream>
+#include <memory>
 #include <regex>
 #include <sstream>
 
@@ -295,15 +296,14 @@ bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitu
 
 namespace {
 
-bool GenerateTrajectoryPositions(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
-                                 std::vector<Eigen::Vector3d>* positions, bool* known,
-                                 std::string* error) {
+bool GenerateTrajectoryStream(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
+                              PositionStream* stream, bool* known, std::string* error) {
   *known = true;
   if (kind == "line") {
     Eigen::Vector3d from, to;
     return ParsePosition("from", FLAGS_from, &from, error) &&
            ParsePosition("to", FLAGS_to, &to, error) &&
-           LinePositions(from, to, FLAGS_nodes, positions, error);
+           LinePositionStream(from, to, FLAGS_nodes, stream, error);
   }
   if (kind == "arc") {
     ArcSpec arc;
@@ -312,7 +312,7 @@ bool GenerateTrajectoryPositions(const std::string& kind, const Eigen::Vector3d&
     arc.end_deg = FLAGS_end_deg;
     arc.nodes = FLAGS_nodes;
     return ParseVector3("centre", FLAGS_centre, &arc.centre_m, error) &&
-           ArcPositions(arc, positions, error);
+           ArcPositionStream(arc, stream, error);
   }
   if (kind == "grid") {
     FocalGridSpec grid;
@@ -321,7 +321,11 @@ bool GenerateTrajectoryPositions(const std::string& kind, const Eigen::Vector3d&
     grid.azimuth_step_deg = FLAGS_azimuth_step_deg;
     grid.focal_centre_m = focal_centre_m;
     grid.focal_radius_m = FLAGS_focal_radius;
-    return FocalSpherePositions(grid, positions, error);
+    auto positions = std::make_shared<std::vector<Eigen::Vector3d>>();
+    if (!FocalSpherePositions(grid, positions.get(), error)) return false;
+    stream->count = static_cast<long long>(positions->size());
+    stream->next = [positions, k = size_t{0}]() mutable { return (*positions)[k++]; };
+    return true;
   }
   if (kind == "random") {
     RandomWorkspaceSpec spec;
@@ -331,7 +335,7 @@ bool GenerateTrajectoryPositions(const std::string& kind, const Eigen::Vector3d&
     spec.sphere.focal_centre_m = focal_centre_m;
     spec.sphere.focal_radius_m = FLAGS_focal_radius;
     spec.seed = FLAGS_seed;
-    return RandomWorkspacePositions(spec, positions, error);
+    return RandomWorkspacePositionStream(spec, stream, error);
   }
   *known = false;
   return false;
@@ -339,20 +343,33 @@ bool GenerateTrajectoryPositions(const std::string& kind, const Eigen::Vector3d&
 
 }  // namespace
 
-bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
-                                  std::vector<Eigen::Vector3d>* positions, bool* known,
-                                  std::string* error) {
-  if (!GenerateTrajectoryPositions(kind, focal_centre_m, positions, known, error)) return false;
-  // Every node within the limits a dataset's positions obey (an arc of radius 1e6 m).
+bool TrajectoryPositionStreamFromFlags(const std::string& kind,
+                                       const Eigen::Vector3d& focal_centre_m,
+                                       PositionStream* stream, bool* known, std::string* error) {
+  if (!GenerateTrajectoryStream(kind, focal_centre_m, stream, known, error)) return false;
+  // Every node within the limits a dataset's positions obey (an arc of radius 1e6 m),
+  // checked on a copy of the stream, which leaves the original at its start.
   const PlausibilityLimits limits;
-  for (size_t n = 0; n < positions->size(); ++n) {
-    const Eigen::Vector3d& p = (*positions)[n];
+  PositionStream check = *stream;
+  for (long long n = 0; n < check.count; ++n) {
+    const Eigen::Vector3d p = check.next();
     if (std::string why; !CheckPosition(p, limits, &why)) {
       *error = "node " + std::to_string(n) + " at position (" + FormatDouble(p[0]) + ", " +
                FormatDouble(p[1]) + ", " + FormatDouble(p[2]) + ") m: " + why;
       return false;
     }
   }
+  return true;
+}
+
+bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
+                                  std::vector<Eigen::Vector3d>* positions, bool* known,
+                                  std::string* error) {
+  PositionStream stream;
+  if (!TrajectoryPositionStreamFromFlags(kind, focal_centre_m, &stream, known, error)) return false;
+  positions->clear();
+  positions->reserve(static_cast<size_t>(stream.count));
+  for (long long n = 0; n < stream.count; ++n) positions->push_back(stream.next());
   return true;
 }
 

@@ -516,6 +516,98 @@ TEST_F(DatasetTest, SkipInvalidRowsNeverSkipsHeaderErrorsOrEverything) {
   EXPECT_TRUE(Contains(error, "data.csv:2: column 'time_s'"));
 }
 
+// Reads `path` with DatasetChunkReader, `chunk` samples at a time, into one dataset (the
+// chunks concatenated); the error message on failure, "" on success.
+std::string ReadInChunks(const std::string& path, const DatasetReadOptions& options, size_t chunk,
+                         Dataset* whole) {
+  DatasetChunkReader reader;
+  std::string error;
+  if (!reader.Open(path, options, &error)) return error;
+  for (bool done = false; !done;) {
+    Dataset part;
+    if (!reader.Next(chunk, &part, &done, &error)) return error;
+    EXPECT_LE(part.samples.size(), chunk);
+    for (Sample& s : part.samples) whole->samples.push_back(std::move(s));
+    for (std::string& s : part.skipped) whole->skipped.push_back(std::move(s));
+    whole->path = part.path;
+    whole->has_planned_attitude = part.has_planned_attitude;
+    whole->has_unstretched_lengths = part.has_unstretched_lengths;
+    whole->attitude_as_quaternion = part.attitude_as_quaternion;
+    whole->session_labels = part.session_labels;
+  }
+  return "";
+}
+
+// fastcal evaluate reads its data in chunks (issue 20): the chunked reader gives
+// ReadDataset's samples, skipped rows and messages, whatever the chunk size, on good
+// files, bad rows (skipped or not), bad headers and whole-file problems.
+TEST_F(DatasetTest, ChunkedReaderGivesTheSamplesAndMessagesOfReadDataset) {
+  const std::string rows = std::string("# c\n") + kHeader + kRow + kRow + kRow;
+  const auto to_radians = [](int row, std::vector<std::string>* f) {
+    for (int c = 4; row >= 0 && c < 7; ++c) {
+      (*f)[c] = internal::FormatDouble("%.17g", std::stod((*f)[c]) * M_PI / 180.0);
+    }
+  };
+  const std::vector<std::string> texts = {
+      rows,
+      "\xEF\xBB\xBF" + rows + "1,1,2,140,0,0,0,150,151,152,153,154,155",  // no final newline
+      rows + "1,1,2,140,0,0,0,150,151,abc,153,154,155\n" + kRow,
+      rows + "2,1,2,140,0,0,0,150,151,152\n\n# x\n" + kRow + "3,1,2,140,0,0,0,1,2,3,4,-1,6\n",
+      std::string(kHeader) + "0,1,2,140,0,0,0,150,151,244,5,153,154,155\n" + kRow,
+      std::string(kHeader) + "x,1,2,140,0,0,0,150,151,152,153,154,155\n",
+      "T7_kN," + std::string(kHeader) + "1," + kRow,
+      std::string("# nothing\n") + kHeader,
+      "",
+      std::string(kHeader) + kRow + "\r\n",
+      "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN,"
+      "session\n0,1,2,140,0,0,0,1,2,3,4,5,6,B\n1,1,2,140,0,0,0,1,2,3,4,5,6,A\n"
+      "2,1,2,140,0,0,0,1,2,3,4,5,6,B\n",
+      CircleWith(to_radians),
+      CircleWith([](int, std::vector<std::string>*) {}),
+  };
+  int failures = 0;
+  for (size_t k = 0; k < texts.size(); ++k) {
+    const std::string path = PathOf("data" + std::to_string(k) + ".csv");
+    WriteText("data" + std::to_string(k) + ".csv", texts[k]);
+    for (bool skip : {false, true}) {
+      DatasetReadOptions options;
+      options.skip_invalid_rows = skip;
+      Dataset expected;
+      std::string expected_error;
+      const bool ok = ReadDataset(path, options, &expected, &expected_error);
+      failures += !ok;
+      for (size_t chunk : {1, 2, 7, 100000}) {
+        SCOPED_TRACE("text " + std::to_string(k) + (skip ? " skip" : "") + " chunk " +
+                     std::to_string(chunk));
+        Dataset got;
+        const std::string error = ReadInChunks(path, options, chunk, &got);
+        EXPECT_EQ(error, ok ? "" : expected_error);
+        if (!ok || !error.empty()) continue;
+        EXPECT_EQ(got.path, expected.path);
+        EXPECT_EQ(got.skipped, expected.skipped);
+        EXPECT_EQ(got.session_labels, expected.session_labels);
+        ASSERT_EQ(got.samples.size(), expected.samples.size());
+        for (size_t n = 0; n < got.samples.size(); ++n) {
+          EXPECT_EQ(got.samples[n].line, expected.samples[n].line);
+          EXPECT_EQ(got.samples[n].session, expected.samples[n].session);
+          ExpectSamplesEqual(expected.samples[n], got.samples[n], expected.attitude_as_quaternion,
+                             expected.has_planned_attitude, expected.has_unstretched_lengths);
+        }
+      }
+    }
+  }
+  EXPECT_GE(failures, 10);  // the bad files above fail (without skip, and some with it)
+  // Refused before reading, as ReadDataset refuses: a directory, a file above the limit.
+  Dataset unused;
+  std::string expected_error;
+  EXPECT_FALSE(ReadDataset(dir_.string(), DatasetReadOptions(), &unused, &expected_error));
+  EXPECT_EQ(ReadInChunks(dir_.string(), DatasetReadOptions(), 5, &unused), expected_error);
+  DatasetReadOptions small;
+  small.max_file_bytes = 10;
+  EXPECT_FALSE(ReadDataset(PathOf("data0.csv"), small, &unused, &expected_error));
+  EXPECT_EQ(ReadInChunks(PathOf("data0.csv"), small, 5, &unused), expected_error);
+}
+
 TEST_F(DatasetTest, RoundTripIsExact) {
   constexpr int kRows = 50;
   unsigned seed = 20240501;

@@ -642,5 +642,48 @@ TEST(SimulationTest, StreamedSimulationWritesTheSameFile) {
   fs::remove_all(dir, ignored);
 }
 
+// fastcal simulate draws its planned poses as it goes (issue 20: memory independent of
+// the number of samples): a PoseStream gives the samples the pose vector gives, and the
+// caller's stream is not advanced (SimulateStream works on a copy).
+TEST(SimulationTest, PoseStreamSimulatesTheSameSamplesAsThePoseVector) {
+  SimulationOptions options;
+  options.attitude_control_sigma_deg = 0.2;
+  options.outlier_fraction = 0.05;
+  options.sessions = 2;
+  const std::vector<Pose> planned = Circle(40);
+  Dataset whole;
+  ASSERT_TRUE(
+      Simulate(CableRobot::NominalFast(), planned, options, &whole, nullptr, nullptr, nullptr));
+  PoseStream stream;
+  stream.count = static_cast<long long>(planned.size());
+  stream.next = [&planned, n = size_t{0}]() mutable { return planned[n++]; };
+  std::vector<Sample> streamed;
+  const SampleSink keep = [&streamed](const Sample& s, std::string*) {
+    streamed.push_back(s);
+    return true;
+  };
+  std::string error;
+  ASSERT_TRUE(
+      SimulateStream(CableRobot::NominalFast(), stream, options, keep, nullptr, nullptr, &error))
+      << error;
+  ASSERT_EQ(streamed.size(), whole.samples.size());
+  for (size_t n = 0; n < streamed.size(); ++n) {
+    EXPECT_EQ(streamed[n].tension_n, whole.samples[n].tension_n) << n;
+    EXPECT_EQ(streamed[n].pose.position_m, whole.samples[n].pose.position_m) << n;
+    EXPECT_EQ(streamed[n].session, whole.samples[n].session) << n;
+  }
+  EXPECT_EQ(stream.next().position_m, planned[0].position_m);  // not advanced by the run
+
+  // A non-finite pose is named when drawn, as the vector's check names it.
+  Pose bad = planned[5];
+  bad.position_m.x() = std::nan("");
+  PoseStream broken;
+  broken.count = 10;
+  broken.next = [&planned, bad, n = 0]() mutable { return n == 5 ? (++n, bad) : planned[n++]; };
+  EXPECT_FALSE(SimulateStream(CableRobot::NominalFast(), broken, SimulationOptions(), keep, nullptr,
+                              nullptr, &error));
+  EXPECT_EQ(error, "planned pose of node 5 is not finite");
+}
+
 }  // namespace
 }  // namespace fastcal

@@ -63,6 +63,42 @@ TEST(LinePositions, TwoNodesAreTheEnds) {
 
 // ---- Arc ----
 
+// The streams simulate draws its positions from (issue 20) give the vectors' positions bit
+// for bit, and a copy of a stream starts where the original stands, so a checking pass over
+// a copy leaves the original at its start.
+TEST(PositionStream, GivesTheVectorsPositionsAndCopiesKeepTheirPlace) {
+  RandomWorkspaceSpec random;
+  random.samples = 500;
+  random.radial_spread_m = 3.0;
+  random.seed = 7;
+  ArcSpec arc;
+  arc.centre_m = Eigen::Vector3d(0.0, 0.0, 150.0);
+  arc.radius_m = 50.0;
+  arc.end_deg = 360.0;
+  arc.nodes = 77;
+  std::vector<Eigen::Vector3d> from_vector[3];
+  PositionStream streams[3];
+  ASSERT_TRUE(RandomWorkspacePositions(random, &from_vector[0], nullptr));
+  ASSERT_TRUE(RandomWorkspacePositionStream(random, &streams[0], nullptr));
+  ASSERT_TRUE(ArcPositions(arc, &from_vector[1], nullptr));
+  ASSERT_TRUE(ArcPositionStream(arc, &streams[1], nullptr));
+  const Eigen::Vector3d from(50.0, 0.0, 150.0), to(-50.0, 0.0, 150.0);
+  ASSERT_TRUE(LinePositions(from, to, 101, &from_vector[2], nullptr));
+  ASSERT_TRUE(LinePositionStream(from, to, 101, &streams[2], nullptr));
+  for (int k = 0; k < 3; ++k) {
+    ASSERT_EQ(streams[k].count, static_cast<long long>(from_vector[k].size()));
+    PositionStream copy = streams[k];
+    for (size_t n = 0; n < from_vector[k].size(); ++n) EXPECT_EQ(copy.next(), from_vector[k][n]);
+    for (size_t n = 0; n < from_vector[k].size(); ++n) {
+      EXPECT_EQ(streams[k].next(), from_vector[k][n]) << k << " " << n;
+    }
+  }
+  std::string error;
+  random.samples = 0;
+  EXPECT_FALSE(RandomWorkspacePositionStream(random, &streams[0], &error));
+  EXPECT_EQ(error, "samples must be >= 1 (got 0)");
+}
+
 TEST(ArcPositions, PaperHalfCircle) {
   ArcSpec spec;
   spec.centre_m = Eigen::Vector3d(0.0, 0.0, 150.0);

@@ -456,20 +456,19 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
 // every angle of the file is below 1 deg where the focal attitude law (how FAST flies)
 // tilts the cabin by several degrees on most samples. Returns the
 // message, or "" when neither holds.
-std::string AttitudeInRadiansProblem(const Dataset& d) {
-  constexpr double kDegPerRad = 57.29577951308232;
-  constexpr double kFactorTolerance = 0.25;       // of kDegPerRad: 43 to 72
-  constexpr double kSignificantPlannedDeg = 1.0;  // planned angles compared from here
-  constexpr int kFewestAngles = 10;
-  constexpr double kLevelBelowDeg = 1.0;
-  constexpr double kFocalTiltDeg = 5.0;  // "several degrees" of the focal law
-  if (d.attitude_as_quaternion || d.samples.empty()) return "";
-  const std::string columns = d.path + ": roll_deg, pitch_deg, yaw_deg look like radians: ";
-  const std::string fix = "; write degrees (radians x 57.2958)";
-  if (d.has_planned_attitude) {
-    double pm = 0.0, mm = 0.0;
-    int angles = 0;
-    for (const Sample& s : d.samples) {
+// The sums AttitudeInRadiansProblem judges, gathered sample by sample (a file read in
+// chunks is judged as a whole).
+struct RadiansCheck {
+  double pm = 0.0, mm = 0.0;  // planned . measured, measured . measured (significant angles)
+  int angles = 0;
+  double largest_deg = 0.0, largest_focal_deg = 0.0;
+  int tilted = 0, samples = 0;
+
+  void Add(const Sample& s, bool planned) {
+    constexpr double kSignificantPlannedDeg = 1.0;  // planned angles compared from here
+    constexpr double kFocalTiltDeg = 5.0;           // "several degrees" of the focal law
+    ++samples;
+    if (planned) {
       for (int a = 0; a < 3; ++a) {
         if (std::abs(s.planned_rpy_deg[a]) < kSignificantPlannedDeg) continue;
         pm += s.planned_rpy_deg[a] * s.measured_rpy_deg[a];
@@ -477,32 +476,40 @@ std::string AttitudeInRadiansProblem(const Dataset& d) {
         ++angles;
       }
     }
-    const double factor = mm > 0.0 ? pm / mm : 0.0;
-    if (angles >= kFewestAngles && std::abs(factor / kDegPerRad - 1.0) <= kFactorTolerance) {
-      return columns + "the planned_*_deg angles are " + internal::FormatDouble("%.3g", factor) +
-             " times the measured ones (least squares over " + std::to_string(angles) +
-             " angles above 1 deg)" + fix;
-    }
-  }
-  // Measured (and planned, when given) angles all below 1 deg where FAST tilts.
-  double largest_deg = 0.0, largest_focal_deg = 0.0;
-  int tilted = 0;
-  for (const Sample& s : d.samples) {
     largest_deg = std::max(largest_deg, s.measured_rpy_deg.cwiseAbs().maxCoeff());
-    if (d.has_planned_attitude) {
-      largest_deg = std::max(largest_deg, s.planned_rpy_deg.cwiseAbs().maxCoeff());
-    }
+    if (planned) largest_deg = std::max(largest_deg, s.planned_rpy_deg.cwiseAbs().maxCoeff());
     const Eigen::AngleAxisd focal(FocalAttitude(s.pose.position_m, FocalAttitudeLaw()));
     const double focal_deg = std::abs(focal.angle()) * kDegPerRad;
     largest_focal_deg = std::max(largest_focal_deg, focal_deg);
     if (focal_deg > kFocalTiltDeg) ++tilted;
   }
-  const int n = static_cast<int>(d.samples.size());
-  if (n < kFewestAngles || largest_deg >= kLevelBelowDeg || 2 * tilted < n) return "";
+  static constexpr double kDegPerRad = 57.29577951308232;
+};
+
+std::string AttitudeInRadiansProblem(const std::string& path, bool quaternion, bool planned,
+                                     const RadiansCheck& c) {
+  constexpr double kDegPerRad = RadiansCheck::kDegPerRad;
+  constexpr double kFactorTolerance = 0.25;  // of kDegPerRad: 43 to 72
+  constexpr int kFewestAngles = 10;
+  constexpr double kLevelBelowDeg = 1.0;
+  if (quaternion || c.samples == 0) return "";
+  const std::string columns = path + ": roll_deg, pitch_deg, yaw_deg look like radians: ";
+  const std::string fix = "; write degrees (radians x 57.2958)";
+  if (planned) {
+    const double factor = c.mm > 0.0 ? c.pm / c.mm : 0.0;
+    if (c.angles >= kFewestAngles && std::abs(factor / kDegPerRad - 1.0) <= kFactorTolerance) {
+      return columns + "the planned_*_deg angles are " + internal::FormatDouble("%.3g", factor) +
+             " times the measured ones (least squares over " + std::to_string(c.angles) +
+             " angles above 1 deg)" + fix;
+    }
+  }
+  // Measured (and planned, when given) angles all below 1 deg where FAST tilts.
+  const int n = c.samples;
+  if (n < kFewestAngles || c.largest_deg >= kLevelBelowDeg || 2 * c.tilted < n) return "";
   return columns + "every angle is below 1 deg (largest " +
-         internal::FormatDouble("%.3g", largest_deg) +
+         internal::FormatDouble("%.3g", c.largest_deg) +
          " deg), while the focal attitude law tilts the cabin by up to " +
-         internal::FormatDouble("%.3g", largest_focal_deg) + " deg at these positions" + fix;
+         internal::FormatDouble("%.3g", c.largest_focal_deg) + " deg at these positions" + fix;
 }
 
 // The index of `label` in dataset->session_labels, appended when new.
@@ -515,66 +522,117 @@ int SessionIndex(std::string_view label, Dataset* dataset) {
   return static_cast<int>(labels.size()) - 1;
 }
 
+// Reads a dataset line by line, for ParseDataset (the whole text) and DatasetChunkReader
+// (a file in pieces): one set of checks and messages for both. Samples and skipped rows
+// go to the Dataset given to each Line; the header's flags and the session labels stay
+// in layout().
+class LineParser {
+ public:
+  LineParser(const std::string& source_name, const DatasetReadOptions& options)
+      : options_(options) {
+    layout_.path = source_name;
+  }
+
+  // One line of the file (without its '\n'), numbered from 1.
+  bool Line(int line_number, std::string_view line, Dataset* out, std::string* error) {
+    if (IsCommentOrBlank(line)) return true;
+    const std::string where = layout_.path + ":" + std::to_string(line_number) + ": ";
+    if (!have_header_) {
+      if (!ParseHeader(line, where, &header_, error)) return false;
+      have_header_ = true;
+      layout_.has_planned_attitude = header_.planned;
+      layout_.has_unstretched_lengths = header_.unstretched;
+      layout_.attitude_as_quaternion = header_.quaternion;
+      return true;
+    }
+    ++rows_;
+    Sample sample;
+    sample.line = line_number;
+    std::string reason;
+    FieldValues values{};
+    if (ParseRow(line, header_, options_.limits, have_previous_ ? &previous_ : nullptr, &sample,
+                 &values, &reason)) {
+      if (header_.session_field >= 0) {
+        sample.session = SessionIndex(SplitFields(line)[header_.session_field], &layout_);
+      }
+      radians_.Add(sample, header_.planned);
+      out->samples.push_back(std::move(sample));
+      previous_ = values;
+      have_previous_ = true;
+    } else if (options_.skip_invalid_rows) {
+      if (first_skipped_.empty()) first_skipped_ = where + reason;
+      out->skipped.push_back(where + reason);
+    } else {
+      *error = where + reason;
+      return false;
+    }
+    return true;
+  }
+
+  // The checks of the whole file, after its last line.
+  bool Finish(std::string* error) const {
+    const std::string& source_name = layout_.path;
+    if (!have_header_) {
+      *error = source_name + ": no header line (and no data rows)";
+      return false;
+    }
+    if (rows_ == 0) {
+      *error = source_name + ": no data rows";
+      return false;
+    }
+    if (!have_previous_) {
+      *error = source_name + ": no valid data rows: all " + std::to_string(rows_) +
+               " rows skipped; first: " + first_skipped_;
+      return false;
+    }
+    if (const std::string why =
+            AttitudeInRadiansProblem(source_name, header_.quaternion, header_.planned, radians_);
+        !why.empty()) {
+      *error = why;
+      return false;
+    }
+    return true;
+  }
+
+  // The path, the header's column flags and the session labels met so far.
+  const Dataset& layout() const { return layout_; }
+
+ private:
+  DatasetReadOptions options_;
+  Dataset layout_;
+  Header header_;
+  bool have_header_ = false;
+  int rows_ = 0;
+  FieldValues previous_{};  // the last valid row
+  bool have_previous_ = false;
+  std::string first_skipped_;
+  RadiansCheck radians_;
+};
+
+// Copies the layout's path, flags and session labels into `data` (its samples and
+// skipped rows kept).
+void TakeLayout(const Dataset& layout, Dataset* data) {
+  data->path = layout.path;
+  data->has_planned_attitude = layout.has_planned_attitude;
+  data->has_unstretched_lengths = layout.has_unstretched_lengths;
+  data->attitude_as_quaternion = layout.attitude_as_quaternion;
+  data->session_labels = layout.session_labels;
+}
+
 bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
                       const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
   Dataset result;
-  result.path = source_name;
-  Header header;
-  bool have_header = false;
-  int rows = 0;
-  FieldValues previous{};  // the last valid row
+  LineParser parser(source_name, options);
   std::string_view rest(text);
   if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // UTF-8 byte order mark
   for (int line_number = 1; !rest.empty(); ++line_number) {
     const size_t newline = rest.find('\n');
     const std::string_view line = rest.substr(0, newline);
     rest.remove_prefix(newline == std::string_view::npos ? rest.size() : newline + 1);
-    if (IsCommentOrBlank(line)) continue;
-    const std::string where = source_name + ":" + std::to_string(line_number) + ": ";
-    if (!have_header) {
-      if (!ParseHeader(line, where, &header, error)) return false;
-      have_header = true;
-      continue;
-    }
-    ++rows;
-    Sample sample;
-    sample.line = line_number;
-    std::string reason;
-    FieldValues values{};
-    if (ParseRow(line, header, options.limits, result.samples.empty() ? nullptr : &previous,
-                 &sample, &values, &reason)) {
-      if (header.session_field >= 0) {
-        sample.session = SessionIndex(SplitFields(line)[header.session_field], &result);
-      }
-      result.samples.push_back(std::move(sample));
-      previous = values;
-    } else if (options.skip_invalid_rows) {
-      result.skipped.push_back(where + reason);
-    } else {
-      *error = where + reason;
-      return false;
-    }
+    if (!parser.Line(line_number, line, &result, error)) return false;
   }
-  if (!have_header) {
-    *error = source_name + ": no header line (and no data rows)";
-    return false;
-  }
-  if (rows == 0) {
-    *error = source_name + ": no data rows";
-    return false;
-  }
-  if (result.samples.empty()) {
-    *error = source_name + ": no valid data rows: all " + std::to_string(rows) +
-             " rows skipped; first: " + result.skipped.front();
-    return false;
-  }
-  result.has_planned_attitude = header.planned;
-  result.has_unstretched_lengths = header.unstretched;
-  result.attitude_as_quaternion = header.quaternion;
-  if (const std::string why = AttitudeInRadiansProblem(result); !why.empty()) {
-    *error = why;
-    return false;
-  }
+  if (!parser.Finish(error)) return false;
+  TakeLayout(parser.layout(), &result);
   *dataset = std::move(result);
   return true;
 }
@@ -768,6 +826,66 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
     return false;
   }
   return ParseDataset(text, path, options, dataset, error);
+}
+
+struct DatasetChunkReader::State {
+  State(const std::string& path, const DatasetReadOptions& options) : parser(path, options) {}
+  internal::RegularFileReader file;
+  LineParser parser;
+  std::string text;  // read and not yet parsed: the start of a line
+  size_t start = 0;  // where in `text` the next line starts
+  int line_number = 0;
+  bool first = true;  // before the first line (a byte order mark may open it)
+  bool end = false;   // the whole file is in `text`
+  bool done = false;  // the whole-file checks passed
+};
+
+DatasetChunkReader::DatasetChunkReader() = default;
+DatasetChunkReader::~DatasetChunkReader() = default;
+
+bool DatasetChunkReader::Open(const std::string& path, const DatasetReadOptions& options,
+                              std::string* error) {
+  state_ = std::make_unique<State>(path, options);
+  return state_->file.Open(path, options.max_file_bytes, "dataset", error);
+}
+
+bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, std::string* error) {
+  constexpr size_t kReadBytes = 1 << 20;  // read at a time: ~4000 rows of 24 columns
+  std::string message;
+  bool ok = true;
+  chunk->samples.clear();
+  chunk->skipped.clear();
+  try {
+    State& st = *state_;
+    while (ok && !st.done && chunk->samples.size() < std::max<size_t>(max_samples, 1)) {
+      const size_t newline = st.text.find('\n', st.start);
+      if (newline == std::string::npos && !st.end) {
+        st.text.erase(0, st.start);  // keep the unfinished line only
+        st.start = 0;
+        ok = st.file.Read(kReadBytes, &st.text, &st.end, &message);
+        continue;
+      }
+      if (newline == std::string::npos && st.start == st.text.size()) {
+        ok = st.parser.Finish(&message);
+        st.done = ok;
+        continue;
+      }
+      std::string_view line(st.text);
+      line = line.substr(st.start,
+                         newline == std::string::npos ? std::string::npos : newline - st.start);
+      st.start = newline == std::string::npos ? st.text.size() : newline + 1;
+      if (st.first && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
+      st.first = false;
+      ok = st.parser.Line(++st.line_number, line, chunk, &message);
+    }
+    TakeLayout(st.parser.layout(), chunk);
+    *done = st.done;
+  } catch (const std::exception& e) {
+    message = state_->parser.layout().path + ": " + e.what();
+    ok = false;
+  }
+  if (!ok && error != nullptr) *error = message;
+  return ok;
 }
 
 std::string SampleWhere(const Dataset& data, const Sample& sample) {

@@ -24,6 +24,25 @@ std::string CannotSolve(const Dataset& data, const Sample& sample, const std::st
 
 }  // namespace
 
+TensionPredictor::TensionPredictor(const CableRobot& robot, AttitudeSource attitude,
+                                   StaticsMethod method)
+    : robot_(robot), attitude_(attitude), options_(ModelFitStaticsOptions(method)) {
+  // As Calibrate solves; consecutive telemetry samples are close.
+  options_.warm_start = true;
+}
+
+bool TensionPredictor::Predict(const Dataset& data, const Sample& sample,
+                               std::array<double, kNumCables>* predicted_n, std::string* error) {
+  if (SolveStatics(robot_, PoseOf(sample, attitude_), options_, &solution_) != StaticsStatus::kOk) {
+    *error = CannotSolve(data, sample, "the model", "", solution_);
+    return false;
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    (*predicted_n)[i] = robot_.cables[i].SensorReadingN(solution_.cables[i].lower_tension_n);
+  }
+  return true;
+}
+
 bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSource attitude,
                      StaticsMethod method, std::vector<std::array<double, kNumCables>>* predicted,
                      std::string* error) {
@@ -31,19 +50,10 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
     *error = data.path + ": no planned attitude columns (planned_roll_deg, ...)";
     return false;
   }
-  StaticsOptions options = ModelFitStaticsOptions(method);  // as Calibrate solves
-  options.warm_start = true;  // consecutive telemetry samples are close
-  StaticsSolution solution;
+  TensionPredictor predictor(robot, attitude, method);
   predicted->assign(data.samples.size(), {});
   for (size_t n = 0; n < data.samples.size(); ++n) {
-    const Sample& s = data.samples[n];
-    if (SolveStatics(robot, PoseOf(s, attitude), options, &solution) != StaticsStatus::kOk) {
-      *error = CannotSolve(data, s, "the model", "", solution);
-      return false;
-    }
-    for (int i = 0; i < kNumCables; ++i) {
-      (*predicted)[n][i] = robot.cables[i].SensorReadingN(solution.cables[i].lower_tension_n);
-    }
+    if (!predictor.Predict(data, data.samples[n], &(*predicted)[n], error)) return false;
   }
   return true;
 }
@@ -84,45 +94,55 @@ int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name
   return removed;
 }
 
+void ErrorStatsAccumulator::Add(const std::array<double, kNumCables>& predicted_n,
+                                const std::array<double, kNumCables>& measured_n,
+                                const std::array<bool, kNumCables>* excluded) {
+  ++st_.samples;
+  for (int i = 0; i < kNumCables; ++i) {
+    if (excluded != nullptr && (*excluded)[i]) {
+      ++st_.excluded[i];
+      continue;
+    }
+    const double d = predicted_n[i] - measured_n[i];
+    sum_[i] += d;
+    sum2_[i] += d * d;
+    st_.max_abs_n[i] = std::max(st_.max_abs_n[i], std::abs(d));
+    // Percent of the predicted reading, not of the measured one: a dropout reads 0 kN
+    // (100 d / 0 = inf), and the prediction of a pose the model holds is > 0. A
+    // prediction <= 0 (a negative sensor bias) leaves the reading out of the percents.
+    if (!(predicted_n[i] > 0.0)) continue;
+    const double pct = 100.0 * d / predicted_n[i];
+    sum2_pct_[i] += pct * pct;
+    ++percent_readings_[i];
+    st_.max_abs_percent[i] = std::max(st_.max_abs_percent[i], std::abs(pct));
+  }
+}
+
+CableErrorStats ErrorStatsAccumulator::Finish() const {
+  CableErrorStats st = st_;
+  for (int i = 0; i < kNumCables; ++i) {
+    const int readings = st.samples - st.excluded[i];
+    if (readings == 0) continue;
+    st.mean_n[i] = sum_[i] / readings;
+    st.rms_n[i] = std::sqrt(sum2_[i] / readings);
+    if (percent_readings_[i] > 0) {
+      st.rms_percent[i] = std::sqrt(sum2_pct_[i] / percent_readings_[i]);
+    }
+  }
+  return st;
+}
+
 CableErrorStats ErrorStats(const Dataset& data,
                            const std::vector<std::array<double, kNumCables>>& predicted,
                            const std::vector<bool>& held_out, bool select_held_out,
                            const ReadingMask& excluded) {
-  CableErrorStats st;
-  std::array<double, kNumCables> sum{}, sum2{}, sum2_pct{};
-  std::array<int, kNumCables> percent_readings{};
+  ErrorStatsAccumulator acc;
   for (size_t n = 0; n < data.samples.size(); ++n) {
     const bool h = !held_out.empty() && held_out[n];
     if (h != select_held_out) continue;
-    ++st.samples;
-    for (int i = 0; i < kNumCables; ++i) {
-      if (!excluded.empty() && excluded[n][i]) {
-        ++st.excluded[i];
-        continue;
-      }
-      const double measured = data.samples[n].tension_n[i];
-      const double d = predicted[n][i] - measured;
-      sum[i] += d;
-      sum2[i] += d * d;
-      st.max_abs_n[i] = std::max(st.max_abs_n[i], std::abs(d));
-      // Percent of the predicted reading, not of the measured one: a dropout reads 0 kN
-      // (100 d / 0 = inf), and the prediction of a pose the model holds is > 0. A
-      // prediction <= 0 (a negative sensor bias) leaves the reading out of the percents.
-      if (!(predicted[n][i] > 0.0)) continue;
-      const double pct = 100.0 * d / predicted[n][i];
-      sum2_pct[i] += pct * pct;
-      ++percent_readings[i];
-      st.max_abs_percent[i] = std::max(st.max_abs_percent[i], std::abs(pct));
-    }
+    acc.Add(predicted[n], data.samples[n].tension_n, excluded.empty() ? nullptr : &excluded[n]);
   }
-  for (int i = 0; i < kNumCables; ++i) {
-    const int readings = st.samples - st.excluded[i];
-    if (readings == 0) continue;
-    st.mean_n[i] = sum[i] / readings;
-    st.rms_n[i] = std::sqrt(sum2[i] / readings);
-    if (percent_readings[i] > 0) st.rms_percent[i] = std::sqrt(sum2_pct[i] / percent_readings[i]);
-  }
-  return st;
+  return acc.Finish();
 }
 
 bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dataset& data,
@@ -138,15 +158,22 @@ bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dat
   return true;
 }
 
+std::string EvaluationVariantName(AttitudeSource attitude) {
+  return attitude == AttitudeSource::kPlanned ? "model, planned attitude"
+                                              : "model, measured attitude";
+}
+
 bool EvaluateModel(const CableRobot& robot, const Dataset& data, StaticsMethod method,
                    std::vector<VariantEvaluation>* variants, std::string* error) {
-  std::vector<std::pair<std::string, AttitudeSource>> list;
-  if (data.has_planned_attitude)
-    list.emplace_back("model, planned attitude", AttitudeSource::kPlanned);
-  list.emplace_back("model, measured attitude", AttitudeSource::kMeasured);
-  for (const auto& [name, attitude] : list) {
+  std::vector<AttitudeSource> list;
+  if (data.has_planned_attitude) list.push_back(AttitudeSource::kPlanned);
+  list.push_back(AttitudeSource::kMeasured);
+  for (AttitudeSource attitude : list) {
     VariantEvaluation e;
-    if (!EvaluateVariant(name, robot, data, attitude, method, {}, &e, error)) return false;
+    if (!EvaluateVariant(EvaluationVariantName(attitude), robot, data, attitude, method, {}, &e,
+                         error)) {
+      return false;
+    }
     variants->push_back(std::move(e));
   }
   return true;

@@ -35,6 +35,8 @@ EvaluationScreen ScreenEvaluation(const Dataset& data, const VariantEvaluation& 
       g.predicted_n = variant.predicted_n[t][i];
       g.residual_sigma = whitened[t][i];
       out.gross_errors.push_back(g);
+      ++out.count;
+      ++out.count_per_cable[i];
     }
   }
   out.excluded = std::move(screen.flagged);

@@ -18,6 +18,7 @@
 #include <limits>
 #include <new>
 #include <string>
+#include <tuple>
 #include <utility>
 #include <vector>
 
@@ -97,6 +98,19 @@ bool HasPredictions(const ReportInputs& in, const VariantEvaluation& v) {
   return in.data && !in.data->samples.empty() && v.predicted_n.size() == in.data->samples.size();
 }
 
+// The first and last time of the samples (inf, -inf for none).
+std::pair<double, double> TimeRange(const ReportInputs& in) {
+  if (in.sample_stream != nullptr) {
+    return {in.sample_stream->time_min_s, in.sample_stream->time_max_s};
+  }
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (const Sample& s : in.data->samples) {
+    lo = std::min(lo, s.time_s);
+    hi = std::max(hi, s.time_s);
+  }
+  return {lo, hi};
+}
+
 std::string NoiseText(const CalibrationSpec& spec) {
   return "σ = √[(" + Printf("%.6g", spec.tension_sigma_n / kNPerKn) + " kN)² + (" +
          Printf("%.6g", spec.tension_sigma_percent) + " % of the predicted reading)²]";
@@ -153,12 +167,8 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
   if (in.data) {
     const Dataset& d = *in.data;
     data.Plain(": " + Int(NumSamples(in)) + " samples");
-    if (!d.samples.empty()) {
-      double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-      for (const Sample& s : d.samples) {
-        lo = std::min(lo, s.time_s);
-        hi = std::max(hi, s.time_s);
-      }
+    if (NumSamples(in) > 0) {
+      const auto [lo, hi] = TimeRange(in);
       data.Plain(", t = " + Sig6(lo) + " to " + Sig6(hi) + " s");
     }
     data.Plain(d.attitude_as_quaternion ? ", attitude as quaternion" : ", attitude as angles");
@@ -379,7 +389,6 @@ void AddEstimates(const CalibrationResult& r, Document* doc) {
 }
 
 std::string RatioText(double ratio) { return "s/s1 = " + Printf("%.2g", ratio); }
-
 
 // The singular-value ratios before, after, and of the data alone, side by side.
 void AddSingularValueTable(const CalibrationResult& r, Document* doc) {
@@ -602,22 +611,6 @@ void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
                            rows, nullptr));
 }
 
-// x coordinates of the time plots: time_s, or the sample index when time does not vary.
-std::vector<double> SampleAxis(const Dataset& d, std::string* label) {
-  std::vector<double> x;
-  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const Sample& s : d.samples) {
-    lo = std::min(lo, s.time_s);
-    hi = std::max(hi, s.time_s);
-  }
-  const bool use_time = std::isfinite(lo) && std::isfinite(hi) && hi > lo;
-  *label = use_time ? "t [s]" : "sample index";
-  for (size_t n = 0; n < d.samples.size(); ++n) {
-    x.push_back(use_time ? d.samples[n].time_s : static_cast<double>(n));
-  }
-  return x;
-}
-
 // Puts `item` at index `slot` of `v`, padding with empty (unnamed, pointless) series: the
 // charts colour a series by its index, and a variant keeps its colour (its index in the
 // RMS table, PlotSeriesColour) in every chart.
@@ -634,15 +627,6 @@ size_t HeldOutSlot(const ReportInputs& in) {
   return in.variants.size() <= 5 ? 5 : in.variants.size();
 }
 
-// Thins a series for drawing (ThinMinMaxPerBucket) and records in *buckets the number of
-// buckets of the longest series thinned.
-PlotSeries Thin(PlotSeries s, int* buckets) {
-  int b = 0;
-  PlotSeries thinned = ThinMinMaxPerBucket(s, kMaxPlotPointsPerSeries, &b);
-  *buckets = std::max(*buckets, b);
-  return thinned;
-}
-
 // Says in a figure caption that its series were thinned (buckets > 0), and how.
 std::string ThinningNote(int num_samples, int buckets) {
   if (buckets <= 0) return "";
@@ -654,55 +638,184 @@ std::string ThinningNote(int num_samples, int buckets) {
          "and outliers stay visible. The tables and statistics use all samples.";
 }
 
+// The samples the plots draw, as a stream: in.sample_stream, or data->samples with the
+// variants' predictions, the gross errors (calibrate's or evaluate's screen) and the
+// held-out flags. Both are drawn by one code path, in two replays.
+ReportSampleStream SamplesOf(const ReportInputs& in) {
+  if (in.sample_stream != nullptr) return *in.sample_stream;
+  ReportSampleStream out;
+  const Dataset& d = *in.data;
+  out.samples = static_cast<long long>(d.samples.size());
+  std::tie(out.time_min_s, out.time_max_s) = TimeRange(in);
+  out.is_trajectory = internal::IsTrajectory(d);
+  for (const VariantEvaluation& v : in.variants)
+    out.has_predictions.push_back(HasPredictions(in, v));
+  const ReadingMask* gross = in.result              ? &in.result->excluded
+                             : in.evaluation_screen ? &in.evaluation_screen->excluded
+                                                    : nullptr;
+  out.replay = [&in, &d, gross, has = out.has_predictions](
+                   const std::function<void(const ReportSample&)>& visit, std::string*) {
+    std::vector<std::array<double, kNumCables>> predicted(in.variants.size());
+    ReportSample r;
+    r.predicted_n = predicted.data();
+    for (size_t n = 0; n < d.samples.size(); ++n) {
+      r.time_s = d.samples[n].time_s;
+      r.measured_n = d.samples[n].tension_n;
+      for (size_t k = 0; k < predicted.size(); ++k) {
+        if (has[k]) predicted[k] = in.variants[k].predicted_n[n];
+      }
+      for (int i = 0; i < kNumCables; ++i) {
+        r.gross[i] = gross != nullptr && n < gross->size() && (*gross)[n][i];
+      }
+      r.held_out = IsHeldOut(in, n);
+      visit(r);
+    }
+    return true;
+  };
+  return out;
+}
+
+// A series thinned as it is fed: min/max per bucket (ThinMinMaxPerBucket) along a
+// trajectory, every k-th point (ThinEvenly) for unordered samples. Its length and whether
+// it has a gap come from the first replay.
+class SeriesThinner {
+ public:
+  SeriesThinner(PlotSeries style, size_t n, bool any_gap, bool even)
+      : style_(std::move(style)),
+        even_(even),
+        stride_(std::max<size_t>(1, (n + kMaxPlotPointsPerSeries - 1) / kMaxPlotPointsPerSeries)),
+        min_max_(n, any_gap, kMaxPlotPointsPerSeries) {}
+  void Add(double x, double y) {
+    if (!even_) return min_max_.Add(x, y);
+    if (next_++ % stride_ != 0) return;
+    style_.x.push_back(x);
+    style_.y.push_back(y);
+  }
+  PlotSeries Finish() const { return even_ ? style_ : min_max_.Finish(style_); }
+  // The stride (even) or the number of buckets (min/max, 0 when not thinned).
+  int Thinning() const { return even_ ? static_cast<int>(stride_) : min_max_.buckets(); }
+
+ private:
+  PlotSeries style_;
+  bool even_;
+  size_t stride_, next_ = 0;
+  MinMaxBucketThinner min_max_;
+};
+
+// A series' length and whether it has a non-finite point, from the first replay.
+struct SeriesShape {
+  size_t n = 0;
+  bool any_gap = false;
+  void Add(double x, double y) {
+    ++n;
+    any_gap = any_gap || !std::isfinite(x) || !std::isfinite(y);
+  }
+};
+
 // What every time plot shares: the x axis, the variants drawn, and how.
 struct TimePlots {
   const ReportInputs& in;
-  const Dataset& d;
+  ReportSampleStream samples;
   std::string x_label;
-  std::vector<double> x;
+  bool use_time = false;
   std::vector<size_t> shown;  // PlotVariants
   bool holdout = false;
   bool ordered = true;  // a trajectory: lines join the samples; else dots
   std::string not_drawn;
 
-  // Thins a series for drawing: min/max per bucket along a trajectory (peaks stay
-  // visible), every k-th point for unordered samples (extremes of an unordered cloud
-  // would draw false bands).
-  PlotSeries Thin(PlotSeries s, int* thinning) const {
-    if (!ordered) return internal::ThinEvenly(s, kMaxPlotPointsPerSeries, thinning);
-    return ::fastcal::Thin(std::move(s), thinning);
-  }
   std::string ThinningNote(int thinning) const {
     return ordered ? ::fastcal::ThinningNote(NumSamples(in), thinning)
                    : internal::EvenThinningNote(NumSamples(in), thinning);
   }
 
   TimePlots(const ReportInputs& inputs)  // NOLINT: a view of the inputs
-      : in(inputs), d(*inputs.data), x(SampleAxis(d, &x_label)), shown(PlotVariants(inputs)) {
+      : in(inputs), samples(SamplesOf(inputs)), shown(PlotVariants(inputs)) {
+    // x: time_s, or the sample index when time does not vary.
+    use_time = std::isfinite(samples.time_min_s) && std::isfinite(samples.time_max_s) &&
+               samples.time_max_s > samples.time_min_s;
+    x_label = use_time ? "t [s]" : "sample index";
     holdout = NumHeldOut(in) > 0;
-    ordered = internal::IsTrajectory(d);
+    ordered = samples.is_trajectory;
     if ((in.result && !in.result->gross_errors.empty()) ||
-        (in.evaluation_screen && !in.evaluation_screen->gross_errors.empty())) {
+        (in.evaluation_screen && in.evaluation_screen->count > 0)) {
       not_drawn = " Gross errors are not drawn.";
     }
   }
+  double X(const ReportSample& s, long long n) const {
+    return use_time ? s.time_s : static_cast<double>(n);
+  }
+  bool Predicted(size_t k) const {
+    return k < samples.has_predictions.size() && samples.has_predictions[k];
+  }
   // With a calibration the "before" variant is dashed, the calibrated one solid.
   PlotSeries Model(const std::string& name, size_t k) const {
-    PlotSeries p{name, x, {}, in.result != nullptr && k + 1 < shown.size(), !ordered};
+    PlotSeries p{name, {}, {}, in.result != nullptr && k + 1 < shown.size(), !ordered};
     p.marker_radius_px = kMeasuredDotRadiusPx;
     return p;
   }
-  // Gross errors are not drawn: one 99999 kN reading would flatten every other point.
-  bool Drawn(size_t n, int i) const {
-    const ReadingMask* gross = in.result              ? &in.result->excluded
-                               : in.evaluation_screen ? &in.evaluation_screen->excluded
-                                                      : nullptr;
-    return gross == nullptr || n >= gross->size() || !(*gross)[n][i];
-  }
-  double ResidualKn(const VariantEvaluation& v, size_t n, int i) const {
-    return (v.predicted_n[n][i] - d.samples[n].tension_n[i]) / kNPerKn;
-  }
 };
+
+// Every series of the time plots and the histogram, per cable: the models' tensions
+// (index k of `shown`), the measured ones (fitted, held out), the models' residuals
+// (gross errors a gap).
+struct TimeSeries {
+  std::array<std::vector<SeriesShape>, kNumCables> model_shape, residual_shape;
+  std::array<SeriesShape, kNumCables> fitted_shape, held_shape;
+  double residual_lo = std::numeric_limits<double>::infinity(), residual_hi = -residual_lo;
+};
+
+// The points of every time series, in replay order: of cable i, the tension and the
+// residual of variant shown[k] (a gross error's residual NaN: a gap), and the measured
+// tension (gross errors left out), of a fitted or a held-out sample.
+enum class PointKind { kModel, kResidual, kMeasured, kHeldOut };
+using PointVisitor = std::function<void(PointKind kind, int i, size_t k, double x, double y)>;
+bool ReplayPoints(const TimePlots& t, const PointVisitor& visit, std::string* error) {
+  long long n = 0;
+  return t.samples.replay(
+      [&](const ReportSample& s) {
+        const double x = t.X(s, n++);
+        for (int i = 0; i < kNumCables; ++i) {
+          for (size_t k = 0; k < t.shown.size(); ++k) {
+            if (!t.Predicted(t.shown[k])) continue;
+            const double predicted = s.predicted_n[t.shown[k]][i];
+            visit(PointKind::kModel, i, k, x, predicted / kNPerKn);
+            visit(PointKind::kResidual, i, k, x,
+                  s.gross[i] ? NAN : (predicted - s.measured_n[i]) / kNPerKn);
+          }
+          if (s.gross[i]) continue;
+          visit(s.held_out ? PointKind::kHeldOut : PointKind::kMeasured, i, 0, x,
+                s.measured_n[i] / kNPerKn);
+        }
+      },
+      error);
+}
+
+// First replay: the series' lengths and gaps, and the residuals' range.
+bool ShapeSeries(const TimePlots& t, TimeSeries* ts, std::string* error) {
+  for (int i = 0; i < kNumCables; ++i) {
+    ts->model_shape[i].assign(t.shown.size(), {});
+    ts->residual_shape[i].assign(t.shown.size(), {});
+  }
+  return ReplayPoints(
+      t,
+      [ts](PointKind kind, int i, size_t k, double x, double y) {
+        switch (kind) {
+          case PointKind::kModel:
+            return ts->model_shape[i][k].Add(x, y);
+          case PointKind::kResidual:
+            ts->residual_shape[i][k].Add(x, y);
+            if (!std::isfinite(y)) return;
+            ts->residual_lo = std::min(ts->residual_lo, y);
+            ts->residual_hi = std::max(ts->residual_hi, y);
+            return;
+          case PointKind::kMeasured:
+            return ts->fitted_shape[i].Add(x, y);
+          case PointKind::kHeldOut:
+            return ts->held_shape[i].Add(x, y);
+        }
+      },
+      error);
+}
 
 PlotOptions CablePlotOptions(const std::string& title, const std::string& x_label,
                              const std::string& y_label) {
@@ -715,113 +828,130 @@ PlotOptions CablePlotOptions(const std::string& title, const std::string& x_labe
   return o;
 }
 
-// Tension against time, one plot per cable: the measured tensions as small translucent
-// dots, drawn first, and the model over them.
-void AddTensionPlots(const TimePlots& t, Document* doc) {
-  int buckets = 0;
-  std::vector<std::string> svgs;
+// The figures of AddPlots, drawn from the second replay.
+struct TimeFigures {
+  std::vector<std::string> tension_svgs, residual_svgs;
+  int tension_thinning = 0, residual_buckets = 0;
+  std::string histogram_svg;  // empty: no variant has predictions
+};
+
+// Second replay: every series thinned as it goes, the residuals binned.
+bool DrawTimeFigures(const TimePlots& t, const TimeSeries& ts, TimeFigures* f, std::string* error) {
+  std::array<std::vector<SeriesThinner>, kNumCables> models, residuals;
+  std::vector<SeriesThinner> fitted, held;
+  std::vector<std::string> histogram_names;
+  bool any = false;
   for (int i = 0; i < kNumCables; ++i) {
-    std::vector<PlotSeries> series;
     for (size_t k = 0; k < t.shown.size(); ++k) {
       const VariantEvaluation& v = t.in.variants[t.shown[k]];
-      if (!HasPredictions(t.in, v)) continue;
-      PlotSeries p = t.Model(v.name, k);
-      for (const auto& predicted : v.predicted_n) p.y.push_back(predicted[i] / kNPerKn);
-      PutAt(&series, t.shown[k], t.Thin(std::move(p), &buckets));
+      models[i].emplace_back(t.Model(v.name, k), ts.model_shape[i][k].n,
+                             ts.model_shape[i][k].any_gap, !t.ordered);
+      residuals[i].emplace_back(t.Model(v.name, k), ts.residual_shape[i][k].n,
+                                ts.residual_shape[i][k].any_gap, false);
     }
-    PlotSeries fitted{t.holdout ? "measured (fitted)" : "measured", {}, {}, false, true};
-    PlotSeries held{"measured (held out)", {}, {}, false, true};
-    for (size_t n = 0; n < t.d.samples.size(); ++n) {
-      if (!t.Drawn(n, i)) continue;
-      PlotSeries& m = IsHeldOut(t.in, n) ? held : fitted;
-      m.x.push_back(t.x[n]);
-      m.y.push_back(t.d.samples[n].tension_n[i] / kNPerKn);
-    }
-    fitted.marker_radius_px = held.marker_radius_px = kMeasuredDotRadiusPx;
-    fitted.opacity = kMeasuredDotOpacity;
-    held.opacity = kHeldOutDotOpacity;
-    if (t.holdout) PutAt(&series, HeldOutSlot(t.in), t.Thin(std::move(held), &buckets));
-    PutAt(&series, MeasuredSlot(t.in), t.Thin(std::move(fitted), &buckets));
-    svgs.push_back(SvgLinePlot(series, CablePlotOptions("Cable " + Int(i + 1) + ": tension",
-                                                        t.x_label, "T" + Int(i + 1) + " [kN]")));
+    PlotSeries m{t.holdout ? "measured (fitted)" : "measured", {}, {}, false, true};
+    PlotSeries h{"measured (held out)", {}, {}, false, true};
+    m.marker_radius_px = h.marker_radius_px = kMeasuredDotRadiusPx;
+    m.opacity = kMeasuredDotOpacity;
+    h.opacity = kHeldOutDotOpacity;
+    fitted.emplace_back(m, ts.fitted_shape[i].n, ts.fitted_shape[i].any_gap, !t.ordered);
+    held.emplace_back(h, ts.held_shape[i].n, ts.held_shape[i].any_gap, !t.ordered);
   }
-  doc->Figure(std::move(svgs),
+  for (size_t k : t.shown) {
+    if (!t.Predicted(k)) continue;
+    if (histogram_names.size() <= k) histogram_names.resize(k + 1);
+    histogram_names[k] = t.in.variants[k].name;
+    any = true;
+  }
+  HistogramBins histogram(histogram_names, ts.residual_lo, ts.residual_hi, kResidualBins);
+  const bool ok = ReplayPoints(
+      t,
+      [&](PointKind kind, int i, size_t k, double x, double y) {
+        switch (kind) {
+          case PointKind::kModel:
+            return models[i][k].Add(x, y);
+          case PointKind::kResidual:
+            residuals[i][k].Add(x, y);
+            return histogram.Add(t.shown[k], y);  // a gap (NaN) is not counted
+          case PointKind::kMeasured:
+            return fitted[i].Add(x, y);
+          case PointKind::kHeldOut:
+            return held[i].Add(x, y);
+        }
+      },
+      error);
+  if (!ok) return false;
+  for (int i = 0; i < kNumCables; ++i) {
+    std::vector<PlotSeries> series, residual_series;
+    for (size_t k = 0; k < t.shown.size(); ++k) {
+      if (!t.Predicted(t.shown[k])) continue;
+      PutAt(&series, t.shown[k], models[i][k].Finish());
+      f->tension_thinning = std::max(f->tension_thinning, models[i][k].Thinning());
+      PutAt(&residual_series, t.shown[k], residuals[i][k].Finish());
+      f->residual_buckets = std::max(f->residual_buckets, residuals[i][k].Thinning());
+    }
+    if (t.holdout) {
+      PutAt(&series, HeldOutSlot(t.in), held[i].Finish());
+      f->tension_thinning = std::max(f->tension_thinning, held[i].Thinning());
+    }
+    PutAt(&series, MeasuredSlot(t.in), fitted[i].Finish());
+    f->tension_thinning = std::max(f->tension_thinning, fitted[i].Thinning());
+    f->tension_svgs.push_back(
+        SvgLinePlot(series, CablePlotOptions("Cable " + Int(i + 1) + ": tension", t.x_label,
+                                             "T" + Int(i + 1) + " [kN]")));
+    f->residual_svgs.push_back(
+        SvgLinePlot(residual_series, CablePlotOptions("Cable " + Int(i + 1) + ": model - measured",
+                                                      t.x_label, "model - measured [kN]")));
+  }
+  if (any) {
+    PlotOptions o;
+    o.title = "Model - measured, all cables and samples";
+    o.x_label = "model - measured [kN]";
+    o.width_px = kWidePlotWidthPx;
+    o.height_px = kWidePlotHeightPx;
+    f->histogram_svg = histogram.Svg(o);
+  }
+  return true;
+}
+
+void AddPlots(const ReportInputs& in, Document* doc) {
+  doc->Heading(2, "Plots");
+  if (!in.data || NumSamples(in) == 0) {
+    doc->Paragraph("No samples to plot.");
+    return;
+  }
+  const TimePlots t(in);
+  TimeSeries ts;
+  TimeFigures f;
+  std::string error;
+  if (!ShapeSeries(t, &ts, &error) || !DrawTimeFigures(t, ts, &f, &error)) {
+    doc->Paragraph("The samples could not be read back to plot them: " + error);
+    return;
+  }
+  // Tension against time, one plot per cable: the measured tensions as small translucent
+  // dots, drawn first, and the model over them.
+  doc->Figure(std::move(f.tension_svgs),
               std::string("Measured lower-end tension (translucent dots, drawn underneath") +
                   (t.holdout ? "; held-out samples in light blue" : "") + ") and the model " +
                   (t.ordered ? "predictions (lines on top; dashed: before calibration)"
                              : "predictions (dots on top: the samples are not a trajectory, so "
                                "nothing joins them)") +
-                  " against time, per cable [kN]." + t.not_drawn + t.ThinningNote(buckets));
-}
-
-// Residual distribution, all cables and samples pooled. False when no variant has
-// predictions.
-bool AddResidualHistogram(const TimePlots& t, Document* doc) {
-  std::vector<HistogramSeries> histograms;
-  bool any = false;
-  for (size_t k : t.shown) {
-    const VariantEvaluation& v = t.in.variants[k];
-    if (!HasPredictions(t.in, v)) continue;
-    HistogramSeries h{v.name, {}};
-    for (size_t n = 0; n < t.d.samples.size(); ++n) {
-      for (int i = 0; i < kNumCables; ++i) {
-        if (t.Drawn(n, i)) h.values.push_back(t.ResidualKn(v, n, i));
-      }
-    }
-    PutAt(&histograms, k, std::move(h));
-    any = true;
-  }
-  if (!any) return false;
-  PlotOptions o;
-  o.title = "Model - measured, all cables and samples";
-  o.x_label = "model - measured [kN]";
-  o.width_px = kWidePlotWidthPx;
-  o.height_px = kWidePlotHeightPx;
-  doc->Figure({SvgHistogram(histograms, kResidualBins, o)},
-              "Distribution of model - measured over all cables and all " + Int(NumSamples(t.in)) +
-                  " samples [kN]: a calibrated model should centre on 0 with the width of the "
-                  "sensor noise.");
-  return true;
-}
-
-// Residual against time, one plot per cable.
-void AddResidualTimePlots(const TimePlots& t, Document* doc) {
-  std::vector<std::string> svgs;
-  int buckets = 0;
-  for (int i = 0; i < kNumCables; ++i) {
-    std::vector<PlotSeries> series;
-    for (size_t k = 0; k < t.shown.size(); ++k) {
-      const VariantEvaluation& v = t.in.variants[t.shown[k]];
-      if (!HasPredictions(t.in, v)) continue;
-      PlotSeries p = t.Model(v.name, k);
-      for (size_t n = 0; n < t.d.samples.size(); ++n) {
-        p.y.push_back(t.Drawn(n, i) ? t.ResidualKn(v, n, i) : NAN);
-      }
-      PutAt(&series, t.shown[k], Thin(std::move(p), &buckets));
-    }
-    svgs.push_back(
-        SvgLinePlot(series, CablePlotOptions("Cable " + Int(i + 1) + ": model - measured",
-                                             t.x_label, "model - measured [kN]")));
-  }
-  doc->Figure(std::move(svgs),
-              "Model - measured against time, per cable [kN]: a pattern that repeats with "
-              "the pose is model error; what remains after calibration should look like noise." +
-                  t.not_drawn + t.ThinningNote(buckets));
-}
-
-void AddPlots(const ReportInputs& in, Document* doc) {
-  doc->Heading(2, "Plots");
-  if (!in.data || in.data->samples.empty()) {
-    doc->Paragraph("No samples to plot.");
-    return;
-  }
-  const TimePlots t(in);
-  AddTensionPlots(t, doc);
-  if (!AddResidualHistogram(t, doc)) {
+                  " against time, per cable [kN]." + t.not_drawn +
+                  t.ThinningNote(f.tension_thinning));
+  // Residual distribution, all cables and samples pooled.
+  if (f.histogram_svg.empty()) {
     doc->Paragraph("No model predictions to plot residuals of.");
     return;
   }
-  AddResidualTimePlots(t, doc);
+  doc->Figure({f.histogram_svg},
+              "Distribution of model - measured over all cables and all " + Int(NumSamples(in)) +
+                  " samples [kN]: a calibrated model should centre on 0 with the width of the "
+                  "sensor noise.");
+  // Residual against time, one plot per cable.
+  doc->Figure(std::move(f.residual_svgs),
+              "Model - measured against time, per cable [kN]: a pattern that repeats with "
+              "the pose is model error; what remains after calibration should look like noise." +
+                  t.not_drawn + t.ThinningNote(f.residual_buckets));
   if (in.result) internal::AddDiagnosticPlots(in, doc);
 }
 
@@ -1188,6 +1318,31 @@ std::string RenderHtml(const Document& doc) {
 // Writes `content` to a new temporary file in the directory of `path`, flushes it to
 
 }  // namespace
+
+ReportSampleStream ReportSamplesOf(const StreamedEvaluation& evaluation) {
+  ReportSampleStream out;
+  out.samples = evaluation.samples();
+  out.time_min_s = evaluation.time_min_s();
+  out.time_max_s = evaluation.time_max_s();
+  out.is_trajectory = internal::IsTrajectory(evaluation.samples(), evaluation.median_step_m(),
+                                             evaluation.position_spread_m());
+  out.has_predictions.assign(evaluation.variants().size(), false);
+  for (int k = 0; k < evaluation.predicted_variants(); ++k) out.has_predictions[k] = true;
+  out.replay = [&evaluation](const std::function<void(const ReportSample&)>& visit,
+                             std::string* error) {
+    return evaluation.ForEach(
+        [&visit](const EvaluatedSample& s) {
+          ReportSample r;
+          r.time_s = s.time_s;
+          r.measured_n = s.measured_n;
+          r.predicted_n = s.predicted_n.data();
+          r.gross = s.gross;
+          visit(r);
+        },
+        error);
+  };
+  return out;
+}
 
 std::string ReportMarkdown(const ReportInputs& inputs) {
   try {

@@ -131,7 +131,11 @@ bool IsTrajectory(const Dataset& data) {
     steps.push_back((data.samples[t].pose.position_m - data.samples[t - 1].pose.position_m).norm());
   }
   std::nth_element(steps.begin(), steps.begin() + steps.size() / 2, steps.end());
-  return steps[steps.size() / 2] <= kTrajectoryStepFraction * spread;
+  return IsTrajectory(static_cast<long long>(n), steps[steps.size() / 2], spread);
+}
+
+bool IsTrajectory(long long n, double median_step_m, double spread_m) {
+  return n < 3 || median_step_m <= kTrajectoryStepFraction * spread_m;
 }
 
 double OffAxisDeg(const Eigen::Vector3d& position_m) {
@@ -293,14 +297,19 @@ void AddEvaluationGrossErrors(const ReportInputs& in, Document* doc) {
       "its cable's residuals whitened by the default noise model, 3 % of the reading, at "
       "least that noise) is a gross error, named here and left out of the rows \"... - "
       "gross errors\" of the RMS table. " +
-      Int(static_cast<long long>(e.gross_errors.size())) +
-      (e.gross_errors.size() == 1 ? " reading was" : " readings were") + " flagged. Threshold " +
+      Int(e.count) + (e.count == 1 ? " reading was" : " readings were") + " flagged. Threshold " +
       DescribeGrossErrorThreshold(e.threshold) + ".");
   std::array<int, kNumCables> counts{};
-  for (const ReadingResidual& g : e.gross_errors) ++counts[g.cable - 1];
+  for (int i = 0; i < kNumCables; ++i) counts[i] = static_cast<int>(e.count_per_cable[i]);
   AddPerCableScreen(counts, e.cables, doc);
   if (!e.gross_errors.empty()) {
-    AddReadingsTable(e.gross_errors, "Gross errors (line in the data file)", doc);
+    const bool all = static_cast<long long>(e.gross_errors.size()) == e.count;
+    AddReadingsTable(e.gross_errors,
+                     all ? Text("Gross errors (line in the data file)")
+                         : Text("Gross errors (line in the data file; the first " +
+                                Int(static_cast<long long>(e.gross_errors.size())) + " of " +
+                                Int(e.count) + ")"),
+                     doc);
   }
 }
 
@@ -592,8 +601,7 @@ void WriteEvaluationGrossErrorsJson(const ReportInputs& in, JsonWriter* w) {
   w->Key("variant").String(e.variant);
   w->Key("threshold_sigmas").Number(e.threshold.sigmas);
   JsonGrossErrorThreshold(e.threshold, w);
-  std::vector<double> counts(kNumCables, 0.0), centre, scale;
-  for (const ReadingResidual& g : e.gross_errors) ++counts[g.cable - 1];
+  std::vector<double> counts(e.count_per_cable.begin(), e.count_per_cable.end()), centre, scale;
   for (const RobustScale& c : e.cables) {
     centre.push_back(c.centre);
     scale.push_back(c.scale);

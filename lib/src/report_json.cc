@@ -22,6 +22,7 @@ double RmsAllCables(const std::array<double, kNumCables>& rms) {
 }
 
 int NumSamples(const ReportInputs& in) {
+  if (in.sample_stream != nullptr) return static_cast<int>(in.sample_stream->samples);
   return in.data ? static_cast<int>(in.data->samples.size()) : 0;
 }
 

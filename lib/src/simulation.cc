@@ -163,20 +163,15 @@ std::string Vec(const Eigen::Vector3d& v) {
   return "(" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + ")";
 }
 
-bool CheckInputs(const CableRobot& truth, const std::vector<Pose>& planned,
+bool CheckInputs(const CableRobot& truth, const PoseStream& planned,
                  const SimulationOptions& options, std::string* error) {
   if (!options.IsValid(error)) return false;
   std::string why;
   if (!truth.IsValid(&why)) return Fail(error, "truth model: " + why);
-  if (planned.empty()) return Fail(error, "no planned poses");
-  if (static_cast<size_t>(options.sessions) > planned.size()) {
+  if (planned.count <= 0) return Fail(error, "no planned poses");
+  if (options.sessions > planned.count) {
     return Fail(error, std::to_string(options.sessions) + " sessions for " +
-                           std::to_string(planned.size()) + " poses: at most one per pose");
-  }
-  for (size_t n = 0; n < planned.size(); ++n) {
-    if (!IsFinite(planned[n])) {
-      return Fail(error, "planned pose of node " + std::to_string(n) + " is not finite");
-    }
+                           std::to_string(planned.count) + " poses: at most one per pose");
   }
   return true;
 }
@@ -312,12 +307,12 @@ Eigen::Vector3d StepShiftAt(const SimulationOptions& options, double t) {
 
 // Stages: check the inputs, draw the truth model, then per planned pose the actual pose
 // and its statics, the measured pose and the readings; last the summary.
-bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
-                  const SimulationOptions& options, const SampleSink& sink, CableRobot* truth_used,
-                  SimulationSummary* summary, std::string* error) {
+bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const SimulationOptions& options,
+                  const SampleSink& sink, CableRobot* truth_used, SimulationSummary* summary,
+                  std::string* error) {
   if (!CheckInputs(truth, planned, options, error)) return false;
   SimulationSummary stats;
-  stats.samples = static_cast<int>(planned.size());
+  stats.samples = static_cast<int>(planned.count);
   CableRobot model = truth;
   if (!DrawTruthModel(options, &model, &stats, error)) return false;
   const Eigen::Vector3d mass_centre_m = model.mass_centre_cabin_m;
@@ -330,29 +325,32 @@ bool SimulateImpl(const CableRobot& truth, const std::vector<Pose>& planned,
   statics.warm_start = true;
   StaticsSolution solution;
 
-  for (size_t n = 0; n < planned.size(); ++n) {
+  for (size_t n = 0; n < static_cast<size_t>(planned.count); ++n) {
+    const Pose planned_pose = planned.next();
+    if (!IsFinite(planned_pose)) {
+      return Fail(error, "planned pose of node " + std::to_string(n) + " is not finite");
+    }
     Sample s;
     s.time_s = static_cast<double>(n) * options.sample_interval_s;
     s.has_planned_attitude = true;
-    s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned[n].rotation));
+    s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned_pose.rotation));
     s.planned_rotation =
         RotationFromRpyDeg(s.planned_rpy_deg[0], s.planned_rpy_deg[1], s.planned_rpy_deg[2]);
     Eigen::Vector3d actual_rpy_deg;
-    if (!SolveActual(n, planned[n], s.planned_rpy_deg, options,
+    if (!SolveActual(n, planned_pose, s.planned_rpy_deg, options,
                      mass_centre_m + StepShiftAt(options, s.time_s), statics, &processes, &model,
                      &actual_rpy_deg, &solution, error)) {
       return false;
     }
-    MeasurePose(planned[n].position_m, actual_rpy_deg, options, &processes, &s);
+    MeasurePose(planned_pose.position_m, actual_rpy_deg, options, &processes, &s);
     if (!MeasureTensions(n, model, solution, options, &processes, &stats, &s, error)) return false;
     // Consecutive equal sessions, labelled "1" .. "N" (SimulatedDatasetLayout).
     if (options.sessions > 1) {
-      s.session = static_cast<int>(static_cast<long long>(n) * options.sessions /
-                                   static_cast<long long>(planned.size()));
+      s.session = static_cast<int>(static_cast<long long>(n) * options.sessions / planned.count);
     }
     if (!sink(s, error)) return false;
   }
-  Summarise(processes, static_cast<double>(planned.size()), &stats);
+  Summarise(processes, static_cast<double>(planned.count), &stats);
   model.mass_centre_cabin_m = mass_centre_m;  // the truth written out: the mean
 
   if (truth_used != nullptr) *truth_used = std::move(model);
@@ -420,9 +418,9 @@ Dataset SimulatedDatasetLayout(int sessions) {
   return layout;
 }
 
-bool SimulateStream(const CableRobot& truth, const std::vector<Pose>& planned,
-                    const SimulationOptions& options, const SampleSink& sink,
-                    CableRobot* truth_used, SimulationSummary* summary, std::string* error) {
+bool SimulateStream(const CableRobot& truth, PoseStream planned, const SimulationOptions& options,
+                    const SampleSink& sink, CableRobot* truth_used, SimulationSummary* summary,
+                    std::string* error) {
   std::string message;
   try {
     if (SimulateImpl(truth, planned, options, sink, truth_used, summary, &message)) return true;
@@ -430,6 +428,22 @@ bool SimulateStream(const CableRobot& truth, const std::vector<Pose>& planned,
     message = std::string("simulation failed: ") + e.what();
   }
   return Fail(error, message);
+}
+
+bool SimulateStream(const CableRobot& truth, const std::vector<Pose>& planned,
+                    const SimulationOptions& options, const SampleSink& sink,
+                    CableRobot* truth_used, SimulationSummary* summary, std::string* error) {
+  // Every pose checked before the first sample is handed over, as before streams.
+  for (size_t n = 0; n < planned.size(); ++n) {
+    if (!IsFinite(planned[n]) && options.IsValid(nullptr) && truth.IsValid(nullptr) &&
+        static_cast<size_t>(options.sessions) <= planned.size()) {
+      return Fail(error, "planned pose of node " + std::to_string(n) + " is not finite");
+    }
+  }
+  PoseStream stream;
+  stream.count = static_cast<long long>(planned.size());
+  stream.next = [&planned, n = size_t{0}]() mutable { return planned[n++]; };
+  return SimulateStream(truth, std::move(stream), options, sink, truth_used, summary, error);
 }
 
 bool Simulate(const CableRobot& truth, const std::vector<Pose>& planned,

@@ -594,84 +594,130 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
   return out;
 }
 
-PlotSeries ThinMinMaxPerBucket(const PlotSeries& series, int max_points, int* buckets) {
-  if (buckets != nullptr) *buckets = 0;
+MinMaxBucketThinner::MinMaxBucketThinner(size_t n, bool any_gap, int max_points) : n_(n) {
   max_points = std::max(max_points, 4);
-  const size_t n = std::min(series.x.size(), series.y.size());
-  if (n <= static_cast<size_t>(max_points)) return series;
-  auto finite = [&series](size_t i) {
-    return std::isfinite(series.x[i]) && std::isfinite(series.y[i]);
-  };
-  bool any_gap = false;
-  for (size_t i = 0; i < n && !any_gap; ++i) any_gap = !finite(i);
-  const size_t num_buckets = static_cast<size_t>(max_points) / (any_gap ? 3 : 2);
-  PlotSeries out = series;
-  out.x.clear();
-  out.y.clear();
-  out.x.reserve(static_cast<size_t>(max_points));
-  out.y.reserve(static_cast<size_t>(max_points));
+  thinning_ = n > static_cast<size_t>(max_points);
+  if (!thinning_) return;
+  num_buckets_ = static_cast<size_t>(max_points) / (any_gap ? 3 : 2);
+  // Bucket b holds the indices [n b / B, n (b + 1) / B): lengths differ by at most 1.
+  end_ = n_ / num_buckets_;
+  x_.reserve(static_cast<size_t>(max_points));
+  y_.reserve(static_cast<size_t>(max_points));
+}
+
+void MinMaxBucketThinner::CloseBucket() {
   constexpr size_t kNone = static_cast<size_t>(-1);
-  for (size_t b = 0; b < num_buckets; ++b) {
-    // Bucket b holds the indices [n b / B, n (b + 1) / B): lengths differ by at most 1.
-    const size_t begin = n * b / num_buckets, end = n * (b + 1) / num_buckets;
-    size_t lo = kNone, hi = kNone, gap = kNone;
-    for (size_t i = begin; i < end; ++i) {
-      if (!finite(i)) {
-        if (gap == kNone) gap = i;
-        continue;
-      }
-      if (lo == kNone || series.y[i] < series.y[lo]) lo = i;
-      if (hi == kNone || series.y[i] > series.y[hi]) hi = i;
-    }
-    std::array<size_t, 3> keep = {lo, hi == lo ? kNone : hi, gap};
-    std::sort(keep.begin(), keep.end());  // kNone sorts last.
-    for (size_t i : keep) {
-      if (i == kNone) break;
-      out.x.push_back(series.x[i]);
-      out.y.push_back(series.y[i]);
-    }
+  std::array<Point, 3> keep = {lo_set_ ? lo_ : Point{kNone, 0, 0},
+                               hi_set_ && hi_.index != lo_.index ? hi_ : Point{kNone, 0, 0},
+                               gap_set_ ? gap_ : Point{kNone, 0, 0}};
+  std::sort(keep.begin(), keep.end(),
+            [](const Point& a, const Point& b) { return a.index < b.index; });  // kNone last
+  for (const Point& p : keep) {
+    if (p.index == kNone) break;
+    x_.push_back(p.x);
+    y_.push_back(p.y);
   }
-  if (buckets != nullptr) *buckets = static_cast<int>(num_buckets);
-  return out;
+  lo_set_ = hi_set_ = gap_set_ = false;
+  ++bucket_;
+  end_ = n_ * (bucket_ + 1) / num_buckets_;
+}
+
+void MinMaxBucketThinner::Add(double x, double y) {
+  const size_t i = next_++;
+  if (!thinning_) {
+    x_.push_back(x);
+    y_.push_back(y);
+    return;
+  }
+  while (bucket_ < num_buckets_ && i >= end_) CloseBucket();
+  if (!std::isfinite(x) || !std::isfinite(y)) {
+    if (!gap_set_) gap_ = {i, x, y};
+    gap_set_ = true;
+    return;
+  }
+  if (!lo_set_ || y < lo_.y) lo_ = {i, x, y};
+  if (!hi_set_ || y > hi_.y) hi_ = {i, x, y};
+  lo_set_ = hi_set_ = true;
+}
+
+PlotSeries MinMaxBucketThinner::Finish(PlotSeries style) const {
+  MinMaxBucketThinner copy = *this;
+  while (copy.thinning_ && copy.bucket_ < copy.num_buckets_) copy.CloseBucket();
+  style.x = std::move(copy.x_);
+  style.y = std::move(copy.y_);
+  return style;
+}
+
+PlotSeries ThinMinMaxPerBucket(const PlotSeries& series, int max_points, int* buckets) {
+  const size_t n = std::min(series.x.size(), series.y.size());
+  bool any_gap = false;
+  for (size_t i = 0; i < n && !any_gap; ++i) {
+    any_gap = !std::isfinite(series.x[i]) || !std::isfinite(series.y[i]);
+  }
+  MinMaxBucketThinner thinner(n, any_gap, max_points);
+  for (size_t i = 0; i < n; ++i) thinner.Add(series.x[i], series.y[i]);
+  if (buckets != nullptr) *buckets = thinner.buckets();
+  if (thinner.buckets() == 0) return series;
+  PlotSeries style = series;
+  style.x.clear();
+  style.y.clear();
+  return thinner.Finish(std::move(style));
 }
 
 std::string SvgHistogram(const std::vector<HistogramSeries>& series, int bins,
                          const PlotOptions& options) {
-  bins = std::clamp(bins, 1, 1000);
   constexpr double kInf = std::numeric_limits<double>::infinity();
   double lo = kInf, hi = -kInf;
+  std::vector<std::string> names;
   for (const HistogramSeries& s : series) {
+    names.push_back(s.name);
     for (double v : s.values) {
       if (!std::isfinite(v)) continue;
       lo = std::min(lo, v);
       hi = std::max(hi, v);
     }
   }
-  if (lo > hi) return NoDataSvg(options, "no data");
-  if (hi - lo <= 1e-12 * std::max(std::fabs(lo), std::fabs(hi))) {
-    const double pad = lo == 0.0 ? 0.5 : 0.005 * std::fabs(lo);
-    lo -= pad;
-    hi += pad;
-  }
-  const double bin_width = (hi - lo) / bins;
-
-  std::vector<std::vector<long>> counts(series.size(), std::vector<long>(bins, 0));
-  long max_count = 0;
-  std::vector<LegendItem> legend;
+  HistogramBins h(std::move(names), lo, hi, bins);
   for (size_t si = 0; si < series.size(); ++si) {
-    long n = 0;
-    for (double v : series[si].values) {
-      if (!std::isfinite(v)) continue;
-      const int b = std::clamp(static_cast<int>(std::floor((v - lo) / bin_width)), 0, bins - 1);
-      max_count = std::max(max_count, ++counts[si][b]);
-      ++n;
-    }
-    if (!series[si].name.empty()) {
+    for (double v : series[si].values) h.Add(si, v);
+  }
+  return h.Svg(options);
+}
+
+HistogramBins::HistogramBins(std::vector<std::string> names, double lo, double hi, int bins)
+    : names_(std::move(names)), lo_(lo), hi_(hi), bins_(std::clamp(bins, 1, 1000)) {
+  if (lo_ <= hi_ && hi_ - lo_ <= 1e-12 * std::max(std::fabs(lo_), std::fabs(hi_))) {
+    const double pad = lo_ == 0.0 ? 0.5 : 0.005 * std::fabs(lo_);
+    lo_ -= pad;
+    hi_ += pad;
+  }
+  bin_width_ = (hi_ - lo_) / bins_;
+  counts_.assign(names_.size(), std::vector<long>(bins_, 0));
+  n_.assign(names_.size(), 0);
+}
+
+void HistogramBins::Add(size_t series, double value) {
+  if (!std::isfinite(value) || series >= counts_.size() || !(lo_ <= hi_)) return;
+  const int b = std::clamp(static_cast<int>(std::floor((value - lo_) / bin_width_)), 0, bins_ - 1);
+  ++counts_[series][b];
+  ++n_[series];
+}
+
+std::string HistogramBins::Svg(const PlotOptions& options) const {
+  if (!(lo_ <= hi_)) return NoDataSvg(options, "no data");
+  const double lo = lo_, hi = hi_, bin_width = bin_width_;
+  const int bins = bins_;
+  long max_count = 0;
+  for (const std::vector<long>& c : counts_) {
+    for (long v : c) max_count = std::max(max_count, v);
+  }
+  std::vector<LegendItem> legend;
+  for (size_t si = 0; si < names_.size(); ++si) {
+    if (!names_[si].empty()) {
       legend.push_back(
-          {series[si].name + " (n=" + std::to_string(n) + ")", Colour(si), Swatch::kBox});
+          {names_[si] + " (n=" + std::to_string(n_[si]) + ")", Colour(si), Swatch::kBox});
     }
   }
-
   PlotOptions opts = options;
   if (opts.y_label.empty()) opts.y_label = "count";
   Frame f = StartFrame(opts, std::move(legend), kXTickLabelsPx);
@@ -687,10 +733,10 @@ std::string SvgHistogram(const std::vector<HistogramSeries>& series, int bins,
   OpenSvg(&out, f.size, opts.title);
   DrawYAxis(&out, box, ys, y_ticks, opts);
   DrawXAxis(&out, box, xs, x_axis.ticks, opts, f.size);
-  for (size_t si = 0; si < series.size(); ++si) {
+  for (size_t si = 0; si < counts_.size(); ++si) {
     const char* colour = Colour(si);
     for (int b = 0; b < bins; ++b) {
-      const long c = counts[si][b];
+      const long c = counts_[si][b];
       if (c == 0) continue;
       const double x0 = xs(lo + b * bin_width), x1 = xs(lo + (b + 1) * bin_width);
       const double y = ys(static_cast<double>(c));

@@ -73,6 +73,15 @@ Eigen::Vector3d OnSphere(const Eigen::Vector3d& centre_m, double distance_m, dou
 // Uniform in [0, 1) from the raw 64-bit output: the same on every standard library.
 double Uniform01(std::mt19937_64& rng) { return static_cast<double>(rng() >> 11) * 0x1.0p-53; }
 
+// The rest of a stream, as a vector (the *Positions functions). Always true.
+bool Drain(PositionStream* stream, std::vector<Eigen::Vector3d>* positions) {
+  std::vector<Eigen::Vector3d> out;
+  out.reserve(static_cast<size_t>(stream->count));
+  for (long long k = 0; k < stream->count; ++k) out.push_back(stream->next());
+  *positions = std::move(out);
+  return true;
+}
+
 bool CheckPositions(const std::vector<Eigen::Vector3d>& positions, std::string* error) {
   for (size_t i = 0; i < positions.size(); ++i) {
     if (!positions[i].allFinite()) {
@@ -141,26 +150,30 @@ bool IsSkipped(std::string_view line) {
 
 }  // namespace
 
-bool LinePositions(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, int nodes,
-                   std::vector<Eigen::Vector3d>* positions, std::string* error) {
-  if (positions == nullptr) return Fail(error, "positions must not be null");
+bool LinePositionStream(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, int nodes,
+                        PositionStream* stream, std::string* error) {
+  if (stream == nullptr) return Fail(error, "positions must not be null");
   if (nodes < 2) return Fail(error, "nodes must be >= 2 (got " + std::to_string(nodes) + ")");
   if (nodes > kMaxPositions) return Fail(error, TooMany("nodes", nodes));
   if (!from_m.allFinite()) return Fail(error, "from_m must be finite");
   if (!to_m.allFinite()) return Fail(error, "to_m must be finite");
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(nodes);
-  for (int k = 0; k < nodes; ++k) {
-    const double t = static_cast<double>(k) / (nodes - 1);  // t = 1 exactly at the end
-    out.push_back((1.0 - t) * from_m + t * to_m);
-  }
-  *positions = std::move(out);
+  stream->count = nodes;
+  stream->next = [from_m, to_m, nodes, k = 0]() mutable {
+    const double t = static_cast<double>(k++) / (nodes - 1);  // t = 1 exactly at the end
+    return Eigen::Vector3d((1.0 - t) * from_m + t * to_m);
+  };
   return true;
 }
 
-bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions,
-                  std::string* error) {
+bool LinePositions(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, int nodes,
+                   std::vector<Eigen::Vector3d>* positions, std::string* error) {
   if (positions == nullptr) return Fail(error, "positions must not be null");
+  PositionStream stream;
+  return LinePositionStream(from_m, to_m, nodes, &stream, error) && Drain(&stream, positions);
+}
+
+bool ArcPositionStream(const ArcSpec& spec, PositionStream* stream, std::string* error) {
+  if (stream == nullptr) return Fail(error, "positions must not be null");
   if (!spec.centre_m.allFinite()) return Fail(error, "centre_m must be finite");
   if (!IsPositiveFinite(spec.radius_m)) {
     return Fail(error, "radius_m must be > 0 and finite (got " + Num(spec.radius_m) + ")");
@@ -180,15 +193,21 @@ bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions,
   }
   // A full turn divides into `nodes` steps so the end node (= start) is left out.
   const int steps = full_turn ? spec.nodes : spec.nodes - 1;
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(spec.nodes);
-  for (int k = 0; k < spec.nodes; ++k) {
-    const double angle_rad = (spec.start_deg + span_deg * k / steps) * kDegToRad;
-    out.push_back(spec.centre_m +
-                  spec.radius_m * Eigen::Vector3d(std::cos(angle_rad), std::sin(angle_rad), 0.0));
-  }
-  *positions = std::move(out);
+  stream->count = spec.nodes;
+  stream->next = [spec, span_deg, steps, k = 0]() mutable {
+    const double angle_rad = (spec.start_deg + span_deg * k++ / steps) * kDegToRad;
+    return Eigen::Vector3d(spec.centre_m + spec.radius_m * Eigen::Vector3d(std::cos(angle_rad),
+                                                                           std::sin(angle_rad),
+                                                                           0.0));
+  };
   return true;
+}
+
+bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions,
+                  std::string* error) {
+  if (positions == nullptr) return Fail(error, "positions must not be null");
+  PositionStream stream;
+  return ArcPositionStream(spec, &stream, error) && Drain(&stream, positions);
 }
 
 bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d>* positions,
@@ -232,9 +251,9 @@ bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d
   return true;
 }
 
-bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
-                              std::vector<Eigen::Vector3d>* positions, std::string* error) {
-  if (positions == nullptr) return Fail(error, "positions must not be null");
+bool RandomWorkspacePositionStream(const RandomWorkspaceSpec& spec, PositionStream* stream,
+                                   std::string* error) {
+  if (stream == nullptr) return Fail(error, "positions must not be null");
   if (spec.samples > kMaxPositions) return Fail(error, TooMany("samples", spec.samples));
   if (spec.samples < 1) {
     return Fail(error, "samples must be >= 1 (got " + std::to_string(spec.samples) + ")");
@@ -246,21 +265,25 @@ bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
     return Fail(error, "radial_spread_m must be in [0, sphere.focal_radius_m) (got " +
                            Num(spec.radial_spread_m) + ")");
   }
-  std::mt19937_64 rng(spec.seed);
   const double cos_max = std::cos(spec.max_off_axis_deg * kDegToRad);
-  std::vector<Eigen::Vector3d> out;
-  out.reserve(spec.samples);
-  for (int i = 0; i < spec.samples; ++i) {
+  stream->count = spec.samples;
+  stream->next = [spec, cos_max, rng = std::mt19937_64(spec.seed)]() mutable {
     // Uniform cos(theta) and azimuth give a uniform density over the cap's area.
     const double cos_theta = 1.0 - Uniform01(rng) * (1.0 - cos_max);
     const double phi_rad = 2.0 * M_PI * Uniform01(rng);
     const double offset_m = spec.radial_spread_m * (2.0 * Uniform01(rng) - 1.0);
     const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
-    out.push_back(OnSphere(spec.sphere.focal_centre_m, spec.sphere.focal_radius_m + offset_m,
-                           cos_theta, sin_theta, phi_rad));
-  }
-  *positions = std::move(out);
+    return OnSphere(spec.sphere.focal_centre_m, spec.sphere.focal_radius_m + offset_m, cos_theta,
+                    sin_theta, phi_rad);
+  };
   return true;
+}
+
+bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
+                              std::vector<Eigen::Vector3d>* positions, std::string* error) {
+  if (positions == nullptr) return Fail(error, "positions must not be null");
+  PositionStream stream;
+  return RandomWorkspacePositionStream(spec, &stream, error) && Drain(&stream, positions);
 }
 
 bool RandomPosesAroundFocalLaw(const RandomPoseSpec& spec, std::vector<Pose>* poses,

@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -108,6 +109,35 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
 // becomes Dataset::path.
 bool ParseDataset(const std::string& text, const std::string& source_name,
                   const DatasetReadOptions& options, Dataset* dataset, std::string* error);
+
+// Reads a dataset file a chunk of rows at a time, for files too long to hold (fastcal
+// evaluate at 10^6 samples): memory bounded by the chunk, not the file. Every row is
+// checked as ReadDataset checks it, with the same messages (file, line, column), and
+// the same options (skip_invalid_rows, max_file_bytes, limits); the checks of the
+// whole file (no header, no data rows, every row skipped, angles that look like radians)
+// are made after the last row, by the Next that sets *done. Concatenating the chunks'
+// samples and skipped rows gives ReadDataset's.
+class DatasetChunkReader {
+ public:
+  DatasetChunkReader();
+  DatasetChunkReader(const DatasetChunkReader&) = delete;
+  DatasetChunkReader& operator=(const DatasetChunkReader&) = delete;
+  ~DatasetChunkReader();
+
+  // Opens `path`, refusing what ReadDataset refuses before reading (a directory, device,
+  // pipe, a file larger than options.max_file_bytes).
+  bool Open(const std::string& path, const DatasetReadOptions& options, std::string* error);
+  // Replaces chunk->samples and chunk->skipped by the next at most `max_samples` (>= 1)
+  // valid samples and the rows skipped before the last of them, and sets chunk's path,
+  // column flags and session labels (those met so far; sample.session indexes them).
+  // *done: the file is finished and passed the whole-file checks (the chunk may still
+  // hold samples). False, with the message ReadDataset would give, on an error.
+  bool Next(size_t max_samples, Dataset* chunk, bool* done, std::string* error);
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
 
 // Writes `dataset` in the format ReadDataset reads: `header_comment` (may be empty, may
 // have several lines) as leading '# ' lines, then the columns

@@ -41,6 +41,24 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
                      StaticsMethod method, std::vector<std::array<double, kNumCables>>* predicted,
                      std::string* error);
 
+// PredictTensions a sample at a time, each solve warm started from the one before, so
+// that a dataset read in chunks is predicted as the whole one is: the same numbers, bit
+// for bit. `robot` must outlive the predictor.
+class TensionPredictor {
+ public:
+  TensionPredictor(const CableRobot& robot, AttitudeSource attitude, StaticsMethod method);
+  // The predicted readings of `sample` (of `data`, named in the message: "<file>:<line>:
+  // the model cannot solve this pose: <why>"). False when the model cannot hold the pose.
+  bool Predict(const Dataset& data, const Sample& sample,
+               std::array<double, kNumCables>* predicted_n, std::string* error);
+
+ private:
+  const CableRobot& robot_;
+  AttitudeSource attitude_;
+  StaticsOptions options_;
+  StaticsSolution solution_;
+};
+
 // Removes from data->samples every sample whose pose `robot` cannot solve (SolveStatics
 // not ok) with one of `methods` at one of `attitudes` (kPlanned only when the data has a
 // planned attitude), and appends one message per removed sample to data->skipped, after
@@ -63,6 +81,22 @@ CableErrorStats ErrorStats(const Dataset& data,
                            const std::vector<bool>& held_out, bool select_held_out,
                            const ReadingMask& excluded = {});
 
+// ErrorStats gathered a sample at a time, in sample order (a dataset read in chunks):
+// the same sums in the same order, so the same statistics bit for bit. `excluded` (may
+// be null): the readings of the sample to leave out.
+class ErrorStatsAccumulator {
+ public:
+  void Add(const std::array<double, kNumCables>& predicted_n,
+           const std::array<double, kNumCables>& measured_n,
+           const std::array<bool, kNumCables>* excluded = nullptr);
+  CableErrorStats Finish() const;
+
+ private:
+  CableErrorStats st_;
+  std::array<double, kNumCables> sum_{}, sum2_{}, sum2_pct_{};
+  std::array<int, kNumCables> percent_readings_{};
+};
+
 // One row group of the RMS table: a model, an attitude source, and its statistics on the
 // fitted and the held-out samples.
 struct VariantEvaluation {
@@ -75,6 +109,10 @@ bool EvaluateVariant(const std::string& name, const CableRobot& robot, const Dat
                      AttitudeSource attitude, StaticsMethod method,
                      const std::vector<bool>& held_out, VariantEvaluation* evaluation,
                      std::string* error, const ReadingMask& excluded = {});
+
+// The name of the row of `fastcal evaluate`'s table for an attitude source: "model,
+// planned attitude" or "model, measured attitude".
+std::string EvaluationVariantName(AttitudeSource attitude);
 
 // The table of `fastcal evaluate`: `robot` against every sample at each attitude the data
 // has, "model, planned attitude" (when it has one) then "model, measured attitude", with

@@ -25,7 +25,11 @@ struct EvaluationScreen {
   GrossErrorThreshold threshold;
   std::array<RobustScale, kNumCables> cables{};  // per cable centre and scale [sigma]
   ReadingMask excluded;                          // per sample: the gross errors
-  std::vector<ReadingResidual> gross_errors;     // in file order
+  std::vector<ReadingResidual> gross_errors;     // in file order (streamed: the first ones)
+  // How many readings were flagged, in all and per cable (gross_errors may list fewer:
+  // StreamedEvaluation names at most EvaluationStreamOptions::max_named_gross_errors).
+  long long count = 0;
+  std::array<long long, kNumCables> count_per_cable{};
 };
 
 // Screens the readings of `data` against `variant`'s predictions (predicted_n filled),

@@ -31,6 +31,8 @@
 #ifndef FASTCAL_REPORT_H_
 #define FASTCAL_REPORT_H_
 
+#include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -40,8 +42,34 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
+#include "fastcal/evaluation_stream.h"
 
 namespace fastcal {
+
+// A sample as the report's plots see it.
+struct ReportSample {
+  double time_s = 0.0;
+  std::array<double, kNumCables> measured_n{};
+  // predicted_n[k]: the predicted readings of ReportInputs::variants[k], for each k with
+  // ReportSampleStream::has_predictions[k].
+  const std::array<double, kNumCables>* predicted_n = nullptr;
+  std::array<bool, kNumCables> gross{};  // gross errors: not drawn
+  bool held_out = false;
+};
+
+// The samples of an evaluation too long to hold (fastcal evaluate streams its file:
+// evaluation_stream.h), replayed in order as often as the plots need (twice: the first
+// replay finds the series' lengths and ranges, the second thins them), so that the
+// report's memory is independent of their number. Everything drawn is what the samples
+// held in ReportInputs::data with the variants' predicted_n would draw.
+struct ReportSampleStream {
+  long long samples = 0;
+  double time_min_s = 0.0, time_max_s = 0.0;
+  bool is_trajectory = true;          // internal::IsTrajectory of the samples
+  std::vector<bool> has_predictions;  // per variant of ReportInputs::variants
+  std::function<bool(const std::function<void(const ReportSample&)>& visit, std::string* error)>
+      replay;
+};
 
 struct ReportInputs {
   // The input files as given on the command line; an empty model path means the built-in
@@ -76,7 +104,15 @@ struct ReportInputs {
   // For an evaluation-only report: the gross-error screen of the readings (not owned;
   // null: not screened).
   const EvaluationScreen* evaluation_screen = nullptr;
+  // For an evaluation-only report of a file too long to hold: its samples (not owned).
+  // `data` then holds the path, column flags and skipped rows only, and the variants'
+  // predicted_n are empty. Null: data->samples are the samples.
+  const ReportSampleStream* sample_stream = nullptr;
 };
+
+// The samples of a streamed evaluation for its report: replayed from its temporary file
+// (`evaluation` must outlive the stream's use).
+ReportSampleStream ReportSamplesOf(const StreamedEvaluation& evaluation);
 
 // The report as Markdown, HTML and JSON. Each is deterministic (its only date is
 // run_utc). They return

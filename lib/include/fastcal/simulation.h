@@ -169,6 +169,20 @@ bool SimulateStream(const CableRobot& truth, const std::vector<Pose>& planned,
                     const SimulationOptions& options, const SampleSink& sink,
                     CableRobot* truth_used, SimulationSummary* summary, std::string* error);
 
+// Planned poses handed out one at a time: `next` gives pose n on its n-th call,
+// n = 0 .. count - 1 (e.g. a PositionStream of trajectory.h with an attitude law).
+struct PoseStream {
+  long long count = 0;
+  std::function<Pose()> next;
+};
+// The same simulation drawing the planned poses from `planned` as it goes (a copy of it:
+// the caller's stream is not advanced), so that neither the poses nor the samples are
+// held: fastcal simulate's memory is then independent of the number of samples. A
+// non-finite pose is found when it is drawn (the samples before it already handed over).
+bool SimulateStream(const CableRobot& truth, PoseStream planned, const SimulationOptions& options,
+                    const SampleSink& sink, CableRobot* truth_used, SimulationSummary* summary,
+                    std::string* error);
+
 // The column groups of a simulated dataset (planned attitude, unstretched lengths,
 // roll/pitch/yaw) and, for more than one session, the session labels "1" .. "N"
 // (SimulationOptions::sessions), with no samples: the layout a DatasetWriter of

@@ -62,6 +62,29 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
 // *buckets (if not null) is set to the number of buckets, 0 if nothing was thinned.
 PlotSeries ThinMinMaxPerBucket(const PlotSeries& series, int max_points, int* buckets = nullptr);
 
+// ThinMinMaxPerBucket fed a point at a time, for a series too long to hold: given its
+// length n and whether any of its points is non-finite (both known from a first pass),
+// Add each point in order, then Finish gives exactly ThinMinMaxPerBucket's result (the
+// style of `style`, the points thinned). Memory: at most max_points points.
+class MinMaxBucketThinner {
+ public:
+  MinMaxBucketThinner(size_t n, bool any_gap, int max_points);
+  void Add(double x, double y);
+  PlotSeries Finish(PlotSeries style) const;
+  int buckets() const { return thinning_ ? static_cast<int>(num_buckets_) : 0; }
+
+ private:
+  void CloseBucket();
+  struct Point {
+    size_t index;
+    double x, y;
+  };
+  size_t n_, num_buckets_ = 0, bucket_ = 0, next_ = 0, end_ = 0;
+  bool thinning_ = false, lo_set_ = false, hi_set_ = false, gap_set_ = false;
+  Point lo_{}, hi_{}, gap_{};
+  std::vector<double> x_, y_;
+};
+
 struct HistogramSeries {
   std::string name;
   std::vector<double> values;  // Non-finite values are ignored.
@@ -73,6 +96,25 @@ struct HistogramSeries {
 // defaults to "count".
 std::string SvgHistogram(const std::vector<HistogramSeries>& series, int bins,
                          const PlotOptions& options);
+
+// SvgHistogram's bins, filled a value at a time (values too many to hold): bin edges
+// from the finite extremes lo and hi of all series (a first pass), widened as
+// SvgHistogram widens them when they are equal; Add a finite value of series s; Svg draws
+// exactly what SvgHistogram draws for the same values. Series are named as in
+// HistogramSeries (empty: no legend entry).
+class HistogramBins {
+ public:
+  HistogramBins(std::vector<std::string> names, double lo, double hi, int bins);
+  void Add(size_t series, double value);
+  std::string Svg(const PlotOptions& options) const;
+
+ private:
+  std::vector<std::string> names_;
+  double lo_, hi_, bin_width_;
+  int bins_;
+  std::vector<std::vector<long>> counts_;
+  std::vector<long> n_;
+};
 
 // One group per category (e.g. cable 1..6), one bar per series.
 struct BarGroup {

@@ -19,6 +19,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -51,6 +52,23 @@ struct ArcSpec {
 // node at the end: the `nodes` points are distinct, spaced 360/nodes deg apart.
 // Multiple turns are rejected (they would repeat points).
 bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions, std::string* error);
+
+// Positions handed out one at a time, in order, for runs too long to hold (fastcal
+// simulate at 10^6 samples: memory independent of their number). `next` gives position
+// k on its k-th call, k = 0 .. count - 1, bit for bit the element k of the vector the
+// matching *Positions function returns. A copy of the stream starts where the original
+// stands (its generator state is copied), so a copy can be drained to check the
+// positions before the original is used.
+struct PositionStream {
+  long long count = 0;
+  std::function<Eigen::Vector3d()> next;
+};
+
+// Streams of LinePositions, ArcPositions and RandomWorkspacePositions: the same checks and
+// messages, the same positions.
+bool LinePositionStream(const Eigen::Vector3d& from_m, const Eigen::Vector3d& to_m, int nodes,
+                        PositionStream* stream, std::string* error);
+bool ArcPositionStream(const ArcSpec& spec, PositionStream* stream, std::string* error);
 
 // Regular grid on the lower cap of the focal sphere.
 struct FocalGridSpec {
@@ -96,6 +114,9 @@ struct RandomWorkspaceSpec {
 // changes only the offsets, not the directions). Returns `samples` positions.
 bool RandomWorkspacePositions(const RandomWorkspaceSpec& spec,
                               std::vector<Eigen::Vector3d>* positions, std::string* error);
+
+bool RandomWorkspacePositionStream(const RandomWorkspaceSpec& spec, PositionStream* stream,
+                                   std::string* error);
 
 // Poses at `positions` with the attitude of the focal attitude law (FocalAttitude, pose.h).
 // Positions must be finite and strictly below the focal centre (the law is defined for

@@ -21,6 +21,29 @@ bool WriteFileAtomically(const std::string& path, const std::string& content, st
 bool ReadRegularFile(const std::string& path, long long max_bytes, const std::string& what,
                      std::string* text, std::string* error);
 
+// ReadRegularFile piece by piece, for a file read in chunks (DatasetChunkReader): Open
+// makes its checks before reading; Read appends up to `max` further bytes to *text, sets
+// *end at the end of the file, and refuses a file that grows past max_bytes; the same
+// messages. The file is closed at the end, on failure and by the destructor.
+class RegularFileReader {
+ public:
+  RegularFileReader() = default;
+  RegularFileReader(const RegularFileReader&) = delete;
+  RegularFileReader& operator=(const RegularFileReader&) = delete;
+  ~RegularFileReader();
+  bool Open(const std::string& path, long long max_bytes, const std::string& what,
+            std::string* error);
+  bool Read(size_t max, std::string* text, bool* end, std::string* error);
+  // The file's size when opened (bytes).
+  long long size() const { return size_; }
+
+ private:
+  bool Fail(const std::string& why, std::string* error);
+  int fd_ = -1;
+  std::string name_, too_large_;
+  long long max_bytes_ = 0, read_bytes_ = 0, size_ = 0;
+};
+
 // Reads a whole file in chunks handed to `sink` in order, for files too large to hold (a
 // digest); the same messages (error may not be null).
 bool ReadFileChunks(const std::string& path, const std::function<void(const char*, size_t)>& sink,

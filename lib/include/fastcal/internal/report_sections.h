@@ -20,6 +20,8 @@ namespace fastcal::internal {
 // consecutive positions below kTrajectoryStepFraction of the positions' RMS spread.
 inline constexpr double kTrajectoryStepFraction = 0.2;
 bool IsTrajectory(const Dataset& data);
+// The same test from its numbers: n samples, the median step and the RMS spread.
+bool IsTrajectory(long long n, double median_step_m, double spread_m);
 
 // Every k-th point of a series with more than `max_points` (k the smallest that leaves
 // at most max_points; *stride receives k, 1 if nothing was thinned). For data that are not
