@@ -516,6 +516,12 @@ TEST_F(DatasetTest, SkipInvalidRowsNeverSkipsHeaderErrorsOrEverything) {
   EXPECT_TRUE(Contains(error, "data.csv:2: column 'time_s'"));
 }
 
+std::string Repeated(const std::string& text, int times) {
+  std::string out;
+  for (int k = 0; k < times; ++k) out += text;
+  return out;
+}
+
 // Reads `path` with DatasetChunkReader, `chunk` samples at a time, into one dataset (the
 // chunks concatenated); the error message on failure, "" on success.
 std::string ReadInChunks(const std::string& path, const DatasetReadOptions& options, size_t chunk,
@@ -538,9 +544,11 @@ std::string ReadInChunks(const std::string& path, const DatasetReadOptions& opti
   return "";
 }
 
-// fastcal evaluate reads its data in chunks (issue 20): the chunked reader gives
-// ReadDataset's samples, skipped rows and messages, whatever the chunk size, on good
-// files, bad rows (skipped or not), bad headers and whole-file problems.
+// fastcal evaluate reads its data in chunks, and ReadDataset reads through the chunked
+// reader with rows parsed on several threads (issue 20): both give the samples, skipped
+// rows and messages of the whole text read line by line (ParseDataset), whatever the
+// chunk size and the number of threads, on good files, bad rows (skipped or not), bad
+// headers and whole-file problems.
 TEST_F(DatasetTest, ChunkedReaderGivesTheSamplesAndMessagesOfReadDataset) {
   const std::string rows = std::string("# c\n") + kHeader + kRow + kRow + kRow;
   const auto to_radians = [](int row, std::vector<std::string>* f) {
@@ -564,23 +572,33 @@ TEST_F(DatasetTest, ChunkedReaderGivesTheSamplesAndMessagesOfReadDataset) {
       "2,1,2,140,0,0,0,1,2,3,4,5,6,B\n",
       CircleWith(to_radians),
       CircleWith([](int, std::vector<std::string>*) {}),
+      // Long enough for several parse chunks per thread, a bad row deep inside.
+      std::string(kHeader) + Repeated(kRow, 1500) + "1,1,2,140,0,0,0,150,151,244,5,153,154,155\n" +
+          Repeated(kRow, 1500),
   };
   int failures = 0;
   for (size_t k = 0; k < texts.size(); ++k) {
     const std::string path = PathOf("data" + std::to_string(k) + ".csv");
     WriteText("data" + std::to_string(k) + ".csv", texts[k]);
-    for (bool skip : {false, true}) {
+    for (int variant = 0; variant < 4; ++variant) {
+      const bool skip = variant % 2 == 1;
       DatasetReadOptions options;
       options.skip_invalid_rows = skip;
+      options.threads = variant < 2 ? 1 : 3;
       Dataset expected;
       std::string expected_error;
-      const bool ok = ReadDataset(path, options, &expected, &expected_error);
+      const bool ok = ParseDataset(texts[k], path, options, &expected, &expected_error);
       failures += !ok;
-      for (size_t chunk : {1, 2, 7, 100000}) {
-        SCOPED_TRACE("text " + std::to_string(k) + (skip ? " skip" : "") + " chunk " +
-                     std::to_string(chunk));
+      for (size_t chunk : {size_t{1}, size_t{2}, size_t{7}, size_t{100000}, size_t{0}}) {
+        SCOPED_TRACE("text " + std::to_string(k) + (skip ? " skip" : "") + " threads " +
+                     std::to_string(options.threads) + " chunk " + std::to_string(chunk));
         Dataset got;
-        const std::string error = ReadInChunks(path, options, chunk, &got);
+        std::string error;
+        if (chunk > 0) {
+          error = ReadInChunks(path, options, chunk, &got);
+        } else if (!ReadDataset(path, options, &got, &error)) {  // 0: the whole file
+          EXPECT_FALSE(error.empty());
+        }
         EXPECT_EQ(error, ok ? "" : expected_error);
         if (!ok || !error.empty()) continue;
         EXPECT_EQ(got.path, expected.path);
@@ -596,7 +614,7 @@ TEST_F(DatasetTest, ChunkedReaderGivesTheSamplesAndMessagesOfReadDataset) {
       }
     }
   }
-  EXPECT_GE(failures, 10);  // the bad files above fail (without skip, and some with it)
+  EXPECT_GE(failures, 20);  // the bad files above fail (without skip, and some with it)
   // Refused before reading, as ReadDataset refuses: a directory, a file above the limit.
   Dataset unused;
   std::string expected_error;

@@ -26,6 +26,7 @@
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/plausibility.h"
 #include "fastcal/pose.h"
 
@@ -554,19 +555,60 @@ class LineParser {
     FieldValues values{};
     if (ParseRow(line, header_, options_.limits, have_previous_ ? &previous_ : nullptr, &sample,
                  &values, &reason)) {
-      if (header_.session_field >= 0) {
-        sample.session = SessionIndex(SplitFields(line)[header_.session_field], &layout_);
-      }
-      radians_.Add(sample, header_.planned);
-      out->samples.push_back(std::move(sample));
-      previous_ = values;
-      have_previous_ = true;
+      Take(line, &sample, values, out);
     } else if (options_.skip_invalid_rows) {
       if (first_skipped_.empty()) first_skipped_ = where() + reason;
       out->skipped.push_back(where() + reason);
     } else {
       *error = where() + reason;
       return false;
+    }
+    return true;
+  }
+
+  // Lines (numbered, without '\n') as Line takes them one by one, the same samples,
+  // skipped rows and messages: once the header is known, the rows are parsed on
+  // options.threads threads (a row's parse depends on no other valid row), then taken in
+  // order; a row that fails is parsed again by Line, for its message (which may name the
+  // previous row).
+  bool Lines(const std::vector<std::pair<int, std::string_view>>& lines, Dataset* out,
+             std::string* error) {
+    size_t next = 0;
+    for (; next < lines.size() && !have_header_; ++next) {
+      if (!Line(lines[next].first, lines[next].second, out, error)) return false;
+    }
+    struct Parsed {
+      bool row = false, ok = false;
+      Sample sample;
+      FieldValues values{};
+    };
+    const int count = static_cast<int>(lines.size() - next);
+    std::vector<Parsed> parsed(count);
+    internal::ForEachChunk(
+        count, options_.threads,
+        [&](int begin, int end) {
+          std::string reason;
+          for (int k = begin; k < end; ++k) {
+            const auto& [number, line] = lines[next + k];
+            Parsed& p = parsed[k];
+            p.row = !IsCommentOrBlank(line);
+            p.sample.line = number;
+            p.ok = p.row &&
+                   ParseRow(line, header_, options_.limits, nullptr, &p.sample, &p.values, &reason);
+          }
+          return -1;
+        },
+        kParseChunkRows);
+    for (int k = 0; k < count; ++k) {
+      Parsed& p = parsed[k];
+      const auto& [number, line] = lines[next + k];
+      if (!p.row) continue;
+      if (!p.ok) {
+        if (!Line(number, line, out, error)) return false;
+        continue;
+      }
+      ++rows_;
+      Take(line, &p.sample, p.values, out);
     }
     return true;
   }
@@ -600,6 +642,20 @@ class LineParser {
   const Dataset& layout() const { return layout_; }
 
  private:
+  // Rows a thread parses at a time in Lines.
+  static constexpr int kParseChunkRows = 512;
+
+  // A valid row: its session, the radians check, the sample kept.
+  void Take(std::string_view line, Sample* sample, const FieldValues& values, Dataset* out) {
+    if (header_.session_field >= 0) {
+      sample->session = SessionIndex(SplitFields(line)[header_.session_field], &layout_);
+    }
+    radians_.Add(*sample, header_.planned);
+    out->samples.push_back(std::move(*sample));
+    previous_ = values;
+    have_previous_ = true;
+  }
+
   DatasetReadOptions options_;
   Dataset layout_;
   Header header_;
@@ -870,26 +926,34 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
   chunk->skipped.clear();
   try {
     State& st = *state_;
-    while (ok && !st.done && chunk->samples.size() < std::max<size_t>(max_samples, 1)) {
-      const size_t newline = st.text.find('\n', st.start);
-      if (newline == std::string::npos && !st.end) {
+    const size_t wanted = std::max<size_t>(max_samples, 1);
+    std::vector<std::pair<int, std::string_view>> lines;
+    while (ok && !st.done && chunk->samples.size() < wanted) {
+      // The complete lines read so far (each gives at most one sample), parsed together.
+      lines.clear();
+      while (chunk->samples.size() + lines.size() < wanted) {
+        const size_t newline = st.text.find('\n', st.start);
+        if (newline == std::string::npos && (!st.end || st.start == st.text.size())) break;
+        std::string_view line(st.text);
+        line = line.substr(st.start,
+                           newline == std::string::npos ? std::string::npos : newline - st.start);
+        st.start = newline == std::string::npos ? st.text.size() : newline + 1;
+        if (st.first && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
+        st.first = false;
+        lines.emplace_back(++st.line_number, line);
+      }
+      if (!lines.empty()) {
+        ok = st.parser.Lines(lines, chunk, &message);
+        continue;
+      }
+      if (!st.end) {
         st.text.erase(0, st.start);  // keep the unfinished line only
         st.start = 0;
         ok = st.file.Read(kReadBytes, &st.text, &st.end, &message);
         continue;
       }
-      if (newline == std::string::npos && st.start == st.text.size()) {
-        ok = st.parser.Finish(&message);
-        st.done = ok;
-        continue;
-      }
-      std::string_view line(st.text);
-      line = line.substr(st.start,
-                         newline == std::string::npos ? std::string::npos : newline - st.start);
-      st.start = newline == std::string::npos ? st.text.size() : newline + 1;
-      if (st.first && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
-      st.first = false;
-      ok = st.parser.Line(++st.line_number, line, chunk, &message);
+      ok = st.parser.Finish(&message);
+      st.done = ok;
     }
     TakeLayout(st.parser.layout(), chunk);
     *done = st.done;

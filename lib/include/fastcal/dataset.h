@@ -93,6 +93,10 @@ struct DatasetReadOptions {
   // and column, or skipped rows under skip_invalid_rows. A reading of 0 kN (a dropout) is
   // accepted: the calibration flags it as a gross error.
   PlausibilityLimits limits;
+  // Threads that parse rows (ReadDataset, DatasetChunkReader): rows are parsed in batches
+  // in parallel and taken in file order, so the samples, skipped rows and messages are
+  // the same on any number. >= 1; default 1.
+  int threads = 1;
 };
 
 // "<file>:<line>" of a sample, for messages: the file of its session when the dataset was
