@@ -117,7 +117,9 @@ CalibrationSpec Spec(StaticsMethod forward) {
 int ReadCalibrateReport(const std::string& csv, const std::string& dir) {
   Dataset data;
   std::string error;
-  if (!ReadDataset(csv, DatasetReadOptions(), &data, &error)) return 1;
+  DatasetReadOptions read;
+  read.threads = 2;  // as fastcal calibrate reads
+  if (!ReadDataset(csv, read, &data, &error)) return 1;
   const CableRobot model = CableRobot::NominalFast();
   const CalibrationSpec spec = Spec(StaticsMethod::kExact);
   CalibrationResult result;
