@@ -91,7 +91,8 @@ Usage:
                       listed with its line on stderr, in the report and in summary.json
   --quiet             no per-iteration solver progress
   --timings           after the run, the wall time of reading, of each stage of the
-                      fit and of writing (stderr)
+                      fit (with the cores it kept busy and the peak memory) and of
+                      writing (stderr)
 
 Before solving, the free set is checked: if the data (and priors) cannot determine it --
 e.g. cabin mass together with a common sensor gain, or tower offsets from one circle --
@@ -788,28 +789,26 @@ class Stopwatch {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
-// --timings: read, the fit's stages, write (stderr), with the peak resident memory at
-// the end of each.
+// --timings: read, the fit's stages (with the cores they kept busy), write (stderr), with
+// the peak resident memory at the end of each stage.
 std::string TimingLines(double read_s, double fit_s, double write_s,
                         const std::vector<CalibrationResult::Stage>& stages) {
   std::ostringstream s;
-  char buf[120];
-  const auto line = [&](const std::string& name, double seconds, double peak_mb) {
-    std::snprintf(buf, sizeof(buf), "  %-24s %8.3f s", name.c_str(), seconds);
+  char buf[160];
+  s << "timings (wall; cores busy: CPU time / wall; peak resident memory so far):\n";
+  const auto line = [&](const std::string& name, double seconds) {
+    std::snprintf(buf, sizeof(buf), "  %-24s %8.3f s\n", name.c_str(), seconds);
     s << buf;
-    if (peak_mb > 0.0) {
-      std::snprintf(buf, sizeof(buf), "  %8.0f MB", peak_mb);
-      s << buf;
-    }
-    s << "\n";
   };
-  s << "timings (wall; peak resident memory so far):\n";
-  line("read inputs", read_s, 0.0);
-  line("fit", fit_s, 0.0);
+  line("read inputs", read_s);
+  line("fit", fit_s);
   for (const CalibrationResult::Stage& stage : stages) {
-    line("  " + stage.name, stage.seconds, stage.peak_resident_mb);
+    std::snprintf(buf, sizeof(buf), "    %-22s %8.3f s  %4.1f  %6.0f MB\n", stage.name.c_str(),
+                  stage.seconds, stage.seconds > 0.0 ? stage.cpu_seconds / stage.seconds : 0.0,
+                  stage.peak_resident_mb);
+    s << buf;
   }
-  line("write outputs", write_s, 0.0);
+  line("write outputs", write_s);
   return s.str();
 }
 

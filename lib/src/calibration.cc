@@ -45,11 +45,16 @@ constexpr double kFirstPassFunctionTolerance = 1e-4;
 // Chance that noise alone makes some candidate of the misfit ranking "significant".
 constexpr double kMisfitFamilyError = 0.01;
 
-// The process's peak resident memory so far (MB), 0 where getrusage does not say.
-double PeakResidentMb() {
+// The process's CPU time so far (s, user and system, all threads) and peak resident
+// memory (MB); 0 where getrusage does not say.
+struct Usage {
+  double cpu_s = 0.0, peak_mb = 0.0;
+};
+Usage ProcessUsage() {
   rusage usage;
-  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0.0;
-  return usage.ru_maxrss / 1024.0;  // kB on Linux
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return {};
+  const auto seconds = [](const timeval& t) { return t.tv_sec + 1e-6 * t.tv_usec; };
+  return {seconds(usage.ru_utime) + seconds(usage.ru_stime), usage.ru_maxrss / 1024.0};
 }
 
 // x with P(chi-square(1 dof) > x) = tail: the square of the two-sided normal quantile.
@@ -1444,10 +1449,12 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
                                {"evaluate", Evaluate}};
   for (const NamedStage& s : stages) {
     const auto start = std::chrono::steady_clock::now();
+    const Usage before = ProcessUsage();
     const CalibrationStatus status = s.stage(run);
+    const Usage after = ProcessUsage();
     result->stages.push_back(
         {s.name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-         PeakResidentMb()});
+         after.cpu_s - before.cpu_s, after.peak_mb});
     if (status != CalibrationStatus::kOk) return status;
   }
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

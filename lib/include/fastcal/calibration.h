@@ -290,12 +290,14 @@ struct CalibrationResult {
   double forward_model_max_rel_error = 0.0;
   double forward_model_rms_rel_error = 0.0;
   double seconds = 0.0;
-  // Each stage of the pipeline, in order: its wall time and the process's peak resident
-  // memory at its end (getrusage; 0 where unavailable): where a long dataset's time and
-  // memory go (printed by `fastcal calibrate --timings`).
+  // Each stage of the pipeline, in order: its wall time, the process's CPU time over it
+  // (all threads: cpu_seconds / seconds is how many cores were busy) and the process's
+  // peak resident memory at its end (getrusage; 0 where unavailable): where a long
+  // dataset's time and memory go (printed by `fastcal calibrate --timings`).
   struct Stage {
     std::string name;
     double seconds = 0.0;
+    double cpu_seconds = 0.0;
     double peak_resident_mb = 0.0;
   };
   std::vector<Stage> stages;
