@@ -362,6 +362,35 @@ CalibrationSpec MassCentreSpec() {
   return spec;
 }
 
+// The worst fitted readings are the largest |model - measured| / sigma at the solution,
+// largest first: recomputed here from the calibrated row of the RMS table (the fit's last
+// prediction) and the spec's noise model over every fitted reading.
+TEST(CalibrationTest, WorstReadingsAreTheLargestResiduals) {
+  constexpr double kRelTol = 1e-12;
+  const Dataset data = CircleData(Truth(), 400, 0.03, 41);
+  const CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+  CalibrationResult result;
+  ASSERT_TRUE(CalibrateNominal(spec, data, &result));
+  const VariantEvaluation& calibrated = result.variants.back();
+  ASSERT_EQ(calibrated.predicted_n.size(), data.samples.size());
+  std::vector<double> sizes;
+  for (size_t t = 0; t < data.samples.size(); ++t) {
+    const std::array<double, kNumCables> sigma = internal::TensionSigmas(
+        calibrated.predicted_n[t], spec.tension_sigma_n, spec.tension_sigma_percent);
+    for (int i = 0; i < kNumCables; ++i) {
+      sizes.push_back(std::abs(calibrated.predicted_n[t][i] - data.samples[t].tension_n[i]) /
+                      sigma[i]);
+    }
+  }
+  std::sort(sizes.rbegin(), sizes.rend());
+  const size_t kept = static_cast<size_t>(CalibrationOptions().worst_readings);
+  ASSERT_EQ(result.worst_readings.size(), kept);
+  for (size_t k = 0; k < kept; ++k) {
+    EXPECT_NEAR(std::abs(result.worst_readings[k].residual_sigma), sizes[k], kRelTol * sizes[k])
+        << "rank " << k;
+  }
+}
+
 // Gross errors: readings several times off, a dropout near zero and one 150 kN too high
 // are named by line and cable and kept out of the fit, which then agrees with the fit of
 // the clean data within its sigma.

@@ -1489,4 +1489,29 @@ TEST_F(CliTest, CalibrateTimingsNameEachStage) {
   }
 }
 
+// calibrate's residuals.csv is formatted in chunks of rows on two threads and written in
+// order (issue 20): on 5000 samples (three chunks of every-other rows) every second sample
+// is there once, in file order, each row with its 4 + 6 x 4 fields.
+TEST_F(CliTest, ResidualsOfALongCalibrationAreInFileOrder) {
+  const std::string data = Path("long.csv");
+  CommandResult r = Fastcal("simulate --trajectory=random --samples=5000 --seed=8 --out=" + data);
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = Fastcal("calibrate --quiet --residuals-every=2 --spec=" + Source() +
+              "/calibration_data/spec_mass_centre.yaml --data=" + data + " --out=" + Path("long"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::istringstream csv(ReadFile(Path("long") + "/residuals.csv"));
+  std::string line;
+  int rows = 0, expected_line = 0;
+  while (std::getline(csv, line)) {
+    if (line.empty() || line[0] == '#' || line.rfind("line,", 0) == 0) continue;
+    if (expected_line == 0) expected_line = std::stoi(line);  // the first data row's line
+    EXPECT_EQ(std::stoi(line), expected_line) << "row " << rows;
+    EXPECT_EQ(std::count(line.begin(), line.end(), ','), 3 + 6 * 4)
+        << line;  // 6 measured, 3 variants x 6
+    expected_line += 2;
+    ++rows;
+  }
+  EXPECT_EQ(rows, 2500);
+}
+
 }  // namespace

@@ -361,8 +361,10 @@ ReadingMask ScreenReadings(Run& run) {
 }
 
 // ---------------------------------------------------------------------------------------
-// Stage: the least-squares problem with the current weights, exclusions and warm starts
-// (Ceres owns the cost and loss objects it is given).
+// Stage: the least-squares problem with the current weights, exclusions and warm starts:
+// the data term folded into one block (folded_cost.h; it refers to run's arrays, which
+// stay unchanged while the problem lives; the robust loss is applied inside it), and one
+// block per prior (Ceres owns the cost objects).
 
 void BuildProblem(Run& run) {
   run.problem.reset();

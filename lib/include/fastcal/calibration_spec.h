@@ -102,11 +102,15 @@ struct CalibrationSpec {
   double max_gross_error_fraction = 0.25;
   // Attitude used in the fit: the measured one (default) or the planned one.
   bool use_planned_attitude = false;
-  // Ceres options.
+  // Ceres options. Pass 1 (weights from the initial model) stops at a relative cost
+  // decrease of 1e-4 or function_tolerance, whichever is larger; later passes at these.
   int max_iterations = 100;
   double function_tolerance = 1e-12;
   double gradient_tolerance = 1e-12;
   double parameter_tolerance = 1e-12;
+  // Threads of every pass over the samples (the fit, the linearisation, the RMS table):
+  // the results are the same bits on any number (calibration.md, "At 10^5 and 10^6
+  // samples").
   int num_threads = 2;
   // Joint fit of several sessions (`sessions: {separate: [...]}`, sessions.h): the free
   // parameters of these groups ("mass_centre_m", ParameterGroupName) get one value per
