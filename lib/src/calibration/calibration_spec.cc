@@ -35,7 +35,7 @@
 #include "fastcal/internal/quote.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/plausibility.h"
-#include "yaml_document.h"
+#include "util/yaml_document.h"
 
 namespace fastcal {
 namespace {

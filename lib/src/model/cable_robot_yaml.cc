@@ -28,7 +28,7 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/model_plausibility.h"
-#include "yaml_document.h"
+#include "util/yaml_document.h"
 
 namespace fastcal {
 namespace {

@@ -1,5 +1,5 @@
 // Bounded reading of a YAML stream's first document (yaml_document.h).
-#include "yaml_document.h"
+#include "util/yaml_document.h"
 
 #include <yaml-cpp/eventhandler.h>
 
