@@ -146,8 +146,9 @@ TEST(LocateTest, InvertsSolveWithCablesAsBuilt) {
   int solved = 0;
   ExpectRoundTrips(robot, poses, &solved);
   EXPECT_EQ(solved, static_cast<int>(poses.size()));
-  // The attachments matter: the uniform model puts the cabin elsewhere for these lengths.
-  constexpr double kMinShiftM = 0.01;
+  // The attachments matter: the uniform model puts the cabin elsewhere for these lengths
+  // (0.46-0.67 m over the cap's grid, docs/model.md).
+  constexpr double kMinShiftM = 0.3;
   Lengths s0;
   ASSERT_TRUE(LengthsAt(robot, poses[5], &s0));
   LocateSolution uniform;

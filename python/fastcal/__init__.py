@@ -49,6 +49,7 @@ __all__ = [
     "Dataset",
     "Error",
     "InputError",
+    "LocateResult",
     "Model",
     "StaticsResult",
     "__version__",
@@ -59,6 +60,7 @@ __all__ = [
     "focal_attitude",
     "focal_grid",
     "line",
+    "locate",
     "quat_from_rpy_deg",
     "random_workspace",
     "read_dataset",
@@ -88,7 +90,7 @@ def _rows(value: ArrayLike, columns: int, name: str) -> Tuple[np.ndarray, bool]:
 
 
 def _attitude(
-    n: int, rpy_deg: Optional[ArrayLike], quat: Optional[ArrayLike]
+    n: int, rpy_deg: Optional[ArrayLike], quat: Optional[ArrayLike], rows_of: str = "positions"
 ) -> Tuple[str, np.ndarray]:
     """The attitude arguments as the core takes them: a kind and an (n, k) array."""
     if rpy_deg is not None and quat is not None:
@@ -99,7 +101,7 @@ def _attitude(
     name = "rpy_deg" if kind == "rpy" else "quat"
     array, _ = _rows(value, columns, name)
     if array.shape[0] != n:
-        raise InputError(f"{name} has {array.shape[0]} rows for {n} positions")
+        raise InputError(f"{name} has {array.shape[0]} rows for {n} {rows_of}")
     return kind, array
 
 
@@ -237,6 +239,163 @@ def solve(
         },
     )
     return StaticsResult(raw, single)
+
+
+STABILITY_NAMES: List[str] = _fastcal.stability_names()
+"""The stability of a located pose, by code: 'unknown' (no answer), 'stable',
+'unstable', 'marginal' (fastcal locate's stability column)."""
+_STABILITY_NAMES_ARRAY = np.array(STABILITY_NAMES, dtype=object)
+
+
+class LocateResult:
+    """Where the cabin hangs for one row of lengths or n rows (fastcal.locate).
+
+    For n rows (lengths of shape (n, 6)) each array has a leading axis of n; for one
+    ((6,)) it has none, and `status`, `ok`, `stability` are scalars.
+
+    Attributes:
+        position_m: the cabin-frame origin, global frame, (n, 3).
+        quat: the attitude as unit quaternions (w, x, y, z), (n, 4); rpy_deg the same as
+            roll, pitch, yaw, R = Rz(yaw) Ry(pitch) Rx(roll), (n, 3).
+        lower_tension_kN: the tensions at the cabin ends there, (n, 6).
+        s0_m: the lengths of the answer's equilibrium, (n, 6): the given ones for lengths
+            alone, the fitted pose's with a measured attitude or tensions.
+        status: 'ok' or why not ('no_equilibrium', 'overstretched_cable', ...;
+            STATUS_NAMES), ok: status == 'ok'.
+        stability: 'stable', 'unstable', 'marginal' ('unknown' where not ok).
+        min_stiffness_kN_per_m: smallest eigenvalue of the stiffness of the potential
+            energy with the lengths held (rotations scaled by the cabin's size): < 0 unstable.
+        other_equilibria: other equilibria of the same lengths found within
+            search_radius_m; nearest_other_m their nearest's distance (NaN: none).
+        covariance: of (position (m), rotation vector (rad, global axes)), (n, 6, 6);
+            sigma_position_m (n, 3) and sigma_rpy_deg (n, 3) from it.
+        pose_per_length: d(position, rotation vector)/d s0_j, (n, 6, 6).
+        readings, chi2: readings the pose fits and their whitened residuals squared
+            (lengths alone: 6 and 0).
+        error_estimate_m: the next Newton step's size after the last.
+        messages: row index -> the account of a row that failed, is not stable or has
+            another equilibrium nearby (the CLI's words).
+
+    A failed row has NaN numbers, with `status` saying why.
+    """
+
+    def __init__(self, raw: Dict[str, Any], single: bool) -> None:
+        self._single = single
+        pick = (lambda a: a[0]) if single else (lambda a: a)
+        codes = raw["status_code"]
+        self.position_m: np.ndarray = pick(raw["position_m"])
+        self.quat: np.ndarray = pick(raw["quat"])
+        rpy = np.full((len(codes), 3), np.nan)
+        ok = codes == 0
+        if ok.any():
+            rpy[ok] = _fastcal.rpy_deg_from_quat(raw["quat"][ok])
+        self.rpy_deg: np.ndarray = pick(rpy)
+        self.lower_tension_kN: np.ndarray = pick(raw["lower_tension_kN"])
+        self.s0_m: np.ndarray = pick(raw["s0_m"])
+        self.status = pick(_STATUS_NAMES_ARRAY[codes])
+        self.ok = pick(ok)
+        self.stability = pick(_STABILITY_NAMES_ARRAY[raw["stability_code"]])
+        self.min_stiffness_kN_per_m = pick(raw["min_stiffness_kN_per_m"])
+        self.other_equilibria = pick(raw["other_equilibria"])
+        self.nearest_other_m = pick(raw["nearest_other_m"])
+        covariance = raw["covariance"]
+        self.covariance: np.ndarray = pick(covariance)
+        variances = np.diagonal(covariance, axis1=1, axis2=2)
+        self.sigma_position_m: np.ndarray = pick(np.sqrt(np.maximum(variances[:, :3], 0.0)))
+        sigma_rpy = np.full((len(codes), 3), np.nan)
+        if ok.any():
+            j = _fastcal.rpy_deg_per_rotation_vector(raw["quat"][ok])
+            c = np.einsum("kab,kbc,kdc->kad", j, covariance[ok][:, 3:, 3:], j)
+            sigma_rpy[ok] = np.sqrt(np.maximum(np.diagonal(c, axis1=1, axis2=2), 0.0))
+        self.sigma_rpy_deg: np.ndarray = pick(sigma_rpy)
+        self.pose_per_length: np.ndarray = pick(raw["pose_per_length"])
+        self.readings = pick(raw["readings"])
+        self.chi2 = pick(raw["chi2"])
+        self.error_estimate_m = pick(raw["error_estimate_m"])
+        self.messages: Dict[int, str] = dict(raw["messages"])
+
+    def __len__(self) -> int:
+        return 1 if self._single else len(self.ok)
+
+    def __repr__(self) -> str:
+        n = len(self)
+        failed = n - int(np.sum(self.ok))
+        unstable = int(np.sum(np.atleast_1d(self.stability) != "stable")) - failed
+        return (
+            f"<fastcal.LocateResult: {n} row{'s' if n != 1 else ''}, {failed} failed, "
+            f"{unstable} not stable>"
+        )
+
+
+def locate(
+    lengths_m: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    tensions_kN: Optional[ArrayLike] = None,
+    model: Optional[Model] = None,
+    *,
+    warm_start: bool = True,
+    search_radius_m: float = 2.0,
+    length_sigma_m: float = 0.01,
+    tension_sigma_percent: float = 3.0,
+    tension_sigma_kN: float = 0.0,
+    attitude_sigma_deg: float = 0.05,
+    max_strain: float = 0.05,
+    max_length_ratio: float = 1.5,
+    min_reflector_clearance_m: float = 0.0,
+) -> LocateResult:
+    """Where the cabin hangs, from the six unstretched cable lengths (forward statics).
+
+    Args:
+        lengths_m: unstretched lengths s0, cable 1 first: (6,) or (n, 6).
+        rpy_deg, quat: a measured attitude per row ((3,)/(n, 3) or (4,)/(n, 4)), at most
+            one: the pose is then fitted to the lengths and the attitude together.
+        tensions_kN: measured tension readings per row, (6,) or (n, 6) (the model's
+            sensor gain and bias apply): fitted too.
+        model: the model; None for Model.nominal().
+        warm_start: each row starts from the previous row's answer (a trajectory); the
+            first, and any whose warm start fails, follows the equilibrium from the home
+            pose as the lengths move from its lengths to the row's.
+        search_radius_m: look for other equilibria of the same lengths this far from the
+            answer (m, anchors' move); 0: none.
+        length_sigma_m, tension_sigma_percent, tension_sigma_kN, attitude_sigma_deg:
+            the measurements' sigmas (the fit's weights, and `covariance`).
+        max_strain, max_length_ratio, min_reflector_clearance_m: the model's range, as
+            in solve().
+
+    Returns:
+        A LocateResult (arrays with a leading axis of n for (n, 6) lengths). Rows that
+        fail are marked in `status`/`ok`, not raised. Solved in C++ without the GIL.
+
+    Raises:
+        InputError: a wrong shape, a non-unit quaternion, a bad sigma or option.
+    """
+    lengths, single = _rows(lengths_m, 6, "lengths_m")
+    n = lengths.shape[0]
+    kind, attitude = _attitude(n, rpy_deg, quat, "rows of lengths_m")
+    if tensions_kN is None:
+        tensions = np.zeros((0, 6))
+    else:
+        tensions, _ = _rows(tensions_kN, 6, "tensions_kN")
+    raw = _fastcal.locate(
+        model if model is not None else Model.nominal(),
+        lengths,
+        kind,
+        attitude,
+        tensions,
+        {
+            "warm_start": warm_start,
+            "search_radius_m": search_radius_m,
+            "length_sigma_m": length_sigma_m,
+            "tension_sigma_percent": tension_sigma_percent,
+            "tension_sigma_kN": tension_sigma_kN,
+            "attitude_sigma_deg": attitude_sigma_deg,
+            "max_strain": max_strain,
+            "max_length_ratio": max_length_ratio,
+            "min_reflector_clearance_m": min_reflector_clearance_m,
+        },
+    )
+    return LocateResult(raw, single)
 
 
 def line(from_m: ArrayLike, to_m: ArrayLike, nodes: int = 101) -> np.ndarray:

@@ -202,6 +202,9 @@ std::string FormatNumber(double value, int shift) {
 struct Header {
   std::array<int, kNumColumns> field_of{};
   std::vector<int> column_of_field;
+  // Which column groups the file has: all but the lengths always in a measurement file
+  // (DatasetColumns::kMeasurements), each optional in a lengths file (kLengths).
+  bool time = true, position = true, attitude = true, tensions = true;
   bool quaternion = false;
   bool planned = false;
   bool unstretched = false;
@@ -225,8 +228,8 @@ bool GroupPresent(const Header& header, int first, int count, const std::string&
   return false;
 }
 
-bool ParseHeader(std::string_view line, const std::string& where, Header* header,
-                 std::string* error) {
+bool ParseHeader(std::string_view line, const std::string& where, DatasetColumns columns,
+                 Header* header, std::string* error) {
   header->field_of.fill(-1);
   const std::string separator_error = internal::WrongSeparatorMessage(line);
   if (!separator_error.empty()) {
@@ -271,10 +274,22 @@ bool ParseHeader(std::string_view line, const std::string& where, Header* header
     *error = where + "missing column " + Quoted(kColumnNames[column]);
     return false;
   };
-  for (int c = kTime; c <= kZ; ++c) {
-    if (!require(c)) return false;
-  }
   bool ok = true;
+  const bool lengths_file = columns == DatasetColumns::kLengths;
+  if (lengths_file) {
+    // Only the lengths are required; every other group complete or absent.
+    header->time = header->field_of[kTime] >= 0;
+    header->position =
+        GroupPresent(*header, kX, 3, where, "the position needs all three or none", &ok, error);
+    if (!ok) return false;
+    header->tensions = GroupPresent(*header, kTension1, kNumCables, where,
+                                    "the measured tensions need all six or none", &ok, error);
+    if (!ok) return false;
+  } else {
+    for (int c = kTime; c <= kZ; ++c) {
+      if (!require(c)) return false;
+    }
+  }
   const bool rpy = GroupPresent(*header, kRoll, 3, where,
                                 "the measured attitude as angles needs all three", &ok, error);
   if (!ok) return false;
@@ -287,12 +302,13 @@ bool ParseHeader(std::string_view line, const std::string& where, Header* header
              "qw,qx,qy,qz";
     return false;
   }
-  if (!rpy && !quaternion) {
+  if (!rpy && !quaternion && !lengths_file) {
     *error = where + "missing measured attitude: columns roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz";
     return false;
   }
+  header->attitude = rpy || quaternion;
   header->quaternion = quaternion;
-  for (int i = 0; i < kNumCables; ++i) {
+  for (int i = 0; i < kNumCables && !lengths_file; ++i) {
     if (!require(kTension1 + i)) return false;
   }
   header->planned = GroupPresent(*header, kPlannedRoll, 3, where,
@@ -300,6 +316,11 @@ bool ParseHeader(std::string_view line, const std::string& where, Header* header
   if (!ok) return false;
   header->unstretched = GroupPresent(*header, kUnstretched1, kNumCables, where,
                                      "the unstretched lengths need all six or none", &ok, error);
+  if (ok && lengths_file && !header->unstretched) {
+    *error = where + "missing column " + Quoted(kColumnNames[kUnstretched1]) +
+             " (a lengths file needs s0_1_m ... s0_6_m)";
+    return false;
+  }
   return ok;
 }
 
@@ -412,7 +433,7 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     if (!CheckValue(column, value[column], limits, &why)) return fail(why);
     if (IsTension(column)) value[column] = ScaleByKilo(fields[f], value[column]);
   }
-  {
+  if (header.position) {
     const Eigen::Vector3d position(value[kX], value[kY], value[kZ]);
     std::string why;
     if (!CheckPosition(position, limits, &why)) {
@@ -422,7 +443,9 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
   }
   sample->time_s = value[kTime];
   sample->pose.position_m = Eigen::Vector3d(value[kX], value[kY], value[kZ]);
-  if (header.quaternion) {
+  if (!header.attitude) {
+    // A lengths file without an attitude: the identity, unused (Dataset::has_attitude).
+  } else if (header.quaternion) {
     sample->measured_quaternion_wxyz =
         Eigen::Vector4d(value[kQw], value[kQx], value[kQy], value[kQz]);
     std::string why;
@@ -541,8 +564,12 @@ class LineParser {
     // Built only for a message: two allocations a row add up at 10^6 rows.
     const auto where = [&] { return layout_.path + ":" + std::to_string(line_number) + ": "; };
     if (!have_header_) {
-      if (!ParseHeader(line, where(), &header_, error)) return false;
+      if (!ParseHeader(line, where(), options_.columns, &header_, error)) return false;
       have_header_ = true;
+      layout_.has_time = header_.time;
+      layout_.has_position = header_.position;
+      layout_.has_measured_attitude = header_.attitude;
+      layout_.has_tensions = header_.tensions;
       layout_.has_planned_attitude = header_.planned;
       layout_.has_unstretched_lengths = header_.unstretched;
       layout_.attitude_as_quaternion = header_.quaternion;
@@ -650,7 +677,7 @@ class LineParser {
     if (header_.session_field >= 0) {
       sample->session = SessionIndex(SplitFields(line)[header_.session_field], &layout_);
     }
-    radians_.Add(*sample, header_.planned);
+    if (header_.position && header_.attitude) radians_.Add(*sample, header_.planned);
     out->samples.push_back(std::move(*sample));
     previous_ = values;
     have_previous_ = true;
@@ -674,6 +701,10 @@ void TakeLayout(const Dataset& layout, Dataset* data) {
   data->has_planned_attitude = layout.has_planned_attitude;
   data->has_unstretched_lengths = layout.has_unstretched_lengths;
   data->attitude_as_quaternion = layout.attitude_as_quaternion;
+  data->has_time = layout.has_time;
+  data->has_position = layout.has_position;
+  data->has_measured_attitude = layout.has_measured_attitude;
+  data->has_tensions = layout.has_tensions;
   data->session_labels = layout.session_labels;
 }
 

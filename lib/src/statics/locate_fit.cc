@@ -53,7 +53,23 @@ struct FitPoint {
   Jacobian j;
   double cost = 0.0;
   LocateFit fit;  // residuals in units (model minus measured)
+  // The tension rows' sigmas: those used in r and j (frozen: the step's start's), and
+  // this point's own, from its predicted readings (Reweight).
+  std::array<double, kNumCables> used_sigma_n{}, own_sigma_n{};
+  int first_tension_row = -1;  // -1: no tension rows
 };
+
+// The tension rows of *f divided by its own sigmas instead of the frozen ones.
+void Reweight(FitPoint* f) {
+  for (int i = 0; i < kNumCables && f->first_tension_row >= 0; ++i) {
+    const double scale = f->used_sigma_n[i] / f->own_sigma_n[i];
+    f->r[f->first_tension_row + i] *= scale;
+    f->j.row(f->first_tension_row + i) *= scale;
+    f->used_sigma_n[i] = f->own_sigma_n[i];
+  }
+  f->cost = f->r.squaredNorm();
+  f->fit.chi2 = f->cost;
+}
 
 // d(s0)/dx and d(T_i)/dx at an equilibrium (file comment); false where G or K is singular.
 bool ReadingDerivatives(const ForwardLinearisation& lin, const ForwardState& x,
@@ -70,12 +86,15 @@ bool ReadingDerivatives(const ForwardLinearisation& lin, const ForwardState& x,
   return true;
 }
 
-// The fit's residuals and Jacobian at `pose`; `warm` starts the inverse statics. A status
-// other than ok where the model has no answer there.
+// The fit's residuals and Jacobian at `pose`; `warm` starts the inverse statics. The
+// tensions are divided by `frozen_sigma_n` when not null (a trial step is judged by the
+// cost of its start's weights), else by the sigmas of their own predicted readings. A
+// status other than ok where the model has no answer there.
 StaticsStatus EvaluateFit(const CableRobot& robot, const StaticsParameters<double>& p,
                           const LocateMeasurement& m, const LocateNoise& noise,
                           const LocateOptions& options, const StaticsSolution& warm,
-                          const Pose& pose, FitPoint* f) {
+                          const Pose& pose, const std::array<double, kNumCables>* frozen_sigma_n,
+                          FitPoint* f) {
   StaticsOptions so = options.statics;
   so.method = StaticsMethod::kExact;
   so.warm_start = true;
@@ -105,13 +124,16 @@ StaticsStatus EvaluateFit(const CableRobot& robot, const StaticsParameters<doubl
     f->r[n] = f->fit.length_residual_m[i] / noise.length_sigma_m;
     f->j.row(n) = ds0.row(i) / noise.length_sigma_m;
   }
+  f->first_tension_row = m.has_tensions ? n : -1;
   if (m.has_tensions) {
     for (int i = 0; i < kNumCables; ++i, ++n) {
       const CableProperties& c = robot.cables[i];
       const double reading = c.SensorReadingN(f->statics.cables[i].lower_tension_n);
       const double relative = noise.tension_sigma_percent / 100.0 * reading;
-      const double sigma =
+      f->own_sigma_n[i] =
           std::sqrt(noise.tension_sigma_n * noise.tension_sigma_n + relative * relative);
+      const double sigma = frozen_sigma_n != nullptr ? (*frozen_sigma_n)[i] : f->own_sigma_n[i];
+      f->used_sigma_n[i] = sigma;
       f->fit.tension_residual_n[i] = reading - m.tension_n[i];
       f->r[n] = f->fit.tension_residual_n[i] / sigma;
       f->j.row(n) = c.sensor_gain * dt.row(i) / sigma;
@@ -134,8 +156,10 @@ StaticsStatus EvaluateFit(const CableRobot& robot, const StaticsParameters<doubl
   return StaticsStatus::kOk;
 }
 
-// Gauss-Newton from *f (evaluated at the lengths' answer) until its step is small; the
-// cost never rises (a step that would raise it is halved).
+// Gauss-Newton from *f (evaluated at the lengths' answer, with its own weights) until its
+// step is small. The tensions' weights follow the predicted readings (iteratively
+// reweighted, as the calibration's passes): a step is judged by the cost with its start's
+// weights, which it never raises (a step that would is halved), then reweighted.
 StaticsStatus FitPose(const CableRobot& robot, const StaticsParameters<double>& p,
                       const LocateMeasurement& m, const LocateNoise& noise,
                       const LocateOptions& options, FitPoint* f) {
@@ -157,12 +181,13 @@ StaticsStatus FitPose(const CableRobot& robot, const StaticsParameters<double>& 
       ForwardState moved;
       moved.pose = f->pose;
       moved = internal::MoveState(moved, dx, internal::ZeroForces(), fraction);
-      accepted = EvaluateFit(robot, p, m, noise, options, f->statics, moved.pose, &trial) ==
-                     StaticsStatus::kOk &&
+      accepted = EvaluateFit(robot, p, m, noise, options, f->statics, moved.pose, &f->used_sigma_n,
+                             &trial) == StaticsStatus::kOk &&
                  (trial.cost <= f->cost || fraction * step <= tolerance_m);
     }
     if (!accepted) return StaticsStatus::kNotConverged;
     *f = trial;
+    Reweight(f);
   }
   return StaticsStatus::kNotConverged;
 }
@@ -219,8 +244,8 @@ StaticsStatus LocateFromMeasurements(const CableRobot& robot, const LocateMeasur
   }
   const StaticsParameters<double> p = MakeStaticsParameters(robot);
   FitPoint f;
-  status =
-      EvaluateFit(robot, p, measurement, noise, options, solution->statics, solution->pose, &f);
+  status = EvaluateFit(robot, p, measurement, noise, options, solution->statics, solution->pose,
+                       nullptr, &f);
   if (status == StaticsStatus::kOk) status = FitPose(robot, p, measurement, noise, options, &f);
   if (status != StaticsStatus::kOk) {
     ResetLocateSolution(measurement.length_m, solution);

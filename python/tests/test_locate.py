@@ -1,0 +1,92 @@
+"""fastcal.locate: the forward statics on numpy arrays, round trips through solve, fits."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import fastcal
+
+ROUND_TRIP_M = 1e-9  # locate gives back solve's pose (docs/model.md, "Forward statics")
+K1_LENGTH_M = 319.4245427  # every cable at K1 = (0, 0, 140), R = I (solve, 10 digits)
+
+
+def test_locate_inverts_solve_along_an_arc() -> None:
+    p = fastcal.arc(centre_m=(0, 0, 150), radius_m=50, nodes=21)
+    q = fastcal.focal_attitude(p)
+    solved = fastcal.solve(p, quat=q)
+    located = fastcal.locate(solved.s0_m)
+    assert located.position_m.shape == (21, 3) and located.quat.shape == (21, 4)
+    assert located.ok.all() and (located.stability == "stable").all()
+    assert np.abs(located.position_m - p).max() < ROUND_TRIP_M
+    # q and -q are one attitude: compare |q . q'|.
+    assert np.abs(np.abs(np.sum(located.quat * q, axis=1)) - 1).max() < 1e-12
+    np.testing.assert_allclose(located.lower_tension_kN, solved.lower_tension_kN, rtol=1e-9)
+    np.testing.assert_array_equal(located.s0_m, solved.s0_m)
+    assert (located.readings == 6).all() and (located.chi2 == 0).all()
+    assert located.covariance.shape == (21, 6, 6)
+    assert located.pose_per_length.shape == (21, 6, 6)
+    # Warm (the default) and cold give the same poses.
+    cold = fastcal.locate(solved.s0_m, warm_start=False, search_radius_m=0)
+    np.testing.assert_allclose(cold.position_m, located.position_m, atol=ROUND_TRIP_M)
+
+
+def test_one_row_has_scalars_and_sigmas_follow_the_length_sigma() -> None:
+    one = fastcal.locate([K1_LENGTH_M] * 6)
+    assert one.position_m.shape == (3,)
+    assert one.status == "ok" and one.ok and one.stability == "stable"
+    assert abs(one.position_m[2] - 140.0) < 1e-6
+    assert one.other_equilibria == 0 and np.isnan(one.nearest_other_m)
+    assert one.min_stiffness_kN_per_m > 0
+    # Lengths alone: the covariance is sigma_L^2 P P^T, so sigmas scale with sigma_L.
+    finer = fastcal.locate([K1_LENGTH_M] * 6, length_sigma_m=0.001)
+    np.testing.assert_allclose(finer.sigma_position_m, one.sigma_position_m / 10, rtol=1e-9)
+    np.testing.assert_allclose(finer.sigma_rpy_deg, one.sigma_rpy_deg / 10, rtol=1e-9)
+
+
+def test_measured_attitude_and_tensions_are_fitted() -> None:
+    p = fastcal.arc(centre_m=(0, 0, 150), radius_m=50, nodes=5)
+    q = fastcal.focal_attitude(p)
+    solved = fastcal.solve(p, quat=q)
+    fitted = fastcal.locate(solved.s0_m, quat=q, tensions_kN=solved.lower_tension_kN)
+    assert (fitted.readings == 15).all()
+    assert fitted.chi2.max() < 1e-10
+    assert np.abs(fitted.position_m - p).max() < 1e-7
+    # The attitude as roll/pitch/yaw is the same measurement.
+    by_rpy = fastcal.locate(solved.s0_m, rpy_deg=fastcal.rpy_deg_from_quat(q))
+    assert (by_rpy.readings == 9).all()
+    # More measurements, smaller sigmas than the lengths' alone.
+    alone = fastcal.locate(solved.s0_m)
+    assert (fitted.sigma_position_m < alone.sigma_position_m).all()
+
+
+def test_lengths_no_equilibrium_holds_are_marked_not_raised() -> None:
+    r = fastcal.locate(np.array([[250.0] * 6, [K1_LENGTH_M] * 6]))
+    assert list(r.status) == ["overstretched_cable", "ok"]
+    assert list(r.stability) == ["unknown", "stable"]
+    assert np.isnan(r.position_m[0]).all() and np.isnan(r.lower_tension_kN[0]).all()
+    assert "stretched beyond" in r.messages[0]
+    assert 1 not in r.messages
+
+
+def test_top_heavy_cabin_is_unstable_and_not_unique() -> None:
+    model = fastcal.Model.nominal()
+    model.mass_centre_cabin_m = [0.0, 0.0, 12.0]
+    lengths = fastcal.solve([0.0, 0.0, 140.0], model=model).s0_m
+    r = fastcal.locate(lengths, model=model)
+    assert r.ok and r.stability == "unstable" and r.min_stiffness_kN_per_m < 0
+    assert r.other_equilibria > 0 and r.nearest_other_m > 0
+    assert "not unique" in r.messages[0]
+
+
+def test_bad_arguments_raise_input_error() -> None:
+    with pytest.raises(fastcal.InputError, match=r"lengths_m must have shape \(6,\)"):
+        fastcal.locate([1.0, 2.0, 3.0])
+    with pytest.raises(fastcal.InputError, match="tensions_kN must have shape"):
+        fastcal.locate([K1_LENGTH_M] * 6, tensions_kN=[1.0, 2.0])
+    with pytest.raises(fastcal.InputError, match="quat has 2 rows for 1 rows of lengths_m"):
+        fastcal.locate([K1_LENGTH_M] * 6, quat=[[1, 0, 0, 0], [1, 0, 0, 0]])
+    with pytest.raises(fastcal.InputError, match="length_sigma_m"):
+        fastcal.locate([K1_LENGTH_M] * 6, length_sigma_m=0.0)
+    with pytest.raises(fastcal.InputError, match="search_radius_m"):
+        fastcal.locate([K1_LENGTH_M] * 6, search_radius_m=-1.0)
