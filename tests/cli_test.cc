@@ -1593,6 +1593,39 @@ TEST_F(CliTest, LocateReadsASimulatedSurvey) {
   EXPECT_EQ(rows[0].at("chi2"), "0");
 }
 
+// simulate's length readings carry the encoders' offsets (written into the truth model)
+// and noise: locate with the truth model finds the cabin within millimetres, with the
+// nominal model (offsets unknown) decimetres off.
+TEST_F(CliTest, SimulatedEncoderLengthsLocateWithTheirTruthModel) {
+  const std::string data = Path("enc.csv");
+  CommandResult r = Fastcal(
+      "simulate --trajectory=random --samples=20 --seed=4 --length-offset-spread-m=0.3 "
+      "--length-noise-m=0.002 --out=" +
+      data);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("length-encoder offsets (m):"), std::string::npos) << r.output;
+  EXPECT_NE(ReadFile(Path("enc.truth.yaml")).find("length_offset_m: "), std::string::npos);
+  const auto rms_of = [](const std::string& output) {
+    const std::smatch m = [&] {
+      std::smatch found;
+      std::regex_search(output, found, std::regex("RMS ([0-9.e+-]+) m"));
+      return found;
+    }();
+    return m.empty() ? -1.0 : std::stod(m[1]);
+  };
+  r = Fastcal("locate --use=lengths --search-radius-m=0 --model=" + Path("enc.truth.yaml") +
+              " --data=" + data + " --output=" + Path("a.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_LT(rms_of(r.output), 0.01) << r.output;
+  EXPECT_GE(rms_of(r.output), 0.0) << r.output;
+  r = Fastcal("locate --use=lengths --search-radius-m=0 --data=" + data +
+              " --output=" + Path("b.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_GT(rms_of(r.output), 0.1) << r.output;
+  RunBoundedAndExpect({"simulate --length-noise-m=-1 --out=" + Path("x.csv"), 2,
+                       "--length-noise-m must be finite and >= 0"});
+}
+
 TEST_F(CliTest, LocateRefusesBadInputAndNamesIt) {
   const std::string k1 = "--lengths=319.4245,319.4245,319.4245,319.4245,319.4245,319.4245";
   Write("short.csv", "time_s,s0_1_m,s0_2_m\n0,300,300\n");

@@ -407,10 +407,14 @@ TEST(LocateTest, FitOfConsistentMeasurementsIsThePose) {
   CableRobot robot = CableRobot::NominalFast();
   robot.cables[2].sensor_gain = 1.02;
   robot.cables[4].sensor_bias_n = -1500.0;
+  robot.cables[1].length_offset_m = 0.35;  // the encoders read s0 + offset
+  robot.cables[5].length_offset_m = -1.2;
   const Pose pose = FocalPose(Eigen::Vector3d(42.65, 33.73, 149.52));
   StaticsSolution inverse;
   LocateMeasurement m;
   ASSERT_TRUE(LengthsAt(robot, pose, &m.length_m, &inverse));
+  for (int i = 0; i < kNumCables; ++i)
+    m.length_m[i] = robot.cables[i].EncoderReadingM(m.length_m[i]);
   m.has_attitude = true;
   m.rotation = pose.rotation;
   m.has_tensions = true;

@@ -529,7 +529,9 @@ def simulate(
     attitude_measurement_sigma_deg, position_measurement_sigma_m,
     tension_drift_percent, tension_drift_time_s, mass_centre_drift_m,
     mass_centre_drift_time_s, sensor_gain_spread_percent, sensor_bias_spread_kn,
-    density_mismatch_percent, sample_interval_s (1), seed (1), method ('exact'),
+    density_mismatch_percent, length_offset_spread_m and length_noise_m (the s0 columns:
+    encoder offsets drawn once, written into the truth model, and reading noise),
+    sample_interval_s (1), seed (1), method ('exact'),
     sessions (1: the samples cut into that many consecutive sessions, labelled 1..N),
     mass_centre_steps ([(time_s, (dx, dy, dz)), ...]: the mass centre moves by the shift
     at that time and stays).

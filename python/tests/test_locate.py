@@ -90,3 +90,16 @@ def test_bad_arguments_raise_input_error() -> None:
         fastcal.locate([K1_LENGTH_M] * 6, length_sigma_m=0.0)
     with pytest.raises(fastcal.InputError, match="search_radius_m"):
         fastcal.locate([K1_LENGTH_M] * 6, search_radius_m=-1.0)
+
+
+def test_encoder_offsets_of_a_simulation_are_removed_by_the_truth_model() -> None:
+    p = fastcal.random_workspace(samples=8, seed=3)
+    data, truth, summary = fastcal.simulate(
+        p, quat=fastcal.focal_attitude(p), length_offset_spread_m=0.3, seed=2
+    )
+    np.testing.assert_array_equal(truth.length_offset_m, summary["length_offset_m"])
+    assert np.abs(truth.length_offset_m).max() > 0.0
+    with_truth = fastcal.locate(data.s0_m, model=truth)
+    assert np.abs(with_truth.position_m - p).max() < 1e-6
+    nominal = fastcal.locate(data.s0_m)
+    assert np.abs(nominal.position_m - p).max() > 0.1

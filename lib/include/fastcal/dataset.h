@@ -42,7 +42,9 @@ struct Sample {
   // Measured lower-end cable tensions, cable i at index i-1 (>= 0: 0 is a dropout, which
   // a calibration flags as a gross error; at most PlausibilityLimits::max_tension_n).
   std::array<double, kNumCables> tension_n{};
-  // Commanded unstretched cable lengths, when the file has the s0_*_m columns (> 0).
+  // The winches' length readings, when the file has the s0_*_m columns (> 0): each cable's
+  // unstretched length as its encoder gives it (commanded or measured), the model's s0
+  // plus CableProperties::length_offset_m.
   bool has_unstretched_lengths = false;
   std::array<double, kNumCables> unstretched_length_m{};
   // The survey (session) the sample belongs to: an index into Dataset::session_labels,

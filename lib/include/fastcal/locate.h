@@ -158,7 +158,9 @@ std::string DescribeLocateStatus(const LocateSolution& solution);
 
 // What was measured at one instant.
 struct LocateMeasurement {
-  // The lengths as the winches' encoders give them (m).
+  // The lengths as the winches' encoders give them (m): the model's unstretched length
+  // plus its length_offset_m (CableProperties::EncoderReadingM), which
+  // LocateFromMeasurements removes.
   std::array<double, kNumCables> length_m{};
   bool has_attitude = false;
   Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // measured attitude

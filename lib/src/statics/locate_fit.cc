@@ -226,13 +226,17 @@ bool LocateNoise::IsValid(std::string* error) const {
   return false;
 }
 
-StaticsStatus LocateFromMeasurements(const CableRobot& robot, const LocateMeasurement& measurement,
+StaticsStatus LocateFromMeasurements(const CableRobot& robot, const LocateMeasurement& measured,
                                      const LocateNoise& noise, const LocateOptions& options,
                                      LocateSolution* solution) {
-  if (!noise.IsValid(nullptr) || !MeasurementUsable(measurement)) {
-    ResetLocateSolution(measurement.length_m, solution);
+  if (!noise.IsValid(nullptr) || !MeasurementUsable(measured)) {
+    ResetLocateSolution(measured.length_m, solution);
     return solution->status = solution->statics.status = StaticsStatus::kInvalidInput;
   }
+  // The encoders' zeros removed: the unstretched lengths the statics hold (residuals,
+  // model minus measured, are unchanged by moving the offset to the other side).
+  LocateMeasurement measurement = measured;
+  for (int i = 0; i < kNumCables; ++i) measurement.length_m[i] -= robot.cables[i].length_offset_m;
   StaticsStatus status = Locate(robot, measurement.length_m, options, solution);
   if (status != StaticsStatus::kOk) return status;
   const double variance = noise.length_sigma_m * noise.length_sigma_m;
