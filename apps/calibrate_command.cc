@@ -328,10 +328,13 @@ bool WriteResidualsFile(const std::string& dir, const Dataset& data,
 // column, then T1..T6, so that every row lines up under its header.
 constexpr int kLabelWidth = 40;
 
-std::string CableHeader(const std::string& title) {
+std::string CableHeader(const std::string& title, const char* prefix = "T") {
   char buf[160];
+  std::string names[kNumCables];
+  for (int i = 0; i < kNumCables; ++i) names[i] = prefix + std::to_string(i + 1);
   std::snprintf(buf, sizeof(buf), "  %-*s %8s %8s %8s %8s %8s %8s\n", kLabelWidth, title.c_str(),
-                "T1", "T2", "T3", "T4", "T5", "T6");
+                names[0].c_str(), names[1].c_str(), names[2].c_str(), names[3].c_str(),
+                names[4].c_str(), names[5].c_str());
   return buf;
 }
 
@@ -345,6 +348,18 @@ std::string CableRow(const std::string& label, const std::array<double, kNumCabl
     row += std::string(buf) == " -0.000" ? "    0.000" : buf;
   }
   return row + "\n";
+}
+
+// With lengths in the fit: their RMS per cable before and after (mm), else "".
+std::string LengthTable(const LengthEvaluation& l) {
+  if (!l.used) return "";
+  std::string s = "\n" + CableHeader("RMS model - measured length (mm)", "L");
+  s += CableRow("initial model", l.initial.rms_m, 1e3);
+  s += CableRow("calibrated model", l.calibrated.rms_m, 1e3);
+  if (l.calibrated_holdout.samples > 0) {
+    s += CableRow("calibrated model [hold-out]", l.calibrated_holdout.rms_m, 1e3);
+  }
+  return s;
 }
 
 std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
@@ -705,10 +720,18 @@ std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::st
   for (size_t k = 0; k < std::min(list.size(), kShown); ++k) {
     const ReadingResidual& e = list[k];
     char buf[200];
-    std::snprintf(buf, sizeof(buf),
-                  "%sline %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
-                  indent.c_str(), e.line, e.cable, e.measured_n / kNPerKn, e.predicted_n / kNPerKn,
-                  e.residual_sigma, e.held_out ? " (held out)" : "");
+    if (e.length) {
+      std::snprintf(buf, sizeof(buf),
+                    "%sline %d, length of cable %d: measured %.4f m, predicted %.4f m, %+.1f "
+                    "sigma%s\n",
+                    indent.c_str(), e.line, e.cable, e.measured_m, e.predicted_m, e.residual_sigma,
+                    e.held_out ? " (held out)" : "");
+    } else {
+      std::snprintf(buf, sizeof(buf),
+                    "%sline %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
+                    indent.c_str(), e.line, e.cable, e.measured_n / kNPerKn,
+                    e.predicted_n / kNPerKn, e.residual_sigma, e.held_out ? " (held out)" : "");
+    }
     s << buf;
   }
   if (list.size() > kShown) {
@@ -844,8 +867,8 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
     s << Wrapped("strongly correlated: " + pairs, "  ", "    ", kNoteLines);
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
-    << RmsTable(variants) << CrossValidationLine(result) << "\nwrote " << FLAGS_out
-    << "/{model_calibrated.yaml, report.html, report.md, summary.json"
+    << RmsTable(variants) << CrossValidationLine(result) << LengthTable(result.lengths)
+    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, report.html, report.md, summary.json"
     << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
 }

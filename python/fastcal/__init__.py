@@ -563,7 +563,12 @@ class CalibrationResult:
         free_names: the free parameters, in the order of `correlation`'s rows.
         correlation: correlation matrix of the free estimates (total covariance), (k, k).
         outliers: the gross errors kept out of the fit, in file order: dicts of line,
-            cable (1-6), measured_kN, predicted_kN, residual_sigma, held_out.
+            cable (1-6), reading ('tension', or 'length' with the lengths in the fit),
+            measured_kN and predicted_kN (a length: measured_m, predicted_m),
+            residual_sigma, held_out.
+        lengths: with the lengths in the fit (spec noise.length_sigma_m), a dict of
+            sigma_m and per cable (6,) initial_rms_m, calibrated_rms_m,
+            calibrated_mean_m (model minus measured); None without.
         worst_readings: the fitted readings with the largest |residual| / sigma.
         misfit_ranking: fixed parameters by the chi-square decrease freeing each would
             bring (name, expected_chi_square_decrease, significant); misfit_threshold
@@ -613,6 +618,7 @@ class CalibrationResult:
             if v["holdout"] is not None
         }
         self.cross_validation_rms_kN: Optional[np.ndarray] = raw["cross_validation_rms_kN"]
+        self.lengths: Optional[Dict[str, Any]] = raw["lengths"]
         self.verdict: str = raw["verdict"]
         self.verdict_text: str = raw["verdict_text"]
         self.notes: List[str] = raw["notes"]

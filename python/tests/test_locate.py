@@ -103,3 +103,19 @@ def test_encoder_offsets_of_a_simulation_are_removed_by_the_truth_model() -> Non
     assert np.abs(with_truth.position_m - p).max() < 1e-6
     nominal = fastcal.locate(data.s0_m)
     assert np.abs(nominal.position_m - p).max() > 0.1
+
+
+def test_a_calibration_with_lengths_reports_them(data_dir) -> None:
+    p = fastcal.random_workspace(samples=150, seed=4, radial_spread_m=3.0)
+    truth = fastcal.Model.nominal()
+    truth.length_offset_m = [0.1, -0.2, 0.05, 0.3, -0.1, 0.0]
+    data, _, _ = fastcal.simulate(p, quat=fastcal.focal_attitude(p), model=truth, seed=6,
+                                  length_noise_m=0.005)
+    result = fastcal.calibrate(str(data_dir / "spec_lengths.yaml"), data)
+    assert result.lengths is not None and result.lengths["sigma_m"] == 0.005
+    assert (result.lengths["calibrated_rms_m"] < 0.01).all()
+    for i, offset in enumerate(truth.length_offset_m):
+        name = f"length_offset_m[{i + 1}]"
+        assert abs(result.estimates[name] - offset) < 3 * result.sigma_total[name]
+    np.testing.assert_allclose(result.model.length_offset_m, [result.estimates[
+        f"length_offset_m[{i + 1}]"] for i in range(6)])

@@ -73,6 +73,9 @@ struct Prediction {
   std::vector<std::array<double, kNumCables>> sigma_n;    // whitening sigma from the reading
   std::vector<std::array<double, kNumCables>> whitened;   // (reading - measured) / sigma
   std::vector<internal::CompactStart> starts;             // the statics there (warm starts)
+  // With lengths in the fit (else empty): s0 + offset, and (that - measured) / sigma_L.
+  std::vector<std::array<double, kNumCables>> length_m;
+  std::vector<std::array<double, kNumCables>> length_whitened;
 };
 
 struct Run {
@@ -99,6 +102,10 @@ struct Run {
   // The weights and exclusions of the current problem, per fitted sample / dataset sample.
   std::vector<std::array<double, kNumCables>> sigma_n;
   ReadingMask excluded;
+  // With lengths in the fit: the lengths kept out, per dataset sample, and the initial
+  // model's predicted lengths (for the table before and after).
+  ReadingMask length_excluded;
+  std::vector<std::array<double, kNumCables>> initial_length_m;
   // The slow sensor error the current problem whitens by (inactive: white noise only),
   // and per fitted sample each reading's sigma_slow / sigma_white (sample_rows.h).
   SlowErrorProcess slow;
@@ -140,8 +147,12 @@ struct Run {
     s.statics = statics;
     s.slow_error = slow;
     s.slow_rho = &slow_rho;
+    s.length_sigma_m = spec.length_sigma_m;
+    s.length_excluded = &length_excluded;
     return s;
   }
+  // Readings per sample: the tensions, and the lengths when the spec uses them.
+  int Readings() const { return spec.UsesLengths() ? 2 * kNumCables : kNumCables; }
   CalibrationStatus Fail(CalibrationStatus status, const std::string& why) const {
     *error = why;
     return status;
@@ -185,9 +196,11 @@ std::unique_ptr<ceres::LossFunction> MakeLoss(const CalibrationSpec& spec) {
 
 int CountExcluded(const Run& run) {
   int count = 0;
-  if (run.excluded.empty()) return 0;
-  for (int t : run.fit) {
-    for (bool e : run.excluded[t]) count += e;
+  for (const ReadingMask* mask : {&run.excluded, &run.length_excluded}) {
+    if (mask->empty()) continue;
+    for (int t : run.fit) {
+      for (bool e : (*mask)[t]) count += e;
+    }
   }
   return count;
 }
@@ -210,6 +223,12 @@ CalibrationStatus ValidateInputs(Run& run) {
                         StaticsMethodName(run.spec.forward_model) +
                         " models uniform cables, but the model's cables carry attachments; "
                         "use forward_model: exact");
+  }
+  if (run.spec.UsesLengths() && !run.data.has_unstretched_lengths) {
+    return run.Fail(CalibrationStatus::kInvalidInput,
+                    run.data.path +
+                        ": the spec fits the lengths (noise.length_sigma_m) but the dataset has "
+                        "no s0_1_m ... s0_6_m columns");
   }
   if (run.spec.use_planned_attitude && !run.data.has_planned_attitude) {
     return run.Fail(CalibrationStatus::kInvalidInput,
@@ -242,7 +261,7 @@ CalibrationStatus ValidateInputs(Run& run) {
   }
   r.num_fit_samples = static_cast<int>(run.fit.size());
   for (int k = 0; k < run.n; ++k) run.num_priors += run.Free(k).has_prior;
-  r.num_residuals = kNumCables * r.num_fit_samples + run.num_priors;
+  r.num_residuals = run.Readings() * r.num_fit_samples + run.num_priors;
   if (run.fit.empty()) return run.Fail(CalibrationStatus::kInvalidInput, "no samples to fit");
   if (r.num_residuals <= run.n) {
     return run.Fail(CalibrationStatus::kInvalidInput,
@@ -308,16 +327,20 @@ CalibrationStatus Predict(Run& run) {
   // One model per session (a single one without sessions).
   const size_t sessions = std::max<size_t>(1, run.data.session_labels.size());
   std::vector<StaticsParameters<double>> session_params(sessions);
-  std::vector<std::array<double, kNumCables>> session_gain(sessions), session_bias(sessions);
+  std::vector<std::array<double, kNumCables>> session_gain(sessions), session_bias(sessions),
+      session_offset(sessions);
   for (size_t k = 0; k < sessions; ++k) {
     run.cm->Assemble(run.theta.data(), &session_params[k], &session_gain[k], &session_bias[k],
-                     static_cast<int>(k));
+                     static_cast<int>(k), &session_offset[k]);
   }
+  const bool lengths = run.spec.UsesLengths();
   const int num_samples = static_cast<int>(run.data.samples.size());
   Prediction& at = run.at;
   at.reading_n.resize(num_samples);
   at.sigma_n.resize(num_samples);
   at.whitened.resize(num_samples);
+  at.length_m.resize(lengths ? num_samples : 0);
+  at.length_whitened.resize(lengths ? num_samples : 0);
   // Each sample starts from its statics at the previous parameters, when there are any.
   at.starts.resize(num_samples);
   StaticsOptions options = run.statics;
@@ -345,6 +368,12 @@ CalibrationStatus Predict(Run& run) {
           for (int i = 0; i < kNumCables; ++i) {
             at.whitened[t][i] = (at.reading_n[t][i] - sample.tension_n[i]) / at.sigma_n[t][i];
           }
+          for (int i = 0; i < kNumCables && lengths; ++i) {
+            at.length_m[t][i] =
+                solution.cables[i].unstretched_length_m + session_offset[sample.session][i];
+            at.length_whitened[t][i] =
+                (at.length_m[t][i] - sample.unstretched_length_m[i]) / run.spec.length_sigma_m;
+          }
         }
         return -1;
       });
@@ -361,15 +390,18 @@ CalibrationStatus Predict(Run& run) {
 // The screen's threshold: the spec's as a floor, raised with the number of readings
 // screened (all samples') so that noise alone names none (gross_errors.h).
 GrossErrorThreshold ScreenThreshold(const Run& run) {
-  return ChooseGrossErrorThreshold(static_cast<long long>(kNumCables) * run.data.samples.size(),
+  return ChooseGrossErrorThreshold(static_cast<long long>(run.Readings()) * run.data.samples.size(),
                                    run.spec.gross_error_threshold_sigmas);
 }
 
-// Stage helper: the gross errors at the current prediction, judged by the fitted samples.
-ReadingMask ScreenReadings(Run& run) {
+// Stage helper: the gross errors at the current prediction, judged by the fitted samples:
+// the tensions' and, with lengths in the fit, the lengths' (*lengths; each reading
+// against its own cable's robust scale).
+ReadingMask ScreenReadings(Run& run, ReadingMask* lengths) {
+  lengths->clear();
   if (!run.spec.detect_gross_errors) return {};
-  GrossErrorScreen screen =
-      ScreenGrossErrors(run.at.whitened, run.is_fit, ScreenThreshold(run).sigmas);
+  const double threshold = ScreenThreshold(run).sigmas;
+  GrossErrorScreen screen = ScreenGrossErrors(run.at.whitened, run.is_fit, threshold);
   GrossErrorSummary& g = run.result->gross_error_summary;
   for (int i = 0; i < kNumCables; ++i) {
     g.centre[i] = screen.cables[i].centre;
@@ -377,6 +409,17 @@ ReadingMask ScreenReadings(Run& run) {
   }
   g.fitted_readings = screen.judged;
   g.fitted_flagged = screen.count;
+  if (run.spec.UsesLengths()) {
+    GrossErrorScreen length_screen =
+        ScreenGrossErrors(run.at.length_whitened, run.is_fit, threshold);
+    for (int i = 0; i < kNumCables; ++i) {
+      g.length_centre[i] = length_screen.cables[i].centre;
+      g.length_scale[i] = length_screen.cables[i].scale;
+    }
+    g.fitted_readings += length_screen.judged;
+    g.fitted_flagged += length_screen.count;
+    *lengths = std::move(length_screen.flagged);
+  }
   return std::move(screen.flagged);
 }
 
@@ -408,6 +451,20 @@ void BuildProblem(Run& run) {
 // ---------------------------------------------------------------------------------------
 // Stage: refuse a free set the data and priors cannot determine (before solving).
 
+// Why lengths and tensions together may not separate an encoder's offset from the rest,
+// when a direction the data cannot determine involves one.
+std::string LengthOffsetHint(const std::vector<ParameterDirection>& directions) {
+  for (const ParameterDirection& d : directions) {
+    for (const auto& [name, weight] : d.weights) {
+      if (name.rfind(ParameterGroupName(ParameterKind::kLengthOffset), 0) != 0) continue;
+      return "a length encoder's offset adds the same to every reading of its cable's length, "
+             "so the lengths tell it from the cable's stretch (EA), sag (density) and "
+             "geometry only where the tensions and poses vary over the survey; ";
+    }
+  }
+  return "";
+}
+
 std::string DescribeRefusal(const Run& run) {
   const Identifiability& before = run.result->before;
   std::ostringstream refuse;
@@ -417,6 +474,7 @@ std::string DescribeRefusal(const Run& run) {
       refuse << "  - " << d.Describe() << "   (singular value ratio "
              << RatioText(d.singular_value_ratio) << ")\n";
     }
+    refuse << LengthOffsetHint(before.undetermined);
     return refuse.str();
   }
   bool any = false;
@@ -445,6 +503,7 @@ std::string DescribeRefusal(const Run& run) {
     refuse << "  - " << d.Describe() << "   (singular value ratio "
            << RatioText(d.singular_value_ratio) << ")\n";
   }
+  refuse << LengthOffsetHint(before.poorly_determined);
   return refuse.str();
 }
 
@@ -564,15 +623,19 @@ CalibrationStatus SolveAndReweight(Run& run) {
     if (!summary.IsSolutionUsable()) break;
     const CalibrationStatus status = Predict(run);
     if (status != CalibrationStatus::kOk) return status;
-    const bool slow_settled =
-        ReestimateSlowError(run, pass < std::max(2, run.options.max_passes));
-    ReadingMask screened = ScreenReadings(run);
-    if (pass >= 2 && screened == run.excluded && slow_settled) break;
+    const bool slow_settled = ReestimateSlowError(run, pass < std::max(2, run.options.max_passes));
+    ReadingMask screened_lengths;
+    ReadingMask screened = ScreenReadings(run, &screened_lengths);
+    if (pass >= 2 && screened == run.excluded && screened_lengths == run.length_excluded &&
+        slow_settled) {
+      break;
+    }
     if (pass == std::max(2, run.options.max_passes)) {
       r.gross_error_summary.settled = false;
       break;
     }
     run.excluded = std::move(screened);
+    run.length_excluded = std::move(screened_lengths);
   }
   r.ceres_brief_report = brief;
   r.ceres_full_report = full;
@@ -584,7 +647,7 @@ CalibrationStatus SolveAndReweight(Run& run) {
     return run.Fail(CalibrationStatus::kSolverFailed, "the solver failed: " + summary.message);
   }
   const int excluded = CountExcluded(run);
-  r.num_residuals = kNumCables * r.num_fit_samples - excluded + run.num_priors;
+  r.num_residuals = run.Readings() * r.num_fit_samples - excluded + run.num_priors;
   r.reduced_chi_square = 2.0 * summary.final_cost / (r.num_residuals - run.n);
   return CalibrationStatus::kOk;
 }
@@ -603,17 +666,36 @@ CalibrationStatus CheckStatedSlowError(Run& run) {
 // ---------------------------------------------------------------------------------------
 // Stage: the gross errors, named; a dataset that is mostly gross errors is refused.
 
+// Reading i of sample t: a tension (i < 6) or, with lengths in the fit, the length of
+// cable i - 6.
 ReadingResidual ReadingAt(const Run& run, int t, int i) {
   ReadingResidual g;
   const Sample& s = run.data.samples[t];
   g.sample = t;
   g.line = s.line;
-  g.cable = i + 1;
-  g.measured_n = s.tension_n[i];
-  g.predicted_n = run.at.reading_n[t][i];
-  g.residual_sigma = run.at.whitened[t][i];
   g.held_out = !run.is_fit[t];
+  g.length = i >= kNumCables;
+  const int c = i % kNumCables;
+  g.cable = c + 1;
+  if (g.length) {
+    g.measured_m = s.unstretched_length_m[c];
+    g.predicted_m = run.at.length_m[t][c];
+    g.residual_sigma = run.at.length_whitened[t][c];
+    return g;
+  }
+  g.measured_n = s.tension_n[c];
+  g.predicted_n = run.at.reading_n[t][c];
+  g.residual_sigma = run.at.whitened[t][c];
   return g;
+}
+
+// Whether reading i of sample t is kept out, and its whitened residual (ReadingAt's i).
+bool ReadingExcluded(const Run& run, int t, int i) {
+  const ReadingMask& mask = i < kNumCables ? run.excluded : run.length_excluded;
+  return !mask.empty() && mask[t][i % kNumCables];
+}
+double ReadingWhitened(const Run& run, int t, int i) {
+  return i < kNumCables ? run.at.whitened[t][i] : run.at.length_whitened[t][i - kNumCables];
 }
 
 // More than half of the fitted readings farther from the fit than the threshold in
@@ -636,22 +718,24 @@ CalibrationStatus NameGrossErrors(Run& run) {
   g.enabled = run.spec.detect_gross_errors;
   g.threshold = ScreenThreshold(run);
   g.threshold_sigmas = g.threshold.sigmas;
-  g.fitted_readings = kNumCables * r.num_fit_samples;
+  g.fitted_readings = run.Readings() * r.num_fit_samples;
   r.excluded = run.excluded;
+  r.length_excluded = run.length_excluded;
   if (!g.enabled) return CalibrationStatus::kOk;
-  for (size_t t = 0; t < run.excluded.size(); ++t) {
-    for (int i = 0; i < kNumCables; ++i) {
-      if (!run.excluded[t][i]) continue;
-      r.gross_errors.push_back(ReadingAt(run, static_cast<int>(t), i));
-      ++g.count[i];
+  const int num_samples = static_cast<int>(run.data.samples.size());
+  for (int t = 0; t < num_samples && !run.excluded.empty(); ++t) {
+    for (int i = 0; i < run.Readings(); ++i) {
+      if (!ReadingExcluded(run, t, i)) continue;
+      r.gross_errors.push_back(ReadingAt(run, t, i));
+      ++(i < kNumCables ? g.count[i] : g.length_count[i - kNumCables]);
     }
   }
   g.fitted_flagged = CountExcluded(run);
   int far = 0;
   const ReadingResidual* first_far = nullptr;
   for (int t : run.fit) {
-    for (int i = 0; i < kNumCables; ++i) {
-      if (std::abs(run.at.whitened[t][i]) <= g.threshold_sigmas) continue;
+    for (int i = 0; i < run.Readings(); ++i) {
+      if (std::abs(ReadingWhitened(run, t, i)) <= g.threshold_sigmas) continue;
       ++far;
       if (first_far == nullptr && r.gross_errors.empty()) {
         r.gross_errors.push_back(ReadingAt(run, t, i));  // named in the refusal only
@@ -676,10 +760,10 @@ CalibrationStatus NameGrossErrors(Run& run) {
     return CalibrationStatus::kOk;
   }
   const ReadingResidual& first = r.gross_errors.front();
-  return run.Fail(CalibrationStatus::kMostlyGrossErrors,
-                  message + "the first is " +
-                      SampleWhere(run.data, run.data.samples[first.sample]) + " cable " +
-                      std::to_string(first.cable));
+  return run.Fail(
+      CalibrationStatus::kMostlyGrossErrors,
+      message + "the first is " + SampleWhere(run.data, run.data.samples[first.sample]) +
+          (first.length ? " length of cable " : " cable ") + std::to_string(first.cable));
 }
 
 // ---------------------------------------------------------------------------------------
@@ -692,6 +776,8 @@ std::vector<ParameterSpec> Candidates(const Run& run, std::vector<double>* value
   std::vector<ParameterSpec> out;
   value_si->clear();
   for (ParameterSpec c : AllModelParameters(run.model)) {
+    // Without lengths in the fit an encoder's offset moves no reading.
+    if (c.kind == ParameterKind::kLengthOffset && !run.spec.UsesLengths()) continue;
     bool free = false;
     for (const ParameterSpec& p : run.spec.parameters) {
       if (!SameParameter(p, c)) continue;
@@ -743,7 +829,7 @@ BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
   in.information.diagonal() += in.prior_information;
   in.scores = std::move(lin.scores);
   in.jacobians = std::move(lin.jacobians);
-  in.rows_per_sample = kNumCables;
+  in.rows_per_sample = run.Readings();
   in.num_residuals = run.result->num_residuals;
   in.chi_square = lin.raw_chi_square + PriorChiSquare(run);
   in.robust_loss = run.loss != nullptr;
@@ -1003,9 +1089,9 @@ CalibrationStatus FindWorstReadings(Run& run) {
   const size_t keep = static_cast<size_t>(std::max(0, run.options.worst_readings));
   std::vector<Entry> heap;  // the best of the worst on top (a heap under `worse`)
   for (int t : run.fit) {
-    for (int i = 0; i < kNumCables && keep > 0; ++i) {
-      if (!run.excluded.empty() && run.excluded[t][i]) continue;
-      const Entry e{std::abs(run.at.whitened[t][i]), t, i};
+    for (int i = 0; i < run.Readings() && keep > 0; ++i) {
+      if (ReadingExcluded(run, t, i)) continue;
+      const Entry e{std::abs(ReadingWhitened(run, t, i)), t, i};
       if (heap.size() < keep) {
         heap.push_back(e);
         std::push_heap(heap.begin(), heap.end(), worse);
@@ -1022,6 +1108,7 @@ CalibrationStatus FindWorstReadings(Run& run) {
   for (const Entry& e : heap) worst.push_back(ReadingAt(run, e.t, e.i));
   run.at.whitened = std::vector<std::array<double, kNumCables>>();
   run.at.sigma_n = std::vector<std::array<double, kNumCables>>();
+  run.at.length_whitened = std::vector<std::array<double, kNumCables>>();
   return CalibrationStatus::kOk;
 }
 
@@ -1081,6 +1168,7 @@ CalibrationStatus ScanChanges(Run& run) {
   ChangeScanInputs in;
   in.residuals = &run.lin.residuals;
   in.jacobians = &run.lin.jacobians;
+  in.rows_per_sample = run.Readings();
   in.num_free = run.n;
   in.prior_information = Eigen::VectorXd::Zero(run.n);
   in.prior_gradient = Eigen::VectorXd::Zero(run.n);
@@ -1411,9 +1499,54 @@ void AddNotes(Run& run) {
 // ---------------------------------------------------------------------------------------
 // Stage: the model against the measurements before and after (the paper's Table 6):
 // the initial model at each attitude the data has and the calibrated one at the fit's,
-// exact statics, gross errors left out.
+// exact statics, gross errors left out; with lengths in the fit their residuals too.
+
+// Model minus measured lengths per cable over the fitted samples (`held_out` false) or
+// the held-out ones, the gross errors left out.
+LengthResidualStats LengthStats(const Run& run,
+                                const std::vector<std::array<double, kNumCables>>& model_m,
+                                bool held_out) {
+  LengthResidualStats s;
+  std::array<double, kNumCables> sum{}, sum2{};
+  std::array<int, kNumCables> count{};
+  for (size_t t = 0; t < model_m.size(); ++t) {
+    if (run.result->held_out[t] != held_out) continue;
+    ++s.samples;
+    for (int i = 0; i < kNumCables; ++i) {
+      if (!run.length_excluded.empty() && run.length_excluded[t][i]) {
+        ++s.excluded[i];
+        continue;
+      }
+      const double d = model_m[t][i] - run.data.samples[t].unstretched_length_m[i];
+      sum[i] += d;
+      sum2[i] += d * d;
+      s.max_abs_m[i] = std::max(s.max_abs_m[i], std::abs(d));
+      ++count[i];
+    }
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    if (count[i] == 0) continue;
+    s.mean_m[i] = sum[i] / count[i];
+    s.rms_m[i] = std::sqrt(sum2[i] / count[i]);
+  }
+  return s;
+}
+
+void EvaluateLengths(Run& run) {
+  LengthEvaluation& l = run.result->lengths;
+  if (!run.spec.UsesLengths()) return;
+  l.used = true;
+  l.sigma_m = run.spec.length_sigma_m;
+  l.initial = LengthStats(run, run.initial_length_m, false);
+  l.calibrated = LengthStats(run, run.at.length_m, false);
+  l.initial_holdout = LengthStats(run, run.initial_length_m, true);
+  l.calibrated_holdout = LengthStats(run, run.at.length_m, true);
+  run.initial_length_m = std::vector<std::array<double, kNumCables>>();
+}
+
 CalibrationStatus Evaluate(Run& run) {
   CalibrationResult& r = *run.result;
+  EvaluateLengths(run);
   if (!run.options.evaluate) return CalibrationStatus::kOk;
   // With exact statics the last prediction is the calibrated model's row already, and
   // its statics each sample's warm start for the other rows.
@@ -1476,7 +1609,8 @@ CalibrationStatus PredictAndScreen(Run& run) {
   const CalibrationStatus status = Predict(run);
   if (status != CalibrationStatus::kOk) return status;
   internal::WhitenPrediction(run.slow, run.View(), &run.at.whitened);
-  run.excluded = ScreenReadings(run);
+  run.excluded = ScreenReadings(run, &run.length_excluded);
+  run.initial_length_m = run.at.length_m;
   return status;
 }
 

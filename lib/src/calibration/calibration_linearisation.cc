@@ -17,10 +17,13 @@ namespace {
 constexpr int kQrChunkRows = 1024;
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// A sample's residuals: its readings (FittedSamples::readings), six or twelve.
+using SampleResiduals = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxReadings, 1>;
 
 bool IsPerCableGroup(ParameterKind kind) {
   return kind == ParameterKind::kLinearDensity || kind == ParameterKind::kEa ||
-         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias;
+         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias ||
+         kind == ParameterKind::kLengthOffset;
 }
 
 // Whether basis parameter `b` is part of parameter `p`: itself, or one cable of a
@@ -32,7 +35,7 @@ bool Covers(const ParameterSpec& p, const ParameterSpec& b) {
 // The robust loss's IRLS weight sqrt(rho'(|r|^2)) of a sample's residuals (1 without a
 // loss); `curvature` (may be null) receives 2 rho'' for the loss's exact Hessian
 // rho' J^T J + 2 rho'' (J^T r)(J^T r)^T (0 without a loss).
-double LossWeight(const ceres::LossFunction* loss, const Eigen::Matrix<double, kNumCables, 1>& r,
+double LossWeight(const ceres::LossFunction* loss, const SampleResiduals& r,
                   double* curvature = nullptr) {
   if (curvature != nullptr) *curvature = 0.0;
   if (loss == nullptr) return 1.0;
@@ -48,14 +51,21 @@ bool EvaluateRows(const TensionResidual& f, const double* theta, int t, SampleRo
   for (int i = 0; i < kNumCables; ++i) {
     if (f.excluded[i]) std::fill(rows->Row(t, i), rows->Row(t, i) + rows->columns, 0.0);
   }
+  for (int i = 0; i < kNumCables && f.readings() > kNumCables; ++i) {
+    if (!f.length_excluded[i]) continue;
+    double* row = rows->Row(t, kNumCables + i);
+    std::fill(row, row + rows->columns, 0.0);
+  }
   return true;
 }
 
 // Sample t's residuals and n-column Jacobian from `rows`.
-void RowsOf(const SampleRows& rows, int t, Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j) {
+void RowsOf(const SampleRows& rows, int t, SampleResiduals* r, RowMatrix* j) {
   const int n = rows.columns - 1;
   const double* values = rows.Of(t);
-  for (int i = 0; i < kNumCables; ++i) {
+  r->resize(rows.readings);
+  j->resize(rows.readings, n);
+  for (int i = 0; i < rows.readings; ++i) {
     for (int k = 0; k < n; ++k) (*j)(i, k) = values[i * rows.columns + k];
     (*r)[i] = values[i * rows.columns + n];
   }
@@ -134,9 +144,9 @@ struct FreeSums {
 // The cross-validation block sums of one sample: the whitened rows r, j for the
 // prediction, the rows as evaluated (r_raw, j_raw: before the slow-error whitening; the
 // same without it) in newtons for the RMS.
-void AddToFold(const TensionResidual& f, const Eigen::Matrix<double, kNumCables, 1>& r,
-               const RowMatrix& j, const Eigen::Matrix<double, kNumCables, 1>& r_raw,
-               const RowMatrix& j_raw, double weight, FoldSums* fold) {
+void AddToFold(const TensionResidual& f, const SampleResiduals& r, const RowMatrix& j,
+               const SampleResiduals& r_raw, const RowMatrix& j_raw, double weight,
+               FoldSums* fold) {
   ++fold->samples;
   fold->information.noalias() += weight * weight * j.transpose() * j;
   fold->gradient.noalias() += weight * weight * j.transpose() * r;
@@ -161,7 +171,7 @@ struct FreeChunk {
 
 // Fitted samples [begin, end) evaluated into chunk->rows; the first that fails, or -1.
 int EvaluateFree(const LinearisationInputs& in, int begin, int end, FreeChunk* chunk) {
-  chunk->rows.Reset(begin, end, in.samples.model->num_free() + 1);
+  chunk->rows.Reset(begin, end, in.samples.model->num_free() + 1, in.samples.readings());
   for (int t = begin; t < end; ++t) {
     if (!EvaluateRows(in.samples.At(t), in.theta, t, &chunk->rows)) return t;
   }
@@ -174,8 +184,8 @@ void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   FreeSums* sums = &chunk->sums;
-  RowMatrix j(kNumCables, n), j_raw(kNumCables, n);
-  Eigen::Matrix<double, kNumCables, 1> r, r_raw;
+  RowMatrix j, j_raw;
+  SampleResiduals r, r_raw;
   for (int t = begin; t < end; ++t) {
     const TensionResidual f = in.samples.At(t);
     RowsOf(chunk->rows, t, &r, &j);
@@ -186,7 +196,7 @@ void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
     const Eigen::VectorXd rw = weight * r;
     out->residuals.row(t) = r.transpose();
     out->scores.row(t) = rw.transpose() * jw;
-    for (int i = 0; i < kNumCables; ++i) {
+    for (int i = 0; i < jw.rows(); ++i) {
       out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
     }
     sums->information.noalias() += jw.transpose() * jw;
@@ -203,6 +213,9 @@ void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
     sums->chi_square += rw.squaredNorm();
     sums->raw_chi_square += r.squaredNorm();
     for (bool e : f.excluded) sums->readings += !e;
+    for (int i = 0; i < kNumCables && f.readings() > kNumCables; ++i) {
+      sums->readings += !f.length_excluded[i];
+    }
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
     AddToFold(f, r, j, r_raw, j_raw, weight, &sums->folds[block]);
   }
@@ -251,7 +264,7 @@ int SessionOf(const CandidatePass& pass, int fitted_sample) {
 // the first that fails (a fitted sample), or -1.
 int EvaluateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
                        int end, CandidateChunk* chunk) {
-  chunk->rows.Reset(begin, end, pass.basis.front().num_free() + 1);
+  chunk->rows.Reset(begin, end, pass.basis.front().num_free() + 1, pass.in.samples.readings());
   for (int k = begin; k < end; ++k) {
     const int session = SessionOf(pass, samples[k]);
     const TensionResidual f = pass.in.samples.At(samples[k], &pass.basis[session]);
@@ -263,8 +276,8 @@ int EvaluateCandidates(const CandidatePass& pass, const std::vector<int>& sample
 // The (whitened) basis rows of samples [begin, end) into the chunk's sums.
 void AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
                           int end, CandidateChunk* chunk, Eigen::MatrixXd* scores) {
-  RowMatrix b(kNumCables, pass.basis.front().num_free());
-  Eigen::Matrix<double, kNumCables, 1> r;
+  RowMatrix b;
+  SampleResiduals r;
   CandidateSums* sums = &chunk->sums;
   for (int k = begin; k < end; ++k) {
     const int session = SessionOf(pass, samples[k]);
@@ -306,13 +319,17 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   const int num_fit = in.samples.size();
   const int blocks = std::clamp(in.cross_validation_blocks, 1, std::max(1, num_fit));
   out->scores = Eigen::MatrixXd::Zero(num_fit, n);
-  out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
-  out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
+  const int readings = in.samples.readings();
+  out->residuals = Eigen::MatrixXd::Zero(num_fit, readings);
+  out->jacobians = SampleJacobians::Zero(num_fit, readings * n);
   const int sessions = static_cast<int>(in.samples.data->session_labels.size());
   FreeSums total(n, blocks, sessions);
   SampleRowWhitener whitener(in.samples, n + 1);
   const int failed = ReduceChunksInOrder<FreeChunk>(
-      num_fit, in.num_threads, [&] { return FreeChunk{FreeSums(n, blocks, sessions), {}, {}}; },
+      num_fit, in.num_threads,
+      [&] {
+        return FreeChunk{FreeSums(n, blocks, sessions), {}, {}};
+      },
       [&](int begin, int end, FreeChunk* chunk) { return EvaluateFree(in, begin, end, chunk); },
       [&](int, int, FreeChunk* chunk) {
         chunk->raw = chunk->rows;
@@ -346,7 +363,8 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   const int q = static_cast<int>(in.candidates.size());
   const CableRobot& model = fitted.robot();
   CalibrationSpec basis_spec;
-  basis_spec.parameters = BasisParameters(model);
+  const bool lengths = in.samples.readings() > kNumCables;
+  basis_spec.parameters = BasisParameters(model, lengths);
   CandidatePass pass{in, {}, {}, {}, {}, {}};
   const int sessions = std::max<int>(1, static_cast<int>(in.samples.data->session_labels.size()));
   for (int s = 0; s < sessions; ++s) {
@@ -355,18 +373,17 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   }
   for (int k = 0; k < n; ++k) {
     const ParameterSpec& p = fitted.spec().parameters[fitted.spec_index(k)];
-    pass.free_columns.push_back(BasisColumns(p, model));
+    pass.free_columns.push_back(BasisColumns(p, model, lengths));
     pass.free_session.push_back(p.session);
   }
   for (const ParameterSpec& p : in.candidates) {
-    pass.candidate_columns.push_back(BasisColumns(p, model));
+    pass.candidate_columns.push_back(BasisColumns(p, model, lengths));
   }
   // With a slow error the whitening needs neighbours: contiguous runs (each a series of
   // its own) rather than single samples spread out.
   const std::vector<int> samples =
-      in.samples.whitened()
-          ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
-          : CandidateSamples(in.samples.size(), in.max_candidate_samples);
+      in.samples.whitened() ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
+                            : CandidateSamples(in.samples.size(), in.max_candidate_samples);
   const auto zero = [&] {
     return CandidateSums{Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q),
                          Eigen::VectorXd::Zero(q), Eigen::MatrixXd::Zero(n, n)};
@@ -376,7 +393,9 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   SampleRowWhitener whitener(in.samples, pass.basis.front().num_free() + 1);
   const int failed = ReduceChunksInOrder<CandidateChunk>(
       static_cast<int>(samples.size()), in.num_threads,
-      [&] { return CandidateChunk{zero(), {}}; },
+      [&] {
+        return CandidateChunk{zero(), {}};
+      },
       [&](int begin, int end, CandidateChunk* chunk) {
         return EvaluateCandidates(pass, samples, begin, end, chunk);
       },
@@ -409,18 +428,19 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
 
 }  // namespace
 
-std::vector<ParameterSpec> BasisParameters(const CableRobot& model) {
+std::vector<ParameterSpec> BasisParameters(const CableRobot& model, bool lengths) {
   std::vector<ParameterSpec> basis;
   for (ParameterSpec p : AllModelParameters(model)) {
     if (IsPerCableGroup(p.kind) && p.index < 0) continue;
+    if (p.kind == ParameterKind::kLengthOffset && !lengths) continue;
     p.free = true;
     basis.push_back(p);
   }
   return basis;
 }
 
-std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model) {
-  const std::vector<ParameterSpec> basis = BasisParameters(model);
+std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model, bool lengths) {
+  const std::vector<ParameterSpec> basis = BasisParameters(model, lengths);
   std::vector<int> columns;
   for (size_t c = 0; c < basis.size(); ++c) {
     if (Covers(p, basis[c])) columns.push_back(static_cast<int>(c));

@@ -11,6 +11,7 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
     anchor_of_cable_[i] = robot.cables[i].anchor_index;
     base_gain_[i] = robot.cables[i].sensor_gain;
     base_bias_n_[i] = robot.cables[i].sensor_bias_n;
+    base_offset_m_[i] = robot.cables[i].length_offset_m;
   }
   for (size_t j = 0; j < spec.parameters.size(); ++j) {
     const ParameterSpec& s = spec.parameters[j];
@@ -51,6 +52,9 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
         case ParameterKind::kAttachmentMass:
         case ParameterKind::kAttachmentDensity:
           if (i == s.index) base_.chain[i].value[s.component] = v;
+          break;
+        case ParameterKind::kLengthOffset:
+          if (cable) base_offset_m_[i] = v;
           break;
       }
     }
@@ -94,6 +98,12 @@ double CalibrationModel::BaseValue(const ParameterSpec& s) const {
     case ParameterKind::kAttachmentMass:
     case ParameterKind::kAttachmentDensity:
       return base_.chain[c].value[s.component];
+    case ParameterKind::kLengthOffset: {
+      if (s.index >= 0) return base_offset_m_[c];
+      double sum = 0;
+      for (double d : base_offset_m_) sum += d;
+      return sum / kNumCables;
+    }
   }
   return 0.0;
 }
@@ -109,8 +119,8 @@ std::vector<double> CalibrationModel::InitialTheta() const {
 
 CableRobot CalibrationModel::ToRobot(const double* theta, int session) const {
   StaticsParameters<double> p;
-  std::array<double, kNumCables> gain, bias;
-  Assemble(theta, &p, &gain, &bias, session);
+  std::array<double, kNumCables> gain, bias, offset;
+  Assemble(theta, &p, &gain, &bias, session, &offset);
   CableRobot out = robot_;
   // Anchor points: the offset of the first cable tied to each point (all its cables
   // carry the same offset by construction).
@@ -129,6 +139,7 @@ CableRobot CalibrationModel::ToRobot(const double* theta, int session) const {
     c.linear_density_kg_per_m = p.linear_density_kg_per_m[i];
     c.sensor_gain = gain[i];
     c.sensor_bias_n = bias[i];
+    c.length_offset_m = offset[i];
     for (size_t j = 0; j < c.attachments.size(); ++j)
       c.attachments[j].SetValue(p.chain[i].value[j]);
   }
@@ -160,12 +171,19 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
   if (starts != nullptr && !starts->empty()) f.start = (*starts)[t];
   if (excluded != nullptr && !excluded->empty()) f.excluded = (*excluded)[t];
   f.session = sample.session;
+  if (length_sigma_m > 0.0) {
+    f.length_sigma_m = length_sigma_m;
+    f.measured_length_m = sample.unstretched_length_m;
+    if (length_excluded != nullptr && !length_excluded->empty()) {
+      f.length_excluded = (*length_excluded)[t];
+    }
+  }
   return f;
 }
 
 TensionCost::TensionCost(const TensionResidual& functor)
     : functor_(functor), n_(functor.model->num_free()) {
-  set_num_residuals(kNumCables);
+  set_num_residuals(functor.readings());
   mutable_parameter_block_sizes()->push_back(n_);
 }
 
@@ -174,9 +192,9 @@ bool TensionCost::EvaluateJet(const double* theta, double* residuals, double* ja
   using Jet = ceres::Jet<double, N>;
   std::array<Jet, N> t;
   for (int k = 0; k < n_; ++k) t[k] = Jet(theta[k], k);
-  std::array<Jet, kNumCables> r;
+  std::array<Jet, kMaxReadings> r;
   if (!functor_(t.data(), r.data())) return false;
-  for (int i = 0; i < kNumCables; ++i) {
+  for (int i = 0; i < functor_.readings(); ++i) {
     residuals[i] = r[i].a;
     for (int k = 0; k < n_; ++k) jacobian[i * n_ + k] = r[i].v[k];
   }

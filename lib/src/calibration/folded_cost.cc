@@ -11,9 +11,10 @@
 
 namespace fastcal::internal {
 
-double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n) {
+double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n,
+                      int readings) {
   double sq_norm = 0.0;
-  for (int i = 0; i < kNumCables; ++i) sq_norm += residuals[i] * residuals[i];
+  for (int i = 0; i < readings; ++i) sq_norm += residuals[i] * residuals[i];
   if (loss == nullptr) return sq_norm;
   double rho[3];
   loss->Evaluate(sq_norm, rho);
@@ -27,14 +28,14 @@ double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double
   if (jacobian != nullptr) {
     for (int k = 0; k < n; ++k) {
       double r_dot_j = 0.0;  // (r^T J)_k
-      for (int i = 0; i < kNumCables; ++i) r_dot_j += residuals[i] * jacobian[i * n + k];
-      for (int i = 0; i < kNumCables; ++i) {
+      for (int i = 0; i < readings; ++i) r_dot_j += residuals[i] * jacobian[i * n + k];
+      for (int i = 0; i < readings; ++i) {
         jacobian[i * n + k] =
             sqrt_rho1 * (jacobian[i * n + k] - alpha_sq_norm * residuals[i] * r_dot_j);
       }
     }
   }
-  for (int i = 0; i < kNumCables; ++i) residuals[i] *= residual_scaling;
+  for (int i = 0; i < readings; ++i) residuals[i] *= residual_scaling;
   return rho[0];
 }
 
@@ -52,13 +53,14 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
     double rho = 0.0;
   };
   const int n = n_;
+  const int m = samples_.readings();
   *r_aug = Eigen::MatrixXd();
   *rho_sum = 0.0;
   SampleRowWhitener whitener(samples_, n + 1);
   const int failed = ReduceChunksInOrder<Part>(
       samples_.size(), threads_, [] { return Part(); },
       [&](int begin, int end, Part* part) {
-        part->rows.Reset(begin, end, n + 1);
+        part->rows.Reset(begin, end, n + 1, m);
         for (int t = begin; t < end; ++t) {
           if (!EvaluateSampleRows(samples_.At(t), theta, t, &part->rows)) return t;
         }
@@ -67,19 +69,19 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
       [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
       [&](int begin, int end, Part* part) {
         using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-        RowMatrix j(kNumCables, n);
-        double r[kNumCables];
-        Eigen::MatrixXd rows(kNumCables * (end - begin), n + 1);
+        RowMatrix j(m, n);
+        double r[kMaxReadings];
+        Eigen::MatrixXd rows(m * (end - begin), n + 1);
         for (int t = begin; t < end; ++t) {
-          for (int i = 0; i < kNumCables; ++i) {
+          for (int i = 0; i < m; ++i) {
             const double* row = part->rows.Row(t, i);
             for (int k = 0; k < n; ++k) j(i, k) = row[k];
             r[i] = row[n];
           }
-          part->rho += CorrectForLoss(loss_, r, j.data(), n);
-          const int row = kNumCables * (t - begin);
-          rows.block(row, 0, kNumCables, n) = j;
-          for (int i = 0; i < kNumCables; ++i) rows(row + i, n) = r[i];
+          part->rho += CorrectForLoss(loss_, r, j.data(), n, m);
+          const int row = m * (t - begin);
+          rows.block(row, 0, m, n) = j;
+          for (int i = 0; i < m; ++i) rows(row + i, n) = r[i];
         }
         part->r = FoldRows(part->r, rows);
         return -1;
@@ -101,7 +103,7 @@ double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
   const int failed = ReduceChunksInOrder<Part>(
       samples_.size(), threads_, [] { return Part(); },
       [&](int begin, int end, Part* part) {
-        part->rows.Reset(begin, end, 1);
+        part->rows.Reset(begin, end, 1, samples_.readings());
         for (int t = begin; t < end; ++t) {
           if (!EvaluateSampleRows(samples_.At(t), theta, t, &part->rows)) return t;
         }
@@ -110,7 +112,7 @@ double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
       [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
       [&](int begin, int end, Part* part) {
         for (int t = begin; t < end; ++t) {
-          part->sum += CorrectForLoss(loss_, part->rows.Of(t), nullptr, n_);
+          part->sum += CorrectForLoss(loss_, part->rows.Of(t), nullptr, n_, samples_.readings());
         }
         return -1;
       },

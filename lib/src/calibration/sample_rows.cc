@@ -6,22 +6,23 @@
 namespace fastcal::internal {
 
 bool EvaluateSampleRows(const TensionResidual& f, const double* theta, int t, SampleRows* rows) {
-  double r[kNumCables];
+  double r[kMaxReadings];
   double* out = rows->Of(t);
   const int columns = rows->columns;
+  const int readings = f.readings();
   if (columns == 1) {
     if (!f(theta, r)) return false;
-    std::copy(r, r + kNumCables, out);
+    std::copy(r, r + readings, out);
     return true;
   }
   const int n = columns - 1;
   thread_local std::vector<double> jacobian;
-  jacobian.resize(static_cast<size_t>(kNumCables) * n);
+  jacobian.resize(static_cast<size_t>(readings) * n);
   const TensionCost cost(f);
   const double* parameters[1] = {theta};
   double* jacobians[1] = {jacobian.data()};
   if (!cost.Evaluate(parameters, r, jacobians)) return false;
-  for (int i = 0; i < kNumCables; ++i) {
+  for (int i = 0; i < readings; ++i) {
     double* row = out + i * columns;
     std::copy(jacobian.data() + i * n, jacobian.data() + (i + 1) * n, row);
     row[n] = r[i];

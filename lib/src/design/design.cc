@@ -507,6 +507,15 @@ bool SetUp(const CableRobot& robot, const CalibrationSpec& spec, const DesignOpt
            DesignProblem* pr, std::string* error) {
   if (!o.IsValid(error)) return false;
   if (!spec.IsValid(error)) return false;
+  if (spec.UsesLengths()) {
+    // The design's information is the tensions' (six rows a pose): with the lengths its
+    // predicted sigmas would be another calibration's.
+    *error =
+        "noise.length_sigma_m: the design does not yet count the winches' lengths as "
+        "readings; design with the spec's tensions alone (leave out length_sigma_m and the "
+        "length_offset_m group)";
+    return false;
+  }
   if (!internal::SetUpDesignProblem(spec, pr, error)) return false;
   if (o.samples < pr->n) {
     *error = std::to_string(o.samples) + " samples cannot determine the spec's " +

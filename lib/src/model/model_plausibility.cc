@@ -121,6 +121,9 @@ bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity) {
     case ParameterKind::kAttachmentDensity:
       *quantity = ModelQuantity::kAttachmentDensityKgPerM;
       return true;
+    case ParameterKind::kLengthOffset:
+      *quantity = ModelQuantity::kLengthOffsetM;
+      return true;
     default:
       return false;
   }

@@ -73,10 +73,11 @@ struct Linearisation {
   // the loss's exact Hessian (Triggs et al. 2000), which Gauss-Newton leaves out and
   // which the M-estimator's sandwich needs. 0 without a loss.
   Eigen::MatrixXd loss_curvature;
-  Eigen::MatrixXd r_factor;     // upper triangular R, R^T R = J_x^T J_x
-  Eigen::MatrixXd scores;       // s_t, one row per fitted sample
-  SampleJacobians jacobians;    // J_t (6 x n, row after row), one row per fitted sample
-  Eigen::MatrixXd residuals;    // r_t (fitted samples x 6); 0 where excluded
+  Eigen::MatrixXd r_factor;   // upper triangular R, R^T R = J_x^T J_x
+  Eigen::MatrixXd scores;     // s_t, one row per fitted sample
+  SampleJacobians jacobians;  // J_t (readings x n, row after row), one row per fitted sample
+  Eigen::MatrixXd
+      residuals;  // r_t (fitted samples x readings: 6, or 12 with lengths); 0 where excluded
   double chi_square = 0.0;      // sum (w r)^2 over the data, w the robust loss's weight
   double raw_chi_square = 0.0;  // sum r^2 over the data
   int readings = 0;             // readings not excluded
@@ -102,10 +103,12 @@ struct Linearisation {
   std::vector<int> candidate_rows;
 };
 
-// The basis parameters, in order (all free, no initial: the model's values).
-std::vector<ParameterSpec> BasisParameters(const CableRobot& model);
+// The basis parameters, in order (all free, no initial: the model's values); the length
+// encoders' offsets only with `lengths` (else they move no reading).
+std::vector<ParameterSpec> BasisParameters(const CableRobot& model, bool lengths = false);
 // The basis columns a parameter (of a spec or a candidate) is the sum of.
-std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model);
+std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model,
+                              bool lengths = false);
 
 // Both passes. False, with *error naming the sample's line, when the statics fail there.
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error);

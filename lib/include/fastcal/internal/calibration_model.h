@@ -3,8 +3,11 @@
 //   r_i = (gain_i * T_i(theta; pose) + bias_i - T_measured_i) / sigma_i,   i = 1..6
 // with T_i the forward model's lower-end tension (statics.h) and
 //   sigma_i^2 = sigma_abs^2 + (percent/100 * T_predicted_i)^2
-// (the predicted reading at the previous pass's parameters: calibration.cc), and
-// r_i = 0 for a reading kept out of the fit (a gross error).
+// (the predicted reading at the previous pass's parameters: calibration.cc), and, with
+// the lengths in the fit (spec noise.length_sigma_m), six more readings of the same sample:
+//   r_6+i = (s0_i(theta; pose) + offset_i - s0_measured_i) / sigma_L,      i = 1..6
+// with s0_i exact's unstretched length and offset_i the winch encoder's zero
+// (length_offset_m); r = 0 for a reading kept out of the fit (a gross error).
 // TensionResidual is a pure functor (const members, no side effects); TensionCost wraps
 // it with a Jet whose size is chosen at run time from the number of free parameters, so
 // the whole Jacobian comes from one pass through the statics.
@@ -33,6 +36,10 @@ namespace fastcal::internal {
 // one per attachment.
 inline constexpr int kMaxFreeParameters = 128;
 
+// Readings of one sample: the six tensions (rows 0..5), then with lengths in the fit the
+// six lengths (rows 6..11).
+inline constexpr int kMaxReadings = 2 * kNumCables;
+
 class CalibrationModel {
  public:
   // `spec` must be valid for `robot` (anchor indices in range).
@@ -53,14 +60,18 @@ class CalibrationModel {
   CableRobot ToRobot(const double* theta, int session = 0) const;
 
   // The statics parameters and sensor model at theta for a sample of `session`: a
-  // parameter of another session (ParameterSpec::session) does not apply.
+  // parameter of another session (ParameterSpec::session) does not apply. `offset_m`
+  // (may be null) receives the length encoders' offsets.
   template <typename T>
   void Assemble(const T* theta, StaticsParameters<T>* p, std::array<T, kNumCables>* gain,
-                std::array<T, kNumCables>* bias, int session = 0) const {
+                std::array<T, kNumCables>* bias, int session = 0,
+                std::array<T, kNumCables>* offset_m = nullptr) const {
     CastParametersInto(base_, p);
+    std::array<T, kNumCables> offset;
     for (int i = 0; i < kNumCables; ++i) {
       (*gain)[i] = T(base_gain_[i]);
       (*bias)[i] = T(base_bias_n_[i]);
+      offset[i] = T(base_offset_m_[i]);
     }
     for (int k = 0; k < num_free(); ++k) {
       const ParameterSpec& s = spec_.parameters[free_[k]];
@@ -105,8 +116,14 @@ class CalibrationModel {
         case ParameterKind::kAttachmentDensity:
           p->chain[s.index].value[s.component] = v;
           break;
+        case ParameterKind::kLengthOffset:
+          for (int i = 0; i < kNumCables; ++i) {
+            if (s.index < 0 || s.index == i) offset[i] = v;
+          }
+          break;
       }
     }
+    if (offset_m != nullptr) *offset_m = offset;
   }
 
  private:
@@ -115,7 +132,7 @@ class CalibrationModel {
   std::vector<int> free_;
   std::array<int, kNumCables> anchor_of_cable_{};
   StaticsParameters<double> base_;  // the robot with fixed overrides applied
-  std::array<double, kNumCables> base_gain_{}, base_bias_n_{};
+  std::array<double, kNumCables> base_gain_{}, base_bias_n_{}, base_offset_m_{};
 };
 
 // Whitening sigma of each cable's reading: sqrt(abs^2 + (percent/100 * reading)^2).
@@ -135,12 +152,20 @@ struct TensionResidual {
   // Readings kept out of the fit: their residual is 0, whatever the parameters.
   std::array<bool, kNumCables> excluded{};
   int session = 0;  // the sample's (Sample::session)
+  // With the lengths in the fit (length_sigma_m > 0): the measured lengths, their sigma,
+  // and the lengths kept out. readings() residuals in all.
+  std::array<double, kNumCables> measured_length_m{};
+  double length_sigma_m = 0.0;
+  std::array<bool, kNumCables> length_excluded{};
+
+  int readings() const { return length_sigma_m > 0.0 ? kMaxReadings : kNumCables; }
 
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
     StaticsParameters<T> p;
-    std::array<T, kNumCables> gain, bias, tension;
-    model->Assemble(theta, &p, &gain, &bias, session);
+    std::array<T, kNumCables> gain, bias, tension, offset, length;
+    const bool lengths = length_sigma_m > 0.0;
+    model->Assemble(theta, &p, &gain, &bias, session, &offset);
     // Physical limits: a non-positive gain here, and non-positive mass, density or EA in
     // the statics, make the evaluation fail, which Ceres treats as an infeasible step.
     for (const T& g : gain) {
@@ -150,12 +175,18 @@ struct TensionResidual {
     start.Restore(pose, statics.method, &solution);
     StaticsOptions options = statics;
     options.warm_start = true;
-    if (ModelLowerTensions(p, pose, options, &tension, &solution) != StaticsStatus::kOk) {
+    if (ModelLowerTensions(p, pose, options, &tension, &solution, lengths ? &length : nullptr) !=
+        StaticsStatus::kOk) {
       return false;
     }
     for (int i = 0; i < kNumCables; ++i) {
       residuals[i] =
           excluded[i] ? T(0.0) : (gain[i] * tension[i] + bias[i] - measured_n[i]) / sigma_n[i];
+    }
+    for (int i = 0; i < kNumCables && lengths; ++i) {
+      residuals[kNumCables + i] =
+          length_excluded[i] ? T(0.0)
+                             : (length[i] + offset[i] - measured_length_m[i]) / length_sigma_m;
     }
     return true;
   }
@@ -173,6 +204,10 @@ struct FittedSamples {
   const std::vector<CompactStart>* starts = nullptr;
   // Per dataset sample: readings kept out of the fit (may be null or empty).
   const ReadingMask* excluded = nullptr;
+  // The lengths as readings (CalibrationSpec::length_sigma_m; 0: not used) and, per
+  // dataset sample, the lengths kept out (may be null or empty).
+  double length_sigma_m = 0.0;
+  const ReadingMask* length_excluded = nullptr;
   bool use_planned_attitude = false;
   StaticsOptions statics;
   // The slow sensor error the rows are whitened by (slow_error.h; inactive: white noise
@@ -182,6 +217,8 @@ struct FittedSamples {
   const std::vector<std::array<double, kNumCables>>* slow_rho = nullptr;
 
   int size() const { return static_cast<int>(fit->size()); }
+  // Readings (rows) per sample: the tensions, and the lengths when used.
+  int readings() const { return length_sigma_m > 0.0 ? kMaxReadings : kNumCables; }
   bool whitened() const { return slow_error.IsActive() && slow_rho != nullptr; }
   // Fitted sample j's residual through `through` (default: model).
   TensionResidual At(int j, const CalibrationModel* through = nullptr) const;
