@@ -1449,6 +1449,16 @@ TEST_F(CliTest, DesignWritesPosesSimulateReadsAndRefusesBadInput) {
     EXPECT_TRUE(fs::exists(out + "/" + file)) << file;
   }
   EXPECT_NE(ReadFile(out + "/design.json").find("\"sigma_total\""), std::string::npos);
+  // What binds the poses over the plausible range (issue 29): console, JSON and HTML.
+  EXPECT_NE(r.output.find("holds over the plausible range: mass_centre_m +-0.25 m (margin)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("binding: min_tension at"), std::string::npos) << r.output;
+  for (const char* key :
+       {"\"plausible_range\"", "\"binding\"", "\"limit_kN\": 50", "\"tightest_stop\""}) {
+    EXPECT_NE(ReadFile(out + "/design.json").find(key), std::string::npos) << key;
+  }
+  EXPECT_NE(ReadFile(out + "/design.html").find("<h2>Poses that hold</h2>"), std::string::npos);
   r = Fastcal("simulate --poses=" + out + "/poses.csv --out=" + Path("sim.csv"));
   ASSERT_EQ(r.code, 0) << r.output;
   r = Fastcal("solve --poses=" + out + "/poses.csv --output=" + Path("solve.csv"));
@@ -1467,6 +1477,9 @@ TEST_F(CliTest, DesignWritesPosesSimulateReadsAndRefusesBadInput) {
            " --parameters=cabin_mass_kg --out=" + Path("never"),
        2, "'cabin_mass_kg' is not a free parameter"},
       {"design --spec=" + spec + " --out=" + Path("never"), 2, "--samples=N"},
+      {"design --spec=" + spec + " --samples=40" + grid +
+           " --range-prior-sigmas=-1 --out=" + Path("never"),
+       2, "--range-prior-sigmas must be >= 0"},
   };
   for (const ExpectedRun& c : bad) RunBoundedAndExpect(c);
   Write("nothing_free.yaml", "parameters:\n  mass_centre_m: {x: {free: false}}\n");
