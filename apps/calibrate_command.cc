@@ -177,8 +177,10 @@ each sample is kept meanwhile in a temporary file in /tmp (about 200 bytes a sam
 
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
 // replace there.
-const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "report.html",
-                                                    "report.md", "summary.json", "residuals.csv"};
+// "A*B": any name from A to B (a joint fit of sessions writes one model per session).
+const std::vector<std::string> kCalibrateOutputs = {
+    "model_calibrated.yaml", "model_calibrated@*.yaml", "report.html", "report.md", "summary.json",
+    "residuals.csv"};
 const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
                                                    "residuals.csv"};
 

@@ -32,7 +32,7 @@ import sys
 import tempfile
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-BIN = os.path.join(ROOT, "build", "bin", "fastcal")
+BIN = os.environ.get("FASTCAL_BIN", os.path.join(ROOT, "build", "bin", "fastcal"))
 TRUTH_MC = (0.22, 0.11, 0.5)
 COMMON = ["--trajectory=random", "--max-off-axis-deg=40", "--interval-s=1",
           "--mass-centre=%g,%g,%g" % TRUTH_MC, "--tension-noise-pct=3",
