@@ -2,13 +2,17 @@
 // split times, its null distribution by parametric bootstrap, binary segmentation.
 #include "fastcal/change_scan.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/number_text.h"
+#include "util/yaml_document.h"
 
 namespace fastcal {
 namespace {
@@ -440,9 +444,11 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
       shifts += (k ? ", " : "") + scan.parameters[k] + " " + FormatDouble("%+.3g", c.shift[k]) +
                 " +- " + FormatDouble("%.2g", c.shift_sigma[k]) + " " + scan.units[k];
     }
-    out += (out.empty() ? "" : "; ") + std::string("a change at t = ") +
-           FormatDouble("%.6g", c.time_s) + " s (line " + std::to_string(c.line) + ", p " +
-           FormatDouble("%.2g", c.p_value) + "): " + shifts;
+    const std::string when = scan.time_display.absolute
+                                 ? TimeText(c.time_s, scan.time_display)
+                                 : "t = " + TimeText(c.time_s, scan.time_display);
+    out += (out.empty() ? "" : "; ") + std::string("a change at ") + when + " (line " +
+           std::to_string(c.line) + ", p " + FormatDouble("%.2g", c.p_value) + "): " + shifts;
   }
   if (scan.widening > kMemoryWorthSaying) {
     out += " (the residuals' memory widens the scan by " + FormatDouble("%.2g", scan.widening) +
@@ -450,9 +456,59 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
            "\"Change scan\")";
   }
   return out + ". The estimates are an average over " + (scan.changes.size() == 1 ? "it" : "them") +
-         ": split the survey there into sessions (a session column) and fit with sessions: "
-         "{separate: [" +
-         groups + "]}";
+         ": cut the survey there, --sessions-at=" + SessionsAtText(scan) +
+         ", and fit with sessions: {separate: [" + groups + "]}";
+}
+
+std::string SessionsAtText(const ChangeScanResult& scan) {
+  std::string text;
+  for (const FoundChange& c : scan.changes) {
+    text += (text.empty() ? "" : ",") + TimeValueText(c.time_s, scan.time_display);
+  }
+  return text;
+}
+
+bool ReadSummaryChangeTimes(const std::string& path, std::vector<double>* times_s,
+                            std::string* error) {
+  constexpr long long kMaxSummaryBytes = 256LL << 20;
+  std::string text;
+  if (!internal::ReadRegularFile(path, kMaxSummaryBytes, "summary.json", &text, error)) {
+    return false;
+  }
+  const std::string what = path + ": ";
+  try {
+    const internal::YamlDocuments documents = internal::LoadYamlDocuments(text);
+    const YAML::Node& root = documents.first;
+    if (!root.IsMap() || !root["changes"] || !root["change_scan"]) {
+      *error = what + "not the summary.json of fastcal calibrate (no \"changes\")";
+      return false;
+    }
+    if (root["change_scan"].IsNull()) {
+      *error = what + "that calibration had no change scan (a spec with change_scan: {...}, "
+                      "docs/calibration.md, \"Change scan\")";
+      return false;
+    }
+    const YAML::Node changes = root["changes"];
+    if (!changes.IsSequence() || changes.size() == 0) {
+      *error = what + "its change scan found no change: nothing to cut at";
+      return false;
+    }
+    std::vector<double> times;
+    for (const YAML::Node& change : changes) {
+      double t = 0.0;
+      if (!change.IsMap() || !change["time_s"] ||
+          !internal::ParseDouble(change["time_s"].Scalar(), &t) || !std::isfinite(t)) {
+        *error = what + "a change without a finite time_s";
+        return false;
+      }
+      times.push_back(t);
+    }
+    *times_s = std::move(times);
+    return true;
+  } catch (const std::exception& e) {
+    *error = what + "cannot read it as JSON: " + e.what();
+    return false;
+  }
 }
 
 }  // namespace fastcal
