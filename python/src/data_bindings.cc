@@ -310,8 +310,8 @@ Dataset ParseDatasetOrThrow(const std::string& text, const std::string& source_n
   return data;
 }
 
-// The canonical CSV text of columns of numbers (`names`, values (n, k), each to 17
-// significant digits: read back to the same double) and optional session labels per
+// The canonical CSV text of columns of numbers (`names`, values (n, k), each with the
+// fewest digits that read back to the same double) and optional session labels per
 // row, for Dataset.from_arrays: read by ParseDataset, so checked as a file is.
 std::string CanonicalText(const std::vector<std::string>& names, const DoubleArray& values,
                           const std::vector<std::string>& sessions) {
@@ -328,8 +328,7 @@ std::string CanonicalText(const std::vector<std::string>& names, const DoubleArr
   std::string text;
   for (size_t c = 0; c < names.size(); ++c) text += (c ? "," : "") + names[c];
   if (!sessions.empty()) text += ",session";
-  text += "
-";
+  text += "\n";
   text.reserve(text.size() + static_cast<size_t>(n * k) * 20);
   char buffer[64];
   for (py::ssize_t r = 0; r < n; ++r) {

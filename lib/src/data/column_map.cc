@@ -543,41 +543,59 @@ double ScaleDecimal(std::string_view field, double parsed, int shift) {
   const double fallback = parsed * std::pow(10.0, shift);
   if (field.find_first_of("xX") != std::string_view::npos) return fallback;  // hex float
   const size_t e = field.find_first_of("eE");
-  std::string shifted;
-  if (e == std::string_view::npos) {
-    shifted.assign(field);
-    shifted += "e" + std::to_string(shift);
-  } else {
+  long exponent = 0;
+  std::string_view mantissa = field;
+  if (e != std::string_view::npos) {
     std::string_view exponent_text = field.substr(e + 1);
     if (!exponent_text.empty() && exponent_text.front() == '+') exponent_text.remove_prefix(1);
-    long exponent = 0;
     const auto [ptr, ec] = std::from_chars(exponent_text.data(),
                                            exponent_text.data() + exponent_text.size(), exponent);
     if (ec != std::errc() || std::labs(exponent) > kMaxShiftableExponent) return fallback;
-    shifted.assign(field.substr(0, e));
-    shifted += "e" + std::to_string(exponent + shift);
+    mantissa = field.substr(0, e);
   }
+  // "<mantissa>e<exponent + shift>", on the stack for the usual field (no allocation a
+  // field: 10^6 rows of them).
+  char stack[96];
+  std::string heap;
+  char* out = stack;
+  if (mantissa.size() + 24 > sizeof(stack)) {
+    heap.resize(mantissa.size() + 24);
+    out = heap.data();
+  }
+  std::memcpy(out, mantissa.data(), mantissa.size());
+  char* end = out + mantissa.size();
+  *end++ = 'e';
+  end = std::to_chars(end, out + mantissa.size() + 24, exponent + shift).ptr;
   double scaled = fallback;
-  ParseDouble(shifted, &scaled);
+  ParseDouble(std::string_view(out, static_cast<size_t>(end - out)), &scaled);
   return scaled;
 }
 
 namespace {
 
-// The field with a decimal comma made a point, in `buffer` when it has to change.
-std::string_view DecimalPoint(std::string_view field, char decimal, std::string* buffer) {
+// The field with a decimal comma made a point: in `stack` (64 bytes) when it fits, else
+// in `heap`.
+std::string_view DecimalPoint(std::string_view field, char decimal, char* stack,
+                              std::string* heap) {
   if (decimal != ',' || field.find(',') == std::string_view::npos) return field;
-  buffer->assign(field);
-  std::replace(buffer->begin(), buffer->end(), ',', '.');
-  return *buffer;
+  char* out = stack;
+  if (field.size() > 64) {
+    heap->assign(field);
+    out = heap->data();
+  } else {
+    std::memcpy(stack, field.data(), field.size());
+  }
+  std::replace(out, out + field.size(), ',', '.');
+  return std::string_view(out, field.size());
 }
 
 }  // namespace
 
 bool ReadConvertedNumber(std::string_view field, char decimal, const ValueConversion& conversion,
                          double* file_value, double* internal, std::string* why) {
-  std::string buffer;
-  const std::string_view text = DecimalPoint(field, decimal, &buffer);
+  char stack[64];
+  std::string heap;
+  const std::string_view text = DecimalPoint(field, decimal, stack, &heap);
   double parsed = 0.0;
   if (!ParseFiniteDecimal(text, &parsed, why)) {
     if (decimal == ',' && text != field) *why = Quote(field) + " is not a number";

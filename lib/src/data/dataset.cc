@@ -287,6 +287,18 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
              "NAME, format: seconds | unix_s | unix_ms | iso8601, zone: ...})";
     return false;
   }
+  {
+    // The map gives what a dataset needs, before the header is looked at.
+    Header given;
+    given.field_of.fill(-1);
+    given.field_of[kTime] = 0;
+    for (int c = kX; c < kNumColumns; ++c) {
+      if (map.Find(kColumnNames[c]) != nullptr) given.field_of[c] = 0;
+    }
+    if (!CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", &given, error)) {
+      return false;
+    }
+  }
   internal::MappedHeader mapped;
   if (!internal::ResolveMappedHeader(map, fields, ColumnMapNames(), where, path, &mapped, error)) {
     return false;
@@ -364,7 +376,9 @@ bool ParseHeader(std::string_view line, const std::string& where, const std::str
       if (name == kColumnNames[c]) column = c;
     }
     if (column < 0) {
-      *error = where + "unknown column " + Quoted(name) + " (accepted: " + AcceptedColumns() + ")";
+      *error = where + "unknown column " + Quoted(name) + " (accepted: " + AcceptedColumns() +
+               "; an export with other names, units or channels is read through a column map, "
+               "--columns=MAP.yaml, docs/data-format.md)";
       return false;
     }
     if (header->field_of[column] >= 0) {
@@ -453,7 +467,8 @@ std::string TooManyFieldsMessage(const std::vector<std::string_view>& fields, co
     return message + ": a decimal comma? " +
            Quoted(std::string(fields[best]) + "," + std::string(fields[best + 1])) + " in column " +
            Quoted(kColumnNames[header.column_of_field[best]]) +
-           " reads as two fields; numbers must use '.' as the decimal point";
+           " reads as two fields; numbers must use '.' as the decimal point (or say decimal: "
+           "\",\" in a column map, --columns)";
   }
   return message + " (fields cannot contain a comma; a decimal comma must be a '.')";
 }
@@ -1062,6 +1077,9 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   return true;
 }
 
+// The longest record read through a column map (a row is a few hundred bytes).
+constexpr size_t kMaxMappedRecordBytes = 16u << 20;
+
 struct DatasetChunkReader::State {
   State(const std::string& path, const DatasetReadOptions& options) : parser(path, options) {}
   internal::RegularFileReader file;
@@ -1115,6 +1133,15 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
         int breaks = 0;  // line breaks inside a quoted field of the record
         const size_t newline =
             internal::RecordEnd(st.text, st.start, st.parser.quotes(), &breaks);
+        if (newline == std::string::npos && st.parser.quotes() &&
+            st.text.size() - st.start > kMaxMappedRecordBytes) {
+          // A quote left open would make the rest of the file one record, scanned anew
+          // at every read.
+          message = st.parser.layout().path + ":" + std::to_string(st.line_number + 1) +
+                    ": a record longer than 16 MiB (a quote not closed?)";
+          ok = false;
+          break;
+        }
         if (newline == std::string::npos && (!st.end || st.start == st.text.size())) break;
         std::string_view line(st.text);
         line = line.substr(st.start,
