@@ -525,7 +525,12 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
   }
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
             "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
-            report.data_digest + ")\nverdict: " + FitVerdictName(result.verdict) +
+            report.data_digest + ")" +
+            (report.columns_path.empty()
+                 ? ""
+                 : "\nread through the column map " + report.columns_path + " (sha256 " +
+                       report.columns_digest + ")") +
+            "\nverdict: " + FitVerdictName(result.verdict) +
             "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
             "budget):";
   for (const ParameterEstimate& p : result.parameters) {

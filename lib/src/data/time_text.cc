@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <sstream>
 #include <string>
 
@@ -149,17 +150,18 @@ bool ParseIso8601(std::string_view text, int default_offset_s, double* unix_s, s
   if (colon2 != std::string_view::npos) {
     const std::string_view s = body.substr(colon2 + 1);
     if (TwoDigits(s, 0) < 0) return fail(": the seconds must be two digits");
-    std::string digits(s);
-    if (digits.size() > 2) {
+    char digits[40];  // "ss.ffffff...": no allocation a row
+    if (s.size() > sizeof(digits)) return fail(": the seconds must be ss[.fff]");
+    std::memcpy(digits, s.data(), s.size());
+    if (s.size() > 2) {
       if (digits[2] != '.' && digits[2] != ',') return fail(": the seconds must be ss[.fff]");
       digits[2] = '.';
-      if (digits.size() == 3 || digits.find_first_not_of("0123456789", 3) != std::string::npos) {
+      if (s.size() == 3 || s.find_first_not_of("0123456789", 3) != std::string_view::npos) {
         return fail(": the seconds must be ss[.fff]");
       }
     }
-    const auto [end, ec] =
-        std::from_chars(digits.data(), digits.data() + digits.size(), seconds);
-    if (ec != std::errc() || end != digits.data() + digits.size()) return fail("");
+    const auto [end, ec] = std::from_chars(digits, digits + s.size(), seconds);
+    if (ec != std::errc() || end != digits + s.size()) return fail("");
     if (!(seconds < 60.0)) return fail(": seconds beyond 59");
   }
   // The date, hour and minute: the date library's, cached per thread (rows of one minute

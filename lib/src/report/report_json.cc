@@ -316,6 +316,11 @@ void JsonSamples(const ReportInputs& in, JsonWriter* w) {
   // Rows left out of the dataset (malformed, or a pose the model cannot solve), each
   // "file:line: why".
   w->Key("skipped").Int(in.data ? static_cast<long long>(in.data->skipped.size()) : 0);
+  w->Key("skipped_rows").BeginArray();
+  if (in.data) {
+    for (const std::string& why : in.data->skipped) w->String(why);
+  }
+  w->EndArray();
   // The samples' first and last time: time_s to 17 digits, and as dates and times (ISO
   // 8601, the data's zone) when they are Unix times (time_text.h), else null.
   double first = std::numeric_limits<double>::infinity(), last = -first;
@@ -335,11 +340,6 @@ void JsonSamples(const ReportInputs& in, JsonWriter* w) {
   if (display.absolute) w->String(IsoUnixTime(first, display.offset_s)); else w->Null();
   w->Key("time_last");
   if (display.absolute) w->String(IsoUnixTime(last, display.offset_s)); else w->Null();
-  w->Key("skipped_rows").BeginArray();
-  if (in.data) {
-    for (const std::string& why : in.data->skipped) w->String(why);
-  }
-  w->EndArray();
   w->EndObject();
 }
 
