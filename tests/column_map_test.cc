@@ -596,6 +596,10 @@ TEST(TimeTextTest, ShowsUnixTimesAsDatesAndSecondsAsSeconds) {
     ASSERT_TRUE(ParseTimeValue(TimeValueText(t, utc), 3600, &back, &why)) << why;
     EXPECT_NEAR(back, t, 1e-6);
   }
+  // Beyond year 9999: a number, not a date (and no overflow).
+  EXPECT_FALSE(IsUnixTime(1e300));
+  EXPECT_EQ(TimeText(1e300, beijing), "1e+300 s");
+  EXPECT_EQ(TimeRangeText(3e11, 3e11, beijing), "t = 3e+11 to 3e+11 s");
   double t = 0.0;
   std::string why;
   ASSERT_TRUE(ParseTimeValue("800.5", 0, &t, &why));

@@ -20,9 +20,14 @@
 namespace fastcal {
 
 inline constexpr double kUnixTimeFromS = 1e8;
+// Dates are shown up to the end of year 9999 (10000-01-01T00:00:00Z); a larger time_s is
+// shown as seconds.
+inline constexpr double kUnixTimeUntilS = 253402300800.0;
 
-// True when `time_s` is a Unix time by the rule above.
-inline bool IsUnixTime(double time_s) { return time_s >= kUnixTimeFromS; }
+// True when `time_s` is a Unix time by the rule above (and before year 10000).
+inline bool IsUnixTime(double time_s) {
+  return time_s >= kUnixTimeFromS && time_s < kUnixTimeUntilS;
+}
 
 // A fixed offset from UTC, in seconds east of Greenwich: "Z", "UTC", "+08:00", "+0800",
 // "+08", "-05:30" (|offset| <= 14 h). False with *why otherwise (a zone name such as

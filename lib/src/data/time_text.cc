@@ -212,14 +212,20 @@ bool ParseTimePattern(std::string_view text, const std::string& pattern, int def
   return true;
 }
 
+// Within the years a date is shown for (0001 to 9999), with room for the zone.
+static bool Showable(double unix_s) {
+  return std::isfinite(unix_s) && unix_s > -62135596800.0 + 86400.0 &&
+         unix_s < kUnixTimeUntilS - 86400.0;
+}
+
 std::string FormatUnixTime(double unix_s, int offset_s, int decimals) {
-  if (!std::isfinite(unix_s)) return "n/a";
+  if (!Showable(unix_s)) return internal::FormatDouble("%.6g", unix_s) + " s";
   decimals = decimals < 0 ? 0 : decimals > 6 ? 6 : decimals;
   return CivilText(LocalMicros(unix_s, offset_s, decimals), decimals);
 }
 
 std::string IsoUnixTime(double unix_s, int offset_s) {
-  if (!std::isfinite(unix_s)) return "n/a";
+  if (!Showable(unix_s)) return internal::FormatDouble("%.17g", unix_s);
   std::string text = CivilText(LocalMicros(unix_s, offset_s, 6), 6);
   text[10] = 'T';
   while (text.back() == '0') text.pop_back();
@@ -238,6 +244,7 @@ namespace {
 
 // Digits of the second worth showing: 0, or 3 when the time has a fraction at 1 ms.
 int ShownDecimals(double unix_s, int offset_s) {
+  if (!Showable(unix_s)) return 0;
   return LocalMicros(unix_s, offset_s, 3) % kMicrosPerSecond == 0 ? 0 : 3;
 }
 
@@ -251,14 +258,16 @@ std::string StripFraction(std::string text) {
 }  // namespace
 
 std::string TimeText(double time_s, const TimeDisplay& display) {
-  if (!display.absolute) return internal::FormatDouble("%.6g", time_s) + " s";
+  if (!display.absolute || !Showable(time_s)) {
+    return internal::FormatDouble("%.6g", time_s) + " s";
+  }
   return StripFraction(FormatUnixTime(time_s, display.offset_s,
                                       ShownDecimals(time_s, display.offset_s))) +
          " " + UtcOffsetName(display.offset_s);
 }
 
 std::string TimeRangeText(double from_s, double to_s, const TimeDisplay& display) {
-  if (!display.absolute) {
+  if (!display.absolute || !Showable(from_s) || !Showable(to_s)) {
     return "t = " + internal::FormatDouble("%.6g", from_s) + " to " +
            internal::FormatDouble("%.6g", to_s) + " s";
   }
@@ -266,7 +275,9 @@ std::string TimeRangeText(double from_s, double to_s, const TimeDisplay& display
                                 ShownDecimals(to_s, display.offset_s));
   const std::string a = StripFraction(FormatUnixTime(from_s, display.offset_s, decimals));
   std::string b = StripFraction(FormatUnixTime(to_s, display.offset_s, decimals));
-  if (a.compare(0, 10, b, 0, 10) == 0) b = b.substr(11);  // the same day: the date once
+  if (a.size() >= 19 && b.size() >= 19 && a.compare(0, 10, b, 0, 10) == 0) {
+    b = b.substr(11);  // the same day: the date once
+  }
   return a + " to " + b + " " + UtcOffsetName(display.offset_s);
 }
 
@@ -274,7 +285,9 @@ std::string TimeAxisLabel(double from_s, double to_s, const TimeDisplay& display
   const std::string a = FormatUnixTime(from_s, display.offset_s);
   const std::string b = FormatUnixTime(to_s, display.offset_s);
   const std::string zone = "(" + UtcOffsetName(display.offset_s) + ")";
-  if (a.compare(0, 10, b, 0, 10) == 0) return "time on " + a.substr(0, 10) + " " + zone;
+  if (a.size() >= 19 && b.size() >= 19 && a.compare(0, 10, b, 0, 10) == 0) {
+    return "time on " + a.substr(0, 10) + " " + zone;
+  }
   return "time " + zone;
 }
 

@@ -448,12 +448,16 @@ std::vector<double> TimeTicks(double lo, double hi, double step, int offset_s) {
 std::vector<std::string> TimeTickLabels(const std::vector<double>& ticks, double lo, double hi,
                                         double step, int offset_s) {
   const std::string first = FormatUnixTime(lo, offset_s), last = FormatUnixTime(hi, offset_s);
-  const bool one_day = first.compare(0, 10, last, 0, 10) == 0;
-  const bool one_year = first.compare(0, 4, last, 0, 4) == 0;
+  const bool one_day = first.size() >= 19 && last.size() >= 19 &&
+                       first.compare(0, 10, last, 0, 10) == 0;
+  const bool one_year = first.size() >= 19 && last.size() >= 19 &&
+                        first.compare(0, 4, last, 0, 4) == 0;
   std::vector<std::string> labels;
   for (double t : ticks) {
     const std::string text = FormatUnixTime(t, offset_s);  // "2024-05-01 12:34:56"
-    if (step >= kDaySeconds) {
+    if (text.size() < 19) {  // beyond the years shown as dates: the number
+      labels.push_back(text);
+    } else if (step >= kDaySeconds) {
       labels.push_back(one_year ? text.substr(5, 5) : text.substr(0, 10));
     } else {
       const std::string clock = text.substr(11, step < 60.0 ? 8 : 5);
