@@ -36,7 +36,7 @@ const char kCommand[] = "import";
 
 std::string Help() {
   return std::string(
-             R"(fastcal import: read a telemetry export through a column map and write the canonical dataset.
+             R"(fastcal import: read a telemetry export through a column map, write the canonical dataset.
 
 Usage:
   fastcal import --columns=MAP.yaml --data=EXPORT.csv --out=DATA.csv [--force]

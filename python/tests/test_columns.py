@@ -242,3 +242,11 @@ def test_the_cli_refuses_an_xlsx_naming_the_python_route(
     assert run.returncode == 2
     assert "fastcal.read_dataset(" in run.stderr
     assert "xlsx2csv" in run.stderr
+
+
+def test_the_bundled_export_is_what_its_script_writes(source_dir: pathlib.Path) -> None:
+    run = subprocess.run(
+        [sys.executable, str(source_dir / "scripts" / "make_fast_export.py"), "--check"],
+        capture_output=True, text=True, check=False,
+    )
+    assert run.returncode == 0, run.stdout + run.stderr
