@@ -403,10 +403,11 @@ TEST(ColumnMapTest, HeaderLineUnitRowQuotesAndTrailingDelimiters) {
       "s,mm,m,m,deg,deg,deg,N,kN,kN,kN,kN,kN,\n"
       "\n"
       "2.5,70960,4.65,156.73,0.35,-5.30,0.09,214000,190.2,141.8,149.9,188.6,207.1,\n"
+      ",,,,,,,,,,,,,\n"  // a spreadsheet's empty row: blank
       "5,\"70 960\",4.65,156.73,0.35,-5.30,0.09,214000,190.2,141.8,149.9,188.6,207.1\n";
-  // Line 7's position has a space: an error naming it (line numbers count every line).
+  // Line 8's position has a space: an error naming it (line numbers count every line).
   EXPECT_TRUE(Contains(MappedError(text, map),
-                       "data.csv:7: column 'Pos X, mm' (x_m, mm): '70 960' is not a number"));
+                       "data.csv:8: column 'Pos X, mm' (x_m, mm): '70 960' is not a number"));
   std::string good = text;
   good.replace(good.find("70 960"), 6, "70960");
   const Dataset d = Mapped(good, map);

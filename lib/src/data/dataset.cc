@@ -680,6 +680,17 @@ class LineParser {
   // Whether the records may hold quoted line breaks (read through a column map).
   bool quotes() const { return header_.map != nullptr; }
 
+  // A comment or blank line; through a column map also a row of empty fields only
+  // (";;;;", as spreadsheets export their empty rows), once the delimiter is known.
+  bool Blank(std::string_view line) const {
+    if (IsCommentOrBlank(line)) return true;
+    if (header_.map == nullptr || !have_header_) return false;
+    for (char c : line) {
+      if (c != header_.delimiter && c != ' ' && c != '\t' && c != '\r' && c != '"') return false;
+    }
+    return true;
+  }
+
   // One line of the file (without its '\n'), numbered from 1; through a column map, one
   // record (which may span lines inside quotes), numbered by its first line.
   bool Line(int line_number, std::string_view line, Dataset* out, std::string* error) {
@@ -696,7 +707,7 @@ class LineParser {
                  " in " + header_.map->path + ") is empty";
         return false;
       }
-    } else if (IsCommentOrBlank(line) || line_number <= skip_until_) {
+    } else if (Blank(line) || line_number <= skip_until_) {
       return true;
     }
     if (!have_header_) {
@@ -751,7 +762,7 @@ class LineParser {
           for (int k = begin; k < end; ++k) {
             const auto& [number, line] = lines[next + k];
             Parsed& p = parsed[k];
-            p.row = !IsCommentOrBlank(line) && number > skip_until_;
+            p.row = !Blank(line) && number > skip_until_;
             p.sample.line = number;
             p.ok = p.row &&
                    ParseRow(line, header_, options_.limits, nullptr, &p.sample, &p.values, &reason);

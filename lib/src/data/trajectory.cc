@@ -571,6 +571,10 @@ bool ParsePosesCsvImpl(const std::string& text, const std::string& path, const C
       if (first != std::string::npos && line[first] == '#') line.erase(0, first + 1);
     } else if (IsSkipped(line) || record_line <= skip_until) {
       continue;
+    } else if (map != nullptr && has_header &&
+               line.find_first_not_of(std::string(1, columns.delimiter) + " \t\r\"") ==
+                   std::string::npos) {
+      continue;  // a spreadsheet's empty row (";;;;")
     }
     if (map != nullptr) {
       scratch.clear();
