@@ -169,6 +169,22 @@ TEST_F(CliColumnsTest, EveryCommandThatReadsTelemetryTakesTheMap) {
   const std::string json = ReadFile(Path("eval/summary.json"));
   EXPECT_TRUE(Contains(json, "\"time_first\": \"2024-05-01T20:00:00+08:00\""));
   EXPECT_TRUE(Contains(json, "\"columns\": {"));
+  // calibrate: the same estimates as from the canonical survey (only the lines differ: the
+  // export has one line less above its rows).
+  const std::string spec = " --quiet --spec=" + Data("spec_realistic.yaml");
+  const CommandResult fit_mapped = Fastcal("calibrate" + spec + columns + " --data=" +
+                                           Data("fast_export.csv") + " --out=" + Path("fit1"));
+  ASSERT_EQ(fit_mapped.code, 0) << fit_mapped.output;
+  const CommandResult fit = Fastcal("calibrate" + spec + " --data=" +
+                                    Data("realistic_survey.csv") + " --out=" + Path("fit2"));
+  ASSERT_EQ(fit.code, 0) << fit.output;
+  const auto estimates = [](const std::string& out) {
+    const size_t from = out.find("free parameter");
+    return out.substr(from, out.find("gross errors") - from);
+  };
+  EXPECT_EQ(estimates(fit_mapped.output), estimates(fit.output));
+  EXPECT_TRUE(Contains(ReadFile(Path("fit1/model_calibrated.yaml")),
+                       "# read through the column map " + Data("fast_export.columns.yaml")));
   // solve --poses and simulate --poses.
   CommandResult r = Fastcal("solve --poses=" + Data("fast_export.csv") + columns +
                             " --output=" + Path("solved.csv"));

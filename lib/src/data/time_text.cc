@@ -119,7 +119,8 @@ std::string UtcOffsetName(int offset_s) {
 bool ParseIso8601(std::string_view text, int default_offset_s, double* unix_s, std::string* why) {
   const auto fail = [&](const std::string& what) {
     *why = internal::Quote(text) + " is not an ISO 8601 date and time" + what +
-           " (e.g. 2024-05-01T12:34:56.5+08:00 or 2024-05-01 12:34:56)";
+           " (e.g. 2024-05-01T12:34:56.5+08:00 or 2024-05-01 12:34:56; another layout "
+           "needs a pattern in the column map, format: \"%Y/%m/%d %H:%M:%S\")";
     return false;
   };
   if (text.empty()) {
