@@ -16,6 +16,7 @@
 
 #include "fastcal/dataset.h"
 #include "fastcal/sessions.h"
+#include "fastcal/svg_plot.h"
 #include "fastcal/time_text.h"
 #include "fastcal/trajectory.h"
 
@@ -609,6 +610,35 @@ TEST(TimeTextTest, ShowsUnixTimesAsDatesAndSecondsAsSeconds) {
   EXPECT_EQ(t, kUnix);
   EXPECT_FALSE(ParseTimeValue("noon", 0, &t, &why));
   EXPECT_TRUE(Contains(why, "'noon' is neither a time in seconds"));
+}
+
+TEST(TimeTextTest, PlotsOfUnixTimesHaveAClockTimeAxis) {
+  constexpr double kStart = 1714564800.0;  // 2024-05-01T20:00:00+08:00
+  PlotSeries series{"T1", {}, {}};
+  for (int k = 0; k <= 1440; ++k) {
+    series.x.push_back(kStart + 2.0 * k);
+    series.y.push_back(150.0 + k % 7);
+  }
+  PlotOptions options;
+  options.x_unix_time = true;
+  options.x_time_offset_s = 8 * 3600;
+  options.x_label = TimeAxisLabel(kStart, kStart + 2880, TimeDisplayFor(kStart, 8 * 3600));
+  const std::string svg = SvgLinePlot({series}, options);
+  EXPECT_TRUE(Contains(svg, ">20:10<"));
+  EXPECT_TRUE(Contains(svg, ">20:40<"));
+  EXPECT_TRUE(Contains(svg, "time on 2024-05-01 (UTC+08:00)"));
+  EXPECT_EQ(svg.find("e+09"), std::string::npos);
+  EXPECT_EQ(svg.find(">1.71"), std::string::npos);
+  // Over days: dates with the clock; over weeks: dates.
+  series.x = {kStart, kStart + 3 * 86400.0};
+  series.y = {1, 2};
+  const std::string days = SvgLinePlot({series}, options);
+  EXPECT_TRUE(Contains(days, ">05-02 ")) << days;
+  series.x = {kStart, kStart + 60 * 86400.0};
+  EXPECT_TRUE(Contains(SvgLinePlot({series}, options), ">05-"));
+  // A few seconds: seconds on the clock.
+  series.x = {kStart, kStart + 20.0};
+  EXPECT_TRUE(Contains(SvgLinePlot({series}, options), ">20:00:10<"));
 }
 
 TEST(TimeTextTest, CutsASurveyIntoSessionsAtTimes) {
