@@ -1022,6 +1022,7 @@ void AddCalibratedModel(const ReportInputs& in, Document* doc) {
                             "), then use it like any model file:"));
   doc->Pre("",
            "fastcal evaluate --model=" + dir + "/model_calibrated.yaml --data=" + other +
+               (in.columns_path.empty() ? "" : " --columns=" + in.columns_path) +
                "\nfastcal solve --model=" + dir +
                "/model_calibrated.yaml --position=0,0,140 --method=exact",
            false);
