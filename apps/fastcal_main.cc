@@ -30,6 +30,8 @@ Commands:
              HTML map of the focal-sphere cap
   design     the calibration survey that determines the wanted parameters best: poses,
              samples per pose and flight order, with predicted sigma_total
+  import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
+             comma), read through a column map, written as the canonical dataset CSV
 
 Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
 )";
@@ -58,6 +60,7 @@ int main(int argc, char** argv) {
     if (command == "simulate") return RunSimulate(argc, argv);
     if (command == "workspace") return RunWorkspace(argc, argv);
     if (command == "design") return RunDesign(argc, argv);
+    if (command == "import") return RunImport(argc, argv);
   } catch (const std::bad_alloc&) {
     // Outputs are written last and atomically: nothing is left behind.
     std::cerr << "fastcal " << command

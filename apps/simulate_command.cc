@@ -149,7 +149,9 @@ Trajectory (--trajectory=, default circle):
   random  --samples=100 --max-off-axis-deg=40 --radial-spread=0 (m, off the sphere),
           positions drawn with --seed
   poses   --poses=FILE.csv: x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or
-          qw,qx,qy,qz (the planned attitudes); --poses alone implies this trajectory
+          qw,qx,qy,qz (the planned attitudes); --poses alone implies this trajectory;
+          --columns=MAP.yaml reads it as exported, through a column map
+          (docs/data-format.md, "Column maps")
 Planned attitude (--attitude-law): focal (default for trajectories: tilt z' toward
 --focal-centre=0,0,300 by --tilt-fraction=0.41 of the off-axis angle) or none (R = I).
 A --poses file keeps its own attitudes unless --attitude-law is given.
@@ -223,7 +225,7 @@ Examples (the bundled datasets):
 
 // clang-format off
 const std::set<std::string> kFlags = {
-    "truth", "mass-centre", "sensor-gain", "sensor-bias-kn", "density-mismatch-pct", "method",
+    "truth", "columns", "mass-centre", "sensor-gain", "sensor-bias-kn", "density-mismatch-pct", "method",
     "trajectory", "nodes", "from", "to", "centre", "radius", "start-deg", "end-deg",
     "max-off-axis-deg", "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "samples",
     "radial-spread", "poses", "attitude-law", "tilt-fraction", "focal-centre",
@@ -613,6 +615,10 @@ std::string Summary(const SimulationSummary& s, const SimulationOptions& options
 int RunSimulate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+  if (FlagGiven("columns") && FLAGS_poses.empty()) {
+    PrintError(kCommand, "--columns applies to --poses=FILE (a pose file read as exported)");
+    return kExitUsage;
+  }
 
   if (FLAGS_out.empty() || FLAGS_out == "-") {
     PrintError(kCommand, "give --out=FILE.csv (the truth model goes beside it)");
