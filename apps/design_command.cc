@@ -3,6 +3,7 @@
 #include <gflags/gflags.h>
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <sstream>
@@ -67,9 +68,9 @@ draws the random survey compared against).
                          its least useful stops (their samples dwell at the others)
 Grid and limits, as fastcal workspace: --max-off-axis-deg=40 --off-axis-step-deg=1
   --azimuth-step-deg=5 --focal-radius=160 --focal-centre=0,0,300 --tilt-fraction=0.41
-  --max-tension-kn=inf --max-strain=0.05 --max-length-ratio=1.5, and with the design's
+  --max-tension-kN=inf --max-strain=0.05 --max-length-ratio=1.5, and with the design's
   own margins (the optimum lies on the workspace's edge, where cables near slack sag by
-  metres for a small error of the model): --min-tension-kn=50 --reflector-clearance=5
+  metres for a small error of the model): --min-tension-kN=50 --reflector-clearance=5
 
 Outputs (written only when everything succeeded):
   poses.csv    x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg, one row per sample in flight
@@ -78,6 +79,8 @@ Outputs (written only when everything succeeded):
                the design, the paper's circle and a random survey of N samples
   design.html  the stops and path on the cap, the predicted sigmas side by side, what
                limits the design and what a better prior would buy
+Every sigma is in its parameter's unit, the one its name carries (sensor_bias_kN: kN).
+A summary on stdout (> design.txt keeps it); each stage's progress on stderr.
 
 Example:
   fastcal design --spec=calibration_data/spec_realistic.yaml --samples=360 \
@@ -95,8 +98,8 @@ const std::set<std::string> kFlags = {"spec",
                                       "off-axis-step-deg",
                                       "azimuth-step-deg",
                                       "focal-radius",
-                                      "min-tension-kn",
-                                      "max-tension-kn",
+                                      "min-tension-kN",
+                                      "max-tension-kN",
                                       "interval-s",
                                       "max-extra-tilt-deg",
                                       "max-extra-yaw-deg",
@@ -115,7 +118,7 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   if (!FlagGiven("reflector-clearance")) {
     o->workspace.statics.min_reflector_clearance_m = kDesignReflectorClearanceM;
   }
-  if (!FlagGiven("min-tension-kn")) o->workspace.min_tension_n = kDesignMinTensionN;
+  if (!FlagGiven("min-tension-kN")) o->workspace.min_tension_n = kDesignMinTensionN;
   o->max_extra_tilt_deg = FLAGS_max_extra_tilt_deg;
   o->max_extra_yaw_deg = FLAGS_max_extra_yaw_deg;
   o->samples = FLAGS_samples;
@@ -150,6 +153,8 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   return false;
 }
 
+// The result, on stdout: what was chosen, and the predicted sigma_total of each wanted
+// parameter in its own unit (the one in its name: kN for sensor_bias_kN).
 std::string Summary(const Design& d) {
   std::ostringstream s;
   s << "fastcal design: " << d.options.samples << " samples at " << d.stops.size() << " stops from "
@@ -158,13 +163,19 @@ std::string Summary(const Design& d) {
   if (d.options.speed_m_per_s > 0.0) {
     s << ", " << FormatDouble(d.duration_s / kSecondsPerMinute, 4) << " min";
   }
-  s << "\n  predicted sigma_total (design | paper's circle | random survey):";
+  char row[160];
+  std::snprintf(row, sizeof(row), "\n  %-30s %-6s %11s %15s %14s", "predicted sigma_total", "unit",
+                "design", "paper's circle", "random survey");
+  s << row;
   for (int k : d.wanted) {
-    auto sig = [k](const DesignPrediction& p) {
-      return p.ok ? FormatDouble(p.budget.parameters[k].total, 4) : std::string("n/a");
+    auto sig = [&d, k](const DesignPrediction& p) {
+      return p.ok ? FormatDouble(p.budget.parameters[k].total / d.free_to_si[k], 4)
+                  : std::string("n/a");
     };
-    s << "\n    " << d.free_names[k] << ": " << sig(d.design) << " | " << sig(d.circle) << " | "
-      << sig(d.random);
+    std::snprintf(row, sizeof(row), "\n    %-28s %-6s %11s %15s %14s", d.free_names[k].c_str(),
+                  d.free_units[k] == "1" ? "" : d.free_units[k].c_str(), sig(d.design).c_str(),
+                  sig(d.circle).c_str(), sig(d.random).c_str());
+    s << row;
   }
   s << "\n  limited by " << d.limiting_part << " (" << FormatDouble(100.0 * d.limiting_share, 3)
     << "% of the wanted variance)";
@@ -186,6 +197,10 @@ int RunDesign(int argc, char** argv) {
   CableRobot robot;
   CalibrationSpec spec;
   DesignOptions options;
+  // Progress on stderr: a design with extra attitudes takes about 20 s.
+  options.progress = [](const std::string& stage) {
+    std::cerr << "fastcal design: " << stage << std::endl;
+  };
   if (!CheckOutputDirectory("out", FLAGS_out, &error) ||
       !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(robot.anchor_points_cabin_m.size()), &spec,
@@ -209,7 +224,8 @@ int RunDesign(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitFailure;
   }
-  std::cerr << Summary(design) << "\n";
+  // The summary of what was written is the result: stdout (docs/cli.md, "Output streams").
+  std::cout << Summary(design) << "\n";
   return 0;
 }
 

@@ -173,6 +173,9 @@ enum class StaticsStatus {
 // "singular", "catenary_failed", "not_converged", "inaccurate", "attachment_beyond_cable",
 // "unsupported_model".
 const char* StaticsStatusName(StaticsStatus status);
+// The enum's last status: every status is a value from kOk (0) to this one, which lists
+// (solve --help, the Python module's STATUS_NAMES) run through. A new status goes last.
+inline constexpr StaticsStatus kLastStaticsStatus = StaticsStatus::kUnsupportedModel;
 
 struct CableSolution {
   // Force applied ON the cable at its lower end by the cabin, global frame (N). The
