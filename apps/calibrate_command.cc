@@ -194,7 +194,11 @@ bool CheckResidualsEvery(std::string* error) {
 }
 
 // CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
-bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
+bool CheckOutFlag(std::vector<std::string> outputs, std::string* error) {
+  // A joint fit of sessions also wrote one model per session.
+  if (std::find(outputs.begin(), outputs.end(), "model_calibrated.yaml") != outputs.end()) {
+    outputs.push_back("model_calibrated@*.yaml");
+  }
   return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
 }
 
