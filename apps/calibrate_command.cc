@@ -851,8 +851,8 @@ std::string TimingLines(double read_s, double fit_s, double write_s,
 }
 
 // The verdict: its reason cut to a few lines (the report has it whole), then what the
-// sessions and the change scan found, each whole on its own lines: a change found is the
-// news of the run, never cut off behind the misfit's explanation.
+// sessions, the change scan and the sensor-step test found, each whole on its own lines: a
+// change found is the news of the run, never cut off behind the misfit's explanation.
 std::string VerdictLines(const CalibrationResult& result) {
   constexpr size_t kFindingLines = 8;
   std::string reason = result.verdict_text;
@@ -866,6 +866,10 @@ std::string VerdictLines(const CalibrationResult& result) {
     reason.resize(reason.size() - tail.size());
     findings.insert(findings.begin(), label + ": " + part);
   };
+  // The verdict's parts in the reverse of their order (calibration_verdict.cc).
+  if (const std::string steps = SensorStepVerdict(result.sensor_steps); !steps.empty()) {
+    split_off("sensor steps", steps);
+  }
   if (result.change_scan.enabled) split_off("change scan", ChangeScanVerdict(result.change_scan));
   if (!result.session_differences.empty()) {
     split_off("sessions", SessionVerdict(result.session_differences));

@@ -653,8 +653,9 @@ int RunSimulate(int argc, char** argv) {
                 FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
     }
     if (summary.session_bias_n.size() > 1 && options.sensor_rezero_kn > 0.0) {
-      header += "\nSensors re-zeroed at each new session; the biases (kN) per session, cables "
-                "1..6:";
+      header +=
+          "\nSensors re-zeroed at each new session; the biases (kN) per session, cables "
+          "1..6:";
       for (size_t k = 0; k < summary.session_bias_n.size(); ++k) {
         header += "\n  session " + std::to_string(k + 1) + ":";
         for (double b : summary.session_bias_n[k]) header += " " + FormatDouble(b / 1e3, 6);
