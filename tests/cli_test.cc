@@ -217,10 +217,15 @@ TEST_F(CliTest, TwoSurveysAsTwoFilesAreFittedJointly) {
   // Each session's model evaluates on its own survey.
   r = Fastcal("evaluate --model=" + out + "/model_calibrated@b.yaml --data=" + Path("b.csv"));
   EXPECT_EQ(r.code, 0) << r.output;
-  // --force replaces the joint fit's results, the sessions' models included.
+  // --force replaces the joint fit's results, the sessions' models included, by another
+  // joint fit or by a fit of one survey.
   r = Fastcal("calibrate --quiet --force --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") +
               "," + Path("b.csv") + " --out=" + out);
   EXPECT_EQ(r.code, 0) << r.output;
+  r = Fastcal("calibrate --quiet --force --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") +
+              " --out=" + out);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "model_calibrated@b.yaml"));
   // The same file twice is one label twice: refused, naming both.
   r = Fastcal("calibrate --quiet --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") + "," +
               Path("a.csv") + " --out=" + Path("twice"));
