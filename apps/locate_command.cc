@@ -264,7 +264,7 @@ bool RowsFromFile(std::vector<Row>* rows, std::string* error) {
     return false;
   }
   DatasetReadOptions read;
-  read.columns = DatasetColumns::kLengths;
+  read.required_columns = DatasetColumns::kLengths;
   Dataset data;
   if (!ReadDataset(FLAGS_data, read, &data, error)) return false;
   rows->clear();

@@ -447,7 +447,7 @@ TEST_F(DatasetTest, AttitudesInRadiansUnderDegreeColumnsAreRefused) {
 // may be there, complete, or not.
 TEST_F(DatasetTest, LengthsFileNeedsOnlyTheLengths) {
   DatasetReadOptions options;
-  options.columns = DatasetColumns::kLengths;
+  options.required_columns = DatasetColumns::kLengths;
   const std::string lengths = "s0_1_m,s0_2_m,s0_3_m,s0_4_m,s0_5_m,s0_6_m";
   Dataset d;
   std::string error;
