@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/dataset.h"
+#include "fastcal/gross_errors.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/locate.h"
@@ -108,11 +109,14 @@ existing FILE is refused unless --force). Columns, units in the names:
   readings,chi2            readings the pose fits, their whitened residuals squared
                            (lengths alone: 6 and 0)
   error_estimate_m         the next Newton step's size after the last: the pose's error
-  message                  the account of the row ("" when ok and stable and alone)
+  message                  the account of the row ("" when ok, stable, alone and, for a
+                           fit, chi2 below what a correct noise model exceeds once in 1000
+                           rows: beyond it "the measurements disagree")
 A row that fails (no equilibrium, or one outside the model's range) is an error naming
 the row and line (exit 1, no output) unless --keep-going, which writes it with its status
 and message and empty numbers. An unstable or non-unique answer is not a failure: it is
-written, and the summary on stderr counts and names it.
+written, and the summary on stderr counts and names it; so is a fit whose measurements
+disagree.
 
 Examples:
   fastcal locate --lengths=312.61,312.61,312.61,312.61,312.61,312.61
@@ -151,8 +155,19 @@ struct Answer {
   double nearest_other_m = 0.0;
   int readings = 0;
   double chi2 = 0.0;
+  bool misfit = false;  // the fit's chi2 beyond what its noise model allows (MisfitLimit)
   double error_estimate_m = 0.0;
 };
+
+// A fit's chi2 that a correct noise model exceeds once in 1000 rows: beyond it the
+// measurements disagree with the model or one another. Wilson and Hilferty's cube-root
+// normal approximation of the chi-square quantile (within 1% from 3 degrees of freedom).
+constexpr double kMisfitTail = 1e-3;
+double MisfitLimit(int dof) {
+  const double z = TwoSidedNormalQuantile(2.0 * kMisfitTail);  // one-sided kMisfitTail
+  const double a = 2.0 / (9.0 * dof);
+  return dof * std::pow(1.0 - a + z * std::sqrt(a), 3);
+}
 
 // Which measurements the fit uses (--use); lengths always.
 struct Use {
@@ -315,6 +330,16 @@ Answer AnswerOf(const LocateSolution& s) {
   a.nearest_other_m = s.nearest_other.distance_m;
   a.readings = s.fit.readings;
   a.chi2 = s.fit.chi2;
+  const int dof = s.fit.readings - 6;
+  a.misfit = ok && s.fit.fitted && dof > 0 && s.fit.chi2 > MisfitLimit(dof);
+  if (a.misfit) {
+    a.message += (a.message.empty() ? "" : "; ") + std::string("the measurements disagree: chi2 ") +
+                 FormatDouble(s.fit.chi2, 4) + " over " + std::to_string(dof) +
+                 " degrees of freedom, where a correct noise model stays below " +
+                 FormatDouble(MisfitLimit(dof), 3) +
+                 " in 999 rows of 1000 (a slipped encoder, a sensor's error, sigmas too "
+                 "small, or another model)";
+  }
   a.error_estimate_m = s.error_estimate_m;
   return a;
 }
@@ -361,8 +386,8 @@ std::string Csv(const std::vector<Row>& rows, const std::vector<Answer>& answers
 std::string Findings(const std::vector<Row>& rows, const std::vector<Answer>& answers,
                      size_t* failed) {
   std::ostringstream s;
-  size_t unstable = 0, others = 0, compared = 0, worst_row = 0;
-  std::string first_unusual;
+  size_t unstable = 0, others = 0, compared = 0, worst_row = 0, misfits = 0;
+  std::string first_unusual, first_misfit;
   double sum2 = 0.0, worst = 0.0;
   *failed = 0;
   for (size_t n = 0; n < rows.size(); ++n) {
@@ -375,6 +400,8 @@ std::string Findings(const std::vector<Row>& rows, const std::vector<Answer>& an
     unstable += a.stability != Stability::kStable ? 1 : 0;
     others += a.other_equilibria > 0 ? 1 : 0;
     if (unusual && first_unusual.empty()) first_unusual = RowName(rows, n) + ": " + a.message;
+    misfits += a.misfit ? 1 : 0;
+    if (a.misfit && first_misfit.empty()) first_misfit = RowName(rows, n) + ": " + a.message;
     if (rows[n].has_position) {
       const double d = (a.pose.position_m - rows[n].position_m).norm();
       sum2 += d * d;
@@ -388,6 +415,9 @@ std::string Findings(const std::vector<Row>& rows, const std::vector<Answer>& an
   if (unstable + others > 0) {
     s << "\n  " << unstable << " not stable, " << others
       << " with another equilibrium nearby; first: " << first_unusual;
+  }
+  if (misfits > 0) {
+    s << "\n  " << misfits << " whose measurements disagree; first: " << first_misfit;
   }
   if (compared > 0) {
     s << "\n  against the file's x_m,y_m,z_m: RMS " << FormatDouble(std::sqrt(sum2 / compared), 4)

@@ -1612,6 +1612,62 @@ TEST_F(CliTest, SimulatedEncoderLengthsLocateWithTheirTruthModel) {
                        "--length-noise-m must be finite and >= 0"});
 }
 
+// The fit with attitude and tensions: lengths read through encoders whose offsets the
+// nominal model does not know disagree with the tensions and attitude, on every row; the
+// truth model's lengths agree with them. The summary counts the rows that disagree.
+TEST_F(CliTest, LocateSaysWhenTheMeasurementsDisagree) {
+  const std::string data = Path("enc.csv");
+  CommandResult r = Fastcal(
+      "simulate --trajectory=random --samples=20 --seed=4 --length-offset-spread-m=0.3 "
+      "--length-noise-m=0.005 --out=" +
+      data);
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = Fastcal("locate --search-radius-m=0 --data=" + data + " --output=" + Path("nominal.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("20 whose measurements disagree; first: row 0"), std::string::npos)
+      << r.output;
+  for (const auto& row : CsvRows(ReadFile(Path("nominal.csv")))) {
+    EXPECT_EQ(row.at("status"), "ok");
+    EXPECT_NE(row.at("message").find("the measurements disagree: chi2 "), std::string::npos);
+    EXPECT_NE(row.at("message").find("over 9 degrees of freedom"), std::string::npos);
+  }
+  r = Fastcal("locate --search-radius-m=0 --model=" + Path("enc.truth.yaml") + " --data=" + data +
+              " --output=" + Path("truth.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_EQ(r.output.find("disagree"), std::string::npos) << r.output;
+}
+
+// A calibration with the winches' lengths from the command line (docs/calibration.md,
+// "Lengths"): the console's length table before and after, summary.json's lengths; a
+// dataset without the s0 columns refused naming the file.
+TEST_F(CliTest, CalibrateWithLengths) {
+  const std::string spec = Source() + "/calibration_data/spec_lengths.yaml";
+  const std::string data = Path("lengths.csv");
+  CommandResult r = Fastcal("simulate --truth=" + Source() +
+                            "/calibration_data/lengths.truth.yaml --trajectory=random "
+                            "--samples=200 --radial-spread=3 --seed=21 --length-noise-m=0.005 "
+                            "--out=" +
+                            data);
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = Fastcal("calibrate --quiet --spec=" + spec + " --data=" + data + " --out=" + Path("out"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("verdict: ok"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("RMS model - measured length (mm)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("length_offset_m[1..6]"), std::string::npos) << r.output;
+  const std::string summary = ReadFile(Path("out") + "/summary.json");
+  EXPECT_NE(summary.find("\"lengths\": {"), std::string::npos);
+  EXPECT_NE(ReadFile(Path("out") + "/report.md").find("## Lengths"), std::string::npos);
+  EXPECT_NE(ReadFile(Path("out") + "/model_calibrated.yaml").find("length_offset_m: "),
+            std::string::npos);
+  Write("no_lengths.csv",
+        "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
+        "0,0,0,140,0,0,0,160,160,160,160,160,160\n");
+  RunBoundedAndExpect(
+      {"calibrate --spec=" + spec + " --data=" + Path("no_lengths.csv") + " --out=" + Path("out2"),
+       2, "no_lengths.csv: the spec fits the lengths (noise.length_sigma_m)"});
+  EXPECT_FALSE(fs::exists(Path("out2") + "/summary.json"));
+}
+
 TEST_F(CliTest, LocateRefusesBadInputAndNamesIt) {
   const std::string k1 = "--lengths=319.4245,319.4245,319.4245,319.4245,319.4245,319.4245";
   Write("short.csv", "time_s,s0_1_m,s0_2_m\n0,300,300\n");

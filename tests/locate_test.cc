@@ -381,7 +381,8 @@ TEST(LocateTest, BadInputIsAStatusWithNoNumbers) {
 }
 
 // Lengths no FAST pose has: every cable 250 m long holds the cabin only by stretching
-// them 17%; 400 m lets it sink into the reflector. Each says why, with no numbers.
+// them 17%; 400 m lets it sink into the reflector; 200 and 400 m alternately stretch
+// three cables by tens of percent. Each says why, with no numbers.
 TEST(LocateTest, LengthsOutsideTheModelsRangeSayWhy) {
   const CableRobot robot = CableRobot::NominalFast();
   LocateSolution s;
@@ -397,6 +398,12 @@ TEST(LocateTest, LengthsOutsideTheModelsRangeSayWhy) {
   EXPECT_EQ(Locate(robot, l, LocateOptions(), &s), StaticsStatus::kReflectorContact);
   EXPECT_NE(DescribeLocateStatus(s).find("through the reflector"), std::string::npos)
       << DescribeLocateStatus(s);
+  // Alternately 200 and 400 m: cables stretched by tens of percent, where rounding alone
+  // lifts the check's error estimate above 1e-12; the range is the reason given.
+  l = {200.0, 400.0, 200.0, 400.0, 200.0, 400.0};
+  EXPECT_EQ(Locate(robot, l, LocateOptions(), &s), StaticsStatus::kOverstretchedCable)
+      << DescribeLocateStatus(s);
+  EXPECT_EQ(s.pose.position_m, Eigen::Vector3d::Zero());
 }
 
 // The fit: measurements made by the inverse statics at a pose give the pose back with no

@@ -382,7 +382,7 @@ std::string LengthOffsetHint(const std::vector<ParameterDirection>& directions) 
       if (name.rfind(ParameterGroupName(ParameterKind::kLengthOffset), 0) != 0) continue;
       return "a length encoder's offset adds the same to every reading of its cable's length, "
              "so the lengths tell it from the cable's stretch (EA), sag (density) and "
-             "geometry only where the tensions and poses vary over the survey; ";
+             "geometry only where the tensions and poses vary over the survey.\n";
     }
   }
   return "";

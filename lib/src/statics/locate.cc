@@ -24,6 +24,10 @@
 namespace fastcal {
 namespace {
 
+// The check's tolerance when it only asks whether an answer that failed on rounding lies
+// outside the model's range (Finish).
+constexpr double kLooseRelativeTolerance = 1e-8;
+
 using internal::ForwardLinearisation;
 using internal::ForwardScales;
 using internal::ForwardState;
@@ -322,6 +326,18 @@ StaticsStatus Finish(const Solver& s, const Lengths& s0, const ForwardState& x,
                      const ForwardLinearisation& lin, double estimate_m, LocateSolution* sol) {
   const StaticsStatus status =
       CheckStaticsState(s.p, x.pose, CableStates(x, s0), s.o.statics, &sol->statics);
+  if (status == StaticsStatus::kNotConverged && sol->statics.limit > 0.0) {
+    // Far outside the model's range (a cable stretched by 50%) rounding alone can lift the
+    // error estimate above its 1e-12: the range is then the reason to give, not the digits.
+    StaticsOptions loose = s.o.statics;
+    loose.exact_relative_tolerance = kLooseRelativeTolerance;
+    StaticsSolution range;
+    const StaticsStatus why = CheckStaticsState(s.p, x.pose, CableStates(x, s0), loose, &range);
+    if (why != StaticsStatus::kOk && why != StaticsStatus::kNotConverged) {
+      sol->statics = range;
+      return why;
+    }
+  }
   if (status != StaticsStatus::kOk) return status;
   sol->pose = x.pose;
   sol->force_n = x.force_n;
