@@ -259,6 +259,86 @@ TEST(CalibrationLengthsTest, ASlippedEncoderIsAGrossErrorOfALength) {
   }
 }
 
+// An encoder's offset the spec leaves fixed at 0 while the truth has 2 cm on cable 4: the
+// misfit ranking names it first, significant, and its one-step change is the 2 cm.
+TEST(CalibrationLengthsTest, MisfitRankingNamesAFixedEncodersOffset) {
+  constexpr double kChangeTolM = 0.004;  // the one-step change against the truth's 2 cm
+  CableRobot truth = CableRobot::NominalFast();
+  truth.cables[3].length_offset_m = 0.02;
+  const Dataset data = Telemetry(truth, SurveyPoses(), 7);
+  CalibrationResult r;
+  std::string error;
+  ASSERT_EQ(Calibrate(CableRobot::NominalFast(),
+                      Parse("noise: {tension_sigma_percent: 3, length_sigma_m: 0.005}\n"
+                            "parameters:\n"
+                            "  mass_centre_m: {x: {free: true}, y: {free: true}}\n"),
+                      data, CalibrationOptions(), &r, &error),
+            CalibrationStatus::kOk)
+      << error;
+  ASSERT_FALSE(r.misfit_ranking.empty());
+  const MisfitCandidate& top = r.misfit_ranking.front();
+  EXPECT_EQ(top.name, "length_offset_m[4]");
+  EXPECT_TRUE(top.significant);
+  EXPECT_NEAR(top.change, 0.02, kChangeTolM);
+  // Without the lengths in the fit no offset is a candidate (it moves no reading).
+  ASSERT_EQ(Calibrate(CableRobot::NominalFast(),
+                      Parse("parameters:\n  mass_centre_m: {x: {free: true}, y: {free: true}}\n"),
+                      data, CalibrationOptions(), &r, &error),
+            CalibrationStatus::kOk)
+      << error;
+  for (const MisfitCandidate& c : r.misfit_ranking) {
+    EXPECT_EQ(c.name.rfind("length_offset_m", 0), std::string::npos) << c.name;
+  }
+}
+
+// Cable 2's encoder offset considered (fixed at 0, known to 1 cm): what it adds to each
+// EA's sigma_total is, to first order, how far the estimate moves when the offset is
+// fixed 1 cm away instead, which two fits measure independently of the budget.
+TEST(CalibrationLengthsTest, AConsideredOffsetAddsWhatMovingItMovesTheEstimates) {
+  constexpr double kRelTol = 0.05;  // linearisation over 1 cm
+  constexpr double kOffsetSigmaM = 0.01;
+  CableRobot truth = Truth();
+  for (auto& c : truth.cables) c.length_offset_m = 0.0;
+  const Dataset data = Telemetry(truth, SurveyPoses(), 9);
+  const std::string head =
+      "noise: {tension_sigma_percent: 3, length_sigma_m: 0.005}\n"
+      "parameters:\n"
+      "  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}\n"
+      "  ea_n: {mode: per_cable, free: true}\n"
+      "  length_offset_m:\n"
+      "    mode: per_cable\n";
+  CalibrationResult considered, at_zero, moved;
+  std::string error;
+  const CableRobot nominal = CableRobot::NominalFast();
+  ASSERT_EQ(Calibrate(nominal,
+                      Parse(head + "    cables: [{}, {prior: {mean: 0, sigma: 0.01}}, {}, {}, {}, "
+                                   "{}]\n"),
+                      data, CalibrationOptions(), &considered, &error),
+            CalibrationStatus::kOk)
+      << error;
+  ASSERT_EQ(Calibrate(nominal, Parse(head), data, CalibrationOptions(), &at_zero, &error),
+            CalibrationStatus::kOk)
+      << error;
+  ASSERT_EQ(Calibrate(nominal, Parse(head + "    cables: [{}, {initial: 0.01}, {}, {}, {}, {}]\n"),
+                      data, CalibrationOptions(), &moved, &error),
+            CalibrationStatus::kOk)
+      << error;
+  ASSERT_EQ(considered.parameters.size(), at_zero.parameters.size());
+  int checked = 0;
+  for (size_t k = 0; k < considered.parameters.size(); ++k) {
+    const ParameterEstimate& e = considered.parameters[k];
+    if (e.name.rfind("ea_n[", 0) != 0) continue;
+    const double shift = std::abs(moved.parameters[k].estimate - at_zero.parameters[k].estimate) *
+                         (kOffsetSigmaM / 0.01);
+    EXPECT_NEAR(e.sigma_systematic, shift, kRelTol * shift + 1e-3 * e.sigma) << e.name;
+    ++checked;
+  }
+  EXPECT_EQ(checked, kNumCables);
+  // Cable 2's own EA carries most of it.
+  EXPECT_GT(considered.parameters[3 + 1].sigma_systematic,
+            3.0 * considered.parameters[3].sigma_systematic);
+}
+
 TEST(CalibrationLengthsTest, LengthsNeedTheDatasetsColumns) {
   Dataset data = Telemetry(Truth(), SurveyPoses(), 2);
   data.has_unstretched_lengths = false;
