@@ -11,6 +11,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "fastcal/cable_robot.h"
+#include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/gross_errors.h"
 #include "fastcal/internal/csv.h"
@@ -19,6 +20,7 @@
 #include "fastcal/plausibility.h"
 
 DECLARE_string(model);
+DECLARE_string(spec);  // calibrate_command.cc; here the sigmas of its noise
 DECLARE_string(data);
 DECLARE_string(rpy);
 DECLARE_string(quat);
@@ -88,6 +90,8 @@ Measurements:
   Sigmas (the fit's weights and the answer's sigmas): --length-sigma-m=0.01,
   --tension-sigma-percent=3 and --tension-sigma-kN=0 (sigma^2 = abs^2 + (pct/100
   predicted reading)^2, as a calibration spec's noise), --attitude-sigma-deg=0.05.
+  --spec=SPEC.yaml takes them from a calibration spec's noise (tension_sigma_kN,
+  tension_sigma_percent, and length_sigma_m when it has one); a flag given overrides.
 
 Model: --model=FILE.yaml (docs/model-format.md; a calibrated model from fastcal
 calibrate works); default the nominal FAST model. Model range: --max-strain=0.05,
@@ -126,7 +130,7 @@ Examples:
 
 // clang-format off
 const std::set<std::string> kFlags = {
-    "model", "data", "lengths", "rpy", "quat", "tensions-kN", "use", "length-sigma-m",
+    "model", "data", "lengths", "rpy", "quat", "tensions-kN", "use", "spec", "length-sigma-m",
     "tension-sigma-percent", "tension-sigma-kN", "attitude-sigma-deg", "search-radius-m",
     "warm-start", "output", "force", "keep-going", "max-strain", "max-length-ratio",
     "reflector-clearance"};
@@ -201,11 +205,24 @@ bool ParseUse(Use* use, std::string* error) {
   return true;
 }
 
-bool NoiseFromFlags(LocateNoise* noise, std::string* error) {
+// The sigmas: --spec's noise (its length_sigma_m when it has one), each overridden by its
+// flag when given; the flags' defaults without --spec.
+bool NoiseFromFlags(const CableRobot& robot, LocateNoise* noise, std::string* error) {
   noise->length_sigma_m = FLAGS_length_sigma_m;
   noise->tension_sigma_percent = FLAGS_tension_sigma_percent;
   noise->tension_sigma_n = FLAGS_tension_sigma_kN * kNPerKn;
   noise->attitude_sigma_deg = FLAGS_attitude_sigma_deg;
+  if (!FLAGS_spec.empty()) {
+    CalibrationSpec spec;
+    if (!LoadCalibrationSpec(FLAGS_spec, robot, &spec, error)) return false;
+    if (spec.UsesLengths() && !FlagGiven("length-sigma-m")) {
+      noise->length_sigma_m = spec.length_sigma_m;
+    }
+    if (!FlagGiven("tension-sigma-percent")) {
+      noise->tension_sigma_percent = spec.tension_sigma_percent;
+    }
+    if (!FlagGiven("tension-sigma-kN")) noise->tension_sigma_n = spec.tension_sigma_n;
+  }
   if (noise->IsValid(error)) return true;
   *error = WithFlagNames(*error, {{"length_sigma_m", "--length-sigma-m"},
                                   {"tension_sigma_n", "--tension-sigma-kN"},
@@ -454,7 +471,7 @@ int RunLocate(int argc, char** argv) {
       CheckFlagsApply({{"force", !FLAGS_output.empty() && FLAGS_output != "-", "--output=FILE"}},
                       "output to stdout", &error) &&
       LoadModelFlag("model", FLAGS_model, &robot, &error) && OptionsFromFlags(&options, &error) &&
-      NoiseFromFlags(&noise, &error) && ParseUse(&use, &error);
+      NoiseFromFlags(robot, &noise, &error) && ParseUse(&use, &error);
   if (!ok) {
     PrintError(kCommand, error);
     return kExitUsage;

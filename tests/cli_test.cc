@@ -1668,6 +1668,28 @@ TEST_F(CliTest, CalibrateWithLengths) {
   EXPECT_FALSE(fs::exists(Path("out2") + "/summary.json"));
 }
 
+// --spec takes the sigmas from a calibration spec's noise: spec_lengths.yaml's 5 mm
+// lengths halve the pose's sigma from lengths alone (default 1 cm); a flag overrides it.
+TEST_F(CliTest, LocateTakesItsSigmasFromASpec) {
+  constexpr double kRelTol = 1e-6;
+  const std::string k1 = "--lengths=319.4245,319.4245,319.4245,319.4245,319.4245,319.4245";
+  const std::string spec = " --spec=" + Source() + "/calibration_data/spec_lengths.yaml";
+  const auto sigma_x = [&](const std::string& flags, const std::string& name) {
+    const CommandResult r = Fastcal("locate " + k1 + flags + " --output=" + Path(name));
+    EXPECT_EQ(r.code, 0) << r.output;
+    const auto rows = CsvRows(ReadFile(Path(name)));
+    return rows.size() == 1 ? std::stod(rows[0].at("sigma_x_m")) : -1.0;
+  };
+  const double by_default = sigma_x("", "a.csv");
+  const double by_spec = sigma_x(spec, "b.csv");
+  const double overridden = sigma_x(spec + " --length-sigma-m=0.01", "c.csv");
+  EXPECT_GT(by_default, 0.0);
+  EXPECT_NEAR(by_spec, 0.5 * by_default, kRelTol * by_default);
+  EXPECT_NEAR(overridden, by_default, kRelTol * by_default);
+  RunBoundedAndExpect(
+      {"locate " + k1 + " --spec=" + Path("nosuch.yaml"), 2, "nosuch.yaml: cannot open"});
+}
+
 TEST_F(CliTest, LocateRefusesBadInputAndNamesIt) {
   const std::string k1 = "--lengths=319.4245,319.4245,319.4245,319.4245,319.4245,319.4245";
   Write("short.csv", "time_s,s0_1_m,s0_2_m\n0,300,300\n");
