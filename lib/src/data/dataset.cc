@@ -3,6 +3,7 @@
 #include "fastcal/dataset.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -903,6 +904,9 @@ struct DatasetChunkReader::State {
   LineParser parser;
   std::string text;  // read and not yet parsed: the start of a line
   size_t start = 0;  // where in `text` the next line starts
+  // How far from `start` is known to hold no newline: each read is searched once, so
+  // that a long line costs linear time (issue 29: a 1 GiB line took a minute).
+  size_t searched = 0;
   int line_number = 0;
   bool first = true;  // before the first line (a byte order mark may open it)
   bool end = false;   // the whole file is in `text`
@@ -932,7 +936,15 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
       // The complete lines read so far (each gives at most one sample), parsed together.
       lines.clear();
       while (chunk->samples.size() + lines.size() < wanted) {
-        const size_t newline = st.text.find('\n', st.start);
+        const size_t newline = st.text.find('\n', st.start + st.searched);
+        st.searched = newline == std::string::npos ? st.text.size() - st.start : 0;
+        if (newline == std::string::npos && st.searched > kMaxDatasetLineBytes) {
+          message = st.parser.layout().path + ":" + std::to_string(st.line_number + 1) +
+                    ": a line longer than " + std::to_string(kMaxDatasetLineBytes >> 20) +
+                    " MiB: not a dataset (its lines are under 1 KiB)";
+          ok = false;
+          break;
+        }
         if (newline == std::string::npos && (!st.end || st.start == st.text.size())) break;
         std::string_view line(st.text);
         line = line.substr(st.start,
@@ -942,6 +954,7 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
         st.first = false;
         lines.emplace_back(++st.line_number, line);
       }
+      if (!ok) break;
       if (!lines.empty()) {
         ok = st.parser.Lines(lines, chunk, &message);
         continue;
@@ -1010,11 +1023,14 @@ bool DatasetWriter::Open(const std::string& path, const Dataset& layout,
   layout_.session_labels = layout.session_labels;
   columns_ = ColumnsOf(layout_);
   rows_ = 0;
+  io_failed_ = false;
   file_ = std::fopen(path.c_str(), "wbx");  // x: never over an existing file
   if (file_ == nullptr) {
+    io_failed_ = true;
     *error = path + ": cannot create: " + std::strerror(errno);
     return false;
   }
+  ::flock(::fileno(file_), LOCK_EX | LOCK_NB);  // a temporary in use, not a killed run's
   buffer_ = HeaderText(columns_, header_comment, !layout_.session_labels.empty());
   return Flush(error);
 }
@@ -1046,10 +1062,12 @@ bool DatasetWriter::Close(std::string* error) {
   }
   if (ok && (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0)) {
     *error = path_ + ": cannot write: " + std::strerror(errno);
+    io_failed_ = true;
     ok = false;
   }
   if (std::fclose(file_) != 0 && ok) {
     *error = path_ + ": cannot write: " + std::strerror(errno);
+    io_failed_ = true;
     ok = false;
   }
   file_ = nullptr;
@@ -1059,6 +1077,7 @@ bool DatasetWriter::Close(std::string* error) {
 bool DatasetWriter::Flush(std::string* error) {
   if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
     *error = path_ + ": cannot write: " + std::strerror(errno);
+    io_failed_ = true;
     return false;
   }
   buffer_.clear();

@@ -1,0 +1,100 @@
+// Helpers of the end-to-end command-line tests (cli_test.cc, cli_faults_test.cc): run the
+// fastcal binary ($FASTCAL_BIN, set by CTest) through a shell and collect its exit code and
+// output, in a fresh directory per test.
+#ifndef FASTCAL_TESTS_CLI_TEST_UTIL_H_
+#define FASTCAL_TESTS_CLI_TEST_UTIL_H_
+
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include "bounded_process.h"
+
+namespace fastcal::test {
+
+struct CommandResult {
+  int code = -1;
+  std::string output;  // stdout and stderr
+};
+
+inline std::string Bin() {
+  const char* bin = (std::getenv("FASTCAL_BIN") ? std::getenv("FASTCAL_BIN") : FASTCAL_TEST_BIN);
+  return bin ? bin : "";
+}
+inline std::string Source() {
+  const char* dir = (std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR")
+                                                       : FASTCAL_TEST_SOURCE_DIR);
+  return dir ? dir : "";
+}
+
+// Runs `command_line` with /bin/sh, stderr joined to stdout.
+inline CommandResult Shell(const std::string& command_line) {
+  CommandResult r;
+  const std::string command = command_line + " 2>&1";
+  FILE* pipe = popen(command.c_str(), "r");
+  if (pipe == nullptr) return r;
+  char buf[4096];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) r.output.append(buf, n);
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+inline CommandResult Fastcal(const std::string& args) { return Shell(Bin() + " " + args); }
+
+inline std::string ReadFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (Bin().empty() || Source().empty()) GTEST_SKIP() << "FASTCAL_BIN / FASTCAL_SOURCE_DIR unset";
+    // The process id keeps two suites run at once (two checkouts on one machine) apart.
+    dir_ = std::filesystem::path(::testing::TempDir()) /
+           ("fastcal_cli_" +
+            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
+            std::to_string(::getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+  }
+  void TearDown() override { std::filesystem::remove_all(dir_); }
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+  void Write(const std::string& name, const std::string& text) const {
+    std::ofstream(Path(name)) << text;
+  }
+  // A command line, its exit code and a text its output must contain.
+  struct ExpectedRun {
+    std::string args;
+    int code;
+    std::string expected;
+  };
+  // Runs `fastcal c.args` bounded (a regression of a limit must fail, not exhaust the
+  // machine: 60 s, and 4 GB of address space except under a sanitizer, which reserves
+  // terabytes) and checks its exit code and output; returns the result for more checks.
+  CommandResult RunBoundedAndExpect(const ExpectedRun& c) const {
+    const std::string limit =
+        std::string(kUnderSanitizer ? "" : "ulimit -v 4000000; ") + "timeout 60 ";
+    const CommandResult r = Shell(limit + Bin() + " " + c.args);
+    EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output.substr(0, 2000);
+    EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args << "\n"
+                                                            << r.output.substr(0, 2000);
+    return r;
+  }
+  std::filesystem::path dir_;
+};
+
+}  // namespace fastcal::test
+
+#endif  // FASTCAL_TESTS_CLI_TEST_UTIL_H_
