@@ -179,8 +179,10 @@ bytes a sample); a full disk there is exit 1, naming the directory.
 
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
 // replace there.
-const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "report.html",
-                                                    "report.md", "summary.json", "residuals.csv"};
+// "A*B": any name from A to B (a joint fit of sessions writes one model per session).
+const std::vector<std::string> kCalibrateOutputs = {
+    "model_calibrated.yaml", "model_calibrated@*.yaml", "report.html", "report.md", "summary.json",
+    "residuals.csv"};
 const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
                                                    "residuals.csv"};
 

@@ -288,11 +288,24 @@ bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::
                ", or --force to replace a previous run's results)";
       return false;
     }
-    // --force replaces a previous run's results, never anything else.
+    // --force replaces a previous run's results, never anything else. An entry "A*B"
+    // stands for the names that start with A and end with B (a session's model).
+    const auto is_result = [&](const std::string& name) {
+      for (const std::string& r : *replaceable) {
+        const size_t star = r.find('*');
+        if (star == std::string::npos ? name == r
+                                      : name.size() >= r.size() - 1 &&
+                                            name.compare(0, star, r, 0, star) == 0 &&
+                                            name.compare(name.size() - (r.size() - star - 1),
+                                                         std::string::npos, r, star + 1) == 0) {
+          return true;
+        }
+      }
+      return false;
+    };
     for (const auto& entry : std::filesystem::directory_iterator(dir, ec)) {
       const std::string name = entry.path().filename().string();
-      if (std::find(replaceable->begin(), replaceable->end(), name) == replaceable->end() ||
-          !entry.is_regular_file(ec)) {
+      if (!is_result(name) || !entry.is_regular_file(ec)) {
         *error = where + "holds '" + internal::Escape(name) +
                  "', which is not a fastcal result: --force replaces only a previous run's "
                  "results (choose a new --" +

@@ -152,12 +152,17 @@ CSV columns, units in the names:
   end_residual_m          largest distance between a cable's computed upper end and its
                           tower top (the catenaries' end conditions)
   error_estimate_pct      the method's estimate of its largest tension error, %
+  equilibrium             exact: which equilibrium, where sagging cables allow several:
+                          taut (the only one this taut), home (followed from the home
+                          pose), several (others were met: this is the home pose's),
+                          unreachable (none from the home pose, yet one exists); empty
+                          for aas (docs/model.md, "Which equilibrium exact returns")
   message                 why a pose failed, in double quotes ("" when ok)
   status is a short code: ok, no_equilibrium, sagging_cable, overstretched_cable,
   reflector_contact, not_converged, inaccurate, vertical_cable, singular,
   catenary_failed, invalid_input (docs/cli.md).
   compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact,
-  aas_error_estimate_pct, message.
+  aas_error_estimate_pct, equilibrium (exact's), message.
 A summary line on stderr names the model (its file, or "nominal FAST"), the attitude
 used and the time per pose.
 
@@ -698,6 +703,7 @@ std::string CsvHeader(bool single) {
     for (int i = 1; i <= kNumCables; ++i) out << ",err" << i << "_pct";
     out << ",aas_error_estimate_pct";
   }
+  out << ",equilibrium";
   out << ",message\n";
   return out.str();
 }
@@ -727,6 +733,7 @@ void AppendCsvRow(long long n, const Pose& pose, const StaticsSolution* single,
     put(s.moment_residual_nm);
     put(s.end_residual_m);
     put(100.0 * s.error_estimate);
+    out << "," << EquilibriumCode(s);
   } else {
     const StaticsSolution& a = *aas;
     const StaticsSolution& e = *exact;
@@ -741,6 +748,7 @@ void AppendCsvRow(long long n, const Pose& pose, const StaticsSolution* single,
       put(ok ? 100.0 * (a.cables[i].lower_tension_n / e.cables[i].lower_tension_n - 1.0) : 0.0);
     }
     put(100.0 * a.error_estimate);
+    out << "," << EquilibriumCode(e);
   }
   out << "," << internal::QuotedCsvField(status.second) << "\n";
   *text += out.str();
@@ -749,6 +757,7 @@ void AppendCsvRow(long long n, const Pose& pose, const StaticsSolution* single,
 void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
   const auto [status, message] = StatusAndMessage(s);
   j->Key("status").String(status);
+  if (s.method == StaticsMethod::kExact) j->Key("equilibrium").String(EquilibriumCode(s));
   if (s.status != StaticsStatus::kOk) {
     j->Key("message").String(message);
     if (s.cable >= 0) j->Key("cable").Int(s.cable + 1);
@@ -808,6 +817,7 @@ struct Totals {
   long long failed = 0;                        // poses any method failed (--keep-going)
   std::string first_failure;                   // NodeFailure of the first
   std::array<double, kNumCables> worst_pct{};  // compare: max |aas - exact| / exact
+  long long several = 0;  // poses where exact met several equilibria (EquilibriumCode)
 };
 
 // Solves the poses one at a time (one method, or aas and exact for compare), each row
@@ -855,6 +865,8 @@ bool SolveStream(const CableRobot& robot, const PoseStream& stream, const Static
       if (totals->first_failure.empty()) totals->first_failure = failure;
     }
     totals->failed += pose_ok ? 0 : 1;
+    const StaticsSolution& exact_solution = compare ? exact->solution : single->solution;
+    totals->several += exact_solution.other_equilibrium ? 1 : 0;
     if (compare && pose_ok) {
       for (int i = 0; i < kNumCables; ++i) {
         totals->worst_pct[i] = std::max(
@@ -961,6 +973,13 @@ int RunSolve(int argc, char** argv) {
                  "numbers "
                  "(exit 0). First: "
               << totals.first_failure << std::endl;
+  }
+  if (totals.several > 0) {
+    std::cerr << "fastcal solve: several equilibria hold " << totals.several << " of " << n
+              << (n == 1 ? " pose" : " poses")
+              << " (column equilibrium: several, unreachable); exact returns the one followed "
+                 "from the home pose (docs/model.md, \"Which equilibrium exact returns\")"
+              << std::endl;
   }
   return 0;
 }

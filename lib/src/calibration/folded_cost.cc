@@ -7,6 +7,7 @@
 
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/sample_chunks.h"
+#include "fastcal/internal/sample_rows.h"
 
 namespace fastcal::internal {
 
@@ -46,24 +47,35 @@ FoldedTensionCost::FoldedTensionCost(const FittedSamples& samples, const ceres::
 
 bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const {
   struct Part {
+    SampleRows rows;    // the chunk's rows, Jacobian then residual
     Eigen::MatrixXd r;  // (n + 1) x (n + 1), upper triangular
     double rho = 0.0;
   };
   const int n = n_;
   *r_aug = Eigen::MatrixXd();
   *rho_sum = 0.0;
-  const int failed = ReduceChunks<Part>(
+  SampleRowWhitener whitener(samples_, n + 1);
+  const int failed = ReduceChunksInOrder<Part>(
       samples_.size(), threads_, [] { return Part(); },
       [&](int begin, int end, Part* part) {
+        part->rows.Reset(begin, end, n + 1);
+        for (int t = begin; t < end; ++t) {
+          if (!EvaluateSampleRows(samples_.At(t), theta, t, &part->rows)) return t;
+        }
+        return -1;
+      },
+      [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
+      [&](int begin, int end, Part* part) {
         using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-        Eigen::MatrixXd rows(kNumCables * (end - begin), n + 1);
         RowMatrix j(kNumCables, n);
         double r[kNumCables];
+        Eigen::MatrixXd rows(kNumCables * (end - begin), n + 1);
         for (int t = begin; t < end; ++t) {
-          const TensionCost cost(samples_.At(t));
-          const double* parameters[1] = {theta};
-          double* jacobians[1] = {j.data()};
-          if (!cost.Evaluate(parameters, r, jacobians)) return t;
+          for (int i = 0; i < kNumCables; ++i) {
+            const double* row = part->rows.Row(t, i);
+            for (int k = 0; k < n; ++k) j(i, k) = row[k];
+            r[i] = row[n];
+          }
           part->rho += CorrectForLoss(loss_, r, j.data(), n);
           const int row = kNumCables * (t - begin);
           rows.block(row, 0, kNumCables, n) = j;
@@ -80,18 +92,29 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
 }
 
 double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
+  struct Part {
+    SampleRows rows;  // the chunk's residuals
+    double sum = 0.0;
+  };
   double total = 0.0;
-  const int failed = ReduceChunks<double>(
-      samples_.size(), threads_, [] { return 0.0; },
-      [&](int begin, int end, double* sum) {
-        double r[kNumCables];
-        for (int j = begin; j < end; ++j) {
-          if (!samples_.At(j)(theta, r)) return j;
-          *sum += CorrectForLoss(loss_, r, nullptr, n_);
+  SampleRowWhitener whitener(samples_, 1);
+  const int failed = ReduceChunksInOrder<Part>(
+      samples_.size(), threads_, [] { return Part(); },
+      [&](int begin, int end, Part* part) {
+        part->rows.Reset(begin, end, 1);
+        for (int t = begin; t < end; ++t) {
+          if (!EvaluateSampleRows(samples_.At(t), theta, t, &part->rows)) return t;
         }
         return -1;
       },
-      [&](const double& sum) { total += sum; });
+      [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
+      [&](int begin, int end, Part* part) {
+        for (int t = begin; t < end; ++t) {
+          part->sum += CorrectForLoss(loss_, part->rows.Of(t), nullptr, n_);
+        }
+        return -1;
+      },
+      [&](const Part& part) { total += part.sum; });
   *ok = failed < 0;
   return total;
 }

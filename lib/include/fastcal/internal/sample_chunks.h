@@ -131,20 +131,47 @@ int ForEachChunk(int count, int threads, const Work& work, int chunk = kSampleCh
   return failed.load() < count ? failed.load() : -1;
 }
 
-// Like ForEachChunk, with sums: work(begin, end, &local) adds a chunk into the thread's
-// `local` (made by make()); merge(local) adds it into the total, called in chunk order
-// under a lock, after which `local` is made afresh.
-// A thread whose `work` or `merge` throws abandons the pass: the threads waiting for their
-// turn to merge are released, and the exception is rethrown.
-template <typename Local, typename Make, typename Work, typename Merge>
-int ReduceChunks(int count, int threads, const Make& make, const Work& work, const Merge& merge,
-                 int chunk = kSampleChunk, const ThreadStarter& start = nullptr) {
+// Like ForEachChunk, with sums and a stage that must see the chunks in order:
+//   work(begin, end, &local)     in parallel: the chunk's costly part, into the thread's
+//                                `local` (made by make()); the first failing index or -1
+//   ordered(begin, end, &local)  strictly in chunk order, one chunk at a time: a recursion
+//                                in time order over what work computed (the slow-error
+//                                filter, slow_error_filter.h)
+//   finish(begin, end, &local)   in parallel again (e.g. fold what ordered produced)
+//   merge(local)                 in chunk order under a lock; then `local` is made afresh.
+// After a failure, ordered, finish and merge are skipped (the total is discarded). A thread
+// whose stage throws abandons the pass: the threads waiting for their turn are released,
+// and the exception is rethrown (issue 29).
+template <typename Local, typename Make, typename Work, typename Ordered, typename Finish,
+          typename Merge>
+int ReduceChunksInOrder(int count, int threads, const Make& make, const Work& work,
+                        const Ordered& ordered, const Finish& finish, const Merge& merge,
+                        int chunk = kSampleChunk, const ThreadStarter& start = nullptr) {
   std::atomic<int> next{0};
   std::atomic<int> failed{count};
   std::mutex mutex;
   std::condition_variable turn;
-  int merged = 0;          // chunks merged (or passed over after a failure), in order
-  bool abandoned = false;  // an exception: no chunk will be merged any more
+  int ordered_chunks = 0;  // chunks through `ordered` (or passed over), in order
+  int merged = 0;          // chunks merged (or passed over), in order
+  bool abandoned = false;  // an exception: no chunk takes its turn any more
+  const auto record = [&](int f) {
+    if (f < 0) return;
+    int seen = failed.load();
+    while (f < seen && !failed.compare_exchange_weak(seen, f)) {
+    }
+  };
+  // Waits for chunk `index`'s turn on `counter`, runs `step` unless something failed;
+  // false when the pass was abandoned meanwhile.
+  const auto in_turn = [&](int* counter, int index, const auto& step) {
+    std::unique_lock<std::mutex> lock(mutex);
+    turn.wait(lock, [&] { return *counter == index || abandoned; });
+    if (abandoned) return false;
+    if (failed.load() == count) step();
+    ++*counter;
+    lock.unlock();
+    turn.notify_all();
+    return true;
+  };
   const auto abandon = [&] {
     {
       std::lock_guard<std::mutex> lock(mutex);
@@ -160,22 +187,13 @@ int ReduceChunks(int count, int threads, const Make& make, const Work& work, con
           for (;;) {
             const int begin = next.fetch_add(chunk);
             if (begin >= count) return;
+            const int end = std::min(count, begin + chunk);
             const int index = begin / chunk;
             // Past a failure the chunk is not needed: the total is discarded.
-            const int f =
-                begin > failed.load() ? -1 : work(begin, std::min(count, begin + chunk), &local);
-            if (f >= 0) {
-              int seen = failed.load();
-              while (f < seen && !failed.compare_exchange_weak(seen, f)) {
-              }
-            }
-            std::unique_lock<std::mutex> lock(mutex);
-            turn.wait(lock, [&] { return merged == index || abandoned; });
-            if (abandoned) return;
-            if (failed.load() == count) merge(local);
-            ++merged;
-            lock.unlock();
-            turn.notify_all();
+            record(begin > failed.load() ? -1 : work(begin, end, &local));
+            if (!in_turn(&ordered_chunks, index, [&] { ordered(begin, end, &local); })) return;
+            if (failed.load() == count) record(finish(begin, end, &local));
+            if (!in_turn(&merged, index, [&] { merge(local); })) return;
             local = make();
           }
         } catch (...) {
@@ -185,6 +203,17 @@ int ReduceChunks(int count, int threads, const Make& make, const Work& work, con
       },
       start);
   return failed.load() < count ? failed.load() : -1;
+}
+
+// ReduceChunksInOrder without the ordered stage: work(begin, end, &local) adds a chunk
+// into the thread's `local`; merge(local) adds it into the total, in chunk order.
+template <typename Local, typename Make, typename Work, typename Merge>
+int ReduceChunks(int count, int threads, const Make& make, const Work& work, const Merge& merge,
+                 int chunk = kSampleChunk, const ThreadStarter& start = nullptr) {
+  const auto none = [](int, int, Local*) {};
+  const auto no_finish = [](int, int, Local*) { return -1; };
+  return ReduceChunksInOrder<Local>(count, threads, make, work, none, no_finish, merge, chunk,
+                                    start);
 }
 
 }  // namespace fastcal::internal
