@@ -944,7 +944,12 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
     << RmsTable(variants) << CrossValidationLine(result) << PaperTable6Lines(PositionsOf(data))
-    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, report.html, report.md, summary.json"
+    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, ";
+  // One model a session when the spec separates parameters by session.
+  for (size_t k = 0; k < result.session_models.size(); ++k) {
+    s << "model_calibrated@" << result.session_labels[k] << ".yaml, ";
+  }
+  s << "report.html, report.md, summary.json"
     << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
 }
