@@ -72,6 +72,8 @@ TEST(CalibrationLengthsTest, SpecReadsLengthsAndOffsetsAndRefusesThemAlone) {
   EXPECT_NE(ParseError("noise: {length_sigma_m: 0}\n").find("spec.yaml:1: noise.length_sigma_m"),
             std::string::npos);
   EXPECT_NE(ParseError("noise: {length_sigma_m: 5}\n").find("mm written as m?"), std::string::npos);
+  // An encoder's tenth of a millimetre is a sigma (the tension sensors' floor is not).
+  EXPECT_EQ(Parse("noise: {length_sigma_m: 0.0001}\n").length_sigma_m, 0.0001);
   // A fixed offset without the lengths is harmless: the model's value, listed.
   EXPECT_FALSE(Parse("parameters: {length_offset_m: {initial: 0.2}}\n").UsesLengths());
 }
