@@ -976,8 +976,8 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
     << RmsTable(variants) << CrossValidationLine(result) << LengthTable(result.lengths)
-    << PaperTable6Lines(PositionsOf(data))
-    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, ";
+    << PaperTable6Lines(PositionsOf(data)) << "\nwrote " << FLAGS_out
+    << "/{model_calibrated.yaml, ";
   // One model a session when the spec separates parameters by session.
   for (size_t k = 0; k < result.session_models.size(); ++k) {
     s << "model_calibrated@" << result.session_labels[k] << ".yaml, ";
