@@ -502,9 +502,10 @@ int RunLocate(int argc, char** argv) {
       return kExitFailure;
     }
   }
-  if (!WriteOutput(FLAGS_output, Csv(rows, answers), &error)) {
+  // The output was checked before the work: a failure now is the machine's (a full disk).
+  if (!WriteOutput(FLAGS_output, Csv(rows, answers), &error, FLAGS_force)) {
     PrintError(kCommand, error);
-    return kExitUsage;
+    return kExitFailure;
   }
   size_t failed = 0;
   const std::string findings = Findings(rows, answers, &failed);
