@@ -426,6 +426,7 @@ class LocateResult:
         )
 
 
+@_renamed_keywords({"min_reflector_clearance_m": "reflector_clearance_m"})
 def locate(
     lengths_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,
@@ -435,13 +436,14 @@ def locate(
     *,
     warm_start: bool = True,
     search_radius_m: float = 2.0,
-    length_sigma_m: float = 0.01,
-    tension_sigma_percent: float = 3.0,
-    tension_sigma_kN: float = 0.0,
+    spec: Optional[Union[PathLike, Mapping[str, Any]]] = None,
+    length_sigma_m: Optional[float] = None,
+    tension_sigma_percent: Optional[float] = None,
+    tension_sigma_kN: Optional[float] = None,
     attitude_sigma_deg: float = 0.05,
     max_strain: float = 0.05,
     max_length_ratio: float = 1.5,
-    min_reflector_clearance_m: float = 0.0,
+    reflector_clearance_m: float = 0.0,
 ) -> LocateResult:
     """Where the cabin hangs, from the six unstretched cable lengths (forward statics).
 
@@ -457,10 +459,14 @@ def locate(
             pose as the lengths move from its lengths to the row's.
         search_radius_m: look for other equilibria of the same lengths this far from the
             answer (m, anchors' move); 0: none.
+        spec: a calibration spec (file or dict) whose noise gives the sigmas below
+            (its tension sigmas, and length_sigma_m when it has one), as `fastcal locate
+            --spec`; a sigma given as a keyword overrides it.
         length_sigma_m, tension_sigma_percent, tension_sigma_kN, attitude_sigma_deg:
-            the measurements' sigmas (the fit's weights, and `covariance`).
-        max_strain, max_length_ratio, min_reflector_clearance_m: the model's range, as
-            in solve().
+            the measurements' sigmas (the fit's weights, and `covariance`); without
+            them and a spec 0.01 m, 3 %, 0 kN (attitude 0.05 deg).
+        max_strain, max_length_ratio, reflector_clearance_m: the model's range, as in
+            solve() (min_reflector_clearance_m, the former name, warns).
 
     Returns:
         A LocateResult (arrays with a leading axis of n for (n, 6) lengths). Rows that
@@ -476,8 +482,24 @@ def locate(
         tensions = np.zeros((0, 6))
     else:
         tensions, _ = _rows(tensions_kN, 6, "tensions_kN")
+    robot = model if model is not None else Model.nominal()
+    noise: Dict[str, Any] = {
+        "length_sigma_m": 0.01,
+        "tension_sigma_percent": 3.0,
+        "tension_sigma_kN": 0.0,
+    }
+    if spec is not None:
+        given = _fastcal.spec_noise(robot, *_spec_argument(spec))
+        noise.update({k: v for k, v in given.items() if v is not None})
+    for name, value in (
+        ("length_sigma_m", length_sigma_m),
+        ("tension_sigma_percent", tension_sigma_percent),
+        ("tension_sigma_kN", tension_sigma_kN),
+    ):
+        if value is not None:
+            noise[name] = value
     raw = _fastcal.locate(
-        model if model is not None else Model.nominal(),
+        robot,
         lengths,
         kind,
         attitude,
@@ -485,13 +507,11 @@ def locate(
         {
             "warm_start": warm_start,
             "search_radius_m": search_radius_m,
-            "length_sigma_m": length_sigma_m,
-            "tension_sigma_percent": tension_sigma_percent,
-            "tension_sigma_kN": tension_sigma_kN,
+            **noise,
             "attitude_sigma_deg": attitude_sigma_deg,
             "max_strain": max_strain,
             "max_length_ratio": max_length_ratio,
-            "min_reflector_clearance_m": min_reflector_clearance_m,
+            "min_reflector_clearance_m": reflector_clearance_m,
         },
     )
     return LocateResult(raw, single)

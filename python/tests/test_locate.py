@@ -124,3 +124,18 @@ def test_a_calibration_with_lengths_reports_them(data_dir) -> None:
         assert abs(result.estimates[name] - offset) < 3 * result.sigma_total[name]
     np.testing.assert_allclose(result.model.length_offset_m, [result.estimates[
         f"length_offset_m[{i + 1}]"] for i in range(6)])
+
+
+def test_sigmas_from_a_spec_and_the_former_keyword(data_dir) -> None:
+    alone = fastcal.locate([K1_LENGTH_M] * 6)
+    spec = fastcal.locate([K1_LENGTH_M] * 6, spec=data_dir / "spec_lengths.yaml")  # 5 mm
+    as_dict = fastcal.locate([K1_LENGTH_M] * 6, spec={"noise": {"length_sigma_m": 0.005}})
+    overridden = fastcal.locate([K1_LENGTH_M] * 6, spec=data_dir / "spec_lengths.yaml",
+                                length_sigma_m=0.01)
+    np.testing.assert_allclose(spec.sigma_position_m, 0.5 * alone.sigma_position_m, rtol=1e-9)
+    np.testing.assert_allclose(as_dict.sigma_position_m, spec.sigma_position_m, rtol=1e-12)
+    np.testing.assert_allclose(overridden.sigma_position_m, alone.sigma_position_m, rtol=1e-12)
+    with pytest.raises(fastcal.InputError, match="length_sigma_m"):
+        fastcal.locate([K1_LENGTH_M] * 6, spec={"noise": {"length_sigma_m": -1}})
+    with pytest.warns(DeprecationWarning, match="use reflector_clearance_m="):
+        fastcal.locate([K1_LENGTH_M] * 6, min_reflector_clearance_m=0.0)
