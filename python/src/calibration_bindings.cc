@@ -314,14 +314,14 @@ py::dict Evaluate(const CableRobot& model_argument, const Dataset& data,
 
 // A spec's white noise, for locate's weights (fastcal.locate(spec=...)): the tension
 // sigmas, and the lengths' when the spec has them (None otherwise).
-py::dict SpecNoise(const CableRobot& model, const std::string& spec_path_or_text,
-                   bool spec_is_text, const std::string& spec_source) {
+py::dict SpecNoise(const CableRobot& model, const std::string& spec_path_or_text, bool spec_is_text,
+                   const std::string& spec_source) {
   const CalibrationSpec spec = Spec(model, spec_path_or_text, spec_is_text, spec_source);
   py::dict d;
   d["tension_sigma_kN"] = spec.tension_sigma_n / kNPerKn;
   d["tension_sigma_percent"] = spec.tension_sigma_percent;
-  d["length_sigma_m"] = spec.UsesLengths() ? py::object(py::float_(spec.length_sigma_m))
-                                           : py::object(py::none());
+  d["length_sigma_m"] =
+      spec.UsesLengths() ? py::object(py::float_(spec.length_sigma_m)) : py::object(py::none());
   return d;
 }
 
