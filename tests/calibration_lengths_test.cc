@@ -12,6 +12,7 @@
 
 #include "fastcal/calibration.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/design.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
@@ -339,6 +340,30 @@ TEST(CalibrationLengthsTest, AConsideredOffsetAddsWhatMovingItMovesTheEstimates)
   // Cable 2's own EA carries most of it.
   EXPECT_GT(considered.parameters[3 + 1].sigma_systematic,
             3.0 * considered.parameters[3].sigma_systematic);
+}
+
+// The design counts the lengths as the calibration does: its predicted formal sigma of
+// every free parameter (mass centre, EA and offset per cable) at the survey's poses is the
+// sigma the calibration with lengths reports on telemetry simulated there.
+TEST(CalibrationLengthsTest, DesignPredictsTheSigmasOfACalibrationWithLengths) {
+  constexpr double kRelTol = 0.03;  // the fit's weights follow its own predicted readings
+  const CableRobot nominal = CableRobot::NominalFast();
+  const CalibrationSpec spec = Parse(kLengthsSpec);
+  const std::vector<Pose> poses = SurveyPoses();
+  DesignPrediction predicted;
+  std::string error;
+  ASSERT_TRUE(PredictSurvey(nominal, spec, DesignOptions(), poses, &predicted, &error)) << error;
+  ASSERT_TRUE(predicted.ok) << predicted.note;
+  CalibrationResult r;
+  ASSERT_EQ(Calibrate(nominal, spec, Telemetry(nominal, poses, 13), CalibrationOptions(), &r,
+                      &error),
+            CalibrationStatus::kOk)
+      << error;
+  ASSERT_EQ(predicted.budget.parameters.size(), r.parameters.size());
+  for (size_t k = 0; k < r.parameters.size(); ++k) {
+    const double sigma = predicted.budget.parameters[k].formal;
+    EXPECT_NEAR(r.parameters[k].sigma, sigma, kRelTol * sigma) << r.parameters[k].name;
+  }
 }
 
 TEST(CalibrationLengthsTest, LengthsNeedTheDatasetsColumns) {

@@ -376,7 +376,7 @@ DesignPrediction Predict(const DesignProblem& pr, const DesignSums& s, int sampl
   in.prior_information = pr.prior_information;
   int priors = 0;
   for (int k = 0; k < pr.n; ++k) priors += pr.prior_information[k] > 0.0;
-  in.num_residuals = 6 * samples + priors;
+  in.num_residuals = pr.rows * samples + priors;
   in.chi_square = in.num_residuals - pr.n;  // chi^2 / nu = 1: no misfit widening
   in.consider_cross = s.c;
   in.consider_sigma = pr.consider_variance.cwiseSqrt();
@@ -541,15 +541,6 @@ bool SetUp(const CableRobot& robot, const CalibrationSpec& spec, const DesignOpt
            DesignProblem* pr, std::string* error) {
   if (!o.IsValid(error)) return false;
   if (!spec.IsValid(error)) return false;
-  if (spec.UsesLengths()) {
-    // The design's information is the tensions' (six rows a pose): with the lengths its
-    // predicted sigmas would be another calibration's.
-    *error =
-        "noise.length_sigma_m: the design does not yet count the winches' lengths as "
-        "readings; design with the spec's tensions alone (leave out length_sigma_m and the "
-        "length_offset_m group)";
-    return false;
-  }
   if (!internal::SetUpDesignProblem(spec, pr, error)) return false;
   if (o.samples < pr->n) {
     *error = std::to_string(o.samples) + " samples cannot determine the spec's " +

@@ -1,7 +1,9 @@
 // A survey design's information and criterion (internal/design_information.h; formulas in
 // design.h). The Jacobian comes from the calibration's own residual, TensionResidual
 // through TensionCost, with the consider parameters freed so that one Jet pass gives
-// both [J_x J_c]: the same derivatives the calibration's budget uses.
+// both [J_x J_c]: the same derivatives the calibration's budget uses. With the winches'
+// lengths in the spec (noise.length_sigma_m) each pose has twelve rows, the six tensions'
+// and the six lengths' (calibration_model.h), each whitened by its sigma.
 #include "fastcal/internal/design_information.h"
 
 #include <Eigen/Cholesky>
@@ -16,8 +18,6 @@
 
 namespace fastcal::internal {
 namespace {
-
-constexpr int kRows = kNumCables;  // readings per sample
 
 // P_w^-1 (D) or diag(weights) (A), embedded in n x n: the criterion's weight on P.
 bool CriterionWeight(const DesignProblem& pr, const Eigen::MatrixXd& total, Eigen::MatrixXd* w) {
@@ -78,6 +78,7 @@ bool SetUpDesignProblem(const CalibrationSpec& spec, DesignProblem* problem, std
     if (g == static_cast<int>(pr.consider_groups.size())) pr.consider_groups.push_back(group);
     pr.consider_group.push_back(g);
   }
+  pr.rows = spec.UsesLengths() ? kMaxReadings : kNumCables;
   pr.x_rows.resize(0, pr.n);
   pr.z_rows.resize(0, pr.q);
   pr.wanted_weight = Eigen::VectorXd::Zero(pr.n);
@@ -101,12 +102,15 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
   }
   TensionResidual f{&model,        Pose(), {}, {}, ModelFitStaticsOptions(spec.forward_model),
                     CompactStart()};
-  f.sigma_n.fill(1.0);  // residual = reading; whitened below
+  f.sigma_n.fill(1.0);                             // residual = reading; whitened below
+  if (spec.UsesLengths()) f.length_sigma_m = 1.0;  // residual = s0 + offset; likewise
+  const int rows = pr.rows;
   const int first = static_cast<int>(pr.x_rows.rows());
-  pr.x_rows.conservativeResize(first + kRows * static_cast<int>(poses.size()), pr.n);
-  pr.z_rows.conservativeResize(first + kRows * static_cast<int>(poses.size()), pr.q);
-  Eigen::Matrix<double, kRows, Eigen::Dynamic, Eigen::RowMajor> jac(kRows, model.num_free());
-  std::array<double, kRows> reading{};
+  pr.x_rows.conservativeResize(first + rows * static_cast<int>(poses.size()), pr.n);
+  pr.z_rows.conservativeResize(first + rows * static_cast<int>(poses.size()), pr.q);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jac(rows,
+                                                                             model.num_free());
+  std::array<double, kMaxReadings> reading{};
   for (size_t t = 0; t < poses.size(); ++t) {
     f.pose = poses[t];
     const TensionCost cost(f);
@@ -121,12 +125,15 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
       pr.z_rows.conservativeResize(first, pr.q);
       return false;
     }
-    const std::array<double, kRows> sigma =
-        TensionSigmas(reading, spec.tension_sigma_n, spec.tension_sigma_percent);
-    for (int i = 0; i < kRows; ++i) {
-      const int row = first + kRows * static_cast<int>(t) + i;
+    std::array<double, kNumCables> tension{};
+    std::copy(reading.begin(), reading.begin() + kNumCables, tension.begin());
+    const std::array<double, kNumCables> sigma =
+        TensionSigmas(tension, spec.tension_sigma_n, spec.tension_sigma_percent);
+    for (int i = 0; i < rows; ++i) {
+      const int row = first + rows * static_cast<int>(t) + i;
+      const double sigma_i = i < kNumCables ? sigma[i] : spec.length_sigma_m;
       for (int k = 0; k < model.num_free(); ++k) {
-        const double v = jac(i, k) / sigma[i];
+        const double v = jac(i, k) / sigma_i;
         if (column[k] < pr.n) {
           pr.x_rows(row, column[k]) = v;
         } else {
@@ -144,19 +151,19 @@ DesignSums SumsOf(const DesignProblem& pr, const Eigen::VectorXd& weights) {
   s.c = Eigen::MatrixXd::Zero(pr.n, pr.q);
   for (int k = 0; k < pr.candidates(); ++k) {
     if (!(weights[k] > 0.0)) continue;
-    const auto x = pr.x_rows.middleRows(kRows * k, kRows);
+    const auto x = pr.x_rows.middleRows(pr.rows * k, pr.rows);
     s.m.noalias() += weights[k] * (x.transpose() * x);
     if (pr.q > 0)
-      s.c.noalias() += weights[k] * (x.transpose() * pr.z_rows.middleRows(kRows * k, kRows));
+      s.c.noalias() += weights[k] * (x.transpose() * pr.z_rows.middleRows(pr.rows * k, pr.rows));
   }
   return s;
 }
 
 DesignSums SumsOfCandidate(const DesignProblem& pr, int k) {
-  const auto x = pr.x_rows.middleRows(kRows * k, kRows);
+  const auto x = pr.x_rows.middleRows(pr.rows * k, pr.rows);
   DesignSums s;
   s.m = x.transpose() * x;
-  s.c = x.transpose() * pr.z_rows.middleRows(kRows * k, kRows);
+  s.c = x.transpose() * pr.z_rows.middleRows(pr.rows * k, pr.rows);
   return s;
 }
 
@@ -206,7 +213,7 @@ bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::V
   const Eigen::MatrixXd kwk = k * w * k;
   const Eigen::MatrixXd g = kwk + k * w * q + q * w * k;
   const Eigen::MatrixXd h = pr.consider_variance.asDiagonal() * kc.transpose() * w * k;
-  // Per row: -x G x^T + 2 z H x^T; per candidate: the sum over its six rows. In chunks,
+  // Per row: -x G x^T + 2 z H x^T; per candidate: the sum over its rows. In chunks,
   // so that the temporaries stay small (the rows of 40 000 candidates are ~40 MB), the
   // chunks shared by two threads (the gradient is most of a design's time).
   constexpr int kChunkCandidates = 512;
@@ -218,15 +225,15 @@ bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::V
     for (int chunk = first_chunk; chunk < chunks; chunk += kThreads) {
       const int c0 = chunk * kChunkCandidates;
       const int count = std::min(kChunkCandidates, pr.candidates() - c0);
-      const auto x = pr.x_rows.middleRows(kRows * c0, kRows * count);
+      const auto x = pr.x_rows.middleRows(pr.rows * c0, pr.rows * count);
       xg.noalias() = x * g;
       Eigen::VectorXd per_row = -(xg.cwiseProduct(x)).rowwise().sum();
       if (pr.q > 0) {
-        zh.noalias() = pr.z_rows.middleRows(kRows * c0, kRows * count) * h;
+        zh.noalias() = pr.z_rows.middleRows(pr.rows * c0, pr.rows * count) * h;
         per_row += 2.0 * (zh.cwiseProduct(x)).rowwise().sum();
       }
       for (int c = 0; c < count; ++c) {
-        (*gradient)[c0 + c] = per_row.segment(kRows * c, kRows).sum();
+        (*gradient)[c0 + c] = per_row.segment(pr.rows * c, pr.rows).sum();
       }
     }
   };
