@@ -355,9 +355,9 @@ TEST(CalibrationLengthsTest, DesignPredictsTheSigmasOfACalibrationWithLengths) {
   ASSERT_TRUE(PredictSurvey(nominal, spec, DesignOptions(), poses, &predicted, &error)) << error;
   ASSERT_TRUE(predicted.ok) << predicted.note;
   CalibrationResult r;
-  ASSERT_EQ(Calibrate(nominal, spec, Telemetry(nominal, poses, 13), CalibrationOptions(), &r,
-                      &error),
-            CalibrationStatus::kOk)
+  ASSERT_EQ(
+      Calibrate(nominal, spec, Telemetry(nominal, poses, 13), CalibrationOptions(), &r, &error),
+      CalibrationStatus::kOk)
       << error;
   ASSERT_EQ(predicted.budget.parameters.size(), r.parameters.size());
   for (size_t k = 0; k < r.parameters.size(); ++k) {
