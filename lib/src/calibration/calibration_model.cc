@@ -163,39 +163,133 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
   return f;
 }
 
-TensionCost::TensionCost(const TensionResidual& functor)
-    : functor_(functor), n_(functor.model->num_free()) {
-  set_num_residuals(kNumCables);
-  mutable_parameter_block_sizes()->push_back(n_);
+void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
+                                       const std::array<double, kNumCables>& gain, int session,
+                                       double* jacobian) const {
+  const int n = num_free();
+  Eigen::Map<Eigen::Matrix<double, kNumCables, Eigen::Dynamic, Eigen::RowMajor>> j(jacobian,
+                                                                                   kNumCables, n);
+  j.setZero();
+  const auto cables = [](const ParameterSpec& s, int i) { return s.index < 0 || s.index == i; };
+  for (int k = 0; k < n; ++k) {
+    const ParameterSpec& s = spec_.parameters[free_[k]];
+    if (s.session >= 0 && s.session != session) continue;
+    auto column = j.col(k);
+    switch (s.kind) {
+      case ParameterKind::kMassCentre:
+        column = gradient.mass_centre_cabin_m.col(s.component);
+        break;
+      case ParameterKind::kCabinMass:
+        column = gradient.cabin_mass_kg;
+        break;
+      case ParameterKind::kLinearDensity:
+        for (int i = 0; i < kNumCables; ++i) {
+          if (cables(s, i)) column += gradient.linear_density_kg_per_m[i];
+        }
+        break;
+      case ParameterKind::kEa:
+        for (int i = 0; i < kNumCables; ++i) {
+          if (cables(s, i)) column += gradient.ea_n[i];
+        }
+        break;
+      case ParameterKind::kAnchorOffset:
+        for (int i = 0; i < kNumCables; ++i) {
+          if (anchor_of_cable_[i] == s.index) column += gradient.anchor_m[i].col(s.component);
+        }
+        break;
+      case ParameterKind::kTowerOffset:
+        column = gradient.tower_top_m[s.index].col(s.component);
+        break;
+      case ParameterKind::kAttachmentMass:
+      case ParameterKind::kAttachmentDensity:
+        column = gradient.chain_value[s.index][s.component];
+        break;
+      case ParameterKind::kSensorGain:
+      case ParameterKind::kSensorBias:
+        break;  // after the statics: below
+    }
+    // The readings are gain_i T_i + bias_i.
+    for (int i = 0; i < kNumCables; ++i) {
+      if (s.kind == ParameterKind::kSensorGain) {
+        column[i] = cables(s, i) ? gradient.tension_n[i] : 0.0;
+      } else if (s.kind == ParameterKind::kSensorBias) {
+        column[i] = cables(s, i) ? 1.0 : 0.0;
+      } else {
+        column[i] *= gain[i];
+      }
+    }
+  }
 }
 
-template <int N>
-bool TensionCost::EvaluateJet(const double* theta, double* residuals, double* jacobian) const {
-  using Jet = ceres::Jet<double, N>;
-  std::array<Jet, N> t;
-  for (int k = 0; k < n_; ++k) t[k] = Jet(theta[k], k);
-  std::array<Jet, kNumCables> r;
-  if (!functor_(t.data(), r.data())) return false;
+bool TensionResidual::Evaluate(const double* theta, double* residuals, double* jacobian) const {
+  if (jacobian == nullptr) return (*this)(theta, residuals);
+  if (statics.method != StaticsMethod::kExact) {
+    return TensionCost::EvaluateJet(*this, theta, residuals, jacobian);
+  }
+  StaticsParameters<double> p;
+  std::array<double, kNumCables> gain, bias;
+  model->Assemble(theta, &p, &gain, &bias, session);
+  for (double g : gain) {
+    if (!(g > 0.0)) return false;  // as operator()
+  }
+  StaticsSolution solution;
+  start.Restore(pose, statics.method, &solution);
+  StaticsOptions options = statics;
+  options.warm_start = true;
+  if (SolveStaticsWithParameters(p, pose, options, &solution) != StaticsStatus::kOk) return false;
+  TensionGradient gradient;
+  if (ExactTensionGradient(p, pose, solution, options.catenary.vertical_span_fraction, &gradient) !=
+      StaticsStatus::kOk) {
+    return false;
+  }
+  const int n = model->num_free();
+  model->ReadingJacobian(gradient, gain, session, jacobian);
   for (int i = 0; i < kNumCables; ++i) {
-    residuals[i] = r[i].a;
-    for (int k = 0; k < n_; ++k) jacobian[i * n_ + k] = r[i].v[k];
+    const double t = solution.cables[i].lower_tension_n;
+    residuals[i] = excluded[i] ? 0.0 : (gain[i] * t + bias[i] - measured_n[i]) / sigma_n[i];
+    const double scale = excluded[i] ? 0.0 : 1.0 / sigma_n[i];
+    for (int k = 0; k < n; ++k) jacobian[i * n + k] *= scale;
   }
   return true;
 }
 
+TensionCost::TensionCost(const TensionResidual& functor) : functor_(functor) {
+  set_num_residuals(kNumCables);
+  mutable_parameter_block_sizes()->push_back(functor.model->num_free());
+}
+
+template <int N>
+bool TensionCost::EvaluateJetOf(const TensionResidual& f, const double* theta, double* residuals,
+                                double* jacobian) {
+  using Jet = ceres::Jet<double, N>;
+  const int n = f.model->num_free();
+  std::array<Jet, N> t;
+  for (int k = 0; k < n; ++k) t[k] = Jet(theta[k], k);
+  std::array<Jet, kNumCables> r;
+  if (!f(t.data(), r.data())) return false;
+  for (int i = 0; i < kNumCables; ++i) {
+    residuals[i] = r[i].a;
+    for (int k = 0; k < n; ++k) jacobian[i * n + k] = r[i].v[k];
+  }
+  return true;
+}
+
+bool TensionCost::EvaluateJet(const TensionResidual& f, const double* theta, double* residuals,
+                              double* j) {
+  const int n = f.model->num_free();
+  if (n <= 1) return EvaluateJetOf<1>(f, theta, residuals, j);
+  if (n <= 2) return EvaluateJetOf<2>(f, theta, residuals, j);
+  if (n <= 4) return EvaluateJetOf<4>(f, theta, residuals, j);
+  if (n <= 8) return EvaluateJetOf<8>(f, theta, residuals, j);
+  if (n <= 16) return EvaluateJetOf<16>(f, theta, residuals, j);
+  if (n <= 32) return EvaluateJetOf<32>(f, theta, residuals, j);
+  if (n <= 64) return EvaluateJetOf<64>(f, theta, residuals, j);
+  return EvaluateJetOf<kMaxFreeParameters>(f, theta, residuals, j);
+}
+
 bool TensionCost::Evaluate(double const* const* parameters, double* residuals,
                            double** jacobians) const {
-  const double* theta = parameters[0];
-  if (jacobians == nullptr || jacobians[0] == nullptr) return functor_(theta, residuals);
-  double* j = jacobians[0];
-  if (n_ <= 1) return EvaluateJet<1>(theta, residuals, j);
-  if (n_ <= 2) return EvaluateJet<2>(theta, residuals, j);
-  if (n_ <= 4) return EvaluateJet<4>(theta, residuals, j);
-  if (n_ <= 8) return EvaluateJet<8>(theta, residuals, j);
-  if (n_ <= 16) return EvaluateJet<16>(theta, residuals, j);
-  if (n_ <= 32) return EvaluateJet<32>(theta, residuals, j);
-  if (n_ <= 64) return EvaluateJet<64>(theta, residuals, j);
-  return EvaluateJet<kMaxFreeParameters>(theta, residuals, j);
+  return functor_.Evaluate(parameters[0], residuals, jacobians != nullptr ? jacobians[0] : nullptr);
 }
 
 PriorCost::PriorCost(int num_free, int k, double mean, double sigma)

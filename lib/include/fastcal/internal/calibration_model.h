@@ -5,9 +5,14 @@
 //   sigma_i^2 = sigma_abs^2 + (percent/100 * T_predicted_i)^2
 // (the predicted reading at the previous pass's parameters: calibration.cc), and
 // r_i = 0 for a reading kept out of the fit (a gross error).
-// TensionResidual is a pure functor (const members, no side effects); TensionCost wraps
-// it with a Jet whose size is chosen at run time from the number of free parameters, so
-// the whole Jacobian comes from one pass through the statics.
+// TensionResidual is a pure functor (const members, no side effects). Its Evaluate is the
+// one stage every consumer (the folded cost, the linearisation, the design) reads a
+// sample's six rows and their 6 x n Jacobian from. With exact statics the Jacobian is
+// analytic: the statics' part by the implicit-function theorem (tension_gradient.h),
+// contracted with the parameter map (CalibrationModel::ReadingJacobian), the sensors' gain
+// and bias directly; ~1 us a sample whatever n (issue 28). With aas and aas-refined,
+// whose solutions are explicit sequences of solves, a ceres::Jet as wide as n replays
+// them (TensionCost::EvaluateJet).
 #ifndef FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 #define FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 
@@ -23,6 +28,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/compact_start.h"
+#include "fastcal/internal/tension_gradient.h"
 #include "fastcal/statics.h"
 
 namespace fastcal::internal {
@@ -50,6 +56,12 @@ class CalibrationModel {
   // The calibrated model: the input robot with the parameters set to theta (those of
   // `session` where a parameter has one copy per session: sessions.h).
   CableRobot ToRobot(const double* theta, int session = 0) const;
+
+  // d reading_i / d theta_k (6 x n, row-major) of the readings gain_i T_i + bias_i at a
+  // sample of `session`: Assemble's map differentiated, with `gradient` the statics' and
+  // `gain` Assemble's at theta. A parameter of another session has a zero column.
+  void ReadingJacobian(const TensionGradient& gradient, const std::array<double, kNumCables>& gain,
+                       int session, double* jacobian) const;
 
   // The statics parameters and sensor model at theta for a sample of `session`: a
   // parameter of another session (ParameterSpec::session) does not apply.
@@ -135,6 +147,10 @@ struct TensionResidual {
   std::array<bool, kNumCables> excluded{};
   int session = 0;  // the sample's (Sample::session)
 
+  // The six residuals and, when `jacobian` is not null, their Jacobian (6 x n, row-major;
+  // rows of excluded readings zero) at theta. False where the statics fail.
+  bool Evaluate(const double* theta, double* residuals, double* jacobian) const;
+
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
     StaticsParameters<T> p;
@@ -180,18 +196,24 @@ struct FittedSamples {
   TensionResidual At(int j, const CalibrationModel* through = nullptr) const;
 };
 
-// ceres::CostFunction over one parameter block (theta) of size num_free <= 64.
+// ceres::CostFunction over one parameter block (theta) of size num_free <=
+// kMaxFreeParameters: TensionResidual::Evaluate.
 class TensionCost : public ceres::CostFunction {
  public:
   explicit TensionCost(const TensionResidual& functor);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // The Jacobian by a ceres::Jet through the replayed statics, whatever the method:
+  // aas's and aas-refined's derivatives, and a reference for the analytic ones (tests).
+  static bool EvaluateJet(const TensionResidual& f, const double* theta, double* residuals,
+                          double* jacobian);
+
  private:
   template <int N>
-  bool EvaluateJet(const double* theta, double* residuals, double* jacobian) const;
+  static bool EvaluateJetOf(const TensionResidual& f, const double* theta, double* residuals,
+                            double* jacobian);
   TensionResidual functor_;
-  int n_;
 };
 
 // (theta_k - mean) / sigma on one coordinate of theta.
