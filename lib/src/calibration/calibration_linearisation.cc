@@ -11,9 +11,6 @@
 namespace fastcal::internal {
 namespace {
 
-// Rows of the free Jacobian folded into the R factor at a time.
-constexpr int kQrChunkRows = 1024;
-
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 bool IsPerCableGroup(ParameterKind kind) {
@@ -27,20 +24,14 @@ bool Covers(const ParameterSpec& p, const ParameterSpec& b) {
   return SameParameter(p, b) || (p.kind == b.kind && IsPerCableGroup(p.kind) && p.index < 0);
 }
 
-// Residuals and Jacobian (rows of excluded readings zero) of `f` at `theta`, and the
-// robust loss's IRLS weight sqrt(rho'(|r|^2)) (1 without a loss).
+// Residuals and Jacobian (rows of excluded readings zero) of fitted sample `t` at `at`,
+// and the robust loss's IRLS weight sqrt(rho'(|r|^2)) (1 without a loss).
 // `curvature` (may be null) receives 2 rho'' for the loss's exact Hessian
 // rho' J^T J + 2 rho'' (J^T r)(J^T r)^T (0 without a loss).
-bool EvaluateSample(const TensionResidual& f, const double* theta, const ceres::LossFunction* loss,
-                    Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j, double* weight,
-                    double* curvature = nullptr) {
-  const TensionCost cost(f);
-  const double* parameters[1] = {theta};
-  double* jacobians[1] = {j->data()};
-  if (!cost.Evaluate(parameters, r->data(), jacobians)) return false;
-  for (int i = 0; i < kNumCables; ++i) {
-    if (f.excluded[i]) j->row(i).setZero();  // r_i is 0 already
-  }
+bool EvaluateSample(const FittedSamples& samples, int t, const ModelAtTheta& at,
+                    const ceres::LossFunction* loss, Eigen::Matrix<double, kNumCables, 1>* r,
+                    RowMatrix* j, double* weight, double* curvature = nullptr) {
+  if (!samples.Rows(t, at, r->data(), j->data())) return false;
   *weight = 1.0;
   if (curvature != nullptr) *curvature = 0.0;
   if (loss != nullptr) {
@@ -56,8 +47,8 @@ bool EvaluateSample(const TensionResidual& f, const double* theta, const ceres::
 // The free pass.
 
 struct FreeSums {
-  Eigen::MatrixXd information, curvature, r_factor, pending;
-  int pending_rows = 0;
+  Eigen::MatrixXd information, curvature;
+  RowFold fold;  // of the weighted rows: the R factor
   double chi_square = 0.0, raw_chi_square = 0.0;
   int readings = 0;
   std::vector<FoldSums> folds;
@@ -65,7 +56,7 @@ struct FreeSums {
   FreeSums(int n, int blocks)
       : information(Eigen::MatrixXd::Zero(n, n)),
         curvature(Eigen::MatrixXd::Zero(n, n)),
-        pending(kQrChunkRows, n),
+        fold(n),
         folds(blocks) {
     for (FoldSums& f : folds) {
       f.information = Eigen::MatrixXd::Zero(n, n);
@@ -77,20 +68,10 @@ struct FreeSums {
     }
   }
 
-  void AddRows(const Eigen::MatrixXd& rows) {
-    if (pending_rows + rows.rows() > pending.rows()) Flush();
-    pending.middleRows(pending_rows, rows.rows()) = rows;
-    pending_rows += static_cast<int>(rows.rows());
-  }
-  void Flush() {
-    r_factor = FoldRows(r_factor, pending.topRows(pending_rows));
-    pending_rows = 0;
-  }
+  void AddRows(const RowMatrix& rows) { fold.Add(rows.data(), static_cast<int>(rows.rows())); }
 
-  void Add(FreeSums& o) {
-    o.Flush();
-    Flush();
-    r_factor = FoldRows(r_factor, o.r_factor);
+  void Add(const FreeSums& o) {
+    fold.Add(o.fold);
     information += o.information;
     curvature += o.curvature;
     chi_square += o.chi_square;
@@ -113,14 +94,16 @@ struct FreeSums {
 };
 
 // The cross-validation block sums of one sample: raw (unweighted) rows in newtons.
-void AddToFold(const TensionResidual& f, const Eigen::Matrix<double, kNumCables, 1>& r,
-               const RowMatrix& j, double weight, FoldSums* fold) {
+void AddToFold(const std::array<bool, kNumCables>& excluded,
+               const std::array<double, kNumCables>& sigma_n,
+               const Eigen::Matrix<double, kNumCables, 1>& r, const RowMatrix& j, double weight,
+               FoldSums* fold) {
   ++fold->samples;
   fold->information.noalias() += weight * weight * j.transpose() * j;
   fold->gradient.noalias() += weight * weight * j.transpose() * r;
   for (int i = 0; i < kNumCables; ++i) {
-    if (f.excluded[i]) continue;
-    const double s = f.sigma_n[i];
+    if (excluded[i]) continue;
+    const double s = sigma_n[i];
     const Eigen::VectorXd ji = s * j.row(i).transpose();  // N per parameter unit
     const double ri = s * r[i];                           // N
     ++fold->readings[i];
@@ -131,17 +114,17 @@ void AddToFold(const TensionResidual& f, const Eigen::Matrix<double, kNumCables,
 }
 
 // Fitted samples [begin, end) into `sums`; the first that fails, or -1.
-int AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisation* out,
-                   FreeSums* sums) {
+int AccumulateFree(const LinearisationInputs& in, const ModelAtTheta& at, int begin, int end,
+                   Linearisation* out, FreeSums* sums) {
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   RowMatrix j(kNumCables, n);
   Eigen::Matrix<double, kNumCables, 1> r;
   for (int t = begin; t < end; ++t) {
-    const TensionResidual f = in.samples.At(t);
     double weight = 1.0, curvature = 0.0;
-    if (!EvaluateSample(f, in.theta, in.loss, &r, &j, &weight, &curvature)) return t;
-    const Eigen::MatrixXd jw = weight * j;
+    if (!EvaluateSample(in.samples, t, at, in.loss, &r, &j, &weight, &curvature)) return t;
+    const std::array<bool, kNumCables> excluded = in.samples.Excluded(t);
+    const RowMatrix jw = weight * j;
     const Eigen::VectorXd rw = weight * r;
     out->residuals.row(t) = r.transpose();
     out->scores.row(t) = rw.transpose() * jw;
@@ -156,11 +139,11 @@ int AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisat
     sums->AddRows(jw);
     sums->chi_square += rw.squaredNorm();
     sums->raw_chi_square += r.squaredNorm();
-    for (bool e : f.excluded) sums->readings += !e;
+    for (bool e : excluded) sums->readings += !e;
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
-    AddToFold(f, r, j, weight, &sums->folds[block]);
+    AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, weight, &sums->folds[block]);
   }
-  sums->Flush();
+  sums->fold.Flush();
   return -1;
 }
 
@@ -169,8 +152,10 @@ int AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisat
 
 struct CandidatePass {
   const LinearisationInputs& in;
-  // The basis at the calibrated model of each session (one without sessions).
+  // The basis at the calibrated model of each session (one without sessions), and each
+  // assembled at its own values.
   std::vector<CalibrationModel> basis;
+  std::vector<ModelAtTheta> basis_at;
   std::vector<std::vector<double>> theta;  // each basis's own values
   std::vector<std::vector<int>> free_columns, candidate_columns;
   std::vector<int> free_session;  // of each free parameter (ParameterSpec::session)
@@ -200,9 +185,8 @@ int AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samp
   Eigen::Matrix<double, kNumCables, 1> r;
   for (int k = begin; k < end; ++k) {
     const int session = in.data->samples[(*in.fit)[samples[k]]].session;
-    const TensionResidual f = in.At(samples[k], &pass.basis[session]);
     double weight = 1.0;
-    if (!EvaluateSample(f, pass.theta[session].data(), pass.in.loss, &r, &b, &weight)) {
+    if (!EvaluateSample(in, samples[k], pass.basis_at[session], pass.in.loss, &r, &b, &weight)) {
       return samples[k];
     }
     Eigen::MatrixXd jx = weight * Combine(b, pass.free_columns);
@@ -245,18 +229,20 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
   out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
   FreeSums total(n, blocks);
+  const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
   const int failed = ReduceChunks<FreeSums>(
       num_fit, in.num_threads, [&] { return FreeSums(n, blocks); },
-      [&](int begin, int end, FreeSums* sums) { return AccumulateFree(in, begin, end, out, sums); },
+      [&](int begin, int end, FreeSums* sums) {
+        return AccumulateFree(in, at, begin, end, out, sums);
+      },
       [&](FreeSums& sums) { total.Add(sums); });
   if (failed >= 0) {
     *error = CannotSolve(in, failed);
     return false;
   }
-  total.Flush();
   out->information = std::move(total.information);
   out->loss_curvature = std::move(total.curvature);
-  out->r_factor = std::move(total.r_factor);
+  out->r_factor = total.fold.r();
   out->chi_square = total.chi_square;
   out->raw_chi_square = total.raw_chi_square;
   out->readings = total.readings;
@@ -271,11 +257,14 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   const CableRobot& model = fitted.robot();
   CalibrationSpec basis_spec;
   basis_spec.parameters = BasisParameters(model);
-  CandidatePass pass{in, {}, {}, {}, {}, {}};
-  const int sessions = std::max<int>(1, static_cast<int>(in.samples.data->session_labels.size()));
+  CandidatePass pass{in, {}, {}, {}, {}, {}, {}};
+  const int sessions = in.samples.sessions();
+  pass.basis.reserve(sessions);  // basis_at refers to them
+  pass.theta.reserve(sessions);
   for (int s = 0; s < sessions; ++s) {
     pass.basis.emplace_back(fitted.ToRobot(in.theta, s), basis_spec);
     pass.theta.push_back(pass.basis.back().InitialTheta());
+    pass.basis_at.emplace_back(pass.basis.back(), pass.theta.back().data(), sessions);
   }
   for (int k = 0; k < n; ++k) {
     const ParameterSpec& p = fitted.spec().parameters[fitted.spec_index(k)];
@@ -337,21 +326,6 @@ std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model) {
     if (Covers(p, basis[c])) columns.push_back(static_cast<int>(c));
   }
   return columns;
-}
-
-Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows) {
-  // A fold with nothing yet has a 0 x 0 R factor, not 0 x n: Eigen's assert (on in the
-  // sanitizer build) refuses assigning it to a 0 x n block, so empty parts are skipped.
-  const int n = static_cast<int>(std::max(top.cols(), rows.cols()));
-  Eigen::MatrixXd m(top.rows() + rows.rows(), n);
-  if (top.rows() > 0) m.topRows(top.rows()) = top;
-  if (rows.rows() > 0) m.bottomRows(rows.rows()) = rows;
-  if (m.rows() == 0) return Eigen::MatrixXd::Zero(n, n);
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(m);
-  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(n, n);
-  const int k = static_cast<int>(std::min<Eigen::Index>(n, m.rows()));
-  r.topRows(k) = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
-  return r;
 }
 
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error) {

@@ -1,6 +1,7 @@
 // Parameter mapping and cost functions of the calibration (calibration_model.h).
 #include "fastcal/internal/calibration_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fastcal::internal {
@@ -16,6 +17,8 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
     const ParameterSpec& s = spec.parameters[j];
     if (s.free) {
       free_.push_back(static_cast<int>(j));
+      frees_geometry_ = frees_geometry_ || s.kind == ParameterKind::kAnchorOffset ||
+                        s.kind == ParameterKind::kTowerOffset;
       continue;
     }
     if (!s.has_initial) continue;
@@ -221,36 +224,103 @@ void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
   }
 }
 
+ModelAtTheta::ModelAtTheta(const CalibrationModel& model, const double* theta, int sessions)
+    : model_(&model), theta_(theta), sessions_(std::max(1, sessions)) {
+  for (size_t k = 0; k < sessions_.size(); ++k) {
+    Session& s = sessions_[k];
+    model.Assemble(theta, &s.statics, &s.gain, &s.bias, static_cast<int>(k));
+    s.gains_positive = std::all_of(s.gain.begin(), s.gain.end(), [](double g) { return g > 0.0; });
+  }
+}
+
+namespace {
+
+// What the rows of one sample need besides the model.
+struct SampleView {
+  Pose pose;
+  const CompactStart* start;
+  const std::array<double, kNumCables>& measured_n;
+  const std::array<double, kNumCables>& sigma_n;
+  const std::array<bool, kNumCables>* excluded;  // null: none
+  int session;
+};
+
+// A sample's residuals, and with `jacobian` their analytic Jacobian (exact statics only),
+// through assembled parameters: TensionResidual's operator() in double, and its
+// implicit-function derivatives.
+bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
+                 const StaticsOptions& statics, const SampleView& x, double* residuals,
+                 double* jacobian) {
+  if (!m.gains_positive) return false;  // as operator()
+  StaticsSolution solution;
+  if (x.start != nullptr) {
+    x.start->Restore(x.pose, statics.method, &solution);
+  } else {
+    CompactStart().Restore(x.pose, statics.method, &solution);
+  }
+  StaticsOptions options = statics;
+  options.warm_start = true;
+  if (SolveStaticsWithParameters(m.statics, x.pose, options, &solution) != StaticsStatus::kOk) {
+    return false;
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    const bool out = x.excluded != nullptr && (*x.excluded)[i];
+    const double t = solution.cables[i].lower_tension_n;
+    residuals[i] = out ? 0.0 : (m.gain[i] * t + m.bias[i] - x.measured_n[i]) / x.sigma_n[i];
+  }
+  if (jacobian == nullptr) return true;
+  TensionGradient gradient;
+  if (ExactTensionGradient(m.statics, x.pose, solution, options.catenary.vertical_span_fraction,
+                           model.frees_geometry(), &gradient) != StaticsStatus::kOk) {
+    return false;
+  }
+  const int n = model.num_free();
+  model.ReadingJacobian(gradient, m.gain, x.session, jacobian);
+  for (int i = 0; i < kNumCables; ++i) {
+    const bool out = x.excluded != nullptr && (*x.excluded)[i];
+    const double scale = out ? 0.0 : 1.0 / x.sigma_n[i];
+    for (int k = 0; k < n; ++k) jacobian[i * n + k] *= scale;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool TensionResidual::Evaluate(const double* theta, double* residuals, double* jacobian) const {
   if (jacobian == nullptr) return (*this)(theta, residuals);
   if (statics.method != StaticsMethod::kExact) {
     return TensionCost::EvaluateJet(*this, theta, residuals, jacobian);
   }
-  StaticsParameters<double> p;
-  std::array<double, kNumCables> gain, bias;
-  model->Assemble(theta, &p, &gain, &bias, session);
-  for (double g : gain) {
-    if (!(g > 0.0)) return false;  // as operator()
+  ModelAtTheta::Session m;
+  model->Assemble(theta, &m.statics, &m.gain, &m.bias, session);
+  m.gains_positive = std::all_of(m.gain.begin(), m.gain.end(), [](double g) { return g > 0.0; });
+  return RowsThrough(*model, m, statics, {pose, &start, measured_n, sigma_n, &excluded, session},
+                     residuals, jacobian);
+}
+
+bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const {
+  if (jacobian != nullptr && statics.method != StaticsMethod::kExact) {
+    return At(j, &at.model()).Evaluate(at.theta(), residuals, jacobian);
   }
-  StaticsSolution solution;
-  start.Restore(pose, statics.method, &solution);
-  StaticsOptions options = statics;
-  options.warm_start = true;
-  if (SolveStaticsWithParameters(p, pose, options, &solution) != StaticsStatus::kOk) return false;
-  TensionGradient gradient;
-  if (ExactTensionGradient(p, pose, solution, options.catenary.vertical_span_fraction, &gradient) !=
-      StaticsStatus::kOk) {
-    return false;
-  }
-  const int n = model->num_free();
-  model->ReadingJacobian(gradient, gain, session, jacobian);
-  for (int i = 0; i < kNumCables; ++i) {
-    const double t = solution.cables[i].lower_tension_n;
-    residuals[i] = excluded[i] ? 0.0 : (gain[i] * t + bias[i] - measured_n[i]) / sigma_n[i];
-    const double scale = excluded[i] ? 0.0 : 1.0 / sigma_n[i];
-    for (int k = 0; k < n; ++k) jacobian[i * n + k] *= scale;
-  }
-  return true;
+  const int t = (*fit)[j];
+  const Sample& sample = data->samples[t];
+  SampleView x{sample.pose,
+               starts != nullptr && !starts->empty() ? &(*starts)[t] : nullptr,
+               sample.tension_n,
+               (*sigma_n)[j],
+               excluded != nullptr && !excluded->empty() ? &(*excluded)[t] : nullptr,
+               sample.session};
+  if (use_planned_attitude) x.pose.rotation = sample.planned_rotation;
+  return RowsThrough(at.model(), at.session(sample.session), statics, x, residuals, jacobian);
+}
+
+std::array<bool, kNumCables> FittedSamples::Excluded(int j) const {
+  if (excluded == nullptr || excluded->empty()) return {};
+  return (*excluded)[(*fit)[j]];
+}
+
+int FittedSamples::sessions() const {
+  return std::max<int>(1, static_cast<int>(data->session_labels.size()));
 }
 
 TensionCost::TensionCost(const TensionResidual& functor) : functor_(functor) {

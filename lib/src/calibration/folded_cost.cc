@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "fastcal/internal/calibration_linearisation.h"
+#include "fastcal/internal/row_fold.h"
 #include "fastcal/internal/sample_chunks.h"
 
 namespace fastcal::internal {
@@ -46,47 +46,47 @@ FoldedTensionCost::FoldedTensionCost(const FittedSamples& samples, const ceres::
 
 bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const {
   struct Part {
-    Eigen::MatrixXd r;  // (n + 1) x (n + 1), upper triangular
+    RowFold fold;  // of the rows (J r), (n + 1) columns
     double rho = 0.0;
   };
   const int n = n_;
-  *r_aug = Eigen::MatrixXd();
+  const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
+  RowFold total(n + 1);
   *rho_sum = 0.0;
   const int failed = ReduceChunks<Part>(
-      samples_.size(), threads_, [] { return Part(); },
+      samples_.size(), threads_, [n] { return Part{RowFold(n + 1)}; },
       [&](int begin, int end, Part* part) {
-        using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-        Eigen::MatrixXd rows(kNumCables * (end - begin), n + 1);
-        RowMatrix j(kNumCables, n);
+        std::vector<double> j(kNumCables * n), rows(kNumCables * (n + 1));
         double r[kNumCables];
         for (int t = begin; t < end; ++t) {
-          const TensionCost cost(samples_.At(t));
-          const double* parameters[1] = {theta};
-          double* jacobians[1] = {j.data()};
-          if (!cost.Evaluate(parameters, r, jacobians)) return t;
+          if (!samples_.Rows(t, at, r, j.data())) return t;
           part->rho += CorrectForLoss(loss_, r, j.data(), n);
-          const int row = kNumCables * (t - begin);
-          rows.block(row, 0, kNumCables, n) = j;
-          for (int i = 0; i < kNumCables; ++i) rows(row + i, n) = r[i];
+          for (int i = 0; i < kNumCables; ++i) {
+            std::copy(&j[i * n], &j[i * n] + n, &rows[i * (n + 1)]);
+            rows[i * (n + 1) + n] = r[i];
+          }
+          part->fold.Add(rows.data(), kNumCables);
         }
-        part->r = FoldRows(part->r, rows);
+        part->fold.Flush();
         return -1;
       },
       [&](const Part& part) {
-        *r_aug = FoldRows(*r_aug, part.r);
+        total.Add(part.fold);
         *rho_sum += part.rho;
       });
+  *r_aug = total.r();
   return failed < 0;
 }
 
 double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
+  const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
   double total = 0.0;
   const int failed = ReduceChunks<double>(
       samples_.size(), threads_, [] { return 0.0; },
       [&](int begin, int end, double* sum) {
         double r[kNumCables];
         for (int j = begin; j < end; ++j) {
-          if (!samples_.At(j)(theta, r)) return j;
+          if (!samples_.Rows(j, at, r, nullptr)) return j;
           *sum += CorrectForLoss(loss_, r, nullptr, n_);
         }
         return -1;

@@ -2,8 +2,8 @@
 // (internal/tension_gradient.h, where the equations are).
 #include "fastcal/internal/tension_gradient.h"
 
-#include <Eigen/LU>
 #include <cmath>
+#include <utility>
 
 namespace fastcal::internal {
 namespace {
@@ -68,9 +68,40 @@ struct CableLine {
   CableEnd end;
 };
 
+using Matrix6d = Eigen::Matrix<double, 6, 6>;
+
+// The inverse of a 6x6 matrix by Gauss-Jordan elimination with partial pivoting, written
+// out: Eigen's PartialPivLU::inverse() took a third of the gradient's time in its general
+// blocked solves. False when a pivot is 0 or the result is not finite.
+bool Invert6(Matrix6d m, Matrix6d* inverse) {
+  Matrix6d& x = *inverse;
+  x.setIdentity();
+  for (int c = 0; c < 6; ++c) {
+    int p = c;
+    for (int r = c + 1; r < 6; ++r) {
+      if (std::abs(m(r, c)) > std::abs(m(p, c))) p = r;
+    }
+    if (!(std::abs(m(p, c)) > 0.0)) return false;
+    if (p != c) {
+      m.row(p).swap(m.row(c));
+      x.row(p).swap(x.row(c));
+    }
+    const double inv_pivot = 1.0 / m(c, c);
+    m.row(c) *= inv_pivot;
+    x.row(c) *= inv_pivot;
+    for (int r = 0; r < 6; ++r) {
+      if (r == c) continue;
+      const double f = m(r, c);
+      m.row(r) -= f * m.row(c);
+      x.row(r) -= f * x.row(c);
+    }
+  }
+  return x.allFinite();
+}
+
 // d T / d (the cable's chord, global axes) and d T / d (its lever r = R a, global axes).
-void GeometryColumns(const PoseGeometry<double>& g, const Eigen::Matrix<double, 6, 6>& k, int i,
-                     const CableLine& c, const Vector6d& beta, Matrix63d* chord, Matrix63d* lever) {
+void GeometryColumns(const PoseGeometry<double>& g, const Matrix6d& k, int i, const CableLine& c,
+                     const Vector6d& beta, Matrix63d* chord, Matrix63d* lever) {
   const double ux = g.ux[i], uy = g.uy[i], inv_l = 1.0 / g.span[i];
   const Vector3T<double>& r = g.r[i];
   // The equilibrium rows' response to the chord's horizontal direction turning by phi.
@@ -89,14 +120,15 @@ void GeometryColumns(const PoseGeometry<double>& g, const Eigen::Matrix<double, 
 
 StaticsStatus ExactTensionGradient(const StaticsParameters<double>& p, const Pose& pose,
                                    const StaticsSolution& solution, double vertical_span_fraction,
-                                   TensionGradient* gradient) {
+                                   bool geometry, TensionGradient* gradient) {
   TensionGradient& out = *gradient;
   PoseGeometry<double> g;
   int cable = -1;
-  const StaticsStatus status = ComputeGeometry(p, pose, vertical_span_fraction, &g, &cable);
+  const StaticsStatus status =
+      ComputeGeometry(p, pose, vertical_span_fraction, &g, &cable, /*null_basis=*/false);
   if (status != StaticsStatus::kOk) return status;
   std::array<CableLine, kNumCables> lines;
-  Eigen::Matrix<double, 6, 6> a_matrix;
+  Matrix6d a_matrix;
   Vector6d d1;  // d T / d Fl along the cable's line
   for (int i = 0; i < kNumCables; ++i) {
     const CableSolution& s = solution.cables[i];
@@ -120,9 +152,9 @@ StaticsStatus ExactTensionGradient(const StaticsParameters<double>& p, const Pos
     a_matrix.col(i) << g.ux[i], g.uy[i], c.a, r[1] * c.a + r[2] * g.uy[i],
         r[0] * c.a + r[2] * g.ux[i], r[1] * g.ux[i] - r[0] * g.uy[i];
   }
-  const Eigen::PartialPivLU<Eigen::Matrix<double, 6, 6>> lu(a_matrix);
-  const Eigen::Matrix<double, 6, 6> k = d1.asDiagonal() * lu.inverse();
-  if (!k.allFinite()) return StaticsStatus::kSingular;
+  Matrix6d k;
+  if (!Invert6(a_matrix, &k)) return StaticsStatus::kSingular;
+  k = d1.asDiagonal() * k;
   const Eigen::Matrix3d& rotation = pose.rotation;
   for (int i = 0; i < kNumCables; ++i) {
     const CableLine& c = lines[i];
@@ -137,6 +169,7 @@ StaticsStatus ExactTensionGradient(const StaticsParameters<double>& p, const Pos
     for (int j = 0; j < p.chain[i].num_attachments; ++j) {
       out.chain_value[i][j] = (c.nu0 * e.dspan_dvalue[j] + c.nu1 * e.drise_dvalue[j]) * beta;
     }
+    if (!geometry) continue;
     Matrix63d chord, lever;
     GeometryColumns(g, k, i, c, beta, &chord, &lever);
     out.tower_top_m[i] = chord;  // c = B - (R a + p)

@@ -39,6 +39,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/row_fold.h"
 #include "fastcal/statics.h"
 #include "fastcal/uncertainty.h"
 
@@ -104,10 +105,6 @@ std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model);
 
 // Both passes. False, with *error naming the sample's line, when the statics fail there.
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error);
-
-// Upper-triangular R with R^T R = A^T A for A the rows of `top` stacked on `rows` (a QR
-// of the stack; `top` may be empty).
-Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows);
 
 }  // namespace fastcal::internal
 

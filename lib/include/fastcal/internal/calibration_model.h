@@ -57,6 +57,9 @@ class CalibrationModel {
   // `session` where a parameter has one copy per session: sessions.h).
   CableRobot ToRobot(const double* theta, int session = 0) const;
 
+  // Whether an anchor or tower offset is free: the statics' gradient needs its geometry
+  // columns (ExactTensionGradient).
+  bool frees_geometry() const { return frees_geometry_; }
   // d reading_i / d theta_k (6 x n, row-major) of the readings gain_i T_i + bias_i at a
   // sample of `session`: Assemble's map differentiated, with `gradient` the statics' and
   // `gain` Assemble's at theta. A parameter of another session has a zero column.
@@ -124,9 +127,32 @@ class CalibrationModel {
   CableRobot robot_;
   CalibrationSpec spec_;
   std::vector<int> free_;
+  bool frees_geometry_ = false;
   std::array<int, kNumCables> anchor_of_cable_{};
   StaticsParameters<double> base_;  // the robot with fixed overrides applied
   std::array<double, kNumCables> base_gain_{}, base_bias_n_{};
+};
+
+// The model at one theta for a pass over many samples: the statics parameters, gains and
+// biases of each session assembled once (CalibrationModel::Assemble per sample copied
+// ~2.5 kB of parameters for each: a tenth of a solve).
+class ModelAtTheta {
+ public:
+  struct Session {
+    StaticsParameters<double> statics;
+    std::array<double, kNumCables> gain, bias;
+    bool gains_positive = false;  // else every evaluation fails (TensionResidual)
+  };
+  // `theta` must outlive this; sessions >= 1.
+  ModelAtTheta(const CalibrationModel& model, const double* theta, int sessions);
+  const CalibrationModel& model() const { return *model_; }
+  const double* theta() const { return theta_; }
+  const Session& session(int s) const { return sessions_[s]; }
+
+ private:
+  const CalibrationModel* model_;
+  const double* theta_;
+  std::vector<Session> sessions_;
 };
 
 // Whitening sigma of each cable's reading: sqrt(abs^2 + (percent/100 * reading)^2).
@@ -194,6 +220,15 @@ struct FittedSamples {
   int size() const { return static_cast<int>(fit->size()); }
   // Fitted sample j's residual through `through` (default: model).
   TensionResidual At(int j, const CalibrationModel* through = nullptr) const;
+  // The stage every pass over the samples reads from: fitted sample j's six residuals and,
+  // when `jacobian` is not null, their Jacobian (6 x n, row-major) at `at` (through the
+  // model `at` was made for, with at least as many sessions as the data). The same
+  // numbers as At(j, &at.model()).Evaluate(at.theta(), ...).
+  bool Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const;
+  // The number of sessions a ModelAtTheta for these samples needs.
+  int sessions() const;
+  // Fitted sample j's readings kept out of the fit.
+  std::array<bool, kNumCables> Excluded(int j) const;
 };
 
 // ceres::CostFunction over one parameter block (theta) of size num_free <=

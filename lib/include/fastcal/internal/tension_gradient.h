@@ -48,7 +48,8 @@ using Matrix63d = Eigen::Matrix<double, kNumCables, 3>;
 // d tension / d parameter: entry (i) of each vector is cable i's lower-end tension's
 // derivative (N per parameter unit), one vector per parameter of StaticsParameters.
 struct TensionGradient {
-  std::array<double, kNumCables> tension_n{};     // the solution's lower-end tensions
+  std::array<double, kNumCables> tension_n{};  // the solution's lower-end tensions
+  // Only when asked for (ExactTensionGradient's `geometry`): left as they are otherwise.
   std::array<Matrix63d, kNumCables> tower_top_m;  // d T / d tower_top_m[c] (global axes)
   std::array<Matrix63d, kNumCables> anchor_m;     // d T / d anchor_cabin_m[c] (cabin axes)
   std::array<Vector6d, kNumCables> ea_n;
@@ -59,12 +60,13 @@ struct TensionGradient {
   Matrix63d mass_centre_cabin_m;  // cabin axes
 };
 
-// The gradient at `solution`, an exact solution (status ok) of `p` at `pose`. Returns
-// kSingular where the equilibrium system cannot be factored (it was solved, so only at a
-// pose the solver itself barely held), kVerticalCable as ComputeGeometry.
+// The gradient at `solution`, an exact solution (status ok) of `p` at `pose`; the tower
+// and anchor columns only with `geometry` (36 of the ~100 columns, a fifth of the cost).
+// Returns kSingular where the equilibrium system cannot be factored (it was solved, so
+// only at a pose the solver itself barely held), kVerticalCable as ComputeGeometry.
 StaticsStatus ExactTensionGradient(const StaticsParameters<double>& p, const Pose& pose,
                                    const StaticsSolution& solution, double vertical_span_fraction,
-                                   TensionGradient* gradient);
+                                   bool geometry, TensionGradient* gradient);
 
 }  // namespace fastcal::internal
 
