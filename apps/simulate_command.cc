@@ -69,6 +69,10 @@ DEFINE_double(attitude_control_time_s, 0.0,
               "simulate: correlation time of the attitude control error (s); 0 = white.");
 DEFINE_double(tension_drift_pct, 0.0, "simulate: slow tension error sigma per cable (%).");
 DEFINE_double(tension_drift_time_s, 0.0, "simulate: its correlation time (s).");
+DEFINE_double(tension_drift_kn, 0.0, "simulate: absolute part of the slow tension error (kN).");
+DEFINE_double(session_gap_s, 0.0, "simulate: time between consecutive sessions (s).");
+DEFINE_double(sensor_rezero_kn, 0.0,
+              "simulate: sensors re-zeroed at each new session, bias change sigma (kN).");
 DEFINE_double(mass_centre_drift_m, 0.0, "simulate: mass-centre drift sigma per axis (m).");
 DEFINE_double(mass_centre_drift_time_s, 0.0, "simulate: its correlation time (s).");
 DEFINE_double(sensor_gain_spread_pct, 0.0, "simulate: per-cable gain spread drawn once (%).");
@@ -161,6 +165,8 @@ source with its own generator, so changing one sigma leaves the others' numbers 
   --mass-centre-drift-time-s=0 its correlation time (s)
   --tension-drift-pct=0      slow relative tension error per cable (%)
   --tension-drift-time-s=0   its correlation time (s)
+  --tension-drift-kn=0       absolute part of the slow error (kN): its sd is then
+                             sqrt(kn^2 + (pct/100 y_i)^2), one process per cable
   --attitude-noise-deg=0     measured minus actual attitude, per angle (deg)
   --position-noise-m=0       measured minus actual position, per axis (m)
   --tension-noise-pct=3      relative tension noise (%, the paper's sensors: ~3%)
@@ -176,7 +182,12 @@ Sessions and steps of the mass centre (the cabin's structure changed):
                              session after the first (needs --sessions >= 2)
   --mass-centre-step=T:dx,dy,dz  the mass centre moves by this at time T (s) and stays;
                              several joined by ';' (steps add up)
-The truth model written out has the mass centre before any step; its header lists them.
+  --session-gap-s=0          time between one session's end and the next one's start (s),
+                             added to time_s; the slow errors decorrelate over it
+  --sensor-rezero-kn=0       sensors re-zeroed at the start of each session after the
+                             first: each cable's bias moves by N(0, kN)
+The truth model written out has the mass centre before any step and the first session's
+sensor biases; its header lists the steps and every session's biases.
 
 Output: --out=FILE.csv (required), --force to replace existing files, --interval-s=1
 between samples. A summary on stderr:
@@ -220,7 +231,8 @@ const std::set<std::string> kFlags = {
     "tension-noise-kn", "outlier-fraction", "outlier-scale-pct", "seed", "interval-s", "out",
     "force", "attitude-control-time-s", "tension-drift-pct", "tension-drift-time-s",
     "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-pct",
-    "sensor-bias-spread-kn", "sessions", "session-shift-m", "mass-centre-step"};
+    "sensor-bias-spread-kn", "sessions", "session-shift-m", "mass-centre-step",
+    "tension-drift-kn", "session-gap-s", "sensor-rezero-kn"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -314,7 +326,8 @@ bool StepsAtSessions(int samples, SimulationOptions* options, std::string* error
     const long long first =
         (static_cast<long long>(k) * samples + options->sessions - 1) / options->sessions;
     options->mass_centre_steps.push_back(
-        {static_cast<double>(first) * options->sample_interval_s, shift});
+        {static_cast<double>(first) * options->sample_interval_s + k * options->session_gap_s,
+         shift});
   }
   return true;
 }
@@ -338,6 +351,15 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->seed = FLAGS_seed;
   options->sample_interval_s = FLAGS_interval_s;
   options->sessions = FLAGS_sessions;
+  options->tension_drift_kn = FLAGS_tension_drift_kn;
+  options->session_gap_s = FLAGS_session_gap_s;
+  options->sensor_rezero_kn = FLAGS_sensor_rezero_kn;
+  for (const char* flag : {"session-gap-s", "sensor-rezero-kn"}) {
+    if (FlagGiven(flag) && FLAGS_sessions < 2) {
+      *error = std::string("--") + flag + " needs --sessions=N with N >= 2";
+      return false;
+    }
+  }
   if (!SetStepsFromFlags(options, error)) return false;
   options->method = StaticsMethod::kExact;
   if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &options->method)) {
@@ -362,7 +384,10 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
                                  {"sensor_gain_spread_percent", "--sensor-gain-spread-pct"},
                                  {"sensor_bias_spread_kn", "--sensor-bias-spread-kn"},
                                  {"sample_interval_s", "--interval-s"},
-                                 {"sessions", "--sessions"}});
+                                 {"sessions", "--sessions"},
+                                 {"tension_drift_kn", "--tension-drift-kn"},
+                                 {"session_gap_s", "--session-gap-s"},
+                                 {"sensor_rezero_kn", "--sensor-rezero-kn"}});
     return false;
   }
   return true;
@@ -569,7 +594,7 @@ std::string Summary(const SimulationSummary& s, const SimulationOptions& options
     out << "\n  density factors:";
     for (double f : s.density_factor) out << " " << FormatDouble(f, 6);
   }
-  if (options.tension_drift_percent > 0.0) {
+  if (options.tension_drift_percent > 0.0 || options.tension_drift_kn > 0.0) {
     out << "\n  slow tension error RMS per cable (%):";
     for (double v : s.tension_drift_rms_relative) out << " " << FormatDouble(100.0 * v, 4);
   }
@@ -634,6 +659,14 @@ int RunSimulate(int argc, char** argv) {
                 FormatDouble(options.mass_centre_drift_time_s) +
                 " s); its average over the samples was (" + FormatDouble(m.x(), 6) + ", " +
                 FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
+    }
+    if (summary.session_bias_n.size() > 1 && options.sensor_rezero_kn > 0.0) {
+      header += "\nSensors re-zeroed at each new session; the biases (kN) per session, cables "
+                "1..6:";
+      for (size_t k = 0; k < summary.session_bias_n.size(); ++k) {
+        header += "\n  session " + std::to_string(k + 1) + ":";
+        for (double b : summary.session_bias_n[k]) header += " " + FormatDouble(b / 1e3, 6);
+      }
     }
     return header;
   };

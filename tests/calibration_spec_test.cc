@@ -451,6 +451,63 @@ TEST(CalibrationSpecTest, WrittenSpecReadsBackIdentical) {
   }
 }
 
+TEST(CalibrationSpecTest, SlowErrorIsReadAndWrittenBack) {
+  EXPECT_FALSE(ParseOk("").slow_error.enabled);  // off unless asked for
+  EXPECT_FALSE(ParseOk("noise: {slow_error: none}").slow_error.enabled);
+  const CalibrationSpec both = ParseOk("noise: {slow_error: estimate}");
+  EXPECT_TRUE(both.slow_error.enabled && both.slow_error.estimate_amplitude &&
+              both.slow_error.amplitude_in_percent && both.slow_error.estimate_time_constant);
+  EXPECT_FALSE(both.slow_error.Initial().IsActive());  // white until estimated
+  const CalibrationSpec stated = ParseOk(
+      "noise:\n  slow_error: {sigma_percent: 1.5, sigma_kN: 0.5, time_constant_s: 60}\n");
+  EXPECT_FALSE(stated.slow_error.estimates_any());
+  EXPECT_DOUBLE_EQ(stated.slow_error.stated.sigma_percent, 1.5);
+  EXPECT_DOUBLE_EQ(stated.slow_error.stated.sigma_n, 0.5 * kNewtonsPerKilonewton);
+  EXPECT_DOUBLE_EQ(stated.slow_error.Initial().time_constant_s, 60.0);
+  const CalibrationSpec kn =
+      ParseOk("noise: {slow_error: {sigma_kN: estimate, time_constant_s: 20}}");
+  EXPECT_TRUE(kn.slow_error.estimate_amplitude && !kn.slow_error.amplitude_in_percent);
+  EXPECT_FALSE(kn.slow_error.estimate_time_constant);
+  for (const CalibrationSpec& spec : {both, stated, kn}) {
+    const std::string yaml = CalibrationSpecToYaml(spec);
+    SCOPED_TRACE(yaml);
+    const CalibrationSpec again = ParseOk(yaml);
+    EXPECT_EQ(CalibrationSpecToYaml(again), yaml);
+    EXPECT_EQ(again.slow_error.estimate_amplitude, spec.slow_error.estimate_amplitude);
+    EXPECT_EQ(again.slow_error.amplitude_in_percent, spec.slow_error.amplitude_in_percent);
+    EXPECT_EQ(again.slow_error.stated.sigma_n, spec.slow_error.stated.sigma_n);
+  }
+}
+
+TEST(CalibrationSpecTest, SlowErrorErrorsNameTheKey) {
+  const std::pair<const char*, const char*> cases[] = {
+      {"noise: {slow_error: maybe}", "noise.slow_error: unknown value"},
+      {"noise: {slow_error: {sigma_percent: 1}}", "time_constant_s is missing"},
+      {"noise: {slow_error: {time_constant_s: 10}}", "no amplitude"},
+      {"noise: {slow_error: {sigma_percent: estimate, sigma_kN: estimate, time_constant_s: 1}}",
+       "both \"estimate\""},
+      {"noise: {slow_error: {sigma_percent: -1, time_constant_s: 1}}",
+       "noise.slow_error.sigma_percent: must be >= 0"},
+      {"noise: {slow_error: {sigma_percent: 1, time_constant_s: 0}}",
+       "noise.slow_error.time_constant_s: must be > 0"},
+      {"noise: {slow_error: {sigma_percent: 1, time_constant_s: 1e9}}", "at most a year"},
+      {"noise: {slow_error: {sigma_percent: 1, tau: 1}}", "noise.slow_error.tau: unknown key"},
+  };
+  for (const auto& [text, expected] : cases) {
+    const std::string error = ParseError(text);
+    EXPECT_NE(error.find(expected), std::string::npos) << text << " -> " << error;
+    EXPECT_EQ(error.rfind(std::string(kSource) + ":1: ", 0), 0u) << error;
+  }
+  CalibrationSpec spec;
+  spec.slow_error.enabled = true;
+  spec.slow_error.stated.sigma_percent = 1.0;
+  std::string why;
+  EXPECT_FALSE(spec.IsValid(&why));  // no time constant
+  EXPECT_NE(why.find("slow_error: time_constant_s"), std::string::npos) << why;
+  spec.slow_error.stated.time_constant_s = 30.0;
+  EXPECT_TRUE(spec.IsValid(&why)) << why;
+}
+
 TEST(CalibrationSpecTest, BuiltSpecWritesTheSameSiValues) {
   // Values in newtons that are the image of some kN number: exact after a round trip.
   CalibrationSpec spec;

@@ -87,6 +87,10 @@ struct Fixture {
     excluded.assign(data.samples.size(), {});
     excluded[7][2] = true;  // a reading kept out: residual 0 whatever theta
   }
+  // A slow sensor error (slow_error.h), off unless WithSlowError is called.
+  SlowErrorProcess slow;
+  std::vector<std::array<double, kNumCables>> slow_rho;
+
   FittedSamples Samples() const {
     FittedSamples s;
     s.model = &model;
@@ -95,7 +99,23 @@ struct Fixture {
     s.sigma_n = &sigma_n;
     s.excluded = &excluded;
     s.statics = ModelFitStaticsOptions(StaticsMethod::kExact);
+    s.slow_error = slow;
+    s.slow_rho = &slow_rho;
     return s;
+  }
+  // Samples 1 s apart, a second session from `session_start` on, and a slow error with
+  // tau = 20 s whose ratio to the white sigma varies by reading.
+  void WithSlowError(int session_start) {
+    data.session_labels = {"a", "b"};
+    for (size_t t = 0; t < data.samples.size(); ++t) {
+      data.samples[t].time_s = static_cast<double>(t);
+      data.samples[t].session = static_cast<int>(t) >= session_start ? 1 : 0;
+      std::array<double, kNumCables> rho{};
+      for (int i = 0; i < kNumCables; ++i) rho[i] = 0.6 + 0.4 * std::sin(0.1 * t + i);
+      slow_rho.push_back(rho);
+    }
+    slow.sigma_percent = 2.0;
+    slow.time_constant_s = 20.0;
   }
 };
 
@@ -167,24 +187,91 @@ TEST(FoldedCostTest, MatchesOneCeresBlockPerSample) {
   }
 }
 
+// With a slow sensor error the folded block is generalised least squares: cost, gradient
+// and Gauss-Newton matrix those of r^T Sigma^-1 r per cable, Sigma = I + D C D (D the
+// ratios, C_ts = exp(-|t - s| / tau) within a session, 0 across), computed densely from
+// the per-sample rows; the reading kept out is missing. Over two chunks, so that the
+// filters carry across a chunk boundary, and with a session break inside the second.
+TEST(FoldedCostTest, SlowErrorGivesDenseGeneralisedLeastSquares) {
+  constexpr int kSamples = kSampleChunk + 60;
+  Fixture f(kSamples);
+  f.WithSlowError(kSampleChunk + 20);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[2] += 0.4;
+  const FittedSamples samples = f.Samples();
+  const int n = static_cast<int>(theta.size());
+  Evaluation dense{0.0, Eigen::VectorXd::Zero(n), Eigen::MatrixXd::Zero(n, n)};
+  std::vector<Eigen::Matrix<double, kNumCables, Eigen::Dynamic, Eigen::RowMajor>> jac(kSamples);
+  std::vector<Eigen::Matrix<double, kNumCables, 1>> res(kSamples);
+  for (int t = 0; t < kSamples; ++t) {
+    jac[t].resize(kNumCables, n);
+    const TensionCost cost(samples.At(t));
+    const double* parameters[1] = {theta.data()};
+    double* jacobians[1] = {jac[t].data()};
+    ASSERT_TRUE(cost.Evaluate(parameters, res[t].data(), jacobians));
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    std::vector<int> kept;
+    for (int t = 0; t < kSamples; ++t) {
+      if (!f.excluded[t][i]) kept.push_back(t);
+    }
+    const int m = static_cast<int>(kept.size());
+    Eigen::MatrixXd sigma = Eigen::MatrixXd::Identity(m, m), j(m, n);
+    Eigen::VectorXd r(m);
+    for (int a = 0; a < m; ++a) {
+      const int ta = kept[a];
+      j.row(a) = jac[ta].row(i);
+      r[a] = res[ta][i];
+      for (int b = 0; b < m; ++b) {
+        const int tb = kept[b];
+        if (f.data.samples[ta].session != f.data.samples[tb].session) continue;
+        sigma(a, b) += f.slow_rho[ta][i] * f.slow_rho[tb][i] *
+                       std::exp(-std::abs(ta - tb) / f.slow.time_constant_s);
+      }
+    }
+    const Eigen::LLT<Eigen::MatrixXd> llt(sigma);
+    dense.cost += 0.5 * r.dot(llt.solve(r));
+    dense.gradient += j.transpose() * llt.solve(r);
+    dense.normal += j.transpose() * llt.solve(j);
+  }
+  ceres::Problem folded;
+  folded.AddResidualBlock(new FoldedTensionCost(samples, nullptr, 2), nullptr, theta.data());
+  const Evaluation b = Evaluate(&folded);
+  EXPECT_NEAR(b.cost, dense.cost, kRelTol * dense.cost);
+  EXPECT_LT((b.gradient - dense.gradient).norm(), kRelTol * dense.gradient.norm());
+  EXPECT_LT((b.normal - dense.normal).norm(), kRelTol * dense.normal.norm());
+  double cost_only = 0.0;
+  ASSERT_TRUE(
+      folded.Evaluate(ceres::Problem::EvaluateOptions(), &cost_only, nullptr, nullptr, nullptr));
+  EXPECT_NEAR(cost_only, dense.cost, kRelTol * dense.cost);
+}
+
+// The folded block's residuals and Jacobian on `threads` threads, theta moved off the
+// initial model.
+std::vector<double> FoldedOnThreads(const Fixture& f, const ceres::LossFunction* loss,
+                                    int threads) {
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[0] += 0.1;
+  const FoldedTensionCost cost(f.Samples(), loss, threads);
+  std::vector<double> out(cost.num_residuals() * (1 + theta.size()));
+  const double* parameters[1] = {theta.data()};
+  double* jacobians[1] = {out.data() + cost.num_residuals()};
+  EXPECT_TRUE(cost.Evaluate(parameters, out.data(), jacobians));
+  return out;
+}
+
 // One thread or three: the same bits.
 TEST(FoldedCostTest, ThreadsGiveTheSameBits) {
   const Fixture f(3 * kSampleChunk + 7);
-  std::vector<double> theta = f.model.InitialTheta();
-  theta[0] += 0.1;
   const ceres::HuberLoss huber(1.0);
-  std::vector<double> residuals[2], jacobian[2];
-  const int threads[2] = {1, 3};
-  for (int k = 0; k < 2; ++k) {
-    const FoldedTensionCost cost(f.Samples(), &huber, threads[k]);
-    residuals[k].resize(cost.num_residuals());
-    jacobian[k].resize(cost.num_residuals() * theta.size());
-    const double* parameters[1] = {theta.data()};
-    double* jacobians[1] = {jacobian[k].data()};
-    ASSERT_TRUE(cost.Evaluate(parameters, residuals[k].data(), jacobians));
-  }
-  EXPECT_EQ(residuals[0], residuals[1]);
-  EXPECT_EQ(jacobian[0], jacobian[1]);
+  EXPECT_EQ(FoldedOnThreads(f, &huber, 1), FoldedOnThreads(f, &huber, 3));
+}
+
+// With the slow error's filters in the ordered stage too.
+TEST(FoldedCostTest, ThreadsGiveTheSameBitsWithASlowError) {
+  Fixture f(3 * kSampleChunk + 7);
+  f.WithSlowError(2 * kSampleChunk + 500);
+  EXPECT_EQ(FoldedOnThreads(f, nullptr, 1), FoldedOnThreads(f, nullptr, 3));
 }
 
 // A sample the statics cannot solve (a non-positive density) fails the evaluation, as one
@@ -226,6 +313,37 @@ TEST(SampleChunksTest, SumsDoNotDependOnThreads) {
         [&](const double& sum) { total += sum; }, kChunk);
     EXPECT_EQ(failed, -1);
     EXPECT_EQ(total, serial) << threads << " threads";
+  }
+}
+
+// The ordered stage sees the chunks one at a time in chunk order (a running recursion
+// gives the serial answer), between parallel work and merge, on any number of threads.
+TEST(SampleChunksTest, OrderedStageRunsInChunkOrder) {
+  constexpr int kCount = 3000, kChunk = 64;
+  std::vector<double> serial(kCount);
+  double state = 0.0;
+  for (int t = 0; t < kCount; ++t) serial[t] = state = 0.9 * state + std::sin(t);
+  for (int threads : {1, 2, 4}) {
+    std::vector<double> out(kCount);
+    double carried = 0.0;
+    int chunks = 0;
+    const int failed = ReduceChunksInOrder<std::vector<double>>(
+        kCount, threads, [] { return std::vector<double>(); },
+        [&](int begin, int end, std::vector<double>* v) {
+          for (int t = begin; t < end; ++t) v->push_back(std::sin(t));
+          return -1;
+        },
+        [&](int begin, int end, std::vector<double>* v) {
+          for (int t = begin; t < end; ++t) (*v)[t - begin] = carried = 0.9 * carried + (*v)[t - begin];
+        },
+        [&](int begin, int end, std::vector<double>* v) {
+          std::copy(v->begin(), v->end(), out.begin() + begin);
+          return -1;
+        },
+        [&](const std::vector<double>&) { ++chunks; }, kChunk);
+    EXPECT_EQ(failed, -1);
+    EXPECT_EQ(out, serial) << threads << " threads";
+    EXPECT_EQ(chunks, (kCount + kChunk - 1) / kChunk);
   }
 }
 

@@ -298,5 +298,80 @@ TEST(SessionsTest, DifferenceSigmaTotalMatchesSpreadOverSeeds) {
   EXPECT_EQ(found, kSeeds);  // 5 cm in x is many sigma on 150 + 150 poses
 }
 
+// Two surveys three days apart with slow sensor errors (2%, 60 s), sensors and cables
+// shared; optionally cable 3's sensor re-zeroed between them by `step_kn`.
+Dataset DriftingSessions(double step_kn, std::uint64_t seed) {
+  SimulationOptions o;
+  o.seed = seed;
+  o.sessions = 2;
+  o.session_gap_s = 3 * 86400.0;
+  o.tension_drift_percent = 2.0;
+  o.tension_drift_time_s = 60.0;
+  o.sensor_bias_spread_kn = 1.5;
+  o.sensor_gain_spread_percent = 1.0;
+  CableRobot truth = CableRobot::NominalFast();
+  truth.mass_centre_cabin_m = Eigen::Vector3d(0.22, 0.11, 0.5);
+  Dataset data;
+  std::string error;
+  EXPECT_TRUE(Simulate(truth, RandomCapPoses(600, seed), o, &data, nullptr, nullptr, &error))
+      << error;
+  for (Sample& s : data.samples) {
+    if (s.session == 1) s.tension_n[2] += step_kn * 1e3;
+  }
+  return data;
+}
+
+CalibrationSpec DriftingSessionsSpec() {
+  CalibrationSpec spec;
+  std::string error;
+  EXPECT_TRUE(ParseCalibrationSpecYaml(
+      "noise: {tension_sigma_percent: 3, slow_error: estimate}\n"
+      "parameters:\n  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}\n"
+      "  sensor_bias_kN: {mode: per_cable, free: true, prior: {mean: 0, sigma: 2}}\n"
+      "  sensor_gain: {mode: per_cable, free: true, prior: {mean: 1, sigma: 0.01}}\n"
+      "sessions: {separate: [mass_centre_m]}\n",
+      "spec", 3, &spec, &error))
+      << error;
+  return spec;
+}
+
+TEST(SessionsTest, ReZeroedSensorIsNamedAndNotReadAsAMove) {
+  // A 4 kN step of cable 3's offset (the slow error explains ~1 kN between the sessions'
+  // means): named, fitted per session, and the mass centre stays put. Without it, no
+  // sensor is accused and the biases stay shared.
+  constexpr double kStepKn = 4.0;
+  constexpr double kMoveSigmas = 3.0;  // the verdict's own threshold
+  for (double step : {0.0, kStepKn}) {
+    SCOPED_TRACE(step);
+    const Dataset data = DriftingSessions(step, 21);
+    CalibrationResult r;
+    std::string error;
+    ASSERT_EQ(Calibrate(CableRobot::NominalFast(), DriftingSessionsSpec(), data, {}, &r, &error),
+              CalibrationStatus::kOk)
+        << error;
+    ASSERT_TRUE(r.sensor_steps.tested);
+    ASSERT_TRUE(r.slow_error.enabled);
+    EXPECT_FALSE(r.slow_error.amplitude_at_floor);
+    for (const SessionDifference& d : r.session_differences) {
+      if (d.name.rfind("mass_centre_m", 0) != 0) continue;
+      EXPECT_LT(std::abs(d.Sigmas()), kMoveSigmas) << d.name << " " << d.difference;
+    }
+    if (step == 0.0) {
+      EXPECT_TRUE(r.sensor_steps.separated.empty());
+      continue;
+    }
+    EXPECT_EQ(r.sensor_steps.separated, std::vector<std::string>{"sensor_bias_kN[3]"});
+    EXPECT_NE(r.verdict_text.find("cable 3 in session 2"), std::string::npos) << r.verdict_text;
+    // Fitted per session: the difference of its copies is the step.
+    bool seen = false;
+    for (const SessionDifference& d : r.session_differences) {
+      if (d.name != "sensor_bias_kN[3]") continue;
+      seen = true;
+      EXPECT_NEAR(d.difference, kStepKn, 3.0 * d.sigma_total);
+    }
+    EXPECT_TRUE(seen);
+  }
+}
+
 }  // namespace
 }  // namespace fastcal

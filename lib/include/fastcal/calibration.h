@@ -43,6 +43,8 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/gross_errors.h"
 #include "fastcal/sessions.h"
+#include "fastcal/sensor_steps.h"
+#include "fastcal/slow_error.h"
 #include "fastcal/uncertainty.h"
 
 namespace fastcal {
@@ -91,6 +93,9 @@ struct CalibrationOptions {
   // Least-squares passes at most: 2 when nothing changes (weights from the initial
   // model, then from the first fit), more while the set of gross errors still changes.
   int max_passes = 4;
+  // A joint fit of sessions whose sensor-step test (sensor_steps.h) accuses a shared bias
+  // is fitted again with that bias per session. Off: the accusation is reported only.
+  bool separate_stepped_sensors = true;
   // Readings listed as the worst fitted ones (largest |residual| / sigma).
   int worst_readings = 10;
   // The misfit ranking and the consider parameters' sensitivities come from at most this
@@ -255,6 +260,9 @@ struct CalibrationResult {
   // initial model at each attitude the data has, then the calibrated one at the fit's
   // attitude (the last). Empty with CalibrationOptions::evaluate off.
   std::vector<VariantEvaluation> variants;
+  // The slow sensor error the fit whitened by, and what the residuals say of it
+  // (spec noise.slow_error; slow_error.h). enabled false: white noise only.
+  SlowErrorReport slow_error;
   // Integrated autocorrelation time of each cable's whitened residuals (file order).
   std::array<double, kNumCables> residual_tau{};
   FitVerdict verdict = FitVerdict::kOk;
@@ -273,6 +281,10 @@ struct CalibrationResult {
   std::vector<SessionDifference> session_differences;
   // The scan for a change within the survey (spec change_scan; change_scan.h).
   ChangeScanResult change_scan;
+  // A joint fit of sessions: the test of sensors re-zeroed between them (sensor_steps.h),
+  // from the fit with the spec's shared biases; when it accuses some, the result is that
+  // of the fit again with their biases per session (`separated`).
+  SensorStepTest sensor_steps;
   std::vector<bool> held_out;  // per dataset sample
   int num_fit_samples = 0;
   int num_residuals = 0;

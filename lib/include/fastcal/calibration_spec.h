@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/slow_error.h"
 #include "fastcal/statics.h"
 
 namespace fastcal {
@@ -65,6 +66,22 @@ struct ParameterSpec {
   bool IsConsider() const { return !free && has_prior; }
 };
 
+// The slow sensor error of the spec (noise.slow_error; slow_error.h): off by default.
+// Each part is stated (a number) or estimated from the fit's residuals ("estimate"); at
+// most one amplitude part (sigma_percent or sigma_kN) is estimated.
+struct SlowErrorSpec {
+  bool enabled = false;
+  SlowErrorProcess stated;  // the stated parts (SI); an estimated part's entry is unused
+  bool estimate_amplitude = false;
+  bool amplitude_in_percent = true;  // the estimated part: sigma_percent, else sigma_kN
+  bool estimate_time_constant = false;
+
+  bool estimates_any() const { return enabled && (estimate_amplitude || estimate_time_constant); }
+  // The process to whiten with before anything is estimated: the stated one, or (for an
+  // estimated part) white noise only.
+  SlowErrorProcess Initial() const;
+};
+
 enum class RobustLoss { kNone, kHuber, kCauchy };
 const char* RobustLossName(RobustLoss loss);  // "none", "huber", "cauchy"
 
@@ -81,6 +98,8 @@ struct CalibrationSpec {
   // the model's reading (docs/calibration.md: why not the measured one).
   double tension_sigma_n = 0.0;
   double tension_sigma_percent = 3.0;
+  // Slow error of each tension reading, on top of the white noise above (slow_error.h).
+  SlowErrorSpec slow_error;
   RobustLoss robust_loss = RobustLoss::kNone;
   double robust_loss_scale = 1.0;  // in units of sigma (whitened residual)
   // Fraction of the samples held out of the fit and used only to evaluate: whole

@@ -31,6 +31,16 @@
 // noise of a unit's sum drawn from its information's square root), so the scan costs
 // O(units n^2) per replicate whatever the survey's length.
 //
+// A step or a drift? Beside the steps, the scanned parameters' linear trend over the whole
+// survey is tested the same way (Z_t = J_t,G s_t, s_t = (t - mid) / N over the fitted
+// samples: s spans one unit, so its estimate is the change over the survey). A single test,
+// chi-square with p degrees of freedom without a trend; its statistic against the best
+// step's tells the two apart: for a true step the best step explains more (a trend
+// captures 3/4 of a mid-survey step's chi-square), for a steady drift the trend does
+// (a step captures 3/4 of a trend's). A mass centre that wanders, rather than steps, is
+// said to wander (ChangeScanVerdict) when the trend explains at least as much as the best
+// step, or when binary segmentation needs more than one step.
+//
 // Several changes: binary segmentation (Vostrikova 1981). Each round scans every segment
 // between the changes found so far, with those changes in the nuisance; the segment
 // whose maximum is most significant, if below `significance`, adds its change. At most
@@ -92,6 +102,14 @@ struct ChangeScanOutput {
   double widening = 1.0;                // the first round's w
   int unit_samples = 1;                 // samples per split unit
   std::vector<DetectedChange> changes;  // in time order
+  // The linear trend over the survey (above): its statistic (widened by the first
+  // round's w), p-value (chi-square, p degrees of freedom), and the scanned parameters'
+  // change over the survey with its sigma; the first round's best step statistic.
+  double trend_statistic = 0.0;
+  double trend_p_value = 1.0;
+  Eigen::VectorXd trend_shift;
+  Eigen::VectorXd trend_shift_sigma;
+  double best_step_statistic = 0.0;
 };
 
 // False, with *error, for inputs that do not fit together (sizes, no scanned
@@ -129,6 +147,15 @@ struct ChangeScanResult {
   int replicates = 0;
   double widening = 1.0;
   std::vector<FoundChange> changes;  // in time order; empty when none was found
+  // The linear trend over the survey (ChangeScanOutput's), in the parameters' units, and
+  // whether the data show a wandering rather than a step: a change was found and the trend
+  // explains at least as much as the best step, or more than one step was needed.
+  double trend_statistic = 0.0;
+  double trend_p_value = 1.0;
+  std::vector<double> trend_shift;
+  std::vector<double> trend_shift_sigma;
+  double best_step_statistic = 0.0;
+  bool wanders = false;
 };
 
 // One sentence for the verdict: the changes found (when, how much, p), or that none was.

@@ -15,7 +15,10 @@
 //   measured tension    m_i    = y_i (1 + N(0, tension_noise_percent / 100) + u_i,n)
 //                                + N(0, 1000 tension_noise_kn)
 //                        u_i per cable AR(1) with sigma tension_drift_percent / 100 and
-//                        correlation time tension_drift_time_s (a slow sensor error)
+//                        correlation time tension_drift_time_s (a slow sensor error);
+//                        with tension_drift_kn > 0 the slow error is instead
+//                        sqrt(kn^2 + (pct/100 y_i)^2) v_i,n in newtons, v_i the standardised
+//                        process (slow_error.h)
 //                        or, with probability outlier_fraction, an outlier
 //                        m_i    = y_i (1 + U(-s, s) / 100),  s = outlier_scale_percent
 //   measured attitude   a_meas = a_act + N(0, attitude_measurement_sigma_deg)  per rpy angle
@@ -66,6 +69,9 @@ struct SimulationOptions {
   // in percent of the reading and correlation time (s). >= 0; default 0 (none).
   double tension_drift_percent = 0.0;
   double tension_drift_time_s = 0.0;
+  // Its absolute part (kN), >= 0, default 0: the slow error's sd is then
+  // sqrt(kn^2 + (percent/100 reading)^2) (slow_error.h's process), one process per cable.
+  double tension_drift_kn = 0.0;
   // Drift of the cabin's mass centre about the truth model's, per axis AR(1): standard
   // deviation (m) and correlation time (s). >= 0; default 0 (none). The truth model
   // written out keeps the mean; SimulationSummary has the realised average.
@@ -110,6 +116,14 @@ struct SimulationOptions {
   // one sample longer when it does not divide), labelled "1" .. "N" in the dataset's
   // session column (docs/data-format.md, "Sessions"). >= 1; 1: no session column.
   int sessions = 1;
+  // Time between the end of one session and the start of the next (s), added to the
+  // time stamps; the slow processes (drift, control error) decorrelate over it as over any
+  // time. >= 0; default 0.
+  double session_gap_s = 0.0;
+  // Sensors re-zeroed at the start of each session after the first: each cable's bias
+  // moves by N(0, sensor_rezero_kn) kN. >= 0; default 0. The truth model written out has
+  // the first session's biases; SimulationSummary::session_bias_n has every session's.
+  double sensor_rezero_kn = 0.0;
 
   // False, with the offending field named in *error (may be null), for a value out of range.
   bool IsValid(std::string* error) const;
@@ -135,6 +149,8 @@ struct SimulationSummary {
   std::array<double, kNumCables> density_factor{};
   // Per cable: RMS of the slow tension error u (dimensionless).
   std::array<double, kNumCables> tension_drift_rms_relative{};
+  // Each session's sensor biases (N), first session first (they differ when re-zeroed).
+  std::vector<std::array<double, kNumCables>> session_bias_n;
   // Average over the samples of the actual mass centre (cabin frame, m), and the RMS
   // over samples and axes of its drift about the truth model's.
   Eigen::Vector3d mass_centre_mean_m = Eigen::Vector3d::Zero();

@@ -18,6 +18,7 @@
 #include "fastcal/gross_errors.h"
 #include "fastcal/internal/calibration_evaluation.h"
 #include "fastcal/internal/calibration_linearisation.h"
+#include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/folded_cost.h"
 #include "fastcal/internal/identifiability.h"
@@ -98,6 +99,10 @@ struct Run {
   // The weights and exclusions of the current problem, per fitted sample / dataset sample.
   std::vector<std::array<double, kNumCables>> sigma_n;
   ReadingMask excluded;
+  // The slow sensor error the current problem whitens by (inactive: white noise only),
+  // and per fitted sample each reading's sigma_slow / sigma_white (sample_rows.h).
+  SlowErrorProcess slow;
+  std::vector<std::array<double, kNumCables>> slow_rho;
   std::unique_ptr<ceres::Problem> problem;
   // At the solution: the candidates of the misfit ranking (and consider parameters),
   // the linearisation, and the normal matrix with the priors.
@@ -112,6 +117,16 @@ struct Run {
     return pose;
   }
   const ParameterSpec& Free(int k) const { return spec.parameters[cm->spec_index(k)]; }
+  // The current prediction, the fitted samples and their exclusions.
+  internal::PredictionView View() const {
+    internal::PredictionView v;
+    v.data = &data;
+    v.reading_n = &at.reading_n;
+    v.sigma_n = &at.sigma_n;
+    v.fit = &fit;
+    v.excluded = &excluded;
+    return v;
+  }
   // The fitted samples with the current weights, warm starts and exclusions.
   internal::FittedSamples Samples() const {
     internal::FittedSamples s;
@@ -123,6 +138,8 @@ struct Run {
     s.excluded = &excluded;
     s.use_planned_attitude = spec.use_planned_attitude;
     s.statics = statics;
+    s.slow_error = slow;
+    s.slow_rho = &slow_rho;
     return s;
   }
   CalibrationStatus Fail(CalibrationStatus status, const std::string& why) const {
@@ -237,6 +254,9 @@ CalibrationStatus ValidateInputs(Run& run) {
   }
   run.theta = run.cm->InitialTheta();
   run.statics = ModelFitStaticsOptions(run.spec.forward_model);
+  run.slow = run.spec.slow_error.Initial();
+  r.slow_error.enabled = run.spec.slow_error.enabled;
+  r.slow_error.process = run.slow;
   run.loss = MakeLoss(run.spec);
   return CalibrationStatus::kOk;
 }
@@ -371,6 +391,7 @@ void BuildProblem(Run& run) {
   run.problem = std::make_unique<ceres::Problem>();
   run.sigma_n.resize(run.fit.size());
   for (size_t j = 0; j < run.fit.size(); ++j) run.sigma_n[j] = run.at.sigma_n[run.fit[j]];
+  run.slow_rho = internal::SlowErrorRatios(run.slow, run.View());
   run.problem->AddResidualBlock(
       new internal::FoldedTensionCost(run.Samples(), run.loss.get(), run.spec.num_threads), nullptr,
       run.theta.data());
@@ -475,6 +496,45 @@ std::string PassNote(int pass, int excluded) {
   return s;
 }
 
+// Relative change of the slow error's amplitude and time constant within which a new
+// estimate leaves the process the fit used as it is (the passes stop).
+constexpr double kSlowErrorSettled = 0.05;
+// Fitted samples the slow error's estimate uses at most (contiguous runs beyond).
+constexpr int kSlowErrorEstimateSamples = 100000;
+
+bool Settled(double before, double after) {
+  return std::abs(after - before) <= kSlowErrorSettled * std::max(std::abs(before), 1e-300);
+}
+
+// Stage helper, after each pass's prediction: the slow error re-estimated from the
+// residuals over their white sigma (when the spec estimates a part), and those residuals
+// whitened by the process for the screen. True when the process the pass used stands
+// (nothing estimated, or the new estimate within kSlowErrorSettled of it).
+// On the last pass (`may_change` false) the process stays what the fit used.
+bool ReestimateSlowError(Run& run, bool may_change) {
+  SlowErrorReport& report = run.result->slow_error;
+  bool settled = true;
+  if (run.spec.slow_error.estimates_any()) {
+    const SlowErrorReport estimate = internal::EstimateSlowError(
+        internal::SlowErrorInputs(run.spec, run.View(), kSlowErrorEstimateSamples));
+    const SlowErrorProcess& used = run.slow;
+    const SlowErrorProcess& next = estimate.process;
+    const bool floor = estimate.amplitude_at_floor && report.amplitude_at_floor;
+    settled = used.IsActive() &&
+              ((Settled(used.sigma_percent, next.sigma_percent) &&
+                Settled(used.sigma_n, next.sigma_n) &&
+                Settled(used.time_constant_s, next.time_constant_s)) ||
+               floor);
+    const int passes = report.passes + 1;
+    report = estimate;
+    report.passes = passes;
+    if (!settled && may_change) run.slow = next;
+    report.process = run.slow;
+  }
+  internal::WhitenPrediction(run.slow, run.View(), &run.at.whitened);
+  return settled;
+}
+
 CalibrationStatus SolveAndReweight(Run& run) {
   CalibrationResult& r = *run.result;
   std::unique_ptr<ProgressCallback> callback;
@@ -504,8 +564,10 @@ CalibrationStatus SolveAndReweight(Run& run) {
     if (!summary.IsSolutionUsable()) break;
     const CalibrationStatus status = Predict(run);
     if (status != CalibrationStatus::kOk) return status;
+    const bool slow_settled =
+        ReestimateSlowError(run, pass < std::max(2, run.options.max_passes));
     ReadingMask screened = ScreenReadings(run);
-    if (pass >= 2 && screened == run.excluded) break;
+    if (pass >= 2 && screened == run.excluded && slow_settled) break;
     if (pass == std::max(2, run.options.max_passes)) {
       r.gross_error_summary.settled = false;
       break;
@@ -524,6 +586,17 @@ CalibrationStatus SolveAndReweight(Run& run) {
   const int excluded = CountExcluded(run);
   r.num_residuals = kNumCables * r.num_fit_samples - excluded + run.num_priors;
   r.reduced_chi_square = 2.0 * summary.final_cost / (r.num_residuals - run.n);
+  return CalibrationStatus::kOk;
+}
+
+// Stage: a slow error the spec states in full, checked against the residuals of the fit
+// (the maximum-likelihood process, and whether the stated one is rejected).
+CalibrationStatus CheckStatedSlowError(Run& run) {
+  if (!run.spec.slow_error.enabled || run.spec.slow_error.estimates_any()) {
+    return CalibrationStatus::kOk;
+  }
+  run.result->slow_error = internal::EstimateSlowError(
+      internal::SlowErrorInputs(run.spec, run.View(), kSlowErrorEstimateSamples));
   return CalibrationStatus::kOk;
 }
 
@@ -977,6 +1050,23 @@ CalibrationStatus EstimateUncertainty(Run& run) {
   return CalibrationStatus::kOk;
 }
 
+// Stage: sensors re-zeroed between sessions (sensor_steps.h), from the linearisation's
+// per-session sums.
+CalibrationStatus TestSensorStepsStage(Run& run) {
+  if (!run.result->covariance_ok) return CalibrationStatus::kOk;
+  std::vector<ParameterSpec> free;
+  for (int k = 0; k < run.n; ++k) free.push_back(run.Free(k));
+  SensorStepInputs in;
+  in.free = &free;
+  in.information = &run.information;
+  in.session_information = &run.lin.session_information;
+  in.session_gradient = &run.lin.session_gradient;
+  in.labels = &run.data.session_labels;
+  in.widening = run.result->budget.misfit_factor;
+  run.result->sensor_steps = TestSensorSteps(in);
+  return CalibrationStatus::kOk;
+}
+
 // Stage: the scan for a step of the spec's change_scan groups within the survey
 // (change_scan.h), on the linearisation and with the budget's widening.
 CalibrationStatus ScanChanges(Run& run) {
@@ -997,7 +1087,8 @@ CalibrationStatus ScanChanges(Run& run) {
   for (int k = 0; k < run.n; ++k) {
     const ParameterSpec& p = run.Free(k);
     const std::string group = ParameterGroupName(p.kind);
-    if (std::count(scan.groups.begin(), scan.groups.end(), group) != 0) {
+    if (std::count(scan.groups.begin(), scan.groups.end(), group) != 0 ||
+        std::count(scan.groups.begin(), scan.groups.end(), p.name) != 0) {
       if (p.session >= 0) {
         return run.Fail(CalibrationStatus::kInvalidInput,
                         "spec: change_scan and sessions.separate both name " + group +
@@ -1051,6 +1142,16 @@ CalibrationStatus ScanChanges(Run& run) {
     }
     scan.changes.push_back(std::move(f));
   }
+  scan.trend_statistic = out.trend_statistic;
+  scan.trend_p_value = out.trend_p_value;
+  scan.best_step_statistic = out.best_step_statistic;
+  for (int j = 0; j < out.trend_shift.size(); ++j) {
+    const double to_si = run.Free(in.scanned[j]).to_si;
+    scan.trend_shift.push_back(out.trend_shift[j] / to_si);
+    scan.trend_shift_sigma.push_back(out.trend_shift_sigma[j] / to_si);
+  }
+  scan.wanders = !scan.changes.empty() &&
+                 (scan.changes.size() > 1 || scan.trend_statistic >= scan.best_step_statistic);
   return CalibrationStatus::kOk;
 }
 
@@ -1265,6 +1366,10 @@ void NoteWhatTheMisfitWouldMove(CalibrationResult* r) {
 void AddNotes(Run& run) {
   CalibrationResult& r = *run.result;
   const UncertaintyBudget& b = r.budget;
+  for (const std::string& slow :
+       {DescribeSlowError(r.slow_error), DescribeStatedSlowErrorCheck(r.slow_error)}) {
+    if (!slow.empty()) r.notes.push_back(slow);
+  }
   if (r.covariance_ok && b.correlation_measured && !b.correlated) {
     r.notes.push_back("residuals uncorrelated in time (largest autocorrelation time " +
                       Fixed("%.3g", b.tau) + " samples, not significantly above 1)");
@@ -1369,7 +1474,9 @@ CalibrationStatus Conclude(Run& run) {
 // Stage: the initial model's readings, screened for gross errors.
 CalibrationStatus PredictAndScreen(Run& run) {
   const CalibrationStatus status = Predict(run);
-  if (status == CalibrationStatus::kOk) run.excluded = ScreenReadings(run);
+  if (status != CalibrationStatus::kOk) return status;
+  internal::WhitenPrediction(run.slow, run.View(), &run.at.whitened);
+  run.excluded = ScreenReadings(run);
   return status;
 }
 
@@ -1378,6 +1485,52 @@ CalibrationStatus PredictAndScreen(Run& run) {
 CalibrationStatus BuildAndCheck(Run& run) {
   BuildProblem(run);
   return CheckIdentifiability(run);
+}
+
+// The sensor-step test's verdict beside the refit's own.
+void AddSensorStepVerdict(CalibrationResult* r) {
+  const std::string steps = SensorStepVerdict(r->sensor_steps);
+  if (steps.empty()) return;
+  r->verdict_text += "; " + steps;
+}
+
+CalibrationStatus RunPipeline(const CableRobot& model, const CalibrationSpec& spec,
+                              const Dataset& data, const CalibrationOptions& options,
+                              CalibrationResult* result, std::string* error) {
+  // A joint fit of several sessions: the separate groups' copies (sessions.h).
+  const CalibrationSpec joint = SeparateSessionParameters(spec, data.session_labels);
+  Run run(model, joint, data, options, result, error);
+  using Stage = CalibrationStatus (*)(Run&);
+  struct NamedStage {
+    const char* name;
+    Stage stage;
+  };
+  const NamedStage stages[] = {{"validate", ValidateInputs},
+                               {"forward model error", MeasureForwardModelError},
+                               {"predict and screen", PredictAndScreen},
+                               {"build and check", BuildAndCheck},
+                               {"solve and reweight", SolveAndReweight},
+                               {"slow error", CheckStatedSlowError},
+                               {"name gross errors", NameGrossErrors},
+                               {"worst readings", FindWorstReadings},
+                               {"linearise", LineariseAtSolution},
+                               {"uncertainty", EstimateUncertainty},
+                               {"sensor steps", TestSensorStepsStage},
+                               {"change scan", ScanChanges},
+                               {"diagnose", Diagnose},
+                               {"conclude", Conclude},
+                               {"evaluate", Evaluate}};
+  for (const NamedStage& s : stages) {
+    const auto start = std::chrono::steady_clock::now();
+    const Usage before = ProcessUsage();
+    const CalibrationStatus status = s.stage(run);
+    const Usage after = ProcessUsage();
+    result->stages.push_back(
+        {s.name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
+         after.cpu_s - before.cpu_s, after.peak_mb});
+    if (status != CalibrationStatus::kOk) return status;
+  }
+  return CalibrationStatus::kOk;
 }
 
 }  // namespace
@@ -1428,39 +1581,27 @@ CalibrationStatus Calibrate(const CableRobot& model, const CalibrationSpec& spec
   const auto t0 = std::chrono::steady_clock::now();
   *result = CalibrationResult();
   if (!CheckSessions(data, error)) return CalibrationStatus::kInvalidInput;
-  // A joint fit of several sessions: the separate groups' copies (sessions.h).
-  const CalibrationSpec joint = SeparateSessionParameters(spec, data.session_labels);
-  Run run(model, joint, data, options, result, error);
-  using Stage = CalibrationStatus (*)(Run&);
-  struct NamedStage {
-    const char* name;
-    Stage stage;
-  };
-  const NamedStage stages[] = {{"validate", ValidateInputs},
-                               {"forward model error", MeasureForwardModelError},
-                               {"predict and screen", PredictAndScreen},
-                               {"build and check", BuildAndCheck},
-                               {"solve and reweight", SolveAndReweight},
-                               {"name gross errors", NameGrossErrors},
-                               {"worst readings", FindWorstReadings},
-                               {"linearise", LineariseAtSolution},
-                               {"uncertainty", EstimateUncertainty},
-                               {"change scan", ScanChanges},
-                               {"diagnose", Diagnose},
-                               {"conclude", Conclude},
-                               {"evaluate", Evaluate}};
-  for (const NamedStage& s : stages) {
-    const auto start = std::chrono::steady_clock::now();
-    const Usage before = ProcessUsage();
-    const CalibrationStatus status = s.stage(run);
-    const Usage after = ProcessUsage();
-    result->stages.push_back(
-        {s.name, std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(),
-         after.cpu_s - before.cpu_s, after.peak_mb});
-    if (status != CalibrationStatus::kOk) return status;
+  CalibrationStatus status = RunPipeline(model, spec, data, options, result, error);
+  // Sensors re-zeroed between sessions: fitted again with their biases per session.
+  const SensorStepTest steps = result->sensor_steps;
+  if (status == CalibrationStatus::kOk && options.separate_stepped_sensors &&
+      !steps.separated.empty()) {
+    if (options.progress) {
+      options.progress("sensor offsets stepped between sessions: fitting again with their "
+                       "biases per session");
+    }
+    CalibrationSpec refit = spec;
+    for (const std::string& name : steps.separated) refit.separate_groups.push_back(name);
+    std::vector<CalibrationResult::Stage> first_stages = result->stages;
+    for (CalibrationResult::Stage& stage : first_stages) stage.name = "first fit: " + stage.name;
+    *result = CalibrationResult();
+    status = RunPipeline(model, refit, data, options, result, error);
+    result->stages.insert(result->stages.begin(), first_stages.begin(), first_stages.end());
+    result->sensor_steps = steps;
+    if (status == CalibrationStatus::kOk) AddSensorStepVerdict(result);
   }
   result->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  return CalibrationStatus::kOk;
+  return status;
 }
 
 }  // namespace fastcal

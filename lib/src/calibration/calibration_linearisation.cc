@@ -1,12 +1,13 @@
 // The calibration linearised at its solution (internal/calibration_linearisation.h).
 #include "fastcal/internal/calibration_linearisation.h"
 
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <thread>
 
 #include "fastcal/internal/sample_chunks.h"
+#include "fastcal/internal/sample_rows.h"
+#include "fastcal/internal/slow_error_estimate.h"
 
 namespace fastcal::internal {
 namespace {
@@ -24,23 +25,27 @@ bool Covers(const ParameterSpec& p, const ParameterSpec& b) {
   return SameParameter(p, b) || (p.kind == b.kind && IsPerCableGroup(p.kind) && p.index < 0);
 }
 
-// Residuals and Jacobian (rows of excluded readings zero) of fitted sample `t` at `at`,
-// and the robust loss's IRLS weight sqrt(rho'(|r|^2)) (1 without a loss).
-// `curvature` (may be null) receives 2 rho'' for the loss's exact Hessian
+// The robust loss's IRLS weight sqrt(rho'(|r|^2)) of a sample's residuals (1 without a
+// loss); `curvature` (may be null) receives 2 rho'' for the loss's exact Hessian
 // rho' J^T J + 2 rho'' (J^T r)(J^T r)^T (0 without a loss).
-bool EvaluateSample(const FittedSamples& samples, int t, const ModelAtTheta& at,
-                    const ceres::LossFunction* loss, Eigen::Matrix<double, kNumCables, 1>* r,
-                    RowMatrix* j, double* weight, double* curvature = nullptr) {
-  if (!samples.Rows(t, at, r->data(), j->data())) return false;
-  *weight = 1.0;
+double LossWeight(const ceres::LossFunction* loss, const Eigen::Matrix<double, kNumCables, 1>& r,
+                  double* curvature = nullptr) {
   if (curvature != nullptr) *curvature = 0.0;
-  if (loss != nullptr) {
-    double rho[3];
-    loss->Evaluate(r->squaredNorm(), rho);
-    *weight = std::sqrt(std::max(rho[1], 0.0));
-    if (curvature != nullptr) *curvature = 2.0 * rho[2];
+  if (loss == nullptr) return 1.0;
+  double rho[3];
+  loss->Evaluate(r.squaredNorm(), rho);
+  if (curvature != nullptr) *curvature = 2.0 * rho[2];
+  return std::sqrt(std::max(rho[1], 0.0));
+}
+
+// Sample t's residuals and n-column Jacobian from `rows`.
+void RowsOf(const SampleRows& rows, int t, Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j) {
+  const int n = rows.columns - 1;
+  const double* values = rows.Of(t);
+  for (int i = 0; i < kNumCables; ++i) {
+    for (int k = 0; k < n; ++k) (*j)(i, k) = values[i * rows.columns + k];
+    (*r)[i] = values[i * rows.columns + n];
   }
-  return true;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -52,12 +57,18 @@ struct FreeSums {
   double chi_square = 0.0, raw_chi_square = 0.0;
   int readings = 0;
   std::vector<FoldSums> folds;
+  std::vector<Eigen::MatrixXd> session_information;  // with two or more sessions
+  std::vector<Eigen::VectorXd> session_gradient;
 
-  FreeSums(int n, int blocks)
+  FreeSums(int n, int blocks, int sessions)
       : information(Eigen::MatrixXd::Zero(n, n)),
         curvature(Eigen::MatrixXd::Zero(n, n)),
         fold(n),
         folds(blocks) {
+    for (int s = 0; sessions > 1 && s < sessions; ++s) {
+      session_information.push_back(Eigen::MatrixXd::Zero(n, n));
+      session_gradient.push_back(Eigen::VectorXd::Zero(n));
+    }
     for (FoldSums& f : folds) {
       f.information = Eigen::MatrixXd::Zero(n, n);
       f.gradient = Eigen::VectorXd::Zero(n);
@@ -77,6 +88,10 @@ struct FreeSums {
     chi_square += o.chi_square;
     raw_chi_square += o.raw_chi_square;
     readings += o.readings;
+    for (size_t k = 0; k < session_information.size(); ++k) {
+      session_information[k] += o.session_information[k];
+      session_gradient[k] += o.session_gradient[k];
+    }
     for (size_t k = 0; k < folds.size(); ++k) {
       FoldSums& f = folds[k];
       const FoldSums& g = o.folds[k];
@@ -93,19 +108,22 @@ struct FreeSums {
   }
 };
 
-// The cross-validation block sums of one sample: raw (unweighted) rows in newtons.
+// The cross-validation block sums of one sample: the whitened rows r, j for the
+// prediction, the rows as evaluated (r_raw, j_raw: before the slow-error whitening; the
+// same without it) in newtons for the RMS.
 void AddToFold(const std::array<bool, kNumCables>& excluded,
                const std::array<double, kNumCables>& sigma_n,
-               const Eigen::Matrix<double, kNumCables, 1>& r, const RowMatrix& j, double weight,
-               FoldSums* fold) {
+               const Eigen::Matrix<double, kNumCables, 1>& r, const RowMatrix& j,
+               const Eigen::Matrix<double, kNumCables, 1>& r_raw, const RowMatrix& j_raw,
+               double weight, FoldSums* fold) {
   ++fold->samples;
   fold->information.noalias() += weight * weight * j.transpose() * j;
   fold->gradient.noalias() += weight * weight * j.transpose() * r;
   for (int i = 0; i < kNumCables; ++i) {
     if (excluded[i]) continue;
     const double s = sigma_n[i];
-    const Eigen::VectorXd ji = s * j.row(i).transpose();  // N per parameter unit
-    const double ri = s * r[i];                           // N
+    const Eigen::VectorXd ji = s * j_raw.row(i).transpose();  // N per parameter unit
+    const double ri = s * r_raw[i];                           // N
     ++fold->readings[i];
     fold->sse_n2[i] += ri * ri;
     fold->cross_n2[i] += ri * ji;
@@ -113,17 +131,37 @@ void AddToFold(const std::array<bool, kNumCables>& excluded,
   }
 }
 
-// Fitted samples [begin, end) into `sums`; the first that fails, or -1.
-int AccumulateFree(const LinearisationInputs& in, const ModelAtTheta& at, int begin, int end,
-                   Linearisation* out, FreeSums* sums) {
+// A chunk of the free pass: its rows as evaluated (for the cross-validation's sums in
+// newtons) and whitened, and its sums.
+struct FreeChunk {
+  FreeSums sums;
+  SampleRows raw, rows;
+};
+
+// Fitted samples [begin, end) evaluated into chunk->rows; the first that fails, or -1.
+int EvaluateFree(const LinearisationInputs& in, const ModelAtTheta& at, int begin, int end,
+                 FreeChunk* chunk) {
+  chunk->rows.Reset(begin, end, in.samples.model->num_free() + 1);
+  for (int t = begin; t < end; ++t) {
+    if (!EvaluateSampleRows(in.samples, t, at, t, &chunk->rows)) return t;
+  }
+  return -1;
+}
+
+// The whitened rows of fitted samples [begin, end) into `sums`.
+void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisation* out,
+                    FreeChunk* chunk) {
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
-  RowMatrix j(kNumCables, n);
-  Eigen::Matrix<double, kNumCables, 1> r;
+  FreeSums* sums = &chunk->sums;
+  RowMatrix j(kNumCables, n), j_raw(kNumCables, n);
+  Eigen::Matrix<double, kNumCables, 1> r, r_raw;
   for (int t = begin; t < end; ++t) {
-    double weight = 1.0, curvature = 0.0;
-    if (!EvaluateSample(in.samples, t, at, in.loss, &r, &j, &weight, &curvature)) return t;
     const std::array<bool, kNumCables> excluded = in.samples.Excluded(t);
+    RowsOf(chunk->rows, t, &r, &j);
+    RowsOf(chunk->raw, t, &r_raw, &j_raw);
+    double curvature = 0.0;
+    const double weight = LossWeight(in.loss, r, &curvature);
     const RowMatrix jw = weight * j;
     const Eigen::VectorXd rw = weight * r;
     out->residuals.row(t) = r.transpose();
@@ -132,6 +170,11 @@ int AccumulateFree(const LinearisationInputs& in, const ModelAtTheta& at, int be
       out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
     }
     sums->information.noalias() += jw.transpose() * jw;
+    if (!sums->session_information.empty()) {
+      const int session = in.samples.data->samples[(*in.samples.fit)[t]].session;
+      sums->session_information[session].noalias() += jw.transpose() * jw;
+      sums->session_gradient[session].noalias() += jw.transpose() * rw;
+    }
     if (curvature != 0.0) {
       const Eigen::VectorXd jr = j.transpose() * r;
       sums->curvature.noalias() += curvature * jr * jr.transpose();
@@ -141,10 +184,10 @@ int AccumulateFree(const LinearisationInputs& in, const ModelAtTheta& at, int be
     sums->raw_chi_square += r.squaredNorm();
     for (bool e : excluded) sums->readings += !e;
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
-    AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, weight, &sums->folds[block]);
+    AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, r_raw, j_raw, weight,
+              &sums->folds[block]);
   }
   sums->fold.Flush();
-  return -1;
 }
 
 // ---------------------------------------------------------------------------------------
@@ -176,19 +219,39 @@ Eigen::MatrixXd Combine(const RowMatrix& basis, const std::vector<std::vector<in
   return j;
 }
 
-// The candidate pass's samples [begin, end) into `sums`; the first that fails (a fitted
-// sample), or -1.
-int AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
-                         int end, CandidateSums* sums, Eigen::MatrixXd* scores) {
+// A chunk of the candidate pass: the basis rows of its samples, and its sums.
+struct CandidateChunk {
+  CandidateSums sums;
+  SampleRows rows;
+};
+
+int SessionOf(const CandidatePass& pass, int fitted_sample) {
   const FittedSamples& in = pass.in.samples;
+  return in.data->samples[(*in.fit)[fitted_sample]].session;
+}
+
+// The basis rows of the candidate pass's samples [begin, end) (positions in `samples`);
+// the first that fails (a fitted sample), or -1.
+int EvaluateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
+                       int end, CandidateChunk* chunk) {
+  chunk->rows.Reset(begin, end, pass.basis.front().num_free() + 1);
+  for (int k = begin; k < end; ++k) {
+    const ModelAtTheta& at = pass.basis_at[SessionOf(pass, samples[k])];
+    if (!EvaluateSampleRows(pass.in.samples, samples[k], at, k, &chunk->rows)) return samples[k];
+  }
+  return -1;
+}
+
+// The (whitened) basis rows of samples [begin, end) into the chunk's sums.
+void AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
+                          int end, CandidateChunk* chunk, Eigen::MatrixXd* scores) {
   RowMatrix b(kNumCables, pass.basis.front().num_free());
   Eigen::Matrix<double, kNumCables, 1> r;
+  CandidateSums* sums = &chunk->sums;
   for (int k = begin; k < end; ++k) {
-    const int session = in.data->samples[(*in.fit)[samples[k]]].session;
-    double weight = 1.0;
-    if (!EvaluateSample(in, samples[k], pass.basis_at[session], pass.in.loss, &r, &b, &weight)) {
-      return samples[k];
-    }
+    const int session = SessionOf(pass, samples[k]);
+    RowsOf(chunk->rows, k, &r, &b);
+    const double weight = LossWeight(pass.in.loss, r);
     Eigen::MatrixXd jx = weight * Combine(b, pass.free_columns);
     for (size_t c = 0; c < pass.free_session.size(); ++c) {
       // Another session's copy: no effect on this sample.
@@ -202,7 +265,6 @@ int AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samp
     sums->information.noalias() += jx.transpose() * jx;
     scores->row(k) = g.transpose();
   }
-  return -1;
 }
 
 // Evenly spaced fitted samples, at most `budget` of them.
@@ -228,14 +290,24 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   out->scores = Eigen::MatrixXd::Zero(num_fit, n);
   out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
   out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
-  FreeSums total(n, blocks);
+  const int sessions = static_cast<int>(in.samples.data->session_labels.size());
+  FreeSums total(n, blocks, sessions);
   const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
-  const int failed = ReduceChunks<FreeSums>(
-      num_fit, in.num_threads, [&] { return FreeSums(n, blocks); },
-      [&](int begin, int end, FreeSums* sums) {
-        return AccumulateFree(in, at, begin, end, out, sums);
+  SampleRowWhitener whitener(in.samples, n + 1);
+  const int failed = ReduceChunksInOrder<FreeChunk>(
+      num_fit, in.num_threads, [&] { return FreeChunk{FreeSums(n, blocks, sessions), {}, {}}; },
+      [&](int begin, int end, FreeChunk* chunk) {
+        return EvaluateFree(in, at, begin, end, chunk);
       },
-      [&](FreeSums& sums) { total.Add(sums); });
+      [&](int, int, FreeChunk* chunk) {
+        chunk->raw = chunk->rows;
+        whitener.Whiten(&chunk->rows);
+      },
+      [&](int begin, int end, FreeChunk* chunk) {
+        AccumulateFree(in, begin, end, out, chunk);
+        return -1;
+      },
+      [&](FreeChunk& chunk) { total.Add(chunk.sums); });
   if (failed >= 0) {
     *error = CannotSolve(in, failed);
     return false;
@@ -247,6 +319,8 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   out->raw_chi_square = total.raw_chi_square;
   out->readings = total.readings;
   out->folds = std::move(total.folds);
+  out->session_information = std::move(total.session_information);
+  out->session_gradient = std::move(total.session_gradient);
   return true;
 }
 
@@ -274,19 +348,32 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   for (const ParameterSpec& p : in.candidates) {
     pass.candidate_columns.push_back(BasisColumns(p, model));
   }
-  const std::vector<int> samples = CandidateSamples(in.samples.size(), in.max_candidate_samples);
+  // With a slow error the whitening needs neighbours: contiguous runs (each a series of
+  // its own) rather than single samples spread out.
+  const std::vector<int> samples =
+      in.samples.whitened()
+          ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
+          : CandidateSamples(in.samples.size(), in.max_candidate_samples);
   const auto zero = [&] {
     return CandidateSums{Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q),
                          Eigen::VectorXd::Zero(q), Eigen::MatrixXd::Zero(n, n)};
   };
   CandidateSums total = zero();
   out->candidate_scores = Eigen::MatrixXd::Zero(static_cast<int>(samples.size()), q);
-  const int failed = ReduceChunks<CandidateSums>(
-      static_cast<int>(samples.size()), in.num_threads, zero,
-      [&](int begin, int end, CandidateSums* sums) {
-        return AccumulateCandidates(pass, samples, begin, end, sums, &out->candidate_scores);
+  SampleRowWhitener whitener(in.samples, pass.basis.front().num_free() + 1);
+  const int failed = ReduceChunksInOrder<CandidateChunk>(
+      static_cast<int>(samples.size()), in.num_threads,
+      [&] { return CandidateChunk{zero(), {}}; },
+      [&](int begin, int end, CandidateChunk* chunk) {
+        return EvaluateCandidates(pass, samples, begin, end, chunk);
       },
-      [&](const CandidateSums& sums) {
+      [&](int, int, CandidateChunk* chunk) { whitener.Whiten(&chunk->rows, &samples); },
+      [&](int begin, int end, CandidateChunk* chunk) {
+        AccumulateCandidates(pass, samples, begin, end, chunk, &out->candidate_scores);
+        return -1;
+      },
+      [&](const CandidateChunk& chunk) {
+        const CandidateSums& sums = chunk.sums;
         total.cross += sums.cross;
         total.self += sums.self;
         total.gradient += sums.gradient;

@@ -19,6 +19,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -186,6 +187,14 @@ std::string CheckNoiseSigma(ModelQuantity quantity, double value_si) {
   return CheckQuantity(quantity, value_si, PlausibilityLimits(), &why) ? "" : why;
 }
 
+// A slow error's time constant: > 0 and shorter than a year (a longer memory is a
+// constant offset: the sensors' biases).
+std::string CheckTimeConstant(double value_s) {
+  constexpr double kYearS = 365.25 * 86400.0;
+  if (!(std::isfinite(value_s) && value_s > 0.0)) return "must be > 0 (seconds)";
+  return value_s <= kYearS ? "" : "must be at most a year (31557600 s)";
+}
+
 std::string CheckPositive(double value) {
   return std::isfinite(value) && value > 0.0 ? "" : "must be > 0";
 }
@@ -208,11 +217,14 @@ std::string CheckSignificance(double p) {
   return p >= 1e-4 && p <= 0.5 ? "" : "must be between 0.0001 and 0.5";
 }
 
-// A group named by sessions.separate or change_scan.parameters must have a free
-// parameter: only free parameters can differ between sessions or step.
+// A group (or one parameter, by its name) named by sessions.separate or
+// change_scan.parameters must have a free parameter: only free parameters can differ
+// between sessions or step.
 std::string GroupWithoutFreeParameter(const CalibrationSpec& spec, const std::string& group) {
   for (const ParameterSpec& p : spec.parameters) {
-    if (p.free && group == ParameterGroupName(p.kind)) return "";
+    // A joint fit's copies are named NAME@SESSION (sessions.h).
+    const std::string name = p.name.substr(0, p.name.find('@'));
+    if (p.free && (group == ParameterGroupName(p.kind) || group == name)) return "";
   }
   return group + " has no free parameter in this spec (free: true under parameters)";
 }
@@ -527,7 +539,12 @@ class Reader {
 
   bool ReadNoise(const KeyValue& noise, CalibrationSpec* spec) {
     KeyMap keys;
-    if (!ReadMap(noise, "noise", {"tension_sigma_kN", "tension_sigma_percent"}, &keys)) {
+    if (!ReadMap(noise, "noise", {"tension_sigma_kN", "tension_sigma_percent", "slow_error"},
+                 &keys)) {
+      return false;
+    }
+    if (const KeyValue* kv = Find(keys, "slow_error");
+        kv != nullptr && !ReadSlowError(*kv, &spec->slow_error)) {
       return false;
     }
     if (const KeyValue* kv = Find(keys, "tension_sigma_kN")) {
@@ -550,6 +567,66 @@ class Reader {
     }
     if (spec->tension_sigma_n == 0.0 && spec->tension_sigma_percent == 0.0) {
       return Fail(noise.line, "noise", kBothNoiseZero);
+    }
+    return true;
+  }
+
+  // noise.slow_error: none, estimate, or {sigma_percent, sigma_kN, time_constant_s}, each a
+  // number or "estimate" (slow_error.h).
+  bool ReadSlowError(const KeyValue& kv, SlowErrorSpec* slow) {
+    const std::string path = "noise.slow_error";
+    *slow = SlowErrorSpec();
+    if (kv.value.IsScalar()) {
+      int choice = 0;
+      if (!ReadChoice(kv, path, {"none", "estimate"}, &choice)) return false;
+      slow->enabled = choice == 1;
+      slow->estimate_amplitude = slow->estimate_time_constant = slow->enabled;
+      return true;
+    }
+    KeyMap keys;
+    if (!ReadMap(kv, path, {"sigma_percent", "sigma_kN", "time_constant_s"}, &keys)) return false;
+    slow->enabled = true;
+    // Each part: a number (with its check), or "estimate".
+    const auto part = [&](const char* key, double to_si, bool* estimated, double* value_si,
+                          const std::function<std::string(double)>& check) {
+      const KeyValue* p = Find(keys, key);
+      if (p == nullptr) return true;
+      const std::string key_path = Join(path, key);
+      if (p->value.IsScalar() && p->value.Scalar() == "estimate") {
+        *estimated = true;
+        return true;
+      }
+      double v = 0.0;
+      if (!ReadDouble(*p, key_path, &v) || !Check(check(v * to_si), p->line, key_path)) {
+        return false;
+      }
+      *value_si = v * to_si;
+      return true;
+    };
+    bool percent_estimated = false, kn_estimated = false;
+    if (!part("sigma_percent", 1.0, &percent_estimated, &slow->stated.sigma_percent,
+              [](double v) { return CheckNoiseSigma(ModelQuantity::kTensionSigmaPercent, v); }) ||
+        !part("sigma_kN", kNewtonsPerKilonewton, &kn_estimated, &slow->stated.sigma_n,
+              [](double v) { return CheckNoiseSigma(ModelQuantity::kTensionSigmaN, v); }) ||
+        !part("time_constant_s", 1.0, &slow->estimate_time_constant,
+              &slow->stated.time_constant_s, CheckTimeConstant)) {
+      return false;
+    }
+    if (percent_estimated && kn_estimated) {
+      return Fail(kv.line, path,
+                  "sigma_percent and sigma_kN are both \"estimate\"; estimate one of them (the "
+                  "other a number, or left out)");
+    }
+    slow->estimate_amplitude = percent_estimated || kn_estimated;
+    slow->amplitude_in_percent = !kn_estimated;
+    if (Find(keys, "time_constant_s") == nullptr) {
+      return Fail(kv.line, path, "time_constant_s is missing (a number of seconds, or estimate)");
+    }
+    if (!slow->estimate_amplitude && slow->stated.sigma_percent == 0.0 &&
+        slow->stated.sigma_n == 0.0) {
+      return Fail(kv.line, path,
+                  "no amplitude: give sigma_percent or sigma_kN (a number, or estimate), or "
+                  "write slow_error: none");
     }
     return true;
   }
@@ -647,10 +724,13 @@ class Reader {
       const int line = LineOf(item) > 0 ? LineOf(item) : kv.line;
       if (!item.IsScalar()) return Fail(line, path, "expected a parameter group name");
       const std::string name = item.Scalar();
-      if (std::find(keys.begin(), keys.end(), name) == keys.end()) {
+      const bool parameter = std::any_of(spec.parameters.begin(), spec.parameters.end(),
+                                         [&](const ParameterSpec& p) { return p.name == name; });
+      if (std::find(keys.begin(), keys.end(), name) == keys.end() && !parameter) {
         return Fail(line, path,
                     "unknown parameter group " + internal::Quote(name) +
-                        " (accepted: " + ListOf(keys) + ")");
+                        " (accepted: " + ListOf(keys) +
+                        ", or one parameter's name, e.g. sensor_bias_kN[3])");
       }
       if (std::find(groups->begin(), groups->end(), name) != groups->end()) {
         return Fail(line, path, name + " is listed twice");
@@ -1046,6 +1126,29 @@ std::vector<std::string> AxisLines(const CalibrationSpec& spec, const GroupInfo&
 
 namespace {
 
+// The slow error's parts: stated ones plausible, an amplitude and a time constant.
+std::string SlowErrorProblem(const SlowErrorSpec& slow) {
+  if (!slow.enabled) return "";
+  std::string why;
+  if (!slow.stated.IsValid(&why)) return why;
+  if (!(slow.estimate_amplitude && slow.amplitude_in_percent)) {
+    why = CheckNoiseSigma(ModelQuantity::kTensionSigmaPercent, slow.stated.sigma_percent);
+    if (!why.empty()) return "sigma_percent: " + why;
+  }
+  if (!(slow.estimate_amplitude && !slow.amplitude_in_percent)) {
+    why = CheckNoiseSigma(ModelQuantity::kTensionSigmaN, slow.stated.sigma_n);
+    if (!why.empty()) return "sigma_n: " + why;
+  }
+  if (!slow.estimate_time_constant) {
+    why = CheckTimeConstant(slow.stated.time_constant_s);
+    if (!why.empty()) return "time_constant_s: " + why;
+  }
+  if (!slow.estimate_amplitude && slow.stated.sigma_percent == 0.0 && slow.stated.sigma_n == 0.0) {
+    return "no amplitude (sigma_percent and sigma_n are 0 and none is estimated)";
+  }
+  return "";
+}
+
 // The first problem with the spec's options (everything but the parameters), as
 // "field: why"; empty when there is none.
 std::string OptionsProblem(const CalibrationSpec& s) {
@@ -1059,6 +1162,7 @@ std::string OptionsProblem(const CalibrationSpec& s) {
       {"tension_sigma_percent",
        CheckNoiseSigma(ModelQuantity::kTensionSigmaPercent, s.tension_sigma_percent)},
       {"noise", s.tension_sigma_n == 0.0 && s.tension_sigma_percent == 0.0 ? kBothNoiseZero : ""},
+      {"slow_error", SlowErrorProblem(s.slow_error)},
       {"robust_loss", known_loss ? "" : "unknown loss"},
       {"robust_loss_scale", CheckPositive(s.robust_loss_scale)},
       {"holdout_fraction", CheckHoldoutFraction(s.holdout_fraction)},
@@ -1255,14 +1359,33 @@ std::string SessionsYaml(const CalibrationSpec& spec) {
   return out.str();
 }
 
+std::string SlowErrorYaml(const SlowErrorSpec& slow) {
+  if (!slow.enabled) return "none";
+  const auto part = [](bool estimated, const std::string& value) {
+    return estimated ? std::string("estimate") : value;
+  };
+  const bool percent = slow.estimate_amplitude && slow.amplitude_in_percent;
+  const bool kn = slow.estimate_amplitude && !slow.amplitude_in_percent;
+  return "{sigma_percent: " + part(percent, Num(slow.stated.sigma_percent)) +
+         ", sigma_kN: " + part(kn, NumInUnit(slow.stated.sigma_n, kNewtonsPerKilonewton)) +
+         ", time_constant_s: " +
+         part(slow.estimate_time_constant, Num(slow.stated.time_constant_s)) + "}";
+}
+
 }  // namespace
+
+SlowErrorProcess SlowErrorSpec::Initial() const {
+  if (!enabled || estimates_any()) return SlowErrorProcess();
+  return stated;
+}
 
 std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
   std::ostringstream out;
   out << "format: " << kFormatName << "\n";
   out << "forward_model: " << StaticsMethodName(spec.forward_model) << "\n";
   out << "noise: {tension_sigma_kN: " << NumInUnit(spec.tension_sigma_n, kNewtonsPerKilonewton)
-      << ", tension_sigma_percent: " << Num(spec.tension_sigma_percent) << "}\n";
+      << ", tension_sigma_percent: " << Num(spec.tension_sigma_percent)
+      << ", slow_error: " << SlowErrorYaml(spec.slow_error) << "}\n";
   const char* loss = RobustLossName(spec.robust_loss);
   out << "robust_loss: {type: " << (loss != nullptr ? loss : "unknown")
       << ", scale: " << Num(spec.robust_loss_scale) << "}\n";

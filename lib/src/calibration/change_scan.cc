@@ -299,6 +299,53 @@ std::vector<int> StepsForWidening(const Round& r, std::vector<int> steps) {
   return steps;
 }
 
+// P(chi-square with `dof` degrees of freedom > x), for dof 1..3 (the scanned parameters
+// of a mass centre): closed forms.
+double ChiSquareTail(double x, int dof) {
+  if (!(x > 0.0)) return 1.0;
+  if (dof == 1) return std::erfc(std::sqrt(x / 2.0));
+  if (dof == 2) return std::exp(-x / 2.0);
+  if (dof == 3) {
+    return std::erfc(std::sqrt(x / 2.0)) + std::sqrt(2.0 * x / M_PI) * std::exp(-x / 2.0);
+  }
+  // More parameters: the Wilson-Hilferty normal approximation.
+  const double k = dof, z = (std::cbrt(x / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
+  return 0.5 * std::erfc(z / std::sqrt(2.0));
+}
+
+// The scanned parameters' linear trend over the survey (change_scan.h), widened by w.
+void TestTrend(const ChangeScanInputs& in, double w, ChangeScanOutput* out) {
+  const int rows = static_cast<int>(in.residuals->rows());
+  const int n = in.num_free, m = in.rows_per_sample, p = static_cast<int>(in.scanned.size());
+  Eigen::MatrixXd info = Eigen::MatrixXd::Zero(n, n), cross = Eigen::MatrixXd::Zero(n, p);
+  Eigen::MatrixXd self = Eigen::MatrixXd::Zero(p, p);
+  Eigen::VectorXd gradient = Eigen::VectorXd::Zero(n), score = Eigen::VectorXd::Zero(p);
+  Eigen::MatrixXd j(m, n), z(m, p);
+  for (int t = 0; t < rows; ++t) {
+    const double s = (t - 0.5 * (rows - 1)) / rows;
+    for (int i = 0; i < m; ++i) j.row(i) = in.jacobians->row(t).segment(i * n, n).cast<double>();
+    for (int g = 0; g < p; ++g) z.col(g) = s * j.col(in.scanned[g]);
+    const Eigen::VectorXd r = in.residuals->row(t).transpose();
+    info.noalias() += j.transpose() * j;
+    cross.noalias() += j.transpose() * z;
+    self.noalias() += z.transpose() * z;
+    gradient.noalias() += j.transpose() * r;
+    score.noalias() += z.transpose() * r;
+  }
+  info.diagonal() += in.prior_information;
+  gradient += in.prior_gradient;
+  const Eigen::LDLT<Eigen::MatrixXd> nuisance(info);
+  const Eigen::MatrixXd schur = self - cross.transpose() * nuisance.solve(cross);
+  const Eigen::VectorXd h = score - cross.transpose() * nuisance.solve(gradient);
+  const Eigen::LDLT<Eigen::MatrixXd> s(schur);
+  if (s.info() != Eigen::Success || !(s.vectorD().minCoeff() > 0.0)) return;
+  const Eigen::MatrixXd s_inverse = s.solve(Eigen::MatrixXd::Identity(p, p));
+  out->trend_statistic = h.dot(s_inverse * h) / (w * w);
+  out->trend_p_value = ChiSquareTail(out->trend_statistic, p);
+  out->trend_shift = -s_inverse * h;
+  out->trend_shift_sigma = w * s_inverse.diagonal().cwiseMax(0.0).cwiseSqrt();
+}
+
 double PValue(const std::vector<double>& null_maxima, double observed) {
   const auto above = std::count_if(null_maxima.begin(), null_maxima.end(),
                                    [observed](double w) { return w >= observed; });
@@ -375,6 +422,10 @@ bool ScanForChanges(const ChangeScanInputs& in, ChangeScanOutput* out, std::stri
       }
       out->threshold = Quantile(maxima[0], in.significance);
       out->widening = w;
+      for (const Round::Split& s : r.splits()) {
+        out->best_step_statistic = std::max(out->best_step_statistic, s.statistic);
+      }
+      TestTrend(in, w, out);
     }
     if (round == in.max_changes) break;
     // The most significant segment maximum.
@@ -444,10 +495,26 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
            FormatDouble("%.6g", c.time_s) + " s (line " + std::to_string(c.line) + ", p " +
            FormatDouble("%.2g", c.p_value) + "): " + shifts;
   }
+  if (scan.wanders) {
+    std::string trend;
+    for (size_t k = 0; k < scan.trend_shift.size(); ++k) {
+      trend += (k ? ", " : "") + scan.parameters[k] + " " +
+               FormatDouble("%+.3g", scan.trend_shift[k]) + " +- " +
+               FormatDouble("%.2g", scan.trend_shift_sigma[k]) + " " + scan.units[k];
+    }
+    out += "; but the data show a wandering rather than a step (" +
+           std::string(scan.changes.size() > 1 ? "several steps were needed, "
+                                               : "") +
+           "a steady trend explains " +
+           (scan.trend_statistic >= scan.best_step_statistic ? "at least as much as"
+                                                             : "much of what") +
+           " the best step: statistic " + FormatDouble("%.3g", scan.trend_statistic) + " against " +
+           FormatDouble("%.3g", scan.best_step_statistic) + "; over the survey " + trend + ")";
+  }
   if (scan.widening > kMemoryWorthSaying) {
     out += " (the residuals' memory widens the scan by " + FormatDouble("%.2g", scan.widening) +
-           ": a slow drift of the sensors can also look like a step; docs/calibration.md, "
-           "\"Change scan\")";
+           ": an error the noise model leaves out (a slow drift it does not model) can also "
+           "look like a step; docs/calibration.md, \"Change scan\")";
   }
   return out + ". The estimates are an average over " + (scan.changes.size() == 1 ? "it" : "them") +
          ": split the survey there into sessions (a session column) and fit with sessions: "

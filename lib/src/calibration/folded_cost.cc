@@ -7,6 +7,7 @@
 
 #include "fastcal/internal/row_fold.h"
 #include "fastcal/internal/sample_chunks.h"
+#include "fastcal/internal/sample_rows.h"
 
 namespace fastcal::internal {
 
@@ -46,20 +47,34 @@ FoldedTensionCost::FoldedTensionCost(const FittedSamples& samples, const ceres::
 
 bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const {
   struct Part {
-    RowFold fold;  // of the rows (J r), (n + 1) columns
+    SampleRows rows;  // the chunk's rows, Jacobian then residual
+    RowFold fold;     // of the rows with the loss's correction, (n + 1) columns
     double rho = 0.0;
   };
   const int n = n_;
   const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
   RowFold total(n + 1);
   *rho_sum = 0.0;
-  const int failed = ReduceChunks<Part>(
-      samples_.size(), threads_, [n] { return Part{RowFold(n + 1)}; },
+  SampleRowWhitener whitener(samples_, n + 1);
+  const int failed = ReduceChunksInOrder<Part>(
+      samples_.size(), threads_, [n] { return Part{{}, RowFold(n + 1)}; },
+      [&](int begin, int end, Part* part) {
+        part->rows.Reset(begin, end, n + 1);
+        for (int t = begin; t < end; ++t) {
+          if (!EvaluateSampleRows(samples_, t, at, t, &part->rows)) return t;
+        }
+        return -1;
+      },
+      [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
       [&](int begin, int end, Part* part) {
         std::vector<double> j(kNumCables * n), rows(kNumCables * (n + 1));
         double r[kNumCables];
         for (int t = begin; t < end; ++t) {
-          if (!samples_.Rows(t, at, r, j.data())) return t;
+          for (int i = 0; i < kNumCables; ++i) {
+            const double* row = part->rows.Row(t, i);
+            std::copy(row, row + n, &j[i * n]);
+            r[i] = row[n];
+          }
           part->rho += CorrectForLoss(loss_, r, j.data(), n);
           for (int i = 0; i < kNumCables; ++i) {
             std::copy(&j[i * n], &j[i * n] + n, &rows[i * (n + 1)]);
@@ -80,18 +95,29 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
 
 double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
   const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
+  struct Part {
+    SampleRows rows;  // the chunk's residuals
+    double sum = 0.0;
+  };
   double total = 0.0;
-  const int failed = ReduceChunks<double>(
-      samples_.size(), threads_, [] { return 0.0; },
-      [&](int begin, int end, double* sum) {
-        double r[kNumCables];
-        for (int j = begin; j < end; ++j) {
-          if (!samples_.Rows(j, at, r, nullptr)) return j;
-          *sum += CorrectForLoss(loss_, r, nullptr, n_);
+  SampleRowWhitener whitener(samples_, 1);
+  const int failed = ReduceChunksInOrder<Part>(
+      samples_.size(), threads_, [] { return Part(); },
+      [&](int begin, int end, Part* part) {
+        part->rows.Reset(begin, end, 1);
+        for (int t = begin; t < end; ++t) {
+          if (!EvaluateSampleRows(samples_, t, at, t, &part->rows)) return t;
         }
         return -1;
       },
-      [&](const double& sum) { total += sum; });
+      [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
+      [&](int begin, int end, Part* part) {
+        for (int t = begin; t < end; ++t) {
+          part->sum += CorrectForLoss(loss_, part->rows.Of(t), nullptr, n_);
+        }
+        return -1;
+      },
+      [&](const Part& part) { total += part.sum; });
   *ok = failed < 0;
   return total;
 }

@@ -14,9 +14,10 @@ namespace {
 
 constexpr char kSessionSeparator = '@';
 
+// Whether p is in one of the groups, or is one of the parameters named among them.
 bool InGroups(const ParameterSpec& p, const std::vector<std::string>& groups) {
   for (const std::string& g : groups) {
-    if (g == ParameterGroupName(p.kind)) return true;
+    if (g == ParameterGroupName(p.kind) || g == p.name) return true;
   }
   return false;
 }

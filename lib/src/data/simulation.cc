@@ -27,6 +27,7 @@ enum Stream : std::uint64_t {
   kTensionDriftStream,
   kMassCentreDriftStream,
   kSensorSpreadStream,
+  kSensorRezeroStream,
 };
 
 bool Fail(std::string* error, const std::string& message) {
@@ -84,16 +85,20 @@ class Random {
 class Ar1 {
  public:
   Ar1(double sigma, double time_s, double dt)
-      : sigma_(sigma), phi_(time_s > 0.0 ? std::exp(-dt / time_s) : 0.0) {}
-  double Next(Random* rng) {
+      : sigma_(sigma), time_s_(time_s), phi_(Phi(dt)) {}
+  double Next(Random* rng) { return Step(rng, phi_); }
+  // The next value `dt` after the last, not the sample interval (a gap between sessions).
+  double NextAfter(Random* rng, double dt) { return Step(rng, Phi(dt)); }
+
+ private:
+  double Phi(double dt) const { return time_s_ > 0.0 ? std::exp(-dt / time_s_) : 0.0; }
+  double Step(Random* rng, double phi) {
     const double xi = rng->Normal();
-    x_ = first_ ? sigma_ * xi : phi_ * x_ + sigma_ * std::sqrt(1.0 - phi_ * phi_) * xi;
+    x_ = first_ ? sigma_ * xi : phi * x_ + sigma_ * std::sqrt(1.0 - phi * phi) * xi;
     first_ = false;
     return x_;
   }
-
- private:
-  double sigma_, phi_;
+  double sigma_, time_s_, phi_;
   double x_ = 0.0;
   bool first_ = true;
 };
@@ -107,6 +112,11 @@ class Ar1Vector {
     const double a = x_[0].Next(rng);
     const double b = x_[1].Next(rng);
     return Eigen::Vector3d(a, b, x_[2].Next(rng));
+  }
+  Eigen::Vector3d NextAfter(Random* rng, double dt) {
+    const double a = x_[0].NextAfter(rng, dt);
+    const double b = x_[1].NextAfter(rng, dt);
+    return Eigen::Vector3d(a, b, x_[2].NextAfter(rng, dt));
   }
 
  private:
@@ -187,12 +197,21 @@ struct Processes {
         outlier_rng(o.seed, kOutlierStream),
         drift_rng(o.seed, kTensionDriftStream),
         mass_centre_rng(o.seed, kMassCentreDriftStream),
+        rezero_rng(o.seed, kSensorRezeroStream),
         control(o.attitude_control_sigma_deg, o.attitude_control_time_s, o.sample_interval_s),
         mass_centre_drift(o.mass_centre_drift_m, o.mass_centre_drift_time_s, o.sample_interval_s),
-        tension_drift(kNumCables, Ar1(o.tension_drift_percent / 100.0, o.tension_drift_time_s,
+        tension_drift(kNumCables, Ar1(DriftSigma(o), o.tension_drift_time_s,
                                       o.sample_interval_s)) {}
+  // The drift processes' sigma: the relative one (their values are fractions of the
+  // reading), or 1 when only the absolute part is given (scaled by it), else 0.
+  static double DriftSigma(const SimulationOptions& o) {
+    if (o.tension_drift_percent > 0.0) return o.tension_drift_percent / 100.0;
+    return o.tension_drift_kn > 0.0 ? 1.0 : 0.0;
+  }
   Random control_rng, attitude_rng, position_rng, tension_rng, outlier_rng, drift_rng,
-      mass_centre_rng;
+      mass_centre_rng, rezero_rng;
+  // The time since the previous sample (the interval, or more across a session gap).
+  double dt = 0.0;
   Ar1Vector control, mass_centre_drift;
   std::vector<Ar1> tension_drift;
   // Sums over the samples.
@@ -207,8 +226,8 @@ bool SolveActual(size_t n, const Pose& planned_pose, const Eigen::Vector3d& plan
                  const SimulationOptions& options, const Eigen::Vector3d& mass_centre_m,
                  const StaticsOptions& statics, Processes* p, CableRobot* model,
                  Eigen::Vector3d* actual_rpy_deg, StaticsSolution* solution, std::string* error) {
-  const Eigen::Vector3d control_deg = p->control.Next(&p->control_rng);
-  const Eigen::Vector3d drift_m = p->mass_centre_drift.Next(&p->mass_centre_rng);
+  const Eigen::Vector3d control_deg = p->control.NextAfter(&p->control_rng, p->dt);
+  const Eigen::Vector3d drift_m = p->mass_centre_drift.NextAfter(&p->mass_centre_rng, p->dt);
   model->mass_centre_cabin_m = mass_centre_m + drift_m;
   p->mass_centre_sum += model->mass_centre_cabin_m;
   p->mass_centre_sq += drift_m.squaredNorm();
@@ -243,6 +262,14 @@ void MeasurePose(const Eigen::Vector3d& position_m, const Eigen::Vector3d& actua
   p->position_sq += position_noise_m.squaredNorm();
 }
 
+double SlowErrorN(const SimulationOptions& o, double reading_n, double drift) {
+  if (!(o.tension_drift_kn > 0.0)) return reading_n * drift;
+  const double relative = o.tension_drift_percent / 100.0;
+  const double sigma_n = std::hypot(o.tension_drift_kn * kNPerKn, relative * reading_n);
+  // drift = relative u, or u itself (sigma 1) without a relative part.
+  return sigma_n * (relative > 0.0 ? drift / relative : drift);
+}
+
 // The six readings of sample n: the sensor's reading of the true tension, with the slow
 // drift and the noise, or an outlier; the commanded s0 alongside.
 bool MeasureTensions(size_t n, const CableRobot& model, const StaticsSolution& solution,
@@ -256,8 +283,13 @@ bool MeasureTensions(size_t n, const CableRobot& model, const StaticsSolution& s
                              ": sensor reading gain * tension + bias = " +
                              Num(reading_n / kNPerKn) + " kN is not > 0 (check the bias)");
     }
-    const double drift = p->tension_drift[i].Next(&p->drift_rng);
-    p->drift_sq[i] += drift * drift;
+    const double drift = p->tension_drift[i].NextAfter(&p->drift_rng, p->dt);
+    // The slow error in newtons: drift * reading when it is relative only (the same
+    // numbers as before the absolute part existed), else sigma_e(reading) u with u the
+    // standardised process and sigma_e^2 = abs^2 + (pct/100 reading)^2 (slow_error.h).
+    const double slow_n = SlowErrorN(options, reading_n, drift);
+    const double slow_relative = options.tension_drift_kn > 0.0 ? slow_n / reading_n : drift;
+    p->drift_sq[i] += slow_relative * slow_relative;
     // Both draws are made for every reading, outlier or not, to keep streams aligned.
     const bool outlier = p->outlier_rng.Uniform01() < options.outlier_fraction;
     const double outlier_u = 2.0 * p->outlier_rng.Uniform01() - 1.0;
@@ -271,7 +303,9 @@ bool MeasureTensions(size_t n, const CableRobot& model, const StaticsSolution& s
       const double relative = options.tension_noise_percent / 100.0 * p->tension_rng.Normal();
       const double absolute_n = options.tension_noise_kn * kNPerKn * p->tension_rng.Normal();
       measured_n = outlier ? reading_n * (1.0 + options.outlier_scale_percent / 100.0 * outlier_u)
-                           : reading_n * (1.0 + relative + drift) + absolute_n;
+                           : options.tension_drift_kn > 0.0
+                                 ? reading_n * (1.0 + relative) + slow_n + absolute_n
+                                 : reading_n * (1.0 + relative + drift) + absolute_n;
     }
     s->tension_n[i] = measured_n;
     s->unstretched_length_m[i] = solution.cables[i].unstretched_length_m;
@@ -305,6 +339,22 @@ Eigen::Vector3d StepShiftAt(const SimulationOptions& options, double t) {
   return shift;
 }
 
+std::array<double, kNumCables> SensorBiases(const CableRobot& model) {
+  std::array<double, kNumCables> bias{};
+  for (int i = 0; i < kNumCables; ++i) bias[i] = model.cables[i].sensor_bias_n;
+  return bias;
+}
+
+// A maintenance between sessions: each sensor re-zeroed, its bias moved by
+// N(0, sensor_rezero_kn) (drawn whether or not the spread is 0, to keep streams aligned).
+void ReZeroSensors(const SimulationOptions& options, int session, Processes* p, CableRobot* model,
+                   SimulationSummary* stats) {
+  for (int i = 0; i < kNumCables; ++i) {
+    model->cables[i].sensor_bias_n += options.sensor_rezero_kn * kNPerKn * p->rezero_rng.Normal();
+  }
+  stats->session_bias_n.resize(session + 1, SensorBiases(*model));
+}
+
 // Stages: check the inputs, draw the truth model, then per planned pose the actual pose
 // and its statics, the measured pose and the readings; last the summary.
 bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const SimulationOptions& options,
@@ -324,6 +374,9 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
   // Consecutive nodes are usually close; a failed warm start is retried cold.
   statics.warm_start = true;
   StaticsSolution solution;
+  const CableRobot first_session = model;  // the truth written out: the first session's
+  stats.session_bias_n.push_back(SensorBiases(model));
+  int session = 0;
 
   for (size_t n = 0; n < static_cast<size_t>(planned.count); ++n) {
     const Pose planned_pose = planned.next();
@@ -331,7 +384,16 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
       return Fail(error, "planned pose of node " + std::to_string(n) + " is not finite");
     }
     Sample s;
-    s.time_s = static_cast<double>(n) * options.sample_interval_s;
+    // Consecutive equal sessions, labelled "1" .. "N" (SimulatedDatasetLayout), each
+    // session_gap_s after the previous one's end; the sensors re-zeroed at its start.
+    if (options.sessions > 1) {
+      s.session = static_cast<int>(static_cast<long long>(n) * options.sessions / planned.count);
+    }
+    const bool new_session = n > 0 && s.session != session;
+    if (new_session) ReZeroSensors(options, s.session, &processes, &model, &stats);
+    session = s.session;
+    s.time_s = static_cast<double>(n) * options.sample_interval_s + session * options.session_gap_s;
+    processes.dt = options.sample_interval_s + (new_session ? options.session_gap_s : 0.0);
     s.has_planned_attitude = true;
     s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned_pose.rotation));
     s.planned_rotation =
@@ -344,13 +406,12 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
     }
     MeasurePose(planned_pose.position_m, actual_rpy_deg, options, &processes, &s);
     if (!MeasureTensions(n, model, solution, options, &processes, &stats, &s, error)) return false;
-    // Consecutive equal sessions, labelled "1" .. "N" (SimulatedDatasetLayout).
-    if (options.sessions > 1) {
-      s.session = static_cast<int>(static_cast<long long>(n) * options.sessions / planned.count);
-    }
     if (!sink(s, error)) return false;
   }
   Summarise(processes, static_cast<double>(planned.count), &stats);
+  for (int i = 0; i < kNumCables; ++i) {
+    model.cables[i].sensor_bias_n = first_session.cables[i].sensor_bias_n;
+  }
   model.mass_centre_cabin_m = mass_centre_m;  // the truth written out: the mean
 
   if (truth_used != nullptr) *truth_used = std::move(model);
@@ -369,6 +430,9 @@ bool SimulationOptions::IsValid(std::string* error) const {
       {"attitude_control_time_s", attitude_control_time_s},
       {"tension_drift_percent", tension_drift_percent},
       {"tension_drift_time_s", tension_drift_time_s},
+      {"tension_drift_kn", tension_drift_kn},
+      {"session_gap_s", session_gap_s},
+      {"sensor_rezero_kn", sensor_rezero_kn},
       {"mass_centre_drift_m", mass_centre_drift_m},
       {"mass_centre_drift_time_s", mass_centre_drift_time_s},
       {"sensor_gain_spread_percent", sensor_gain_spread_percent},

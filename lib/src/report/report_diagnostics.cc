@@ -485,6 +485,38 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
 
 namespace {
 
+// The slow sensor error: the process the fit whitened by and what the residuals say.
+void JsonSlowError(const SlowErrorReport& s, JsonWriter* w) {
+  w->Key("slow_error").BeginObject();
+  w->Key("enabled").Bool(s.enabled);
+  if (s.enabled) {
+    w->Key("sigma_percent").Number(s.process.sigma_percent);
+    w->Key("sigma_kN").Number(s.process.sigma_n / 1e3);
+    w->Key("time_constant_s").Number(s.process.time_constant_s);
+    w->Key("amplitude_estimated").Bool(s.amplitude_estimated);
+    w->Key("amplitude_part").String(s.amplitude_in_percent ? "sigma_percent" : "sigma_kN");
+    w->Key("amplitude_sigma").Number(s.amplitude_in_percent ? s.amplitude_sigma
+                                                            : s.amplitude_sigma / 1e3);
+    w->Key("amplitude_at_floor").Bool(s.amplitude_at_floor);
+    w->Key("time_constant_estimated").Bool(s.time_constant_estimated);
+    w->Key("time_constant_sigma_s").Number(s.time_constant_sigma_s);
+    w->Key("time_constant_at_bound").Bool(s.time_constant_at_bound);
+    w->Key("likelihood_ratio_vs_white").Number(s.likelihood_ratio_vs_white);
+    w->Key("maximum_likelihood").BeginObject();
+    w->Key("sigma_percent").Number(s.maximum_likelihood.sigma_percent);
+    w->Key("sigma_kN").Number(s.maximum_likelihood.sigma_n / 1e3);
+    w->Key("time_constant_s").Number(s.maximum_likelihood.time_constant_s);
+    w->EndObject();
+    w->Key("stated_likelihood_ratio").Number(s.stated_likelihood_ratio);
+    w->Key("stated_p_value").Number(s.stated_p_value);
+    w->Key("stated_contradicted").Bool(s.stated_contradicted);
+    w->Key("series").Int(s.series);
+    w->Key("samples_used").Int(s.samples_used);
+    w->Key("passes").Int(s.passes);
+  }
+  w->EndObject();
+}
+
 void JsonVerdictAndBudget(const CalibrationResult& r, JsonWriter* w) {
   w->Key("verdict").BeginObject();
   w->Key("status").String(FitVerdictName(r.verdict));
@@ -508,6 +540,7 @@ void JsonVerdictAndBudget(const CalibrationResult& r, JsonWriter* w) {
   for (const std::string& g : b.consider_groups) w->String(g);
   w->EndArray();
   w->EndObject();
+  JsonSlowError(r.slow_error, w);
 }
 
 void JsonReadings(const char* key, const std::vector<ReadingResidual>& list, JsonWriter* w) {

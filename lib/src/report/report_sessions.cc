@@ -145,6 +145,29 @@ void WriteSessionsJson(const CalibrationResult& r, JsonWriter* w) {
     w->EndObject();
   }
   w->EndArray();
+  const SensorStepTest& steps = r.sensor_steps;
+  w->Key("sensor_steps").BeginObject();
+  w->Key("tested").Bool(steps.tested);
+  w->Key("threshold").Number(steps.threshold);
+  w->Key("widening").Number(steps.widening);
+  w->Key("tests").BeginArray();
+  for (const SensorStep& s : steps.tests) {
+    w->BeginObject();
+    w->Key("parameter").String(s.parameter);
+    w->Key("cable").Int(s.cable + 1);
+    w->Key("session").String(s.session);
+    w->Key("step").Number(s.step);
+    w->Key("sigma").Number(s.sigma);
+    w->Key("unit").String(s.unit);
+    w->Key("statistic").Number(s.statistic);
+    w->Key("significant").Bool(s.significant);
+    w->EndObject();
+  }
+  w->EndArray();
+  w->Key("separated").BeginArray();
+  for (const std::string& name : steps.separated) w->String(name);
+  w->EndArray();
+  w->EndObject();
 }
 
 namespace {
@@ -262,6 +285,22 @@ void WriteChangeScanJson(const CalibrationResult& r, JsonWriter* w) {
     w->Key("widening").Number(scan.widening);
     w->Key("time_s").NumberArray(scan.time_s);
     w->Key("statistic").NumberArray(scan.statistic);
+    w->Key("best_step_statistic").Number(scan.best_step_statistic);
+    w->Key("trend").BeginObject();
+    w->Key("statistic").Number(scan.trend_statistic);
+    w->Key("p_value").Number(scan.trend_p_value);
+    w->Key("shifts").BeginObject();
+    for (size_t k = 0; k < scan.trend_shift.size(); ++k) {
+      w->Key(scan.parameters[k]).Number(scan.trend_shift[k]);
+    }
+    w->EndObject();
+    w->Key("shift_sigmas").BeginObject();
+    for (size_t k = 0; k < scan.trend_shift_sigma.size(); ++k) {
+      w->Key(scan.parameters[k]).Number(scan.trend_shift_sigma[k]);
+    }
+    w->EndObject();
+    w->EndObject();
+    w->Key("wanders").Bool(scan.wanders);
     w->EndObject();
   }
   // Empty when none was found (or no scan was asked for).

@@ -82,6 +82,11 @@ struct Linearisation {
   double raw_chi_square = 0.0;  // sum r^2 over the data
   int readings = 0;             // readings not excluded
   std::vector<FoldSums> folds;
+  // With two or more sessions, per session: J_x^T J_x and J_x^T r over its samples (rows
+  // weighted as above), for the test of sensors re-zeroed between sessions
+  // (sensor_steps.h). Empty with one session.
+  std::vector<Eigen::MatrixXd> session_information;
+  std::vector<Eigen::VectorXd> session_gradient;
   // Candidates (scaled to all fitted samples).
   Eigen::MatrixXd cross;         // J_x^T J_c
   Eigen::VectorXd self;          // diag(J_c^T J_c)

@@ -29,6 +29,7 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/compact_start.h"
 #include "fastcal/internal/tension_gradient.h"
+#include "fastcal/slow_error.h"
 #include "fastcal/statics.h"
 
 namespace fastcal::internal {
@@ -216,8 +217,14 @@ struct FittedSamples {
   const ReadingMask* excluded = nullptr;
   bool use_planned_attitude = false;
   StaticsOptions statics;
+  // The slow sensor error the rows are whitened by (slow_error.h; inactive: white noise
+  // only, nothing whitened), and per fitted sample each reading's
+  // rho = sigma_slow(reading) / sigma_white (sample_rows.h).
+  SlowErrorProcess slow_error;
+  const std::vector<std::array<double, kNumCables>>* slow_rho = nullptr;
 
   int size() const { return static_cast<int>(fit->size()); }
+  bool whitened() const { return slow_error.IsActive() && slow_rho != nullptr; }
   // Fitted sample j's residual through `through` (default: model).
   TensionResidual At(int j, const CalibrationModel* through = nullptr) const;
   // The stage every pass over the samples reads from: fitted sample j's six residuals and,

@@ -60,41 +60,67 @@ int ForEachChunk(int count, int threads, const Work& work, int chunk = kSampleCh
   return failed.load() < count ? failed.load() : -1;
 }
 
-// Like ForEachChunk, with sums: work(begin, end, &local) adds a chunk into the thread's
-// `local` (made by make()); merge(local) adds it into the total, called in chunk order
-// under a lock, after which `local` is made afresh.
-template <typename Local, typename Make, typename Work, typename Merge>
-int ReduceChunks(int count, int threads, const Make& make, const Work& work, const Merge& merge,
-                 int chunk = kSampleChunk) {
+// Like ForEachChunk, with sums and a stage that must see the chunks in order:
+//   work(begin, end, &local)     in parallel: the chunk's costly part, into the thread's
+//                                `local` (made by make()); the first failing index or -1
+//   ordered(begin, end, &local)  strictly in chunk order, one chunk at a time: a recursion
+//                                in time order over what work computed (the slow-error
+//                                filter, slow_error_filter.h)
+//   finish(begin, end, &local)   in parallel again (e.g. fold what ordered produced)
+//   merge(local)                 in chunk order under a lock; then `local` is made afresh.
+// After a failure, ordered, finish and merge are skipped (the total is discarded).
+template <typename Local, typename Make, typename Work, typename Ordered, typename Finish,
+          typename Merge>
+int ReduceChunksInOrder(int count, int threads, const Make& make, const Work& work,
+                        const Ordered& ordered, const Finish& finish, const Merge& merge,
+                        int chunk = kSampleChunk) {
   std::atomic<int> next{0};
   std::atomic<int> failed{count};
   std::mutex mutex;
   std::condition_variable turn;
-  int merged = 0;  // chunks merged (or passed over after a failure), in order
+  int ordered_chunks = 0;  // chunks through `ordered` (or passed over), in order
+  int merged = 0;          // chunks merged (or passed over), in order
+  const auto record = [&](int f) {
+    if (f < 0) return;
+    int seen = failed.load();
+    while (f < seen && !failed.compare_exchange_weak(seen, f)) {
+    }
+  };
+  // Waits for chunk `index`'s turn on `counter`, runs `step` unless something failed.
+  const auto in_turn = [&](int* counter, int index, const auto& step) {
+    std::unique_lock<std::mutex> lock(mutex);
+    turn.wait(lock, [&] { return *counter == index; });
+    if (failed.load() == count) step();
+    ++*counter;
+    lock.unlock();
+    turn.notify_all();
+  };
   OnThreads(ChunkThreads(count, chunk, threads), [&](int) {
     Local local = make();
     for (;;) {
       const int begin = next.fetch_add(chunk);
       if (begin >= count) return;
+      const int end = std::min(count, begin + chunk);
       const int index = begin / chunk;
       // Past a failure the chunk is not needed: the total is discarded.
-      const int f =
-          begin > failed.load() ? -1 : work(begin, std::min(count, begin + chunk), &local);
-      if (f >= 0) {
-        int seen = failed.load();
-        while (f < seen && !failed.compare_exchange_weak(seen, f)) {
-        }
-      }
-      std::unique_lock<std::mutex> lock(mutex);
-      turn.wait(lock, [&] { return merged == index; });
-      if (failed.load() == count) merge(local);
-      ++merged;
-      lock.unlock();
-      turn.notify_all();
+      record(begin > failed.load() ? -1 : work(begin, end, &local));
+      in_turn(&ordered_chunks, index, [&] { ordered(begin, end, &local); });
+      if (failed.load() == count) record(finish(begin, end, &local));
+      in_turn(&merged, index, [&] { merge(local); });
       local = make();
     }
   });
   return failed.load() < count ? failed.load() : -1;
+}
+
+// ReduceChunksInOrder without the ordered stage: work(begin, end, &local) adds a chunk
+// into the thread's `local`; merge(local) adds it into the total, in chunk order.
+template <typename Local, typename Make, typename Work, typename Merge>
+int ReduceChunks(int count, int threads, const Make& make, const Work& work, const Merge& merge,
+                 int chunk = kSampleChunk) {
+  const auto none = [](int, int, Local*) {};
+  const auto no_finish = [](int, int, Local*) { return -1; };
+  return ReduceChunksInOrder<Local>(count, threads, make, work, none, no_finish, merge, chunk);
 }
 
 }  // namespace fastcal::internal

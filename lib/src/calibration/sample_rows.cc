@@ -1,0 +1,54 @@
+// Rows of fitted samples and their whitening in time order (internal/sample_rows.h).
+#include "fastcal/internal/sample_rows.h"
+
+#include <algorithm>
+
+namespace fastcal::internal {
+
+bool EvaluateSampleRows(const FittedSamples& samples, int j, const ModelAtTheta& at, int t,
+                        SampleRows* rows) {
+  double r[kNumCables];
+  double* out = rows->Of(t);
+  const int columns = rows->columns;
+  if (columns == 1) {
+    if (!samples.Rows(j, at, r, nullptr)) return false;
+    std::copy(r, r + kNumCables, out);
+    return true;
+  }
+  const int n = columns - 1;
+  thread_local std::vector<double> jacobian;
+  jacobian.resize(static_cast<size_t>(kNumCables) * n);
+  if (!samples.Rows(j, at, r, jacobian.data())) return false;
+  for (int i = 0; i < kNumCables; ++i) {
+    double* row = out + i * columns;
+    std::copy(jacobian.data() + i * n, jacobian.data() + (i + 1) * n, row);
+    row[n] = r[i];
+  }
+  return true;
+}
+
+SampleRowWhitener::SampleRowWhitener(const FittedSamples& samples, int columns)
+    : samples_(samples),
+      whitener_(samples.whitened() ? samples.slow_error : SlowErrorProcess(), columns) {}
+
+double SampleRowWhitener::Whiten(SampleRows* rows, const std::vector<int>* index) {
+  if (!whitener_.active()) return 0.0;
+  double log_f = 0.0;
+  for (int k = rows->begin; k < rows->end; ++k) {
+    const int j = index != nullptr ? (*index)[k] : k;
+    const int t = (*samples_.fit)[j];
+    const Sample& sample = samples_.data->samples[t];
+    std::array<bool, kNumCables> excluded{};
+    if (samples_.excluded != nullptr && !samples_.excluded->empty()) {
+      excluded = (*samples_.excluded)[t];
+    }
+    log_f += whitener_.Whiten(sample.time_s, sample.session, (*samples_.slow_rho)[j].data(),
+                              excluded.data(), rows->Of(k));
+    for (int i = 0; i < kNumCables; ++i) {
+      if (excluded[i]) std::fill(rows->Row(k, i), rows->Row(k, i) + rows->columns, 0.0);
+    }
+  }
+  return log_f;
+}
+
+}  // namespace fastcal::internal

@@ -1,0 +1,373 @@
+// The slow-error process estimated from a fit's residuals (internal/slow_error_estimate.h).
+#include "fastcal/internal/slow_error_estimate.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <utility>
+
+#include "fastcal/internal/slow_error_filter.h"
+
+namespace fastcal::internal {
+namespace {
+
+// tau's search range, in units of the median sampling interval (below: white at this
+// sampling) and of the longest series' span (beyond: a constant the biases absorb).
+constexpr double kMinTauPerInterval = 0.2;
+constexpr double kMaxTauPerSpan = 10.0;
+// The amplitude's search range, as a ratio to the white sigma.
+constexpr double kMaxSlowErrorRatio = 20.0;
+// Nelder-Mead: at most this many evaluations, stopping when the simplex's values agree
+// to this (in -2 l, i.e. a hundredth of a log-likelihood unit).
+constexpr int kMaxEvaluations = 120;
+constexpr double kValueTolerance = 1e-2;
+// Step of the central differences for the curvature, in log units.
+constexpr double kCurvatureStep = 0.1;
+// Chi-square(2) 99% quantile: a stated process the likelihood rejects at 1%.
+constexpr double kChiSquare2Quantile99 = 9.21034;
+
+// The ratio sigma_e / s of one reading: the stated part plus the estimated one.
+struct RatioModel {
+  SlowErrorProcess process;
+  double Ratio(double reading_n, double sigma_n) const {
+    return process.SigmaN(reading_n) / sigma_n;
+  }
+};
+
+// Per cable and session: X~^T X~ and X~^T x~ of the nuisance columns.
+struct NuisanceSums {
+  Eigen::Matrix2d gram = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d cross = Eigen::Vector2d::Zero();
+};
+
+// log det G - b^T G^-1 b of the first `columns` nuisance columns; a column the session
+// does not inform (the gain's, when the reading hardly changes) is dropped.
+double RestrictedTerm(const NuisanceSums& sums, int columns) {
+  for (int c = columns; c >= 1; --c) {
+    const Eigen::MatrixXd g = sums.gram.topLeftCorner(c, c);
+    const double trace = g.trace();
+    if (!(trace > 0.0)) return 0.0;  // no reading of this cable in this session
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(g);
+    const Eigen::VectorXd d = ldlt.vectorD();
+    if (d.minCoeff() <= 1e-12 * trace) continue;
+    const Eigen::VectorXd b = sums.cross.head(c);
+    return d.array().log().sum() - b.dot(ldlt.solve(b));
+  }
+  return 0.0;
+}
+
+int CountSessions(const std::vector<SlowErrorSample>& samples) {
+  int sessions = 1;
+  for (const SlowErrorSample& s : samples) sessions = std::max(sessions, s.session + 1);
+  return sessions;
+}
+
+}  // namespace
+
+double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
+                                      const SlowErrorProcess& process) {
+  const int nuisance = in.gain_nuisance ? 2 : 1;
+  const int columns = 1 + nuisance;
+  std::vector<std::array<NuisanceSums, kNumCables>> sums(CountSessions(in.samples));
+  // White noise alone: an inactive whitener leaves the rows as they are (F = 1).
+  ReadingWhitener whitener(process, columns);
+  double total = 0.0;
+  double rows[kNumCables * 3], rho[kNumCables];
+  for (const SlowErrorSample& s : in.samples) {
+    for (int i = 0; i < kNumCables; ++i) {
+      double* row = rows + i * columns;
+      row[0] = s.x[i];
+      row[1] = 1.0 / s.sigma_n[i];
+      if (nuisance == 2) row[2] = s.reading_n[i] / s.sigma_n[i];
+      rho[i] = process.IsActive() ? process.SigmaN(s.reading_n[i]) / s.sigma_n[i] : 0.0;
+    }
+    total += whitener.Whiten(s.time_s, s.session, rho, s.excluded.data(), rows);
+    for (int i = 0; i < kNumCables; ++i) {
+      if (s.excluded[i]) continue;  // as if missing: the state only moves on in time
+      const double* row = rows + i * columns;
+      total += row[0] * row[0];
+      NuisanceSums& n = sums[s.session][i];
+      for (int a = 0; a < nuisance; ++a) {
+        n.cross[a] += row[1 + a] * row[0];
+        for (int b = 0; b < nuisance; ++b) n.gram(a, b) += row[1 + a] * row[1 + b];
+      }
+    }
+  }
+  for (const auto& session : sums) {
+    for (const NuisanceSums& n : session) total += RestrictedTerm(n, nuisance);
+  }
+  return total;
+}
+
+namespace {
+
+// The search: y = (log a, log tau), a the estimated amplitude part (percent or N), with
+// the stated coordinates held.
+struct Search {
+  const SlowErrorEstimateInputs* in = nullptr;
+  bool free[2] = {false, false};
+  double lower[2] = {0.0, 0.0}, upper[2] = {0.0, 0.0};
+  double a_ref = 1.0;  // the amplitude equal to the white sigma at a median reading
+
+  SlowErrorProcess At(const Eigen::Vector2d& y) const {
+    SlowErrorProcess p = in->spec.stated;
+    if (free[0]) {
+      (in->spec.amplitude_in_percent ? p.sigma_percent : p.sigma_n) = std::exp(y[0]);
+    }
+    if (free[1]) p.time_constant_s = std::exp(y[1]);
+    return p;
+  }
+  Eigen::Vector2d Clamp(Eigen::Vector2d y) const {
+    for (int k = 0; k < 2; ++k) y[k] = std::clamp(y[k], lower[k], upper[k]);
+    return y;
+  }
+  double Value(const Eigen::Vector2d& y) const {
+    return SlowErrorMinusTwoLogLikelihood(*in, At(Clamp(y)));
+  }
+};
+
+double Median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Bounds from the data: the amplitude's around the white sigma, tau's between a fraction
+// of the sampling interval and many times the longest series.
+Search MakeSearch(const SlowErrorEstimateInputs& in) {
+  Search s;
+  s.in = &in;
+  s.free[0] = in.spec.estimate_amplitude;
+  s.free[1] = in.spec.estimate_time_constant;
+  std::vector<double> ratio, dt;
+  double span = 0.0, series_start = 0.0;
+  for (size_t t = 0; t < in.samples.size(); ++t) {
+    const SlowErrorSample& x = in.samples[t];
+    const bool fresh = t == 0 || StartsNewSeries(in.samples[t - 1].time_s,
+                                                 in.samples[t - 1].session, x.time_s, x.session);
+    if (fresh) {
+      series_start = x.time_s;
+    } else if (x.time_s > in.samples[t - 1].time_s) {
+      dt.push_back(x.time_s - in.samples[t - 1].time_s);
+    }
+    span = std::max(span, x.time_s - series_start);
+    if (t % 16 == 0) {  // a median needs no more
+      for (int i = 0; i < kNumCables; ++i) {
+        ratio.push_back(in.spec.amplitude_in_percent ? 100.0 * x.sigma_n[i] / x.reading_n[i]
+                                                     : x.sigma_n[i]);
+      }
+    }
+  }
+  s.a_ref = std::max(Median(ratio), 1e-12);
+  const double interval = dt.empty() ? 1.0 : Median(dt);
+  s.lower[0] = std::log(kMinSlowErrorRatio * s.a_ref);
+  s.upper[0] = std::log(kMaxSlowErrorRatio * s.a_ref);
+  s.lower[1] = std::log(kMinTauPerInterval * interval);
+  s.upper[1] = std::log(std::max(kMaxTauPerSpan * span, 10.0 * interval));
+  return s;
+}
+
+// The best point of a coarse grid over the free coordinates (the likelihood can have a
+// ridge along which Nelder-Mead alone would stall far from the maximum).
+Eigen::Vector2d GridStart(const Search& s, const Eigen::Vector2d& fixed) {
+  constexpr int kAmplitudeNodes = 6, kTauNodes = 8;
+  Eigen::Vector2d best = fixed;
+  double best_value = std::numeric_limits<double>::infinity();
+  const int na = s.free[0] ? kAmplitudeNodes : 1, nt = s.free[1] ? kTauNodes : 1;
+  for (int a = 0; a < na; ++a) {
+    for (int t = 0; t < nt; ++t) {
+      Eigen::Vector2d y = fixed;
+      // The amplitude's grid spans 0.05 to 3 white sigmas; tau's its whole range.
+      if (s.free[0]) y[0] = std::log(s.a_ref * 0.05 * std::pow(60.0, a / (na - 1.0)));
+      if (s.free[1]) y[1] = s.lower[1] + (s.upper[1] - s.lower[1]) * (t + 0.5) / nt;
+      const double v = s.Value(y);
+      if (v < best_value) {
+        best_value = v;
+        best = y;
+      }
+    }
+  }
+  return s.Clamp(best);
+}
+
+// Nelder-Mead over the free coordinates (Nelder and Mead 1965; standard coefficients).
+Eigen::Vector2d NelderMead(const Search& s, Eigen::Vector2d start) {
+  std::vector<int> dims;
+  for (int k = 0; k < 2; ++k) {
+    if (s.free[k]) dims.push_back(k);
+  }
+  const int d = static_cast<int>(dims.size());
+  std::vector<Eigen::Vector2d> x(d + 1, start);
+  for (int k = 0; k < d; ++k) x[k + 1][dims[k]] += 0.5;
+  std::vector<double> f(d + 1);
+  for (int k = 0; k <= d; ++k) {
+    x[k] = s.Clamp(x[k]);
+    f[k] = s.Value(x[k]);
+  }
+  int evaluations = d + 1;
+  while (evaluations < kMaxEvaluations) {
+    std::vector<int> order(d + 1);
+    for (int k = 0; k <= d; ++k) order[k] = k;
+    std::sort(order.begin(), order.end(), [&](int a, int b) { return f[a] < f[b]; });
+    const int best = order.front(), worst = order.back();
+    if (f[worst] - f[best] < kValueTolerance) break;
+    Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+    for (int k = 0; k < d; ++k) centroid += x[order[k]] / d;
+    const auto probe = [&](double c) {
+      const Eigen::Vector2d y = s.Clamp(centroid + c * (x[worst] - centroid));
+      ++evaluations;
+      return std::make_pair(y, s.Value(y));
+    };
+    auto [reflected, fr] = probe(-1.0);
+    if (fr < f[best]) {
+      auto [expanded, fe] = probe(-2.0);
+      if (fe < fr) std::tie(reflected, fr) = std::tie(expanded, fe);
+      x[worst] = reflected;
+      f[worst] = fr;
+      continue;
+    }
+    if (fr < f[order[d - 1]]) {  // better than the second worst
+      x[worst] = reflected;
+      f[worst] = fr;
+      continue;
+    }
+    auto [contracted, fc] = probe(fr < f[worst] ? -0.5 : 0.5);
+    if (fc < std::min(fr, f[worst])) {
+      x[worst] = contracted;
+      f[worst] = fc;
+      continue;
+    }
+    for (int k = 0; k <= d; ++k) {  // shrink toward the best
+      if (k == best) continue;
+      x[k] = s.Clamp(x[best] + 0.5 * (x[k] - x[best]));
+      f[k] = s.Value(x[k]);
+      ++evaluations;
+    }
+  }
+  int best = 0;
+  for (int k = 1; k <= d; ++k) {
+    if (f[k] < f[best]) best = k;
+  }
+  return x[best];
+}
+
+bool AtBound(const Search& s, const Eigen::Vector2d& y, int k) {
+  const double margin = 0.05 * (s.upper[k] - s.lower[k]);
+  return s.free[k] && (y[k] <= s.lower[k] + margin || y[k] >= s.upper[k] - margin);
+}
+
+// 1-sigma of the free coordinates in log units, from the curvature of -2 l / 2 at y
+// (0 for a coordinate at a bound or without curvature).
+Eigen::Vector2d LogSigmas(const Search& s, const Eigen::Vector2d& y, double value) {
+  const double h = kCurvatureStep;
+  Eigen::Matrix2d hessian = Eigen::Matrix2d::Identity();
+  std::vector<int> dims;
+  for (int k = 0; k < 2; ++k) {
+    if (s.free[k] && !AtBound(s, y, k)) dims.push_back(k);
+  }
+  for (int a : dims) {
+    Eigen::Vector2d e = Eigen::Vector2d::Zero();
+    e[a] = h;
+    hessian(a, a) = (s.Value(y + e) - 2.0 * value + s.Value(y - e)) / (h * h) / 2.0;
+  }
+  if (dims.size() == 2) {
+    const Eigen::Vector2d e0(h, 0.0), e1(0.0, h);
+    hessian(0, 1) = hessian(1, 0) = (s.Value(y + e0 + e1) - s.Value(y + e0 - e1) -
+                                     s.Value(y - e0 + e1) + s.Value(y - e0 - e1)) /
+                                    (4.0 * h * h) / 2.0;
+  }
+  Eigen::Vector2d sigma = Eigen::Vector2d::Zero();
+  if (dims.empty()) return sigma;
+  const Eigen::LDLT<Eigen::Matrix2d> ldlt(hessian);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) return sigma;
+  const Eigen::Matrix2d covariance = ldlt.solve(Eigen::Matrix2d::Identity());
+  for (int k : dims) sigma[k] = std::sqrt(std::max(covariance(k, k), 0.0));
+  return sigma;
+}
+
+int CountSeries(const std::vector<SlowErrorSample>& samples) {
+  int series = 0;
+  for (size_t t = 0; t < samples.size(); ++t) {
+    series += t == 0 || StartsNewSeries(samples[t - 1].time_s, samples[t - 1].session,
+                                        samples[t].time_s, samples[t].session);
+  }
+  return series;
+}
+
+// The maximum over the free coordinates of `search`, from the stated values.
+Eigen::Vector2d Maximise(const Search& search) {
+  const SlowErrorProcess& stated = search.in->spec.stated;
+  const double stated_a =
+      search.in->spec.amplitude_in_percent ? stated.sigma_percent : stated.sigma_n;
+  Eigen::Vector2d fixed(std::log(std::max(stated_a, 1e-300)),
+                        std::log(std::max(stated.time_constant_s, 1e-300)));
+  return NelderMead(search, GridStart(search, fixed));
+}
+
+}  // namespace
+
+SlowErrorReport EstimateSlowError(const SlowErrorEstimateInputs& in) {
+  SlowErrorReport report;
+  report.enabled = true;
+  report.amplitude_estimated = in.spec.estimate_amplitude;
+  report.amplitude_in_percent = in.spec.amplitude_in_percent;
+  report.time_constant_estimated = in.spec.estimate_time_constant;
+  report.series = CountSeries(in.samples);
+  report.samples_used = static_cast<int>(in.samples.size());
+  const double white = SlowErrorMinusTwoLogLikelihood(in, SlowErrorProcess());
+  // Both parts free: the maximum-likelihood process (the estimate itself, or the check of
+  // a stated one).
+  SlowErrorEstimateInputs both = in;
+  both.spec.estimate_amplitude = both.spec.estimate_time_constant = true;
+  const Search full = MakeSearch(both);
+  const Eigen::Vector2d ml = Maximise(full);
+  const double ml_value = full.Value(ml);
+  report.maximum_likelihood = full.At(ml);
+  Eigen::Vector2d y = ml;
+  double value = ml_value;
+  const Search search = MakeSearch(in);
+  if (!in.spec.estimate_amplitude || !in.spec.estimate_time_constant) {
+    y = in.spec.estimates_any() ? Maximise(search) : Eigen::Vector2d::Zero();
+    value = SlowErrorMinusTwoLogLikelihood(in, search.At(y));
+  }
+  report.process = search.At(y);
+  report.likelihood_ratio_vs_white = white - value;
+  if (!in.spec.estimates_any()) {
+    report.stated_likelihood_ratio = std::max(0.0, value - ml_value);
+    report.stated_p_value = std::exp(-report.stated_likelihood_ratio / 2.0);  // chi-square(2)
+    report.stated_contradicted = report.stated_likelihood_ratio > kChiSquare2Quantile99;
+    return report;
+  }
+  report.amplitude_at_floor = in.spec.estimate_amplitude && y[0] <= search.lower[0] + 0.05;
+  report.time_constant_at_bound = AtBound(search, y, 1);
+  const Eigen::Vector2d log_sigma = LogSigmas(search, y, value);
+  if (in.spec.estimate_amplitude) {
+    const double a =
+        in.spec.amplitude_in_percent ? report.process.sigma_percent : report.process.sigma_n;
+    report.amplitude_sigma = a * log_sigma[0];
+  }
+  if (in.spec.estimate_time_constant) {
+    report.time_constant_sigma_s = report.process.time_constant_s * log_sigma[1];
+  }
+  return report;
+}
+
+std::vector<int> SlowErrorEstimateSamples(int count, int budget) {
+  std::vector<int> indices;
+  if (count <= budget) {
+    for (int t = 0; t < count; ++t) indices.push_back(t);
+    return indices;
+  }
+  constexpr int kRuns = 10;
+  const int run = budget / kRuns;
+  for (int k = 0; k < kRuns; ++k) {
+    const long long start = static_cast<long long>(k) * (count - run) / (kRuns - 1);
+    for (int t = 0; t < run; ++t) indices.push_back(static_cast<int>(start + t));
+  }
+  return indices;
+}
+
+}  // namespace fastcal::internal
