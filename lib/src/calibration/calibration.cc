@@ -721,8 +721,23 @@ double PriorChiSquare(const Run& run) {
   return chi;
 }
 
+// The linearisation's inputs at the current solution (without candidates). The per-sample
+// Jacobians are kept only for the change scan (calibration_linearisation.h).
+internal::LinearisationInputs LinearisationInputsOf(const Run& run) {
+  internal::LinearisationInputs in;
+  in.samples = run.Samples();
+  in.theta = run.theta.data();
+  in.loss = run.loss.get();
+  in.cross_validation_blocks = run.spec.cross_validation_blocks;
+  in.num_threads = run.spec.num_threads;
+  in.max_candidate_samples = run.options.max_candidate_samples;
+  in.keep_jacobians = !run.spec.change_scan_groups.empty();
+  return in;
+}
+
 // The budget's inputs. The linearisation's per-sample scores and Jacobians are moved
-// in, not copied (~130 MB at 10^6 samples): ReturnSeries gives them back.
+// in, not copied (~130 MB at 10^6 samples): ReturnSeries gives them back. Without kept
+// Jacobians, the budget has them replayed from the linearisation's inputs.
 BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
                               const std::vector<ParameterSpec>& candidates) {
   BudgetInputs in;
@@ -743,6 +758,11 @@ BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
   in.information.diagonal() += in.prior_information;
   in.scores = std::move(lin.scores);
   in.jacobians = std::move(lin.jacobians);
+  if (in.jacobians.rows() == 0) {
+    in.jacobian_replay = [&run](const std::function<void(int, const float*)>& visit) {
+      return internal::ReplayFreeJacobians(LinearisationInputsOf(run), visit);
+    };
+  }
   in.rows_per_sample = kNumCables;
   in.num_residuals = run.result->num_residuals;
   in.chi_square = lin.raw_chi_square + PriorChiSquare(run);
@@ -786,14 +806,8 @@ void FillCorrelation(Run& run) {
 
 CalibrationStatus Linearise(Run& run, const std::vector<ParameterSpec>& candidates,
                             internal::Linearisation* lin) {
-  internal::LinearisationInputs in;
-  in.samples = run.Samples();
-  in.theta = run.theta.data();
-  in.loss = run.loss.get();
+  internal::LinearisationInputs in = LinearisationInputsOf(run);
   in.candidates = candidates;
-  in.cross_validation_blocks = run.spec.cross_validation_blocks;
-  in.num_threads = run.spec.num_threads;
-  in.max_candidate_samples = run.options.max_candidate_samples;
   std::string why;
   if (!internal::Linearise(in, lin, &why)) return run.Fail(CalibrationStatus::kSolverFailed, why);
   return CalibrationStatus::kOk;

@@ -166,8 +166,10 @@ void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
     const Eigen::VectorXd rw = weight * r;
     out->residuals.row(t) = r.transpose();
     out->scores.row(t) = rw.transpose() * jw;
-    for (int i = 0; i < kNumCables; ++i) {
-      out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
+    if (in.keep_jacobians) {
+      for (int i = 0; i < kNumCables; ++i) {
+        out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
+      }
     }
     sums->information.noalias() += jw.transpose() * jw;
     if (!sums->session_information.empty()) {
@@ -289,7 +291,7 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   const int blocks = std::clamp(in.cross_validation_blocks, 1, std::max(1, num_fit));
   out->scores = Eigen::MatrixXd::Zero(num_fit, n);
   out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
-  out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
+  if (in.keep_jacobians) out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
   const int sessions = static_cast<int>(in.samples.data->session_labels.size());
   FreeSums total(n, blocks, sessions);
   const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
@@ -418,6 +420,41 @@ std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model) {
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error) {
   *out = Linearisation();
   return LineariseFree(in, out, error) && LineariseCandidates(in, out, error);
+}
+
+bool ReplayFreeJacobians(const LinearisationInputs& in,
+                         const std::function<void(int t, const float* jacobian)>& visit) {
+  const int n = in.samples.model->num_free();
+  const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
+  SampleRowWhitener whitener(in.samples, n + 1);
+  struct Chunk {
+    SampleRows rows;
+  };
+  const int failed = ReduceChunksInOrder<Chunk>(
+      in.samples.size(), in.num_threads, [] { return Chunk(); },
+      [&](int begin, int end, Chunk* chunk) {
+        chunk->rows.Reset(begin, end, n + 1);
+        for (int t = begin; t < end; ++t) {
+          if (!EvaluateSampleRows(in.samples, t, at, t, &chunk->rows)) return t;
+        }
+        return -1;
+      },
+      [&](int, int, Chunk* chunk) { whitener.Whiten(&chunk->rows); },
+      [](int, int, Chunk*) { return -1; },
+      [&](const Chunk& chunk) {
+        // As AccumulateFree stores them: the rows weighted by the loss's, as floats.
+        RowMatrix j(kNumCables, n);
+        Eigen::Matrix<double, kNumCables, 1> r;
+        std::vector<float> jw(kNumCables * n);
+        for (int t = chunk.rows.begin; t < chunk.rows.end; ++t) {
+          RowsOf(chunk.rows, t, &r, &j);
+          const double weight = LossWeight(in.loss, r);
+          const RowMatrix weighted = weight * j;
+          for (int k = 0; k < kNumCables * n; ++k) jw[k] = static_cast<float>(weighted.data()[k]);
+          visit(t, jw.data());
+        }
+      });
+  return failed < 0;
 }
 
 }  // namespace fastcal::internal

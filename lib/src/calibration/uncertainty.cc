@@ -89,15 +89,18 @@ Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& floor, const Eigen:
   return scale.asDiagonal() * data * scale.asDiagonal();
 }
 
-// The influence series' largest tau, and the bandwidth it calls for. Sets b->correlated
-// when some tau is above 1 by more than kTauSignificance standard deviations of tau for
-// a white series, sqrt((4 W + 2) / N) with W the window (Madras and Sokal 1988).
-void ChooseBandwidth(const Eigen::MatrixXd& influence, UncertaintyBudget* b,
+// The influence series' (u_t = M^-1 s_t) largest tau, and the bandwidth it calls for.
+// Sets b->correlated when some tau is above 1 by more than kTauSignificance standard
+// deviations of tau for a white series, sqrt((4 W + 2) / N) with W the window (Madras
+// and Sokal 1988). One series at a time: N doubles, not N x n.
+void ChooseBandwidth(const Eigen::MatrixXd& scores, UncertaintyBudget* b,
                      std::vector<double>* tau) {
-  const int n_samples = static_cast<int>(influence.rows());
+  const int n_samples = static_cast<int>(scores.rows());
   b->tau = 1.0;
-  for (int k = 0; k < influence.cols(); ++k) {
-    const AutocorrelationTime a = IntegratedAutocorrelationTime(influence.col(k));
+  Eigen::VectorXd influence(n_samples);
+  for (int k = 0; k < scores.cols(); ++k) {
+    influence.noalias() = scores * b->formal.col(k);
+    const AutocorrelationTime a = IntegratedAutocorrelationTime(influence);
     (*tau)[k] = a.tau;
     b->tau = std::max(b->tau, a.tau);
     b->correlation_reliable = b->correlation_reliable && a.reliable;
@@ -108,14 +111,23 @@ void ChooseBandwidth(const Eigen::MatrixXd& influence, UncertaintyBudget* b,
   b->bandwidth = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(n_samples)));
 }
 
+// BatchCorrection from the inputs' stored Jacobians, or their replay.
+Eigen::VectorXd CorrectionOf(const BudgetInputs& in, const Eigen::MatrixXd& formal, int bandwidth) {
+  if (in.jacobians.rows() > 0 || !in.jacobian_replay) {
+    return BatchCorrection(in.jacobians, in.rows_per_sample, formal, bandwidth);
+  }
+  return BatchCorrection(in.jacobian_replay, static_cast<int>(in.scores.rows()),
+                         in.rows_per_sample, formal, bandwidth);
+}
+
 // The batch correction at the chosen bandwidth, halving it while the correction says the
 // fit absorbed most of a batch (then the widening is a lower bound).
 Eigen::VectorXd CorrectionWithinLimit(const BudgetInputs& in, UncertaintyBudget* b) {
-  Eigen::VectorXd c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, b->bandwidth);
+  Eigen::VectorXd c = CorrectionOf(in, b->formal, b->bandwidth);
   while (b->bandwidth > 1 && !(c.maxCoeff() <= kMaxBatchCorrection)) {
     b->bandwidth = std::max(1, b->bandwidth / 2);
     b->correlation_reliable = false;
-    c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, b->bandwidth);
+    c = CorrectionOf(in, b->formal, b->bandwidth);
   }
   b->max_batch_correction = c.size() > 0 ? c.maxCoeff() : 1.0;
   return c.cwiseMax(1.0);
@@ -150,7 +162,7 @@ Eigen::MatrixXd DataCovariance(const BudgetInputs& in, UncertaintyBudget* b) {
   b->widest_bandwidth = b->bandwidth;
   const int cap = static_cast<int>(kMaxBandwidthFraction * b->samples);
   for (int l = 2 * b->bandwidth; l <= cap; l *= 2) {
-    const Eigen::VectorXd c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, l);
+    const Eigen::VectorXd c = CorrectionOf(in, b->formal, l);
     if (!(c.maxCoeff() <= kMaxBatchCorrection)) break;
     const Eigen::MatrixXd p = DataCovarianceAt(in, b->formal, c, l);
     const double noise = std::sqrt(4.0 * l / (3.0 * b->samples));
@@ -252,35 +264,50 @@ Eigen::MatrixXd LongRunCovarianceOfSum(const Eigen::MatrixXd& scores, int bandwi
 
 Eigen::VectorXd BatchCorrection(const SampleJacobians& jacobians, int rows_per_sample,
                                 const Eigen::MatrixXd& inverse_information, int bandwidth) {
-  const int n = static_cast<int>(inverse_information.rows());
   const int n_samples = static_cast<int>(jacobians.rows());
+  const int n = static_cast<int>(inverse_information.rows());
   if (n_samples == 0 || rows_per_sample < 1 || jacobians.cols() != rows_per_sample * n) {
     return Eigen::VectorXd::Ones(n);
   }
-  const int l = std::clamp(bandwidth, 1, n_samples);
-  const int batches = n_samples - l + 1;
+  const SampleJacobianReplay replay = [&](const std::function<void(int, const float*)>& visit) {
+    for (int t = 0; t < n_samples; ++t) visit(t, jacobians.row(t).data());
+    return true;
+  };
+  return BatchCorrection(replay, n_samples, rows_per_sample, inverse_information, bandwidth);
+}
+
+Eigen::VectorXd BatchCorrection(const SampleJacobianReplay& replay, int samples,
+                                int rows_per_sample, const Eigen::MatrixXd& inverse_information,
+                                int bandwidth) {
+  const int n = static_cast<int>(inverse_information.rows());
+  if (samples == 0 || rows_per_sample < 1 || !replay) return Eigen::VectorXd::Ones(n);
+  const int l = std::clamp(bandwidth, 1, samples);
   const int stride = std::max(1, l / 16);
-  // Per sample J_t^T J_t, added to and removed from the running window sum.
+  const int width = rows_per_sample * n;
+  // Per sample J_t^T J_t, added to and removed from the running window sum; the rows of
+  // the last l samples in a ring (the one leaving the window is l behind).
   using Rows = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  std::vector<float> ring(static_cast<size_t>(l) * width);
   // Without allocation per sample (10^6 of them).
   Eigen::MatrixXd j(rows_per_sample, n);
   Eigen::MatrixXd window = Eigen::MatrixXd::Zero(n, n);
-  auto add = [&](int t, double sign) {
-    j = Eigen::Map<const Rows>(jacobians.row(t).data(), rows_per_sample, n).cast<double>();
+  auto add = [&](const float* rows, double sign) {
+    j = Eigen::Map<const Rows>(rows, rows_per_sample, n).cast<double>();
     window.noalias() += sign * (j.transpose() * j);
   };
-  for (int t = 0; t < l; ++t) add(t, 1.0);
   Eigen::VectorXd kept = Eigen::VectorXd::Zero(n), all = Eigen::VectorXd::Zero(n);
-  for (int b = 0; b < batches; ++b) {
-    if (b > 0) {
-      add(b + l - 1, 1.0);
-      add(b - 1, -1.0);
-    }
-    if (b % stride != 0) continue;
+  const bool ok = replay([&](int t, const float* rows) {
+    float* slot = ring.data() + static_cast<size_t>(t % l) * width;
+    add(rows, 1.0);
+    if (t >= l) add(slot, -1.0);  // sample t - l leaves the window
+    std::copy(rows, rows + width, slot);
+    const int b = t - l + 1;  // the window [b, t] is complete
+    if (b < 0 || b % stride != 0) return;
     const Eigen::MatrixXd absorbed = window * inverse_information * window;
     all += window.diagonal();
     kept += window.diagonal() - absorbed.diagonal();
-  }
+  });
+  if (!ok) return Eigen::VectorXd::Ones(n);
   Eigen::VectorXd c(n);
   for (int k = 0; k < n; ++k) {
     c[k] = kept[k] > 0.0 ? all[k] / kept[k] : std::numeric_limits<double>::infinity();
@@ -310,7 +337,7 @@ bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
   Eigen::MatrixXd data = b->formal;
   b->correlation_measured =
       b->samples >= kMinSamplesForCorrelation && in.scores.cols() == n && dof > 0;
-  if (b->correlation_measured) ChooseBandwidth(in.scores * b->formal, b, &tau);
+  if (b->correlation_measured) ChooseBandwidth(in.scores, b, &tau);
   if (b->correlated) data = DataCovariance(in, b);
   b->effective_samples = b->samples / b->tau;
   b->statistical = StatisticalCovariance(MisfitFloor(in, b->formal, b->misfit_factor), data);
