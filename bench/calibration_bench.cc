@@ -281,13 +281,14 @@ void BM_SampleRows(benchmark::State& state) {
   const int count = static_cast<int>(data.samples.size());
   std::vector<int> fit(count);
   std::vector<std::array<double, kNumCables>> sigma(count);
-  std::vector<internal::CompactStart> starts(count);
+  internal::CompactStarts starts(StaticsMethod::kExact);
+  starts.Reset(count);
   const StaticsOptions statics = ModelFitStaticsOptions(StaticsMethod::kExact);
   for (int t = 0; t < count; ++t) {
     fit[t] = t;
     StaticsSolution s;
     SolveStatics(model, data.samples[t].pose, statics, &s);
-    starts[t] = internal::CompactStart::Of(s);
+    starts.Set(t, s);
     sigma[t] = internal::TensionSigmas(data.samples[t].tension_n, 0.0, 3.0);
   }
   internal::FittedSamples samples;

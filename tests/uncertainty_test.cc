@@ -170,7 +170,7 @@ BudgetInputs LinearBudgetInputs(const LinearFit& f) {
   BudgetInputs in;
   in.information = f.j.transpose() * f.j;
   in.prior_information = Eigen::VectorXd::Zero(f.j.cols());
-  in.scores = f.j.array().colwise() * f.residuals.array();
+  in.scores = (f.j.array().colwise() * f.residuals.array()).matrix().cast<float>();
   in.jacobians = f.j.cast<float>();
   in.rows_per_sample = 1;
   in.num_residuals = static_cast<int>(f.j.rows());

@@ -72,7 +72,7 @@ struct Prediction {
   std::vector<std::array<double, kNumCables>> reading_n;  // gain T + bias
   std::vector<std::array<double, kNumCables>> sigma_n;    // whitening sigma from the reading
   std::vector<std::array<double, kNumCables>> whitened;   // (reading - measured) / sigma
-  std::vector<internal::CompactStart> starts;             // the statics there (warm starts)
+  internal::CompactStarts starts;                          // the statics there (warm starts)
 };
 
 struct Run {
@@ -319,12 +319,16 @@ CalibrationStatus Predict(Run& run) {
   at.sigma_n.resize(num_samples);
   at.whitened.resize(num_samples);
   // Each sample starts from its statics at the previous parameters, when there are any.
-  at.starts.resize(num_samples);
+  if (at.starts.method() != run.statics.method ||
+      at.starts.size() != static_cast<size_t>(num_samples)) {
+    at.starts = internal::CompactStarts(run.statics.method);
+    at.starts.Reset(num_samples);
+  }
   StaticsOptions options = run.statics;
   options.warm_start = true;
   const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& sample = run.data.samples[t];
-    at.starts[t].Restore(run.PoseOf(sample), options.method, solution);
+    at.starts.At(t).Restore(run.PoseOf(sample), options.method, solution);
     return SolveStaticsWithParameters(session_params[sample.session], run.PoseOf(sample), options,
                                       solution);
   };
@@ -334,7 +338,7 @@ CalibrationStatus Predict(Run& run) {
         for (int t = begin; t < end; ++t) {
           const Sample& sample = run.data.samples[t];
           if (solve(t, &solution) != StaticsStatus::kOk) return t;
-          at.starts[t] = internal::CompactStart::Of(solution);
+          at.starts.Set(t, solution);
           const std::array<double, kNumCables>& gain = session_gain[sample.session];
           const std::array<double, kNumCables>& bias = session_bias[sample.session];
           for (int i = 0; i < kNumCables; ++i) {
@@ -844,7 +848,7 @@ Eigen::VectorXd ScoreStatistics(const Run& run, const internal::Linearisation& l
   const Eigen::MatrixXd projection = information.ldlt().solve(lin.cross) / lin.candidate_scale;
   Eigen::MatrixXd projected = lin.candidate_scores;
   for (int k = 0; k < rows; ++k) {
-    projected.row(k) -= lin.scores.row(lin.candidate_rows[k]) * projection;
+    projected.row(k) -= lin.candidate_free_scores.row(k) * projection;
   }
   const UncertaintyBudget& b = run.result->budget;
   const double stride = static_cast<double>(run.fit.size()) / rows;
@@ -931,7 +935,9 @@ void RankMisfit(Run& run, const internal::Linearisation& lin,
   Eigen::MatrixXd same_samples = lin.candidate_information;
   same_samples.diagonal() += information.diagonal() - lin.information.diagonal();
   Eigen::VectorXd free_gradient = Eigen::VectorXd::Zero(run.n);
-  for (int row : lin.candidate_rows) free_gradient += lin.scores.row(row).transpose();
+  for (int k = 0; k < static_cast<int>(lin.candidate_rows.size()); ++k) {
+    free_gradient += lin.candidate_free_scores.row(k).transpose();
+  }
   free_gradient *= lin.candidate_scale;
   for (int k = 0; k < run.n; ++k) {
     const ParameterSpec& p = run.Free(k);

@@ -149,8 +149,8 @@ int EvaluateFree(const LinearisationInputs& in, const ModelAtTheta& at, int begi
 }
 
 // The whitened rows of fitted samples [begin, end) into `sums`.
-void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisation* out,
-                    FreeChunk* chunk) {
+void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candidate_row,
+                    int begin, int end, Linearisation* out, FreeChunk* chunk) {
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   FreeSums* sums = &chunk->sums;
@@ -165,7 +165,9 @@ void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
     const RowMatrix jw = weight * j;
     const Eigen::VectorXd rw = weight * r;
     out->residuals.row(t) = r.transpose();
-    out->scores.row(t) = rw.transpose() * jw;
+    const Eigen::RowVectorXd score = rw.transpose() * jw;
+    out->scores.row(t) = score.cast<float>();
+    if (candidate_row[t] >= 0) out->candidate_free_scores.row(candidate_row[t]) = score;
     if (in.keep_jacobians) {
       for (int i = 0; i < kNumCables; ++i) {
         out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
@@ -285,11 +287,16 @@ std::string CannotSolve(const LinearisationInputs& in, int fitted_sample) {
   return SampleWhere(data, s) + ": the calibrated model cannot solve this pose";
 }
 
+// The free pass; out->candidate_rows must be set (their scores are kept in double).
 bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::string* error) {
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   const int blocks = std::clamp(in.cross_validation_blocks, 1, std::max(1, num_fit));
-  out->scores = Eigen::MatrixXd::Zero(num_fit, n);
+  out->scores = SampleScores::Zero(num_fit, n);
+  std::vector<int> candidate_row(num_fit, -1);  // each fitted sample's candidate row, or -1
+  for (size_t k = 0; k < out->candidate_rows.size(); ++k) candidate_row[out->candidate_rows[k]] = k;
+  out->candidate_free_scores =
+      Eigen::MatrixXd::Zero(static_cast<int>(out->candidate_rows.size()), n);
   out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
   if (in.keep_jacobians) out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
   const int sessions = static_cast<int>(in.samples.data->session_labels.size());
@@ -306,7 +313,7 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
         whitener.Whiten(&chunk->rows);
       },
       [&](int begin, int end, FreeChunk* chunk) {
-        AccumulateFree(in, begin, end, out, chunk);
+        AccumulateFree(in, candidate_row, begin, end, out, chunk);
         return -1;
       },
       [&](FreeChunk& chunk) { total.Add(chunk.sums); });
@@ -350,12 +357,7 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   for (const ParameterSpec& p : in.candidates) {
     pass.candidate_columns.push_back(BasisColumns(p, model));
   }
-  // With a slow error the whitening needs neighbours: contiguous runs (each a series of
-  // its own) rather than single samples spread out.
-  const std::vector<int> samples =
-      in.samples.whitened()
-          ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
-          : CandidateSamples(in.samples.size(), in.max_candidate_samples);
+  const std::vector<int>& samples = out->candidate_rows;
   const auto zero = [&] {
     return CandidateSums{Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q),
                          Eigen::VectorXd::Zero(q), Eigen::MatrixXd::Zero(n, n)};
@@ -390,7 +392,6 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   out->self = scale * total.self;
   out->gradient = scale * total.gradient;
   out->candidate_samples = static_cast<int>(samples.size());
-  out->candidate_rows = samples;
   out->candidate_information = scale * total.information;
   out->candidate_scale = scale;
   return true;
@@ -419,6 +420,11 @@ std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model) {
 
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error) {
   *out = Linearisation();
+  // The candidate pass's samples. With a slow error the whitening needs neighbours:
+  // contiguous runs (each a series of its own) rather than single samples spread out.
+  out->candidate_rows = in.samples.whitened()
+                            ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
+                            : CandidateSamples(in.samples.size(), in.max_candidate_samples);
   return LineariseFree(in, out, error) && LineariseCandidates(in, out, error);
 }
 

@@ -160,7 +160,7 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
   f.measured_n = sample.tension_n;
   f.sigma_n = (*sigma_n)[j];
   f.statics = statics;
-  if (starts != nullptr && !starts->empty()) f.start = (*starts)[t];
+  if (starts != nullptr && !starts->empty()) f.start = starts->At(t);
   if (excluded != nullptr && !excluded->empty()) f.excluded = (*excluded)[t];
   f.session = sample.session;
   return f;
@@ -238,7 +238,7 @@ namespace {
 // What the rows of one sample need besides the model.
 struct SampleView {
   Pose pose;
-  const CompactStart* start;
+  CompactStart start;
   const std::array<double, kNumCables>& measured_n;
   const std::array<double, kNumCables>& sigma_n;
   const std::array<bool, kNumCables>* excluded;  // null: none
@@ -253,11 +253,7 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
                  double* jacobian) {
   if (!m.gains_positive) return false;  // as operator()
   StaticsSolution solution;
-  if (x.start != nullptr) {
-    x.start->Restore(x.pose, statics.method, &solution);
-  } else {
-    CompactStart().Restore(x.pose, statics.method, &solution);
-  }
+  x.start.Restore(x.pose, statics.method, &solution);
   StaticsOptions options = statics;
   options.warm_start = true;
   if (SolveStaticsWithParameters(m.statics, x.pose, options, &solution) != StaticsStatus::kOk) {
@@ -294,7 +290,7 @@ bool TensionResidual::Evaluate(const double* theta, double* residuals, double* j
   ModelAtTheta::Session m;
   model->Assemble(theta, &m.statics, &m.gain, &m.bias, session);
   m.gains_positive = std::all_of(m.gain.begin(), m.gain.end(), [](double g) { return g > 0.0; });
-  return RowsThrough(*model, m, statics, {pose, &start, measured_n, sigma_n, &excluded, session},
+  return RowsThrough(*model, m, statics, {pose, start, measured_n, sigma_n, &excluded, session},
                      residuals, jacobian);
 }
 
@@ -305,7 +301,7 @@ bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, doubl
   const int t = (*fit)[j];
   const Sample& sample = data->samples[t];
   SampleView x{sample.pose,
-               starts != nullptr && !starts->empty() ? &(*starts)[t] : nullptr,
+               starts != nullptr && !starts->empty() ? starts->At(t) : CompactStart(),
                sample.tension_n,
                (*sigma_n)[j],
                excluded != nullptr && !excluded->empty() ? &(*excluded)[t] : nullptr,

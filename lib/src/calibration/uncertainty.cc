@@ -31,6 +31,36 @@ double Median(std::vector<double>* v) {
   return 0.5 * (*mid + *std::max_element(v->begin(), mid));
 }
 
+// Omega_hat (LongRunCovarianceOfSum) of double or float scores, its sums in double.
+template <typename Scores>
+Eigen::MatrixXd LongRunCovarianceOf(const Scores& scores, int bandwidth) {
+  const int n_samples = static_cast<int>(scores.rows());
+  const int n = static_cast<int>(scores.cols());
+  if (n_samples < 1) return Eigen::MatrixXd::Zero(n, n);
+  const int l = std::clamp(bandwidth, 1, n_samples);
+  const int batches = n_samples - l + 1;
+  // The window sums in blocks of rows: memory independent of the number of samples.
+  constexpr int kBlock = 4096;
+  Eigen::MatrixXd windows(std::min(kBlock, batches), n);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n, n);
+  // The window's sum in double, whatever the scores' type.
+  Eigen::RowVectorXd window = scores.topRows(l).template cast<double>().colwise().sum();
+  for (int first = 0; first < batches; first += kBlock) {
+    const int rows = std::min(kBlock, batches - first);
+    for (int k = 0; k < rows; ++k) {
+      const int j = first + k;
+      if (j > 0) {
+        window += scores.row(j + l - 1).template cast<double>() -
+                  scores.row(j - 1).template cast<double>();
+      }
+      windows.row(k) = window;
+    }
+    sum.selfadjointView<Eigen::Lower>().rankUpdate(windows.topRows(rows).transpose());
+  }
+  sum = sum.selfadjointView<Eigen::Lower>();
+  return static_cast<double>(n_samples) / (static_cast<double>(batches) * l) * sum;
+}
+
 // Autocovariances c_0 .. c_{max_lag} of a mean-subtracted series, by FFT of the series
 // zero-padded to at least twice its length (so the circular correlation is the linear one).
 std::vector<double> Autocovariance(const Eigen::VectorXd& x, int max_lag) {
@@ -93,13 +123,18 @@ Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& floor, const Eigen:
 // Sets b->correlated when some tau is above 1 by more than kTauSignificance standard
 // deviations of tau for a white series, sqrt((4 W + 2) / N) with W the window (Madras
 // and Sokal 1988). One series at a time: N doubles, not N x n.
-void ChooseBandwidth(const Eigen::MatrixXd& scores, UncertaintyBudget* b,
-                     std::vector<double>* tau) {
+void ChooseBandwidth(const SampleScores& scores, UncertaintyBudget* b, std::vector<double>* tau) {
   const int n_samples = static_cast<int>(scores.rows());
+  const int n = static_cast<int>(scores.cols());
   b->tau = 1.0;
   Eigen::VectorXd influence(n_samples);
-  for (int k = 0; k < scores.cols(); ++k) {
-    influence.noalias() = scores * b->formal.col(k);
+  for (int k = 0; k < n; ++k) {
+    const Eigen::VectorXd p = b->formal.col(k);
+    for (int t = 0; t < n_samples; ++t) {
+      double u = 0.0;  // in double, from the float scores
+      for (int c = 0; c < n; ++c) u += static_cast<double>(scores(t, c)) * p[c];
+      influence[t] = u;
+    }
     const AutocorrelationTime a = IntegratedAutocorrelationTime(influence);
     (*tau)[k] = a.tau;
     b->tau = std::max(b->tau, a.tau);
@@ -116,8 +151,8 @@ Eigen::VectorXd CorrectionOf(const BudgetInputs& in, const Eigen::MatrixXd& form
   if (in.jacobians.rows() > 0 || !in.jacobian_replay) {
     return BatchCorrection(in.jacobians, in.rows_per_sample, formal, bandwidth);
   }
-  return BatchCorrection(in.jacobian_replay, static_cast<int>(in.scores.rows()),
-                         in.rows_per_sample, formal, bandwidth);
+  return BatchCorrection(in.jacobian_replay, static_cast<int>(in.scores.rows()), in.rows_per_sample,
+                         formal, bandwidth);
 }
 
 // The batch correction at the chosen bandwidth, halving it while the correction says the
@@ -138,7 +173,7 @@ Eigen::MatrixXd DataCovarianceAt(const BudgetInputs& in, const Eigen::MatrixXd& 
                                  const Eigen::VectorXd& correction, int bandwidth) {
   const Eigen::VectorXd root_c = correction.cwiseMax(1.0).cwiseSqrt();
   Eigen::MatrixXd meat =
-      root_c.asDiagonal() * LongRunCovarianceOfSum(in.scores, bandwidth) * root_c.asDiagonal();
+      root_c.asDiagonal() * LongRunCovarianceOf(in.scores, bandwidth) * root_c.asDiagonal();
   meat.diagonal() += in.prior_information;
   return formal * meat * formal;
 }
@@ -239,27 +274,7 @@ AutocorrelationTime IntegratedAutocorrelationTime(const Eigen::Ref<const Eigen::
 }
 
 Eigen::MatrixXd LongRunCovarianceOfSum(const Eigen::MatrixXd& scores, int bandwidth) {
-  const int n_samples = static_cast<int>(scores.rows());
-  const int n = static_cast<int>(scores.cols());
-  if (n_samples < 1) return Eigen::MatrixXd::Zero(n, n);
-  const int l = std::clamp(bandwidth, 1, n_samples);
-  const int batches = n_samples - l + 1;
-  // The window sums in blocks of rows: memory independent of the number of samples.
-  constexpr int kBlock = 4096;
-  Eigen::MatrixXd windows(std::min(kBlock, batches), n);
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n, n);
-  Eigen::RowVectorXd window = scores.topRows(l).colwise().sum();
-  for (int first = 0; first < batches; first += kBlock) {
-    const int rows = std::min(kBlock, batches - first);
-    for (int k = 0; k < rows; ++k) {
-      const int j = first + k;
-      if (j > 0) window += scores.row(j + l - 1) - scores.row(j - 1);
-      windows.row(k) = window;
-    }
-    sum.selfadjointView<Eigen::Lower>().rankUpdate(windows.topRows(rows).transpose());
-  }
-  sum = sum.selfadjointView<Eigen::Lower>();
-  return static_cast<double>(n_samples) / (static_cast<double>(batches) * l) * sum;
+  return LongRunCovarianceOf(scores, bandwidth);
 }
 
 Eigen::VectorXd BatchCorrection(const SampleJacobians& jacobians, int rows_per_sample,
@@ -327,7 +342,7 @@ bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
     // An M-estimator's covariance for white residuals: the sandwich
     // H^-1 (sum_t psi_t psi_t^T + Lambda) H^-1 (the scores are psi, M is H); it carries
     // the residuals' scale itself, so no misfit factor on top.
-    Eigen::MatrixXd meat = LongRunCovarianceOfSum(in.scores, 1);
+    Eigen::MatrixXd meat = LongRunCovarianceOf(in.scores, 1);
     meat.diagonal() += in.prior_information;
     b->formal = b->formal * meat * b->formal;
   } else if (std::isfinite(b->reduced_chi_square) && b->reduced_chi_square > in.misfit_threshold) {

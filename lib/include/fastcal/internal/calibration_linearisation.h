@@ -83,7 +83,7 @@ struct Linearisation {
   // which the M-estimator's sandwich needs. 0 without a loss.
   Eigen::MatrixXd loss_curvature;
   Eigen::MatrixXd r_factor;     // upper triangular R, R^T R = J_x^T J_x
-  Eigen::MatrixXd scores;       // s_t, one row per fitted sample
+  SampleScores scores;          // s_t, one row per fitted sample (float: uncertainty.h)
   // J_t (6 x n, row after row), one row per fitted sample: with keep_jacobians only.
   SampleJacobians jacobians;
   Eigen::MatrixXd residuals;    // r_t (fitted samples x 6); 0 where excluded
@@ -106,10 +106,12 @@ struct Linearisation {
   // test's Schur complement is a small difference of large numbers for a candidate near
   // the free parameters' span, so its two terms must come from the same samples.
   Eigen::MatrixXd candidate_information;
-  // Per sample of the candidate pass (in time order): J_c,t^T r_t (unscaled), and the
-  // sample's row in `scores` (for the score test's long-run variance).
+  // Per sample of the candidate pass (in time order): J_c,t^T r_t (unscaled), the
+  // sample's row in `scores` and its score s_t in double (the score test projects the
+  // candidates' scores on these, a difference of nearly equal numbers).
   Eigen::MatrixXd candidate_scores;
   std::vector<int> candidate_rows;
+  Eigen::MatrixXd candidate_free_scores;
 };
 
 // The basis parameters, in order (all free, no initial: the model's values).

@@ -212,7 +212,7 @@ struct FittedSamples {
   // Per fitted sample: the whitening sigmas.
   const std::vector<std::array<double, kNumCables>>* sigma_n = nullptr;
   // Per dataset sample: warm starts (may be null or empty: cold starts).
-  const std::vector<CompactStart>* starts = nullptr;
+  const CompactStarts* starts = nullptr;
   // Per dataset sample: readings kept out of the fit (may be null or empty).
   const ReadingMask* excluded = nullptr;
   bool use_planned_attitude = false;
