@@ -1184,7 +1184,11 @@ CalibrationStatus Diagnose(Run& run) {
   for (int i = 0; i < kNumCables; ++i) {
     r.residual_tau[i] = IntegratedAutocorrelationTime(run.lin.residuals.col(i)).tau;
   }
-  run.lin = internal::Linearisation();  // the per-sample Jacobians: ~100 MB at 1e5 samples
+  // The linearisation's per-sample series and the last pass's weights are not needed
+  // beyond here: ~300 MB at 10^6 samples, freed before the RMS table's predictions.
+  run.lin = internal::Linearisation();
+  run.sigma_n = std::vector<std::array<double, kNumCables>>();
+  run.slow_rho = std::vector<std::array<double, kNumCables>>();
   return CalibrationStatus::kOk;
 }
 
