@@ -22,26 +22,32 @@
 #include <sstream>
 
 #include "cli_util.h"
+#include "columns_flag.h"
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/change_scan.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/evaluation_stream.h"
 #include "fastcal/file_digest.h"
+#include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/internal/report_document.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/sessions.h"
+#include "fastcal/trajectory.h"
 #include "fastcal/version.h"
 
 DECLARE_string(model);
 DECLARE_string(method);
 DECLARE_bool(force);
+DECLARE_string(columns);
+DECLARE_string(sessions_at);
 DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
 DEFINE_string(data, "",
               "Measurement CSV (docs/data-format.md); several, comma-separated, are one "
@@ -68,6 +74,7 @@ const char kCalibrateHelp[] =
 
 Usage:
   fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml] [--force]
+                    [--columns=MAP.yaml] [--sessions-at=TIME,...]
 
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
   --spec=FILE         which parameters are free, initial values, priors (a fixed
@@ -79,6 +86,18 @@ Usage:
                       qw,qx,qy,qz), T1_kN..T6_kN, optional planned_*_deg, s0_*_m and
                       session (docs/data-format.md). --data=a.csv,b.csv: several
                       surveys, one session each, labelled by file name ("a", "b")
+  --columns=MAP.yaml  read --data as exported, through a column map (format
+                      fastcal-columns-1): source column names, units (mm, rad, N, tf...),
+                      time stamps (unix_s, unix_ms, iso8601 with a zone), delimiter,
+                      decimal comma, header line, unit row, extra channels
+                      (docs/data-format.md, "Column maps"); an .xlsx: Python's
+                      fastcal.read_dataset, or xlsx2csv first
+  --sessions-at=TIME[,TIME...]  cut one survey into sessions s1, s2, ... at these times (a
+                      sample at or after a time goes to the next): each a number in the
+                      data's time_s or an ISO 8601 date and time (without a zone, the
+                      column map's, else UTC); --sessions-at=DIR/summary.json takes the
+                      changes a previous run's change scan found. With a spec that says
+                      sessions: {separate: [...]} (calibration_data/spec_sessions.yaml)
   --out=DIR           output directory; must not exist or be empty. Written only when the
                       calibration succeeded: nothing is left behind on failure.
   --force             let --out be a previous run's results (only the files listed under
@@ -156,6 +175,8 @@ Usage:
                  default the nominal FAST model
   --data=FILE    telemetry export (docs/data-format.md); several, comma-separated, are
                  read together (one session each)
+  --columns=MAP.yaml  read --data as exported, through a column map (docs/data-format.md,
+                 "Column maps")
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
   --force        let --out be a previous evaluate's results, replaced when complete
@@ -177,8 +198,10 @@ each sample is kept meanwhile in a temporary file in /tmp (about 200 bytes a sam
 
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
 // replace there.
-const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "report.html",
-                                                    "report.md", "summary.json", "residuals.csv"};
+// "A*B": any name from A to B (a joint fit of sessions writes one model per session).
+const std::vector<std::string> kCalibrateOutputs = {
+    "model_calibrated.yaml", "model_calibrated@*.yaml", "report.html", "report.md", "summary.json",
+    "residuals.csv"};
 const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
                                                    "residuals.csv"};
 
@@ -359,6 +382,25 @@ std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
   return s;
 }
 
+// The paper's published Table 6 under the RMS table when the data fly its measured circle
+// (PaperCircleMatcher: by the positions, whoever made the file); "" otherwise.
+std::string PaperTable6Lines(const PaperCircleMatcher& positions) {
+  if (!positions.Matches()) return "";
+  const char* labels[] = {"paper's Table 6: AAS", "paper's Table 6: actual attitudes",
+                          "paper's Table 6: + corrected mass centre"};
+  std::string s = "  the same circle on the telescope (the paper's published RMS, kN):\n";
+  for (size_t k = 0; k < internal::kPaperTable6.size(); ++k) {
+    s += CableRow(labels[k], internal::kPaperTable6[k].rms_kn, 1.0);
+  }
+  return s;
+}
+
+PaperCircleMatcher PositionsOf(const Dataset& data) {
+  PaperCircleMatcher matcher;
+  for (const Sample& sample : data.samples) matcher.Add(sample.pose.position_m);
+  return matcher;
+}
+
 // --data's files: split at ',' (one session each, sessions.h), unless the whole value names
 // an existing file.
 std::vector<std::string> DataPaths() {
@@ -400,7 +442,18 @@ bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   DatasetReadOptions read;
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   read.threads = kReadThreads;
-  return ReadSessionDatasets(paths, read, data, error);
+  if (!ColumnsFromFlag(&read.columns, error) || !ReadSessionDatasets(paths, read, data, error)) {
+    return false;
+  }
+  // --sessions-at: one survey cut into sessions at times.
+  std::vector<double> cuts;
+  if (!SessionCutsFromFlag(*data, &cuts, error)) return false;
+  if (cuts.empty()) return true;
+  if (!CutSessionsAt(cuts, data, error)) {
+    *error = "--sessions-at: " + *error;
+    return false;
+  }
+  return true;
 }
 
 // Lists the rows --skip-invalid-rows skipped (malformed, or a pose the model cannot solve)
@@ -496,7 +549,12 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
   }
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
             "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
-            report.data_digest + ")\nverdict: " + FitVerdictName(result.verdict) +
+            report.data_digest + ")" +
+            (report.columns_path.empty()
+                 ? ""
+                 : "\nread through the column map " + report.columns_path + " (sha256 " +
+                       report.columns_digest + ")") +
+            "\nverdict: " + FitVerdictName(result.verdict) +
             "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
             "budget):";
   for (const ParameterEstimate& p : result.parameters) {
@@ -528,10 +586,9 @@ std::string ChiSquareWarning(const CalibrationResult& result) {
   return "";
 }
 
-// "1.23 mm", "0.031 kg/m": a sigma in the parameter's unit, 2 significant digits, with
-// lengths shown in mm below 1 m.
+// "0.0012 m", "0.031 kg/m": a sigma in the parameter's unit (the one its name carries, as
+// its estimate beside it), 2 significant digits.
 std::string SigmaText(double sigma, const std::string& unit) {
-  if (unit == "m" && std::abs(sigma) < 1.0) return FormatDouble(sigma * 1e3, 2) + " mm";
   return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
 }
 
@@ -587,6 +644,18 @@ std::string EstimateFlags(const ParameterEstimate& p) {
   return flags;
 }
 
+// A row of the estimates table with its note: after it when the row stays within
+// kConsoleWidth, else on the next line, indented (a NOT SOUND note is 60 columns).
+std::string WithNote(std::string row, std::string note) {
+  while (!note.empty() && note.back() == ' ') note.pop_back();
+  if (note.empty()) return row;
+  if (row.size() + 2 + note.size() <= kConsoleWidth) return row + "  " + note;
+  while (!row.empty() && row.back() == ' ') row.pop_back();
+  std::string wrapped = Wrapped(note, "      ", "      ", kNoteLines);
+  wrapped.pop_back();  // the rows are joined with newlines by the caller
+  return row + "\n" + wrapped;
+}
+
 // The free estimates: value +- sigma_total, the formal sigma and the widening. A group of
 // more than three per-cable or per-point parameters (sensor_gain[1..6]) is one row: the
 // range of its estimates and of their sigma_total. At most kEstimateRows rows; the fixed
@@ -607,11 +676,11 @@ std::string EstimatesTable(const CalibrationResult& result) {
     const std::vector<const ParameterEstimate*>& g = groups[key];
     if (g.size() < kGroupedFrom) {
       for (const ParameterEstimate* p : g) {
-        std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", p->name.c_str(),
+        std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s", p->name.c_str(),
                       ValueWithSigma(p->estimate, p->sigma_total, p->unit).c_str(),
                       SigmaText(p->sigma, p->unit).c_str(),
-                      ("x" + FormatDouble(p->widening, 2)).c_str(), EstimateFlags(*p).c_str());
-        rows.push_back(buf);
+                      ("x" + FormatDouble(p->widening, 2)).c_str());
+        rows.push_back(WithNote(buf, EstimateFlags(*p)));
       }
       continue;
     }
@@ -639,12 +708,13 @@ std::string EstimatesTable(const CalibrationResult& result) {
     };
     const std::string label =
         key + "[" + index_of(g.front()->name) + ".." + index_of(g.back()->name) + "]";
+    // The unit after the sigmas, as on a single row ("0.19 +- 0.03 m"): it is both's.
     const std::string unit = g.front()->unit == "1" ? "" : " " + g.front()->unit;
-    const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + unit + " +- " +
-                              FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2);
-    std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", label.c_str(), range.c_str(),
-                  "", ("<= x" + FormatDouble(widest, 2)).c_str(), flags.c_str());
-    rows.push_back(buf);
+    const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + " +- " +
+                              FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2) + unit;
+    std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s", label.c_str(), range.c_str(), "",
+                  ("<= x" + FormatDouble(widest, 2)).c_str());
+    rows.push_back(WithNote(buf, flags));
   }
   std::ostringstream s;
   std::snprintf(buf, sizeof(buf), "  %-29s %-31s %9s %8s  %s\n", "free parameter",
@@ -741,15 +811,15 @@ std::string MisfitLine(const CalibrationResult& result) {
             FormatDouble(top.expected_decrease, 3) + ", from " + top.name + ")",
         "  ", "    ", kNoteLines);
   }
-  std::string line = "  the misfit is best explained by freeing:";
+  std::string line = "the misfit is best explained by freeing:";
   for (size_t k = 0; k < std::min(kShown, result.misfit_ranking.size()); ++k) {
     const MisfitCandidate& c = result.misfit_ranking[k];
     if (!c.significant) break;
     line += std::string(k ? ", " : " ") + c.name + " (about " +
             FormatDouble(c.expected_decrease, 3) + ")";
   }
-  return Wrapped(line + " [expected chi-square decrease; each beyond the residuals' own noise]", "",
-                 "    ", kNoteLines);
+  return Wrapped(line + " [expected chi-square decrease; each beyond the residuals' own noise]",
+                 "  ", "    ", kNoteLines);
 }
 
 std::string CrossValidationLine(const CalibrationResult& result) {
@@ -812,6 +882,37 @@ std::string TimingLines(double read_s, double fit_s, double write_s,
   return s.str();
 }
 
+// The verdict: its reason cut to a few lines (the report has it whole), then what the
+// sessions, the change scan and the sensor-step test found, each whole on its own lines: a
+// change found is the news of the run, never cut off behind the misfit's explanation.
+std::string VerdictLines(const CalibrationResult& result) {
+  constexpr size_t kFindingLines = 8;
+  std::string reason = result.verdict_text;
+  std::vector<std::string> findings;  // in the verdict's order: sessions, then the scan
+  auto split_off = [&reason, &findings](const std::string& label, const std::string& part) {
+    const std::string tail = "; " + part;
+    if (reason.size() <= tail.size() ||
+        reason.compare(reason.size() - tail.size(), tail.size(), tail) != 0) {
+      return;
+    }
+    reason.resize(reason.size() - tail.size());
+    findings.insert(findings.begin(), label + ": " + part);
+  };
+  // The verdict's parts in the reverse of their order (calibration_verdict.cc).
+  if (const std::string steps = SensorStepVerdict(result.sensor_steps); !steps.empty()) {
+    split_off("sensor steps", steps);
+  }
+  if (result.change_scan.enabled) split_off("change scan", ChangeScanVerdict(result.change_scan));
+  if (!result.session_differences.empty()) {
+    split_off("sessions", SessionVerdict(result.session_differences));
+  }
+  std::string out =
+      Wrapped(std::string("verdict: ") + FitVerdictName(result.verdict) + ": " + reason, "", "  ",
+              2 * kNoteLines);
+  for (const std::string& f : findings) out += Wrapped(f, "  ", "    ", kFindingLines);
+  return out;
+}
+
 std::string CalibrationConsole(const CalibrationResult& result, const Dataset& data,
                                const std::vector<VariantEvaluation>& variants) {
   std::ostringstream s;
@@ -823,11 +924,7 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
                 result.reduced_chi_square, band.half_width, result.num_residuals,
                 result.num_fit_samples,
                 static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
-  s << buf
-    << Wrapped(
-           std::string("verdict: ") + FitVerdictName(result.verdict) + ": " + result.verdict_text,
-           "", "  ", 2 * kNoteLines)
-    << "\n"
+  s << buf << VerdictLines(result) << "\n"
     << EstimatesTable(result) << ConsiderLines(result) << SessionLines(result);
   for (const std::string& note : result.notes) s << Wrapped(note, "  ", "    ", kNoteLines);
   for (const ParameterDirection& d : result.data_only.undetermined) {
@@ -844,8 +941,8 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
     s << Wrapped("strongly correlated: " + pairs, "  ", "    ", kNoteLines);
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
-    << RmsTable(variants) << CrossValidationLine(result) << "\nwrote " << FLAGS_out
-    << "/{model_calibrated.yaml, report.html, report.md, summary.json"
+    << RmsTable(variants) << CrossValidationLine(result) << PaperTable6Lines(PositionsOf(data))
+    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, report.html, report.md, summary.json"
     << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
 }
@@ -915,6 +1012,8 @@ ReportInputs ReportProvenance(int argc, char** argv, bool with_spec,
   report.model_path = FLAGS_model;
   report.data_path = FLAGS_data;
   report.model_digest = Digest(FLAGS_model);
+  report.columns_path = FLAGS_columns;
+  report.columns_digest = ColumnsDigest();
   report.data_digest = data_digest != nullptr ? *data_digest : DataDigest();
   if (with_spec) {
     report.spec_path = FLAGS_spec;
@@ -987,7 +1086,7 @@ int RunCalibrate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kCalibrateHelp,
                     {"model", "spec", "data", "out", "skip-invalid-rows", "quiet", "force",
-                     "residuals-every", "timings"},
+                     "residuals-every", "timings", "columns", "sessions-at"},
                     &exit_code)) {
     return exit_code;
   }
@@ -1012,6 +1111,13 @@ int RunCalibrate(int argc, char** argv) {
     return kExitUsage;
   }
   const double read_s = watch.Lap();
+  if (!FLAGS_sessions_at.empty() && spec.separate_groups.empty()) {
+    std::cerr << "fastcal calibrate: note: --sessions-at cut the survey into "
+              << data.session_labels.size()
+              << " sessions, but the spec separates no parameter per session (sessions: "
+                 "{separate: [mass_centre_m]}, as calibration_data/spec_sessions.yaml): they "
+                 "are fitted as one\n";
+  }
   const CableRobot initial = InitialCalibrationModel(model, spec);
   const std::vector<StaticsMethod> methods = {StaticsMethod::kExact, spec.forward_model};
   if (FLAGS_skip_invalid_rows) {
@@ -1082,13 +1188,13 @@ std::string EvaluationGrossErrorLines(const EvaluationScreen& screen) {
 // error (kN) per cable, then the gross errors.
 std::string EvaluationConsole(const Dataset& data, long long samples, StaticsMethod method,
                               const std::vector<VariantEvaluation>& variants,
-                              const EvaluationScreen& screen) {
+                              const EvaluationScreen& screen, const PaperCircleMatcher& positions) {
   std::ostringstream s;
   s << "fastcal evaluate: " << samples << " samples";
   s << SkippedNote(data);
   s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
     << StaticsMethodName(method) << "\n\n"
-    << RmsTable(variants);
+    << RmsTable(variants) << PaperTable6Lines(positions);
   for (const VariantEvaluation& v : variants) {
     s << "\n" << CableHeader(v.name + ":");
     s << CableRow("  RMS (%)", v.fit.rms_percent, 1.0);
@@ -1152,6 +1258,10 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
   options.method = method;
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   options.read.threads = kReadThreads;
+  if (!ColumnsFromFlag(&options.read.columns, &error)) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
   StreamedEvaluation evaluation;
   const EvaluationStreamStatus status = evaluation.Run(model, paths, options, &error);
   if (status == EvaluationStreamStatus::kInvalidInput) {
@@ -1185,8 +1295,14 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
     };
     if (!WriteOutDirectory(command, {}, report, kEvaluateOutputs, residuals)) return kExitUsage;
   }
+  PaperCircleMatcher positions;
+  if (!evaluation.ForEach([&positions](const EvaluatedSample& s) { positions.Add(s.position_m); },
+                          &error)) {
+    PrintError(command, error);
+    return kExitFailure;
+  }
   std::cout << EvaluationConsole(data, evaluation.samples(), method, evaluation.variants(),
-                                 evaluation.screen());
+                                 evaluation.screen(), positions);
   return 0;
 }
 
@@ -1195,7 +1311,8 @@ int RunEvaluate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(
           argc, argv, command, kEvaluateHelp,
-          {"model", "data", "out", "method", "skip-invalid-rows", "force", "residuals-every"},
+          {"model", "data", "out", "method", "skip-invalid-rows", "force", "residuals-every",
+           "columns"},
           &exit_code)) {
     return exit_code;
   }

@@ -6,6 +6,7 @@
 #include <iostream>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "cli_util.h"
 #include "commands.h"
@@ -30,6 +31,8 @@ Commands:
              HTML map of the focal-sphere cap
   design     the calibration survey that determines the wanted parameters best: poses,
              samples per pose and flight order, with predicted sigma_total
+  import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
+             comma), read through a column map, written as the canonical dataset CSV
 
 Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
 )";
@@ -58,12 +61,17 @@ int main(int argc, char** argv) {
     if (command == "simulate") return RunSimulate(argc, argv);
     if (command == "workspace") return RunWorkspace(argc, argv);
     if (command == "design") return RunDesign(argc, argv);
+    if (command == "import") return RunImport(argc, argv);
   } catch (const std::bad_alloc&) {
     // Outputs are written last and atomically: nothing is left behind.
     std::cerr << "fastcal " << command
               << ": out of memory: the input or the flags ask for more than this machine has\n";
     return kExitFailure;
   }
-  std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command) << "\n\n" << kUsage;
+  const std::vector<std::string> closest =
+      ClosestNames(command, {"solve", "calibrate", "evaluate", "simulate", "workspace", "design"});
+  std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command)
+            << (closest.empty() ? "" : "; did you mean " + closest.front() + "?") << "\n\n"
+            << kUsage;
   return kExitUsage;
 }

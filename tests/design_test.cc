@@ -7,8 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <random>
+#include <regex>
+#include <string>
+#include <vector>
 
 #include "fastcal/calibration.h"
 #include "fastcal/calibration_spec.h"
@@ -127,6 +131,8 @@ TEST(Design, MatchesBruteForceOnASmallCandidateSet) {
     DesignOptions o = SmallGrid();
     o.samples = 6;  // C(9 + 6 - 1, 6) = 3003 designs
     o.criterion = criterion;
+    // The nine nominal positions: two of them do not hold over the default plausible range.
+    o.range_prior_sigmas = o.range_mass_centre_m = 0.0;
     Design d;
     std::string error;
     ASSERT_TRUE(DesignSurvey(robot, spec, o, &d, &error)) << error;
@@ -272,6 +278,46 @@ TEST(Design, BadInput) {
   EXPECT_NE(error.find("needs speed_m_per_s"), std::string::npos) << error;
 }
 
+// The outputs speak in each parameter's spec unit: a sensor bias's sigma in kN (its
+// name's), bounded by its 2 kN prior, not in N; the page numbers the stops in flight
+// order from a marked start, in the report's style; each stage says it started.
+TEST(Design, OutputsAreInTheSpecsUnitsAndThePageShowsTheOrder) {
+  const CableRobot robot = CableRobot::NominalFast();
+  DesignOptions o = SmallGrid();
+  o.samples = 20;
+  std::vector<std::string> stages;
+  o.progress = [&stages](const std::string& stage) { stages.push_back(stage); };
+  Design d;
+  std::string error;
+  ASSERT_TRUE(DesignSurvey(robot, Spec(), o, &d, &error)) << error;
+  EXPECT_GE(stages.size(), 5u);
+  EXPECT_NE(stages.front().find("candidate poses"), std::string::npos) << stages.front();
+  const int bias = 4;  // mass_centre_m.x, .y, .z, sensor_gain, sensor_bias_kN
+  ASSERT_EQ(d.free_names[bias], "sensor_bias_kN");
+  const double sigma_n = d.design.budget.parameters[bias].total;  // SI inside
+  ASSERT_GT(sigma_n, 1.0);
+  ASSERT_LE(sigma_n, 2e3);
+  const std::string json = DesignJson(d, "test");
+  std::smatch top;  // the top-level parameters[]: name, unit, sigma_total
+  ASSERT_TRUE(std::regex_search(json, top,
+                                std::regex("\"name\": \"sensor_bias_kN\",\\s*\"unit\": \"kN\",\\s*"
+                                           "\"sigma_total\": ([0-9.e+-]+)")))
+      << json.substr(0, 3000);
+  EXPECT_NEAR(std::stod(top[1]), sigma_n / 1e3, 1e-9 * sigma_n);
+  EXPECT_NE(json.find("\"unit\": \"m\""), std::string::npos);
+  const std::string html = DesignHtml(d, robot, "test");
+  EXPECT_NE(html.find("<circle class=\"start\""), std::string::npos);
+  EXPECT_NE(html.find(">start</text>"), std::string::npos);
+  int numbered = 0;
+  for (size_t k = html.find("class=\"stop-number\""); k != std::string::npos;
+       k = html.find("class=\"stop-number\"", k + 1)) {
+    ++numbered;
+  }
+  EXPECT_GE(numbered, 2);
+  EXPECT_NE(html.find(">1</text>"), std::string::npos);
+  EXPECT_NE(html.find(".banner-good"), std::string::npos);  // the report's style sheet
+}
+
 TEST(Design, TimeBudgetIsKept) {
   const CableRobot robot = CableRobot::NominalFast();
   DesignOptions o = TiltedCap();
@@ -287,6 +333,93 @@ TEST(Design, TimeBudgetIsKept) {
   EXPECT_LT(d.stops.size(), free_time.stops.size());
   EXPECT_EQ(static_cast<int>(d.poses.size()), o.samples);
   EXPECT_GE(d.design.criterion, free_time.design.criterion);
+}
+
+// Issue 29, item 6: the tilted and turned design once chose poses where a cable nearly
+// slackens at the nominal point, and a mass centre 16 cm off with cables 1.5% lighter had
+// no equilibrium there. The spec of this test frees the mass centre (no prior: +-0.25 m
+// per axis) and the common density (prior +-0.18 kg/m: +-0.36 kg/m at 2 sigma): 16
+// corners, every one of which the test solves itself at every stop, with a plain model.
+constexpr char kRangeSpec[] = R"(
+parameters:
+  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}
+  linear_density_kg_per_m: {free: true, prior: {mean: 11.718, sigma: 0.18}}
+  sensor_gain: {free: true, prior: {mean: 1, sigma: 0.01}}
+)";
+
+// The smallest lower-end tension over the 16 corners at `pose` (N), or -1 where the
+// statics fail at one of them (reflector clearance as in `o`).
+double LowestOverTheCorners(const DesignOptions& o, const Pose& pose) {
+  constexpr double kMassCentreM = 0.25, kDensityKgPerM = 2 * 0.18;
+  double lowest = INFINITY;
+  for (int corner = 0; corner < 16; ++corner) {
+    CableRobot robot = CableRobot::NominalFast();
+    for (int axis = 0; axis < 3; ++axis) {
+      robot.mass_centre_cabin_m[axis] += (corner >> axis & 1 ? 1 : -1) * kMassCentreM;
+    }
+    for (CableProperties& c : robot.cables) {
+      c.linear_density_kg_per_m += (corner >> 3 & 1 ? 1 : -1) * kDensityKgPerM;
+    }
+    StaticsSolution s;
+    if (SolveStatics(robot, pose, o.workspace.statics, &s) != StaticsStatus::kOk) return -1.0;
+    for (const CableSolution& c : s.cables) lowest = std::min(lowest, c.lower_tension_n);
+  }
+  return lowest;
+}
+
+TEST(Design, EveryStopHoldsAtEveryCornerOfThePlausibleRange) {
+  const CableRobot robot = CableRobot::NominalFast();
+  const CalibrationSpec spec = Spec(kRangeSpec);
+  DesignOptions o = TiltedCap();
+  o.max_extra_yaw_deg = 10.0;
+  Design d;
+  std::string error;
+  ASSERT_TRUE(DesignSurvey(robot, spec, o, &d, &error)) << error;
+  ASSERT_EQ(d.range.size(), 4u);
+  EXPECT_EQ(d.range[3].name, "linear_density_kg_per_m");
+  EXPECT_NEAR(d.range[3].delta_si, 0.36, 1e-12);
+  EXPECT_TRUE(d.range[3].from_prior);
+  EXPECT_FALSE(d.range[0].from_prior);
+  EXPECT_GT(d.rejected_off_nominal, 0);
+  for (const DesignStop& stop : d.stops) {
+    const Pose& pose = d.candidates[stop.candidate].pose;
+    EXPECT_GE(LowestOverTheCorners(o, pose), o.workspace.min_tension_n)
+        << "stop at " << pose.position_m.transpose();
+    // What binds it, reported: a limit kept, at a corner of the range.
+    const DesignBinding& b = stop.binding;
+    ASSERT_FALSE(b.constraint.empty());
+    EXPECT_GE(b.constraint == "reflector_clearance" ? b.value : b.value - b.limit, 0.0);
+    EXPECT_EQ(b.corner_si.size(), d.range.size());
+  }
+  // Without the range (the nominal point only, as before issue 29) the design picks stops
+  // that do not hold there: the check above fails on them.
+  DesignOptions nominal_only = o;
+  nominal_only.range_prior_sigmas = nominal_only.range_mass_centre_m = 0.0;
+  Design before;
+  ASSERT_TRUE(DesignSurvey(robot, spec, nominal_only, &before, &error)) << error;
+  EXPECT_TRUE(before.range.empty());
+  int failing = 0;
+  for (const DesignStop& stop : before.stops) {
+    failing +=
+        LowestOverTheCorners(o, before.candidates[stop.candidate].pose) < o.workspace.min_tension_n;
+  }
+  EXPECT_GT(failing, 0);
+}
+
+TEST(Design, RangeOptionsAreChecked) {
+  DesignOptions o;
+  std::string error;
+  o.range_prior_sigmas = -1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("range_prior_sigmas"), std::string::npos) << error;
+  o = DesignOptions();
+  o.range_relative = 1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("range_relative"), std::string::npos) << error;
+  o = DesignOptions();
+  o.range_mass_centre_m = NAN;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("range_mass_centre_m"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -19,11 +19,13 @@ fastcal.CalibrationError (a RuntimeError).
 
 from __future__ import annotations
 
+import difflib
+import functools
 import json
 import os
 import re
 import warnings
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, TypeVar, Union
 
 try:
     import numpy as np
@@ -67,7 +69,43 @@ __all__ = [
     "solve",
 ]
 
+
+
+def __dir__() -> List[str]:
+    """What the package offers (__all__), not the modules it imports (np, os, re, json)."""
+    return sorted(__all__ + ["STATUS_NAMES"])
+
+
 ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
+_Function = TypeVar("_Function", bound=Callable[..., Any])
+
+
+def _renamed_keywords(renamed: Mapping[str, str]) -> Callable[[_Function], _Function]:
+    """Accepts each keyword's old name (a key of `renamed`) as its new one, with a
+    DeprecationWarning: the keywords now have the command line's names (docs/python.md,
+    "Names")."""
+
+    def wrap(function: _Function) -> _Function:
+        @functools.wraps(function)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            for old, new in renamed.items():
+                if old not in kwargs:
+                    continue
+                if new in kwargs:
+                    raise TypeError(f"{function.__name__}() got both {old}= and {new}=")
+                warnings.warn(
+                    f"{function.__name__}({old}=...) is deprecated: use {new}= (the command "
+                    f"line's --{new.replace('_', '-')})",
+                    DeprecationWarning,
+                    stacklevel=2,
+                )
+                kwargs[new] = kwargs.pop(old)
+            return function(*args, **kwargs)
+
+        return call  # type: ignore[return-value]
+
+    return wrap
+
 PathLike = Union[str, "os.PathLike[str]"]
 
 STATUS_NAMES: List[str] = _fastcal.statics_status_names()
@@ -98,6 +136,8 @@ def _attitude(
     kind, value, columns = ("rpy", rpy_deg, 3) if rpy_deg is not None else ("quat", quat, 4)
     name = "rpy_deg" if kind == "rpy" else "quat"
     array, _ = _rows(value, columns, name)
+    if array.shape[0] == 1 and n > 1:  # one attitude for every position, as numpy broadcasts
+        array = np.ascontiguousarray(np.repeat(array, n, axis=0))
     if array.shape[0] != n:
         raise InputError(f"{name} has {array.shape[0]} rows for {n} positions")
     return kind, array
@@ -108,6 +148,27 @@ def _point(value: ArrayLike, name: str) -> np.ndarray:
     if array.shape != (3,):
         raise InputError(f"{name} must have shape (3,), got {array.shape}")
     return array
+
+
+# The library's option fields behind keywords named as the command line's flags.
+_SOLVE_OPTION_FIELDS = {
+    "refined_tolerance": "refined_relative_tolerance",
+    "aas_max_error": "aas_max_relative_error",
+    "exact_tolerance": "exact_relative_tolerance",
+    "reflector_clearance_m": "min_reflector_clearance_m",
+}
+
+
+def _call_with_names(fields: Mapping[str, str], function: Callable[..., Any], *args: Any) -> Any:
+    """function(*args), an InputError's message naming the keywords instead of the
+    library's fields (keyword -> field in `fields`)."""
+    try:
+        return function(*args)
+    except InputError as error:
+        message = str(error)
+        for keyword, field in fields.items():
+            message = re.sub(rf"\b{re.escape(field)}\b", keyword, message)
+        raise InputError(message) from None
 
 
 class StaticsResult:
@@ -166,6 +227,14 @@ class StaticsResult:
         return f"<fastcal.StaticsResult: {n} pose{'s' if n != 1 else ''}, {failed} failed>"
 
 
+@_renamed_keywords(
+    {
+        "refined_relative_tolerance": "refined_tolerance",
+        "aas_max_relative_error": "aas_max_error",
+        "exact_relative_tolerance": "exact_tolerance",
+        "min_reflector_clearance_m": "reflector_clearance_m",
+    }
+)
 def solve(
     position_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,
@@ -175,39 +244,45 @@ def solve(
     *,
     warm_start: bool = False,
     max_refinement_steps: int = 8,
-    refined_relative_tolerance: float = 1e-6,
-    aas_max_relative_error: float = 1e-2,
-    exact_relative_tolerance: float = 1e-12,
+    refined_tolerance: float = 1e-6,
+    aas_max_error: float = 1e-2,
+    exact_tolerance: float = 1e-12,
     max_strain: float = 0.05,
     max_length_ratio: float = 1.5,
-    min_reflector_clearance_m: float = 0.0,
+    reflector_clearance_m: float = 0.0,
 ) -> StaticsResult:
     """Cable forces, tensions and unstretched lengths at one pose or many.
 
     Args:
         position_m: position of the cabin-frame origin, global frame: (3,) or (n, 3).
         rpy_deg: attitude as roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll):
-            (3,) or (n, 3). At most one of rpy_deg and quat; neither means R = I.
-        quat: attitude as unit quaternions (w, x, y, z): (4,) or (n, 4). E.g. the focal
-            law's, fastcal.focal_attitude(position_m).
+            (3,) or (n, 3); one (3,) attitude applies to every position. At most one of
+            rpy_deg and quat; neither means R = I.
+        quat: attitude as unit quaternions (w, x, y, z): (4,) or (n, 4), one for all as
+            rpy_deg. E.g. the focal law's, fastcal.focal_attitude(position_m).
         method: 'exact' (Newton on all unknowns; where its start fails it follows the
             equilibrium from the home pose), 'aas-refined' (the paper's AAS refined by
             Newton steps on its tangent until its error estimate is below
-            refined_relative_tolerance) or 'aas' (the paper's; 'inaccurate' when its
-            error estimate exceeds aas_max_relative_error).
+            refined_tolerance) or 'aas' (the paper's; 'inaccurate' when its error
+            estimate exceeds aas_max_error).
         model: the model; None for Model.nominal().
         warm_start: start each pose from the previous pose's solution (a trajectory);
             off, each pose is solved on its own and the order does not matter.
         max_refinement_steps: at most this many steps of 'aas-refined' (>= 1), then
             'not_converged'.
-        refined_relative_tolerance: where 'aas-refined' stops.
-        aas_max_relative_error: the largest error estimate 'aas' calls 'ok'.
-        exact_relative_tolerance: where 'exact' stops.
+        refined_tolerance: where 'aas-refined' stops (relative tension error).
+        aas_max_error: the largest relative error estimate 'aas' calls 'ok'.
+        exact_tolerance: where 'exact' stops (relative).
         max_strain: tensions above max_strain * EA are refused ('overstretched_cable').
         max_length_ratio: unstretched lengths above this times the chord are refused
             ('sagging_cable').
-        min_reflector_clearance_m: with a reflector in the model, a cable closer to its
+        reflector_clearance_m: with a reflector in the model, a cable closer to its
             surface than this is refused ('reflector_contact').
+
+    The keywords are the command line's flags (--aas-max-error: aas_max_error), with
+    the unit where the flag leaves it implicit (--reflector-clearance:
+    reflector_clearance_m). The former names (aas_max_relative_error, ...) still work,
+    with a DeprecationWarning.
 
     Returns:
         A StaticsResult: arrays with a leading axis of n for (n, 3) positions, none for
@@ -219,7 +294,9 @@ def solve(
     """
     positions, single = _rows(position_m, 3, "position_m")
     kind, attitude = _attitude(positions.shape[0], rpy_deg, quat)
-    raw = _fastcal.solve(
+    raw = _call_with_names(
+        _SOLVE_OPTION_FIELDS,
+        _fastcal.solve,
         model if model is not None else Model.nominal(),
         positions,
         kind,
@@ -228,12 +305,12 @@ def solve(
         {
             "warm_start": warm_start,
             "max_refinement_steps": max_refinement_steps,
-            "refined_relative_tolerance": refined_relative_tolerance,
-            "aas_max_relative_error": aas_max_relative_error,
-            "exact_relative_tolerance": exact_relative_tolerance,
+            "refined_relative_tolerance": refined_tolerance,
+            "aas_max_relative_error": aas_max_error,
+            "exact_relative_tolerance": exact_tolerance,
             "max_strain": max_strain,
             "max_length_ratio": max_length_ratio,
-            "min_reflector_clearance_m": min_reflector_clearance_m,
+            "min_reflector_clearance_m": reflector_clearance_m,
         },
     )
     return StaticsResult(raw, single)
@@ -334,24 +411,317 @@ def quat_from_rpy_deg(rpy_deg: ArrayLike) -> np.ndarray:
     return quat[0] if single else quat
 
 
-def read_dataset(
-    path: Union[PathLike, Sequence[PathLike]], skip_invalid_rows: bool = False
-) -> Dataset:
-    """Reads a telemetry CSV (docs/data-format.md), or several as one session each.
+_DICT_COLUMNS = "columns (dict)"
+_SPREADSHEET_SUFFIXES = (".xlsx", ".xlsm")
+ColumnsLike = Union[PathLike, Mapping[str, Any]]
 
-    With a list of paths, the files are merged, one session per file labelled by its
-    name without directory and extension (a file with a `session` column keeps its
-    labels); Dataset.session_labels and Dataset.session say which sample is whose.
-    With skip_invalid_rows, a row with a bad value is left out and listed in
-    Dataset.skipped instead of raising. Raises InputError naming the file, line and
-    column, e.g. "data.csv:12: column 'T3_kN': 'abc' is not a number", or two files
-    with the same label.
+
+def _columns_argument(columns: Optional[ColumnsLike]) -> Tuple[str, str]:
+    """A column map as (YAML text, name for messages): a file's text, or a dict as JSON
+    (which is YAML); ("", "") for none."""
+    if columns is None:
+        return "", ""
+    if isinstance(columns, Mapping):
+        return json.dumps(columns, indent=1), _DICT_COLUMNS
+    path = os.fspath(columns)
+    with open(path, encoding="utf-8") as f:  # FileNotFoundError as open() gives it
+        return f.read(), path
+
+
+def _map_errors(call: Any) -> Any:
+    """Runs call(); a dict column map's messages name its key path (a dict has no lines)."""
+    try:
+        return call()
+    except InputError as error:
+        message = re.sub(rf"{re.escape(_DICT_COLUMNS)}:\d+: ", f"{_DICT_COLUMNS}: ", str(error))
+        raise InputError(message) from None
+
+
+def _cell_text(value: Any, decimal: str) -> str:
+    """A spreadsheet cell as the text a CSV export would hold."""
+    import datetime
+
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        text = repr(value)
+        return text.replace(".", ",") if decimal == "," else text
+    if isinstance(value, datetime.datetime):
+        return value.isoformat(sep=" ")
+    if isinstance(value, (datetime.date, datetime.time)):
+        return value.isoformat()
+    return str(value)
+
+
+def _spreadsheet_text(path: str, sheet: Optional[Union[str, int]], decimal: str) -> Tuple[str, str]:
+    """The rows of a sheet of an .xlsx workbook as CSV text, one line per sheet row (so
+    messages name the sheet's row numbers), and the source name for messages."""
+    import csv
+    import io
+
+    try:
+        import openpyxl
+    except ImportError:
+        raise ImportError(
+            f"{path}: reading an .xlsx workbook needs openpyxl, which is not installed: "
+            "apt-get install python3-openpyxl (Debian), or convert the sheet to CSV with "
+            f"xlsx2csv {path} export.csv (Debian package xlsx2csv) and read that"
+        ) from None
+    if not os.path.exists(path):
+        raise FileNotFoundError(2, "No such file or directory", path)
+    book = openpyxl.load_workbook(path, read_only=True, data_only=True)
+    try:
+        if sheet is None:
+            ws = book.worksheets[0]
+        elif isinstance(sheet, int):
+            if not 0 <= sheet < len(book.worksheets):
+                raise InputError(
+                    f"{path}: no sheet {sheet} (the workbook has {len(book.worksheets)}: "
+                    f"{', '.join(book.sheetnames)})"
+                )
+            ws = book.worksheets[sheet]
+        else:
+            if sheet not in book.sheetnames:
+                raise InputError(
+                    f"{path}: no sheet {sheet!r} (sheets: {', '.join(book.sheetnames)})"
+                )
+            ws = book[sheet]
+        rows = [list(r) for r in ws.iter_rows(values_only=True)]
+        name = ws.title
+    finally:
+        book.close()
+    width = 0
+    for r in rows:
+        for k in range(len(r) - 1, -1, -1):
+            if r[k] is not None:
+                width = max(width, k + 1)
+                break
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    for r in rows:
+        if all(v is None for v in r):
+            out.write("\n")  # a blank row stays a (blank) line: row numbers hold
+            continue
+        cells = [_cell_text(v, decimal) for v in r[:width]]
+        cells += [""] * (width - len(cells))
+        writer.writerow(cells)
+    return out.getvalue(), f"{path}[{name}]"
+
+
+def read_dataset(
+    path: Union[PathLike, Sequence[PathLike]],
+    skip_invalid_rows: bool = False,
+    columns: Optional[ColumnsLike] = None,
+    sheet: Optional[Union[str, int]] = None,
+) -> Dataset:
+    """Reads telemetry (docs/data-format.md): a canonical CSV, an export through a
+    column map, or a sheet of an .xlsx workbook; or several files as one session each.
+
+    Args:
+        path: a file, or a list of files (merged, one session per file labelled by its
+            name without directory and extension; a file with a `session` column keeps
+            its labels; Dataset.session_labels and Dataset.session say which sample is
+            whose).
+        skip_invalid_rows: leave out a row with a bad value, listed in Dataset.skipped,
+            instead of raising.
+        columns: a column map (format fastcal-columns-1, docs/data-format.md, "Column
+            maps"): its file, or the same content as a dict, e.g.
+            {"format": "fastcal-columns-1", "time": {"column": "SysTime", "format":
+            "iso8601", "zone": "+08:00"}, "columns": {"x_m": {"column": "X", "unit":
+            "mm"}, ...}, "unmapped": "ignore"}. None: the canonical columns.
+        sheet: for an .xlsx workbook (read with openpyxl, python3-openpyxl), the sheet's
+            name or 0-based index; None: the first. Its rows are read as a CSV export's
+            lines (row numbers in messages are the sheet's), with the map's header_line,
+            skip_after_header, units and time stamps; date cells are read as dates and
+            times in the map's zone.
+
+    Raises InputError naming the file (the sheet), line (row) and column, e.g.
+    "data.csv:12: column 'T3_kN': 'abc' is not a number" or, through a map,
+    "export.csv:12: column 'CableForce3' (T3_kN, N): 'abc' is not a number"; the map's
+    own errors name its key and line; ImportError for an .xlsx without openpyxl.
     """
     if isinstance(path, (str, bytes, os.PathLike)):
         paths = [os.fspath(path)]
     else:
         paths = [os.fspath(p) for p in path]
-    return _fastcal.read_dataset(paths, skip_invalid_rows)
+    map_text, map_source = _columns_argument(columns)
+    for p in paths:
+        if str(p).lower().endswith((".xls", ".ods")):
+            raise InputError(
+                f"{p}: an .xls or .ods workbook: save it as .xlsx (read here, with "
+                "openpyxl) or export the sheet as CSV"
+            )
+    spreadsheets = [p for p in paths if str(p).lower().endswith(_SPREADSHEET_SUFFIXES)]
+    if spreadsheets:
+        if len(paths) > 1:
+            raise InputError(
+                "read_dataset: a workbook is read on its own; read each and merge as CSV "
+                "(Dataset.save), or give CSV files"
+            )
+        decimal = "."
+        if map_text:
+            decimal = _map_errors(lambda: _fastcal.column_map_decimal(map_text, map_source))
+        text, source = _spreadsheet_text(paths[0], sheet, decimal)
+        return _map_errors(
+            lambda: _fastcal.parse_dataset(
+                text, source, skip_invalid_rows, map_text, map_source, False
+            )
+        )
+    if sheet is not None:
+        raise InputError(f"read_dataset: sheet= is for an .xlsx workbook, not {paths[0]}")
+    return _map_errors(
+        lambda: _fastcal.read_dataset(paths, skip_invalid_rows, map_text, map_source)
+    )
+
+
+def _dataset_from_arrays(
+    time_s: ArrayLike,
+    position_m: ArrayLike,
+    tension_kN: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    planned_rpy_deg: Optional[ArrayLike] = None,
+    s0_m: Optional[ArrayLike] = None,
+    session: Optional[Sequence[str]] = None,
+    skip_invalid_rows: bool = False,
+) -> Dataset:
+    """A Dataset from numpy arrays, checked as a file is read (docs/data-format.md).
+
+    Args:
+        time_s: (n,) seconds (any epoch, or Unix seconds: times >= 1e8 s are shown as
+            dates and times, UTC).
+        position_m: (n, 3) measured position; tension_kN: (n, 6) measured tensions.
+        rpy_deg: (n, 3) measured roll, pitch, yaw (deg), or quat: (n, 4) w, x, y, z;
+            one of the two.
+        planned_rpy_deg: (n, 3), optional; s0_m: (n, 6) unstretched lengths, optional.
+        session: n labels (letters, digits, '-', '_'), optional.
+        skip_invalid_rows: leave bad rows out (Dataset.skipped) instead of raising.
+
+    The same checks as the file reader (finite values, plausible positions, angles and
+    tensions, unit quaternions, attitudes in radians): a bad value raises InputError
+    naming the row (1-based) and the column, "arrays, row 3: column 'T2_kN': -5 kN is
+    negative: a tension reading is >= 0". Dataset.line is the 1-based row.
+    """
+    t = np.asarray(time_s, dtype=np.float64).reshape(-1)
+    n = t.shape[0]
+    parts: List[Tuple[List[str], np.ndarray]] = [(["time_s"], t.reshape(n, 1))]
+
+    def add(names: List[str], value: Optional[ArrayLike], label: str) -> None:
+        if value is None:
+            return
+        array = np.asarray(value, dtype=np.float64)
+        if array.ndim == 1 and len(names) > 1 and array.shape[0] == len(names) and n != len(names):
+            array = np.broadcast_to(array, (n, len(names)))
+        if array.shape != (n, len(names)):
+            raise InputError(
+                f"from_arrays: {label} must have shape ({n}, {len(names)}), got {array.shape}"
+            )
+        parts.append((names, array))
+
+    add(["x_m", "y_m", "z_m"], position_m, "position_m")
+    if rpy_deg is not None and quat is not None:
+        raise InputError("from_arrays: give rpy_deg or quat, not both")
+    if rpy_deg is None and quat is None:
+        raise InputError("from_arrays: the measured attitude is needed: rpy_deg or quat")
+    add(["roll_deg", "pitch_deg", "yaw_deg"], rpy_deg, "rpy_deg")
+    add(["qw", "qx", "qy", "qz"], quat, "quat")
+    add(["planned_roll_deg", "planned_pitch_deg", "planned_yaw_deg"], planned_rpy_deg,
+        "planned_rpy_deg")
+    add([f"T{i}_kN" for i in range(1, 7)], tension_kN, "tension_kN")
+    add([f"s0_{i}_m" for i in range(1, 7)], s0_m, "s0_m")
+    names = [name for group, _ in parts for name in group]
+    values = np.ascontiguousarray(np.hstack([a for _, a in parts]))
+    labels = [] if session is None else [str(s) for s in session]
+    text = _fastcal.canonical_text(names, values, labels)
+    return _fastcal.parse_dataset(text, "arrays", skip_invalid_rows, "", "", True)
+
+
+def _dataset_from_dataframe(
+    df: Any, columns: Optional[ColumnsLike] = None, skip_invalid_rows: bool = False
+) -> Dataset:
+    """A Dataset from a pandas DataFrame, checked as a file is read.
+
+    Without `columns` the DataFrame's columns are fastcal's (time_s, x_m, ..., T6_kN,
+    optionally session, docs/data-format.md); with a column map (a file or a dict,
+    read_dataset) they are the export's, named and converted by the map (its
+    header_line, skip_after_header and decimal do not apply: a DataFrame has its names
+    and its numbers). Datetime columns are read as dates and times (the map's zone when
+    they have none). Messages name the row (1-based, in the DataFrame's order) and the
+    column: "DataFrame, row 3: column 'CableForce2' (T2_kN, N): ...".
+    """
+    map_text, map_source = _columns_argument(columns)
+    frame = df.reset_index(drop=True) if hasattr(df, "reset_index") else df
+    try:
+        text = frame.to_csv(index=False, lineterminator="\n")
+    except TypeError:  # pandas before 1.5
+        text = frame.to_csv(index=False, line_terminator="\n")
+    return _map_errors(
+        lambda: _fastcal.parse_dataset(
+            text, "DataFrame", skip_invalid_rows, map_text, map_source, True
+        )
+    )
+
+
+Dataset.from_arrays = staticmethod(_dataset_from_arrays)  # type: ignore[attr-defined]
+Dataset.from_dataframe = staticmethod(_dataset_from_dataframe)  # type: ignore[attr-defined]
+
+
+# simulate()'s keywords: the command line's flags (--attitude-control-deg:
+# attitude_control_deg), each with the SimulationOptions field it sets where the two differ.
+_SIMULATE_OPTION_FIELDS = {
+    "attitude_control_deg": "attitude_control_sigma_deg",
+    "attitude_noise_deg": "attitude_measurement_sigma_deg",
+    "position_noise_m": "position_measurement_sigma_m",
+    "tension_noise_kN": "tension_noise_kn",
+    "sensor_bias_spread_kN": "sensor_bias_spread_kn",
+    "interval_s": "sample_interval_s",
+}
+_SIMULATE_OPTIONS = sorted(
+    list(_SIMULATE_OPTION_FIELDS)
+    + [
+        "attitude_control_time_s",
+        "density_mismatch_percent",
+        "mass_centre_drift_m",
+        "mass_centre_drift_time_s",
+        "mass_centre_steps",
+        "method",
+        "outlier_fraction",
+        "outlier_scale_percent",
+        "seed",
+        "sensor_gain_spread_percent",
+        "sessions",
+        "tension_drift_percent",
+        "tension_drift_time_s",
+        "tension_noise_percent",
+    ]
+)
+
+
+def _simulation_fields(options: Mapping[str, Any]) -> Dict[str, Any]:
+    """simulate()'s keywords as the library's fields; a former name (the field's) with a
+    DeprecationWarning, an unknown one refused with the closest names."""
+    old_names = {field: keyword for keyword, field in _SIMULATE_OPTION_FIELDS.items()}
+    fields: Dict[str, Any] = {}
+    for name, value in options.items():
+        if name in old_names:
+            warnings.warn(
+                f"simulate({name}=...) is deprecated: use {old_names[name]}= (the command "
+                f"line's --{old_names[name].replace('_', '-')})",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+            name = old_names[name]
+        if name not in _SIMULATE_OPTIONS:
+            close = difflib.get_close_matches(name, _SIMULATE_OPTIONS, n=3)
+            guess = f"; did you mean {' or '.join(close)}?" if close else ""
+            raise InputError(f"simulate: unknown option '{name}'{guess} (accepted: " +
+                             ", ".join(_SIMULATE_OPTIONS) + ")")
+        fields[_SIMULATE_OPTION_FIELDS.get(name, name)] = value
+    return fields
 
 
 def simulate(
@@ -364,16 +734,17 @@ def simulate(
     """Synthetic telemetry from a known ("truth") model at planned poses.
 
     The planned poses are positions (n, 3) with an attitude as in solve(). Options are
-    the fields of the C++ SimulationOptions (simulation.h, docs/cli.md's `simulate`):
-    tension_noise_percent (3), tension_noise_kn, outlier_fraction,
-    outlier_scale_percent, attitude_control_sigma_deg, attitude_control_time_s,
-    attitude_measurement_sigma_deg, position_measurement_sigma_m,
-    tension_drift_percent, tension_drift_time_s, mass_centre_drift_m,
-    mass_centre_drift_time_s, sensor_gain_spread_percent, sensor_bias_spread_kn,
-    density_mismatch_percent, sample_interval_s (1), seed (1), method ('exact'),
-    sessions (1: the samples cut into that many consecutive sessions, labelled 1..N),
-    mass_centre_steps ([(time_s, (dx, dy, dz)), ...]: the mass centre moves by the shift
-    at that time and stays).
+    `fastcal simulate`'s flags (docs/cli.md), with underscores:
+    tension_noise_percent (3), tension_noise_kN, outlier_fraction,
+    outlier_scale_percent, attitude_control_deg, attitude_control_time_s,
+    attitude_noise_deg, position_noise_m, tension_drift_percent, tension_drift_time_s,
+    mass_centre_drift_m, mass_centre_drift_time_s, sensor_gain_spread_percent,
+    sensor_bias_spread_kN, density_mismatch_percent, interval_s (1), seed (1), method
+    ('exact'), sessions (1: the samples cut into that many consecutive sessions,
+    labelled 1..N), mass_centre_steps ([(time_s, (dx, dy, dz)), ...]: the mass centre
+    moves by the shift at that time and stays). The former names, SimulationOptions'
+    fields (attitude_control_sigma_deg, tension_noise_kn, sample_interval_s, ...), still
+    work with a DeprecationWarning.
 
     Returns:
         (dataset, truth_used, summary): the telemetry, the truth model after the drawn
@@ -383,7 +754,10 @@ def simulate(
     positions, _ = _rows(position_m, 3, "position_m")
     kind, attitude = _attitude(positions.shape[0], rpy_deg, quat)
     truth = model if model is not None else Model.nominal()
-    return _fastcal.simulate(truth, positions, kind, attitude, dict(options))
+    fields = _simulation_fields(options)
+    return _call_with_names(
+        _SIMULATE_OPTION_FIELDS, _fastcal.simulate, truth, positions, kind, attitude, fields
+    )
 
 
 class CalibrationResult:
@@ -566,6 +940,7 @@ def evaluate(
     return _fastcal.evaluate(model, data, method)
 
 
+@_renamed_keywords({"sample_interval_s": "interval_s"})
 def design(
     spec: Union[PathLike, Mapping[str, Any]],
     samples: int,
@@ -577,7 +952,7 @@ def design(
     parameters: Sequence[str] = (),
     seed: int = 1,
     speed_m_per_s: float = 0.0,
-    sample_interval_s: float = 1.0,
+    interval_s: float = 1.0,
     minutes: float = 0.0,
     min_tension_kN: Optional[float] = None,
     max_tension_kN: Optional[float] = None,
@@ -600,8 +975,9 @@ def design(
         criterion: 'A' (sum of the wanted variances) or 'D' (their log-determinant).
         parameters: the wanted parameters; empty: the free ones without a prior.
         seed: draws the random survey the design is compared with.
-        speed_m_per_s, sample_interval_s: the path's duration; minutes: a time budget
-            (needs a speed).
+        speed_m_per_s, interval_s: the path's duration (cabin speed, time per sample);
+            minutes: a time budget (needs a speed). (interval_s was sample_interval_s:
+            the old name still works, with a DeprecationWarning.)
         min_tension_kN, max_tension_kN, reflector_clearance_m: the candidates' limits;
             None: the design's defaults (50 kN, none, 5 m).
         max_off_axis_deg, off_axis_step_deg, azimuth_step_deg: the grid; None: the
@@ -612,9 +988,11 @@ def design(
         yaw_deg in flight order (what poses.csv holds); 'stops' (dicts: samples,
         position_m, extra_tilt_deg, tilt_direction_deg, extra_yaw_deg); 'wanted';
         'design', 'circle', 'random': {'ok', 'note', 'criterion', 'sigma_total':
-        {name: SI value}}; 'path_length_m', 'duration_s' (nan without a speed),
-        'candidates', 'rejected_candidates', 'limiting_part', 'limiting_share',
-        'prior_halved' ({group: {wanted name: sigma_total with its sigma halved}}).
+        {name: value}}; 'units' ({name: unit}); 'path_length_m', 'duration_s' (nan
+        without a speed), 'candidates', 'rejected_candidates', 'limiting_part',
+        'limiting_share', 'prior_halved' ({group: {wanted name: sigma_total with its
+        sigma halved}}). Every sigma is in its parameter's unit, the one its name
+        carries and the spec's (sensor_bias_kN[1] in kN), as calibrate() reports it.
 
     Raises:
         InputError: a bad spec or option, nothing free, fewer samples than free
@@ -633,7 +1011,7 @@ def design(
         "parameters": [str(p) for p in parameters],
         "seed": int(seed),
         "speed_m_per_s": float(speed_m_per_s),
-        "sample_interval_s": float(sample_interval_s),
+        "sample_interval_s": float(interval_s),
         "time_budget_s": 60.0 * float(minutes),
         "min_tension_kN": min_tension_kN,
         "max_tension_kN": max_tension_kN,

@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
+#include <map>
 #include <sstream>
 
 #include "fastcal/design.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/report_document.h"
 #include "fastcal/svg_plot.h"
 
 namespace fastcal {
@@ -32,6 +35,69 @@ Shown ShownUnit(const Design& d, int k) {
   return {1.0 / d.free_to_si[k], d.free_units[k]};
 }
 
+// A free parameter's value in the spec's unit, its name's (sensor_bias_kN in kN): the
+// library is SI inside, the files speak as the spec and calibrate's outputs do.
+double InSpecUnit(const Design& d, size_t k, double si_value) { return si_value / d.free_to_si[k]; }
+
+// The range's parameters grouped by name before '.' or '[' with their offset in file
+// units, e.g. "mass_centre_m +-0.25 m (margin); linear_density_kg_per_m +-0.36 kg/m (2
+// sigma)".
+std::string RangeText(const Design& d) {
+  std::string out;
+  for (size_t j = 0; j < d.range.size(); ++j) {
+    const DesignRangeParameter& r = d.range[j];
+    const std::string group = r.name.substr(0, r.name.find_first_of(".["));
+    const std::string text =
+        group + " +-" + Fmt("%.3g", r.delta_si / r.to_si) + " " + r.unit +
+        (r.from_prior ? " (" + Fmt("%.3g", d.options.range_prior_sigmas) + " sigma of its prior)"
+                      : " (margin)");
+    if (out.find(text) == std::string::npos) out += (out.empty() ? "" : "; ") + text;
+  }
+  return out.empty() ? "none (the initial values only)" : out;
+}
+
+// Where in the range a binding is reached, compactly: per group of parameters (name
+// before '.' or '['), the offset and each parameter's side in order, e.g.
+// "mass_centre_m +-0.25 m: ++-; linear_density_kg_per_m +-0.36 kg/m: +-----" (0: at its
+// initial value). design.json names each parameter.
+std::string CornerText(const Design& d, const DesignBinding& b) {
+  std::string out, group;
+  bool off = false;
+  for (size_t j = 0; j < b.corner_si.size() && j < d.range.size(); ++j) {
+    const DesignRangeParameter& r = d.range[j];
+    const std::string g = r.name.substr(0, r.name.find_first_of(".["));
+    if (g != group) {
+      group = g;
+      out += (out.empty() ? "" : "; ") + g + " +-" + Fmt("%.3g", r.delta_si / r.to_si) + " " +
+             r.unit + ": ";
+    }
+    out += b.corner_si[j] > 0.0 ? '+' : b.corner_si[j] < 0.0 ? '-' : '0';
+    off |= b.corner_si[j] != 0.0;
+  }
+  return off ? out : "the initial values";
+}
+
+// A binding's value and limit in the units of files: kN for tensions, m for clearance.
+bool IsTension(const DesignBinding& b) { return b.constraint != "reflector_clearance"; }
+double BindingShown(const DesignBinding& b, double si) { return IsTension(b) ? si / 1e3 : si; }
+std::string BindingUnit(const DesignBinding& b) { return IsTension(b) ? "kN" : "m"; }
+
+// The stop whose binding has the least slack (its value nearest its limit, relatively).
+int TightestStop(const Design& d) {
+  int tightest = -1;
+  double least = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < d.stops.size(); ++k) {
+    const DesignBinding& b = d.stops[k].binding;
+    if (b.constraint.empty()) continue;
+    const double slack = std::abs(b.value - b.limit) / std::max(std::abs(b.limit), 1.0);
+    if (slack < least) {
+      least = slack;
+      tightest = static_cast<int>(k);
+    }
+  }
+  return tightest;
+}
+
 void WritePrediction(JsonWriter& j, const Design& d, const DesignPrediction& p) {
   j.BeginObject();
   j.Key("ok").Bool(p.ok);
@@ -42,13 +108,18 @@ void WritePrediction(JsonWriter& j, const Design& d, const DesignPrediction& p) 
   for (size_t k = 0; k < d.free_names.size(); ++k) {
     const bool wanted =
         std::find(d.wanted.begin(), d.wanted.end(), static_cast<int>(k)) != d.wanted.end();
-    j.BeginObject().Key("name").String(d.free_names[k]).Key("wanted").Bool(wanted);
+    j.BeginObject().Key("name").String(d.free_names[k]).Key("unit").String(d.free_units[k]);
+    j.Key("wanted").Bool(wanted);
     if (p.ok) {
       const ParameterBudget& b = p.budget.parameters[k];
-      j.Key("sigma_total").Number(b.total).Key("formal").Number(b.formal);
-      j.Key("systematic").Number(b.systematic);
-      j.Key("budget_variance").BeginObject().Key("noise").Number(p.noise_variance[k]);
-      for (size_t g = 0; g < p.parts.size(); ++g) j.Key(p.parts[g]).Number(p.part_variance[g][k]);
+      const double squared = InSpecUnit(d, k, InSpecUnit(d, k, 1.0));  // variances' scale
+      j.Key("sigma_total").Number(InSpecUnit(d, k, b.total));
+      j.Key("formal").Number(InSpecUnit(d, k, b.formal));
+      j.Key("systematic").Number(InSpecUnit(d, k, b.systematic));
+      j.Key("budget_variance").BeginObject().Key("noise").Number(p.noise_variance[k] * squared);
+      for (size_t g = 0; g < p.parts.size(); ++g) {
+        j.Key(p.parts[g]).Number(p.part_variance[g][k] * squared);
+      }
       j.EndObject();
     } else {
       j.Key("sigma_total").Null();
@@ -113,15 +184,46 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
     j.Key("extra_tilt_deg").Number(c.extra_tilt_deg);
     j.Key("tilt_direction_deg").Number(c.tilt_direction_deg);
     j.Key("extra_yaw_deg").Number(c.extra_yaw_deg);
+    const DesignBinding& b = s.binding;
+    if (!b.constraint.empty()) {
+      const std::string unit = BindingUnit(b);
+      j.Key("binding").BeginObject().Key("constraint").String(b.constraint);
+      if (b.cable >= 0) j.Key("cable").Int(b.cable + 1);
+      j.Key("value_" + unit).Number(BindingShown(b, b.value));
+      j.Key("limit_" + unit).Number(BindingShown(b, b.limit));
+      j.Key("corner").BeginObject();
+      for (size_t k = 0; k < b.corner_si.size() && k < d.range.size(); ++k) {
+        if (b.corner_si[k] == 0.0) continue;
+        j.Key(d.range[k].name).Number(b.corner_si[k] / d.range[k].to_si);
+      }
+      j.EndObject().EndObject();
+    }
     j.EndObject();
   }
   j.EndArray();
+  j.Key("plausible_range").BeginObject();
+  j.Key("prior_sigmas").Number(o.range_prior_sigmas);
+  j.Key("mass_centre_m").Number(o.range_mass_centre_m);
+  j.Key("offset_m").Number(o.range_offset_m);
+  j.Key("relative").Number(o.range_relative);
+  j.Key("min_tension_kN").Number(o.workspace.min_tension_n / 1e3);
+  j.Key("rejected_off_nominal").Int(d.rejected_off_nominal);
+  j.Key("parameters").BeginArray();
+  for (const DesignRangeParameter& r : d.range) {
+    j.BeginObject().Key("name").String(r.name).Key("unit").String(r.unit);
+    j.Key("delta").Number(r.delta_si / r.to_si).Key("from_prior").Bool(r.from_prior).EndObject();
+  }
+  j.EndArray();
+  const int tightest = TightestStop(d);
+  if (tightest >= 0) j.Key("tightest_stop").Int(tightest + 1);
+  j.EndObject();
   j.Key("design");
   WritePrediction(j, d, d.design);
   j.Key("parameters").BeginArray();  // the design's, at the top for a quick read
   for (size_t k = 0; k < d.free_names.size(); ++k) {
-    j.BeginObject().Key("name").String(d.free_names[k]);
-    j.Key("sigma_total").Number(d.design.ok ? d.design.budget.parameters[k].total : NAN);
+    j.BeginObject().Key("name").String(d.free_names[k]).Key("unit").String(d.free_units[k]);
+    j.Key("sigma_total")
+        .Number(d.design.ok ? InSpecUnit(d, k, d.design.budget.parameters[k].total) : NAN);
     j.EndObject();
   }
   j.EndArray();
@@ -134,7 +236,11 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
   j.Key("prior_halved").BeginArray();
   for (const DesignPriorEffect& e : d.prior_effects) {
     j.BeginObject().Key("group").String(e.group).Key("consider").Bool(e.consider);
-    j.Key("sigma_total").NumberArray(e.sigma_total).EndObject();
+    std::vector<double> sigma_total;  // of each wanted parameter, in its spec unit
+    for (size_t w = 0; w < e.sigma_total.size(); ++w) {
+      sigma_total.push_back(InSpecUnit(d, d.wanted[w], e.sigma_total[w]));
+    }
+    j.Key("sigma_total").NumberArray(sigma_total).EndObject();
   }
   j.EndArray();
   j.EndObject();
@@ -149,7 +255,7 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   const FocalGridSpec& g = d.options.workspace.grid;
   const double rim_m = g.focal_radius_m * std::sin(g.max_off_axis_deg * M_PI / 180.0);
   const double extent_m = rim_m;  // the towers are drawn at the rim, by their direction
-  const double size = 620.0, half = size / 2.0, scale = (half - 40.0) / extent_m;
+  const double size = 640.0, half = size / 2.0, scale = (half - 56.0) / extent_m;
   auto X = [&](double x) { return Fmt("%.1f", half + scale * (x - g.focal_centre_m.x())); };
   auto Y = [&](double y) { return Fmt("%.1f", half - scale * (y - g.focal_centre_m.y())); };
   std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Fmt("%.0f", size) +
@@ -173,7 +279,22 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   }
   s += "<path class=\"path\" d=\"" + path +
        "\" fill=\"none\" stroke=\"#0072B2\" stroke-width=\"1.2\"/>\n";
+  // The flight order: each stop's number beside it, the first also marked "start" with a
+  // ring, so that the path reads without its tooltips.
+  if (!d.stops.empty()) {
+    const Eigen::Vector3d& p0 = d.candidates[d.stops.front().candidate].pose.position_m;
+    s += "<circle class=\"start\" cx=\"" + X(p0.x()) + "\" cy=\"" + Y(p0.y()) +
+         "\" r=\"13\" fill=\"none\" stroke=\"#111\" stroke-width=\"2\"/>\n<text x=\"" +
+         Fmt("%.1f", half + scale * (p0.x() - g.focal_centre_m.x()) + 16.0) + "\" y=\"" +
+         Fmt("%.1f", half - scale * (p0.y() - g.focal_centre_m.y()) - 12.0) +
+         "\" font-weight=\"bold\">start</text>\n";
+  }
   int order = 0;
+  struct Number {
+    double x_px = 0.0, y_px = 0.0, radius_px = 0.0;
+    std::string label;
+  };
+  std::map<std::string, Number> numbers;  // by drawn position
   for (const DesignStop& st : d.stops) {
     const DesignCandidate& c = d.candidates[st.candidate];
     const Eigen::Vector3d rpy = RpyDegFromRotation(c.pose.rotation);
@@ -189,13 +310,24 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
          Fmt("%.2f", rpy[1]) + ", " + Fmt("%.2f", rpy[2]) + ") deg; extra tilt " +
          Fmt("%.3g", c.extra_tilt_deg) + " deg toward " + Fmt("%.3g", c.tilt_direction_deg) +
          " deg, extra yaw " + Fmt("%.3g", c.extra_yaw_deg) + " deg</title></circle>\n";
+    // Stops at one position (other attitudes) share one label: "18, 19".
+    Number& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
+    n.x_px = half + scale * (c.pose.position_m.x() - g.focal_centre_m.x());
+    n.y_px = half - scale * (c.pose.position_m.y() - g.focal_centre_m.y());
+    n.radius_px = std::max(n.radius_px, radius);
+    n.label += (n.label.empty() ? "" : ", ") + std::to_string(order);
+  }
+  for (const auto& [at, n] : numbers) {
+    s += "<text class=\"stop-number\" x=\"" + Fmt("%.1f", n.x_px + n.radius_px + 2.0) + "\" y=\"" +
+         Fmt("%.1f", n.y_px - 3.0) + "\" font-size=\"11\" font-weight=\"bold\" fill=\"#222\">" +
+         n.label + "</text>\n";
   }
   for (int i = 0; i < kNumCables; ++i) {
     const Eigen::Vector3d t = robot.cables[i].tower_top_m - g.focal_centre_m;
     const double a = std::atan2(t.y(), t.x());
-    const double r = scale * rim_m + 18.0;
+    const double r = scale * rim_m + 34.0;  // beyond the stops' numbers on the rim
     s += "<text x=\"" + Fmt("%.1f", half + r * std::cos(a)) + "\" y=\"" +
-         Fmt("%.1f", half - r * std::sin(a)) + "\" text-anchor=\"middle\">T" +
+         Fmt("%.1f", half - r * std::sin(a) + 4.0) + "\" text-anchor=\"middle\" fill=\"#777\">T" +
          std::to_string(i + 1) + "</text>\n";
   }
   s += "<text x=\"10\" y=\"18\">seen from above; rim: " + Fmt("%.3g", g.max_off_axis_deg) +
@@ -203,26 +335,30 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   return s;
 }
 
-std::string SigmaCell(const DesignPrediction& p, int k, double scale) {
-  if (!p.ok) return "<td>n/a</td>";
-  return "<td class=\"num\">" + Fmt("%.4g", p.budget.parameters[k].total * scale) + "</td>";
+internal::Text SigmaCell(const DesignPrediction& p, int k, double scale) {
+  if (!p.ok) return internal::Text("n/a");
+  return internal::Text(Fmt("%.4g", p.budget.parameters[k].total * scale));
 }
 
-std::string SigmaTable(const Design& d) {
-  std::string h =
-      "<table><thead><tr><th>parameter</th><th>unit</th><th>design</th><th>paper's "
-      "circle</th><th>random survey</th></tr></thead><tbody>\n";
+bool IsWanted(const Design& d, size_t k) {
+  return std::find(d.wanted.begin(), d.wanted.end(), static_cast<int>(k)) != d.wanted.end();
+}
+
+internal::Table SigmaTable(const Design& d) {
+  internal::Table t;
+  t.header = {"parameter", "unit", "design", "paper's circle", "random survey"};
+  t.right_align = {false, false, true, true, true};
   for (size_t k = 0; k < d.free_names.size(); ++k) {
-    const bool wanted =
-        std::find(d.wanted.begin(), d.wanted.end(), static_cast<int>(k)) != d.wanted.end();
     const Shown u = ShownUnit(d, static_cast<int>(k));
-    h += std::string(wanted ? "<tr class=\"wanted\">" : "<tr>") + "<th>" +
-         XmlEscape(d.free_names[k]) + (wanted ? " (wanted)" : "") + "</th><td>" + u.unit + "</td>" +
-         SigmaCell(d.design, static_cast<int>(k), u.scale) +
-         SigmaCell(d.circle, static_cast<int>(k), u.scale) +
-         SigmaCell(d.random, static_cast<int>(k), u.scale) + "</tr>\n";
+    internal::Text name;
+    name.Code(d.free_names[k]);
+    if (IsWanted(d, k)) name.Bold(" (wanted)");
+    t.rows.push_back({name, internal::Text(u.unit),
+                      SigmaCell(d.design, static_cast<int>(k), u.scale),
+                      SigmaCell(d.circle, static_cast<int>(k), u.scale),
+                      SigmaCell(d.random, static_cast<int>(k), u.scale)});
   }
-  return h + "</tbody></table>\n";
+  return t;
 }
 
 std::string SigmaBars(const Design& d) {
@@ -242,58 +378,117 @@ std::string SigmaBars(const Design& d) {
   return SvgGroupedBars(groups, {"design", "paper's circle", "random survey"}, o);
 }
 
-std::string LimitsText(const Design& d) {
-  std::string h =
-      "<h2>What limits the design</h2>\n<p>The largest part of the wanted "
-      "parameters' summed variance is <b>" +
-      XmlEscape(d.limiting_part == "noise" ? "the tension noise of the data" : d.limiting_part) +
-      "</b>: " + Fmt("%.0f", 100.0 * d.limiting_share) + "% of it.</p>\n";
-  if (d.prior_effects.empty()) return h;
-  h += "<p>With one prior (or consider) sigma halved, the design's sigma_total would be:</p>\n"
-       "<table><thead><tr><th>sigma halved</th>";
+void AddLimits(const Design& d, internal::Document* doc) {
+  doc->Heading(2, "What limits the design");
+  doc->Paragraph(
+      internal::Text("The largest part of the wanted parameters' summed variance is ")
+          .Bold(d.limiting_part == "noise" ? "the tension noise of the data" : d.limiting_part)
+          .Plain(": " + Fmt("%.0f", 100.0 * d.limiting_share) + "% of it."));
+  if (d.prior_effects.empty()) return;
+  doc->Paragraph("With one prior (or consider) sigma halved, the design's sigma_total would be:");
+  internal::Table t;
+  t.header = {"sigma halved"};
+  t.right_align = {false};
   for (int k : d.wanted) {
-    h += "<th>" + XmlEscape(d.free_names[k]) + " (" + ShownUnit(d, k).unit + ")</th>";
+    t.header.push_back(
+        internal::Text().Code(d.free_names[k]).Plain(" (" + ShownUnit(d, k).unit + ")"));
+    t.right_align.push_back(true);
   }
-  h += "</tr></thead><tbody>\n<tr><th>none (as designed)</th>";
-  for (int k : d.wanted) {
-    h += SigmaCell(d.design, k, ShownUnit(d, k).scale);
-  }
-  h += "</tr>\n";
+  std::vector<internal::Text> designed = {"none (as designed)"};
+  for (int k : d.wanted) designed.push_back(SigmaCell(d.design, k, ShownUnit(d, k).scale));
+  t.rows.push_back(designed);
   for (const DesignPriorEffect& e : d.prior_effects) {
-    h += "<tr><th>" + XmlEscape(e.group) + (e.consider ? " (consider)" : " (prior)") + "</th>";
+    std::vector<internal::Text> row = {
+        internal::Text().Code(e.group).Plain(e.consider ? " (consider)" : " (prior)")};
     for (size_t w = 0; w < e.sigma_total.size(); ++w) {
-      h += "<td class=\"num\">" + Fmt("%.4g", e.sigma_total[w] * ShownUnit(d, d.wanted[w]).scale) +
-           "</td>";
+      row.push_back(Fmt("%.4g", e.sigma_total[w] * ShownUnit(d, d.wanted[w]).scale));
     }
-    h += "</tr>\n";
+    t.rows.push_back(row);
   }
-  return h + "</tbody></table>\n";
+  doc->AddTable(std::move(t));
 }
 
-}  // namespace
-
-std::string DesignHtml(const Design& d, const CableRobot& robot, const std::string& provenance) {
-  const DesignOptions& o = d.options;
-  std::string h =
-      "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>fastcal design"
-      "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 "
-      "1em}table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:"
-      "3px 8px;text-align:left}td.num{text-align:right;font-variant-numeric:tabular-nums}"
-      "tr.wanted th{color:#0072B2}.wrap{overflow-x:auto}code{background:#f3f3f3}</style>"
-      "</head><body>\n<h1>Calibration survey design</h1>\n";
-  // One line of the provenance per line of the page (command line, then version and model).
-  std::string lines = XmlEscape(provenance);
-  for (size_t at = lines.find('\n'); at != std::string::npos; at = lines.find('\n', at + 6)) {
-    lines.replace(at, 1, "<br>\n");
+// Stops by their binding constraint, e.g. "min_tension at 20 of 23 stops,
+// reflector_clearance at 3".
+std::string BindingCounts(const Design& d) {
+  std::vector<std::pair<std::string, int>> counts;
+  for (const DesignStop& st : d.stops) {
+    auto it = std::find_if(counts.begin(), counts.end(),
+                           [&](const auto& c) { return c.first == st.binding.constraint; });
+    if (it == counts.end()) {
+      counts.push_back({st.binding.constraint, 1});
+    } else {
+      ++it->second;
+    }
   }
-  h += "<p><code>" + lines + "</code></p>\n";
-  h += "<p>" + std::to_string(o.samples) + " samples at " + std::to_string(d.stops.size()) +
-       " stops, chosen " + DesignCriterionName(o.criterion) + "-optimally from " +
-       std::to_string(d.candidates.size()) + " feasible candidate poses (" +
-       std::to_string(d.rejected_candidates) + " infeasible left out); extra tilt up to " +
-       Fmt("%.3g", o.max_extra_tilt_deg) + " deg, extra yaw up to " +
-       Fmt("%.3g", o.max_extra_yaw_deg) + " deg off the focal law. Path " +
-       Fmt("%.4g", d.path_length_m) + " m";
+  std::string out;
+  for (size_t k = 0; k < counts.size(); ++k) {
+    out += (k ? ", " : "") + counts[k].first + " at " + std::to_string(counts[k].second);
+    if (k == 0) out += " of " + std::to_string(d.stops.size()) + " stops";
+  }
+  return out;
+}
+
+// A binding in words: "cable 6 at 51.2 kN (limit 50 kN)".
+std::string BindingText(const DesignBinding& b) {
+  return (b.cable >= 0 ? "cable " + std::to_string(b.cable + 1) + " at " : std::string("")) +
+         Fmt("%.4g", BindingShown(b, b.value)) + " " + BindingUnit(b) + " (limit " +
+         Fmt("%.4g", BindingShown(b, b.limit)) + " " + BindingUnit(b) + ")";
+}
+
+void AddRange(const Design& d, internal::Document* doc) {
+  const WorkspaceOptions& w = d.options.workspace;
+  doc->Heading(2, "Poses that hold");
+  doc->Paragraph(
+      "Every candidate was judged at the spec's initial values and over the plausible range of "
+      "its parameters: " +
+      RangeText(d) +
+      ". At the initial values and at the corner of that box where each cable's tension is "
+      "lowest" +
+      (std::isfinite(w.max_tension_n) ? std::string(" (and highest)") : std::string("")) +
+      ", the statics must hold with every lower-end tension at least " +
+      Fmt("%.4g", w.min_tension_n / 1e3) + " kN" +
+      (std::isfinite(w.max_tension_n) ? " and at most " + Fmt("%.4g", w.max_tension_n / 1e3) + " kN"
+                                      : std::string("")) +
+      " and every cable " + Fmt("%.3g", w.statics.min_reflector_clearance_m) +
+      " m clear of the reflector. " + std::to_string(d.rejected_off_nominal) +
+      " candidates feasible at the initial values only were left out.");
+  if (d.stops.empty()) return;
+  const int tightest = TightestStop(d);
+  doc->Paragraph(internal::Text("What binds each stop, at its worst corner (bold: the tightest). "
+                                "Where in the range: per group, each parameter's side of its "
+                                "initial value (+ or -), in the order of ")
+                     .Code("plausible_range.parameters")
+                     .Plain(" in design.json."));
+  internal::Table t;
+  t.header = {"stop", "position (m)", "binds", "there", "where in the range"};
+  t.right_align = {true, false, false, false, false};
+  for (size_t k = 0; k < d.stops.size(); ++k) {
+    const DesignBinding& b = d.stops[k].binding;
+    const Eigen::Vector3d& p = d.candidates[d.stops[k].candidate].pose.position_m;
+    const bool bold = static_cast<int>(k) == tightest;
+    std::vector<internal::Text> row;
+    for (const std::string& cell :
+         {std::to_string(k + 1),
+          "(" + Fmt("%.2f", p.x()) + ", " + Fmt("%.2f", p.y()) + ", " + Fmt("%.2f", p.z()) + ")",
+          b.constraint, BindingText(b), CornerText(d, b)}) {
+      row.push_back(bold ? internal::Text().Bold(cell) : internal::Text(cell));
+    }
+    t.rows.push_back(row);
+  }
+  doc->AddTable(std::move(t));
+}
+
+// What was designed, in one paragraph: samples, stops, candidates, attitudes, path.
+std::string SurveyText(const Design& d) {
+  const DesignOptions& o = d.options;
+  std::string h = std::to_string(o.samples) + " samples at " + std::to_string(d.stops.size()) +
+                  " stops, chosen " + DesignCriterionName(o.criterion) + "-optimally from " +
+                  std::to_string(d.candidates.size()) + " feasible candidate poses (" +
+                  std::to_string(d.rejected_candidates) +
+                  " infeasible left out); extra tilt up to " + Fmt("%.3g", o.max_extra_tilt_deg) +
+                  " deg, extra yaw up to " + Fmt("%.3g", o.max_extra_yaw_deg) +
+                  " deg off the focal law. Path " + Fmt("%.4g", d.path_length_m) + " m";
   if (o.speed_m_per_s > 0.0) {
     h += ", " + Fmt("%.4g", d.duration_s / 60.0) + " min at " + Fmt("%.3g", o.speed_m_per_s) +
          " m/s (" + Fmt("%.4g", d.travel_s / 60.0) + " min flying, " +
@@ -303,17 +498,49 @@ std::string DesignHtml(const Design& d, const CableRobot& robot, const std::stri
     h += "; time budget " + Fmt("%.4g", o.time_budget_s / 60.0) + " min (" +
          std::to_string(d.unconstrained_stops) + " stops without it)";
   }
-  h += ".</p>\n<h2>Poses and path on the cap</h2>\n<div class=\"wrap\">" + CapSvg(d, robot) +
-       "</div>\n<p>Grey: candidate positions. Circles: the stops (area by samples; blue at "
-       "the focal law, green tilted, purple turned only), joined by the path in flight order; "
-       "dashed: the paper's circle.</p>\n";
-  h += "<h2>Predicted sigma_total</h2>\n<p>From the calibration's own linearisation and noise "
-       "model at the spec's initial values: white residuals at the stated noise, priors, "
-       "nuisance parameters marginalised, consider parameters included. The circle and the "
-       "random survey have the same number of samples.</p>\n<div class=\"wrap\">" +
-       SigmaBars(d) + "</div>\n" + SigmaTable(d);
-  h += LimitsText(d);
-  return h + "</body></html>\n";
+  return h + ".";
+}
+
+}  // namespace
+
+// The page in the calibration report's style (internal::RenderHtmlPage).
+std::string DesignHtml(const Design& d, const CableRobot& robot, const std::string& provenance) {
+  internal::Document doc;
+  doc.title = "fastcal design";
+  doc.Heading(1, "Calibration survey design");
+  doc.Pre("", provenance, false);
+  doc.Paragraph(SurveyText(d));
+  doc.Heading(2, "Poses and path on the cap");
+  doc.Figure({CapSvg(d, robot)},
+             "Seen from above. Grey: candidate positions. Circles: the stops (area by samples; "
+             "blue at the focal law, green tilted, purple turned only), numbered in flight "
+             "order from the ringed start and joined by the path; dashed: the paper's circle. "
+             "Hover a stop for its pose.");
+  doc.Heading(2, "Predicted sigma_total");
+  doc.Paragraph(
+      "From the calibration's own linearisation and noise model at the spec's initial "
+      "values: white residuals at the stated noise, priors, nuisance parameters "
+      "marginalised, consider parameters included. The circle and the random survey have "
+      "the same number of samples. Lengths in mm.");
+  doc.Figure({SigmaBars(d)}, "The wanted parameters' predicted sigma_total by survey.");
+  doc.AddTable(SigmaTable(d));
+  AddLimits(d, &doc);
+  AddRange(d, &doc);
+  return internal::RenderHtmlPage(doc);
+}
+
+std::string DesignRangeSummary(const Design& d) {
+  std::string out = "holds over the plausible range: " + RangeText(d) + "; " +
+                    std::to_string(d.rejected_off_nominal) +
+                    " candidates feasible at the initial values only left out";
+  const int tightest = TightestStop(d);
+  if (tightest < 0) return out;
+  const DesignBinding& b = d.stops[tightest].binding;
+  return out + "\nbinding: " + BindingCounts(d) + "; tightest: stop " +
+         std::to_string(tightest + 1) + ", " + b.constraint + ", " + BindingText(b) +
+         (d.range.empty() ? std::string(" at the initial values")
+                          : " at a corner of the range (design.json: stops[" +
+                                std::to_string(tightest) + "].binding.corner)");
 }
 
 }  // namespace fastcal
