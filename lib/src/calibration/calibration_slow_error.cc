@@ -52,6 +52,7 @@ SlowErrorEstimateInputs SlowErrorInputs(const CalibrationSpec& spec, const Predi
                                         int budget) {
   SlowErrorEstimateInputs in;
   in.spec = spec.slow_error;
+  in.num_threads = spec.num_threads;
   for (const ParameterSpec& p : spec.parameters) {
     in.gain_nuisance = in.gain_nuisance || (p.free && p.kind == ParameterKind::kSensorGain);
   }
