@@ -93,53 +93,23 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
   return failed < 0;
 }
 
-double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
-  const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
-  struct Part {
-    SampleRows rows;  // the chunk's residuals
-    double sum = 0.0;
-  };
-  double total = 0.0;
-  SampleRowWhitener whitener(samples_, 1);
-  const int failed = ReduceChunksInOrder<Part>(
-      samples_.size(), threads_, [] { return Part(); },
-      [&](int begin, int end, Part* part) {
-        part->rows.Reset(begin, end, 1);
-        for (int t = begin; t < end; ++t) {
-          if (!EvaluateSampleRows(samples_, t, at, t, &part->rows)) return t;
-        }
-        return -1;
-      },
-      [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
-      [&](int begin, int end, Part* part) {
-        for (int t = begin; t < end; ++t) {
-          part->sum += CorrectForLoss(loss_, part->rows.Of(t), nullptr, n_);
-        }
-        return -1;
-      },
-      [&](const Part& part) { total += part.sum; });
-  *ok = failed < 0;
-  return total;
-}
-
 bool FoldedTensionCost::Evaluate(double const* const* parameters, double* residuals,
                                  double** jacobians) const {
   const double* theta = parameters[0];
   const int n = n_;
-  if (jacobians == nullptr || jacobians[0] == nullptr) {
-    bool ok = false;
-    const double s = Cost(theta, &ok);
-    if (!ok) return false;
-    std::fill(residuals, residuals + n, 0.0);
-    residuals[n] = std::sqrt(s);
-    return true;
-  }
+  // Every evaluation folds the Jacobian too (see Memo in the header): a trial step's cost
+  // is followed, when the step is taken, by the Jacobian at the same theta.
   std::lock_guard<std::mutex> lock(mutex_);
   if (memo_theta_.empty() || !std::equal(theta, theta + n, memo_theta_.begin())) {
     memo_theta_.assign(theta, theta + n);
     memo_ok_ = Fold(theta, &memo_r_aug_, &memo_rho_sum_);
   }
   if (!memo_ok_) return false;
+  if (jacobians == nullptr || jacobians[0] == nullptr) {
+    std::fill(residuals, residuals + n, 0.0);
+    residuals[n] = std::sqrt(memo_rho_sum_);
+    return true;
+  }
   const Eigen::VectorXd z = memo_r_aug_.col(n).head(n);
   for (int k = 0; k < n; ++k) residuals[k] = z[k];
   residuals[n] = std::sqrt(std::max(0.0, memo_rho_sum_ - z.squaredNorm()));
