@@ -79,7 +79,7 @@ double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
   // has the same bits on any number of threads. Each cable's nuisance sums are its own.
   std::vector<std::array<double, kNumCables>> log_f(count), square(count);
   const int groups = std::clamp(in.num_threads, 1, kNumCables);
-  OnThreads(groups, [&](int group) {
+  const auto whiten_group = [&](int group) {
     const int first = kNumCables * group / groups, end = kNumCables * (group + 1) / groups;
     // White noise alone: an inactive whitener leaves the rows as they are (F = 1).
     ReadingWhitener whitener(process, columns, first, end);
@@ -107,7 +107,9 @@ double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
         }
       }
     }
-  });
+  };
+  // The groups of threads the system refused (OnThreads) are whitened here afterwards.
+  for (int g = OnThreads(groups, whiten_group); g < groups; ++g) whiten_group(g);
   double total = 0.0;
   for (int t = 0; t < count; ++t) {
     const SlowErrorSample& s = in.samples[t];
