@@ -27,7 +27,9 @@
 // warm-started from the initial parameters' solution, at parameters a fit step away),
 // 1 derivatives (the tensions' gradient by the implicit-function theorem and the 6 x 21
 // Jacobian), 2 folding (the robust loss's correction and the QR fold of the rows into R),
-// 3 statics and derivatives together (TensionResidual::Evaluate). One thread.
+// 3 statics and derivatives together (TensionResidual::Evaluate), 4 the same by a Jet as
+// wide as n through the replayed statics (TensionCost::EvaluateJet: before issue 28). One
+// thread.
 // Run: build/bench/calibration_bench --benchmark_filter=EndToEnd   (about a minute)
 //      build/bench/calibration_bench --benchmark_filter='Realistic|SampleRows'  (~2 min)
 #include <benchmark/benchmark.h>
@@ -329,14 +331,16 @@ void BM_SampleRows(benchmark::State& state) {
   const int part = static_cast<int>(state.range(0));
   for (auto _ : state) {
     double sink = 0.0;
-    if (part == 0 || part == 3) {
+    if (part == 0 || part == 3 || part == 4) {
       for (int t = 0; t < count; ++t) {
         const internal::TensionResidual f = samples.At(t);
         double r[kNumCables];
         if (part == 0) {
           f(theta.data(), r);
-        } else {
+        } else if (part == 3) {
           f.Evaluate(theta.data(), r, j.data());
+        } else {
+          internal::TensionCost::EvaluateJet(f, theta.data(), r, j.data());
         }
         sink += r[0];
       }
@@ -373,11 +377,12 @@ void BM_SampleRows(benchmark::State& state) {
     benchmark::DoNotOptimize(sink);
   }
   state.SetItemsProcessed(state.iterations() * count);
-  const char* names[] = {"statics", "derivatives", "folding", "statics and derivatives"};
+  const char* names[] = {"statics", "derivatives", "folding", "statics and derivatives",
+                         "statics and derivatives by Jets"};
   state.SetLabel(names[part]);
 }
 
-BENCHMARK(BM_SampleRows)->DenseRange(0, 3)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_SampleRows)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
 
 BENCHMARK(BM_CalibrateEndToEnd)->Apply(EndToEndSizes);
 
