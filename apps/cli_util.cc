@@ -842,7 +842,15 @@ std::string Wrapped(const std::string& text, const std::string& first_indent,
   if (lines.size() > max_lines) {
     lines.resize(max_lines);
     std::string& last = lines.back();
-    if (last.size() + cut.size() > kConsoleWidth) last.resize(kConsoleWidth - cut.size());
+    // Whole words dropped until the mark fits: a number cut in the middle would misread.
+    while (last.size() + cut.size() > kConsoleWidth) {
+      const size_t space = last.find_last_of(' ');
+      if (space == std::string::npos || space <= indent.size()) {
+        last.resize(kConsoleWidth - cut.size());
+        break;
+      }
+      last.resize(space);
+    }
     last += cut;
   }
   std::string out;
