@@ -576,10 +576,9 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
             "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
             report.data_digest + ")" +
-            (report.columns_path.empty()
-                 ? ""
-                 : "\nread through the column map " + report.columns_path + " (sha256 " +
-                       report.columns_digest + ")") +
+            (report.columns_path.empty() ? ""
+                                         : "\nread through the column map " + report.columns_path +
+                                               " (sha256 " + report.columns_digest + ")") +
             "\nverdict: " + FitVerdictName(result.verdict) +
             "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
             "budget):";
@@ -618,40 +617,9 @@ std::string SigmaText(double sigma, const std::string& unit) {
   return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
 }
 
-// The console is one screen: at most kConsoleWidth columns, long notes cut to
-// kNoteLines lines (the report has them whole).
-constexpr size_t kConsoleWidth = 100;
+// Long notes are cut to kNoteLines lines on the console (the report has them whole).
 constexpr size_t kNoteLines = 2;
 constexpr size_t kEstimateRows = 14;
-
-// `text` wrapped at kConsoleWidth, each line after the first indented by `indent`; cut
-// after `max_lines` lines with "... (report.md)".
-std::string Wrapped(const std::string& text, const std::string& first_indent,
-                    const std::string& indent, size_t max_lines) {
-  std::istringstream words(text);
-  std::vector<std::string> lines = {first_indent};
-  std::string word;
-  while (words >> word) {
-    std::string& line = lines.back();
-    const bool starts = line.size() == (lines.size() == 1 ? first_indent : indent).size();
-    if (!starts && line.size() + 1 + word.size() > kConsoleWidth) {
-      lines.push_back(indent + word);
-    } else {
-      line += (starts ? "" : " ") + word;
-    }
-  }
-  const char kCut[] = " ... (report.md)";
-  if (lines.size() > max_lines) {
-    lines.resize(max_lines);
-    std::string& last = lines.back();
-    if (last.size() + sizeof(kCut) - 1 > kConsoleWidth)
-      last.resize(kConsoleWidth - sizeof(kCut) + 1);
-    last += kCut;
-  }
-  std::string out;
-  for (const std::string& line : lines) out += line + "\n";
-  return out;
-}
 
 // Short flags of an estimate's note; the full notes are in the report.
 std::string EstimateFlags(const ParameterEstimate& p) {
@@ -1353,11 +1321,10 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
 int RunEvaluate(int argc, char** argv) {
   const char* command = "evaluate";
   int exit_code = 0;
-  if (!StartCommand(
-          argc, argv, command, kEvaluateHelp,
-          {"model", "data", "out", "method", "skip-invalid-rows", "force", "residuals-every",
-           "columns"},
-          &exit_code)) {
+  if (!StartCommand(argc, argv, command, kEvaluateHelp,
+                    {"model", "data", "out", "method", "skip-invalid-rows", "force",
+                     "residuals-every", "columns"},
+                    &exit_code)) {
     return exit_code;
   }
   std::string error;

@@ -387,11 +387,11 @@ bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::
     const auto is_result = [&](const std::string& name) {
       for (const std::string& r : *replaceable) {
         const size_t star = r.find('*');
-        if (star == std::string::npos ? name == r
-                                      : name.size() >= r.size() - 1 &&
-                                            name.compare(0, star, r, 0, star) == 0 &&
-                                            name.compare(name.size() - (r.size() - star - 1),
-                                                         std::string::npos, r, star + 1) == 0) {
+        if (star == std::string::npos
+                ? name == r
+                : name.size() >= r.size() - 1 && name.compare(0, star, r, 0, star) == 0 &&
+                      name.compare(name.size() - (r.size() - star - 1), std::string::npos, r,
+                                   star + 1) == 0) {
           return true;
         }
       }
@@ -827,6 +827,40 @@ bool WriteDirectoryAtomically(const std::string& dir,
     return false;
   }
   return true;
+}
+
+std::string Wrapped(const std::string& text, const std::string& first_indent,
+                    const std::string& indent, size_t max_lines, const std::string& full_text_in) {
+  std::istringstream words(text);
+  std::vector<std::string> lines = {first_indent};
+  std::string word;
+  while (words >> word) {
+    std::string& line = lines.back();
+    const bool starts = line.size() == (lines.size() == 1 ? first_indent : indent).size();
+    if (!starts && line.size() + 1 + word.size() > kConsoleWidth) {
+      lines.push_back(indent + word);
+    } else {
+      line += (starts ? "" : " ") + word;
+    }
+  }
+  const std::string cut = " ... (" + full_text_in + ")";
+  if (lines.size() > max_lines) {
+    lines.resize(max_lines);
+    std::string& last = lines.back();
+    // Whole words dropped until the mark fits: a number cut in the middle would misread.
+    while (last.size() + cut.size() > kConsoleWidth) {
+      const size_t space = last.find_last_of(' ');
+      if (space == std::string::npos || space <= indent.size()) {
+        last.resize(kConsoleWidth - cut.size());
+        break;
+      }
+      last.resize(space);
+    }
+    last += cut;
+  }
+  std::string out;
+  for (const std::string& line : lines) out += line + "\n";
+  return out;
 }
 
 }  // namespace fastcal::cli

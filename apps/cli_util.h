@@ -19,6 +19,16 @@
 
 namespace fastcal::cli {
 
+// The console is one screen: at most kConsoleWidth columns (calibrate's and design's
+// summaries).
+constexpr size_t kConsoleWidth = 100;
+
+// `text` wrapped at kConsoleWidth, each line after the first indented by `indent`; cut
+// after `max_lines` lines with " ... (FULL_TEXT_IN)", where the whole text is.
+std::string Wrapped(const std::string& text, const std::string& first_indent,
+                    const std::string& indent, size_t max_lines,
+                    const std::string& full_text_in = "report.md");
+
 // Exit codes: 0 success, 1 a computation failed (infeasible pose, solver), 2 bad usage or
 // bad input (flags, files).
 inline constexpr int kExitFailure = 1;
