@@ -123,6 +123,13 @@ noise has a 1% chance of naming any reading, 5.64 at 10^5 samples, 6.03 at 10^6)
 out of the fit and named by file line and cable; a dataset mostly made of them is
 refused (exit 1).
 
+Winch lengths: with noise: {length_sigma_m: ...} in the spec, the s0_1_m..s0_6_m columns
+(the encoders' readings) are measurements too, six per sample beside the tensions, and
+length_offset_m (each encoder's zero) may be free; a slipped encoder is a gross error of
+a length ("line 812, length of cable 3"), and the console, report and summary.json give
+model minus measured length per cable before and after (docs/calibration.md, "Lengths";
+calibration_data/spec_lengths.yaml).
+
 Each estimate comes with sigma_total, the uncertainty to quote: the formal sigma (stated
 noise, independent samples) widened by the misfit and by residuals correlated in time,
 plus what the consider parameters add. The console and report show its parts, the
@@ -137,8 +144,10 @@ Outputs in DIR:
                           errors and worst readings, misfit ranking, identifiability, RMS
                           per cable before and after (the paper's Table 6), block
                           cross-validation, plots
-  summary.json            the same, machine-readable (outliers: line, cable, measured_kN,
-                          predicted_kN, residual_sigma), with provenance and the UTC time
+  summary.json            the same, machine-readable (outliers: line, cable, reading,
+                          measured_kN and predicted_kN or, for a length, measured_m and
+                          predicted_m, residual_sigma; lengths), with provenance and the
+                          UTC time
   model_calibrated@LABEL.yaml  with sessions: {separate: [...]} in the spec and data of
                           two or more sessions, the calibrated model of each session
                           (model_calibrated.yaml is the first's)
@@ -353,10 +362,13 @@ bool WriteResidualsFile(const std::string& dir, const Dataset& data,
 // column, then T1..T6, so that every row lines up under its header.
 constexpr int kLabelWidth = 40;
 
-std::string CableHeader(const std::string& title) {
+std::string CableHeader(const std::string& title, const char* prefix = "T") {
   char buf[160];
+  std::string names[kNumCables];
+  for (int i = 0; i < kNumCables; ++i) names[i] = prefix + std::to_string(i + 1);
   std::snprintf(buf, sizeof(buf), "  %-*s %8s %8s %8s %8s %8s %8s\n", kLabelWidth, title.c_str(),
-                "T1", "T2", "T3", "T4", "T5", "T6");
+                names[0].c_str(), names[1].c_str(), names[2].c_str(), names[3].c_str(),
+                names[4].c_str(), names[5].c_str());
   return buf;
 }
 
@@ -370,6 +382,18 @@ std::string CableRow(const std::string& label, const std::array<double, kNumCabl
     row += std::string(buf) == " -0.000" ? "    0.000" : buf;
   }
   return row + "\n";
+}
+
+// With lengths in the fit: their RMS per cable before and after (mm), else "".
+std::string LengthTable(const LengthEvaluation& l) {
+  if (!l.used) return "";
+  std::string s = "\n" + CableHeader("RMS model - measured length (mm)", "L");
+  s += CableRow("initial model", l.initial.rms_m, 1e3);
+  s += CableRow("calibrated model", l.calibrated.rms_m, 1e3);
+  if (l.calibrated_holdout.samples > 0) {
+    s += CableRow("calibrated model [hold-out]", l.calibrated_holdout.rms_m, 1e3);
+  }
+  return s;
 }
 
 std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
@@ -745,10 +769,18 @@ std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::st
   for (size_t k = 0; k < std::min(list.size(), kShown); ++k) {
     const ReadingResidual& e = list[k];
     char buf[200];
-    std::snprintf(buf, sizeof(buf),
-                  "%sline %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
-                  indent.c_str(), e.line, e.cable, e.measured_n / kNPerKn, e.predicted_n / kNPerKn,
-                  e.residual_sigma, e.held_out ? " (held out)" : "");
+    if (e.length) {
+      std::snprintf(buf, sizeof(buf),
+                    "%sline %d, length of cable %d: measured %.4f m, predicted %.4f m, %+.1f "
+                    "sigma%s\n",
+                    indent.c_str(), e.line, e.cable, e.measured_m, e.predicted_m, e.residual_sigma,
+                    e.held_out ? " (held out)" : "");
+    } else {
+      std::snprintf(buf, sizeof(buf),
+                    "%sline %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
+                    indent.c_str(), e.line, e.cable, e.measured_n / kNPerKn,
+                    e.predicted_n / kNPerKn, e.residual_sigma, e.held_out ? " (held out)" : "");
+    }
     s << buf;
   }
   if (list.size() > kShown) {
@@ -911,8 +943,9 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
     s << Wrapped("strongly correlated: " + pairs, "  ", "    ", kNoteLines);
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
-    << RmsTable(variants) << CrossValidationLine(result) << PaperTable6Lines(PositionsOf(data))
-    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, ";
+    << RmsTable(variants) << CrossValidationLine(result) << LengthTable(result.lengths)
+    << PaperTable6Lines(PositionsOf(data)) << "\nwrote " << FLAGS_out
+    << "/{model_calibrated.yaml, ";
   // One model a session when the spec separates parameters by session.
   for (size_t k = 0; k < result.session_models.size(); ++k) {
     s << "model_calibrated@" << result.session_labels[k] << ".yaml, ";

@@ -490,6 +490,11 @@ bool ParseVector4(const std::string& name, const std::string& text, Eigen::Vecto
   return ParseList(name, text, 4, v->data(), error);
 }
 
+bool ParseSix(const std::string& name, const std::string& text, std::array<double, 6>* v,
+              std::string* error) {
+  return ParseList(name, text, 6, v->data(), error);
+}
+
 bool ParsePosition(const std::string& name, const std::string& text, Eigen::Vector3d* position_m,
                    std::string* error) {
   if (!ParseVector3(name, text, position_m, error)) return false;

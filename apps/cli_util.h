@@ -3,6 +3,7 @@
 #define FASTCAL_APPS_CLI_UTIL_H_
 
 #include <Eigen/Core>
+#include <array>
 #include <filesystem>
 #include <functional>
 #include <future>
@@ -137,6 +138,9 @@ bool ParseVector3(const std::string& name, const std::string& text, Eigen::Vecto
                   std::string* error);
 bool ParseVector4(const std::string& name, const std::string& text, Eigen::Vector4d* v,
                   std::string* error);
+// Six finite numbers, one per cable (--lengths, --tensions-kN).
+bool ParseSix(const std::string& name, const std::string& text, std::array<double, 6>* v,
+              std::string* error);
 
 // A cabin position (--position, --from, --to): ParseVector3, then the plausibility limits
 // a dataset's positions obey (plausibility.h): "--position=0,0,-50: z = -50 m is below the

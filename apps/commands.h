@@ -17,6 +17,7 @@
 namespace fastcal::cli {
 
 int RunSolve(int argc, char** argv);
+int RunLocate(int argc, char** argv);
 int RunCalibrate(int argc, char** argv);
 int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);

@@ -24,6 +24,8 @@ Usage: fastcal <command> [--flag=value ...]
 Commands:
   solve      cable forces, tensions and unstretched lengths at a pose or along a trajectory
              (exact, AAS, refined AAS, or AAS against exact), every answer checked
+  locate     where the cabin hangs, from the six unstretched cable lengths (with a
+             measured attitude and tensions, the pose that fits them all); stability
   calibrate  estimate mass centre, cable density, offsets, sensor gains... from measured
              poses and tensions; refuse free sets the data cannot determine; report
   evaluate   RMS of model minus measured tensions per cable, for any model file
@@ -47,6 +49,7 @@ namespace {
 int Dispatch(const std::string& command, int argc, char** argv, bool* known) {
   *known = true;
   if (command == "solve") return RunSolve(argc, argv);
+  if (command == "locate") return RunLocate(argc, argv);
   if (command == "calibrate") return RunCalibrate(argc, argv);
   if (command == "evaluate") return RunEvaluate(argc, argv);
   if (command == "simulate") return RunSimulate(argc, argv);

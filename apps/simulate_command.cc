@@ -80,6 +80,9 @@ DEFINE_double(mass_centre_drift_m, 0.0, "simulate: mass-centre drift sigma per a
 DEFINE_double(mass_centre_drift_time_s, 0.0, "simulate: its correlation time (s).");
 DEFINE_double(sensor_gain_spread_percent, 0.0, "simulate: per-cable gain spread drawn once (%).");
 DEFINE_double(sensor_bias_spread_kN, 0.0, "simulate: per-cable bias spread drawn once (kN).");
+DEFINE_double(length_offset_spread_m, 0.0,
+              "simulate: per-cable length-encoder offset spread drawn once (m).");
+DEFINE_double(length_noise_m, 0.0, "simulate: sigma of each length reading's noise (m).");
 DEFINE_int32(sessions, 1, "simulate: consecutive sessions (session column 1..N).");
 DEFINE_string(session_shift_m, "",
               "simulate: mass centre moved by dx,dy,dz (m) at each new session.");
@@ -122,9 +125,12 @@ An AR(1) process with correlation time tau steps by phi = exp(-interval / tau) a
 stationary; tau = 0 draws it afresh every sample (white).
   measured attitude   a_act + N(0, attitude-noise-deg)                per angle
   measured position   p + N(0, position-noise-m)                      per axis
+  measured length     s0_i + o_i + N(0, length-noise-m), o_i the encoder's offset (the
+                      truth model's length_offset_m, spread by length-offset-spread-m)
 The CSV has time_s = n * interval-s, the measured pose (x_m,y_m,z_m,roll_deg,pitch_deg,
-yaw_deg), the planned attitude (planned_roll_deg,..), T1_kN..T6_kN and, as the commanded
-lengths, the truth solution's unstretched lengths s0_1_m..s0_6_m.
+yaw_deg), the planned attitude (planned_roll_deg,..), T1_kN..T6_kN and the measured
+lengths s0_1_m..s0_6_m (the truth solution's unstretched lengths exactly, without
+--length-offset-spread-m and --length-noise-m or offsets in the truth model).
 
 Truth model:
   --truth=FILE.yaml               model (docs/model-format.md); default the nominal FAST
@@ -138,6 +144,8 @@ Truth model:
   --sensor-gain-spread-percent=0  multiply each cable's sensor gain by 1 + N(0, p/100),
                                   drawn once (written to FILE.truth.yaml)
   --sensor-bias-spread-kN=0       add N(0, kN) to each cable's sensor bias, drawn once
+  --length-offset-spread-m=0      add N(0, m) to each cable's length-encoder offset, drawn
+                                  once (written to FILE.truth.yaml as length_offset_m)
   --method=exact                  statics of the truth tensions: exact (default),
                                   aas-refined, aas
   (Until 0.2 the units were spelt -kn and -pct: --sensor-bias-kn, --tension-noise-pct...;
@@ -180,6 +188,7 @@ source with its own generator, so changing one sigma leaves the others' numbers 
   --tension-noise-kN=0            absolute tension noise (kN), added to the relative one
   --outlier-fraction=0            probability that a reading is an outlier instead
   --outlier-scale-percent=30      outlier half-width (%), in [0, 100)
+  --length-noise-m=0              noise of each length reading (m)
 A noise draw that would make a reading <= 0 is redrawn (counted in the summary).
 
 Sessions and steps of the mass centre (the cabin's structure changed):
@@ -243,7 +252,8 @@ const std::set<std::string> kFlags = {
     "force", "attitude-control-time-s", "tension-drift-percent", "tension-drift-time-s",
     "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-percent",
     "sensor-bias-spread-kN", "sessions", "session-shift-m", "mass-centre-step",
-    "tension-drift-kN", "session-gap-s", "sensor-rezero-kN"};
+    "tension-drift-kN", "session-gap-s", "sensor-rezero-kN", "length-offset-spread-m",
+    "length-noise-m"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -359,6 +369,8 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->mass_centre_drift_time_s = FLAGS_mass_centre_drift_time_s;
   options->sensor_gain_spread_percent = FLAGS_sensor_gain_spread_percent;
   options->sensor_bias_spread_kn = FLAGS_sensor_bias_spread_kN;
+  options->length_offset_spread_m = FLAGS_length_offset_spread_m;
+  options->length_noise_m = FLAGS_length_noise_m;
   options->seed = FLAGS_seed;
   options->sample_interval_s = FLAGS_interval_s;
   options->sessions = FLAGS_sessions;
@@ -394,6 +406,8 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
                                  {"mass_centre_drift_time_s", "--mass-centre-drift-time-s"},
                                  {"sensor_gain_spread_percent", "--sensor-gain-spread-percent"},
                                  {"sensor_bias_spread_kn", "--sensor-bias-spread-kN"},
+                                 {"length_offset_spread_m", "--length-offset-spread-m"},
+                                 {"length_noise_m", "--length-noise-m"},
                                  {"sample_interval_s", "--interval-s"},
                                  {"sessions", "--sessions"},
                                  {"tension_drift_kn", "--tension-drift-kN"},
@@ -582,6 +596,12 @@ std::string Summary(const SimulationSummary& s, const SimulationOptions& options
         << " m per axis; average actual mass centre (" << FormatDouble(s.mass_centre_mean_m.x(), 6)
         << ", " << FormatDouble(s.mass_centre_mean_m.y(), 6) << ", "
         << FormatDouble(s.mass_centre_mean_m.z(), 6) << ") m";
+  }
+  if (options.length_offset_spread_m > 0.0 || options.length_noise_m > 0.0) {
+    out << "\n  length-encoder offsets (m):";
+    for (double v : s.length_offset_m) out << " " << FormatDouble(v, 4);
+    out << "; length noise RMS per cable (m):";
+    for (double v : s.length_noise_rms_m) out << " " << FormatDouble(v, 4);
   }
   if (s.redrawn > 0) out << "\n  " << s.redrawn << " noise draws redrawn (reading <= 0)";
   return out.str();

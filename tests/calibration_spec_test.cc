@@ -585,7 +585,7 @@ const ErrorCase kErrorCases[] = {
     {"parameters:\n  mass_center_m: {x: {free: true}}\n", 2, "parameters.mass_center_m",
      "unknown parameter (accepted: mass_centre_m, cabin_mass_kg, linear_density_kg_per_m, ea_n, "
      "anchor_offset_m, tower_offset_m, sensor_gain, sensor_bias_kN, attachment_mass_kg, "
-     "attachment_density_kg_per_m)"},
+     "attachment_density_kg_per_m, length_offset_m)"},
     {"parameters:\n  mass_centre_m:\n    w: {free: true}\n", 3, "parameters.mass_centre_m.w",
      "unknown key"},
     {"parameters:\n  cabin_mass_kg: {free: true, inital: 3}\n", 2,
@@ -691,8 +691,9 @@ TEST(CalibrationSpecTest, FixedWithPriorIsAConsiderParameter) {
 // The candidates of the misfit ranking: every parameter a spec can name.
 TEST(CalibrationSpecTest, AllModelParametersNamesEveryParameterOnce) {
   const std::vector<ParameterSpec> all = AllModelParameters(3);
-  // 3 mass centre, 1 cabin mass, 4 per-cable groups x (common + 6), 3 x 3 anchor, 6 x 3 tower.
-  EXPECT_EQ(all.size(), 3u + 1u + 4u * 7u + 9u + 18u);
+  // 3 mass centre, 1 cabin mass, 4 per-cable groups x (common + 6), 3 x 3 anchor, 6 x 3 tower,
+  // the length offsets (common + 6).
+  EXPECT_EQ(all.size(), 3u + 1u + 4u * 7u + 9u + 18u + 7u);
   for (size_t a = 0; a < all.size(); ++a) {
     EXPECT_FALSE(all[a].free);
     for (size_t b = a + 1; b < all.size(); ++b) {
@@ -701,8 +702,9 @@ TEST(CalibrationSpecTest, AllModelParametersNamesEveryParameterOnce) {
     }
   }
   EXPECT_EQ(all[0].name, "mass_centre_m.x");
-  EXPECT_EQ(all.back().name, "sensor_bias_kN[6]");
-  EXPECT_EQ(all.back().to_si, kNewtonsPerKilonewton);
+  EXPECT_EQ(all.back().name, "length_offset_m[6]");
+  EXPECT_EQ(all[all.size() - 8].name, "sensor_bias_kN[6]");
+  EXPECT_EQ(all[all.size() - 8].to_si, kNewtonsPerKilonewton);
   EXPECT_STREQ(ParameterGroupName(ParameterKind::kTowerOffset), "tower_offset_m");
 }
 

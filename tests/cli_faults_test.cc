@@ -66,6 +66,7 @@ TEST_F(CliFaultsTest, StandardOutputIsCheckedLikeAnyResultFile) {
       "workspace",
       "simulate --trajectory=random --samples=10 --out=" + Path("s.csv"),
       "solve --help",
+      "locate --lengths=319.4245,319.4245,319.4245,319.4245,319.4245,319.4245",
   };
   for (const std::string& args : commands) {
     const CommandResult r = Shell("(" + Bin() + " " + args + " >/dev/full)");

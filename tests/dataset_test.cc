@@ -444,6 +444,45 @@ TEST_F(DatasetTest, AttitudesInRadiansUnderDegreeColumnsAreRefused) {
 }
 
 // "-0" is written as "0" (issue 17, item 7): the same value, and a reader wonders.
+// A lengths file (fastcal locate): the six s0 columns are all it needs; every other group
+// may be there, complete, or not.
+TEST_F(DatasetTest, LengthsFileNeedsOnlyTheLengths) {
+  DatasetReadOptions options;
+  options.required_columns = DatasetColumns::kLengths;
+  const std::string lengths = "s0_1_m,s0_2_m,s0_3_m,s0_4_m,s0_5_m,s0_6_m";
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(ParseDataset(lengths + "\n300,301,302,303,304,305\n", "l.csv", options, &d, &error))
+      << error;
+  ASSERT_EQ(d.samples.size(), 1u);
+  EXPECT_FALSE(d.has_time || d.has_position || d.has_measured_attitude || d.has_tensions);
+  EXPECT_TRUE(d.has_unstretched_lengths);
+  EXPECT_EQ(d.samples[0].unstretched_length_m[5], 305.0);
+  EXPECT_EQ(d.samples[0].pose.rotation, Eigen::Matrix3d::Identity());
+  // With an attitude and tensions, no position.
+  ASSERT_TRUE(ParseDataset("time_s,qw,qx,qy,qz,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN," + lengths +
+                               "\n2,1,0,0,0,150,151,152,153,154,155,300,301,302,303,304,305\n",
+                           "l.csv", options, &d, &error))
+      << error;
+  EXPECT_TRUE(d.has_time && d.has_measured_attitude && d.has_tensions);
+  EXPECT_FALSE(d.has_position);
+  EXPECT_EQ(d.samples[0].tension_n[0], 150000.0);
+  // What a lengths file cannot lack, and half groups.
+  EXPECT_FALSE(ParseDataset("time_s,x_m,y_m,z_m\n0,0,0,140\n", "l.csv", options, &d, &error));
+  EXPECT_TRUE(Contains(error, "l.csv:1: missing column 's0_1_m' (a lengths file needs"));
+  EXPECT_FALSE(ParseDataset("x_m,y_m," + lengths + "\n0,0,300,301,302,303,304,305\n", "l.csv",
+                            options, &d, &error));
+  EXPECT_TRUE(Contains(error, "missing column 'z_m' (the position needs all three or none)"));
+  EXPECT_FALSE(ParseDataset("T1_kN," + lengths + "\n150,300,301,302,303,304,305\n", "l.csv",
+                            options, &d, &error));
+  EXPECT_TRUE(Contains(error, "missing column 'T2_kN' (the measured tensions need all six"));
+  // A measurement file still needs its columns, and keeps its flags.
+  EXPECT_TRUE(Contains(ParseError(lengths + "\n300,301,302,303,304,305\n"), "missing column"));
+  const Dataset full = ParseOk(std::string(kHeader) + kRow);
+  EXPECT_TRUE(full.has_time && full.has_position && full.has_measured_attitude &&
+              full.has_tensions);
+}
+
 TEST_F(DatasetTest, NegativeZeroIsWrittenAsZero) {
   const Dataset d =
       ParseOk(std::string(kHeader) + "0.5,-0,2,140,-0,0.2,-0.0,150,151,152,153,154,0\n");

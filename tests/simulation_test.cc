@@ -390,6 +390,60 @@ TEST(SimulationTest, SensorGainAndBiasSpreadsAreDrawnOnceAndWrittenOut) {
   }
 }
 
+// The length readings are the winches' encoders: each cable's s0 plus an offset drawn
+// once (written into the truth model) plus white noise of the requested sigma; turning
+// them on changes no other number.
+TEST(SimulationTest, LengthReadingsHaveTheirOffsetsAndNoise) {
+  constexpr double kOffsetSpreadM = 0.5, kNoiseM = 0.003;
+  constexpr int kNodes = 360;  // 2160 readings: the RMS within kRmsTolerance relative
+  const CableRobot truth = CableRobot::NominalFast();
+  const std::vector<Pose> planned = Circle(kNodes);
+  SimulationOptions options;  // 3% tension noise
+  Dataset plain, encoded;
+  CableRobot used;
+  SimulationSummary summary;
+  std::string error;
+  ASSERT_TRUE(Simulate(truth, planned, options, &plain, nullptr, nullptr, &error)) << error;
+  options.length_offset_spread_m = kOffsetSpreadM;
+  options.length_noise_m = kNoiseM;
+  ASSERT_TRUE(Simulate(truth, planned, options, &encoded, &used, &summary, &error)) << error;
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_NE(used.cables[i].length_offset_m, 0.0) << i;
+    EXPECT_LT(std::abs(used.cables[i].length_offset_m), 5 * kOffsetSpreadM) << i;
+    EXPECT_EQ(summary.length_offset_m[i], used.cables[i].length_offset_m);
+  }
+  double sum2 = 0.0;
+  for (size_t n = 0; n < planned.size(); ++n) {
+    EXPECT_EQ(plain.samples[n].tension_n, encoded.samples[n].tension_n) << n;
+    EXPECT_EQ(plain.samples[n].pose.rotation, encoded.samples[n].pose.rotation) << n;
+    for (int i = 0; i < kNumCables; ++i) {
+      // Without length errors the column is the truth's s0 (ExactAt agrees to 1e-9 m).
+      const double s0 = plain.samples[n].unstretched_length_m[i];
+      const double noise =
+          encoded.samples[n].unstretched_length_m[i] - used.cables[i].EncoderReadingM(s0);
+      sum2 += noise * noise;
+    }
+  }
+  const double rms = std::sqrt(sum2 / (kNumCables * planned.size()));
+  EXPECT_NEAR(rms / kNoiseM, 1.0, kRmsTolerance / kNoiseSigma);
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_NEAR(summary.length_noise_rms_m[i] / kNoiseM, 1.0, 3 * kRmsTolerance / kNoiseSigma);
+  }
+  const StaticsSolution exact = ExactAt(truth, planned[0]);
+  EXPECT_NEAR(plain.samples[0].unstretched_length_m[0], exact.cables[0].unstretched_length_m,
+              kLengthTolerance_m);
+  // The offsets are in the truth model written out.
+  CableRobot reread;
+  ASSERT_TRUE(ParseCableRobotYaml(CableRobotToYaml(used, ""), "truth.yaml", &reread, &error))
+      << error;
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_EQ(reread.cables[i].length_offset_m, used.cables[i].length_offset_m);
+  }
+  options.length_noise_m = -1.0;
+  EXPECT_FALSE(options.IsValid(&error));
+  EXPECT_NE(error.find("length_noise_m"), std::string::npos) << error;
+}
+
 TEST(SimulationTest, DensityMismatchChangesTheTruthReproducibly) {
   const CableRobot truth = CableRobot::NominalFast();
   const std::vector<Pose> planned = Circle(6);

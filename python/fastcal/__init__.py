@@ -51,6 +51,7 @@ __all__ = [
     "Dataset",
     "Error",
     "InputError",
+    "LocateResult",
     "Model",
     "StaticsResult",
     "__version__",
@@ -61,6 +62,7 @@ __all__ = [
     "focal_attitude",
     "focal_grid",
     "line",
+    "locate",
     "quat_from_rpy_deg",
     "random_workspace",
     "read_dataset",
@@ -126,7 +128,7 @@ def _rows(value: ArrayLike, columns: int, name: str) -> Tuple[np.ndarray, bool]:
 
 
 def _attitude(
-    n: int, rpy_deg: Optional[ArrayLike], quat: Optional[ArrayLike]
+    n: int, rpy_deg: Optional[ArrayLike], quat: Optional[ArrayLike], rows_of: str = "positions"
 ) -> Tuple[str, np.ndarray]:
     """The attitude arguments as the core takes them: a kind and an (n, k) array."""
     if rpy_deg is not None and quat is not None:
@@ -139,7 +141,7 @@ def _attitude(
     if array.shape[0] == 1 and n > 1:  # one attitude for every position, as numpy broadcasts
         array = np.ascontiguousarray(np.repeat(array, n, axis=0))
     if array.shape[0] != n:
-        raise InputError(f"{name} has {array.shape[0]} rows for {n} positions")
+        raise InputError(f"{name} has {array.shape[0]} rows for {n} {rows_of}")
     return kind, array
 
 
@@ -336,6 +338,183 @@ def solve(
         },
     )
     return StaticsResult(raw, single)
+
+
+STABILITY_NAMES: List[str] = _fastcal.stability_names()
+"""The stability of a located pose, by code: 'unknown' (no answer), 'stable',
+'unstable', 'marginal' (fastcal locate's stability column)."""
+_STABILITY_NAMES_ARRAY = np.array(STABILITY_NAMES, dtype=object)
+
+
+class LocateResult:
+    """Where the cabin hangs for one row of lengths or n rows (fastcal.locate).
+
+    For n rows (lengths of shape (n, 6)) each array has a leading axis of n; for one
+    ((6,)) it has none, and `status`, `ok`, `stability` are scalars.
+
+    Attributes:
+        position_m: the cabin-frame origin, global frame, (n, 3).
+        quat: the attitude as unit quaternions (w, x, y, z), (n, 4); rpy_deg the same as
+            roll, pitch, yaw, R = Rz(yaw) Ry(pitch) Rx(roll), (n, 3).
+        lower_tension_kN: the tensions at the cabin ends there, (n, 6).
+        s0_m: the lengths of the answer's equilibrium, (n, 6): the given ones for lengths
+            alone, the fitted pose's with a measured attitude or tensions.
+        status: 'ok' or why not ('no_equilibrium', 'overstretched_cable', ...;
+            STATUS_NAMES), ok: status == 'ok'.
+        stability: 'stable', 'unstable', 'marginal' ('unknown' where not ok).
+        min_stiffness_kN_per_m: smallest eigenvalue of the stiffness of the potential
+            energy with the lengths held (rotations scaled by the cabin's size): < 0 unstable.
+        other_equilibria: other equilibria of the same lengths found within
+            search_radius_m; nearest_other_m their nearest's distance (NaN: none).
+        covariance: of (position (m), rotation vector (rad, global axes)), (n, 6, 6);
+            sigma_position_m (n, 3) and sigma_rpy_deg (n, 3) from it.
+        pose_per_length: d(position, rotation vector)/d s0_j, (n, 6, 6).
+        readings, chi2: readings the pose fits and their whitened residuals squared
+            (lengths alone: 6 and 0).
+        error_estimate_m: the next Newton step's size after the last.
+        messages: row index -> the account of a row that failed, is not stable or has
+            another equilibrium nearby (the CLI's words).
+
+    A failed row has NaN numbers, with `status` saying why.
+    """
+
+    def __init__(self, raw: Dict[str, Any], single: bool) -> None:
+        self._single = single
+        pick = (lambda a: a[0]) if single else (lambda a: a)
+        codes = raw["status_code"]
+        self.position_m: np.ndarray = pick(raw["position_m"])
+        self.quat: np.ndarray = pick(raw["quat"])
+        rpy = np.full((len(codes), 3), np.nan)
+        ok = codes == 0
+        if ok.any():
+            rpy[ok] = _fastcal.rpy_deg_from_quat(raw["quat"][ok])
+        self.rpy_deg: np.ndarray = pick(rpy)
+        self.lower_tension_kN: np.ndarray = pick(raw["lower_tension_kN"])
+        self.s0_m: np.ndarray = pick(raw["s0_m"])
+        self.status = pick(_STATUS_NAMES_ARRAY[codes])
+        self.ok = pick(ok)
+        self.stability = pick(_STABILITY_NAMES_ARRAY[raw["stability_code"]])
+        self.min_stiffness_kN_per_m = pick(raw["min_stiffness_kN_per_m"])
+        self.other_equilibria = pick(raw["other_equilibria"])
+        self.nearest_other_m = pick(raw["nearest_other_m"])
+        covariance = raw["covariance"]
+        self.covariance: np.ndarray = pick(covariance)
+        variances = np.diagonal(covariance, axis1=1, axis2=2)
+        self.sigma_position_m: np.ndarray = pick(np.sqrt(np.maximum(variances[:, :3], 0.0)))
+        sigma_rpy = np.full((len(codes), 3), np.nan)
+        if ok.any():
+            j = _fastcal.rpy_deg_per_rotation_vector(raw["quat"][ok])
+            c = np.einsum("kab,kbc,kdc->kad", j, covariance[ok][:, 3:, 3:], j)
+            sigma_rpy[ok] = np.sqrt(np.maximum(np.diagonal(c, axis1=1, axis2=2), 0.0))
+        self.sigma_rpy_deg: np.ndarray = pick(sigma_rpy)
+        self.pose_per_length: np.ndarray = pick(raw["pose_per_length"])
+        self.readings = pick(raw["readings"])
+        self.chi2 = pick(raw["chi2"])
+        self.error_estimate_m = pick(raw["error_estimate_m"])
+        self.messages: Dict[int, str] = dict(raw["messages"])
+
+    def __len__(self) -> int:
+        return 1 if self._single else len(self.ok)
+
+    def __repr__(self) -> str:
+        n = len(self)
+        failed = n - int(np.sum(self.ok))
+        unstable = int(np.sum(np.atleast_1d(self.stability) != "stable")) - failed
+        return (
+            f"<fastcal.LocateResult: {n} row{'s' if n != 1 else ''}, {failed} failed, "
+            f"{unstable} not stable>"
+        )
+
+
+@_renamed_keywords({"min_reflector_clearance_m": "reflector_clearance_m"})
+def locate(
+    lengths_m: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    tensions_kN: Optional[ArrayLike] = None,
+    model: Optional[Model] = None,
+    *,
+    warm_start: bool = True,
+    search_radius_m: float = 2.0,
+    spec: Optional[Union[PathLike, Mapping[str, Any]]] = None,
+    length_sigma_m: Optional[float] = None,
+    tension_sigma_percent: Optional[float] = None,
+    tension_sigma_kN: Optional[float] = None,
+    attitude_sigma_deg: float = 0.05,
+    max_strain: float = 0.05,
+    max_length_ratio: float = 1.5,
+    reflector_clearance_m: float = 0.0,
+) -> LocateResult:
+    """Where the cabin hangs, from the six unstretched cable lengths (forward statics).
+
+    Args:
+        lengths_m: unstretched lengths s0, cable 1 first: (6,) or (n, 6).
+        rpy_deg, quat: a measured attitude per row ((3,)/(n, 3) or (4,)/(n, 4)), at most
+            one: the pose is then fitted to the lengths and the attitude together.
+        tensions_kN: measured tension readings per row, (6,) or (n, 6) (the model's
+            sensor gain and bias apply): fitted too.
+        model: the model; None for Model.nominal().
+        warm_start: each row starts from the previous row's answer (a trajectory); the
+            first, and any whose warm start fails, follows the equilibrium from the home
+            pose as the lengths move from its lengths to the row's.
+        search_radius_m: look for other equilibria of the same lengths this far from the
+            answer (m, anchors' move); 0: none.
+        spec: a calibration spec (file or dict) whose noise gives the sigmas below
+            (its tension sigmas, and length_sigma_m when it has one), as `fastcal locate
+            --spec`; a sigma given as a keyword overrides it.
+        length_sigma_m, tension_sigma_percent, tension_sigma_kN, attitude_sigma_deg:
+            the measurements' sigmas (the fit's weights, and `covariance`); without
+            them and a spec 0.01 m, 3 %, 0 kN (attitude 0.05 deg).
+        max_strain, max_length_ratio, reflector_clearance_m: the model's range, as in
+            solve() (min_reflector_clearance_m, the former name, warns).
+
+    Returns:
+        A LocateResult (arrays with a leading axis of n for (n, 6) lengths). Rows that
+        fail are marked in `status`/`ok`, not raised. Solved in C++ without the GIL.
+
+    Raises:
+        InputError: a wrong shape, a non-unit quaternion, a bad sigma or option.
+    """
+    lengths, single = _rows(lengths_m, 6, "lengths_m")
+    n = lengths.shape[0]
+    kind, attitude = _attitude(n, rpy_deg, quat, "rows of lengths_m")
+    if tensions_kN is None:
+        tensions = np.zeros((0, 6))
+    else:
+        tensions, _ = _rows(tensions_kN, 6, "tensions_kN")
+    robot = model if model is not None else Model.nominal()
+    noise: Dict[str, Any] = {
+        "length_sigma_m": 0.01,
+        "tension_sigma_percent": 3.0,
+        "tension_sigma_kN": 0.0,
+    }
+    if spec is not None:
+        given = _fastcal.spec_noise(robot, *_spec_argument(spec))
+        noise.update({k: v for k, v in given.items() if v is not None})
+    for name, value in (
+        ("length_sigma_m", length_sigma_m),
+        ("tension_sigma_percent", tension_sigma_percent),
+        ("tension_sigma_kN", tension_sigma_kN),
+    ):
+        if value is not None:
+            noise[name] = value
+    raw = _fastcal.locate(
+        robot,
+        lengths,
+        kind,
+        attitude,
+        tensions,
+        {
+            "warm_start": warm_start,
+            "search_radius_m": search_radius_m,
+            **noise,
+            "attitude_sigma_deg": attitude_sigma_deg,
+            "max_strain": max_strain,
+            "max_length_ratio": max_length_ratio,
+            "min_reflector_clearance_m": reflector_clearance_m,
+        },
+    )
+    return LocateResult(raw, single)
 
 
 def line(from_m: ArrayLike, to_m: ArrayLike, nodes: int = 101) -> np.ndarray:
@@ -715,6 +894,8 @@ _SIMULATE_OPTIONS = sorted(
     + [
         "attitude_control_time_s",
         "density_mismatch_percent",
+        "length_noise_m",
+        "length_offset_spread_m",
         "mass_centre_drift_m",
         "mass_centre_drift_time_s",
         "mass_centre_steps",
@@ -769,8 +950,10 @@ def simulate(
     outlier_scale_percent, attitude_control_deg, attitude_control_time_s,
     attitude_noise_deg, position_noise_m, tension_drift_percent, tension_drift_time_s,
     mass_centre_drift_m, mass_centre_drift_time_s, sensor_gain_spread_percent,
-    sensor_bias_spread_kN, density_mismatch_percent, interval_s (1), seed (1), method
-    ('exact'), sessions (1: the samples cut into that many consecutive sessions,
+    sensor_bias_spread_kN, density_mismatch_percent, length_offset_spread_m and
+    length_noise_m (the s0 columns: encoder offsets drawn once, written into the truth
+    model, and reading noise), interval_s (1), seed (1),
+    method ('exact'), sessions (1: the samples cut into that many consecutive sessions,
     labelled 1..N), mass_centre_steps ([(time_s, (dx, dy, dz)), ...]: the mass centre
     moves by the shift at that time and stays). The former names, SimulationOptions'
     fields (attitude_control_sigma_deg, tension_noise_kn, sample_interval_s, ...), still
@@ -813,7 +996,12 @@ class CalibrationResult:
         free_names: the free parameters, in the order of `correlation`'s rows.
         correlation: correlation matrix of the free estimates (total covariance), (k, k).
         outliers: the gross errors kept out of the fit, in file order: dicts of line,
-            cable (1-6), measured_kN, predicted_kN, residual_sigma, held_out.
+            cable (1-6), reading ('tension', or 'length' with the lengths in the fit),
+            measured_kN and predicted_kN (a length: measured_m, predicted_m),
+            residual_sigma, held_out.
+        lengths: with the lengths in the fit (spec noise.length_sigma_m), a dict of
+            sigma_m and per cable (6,) initial_rms_m, calibrated_rms_m,
+            calibrated_mean_m (model minus measured); None without.
         worst_readings: the fitted readings with the largest |residual| / sigma.
         misfit_ranking: fixed parameters by the chi-square decrease freeing each would
             bring (name, expected_chi_square_decrease, significant); misfit_threshold
@@ -863,6 +1051,7 @@ class CalibrationResult:
             if v["holdout"] is not None
         }
         self.cross_validation_rms_kN: Optional[np.ndarray] = raw["cross_validation_rms_kN"]
+        self.lengths: Optional[Dict[str, Any]] = raw["lengths"]
         self.verdict: str = raw["verdict"]
         self.verdict_text: str = raw["verdict_text"]
         self.notes: List[str] = raw["notes"]

@@ -95,6 +95,7 @@ std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::str
 
 void BindModel(py::module_& m);
 void BindStatics(py::module_& m);
+void BindLocate(py::module_& m);
 void BindData(py::module_& m);
 void BindCalibration(py::module_& m);
 void BindDesign(py::module_& m);

@@ -67,8 +67,14 @@ py::dict Reading(const ReadingResidual& r) {
   py::dict d;
   d["line"] = r.line;
   d["cable"] = r.cable;
-  d["measured_kN"] = r.measured_n / kNPerKn;
-  d["predicted_kN"] = r.predicted_n / kNPerKn;
+  d["reading"] = r.length ? "length" : "tension";
+  if (r.length) {
+    d["measured_m"] = r.measured_m;
+    d["predicted_m"] = r.predicted_m;
+  } else {
+    d["measured_kN"] = r.measured_n / kNPerKn;
+    d["predicted_kN"] = r.predicted_n / kNPerKn;
+  }
   d["residual_sigma"] = r.residual_sigma;
   d["held_out"] = r.held_out;
   return d;
@@ -185,6 +191,16 @@ py::dict ResultDict(const CalibrationResult& r) {
                                      ? py::object(PerCableKn(r.cross_validation.rms_n))
                                      : py::object(py::none());
   d["residual_tau"] = PerCable(r.residual_tau);
+  if (r.lengths.used) {  // model minus measured lengths per cable (m), before and after
+    py::dict lengths;
+    lengths["sigma_m"] = r.lengths.sigma_m;
+    lengths["initial_rms_m"] = PerCable(r.lengths.initial.rms_m);
+    lengths["calibrated_rms_m"] = PerCable(r.lengths.calibrated.rms_m);
+    lengths["calibrated_mean_m"] = PerCable(r.lengths.calibrated.mean_m);
+    d["lengths"] = lengths;
+  } else {
+    d["lengths"] = py::none();
+  }
   py::dict budget;
   budget["reduced_chi_square"] = r.budget.reduced_chi_square;
   budget["misfit_factor"] = r.budget.misfit_factor;
@@ -296,9 +312,24 @@ py::dict Evaluate(const CableRobot& model_argument, const Dataset& data,
   return out;
 }
 
+// A spec's white noise, for locate's weights (fastcal.locate(spec=...)): the tension
+// sigmas, and the lengths' when the spec has them (None otherwise).
+py::dict SpecNoise(const CableRobot& model, const std::string& spec_path_or_text, bool spec_is_text,
+                   const std::string& spec_source) {
+  const CalibrationSpec spec = Spec(model, spec_path_or_text, spec_is_text, spec_source);
+  py::dict d;
+  d["tension_sigma_kN"] = spec.tension_sigma_n / kNPerKn;
+  d["tension_sigma_percent"] = spec.tension_sigma_percent;
+  d["length_sigma_m"] =
+      spec.UsesLengths() ? py::object(py::float_(spec.length_sigma_m)) : py::object(py::none());
+  return d;
+}
+
 }  // namespace
 
 void BindCalibration(py::module_& m) {
+  m.def("spec_noise", &SpecNoise, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
+        py::arg("spec_source"));
   m.def("calibrate", &Calibrate, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
         py::arg("spec_source"), py::arg("data"));
   m.def("evaluate", &Evaluate, py::arg("model"), py::arg("data"), py::arg("method"));

@@ -55,6 +55,8 @@ SimulationOptions MakeSimulationOptions(const py::dict& kwargs) {
       {"outlier_fraction", &o.outlier_fraction},
       {"outlier_scale_percent", &o.outlier_scale_percent},
       {"density_mismatch_percent", &o.density_mismatch_percent},
+      {"length_offset_spread_m", &o.length_offset_spread_m},
+      {"length_noise_m", &o.length_noise_m},
       {"sample_interval_s", &o.sample_interval_s}};
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::str(key);
@@ -117,6 +119,9 @@ py::dict SummaryDict(const SimulationSummary& s) {
   d["mass_centre_mean_m"] =
       std::vector<double>(s.mass_centre_mean_m.data(), s.mass_centre_mean_m.data() + 3);
   d["mass_centre_drift_rms_m"] = s.mass_centre_drift_rms_m;
+  d["length_offset_m"] = std::vector<double>(s.length_offset_m.begin(), s.length_offset_m.end());
+  d["length_noise_rms_m"] =
+      std::vector<double>(s.length_noise_rms_m.begin(), s.length_noise_rms_m.end());
   return d;
 }
 

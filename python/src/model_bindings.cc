@@ -308,6 +308,9 @@ ValueError ("assignment destination is read-only") instead of changing nothing.
                    "Mass per unit unstretched length of each cable, shape (6,).");
   PerCableProperty(model, "sensor_gain", &CableProperties::sensor_gain,
                    "Tension sensor gain per cable: reading = gain * tension + bias, shape (6,).");
+  PerCableProperty(model, "length_offset_m", &CableProperties::length_offset_m,
+                   "Length encoder zero per cable (m): reading = unstretched length + offset, "
+                   "shape (6,).");
   // The bias in kN, as every tension of the module and the model file's key
   // (sensor_bias_kN); formerly sensor_bias_n, in N (docs/python.md, Decisions).
   model.def_property(

@@ -43,6 +43,10 @@ struct CableProperties {
   // sensor_bias_kN, optional).
   double sensor_gain = 1.0;
   double sensor_bias_n = 0.0;
+  // The winch's length encoder: measured length = unstretched length s0 + this offset
+  // (its zero). 0 by default; a calibration with lengths may estimate it (YAML key
+  // length_offset_m, optional).
+  double length_offset_m = 0.0;
   // Sensors, connectors and hung lines the cable carries (cable_attachment.h), in the
   // model file's order; none for a uniform cable. At most kMaxAttachmentsPerCable.
   std::vector<CableAttachment> attachments;
@@ -50,6 +54,8 @@ struct CableProperties {
   // What this cable's sensor reads when the cable's lower-end tension is `tension_n`
   // (e.g. StaticsSolution's lower_tension_n, which is the true tension).
   double SensorReadingN(double tension_n) const { return sensor_gain * tension_n + sensor_bias_n; }
+  // What this cable's encoder reads when its unstretched length is `length_m`.
+  double EncoderReadingM(double length_m) const { return length_m + length_offset_m; }
 };
 
 // The reflector: the lower cap of a sphere, within a circle of diameter aperture_m seen

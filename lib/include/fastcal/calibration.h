@@ -42,8 +42,8 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/gross_errors.h"
-#include "fastcal/sessions.h"
 #include "fastcal/sensor_steps.h"
+#include "fastcal/sessions.h"
 #include "fastcal/slow_error.h"
 #include "fastcal/uncertainty.h"
 
@@ -77,6 +77,8 @@ struct CalibrationOptions {
   // hung lines 0.6-1.6 kg/m; an estimate this uncertain says little about either.
   double max_sigma_attachment_mass_kg = 100.0;
   double max_sigma_attachment_density_kg_per_m = 0.5;
+  // A winch encoder's zero (length_offset_m): a decimetre says little about a length.
+  double max_sigma_length_offset_m = 0.1;
   // A reduced chi-square above this is a fit that failed (the typical residual 5 times
   // the stated noise): the model does not describe the data, and the linearised
   // uncertainties no longer mean anything. Between the band and this the misfit is
@@ -165,7 +167,8 @@ struct ParameterEstimate {
   double moved_by_sigmas = 0.0;
 };
 
-// One tension reading: a gross error, or one of the worst fitted readings.
+// One reading, a tension or (with lengths in the fit) a length: a gross error, or one of
+// the worst fitted readings.
 struct ReadingResidual {
   int sample = -1;  // index into Dataset::samples
   int line = 0;     // line in the file
@@ -174,6 +177,11 @@ struct ReadingResidual {
   double predicted_n = 0.0;     // the model's reading at the solution
   double residual_sigma = 0.0;  // (predicted - measured) / sigma at the solution
   bool held_out = false;
+  // A length reading (s0_<cable>_m): measured and predicted (s0 + offset) in metres, and
+  // measured_n, predicted_n 0. A slipped encoder is a gross error of a length.
+  bool length = false;
+  double measured_m = 0.0;
+  double predicted_m = 0.0;
 };
 
 struct GrossErrorSummary {
@@ -190,6 +198,31 @@ struct GrossErrorSummary {
   int fitted_readings = 0;  // readings of the fitted samples
   int fitted_flagged = 0;
   bool settled = true;  // the flagged set stopped changing before max_passes
+  // With lengths in the fit, the same per cable for the length readings (screened on
+  // their own: another sensor, another scale).
+  std::array<double, kNumCables> length_centre{};
+  std::array<double, kNumCables> length_scale{};
+  std::array<int, kNumCables> length_count{};
+};
+
+// Model minus measured length per cable (m): s0 of the model at the sample's pose plus
+// the encoder's offset, against the s0_<i>_m column.
+struct LengthResidualStats {
+  int samples = 0;
+  std::array<int, kNumCables> excluded{};  // gross errors left out, per cable
+  std::array<double, kNumCables> mean_m{};
+  std::array<double, kNumCables> rms_m{};
+  std::array<double, kNumCables> max_abs_m{};
+};
+
+// The lengths in a calibration (spec noise.length_sigma_m): their residuals per cable at
+// the initial and at the calibrated parameters, over the fitted samples and the held-out
+// ones, gross errors left out.
+struct LengthEvaluation {
+  bool used = false;
+  double sigma_m = 0.0;
+  LengthResidualStats initial, calibrated;
+  LengthResidualStats initial_holdout, calibrated_holdout;  // samples 0: nothing held out
 };
 
 // The chi-square decrease expected from freeing a fixed parameter (score test), with
@@ -246,7 +279,8 @@ struct CalibrationResult {
   // Gross errors among the readings, in file order, and the screen's numbers.
   std::vector<ReadingResidual> gross_errors;
   GrossErrorSummary gross_error_summary;
-  ReadingMask excluded;  // per dataset sample: readings kept out (the gross errors)
+  ReadingMask excluded;         // per dataset sample: readings kept out (the gross errors)
+  ReadingMask length_excluded;  // the same for the lengths (empty without them)
   // The fitted readings with the largest |residual| / sigma, largest first.
   std::vector<ReadingResidual> worst_readings;
   // Every fixed parameter the model has, by the chi-square decrease expected from
@@ -260,6 +294,8 @@ struct CalibrationResult {
   // initial model at each attitude the data has, then the calibrated one at the fit's
   // attitude (the last). Empty with CalibrationOptions::evaluate off.
   std::vector<VariantEvaluation> variants;
+  // The lengths' residuals before and after (used false without lengths in the fit).
+  LengthEvaluation lengths;
   // The slow sensor error the fit whitened by, and what the residuals say of it
   // (spec noise.slow_error; slow_error.h). enabled false: white noise only.
   SlowErrorReport slow_error;

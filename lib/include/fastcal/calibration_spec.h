@@ -14,6 +14,9 @@
 //   attachment_mass_kg[i][j]        kg    point mass j of cable i (cable_attachment.h;
 //   attachment_density_kg_per_m[i][j] kg/m  added density j of cable i; j = 1.. counts
 //                                         the cable's attachments in the model file)
+//   length_offset_m / length_offset_m[i]  m  a winch encoder's zero: measured length =
+//                                         unstretched length + offset (needs the lengths
+//                                         in the fit: noise.length_sigma_m)
 // Values in the file are in the unit the name carries (kN for the bias); inside
 // everything is SI (ParameterSpec::to_si converts).
 #ifndef FASTCAL_CALIBRATION_SPEC_H_
@@ -40,6 +43,7 @@ enum class ParameterKind {
   // cables[index].attachments (of the matching kind).
   kAttachmentMass,
   kAttachmentDensity,
+  kLengthOffset,  // cable = 0..5, or -1 for common
 };
 
 struct ParameterSpec {
@@ -98,6 +102,12 @@ struct CalibrationSpec {
   // the model's reading (docs/calibration.md: why not the measured one).
   double tension_sigma_n = 0.0;
   double tension_sigma_percent = 3.0;
+  // The winches' lengths (the dataset's s0_<i>_m columns) as measurements, each with this
+  // sigma (m): rows beside each sample's six tensions, residual (s0_model + offset -
+  // measured) / sigma (docs/calibration.md, "Lengths"). 0 (the default): lengths are not
+  // used. Needs forward_model exact.
+  double length_sigma_m = 0.0;
+  bool UsesLengths() const { return length_sigma_m > 0.0; }
   // Slow error of each tension reading, on top of the white noise above (slow_error.h).
   SlowErrorSpec slow_error;
   RobustLoss robust_loss = RobustLoss::kNone;

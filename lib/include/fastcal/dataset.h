@@ -44,7 +44,9 @@ struct Sample {
   // Measured lower-end cable tensions, cable i at index i-1 (>= 0: 0 is a dropout, which
   // a calibration flags as a gross error; at most PlausibilityLimits::max_tension_n).
   std::array<double, kNumCables> tension_n{};
-  // Commanded unstretched cable lengths, when the file has the s0_*_m columns (> 0).
+  // The winches' length readings, when the file has the s0_*_m columns (> 0): each cable's
+  // unstretched length as its encoder gives it (commanded or measured), the model's s0
+  // plus CableProperties::length_offset_m.
   bool has_unstretched_lengths = false;
   std::array<double, kNumCables> unstretched_length_m{};
   // The survey (session) the sample belongs to: an index into Dataset::session_labels,
@@ -67,6 +69,12 @@ struct Dataset {
   bool has_unstretched_lengths = false;
   // Measured attitude given as qw,qx,qy,qz (true) or roll_deg,pitch_deg,yaw_deg (false).
   bool attitude_as_quaternion = false;
+  // Always true for a measurement file; a lengths file (DatasetColumns::kLengths) may
+  // lack any of these groups, whose values are then 0 (the identity attitude) and unused.
+  bool has_time = true;
+  bool has_position = true;
+  bool has_measured_attitude = true;
+  bool has_tensions = true;
   // The sessions, in the order of their first sample (docs/data-format.md, "Sessions"):
   // from the file's `session` column, or one per file when several files are merged
   // (sessions.h). Empty: no session column, one survey.
@@ -84,7 +92,18 @@ struct Dataset {
   int time_offset_s = 0;
 };
 
+// The columns a file must have (docs/data-format.md).
+enum class DatasetColumns {
+  // A measurement file (calibrate, evaluate): time_s, the position, the measured attitude
+  // and the six tensions; the planned attitude and the lengths optional.
+  kMeasurements,
+  // A lengths file (fastcal locate): the six s0_<i>_m; time_s, the position, the measured
+  // attitude, the planned attitude and the tensions optional, each group complete or absent.
+  kLengths,
+};
+
 struct DatasetReadOptions {
+  DatasetColumns required_columns = DatasetColumns::kMeasurements;
   // When true, a row with a problem in its values (wrong number of fields, a missing,
   // non-numeric or non-finite value, a value beyond `limits` below, a non-unit quaternion)
   // is skipped and listed in Dataset::skipped instead of failing the read.

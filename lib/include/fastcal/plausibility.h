@@ -69,6 +69,11 @@ struct PlausibilityLimits {
   double max_sensor_gain = 2.0;
   // Largest |bias|, N: half the working tension of about 200 kN.
   double max_abs_sensor_bias_n = 1.0e5;
+  // Largest |zero offset| of a winch's length encoder, m: a winch re-zeroed a few metres
+  // off is possible; 20 m (7% of a cable) is a configuration slip.
+  double max_abs_length_offset_m = 20.0;
+  // Stated length noise, m: a metre would make the lengths worthless for the pose.
+  double max_length_sigma_m = 1.0;
   // Stated tension noise: beyond a quarter of the working tension (50 kN) or 50% the
   // readings would carry no information.
   double max_tension_sigma_n = 5.0e4;
@@ -131,6 +136,8 @@ enum class ModelQuantity {
   kOffsetM,  // one component of an anchor or tower offset
   kSensorGain,
   kSensorBiasN,
+  kLengthOffsetM,  // a winch encoder's zero offset
+  kLengthSigmaM,   // stated noise of a measured length
   kTensionSigmaN,
   kTensionSigmaPercent,
   kAttachmentMassKg,

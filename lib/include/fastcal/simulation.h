@@ -21,6 +21,8 @@
 //                        process (slow_error.h)
 //                        or, with probability outlier_fraction, an outlier
 //                        m_i    = y_i (1 + U(-s, s) / 100),  s = outlier_scale_percent
+//   measured length     l_i    = s0_i + o_i + N(0, length_noise_m)   (a winch's encoder,
+//                                o_i its zero offset: the truth model's length_offset_m)
 //   measured attitude   a_meas = a_act + N(0, attitude_measurement_sigma_deg)  per rpy angle
 //   measured position   p_meas = p + N(0, position_measurement_sigma_m)        per axis
 // with R(a) = RotationFromRpyDeg(a) and a_plan = RpyDegFromRotation(planned rotation).
@@ -30,7 +32,8 @@
 // Drawn once, before the trajectory (the truth model written out has them): each cable's
 // linear density times (1 + N(0, density_mismatch_percent / 100)) (non-uniform cables:
 // sensors, wiring); its sensor gain times (1 + N(0, sensor_gain_spread_percent / 100));
-// its sensor bias plus N(0, 1000 sensor_bias_spread_kn) N.
+// its sensor bias plus N(0, 1000 sensor_bias_spread_kn) N; its length encoder's offset plus
+// N(0, length_offset_spread_m).
 //
 // Random numbers: std::mt19937_64, converted by hand (uniform from the top 53 bits,
 // Gaussian by Box-Muller), so a seed gives the same dataset with every standard library.
@@ -102,6 +105,11 @@ struct SimulationOptions {
   // Standard deviation of the per-cable density factor of the truth model, in percent.
   // >= 0; default 0 (the truth model as given).
   double density_mismatch_percent = 0.0;
+  // Spread of the per-cable length-encoder offsets drawn once about the truth model's
+  // (m), and the white noise of each length reading (m). >= 0; default 0: the datasets'
+  // s0 columns are then the truth's unstretched lengths exactly.
+  double length_offset_spread_m = 0.0;
+  double length_noise_m = 0.0;
   // Seed of all generators; default 1.
   std::uint64_t seed = 1;
   // Statics method of the truth tensions and lengths; default exact.
@@ -147,6 +155,10 @@ struct SimulationSummary {
   double position_measurement_rms_m = 0.0;
   // Density factors applied to the truth model, cable i at index i-1.
   std::array<double, kNumCables> density_factor{};
+  // Per cable: the length encoder's offset of the truth model used (m), and the RMS of the
+  // length noise added (m).
+  std::array<double, kNumCables> length_offset_m{};
+  std::array<double, kNumCables> length_noise_rms_m{};
   // Per cable: RMS of the slow tension error u (dimensionless).
   std::array<double, kNumCables> tension_drift_rms_relative{};
   // Each session's sensor biases (N), first session first (they differ when re-zeroed).
@@ -162,8 +174,9 @@ struct SimulationSummary {
 // planned pose, in order: time, measured position and attitude (as roll/pitch/yaw;
 // Sample::measured_rpy_deg and pose.rotation agree exactly), the planned attitude
 // (planned_rpy_deg = RpyDegFromRotation(planned rotation), planned_rotation rebuilt from
-// those angles, so equal to the planned rotation to rounding), the measured tensions and,
-// as the commanded lengths, the truth solution's unstretched lengths. Every value is such
+// those angles, so equal to the planned rotation to rounding), the measured tensions and
+// the measured lengths (the truth solution's unstretched lengths through the encoders:
+// offset and noise). Every value is such
 // that WriteDataset then ReadDataset gives back the same dataset. *truth_used receives
 // the truth model after the density mismatch (the model the tensions come from).
 //

@@ -31,9 +31,11 @@ namespace fastcal {
 
 int internal::CountExcluded(const Run& run) {
   int count = 0;
-  if (run.excluded.empty()) return 0;
-  for (int t : run.fit) {
-    for (bool e : run.excluded[t]) count += e;
+  for (const ReadingMask* mask : {&run.excluded, &run.length_excluded}) {
+    if (mask->empty()) continue;
+    for (int t : run.fit) {
+      for (bool e : (*mask)[t]) count += e;
+    }
   }
   return count;
 }
@@ -43,12 +45,29 @@ ReadingResidual internal::ReadingAt(const Run& run, int t, int i) {
   const Sample& s = run.data.samples[t];
   g.sample = t;
   g.line = s.line;
-  g.cable = i + 1;
-  g.measured_n = s.tension_n[i];
-  g.predicted_n = run.at.reading_n[t][i];
-  g.residual_sigma = run.at.whitened[t][i];
   g.held_out = !run.is_fit[t];
+  g.length = i >= kNumCables;
+  const int c = i % kNumCables;
+  g.cable = c + 1;
+  if (g.length) {
+    g.measured_m = s.unstretched_length_m[c];
+    g.predicted_m = run.at.length_m[t][c];
+    g.residual_sigma = run.at.length_whitened[t][c];
+    return g;
+  }
+  g.measured_n = s.tension_n[c];
+  g.predicted_n = run.at.reading_n[t][c];
+  g.residual_sigma = run.at.whitened[t][c];
   return g;
+}
+
+bool internal::ReadingExcluded(const Run& run, int t, int i) {
+  const ReadingMask& mask = i < kNumCables ? run.excluded : run.length_excluded;
+  return !mask.empty() && mask[t][i % kNumCables];
+}
+
+double internal::ReadingWhitened(const Run& run, int t, int i) {
+  return i < kNumCables ? run.at.whitened[t][i] : run.at.length_whitened[t][i - kNumCables];
 }
 
 namespace {
@@ -130,6 +149,12 @@ CalibrationStatus ValidateInputs(Run& run) {
                         " models uniform cables, but the model's cables carry attachments; "
                         "use forward_model: exact");
   }
+  if (run.spec.UsesLengths() && !run.data.has_unstretched_lengths) {
+    return run.Fail(CalibrationStatus::kInvalidInput,
+                    run.data.path +
+                        ": the spec fits the lengths (noise.length_sigma_m) but the dataset has "
+                        "no s0_1_m ... s0_6_m columns");
+  }
   if (run.spec.use_planned_attitude && !run.data.has_planned_attitude) {
     return run.Fail(CalibrationStatus::kInvalidInput,
                     run.data.path +
@@ -161,7 +186,7 @@ CalibrationStatus ValidateInputs(Run& run) {
   }
   r.num_fit_samples = static_cast<int>(run.fit.size());
   for (int k = 0; k < run.n; ++k) run.num_priors += run.Free(k).has_prior;
-  r.num_residuals = kNumCables * r.num_fit_samples + run.num_priors;
+  r.num_residuals = run.Readings() * r.num_fit_samples + run.num_priors;
   if (run.fit.empty()) return run.Fail(CalibrationStatus::kInvalidInput, "no samples to fit");
   if (r.num_residuals <= run.n) {
     return run.Fail(CalibrationStatus::kInvalidInput,
@@ -227,16 +252,20 @@ CalibrationStatus Predict(Run& run) {
   // One model per session (a single one without sessions).
   const size_t sessions = std::max<size_t>(1, run.data.session_labels.size());
   std::vector<StaticsParameters<double>> session_params(sessions);
-  std::vector<std::array<double, kNumCables>> session_gain(sessions), session_bias(sessions);
+  std::vector<std::array<double, kNumCables>> session_gain(sessions), session_bias(sessions),
+      session_offset(sessions);
   for (size_t k = 0; k < sessions; ++k) {
     run.cm->Assemble(run.theta.data(), &session_params[k], &session_gain[k], &session_bias[k],
-                     static_cast<int>(k));
+                     static_cast<int>(k), &session_offset[k]);
   }
+  const bool lengths = run.spec.UsesLengths();
   const int num_samples = static_cast<int>(run.data.samples.size());
   Prediction& at = run.at;
   at.reading_n.resize(num_samples);
   at.sigma_n.resize(num_samples);
   at.whitened.resize(num_samples);
+  at.length_m.resize(lengths ? num_samples : 0);
+  at.length_whitened.resize(lengths ? num_samples : 0);
   // Each sample starts from its statics at the previous parameters, when there are any.
   if (at.starts.method() != run.statics.method ||
       at.starts.size() != static_cast<size_t>(num_samples)) {
@@ -268,6 +297,12 @@ CalibrationStatus Predict(Run& run) {
           for (int i = 0; i < kNumCables; ++i) {
             at.whitened[t][i] = (at.reading_n[t][i] - sample.tension_n[i]) / at.sigma_n[t][i];
           }
+          for (int i = 0; i < kNumCables && lengths; ++i) {
+            at.length_m[t][i] =
+                solution.cables[i].unstretched_length_m + session_offset[sample.session][i];
+            at.length_whitened[t][i] =
+                (at.length_m[t][i] - sample.unstretched_length_m[i]) / run.spec.length_sigma_m;
+          }
         }
         return -1;
       });
@@ -284,15 +319,18 @@ CalibrationStatus Predict(Run& run) {
 // The screen's threshold: the spec's as a floor, raised with the number of readings
 // screened (all samples') so that noise alone names none (gross_errors.h).
 GrossErrorThreshold ScreenThreshold(const Run& run) {
-  return ChooseGrossErrorThreshold(static_cast<long long>(kNumCables) * run.data.samples.size(),
+  return ChooseGrossErrorThreshold(static_cast<long long>(run.Readings()) * run.data.samples.size(),
                                    run.spec.gross_error_threshold_sigmas);
 }
 
-// Stage helper: the gross errors at the current prediction, judged by the fitted samples.
-ReadingMask ScreenReadings(Run& run) {
+// Stage helper: the gross errors at the current prediction, judged by the fitted samples:
+// the tensions' and, with lengths in the fit, the lengths' (*lengths; each reading
+// against its own cable's robust scale).
+ReadingMask ScreenReadings(Run& run, ReadingMask* lengths) {
+  lengths->clear();
   if (!run.spec.detect_gross_errors) return {};
-  GrossErrorScreen screen =
-      ScreenGrossErrors(run.at.whitened, run.is_fit, ScreenThreshold(run).sigmas);
+  const double threshold = ScreenThreshold(run).sigmas;
+  GrossErrorScreen screen = ScreenGrossErrors(run.at.whitened, run.is_fit, threshold);
   GrossErrorSummary& g = run.result->gross_error_summary;
   for (int i = 0; i < kNumCables; ++i) {
     g.centre[i] = screen.cables[i].centre;
@@ -300,6 +338,17 @@ ReadingMask ScreenReadings(Run& run) {
   }
   g.fitted_readings = screen.judged;
   g.fitted_flagged = screen.count;
+  if (run.spec.UsesLengths()) {
+    GrossErrorScreen length_screen =
+        ScreenGrossErrors(run.at.length_whitened, run.is_fit, threshold);
+    for (int i = 0; i < kNumCables; ++i) {
+      g.length_centre[i] = length_screen.cables[i].centre;
+      g.length_scale[i] = length_screen.cables[i].scale;
+    }
+    g.fitted_readings += length_screen.judged;
+    g.fitted_flagged += length_screen.count;
+    *lengths = std::move(length_screen.flagged);
+  }
   return std::move(screen.flagged);
 }
 
@@ -331,6 +380,20 @@ void BuildProblem(Run& run) {
 // ---------------------------------------------------------------------------------------
 // Stage: refuse a free set the data and priors cannot determine (before solving).
 
+// Why lengths and tensions together may not separate an encoder's offset from the rest,
+// when a direction the data cannot determine involves one.
+std::string LengthOffsetHint(const std::vector<ParameterDirection>& directions) {
+  for (const ParameterDirection& d : directions) {
+    for (const auto& [name, weight] : d.weights) {
+      if (name.rfind(ParameterGroupName(ParameterKind::kLengthOffset), 0) != 0) continue;
+      return "a length encoder's offset adds the same to every reading of its cable's length, "
+             "so the lengths tell it from the cable's stretch (EA), sag (density) and "
+             "geometry only where the tensions and poses vary over the survey.\n";
+    }
+  }
+  return "";
+}
+
 std::string DescribeRefusal(const Run& run) {
   const Identifiability& before = run.result->before;
   std::ostringstream refuse;
@@ -340,6 +403,7 @@ std::string DescribeRefusal(const Run& run) {
       refuse << "  - " << d.Describe() << "   (singular value ratio "
              << RatioText(d.singular_value_ratio) << ")\n";
     }
+    refuse << LengthOffsetHint(before.undetermined);
     return refuse.str();
   }
   bool any = false;
@@ -368,6 +432,7 @@ std::string DescribeRefusal(const Run& run) {
     refuse << "  - " << d.Describe() << "   (singular value ratio "
            << RatioText(d.singular_value_ratio) << ")\n";
   }
+  refuse << LengthOffsetHint(before.poorly_determined);
   return refuse.str();
 }
 
@@ -492,13 +557,18 @@ CalibrationStatus SolveAndReweight(Run& run) {
     const CalibrationStatus status = Predict(run);
     if (status != CalibrationStatus::kOk) return status;
     const bool slow_settled = ReestimateSlowError(run, pass < std::max(2, run.options.max_passes));
-    ReadingMask screened = ScreenReadings(run);
-    if (pass >= 2 && screened == run.excluded && slow_settled) break;
+    ReadingMask screened_lengths;
+    ReadingMask screened = ScreenReadings(run, &screened_lengths);
+    if (pass >= 2 && screened == run.excluded && screened_lengths == run.length_excluded &&
+        slow_settled) {
+      break;
+    }
     if (pass == std::max(2, run.options.max_passes)) {
       r.gross_error_summary.settled = false;
       break;
     }
     run.excluded = std::move(screened);
+    run.length_excluded = std::move(screened_lengths);
   }
   r.ceres_brief_report = brief;
   r.ceres_full_report = full;
@@ -510,7 +580,7 @@ CalibrationStatus SolveAndReweight(Run& run) {
     return run.Fail(CalibrationStatus::kSolverFailed, "the solver failed: " + summary.message);
   }
   const int excluded = CountExcluded(run);
-  r.num_residuals = kNumCables * r.num_fit_samples - excluded + run.num_priors;
+  r.num_residuals = run.Readings() * r.num_fit_samples - excluded + run.num_priors;
   r.reduced_chi_square = 2.0 * summary.final_cost / (r.num_residuals - run.n);
   return CalibrationStatus::kOk;
 }
@@ -549,22 +619,24 @@ CalibrationStatus NameGrossErrors(Run& run) {
   g.enabled = run.spec.detect_gross_errors;
   g.threshold = ScreenThreshold(run);
   g.threshold_sigmas = g.threshold.sigmas;
-  g.fitted_readings = kNumCables * r.num_fit_samples;
+  g.fitted_readings = run.Readings() * r.num_fit_samples;
   r.excluded = run.excluded;
+  r.length_excluded = run.length_excluded;
   if (!g.enabled) return CalibrationStatus::kOk;
-  for (size_t t = 0; t < run.excluded.size(); ++t) {
-    for (int i = 0; i < kNumCables; ++i) {
-      if (!run.excluded[t][i]) continue;
-      r.gross_errors.push_back(ReadingAt(run, static_cast<int>(t), i));
-      ++g.count[i];
+  const int num_samples = static_cast<int>(run.data.samples.size());
+  for (int t = 0; t < num_samples && !run.excluded.empty(); ++t) {
+    for (int i = 0; i < run.Readings(); ++i) {
+      if (!ReadingExcluded(run, t, i)) continue;
+      r.gross_errors.push_back(ReadingAt(run, t, i));
+      ++(i < kNumCables ? g.count[i] : g.length_count[i - kNumCables]);
     }
   }
   g.fitted_flagged = CountExcluded(run);
   int far = 0;
   const ReadingResidual* first_far = nullptr;
   for (int t : run.fit) {
-    for (int i = 0; i < kNumCables; ++i) {
-      if (std::abs(run.at.whitened[t][i]) <= g.threshold_sigmas) continue;
+    for (int i = 0; i < run.Readings(); ++i) {
+      if (std::abs(ReadingWhitened(run, t, i)) <= g.threshold_sigmas) continue;
       ++far;
       if (first_far == nullptr && r.gross_errors.empty()) {
         r.gross_errors.push_back(ReadingAt(run, t, i));  // named in the refusal only
@@ -589,10 +661,10 @@ CalibrationStatus NameGrossErrors(Run& run) {
     return CalibrationStatus::kOk;
   }
   const ReadingResidual& first = r.gross_errors.front();
-  return run.Fail(CalibrationStatus::kMostlyGrossErrors,
-                  message + "the first is " +
-                      SampleWhere(run.data, run.data.samples[first.sample]) + " cable " +
-                      std::to_string(first.cable));
+  return run.Fail(
+      CalibrationStatus::kMostlyGrossErrors,
+      message + "the first is " + SampleWhere(run.data, run.data.samples[first.sample]) +
+          (first.length ? " length of cable " : " cable ") + std::to_string(first.cable));
 }
 
 // Stage: the initial model's readings, screened for gross errors.
@@ -600,7 +672,8 @@ CalibrationStatus PredictAndScreen(Run& run) {
   const CalibrationStatus status = Predict(run);
   if (status != CalibrationStatus::kOk) return status;
   internal::WhitenPrediction(run.slow, run.View(), &run.at.whitened);
-  run.excluded = ScreenReadings(run);
+  run.excluded = ScreenReadings(run, &run.length_excluded);
+  run.initial_length_m = run.at.length_m;
   return status;
 }
 

@@ -28,6 +28,8 @@ std::vector<ParameterSpec> Candidates(const Run& run, std::vector<double>* value
   std::vector<ParameterSpec> out;
   value_si->clear();
   for (ParameterSpec c : AllModelParameters(run.model)) {
+    // Without lengths in the fit an encoder's offset moves no reading.
+    if (c.kind == ParameterKind::kLengthOffset && !run.spec.UsesLengths()) continue;
     bool free = false;
     for (const ParameterSpec& p : run.spec.parameters) {
       if (!SameParameter(p, c)) continue;
@@ -99,7 +101,7 @@ BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
       return internal::ReplayFreeJacobians(LinearisationInputsOf(run), visit);
     };
   }
-  in.rows_per_sample = kNumCables;
+  in.rows_per_sample = run.Readings();
   in.num_residuals = run.result->num_residuals;
   in.chi_square = lin.raw_chi_square + PriorChiSquare(run);
   in.robust_loss = run.loss != nullptr;
@@ -357,9 +359,9 @@ CalibrationStatus FindWorstReadings(Run& run) {
   const size_t keep = static_cast<size_t>(std::max(0, run.options.worst_readings));
   std::vector<Entry> heap;  // the best of the worst on top (a heap under `worse`)
   for (int t : run.fit) {
-    for (int i = 0; i < kNumCables && keep > 0; ++i) {
-      if (!run.excluded.empty() && run.excluded[t][i]) continue;
-      const Entry e{std::abs(run.at.whitened[t][i]), t, i};
+    for (int i = 0; i < run.Readings() && keep > 0; ++i) {
+      if (ReadingExcluded(run, t, i)) continue;
+      const Entry e{std::abs(ReadingWhitened(run, t, i)), t, i};
       if (heap.size() < keep) {
         heap.push_back(e);
         std::push_heap(heap.begin(), heap.end(), worse);
@@ -376,6 +378,7 @@ CalibrationStatus FindWorstReadings(Run& run) {
   for (const Entry& e : heap) worst.push_back(ReadingAt(run, e.t, e.i));
   run.at.whitened = std::vector<std::array<double, kNumCables>>();
   run.at.sigma_n = std::vector<std::array<double, kNumCables>>();
+  run.at.length_whitened = std::vector<std::array<double, kNumCables>>();
   return CalibrationStatus::kOk;
 }
 
@@ -473,6 +476,7 @@ CalibrationStatus ScanChanges(Run& run) {
   ChangeScanInputs in;
   in.residuals = &run.lin.residuals;
   in.jacobians = &run.lin.jacobians;
+  in.rows_per_sample = run.Readings();
   in.num_free = run.n;
   in.prior_information = Eigen::VectorXd::Zero(run.n);
   in.prior_gradient = Eigen::VectorXd::Zero(run.n);

@@ -13,10 +13,13 @@ namespace fastcal::internal {
 namespace {
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// A sample's residuals: its readings (FittedSamples::readings), six or twelve.
+using SampleResiduals = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxReadings, 1>;
 
 bool IsPerCableGroup(ParameterKind kind) {
   return kind == ParameterKind::kLinearDensity || kind == ParameterKind::kEa ||
-         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias;
+         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias ||
+         kind == ParameterKind::kLengthOffset;
 }
 
 // Whether basis parameter `b` is part of parameter `p`: itself, or one cable of a
@@ -28,7 +31,7 @@ bool Covers(const ParameterSpec& p, const ParameterSpec& b) {
 // The robust loss's IRLS weight sqrt(rho'(|r|^2)) of a sample's residuals (1 without a
 // loss); `curvature` (may be null) receives 2 rho'' for the loss's exact Hessian
 // rho' J^T J + 2 rho'' (J^T r)(J^T r)^T (0 without a loss).
-double LossWeight(const ceres::LossFunction* loss, const Eigen::Matrix<double, kNumCables, 1>& r,
+double LossWeight(const ceres::LossFunction* loss, const SampleResiduals& r,
                   double* curvature = nullptr) {
   if (curvature != nullptr) *curvature = 0.0;
   if (loss == nullptr) return 1.0;
@@ -39,10 +42,12 @@ double LossWeight(const ceres::LossFunction* loss, const Eigen::Matrix<double, k
 }
 
 // Sample t's residuals and n-column Jacobian from `rows`.
-void RowsOf(const SampleRows& rows, int t, Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j) {
+void RowsOf(const SampleRows& rows, int t, SampleResiduals* r, RowMatrix* j) {
   const int n = rows.columns - 1;
   const double* values = rows.Of(t);
-  for (int i = 0; i < kNumCables; ++i) {
+  r->resize(rows.readings);
+  j->resize(rows.readings, n);
+  for (int i = 0; i < rows.readings; ++i) {
     for (int k = 0; k < n; ++k) (*j)(i, k) = values[i * rows.columns + k];
     (*r)[i] = values[i * rows.columns + n];
   }
@@ -112,9 +117,8 @@ struct FreeSums {
 // prediction, the rows as evaluated (r_raw, j_raw: before the slow-error whitening; the
 // same without it) in newtons for the RMS.
 void AddToFold(const std::array<bool, kNumCables>& excluded,
-               const std::array<double, kNumCables>& sigma_n,
-               const Eigen::Matrix<double, kNumCables, 1>& r, const RowMatrix& j,
-               const Eigen::Matrix<double, kNumCables, 1>& r_raw, const RowMatrix& j_raw,
+               const std::array<double, kNumCables>& sigma_n, const SampleResiduals& r,
+               const RowMatrix& j, const SampleResiduals& r_raw, const RowMatrix& j_raw,
                double weight, FoldSums* fold) {
   ++fold->samples;
   fold->information.noalias() += weight * weight * j.transpose() * j;
@@ -141,7 +145,7 @@ struct FreeChunk {
 // Fitted samples [begin, end) evaluated into chunk->rows; the first that fails, or -1.
 int EvaluateFree(const LinearisationInputs& in, const ModelAtTheta& at, int begin, int end,
                  FreeChunk* chunk) {
-  chunk->rows.Reset(begin, end, in.samples.model->num_free() + 1);
+  chunk->rows.Reset(begin, end, in.samples.model->num_free() + 1, in.samples.readings());
   for (int t = begin; t < end; ++t) {
     if (!EvaluateSampleRows(in.samples, t, at, t, &chunk->rows)) return t;
   }
@@ -154,8 +158,8 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   FreeSums* sums = &chunk->sums;
-  RowMatrix j(kNumCables, n), j_raw(kNumCables, n);
-  Eigen::Matrix<double, kNumCables, 1> r, r_raw;
+  RowMatrix j, j_raw;
+  SampleResiduals r, r_raw;
   for (int t = begin; t < end; ++t) {
     const std::array<bool, kNumCables> excluded = in.samples.Excluded(t);
     RowsOf(chunk->rows, t, &r, &j);
@@ -169,7 +173,7 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
     out->scores.row(t) = score.cast<float>();
     if (candidate_row[t] >= 0) out->candidate_free_scores.row(candidate_row[t]) = score;
     if (in.keep_jacobians) {
-      for (int i = 0; i < kNumCables; ++i) {
+      for (int i = 0; i < jw.rows(); ++i) {
         out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
       }
     }
@@ -187,6 +191,10 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
     sums->chi_square += rw.squaredNorm();
     sums->raw_chi_square += r.squaredNorm();
     for (bool e : excluded) sums->readings += !e;
+    if (in.samples.readings() > kNumCables) {
+      const std::array<bool, kNumCables> length_excluded = in.samples.LengthExcluded(t);
+      for (bool e : length_excluded) sums->readings += !e;
+    }
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
     AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, r_raw, j_raw, weight,
               &sums->folds[block]);
@@ -238,7 +246,7 @@ int SessionOf(const CandidatePass& pass, int fitted_sample) {
 // the first that fails (a fitted sample), or -1.
 int EvaluateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
                        int end, CandidateChunk* chunk) {
-  chunk->rows.Reset(begin, end, pass.basis.front().num_free() + 1);
+  chunk->rows.Reset(begin, end, pass.basis.front().num_free() + 1, pass.in.samples.readings());
   for (int k = begin; k < end; ++k) {
     const ModelAtTheta& at = pass.basis_at[SessionOf(pass, samples[k])];
     if (!EvaluateSampleRows(pass.in.samples, samples[k], at, k, &chunk->rows)) return samples[k];
@@ -249,8 +257,8 @@ int EvaluateCandidates(const CandidatePass& pass, const std::vector<int>& sample
 // The (whitened) basis rows of samples [begin, end) into the chunk's sums.
 void AccumulateCandidates(const CandidatePass& pass, const std::vector<int>& samples, int begin,
                           int end, CandidateChunk* chunk, Eigen::MatrixXd* scores) {
-  RowMatrix b(kNumCables, pass.basis.front().num_free());
-  Eigen::Matrix<double, kNumCables, 1> r;
+  RowMatrix b;
+  SampleResiduals r;
   CandidateSums* sums = &chunk->sums;
   for (int k = begin; k < end; ++k) {
     const int session = SessionOf(pass, samples[k]);
@@ -297,8 +305,9 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   for (size_t k = 0; k < out->candidate_rows.size(); ++k) candidate_row[out->candidate_rows[k]] = k;
   out->candidate_free_scores =
       Eigen::MatrixXd::Zero(static_cast<int>(out->candidate_rows.size()), n);
-  out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
-  if (in.keep_jacobians) out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
+  const int readings = in.samples.readings();
+  out->residuals = Eigen::MatrixXd::Zero(num_fit, readings);
+  if (in.keep_jacobians) out->jacobians = SampleJacobians::Zero(num_fit, readings * n);
   const int sessions = static_cast<int>(in.samples.data->session_labels.size());
   FreeSums total(n, blocks, sessions);
   const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
@@ -339,7 +348,8 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   const int q = static_cast<int>(in.candidates.size());
   const CableRobot& model = fitted.robot();
   CalibrationSpec basis_spec;
-  basis_spec.parameters = BasisParameters(model);
+  const bool lengths = in.samples.readings() > kNumCables;
+  basis_spec.parameters = BasisParameters(model, lengths);
   CandidatePass pass{in, {}, {}, {}, {}, {}, {}};
   const int sessions = in.samples.sessions();
   pass.basis.reserve(sessions);  // basis_at refers to them
@@ -351,11 +361,11 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   }
   for (int k = 0; k < n; ++k) {
     const ParameterSpec& p = fitted.spec().parameters[fitted.spec_index(k)];
-    pass.free_columns.push_back(BasisColumns(p, model));
+    pass.free_columns.push_back(BasisColumns(p, model, lengths));
     pass.free_session.push_back(p.session);
   }
   for (const ParameterSpec& p : in.candidates) {
-    pass.candidate_columns.push_back(BasisColumns(p, model));
+    pass.candidate_columns.push_back(BasisColumns(p, model, lengths));
   }
   const std::vector<int>& samples = out->candidate_rows;
   const auto zero = [&] {
@@ -399,18 +409,19 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
 
 }  // namespace
 
-std::vector<ParameterSpec> BasisParameters(const CableRobot& model) {
+std::vector<ParameterSpec> BasisParameters(const CableRobot& model, bool lengths) {
   std::vector<ParameterSpec> basis;
   for (ParameterSpec p : AllModelParameters(model)) {
     if (IsPerCableGroup(p.kind) && p.index < 0) continue;
+    if (p.kind == ParameterKind::kLengthOffset && !lengths) continue;
     p.free = true;
     basis.push_back(p);
   }
   return basis;
 }
 
-std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model) {
-  const std::vector<ParameterSpec> basis = BasisParameters(model);
+std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model, bool lengths) {
+  const std::vector<ParameterSpec> basis = BasisParameters(model, lengths);
   std::vector<int> columns;
   for (size_t c = 0; c < basis.size(); ++c) {
     if (Covers(p, basis[c])) columns.push_back(static_cast<int>(c));
@@ -439,7 +450,7 @@ bool ReplayFreeJacobians(const LinearisationInputs& in,
   const int failed = ReduceChunksInOrder<Chunk>(
       in.samples.size(), in.num_threads, [] { return Chunk(); },
       [&](int begin, int end, Chunk* chunk) {
-        chunk->rows.Reset(begin, end, n + 1);
+        chunk->rows.Reset(begin, end, n + 1, in.samples.readings());
         for (int t = begin; t < end; ++t) {
           if (!EvaluateSampleRows(in.samples, t, at, t, &chunk->rows)) return t;
         }
@@ -449,14 +460,15 @@ bool ReplayFreeJacobians(const LinearisationInputs& in,
       [](int, int, Chunk*) { return -1; },
       [&](const Chunk& chunk) {
         // As AccumulateFree stores them: the rows weighted by the loss's, as floats.
-        RowMatrix j(kNumCables, n);
-        Eigen::Matrix<double, kNumCables, 1> r;
-        std::vector<float> jw(kNumCables * n);
+        const int m = chunk.rows.readings;
+        RowMatrix j;
+        SampleResiduals r;
+        std::vector<float> jw(m * n);
         for (int t = chunk.rows.begin; t < chunk.rows.end; ++t) {
           RowsOf(chunk.rows, t, &r, &j);
           const double weight = LossWeight(in.loss, r);
           const RowMatrix weighted = weight * j;
-          for (int k = 0; k < kNumCables * n; ++k) jw[k] = static_cast<float>(weighted.data()[k]);
+          for (int k = 0; k < m * n; ++k) jw[k] = static_cast<float>(weighted.data()[k]);
           visit(t, jw.data());
         }
       });

@@ -12,6 +12,7 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
     anchor_of_cable_[i] = robot.cables[i].anchor_index;
     base_gain_[i] = robot.cables[i].sensor_gain;
     base_bias_n_[i] = robot.cables[i].sensor_bias_n;
+    base_offset_m_[i] = robot.cables[i].length_offset_m;
   }
   for (size_t j = 0; j < spec.parameters.size(); ++j) {
     const ParameterSpec& s = spec.parameters[j];
@@ -55,6 +56,9 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
         case ParameterKind::kAttachmentDensity:
           if (i == s.index) base_.chain[i].value[s.component] = v;
           break;
+        case ParameterKind::kLengthOffset:
+          if (cable) base_offset_m_[i] = v;
+          break;
       }
     }
   }
@@ -97,6 +101,12 @@ double CalibrationModel::BaseValue(const ParameterSpec& s) const {
     case ParameterKind::kAttachmentMass:
     case ParameterKind::kAttachmentDensity:
       return base_.chain[c].value[s.component];
+    case ParameterKind::kLengthOffset: {
+      if (s.index >= 0) return base_offset_m_[c];
+      double sum = 0;
+      for (double d : base_offset_m_) sum += d;
+      return sum / kNumCables;
+    }
   }
   return 0.0;
 }
@@ -112,8 +122,8 @@ std::vector<double> CalibrationModel::InitialTheta() const {
 
 CableRobot CalibrationModel::ToRobot(const double* theta, int session) const {
   StaticsParameters<double> p;
-  std::array<double, kNumCables> gain, bias;
-  Assemble(theta, &p, &gain, &bias, session);
+  std::array<double, kNumCables> gain, bias, offset;
+  Assemble(theta, &p, &gain, &bias, session, &offset);
   CableRobot out = robot_;
   // Anchor points: the offset of the first cable tied to each point (all its cables
   // carry the same offset by construction).
@@ -132,6 +142,7 @@ CableRobot CalibrationModel::ToRobot(const double* theta, int session) const {
     c.linear_density_kg_per_m = p.linear_density_kg_per_m[i];
     c.sensor_gain = gain[i];
     c.sensor_bias_n = bias[i];
+    c.length_offset_m = offset[i];
     for (size_t j = 0; j < c.attachments.size(); ++j)
       c.attachments[j].SetValue(p.chain[i].value[j]);
   }
@@ -163,6 +174,13 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
   if (starts != nullptr && !starts->empty()) f.start = starts->At(t);
   if (excluded != nullptr && !excluded->empty()) f.excluded = (*excluded)[t];
   f.session = sample.session;
+  if (length_sigma_m > 0.0) {
+    f.length_sigma_m = length_sigma_m;
+    f.measured_length_m = sample.unstretched_length_m;
+    if (length_excluded != nullptr && !length_excluded->empty()) {
+      f.length_excluded = (*length_excluded)[t];
+    }
+  }
   return f;
 }
 
@@ -209,6 +227,7 @@ void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
         break;
       case ParameterKind::kSensorGain:
       case ParameterKind::kSensorBias:
+      case ParameterKind::kLengthOffset:  // no tension depends on it (lengths: Jets)
         break;  // after the statics: below
     }
     // The readings are gain_i T_i + bias_i.
@@ -284,7 +303,7 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
 
 bool TensionResidual::Evaluate(const double* theta, double* residuals, double* jacobian) const {
   if (jacobian == nullptr) return (*this)(theta, residuals);
-  if (statics.method != StaticsMethod::kExact) {
+  if (statics.method != StaticsMethod::kExact || length_sigma_m > 0.0) {
     return TensionCost::EvaluateJet(*this, theta, residuals, jacobian);
   }
   ModelAtTheta::Session m;
@@ -295,7 +314,7 @@ bool TensionResidual::Evaluate(const double* theta, double* residuals, double* j
 }
 
 bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const {
-  if (jacobian != nullptr && statics.method != StaticsMethod::kExact) {
+  if (length_sigma_m > 0.0 || (jacobian != nullptr && statics.method != StaticsMethod::kExact)) {
     return At(j, &at.model()).Evaluate(at.theta(), residuals, jacobian);
   }
   const int t = (*fit)[j];
@@ -315,12 +334,17 @@ std::array<bool, kNumCables> FittedSamples::Excluded(int j) const {
   return (*excluded)[(*fit)[j]];
 }
 
+std::array<bool, kNumCables> FittedSamples::LengthExcluded(int j) const {
+  if (length_excluded == nullptr || length_excluded->empty()) return {};
+  return (*length_excluded)[(*fit)[j]];
+}
+
 int FittedSamples::sessions() const {
   return std::max<int>(1, static_cast<int>(data->session_labels.size()));
 }
 
 TensionCost::TensionCost(const TensionResidual& functor) : functor_(functor) {
-  set_num_residuals(kNumCables);
+  set_num_residuals(functor.readings());
   mutable_parameter_block_sizes()->push_back(functor.model->num_free());
 }
 
@@ -331,9 +355,9 @@ bool TensionCost::EvaluateJetOf(const TensionResidual& f, const double* theta, d
   const int n = f.model->num_free();
   std::array<Jet, N> t;
   for (int k = 0; k < n; ++k) t[k] = Jet(theta[k], k);
-  std::array<Jet, kNumCables> r;
+  std::array<Jet, kMaxReadings> r;
   if (!f(t.data(), r.data())) return false;
-  for (int i = 0; i < kNumCables; ++i) {
+  for (int i = 0; i < f.readings(); ++i) {
     residuals[i] = r[i].a;
     for (int k = 0; k < n; ++k) jacobian[i * n + k] = r[i].v[k];
   }

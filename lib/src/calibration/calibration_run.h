@@ -36,6 +36,9 @@ struct Prediction {
   std::vector<std::array<double, kNumCables>> sigma_n;    // whitening sigma from the reading
   std::vector<std::array<double, kNumCables>> whitened;   // (reading - measured) / sigma
   internal::CompactStarts starts;                          // the statics there (warm starts)
+  // With lengths in the fit (else empty): s0 + offset, and (that - measured) / sigma_L.
+  std::vector<std::array<double, kNumCables>> length_m;
+  std::vector<std::array<double, kNumCables>> length_whitened;
 };
 
 struct Run {
@@ -62,6 +65,10 @@ struct Run {
   // The weights and exclusions of the current problem, per fitted sample / dataset sample.
   std::vector<std::array<double, kNumCables>> sigma_n;
   ReadingMask excluded;
+  // With lengths in the fit: the lengths kept out, per dataset sample, and the initial
+  // model's predicted lengths (for the table before and after).
+  ReadingMask length_excluded;
+  std::vector<std::array<double, kNumCables>> initial_length_m;
   // The slow sensor error the current problem whitens by (inactive: white noise only),
   // and per fitted sample each reading's sigma_slow / sigma_white (sample_rows.h).
   SlowErrorProcess slow;
@@ -103,8 +110,12 @@ struct Run {
     s.statics = statics;
     s.slow_error = slow;
     s.slow_rho = &slow_rho;
+    s.length_sigma_m = spec.length_sigma_m;
+    s.length_excluded = &length_excluded;
     return s;
   }
+  // Readings per sample: the tensions, and the lengths when the spec uses them.
+  int Readings() const { return spec.UsesLengths() ? 2 * kNumCables : kNumCables; }
   CalibrationStatus Fail(CalibrationStatus status, const std::string& why) const {
     *error = why;
     return status;
@@ -126,8 +137,12 @@ inline double ChiSquare1Quantile(double tail) {
 
 // Readings of the fitted samples kept out of the fit.
 int CountExcluded(const Run& run);
-// Reading i of dataset sample t at the current prediction (its whitened residual).
+// Reading i of dataset sample t at the current prediction (its whitened residual): a
+// tension (i < 6) or, with lengths in the fit, the length of cable i - 6.
 ReadingResidual ReadingAt(const Run& run, int t, int i);
+// Whether reading i of sample t is kept out, and its whitened residual (ReadingAt's i).
+bool ReadingExcluded(const Run& run, int t, int i);
+double ReadingWhitened(const Run& run, int t, int i);
 
 // Stages of calibration_diagnostics.cc.
 CalibrationStatus FindWorstReadings(Run& run);

@@ -67,6 +67,7 @@ constexpr GroupInfo kGroups[] = {
     {ParameterKind::kSensorBias, "sensor_bias_kN", "kN", kNewtonsPerKilonewton},
     {ParameterKind::kAttachmentMass, "attachment_mass_kg", "kg", 1.0},
     {ParameterKind::kAttachmentDensity, "attachment_density_kg_per_m", "kg/m", 1.0},
+    {ParameterKind::kLengthOffset, "length_offset_m", "m", 1.0},
 };
 
 bool IsAttachment(ParameterKind kind) {
@@ -100,7 +101,8 @@ const GroupInfo* InfoOf(ParameterKind kind) {
 // Groups that are either one parameter for all cables or one per cable.
 bool IsPerCableCapable(ParameterKind kind) {
   return kind == ParameterKind::kLinearDensity || kind == ParameterKind::kEa ||
-         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias;
+         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias ||
+         kind == ParameterKind::kLengthOffset;
 }
 
 bool IsVector(ParameterKind kind) {
@@ -221,6 +223,35 @@ std::string CheckTimeConstant(double value_s) {
 
 std::string CheckPositive(double value) {
   return std::isfinite(value) && value > 0.0 ? "" : "must be > 0";
+}
+
+// The lengths' sigma: > 0 when given (leave it out for no lengths) and plausible.
+std::string CheckLengthSigma(double value_m) {
+  if (!(std::isfinite(value_m) && value_m > 0.0)) {
+    return "must be > 0 (leave it out to fit without the lengths)";
+  }
+  // Not CheckNoiseSigma: its floor is the tension sensors'; an encoder may resolve 0.1 mm.
+  std::string why;
+  return CheckQuantity(ModelQuantity::kLengthSigmaM, value_m, PlausibilityLimits(), &why) ? ""
+                                                                                          : why;
+}
+
+// Lengths in the fit need exact's s0 (aas's are not solved in a fit), and a free or
+// consider length_offset_m needs the lengths in the fit.
+std::string LengthsProblem(const CalibrationSpec& s) {
+  if (s.UsesLengths() && s.forward_model != StaticsMethod::kExact) {
+    return "length_sigma_m: the lengths need forward_model: exact (the other methods' "
+           "unstretched lengths are approximate)";
+  }
+  if (s.UsesLengths()) return "";
+  for (const ParameterSpec& p : s.parameters) {
+    if (p.kind == ParameterKind::kLengthOffset && (p.free || p.IsConsider())) {
+      return p.name +
+             ": the lengths are not in the fit, so nothing determines it: give "
+             "noise.length_sigma_m (the dataset's s0_<i>_m columns then count)";
+    }
+  }
+  return "";
 }
 
 constexpr char kBothNoiseZero[] =
@@ -573,9 +604,17 @@ class Reader {
 
   bool ReadNoise(const KeyValue& noise, CalibrationSpec* spec) {
     KeyMap keys;
-    if (!ReadMap(noise, "noise", {"tension_sigma_kN", "tension_sigma_percent", "slow_error"},
+    if (!ReadMap(noise, "noise",
+                 {"tension_sigma_kN", "tension_sigma_percent", "slow_error", "length_sigma_m"},
                  &keys)) {
       return false;
+    }
+    if (const KeyValue* kv = Find(keys, "length_sigma_m")) {
+      const std::string path = "noise.length_sigma_m";
+      if (!ReadDouble(*kv, path, &spec->length_sigma_m) ||
+          !Check(CheckLengthSigma(spec->length_sigma_m), kv->line, path)) {
+        return false;
+      }
     }
     if (const KeyValue* kv = Find(keys, "slow_error");
         kv != nullptr && !ReadSlowError(*kv, &spec->slow_error)) {
@@ -1197,6 +1236,7 @@ std::string OptionsProblem(const CalibrationSpec& s) {
       {"tension_sigma_percent",
        CheckNoiseSigma(ModelQuantity::kTensionSigmaPercent, s.tension_sigma_percent)},
       {"noise", s.tension_sigma_n == 0.0 && s.tension_sigma_percent == 0.0 ? kBothNoiseZero : ""},
+      {"length_sigma_m", s.length_sigma_m == 0.0 ? "" : CheckLengthSigma(s.length_sigma_m)},
       {"slow_error", SlowErrorProblem(s.slow_error)},
       {"robust_loss", known_loss ? "" : "unknown loss"},
       {"robust_loss_scale", CheckPositive(s.robust_loss_scale)},
@@ -1263,6 +1303,7 @@ bool CalibrationSpec::IsValid(std::string* error) const {
     return false;
   };
   if (const std::string w = OptionsProblem(*this); !w.empty()) return fail(w);
+  if (const std::string w = LengthsProblem(*this); !w.empty()) return fail(w);
   for (const auto* list : {&separate_groups, &change_scan_groups}) {
     for (const std::string& group : *list) {
       const std::string w = GroupWithoutFreeParameter(*this, group);
@@ -1420,7 +1461,9 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
   out << "forward_model: " << StaticsMethodName(spec.forward_model) << "\n";
   out << "noise: {tension_sigma_kN: " << NumInUnit(spec.tension_sigma_n, kNewtonsPerKilonewton)
       << ", tension_sigma_percent: " << Num(spec.tension_sigma_percent)
-      << ", slow_error: " << SlowErrorYaml(spec.slow_error) << "}\n";
+      << ", slow_error: " << SlowErrorYaml(spec.slow_error);
+  if (spec.UsesLengths()) out << ", length_sigma_m: " << Num(spec.length_sigma_m);
+  out << "}\n";
   const char* loss = RobustLossName(spec.robust_loss);
   out << "robust_loss: {type: " << (loss != nullptr ? loss : "unknown")
       << ", scale: " << Num(spec.robust_loss_scale) << "}\n";

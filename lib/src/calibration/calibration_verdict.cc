@@ -254,14 +254,58 @@ void AddNotes(Run& run) {
   NoteWhatTheMisfitWouldMove(&r);
 }
 
+// Model minus measured lengths per cable over the fitted samples (`held_out` false) or
+// the held-out ones, the gross errors left out.
+LengthResidualStats LengthStats(const Run& run,
+                                const std::vector<std::array<double, kNumCables>>& model_m,
+                                bool held_out) {
+  LengthResidualStats s;
+  std::array<double, kNumCables> sum{}, sum2{};
+  std::array<int, kNumCables> count{};
+  for (size_t t = 0; t < model_m.size(); ++t) {
+    if (run.result->held_out[t] != held_out) continue;
+    ++s.samples;
+    for (int i = 0; i < kNumCables; ++i) {
+      if (!run.length_excluded.empty() && run.length_excluded[t][i]) {
+        ++s.excluded[i];
+        continue;
+      }
+      const double d = model_m[t][i] - run.data.samples[t].unstretched_length_m[i];
+      sum[i] += d;
+      sum2[i] += d * d;
+      s.max_abs_m[i] = std::max(s.max_abs_m[i], std::abs(d));
+      ++count[i];
+    }
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    if (count[i] == 0) continue;
+    s.mean_m[i] = sum[i] / count[i];
+    s.rms_m[i] = std::sqrt(sum2[i] / count[i]);
+  }
+  return s;
+}
+
+void EvaluateLengths(Run& run) {
+  LengthEvaluation& l = run.result->lengths;
+  if (!run.spec.UsesLengths()) return;
+  l.used = true;
+  l.sigma_m = run.spec.length_sigma_m;
+  l.initial = LengthStats(run, run.initial_length_m, false);
+  l.calibrated = LengthStats(run, run.at.length_m, false);
+  l.initial_holdout = LengthStats(run, run.initial_length_m, true);
+  l.calibrated_holdout = LengthStats(run, run.at.length_m, true);
+  run.initial_length_m = std::vector<std::array<double, kNumCables>>();
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------
 // Stage: the model against the measurements before and after (the paper's Table 6):
 // the initial model at each attitude the data has and the calibrated one at the fit's,
-// exact statics, gross errors left out.
+// exact statics, gross errors left out; with lengths in the fit their residuals too.
 CalibrationStatus Evaluate(Run& run) {
   CalibrationResult& r = *run.result;
+  EvaluateLengths(run);
   if (!run.options.evaluate) return CalibrationStatus::kOk;
   // With exact statics the last prediction is the calibrated model's row already, and
   // its statics each sample's warm start for the other rows.

@@ -11,9 +11,10 @@
 
 namespace fastcal::internal {
 
-double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n) {
+double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n,
+                      int readings) {
   double sq_norm = 0.0;
-  for (int i = 0; i < kNumCables; ++i) sq_norm += residuals[i] * residuals[i];
+  for (int i = 0; i < readings; ++i) sq_norm += residuals[i] * residuals[i];
   if (loss == nullptr) return sq_norm;
   double rho[3];
   loss->Evaluate(sq_norm, rho);
@@ -27,14 +28,14 @@ double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double
   if (jacobian != nullptr) {
     for (int k = 0; k < n; ++k) {
       double r_dot_j = 0.0;  // (r^T J)_k
-      for (int i = 0; i < kNumCables; ++i) r_dot_j += residuals[i] * jacobian[i * n + k];
-      for (int i = 0; i < kNumCables; ++i) {
+      for (int i = 0; i < readings; ++i) r_dot_j += residuals[i] * jacobian[i * n + k];
+      for (int i = 0; i < readings; ++i) {
         jacobian[i * n + k] =
             sqrt_rho1 * (jacobian[i * n + k] - alpha_sq_norm * residuals[i] * r_dot_j);
       }
     }
   }
-  for (int i = 0; i < kNumCables; ++i) residuals[i] *= residual_scaling;
+  for (int i = 0; i < readings; ++i) residuals[i] *= residual_scaling;
   return rho[0];
 }
 
@@ -52,6 +53,7 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
     double rho = 0.0;
   };
   const int n = n_;
+  const int m = samples_.readings();
   const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
   RowFold total(n + 1);
   *rho_sum = 0.0;
@@ -59,7 +61,7 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
   const int failed = ReduceChunksInOrder<Part>(
       samples_.size(), threads_, [n] { return Part{{}, RowFold(n + 1)}; },
       [&](int begin, int end, Part* part) {
-        part->rows.Reset(begin, end, n + 1);
+        part->rows.Reset(begin, end, n + 1, m);
         for (int t = begin; t < end; ++t) {
           if (!EvaluateSampleRows(samples_, t, at, t, &part->rows)) return t;
         }
@@ -67,20 +69,20 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
       },
       [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
       [&](int begin, int end, Part* part) {
-        std::vector<double> j(kNumCables * n), rows(kNumCables * (n + 1));
-        double r[kNumCables];
+        std::vector<double> j(m * n), rows(m * (n + 1));
+        double r[kMaxReadings];
         for (int t = begin; t < end; ++t) {
-          for (int i = 0; i < kNumCables; ++i) {
+          for (int i = 0; i < m; ++i) {
             const double* row = part->rows.Row(t, i);
             std::copy(row, row + n, &j[i * n]);
             r[i] = row[n];
           }
-          part->rho += CorrectForLoss(loss_, r, j.data(), n);
-          for (int i = 0; i < kNumCables; ++i) {
+          part->rho += CorrectForLoss(loss_, r, j.data(), n, m);
+          for (int i = 0; i < m; ++i) {
             std::copy(&j[i * n], &j[i * n] + n, &rows[i * (n + 1)]);
             rows[i * (n + 1) + n] = r[i];
           }
-          part->fold.Add(rows.data(), kNumCables);
+          part->fold.Add(rows.data(), m);
         }
         part->fold.Flush();
         return -1;

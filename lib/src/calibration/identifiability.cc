@@ -45,6 +45,8 @@ double MaxSigma(const ParameterSpec& p, double initial, const CalibrationOptions
       return o.max_sigma_attachment_mass_kg;
     case ParameterKind::kAttachmentDensity:
       return o.max_sigma_attachment_density_kg_per_m;
+    case ParameterKind::kLengthOffset:
+      return o.max_sigma_length_offset_m;
   }
   return std::numeric_limits<double>::infinity();
 }

@@ -7,19 +7,20 @@ namespace fastcal::internal {
 
 bool EvaluateSampleRows(const FittedSamples& samples, int j, const ModelAtTheta& at, int t,
                         SampleRows* rows) {
-  double r[kNumCables];
+  double r[kMaxReadings];
   double* out = rows->Of(t);
   const int columns = rows->columns;
+  const int readings = samples.readings();
   if (columns == 1) {
     if (!samples.Rows(j, at, r, nullptr)) return false;
-    std::copy(r, r + kNumCables, out);
+    std::copy(r, r + readings, out);
     return true;
   }
   const int n = columns - 1;
   thread_local std::vector<double> jacobian;
-  jacobian.resize(static_cast<size_t>(kNumCables) * n);
+  jacobian.resize(static_cast<size_t>(readings) * n);
   if (!samples.Rows(j, at, r, jacobian.data())) return false;
-  for (int i = 0; i < kNumCables; ++i) {
+  for (int i = 0; i < readings; ++i) {
     double* row = out + i * columns;
     std::copy(jacobian.data() + i * n, jacobian.data() + (i + 1) * n, row);
     row[n] = r[i];

@@ -186,6 +186,9 @@ std::string FormatNumber(double value, int shift) {
 struct Header {
   std::array<int, kNumColumns> field_of{};
   std::vector<int> column_of_field;
+  // Which column groups the file has: all but the lengths always in a measurement file
+  // (DatasetColumns::kMeasurements), each optional in a lengths file (kLengths).
+  bool time = true, position = true, attitude = true, tensions = true;
   bool quaternion = false;
   bool planned = false;
   bool unstretched = false;
@@ -225,17 +228,30 @@ bool GroupPresent(const Header& header, int first, int count, const std::string&
 
 // The columns a dataset needs, and its groups whole or absent. `where` is the header's
 // "file:line: " (or the map's "map.yaml:5: columns: "), `missing` as in GroupPresent.
-bool CheckColumnGroups(const std::string& where, const char* missing, Header* header,
-                       std::string* error) {
+bool CheckColumnGroups(const std::string& where, const char* missing, DatasetColumns required,
+                       Header* header, std::string* error) {
   const auto require = [&](int column) {
     if (header->field_of[column] >= 0) return true;
     *error = where + missing + Quoted(kColumnNames[column]);
     return false;
   };
-  for (int c = kTime; c <= kZ; ++c) {
-    if (!require(c)) return false;
-  }
   bool ok = true;
+  const bool lengths_file = required == DatasetColumns::kLengths;
+  if (lengths_file) {
+    // Only the lengths are required; every other group complete or absent.
+    header->time = header->field_of[kTime] >= 0;
+    header->position = GroupPresent(*header, kX, 3, where, "the position needs all three or none",
+                                    missing, &ok, error);
+    if (!ok) return false;
+    header->tensions =
+        GroupPresent(*header, kTension1, kNumCables, where,
+                     "the measured tensions need all six or none", missing, &ok, error);
+    if (!ok) return false;
+  } else {
+    for (int c = kTime; c <= kZ; ++c) {
+      if (!require(c)) return false;
+    }
+  }
   const bool rpy =
       GroupPresent(*header, kRoll, 3, where, "the measured attitude as angles needs all three",
                    missing, &ok, error);
@@ -250,12 +266,13 @@ bool CheckColumnGroups(const std::string& where, const char* missing, Header* he
              "qw,qx,qy,qz";
     return false;
   }
-  if (!rpy && !quaternion) {
+  if (!rpy && !quaternion && !lengths_file) {
     *error = where + "missing measured attitude: columns roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz";
     return false;
   }
+  header->attitude = rpy || quaternion;
   header->quaternion = quaternion;
-  for (int i = 0; i < kNumCables; ++i) {
+  for (int i = 0; i < kNumCables && !lengths_file; ++i) {
     if (!require(kTension1 + i)) return false;
   }
   header->planned =
@@ -265,13 +282,18 @@ bool CheckColumnGroups(const std::string& where, const char* missing, Header* he
   header->unstretched =
       GroupPresent(*header, kUnstretched1, kNumCables, where,
                    "the unstretched lengths need all six or none", missing, &ok, error);
+  if (ok && lengths_file && !header->unstretched) {
+    *error = where + missing + Quoted(kColumnNames[kUnstretched1]) +
+             " (a lengths file needs s0_1_m ... s0_6_m)";
+    return false;
+  }
   return ok;
 }
 
 // The header of an export read through a column map: its source columns matched to the
 // map's (column_reading.h), the conversions, the labels of messages.
 bool ParseMappedHeader(std::string_view line, const std::string& where, const std::string& path,
-                       Header* header, std::string* error) {
+                       DatasetColumns required, Header* header, std::string* error) {
   const ColumnMap& map = *header->map;
   header->delimiter =
       map.delimiter != 0 ? map.delimiter : internal::DetectDelimiter(line, map.decimal);
@@ -298,7 +320,7 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
     for (int c = kX; c < kNumColumns; ++c) {
       if (map.Find(kColumnNames[c]) != nullptr) given.field_of[c] = 0;
     }
-    if (!CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", &given, error)) {
+    if (!CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", required, &given, error)) {
       return false;
     }
   }
@@ -344,14 +366,15 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
   if (header->field_of[kRoll] >= 0) {
     header->rpy_label = names(kRoll, 3).substr(8);
   }
-  return CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", header, error);
+  return CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", required, header, error);
 }
 
 bool ParseHeader(std::string_view line, const std::string& where, const std::string& path,
+                 DatasetColumns required,
                  Header* header, std::string* error) {
   header->field_of.fill(-1);
   for (int c = 0; c < kNumColumns; ++c) header->label[c] = "column " + Quoted(kColumnNames[c]);
-  if (header->map != nullptr) return ParseMappedHeader(line, where, path, header, error);
+  if (header->map != nullptr) return ParseMappedHeader(line, where, path, required, header, error);
   const std::string separator_error = internal::WrongSeparatorMessage(line);
   if (!separator_error.empty()) {
     *error = where + separator_error;
@@ -396,7 +419,7 @@ bool ParseHeader(std::string_view line, const std::string& where, const std::str
     header->conversion[c].shift = IsTension(c) ? kKilo : 0;
     header->conversion[c].internal_per_file = IsTension(c) ? 1e3 : 1.0;
   }
-  return CheckColumnGroups(where, "missing column ", header, error);
+  return CheckColumnGroups(where, "missing column ", required, header, error);
 }
 
 // Parses one data row into *sample; on failure *reason says why (without file:line).
@@ -555,7 +578,7 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
   // "-0" is the reading 0, and the writer writes it so: a written and re-read dataset then
   // holds the same bits (the fuzzer's round trip), and -0 never reaches a sign test.
   for (double& v : value) v += 0.0;
-  {
+  if (header.position) {
     const Eigen::Vector3d position(value[kX], value[kY], value[kZ]);
     std::string why;
     if (!CheckPosition(position, limits, &why)) {
@@ -565,7 +588,9 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
   }
   sample->time_s = value[kTime];
   sample->pose.position_m = Eigen::Vector3d(value[kX], value[kY], value[kZ]);
-  if (header.quaternion) {
+  if (!header.attitude) {
+    // A lengths file without an attitude: the identity, unused (Dataset::has_attitude).
+  } else if (header.quaternion) {
     sample->measured_quaternion_wxyz =
         Eigen::Vector4d(value[kQw], value[kQx], value[kQy], value[kQz]);
     std::string why;
@@ -717,9 +742,15 @@ class LineParser {
       return true;
     }
     if (!have_header_) {
-      if (!ParseHeader(line, where(), layout_.path, &header_, error)) return false;
+      if (!ParseHeader(line, where(), layout_.path, options_.required_columns, &header_, error)) {
+        return false;
+      }
       have_header_ = true;
       if (header_.map != nullptr) skip_until_ = line_number + header_.map->skip_after_header;
+      layout_.has_time = header_.time;
+      layout_.has_position = header_.position;
+      layout_.has_measured_attitude = header_.attitude;
+      layout_.has_tensions = header_.tensions;
       layout_.has_planned_attitude = header_.planned;
       layout_.has_unstretched_lengths = header_.unstretched;
       layout_.attitude_as_quaternion = header_.quaternion;
@@ -837,7 +868,7 @@ class LineParser {
         sample->session = SessionIndex(SplitFields(line)[header_.session_field], &layout_);
       }
     }
-    radians_.Add(*sample, header_.planned);
+    if (header_.position && header_.attitude) radians_.Add(*sample, header_.planned);
     out->samples.push_back(std::move(*sample));
     previous_ = values;
     have_previous_ = true;
@@ -862,6 +893,10 @@ void TakeLayout(const Dataset& layout, Dataset* data) {
   data->has_planned_attitude = layout.has_planned_attitude;
   data->has_unstretched_lengths = layout.has_unstretched_lengths;
   data->attitude_as_quaternion = layout.attitude_as_quaternion;
+  data->has_time = layout.has_time;
+  data->has_position = layout.has_position;
+  data->has_measured_attitude = layout.has_measured_attitude;
+  data->has_tensions = layout.has_tensions;
   data->session_labels = layout.session_labels;
   data->time_offset_s = layout.time_offset_s;
 }

@@ -1,5 +1,6 @@
 // Synthetic telemetry from a truth model: attitude control error, pose and tension sensor
-// noise, outliers, sensor gain and bias, per-cable density mismatch (model: simulation.h).
+// noise, outliers, sensor gain and bias, per-cable density mismatch, length-encoder offsets
+// and noise (model: simulation.h).
 #include "fastcal/simulation.h"
 
 #include <cmath>
@@ -28,6 +29,8 @@ enum Stream : std::uint64_t {
   kMassCentreDriftStream,
   kSensorSpreadStream,
   kSensorRezeroStream,
+  kLengthOffsetStream,
+  kLengthNoiseStream,
 };
 
 bool Fail(std::string* error, const std::string& message) {
@@ -163,6 +166,11 @@ bool DrawTruthModel(const SimulationOptions& options, CableRobot* model, Simulat
   for (int i = 0; i < kNumCables; ++i) {
     model->cables[i].sensor_bias_n += options.sensor_bias_spread_kn * kNPerKn * sensor_rng.Normal();
   }
+  Random length_rng(options.seed, kLengthOffsetStream);
+  for (int i = 0; i < kNumCables; ++i) {
+    model->cables[i].length_offset_m += options.length_offset_spread_m * length_rng.Normal();
+    stats->length_offset_m[i] = model->cables[i].length_offset_m;
+  }
   return true;
 }
 
@@ -198,6 +206,7 @@ struct Processes {
         drift_rng(o.seed, kTensionDriftStream),
         mass_centre_rng(o.seed, kMassCentreDriftStream),
         rezero_rng(o.seed, kSensorRezeroStream),
+        length_rng(o.seed, kLengthNoiseStream),
         control(o.attitude_control_sigma_deg, o.attitude_control_time_s, o.sample_interval_s),
         mass_centre_drift(o.mass_centre_drift_m, o.mass_centre_drift_time_s, o.sample_interval_s),
         tension_drift(kNumCables, Ar1(DriftSigma(o), o.tension_drift_time_s,
@@ -209,7 +218,7 @@ struct Processes {
     return o.tension_drift_kn > 0.0 ? 1.0 : 0.0;
   }
   Random control_rng, attitude_rng, position_rng, tension_rng, outlier_rng, drift_rng,
-      mass_centre_rng, rezero_rng;
+      mass_centre_rng, rezero_rng, length_rng;
   // The time since the previous sample (the interval, or more across a session gap).
   double dt = 0.0;
   Ar1Vector control, mass_centre_drift;
@@ -217,7 +226,7 @@ struct Processes {
   // Sums over the samples.
   Eigen::Vector3d mass_centre_sum = Eigen::Vector3d::Zero();
   double mass_centre_sq = 0.0, control_sq = 0.0, attitude_sq = 0.0, position_sq = 0.0;
-  std::array<double, kNumCables> drift_sq{}, noise_sq{}, relative_sq{};
+  std::array<double, kNumCables> drift_sq{}, noise_sq{}, relative_sq{}, length_sq{};
 };
 
 // The actual pose of sample n (the planned one with the control error) and its statics
@@ -271,7 +280,8 @@ double SlowErrorN(const SimulationOptions& o, double reading_n, double drift) {
 }
 
 // The six readings of sample n: the sensor's reading of the true tension, with the slow
-// drift and the noise, or an outlier; the commanded s0 alongside.
+// drift and the noise, or an outlier; the encoder's reading of s0 alongside (offset and
+// noise).
 bool MeasureTensions(size_t n, const CableRobot& model, const StaticsSolution& solution,
                      const SimulationOptions& options, Processes* p, SimulationSummary* stats,
                      Sample* s, std::string* error) {
@@ -308,7 +318,15 @@ bool MeasureTensions(size_t n, const CableRobot& model, const StaticsSolution& s
                                  : reading_n * (1.0 + relative + drift) + absolute_n;
     }
     s->tension_n[i] = measured_n;
-    s->unstretched_length_m[i] = solution.cables[i].unstretched_length_m;
+    const double length_noise_m = options.length_noise_m * p->length_rng.Normal();
+    s->unstretched_length_m[i] =
+        model.cables[i].EncoderReadingM(solution.cables[i].unstretched_length_m) + length_noise_m;
+    p->length_sq[i] += length_noise_m * length_noise_m;
+    if (!(s->unstretched_length_m[i] > 0.0)) {
+      return Fail(error, "node " + std::to_string(n) + ", cable " + std::to_string(i + 1) +
+                             ": the length reading s0 + offset + noise = " +
+                             Num(s->unstretched_length_m[i]) + " m is not > 0");
+    }
     stats->outliers[i] += outlier ? 1 : 0;
     p->noise_sq[i] += (measured_n - reading_n) * (measured_n - reading_n);
     p->relative_sq[i] += (measured_n / reading_n - 1.0) * (measured_n / reading_n - 1.0);
@@ -322,6 +340,7 @@ void Summarise(const Processes& p, double count, SimulationSummary* stats) {
     stats->tension_noise_rms_n[i] = std::sqrt(p.noise_sq[i] / count);
     stats->tension_noise_rms_relative[i] = std::sqrt(p.relative_sq[i] / count);
     stats->tension_drift_rms_relative[i] = std::sqrt(p.drift_sq[i] / count);
+    stats->length_noise_rms_m[i] = std::sqrt(p.length_sq[i] / count);
   }
   stats->mass_centre_mean_m = p.mass_centre_sum / count;
   stats->mass_centre_drift_rms_m = std::sqrt(p.mass_centre_sq / (3.0 * count));
@@ -442,6 +461,8 @@ bool SimulationOptions::IsValid(std::string* error) const {
       {"tension_noise_percent", tension_noise_percent},
       {"tension_noise_kn", tension_noise_kn},
       {"density_mismatch_percent", density_mismatch_percent},
+      {"length_offset_spread_m", length_offset_spread_m},
+      {"length_noise_m", length_noise_m},
   };
   for (const auto& f : non_negative) {
     if (!NonNegativeFinite(f.value)) {

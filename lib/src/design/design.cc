@@ -376,7 +376,7 @@ DesignPrediction Predict(const DesignProblem& pr, const DesignSums& s, int sampl
   in.prior_information = pr.prior_information;
   int priors = 0;
   for (int k = 0; k < pr.n; ++k) priors += pr.prior_information[k] > 0.0;
-  in.num_residuals = 6 * samples + priors;
+  in.num_residuals = pr.rows * samples + priors;
   in.chi_square = in.num_residuals - pr.n;  // chi^2 / nu = 1: no misfit widening
   in.consider_cross = s.c;
   in.consider_sigma = pr.consider_variance.cwiseSqrt();

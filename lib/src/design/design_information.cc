@@ -1,7 +1,9 @@
 // A survey design's information and criterion (internal/design_information.h; formulas in
 // design.h). The Jacobian comes from the calibration's own residual, TensionResidual
 // through TensionCost, with the consider parameters freed so that one Jet pass gives
-// both [J_x J_c]: the same derivatives the calibration's budget uses.
+// both [J_x J_c]: the same derivatives the calibration's budget uses. With the winches'
+// lengths in the spec (noise.length_sigma_m) each pose has twelve rows, the six tensions'
+// and the six lengths' (calibration_model.h), each whitened by its sigma.
 #include "fastcal/internal/design_information.h"
 
 #include <Eigen/Cholesky>
@@ -16,8 +18,6 @@
 
 namespace fastcal::internal {
 namespace {
-
-constexpr int kRows = kNumCables;  // readings per sample
 
 // A factor S (n x m, m the wanted parameters) of the criterion's weight on P, W = S S^T:
 // A: diag(weights) on the wanted parameters, so S = sqrt(weight) on the diagonal; D: P_w^-1
@@ -82,6 +82,7 @@ bool SetUpDesignProblem(const CalibrationSpec& spec, DesignProblem* problem, std
     if (g == static_cast<int>(pr.consider_groups.size())) pr.consider_groups.push_back(group);
     pr.consider_group.push_back(g);
   }
+  pr.rows = spec.UsesLengths() ? kMaxReadings : kNumCables;
   pr.x_rows.resize(0, pr.n);
   pr.z_rows.resize(0, pr.q);
   pr.wanted_weight = Eigen::VectorXd::Zero(pr.n);
@@ -105,12 +106,15 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
   }
   TensionResidual f{&model,        Pose(), {}, {}, ModelFitStaticsOptions(spec.forward_model),
                     CompactStart()};
-  f.sigma_n.fill(1.0);  // residual = reading; whitened below
+  f.sigma_n.fill(1.0);                             // residual = reading; whitened below
+  if (spec.UsesLengths()) f.length_sigma_m = 1.0;  // residual = s0 + offset; likewise
+  const int rows = pr.rows;
   const int first = static_cast<int>(pr.x_rows.rows());
-  pr.x_rows.conservativeResize(first + kRows * static_cast<int>(poses.size()), pr.n);
-  pr.z_rows.conservativeResize(first + kRows * static_cast<int>(poses.size()), pr.q);
-  Eigen::Matrix<double, kRows, Eigen::Dynamic, Eigen::RowMajor> jac(kRows, model.num_free());
-  std::array<double, kRows> reading{};
+  pr.x_rows.conservativeResize(first + rows * static_cast<int>(poses.size()), pr.n);
+  pr.z_rows.conservativeResize(first + rows * static_cast<int>(poses.size()), pr.q);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jac(rows,
+                                                                             model.num_free());
+  std::array<double, kMaxReadings> reading{};
   for (size_t t = 0; t < poses.size(); ++t) {
     f.pose = poses[t];
     const TensionCost cost(f);
@@ -125,12 +129,15 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
       pr.z_rows.conservativeResize(first, pr.q);
       return false;
     }
-    const std::array<double, kRows> sigma =
-        TensionSigmas(reading, spec.tension_sigma_n, spec.tension_sigma_percent);
-    for (int i = 0; i < kRows; ++i) {
-      const int row = first + kRows * static_cast<int>(t) + i;
+    std::array<double, kNumCables> tension{};
+    std::copy(reading.begin(), reading.begin() + kNumCables, tension.begin());
+    const std::array<double, kNumCables> sigma =
+        TensionSigmas(tension, spec.tension_sigma_n, spec.tension_sigma_percent);
+    for (int i = 0; i < rows; ++i) {
+      const int row = first + rows * static_cast<int>(t) + i;
+      const double sigma_i = i < kNumCables ? sigma[i] : spec.length_sigma_m;
       for (int k = 0; k < model.num_free(); ++k) {
-        const double v = jac(i, k) / sigma[i];
+        const double v = jac(i, k) / sigma_i;
         if (column[k] < pr.n) {
           pr.x_rows(row, column[k]) = v;
         } else {
@@ -148,19 +155,19 @@ DesignSums SumsOf(const DesignProblem& pr, const Eigen::VectorXd& weights) {
   s.c = Eigen::MatrixXd::Zero(pr.n, pr.q);
   for (int k = 0; k < pr.candidates(); ++k) {
     if (!(weights[k] > 0.0)) continue;
-    const auto x = pr.x_rows.middleRows(kRows * k, kRows);
+    const auto x = pr.x_rows.middleRows(pr.rows * k, pr.rows);
     s.m.noalias() += weights[k] * (x.transpose() * x);
     if (pr.q > 0)
-      s.c.noalias() += weights[k] * (x.transpose() * pr.z_rows.middleRows(kRows * k, kRows));
+      s.c.noalias() += weights[k] * (x.transpose() * pr.z_rows.middleRows(pr.rows * k, pr.rows));
   }
   return s;
 }
 
 DesignSums SumsOfCandidate(const DesignProblem& pr, int k) {
-  const auto x = pr.x_rows.middleRows(kRows * k, kRows);
+  const auto x = pr.x_rows.middleRows(pr.rows * k, pr.rows);
   DesignSums s;
   s.m = x.transpose() * x;
-  s.c = x.transpose() * pr.z_rows.middleRows(kRows * k, kRows);
+  s.c = x.transpose() * pr.z_rows.middleRows(pr.rows * k, pr.rows);
   return s;
 }
 
@@ -217,7 +224,7 @@ bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::V
   ab.leftCols(m) = k * factor;
   ab.rightCols(m) = ab.leftCols(m) + 2.0 * (kc * p);
   const Eigen::MatrixXd e = -2.0 * p;
-  // Per candidate: the sum over its six rows. In chunks, so that the temporaries stay
+  // Per candidate: the sum over its rows. In chunks, so that the temporaries stay
   // small, the chunks shared by two threads (the gradient is most of a design's time).
   constexpr int kChunkCandidates = 512;
   constexpr int kThreads = 2;
@@ -228,14 +235,14 @@ bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::V
     for (int chunk = first_chunk; chunk < chunks; chunk += kThreads) {
       const int c0 = chunk * kChunkCandidates;
       const int count = std::min(kChunkCandidates, pr.candidates() - c0);
-      uy.noalias() = pr.x_rows.middleRows(kRows * c0, kRows * count) * ab;
+      uy.noalias() = pr.x_rows.middleRows(pr.rows * c0, pr.rows * count) * ab;
       if (pr.q > 0) {
-        uy.rightCols(m).noalias() += pr.z_rows.middleRows(kRows * c0, kRows * count) * e;
+        uy.rightCols(m).noalias() += pr.z_rows.middleRows(pr.rows * c0, pr.rows * count) * e;
       }
       const Eigen::VectorXd per_row =
           -(uy.leftCols(m).cwiseProduct(uy.rightCols(m))).rowwise().sum();
       for (int c = 0; c < count; ++c) {
-        (*gradient)[c0 + c] = per_row.segment(kRows * c, kRows).sum();
+        (*gradient)[c0 + c] = per_row.segment(pr.rows * c, pr.rows).sum();
       }
     }
   };

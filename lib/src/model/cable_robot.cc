@@ -74,6 +74,7 @@ bool CableRobot::IsValid(std::string* error) const {
       return fail(key + ".sensor_gain", "must be > 0");
     }
     if (!std::isfinite(c.sensor_bias_n)) return fail(key + ".sensor_bias_kN", "must be finite");
+    if (!std::isfinite(c.length_offset_m)) return fail(key + ".length_offset_m", "must be finite");
     if (c.attachments.size() > static_cast<size_t>(kMaxAttachmentsPerCable)) {
       return fail(key + ".attachments",
                   "has " + std::to_string(c.attachments.size()) + " entries; at most " +

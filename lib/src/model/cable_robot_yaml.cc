@@ -226,9 +226,10 @@ class Parser {
       const std::vector<std::string> required = {"tower_top_m", "anchor", "ea_n",
                                                  "linear_density_kg_per_m"};
       std::vector<std::string> allowed = required;
-      allowed.push_back("sensor_gain");     // optional, default 1
-      allowed.push_back("sensor_bias_kN");  // optional, default 0
-      allowed.push_back("attachments");     // optional, default none
+      allowed.push_back("sensor_gain");      // optional, default 1
+      allowed.push_back("sensor_bias_kN");   // optional, default 0
+      allowed.push_back("length_offset_m");  // optional, default 0
+      allowed.push_back("attachments");      // optional, default none
       std::map<std::string, Entry> keys;
       if (!ReadMap(list[i], cable_line, cable_path, allowed, &keys)) return false;
       for (const std::string& name : required) {
@@ -265,6 +266,12 @@ class Parser {
           return false;
         }
         c.sensor_bias_n = bias_kn * 1e3;
+      }
+      c.length_offset_m = 0.0;
+      if (keys.count("length_offset_m") &&
+          !ReadDouble(keys["length_offset_m"].value, LineOf(keys["length_offset_m"].key),
+                      Join(cable_path, "length_offset_m"), &c.length_offset_m)) {
+        return false;
       }
       c.attachments.clear();
       if (keys.count("attachments") &&
@@ -495,6 +502,10 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
     if (c.sensor_gain != 1.0 || c.sensor_bias_n != 0.0) {
       out << "    sensor_gain: " << Num(c.sensor_gain) << "  # reading = gain * tension + bias\n";
       out << "    sensor_bias_kN: " << Num(c.sensor_bias_n / 1e3) << "\n";
+    }
+    if (c.length_offset_m != 0.0) {
+      out << "    length_offset_m: " << Num(c.length_offset_m)
+          << "  # encoder reading = unstretched length + offset\n";
     }
     if (!c.attachments.empty()) {
       out << "    attachments:  # arc length from the lower (cabin) end, unstretched, m\n";

@@ -65,6 +65,8 @@ std::vector<ModelValue> ModelValues(const CableRobot& robot) {
                       c.linear_density_kg_per_m, n.linear_density_kg_per_m});
     values.push_back({key + "sensor_gain", ModelQuantity::kSensorGain, c.sensor_gain, 1.0});
     values.push_back({key + "sensor_bias_kN", ModelQuantity::kSensorBiasN, c.sensor_bias_n, 0.0});
+    values.push_back(
+        {key + "length_offset_m", ModelQuantity::kLengthOffsetM, c.length_offset_m, 0.0});
     for (size_t j = 0; j < c.attachments.size(); ++j) {
       CableAttachment a = c.attachments[j];
       const std::string at = key + "attachments[" + std::to_string(j) + "].";
@@ -126,6 +128,9 @@ bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity) {
       return true;
     case ParameterKind::kAttachmentDensity:
       *quantity = ModelQuantity::kAttachmentDensityKgPerM;
+      return true;
+    case ParameterKind::kLengthOffset:
+      *quantity = ModelQuantity::kLengthOffsetM;
       return true;
     default:
       return false;

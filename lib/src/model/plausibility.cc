@@ -51,6 +51,8 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
       {"min_sensor_gain", min_sensor_gain},
       {"max_sensor_gain", max_sensor_gain},
       {"max_abs_sensor_bias_n", max_abs_sensor_bias_n},
+      {"max_abs_length_offset_m", max_abs_length_offset_m},
+      {"max_length_sigma_m", max_length_sigma_m},
       {"max_tension_sigma_n", max_tension_sigma_n},
       {"max_tension_sigma_percent", max_tension_sigma_percent},
       {"max_attachment_mass_kg", max_attachment_mass_kg},
@@ -111,6 +113,10 @@ QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& l
       return {limits.min_sensor_gain, limits.max_sensor_gain, 1.0, "", 1.0};
     case ModelQuantity::kSensorBiasN:
       return {-limits.max_abs_sensor_bias_n, limits.max_abs_sensor_bias_n, 0.0, "kN", 1e3};
+    case ModelQuantity::kLengthOffsetM:
+      return {-limits.max_abs_length_offset_m, limits.max_abs_length_offset_m, 0.0, "m", 1.0};
+    case ModelQuantity::kLengthSigmaM:
+      return {0.0, limits.max_length_sigma_m, 0.0, "m", 1.0};
     case ModelQuantity::kTensionSigmaN:
       return {0.0, limits.max_tension_sigma_n, 0.0, "kN", 1e3};
     case ModelQuantity::kTensionSigmaPercent:
@@ -154,6 +160,8 @@ SlipHints SlipHintsOf(ModelQuantity quantity) {
     case ModelQuantity::kAttachmentMassKg:
       return {nullptr, "grams written as kg?"};
     case ModelQuantity::kAttachmentPositionM:
+    case ModelQuantity::kLengthOffsetM:
+    case ModelQuantity::kLengthSigmaM:
       return {nullptr, "mm written as m?"};
     case ModelQuantity::kEaN:
       return {"kN written as N?", nullptr};

@@ -1192,6 +1192,7 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
   if (!in.result) AddCablesAsBuilt(in, &doc);
   if (!in.result) internal::AddEvaluationGrossErrors(in, &doc);
   AddRmsTables(in, with_plots, &doc);
+  if (in.result) internal::AddLengths(*in.result, &doc);
   if (in.result) internal::AddCrossValidation(*in.result, &doc);
   if (with_plots) {
     AddPlots(in, &doc);

@@ -222,14 +222,23 @@ void AddReadingsTable(const std::vector<ReadingResidual>& list, const Text& capt
                       Document* doc) {
   Table t;
   t.caption = caption;
-  t.header = {"Line",    "Cable", "Measured [kN]", "Predicted [kN]", "(model - measured) / σ",
+  // With lengths in the fit a reading is a tension (kN) or a length (m, marked).
+  const bool lengths =
+      std::any_of(list.begin(), list.end(), [](const auto& e) { return e.length; });
+  t.header = {"Line",
+              "Cable",
+              lengths ? "Measured [kN, or m]" : "Measured [kN]",
+              lengths ? "Predicted [kN, or m]" : "Predicted [kN]",
+              "(model - measured) / σ",
               "Held out"};
   t.right_align = {true, true, true, true, true, false};
   bool any_held_out = false;
   for (size_t k = 0; k < std::min(list.size(), kMaxReadingRows); ++k) {
     const ReadingResidual& e = list[k];
     any_held_out = any_held_out || e.held_out;
-    t.rows.push_back({Int(e.line), Int(e.cable), Kn3(e.measured_n), Kn3(e.predicted_n),
+    t.rows.push_back({Int(e.line), e.length ? Int(e.cable) + " (length)" : Int(e.cable),
+                      e.length ? Printf("%.4f m", e.measured_m) : Kn3(e.measured_n),
+                      e.length ? Printf("%.4f m", e.predicted_m) : Kn3(e.predicted_n),
                       Printf("%+.1f", e.residual_sigma), e.held_out ? "yes" : ""});
   }
   if (!any_held_out) {  // an empty column is not drawn
@@ -246,10 +255,12 @@ void AddReadingsTable(const std::vector<ReadingResidual>& list, const Text& capt
 
 // The screen per cable: readings flagged, median and robust scale of the residuals.
 void AddPerCableScreen(const std::array<int, kNumCables>& counts,
-                       const std::array<RobustScale, kNumCables>& scales, Document* doc) {
+                       const std::array<RobustScale, kNumCables>& scales, Document* doc,
+                       bool lengths = false) {
   Table s;
-  s.caption = "Per cable";
-  s.header = {"", "T1", "T2", "T3", "T4", "T5", "T6"};
+  s.caption = lengths ? "Per cable, lengths" : "Per cable";
+  s.header = lengths ? std::vector<Text>{"", "L1", "L2", "L3", "L4", "L5", "L6"}
+                     : std::vector<Text>{"", "T1", "T2", "T3", "T4", "T5", "T6"};
   s.right_align = {false, true, true, true, true, true, true};
   std::vector<Text> count = {"gross errors"}, centre = {"median residual [σ]"},
                     scale = {"robust scale [σ]"};
@@ -283,6 +294,10 @@ void AddGrossErrors(const ReportInputs& in, Document* doc) {
     std::array<RobustScale, kNumCables> scales;
     for (int i = 0; i < kNumCables; ++i) scales[i] = {g.centre[i], g.scale[i]};
     AddPerCableScreen(g.count, scales, doc);
+    if (r.lengths.used) {  // screened on their own scales: a slipped encoder is one
+      for (int i = 0; i < kNumCables; ++i) scales[i] = {g.length_centre[i], g.length_scale[i]};
+      AddPerCableScreen(g.length_count, scales, doc, /*lengths=*/true);
+    }
   }
   if (!r.gross_errors.empty())
     AddReadingsTable(r.gross_errors, "Gross errors (line in the data file)", doc);
@@ -290,6 +305,36 @@ void AddGrossErrors(const ReportInputs& in, Document* doc) {
     AddReadingsTable(r.worst_readings, "The worst fitted readings (largest |model - measured| / σ)",
                      doc);
   }
+}
+
+void AddLengths(const CalibrationResult& r, Document* doc) {
+  const LengthEvaluation& l = r.lengths;
+  if (!l.used) return;
+  doc->Heading(2, "Lengths");
+  doc->Paragraph(
+      "The winches' lengths (s0_<i>_m) as measurements, σ = " + Printf("%.3g", l.sigma_m * 1e3) +
+      " mm each: model (its unstretched length at the sample's pose, exact statics, plus the "
+      "encoder's offset length_offset_m) minus measured, per cable, in mm; gross errors left "
+      "out.");
+  Table t;
+  t.caption = "Model - measured length [mm]";
+  t.header = {"", "Samples", "L1", "L2", "L3", "L4", "L5", "L6"};
+  t.right_align = {false, true, true, true, true, true, true, true};
+  const auto add = [&](const std::string& name, const LengthResidualStats& s,
+                       std::array<double, kNumCables> LengthResidualStats::*member) {
+    if (s.samples == 0) return;
+    std::vector<Text> row = {name, Int(s.samples)};
+    // Below half the last digit: 0, not "-0.00".
+    for (double v : s.*member) row.push_back(Printf("%.2f", std::abs(v) < 5e-6 ? 0.0 : v * 1e3));
+    t.rows.push_back(std::move(row));
+  };
+  add("RMS, initial model", l.initial, &LengthResidualStats::rms_m);
+  add("RMS, calibrated model", l.calibrated, &LengthResidualStats::rms_m);
+  add("mean, calibrated model", l.calibrated, &LengthResidualStats::mean_m);
+  add("largest |.|, calibrated model", l.calibrated, &LengthResidualStats::max_abs_m);
+  add("RMS, initial model, held out", l.initial_holdout, &LengthResidualStats::rms_m);
+  add("RMS, calibrated model, held out", l.calibrated_holdout, &LengthResidualStats::rms_m);
+  doc->AddTable(std::move(t));
 }
 
 void AddEvaluationGrossErrors(const ReportInputs& in, Document* doc) {
@@ -612,10 +657,16 @@ void JsonReadings(const char* key, const std::vector<ReadingResidual>& list, Jso
     w->BeginObject();
     w->Key("line").Int(e.line);
     w->Key("cable").Int(e.cable);
-    w->Key("measured_kN").Number(e.measured_n / kNPerKn);
-    w->Key("predicted_kN").Number(e.predicted_n / kNPerKn);
+    if (e.length) {
+      w->Key("measured_m").Number(e.measured_m);
+      w->Key("predicted_m").Number(e.predicted_m);
+    } else {
+      w->Key("measured_kN").Number(e.measured_n / kNPerKn);
+      w->Key("predicted_kN").Number(e.predicted_n / kNPerKn);
+    }
     w->Key("residual_sigma").Number(e.residual_sigma);
     w->Key("held_out").Bool(e.held_out);
+    w->Key("reading").String(e.length ? "length" : "tension");
     w->EndObject();
   }
   w->EndArray();
@@ -644,6 +695,12 @@ void JsonGrossErrors(const CalibrationResult& r, JsonWriter* w) {
   w->Key("fitted_readings").Int(g.fitted_readings);
   w->Key("fitted_flagged").Int(g.fitted_flagged);
   w->Key("settled").Bool(g.settled);
+  if (r.lengths.used) {
+    w->Key("length_count_per_cable")
+        .NumberArray(std::vector<double>(g.length_count.begin(), g.length_count.end()));
+    w->Key("length_robust_centre_sigma").NumberArray(g.length_centre);
+    w->Key("length_robust_scale_sigma").NumberArray(g.length_scale);
+  }
   w->EndObject();
   JsonReadings("outliers", r.gross_errors, w);
   JsonReadings("worst_readings", r.worst_readings, w);
@@ -709,10 +766,37 @@ void WriteEvaluationGrossErrorsJson(const ReportInputs& in, JsonWriter* w) {
   JsonReadings("outliers", e.gross_errors, w);
 }
 
+void JsonLengthStats(const char* key, const LengthResidualStats& s, JsonWriter* w) {
+  w->Key(key);
+  if (s.samples == 0) {
+    w->Null();
+    return;
+  }
+  w->BeginObject();
+  w->Key("samples").Int(s.samples);
+  w->Key("excluded").NumberArray(std::vector<double>(s.excluded.begin(), s.excluded.end()));
+  w->Key("mean_m").NumberArray(s.mean_m);
+  w->Key("rms_m").NumberArray(s.rms_m);
+  w->Key("max_abs_m").NumberArray(s.max_abs_m);
+  w->EndObject();
+}
+
 void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w) {
   JsonVerdictAndBudget(r, w);
   JsonGrossErrors(r, w);
   JsonMisfitAndValidation(r, w);
+  w->Key("lengths");
+  if (!r.lengths.used) {
+    w->Null();
+    return;
+  }
+  w->BeginObject();
+  w->Key("sigma_m").Number(r.lengths.sigma_m);
+  JsonLengthStats("initial", r.lengths.initial, w);
+  JsonLengthStats("calibrated", r.lengths.calibrated, w);
+  JsonLengthStats("initial_holdout", r.lengths.initial_holdout, w);
+  JsonLengthStats("calibrated_holdout", r.lengths.calibrated_holdout, w);
+  w->EndObject();
 }
 
 }  // namespace fastcal::internal

@@ -20,6 +20,8 @@
 #include <optional>
 #include <sstream>
 
+#include "fastcal/internal/forward_statics.h"
+
 namespace fastcal {
 namespace {
 
@@ -1373,6 +1375,57 @@ std::string DescribeStatus(const StaticsSolution& solution) {
                 "pose (docs/model.md, \"Which equilibrium exact returns\")");
   }
   return s.str();
+}
+
+// A state from outside (the forward statics, locate.h), checked as exact's own solutions
+// are: its error estimate at most exact_relative_tolerance (kNotConverged otherwise), the
+// equilibrium residuals, the model range and the reflector (statics_core.h).
+StaticsStatus CheckStaticsState(const StaticsParameters<double>& p, const Pose& pose,
+                                const std::array<internal::CableState<double>, kNumCables>& state,
+                                const StaticsOptions& options, StaticsSolution* solution) {
+  StaticsSolution* sol = solution;
+  sol->method = StaticsMethod::kExact;
+  sol->cable = -1;
+  sol->outer_iterations = sol->catenary_iterations = 0;
+  sol->continuation = sol->has_previous = false;
+  sol->force_residual_n = sol->moment_residual_nm = 0.0;
+  sol->end_residual_m = sol->error_estimate = 0.0;
+  sol->limit_value = sol->limit = 0.0;
+  sol->reflector_clearance_m = std::numeric_limits<double>::infinity();
+  sol->pose = pose;
+  StaticsStatus status = StaticsStatus::kInvalidInput;
+  Geometry g;
+  bool usable = BrokenRule(options) == OptionsRule::kNone && IsFinite(pose) && ParametersUsable(p);
+  for (const CableState<double>& c : state) usable = usable && c.fl > 0.0 && c.s0 > 0.0;
+  if (usable) {
+    status = internal::ComputeGeometry(p, pose, options.catenary.vertical_span_fraction, &g,
+                                       &sol->cable);
+  }
+  if (status == StaticsStatus::kOk) {
+    Context c{p, options, sol};
+    CableLinearisation<double> lin;
+    internal::LineariseCables(p, g, state, &lin);
+    EquilibriumResponse response;
+    std::array<double, kNumCables> unused;
+    if (!internal::SolveEquilibrium<double, true>(g, lin.a, lin.b, &unused, &response)) {
+      status = StaticsStatus::kSingular;
+    } else {
+      const Check check = CheckAfterStep(p, g, state, lin, response);
+      if (!(check.error_estimate <= options.exact_relative_tolerance)) {
+        sol->limit_value = check.error_estimate;
+        sol->limit = options.exact_relative_tolerance;
+        status = StaticsStatus::kNotConverged;
+      } else {
+        status = Finish(&c, g, state, check);
+      }
+    }
+  }
+  if (status != StaticsStatus::kOk) {
+    sol->cables = {};  // no numbers where an error belongs (SolveStaticsWithParameters)
+    sol->force_residual_n = sol->moment_residual_nm = 0.0;
+    sol->end_residual_m = sol->error_estimate = 0.0;
+  }
+  return sol->status = status;
 }
 
 }  // namespace fastcal

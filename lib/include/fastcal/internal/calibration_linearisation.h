@@ -84,9 +84,10 @@ struct Linearisation {
   Eigen::MatrixXd loss_curvature;
   Eigen::MatrixXd r_factor;     // upper triangular R, R^T R = J_x^T J_x
   SampleScores scores;          // s_t, one row per fitted sample (float: uncertainty.h)
-  // J_t (6 x n, row after row), one row per fitted sample: with keep_jacobians only.
+  // J_t (readings x n, row after row; 6 readings, 12 with lengths), one row per fitted
+  // sample: with keep_jacobians only.
   SampleJacobians jacobians;
-  Eigen::MatrixXd residuals;    // r_t (fitted samples x 6); 0 where excluded
+  Eigen::MatrixXd residuals;    // r_t (fitted samples x readings); 0 where excluded
   double chi_square = 0.0;      // sum (w r)^2 over the data, w the robust loss's weight
   double raw_chi_square = 0.0;  // sum r^2 over the data
   int readings = 0;             // readings not excluded
@@ -115,9 +116,10 @@ struct Linearisation {
 };
 
 // The basis parameters, in order (all free, no initial: the model's values).
-std::vector<ParameterSpec> BasisParameters(const CableRobot& model);
+std::vector<ParameterSpec> BasisParameters(const CableRobot& model, bool lengths = false);
 // The basis columns a parameter (of a spec or a candidate) is the sum of.
-std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model);
+std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model,
+                              bool lengths = false);
 
 // Both passes. False, with *error naming the sample's line, when the statics fail there.
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error);

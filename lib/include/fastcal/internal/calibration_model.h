@@ -3,8 +3,11 @@
 //   r_i = (gain_i * T_i(theta; pose) + bias_i - T_measured_i) / sigma_i,   i = 1..6
 // with T_i the forward model's lower-end tension (statics.h) and
 //   sigma_i^2 = sigma_abs^2 + (percent/100 * T_predicted_i)^2
-// (the predicted reading at the previous pass's parameters: calibration.cc), and
-// r_i = 0 for a reading kept out of the fit (a gross error).
+// (the predicted reading at the previous pass's parameters: calibration.cc), and, with
+// the lengths in the fit (spec noise.length_sigma_m), six more readings of the same sample:
+//   r_6+i = (s0_i(theta; pose) + offset_i - s0_measured_i) / sigma_L,      i = 1..6
+// with s0_i exact's unstretched length and offset_i the winch encoder's zero
+// (length_offset_m); r = 0 for a reading kept out of the fit (a gross error).
 // TensionResidual is a pure functor (const members, no side effects). Its Evaluate is the
 // one stage every consumer (the folded cost, the linearisation, the design) reads a
 // sample's six rows and their 6 x n Jacobian from. With exact statics the Jacobian is
@@ -12,7 +15,9 @@
 // contracted with the parameter map (CalibrationModel::ReadingJacobian), the sensors' gain
 // and bias directly; ~1 us a sample whatever n (issue 28). With aas and aas-refined,
 // whose solutions are explicit sequences of solves, a ceres::Jet as wide as n replays
-// them (TensionCost::EvaluateJet).
+// them (TensionCost::EvaluateJet). With the lengths in the fit the Jet replays exact's
+// solution too (statics_jet.h gives s0's derivatives through the implicit-function
+// theorem): slower than the analytic rows, the same numbers.
 #ifndef FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 #define FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 
@@ -38,6 +43,10 @@ namespace fastcal::internal {
 // linearisation's basis (every parameter the model has) needs 55 for FAST's layout, plus
 // one per attachment.
 inline constexpr int kMaxFreeParameters = 128;
+
+// Readings of one sample: the six tensions (rows 0..5), then with lengths in the fit the
+// six lengths (rows 6..11).
+inline constexpr int kMaxReadings = 2 * kNumCables;
 
 class CalibrationModel {
  public:
@@ -71,11 +80,14 @@ class CalibrationModel {
   // parameter of another session (ParameterSpec::session) does not apply.
   template <typename T>
   void Assemble(const T* theta, StaticsParameters<T>* p, std::array<T, kNumCables>* gain,
-                std::array<T, kNumCables>* bias, int session = 0) const {
+                std::array<T, kNumCables>* bias, int session = 0,
+                std::array<T, kNumCables>* offset_m = nullptr) const {
     CastParametersInto(base_, p);
+    std::array<T, kNumCables> offset;
     for (int i = 0; i < kNumCables; ++i) {
       (*gain)[i] = T(base_gain_[i]);
       (*bias)[i] = T(base_bias_n_[i]);
+      offset[i] = T(base_offset_m_[i]);
     }
     for (int k = 0; k < num_free(); ++k) {
       const ParameterSpec& s = spec_.parameters[free_[k]];
@@ -120,8 +132,14 @@ class CalibrationModel {
         case ParameterKind::kAttachmentDensity:
           p->chain[s.index].value[s.component] = v;
           break;
+        case ParameterKind::kLengthOffset:
+          for (int i = 0; i < kNumCables; ++i) {
+            if (s.index < 0 || s.index == i) offset[i] = v;
+          }
+          break;
       }
     }
+    if (offset_m != nullptr) *offset_m = offset;
   }
 
  private:
@@ -131,7 +149,7 @@ class CalibrationModel {
   bool frees_geometry_ = false;
   std::array<int, kNumCables> anchor_of_cable_{};
   StaticsParameters<double> base_;  // the robot with fixed overrides applied
-  std::array<double, kNumCables> base_gain_{}, base_bias_n_{};
+  std::array<double, kNumCables> base_gain_{}, base_bias_n_{}, base_offset_m_{};
 };
 
 // The model at one theta for a pass over many samples: the statics parameters, gains and
@@ -173,16 +191,24 @@ struct TensionResidual {
   // Readings kept out of the fit: their residual is 0, whatever the parameters.
   std::array<bool, kNumCables> excluded{};
   int session = 0;  // the sample's (Sample::session)
+  // With the lengths in the fit (length_sigma_m > 0): the measured lengths, their sigma,
+  // and the lengths kept out. readings() residuals in all.
+  std::array<double, kNumCables> measured_length_m{};
+  double length_sigma_m = 0.0;
+  std::array<bool, kNumCables> length_excluded{};
 
-  // The six residuals and, when `jacobian` is not null, their Jacobian (6 x n, row-major;
-  // rows of excluded readings zero) at theta. False where the statics fail.
+  int readings() const { return length_sigma_m > 0.0 ? kMaxReadings : kNumCables; }
+
+  // The readings() residuals and, when `jacobian` is not null, their Jacobian (readings()
+  // x n, row-major; rows of excluded readings zero) at theta. False where the statics fail.
   bool Evaluate(const double* theta, double* residuals, double* jacobian) const;
 
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
     StaticsParameters<T> p;
-    std::array<T, kNumCables> gain, bias, tension;
-    model->Assemble(theta, &p, &gain, &bias, session);
+    std::array<T, kNumCables> gain, bias, tension, offset, length;
+    const bool lengths = length_sigma_m > 0.0;
+    model->Assemble(theta, &p, &gain, &bias, session, &offset);
     // Physical limits: a non-positive gain here, and non-positive mass, density or EA in
     // the statics, make the evaluation fail, which Ceres treats as an infeasible step.
     for (const T& g : gain) {
@@ -192,12 +218,18 @@ struct TensionResidual {
     start.Restore(pose, statics.method, &solution);
     StaticsOptions options = statics;
     options.warm_start = true;
-    if (ModelLowerTensions(p, pose, options, &tension, &solution) != StaticsStatus::kOk) {
+    if (ModelLowerTensions(p, pose, options, &tension, &solution, lengths ? &length : nullptr) !=
+        StaticsStatus::kOk) {
       return false;
     }
     for (int i = 0; i < kNumCables; ++i) {
       residuals[i] =
           excluded[i] ? T(0.0) : (gain[i] * tension[i] + bias[i] - measured_n[i]) / sigma_n[i];
+    }
+    for (int i = 0; i < kNumCables && lengths; ++i) {
+      residuals[kNumCables + i] =
+          length_excluded[i] ? T(0.0)
+                             : (length[i] + offset[i] - measured_length_m[i]) / length_sigma_m;
     }
     return true;
   }
@@ -222,8 +254,14 @@ struct FittedSamples {
   // rho = sigma_slow(reading) / sigma_white (sample_rows.h).
   SlowErrorProcess slow_error;
   const std::vector<std::array<double, kNumCables>>* slow_rho = nullptr;
+  // The lengths as readings (CalibrationSpec::length_sigma_m; 0: not used) and, per
+  // dataset sample, the lengths kept out (may be null or empty).
+  double length_sigma_m = 0.0;
+  const ReadingMask* length_excluded = nullptr;
 
   int size() const { return static_cast<int>(fit->size()); }
+  // Rows per sample: the six tensions, twelve with the lengths.
+  int readings() const { return length_sigma_m > 0.0 ? kMaxReadings : kNumCables; }
   bool whitened() const { return slow_error.IsActive() && slow_rho != nullptr; }
   // Fitted sample j's residual through `through` (default: model).
   TensionResidual At(int j, const CalibrationModel* through = nullptr) const;
@@ -234,8 +272,9 @@ struct FittedSamples {
   bool Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const;
   // The number of sessions a ModelAtTheta for these samples needs.
   int sessions() const;
-  // Fitted sample j's readings kept out of the fit.
+  // Fitted sample j's readings kept out of the fit, and its lengths kept out.
   std::array<bool, kNumCables> Excluded(int j) const;
+  std::array<bool, kNumCables> LengthExcluded(int j) const;
 };
 
 // ceres::CostFunction over one parameter block (theta) of size num_free <=

@@ -27,10 +27,12 @@ struct DesignProblem {
   std::vector<int> wanted;  // indices into the free parameters
   DesignCriterion criterion = DesignCriterion::kA;
   Eigen::VectorXd wanted_weight;  // A: weight of each wanted variance (n; 0 elsewhere)
-  // Whitened Jacobian rows, 6 per candidate (candidate k's rows 6k..6k+5): free (X) and
-  // consider (Z) columns.
+  // Readings per pose: the six tensions, twelve with the lengths (spec noise.length_sigma_m).
+  int rows = 6;
+  // Whitened Jacobian rows, `rows` per candidate (candidate k's rows rows k .. rows k +
+  // rows - 1): free (X) and consider (Z) columns.
   Eigen::MatrixXd x_rows, z_rows;
-  int candidates() const { return static_cast<int>(x_rows.rows() / 6); }
+  int candidates() const { return static_cast<int>(x_rows.rows() / rows); }
 };
 
 // The free and consider parameters of `spec` (consider = fixed with a prior). False

@@ -46,7 +46,8 @@ namespace fastcal::internal {
 // Corrector): r <- s_r r, J <- sqrt(rho') (J - (alpha / |r|^2) r r^T J), with
 // alpha = 1 - sqrt(1 + 2 |r|^2 rho'' / rho') when rho'' > 0, else 0 and s_r = sqrt(rho').
 // Returns rho(|r|^2) (|r|^2 without a loss). `jacobian` (6 x n, row-major) may be null.
-double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n);
+double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n,
+                      int readings = kNumCables);
 
 class FoldedTensionCost : public ceres::CostFunction {
  public:

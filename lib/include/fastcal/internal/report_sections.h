@@ -39,6 +39,8 @@ double AzimuthDeg(const Eigen::Vector3d& position_m);
 
 void AddUncertaintyBudget(const CalibrationResult& r, Document* doc);
 void AddGrossErrors(const ReportInputs& in, Document* doc);
+// With lengths in the fit: their residuals per cable before and after (nothing without).
+void AddLengths(const CalibrationResult& r, Document* doc);
 // evaluate's: the screen of the readings against the model (in.evaluation_screen).
 void AddEvaluationGrossErrors(const ReportInputs& in, Document* doc);
 void WriteEvaluationGrossErrorsJson(const ReportInputs& in, JsonWriter* w);
@@ -47,7 +49,8 @@ void AddCrossValidation(const CalibrationResult& r, Document* doc);
 void AddDiagnosticPlots(const ReportInputs& in, Document* doc);
 
 // summary.json's keys for the same: verdict, uncertainty_budget, gross_errors, outliers,
-// worst_readings, misfit_ranking, cross_validation, residual_autocorrelation_time.
+// worst_readings, misfit_ranking, cross_validation, residual_autocorrelation_time, lengths
+// (null without them).
 void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w);
 
 // A joint fit's sessions (report_sessions.cc): the separate parameters per session with

@@ -2,10 +2,11 @@
 // between computing each sample's residuals and Jacobian (on several threads) and using
 // them (the folded cost's QR, the linearisation's sums).
 //
-// Each sample has six rows, one per reading, each `columns` wide: the Jacobian's n
-// columns and then the residual r = (prediction - measured) / sigma_white (columns = 1:
-// the residual alone). With a slow sensor error (FittedSamples::slow_error) the rows of
-// each cable are whitened by its Kalman filter (slow_error_filter.h) in time order, which
+// Each sample has a row per reading, each `columns` wide: the Jacobian's n columns and
+// then the residual r = (prediction - measured) / sigma_white (columns = 1: the residual
+// alone); six rows, the tensions, or twelve with the lengths in the fit (rows 6..11, white:
+// the slow error is the tension sensors'). With a slow sensor error (FittedSamples::slow_error) the
+// rows of each cable are whitened by its Kalman filter (slow_error_filter.h) in time order, which
 // needs the chunks in order: SampleRowWhitener carries the filters from chunk to chunk,
 // inside ReduceChunksInOrder's ordered stage (sample_chunks.h). Readings kept out of the
 // fit (gross errors) move the filters on in time only, and their rows are zero.
@@ -22,19 +23,19 @@ namespace fastcal::internal {
 struct SampleRows {
   int begin = 0, end = 0;  // fitted samples [begin, end)
   int columns = 1;
-  std::vector<double> values;  // sample t's rows at Of(t), row-major, 6 x columns
+  int readings = kNumCables;   // rows per sample (FittedSamples::readings)
+  std::vector<double> values;  // sample t's rows at Of(t), row-major, readings x columns
 
-  void Reset(int first, int last, int width) {
+  void Reset(int first, int last, int width, int rows_per_sample = kNumCables) {
     begin = first;
     end = last;
     columns = width;
-    values.assign(static_cast<size_t>(last - first) * kNumCables * width, 0.0);
+    readings = rows_per_sample;
+    values.assign(static_cast<size_t>(last - first) * readings * width, 0.0);
   }
-  double* Of(int t) {
-    return values.data() + static_cast<size_t>(t - begin) * kNumCables * columns;
-  }
+  double* Of(int t) { return values.data() + static_cast<size_t>(t - begin) * readings * columns; }
   const double* Of(int t) const {
-    return values.data() + static_cast<size_t>(t - begin) * kNumCables * columns;
+    return values.data() + static_cast<size_t>(t - begin) * readings * columns;
   }
   // Row `i` of sample t.
   double* Row(int t, int i) { return Of(t) + i * columns; }

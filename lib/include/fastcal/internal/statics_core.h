@@ -628,12 +628,15 @@ inline CatenaryCurvePoint CurveGuess(double fl, const PoseGeometry<double>& g, i
 
 // Lower-end tensions |F_i| of the model at `pose`, in scalar T, for the calibration's
 // residuals. For a Jet the derivatives are those of the chosen method's solution (see
-// the file comment). `solution` (may be null) receives the double solution.
+// the file comment). `solution` (may be null) receives the double solution; `length_m`
+// (may be null) the unstretched lengths s0_i, exact's with their derivatives (the other
+// methods' without: a fit with lengths uses exact).
 template <typename T>
 StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose,
                                  const StaticsOptions& options,
                                  std::array<T, kNumCables>* tension_n,
-                                 StaticsSolution* solution = nullptr);
+                                 StaticsSolution* solution = nullptr,
+                                 std::array<T, kNumCables>* length_m = nullptr);
 
 }  // namespace fastcal
 

@@ -17,7 +17,8 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
 template <typename T>
 StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose,
                                  const StaticsOptions& options,
-                                 std::array<T, kNumCables>* tension_n, StaticsSolution* solution) {
+                                 std::array<T, kNumCables>* tension_n, StaticsSolution* solution,
+                                 std::array<T, kNumCables>* length_m) {
   using std::sqrt;
   StaticsSolution local;
   StaticsSolution* sol = solution != nullptr ? solution : &local;
@@ -28,6 +29,9 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
     status = SolveStaticsWithParameters(p, pose, cold, sol);
     if (status != StaticsStatus::kOk) return status;
     for (int i = 0; i < kNumCables; ++i) (*tension_n)[i] = sol->cables[i].lower_tension_n;
+    for (int i = 0; i < kNumCables && length_m != nullptr; ++i) {
+      (*length_m)[i] = sol->cables[i].unstretched_length_m;
+    }
     return status;
   } else {
     status = SolveStaticsWithParameters(ScalarParameters(p), pose, cold, sol);
@@ -77,6 +81,11 @@ StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose
     }
     for (int i = 0; i < kNumCables; ++i) {
       (*tension_n)[i] = sqrt(st[i].fl * st[i].fl + st[i].fz * st[i].fz);
+    }
+    for (int i = 0; i < kNumCables && length_m != nullptr; ++i) {
+      (*length_m)[i] = options.method == StaticsMethod::kExact
+                           ? st[i].s0
+                           : T(sol->cables[i].unstretched_length_m);
     }
     return StaticsStatus::kOk;
   }
