@@ -167,6 +167,9 @@ class Document {
 // calibration report, design.html and solve's trajectory plot share it.
 std::string RenderHtmlPage(const Document& doc);
 
+// The document as Markdown (report.md): tables as pipe tables, figures as their captions.
+std::string RenderMarkdown(const Document& doc);
+
 }  // namespace fastcal::internal
 
 #endif  // FASTCAL_INTERNAL_REPORT_DOCUMENT_H_
