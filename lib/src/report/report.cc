@@ -1,7 +1,7 @@
 // The calibration and evaluation report (report.h): the content is built once as a small
 // document (headings, paragraphs, lists, tables, preformatted blocks, SVG figures) and then
-// rendered as Markdown and as self-contained HTML; summary.json is written directly with
-// JsonWriter. Tensions are converted N -> kN here, at the edge, and only here.
+// rendered as Markdown and as self-contained HTML (report_render.cc); summary.json is written
+// directly with JsonWriter. Tensions are converted N -> kN here, at the edge, and only here.
 #include "fastcal/report.h"
 
 #include <fcntl.h>
