@@ -16,7 +16,9 @@ namespace fastcal::internal {
 namespace {
 
 bool MovesTheForces(ParameterKind kind) {
-  return kind != ParameterKind::kSensorGain && kind != ParameterKind::kSensorBias;
+  // The sensors' gains and biases and the length encoders' offsets are of the readings.
+  return kind != ParameterKind::kSensorGain && kind != ParameterKind::kSensorBias &&
+         kind != ParameterKind::kLengthOffset;
 }
 
 // The spec with every statics parameter that has a prior freed (a considered one held
@@ -45,7 +47,8 @@ double MarginOf(const ParameterSpec& p, double value, const DesignOptions& o) {
       return o.range_relative * std::abs(value);
     case ParameterKind::kSensorGain:
     case ParameterKind::kSensorBias:
-      break;
+    case ParameterKind::kLengthOffset:
+      break;  // of the readings, not of the statics: no range to hold over
   }
   return 0.0;
 }
