@@ -28,6 +28,8 @@ Commands:
   simulate   synthetic telemetry from a "truth" model along a trajectory, with noise
   workspace  where the cabin can go with every cable within tension limits: CSV and an
              HTML map of the focal-sphere cap
+  track      the mass centre and the sensors through a season of telemetry: a window
+             (day) at a time as one joint fit, with the events (moves, re-zeroed sensors)
   design     the calibration survey that determines the wanted parameters best: poses,
              samples per pose and flight order, with predicted sigma_total
 
@@ -58,6 +60,7 @@ int main(int argc, char** argv) {
     if (command == "simulate") return RunSimulate(argc, argv);
     if (command == "workspace") return RunWorkspace(argc, argv);
     if (command == "design") return RunDesign(argc, argv);
+    if (command == "track") return RunTrack(argc, argv);
   } catch (const std::bad_alloc&) {
     // Outputs are written last and atomically: nothing is left behind.
     std::cerr << "fastcal " << command

@@ -82,6 +82,10 @@ DEFINE_string(session_shift_m, "",
               "simulate: mass centre moved by dx,dy,dz (m) at each new session.");
 DEFINE_string(mass_centre_step, "",
               "simulate: mass centre steps T:dx,dy,dz (s: m), several joined by ';'.");
+DEFINE_int32(days, 0, "simulate: a season: the samples cut into N days, one session a day.");
+DEFINE_string(start, "", "simulate: time of the first sample (s; a Unix time for a season).");
+DEFINE_string(sensor_step, "",
+              "simulate: sensors re-zeroed: T:CABLE:DKN (s, 1..6, kN), several joined by ';'.");
 
 namespace fastcal::cli {
 namespace {
@@ -186,6 +190,12 @@ Sessions and steps of the mass centre (the cabin's structure changed):
                              added to time_s; the slow errors decorrelate over it
   --sensor-rezero-kn=0       sensors re-zeroed at the start of each session after the
                              first: each cable's bias moves by N(0, kN)
+  --sensor-step=T:CABLE:DKN  one sensor re-zeroed: cable CABLE's bias moves by DKN kN at
+                             time T (s) and stays; several joined by ';'
+A season (fastcal track): --start=T, the first sample's time (s; a Unix time, e.g.
+1714593600 for 2024-05-01T20:00:00Z), and --days=N, the samples cut into N sessions a day
+apart (each day's samples --interval-s apart from --start + k days; the slow errors
+decorrelate overnight). Steps' times T are in the same seconds.
 The truth model written out has the mass centre before any step and the first session's
 sensor biases; its header lists the steps and every session's biases.
 
@@ -232,7 +242,7 @@ const std::set<std::string> kFlags = {
     "force", "attitude-control-time-s", "tension-drift-pct", "tension-drift-time-s",
     "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-pct",
     "sensor-bias-spread-kn", "sessions", "session-shift-m", "mass-centre-step",
-    "tension-drift-kn", "session-gap-s", "sensor-rezero-kn"};
+    "tension-drift-kn", "session-gap-s", "sensor-rezero-kn", "days", "start", "sensor-step"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -313,6 +323,51 @@ bool SetStepsFromFlags(SimulationOptions* options, std::string* error) {
     *error = "--session-shift-m needs --sessions=N with N >= 2";
     return false;
   }
+  std::stringstream sensors(FLAGS_sensor_step);
+  while (!FLAGS_sensor_step.empty() && std::getline(sensors, item, ';')) {
+    const size_t first = item.find(':'), second = item.find(':', first + 1);
+    SensorBiasStep step;
+    double cable = 0.0, shift_kn = 0.0;
+    std::string why;
+    if (second == std::string::npos ||
+        !ParseNumberItem(item.substr(0, first), &step.time_s, &why) ||
+        !ParseNumberItem(item.substr(first + 1, second - first - 1), &cable, &why) ||
+        !ParseNumberItem(item.substr(second + 1), &shift_kn, &why) || cable < 1 ||
+        cable > kNumCables || cable != std::floor(cable)) {
+      *error =
+          "--sensor-step needs T:CABLE:DKN (time in s, cable 1..6, bias change in kN), "
+          "several joined by ';', got " +
+          internal::Quote(item) + (why.empty() ? "" : ": " + why);
+      return false;
+    }
+    step.cable = static_cast<int>(cable) - 1;
+    step.shift_n = shift_kn * kNPerKn;
+    options->sensor_bias_steps.push_back(step);
+  }
+  return true;
+}
+
+// --days: the samples cut into one session a day, each starting 24 h after the one before
+// (needs the trajectory's length, known in RunSimulate).
+bool DaysFromFlags(long long samples, SimulationOptions* options, std::string* error) {
+  if (FLAGS_days == 0) return true;
+  constexpr double kDayS = 86400.0;
+  if (FLAGS_days < 1 || FlagGiven("sessions") || FlagGiven("session-gap-s")) {
+    *error =
+        "--days=N (N >= 1) sets the sessions and the gaps between them: give it without "
+        "--sessions and --session-gap-s";
+    return false;
+  }
+  const double per_day = static_cast<double>(samples) / FLAGS_days;
+  if (samples % FLAGS_days != 0 || per_day * options->sample_interval_s > kDayS) {
+    *error = "--days=" + std::to_string(FLAGS_days) + ": the trajectory's " +
+             std::to_string(samples) +
+             " samples must be a whole number a day, each day's lasting at most 24 h at "
+             "--interval-s";
+    return false;
+  }
+  options->sessions = FLAGS_days;
+  options->session_gap_s = kDayS - per_day * options->sample_interval_s;
   return true;
 }
 
@@ -326,7 +381,8 @@ bool StepsAtSessions(int samples, SimulationOptions* options, std::string* error
     const long long first =
         (static_cast<long long>(k) * samples + options->sessions - 1) / options->sessions;
     options->mass_centre_steps.push_back(
-        {static_cast<double>(first) * options->sample_interval_s + k * options->session_gap_s,
+        {options->start_time_s + static_cast<double>(first) * options->sample_interval_s +
+             k * options->session_gap_s,
          shift});
   }
   return true;
@@ -354,6 +410,14 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->tension_drift_kn = FLAGS_tension_drift_kn;
   options->session_gap_s = FLAGS_session_gap_s;
   options->sensor_rezero_kn = FLAGS_sensor_rezero_kn;
+  if (!FLAGS_start.empty()) {
+    std::string why;
+    if (!ParseNumberItem(FLAGS_start, &options->start_time_s, &why)) {
+      *error = "--start=" + internal::Quote(FLAGS_start) +
+               ": give the first sample's time in s (a Unix time for a season): " + why;
+      return false;
+    }
+  }
   for (const char* flag : {"session-gap-s", "sensor-rezero-kn"}) {
     if (FlagGiven(flag) && FLAGS_sessions < 2) {
       *error = std::string("--") + flag + " needs --sessions=N with N >= 2";
@@ -387,7 +451,9 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
                                  {"sessions", "--sessions"},
                                  {"tension_drift_kn", "--tension-drift-kn"},
                                  {"session_gap_s", "--session-gap-s"},
-                                 {"sensor_rezero_kn", "--sensor-rezero-kn"}});
+                                 {"sensor_rezero_kn", "--sensor-rezero-kn"},
+                                 {"start_time_s", "--start"},
+                                 {"sensor_bias_steps", "--sensor-step"}});
     return false;
   }
   return true;
@@ -636,7 +702,8 @@ int RunSimulate(int argc, char** argv) {
     PrintError(kCommand, "no poses to simulate");
     return kExitUsage;
   }
-  if (!StepsAtSessions(static_cast<int>(poses.count), &options, &error)) {
+  if (!DaysFromFlags(poses.count, &options, &error) ||
+      !StepsAtSessions(static_cast<int>(poses.count), &options, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -661,8 +728,9 @@ int RunSimulate(int argc, char** argv) {
                 FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
     }
     if (summary.session_bias_n.size() > 1 && options.sensor_rezero_kn > 0.0) {
-      header += "\nSensors re-zeroed at each new session; the biases (kN) per session, cables "
-                "1..6:";
+      header +=
+          "\nSensors re-zeroed at each new session; the biases (kN) per session, cables "
+          "1..6:";
       for (size_t k = 0; k < summary.session_bias_n.size(); ++k) {
         header += "\n  session " + std::to_string(k + 1) + ":";
         for (double b : summary.session_bias_n[k]) header += " " + FormatDouble(b / 1e3, 6);

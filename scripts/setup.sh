@@ -9,6 +9,9 @@ packages=(cmake g++ make libceres-dev libeigen3-dev libgflags-dev libgoogle-glog
           # The Python module: pybind11's headers and CMake package, Python's headers,
           # NumPy; pytest runs its tests, matplotlib the plot of docs/python.md.
           pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
+          # fastcal.track(client=...): each window's fold a task on a Dask cluster (its
+          # tests run a two-worker LocalCluster on the loopback interface).
+          python3-dask python3-distributed
           locales)  # de_DE.UTF-8: tests/calibration_test.cc, decimal comma
 missing=()
 for p in "${packages[@]}"; do

@@ -78,6 +78,7 @@ void BindStatics(py::module_& m);
 void BindData(py::module_& m);
 void BindCalibration(py::module_& m);
 void BindDesign(py::module_& m);
+void BindTrack(py::module_& m);
 
 }  // namespace fastcal::python
 

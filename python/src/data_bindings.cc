@@ -3,6 +3,7 @@
 #include <pybind11/stl.h>
 
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "bindings.h"
@@ -51,7 +52,9 @@ SimulationOptions MakeSimulationOptions(const py::dict& kwargs) {
       {"outlier_fraction", &o.outlier_fraction},
       {"outlier_scale_percent", &o.outlier_scale_percent},
       {"density_mismatch_percent", &o.density_mismatch_percent},
-      {"sample_interval_s", &o.sample_interval_s}};
+      {"sample_interval_s", &o.sample_interval_s},
+      {"start_time_s", &o.start_time_s},
+      {"session_gap_s", &o.session_gap_s}};
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::str(key);
     bool known = false;
@@ -74,6 +77,13 @@ SimulationOptions MakeSimulationOptions(const py::dict& kwargs) {
         }
         o.mass_centre_steps.push_back(
             {pair.first, Eigen::Vector3d(pair.second[0], pair.second[1], pair.second[2])});
+      }
+    } else if (name == "sensor_bias_steps") {
+      // [(time_s, cable 1..6, shift_kN), ...]
+      for (const py::handle step : value) {
+        const auto t = step.cast<std::tuple<double, int, double>>();
+        o.sensor_bias_steps.push_back(
+            {std::get<0>(t), std::get<1>(t) - 1, std::get<2>(t) * kNPerKn});
       }
     } else if (name == "method") {
       if (!ParseStaticsMethod(value.cast<std::string>(), &o.method)) {

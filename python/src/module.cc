@@ -108,4 +108,5 @@ PYBIND11_MODULE(_fastcal, m) {
   BindData(m);
   BindCalibration(m);
   BindDesign(m);
+  BindTrack(m);
 }

@@ -42,6 +42,17 @@ class JsonWriter {
     }
     return *this;
   }
+  // All 17 significant digits (%.17g): reads back to the same double, for values another
+  // run reads (a change's time, fastcal calibrate --sessions-at=summary.json).
+  JsonWriter& ExactNumber(double value) {
+    Separate();
+    if (!std::isfinite(value)) {
+      out_ += "null";
+    } else {
+      out_ += value == 0.0 ? "0" : internal::FormatDouble("%.17g", value);
+    }
+    return *this;
+  }
   JsonWriter& Int(long long value) {
     Separate();
     out_ += std::to_string(value);

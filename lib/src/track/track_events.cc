@@ -1,0 +1,256 @@
+// The track's events (track.h): sensor biases that stepped between windows (a score
+// scan over cables and window boundaries, binary segmentation), and per-window groups
+// that changed between consecutive windows (Wald tests), each kind at a family-wise
+// false-alarm rate over the season (Bonferroni).
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "fastcal/internal/number_text.h"
+#include "track/track_run.h"
+
+namespace fastcal::internal {
+namespace {
+
+struct Candidate {
+  int column = -1;  // shared column (index into layout.shared_columns)
+  int u = 0;        // the first used window of the new stretch
+  double statistic = 0.0;
+};
+
+// The per-cable sensor biases among the shared columns.
+std::vector<int> BiasColumns(const TrackRun& run) {
+  std::vector<int> out;
+  for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+    const ParameterSpec& s = run.layout.Column(run.layout.shared_columns[j]);
+    if (s.kind == ParameterKind::kSensorBias && s.index >= 0) out.push_back(static_cast<int>(j));
+  }
+  return out;
+}
+
+// The score statistic of "bias column j differs from used window u on, within its
+// stretch" (track.h), widened by the windows' information-weighted widening.
+double StepStatistic(const TrackRun& run, int j, int u) {
+  const int column = run.layout.shared_columns[j];
+  const std::vector<int> order = LocalOrder(run);
+  const int entry = run.entry_of[u][j];
+  std::vector<Eigen::VectorXd> local(run.used.size());
+  double g = 0.0, h = 0.0, widened = 0.0;
+  for (size_t v = u; v < run.used.size() && run.entry_of[v][j] == entry; ++v) {
+    const WindowFold& f = run.windows[run.used[v]].fold;
+    g += GradientAtSolution(run, static_cast<int>(v))[column];
+    const double hv = f.information(column, column);
+    h += hv;
+    widened += run.widening[v] * hv;
+    local[v] = Eigen::VectorXd(order.size());
+    for (size_t r = 0; r < order.size(); ++r) local[v][r] = f.information(order[r], column);
+  }
+  const double a = h - InverseQuadratic(run, local);
+  if (!(a > 1e-12 * h) || !(h > 0.0)) return 0.0;
+  return g * g / (a * (widened / h));
+}
+
+Candidate BestStep(const TrackRun& run, const std::vector<int>& columns) {
+  Candidate best;
+  for (int j : columns) {
+    for (size_t u = 1; u < run.used.size(); ++u) {
+      if (run.entry_of[u - 1][j] != run.entry_of[u][j]) continue;  // already split there
+      const double t = StepStatistic(run, j, static_cast<int>(u));
+      if (t > best.statistic) best = {j, static_cast<int>(u), t};
+    }
+  }
+  return best;
+}
+
+std::string WindowText(const TrackRun& run, int u) { return run.windows[run.used[u]].label; }
+
+// An event between used windows u - 1 and u.
+TrackEvent EventAt(const TrackRun& run, int u, const std::string& kind, double statistic, int dof,
+                   double threshold, int tests) {
+  TrackEvent e;
+  e.kind = kind;
+  e.window = u;
+  e.time_s = run.windows[run.used[u]].first_s;
+  e.previous_time_s = run.windows[run.used[u - 1]].last_s;
+  e.degrees_of_freedom = dof;
+  e.statistic = statistic;
+  e.threshold = threshold;
+  e.p_value = std::min(1.0, tests * ChiSquareTailProbability(statistic, dof));
+  return e;
+}
+
+// The Wald test of a split bias's step (entry e after entry e0), from the final fit.
+TrackEvent SensorEvent(const TrackRun& run, int e0, int e, double threshold, int tests) {
+  const SharedEntry& entry = run.shared[e];
+  const ParameterSpec& s = run.layout.Column(run.layout.shared_columns[entry.column]);
+  const double d = run.solver.b()[e] - run.solver.b()[e0];
+  const Eigen::MatrixXd p = run.solver.SandwichBB();
+  double variance = p(e, e) + p(e0, e0) - 2.0 * p(e, e0);
+  for (int c = 0; c < run.consider_sigma.size(); ++c) {
+    variance +=
+        std::pow((run.consider_x.b(e, c) - run.consider_x.b(e0, c)) * run.consider_sigma[c], 2);
+  }
+  int u = 0;
+  while (u < static_cast<int>(run.used.size()) && run.entry_of[u][entry.column] != e) ++u;
+  TrackEvent event = EventAt(run, std::max(1, u), "sensor", d * d / std::max(variance, 1e-300), 1,
+                             threshold, tests);
+  event.parameters.push_back(
+      {s.name, s.unit, d / s.to_si, std::sqrt(std::max(variance, 0.0)) / s.to_si});
+  event.cables.push_back(s.index + 1);
+  return event;
+}
+
+// The per-window groups tested together: a vector quantity's axes, or one parameter.
+std::vector<std::vector<int>> WindowGroups(const TrackRun& run) {
+  std::map<std::string, std::vector<int>> by_key;
+  std::vector<std::string> keys;
+  for (size_t a = 0; a < run.layout.window_columns.size(); ++a) {
+    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[a]);
+    const bool vector = s.kind == ParameterKind::kMassCentre ||
+                        s.kind == ParameterKind::kAnchorOffset ||
+                        s.kind == ParameterKind::kTowerOffset;
+    const std::string key =
+        vector ? std::string(ParameterGroupName(s.kind)) + "/" + std::to_string(s.index) : s.name;
+    if (!by_key.count(key)) keys.push_back(key);
+    by_key[key].push_back(static_cast<int>(a));
+  }
+  std::vector<std::vector<int>> groups;
+  for (const std::string& k : keys) groups.push_back(by_key[k]);
+  return groups;
+}
+
+}  // namespace
+
+// The entry of the same column just before entry e (the stretch before its step), or -1.
+int PreviousEntry(const TrackRun& run, int e) {
+  int previous = -1;
+  for (size_t k = 0; k < run.shared.size(); ++k) {
+    if (run.shared[k].column != run.shared[e].column ||
+        !(run.shared[k].from_s < run.shared[e].from_s)) {
+      continue;
+    }
+    if (previous < 0 || run.shared[k].from_s > run.shared[previous].from_s) {
+      previous = static_cast<int>(k);
+    }
+  }
+  return previous;
+}
+
+// The Wald statistic of the step at entry e (after PreviousEntry), widened.
+double StepWald(const TrackRun& run, int e) {
+  const int e0 = PreviousEntry(run, e);
+  const Eigen::MatrixXd p = run.solver.SandwichBB();
+  const double d = run.solver.b()[e] - run.solver.b()[e0];
+  const double variance = p(e, e) + p(e0, e0) - 2.0 * p(e, e0);
+  return variance > 0.0 ? d * d / variance : 0.0;
+}
+
+// Steps the fitted track no longer holds significant (the scan's score test is at the
+// fit without them, the Wald test at the fit with them): the weakest is joined back to
+// the stretch before it, and the track refitted, until every step stands.
+TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
+  for (;;) {
+    ComputeWidening(run);
+    int weakest = -1;
+    double smallest = threshold;
+    for (size_t e = 0; e < run.shared.size(); ++e) {
+      if (PreviousEntry(run, static_cast<int>(e)) < 0) continue;
+      const double t = StepWald(run, static_cast<int>(e));
+      if (t <= smallest) {
+        smallest = t;
+        weakest = static_cast<int>(e);
+      }
+    }
+    if (weakest < 0) return TrackStatus::kOk;
+    run.Progress("sensor step of " +
+                 run.layout.Column(run.layout.shared_columns[run.shared[weakest].column]).name +
+                 " no longer significant once fitted (Wald " + FormatDouble("%.1f", smallest) +
+                 "): joined back");
+    run.shared.erase(run.shared.begin() + weakest);
+    run.splits.erase(std::remove(run.splits.begin(), run.splits.end(), weakest), run.splits.end());
+    for (int& s : run.splits) s -= s > weakest;
+    const TrackStatus status = Iterate(run, false);
+    if (status != TrackStatus::kOk) return status;
+  }
+}
+
+TrackStatus ScanSensorSteps(TrackRun& run) {
+  const std::vector<int> columns = BiasColumns(run);
+  const int boundaries = static_cast<int>(run.used.size()) - 1;
+  run.result->sensor_tests = static_cast<int>(columns.size()) * std::max(0, boundaries);
+  if (run.result->sensor_tests == 0) return TrackStatus::kOk;
+  const double threshold = ChiSquareQuantile(run.options.false_alarm / run.result->sensor_tests, 1);
+  for (int round = 0; round < run.options.max_sensor_steps; ++round) {
+    ComputeWidening(run);
+    const Candidate best = BestStep(run, columns);
+    if (!(best.statistic > threshold)) break;
+    const int e = run.entry_of[best.u][best.column];
+    SharedEntry split = run.shared[e];
+    split.from_s = run.windows[run.used[best.u]].start_s;
+    run.shared.push_back(split);
+    run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
+    run.Progress("sensor step: " + run.layout.Column(run.layout.shared_columns[best.column]).name +
+                 " from window " + WindowText(run, best.u) + " (statistic " +
+                 FormatDouble("%.1f", best.statistic) + ", threshold " +
+                 FormatDouble("%.1f", threshold) + "): fitted per stretch");
+    // The next solve maps the new stretch's windows to the new entry; Gauss-Newton then
+    // refolds the windows that move.
+    const TrackStatus status = Iterate(run, false);
+    if (status != TrackStatus::kOk) return status;
+  }
+  return DropWeakSteps(run, threshold);
+}
+
+TrackStatus FindParameterEvents(TrackRun& run) {
+  TrackResult& r = *run.result;
+  r.events.clear();
+  // Sensor events: every split bias, tested on the final fit.
+  if (r.sensor_tests > 0) {
+    const double threshold = ChiSquareQuantile(run.options.false_alarm / r.sensor_tests, 1);
+    for (size_t e = 0; e < run.shared.size(); ++e) {
+      const int previous = PreviousEntry(run, static_cast<int>(e));
+      if (previous >= 0) {
+        r.events.push_back(
+            SensorEvent(run, previous, static_cast<int>(e), threshold, r.sensor_tests));
+      }
+    }
+  }
+  // Parameter events: consecutive windows' per-window groups.
+  const std::vector<std::vector<int>> groups = WindowGroups(run);
+  const int boundaries = static_cast<int>(run.used.size()) - 1;
+  r.parameter_tests = static_cast<int>(groups.size()) * std::max(0, boundaries);
+  for (const std::vector<int>& g : groups) {
+    const int dof = static_cast<int>(g.size());
+    const double threshold =
+        ChiSquareQuantile(run.options.false_alarm / std::max(1, r.parameter_tests), dof);
+    const ParameterSpec& first = run.layout.Column(run.layout.window_columns[g[0]]);
+    const bool sensor =
+        first.kind == ParameterKind::kSensorBias || first.kind == ParameterKind::kSensorGain;
+    for (int u = 1; u <= boundaries; ++u) {
+      const Eigen::MatrixXd c = TotalCovariance(run, u, u) + TotalCovariance(run, u - 1, u - 1) -
+                                TotalCovariance(run, u, u - 1) - TotalCovariance(run, u - 1, u);
+      Eigen::VectorXd d(dof);
+      Eigen::MatrixXd cg(dof, dof);
+      for (int x = 0; x < dof; ++x) {
+        d[x] = run.solver.a(u)[g[x]] - run.solver.a(u - 1)[g[x]];
+        for (int y = 0; y < dof; ++y) cg(x, y) = c(g[x], g[y]);
+      }
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(cg);
+      const double t = d.dot(ldlt.solve(d));
+      if (!(t > threshold)) continue;
+      TrackEvent e =
+          EventAt(run, u, sensor ? "sensor" : "parameter", t, dof, threshold, r.parameter_tests);
+      for (int x = 0; x < dof; ++x) {
+        const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[x]]);
+        e.parameters.push_back({s.name, s.unit, d[x] / s.to_si, std::sqrt(cg(x, x)) / s.to_si});
+        if (sensor && s.index >= 0) e.cables.push_back(s.index + 1);
+      }
+      r.events.push_back(e);
+    }
+  }
+  std::stable_sort(r.events.begin(), r.events.end(),
+                   [](const TrackEvent& a, const TrackEvent& b) { return a.time_s < b.time_s; });
+  return TrackStatus::kOk;
+}
+
+}  // namespace fastcal::internal
