@@ -177,8 +177,10 @@ each sample is kept meanwhile in a temporary file in /tmp (about 200 bytes a sam
 
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
 // replace there.
-const std::vector<std::string> kCalibrateOutputs = {"model_calibrated.yaml", "report.html",
-                                                    "report.md", "summary.json", "residuals.csv"};
+// "A*B": any name from A to B (a joint fit of sessions writes one model per session).
+const std::vector<std::string> kCalibrateOutputs = {
+    "model_calibrated.yaml", "model_calibrated@*.yaml", "report.html", "report.md", "summary.json",
+    "residuals.csv"};
 const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
                                                    "residuals.csv"};
 
@@ -191,11 +193,7 @@ bool CheckResidualsEvery(std::string* error) {
 }
 
 // CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
-bool CheckOutFlag(std::vector<std::string> outputs, std::string* error) {
-  // A joint fit of sessions also wrote one model per session.
-  if (std::find(outputs.begin(), outputs.end(), "model_calibrated.yaml") != outputs.end()) {
-    outputs.push_back("model_calibrated@*.yaml");
-  }
+bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
   return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
 }
 

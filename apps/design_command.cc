@@ -28,6 +28,14 @@ DEFINE_double(speed_m_per_s, 0.0, "design: cabin speed between stops (m/s); 0: n
 DEFINE_double(minutes, 0.0, "design: time budget of the survey (min); 0: none.");
 DEFINE_string(criterion, "A", "design: A (sum of variances) or D (log-determinant).");
 DEFINE_string(parameters, "", "design: wanted parameters, comma-separated; default: see --help.");
+DEFINE_double(range_prior_sigmas, 2.0,
+              "design: plausible range of a parameter with a prior, in its sigmas.");
+DEFINE_double(range_mass_centre_m, 0.25,
+              "design: plausible range of a free mass centre without a prior (m per axis).");
+DEFINE_double(range_offset_m, 0.05,
+              "design: plausible range of free anchor and tower offsets without a prior (m).");
+DEFINE_double(range_relative, 0.03,
+              "design: plausible range of other free parameters without a prior (fraction).");
 
 namespace fastcal::cli {
 namespace {
@@ -71,6 +79,17 @@ Grid and limits, as fastcal workspace: --max-off-axis-deg=40 --off-axis-step-deg
   own margins (the optimum lies on the workspace's edge, where cables near slack sag by
   metres for a small error of the model): --min-tension-kn=50 --reflector-clearance=5
 
+Poses that hold (docs/design.md): a candidate must also hold over the plausible range of
+the spec's statics parameters (free or considered; not the sensors'): each at its initial
+value +- --range-prior-sigmas=2 of its prior's sigma, or, free without a prior, +-
+--range-mass-centre-m=0.25 (mass centre, per axis), --range-offset-m=0.05 (anchor and
+tower offsets) or --range-relative=0.03 of its value (mass, densities, EA, attachments).
+At the corner of that box where each cable's tension is lowest (found from each
+parameter's effect, then solved exactly) the statics must be ok, every tension at least
+--min-tension-kn and every cable --reflector-clearance clear of the reflector. All four
+0: the initial values only. The summary names what binds (the tightest stop, its cable
+and the corner); design.json has it per stop.
+
 Outputs (written only when everything succeeded):
   poses.csv    x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg, one row per sample in flight
                order: read by `fastcal simulate --poses` and `fastcal solve --poses`
@@ -106,7 +125,11 @@ const std::set<std::string> kFlags = {"spec",
                                       "parameters",
                                       "max-strain",
                                       "max-length-ratio",
-                                      "reflector-clearance"};
+                                      "reflector-clearance",
+                                      "range-prior-sigmas",
+                                      "range-mass-centre-m",
+                                      "range-offset-m",
+                                      "range-relative"};
 
 bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   // The candidates' grid and limits exactly as `fastcal workspace` reads them.
@@ -118,6 +141,10 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   if (!FlagGiven("min-tension-kn")) o->workspace.min_tension_n = kDesignMinTensionN;
   o->max_extra_tilt_deg = FLAGS_max_extra_tilt_deg;
   o->max_extra_yaw_deg = FLAGS_max_extra_yaw_deg;
+  o->range_prior_sigmas = FLAGS_range_prior_sigmas;
+  o->range_mass_centre_m = FLAGS_range_mass_centre_m;
+  o->range_offset_m = FLAGS_range_offset_m;
+  o->range_relative = FLAGS_range_relative;
   o->samples = FLAGS_samples;
   o->seed = FLAGS_seed;
   o->speed_m_per_s = FLAGS_speed_m_per_s;
@@ -146,7 +173,11 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
                           {"samples", "--samples"},
                           {"speed_m_per_s", "--speed-m-per-s"},
                           {"sample_interval_s", "--interval-s"},
-                          {"time_budget_s", "--minutes"}});
+                          {"time_budget_s", "--minutes"},
+                          {"range_prior_sigmas", "--range-prior-sigmas"},
+                          {"range_mass_centre_m", "--range-mass-centre-m"},
+                          {"range_offset_m", "--range-offset-m"},
+                          {"range_relative", "--range-relative"}});
   return false;
 }
 
@@ -168,6 +199,8 @@ std::string Summary(const Design& d) {
   }
   s << "\n  limited by " << d.limiting_part << " (" << FormatDouble(100.0 * d.limiting_share, 3)
     << "% of the wanted variance)";
+  std::istringstream range(DesignRangeSummary(d));
+  for (std::string line; std::getline(range, line);) s << "\n  " << line;
   return s.str();
 }
 

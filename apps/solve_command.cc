@@ -145,12 +145,17 @@ CSV columns, units in the names:
   end_residual_m          largest distance between a cable's computed upper end and its
                           tower top (the catenaries' end conditions)
   error_estimate_pct      the method's estimate of its largest tension error, %
+  equilibrium             exact: which equilibrium, where sagging cables allow several:
+                          taut (the only one this taut), home (followed from the home
+                          pose), several (others were met: this is the home pose's),
+                          unreachable (none from the home pose, yet one exists); empty
+                          for aas (docs/model.md, "Which equilibrium exact returns")
   message                 why a pose failed, in double quotes ("" when ok)
   status is a short code: ok, no_equilibrium, sagging_cable, overstretched_cable,
   reflector_contact, not_converged, inaccurate, vertical_cable, singular,
   catenary_failed, invalid_input (docs/cli.md).
   compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact,
-  aas_error_estimate_pct, message.
+  aas_error_estimate_pct, equilibrium (exact's), message.
 A summary line on stderr names the model (its file, or "nominal FAST"), the attitude
 used and the time per pose.
 
@@ -659,6 +664,7 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
     for (int i = 1; i <= kNumCables; ++i) out << ",err" << i << "_pct";
     out << ",aas_error_estimate_pct";
   }
+  out << ",equilibrium";
   out << ",message\n";
   for (size_t n = 0; n < poses.size(); ++n) {
     const Eigen::Vector3d rpy = RpyDegFromRotation(poses[n].rotation);
@@ -682,6 +688,7 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
       put(s.moment_residual_nm);
       put(s.end_residual_m);
       put(100.0 * s.error_estimate);
+      out << "," << EquilibriumCode(s);
     } else {
       const StaticsSolution& a = aas->solutions[n];
       const StaticsSolution& e = exact->solutions[n];
@@ -696,6 +703,7 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
         put(ok ? 100.0 * (a.cables[i].lower_tension_n / e.cables[i].lower_tension_n - 1.0) : 0.0);
       }
       put(100.0 * a.error_estimate);
+      out << "," << EquilibriumCode(e);
     }
     out << "," << internal::QuotedCsvField(status.second) << "\n";
   }
@@ -722,6 +730,7 @@ std::array<double, kNumCables> MaxAbsErrorPct(const Run& aas, const Run& exact) 
 void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
   const auto [status, message] = StatusAndMessage(s);
   j->Key("status").String(status);
+  if (s.method == StaticsMethod::kExact) j->Key("equilibrium").String(EquilibriumCode(s));
   if (s.status != StaticsStatus::kOk) {
     j->Key("message").String(message);
     if (s.cable >= 0) j->Key("cable").Int(s.cable + 1);
@@ -805,6 +814,13 @@ Failures CountFailures(const std::vector<Pose>& poses,
   return f;
 }
 
+// Poses where exact met several equilibria (EquilibriumCode "several" or "unreachable").
+size_t CountSeveral(const Run& run) {
+  size_t count = 0;
+  for (const StaticsSolution& s : run.solutions) count += s.other_equilibrium ? 1 : 0;
+  return count;
+}
+
 std::string TimingLine(const char* name, const Run& run, size_t n, bool warm) {
   std::ostringstream s;
   s.precision(3);
@@ -846,6 +862,7 @@ int RunSolve(int argc, char** argv) {
   std::string content;
   std::ostringstream timing;
   Failures failures;
+  size_t several = 0;
   if (!compare) {
     Run run;
     if (!SolveAll(robot, poses, options, &run, &error)) {
@@ -856,6 +873,7 @@ int RunSolve(int argc, char** argv) {
                                      : CsvRows(poses, &run, nullptr, nullptr);
     timing << TimingLine(StaticsMethodName(options.method), run, poses.size(), options.warm_start);
     failures = CountFailures(poses, {{&run, options.method}});
+    several = CountSeveral(run);
   } else {
     Run aas, exact;
     StaticsOptions o = options;
@@ -876,6 +894,7 @@ int RunSolve(int argc, char** argv) {
            << "max |aas - exact| / exact per cable (%):";
     for (double e : MaxAbsErrorPct(aas, exact)) timing << " " << FormatDouble(e, 4);
     failures = CountFailures(poses, {{&aas, StaticsMethod::kAas}, {&exact, StaticsMethod::kExact}});
+    several = CountSeveral(exact);
   }
   if (!WriteOutput(FLAGS_output, content, &error)) {
     PrintError(kCommand, error);
@@ -895,6 +914,13 @@ int RunSolve(int argc, char** argv) {
                  "numbers "
                  "(exit 0). First: "
               << failures.first << std::endl;
+  }
+  if (several > 0) {
+    std::cerr << "fastcal solve: several equilibria hold " << several << " of " << poses.size()
+              << (poses.size() == 1 ? " pose" : " poses")
+              << " (column equilibrium: several, unreachable); exact returns the one followed "
+                 "from the home pose (docs/model.md, \"Which equilibrium exact returns\")"
+              << std::endl;
   }
   return 0;
 }

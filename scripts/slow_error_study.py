@@ -66,6 +66,10 @@ CASES = {
     "sessions-rezeroed": ("spec_sessions.yaml",
                           ["--samples=800", "--sessions=2", "--session-gap-s=%d" % THREE_DAYS_S,
                            "--sensor-rezero-kn=1"] + drift(2, 60), "sessions", (0.0, 0.0, 0.0)),
+    "sessions-rezeroed-3kn": ("spec_sessions.yaml",
+                              ["--samples=800", "--sessions=2",
+                               "--session-gap-s=%d" % THREE_DAYS_S, "--sensor-rezero-kn=3"]
+                              + drift(2, 60), "sessions", (0.0, 0.0, 0.0)),
     "sessions-moved-3cm": ("spec_sessions.yaml",
                            ["--samples=800", "--sessions=2", "--session-gap-s=%d" % THREE_DAYS_S,
                             "--session-shift-m=0.03,0,0"] + drift(2, 60), "sessions",
@@ -110,7 +114,7 @@ def rms(values):
 
 def study(case, seeds, work):
     kind, truth = CASES[case][2], CASES[case][3]
-    alarms, accused, pulls, covered, axes = 0, 0, [], 0, 0
+    alarms, accused, pulls, covered, axes, wanders = 0, 0, [], 0, 0, 0
     slow = []
     for seed in range(1, seeds + 1):
         s = survey(case, seed, work)
@@ -119,6 +123,7 @@ def study(case, seeds, work):
         if kind == "scan":
             changes = s["changes"]
             alarms += bool(changes)
+            wanders += bool(changes) and s["change_scan"].get("wanders", False)
             if truth is not None and changes:
                 c = max(changes, key=lambda c: c["statistic"])
                 for k, axis in enumerate("xyz"):
@@ -139,6 +144,7 @@ def study(case, seeds, work):
     line = case + ": "
     if kind == "scan":
         line += "change reported in " + rate(alarms, seeds)
+        line += " (said to be a wandering, not a step, in %d)" % wanders
     elif kind == "sessions":
         line += "move claimed in " + rate(alarms, seeds) + "; a sensor accused in " + rate(accused, seeds)
     else:

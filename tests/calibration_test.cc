@@ -660,6 +660,13 @@ TEST(CalibrationTest, SigmaTotalCoversTheTruthOnRealisticData) {
       spec.parameters.push_back(p);
     }
   }
+  // The same spec with the slow sensor error estimated (the recommended specs' noise):
+  // the single-survey coverage must not suffer, and the estimate must find the drift.
+  CalibrationSpec slow_spec = spec;
+  slow_spec.slow_error.enabled = true;
+  slow_spec.slow_error.estimate_amplitude = slow_spec.slow_error.estimate_time_constant = true;
+  int slow_covered = 0, slow_process_covered = 0;
+  double slow_z2 = 0.0;
   // The priors are centred on the truth's cable parameters (nominal, before the spread).
   CableRobot truth = CableRobot::NominalFast();
   truth.mass_centre_cabin_m = kTruthMassCentreM;
@@ -698,12 +705,42 @@ TEST(CalibrationTest, SigmaTotalCoversTheTruthOnRealisticData) {
       z2 += std::pow(e / p.sigma_total, 2);
       ++count;
     }
+    CalibrationResult slow;
+    ASSERT_TRUE(CalibrateNominal(slow_spec, data, &slow));
+    for (int k = 0; k < 3; ++k) {
+      const ParameterEstimate& p = slow.parameters[k];
+      const double e = p.estimate - summary.mass_centre_mean_m[k];
+      slow_covered += std::abs(e) < 2.0 * p.sigma_total;
+      slow_z2 += std::pow(e / p.sigma_total, 2);
+    }
+    // The simulated drift: 2% of the reading, 120 s; within 3 of the estimate's sigmas.
+    const SlowErrorReport& d = slow.slow_error;
+    slow_process_covered +=
+        std::abs(d.process.sigma_percent - o.tension_drift_percent) < 3.0 * d.amplitude_sigma &&
+        std::abs(d.process.time_constant_s - o.tension_drift_time_s) <
+            3.0 * d.time_constant_sigma_s;
   }
   // The figures docs/calibration.md quotes.
   std::printf(
       "coverage within 2 sigma_total %d/%d, within 2 formal sigma %d/%d, "
-      "mean z^2 %.2f, ranking false alarms %d/%d, model-incomplete verdicts %d/%d\n",
-      covered, count, covered_formal, count, z2 / count, flagged, kSeeds, incomplete, kSeeds);
+      "mean z^2 %.2f, ranking false alarms %d/%d, model-incomplete verdicts %d/%d; with the "
+      "slow error estimated: coverage %d/%d, mean z^2 %.2f, drift within 3 sigma %d/%d\n",
+      covered, count, covered_formal, count, z2 / count, flagged, kSeeds, incomplete, kSeeds,
+      slow_covered, count, slow_z2 / count, slow_process_covered, kSeeds);
+  // Lower than the white spec's 55/60 here (51/60, mean z^2 1.44): this survey's mass
+  // centre wanders (1 cm, 10 minutes) and its grid puts most of the mass centre's
+  // information in the last rings, so the estimate is an average over them, not over the
+  // survey; the white spec's sigma_total, widened for the sensors' drift, happened to
+  // cover that too. On random poses, or with the mass centre fixed, the coverage is that
+  // of white data (docs/calibration.md, "Slow sensor errors").
+  constexpr double kMinSlowCoverage = 0.8, kMaxSlowMeanZ2 = 1.7;
+  EXPECT_GE(slow_covered, kMinSlowCoverage * count);
+  EXPECT_GT(slow_z2 / count, kMinMeanZ2);
+  EXPECT_LT(slow_z2 / count, kMaxSlowMeanZ2);
+  // 3 sigma per part, two parts: nearly always; the mass-centre drift and the attitude
+  // control error also wander, which the estimate partly takes for the sensors'.
+  constexpr double kMinProcessCoverage = 0.8;
+  EXPECT_GE(slow_process_covered, kMinProcessCoverage * kSeeds);
   EXPECT_GE(covered, kMinCoverage * count);
   EXPECT_LE(covered_formal, kMaxFormalCoverage * count);
   EXPECT_GT(z2 / count, kMinMeanZ2);
@@ -788,37 +825,46 @@ TEST(CalibrationTest, BlockCrossValidationMatchesRefitsWithoutEachBlock) {
 // One thread or more: the same numbers, to the last bit (issue 20).
 TEST(CalibrationTest, ThreadsDoNotChangeTheResult) {
   // Three chunks of samples (internal/sample_chunks.h), a robust loss and a hold-out:
-  // every number the outputs print is the same bits on 1, 2 and 3 threads.
-  const Dataset data = CircleData(Truth(), 2600, 0.03, 33);
-  CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
-  spec.robust_loss = RobustLoss::kHuber;
-  spec.robust_loss_scale = 2.0;
-  spec.holdout_fraction = 0.2;
-  CalibrationResult results[3];
-  for (int k = 0; k < 3; ++k) {
-    spec.num_threads = k + 1;
-    ASSERT_TRUE(CalibrateNominal(spec, data, &results[k]));
-  }
-  for (int k = 1; k < 3; ++k) {
-    const CalibrationResult& a = results[0];
-    const CalibrationResult& b = results[k];
-    SCOPED_TRACE(std::to_string(k + 1) + " threads");
-    EXPECT_EQ(a.final_cost, b.final_cost);
-    EXPECT_EQ(a.reduced_chi_square, b.reduced_chi_square);
-    EXPECT_EQ(a.iterations, b.iterations);
-    for (size_t p = 0; p < a.parameters.size(); ++p) {
-      EXPECT_EQ(a.parameters[p].estimate, b.parameters[p].estimate) << a.parameters[p].name;
-      EXPECT_EQ(a.parameters[p].sigma_total, b.parameters[p].sigma_total) << a.parameters[p].name;
+  // every number the outputs print is the same bits on 1, 2 and 3 threads; with white
+  // noise and with a slow sensor error estimated and whitened (its filters in time order).
+  Dataset data = CircleData(Truth(), 2600, 0.03, 33);
+  for (size_t t = 0; t < data.samples.size(); ++t) data.samples[t].time_s = static_cast<double>(t);
+  for (bool slow : {false, true}) {
+    SCOPED_TRACE(slow ? "slow error" : "white");
+    CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+    spec.robust_loss = RobustLoss::kHuber;
+    spec.robust_loss_scale = 2.0;
+    spec.holdout_fraction = 0.2;
+    spec.slow_error.enabled = spec.slow_error.estimate_amplitude = slow;
+    spec.slow_error.estimate_time_constant = slow;
+    CalibrationResult results[3];
+    for (int k = 0; k < 3; ++k) {
+      spec.num_threads = k + 1;
+      ASSERT_TRUE(CalibrateNominal(spec, data, &results[k]));
     }
-    ASSERT_EQ(a.variants.size(), b.variants.size());
-    for (size_t v = 0; v < a.variants.size(); ++v) {
-      EXPECT_EQ(a.variants[v].fit.rms_n, b.variants[v].fit.rms_n) << a.variants[v].name;
-      EXPECT_EQ(a.variants[v].holdout.rms_n, b.variants[v].holdout.rms_n) << a.variants[v].name;
-    }
-    EXPECT_EQ(a.cross_validation.rms_n, b.cross_validation.rms_n);
-    ASSERT_EQ(a.misfit_ranking.size(), b.misfit_ranking.size());
-    for (size_t c = 0; c < a.misfit_ranking.size(); ++c) {
-      EXPECT_EQ(a.misfit_ranking[c].expected_decrease, b.misfit_ranking[c].expected_decrease);
+    for (int k = 1; k < 3; ++k) {
+      const CalibrationResult& a = results[0];
+      const CalibrationResult& b = results[k];
+      SCOPED_TRACE(std::to_string(k + 1) + " threads");
+      EXPECT_EQ(a.final_cost, b.final_cost);
+      EXPECT_EQ(a.reduced_chi_square, b.reduced_chi_square);
+      EXPECT_EQ(a.iterations, b.iterations);
+      for (size_t p = 0; p < a.parameters.size(); ++p) {
+        EXPECT_EQ(a.parameters[p].estimate, b.parameters[p].estimate) << a.parameters[p].name;
+        EXPECT_EQ(a.parameters[p].sigma_total, b.parameters[p].sigma_total) << a.parameters[p].name;
+      }
+      ASSERT_EQ(a.variants.size(), b.variants.size());
+      for (size_t v = 0; v < a.variants.size(); ++v) {
+        EXPECT_EQ(a.variants[v].fit.rms_n, b.variants[v].fit.rms_n) << a.variants[v].name;
+        EXPECT_EQ(a.variants[v].holdout.rms_n, b.variants[v].holdout.rms_n) << a.variants[v].name;
+      }
+      EXPECT_EQ(a.cross_validation.rms_n, b.cross_validation.rms_n);
+      ASSERT_EQ(a.misfit_ranking.size(), b.misfit_ranking.size());
+      for (size_t c = 0; c < a.misfit_ranking.size(); ++c) {
+        EXPECT_EQ(a.misfit_ranking[c].expected_decrease, b.misfit_ranking[c].expected_decrease);
+      }
+      EXPECT_EQ(a.slow_error.process.sigma_percent, b.slow_error.process.sigma_percent);
+      EXPECT_EQ(a.slow_error.process.time_constant_s, b.slow_error.process.time_constant_s);
     }
   }
 }

@@ -31,7 +31,8 @@ struct LinearSurvey {
 
 LinearSurvey MakeSurvey(int samples, int n,
                         const std::vector<std::pair<int, Eigen::VectorXd>>& steps,
-                        const std::vector<int>& scanned, std::uint64_t seed) {
+                        const std::vector<int>& scanned, std::uint64_t seed,
+                        const Eigen::VectorXd& ramp = Eigen::VectorXd()) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
   Eigen::MatrixXd j(samples * kRows, n);
@@ -44,6 +45,10 @@ LinearSurvey MakeSurvey(int samples, int n,
         if (t < at) continue;
         for (size_t g = 0; g < scanned.size(); ++g)
           signal += j(t * kRows + i, scanned[g]) * shift[g];
+      }
+      // A steady drift: `ramp` over the whole survey, centred.
+      for (int g = 0; g < ramp.size(); ++g) {
+        signal += j(t * kRows + i, scanned[g]) * ramp[g] * (t - 0.5 * (samples - 1)) / samples;
       }
       y[t * kRows + i] = signal + normal(rng);
     }
@@ -125,6 +130,38 @@ TEST(ChangeScanTest, AStepOfKnownSizeAndTimeIsFound) {
       EXPECT_LT(std::abs(c.shift[g] - shift[g]) / c.shift_sigma[g], kMaxPull) << "seed " << seed;
     }
   }
+}
+
+TEST(ChangeScanTest, ASteadyDriftIsToldFromAStep) {
+  // The same size of change, (0.6, -0.4), as a step at mid-survey or as a steady drift over
+  // the whole survey: the best step's statistic beats the trend's for the step, the trend's
+  // beats the step's for the drift, and the trend's estimate covers the drift.
+  constexpr double kMaxPull = 3.0;
+  const std::vector<int> scanned = {1, 2};
+  Eigen::VectorXd change(2);
+  change << 0.6, -0.4;
+  for (int seed = 1; seed <= 5; ++seed) {
+    ChangeScanOutput step, drift;
+    std::string error;
+    const LinearSurvey a = MakeSurvey(200, 5, {{100, change}}, scanned, seed);
+    ASSERT_TRUE(ScanForChanges(Inputs(a, 5, scanned), &step, &error)) << error;
+    EXPECT_GT(step.best_step_statistic, step.trend_statistic) << "seed " << seed;
+    const LinearSurvey b = MakeSurvey(200, 5, {}, scanned, seed, change);
+    ASSERT_TRUE(ScanForChanges(Inputs(b, 5, scanned), &drift, &error)) << error;
+    EXPECT_GT(drift.trend_statistic, drift.best_step_statistic) << "seed " << seed;
+    EXPECT_LT(drift.trend_p_value, 1e-6);
+    for (int g = 0; g < 2; ++g) {
+      EXPECT_LT(std::abs(drift.trend_shift[g] - change[g]) / drift.trend_shift_sigma[g], kMaxPull)
+          << "seed " << seed;
+    }
+  }
+  // Without a change the trend's statistic is chi-square with 2 degrees of freedom: its
+  // p-value is not small on these seeds.
+  const LinearSurvey none = MakeSurvey(200, 5, {}, scanned, 9);
+  ChangeScanOutput out;
+  std::string error;
+  ASSERT_TRUE(ScanForChanges(Inputs(none, 5, scanned), &out, &error)) << error;
+  EXPECT_GT(out.trend_p_value, 0.01);
 }
 
 TEST(ChangeScanTest, BinarySegmentationFindsTwoStepsInTimeOrder) {

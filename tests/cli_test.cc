@@ -157,6 +157,38 @@ TEST_F(CliTest, SolveBadInputExitsNonZeroAndNamesTheProblem) {
   EXPECT_EQ(r.code, 2);
 }
 
+// Issue 29, item 7: with 60 kg/m cables a pose solved after another (warm start) gave
+// another equilibrium than solved alone (T1 405.5 kN against 515.2 kN), both ok. Now the
+// row before changes nothing, and the column equilibrium and a line on stderr say that
+// several equilibria hold the pose.
+TEST_F(CliTest, SolveAnswerDoesNotDependOnTheRowBefore) {
+  std::string model = ReadFile(Source() + "/calibration_data/nominal_fast.yaml");
+  for (size_t at = model.find("11.718"); at != std::string::npos; at = model.find("11.718")) {
+    model.replace(at, 6, "60");
+  }
+  Write("heavy.yaml", model);
+  Write("pair.csv",
+        "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n-111,-31,182,-8,23,10\n-111,-33,182,-8,23,10\n");
+  Write("alone.csv", "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n-111,-33,182,-8,23,10\n");
+  std::string last[2];
+  int k = 0;
+  for (const char* poses : {"pair.csv", "alone.csv"}) {
+    const std::string out = Path(std::string(poses) + ".out");
+    const CommandResult r = Fastcal("solve --model=" + Path("heavy.yaml") +
+                                    " --poses=" + Path(poses) + " --output=" + out);
+    ASSERT_EQ(r.code, 0) << r.output;
+    EXPECT_NE(r.output.find("several equilibria hold 1 of"), std::string::npos) << r.output;
+    const std::string csv = ReadFile(out);
+    EXPECT_NE(csv.find(",equilibrium,message\n"), std::string::npos) << csv;
+    last[k] = csv.substr(csv.rfind("\n", csv.size() - 2) + 1);
+    EXPECT_NE(last[k].find(",several,"), std::string::npos) << last[k];
+    ++k;
+  }
+  // The same row but its node number: the same tensions, to the digit.
+  EXPECT_EQ(last[0].substr(last[0].find(',')), last[1].substr(last[1].find(',')));
+  EXPECT_NE(last[1].find(",ok,405.5"), std::string::npos) << last[1];
+}
+
 // Simulate a small circle, calibrate it, and check the calibrated model reproduces the
 // reported RMS through evaluate.
 // Cables as built from the command line (issue 18): the bundled model with attachments
@@ -285,10 +317,15 @@ TEST_F(CliTest, TwoSurveysAsTwoFilesAreFittedJointly) {
   // Each session's model evaluates on its own survey.
   r = Fastcal("evaluate --model=" + out + "/model_calibrated@b.yaml --data=" + Path("b.csv"));
   EXPECT_EQ(r.code, 0) << r.output;
-  // --force replaces the joint fit's results, the sessions' models included.
+  // --force replaces the joint fit's results, the sessions' models included, by another
+  // joint fit or by a fit of one survey.
   r = Fastcal("calibrate --quiet --force --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") +
               "," + Path("b.csv") + " --out=" + out);
   EXPECT_EQ(r.code, 0) << r.output;
+  r = Fastcal("calibrate --quiet --force --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") +
+              " --out=" + out);
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_FALSE(fs::exists(fs::path(out) / "model_calibrated@b.yaml"));
   // The same file twice is one label twice: refused, naming both.
   r = Fastcal("calibrate --quiet --spec=" + Path("spec.yaml") + " --data=" + Path("a.csv") + "," +
               Path("a.csv") + " --out=" + Path("twice"));
@@ -1423,6 +1460,16 @@ TEST_F(CliTest, DesignWritesPosesSimulateReadsAndRefusesBadInput) {
     EXPECT_TRUE(fs::exists(out + "/" + file)) << file;
   }
   EXPECT_NE(ReadFile(out + "/design.json").find("\"sigma_total\""), std::string::npos);
+  // What binds the poses over the plausible range (issue 29): console, JSON and HTML.
+  EXPECT_NE(r.output.find("holds over the plausible range: mass_centre_m +-0.25 m (margin)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("binding: min_tension at"), std::string::npos) << r.output;
+  for (const char* key :
+       {"\"plausible_range\"", "\"binding\"", "\"limit_kN\": 50", "\"tightest_stop\""}) {
+    EXPECT_NE(ReadFile(out + "/design.json").find(key), std::string::npos) << key;
+  }
+  EXPECT_NE(ReadFile(out + "/design.html").find("<h2>Poses that hold</h2>"), std::string::npos);
   r = Fastcal("simulate --poses=" + out + "/poses.csv --out=" + Path("sim.csv"));
   ASSERT_EQ(r.code, 0) << r.output;
   r = Fastcal("solve --poses=" + out + "/poses.csv --output=" + Path("solve.csv"));
@@ -1441,6 +1488,9 @@ TEST_F(CliTest, DesignWritesPosesSimulateReadsAndRefusesBadInput) {
            " --parameters=cabin_mass_kg --out=" + Path("never"),
        2, "'cabin_mass_kg' is not a free parameter"},
       {"design --spec=" + spec + " --out=" + Path("never"), 2, "--samples=N"},
+      {"design --spec=" + spec + " --samples=40" + grid +
+           " --range-prior-sigmas=-1 --out=" + Path("never"),
+       2, "--range-prior-sigmas must be >= 0"},
   };
   for (const ExpectedRun& c : bad) RunBoundedAndExpect(c);
   Write("nothing_free.yaml", "parameters:\n  mass_centre_m: {x: {free: false}}\n");

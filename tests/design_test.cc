@@ -127,6 +127,8 @@ TEST(Design, MatchesBruteForceOnASmallCandidateSet) {
     DesignOptions o = SmallGrid();
     o.samples = 6;  // C(9 + 6 - 1, 6) = 3003 designs
     o.criterion = criterion;
+    // The nine nominal positions: two of them do not hold over the default plausible range.
+    o.range_prior_sigmas = o.range_mass_centre_m = 0.0;
     Design d;
     std::string error;
     ASSERT_TRUE(DesignSurvey(robot, spec, o, &d, &error)) << error;
@@ -287,6 +289,93 @@ TEST(Design, TimeBudgetIsKept) {
   EXPECT_LT(d.stops.size(), free_time.stops.size());
   EXPECT_EQ(static_cast<int>(d.poses.size()), o.samples);
   EXPECT_GE(d.design.criterion, free_time.design.criterion);
+}
+
+// Issue 29, item 6: the tilted and turned design once chose poses where a cable nearly
+// slackens at the nominal point, and a mass centre 16 cm off with cables 1.5% lighter had
+// no equilibrium there. The spec of this test frees the mass centre (no prior: +-0.25 m
+// per axis) and the common density (prior +-0.18 kg/m: +-0.36 kg/m at 2 sigma): 16
+// corners, every one of which the test solves itself at every stop, with a plain model.
+constexpr char kRangeSpec[] = R"(
+parameters:
+  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}
+  linear_density_kg_per_m: {free: true, prior: {mean: 11.718, sigma: 0.18}}
+  sensor_gain: {free: true, prior: {mean: 1, sigma: 0.01}}
+)";
+
+// The smallest lower-end tension over the 16 corners at `pose` (N), or -1 where the
+// statics fail at one of them (reflector clearance as in `o`).
+double LowestOverTheCorners(const DesignOptions& o, const Pose& pose) {
+  constexpr double kMassCentreM = 0.25, kDensityKgPerM = 2 * 0.18;
+  double lowest = INFINITY;
+  for (int corner = 0; corner < 16; ++corner) {
+    CableRobot robot = CableRobot::NominalFast();
+    for (int axis = 0; axis < 3; ++axis) {
+      robot.mass_centre_cabin_m[axis] += (corner >> axis & 1 ? 1 : -1) * kMassCentreM;
+    }
+    for (CableProperties& c : robot.cables) {
+      c.linear_density_kg_per_m += (corner >> 3 & 1 ? 1 : -1) * kDensityKgPerM;
+    }
+    StaticsSolution s;
+    if (SolveStatics(robot, pose, o.workspace.statics, &s) != StaticsStatus::kOk) return -1.0;
+    for (const CableSolution& c : s.cables) lowest = std::min(lowest, c.lower_tension_n);
+  }
+  return lowest;
+}
+
+TEST(Design, EveryStopHoldsAtEveryCornerOfThePlausibleRange) {
+  const CableRobot robot = CableRobot::NominalFast();
+  const CalibrationSpec spec = Spec(kRangeSpec);
+  DesignOptions o = TiltedCap();
+  o.max_extra_yaw_deg = 10.0;
+  Design d;
+  std::string error;
+  ASSERT_TRUE(DesignSurvey(robot, spec, o, &d, &error)) << error;
+  ASSERT_EQ(d.range.size(), 4u);
+  EXPECT_EQ(d.range[3].name, "linear_density_kg_per_m");
+  EXPECT_NEAR(d.range[3].delta_si, 0.36, 1e-12);
+  EXPECT_TRUE(d.range[3].from_prior);
+  EXPECT_FALSE(d.range[0].from_prior);
+  EXPECT_GT(d.rejected_off_nominal, 0);
+  for (const DesignStop& stop : d.stops) {
+    const Pose& pose = d.candidates[stop.candidate].pose;
+    EXPECT_GE(LowestOverTheCorners(o, pose), o.workspace.min_tension_n)
+        << "stop at " << pose.position_m.transpose();
+    // What binds it, reported: a limit kept, at a corner of the range.
+    const DesignBinding& b = stop.binding;
+    ASSERT_FALSE(b.constraint.empty());
+    EXPECT_GE(b.constraint == "reflector_clearance" ? b.value : b.value - b.limit, 0.0);
+    EXPECT_EQ(b.corner_si.size(), d.range.size());
+  }
+  // Without the range (the nominal point only, as before issue 29) the design picks stops
+  // that do not hold there: the check above fails on them.
+  DesignOptions nominal_only = o;
+  nominal_only.range_prior_sigmas = nominal_only.range_mass_centre_m = 0.0;
+  Design before;
+  ASSERT_TRUE(DesignSurvey(robot, spec, nominal_only, &before, &error)) << error;
+  EXPECT_TRUE(before.range.empty());
+  int failing = 0;
+  for (const DesignStop& stop : before.stops) {
+    failing +=
+        LowestOverTheCorners(o, before.candidates[stop.candidate].pose) < o.workspace.min_tension_n;
+  }
+  EXPECT_GT(failing, 0);
+}
+
+TEST(Design, RangeOptionsAreChecked) {
+  DesignOptions o;
+  std::string error;
+  o.range_prior_sigmas = -1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("range_prior_sigmas"), std::string::npos) << error;
+  o = DesignOptions();
+  o.range_relative = 1.0;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("range_relative"), std::string::npos) << error;
+  o = DesignOptions();
+  o.range_mass_centre_m = NAN;
+  EXPECT_FALSE(o.IsValid(&error));
+  EXPECT_NE(error.find("range_mass_centre_m"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -39,7 +39,9 @@
 // captures 3/4 of a mid-survey step's chi-square), for a steady drift the trend does
 // (a step captures 3/4 of a trend's). A mass centre that wanders, rather than steps, is
 // said to wander (ChangeScanVerdict) when the trend explains at least as much as the best
-// step, or when binary segmentation needs more than one step.
+// step, when binary segmentation needs more than one step, or when the change's time is
+// not determined (ChangeScanResult::change_time_*: its interval spans more than
+// kMaxStepTimeFraction of the survey).
 //
 // Several changes: binary segmentation (Vostrikova 1981). Each round scans every segment
 // between the changes found so far, with those changes in the nuisance; the segment
@@ -155,8 +157,19 @@ struct ChangeScanResult {
   std::vector<double> trend_shift;
   std::vector<double> trend_shift_sigma;
   double best_step_statistic = 0.0;
+  // The first round's change time, as a likelihood-ratio interval: the split times whose
+  // statistic is within the chi-square(p) 95% point of the largest (Siegmund 1988's
+  // confidence region for a change point, in its simplest form). A sharp step gives a few
+  // samples; a gradual change, or a weak one, a wide span.
+  double change_time_low_s = 0.0;
+  double change_time_high_s = 0.0;
   bool wanders = false;
 };
+
+// The fraction of the scanned span the change time's interval may cover for a change to
+// count as a step: wider, its time is not determined, and the change is reported as
+// gradual (a wandering).
+inline constexpr double kMaxStepTimeFraction = 0.2;
 
 // One sentence for the verdict: the changes found (when, how much, p), or that none was.
 std::string ChangeScanVerdict(const ChangeScanResult& scan);

@@ -37,6 +37,17 @@
 // as `fastcal workspace` judges a node: statics ok (model range, reflector clearance)
 // and every lower-end tension within the limits.
 //
+// Poses that hold over the plausible range (docs/design.md): the optimum lies on the
+// feasible set's edge, where a cable near slack sags by metres for a small error of the
+// model, so a candidate must also hold off the spec's initial values: each statics
+// parameter of the spec (free or considered; not the sensors' gains and biases, which
+// change readings, not forces) by +- range_prior_sigmas of its prior's sigma, or, free
+// without a prior, +- its kind's margin (range_*). From each parameter's effect on the six
+// tensions (one solve per parameter at +delta) the corner of that box where each cable's
+// tension is lowest is solved exactly; at the nominal point and at every such corner the
+// statics must be ok and the tensions and clearance within the workspace's limits
+// (min_tension_n is the margin kept there). What binds each stop is reported.
+//
 // A time budget: flying the stops in order takes path_length / speed plus N samples
 // times the sample interval. When that is over the budget the design drops its least
 // useful stops one at a time (their samples go to the others: dwell) until it fits.
@@ -92,6 +103,16 @@ struct DesignOptions {
   int tilt_directions = 4;
   // Largest extra turn about z' off the law (deg, in [0, 90]); 0: none.
   double max_extra_yaw_deg = 0.0;
+  // The plausible range every candidate must hold over (the file comment; docs/design.md):
+  // a parameter with a prior +- range_prior_sigmas of its sigma (2: a 1.5% density prior
+  // gives +-3%); free without a prior, +- range_mass_centre_m per axis of the mass centre
+  // (0.25 m: the paper's own calibration moved it ~0.25 m from nominal), range_offset_m
+  // (anchor and tower offsets, 0.05 m), or range_relative of the value (cabin mass,
+  // densities, EA, attachments; 3%). All 0: the nominal point only, as before issue 29.
+  double range_prior_sigmas = 2.0;
+  double range_mass_centre_m = 0.25;
+  double range_offset_m = 0.05;
+  double range_relative = 0.03;
   // Samples in the survey (>= the number of free parameters).
   int samples = 360;
   DesignCriterion criterion = DesignCriterion::kA;
@@ -151,21 +172,49 @@ struct DesignPriorEffect {
   std::vector<double> sigma_total;  // of each wanted parameter with that prior halved
 };
 
+// A statics parameter of the spec and how far off its initial value the designed poses
+// hold (DesignOptions::range_*).
+struct DesignRangeParameter {
+  std::string name;  // the spec's, e.g. "mass_centre_m.x"
+  std::string unit;  // its unit in files (SI value = file value * to_si)
+  double to_si = 1.0;
+  double delta_si = 0.0;    // +- this
+  bool from_prior = false;  // range_prior_sigmas x its prior's sigma; else a range_* margin
+};
+
+// What binds a designed pose: its tightest limit over the plausible range.
+struct DesignBinding {
+  // "min_tension" (the margin), "max_tension", or "reflector_clearance"; empty: none
+  // computed.
+  std::string constraint;
+  int cable = -1;      // 0-based: the lowest (or highest, or nearest) cable there
+  double value = 0.0;  // the tension (N) or clearance (m) there
+  double limit = 0.0;  // the limit it keeps (N or m)
+  // Where in the range: each parameter's offset from its initial value (SI), parallel
+  // to Design::range (0 everywhere: the nominal point).
+  std::vector<double> corner_si;
+};
+
 struct DesignStop {
   int candidate = 0;  // index into Design::candidates
   int samples = 0;    // samples taken there (dwell = samples x sample interval)
+  DesignBinding binding;
 };
 
 struct Design {
   DesignOptions options;
   std::vector<DesignCandidate> candidates;  // the feasible ones
-  int rejected_candidates = 0;              // infeasible ones
-  std::vector<std::string> free_names;      // spec order
-  std::vector<std::string> free_units;      // their units in files (the spec's)
-  std::vector<double> free_to_si;           // SI value = file value * to_si
-  std::vector<int> wanted;                  // indices into free_names
-  std::vector<DesignStop> stops;            // in flight order
-  std::vector<Pose> poses;                  // one per sample, in flight order
+  int rejected_candidates = 0;              // infeasible ones (rejected_off_nominal too)
+  // The plausible range (DesignOptions::range_*), and how many candidates feasible at
+  // the nominal point were left out because they do not hold over it.
+  std::vector<DesignRangeParameter> range;
+  int rejected_off_nominal = 0;
+  std::vector<std::string> free_names;  // spec order
+  std::vector<std::string> free_units;  // their units in files (the spec's)
+  std::vector<double> free_to_si;       // SI value = file value * to_si
+  std::vector<int> wanted;              // indices into free_names
+  std::vector<DesignStop> stops;        // in flight order
+  std::vector<Pose> poses;              // one per sample, in flight order
   double path_length_m = 0.0;
   double travel_s = 0.0, dwell_s = 0.0, duration_s = 0.0;  // 0 without a speed
   // Distinct stops the optimum had before the time budget dropped some (= stops.size()
@@ -200,6 +249,9 @@ std::string DesignPosesCsv(const Design& design, const std::string& provenance);
 // survey `parameters[]: {name, wanted, sigma_total, formal, systematic}`, the budget's
 // parts, what limits the design and what a better prior would buy.
 std::string DesignJson(const Design& design, const std::string& provenance);
+// Two lines for the console: the plausible range the poses hold over and what binds
+// them (the tightest stop, the constraint, the cable and the numbers).
+std::string DesignRangeSummary(const Design& design);
 // A self-contained HTML page: the stops and the path on the cap seen from above (with
 // the circle), the predicted sigma_total side by side, the limits and prior effects.
 std::string DesignHtml(const Design& design, const CableRobot& robot,

@@ -16,9 +16,11 @@
 // (>= 1). Without a step the statistic is chi-square with 1 degree of freedom; the
 // threshold is its 1 - alpha / m quantile over the m tests (Bonferroni: alpha = 1% that
 // any sensor is accused by chance). With two sessions the test of session 2 is the test of
-// session 1; from three on every session is tested. The calibration then fits each
-// accused sensor's bias per session (sessions.separate gets its name) and says so: a
-// re-zeroed sensor is named, and never read as a mass-centre move.
+// session 1; from three on every session is tested. When one sensor is accused the
+// calibration fits every shared bias per session (sessions.separate gets their names:
+// a maintenance that re-zeroes one sensor may re-zero the others by less than the test
+// sees, and those steps too would move the separate parameters) and says so: a re-zeroed
+// sensor is named, and no step is read as a mass-centre move.
 #ifndef FASTCAL_SENSOR_STEPS_H_
 #define FASTCAL_SENSOR_STEPS_H_
 
@@ -49,7 +51,7 @@ struct SensorStepTest {
   double threshold = 0.0;
   double widening = 1.0;
   std::vector<SensorStep> tests;       // every test: per bias, per session
-  std::vector<std::string> separated;  // biases then fitted per session (the accused)
+  std::vector<std::string> separated;  // biases then fitted per session: all, when one is accused
 };
 
 struct SensorStepInputs {

@@ -174,6 +174,17 @@ enum class StaticsStatus {
 // "unsupported_model".
 const char* StaticsStatusName(StaticsStatus status);
 
+// exact only: which equilibrium a solution is, where sagging cables let several hold one
+// pose (docs/model.md, "Which equilibrium exact returns").
+enum class EquilibriumBranch {
+  kNone = 0,  // none returned (a failure before an equilibrium was found), or aas/aas-refined
+  kTaut,      // the taut-cable equilibrium: its cables so nearly straight that it is proven
+              // the only one that taut (StaticsSolution::taut_certificate < 1/2), whatever
+              // the start that found it
+  kFromHome,  // followed from the home pose; its cables sag too much for that proof, and
+              // others may hold the pose (other_equilibrium says whether one was met)
+};
+
 struct CableSolution {
   // Force applied ON the cable at its lower end by the cabin, global frame (N). The
   // cabin feels -force_n.
@@ -200,6 +211,17 @@ struct StaticsSolution {
   int outer_iterations = 0;     // refinement steps or exact Newton iterations (all starts)
   int catenary_iterations = 0;  // total per-cable Newton iterations
   bool continuation = false;    // exact followed the equilibrium from the home pose
+  // exact: which equilibrium this is (also with a model-range status: of the equilibrium
+  // whose range was checked), and its taut-cable certificate, sum_i |a_i - a_t,i| kappa_i
+  // (or a bound of it; docs/model.md): below 1/2 for at most one equilibrium of a pose.
+  EquilibriumBranch branch = EquilibriumBranch::kNone;
+  double taut_certificate = 0.0;
+  // exact: the solve met an equilibrium other than the one returned (its start from AAS
+  // converged to it): several hold this pose. With kNoEquilibrium (or kNotConverged): the
+  // home pose's branch does not reach the pose, yet an equilibrium exists there, reached
+  // only through a fold (a jump of the cable lengths). Never set by a warm start's find:
+  // the answer and this flag depend on the pose, not on the solve before.
+  bool other_equilibrium = false;
   // |sum(-F_i) + W| and |sum r_i x (-F_i) + e x W| of the returned forces.
   double force_residual_n = 0.0;
   double moment_residual_nm = 0.0;
@@ -242,6 +264,12 @@ struct StaticsSolution {
 // failure the forces are zero (never NaN) and `cable`, limit_value and limit say why.
 StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const StaticsOptions& options,
                            StaticsSolution* solution);
+
+// Short code for files of which equilibrium a solution is: "taut" (kTaut), "home"
+// (kFromHome), "several" (either, with other_equilibrium), "unreachable" (no equilibrium
+// from the home pose, but other_equilibrium), "" (none of these: no equilibrium found,
+// or not exact).
+const char* EquilibriumCode(const StaticsSolution& solution);
 
 // A one-line human-readable account of a solution's status, naming the cable (1-based)
 // and the numbers behind it.

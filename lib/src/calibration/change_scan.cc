@@ -309,7 +309,8 @@ double ChiSquareTail(double x, int dof) {
     return std::erfc(std::sqrt(x / 2.0)) + std::sqrt(2.0 * x / M_PI) * std::exp(-x / 2.0);
   }
   // More parameters: the Wilson-Hilferty normal approximation.
-  const double k = dof, z = (std::cbrt(x / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
+  const double k = dof,
+               z = (std::cbrt(x / k) - (1.0 - 2.0 / (9.0 * k))) / std::sqrt(2.0 / (9.0 * k));
   return 0.5 * std::erfc(z / std::sqrt(2.0));
 }
 
@@ -502,13 +503,13 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
                FormatDouble("%+.3g", scan.trend_shift[k]) + " +- " +
                FormatDouble("%.2g", scan.trend_shift_sigma[k]) + " " + scan.units[k];
     }
-    out += "; but the data show a wandering rather than a step (" +
-           std::string(scan.changes.size() > 1 ? "several steps were needed, "
-                                               : "") +
-           "a steady trend explains " +
+    out += "; but the data show a gradual change (a wandering) rather than a step: " +
+           std::string(scan.changes.size() > 1 ? "several steps were needed; " : "") +
+           "its time is between t = " + FormatDouble("%.6g", scan.change_time_low_s) + " and " +
+           FormatDouble("%.6g", scan.change_time_high_s) + " s (95%); a steady trend explains " +
            (scan.trend_statistic >= scan.best_step_statistic ? "at least as much as"
-                                                             : "much of what") +
-           " the best step: statistic " + FormatDouble("%.3g", scan.trend_statistic) + " against " +
+                                                             : "some of what") +
+           " the best step (statistic " + FormatDouble("%.3g", scan.trend_statistic) + " against " +
            FormatDouble("%.3g", scan.best_step_statistic) + "; over the survey " + trend + ")";
   }
   if (scan.widening > kMemoryWorthSaying) {

@@ -55,12 +55,16 @@ SensorStepTest TestSensorSteps(const SensorStepInputs& in) {
         step.sigma = out.widening / std::sqrt(a) / free[k].to_si;
         step.significant = step.statistic > out.threshold;
       }
-      if (step.significant && std::find(out.separated.begin(), out.separated.end(),
-                                        step.parameter) == out.separated.end()) {
-        out.separated.push_back(step.parameter);
-      }
       out.tests.push_back(step);
     }
+  }
+  // One accused sensor: a maintenance happened, and it may have re-zeroed the others by
+  // less than the test can see; their steps would still move the separate parameters. So
+  // every shared bias is then fitted per session.
+  const bool accused = std::any_of(out.tests.begin(), out.tests.end(),
+                                   [](const SensorStep& s) { return s.significant; });
+  for (int k : biases) {
+    if (accused) out.separated.push_back(free[k].name);
   }
   return out;
 }
@@ -77,8 +81,9 @@ std::string SensorStepVerdict(const SensorStepTest& test) {
   }
   if (accused.empty()) return "";
   return "sensor offsets stepped between sessions (re-zeroed?): " + accused +
-         "; their biases are fitted per session, so the step is not read as a change of the "
-         "separate parameters";
+         "; every sensor's bias is then fitted per session (a maintenance that re-zeroes one "
+         "may re-zero the others by less than the test sees), so no step is read as a change "
+         "of the separate parameters";
 }
 
 }  // namespace fastcal

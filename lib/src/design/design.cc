@@ -8,6 +8,7 @@
 #include <numeric>
 
 #include "fastcal/internal/design_information.h"
+#include "fastcal/internal/design_range.h"
 #include "fastcal/survey_path.h"
 
 namespace fastcal {
@@ -181,7 +182,7 @@ void FlyStops(const std::vector<DesignCandidate>& candidates, const std::vector<
   d->stops.clear();
   d->poses.clear();
   for (int k : order) {
-    d->stops.push_back({support[k], counts[support[k]]});
+    d->stops.push_back({support[k], counts[support[k]], {}});
     for (int s = 0; s < counts[support[k]]; ++s) d->poses.push_back(candidates[support[k]].pose);
   }
   d->dwell_s = o.samples * o.sample_interval_s;
@@ -266,6 +267,18 @@ bool DesignOptions::IsValid(std::string* error) const {
   }
   if (tilt_directions < 1 || tilt_directions > 36) {
     return fail("tilt_directions must be in [1, 36] (got " + std::to_string(tilt_directions) + ")");
+  }
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"range_prior_sigmas", range_prior_sigmas},
+        {"range_mass_centre_m", range_mass_centre_m},
+        {"range_offset_m", range_offset_m},
+        {"range_relative", range_relative}}) {
+    if (!(value >= 0.0) || !std::isfinite(value)) {
+      return fail(std::string(name) + " must be >= 0 and finite (got " + Num(value) + ")");
+    }
+  }
+  if (!(range_relative < 1.0)) {
+    return fail("range_relative must be below 1 (got " + Num(range_relative) + ")");
   }
   if (samples < 1 || samples > 1000000) {
     return fail("samples must be in [1, 1e6] (got " + std::to_string(samples) + ")");
@@ -503,6 +516,27 @@ DesignPrediction PredictPoses(const CableRobot& robot, const CalibrationSpec& sp
   return PredictWithParts(spec, pr, internal::SumsOf(pr, ones), static_cast<int>(poses.size()));
 }
 
+// Stage: the candidates that hold over the plausible range (design.h); the others are
+// counted in rejected_off_nominal (and rejected_candidates).
+bool KeepThoseThatHold(const internal::PlausibleRange& range, Design* d, std::string* error) {
+  d->range = range.parameters();
+  std::vector<DesignCandidate> kept;
+  for (const DesignCandidate& c : d->candidates) {
+    if (range.Holds(c.pose, nullptr)) kept.push_back(c);
+  }
+  d->rejected_off_nominal = static_cast<int>(d->candidates.size() - kept.size());
+  d->rejected_candidates += d->rejected_off_nominal;
+  if (kept.empty()) {
+    *error = "no candidate pose holds over the plausible range of the spec's parameters: " +
+             std::to_string(d->rejected_off_nominal) +
+             " are feasible at the initial values only (narrow the range: "
+             "DesignOptions::range_*, or lower the tension margin)";
+    return false;
+  }
+  d->candidates = std::move(kept);
+  return true;
+}
+
 bool SetUp(const CableRobot& robot, const CalibrationSpec& spec, const DesignOptions& o,
            DesignProblem* pr, std::string* error) {
   if (!o.IsValid(error)) return false;
@@ -535,6 +569,8 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
   if (!internal::DesignCandidates(robot, options, &d.candidates, &d.rejected_candidates, error)) {
     return false;
   }
+  const internal::PlausibleRange range(robot, spec, options);
+  if (!KeepThoseThatHold(range, &d, error)) return false;
   std::vector<Pose> poses;
   for (const DesignCandidate& c : d.candidates) poses.push_back(c.pose);
   if (!internal::AddPoseRows(robot, spec, poses, &pr, error)) return false;
@@ -552,6 +588,7 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
     return false;
   }
   if (!KeepWithinBudget(pr, d.candidates, options, &counts, &d, error)) return false;
+  for (DesignStop& stop : d.stops) range.Holds(d.candidates[stop.candidate].pose, &stop.binding);
   const DesignSums s = internal::SumsOf(pr, ToWeights(counts));
   d.design = PredictWithParts(spec, pr, s, options.samples);
   ExplainLimits(spec, pr, s, &d);

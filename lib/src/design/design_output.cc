@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <sstream>
 
 #include "fastcal/design.h"
@@ -30,6 +31,65 @@ struct Shown {
 Shown ShownUnit(const Design& d, int k) {
   if (d.free_units[k] == "m") return {1e3, "mm"};
   return {1.0 / d.free_to_si[k], d.free_units[k]};
+}
+
+// The range's parameters grouped by name before '.' or '[' with their offset in file
+// units, e.g. "mass_centre_m +-0.25 m (margin); linear_density_kg_per_m +-0.36 kg/m (2
+// sigma)".
+std::string RangeText(const Design& d) {
+  std::string out;
+  for (size_t j = 0; j < d.range.size(); ++j) {
+    const DesignRangeParameter& r = d.range[j];
+    const std::string group = r.name.substr(0, r.name.find_first_of(".["));
+    const std::string text =
+        group + " +-" + Fmt("%.3g", r.delta_si / r.to_si) + " " + r.unit +
+        (r.from_prior ? " (" + Fmt("%.3g", d.options.range_prior_sigmas) + " sigma of its prior)"
+                      : " (margin)");
+    if (out.find(text) == std::string::npos) out += (out.empty() ? "" : "; ") + text;
+  }
+  return out.empty() ? "none (the initial values only)" : out;
+}
+
+// Where in the range a binding is reached, compactly: per group of parameters (name
+// before '.' or '['), the offset and each parameter's side in order, e.g.
+// "mass_centre_m +-0.25 m: ++-; linear_density_kg_per_m +-0.36 kg/m: +-----" (0: at its
+// initial value). design.json names each parameter.
+std::string CornerText(const Design& d, const DesignBinding& b) {
+  std::string out, group;
+  bool off = false;
+  for (size_t j = 0; j < b.corner_si.size() && j < d.range.size(); ++j) {
+    const DesignRangeParameter& r = d.range[j];
+    const std::string g = r.name.substr(0, r.name.find_first_of(".["));
+    if (g != group) {
+      group = g;
+      out += (out.empty() ? "" : "; ") + g + " +-" + Fmt("%.3g", r.delta_si / r.to_si) + " " +
+             r.unit + ": ";
+    }
+    out += b.corner_si[j] > 0.0 ? '+' : b.corner_si[j] < 0.0 ? '-' : '0';
+    off |= b.corner_si[j] != 0.0;
+  }
+  return off ? out : "the initial values";
+}
+
+// A binding's value and limit in the units of files: kN for tensions, m for clearance.
+bool IsTension(const DesignBinding& b) { return b.constraint != "reflector_clearance"; }
+double BindingShown(const DesignBinding& b, double si) { return IsTension(b) ? si / 1e3 : si; }
+std::string BindingUnit(const DesignBinding& b) { return IsTension(b) ? "kN" : "m"; }
+
+// The stop whose binding has the least slack (its value nearest its limit, relatively).
+int TightestStop(const Design& d) {
+  int tightest = -1;
+  double least = std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < d.stops.size(); ++k) {
+    const DesignBinding& b = d.stops[k].binding;
+    if (b.constraint.empty()) continue;
+    const double slack = std::abs(b.value - b.limit) / std::max(std::abs(b.limit), 1.0);
+    if (slack < least) {
+      least = slack;
+      tightest = static_cast<int>(k);
+    }
+  }
+  return tightest;
 }
 
 void WritePrediction(JsonWriter& j, const Design& d, const DesignPrediction& p) {
@@ -113,9 +173,39 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
     j.Key("extra_tilt_deg").Number(c.extra_tilt_deg);
     j.Key("tilt_direction_deg").Number(c.tilt_direction_deg);
     j.Key("extra_yaw_deg").Number(c.extra_yaw_deg);
+    const DesignBinding& b = s.binding;
+    if (!b.constraint.empty()) {
+      const std::string unit = BindingUnit(b);
+      j.Key("binding").BeginObject().Key("constraint").String(b.constraint);
+      if (b.cable >= 0) j.Key("cable").Int(b.cable + 1);
+      j.Key("value_" + unit).Number(BindingShown(b, b.value));
+      j.Key("limit_" + unit).Number(BindingShown(b, b.limit));
+      j.Key("corner").BeginObject();
+      for (size_t k = 0; k < b.corner_si.size() && k < d.range.size(); ++k) {
+        if (b.corner_si[k] == 0.0) continue;
+        j.Key(d.range[k].name).Number(b.corner_si[k] / d.range[k].to_si);
+      }
+      j.EndObject().EndObject();
+    }
     j.EndObject();
   }
   j.EndArray();
+  j.Key("plausible_range").BeginObject();
+  j.Key("prior_sigmas").Number(o.range_prior_sigmas);
+  j.Key("mass_centre_m").Number(o.range_mass_centre_m);
+  j.Key("offset_m").Number(o.range_offset_m);
+  j.Key("relative").Number(o.range_relative);
+  j.Key("min_tension_kN").Number(o.workspace.min_tension_n / 1e3);
+  j.Key("rejected_off_nominal").Int(d.rejected_off_nominal);
+  j.Key("parameters").BeginArray();
+  for (const DesignRangeParameter& r : d.range) {
+    j.BeginObject().Key("name").String(r.name).Key("unit").String(r.unit);
+    j.Key("delta").Number(r.delta_si / r.to_si).Key("from_prior").Bool(r.from_prior).EndObject();
+  }
+  j.EndArray();
+  const int tightest = TightestStop(d);
+  if (tightest >= 0) j.Key("tightest_stop").Int(tightest + 1);
+  j.EndObject();
   j.Key("design");
   WritePrediction(j, d, d.design);
   j.Key("parameters").BeginArray();  // the design's, at the top for a quick read
@@ -270,7 +360,84 @@ std::string LimitsText(const Design& d) {
   return h + "</tbody></table>\n";
 }
 
+// Stops by their binding constraint, e.g. "min_tension at 20 of 23 stops,
+// reflector_clearance at 3".
+std::string BindingCounts(const Design& d) {
+  std::vector<std::pair<std::string, int>> counts;
+  for (const DesignStop& st : d.stops) {
+    auto it = std::find_if(counts.begin(), counts.end(),
+                           [&](const auto& c) { return c.first == st.binding.constraint; });
+    if (it == counts.end()) {
+      counts.push_back({st.binding.constraint, 1});
+    } else {
+      ++it->second;
+    }
+  }
+  std::string out;
+  for (size_t k = 0; k < counts.size(); ++k) {
+    out += (k ? ", " : "") + counts[k].first + " at " + std::to_string(counts[k].second);
+    if (k == 0) out += " of " + std::to_string(d.stops.size()) + " stops";
+  }
+  return out;
+}
+
+// A binding in words: "cable 6 at 51.2 kN (limit 50 kN)".
+std::string BindingText(const DesignBinding& b) {
+  return (b.cable >= 0 ? "cable " + std::to_string(b.cable + 1) + " at " : std::string("")) +
+         Fmt("%.4g", BindingShown(b, b.value)) + " " + BindingUnit(b) + " (limit " +
+         Fmt("%.4g", BindingShown(b, b.limit)) + " " + BindingUnit(b) + ")";
+}
+
+std::string RangeSection(const Design& d) {
+  const WorkspaceOptions& w = d.options.workspace;
+  std::string h =
+      "<h2>Poses that hold</h2>\n<p>Every candidate was judged at the spec's initial values and "
+      "over the plausible range of its parameters: " +
+      XmlEscape(RangeText(d)) +
+      ". At the initial values and at the corner of that box where each cable's tension is "
+      "lowest" +
+      (std::isfinite(w.max_tension_n) ? std::string(" (and highest)") : std::string("")) +
+      ", the statics must hold with every lower-end tension at least " +
+      Fmt("%.4g", w.min_tension_n / 1e3) + " kN" +
+      (std::isfinite(w.max_tension_n) ? " and at most " + Fmt("%.4g", w.max_tension_n / 1e3) + " kN"
+                                      : std::string("")) +
+      " and every cable " + Fmt("%.3g", w.statics.min_reflector_clearance_m) +
+      " m clear of the reflector. " + std::to_string(d.rejected_off_nominal) +
+      " candidates feasible at the initial values only were left out.</p>\n";
+  if (d.stops.empty()) return h;
+  const int tightest = TightestStop(d);
+  h += "<p>What binds each stop, at its worst corner (bold: the tightest). Where in the range: "
+       "per group, each parameter's side of its initial value (+ or -), in the order of "
+       "<code>plausible_range.parameters</code> in design.json.</p>\n<div "
+       "class=\"wrap\"><table><thead><tr><th>stop</th><th>position (m)</th><th>binds</th>"
+       "<th>there</th><th>where in the range</th></tr></thead><tbody>\n";
+  for (size_t k = 0; k < d.stops.size(); ++k) {
+    const DesignBinding& b = d.stops[k].binding;
+    const Eigen::Vector3d& p = d.candidates[d.stops[k].candidate].pose.position_m;
+    const bool bold = static_cast<int>(k) == tightest;
+    h += std::string(bold ? "<tr style=\"font-weight:bold\">" : "<tr>") + "<td class=\"num\">" +
+         std::to_string(k + 1) + "</td><td>(" + Fmt("%.2f", p.x()) + ", " + Fmt("%.2f", p.y()) +
+         ", " + Fmt("%.2f", p.z()) + ")</td><td>" + XmlEscape(b.constraint) + "</td><td>" +
+         XmlEscape(BindingText(b)) + "</td><td>" + XmlEscape(CornerText(d, b)) + "</td></tr>\n";
+  }
+  return h + "</tbody></table></div>\n";
+}
+
 }  // namespace
+
+std::string DesignRangeSummary(const Design& d) {
+  std::string out = "holds over the plausible range: " + RangeText(d) + "; " +
+                    std::to_string(d.rejected_off_nominal) +
+                    " candidates feasible at the initial values only left out";
+  const int tightest = TightestStop(d);
+  if (tightest < 0) return out;
+  const DesignBinding& b = d.stops[tightest].binding;
+  return out + "\nbinding: " + BindingCounts(d) + "; tightest: stop " +
+         std::to_string(tightest + 1) + ", " + b.constraint + ", " + BindingText(b) +
+         (d.range.empty() ? std::string(" at the initial values")
+                          : " at a corner of the range (design.json: stops[" +
+                                std::to_string(tightest) + "].binding.corner)");
+}
 
 std::string DesignHtml(const Design& d, const CableRobot& robot, const std::string& provenance) {
   const DesignOptions& o = d.options;
@@ -313,6 +480,7 @@ std::string DesignHtml(const Design& d, const CableRobot& robot, const std::stri
        "random survey have the same number of samples.</p>\n<div class=\"wrap\">" +
        SigmaBars(d) + "</div>\n" + SigmaTable(d);
   h += LimitsText(d);
+  h += RangeSection(d);
   return h + "</body></html>\n";
 }
 

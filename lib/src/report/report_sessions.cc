@@ -300,6 +300,8 @@ void WriteChangeScanJson(const CalibrationResult& r, JsonWriter* w) {
     }
     w->EndObject();
     w->EndObject();
+    w->Key("change_time_low_s").Number(scan.change_time_low_s);
+    w->Key("change_time_high_s").Number(scan.change_time_high_s);
     w->Key("wanders").Bool(scan.wanders);
     w->EndObject();
   }

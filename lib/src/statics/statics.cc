@@ -178,6 +178,95 @@ struct PreviousSolve {
   }
 };
 
+// Which equilibrium (docs/model.md, "Which equilibrium exact returns"). Where cables sag,
+// several equilibria can hold one pose. In the reduced unknowns c (Fl = N c, N the null
+// basis of the rows without Fz, PoseGeometry) the equilibrium is G(c) = 0 in three
+// equations whose Jacobian J(a) = V(a) N depends on the state only through each cable's
+// tangent slope a_i = dFz/dFl along its family of lengths, affinely and by rank one:
+//   J(a) = J_t + sum_i (a_i - a_t,i) u_i n_i^T,   u_i = (1, r_y,i, r_x,i),  n_i = row i of N,
+// with J_t = J(a_t) the straight cables' (a_t,i = -Z_i/L_i: the force along the chord).
+// J(a) = J_t (I + E) is nonsingular, det J(a) of J_t's sign, wherever
+//   sum_i |a_i - a_t,i| kappa_i < 1,   kappa_i = |J_t^-1 u_i|_inf |n_i|_1   (|E|_inf <= it).
+// The taut-cable certificate of an equilibrium X is that sum at X. Two equilibria X, Y
+// with certificates below 1/2 are one: on the convex set {c : Fl_i >= min(Fl_i(X),
+// Fl_i(Y))} each |a_i - a_t,i| is at most its larger value at X or Y (it grows as a cable
+// slackens: measured over FAST's chords, 2 to 60 kg/m, except for a wiggle where a cable
+// is stretched nearly straight, below 0.003 of slope at 11.7 kg/m), so the sum stays
+// below 1 there, and G, whose every average Jacobian along a segment there is then
+// nonsingular, takes no value twice. So at most one equilibrium is certified
+// (kCertified), whatever the start found it: the taut-cable equilibrium. Elsewhere the
+// sign of det J(a) against det J_t tells the two sides of a fold apart: the continuation
+// keeps it.
+constexpr double kCertified = 0.5;
+struct TautReference {
+  Eigen::Matrix3d j_t;                   // J(a_t)
+  std::array<double, kNumCables> slope;  // a_t
+  std::array<double, kNumCables> kappa;  // |J_t^-1 u_i|_inf |n_i|_1; +inf when J_t is singular
+  double det_t;                          // det J_t
+};
+
+// J(a) = V(a) N for slopes a (SolveEquilibriumReduced's 3x3 matrix).
+Eigen::Matrix3d ReducedJacobian(const Geometry& g, const std::array<double, kNumCables>& a) {
+  Eigen::Matrix3d j = Eigen::Matrix3d::Zero();
+  for (int i = 0; i < kNumCables; ++i) {
+    const Eigen::Vector3d& r = g.r[i];
+    const Eigen::Vector3d v(a[i], r[1] * a[i] + r[2] * g.uy[i], r[0] * a[i] + r[2] * g.ux[i]);
+    j += v * g.null_basis.row(i);
+  }
+  return j;
+}
+
+TautReference MakeTautReference(const Geometry& g) {
+  TautReference t;
+  for (int i = 0; i < kNumCables; ++i) t.slope[i] = -g.rise[i] / g.span[i];
+  t.j_t = ReducedJacobian(g, t.slope);
+  const internal::Adjugate3 adj(t.j_t);
+  t.det_t = adj.det;
+  const bool usable = adj.ConditionedBetterThan(internal::kMinEquilibriumReciprocalCondition);
+  const double inv_det = 1.0 / std::abs(adj.det);
+  for (int i = 0; i < kNumCables; ++i) {
+    const Eigen::Vector3d y = adj.adjugate * Eigen::Vector3d(1.0, g.r[i][1], g.r[i][0]);
+    t.kappa[i] = usable ? y.cwiseAbs().maxCoeff() * inv_det * g.null_basis.row(i).cwiseAbs().sum()
+                        : std::numeric_limits<double>::infinity();
+  }
+  return t;
+}
+
+// A converged state's tangents: each cable's slope a_i and the inverse of J(a), the last
+// Newton step's equilibrium response (the same linearisation).
+struct Tangent {
+  std::array<double, kNumCables> slope;
+  EquilibriumResponse response;
+};
+
+// The taut-cable certificate of a converged state (kCertified), or an upper bound of it.
+// First the bound from J(a)^-1, which the last step computed: with
+// eps = sum_i |a_i - a_t,i| |J(a)^-1 u_i|_inf |n_i|_1 < 1,
+// J_t^-1 = (I - J(a)^-1 sum_i (a_i - a_t,i) u_i n_i^T)^-1 J(a)^-1 bounds kappa_i by
+// kappa'_i / (1 - eps), so the certificate is at most eps / (1 - eps): certified for
+// eps < 1/3 (on FAST's workspace eps ~ 0.005). Otherwise J_t itself.
+double TautCertificate(const Geometry& g, const Tangent& t) {
+  constexpr double kBoundEnough = kCertified / (1.0 + kCertified);
+  std::array<double, kNumCables> deviation;
+  double eps = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    deviation[i] = std::abs(t.slope[i] + g.rise[i] / g.span[i]);
+    const Eigen::Vector3d y = t.response * Eigen::Vector3d(1.0, g.r[i][1], g.r[i][0]);
+    eps += deviation[i] * y.cwiseAbs().maxCoeff() * g.null_basis.row(i).cwiseAbs().sum();
+  }
+  if (eps < kBoundEnough) return eps / (1.0 - eps);
+  const TautReference taut = MakeTautReference(g);
+  double sum = 0.0;
+  for (int i = 0; i < kNumCables; ++i) sum += deviation[i] * taut.kappa[i];
+  return sum;
+}
+
+// Whether slopes `a` lie on the straight cables' side of every fold: det J(a) has J_t's sign.
+bool OnTautSide(const Geometry& g, const TautReference& t,
+                const std::array<double, kNumCables>& a) {
+  return internal::Adjugate3(ReducedJacobian(g, a)).det * t.det_t > 0.0;
+}
+
 // Shared by the stages of one solve.
 struct Context {
   const StaticsParameters<double>& p;
@@ -365,11 +454,12 @@ StaticsStatus SolveAasRefined(Context* c, const Geometry& g, bool warm, State* s
 }
 
 // Newton on the reduced system from *st at the pose of `g`, at most max_steps steps, until
-// the error estimate is <= tolerance; then *check holds the checks of *st. Otherwise
+// the error estimate is <= tolerance; then *check holds the checks of *st and *tangent (if
+// not null) the last linearisation's slopes and response. Otherwise
 // kNotConverged, or a step's failure (kNoEquilibrium: a step left Fl > 0 or s0 > 0;
 // kSingular), with *st the last iterate.
 StaticsStatus Newton(Context* c, const Geometry& g, int max_steps, double tolerance, State* st,
-                     Check* check) {
+                     Check* check, Tangent* tangent = nullptr) {
   // Newton's error after a step of relative size d is ~C d^2, C ~ 1 where the cables are
   // taut (0.06-1.2 measured; larger where they sag): the new iterate is checked once d^2
   // is below the tolerance. A check that cannot pass would cost six catenary evaluations
@@ -402,12 +492,27 @@ StaticsStatus Newton(Context* c, const Geometry& g, int max_steps, double tolera
         internal::SolveEquilibrium<double, true>(g, lin.a, lin.b, &unused, &response);
       }
       *check = CheckAfterStep(c->p, g, *st, lin, response);
-      if (check->error_estimate <= tolerance) return StaticsStatus::kOk;
+      if (check->error_estimate <= tolerance) {
+        if (tangent != nullptr) *tangent = {lin.a, response};  // to the step's size
+        return StaticsStatus::kOk;
+      }
     }
     internal::LineariseCables(c->p, g, *st, &lin);
     previous_step = relative_step;
   }
   return StaticsStatus::kNotConverged;
+}
+
+// Whether two converged states are the same equilibrium (both to ~1e-12: 1e-8 of the
+// largest horizontal force apart at most).
+bool SameEquilibrium(const State& a, const State& b) {
+  constexpr double kSameRelative = 1e-8;
+  double largest = 0.0, apart = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    largest = std::max(largest, std::abs(a[i].fl));
+    apart = std::max(apart, std::max(std::abs(a[i].fl - b[i].fl), std::abs(a[i].fz - b[i].fz)));
+  }
+  return apart <= kSameRelative * largest;
 }
 
 // The home pose of the continuation (kHomeDepthPerTowerRadius).
@@ -444,22 +549,32 @@ double LargestLengthRatio(const Geometry& g, const State& st, int* cable) {
   return worst;
 }
 
+// Newton at one point of the continuation's path, accepted only on the straight cables'
+// side of every fold (OnTautSide): when a step of the path jumps a fold, Newton from the
+// extrapolated start can land beyond it, on another equilibrium.
+bool SolvePathPoint(Context* c, const Geometry& g, int max_steps, State* st) {
+  Check check;
+  Tangent tangent;
+  return Newton(c, g, max_steps, kPathPointTolerance, st, &check, &tangent) == StaticsStatus::kOk &&
+         OnTautSide(g, MakeTautReference(g), tangent.slope);
+}
+
 // exact's fallback: the equilibrium followed from the home pose to `pose` in steps along
 // a straight path (position, and attitude by slerp), each point solved by Newton from
-// the previous ones extrapolated; a failed step is halved, a good one doubled. kOk with
-// *st solved (to kPathPointTolerance) at `pose`; kNoEquilibrium when the steps shrink
-// below kMinPathStep (sol->cable: the slackest cable there, limit_value its s0/k);
-// kNotConverged when *budget Newton steps run out or the home pose has no solution.
+// the previous ones extrapolated (SolvePathPoint: on the home pose's side of every fold);
+// a failed step is halved, a good one doubled. kOk with *st solved (to
+// kPathPointTolerance) at `pose`; kNoEquilibrium when the steps shrink below kMinPathStep
+// (sol->cable: the slackest cable there, limit_value its s0/k); kNotConverged when
+// *budget Newton steps run out or the home pose has no solution.
 StaticsStatus FollowFromHome(Context* c, const Pose& pose, int* budget, State* st) {
   const Pose home = HomePose(c->p);
   Geometry g;
-  Check check;
   int* cable = &c->sol->cable;
   const int start_iterations = c->sol->outer_iterations;
   if (internal::ComputeGeometry(c->p, home, c->o.catenary.vertical_span_fraction, &g, cable) !=
           StaticsStatus::kOk ||
       ExactStart(c, g, st) != StaticsStatus::kOk ||
-      Newton(c, g, kPathPointIterations, kPathPointTolerance, st, &check) != StaticsStatus::kOk) {
+      !SolvePathPoint(c, g, kPathPointIterations, st)) {
     return StaticsStatus::kNotConverged;
   }
   int used = c->sol->outer_iterations - start_iterations;
@@ -482,11 +597,11 @@ StaticsStatus FollowFromHome(Context* c, const Pose& pose, int* budget, State* s
       }
     }
     const int before = c->sol->outer_iterations;
-    const bool solved = internal::ComputeGeometry(c->p, PoseOnPath(home, pose, t_next),
-                                                  c->o.catenary.vertical_span_fraction, &g,
-                                                  cable) == StaticsStatus::kOk &&
-                        Newton(c, g, std::min(kPathPointIterations, *budget - used),
-                               kPathPointTolerance, &trial, &check) == StaticsStatus::kOk;
+    const bool solved =
+        internal::ComputeGeometry(c->p, PoseOnPath(home, pose, t_next),
+                                  c->o.catenary.vertical_span_fraction, &g,
+                                  cable) == StaticsStatus::kOk &&
+        SolvePathPoint(c, g, std::min(kPathPointIterations, *budget - used), &trial);
     used += c->sol->outer_iterations - before;
     if (solved) {
       previous = *st;
@@ -752,14 +867,17 @@ void WarmStart(const StaticsParameters<double>& p, const PreviousSolve& previous
   }
 }
 
-// exact: Newton from the previous solution (warm) or from AAS; where that fails or ends
-// outside the model's range, and `may_follow`, the continuation from the home pose decides.
+// exact: Newton from the previous solution (warm) or from AAS. An equilibrium found there
+// is the answer when it is certified taut (TautReference: the only one that taut), its
+// model range the status. Otherwise, and where the start fails, the continuation from
+// the home pose decides (only when `may_follow`: a warm attempt leaves it to the cold one).
 StaticsStatus SolveExact(Context* c, const Geometry& g, const Pose& pose,
                          const PreviousSolve* previous, bool may_follow) {
   const StaticsOptions& o = c->o;
   StaticsSolution* sol = c->sol;
   State st;
   Check check;
+  Tangent tangent;
   StaticsStatus status = StaticsStatus::kOk;
   if (previous != nullptr) {
     WarmStart(c->p, *previous, pose, &st);
@@ -767,18 +885,23 @@ StaticsStatus SolveExact(Context* c, const Geometry& g, const Pose& pose,
     status = ExactStart(c, g, &st);
   }
   if (status == StaticsStatus::kOk) {
-    status = Newton(c, g, o.exact_max_iterations, o.exact_relative_tolerance, &st, &check);
+    status =
+        Newton(c, g, o.exact_max_iterations, o.exact_relative_tolerance, &st, &check, &tangent);
   }
-  // A converged solution outside the model's range is kept in case the continuation
-  // finds none: it is an equilibrium, and its range status the answer.
   const bool converged = status == StaticsStatus::kOk;
-  const State direct = st;
-  const Check direct_check = check;
   if (converged) {
-    status = Finish(c, g, st, check);
-    if (status == StaticsStatus::kOk || !may_follow) return status;
+    // Certified taut (kCertified): the only such equilibrium, the answer whatever the start,
+    // and its model range the status.
+    sol->taut_certificate = TautCertificate(g, tangent);
+    if (sol->taut_certificate < kCertified) {
+      sol->branch = EquilibriumBranch::kTaut;
+      return Finish(c, g, st, check);
+    }
   }
+  // A warm start's uncertified equilibrium may be another than the cold solve's: the cold
+  // solve (the caller's retry) decides, so that the answer does not depend on the start.
   if (!may_follow) return StaticsStatus::kNotConverged;
+  const State direct = st;
   sol->continuation = true;
   sol->cable = -1;
   sol->limit_value = sol->limit = 0.0;
@@ -786,14 +909,20 @@ StaticsStatus SolveExact(Context* c, const Geometry& g, const Pose& pose,
   status = FollowFromHome(c, pose, &budget, &st);
   if (status == StaticsStatus::kOk) {
     status = Newton(c, g, std::min(o.exact_max_iterations, std::max(budget, 1)),
-                    o.exact_relative_tolerance, &st, &check);
-    if (status == StaticsStatus::kOk) return Finish(c, g, st, check);
+                    o.exact_relative_tolerance, &st, &check, &tangent);
+    if (status == StaticsStatus::kOk) {
+      sol->taut_certificate = TautCertificate(g, tangent);
+      sol->branch = sol->taut_certificate < kCertified ? EquilibriumBranch::kTaut
+                                                       : EquilibriumBranch::kFromHome;
+      sol->other_equilibrium = converged && !SameEquilibrium(direct, st);
+      return Finish(c, g, st, check);
+    }
     if (status == StaticsStatus::kNoEquilibrium) status = StaticsStatus::kNotConverged;
   }
-  if (converged) {  // the continuation found no equilibrium, or ran out of iterations
-    sol->limit_value = sol->limit = 0.0;
-    return Finish(c, g, direct, direct_check);
-  }
+  // The home pose's branch does not reach the pose (or the budget ran out), but AAS's
+  // start found an equilibrium: one the cabin reaches only through a fold, a jump of the
+  // cable lengths. Not the answer; the status says that it exists.
+  sol->other_equilibrium = converged;
   return status;
 }
 
@@ -806,6 +935,9 @@ StaticsStatus Attempt(const StaticsParameters<double>& p, const Pose& pose, cons
   sol->outer_iterations = 0;
   sol->catenary_iterations = 0;
   sol->continuation = false;
+  sol->branch = EquilibriumBranch::kNone;
+  sol->taut_certificate = 0.0;
+  sol->other_equilibrium = false;
   sol->force_residual_n = 0.0;
   sol->moment_residual_nm = 0.0;
   sol->end_residual_m = 0.0;
@@ -900,6 +1032,21 @@ const char* StaticsStatusName(StaticsStatus status) {
       return "unsupported_model";
   }
   return "unknown";
+}
+
+const char* EquilibriumCode(const StaticsSolution& solution) {
+  if (solution.other_equilibrium) {
+    return solution.branch == EquilibriumBranch::kNone ? "unreachable" : "several";
+  }
+  switch (solution.branch) {
+    case EquilibriumBranch::kTaut:
+      return "taut";
+    case EquilibriumBranch::kFromHome:
+      return "home";
+    case EquilibriumBranch::kNone:
+      break;
+  }
+  return "";
 }
 
 namespace {
@@ -1170,12 +1317,13 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       s << "cable " << c << " is vertical: its horizontal force direction is undefined";
       break;
     case StaticsStatus::kNoEquilibrium:
-      s << "no equilibrium with positive cable forces: the cables cannot hold the cabin here "
-           "(followed from the home pose, the equilibrium ends before this pose";
+      // Not "the cables cannot hold the cabin here": with sagging cables another
+      // equilibrium, beyond a fold, may (docs/model.md, "Which equilibrium exact returns").
+      s << "no equilibrium with positive cable forces reached from the home pose: followed "
+           "from there, the equilibrium ends before this pose";
       if (solution.cable >= 0 && solution.limit_value > 1.05) {
-        s << "; cable " << c << " then hung in a loop, s0/k = " << Sig(solution.limit_value);
+        s << " (cable " << c << " then hung in a loop, s0/k = " << Sig(solution.limit_value) << ")";
       }
-      s << ")";
       break;
     case StaticsStatus::kSaggingCable:
     case StaticsStatus::kOverstretchedCable:
@@ -1215,6 +1363,14 @@ std::string DescribeStatus(const StaticsSolution& solution) {
       s << "cable " << c << " carries attachments (sensors, hung lines), which aas and "
         << "aas-refined do not model (their secant lines are the uniform cable's); use exact";
       break;
+  }
+  if (solution.other_equilibrium) {
+    s << (solution.branch == EquilibriumBranch::kNone
+              ? "; another equilibrium holds this pose, reached only through a fold (a jump of "
+                "the cable lengths), not the home pose's (docs/model.md, \"Which equilibrium "
+                "exact returns\")"
+              : "; several equilibria hold this pose: this is the one followed from the home "
+                "pose (docs/model.md, \"Which equilibrium exact returns\")");
   }
   return s.str();
 }
