@@ -195,7 +195,7 @@ Sessions and steps of the mass centre (the cabin's structure changed):
 A season (fastcal track): --start=T, the first sample's time (s; a Unix time, e.g.
 1714593600 for 2024-05-01T20:00:00Z), and --days=N, the samples cut into N sessions a day
 apart (each day's samples --interval-s apart from --start + k days; the slow errors
-decorrelate overnight). Steps' times T are in the same seconds.
+decorrelate overnight; no session column). Steps' times T are in the same seconds.
 The truth model written out has the mass centre before any step and the first session's
 sensor biases; its header lists the steps and every session's biases.
 
@@ -603,7 +603,9 @@ bool SimulateAndWrite(const CableRobot& truth, const PoseStream& poses,
   const std::string yaml_tmp = yaml_path + tmp;
   *simulation_failed = false;
   DatasetWriter writer;
-  if (!writer.Open(csv_tmp, SimulatedDatasetLayout(options.sessions), csv_header, error)) {
+  // A season's days are not surveys: no session column (a track cuts the data by time).
+  const int labelled = FLAGS_days > 0 ? 1 : options.sessions;
+  if (!writer.Open(csv_tmp, SimulatedDatasetLayout(labelled), csv_header, error)) {
     *error = "writing " + csv_path + ": " + *error;
     return false;
   }

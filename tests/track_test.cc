@@ -245,6 +245,7 @@ TEST_F(SeasonTest, FindsTheStepAndTheReZeroedSensorAndNothingElse) {
     EXPECT_NEAR(step.parameters[a].shift, truth[a], 3.0 * step.parameters[a].sigma_total)
         << step.parameters[a].name;
   }
+  EXPECT_FALSE(step.within_window);  // between two days' telemetry: the window's resolution
   const TrackEvent& zero = r.events[1];
   EXPECT_EQ(zero.kind, "sensor");
   EXPECT_EQ(r.windows[zero.window].label, "2024-05-06");
@@ -346,6 +347,30 @@ TEST_F(SeasonTest, UpdateFoldsOnlyTheNewDay) {
   // Nothing new: nothing folded.
   const TrackResult again = Track(*spec_, {a, b}, dir + "/track");
   EXPECT_EQ(again.folds, 0);
+}
+
+// A step inside a day's telemetry shows as a change on both sides of that day: one event,
+// timed at its block within the day.
+TEST(TrackTest, StepInsideADayIsOneEventAtItsBlock) {
+  constexpr int kDays = 5, kPerDay = 300;
+  const double step_s = kStartS + 2 * kDayS + 0.5 * kPerDay * kIntervalS;  // mid-day 3
+  SimulationOptions o;
+  o.mass_centre_steps.push_back({step_s, {0.05, 0.0, 0.0}});
+  CableRobot truth;
+  const Dataset data = Season(kDays, kPerDay, 31, o, &truth);
+  const std::string dir = TempDir("inside");
+  fs::create_directories(dir);
+  const TrackResult r =
+      Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
+            {Write(data, dir + "/season.csv")}, dir + "/track");
+  ASSERT_EQ(r.events.size(), 1u);
+  const TrackEvent& e = r.events[0];
+  EXPECT_TRUE(e.within_window);
+  EXPECT_EQ(r.windows[e.window].label, "2024-05-03");
+  EXPECT_EQ(r.windows[e.previous_window].label, "2024-05-02");
+  // Within two blocks (a block: about 10 samples, 200 s) of the truth.
+  EXPECT_NEAR(e.time_s, step_s, 2 * kPerDay / 32.0 * kIntervalS + kIntervalS);
+  EXPECT_NEAR(e.parameters[0].shift, 0.05, 3.0 * e.parameters[0].sigma_total);
 }
 
 TEST(TrackBadInputTest, RefusesWhatItCannotTrack) {

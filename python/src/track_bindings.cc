@@ -56,7 +56,8 @@ py::dict EventDict(const TrackResult& r, const TrackEvent& e) {
   d["time_s"] = e.time_s;
   d["after_s"] = e.previous_time_s;
   d["window"] = r.windows[e.window].label;
-  d["previous_window"] = r.windows[e.window - 1].label;
+  d["previous_window"] = r.windows[e.previous_window].label;
+  d["within_window"] = e.within_window;
   py::dict parameters;
   for (const TrackEventParameter& p : e.parameters) {
     py::dict q;

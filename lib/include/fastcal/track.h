@@ -34,7 +34,9 @@
 //              covariance from the sandwich (consecutive windows share b: their estimates
 //              are correlated, and the shared part cancels).
 // An event's time is the first sample of the later window (resolution: the window; the
-// last sample of the earlier one is given too).
+// last sample of the earlier one is given too), refined to a block of a window's samples
+// when the scan within it finds the step inside (a step inside a window shows as a change
+// on both sides of it: one event then, from the window before to the window after).
 //
 // Outputs in DIR (WriteTrack; formats in docs/calibration.md, "Tracking: files"):
 // track.csv, events.json, model_calibrated@WINDOW.yaml (the latest window, and one per
@@ -92,8 +94,10 @@ struct TrackOptions {
   DatasetReadOptions read;
   // Gauss-Newton iterations (each a fold of the windows that moved) at most.
   int max_iterations = 20;
-  // Converged when every parameter's step is below this fraction of its formal sigma.
-  double step_tolerance_sigmas = 0.01;
+  // Converged when every parameter's step is below this fraction of its formal sigma
+  // (then one more fold at the solution, with the consider parameters' columns: the
+  // estimates' change over it is of the order of the step squared).
+  double step_tolerance_sigmas = 0.05;
   // Each kind of event: the chance that noise alone reports any over the whole season.
   double false_alarm = 0.01;
   // Sensor steps fitted at most (binary segmentation).
@@ -151,9 +155,14 @@ struct TrackEventParameter {
 
 struct TrackEvent {
   std::string kind;              // "parameter" or "sensor"
-  double time_s = 0.0;           // the first sample of the later window
-  double previous_time_s = 0.0;  // the last sample of the earlier window
-  int window = 0;                // index of the later window
+  // The first sample of the later window, and the last of the earlier one; or, when the
+  // step is inside a window's telemetry (within_window), the first sample of the block
+  // where it is and the last of the block before.
+  double time_s = 0.0;
+  double previous_time_s = 0.0;
+  bool within_window = false;
+  int window = 0;           // index of the window the new value is first seen in
+  int previous_window = 0;  // index of the last window before the change
   std::vector<TrackEventParameter> parameters;
   std::vector<int> cables;  // 1-based, for a sensor event
   int degrees_of_freedom = 1;

@@ -103,9 +103,10 @@ struct WindowFold {
   Eigen::MatrixXd information;  // H (n x n)
   Eigen::VectorXd gradient;     // g (n)
   double chi_square = 0.0;      // c
-  // Per block, in time order: its samples, its score J^T r (blocks x n) and the rows of
+  // Per block, in time order: its samples, its first and last sample's time, its score J^T r (blocks x n) and the rows of
   // its information of the kWindow columns (per block p x n, p the kWindow columns in order).
   std::vector<long long> block_samples;
+  std::vector<double> block_first_time_s, block_last_time_s;
   Eigen::MatrixXd block_scores;
   std::vector<Eigen::MatrixXd> block_information;
   // Per cable, over the fitted readings: sum of (reading - measured)^2 (N^2) and count.

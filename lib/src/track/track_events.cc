@@ -92,7 +92,8 @@ TrackEvent SensorEvent(const TrackRun& run, int e0, int e, double threshold, int
   }
   int u = 0;
   while (u < static_cast<int>(run.used.size()) && run.entry_of[u][entry.column] != e) ++u;
-  TrackEvent event = EventAt(run, std::max(1, u), "sensor", d * d / std::max(variance, 1e-300), 1,
+  u = std::max(1, u);
+  TrackEvent event = EventAt(run, u - 1, u, "sensor", d * d / std::max(variance, 1e-300), 1,
                              threshold, tests);
   event.parameters.push_back(
       {s.name, s.unit, d / s.to_si, std::sqrt(std::max(variance, 0.0)) / s.to_si});
@@ -119,7 +120,141 @@ std::vector<std::vector<int>> WindowGroups(const TrackRun& run) {
   return groups;
 }
 
+
+// The Wald test of a group's change from used window `from` to `to` (later minus earlier,
+// its covariance from the sandwich and the consider part: the shared error cancels).
+struct GroupChange {
+  Eigen::VectorXd d;
+  Eigen::MatrixXd covariance;
+  double statistic = 0.0;
+};
+GroupChange Change(const TrackRun& run, const std::vector<int>& g, int from, int to) {
+  const int dof = static_cast<int>(g.size());
+  const Eigen::MatrixXd c = TotalCovariance(run, to, to) + TotalCovariance(run, from, from) -
+                            TotalCovariance(run, to, from) - TotalCovariance(run, from, to);
+  GroupChange out;
+  out.d.resize(dof);
+  out.covariance.resize(dof, dof);
+  for (int x = 0; x < dof; ++x) {
+    out.d[x] = run.solver.a(to)[g[x]] - run.solver.a(from)[g[x]];
+    for (int y = 0; y < dof; ++y) out.covariance(x, y) = c(g[x], g[y]);
+  }
+  out.statistic = out.d.dot(Eigen::LDLT<Eigen::MatrixXd>(out.covariance).solve(out.d));
+  return out;
+}
+
+// A step of group g within used window u's telemetry: the score test of "the group
+// differs from block j on", at the joint fit, over the window's block boundaries (the
+// fold's block scores and information rows, moved to the solution), judged against the
+// window's misfit alone (a step inside the window is what its block correlation shows).
+struct InnerStep {
+  double statistic = 0.0;
+  int block = -1;
+  int splits = 0;
+};
+InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& g) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  const int blocks = static_cast<int>(f.block_samples.size());
+  const int pg = static_cast<int>(g.size());
+  InnerStep best;
+  best.splits = std::max(0, blocks - 1);
+  if (blocks < 2) return best;
+  const std::vector<int> order = LocalOrder(run);
+  const std::vector<int>& wc = run.layout.window_columns;
+  const ArrowBlock& k = run.problem.blocks[u];
+  const Eigen::VectorXd d = StepOf(run, u);
+  Eigen::VectorXd score = Eigen::VectorXd::Zero(pg);
+  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pg, f.information.cols());
+  for (int j = blocks - 1; j >= 1; --j) {
+    for (int x = 0; x < pg; ++x) {
+      score[x] += f.block_scores(j, wc[g[x]]) + f.block_information[j].row(g[x]).dot(d);
+      cross.row(x) += f.block_information[j].row(g[x]);
+    }
+    Eigen::MatrixXd self(pg, pg);
+    for (int x = 0; x < pg; ++x) {
+      for (int y = 0; y < pg; ++y) self(x, y) = cross(x, wc[g[y]]);
+    }
+    ArrowVector c;
+    for (const ArrowBlock& other : run.problem.blocks) c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
+    c.b = Eigen::MatrixXd::Zero(run.problem.q, pg);
+    for (int x = 0; x < pg; ++x) {
+      for (int r = 0; r < k.p; ++r) c.a[u](r, x) = cross(x, order[r]);
+      for (int m = 0; m < k.m(); ++m) c.b(k.shared_index[m], x) += cross(x, order[k.p + m]);
+    }
+    const ArrowVector solved = run.solver.SolveFor(c);
+    const Eigen::MatrixXd schur =
+        self - c.a[u].transpose() * solved.a[u] - c.b.transpose() * solved.b;
+    const double t = score.dot(Eigen::LDLT<Eigen::MatrixXd>(schur).solve(score)) / run.birge[u];
+    if (std::isfinite(t) && t > best.statistic) {
+      best.statistic = t;
+      best.block = j;
+    }
+  }
+  return best;
+}
+
+// Whether the scan of window u found a step inside it (Bonferroni over its splits).
+bool Inside(const TrackRun& run, const InnerStep& step, int dof) {
+  return step.block > 0 &&
+         step.statistic > ChiSquareQuantile(run.options.false_alarm / step.splits, dof);
+}
+
+// The event's time refined to the block of window u where the step is (its first sample,
+// and the block before's last).
+void RefineTime(const TrackRun& run, int u, const InnerStep& step, TrackEvent* e) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  e->time_s = f.block_first_time_s[step.block];
+  e->previous_time_s = f.block_last_time_s[step.block - 1];
+  e->within_window = true;
+}
+
+// The events of group g: each change between consecutive windows beyond the threshold.
+// A step inside window u shows as a change on both sides of it: when window u's own scan
+// finds it, the two are one event (u - 1 to u + 1) at the step's block; a single change
+// is timed inside the window whose scan finds the step, else at the window's resolution.
+void GroupEvents(const TrackRun& run, const std::vector<int>& g, std::vector<TrackEvent>* out) {
+  const TrackResult& r = *run.result;
+  const int dof = static_cast<int>(g.size());
+  const int tests = std::max(1, r.parameter_tests);
+  const double threshold = ChiSquareQuantile(run.options.false_alarm / tests, dof);
+  const ParameterSpec& first = run.layout.Column(run.layout.window_columns[g[0]]);
+  const bool sensor =
+      first.kind == ParameterKind::kSensorBias || first.kind == ParameterKind::kSensorGain;
+  const int windows = static_cast<int>(run.used.size());
+  std::vector<bool> changed(windows, false);
+  for (int u = 1; u < windows; ++u) changed[u] = Change(run, g, u - 1, u).statistic > threshold;
+  for (int u = 1; u < windows; ++u) {
+    if (!changed[u]) continue;
+    int from = u - 1, to = u;
+    const InnerStep here = ScanWithin(run, u, g);
+    const bool both_sides = u + 1 < windows && changed[u + 1] && Inside(run, here, dof);
+    if (both_sides) {
+      to = u + 1;
+      changed[u + 1] = false;
+    }
+    const GroupChange change = Change(run, g, from, to);
+    TrackEvent e = EventAt(run, from, to, sensor ? "sensor" : "parameter", change.statistic, dof,
+                           threshold, tests);
+    if (both_sides || Inside(run, here, dof)) {
+      RefineTime(run, u, here, &e);
+      e.window = u;
+    } else if (const InnerStep before = ScanWithin(run, u - 1, g); Inside(run, before, dof)) {
+      RefineTime(run, u - 1, before, &e);
+      e.window = u - 1;
+    }
+    for (int x = 0; x < dof; ++x) {
+      const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[x]]);
+      e.parameters.push_back({s.name, s.unit, change.d[x] / s.to_si,
+                              std::sqrt(change.covariance(x, x)) / s.to_si});
+      if (sensor && s.index >= 0) e.cables.push_back(s.index + 1);
+    }
+    out->push_back(e);
+  }
+}
+
 }  // namespace
+
+namespace {
 
 // The entry of the same column just before entry e (the stretch before its step), or -1.
 int PreviousEntry(const TrackRun& run, int e) {
@@ -174,6 +309,8 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
   }
 }
 
+}  // namespace
+
 TrackStatus ScanSensorSteps(TrackRun& run) {
   const std::vector<int> columns = BiasColumns(run);
   const int boundaries = static_cast<int>(run.used.size()) - 1;
@@ -219,35 +356,7 @@ TrackStatus FindParameterEvents(TrackRun& run) {
   const std::vector<std::vector<int>> groups = WindowGroups(run);
   const int boundaries = static_cast<int>(run.used.size()) - 1;
   r.parameter_tests = static_cast<int>(groups.size()) * std::max(0, boundaries);
-  for (const std::vector<int>& g : groups) {
-    const int dof = static_cast<int>(g.size());
-    const double threshold =
-        ChiSquareQuantile(run.options.false_alarm / std::max(1, r.parameter_tests), dof);
-    const ParameterSpec& first = run.layout.Column(run.layout.window_columns[g[0]]);
-    const bool sensor =
-        first.kind == ParameterKind::kSensorBias || first.kind == ParameterKind::kSensorGain;
-    for (int u = 1; u <= boundaries; ++u) {
-      const Eigen::MatrixXd c = TotalCovariance(run, u, u) + TotalCovariance(run, u - 1, u - 1) -
-                                TotalCovariance(run, u, u - 1) - TotalCovariance(run, u - 1, u);
-      Eigen::VectorXd d(dof);
-      Eigen::MatrixXd cg(dof, dof);
-      for (int x = 0; x < dof; ++x) {
-        d[x] = run.solver.a(u)[g[x]] - run.solver.a(u - 1)[g[x]];
-        for (int y = 0; y < dof; ++y) cg(x, y) = c(g[x], g[y]);
-      }
-      const Eigen::LDLT<Eigen::MatrixXd> ldlt(cg);
-      const double t = d.dot(ldlt.solve(d));
-      if (!(t > threshold)) continue;
-      TrackEvent e =
-          EventAt(run, u, sensor ? "sensor" : "parameter", t, dof, threshold, r.parameter_tests);
-      for (int x = 0; x < dof; ++x) {
-        const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[x]]);
-        e.parameters.push_back({s.name, s.unit, d[x] / s.to_si, std::sqrt(cg(x, x)) / s.to_si});
-        if (sensor && s.index >= 0) e.cables.push_back(s.index + 1);
-      }
-      r.events.push_back(e);
-    }
-  }
+  for (const std::vector<int>& g : groups) GroupEvents(run, g, &r.events);
   std::stable_sort(r.events.begin(), r.events.end(),
                    [](const TrackEvent& a, const TrackEvent& b) { return a.time_s < b.time_s; });
   return TrackStatus::kOk;

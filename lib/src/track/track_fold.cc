@@ -184,6 +184,9 @@ bool FoldRowsInBlocks(const FoldTask& task, const internal::FittedSamples& sampl
         }
         fold->block_information.push_back(rows_of_window);
         fold->block_samples.push_back(part.rows.end - part.rows.begin);
+        const std::vector<Sample>& in = samples.data->samples;
+        fold->block_first_time_s.push_back(in[(*samples.fit)[part.rows.begin]].time_s);
+        fold->block_last_time_s.push_back(in[(*samples.fit)[part.rows.end - 1]].time_s);
         total = internal::FoldRows(total, part.r);
       },
       block);

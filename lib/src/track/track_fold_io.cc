@@ -62,9 +62,10 @@ class Reader {
     Raw(&v, sizeof(v));
     return v;
   }
+  // A count of items that each take at least one byte: no more than the bytes left.
   std::int64_t Count() {
     const std::int64_t v = Int();
-    if (v < 0 || v > kMaxCount) ok_ = false;
+    if (v < 0 || v > kMaxCount || v > static_cast<std::int64_t>(in_.size() - pos_)) ok_ = false;
     return ok_ ? v : 0;
   }
   double Real() {
@@ -285,6 +286,10 @@ std::string SerializeWindowFold(const WindowFold& f) {
   w.Real(f.chi_square);
   w.Int(static_cast<std::int64_t>(f.block_samples.size()));
   for (long long n : f.block_samples) w.Int(n);
+  for (size_t b = 0; b < f.block_samples.size(); ++b) {
+    w.Real(f.block_first_time_s[b]);
+    w.Real(f.block_last_time_s[b]);
+  }
   w.Matrix(f.block_scores);
   w.Int(static_cast<std::int64_t>(f.block_information.size()));
   for (const Eigen::MatrixXd& m : f.block_information) w.Matrix(m);
@@ -337,6 +342,12 @@ bool ParseWindowFold(const std::string& bytes, const std::string& source, Window
   f.chi_square = r.Real();
   f.block_samples.resize(r.Count());
   for (long long& n : f.block_samples) n = r.Int();
+  f.block_first_time_s.resize(f.block_samples.size());
+  f.block_last_time_s.resize(f.block_samples.size());
+  for (size_t b = 0; b < f.block_samples.size(); ++b) {
+    f.block_first_time_s[b] = r.Real();
+    f.block_last_time_s[b] = r.Real();
+  }
   f.block_scores = r.Matrix();
   f.block_information.resize(r.Count());
   for (Eigen::MatrixXd& m : f.block_information) m = r.Matrix();

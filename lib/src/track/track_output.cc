@@ -106,7 +106,8 @@ std::string EventsJson(const TrackResult& r) {
     j.Key("after").String(TrackTimeText(e.previous_time_s));
     j.Key("after_s").ExactNumber(e.previous_time_s);
     j.Key("window").String(r.windows[e.window].label);
-    j.Key("previous_window").String(r.windows[e.window - 1].label);
+    j.Key("previous_window").String(r.windows[e.previous_window].label);
+    j.Key("within_window").Bool(e.within_window);
     j.Key("kind").String(e.kind);
     j.Key("parameters").BeginObject();
     for (const TrackEventParameter& p : e.parameters) {
@@ -138,7 +139,11 @@ TrackStatus BuildModels(TrackRun& run) {
   const int windows = static_cast<int>(run.used.size());
   if (windows == 0) return TrackStatus::kOk;
   std::vector<bool> boundary(windows + 1, false);
-  for (const TrackEvent& e : r.events) boundary[e.window] = true;
+  for (const TrackEvent& e : r.events) {
+    boundary[e.window] = true;
+    // A step inside a window's telemetry: that window is a stretch of its own (mixed).
+    if (e.within_window) boundary[e.window + 1] = true;
+  }
   boundary[0] = boundary[windows] = true;
   const int p = static_cast<int>(run.layout.window_columns.size());
   for (int first = 0; first < windows;) {

@@ -98,6 +98,7 @@ struct TrackRun {
   // After the solve: per used window its widening f_w, and the consider parameters'
   // M^-1 C (C = J_x^T J_c) and sigmas (SI).
   std::vector<double> widening;
+  std::vector<double> birge;  // its misfit part alone
   // The shared entries split by the sensor-step scan in this run (indices into `shared`).
   std::vector<int> splits;
   ArrowVector consider_x;
@@ -132,6 +133,10 @@ bool LoadFold(const TrackRun& run, TrackWindowState* w, std::string* error);
 // Stages of track_solve.cc.
 void InitialPoints(TrackRun& run);
 TrackStatus Iterate(TrackRun& run, bool estimate_slow_error);
+// A last fold of the moving windows at the solution with the consider parameters'
+// columns too (the iterations fold without them: narrower derivatives, the same fit),
+// and the solve over it.
+TrackStatus FoldConsider(TrackRun& run);
 TrackStatus Uncertainties(TrackRun& run);
 // Used window u's solution minus its fold's point, per column (fold order).
 Eigen::VectorXd StepOf(const TrackRun& run, int u);

@@ -31,7 +31,9 @@ bool Moving(const TrackRun& run, const TrackWindowState& w) {
   return !run.update || run.options.refold_all || w.folded || !w.has_fold;
 }
 
-FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_run) {
+// The task of window w: its point over every column, or (without `consider`) over the
+// fitted columns alone, the consider parameters then fixed at their values.
+FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_run, bool consider) {
   FoldTask t;
   t.label = w.label;
   // Absolute: a worker of a Dask cluster may run in another directory.
@@ -41,14 +43,20 @@ FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_ru
   for (int f : w.files) t.files[f] = run.files[f].path;
   t.model_yaml = run.model_yaml;
   t.parameters = run.layout.parameters;
-  t.roles = run.layout.roles;
+  for (int k = 0; k < run.layout.size(); ++k) {
+    if (!consider && run.layout.roles[k] == FoldRole::kConsider) {
+      t.parameters[run.layout.spec_index[k]].free = false;
+      continue;
+    }
+    t.roles.push_back(run.layout.roles[k]);
+    t.theta_si.push_back(w.theta[k]);
+  }
   t.forward_model = run.spec.forward_model;
   t.tension_sigma_n = run.spec.tension_sigma_n;
   t.tension_sigma_percent = run.spec.tension_sigma_percent;
   t.detect_gross_errors = run.spec.detect_gross_errors;
   t.gross_error_threshold_sigmas = run.gross_threshold_sigmas;
   t.slow_error = run.slow;
-  t.theta_si = w.theta;
   t.blocks = run.options.blocks;
   t.residual_samples = residual_run;
   return t;
@@ -93,15 +101,58 @@ int ResidualRun(const TrackRun& run) {
   return std::clamp(run.options.slow_error_samples / used, kMinResidualRun, kMaxResidualRun);
 }
 
-// Folds every dirty used window at its point.
-bool FoldDirty(TrackRun& run) {
+// A fold without the consider columns laid out over every column: theirs zero (they are
+// used only after the final pass, which folds them). False when the fold is not of the
+// layout.
+bool ExpandToLayout(const TrackRun& run, WindowFold* f) {
+  const int n = run.layout.size();
+  const int m = static_cast<int>(f->columns.size());
+  if (m == n) return true;
+  std::vector<int> from(n, -1);  // layout column -> fold column
+  int next = 0;
+  for (int k = 0; k < n; ++k) {
+    if (run.layout.roles[k] == FoldRole::kConsider) continue;
+    if (next >= m || f->columns[next] != run.layout.Column(k).name) return false;
+    from[k] = next++;
+  }
+  if (next != m) return false;
+  WindowFold x = *f;
+  x.columns.clear();
+  x.roles = run.layout.roles;
+  x.theta_si.assign(n, 0.0);
+  x.information = Eigen::MatrixXd::Zero(n, n);
+  x.gradient = Eigen::VectorXd::Zero(n);
+  x.block_scores = Eigen::MatrixXd::Zero(f->block_scores.rows(), n);
+  for (Eigen::MatrixXd& rows : x.block_information) rows = Eigen::MatrixXd::Zero(rows.rows(), n);
+  for (int k = 0, c = 0; k < n; ++k) {
+    x.columns.push_back(run.layout.Column(k).name);
+    if (from[k] < 0) {
+      x.theta_si[k] = run.consider_si[c++];
+      continue;
+    }
+    x.theta_si[k] = f->theta_si[from[k]];
+    x.gradient[k] = f->gradient[from[k]];
+    x.block_scores.col(k) = f->block_scores.col(from[k]);
+    for (size_t b = 0; b < x.block_information.size(); ++b) {
+      x.block_information[b].col(k) = f->block_information[b].col(from[k]);
+    }
+    for (int l = 0; l < n; ++l) {
+      if (from[l] >= 0) x.information(k, l) = f->information(from[k], from[l]);
+    }
+  }
+  *f = std::move(x);
+  return true;
+}
+
+// Folds every dirty used window at its point (with the consider columns when `consider`).
+bool FoldDirty(TrackRun& run, bool consider = false) {
   std::vector<int> which;
   std::vector<std::string> tasks;
   const int residual_run = ResidualRun(run);
   for (int w : run.used) {
     if (!run.windows[w].dirty) continue;
     which.push_back(w);
-    tasks.push_back(SerializeFoldTask(TaskFor(run, run.windows[w], residual_run)));
+    tasks.push_back(SerializeFoldTask(TaskFor(run, run.windows[w], residual_run, consider)));
   }
   if (tasks.empty()) return true;
   run.Progress("folding " + std::to_string(tasks.size()) + " window" +
@@ -120,8 +171,7 @@ bool FoldDirty(TrackRun& run) {
     if (!ParseWindowFold(folds[k], "the fold of window " + w.label, &w.fold, run.error)) {
       return false;
     }
-    if (w.fold.theta_si != w.theta ||
-        w.fold.columns.size() != static_cast<size_t>(run.layout.size())) {
+    if (!ExpandToLayout(run, &w.fold) || w.fold.theta_si != w.theta) {
       *run.error = "the fold of window " + w.label + " is not of the task sent";
       return false;
     }
@@ -421,6 +471,22 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
   BuildProblem(run);
   if (!run.solver.Solve(run.problem))
     return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
+  return TrackStatus::kOk;
+}
+
+TrackStatus FoldConsider(TrackRun& run) {
+  if (run.layout.consider_columns.empty()) return TrackStatus::kOk;
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    TrackWindowState& w = run.windows[run.used[u]];
+    if (!Moving(run, w)) continue;
+    PointFromSolution(run, static_cast<int>(u), &w.theta);
+    w.dirty = true;
+  }
+  run.Progress("the consider parameters' columns, at the solution:");
+  if (!FoldDirty(run, true)) return TrackStatus::kInfeasible;
+  BuildProblem(run);
+  if (!run.solver.Solve(run.problem)) return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
+  for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
   return TrackStatus::kOk;
 }
 

@@ -133,6 +133,7 @@ TrackWindow WindowResult(const TrackRun& run, int u) {
 
 void ComputeWidening(TrackRun& run) {
   run.widening.assign(run.used.size(), 1.0);
+  run.birge.assign(run.used.size(), 1.0);
   for (size_t u = 0; u < run.used.size(); ++u) {
     const WindowFold& f = run.windows[run.used[u]].fold;
     const Eigen::VectorXd d = StepOf(run, static_cast<int>(u));
@@ -141,6 +142,7 @@ void ComputeWidening(TrackRun& run) {
     // The Birge ratio where the misfit is beyond the band, as the calibration's budget.
     double birge = 1.0;
     if (nu > 0.0 && chi2 / nu > 1.0 + 3.0 * std::sqrt(2.0 / nu)) birge = chi2 / nu;
+    run.birge[u] = birge;
     run.widening[u] = std::max(birge, BlockWidening(run, f, d));
     run.problem.blocks[u].scale = run.widening[u];
   }
