@@ -22,6 +22,7 @@
 #include <sstream>
 
 #include "cli_util.h"
+#include "columns_flag.h"
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration.h"
@@ -42,6 +43,8 @@
 DECLARE_string(model);
 DECLARE_string(method);
 DECLARE_bool(force);
+DECLARE_string(columns);
+DECLARE_string(sessions_at);
 DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
 DEFINE_string(data, "",
               "Measurement CSV (docs/data-format.md); several, comma-separated, are one "
@@ -68,6 +71,7 @@ const char kCalibrateHelp[] =
 
 Usage:
   fastcal calibrate --spec=SPEC.yaml --data=DATA.csv --out=DIR [--model=MODEL.yaml] [--force]
+                    [--columns=MAP.yaml] [--sessions-at=TIME,...]
 
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
   --spec=FILE         which parameters are free, initial values, priors (a fixed
@@ -79,6 +83,18 @@ Usage:
                       qw,qx,qy,qz), T1_kN..T6_kN, optional planned_*_deg, s0_*_m and
                       session (docs/data-format.md). --data=a.csv,b.csv: several
                       surveys, one session each, labelled by file name ("a", "b")
+  --columns=MAP.yaml  read --data as exported, through a column map (format
+                      fastcal-columns-1): source column names, units (mm, rad, N, tf...),
+                      time stamps (unix_s, unix_ms, iso8601 with a zone), delimiter,
+                      decimal comma, header line, unit row, extra channels
+                      (docs/data-format.md, "Column maps"); an .xlsx: Python's
+                      fastcal.read_dataset, or xlsx2csv first
+  --sessions-at=TIME[,TIME...]  cut one survey into sessions s1, s2, ... at these times (a
+                      sample at or after a time goes to the next): each a number in the
+                      data's time_s or an ISO 8601 date and time (without a zone, the
+                      column map's, else UTC); --sessions-at=DIR/summary.json takes the
+                      changes a previous run's change scan found. With a spec that says
+                      sessions: {separate: [...]} (calibration_data/spec_sessions.yaml)
   --out=DIR           output directory; must not exist or be empty. Written only when the
                       calibration succeeded: nothing is left behind on failure.
   --force             let --out be a previous run's results (only the files listed under
@@ -156,6 +172,8 @@ Usage:
                  default the nominal FAST model
   --data=FILE    telemetry export (docs/data-format.md); several, comma-separated, are
                  read together (one session each)
+  --columns=MAP.yaml  read --data as exported, through a column map (docs/data-format.md,
+                 "Column maps")
   --method=M     statics method: exact (default), aas-refined, aas
   --out=DIR      also write report.html, report.md, summary.json and residuals.csv
   --force        let --out be a previous evaluate's results, replaced when complete
@@ -402,7 +420,18 @@ bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   DatasetReadOptions read;
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   read.threads = kReadThreads;
-  return ReadSessionDatasets(paths, read, data, error);
+  if (!ColumnsFromFlag(&read.columns, error) || !ReadSessionDatasets(paths, read, data, error)) {
+    return false;
+  }
+  // --sessions-at: one survey cut into sessions at times.
+  std::vector<double> cuts;
+  if (!SessionCutsFromFlag(*data, &cuts, error)) return false;
+  if (cuts.empty()) return true;
+  if (!CutSessionsAt(cuts, data, error)) {
+    *error = "--sessions-at: " + *error;
+    return false;
+  }
+  return true;
 }
 
 // Lists the rows --skip-invalid-rows skipped (malformed, or a pose the model cannot solve)
@@ -498,7 +527,12 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
   }
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
             "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
-            report.data_digest + ")\nverdict: " + FitVerdictName(result.verdict) +
+            report.data_digest + ")" +
+            (report.columns_path.empty()
+                 ? ""
+                 : "\nread through the column map " + report.columns_path + " (sha256 " +
+                       report.columns_digest + ")") +
+            "\nverdict: " + FitVerdictName(result.verdict) +
             "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
             "budget):";
   for (const ParameterEstimate& p : result.parameters) {
@@ -917,6 +951,8 @@ ReportInputs ReportProvenance(int argc, char** argv, bool with_spec,
   report.model_path = FLAGS_model;
   report.data_path = FLAGS_data;
   report.model_digest = Digest(FLAGS_model);
+  report.columns_path = FLAGS_columns;
+  report.columns_digest = ColumnsDigest();
   report.data_digest = data_digest != nullptr ? *data_digest : DataDigest();
   if (with_spec) {
     report.spec_path = FLAGS_spec;
@@ -989,7 +1025,7 @@ int RunCalibrate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, command, kCalibrateHelp,
                     {"model", "spec", "data", "out", "skip-invalid-rows", "quiet", "force",
-                     "residuals-every", "timings"},
+                     "residuals-every", "timings", "columns", "sessions-at"},
                     &exit_code)) {
     return exit_code;
   }
@@ -1014,6 +1050,13 @@ int RunCalibrate(int argc, char** argv) {
     return kExitUsage;
   }
   const double read_s = watch.Lap();
+  if (!FLAGS_sessions_at.empty() && spec.separate_groups.empty()) {
+    std::cerr << "fastcal calibrate: note: --sessions-at cut the survey into "
+              << data.session_labels.size()
+              << " sessions, but the spec separates no parameter per session (sessions: "
+                 "{separate: [mass_centre_m]}, as calibration_data/spec_sessions.yaml): they "
+                 "are fitted as one\n";
+  }
   const CableRobot initial = InitialCalibrationModel(model, spec);
   const std::vector<StaticsMethod> methods = {StaticsMethod::kExact, spec.forward_model};
   if (FLAGS_skip_invalid_rows) {
@@ -1154,6 +1197,10 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
   options.method = method;
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   options.read.threads = kReadThreads;
+  if (!ColumnsFromFlag(&options.read.columns, &error)) {
+    PrintError(command, error);
+    return kExitUsage;
+  }
   StreamedEvaluation evaluation;
   const EvaluationStreamStatus status = evaluation.Run(model, paths, options, &error);
   if (status == EvaluationStreamStatus::kInvalidInput) {
@@ -1197,7 +1244,8 @@ int RunEvaluate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(
           argc, argv, command, kEvaluateHelp,
-          {"model", "data", "out", "method", "skip-invalid-rows", "force", "residuals-every"},
+          {"model", "data", "out", "method", "skip-invalid-rows", "force", "residuals-every",
+           "columns"},
           &exit_code)) {
     return exit_code;
   }

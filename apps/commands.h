@@ -21,6 +21,7 @@ int RunEvaluate(int argc, char** argv);
 int RunSimulate(int argc, char** argv);
 int RunWorkspace(int argc, char** argv);
 int RunDesign(int argc, char** argv);
+int RunImport(int argc, char** argv);
 int RunTrack(int argc, char** argv);
 
 // Positions of the trajectory `kind` (line, arc, grid, random) from the shared trajectory

@@ -32,6 +32,8 @@ Commands:
              (day) at a time as one joint fit, with the events (moves, re-zeroed sensors)
   design     the calibration survey that determines the wanted parameters best: poses,
              samples per pose and flight order, with predicted sigma_total
+  import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
+             comma), read through a column map, written as the canonical dataset CSV
 
 Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
 )";
@@ -60,6 +62,7 @@ int main(int argc, char** argv) {
     if (command == "simulate") return RunSimulate(argc, argv);
     if (command == "workspace") return RunWorkspace(argc, argv);
     if (command == "design") return RunDesign(argc, argv);
+    if (command == "import") return RunImport(argc, argv);
     if (command == "track") return RunTrack(argc, argv);
   } catch (const std::bad_alloc&) {
     // Outputs are written last and atomically: nothing is left behind.

@@ -24,6 +24,7 @@
 #include "fastcal/internal/quote.h"
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
+#include "fastcal/time_text.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/version.h"
 
@@ -83,7 +84,7 @@ DEFINE_string(session_shift_m, "",
 DEFINE_string(mass_centre_step, "",
               "simulate: mass centre steps T:dx,dy,dz (s: m), several joined by ';'.");
 DEFINE_int32(days, 0, "simulate: a season: the samples cut into N days, one session a day.");
-DEFINE_string(start, "", "simulate: time of the first sample (s; a Unix time for a season).");
+DEFINE_string(start, "", "simulate: time of the first sample (s, or ISO 8601).");
 DEFINE_string(sensor_step, "",
               "simulate: sensors re-zeroed: T:CABLE:DKN (s, 1..6, kN), several joined by ';'.");
 
@@ -153,7 +154,9 @@ Trajectory (--trajectory=, default circle):
   random  --samples=100 --max-off-axis-deg=40 --radial-spread=0 (m, off the sphere),
           positions drawn with --seed
   poses   --poses=FILE.csv: x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or
-          qw,qx,qy,qz (the planned attitudes); --poses alone implies this trajectory
+          qw,qx,qy,qz (the planned attitudes); --poses alone implies this trajectory;
+          --columns=MAP.yaml reads it as exported, through a column map
+          (docs/data-format.md, "Column maps")
 Planned attitude (--attitude-law): focal (default for trajectories: tilt z' toward
 --focal-centre=0,0,300 by --tilt-fraction=0.41 of the off-axis angle) or none (R = I).
 A --poses file keeps its own attitudes unless --attitude-law is given.
@@ -192,10 +195,11 @@ Sessions and steps of the mass centre (the cabin's structure changed):
                              first: each cable's bias moves by N(0, kN)
   --sensor-step=T:CABLE:DKN  one sensor re-zeroed: cable CABLE's bias moves by DKN kN at
                              time T (s) and stays; several joined by ';'
-A season (fastcal track): --start=T, the first sample's time (s; a Unix time, e.g.
-1714593600 for 2024-05-01T20:00:00Z), and --days=N, the samples cut into N sessions a day
+A season (fastcal track): --start=T, the first sample's time (s, or ISO 8601 such as
+2024-05-01T20:00:00Z, a zone-less one in UTC: Unix seconds), and --days=N, the samples cut into N sessions a day
 apart (each day's samples --interval-s apart from --start + k days; the slow errors
-decorrelate overnight; no session column). Steps' times T are in the same seconds.
+decorrelate overnight; no session column). Steps' times T are in the same seconds, or ISO
+8601 times.
 The truth model written out has the mass centre before any step and the first session's
 sensor biases; its header lists the steps and every session's biases.
 
@@ -233,7 +237,7 @@ Examples (the bundled datasets):
 
 // clang-format off
 const std::set<std::string> kFlags = {
-    "truth", "mass-centre", "sensor-gain", "sensor-bias-kn", "density-mismatch-pct", "method",
+    "truth", "columns", "mass-centre", "sensor-gain", "sensor-bias-kn", "density-mismatch-pct", "method",
     "trajectory", "nodes", "from", "to", "centre", "radius", "start-deg", "end-deg",
     "max-off-axis-deg", "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "samples",
     "radial-spread", "poses", "attitude-law", "tilt-fraction", "focal-centre",
@@ -306,14 +310,15 @@ bool SetStepsFromFlags(SimulationOptions* options, std::string* error) {
   std::stringstream list(FLAGS_mass_centre_step);
   std::string item;
   while (!FLAGS_mass_centre_step.empty() && std::getline(list, item, ';')) {
-    const size_t colon = item.find(':');
+    // The shift follows the last ':' (an ISO 8601 time has its own).
+    const size_t colon = item.rfind(':');
     MassCentreStep step;
     std::string why;
-    if (colon == std::string::npos || !ParseNumberItem(item.substr(0, colon), &step.time_s, &why) ||
+    if (colon == std::string::npos || !ParseTimeValue(item.substr(0, colon), 0, &step.time_s, &why) ||
         !ParseVector3("mass-centre-step", item.substr(colon + 1), &step.shift_m, error)) {
       *error =
-          "--mass-centre-step needs T:dx,dy,dz (time in s, shift in m), several joined by "
-          "';', got " +
+          "--mass-centre-step needs T:dx,dy,dz (time in s or ISO 8601, shift in m), several "
+          "joined by ';', got " +
           internal::Quote(item) + (why.empty() ? "" : ": " + why);
       return false;
     }
@@ -325,12 +330,15 @@ bool SetStepsFromFlags(SimulationOptions* options, std::string* error) {
   }
   std::stringstream sensors(FLAGS_sensor_step);
   while (!FLAGS_sensor_step.empty() && std::getline(sensors, item, ';')) {
-    const size_t first = item.find(':'), second = item.find(':', first + 1);
+    // CABLE and DKN follow the last two ':' (an ISO 8601 time has its own).
+    const size_t second = item.rfind(':');
+    const size_t first = second == std::string::npos || second == 0 ? std::string::npos
+                                                                     : item.rfind(':', second - 1);
     SensorBiasStep step;
     double cable = 0.0, shift_kn = 0.0;
     std::string why;
-    if (second == std::string::npos ||
-        !ParseNumberItem(item.substr(0, first), &step.time_s, &why) ||
+    if (first == std::string::npos ||
+        !ParseTimeValue(item.substr(0, first), 0, &step.time_s, &why) ||
         !ParseNumberItem(item.substr(first + 1, second - first - 1), &cable, &why) ||
         !ParseNumberItem(item.substr(second + 1), &shift_kn, &why) || cable < 1 ||
         cable > kNumCables || cable != std::floor(cable)) {
@@ -412,9 +420,9 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->sensor_rezero_kn = FLAGS_sensor_rezero_kn;
   if (!FLAGS_start.empty()) {
     std::string why;
-    if (!ParseNumberItem(FLAGS_start, &options->start_time_s, &why)) {
+    if (!ParseTimeValue(FLAGS_start, 0, &options->start_time_s, &why)) {
       *error = "--start=" + internal::Quote(FLAGS_start) +
-               ": give the first sample's time in s (a Unix time for a season): " + why;
+               ": give the first sample's time in s or ISO 8601 (2024-05-01T20:00:00Z): " + why;
       return false;
     }
   }
@@ -681,6 +689,10 @@ std::string Summary(const SimulationSummary& s, const SimulationOptions& options
 int RunSimulate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+  if (FlagGiven("columns") && FLAGS_poses.empty()) {
+    PrintError(kCommand, "--columns applies to --poses=FILE (a pose file read as exported)");
+    return kExitUsage;
+  }
 
   if (FLAGS_out.empty() || FLAGS_out == "-") {
     PrintError(kCommand, "give --out=FILE.csv (the truth model goes beside it)");

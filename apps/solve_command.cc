@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_util.h"
+#include "columns_flag.h"
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/csv.h"
@@ -108,6 +109,9 @@ Trajectories:
   --poses=FILE.csv  x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz,
           time_s; a dataset's other columns (planned_*_deg, T<i>_kN, s0_<i>_m) are
           ignored, so a calibration dataset works; any other column is an error
+  --columns=MAP.yaml  read --poses as exported, through a column map (x_m, y_m, z_m, the
+          attitude and time as the map names them, in its units; docs/data-format.md,
+          "Column maps")
 
 Method (--method):
   exact        (default) the coupled Newton solution to --exact-tolerance=1e-12; where its
@@ -172,6 +176,7 @@ Examples:
 )";
 
 const std::set<std::string> kFlags = {"model",
+                                      "columns",
                                       "method",
                                       "position",
                                       "rpy",
@@ -287,7 +292,12 @@ bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
 bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitude_law,
                               const FocalAttitudeLaw& law, std::vector<Pose>* poses,
                               std::string* error) {
-  if (!ReadPosesCsv(path, poses, nullptr, error)) return false;
+  std::shared_ptr<const ColumnMap> columns;  // --columns: the file as exported
+  if (!ColumnsFromFlag(&columns, error)) return false;
+  if (columns != nullptr ? !ReadPosesCsv(path, *columns, poses, nullptr, error)
+                         : !ReadPosesCsv(path, poses, nullptr, error)) {
+    return false;
+  }
   if (attitude_law == "focal") {
     std::vector<Eigen::Vector3d> positions;
     for (const Pose& p : *poses) positions.push_back(p.position_m);
@@ -834,6 +844,10 @@ std::string TimingLine(const char* name, const Run& run, size_t n, bool warm) {
 int RunSolve(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+  if (FlagGiven("columns") && FLAGS_poses.empty()) {
+    PrintError(kCommand, "--columns applies to --poses=FILE (a pose file read as exported)");
+    return kExitUsage;
+  }
 
   std::string error;
   if (!CheckCanWrite("output", FLAGS_output, FLAGS_force, &error)) {

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "cli_util.h"
+#include "columns_flag.h"
 #include "commands.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/internal/number_text.h"
@@ -43,6 +44,7 @@ const char kHelp[] =
 
 Usage:
   fastcal track --spec=SPEC.yaml --data=DIR_OR_FILES --out=DIR [--window=1d] [--model=MODEL.yaml]
+                [--columns=MAP.yaml]
 
   --spec=FILE         the calibration spec; its sessions.separate groups are fitted per
                       window, every other free parameter once for all windows
@@ -56,6 +58,9 @@ Usage:
   --window=1d         windows: a calendar day in UTC (1d), another duration aligned to
                       1970-01-01T00:00Z (12h, 30m, 3600s, 7d), or 'file' (one per file)
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
+  --columns=MAP.yaml  read every data file as exported, through a column map (ISO 8601
+                      times, units, delimiters: docs/data-format.md, "Column maps"); an
+                      update must use the same map
   --threads=2         windows folded at once
   --min-window-samples=100  windows with fewer samples are left out (and named)
   --false-alarm=0.01  each kind of event: the chance that noise alone reports any over
@@ -98,7 +103,7 @@ Exit codes: 0 the track was written, 1 the fit failed (a pose the model cannot s
 parameters undetermined), 2 bad input. Python: fastcal.track (also on a Dask cluster).
 
 Example:
-  fastcal simulate --trajectory=random --days=10 --hours-per-day=1 --interval-s=2 \
+  fastcal simulate --trajectory=random --samples=18000 --days=10 --interval-s=2 \
       --start=2024-05-01T20:00:00Z --mass-centre-step=2024-05-05T20:00:00Z:0.05,0,0 \
       --sensor-step=2024-05-08T20:00:00Z:3:5 --out=season.csv
   fastcal track --spec=calibration_data/spec_track.yaml --data=season.csv --out=track
@@ -182,7 +187,8 @@ int RunTrack(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp,
                     {"model", "spec", "data", "out", "window", "threads", "refold", "force",
-                     "quiet", "skip-invalid-rows", "min-window-samples", "false-alarm"},
+                     "quiet", "skip-invalid-rows", "min-window-samples", "false-alarm",
+                     "columns"},
                     &exit_code)) {
     return exit_code;
   }
@@ -212,6 +218,7 @@ int RunTrack(int argc, char** argv) {
   options.min_window_samples = FLAGS_min_window_samples;
   options.false_alarm = FLAGS_false_alarm;
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
+  if (!ColumnsFromFlag(&options.read.columns, &error)) return usage(error);
   if (!FLAGS_quiet) {
     options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
   }

@@ -6,9 +6,13 @@ set -euo pipefail
 packages=(cmake g++ make libceres-dev libeigen3-dev libgflags-dev libgoogle-glog-dev
           libyaml-cpp-dev libgtest-dev libbenchmark-dev
           libssl-dev  # libcrypto: SHA-256 of the input files (provenance)
+          libhowardhinnant-date-dev  # date/date.h: ISO 8601 time stamps of column maps
           # The Python module: pybind11's headers and CMake package, Python's headers,
           # NumPy; pytest runs its tests, matplotlib the plot of docs/python.md.
           pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib
+          # Optional at run time: .xlsx exports (openpyxl) and DataFrames (pandas) in
+          # fastcal.read_dataset / Dataset.from_dataframe; installed so their tests run.
+          python3-openpyxl python3-pandas
           # fastcal.track(client=...): each window's fold a task on a Dask cluster (its
           # tests run a two-worker LocalCluster on the loopback interface).
           python3-dask python3-distributed

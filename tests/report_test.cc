@@ -728,7 +728,8 @@ TEST_F(ReportTest, JsonIsWellFormedWithTheSummary) {
   EXPECT_TRUE(Contains(json, "\"data_only\": {"));
   EXPECT_TRUE(Contains(json,
                        "\"samples\": {\n    \"total\": 20,\n    \"fitted\": 16,\n"
-                       "    \"held_out\": 4,\n    \"skipped\": 0,\n    \"skipped_rows\": []\n"))
+                       "    \"held_out\": 4,\n    \"skipped\": 0,\n    \"skipped_rows\": [],\n"
+                       "    \"time_first_s\": "))
       << json;
   EXPECT_TRUE(Contains(json, "null"));  // the NaN statistic
   EXPECT_TRUE(NonFiniteWords(json).empty());

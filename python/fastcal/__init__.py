@@ -336,24 +336,263 @@ def quat_from_rpy_deg(rpy_deg: ArrayLike) -> np.ndarray:
     return quat[0] if single else quat
 
 
-def read_dataset(
-    path: Union[PathLike, Sequence[PathLike]], skip_invalid_rows: bool = False
-) -> Dataset:
-    """Reads a telemetry CSV (docs/data-format.md), or several as one session each.
+_DICT_COLUMNS = "columns (dict)"
+_SPREADSHEET_SUFFIXES = (".xlsx", ".xlsm")
+ColumnsLike = Union[PathLike, Mapping[str, Any]]
 
-    With a list of paths, the files are merged, one session per file labelled by its
-    name without directory and extension (a file with a `session` column keeps its
-    labels); Dataset.session_labels and Dataset.session say which sample is whose.
-    With skip_invalid_rows, a row with a bad value is left out and listed in
-    Dataset.skipped instead of raising. Raises InputError naming the file, line and
-    column, e.g. "data.csv:12: column 'T3_kN': 'abc' is not a number", or two files
-    with the same label.
+
+def _columns_argument(columns: Optional[ColumnsLike]) -> Tuple[str, str]:
+    """A column map as (YAML text, name for messages): a file's text, or a dict as JSON
+    (which is YAML); ("", "") for none."""
+    if columns is None:
+        return "", ""
+    if isinstance(columns, Mapping):
+        return json.dumps(columns, indent=1), _DICT_COLUMNS
+    path = os.fspath(columns)
+    with open(path, encoding="utf-8") as f:  # FileNotFoundError as open() gives it
+        return f.read(), path
+
+
+def _map_errors(call: Any) -> Any:
+    """Runs call(); a dict column map's messages name its key path (a dict has no lines)."""
+    try:
+        return call()
+    except InputError as error:
+        message = re.sub(rf"{re.escape(_DICT_COLUMNS)}:\d+: ", f"{_DICT_COLUMNS}: ", str(error))
+        raise InputError(message) from None
+
+
+def _cell_text(value: Any, decimal: str) -> str:
+    """A spreadsheet cell as the text a CSV export would hold."""
+    import datetime
+
+    if value is None:
+        return ""
+    if isinstance(value, bool):
+        return "1" if value else "0"
+    if isinstance(value, int):
+        return str(value)
+    if isinstance(value, float):
+        text = repr(value)
+        return text.replace(".", ",") if decimal == "," else text
+    if isinstance(value, datetime.datetime):
+        return value.isoformat(sep=" ")
+    if isinstance(value, (datetime.date, datetime.time)):
+        return value.isoformat()
+    return str(value)
+
+
+def _spreadsheet_text(path: str, sheet: Optional[Union[str, int]], decimal: str) -> Tuple[str, str]:
+    """The rows of a sheet of an .xlsx workbook as CSV text, one line per sheet row (so
+    messages name the sheet's row numbers), and the source name for messages."""
+    import csv
+    import io
+
+    try:
+        import openpyxl
+    except ImportError:
+        raise ImportError(
+            f"{path}: reading an .xlsx workbook needs openpyxl, which is not installed: "
+            "apt-get install python3-openpyxl (Debian), or convert the sheet to CSV with "
+            f"xlsx2csv {path} export.csv (Debian package xlsx2csv) and read that"
+        ) from None
+    if not os.path.exists(path):
+        raise FileNotFoundError(2, "No such file or directory", path)
+    book = openpyxl.load_workbook(path, read_only=True, data_only=True)
+    try:
+        if sheet is None:
+            ws = book.worksheets[0]
+        elif isinstance(sheet, int):
+            if not 0 <= sheet < len(book.worksheets):
+                raise InputError(
+                    f"{path}: no sheet {sheet} (the workbook has {len(book.worksheets)}: "
+                    f"{', '.join(book.sheetnames)})"
+                )
+            ws = book.worksheets[sheet]
+        else:
+            if sheet not in book.sheetnames:
+                raise InputError(
+                    f"{path}: no sheet {sheet!r} (sheets: {', '.join(book.sheetnames)})"
+                )
+            ws = book[sheet]
+        rows = [list(r) for r in ws.iter_rows(values_only=True)]
+        name = ws.title
+    finally:
+        book.close()
+    width = 0
+    for r in rows:
+        for k in range(len(r) - 1, -1, -1):
+            if r[k] is not None:
+                width = max(width, k + 1)
+                break
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    for r in rows:
+        if all(v is None for v in r):
+            out.write("\n")  # a blank row stays a (blank) line: row numbers hold
+            continue
+        cells = [_cell_text(v, decimal) for v in r[:width]]
+        cells += [""] * (width - len(cells))
+        writer.writerow(cells)
+    return out.getvalue(), f"{path}[{name}]"
+
+
+def read_dataset(
+    path: Union[PathLike, Sequence[PathLike]],
+    skip_invalid_rows: bool = False,
+    columns: Optional[ColumnsLike] = None,
+    sheet: Optional[Union[str, int]] = None,
+) -> Dataset:
+    """Reads telemetry (docs/data-format.md): a canonical CSV, an export through a
+    column map, or a sheet of an .xlsx workbook; or several files as one session each.
+
+    Args:
+        path: a file, or a list of files (merged, one session per file labelled by its
+            name without directory and extension; a file with a `session` column keeps
+            its labels; Dataset.session_labels and Dataset.session say which sample is
+            whose).
+        skip_invalid_rows: leave out a row with a bad value, listed in Dataset.skipped,
+            instead of raising.
+        columns: a column map (format fastcal-columns-1, docs/data-format.md, "Column
+            maps"): its file, or the same content as a dict, e.g.
+            {"format": "fastcal-columns-1", "time": {"column": "SysTime", "format":
+            "iso8601", "zone": "+08:00"}, "columns": {"x_m": {"column": "X", "unit":
+            "mm"}, ...}, "unmapped": "ignore"}. None: the canonical columns.
+        sheet: for an .xlsx workbook (read with openpyxl, python3-openpyxl), the sheet's
+            name or 0-based index; None: the first. Its rows are read as a CSV export's
+            lines (row numbers in messages are the sheet's), with the map's header_line,
+            skip_after_header, units and time stamps; date cells are read as dates and
+            times in the map's zone.
+
+    Raises InputError naming the file (the sheet), line (row) and column, e.g.
+    "data.csv:12: column 'T3_kN': 'abc' is not a number" or, through a map,
+    "export.csv:12: column 'CableForce3' (T3_kN, N): 'abc' is not a number"; the map's
+    own errors name its key and line; ImportError for an .xlsx without openpyxl.
     """
     if isinstance(path, (str, bytes, os.PathLike)):
         paths = [os.fspath(path)]
     else:
         paths = [os.fspath(p) for p in path]
-    return _fastcal.read_dataset(paths, skip_invalid_rows)
+    map_text, map_source = _columns_argument(columns)
+    for p in paths:
+        if str(p).lower().endswith((".xls", ".ods")):
+            raise InputError(
+                f"{p}: an .xls or .ods workbook: save it as .xlsx (read here, with "
+                "openpyxl) or export the sheet as CSV"
+            )
+    spreadsheets = [p for p in paths if str(p).lower().endswith(_SPREADSHEET_SUFFIXES)]
+    if spreadsheets:
+        if len(paths) > 1:
+            raise InputError(
+                "read_dataset: a workbook is read on its own; read each and merge as CSV "
+                "(Dataset.save), or give CSV files"
+            )
+        decimal = "."
+        if map_text:
+            decimal = _map_errors(lambda: _fastcal.column_map_decimal(map_text, map_source))
+        text, source = _spreadsheet_text(paths[0], sheet, decimal)
+        return _map_errors(
+            lambda: _fastcal.parse_dataset(
+                text, source, skip_invalid_rows, map_text, map_source, False
+            )
+        )
+    if sheet is not None:
+        raise InputError(f"read_dataset: sheet= is for an .xlsx workbook, not {paths[0]}")
+    return _map_errors(
+        lambda: _fastcal.read_dataset(paths, skip_invalid_rows, map_text, map_source)
+    )
+
+
+def _dataset_from_arrays(
+    time_s: ArrayLike,
+    position_m: ArrayLike,
+    tension_kN: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    planned_rpy_deg: Optional[ArrayLike] = None,
+    s0_m: Optional[ArrayLike] = None,
+    session: Optional[Sequence[str]] = None,
+    skip_invalid_rows: bool = False,
+) -> Dataset:
+    """A Dataset from numpy arrays, checked as a file is read (docs/data-format.md).
+
+    Args:
+        time_s: (n,) seconds (any epoch, or Unix seconds: times >= 1e8 s are shown as
+            dates and times, UTC).
+        position_m: (n, 3) measured position; tension_kN: (n, 6) measured tensions.
+        rpy_deg: (n, 3) measured roll, pitch, yaw (deg), or quat: (n, 4) w, x, y, z;
+            one of the two.
+        planned_rpy_deg: (n, 3), optional; s0_m: (n, 6) unstretched lengths, optional.
+        session: n labels (letters, digits, '-', '_'), optional.
+        skip_invalid_rows: leave bad rows out (Dataset.skipped) instead of raising.
+
+    The same checks as the file reader (finite values, plausible positions, angles and
+    tensions, unit quaternions, attitudes in radians): a bad value raises InputError
+    naming the row (1-based) and the column, "arrays, row 3: column 'T2_kN': -5 kN is
+    negative: a tension reading is >= 0". Dataset.line is the 1-based row.
+    """
+    t = np.asarray(time_s, dtype=np.float64).reshape(-1)
+    n = t.shape[0]
+    parts: List[Tuple[List[str], np.ndarray]] = [(["time_s"], t.reshape(n, 1))]
+
+    def add(names: List[str], value: Optional[ArrayLike], label: str) -> None:
+        if value is None:
+            return
+        array = np.asarray(value, dtype=np.float64)
+        if array.ndim == 1 and len(names) > 1 and array.shape[0] == len(names) and n != len(names):
+            array = np.broadcast_to(array, (n, len(names)))
+        if array.shape != (n, len(names)):
+            raise InputError(
+                f"from_arrays: {label} must have shape ({n}, {len(names)}), got {array.shape}"
+            )
+        parts.append((names, array))
+
+    add(["x_m", "y_m", "z_m"], position_m, "position_m")
+    if rpy_deg is not None and quat is not None:
+        raise InputError("from_arrays: give rpy_deg or quat, not both")
+    if rpy_deg is None and quat is None:
+        raise InputError("from_arrays: the measured attitude is needed: rpy_deg or quat")
+    add(["roll_deg", "pitch_deg", "yaw_deg"], rpy_deg, "rpy_deg")
+    add(["qw", "qx", "qy", "qz"], quat, "quat")
+    add(["planned_roll_deg", "planned_pitch_deg", "planned_yaw_deg"], planned_rpy_deg,
+        "planned_rpy_deg")
+    add([f"T{i}_kN" for i in range(1, 7)], tension_kN, "tension_kN")
+    add([f"s0_{i}_m" for i in range(1, 7)], s0_m, "s0_m")
+    names = [name for group, _ in parts for name in group]
+    values = np.ascontiguousarray(np.hstack([a for _, a in parts]))
+    labels = [] if session is None else [str(s) for s in session]
+    text = _fastcal.canonical_text(names, values, labels)
+    return _fastcal.parse_dataset(text, "arrays", skip_invalid_rows, "", "", True)
+
+
+def _dataset_from_dataframe(
+    df: Any, columns: Optional[ColumnsLike] = None, skip_invalid_rows: bool = False
+) -> Dataset:
+    """A Dataset from a pandas DataFrame, checked as a file is read.
+
+    Without `columns` the DataFrame's columns are fastcal's (time_s, x_m, ..., T6_kN,
+    optionally session, docs/data-format.md); with a column map (a file or a dict,
+    read_dataset) they are the export's, named and converted by the map (its
+    header_line, skip_after_header and decimal do not apply: a DataFrame has its names
+    and its numbers). Datetime columns are read as dates and times (the map's zone when
+    they have none). Messages name the row (1-based, in the DataFrame's order) and the
+    column: "DataFrame, row 3: column 'CableForce2' (T2_kN, N): ...".
+    """
+    map_text, map_source = _columns_argument(columns)
+    frame = df.reset_index(drop=True) if hasattr(df, "reset_index") else df
+    try:
+        text = frame.to_csv(index=False, lineterminator="\n")
+    except TypeError:  # pandas before 1.5
+        text = frame.to_csv(index=False, line_terminator="\n")
+    return _map_errors(
+        lambda: _fastcal.parse_dataset(
+            text, "DataFrame", skip_invalid_rows, map_text, map_source, True
+        )
+    )
+
+
+Dataset.from_arrays = staticmethod(_dataset_from_arrays)  # type: ignore[attr-defined]
+Dataset.from_dataframe = staticmethod(_dataset_from_dataframe)  # type: ignore[attr-defined]
 
 
 def simulate(
@@ -739,6 +978,7 @@ def track(
     threads: int = 2,
     refold: bool = False,
     force: bool = False,
+    columns: Optional[ColumnsLike] = None,
 ) -> TrackResult:
     """The mass centre and the sensors through a season of telemetry (`fastcal track`).
 
@@ -765,6 +1005,8 @@ def track(
         threads: windows folded at once without a client.
         refold: on an update, refold every window (as a fresh track would).
         force: `out` holds a track of another model, spec or windowing: build it afresh.
+        columns: a column map (a file or a dict, as read_dataset takes) through which
+            every data file is read: an export as it comes, ISO 8601 times included.
 
     Raises:
         InputError: bad data, spec, window or directory. CalibrationError: a pose the
@@ -785,8 +1027,11 @@ def track(
             futures = dask_client.map(_fold_task, tasks, pure=False)
             return dask_client.gather(futures)
 
-    raw = _fastcal.track(
-        model, spec_text, is_text, source, paths, os.fspath(out), window, threads, refold,
-        force, fold_many,
+    map_text, map_source = _columns_argument(columns)
+    raw = _map_errors(
+        lambda: _fastcal.track(
+            model, spec_text, is_text, source, paths, os.fspath(out), window, threads, refold,
+            force, map_text, map_source, fold_many,
+        )
     )
     return TrackResult(raw, os.fspath(out))

@@ -12,12 +12,14 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <system_error>
 #include <utility>
 #include <vector>
 
+#include "fastcal/column_map.h"
 #include "fastcal/pose.h"
 
 namespace fastcal::python {
@@ -72,6 +74,15 @@ DoubleArray NewArray(const std::vector<py::ssize_t>& shape);
 // the row of a non-unit quaternion.
 std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::string& attitude_kind,
                                   const DoubleArray& attitude);
+
+// The column map of `map_text` (YAML; "" for none: null), named `map_source` in messages
+// (InputError otherwise). `csv_layout` (for text the module wrote itself from a
+// spreadsheet or a DataFrame): fields separated by ',' with RFC 4180 quotes;
+// `header_first` also puts the names on the first line with nothing skipped after them
+// (a DataFrame's).
+std::shared_ptr<const ColumnMap> MapOrThrow(const std::string& map_text,
+                                            const std::string& map_source, bool csv_layout,
+                                            bool header_first);
 
 void BindModel(py::module_& m);
 void BindStatics(py::module_& m);

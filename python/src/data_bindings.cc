@@ -2,12 +2,16 @@
 // (simulation.h).
 #include <pybind11/stl.h>
 
+#include <charconv>
+#include <cmath>
+#include <memory>
 #include <string>
 #include <tuple>
 #include <vector>
 
 #include "bindings.h"
 #include "fastcal/cable_robot.h"
+#include "fastcal/column_map.h"
 #include "fastcal/dataset.h"
 #include "fastcal/sessions.h"
 #include "fastcal/simulation.h"
@@ -126,10 +130,32 @@ py::dict SummaryDict(const SimulationSummary& s) {
   return d;
 }
 
+}  // namespace
+
+std::shared_ptr<const ColumnMap> MapOrThrow(const std::string& map_text,
+                                            const std::string& map_source, bool csv_layout,
+                                            bool header_first) {
+  if (map_text.empty()) return nullptr;
+  auto map = std::make_shared<ColumnMap>();
+  std::string error;
+  if (!ParseColumnMap(map_text, map_source, map.get(), &error)) throw InputError(error);
+  if (csv_layout) map->delimiter = ',';
+  if (header_first) {
+    map->header_line = 1;
+    map->skip_after_header = 0;
+    map->decimal = '.';
+  }
+  return map;
+}
+
+namespace {
+
 // One file, or several merged as one session each (sessions.h).
-Dataset ReadDatasetOrThrow(const std::vector<std::string>& paths, bool skip_invalid_rows) {
+Dataset ReadDatasetOrThrow(const std::vector<std::string>& paths, bool skip_invalid_rows,
+                           const std::string& map_text, const std::string& map_source) {
   DatasetReadOptions options;
   options.skip_invalid_rows = skip_invalid_rows;
+  options.columns = MapOrThrow(map_text, map_source, false, false);
   Dataset data;
   std::string error;
   bool ok = false;
@@ -156,6 +182,8 @@ the order of their first sample, empty without; session (n,) each sample's index
       .def_readonly("path", &Dataset::path)
       .def_readonly("skipped", &Dataset::skipped)
       .def_readonly("session_labels", &Dataset::session_labels)
+      .def_readonly("time_offset_s", &Dataset::time_offset_s,
+                    "The zone its times are shown in (the column map's), seconds east of UTC.")
       .def_property_readonly("session",
                              [](const Dataset& d) {
                                py::array_t<int> out(static_cast<py::ssize_t>(d.samples.size()));
@@ -254,11 +282,95 @@ py::tuple SimulateFromArrays(const CableRobot& truth, const DoubleArray& positio
   return py::make_tuple(data, truth_used, SummaryDict(summary));
 }
 
+// A dataset from text the module wrote (a spreadsheet's rows, a DataFrame), read as a
+// file is: ParseDataset with the map (if any).
+Dataset ParseDatasetOrThrow(const std::string& text, const std::string& source_name,
+                            bool skip_invalid_rows, const std::string& map_text,
+                            const std::string& map_source, bool header_first) {
+  DatasetReadOptions options;
+  options.skip_invalid_rows = skip_invalid_rows;
+  options.columns = MapOrThrow(map_text, map_source, true, header_first);
+  Dataset data;
+  std::string error;
+  bool ok = false;
+  {
+    py::gil_scoped_release release;
+    ok = ParseDataset(text, source_name, options, &data, &error);
+  }
+  if (!header_first) {
+    if (!ok) throw InputError(error);
+    return data;
+  }
+  // Arrays and DataFrames: rows numbered from 1 after the names, not lines.
+  const auto rows = [&source_name](const std::string& message) {
+    const std::string prefix = source_name + ":";
+    if (message.compare(0, prefix.size(), prefix) != 0) return message;
+    size_t end = prefix.size();
+    int line = 0;
+    while (end < message.size() && message[end] >= '0' && message[end] <= '9') {
+      line = line * 10 + (message[end++] - '0');
+    }
+    if (end == prefix.size()) return message;
+    return source_name + (line <= 1 ? ", columns" : ", row " + std::to_string(line - 1)) +
+           message.substr(end);
+  };
+  if (!ok) throw InputError(rows(error));
+  for (Sample& s : data.samples) s.line -= 1;
+  for (std::string& why : data.skipped) why = rows(why);
+  return data;
+}
+
+// The canonical CSV text of columns of numbers (`names`, values (n, k), each with the
+// fewest digits that read back to the same double) and optional session labels per
+// row, for Dataset.from_arrays: read by ParseDataset, so checked as a file is.
+std::string CanonicalText(const std::vector<std::string>& names, const DoubleArray& values,
+                          const std::vector<std::string>& sessions) {
+  const auto v = values.unchecked<2>();
+  const py::ssize_t n = v.shape(0), k = v.shape(1);
+  if (k != static_cast<py::ssize_t>(names.size())) {
+    throw InputError("from_arrays: " + std::to_string(k) + " columns of values for " +
+                     std::to_string(names.size()) + " names");
+  }
+  if (!sessions.empty() && static_cast<py::ssize_t>(sessions.size()) != n) {
+    throw InputError("from_arrays: session has " + std::to_string(sessions.size()) +
+                     " labels for " + std::to_string(n) + " rows");
+  }
+  std::string text;
+  for (size_t c = 0; c < names.size(); ++c) text += (c ? "," : "") + names[c];
+  if (!sessions.empty()) text += ",session";
+  text += "\n";
+  text.reserve(text.size() + static_cast<size_t>(n * k) * 20);
+  char buffer[64];
+  for (py::ssize_t r = 0; r < n; ++r) {
+    for (py::ssize_t c = 0; c < k; ++c) {
+      if (c > 0) text += ',';
+      const double x = v(r, c);
+      if (std::isfinite(x)) {
+        const auto result = std::to_chars(buffer, buffer + sizeof(buffer), x);
+        text.append(buffer, result.ptr);
+      } else {
+        text += std::isnan(x) ? "nan" : x > 0 ? "inf" : "-inf";
+      }
+    }
+    if (!sessions.empty()) text += "," + sessions[static_cast<size_t>(r)];
+    text += '\n';
+  }
+  return text;
+}
+
 }  // namespace
 
 void BindData(py::module_& m) {
   BindDatasetClass(m);
-  m.def("read_dataset", &ReadDatasetOrThrow, py::arg("paths"), py::arg("skip_invalid_rows"));
+  m.def("read_dataset", &ReadDatasetOrThrow, py::arg("paths"), py::arg("skip_invalid_rows"),
+        py::arg("map_text") = "", py::arg("map_source") = "");
+  m.def("parse_dataset", &ParseDatasetOrThrow, py::arg("text"), py::arg("source_name"),
+        py::arg("skip_invalid_rows"), py::arg("map_text"), py::arg("map_source"),
+        py::arg("header_first"));
+  m.def("canonical_text", &CanonicalText);
+  m.def("column_map_decimal", [](const std::string& map_text, const std::string& map_source) {
+    return std::string(1, MapOrThrow(map_text, map_source, false, false)->decimal);
+  });
   m.def("simulate", &SimulateFromArrays);
 }
 

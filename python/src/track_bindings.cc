@@ -129,7 +129,8 @@ const char* StatusName(TrackStatus status) {
 py::dict Track(const CableRobot& model, const std::string& spec_path_or_text, bool spec_is_text,
                const std::string& spec_source, const std::vector<std::string>& data,
                const std::string& out, const std::string& window_text, int threads, bool refold,
-               bool force, const py::object& fold_many) {
+               bool force, const std::string& map_text, const std::string& map_source,
+               const py::object& fold_many) {
   CalibrationSpec spec;
   std::string error;
   if (!spec_is_text) RequireExistingFile(spec_path_or_text, "spec");
@@ -144,6 +145,7 @@ py::dict Track(const CableRobot& model, const std::string& spec_path_or_text, bo
   options.threads = threads;
   options.refold_all = refold;
   options.force = force;
+  options.read.columns = MapOrThrow(map_text, map_source, false, false);
   if (!fold_many.is_none()) {
     options.runner = [&fold_many](const std::vector<std::string>& tasks,
                                   std::vector<std::string>* folds, std::string* why) {
@@ -189,7 +191,8 @@ py::bytes FoldTaskBytes(const py::bytes& task) {
 void BindTrack(py::module_& m) {
   m.def("track", &Track, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
         py::arg("spec_source"), py::arg("data"), py::arg("out"), py::arg("window"),
-        py::arg("threads"), py::arg("refold"), py::arg("force"), py::arg("fold_many"));
+        py::arg("threads"), py::arg("refold"), py::arg("force"), py::arg("map_text"),
+        py::arg("map_source"), py::arg("fold_many"));
   m.def("fold_task", &FoldTaskBytes, py::arg("task"));
 }
 

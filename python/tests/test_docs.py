@@ -22,7 +22,7 @@ def test_worked_example(
     source_dir: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     blocks = example_blocks(source_dir)
-    assert set(blocks) == {"main", "plot"}
+    assert set(blocks) == {"main", "plot", "columns"}
     # Run where the example expects to be: beside calibration_data/.
     (tmp_path / "calibration_data").symlink_to(source_dir / "calibration_data")
     monkeypatch.chdir(tmp_path)
@@ -35,3 +35,16 @@ def test_worked_example(
     os.environ.setdefault("MPLBACKEND", "Agg")
     exec(compile(blocks["plot"], "docs/python.md (plot)", "exec"), namespace)
     assert (tmp_path / "tensions.png").stat().st_size > 0
+
+
+def test_columns_example(
+    source_dir: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/python.md's "Telemetry as it comes" runs as written."""
+    blocks = example_blocks(source_dir)
+    (tmp_path / "calibration_data").symlink_to(source_dir / "calibration_data")
+    monkeypatch.chdir(tmp_path)
+    namespace: dict = {}
+    exec(compile(blocks["columns"], "docs/python.md (columns)", "exec"), namespace)
+    assert len(namespace["export"]) == 1441
+    assert len(namespace["arrays"]) == 1441

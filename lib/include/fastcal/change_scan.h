@@ -55,6 +55,7 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/time_text.h"
 #include "fastcal/uncertainty.h"
 
 namespace fastcal {
@@ -164,6 +165,9 @@ struct ChangeScanResult {
   double change_time_low_s = 0.0;
   double change_time_high_s = 0.0;
   bool wanders = false;
+  // How the data's times read (time_text.h): dates and times in the data's zone when
+  // they are Unix times, seconds otherwise; the verdict and the report use it.
+  TimeDisplay time_display;
 };
 
 // The fraction of the scanned span the change time's interval may cover for a change to
@@ -171,8 +175,21 @@ struct ChangeScanResult {
 // gradual (a wandering).
 inline constexpr double kMaxStepTimeFraction = 0.2;
 
-// One sentence for the verdict: the changes found (when, how much, p), or that none was.
+// One sentence for the verdict: the changes found (when, how much, p), or that none was;
+// with changes, the --sessions-at value that cuts the survey there.
 std::string ChangeScanVerdict(const ChangeScanResult& scan);
+
+// The value of --sessions-at that cuts the survey at the changes found ("" for none):
+// each change's time (of its first sample), ISO 8601 with the data's zone for Unix times
+// (to the microsecond: a cut takes samples within 1 us of it as after it).
+std::string SessionsAtText(const ChangeScanResult& scan);
+
+// The times of the changes a previous calibration found, from its summary.json (its
+// "changes", each "time_s" written to 17 digits), for fastcal calibrate
+// --sessions-at=DIR/summary.json. False, with *error naming the file, when it cannot be
+// read, is not a calibration's summary.json, had no change scan, or found no change.
+bool ReadSummaryChangeTimes(const std::string& path, std::vector<double>* times_s,
+                            std::string* error);
 
 }  // namespace fastcal
 

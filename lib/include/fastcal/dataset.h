@@ -15,8 +15,10 @@
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/column_map.h"
 #include "fastcal/plausibility.h"
 #include "fastcal/pose.h"
+#include "fastcal/time_text.h"
 
 namespace fastcal {
 
@@ -76,6 +78,10 @@ struct Dataset {
   // order, formatted like the error the row would otherwise have caused ("file:line: ...");
   // then those of samples removed by SkipUnsolvableSamples (evaluation.h).
   std::vector<std::string> skipped;
+  // The zone Unix times (time_text.h: time_s >= 1e8 s) are shown in by reports, plots and
+  // messages, in seconds east of UTC: the column map's time zone when the file was read
+  // through one, else 0 (UTC). time_s itself is always UTC.
+  int time_offset_s = 0;
 };
 
 struct DatasetReadOptions {
@@ -97,7 +103,18 @@ struct DatasetReadOptions {
   // in parallel and taken in file order, so the samples, skipped rows and messages are
   // the same on any number. >= 1; default 1.
   int threads = 1;
+  // Read the file as an export through this column map (column_map.h, docs/data-format.md,
+  // "Column maps"): its delimiter, decimal mark, header line, source columns, units and
+  // time stamps; null: the canonical format above. Messages then name the source column
+  // and the fastcal name ("data.csv:12: column 'CableForce3' (T3_kN, N): 'abc' is not a
+  // number"), and those about the map its file, line and key.
+  std::shared_ptr<const ColumnMap> columns;
 };
+
+// How the dataset's times read (time_text.h): dates and times in its zone
+// (Dataset::time_offset_s) when its earliest time is a Unix time (>= 1e8 s), seconds
+// otherwise.
+TimeDisplay TimeDisplayOf(const Dataset& data);
 
 // "<file>:<line>" of a sample, for messages: the file of its session when the dataset was
 // merged from several (Dataset::session_paths), else Dataset::path.
@@ -175,6 +192,10 @@ class DatasetWriter {
   bool Open(const std::string& path, const Dataset& layout, const std::string& header_comment,
             std::string* error);
   bool Write(const Sample& sample, std::string* error);
+  // The session labels grown as a reader meets them (DatasetChunkReader: a chunk's
+  // session_labels are those met so far): `labels` replaces the layout's when it opened
+  // with labels (a session column) and begins with them. For streamed copies.
+  void UpdateSessionLabels(const std::vector<std::string>& labels);
   bool Close(std::string* error);
 
  private:

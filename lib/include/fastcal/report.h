@@ -78,6 +78,9 @@ struct ReportInputs {
   // FileSha256 of each file (64 hex digits, as sha256sum prints them), filled by the
   // caller; empty if not known.
   std::string model_digest, spec_digest, data_digest;
+  // The column map the data was read through (--columns, column_map.h) and its digest;
+  // empty: the canonical format.
+  std::string columns_path, columns_digest;
   std::string software_version;  // FASTCAL_VERSION (fastcal/version.h)
   std::string command_line;
   // When the run happened, UTC, e.g. "2026-11-22T15:04:05Z"; empty: not recorded.

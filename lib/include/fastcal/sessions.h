@@ -44,6 +44,23 @@ bool MergeSessionFiles(const std::vector<Dataset>& files, Dataset* merged, std::
 bool ReadSessionDatasets(const std::vector<std::string>& paths, const DatasetReadOptions& options,
                          Dataset* dataset, std::string* error);
 
+// Cutting one survey into sessions at times (fastcal calibrate --sessions-at, after a
+// change scan found a step): sample times at or after cut k (and before cut k+1) form
+// session k+1, labelled SessionCutLabel(k) = "s1", "s2", ... in time order. A sample
+// within kSessionCutToleranceS before a cut counts as after it (a cut written as text to
+// the microsecond, time_text.h). `cuts_s` must increase, in the data's time_s (Unix
+// seconds when its times are absolute).
+inline constexpr double kSessionCutToleranceS = 1e-6;
+std::string SessionCutLabel(int index);
+// The session (0-based) of a sample at `time_s`.
+int SessionOfTime(const std::vector<double>& cuts_s, double time_s);
+// False, with *error, when `cuts_s` is empty, not finite or not increasing.
+bool CheckSessionCuts(const std::vector<double>& cuts_s, std::string* error);
+// Sets data's sessions by the cuts. Refuses data that has sessions already (a session
+// column, several files) and a cut that leaves a session without samples (naming its
+// times as the data's times read, time_text.h).
+bool CutSessionsAt(const std::vector<double>& cuts_s, Dataset* data, std::string* error);
+
 // "mass_centre_m.x@B".
 std::string SessionParameterName(const std::string& name, const std::string& label);
 // The name without its "@LABEL" ("mass_centre_m.x").

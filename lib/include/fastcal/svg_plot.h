@@ -40,6 +40,11 @@ struct PlotOptions {
   std::string title, x_label, y_label;  // Axis labels should carry units, e.g. "t [s]".
   int width_px = 720;
   int height_px = 300;
+  // SvgLinePlot: the x values are Unix times (time_text.h): the x axis shows clock times
+  // ("12:30", "12:30:15"; "05-02 00:00" or dates over more than a day) at round steps
+  // (1 s to 4 weeks) in the zone x_time_offset_s (seconds east of UTC), not 1.7145e+09.
+  bool x_unix_time = false;
+  int x_time_offset_s = 0;
 };
 
 // Lines (or markers) over shared axes. Each series with at least one finite point is

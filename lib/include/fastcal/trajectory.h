@@ -23,6 +23,7 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/column_map.h"
 #include "fastcal/pose.h"
 
 namespace fastcal {
@@ -182,6 +183,15 @@ bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector
 // Same, from the file's text; `source_name` stands for the file name in messages.
 bool ParsePosesCsv(const std::string& text, const std::string& source_name,
                    std::vector<Pose>* poses, std::vector<double>* times_s, std::string* error);
+// The same, an export read through a column map (column_map.h): x_m, y_m, z_m, the
+// attitude (roll/pitch/yaw or the quaternion) and the time as the map names and converts
+// them; its other entries (tensions, planned attitude) are not read. Messages name the
+// source column and the fastcal name; a map without x, y, z names the map's key and line.
+bool ReadPosesCsv(const std::string& path, const ColumnMap& columns, std::vector<Pose>* poses,
+                  std::vector<double>* times_s, std::string* error);
+bool ParsePosesCsv(const std::string& text, const std::string& source_name,
+                   const ColumnMap& columns, std::vector<Pose>* poses,
+                   std::vector<double>* times_s, std::string* error);
 
 // Largest pose file ReadPosesCsv reads, as for a dataset (DatasetReadOptions).
 inline constexpr long long kMaxPoseFileBytes = 1LL << 30;  // 1 GiB

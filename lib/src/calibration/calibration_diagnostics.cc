@@ -500,6 +500,7 @@ CalibrationStatus ScanChanges(Run& run) {
     break;
   }
   scan.unit_samples = out.unit_samples;
+  scan.time_display = TimeDisplayOf(run.data);
   for (size_t k = 0; k < out.splits.size(); ++k) {
     scan.time_s.push_back(run.data.samples[run.fit[out.splits[k]]].time_s);
     scan.statistic.push_back(out.statistic[k]);

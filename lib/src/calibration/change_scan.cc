@@ -2,13 +2,17 @@
 // split times, its null distribution by parametric bootstrap, binary segmentation.
 #include "fastcal/change_scan.h"
 
+#include <yaml-cpp/yaml.h>
+
 #include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <random>
 
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/number_text.h"
+#include "util/yaml_document.h"
 
 namespace fastcal {
 namespace {
@@ -471,6 +475,15 @@ bool ScanForChanges(const ChangeScanInputs& in, ChangeScanOutput* out, std::stri
   return true;
 }
 
+namespace {
+
+// "2024-05-01 12:00:03 +08:00" for a Unix time, "t = 800 s" for seconds.
+std::string Instant(double time_s, const TimeDisplay& display) {
+  return display.absolute ? TimeText(time_s, display) : "t = " + TimeText(time_s, display);
+}
+
+}  // namespace
+
 std::string ChangeScanVerdict(const ChangeScanResult& scan) {
   using internal::FormatDouble;
   std::string groups;
@@ -492,9 +505,9 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
       shifts += (k ? ", " : "") + scan.parameters[k] + " " + FormatDouble("%+.3g", c.shift[k]) +
                 " +- " + FormatDouble("%.2g", c.shift_sigma[k]) + " " + scan.units[k];
     }
-    out += (out.empty() ? "" : "; ") + std::string("a change at t = ") +
-           FormatDouble("%.6g", c.time_s) + " s (line " + std::to_string(c.line) + ", p " +
-           FormatDouble("%.2g", c.p_value) + "): " + shifts;
+    out += (out.empty() ? "" : "; ") + std::string("a change at ") +
+           Instant(c.time_s, scan.time_display) + " (line " +
+           std::to_string(c.line) + ", p " + FormatDouble("%.2g", c.p_value) + "): " + shifts;
   }
   if (scan.wanders) {
     std::string trend;
@@ -505,8 +518,9 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
     }
     out += "; but the data show a gradual change (a wandering) rather than a step: " +
            std::string(scan.changes.size() > 1 ? "several steps were needed; " : "") +
-           "its time is between t = " + FormatDouble("%.6g", scan.change_time_low_s) + " and " +
-           FormatDouble("%.6g", scan.change_time_high_s) + " s (95%); a steady trend explains " +
+           "its time is between " + Instant(scan.change_time_low_s, scan.time_display) +
+           " and " + Instant(scan.change_time_high_s, scan.time_display) +
+           " (95%); a steady trend explains " +
            (scan.trend_statistic >= scan.best_step_statistic ? "at least as much as"
                                                              : "some of what") +
            " the best step (statistic " + FormatDouble("%.3g", scan.trend_statistic) + " against " +
@@ -518,9 +532,59 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
            "look like a step; docs/calibration.md, \"Change scan\")";
   }
   return out + ". The estimates are an average over " + (scan.changes.size() == 1 ? "it" : "them") +
-         ": split the survey there into sessions (a session column) and fit with sessions: "
-         "{separate: [" +
-         groups + "]}";
+         ": cut the survey there, --sessions-at=" + SessionsAtText(scan) +
+         ", and fit with sessions: {separate: [" + groups + "]}";
+}
+
+std::string SessionsAtText(const ChangeScanResult& scan) {
+  std::string text;
+  for (const FoundChange& c : scan.changes) {
+    text += (text.empty() ? "" : ",") + TimeValueText(c.time_s, scan.time_display);
+  }
+  return text;
+}
+
+bool ReadSummaryChangeTimes(const std::string& path, std::vector<double>* times_s,
+                            std::string* error) {
+  constexpr long long kMaxSummaryBytes = 256LL << 20;
+  std::string text;
+  if (!internal::ReadRegularFile(path, kMaxSummaryBytes, "summary.json", &text, error)) {
+    return false;
+  }
+  const std::string what = path + ": ";
+  try {
+    const internal::YamlDocuments documents = internal::LoadYamlDocuments(text);
+    const YAML::Node& root = documents.first;
+    if (!root.IsMap() || !root["changes"] || !root["change_scan"]) {
+      *error = what + "not the summary.json of fastcal calibrate (no \"changes\")";
+      return false;
+    }
+    if (root["change_scan"].IsNull()) {
+      *error = what + "that calibration had no change scan (a spec with change_scan: {...}, "
+                      "docs/calibration.md, \"Change scan\")";
+      return false;
+    }
+    const YAML::Node changes = root["changes"];
+    if (!changes.IsSequence() || changes.size() == 0) {
+      *error = what + "its change scan found no change: nothing to cut at";
+      return false;
+    }
+    std::vector<double> times;
+    for (const YAML::Node& change : changes) {
+      double t = 0.0;
+      if (!change.IsMap() || !change["time_s"] ||
+          !internal::ParseDouble(change["time_s"].Scalar(), &t) || !std::isfinite(t)) {
+        *error = what + "a change without a finite time_s";
+        return false;
+      }
+      times.push_back(t);
+    }
+    *times_s = std::move(times);
+    return true;
+  } catch (const std::exception& e) {
+    *error = what + "cannot read it as JSON: " + e.what();
+    return false;
+  }
 }
 
 }  // namespace fastcal

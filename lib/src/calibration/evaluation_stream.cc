@@ -200,6 +200,7 @@ bool StreamedEvaluation::Chunks(const std::vector<std::string>& paths,
     merged_.has_unstretched_lengths = chunk.has_unstretched_lengths;
     merged_.attitude_as_quaternion = chunk.attitude_as_quaternion;
     merged_.session_labels = chunk.session_labels;
+    merged_.time_offset_s = chunk.time_offset_s;
   }
   return true;
 }
@@ -233,6 +234,7 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
   layout_.attitude_as_quaternion = merged_.attitude_as_quaternion;
   layout_.session_labels = merged_.session_labels;
   layout_.session_paths = merged_.session_paths;
+  layout_.time_offset_s = merged_.time_offset_s;
   for (std::string& why : p.unsolvable) layout_.skipped.push_back(std::move(why));
   if (std::fflush(spill_) != 0) {
     *error = "evaluation: cannot write the temporary file: " + std::string(std::strerror(errno));

@@ -75,6 +75,7 @@ bool MergeSessionFiles(const std::vector<Dataset>& files, Dataset* merged, std::
   out.has_planned_attitude = true;
   out.has_unstretched_lengths = true;
   out.attitude_as_quaternion = files.front().attitude_as_quaternion;
+  out.time_offset_s = files.front().time_offset_s;
   std::vector<size_t> owner;
   for (size_t f = 0; f < files.size(); ++f) {
     out.path += (f == 0 ? "" : ",") + files[f].path;
@@ -94,6 +95,64 @@ bool ReadSessionDatasets(const std::vector<std::string>& paths, const DatasetRea
     if (!ReadDataset(paths[f], options, &files[f], error)) return false;
   }
   return MergeSessionFiles(files, dataset, error);
+}
+
+std::string SessionCutLabel(int index) { return "s" + std::to_string(index + 1); }
+
+int SessionOfTime(const std::vector<double>& cuts_s, double time_s) {
+  int session = 0;
+  while (session < static_cast<int>(cuts_s.size()) &&
+         time_s >= cuts_s[session] - kSessionCutToleranceS) {
+    ++session;
+  }
+  return session;
+}
+
+bool CheckSessionCuts(const std::vector<double>& cuts_s, std::string* error) {
+  if (cuts_s.empty()) {
+    *error = "no time to cut at";
+    return false;
+  }
+  for (size_t k = 0; k < cuts_s.size(); ++k) {
+    if (!std::isfinite(cuts_s[k])) {
+      *error = "cut " + std::to_string(k + 1) + " is not a finite time";
+      return false;
+    }
+    if (k > 0 && !(cuts_s[k] > cuts_s[k - 1])) {
+      *error = "the times must increase (" + internal::FormatDouble("%.17g", cuts_s[k - 1]) +
+               " then " + internal::FormatDouble("%.17g", cuts_s[k]) + ")";
+      return false;
+    }
+  }
+  return true;
+}
+
+bool CutSessionsAt(const std::vector<double>& cuts_s, Dataset* data, std::string* error) {
+  const TimeDisplay display = TimeDisplayOf(*data);
+  if (!CheckSessionCuts(cuts_s, error)) return false;
+  if (!data->session_labels.empty()) {
+    *error = data->path + ": the data has sessions already (" +
+             std::to_string(data->session_labels.size()) +
+             ", from a session column or several files): cutting at times is for one survey";
+    return false;
+  }
+  std::vector<long long> count(cuts_s.size() + 1, 0);
+  for (const Sample& s : data->samples) ++count[SessionOfTime(cuts_s, s.time_s)];
+  for (size_t k = 0; k < count.size(); ++k) {
+    if (count[k] > 0) continue;
+    const std::string from = k == 0 ? "the start" : TimeText(cuts_s[k - 1], display);
+    const std::string to = k == cuts_s.size() ? "the end" : TimeText(cuts_s[k], display);
+    *error = data->path + ": no sample from " + from + " to " + to + " (session " +
+             SessionCutLabel(static_cast<int>(k)) + " would be empty): cut within the survey";
+    return false;
+  }
+  data->session_labels.clear();
+  for (size_t k = 0; k < count.size(); ++k) {
+    data->session_labels.push_back(SessionCutLabel(static_cast<int>(k)));
+  }
+  data->session_paths.clear();
+  for (Sample& s : data->samples) s.session = SessionOfTime(cuts_s, s.time_s);
+  return true;
 }
 
 std::string SessionParameterName(const std::string& name, const std::string& label) {

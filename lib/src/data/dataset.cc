@@ -16,13 +16,16 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <deque>
 #include <exception>
 #include <filesystem>
 #include <functional>
 #include <limits>
 #include <string_view>
 
+#include "fastcal/column_map.h"
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/column_reading.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
@@ -68,12 +71,11 @@ constexpr const char* kColumnNames[kNumColumns] = {
 // has no Column; its field maps to this.
 constexpr char kSessionColumn[] = "session";
 constexpr int kSessionField = -1;
+// A field of an export read through a column map that fastcal does not read.
+constexpr int kIgnoredField = -2;
 
 // Files hold tensions in kN, memory in N: the decimal exponent shifts by this much.
 constexpr int kKilo = 3;
-// Exponents beyond this (e.g. "0e999999") are converted by multiplication instead of by
-// shifting the decimal text; such values are 0 or non-finite anyway.
-constexpr long kMaxShiftableExponent = 100000;
 // WriteDataset refuses a pose.rotation farther than this (max |R^T R - I| entry) from a
 // rotation: it could not be written as angles or a quaternion.
 constexpr double kRotationTolerance = 1e-6;
@@ -136,26 +138,7 @@ bool ParseNumber(std::string_view field, double* value, std::string* reason) {
 // decimal exponent of the text, so the result is the correctly rounded value of the
 // decimal number and the writer's inverse shift round-trips exactly.
 double ScaleByKilo(std::string_view field, double parsed_value) {
-  const std::string text(field);
-  if (text.find_first_of("xX") != std::string::npos) return parsed_value * 1e3;  // hex float
-  const size_t e = text.find_first_of("eE");
-  std::string shifted;
-  if (e == std::string::npos) {
-    shifted = text + "e" + std::to_string(kKilo);
-  } else {
-    std::string_view exponent_text = field.substr(e + 1);
-    if (!exponent_text.empty() && exponent_text.front() == '+') exponent_text.remove_prefix(1);
-    long exponent = 0;
-    const auto [ptr, ec] = std::from_chars(exponent_text.data(),
-                                           exponent_text.data() + exponent_text.size(), exponent);
-    if (ec != std::errc() || std::labs(exponent) > kMaxShiftableExponent) {
-      return parsed_value * 1e3;
-    }
-    shifted = text.substr(0, e) + "e" + std::to_string(exponent + kKilo);
-  }
-  double scaled = parsed_value * 1e3;
-  internal::ParseDouble(shifted, &scaled);
-  return scaled;
+  return internal::ScaleDecimal(field, parsed_value, kKilo);
 }
 
 // The shortest decimal text that ParseNumber reads back as value * 10^-shift exactly
@@ -206,18 +189,32 @@ struct Header {
   bool planned = false;
   bool unstretched = false;
   int session_field = -1;  // the field holding the session label, or -1
+  // Read through a column map (column_map.h; null: the canonical format): the fields are
+  // split at `delimiter` with quotes, numbers have the map's decimal mark and are
+  // converted by `conversion`; fields of no column are kIgnoredField.
+  const ColumnMap* map = nullptr;
+  char delimiter = ',';
+  std::array<internal::ValueConversion, kNumColumns> conversion{};
+  // How messages name a column: "column 'x_m'", or through a map "column 'SDP_PhaPos_X'
+  // (x_m)"; the position's three and the quaternion's four together.
+  std::array<std::string, kNumColumns> label;
+  std::string session_label = "column 'session'";
+  std::string position_label = "columns 'x_m,y_m,z_m'";
+  std::string quaternion_label = "columns 'qw,qx,qy,qz'";
+  std::string rpy_label = "roll_deg, pitch_deg, yaw_deg";
 };
 
 // Checks that a group of columns is all present or all absent; on a partial group names
-// the first missing column. Returns whether the group is present.
+// the first missing column (`missing`: "missing column ", or a map's "no entry for ").
+// Returns whether the group is present.
 bool GroupPresent(const Header& header, int first, int count, const std::string& where,
-                  const char* group_note, bool* ok, std::string* error) {
+                  const char* group_note, const char* missing, bool* ok, std::string* error) {
   int present = 0;
   for (int c = first; c < first + count; ++c) present += header.field_of[c] >= 0 ? 1 : 0;
   if (present == 0 || present == count) return present == count;
   for (int c = first; c < first + count; ++c) {
     if (header.field_of[c] < 0) {
-      *error = where + "missing column " + Quoted(kColumnNames[c]) + " (" + group_note + ")";
+      *error = where + missing + Quoted(kColumnNames[c]) + " (" + group_note + ")";
       break;
     }
   }
@@ -225,9 +222,133 @@ bool GroupPresent(const Header& header, int first, int count, const std::string&
   return false;
 }
 
-bool ParseHeader(std::string_view line, const std::string& where, Header* header,
-                 std::string* error) {
+// The columns a dataset needs, and its groups whole or absent. `where` is the header's
+// "file:line: " (or the map's "map.yaml:5: columns: "), `missing` as in GroupPresent.
+bool CheckColumnGroups(const std::string& where, const char* missing, Header* header,
+                       std::string* error) {
+  const auto require = [&](int column) {
+    if (header->field_of[column] >= 0) return true;
+    *error = where + missing + Quoted(kColumnNames[column]);
+    return false;
+  };
+  for (int c = kTime; c <= kZ; ++c) {
+    if (!require(c)) return false;
+  }
+  bool ok = true;
+  const bool rpy = GroupPresent(*header, kRoll, 3, where,
+                                "the measured attitude as angles needs all three", missing, &ok,
+                                error);
+  if (!ok) return false;
+  const bool quaternion =
+      GroupPresent(*header, kQw, 4, where, "the measured attitude as a quaternion needs all four",
+                   missing, &ok, error);
+  if (!ok) return false;
+  if (rpy && quaternion) {
+    *error = where +
+             "measured attitude given twice: use either roll_deg,pitch_deg,yaw_deg or "
+             "qw,qx,qy,qz";
+    return false;
+  }
+  if (!rpy && !quaternion) {
+    *error = where + "missing measured attitude: columns roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz";
+    return false;
+  }
+  header->quaternion = quaternion;
+  for (int i = 0; i < kNumCables; ++i) {
+    if (!require(kTension1 + i)) return false;
+  }
+  header->planned = GroupPresent(*header, kPlannedRoll, 3, where,
+                                 "the planned attitude needs all three or none", missing, &ok,
+                                 error);
+  if (!ok) return false;
+  header->unstretched =
+      GroupPresent(*header, kUnstretched1, kNumCables, where,
+                   "the unstretched lengths need all six or none", missing, &ok, error);
+  return ok;
+}
+
+// The header of an export read through a column map: its source columns matched to the
+// map's (column_reading.h), the conversions, the labels of messages.
+bool ParseMappedHeader(std::string_view line, const std::string& where, const std::string& path,
+                       Header* header, std::string* error) {
+  const ColumnMap& map = *header->map;
+  header->delimiter = map.delimiter != 0 ? map.delimiter : internal::DetectDelimiter(line, map.decimal);
+  std::vector<std::string_view> fields;
+  std::deque<std::string> scratch;
+  std::string why;
+  if (!internal::SplitRecord(line, header->delimiter, &fields, &scratch, &why)) {
+    *error = where + "header: " + why;
+    return false;
+  }
+  // Trailing delimiters (a spreadsheet's empty cells at the end): no columns.
+  while (fields.size() > 1 && fields.back().empty()) fields.pop_back();
+  if (!map.has_time) {
+    *error = map.path + ": time: missing: a dataset needs the time of each row (time: {column: "
+             "NAME, format: seconds | unix_s | unix_ms | iso8601, zone: ...})";
+    return false;
+  }
+  {
+    // The map gives what a dataset needs, before the header is looked at.
+    Header given;
+    given.field_of.fill(-1);
+    given.field_of[kTime] = 0;
+    for (int c = kX; c < kNumColumns; ++c) {
+      if (map.Find(kColumnNames[c]) != nullptr) given.field_of[c] = 0;
+    }
+    if (!CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", &given, error)) {
+      return false;
+    }
+  }
+  internal::MappedHeader mapped;
+  if (!internal::ResolveMappedHeader(map, fields, ColumnMapNames(), where, path, &mapped, error)) {
+    return false;
+  }
+  constexpr int kSessionTarget = kNumColumns - 1;  // ColumnMapNames(): the columns after
+                                                   // time_s, then session
+  header->column_of_field.assign(fields.size(), kIgnoredField);
+  for (size_t f = 0; f < fields.size(); ++f) {
+    const int target = mapped.target_of_field[f];
+    if (target == internal::kTimeTarget) {
+      header->column_of_field[f] = kTime;
+      header->field_of[kTime] = static_cast<int>(f);
+      header->label[kTime] = "column " + Quoted(map.time.column) + " (time_s, " +
+                             TimeFormatName(map.time.format, map.time.pattern) + ")";
+    } else if (target == kSessionTarget) {
+      header->column_of_field[f] = kSessionField;
+      header->session_field = static_cast<int>(f);
+      header->session_label = "column " + Quoted(fields[f]) + " (session)";
+    } else if (target >= 0) {
+      const int column = target + 1;
+      const ColumnMapEntry& entry = *mapped.entry_of_target[target];
+      header->column_of_field[f] = column;
+      header->field_of[column] = static_cast<int>(f);
+      header->conversion[column] = internal::ConversionOf(entry.name, entry.unit);
+      const std::string unit = entry.unit == CanonicalUnitOf(entry.name) ? "" : ", " + entry.unit;
+      header->label[column] = "column " + Quoted(entry.column) + " (" + entry.name + unit + ")";
+    }
+  }
+  const auto names = [&](int first, int count) {
+    std::string sources, fastcal;
+    for (int c = first; c < first + count; ++c) {
+      const ColumnMapEntry* e = map.Find(kColumnNames[c]);
+      sources += (c > first ? "," : "") + (e ? e->column : std::string("?"));
+      fastcal += (c > first ? "," : "") + std::string(kColumnNames[c]);
+    }
+    return "columns " + Quoted(sources) + " (" + fastcal + ")";
+  };
+  header->position_label = names(kX, 3);
+  header->quaternion_label = names(kQw, 4);
+  if (header->field_of[kRoll] >= 0) {
+    header->rpy_label = names(kRoll, 3).substr(8);
+  }
+  return CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", header, error);
+}
+
+bool ParseHeader(std::string_view line, const std::string& where, const std::string& path,
+                 Header* header, std::string* error) {
   header->field_of.fill(-1);
+  for (int c = 0; c < kNumColumns; ++c) header->label[c] = "column " + Quoted(kColumnNames[c]);
+  if (header->map != nullptr) return ParseMappedHeader(line, where, path, header, error);
   const std::string separator_error = internal::WrongSeparatorMessage(line);
   if (!separator_error.empty()) {
     *error = where + separator_error;
@@ -255,7 +376,9 @@ bool ParseHeader(std::string_view line, const std::string& where, Header* header
       if (name == kColumnNames[c]) column = c;
     }
     if (column < 0) {
-      *error = where + "unknown column " + Quoted(name) + " (accepted: " + AcceptedColumns() + ")";
+      *error = where + "unknown column " + Quoted(name) + " (accepted: " + AcceptedColumns() +
+               "; an export with other names, units or channels is read through a column map, "
+               "--columns=MAP.yaml, docs/data-format.md)";
       return false;
     }
     if (header->field_of[column] >= 0) {
@@ -266,41 +389,11 @@ bool ParseHeader(std::string_view line, const std::string& where, Header* header
     header->field_of[column] = static_cast<int>(f);
     header->column_of_field.push_back(column);
   }
-  const auto require = [&](int column) {
-    if (header->field_of[column] >= 0) return true;
-    *error = where + "missing column " + Quoted(kColumnNames[column]);
-    return false;
-  };
-  for (int c = kTime; c <= kZ; ++c) {
-    if (!require(c)) return false;
+  for (int c = 0; c < kNumColumns; ++c) {
+    header->conversion[c].shift = IsTension(c) ? kKilo : 0;
+    header->conversion[c].internal_per_file = IsTension(c) ? 1e3 : 1.0;
   }
-  bool ok = true;
-  const bool rpy = GroupPresent(*header, kRoll, 3, where,
-                                "the measured attitude as angles needs all three", &ok, error);
-  if (!ok) return false;
-  const bool quaternion = GroupPresent(
-      *header, kQw, 4, where, "the measured attitude as a quaternion needs all four", &ok, error);
-  if (!ok) return false;
-  if (rpy && quaternion) {
-    *error = where +
-             "measured attitude given twice: use either roll_deg,pitch_deg,yaw_deg or "
-             "qw,qx,qy,qz";
-    return false;
-  }
-  if (!rpy && !quaternion) {
-    *error = where + "missing measured attitude: columns roll_deg,pitch_deg,yaw_deg or qw,qx,qy,qz";
-    return false;
-  }
-  header->quaternion = quaternion;
-  for (int i = 0; i < kNumCables; ++i) {
-    if (!require(kTension1 + i)) return false;
-  }
-  header->planned = GroupPresent(*header, kPlannedRoll, 3, where,
-                                 "the planned attitude needs all three or none", &ok, error);
-  if (!ok) return false;
-  header->unstretched = GroupPresent(*header, kUnstretched1, kNumCables, where,
-                                     "the unstretched lengths need all six or none", &ok, error);
-  return ok;
+  return CheckColumnGroups(where, "missing column ", header, error);
 }
 
 // Parses one data row into *sample; on failure *reason says why (without file:line).
@@ -374,29 +467,57 @@ std::string TooManyFieldsMessage(const std::vector<std::string_view>& fields, co
     return message + ": a decimal comma? " +
            Quoted(std::string(fields[best]) + "," + std::string(fields[best + 1])) + " in column " +
            Quoted(kColumnNames[header.column_of_field[best]]) +
-           " reads as two fields; numbers must use '.' as the decimal point";
+           " reads as two fields; numbers must use '.' as the decimal point (or say decimal: "
+           "\",\" in a column map, --columns)";
   }
   return message + " (fields cannot contain a comma; a decimal comma must be a '.')";
+}
+
+// The fields of a row read through a column map, a trailing delimiter dropped; false
+// with *reason on a quote left open or a wrong number of fields.
+bool SplitMappedRow(std::string_view line, const Header& header,
+                    std::vector<std::string_view>* fields, std::string* reason) {
+  thread_local std::deque<std::string> scratch;
+  scratch.clear();
+  if (!internal::SplitRecord(line, header.delimiter, fields, &scratch, reason)) return false;
+  const size_t expected = header.column_of_field.size();
+  // Trailing delimiters beyond the header's columns (empty fields): none.
+  while (fields->size() > expected && fields->back().empty()) fields->pop_back();
+  if (fields->size() == expected) return true;
+  *reason = "expected " + std::to_string(expected) + " fields (as in the header), found " +
+            std::to_string(fields->size());
+  if (fields->size() > expected && header.delimiter == ',' && header.map->decimal == '.') {
+    *reason += " (a decimal comma? say decimal: \",\" and the delimiter in the column map)";
+  } else if (fields->size() < expected) {
+    *reason += " (separated by " + internal::DelimiterName(header.delimiter) + ")";
+  }
+  return false;
 }
 
 bool ParseRow(std::string_view line, const Header& header, const PlausibilityLimits& limits,
               const FieldValues* previous, Sample* sample, FieldValues* values,
               std::string* reason) {
-  const std::vector<std::string_view> fields = SplitFields(line);
-  if (fields.size() != header.column_of_field.size()) {
-    *reason = fields.size() > header.column_of_field.size()
-                  ? TooManyFieldsMessage(fields, header, limits, previous)
-                  : "expected " + std::to_string(header.column_of_field.size()) +
-                        " fields (as in the header), found " + std::to_string(fields.size());
-    return false;
+  std::vector<std::string_view> fields;
+  if (header.map != nullptr) {
+    if (!SplitMappedRow(line, header, &fields, reason)) return false;
+  } else {
+    fields = SplitFields(line);
+    if (fields.size() != header.column_of_field.size()) {
+      *reason = fields.size() > header.column_of_field.size()
+                    ? TooManyFieldsMessage(fields, header, limits, previous)
+                    : "expected " + std::to_string(header.column_of_field.size()) +
+                          " fields (as in the header), found " + std::to_string(fields.size());
+      return false;
+    }
   }
   FieldValues& value = *values;
   value.fill(0.0);
   for (size_t f = 0; f < fields.size(); ++f) {
     const int column = header.column_of_field[f];
+    if (column == kIgnoredField) continue;
     if (column == kSessionField) {
       if (!IsValidSessionLabel(std::string(fields[f]))) {
-        *reason = "column " + Quoted(kSessionColumn) + ": " + Quoted(std::string(fields[f])) +
+        *reason = header.session_label + ": " + Quoted(std::string(fields[f])) +
                   " is not a session label (letters, digits, '-' and '_', at most " +
                   std::to_string(kMaxSessionLabelLength) + ")";
         return false;
@@ -404,10 +525,26 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
       continue;
     }
     const auto fail = [&](const std::string& why) {
-      *reason = "column " + Quoted(kColumnNames[column]) + ": " + why;
+      *reason = header.label[column] + ": " + why;
       return false;
     };
     std::string why;
+    if (header.map != nullptr) {
+      if (column == kTime) {
+        if (!internal::ReadTimeField(fields[f], header.map->time, header.map->decimal,
+                                     &value[column], &why)) {
+          return fail(why);
+        }
+        continue;
+      }
+      double file_value = 0.0;
+      if (!internal::ReadConvertedNumber(fields[f], header.map->decimal, header.conversion[column],
+                                         &file_value, &value[column], &why) ||
+          !CheckValue(column, file_value, limits, &why)) {
+        return fail(why);
+      }
+      continue;
+    }
     if (!ParseNumber(fields[f], &value[column], &why)) return fail(why);
     if (!CheckValue(column, value[column], limits, &why)) return fail(why);
     if (IsTension(column)) value[column] = ScaleByKilo(fields[f], value[column]);
@@ -416,7 +553,7 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     const Eigen::Vector3d position(value[kX], value[kY], value[kZ]);
     std::string why;
     if (!CheckPosition(position, limits, &why)) {
-      *reason = "columns 'x_m,y_m,z_m': " + why;
+      *reason = header.position_label + ": " + why;
       return false;
     }
   }
@@ -428,7 +565,7 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     std::string why;
     if (!RotationFromQuaternion(value[kQw], value[kQx], value[kQy], value[kQz],
                                 &sample->pose.rotation, &why)) {
-      *reason = "columns 'qw,qx,qy,qz': " + why;
+      *reason = header.quaternion_label + ": " + why;
       return false;
     }
   } else {
@@ -488,15 +625,18 @@ struct RadiansCheck {
   static constexpr double kDegPerRad = 57.29577951308232;
 };
 
-std::string AttitudeInRadiansProblem(const std::string& path, bool quaternion, bool planned,
+std::string AttitudeInRadiansProblem(const std::string& path, const Header& header,
                                      const RadiansCheck& c) {
+  const bool quaternion = header.quaternion, planned = header.planned;
   constexpr double kDegPerRad = RadiansCheck::kDegPerRad;
   constexpr double kFactorTolerance = 0.25;  // of kDegPerRad: 43 to 72
   constexpr int kFewestAngles = 10;
   constexpr double kLevelBelowDeg = 1.0;
   if (quaternion || c.samples == 0) return "";
-  const std::string columns = path + ": roll_deg, pitch_deg, yaw_deg look like radians: ";
-  const std::string fix = "; write degrees (radians x 57.2958)";
+  const std::string columns = path + ": " + header.rpy_label + " look like radians: ";
+  const std::string fix = header.map != nullptr
+                              ? "; say unit: rad for them in the column map " + header.map->path
+                              : "; write degrees (radians x 57.2958)";
   if (planned) {
     const double factor = c.mm > 0.0 ? c.pm / c.mm : 0.0;
     if (c.angles >= kFewestAngles && std::abs(factor / kDegPerRad - 1.0) <= kFactorTolerance) {
@@ -533,16 +673,47 @@ class LineParser {
   LineParser(const std::string& source_name, const DatasetReadOptions& options)
       : options_(options) {
     layout_.path = source_name;
+    header_.map = options_.columns.get();
+    if (header_.map != nullptr) layout_.time_offset_s = header_.map->time.offset_s;
   }
 
-  // One line of the file (without its '\n'), numbered from 1.
-  bool Line(int line_number, std::string_view line, Dataset* out, std::string* error) {
+  // Whether the records may hold quoted line breaks (read through a column map).
+  bool quotes() const { return header_.map != nullptr; }
+
+  // A comment or blank line; through a column map also a row of empty fields only
+  // (";;;;", as spreadsheets export their empty rows), once the delimiter is known.
+  bool Blank(std::string_view line) const {
     if (IsCommentOrBlank(line)) return true;
+    if (header_.map == nullptr || !have_header_) return false;
+    for (char c : line) {
+      if (c != header_.delimiter && c != ' ' && c != '\t' && c != '\r' && c != '"') return false;
+    }
+    return true;
+  }
+
+  // One line of the file (without its '\n'), numbered from 1; through a column map, one
+  // record (which may span lines inside quotes), numbered by its first line.
+  bool Line(int line_number, std::string_view line, Dataset* out, std::string* error) {
     // Built only for a message: two allocations a row add up at 10^6 rows.
     const auto where = [&] { return layout_.path + ":" + std::to_string(line_number) + ": "; };
+    const int header_line = header_.map != nullptr ? header_.map->header_line : 0;
+    if (!have_header_ && header_line > 0) {
+      // The map says where the names are: the lines before are not read, whatever they hold.
+      if (line_number < header_line) return true;
+      line = Trim(line);
+      if (!line.empty() && line.front() == '#') line.remove_prefix(1);  // "#time,x,..."
+      if (Trim(line).empty()) {
+        *error = where() + "the header line (header_line: " + std::to_string(header_line) +
+                 " in " + header_.map->path + ") is empty";
+        return false;
+      }
+    } else if (Blank(line) || line_number <= skip_until_) {
+      return true;
+    }
     if (!have_header_) {
-      if (!ParseHeader(line, where(), &header_, error)) return false;
+      if (!ParseHeader(line, where(), layout_.path, &header_, error)) return false;
       have_header_ = true;
+      if (header_.map != nullptr) skip_until_ = line_number + header_.map->skip_after_header;
       layout_.has_planned_attitude = header_.planned;
       layout_.has_unstretched_lengths = header_.unstretched;
       layout_.attitude_as_quaternion = header_.quaternion;
@@ -591,7 +762,7 @@ class LineParser {
           for (int k = begin; k < end; ++k) {
             const auto& [number, line] = lines[next + k];
             Parsed& p = parsed[k];
-            p.row = !IsCommentOrBlank(line);
+            p.row = !Blank(line) && number > skip_until_;
             p.sample.line = number;
             p.ok = p.row &&
                    ParseRow(line, header_, options_.limits, nullptr, &p.sample, &p.values, &reason);
@@ -618,6 +789,10 @@ class LineParser {
     const std::string& source_name = layout_.path;
     if (!have_header_) {
       *error = source_name + ": no header line (and no data rows)";
+      if (header_.map != nullptr && header_.map->header_line > 0) {
+        *error += ": the column map " + header_.map->path + " says header_line: " +
+                  std::to_string(header_.map->header_line);
+      }
       return false;
     }
     if (rows_ == 0) {
@@ -630,7 +805,7 @@ class LineParser {
       return false;
     }
     if (const std::string why =
-            AttitudeInRadiansProblem(source_name, header_.quaternion, header_.planned, radians_);
+            AttitudeInRadiansProblem(source_name, header_, radians_);
         !why.empty()) {
       *error = why;
       return false;
@@ -648,7 +823,14 @@ class LineParser {
   // A valid row: its session, the radians check, the sample kept.
   void Take(std::string_view line, Sample* sample, const FieldValues& values, Dataset* out) {
     if (header_.session_field >= 0) {
-      sample->session = SessionIndex(SplitFields(line)[header_.session_field], &layout_);
+      if (header_.map != nullptr) {
+        std::vector<std::string_view> fields;
+        std::string ignored;
+        SplitMappedRow(line, header_, &fields, &ignored);
+        sample->session = SessionIndex(fields[header_.session_field], &layout_);
+      } else {
+        sample->session = SessionIndex(SplitFields(line)[header_.session_field], &layout_);
+      }
     }
     radians_.Add(*sample, header_.planned);
     out->samples.push_back(std::move(*sample));
@@ -660,6 +842,7 @@ class LineParser {
   Dataset layout_;
   Header header_;
   bool have_header_ = false;
+  int skip_until_ = 0;  // lines up to this one after the header are skipped (a unit row)
   int rows_ = 0;
   FieldValues previous_{};  // the last valid row
   bool have_previous_ = false;
@@ -675,19 +858,27 @@ void TakeLayout(const Dataset& layout, Dataset* data) {
   data->has_unstretched_lengths = layout.has_unstretched_lengths;
   data->attitude_as_quaternion = layout.attitude_as_quaternion;
   data->session_labels = layout.session_labels;
+  data->time_offset_s = layout.time_offset_s;
 }
 
 bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
                       const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
   Dataset result;
+  if (const std::string spreadsheet = internal::SpreadsheetMessage(source_name, std::string_view(text).substr(0, 8), false);
+      !spreadsheet.empty()) {
+    *error = spreadsheet;
+    return false;
+  }
   LineParser parser(source_name, options);
   std::string_view rest(text);
   if (rest.substr(0, 3) == "\xEF\xBB\xBF") rest.remove_prefix(3);  // UTF-8 byte order mark
   for (int line_number = 1; !rest.empty(); ++line_number) {
-    const size_t newline = rest.find('\n');
+    int breaks = 0;  // line breaks inside a quoted field of the record
+    const size_t newline = internal::RecordEnd(rest, 0, parser.quotes(), &breaks);
     const std::string_view line = rest.substr(0, newline);
     rest.remove_prefix(newline == std::string_view::npos ? rest.size() : newline + 1);
     if (!parser.Line(line_number, line, &result, error)) return false;
+    line_number += breaks;
   }
   if (!parser.Finish(error)) return false;
   TakeLayout(parser.layout(), &result);
@@ -897,6 +1088,9 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   return true;
 }
 
+// The longest record read through a column map (a row is a few hundred bytes).
+constexpr size_t kMaxMappedRecordBytes = 16u << 20;
+
 struct DatasetChunkReader::State {
   State(const std::string& path, const DatasetReadOptions& options) : parser(path, options) {}
   internal::RegularFileReader file;
@@ -915,6 +1109,11 @@ DatasetChunkReader::~DatasetChunkReader() = default;
 bool DatasetChunkReader::Open(const std::string& path, const DatasetReadOptions& options,
                               std::string* error) {
   state_ = std::make_unique<State>(path, options);
+  if (const std::string spreadsheet = internal::SpreadsheetMessage(path, "");
+      !spreadsheet.empty()) {
+    if (error != nullptr) *error = spreadsheet;
+    return false;
+  }
   return state_->file.Open(path, options.max_file_bytes, "dataset", error);
 }
 
@@ -932,7 +1131,28 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
       // The complete lines read so far (each gives at most one sample), parsed together.
       lines.clear();
       while (chunk->samples.size() + lines.size() < wanted) {
-        const size_t newline = st.text.find('\n', st.start);
+        if (st.first && st.start == 0) {
+          if (!st.end && st.text.size() < 8) break;  // the first bytes, to tell a spreadsheet
+          const std::string spreadsheet =
+              internal::SpreadsheetMessage(st.parser.layout().path, std::string_view(st.text).substr(0, 8));
+          if (!spreadsheet.empty()) {
+            message = spreadsheet;
+            ok = false;
+            break;
+          }
+        }
+        int breaks = 0;  // line breaks inside a quoted field of the record
+        const size_t newline =
+            internal::RecordEnd(st.text, st.start, st.parser.quotes(), &breaks);
+        if (newline == std::string::npos && st.parser.quotes() &&
+            st.text.size() - st.start > kMaxMappedRecordBytes) {
+          // A quote left open would make the rest of the file one record, scanned anew
+          // at every read.
+          message = st.parser.layout().path + ":" + std::to_string(st.line_number + 1) +
+                    ": a record longer than 16 MiB (a quote not closed?)";
+          ok = false;
+          break;
+        }
         if (newline == std::string::npos && (!st.end || st.start == st.text.size())) break;
         std::string_view line(st.text);
         line = line.substr(st.start,
@@ -941,7 +1161,9 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
         if (st.first && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
         st.first = false;
         lines.emplace_back(++st.line_number, line);
+        st.line_number += breaks;
       }
+      if (!ok) break;
       if (!lines.empty()) {
         ok = st.parser.Lines(lines, chunk, &message);
         continue;
@@ -963,6 +1185,12 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
   }
   if (!ok && error != nullptr) *error = message;
   return ok;
+}
+
+TimeDisplay TimeDisplayOf(const Dataset& data) {
+  double earliest = std::numeric_limits<double>::infinity();
+  for (const Sample& s : data.samples) earliest = std::min(earliest, s.time_s);
+  return TimeDisplayFor(earliest, data.time_offset_s);
 }
 
 std::string SampleWhere(const Dataset& data, const Sample& sample) {
@@ -1032,6 +1260,15 @@ bool DatasetWriter::Write(const Sample& sample, std::string* error) {
   ++rows_;
   constexpr size_t kFlushBytes = 1 << 20;  // a few thousand rows per write
   return buffer_.size() < kFlushBytes || Flush(error);
+}
+
+void DatasetWriter::UpdateSessionLabels(const std::vector<std::string>& labels) {
+  std::vector<std::string>& own = layout_.session_labels;
+  if (own.empty() || labels.size() < own.size() ||
+      !std::equal(own.begin(), own.end(), labels.begin())) {
+    return;
+  }
+  own = labels;
 }
 
 bool DatasetWriter::Close(std::string* error) {

@@ -5,13 +5,16 @@
 #include <array>
 #include <cmath>
 #include <cstdlib>
+#include <deque>
 #include <random>
 #include <set>
 #include <sstream>
 #include <string_view>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/column_map.h"
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/column_reading.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
@@ -364,7 +367,68 @@ struct PoseColumns {
   size_t num_fields = 0;
   bool has_rpy = false;
   bool has_quaternion = false;
+  // Read through a column map (null: the canonical columns): the delimiter, each
+  // column's conversion, and how messages name it.
+  const ColumnMap* map = nullptr;
+  char delimiter = ',';
+  std::array<internal::ValueConversion, kNumColumns> conversion{};
+  std::array<std::string, kNumColumns> label;
+  std::string position_label = "columns 'x_m,y_m,z_m'";
+  std::string quaternion_label = "columns 'qw,qx,qy,qz'";
 };
+
+// The header of a pose file read through a column map: x, y, z, the attitude and the
+// time as the map names them (its other entries are not read).
+bool ParseMappedPoseHeader(const std::vector<std::string_view>& fields, const std::string& where,
+                           const std::string& path, PoseColumns* columns, std::string* error) {
+  const ColumnMap& map = *columns->map;
+  std::vector<std::string> names;
+  for (int c = 0; c < kTime; ++c) names.push_back(kColumnNames[c]);
+  internal::MappedHeader mapped;
+  if (!internal::ResolveMappedHeader(map, fields, names, where, path, &mapped, error)) return false;
+  std::array<int, kNumColumns>& index = columns->index;
+  index.fill(-1);
+  columns->num_fields = fields.size();
+  for (int c = 0; c < kTime; ++c) {
+    index[c] = mapped.field_of_target[c];
+    const ColumnMapEntry* e = mapped.entry_of_target[c];
+    if (e == nullptr) continue;
+    columns->conversion[c] = internal::ConversionOf(e->name, e->unit);
+    columns->label[c] = "column " + internal::Quote(e->column) + " (" + e->name + ")";
+  }
+  index[kTime] = mapped.time_field;
+  if (map.has_time) {
+    columns->label[kTime] = "column " + internal::Quote(map.time.column) + " (time_s)";
+  }
+  const auto group = [&](int first, int count) {
+    std::string sources, fastcal;
+    for (int c = first; c < first + count; ++c) {
+      const ColumnMapEntry* e = mapped.entry_of_target[c];
+      sources += (c > first ? "," : "") + (e ? e->column : std::string("?"));
+      fastcal += (c > first ? "," : "") + std::string(kColumnNames[c]);
+    }
+    return "columns " + internal::Quote(sources) + " (" + fastcal + ")";
+  };
+  columns->position_label = group(kX, 3);
+  columns->quaternion_label = group(kQw, 4);
+  columns->has_rpy = index[kRoll] >= 0 || index[kPitch] >= 0 || index[kYaw] >= 0;
+  columns->has_quaternion =
+      index[kQw] >= 0 || index[kQx] >= 0 || index[kQy] >= 0 || index[kQz] >= 0;
+  const std::string map_where = internal::ColumnsWhere(map);
+  if (columns->has_rpy && columns->has_quaternion) {
+    return Fail(error, map_where + "both roll/pitch/yaw and quaternion (qw,qx,qy,qz); give one attitude");
+  }
+  std::vector<int> required = {kX, kY, kZ};
+  if (columns->has_rpy) required.insert(required.end(), {kRoll, kPitch, kYaw});
+  if (columns->has_quaternion) required.insert(required.end(), {kQw, kQx, kQy, kQz});
+  for (int c : required) {
+    if (index[c] < 0) {
+      return Fail(error, map_where + "no entry for '" + std::string(kColumnNames[c]) +
+                             "' (a pose file needs x_m, y_m, z_m and, if any, a whole attitude)");
+    }
+  }
+  return true;
+}
 
 // The header line: known or ignored (dataset) columns, each once; x, y, z and at most one
 // complete attitude group. `where` is "path:line: ".
@@ -418,9 +482,12 @@ bool ParsePoseHeader(const std::string& line, const std::vector<std::string_view
 
 // One data row: numbers, plausible angles and position, a unit quaternion; *time_s is
 // set when the file has time_s.
-bool ParsePoseRow(const std::vector<std::string_view>& fields, const std::string& where,
+bool ParsePoseRow(std::vector<std::string_view> fields, const std::string& where,
                   const PoseColumns& columns, const PlausibilityLimits& limits, Pose* pose,
                   double* time_s, std::string* error) {
+  while (columns.map != nullptr && fields.size() > columns.num_fields && fields.back().empty()) {
+    fields.pop_back();  // trailing delimiters
+  }
   if (fields.size() != columns.num_fields) {
     return Fail(error, where + "expected " + std::to_string(columns.num_fields) +
                            " fields (as in the header), got " + std::to_string(fields.size()));
@@ -430,14 +497,22 @@ bool ParsePoseRow(const std::vector<std::string_view>& fields, const std::string
   for (int c = 0; c < kNumColumns; ++c) {
     if (index[c] < 0) continue;
     std::string why;
-    if (!ParseNumber(fields[index[c]], &values[c], &why) ||
-        (c >= kRoll && c <= kYaw && !CheckAngleDeg(values[c], limits, &why))) {
-      return Fail(error, where + "column '" + kColumnNames[c] + "': " + why);
+    double file_value = 0.0;
+    const bool read =
+        columns.map == nullptr
+            ? ParseNumber(fields[index[c]], &values[c], &why)
+        : c == kTime ? internal::ReadTimeField(fields[index[c]], columns.map->time,
+                                               columns.map->decimal, &values[c], &why)
+                     : internal::ReadConvertedNumber(fields[index[c]], columns.map->decimal,
+                                                     columns.conversion[c], &file_value,
+                                                     &values[c], &why);
+    if (!read || (c >= kRoll && c <= kYaw && !CheckAngleDeg(values[c], limits, &why))) {
+      return Fail(error, where + columns.label[c] + ": " + why);
     }
   }
   pose->position_m = Eigen::Vector3d(values[kX], values[kY], values[kZ]);
   if (std::string why; !CheckPosition(pose->position_m, limits, &why)) {
-    return Fail(error, where + "columns 'x_m,y_m,z_m': " + why);
+    return Fail(error, where + columns.position_label + ": " + why);
   }
   if (columns.has_rpy) {
     pose->rotation = RotationFromRpyDeg(values[kRoll], values[kPitch], values[kYaw]);
@@ -445,33 +520,83 @@ bool ParsePoseRow(const std::vector<std::string_view>& fields, const std::string
     std::string why;
     if (!RotationFromQuaternion(values[kQw], values[kQx], values[kQy], values[kQz], &pose->rotation,
                                 &why)) {
-      return Fail(error, where + "columns 'qw,qx,qy,qz': " + why);
+      return Fail(error, where + columns.quaternion_label + ": " + why);
     }
   }
   *time_s = values[kTime];
   return true;
 }
 
-bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector<Pose>* poses,
-                   std::vector<double>* times_s, std::string* error) {
+namespace {
+
+// The pose file read through `map` (null: the canonical columns).
+bool ParsePosesCsvImpl(const std::string& text, const std::string& path, const ColumnMap* map,
+                       std::vector<Pose>* poses, std::vector<double>* times_s,
+                       std::string* error) {
   if (poses == nullptr) return Fail(error, "poses must not be null");
-  std::istringstream in(text);
+  if (const std::string spreadsheet =
+          internal::SpreadsheetMessage(path, std::string_view(text).substr(0, 8), false);
+      !spreadsheet.empty()) {
+    return Fail(error, spreadsheet);
+  }
   const PlausibilityLimits limits;  // as for a dataset, by default
   PoseColumns columns;
+  columns.map = map;
+  for (int c = 0; c < kNumColumns; ++c) {
+    columns.label[c] = std::string("column '") + kColumnNames[c] + "'";
+  }
   bool has_header = false;
   std::vector<Pose> out_poses;
   std::vector<double> out_times;
   std::string line;
   long line_number = 0;
-  while (std::getline(in, line)) {
+  long skip_until = 0;
+  std::string_view rest(text);
+  std::vector<std::string_view> fields;
+  std::deque<std::string> scratch;
+  while (!rest.empty()) {
     ++line_number;
+    int breaks = 0;
+    const size_t end = internal::RecordEnd(rest, 0, map != nullptr, &breaks);
+    line.assign(rest.substr(0, end));
+    rest.remove_prefix(end == std::string_view::npos ? rest.size() : end + 1);
+    const long record_line = line_number;
+    line_number += breaks;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line_number == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // BOM
-    if (IsSkipped(line)) continue;
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
-    const std::vector<std::string_view> fields = SplitFields(line);
+    if (record_line == 1 && line.compare(0, 3, "\xEF\xBB\xBF") == 0) line.erase(0, 3);  // BOM
+    const std::string where = path + ":" + std::to_string(record_line) + ": ";
+    if (map != nullptr && !has_header && map->header_line > 0) {
+      if (record_line < map->header_line) continue;
+      const size_t first = line.find_first_not_of(" \t");
+      if (first != std::string::npos && line[first] == '#') line.erase(0, first + 1);
+    } else if (IsSkipped(line) || record_line <= skip_until) {
+      continue;
+    } else if (map != nullptr && has_header &&
+               line.find_first_not_of(std::string(1, columns.delimiter) + " \t\r\"") ==
+                   std::string::npos) {
+      continue;  // a spreadsheet's empty row (";;;;")
+    }
+    if (map != nullptr) {
+      scratch.clear();
+      std::string why;
+      if (!has_header) {
+        columns.delimiter = map->delimiter != 0 ? map->delimiter
+                                                : internal::DetectDelimiter(line, map->decimal);
+      }
+      if (!internal::SplitRecord(line, columns.delimiter, &fields, &scratch, &why)) {
+        return Fail(error, where + why);
+      }
+    } else {
+      fields = SplitFields(line);
+    }
     if (!has_header) {
-      if (!ParsePoseHeader(line, fields, where, &columns, error)) return false;
+      if (map != nullptr) {
+        while (fields.size() > 1 && fields.back().empty()) fields.pop_back();
+        if (!ParseMappedPoseHeader(fields, where, path, &columns, error)) return false;
+        skip_until = record_line + map->skip_after_header;
+      } else if (!ParsePoseHeader(line, fields, where, &columns, error)) {
+        return false;
+      }
       has_header = true;
       continue;
     }
@@ -489,13 +614,37 @@ bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector
   return true;
 }
 
-bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
-                  std::string* error) {
+bool ReadPosesCsvImpl(const std::string& path, const ColumnMap* map, std::vector<Pose>* poses,
+                      std::vector<double>* times_s, std::string* error) {
+  if (const std::string spreadsheet = internal::SpreadsheetMessage(path, "");
+      !spreadsheet.empty()) {
+    return Fail(error, spreadsheet);
+  }
   std::string text, message;
   if (!internal::ReadRegularFile(path, kMaxPoseFileBytes, "pose", &text, &message)) {
     return Fail(error, message);
   }
-  return ParsePosesCsv(text, path, poses, times_s, error);
+  return ParsePosesCsvImpl(text, path, map, poses, times_s, error);
+}
+
+}  // namespace
+
+bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector<Pose>* poses,
+                   std::vector<double>* times_s, std::string* error) {
+  return ParsePosesCsvImpl(text, path, nullptr, poses, times_s, error);
+}
+bool ParsePosesCsv(const std::string& text, const std::string& source_name,
+                   const ColumnMap& columns, std::vector<Pose>* poses,
+                   std::vector<double>* times_s, std::string* error) {
+  return ParsePosesCsvImpl(text, source_name, &columns, poses, times_s, error);
+}
+bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
+                  std::string* error) {
+  return ReadPosesCsvImpl(path, nullptr, poses, times_s, error);
+}
+bool ReadPosesCsv(const std::string& path, const ColumnMap& columns, std::vector<Pose>* poses,
+                  std::vector<double>* times_s, std::string* error) {
+  return ReadPosesCsvImpl(path, &columns, poses, times_s, error);
 }
 
 }  // namespace fastcal

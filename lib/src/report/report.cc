@@ -164,12 +164,16 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
     row("Calibration spec", FileText(in.spec_path, in.spec_digest, "given in code"));
   }
   Text data = FileText(in.data_path, in.data_digest, "given in code");
+  if (!in.columns_path.empty()) {
+    data.Plain(", read through the column map ").Code(in.columns_path);
+    if (!in.columns_digest.empty()) data.Plain(" (SHA-256 ").Code(in.columns_digest).Plain(")");
+  }
   if (in.data) {
     const Dataset& d = *in.data;
     data.Plain(": " + Int(NumSamples(in)) + " samples");
     if (NumSamples(in) > 0) {
       const auto [lo, hi] = TimeRange(in);
-      data.Plain(", t = " + Sig6(lo) + " to " + Sig6(hi) + " s");
+      data.Plain(", " + TimeRangeText(lo, hi, TimeDisplayFor(lo, d.time_offset_s)));
     }
     data.Plain(d.attitude_as_quaternion ? ", attitude as quaternion" : ", attitude as angles");
     if (d.has_planned_attitude) data.Plain(", with planned attitude");
@@ -718,6 +722,7 @@ struct TimePlots {
   ReportSampleStream samples;
   std::string x_label;
   bool use_time = false;
+  TimeDisplay display;  // Unix times: a clock-time axis in the data's zone
   std::vector<size_t> shown;  // PlotVariants
   bool holdout = false;
   bool ordered = true;  // a trajectory: lines join the samples; else dots
@@ -733,7 +738,10 @@ struct TimePlots {
     // x: time_s, or the sample index when time does not vary.
     use_time = std::isfinite(samples.time_min_s) && std::isfinite(samples.time_max_s) &&
                samples.time_max_s > samples.time_min_s;
-    x_label = use_time ? "t [s]" : "sample index";
+    display = TimeDisplayFor(samples.time_min_s, in.data ? in.data->time_offset_s : 0);
+    x_label = !use_time          ? "sample index"
+              : display.absolute ? TimeAxisLabel(samples.time_min_s, samples.time_max_s, display)
+                                 : "t [s]";
     holdout = NumHeldOut(in) > 0;
     ordered = samples.is_trajectory;
     if ((in.result && !in.result->gross_errors.empty()) ||
@@ -896,12 +904,16 @@ bool DrawTimeFigures(const TimePlots& t, const TimeSeries& ts, TimeFigures* f, s
     }
     PutAt(&series, MeasuredSlot(t.in), fitted[i].Finish());
     f->tension_thinning = std::max(f->tension_thinning, fitted[i].Thinning());
-    f->tension_svgs.push_back(
-        SvgLinePlot(series, CablePlotOptions("Cable " + Int(i + 1) + ": tension", t.x_label,
-                                             "T" + Int(i + 1) + " [kN]")));
-    f->residual_svgs.push_back(
-        SvgLinePlot(residual_series, CablePlotOptions("Cable " + Int(i + 1) + ": model - measured",
-                                                      t.x_label, "model - measured [kN]")));
+    PlotOptions tension_options =
+        CablePlotOptions("Cable " + Int(i + 1) + ": tension", t.x_label, "T" + Int(i + 1) + " [kN]");
+    PlotOptions residual_options = CablePlotOptions("Cable " + Int(i + 1) + ": model - measured",
+                                                    t.x_label, "model - measured [kN]");
+    for (PlotOptions* o : {&tension_options, &residual_options}) {
+      o->x_unix_time = t.use_time && t.display.absolute;
+      o->x_time_offset_s = t.display.offset_s;
+    }
+    f->tension_svgs.push_back(SvgLinePlot(series, tension_options));
+    f->residual_svgs.push_back(SvgLinePlot(residual_series, residual_options));
   }
   if (any) {
     PlotOptions o;
@@ -1010,6 +1022,7 @@ void AddCalibratedModel(const ReportInputs& in, Document* doc) {
                             "), then use it like any model file:"));
   doc->Pre("",
            "fastcal evaluate --model=" + dir + "/model_calibrated.yaml --data=" + other +
+               (in.columns_path.empty() ? "" : " --columns=" + in.columns_path) +
                "\nfastcal solve --model=" + dir +
                "/model_calibrated.yaml --position=0,0,140 --method=exact",
            false);

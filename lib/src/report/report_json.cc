@@ -137,6 +137,7 @@ void JsonProvenance(const ReportInputs& in, JsonWriter* w) {
   JsonFile(w, "model", in.model_path, in.model_digest);
   JsonFile(w, "spec", in.spec_path, in.spec_digest);
   JsonFile(w, "data", in.data_path, in.data_digest);
+  JsonFile(w, "columns", in.columns_path, in.columns_digest);
   w->EndObject();
   w->Key("spec_yaml");
   if (spec)
@@ -320,6 +321,25 @@ void JsonSamples(const ReportInputs& in, JsonWriter* w) {
     for (const std::string& why : in.data->skipped) w->String(why);
   }
   w->EndArray();
+  // The samples' first and last time: time_s to 17 digits, and as dates and times (ISO
+  // 8601, the data's zone) when they are Unix times (time_text.h), else null.
+  double first = std::numeric_limits<double>::infinity(), last = -first;
+  if (in.sample_stream != nullptr) {
+    first = in.sample_stream->time_min_s;
+    last = in.sample_stream->time_max_s;
+  } else if (in.data) {
+    for (const Sample& s : in.data->samples) {
+      first = std::min(first, s.time_s);
+      last = std::max(last, s.time_s);
+    }
+  }
+  const TimeDisplay display = TimeDisplayFor(first, in.data ? in.data->time_offset_s : 0);
+  w->Key("time_first_s").ExactNumber(first);
+  w->Key("time_last_s").ExactNumber(last);
+  w->Key("time_first");
+  if (display.absolute) w->String(IsoUnixTime(first, display.offset_s)); else w->Null();
+  w->Key("time_last");
+  if (display.absolute) w->String(IsoUnixTime(last, display.offset_s)); else w->Null();
   w->EndObject();
 }
 

@@ -191,7 +191,11 @@ std::string ChangeScanPlot(const ChangeScanResult& scan) {
   }
   PlotOptions o;
   o.title = "Change scan: a step of the scanned parameters at each time";
-  o.x_label = "time of the first sample after the step [s]";
+  const TimeDisplay& display = scan.time_display;
+  o.x_unix_time = display.absolute;
+  o.x_time_offset_s = display.offset_s;
+  o.x_label = display.absolute ? "first sample after the step: " + TimeAxisLabel(t0, t1, display)
+                               : "time of the first sample after the step [s]";
   o.y_label = "W (first round)";
   std::vector<PlotSeries> series{statistic, threshold};
   if (!scan.changes.empty()) series.push_back(changes);
@@ -237,19 +241,22 @@ void AddChangeScan(const CalibrationResult& r, bool with_plots, Document* doc) {
             .Bold(Int(static_cast<long long>(scan.changes.size())) +
                   (scan.changes.size() == 1 ? " change found." : " changes found."))
             .Plain(" The estimates are an average over the segments: cut the survey at the "
-                   "change (a session column, docs/data-format.md) and fit with sessions: "
-                   "{separate: [...]}, which gives each segment its own value and the "
-                   "difference its sigma_total."));
+                   "change and fit with sessions: {separate: [...]}, which gives each segment "
+                   "its own value and the difference its sigma_total: ")
+            .Code("fastcal calibrate --sessions-at=" + SessionsAtText(scan) + " ...")
+            .Plain(" (or --sessions-at=DIR/summary.json, this run's; docs/cli.md)."));
     Table t;
     t.caption = "Changes found (step: later minus earlier, +- its sigma)";
-    t.header = {"time [s]", "line", "W", "p"};
+    t.header = {scan.time_display.absolute ? "time" : "time [s]", "line", "W", "p"};
     t.right_align = {true, true, true, true};
     for (const std::string& p : scan.parameters) {
       t.header.push_back(Text().Code(p));
       t.right_align.push_back(true);
     }
     for (const FoundChange& c : scan.changes) {
-      std::vector<Text> row{Text(Sig6(c.time_s)), Text(Int(c.line)), Text(Sig3(c.statistic)),
+      const std::string when = scan.time_display.absolute ? TimeText(c.time_s, scan.time_display)
+                                                          : Sig6(c.time_s);
+      std::vector<Text> row{Text(when), Text(Int(c.line)), Text(Sig3(c.statistic)),
                             Text(Printf("%.2g", c.p_value))};
       for (size_t k = 0; k < c.shift.size(); ++k) {
         row.push_back(Text(Printf("%+.3g", c.shift[k]) + " +- " + Sig3(c.shift_sigma[k]) + " " +
@@ -309,7 +316,14 @@ void WriteChangeScanJson(const CalibrationResult& r, JsonWriter* w) {
   w->Key("changes").BeginArray();
   for (const FoundChange& c : scan.changes) {
     w->BeginObject();
-    w->Key("time_s").Number(c.time_s);
+    w->Key("time_s").ExactNumber(c.time_s);
+    // The date and time when the data's times are Unix times (ISO 8601, the data's zone).
+    w->Key("time");
+    if (scan.time_display.absolute) {
+      w->String(IsoUnixTime(c.time_s, scan.time_display.offset_s));
+    } else {
+      w->Null();
+    }
     w->Key("line").Number(c.line);
     w->Key("statistic").Number(c.statistic);
     w->Key("p_value").Number(c.p_value);
@@ -324,6 +338,13 @@ void WriteChangeScanJson(const CalibrationResult& r, JsonWriter* w) {
     w->EndObject();
   }
   w->EndArray();
+  // The value of --sessions-at that cuts the survey at the changes (null without).
+  w->Key("sessions_at");
+  if (scan.changes.empty()) {
+    w->Null();
+  } else {
+    w->String(SessionsAtText(scan));
+  }
 }
 
 }  // namespace fastcal::internal

@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "fastcal/internal/number_text.h"
+#include "fastcal/time_text.h"
 
 namespace fastcal {
 namespace {
@@ -425,6 +426,81 @@ Axis FitXAxis(double lo, double hi, double plot_w, double margin) {
   }
 }
 
+// A time axis (PlotOptions::x_unix_time): tick steps of round times, from a second to a
+// week, aligned in the axis' zone.
+constexpr double kTimeSteps[] = {1,     2,     5,     10,    15,    30,     60,     120,
+                                 300,   600,   900,   1800,  3600,  7200,   10800,  21600,
+                                 43200, 86400, 172800, 604800, 1209600, 2419200};
+constexpr double kDaySeconds = 86400.0;
+
+// Ticks at multiples of `step` in local time (Unix time + offset_s) within [lo, hi].
+std::vector<double> TimeTicks(double lo, double hi, double step, int offset_s) {
+  std::vector<double> ticks;
+  const double first = std::ceil((lo + offset_s) / step - 1e-9) * step - offset_s;
+  for (double t = first; t <= hi + 1e-9 * step && ticks.size() < 1000; t += step) {
+    ticks.push_back(t);
+  }
+  return ticks;
+}
+
+// The labels of time ticks: clock times ("12:30", "12:30:15"), with the date ("05-02
+// 00:00", "2024-05-02") when the axis spans more than a day.
+std::vector<std::string> TimeTickLabels(const std::vector<double>& ticks, double lo, double hi,
+                                        double step, int offset_s) {
+  const std::string first = FormatUnixTime(lo, offset_s), last = FormatUnixTime(hi, offset_s);
+  const bool one_day = first.size() >= 19 && last.size() >= 19 &&
+                       first.compare(0, 10, last, 0, 10) == 0;
+  const bool one_year = first.size() >= 19 && last.size() >= 19 &&
+                        first.compare(0, 4, last, 0, 4) == 0;
+  std::vector<std::string> labels;
+  for (double t : ticks) {
+    const std::string text = FormatUnixTime(t, offset_s);  // "2024-05-01 12:34:56"
+    if (text.size() < 19) {  // beyond the years shown as dates: the number
+      labels.push_back(text);
+    } else if (step >= kDaySeconds) {
+      labels.push_back(one_year ? text.substr(5, 5) : text.substr(0, 10));
+    } else {
+      const std::string clock = text.substr(11, step < 60.0 ? 8 : 5);
+      labels.push_back(one_day ? clock : text.substr(5, 5) + " " + clock);
+    }
+  }
+  return labels;
+}
+
+struct TimeAxis {
+  double lo = 0.0, hi = 1.0, step = 1.0;
+  std::vector<double> ticks;
+  std::vector<std::string> labels;
+};
+
+// A snug time axis (as SnugAxis) with room between its labels.
+TimeAxis FitTimeAxis(double lo, double hi, double plot_w, double margin, int offset_s) {
+  if (!(hi > lo)) {
+    lo -= 30.0;
+    hi += 30.0;
+  }
+  const double pad = margin * (hi - lo);
+  TimeAxis axis;
+  axis.lo = lo - pad;
+  axis.hi = hi + pad;
+  const int target = std::clamp(static_cast<int>(plot_w / 90.0), 2, 10);
+  for (double step : kTimeSteps) {
+    if ((axis.hi - axis.lo) / step > target * 1.5 && step != kTimeSteps[std::size(kTimeSteps) - 1]) {
+      continue;
+    }
+    axis.step = step;
+    axis.ticks = TimeTicks(axis.lo, axis.hi, step, offset_s);
+    axis.labels = TimeTickLabels(axis.ticks, axis.lo, axis.hi, step, offset_s);
+    const double spacing = plot_w * step / (axis.hi - axis.lo);
+    if (axis.ticks.size() >= 2 &&
+        spacing < MaxTextWidth(axis.labels, kTickFontPx) + 12.0) {
+      continue;  // labels would overlap: a longer step
+    }
+    if (axis.ticks.size() >= 2 || step == kTimeSteps[std::size(kTimeSteps) - 1]) break;
+  }
+  return axis;
+}
+
 void DrawYAxis(std::string* out, const Box& box, const Scale& ys, const std::vector<double>& ticks,
                const PlotOptions& options) {
   const std::vector<std::string> labels = TickLabels(ticks);
@@ -446,8 +522,9 @@ void XLabel(std::string* out, const Box& box, const PlotOptions& options, Size s
 }
 
 void DrawXAxis(std::string* out, const Box& box, const Scale& xs, const std::vector<double>& ticks,
-               const PlotOptions& options, Size size) {
-  const std::vector<std::string> labels = TickLabels(ticks);
+               const PlotOptions& options, Size size,
+               const std::vector<std::string>* tick_labels = nullptr) {
+  const std::vector<std::string> labels = tick_labels ? *tick_labels : TickLabels(ticks);
   const double bottom = box.y + box.h;
   for (size_t i = 0; i < ticks.size(); ++i) {
     const double x = xs(ticks[i]);
@@ -534,7 +611,16 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
   Frame f = StartFrame(options, std::move(legend), kXTickLabelsPx);
   const Axis y_axis = SnugAxis(y_lo, y_hi, YTickTarget(f.box.h), kYMargin);
   FinishFrame(&f, options, TickLabels(y_axis.ticks), 30.0);
-  const Axis x_axis = FitXAxis(x_lo, x_hi, f.box.w, kXMargin);
+  Axis x_axis;
+  TimeAxis time_axis;
+  if (options.x_unix_time) {
+    time_axis = FitTimeAxis(x_lo, x_hi, f.box.w, kXMargin, options.x_time_offset_s);
+    x_axis.lo = time_axis.lo;
+    x_axis.hi = time_axis.hi;
+    x_axis.ticks = time_axis.ticks;
+  } else {
+    x_axis = FitXAxis(x_lo, x_hi, f.box.w, kXMargin);
+  }
   const Box& box = f.box;
   const Scale xs{x_axis.lo, x_axis.hi, box.x, box.x + box.w};
   const Scale ys{y_axis.lo, y_axis.hi, box.y + box.h, box.y};
@@ -542,7 +628,8 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
   std::string out;
   OpenSvg(&out, f.size, options.title);
   DrawYAxis(&out, box, ys, y_axis.ticks, options);
-  DrawXAxis(&out, box, xs, x_axis.ticks, options, f.size);
+  DrawXAxis(&out, box, xs, x_axis.ticks, options, f.size,
+            options.x_unix_time ? &time_axis.labels : nullptr);
 
   // An isolated point of a line (between gaps): a small stroked ring, reads as a dot.
   constexpr const char* kDot = "m-1.2 0a1.2 1.2 0 1 0 2.4 0a1.2 1.2 0 1 0 -2.4 0";

@@ -10,6 +10,7 @@
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/sessions.h"
+#include "fastcal/time_text.h"
 #include "track/track_run.h"
 
 namespace fastcal {
@@ -18,8 +19,6 @@ namespace {
 using internal::TrackRun;
 
 constexpr double kSecondsPerDay = 86400.0;
-// Unix times start here (time_text.h's rule: smaller times are seconds of any epoch).
-constexpr double kUnixTimeFromS = 1e8;
 
 bool InGroups(const ParameterSpec& p, const std::vector<std::string>& groups) {
   for (const std::string& g : groups) {
@@ -93,6 +92,7 @@ TrackStatus Validate(TrackRun& run) {
   }
   run.model_yaml = CableRobotToYaml(run.model, "");
   run.spec_yaml = CalibrationSpecToYaml(run.spec);
+  if (run.options.read.columns) run.columns_text = run.options.read.columns->text;
   run.result->window = run.window;
   run.result->false_alarm = run.options.false_alarm;
   for (int k : run.layout.window_columns) {
@@ -121,62 +121,20 @@ TrackStatus Points(TrackRun& run) {
 
 TrackStatus Solve(TrackRun& run) { return internal::Iterate(run, true); }
 
-std::string Two(int v) {
-  char buffer[8];
-  std::snprintf(buffer, sizeof(buffer), "%02d", v);
-  return buffer;
-}
-
-// Civil date of a day count from 1970-01-01 (Hinnant's days_from_civil, inverted).
-void CivilFromDays(long long z, long long* y, int* m, int* d) {
-  z += 719468;
-  const long long era = (z >= 0 ? z : z - 146096) / 146097;
-  const long long doe = z - era * 146097;
-  const long long yoe = (doe - doe / 1460 + doe / 36524 - doe / 146096) / 365;
-  const long long doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
-  const long long mp = (5 * doy + 2) / 153;
-  *d = static_cast<int>(doy - (153 * mp + 2) / 5 + 1);
-  *m = static_cast<int>(mp < 10 ? mp + 3 : mp - 9);
-  *y = yoe + era * 400 + (*m <= 2);
-}
-
-std::string DateText(long long day) {
-  long long y = 0;
-  int m = 0, d = 0;
-  CivilFromDays(day, &y, &m, &d);
-  return std::to_string(y) + "-" + Two(m) + "-" + Two(d);
-}
-
 }  // namespace
 
 namespace internal {
 
 std::string TrackTimeText(double time_s) {
-  if (!(time_s >= kUnixTimeFromS && time_s < 253402300800.0)) {
-    return FormatDouble("%.17g", time_s);
-  }
-  const double day = std::floor(time_s / kSecondsPerDay);
-  const double in_day = time_s - day * kSecondsPerDay;
-  const int whole = static_cast<int>(std::floor(in_day));
-  std::string text = DateText(static_cast<long long>(day)) + "T" + Two(whole / 3600) + ":" +
-                     Two(whole / 60 % 60) + ":" + Two(whole % 60);
-  const double fraction = in_day - whole;
-  if (fraction > 0.0) {
-    std::string f = FormatDouble("%.6f", fraction).substr(1);  // ".123456"
-    while (f.back() == '0') f.pop_back();
-    if (f.size() > 1) text += f;
-  }
-  return text + "Z";
+  return IsUnixTime(time_s) ? IsoUnixTime(time_s, 0) : TimeValueText(time_s, TimeDisplay());
 }
 
-std::string WindowLabel(const WindowSpec& window, long long key, double start_s) {
-  if (!(start_s >= kUnixTimeFromS)) return "t" + FormatDouble("%.0f", start_s);
-  const long long day = static_cast<long long>(std::floor(start_s / kSecondsPerDay));
-  if (std::fmod(window.duration_s, kSecondsPerDay) == 0.0) return DateText(day);
-  const int in_day = static_cast<int>(start_s - day * kSecondsPerDay);
-  std::string label = DateText(day) + "T" + Two(in_day / 3600) + Two(in_day / 60 % 60);
-  if (in_day % 60 != 0) label += Two(in_day % 60);
-  (void)key;
+std::string WindowLabel(const WindowSpec& window, double start_s) {
+  if (!IsUnixTime(start_s)) return "t" + FormatDouble("%.0f", start_s);
+  const std::string text = FormatUnixTime(start_s, 0);  // "2024-05-01 06:00:00"
+  if (std::fmod(window.duration_s, kSecondsPerDay) == 0.0) return text.substr(0, 10);
+  std::string label = text.substr(0, 10) + "T" + text.substr(11, 2) + text.substr(14, 2);
+  if (text.substr(17, 2) != "00") label += text.substr(17, 2);
   return label + "Z";
 }
 

@@ -47,6 +47,7 @@ std::string StateJson(const TrackRun& run) {
   j.Key("generation").Int(run.generation);
   j.Key("model_yaml").String(run.model_yaml);
   j.Key("spec_yaml").String(run.spec_yaml);
+  j.Key("columns").String(run.columns_text);
   j.Key("slow_error").BeginObject();
   j.Key("sigma_n").ExactNumber(run.slow.sigma_n);
   j.Key("sigma_percent").ExactNumber(run.slow.sigma_percent);
@@ -113,7 +114,7 @@ std::string Text(const YAML::Node& node) {
 // The saved state into `run` (files, windows, shared values, slow error). Throws
 // YAML::Exception on a malformed file.
 struct SavedState {
-  std::string window, model_yaml, spec_yaml;
+  std::string window, model_yaml, spec_yaml, columns;
   int generation = 0;
   SlowErrorProcess slow;
   std::vector<TrackFile> files;
@@ -130,6 +131,7 @@ SavedState ParseState(const std::string& text) {
   s.generation = static_cast<int>(Integer(root["generation"]));
   s.model_yaml = Text(root["model_yaml"]);
   s.spec_yaml = Text(root["spec_yaml"]);
+  s.columns = Text(root["columns"]);
   s.slow.sigma_n = Real(root["slow_error"]["sigma_n"]);
   s.slow.sigma_percent = Real(root["slow_error"]["sigma_percent"]);
   s.slow.time_constant_s = Real(root["slow_error"]["time_constant_s"]);
@@ -167,6 +169,9 @@ std::string Mismatch(const TrackRun& run, const SavedState& s) {
   if (s.model_yaml != run.model_yaml) return "another model";
   if (s.spec_yaml != run.spec_yaml) return "another spec";
   if (s.window != WindowSpecText(run.window)) return "windows of " + s.window;
+  if (s.columns != run.columns_text) {
+    return s.columns.empty() ? "files read without a column map" : "files read through another column map";
+  }
   for (const TrackFile& f : s.files) {
     if (std::find(run.data_paths.begin(), run.data_paths.end(), f.path) == run.data_paths.end()) {
       return "data of " + f.path + ", not given now";
@@ -287,7 +292,7 @@ bool Route(Router& router, const Sample& s, int file_index, const std::string& s
     const double d = run.window.duration_s;
     const double k = std::floor(s.time_s / d);
     w = router.WindowFor(static_cast<long long>(k), k * d, (k + 1.0) * d,
-                         WindowLabel(run.window, static_cast<long long>(k), k * d));
+                         WindowLabel(run.window, k * d));
   }
   TrackWindowState& win = run.windows[w];
   win.first_s = std::min(win.first_s, s.time_s);

@@ -64,14 +64,16 @@ Candidate BestStep(const TrackRun& run, const std::vector<int>& columns) {
 
 std::string WindowText(const TrackRun& run, int u) { return run.windows[run.used[u]].label; }
 
-// An event between used windows u - 1 and u.
-TrackEvent EventAt(const TrackRun& run, int u, const std::string& kind, double statistic, int dof,
-                   double threshold, int tests) {
+// An event between used windows `from` (the last with the old value) and `to` (the first
+// with the new one).
+TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind,
+                   double statistic, int dof, double threshold, int tests) {
   TrackEvent e;
   e.kind = kind;
-  e.window = u;
-  e.time_s = run.windows[run.used[u]].first_s;
-  e.previous_time_s = run.windows[run.used[u - 1]].last_s;
+  e.window = to;
+  e.previous_window = from;
+  e.time_s = run.windows[run.used[to]].first_s;
+  e.previous_time_s = run.windows[run.used[from]].last_s;
   e.degrees_of_freedom = dof;
   e.statistic = statistic;
   e.threshold = threshold;

@@ -8,27 +8,36 @@
 #include "fastcal/internal/number_text.h"
 #include "fastcal/slow_error.h"
 #include "fastcal/svg_plot.h"
+#include "fastcal/time_text.h"
 #include "track/track_run.h"
 
 namespace fastcal::internal {
 namespace {
 
-constexpr double kSecondsPerDay = 86400.0;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string Esc(const std::string& s) { return XmlEscape(s); }
 
-// The x of a window: its middle, in days since the first window's start.
+// The time axis: dates and clock times in UTC for Unix times (svg_plot.h's clock-time
+// axis), seconds otherwise.
 struct TimeAxis {
-  double origin_s = 0.0;
+  bool absolute = false;
   std::string label;
-  double X(double t) const { return (t - origin_s) / kSecondsPerDay; }
+  double X(double t) const { return t; }
+  void Apply(PlotOptions* o) const {
+    o->x_label = label;
+    o->x_unix_time = absolute;
+    o->x_time_offset_s = 0;
+  }
 };
 
 TimeAxis AxisOf(const TrackResult& r) {
   TimeAxis axis;
-  axis.origin_s = r.windows.front().start_s;
-  axis.label = "days since " + TrackTimeText(axis.origin_s);
+  const TimeDisplay display = TimeDisplayFor(r.windows.front().first_time_s, 0);
+  axis.absolute = display.absolute;
+  axis.label = axis.absolute ? TimeAxisLabel(r.windows.front().first_time_s,
+                                             r.windows.back().last_time_s, display)
+                             : "time_s [s]";
   return axis;
 }
 
@@ -70,7 +79,7 @@ std::string ParameterPlot(const TrackResult& r, const TimeAxis& axis, size_t k) 
   }
   PlotOptions o;
   o.title = r.window_parameters[k] + " per window";
-  o.x_label = axis.label;
+  axis.Apply(&o);
   o.y_label = r.window_parameters[k] + " [" + r.window_units[k] + "]";
   o.width_px = 1100;
   o.height_px = 260;
@@ -94,7 +103,7 @@ std::string OffsetPlot(const TrackResult& r, const TimeAxis& axis) {
   series.push_back(EventLines(r, axis, lo, hi, "sensor"));
   PlotOptions o;
   o.title = "what each sensor's bias reads per window";
-  o.x_label = axis.label;
+  axis.Apply(&o);
   o.y_label = "offset [kN]";
   o.width_px = 1100;
   o.height_px = 300;

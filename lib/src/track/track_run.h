@@ -79,6 +79,7 @@ struct TrackRun {
   bool update = false;  // DIR held a track
   int generation = 0;   // of this run's fold files
   std::string model_yaml, spec_yaml;
+  std::string columns_text;  // the column map the files are read through ("" none)
   TrackLayout layout;
   std::vector<TrackFile> files;
   std::vector<TrackWindowState> windows;  // time order
@@ -118,7 +119,7 @@ struct TrackRun {
 // seconds as a number.
 std::string TrackTimeText(double time_s);
 // The window's label from its key (track.h, TrackWindow::label).
-std::string WindowLabel(const WindowSpec& window, long long key, double start_s);
+std::string WindowLabel(const WindowSpec& window, double start_s);
 
 // Stages of track_data.cc.
 TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<std::string>* out,

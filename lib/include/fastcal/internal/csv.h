@@ -17,7 +17,8 @@ inline std::string WrongSeparatorMessage(std::string_view header) {
                                                                         : nullptr;
   if (separator == nullptr) return "";
   return std::string("the header is separated by ") + separator +
-         ": fields must be separated by commas";
+         ": fields must be separated by commas, or read the export as it is through a "
+         "column map (--columns=MAP.yaml, docs/data-format.md, \"Column maps\")";
 }
 
 // `text` as one CSV field in double quotes, inner quotes doubled (RFC 4180), so that

@@ -1,0 +1,252 @@
+"""Telemetry as it comes: column maps, spreadsheets, arrays and DataFrames
+(docs/data-format.md, "Column maps"; docs/python.md)."""
+
+from __future__ import annotations
+
+import datetime
+import pathlib
+import subprocess
+import sys
+from typing import Optional
+
+import numpy as np
+import pytest
+
+import fastcal
+
+FAST_MAP = {
+    "format": "fastcal-columns-1",
+    "delimiter": ";",
+    "decimal": ",",
+    "header_line": 2,
+    "skip_after_header": 1,
+    "time": {"column": "SysTime", "format": "iso8601", "zone": "+08:00"},
+    "columns": {
+        "x_m": {"column": "SDP_PhaPos_X", "unit": "mm"},
+        "y_m": {"column": "SDP_PhaPos_Y", "unit": "mm"},
+        "z_m": {"column": "SDP_PhaPos_Z", "unit": "mm"},
+        "yaw_deg": "SDP_SwtDPose_Y",
+        "pitch_deg": "SDP_SwtDPose_P",
+        "roll_deg": "SDP_SwtDPose_R",
+        **{f"T{i}_kN": {"column": f"CableForce{i}", "unit": "N"} for i in range(1, 7)},
+    },
+    "unmapped": "ignore",
+}
+START = 1714564800.0  # 2024-05-01T20:00:00+08:00
+
+
+def test_the_bundled_export_reads_through_its_map_as_the_survey(data_dir: pathlib.Path) -> None:
+    survey = fastcal.read_dataset(data_dir / "realistic_survey.csv")
+    exported = fastcal.read_dataset(
+        data_dir / "fast_export.csv", columns=data_dir / "fast_export.columns.yaml"
+    )
+    assert len(exported) == len(survey)
+    np.testing.assert_array_equal(exported.position_m, survey.position_m)
+    np.testing.assert_array_equal(exported.tension_kN, survey.tension_kN)
+    np.testing.assert_array_equal(exported.planned_rpy_deg, survey.planned_rpy_deg)
+    np.testing.assert_array_equal(exported.time_s - START, survey.time_s)
+    assert exported.time_offset_s == 8 * 3600
+    # The map as a dict: the same.
+    as_dict = fastcal.read_dataset(data_dir / "fast_export.csv", columns=FAST_MAP)
+    np.testing.assert_array_equal(as_dict.tension_kN, survey.tension_kN)
+
+
+def test_map_errors_name_the_key_and_line(tmp_path: pathlib.Path, data_dir: pathlib.Path) -> None:
+    bad = tmp_path / "map.yaml"
+    bad.write_text(
+        "format: fastcal-columns-1\ntime: SysTime\ncolumns:\n  x_m: {column: X, unit: inch}\n"
+    )
+    with pytest.raises(fastcal.InputError, match=r"map.yaml:4: columns.x_m.unit: unknown unit 'inch'"):
+        fastcal.read_dataset(data_dir / "fast_export.csv", columns=bad)
+    # A dict has no lines: the key path alone.
+    broken = dict(FAST_MAP, columns={**FAST_MAP["columns"], "y_m": {"column": "SDP_PhaPos_X"}})
+    with pytest.raises(fastcal.InputError) as error:
+        fastcal.read_dataset(data_dir / "fast_export.csv", columns=broken)
+    assert str(error.value).startswith("columns (dict): columns.y_m.column: source column ")
+    with pytest.raises(FileNotFoundError):
+        fastcal.read_dataset(data_dir / "fast_export.csv", columns=tmp_path / "missing.yaml")
+
+
+def test_value_errors_name_the_source_column_and_the_fastcal_name(tmp_path: pathlib.Path) -> None:
+    path = tmp_path / "export.csv"
+    path.write_text(
+        "t;X;Y;Z;R;P;W;F1;F2;F3;F4;F5;F6\n0;1000;0;150000;0;0;0;2e5;2e5;abc;2e5;2e5;2e5\n"
+    )
+    columns = {
+        "format": "fastcal-columns-1",
+        "time": "t",
+        "columns": {
+            "x_m": {"column": "X", "unit": "mm"},
+            "y_m": {"column": "Y", "unit": "mm"},
+            "z_m": {"column": "Z", "unit": "mm"},
+            "roll_deg": "R",
+            "pitch_deg": "P",
+            "yaw_deg": "W",
+            **{f"T{i}_kN": {"column": f"F{i}", "unit": "N"} for i in range(1, 7)},
+        },
+    }
+    with pytest.raises(fastcal.InputError, match=r"export.csv:2: column 'F3' \(T3_kN, N\): 'abc'"):
+        fastcal.read_dataset(path, columns=columns)
+
+
+def _survey_arrays(data_dir: pathlib.Path) -> fastcal.Dataset:
+    return fastcal.read_dataset(data_dir / "realistic_survey.csv")
+
+
+def test_from_arrays_checks_as_the_reader_does(data_dir: pathlib.Path) -> None:
+    survey = _survey_arrays(data_dir)
+    data = fastcal.Dataset.from_arrays(
+        survey.time_s, survey.position_m, survey.tension_kN, rpy_deg=survey.rpy_deg,
+        planned_rpy_deg=survey.planned_rpy_deg, s0_m=survey.s0_m,
+    )
+    assert len(data) == len(survey)
+    # Tensions are held in N: kN to N and back, to the last bit or one ulp.
+    np.testing.assert_allclose(data.tension_kN, survey.tension_kN, rtol=3e-16, atol=0)
+    np.testing.assert_array_equal(data.position_m, survey.position_m)
+    np.testing.assert_array_equal(data.rpy_deg, survey.rpy_deg)
+    assert data.line[0] == 1  # rows, from 1
+    tension = survey.tension_kN.copy()
+    tension[2, 1] = -5.0
+    with pytest.raises(fastcal.InputError, match=r"^arrays, row 3: column 'T2_kN': -5 kN is negative"):
+        fastcal.Dataset.from_arrays(survey.time_s, survey.position_m, tension, rpy_deg=survey.rpy_deg)
+    position = survey.position_m.copy()
+    position[4, 2] = np.nan
+    with pytest.raises(fastcal.InputError, match=r"row 5: column 'z_m': value is not finite"):
+        fastcal.Dataset.from_arrays(survey.time_s, position, survey.tension_kN, rpy_deg=survey.rpy_deg)
+    with pytest.raises(fastcal.InputError, match="rpy_deg or quat"):
+        fastcal.Dataset.from_arrays(survey.time_s, survey.position_m, survey.tension_kN)
+    with pytest.raises(fastcal.InputError, match=r"tension_kN must have shape \(1441, 6\)"):
+        fastcal.Dataset.from_arrays(survey.time_s, survey.position_m, survey.tension_kN[:, :5],
+                                    rpy_deg=survey.rpy_deg)
+    # Radians under degrees, as the file reader refuses them.
+    with pytest.raises(fastcal.InputError, match="look like radians"):
+        fastcal.Dataset.from_arrays(survey.time_s, survey.position_m, survey.tension_kN,
+                                    rpy_deg=np.radians(survey.rpy_deg),
+                                    planned_rpy_deg=np.radians(survey.planned_rpy_deg))
+    skipped = fastcal.Dataset.from_arrays(survey.time_s, survey.position_m, tension,
+                                          rpy_deg=survey.rpy_deg, skip_invalid_rows=True)
+    assert len(skipped) == len(survey) - 1
+    assert skipped.skipped[0].startswith("arrays, row 3: ")
+    sessions = ["a" if k < 700 else "b" for k in range(len(survey))]
+    labelled = fastcal.Dataset.from_arrays(survey.time_s, survey.position_m, survey.tension_kN,
+                                           quat=survey.quat, session=sessions)
+    assert labelled.session_labels == ["a", "b"]
+
+
+def test_from_dataframe(data_dir: pathlib.Path) -> None:
+    pd = pytest.importorskip("pandas", reason="python3-pandas is not installed")
+    survey = _survey_arrays(data_dir)
+    frame = pd.DataFrame({"time_s": survey.time_s})
+    for k, name in enumerate(("x_m", "y_m", "z_m")):
+        frame[name] = survey.position_m[:, k]
+    for k, name in enumerate(("roll_deg", "pitch_deg", "yaw_deg")):
+        frame[name] = survey.rpy_deg[:, k]
+    for i in range(6):
+        frame[f"T{i + 1}_kN"] = survey.tension_kN[:, i]
+    data = fastcal.Dataset.from_dataframe(frame)
+    np.testing.assert_allclose(data.tension_kN, survey.tension_kN, rtol=3e-16, atol=0)
+    np.testing.assert_array_equal(data.time_s, survey.time_s)
+    # The export's names, a datetime column and newtons, through a map.
+    export = pd.DataFrame(
+        {
+            "SysTime": pd.Timestamp("2024-05-01 20:00:00") + pd.to_timedelta(survey.time_s, unit="s"),
+            "SDP_PhaPos_X": survey.position_m[:, 0] * 1e3,
+            "SDP_PhaPos_Y": survey.position_m[:, 1] * 1e3,
+            "SDP_PhaPos_Z": survey.position_m[:, 2] * 1e3,
+            "SDP_SwtDPose_Y": survey.rpy_deg[:, 2],
+            "SDP_SwtDPose_P": survey.rpy_deg[:, 1],
+            "SDP_SwtDPose_R": survey.rpy_deg[:, 0],
+            "WindSpeed": 2.0,
+        }
+    )
+    for i in range(6):
+        export[f"CableForce{i + 1}"] = survey.tension_kN[:, i] * 1e3
+    mapped = fastcal.Dataset.from_dataframe(export, columns=FAST_MAP)
+    np.testing.assert_allclose(mapped.position_m, survey.position_m, rtol=1e-15, atol=1e-12)
+    np.testing.assert_allclose(mapped.tension_kN, survey.tension_kN, rtol=1e-15)
+    np.testing.assert_array_equal(mapped.time_s, START + survey.time_s)
+    export.loc[7, "CableForce2"] = -3.0
+    with pytest.raises(fastcal.InputError, match=r"^DataFrame, row 8: column 'CableForce2' \(T2_kN, N\)"):
+        fastcal.Dataset.from_dataframe(export, columns=FAST_MAP)
+
+
+def _write_workbook(path: pathlib.Path, survey: fastcal.Dataset, rows: int) -> None:
+    openpyxl = pytest.importorskip("openpyxl", reason="python3-openpyxl is not installed")
+    book = openpyxl.Workbook()
+    sheet = book.active
+    sheet.title = "Telemetry"
+    sheet.append(["FAST feed cabin telemetry, export of 2024-05-01"])
+    sheet.append(["SysTime", "SDP_PhaPos_X", "SDP_PhaPos_Y", "SDP_PhaPos_Z", "SDP_SwtDPose_Y",
+                  "SDP_SwtDPose_P", "SDP_SwtDPose_R"] + [f"CableForce{i}" for i in range(1, 7)]
+                 + ["WindSpeed"])
+    sheet.append(["(Beijing time)", "mm", "mm", "mm", "deg", "deg", "deg"] + ["N"] * 6 + ["m/s"])
+    start = datetime.datetime(2024, 5, 1, 20, 0, 0)
+    for k in range(rows):
+        sheet.append(
+            [start + datetime.timedelta(seconds=float(survey.time_s[k]))]
+            + [float(v) * 1e3 for v in survey.position_m[k]]
+            + [float(survey.rpy_deg[k, 2]), float(survey.rpy_deg[k, 1]), float(survey.rpy_deg[k, 0])]
+            + [float(v) * 1e3 for v in survey.tension_kN[k]]
+            + [2.5]
+        )
+    book.save(path)
+
+
+def test_reads_an_xlsx_workbook_through_a_map(tmp_path: pathlib.Path, data_dir: pathlib.Path) -> None:
+    survey = _survey_arrays(data_dir)
+    path = tmp_path / "export.xlsx"
+    _write_workbook(path, survey, 40)
+    columns = dict(FAST_MAP)
+    del columns["delimiter"]
+    columns["decimal"] = "."
+    data = fastcal.read_dataset(path, columns=columns)
+    assert len(data) == 40
+    assert data.line[0] == 4  # the sheet's row
+    np.testing.assert_allclose(data.position_m, survey.position_m[:40], rtol=1e-15, atol=1e-12)
+    np.testing.assert_allclose(data.tension_kN, survey.tension_kN[:40], rtol=1e-15)
+    np.testing.assert_array_equal(data.time_s, START + survey.time_s[:40])
+    same = fastcal.read_dataset(path, columns=columns, sheet="Telemetry")
+    np.testing.assert_array_equal(same.time_s, data.time_s)
+    with pytest.raises(fastcal.InputError, match=r"no sheet 'Other' \(sheets: Telemetry\)"):
+        fastcal.read_dataset(path, columns=columns, sheet="Other")
+    # A bad cell: the sheet's row and the source column.
+    import openpyxl
+
+    book = openpyxl.load_workbook(path)
+    book.active["H10"] = "n/a"
+    book.save(path)
+    with pytest.raises(fastcal.InputError,
+                       match=r"export.xlsx\[Telemetry\]:10: column 'CableForce1' \(T1_kN, N\): 'n/a'"):
+        fastcal.read_dataset(path, columns=columns)
+
+
+def test_an_xlsx_without_openpyxl_names_the_package(
+    tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    path = tmp_path / "export.xlsx"
+    path.write_bytes(b"PK\x03\x04")
+    monkeypatch.setitem(sys.modules, "openpyxl", None)  # import openpyxl now fails
+    with pytest.raises(ImportError, match="apt-get install python3-openpyxl"):
+        fastcal.read_dataset(path, columns=FAST_MAP)
+
+
+def test_the_cli_refuses_an_xlsx_naming_the_python_route(
+    tmp_path: pathlib.Path, cli: Optional[str]
+) -> None:
+    if cli is None:
+        pytest.skip("the fastcal executable was not built")
+    path = tmp_path / "export.xlsx"
+    path.write_bytes(b"PK\x03\x04 a workbook")
+    run = subprocess.run([cli, "evaluate", f"--data={path}"], capture_output=True, text=True,
+                         check=False)
+    assert run.returncode == 2
+    assert "fastcal.read_dataset(" in run.stderr
+    assert "xlsx2csv" in run.stderr
+
+
+def test_the_bundled_export_is_what_its_script_writes(source_dir: pathlib.Path) -> None:
+    run = subprocess.run(
+        [sys.executable, str(source_dir / "scripts" / "make_fast_export.py"), "--check"],
+        capture_output=True, text=True, check=False,
+    )
+    assert run.returncode == 0, run.stdout + run.stderr
