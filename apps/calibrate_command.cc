@@ -27,17 +27,20 @@
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/change_scan.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/evaluation_stream.h"
 #include "fastcal/file_digest.h"
+#include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/internal/report_document.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/sessions.h"
+#include "fastcal/trajectory.h"
 #include "fastcal/version.h"
 
 DECLARE_string(model);
@@ -379,6 +382,25 @@ std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
   return s;
 }
 
+// The paper's published Table 6 under the RMS table when the data fly its measured circle
+// (PaperCircleMatcher: by the positions, whoever made the file); "" otherwise.
+std::string PaperTable6Lines(const PaperCircleMatcher& positions) {
+  if (!positions.Matches()) return "";
+  const char* labels[] = {"paper's Table 6: AAS", "paper's Table 6: actual attitudes",
+                          "paper's Table 6: + corrected mass centre"};
+  std::string s = "  the same circle on the telescope (the paper's published RMS, kN):\n";
+  for (size_t k = 0; k < internal::kPaperTable6.size(); ++k) {
+    s += CableRow(labels[k], internal::kPaperTable6[k].rms_kn, 1.0);
+  }
+  return s;
+}
+
+PaperCircleMatcher PositionsOf(const Dataset& data) {
+  PaperCircleMatcher matcher;
+  for (const Sample& sample : data.samples) matcher.Add(sample.pose.position_m);
+  return matcher;
+}
+
 // --data's files: split at ',' (one session each, sessions.h), unless the whole value names
 // an existing file.
 std::vector<std::string> DataPaths() {
@@ -564,10 +586,9 @@ std::string ChiSquareWarning(const CalibrationResult& result) {
   return "";
 }
 
-// "1.23 mm", "0.031 kg/m": a sigma in the parameter's unit, 2 significant digits, with
-// lengths shown in mm below 1 m.
+// "0.0012 m", "0.031 kg/m": a sigma in the parameter's unit (the one its name carries, as
+// its estimate beside it), 2 significant digits.
 std::string SigmaText(double sigma, const std::string& unit) {
-  if (unit == "m" && std::abs(sigma) < 1.0) return FormatDouble(sigma * 1e3, 2) + " mm";
   return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
 }
 
@@ -623,6 +644,18 @@ std::string EstimateFlags(const ParameterEstimate& p) {
   return flags;
 }
 
+// A row of the estimates table with its note: after it when the row stays within
+// kConsoleWidth, else on the next line, indented (a NOT SOUND note is 60 columns).
+std::string WithNote(std::string row, std::string note) {
+  while (!note.empty() && note.back() == ' ') note.pop_back();
+  if (note.empty()) return row;
+  if (row.size() + 2 + note.size() <= kConsoleWidth) return row + "  " + note;
+  while (!row.empty() && row.back() == ' ') row.pop_back();
+  std::string wrapped = Wrapped(note, "      ", "      ", kNoteLines);
+  wrapped.pop_back();  // the rows are joined with newlines by the caller
+  return row + "\n" + wrapped;
+}
+
 // The free estimates: value +- sigma_total, the formal sigma and the widening. A group of
 // more than three per-cable or per-point parameters (sensor_gain[1..6]) is one row: the
 // range of its estimates and of their sigma_total. At most kEstimateRows rows; the fixed
@@ -643,11 +676,11 @@ std::string EstimatesTable(const CalibrationResult& result) {
     const std::vector<const ParameterEstimate*>& g = groups[key];
     if (g.size() < kGroupedFrom) {
       for (const ParameterEstimate* p : g) {
-        std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", p->name.c_str(),
+        std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s", p->name.c_str(),
                       ValueWithSigma(p->estimate, p->sigma_total, p->unit).c_str(),
                       SigmaText(p->sigma, p->unit).c_str(),
-                      ("x" + FormatDouble(p->widening, 2)).c_str(), EstimateFlags(*p).c_str());
-        rows.push_back(buf);
+                      ("x" + FormatDouble(p->widening, 2)).c_str());
+        rows.push_back(WithNote(buf, EstimateFlags(*p)));
       }
       continue;
     }
@@ -675,12 +708,13 @@ std::string EstimatesTable(const CalibrationResult& result) {
     };
     const std::string label =
         key + "[" + index_of(g.front()->name) + ".." + index_of(g.back()->name) + "]";
+    // The unit after the sigmas, as on a single row ("0.19 +- 0.03 m"): it is both's.
     const std::string unit = g.front()->unit == "1" ? "" : " " + g.front()->unit;
-    const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + unit + " +- " +
-                              FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2);
-    std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s  %s", label.c_str(), range.c_str(),
-                  "", ("<= x" + FormatDouble(widest, 2)).c_str(), flags.c_str());
-    rows.push_back(buf);
+    const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + " +- " +
+                              FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2) + unit;
+    std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s", label.c_str(), range.c_str(), "",
+                  ("<= x" + FormatDouble(widest, 2)).c_str());
+    rows.push_back(WithNote(buf, flags));
   }
   std::ostringstream s;
   std::snprintf(buf, sizeof(buf), "  %-29s %-31s %9s %8s  %s\n", "free parameter",
@@ -777,15 +811,15 @@ std::string MisfitLine(const CalibrationResult& result) {
             FormatDouble(top.expected_decrease, 3) + ", from " + top.name + ")",
         "  ", "    ", kNoteLines);
   }
-  std::string line = "  the misfit is best explained by freeing:";
+  std::string line = "the misfit is best explained by freeing:";
   for (size_t k = 0; k < std::min(kShown, result.misfit_ranking.size()); ++k) {
     const MisfitCandidate& c = result.misfit_ranking[k];
     if (!c.significant) break;
     line += std::string(k ? ", " : " ") + c.name + " (about " +
             FormatDouble(c.expected_decrease, 3) + ")";
   }
-  return Wrapped(line + " [expected chi-square decrease; each beyond the residuals' own noise]", "",
-                 "    ", kNoteLines);
+  return Wrapped(line + " [expected chi-square decrease; each beyond the residuals' own noise]",
+                 "  ", "    ", kNoteLines);
 }
 
 std::string CrossValidationLine(const CalibrationResult& result) {
@@ -848,6 +882,37 @@ std::string TimingLines(double read_s, double fit_s, double write_s,
   return s.str();
 }
 
+// The verdict: its reason cut to a few lines (the report has it whole), then what the
+// sessions, the change scan and the sensor-step test found, each whole on its own lines: a
+// change found is the news of the run, never cut off behind the misfit's explanation.
+std::string VerdictLines(const CalibrationResult& result) {
+  constexpr size_t kFindingLines = 8;
+  std::string reason = result.verdict_text;
+  std::vector<std::string> findings;  // in the verdict's order: sessions, then the scan
+  auto split_off = [&reason, &findings](const std::string& label, const std::string& part) {
+    const std::string tail = "; " + part;
+    if (reason.size() <= tail.size() ||
+        reason.compare(reason.size() - tail.size(), tail.size(), tail) != 0) {
+      return;
+    }
+    reason.resize(reason.size() - tail.size());
+    findings.insert(findings.begin(), label + ": " + part);
+  };
+  // The verdict's parts in the reverse of their order (calibration_verdict.cc).
+  if (const std::string steps = SensorStepVerdict(result.sensor_steps); !steps.empty()) {
+    split_off("sensor steps", steps);
+  }
+  if (result.change_scan.enabled) split_off("change scan", ChangeScanVerdict(result.change_scan));
+  if (!result.session_differences.empty()) {
+    split_off("sessions", SessionVerdict(result.session_differences));
+  }
+  std::string out =
+      Wrapped(std::string("verdict: ") + FitVerdictName(result.verdict) + ": " + reason, "", "  ",
+              2 * kNoteLines);
+  for (const std::string& f : findings) out += Wrapped(f, "  ", "    ", kFindingLines);
+  return out;
+}
+
 std::string CalibrationConsole(const CalibrationResult& result, const Dataset& data,
                                const std::vector<VariantEvaluation>& variants) {
   std::ostringstream s;
@@ -859,11 +924,7 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
                 result.reduced_chi_square, band.half_width, result.num_residuals,
                 result.num_fit_samples,
                 static_cast<int>(data.samples.size()) - result.num_fit_samples, result.seconds);
-  s << buf
-    << Wrapped(
-           std::string("verdict: ") + FitVerdictName(result.verdict) + ": " + result.verdict_text,
-           "", "  ", 2 * kNoteLines)
-    << "\n"
+  s << buf << VerdictLines(result) << "\n"
     << EstimatesTable(result) << ConsiderLines(result) << SessionLines(result);
   for (const std::string& note : result.notes) s << Wrapped(note, "  ", "    ", kNoteLines);
   for (const ParameterDirection& d : result.data_only.undetermined) {
@@ -880,8 +941,8 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
     s << Wrapped("strongly correlated: " + pairs, "  ", "    ", kNoteLines);
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
-    << RmsTable(variants) << CrossValidationLine(result) << "\nwrote " << FLAGS_out
-    << "/{model_calibrated.yaml, report.html, report.md, summary.json"
+    << RmsTable(variants) << CrossValidationLine(result) << PaperTable6Lines(PositionsOf(data))
+    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, report.html, report.md, summary.json"
     << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
 }
@@ -1127,13 +1188,13 @@ std::string EvaluationGrossErrorLines(const EvaluationScreen& screen) {
 // error (kN) per cable, then the gross errors.
 std::string EvaluationConsole(const Dataset& data, long long samples, StaticsMethod method,
                               const std::vector<VariantEvaluation>& variants,
-                              const EvaluationScreen& screen) {
+                              const EvaluationScreen& screen, const PaperCircleMatcher& positions) {
   std::ostringstream s;
   s << "fastcal evaluate: " << samples << " samples";
   s << SkippedNote(data);
   s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
     << StaticsMethodName(method) << "\n\n"
-    << RmsTable(variants);
+    << RmsTable(variants) << PaperTable6Lines(positions);
   for (const VariantEvaluation& v : variants) {
     s << "\n" << CableHeader(v.name + ":");
     s << CableRow("  RMS (%)", v.fit.rms_percent, 1.0);
@@ -1234,8 +1295,14 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
     };
     if (!WriteOutDirectory(command, {}, report, kEvaluateOutputs, residuals)) return kExitUsage;
   }
+  PaperCircleMatcher positions;
+  if (!evaluation.ForEach([&positions](const EvaluatedSample& s) { positions.Add(s.position_m); },
+                          &error)) {
+    PrintError(command, error);
+    return kExitFailure;
+  }
   std::cout << EvaluationConsole(data, evaluation.samples(), method, evaluation.variants(),
-                                 evaluation.screen());
+                                 evaluation.screen(), positions);
   return 0;
 }
 

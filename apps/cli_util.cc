@@ -34,9 +34,86 @@ bool WantsHelp(int argc, char** argv, int first) {
   return false;
 }
 
+namespace {
+
+// One spelling per unit, the data's (T1_kN, tension_sigma_percent); the old names stay
+// accepted, with a note, so that scripts and the bundled datasets' headers still run.
+const std::vector<std::pair<std::string, std::string>>& RenamedFlags() {
+  static const std::vector<std::pair<std::string, std::string>> kRenamed = {
+      {"min-tension-kn", "min-tension-kN"},
+      {"max-tension-kn", "max-tension-kN"},
+      {"sensor-bias-kn", "sensor-bias-kN"},
+      {"sensor-bias-spread-kn", "sensor-bias-spread-kN"},
+      {"tension-noise-kn", "tension-noise-kN"},
+      {"tension-noise-pct", "tension-noise-percent"},
+      {"outlier-scale-pct", "outlier-scale-percent"},
+      {"density-mismatch-pct", "density-mismatch-percent"},
+      {"tension-drift-pct", "tension-drift-percent"},
+      {"tension-drift-kn", "tension-drift-kN"},
+      {"sensor-rezero-kn", "sensor-rezero-kN"},
+      {"sensor-gain-spread-pct", "sensor-gain-spread-percent"}};
+  return kRenamed;
+}
+
+}  // namespace
+
+std::string DeprecatedFlagName(const std::string& old_name) {
+  for (const auto& [old, renamed] : RenamedFlags()) {
+    if (old == old_name) return renamed;
+  }
+  return "";
+}
+
+namespace {
+
+// Levenshtein distance of a and b, ignoring case (--min-tension-KN is one slip away).
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
+                        std::tolower(static_cast<unsigned char>(b[j - 1]));
+      const size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
+      diagonal = row[j];
+      row[j] = next;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::vector<std::string> ClosestNames(const std::string& name,
+                                      const std::set<std::string>& allowed) {
+  constexpr size_t kMaxShown = 3;
+  // Within a third of the name's length (at least 2): "--tension-nosie-percent" finds its
+  // flag, "--x" does not get a list of every short one.
+  const size_t within = std::max<size_t>(2, name.size() / 3);
+  std::vector<std::pair<size_t, std::string>> ranked;
+  for (const std::string& flag : allowed) {
+    size_t d = EditDistance(name, flag);
+    // A slip in an old name ("--tension-nosie-pct") leads to the new one.
+    for (const auto& [old, renamed] : RenamedFlags()) {
+      if (renamed == flag) d = std::min(d, EditDistance(name, old));
+    }
+    // A flag the name is the start of ("--tension-noise" for --tension-noise-percent).
+    const bool starts = name.size() >= 3 && flag.rfind(name, 0) == 0;
+    if (d <= within || starts) ranked.emplace_back(starts ? std::min(d, within) : d, flag);
+  }
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::vector<std::string> out;
+  for (size_t k = 0; k < ranked.size() && k < kMaxShown; ++k) out.push_back(ranked[k].second);
+  return out;
+}
+
 bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string& command,
                             const std::set<std::string>& allowed,
-                            std::vector<std::string>* normalised, std::string* error) {
+                            std::vector<std::string>* normalised, std::string* error,
+                            std::vector<std::string>* notes) {
   normalised->assign(1, argv[0]);
   std::set<std::string> seen;
   for (int i = first; i < argc; ++i) {
@@ -49,6 +126,14 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
     const size_t start = arg[1] == '-' ? 2 : 1;
     const size_t eq = arg.find('=');
     std::string name = arg.substr(start, eq == std::string::npos ? std::string::npos : eq - start);
+    if (const std::string renamed = DeprecatedFlagName(name);
+        !allowed.count(name) && !renamed.empty() && allowed.count(renamed)) {
+      if (notes != nullptr) {
+        notes->push_back("--" + name + " is deprecated; use --" + renamed +
+                         " (units spelt as in the data: _kN, _percent)");
+      }
+      name = renamed;
+    }
     std::string bare = name;
     if (!allowed.count(bare) && bare.rfind("no", 0) == 0 && allowed.count(bare.substr(2))) {
       bare = bare.substr(2);  // gflags' --noflag form of a boolean
@@ -58,8 +143,16 @@ bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string&
       if (c == '-') c = '_';
     }
     if (!allowed.count(bare)) {
+      std::string guess;
+      const std::vector<std::string> closest = ClosestNames(name, allowed);
+      for (size_t k = 0; k < closest.size(); ++k) {
+        guess += std::string(k == 0                   ? "; did you mean "
+                             : k + 1 < closest.size() ? ", "
+                                                      : " or ") +
+                 "--" + closest[k];
+      }
       *error = "unknown flag --" + internal::Escape(name.substr(0, internal::kMaxQuotedBytes)) +
-               " (see fastcal " + command + " --help)";
+               (guess.empty() ? "" : guess + "?") + " (see fastcal " + command + " --help)";
       return false;
     }
     if (!seen.insert(bare).second) {
@@ -128,13 +221,14 @@ bool StartCommand(int argc, char** argv, const std::string& command, const char*
     *exit_code = 0;
     return false;
   }
-  std::vector<std::string> args;
+  std::vector<std::string> args, notes;
   std::string error;
-  if (!CheckAndNormaliseFlags(argc, argv, 2, command, allowed, &args, &error)) {
+  if (!CheckAndNormaliseFlags(argc, argv, 2, command, allowed, &args, &error, &notes)) {
     PrintError(command, error);
     *exit_code = kExitUsage;
     return false;
   }
+  for (const std::string& note : notes) PrintError(command, "note: " + note);
   ParseFlags(args);
   return true;
 }

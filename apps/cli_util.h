@@ -21,12 +21,27 @@ inline constexpr int kExitUsage = 2;
 
 // Checks every "--name[=value]" in argv[first..] against `allowed` (names with dashes as
 // the user types them), rewrites dashes in the names to the underscores gflags uses, and
-// returns the rewritten argument vector (argv[0] first). On an unknown flag, a flag given
-// twice (--noforce and --force count as one flag) or a positional argument, returns false
-// with the message in *error.
+// returns the rewritten argument vector (argv[0] first). A deprecated name
+// (DeprecatedFlagName) whose new name is allowed is taken as the new one, with a note in
+// *notes (may be null). On an unknown flag (named with the closest allowed ones: "did
+// you mean"), a flag given twice (--noforce and --force, or an old and a new name, count
+// as one flag) or a positional argument, returns false with the message in *error.
 bool CheckAndNormaliseFlags(int argc, char** argv, int first, const std::string& command,
                             const std::set<std::string>& allowed,
-                            std::vector<std::string>* normalised, std::string* error);
+                            std::vector<std::string>* normalised, std::string* error,
+                            std::vector<std::string>* notes = nullptr);
+
+// The current name of a flag renamed so that its unit is spelt as the data spell it
+// (`_kN`, `_percent`: --min-tension-kn is now --min-tension-kN, --tension-noise-pct
+// --tension-noise-percent); "" for any other name. Names with dashes.
+std::string DeprecatedFlagName(const std::string& old_name);
+
+// The allowed names (a command's flags, or the commands) closest to a misspelt `name`
+// (edit distance, ignoring case, within about a third of its length; or the names it is
+// the start of; a flag's former spelling counts as the flag), at most three, best first:
+// what "did you mean" offers.
+std::vector<std::string> ClosestNames(const std::string& name,
+                                      const std::set<std::string>& allowed);
 
 // True when argv has -h, --help or -help.
 bool WantsHelp(int argc, char** argv, int first);

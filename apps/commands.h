@@ -24,7 +24,7 @@ int RunDesign(int argc, char** argv);
 int RunImport(int argc, char** argv);
 int RunTrack(int argc, char** argv);
 
-// Positions of the trajectory `kind` (line, arc, grid, random) from the shared trajectory
+// Positions of the trajectory `kind` (circle, line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.
 bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
                                   std::vector<Eigen::Vector3d>* positions, bool* known,
@@ -36,13 +36,11 @@ bool TrajectoryPositionStreamFromFlags(const std::string& kind,
                                        const Eigen::Vector3d& focal_centre_m,
                                        PositionStream* stream, bool* known, std::string* error);
 
-// The scopes of the trajectory flags (cli_util.h) for trajectory `kind` (line, arc, grid,
-// random, circle with `with_circle` (simulate's, which takes --nodes), or another mode:
-// point, poses): each generator's parameters apply to their generators only,
-// --tilt-fraction to the focal attitude law (`focal_law`: the poses fly it),
-// --focal-centre to that law and to the focal-sphere trajectories grid and random.
-std::vector<FlagScope> TrajectoryFlagScopes(const std::string& kind, bool focal_law,
-                                            bool with_circle);
+// The scopes of the trajectory flags (cli_util.h) for trajectory `kind` (circle, line, arc,
+// grid, random, or another mode: point, poses): each generator's parameters apply to their
+// generators only, --tilt-fraction to the focal attitude law (`focal_law`: the poses fly
+// it), --focal-centre to that law and to the focal-sphere trajectories grid and random.
+std::vector<FlagScope> TrajectoryFlagScopes(const std::string& kind, bool focal_law);
 
 // A trajectory generator's message (trajectory.h names its parameters) with the flag
 // names instead.

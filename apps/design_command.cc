@@ -3,6 +3,7 @@
 #include <gflags/gflags.h>
 
 #include <cmath>
+#include <cstdio>
 #include <iostream>
 #include <limits>
 #include <sstream>
@@ -75,9 +76,9 @@ draws the random survey compared against).
                          its least useful stops (their samples dwell at the others)
 Grid and limits, as fastcal workspace: --max-off-axis-deg=40 --off-axis-step-deg=1
   --azimuth-step-deg=5 --focal-radius=160 --focal-centre=0,0,300 --tilt-fraction=0.41
-  --max-tension-kn=inf --max-strain=0.05 --max-length-ratio=1.5, and with the design's
+  --max-tension-kN=inf --max-strain=0.05 --max-length-ratio=1.5, and with the design's
   own margins (the optimum lies on the workspace's edge, where cables near slack sag by
-  metres for a small error of the model): --min-tension-kn=50 --reflector-clearance=5
+  metres for a small error of the model): --min-tension-kN=50 --reflector-clearance=5
 
 Poses that hold (docs/design.md): a candidate must also hold over the plausible range of
 the spec's statics parameters (free or considered; not the sensors'): each at its initial
@@ -86,7 +87,7 @@ value +- --range-prior-sigmas=2 of its prior's sigma, or, free without a prior, 
 tower offsets) or --range-relative=0.03 of its value (mass, densities, EA, attachments).
 At the corner of that box where each cable's tension is lowest (found from each
 parameter's effect, then solved exactly) the statics must be ok, every tension at least
---min-tension-kn and every cable --reflector-clearance clear of the reflector. All four
+--min-tension-kN and every cable --reflector-clearance clear of the reflector. All four
 0: the initial values only. The summary names what binds (the tightest stop, its cable
 and the corner); design.json has it per stop.
 
@@ -97,6 +98,8 @@ Outputs (written only when everything succeeded):
                the design, the paper's circle and a random survey of N samples
   design.html  the stops and path on the cap, the predicted sigmas side by side, what
                limits the design and what a better prior would buy
+Every sigma is in its parameter's unit, the one its name carries (sensor_bias_kN: kN).
+A summary on stdout (> design.txt keeps it); each stage's progress on stderr.
 
 Example:
   fastcal design --spec=calibration_data/spec_realistic.yaml --samples=360 \
@@ -114,8 +117,8 @@ const std::set<std::string> kFlags = {"spec",
                                       "off-axis-step-deg",
                                       "azimuth-step-deg",
                                       "focal-radius",
-                                      "min-tension-kn",
-                                      "max-tension-kn",
+                                      "min-tension-kN",
+                                      "max-tension-kN",
                                       "interval-s",
                                       "max-extra-tilt-deg",
                                       "max-extra-yaw-deg",
@@ -138,7 +141,7 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   if (!FlagGiven("reflector-clearance")) {
     o->workspace.statics.min_reflector_clearance_m = kDesignReflectorClearanceM;
   }
-  if (!FlagGiven("min-tension-kn")) o->workspace.min_tension_n = kDesignMinTensionN;
+  if (!FlagGiven("min-tension-kN")) o->workspace.min_tension_n = kDesignMinTensionN;
   o->max_extra_tilt_deg = FLAGS_max_extra_tilt_deg;
   o->max_extra_yaw_deg = FLAGS_max_extra_yaw_deg;
   o->range_prior_sigmas = FLAGS_range_prior_sigmas;
@@ -181,6 +184,8 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   return false;
 }
 
+// The result, on stdout: what was chosen, and the predicted sigma_total of each wanted
+// parameter in its own unit (the one in its name: kN for sensor_bias_kN).
 std::string Summary(const Design& d) {
   std::ostringstream s;
   s << "fastcal design: " << d.options.samples << " samples at " << d.stops.size() << " stops from "
@@ -189,13 +194,19 @@ std::string Summary(const Design& d) {
   if (d.options.speed_m_per_s > 0.0) {
     s << ", " << FormatDouble(d.duration_s / kSecondsPerMinute, 4) << " min";
   }
-  s << "\n  predicted sigma_total (design | paper's circle | random survey):";
+  char row[160];
+  std::snprintf(row, sizeof(row), "\n  %-30s %-6s %11s %15s %14s", "predicted sigma_total", "unit",
+                "design", "paper's circle", "random survey");
+  s << row;
   for (int k : d.wanted) {
-    auto sig = [k](const DesignPrediction& p) {
-      return p.ok ? FormatDouble(p.budget.parameters[k].total, 4) : std::string("n/a");
+    auto sig = [&d, k](const DesignPrediction& p) {
+      return p.ok ? FormatDouble(p.budget.parameters[k].total / d.free_to_si[k], 4)
+                  : std::string("n/a");
     };
-    s << "\n    " << d.free_names[k] << ": " << sig(d.design) << " | " << sig(d.circle) << " | "
-      << sig(d.random);
+    std::snprintf(row, sizeof(row), "\n    %-28s %-6s %11s %15s %14s", d.free_names[k].c_str(),
+                  d.free_units[k] == "1" ? "" : d.free_units[k].c_str(), sig(d.design).c_str(),
+                  sig(d.circle).c_str(), sig(d.random).c_str());
+    s << row;
   }
   s << "\n  limited by " << d.limiting_part << " (" << FormatDouble(100.0 * d.limiting_share, 3)
     << "% of the wanted variance)";
@@ -219,6 +230,10 @@ int RunDesign(int argc, char** argv) {
   CableRobot robot;
   CalibrationSpec spec;
   DesignOptions options;
+  // Progress on stderr: a design with extra attitudes takes about 20 s.
+  options.progress = [](const std::string& stage) {
+    std::cerr << "fastcal design: " << stage << std::endl;
+  };
   if (!CheckOutputDirectory("out", FLAGS_out, &error) ||
       !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(robot.anchor_points_cabin_m.size()), &spec,
@@ -242,7 +257,8 @@ int RunDesign(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitFailure;
   }
-  std::cerr << Summary(design) << "\n";
+  // The summary of what was written is the result: stdout (docs/cli.md, "Output streams").
+  std::cout << Summary(design) << "\n";
   return 0;
 }
 

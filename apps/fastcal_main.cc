@@ -6,6 +6,7 @@
 #include <iostream>
 #include <new>
 #include <string>
+#include <vector>
 
 #include "cli_util.h"
 #include "commands.h"
@@ -70,6 +71,10 @@ int main(int argc, char** argv) {
               << ": out of memory: the input or the flags ask for more than this machine has\n";
     return kExitFailure;
   }
-  std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command) << "\n\n" << kUsage;
+  const std::vector<std::string> closest =
+      ClosestNames(command, {"solve", "calibrate", "evaluate", "simulate", "workspace", "design"});
+  std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command)
+            << (closest.empty() ? "" : "; did you mean " + closest.front() + "?") << "\n\n"
+            << kUsage;
   return kExitUsage;
 }

@@ -58,26 +58,26 @@ DEFINE_string(mass_centre, "", "simulate: truth mass centre x,y,z in the cabin f
 DEFINE_double(attitude_control_deg, 0.0, "simulate: sigma of actual - planned rpy (deg).");
 DEFINE_double(attitude_noise_deg, 0.0, "simulate: sigma of measured - actual rpy (deg).");
 DEFINE_double(position_noise_m, 0.0, "simulate: sigma of measured - actual position (m).");
-DEFINE_double(tension_noise_pct, 3.0, "simulate: relative tension noise sigma (%).");
-DEFINE_double(tension_noise_kn, 0.0, "simulate: absolute tension noise sigma (kN).");
+DEFINE_double(tension_noise_percent, 3.0, "simulate: relative tension noise sigma (%).");
+DEFINE_double(tension_noise_kN, 0.0, "simulate: absolute tension noise sigma (kN).");
 DEFINE_double(outlier_fraction, 0.0, "simulate: probability of an outlier reading.");
-DEFINE_double(outlier_scale_pct, 30.0, "simulate: outlier = reading (1 + U(-s, s)/100).");
-DEFINE_double(density_mismatch_pct, 0.0, "simulate: per-cable density factor sigma (%).");
+DEFINE_double(outlier_scale_percent, 30.0, "simulate: outlier = reading (1 + U(-s, s)/100).");
+DEFINE_double(density_mismatch_percent, 0.0, "simulate: per-cable density factor sigma (%).");
 DEFINE_string(sensor_gain, "", "simulate: sensor gains g1,...,g6 or one for all.");
-DEFINE_string(sensor_bias_kn, "", "simulate: sensor biases b1,...,b6 or one for all (kN).");
+DEFINE_string(sensor_bias_kN, "", "simulate: sensor biases b1,...,b6 or one for all (kN).");
 DEFINE_double(interval_s, 1.0, "simulate: time between samples (s).");
 DEFINE_double(attitude_control_time_s, 0.0,
               "simulate: correlation time of the attitude control error (s); 0 = white.");
-DEFINE_double(tension_drift_pct, 0.0, "simulate: slow tension error sigma per cable (%).");
+DEFINE_double(tension_drift_percent, 0.0, "simulate: slow tension error sigma per cable (%).");
 DEFINE_double(tension_drift_time_s, 0.0, "simulate: its correlation time (s).");
-DEFINE_double(tension_drift_kn, 0.0, "simulate: absolute part of the slow tension error (kN).");
+DEFINE_double(tension_drift_kN, 0.0, "simulate: absolute part of the slow tension error (kN).");
 DEFINE_double(session_gap_s, 0.0, "simulate: time between consecutive sessions (s).");
-DEFINE_double(sensor_rezero_kn, 0.0,
+DEFINE_double(sensor_rezero_kN, 0.0,
               "simulate: sensors re-zeroed at each new session, bias change sigma (kN).");
 DEFINE_double(mass_centre_drift_m, 0.0, "simulate: mass-centre drift sigma per axis (m).");
 DEFINE_double(mass_centre_drift_time_s, 0.0, "simulate: its correlation time (s).");
-DEFINE_double(sensor_gain_spread_pct, 0.0, "simulate: per-cable gain spread drawn once (%).");
-DEFINE_double(sensor_bias_spread_kn, 0.0, "simulate: per-cable bias spread drawn once (kN).");
+DEFINE_double(sensor_gain_spread_percent, 0.0, "simulate: per-cable gain spread drawn once (%).");
+DEFINE_double(sensor_bias_spread_kN, 0.0, "simulate: per-cable bias spread drawn once (kN).");
 DEFINE_int32(sessions, 1, "simulate: consecutive sessions (session column 1..N).");
 DEFINE_string(session_shift_m, "",
               "simulate: mass centre moved by dx,dy,dz (m) at each new session.");
@@ -93,10 +93,6 @@ namespace {
 
 constexpr char kCommand[] = "simulate";
 constexpr double kNPerKn = 1e3;
-// The paper's measured circle (docs/model.md, "Measured data").
-const Eigen::Vector3d kCircleCentre_m(0.0, 0.0, 156.73);
-constexpr double kCircleRadius_m = 71.11;
-constexpr int kCircleNodes = 360;
 
 const char kHelp[] =
     R"(fastcal simulate: synthetic telemetry of the FAST cable robot from a known truth model.
@@ -119,10 +115,11 @@ roll,pitch,yaw):
                       mass-centre-drift-m, correlation time mass-centre-drift-time-s
   truth tensions      T_i, s0_i from the truth model's statics at (p, a_act), --method
   sensor reading      y_i = gain_i T_i + bias_i
-  measured tension    y_i (1 + N(0, tension-noise-pct/100) + u_i(t)) + N(0, tension-noise-kn),
-                      u_i per cable AR(1): sigma tension-drift-pct/100, correlation time
-                      tension-drift-time-s (a slow sensor error); or, with probability
-                      outlier-fraction, y_i (1 + U(-s, s)/100), s = outlier-scale-pct
+  measured tension    y_i (1 + N(0, tension-noise-percent/100) + u_i(t))
+                      + N(0, tension-noise-kN), u_i per cable AR(1): sigma
+                      tension-drift-percent/100, correlation time tension-drift-time-s (a
+                      slow sensor error); or, with probability outlier-fraction,
+                      y_i (1 + U(-s, s)/100), s = outlier-scale-percent
 An AR(1) process with correlation time tau steps by phi = exp(-interval / tau) and starts
 stationary; tau = 0 draws it afresh every sample (white).
   measured attitude   a_act + N(0, attitude-noise-deg)                per angle
@@ -132,17 +129,21 @@ yaw_deg), the planned attitude (planned_roll_deg,..), T1_kN..T6_kN and, as the c
 lengths, the truth solution's unstretched lengths s0_1_m..s0_6_m.
 
 Truth model:
-  --truth=FILE.yaml        model (docs/model-format.md); default the nominal FAST model
-  --mass-centre=x,y,z      override its mass centre, cabin frame (m)
-  --sensor-gain=g|g1,..,g6     override the sensor gains (one value = all cables)
-  --sensor-bias-kn=b|b1,..,b6  override the sensor biases (kN)
-  --density-mismatch-pct=0     multiply each cable's linear density by 1 + N(0, pct/100),
-                               drawn once (non-uniform cables); the result is the truth
-                               model written to FILE.truth.yaml
-  --sensor-gain-spread-pct=0   multiply each cable's sensor gain by 1 + N(0, pct/100),
-                               drawn once (written to FILE.truth.yaml)
-  --sensor-bias-spread-kn=0    add N(0, kN) to each cable's sensor bias, drawn once
-  --method=exact           statics of the truth tensions: exact (default), aas-refined, aas
+  --truth=FILE.yaml               model (docs/model-format.md); default the nominal FAST
+                                  model
+  --mass-centre=x,y,z             override its mass centre, cabin frame (m)
+  --sensor-gain=g|g1,..,g6        override the sensor gains (one value = all cables)
+  --sensor-bias-kN=b|b1,..,b6     override the sensor biases (kN)
+  --density-mismatch-percent=0    multiply each cable's linear density by 1 + N(0, p/100),
+                                  drawn once (non-uniform cables); the result is the truth
+                                  model written to FILE.truth.yaml
+  --sensor-gain-spread-percent=0  multiply each cable's sensor gain by 1 + N(0, p/100),
+                                  drawn once (written to FILE.truth.yaml)
+  --sensor-bias-spread-kN=0       add N(0, kN) to each cable's sensor bias, drawn once
+  --method=exact                  statics of the truth tensions: exact (default),
+                                  aas-refined, aas
+  (Until 0.2 the units were spelt -kn and -pct: --sensor-bias-kn, --tension-noise-pct...;
+  those names still work, with a note on stderr.)
 
 Trajectory (--trajectory=, default circle):
   circle  the paper's measured circle: centre (0,0,156.73), radius 71.11 m, full turn,
@@ -166,69 +167,72 @@ never silently ignored; so is a flag given twice.
 
 Errors (all zero-mean Gaussian unless stated; one --seed=1 drives them all, each error
 source with its own generator, so changing one sigma leaves the others' numbers alone):
-  --attitude-control-deg=0   actual minus planned attitude, per angle (deg)
-  --attitude-control-time-s=0  its correlation time (s); 0 = white
-  --mass-centre-drift-m=0    drift of the mass centre about the truth model's, per axis (m)
-  --mass-centre-drift-time-s=0 its correlation time (s)
-  --tension-drift-pct=0      slow relative tension error per cable (%)
-  --tension-drift-time-s=0   its correlation time (s)
-  --tension-drift-kn=0       absolute part of the slow error (kN): its sd is then
-                             sqrt(kn^2 + (pct/100 y_i)^2), one process per cable
-  --attitude-noise-deg=0     measured minus actual attitude, per angle (deg)
-  --position-noise-m=0       measured minus actual position, per axis (m)
-  --tension-noise-pct=3      relative tension noise (%, the paper's sensors: ~3%)
-  --tension-noise-kn=0       absolute tension noise (kN), added to the relative one
-  --outlier-fraction=0       probability that a reading is an outlier instead
-  --outlier-scale-pct=30     outlier half-width (%), in [0, 100)
+  --attitude-control-deg=0        actual minus planned attitude, per angle (deg)
+  --attitude-control-time-s=0     its correlation time (s); 0 = white
+  --mass-centre-drift-m=0         drift of the mass centre about the truth model's, per
+                                  axis (m)
+  --mass-centre-drift-time-s=0    its correlation time (s)
+  --tension-drift-percent=0       slow relative tension error per cable (%)
+  --tension-drift-time-s=0        its correlation time (s)
+  --tension-drift-kN=0            absolute part of the slow error (kN): its sd is then
+                                  sqrt(kN^2 + (percent/100 y_i)^2), one process per cable
+  --attitude-noise-deg=0          measured minus actual attitude, per angle (deg)
+  --position-noise-m=0            measured minus actual position, per axis (m)
+  --tension-noise-percent=3       relative tension noise (%, the paper's sensors: ~3%)
+  --tension-noise-kN=0            absolute tension noise (kN), added to the relative one
+  --outlier-fraction=0            probability that a reading is an outlier instead
+  --outlier-scale-percent=30      outlier half-width (%), in [0, 100)
 A noise draw that would make a reading <= 0 is redrawn (counted in the summary).
 
 Sessions and steps of the mass centre (the cabin's structure changed):
-  --sessions=1               cut the samples into N consecutive sessions of equal length,
-                             labelled 1..N in a session column (docs/data-format.md)
-  --session-shift-m=dx,dy,dz the mass centre moves by this at the first sample of each
-                             session after the first (needs --sessions >= 2)
-  --mass-centre-step=T:dx,dy,dz  the mass centre moves by this at time T (s) and stays;
-                             several joined by ';' (steps add up)
-  --session-gap-s=0          time between one session's end and the next one's start (s),
-                             added to time_s; the slow errors decorrelate over it
-  --sensor-rezero-kn=0       sensors re-zeroed at the start of each session after the
-                             first: each cable's bias moves by N(0, kN)
-  --sensor-step=T:CABLE:DKN  one sensor re-zeroed: cable CABLE's bias moves by DKN kN at
-                             time T (s) and stays; several joined by ';'
+  --sessions=1                    cut the samples into N consecutive sessions of equal
+                                  length, labelled 1..N in a session column
+                                  (docs/data-format.md)
+  --session-shift-m=dx,dy,dz      the mass centre moves by this at the first sample of
+                                  each session after the first (needs --sessions >= 2)
+  --mass-centre-step=T:dx,dy,dz   the mass centre moves by this at time T (s or ISO 8601)
+                                  and stays; several joined by ';' (steps add up)
+  --session-gap-s=0               time between one session's end and the next one's start
+                                  (s), added to time_s; the slow errors decorrelate over it
+  --sensor-rezero-kN=0            sensors re-zeroed at the start of each session after the
+                                  first: each cable's bias moves by N(0, kN)
+  --sensor-step=T:CABLE:DKN       one sensor re-zeroed: cable CABLE's bias moves by DKN kN
+                                  at time T (s or ISO 8601) and stays; several joined by ';'
 A season (fastcal track): --start=T, the first sample's time (s, or ISO 8601 such as
-2024-05-01T20:00:00Z, a zone-less one in UTC: Unix seconds), and --days=N, the samples cut into N sessions a day
-apart (each day's samples --interval-s apart from --start + k days; the slow errors
-decorrelate overnight; no session column). Steps' times T are in the same seconds, or ISO
-8601 times.
+2024-05-01T20:00:00Z; a zone-less one is UTC), and --days=N, the samples cut into N
+sessions a day apart (each day's samples --interval-s apart from --start + k days; the
+slow errors decorrelate overnight; no session column). Steps' times T are in the same
+seconds, or ISO 8601 times.
 The truth model written out has the mass centre before any step and the first session's
 sensor biases; its header lists the steps and every session's biases.
 
 Output: --out=FILE.csv (required), --force to replace existing files, --interval-s=1
-between samples. A summary on stderr:
-samples, RMS of the noise added per cable (kN and %), outliers, pose-error RMS.
+between samples. A summary of what was written on stdout (> sim.txt keeps it): samples,
+RMS of the noise added per cable (kN and %), outliers, pose-error RMS; notes and errors
+on stderr.
 
 Exit codes: 0 ok, 1 the truth model cannot hold a pose (the node is named), 2 bad input.
 
 Examples (the bundled datasets):
   # the paper's measured circle, mass centre moved as the authors found it
   fastcal simulate --mass-centre=0.22,0.11,0.5 --nodes=360 --attitude-control-deg=0.2 \
-    --attitude-noise-deg=0.02 --position-noise-m=0.01 --tension-noise-pct=3 --seed=1 \
+    --attitude-noise-deg=0.02 --position-noise-m=0.01 --tension-noise-percent=3 --seed=1 \
     --force --out=calibration_data/circle_paper.csv
   # many zenith angles: 600 random poses on the focal-sphere cap up to 40 deg, +-3 m
   fastcal simulate --trajectory=random --samples=600 --max-off-axis-deg=40 \
     --radial-spread=3 --attitude-law=focal --mass-centre=0.22,0.11,0.5 \
     --attitude-control-deg=0.2 --attitude-noise-deg=0.02 --position-noise-m=0.01 \
-    --tension-noise-pct=3 --seed=2 --force \
+    --tension-noise-percent=3 --seed=2 --force \
     --out=calibration_data/workspace_multi_zenith.csv
   # realistic telemetry: rings over the cap, smooth control error, slow tension error,
   # drifting mass centre, per-cable densities, gains and biases (calibration_data/README.md)
   fastcal simulate --trajectory=grid --max-off-axis-deg=40 --off-axis-step-deg=5 \
     --azimuth-step-deg=2 --interval-s=2 --mass-centre=0.22,0.11,0.5 \
     --attitude-control-deg=0.2 --attitude-control-time-s=60 --attitude-noise-deg=0.02 \
-    --position-noise-m=0.01 --tension-noise-pct=3 --tension-drift-pct=2 \
+    --position-noise-m=0.01 --tension-noise-percent=3 --tension-drift-percent=2 \
     --tension-drift-time-s=120 --mass-centre-drift-m=0.01 --mass-centre-drift-time-s=600 \
-    --density-mismatch-pct=1.5 --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=2 \
-    --outlier-fraction=0.002 --outlier-scale-pct=90 --seed=5 --force \
+    --density-mismatch-percent=1.5 --sensor-gain-spread-percent=1 --sensor-bias-spread-kN=2 \
+    --outlier-fraction=0.002 --outlier-scale-percent=90 --seed=5 --force \
     --out=calibration_data/realistic_survey.csv
   # sensor gain errors and 2% outliers on a straight line
   fastcal simulate --trajectory=line --sensor-gain=1.02,0.98,1,1,1.01,0.99 \
@@ -237,16 +241,17 @@ Examples (the bundled datasets):
 
 // clang-format off
 const std::set<std::string> kFlags = {
-    "truth", "columns", "mass-centre", "sensor-gain", "sensor-bias-kn", "density-mismatch-pct", "method",
+    "truth", "columns", "mass-centre", "sensor-gain", "sensor-bias-kN", "density-mismatch-percent",
+    "method",
     "trajectory", "nodes", "from", "to", "centre", "radius", "start-deg", "end-deg",
     "max-off-axis-deg", "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "samples",
     "radial-spread", "poses", "attitude-law", "tilt-fraction", "focal-centre",
-    "attitude-control-deg", "attitude-noise-deg", "position-noise-m", "tension-noise-pct",
-    "tension-noise-kn", "outlier-fraction", "outlier-scale-pct", "seed", "interval-s", "out",
-    "force", "attitude-control-time-s", "tension-drift-pct", "tension-drift-time-s",
-    "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-pct",
-    "sensor-bias-spread-kn", "sessions", "session-shift-m", "mass-centre-step",
-    "tension-drift-kn", "session-gap-s", "sensor-rezero-kn", "days", "start", "sensor-step"};
+    "attitude-control-deg", "attitude-noise-deg", "position-noise-m", "tension-noise-percent",
+    "tension-noise-kN", "outlier-fraction", "outlier-scale-percent", "seed", "interval-s", "out",
+    "force", "attitude-control-time-s", "tension-drift-percent", "tension-drift-time-s",
+    "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-percent",
+    "sensor-bias-spread-kN", "sessions", "session-shift-m", "mass-centre-step",
+    "tension-drift-kN", "session-gap-s", "sensor-rezero-kN", "days", "start", "sensor-step"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -291,8 +296,8 @@ bool LoadTruth(CableRobot* truth, std::string* error) {
       truth->cables[i].sensor_gain = values[i];
     }
   }
-  if (!FLAGS_sensor_bias_kn.empty()) {
-    if (!ParseOneOrSix("sensor-bias-kn", FLAGS_sensor_bias_kn, &values, error)) return false;
+  if (!FLAGS_sensor_bias_kN.empty()) {
+    if (!ParseOneOrSix("sensor-bias-kN", FLAGS_sensor_bias_kN, &values, error)) return false;
     for (int i = 0; i < kNumCables; ++i) truth->cables[i].sensor_bias_n = values[i] * kNPerKn;
   }
   std::string why;
@@ -400,24 +405,24 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->attitude_control_sigma_deg = FLAGS_attitude_control_deg;
   options->attitude_measurement_sigma_deg = FLAGS_attitude_noise_deg;
   options->position_measurement_sigma_m = FLAGS_position_noise_m;
-  options->tension_noise_percent = FLAGS_tension_noise_pct;
-  options->tension_noise_kn = FLAGS_tension_noise_kn;
+  options->tension_noise_percent = FLAGS_tension_noise_percent;
+  options->tension_noise_kn = FLAGS_tension_noise_kN;
   options->outlier_fraction = FLAGS_outlier_fraction;
-  options->outlier_scale_percent = FLAGS_outlier_scale_pct;
-  options->density_mismatch_percent = FLAGS_density_mismatch_pct;
+  options->outlier_scale_percent = FLAGS_outlier_scale_percent;
+  options->density_mismatch_percent = FLAGS_density_mismatch_percent;
   options->attitude_control_time_s = FLAGS_attitude_control_time_s;
-  options->tension_drift_percent = FLAGS_tension_drift_pct;
+  options->tension_drift_percent = FLAGS_tension_drift_percent;
   options->tension_drift_time_s = FLAGS_tension_drift_time_s;
   options->mass_centre_drift_m = FLAGS_mass_centre_drift_m;
   options->mass_centre_drift_time_s = FLAGS_mass_centre_drift_time_s;
-  options->sensor_gain_spread_percent = FLAGS_sensor_gain_spread_pct;
-  options->sensor_bias_spread_kn = FLAGS_sensor_bias_spread_kn;
+  options->sensor_gain_spread_percent = FLAGS_sensor_gain_spread_percent;
+  options->sensor_bias_spread_kn = FLAGS_sensor_bias_spread_kN;
   options->seed = FLAGS_seed;
   options->sample_interval_s = FLAGS_interval_s;
   options->sessions = FLAGS_sessions;
-  options->tension_drift_kn = FLAGS_tension_drift_kn;
+  options->tension_drift_kn = FLAGS_tension_drift_kN;
   options->session_gap_s = FLAGS_session_gap_s;
-  options->sensor_rezero_kn = FLAGS_sensor_rezero_kn;
+  options->sensor_rezero_kn = FLAGS_sensor_rezero_kN;
   if (!FLAGS_start.empty()) {
     std::string why;
     if (!ParseTimeValue(FLAGS_start, 0, &options->start_time_s, &why)) {
@@ -426,7 +431,7 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
       return false;
     }
   }
-  for (const char* flag : {"session-gap-s", "sensor-rezero-kn"}) {
+  for (const char* flag : {"session-gap-s", "sensor-rezero-kN"}) {
     if (FlagGiven(flag) && FLAGS_sessions < 2) {
       *error = std::string("--") + flag + " needs --sessions=N with N >= 2";
       return false;
@@ -443,23 +448,23 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
     *error = WithFlagNames(why, {{"attitude_control_sigma_deg", "--attitude-control-deg"},
                                  {"attitude_measurement_sigma_deg", "--attitude-noise-deg"},
                                  {"position_measurement_sigma_m", "--position-noise-m"},
-                                 {"tension_noise_percent", "--tension-noise-pct"},
-                                 {"tension_noise_kn", "--tension-noise-kn"},
+                                 {"tension_noise_percent", "--tension-noise-percent"},
+                                 {"tension_noise_kn", "--tension-noise-kN"},
                                  {"outlier_fraction", "--outlier-fraction"},
-                                 {"outlier_scale_percent", "--outlier-scale-pct"},
-                                 {"density_mismatch_percent", "--density-mismatch-pct"},
+                                 {"outlier_scale_percent", "--outlier-scale-percent"},
+                                 {"density_mismatch_percent", "--density-mismatch-percent"},
                                  {"attitude_control_time_s", "--attitude-control-time-s"},
-                                 {"tension_drift_percent", "--tension-drift-pct"},
+                                 {"tension_drift_percent", "--tension-drift-percent"},
                                  {"tension_drift_time_s", "--tension-drift-time-s"},
                                  {"mass_centre_drift_m", "--mass-centre-drift-m"},
                                  {"mass_centre_drift_time_s", "--mass-centre-drift-time-s"},
-                                 {"sensor_gain_spread_percent", "--sensor-gain-spread-pct"},
-                                 {"sensor_bias_spread_kn", "--sensor-bias-spread-kn"},
+                                 {"sensor_gain_spread_percent", "--sensor-gain-spread-percent"},
+                                 {"sensor_bias_spread_kn", "--sensor-bias-spread-kN"},
                                  {"sample_interval_s", "--interval-s"},
                                  {"sessions", "--sessions"},
-                                 {"tension_drift_kn", "--tension-drift-kn"},
+                                 {"tension_drift_kn", "--tension-drift-kN"},
                                  {"session_gap_s", "--session-gap-s"},
-                                 {"sensor_rezero_kn", "--sensor-rezero-kn"},
+                                 {"sensor_rezero_kn", "--sensor-rezero-kN"},
                                  {"start_time_s", "--start"},
                                  {"sensor_bias_steps", "--sensor-step"}});
     return false;
@@ -485,8 +490,7 @@ bool CheckFlagsApplyToTrajectory(const std::string& trajectory, std::string* err
   if (!kinds.count(trajectory)) return true;
   const bool focal_law =
       FLAGS_attitude_law == "focal" || (trajectory != "poses" && FLAGS_attitude_law != "none");
-  const std::vector<FlagScope> scopes =
-      TrajectoryFlagScopes(trajectory, focal_law, /*with_circle=*/true);
+  const std::vector<FlagScope> scopes = TrajectoryFlagScopes(trajectory, focal_law);
   std::string mode = "--trajectory=" + trajectory;
   if (trajectory == "poses") mode = "--poses";
   if (trajectory == "circle" && !FlagGiven("trajectory")) mode += " (the default)";
@@ -560,24 +564,13 @@ bool BuildPoses(PoseStream* poses, std::string* error) {
   }
 
   PositionStream positions;
-  bool ok = false;
-  if (trajectory == "circle") {
-    ArcSpec arc;
-    arc.centre_m = kCircleCentre_m;
-    arc.radius_m = kCircleRadius_m;
-    arc.start_deg = 0.0;
-    arc.end_deg = 360.0;
-    arc.nodes = FlagGiven("nodes") ? FLAGS_nodes : kCircleNodes;
-    ok = ArcPositionStream(arc, &positions, error);
-  } else {
-    bool known = false;
-    ok = TrajectoryPositionStreamFromFlags(trajectory, law.focal_centre_m, &positions, &known,
-                                           error);
-    if (!known) {
-      *error = "--trajectory must be circle, line, arc, grid, random or poses, got " +
-               internal::Quote(trajectory);
-      return false;
-    }
+  bool known = false;
+  const bool ok =
+      TrajectoryPositionStreamFromFlags(trajectory, law.focal_centre_m, &positions, &known, error);
+  if (!known) {
+    *error = "--trajectory must be circle, line, arc, grid, random or poses, got " +
+             internal::Quote(trajectory);
+    return false;
   }
   if (!ok) {
     *error = "--trajectory=" + trajectory + ": " + WithTrajectoryFlagNames(*error);

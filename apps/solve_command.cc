@@ -19,6 +19,8 @@
 #include "fastcal/plausibility.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
+#include "fastcal/trajectory_plot.h"
+#include "fastcal/version.h"
 
 DEFINE_string(model, "", "Model YAML (docs/model-format.md); empty = nominal FAST.");
 DEFINE_string(method, "exact", "exact | aas | aas-refined | compare");
@@ -31,10 +33,10 @@ DEFINE_string(attitude_law, "",
               "trajectories, R = I for one --position, the file's own for --poses.");
 DEFINE_double(tilt_fraction, 0.41, "Focal law: fraction of the off-axis angle.");
 DEFINE_string(focal_centre, "0,0,300", "Focal law and grids: focal-sphere centre x,y,z (m).");
-DEFINE_string(trajectory, "point", "point | line | arc | grid | random");
+DEFINE_string(trajectory, "point", "point | circle | line | arc | grid | random");
 DEFINE_string(from, "50,0,150", "line: first node x,y,z (m).");
 DEFINE_string(to, "-50,0,150", "line: last node x,y,z (m).");
-DEFINE_int32(nodes, 101, "line, arc: number of nodes.");
+DEFINE_int32(nodes, 101, "line, arc (101), circle (360): number of nodes.");
 DEFINE_string(centre, "0,0,150", "arc: centre x,y,z (m); the arc is horizontal.");
 DEFINE_double(radius, 50.0, "arc: radius (m).");
 DEFINE_double(start_deg, 0.0, "arc: first angle from +x toward +y (deg).");
@@ -65,6 +67,7 @@ DEFINE_double(reflector_clearance, 0.0,
 DEFINE_bool(warm_start, true, "Start each trajectory node from the previous solution.");
 DEFINE_bool(keep_going, false,
             "Write infeasible poses as rows with their status instead of failing.");
+DEFINE_string(plot, "", "solve: the tensions along a trajectory as a self-contained HTML page.");
 
 namespace fastcal::cli {
 namespace {
@@ -77,7 +80,7 @@ const char kHelp[] =
 
 Usage:
   fastcal solve --position=x,y,z [attitude] [options]
-  fastcal solve --trajectory=line|arc|grid|random [trajectory flags] [options]
+  fastcal solve --trajectory=circle|line|arc|grid|random [trajectory flags] [options]
   fastcal solve --poses=FILE.csv [options]
 
 Each flag belongs to a mode: a flag given for another one (--nodes with --position,
@@ -99,6 +102,8 @@ Attitude (at most one):
   The summary line on stderr says which attitude was used.
 
 Trajectories:
+  circle  the paper's measured circle (its Table 6): radius 71.11 m about (0,0,156.73),
+          a full turn, --nodes=360 (as simulate's default trajectory)
   line    --from=50,0,150 --to=-50,0,150 --nodes=101        (the paper's Table 4)
   arc     --centre=0,0,150 --radius=50 --start-deg=0 --end-deg=180 --nodes=101
           (Table 5; --end-deg=360 is a full circle without a repeated node)
@@ -155,13 +160,18 @@ CSV columns, units in the names:
                           unreachable (none from the home pose, yet one exists); empty
                           for aas (docs/model.md, "Which equilibrium exact returns")
   message                 why a pose failed, in double quotes ("" when ok)
-  status is a short code: ok, no_equilibrium, sagging_cable, overstretched_cable,
-  reflector_contact, not_converged, inaccurate, vertical_cable, singular,
-  catenary_failed, invalid_input (docs/cli.md).
+  status is a short code, one of:
+@STATUSES@
+  (what each means: docs/cli.md, "fastcal solve").
   compare: T<i>_aas_kN, T<i>_exact_kN, err<i>_pct = 100 (aas - exact)/exact,
   aas_error_estimate_pct, equilibrium (exact's), message.
 A summary line on stderr names the model (its file, or "nominal FAST"), the attitude
 used and the time per pose.
+
+Plot: --plot=FILE.html (a trajectory or --poses) writes the six lower-end tensions along
+the path, against the distance travelled (node number for grid and random), as the
+paper's Figs. 9 and 10; with --method=compare AAS and exact side by side and AAS's
+relative error per cable. A self-contained page (no scripts), written with the output.
 
 A pose the cables cannot hold (no equilibrium, or one outside the model's range), a
 vertical cable or a solver failure is an error naming the node, the cable and the
@@ -173,7 +183,29 @@ Examples:
   fastcal solve --position=0,0,140 --method=compare
   fastcal solve --position=42.65,33.73,149.52 --attitude-law=focal --method=exact
   fastcal solve --trajectory=arc --attitude-law=focal --method=compare --output=arc.csv
+  fastcal solve --trajectory=line --method=compare --output=line.csv --plot=line.html
 )";
+
+// kHelp with the status codes listed from the library (StaticsStatusName), so that a
+// status added there is never missing here.
+std::string Help() {
+  constexpr size_t kWidth = 88;
+  const int last = static_cast<int>(kLastStaticsStatus);
+  std::string codes, line = "   ";
+  for (int s = 0; s <= last; ++s) {
+    const std::string item =
+        std::string(" ") + StaticsStatusName(static_cast<StaticsStatus>(s)) + (s < last ? "," : "");
+    if (line.size() + item.size() > kWidth) {
+      codes += line + "\n";
+      line = "   ";
+    }
+    line += item;
+  }
+  std::string help = kHelp;
+  const std::string placeholder = "@STATUSES@";
+  help.replace(help.find(placeholder), placeholder.size(), codes + line);
+  return help;
+}
 
 const std::set<std::string> kFlags = {"model",
                                       "columns",
@@ -214,7 +246,8 @@ const std::set<std::string> kFlags = {"model",
                                       "max-length-ratio",
                                       "reflector-clearance",
                                       "warm-start",
-                                      "keep-going"};
+                                      "keep-going",
+                                      "plot"};
 
 // The trajectory generators' parameter names (trajectory.h) and the flags that set them.
 const std::vector<std::pair<std::string, std::string>> kTrajectoryFlagNames = {
@@ -253,11 +286,10 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kTrajectoryF
 
 }  // namespace
 
-std::vector<FlagScope> TrajectoryFlagScopes(const std::string& kind, bool focal_law,
-                                            bool with_circle) {
+std::vector<FlagScope> TrajectoryFlagScopes(const std::string& kind, bool focal_law) {
   std::vector<FlagScope> scopes;
   for (auto [flag, kinds] : kTrajectoryFlagKinds) {
-    if (with_circle && flag == "nodes") kinds.push_back("circle");
+    if (flag == "nodes") kinds.push_back("circle");
     FlagScope scope{flag, false, "--trajectory="};
     for (size_t i = 0; i < kinds.size(); ++i) {
       scope.applies = scope.applies || kinds[i] == kind;
@@ -314,6 +346,12 @@ namespace {
 bool GenerateTrajectoryStream(const std::string& kind, const Eigen::Vector3d& focal_centre_m,
                               PositionStream* stream, bool* known, std::string* error) {
   *known = true;
+  if (kind == "circle") {
+    // The paper's measured circle (trajectory.h), 360 nodes unless --nodes says otherwise.
+    ArcSpec circle = PaperCircleArc();
+    if (FlagGiven("nodes")) circle.nodes = FLAGS_nodes;
+    return ArcPositionStream(circle, stream, error);
+  }
   if (kind == "line") {
     Eigen::Vector3d from, to;
     return ParsePosition("from", FLAGS_from, &from, error) &&
@@ -510,7 +548,7 @@ bool TrajectoryPoses(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std:
   const bool ok =
       TrajectoryPositionsFromFlags(FLAGS_trajectory, law.focal_centre_m, &positions, &known, error);
   if (!known) {
-    *error = "--trajectory must be point, line, arc, grid or random, got " +
+    *error = "--trajectory must be point, circle, line, arc, grid or random, got " +
              internal::Quote(FLAGS_trajectory);
     return false;
   }
@@ -544,11 +582,12 @@ bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* er
 // silently ignored. An unknown mode is left to BuildPoses to name.
 bool CheckFlagsApplyToMode(std::string* error) {
   const std::string kind = !FLAGS_poses.empty() ? "poses" : FLAGS_trajectory;
-  const bool generated = kind == "line" || kind == "arc" || kind == "grid" || kind == "random";
+  const bool generated =
+      kind == "circle" || kind == "line" || kind == "arc" || kind == "grid" || kind == "random";
   if (!generated && kind != "poses" && !(kind == "point" && !FLAGS_position.empty())) return true;
   const bool focal_law =
       FLAGS_attitude_law == "focal" || (generated && FLAGS_attitude_law != "none");
-  std::vector<FlagScope> scopes = TrajectoryFlagScopes(kind, focal_law, /*with_circle=*/false);
+  std::vector<FlagScope> scopes = TrajectoryFlagScopes(kind, focal_law);
   scopes.push_back({"seed", kind == "random", "--trajectory=random"});
   std::string mode = kind == "point"   ? "a single --position"
                      : kind == "poses" ? "--poses"
@@ -561,10 +600,13 @@ bool CheckFlagsApplyToMode(std::string* error) {
       {"aas-max-error", FLAGS_method == "aas" || FLAGS_method == "compare",
        "--method=aas or compare"},
       {"exact-tolerance", exact, "--method=exact (the default) or compare"}};
+  scopes.push_back({"plot", kind != "point", "a --trajectory or --poses"});
   const bool to_file = !FLAGS_output.empty() && FLAGS_output != "-";
+  const std::vector<FlagScope> output_scopes = {
+      {"force", to_file || !FLAGS_plot.empty(), "--output=FILE or --plot"}};
   return CheckFlagsApply(scopes, mode, error) &&
          CheckFlagsApply(method_scopes, "--method=" + FLAGS_method, error) &&
-         CheckFlagsApply({{"force", to_file, "--output=FILE"}}, "output to stdout", error);
+         CheckFlagsApply(output_scopes, "output to stdout", error);
 }
 
 bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* error) {
@@ -824,6 +866,47 @@ Failures CountFailures(const std::vector<Pose>& poses,
   return f;
 }
 
+// --plot=FILE.html: for a trajectory or --poses (CheckFlagsApplyToMode), a file other
+// than --output's, checked before any work as --output is.
+bool CheckPlotFlag(std::string* error) {
+  if (FLAGS_plot.empty()) return true;
+  if (FLAGS_plot == "-") {
+    *error = "--plot needs a file name (--plot=FILE.html); the table is what goes to stdout";
+    return false;
+  }
+  if (!FLAGS_output.empty() && FLAGS_output != "-" &&
+      ResolveOutputPath(FLAGS_output) == ResolveOutputPath(FLAGS_plot)) {
+    *error = "--output and --plot name the same file: " + internal::Quote(FLAGS_plot);
+    return false;
+  }
+  return CheckCanWrite("plot", FLAGS_plot, FLAGS_force, error);
+}
+
+std::string PlotPage(const std::vector<Pose>& poses, const std::string& provenance,
+                     const std::vector<TrajectoryRun>& runs) {
+  TrajectoryPlotInputs in;
+  const std::string mode =
+      !FLAGS_poses.empty() ? "--poses=" + FLAGS_poses : "--trajectory=" + FLAGS_trajectory;
+  in.title = "Tensions along " + mode;
+  in.provenance = provenance;
+  in.poses = &poses;
+  // A grid or a random sample of the cap is no path: its nodes in order instead.
+  in.along_path = FLAGS_trajectory != "grid" && FLAGS_trajectory != "random";
+  in.runs = runs;
+  return TrajectoryPlotHtml(in);
+}
+
+// The table (stdout or --output) and the plot (--plot): two files are renamed into place
+// together; with the table on stdout the plot is written first, so that a failure to write
+// it leaves nothing half done.
+bool WriteResults(const std::string& table, const std::string& plot, std::string* error) {
+  if (FLAGS_plot.empty()) return WriteOutput(FLAGS_output, table, error);
+  if (FLAGS_output.empty() || FLAGS_output == "-") {
+    return WriteOutput(FLAGS_plot, plot, error) && WriteOutput(FLAGS_output, table, error);
+  }
+  return WriteOutputsTogether({{FLAGS_output, table}, {FLAGS_plot, plot}}, error);
+}
+
 // Poses where exact met several equilibria (EquilibriumCode "several" or "unreachable").
 size_t CountSeveral(const Run& run) {
   size_t count = 0;
@@ -843,14 +926,15 @@ std::string TimingLine(const char* name, const Run& run, size_t n, bool warm) {
 
 int RunSolve(int argc, char** argv) {
   int exit_code = 0;
-  if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+  static const std::string help = Help();
+  if (!StartCommand(argc, argv, kCommand, help.c_str(), kFlags, &exit_code)) return exit_code;
   if (FlagGiven("columns") && FLAGS_poses.empty()) {
     PrintError(kCommand, "--columns applies to --poses=FILE (a pose file read as exported)");
     return kExitUsage;
   }
 
   std::string error;
-  if (!CheckCanWrite("output", FLAGS_output, FLAGS_force, &error)) {
+  if (!CheckCanWrite("output", FLAGS_output, FLAGS_force, &error) || !CheckPlotFlag(&error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -876,9 +960,9 @@ int RunSolve(int argc, char** argv) {
   std::string content;
   std::ostringstream timing;
   Failures failures;
+  Run run, aas, exact;  // run: one method; aas and exact: compare
   size_t several = 0;
   if (!compare) {
-    Run run;
     if (!SolveAll(robot, poses, options, &run, &error)) {
       PrintError(kCommand, error);
       return kExitFailure;
@@ -889,7 +973,6 @@ int RunSolve(int argc, char** argv) {
     failures = CountFailures(poses, {{&run, options.method}});
     several = CountSeveral(run);
   } else {
-    Run aas, exact;
     StaticsOptions o = options;
     o.method = StaticsMethod::kAas;
     if (!SolveAll(robot, poses, o, &aas, &error)) {
@@ -910,7 +993,15 @@ int RunSolve(int argc, char** argv) {
     failures = CountFailures(poses, {{&aas, StaticsMethod::kAas}, {&exact, StaticsMethod::kExact}});
     several = CountSeveral(exact);
   }
-  if (!WriteOutput(FLAGS_output, content, &error)) {
+  const std::string provenance = CommandLine(argc, argv, {"force"}) + "\nfastcal " +
+                                 FASTCAL_VERSION + ", model " + ModelName(FLAGS_model) +
+                                 ", attitude " + attitude;
+  const std::string plot =
+      FLAGS_plot.empty() ? ""
+      : compare
+          ? PlotPage(poses, provenance, {{"aas", &aas.solutions}, {"exact", &exact.solutions}})
+          : PlotPage(poses, provenance, {{FLAGS_method, &run.solutions}});
+  if (!WriteResults(content, plot, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

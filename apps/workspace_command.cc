@@ -30,8 +30,8 @@ DECLARE_bool(force);
 
 DEFINE_double(radial_offset, 0.0,
               "workspace: > 0 adds the grid this far (m) inside and outside the focal sphere.");
-DEFINE_double(min_tension_kn, 0.0, "workspace: smallest lower-end tension allowed (kN).");
-DEFINE_double(max_tension_kn, std::numeric_limits<double>::infinity(),
+DEFINE_double(min_tension_kN, 0.0, "workspace: smallest lower-end tension allowed (kN).");
+DEFINE_double(max_tension_kN, std::numeric_limits<double>::infinity(),
               "workspace: largest lower-end tension allowed (kN); inf: none.");
 DEFINE_string(html, "", "workspace: also write the map as a self-contained HTML file.");
 
@@ -47,7 +47,7 @@ const char kHelp[] =
     R"(fastcal workspace: where the cabin can go with every cable within limits.
 
 Usage:
-  fastcal workspace [--min-tension-kn=KN] [--max-tension-kn=KN] [--output=ws.csv]
+  fastcal workspace [--min-tension-kN=KN] [--max-tension-kN=KN] [--output=ws.csv]
                     [--html=ws.html] [options]
 
 Solves every node of a grid on the focal-sphere cap at the focal attitude law and says
@@ -61,7 +61,7 @@ Grid (the focal-sphere cap, as solve --trajectory=grid, with finer defaults):
   --radial-offset=0       m; > 0 adds the same grid this far inside and outside the sphere
 Attitude: the focal law, --tilt-fraction=0.41 (docs/model.md).
 Limits:
-  --min-tension-kn=0 --max-tension-kn=inf   lower-end tension, kN
+  --min-tension-kN=0 --max-tension-kN=inf   lower-end tension, kN
   --max-strain=0.05 --max-length-ratio=1.5  the model's range (tension / EA, s0 / chord)
   --reflector-clearance=0                   m, how close a cable may come to the reflector
 Statics: --method=exact (default), aas-refined or aas. Model: --model=FILE.yaml (default
@@ -75,10 +75,10 @@ min_tension_kN, min_tension_cable, max_tension_kN, max_tension_cable,
 max_upper_tension_kN (the tower end), message (quoted). --html=FILE.html writes the map:
 a polar plot of the cap per layer, colour = the smallest lower-end tension, a mark per
 infeasible node for its reason. Files are written only when everything succeeded; an
-existing one only with --force. A summary on stderr.
+existing one only with --force. A summary on stderr (on stdout with --output=FILE).
 
 Examples:
-  fastcal workspace --min-tension-kn=50 --max-tension-kn=500 --html=ws.html --output=ws.csv
+  fastcal workspace --min-tension-kN=50 --max-tension-kN=500 --html=ws.html --output=ws.csv
   fastcal workspace --max-off-axis-deg=45 --radial-offset=5 --html=edge.html --output=edge.csv
 )";
 
@@ -91,8 +91,8 @@ const std::set<std::string> kFlags = {"model",
                                       "azimuth-step-deg",
                                       "focal-radius",
                                       "radial-offset",
-                                      "min-tension-kn",
-                                      "max-tension-kn",
+                                      "min-tension-kN",
+                                      "max-tension-kN",
                                       "max-strain",
                                       "max-length-ratio",
                                       "reflector-clearance",
@@ -170,18 +170,18 @@ bool WorkspaceOptionsFromFlags(WorkspaceOptions* o, std::string* error) {
   o->attitude_law.tilt_fraction = FLAGS_tilt_fraction;
   o->radial_offset_m = FLAGS_radial_offset;
   // Checked here too, so that the message gives the flags' own numbers (kN).
-  if (!(FLAGS_min_tension_kn >= 0.0) || !std::isfinite(FLAGS_min_tension_kn)) {
+  if (!(FLAGS_min_tension_kN >= 0.0) || !std::isfinite(FLAGS_min_tension_kN)) {
     *error =
-        "--min-tension-kn must be >= 0 and finite (got " + FormatDouble(FLAGS_min_tension_kn) + ")";
+        "--min-tension-kN must be >= 0 and finite (got " + FormatDouble(FLAGS_min_tension_kN) + ")";
     return false;
   }
-  if (!(FLAGS_max_tension_kn > FLAGS_min_tension_kn)) {
-    *error = "--max-tension-kn must be above --min-tension-kn (got " +
-             FormatDouble(FLAGS_max_tension_kn) + " <= " + FormatDouble(FLAGS_min_tension_kn) + ")";
+  if (!(FLAGS_max_tension_kN > FLAGS_min_tension_kN)) {
+    *error = "--max-tension-kN must be above --min-tension-kN (got " +
+             FormatDouble(FLAGS_max_tension_kN) + " <= " + FormatDouble(FLAGS_min_tension_kN) + ")";
     return false;
   }
-  o->min_tension_n = FLAGS_min_tension_kn * kNPerKn;
-  o->max_tension_n = FLAGS_max_tension_kn * kNPerKn;
+  o->min_tension_n = FLAGS_min_tension_kN * kNPerKn;
+  o->max_tension_n = FLAGS_max_tension_kN * kNPerKn;
   if (!ParseStaticsMethod(FLAGS_method, &o->statics.method)) {
     *error = "--method must be exact, aas-refined or aas, got '" + FLAGS_method + "'";
     return false;
@@ -195,8 +195,8 @@ bool WorkspaceOptionsFromFlags(WorkspaceOptions* o, std::string* error) {
                           {"grid.focal_radius_m", "--focal-radius"},
                           {"grid.focal_centre_m", "--focal-centre"},
                           {"radial_offset_m", "--radial-offset"},
-                          {"min_tension_n", "--min-tension-kn"},
-                          {"max_tension_n", "--max-tension-kn"},
+                          {"min_tension_n", "--min-tension-kN"},
+                          {"max_tension_n", "--max-tension-kN"},
                           {"attitude_law.focal_centre_m", "--focal-centre"},
                           {"attitude_law.tilt_fraction", "--tilt-fraction"}});
   return false;

@@ -21,10 +21,10 @@ work=${3:-$(mktemp -d)}
 mkdir -p "$work"
 bin="$root/build/bin/fastcal"
 common=(--trajectory=random --samples=600 --max-off-axis-deg=40 --interval-s=2
-        --mass-centre=0.22,0.11,0.5 --tension-noise-pct=3 --density-mismatch-pct=1.5
-        --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=2 --attitude-noise-deg=0.02
+        --mass-centre=0.22,0.11,0.5 --tension-noise-percent=3 --density-mismatch-percent=1.5
+        --sensor-gain-spread-percent=1 --sensor-bias-spread-kN=2 --attitude-noise-deg=0.02
         --position-noise-m=0.01 --attitude-control-deg=0.2)
-slow=(--attitude-control-time-s=60 --tension-drift-pct=2 --tension-drift-time-s=120)
+slow=(--attitude-control-time-s=60 --tension-drift-percent=2 --tension-drift-time-s=120)
 case $case_ in
   white) extra=() ;;
   sensor) extra=("${slow[@]}") ;;

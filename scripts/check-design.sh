@@ -17,8 +17,8 @@ spec="$root/calibration_data/spec_realistic.yaml"
 rm -rf "$out"
 "$bin" design --spec="$spec" --samples=360 --out="$out/design" "$@"
 for seed in $(seq 1 "$seeds"); do
-  "$bin" simulate --poses="$out/design/poses.csv" --seed="$seed" --density-mismatch-pct=1.5 \
-    --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=2 --out="$out/sim$seed.csv" 2>/dev/null
+  "$bin" simulate --poses="$out/design/poses.csv" --seed="$seed" --density-mismatch-percent=1.5 \
+    --sensor-gain-spread-percent=1 --sensor-bias-spread-kN=2 --out="$out/sim$seed.csv" 2>/dev/null
   "$bin" calibrate --spec="$spec" --data="$out/sim$seed.csv" --out="$out/cal$seed" --quiet \
     >/dev/null 2>&1
 done

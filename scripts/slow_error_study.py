@@ -35,14 +35,14 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 BIN = os.environ.get("FASTCAL_BIN", os.path.join(ROOT, "build", "bin", "fastcal"))
 TRUTH_MC = (0.22, 0.11, 0.5)
 COMMON = ["--trajectory=random", "--max-off-axis-deg=40", "--interval-s=1",
-          "--mass-centre=%g,%g,%g" % TRUTH_MC, "--tension-noise-pct=3",
-          "--density-mismatch-pct=1.5", "--sensor-gain-spread-pct=1",
-          "--sensor-bias-spread-kn=1.5", "--attitude-noise-deg=0.02", "--position-noise-m=0.01"]
+          "--mass-centre=%g,%g,%g" % TRUTH_MC, "--tension-noise-percent=3",
+          "--density-mismatch-percent=1.5", "--sensor-gain-spread-percent=1",
+          "--sensor-bias-spread-kN=1.5", "--attitude-noise-deg=0.02", "--position-noise-m=0.01"]
 THREE_DAYS_S = 3 * 86400
 
 
 def drift(pct, tau):
-    return ["--tension-drift-pct=%g" % pct, "--tension-drift-time-s=%g" % tau]
+    return ["--tension-drift-percent=%g" % pct, "--tension-drift-time-s=%g" % tau]
 
 
 # name: (spec, simulate flags, kind, truth of what changed)
@@ -65,10 +65,10 @@ CASES = {
                           + drift(1, 20), "sessions", (0.0, 0.0, 0.0)),
     "sessions-rezeroed": ("spec_sessions.yaml",
                           ["--samples=800", "--sessions=2", "--session-gap-s=%d" % THREE_DAYS_S,
-                           "--sensor-rezero-kn=1"] + drift(2, 60), "sessions", (0.0, 0.0, 0.0)),
+                           "--sensor-rezero-kN=1"] + drift(2, 60), "sessions", (0.0, 0.0, 0.0)),
     "sessions-rezeroed-3kn": ("spec_sessions.yaml",
                               ["--samples=800", "--sessions=2",
-                               "--session-gap-s=%d" % THREE_DAYS_S, "--sensor-rezero-kn=3"]
+                               "--session-gap-s=%d" % THREE_DAYS_S, "--sensor-rezero-kN=3"]
                               + drift(2, 60), "sessions", (0.0, 0.0, 0.0)),
     "sessions-moved-3cm": ("spec_sessions.yaml",
                            ["--samples=800", "--sessions=2", "--session-gap-s=%d" % THREE_DAYS_S,

@@ -23,8 +23,8 @@ using testing::ReadText;
 // sixth's; the season of the tests.
 constexpr char kSeasonFlags[] =
     " --trajectory=random --samples=1680 --days=7 --interval-s=20 --start=1714593600"
-    " --mass-centre=0.22,0.11,0.5 --tension-drift-pct=1 --tension-drift-time-s=120"
-    " --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=1.5 --seed=4"
+    " --mass-centre=0.22,0.11,0.5 --tension-drift-percent=1 --tension-drift-time-s=120"
+    " --sensor-gain-spread-percent=1 --sensor-bias-spread-kN=1.5 --seed=4"
     " --mass-centre-step=1714762800:0.05,0,0 --sensor-step=1715022000:2:5";
 
 class CliTrackTest : public ::testing::Test {

@@ -7,8 +7,12 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <random>
+#include <regex>
+#include <string>
+#include <vector>
 
 #include "fastcal/calibration.h"
 #include "fastcal/calibration_spec.h"
@@ -272,6 +276,46 @@ TEST(Design, BadInput) {
   o.speed_m_per_s = 0.0;
   EXPECT_FALSE(o.IsValid(&error));
   EXPECT_NE(error.find("needs speed_m_per_s"), std::string::npos) << error;
+}
+
+// The outputs speak in each parameter's spec unit: a sensor bias's sigma in kN (its
+// name's), bounded by its 2 kN prior, not in N; the page numbers the stops in flight
+// order from a marked start, in the report's style; each stage says it started.
+TEST(Design, OutputsAreInTheSpecsUnitsAndThePageShowsTheOrder) {
+  const CableRobot robot = CableRobot::NominalFast();
+  DesignOptions o = SmallGrid();
+  o.samples = 20;
+  std::vector<std::string> stages;
+  o.progress = [&stages](const std::string& stage) { stages.push_back(stage); };
+  Design d;
+  std::string error;
+  ASSERT_TRUE(DesignSurvey(robot, Spec(), o, &d, &error)) << error;
+  EXPECT_GE(stages.size(), 5u);
+  EXPECT_NE(stages.front().find("candidate poses"), std::string::npos) << stages.front();
+  const int bias = 4;  // mass_centre_m.x, .y, .z, sensor_gain, sensor_bias_kN
+  ASSERT_EQ(d.free_names[bias], "sensor_bias_kN");
+  const double sigma_n = d.design.budget.parameters[bias].total;  // SI inside
+  ASSERT_GT(sigma_n, 1.0);
+  ASSERT_LE(sigma_n, 2e3);
+  const std::string json = DesignJson(d, "test");
+  std::smatch top;  // the top-level parameters[]: name, unit, sigma_total
+  ASSERT_TRUE(std::regex_search(json, top,
+                                std::regex("\"name\": \"sensor_bias_kN\",\\s*\"unit\": \"kN\",\\s*"
+                                           "\"sigma_total\": ([0-9.e+-]+)")))
+      << json.substr(0, 3000);
+  EXPECT_NEAR(std::stod(top[1]), sigma_n / 1e3, 1e-9 * sigma_n);
+  EXPECT_NE(json.find("\"unit\": \"m\""), std::string::npos);
+  const std::string html = DesignHtml(d, robot, "test");
+  EXPECT_NE(html.find("<circle class=\"start\""), std::string::npos);
+  EXPECT_NE(html.find(">start</text>"), std::string::npos);
+  int numbered = 0;
+  for (size_t k = html.find("class=\"stop-number\""); k != std::string::npos;
+       k = html.find("class=\"stop-number\"", k + 1)) {
+    ++numbered;
+  }
+  EXPECT_GE(numbered, 2);
+  EXPECT_NE(html.find(">1</text>"), std::string::npos);
+  EXPECT_NE(html.find(".banner-good"), std::string::npos);  // the report's style sheet
 }
 
 TEST(Design, TimeBudgetIsKept) {

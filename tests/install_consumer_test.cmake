@@ -109,4 +109,41 @@ print(fastcal.__version__)
     message(FATAL_ERROR "installed fastcal.__version__: ${out}")
   endif()
 endif()
+# The README's add_subdirectory recipe (the block after "<!-- consumer: subdirectory
+# CMakeLists.txt -->"), configured as a parent project that sets no build type: the
+# fastcal library gets -O2 (and CMake says so), the parent's own target keeps its flags;
+# a parent's build type is left alone. Read from compile_commands.json, not timed.
+function(compile_command commands source result)
+  string(REGEX MATCH "\"command\": \"[^\"]*${source}[^\"]*\"" found "${commands}")
+  if(NOT found)
+    message(FATAL_ERROR "no compile command for ${source} in compile_commands.json")
+  endif()
+  set(${result} "${found}" PARENT_SCOPE)
+endfunction()
+set(parent ${WORK_DIR}/parent)
+file(MAKE_DIRECTORY ${parent})
+readme_block("${readme}" "subdirectory CMakeLists.txt" block)
+string(REPLACE "path/to/fastcal" "${SOURCE_DIR}" block "${block}")
+file(WRITE ${parent}/CMakeLists.txt "${block}")
+readme_block("${readme}" main.cc block)
+file(WRITE ${parent}/main.cc "${block}")
+foreach(build_type "" Debug)
+  set(dir ${parent}/build${build_type})
+  run(COMMAND ${CMAKE_COMMAND} -S ${parent} -B ${dir} ${generator_args}
+    -DCMAKE_BUILD_TYPE=${build_type} -DCMAKE_EXPORT_COMPILE_COMMANDS=ON OUTPUT configured)
+  file(READ ${dir}/compile_commands.json commands)
+  compile_command("${commands}" "lib/src/statics/statics.cc" library)
+  compile_command("${commands}" "main.cc" app)
+  if(build_type STREQUAL "")
+    if(NOT configured MATCHES "fastcal: the parent project sets no CMAKE_BUILD_TYPE"
+        OR NOT library MATCHES " -O2 " OR app MATCHES " -O")
+      message(FATAL_ERROR "embedded without a build type, the library is not optimised alone:\n"
+        "${library}\n${app}\n${configured}")
+    endif()
+  elseif(configured MATCHES "fastcal: the parent project" OR library MATCHES " -O2 "
+      OR NOT library MATCHES " -g ")
+    message(FATAL_ERROR "the parent's ${build_type} build was overridden:\n${library}")
+  endif()
+endforeach()
+
 file(REMOVE_RECURSE ${WORK_DIR})

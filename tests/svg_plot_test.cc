@@ -603,6 +603,98 @@ TEST(SvgPolarMap, CellsMarksScaleAndLabels) {
   EXPECT_NE(SvgPolarMap({}, options).find("no data"), std::string::npos);
 }
 
+// The colour bar marks a value (a limit) with its label; a value beyond the scale at the
+// bar's end. A filled mark is drawn dark, in the map and in the legend.
+TEST(SvgPolarMap, ValueMarksOnTheColourBarAndFilledMarks) {
+  std::vector<PolarCell> cells;
+  for (int k = 0; k < 12; ++k) {
+    cells.push_back(
+        {0.5, 1.5, 30.0 * k - 15.0, 30.0 * k + 15.0, 100.0 + 5.0 * k, k % 2 == 0 ? 0 : 1, ""});
+  }
+  PolarMapOptions options;
+  options.marks = {{"below the minimum", MarkShape::kTriangleDown, true},
+                   {"above the maximum", MarkShape::kTriangleUp, false}};
+  options.value_marks = {{130.0, "minimum 130 kN"}, {900.0, "beyond"}};
+  const std::string svg = SvgPolarMap(cells, options);
+  ExpectValidSvg(svg);
+  EXPECT_NE(svg.find(">minimum 130 kN<"), std::string::npos);
+  EXPECT_NE(svg.find(">beyond<"), std::string::npos);
+  // Six marks of each kind, plus one in each legend entry: the filled one's outline is
+  // filled with the outline's dark colour, the other's not (its white halo shows).
+  const std::regex outline("<path d=\"[^\"]+\" fill=\"([^\"]+)\" stroke=\"#111111\"");
+  int filled = 0, hollow = 0;
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), outline);
+       it != std::sregex_iterator(); ++it) {
+    ((*it)[1] == "none" ? hollow : filled) += 1;
+    if ((*it)[1] != "none") {
+      EXPECT_EQ((*it)[1], "#111111");
+    }
+  }
+  EXPECT_EQ(filled, 7);
+  EXPECT_EQ(hollow, 7);
+}
+
+// A series may name its colour and be drawn over everything else (gross errors).
+TEST(SvgLinePlot, ASeriesOwnColourAndOnTop) {
+  PlotSeries line{"model", {0, 1, 2}, {1, 2, 3}};
+  PlotSeries gross{"gross error", {1}, {9}, false, true};
+  gross.colour = "#C00000";
+  gross.on_top = true;
+  const std::string svg = SvgLinePlot({gross, line}, PlotOptions());
+  ExpectValidSvg(svg);
+  const size_t model = svg.find("stroke=\"" + PlotSeriesColour(1) + "\" stroke-width=\"1.8\"");
+  const size_t red = svg.find("stroke=\"#C00000\" stroke-width=\"6\"");
+  ASSERT_NE(model, std::string::npos) << svg;
+  ASSERT_NE(red, std::string::npos) << svg;
+  EXPECT_GT(red, model);  // drawn after the line, though a marker and first in the list
+  EXPECT_EQ(svg.find(PlotSeriesColour(0)), std::string::npos);  // its own colour, not slot 0's
+}
+
+// A dot-and-whisker plot: one dot per row at its value, a thick bar of +-sigma and a thin
+// one of +-wide_sigmas sigma, the reference line, labels and notes; the axis covers the
+// bars and the reference; the emphasised row in the second colour.
+TEST(SvgIntervalPlot, DotsBarsReferenceAndLabels) {
+  IntervalPlotOptions o;
+  o.plot.title = "later minus earlier";
+  o.plot.x_label = "difference [m]";
+  o.reference = 0.0;
+  o.wide_sigmas = 3.0;
+  const std::vector<IntervalRow> rows = {
+      {"x: day1 \u2192 day2", 0.05, 0.002, "+0.05 \u00b1 0.002 m (25 \u03c3)", true},
+      {"y: day1 \u2192 day2", 0.001, 0.002, "+0.001 \u00b1 0.002 m (0.5 \u03c3)", false},
+      {"z: (none)", kNaN, 0.0, "n/a", false}};
+  const std::string svg = SvgIntervalPlot(rows, o);
+  ExpectValidSvg(svg);
+  EXPECT_EQ(Count(svg, "<circle class=\"value\""), 2);
+  EXPECT_EQ(Count(svg, "class=\"sigma\""), 2);
+  EXPECT_EQ(Count(svg, "class=\"wide\""), 2);
+  EXPECT_EQ(Count(svg, "stroke-dasharray=\"5 4\""), 1);  // the reference line
+  EXPECT_NE(svg.find("x: day1 \u2192 day2"), std::string::npos);
+  EXPECT_NE(svg.find("(25 \u03c3)"), std::string::npos);
+  EXPECT_NE(svg.find(">z: (none)<"), std::string::npos);
+  EXPECT_NE(svg.find("fill=\"" + PlotSeriesColour(1) + "\""), std::string::npos);
+  EXPECT_NE(svg.find("fill=\"" + PlotSeriesColour(0) + "\""), std::string::npos);
+  // The thin bar of row 2 (0.001 +- 0.006) reaches below zero, inside the frame.
+  std::smatch reference;
+  ASSERT_TRUE(std::regex_search(svg, reference,
+                                std::regex("<line x1=\"([0-9.]+)\"[^>]*stroke-dasharray=\"5 4\"")));
+  std::vector<double> wide;
+  const std::regex wide_line("<line x1=\"([0-9.]+)\"[^>]*class=\"wide\"");
+  for (auto it = std::sregex_iterator(svg.begin(), svg.end(), wide_line);
+       it != std::sregex_iterator(); ++it) {
+    wide.push_back(std::stod((*it)[1]));
+  }
+  ASSERT_EQ(wide.size(), 2u);
+  EXPECT_LT(wide[1], std::stod(reference[1]));
+  EXPECT_GT(wide[1], 0.0);
+  EXPECT_GT(wide[0], std::stod(reference[1]));  // row 1's reaches 0.044: clear of zero
+  // The dots sit where their values are: x's to the right of y's.
+  const std::vector<std::string> cx = Attribute(svg, "<circle class=\"value\"", "cx");
+  ASSERT_EQ(cx.size(), 2u);
+  EXPECT_GT(std::stod(cx[0]), std::stod(cx[1]));
+  EXPECT_NE(SvgIntervalPlot({{"a", kNaN, 1.0, "", false}}, o).find("no data"), std::string::npos);
+}
+
 TEST(XmlProblem, DetectsMalformedMarkup) {
   EXPECT_EQ(XmlProblem("<svg><g></g></svg>"), "");
   EXPECT_NE(XmlProblem("<svg><g></svg>"), "");

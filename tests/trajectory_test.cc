@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <string>
@@ -163,6 +164,49 @@ TEST(ArcPositions, NegativeSpanRunsClockwiseAndFullTurnBackwards) {
 }
 
 // ---- Focal sphere grid ----
+
+// ---- The paper's measured circle ----
+
+// The circle the paper measured, and its recognition in a dataset's positions: the
+// whole turn within a metre (a measured position scatters by centimetres), in any order;
+// not another radius, height or a half turn.
+TEST(PaperCircleMatcher, RecognisesTheMeasuredCircleAndNothingElse) {
+  const ArcSpec circle = PaperCircleArc();
+  EXPECT_EQ(circle.centre_m, Eigen::Vector3d(0.0, 0.0, 156.73));
+  EXPECT_EQ(circle.radius_m, 71.11);
+  EXPECT_EQ(circle.nodes, 360);
+  std::vector<Eigen::Vector3d> p;
+  ASSERT_TRUE(ArcPositions(circle, &p, nullptr));
+  auto matches = [](const std::vector<Eigen::Vector3d>& positions) {
+    PaperCircleMatcher m;
+    for (const Eigen::Vector3d& x : positions) m.Add(x);
+    return m.Matches();
+  };
+  EXPECT_TRUE(matches(p));
+  std::vector<Eigen::Vector3d> scattered = p;  // measured: +-0.9 m, shuffled
+  for (size_t k = 0; k < scattered.size(); ++k) {
+    scattered[k] += Eigen::Vector3d(0.9 * std::cos(7.0 * k), 0.0, -0.9 * std::sin(3.0 * k));
+  }
+  std::reverse(scattered.begin(), scattered.end());
+  EXPECT_TRUE(matches(scattered));
+  EXPECT_FALSE(matches({}));
+  ArcSpec other = circle;
+  other.radius_m = 70.0;  // 1.11 m inside
+  ASSERT_TRUE(ArcPositions(other, &p, nullptr));
+  EXPECT_FALSE(matches(p));
+  other = circle;
+  other.centre_m.z() = 155.5;
+  ASSERT_TRUE(ArcPositions(other, &p, nullptr));
+  EXPECT_FALSE(matches(p));
+  other = circle;
+  other.end_deg = 180.0;  // half a turn
+  ASSERT_TRUE(ArcPositions(other, &p, nullptr));
+  EXPECT_FALSE(matches(p));
+  // One position elsewhere (a stray sample) is not the paper's survey either.
+  ASSERT_TRUE(ArcPositions(circle, &p, nullptr));
+  p.push_back(Eigen::Vector3d(0.0, 0.0, 140.0));
+  EXPECT_FALSE(matches(p));
+}
 
 TEST(FocalSpherePositions, DefaultGridCoversTheCap) {
   std::vector<Eigen::Vector3d> p;

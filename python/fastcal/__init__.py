@@ -19,11 +19,13 @@ fastcal.CalibrationError (a RuntimeError).
 
 from __future__ import annotations
 
+import difflib
+import functools
 import json
 import os
 import re
 import warnings
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, TypeVar, Union
 
 try:
     import numpy as np
@@ -69,7 +71,43 @@ __all__ = [
     "TrackResult",
 ]
 
+
+
+def __dir__() -> List[str]:
+    """What the package offers (__all__), not the modules it imports (np, os, re, json)."""
+    return sorted(__all__ + ["STATUS_NAMES"])
+
+
 ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]]]
+_Function = TypeVar("_Function", bound=Callable[..., Any])
+
+
+def _renamed_keywords(renamed: Mapping[str, str]) -> Callable[[_Function], _Function]:
+    """Accepts each keyword's old name (a key of `renamed`) as its new one, with a
+    DeprecationWarning: the keywords now have the command line's names (docs/python.md,
+    "Names")."""
+
+    def wrap(function: _Function) -> _Function:
+        @functools.wraps(function)
+        def call(*args: Any, **kwargs: Any) -> Any:
+            for old, new in renamed.items():
+                if old not in kwargs:
+                    continue
+                if new in kwargs:
+                    raise TypeError(f"{function.__name__}() got both {old}= and {new}=")
+                warnings.warn(
+                    f"{function.__name__}({old}=...) is deprecated: use {new}= (the command "
+                    f"line's --{new.replace('_', '-')})",
+                    DeprecationWarning,
+                    stacklevel=2,
+                )
+                kwargs[new] = kwargs.pop(old)
+            return function(*args, **kwargs)
+
+        return call  # type: ignore[return-value]
+
+    return wrap
+
 PathLike = Union[str, "os.PathLike[str]"]
 
 STATUS_NAMES: List[str] = _fastcal.statics_status_names()
@@ -100,6 +138,8 @@ def _attitude(
     kind, value, columns = ("rpy", rpy_deg, 3) if rpy_deg is not None else ("quat", quat, 4)
     name = "rpy_deg" if kind == "rpy" else "quat"
     array, _ = _rows(value, columns, name)
+    if array.shape[0] == 1 and n > 1:  # one attitude for every position, as numpy broadcasts
+        array = np.ascontiguousarray(np.repeat(array, n, axis=0))
     if array.shape[0] != n:
         raise InputError(f"{name} has {array.shape[0]} rows for {n} positions")
     return kind, array
@@ -110,6 +150,27 @@ def _point(value: ArrayLike, name: str) -> np.ndarray:
     if array.shape != (3,):
         raise InputError(f"{name} must have shape (3,), got {array.shape}")
     return array
+
+
+# The library's option fields behind keywords named as the command line's flags.
+_SOLVE_OPTION_FIELDS = {
+    "refined_tolerance": "refined_relative_tolerance",
+    "aas_max_error": "aas_max_relative_error",
+    "exact_tolerance": "exact_relative_tolerance",
+    "reflector_clearance_m": "min_reflector_clearance_m",
+}
+
+
+def _call_with_names(fields: Mapping[str, str], function: Callable[..., Any], *args: Any) -> Any:
+    """function(*args), an InputError's message naming the keywords instead of the
+    library's fields (keyword -> field in `fields`)."""
+    try:
+        return function(*args)
+    except InputError as error:
+        message = str(error)
+        for keyword, field in fields.items():
+            message = re.sub(rf"\b{re.escape(field)}\b", keyword, message)
+        raise InputError(message) from None
 
 
 class StaticsResult:
@@ -168,6 +229,14 @@ class StaticsResult:
         return f"<fastcal.StaticsResult: {n} pose{'s' if n != 1 else ''}, {failed} failed>"
 
 
+@_renamed_keywords(
+    {
+        "refined_relative_tolerance": "refined_tolerance",
+        "aas_max_relative_error": "aas_max_error",
+        "exact_relative_tolerance": "exact_tolerance",
+        "min_reflector_clearance_m": "reflector_clearance_m",
+    }
+)
 def solve(
     position_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,
@@ -177,39 +246,45 @@ def solve(
     *,
     warm_start: bool = False,
     max_refinement_steps: int = 8,
-    refined_relative_tolerance: float = 1e-6,
-    aas_max_relative_error: float = 1e-2,
-    exact_relative_tolerance: float = 1e-12,
+    refined_tolerance: float = 1e-6,
+    aas_max_error: float = 1e-2,
+    exact_tolerance: float = 1e-12,
     max_strain: float = 0.05,
     max_length_ratio: float = 1.5,
-    min_reflector_clearance_m: float = 0.0,
+    reflector_clearance_m: float = 0.0,
 ) -> StaticsResult:
     """Cable forces, tensions and unstretched lengths at one pose or many.
 
     Args:
         position_m: position of the cabin-frame origin, global frame: (3,) or (n, 3).
         rpy_deg: attitude as roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll):
-            (3,) or (n, 3). At most one of rpy_deg and quat; neither means R = I.
-        quat: attitude as unit quaternions (w, x, y, z): (4,) or (n, 4). E.g. the focal
-            law's, fastcal.focal_attitude(position_m).
+            (3,) or (n, 3); one (3,) attitude applies to every position. At most one of
+            rpy_deg and quat; neither means R = I.
+        quat: attitude as unit quaternions (w, x, y, z): (4,) or (n, 4), one for all as
+            rpy_deg. E.g. the focal law's, fastcal.focal_attitude(position_m).
         method: 'exact' (Newton on all unknowns; where its start fails it follows the
             equilibrium from the home pose), 'aas-refined' (the paper's AAS refined by
             Newton steps on its tangent until its error estimate is below
-            refined_relative_tolerance) or 'aas' (the paper's; 'inaccurate' when its
-            error estimate exceeds aas_max_relative_error).
+            refined_tolerance) or 'aas' (the paper's; 'inaccurate' when its error
+            estimate exceeds aas_max_error).
         model: the model; None for Model.nominal().
         warm_start: start each pose from the previous pose's solution (a trajectory);
             off, each pose is solved on its own and the order does not matter.
         max_refinement_steps: at most this many steps of 'aas-refined' (>= 1), then
             'not_converged'.
-        refined_relative_tolerance: where 'aas-refined' stops.
-        aas_max_relative_error: the largest error estimate 'aas' calls 'ok'.
-        exact_relative_tolerance: where 'exact' stops.
+        refined_tolerance: where 'aas-refined' stops (relative tension error).
+        aas_max_error: the largest relative error estimate 'aas' calls 'ok'.
+        exact_tolerance: where 'exact' stops (relative).
         max_strain: tensions above max_strain * EA are refused ('overstretched_cable').
         max_length_ratio: unstretched lengths above this times the chord are refused
             ('sagging_cable').
-        min_reflector_clearance_m: with a reflector in the model, a cable closer to its
+        reflector_clearance_m: with a reflector in the model, a cable closer to its
             surface than this is refused ('reflector_contact').
+
+    The keywords are the command line's flags (--aas-max-error: aas_max_error), with
+    the unit where the flag leaves it implicit (--reflector-clearance:
+    reflector_clearance_m). The former names (aas_max_relative_error, ...) still work,
+    with a DeprecationWarning.
 
     Returns:
         A StaticsResult: arrays with a leading axis of n for (n, 3) positions, none for
@@ -221,7 +296,9 @@ def solve(
     """
     positions, single = _rows(position_m, 3, "position_m")
     kind, attitude = _attitude(positions.shape[0], rpy_deg, quat)
-    raw = _fastcal.solve(
+    raw = _call_with_names(
+        _SOLVE_OPTION_FIELDS,
+        _fastcal.solve,
         model if model is not None else Model.nominal(),
         positions,
         kind,
@@ -230,12 +307,12 @@ def solve(
         {
             "warm_start": warm_start,
             "max_refinement_steps": max_refinement_steps,
-            "refined_relative_tolerance": refined_relative_tolerance,
-            "aas_max_relative_error": aas_max_relative_error,
-            "exact_relative_tolerance": exact_relative_tolerance,
+            "refined_relative_tolerance": refined_tolerance,
+            "aas_max_relative_error": aas_max_error,
+            "exact_relative_tolerance": exact_tolerance,
             "max_strain": max_strain,
             "max_length_ratio": max_length_ratio,
-            "min_reflector_clearance_m": min_reflector_clearance_m,
+            "min_reflector_clearance_m": reflector_clearance_m,
         },
     )
     return StaticsResult(raw, single)
@@ -595,6 +672,63 @@ Dataset.from_arrays = staticmethod(_dataset_from_arrays)  # type: ignore[attr-de
 Dataset.from_dataframe = staticmethod(_dataset_from_dataframe)  # type: ignore[attr-defined]
 
 
+# simulate()'s keywords: the command line's flags (--attitude-control-deg:
+# attitude_control_deg), each with the SimulationOptions field it sets where the two differ.
+_SIMULATE_OPTION_FIELDS = {
+    "attitude_control_deg": "attitude_control_sigma_deg",
+    "attitude_noise_deg": "attitude_measurement_sigma_deg",
+    "position_noise_m": "position_measurement_sigma_m",
+    "tension_noise_kN": "tension_noise_kn",
+    "sensor_bias_spread_kN": "sensor_bias_spread_kn",
+    "interval_s": "sample_interval_s",
+}
+_SIMULATE_OPTIONS = sorted(
+    list(_SIMULATE_OPTION_FIELDS)
+    + [
+        "attitude_control_time_s",
+        "density_mismatch_percent",
+        "mass_centre_drift_m",
+        "mass_centre_drift_time_s",
+        "mass_centre_steps",
+        "method",
+        "outlier_fraction",
+        "outlier_scale_percent",
+        "seed",
+        "sensor_bias_steps",
+        "sensor_gain_spread_percent",
+        "session_gap_s",
+        "sessions",
+        "start_time_s",
+        "tension_drift_percent",
+        "tension_drift_time_s",
+        "tension_noise_percent",
+    ]
+)
+
+
+def _simulation_fields(options: Mapping[str, Any]) -> Dict[str, Any]:
+    """simulate()'s keywords as the library's fields; a former name (the field's) with a
+    DeprecationWarning, an unknown one refused with the closest names."""
+    old_names = {field: keyword for keyword, field in _SIMULATE_OPTION_FIELDS.items()}
+    fields: Dict[str, Any] = {}
+    for name, value in options.items():
+        if name in old_names:
+            warnings.warn(
+                f"simulate({name}=...) is deprecated: use {old_names[name]}= (the command "
+                f"line's --{old_names[name].replace('_', '-')})",
+                DeprecationWarning,
+                stacklevel=3,
+            )
+            name = old_names[name]
+        if name not in _SIMULATE_OPTIONS:
+            close = difflib.get_close_matches(name, _SIMULATE_OPTIONS, n=3)
+            guess = f"; did you mean {' or '.join(close)}?" if close else ""
+            raise InputError(f"simulate: unknown option '{name}'{guess} (accepted: " +
+                             ", ".join(_SIMULATE_OPTIONS) + ")")
+        fields[_SIMULATE_OPTION_FIELDS.get(name, name)] = value
+    return fields
+
+
 def simulate(
     position_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,
@@ -605,18 +739,20 @@ def simulate(
     """Synthetic telemetry from a known ("truth") model at planned poses.
 
     The planned poses are positions (n, 3) with an attitude as in solve(). Options are
-    the fields of the C++ SimulationOptions (simulation.h, docs/cli.md's `simulate`):
-    tension_noise_percent (3), tension_noise_kn, outlier_fraction,
-    outlier_scale_percent, attitude_control_sigma_deg, attitude_control_time_s,
-    attitude_measurement_sigma_deg, position_measurement_sigma_m,
-    tension_drift_percent, tension_drift_time_s, mass_centre_drift_m,
-    mass_centre_drift_time_s, sensor_gain_spread_percent, sensor_bias_spread_kn,
-    density_mismatch_percent, sample_interval_s (1), seed (1), method ('exact'),
-    sessions (1: the samples cut into that many consecutive sessions, labelled 1..N),
-    mass_centre_steps ([(time_s, (dx, dy, dz)), ...]: the mass centre moves by the shift
-    at that time and stays), start_time_s (0: the first sample's time, e.g. a Unix time),
-    session_gap_s (0: time between sessions; 86400 - a day's span makes a session a day),
-    sensor_bias_steps ([(time_s, cable 1..6, shift_kN), ...]: one sensor re-zeroed).
+    `fastcal simulate`'s flags (docs/cli.md), with underscores:
+    tension_noise_percent (3), tension_noise_kN, outlier_fraction,
+    outlier_scale_percent, attitude_control_deg, attitude_control_time_s,
+    attitude_noise_deg, position_noise_m, tension_drift_percent, tension_drift_time_s,
+    mass_centre_drift_m, mass_centre_drift_time_s, sensor_gain_spread_percent,
+    sensor_bias_spread_kN, density_mismatch_percent, interval_s (1), seed (1), method
+    ('exact'), sessions (1: the samples cut into that many consecutive sessions,
+    labelled 1..N), mass_centre_steps ([(time_s, (dx, dy, dz)), ...]: the mass centre
+    moves by the shift at that time and stays), start_time_s (0: the first sample's
+    time, e.g. a Unix time), session_gap_s (0: time between sessions; 86400 - a day's
+    span makes a session a day), sensor_bias_steps ([(time_s, cable 1..6, shift_kN),
+    ...]: one sensor re-zeroed). The former names, SimulationOptions' fields
+    (attitude_control_sigma_deg, tension_noise_kn, sample_interval_s, ...), still work
+    with a DeprecationWarning.
 
     Returns:
         (dataset, truth_used, summary): the telemetry, the truth model after the drawn
@@ -626,7 +762,10 @@ def simulate(
     positions, _ = _rows(position_m, 3, "position_m")
     kind, attitude = _attitude(positions.shape[0], rpy_deg, quat)
     truth = model if model is not None else Model.nominal()
-    return _fastcal.simulate(truth, positions, kind, attitude, dict(options))
+    fields = _simulation_fields(options)
+    return _call_with_names(
+        _SIMULATE_OPTION_FIELDS, _fastcal.simulate, truth, positions, kind, attitude, fields
+    )
 
 
 class CalibrationResult:
@@ -809,6 +948,7 @@ def evaluate(
     return _fastcal.evaluate(model, data, method)
 
 
+@_renamed_keywords({"sample_interval_s": "interval_s"})
 def design(
     spec: Union[PathLike, Mapping[str, Any]],
     samples: int,
@@ -820,7 +960,7 @@ def design(
     parameters: Sequence[str] = (),
     seed: int = 1,
     speed_m_per_s: float = 0.0,
-    sample_interval_s: float = 1.0,
+    interval_s: float = 1.0,
     minutes: float = 0.0,
     min_tension_kN: Optional[float] = None,
     max_tension_kN: Optional[float] = None,
@@ -843,8 +983,9 @@ def design(
         criterion: 'A' (sum of the wanted variances) or 'D' (their log-determinant).
         parameters: the wanted parameters; empty: the free ones without a prior.
         seed: draws the random survey the design is compared with.
-        speed_m_per_s, sample_interval_s: the path's duration; minutes: a time budget
-            (needs a speed).
+        speed_m_per_s, interval_s: the path's duration (cabin speed, time per sample);
+            minutes: a time budget (needs a speed). (interval_s was sample_interval_s:
+            the old name still works, with a DeprecationWarning.)
         min_tension_kN, max_tension_kN, reflector_clearance_m: the candidates' limits;
             None: the design's defaults (50 kN, none, 5 m).
         max_off_axis_deg, off_axis_step_deg, azimuth_step_deg: the grid; None: the
@@ -855,9 +996,11 @@ def design(
         yaw_deg in flight order (what poses.csv holds); 'stops' (dicts: samples,
         position_m, extra_tilt_deg, tilt_direction_deg, extra_yaw_deg); 'wanted';
         'design', 'circle', 'random': {'ok', 'note', 'criterion', 'sigma_total':
-        {name: SI value}}; 'path_length_m', 'duration_s' (nan without a speed),
-        'candidates', 'rejected_candidates', 'limiting_part', 'limiting_share',
-        'prior_halved' ({group: {wanted name: sigma_total with its sigma halved}}).
+        {name: value}}; 'units' ({name: unit}); 'path_length_m', 'duration_s' (nan
+        without a speed), 'candidates', 'rejected_candidates', 'limiting_part',
+        'limiting_share', 'prior_halved' ({group: {wanted name: sigma_total with its
+        sigma halved}}). Every sigma is in its parameter's unit, the one its name
+        carries and the spec's (sensor_bias_kN[1] in kN), as calibrate() reports it.
 
     Raises:
         InputError: a bad spec or option, nothing free, fewer samples than free
@@ -876,7 +1019,7 @@ def design(
         "parameters": [str(p) for p in parameters],
         "seed": int(seed),
         "speed_m_per_s": float(speed_m_per_s),
-        "sample_interval_s": float(sample_interval_s),
+        "sample_interval_s": float(interval_s),
         "time_budget_s": 60.0 * float(minutes),
         "min_tension_kN": min_tension_kN,
         "max_tension_kN": max_tension_kN,

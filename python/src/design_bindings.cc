@@ -13,9 +13,9 @@ py::dict Prediction(const Design& d, const DesignPrediction& p) {
   py::dict out;
   out["ok"] = p.ok;
   out["note"] = p.note;
-  py::dict sigma;
+  py::dict sigma;  // in each parameter's spec unit (kN for sensor_bias_kN), as calibrate's
   for (size_t k = 0; k < d.free_names.size(); ++k) {
-    sigma[py::str(d.free_names[k])] = p.ok ? p.budget.parameters[k].total : NAN;
+    sigma[py::str(d.free_names[k])] = p.ok ? p.budget.parameters[k].total / d.free_to_si[k] : NAN;
   }
   out["sigma_total"] = sigma;
   out["criterion"] = p.ok ? p.criterion : NAN;
@@ -53,6 +53,10 @@ py::dict DesignDict(const Design& d) {
   out["rejected_candidates"] = d.rejected_candidates;
   out["path_length_m"] = d.path_length_m;
   out["duration_s"] = d.options.speed_m_per_s > 0.0 ? d.duration_s : NAN;
+  py::dict units;
+  for (size_t k = 0; k < d.free_names.size(); ++k)
+    units[py::str(d.free_names[k])] = d.free_units[k];
+  out["units"] = units;
   out["design"] = Prediction(d, d.design);
   out["circle"] = Prediction(d, d.circle);
   out["random"] = Prediction(d, d.random);
@@ -62,7 +66,7 @@ py::dict DesignDict(const Design& d) {
   for (const DesignPriorEffect& e : d.prior_effects) {
     py::dict sigma;
     for (size_t w = 0; w < e.sigma_total.size(); ++w) {
-      sigma[py::str(d.free_names[d.wanted[w]])] = e.sigma_total[w];
+      sigma[py::str(d.free_names[d.wanted[w]])] = e.sigma_total[w] / d.free_to_si[d.wanted[w]];
     }
     halved[py::str(e.group)] = sigma;
   }

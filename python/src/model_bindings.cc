@@ -13,6 +13,15 @@ namespace {
 
 // A per-cable field of CableProperties as a (6,) array property, both ways.
 
+// A getter's array, a copy of the model's values, made read-only: `model.ea_n[0] = 1`
+// raises ("assignment destination is read-only") instead of editing a copy that nothing
+// reads; a whole array assigned (model.ea_n = values) is what changes the model.
+template <typename Array>
+Array ReadOnly(Array array) {
+  array.attr("flags").attr("writeable") = false;
+  return array;
+}
+
 // cables[i].attachments as a list of six lists of dicts (docs/model-format.md): a point
 // mass {at_m, mass_kg}, added weight {from_m, to_m, added_density_kg_per_m}.
 py::list GetAttachments(const CableRobot& r) {
@@ -77,7 +86,7 @@ void PerCableProperty(py::class_<CableRobot>& model, const char* name,
       [field](const CableRobot& r) {
         DoubleArray out = NewArray({kNumCables});
         for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = r.cables[i].*field;
-        return out;
+        return ReadOnly(out);
       },
       [field, name](CableRobot& r, const DoubleArray& values) {
         if (values.ndim() != 1 || values.shape(0) != kNumCables) {
@@ -112,7 +121,7 @@ CableRobot Load(const std::string& path) {
 py::object GetReflector(const CableRobot& r) {
   if (!r.reflector) return py::none();
   py::dict d;
-  d["centre_m"] = Vector3(r.reflector->centre_m);
+  d["centre_m"] = ReadOnly(Vector3(r.reflector->centre_m));
   d["radius_m"] = r.reflector->radius_m;
   d["aperture_m"] = r.reflector->aperture_m;
   return std::move(d);
@@ -147,7 +156,7 @@ DoubleArray GetAnchorPoints(const CableRobot& r) {
   for (py::ssize_t j = 0; j < n; ++j) {
     for (int k = 0; k < 3; ++k) out.mutable_data()[3 * j + k] = r.anchor_points_cabin_m[j][k];
   }
-  return out;
+  return ReadOnly(out);
 }
 
 void SetAnchorPoints(CableRobot& r, const DoubleArray& v) {
@@ -163,7 +172,7 @@ DoubleArray GetTowerTops(const CableRobot& r) {
   for (int i = 0; i < kNumCables; ++i) {
     for (int k = 0; k < 3; ++k) out.mutable_data()[3 * i + k] = r.cables[i].tower_top_m[k];
   }
-  return out;
+  return ReadOnly(out);
 }
 
 void SetTowerTops(CableRobot& r, const DoubleArray& v) {
@@ -178,7 +187,7 @@ void SetTowerTops(CableRobot& r, const DoubleArray& v) {
 py::array_t<int> GetAnchorIndex(const CableRobot& r) {
   py::array_t<int> out(kNumCables);
   for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = r.cables[i].anchor_index;
-  return out;
+  return ReadOnly(out);
 }
 
 void SetAnchorIndex(CableRobot& r, const py::array_t<int, py::array::forcecast>& v) {
@@ -197,7 +206,9 @@ void BindModel(py::module_& m) {
 Model.nominal() is the paper's FAST; Model.load(path) reads a model file, e.g. the
 model_calibrated.yaml of a calibration. Fields are plain numbers or numpy arrays in SI
 units named with their unit; per-cable fields have shape (6,), cable i at index i-1.
-Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
+Arrays are read-only copies: assign a whole array to change one
+(v = model.ea_n.copy(); v[0] *= 1.01; model.ea_n = v); editing one in place raises
+ValueError ("assignment destination is read-only") instead of changing nothing.
 )");
   model.def_static("nominal", &CableRobot::NominalFast, "The nominal FAST model (paper Table 1).")
       .def_static("load", &Load, py::arg("path"),
@@ -224,7 +235,8 @@ Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
       .def_readwrite("gravity_m_per_s2", &CableRobot::gravity_m_per_s2,
                      "Gravitational acceleration along z (negative: z is up).")
       .def_property(
-          "mass_centre_cabin_m", [](const CableRobot& r) { return Vector3(r.mass_centre_cabin_m); },
+          "mass_centre_cabin_m",
+          [](const CableRobot& r) { return ReadOnly(Vector3(r.mass_centre_cabin_m)); },
           [](CableRobot& r, const DoubleArray& v) {
             r.mass_centre_cabin_m = ToVector3(v, "mass_centre_cabin_m");
           },
@@ -265,7 +277,7 @@ Arrays are copies: assign a whole array to change one (model.ea_n = new_values).
         for (int i = 0; i < kNumCables; ++i) {
           out.mutable_data()[i] = r.cables[i].sensor_bias_n / kNPerKn;
         }
-        return out;
+        return ReadOnly(out);
       },
       [](CableRobot& r, const DoubleArray& values) {
         if (values.ndim() != 1 || values.shape(0) != kNumCables) {

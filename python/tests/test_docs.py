@@ -34,7 +34,9 @@ def test_worked_example(
         pytest.skip("matplotlib (python3-matplotlib) is missing: the example ran, its plot did not")
     os.environ.setdefault("MPLBACKEND", "Agg")
     exec(compile(blocks["plot"], "docs/python.md (plot)", "exec"), namespace)
-    assert (tmp_path / "tensions.png").stat().st_size > 0
+    assert (tmp_path / "out" / "tensions.png").stat().st_size > 0
+    # Nothing else written beside calibration_data/: the outputs go under out/.
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["calibration_data", "out"]
 
 
 def test_columns_example(

@@ -92,8 +92,8 @@ def test_the_issue_9_pose_touches_the_reflector() -> None:
 def test_wrong_arguments_are_input_errors_naming_them() -> None:
     with pytest.raises(fastcal.InputError, match=r"position_m must have shape \(3,\) or \(n, 3\)"):
         fastcal.solve([1.0, 2.0])
-    with pytest.raises(fastcal.InputError, match="rpy_deg has 1 rows for 2 positions"):
-        fastcal.solve([[0, 0, 140], [0, 0, 150]], rpy_deg=[0, 0, 0])
+    with pytest.raises(fastcal.InputError, match="rpy_deg has 2 rows for 3 positions"):
+        fastcal.solve([[0, 0, 140], [0, 0, 150], [0, 0, 160]], rpy_deg=[[0, 0, 0], [0, 0, 0]])
     with pytest.raises(fastcal.InputError, match="rpy_deg or quat, not both"):
         fastcal.solve([0, 0, 140], rpy_deg=[0, 0, 0], quat=[1, 0, 0, 0])
     with pytest.raises(fastcal.InputError, match=r"quat\[1\]: quaternion .* must be unit"):

@@ -56,6 +56,7 @@
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -137,6 +138,11 @@ struct DesignOptions {
   // N samples evenly spaced on one turn, attitude by the focal law.
   Eigen::Vector3d circle_centre_m = Eigen::Vector3d(0.0, 0.0, 156.73);
   double circle_radius_m = 71.11;
+  // Called at the start of each stage (candidates, information, approximate design,
+  // exchange, time budget, predictions) with a line saying what it does: a design takes
+  // about 20 s on the default grid with extra attitudes. Empty: silent. The library never
+  // prints; the command line puts these on stderr.
+  std::function<void(const std::string&)> progress;
   // False with *error naming the field when an option is invalid.
   bool IsValid(std::string* error) const;
 };
@@ -246,8 +252,9 @@ bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
 // '#' comment lines with `provenance`.
 std::string DesignPosesCsv(const Design& design, const std::string& provenance);
 // design.json: options, stops, path, and for the design, the circle and the random
-// survey `parameters[]: {name, wanted, sigma_total, formal, systematic}`, the budget's
-// parts, what limits the design and what a better prior would buy.
+// survey `parameters[]: {name, unit, wanted, sigma_total, formal, systematic}`, the
+// budget's parts, what limits the design and what a better prior would buy; each sigma in
+// the parameter's spec unit (free_units: kN for sensor_bias_kN), never SI under a kN name.
 std::string DesignJson(const Design& design, const std::string& provenance);
 // Two lines for the console: the plausible range the poses hold over and what binds
 // them (the tightest stop, the constraint, the cable and the numbers).

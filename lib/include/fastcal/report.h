@@ -21,11 +21,12 @@
 // the misfit (score test); identifiability (singular-value ratios, poorly determined and
 // data-only directions, strong correlations); RMS of model - measured per cable (the
 // paper's Table 6) for each variant on the fitted and the held-out samples, and block
-// cross-validation; plots (per-cable tension and residual against time, joined by lines
-// only for a trajectory; residual against off-axis angle and azimuth; predicted against
-// measured; residual histogram; RMS bars; correlation heatmap); how to use the
-// calibrated model; the Ceres full report. The only date is ReportInputs::run_utc,
-// which the caller gives: the same inputs give the same bytes.
+// cross-validation, with the paper's published Table 6 beside when the data fly its
+// measured circle (PaperCircleMatcher, trajectory.h: by the positions, not the file name); plots
+// (per-cable tension and residual against time, joined by lines only for a trajectory; residual
+// against off-axis angle and azimuth; predicted against measured; residual histogram; RMS bars;
+// correlation heatmap); how to use the calibrated model; the Ceres full report. The only date is
+// ReportInputs::run_utc, which the caller gives: the same inputs give the same bytes.
 //
 // Tensions are in kN in every table, plot and JSON key (the library is SI inside).
 #ifndef FASTCAL_REPORT_H_
@@ -49,11 +50,12 @@ namespace fastcal {
 // A sample as the report's plots see it.
 struct ReportSample {
   double time_s = 0.0;
+  Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // measured
   std::array<double, kNumCables> measured_n{};
   // predicted_n[k]: the predicted readings of ReportInputs::variants[k], for each k with
   // ReportSampleStream::has_predictions[k].
   const std::array<double, kNumCables>* predicted_n = nullptr;
-  std::array<bool, kNumCables> gross{};  // gross errors: not drawn
+  std::array<bool, kNumCables> gross{};  // gross errors: red dots, their residuals not drawn
   bool held_out = false;
 };
 

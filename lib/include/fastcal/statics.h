@@ -173,6 +173,9 @@ enum class StaticsStatus {
 // "singular", "catenary_failed", "not_converged", "inaccurate", "attachment_beyond_cable",
 // "unsupported_model".
 const char* StaticsStatusName(StaticsStatus status);
+// The enum's last status: every status is a value from kOk (0) to this one, which lists
+// (solve --help, the Python module's STATUS_NAMES) run through. A new status goes last.
+inline constexpr StaticsStatus kLastStaticsStatus = StaticsStatus::kUnsupportedModel;
 
 // exact only: which equilibrium a solution is, where sagging cables let several hold one
 // pose (docs/model.md, "Which equilibrium exact returns").

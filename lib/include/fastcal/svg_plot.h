@@ -17,6 +17,7 @@
 #ifndef FASTCAL_SVG_PLOT_H_
 #define FASTCAL_SVG_PLOT_H_
 
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -34,6 +35,10 @@ struct PlotSeries {
   // Opacity of the dots or the line, clamped to [0.05, 1]; below 1 the grid and other
   // series show through.
   double opacity = 1.0;
+  // Its colour, e.g. "#C00000"; empty: the palette's for its index (PlotSeriesColour).
+  std::string colour{};
+  // Drawn last, over every line: marks that must stay visible (gross errors).
+  bool on_top = false;
 };
 
 struct PlotOptions {
@@ -52,8 +57,9 @@ struct PlotOptions {
 // path, and an isolated point between gaps is drawn as a dot. A markers_only series is
 // one zero-length subpath ("M x y h0") per point, stroked with round caps.
 // Z-order: all markers_only series are drawn first (underneath), then the lines, each
-// group in index order, so a line stays visible over dense measured points. Colours and
-// the legend follow the index.
+// group in index order, so a line stays visible over dense measured points; series
+// marked on_top come last. Colours (unless a series names its own) and the legend follow
+// the index.
 std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions& options);
 
 // Thins a long series for drawing while keeping its peaks and outliers (min/max per
@@ -144,12 +150,41 @@ std::string SvgMatrixHeatmap(const std::vector<std::string>& labels,
                              const std::vector<std::vector<double>>& matrix,
                              const PlotOptions& options);
 
+// One row of an interval plot: a value with its standard deviation.
+struct IntervalRow {
+  std::string label;        // left of the row, e.g. "mass_centre_m.x: day1 → day2"
+  double value = 0.0;       // non-finite: the row shows its label only
+  double sigma = 0.0;       // the thick bar spans value ± sigma (< 0 or non-finite: none)
+  std::string note;         // right of the row, e.g. "+0.051 ± 0.0015 m (33.9 σ)"
+  bool emphasised = false;  // drawn in the second palette colour (vermillion), not the first
+};
+
+struct IntervalPlotOptions {
+  PlotOptions plot;  // title, x_label (with the unit), width; the height follows the rows
+  // A vertical reference line, e.g. 0 for differences; non-finite: none.
+  double reference = std::numeric_limits<double>::quiet_NaN();
+  // > 0: a thin bar of value ± wide_sigmas sigma around each thick one (e.g. the 3 σ at
+  // which a difference counts as a change: it reaches the reference line or not).
+  double wide_sigmas = 0.0;
+};
+
+// A dot-and-whisker ("forest") plot, one row per item, on one shared value axis with
+// snug nice ticks: a difference and its sigma read at once against the reference line,
+// where separate bars of the two values would overlap. Each row's dot is a
+// <circle class="value">, its bars <line class="sigma"> (and class="wide"). No rows with a
+// finite value: a "no data" SVG.
+std::string SvgIntervalPlot(const std::vector<IntervalRow>& rows,
+                            const IntervalPlotOptions& options);
+
 // Shapes of the marks a polar map puts on its cells (e.g. why a workspace node fails).
 enum class MarkShape { kCross, kTriangleUp, kTriangleDown, kSquare, kDiamond, kCircle, kPlus };
 
 struct PolarMark {
   std::string label;  // legend text; empty leaves the mark out of the legend
   MarkShape shape = MarkShape::kCross;
+  // A closed shape filled dark instead of white: two marks of one shape family (▼ and
+  // △) then differ in more than their direction.
+  bool filled = false;
 };
 
 // One cell of a polar map: an annular sector, angles from +x toward +y (counter-clockwise
@@ -174,6 +209,9 @@ struct PolarMapOptions {
   std::vector<PolarMark> marks;
   // Labels outside the outer ring at these angles (deg), e.g. the towers.
   std::vector<std::pair<double, std::string>> rim_labels;
+  // Values marked on the colour bar, e.g. {130, "minimum 130"}: a line across it and its
+  // label above; a value beyond the scale is drawn at the bar's end.
+  std::vector<std::pair<double, std::string>> value_marks;
 };
 
 // A polar map: each cell filled by its value on a sequential (viridis-like) scale with a

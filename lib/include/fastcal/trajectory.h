@@ -3,7 +3,7 @@
 // The paper's section 4 scenarios (docs/model.md, "Reference values" and "Measured data"):
 //   - straight line G1 (50, 0, 150) m -> G2 (-50, 0, 150) m, 101 nodes   LinePositions
 //   - half circle of radius 50 m about (0, 0, 150) m, 0..180 deg, 101 nodes   ArcPositions
-//   - measured full circle of radius 71.11 m about (0, 0, 156.73) m   ArcPositions
+//   - measured full circle of radius 71.11 m about (0, 0, 156.73) m   PaperCircleArc
 // and the workspace: the lower cap of the focal sphere (radius 160 m about (0, 0, 300) m)
 // up to 40 deg off-axis, as a regular grid (FocalSpherePositions) or uniformly sampled
 // with optional offsets off the sphere (RandomWorkspacePositions). Positions become poses
@@ -53,6 +53,29 @@ struct ArcSpec {
 // node at the end: the `nodes` points are distinct, spaced 360/nodes deg apart.
 // Multiple turns are rejected (they would repeat points).
 bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions, std::string* error);
+
+// The paper's measured circle (its section 4 and Table 6; docs/model.md, "Measured data"):
+// radius 71.11 m about (0, 0, 156.73) m, one full turn from +x, 360 nodes.
+ArcSpec PaperCircleArc();
+
+// Recognises the paper's measured circle in a dataset's positions, fed one at a time (a
+// file too long to hold is streamed): they fly it when every one lies within
+// kToleranceM of the circle (horizontal distance from its axis minus its radius, and
+// height) and together they visit every 10-degree sector of the turn. By content, not by
+// file name: the report then shows the paper's published Table 6 beside its own, for
+// the bundled circle_paper.csv and for any other survey flown on that circle.
+class PaperCircleMatcher {
+ public:
+  static constexpr double kToleranceM = 1.0;
+  void Add(const Eigen::Vector3d& position_m);
+  bool Matches() const;
+
+ private:
+  static constexpr int kSectors = 36;
+  long long count_ = 0;
+  bool all_near_ = true;
+  std::vector<bool> visited_ = std::vector<bool>(kSectors, false);
+};
 
 // Positions handed out one at a time, in order, for runs too long to hold (fastcal
 // simulate at 10^6 samples: memory independent of their number). `next` gives position

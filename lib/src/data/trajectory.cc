@@ -2,6 +2,7 @@
 // and the pose CSV reader (conventions: trajectory.h).
 #include "fastcal/trajectory.h"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
@@ -211,6 +212,32 @@ bool ArcPositions(const ArcSpec& spec, std::vector<Eigen::Vector3d>* positions,
   if (positions == nullptr) return Fail(error, "positions must not be null");
   PositionStream stream;
   return ArcPositionStream(spec, &stream, error) && Drain(&stream, positions);
+}
+
+ArcSpec PaperCircleArc() {
+  ArcSpec circle;
+  circle.centre_m = Eigen::Vector3d(0.0, 0.0, 156.73);
+  circle.radius_m = 71.11;
+  circle.start_deg = 0.0;
+  circle.end_deg = 360.0;
+  circle.nodes = 360;
+  return circle;
+}
+
+void PaperCircleMatcher::Add(const Eigen::Vector3d& position_m) {
+  static const ArcSpec circle = PaperCircleArc();
+  const Eigen::Vector3d d = position_m - circle.centre_m;
+  const double off_m = std::hypot(d.x(), d.y()) - circle.radius_m;
+  all_near_ = all_near_ && std::abs(off_m) <= kToleranceM && std::abs(d.z()) <= kToleranceM;
+  const double azimuth_deg = std::atan2(d.y(), d.x()) * 180.0 / M_PI;  // (-180, 180]
+  const int sector = static_cast<int>(std::floor((azimuth_deg + 180.0) / (360.0 / kSectors)));
+  visited_[std::clamp(sector, 0, kSectors - 1)] = true;
+  ++count_;
+}
+
+bool PaperCircleMatcher::Matches() const {
+  return count_ > 0 && all_near_ &&
+         std::all_of(visited_.begin(), visited_.end(), [](bool v) { return v; });
 }
 
 bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d>* positions,

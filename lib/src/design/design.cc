@@ -555,6 +555,9 @@ bool SetUp(const CableRobot& robot, const CalibrationSpec& spec, const DesignOpt
 
 bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                   const DesignOptions& options, Design* design, std::string* error) {
+  const auto say = [&options](const std::string& what) {
+    if (options.progress) options.progress(what);
+  };
   DesignProblem pr;
   if (!SetUp(robot, spec, options, &pr, error)) return false;
   Design d;
@@ -566,19 +569,28 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
     d.free_to_si.push_back(p.to_si);
   }
   d.wanted = pr.wanted;
+  say("candidate poses: solving the statics of the grid's nodes and attitudes");
   if (!internal::DesignCandidates(robot, options, &d.candidates, &d.rejected_candidates, error)) {
     return false;
   }
+  say(std::to_string(d.candidates.size()) + " feasible candidates (" +
+      std::to_string(d.rejected_candidates) +
+      " infeasible); those that hold over the parameters' plausible range");
   const internal::PlausibleRange range(robot, spec, options);
   if (!KeepThoseThatHold(range, &d, error)) return false;
+  say(std::to_string(d.candidates.size()) + " candidates hold; their information (Jacobians)");
   std::vector<Pose> poses;
   for (const DesignCandidate& c : d.candidates) poses.push_back(c.pose);
   if (!internal::AddPoseRows(robot, spec, poses, &pr, error)) return false;
   NormaliseWeights(spec, options.samples, &pr);
+  say("approximate design (" + std::to_string(options.approximate_iterations) +
+      " Frank-Wolfe iterations at most)");
   const Eigen::VectorXd w = ApproximateDesign(pr, options.samples, options.approximate_iterations);
   std::vector<int> counts = RoundToSamples(w, options.samples);
   std::vector<int> all(pr.candidates());
   std::iota(all.begin(), all.end(), 0);
+  say("exchange of single samples (" + std::to_string(options.exchange_iterations) +
+      " swaps at most)");
   Exchange(pr, all, options.exchange_width, options.exchange_iterations, &counts);
   const DesignSums s0 = internal::SumsOf(pr, ToWeights(counts));
   if (!std::isfinite(internal::CriterionOf(pr, s0))) {
@@ -587,9 +599,12 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
              "priors, or allow more attitudes (--max-extra-tilt-deg, --max-extra-yaw-deg)";
     return false;
   }
+  say("path through the stops" +
+      std::string(options.time_budget_s > 0.0 ? " within the time budget" : ""));
   if (!KeepWithinBudget(pr, d.candidates, options, &counts, &d, error)) return false;
   for (DesignStop& stop : d.stops) range.Holds(d.candidates[stop.candidate].pose, &stop.binding);
   const DesignSums s = internal::SumsOf(pr, ToWeights(counts));
+  say("predictions for the design, the paper's circle and a random survey");
   d.design = PredictWithParts(spec, pr, s, options.samples);
   ExplainLimits(spec, pr, s, &d);
   std::vector<Pose> reference;

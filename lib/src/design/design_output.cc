@@ -4,11 +4,13 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include "fastcal/design.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/report_document.h"
 #include "fastcal/svg_plot.h"
 
 namespace fastcal {
@@ -32,6 +34,10 @@ Shown ShownUnit(const Design& d, int k) {
   if (d.free_units[k] == "m") return {1e3, "mm"};
   return {1.0 / d.free_to_si[k], d.free_units[k]};
 }
+
+// A free parameter's value in the spec's unit, its name's (sensor_bias_kN in kN): the
+// library is SI inside, the files speak as the spec and calibrate's outputs do.
+double InSpecUnit(const Design& d, size_t k, double si_value) { return si_value / d.free_to_si[k]; }
 
 // The range's parameters grouped by name before '.' or '[' with their offset in file
 // units, e.g. "mass_centre_m +-0.25 m (margin); linear_density_kg_per_m +-0.36 kg/m (2
@@ -102,13 +108,18 @@ void WritePrediction(JsonWriter& j, const Design& d, const DesignPrediction& p) 
   for (size_t k = 0; k < d.free_names.size(); ++k) {
     const bool wanted =
         std::find(d.wanted.begin(), d.wanted.end(), static_cast<int>(k)) != d.wanted.end();
-    j.BeginObject().Key("name").String(d.free_names[k]).Key("wanted").Bool(wanted);
+    j.BeginObject().Key("name").String(d.free_names[k]).Key("unit").String(d.free_units[k]);
+    j.Key("wanted").Bool(wanted);
     if (p.ok) {
       const ParameterBudget& b = p.budget.parameters[k];
-      j.Key("sigma_total").Number(b.total).Key("formal").Number(b.formal);
-      j.Key("systematic").Number(b.systematic);
-      j.Key("budget_variance").BeginObject().Key("noise").Number(p.noise_variance[k]);
-      for (size_t g = 0; g < p.parts.size(); ++g) j.Key(p.parts[g]).Number(p.part_variance[g][k]);
+      const double squared = InSpecUnit(d, k, InSpecUnit(d, k, 1.0));  // variances' scale
+      j.Key("sigma_total").Number(InSpecUnit(d, k, b.total));
+      j.Key("formal").Number(InSpecUnit(d, k, b.formal));
+      j.Key("systematic").Number(InSpecUnit(d, k, b.systematic));
+      j.Key("budget_variance").BeginObject().Key("noise").Number(p.noise_variance[k] * squared);
+      for (size_t g = 0; g < p.parts.size(); ++g) {
+        j.Key(p.parts[g]).Number(p.part_variance[g][k] * squared);
+      }
       j.EndObject();
     } else {
       j.Key("sigma_total").Null();
@@ -210,8 +221,9 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
   WritePrediction(j, d, d.design);
   j.Key("parameters").BeginArray();  // the design's, at the top for a quick read
   for (size_t k = 0; k < d.free_names.size(); ++k) {
-    j.BeginObject().Key("name").String(d.free_names[k]);
-    j.Key("sigma_total").Number(d.design.ok ? d.design.budget.parameters[k].total : NAN);
+    j.BeginObject().Key("name").String(d.free_names[k]).Key("unit").String(d.free_units[k]);
+    j.Key("sigma_total")
+        .Number(d.design.ok ? InSpecUnit(d, k, d.design.budget.parameters[k].total) : NAN);
     j.EndObject();
   }
   j.EndArray();
@@ -224,7 +236,11 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
   j.Key("prior_halved").BeginArray();
   for (const DesignPriorEffect& e : d.prior_effects) {
     j.BeginObject().Key("group").String(e.group).Key("consider").Bool(e.consider);
-    j.Key("sigma_total").NumberArray(e.sigma_total).EndObject();
+    std::vector<double> sigma_total;  // of each wanted parameter, in its spec unit
+    for (size_t w = 0; w < e.sigma_total.size(); ++w) {
+      sigma_total.push_back(InSpecUnit(d, d.wanted[w], e.sigma_total[w]));
+    }
+    j.Key("sigma_total").NumberArray(sigma_total).EndObject();
   }
   j.EndArray();
   j.EndObject();
@@ -239,7 +255,7 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   const FocalGridSpec& g = d.options.workspace.grid;
   const double rim_m = g.focal_radius_m * std::sin(g.max_off_axis_deg * M_PI / 180.0);
   const double extent_m = rim_m;  // the towers are drawn at the rim, by their direction
-  const double size = 620.0, half = size / 2.0, scale = (half - 40.0) / extent_m;
+  const double size = 640.0, half = size / 2.0, scale = (half - 56.0) / extent_m;
   auto X = [&](double x) { return Fmt("%.1f", half + scale * (x - g.focal_centre_m.x())); };
   auto Y = [&](double y) { return Fmt("%.1f", half - scale * (y - g.focal_centre_m.y())); };
   std::string s = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + Fmt("%.0f", size) +
@@ -263,7 +279,22 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   }
   s += "<path class=\"path\" d=\"" + path +
        "\" fill=\"none\" stroke=\"#0072B2\" stroke-width=\"1.2\"/>\n";
+  // The flight order: each stop's number beside it, the first also marked "start" with a
+  // ring, so that the path reads without its tooltips.
+  if (!d.stops.empty()) {
+    const Eigen::Vector3d& p0 = d.candidates[d.stops.front().candidate].pose.position_m;
+    s += "<circle class=\"start\" cx=\"" + X(p0.x()) + "\" cy=\"" + Y(p0.y()) +
+         "\" r=\"13\" fill=\"none\" stroke=\"#111\" stroke-width=\"2\"/>\n<text x=\"" +
+         Fmt("%.1f", half + scale * (p0.x() - g.focal_centre_m.x()) + 16.0) + "\" y=\"" +
+         Fmt("%.1f", half - scale * (p0.y() - g.focal_centre_m.y()) - 12.0) +
+         "\" font-weight=\"bold\">start</text>\n";
+  }
   int order = 0;
+  struct Number {
+    double x_px = 0.0, y_px = 0.0, radius_px = 0.0;
+    std::string label;
+  };
+  std::map<std::string, Number> numbers;  // by drawn position
   for (const DesignStop& st : d.stops) {
     const DesignCandidate& c = d.candidates[st.candidate];
     const Eigen::Vector3d rpy = RpyDegFromRotation(c.pose.rotation);
@@ -279,13 +310,24 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
          Fmt("%.2f", rpy[1]) + ", " + Fmt("%.2f", rpy[2]) + ") deg; extra tilt " +
          Fmt("%.3g", c.extra_tilt_deg) + " deg toward " + Fmt("%.3g", c.tilt_direction_deg) +
          " deg, extra yaw " + Fmt("%.3g", c.extra_yaw_deg) + " deg</title></circle>\n";
+    // Stops at one position (other attitudes) share one label: "18, 19".
+    Number& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
+    n.x_px = half + scale * (c.pose.position_m.x() - g.focal_centre_m.x());
+    n.y_px = half - scale * (c.pose.position_m.y() - g.focal_centre_m.y());
+    n.radius_px = std::max(n.radius_px, radius);
+    n.label += (n.label.empty() ? "" : ", ") + std::to_string(order);
+  }
+  for (const auto& [at, n] : numbers) {
+    s += "<text class=\"stop-number\" x=\"" + Fmt("%.1f", n.x_px + n.radius_px + 2.0) + "\" y=\"" +
+         Fmt("%.1f", n.y_px - 3.0) + "\" font-size=\"11\" font-weight=\"bold\" fill=\"#222\">" +
+         n.label + "</text>\n";
   }
   for (int i = 0; i < kNumCables; ++i) {
     const Eigen::Vector3d t = robot.cables[i].tower_top_m - g.focal_centre_m;
     const double a = std::atan2(t.y(), t.x());
-    const double r = scale * rim_m + 18.0;
+    const double r = scale * rim_m + 34.0;  // beyond the stops' numbers on the rim
     s += "<text x=\"" + Fmt("%.1f", half + r * std::cos(a)) + "\" y=\"" +
-         Fmt("%.1f", half - r * std::sin(a)) + "\" text-anchor=\"middle\">T" +
+         Fmt("%.1f", half - r * std::sin(a) + 4.0) + "\" text-anchor=\"middle\" fill=\"#777\">T" +
          std::to_string(i + 1) + "</text>\n";
   }
   s += "<text x=\"10\" y=\"18\">seen from above; rim: " + Fmt("%.3g", g.max_off_axis_deg) +
@@ -293,26 +335,30 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   return s;
 }
 
-std::string SigmaCell(const DesignPrediction& p, int k, double scale) {
-  if (!p.ok) return "<td>n/a</td>";
-  return "<td class=\"num\">" + Fmt("%.4g", p.budget.parameters[k].total * scale) + "</td>";
+internal::Text SigmaCell(const DesignPrediction& p, int k, double scale) {
+  if (!p.ok) return internal::Text("n/a");
+  return internal::Text(Fmt("%.4g", p.budget.parameters[k].total * scale));
 }
 
-std::string SigmaTable(const Design& d) {
-  std::string h =
-      "<table><thead><tr><th>parameter</th><th>unit</th><th>design</th><th>paper's "
-      "circle</th><th>random survey</th></tr></thead><tbody>\n";
+bool IsWanted(const Design& d, size_t k) {
+  return std::find(d.wanted.begin(), d.wanted.end(), static_cast<int>(k)) != d.wanted.end();
+}
+
+internal::Table SigmaTable(const Design& d) {
+  internal::Table t;
+  t.header = {"parameter", "unit", "design", "paper's circle", "random survey"};
+  t.right_align = {false, false, true, true, true};
   for (size_t k = 0; k < d.free_names.size(); ++k) {
-    const bool wanted =
-        std::find(d.wanted.begin(), d.wanted.end(), static_cast<int>(k)) != d.wanted.end();
     const Shown u = ShownUnit(d, static_cast<int>(k));
-    h += std::string(wanted ? "<tr class=\"wanted\">" : "<tr>") + "<th>" +
-         XmlEscape(d.free_names[k]) + (wanted ? " (wanted)" : "") + "</th><td>" + u.unit + "</td>" +
-         SigmaCell(d.design, static_cast<int>(k), u.scale) +
-         SigmaCell(d.circle, static_cast<int>(k), u.scale) +
-         SigmaCell(d.random, static_cast<int>(k), u.scale) + "</tr>\n";
+    internal::Text name;
+    name.Code(d.free_names[k]);
+    if (IsWanted(d, k)) name.Bold(" (wanted)");
+    t.rows.push_back({name, internal::Text(u.unit),
+                      SigmaCell(d.design, static_cast<int>(k), u.scale),
+                      SigmaCell(d.circle, static_cast<int>(k), u.scale),
+                      SigmaCell(d.random, static_cast<int>(k), u.scale)});
   }
-  return h + "</tbody></table>\n";
+  return t;
 }
 
 std::string SigmaBars(const Design& d) {
@@ -332,32 +378,34 @@ std::string SigmaBars(const Design& d) {
   return SvgGroupedBars(groups, {"design", "paper's circle", "random survey"}, o);
 }
 
-std::string LimitsText(const Design& d) {
-  std::string h =
-      "<h2>What limits the design</h2>\n<p>The largest part of the wanted "
-      "parameters' summed variance is <b>" +
-      XmlEscape(d.limiting_part == "noise" ? "the tension noise of the data" : d.limiting_part) +
-      "</b>: " + Fmt("%.0f", 100.0 * d.limiting_share) + "% of it.</p>\n";
-  if (d.prior_effects.empty()) return h;
-  h += "<p>With one prior (or consider) sigma halved, the design's sigma_total would be:</p>\n"
-       "<table><thead><tr><th>sigma halved</th>";
+void AddLimits(const Design& d, internal::Document* doc) {
+  doc->Heading(2, "What limits the design");
+  doc->Paragraph(
+      internal::Text("The largest part of the wanted parameters' summed variance is ")
+          .Bold(d.limiting_part == "noise" ? "the tension noise of the data" : d.limiting_part)
+          .Plain(": " + Fmt("%.0f", 100.0 * d.limiting_share) + "% of it."));
+  if (d.prior_effects.empty()) return;
+  doc->Paragraph("With one prior (or consider) sigma halved, the design's sigma_total would be:");
+  internal::Table t;
+  t.header = {"sigma halved"};
+  t.right_align = {false};
   for (int k : d.wanted) {
-    h += "<th>" + XmlEscape(d.free_names[k]) + " (" + ShownUnit(d, k).unit + ")</th>";
+    t.header.push_back(
+        internal::Text().Code(d.free_names[k]).Plain(" (" + ShownUnit(d, k).unit + ")"));
+    t.right_align.push_back(true);
   }
-  h += "</tr></thead><tbody>\n<tr><th>none (as designed)</th>";
-  for (int k : d.wanted) {
-    h += SigmaCell(d.design, k, ShownUnit(d, k).scale);
-  }
-  h += "</tr>\n";
+  std::vector<internal::Text> designed = {"none (as designed)"};
+  for (int k : d.wanted) designed.push_back(SigmaCell(d.design, k, ShownUnit(d, k).scale));
+  t.rows.push_back(designed);
   for (const DesignPriorEffect& e : d.prior_effects) {
-    h += "<tr><th>" + XmlEscape(e.group) + (e.consider ? " (consider)" : " (prior)") + "</th>";
+    std::vector<internal::Text> row = {
+        internal::Text().Code(e.group).Plain(e.consider ? " (consider)" : " (prior)")};
     for (size_t w = 0; w < e.sigma_total.size(); ++w) {
-      h += "<td class=\"num\">" + Fmt("%.4g", e.sigma_total[w] * ShownUnit(d, d.wanted[w]).scale) +
-           "</td>";
+      row.push_back(Fmt("%.4g", e.sigma_total[w] * ShownUnit(d, d.wanted[w]).scale));
     }
-    h += "</tr>\n";
+    t.rows.push_back(row);
   }
-  return h + "</tbody></table>\n";
+  doc->AddTable(std::move(t));
 }
 
 // Stops by their binding constraint, e.g. "min_tension at 20 of 23 stops,
@@ -388,12 +436,13 @@ std::string BindingText(const DesignBinding& b) {
          Fmt("%.4g", BindingShown(b, b.limit)) + " " + BindingUnit(b) + ")";
 }
 
-std::string RangeSection(const Design& d) {
+void AddRange(const Design& d, internal::Document* doc) {
   const WorkspaceOptions& w = d.options.workspace;
-  std::string h =
-      "<h2>Poses that hold</h2>\n<p>Every candidate was judged at the spec's initial values and "
-      "over the plausible range of its parameters: " +
-      XmlEscape(RangeText(d)) +
+  doc->Heading(2, "Poses that hold");
+  doc->Paragraph(
+      "Every candidate was judged at the spec's initial values and over the plausible range of "
+      "its parameters: " +
+      RangeText(d) +
       ". At the initial values and at the corner of that box where each cable's tension is "
       "lowest" +
       (std::isfinite(w.max_tension_n) ? std::string(" (and highest)") : std::string("")) +
@@ -403,27 +452,82 @@ std::string RangeSection(const Design& d) {
                                       : std::string("")) +
       " and every cable " + Fmt("%.3g", w.statics.min_reflector_clearance_m) +
       " m clear of the reflector. " + std::to_string(d.rejected_off_nominal) +
-      " candidates feasible at the initial values only were left out.</p>\n";
-  if (d.stops.empty()) return h;
+      " candidates feasible at the initial values only were left out.");
+  if (d.stops.empty()) return;
   const int tightest = TightestStop(d);
-  h += "<p>What binds each stop, at its worst corner (bold: the tightest). Where in the range: "
-       "per group, each parameter's side of its initial value (+ or -), in the order of "
-       "<code>plausible_range.parameters</code> in design.json.</p>\n<div "
-       "class=\"wrap\"><table><thead><tr><th>stop</th><th>position (m)</th><th>binds</th>"
-       "<th>there</th><th>where in the range</th></tr></thead><tbody>\n";
+  doc->Paragraph(internal::Text("What binds each stop, at its worst corner (bold: the tightest). "
+                                "Where in the range: per group, each parameter's side of its "
+                                "initial value (+ or -), in the order of ")
+                     .Code("plausible_range.parameters")
+                     .Plain(" in design.json."));
+  internal::Table t;
+  t.header = {"stop", "position (m)", "binds", "there", "where in the range"};
+  t.right_align = {true, false, false, false, false};
   for (size_t k = 0; k < d.stops.size(); ++k) {
     const DesignBinding& b = d.stops[k].binding;
     const Eigen::Vector3d& p = d.candidates[d.stops[k].candidate].pose.position_m;
     const bool bold = static_cast<int>(k) == tightest;
-    h += std::string(bold ? "<tr style=\"font-weight:bold\">" : "<tr>") + "<td class=\"num\">" +
-         std::to_string(k + 1) + "</td><td>(" + Fmt("%.2f", p.x()) + ", " + Fmt("%.2f", p.y()) +
-         ", " + Fmt("%.2f", p.z()) + ")</td><td>" + XmlEscape(b.constraint) + "</td><td>" +
-         XmlEscape(BindingText(b)) + "</td><td>" + XmlEscape(CornerText(d, b)) + "</td></tr>\n";
+    std::vector<internal::Text> row;
+    for (const std::string& cell :
+         {std::to_string(k + 1),
+          "(" + Fmt("%.2f", p.x()) + ", " + Fmt("%.2f", p.y()) + ", " + Fmt("%.2f", p.z()) + ")",
+          b.constraint, BindingText(b), CornerText(d, b)}) {
+      row.push_back(bold ? internal::Text().Bold(cell) : internal::Text(cell));
+    }
+    t.rows.push_back(row);
   }
-  return h + "</tbody></table></div>\n";
+  doc->AddTable(std::move(t));
+}
+
+// What was designed, in one paragraph: samples, stops, candidates, attitudes, path.
+std::string SurveyText(const Design& d) {
+  const DesignOptions& o = d.options;
+  std::string h = std::to_string(o.samples) + " samples at " + std::to_string(d.stops.size()) +
+                  " stops, chosen " + DesignCriterionName(o.criterion) + "-optimally from " +
+                  std::to_string(d.candidates.size()) + " feasible candidate poses (" +
+                  std::to_string(d.rejected_candidates) +
+                  " infeasible left out); extra tilt up to " + Fmt("%.3g", o.max_extra_tilt_deg) +
+                  " deg, extra yaw up to " + Fmt("%.3g", o.max_extra_yaw_deg) +
+                  " deg off the focal law. Path " + Fmt("%.4g", d.path_length_m) + " m";
+  if (o.speed_m_per_s > 0.0) {
+    h += ", " + Fmt("%.4g", d.duration_s / 60.0) + " min at " + Fmt("%.3g", o.speed_m_per_s) +
+         " m/s (" + Fmt("%.4g", d.travel_s / 60.0) + " min flying, " +
+         Fmt("%.4g", d.dwell_s / 60.0) + " min sampling)";
+  }
+  if (o.time_budget_s > 0.0) {
+    h += "; time budget " + Fmt("%.4g", o.time_budget_s / 60.0) + " min (" +
+         std::to_string(d.unconstrained_stops) + " stops without it)";
+  }
+  return h + ".";
 }
 
 }  // namespace
+
+// The page in the calibration report's style (internal::RenderHtmlPage).
+std::string DesignHtml(const Design& d, const CableRobot& robot, const std::string& provenance) {
+  internal::Document doc;
+  doc.title = "fastcal design";
+  doc.Heading(1, "Calibration survey design");
+  doc.Pre("", provenance, false);
+  doc.Paragraph(SurveyText(d));
+  doc.Heading(2, "Poses and path on the cap");
+  doc.Figure({CapSvg(d, robot)},
+             "Seen from above. Grey: candidate positions. Circles: the stops (area by samples; "
+             "blue at the focal law, green tilted, purple turned only), numbered in flight "
+             "order from the ringed start and joined by the path; dashed: the paper's circle. "
+             "Hover a stop for its pose.");
+  doc.Heading(2, "Predicted sigma_total");
+  doc.Paragraph(
+      "From the calibration's own linearisation and noise model at the spec's initial "
+      "values: white residuals at the stated noise, priors, nuisance parameters "
+      "marginalised, consider parameters included. The circle and the random survey have "
+      "the same number of samples. Lengths in mm.");
+  doc.Figure({SigmaBars(d)}, "The wanted parameters' predicted sigma_total by survey.");
+  doc.AddTable(SigmaTable(d));
+  AddLimits(d, &doc);
+  AddRange(d, &doc);
+  return internal::RenderHtmlPage(doc);
+}
 
 std::string DesignRangeSummary(const Design& d) {
   std::string out = "holds over the plausible range: " + RangeText(d) + "; " +
@@ -437,51 +541,6 @@ std::string DesignRangeSummary(const Design& d) {
          (d.range.empty() ? std::string(" at the initial values")
                           : " at a corner of the range (design.json: stops[" +
                                 std::to_string(tightest) + "].binding.corner)");
-}
-
-std::string DesignHtml(const Design& d, const CableRobot& robot, const std::string& provenance) {
-  const DesignOptions& o = d.options;
-  std::string h =
-      "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>fastcal design"
-      "</title>\n<style>body{font-family:sans-serif;max-width:1100px;margin:1em auto;padding:0 "
-      "1em}table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;padding:"
-      "3px 8px;text-align:left}td.num{text-align:right;font-variant-numeric:tabular-nums}"
-      "tr.wanted th{color:#0072B2}.wrap{overflow-x:auto}code{background:#f3f3f3}</style>"
-      "</head><body>\n<h1>Calibration survey design</h1>\n";
-  // One line of the provenance per line of the page (command line, then version and model).
-  std::string lines = XmlEscape(provenance);
-  for (size_t at = lines.find('\n'); at != std::string::npos; at = lines.find('\n', at + 6)) {
-    lines.replace(at, 1, "<br>\n");
-  }
-  h += "<p><code>" + lines + "</code></p>\n";
-  h += "<p>" + std::to_string(o.samples) + " samples at " + std::to_string(d.stops.size()) +
-       " stops, chosen " + DesignCriterionName(o.criterion) + "-optimally from " +
-       std::to_string(d.candidates.size()) + " feasible candidate poses (" +
-       std::to_string(d.rejected_candidates) + " infeasible left out); extra tilt up to " +
-       Fmt("%.3g", o.max_extra_tilt_deg) + " deg, extra yaw up to " +
-       Fmt("%.3g", o.max_extra_yaw_deg) + " deg off the focal law. Path " +
-       Fmt("%.4g", d.path_length_m) + " m";
-  if (o.speed_m_per_s > 0.0) {
-    h += ", " + Fmt("%.4g", d.duration_s / 60.0) + " min at " + Fmt("%.3g", o.speed_m_per_s) +
-         " m/s (" + Fmt("%.4g", d.travel_s / 60.0) + " min flying, " +
-         Fmt("%.4g", d.dwell_s / 60.0) + " min sampling)";
-  }
-  if (o.time_budget_s > 0.0) {
-    h += "; time budget " + Fmt("%.4g", o.time_budget_s / 60.0) + " min (" +
-         std::to_string(d.unconstrained_stops) + " stops without it)";
-  }
-  h += ".</p>\n<h2>Poses and path on the cap</h2>\n<div class=\"wrap\">" + CapSvg(d, robot) +
-       "</div>\n<p>Grey: candidate positions. Circles: the stops (area by samples; blue at "
-       "the focal law, green tilted, purple turned only), joined by the path in flight order; "
-       "dashed: the paper's circle.</p>\n";
-  h += "<h2>Predicted sigma_total</h2>\n<p>From the calibration's own linearisation and noise "
-       "model at the spec's initial values: white residuals at the stated noise, priors, "
-       "nuisance parameters marginalised, consider parameters included. The circle and the "
-       "random survey have the same number of samples.</p>\n<div class=\"wrap\">" +
-       SigmaBars(d) + "</div>\n" + SigmaTable(d);
-  h += LimitsText(d);
-  h += RangeSection(d);
-  return h + "</body></html>\n";
 }
 
 }  // namespace fastcal

@@ -24,9 +24,11 @@
 
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/json.h"
+#include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/report_document.h"
 #include "fastcal/internal/report_sections.h"
 #include "fastcal/svg_plot.h"
+#include "fastcal/trajectory.h"
 
 namespace fastcal {
 namespace {
@@ -67,6 +69,11 @@ constexpr int kMaxPlotPointsPerSeries = 2000;
 // Measured tensions in the time plots: small translucent dots under the model lines
 // (the held-out ones, sky blue, less translucent to stay visible on white).
 constexpr double kMeasuredDotRadiusPx = 1.8, kMeasuredDotOpacity = 0.45, kHeldOutDotOpacity = 0.7;
+// Gross errors on the tension plots: larger, opaque and red (no series' palette colour).
+constexpr double kGrossDotRadiusPx = 3.5;
+constexpr char kGrossErrorColour[] = "#C00000";
+// How far beyond the other series' range (a fraction of it) a gross error is drawn at most.
+constexpr double kGrossMargin = 0.08;
 
 // ---------------------------------------------------------------------------------------
 // Facts derived from the inputs, shared by the document and the JSON.
@@ -257,24 +264,32 @@ void AddEvaluationSummary(const ReportInputs& in, Document* doc) {
 
 // The verdict's first paragraph and the notes a reader needs beside it.
 void AddVerdictLead(const CalibrationResult& r, Document* doc) {
+  // The verdict's colour says at a glance whether to use the result: green sound, blue
+  // sound with pessimistic sigmas, amber usable with the misfit in sigma_total, red not
+  // to be used as it stands.
   const char* lead = "Good fit:";
+  internal::Tone tone = internal::Tone::kGood;
   switch (r.verdict) {
     case FitVerdict::kOk:
       break;
     case FitVerdict::kNoiseOverstated:
       lead = "Noise overstated:";
+      tone = internal::Tone::kInfo;
       break;
     case FitVerdict::kMisfit:
       lead = "Misfit, scaled into the uncertainties:";
+      tone = internal::Tone::kCaution;
       break;
     case FitVerdict::kFailed:
       lead = "The fit failed:";
+      tone = internal::Tone::kBad;
       break;
     case FitVerdict::kModelIncomplete:
       lead = "Model incomplete:";
+      tone = internal::Tone::kBad;
       break;
   }
-  doc->Paragraph(Text().Bold(lead).Plain(" " + r.verdict_text + "."));
+  doc->Banner(tone, Text().Bold(lead).Plain(" " + r.verdict_text + "."));
   std::vector<Text> notes;
   if (!r.gross_errors.empty()) {
     notes.push_back(Int(static_cast<long long>(r.gross_errors.size())) +
@@ -349,18 +364,57 @@ void AddVerdict(const ReportInputs& in, Document* doc) {
   }
 }
 
+// From this many alike fixed parameters of one group on, the Estimates table shows them as
+// one row.
+constexpr size_t kCollapsedFrom = 4;
+
+// The number of parameters from `first` on that are fixed, of the group of `first`
+// ("tower_offset_m" of "tower_offset_m[2].z") and alike in every column of the table.
+size_t AlikeFixedRun(const std::vector<ParameterEstimate>& all, size_t first) {
+  const auto group = [](const std::string& name) {
+    return name.substr(0, name.find_first_of("[.@"));
+  };
+  const ParameterEstimate& a = all[first];
+  size_t n = 0;
+  for (size_t k = first; k < all.size(); ++k, ++n) {
+    const ParameterEstimate& b = all[k];
+    const bool same = !b.free && group(b.name) == group(a.name) && b.unit == a.unit &&
+                      b.initial == a.initial && b.estimate == a.estimate &&
+                      b.consider == a.consider && b.sigma_total == a.sigma_total &&
+                      b.has_prior == a.has_prior && b.prior_mean == a.prior_mean &&
+                      b.prior_sigma == a.prior_sigma && b.note.empty() && b.moved_by.empty();
+    if (!same) break;
+  }
+  return n;
+}
+
 void AddEstimates(const CalibrationResult& r, Document* doc) {
   doc->Heading(2, "Estimates");
   doc->Paragraph(
       "± σ_total: the uncertainty to quote (see Uncertainty budget); formal σ: for the "
       "stated noise and independent samples only. Priors are Gaussian, mean ± σ. Sensor "
       "biases are in kN, like the spec. Fixed parameters keep their initial value; a "
-      "consider parameter (fixed, with a prior) shows its prior σ.");
+      "consider parameter (fixed, with a prior) shows its prior σ. Four or more alike "
+      "fixed parameters of one group are one row (summary.json lists each).");
   Table t;
   t.header = {"Parameter", "Unit",     "Initial", "Estimate", "± σ_total",
               "formal σ",  "widening", "Prior",   "Note"};
   t.right_align = {false, false, true, true, true, true, true, true, false};
-  for (const ParameterEstimate& p : r.parameters) {
+  for (size_t k = 0; k < r.parameters.size(); ++k) {
+    const ParameterEstimate& p = r.parameters[k];
+    // A run of fixed parameters of one group that are all alike (tower_offset_m: 18 zeros
+    // with one consider prior) is one row, not a screenful of identical ones.
+    const size_t alike = AlikeFixedRun(r.parameters, k);
+    if (alike >= kCollapsedFrom) {
+      const ParameterEstimate& last = r.parameters[k + alike - 1];
+      t.rows.push_back({Text().Code(p.name).Plain(" … ").Code(last.name).Plain(
+                            " (" + Int(static_cast<long long>(alike)) + ", all alike)"),
+                        p.unit, Sig6(p.initial), Text(Sig6(p.estimate)),
+                        p.consider ? Sig3(p.sigma_total) + " (consider)" : "fixed", "", "",
+                        p.has_prior ? Sig6(p.prior_mean) + " ± " + Sig3(p.prior_sigma) : "-", ""});
+      k += alike - 1;
+      continue;
+    }
     std::string total = "fixed", formal = "", widening = "";
     if (p.consider) total = Sig3(p.sigma_total) + " (consider)";
     if (p.free) {
@@ -575,6 +629,39 @@ std::string BarChart(const ReportInputs& in, bool holdout) {
   return SvgGroupedBars(groups, names, o);
 }
 
+ReportSampleStream SamplesOf(const ReportInputs& in);
+
+// Whether the samples fly the paper's measured circle (PaperCircleMatcher): then its
+// Table 6 goes beside this one. A replay of the samples, held or streamed.
+bool FliesPaperCircle(const ReportInputs& in) {
+  if (in.data == nullptr || NumSamples(in) == 0) return false;
+  PaperCircleMatcher matcher;
+  std::string ignored;
+  const bool read = SamplesOf(in).replay(
+      [&matcher](const ReportSample& s) { matcher.Add(s.position_m); }, &ignored);
+  return read && matcher.Matches();
+}
+
+// The paper's published RMS (its Table 6, real telemetry of FAST on that circle), each
+// row beside the variant of this report it corresponds to.
+void AddPaperTable6(Document* doc) {
+  Table t;
+  t.caption = "The paper's Table 6, the same circle on the telescope: RMS [kN]";
+  t.header = {"", "as this report's", "T1", "T2", "T3", "T4", "T5", "T6"};
+  t.right_align = {false, false, true, true, true, true, true, true};
+  for (const internal::PaperRmsRow& row : internal::kPaperTable6) {
+    std::vector<Text> cells = {Text(row.label), Text(row.corresponds_to)};
+    for (double v : row.rms_kn) cells.push_back(Printf("%.3f", v));
+    t.rows.push_back(cells);
+  }
+  doc->AddTable(std::move(t));
+  doc->Paragraph(
+      "These data fly the paper's measured circle (radius 71.11 m about (0, 0, 156.73) m), "
+      "so its published RMS is shown for comparison. The paper's come from the real "
+      "telescope's sensors under PID control, with the AAS statics and the mass centre moved "
+      "by hand to about (0.22, 0.11, 0.5) m; sensor error about 3%.");
+}
+
 void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
   doc->Heading(2, "Model against measurement");
   const std::string method = in.evaluation_method.empty() ? "?" : in.evaluation_method;
@@ -591,6 +678,7 @@ void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
   doc->AddTable(StatsTable(
       in, "RMS of model - measured [kN], " + FitSamplesLabel(in) + " (n = " + Int(fit_n) + ")",
       &CableErrorStats::rms_n, true, StatsRows::kFit, nullptr));
+  if (FliesPaperCircle(in)) AddPaperTable6(doc);
   const bool holdout = AnyHoldout(in);
   if (holdout) {
     int n = 0;
@@ -664,6 +752,7 @@ ReportSampleStream SamplesOf(const ReportInputs& in) {
     r.predicted_n = predicted.data();
     for (size_t n = 0; n < d.samples.size(); ++n) {
       r.time_s = d.samples[n].time_s;
+      r.position_m = d.samples[n].pose.position_m;
       r.measured_n = d.samples[n].tension_n;
       for (size_t k = 0; k < predicted.size(); ++k) {
         if (has[k]) predicted[k] = in.variants[k].predicted_n[n];
@@ -746,7 +835,9 @@ struct TimePlots {
     ordered = samples.is_trajectory;
     if ((in.result && !in.result->gross_errors.empty()) ||
         (in.evaluation_screen && in.evaluation_screen->count > 0)) {
-      not_drawn = " Gross errors are not drawn.";
+      not_drawn =
+          " Gross errors (kept out of the fit) are the red dots on the tension plots, at the "
+          "plot's edge when they lie far beyond its range; their residuals are not drawn.";
     }
   }
   double X(const ReportSample& s, long long n) const {
@@ -768,14 +859,31 @@ struct TimePlots {
 // (gross errors a gap).
 struct TimeSeries {
   std::array<std::vector<SeriesShape>, kNumCables> model_shape, residual_shape;
-  std::array<SeriesShape, kNumCables> fitted_shape, held_shape;
+  std::array<SeriesShape, kNumCables> fitted_shape, held_shape, gross_shape;
   double residual_lo = std::numeric_limits<double>::infinity(), residual_hi = -residual_lo;
+  // Per cable, the range of the models' and the kept readings' tensions: a gross error
+  // beyond it (a 99999 kN spike) is drawn at its edge, so that it cannot flatten the plot.
+  std::array<double, kNumCables> tension_lo, tension_hi;
+  TimeSeries() {
+    tension_lo.fill(std::numeric_limits<double>::infinity());
+    tension_hi.fill(-std::numeric_limits<double>::infinity());
+  }
+  void Span(int i, double y) {
+    if (!std::isfinite(y)) return;
+    tension_lo[i] = std::min(tension_lo[i], y);
+    tension_hi[i] = std::max(tension_hi[i], y);
+  }
+  double OnScale(int i, double y) const {
+    const double margin = kGrossMargin * (tension_hi[i] - tension_lo[i]);
+    if (!(tension_hi[i] >= tension_lo[i]) || !std::isfinite(y)) return y;
+    return std::clamp(y, tension_lo[i] - margin, tension_hi[i] + margin);
+  }
 };
 
 // The points of every time series, in replay order: of cable i, the tension and the
 // residual of variant shown[k] (a gross error's residual NaN: a gap), and the measured
-// tension (gross errors left out), of a fitted or a held-out sample.
-enum class PointKind { kModel, kResidual, kMeasured, kHeldOut };
+// tension of a fitted or a held-out sample, or of a gross error.
+enum class PointKind { kModel, kResidual, kMeasured, kHeldOut, kGross };
 using PointVisitor = std::function<void(PointKind kind, int i, size_t k, double x, double y)>;
 bool ReplayPoints(const TimePlots& t, const PointVisitor& visit, std::string* error) {
   long long n = 0;
@@ -790,9 +898,10 @@ bool ReplayPoints(const TimePlots& t, const PointVisitor& visit, std::string* er
             visit(PointKind::kResidual, i, k, x,
                   s.gross[i] ? NAN : (predicted - s.measured_n[i]) / kNPerKn);
           }
-          if (s.gross[i]) continue;
-          visit(s.held_out ? PointKind::kHeldOut : PointKind::kMeasured, i, 0, x,
-                s.measured_n[i] / kNPerKn);
+          const PointKind measured = s.gross[i]   ? PointKind::kGross
+                                     : s.held_out ? PointKind::kHeldOut
+                                                  : PointKind::kMeasured;
+          visit(measured, i, 0, x, s.measured_n[i] / kNPerKn);
         }
       },
       error);
@@ -809,6 +918,7 @@ bool ShapeSeries(const TimePlots& t, TimeSeries* ts, std::string* error) {
       [ts](PointKind kind, int i, size_t k, double x, double y) {
         switch (kind) {
           case PointKind::kModel:
+            ts->Span(i, y);
             return ts->model_shape[i][k].Add(x, y);
           case PointKind::kResidual:
             ts->residual_shape[i][k].Add(x, y);
@@ -817,9 +927,13 @@ bool ShapeSeries(const TimePlots& t, TimeSeries* ts, std::string* error) {
             ts->residual_hi = std::max(ts->residual_hi, y);
             return;
           case PointKind::kMeasured:
+            ts->Span(i, y);
             return ts->fitted_shape[i].Add(x, y);
           case PointKind::kHeldOut:
+            ts->Span(i, y);
             return ts->held_shape[i].Add(x, y);
+          case PointKind::kGross:
+            return ts->gross_shape[i].Add(x, y);
         }
       },
       error);
@@ -846,7 +960,7 @@ struct TimeFigures {
 // Second replay: every series thinned as it goes, the residuals binned.
 bool DrawTimeFigures(const TimePlots& t, const TimeSeries& ts, TimeFigures* f, std::string* error) {
   std::array<std::vector<SeriesThinner>, kNumCables> models, residuals;
-  std::vector<SeriesThinner> fitted, held;
+  std::vector<SeriesThinner> fitted, held, gross;
   std::vector<std::string> histogram_names;
   bool any = false;
   for (int i = 0; i < kNumCables; ++i) {
@@ -864,6 +978,12 @@ bool DrawTimeFigures(const TimePlots& t, const TimeSeries& ts, TimeFigures* f, s
     h.opacity = kHeldOutDotOpacity;
     fitted.emplace_back(m, ts.fitted_shape[i].n, ts.fitted_shape[i].any_gap, !t.ordered);
     held.emplace_back(h, ts.held_shape[i].n, ts.held_shape[i].any_gap, !t.ordered);
+    // Gross errors: large red dots over everything, so that a reading kept out is seen.
+    PlotSeries g{"gross error", {}, {}, false, true};
+    g.marker_radius_px = kGrossDotRadiusPx;
+    g.colour = kGrossErrorColour;
+    g.on_top = true;
+    gross.emplace_back(g, ts.gross_shape[i].n, ts.gross_shape[i].any_gap, true);
   }
   for (size_t k : t.shown) {
     if (!t.Predicted(k)) continue;
@@ -885,6 +1005,8 @@ bool DrawTimeFigures(const TimePlots& t, const TimeSeries& ts, TimeFigures* f, s
             return fitted[i].Add(x, y);
           case PointKind::kHeldOut:
             return held[i].Add(x, y);
+          case PointKind::kGross:
+            return gross[i].Add(x, ts.OnScale(i, y));
         }
       },
       error);
@@ -904,6 +1026,7 @@ bool DrawTimeFigures(const TimePlots& t, const TimeSeries& ts, TimeFigures* f, s
     }
     PutAt(&series, MeasuredSlot(t.in), fitted[i].Finish());
     f->tension_thinning = std::max(f->tension_thinning, fitted[i].Thinning());
+    if (ts.gross_shape[i].n > 0) PutAt(&series, MeasuredSlot(t.in) + 1, gross[i].Finish());
     PlotOptions tension_options =
         CablePlotOptions("Cable " + Int(i + 1) + ": tension", t.x_label, "T" + Int(i + 1) + " [kN]");
     PlotOptions residual_options = CablePlotOptions("Cable " + Int(i + 1) + ": model - measured",
@@ -1189,6 +1312,9 @@ std::string RenderMarkdown(const Document& doc) {
       }
       case Block::kFigure:
         break;
+      case Block::kBanner:
+        out += "> " + MarkdownInline(b.text) + "\n\n";
+        break;
     }
   }
   while (out.size() >= 2 && out[out.size() - 1] == '\n' && out[out.size() - 2] == '\n') {
@@ -1225,6 +1351,12 @@ figure .charts { display: flex; flex-wrap: wrap; gap: 12px 16px; }
 figure svg { max-width: 100%; height: auto; }
 figcaption { color: #555; font-size: 13px; margin-top: 4px; }
 details { margin: 8px 0; }
+.banner { margin: 12px 0 14px; padding: 10px 14px; border-left: 6px solid; border-radius: 3px;
+  font-size: 15px; max-width: 980px; }
+.banner-good { background: #e7f4ea; border-color: #2e7d32; }
+.banner-caution { background: #fff4d6; border-color: #e0a000; }
+.banner-bad { background: #fde8e6; border-color: #c62828; }
+.banner-info { background: #e8f0fa; border-color: #1f5fa8; }
 summary { cursor: pointer; font-weight: 600; }
 @media print {
   body { background: #fff; font-size: 11px; }
@@ -1259,7 +1391,23 @@ std::string HtmlInline(const Text& text) {
   return out;
 }
 
-std::string RenderHtml(const Document& doc) {
+const char* ToneClass(internal::Tone tone) {
+  switch (tone) {
+    case internal::Tone::kGood:
+      return "banner banner-good";
+    case internal::Tone::kCaution:
+      return "banner banner-caution";
+    case internal::Tone::kBad:
+      return "banner banner-bad";
+    case internal::Tone::kInfo:
+      break;
+  }
+  return "banner banner-info";
+}
+
+}  // namespace
+
+std::string internal::RenderHtmlPage(const Document& doc) {
   std::string out =
       "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
       "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">\n<title>" +
@@ -1319,11 +1467,17 @@ std::string RenderHtml(const Document& doc) {
         for (const std::string& svg : b.svgs) out += svg + "\n";
         out += "</div>\n<figcaption>" + HtmlInline(b.text) + "</figcaption>\n</figure>\n";
         break;
+      case Block::kBanner:
+        out += std::string("<div class=\"") + ToneClass(b.tone) + "\">" + HtmlInline(b.text) +
+               "</div>\n";
+        break;
     }
   }
   out += "</main>\n</body>\n</html>\n";
   return out;
 }
+
+namespace {
 
 // ---------------------------------------------------------------------------------------
 // Files.
@@ -1347,6 +1501,7 @@ ReportSampleStream ReportSamplesOf(const StreamedEvaluation& evaluation) {
         [&visit](const EvaluatedSample& s) {
           ReportSample r;
           r.time_s = s.time_s;
+          r.position_m = s.position_m;
           r.measured_n = s.measured_n;
           r.predicted_n = s.predicted_n.data();
           r.gross = s.gross;
@@ -1367,7 +1522,7 @@ std::string ReportMarkdown(const ReportInputs& inputs) {
 
 std::string ReportHtml(const ReportInputs& inputs) {
   try {
-    return RenderHtml(BuildDocument(inputs, true));
+    return internal::RenderHtmlPage(BuildDocument(inputs, true));
   } catch (const std::exception&) {
     return std::string();
   }

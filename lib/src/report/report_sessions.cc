@@ -2,6 +2,7 @@
 // sessions of a joint fit (sessions.h: each separate parameter per session with its
 // sigma_total, the differences between consecutive sessions) and the change scan
 // (change_scan.h: the statistic over time, its threshold, the changes found).
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -33,39 +34,58 @@ const ParameterEstimate* Find(const CalibrationResult& r, const std::string& nam
   return nullptr;
 }
 
-// One separate parameter over the sessions: the estimates as dots, +- sigma_total as
-// vertical bars (one series broken by gaps).
-std::string SessionPlot(const CalibrationResult& r, const std::string& name) {
-  PlotSeries estimate{"estimate", {}, {}};
-  estimate.markers_only = true;
-  estimate.marker_radius_px = 4.0;
-  PlotSeries bars{"+- sigma_total", {}, {}};
+constexpr int kIntervalPlotWidthPx = 760, kEstimatePlotWidthPx = 420;
+
+// "+0.0509 ± 0.0015 m (33.9 σ)": a difference with its sigma and their ratio.
+std::string DifferenceNote(const SessionDifference& d) {
+  return Printf("%+.3g", d.difference) + " ± " + Sig3(d.sigma_total) + " " + d.unit + " (" +
+         Printf("%.1f", std::abs(d.Sigmas())) + " σ)";
+}
+
+// The differences between consecutive sessions, each with its sigma_total (thick) and
+// the change threshold's width (thin) against zero: what moved reads at once, where the
+// sessions' own bars would overlap (they share the errors that cancel from the
+// difference). One plot per unit.
+std::vector<std::string> DifferencePlots(const CalibrationResult& r) {
+  std::vector<std::string> units, svgs;
+  for (const SessionDifference& d : r.session_differences) {
+    if (std::find(units.begin(), units.end(), d.unit) == units.end()) units.push_back(d.unit);
+  }
+  for (const std::string& unit : units) {
+    std::vector<IntervalRow> rows;
+    for (const SessionDifference& d : r.session_differences) {
+      if (d.unit != unit) continue;
+      rows.push_back({d.name + ": " + d.from + " → " + d.to, d.difference, d.sigma_total,
+                      DifferenceNote(d), std::abs(d.Sigmas()) > kSessionChangeSigmas});
+    }
+    IntervalPlotOptions o;
+    o.plot.title = "Later minus earlier session";
+    o.plot.x_label = "difference [" + unit + "]";
+    o.plot.width_px = kIntervalPlotWidthPx;
+    o.reference = 0.0;
+    o.wide_sigmas = kSessionChangeSigmas;
+    svgs.push_back(SvgIntervalPlot(rows, o));
+  }
+  return svgs;
+}
+
+// One separate parameter per session, each row labelled by its session's name.
+std::string EstimatesPlot(const CalibrationResult& r, const std::string& name) {
+  std::vector<IntervalRow> rows;
   std::string unit;
-  for (size_t s = 0; s < r.session_labels.size(); ++s) {
-    const ParameterEstimate* p = Find(r, SessionParameterName(name, r.session_labels[s]));
+  for (const std::string& label : r.session_labels) {
+    const ParameterEstimate* p = Find(r, SessionParameterName(name, label));
     if (p == nullptr) continue;
     unit = p->unit;
-    const double x = static_cast<double>(s + 1);
-    estimate.x.push_back(x);
-    estimate.y.push_back(p->estimate);
-    bars.x.insert(bars.x.end(), {x, x, kNaN});
-    bars.y.insert(bars.y.end(), {p->estimate - p->sigma_total, p->estimate + p->sigma_total, kNaN});
+    rows.push_back({label, p->estimate, p->sigma_total,
+                    EstimateText(p->estimate, p->sigma_total) + " ± " + Sig3(p->sigma_total),
+                    false});
   }
-  // Half a session of room on either side, so that the first and last bars are not on
-  // the frame (the axes are snug to the data): two faint, unnamed points.
-  PlotSeries room{"", {0.5, r.session_labels.size() + 0.5}, {}};
-  room.markers_only = true;
-  room.marker_radius_px = 0.5;
-  room.opacity = 0.05;
-  if (!estimate.y.empty()) room.y = {estimate.y.front(), estimate.y.back()};
-  PlotOptions o;
-  o.title = name + " per session";
-  o.x_label = "session (1 = " + r.session_labels.front() +
-              (r.session_labels.size() > 1 ? ", 2 = " + r.session_labels[1] : "") + ")";
-  o.y_label = name + " [" + unit + "]";
-  o.width_px = 420;
-  o.height_px = 260;
-  return SvgLinePlot({estimate, bars, room}, o);
+  IntervalPlotOptions o;
+  o.plot.title = name;
+  o.plot.x_label = name + " [" + unit + "]";
+  o.plot.width_px = kEstimatePlotWidthPx;
+  return SvgIntervalPlot(rows, o);
 }
 
 }  // namespace
@@ -120,13 +140,19 @@ void AddSessions(const CalibrationResult& r, bool with_plots, Document* doc) {
   }
   doc->AddTable(diffs);
   if (!with_plots) return;
+  doc->Figure(DifferencePlots(r),
+              "What moved between sessions: each difference (dot) with its sigma_total (thick "
+              "bar) and ± " +
+                  Printf("%g", kSessionChangeSigmas) +
+                  " sigma_total (thin bar), against zero (dashed). A thin bar clear of zero is a "
+                  "change (vermillion). Read this, not the sessions' own bars below: the estimates "
+                  "share the errors of the shared parameters, which cancel from their "
+                  "difference.");
   std::vector<std::string> svgs;
-  for (const std::string& name : names) svgs.push_back(SessionPlot(r, name));
+  for (const std::string& name : names) svgs.push_back(EstimatesPlot(r, name));
   doc->Figure(svgs,
-              "Each separate parameter per session: the estimate with its own +- sigma_total. "
-              "The difference between sessions is sharper than the bars suggest (the table "
-              "above): the estimates share the errors of the shared parameters, which cancel "
-              "from their difference.");
+              "Each separate parameter per session, by the sessions' names: the estimate with "
+              "its own ± sigma_total.");
 }
 
 void WriteSessionsJson(const CalibrationResult& r, JsonWriter* w) {

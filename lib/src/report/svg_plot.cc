@@ -238,6 +238,7 @@ struct LegendItem {
   Swatch swatch;
   double opacity = 1.0;                 // kMarker: of the dot, as drawn in the chart.
   MarkShape shape = MarkShape::kCross;  // kMark: as drawn in the chart.
+  bool filled = false;                  // kMark: a closed shape filled dark
 };
 
 constexpr const char* kMarkColour = "#111111";
@@ -273,14 +274,14 @@ std::string MarkPath(MarkShape shape, double x, double y, double r) {
 }
 
 // A mark drawn on a white halo, so that it reads on light and dark cells alike.
-void DrawMark(std::string* out, MarkShape shape, double x, double y, double r,
+void DrawMark(std::string* out, MarkShape shape, double x, double y, double r, bool filled,
               const std::string& extra = "") {
   const std::string d = MarkPath(shape, x, y, r);
   const bool closed = shape != MarkShape::kCross && shape != MarkShape::kPlus;
   *out += "<path" + (extra.empty() ? "" : " " + extra) + " d=\"" + d + "\" fill=\"" +
           (closed ? "#ffffff" : "none") + "\" stroke=\"#ffffff\" stroke-width=\"3.2\"/>\n";
-  *out += "<path d=\"" + d + "\" fill=\"none\" stroke=\"" + kMarkColour +
-          "\" stroke-width=\"1.3\" stroke-linejoin=\"round\"/>\n";
+  *out += "<path d=\"" + d + "\" fill=\"" + (closed && filled ? kMarkColour : "none") +
+          "\" stroke=\"" + kMarkColour + "\" stroke-width=\"1.3\" stroke-linejoin=\"round\"/>\n";
 }
 
 double LegendItemWidth(const LegendItem& item) {
@@ -328,7 +329,7 @@ void DrawLegend(std::string* out, const std::vector<LegendItem>& items,
                   "/>\n";
           break;
         case Swatch::kMark:
-          DrawMark(out, item.shape, x + kLegendSwatchPx / 2, mid, 4.5);
+          DrawMark(out, item.shape, x + kLegendSwatchPx / 2, mid, 4.5, item.filled);
           break;
         case Swatch::kBox:
         case Swatch::kSolidBox:
@@ -602,7 +603,7 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
   for (size_t i = 0; i < series.size(); ++i) {
     const PlotSeries& s = series[i];
     if (s.name.empty()) continue;
-    legend.push_back({s.name, Colour(i),
+    legend.push_back({s.name, s.colour.empty() ? Colour(i) : s.colour.c_str(),
                       s.markers_only ? Swatch::kMarker
                       : s.dashed     ? Swatch::kDashed
                                      : Swatch::kLine,
@@ -654,7 +655,7 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
     }
     if (run == 1 && !s.markers_only) d += kDot;
     if (d.empty()) return;
-    const std::string colour = Colour(si);
+    const std::string colour = s.colour.empty() ? Colour(si) : XmlEscape(s.colour);
     const double opacity = std::clamp(s.opacity, kMinOpacity, 1.0);
     const std::string opacity_attr =
         opacity < 1.0 ? " stroke-opacity=\"" + Compact(opacity, 2) + "\"" : "";
@@ -668,12 +669,15 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
              (s.dashed ? " stroke-dasharray=\"6 5\"" : "") + opacity_attr + "/>\n";
     }
   };
-  // Markers underneath, lines on top.
+  // Markers underneath, lines on top, then what must stay visible.
   for (size_t si = 0; si < series.size(); ++si) {
-    if (series[si].markers_only) draw(si);
+    if (series[si].markers_only && !series[si].on_top) draw(si);
   }
   for (size_t si = 0; si < series.size(); ++si) {
-    if (!series[si].markers_only) draw(si);
+    if (!series[si].markers_only && !series[si].on_top) draw(si);
+  }
+  for (size_t si = 0; si < series.size(); ++si) {
+    if (series[si].on_top) draw(si);
   }
   DrawBorder(&out, box);
   DrawLegend(&out, f.legend, f.legend_rows, f.size.w, f.legend_top);
@@ -1094,25 +1098,30 @@ struct PolarLayout {
 
 constexpr double kRimLabelsPx = 30.0;  // azimuth and rim labels, outside the disc
 constexpr double kBarHeightPx = 12.0;
-constexpr double kBarBlockPx = 66.0;  // bar, its tick labels, its label, the rings' label
+constexpr double kBarBlockPx = 66.0;    // bar, its tick labels, its label, the rings' label
+constexpr double kValueMarksPx = 14.0;  // the value marks' labels above the bar
 
 PolarLayout LayOutPolarMap(const PolarMapOptions& options) {
   PolarLayout l;
   l.size = ClampedSize(options.plot);
   for (const PolarMark& m : options.marks) {
-    if (!m.label.empty()) l.legend.push_back({m.label, kMarkColour, Swatch::kMark, 1.0, m.shape});
+    if (!m.label.empty()) {
+      l.legend.push_back({m.label, kMarkColour, Swatch::kMark, 1.0, m.shape, m.filled});
+    }
   }
   l.legend_rows = LegendRows(l.legend, l.size.w - 16.0);
   const double legend_h = kLegendRowPx * static_cast<double>(l.legend_rows.size());
   const double top = TitleBottom(options.plot) + kRimLabelsPx;
-  const double bottom = kRimLabelsPx + kBarBlockPx + legend_h + 8.0;
+  // Room above the bar for the labels of its value marks.
+  const double marks_h = options.value_marks.empty() ? 0.0 : kValueMarksPx;
+  const double bottom = kRimLabelsPx + marks_h + kBarBlockPx + legend_h + 8.0;
   l.radius_px = std::max(
       20.0, std::min(0.5 * l.size.w - kRimLabelsPx - 8.0, 0.5 * (l.size.h - top - bottom)));
   l.cx = 0.5 * l.size.w;
   l.cy = top + l.radius_px;
   l.bar_w = std::min(360.0, l.size.w - 80.0);
   l.bar_x = l.cx - 0.5 * l.bar_w;
-  l.bar_y = l.cy + l.radius_px + kRimLabelsPx;
+  l.bar_y = l.cy + l.radius_px + kRimLabelsPx + marks_h;
   l.legend_top = l.bar_y + kBarBlockPx;
   return l;
 }
@@ -1215,6 +1224,12 @@ void DrawColourBar(std::string* out, const PolarLayout& l, double lo, double hi,
     Line(out, x, l.bar_y + kBarHeightPx, x, l.bar_y + kBarHeightPx + kTickLenPx, kAxisColour);
     Text(out, x, l.bar_y + kBarHeightPx + 15.0, labels[k], "middle", kTickFontPx);
   }
+  for (const auto& [value, label] : options.value_marks) {
+    if (!std::isfinite(value) || !(hi > lo)) continue;
+    const double x = l.bar_x + l.bar_w * std::clamp((value - lo) / (hi - lo), 0.0, 1.0);
+    Line(out, x, l.bar_y - 4.0, x, l.bar_y + kBarHeightPx, "#000000", 2.0);
+    Text(out, x, l.bar_y - 7.0, label, "middle", kTickFontPx, "font-weight=\"bold\"");
+  }
   Text(out, l.cx, l.bar_y + kBarHeightPx + 31.0, options.value_label, "middle", kFontPx);
   if (!options.radius_label.empty()) {
     Text(out, l.cx, l.bar_y + kBarHeightPx + 46.0, "rings: " + options.radius_label, "middle",
@@ -1274,11 +1289,86 @@ std::string SvgPolarMap(const std::vector<PolarCell>& cells, const PolarMapOptio
         0.45 * std::min((c.radius_hi - c.radius_lo) * scale, disc ? 1e9 : arc_px), 3.0, 7.0);
     const double a = a_mid * M_PI / 180.0;
     DrawMark(&out, options.marks[c.mark].shape, l.cx + r_mid * std::cos(a),
-             l.cy - r_mid * std::sin(a), size_px,
+             l.cy - r_mid * std::sin(a), size_px, options.marks[c.mark].filled,
              "class=\"mark\" data-mark=\"" + std::to_string(c.mark) + "\"");
   }
   DrawColourBar(&out, l, lo, hi, options);
   DrawLegend(&out, l.legend, l.legend_rows, l.size.w, l.legend_top);
+  CloseSvg(&out);
+  return out;
+}
+
+std::string SvgIntervalPlot(const std::vector<IntervalRow>& rows,
+                            const IntervalPlotOptions& options) {
+  constexpr double kRowPx = 26.0, kAxisPx = 46.0, kGapPx = 10.0, kDotRadiusPx = 4.0;
+  constexpr double kThickPx = 5.0, kThinPx = 1.5;
+  const double reach = std::max(1.0, options.wide_sigmas);
+  auto sigma_of = [](const IntervalRow& r) {
+    return std::isfinite(r.sigma) && r.sigma > 0.0 ? r.sigma : 0.0;
+  };
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  std::vector<std::string> labels, notes;
+  for (const IntervalRow& r : rows) {
+    labels.push_back(r.label);
+    notes.push_back(r.note);
+    if (!std::isfinite(r.value)) continue;
+    lo = std::min(lo, r.value - reach * sigma_of(r));
+    hi = std::max(hi, r.value + reach * sigma_of(r));
+  }
+  PlotOptions sized = options.plot;
+  sized.height_px = static_cast<int>(TitleBottom(sized) + kGapPx + kRowPx * rows.size() + kAxisPx);
+  if (lo > hi) return NoDataSvg(sized, "no data");
+  if (std::isfinite(options.reference)) {
+    lo = std::min(lo, options.reference);
+    hi = std::max(hi, options.reference);
+  }
+  PadDegenerateRange(&lo, &hi);
+  const double margin = kYMargin * (hi - lo);
+  lo -= margin;
+  hi += margin;
+  const Size size = ClampedSize(sized);
+  Box box;
+  box.x = std::min(MaxTextWidth(labels, kFontPx) + 2.0 * kGapPx, 0.45 * size.w);
+  box.w = std::max(60.0, size.w - box.x - MaxTextWidth(notes, kFontPx) - 2.0 * kGapPx);
+  box.y = TitleBottom(sized) + kGapPx;
+  box.h = kRowPx * rows.size();
+  const Scale xs{lo, hi, box.x, box.x + box.w};
+  std::vector<double> ticks;
+  for (double t : NiceTicks(lo, hi, std::max(2, static_cast<int>(box.w / 90.0)))) {
+    if (t >= lo && t <= hi) ticks.push_back(t);
+  }
+  std::string out;
+  OpenSvg(&out, size, sized.title);
+  const std::vector<std::string> tick_labels = TickLabels(ticks);
+  for (size_t k = 0; k < ticks.size(); ++k) {
+    Line(&out, xs(ticks[k]), box.y, xs(ticks[k]), box.y + box.h, kGridColour);
+    Text(&out, xs(ticks[k]), box.y + box.h + 16.0, tick_labels[k], "middle", kTickFontPx);
+  }
+  Text(&out, box.x + box.w / 2.0, box.y + box.h + 36.0, sized.x_label, "middle", kFontPx);
+  if (std::isfinite(options.reference)) {
+    Line(&out, xs(options.reference), box.y, xs(options.reference), box.y + box.h, kAxisColour, 1.2,
+         "stroke-dasharray=\"5 4\"");
+  }
+  for (size_t k = 0; k < rows.size(); ++k) {
+    const IntervalRow& r = rows[k];
+    const double y = box.y + kRowPx * (k + 0.5);
+    Text(&out, box.x - kGapPx, y + 4.0, r.label, "end", kFontPx);
+    Text(&out, box.x + box.w + kGapPx, y + 4.0, r.note, "", kFontPx);
+    if (!std::isfinite(r.value)) continue;
+    const char* colour = Colour(r.emphasised ? 1 : 0);
+    const double s = sigma_of(r);
+    if (options.wide_sigmas > 0.0 && s > 0.0) {
+      Line(&out, xs(r.value - options.wide_sigmas * s), y, xs(r.value + options.wide_sigmas * s), y,
+           colour, kThinPx, "class=\"wide\"");
+    }
+    if (s > 0.0) {
+      Line(&out, xs(r.value - s), y, xs(r.value + s), y, colour, kThickPx,
+           "class=\"sigma\" stroke-opacity=\"0.55\"");
+    }
+    out += "<circle class=\"value\" cx=\"" + Px(xs(r.value)) + "\" cy=\"" + Px(y) + "\" r=\"" +
+           Px(kDotRadiusPx) + "\" fill=\"" + colour + "\"/>\n";
+  }
+  DrawBorder(&out, box);
   CloseSvg(&out);
   return out;
 }

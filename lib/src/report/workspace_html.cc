@@ -25,9 +25,10 @@ struct ReasonStyle {
   const char* code;   // WorkspaceNodeCode
   const char* label;  // legend and table text
   MarkShape shape;
+  bool filled = false;  // dark: below the minimum (▼) is not read as above the maximum (△)
 };
 constexpr std::array<ReasonStyle, 7> kReasons = {{
-    {"below_min_tension", "a cable below the minimum tension", MarkShape::kTriangleDown},
+    {"below_min_tension", "a cable below the minimum tension", MarkShape::kTriangleDown, true},
     {"above_max_tension", "a cable above the maximum tension", MarkShape::kTriangleUp},
     {"no_equilibrium", "no equilibrium: the cables cannot hold the cabin", MarkShape::kCross},
     {"sagging_cable", "a cable longer than the model's range (s0/k)", MarkShape::kCircle},
@@ -107,6 +108,10 @@ std::string LayerMap(const WorkspaceMap& map, const CableRobot& robot, double of
   o.plot.height_px = 780;
   o.value_lo = lo_kn;
   o.value_hi = hi_kn;
+  // The colour is the smallest tension: its limit goes on the colour bar, so that what is
+  // below it reads off the scale.
+  const double min_kn = map.options.min_tension_n / kNPerKn;
+  if (min_kn > 0.0) o.value_marks.push_back({min_kn, "minimum " + Num(min_kn, 4) + " kN"});
   o.radius_label = "off-axis angle [deg] about the focal centre";
   o.value_label = "smallest lower-end cable tension [kN] (grey: no equilibrium in range)";
   o.radius_max = grid.max_off_axis_deg + half_ring;
@@ -115,7 +120,7 @@ std::string LayerMap(const WorkspaceMap& map, const CableRobot& robot, double of
     o.marks.push_back({counts[k] > 0
                            ? std::string(kReasons[k].label) + " (" + std::to_string(counts[k]) + ")"
                            : "",
-                       kReasons[k].shape});
+                       kReasons[k].shape, kReasons[k].filled});
   }
   for (int i = 0; i < kNumCables; ++i) {
     const Eigen::Vector3d d = robot.cables[i].tower_top_m - grid.focal_centre_m;
@@ -224,8 +229,10 @@ std::string WorkspaceHtml(const WorkspaceMap& map, const CableRobot& robot,
   h += "</tbody>\n</table>\n<h2>Nodes by reason</h2>\n" + CountsTable(map);
   h += "<h2>Maps</h2>\n<p>Seen from above, x toward tower 1 (T1) to the right, y up; each "
        "cell is a grid node, the rings its off-axis angle. Colour: the smallest of the six "
-       "lower-end tensions; grey: no equilibrium within the model's range. A mark says why a "
-       "node is not feasible (legend under each map); hover over a cell for its numbers. "
+       "lower-end tensions, the minimum tension marked on its colour bar; grey: no "
+       "equilibrium within the model's range. A mark says why a node is not feasible "
+       "(legend under each map: a dark ▼ below the minimum tension, a white △ above the "
+       "maximum); hover over a cell for its numbers. "
        "The CSV has the same per node, with the cable and the message.</p>\n<div "
        "class=\"maps\">\n";
   double lo_kn = HUGE_VAL, hi_kn = -HUGE_VAL;

@@ -84,8 +84,12 @@ struct Table {
 
 enum class Target { kBoth, kMarkdownOnly, kHtmlOnly };
 
+// How a banner (Document::Banner) looks: green for a sound result, amber for one to read
+// with care, red for one not to use as it stands, blue for information.
+enum class Tone { kGood, kCaution, kBad, kInfo };
+
 struct Block {
-  enum Kind { kHeading, kParagraph, kList, kTable, kPre, kFigure } kind = kParagraph;
+  enum Kind { kHeading, kParagraph, kList, kTable, kPre, kFigure, kBanner } kind = kParagraph;
   Target target = Target::kBoth;
   int level = 2;                  // kHeading
   Text text;                      // kHeading, kParagraph; kPre and kFigure: summary / caption
@@ -94,6 +98,7 @@ struct Block {
   std::string pre;                // kPre: preformatted text
   bool collapsed = false;         // kPre: <details> in HTML
   std::vector<std::string> svgs;  // kFigure: one or more charts, laid out in a grid
+  Tone tone = Tone::kInfo;        // kBanner
 };
 
 class Document {
@@ -142,12 +147,25 @@ class Document {
     b.text = caption;
     blocks_.push_back(std::move(b));
   }
+  // A paragraph set apart by colour (HTML: a tinted box with a coloured edge; Markdown: a
+  // quote), e.g. the verdict, so that "model incomplete" never looks like "good fit".
+  void Banner(Tone tone, const Text& text) {
+    Block b;
+    b.kind = Block::kBanner;
+    b.tone = tone;
+    b.text = text;
+    blocks_.push_back(std::move(b));
+  }
   const std::vector<Block>& blocks() const { return blocks_; }
   std::string title;
 
  private:
   std::vector<Block> blocks_;
 };
+
+// The document as a self-contained HTML page in the report's style (report.cc): the
+// calibration report, design.html and solve's trajectory plot share it.
+std::string RenderHtmlPage(const Document& doc);
 
 }  // namespace fastcal::internal
 
