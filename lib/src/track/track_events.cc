@@ -211,9 +211,10 @@ void RefineTime(const TrackRun& run, int u, const InnerStep& step, TrackEvent* e
 }
 
 // The events of group g: each change between consecutive windows beyond the threshold.
-// A step inside window u shows as a change on both sides of it: when window u's own scan
-// finds it, the two are one event (u - 1 to u + 1) at the step's block; a single change
-// is timed inside the window whose scan finds the step, else at the window's resolution.
+// A step inside window u shows as a change on both sides of it (each about the part of
+// the window after or before the step): when the scan within u finds the step, the two
+// are one event from u - 1 to u + 1, timed at the step's block, whichever side alone was
+// significant; else the event is between the two windows, at the window's resolution.
 void GroupEvents(const TrackRun& run, const std::vector<int>& g, std::vector<TrackEvent>* out) {
   const TrackResult& r = *run.result;
   const int dof = static_cast<int>(g.size());
@@ -225,24 +226,31 @@ void GroupEvents(const TrackRun& run, const std::vector<int>& g, std::vector<Tra
   const int windows = static_cast<int>(run.used.size());
   std::vector<bool> changed(windows, false);
   for (int u = 1; u < windows; ++u) changed[u] = Change(run, g, u - 1, u).statistic > threshold;
+  int last_to = -1;  // the later window of the group's last event: events do not overlap
   for (int u = 1; u < windows; ++u) {
     if (!changed[u]) continue;
-    int from = u - 1, to = u;
+    int from = u - 1, to = u, inside = -1;
+    InnerStep step;
     const InnerStep here = ScanWithin(run, u, g);
-    const bool both_sides = u + 1 < windows && changed[u + 1] && Inside(run, here, dof);
-    if (both_sides) {
-      to = u + 1;
-      changed[u + 1] = false;
+    const InnerStep before = u - 1 != last_to ? ScanWithin(run, u - 1, g) : InnerStep();
+    const bool in_here = Inside(run, here, dof), in_before = Inside(run, before, dof);
+    if (in_here && (!in_before || here.statistic >= before.statistic)) {
+      inside = u;
+      step = here;
+      to = std::min(u + 1, windows - 1);
+    } else if (in_before) {
+      inside = u - 1;
+      step = before;
+      from = std::max(u - 2, 0);
     }
+    for (int v = u + 1; v <= to; ++v) changed[v] = false;
+    last_to = to;
     const GroupChange change = Change(run, g, from, to);
     TrackEvent e = EventAt(run, from, to, sensor ? "sensor" : "parameter", change.statistic, dof,
                            threshold, tests);
-    if (both_sides || Inside(run, here, dof)) {
-      RefineTime(run, u, here, &e);
-      e.window = u;
-    } else if (const InnerStep before = ScanWithin(run, u - 1, g); Inside(run, before, dof)) {
-      RefineTime(run, u - 1, before, &e);
-      e.window = u - 1;
+    if (inside >= 0) {
+      RefineTime(run, inside, step, &e);
+      e.window = inside;
     }
     for (int x = 0; x < dof; ++x) {
       const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[x]]);
