@@ -117,7 +117,7 @@ std::string EventsTable(const TrackResult& r) {
            FormatDouble("%g", 100.0 * r.false_alarm) + "% false-alarm rate over the track).</p>\n";
   }
   std::string h =
-      "<table><tr><th>time (UTC)</th><th>after</th><th>kind</th><th>what changed</th>"
+      "<table><tr><th>time (UTC)</th><th>last sample before</th><th>kind</th><th>what changed</th>"
       "<th>statistic</th><th>p (family-wise)</th></tr>\n";
   for (const TrackEvent& e : r.events) {
     std::string what;
@@ -138,8 +138,9 @@ std::string SharedTable(const TrackResult& r) {
       "<table><tr><th>shared parameter</th><th>estimate</th><th>sigma_total</th>"
       "<th>windows</th></tr>\n";
   for (const TrackShared& s : r.shared) {
-    h += "<tr><td>" + Esc(s.name) + "</td><td>" + FormatDouble("%.6g", s.estimate.value) + " " +
-         Esc(s.unit) + "</td><td>" + FormatDouble("%.2g", s.estimate.sigma_total) + "</td><td>" +
+    const std::string unit = s.unit == "1" || s.unit.empty() ? "" : " " + Esc(s.unit);
+    h += "<tr><td>" + Esc(s.name) + "</td><td>" + FormatDouble("%.6g", s.estimate.value) + unit +
+         "</td><td>" + FormatDouble("%.2g", s.estimate.sigma_total) + "</td><td>" +
          Esc(r.windows[s.from_window].label) + " to " + Esc(r.windows[s.to_window].label) +
          "</td></tr>\n";
   }
@@ -186,7 +187,10 @@ std::string TrackHtml(const TrackResult& r) {
   h += "<h2>Events</h2>\n" + EventsTable(r);
   const TimeAxis axis = AxisOf(r);
   h += "<h2>Per-window parameters</h2>\n<p>Each window's estimate (dots) with its sigma_total "
-       "(bars); dashed lines: parameter events.</p>\n";
+       "(bars); dashed lines: parameter events. A bar holds the error every window shares "
+       "(the cables' and sensors' shared parameters): it cancels from the differences "
+       "between windows, which the events test: the dots can scatter less than the bars suggest, "
+       "and a step well inside them can be significant.</p>\n";
   for (size_t k = 0; k < r.window_parameters.size(); ++k) h += ParameterPlot(r, axis, k) + "\n";
   if (r.windows.front().has_offsets) {
     h += "<h2>Sensors</h2>\n<p>The shared bias of each sensor plus the window's own departure "
