@@ -435,6 +435,35 @@ TEST(TrackTest, StepInsideADayIsOneEventAtItsBlock) {
   EXPECT_NEAR(e.parameters[0].shift, 0.05, 3.0 * e.parameters[0].sigma_total);
 }
 
+// A sensor re-zeroed inside a day's telemetry: one sensor event, timed at its block within
+// the day, the whole step between the days before and after (that day's bias its own),
+// and no move of the mass centre.
+TEST(TrackTest, SensorReZeroedInsideADayIsTimedAtItsBlock) {
+  constexpr int kDays = 5, kPerDay = 300;
+  const double step_s = kStartS + 2 * kDayS + 0.5 * kPerDay * kIntervalS;  // mid-day 3
+  SimulationOptions o;
+  o.sensor_bias_steps.push_back({step_s, 1, 6000.0});  // cable 2, +6 kN
+  CableRobot truth;
+  const Dataset data = Season(kDays, kPerDay, 41, o, &truth);
+  const std::string dir = TempDir("sensor_inside");
+  fs::create_directories(dir);
+  const TrackResult r =
+      Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
+            {Write(data, dir + "/season.csv")}, dir + "/track");
+  ASSERT_EQ(r.events.size(), 1u);
+  const TrackEvent& e = r.events[0];
+  EXPECT_EQ(e.kind, "sensor");
+  ASSERT_EQ(e.cables, std::vector<int>{2});
+  EXPECT_TRUE(e.within_window);
+  EXPECT_EQ(r.windows[e.window].label, "2024-05-03");
+  EXPECT_NEAR(e.time_s, step_s, 2 * kPerDay / 32.0 * kIntervalS + kIntervalS);
+  EXPECT_NEAR(e.parameters[0].shift, 6.0, 3.0 * e.parameters[0].sigma_total);
+  // The day of the step is a stretch of its own: the bias has three values.
+  int entries = 0;
+  for (const TrackShared& s : r.shared) entries += s.name == "sensor_bias_kN[2]";
+  EXPECT_EQ(entries, 3);
+}
+
 TEST(TrackBadInputTest, RefusesWhatItCannotTrack) {
   const std::string dir = TempDir("bad");
   fs::create_directories(dir + "/full");

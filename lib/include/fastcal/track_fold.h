@@ -47,6 +47,12 @@ enum class FoldRole : int {
   kConsider = 2,  // fixed with a prior: held at its value, its sigma propagated
 };
 
+// The fold columns whose block information rows a fold keeps (WindowFold::
+// block_information), in row order: the kWindow columns, then the kShared per-cable
+// sensor biases.
+std::vector<int> BlockRowColumns(const std::vector<ParameterSpec>& columns,
+                                 const std::vector<FoldRole>& roles);
+
 struct FoldTask {
   std::string label;  // the window's
   // The window's sample store (internal/window_store.h), and the data files its samples
@@ -103,8 +109,10 @@ struct WindowFold {
   Eigen::MatrixXd information;  // H (n x n)
   Eigen::VectorXd gradient;     // g (n)
   double chi_square = 0.0;      // c
-  // Per block, in time order: its samples, its first and last sample's time, its score J^T r (blocks x n) and the rows of
-  // its information of the kWindow columns (per block p x n, p the kWindow columns in order).
+  // Per block, in time order: its samples, its first and last sample's time, its score
+  // J^T r (blocks x n) and the rows of its information of the kWindow columns, then of the
+  // kShared per-cable sensor biases (BlockRowColumns; per block rows x n, in column order):
+  // a step of the window's own parameters or of a sensor inside the window's telemetry.
   std::vector<long long> block_samples;
   std::vector<double> block_first_time_s, block_last_time_s;
   Eigen::MatrixXd block_scores;

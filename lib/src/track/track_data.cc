@@ -87,6 +87,11 @@ std::string StateJson(const TrackRun& run) {
     j.Key("name").String(run.layout.Column(run.layout.shared_columns[e.column]).name);
     j.Key("from_s").ExactNumber(std::isfinite(e.from_s) ? e.from_s : -1e308);
     j.Key("value_si").ExactNumber(e.value_si);
+    if (e.inside) {
+      j.Key("inside").Bool(true);
+      j.Key("step_time_s").ExactNumber(e.step_time_s);
+      j.Key("step_previous_s").ExactNumber(e.step_previous_s);
+    }
     j.EndObject();
   }
   j.EndArray();
@@ -159,6 +164,11 @@ SavedState ParseState(const std::string& text) {
     entry.from_s = Real(e["from_s"]);
     if (entry.from_s <= -1e308) entry.from_s = -std::numeric_limits<double>::infinity();
     entry.value_si = Real(e["value_si"]);
+    if (e["inside"] && Text(e["inside"]) == "true") {
+      entry.inside = true;
+      entry.step_time_s = Real(e["step_time_s"]);
+      entry.step_previous_s = Real(e["step_previous_s"]);
+    }
     s.shared.push_back({Text(e["name"]), entry});
   }
   return s;

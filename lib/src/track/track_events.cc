@@ -145,36 +145,41 @@ GroupChange Change(const TrackRun& run, const std::vector<int>& g, int from, int
   return out;
 }
 
-// A step of group g within used window u's telemetry: the score test of "the group
-// differs from block j on", at the joint fit, over the window's block boundaries (the
-// fold's block scores and information rows, moved to the solution), judged against the
-// window's misfit alone (a step inside the window is what its block correlation shows).
+// A step within used window u's telemetry: the score test of "these parameters differ
+// from block j on", at the joint fit, over the window's block boundaries (the fold's block
+// scores and information rows, moved to the solution), judged against the window's misfit
+// alone (a step inside the window is what its block correlation shows). `rows` index the
+// fold's block information rows (track_fold.h, BlockRowColumns), `columns` the fold
+// columns they are of.
 struct InnerStep {
   double statistic = 0.0;
   int block = -1;
   int splits = 0;
 };
-InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& g) {
+InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
+                     const std::vector<int>& columns) {
   const WindowFold& f = run.windows[run.used[u]].fold;
   const int blocks = static_cast<int>(f.block_samples.size());
-  const int pg = static_cast<int>(g.size());
+  const int pg = static_cast<int>(rows.size());
   InnerStep best;
   best.splits = std::max(0, blocks - 1);
   if (blocks < 2) return best;
+  for (int x : rows) {
+    if (x >= f.block_information[0].rows()) return best;  // a fold without the rows
+  }
   const std::vector<int> order = LocalOrder(run);
-  const std::vector<int>& wc = run.layout.window_columns;
   const ArrowBlock& k = run.problem.blocks[u];
   const Eigen::VectorXd d = StepOf(run, u);
   Eigen::VectorXd score = Eigen::VectorXd::Zero(pg);
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pg, f.information.cols());
   for (int j = blocks - 1; j >= 1; --j) {
     for (int x = 0; x < pg; ++x) {
-      score[x] += f.block_scores(j, wc[g[x]]) + f.block_information[j].row(g[x]).dot(d);
-      cross.row(x) += f.block_information[j].row(g[x]);
+      score[x] += f.block_scores(j, columns[x]) + f.block_information[j].row(rows[x]).dot(d);
+      cross.row(x) += f.block_information[j].row(rows[x]);
     }
     Eigen::MatrixXd self(pg, pg);
     for (int x = 0; x < pg; ++x) {
-      for (int y = 0; y < pg; ++y) self(x, y) = cross(x, wc[g[y]]);
+      for (int y = 0; y < pg; ++y) self(x, y) = cross(x, columns[y]);
     }
     ArrowVector c;
     for (const ArrowBlock& other : run.problem.blocks) c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
@@ -193,6 +198,13 @@ InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& g) {
     }
   }
   return best;
+}
+
+// The scan of group g (indices into layout.window_columns: the first block rows).
+InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& g) {
+  std::vector<int> columns;
+  for (int x : g) columns.push_back(run.layout.window_columns[x]);
+  return ScanWithin(run, u, g, columns);
 }
 
 // Whether the scan of window u found a step inside it (Bonferroni over its splits).
@@ -281,26 +293,49 @@ int PreviousEntry(const TrackRun& run, int e) {
   return previous;
 }
 
-// The Wald statistic of the step at entry e (after PreviousEntry), widened.
-double StepWald(const TrackRun& run, int e) {
-  const int e0 = PreviousEntry(run, e);
+// The entry a step at entry e is measured from: the one before it, or, when that one is
+// a window with the step inside (SharedEntry::inside), the one before that (-1: none).
+int StepBase(const TrackRun& run, int e) {
+  const int previous = PreviousEntry(run, e);
+  if (previous < 0 || !run.shared[previous].inside) return previous;
+  return PreviousEntry(run, previous);
+}
+
+// The Wald statistic of the step from entry e0 to entry e, widened.
+double StepWald(const TrackRun& run, int e0, int e) {
   const Eigen::MatrixXd p = run.solver.SandwichBB();
   const double d = run.solver.b()[e] - run.solver.b()[e0];
   const double variance = p(e, e) + p(e0, e0) - 2.0 * p(e, e0);
   return variance > 0.0 ? d * d / variance : 0.0;
 }
 
+void EraseEntry(TrackRun& run, int e) {
+  run.shared.erase(run.shared.begin() + e);
+  run.splits.erase(std::remove(run.splits.begin(), run.splits.end(), e), run.splits.end());
+  for (int& s : run.splits) s -= s > e;
+}
+
+// The first used window whose column takes entry e (-1: none).
+int FirstWindowOf(const TrackRun& run, int e) {
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    if (run.entry_of[u][run.shared[e].column] == e) return static_cast<int>(u);
+  }
+  return -1;
+}
+
 // Steps the fitted track no longer holds significant (the scan's score test is at the
 // fit without them, the Wald test at the fit with them): the weakest is joined back to
-// the stretch before it, and the track refitted, until every step stands.
+// the stretch before it (with the window of its step, when it is inside one), and the
+// track refitted, until every step stands.
 TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
   for (;;) {
     ComputeWidening(run);
     int weakest = -1;
     double smallest = threshold;
     for (size_t e = 0; e < run.shared.size(); ++e) {
-      if (PreviousEntry(run, static_cast<int>(e)) < 0) continue;
-      const double t = StepWald(run, static_cast<int>(e));
+      const int base = StepBase(run, static_cast<int>(e));
+      if (base < 0 || run.shared[e].inside) continue;
+      const double t = StepWald(run, base, static_cast<int>(e));
       if (t <= smallest) {
         smallest = t;
         weakest = static_cast<int>(e);
@@ -311,12 +346,96 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
                  run.layout.Column(run.layout.shared_columns[run.shared[weakest].column]).name +
                  " no longer significant once fitted (Wald " + FormatDouble("%.1f", smallest) +
                  "): joined back");
-    run.shared.erase(run.shared.begin() + weakest);
-    run.splits.erase(std::remove(run.splits.begin(), run.splits.end(), weakest), run.splits.end());
-    for (int& s : run.splits) s -= s > weakest;
+    const int previous = PreviousEntry(run, weakest);
+    const bool inside = run.shared[previous].inside;
+    EraseEntry(run, std::max(weakest, inside ? previous : -1));
+    if (inside) EraseEntry(run, std::min(weakest, previous));
     const TrackStatus status = Iterate(run, false);
     if (status != TrackStatus::kOk) return status;
   }
+}
+
+// A sensor re-zeroed inside a window's telemetry: for each step, the windows on either
+// side of it are scanned for a step of that bias inside their own telemetry (the score
+// test over block boundaries, Bonferroni over them); the window that holds it gets an
+// entry of its own (SharedEntry::inside: its readings are of both values), so that the
+// stretches before and after it are of one value each and the step between them is the
+// whole step, timed at its block.
+TrackStatus IsolateInsideSteps(TrackRun& run) {
+  const std::vector<FoldRole>& roles = run.layout.roles;
+  std::vector<ParameterSpec> columns;
+  for (int k = 0; k < run.layout.size(); ++k) columns.push_back(run.layout.Column(k));
+  const std::vector<int> block_columns = BlockRowColumns(columns, roles);
+  bool isolated = false;
+  const int entries = static_cast<int>(run.shared.size());
+  const int windows = static_cast<int>(run.used.size());
+  // A window the scan already cut out (a step found on either side of it: two halves of
+  // one step inside it) whose own scan finds the step: one step, inside it.
+  for (int m = 0; m < entries; ++m) {
+    const int e0 = PreviousEntry(run, m);
+    if (e0 < 0 || run.shared[m].inside || run.shared[e0].inside) continue;
+    bool followed = false;
+    for (int e = 0; e < entries; ++e) followed = followed || PreviousEntry(run, e) == m;
+    const int j = run.shared[m].column;
+    const int v = FirstWindowOf(run, m);
+    if (!followed || v < 1 || (v + 1 < windows && run.entry_of[v + 1][j] == m)) continue;
+    const int column = run.layout.shared_columns[j];
+    const auto row = std::find(block_columns.begin(), block_columns.end(), column);
+    if (row == block_columns.end()) continue;
+    const InnerStep step =
+        ScanWithin(run, v, {static_cast<int>(row - block_columns.begin())}, {column});
+    if (!Inside(run, step, 1)) continue;
+    const WindowFold& f = run.windows[run.used[v]].fold;
+    run.shared[m].inside = true;
+    run.shared[m].step_time_s = f.block_first_time_s[step.block];
+    run.shared[m].step_previous_s = f.block_last_time_s[step.block - 1];
+    run.Progress("sensor steps of " + run.layout.Column(column).name + " on both sides of window " +
+                 WindowText(run, v) + ": one step inside it (statistic " +
+                 FormatDouble("%.1f", step.statistic) + ")");
+  }
+  for (int e = 0; e < entries; ++e) {
+    const int e0 = PreviousEntry(run, e);
+    if (e0 < 0 || run.shared[e].inside || run.shared[e0].inside) continue;
+    const int j = run.shared[e].column;
+    const int u = FirstWindowOf(run, e);
+    if (u < 1) continue;
+    const int column = run.layout.shared_columns[j];
+    const auto row = std::find(block_columns.begin(), block_columns.end(), column);
+    if (row == block_columns.end()) continue;
+    const std::vector<int> rows = {static_cast<int>(row - block_columns.begin())};
+    // A window is isolated only when its stretch keeps another window.
+    const bool before_ok = u >= 2 && run.entry_of[u - 2][j] == e0;
+    const bool here_ok = u + 1 < windows && run.entry_of[u + 1][j] == e;
+    const InnerStep before = before_ok ? ScanWithin(run, u - 1, rows, {column}) : InnerStep();
+    const InnerStep here = here_ok ? ScanWithin(run, u, rows, {column}) : InnerStep();
+    const bool in_before = Inside(run, before, 1), in_here = Inside(run, here, 1);
+    if (!in_before && !in_here) continue;
+    const bool use_here = in_here && (!in_before || here.statistic >= before.statistic);
+    const int v = use_here ? u : u - 1;
+    const InnerStep& step = use_here ? here : before;
+    const WindowFold& f = run.windows[run.used[v]].fold;
+    SharedEntry mixed = run.shared[use_here ? e : e0];
+    mixed.inside = true;
+    mixed.step_time_s = f.block_first_time_s[step.block];
+    mixed.step_previous_s = f.block_last_time_s[step.block - 1];
+    if (use_here) {
+      // Entry e keeps window u alone; the stretch after it gets a new entry.
+      SharedEntry after = run.shared[e];
+      after.from_s = run.windows[run.used[u + 1]].start_s;
+      mixed.from_s = run.shared[e].from_s;
+      run.shared[e] = mixed;
+      run.shared.push_back(after);
+    } else {
+      mixed.from_s = run.windows[run.used[u - 1]].start_s;
+      run.shared.push_back(mixed);
+    }
+    run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
+    run.Progress("sensor step of " + run.layout.Column(column).name + " inside window " +
+                 WindowText(run, v) + " (statistic " + FormatDouble("%.1f", step.statistic) +
+                 "): the window gets a value of its own");
+    isolated = true;
+  }
+  return isolated ? Iterate(run, false) : TrackStatus::kOk;
 }
 
 }  // namespace
@@ -334,6 +453,7 @@ TrackStatus ScanSensorSteps(TrackRun& run) {
     const int e = run.entry_of[best.u][best.column];
     SharedEntry split = run.shared[e];
     split.from_s = run.windows[run.used[best.u]].start_s;
+    split.inside = false;
     run.shared.push_back(split);
     run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
     run.Progress("sensor step: " + run.layout.Column(run.layout.shared_columns[best.column]).name +
@@ -345,6 +465,9 @@ TrackStatus ScanSensorSteps(TrackRun& run) {
     const TrackStatus status = Iterate(run, false);
     if (status != TrackStatus::kOk) return status;
   }
+  ComputeWidening(run);
+  const TrackStatus status = IsolateInsideSteps(run);
+  if (status != TrackStatus::kOk) return status;
   return DropWeakSteps(run, threshold);
 }
 
@@ -355,11 +478,20 @@ TrackStatus FindParameterEvents(TrackRun& run) {
   if (r.sensor_tests > 0) {
     const double threshold = ChiSquareQuantile(run.options.false_alarm / r.sensor_tests, 1);
     for (size_t e = 0; e < run.shared.size(); ++e) {
+      const int base = StepBase(run, static_cast<int>(e));
+      if (base < 0 || run.shared[e].inside) continue;
+      TrackEvent event = SensorEvent(run, base, static_cast<int>(e), threshold, r.sensor_tests);
       const int previous = PreviousEntry(run, static_cast<int>(e));
-      if (previous >= 0) {
-        r.events.push_back(
-            SensorEvent(run, previous, static_cast<int>(e), threshold, r.sensor_tests));
+      if (run.shared[previous].inside) {
+        // The step inside the window of entry `previous`: timed at its block.
+        const SharedEntry& mixed = run.shared[previous];
+        event.window = std::max(0, FirstWindowOf(run, previous));
+        event.previous_window = std::max(0, event.window - 1);
+        event.time_s = mixed.step_time_s;
+        event.previous_time_s = mixed.step_previous_s;
+        event.within_window = true;
       }
+      r.events.push_back(event);
     }
   }
   // Parameter events: consecutive windows' per-window groups.

@@ -143,7 +143,7 @@ void Summarise(const FoldTask& task, const Dataset& data, const std::vector<int>
 
 // The whitened rows folded block by block (a block is one chunk of the ordered pass).
 bool FoldRowsInBlocks(const FoldTask& task, const internal::FittedSamples& samples,
-                      const std::vector<int>& window_columns, WindowFold* fold, int* failed) {
+                      const std::vector<int>& block_columns, WindowFold* fold, int* failed) {
   const int n = samples.model->num_free();
   const int count = samples.size();
   const int blocks = std::max(1, task.blocks);
@@ -178,9 +178,9 @@ bool FoldRowsInBlocks(const FoldTask& task, const internal::FittedSamples& sampl
         const Eigen::VectorXd zj = part.r.col(n);
         scores.push_back(rj.transpose() * zj);
         const Eigen::MatrixXd info = rj.transpose() * rj;
-        Eigen::MatrixXd rows_of_window(window_columns.size(), n);
-        for (size_t k = 0; k < window_columns.size(); ++k) {
-          rows_of_window.row(k) = info.row(window_columns[k]);
+        Eigen::MatrixXd rows_of_window(block_columns.size(), n);
+        for (size_t k = 0; k < block_columns.size(); ++k) {
+          rows_of_window.row(k) = info.row(block_columns[k]);
         }
         fold->block_information.push_back(rows_of_window);
         fold->block_samples.push_back(part.rows.end - part.rows.begin);
@@ -203,6 +203,21 @@ bool FoldRowsInBlocks(const FoldTask& task, const internal::FittedSamples& sampl
 
 }  // namespace
 
+std::vector<int> BlockRowColumns(const std::vector<ParameterSpec>& columns,
+                                 const std::vector<FoldRole>& roles) {
+  std::vector<int> out;
+  for (size_t k = 0; k < roles.size() && k < columns.size(); ++k) {
+    if (roles[k] == FoldRole::kWindow) out.push_back(static_cast<int>(k));
+  }
+  for (size_t k = 0; k < roles.size() && k < columns.size(); ++k) {
+    if (roles[k] == FoldRole::kShared && columns[k].kind == ParameterKind::kSensorBias &&
+        columns[k].index >= 0) {
+      out.push_back(static_cast<int>(k));
+    }
+  }
+  return out;
+}
+
 bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<int>& file_of,
                  WindowFold* fold, std::string* error) {
   if (!task.IsValid(error)) return false;
@@ -222,11 +237,12 @@ bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<in
   fold->roles = task.roles;
   fold->slow_error = task.slow_error;
   fold->gross_error_threshold_sigmas = task.gross_error_threshold_sigmas;
-  std::vector<int> window_columns;
+  std::vector<ParameterSpec> columns;
   for (int k = 0; k < cm.num_free(); ++k) {
     fold->columns.push_back(task.parameters[cm.spec_index(k)].name);
-    if (task.roles[k] == FoldRole::kWindow) window_columns.push_back(k);
+    columns.push_back(task.parameters[cm.spec_index(k)]);
   }
+  const std::vector<int> block_columns = BlockRowColumns(columns, task.roles);
   const int n = static_cast<int>(data.samples.size());
   if (n == 0) {
     *error = "fold task " + task.label + ": the window has no samples";
@@ -267,7 +283,7 @@ bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<in
   samples.slow_error = task.slow_error;
   samples.slow_rho = &rho;
   int failed = -1;
-  if (!FoldRowsInBlocks(task, samples, window_columns, fold, &failed)) return cannot_solve(failed);
+  if (!FoldRowsInBlocks(task, samples, block_columns, fold, &failed)) return cannot_solve(failed);
   for (long long c : fold->count) fold->readings += c;
   return true;
 }

@@ -59,6 +59,12 @@ struct SharedEntry {
   int column = 0;
   double from_s = -std::numeric_limits<double>::infinity();
   double value_si = 0.0;
+  // A sensor bias's entry for the one window whose telemetry holds its step (the sensor
+  // re-zeroed inside the window: its readings are of both values): the event is between
+  // the entries before and after it, timed at the step's block (its first sample and the
+  // block before's last).
+  bool inside = false;
+  double step_time_s = 0.0, step_previous_s = 0.0;
 };
 
 struct TrackRun {
