@@ -105,6 +105,26 @@ TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
   EXPECT_NE(other.output.find("--force"), std::string::npos) << other.output;
 }
 
+// An export as it comes (FAST's: Beijing time, decimal commas, mm and N) tracked through
+// its column map: the day in UTC, the numbers of the canonical survey; an update must read
+// the files through the same map.
+TEST_F(CliTrackTest, AnExportIsTrackedThroughItsColumnMap) {
+  const std::string data = testing::Source() + "/calibration_data/fast_export.csv";
+  const std::string map = testing::Source() + "/calibration_data/fast_export.columns.yaml";
+  const std::string track = "track --quiet --spec=" + Spec() + " --out=" + Path("t");
+  const auto run = Fastcal(track + " --data=" + data + " --columns=" + map);
+  ASSERT_EQ(run.code, 0) << run.output;
+  EXPECT_NE(run.output.find("1 windows of 1d (2024-05-01 to 2024-05-01), 1441 samples"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(ReadText(Path("t/track.csv")).find("\n2024-05-01T00:00:00Z,2024-05-02T00:00:00Z,1441,"),
+            std::string::npos);
+  // The same file without its map is not the track's.
+  const auto without = Fastcal(track + " --data=" + data);
+  EXPECT_EQ(without.code, 2) << without.output;
+  EXPECT_NE(without.output.find("column map"), std::string::npos) << without.output;
+}
+
 TEST_F(CliTrackTest, BadFlagsAndDirectoriesAreRefused) {
   const auto help = Fastcal("track --help");
   EXPECT_EQ(help.code, 0);
