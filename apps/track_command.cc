@@ -15,6 +15,7 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/time_text.h"
 #include "fastcal/track.h"
 
 DECLARE_string(model);
@@ -80,11 +81,15 @@ has sigma_total: the joint fit's covariance widened per window by its misfit and
 residuals still correlated in time, plus the consider parameters' part.
 
 Events (events.json), each kind at a 1% false-alarm rate over the whole track:
-  sensor     a sensor's bias stepped between two windows (re-zeroed): found by a score
-             scan over cables and window boundaries, then fitted per stretch, so that it
-             does not read as a mass-centre move
-  parameter  a per-window group (the mass centre) changed between consecutive windows
-Time resolution: the window (the event's time is the later window's first sample).
+  sensor     a sensor's bias stepped (re-zeroed) between two windows or inside one: found
+             by a score scan over cables and window boundaries, then fitted per stretch
+             (a window with the step inside gets its own value), so that it does not
+             read as a mass-centre move
+  parameter  a per-window group (the mass centre) changed between consecutive windows,
+             or inside one (then one event from the window before to the window after)
+Time resolution: the window (the event's time is the later window's first sample), or,
+where the window's own telemetry places the step, its block within the window (about
+1/32 of it: "inside the window, at TIME").
 
 Outputs in DIR:
   track.csv               one row per window: window_start, window_end (ISO 8601 UTC),
@@ -166,6 +171,11 @@ std::string Summary(const TrackResult& r, const std::string& out) {
       s << " (cable";
       for (int c : e.cables) s << " " << c;
       s << ")";
+    }
+    if (e.within_window) {
+      s << " inside the window, at "
+        << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
+                                 : internal::FormatDouble("%.17g", e.time_s) + " s");
     }
     s << ":";
     for (const TrackEventParameter& p : e.parameters) {
