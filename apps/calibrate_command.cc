@@ -159,7 +159,8 @@ Streams: the one-screen summary (verdict, free estimates, gross errors, RMS tabl
 stdout; progress, skipped rows, notes and warnings on stderr.
 
 Exit codes: 0 the outputs were written (see the verdict), 1 the calibration failed or was
-refused, or a row's pose cannot be solved (without --skip-invalid-rows), 2 bad input.
+refused, a row's pose cannot be solved (without --skip-invalid-rows), or the machine
+failed (out of memory, a full disk: the file named), 2 bad input.
 
 Example (the bundled paper-like circle):
   fastcal calibrate --spec=calibration_data/spec_mass_centre_density.yaml \
@@ -193,7 +194,8 @@ line and cable, and each row of the RMS table is repeated without them. The mode
 bias (if any) are applied: predicted reading = gain * tension + bias.
 
 The data is read in chunks, so memory does not grow with it (about 20 MB at 10^6 samples);
-each sample is kept meanwhile in a temporary file in /tmp (about 200 bytes a sample).
+each sample is kept meanwhile in an unnamed temporary file in $TMPDIR, else /tmp (about 200
+bytes a sample); a full disk there is exit 1, naming the directory.
 )";
 
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
@@ -550,10 +552,9 @@ std::string CalibratedModelHeader(const CalibrationResult& result, const ReportI
   header += "Calibrated by fastcal " + std::string(FASTCAL_VERSION) + " on " + report.run_utc +
             "\n" + report.command_line + "\ndata " + report.data_path + " (sha256 " +
             report.data_digest + ")" +
-            (report.columns_path.empty()
-                 ? ""
-                 : "\nread through the column map " + report.columns_path + " (sha256 " +
-                       report.columns_digest + ")") +
+            (report.columns_path.empty() ? ""
+                                         : "\nread through the column map " + report.columns_path +
+                                               " (sha256 " + report.columns_digest + ")") +
             "\nverdict: " + FitVerdictName(result.verdict) +
             "\nestimates, +- sigma_total (the uncertainty to quote; report.md, Uncertainty "
             "budget):";
@@ -592,40 +593,9 @@ std::string SigmaText(double sigma, const std::string& unit) {
   return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
 }
 
-// The console is one screen: at most kConsoleWidth columns, long notes cut to
-// kNoteLines lines (the report has them whole).
-constexpr size_t kConsoleWidth = 100;
+// Long notes are cut to kNoteLines lines on the console (the report has them whole).
 constexpr size_t kNoteLines = 2;
 constexpr size_t kEstimateRows = 14;
-
-// `text` wrapped at kConsoleWidth, each line after the first indented by `indent`; cut
-// after `max_lines` lines with "... (report.md)".
-std::string Wrapped(const std::string& text, const std::string& first_indent,
-                    const std::string& indent, size_t max_lines) {
-  std::istringstream words(text);
-  std::vector<std::string> lines = {first_indent};
-  std::string word;
-  while (words >> word) {
-    std::string& line = lines.back();
-    const bool starts = line.size() == (lines.size() == 1 ? first_indent : indent).size();
-    if (!starts && line.size() + 1 + word.size() > kConsoleWidth) {
-      lines.push_back(indent + word);
-    } else {
-      line += (starts ? "" : " ") + word;
-    }
-  }
-  const char kCut[] = " ... (report.md)";
-  if (lines.size() > max_lines) {
-    lines.resize(max_lines);
-    std::string& last = lines.back();
-    if (last.size() + sizeof(kCut) - 1 > kConsoleWidth)
-      last.resize(kConsoleWidth - sizeof(kCut) + 1);
-    last += kCut;
-  }
-  std::string out;
-  for (const std::string& line : lines) out += line + "\n";
-  return out;
-}
 
 // Short flags of an estimate's note; the full notes are in the report.
 std::string EstimateFlags(const ParameterEstimate& p) {
@@ -942,7 +912,12 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
     << RmsTable(variants) << CrossValidationLine(result) << PaperTable6Lines(PositionsOf(data))
-    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, report.html, report.md, summary.json"
+    << "\nwrote " << FLAGS_out << "/{model_calibrated.yaml, ";
+  // One model a session when the spec separates parameters by session.
+  for (size_t k = 0; k < result.session_models.size(); ++k) {
+    s << "model_calibrated@" << result.session_labels[k] << ".yaml, ";
+  }
+  s << "report.html, report.md, summary.json"
     << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
   return s.str();
 }
@@ -963,7 +938,7 @@ bool WriteOutDirectory(const char* command,
     if (!more) return WriteReportFiles(dir, report, why);
     if (!more_beside_report) return WriteReportFiles(dir, report, why) && more(dir, why);
     std::string more_why;
-    std::future<bool> extra = std::async(std::launch::async, [&] { return more(dir, &more_why); });
+    std::future<bool> extra = AsyncOrDeferred([&] { return more(dir, &more_why); });
     const bool reported = WriteReportFiles(dir, report, why);
     const bool extra_written = extra.get();
     if (reported && !extra_written) *why = more_why;
@@ -1103,7 +1078,7 @@ int RunCalibrate(int argc, char** argv) {
   Stopwatch watch;
   // The data files' digest for the report, hashed beside the (one-core) read: ~0.4 s at
   // 10^6 samples that no longer adds to the run.
-  std::future<std::string> data_digest = std::async(std::launch::async, DataDigest);
+  std::future<std::string> data_digest = AsyncOrDeferred(DataDigest);
   if (!CheckResidualsEvery(&error) || !CheckOutFlag(kCalibrateOutputs, &error) ||
       !LoadInputs(&model, &data, &error) ||
       !LoadCalibrationSpec(FLAGS_spec, model, &spec, &error)) {
@@ -1157,7 +1132,7 @@ int RunCalibrate(int argc, char** argv) {
   }
 
   if (!WriteCalibrationOutputs(argc, argv, model, spec, data, data_digest.get(), &result)) {
-    return kExitUsage;
+    return kExitFailure;  // checked before the fit: the machine's failure (a full disk)
   }
   if (FLAGS_timings) std::cerr << TimingLines(read_s, fit_s, watch.Lap(), result.stages);
 
@@ -1264,9 +1239,11 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
   }
   StreamedEvaluation evaluation;
   const EvaluationStreamStatus status = evaluation.Run(model, paths, options, &error);
-  if (status == EvaluationStreamStatus::kInvalidInput) {
+  if (status == EvaluationStreamStatus::kInvalidInput ||
+      status == EvaluationStreamStatus::kSystemError) {
     PrintError(command, error);
-    return kExitUsage;
+    // A full disk is a failure of the machine, not bad input.
+    return status == EvaluationStreamStatus::kSystemError ? kExitFailure : kExitUsage;
   }
   if (const std::string blame = BlameText(evaluation.diagnosis(), "the model"); !blame.empty()) {
     PrintError(command, blame);
@@ -1293,7 +1270,9 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
     const auto residuals = [&evaluation](const std::string& dir, std::string* why) {
       return FLAGS_residuals_every <= 0 || WriteStreamedResiduals(dir, evaluation, why);
     };
-    if (!WriteOutDirectory(command, {}, report, kEvaluateOutputs, residuals)) return kExitUsage;
+    // The output was checked before the work: a failure now is the machine's (a full
+    // disk), not the input's.
+    if (!WriteOutDirectory(command, {}, report, kEvaluateOutputs, residuals)) return kExitFailure;
   }
   PaperCircleMatcher positions;
   if (!evaluation.ForEach([&positions](const EvaluatedSample& s) { positions.Add(s.position_m); },
@@ -1309,11 +1288,10 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
 int RunEvaluate(int argc, char** argv) {
   const char* command = "evaluate";
   int exit_code = 0;
-  if (!StartCommand(
-          argc, argv, command, kEvaluateHelp,
-          {"model", "data", "out", "method", "skip-invalid-rows", "force", "residuals-every",
-           "columns"},
-          &exit_code)) {
+  if (!StartCommand(argc, argv, command, kEvaluateHelp,
+                    {"model", "data", "out", "method", "skip-invalid-rows", "force",
+                     "residuals-every", "columns"},
+                    &exit_code)) {
     return exit_code;
   }
   std::string error;

@@ -17,6 +17,7 @@
 #include <fstream>
 #include <functional>
 #include <iostream>
+#include <memory>
 #include <sstream>
 
 #include "fastcal/internal/atomic_file.h"
@@ -321,6 +322,8 @@ bool CanCreateIn(const std::filesystem::path& dir, bool directory, std::string* 
 bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
                    std::string* error) {
   if (path.empty() || path == "-") return true;
+  // What killed runs left beside it first (internal::RemoveStaleTemporaries).
+  internal::RemoveStaleTemporaries(path);
   const std::string where = "--" + flag + "=" + internal::Escape(path) + ": ";
   std::error_code ec;
   const std::filesystem::file_status status = std::filesystem::status(path, ec);
@@ -359,6 +362,9 @@ bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
 bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error,
                           const std::vector<std::string>* replaceable) {
   const std::string where = "--" + flag + "=" + internal::Escape(dir) + ": ";
+  // What killed runs left beside it first: their temporary directories removed, and a
+  // previous result a --force run had moved aside put back (internal::RemoveStaleTemporaries).
+  internal::RemoveStaleTemporaries(ResolveOutputPath(dir).string());
   std::error_code ec;
   if (std::filesystem::is_symlink(std::filesystem::symlink_status(dir, ec)) &&
       !std::filesystem::exists(dir, ec)) {
@@ -381,11 +387,11 @@ bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::
     const auto is_result = [&](const std::string& name) {
       for (const std::string& r : *replaceable) {
         const size_t star = r.find('*');
-        if (star == std::string::npos ? name == r
-                                      : name.size() >= r.size() - 1 &&
-                                            name.compare(0, star, r, 0, star) == 0 &&
-                                            name.compare(name.size() - (r.size() - star - 1),
-                                                         std::string::npos, r, star + 1) == 0) {
+        if (star == std::string::npos
+                ? name == r
+                : name.size() >= r.size() - 1 && name.compare(0, star, r, 0, star) == 0 &&
+                      name.compare(name.size() - (r.size() - star - 1), std::string::npos, r,
+                                   star + 1) == 0) {
           return true;
         }
       }
@@ -507,36 +513,172 @@ bool ParseRpyDeg(const std::string& name, const std::string& text, Eigen::Vector
   return true;
 }
 
-bool WriteOutput(const std::string& path, const std::string& content, std::string* error) {
+bool WriteOutput(const std::string& path, const std::string& content, std::string* error,
+                 bool replace) {
   if (path.empty() || path == "-") {
-    std::cout << content << std::flush;
+    // Checked here, to stop at once; FinishStandardOutput checks again at exit.
+    std::cout.write(content.data(), static_cast<std::streamsize>(content.size()));
+    std::cout.flush();
+    if (StdoutError() != 0 || !std::cout.good()) {
+      *error = std::string("cannot write to standard output: ") +
+               std::strerror(StdoutError() != 0 ? StdoutError() : EIO) +
+               " (what it received is incomplete)";
+      return false;
+    }
     return true;
   }
-  return internal::WriteFileAtomically(path, content, error);
+  return internal::WriteFileAtomically(path, content, error, replace);
+}
+
+ResultStream::~ResultStream() {
+  if (spill_ != nullptr) std::fclose(spill_);
+}
+
+bool ResultStream::Open(const std::string& path, std::string* error) {
+  to_stdout_ = path.empty() || path == "-";
+  return to_stdout_ || file_.Open(path, error);
+}
+
+bool ResultStream::Spill(std::string* error) {
+  if (spill_ == nullptr) {
+    const char* tmpdir = std::getenv("TMPDIR");
+    spill_directory_ = tmpdir != nullptr && *tmpdir != '\0' ? tmpdir : "/tmp";
+    int err = 0;
+    spill_ = internal::OpenUnnamedFile(spill_directory_, &err);
+    if (spill_ == nullptr) {
+      *error = "cannot create a temporary file in " + internal::Escape(spill_directory_) +
+               " for the output beyond " + std::to_string(kHeldBytes >> 20) +
+               " MiB (TMPDIR names another directory): " + std::strerror(err);
+      return false;
+    }
+  }
+  if (std::fwrite(held_.data(), 1, held_.size(), spill_) != held_.size()) {
+    *error = "cannot write the temporary file in " + internal::Escape(spill_directory_) +
+             " that holds the output (TMPDIR names another directory): " + std::strerror(errno);
+    return false;
+  }
+  held_.clear();
+  return true;
+}
+
+bool ResultStream::Write(std::string_view text, std::string* error) {
+  if (!to_stdout_) return file_.Write(text, error);
+  // Reserved once: growing by doubling would hold up to twice kHeldBytes.
+  if (held_.capacity() < kHeldBytes) held_.reserve(kHeldBytes + (size_t{4} << 20));
+  held_.append(text);
+  return held_.size() < kHeldBytes || Spill(error);
+}
+
+bool ResultStream::Finish(bool replace, std::string* error) {
+  if (!to_stdout_) return file_.Commit(replace, error);
+  if (spill_ == nullptr) return WriteOutput("-", held_, error);
+  if (!Spill(error)) return false;
+  std::rewind(spill_);
+  std::string chunk(size_t{1} << 20, '\0');
+  while (true) {
+    const size_t n = std::fread(chunk.data(), 1, chunk.size(), spill_);
+    if (n == 0) break;
+    if (!WriteOutput("-", chunk.substr(0, n), error)) return false;
+  }
+  if (std::ferror(spill_) != 0) {
+    *error = "cannot read back the temporary file in " + internal::Escape(spill_directory_) +
+             " that holds the output: " + std::strerror(errno);
+    return false;
+  }
+  return true;
 }
 
 bool WriteOutputsTogether(const std::vector<std::pair<std::string, std::string>>& files,
-                          std::string* error) {
-  const std::string suffix = ".tmp." + std::to_string(::getpid());
-  std::vector<std::string> written;
-  auto undo = [&written] {
-    for (const std::string& path : written) std::remove(path.c_str());
-  };
+                          bool replace, std::string* error) {
+  std::vector<std::unique_ptr<internal::AtomicFileWriter>> writers;
   for (const auto& [path, content] : files) {
-    if (!internal::WriteFileAtomically(path + suffix, content, error)) {
-      undo();
+    writers.push_back(std::make_unique<internal::AtomicFileWriter>());
+    if (!writers.back()->Open(path, error) || !writers.back()->Write(content, error) ||
+        !writers.back()->Sync(error)) {
       return false;
     }
-    written.push_back(path + suffix);
   }
-  for (const auto& [path, content] : files) {
-    if (std::rename((path + suffix).c_str(), path.c_str()) != 0) {
-      undo();
-      *error = path + ": cannot rename the temporary file into place";
-      return false;
-    }
+  // Every file is complete in its temporary: now the renames (a failure there, another
+  // process taking a name meanwhile, leaves the ones before it in place).
+  for (auto& writer : writers) {
+    if (!writer->Commit(replace, error)) return false;
   }
   return true;
+}
+
+namespace {
+
+// std::cout's buffer (InstallCheckedStdout): file descriptor 1 through write(2), each
+// write checked, the first error kept.
+class CheckedStdout : public std::streambuf {
+ public:
+  CheckedStdout() { setp(buffer_, buffer_ + sizeof(buffer_)); }
+  int error() const { return error_; }
+
+ protected:
+  int_type overflow(int_type c) override {
+    if (!Drain()) return traits_type::eof();
+    if (!traits_type::eq_int_type(c, traits_type::eof())) {
+      *pptr() = traits_type::to_char_type(c);
+      pbump(1);
+    }
+    return traits_type::not_eof(c);
+  }
+  std::streamsize xsputn(const char* s, std::streamsize n) override {
+    if (n <= epptr() - pptr()) {
+      std::memcpy(pptr(), s, static_cast<size_t>(n));
+      pbump(static_cast<int>(n));
+      return n;
+    }
+    return Drain() && Write(s, static_cast<size_t>(n)) ? n : 0;
+  }
+  int sync() override { return Drain() ? 0 : -1; }
+
+ private:
+  bool Drain() {
+    const bool ok = Write(pbase(), static_cast<size_t>(pptr() - pbase()));
+    setp(buffer_, buffer_ + sizeof(buffer_));
+    return ok;
+  }
+  bool Write(const char* data, size_t size) {
+    while (error_ == 0 && size > 0) {
+      const ssize_t n = ::write(STDOUT_FILENO, data, size);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        error_ = n < 0 ? errno : EIO;
+        break;
+      }
+      data += n;
+      size -= static_cast<size_t>(n);
+    }
+    return error_ == 0;
+  }
+
+  char buffer_[1 << 16];
+  int error_ = 0;
+};
+
+CheckedStdout& StdoutBuffer() {
+  static CheckedStdout buffer;
+  return buffer;
+}
+
+}  // namespace
+
+void InstallCheckedStdout() { std::cout.rdbuf(&StdoutBuffer()); }
+
+int StdoutError() { return StdoutBuffer().error(); }
+
+int FinishStandardOutput(const std::string& command, int exit_code) {
+  std::cout.flush();
+  int why = StdoutError();
+  if (why == 0 && !std::cout.good()) why = EIO;
+  // Closing reports what a network file system defers to close; nothing writes after it.
+  if (why == 0 && ::close(STDOUT_FILENO) != 0 && errno != EBADF) why = errno;
+  if (why == 0) return exit_code;
+  PrintError(command, std::string("cannot write to standard output: ") + std::strerror(why) +
+                          " (what it received is incomplete)");
+  return exit_code != 0 ? exit_code : kExitFailure;
 }
 
 void PrintError(const std::string& command, const std::string& message) {
@@ -563,8 +705,68 @@ std::string FormatDouble(double value, int significant_digits) {
   return buf;
 }
 
-// Writes the given files into a fresh temporary sibling of `dir`, then renames it to
-// `dir`; on any failure removes the temporary directory.
+namespace {
+
+// Puts the complete directory `tmp` in place as `target` (WriteDirectoryAtomically): false
+// with *why on failure, `tmp` then still there. A target another run filled meanwhile is
+// never replaced without --force (`replaceable`); with it, the previous results are
+// swapped out in one step (RENAME_EXCHANGE) or, where the file system lacks that, moved
+// aside first: a crash between the two renames leaves them in ".<name>.old.<pid>", which
+// the next run puts back (internal::RemoveStaleTemporaries).
+bool PublishDirectory(const std::filesystem::path& tmp, const std::filesystem::path& target,
+                      const std::string& dir, const std::vector<std::string>* replaceable,
+                      std::string* why) {
+  std::error_code ec;
+  int err = 0;
+  // An empty target (a new --out made beforehand) is removed first; rmdir refuses one
+  // that another run has filled meanwhile.
+  if (std::filesystem::is_directory(target, ec) && std::filesystem::is_empty(target, ec)) {
+    ::rmdir(target.c_str());
+  }
+  if (internal::RenameNoReplace(tmp, target, &err)) return true;
+  if (err != EEXIST) {
+    *why = std::string("cannot move the results into place: ") + std::strerror(err);
+    return false;
+  }
+  if (replaceable == nullptr) {
+    *why =
+        "another run wrote its results there meanwhile (kept as they are); these results "
+        "were not written: choose a new --out, or --force to replace";
+    return false;
+  }
+  // --force: what is there now must still be a previous run's results only.
+  if (!CheckOutputDirectory("out", dir, why, replaceable)) return false;
+  if (internal::RenameExchange(tmp, target, &err)) {
+    std::filesystem::remove_all(tmp, ec);  // now the previous results
+    return true;
+  }
+  if (err != EINVAL && err != ENOSYS) {
+    *why = std::string("cannot replace the previous results: ") + std::strerror(err);
+    return false;
+  }
+  const std::filesystem::path previous =
+      target.parent_path() /
+      ("." + target.filename().string() + ".old." + std::to_string(::getpid()));
+  std::filesystem::remove_all(previous, ec);
+  std::filesystem::rename(target, previous, ec);
+  if (ec) {
+    *why = "cannot move the previous results aside: " + ec.message();
+    return false;
+  }
+  if (!internal::RenameNoReplace(tmp, target, &err)) {
+    std::filesystem::rename(previous, target, ec);
+    *why = std::string("cannot move the results into place: ") + std::strerror(err);
+    return false;
+  }
+  std::filesystem::remove_all(previous, ec);
+  return true;
+}
+
+}  // namespace
+
+// Writes the given files into a fresh temporary sibling of `dir` (locked while this run
+// writes it), syncs it, then publishes it as `dir` and syncs the parent; on any failure
+// removes the temporary directory.
 bool WriteDirectoryAtomically(const std::string& dir,
                               const std::vector<std::pair<std::string, std::string>>& files,
                               const std::function<bool(const std::string&, std::string*)>& extra,
@@ -579,6 +781,8 @@ bool WriteDirectoryAtomically(const std::string& dir,
              internal::Escape(parent.string()) + "': " + ec.message();
     return false;
   }
+  // What killed runs left beside it (their processes gone): removed, or put back.
+  internal::RemoveStaleTemporaries(target.string());
   const std::filesystem::path tmp =
       parent / ("." + target.filename().string() + ".tmp." + std::to_string(::getpid()));
   std::filesystem::remove_all(tmp, ec);
@@ -589,7 +793,10 @@ bool WriteDirectoryAtomically(const std::string& dir,
         where + "cannot create the temporary directory '" + tmp.string() + "': " + ec.message();
     return false;
   }
+  internal::TemporaryLock lock;
+  lock.Lock(tmp.string());
   auto fail = [&](std::string why) {
+    lock.Release();
     std::filesystem::remove_all(tmp, ec);
     for (size_t at = why.find(tmp.string()); at != std::string::npos;
          at = why.find(tmp.string(), at + dir.size())) {
@@ -604,23 +811,51 @@ bool WriteDirectoryAtomically(const std::string& dir,
   }
   std::string why;
   if (extra && !extra(tmp.string(), &why)) return fail(why);
-  // An existing target is empty, or (--force) a previous run's results: moved aside,
-  // and removed only once the new results are in place.
-  const std::filesystem::path previous =
-      parent / ("." + target.filename().string() + ".old." + std::to_string(::getpid()));
-  const bool replacing = std::filesystem::exists(target, ec);
-  if (replacing) {
-    std::filesystem::remove_all(previous, ec);
-    std::filesystem::rename(target, previous, ec);
-    if (ec) return fail("cannot move the previous results aside: " + ec.message());
+  int err = 0;
+  if (!internal::SyncDirectory(tmp.string(), &err)) {
+    return fail(std::string("cannot write: ") + std::strerror(err));
   }
-  std::filesystem::rename(tmp, target, ec);
-  if (ec) {
-    if (replacing) std::filesystem::rename(previous, target, ec);
-    return fail("cannot move the results into place: " + ec.message());
+  if (!PublishDirectory(tmp, target, dir, replaceable, &why)) return fail(why);
+  // The new name is durable only once the directory holding it is synced.
+  if (!internal::SyncDirectory(parent.string(), &err)) {
+    *error = where + "written, but its directory cannot be synced: " + std::strerror(err);
+    return false;
   }
-  if (replacing) std::filesystem::remove_all(previous, ec);
   return true;
+}
+
+std::string Wrapped(const std::string& text, const std::string& first_indent,
+                    const std::string& indent, size_t max_lines, const std::string& full_text_in) {
+  std::istringstream words(text);
+  std::vector<std::string> lines = {first_indent};
+  std::string word;
+  while (words >> word) {
+    std::string& line = lines.back();
+    const bool starts = line.size() == (lines.size() == 1 ? first_indent : indent).size();
+    if (!starts && line.size() + 1 + word.size() > kConsoleWidth) {
+      lines.push_back(indent + word);
+    } else {
+      line += (starts ? "" : " ") + word;
+    }
+  }
+  const std::string cut = " ... (" + full_text_in + ")";
+  if (lines.size() > max_lines) {
+    lines.resize(max_lines);
+    std::string& last = lines.back();
+    // Whole words dropped until the mark fits: a number cut in the middle would misread.
+    while (last.size() + cut.size() > kConsoleWidth) {
+      const size_t space = last.find_last_of(' ');
+      if (space == std::string::npos || space <= indent.size()) {
+        last.resize(kConsoleWidth - cut.size());
+        break;
+      }
+      last.resize(space);
+    }
+    last += cut;
+  }
+  std::string out;
+  for (const std::string& line : lines) out += line + "\n";
+  return out;
 }
 
 }  // namespace fastcal::cli

@@ -5,14 +5,28 @@
 #include <Eigen/Core>
 #include <filesystem>
 #include <functional>
+#include <future>
 #include <set>
 #include <string>
+#include <string_view>
+#include <system_error>
 #include <utility>
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/internal/atomic_file.h"
 
 namespace fastcal::cli {
+
+// The console is one screen: at most kConsoleWidth columns (calibrate's and design's
+// summaries).
+constexpr size_t kConsoleWidth = 100;
+
+// `text` wrapped at kConsoleWidth, each line after the first indented by `indent`; cut
+// after `max_lines` lines with " ... (FULL_TEXT_IN)", where the whole text is.
+std::string Wrapped(const std::string& text, const std::string& first_indent,
+                    const std::string& indent, size_t max_lines,
+                    const std::string& full_text_in = "report.md");
 
 // Exit codes: 0 success, 1 a computation failed (infeasible pose, solver), 2 bad usage or
 // bad input (flags, files).
@@ -93,6 +107,8 @@ std::string WithFlagNames(const std::string& message,
 // directory even with `force`, a path whose directory does not exist, and a directory
 // where no file can be made (read-only, /proc: a probe file is made and removed), each
 // message starting "--<flag>=<path>: " and naming the directory. "" and "-" (stdout) pass.
+// First removes the temporaries killed runs left beside `path` (their process gone:
+// internal::RemoveStaleTemporaries).
 bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
                    std::string* error);
 
@@ -100,7 +116,8 @@ bool CheckCanWrite(const std::string& flag, const std::string& path, bool force,
 // nearest existing ancestor must take a new directory (a probe is made and removed).
 // With `replaceable` (--force), a directory holding only regular files of those names (a
 // previous run's results) is accepted too. False with a message starting
-// "--<flag>=<dir>: " and naming the directory otherwise.
+// "--<flag>=<dir>: " and naming the directory otherwise. First removes what killed runs
+// left beside it, and puts back a previous result a killed --force run had moved aside.
 bool CheckOutputDirectory(const std::string& flag, const std::string& dir, std::string* error,
                           const std::vector<std::string>* replaceable = nullptr);
 
@@ -131,16 +148,49 @@ bool ParseRpyDeg(const std::string& name, const std::string& text, Eigen::Vector
                  std::string* error);
 
 // Writes `content` to `path` through a temporary file and a rename, so that a failure
-// leaves no partial file; path "" or "-" writes to stdout.
-bool WriteOutput(const std::string& path, const std::string& content, std::string* error);
+// leaves no partial file; path "" or "-" writes to stdout (each write checked: "cannot
+// write to standard output: No space left on device ..."). Without `replace` (--force),
+// a file another process made at `path` meanwhile is not replaced (internal::RenameNoReplace).
+bool WriteOutput(const std::string& path, const std::string& content, std::string* error,
+                 bool replace = true);
+
+// A result written as it is made (solve: memory independent of the number of poses):
+// into a locked temporary beside the file, renamed into place by Finish; or, for stdout
+// (path "" or "-"), held in memory up to kHeldBytes and beyond that in an unnamed
+// temporary file in $TMPDIR (else /tmp), all copied to stdout by Finish. A run that fails
+// before Finish leaves nothing, neither a file nor a partial table on stdout. Errors name
+// the user's file, or standard output, or the temporary directory.
+class ResultStream {
+ public:
+  static constexpr size_t kHeldBytes = size_t{64} << 20;
+
+  ResultStream() = default;
+  ResultStream(const ResultStream&) = delete;
+  ResultStream& operator=(const ResultStream&) = delete;
+  ~ResultStream();
+
+  bool Open(const std::string& path, std::string* error);
+  bool Write(std::string_view text, std::string* error);
+  // `replace`: over an existing file (--force); see WriteOutput.
+  bool Finish(bool replace, std::string* error);
+
+ private:
+  bool Spill(std::string* error);
+
+  bool to_stdout_ = true;
+  internal::AtomicFileWriter file_;
+  std::string held_;
+  std::FILE* spill_ = nullptr;
+  std::string spill_directory_;
+};
 
 // Writes every (path, content) to a temporary file beside it, and renames them into place
 // only once all were written: a failure to write (disk full, no permission) leaves none
 // of the paths changed. On failure removes its temporary files and returns false with the
-// path named in *error. (A rename that fails after others succeeded, which needs the
-// directory to change under us, leaves those in place.)
+// user's path named in *error. (A rename that fails after others succeeded, another
+// process taking the name meanwhile, leaves those in place.) `replace` as WriteOutput's.
 bool WriteOutputsTogether(const std::vector<std::pair<std::string, std::string>>& files,
-                          std::string* error);
+                          bool replace, std::string* error);
 
 // Writes the given (name, content) files and then `extra` (may be empty; it writes into
 // the directory it is given) into a fresh temporary sibling of `dir`, then renames it to
@@ -152,6 +202,31 @@ bool WriteDirectoryAtomically(const std::string& dir,
                               const std::vector<std::pair<std::string, std::string>>& files,
                               const std::function<bool(const std::string&, std::string*)>& extra,
                               const std::vector<std::string>* replaceable, std::string* error);
+// std::async(std::launch::async, fn) or, when the system refuses a thread (a process
+// limit, `ulimit -v`: issue 29), the same work deferred to the caller's get().
+template <typename Fn>
+auto AsyncOrDeferred(Fn fn) -> std::future<decltype(fn())> {
+  try {
+    return std::async(std::launch::async, fn);
+  } catch (const std::system_error&) {
+    return std::async(std::launch::deferred, fn);
+  }
+}
+
+// Standard output is a result file like any other (issue 29). InstallCheckedStdout, at
+// the start of main, gives std::cout a buffer that writes to file descriptor 1 with
+// write(2), checks each write and keeps the first error (a full disk, /dev/full, a closed
+// pipe when SIGPIPE is ignored); StdoutError() is its errno, 0 while all went well.
+// Everything the commands print on stdout goes through std::cout.
+void InstallCheckedStdout();
+int StdoutError();
+
+// Flushes std::cout and closes standard output, checking both. On a failure prints
+// "fastcal <command>: cannot write to standard output: <why> ..." and returns kExitFailure
+// (the machine failed, not the input) unless `exit_code` already says the run failed;
+// otherwise returns `exit_code`. Called once, at the end of main.
+int FinishStandardOutput(const std::string& command, int exit_code);
+
 // "fastcal <command>: <message>" on stderr.
 void PrintError(const std::string& command, const std::string& message);
 

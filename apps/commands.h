@@ -9,6 +9,7 @@
 
 #include "cli_util.h"
 #include "fastcal/pose.h"
+#include "fastcal/simulation.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/workspace.h"
@@ -35,6 +36,16 @@ bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d
 bool TrajectoryPositionStreamFromFlags(const std::string& kind,
                                        const Eigen::Vector3d& focal_centre_m,
                                        PositionStream* stream, bool* known, std::string* error);
+
+// Poses held in memory (a --poses file: bounded by its size; one --position), as a stream.
+PoseStream StreamOf(std::vector<Pose> poses);
+
+// The poses of a generated trajectory, made as they are used: the positions' stream with
+// the focal attitude law (`focal`) or R = I applied to each, so that none is held (solve,
+// simulate). The law's domain is checked first on a copy of the stream; a position it
+// cannot take is named as PosesWithFocalLawFromFlags names it.
+bool PosesFromPositions(const PositionStream& positions, bool focal, const FocalAttitudeLaw& law,
+                        PoseStream* poses, std::string* error);
 
 // The scopes of the trajectory flags (cli_util.h) for trajectory `kind` (circle, line, arc,
 // grid, random, or another mode: point, poses): each generator's parameters apply to their

@@ -210,8 +210,13 @@ std::string Summary(const Design& d) {
   }
   s << "\n  limited by " << d.limiting_part << " (" << FormatDouble(100.0 * d.limiting_share, 3)
     << "% of the wanted variance)";
+  // Each finding wrapped to the console's width; design.html has the stops' detail.
   std::istringstream range(DesignRangeSummary(d));
-  for (std::string line; std::getline(range, line);) s << "\n  " << line;
+  for (std::string line; std::getline(range, line);) {
+    std::string wrapped = Wrapped(line, "  ", "    ", 4, "design.html");
+    wrapped.pop_back();  // the final newline: lines here are joined by a leading one
+    s << "\n" << wrapped;
+  }
   return s.str();
 }
 

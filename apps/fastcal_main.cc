@@ -6,6 +6,7 @@
 #include <iostream>
 #include <new>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "cli_util.h"
@@ -41,40 +42,69 @@ Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/c
 }  // namespace
 }  // namespace fastcal::cli
 
-int main(int argc, char** argv) {
-  using namespace fastcal::cli;
-  google::InitGoogleLogging(argv[0]);
-  FLAGS_logtostderr = true;
-  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h") ||
-      !std::strcmp(argv[1], "help")) {
-    // Asked for: the usage on stdout, exit 0; no command at all is a usage error.
-    (argc < 2 ? std::cerr : std::cout) << kUsage;
-    return argc < 2 ? kExitUsage : 0;
-  }
-  if (!std::strcmp(argv[1], "--version")) {
-    std::cout << "fastcal " << FASTCAL_VERSION << "\n";
-    return 0;
-  }
-  const std::string command = argv[1];
+namespace fastcal::cli {
+namespace {
+
+// Runs `command`; *known is false for a name that is not a command.
+int Dispatch(const std::string& command, int argc, char** argv, bool* known) {
+  *known = true;
+  if (command == "solve") return RunSolve(argc, argv);
+  if (command == "calibrate") return RunCalibrate(argc, argv);
+  if (command == "evaluate") return RunEvaluate(argc, argv);
+  if (command == "simulate") return RunSimulate(argc, argv);
+  if (command == "workspace") return RunWorkspace(argc, argv);
+  if (command == "design") return RunDesign(argc, argv);
+  if (command == "import") return RunImport(argc, argv);
+  if (command == "track") return RunTrack(argc, argv);
+  *known = false;
+  return kExitUsage;
+}
+
+// The command, with what the machine may refuse it (memory, a thread) said in words.
+int RunCommand(const std::string& command, int argc, char** argv) {
+  bool known = true;
+  int code = kExitUsage;
   try {
-    if (command == "solve") return RunSolve(argc, argv);
-    if (command == "calibrate") return RunCalibrate(argc, argv);
-    if (command == "evaluate") return RunEvaluate(argc, argv);
-    if (command == "simulate") return RunSimulate(argc, argv);
-    if (command == "workspace") return RunWorkspace(argc, argv);
-    if (command == "design") return RunDesign(argc, argv);
-    if (command == "import") return RunImport(argc, argv);
-    if (command == "track") return RunTrack(argc, argv);
+    code = Dispatch(command, argc, argv, &known);
   } catch (const std::bad_alloc&) {
     // Outputs are written last and atomically: nothing is left behind.
     std::cerr << "fastcal " << command
               << ": out of memory: the input or the flags ask for more than this machine has\n";
     return kExitFailure;
+  } catch (const std::system_error& e) {
+    // The library falls back to fewer threads; this is what remains (e.g. a thread the
+    // command line itself could not start): a failure of the machine, not of the input.
+    std::cerr << "fastcal " << command << ": the system refused a resource: " << e.what() << "\n";
+    return kExitFailure;
   }
-  const std::vector<std::string> closest =
-      ClosestNames(command, {"solve", "calibrate", "evaluate", "simulate", "workspace", "design"});
-  std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command)
-            << (closest.empty() ? "" : "; did you mean " + closest.front() + "?") << "\n\n"
-            << kUsage;
-  return kExitUsage;
+  if (!known) {
+    const std::vector<std::string> closest = ClosestNames(
+        command, {"solve", "calibrate", "evaluate", "simulate", "workspace", "design", "import"});
+    std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command)
+              << (closest.empty() ? "" : "; did you mean " + closest.front() + "?") << "\n\n"
+              << kUsage;
+  }
+  return code;
+}
+
+}  // namespace
+}  // namespace fastcal::cli
+
+int main(int argc, char** argv) {
+  using namespace fastcal::cli;
+  google::InitGoogleLogging(argv[0]);
+  FLAGS_logtostderr = true;
+  InstallCheckedStdout();  // every result on stdout checked (FinishStandardOutput)
+  const std::string command = argc < 2 ? std::string() : argv[1];
+  int code = 0;
+  if (argc < 2 || command == "--help" || command == "-h" || command == "help") {
+    // Asked for: the usage on stdout, exit 0; no command at all is a usage error.
+    (argc < 2 ? std::cerr : std::cout) << kUsage;
+    code = argc < 2 ? kExitUsage : 0;
+  } else if (command == "--version") {
+    std::cout << "fastcal " << FASTCAL_VERSION << "\n";
+  } else {
+    code = RunCommand(command, argc, argv);
+  }
+  return FinishStandardOutput(command.empty() ? "" : command, code);
 }

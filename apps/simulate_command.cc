@@ -6,9 +6,11 @@
 #include <unistd.h>
 
 #include <array>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <functional>
 #include <iostream>
 #include <memory>
@@ -21,6 +23,7 @@
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/dataset.h"
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
@@ -211,7 +214,8 @@ between samples. A summary of what was written on stdout (> sim.txt keeps it): s
 RMS of the noise added per cable (kN and %), outliers, pose-error RMS; notes and errors
 on stderr.
 
-Exit codes: 0 ok, 1 the truth model cannot hold a pose (the node is named), 2 bad input.
+Exit codes: 0 ok, 1 the truth model cannot hold a pose (the node is named) or the machine
+failed (a full disk: the file named), 2 bad input.
 
 Examples (the bundled datasets):
   # the paper's measured circle, mass centre moved as the authors found it
@@ -498,42 +502,6 @@ bool CheckFlagsApplyToTrajectory(const std::string& trajectory, std::string* err
   return CheckFlagsApply(scopes, mode, error);
 }
 
-// Poses held in memory (a --poses file: bounded by its size), as a stream.
-PoseStream StreamOf(std::vector<Pose> poses) {
-  auto held = std::make_shared<std::vector<Pose>>(std::move(poses));
-  PoseStream stream;
-  stream.count = static_cast<long long>(held->size());
-  stream.next = [held, n = size_t{0}]() mutable { return (*held)[n++]; };
-  return stream;
-}
-
-// The poses of a generated trajectory, made as they are used: the positions' stream with
-// the attitude law applied to each. Checked first on a copy of the stream (no pose kept);
-// a position the law cannot take is named as PosesWithFocalLawFromFlags names it, from
-// the whole list, made only then.
-bool PosesFromPositions(const PositionStream& positions, bool focal, const FocalAttitudeLaw& law,
-                        PoseStream* poses, std::string* error) {
-  if (focal) {
-    PositionStream check = positions;
-    std::vector<Pose> one;
-    for (long long n = 0; n < check.count; ++n) {
-      if (PosesWithFocalLawFromFlags({check.next()}, law, &one, error)) continue;
-      std::vector<Eigen::Vector3d> all;
-      PositionStream again = positions;
-      for (long long k = 0; k < again.count; ++k) all.push_back(again.next());
-      return PosesWithFocalLawFromFlags(all, law, &one, error);
-    }
-  }
-  poses->count = positions.count;
-  poses->next = [positions, focal, law]() mutable {
-    Pose pose;
-    pose.position_m = positions.next();
-    pose.rotation = focal ? FocalAttitude(pose.position_m, law) : Eigen::Matrix3d::Identity();
-    return pose;
-  };
-  return true;
-}
-
 bool BuildPoses(PoseStream* poses, std::string* error) {
   FocalAttitudeLaw law;
   law.tilt_fraction = FLAGS_tilt_fraction;
@@ -591,23 +559,32 @@ std::string TruthPathFor(const std::string& csv_path) {
 
 // Streams the simulation into a temporary beside csv_path (memory independent of the
 // number of samples), then writes the truth model (known only at the end: the
-// mass centre's average) to a temporary beside yaml_path and renames both into place;
-// on failure removes whatever it wrote, so that neither file is left. *simulation_failed
-// tells a failed simulation (exit 1) from a failed write (exit 2).
+// mass centre's average) to a temporary beside yaml_path and renames both into place
+// (over an existing file only with `replace`, --force: a file another run made meanwhile
+// is kept) and syncs their directories; on failure removes whatever it wrote, so that
+// neither file is left. *exit_code on failure: kExitFailure for a failed simulation or a
+// failed write (the machine: a full disk), kExitUsage for a value the dataset cannot hold.
 bool SimulateAndWrite(const CableRobot& truth, const PoseStream& poses,
                       const SimulationOptions& options, const std::string& csv_path,
                       const std::string& csv_header, const std::string& yaml_path,
                       const std::function<std::string(const SimulationSummary&)>& yaml_header,
-                      SimulationSummary* summary, bool* simulation_failed, std::string* error) {
-  const std::string tmp = ".tmp." + std::to_string(::getpid());
-  const std::string csv_tmp = csv_path + tmp;
-  const std::string yaml_tmp = yaml_path + tmp;
-  *simulation_failed = false;
+                      bool replace, SimulationSummary* summary, int* exit_code,
+                      std::string* error) {
+  internal::RemoveStaleTemporaries(csv_path);  // what killed runs left (their pid gone)
+  internal::RemoveStaleTemporaries(yaml_path);
+  const std::string csv_tmp = internal::TemporaryNameFor(csv_path);
+  *exit_code = kExitFailure;
+  // The writer names its temporary: the user's file instead.
+  const auto name_the_users_file = [&] {
+    for (size_t at = error->find(csv_tmp); at != std::string::npos; at = error->find(csv_tmp)) {
+      error->replace(at, csv_tmp.size(), csv_path);
+    }
+  };
   DatasetWriter writer;
   // A season's days are not surveys: no session column (a track cuts the data by time).
   const int labelled = FLAGS_days > 0 ? 1 : options.sessions;
   if (!writer.Open(csv_tmp, SimulatedDatasetLayout(labelled), csv_header, error)) {
-    *error = "writing " + csv_path + ": " + *error;
+    name_the_users_file();
     return false;
   }
   bool write_failed = false;
@@ -618,26 +595,33 @@ bool SimulateAndWrite(const CableRobot& truth, const PoseStream& poses,
   CableRobot truth_used;
   const bool simulated = SimulateStream(truth, poses, options, sink, &truth_used, summary, error);
   if (!simulated || !writer.Close(error)) {
-    *simulation_failed = !simulated && !write_failed;
     std::remove(csv_tmp.c_str());
-    if (!*simulation_failed) *error = "writing " + csv_path + ": " + *error;
+    if (simulated || write_failed) {
+      name_the_users_file();
+      if (error->rfind(csv_path, 0) != 0) *error = "writing " + csv_path + ": " + *error;
+      if (!writer.io_failed()) *exit_code = kExitUsage;
+    }
     return false;
   }
-  if (!SaveCableRobot(truth_used, yaml_tmp, yaml_header(*summary), error)) {
+  internal::AtomicFileWriter yaml;
+  int err = 0;
+  if (!yaml.Open(yaml_path, error) ||
+      !yaml.Write(CableRobotToYaml(truth_used, yaml_header(*summary)), error) ||
+      !yaml.Commit(replace, error)) {
     std::remove(csv_tmp.c_str());
-    *error = "writing " + yaml_path + ": " + *error;
     return false;
   }
-  if (std::rename(yaml_tmp.c_str(), yaml_path.c_str()) != 0) {
-    std::remove(csv_tmp.c_str());
-    std::remove(yaml_tmp.c_str());
-    *error = yaml_path + ": cannot rename the temporary file into place";
-    return false;
-  }
-  if (std::rename(csv_tmp.c_str(), csv_path.c_str()) != 0) {
+  if (replace ? std::rename(csv_tmp.c_str(), csv_path.c_str()) != 0
+              : !internal::RenameNoReplace(csv_tmp, csv_path, &err)) {
+    if (replace) err = errno;
     std::remove(csv_tmp.c_str());
     std::remove(yaml_path.c_str());
-    *error = csv_path + ": cannot rename the temporary file into place";
+    *error = csv_path + ": cannot move into place: " + std::strerror(err) +
+             (err == EEXIST ? " (another run made it meanwhile; kept as it is)" : "");
+    return false;
+  }
+  if (!internal::SyncDirectory(internal::ParentDirectory(csv_path), &err)) {
+    *error = csv_path + ": written, but its directory cannot be synced: " + std::strerror(err);
     return false;
   }
   return true;
@@ -746,11 +730,11 @@ int RunSimulate(int argc, char** argv) {
     return header;
   };
   SimulationSummary summary;
-  bool simulation_failed = false;
+  int failure_code = kExitFailure;
   if (!SimulateAndWrite(truth, poses, options, csv_path, csv_header, yaml_path, yaml_header,
-                        &summary, &simulation_failed, &error)) {
+                        FLAGS_force, &summary, &failure_code, &error)) {
     PrintError(kCommand, error);
-    return simulation_failed ? kExitFailure : kExitUsage;
+    return failure_code;
   }
   // The summary of what was written is the result: stdout (docs/cli.md, "Output streams").
   std::cout << Summary(summary, options, csv_path, yaml_path) << std::endl;

@@ -3,7 +3,10 @@
 // the paper's Tables 2-5).
 #include <gflags/gflags.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <regex>
@@ -143,6 +146,10 @@ not applied here (they are in evaluate and calibrate, which compare with reading
 
 Output: CSV (default) or --format=json, to stdout or --output=FILE (written only when
 everything succeeded; an existing FILE is refused unless --force, which needs --output).
+Poses are solved and written one at a time: memory does not grow with their number
+(about 13 MB); --output streams into a temporary beside FILE, renamed at the end, and
+stdout is held back until the end (in memory up to 64 MiB, beyond that in an unnamed
+file in $TMPDIR, else /tmp), so that a failed run leaves nothing on either.
 CSV columns, units in the names:
   node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status,
   T1_kN..T6_kN            lower-end tensions (what the cabin-side sensors measure)
@@ -426,6 +433,42 @@ bool TrajectoryPositionsFromFlags(const std::string& kind, const Eigen::Vector3d
   return true;
 }
 
+// Poses held in memory (a --poses file: bounded by its size), as a stream.
+PoseStream StreamOf(std::vector<Pose> poses) {
+  auto held = std::make_shared<std::vector<Pose>>(std::move(poses));
+  PoseStream stream;
+  stream.count = static_cast<long long>(held->size());
+  stream.next = [held, n = size_t{0}]() mutable { return (*held)[n++]; };
+  return stream;
+}
+
+// The poses of a generated trajectory, made as they are used: the positions' stream with
+// the attitude law applied to each. Checked first on a copy of the stream (no pose kept);
+// a position the law cannot take is named as PosesWithFocalLawFromFlags names it, from
+// the whole list, made only then.
+bool PosesFromPositions(const PositionStream& positions, bool focal, const FocalAttitudeLaw& law,
+                        PoseStream* poses, std::string* error) {
+  if (focal) {
+    PositionStream check = positions;
+    std::vector<Pose> one;
+    for (long long n = 0; n < check.count; ++n) {
+      if (PosesWithFocalLawFromFlags({check.next()}, law, &one, error)) continue;
+      std::vector<Eigen::Vector3d> all;
+      PositionStream again = positions;
+      for (long long k = 0; k < again.count; ++k) all.push_back(again.next());
+      return PosesWithFocalLawFromFlags(all, law, &one, error);
+    }
+  }
+  poses->count = positions.count;
+  poses->next = [positions, focal, law]() mutable {
+    Pose pose;
+    pose.position_m = positions.next();
+    pose.rotation = focal ? FocalAttitude(pose.position_m, law) : Eigen::Matrix3d::Identity();
+    return pose;
+  };
+  return true;
+}
+
 namespace {
 
 // "focal law (tilt fraction 0.41, focal centre 0,0,300 m)", for the summary line.
@@ -461,7 +504,7 @@ bool AttitudeLawFromFlags(FocalAttitudeLaw* law, std::string* error) {
 constexpr char kIdentityByFlag[] = "R = I (--attitude-law=none)";
 
 // --poses=FILE: its poses, their attitudes replaced only by --attitude-law.
-bool PosesFromFile(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::string* attitude,
+bool PosesFromFile(const FocalAttitudeLaw& law, PoseStream* poses, std::string* attitude,
                    std::string* error) {
   if (FLAGS_trajectory != "point" || !FLAGS_position.empty()) {
     *error = "--poses cannot be combined with --position or --trajectory";
@@ -475,7 +518,12 @@ bool PosesFromFile(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::s
               : FLAGS_attitude_law == "none"
                   ? std::string(kIdentityByFlag)
                   : "as in " + FLAGS_poses + " (R = I if it has no attitude columns)";
-  return ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, poses, error);
+  std::vector<Pose> from_file;
+  if (!ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, &from_file, error)) {
+    return false;
+  }
+  *poses = StreamOf(std::move(from_file));
+  return true;
 }
 
 // The rotation of a single --position from --rpy, --quat or --rotvec; false with
@@ -511,7 +559,7 @@ bool ConstantRotationFromFlags(Eigen::Matrix3d* rotation, std::string* attitude,
 }
 
 // --position=x,y,z with its attitude flag (R = I without one).
-bool SinglePose(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::string* attitude,
+bool SinglePose(const FocalAttitudeLaw& law, PoseStream* poses, std::string* attitude,
                 std::string* error) {
   if (FLAGS_position.empty()) {
     *error = "give --position=x,y,z, a --trajectory or --poses (see fastcal solve --help)";
@@ -520,18 +568,21 @@ bool SinglePose(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::stri
   Pose pose;
   if (!ParsePosition("position", FLAGS_position, &pose.position_m, error)) return false;
   if (FLAGS_attitude_law == "focal") {
-    if (!PosesWithFocalLawFromFlags({pose.position_m}, law, poses, error)) return false;
+    std::vector<Pose> one;
+    if (!PosesWithFocalLawFromFlags({pose.position_m}, law, &one, error)) return false;
     *attitude = FocalLawDescription(law);
+    *poses = StreamOf(std::move(one));
     return true;
   }
   *attitude = FLAGS_attitude_law == "none" ? kIdentityByFlag : "R = I (no attitude flag)";
   if (!ConstantRotationFromFlags(&pose.rotation, attitude, error)) return false;
-  poses->assign(1, pose);
+  *poses = StreamOf({pose});
   return true;
 }
 
 // --trajectory=line|arc|grid|random, flying the focal law unless --attitude-law=none.
-bool TrajectoryPoses(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std::string* attitude,
+// The poses are made as they are solved (PosesFromPositions): none is held.
+bool TrajectoryPoses(const FocalAttitudeLaw& law, PoseStream* poses, std::string* attitude,
                      std::string* error) {
   if (!FLAGS_position.empty()) {
     *error = "--position is for a single pose; drop it or --trajectory";
@@ -543,10 +594,10 @@ bool TrajectoryPoses(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std:
         "attitude law (the default) or, with --attitude-law=none, R = I";
     return false;
   }
-  std::vector<Eigen::Vector3d> positions;
+  PositionStream positions;
   bool known = false;
-  const bool ok =
-      TrajectoryPositionsFromFlags(FLAGS_trajectory, law.focal_centre_m, &positions, &known, error);
+  const bool ok = TrajectoryPositionStreamFromFlags(FLAGS_trajectory, law.focal_centre_m,
+                                                    &positions, &known, error);
   if (!known) {
     *error = "--trajectory must be point, circle, line, arc, grid or random, got " +
              internal::Quote(FLAGS_trajectory);
@@ -558,18 +609,16 @@ bool TrajectoryPoses(const FocalAttitudeLaw& law, std::vector<Pose>* poses, std:
   }
   // Trajectories fly the focal law unless told otherwise: that is how the telescope
   // moves, and what the paper's Tables 4 and 5 use.
-  if (FLAGS_attitude_law == "none") {
-    *attitude = kIdentityByFlag;
-    return PosesWithIdentityAttitude(positions, poses, error);
-  }
-  *attitude = FocalLawDescription(law) +
-              (FLAGS_attitude_law == "focal" ? "" : ", the default for trajectories");
-  return PosesWithFocalLawFromFlags(positions, law, poses, error);
+  const bool focal = FLAGS_attitude_law != "none";
+  *attitude = !focal ? std::string(kIdentityByFlag)
+                     : FocalLawDescription(law) +
+                           (FLAGS_attitude_law == "focal" ? "" : ", the default for trajectories");
+  return PosesFromPositions(positions, focal, law, poses, error);
 }
 
 // The poses to solve from the pose, trajectory and attitude flags; *attitude says in words
 // which attitude they have (for the summary line).
-bool BuildPoses(std::vector<Pose>* poses, std::string* attitude, std::string* error) {
+bool BuildPoses(PoseStream* poses, std::string* attitude, std::string* error) {
   FocalAttitudeLaw law;
   if (!AttitudeLawFromFlags(&law, error)) return false;
   if (!FLAGS_poses.empty()) return PosesFromFile(law, poses, attitude, error);
@@ -654,40 +703,31 @@ bool ModelRangeFromFlags(StaticsOptions* options, std::string* error) {
 
 namespace {
 
+// One method's chain of solutions along the poses (the warm start's source) and the time
+// it took.
 struct Run {
-  std::vector<StaticsSolution> solutions;
+  StaticsOptions options;
+  StaticsSolution solution;  // of the current pose
   double seconds = 0.0;
+
+  const StaticsSolution& Solve(const CableRobot& robot, const Pose& pose) {
+    const auto start = std::chrono::steady_clock::now();
+    SolveStatics(robot, pose, options, &solution);
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return solution;
+  }
+  bool ok() const { return solution.status == StaticsStatus::kOk; }
 };
 
 // "node 3 at position (x, y, z) m: <why> [method exact]".
-std::string NodeFailure(const std::vector<Pose>& poses, size_t n, const StaticsSolution& solution,
+std::string NodeFailure(long long n, const Pose& pose, const StaticsSolution& solution,
                         StaticsMethod method) {
   std::ostringstream s;
-  const Eigen::Vector3d& x = poses[n].position_m;
+  const Eigen::Vector3d& x = pose.position_m;
   s << "node " << n << " at position (" << FormatDouble(x[0]) << ", " << FormatDouble(x[1]) << ", "
     << FormatDouble(x[2]) << ") m: " << DescribeStatus(solution) << " [method "
     << StaticsMethodName(method) << "]";
   return s.str();
-}
-
-// Solves every pose; on failure without --keep-going reports the node and stops.
-bool SolveAll(const CableRobot& robot, const std::vector<Pose>& poses,
-              const StaticsOptions& options, Run* run, std::string* error) {
-  run->solutions.resize(poses.size());
-  StaticsSolution current;
-  const auto start = std::chrono::steady_clock::now();
-  for (size_t n = 0; n < poses.size(); ++n) {
-    SolveStatics(robot, poses[n], options, &current);
-    run->solutions[n] = current;
-  }
-  run->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  for (size_t n = 0; n < poses.size(); ++n) {
-    if (run->solutions[n].status != StaticsStatus::kOk && !FLAGS_keep_going) {
-      *error = NodeFailure(poses, n, run->solutions[n], options.method);
-      return false;
-    }
-  }
-  return true;
 }
 
 // The status code and the message of a row: "ok" and "" on success; for compare the
@@ -699,11 +739,10 @@ std::pair<std::string, std::string> StatusAndMessage(const StaticsSolution& s,
           (method != nullptr ? std::string(method) + ": " : "") + DescribeStatus(s)};
 }
 
-std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run* aas,
-                    const Run* exact) {
+std::string CsvHeader(bool single) {
   std::ostringstream out;
   out << "node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status";
-  if (single != nullptr) {
+  if (single) {
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_upper_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",s0_" << i << "_m";
@@ -718,65 +757,53 @@ std::string CsvRows(const std::vector<Pose>& poses, const Run* single, const Run
   }
   out << ",equilibrium";
   out << ",message\n";
-  for (size_t n = 0; n < poses.size(); ++n) {
-    const Eigen::Vector3d rpy = RpyDegFromRotation(poses[n].rotation);
-    out << n;
-    for (int j = 0; j < 3; ++j) out << "," << FormatDouble(poses[n].position_m[j]);
-    for (int j = 0; j < 3; ++j) out << "," << FormatDouble(rpy[j]);
-    std::pair<std::string, std::string> status;
-    if (single != nullptr) {
-      const StaticsSolution& s = single->solutions[n];
-      status = StatusAndMessage(s);
-      out << "," << status.first;
-      const bool ok = s.status == StaticsStatus::kOk;
-      auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
-      for (const CableSolution& c : s.cables) put(c.lower_tension_n / kNPerKn);
-      for (const CableSolution& c : s.cables) put(c.upper_tension_n / kNPerKn);
-      for (const CableSolution& c : s.cables) put(c.unstretched_length_m);
-      for (const CableSolution& c : s.cables) {
-        for (int j = 0; j < 3; ++j) put(c.force_n[j] / kNPerKn);
-      }
-      put(s.force_residual_n);
-      put(s.moment_residual_nm);
-      put(s.end_residual_m);
-      put(100.0 * s.error_estimate);
-      out << "," << EquilibriumCode(s);
-    } else {
-      const StaticsSolution& a = aas->solutions[n];
-      const StaticsSolution& e = exact->solutions[n];
-      const bool ok = a.status == StaticsStatus::kOk && e.status == StaticsStatus::kOk;
-      status = a.status != StaticsStatus::kOk ? StatusAndMessage(a, "aas")
-                                              : StatusAndMessage(e, "exact");
-      out << "," << status.first;
-      auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
-      for (const CableSolution& c : a.cables) put(c.lower_tension_n / kNPerKn);
-      for (const CableSolution& c : e.cables) put(c.lower_tension_n / kNPerKn);
-      for (int i = 0; i < kNumCables; ++i) {
-        put(ok ? 100.0 * (a.cables[i].lower_tension_n / e.cables[i].lower_tension_n - 1.0) : 0.0);
-      }
-      put(100.0 * a.error_estimate);
-      out << "," << EquilibriumCode(e);
-    }
-    out << "," << internal::QuotedCsvField(status.second) << "\n";
-  }
   return out.str();
 }
 
-std::array<double, kNumCables> MaxAbsErrorPct(const Run& aas, const Run& exact) {
-  std::array<double, kNumCables> worst{};
-  for (size_t n = 0; n < aas.solutions.size(); ++n) {
-    if (aas.solutions[n].status != StaticsStatus::kOk ||
-        exact.solutions[n].status != StaticsStatus::kOk) {
-      continue;
+// One CSV row: `single` (one method), else `aas` against `exact`.
+void AppendCsvRow(long long n, const Pose& pose, const StaticsSolution* single,
+                  const StaticsSolution* aas, const StaticsSolution* exact, std::string* text) {
+  std::ostringstream out;
+  const Eigen::Vector3d rpy = RpyDegFromRotation(pose.rotation);
+  out << n;
+  for (int j = 0; j < 3; ++j) out << "," << FormatDouble(pose.position_m[j]);
+  for (int j = 0; j < 3; ++j) out << "," << FormatDouble(rpy[j]);
+  std::pair<std::string, std::string> status;
+  if (single != nullptr) {
+    const StaticsSolution& s = *single;
+    status = StatusAndMessage(s);
+    out << "," << status.first;
+    const bool ok = s.status == StaticsStatus::kOk;
+    auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
+    for (const CableSolution& c : s.cables) put(c.lower_tension_n / kNPerKn);
+    for (const CableSolution& c : s.cables) put(c.upper_tension_n / kNPerKn);
+    for (const CableSolution& c : s.cables) put(c.unstretched_length_m);
+    for (const CableSolution& c : s.cables) {
+      for (int j = 0; j < 3; ++j) put(c.force_n[j] / kNPerKn);
     }
+    put(s.force_residual_n);
+    put(s.moment_residual_nm);
+    put(s.end_residual_m);
+    put(100.0 * s.error_estimate);
+    out << "," << EquilibriumCode(s);
+  } else {
+    const StaticsSolution& a = *aas;
+    const StaticsSolution& e = *exact;
+    const bool ok = a.status == StaticsStatus::kOk && e.status == StaticsStatus::kOk;
+    status =
+        a.status != StaticsStatus::kOk ? StatusAndMessage(a, "aas") : StatusAndMessage(e, "exact");
+    out << "," << status.first;
+    auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
+    for (const CableSolution& c : a.cables) put(c.lower_tension_n / kNPerKn);
+    for (const CableSolution& c : e.cables) put(c.lower_tension_n / kNPerKn);
     for (int i = 0; i < kNumCables; ++i) {
-      worst[i] =
-          std::max(worst[i], 100.0 * std::abs(aas.solutions[n].cables[i].lower_tension_n /
-                                                  exact.solutions[n].cables[i].lower_tension_n -
-                                              1.0));
+      put(ok ? 100.0 * (a.cables[i].lower_tension_n / e.cables[i].lower_tension_n - 1.0) : 0.0);
     }
+    put(100.0 * a.error_estimate);
+    out << "," << EquilibriumCode(e);
   }
-  return worst;
+  out << "," << internal::QuotedCsvField(status.second) << "\n";
+  *text += out.str();
 }
 
 void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
@@ -809,61 +836,23 @@ void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
   j->Key("outer_iterations").Int(s.outer_iterations);
 }
 
-std::string Json(const std::vector<Pose>& poses, const std::string& method, const Run* single,
-                 const Run* aas, const Run* exact) {
-  JsonWriter j;
-  j.BeginObject();
-  j.Key("method").String(method);
-  j.Key("model").String(ModelName(FLAGS_model));
-  j.Key("poses").BeginArray();
-  for (size_t n = 0; n < poses.size(); ++n) {
-    j.BeginObject();
-    j.Key("node").Int(static_cast<long long>(n));
-    j.Key("position_m").NumberArray(poses[n].position_m);
-    j.Key("rpy_deg").NumberArray(RpyDegFromRotation(poses[n].rotation));
-    if (single != nullptr) {
-      JsonSolution(&j, single->solutions[n]);
-    } else {
-      j.Key("aas").BeginObject();
-      JsonSolution(&j, aas->solutions[n]);
-      j.EndObject();
-      j.Key("exact").BeginObject();
-      JsonSolution(&j, exact->solutions[n]);
-      j.EndObject();
-    }
-    j.EndObject();
-  }
-  j.EndArray();
-  if (single == nullptr) {
-    j.Key("max_abs_relative_error_pct").NumberArray(MaxAbsErrorPct(*aas, *exact));
-    j.Key("seconds_per_pose_aas").Number(aas->seconds / poses.size());
-    j.Key("seconds_per_pose_exact").Number(exact->seconds / poses.size());
+void AppendJsonPose(long long n, const Pose& pose, const StaticsSolution* single,
+                    const StaticsSolution* aas, const StaticsSolution* exact, JsonWriter* j) {
+  j->BeginObject();
+  j->Key("node").Int(n);
+  j->Key("position_m").NumberArray(pose.position_m);
+  j->Key("rpy_deg").NumberArray(RpyDegFromRotation(pose.rotation));
+  if (single != nullptr) {
+    JsonSolution(j, *single);
   } else {
-    j.Key("seconds_per_pose").Number(single->seconds / poses.size());
+    j->Key("aas").BeginObject();
+    JsonSolution(j, *aas);
+    j->EndObject();
+    j->Key("exact").BeginObject();
+    JsonSolution(j, *exact);
+    j->EndObject();
   }
-  j.EndObject();
-  return j.str();
-}
-
-// The poses that failed in any of the runs (only under --keep-going), for the summary.
-struct Failures {
-  size_t count = 0;
-  std::string first;  // NodeFailure of the first
-};
-Failures CountFailures(const std::vector<Pose>& poses,
-                       const std::vector<std::pair<const Run*, StaticsMethod>>& runs) {
-  Failures f;
-  for (size_t n = 0; n < poses.size(); ++n) {
-    bool ok = true;
-    for (const auto& [run, method] : runs) {
-      const StaticsSolution& s = run->solutions[n];
-      if (s.status == StaticsStatus::kOk || !ok) continue;
-      ok = false;
-      if (f.first.empty()) f.first = NodeFailure(poses, n, s, method);
-    }
-    f.count += ok ? 0 : 1;
-  }
-  return f;
+  j->EndObject();
 }
 
 // --plot=FILE.html: for a trajectory or --poses (CheckFlagsApplyToMode), a file other
@@ -896,30 +885,134 @@ std::string PlotPage(const std::vector<Pose>& poses, const std::string& provenan
   return TrajectoryPlotHtml(in);
 }
 
-// The table (stdout or --output) and the plot (--plot): two files are renamed into place
-// together; with the table on stdout the plot is written first, so that a failure to write
-// it leaves nothing half done.
-bool WriteResults(const std::string& table, const std::string& plot, std::string* error) {
-  if (FLAGS_plot.empty()) return WriteOutput(FLAGS_output, table, error);
-  if (FLAGS_output.empty() || FLAGS_output == "-") {
-    return WriteOutput(FLAGS_plot, plot, error) && WriteOutput(FLAGS_output, table, error);
-  }
-  return WriteOutputsTogether({{FLAGS_output, table}, {FLAGS_plot, plot}}, error);
+// What --plot draws: the poses and each method's solutions, held (a plot is of a
+// trajectory a person reads, not of a million poses: the table streams, the plot does not).
+struct PlotData {
+  std::vector<Pose> poses;
+  std::vector<StaticsSolution> single, aas, exact;
+};
+
+// --plot's page, written before the table is renamed into place (RunSolve).
+bool WritePlot(int argc, char** argv, const std::string& attitude, bool compare,
+               const PlotData& plot, std::string* error) {
+  if (FLAGS_plot.empty()) return true;
+  const std::string provenance = CommandLine(argc, argv, {"force"}) + "\nfastcal " +
+                                 FASTCAL_VERSION + ", model " + ModelName(FLAGS_model) +
+                                 ", attitude " + attitude;
+  const std::string page =
+      compare ? PlotPage(plot.poses, provenance, {{"aas", &plot.aas}, {"exact", &plot.exact}})
+              : PlotPage(plot.poses, provenance, {{FLAGS_method, &plot.single}});
+  return WriteOutput(FLAGS_plot, page, error, FLAGS_force);
 }
 
-// Poses where exact met several equilibria (EquilibriumCode "several" or "unreachable").
-size_t CountSeveral(const Run& run) {
-  size_t count = 0;
-  for (const StaticsSolution& s : run.solutions) count += s.other_equilibrium ? 1 : 0;
-  return count;
-}
-
-std::string TimingLine(const char* name, const Run& run, size_t n, bool warm) {
+std::string TimingLine(const char* name, const Run& run, long long n, bool warm) {
   std::ostringstream s;
   s.precision(3);
   s << name << (warm && n > 1 ? " (warm start)" : "") << ": " << 1e6 * run.seconds / n
     << " us/pose";
   return s.str();
+}
+
+// What a whole run found, for the summary lines.
+struct Totals {
+  long long poses = 0;
+  long long failed = 0;                        // poses any method failed (--keep-going)
+  std::string first_failure;                   // NodeFailure of the first
+  std::array<double, kNumCables> worst_pct{};  // compare: max |aas - exact| / exact
+  long long several = 0;  // poses where exact met several equilibria (EquilibriumCode)
+};
+
+// Solves the poses one at a time (one method, or aas and exact for compare), each row
+// formatted and handed to `out` as it is made: memory independent of the number of poses
+// (issue 29). A failure without --keep-going stops the run with the node named.
+bool SolveStream(const CableRobot& robot, const PoseStream& stream, const StaticsOptions& options,
+                 bool compare, ResultStream* out, Run* single, Run* aas, Run* exact, Totals* totals,
+                 PlotData* plot, std::string* error) {
+  const bool json = FLAGS_format == "json";
+  single->options = aas->options = exact->options = options;
+  aas->options.method = StaticsMethod::kAas;
+  exact->options.method = StaticsMethod::kExact;
+  JsonWriter j;
+  std::string text;
+  if (json) {
+    j.BeginObject();
+    j.Key("method").String(compare ? "compare" : FLAGS_method);
+    j.Key("model").String(ModelName(FLAGS_model));
+    j.Key("poses").BeginArray();
+  } else {
+    text = CsvHeader(!compare);
+  }
+  PoseStream poses = stream;
+  constexpr size_t kWriteBytes = 1 << 20;
+  for (long long n = 0; n < poses.count; ++n) {
+    const Pose pose = poses.next();
+    std::vector<std::pair<const Run*, StaticsMethod>> runs;
+    if (compare) {
+      aas->Solve(robot, pose);
+      exact->Solve(robot, pose);
+      runs = {{aas, StaticsMethod::kAas}, {exact, StaticsMethod::kExact}};
+    } else {
+      single->Solve(robot, pose);
+      runs = {{single, options.method}};
+    }
+    bool pose_ok = true;
+    for (const auto& [run, method] : runs) {
+      if (run->ok() || !pose_ok) continue;
+      pose_ok = false;
+      const std::string failure = NodeFailure(n, pose, run->solution, method);
+      if (!FLAGS_keep_going) {
+        *error = failure;
+        return false;
+      }
+      if (totals->first_failure.empty()) totals->first_failure = failure;
+    }
+    totals->failed += pose_ok ? 0 : 1;
+    const StaticsSolution& exact_solution = compare ? exact->solution : single->solution;
+    totals->several += exact_solution.other_equilibrium ? 1 : 0;
+    if (compare && pose_ok) {
+      for (int i = 0; i < kNumCables; ++i) {
+        totals->worst_pct[i] = std::max(
+            totals->worst_pct[i], 100.0 * std::abs(aas->solution.cables[i].lower_tension_n /
+                                                       exact->solution.cables[i].lower_tension_n -
+                                                   1.0));
+      }
+    }
+    const StaticsSolution* one = compare ? nullptr : &single->solution;
+    if (plot != nullptr) {
+      plot->poses.push_back(pose);
+      if (compare) {
+        plot->aas.push_back(aas->solution);
+        plot->exact.push_back(exact->solution);
+      } else {
+        plot->single.push_back(single->solution);
+      }
+    }
+    if (json) {
+      AppendJsonPose(n, pose, one, &aas->solution, &exact->solution, &j);
+      text += j.Take();
+    } else {
+      AppendCsvRow(n, pose, one, &aas->solution, &exact->solution, &text);
+    }
+    if (text.size() >= kWriteBytes) {
+      if (!out->Write(text, error)) return false;
+      text.clear();
+    }
+  }
+  totals->poses = poses.count;
+  if (json) {
+    j.EndArray();
+    const double n = static_cast<double>(poses.count);
+    if (compare) {
+      j.Key("max_abs_relative_error_pct").NumberArray(totals->worst_pct);
+      j.Key("seconds_per_pose_aas").Number(aas->seconds / n);
+      j.Key("seconds_per_pose_exact").Number(exact->seconds / n);
+    } else {
+      j.Key("seconds_per_pose").Number(single->seconds / n);
+    }
+    j.EndObject();
+    text += j.Take();
+  }
+  return out->Write(text, error);
 }
 
 }  // namespace
@@ -945,84 +1038,66 @@ int RunSolve(int argc, char** argv) {
   }
   StaticsOptions options;
   bool compare = false;
-  std::vector<Pose> poses;
+  PoseStream poses;
   std::string attitude;
   if (!SetOptionsFromFlags(&options, &compare, &error) || !CheckFlagsApplyToMode(&error) ||
       !BuildPoses(&poses, &attitude, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  if (poses.empty()) {
+  if (poses.count == 0) {
     PrintError(kCommand, "no poses to solve");
     return kExitUsage;
   }
 
-  std::string content;
-  std::ostringstream timing;
-  Failures failures;
-  Run run, aas, exact;  // run: one method; aas and exact: compare
-  size_t several = 0;
-  if (!compare) {
-    if (!SolveAll(robot, poses, options, &run, &error)) {
-      PrintError(kCommand, error);
-      return kExitFailure;
-    }
-    content = FLAGS_format == "json" ? Json(poses, FLAGS_method, &run, nullptr, nullptr)
-                                     : CsvRows(poses, &run, nullptr, nullptr);
-    timing << TimingLine(StaticsMethodName(options.method), run, poses.size(), options.warm_start);
-    failures = CountFailures(poses, {{&run, options.method}});
-    several = CountSeveral(run);
-  } else {
-    StaticsOptions o = options;
-    o.method = StaticsMethod::kAas;
-    if (!SolveAll(robot, poses, o, &aas, &error)) {
-      PrintError(kCommand, error);
-      return kExitFailure;
-    }
-    o.method = StaticsMethod::kExact;
-    if (!SolveAll(robot, poses, o, &exact, &error)) {
-      PrintError(kCommand, error);
-      return kExitFailure;
-    }
-    content = FLAGS_format == "json" ? Json(poses, "compare", nullptr, &aas, &exact)
-                                     : CsvRows(poses, nullptr, &aas, &exact);
-    timing << TimingLine("aas", aas, poses.size(), options.warm_start) << "; "
-           << TimingLine("exact", exact, poses.size(), options.warm_start) << "\n"
-           << "max |aas - exact| / exact per cable (%):";
-    for (double e : MaxAbsErrorPct(aas, exact)) timing << " " << FormatDouble(e, 4);
-    failures = CountFailures(poses, {{&aas, StaticsMethod::kAas}, {&exact, StaticsMethod::kExact}});
-    several = CountSeveral(exact);
-  }
-  const std::string provenance = CommandLine(argc, argv, {"force"}) + "\nfastcal " +
-                                 FASTCAL_VERSION + ", model " + ModelName(FLAGS_model) +
-                                 ", attitude " + attitude;
-  const std::string plot =
-      FLAGS_plot.empty() ? ""
-      : compare
-          ? PlotPage(poses, provenance, {{"aas", &aas.solutions}, {"exact", &exact.solutions}})
-          : PlotPage(poses, provenance, {{FLAGS_method, &run.solutions}});
-  if (!WriteResults(content, plot, &error)) {
+  ResultStream out;
+  if (!out.Open(FLAGS_output, &error)) {
     PrintError(kCommand, error);
-    return kExitUsage;
+    return kExitFailure;
+  }
+  Run single, aas, exact;
+  Totals totals;
+  PlotData plot;
+  if (!SolveStream(robot, poses, options, compare, &out, &single, &aas, &exact, &totals,
+                   FLAGS_plot.empty() ? nullptr : &plot, &error) ||
+      !WritePlot(argc, argv, attitude, compare, plot, &error)) {
+    PrintError(kCommand, error);
+    return kExitFailure;  // a pose that cannot be held, or the output (a full disk)
+  }
+  if (!out.Finish(FLAGS_force, &error)) {
+    // The table and the plot go together: a plot without its table is removed.
+    if (!FLAGS_plot.empty()) std::remove(FLAGS_plot.c_str());
+    PrintError(kCommand, error);
+    return kExitFailure;
+  }
+  std::ostringstream timing;
+  const long long n = totals.poses;
+  if (!compare) {
+    timing << TimingLine(StaticsMethodName(options.method), single, n, options.warm_start);
+  } else {
+    timing << TimingLine("aas", aas, n, options.warm_start) << "; "
+           << TimingLine("exact", exact, n, options.warm_start) << "\n"
+           << "max |aas - exact| / exact per cable (%):";
+    for (double e : totals.worst_pct) timing << " " << FormatDouble(e, 4);
   }
   // stdout carries the result: the table itself, else (--output=FILE) this summary of
   // it (docs/cli.md, "Output streams").
   std::ostream& summary = FLAGS_output.empty() || FLAGS_output == "-" ? std::cerr : std::cout;
-  summary << "fastcal solve: " << poses.size() << (poses.size() == 1 ? " pose" : " poses");
-  if (failures.count > 0) summary << " (" << failures.count << " failed)";
+  summary << "fastcal solve: " << n << (n == 1 ? " pose" : " poses");
+  if (totals.failed > 0) summary << " (" << totals.failed << " failed)";
   // Paths and flag text on the terminal: control bytes escaped.
   summary << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", attitude "
           << internal::Escape(attitude) << "; " << timing.str() << std::endl;
-  if (failures.count > 0) {
-    std::cerr << "fastcal solve: " << failures.count << " of " << poses.size()
+  if (totals.failed > 0) {
+    std::cerr << "fastcal solve: " << totals.failed << " of " << n
               << " poses failed; --keep-going wrote them with their status, message and empty "
                  "numbers "
                  "(exit 0). First: "
-              << failures.first << std::endl;
+              << totals.first_failure << std::endl;
   }
-  if (several > 0) {
-    std::cerr << "fastcal solve: several equilibria hold " << several << " of " << poses.size()
-              << (poses.size() == 1 ? " pose" : " poses")
+  if (totals.several > 0) {
+    std::cerr << "fastcal solve: several equilibria hold " << totals.several << " of " << n
+              << (n == 1 ? " pose" : " poses")
               << " (column equilibrium: several, unreachable); exact returns the one followed "
                  "from the home pose (docs/model.md, \"Which equilibrium exact returns\")"
               << std::endl;

@@ -197,8 +197,7 @@ int RunTrack(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp,
                     {"model", "spec", "data", "out", "window", "threads", "refold", "force",
-                     "quiet", "skip-invalid-rows", "min-window-samples", "false-alarm",
-                     "columns"},
+                     "quiet", "skip-invalid-rows", "min-window-samples", "false-alarm", "columns"},
                     &exit_code)) {
     return exit_code;
   }

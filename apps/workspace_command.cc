@@ -247,13 +247,14 @@ int RunWorkspace(int argc, char** argv) {
                                                "Made by fastcal " + std::string(FASTCAL_VERSION) +
                                                    ": " + command)});
   }
-  if (!WriteOutputsTogether(files, &error)) {
+  // The outputs were checked before the work: a failure now is the machine's.
+  if (!WriteOutputsTogether(files, FLAGS_force, &error) ||
+      (!to_file && !WriteOutput("-", WorkspaceCsv(map), &error))) {
     PrintError(kCommand, error);
-    return kExitUsage;
+    return kExitFailure;
   }
   // stdout carries the result: the CSV itself, else the summary of what was written
   // (docs/cli.md, "Output streams").
-  if (!to_file) std::cout << WorkspaceCsv(map) << std::flush;
   (to_file ? std::cout : std::cerr) << Summary(map) << std::endl;
   return 0;
 }

@@ -2,14 +2,17 @@
 # The hardening job (docs/hardening.md), run by .ci/run after scripts/test.sh:
 #  1. the whole test suite built with g++ under AddressSanitizer + UndefinedBehaviorSanitizer,
 #     stopping at the first report (build-asan/);
-#  2. the four libFuzzer targets of tests/fuzz built with clang (build-fuzz/), each run for
+#  2. the threaded tests built with g++ under ThreadSanitizer (build-tsan/): the chunked
+#     passes, the threaded reader, a calibration on 1 to 3 threads, the design's gradient,
+#     and command lines that run work beside the main thread; any report fails the job;
+#  3. the four libFuzzer targets of tests/fuzz built with clang (build-fuzz/), each run for
 #     FASTCAL_FUZZ_SECONDS (default 60) from the seed corpus and the regression inputs.
-# Usage: scripts/test-hardening.sh [--sanitizers-only | --fuzz-only]
+# Usage: scripts/test-hardening.sh [--sanitizers-only | --tsan-only | --fuzz-only]
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 mode=${1:-all}
-case "$mode" in all | --sanitizers-only | --fuzz-only) ;; *)
-  echo "usage: $0 [--sanitizers-only | --fuzz-only]" >&2
+case "$mode" in all | --sanitizers-only | --tsan-only | --fuzz-only) ;; *)
+  echo "usage: $0 [--sanitizers-only | --tsan-only | --fuzz-only]" >&2
   exit 2
   ;;
 esac
@@ -25,7 +28,7 @@ export ASAN_OPTIONS=halt_on_error=1:abort_on_error=1:detect_leaks=1:strict_strin
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 start=$SECONDS
 
-if [ "$mode" != --fuzz-only ]; then
+if [ "$mode" = all ] || [ "$mode" = --sanitizers-only ]; then
   sanitize="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
   # g++ 12 under ASan at -O1 warns "may be used uninitialized" inside <regex>'s
   # std::function (a false positive of the instrumented code; none without ASan).
@@ -44,7 +47,53 @@ if [ "$mode" != --fuzz-only ]; then
   echo "hardening: sanitizer suite passed ($((SECONDS - start)) s so far)"
 fi
 
-if [ "$mode" != --sanitizers-only ]; then
+if [ "$mode" = all ] || [ "$mode" = --tsan-only ]; then
+  # Only the tests that run threads (the whole suite under TSan would take most of CI's
+  # time for no more coverage of threads): test binary, then its gtest filter.
+  tsan_tests=(
+    sample_chunks_test '*'
+    folded_cost_test '*'
+    dataset_test '*ChunkedReader*'
+    calibration_test '*ThreadsDoNotChangeTheResult*'
+    design_test '*GradientMatchesNumericDifferentiation*:*MatchesBruteForce*'
+    evaluation_stream_test '*'
+    cli_test '*SimulateCalibrateEvaluateRoundTrip*:*ResidualsOfALongCalibrationAreInFileOrder*'
+    cli_faults_test '*TwoRuns*:*ADeviceAsData*'
+  )
+  targets=(fastcal_cli)
+  for ((k = 0; k < ${#tsan_tests[@]}; k += 2)); do targets+=("${tsan_tests[k]}"); done
+  # No Python (the interpreter is not instrumented), no install test, no benchmarks.
+  cmake -S "$root" -B "$root/build-tsan" -DCMAKE_BUILD_TYPE=Tsan \
+    -DCMAKE_CXX_FLAGS_TSAN="-O1 -g1" -DCMAKE_CXX_FLAGS="-fsanitize=thread -fno-omit-frame-pointer" \
+    -DCMAKE_EXE_LINKER_FLAGS=-fsanitize=thread -DCMAKE_SHARED_LINKER_FLAGS=-fsanitize=thread \
+    -DFASTCAL_BUILD_PYTHON=OFF -DFASTCAL_BUILD_BENCHMARKS=OFF -DFASTCAL_INSTALL=OFF >/dev/null
+  cmake --build "$root/build-tsan" -j "$jobs" --target "${targets[@]}"
+  # Reports go to files (the command line's own, run by the CLI tests, too): any file is
+  # a finding, whatever the exit codes said.
+  reports="$root/build-tsan/tsan-reports"
+  rm -rf "$reports" && mkdir -p "$reports"
+  export TSAN_OPTIONS="halt_on_error=1 second_deadlock_stack=1 log_path=$reports/report"
+  for ((k = 0; k < ${#tsan_tests[@]}; k += 2)); do
+    test=${tsan_tests[k]}
+    status=0
+    (cd "$root/build-tsan/tests" && "./$test" --gtest_filter="${tsan_tests[k + 1]}" \
+      --gtest_brief=1 >"$reports/$test.log" 2>&1) || status=$?
+    if compgen -G "$reports/report.*" >/dev/null; then
+      cat "$reports"/report.* >&2
+      echo "hardening: ThreadSanitizer reported on $test (above)" >&2
+      exit 1
+    fi
+    if [ "$status" -ne 0 ]; then
+      tail -n 40 "$reports/$test.log" >&2
+      echo "hardening: $test failed under ThreadSanitizer (exit $status)" >&2
+      exit 1
+    fi
+  done
+  unset TSAN_OPTIONS
+  echo "hardening: ThreadSanitizer on the threaded tests: no report ($((SECONDS - start)) s so far)"
+fi
+
+if [ "$mode" = all ] || [ "$mode" = --fuzz-only ]; then
   fuzz_flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
   cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" \

@@ -30,10 +30,26 @@ inline constexpr bool kUnderAddressSanitizer = false;
 inline constexpr bool kUnderAddressSanitizer = false;
 #endif
 
+// The same for ThreadSanitizer, which reserves most of the address space too.
+#if defined(__SANITIZE_THREAD__)
+inline constexpr bool kUnderThreadSanitizer = true;
+#elif defined(__has_feature)
+#if __has_feature(thread_sanitizer)
+inline constexpr bool kUnderThreadSanitizer = true;
+#else
+inline constexpr bool kUnderThreadSanitizer = false;
+#endif
+#else
+inline constexpr bool kUnderThreadSanitizer = false;
+#endif
+
+// Whether a sanitizer's reserved shadow memory rules out limits on the address space.
+inline constexpr bool kUnderSanitizer = kUnderAddressSanitizer || kUnderThreadSanitizer;
+
 // Limits this process: SIGALRM after kBoundedSeconds and, without a sanitizer, at most
 // kBoundedAddressSpaceBytes of address space (beyond it allocation throws bad_alloc).
 inline void LimitThisProcess() {
-  if (!kUnderAddressSanitizer) {
+  if (!kUnderSanitizer) {
     const rlimit limit{kBoundedAddressSpaceBytes, kBoundedAddressSpaceBytes};
     setrlimit(RLIMIT_AS, &limit);
   }

@@ -569,7 +569,14 @@ const ErrorCase kErrorCases[] = {
     {"gross_errors: {detect: maybe}\n", 1, "gross_errors.detect", "true or false"},
     {"gross_errors:\n  threshold_sigmas: 0\n", 2, "gross_errors.threshold_sigmas", "> 0"},
     {"gross_errors: {max_fraction: 1.5}\n", 1, "gross_errors.max_fraction", "(0, 1]"},
-    {"solver:\n  threads: 0\n", 2, "solver.threads", ">= 1"},
+    {"solver:\n  threads: 0\n", 2, "solver.threads", "must be 1 to 256"},
+    {"solver:\n  threads: 100000\n", 2, "solver.threads", "must be 1 to 256, got 100000"},
+    {"noise: {tension_sigma_kN: 1e-160, tension_sigma_percent: 0}\n", 1, "noise.tension_sigma_kN",
+     "finer than any tension sensor"},
+    {"noise: {tension_sigma_kN: 1, tension_sigma_percent: 1e-9}\n", 1,
+     "noise.tension_sigma_percent", "finer than any tension sensor"},
+    {"parameters:\n  mass_centre_m:\n    z: {free: true, prior: {mean: 0.5, sigma: 1e-200}}\n", 3,
+     "parameters.mass_centre_m.z.prior.sigma", "holds the parameter fixed"},
     {"solver:\n  max_iterations: 0\n", 2, "solver.max_iterations", ">= 1"},
     {"solver:\n  max_iterations: 1.5\n", 2, "solver.max_iterations", "integer"},
     {"solver:\n  function_tolerance: 0\n", 2, "solver.function_tolerance", "> 0"},
@@ -642,6 +649,17 @@ const ErrorCase kErrorCases[] = {
     {"parameters:\n  mass_centre_m:\n    x: {free: true\n", 4, "YAML syntax error", "flow"},
     {"a: 1\n---\nb: 2\n", 3, "(top level)", "one YAML document"},
 };
+
+// A number out of range is quoted cut short (issue 29: a 10 MB number was echoed whole).
+TEST(CalibrationSpecTest, AnOutOfRangeNumberIsQuotedShort) {
+  const std::string huge = "1" + std::string(10000, '0') + "e99999";
+  for (const std::string& text :
+       {"noise: {tension_sigma_percent: " + huge + "}\n", "solver: {threads: " + huge + "}\n"}) {
+    const std::string error = ParseError(text);
+    EXPECT_NE(error.find("'1000000"), std::string::npos) << error.substr(0, 300);
+    EXPECT_LT(error.size(), 400u) << error.substr(0, 300);
+  }
+}
 
 TEST(CalibrationSpecTest, ErrorsNameTheFileTheLineAndTheKey) {
   for (const ErrorCase& c : kErrorCases) {
@@ -833,12 +851,9 @@ TEST(CalibrationSpecTest, ExampleSpecsLoadWithTheExpectedFreeParameters) {
     int num_free;
   };
   const Example kExamples[] = {
-      {"spec_mass_centre.yaml", 2},
-      {"spec_mass_centre_density.yaml", 4},
-      {"spec_wide.yaml", 3 + 1 + 1 + 6 + 9},
-      {"spec_realistic.yaml", 3 + 6 + 6 + 6},
-      {"spec_sessions.yaml", 3 + 6 + 6 + 6},
-      {"spec_change_scan.yaml", 3 + 6 + 6 + 6},
+      {"spec_mass_centre.yaml", 2},          {"spec_mass_centre_density.yaml", 4},
+      {"spec_wide.yaml", 3 + 1 + 1 + 6 + 9}, {"spec_realistic.yaml", 3 + 6 + 6 + 6},
+      {"spec_sessions.yaml", 3 + 6 + 6 + 6}, {"spec_change_scan.yaml", 3 + 6 + 6 + 6},
   };
   for (const Example& e : kExamples) {
     SCOPED_TRACE(e.file);

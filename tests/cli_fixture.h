@@ -1,6 +1,6 @@
-// The fixture of the end-to-end CLI tests (cli_test.cc, cli_usability_test.cc): the
-// fastcal binary run through the shell, its exit code and output, and a temporary
-// directory per test. The binary comes from $FASTCAL_BIN (set by CTest).
+// The fixture of the end-to-end CLI tests (cli_test.cc, cli_usability_test.cc,
+// cli_faults_test.cc): the fastcal binary run through the shell, its exit code and output,
+// and a temporary directory per test. The binary comes from $FASTCAL_BIN (set by CTest).
 #ifndef FASTCAL_TESTS_CLI_FIXTURE_H_
 #define FASTCAL_TESTS_CLI_FIXTURE_H_
 
@@ -86,8 +86,7 @@ class CliTest : public ::testing::Test {
   // terabytes) and checks its exit code and output; returns the result for more checks.
   CommandResult RunBoundedAndExpect(const ExpectedRun& c) const {
     const std::string limit =
-        std::string(fastcal::test::kUnderAddressSanitizer ? "" : "ulimit -v 4000000; ") +
-        "timeout 60 ";
+        std::string(kUnderSanitizer ? "" : "ulimit -v 4000000; ") + "timeout 60 ";
     const CommandResult r = Shell(limit + Bin() + " " + c.args);
     EXPECT_EQ(r.code, c.code) << c.args << "\n" << r.output.substr(0, 2000);
     EXPECT_NE(r.output.find(c.expected), std::string::npos) << c.args << "\n"

@@ -48,8 +48,8 @@ TEST_F(CliTrackTest, SeasonMoveAndReZeroedSensorAreFoundAndWritten) {
   const auto sim = Fastcal("simulate" + std::string(kSeasonFlags) + " --out=" + Path("s.csv"));
   ASSERT_EQ(sim.code, 0) << sim.output;
   EXPECT_EQ(ReadText(Path("s.csv")).find(",session"), std::string::npos);  // days, no sessions
-  const auto run =
-      Fastcal("track --quiet --spec=" + Spec() + " --data=" + Path("s.csv") + " --out=" + Path("t"));
+  const auto run = Fastcal("track --quiet --spec=" + Spec() + " --data=" + Path("s.csv") +
+                           " --out=" + Path("t"));
   ASSERT_EQ(run.code, 0) << run.output;
   EXPECT_NE(run.output.find("7 windows of 1d (2024-05-01 to 2024-05-07)"), std::string::npos)
       << run.output;
@@ -78,11 +78,13 @@ TEST_F(CliTrackTest, SeasonMoveAndReZeroedSensorAreFoundAndWritten) {
 TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
   // Two files of a three-day season: the first two days, then the third.
   ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=480 --days=2 --interval-s=20 "
-                    "--start=1714593600 --seed=3 --out=" + Path("a.csv"))
+                    "--start=1714593600 --seed=3 --out=" +
+                    Path("a.csv"))
                 .code,
             0);
   ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=240 --days=1 --interval-s=20 "
-                    "--start=1714766400 --seed=5 --out=" + Path("b.csv"))
+                    "--start=1714766400 --seed=5 --out=" +
+                    Path("b.csv"))
                 .code,
             0);
   const std::string track = "track --quiet --spec=" + Spec() + " --out=" + Path("t");
@@ -133,30 +135,30 @@ TEST_F(CliTrackTest, BadFlagsAndDirectoriesAreRefused) {
   const auto unknown = Fastcal("track --windows=1d");
   EXPECT_EQ(unknown.code, 2);
   EXPECT_NE(unknown.output.find("--windows"), std::string::npos) << unknown.output;
-  const auto window = Fastcal("track --spec=" + Spec() + " --data=x.csv --out=" + Path("t") +
-                              " --window=1.5d");
+  const auto window =
+      Fastcal("track --spec=" + Spec() + " --data=x.csv --out=" + Path("t") + " --window=1.5d");
   EXPECT_EQ(window.code, 2);
   EXPECT_NE(window.output.find("--window '1.5d'"), std::string::npos) << window.output;
-  const auto missing = Fastcal("track --spec=" + Spec() + " --data=" + Path("none.csv") +
-                               " --out=" + Path("t"));
+  const auto missing =
+      Fastcal("track --spec=" + Spec() + " --data=" + Path("none.csv") + " --out=" + Path("t"));
   EXPECT_EQ(missing.code, 2);
   EXPECT_NE(missing.output.find("none.csv"), std::string::npos) << missing.output;
   EXPECT_FALSE(fs::exists(Path("t")));
   // A directory holding something else.
   fs::create_directories(Path("busy"));
   std::ofstream(Path("busy/notes.txt")) << "mine";
-  const auto busy = Fastcal("track --spec=" + Spec() + " --data=" + Path("none.csv") +
-                            " --out=" + Path("busy"));
+  const auto busy =
+      Fastcal("track --spec=" + Spec() + " --data=" + Path("none.csv") + " --out=" + Path("busy"));
   EXPECT_EQ(busy.code, 2);
   EXPECT_NE(busy.output.find("holds no track"), std::string::npos) << busy.output;
   EXPECT_TRUE(fs::exists(Path("busy/notes.txt")));
   // The season flags of simulate.
-  const auto days = Fastcal("simulate --trajectory=random --samples=100 --days=3 --out=" +
-                            Path("d.csv"));
+  const auto days =
+      Fastcal("simulate --trajectory=random --samples=100 --days=3 --out=" + Path("d.csv"));
   EXPECT_EQ(days.code, 2);
   EXPECT_NE(days.output.find("--days=3"), std::string::npos) << days.output;
-  const auto step = Fastcal("simulate --trajectory=random --samples=100 --sensor-step=5:7:1 --out=" +
-                            Path("d.csv"));
+  const auto step = Fastcal(
+      "simulate --trajectory=random --samples=100 --sensor-step=5:7:1 --out=" + Path("d.csv"));
   EXPECT_EQ(step.code, 2);
   EXPECT_NE(step.output.find("--sensor-step needs T:CABLE:DKN"), std::string::npos) << step.output;
 }

@@ -29,6 +29,46 @@ TEST(ModelPlausibilityTest, NominalModelIsPlausibleAndEachSlipIsNamedAtItsKey) {
   EXPECT_EQ(why.rfind("cables[1].tower_top_m: z = 270000 m is above the tower tops", 0), 0u) << why;
 }
 
+// Issue 29: gravity, a point-sized reflector and degenerate tower layouts were accepted,
+// then blamed on the solver; each is now refused at its key.
+TEST(ModelPlausibilityTest, TheModelsWorldIsCheckedAtItsKey) {
+  const PlausibilityLimits limits;
+  std::string why;
+  const auto refused = [&](const CableRobot& robot) {
+    EXPECT_FALSE(CheckModelPlausible(robot, limits, &why));
+    return why;
+  };
+  CableRobot robot = CableRobot::NominalFast();
+  robot.gravity_m_per_s2 = -1.0;
+  EXPECT_EQ(refused(robot),
+            "gravity_m_per_s2: -1 m/s^2 is above the plausible maximum of -9.7 m/s^2 (nominal "
+            "FAST: -9.8 m/s^2)");
+  robot = CableRobot::NominalFast();
+  robot.reflector->radius_m = 1e-9;
+  robot.reflector->aperture_m = 1e-9;
+  EXPECT_EQ(refused(robot).rfind("reflector.radius_m: 1e-09 m is below the plausible minimum", 0),
+            0u)
+      << why;
+  robot = CableRobot::NominalFast();
+  robot.reflector->centre_m = Eigen::Vector3d(0.0, 0.0, 1000.0);
+  EXPECT_EQ(refused(robot).rfind("reflector.centre_m: (0, 0, 1000) m is more than 50 m", 0), 0u)
+      << why;
+  // Every tower on one side of the axis: a side the cables cannot pull toward.
+  robot = CableRobot::NominalFast();
+  for (int i = 0; i < kNumCables; ++i) {
+    const double angle = (10.0 + 20.0 * i) * M_PI / 180.0;
+    robot.cables[i].tower_top_m =
+        Eigen::Vector3d(300.0 * std::cos(angle), 300.0 * std::sin(angle), 270.0);
+  }
+  EXPECT_NE(refused(robot).find("leave a gap of 260 deg"), std::string::npos) << why;
+  robot = CableRobot::NominalFast();
+  robot.cables[2].tower_top_m = Eigen::Vector3d(1.0, 1.0, 270.0);
+  EXPECT_EQ(refused(robot).rfind("cables[2].tower_top_m: 1.41421 m from the z axis", 0), 0u) << why;
+  robot = CableRobot::NominalFast();
+  robot.cables[5].tower_top_m.z() = 130.0;  // above the reflector's rim, below the cabin
+  EXPECT_EQ(refused(robot).rfind("cables[5].tower_top_m: z = 130 m is below 150 m", 0), 0u) << why;
+}
+
 TEST(ModelPlausibilityTest, QuantityMessagesGiveTheNominalValueAndTheLikelySlip) {
   const PlausibilityLimits limits;
   std::string why;

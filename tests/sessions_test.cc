@@ -353,7 +353,9 @@ TEST(SessionsTest, ReZeroedSensorIsNamedAndNotReadAsAMove) {
     int accused = 0;
     for (const SensorStep& t : r.sensor_steps.tests) {
       accused += t.significant;
-      if (t.significant) EXPECT_EQ(t.cable, 2);
+      if (t.significant) {
+        EXPECT_EQ(t.cable, 2);
+      }
     }
     EXPECT_EQ(accused, 1);
     EXPECT_EQ(r.sensor_steps.separated.size(), 6u);

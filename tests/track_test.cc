@@ -357,7 +357,8 @@ TEST_F(SeasonTest, UpdateFoldsOnlyTheNewDay) {
 // seasons gave 64% and 96%, rms z 1.05; these 12: 78% and 100%, rms z 0.79).
 TEST(TrackTest, WindowEstimatesCoverTheTruthAtTheirStatedRate) {
   constexpr int kSeasons = 12, kDays = 3, kPerDay = 250;
-  const CalibrationSpec spec = LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}"));
+  const CalibrationSpec spec =
+      LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}"));
   const std::string dir = TempDir("coverage");
   fs::create_directories(dir);
   int within_one = 0, within_two = 0, total = 0, events = 0;
@@ -366,7 +367,8 @@ TEST(TrackTest, WindowEstimatesCoverTheTruthAtTheirStatedRate) {
     SimulationOptions o;
     CableRobot truth;
     Dataset data;
-    // Season()'s telemetry with the priors' spreads: density 0.18 kg/m of 11.718, gain 1%, bias 2 kN.
+    // Season()'s telemetry with the priors' spreads: density 0.18 kg/m of 11.718, gain 1%, bias 2
+    // kN.
     o.seed = 100 + 7 * k;
     o.sample_interval_s = kIntervalS;
     o.start_time_s = kStartS;
@@ -389,7 +391,8 @@ TEST(TrackTest, WindowEstimatesCoverTheTruthAtTheirStatedRate) {
     events += static_cast<int>(r.events.size());
     for (const TrackWindow& w : r.windows) {
       for (int a = 0; a < 3; ++a) {
-        const double z = (w.estimates[a].value - model.mass_centre_cabin_m[a]) / w.estimates[a].sigma_total;
+        const double z =
+            (w.estimates[a].value - model.mass_centre_cabin_m[a]) / w.estimates[a].sigma_total;
         within_one += std::abs(z) < 1.0;
         within_two += std::abs(z) < 2.0;
         sum_z2 += z * z;

@@ -145,6 +145,28 @@ def _attitude(
     return kind, array
 
 
+_INT32_MIN = -(2**31)
+_INT32_MAX = 2**31 - 1
+_UINT64_MAX = 2**64 - 1
+
+
+def _whole(value: Any, name: str, low: int, high: int) -> int:
+    """`value` as a Python int in [low, high]; InputError naming `name` otherwise (a float,
+    a str, a bool, a number out of range), never a raw TypeError of the core."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)):
+        raise InputError(f"{name} must be a whole number, got {value!r}")
+    if not low <= int(value) <= high:
+        raise InputError(f"{name} must be from {low} to {high}, got {int(value)}")
+    return int(value)
+
+
+def _number(value: Any, name: str) -> float:
+    """`value` as a float; InputError naming `name` for what is not a real number."""
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, float, np.number)):
+        raise InputError(f"{name} must be a number, got {value!r}")
+    return float(value)
+
+
 def _point(value: ArrayLike, name: str) -> np.ndarray:
     array = np.asarray(value, dtype=np.float64)
     if array.shape != (3,):
@@ -306,7 +328,7 @@ def solve(
         method,
         {
             "warm_start": warm_start,
-            "max_refinement_steps": max_refinement_steps,
+            "max_refinement_steps": _whole(max_refinement_steps, "max_refinement_steps", 1, 10**6),
             "refined_relative_tolerance": refined_tolerance,
             "aas_max_relative_error": aas_max_error,
             "exact_relative_tolerance": exact_tolerance,
@@ -323,7 +345,9 @@ def line(from_m: ArrayLike, to_m: ArrayLike, nodes: int = 101) -> np.ndarray:
 
     The paper's line G1 -> G2 is line((50, 0, 150), (-50, 0, 150)).
     """
-    return _fastcal.line(_point(from_m, "from_m"), _point(to_m, "to_m"), nodes)
+    return _fastcal.line(
+        _point(from_m, "from_m"), _point(to_m, "to_m"), _whole(nodes, "nodes", _INT32_MIN, _INT32_MAX)
+    )
 
 
 def arc(
@@ -338,7 +362,13 @@ def arc(
     Angles from +x toward +y; a 360 deg span is a full circle without a repeated node.
     The paper's measured circle: arc(centre_m=(0, 0, 156.73), radius_m=71.11).
     """
-    return _fastcal.arc(_point(centre_m, "centre_m"), radius_m, start_deg, end_deg, nodes)
+    return _fastcal.arc(
+        _point(centre_m, "centre_m"),
+        _number(radius_m, "radius_m"),
+        _number(start_deg, "start_deg"),
+        _number(end_deg, "end_deg"),
+        _whole(nodes, "nodes", _INT32_MIN, _INT32_MAX),
+    )
 
 
 def focal_grid(
@@ -350,11 +380,11 @@ def focal_grid(
 ) -> np.ndarray:
     """A regular grid on the lower cap of the focal sphere, axis point first: (n, 3)."""
     return _fastcal.focal_grid(
-        max_off_axis_deg,
-        off_axis_step_deg,
-        azimuth_step_deg,
+        _number(max_off_axis_deg, "max_off_axis_deg"),
+        _number(off_axis_step_deg, "off_axis_step_deg"),
+        _number(azimuth_step_deg, "azimuth_step_deg"),
         _point(focal_centre_m, "focal_centre_m"),
-        focal_radius_m,
+        _number(focal_radius_m, "focal_radius_m"),
     )
 
 
@@ -372,12 +402,12 @@ def random_workspace(
     The same seed gives the same positions on every platform.
     """
     return _fastcal.random_workspace(
-        samples,
-        max_off_axis_deg,
-        radial_spread_m,
-        seed,
+        _whole(samples, "samples", _INT32_MIN, _INT32_MAX),
+        _number(max_off_axis_deg, "max_off_axis_deg"),
+        _number(radial_spread_m, "radial_spread_m"),
+        _whole(seed, "seed", 0, _UINT64_MAX),
         _point(focal_centre_m, "focal_centre_m"),
-        focal_radius_m,
+        _number(focal_radius_m, "focal_radius_m"),
     )
 
 
@@ -763,6 +793,13 @@ def simulate(
     kind, attitude = _attitude(positions.shape[0], rpy_deg, quat)
     truth = model if model is not None else Model.nominal()
     fields = _simulation_fields(options)
+    if "seed" in fields:
+        fields["seed"] = _whole(fields["seed"], "seed", 0, _UINT64_MAX)
+    if "sessions" in fields:
+        fields["sessions"] = _whole(fields["sessions"], "sessions", 1, _INT32_MAX)
+    for key, value in fields.items():
+        if key not in ("seed", "sessions", "method", "mass_centre_steps", "sensor_bias_steps"):
+            fields[key] = _number(value, key)
     return _call_with_names(
         _SIMULATE_OPTION_FIELDS, _fastcal.simulate, truth, positions, kind, attitude, fields
     )
@@ -1012,22 +1049,25 @@ def design(
         model = Model.load(os.fspath(model))
     spec_text, is_text, source = _spec_argument(spec)
     options = {
-        "samples": int(samples),
-        "max_extra_tilt_deg": float(max_extra_tilt_deg),
-        "max_extra_yaw_deg": float(max_extra_yaw_deg),
+        "samples": _whole(samples, "samples", 1, _INT32_MAX),
+        "max_extra_tilt_deg": _number(max_extra_tilt_deg, "max_extra_tilt_deg"),
+        "max_extra_yaw_deg": _number(max_extra_yaw_deg, "max_extra_yaw_deg"),
         "criterion": str(criterion).upper(),
         "parameters": [str(p) for p in parameters],
-        "seed": int(seed),
-        "speed_m_per_s": float(speed_m_per_s),
-        "sample_interval_s": float(interval_s),
-        "time_budget_s": 60.0 * float(minutes),
-        "min_tension_kN": min_tension_kN,
-        "max_tension_kN": max_tension_kN,
-        "reflector_clearance_m": reflector_clearance_m,
-        "max_off_axis_deg": max_off_axis_deg,
-        "off_axis_step_deg": off_axis_step_deg,
-        "azimuth_step_deg": azimuth_step_deg,
+        "seed": _whole(seed, "seed", 0, _UINT64_MAX),
+        "speed_m_per_s": _number(speed_m_per_s, "speed_m_per_s"),
+        "sample_interval_s": _number(interval_s, "interval_s"),
+        "time_budget_s": 60.0 * _number(minutes, "minutes"),
     }
+    for key, value in (
+        ("min_tension_kN", min_tension_kN),
+        ("max_tension_kN", max_tension_kN),
+        ("reflector_clearance_m", reflector_clearance_m),
+        ("max_off_axis_deg", max_off_axis_deg),
+        ("off_axis_step_deg", off_axis_step_deg),
+        ("azimuth_step_deg", azimuth_step_deg),
+    ):
+        options[key] = None if value is None else _number(value, key)
     try:
         return _fastcal.design(model, spec_text, is_text, source, options)
     except InputError as error:
@@ -1160,7 +1200,10 @@ def track(
         model = Model.nominal()
     elif not isinstance(model, Model):
         model = Model.load(os.fspath(model))
-    paths = [os.fspath(data)] if isinstance(data, (str, os.PathLike)) else [os.fspath(p) for p in data]
+    if isinstance(data, (str, os.PathLike)):
+        paths = [os.fspath(data)]
+    else:
+        paths = [os.fspath(p) for p in data]
     spec_text, is_text, source = _spec_argument(spec)
     fold_many = None
     if client is not None:

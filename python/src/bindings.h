@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "fastcal/cable_robot.h"
 #include "fastcal/column_map.h"
 #include "fastcal/pose.h"
 
@@ -42,14 +43,33 @@ struct MissingFileError : std::runtime_error {
   std::string path;
 };
 
+// A path from Python: InputError when it holds a NUL byte, which the system would read as
+// its end (issue 29: "a.yaml\0b" was silently a.yaml).
+inline void CheckPath(const std::string& path, const std::string& what) {
+  if (path.find('\0') != std::string::npos) {
+    throw InputError(what + " path contains a NUL byte: not a file name");
+  }
+}
+
 // Throws MissingFileError when nothing exists at `path` (other problems, a directory or
 // an unreadable file, are the reader's InputError with its message).
 inline void RequireExistingFile(const std::string& path, const std::string& what) {
+  CheckPath(path, what);
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) {
     throw MissingFileError(path, path + ": no such " + what + " file");
   }
 }
+
+// A Python number (int, float, numpy scalar) as a double: InputError naming `what`
+// otherwise (a str, None, a bool), instead of pybind11's cast error.
+double NumberArgument(py::handle value, const std::string& what);
+
+// The model's checks, the very ones a model file passes (CheckModel, model_plausibility.h),
+// with the key named as the Python attribute ("cabin_mass_kg", "ea_n[2]"): InputError
+// otherwise. Every setter of fastcal.Model runs it on the changed copy before keeping it,
+// and every call that takes a model runs it first.
+void ValidateModel(const CableRobot& robot);
 
 // A calibration refused or failed (the command line's exit 1): fastcal.CalibrationError,
 // a RuntimeError, whose `status` says which ("undetermined", "infeasible", ...).

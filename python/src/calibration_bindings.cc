@@ -255,8 +255,12 @@ CalibrationSpec Spec(const CableRobot& model, const std::string& path_or_text, b
   return spec;
 }
 
-py::dict Calibrate(const CableRobot& model, const std::string& spec_path_or_text, bool spec_is_text,
-                   const std::string& spec_source, const Dataset& data) {
+py::dict Calibrate(const CableRobot& model_argument, const std::string& spec_path_or_text,
+                   bool spec_is_text, const std::string& spec_source, const Dataset& data) {
+  // A copy, taken with the GIL held: the fit runs without it, while another thread may
+  // assign to the model's fields (issue 29). The Dataset has no setters.
+  const CableRobot model = model_argument;
+  ValidateModel(model);
   const CalibrationSpec spec = Spec(model, spec_path_or_text, spec_is_text, spec_source);
   CalibrationResult result;
   std::string error;
@@ -271,7 +275,10 @@ py::dict Calibrate(const CableRobot& model, const std::string& spec_path_or_text
   return ResultDict(result);
 }
 
-py::dict Evaluate(const CableRobot& model, const Dataset& data, const std::string& method_name) {
+py::dict Evaluate(const CableRobot& model_argument, const Dataset& data,
+                  const std::string& method_name) {
+  const CableRobot model = model_argument;  // as in Calibrate: a copy before the GIL goes
+  ValidateModel(model);
   StaticsMethod method;
   if (!ParseStaticsMethod(method_name, &method)) {
     throw InputError("method must be 'aas', 'aas-refined' or 'exact', got '" + method_name + "'");

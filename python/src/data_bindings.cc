@@ -251,6 +251,7 @@ the order of their first sample, empty without; session (n,) each sample's index
       .def(
           "save",
           [](const Dataset& d, const std::string& path, const std::string& header_comment) {
+            CheckPath(path, "dataset");
             std::string error;
             if (!WriteDataset(path, d, header_comment, &error)) throw InputError(error);
           },
@@ -264,9 +265,12 @@ the order of their first sample, empty without; session (n,) each sample's index
 
 // simulate(truth, positions, attitude kind and values, options) -> (dataset, truth used,
 // summary dict); the simulation runs without the GIL.
-py::tuple SimulateFromArrays(const CableRobot& truth, const DoubleArray& positions_m,
+py::tuple SimulateFromArrays(const CableRobot& truth_argument, const DoubleArray& positions_m,
                              const std::string& attitude_kind, const DoubleArray& attitude,
                              const py::dict& options) {
+  // A copy before the GIL is released (issue 29: another thread may change the model).
+  const CableRobot truth = truth_argument;
+  ValidateModel(truth);
   const SimulationOptions o = MakeSimulationOptions(options);
   const std::vector<Pose> planned = PosesFromArrays(positions_m, attitude_kind, attitude);
   Dataset data;

@@ -74,8 +74,12 @@ py::dict DesignDict(const Design& d) {
   return out;
 }
 
-py::dict RunDesign(const CableRobot& model, const std::string& spec_path_or_text, bool is_text,
-                   const std::string& spec_source, const py::dict& o) {
+py::dict RunDesign(const CableRobot& model_argument, const std::string& spec_path_or_text,
+                   bool is_text, const std::string& spec_source, const py::dict& o) {
+  // A copy before the GIL is released (issue 29: another thread may change the model).
+  const CableRobot model = model_argument;
+  ValidateModel(model);
+  if (!is_text) RequireExistingFile(spec_path_or_text, "spec");
   CalibrationSpec spec;
   std::string error;
   const int anchors = static_cast<int>(model.anchor_points_cabin_m.size());

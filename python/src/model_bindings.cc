@@ -1,6 +1,7 @@
 // fastcal.Model: the cable robot's parameters (cable_robot.h), its YAML file, and each
 // field as a number or a numpy array (per cable: shape (6,), per point: (n, 3)).
 #include <array>
+#include <cmath>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,6 +11,20 @@
 
 namespace fastcal::python {
 namespace {
+
+// A setter of fastcal.Model: applies `set` to a copy, checks the copy as a model file is
+// checked (ValidateModel: the YAML reader's own checks), and only then keeps it, so that
+// no model is ever held that the reader would refuse (issue 29: a 30 kg cabin, a NaN
+// gain). A change that needs several fields at once is made on a copy (Model.copy()).
+template <typename Value, typename Set>
+auto Validated(Set set) {
+  return [set](CableRobot& robot, Value value) {
+    CableRobot changed = robot;
+    set(changed, value);
+    ValidateModel(changed);
+    robot = std::move(changed);
+  };
+}
 
 // A per-cable field of CableProperties as a (6,) array property, both ways.
 
@@ -52,9 +67,13 @@ void SetAttachments(CableRobot& r, const py::sequence& cables) {
   }
   std::array<std::vector<CableAttachment>, kNumCables> all;
   for (int i = 0; i < kNumCables; ++i) {
+    if (!py::isinstance<py::sequence>(cables[i]) || py::isinstance<py::str>(cables[i])) {
+      throw InputError("attachments[" + std::to_string(i) + "]: expected a list of dicts");
+    }
     const py::sequence on = py::reinterpret_borrow<py::sequence>(cables[i]);
     for (size_t j = 0; j < py::len(on); ++j) {
       const std::string where = "attachments[" + std::to_string(i) + "][" + std::to_string(j) + "]";
+      if (!py::isinstance<py::dict>(on[j])) throw InputError(where + ": expected a dict");
       const py::dict d = py::reinterpret_borrow<py::dict>(on[j]);
       CableAttachment a;
       const bool point = d.contains("at_m") || d.contains("mass_kg");
@@ -65,7 +84,7 @@ void SetAttachments(CableRobot& r, const py::sequence& cables) {
       }
       for (const auto& [key, value] : fields) {
         if (!d.contains(key)) throw InputError(where + "." + key + ": missing");
-        *value = d[key].cast<double>();
+        *value = NumberArgument(d[key], where + "." + key);
       }
       std::string why;
       if (!a.IsValid(&why)) throw InputError(where + "." + why);
@@ -88,12 +107,12 @@ void PerCableProperty(py::class_<CableRobot>& model, const char* name,
         for (int i = 0; i < kNumCables; ++i) out.mutable_data()[i] = r.cables[i].*field;
         return ReadOnly(out);
       },
-      [field, name](CableRobot& r, const DoubleArray& values) {
+      Validated<const DoubleArray&>([field, name](CableRobot& r, const DoubleArray& values) {
         if (values.ndim() != 1 || values.shape(0) != kNumCables) {
           throw InputError(std::string(name) + " must have shape (6,): one value per cable");
         }
         for (int i = 0; i < kNumCables; ++i) r.cables[i].*field = values.data()[i];
-      },
+      }),
       doc);
 }
 
@@ -116,6 +135,17 @@ CableRobot Load(const std::string& path) {
   return robot;
 }
 
+// The file Model.load reads back: a model the reader would refuse is not written.
+void Save(const CableRobot& r, const std::string& path, const std::string& header_comment) {
+  CheckPath(path, "model");
+  ValidateModel(r);
+  std::string error;
+  if (!SaveCableRobot(r, path, header_comment, &error)) throw InputError(error);
+}
+
+double GetCabinMass(const CableRobot& r) { return r.cabin_mass_kg; }
+double GetGravity(const CableRobot& r) { return r.gravity_m_per_s2; }
+
 // Model's array and dict properties: numpy arrays and a dict in, copies out.
 
 py::object GetReflector(const CableRobot& r) {
@@ -132,6 +162,9 @@ void SetReflector(CableRobot& r, const py::object& v) {
     r.reflector.reset();
     return;
   }
+  if (!py::isinstance<py::dict>(v)) {
+    throw InputError("reflector: expected None or a dict {centre_m, radius_m, aperture_m}");
+  }
   const py::dict d = v.cast<py::dict>();
   Reflector reflector;
   for (const auto& [key, value] : d) {
@@ -139,9 +172,9 @@ void SetReflector(CableRobot& r, const py::object& v) {
     if (name == "centre_m") {
       reflector.centre_m = ToVector3(value.cast<DoubleArray>(), "reflector centre_m");
     } else if (name == "radius_m") {
-      reflector.radius_m = value.cast<double>();
+      reflector.radius_m = NumberArgument(value, "reflector radius_m");
     } else if (name == "aperture_m") {
-      reflector.aperture_m = value.cast<double>();
+      reflector.aperture_m = NumberArgument(value, "reflector aperture_m");
     } else {
       throw InputError("reflector: unknown key '" + name +
                        "' (accepted: centre_m, radius_m, aperture_m)");
@@ -190,11 +223,18 @@ py::array_t<int> GetAnchorIndex(const CableRobot& r) {
   return ReadOnly(out);
 }
 
-void SetAnchorIndex(CableRobot& r, const py::array_t<int, py::array::forcecast>& v) {
+// Whole numbers only: 1.5 is refused, not truncated to 1.
+void SetAnchorIndex(CableRobot& r, const DoubleArray& v) {
   if (v.ndim() != 1 || v.shape(0) != kNumCables) {
     throw InputError("anchor_index must have shape (6,)");
   }
-  for (int i = 0; i < kNumCables; ++i) r.cables[i].anchor_index = v.data()[i];
+  for (int i = 0; i < kNumCables; ++i) {
+    const double index = v.data()[i];
+    if (!(index >= 0.0 && index < 1e6 && index == std::floor(index))) {
+      throw InputError("anchor_index[" + std::to_string(i) + "]: expected a whole number >= 0");
+    }
+    r.cables[i].anchor_index = static_cast<int>(index);
+  }
 }
 
 }  // namespace
@@ -213,50 +253,50 @@ ValueError ("assignment destination is read-only") instead of changing nothing.
   model.def_static("nominal", &CableRobot::NominalFast, "The nominal FAST model (paper Table 1).")
       .def_static("load", &Load, py::arg("path"),
                   "Reads a model file. fastcal.InputError names the file, line and key.")
-      .def(
-          "save",
-          [](const CableRobot& r, const std::string& path, const std::string& header_comment) {
-            std::string error;
-            if (!SaveCableRobot(r, path, header_comment, &error)) throw InputError(error);
-          },
-          py::arg("path"), py::arg("header_comment") = "",
-          "Writes the model file (atomically: a failure leaves no partial file).")
+      .def("save", &Save, py::arg("path"), py::arg("header_comment") = "",
+           "Writes the model file (atomically: a failure leaves no partial file). Refuses, "
+           "with fastcal.InputError, a model Model.load would refuse.")
       .def("to_yaml", &CableRobotToYaml, py::arg("header_comment") = "", "The model file's text.")
       .def(
-          "validate",
-          [](const CableRobot& r) {
-            std::string error;
-            if (!r.IsValid(&error)) throw InputError(error);
-          },
-          "Raises fastcal.InputError naming the key of a non-physical value.")
+          "validate", [](const CableRobot& r) { ValidateModel(r); },
+          "Raises fastcal.InputError naming the attribute of a value a model file could not "
+          "hold (the reader's checks; every setter runs them too).")
       .def(
           "copy", [](const CableRobot& r) { return CableRobot(r); }, "An independent copy.")
-      .def_readwrite("cabin_mass_kg", &CableRobot::cabin_mass_kg)
-      .def_readwrite("gravity_m_per_s2", &CableRobot::gravity_m_per_s2,
-                     "Gravitational acceleration along z (negative: z is up).")
+      .def_property("cabin_mass_kg", &GetCabinMass,
+                    Validated<const py::object&>([](CableRobot& r, const py::object& v) {
+                      r.cabin_mass_kg = NumberArgument(v, "cabin_mass_kg");
+                    }),
+                    "Cabin mass (kg).")
+      .def_property("gravity_m_per_s2", &GetGravity,
+                    Validated<const py::object&>([](CableRobot& r, const py::object& v) {
+                      r.gravity_m_per_s2 = NumberArgument(v, "gravity_m_per_s2");
+                    }),
+                    "Gravitational acceleration along z (negative: z is up).")
       .def_property(
           "mass_centre_cabin_m",
           [](const CableRobot& r) { return ReadOnly(Vector3(r.mass_centre_cabin_m)); },
-          [](CableRobot& r, const DoubleArray& v) {
+          Validated<const DoubleArray&>([](CableRobot& r, const DoubleArray& v) {
             r.mass_centre_cabin_m = ToVector3(v, "mass_centre_cabin_m");
-          },
+          }),
           "Mass centre of the cabin in the cabin frame, shape (3,).")
-      .def_property("reflector", &GetReflector, &SetReflector,
+      .def_property("reflector", &GetReflector, Validated<const py::object&>(&SetReflector),
                     "The reflector cables are checked against: None, or a dict {centre_m (3,), "
                     "radius_m, aperture_m} (a sphere's lower cap; docs/model-format.md). Assign a "
                     "whole dict; keys left out keep FAST's values.")
-      .def_property("anchor_points_cabin_m", &GetAnchorPoints, &SetAnchorPoints,
+      .def_property("anchor_points_cabin_m", &GetAnchorPoints,
+                    Validated<const DoubleArray&>(&SetAnchorPoints),
                     "Cabin anchor points in the cabin frame, shape (n, 3).")
-      .def_property("attachments", &GetAttachments, &SetAttachments,
+      .def_property("attachments", &GetAttachments, Validated<const py::sequence&>(&SetAttachments),
                     "What each cable carries (docs/model-format.md): a list of 6 lists (cable "
                     "1 first) of dicts, {at_m, mass_kg} for a point mass, {from_m, to_m, "
                     "added_density_kg_per_m} for added weight; arc lengths in m from the lower "
                     "(cabin) end, unstretched. Assign a whole list; fastcal.InputError names a "
                     "bad entry.")
-      .def_property("tower_top_m", &GetTowerTops, &SetTowerTops,
+      .def_property("tower_top_m", &GetTowerTops, Validated<const DoubleArray&>(&SetTowerTops),
                     "Upper end of each cable (tower top), global frame, shape (6, 3).")
       .def_property(
-          "anchor_index", &GetAnchorIndex, &SetAnchorIndex,
+          "anchor_index", &GetAnchorIndex, Validated<const DoubleArray&>(&SetAnchorIndex),
           "Index into anchor_points_cabin_m of each cable's cabin point (0-based), shape (6,).")
       .def("__repr__", [](const CableRobot& r) {
         return "<fastcal.Model: cabin " + std::to_string(r.cabin_mass_kg) + " kg, " +
@@ -279,12 +319,12 @@ ValueError ("assignment destination is read-only") instead of changing nothing.
         }
         return ReadOnly(out);
       },
-      [](CableRobot& r, const DoubleArray& values) {
+      Validated<const DoubleArray&>([](CableRobot& r, const DoubleArray& values) {
         if (values.ndim() != 1 || values.shape(0) != kNumCables) {
           throw InputError("sensor_bias_kN must have shape (6,): one value per cable");
         }
         for (int i = 0; i < kNumCables; ++i) r.cables[i].sensor_bias_n = values.data()[i] * kNPerKn;
-      },
+      }),
       "Tension sensor bias per cable (kN, as every tension), shape (6,).");
   // The old name, in N, is refused with the new one rather than kept: two units for one
   // quantity is what the rename removes.

@@ -2,8 +2,11 @@
 #include <pybind11/pybind11.h>
 
 #include <cerrno>
+#include <regex>
+#include <utility>
 
 #include "bindings.h"
+#include "fastcal/model_plausibility.h"
 #include "fastcal/version.h"
 
 namespace fastcal::python {
@@ -61,6 +64,49 @@ std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::str
 
 namespace {
 
+// A model check's key paths (the model file's: "cabin.mass_kg", "cables[2].ea_n") as the
+// attributes of fastcal.Model ("cabin_mass_kg", "ea_n[2]").
+std::string AsPythonAttributes(std::string message) {
+  static const std::pair<std::regex, const char*> kRenames[] = {
+      {std::regex(R"(cabin\.mass_kg)"), "cabin_mass_kg"},
+      {std::regex(R"(cabin\.mass_centre_m\.x)"), "mass_centre_cabin_m[0]"},
+      {std::regex(R"(cabin\.mass_centre_m\.y)"), "mass_centre_cabin_m[1]"},
+      {std::regex(R"(cabin\.mass_centre_m\.z)"), "mass_centre_cabin_m[2]"},
+      {std::regex(R"(cabin\.anchor_points_m\[(\d+)\]\.x)"), "anchor_points_cabin_m[$1, 0]"},
+      {std::regex(R"(cabin\.anchor_points_m\[(\d+)\]\.y)"), "anchor_points_cabin_m[$1, 1]"},
+      {std::regex(R"(cabin\.anchor_points_m\[(\d+)\]\.z)"), "anchor_points_cabin_m[$1, 2]"},
+      {std::regex(
+           R"(cables\[(\d+)\]\.(ea_n|linear_density_kg_per_m|sensor_gain|sensor_bias_kN|tower_top_m))"),
+       "$2[$1]"},
+      {std::regex(R"(cables\[(\d+)\]\.anchor\b)"), "anchor_index[$1]"},
+      {std::regex(R"(cables\[(\d+)\]\.attachments)"), "attachments[$1]"}};
+  const size_t colon = message.find(": ");
+  std::string key = message.substr(0, colon);
+  for (const auto& [pattern, replacement] : kRenames)
+    key = std::regex_replace(key, pattern, replacement);
+  return colon == std::string::npos ? key : key + message.substr(colon);
+}
+
+}  // namespace
+
+double NumberArgument(py::handle value, const std::string& what) {
+  if (!py::isinstance<py::bool_>(value)) {
+    try {
+      return value.cast<double>();
+    } catch (const py::cast_error&) {
+    }
+  }
+  throw InputError(what + ": expected a number, got " +
+                   std::string(py::str(value.get_type().attr("__name__"))));
+}
+
+void ValidateModel(const CableRobot& robot) {
+  std::string why;
+  if (!CheckModel(robot, &why)) throw InputError("model: " + AsPythonAttributes(why));
+}
+
+namespace {
+
 // fastcal.Error and its two kinds; each also derives from the built-in exception a Python
 // user would catch for it.
 void RegisterExceptions(py::module_& m) {
@@ -91,6 +137,9 @@ void RegisterExceptions(py::module_& m) {
       py::object instance = py::handle(calibration_error)(e.what());
       instance.attr("status") = e.status;
       PyErr_SetObject(calibration_error, instance.ptr());
+    } catch (const py::cast_error& e) {
+      // An argument of the wrong kind that no check above named: still bad input.
+      PyErr_SetString(input_error, e.what());
     }
   });
 }

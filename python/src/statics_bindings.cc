@@ -45,9 +45,13 @@ struct SolveOutputs {
   py::dict failures;  // pose index -> DescribeStatus, for the failed poses only
 };
 
-py::dict Solve(const CableRobot& robot, const DoubleArray& positions_m,
+py::dict Solve(const CableRobot& model, const DoubleArray& positions_m,
                const std::string& attitude_kind, const DoubleArray& attitude,
                const std::string& method, const py::dict& settings) {
+  // A copy, taken with the GIL held: the loop below runs without it, while another
+  // thread may assign to the model's fields (issue 29: a crash in the statics).
+  const CableRobot robot = model;
+  ValidateModel(robot);
   const StaticsOptions options = MakeStaticsOptions(method, settings);
   const std::vector<Pose> poses = PosesFromArrays(positions_m, attitude_kind, attitude);
   const auto n = static_cast<py::ssize_t>(poses.size());

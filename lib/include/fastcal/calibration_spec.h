@@ -129,7 +129,7 @@ struct CalibrationSpec {
   double parameter_tolerance = 1e-12;
   // Threads of every pass over the samples (the fit, the linearisation, the RMS table):
   // the results are the same bits on any number (calibration.md, "At 10^5 and 10^6
-  // samples").
+  // samples"). 1 to kMaxCalibrationThreads.
   int num_threads = 2;
   // Joint fit of several sessions (`sessions: {separate: [...]}`, sessions.h): the free
   // parameters of these groups ("mass_centre_m", ParameterGroupName) get one value per
@@ -153,6 +153,9 @@ struct CalibrationSpec {
 
 // Largest spec file LoadCalibrationSpec reads: a spec is a few KiB.
 inline constexpr long long kMaxSpecFileBytes = 16LL << 20;  // 16 MiB
+// Most threads a spec may ask for (solver.threads): a pass over the samples uses one per
+// 1024 samples at most, and a thread costs memory; 100000 is a slip.
+inline constexpr int kMaxCalibrationThreads = 256;
 
 // Parses a spec for `model`. Errors name the file, the line and the key; unknown keys and
 // unknown parameter names are errors. The model's anchor points bound anchor_offset_m[j],

@@ -138,6 +138,10 @@ bool ParseDataset(const std::string& text, const std::string& source_name,
 // whole file (no header, no data rows, every row skipped, angles that look like radians)
 // are made after the last row, by the Next that sets *done. Concatenating the chunks'
 // samples and skipped rows gives ReadDataset's.
+// Longest line DatasetChunkReader reads (a dataset's rows and header are under 1 KiB): a
+// longer one is refused as soon as it is seen, with memory and time bounded by it.
+inline constexpr size_t kMaxDatasetLineBytes = size_t{1} << 20;  // 1 MiB
+
 class DatasetChunkReader {
  public:
   DatasetChunkReader();
@@ -182,6 +186,7 @@ bool WriteDataset(const std::string& path, const Dataset& dataset,
 // groups (its flags; its samples are not read); Write appends one sample's row, refusing
 // what WriteDataset refuses; Close flushes, syncs and closes, and refuses a file of no
 // rows. Not atomic: write to a temporary name and rename (and remove it on failure).
+// The open file holds an flock(2) (internal/atomic_file.h: a temporary in use).
 class DatasetWriter {
  public:
   DatasetWriter() = default;
@@ -197,6 +202,9 @@ class DatasetWriter {
   // with labels (a session column) and begins with them. For streamed copies.
   void UpdateSessionLabels(const std::vector<std::string>& labels);
   bool Close(std::string* error);
+  // Whether a failure was the file's (a write, flush, sync or close: a full disk), not a
+  // sample's value.
+  bool io_failed() const { return io_failed_; }
 
  private:
   bool Flush(std::string* error);
@@ -206,6 +214,7 @@ class DatasetWriter {
   std::vector<int> columns_;
   std::string buffer_;
   size_t rows_ = 0;
+  bool io_failed_ = false;
   std::FILE* file_ = nullptr;
 };
 

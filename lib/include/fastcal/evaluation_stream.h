@@ -8,7 +8,8 @@
 // accumulates the per-cable statistics (ErrorStatsAccumulator) and appends one fixed-size
 // binary record per sample (line, time, session, position, measured and predicted
 // readings: 8 (12 + 6 V) bytes for V variants, 144 or 192 bytes) to an unnamed temporary
-// file (std::tmpfile: on disk, deleted when closed), which the later passes read back.
+// file (in options.temporary_directory, $TMPDIR or /tmp: on disk, deleted when closed),
+// which the later passes read back.
 //
 // The robust centre and scale of the screen (gross_errors.h: median and 1.4826 MAD of
 // each cable's whitened residuals) are exact: each median is found by selection passes
@@ -63,6 +64,9 @@ struct EvaluationStreamOptions {
   // Gross errors named in screen.gross_errors, the first in file order; the counts
   // (screen.count, count_per_cable) are exact however many there are.
   size_t max_named_gross_errors = 10000;
+  // Where the temporary file goes (unnamed: O_TMPFILE, or made and unlinked at once);
+  // empty: $TMPDIR when set, else /tmp.
+  std::string temporary_directory;
 };
 
 enum class EvaluationStreamStatus {
@@ -70,6 +74,8 @@ enum class EvaluationStreamStatus {
   kInvalidInput,  // the file: unreadable, a bad header or row (ReadDataset's messages)
   kUnsolvable,    // a pose the model cannot hold (without skip_invalid_rows), or every
                   // sample skipped, or the model likely wrong (see `diagnosis`)
+  kSystemError,   // the machine: the temporary file could not be made, written or read
+                  // back (a full disk); the message names its directory
 };
 
 class StreamedEvaluation {
@@ -140,6 +146,8 @@ class StreamedEvaluation {
   bool Screen(const EvaluationStreamOptions& options, std::string* error);
   bool Trajectory(std::string* error);
   bool GrossErrorRows(const EvaluationStreamOptions& options, std::string* error);
+  // "evaluation: cannot <what> its temporary file in <dir> (...): <strerror(err)>".
+  std::string SpillError(const std::string& what, int err) const;
 
   Dataset layout_;
   Dataset merged_;  // path, column groups and sessions of the data (no samples)
@@ -155,6 +163,7 @@ class StreamedEvaluation {
   double sigma_abs_n_ = 0.0, sigma_percent_ = 0.0;  // the screen's noise model
   std::array<long long, kNumCables> finite_{};      // finite whitened residuals per cable
   std::FILE* spill_ = nullptr;
+  std::string spill_directory_;
 };
 
 }  // namespace fastcal

@@ -25,6 +25,11 @@ namespace fastcal {
 bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limits,
                          std::string* why);
 
+// The checks a model file passes, in the reader's order: CableRobot::IsValid (physical
+// sense, its key paths) then CheckModelPlausible with the default limits. The one
+// validation of a model: the YAML reader and the Python setters both call it.
+bool CheckModel(const CableRobot& robot, std::string* why);
+
 // The plausibility.h quantity of a calibration parameter kind's values; false for a kind
 // without one.
 bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity);

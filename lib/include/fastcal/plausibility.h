@@ -73,12 +73,36 @@ struct PlausibilityLimits {
   // readings would carry no information.
   double max_tension_sigma_n = 5.0e4;
   double max_tension_sigma_percent = 50.0;
+  // Smallest non-zero part (0 is none): 1 N, or 0.001% (2 N of a working tension),
+  // finer than any tension sensor resolves; below them the weights overflow.
+  double min_tension_sigma_n = 1.0;
+  double min_tension_sigma_percent = 1e-3;
   // A cable's attachments (cable_attachment.h): FAST's sensor assemblies weigh 250-650 kg
   // and its hung lines 0.6-1.6 kg/m; 5 t on one cable, 50 kg/m (four times the cable) or
   // a position 2 km up a ~300 m cable is a slip.
   double max_attachment_mass_kg = 5000.0;
   double max_attachment_density_kg_per_m = 50.0;
   double max_attachment_position_m = 2000.0;
+
+  // The model's world (issue 29: these were accepted, then blamed on the solver).
+  // |gravity| in m/s^2: Earth's surface gravity is 9.78 to 9.83 (FAST: about 9.79).
+  double min_abs_gravity_m_per_s2 = 9.7;
+  double max_abs_gravity_m_per_s2 = 9.9;
+  // The model's reflector sphere, m (FAST: radius 300, aperture 500, centre (0, 0, 300)):
+  // a radius within these, an aperture of at least min_reflector_aperture_m, and a centre
+  // within max_reflector_offset_m of (0, 0, radius) per axis (the global origin is the
+  // reflector's lowest point).
+  double min_reflector_radius_m = 100.0;
+  double max_reflector_radius_m = 1000.0;
+  double min_reflector_aperture_m = 100.0;
+  double max_reflector_offset_m = 50.0;
+  // Tower tops: at least this far from the z axis, m (FAST: 300), at least this high
+  // (FAST: 270; the cabin works at 140 to 160 m and hangs from above), and around the
+  // axis with no gap wider than max_tower_gap_deg between neighbours seen from it (FAST:
+  // 60 deg); a wider gap leaves a side the cables cannot pull toward.
+  double min_tower_radius_m = 100.0;
+  double min_tower_top_z_m = 150.0;
+  double max_tower_gap_deg = 150.0;
 
   // False, naming the field, when a limit is not finite or not > 0.
   bool IsValid(std::string* error) const;
@@ -112,6 +136,9 @@ enum class ModelQuantity {
   kAttachmentMassKg,
   kAttachmentDensityKgPerM,
   kAttachmentPositionM,  // at_m, from_m, to_m
+  kGravityMPerS2,        // negative: z is up
+  kReflectorRadiusM,
+  kReflectorApertureM,
 };
 
 // A quantity's plausible range and its nominal FAST value, SI (percent for

@@ -389,7 +389,7 @@ CalibrationStatus CheckIdentifiability(Run& run) {
 ceres::Solver::Options SolverOptions(const Run& run, ProgressCallback* callback) {
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
-  so.num_threads = run.spec.num_threads;
+  so.num_threads = internal::MachineThreads(run.spec.num_threads);
   so.max_num_iterations = run.spec.max_iterations;
   so.function_tolerance = run.spec.function_tolerance;
   so.gradient_tolerance = run.spec.gradient_tolerance;

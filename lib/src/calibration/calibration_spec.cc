@@ -164,27 +164,51 @@ std::string CheckPriorMean(ParameterKind kind, double mean) {
 
 // A prior's sigma: > 0, and not wider than the parameter's plausible range (a sigma of
 // 2000 on sensor_bias_kN is 2000 N written as kN).
+//
+// Nor narrower than kTightestPriorFraction of that range (issue 29: a sigma of 1e-200
+// made the fit's weights infinite, NaN in the fit and Ceres' dumps on stderr): a prior
+// that tight is the parameter held fixed, which the spec says with free: false.
 std::string CheckPriorSigma(ParameterKind kind, double sigma_si) {
+  constexpr double kTightestPriorFraction = 1e-9;
   if (!(std::isfinite(sigma_si) && sigma_si > 0.0)) return "must be > 0";
   ModelQuantity quantity;
   if (!QuantityOfParameter(kind, &quantity)) return "";
   const QuantityRange range = PlausibleRange(quantity, PlausibilityLimits());
   const double width = range.max - range.min;
-  if (sigma_si <= width) return "";
   const std::string unit = range.file_unit;
   auto shown = [&](double v) {
     return internal::FormatDouble("%.6g", v / range.si_per_file_unit) +
            (unit.empty() ? "" : " " + unit);
   };
+  if (sigma_si < kTightestPriorFraction * width) {
+    return shown(sigma_si) + " is below " + shown(kTightestPriorFraction * width) +
+           " (1e-9 of the parameter's plausible range): a prior this tight holds the "
+           "parameter fixed; say so with free: false (and initial: its value)";
+  }
+  if (sigma_si <= width) return "";
   return shown(sigma_si) + " is wider than the whole plausible range of the parameter (" +
          shown(range.min) + " to " + shown(range.max) + ")";
 }
 
 // The noise's sigmas: >= 0 and plausible (a tension sigma of 3000 kN is 3000 N).
+// A part that is not 0 (none) must be at least what a sensor could resolve (issue 29: a
+// tension sigma of 1e-160 kN made the weights infinite and the fit NaN).
 std::string CheckNoiseSigma(ModelQuantity quantity, double value_si) {
   if (!(std::isfinite(value_si) && value_si >= 0.0)) return "must be >= 0";
+  const PlausibilityLimits limits;
+  const bool absolute = quantity == ModelQuantity::kTensionSigmaN;
+  const double floor = absolute ? limits.min_tension_sigma_n : limits.min_tension_sigma_percent;
+  if (value_si > 0.0 && value_si < floor) {
+    return absolute
+               ? internal::FormatDouble("%.6g kN", value_si / kNewtonsPerKilonewton) +
+                     " is below " + internal::FormatDouble("%g kN", floor / kNewtonsPerKilonewton) +
+                     ", finer than any tension sensor resolves (0 means no absolute part)"
+               : internal::FormatDouble("%.6g %%", value_si) + " is below " +
+                     internal::FormatDouble("%g %%", floor) +
+                     ", finer than any tension sensor resolves (0 means no relative part)";
+  }
   std::string why;
-  return CheckQuantity(quantity, value_si, PlausibilityLimits(), &why) ? "" : why;
+  return CheckQuantity(quantity, value_si, limits, &why) ? "" : why;
 }
 
 // A slow error's time constant: > 0 and shorter than a year (a longer memory is a
@@ -208,6 +232,13 @@ std::string CheckHoldoutFraction(double fraction) {
 }
 
 std::string CheckAtLeastOne(int value) { return value >= 1 ? "" : "must be >= 1"; }
+
+std::string CheckThreads(int value) {
+  return value >= 1 && value <= kMaxCalibrationThreads
+             ? ""
+             : "must be 1 to " + std::to_string(kMaxCalibrationThreads) + ", got " +
+                   std::to_string(value);
+}
 
 std::string CheckAtLeastTwo(int value) { return value >= 2 ? "" : "must be >= 2"; }
 
@@ -482,18 +513,21 @@ class Reader {
     }
     for (const char* special : {".nan", ".NaN", ".NAN", ".inf", ".Inf", ".INF", "+.inf", "+.Inf",
                                 "+.INF", "-.inf", "-.Inf", "-.INF"}) {
-      if (text == special) return Fail(kv.line, path, "must be finite, got " + text);
+      if (text == special)
+        return Fail(kv.line, path, "must be finite, got " + internal::Quote(text));
     }
     const char* begin = text.data();
     const char* end = text.data() + text.size();
     if (begin != end && *begin == '+') ++begin;  // YAML allows it, from_chars does not
     double parsed = 0.0;
     const auto [ptr, ec] = std::from_chars(begin, end, parsed);
-    if (ec == std::errc::result_out_of_range) return Fail(kv.line, path, "out of range: " + text);
+    if (ec == std::errc::result_out_of_range)
+      return Fail(kv.line, path, "out of range: " + internal::Quote(text));
     if (ec != std::errc() || ptr != end || begin == end) {
       return Fail(kv.line, path, "expected a number, got " + internal::Quote(text));
     }
-    if (!std::isfinite(parsed)) return Fail(kv.line, path, "must be finite, got " + text);
+    if (!std::isfinite(parsed))
+      return Fail(kv.line, path, "must be finite, got " + internal::Quote(text));
     *value = parsed;
     return true;
   }
@@ -795,12 +829,13 @@ class Reader {
                  &keys)) {
       return false;
     }
-    const std::pair<const char*, int*> kInts[] = {{"max_iterations", &spec->max_iterations},
-                                                  {"threads", &spec->num_threads}};
-    for (const auto& [name, field] : kInts) {
+    const std::tuple<const char*, int*, std::string (*)(int)> kInts[] = {
+        {"max_iterations", &spec->max_iterations, &CheckAtLeastOne},
+        {"threads", &spec->num_threads, &CheckThreads}};
+    for (const auto& [name, field, check] : kInts) {
       const std::string path = Join("solver", name);
       if (const KeyValue* kv = Find(keys, name)) {
-        if (!ReadInteger(*kv, path, field) || !Check(CheckAtLeastOne(*field), kv->line, path)) {
+        if (!ReadInteger(*kv, path, field) || !Check(check(*field), kv->line, path)) {
           return false;
         }
       }
@@ -1171,7 +1206,7 @@ std::string OptionsProblem(const CalibrationSpec& s) {
       {"gross_error_threshold_sigmas", CheckPositive(s.gross_error_threshold_sigmas)},
       {"max_gross_error_fraction", CheckFraction(s.max_gross_error_fraction)},
       {"max_iterations", CheckAtLeastOne(s.max_iterations)},
-      {"num_threads", CheckAtLeastOne(s.num_threads)},
+      {"num_threads", CheckThreads(s.num_threads)},
       {"function_tolerance", CheckPositive(s.function_tolerance)},
       {"gradient_tolerance", CheckPositive(s.gradient_tolerance)},
       {"parameter_tolerance", CheckPositive(s.parameter_tolerance)},

@@ -4,11 +4,14 @@
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <limits>
 
 #include "fastcal/gross_errors.h"
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/quote.h"
 #include "fastcal/sessions.h"
 
 namespace fastcal {
@@ -92,6 +95,14 @@ bool StreamedEvaluation::ReadRecord(std::FILE* file, EvaluatedSample* s) const {
   return true;
 }
 
+std::string StreamedEvaluation::SpillError(const std::string& what, int err) const {
+  return "evaluation: cannot " + what + " its temporary file in " +
+         internal::Escape(spill_directory_) + " (about " +
+         std::to_string(8 * (12 + kNumCables * (1 + std::max(predicted_variants_, 1)))) +
+         " bytes a sample; TMPDIR names another directory): " +
+         (err != 0 ? std::strerror(err) : "read or write error");
+}
+
 bool StreamedEvaluation::ForEach(const std::function<void(const EvaluatedSample&)>& visit,
                                  std::string* error) const {
   if (spill_ == nullptr || samples_ == 0) return true;
@@ -100,8 +111,7 @@ bool StreamedEvaluation::ForEach(const std::function<void(const EvaluatedSample&
   const bool screened = screen_.threshold.readings > 0;
   for (long long t = 0; t < samples_; ++t) {
     if (!ReadRecord(spill_, &s)) {
-      *error =
-          "evaluation: cannot read back the temporary file: " + std::string(std::strerror(errno));
+      *error = SpillError("read back", errno);
       return false;
     }
     s.index = t;
@@ -212,10 +222,16 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
   sigma_abs_n_ = options.spec.tension_sigma_n;
   sigma_percent_ = options.spec.tension_sigma_percent;
   if (!Prepare(paths, options, error)) return EvaluationStreamStatus::kInvalidInput;
-  spill_ = std::tmpfile();
+  spill_directory_ = options.temporary_directory;
+  if (spill_directory_.empty()) {
+    const char* tmpdir = std::getenv("TMPDIR");
+    spill_directory_ = tmpdir != nullptr && *tmpdir != '\0' ? tmpdir : "/tmp";
+  }
+  int err = 0;
+  spill_ = internal::OpenUnnamedFile(spill_directory_, &err);
   if (spill_ == nullptr) {
-    *error = "evaluation: cannot create a temporary file: " + std::string(std::strerror(errno));
-    return EvaluationStreamStatus::kInvalidInput;
+    *error = SpillError("create", err);
+    return EvaluationStreamStatus::kSystemError;
   }
   Pass1 p;
   bool unsolvable = false, write_failed = false;
@@ -225,7 +241,8 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
     return false;
   };
   if (!Chunks(paths, options, pass1, error) || write_failed) {
-    return EvaluationStreamStatus::kInvalidInput;
+    return write_failed ? EvaluationStreamStatus::kSystemError
+                        : EvaluationStreamStatus::kInvalidInput;
   }
   if (unsolvable) return Failure(robot, paths, options, error);
   layout_.path = merged_.path;
@@ -237,8 +254,8 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
   layout_.time_offset_s = merged_.time_offset_s;
   for (std::string& why : p.unsolvable) layout_.skipped.push_back(std::move(why));
   if (std::fflush(spill_) != 0) {
-    *error = "evaluation: cannot write the temporary file: " + std::string(std::strerror(errno));
-    return EvaluationStreamStatus::kInvalidInput;
+    *error = SpillError("write", errno);
+    return EvaluationStreamStatus::kSystemError;
   }
   for (size_t v = 0; v < p.stats.size(); ++v) {
     VariantEvaluation e;
@@ -248,8 +265,9 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
   }
   finite_ = p.finite;
   if (samples_ == 0) return EvaluationStreamStatus::kOk;  // the caller says no sample is left
+  // These only read the temporary file back.
   if (!Screen(options, error) || !Trajectory(error) || !GrossErrorRows(options, error)) {
-    return EvaluationStreamStatus::kInvalidInput;
+    return EvaluationStreamStatus::kSystemError;
   }
   return EvaluationStreamStatus::kOk;
 }
@@ -311,7 +329,7 @@ bool StreamedEvaluation::Append(const Sample& s,
   const std::array<double, kNumCables> w = Whitened(predicted.back(), s.tension_n);
   for (int i = 0; i < kNumCables; ++i) p->finite[i] += std::isfinite(w[i]);
   if (std::fwrite(r.data(), sizeof(double), r.size(), spill_) != r.size()) {
-    *error = "evaluation: cannot write the temporary file: " + std::string(std::strerror(errno));
+    *error = SpillError("write", errno);
     return false;
   }
   return true;

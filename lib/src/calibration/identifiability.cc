@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "fastcal/internal/calibration_linearisation.h"
+#include "fastcal/internal/sample_chunks.h"
 
 namespace fastcal::internal {
 namespace {
@@ -130,7 +131,7 @@ Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>
 // R factor of the whitened Jacobian (data and prior rows) at the current parameters.
 bool JacobianR(ceres::Problem* problem, int num_threads, Eigen::MatrixXd* r) {
   ceres::Problem::EvaluateOptions eo;
-  eo.num_threads = num_threads;
+  eo.num_threads = MachineThreads(num_threads);
   ceres::CRSMatrix j;
   if (!problem->Evaluate(eo, nullptr, nullptr, nullptr, &j)) return false;
   *r = RFactor(j);

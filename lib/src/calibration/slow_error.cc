@@ -68,7 +68,7 @@ std::string DescribeSlowError(const SlowErrorReport& r) {
   if (!r.enabled) return "";
   const bool estimated = r.amplitude_estimated || r.time_constant_estimated;
   std::string text = std::string("slow sensor error (") + (estimated ? "estimated" : "stated") +
-                     ", each cable's reading a Gauss-Markov process): ";
+                     ", a Gauss-Markov process per cable): ";
   if (r.amplitude_estimated && r.amplitude_at_floor) {
     return text + "none found in the residuals (amplitude at its floor, below " +
            Num("%.2g", internal::kMinSlowErrorRatio * 100.0) +
@@ -85,7 +85,7 @@ std::string DescribeSlowError(const SlowErrorReport& r) {
         "survey)";
   }
   text += "; likelihood ratio against white noise " + Num("%.3g", r.likelihood_ratio_vs_white) +
-          "; the fit is generalised least squares on readings whitened by it";
+          "; the fit whitens the readings by it (generalised least squares)";
   return text;
 }
 

@@ -3,6 +3,7 @@
 #include "fastcal/dataset.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <Eigen/Geometry>
@@ -235,9 +236,9 @@ bool CheckColumnGroups(const std::string& where, const char* missing, Header* he
     if (!require(c)) return false;
   }
   bool ok = true;
-  const bool rpy = GroupPresent(*header, kRoll, 3, where,
-                                "the measured attitude as angles needs all three", missing, &ok,
-                                error);
+  const bool rpy =
+      GroupPresent(*header, kRoll, 3, where, "the measured attitude as angles needs all three",
+                   missing, &ok, error);
   if (!ok) return false;
   const bool quaternion =
       GroupPresent(*header, kQw, 4, where, "the measured attitude as a quaternion needs all four",
@@ -257,9 +258,9 @@ bool CheckColumnGroups(const std::string& where, const char* missing, Header* he
   for (int i = 0; i < kNumCables; ++i) {
     if (!require(kTension1 + i)) return false;
   }
-  header->planned = GroupPresent(*header, kPlannedRoll, 3, where,
-                                 "the planned attitude needs all three or none", missing, &ok,
-                                 error);
+  header->planned =
+      GroupPresent(*header, kPlannedRoll, 3, where, "the planned attitude needs all three or none",
+                   missing, &ok, error);
   if (!ok) return false;
   header->unstretched =
       GroupPresent(*header, kUnstretched1, kNumCables, where,
@@ -272,7 +273,8 @@ bool CheckColumnGroups(const std::string& where, const char* missing, Header* he
 bool ParseMappedHeader(std::string_view line, const std::string& where, const std::string& path,
                        Header* header, std::string* error) {
   const ColumnMap& map = *header->map;
-  header->delimiter = map.delimiter != 0 ? map.delimiter : internal::DetectDelimiter(line, map.decimal);
+  header->delimiter =
+      map.delimiter != 0 ? map.delimiter : internal::DetectDelimiter(line, map.decimal);
   std::vector<std::string_view> fields;
   std::deque<std::string> scratch;
   std::string why;
@@ -283,7 +285,8 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
   // Trailing delimiters (a spreadsheet's empty cells at the end): no columns.
   while (fields.size() > 1 && fields.back().empty()) fields.pop_back();
   if (!map.has_time) {
-    *error = map.path + ": time: missing: a dataset needs the time of each row (time: {column: "
+    *error = map.path +
+             ": time: missing: a dataset needs the time of each row (time: {column: "
              "NAME, format: seconds | unix_s | unix_ms | iso8601, zone: ...})";
     return false;
   }
@@ -549,6 +552,9 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     if (!CheckValue(column, value[column], limits, &why)) return fail(why);
     if (IsTension(column)) value[column] = ScaleByKilo(fields[f], value[column]);
   }
+  // "-0" is the reading 0, and the writer writes it so: a written and re-read dataset then
+  // holds the same bits (the fuzzer's round trip), and -0 never reaches a sign test.
+  for (double& v : value) v += 0.0;
   {
     const Eigen::Vector3d position(value[kX], value[kY], value[kZ]);
     std::string why;
@@ -703,8 +709,8 @@ class LineParser {
       line = Trim(line);
       if (!line.empty() && line.front() == '#') line.remove_prefix(1);  // "#time,x,..."
       if (Trim(line).empty()) {
-        *error = where() + "the header line (header_line: " + std::to_string(header_line) +
-                 " in " + header_.map->path + ") is empty";
+        *error = where() + "the header line (header_line: " + std::to_string(header_line) + " in " +
+                 header_.map->path + ") is empty";
         return false;
       }
     } else if (Blank(line) || line_number <= skip_until_) {
@@ -790,8 +796,8 @@ class LineParser {
     if (!have_header_) {
       *error = source_name + ": no header line (and no data rows)";
       if (header_.map != nullptr && header_.map->header_line > 0) {
-        *error += ": the column map " + header_.map->path + " says header_line: " +
-                  std::to_string(header_.map->header_line);
+        *error += ": the column map " + header_.map->path +
+                  " says header_line: " + std::to_string(header_.map->header_line);
       }
       return false;
     }
@@ -804,8 +810,7 @@ class LineParser {
                " rows skipped; first: " + first_skipped_;
       return false;
     }
-    if (const std::string why =
-            AttitudeInRadiansProblem(source_name, header_, radians_);
+    if (const std::string why = AttitudeInRadiansProblem(source_name, header_, radians_);
         !why.empty()) {
       *error = why;
       return false;
@@ -864,7 +869,8 @@ void TakeLayout(const Dataset& layout, Dataset* data) {
 bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
                       const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
   Dataset result;
-  if (const std::string spreadsheet = internal::SpreadsheetMessage(source_name, std::string_view(text).substr(0, 8), false);
+  if (const std::string spreadsheet =
+          internal::SpreadsheetMessage(source_name, std::string_view(text).substr(0, 8), false);
       !spreadsheet.empty()) {
     *error = spreadsheet;
     return false;
@@ -1097,6 +1103,9 @@ struct DatasetChunkReader::State {
   LineParser parser;
   std::string text;  // read and not yet parsed: the start of a line
   size_t start = 0;  // where in `text` the next line starts
+  // How far from `start` is known to hold no newline: each read is searched once, so
+  // that a long line costs linear time (issue 29: a 1 GiB line took a minute).
+  size_t searched = 0;
   int line_number = 0;
   bool first = true;  // before the first line (a byte order mark may open it)
   bool end = false;   // the whole file is in `text`
@@ -1133,23 +1142,30 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
       while (chunk->samples.size() + lines.size() < wanted) {
         if (st.first && st.start == 0) {
           if (!st.end && st.text.size() < 8) break;  // the first bytes, to tell a spreadsheet
-          const std::string spreadsheet =
-              internal::SpreadsheetMessage(st.parser.layout().path, std::string_view(st.text).substr(0, 8));
+          const std::string spreadsheet = internal::SpreadsheetMessage(
+              st.parser.layout().path, std::string_view(st.text).substr(0, 8));
           if (!spreadsheet.empty()) {
             message = spreadsheet;
             ok = false;
             break;
           }
         }
+        // A record ends at the first newline outside quotes. Without quotes each read is
+        // searched once (`searched`); with them the record is rescanned, bounded by
+        // kMaxMappedRecordBytes.
+        const bool quotes = st.parser.quotes();
         int breaks = 0;  // line breaks inside a quoted field of the record
-        const size_t newline =
-            internal::RecordEnd(st.text, st.start, st.parser.quotes(), &breaks);
-        if (newline == std::string::npos && st.parser.quotes() &&
-            st.text.size() - st.start > kMaxMappedRecordBytes) {
-          // A quote left open would make the rest of the file one record, scanned anew
-          // at every read.
+        const size_t newline = quotes ? internal::RecordEnd(st.text, st.start, true, &breaks)
+                                      : st.text.find('\n', st.start + st.searched);
+        st.searched = newline == std::string::npos ? st.text.size() - st.start : 0;
+        if (newline == std::string::npos &&
+            st.searched > (quotes ? kMaxMappedRecordBytes : kMaxDatasetLineBytes)) {
+          // A quote left open would make the rest of the file one record; a file without
+          // line breaks is no dataset.
           message = st.parser.layout().path + ":" + std::to_string(st.line_number + 1) +
-                    ": a record longer than 16 MiB (a quote not closed?)";
+                    (quotes ? ": a record longer than 16 MiB (a quote not closed?)"
+                            : ": a line longer than " + std::to_string(kMaxDatasetLineBytes >> 20) +
+                                  " MiB: not a dataset (its lines are under 1 KiB)");
           ok = false;
           break;
         }
@@ -1238,11 +1254,14 @@ bool DatasetWriter::Open(const std::string& path, const Dataset& layout,
   layout_.session_labels = layout.session_labels;
   columns_ = ColumnsOf(layout_);
   rows_ = 0;
+  io_failed_ = false;
   file_ = std::fopen(path.c_str(), "wbx");  // x: never over an existing file
   if (file_ == nullptr) {
+    io_failed_ = true;
     *error = path + ": cannot create: " + std::strerror(errno);
     return false;
   }
+  ::flock(::fileno(file_), LOCK_EX | LOCK_NB);  // a temporary in use, not a killed run's
   buffer_ = HeaderText(columns_, header_comment, !layout_.session_labels.empty());
   return Flush(error);
 }
@@ -1283,10 +1302,12 @@ bool DatasetWriter::Close(std::string* error) {
   }
   if (ok && (std::fflush(file_) != 0 || ::fsync(::fileno(file_)) != 0)) {
     *error = path_ + ": cannot write: " + std::strerror(errno);
+    io_failed_ = true;
     ok = false;
   }
   if (std::fclose(file_) != 0 && ok) {
     *error = path_ + ": cannot write: " + std::strerror(errno);
+    io_failed_ = true;
     ok = false;
   }
   file_ = nullptr;
@@ -1296,6 +1317,7 @@ bool DatasetWriter::Close(std::string* error) {
 bool DatasetWriter::Flush(std::string* error) {
   if (!buffer_.empty() && std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
     *error = path_ + ": cannot write: " + std::strerror(errno);
+    io_failed_ = true;
     return false;
   }
   buffer_.clear();

@@ -9,9 +9,9 @@
 #include <array>
 #include <cmath>
 #include <limits>
-#include <thread>
 
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/statics.h"
 
 namespace fastcal::internal {
@@ -234,9 +234,9 @@ bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::V
     work(0);
     return true;
   }
-  std::thread other(work, 1);
-  work(0);
-  other.join();
+  // Thread w takes chunks w, w + kThreads, ...; the strides of threads the system refused
+  // (OnThreads: a process limit is not an abort) are taken here afterwards.
+  for (int w = internal::OnThreads(kThreads, work); w < kThreads; ++w) work(w);
   return true;
 }
 

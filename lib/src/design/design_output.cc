@@ -1,6 +1,7 @@
 // A survey design's outputs (design.h): poses.csv, design.json and design.html. The map
 // is the cap seen from above (x toward tower 1's side as in the workspace map), in metres.
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -16,7 +17,15 @@
 namespace fastcal {
 namespace {
 
-std::string Fmt(const char* format, double v) { return internal::FormatDouble(format, v); }
+// printf's text, except that a value that rounds to zero reads "0.00", not "-0.00".
+std::string Fmt(const char* format, double v) {
+  std::string s = internal::FormatDouble(format, v);
+  const size_t end = s.find_first_not_of("-0.", 1);
+  const bool all_zero =
+      end == std::string::npos || !std::isdigit(static_cast<unsigned char>(s[end]));
+  if (!s.empty() && s[0] == '-' && s.size() > 1 && all_zero) s.erase(0, 1);
+  return s;
+}
 
 std::string CommentLines(const std::string& text) {
   std::string out;
@@ -249,6 +258,49 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
 
 namespace {
 
+// A stop's number beside its circle on the map of the cap.
+struct StopNumber {
+  double x_px = 0.0, y_px = 0.0, radius_px = 0.0;
+  std::string label;
+};
+
+// The stops' numbers, each placed at the first of a few spots around its circle (right,
+// left, above, below) where it overlaps no number placed before: stops a few pixels apart
+// (12 and 13 at the rim) stay readable.
+std::string StopNumbers(const std::map<std::string, StopNumber>& numbers) {
+  constexpr double kCharPx = 7.0, kHeightPx = 11.0;  // 11 px bold digits
+  struct Box {
+    double x0, y0, x1, y1;  // y1 the baseline
+  };
+  std::vector<Box> placed;
+  std::string s;
+  for (const auto& [at, n] : numbers) {
+    const double w = kCharPx * static_cast<double>(n.label.size());
+    const double r = n.radius_px + 2.0;
+    const std::pair<double, double> spots[] = {
+        // (left edge, baseline)
+        {n.x_px + r, n.y_px - 3.0},         {n.x_px + r, n.y_px + kHeightPx},
+        {n.x_px - r - w, n.y_px - 3.0},     {n.x_px - r - w, n.y_px + kHeightPx},
+        {n.x_px - w / 2, n.y_px - r - 1.0}, {n.x_px - w / 2, n.y_px + r + kHeightPx}};
+    Box chosen{spots[0].first, spots[0].second - kHeightPx, spots[0].first + w, spots[0].second};
+    for (const auto& [x, y] : spots) {
+      const Box b{x, y - kHeightPx, x + w, y};
+      const bool free = std::none_of(placed.begin(), placed.end(), [&](const Box& o) {
+        return b.x0 < o.x1 && o.x0 < b.x1 && b.y0 < o.y1 && o.y0 < b.y1;
+      });
+      if (free) {
+        chosen = b;
+        break;
+      }
+    }
+    placed.push_back(chosen);
+    s += "<text class=\"stop-number\" x=\"" + Fmt("%.1f", chosen.x0) + "\" y=\"" +
+         Fmt("%.1f", chosen.y1) + "\" font-size=\"11\" font-weight=\"bold\" fill=\"#222\">" +
+         n.label + "</text>\n";
+  }
+  return s;
+}
+
 // The cap seen from above: candidates grey, the stops sized by their samples and filled
 // by their extra tilt, the path, the paper's circle dashed, the towers on the rim.
 std::string CapSvg(const Design& d, const CableRobot& robot) {
@@ -290,11 +342,7 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
          "\" font-weight=\"bold\">start</text>\n";
   }
   int order = 0;
-  struct Number {
-    double x_px = 0.0, y_px = 0.0, radius_px = 0.0;
-    std::string label;
-  };
-  std::map<std::string, Number> numbers;  // by drawn position
+  std::map<std::string, StopNumber> numbers;  // by drawn position
   for (const DesignStop& st : d.stops) {
     const DesignCandidate& c = d.candidates[st.candidate];
     const Eigen::Vector3d rpy = RpyDegFromRotation(c.pose.rotation);
@@ -311,17 +359,13 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
          Fmt("%.3g", c.extra_tilt_deg) + " deg toward " + Fmt("%.3g", c.tilt_direction_deg) +
          " deg, extra yaw " + Fmt("%.3g", c.extra_yaw_deg) + " deg</title></circle>\n";
     // Stops at one position (other attitudes) share one label: "18, 19".
-    Number& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
+    StopNumber& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
     n.x_px = half + scale * (c.pose.position_m.x() - g.focal_centre_m.x());
     n.y_px = half - scale * (c.pose.position_m.y() - g.focal_centre_m.y());
     n.radius_px = std::max(n.radius_px, radius);
     n.label += (n.label.empty() ? "" : ", ") + std::to_string(order);
   }
-  for (const auto& [at, n] : numbers) {
-    s += "<text class=\"stop-number\" x=\"" + Fmt("%.1f", n.x_px + n.radius_px + 2.0) + "\" y=\"" +
-         Fmt("%.1f", n.y_px - 3.0) + "\" font-size=\"11\" font-weight=\"bold\" fill=\"#222\">" +
-         n.label + "</text>\n";
-  }
+  s += StopNumbers(numbers);
   for (int i = 0; i < kNumCables; ++i) {
     const Eigen::Vector3d t = robot.cables[i].tower_top_m - g.focal_centre_m;
     const double a = std::atan2(t.y(), t.x());

@@ -123,7 +123,7 @@ class Parser {
     const std::string& text = node.Scalar();
     const std::string lower = ToLower(text);
     if (lower == ".nan" || lower == ".inf" || lower == "+.inf" || lower == "-.inf") {
-      return Fail(line, path, "must be finite, got " + text);
+      return Fail(line, path, "must be finite, got " + internal::Quote(text));
     }
     // from_chars takes no leading '+'; YAML numbers may have one.
     const char* begin = text.data();
@@ -131,11 +131,13 @@ class Parser {
     if (begin != end && *begin == '+') ++begin;
     double parsed = 0.0;
     const auto [ptr, ec] = std::from_chars(begin, end, parsed);
-    if (ec == std::errc::result_out_of_range) return Fail(line, path, "out of range: " + text);
+    if (ec == std::errc::result_out_of_range)
+      return Fail(line, path, "out of range: " + internal::Quote(text));
     if (ec != std::errc() || ptr != end || begin == end) {
       return Fail(line, path, "expected a number, got " + internal::Quote(text));
     }
-    if (!std::isfinite(parsed)) return Fail(line, path, "must be finite, got " + text);
+    if (!std::isfinite(parsed))
+      return Fail(line, path, "must be finite, got " + internal::Quote(text));
     *value = parsed;
     return true;
   }
@@ -442,7 +444,7 @@ bool ParseCableRobotYaml(const std::string& text, const std::string& source_name
       parser.FailFile("empty model file: omit the model file for the nominal FAST layout");
     } else if (parser.ReadRoot(documents.first, &parsed)) {
       std::string why;
-      if (!parsed.IsValid(&why) || !CheckModelPlausible(parsed, PlausibilityLimits(), &why)) {
+      if (!CheckModel(parsed, &why)) {
         parser.FailValidation(why);
       }
     }

@@ -32,6 +32,14 @@ std::vector<ModelValue> ModelValues(const CableRobot& robot) {
   static const CableRobot nominal = CableRobot::NominalFast();
   static const char kAxes[] = "xyz";
   std::vector<ModelValue> values;
+  values.push_back({"gravity_m_per_s2", ModelQuantity::kGravityMPerS2, robot.gravity_m_per_s2,
+                    nominal.gravity_m_per_s2});
+  if (robot.reflector.has_value()) {
+    values.push_back({"reflector.radius_m", ModelQuantity::kReflectorRadiusM,
+                      robot.reflector->radius_m, nominal.reflector->radius_m});
+    values.push_back({"reflector.aperture_m", ModelQuantity::kReflectorApertureM,
+                      robot.reflector->aperture_m, nominal.reflector->aperture_m});
+  }
   values.push_back(
       {"cabin.mass_kg", ModelQuantity::kCabinMassKg, robot.cabin_mass_kg, nominal.cabin_mass_kg});
   for (int a = 0; a < 3; ++a) {
@@ -79,7 +87,7 @@ double Departure(const ModelValue& v, const PlausibilityLimits& limits) {
   if (range.min > 0.0 && v.value_si > 0.0 && v.nominal_si > 0.0) {
     return std::abs(std::log(v.value_si / v.nominal_si)) / std::log(range.max / range.nominal);
   }
-  return std::abs(v.value_si - v.nominal_si) / range.max;
+  return std::abs(v.value_si - v.nominal_si) / std::max(std::abs(range.min), std::abs(range.max));
 }
 
 std::string InFileUnit(double value_si, const QuantityRange& range) {
@@ -130,6 +138,58 @@ bool CheckParameterValue(ParameterKind kind, double value_si, const Plausibility
   return !QuantityOfParameter(kind, &quantity) || CheckQuantity(quantity, value_si, limits, why);
 }
 
+namespace {
+
+// The reflector's centre near (0, 0, radius): the global origin is its lowest point.
+bool CheckReflectorCentre(const Reflector& reflector, const PlausibilityLimits& limits,
+                          std::string* why) {
+  const Eigen::Vector3d expected(0.0, 0.0, reflector.radius_m);
+  const Eigen::Vector3d off = reflector.centre_m - expected;
+  if (off.cwiseAbs().maxCoeff() <= limits.max_reflector_offset_m) return true;
+  *why = "reflector.centre_m: " + Vec(reflector.centre_m) + " m is more than " +
+         Num(limits.max_reflector_offset_m) + " m from (0, 0, radius_m) = " + Vec(expected) +
+         " m (the global origin is the reflector's lowest point; FAST: (0, 0, 300) m)";
+  return false;
+}
+
+// Tower tops far enough from the axis, high enough, and around it (no gap wider than
+// max_tower_gap_deg between neighbours, seen from the axis).
+bool CheckTowerLayout(const CableRobot& robot, const PlausibilityLimits& limits, std::string* why) {
+  std::vector<std::pair<double, int>> azimuths;
+  for (int i = 0; i < kNumCables; ++i) {
+    const Eigen::Vector3d& top = robot.cables[i].tower_top_m;
+    const std::string key = "cables[" + std::to_string(i) + "].tower_top_m: ";
+    const double radius = top.head<2>().norm();
+    if (!(radius >= limits.min_tower_radius_m)) {
+      *why = key + Num(radius) + " m from the z axis, less than " + Num(limits.min_tower_radius_m) +
+             " m (the towers stand around the workspace; FAST: 300 m)";
+      return false;
+    }
+    if (!(top.z() >= limits.min_tower_top_z_m)) {
+      *why = key + "z = " + Num(top.z()) + " m is below " + Num(limits.min_tower_top_z_m) +
+             " m (the cabin works at 140 to 160 m and hangs from the tower tops; FAST: 270 m)";
+      return false;
+    }
+    azimuths.emplace_back(std::atan2(top.y(), top.x()) * 180.0 / M_PI, i);
+  }
+  std::sort(azimuths.begin(), azimuths.end());
+  for (size_t k = 0; k < azimuths.size(); ++k) {
+    const auto& [from, i] = azimuths[k];
+    const auto& [to, j] = azimuths[(k + 1) % azimuths.size()];
+    const double gap = k + 1 < azimuths.size() ? to - from : to + 360.0 - from;
+    if (gap > limits.max_tower_gap_deg) {
+      *why = "cables[" + std::to_string(j) + "].tower_top_m: the towers of cables " +
+             std::to_string(i + 1) + " and " + std::to_string(j + 1) + " leave a gap of " +
+             Num(gap) + " deg seen from the z axis, more than " + Num(limits.max_tower_gap_deg) +
+             " deg: the towers must surround the workspace (FAST: 60 deg apart)";
+      return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limits,
                          std::string* why) {
   std::string what;
@@ -139,13 +199,25 @@ bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limi
       return false;
     }
   }
+  if (robot.reflector.has_value() && !CheckReflectorCentre(*robot.reflector, limits, &what)) {
+    if (why != nullptr) *why = what;
+    return false;
+  }
   for (int i = 0; i < kNumCables; ++i) {
     if (!CheckPosition(robot.cables[i].tower_top_m, limits, &what)) {
       if (why != nullptr) *why = "cables[" + std::to_string(i) + "].tower_top_m: " + what;
       return false;
     }
   }
+  if (!CheckTowerLayout(robot, limits, &what)) {
+    if (why != nullptr) *why = what;
+    return false;
+  }
   return true;
+}
+
+bool CheckModel(const CableRobot& robot, std::string* why) {
+  return robot.IsValid(why) && CheckModelPlausible(robot, PlausibilityLimits(), why);
 }
 
 std::vector<std::string> FurthestFromNominal(const CableRobot& robot,

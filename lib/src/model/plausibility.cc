@@ -55,7 +55,18 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
       {"max_tension_sigma_percent", max_tension_sigma_percent},
       {"max_attachment_mass_kg", max_attachment_mass_kg},
       {"max_attachment_density_kg_per_m", max_attachment_density_kg_per_m},
-      {"max_attachment_position_m", max_attachment_position_m}};
+      {"max_attachment_position_m", max_attachment_position_m},
+      {"min_tension_sigma_n", min_tension_sigma_n},
+      {"min_tension_sigma_percent", min_tension_sigma_percent},
+      {"min_abs_gravity_m_per_s2", min_abs_gravity_m_per_s2},
+      {"max_abs_gravity_m_per_s2", max_abs_gravity_m_per_s2},
+      {"min_reflector_radius_m", min_reflector_radius_m},
+      {"max_reflector_radius_m", max_reflector_radius_m},
+      {"min_reflector_aperture_m", min_reflector_aperture_m},
+      {"max_reflector_offset_m", max_reflector_offset_m},
+      {"min_tower_radius_m", min_tower_radius_m},
+      {"min_tower_top_z_m", min_tower_top_z_m},
+      {"max_tower_gap_deg", max_tower_gap_deg}};
   for (const auto& [name, value] : fields) {
     if (!(std::isfinite(value) && value > 0.0)) {
       return Fail(error, std::string(name) + ": must be > 0 and finite (got " + Num(value) + ")");
@@ -68,7 +79,9 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
       {"cabin_mass_kg", {min_cabin_mass_kg, max_cabin_mass_kg}},
       {"linear_density_kg_per_m", {min_linear_density_kg_per_m, max_linear_density_kg_per_m}},
       {"ea_n", {min_ea_n, max_ea_n}},
-      {"sensor_gain", {min_sensor_gain, max_sensor_gain}}};
+      {"sensor_gain", {min_sensor_gain, max_sensor_gain}},
+      {"abs_gravity_m_per_s2", {min_abs_gravity_m_per_s2, max_abs_gravity_m_per_s2}},
+      {"reflector_radius_m", {min_reflector_radius_m, max_reflector_radius_m}}};
   for (const auto& [name, range] : ranges) {
     if (range.first > range.second) {
       return Fail(error, std::string("min_") + name + ": must be <= max_" + name);
@@ -108,6 +121,14 @@ QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& l
       return {0.0, limits.max_attachment_density_kg_per_m, 0.0, "kg/m", 1.0};
     case ModelQuantity::kAttachmentPositionM:
       return {0.0, limits.max_attachment_position_m, 0.0, "m", 1.0};
+    case ModelQuantity::kGravityMPerS2:
+      return {-limits.max_abs_gravity_m_per_s2, -limits.min_abs_gravity_m_per_s2, -9.8, "m/s^2",
+              1.0};
+    case ModelQuantity::kReflectorRadiusM:
+      return {limits.min_reflector_radius_m, limits.max_reflector_radius_m, 300.0, "m", 1.0};
+    case ModelQuantity::kReflectorApertureM:
+      return {limits.min_reflector_aperture_m, 2.0 * limits.max_reflector_radius_m, 500.0, "m",
+              1.0};
   }
   return {};
 }

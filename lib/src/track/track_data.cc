@@ -180,7 +180,8 @@ std::string Mismatch(const TrackRun& run, const SavedState& s) {
   if (s.spec_yaml != run.spec_yaml) return "another spec";
   if (s.window != WindowSpecText(run.window)) return "windows of " + s.window;
   if (s.columns != run.columns_text) {
-    return s.columns.empty() ? "files read without a column map" : "files read through another column map";
+    return s.columns.empty() ? "files read without a column map"
+                             : "files read through another column map";
   }
   for (const TrackFile& f : s.files) {
     if (std::find(run.data_paths.begin(), run.data_paths.end(), f.path) == run.data_paths.end()) {

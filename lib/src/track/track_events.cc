@@ -66,8 +66,8 @@ std::string WindowText(const TrackRun& run, int u) { return run.windows[run.used
 
 // An event between used windows `from` (the last with the old value) and `to` (the first
 // with the new one).
-TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind,
-                   double statistic, int dof, double threshold, int tests) {
+TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind, double statistic,
+                   int dof, double threshold, int tests) {
   TrackEvent e;
   e.kind = kind;
   e.window = to;
@@ -95,8 +95,8 @@ TrackEvent SensorEvent(const TrackRun& run, int e0, int e, double threshold, int
   int u = 0;
   while (u < static_cast<int>(run.used.size()) && run.entry_of[u][entry.column] != e) ++u;
   u = std::max(1, u);
-  TrackEvent event = EventAt(run, u - 1, u, "sensor", d * d / std::max(variance, 1e-300), 1,
-                             threshold, tests);
+  TrackEvent event =
+      EventAt(run, u - 1, u, "sensor", d * d / std::max(variance, 1e-300), 1, threshold, tests);
   event.parameters.push_back(
       {s.name, s.unit, d / s.to_si, std::sqrt(std::max(variance, 0.0)) / s.to_si});
   event.cables.push_back(s.index + 1);
@@ -121,7 +121,6 @@ std::vector<std::vector<int>> WindowGroups(const TrackRun& run) {
   for (const std::string& k : keys) groups.push_back(by_key[k]);
   return groups;
 }
-
 
 // The Wald test of a group's change from used window `from` to `to` (later minus earlier,
 // its covariance from the sandwich and the consider part: the shared error cancels).
@@ -182,7 +181,8 @@ InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
       for (int y = 0; y < pg; ++y) self(x, y) = cross(x, columns[y]);
     }
     ArrowVector c;
-    for (const ArrowBlock& other : run.problem.blocks) c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
+    for (const ArrowBlock& other : run.problem.blocks)
+      c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
     c.b = Eigen::MatrixXd::Zero(run.problem.q, pg);
     for (int x = 0; x < pg; ++x) {
       for (int r = 0; r < k.p; ++r) c.a[u](r, x) = cross(x, order[r]);
@@ -266,8 +266,8 @@ void GroupEvents(const TrackRun& run, const std::vector<int>& g, std::vector<Tra
     }
     for (int x = 0; x < dof; ++x) {
       const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[x]]);
-      e.parameters.push_back({s.name, s.unit, change.d[x] / s.to_si,
-                              std::sqrt(change.covariance(x, x)) / s.to_si});
+      e.parameters.push_back(
+          {s.name, s.unit, change.d[x] / s.to_si, std::sqrt(change.covariance(x, x)) / s.to_si});
       if (sensor && s.index >= 0) e.cables.push_back(s.index + 1);
     }
     out->push_back(e);

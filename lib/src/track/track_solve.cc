@@ -485,7 +485,8 @@ TrackStatus FoldConsider(TrackRun& run) {
   run.Progress("the consider parameters' columns, at the solution:");
   if (!FoldDirty(run, true)) return TrackStatus::kInfeasible;
   BuildProblem(run);
-  if (!run.solver.Solve(run.problem)) return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
+  if (!run.solver.Solve(run.problem))
+    return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
   for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
   return TrackStatus::kOk;
 }

@@ -1,56 +1,273 @@
-// Atomic file writes (internal/atomic_file.h).
+// Atomic file writes, their temporaries, and bounded reads (internal/atomic_file.h).
 #include "fastcal/internal/atomic_file.h"
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <limits>
+#include <regex>
+#include <system_error>
+#include <vector>
 
 #include "fastcal/internal/quote.h"
 
 namespace fastcal::internal {
 
-// Writes `content` to a new temporary file beside `path`, then renames it over `path`.
-bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error) {
-  std::string ignored;
-  if (error == nullptr) error = &ignored;
-  static std::atomic<unsigned> counter{0};
-  const std::string temp_path =
-      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
-  const int fd = ::open(temp_path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-  if (fd < 0) {
-    *error = path + ": cannot write: " + std::strerror(errno);
+namespace {
+
+// A temporary older than this whose pid runs but which nobody has locked belongs to a
+// process that reused the pid (the writer locks its temporary right after creating it).
+constexpr int kStaleAfterSeconds = 60;
+
+std::string BaseName(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  return slash == std::string::npos ? path : path.substr(slash + 1);
+}
+
+// The pid of a temporary's name after its prefix: `rest` is "<pid>", or with `counted`
+// also "<pid>.<n>" or "<pid>.tmp.<pid>.<n>" (the forms fastcal writes and wrote); 0 for
+// anything else, which is never touched (a user's "data.csv.tmp.2024.backup").
+pid_t PidOf(std::string_view rest, bool counted) {
+  static const std::regex kExact(R"((\d{1,9}))");
+  static const std::regex kCounted(R"((\d{1,9})(\.\d+|\.tmp\.\d+\.\d+)?)");
+  std::match_results<std::string_view::const_iterator> m;
+  if (!std::regex_match(rest.begin(), rest.end(), m, counted ? kCounted : kExact)) return 0;
+  return static_cast<pid_t>(std::stol(m[1].str()));
+}
+
+// Whether the process that made temporary `path` (pid `pid`) is gone.
+bool MakerIsGone(const std::string& path, pid_t pid, bool lockable) {
+  if (pid == ::getpid()) return false;  // ours: another write of this very run
+  if (::kill(pid, 0) != 0 && errno == ESRCH) return true;
+  if (!lockable) return false;
+  // The pid runs: a reused one (another container's, after a restart) if nobody holds
+  // the temporary's lock and it has not changed for a while.
+  struct stat st {};
+  if (::lstat(path.c_str(), &st) != 0 || ::time(nullptr) - st.st_mtime < kStaleAfterSeconds) {
     return false;
   }
-  const auto fail = [&](const char* what, int err) {
-    *error = path + ": " + what + ": " + std::strerror(err);
-    ::unlink(temp_path.c_str());
-    return false;
-  };
-  size_t written = 0;
-  while (written < content.size()) {
-    const ssize_t n = ::write(fd, content.data() + written, content.size() - written);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd);
-      return fail("cannot write", err);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW | O_NONBLOCK);
+  if (fd < 0) return false;
+  const bool free = ::flock(fd, LOCK_EX | LOCK_NB) == 0;
+  ::close(fd);
+  return free;
+}
+
+void RemoveTree(const std::string& path) {
+  std::error_code ec;
+  std::filesystem::remove_all(path, ec);
+}
+
+}  // namespace
+
+std::string TemporaryNameFor(const std::string& path) {
+  static std::atomic<unsigned> counter{0};
+  return path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
+}
+
+int RemoveStaleTemporaries(const std::string& path) {
+  const std::string name = BaseName(path);
+  if (name.empty() || name == "." || name == "..") return 0;
+  const std::string dir = ParentDirectory(path);
+  const std::string file_prefix = name + ".tmp.";
+  const std::string dir_prefix = "." + name + ".tmp.";
+  const std::string old_prefix = "." + name + ".old.";
+  int removed = 0;
+  DIR* listing = ::opendir(dir.c_str());
+  if (listing == nullptr) return 0;
+  std::vector<std::string> entries;
+  while (const dirent* entry = ::readdir(listing)) entries.emplace_back(entry->d_name);
+  ::closedir(listing);
+  for (const std::string& entry : entries) {
+    const std::string full = dir == "." ? entry : dir + "/" + entry;
+    for (const std::string* prefix : {&file_prefix, &dir_prefix}) {
+      if (entry.rfind(*prefix, 0) != 0) continue;
+      const pid_t pid =
+          PidOf(std::string_view(entry).substr(prefix->size()), prefix == &file_prefix);
+      if (pid > 0 && MakerIsGone(full, pid, /*lockable=*/true)) {
+        RemoveTree(full);
+        ++removed;
+      }
     }
+    if (entry.rfind(old_prefix, 0) == 0) {
+      // A previous result moved aside by a --force run killed before its new one was in
+      // place: put it back if nothing took its place, else it was replaced.
+      const pid_t pid = PidOf(std::string_view(entry).substr(old_prefix.size()), false);
+      if (pid <= 0 || !MakerIsGone(full, pid, /*lockable=*/false)) continue;
+      int err = 0;
+      if (!RenameNoReplace(full, path, &err)) RemoveTree(full);
+      ++removed;
+    }
+  }
+  return removed;
+}
+
+bool RenameNoReplace(const std::string& from, const std::string& to, int* err) {
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return true;
+  *err = errno;
+  if (*err != EINVAL && *err != ENOSYS) return false;
+  struct stat st {};
+  if (::lstat(from.c_str(), &st) != 0) {
+    *err = errno;
+    return false;
+  }
+  if (S_ISDIR(st.st_mode)) {
+    // rename(2) of a directory refuses a non-empty target: results there are kept.
+    if (::rename(from.c_str(), to.c_str()) == 0) return true;
+    *err = errno == ENOTEMPTY ? EEXIST : errno;
+    return false;
+  }
+  if (::link(from.c_str(), to.c_str()) != 0) {
+    *err = errno;
+    return false;
+  }
+  ::unlink(from.c_str());
+  return true;
+}
+
+bool RenameExchange(const std::string& a, const std::string& b, int* err) {
+  if (::renameat2(AT_FDCWD, a.c_str(), AT_FDCWD, b.c_str(), RENAME_EXCHANGE) == 0) return true;
+  *err = errno;
+  return false;
+}
+
+bool SyncDirectory(const std::string& dir, int* err) {
+  const int fd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) {
+    *err = errno;
+    return false;
+  }
+  // EINVAL: a file system that cannot sync a directory (nothing to make durable there).
+  const bool ok = ::fsync(fd) == 0 || errno == EINVAL;
+  if (!ok) *err = errno;
+  ::close(fd);
+  return ok;
+}
+
+std::string ParentDirectory(const std::string& path) {
+  const size_t slash = path.find_last_of('/');
+  if (slash == std::string::npos) return ".";
+  return slash == 0 ? "/" : path.substr(0, slash);
+}
+
+std::FILE* OpenUnnamedFile(const std::string& dir, int* err) {
+  int fd = ::open(dir.c_str(), O_TMPFILE | O_RDWR | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0 && (errno == EOPNOTSUPP || errno == EISDIR || errno == EINVAL)) {
+    std::string name = dir + "/.fastcal-XXXXXX";
+    fd = ::mkstemp(name.data());
+    if (fd >= 0) ::unlink(name.c_str());
+  }
+  if (fd < 0) {
+    *err = errno;
+    return nullptr;
+  }
+  std::FILE* file = ::fdopen(fd, "w+b");
+  if (file == nullptr) {
+    *err = errno;
+    ::close(fd);
+  }
+  return file;
+}
+
+void TemporaryLock::Lock(const std::string& path) {
+  Release();
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd_ >= 0) ::flock(fd_, LOCK_EX | LOCK_NB);
+}
+
+void TemporaryLock::Release() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+}
+
+bool AtomicFileWriter::Fail(const char* what, int err, std::string* error) {
+  if (error != nullptr) *error = path_ + ": " + what + ": " + std::strerror(err);
+  Abort();
+  return false;
+}
+
+bool AtomicFileWriter::Open(const std::string& path, std::string* error) {
+  Abort();
+  path_ = path;
+  RemoveStaleTemporaries(path);
+  temp_path_ = TemporaryNameFor(path);
+  fd_ = ::open(temp_path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+  if (fd_ < 0) {
+    const int err = errno;
+    temp_path_.clear();
+    return Fail("cannot write", err, error);
+  }
+  ::flock(fd_, LOCK_EX | LOCK_NB);  // in use: RemoveStaleTemporaries leaves it
+  return true;
+}
+
+bool AtomicFileWriter::Flush(std::string* error) {
+  size_t written = 0;
+  while (written < buffer_.size()) {
+    const ssize_t n = ::write(fd_, buffer_.data() + written, buffer_.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return Fail("cannot write", errno, error);
     written += static_cast<size_t>(n);
   }
-  if (::fsync(fd) != 0) {
-    const int err = errno;
-    ::close(fd);
-    return fail("cannot write", err);
-  }
-  if (::close(fd) != 0) return fail("cannot write", errno);
-  if (std::rename(temp_path.c_str(), path.c_str()) != 0) return fail("cannot replace", errno);
+  buffer_.clear();
   return true;
+}
+
+bool AtomicFileWriter::Write(std::string_view data, std::string* error) {
+  if (fd_ < 0) return Fail("cannot write", EBADF, error);
+  constexpr size_t kFlushBytes = 1 << 20;
+  buffer_.append(data);
+  return buffer_.size() < kFlushBytes || Flush(error);
+}
+
+bool AtomicFileWriter::Sync(std::string* error) {
+  if (fd_ < 0) return Fail("cannot write", EBADF, error);
+  if (!Flush(error)) return false;
+  if (::fsync(fd_) != 0) return Fail("cannot write", errno, error);
+  return true;
+}
+
+bool AtomicFileWriter::Commit(bool replace, std::string* error) {
+  if (!Sync(error)) return false;
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) return Fail("cannot write", errno, error);
+  int err = 0;
+  if (replace ? ::rename(temp_path_.c_str(), path_.c_str()) != 0
+              : !RenameNoReplace(temp_path_, path_, &err)) {
+    if (replace) err = errno;
+    return Fail(err == EEXIST ? "exists (made by another process meanwhile); not replaced"
+                              : "cannot replace",
+                err, error);
+  }
+  temp_path_.clear();
+  if (!SyncDirectory(ParentDirectory(path_), &err)) return Fail("cannot write", err, error);
+  return true;
+}
+
+void AtomicFileWriter::Abort() {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  if (!temp_path_.empty()) ::unlink(temp_path_.c_str());
+  temp_path_.clear();
+  buffer_.clear();
+}
+
+bool WriteFileAtomically(const std::string& path, const std::string& content, std::string* error,
+                         bool replace) {
+  AtomicFileWriter writer;
+  return writer.Open(path, error) && writer.Write(content, error) && writer.Commit(replace, error);
 }
 
 namespace {
@@ -93,11 +310,12 @@ bool RegularFileReader::Open(const std::string& path, long long max_bytes, const
   struct stat st {};
   if (::fstat(fd_, &st) != 0)
     return Fail(std::string("cannot read: ") + std::strerror(errno), error);
-  if (S_ISDIR(st.st_mode)) return Fail("is a directory, not a " + what + " file", error);
+  const std::string a = !what.empty() && std::strchr("aeiou", what[0]) != nullptr ? "an " : "a ";
+  if (S_ISDIR(st.st_mode)) return Fail("is a directory, not " + a + what + " file", error);
   if (!S_ISREG(st.st_mode)) {
-    return Fail(
-        "not a regular file (a device, pipe or socket): a " + what + " file must be a regular file",
-        error);
+    return Fail("not a regular file (a device, pipe or socket): " + a + what +
+                    " file must be a regular file",
+                error);
   }
   too_large_ = "larger than the limit for a " + what + " file, " + ByteCount(max_bytes) +
                " (docs/data-format.md, \"Limits\")";
@@ -147,23 +365,15 @@ bool ReadRegularFile(const std::string& path, long long max_bytes, const std::st
 
 bool ReadFileChunks(const std::string& path, const std::function<void(const char*, size_t)>& sink,
                     std::string* error) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) {
-    *error = path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
-  char buffer[1 << 16];
-  while (true) {
-    const size_t n = std::fread(buffer, 1, sizeof(buffer), file);
-    if (n > 0) sink(buffer, n);
-    if (n < sizeof(buffer)) break;
-  }
-  const bool failed = std::ferror(file) != 0;
-  const int read_errno = errno;
-  std::fclose(file);
-  if (failed) {
-    *error = path + ": cannot read: " + std::strerror(read_errno);
-    return false;
+  // The reader's checks first: a device (/dev/zero) would never end (issue 29: calibrate
+  // --data=/dev/zero hashed it on a thread of its own, and never exited).
+  RegularFileReader reader;
+  if (!reader.Open(path, std::numeric_limits<long long>::max(), "input", error)) return false;
+  std::string chunk;
+  for (bool end = false; !end;) {
+    chunk.clear();
+    if (!reader.Read(static_cast<size_t>(1) << 16, &chunk, &end, error)) return false;
+    if (!chunk.empty()) sink(chunk.data(), chunk.size());
   }
   return true;
 }

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <sstream>
 #include <string_view>
+#include <vector>
 
 #include "fastcal/internal/quote.h"
 
@@ -68,9 +69,79 @@ size_t EventBudget(const std::string& text) { return 4 * text.size() + 64; }
                 (token == "," ? " (a stray comma outside any [list] or {mapping}?)" : ""));
 }
 
+// Refuses text nested deeper than kMaxYamlDepth before yaml-cpp sees it, in one pass and
+// no memory: yaml-cpp 0.7 tokenizes a whole flow collection before its parser's own depth
+// guard acts (16 MiB of '[' took 3.9 GB and 13 s, then "bad file"). The depth at a point
+// is the block levels open (indentations, and "- " entries started on one line) plus the
+// flow brackets open; quoted scalars and comments are skipped. A bracket inside a plain
+// scalar ("a[1]") counts too: harmless, it closes again.
+void CheckNestingDepth(const std::string& text) {
+  std::vector<size_t> indents;  // of the open block levels
+  int flow = 0;
+  int line = 0;
+  size_t i = 0;
+  const auto refuse = [&](size_t at, size_t line_start) {
+    YAML::Mark mark;
+    mark.pos = static_cast<int>(at);
+    mark.line = line;
+    mark.column = static_cast<int>(at - line_start);
+    throw YAML::ParserException(
+        mark, "nesting deeper than " + std::to_string(kMaxYamlDepth) +
+                  " levels (a model or spec file nests at most 6): not a fastcal file?");
+  };
+  while (i < text.size()) {
+    const size_t line_start = i;
+    size_t indent = 0;
+    for (; i < text.size() && text[i] == ' '; ++i) ++indent;
+    int sequence_entries = 0;  // "- - - x": levels opened on this line
+    if (flow == 0 && i < text.size() && text[i] != '\n' && text[i] != '#' && text[i] != '\r') {
+      while (!indents.empty() && indents.back() > indent) indents.pop_back();
+      if (indents.empty() || indents.back() < indent) indents.push_back(indent);
+      while (i + 1 < text.size() && text[i] == '-' && (text[i + 1] == ' ' || text[i + 1] == '\t')) {
+        ++sequence_entries;
+        i += 2;
+        while (i < text.size() && text[i] == ' ') ++i;
+      }
+    }
+    const int block = static_cast<int>(indents.size()) + sequence_entries;
+    if (block > kMaxYamlDepth) refuse(i, line_start);
+    for (; i < text.size() && text[i] != '\n'; ++i) {
+      const char c = text[i];
+      if (c == '#' && (i == line_start || text[i - 1] == ' ' || text[i - 1] == '\t')) {
+        while (i < text.size() && text[i] != '\n') ++i;
+        break;
+      }
+      if (c == '"' || c == '\'') {
+        // A quoted scalar (possibly over several lines): to its closing quote.
+        for (++i; i < text.size(); ++i) {
+          if (text[i] == '\n') ++line;
+          if (c == '"' && text[i] == '\\') {
+            ++i;
+          } else if (text[i] == c) {
+            if (c == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
+              ++i;
+            } else {
+              break;
+            }
+          }
+        }
+        continue;
+      }
+      if (c == '[' || c == '{') {
+        if (block + ++flow > kMaxYamlDepth) refuse(i, line_start);
+      } else if ((c == ']' || c == '}') && flow > 0) {
+        --flow;
+      }
+    }
+    ++i;  // the newline
+    ++line;
+  }
+}
+
 }  // namespace
 
 YamlDocuments LoadYamlDocuments(const std::string& text) {
+  CheckNestingDepth(text);
   YamlDocuments result;
   std::stringstream stream(text);
   YAML::Parser parser(stream);

@@ -17,6 +17,10 @@
 
 namespace fastcal::internal {
 
+// Deepest nesting LoadYamlDocuments reads (block levels plus flow brackets); a model or
+// spec nests at most 6.
+inline constexpr int kMaxYamlDepth = 32;
+
 struct YamlDocuments {
   // The first document (Null when the text has none: empty, or only comments).
   YAML::Node first;
@@ -27,9 +31,10 @@ struct YamlDocuments {
 };
 
 // Reads `text`, as YAML::LoadAll would, but returns in bounded time and memory on any
-// input. Throws YAML::Exception (with the mark of the problem) on a syntax error,
-// including the text yaml-cpp 0.7 would loop on: "unexpected ',' after the end of the
-// document" at its line and column.
+// input. Text nested deeper than kMaxYamlDepth is refused first, in one linear pass
+// ("nesting deeper than 32 levels ...", at the line where it goes past). Throws YAML::Exception
+// (with the mark of the problem) on a syntax error, including the text yaml-cpp 0.7 would loop on:
+// "unexpected ',' after the end of the document" at its line and column.
 YamlDocuments LoadYamlDocuments(const std::string& text);
 
 }  // namespace fastcal::internal

@@ -79,6 +79,13 @@ class JsonWriter {
     return EndArray();
   }
   const std::string& str() const { return out_; }
+  // The text written since the last Take, removed from the writer (the nesting stays):
+  // a document streamed a piece at a time is the same bytes as str() of it whole.
+  std::string Take() {
+    std::string text;
+    text.swap(out_);
+    return text;
+  }
 
   static std::string Quote(const std::string& s) {
     std::string q = "\"";

@@ -1,0 +1,144 @@
+"""Faults and hostile input from Python (issue 29, items 1 and 10): a model changed by
+another thread while the core runs without the GIL, values the model file reader refuses,
+NUL bytes in paths, and arguments of the wrong kind: each a fastcal.InputError naming
+what is wrong, never a crash, a NaN, an unloadable file or a raw pybind11 error."""
+
+from __future__ import annotations
+
+import math
+import pathlib
+import subprocess
+import sys
+import textwrap
+from typing import Any, Callable
+
+import numpy as np
+import pytest
+
+import fastcal
+
+# How long the race below runs: the crash it guards against came within a second or two.
+RACE_SECONDS = 3.0
+
+RACE = textwrap.dedent(
+    """
+    import sys, threading, time
+    import numpy as np
+    import fastcal
+
+    model = fastcal.Model.nominal()
+    p = fastcal.random_workspace(samples=1000, seed=1)
+    q = fastcal.focal_attitude(p)
+    bare = [[] for _ in range(6)]
+    loaded = [[{"at_m": 10.0 + k, "mass_kg": 30.0} for k in range(8)] for _ in range(6)]
+
+    def tensions(attachments):
+        m = model.copy()
+        m.attachments = attachments
+        return fastcal.solve(p, quat=q, model=m).lower_tension_kN
+
+    expected = (tensions(bare), tensions(loaded))
+    data, _, _ = fastcal.simulate(p[:200], quat=q[:200], seed=1)
+    stop = False
+
+    def writer():
+        while not stop:
+            model.attachments = loaded
+            model.attachments = bare
+
+    thread = threading.Thread(target=writer)
+    thread.start()
+    torn = 0
+    end = time.time() + float(sys.argv[1])
+    while time.time() < end:
+        got = fastcal.solve(p, quat=q, model=model).lower_tension_kN
+        # One model or the other for the whole call, never a mix of both.
+        torn += not any(np.array_equal(got, e) for e in expected)
+        fastcal.evaluate(data, model=model)
+        fastcal.simulate(p[:50], quat=q[:50], model=model, seed=2)
+    stop = True
+    thread.join()
+    print("torn", torn)
+    """
+)
+
+
+def test_a_model_changed_by_another_thread_never_crashes_a_call() -> None:
+    # Before: SIGSEGV in the statics (the core read the model being replaced). Now each
+    # call works on a copy taken while it holds the GIL.
+    run = subprocess.run(
+        [sys.executable, "-c", RACE, str(RACE_SECONDS)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert run.returncode == 0, f"exit {run.returncode}: {run.stderr[-2000:]}"
+    assert run.stdout.strip() == "torn 0"
+
+
+def test_setters_refuse_what_the_model_file_reader_refuses(tmp_path: pathlib.Path) -> None:
+    model = fastcal.Model.nominal()
+    refused = [
+        ("cabin_mass_kg", 30.0, r"model: cabin_mass_kg: 30 kg is below the plausible minimum"),
+        ("cabin_mass_kg", math.nan, r"model: cabin_mass_kg: must be > 0"),
+        ("gravity_m_per_s2", -1.0, r"model: gravity_m_per_s2: -1 m/s\^2 is above"),
+        ("sensor_gain", [math.nan, 1, 1, 1, 1, 1], r"model: sensor_gain\[0\]: must be > 0"),
+        ("linear_density_kg_per_m", [11.718] * 5 + [0.011718], r"linear_density_kg_per_m\[5\]"),
+        ("mass_centre_cabin_m", [0.0, 0.0, 500.0], r"mass_centre_cabin_m\[2\]: 500 m"),
+        ("reflector", {"radius_m": 1e-9, "aperture_m": 1e-9}, r"reflector\.radius_m"),
+        ("tower_top_m", np.tile([300.0, 0.0, 270.0], (6, 1)), r"tower_top_m\[1\]"),
+        ("anchor_index", [0, 0, 1, 1, 2, 7], r"anchor_index\[5\]"),
+        ("anchor_index", [0.5, 0, 1, 1, 2, 2], r"anchor_index\[0\]: expected a whole number"),
+    ]
+    for name, value, message in refused:
+        with pytest.raises(fastcal.InputError, match=message):
+            setattr(model, name, value)
+    # Nothing refused was kept: the model is still one the reader takes, and save writes
+    # a file load reads back.
+    model.validate()
+    path = tmp_path / "m.yaml"
+    model.save(str(path))
+    assert fastcal.Model.load(str(path)).cabin_mass_kg == 30000.0
+
+
+def test_a_value_of_the_wrong_kind_is_an_input_error_naming_it() -> None:
+    model = fastcal.Model.nominal()
+    p = fastcal.line((0, 0, 140), (1, 0, 140), nodes=3)
+    cases: list[tuple[Callable[[], Any], str]] = [
+        (lambda: setattr(model, "cabin_mass_kg", "heavy"), "cabin_mass_kg: expected a number"),
+        (lambda: fastcal.line((0, 0, 140), (1, 0, 140), nodes=10**20), "nodes must be from"),
+        (lambda: fastcal.line((0, 0, 140), (1, 0, 140), nodes=2.5), "nodes must be a whole"),
+        (lambda: fastcal.random_workspace(samples=3, seed=-1), "seed must be from 0"),
+        (lambda: fastcal.simulate(p, seed=-1), "seed must be from 0"),
+        (lambda: fastcal.simulate(p, sessions=2.5), "sessions must be a whole number"),
+        (lambda: fastcal.solve(p, method="aas-refined", max_refinement_steps=10**20),
+         "max_refinement_steps must be from 1"),
+        (lambda: fastcal.design({"format": "fastcal-calibration-spec-1"}, samples="x"),
+         "samples must be a whole number"),
+        (lambda: setattr(model, "attachments", [[[1, 2]]] + [[]] * 5),
+         r"attachments\[0\]\[0\]: expected a dict"),
+        (lambda: setattr(model, "attachments", [[{"at_m": "x", "mass_kg": 3}]] + [[]] * 5),
+         r"attachments\[0\]\[0\]\.at_m: expected a number, got str"),
+    ]
+    for call, message in cases:
+        with pytest.raises(fastcal.InputError, match=message):
+            call()
+
+
+def test_a_nul_byte_in_a_path_is_refused_not_cut(tmp_path: pathlib.Path,
+                                                 data_dir: pathlib.Path) -> None:
+    # Before: "a.yaml\0b" was silently a.yaml (the C string ended at the NUL).
+    model_file = str(data_dir / "nominal_fast.yaml")
+    dataset_file = str(data_dir / "circle_paper.csv")
+    with pytest.raises(fastcal.InputError, match="NUL byte"):
+        fastcal.Model.load(model_file + "\0.bak")
+    with pytest.raises(fastcal.InputError, match="NUL byte"):
+        fastcal.Model.nominal().save(str(tmp_path / "m.yaml") + "\0x")
+    with pytest.raises(fastcal.InputError, match="NUL byte"):
+        fastcal.read_dataset(dataset_file + "\0x")
+    data = fastcal.read_dataset(dataset_file)
+    with pytest.raises(fastcal.InputError, match="NUL byte"):
+        data.save(str(tmp_path / "d.csv") + "\0x")
+    with pytest.raises(fastcal.InputError, match="NUL byte"):
+        fastcal.calibrate(str(data_dir / "spec_mass_centre.yaml") + "\0x", data)
+    assert list(tmp_path.iterdir()) == []  # nothing written under the cut name
