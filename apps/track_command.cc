@@ -165,6 +165,13 @@ std::string Summary(const TrackResult& r, const std::string& out) {
   s << "\nEvents (events.json; each kind at a "
     << internal::FormatDouble("%g", 100.0 * r.false_alarm)
     << "% false-alarm rate over the track): " << r.events.size() << "\n";
+  for (const TrackWander& w : r.wander) {
+    if (w.rms > 0.0) {
+      s << "  (" << w.group << " wanders between windows by "
+        << internal::FormatDouble("%.3g", w.rms) << " " << w.unit
+        << " rms per component beyond its errors: the events are steps beyond that)\n";
+    }
+  }
   for (const TrackEvent& e : r.events) {
     s << "  " << r.windows[e.window].label << "  " << e.kind;
     if (!e.cables.empty()) {

@@ -467,6 +467,38 @@ TEST(TrackTest, SensorReZeroedInsideADayIsTimedAtItsBlock) {
   EXPECT_EQ(entries, 3);
 }
 
+// A mass centre that wanders within and between days (1 cm per axis, 10 minutes, as
+// calibration_data/realistic_survey.csv's) is not a string of steps: its wander between
+// windows is estimated and stated, and no event is reported; a step well beyond the
+// wander still is, on its day.
+TEST(TrackTest, AWanderingMassCentreIsNotAStringOfSteps) {
+  constexpr int kDays = 10, kPerDay = 200;
+  for (const bool step : {false, true}) {
+    SimulationOptions o;
+    o.mass_centre_drift_m = 0.01;
+    o.mass_centre_drift_time_s = 600.0;
+    if (step) o.mass_centre_steps.push_back({kStartS + 6 * kDayS - 3600.0, {0.1, 0.0, 0.0}});
+    CableRobot truth;
+    const Dataset data = Season(kDays, kPerDay, 61, o, &truth);
+    const std::string dir = TempDir(step ? "wander_step" : "wander");
+    fs::create_directories(dir);
+    const TrackResult r =
+        Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
+              {Write(data, dir + "/season.csv")}, dir + "/track");
+    ASSERT_EQ(r.wander.size(), 1u);
+    EXPECT_EQ(r.wander[0].group, "mass_centre_m");
+    EXPECT_GT(r.wander[0].rms, 0.002);
+    EXPECT_LT(r.wander[0].rms, 0.02);
+    if (!step) {
+      EXPECT_TRUE(r.events.empty()) << r.events.size() << " events";
+      continue;
+    }
+    ASSERT_EQ(r.events.size(), 1u);
+    EXPECT_EQ(r.windows[r.events[0].window].label, "2024-05-07");
+    EXPECT_NEAR(r.events[0].parameters[0].shift, 0.1, 3.0 * r.events[0].parameters[0].sigma_total);
+  }
+}
+
 TEST(TrackBadInputTest, RefusesWhatItCannotTrack) {
   const std::string dir = TempDir("bad");
   fs::create_directories(dir + "/full");

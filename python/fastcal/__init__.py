@@ -1090,6 +1090,9 @@ class TrackResult:
             sample), after_s (the earlier one's last), window, previous_window,
             parameters (name -> {shift, sigma_total, unit}), cables (for a sensor),
             statistic, degrees_of_freedom, threshold, p_value (family-wise).
+        wander: per per-window group, its wander between windows beyond its errors
+            (parameters, rms per component, unit; rms 0: none seen): the parameter
+            events are steps beyond it.
         shared: the shared parameters (name, unit, estimate {value, sigma_total,
             sigma_formal}, from_window, to_window: a re-zeroed sensor's bias has one entry
             per stretch).
@@ -1103,6 +1106,7 @@ class TrackResult:
         self.out: str = out
         self.windows: List[Dict[str, Any]] = raw["windows"]
         self.events: List[Dict[str, Any]] = raw["events"]
+        self.wander: List[Dict[str, Any]] = raw["wander"]
         self.shared: List[Dict[str, Any]] = raw["shared"]
         self.window_parameters: List[str] = raw["window_parameters"]
         self.files: List[str] = raw["files"]

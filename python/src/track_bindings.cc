@@ -103,6 +103,15 @@ py::dict ResultDict(const TrackResult& r) {
   d["folds"] = r.folds;
   d["updated"] = r.updated;
   d["notes"] = r.notes;
+  py::list wander;
+  for (const TrackWander& w : r.wander) {
+    py::dict x;
+    x["parameters"] = w.group;
+    x["rms"] = w.rms;
+    x["unit"] = w.unit;
+    wander.append(x);
+  }
+  d["wander"] = wander;
   std::vector<std::string> models;
   for (const auto& m : r.models) models.push_back("model_calibrated@" + m.first + ".yaml");
   d["models"] = models;

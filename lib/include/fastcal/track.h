@@ -173,6 +173,16 @@ struct TrackEvent {
   double p_value = 1.0;
 };
 
+// A per-window group's wander between windows beyond its estimates' errors (a mass
+// centre that moves about within and between days, not in steps): the variance per
+// component that, added to each window's, brings the median of the consecutive windows'
+// difference statistics to the chi-square median; the events are steps beyond it.
+struct TrackWander {
+  std::string group;  // "mass_centre_m", or the parameter's name
+  std::string unit;
+  double rms = 0.0;  // sqrt of the variance per component, in `unit` (0: none seen)
+};
+
 struct TrackResult {
   std::vector<std::string> files;  // every data file of the track
   WindowSpec window;
@@ -182,6 +192,7 @@ struct TrackResult {
   std::vector<TrackEvent> events;  // time order
   double false_alarm = 0.01;
   int parameter_tests = 0, sensor_tests = 0;
+  std::vector<TrackWander> wander;  // per group tested for parameter events
   SlowErrorReport slow_error;
   long long samples = 0, readings = 0, gross_errors = 0;
   double chi_square = 0.0, reduced_chi_square = 0.0;

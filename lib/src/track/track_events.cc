@@ -129,7 +129,10 @@ struct GroupChange {
   Eigen::MatrixXd covariance;
   double statistic = 0.0;
 };
-GroupChange Change(const TrackRun& run, const std::vector<int>& g, int from, int to) {
+// `wander`: the group's variance per component between windows (GroupWander), added to
+// both windows'.
+GroupChange Change(const TrackRun& run, const std::vector<int>& g, int from, int to,
+                   double wander = 0.0) {
   const int dof = static_cast<int>(g.size());
   const Eigen::MatrixXd c = TotalCovariance(run, to, to) + TotalCovariance(run, from, from) -
                             TotalCovariance(run, to, from) - TotalCovariance(run, from, to);
@@ -139,9 +142,48 @@ GroupChange Change(const TrackRun& run, const std::vector<int>& g, int from, int
   for (int x = 0; x < dof; ++x) {
     out.d[x] = run.solver.a(to)[g[x]] - run.solver.a(from)[g[x]];
     for (int y = 0; y < dof; ++y) out.covariance(x, y) = c(g[x], g[y]);
+    out.covariance(x, x) += 2.0 * wander;
   }
   out.statistic = out.d.dot(Eigen::LDLT<Eigen::MatrixXd>(out.covariance).solve(out.d));
   return out;
+}
+
+// Fewest window boundaries from which a group's wander is estimated.
+// (A step inside a window changes the two boundaries around it: the median of 8 or more
+// holds against three such.)
+constexpr int kMinWanderBoundaries = 8;
+
+// The group's wander between windows (track.h, TrackWander): the variance v per component
+// (SI) at which the median over consecutive windows of d^T (C + 2 v I)^-1 d is the
+// chi-square median (a random effect per window, estimated robustly: a few steps among
+// the boundaries do not move the median); 0 when the median is already below it.
+double GroupWander(const TrackRun& run, const std::vector<int>& g) {
+  const int boundaries = static_cast<int>(run.used.size()) - 1;
+  if (boundaries < kMinWanderBoundaries) return 0.0;
+  const int dof = static_cast<int>(g.size());
+  std::vector<GroupChange> changes;
+  for (int u = 1; u <= boundaries; ++u) changes.push_back(Change(run, g, u - 1, u));
+  const double target = ChiSquareQuantile(0.5, dof);
+  const auto median_at = [&](double v) {
+    std::vector<double> t;
+    for (const GroupChange& c : changes) {
+      Eigen::MatrixXd m = c.covariance;
+      m.diagonal().array() += 2.0 * v;
+      t.push_back(c.d.dot(Eigen::LDLT<Eigen::MatrixXd>(m).solve(c.d)));
+    }
+    std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
+    return t[t.size() / 2];
+  };
+  if (!(median_at(0.0) > target)) return 0.0;
+  double scale = 0.0;  // the differences' own variance: where to start
+  for (const GroupChange& c : changes) scale = std::max(scale, c.covariance.diagonal().maxCoeff());
+  double lo = 0.0, hi = std::max(scale, 1e-300);
+  for (int k = 0; k < 200 && median_at(hi) > target; ++k) hi *= 4.0;
+  for (int k = 0; k < 100; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (median_at(mid) > target ? lo : hi) = mid;
+  }
+  return hi;
 }
 
 // A step within used window u's telemetry: the score test of "these parameters differ
@@ -156,7 +198,7 @@ struct InnerStep {
   int splits = 0;
 };
 InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
-                     const std::vector<int>& columns) {
+                     const std::vector<int>& columns, bool widened = false) {
   const WindowFold& f = run.windows[run.used[u]].fold;
   const int blocks = static_cast<int>(f.block_samples.size());
   const int pg = static_cast<int>(rows.size());
@@ -191,7 +233,8 @@ InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
     const ArrowVector solved = run.solver.SolveFor(c);
     const Eigen::MatrixXd schur =
         self - c.a[u].transpose() * solved.a[u] - c.b.transpose() * solved.b;
-    const double t = score.dot(Eigen::LDLT<Eigen::MatrixXd>(schur).solve(score)) / run.birge[u];
+    const double t = score.dot(Eigen::LDLT<Eigen::MatrixXd>(schur).solve(score)) /
+                     (widened ? std::max(run.birge[u], run.widening[u]) : run.birge[u]);
     if (std::isfinite(t) && t > best.statistic) {
       best.statistic = t;
       best.block = j;
@@ -200,11 +243,13 @@ InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
   return best;
 }
 
-// The scan of group g (indices into layout.window_columns: the first block rows).
-InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& g) {
+// The scan of group g (indices into layout.window_columns: the first block rows). A
+// group that wanders (GroupWander) is judged against the window's whole widening, its
+// residuals' correlation in time included: a wander is not a step.
+InnerStep ScanGroupWithin(const TrackRun& run, int u, const std::vector<int>& g, bool wanders) {
   std::vector<int> columns;
   for (int x : g) columns.push_back(run.layout.window_columns[x]);
-  return ScanWithin(run, u, g, columns);
+  return ScanWithin(run, u, g, columns, wanders);
 }
 
 // Whether the scan of window u found a step inside it (Bonferroni over its splits).
@@ -236,28 +281,45 @@ void GroupEvents(const TrackRun& run, const std::vector<int>& g, std::vector<Tra
   const bool sensor =
       first.kind == ParameterKind::kSensorBias || first.kind == ParameterKind::kSensorGain;
   const int windows = static_cast<int>(run.used.size());
+  const double wander = GroupWander(run, g);
+  {
+    TrackWander w;
+    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[0]]);
+    w.group = dof > 1 ? std::string(ParameterGroupName(s.kind)) : s.name;
+    w.unit = s.unit;
+    w.rms = std::sqrt(wander) / s.to_si;
+    run.result->wander.push_back(w);
+  }
   std::vector<bool> changed(windows, false);
-  for (int u = 1; u < windows; ++u) changed[u] = Change(run, g, u - 1, u).statistic > threshold;
+  for (int u = 1; u < windows; ++u) {
+    changed[u] = Change(run, g, u - 1, u, wander).statistic > threshold;
+  }
   int last_to = -1;  // the later window of the group's last event: events do not overlap
   for (int u = 1; u < windows; ++u) {
     if (!changed[u]) continue;
     int from = u - 1, to = u, inside = -1;
     InnerStep step;
-    const InnerStep here = ScanWithin(run, u, g);
-    const InnerStep before = u - 1 != last_to ? ScanWithin(run, u - 1, g) : InnerStep();
+    const InnerStep here = ScanGroupWithin(run, u, g, wander > 0.0);
+    const InnerStep before =
+        u - 1 != last_to ? ScanGroupWithin(run, u - 1, g, wander > 0.0) : InnerStep();
     const bool in_here = Inside(run, here, dof), in_before = Inside(run, before, dof);
-    if (in_here && (!in_before || here.statistic >= before.statistic)) {
+    // The step inside a window is the change across it, which must stand on its own.
+    const auto across = [&](int a, int b) {
+      return Change(run, g, a, b, wander).statistic > threshold;
+    };
+    if (in_here && (!in_before || here.statistic >= before.statistic) &&
+        across(u - 1, std::min(u + 1, windows - 1))) {
       inside = u;
       step = here;
       to = std::min(u + 1, windows - 1);
-    } else if (in_before) {
+    } else if (in_before && across(std::max(u - 2, 0), u)) {
       inside = u - 1;
       step = before;
       from = std::max(u - 2, 0);
     }
     for (int v = u + 1; v <= to; ++v) changed[v] = false;
     last_to = to;
-    const GroupChange change = Change(run, g, from, to);
+    const GroupChange change = Change(run, g, from, to, wander);
     TrackEvent e = EventAt(run, from, to, sensor ? "sensor" : "parameter", change.statistic, dof,
                            threshold, tests);
     if (inside >= 0) {
@@ -474,6 +536,7 @@ TrackStatus ScanSensorSteps(TrackRun& run) {
 TrackStatus FindParameterEvents(TrackRun& run) {
   TrackResult& r = *run.result;
   r.events.clear();
+  r.wander.clear();
   // Sensor events: every split bias, tested on the final fit.
   if (r.sensor_tests > 0) {
     const double threshold = ChiSquareQuantile(run.options.false_alarm / r.sensor_tests, 1);

@@ -98,6 +98,17 @@ std::string EventsJson(const TrackResult& r) {
   j.Key("parameter_tests").Int(r.parameter_tests);
   j.Key("sensor_tests").Int(r.sensor_tests);
   j.Key("windows").Int(static_cast<long long>(r.windows.size()));
+  // Each per-window group's wander between windows beyond its errors (track.h): the
+  // parameter events are steps beyond it.
+  j.Key("wander").BeginArray();
+  for (const TrackWander& w : r.wander) {
+    j.BeginObject();
+    j.Key("parameters").String(w.group);
+    j.Key("rms").Number(w.rms);
+    j.Key("unit").String(w.unit);
+    j.EndObject();
+  }
+  j.EndArray();
   j.Key("events").BeginArray();
   for (const TrackEvent& e : r.events) {
     j.BeginObject();
