@@ -191,6 +191,14 @@ std::string TrackHtml(const TrackResult& r) {
        "(the cables' and sensors' shared parameters): it cancels from the differences "
        "between windows, which the events test: the dots can scatter less than the bars suggest, "
        "and a step well inside them can be significant.</p>\n";
+  for (const TrackWander& w : r.wander) {
+    if (w.rms > 0.0) {
+      h += "<p>" + Esc(w.group) + " wanders between windows by " +
+           FormatDouble("%.3g", w.rms) + " " + Esc(w.unit) +
+           " rms per component beyond its errors (estimated from the differences between "
+           "consecutive windows): the events are steps beyond that.</p>\n";
+    }
+  }
   for (size_t k = 0; k < r.window_parameters.size(); ++k) h += ParameterPlot(r, axis, k) + "\n";
   if (r.windows.front().has_offsets) {
     h += "<h2>Sensors</h2>\n<p>The shared bias of each sensor plus the window's own departure "
