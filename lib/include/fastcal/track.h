@@ -82,6 +82,9 @@ std::string WindowSpecText(const WindowSpec& window);
 using FoldRunner = std::function<bool(const std::vector<std::string>& tasks,
                                       std::vector<std::string>* folds, std::string* error)>;
 
+// Largest data file a track reads (TrackOptions::read).
+inline constexpr long long kTrackMaxFileBytes = 1LL << 40;
+
 struct TrackOptions {
   // One line per stage and iteration; the library never prints.
   std::function<void(const std::string&)> progress;
@@ -90,8 +93,14 @@ struct TrackOptions {
   // Null: fold on this machine's threads.
   FoldRunner runner;
   // How the data files are read (DatasetReadOptions: skip_invalid_rows, limits, a
-  // column map).
-  DatasetReadOptions read;
+  // column map). Each file is streamed a chunk at a time into the window store, so that
+  // a season in one long file is read with bounded memory: files up to 1 TiB (not
+  // ReadDataset's 1 GiB).
+  DatasetReadOptions read = [] {
+    DatasetReadOptions r;
+    r.max_file_bytes = kTrackMaxFileBytes;
+    return r;
+  }();
   // Gauss-Newton iterations (each a fold of the windows that moved) at most.
   int max_iterations = 20;
   // Converged when every parameter's step is below this fraction of its formal sigma
