@@ -14,7 +14,24 @@
 //
 // Data: random poses over the focal-sphere cap (<= 40 deg, +-3 m), focal law, truth mass
 // centre (0.22, 0.11, 0.5) m, 3% tension noise (seeded).
+//
+// BM_RealisticEndToEnd/N (issue 28): the same end to end with the recommended spec,
+// calibration_data/spec_realistic.yaml (mass centre, per-cable densities, gains and biases:
+// 21 free parameters, tower offsets as consider parameters), on the data of
+// `fastcal simulate --trajectory=random --samples=N --tension-noise-pct=3
+// --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=1.5` (seed 1, focal law): wall time,
+// cpu_s (user + system) and peak_rss_MB of the forked child.
+//
+// BM_SampleRows/part (issue 28): one sample's share of a Jacobian evaluation of the fit
+// with spec_realistic.yaml, per sample over 4096 of the samples above: 0 statics (exact,
+// warm-started from the initial parameters' solution, at parameters a fit step away),
+// 1 derivatives (the tensions' gradient by the implicit-function theorem and the 6 x 21
+// Jacobian), 2 folding (the robust loss's correction and the QR fold of the rows into R),
+// 3 statics and derivatives together (TensionResidual::Evaluate), 4 the same by a Jet as
+// wide as n through the replayed statics (TensionCost::EvaluateJet: before issue 28). One
+// thread.
 // Run: build/bench/calibration_bench --benchmark_filter=EndToEnd   (about a minute)
+//      build/bench/calibration_bench --benchmark_filter='Realistic|SampleRows'  (~2 min)
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -26,7 +43,13 @@
 #include <random>
 
 #include "fastcal/calibration.h"
+#include "fastcal/internal/calibration_linearisation.h"
+#include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/folded_cost.h"
+#include "fastcal/internal/row_fold.h"
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/report.h"
+#include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
 
 namespace fastcal {
@@ -113,15 +136,16 @@ CalibrationSpec Spec(StaticsMethod forward) {
   return spec;
 }
 
-// In the child: read, calibrate, write the report into `dir`. Exit code 0 on success.
-int ReadCalibrateReport(const std::string& csv, const std::string& dir) {
+// In the child: read, calibrate with `spec`, write the report into `dir`. Exit code 0 on
+// success.
+int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& spec,
+                        const std::string& dir) {
   Dataset data;
   std::string error;
   DatasetReadOptions read;
   read.threads = 2;  // as fastcal calibrate reads
   if (!ReadDataset(csv, read, &data, &error)) return 1;
   const CableRobot model = CableRobot::NominalFast();
-  const CalibrationSpec spec = Spec(StaticsMethod::kExact);
   CalibrationResult result;
   if (Calibrate(model, spec, data, CalibrationOptions(), &result, &error) !=
       CalibrationStatus::kOk) {
@@ -137,20 +161,16 @@ int ReadCalibrateReport(const std::string& csv, const std::string& dir) {
   return WriteReportFiles(dir, inputs, &error) ? 0 : 3;
 }
 
-void BM_CalibrateEndToEnd(benchmark::State& state) {
-  const std::string csv = DataFile(static_cast<int>(state.range(0)));
-  if (csv.empty()) {
-    state.SkipWithError("cannot write the dataset file");
-    return;
-  }
-  const std::string dir = csv + ".out";
+// Runs `child` in a forked process per iteration: wall time, its CPU time and peak memory.
+template <typename Child>
+void ForkedIterations(benchmark::State& state, const Child& child) {
   for (auto _ : state) {
     const auto start = std::chrono::steady_clock::now();
-    const pid_t child = fork();
-    if (child == 0) _exit(ReadCalibrateReport(csv, dir));
+    const pid_t pid = fork();
+    if (pid == 0) _exit(child());
     int status = 0;
     rusage usage{};
-    wait4(child, &status, 0, &usage);
+    wait4(pid, &status, 0, &usage);
     state.SetIterationTime(
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
@@ -161,18 +181,210 @@ void BM_CalibrateEndToEnd(benchmark::State& state) {
     state.counters["cpu_s"] = usage.ru_utime.tv_sec + usage.ru_utime.tv_usec * 1e-6 +
                               usage.ru_stime.tv_sec + usage.ru_stime.tv_usec * 1e-6;
   }
-  std::filesystem::remove_all(dir);
-  std::filesystem::remove(csv);
   state.counters["samples"] = static_cast<double>(state.range(0));
 }
 
-BENCHMARK(BM_CalibrateEndToEnd)
-    ->Arg(10000)
-    ->Arg(100000)
-    ->Arg(1000000)
-    ->Iterations(1)
-    ->Unit(benchmark::kSecond)
-    ->UseManualTime();
+// Read, calibrate with `spec` and report `csv` (then removed) in a forked child.
+void EndToEnd(benchmark::State& state, const std::string& csv, const CalibrationSpec& spec) {
+  if (csv.empty()) {
+    state.SkipWithError("cannot write the dataset file");
+    return;
+  }
+  const std::string dir = csv + ".out";
+  ForkedIterations(state, [&] { return ReadCalibrateReport(csv, spec, dir); });
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(csv);
+}
+
+// 10^4, 10^5 and 10^6 samples, one run each, in seconds of wall time.
+void EndToEndSizes(benchmark::internal::Benchmark* b) {
+  b->Arg(10000)->Arg(100000)->Arg(1000000)->Iterations(1)->Unit(benchmark::kSecond);
+  b->UseManualTime();
+}
+
+void BM_CalibrateEndToEnd(benchmark::State& state) {
+  EndToEnd(state, DataFile(static_cast<int>(state.range(0))), Spec(StaticsMethod::kExact));
+}
+
+// ---------------------------------------------------------------------------------------
+// spec_realistic.yaml (issue 28).
+
+const char kRealisticSpec[] = FASTCAL_SOURCE_DIR "/calibration_data/spec_realistic.yaml";
+
+// `fastcal simulate --trajectory=random --samples=N --tension-noise-pct=3
+// --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=1.5`'s data, to `sink`.
+bool SimulateRealistic(int samples, const SampleSink& sink) {
+  RandomWorkspaceSpec positions;
+  positions.samples = samples;
+  positions.seed = 1;
+  PositionStream stream;
+  std::string error;
+  if (!RandomWorkspacePositionStream(positions, &stream, &error)) return false;
+  PoseStream poses;
+  poses.count = stream.count;
+  poses.next = [&stream] {
+    Pose pose;
+    pose.position_m = stream.next();
+    pose.rotation = FocalAttitude(pose.position_m, FocalAttitudeLaw());
+    return pose;
+  };
+  SimulationOptions options;
+  options.tension_noise_percent = 3.0;
+  options.sensor_gain_spread_percent = 1.0;
+  options.sensor_bias_spread_kn = 1.5;
+  CableRobot truth_used;
+  SimulationSummary summary;
+  return SimulateStream(CableRobot::NominalFast(), poses, options, sink, &truth_used, &summary,
+                        &error);
+}
+
+std::string RealisticDataFile(int samples) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("fastcal_bench_realistic_" + std::to_string(getpid()) + "_" +
+                             std::to_string(samples) + ".csv"))
+                               .string();
+  DatasetWriter writer;
+  std::string error;
+  if (!writer.Open(path, SimulatedDatasetLayout(), "calibration_bench", &error)) return "";
+  const bool ok = SimulateRealistic(
+      samples, [&](const Sample& s, std::string* e) { return writer.Write(s, e); });
+  return ok && writer.Close(&error) ? path : "";
+}
+
+void BM_RealisticEndToEnd(benchmark::State& state) {
+  CalibrationSpec spec;
+  std::string error;
+  if (!LoadCalibrationSpec(kRealisticSpec, CableRobot::NominalFast(), &spec, &error)) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  EndToEnd(state, RealisticDataFile(static_cast<int>(state.range(0))), spec);
+}
+
+BENCHMARK(BM_RealisticEndToEnd)->Apply(EndToEndSizes);
+
+// The per-sample parts of a Jacobian evaluation (file comment), range(0): the part.
+void BM_SampleRows(benchmark::State& state) {
+  constexpr int kSamples = 4096;
+  Dataset data;
+  SimulateRealistic(kSamples, [&](const Sample& s, std::string*) {
+    data.samples.push_back(s);
+    return true;
+  });
+  const CableRobot model = CableRobot::NominalFast();
+  CalibrationSpec spec;
+  std::string error;
+  if (!LoadCalibrationSpec(kRealisticSpec, model, &spec, &error)) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const internal::CalibrationModel cm(model, spec);
+  const int n = cm.num_free();
+  const int count = static_cast<int>(data.samples.size());
+  std::vector<int> fit(count);
+  std::vector<std::array<double, kNumCables>> sigma(count);
+  internal::CompactStarts starts(StaticsMethod::kExact);
+  starts.Reset(count);
+  const StaticsOptions statics = ModelFitStaticsOptions(StaticsMethod::kExact);
+  for (int t = 0; t < count; ++t) {
+    fit[t] = t;
+    StaticsSolution s;
+    SolveStatics(model, data.samples[t].pose, statics, &s);
+    starts.Set(t, s);
+    sigma[t] = internal::TensionSigmas(data.samples[t].tension_n, 0.0, 3.0);
+  }
+  internal::FittedSamples samples;
+  samples.model = &cm;
+  samples.data = &data;
+  samples.fit = &fit;
+  samples.sigma_n = &sigma;
+  samples.starts = &starts;
+  samples.statics = statics;
+  // A fit step away from the starts: the mass centre moved by 2 cm, the gains by 0.5%.
+  std::vector<double> theta = cm.InitialTheta();
+  for (int k = 0; k < n; ++k) {
+    const ParameterKind kind = spec.parameters[cm.spec_index(k)].kind;
+    if (kind == ParameterKind::kMassCentre) theta[k] += 0.02;
+    if (kind == ParameterKind::kSensorGain) theta[k] *= 1.005;
+  }
+  std::vector<StaticsParameters<double>> params(1);
+  std::array<double, kNumCables> gain, bias;
+  cm.Assemble(theta.data(), &params[0], &gain, &bias);
+  // The solutions, for the derivatives alone; the rows, for the folding alone.
+  std::vector<StaticsSolution> solutions(count);
+  Eigen::MatrixXd rows(kNumCables * count, n + 1);
+  std::vector<double> j(kNumCables * n);
+  for (int t = 0; t < count; ++t) {
+    const internal::TensionResidual f = samples.At(t);
+    f.start.Restore(f.pose, statics.method, &solutions[t]);
+    StaticsOptions warm = statics;
+    warm.warm_start = true;
+    SolveStaticsWithParameters(params[0], f.pose, warm, &solutions[t]);
+    double r[kNumCables];
+    f.Evaluate(theta.data(), r, j.data());
+    for (int i = 0; i < kNumCables; ++i) {
+      for (int k = 0; k < n; ++k) rows(kNumCables * t + i, k) = j[i * n + k];
+      rows(kNumCables * t + i, n) = r[i];
+    }
+  }
+  const ceres::HuberLoss huber(3.0);
+  const int part = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    double sink = 0.0;
+    if (part == 0 || part == 3 || part == 4) {
+      for (int t = 0; t < count; ++t) {
+        const internal::TensionResidual f = samples.At(t);
+        double r[kNumCables];
+        if (part == 0) {
+          f(theta.data(), r);
+        } else if (part == 3) {
+          f.Evaluate(theta.data(), r, j.data());
+        } else {
+          internal::TensionCost::EvaluateJet(f, theta.data(), r, j.data());
+        }
+        sink += r[0];
+      }
+    } else if (part == 1) {
+      for (int t = 0; t < count; ++t) {
+        internal::TensionGradient g;
+        internal::ExactTensionGradient(params[0], data.samples[t].pose, solutions[t],
+                                       statics.catenary.vertical_span_fraction, cm.frees_geometry(),
+                                       &g);
+        cm.ReadingJacobian(g, gain, 0, j.data());
+        sink += j[0];
+      }
+    } else {
+      // As FoldedTensionCost::Fold: each sample's rows corrected for the loss and folded
+      // into R (row_fold.h).
+      internal::RowFold fold(n + 1);
+      std::vector<double> jt(kNumCables * n), block(kNumCables * (n + 1));
+      for (int t = 0; t < count; ++t) {
+        double r[kNumCables];
+        for (int i = 0; i < kNumCables; ++i) {
+          r[i] = rows(kNumCables * t + i, n);
+          for (int k = 0; k < n; ++k) jt[i * n + k] = rows(kNumCables * t + i, k);
+        }
+        sink += internal::CorrectForLoss(&huber, r, jt.data(), n);
+        for (int i = 0; i < kNumCables; ++i) {
+          std::copy(&jt[i * n], &jt[i * n] + n, &block[i * (n + 1)]);
+          block[i * (n + 1) + n] = r[i];
+        }
+        fold.Add(block.data(), kNumCables);
+      }
+      fold.Flush();
+      sink += fold.r()(0, 0);
+    }
+    benchmark::DoNotOptimize(sink);
+  }
+  state.SetItemsProcessed(state.iterations() * count);
+  const char* names[] = {"statics", "derivatives", "folding", "statics and derivatives",
+                         "statics and derivatives by Jets"};
+  state.SetLabel(names[part]);
+}
+
+BENCHMARK(BM_SampleRows)->DenseRange(0, 4)->Unit(benchmark::kMicrosecond);
+
+BENCHMARK(BM_CalibrateEndToEnd)->Apply(EndToEndSizes);
 
 // range(0): samples, range(1): 0 aas, 2 exact.
 void BM_Calibrate(benchmark::State& state) {

@@ -869,6 +869,43 @@ TEST(CalibrationTest, ThreadsDoNotChangeTheResult) {
   }
 }
 
+TEST(CalibrationTest, ReplayedJacobiansGiveTheBudgetOfKeptOnes) {
+  // Slow tension drift: the residuals are correlated, and the budget's batch correction
+  // reads every sample's J_t, replayed from the linearisation's inputs (no change scan,
+  // issue 28) or kept in memory (the change scan's): the same bits. 1500 samples: two
+  // chunks of rows.
+  std::vector<Pose> poses;
+  for (const Sample& s : CircleData(Truth(), 1500, 0.0, 1).samples) poses.push_back(s.pose);
+  SimulationOptions o;
+  o.tension_noise_percent = 3;
+  o.tension_drift_percent = 2;
+  o.tension_drift_time_s = 60;
+  o.seed = 3;
+  Dataset data;
+  std::string error;
+  ASSERT_TRUE(Simulate(Truth(), poses, o, &data, nullptr, nullptr, &error)) << error;
+  CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+  CalibrationOptions options;
+  options.change_scan_replicates = 20;  // the scan's own numbers are not compared
+  CalibrationResult replayed, kept;
+  ASSERT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, options, &replayed, &error),
+            CalibrationStatus::kOk)
+      << error;
+  spec.change_scan_groups = {"mass_centre_m"};
+  ASSERT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, options, &kept, &error),
+            CalibrationStatus::kOk)
+      << error;
+  ASSERT_TRUE(replayed.budget.correlated);
+  EXPECT_EQ(replayed.budget.bandwidth, kept.budget.bandwidth);
+  EXPECT_EQ(replayed.budget.widest_bandwidth, kept.budget.widest_bandwidth);
+  EXPECT_EQ(replayed.budget.max_batch_correction, kept.budget.max_batch_correction);
+  EXPECT_GT(replayed.budget.max_batch_correction, 1.0);
+  for (size_t p = 0; p < replayed.parameters.size(); ++p) {
+    EXPECT_EQ(replayed.parameters[p].sigma_total, kept.parameters[p].sigma_total)
+        << replayed.parameters[p].name;
+  }
+}
+
 // On long data the candidates come from an evenly spaced subsample (the option): the
 // consider budget and the ranking's leader agree with the full pass.
 TEST(CalibrationTest, CandidateSubsampleAgreesWithTheFullPass) {

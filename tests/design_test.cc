@@ -74,7 +74,7 @@ TEST(Design, GradientMatchesNumericDifferentiation) {
     ASSERT_TRUE(internal::AddPoseRows(robot, spec, poses, &pr, &error)) << error;
     pr.wanted = {0, 1, 2};
     pr.wanted_weight = Eigen::VectorXd::Zero(pr.n);
-    pr.wanted_weight.head(3).setOnes();
+    pr.wanted_weight.head(3) << 1.0, 2.0, 0.5;  // A: unequal weights (D ignores them)
     pr.criterion = criterion;
     ASSERT_EQ(pr.q, 1);
     Eigen::VectorXd w = Eigen::VectorXd::LinSpaced(pr.candidates(), 1.0, 3.0);

@@ -274,6 +274,35 @@ TEST(FoldedCostTest, ThreadsGiveTheSameBitsWithASlowError) {
   EXPECT_EQ(FoldedOnThreads(f, nullptr, 1), FoldedOnThreads(f, nullptr, 3));
 }
 
+// A trial step's cost, then the Jacobian at the same theta (the memo): the same numbers
+// as a fresh block's, and the cost the one its residuals carry.
+TEST(FoldedCostTest, CostThenJacobianAtTheSameTheta) {
+  const Fixture f(kSampleChunk + 30);
+  const ceres::HuberLoss huber(1.0);
+  const std::vector<double> fresh = FoldedOnThreads(f, &huber, 2);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[0] += 0.1;  // as FoldedOnThreads
+  const FoldedTensionCost cost(f.Samples(), &huber, 2);
+  const int m = cost.num_residuals();
+  const double* parameters[1] = {theta.data()};
+  std::vector<double> trial(m);
+  ASSERT_TRUE(cost.Evaluate(parameters, trial.data(), nullptr));
+  double fresh_cost = 0.0, trial_cost = 0.0;
+  for (int k = 0; k < m; ++k) {
+    fresh_cost += fresh[k] * fresh[k];
+    trial_cost += trial[k] * trial[k];
+  }
+  constexpr double kRelTol = 1e-12;  // |z|^2 + e^2 against the sum of rho, rounding
+  EXPECT_NEAR(trial_cost, fresh_cost, kRelTol * fresh_cost);
+  std::vector<double> out(m * (1 + theta.size()));
+  double* jacobians[1] = {out.data() + m};
+  ASSERT_TRUE(cost.Evaluate(parameters, out.data(), jacobians));
+  EXPECT_EQ(out, fresh);
+  theta[1] += 0.01;  // another theta: not the memo's
+  ASSERT_TRUE(cost.Evaluate(parameters, trial.data(), nullptr));
+  EXPECT_NE(trial[m - 1] * trial[m - 1], trial_cost);
+}
+
 // A sample the statics cannot solve (a non-positive density) fails the evaluation, as one
 // per-sample block would: Ceres then rejects the step.
 TEST(FoldedCostTest, AnUnsolvableSampleFailsTheEvaluation) {

@@ -290,6 +290,30 @@ TEST(SlowErrorEstimate, StatedTimeConstantEstimatedAmplitude) {
   EXPECT_NEAR(r.process.sigma_percent, truth.slow_percent, 3.0 * r.amplitude_sigma);
 }
 
+TEST(SlowErrorEstimate, ThreadsDoNotChangeTheLikelihood) {
+  // The cables' filters split among threads: the same bits on any number, with readings
+  // left out, two sessions and the gain profiled out too.
+  Truth truth;
+  truth.samples = 500;
+  truth.session_offset_n = 18000.0;
+  SlowErrorEstimateInputs in = Simulate(truth, 7);
+  in.gain_nuisance = true;
+  for (size_t t = 0; t < in.samples.size(); t += 7) in.samples[t].excluded[t % kNumCables] = true;
+  SlowErrorProcess process;
+  process.sigma_percent = truth.slow_percent;
+  process.time_constant_s = truth.tau_s;
+  ASSERT_TRUE(process.IsActive());
+  for (const SlowErrorProcess& p : {process, SlowErrorProcess()}) {
+    in.num_threads = 1;
+    const double one = internal::SlowErrorMinusTwoLogLikelihood(in, p);
+    EXPECT_TRUE(std::isfinite(one));
+    for (int threads : {2, 3, 4, 6, 8}) {
+      in.num_threads = threads;
+      EXPECT_EQ(internal::SlowErrorMinusTwoLogLikelihood(in, p), one) << threads << " threads";
+    }
+  }
+}
+
 TEST(SlowErrorEstimate, SamplesForALongDataset) {
   EXPECT_EQ(internal::SlowErrorEstimateSamples(50, 100).size(), 50u);
   const std::vector<int> runs = internal::SlowErrorEstimateSamples(100000, 1000);

@@ -12,12 +12,15 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/statics.h"
+#include "test_robots.h"
 
 namespace fastcal {
 
 void PrintTo(StaticsStatus status, std::ostream* os) { *os << StaticsStatusName(status); }
 
 namespace {
+
+using testing::AsBuiltRobot;
 
 // Relative agreement of two exact solves of one equilibrium (each to 1e-12).
 constexpr double kSolveTol = 1e-9;
@@ -44,17 +47,6 @@ StaticsSolution Solve(const CableRobot& robot, const Pose& pose,
   StaticsSolution s;
   SolveStatics(robot, pose, options, &s);
   return s;
-}
-
-// The telemetry: each cable a 250-650 kg assembly 2-6 m above the cabin and
-// 0.6-1.6 kg/m of hung lines over the lowest 120-200 m.
-CableRobot AsBuilt() {
-  CableRobot robot = CableRobot::NominalFast();
-  for (int i = 0; i < kNumCables; ++i) {
-    robot.cables[i].attachments = {Point(2.0 + 0.8 * i, 250.0 + 80.0 * i),
-                                   Range(0.0, 120.0 + 16.0 * i, 0.6 + 0.2 * i)};
-  }
-  return robot;
 }
 
 const Eigen::Vector3d kK2(42.65, 33.73, 149.52);
@@ -126,7 +118,7 @@ TEST(StaticsAttachmentsTest, MasslessAttachmentsChangeNothing) {
 }
 
 TEST(StaticsAttachmentsTest, ExactSolvesTheWorkspaceCapWithEquilibriumAndChecks) {
-  const CableRobot robot = AsBuilt();
+  const CableRobot robot = AsBuiltRobot();
   std::mt19937_64 rng(181);
   std::uniform_real_distribution<double> u01(0.0, 1.0);
   StaticsOptions options;
@@ -153,7 +145,7 @@ TEST(StaticsAttachmentsTest, ExactSolvesTheWorkspaceCapWithEquilibriumAndChecks)
 
 TEST(StaticsAttachmentsTest, AasMethodsRefuseCablesWithAttachments) {
   for (StaticsMethod method : {StaticsMethod::kAas, StaticsMethod::kAasRefined}) {
-    const StaticsSolution s = Solve(AsBuilt(), FocalPose(kK2), method);
+    const StaticsSolution s = Solve(AsBuiltRobot(), FocalPose(kK2), method);
     EXPECT_EQ(s.status, StaticsStatus::kUnsupportedModel);
     EXPECT_EQ(s.cable, 0);
     EXPECT_EQ(s.cables[0].lower_tension_n, 0.0);
@@ -179,7 +171,7 @@ TEST(StaticsAttachmentsTest, AnAttachmentBeyondTheCableIsAStatusNotANumber) {
 }
 
 TEST(StaticsAttachmentsTest, ModelFileRoundTripIsBitExact) {
-  CableRobot robot = AsBuilt();
+  CableRobot robot = AsBuiltRobot();
   robot.cables[5].attachments.push_back(Point(0.1 + 0.2, 1.0 / 3.0));
   const std::string yaml = CableRobotToYaml(robot, "test");
   CableRobot back;
@@ -244,7 +236,7 @@ TEST(StaticsAttachmentsTest, BadAttachmentsAreNamedByFileLineAndKey) {
 // attachment's value, and in the cabin's mass-centre z.
 TEST(StaticsAttachmentsTest, JetTensionsMatchCentralDifferencesThroughTheChain) {
   using Jet = ceres::Jet<double, 3>;
-  const CableRobot robot = AsBuilt();
+  const CableRobot robot = AsBuiltRobot();
   const StaticsParameters<double> p0 = MakeStaticsParameters(robot);
   const Pose pose = FocalPose(kK2);
   const StaticsOptions options = ModelFitStaticsOptions(StaticsMethod::kExact);

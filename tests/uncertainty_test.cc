@@ -93,6 +93,54 @@ TEST(BatchCorrectionTest, OneMeanGivesMeketonSchmeiser) {
   EXPECT_EQ(BatchCorrection(SampleJacobians(), 1, inverse, 10), Eigen::VectorXd::Ones(1));
 }
 
+// The running window and its ring of rows (and the replay) against the formula itself:
+// each window's M_j summed directly, windows at a stride of L / 16, random rows.
+TEST(BatchCorrectionTest, RunningWindowsMatchTheFormula) {
+  constexpr int kSamples = 700, kRows = 2, kParameters = 3;
+  constexpr double kRelTol = 1e-10;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  SampleJacobians j(kSamples, kRows * kParameters);
+  for (int t = 0; t < kSamples; ++t) {
+    for (int c = 0; c < kRows * kParameters; ++c) {
+      j(t, c) = static_cast<float>(normal(rng) + std::sin(0.01 * t + c));
+    }
+  }
+  Eigen::MatrixXd information = Eigen::MatrixXd::Zero(kParameters, kParameters);
+  for (int t = 0; t < kSamples; ++t) {
+    const Eigen::MatrixXd jt =
+        Eigen::Map<const Eigen::Matrix<float, kRows, kParameters, Eigen::RowMajor>>(j.row(t).data())
+            .cast<double>();
+    information += jt.transpose() * jt;
+  }
+  const Eigen::MatrixXd inverse = information.inverse();
+  for (int l : {1, 7, 40, 200}) {
+    Eigen::VectorXd all = Eigen::VectorXd::Zero(kParameters), kept = all;
+    for (int b = 0; b + l <= kSamples; b += std::max(1, l / 16)) {
+      Eigen::MatrixXd m = Eigen::MatrixXd::Zero(kParameters, kParameters);
+      for (int t = b; t < b + l; ++t) {
+        const Eigen::MatrixXd jt =
+            Eigen::Map<const Eigen::Matrix<float, kRows, kParameters, Eigen::RowMajor>>(
+                j.row(t).data())
+                .cast<double>();
+        m += jt.transpose() * jt;
+      }
+      all += m.diagonal();
+      kept += (m - m * inverse * m).diagonal();
+    }
+    const Eigen::VectorXd c = BatchCorrection(j, kRows, inverse, l);
+    for (int k = 0; k < kParameters; ++k) {
+      EXPECT_NEAR(c[k], all[k] / kept[k], kRelTol * c[k]) << "L " << l << " parameter " << k;
+    }
+    // A replay that fails gives no correction.
+    const SampleJacobianReplay broken = [](const std::function<void(int, const float*)>&) {
+      return false;
+    };
+    EXPECT_EQ(BatchCorrection(broken, kSamples, kRows, inverse, l),
+              Eigen::VectorXd::Ones(kParameters));
+  }
+}
+
 // A linear fit y = J beta + e with slowly varying regressors and errors = AR(1) + white;
 // stated noise: the white part only.
 struct LinearFit {
@@ -122,7 +170,7 @@ BudgetInputs LinearBudgetInputs(const LinearFit& f) {
   BudgetInputs in;
   in.information = f.j.transpose() * f.j;
   in.prior_information = Eigen::VectorXd::Zero(f.j.cols());
-  in.scores = f.j.array().colwise() * f.residuals.array();
+  in.scores = (f.j.array().colwise() * f.residuals.array()).matrix().cast<float>();
   in.jacobians = f.j.cast<float>();
   in.rows_per_sample = 1;
   in.num_residuals = static_cast<int>(f.j.rows());

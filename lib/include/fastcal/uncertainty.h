@@ -61,6 +61,7 @@
 #define FASTCAL_UNCERTAINTY_H_
 
 #include <Eigen/Core>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -71,6 +72,11 @@ inline constexpr int kMinSamplesForCorrelation = 10;
 
 // Per-sample Jacobian rows, one sample per row (row-major, so a sample's rows are contiguous).
 using SampleJacobians = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+// Per-sample scores s_t (n each), one sample per row, in float (issue 28: 8n bytes a sample
+// was 170 MB at 10^6 samples and 21 parameters). Rounding them moves the long-run
+// covariance and the autocorrelation times by ~1e-7 relative, far below their own noise;
+// every sum over them runs in double.
+using SampleScores = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 // Median and 1.4826 x the median absolute deviation about it: the standard deviation of
 // a normal sample, unmoved by a minority of gross errors. Empty input gives {0, 0}.
@@ -105,6 +111,19 @@ Eigen::MatrixXd LongRunCovarianceOfSum(const Eigen::MatrixXd& scores, int bandwi
 Eigen::VectorXd BatchCorrection(const SampleJacobians& jacobians, int rows_per_sample,
                                 const Eigen::MatrixXd& inverse_information, int bandwidth);
 
+// Each sample's J_t, in time order, without holding them all (issue 28: 0.5 GB at 10^6
+// samples and 21 parameters): calls visit(t, J_t) for t = 0, 1, ..., N - 1, J_t as
+// rows_per_sample x n floats, row-major (valid during the call). False when the rows
+// cannot be had (visit may have been called for some).
+using SampleJacobianReplay =
+    std::function<bool(const std::function<void(int t, const float* jacobian)>& visit)>;
+
+// The same correction from a replay of N samples' Jacobians (same numbers): the window
+// sum's lookback kept in a ring of L samples' rows. All 1 when `replay` fails.
+Eigen::VectorXd BatchCorrection(const SampleJacobianReplay& replay, int samples,
+                                int rows_per_sample, const Eigen::MatrixXd& inverse_information,
+                                int bandwidth);
+
 // Bandwidth per unit of autocorrelation time. The Bartlett kernel's relative bias for a
 // series of integrated autocorrelation time tau is about -tau / (2 L): -6% at 8 tau,
 // while its relative variance, (4/3) L / N, stays small while N >> tau.
@@ -122,10 +141,13 @@ inline constexpr double kGrowthSignificance = 2.0;
 struct BudgetInputs {
   Eigen::MatrixXd information;        // M (n x n), data and priors
   Eigen::VectorXd prior_information;  // Lambda's diagonal (n); 0 without a prior
-  Eigen::MatrixXd scores;             // s_t (N x n) in time order; may be empty
+  SampleScores scores;                // s_t (N x n) in time order; may be empty
   // J_t of each sample, row after row (N x rows_per_sample * n; float to halve the
-  // memory at 1e5 samples); may be empty (then c = 1).
+  // memory at 1e5 samples); may be empty: then from `jacobian_replay`, or c = 1 without.
   SampleJacobians jacobians;
+  // The same rows on demand (only when the residuals are correlated, once per bandwidth
+  // tried): the calibration's replay of its linearisation.
+  SampleJacobianReplay jacobian_replay;
   int rows_per_sample = 1;
   int num_residuals = 0;    // m: data and prior residuals
   double chi_square = 0.0;  // sum of squared whitened residuals at the solution

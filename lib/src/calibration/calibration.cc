@@ -65,6 +65,8 @@ constexpr size_t kForwardErrorSamples = 2000;
 // of the cost saves a Jacobian and a cost evaluation of every sample (2 s at 10^6
 // samples) and leaves pass 2 a start well inside its first step.
 constexpr double kFirstPassFunctionTolerance = 1e-4;
+// Initial trust-region radius of pass 2 and later (Ceres's default 1e4; its maximum 1e16).
+constexpr double kLaterPassTrustRegionRadius = 1e12;
 
 // The process's CPU time so far (s, user and system, all threads) and peak resident
 // memory (MB); 0 where getrusage does not say.
@@ -236,12 +238,16 @@ CalibrationStatus Predict(Run& run) {
   at.sigma_n.resize(num_samples);
   at.whitened.resize(num_samples);
   // Each sample starts from its statics at the previous parameters, when there are any.
-  at.starts.resize(num_samples);
+  if (at.starts.method() != run.statics.method ||
+      at.starts.size() != static_cast<size_t>(num_samples)) {
+    at.starts = internal::CompactStarts(run.statics.method);
+    at.starts.Reset(num_samples);
+  }
   StaticsOptions options = run.statics;
   options.warm_start = true;
   const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& sample = run.data.samples[t];
-    at.starts[t].Restore(run.PoseOf(sample), options.method, solution);
+    at.starts.At(t).Restore(run.PoseOf(sample), options.method, solution);
     return SolveStaticsWithParameters(session_params[sample.session], run.PoseOf(sample), options,
                                       solution);
   };
@@ -251,7 +257,7 @@ CalibrationStatus Predict(Run& run) {
         for (int t = begin; t < end; ++t) {
           const Sample& sample = run.data.samples[t];
           if (solve(t, &solution) != StaticsStatus::kOk) return t;
-          at.starts[t] = internal::CompactStart::Of(solution);
+          at.starts.Set(t, solution);
           const std::array<double, kNumCables>& gain = session_gain[sample.session];
           const std::array<double, kNumCables>& bias = session_bias[sample.session];
           for (int i = 0; i < kNumCables; ++i) {
@@ -443,6 +449,11 @@ CalibrationStatus SolveAndReweight(Run& run) {
   // 2 and later, with the weights of the pass before, meet the spec's tolerances.
   ceres::Solver::Options first = so;
   first.function_tolerance = std::max(so.function_tolerance, kFirstPassFunctionTolerance);
+  // Pass 2 and later start from the pass before's solution, where the Gauss-Newton step is
+  // good: Levenberg-Marquardt's default damping (trust region 1e4) made them creep there in
+  // 3-4 steps where 1-2 do (a Jacobian fold each: issue 28).
+  ceres::Solver::Options later = so;
+  later.initial_trust_region_radius = kLaterPassTrustRegionRadius;
   ceres::Solver::Summary summary;
   std::string brief, full;
   int iterations = 0;
@@ -451,7 +462,7 @@ CalibrationStatus SolveAndReweight(Run& run) {
       BuildProblem(run);
       if (run.options.progress) run.options.progress(PassNote(pass, CountExcluded(run)) + ":");
     }
-    ceres::Solve(pass == 1 ? first : so, run.problem.get(), &summary);
+    ceres::Solve(pass == 1 ? first : later, run.problem.get(), &summary);
     iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
     if (pass == 1) r.initial_cost = summary.initial_cost;  // at the initial parameters
     const std::string label = pass == 1 ? "pass 1 (weights from the initial model)"

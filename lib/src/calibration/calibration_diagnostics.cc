@@ -57,8 +57,23 @@ double PriorChiSquare(const Run& run) {
   return chi;
 }
 
+// The linearisation's inputs at the current solution (without candidates). The per-sample
+// Jacobians are kept only for the change scan (calibration_linearisation.h).
+internal::LinearisationInputs LinearisationInputsOf(const Run& run) {
+  internal::LinearisationInputs in;
+  in.samples = run.Samples();
+  in.theta = run.theta.data();
+  in.loss = run.loss.get();
+  in.cross_validation_blocks = run.spec.cross_validation_blocks;
+  in.num_threads = run.spec.num_threads;
+  in.max_candidate_samples = run.options.max_candidate_samples;
+  in.keep_jacobians = !run.spec.change_scan_groups.empty();
+  return in;
+}
+
 // The budget's inputs. The linearisation's per-sample scores and Jacobians are moved
-// in, not copied (~130 MB at 10^6 samples): ReturnSeries gives them back.
+// in, not copied (~130 MB at 10^6 samples): ReturnSeries gives them back. Without kept
+// Jacobians, the budget has them replayed from the linearisation's inputs.
 BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
                               const std::vector<ParameterSpec>& candidates) {
   BudgetInputs in;
@@ -79,6 +94,11 @@ BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
   in.information.diagonal() += in.prior_information;
   in.scores = std::move(lin.scores);
   in.jacobians = std::move(lin.jacobians);
+  if (in.jacobians.rows() == 0) {
+    in.jacobian_replay = [&run](const std::function<void(int, const float*)>& visit) {
+      return internal::ReplayFreeJacobians(LinearisationInputsOf(run), visit);
+    };
+  }
   in.rows_per_sample = kNumCables;
   in.num_residuals = run.result->num_residuals;
   in.chi_square = lin.raw_chi_square + PriorChiSquare(run);
@@ -122,14 +142,8 @@ void FillCorrelation(Run& run) {
 
 CalibrationStatus Linearise(Run& run, const std::vector<ParameterSpec>& candidates,
                             internal::Linearisation* lin) {
-  internal::LinearisationInputs in;
-  in.samples = run.Samples();
-  in.theta = run.theta.data();
-  in.loss = run.loss.get();
+  internal::LinearisationInputs in = LinearisationInputsOf(run);
   in.candidates = candidates;
-  in.cross_validation_blocks = run.spec.cross_validation_blocks;
-  in.num_threads = run.spec.num_threads;
-  in.max_candidate_samples = run.options.max_candidate_samples;
   std::string why;
   if (!internal::Linearise(in, lin, &why)) return run.Fail(CalibrationStatus::kSolverFailed, why);
   return CalibrationStatus::kOk;
@@ -166,7 +180,7 @@ Eigen::VectorXd ScoreStatistics(const Run& run, const internal::Linearisation& l
   const Eigen::MatrixXd projection = information.ldlt().solve(lin.cross) / lin.candidate_scale;
   Eigen::MatrixXd projected = lin.candidate_scores;
   for (int k = 0; k < rows; ++k) {
-    projected.row(k) -= lin.scores.row(lin.candidate_rows[k]) * projection;
+    projected.row(k) -= lin.candidate_free_scores.row(k) * projection;
   }
   const UncertaintyBudget& b = run.result->budget;
   const double stride = static_cast<double>(run.fit.size()) / rows;
@@ -253,7 +267,9 @@ void RankMisfit(Run& run, const internal::Linearisation& lin,
   Eigen::MatrixXd same_samples = lin.candidate_information;
   same_samples.diagonal() += information.diagonal() - lin.information.diagonal();
   Eigen::VectorXd free_gradient = Eigen::VectorXd::Zero(run.n);
-  for (int row : lin.candidate_rows) free_gradient += lin.scores.row(row).transpose();
+  for (int k = 0; k < static_cast<int>(lin.candidate_rows.size()); ++k) {
+    free_gradient += lin.candidate_free_scores.row(k).transpose();
+  }
   free_gradient *= lin.candidate_scale;
   for (int k = 0; k < run.n; ++k) {
     const ParameterSpec& p = run.Free(k);
@@ -545,7 +561,11 @@ CalibrationStatus Diagnose(Run& run) {
   for (int i = 0; i < kNumCables; ++i) {
     r.residual_tau[i] = IntegratedAutocorrelationTime(run.lin.residuals.col(i)).tau;
   }
-  run.lin = internal::Linearisation();  // the per-sample Jacobians: ~100 MB at 1e5 samples
+  // The linearisation's per-sample series and the last pass's weights are not needed
+  // beyond here: ~300 MB at 10^6 samples, freed before the RMS table's predictions.
+  run.lin = internal::Linearisation();
+  run.sigma_n = std::vector<std::array<double, kNumCables>>();
+  run.slow_rho = std::vector<std::array<double, kNumCables>>();
   return CalibrationStatus::kOk;
 }
 

@@ -17,7 +17,7 @@ namespace {
 // Every sample's reading predicted by models[sample.session] (models[0] for all when
 // there is one). False, naming the first sample a model cannot hold.
 bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset& data,
-                     AttitudeSource attitude, int threads, const std::vector<CompactStart>* starts,
+                     AttitudeSource attitude, int threads, const CompactStarts* starts,
                      std::vector<std::array<double, kNumCables>>* predicted, std::string* error) {
   StaticsOptions options = ModelFitStaticsOptions(StaticsMethod::kExact);
   options.warm_start = true;
@@ -33,7 +33,7 @@ bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset
     const Sample& s = data.samples[t];
     const Pose pose = pose_of(s);
     if (starts != nullptr && !starts->empty()) {
-      (*starts)[t].Restore(pose, StaticsMethod::kExact, solution);
+      starts->At(t).Restore(pose, StaticsMethod::kExact, solution);
     } else {
       solution->status = StaticsStatus::kInvalidInput;  // no start: cold
     }

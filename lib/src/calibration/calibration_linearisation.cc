@@ -1,7 +1,6 @@
 // The calibration linearised at its solution (internal/calibration_linearisation.h).
 #include "fastcal/internal/calibration_linearisation.h"
 
-#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <thread>
@@ -12,9 +11,6 @@
 
 namespace fastcal::internal {
 namespace {
-
-// Rows of the free Jacobian folded into the R factor at a time.
-constexpr int kQrChunkRows = 1024;
 
 using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
@@ -42,15 +38,6 @@ double LossWeight(const ceres::LossFunction* loss, const Eigen::Matrix<double, k
   return std::sqrt(std::max(rho[1], 0.0));
 }
 
-// Sample t's rows at theta through `f` into `rows` (rows of excluded readings zero).
-bool EvaluateRows(const TensionResidual& f, const double* theta, int t, SampleRows* rows) {
-  if (!EvaluateSampleRows(f, theta, t, rows)) return false;
-  for (int i = 0; i < kNumCables; ++i) {
-    if (f.excluded[i]) std::fill(rows->Row(t, i), rows->Row(t, i) + rows->columns, 0.0);
-  }
-  return true;
-}
-
 // Sample t's residuals and n-column Jacobian from `rows`.
 void RowsOf(const SampleRows& rows, int t, Eigen::Matrix<double, kNumCables, 1>* r, RowMatrix* j) {
   const int n = rows.columns - 1;
@@ -65,8 +52,8 @@ void RowsOf(const SampleRows& rows, int t, Eigen::Matrix<double, kNumCables, 1>*
 // The free pass.
 
 struct FreeSums {
-  Eigen::MatrixXd information, curvature, r_factor, pending;
-  int pending_rows = 0;
+  Eigen::MatrixXd information, curvature;
+  RowFold fold;  // of the weighted rows: the R factor
   double chi_square = 0.0, raw_chi_square = 0.0;
   int readings = 0;
   std::vector<FoldSums> folds;
@@ -76,7 +63,7 @@ struct FreeSums {
   FreeSums(int n, int blocks, int sessions)
       : information(Eigen::MatrixXd::Zero(n, n)),
         curvature(Eigen::MatrixXd::Zero(n, n)),
-        pending(kQrChunkRows, n),
+        fold(n),
         folds(blocks) {
     for (int s = 0; sessions > 1 && s < sessions; ++s) {
       session_information.push_back(Eigen::MatrixXd::Zero(n, n));
@@ -92,20 +79,10 @@ struct FreeSums {
     }
   }
 
-  void AddRows(const Eigen::MatrixXd& rows) {
-    if (pending_rows + rows.rows() > pending.rows()) Flush();
-    pending.middleRows(pending_rows, rows.rows()) = rows;
-    pending_rows += static_cast<int>(rows.rows());
-  }
-  void Flush() {
-    r_factor = FoldRows(r_factor, pending.topRows(pending_rows));
-    pending_rows = 0;
-  }
+  void AddRows(const RowMatrix& rows) { fold.Add(rows.data(), static_cast<int>(rows.rows())); }
 
-  void Add(FreeSums& o) {
-    o.Flush();
-    Flush();
-    r_factor = FoldRows(r_factor, o.r_factor);
+  void Add(const FreeSums& o) {
+    fold.Add(o.fold);
     information += o.information;
     curvature += o.curvature;
     chi_square += o.chi_square;
@@ -134,15 +111,17 @@ struct FreeSums {
 // The cross-validation block sums of one sample: the whitened rows r, j for the
 // prediction, the rows as evaluated (r_raw, j_raw: before the slow-error whitening; the
 // same without it) in newtons for the RMS.
-void AddToFold(const TensionResidual& f, const Eigen::Matrix<double, kNumCables, 1>& r,
-               const RowMatrix& j, const Eigen::Matrix<double, kNumCables, 1>& r_raw,
-               const RowMatrix& j_raw, double weight, FoldSums* fold) {
+void AddToFold(const std::array<bool, kNumCables>& excluded,
+               const std::array<double, kNumCables>& sigma_n,
+               const Eigen::Matrix<double, kNumCables, 1>& r, const RowMatrix& j,
+               const Eigen::Matrix<double, kNumCables, 1>& r_raw, const RowMatrix& j_raw,
+               double weight, FoldSums* fold) {
   ++fold->samples;
   fold->information.noalias() += weight * weight * j.transpose() * j;
   fold->gradient.noalias() += weight * weight * j.transpose() * r;
   for (int i = 0; i < kNumCables; ++i) {
-    if (f.excluded[i]) continue;
-    const double s = f.sigma_n[i];
+    if (excluded[i]) continue;
+    const double s = sigma_n[i];
     const Eigen::VectorXd ji = s * j_raw.row(i).transpose();  // N per parameter unit
     const double ri = s * r_raw[i];                           // N
     ++fold->readings[i];
@@ -160,34 +139,39 @@ struct FreeChunk {
 };
 
 // Fitted samples [begin, end) evaluated into chunk->rows; the first that fails, or -1.
-int EvaluateFree(const LinearisationInputs& in, int begin, int end, FreeChunk* chunk) {
+int EvaluateFree(const LinearisationInputs& in, const ModelAtTheta& at, int begin, int end,
+                 FreeChunk* chunk) {
   chunk->rows.Reset(begin, end, in.samples.model->num_free() + 1);
   for (int t = begin; t < end; ++t) {
-    if (!EvaluateRows(in.samples.At(t), in.theta, t, &chunk->rows)) return t;
+    if (!EvaluateSampleRows(in.samples, t, at, t, &chunk->rows)) return t;
   }
   return -1;
 }
 
 // The whitened rows of fitted samples [begin, end) into `sums`.
-void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisation* out,
-                    FreeChunk* chunk) {
+void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candidate_row,
+                    int begin, int end, Linearisation* out, FreeChunk* chunk) {
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   FreeSums* sums = &chunk->sums;
   RowMatrix j(kNumCables, n), j_raw(kNumCables, n);
   Eigen::Matrix<double, kNumCables, 1> r, r_raw;
   for (int t = begin; t < end; ++t) {
-    const TensionResidual f = in.samples.At(t);
+    const std::array<bool, kNumCables> excluded = in.samples.Excluded(t);
     RowsOf(chunk->rows, t, &r, &j);
     RowsOf(chunk->raw, t, &r_raw, &j_raw);
     double curvature = 0.0;
     const double weight = LossWeight(in.loss, r, &curvature);
-    const Eigen::MatrixXd jw = weight * j;
+    const RowMatrix jw = weight * j;
     const Eigen::VectorXd rw = weight * r;
     out->residuals.row(t) = r.transpose();
-    out->scores.row(t) = rw.transpose() * jw;
-    for (int i = 0; i < kNumCables; ++i) {
-      out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
+    const Eigen::RowVectorXd score = rw.transpose() * jw;
+    out->scores.row(t) = score.cast<float>();
+    if (candidate_row[t] >= 0) out->candidate_free_scores.row(candidate_row[t]) = score;
+    if (in.keep_jacobians) {
+      for (int i = 0; i < kNumCables; ++i) {
+        out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
+      }
     }
     sums->information.noalias() += jw.transpose() * jw;
     if (!sums->session_information.empty()) {
@@ -202,11 +186,12 @@ void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
     sums->AddRows(jw);
     sums->chi_square += rw.squaredNorm();
     sums->raw_chi_square += r.squaredNorm();
-    for (bool e : f.excluded) sums->readings += !e;
+    for (bool e : excluded) sums->readings += !e;
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
-    AddToFold(f, r, j, r_raw, j_raw, weight, &sums->folds[block]);
+    AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, r_raw, j_raw, weight,
+              &sums->folds[block]);
   }
-  sums->Flush();
+  sums->fold.Flush();
 }
 
 // ---------------------------------------------------------------------------------------
@@ -214,8 +199,10 @@ void AccumulateFree(const LinearisationInputs& in, int begin, int end, Linearisa
 
 struct CandidatePass {
   const LinearisationInputs& in;
-  // The basis at the calibrated model of each session (one without sessions).
+  // The basis at the calibrated model of each session (one without sessions), and each
+  // assembled at its own values.
   std::vector<CalibrationModel> basis;
+  std::vector<ModelAtTheta> basis_at;
   std::vector<std::vector<double>> theta;  // each basis's own values
   std::vector<std::vector<int>> free_columns, candidate_columns;
   std::vector<int> free_session;  // of each free parameter (ParameterSpec::session)
@@ -253,9 +240,8 @@ int EvaluateCandidates(const CandidatePass& pass, const std::vector<int>& sample
                        int end, CandidateChunk* chunk) {
   chunk->rows.Reset(begin, end, pass.basis.front().num_free() + 1);
   for (int k = begin; k < end; ++k) {
-    const int session = SessionOf(pass, samples[k]);
-    const TensionResidual f = pass.in.samples.At(samples[k], &pass.basis[session]);
-    if (!EvaluateRows(f, pass.theta[session].data(), k, &chunk->rows)) return samples[k];
+    const ModelAtTheta& at = pass.basis_at[SessionOf(pass, samples[k])];
+    if (!EvaluateSampleRows(pass.in.samples, samples[k], at, k, &chunk->rows)) return samples[k];
   }
   return -1;
 }
@@ -301,25 +287,33 @@ std::string CannotSolve(const LinearisationInputs& in, int fitted_sample) {
   return SampleWhere(data, s) + ": the calibrated model cannot solve this pose";
 }
 
+// The free pass; out->candidate_rows must be set (their scores are kept in double).
 bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::string* error) {
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   const int blocks = std::clamp(in.cross_validation_blocks, 1, std::max(1, num_fit));
-  out->scores = Eigen::MatrixXd::Zero(num_fit, n);
+  out->scores = SampleScores::Zero(num_fit, n);
+  std::vector<int> candidate_row(num_fit, -1);  // each fitted sample's candidate row, or -1
+  for (size_t k = 0; k < out->candidate_rows.size(); ++k) candidate_row[out->candidate_rows[k]] = k;
+  out->candidate_free_scores =
+      Eigen::MatrixXd::Zero(static_cast<int>(out->candidate_rows.size()), n);
   out->residuals = Eigen::MatrixXd::Zero(num_fit, kNumCables);
-  out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
+  if (in.keep_jacobians) out->jacobians = SampleJacobians::Zero(num_fit, kNumCables * n);
   const int sessions = static_cast<int>(in.samples.data->session_labels.size());
   FreeSums total(n, blocks, sessions);
+  const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
   SampleRowWhitener whitener(in.samples, n + 1);
   const int failed = ReduceChunksInOrder<FreeChunk>(
       num_fit, in.num_threads, [&] { return FreeChunk{FreeSums(n, blocks, sessions), {}, {}}; },
-      [&](int begin, int end, FreeChunk* chunk) { return EvaluateFree(in, begin, end, chunk); },
+      [&](int begin, int end, FreeChunk* chunk) {
+        return EvaluateFree(in, at, begin, end, chunk);
+      },
       [&](int, int, FreeChunk* chunk) {
         chunk->raw = chunk->rows;
         whitener.Whiten(&chunk->rows);
       },
       [&](int begin, int end, FreeChunk* chunk) {
-        AccumulateFree(in, begin, end, out, chunk);
+        AccumulateFree(in, candidate_row, begin, end, out, chunk);
         return -1;
       },
       [&](FreeChunk& chunk) { total.Add(chunk.sums); });
@@ -327,10 +321,9 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
     *error = CannotSolve(in, failed);
     return false;
   }
-  total.Flush();
   out->information = std::move(total.information);
   out->loss_curvature = std::move(total.curvature);
-  out->r_factor = std::move(total.r_factor);
+  out->r_factor = total.fold.r();
   out->chi_square = total.chi_square;
   out->raw_chi_square = total.raw_chi_square;
   out->readings = total.readings;
@@ -347,11 +340,14 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   const CableRobot& model = fitted.robot();
   CalibrationSpec basis_spec;
   basis_spec.parameters = BasisParameters(model);
-  CandidatePass pass{in, {}, {}, {}, {}, {}};
-  const int sessions = std::max<int>(1, static_cast<int>(in.samples.data->session_labels.size()));
+  CandidatePass pass{in, {}, {}, {}, {}, {}, {}};
+  const int sessions = in.samples.sessions();
+  pass.basis.reserve(sessions);  // basis_at refers to them
+  pass.theta.reserve(sessions);
   for (int s = 0; s < sessions; ++s) {
     pass.basis.emplace_back(fitted.ToRobot(in.theta, s), basis_spec);
     pass.theta.push_back(pass.basis.back().InitialTheta());
+    pass.basis_at.emplace_back(pass.basis.back(), pass.theta.back().data(), sessions);
   }
   for (int k = 0; k < n; ++k) {
     const ParameterSpec& p = fitted.spec().parameters[fitted.spec_index(k)];
@@ -361,12 +357,7 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   for (const ParameterSpec& p : in.candidates) {
     pass.candidate_columns.push_back(BasisColumns(p, model));
   }
-  // With a slow error the whitening needs neighbours: contiguous runs (each a series of
-  // its own) rather than single samples spread out.
-  const std::vector<int> samples =
-      in.samples.whitened()
-          ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
-          : CandidateSamples(in.samples.size(), in.max_candidate_samples);
+  const std::vector<int>& samples = out->candidate_rows;
   const auto zero = [&] {
     return CandidateSums{Eigen::MatrixXd::Zero(n, q), Eigen::VectorXd::Zero(q),
                          Eigen::VectorXd::Zero(q), Eigen::MatrixXd::Zero(n, n)};
@@ -401,7 +392,6 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   out->self = scale * total.self;
   out->gradient = scale * total.gradient;
   out->candidate_samples = static_cast<int>(samples.size());
-  out->candidate_rows = samples;
   out->candidate_information = scale * total.information;
   out->candidate_scale = scale;
   return true;
@@ -428,24 +418,49 @@ std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model) {
   return columns;
 }
 
-Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows) {
-  // A fold with nothing yet has a 0 x 0 R factor, not 0 x n: Eigen's assert (on in the
-  // sanitizer build) refuses assigning it to a 0 x n block, so empty parts are skipped.
-  const int n = static_cast<int>(std::max(top.cols(), rows.cols()));
-  Eigen::MatrixXd m(top.rows() + rows.rows(), n);
-  if (top.rows() > 0) m.topRows(top.rows()) = top;
-  if (rows.rows() > 0) m.bottomRows(rows.rows()) = rows;
-  if (m.rows() == 0) return Eigen::MatrixXd::Zero(n, n);
-  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(m);
-  Eigen::MatrixXd r = Eigen::MatrixXd::Zero(n, n);
-  const int k = static_cast<int>(std::min<Eigen::Index>(n, m.rows()));
-  r.topRows(k) = qr.matrixQR().topRows(k).triangularView<Eigen::Upper>();
-  return r;
-}
-
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error) {
   *out = Linearisation();
+  // The candidate pass's samples. With a slow error the whitening needs neighbours:
+  // contiguous runs (each a series of its own) rather than single samples spread out.
+  out->candidate_rows = in.samples.whitened()
+                            ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
+                            : CandidateSamples(in.samples.size(), in.max_candidate_samples);
   return LineariseFree(in, out, error) && LineariseCandidates(in, out, error);
+}
+
+bool ReplayFreeJacobians(const LinearisationInputs& in,
+                         const std::function<void(int t, const float* jacobian)>& visit) {
+  const int n = in.samples.model->num_free();
+  const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
+  SampleRowWhitener whitener(in.samples, n + 1);
+  struct Chunk {
+    SampleRows rows;
+  };
+  const int failed = ReduceChunksInOrder<Chunk>(
+      in.samples.size(), in.num_threads, [] { return Chunk(); },
+      [&](int begin, int end, Chunk* chunk) {
+        chunk->rows.Reset(begin, end, n + 1);
+        for (int t = begin; t < end; ++t) {
+          if (!EvaluateSampleRows(in.samples, t, at, t, &chunk->rows)) return t;
+        }
+        return -1;
+      },
+      [&](int, int, Chunk* chunk) { whitener.Whiten(&chunk->rows); },
+      [](int, int, Chunk*) { return -1; },
+      [&](const Chunk& chunk) {
+        // As AccumulateFree stores them: the rows weighted by the loss's, as floats.
+        RowMatrix j(kNumCables, n);
+        Eigen::Matrix<double, kNumCables, 1> r;
+        std::vector<float> jw(kNumCables * n);
+        for (int t = chunk.rows.begin; t < chunk.rows.end; ++t) {
+          RowsOf(chunk.rows, t, &r, &j);
+          const double weight = LossWeight(in.loss, r);
+          const RowMatrix weighted = weight * j;
+          for (int k = 0; k < kNumCables * n; ++k) jw[k] = static_cast<float>(weighted.data()[k]);
+          visit(t, jw.data());
+        }
+      });
+  return failed < 0;
 }
 
 }  // namespace fastcal::internal

@@ -1,6 +1,7 @@
 // Parameter mapping and cost functions of the calibration (calibration_model.h).
 #include "fastcal/internal/calibration_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace fastcal::internal {
@@ -16,6 +17,8 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
     const ParameterSpec& s = spec.parameters[j];
     if (s.free) {
       free_.push_back(static_cast<int>(j));
+      frees_geometry_ = frees_geometry_ || s.kind == ParameterKind::kAnchorOffset ||
+                        s.kind == ParameterKind::kTowerOffset;
       continue;
     }
     if (!s.has_initial) continue;
@@ -157,45 +160,202 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
   f.measured_n = sample.tension_n;
   f.sigma_n = (*sigma_n)[j];
   f.statics = statics;
-  if (starts != nullptr && !starts->empty()) f.start = (*starts)[t];
+  if (starts != nullptr && !starts->empty()) f.start = starts->At(t);
   if (excluded != nullptr && !excluded->empty()) f.excluded = (*excluded)[t];
   f.session = sample.session;
   return f;
 }
 
-TensionCost::TensionCost(const TensionResidual& functor)
-    : functor_(functor), n_(functor.model->num_free()) {
-  set_num_residuals(kNumCables);
-  mutable_parameter_block_sizes()->push_back(n_);
+void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
+                                       const std::array<double, kNumCables>& gain, int session,
+                                       double* jacobian) const {
+  const int n = num_free();
+  Eigen::Map<Eigen::Matrix<double, kNumCables, Eigen::Dynamic, Eigen::RowMajor>> j(jacobian,
+                                                                                   kNumCables, n);
+  j.setZero();
+  const auto cables = [](const ParameterSpec& s, int i) { return s.index < 0 || s.index == i; };
+  for (int k = 0; k < n; ++k) {
+    const ParameterSpec& s = spec_.parameters[free_[k]];
+    if (s.session >= 0 && s.session != session) continue;
+    auto column = j.col(k);
+    switch (s.kind) {
+      case ParameterKind::kMassCentre:
+        column = gradient.mass_centre_cabin_m.col(s.component);
+        break;
+      case ParameterKind::kCabinMass:
+        column = gradient.cabin_mass_kg;
+        break;
+      case ParameterKind::kLinearDensity:
+        for (int i = 0; i < kNumCables; ++i) {
+          if (cables(s, i)) column += gradient.linear_density_kg_per_m[i];
+        }
+        break;
+      case ParameterKind::kEa:
+        for (int i = 0; i < kNumCables; ++i) {
+          if (cables(s, i)) column += gradient.ea_n[i];
+        }
+        break;
+      case ParameterKind::kAnchorOffset:
+        for (int i = 0; i < kNumCables; ++i) {
+          if (anchor_of_cable_[i] == s.index) column += gradient.anchor_m[i].col(s.component);
+        }
+        break;
+      case ParameterKind::kTowerOffset:
+        column = gradient.tower_top_m[s.index].col(s.component);
+        break;
+      case ParameterKind::kAttachmentMass:
+      case ParameterKind::kAttachmentDensity:
+        column = gradient.chain_value[s.index][s.component];
+        break;
+      case ParameterKind::kSensorGain:
+      case ParameterKind::kSensorBias:
+        break;  // after the statics: below
+    }
+    // The readings are gain_i T_i + bias_i.
+    for (int i = 0; i < kNumCables; ++i) {
+      if (s.kind == ParameterKind::kSensorGain) {
+        column[i] = cables(s, i) ? gradient.tension_n[i] : 0.0;
+      } else if (s.kind == ParameterKind::kSensorBias) {
+        column[i] = cables(s, i) ? 1.0 : 0.0;
+      } else {
+        column[i] *= gain[i];
+      }
+    }
+  }
 }
 
-template <int N>
-bool TensionCost::EvaluateJet(const double* theta, double* residuals, double* jacobian) const {
-  using Jet = ceres::Jet<double, N>;
-  std::array<Jet, N> t;
-  for (int k = 0; k < n_; ++k) t[k] = Jet(theta[k], k);
-  std::array<Jet, kNumCables> r;
-  if (!functor_(t.data(), r.data())) return false;
+ModelAtTheta::ModelAtTheta(const CalibrationModel& model, const double* theta, int sessions)
+    : model_(&model), theta_(theta), sessions_(std::max(1, sessions)) {
+  for (size_t k = 0; k < sessions_.size(); ++k) {
+    Session& s = sessions_[k];
+    model.Assemble(theta, &s.statics, &s.gain, &s.bias, static_cast<int>(k));
+    s.gains_positive = std::all_of(s.gain.begin(), s.gain.end(), [](double g) { return g > 0.0; });
+  }
+}
+
+namespace {
+
+// What the rows of one sample need besides the model.
+struct SampleView {
+  Pose pose;
+  CompactStart start;
+  const std::array<double, kNumCables>& measured_n;
+  const std::array<double, kNumCables>& sigma_n;
+  const std::array<bool, kNumCables>* excluded;  // null: none
+  int session;
+};
+
+// A sample's residuals, and with `jacobian` their analytic Jacobian (exact statics only),
+// through assembled parameters: TensionResidual's operator() in double, and its
+// implicit-function derivatives.
+bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
+                 const StaticsOptions& statics, const SampleView& x, double* residuals,
+                 double* jacobian) {
+  if (!m.gains_positive) return false;  // as operator()
+  StaticsSolution solution;
+  x.start.Restore(x.pose, statics.method, &solution);
+  StaticsOptions options = statics;
+  options.warm_start = true;
+  if (SolveStaticsWithParameters(m.statics, x.pose, options, &solution) != StaticsStatus::kOk) {
+    return false;
+  }
   for (int i = 0; i < kNumCables; ++i) {
-    residuals[i] = r[i].a;
-    for (int k = 0; k < n_; ++k) jacobian[i * n_ + k] = r[i].v[k];
+    const bool out = x.excluded != nullptr && (*x.excluded)[i];
+    const double t = solution.cables[i].lower_tension_n;
+    residuals[i] = out ? 0.0 : (m.gain[i] * t + m.bias[i] - x.measured_n[i]) / x.sigma_n[i];
+  }
+  if (jacobian == nullptr) return true;
+  TensionGradient gradient;
+  if (ExactTensionGradient(m.statics, x.pose, solution, options.catenary.vertical_span_fraction,
+                           model.frees_geometry(), &gradient) != StaticsStatus::kOk) {
+    return false;
+  }
+  const int n = model.num_free();
+  model.ReadingJacobian(gradient, m.gain, x.session, jacobian);
+  for (int i = 0; i < kNumCables; ++i) {
+    const bool out = x.excluded != nullptr && (*x.excluded)[i];
+    const double scale = out ? 0.0 : 1.0 / x.sigma_n[i];
+    for (int k = 0; k < n; ++k) jacobian[i * n + k] *= scale;
   }
   return true;
 }
 
+}  // namespace
+
+bool TensionResidual::Evaluate(const double* theta, double* residuals, double* jacobian) const {
+  if (jacobian == nullptr) return (*this)(theta, residuals);
+  if (statics.method != StaticsMethod::kExact) {
+    return TensionCost::EvaluateJet(*this, theta, residuals, jacobian);
+  }
+  ModelAtTheta::Session m;
+  model->Assemble(theta, &m.statics, &m.gain, &m.bias, session);
+  m.gains_positive = std::all_of(m.gain.begin(), m.gain.end(), [](double g) { return g > 0.0; });
+  return RowsThrough(*model, m, statics, {pose, start, measured_n, sigma_n, &excluded, session},
+                     residuals, jacobian);
+}
+
+bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const {
+  if (jacobian != nullptr && statics.method != StaticsMethod::kExact) {
+    return At(j, &at.model()).Evaluate(at.theta(), residuals, jacobian);
+  }
+  const int t = (*fit)[j];
+  const Sample& sample = data->samples[t];
+  SampleView x{sample.pose,
+               starts != nullptr && !starts->empty() ? starts->At(t) : CompactStart(),
+               sample.tension_n,
+               (*sigma_n)[j],
+               excluded != nullptr && !excluded->empty() ? &(*excluded)[t] : nullptr,
+               sample.session};
+  if (use_planned_attitude) x.pose.rotation = sample.planned_rotation;
+  return RowsThrough(at.model(), at.session(sample.session), statics, x, residuals, jacobian);
+}
+
+std::array<bool, kNumCables> FittedSamples::Excluded(int j) const {
+  if (excluded == nullptr || excluded->empty()) return {};
+  return (*excluded)[(*fit)[j]];
+}
+
+int FittedSamples::sessions() const {
+  return std::max<int>(1, static_cast<int>(data->session_labels.size()));
+}
+
+TensionCost::TensionCost(const TensionResidual& functor) : functor_(functor) {
+  set_num_residuals(kNumCables);
+  mutable_parameter_block_sizes()->push_back(functor.model->num_free());
+}
+
+template <int N>
+bool TensionCost::EvaluateJetOf(const TensionResidual& f, const double* theta, double* residuals,
+                                double* jacobian) {
+  using Jet = ceres::Jet<double, N>;
+  const int n = f.model->num_free();
+  std::array<Jet, N> t;
+  for (int k = 0; k < n; ++k) t[k] = Jet(theta[k], k);
+  std::array<Jet, kNumCables> r;
+  if (!f(t.data(), r.data())) return false;
+  for (int i = 0; i < kNumCables; ++i) {
+    residuals[i] = r[i].a;
+    for (int k = 0; k < n; ++k) jacobian[i * n + k] = r[i].v[k];
+  }
+  return true;
+}
+
+bool TensionCost::EvaluateJet(const TensionResidual& f, const double* theta, double* residuals,
+                              double* j) {
+  const int n = f.model->num_free();
+  if (n <= 1) return EvaluateJetOf<1>(f, theta, residuals, j);
+  if (n <= 2) return EvaluateJetOf<2>(f, theta, residuals, j);
+  if (n <= 4) return EvaluateJetOf<4>(f, theta, residuals, j);
+  if (n <= 8) return EvaluateJetOf<8>(f, theta, residuals, j);
+  if (n <= 16) return EvaluateJetOf<16>(f, theta, residuals, j);
+  if (n <= 32) return EvaluateJetOf<32>(f, theta, residuals, j);
+  if (n <= 64) return EvaluateJetOf<64>(f, theta, residuals, j);
+  return EvaluateJetOf<kMaxFreeParameters>(f, theta, residuals, j);
+}
+
 bool TensionCost::Evaluate(double const* const* parameters, double* residuals,
                            double** jacobians) const {
-  const double* theta = parameters[0];
-  if (jacobians == nullptr || jacobians[0] == nullptr) return functor_(theta, residuals);
-  double* j = jacobians[0];
-  if (n_ <= 1) return EvaluateJet<1>(theta, residuals, j);
-  if (n_ <= 2) return EvaluateJet<2>(theta, residuals, j);
-  if (n_ <= 4) return EvaluateJet<4>(theta, residuals, j);
-  if (n_ <= 8) return EvaluateJet<8>(theta, residuals, j);
-  if (n_ <= 16) return EvaluateJet<16>(theta, residuals, j);
-  if (n_ <= 32) return EvaluateJet<32>(theta, residuals, j);
-  if (n_ <= 64) return EvaluateJet<64>(theta, residuals, j);
-  return EvaluateJet<kMaxFreeParameters>(theta, residuals, j);
+  return functor_.Evaluate(parameters[0], residuals, jacobians != nullptr ? jacobians[0] : nullptr);
 }
 
 PriorCost::PriorCost(int num_free, int k, double mean, double sigma)

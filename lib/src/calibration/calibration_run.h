@@ -35,7 +35,7 @@ struct Prediction {
   std::vector<std::array<double, kNumCables>> reading_n;  // gain T + bias
   std::vector<std::array<double, kNumCables>> sigma_n;    // whitening sigma from the reading
   std::vector<std::array<double, kNumCables>> whitened;   // (reading - measured) / sigma
-  std::vector<internal::CompactStart> starts;             // the statics there (warm starts)
+  internal::CompactStarts starts;                          // the statics there (warm starts)
 };
 
 struct Run {

@@ -16,8 +16,8 @@ bool Excluded(const PredictionView& at, int t, int i) {
 }  // namespace
 
 ReadingArrays SlowErrorRatios(const SlowErrorProcess& process, const PredictionView& at) {
+  if (!process.IsActive()) return {};  // not read (FittedSamples::whitened): no 48 MB of zeros
   ReadingArrays rho(at.fit->size());
-  if (!process.IsActive()) return rho;
   for (size_t j = 0; j < at.fit->size(); ++j) {
     const int t = (*at.fit)[j];
     for (int i = 0; i < kNumCables; ++i) {
@@ -53,6 +53,7 @@ SlowErrorEstimateInputs SlowErrorInputs(const CalibrationSpec& spec, const Predi
                                         int budget) {
   SlowErrorEstimateInputs in;
   in.spec = spec.slow_error;
+  in.num_threads = spec.num_threads;
   for (const ParameterSpec& p : spec.parameters) {
     in.gain_nuisance = in.gain_nuisance || (p.free && p.kind == ParameterKind::kSensorGain);
   }

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "fastcal/internal/calibration_linearisation.h"
+#include "fastcal/internal/row_fold.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/sample_rows.h"
 
@@ -47,96 +47,69 @@ FoldedTensionCost::FoldedTensionCost(const FittedSamples& samples, const ceres::
 
 bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const {
   struct Part {
-    SampleRows rows;    // the chunk's rows, Jacobian then residual
-    Eigen::MatrixXd r;  // (n + 1) x (n + 1), upper triangular
+    SampleRows rows;  // the chunk's rows, Jacobian then residual
+    RowFold fold;     // of the rows with the loss's correction, (n + 1) columns
     double rho = 0.0;
   };
   const int n = n_;
-  *r_aug = Eigen::MatrixXd();
+  const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
+  RowFold total(n + 1);
   *rho_sum = 0.0;
   SampleRowWhitener whitener(samples_, n + 1);
   const int failed = ReduceChunksInOrder<Part>(
-      samples_.size(), threads_, [] { return Part(); },
+      samples_.size(), threads_, [n] { return Part{{}, RowFold(n + 1)}; },
       [&](int begin, int end, Part* part) {
         part->rows.Reset(begin, end, n + 1);
         for (int t = begin; t < end; ++t) {
-          if (!EvaluateSampleRows(samples_.At(t), theta, t, &part->rows)) return t;
+          if (!EvaluateSampleRows(samples_, t, at, t, &part->rows)) return t;
         }
         return -1;
       },
       [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
       [&](int begin, int end, Part* part) {
-        using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-        RowMatrix j(kNumCables, n);
+        std::vector<double> j(kNumCables * n), rows(kNumCables * (n + 1));
         double r[kNumCables];
-        Eigen::MatrixXd rows(kNumCables * (end - begin), n + 1);
         for (int t = begin; t < end; ++t) {
           for (int i = 0; i < kNumCables; ++i) {
             const double* row = part->rows.Row(t, i);
-            for (int k = 0; k < n; ++k) j(i, k) = row[k];
+            std::copy(row, row + n, &j[i * n]);
             r[i] = row[n];
           }
           part->rho += CorrectForLoss(loss_, r, j.data(), n);
-          const int row = kNumCables * (t - begin);
-          rows.block(row, 0, kNumCables, n) = j;
-          for (int i = 0; i < kNumCables; ++i) rows(row + i, n) = r[i];
+          for (int i = 0; i < kNumCables; ++i) {
+            std::copy(&j[i * n], &j[i * n] + n, &rows[i * (n + 1)]);
+            rows[i * (n + 1) + n] = r[i];
+          }
+          part->fold.Add(rows.data(), kNumCables);
         }
-        part->r = FoldRows(part->r, rows);
+        part->fold.Flush();
         return -1;
       },
       [&](const Part& part) {
-        *r_aug = FoldRows(*r_aug, part.r);
+        total.Add(part.fold);
         *rho_sum += part.rho;
       });
+  *r_aug = total.r();
   return failed < 0;
-}
-
-double FoldedTensionCost::Cost(const double* theta, bool* ok) const {
-  struct Part {
-    SampleRows rows;  // the chunk's residuals
-    double sum = 0.0;
-  };
-  double total = 0.0;
-  SampleRowWhitener whitener(samples_, 1);
-  const int failed = ReduceChunksInOrder<Part>(
-      samples_.size(), threads_, [] { return Part(); },
-      [&](int begin, int end, Part* part) {
-        part->rows.Reset(begin, end, 1);
-        for (int t = begin; t < end; ++t) {
-          if (!EvaluateSampleRows(samples_.At(t), theta, t, &part->rows)) return t;
-        }
-        return -1;
-      },
-      [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
-      [&](int begin, int end, Part* part) {
-        for (int t = begin; t < end; ++t) {
-          part->sum += CorrectForLoss(loss_, part->rows.Of(t), nullptr, n_);
-        }
-        return -1;
-      },
-      [&](const Part& part) { total += part.sum; });
-  *ok = failed < 0;
-  return total;
 }
 
 bool FoldedTensionCost::Evaluate(double const* const* parameters, double* residuals,
                                  double** jacobians) const {
   const double* theta = parameters[0];
   const int n = n_;
-  if (jacobians == nullptr || jacobians[0] == nullptr) {
-    bool ok = false;
-    const double s = Cost(theta, &ok);
-    if (!ok) return false;
-    std::fill(residuals, residuals + n, 0.0);
-    residuals[n] = std::sqrt(s);
-    return true;
-  }
+  // Every evaluation folds the Jacobian too (see Memo in the header): a trial step's cost
+  // is followed, when the step is taken, by the Jacobian at the same theta.
   std::lock_guard<std::mutex> lock(mutex_);
   if (memo_theta_.empty() || !std::equal(theta, theta + n, memo_theta_.begin())) {
     memo_theta_.assign(theta, theta + n);
     memo_ok_ = Fold(theta, &memo_r_aug_, &memo_rho_sum_);
   }
   if (!memo_ok_) return false;
+  if (jacobians == nullptr || jacobians[0] == nullptr) {
+    std::fill(residuals, residuals + n, 0.0);
+    residuals[n] = std::sqrt(memo_rho_sum_);
+    return true;
+  }
   const Eigen::VectorXd z = memo_r_aug_.col(n).head(n);
   for (int k = 0; k < n; ++k) residuals[k] = z[k];
   residuals[n] = std::sqrt(std::max(0.0, memo_rho_sum_ - z.squaredNorm()));

@@ -5,22 +5,20 @@
 
 namespace fastcal::internal {
 
-bool EvaluateSampleRows(const TensionResidual& f, const double* theta, int t, SampleRows* rows) {
+bool EvaluateSampleRows(const FittedSamples& samples, int j, const ModelAtTheta& at, int t,
+                        SampleRows* rows) {
   double r[kNumCables];
   double* out = rows->Of(t);
   const int columns = rows->columns;
   if (columns == 1) {
-    if (!f(theta, r)) return false;
+    if (!samples.Rows(j, at, r, nullptr)) return false;
     std::copy(r, r + kNumCables, out);
     return true;
   }
   const int n = columns - 1;
   thread_local std::vector<double> jacobian;
   jacobian.resize(static_cast<size_t>(kNumCables) * n);
-  const TensionCost cost(f);
-  const double* parameters[1] = {theta};
-  double* jacobians[1] = {jacobian.data()};
-  if (!cost.Evaluate(parameters, r, jacobians)) return false;
+  if (!samples.Rows(j, at, r, jacobian.data())) return false;
   for (int i = 0; i < kNumCables; ++i) {
     double* row = out + i * columns;
     std::copy(jacobian.data() + i * n, jacobian.data() + (i + 1) * n, row);

@@ -9,6 +9,7 @@
 #include <tuple>
 #include <utility>
 
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/slow_error_filter.h"
 
 namespace fastcal::internal {
@@ -71,29 +72,54 @@ double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
                                       const SlowErrorProcess& process) {
   const int nuisance = in.gain_nuisance ? 2 : 1;
   const int columns = 1 + nuisance;
+  const int count = static_cast<int>(in.samples.size());
   std::vector<std::array<NuisanceSums, kNumCables>> sums(CountSessions(in.samples));
-  // White noise alone: an inactive whitener leaves the rows as they are (F = 1).
-  ReadingWhitener whitener(process, columns);
-  double total = 0.0;
-  double rows[kNumCables * 3], rho[kNumCables];
-  for (const SlowErrorSample& s : in.samples) {
-    for (int i = 0; i < kNumCables; ++i) {
-      double* row = rows + i * columns;
-      row[0] = s.x[i];
-      row[1] = 1.0 / s.sigma_n[i];
-      if (nuisance == 2) row[2] = s.reading_n[i] / s.sigma_n[i];
-      rho[i] = process.IsActive() ? process.SigmaN(s.reading_n[i]) / s.sigma_n[i] : 0.0;
-    }
-    total += whitener.Whiten(s.time_s, s.session, rho, s.excluded.data(), rows);
-    for (int i = 0; i < kNumCables; ++i) {
-      if (s.excluded[i]) continue;  // as if missing: the state only moves on in time
-      const double* row = rows + i * columns;
-      total += row[0] * row[0];
-      NuisanceSums& n = sums[s.session][i];
-      for (int a = 0; a < nuisance; ++a) {
-        n.cross[a] += row[1 + a] * row[0];
-        for (int b = 0; b < nuisance; ++b) n.gram(a, b) += row[1 + a] * row[1 + b];
+  // Each cable's filter on its own (cables split among the threads); the terms of -2 l
+  // kept per reading and summed afterwards in the order of one thread, so that the total
+  // has the same bits on any number of threads. Each cable's nuisance sums are its own.
+  std::vector<std::array<double, kNumCables>> log_f(count), square(count);
+  const int groups = std::clamp(in.num_threads, 1, kNumCables);
+  const auto whiten_group = [&](int group) {
+    const int first = kNumCables * group / groups, end = kNumCables * (group + 1) / groups;
+    // White noise alone: an inactive whitener leaves the rows as they are (F = 1).
+    ReadingWhitener whitener(process, columns, first, end);
+    double rows[kNumCables * 3], rho[kNumCables];
+    for (int t = 0; t < count; ++t) {
+      const SlowErrorSample& s = in.samples[t];
+      for (int i = first; i < end; ++i) {
+        double* row = rows + i * columns;
+        row[0] = s.x[i];
+        row[1] = 1.0 / s.sigma_n[i];
+        if (nuisance == 2) row[2] = s.reading_n[i] / s.sigma_n[i];
+        rho[i] = process.IsActive() ? process.SigmaN(s.reading_n[i]) / s.sigma_n[i] : 0.0;
+        log_f[t][i] = 0.0;
       }
+      whitener.Whiten(s.time_s, s.session, rho, s.excluded.data(), rows, log_f[t].data());
+      for (int i = first; i < end; ++i) {
+        square[t][i] = 0.0;
+        if (s.excluded[i]) continue;  // as if missing: the state only moves on in time
+        const double* row = rows + i * columns;
+        square[t][i] = row[0] * row[0];
+        NuisanceSums& n = sums[s.session][i];
+        for (int a = 0; a < nuisance; ++a) {
+          n.cross[a] += row[1 + a] * row[0];
+          for (int b = 0; b < nuisance; ++b) n.gram(a, b) += row[1 + a] * row[1 + b];
+        }
+      }
+    }
+  };
+  // The groups of threads the system refused (OnThreads) are whitened here afterwards.
+  for (int g = OnThreads(groups, whiten_group); g < groups; ++g) whiten_group(g);
+  double total = 0.0;
+  for (int t = 0; t < count; ++t) {
+    const SlowErrorSample& s = in.samples[t];
+    double sample_log_f = 0.0;
+    for (int i = 0; i < kNumCables; ++i) {
+      if (!s.excluded[i]) sample_log_f += log_f[t][i];
+    }
+    total += sample_log_f;
+    for (int i = 0; i < kNumCables; ++i) {
+      if (!s.excluded[i]) total += square[t][i];
     }
   }
   for (const auto& session : sums) {

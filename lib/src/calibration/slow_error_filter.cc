@@ -33,13 +33,18 @@ double SlowErrorFilter::Innovate(double rho, double* row, bool update) {
   return f;
 }
 
-ReadingWhitener::ReadingWhitener(const SlowErrorProcess& process, int columns)
-    : active_(process.IsActive()), time_constant_s_(process.time_constant_s), columns_(columns) {
+ReadingWhitener::ReadingWhitener(const SlowErrorProcess& process, int columns, int first_cable,
+                                 int end_cable)
+    : active_(process.IsActive()),
+      time_constant_s_(process.time_constant_s),
+      columns_(columns),
+      first_cable_(first_cable),
+      end_cable_(end_cable) {
   for (SlowErrorFilter& f : filters_) f = SlowErrorFilter(columns);
 }
 
 double ReadingWhitener::Whiten(double time_s, int session, const double* rho, const bool* excluded,
-                               double* rows) {
+                               double* rows, double* log_f_each) {
   if (!active_) return 0.0;
   const bool fresh =
       !started_ || StartsNewSeries(previous_time_s_, previous_session_, time_s, session);
@@ -49,7 +54,7 @@ double ReadingWhitener::Whiten(double time_s, int session, const double* rho, co
   previous_time_s_ = time_s;
   previous_session_ = session;
   double log_f = 0.0;
-  for (int i = 0; i < kNumCables; ++i) {
+  for (int i = first_cable_; i < end_cable_; ++i) {
     SlowErrorFilter& filter = filters_[i];
     if (fresh) {
       filter.Reset();
@@ -58,7 +63,9 @@ double ReadingWhitener::Whiten(double time_s, int session, const double* rho, co
     }
     const bool update = excluded == nullptr || !excluded[i];
     const double f = filter.Innovate(rho[i], rows + i * columns_, update);
-    if (update) log_f += std::log(f);
+    const double term = update ? std::log(f) : 0.0;
+    if (update) log_f += term;
+    if (log_f_each != nullptr) log_f_each[i] = term;
   }
   return log_f;
 }

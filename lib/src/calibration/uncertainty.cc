@@ -31,6 +31,36 @@ double Median(std::vector<double>* v) {
   return 0.5 * (*mid + *std::max_element(v->begin(), mid));
 }
 
+// Omega_hat (LongRunCovarianceOfSum) of double or float scores, its sums in double.
+template <typename Scores>
+Eigen::MatrixXd LongRunCovarianceOf(const Scores& scores, int bandwidth) {
+  const int n_samples = static_cast<int>(scores.rows());
+  const int n = static_cast<int>(scores.cols());
+  if (n_samples < 1) return Eigen::MatrixXd::Zero(n, n);
+  const int l = std::clamp(bandwidth, 1, n_samples);
+  const int batches = n_samples - l + 1;
+  // The window sums in blocks of rows: memory independent of the number of samples.
+  constexpr int kBlock = 4096;
+  Eigen::MatrixXd windows(std::min(kBlock, batches), n);
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n, n);
+  // The window's sum in double, whatever the scores' type.
+  Eigen::RowVectorXd window = scores.topRows(l).template cast<double>().colwise().sum();
+  for (int first = 0; first < batches; first += kBlock) {
+    const int rows = std::min(kBlock, batches - first);
+    for (int k = 0; k < rows; ++k) {
+      const int j = first + k;
+      if (j > 0) {
+        window += scores.row(j + l - 1).template cast<double>() -
+                  scores.row(j - 1).template cast<double>();
+      }
+      windows.row(k) = window;
+    }
+    sum.selfadjointView<Eigen::Lower>().rankUpdate(windows.topRows(rows).transpose());
+  }
+  sum = sum.selfadjointView<Eigen::Lower>();
+  return static_cast<double>(n_samples) / (static_cast<double>(batches) * l) * sum;
+}
+
 // Autocovariances c_0 .. c_{max_lag} of a mean-subtracted series, by FFT of the series
 // zero-padded to at least twice its length (so the circular correlation is the linear one).
 std::vector<double> Autocovariance(const Eigen::VectorXd& x, int max_lag) {
@@ -89,15 +119,23 @@ Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& floor, const Eigen:
   return scale.asDiagonal() * data * scale.asDiagonal();
 }
 
-// The influence series' largest tau, and the bandwidth it calls for. Sets b->correlated
-// when some tau is above 1 by more than kTauSignificance standard deviations of tau for
-// a white series, sqrt((4 W + 2) / N) with W the window (Madras and Sokal 1988).
-void ChooseBandwidth(const Eigen::MatrixXd& influence, UncertaintyBudget* b,
-                     std::vector<double>* tau) {
-  const int n_samples = static_cast<int>(influence.rows());
+// The influence series' (u_t = M^-1 s_t) largest tau, and the bandwidth it calls for.
+// Sets b->correlated when some tau is above 1 by more than kTauSignificance standard
+// deviations of tau for a white series, sqrt((4 W + 2) / N) with W the window (Madras
+// and Sokal 1988). One series at a time: N doubles, not N x n.
+void ChooseBandwidth(const SampleScores& scores, UncertaintyBudget* b, std::vector<double>* tau) {
+  const int n_samples = static_cast<int>(scores.rows());
+  const int n = static_cast<int>(scores.cols());
   b->tau = 1.0;
-  for (int k = 0; k < influence.cols(); ++k) {
-    const AutocorrelationTime a = IntegratedAutocorrelationTime(influence.col(k));
+  Eigen::VectorXd influence(n_samples);
+  for (int k = 0; k < n; ++k) {
+    const Eigen::VectorXd p = b->formal.col(k);
+    for (int t = 0; t < n_samples; ++t) {
+      double u = 0.0;  // in double, from the float scores
+      for (int c = 0; c < n; ++c) u += static_cast<double>(scores(t, c)) * p[c];
+      influence[t] = u;
+    }
+    const AutocorrelationTime a = IntegratedAutocorrelationTime(influence);
     (*tau)[k] = a.tau;
     b->tau = std::max(b->tau, a.tau);
     b->correlation_reliable = b->correlation_reliable && a.reliable;
@@ -108,14 +146,23 @@ void ChooseBandwidth(const Eigen::MatrixXd& influence, UncertaintyBudget* b,
   b->bandwidth = static_cast<int>(std::clamp(wanted, 1.0, static_cast<double>(n_samples)));
 }
 
+// BatchCorrection from the inputs' stored Jacobians, or their replay.
+Eigen::VectorXd CorrectionOf(const BudgetInputs& in, const Eigen::MatrixXd& formal, int bandwidth) {
+  if (in.jacobians.rows() > 0 || !in.jacobian_replay) {
+    return BatchCorrection(in.jacobians, in.rows_per_sample, formal, bandwidth);
+  }
+  return BatchCorrection(in.jacobian_replay, static_cast<int>(in.scores.rows()), in.rows_per_sample,
+                         formal, bandwidth);
+}
+
 // The batch correction at the chosen bandwidth, halving it while the correction says the
 // fit absorbed most of a batch (then the widening is a lower bound).
 Eigen::VectorXd CorrectionWithinLimit(const BudgetInputs& in, UncertaintyBudget* b) {
-  Eigen::VectorXd c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, b->bandwidth);
+  Eigen::VectorXd c = CorrectionOf(in, b->formal, b->bandwidth);
   while (b->bandwidth > 1 && !(c.maxCoeff() <= kMaxBatchCorrection)) {
     b->bandwidth = std::max(1, b->bandwidth / 2);
     b->correlation_reliable = false;
-    c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, b->bandwidth);
+    c = CorrectionOf(in, b->formal, b->bandwidth);
   }
   b->max_batch_correction = c.size() > 0 ? c.maxCoeff() : 1.0;
   return c.cwiseMax(1.0);
@@ -126,7 +173,7 @@ Eigen::MatrixXd DataCovarianceAt(const BudgetInputs& in, const Eigen::MatrixXd& 
                                  const Eigen::VectorXd& correction, int bandwidth) {
   const Eigen::VectorXd root_c = correction.cwiseMax(1.0).cwiseSqrt();
   Eigen::MatrixXd meat =
-      root_c.asDiagonal() * LongRunCovarianceOfSum(in.scores, bandwidth) * root_c.asDiagonal();
+      root_c.asDiagonal() * LongRunCovarianceOf(in.scores, bandwidth) * root_c.asDiagonal();
   meat.diagonal() += in.prior_information;
   return formal * meat * formal;
 }
@@ -150,7 +197,7 @@ Eigen::MatrixXd DataCovariance(const BudgetInputs& in, UncertaintyBudget* b) {
   b->widest_bandwidth = b->bandwidth;
   const int cap = static_cast<int>(kMaxBandwidthFraction * b->samples);
   for (int l = 2 * b->bandwidth; l <= cap; l *= 2) {
-    const Eigen::VectorXd c = BatchCorrection(in.jacobians, in.rows_per_sample, b->formal, l);
+    const Eigen::VectorXd c = CorrectionOf(in, b->formal, l);
     if (!(c.maxCoeff() <= kMaxBatchCorrection)) break;
     const Eigen::MatrixXd p = DataCovarianceAt(in, b->formal, c, l);
     const double noise = std::sqrt(4.0 * l / (3.0 * b->samples));
@@ -227,60 +274,55 @@ AutocorrelationTime IntegratedAutocorrelationTime(const Eigen::Ref<const Eigen::
 }
 
 Eigen::MatrixXd LongRunCovarianceOfSum(const Eigen::MatrixXd& scores, int bandwidth) {
-  const int n_samples = static_cast<int>(scores.rows());
-  const int n = static_cast<int>(scores.cols());
-  if (n_samples < 1) return Eigen::MatrixXd::Zero(n, n);
-  const int l = std::clamp(bandwidth, 1, n_samples);
-  const int batches = n_samples - l + 1;
-  // The window sums in blocks of rows: memory independent of the number of samples.
-  constexpr int kBlock = 4096;
-  Eigen::MatrixXd windows(std::min(kBlock, batches), n);
-  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(n, n);
-  Eigen::RowVectorXd window = scores.topRows(l).colwise().sum();
-  for (int first = 0; first < batches; first += kBlock) {
-    const int rows = std::min(kBlock, batches - first);
-    for (int k = 0; k < rows; ++k) {
-      const int j = first + k;
-      if (j > 0) window += scores.row(j + l - 1) - scores.row(j - 1);
-      windows.row(k) = window;
-    }
-    sum.selfadjointView<Eigen::Lower>().rankUpdate(windows.topRows(rows).transpose());
-  }
-  sum = sum.selfadjointView<Eigen::Lower>();
-  return static_cast<double>(n_samples) / (static_cast<double>(batches) * l) * sum;
+  return LongRunCovarianceOf(scores, bandwidth);
 }
 
 Eigen::VectorXd BatchCorrection(const SampleJacobians& jacobians, int rows_per_sample,
                                 const Eigen::MatrixXd& inverse_information, int bandwidth) {
-  const int n = static_cast<int>(inverse_information.rows());
   const int n_samples = static_cast<int>(jacobians.rows());
+  const int n = static_cast<int>(inverse_information.rows());
   if (n_samples == 0 || rows_per_sample < 1 || jacobians.cols() != rows_per_sample * n) {
     return Eigen::VectorXd::Ones(n);
   }
-  const int l = std::clamp(bandwidth, 1, n_samples);
-  const int batches = n_samples - l + 1;
+  const SampleJacobianReplay replay = [&](const std::function<void(int, const float*)>& visit) {
+    for (int t = 0; t < n_samples; ++t) visit(t, jacobians.row(t).data());
+    return true;
+  };
+  return BatchCorrection(replay, n_samples, rows_per_sample, inverse_information, bandwidth);
+}
+
+Eigen::VectorXd BatchCorrection(const SampleJacobianReplay& replay, int samples,
+                                int rows_per_sample, const Eigen::MatrixXd& inverse_information,
+                                int bandwidth) {
+  const int n = static_cast<int>(inverse_information.rows());
+  if (samples == 0 || rows_per_sample < 1 || !replay) return Eigen::VectorXd::Ones(n);
+  const int l = std::clamp(bandwidth, 1, samples);
   const int stride = std::max(1, l / 16);
-  // Per sample J_t^T J_t, added to and removed from the running window sum.
+  const int width = rows_per_sample * n;
+  // Per sample J_t^T J_t, added to and removed from the running window sum; the rows of
+  // the last l samples in a ring (the one leaving the window is l behind).
   using Rows = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  std::vector<float> ring(static_cast<size_t>(l) * width);
   // Without allocation per sample (10^6 of them).
   Eigen::MatrixXd j(rows_per_sample, n);
   Eigen::MatrixXd window = Eigen::MatrixXd::Zero(n, n);
-  auto add = [&](int t, double sign) {
-    j = Eigen::Map<const Rows>(jacobians.row(t).data(), rows_per_sample, n).cast<double>();
+  auto add = [&](const float* rows, double sign) {
+    j = Eigen::Map<const Rows>(rows, rows_per_sample, n).cast<double>();
     window.noalias() += sign * (j.transpose() * j);
   };
-  for (int t = 0; t < l; ++t) add(t, 1.0);
   Eigen::VectorXd kept = Eigen::VectorXd::Zero(n), all = Eigen::VectorXd::Zero(n);
-  for (int b = 0; b < batches; ++b) {
-    if (b > 0) {
-      add(b + l - 1, 1.0);
-      add(b - 1, -1.0);
-    }
-    if (b % stride != 0) continue;
+  const bool ok = replay([&](int t, const float* rows) {
+    float* slot = ring.data() + static_cast<size_t>(t % l) * width;
+    add(rows, 1.0);
+    if (t >= l) add(slot, -1.0);  // sample t - l leaves the window
+    std::copy(rows, rows + width, slot);
+    const int b = t - l + 1;  // the window [b, t] is complete
+    if (b < 0 || b % stride != 0) return;
     const Eigen::MatrixXd absorbed = window * inverse_information * window;
     all += window.diagonal();
     kept += window.diagonal() - absorbed.diagonal();
-  }
+  });
+  if (!ok) return Eigen::VectorXd::Ones(n);
   Eigen::VectorXd c(n);
   for (int k = 0; k < n; ++k) {
     c[k] = kept[k] > 0.0 ? all[k] / kept[k] : std::numeric_limits<double>::infinity();
@@ -300,7 +342,7 @@ bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
     // An M-estimator's covariance for white residuals: the sandwich
     // H^-1 (sum_t psi_t psi_t^T + Lambda) H^-1 (the scores are psi, M is H); it carries
     // the residuals' scale itself, so no misfit factor on top.
-    Eigen::MatrixXd meat = LongRunCovarianceOfSum(in.scores, 1);
+    Eigen::MatrixXd meat = LongRunCovarianceOf(in.scores, 1);
     meat.diagonal() += in.prior_information;
     b->formal = b->formal * meat * b->formal;
   } else if (std::isfinite(b->reduced_chi_square) && b->reduced_chi_square > in.misfit_threshold) {
@@ -310,7 +352,7 @@ bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
   Eigen::MatrixXd data = b->formal;
   b->correlation_measured =
       b->samples >= kMinSamplesForCorrelation && in.scores.cols() == n && dof > 0;
-  if (b->correlation_measured) ChooseBandwidth(in.scores * b->formal, b, &tau);
+  if (b->correlation_measured) ChooseBandwidth(in.scores, b, &tau);
   if (b->correlated) data = DataCovariance(in, b);
   b->effective_samples = b->samples / b->tau;
   b->statistical = StatisticalCovariance(MisfitFloor(in, b->formal, b->misfit_factor), data);

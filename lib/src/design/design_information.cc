@@ -19,25 +19,29 @@ namespace {
 
 constexpr int kRows = kNumCables;  // readings per sample
 
-// P_w^-1 (D) or diag(weights) (A), embedded in n x n: the criterion's weight on P.
-bool CriterionWeight(const DesignProblem& pr, const Eigen::MatrixXd& total, Eigen::MatrixXd* w) {
+// A factor S (n x m, m the wanted parameters) of the criterion's weight on P, W = S S^T:
+// A: diag(weights) on the wanted parameters, so S = sqrt(weight) on the diagonal; D: P_w^-1
+// embedded, so S = its Cholesky factor in the wanted rows.
+bool CriterionFactor(const DesignProblem& pr, const Eigen::MatrixXd& total, Eigen::MatrixXd* s) {
   const int n = pr.n;
-  w->setZero(n, n);
+  const int m = static_cast<int>(pr.wanted.size());
+  s->setZero(n, m);
   if (pr.criterion == DesignCriterion::kA) {
-    w->diagonal() = pr.wanted_weight;
+    for (int a = 0; a < m; ++a) {
+      (*s)(pr.wanted[a], a) = std::sqrt(std::max(pr.wanted_weight[pr.wanted[a]], 0.0));
+    }
     return true;
   }
-  const int m = static_cast<int>(pr.wanted.size());
   Eigen::MatrixXd block(m, m);
   for (int a = 0; a < m; ++a) {
     for (int b = 0; b < m; ++b) block(a, b) = total(pr.wanted[a], pr.wanted[b]);
   }
   const Eigen::LLT<Eigen::MatrixXd> llt(block);
   if (llt.info() != Eigen::Success) return false;
-  const Eigen::MatrixXd inverse = llt.solve(Eigen::MatrixXd::Identity(m, m));
-  for (int a = 0; a < m; ++a) {
-    for (int b = 0; b < m; ++b) (*w)(pr.wanted[a], pr.wanted[b]) = inverse(a, b);
-  }
+  const Eigen::LLT<Eigen::MatrixXd> inverse(llt.solve(Eigen::MatrixXd::Identity(m, m)));
+  if (inverse.info() != Eigen::Success) return false;
+  const Eigen::MatrixXd l = inverse.matrixL();
+  for (int a = 0; a < m; ++a) s->row(pr.wanted[a]) = l.row(a);
   return true;
 }
 
@@ -198,33 +202,38 @@ double CriterionOf(const DesignProblem& pr, const DesignSums& sums) {
 bool CriterionGradient(const DesignProblem& pr, const DesignSums& sums, Eigen::VectorXd* gradient) {
   DesignCovariance cov;
   if (!CovarianceOf(pr, sums, &cov)) return false;
-  Eigen::MatrixXd w;
-  if (!CriterionWeight(pr, cov.total, &w)) return false;
+  Eigen::MatrixXd factor;
+  if (!CriterionFactor(pr, cov.total, &factor)) return false;
+  // With W = S S^T, G and H are of rank <= 2m and m (m wanted parameters, often 3 of
+  // 21): for a row x (free columns) and z (consider columns), with u = x K S,
+  // v = x Q S and p = z Sigma_c C^T K S (Q = K C Sigma_c C^T K),
+  //   -x G x^T + 2 z H x^T = -(u.u + 2 u.v) + 2 p.u = -u.(u + 2 v - 2 p),
+  // three products with n x m and q x m matrices per row instead of n x n and q x n.
   const Eigen::MatrixXd& k = cov.k;
   const Eigen::MatrixXd kc = k * sums.c;
-  const Eigen::MatrixXd q = kc * pr.consider_variance.asDiagonal() * kc.transpose();
-  const Eigen::MatrixXd kwk = k * w * k;
-  const Eigen::MatrixXd g = kwk + k * w * q + q * w * k;
-  const Eigen::MatrixXd h = pr.consider_variance.asDiagonal() * kc.transpose() * w * k;
-  // Per row: -x G x^T + 2 z H x^T; per candidate: the sum over its six rows. In chunks,
-  // so that the temporaries stay small (the rows of 40 000 candidates are ~40 MB), the
-  // chunks shared by two threads (the gradient is most of a design's time).
+  const int m = static_cast<int>(factor.cols());
+  const Eigen::MatrixXd p = pr.consider_variance.asDiagonal() * (kc.transpose() * factor);
+  Eigen::MatrixXd ab(pr.n, 2 * m);  // [K S, K S + 2 Q S]: x's rows read once for both
+  ab.leftCols(m) = k * factor;
+  ab.rightCols(m) = ab.leftCols(m) + 2.0 * (kc * p);
+  const Eigen::MatrixXd e = -2.0 * p;
+  // Per candidate: the sum over its six rows. In chunks, so that the temporaries stay
+  // small, the chunks shared by two threads (the gradient is most of a design's time).
   constexpr int kChunkCandidates = 512;
   constexpr int kThreads = 2;
   gradient->resize(pr.candidates());
   const int chunks = (pr.candidates() + kChunkCandidates - 1) / kChunkCandidates;
   auto work = [&](int first_chunk) {
-    Eigen::MatrixXd xg, zh;
+    Eigen::MatrixXd uy;  // [u, u + 2 v - 2 p]
     for (int chunk = first_chunk; chunk < chunks; chunk += kThreads) {
       const int c0 = chunk * kChunkCandidates;
       const int count = std::min(kChunkCandidates, pr.candidates() - c0);
-      const auto x = pr.x_rows.middleRows(kRows * c0, kRows * count);
-      xg.noalias() = x * g;
-      Eigen::VectorXd per_row = -(xg.cwiseProduct(x)).rowwise().sum();
+      uy.noalias() = pr.x_rows.middleRows(kRows * c0, kRows * count) * ab;
       if (pr.q > 0) {
-        zh.noalias() = pr.z_rows.middleRows(kRows * c0, kRows * count) * h;
-        per_row += 2.0 * (zh.cwiseProduct(x)).rowwise().sum();
+        uy.rightCols(m).noalias() += pr.z_rows.middleRows(kRows * c0, kRows * count) * e;
       }
+      const Eigen::VectorXd per_row =
+          -(uy.leftCols(m).cwiseProduct(uy.rightCols(m))).rowwise().sum();
       for (int c = 0; c < count; ++c) {
         (*gradient)[c0 + c] = per_row.segment(kRows * c, kRows).sum();
       }

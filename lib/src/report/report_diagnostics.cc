@@ -131,6 +131,7 @@ bool IsTrajectory(const Dataset& data) {
   for (const Sample& s : data.samples) spread2 += (s.pose.position_m - mean).squaredNorm();
   const double spread = std::sqrt(spread2 / n);
   std::vector<double> steps;
+  steps.reserve(n - 1);
   for (size_t t = 1; t < n; ++t) {
     steps.push_back((data.samples[t].pose.position_m - data.samples[t - 1].pose.position_m).norm());
   }
@@ -464,12 +465,21 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
       s->marker_radius_px = kDotRadiusPx;
       s->opacity = kDotOpacity;
     }
+    const auto drawn = [&](size_t n) { return !(n < r.excluded.size() && r.excluded[n][i]); };
+    size_t points = 0;
+    for (size_t n = 0; n < d.samples.size(); ++n) points += drawn(n);
+    excluded += static_cast<int>(d.samples.size() - points);
+    // ThinEvenly's points, taken as they come: every k-th drawn sample (at 10^6 samples
+    // the whole series first held 100 MB for a moment).
+    const size_t k = std::max<size_t>(1, (points + kMaxScatterPoints - 1) / kMaxScatterPoints);
+    stride = std::max(stride, static_cast<int>(k));
+    size_t index = 0;
     for (size_t n = 0; n < d.samples.size(); ++n) {
-      if (n < r.excluded.size() && r.excluded[n][i]) {
-        ++excluded;
-        continue;
-      }
+      if (!drawn(n)) continue;
       const Sample& s = d.samples[n];
+      lo = std::min(lo, s.tension_n[i] / kNPerKn);
+      hi = std::max(hi, s.tension_n[i] / kNPerKn);
+      if (index++ % k != 0) continue;
       const double residual_kn = (v.predicted_n[n][i] - s.tension_n[i]) / kNPerKn;
       zenith[i].x.push_back(OffAxisDeg(s.pose.position_m));
       zenith[i].y.push_back(residual_kn);
@@ -477,11 +487,6 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc) {
       azimuth[i].y.push_back(residual_kn);
       versus[i].x.push_back(s.tension_n[i] / kNPerKn);
       versus[i].y.push_back(v.predicted_n[n][i] / kNPerKn);
-      lo = std::min(lo, s.tension_n[i] / kNPerKn);
-      hi = std::max(hi, s.tension_n[i] / kNPerKn);
-    }
-    for (PlotSeries* s : {&zenith[i], &azimuth[i], &versus[i]}) {
-      *s = ThinEvenly(*s, kMaxScatterPoints, &stride);
     }
   }
   versus[kNumCables] = PlotSeries{"predicted = measured", {lo, hi}, {lo, hi}, true, false};

@@ -19,7 +19,7 @@ struct RmsTableInputs {
   // Per dataset sample (may be null): exact statics near each variant's, e.g. the fit's
   // at its solution, each sample's warm start (at the same pose: ~3 times cheaper than
   // cold, and the same answer to the solver's tolerance). Null: cold starts.
-  const std::vector<CompactStart>* starts = nullptr;
+  const CompactStarts* starts = nullptr;
   // The calibrated model's readings of every sample, when already predicted with exact
   // statics at the fit's attitude (may be null; moved from: saves a pass over the data).
   std::vector<std::array<double, kNumCables>>* calibrated_readings = nullptr;

@@ -1,12 +1,17 @@
 // The calibration problem linearised at its solution, for the uncertainty budget and the
 // diagnostics (uncertainty.h, calibration.h). Two passes over the fitted samples:
 //
-// Free parameters (every fitted sample): the fit's own residual with a ceres::Jet over
-// the n free parameters gives the whitened residuals r_t and J_t (6 x n). Accumulated:
-//   J_x^T J_x and its R factor (chunked QR, as the identifiability check wants it),
-//   the scores s_t = J_t^T r_t and J_t (kept per sample, time order: the long-run
-//   covariance), and per cross-validation block k: J_x^T J_x, J_x^T r, and per cable i
-//   the sums of (sigma r)^2, sigma^2 r J_x,i and sigma^2 J_x,i^T J_x,i (tension units).
+// Free parameters (every fitted sample): the fit's own rows (FittedSamples::Rows) give the
+// whitened residuals r_t and J_t (6 x n). Accumulated:
+//   J_x^T J_x and its R factor (row_fold.h, as the identifiability check wants it),
+//   the scores s_t = J_t^T r_t and r_t (kept per sample, time order: the long-run
+//   covariance, the residuals' memory), and per cross-validation block k: J_x^T J_x,
+//   J_x^T r, and per cable i the sums of (sigma r)^2, sigma^2 r J_x,i and
+//   sigma^2 J_x,i^T J_x,i (tension units).
+// J_t itself is kept only on request (the change scan's); otherwise ReplayFreeJacobians
+// computes the rows again, in time order, for the budget's batch correction (issue 28:
+// 6n floats a sample, 0.5 GB at 10^6 samples and 21 parameters, for a correction only
+// correlated residuals need).
 //
 // Candidates (every fixed parameter the model has): every parameter a spec can name is a
 // sum of "basis" parameters (mass centre x, y, z, cabin mass, per cable i density_i,
@@ -31,6 +36,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -39,6 +45,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/row_fold.h"
 #include "fastcal/statics.h"
 #include "fastcal/uncertainty.h"
 
@@ -55,6 +62,8 @@ struct LinearisationInputs {
   // Threads of both passes: the results do not depend on it (sample_chunks.h).
   int num_threads = 1;
   int max_candidate_samples = 20000;  // the candidate pass's sample budget (see above)
+  // Keep every sample's J_t in Linearisation::jacobians (the change scan needs them).
+  bool keep_jacobians = false;
 };
 
 struct FoldSums {
@@ -74,8 +83,9 @@ struct Linearisation {
   // which the M-estimator's sandwich needs. 0 without a loss.
   Eigen::MatrixXd loss_curvature;
   Eigen::MatrixXd r_factor;     // upper triangular R, R^T R = J_x^T J_x
-  Eigen::MatrixXd scores;       // s_t, one row per fitted sample
-  SampleJacobians jacobians;    // J_t (6 x n, row after row), one row per fitted sample
+  SampleScores scores;          // s_t, one row per fitted sample (float: uncertainty.h)
+  // J_t (6 x n, row after row), one row per fitted sample: with keep_jacobians only.
+  SampleJacobians jacobians;
   Eigen::MatrixXd residuals;    // r_t (fitted samples x 6); 0 where excluded
   double chi_square = 0.0;      // sum (w r)^2 over the data, w the robust loss's weight
   double raw_chi_square = 0.0;  // sum r^2 over the data
@@ -96,10 +106,12 @@ struct Linearisation {
   // test's Schur complement is a small difference of large numbers for a candidate near
   // the free parameters' span, so its two terms must come from the same samples.
   Eigen::MatrixXd candidate_information;
-  // Per sample of the candidate pass (in time order): J_c,t^T r_t (unscaled), and the
-  // sample's row in `scores` (for the score test's long-run variance).
+  // Per sample of the candidate pass (in time order): J_c,t^T r_t (unscaled), the
+  // sample's row in `scores` and its score s_t in double (the score test projects the
+  // candidates' scores on these, a difference of nearly equal numbers).
   Eigen::MatrixXd candidate_scores;
   std::vector<int> candidate_rows;
+  Eigen::MatrixXd candidate_free_scores;
 };
 
 // The basis parameters, in order (all free, no initial: the model's values).
@@ -110,9 +122,11 @@ std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model);
 // Both passes. False, with *error naming the sample's line, when the statics fail there.
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error);
 
-// Upper-triangular R with R^T R = A^T A for A the rows of `top` stacked on `rows` (a QR
-// of the stack; `top` may be empty).
-Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows);
+// The free pass's J_t again, as Linearisation::jacobians would hold them (the same
+// floats), visited in time order (uncertainty.h, SampleJacobianReplay). False when the
+// statics fail (they did not in Linearise with the same inputs).
+bool ReplayFreeJacobians(const LinearisationInputs& in,
+                         const std::function<void(int t, const float* jacobian)>& visit);
 
 }  // namespace fastcal::internal
 

@@ -5,9 +5,14 @@
 //   sigma_i^2 = sigma_abs^2 + (percent/100 * T_predicted_i)^2
 // (the predicted reading at the previous pass's parameters: calibration.cc), and
 // r_i = 0 for a reading kept out of the fit (a gross error).
-// TensionResidual is a pure functor (const members, no side effects); TensionCost wraps
-// it with a Jet whose size is chosen at run time from the number of free parameters, so
-// the whole Jacobian comes from one pass through the statics.
+// TensionResidual is a pure functor (const members, no side effects). Its Evaluate is the
+// one stage every consumer (the folded cost, the linearisation, the design) reads a
+// sample's six rows and their 6 x n Jacobian from. With exact statics the Jacobian is
+// analytic: the statics' part by the implicit-function theorem (tension_gradient.h),
+// contracted with the parameter map (CalibrationModel::ReadingJacobian), the sensors' gain
+// and bias directly; ~1 us a sample whatever n (issue 28). With aas and aas-refined,
+// whose solutions are explicit sequences of solves, a ceres::Jet as wide as n replays
+// them (TensionCost::EvaluateJet).
 #ifndef FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 #define FASTCAL_INTERNAL_CALIBRATION_MODEL_H_
 
@@ -23,6 +28,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/internal/compact_start.h"
+#include "fastcal/internal/tension_gradient.h"
 #include "fastcal/slow_error.h"
 #include "fastcal/statics.h"
 
@@ -51,6 +57,15 @@ class CalibrationModel {
   // The calibrated model: the input robot with the parameters set to theta (those of
   // `session` where a parameter has one copy per session: sessions.h).
   CableRobot ToRobot(const double* theta, int session = 0) const;
+
+  // Whether an anchor or tower offset is free: the statics' gradient needs its geometry
+  // columns (ExactTensionGradient).
+  bool frees_geometry() const { return frees_geometry_; }
+  // d reading_i / d theta_k (6 x n, row-major) of the readings gain_i T_i + bias_i at a
+  // sample of `session`: Assemble's map differentiated, with `gradient` the statics' and
+  // `gain` Assemble's at theta. A parameter of another session has a zero column.
+  void ReadingJacobian(const TensionGradient& gradient, const std::array<double, kNumCables>& gain,
+                       int session, double* jacobian) const;
 
   // The statics parameters and sensor model at theta for a sample of `session`: a
   // parameter of another session (ParameterSpec::session) does not apply.
@@ -113,9 +128,32 @@ class CalibrationModel {
   CableRobot robot_;
   CalibrationSpec spec_;
   std::vector<int> free_;
+  bool frees_geometry_ = false;
   std::array<int, kNumCables> anchor_of_cable_{};
   StaticsParameters<double> base_;  // the robot with fixed overrides applied
   std::array<double, kNumCables> base_gain_{}, base_bias_n_{};
+};
+
+// The model at one theta for a pass over many samples: the statics parameters, gains and
+// biases of each session assembled once (CalibrationModel::Assemble per sample copied
+// ~2.5 kB of parameters for each: a tenth of a solve).
+class ModelAtTheta {
+ public:
+  struct Session {
+    StaticsParameters<double> statics;
+    std::array<double, kNumCables> gain, bias;
+    bool gains_positive = false;  // else every evaluation fails (TensionResidual)
+  };
+  // `theta` must outlive this; sessions >= 1.
+  ModelAtTheta(const CalibrationModel& model, const double* theta, int sessions);
+  const CalibrationModel& model() const { return *model_; }
+  const double* theta() const { return theta_; }
+  const Session& session(int s) const { return sessions_[s]; }
+
+ private:
+  const CalibrationModel* model_;
+  const double* theta_;
+  std::vector<Session> sessions_;
 };
 
 // Whitening sigma of each cable's reading: sqrt(abs^2 + (percent/100 * reading)^2).
@@ -135,6 +173,10 @@ struct TensionResidual {
   // Readings kept out of the fit: their residual is 0, whatever the parameters.
   std::array<bool, kNumCables> excluded{};
   int session = 0;  // the sample's (Sample::session)
+
+  // The six residuals and, when `jacobian` is not null, their Jacobian (6 x n, row-major;
+  // rows of excluded readings zero) at theta. False where the statics fail.
+  bool Evaluate(const double* theta, double* residuals, double* jacobian) const;
 
   template <typename T>
   bool operator()(const T* theta, T* residuals) const {
@@ -170,7 +212,7 @@ struct FittedSamples {
   // Per fitted sample: the whitening sigmas.
   const std::vector<std::array<double, kNumCables>>* sigma_n = nullptr;
   // Per dataset sample: warm starts (may be null or empty: cold starts).
-  const std::vector<CompactStart>* starts = nullptr;
+  const CompactStarts* starts = nullptr;
   // Per dataset sample: readings kept out of the fit (may be null or empty).
   const ReadingMask* excluded = nullptr;
   bool use_planned_attitude = false;
@@ -185,20 +227,35 @@ struct FittedSamples {
   bool whitened() const { return slow_error.IsActive() && slow_rho != nullptr; }
   // Fitted sample j's residual through `through` (default: model).
   TensionResidual At(int j, const CalibrationModel* through = nullptr) const;
+  // The stage every pass over the samples reads from: fitted sample j's six residuals and,
+  // when `jacobian` is not null, their Jacobian (6 x n, row-major) at `at` (through the
+  // model `at` was made for, with at least as many sessions as the data). The same
+  // numbers as At(j, &at.model()).Evaluate(at.theta(), ...).
+  bool Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const;
+  // The number of sessions a ModelAtTheta for these samples needs.
+  int sessions() const;
+  // Fitted sample j's readings kept out of the fit.
+  std::array<bool, kNumCables> Excluded(int j) const;
 };
 
-// ceres::CostFunction over one parameter block (theta) of size num_free <= 64.
+// ceres::CostFunction over one parameter block (theta) of size num_free <=
+// kMaxFreeParameters: TensionResidual::Evaluate.
 class TensionCost : public ceres::CostFunction {
  public:
   explicit TensionCost(const TensionResidual& functor);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
 
+  // The Jacobian by a ceres::Jet through the replayed statics, whatever the method:
+  // aas's and aas-refined's derivatives, and a reference for the analytic ones (tests).
+  static bool EvaluateJet(const TensionResidual& f, const double* theta, double* residuals,
+                          double* jacobian);
+
  private:
   template <int N>
-  bool EvaluateJet(const double* theta, double* residuals, double* jacobian) const;
+  static bool EvaluateJetOf(const TensionResidual& f, const double* theta, double* residuals,
+                            double* jacobian);
   TensionResidual functor_;
-  int n_;
 };
 
 // (theta_k - mean) / sigma on one coordinate of theta.

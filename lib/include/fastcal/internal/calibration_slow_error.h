@@ -26,7 +26,7 @@ struct PredictionView {
   const ReadingMask* excluded = nullptr;     // per dataset sample (may be empty)
 };
 
-// Per fitted sample j: rho_ji = process.SigmaN(reading) / sigma_white (0 when inactive).
+// Per fitted sample j: rho_ji = process.SigmaN(reading) / sigma_white (empty when inactive).
 ReadingArrays SlowErrorRatios(const SlowErrorProcess& process, const PredictionView& at);
 
 // The prediction's residuals over their white sigma (`x`, per dataset sample) whitened

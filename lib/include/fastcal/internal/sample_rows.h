@@ -40,9 +40,11 @@ struct SampleRows {
   double* Row(int t, int i) { return Of(t) + i * columns; }
 };
 
-// Fitted sample t's rows at theta through `f`: Jacobian (when rows->columns > 1, it must
-// be f.model->num_free() + 1) and residual. False where the statics fail.
-bool EvaluateSampleRows(const TensionResidual& f, const double* theta, int t, SampleRows* rows);
+// Fitted sample j's rows at `at` (FittedSamples::Rows) into rows->Of(t): Jacobian (when
+// rows->columns > 1, it must be at.model().num_free() + 1) and residual; rows of readings
+// kept out of the fit are zero. False where the statics fail.
+bool EvaluateSampleRows(const FittedSamples& samples, int j, const ModelAtTheta& at, int t,
+                        SampleRows* rows);
 
 // The filters of one pass over the fitted samples (or any ordered subset of them).
 class SampleRowWhitener {

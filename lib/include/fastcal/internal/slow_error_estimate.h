@@ -46,6 +46,9 @@ struct SlowErrorEstimateInputs {
   SlowErrorSpec spec;                    // what is stated and what is estimated
   // Nuisance columns profiled out per cable and session: the bias (always) and the gain.
   bool gain_nuisance = false;
+  // Threads the likelihood's filters run on (the cables split among them); the results
+  // are the same bits on any number.
+  int num_threads = 1;
 };
 
 // -2 l_R of `process` (white noise only when inactive), up to a constant.

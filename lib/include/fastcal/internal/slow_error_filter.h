@@ -48,22 +48,29 @@ class SlowErrorFilter {
   bool fresh_ = true;         // the next reading starts a series
 };
 
-// The six cables' filters over a pass's samples in time order (file order).
+// The six cables' filters over a pass's samples in time order (file order); or those of
+// cables [first_cable, end_cable) only (each cable's filter is independent of the others':
+// cables can be whitened on separate threads).
 class ReadingWhitener {
  public:
   // White noise only when !process.IsActive(): Whiten leaves rows alone.
-  ReadingWhitener(const SlowErrorProcess& process, int columns);
+  ReadingWhitener(const SlowErrorProcess& process, int columns, int first_cable = 0,
+                  int end_cable = kNumCables);
 
   bool active() const { return active_; }
   // One sample: `rows` holds its six readings' rows, cable i's at rows + i * columns;
   // rho[i] = sigma_e / s of cable i's reading; excluded (may be null) the readings that do
-  // not update the state. Returns sum log F over the readings that updated it.
-  double Whiten(double time_s, int session, const double* rho, const bool* excluded, double* rows);
+  // not update the state. Returns sum log F over the readings that updated it (in cable
+  // order), and, when log_f is not null, each cable's log F in log_f[i] (0 where the
+  // reading did not update the state). Only the range's cables are read and written.
+  double Whiten(double time_s, int session, const double* rho, const bool* excluded, double* rows,
+                double* log_f = nullptr);
 
  private:
   bool active_ = false;
   double time_constant_s_ = 0.0;
   int columns_ = 1;
+  int first_cable_ = 0, end_cable_ = kNumCables;
   std::array<SlowErrorFilter, kNumCables> filters_;
   bool started_ = false;
   double previous_time_s_ = 0.0;

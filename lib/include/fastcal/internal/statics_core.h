@@ -198,9 +198,11 @@ inline void EquilibriumNullBasis(PoseGeometry<double>* g) {
   solve_for(col, col + 3);
 }
 
+// `null_basis` (double only): also PoseGeometry::null_basis, which only the solvers use.
 template <typename T>
 StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
-                              double vertical_span_fraction, PoseGeometry<T>* g, int* cable) {
+                              double vertical_span_fraction, PoseGeometry<T>* g, int* cable,
+                              bool null_basis = true) {
   using std::sqrt;
   const Eigen::Matrix<T, 3, 3> rotation = pose.rotation.cast<T>();
   const Vector3T<T> position = pose.position_m.cast<T>();
@@ -221,7 +223,9 @@ StaticsStatus ComputeGeometry(const StaticsParameters<T>& p, const Pose& pose,
   }
   g->e = rotation * p.mass_centre_cabin_m;
   g->weight_n = p.cabin_mass_kg * p.gravity_m_per_s2;
-  if constexpr (kIsDouble<T>) EquilibriumNullBasis(g);
+  if constexpr (kIsDouble<T>) {
+    if (null_basis) EquilibriumNullBasis(g);
+  }
   return StaticsStatus::kOk;
 }
 

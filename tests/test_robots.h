@@ -1,0 +1,44 @@
+// Robots and poses several tests share.
+#ifndef FASTCAL_TESTS_TEST_ROBOTS_H_
+#define FASTCAL_TESTS_TEST_ROBOTS_H_
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/trajectory.h"
+
+namespace fastcal::testing {
+
+// Issue 18's telemetry: each cable a 250-650 kg assembly 2-6 m above the cabin and
+// 0.6-1.6 kg/m of hung lines over the lowest 120-200 m.
+inline CableRobot AsBuiltRobot() {
+  CableRobot robot = CableRobot::NominalFast();
+  for (int i = 0; i < kNumCables; ++i) {
+    robot.cables[i].attachments = {
+        CableAttachment::PointMass(2.0 + 0.8 * i, 250.0 + 80.0 * i),
+        CableAttachment::AddedDensity(0.0, 120.0 + 16.0 * i, 0.6 + 0.2 * i)};
+  }
+  return robot;
+}
+
+// `count` random poses up to 35 deg off axis (with the focal law's 2-5 deg extra tilts,
+// inside the model's range), `spread_m` off the focal sphere.
+inline std::vector<Pose> TiltedPoses(int count, std::uint64_t seed, double spread_m = 0.0) {
+  RandomPoseSpec spec;
+  spec.positions.samples = count;
+  spec.positions.seed = seed;
+  spec.positions.max_off_axis_deg = 35.0;
+  spec.positions.radial_spread_m = spread_m;
+  std::vector<Pose> poses;
+  std::string error;
+  EXPECT_TRUE(RandomPosesAroundFocalLaw(spec, &poses, &error)) << error;
+  return poses;
+}
+
+}  // namespace fastcal::testing
+
+#endif  // FASTCAL_TESTS_TEST_ROBOTS_H_
