@@ -45,7 +45,7 @@ CalibrationSpec FoldSpec(const FoldTask& task) {
 // starts there. Returns the first sample the statics cannot solve, or -1.
 struct Prediction {
   ReadingArrays reading_n, sigma_n, x;
-  std::vector<internal::CompactStart> starts;
+  internal::CompactStarts starts;
 };
 int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Dataset& data,
             const StaticsOptions& statics, Prediction* at) {
@@ -56,7 +56,8 @@ int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Da
   at->reading_n.resize(n);
   at->sigma_n.resize(n);
   at->x.resize(n);
-  at->starts.resize(n);
+  at->starts = internal::CompactStarts(statics.method);
+  at->starts.Reset(n);
   StaticsOptions options = statics;
   options.warm_start = true;
   return internal::ForEachChunk(n, task.threads, [&](int begin, int end) {
@@ -68,7 +69,7 @@ int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Da
       if (SolveStaticsWithParameters(params, s.pose, options, &solution) != StaticsStatus::kOk) {
         return t;
       }
-      at->starts[t] = internal::CompactStart::Of(solution);
+      at->starts.Set(t, solution);
       for (int i = 0; i < kNumCables; ++i) {
         at->reading_n[t][i] = gain[i] * solution.cables[i].lower_tension_n + bias[i];
       }
@@ -156,12 +157,13 @@ bool FoldRowsInBlocks(const FoldTask& task, const internal::FittedSamples& sampl
   std::vector<Eigen::VectorXd> scores;
   internal::SampleRowWhitener whitener(samples, n + 1);
   const std::vector<double>& theta = task.theta_si;
+  const internal::ModelAtTheta at(*samples.model, theta.data(), samples.sessions());
   *failed = internal::ReduceChunksInOrder<Part>(
       count, task.threads, [] { return Part(); },
       [&](int begin, int end, Part* part) {
         part->rows.Reset(begin, end, n + 1);
         for (int t = begin; t < end; ++t) {
-          if (!internal::EvaluateSampleRows(samples.At(t), theta.data(), t, &part->rows)) return t;
+          if (!internal::EvaluateSampleRows(samples, t, at, t, &part->rows)) return t;
         }
         return -1;
       },
