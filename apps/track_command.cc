@@ -86,7 +86,10 @@ Events (events.json), each kind at a 1% false-alarm rate over the whole track:
              (a window with the step inside gets its own value), so that it does not
              read as a mass-centre move
   parameter  a per-window group (the mass centre) changed between consecutive windows,
-             or inside one (then one event from the window before to the window after)
+             or inside one (then one event from the window before to the window after),
+             beyond the group's wander from window to window (estimated from all the
+             windows' differences and stated: a mass centre that moves about is not a
+             string of steps)
 Time resolution: the window (the event's time is the later window's first sample), or,
 where the window's own telemetry places the step, its block within the window (about
 1/32 of it: "inside the window, at TIME").
