@@ -17,7 +17,7 @@
 // written once, streamed (not timed).
 // Run: build/bench/track_bench --benchmark_filter=/100000/   (about a minute on 2 cores);
 // /1000000/ a few minutes; /10000000/ (the 10^7 samples in 100 windows) about an
-// hour, and 2 GB of CSV plus 1.6 GB of window store in the temporary directory.
+// hour, and 4 GB of CSV plus 1.6 GB of window store in the temporary directory.
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
