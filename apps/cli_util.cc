@@ -658,9 +658,12 @@ class CheckedStdout : public std::streambuf {
   int error_ = 0;
 };
 
+// Never destroyed: std::cout is flushed by the library's own static destructors after
+// ours have run (libstdc++'s ios_base::Init in a shared library), and must still have a
+// buffer then (ASan found the destroyed one).
 CheckedStdout& StdoutBuffer() {
-  static CheckedStdout buffer;
-  return buffer;
+  static CheckedStdout* const buffer = new CheckedStdout;
+  return *buffer;
 }
 
 }  // namespace
