@@ -24,6 +24,7 @@ int RunSimulate(int argc, char** argv);
 int RunWorkspace(int argc, char** argv);
 int RunDesign(int argc, char** argv);
 int RunImport(int argc, char** argv);
+int RunTrack(int argc, char** argv);
 
 // Positions of the trajectory `kind` (circle, line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.

@@ -32,6 +32,8 @@ Commands:
   simulate   synthetic telemetry from a "truth" model along a trajectory, with noise
   workspace  where the cabin can go with every cable within tension limits: CSV and an
              HTML map of the focal-sphere cap
+  track      the mass centre and the sensors through a season of telemetry: a window
+             (day) at a time as one joint fit, with the events (moves, re-zeroed sensors)
   design     the calibration survey that determines the wanted parameters best: poses,
              samples per pose and flight order, with predicted sigma_total
   import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
@@ -56,6 +58,7 @@ int Dispatch(const std::string& command, int argc, char** argv, bool* known) {
   if (command == "workspace") return RunWorkspace(argc, argv);
   if (command == "design") return RunDesign(argc, argv);
   if (command == "import") return RunImport(argc, argv);
+  if (command == "track") return RunTrack(argc, argv);
   *known = false;
   return kExitUsage;
 }

@@ -27,6 +27,7 @@
 #include "fastcal/internal/quote.h"
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
+#include "fastcal/time_text.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/version.h"
 
@@ -88,6 +89,10 @@ DEFINE_string(session_shift_m, "",
               "simulate: mass centre moved by dx,dy,dz (m) at each new session.");
 DEFINE_string(mass_centre_step, "",
               "simulate: mass centre steps T:dx,dy,dz (s: m), several joined by ';'.");
+DEFINE_int32(days, 0, "simulate: a season: the samples cut into N days, one session a day.");
+DEFINE_string(start, "", "simulate: time of the first sample (s, or ISO 8601).");
+DEFINE_string(sensor_step, "",
+              "simulate: sensors re-zeroed: T:CABLE:DKN (s, 1..6, kN), several joined by ';'.");
 
 namespace fastcal::cli {
 namespace {
@@ -197,12 +202,19 @@ Sessions and steps of the mass centre (the cabin's structure changed):
                                   (docs/data-format.md)
   --session-shift-m=dx,dy,dz      the mass centre moves by this at the first sample of
                                   each session after the first (needs --sessions >= 2)
-  --mass-centre-step=T:dx,dy,dz   the mass centre moves by this at time T (s) and stays;
-                                  several joined by ';' (steps add up)
+  --mass-centre-step=T:dx,dy,dz   the mass centre moves by this at time T (s or ISO 8601)
+                                  and stays; several joined by ';' (steps add up)
   --session-gap-s=0               time between one session's end and the next one's start
                                   (s), added to time_s; the slow errors decorrelate over it
   --sensor-rezero-kN=0            sensors re-zeroed at the start of each session after the
                                   first: each cable's bias moves by N(0, kN)
+  --sensor-step=T:CABLE:DKN       one sensor re-zeroed: cable CABLE's bias moves by DKN kN
+                                  at time T (s or ISO 8601) and stays; several joined by ';'
+A season (fastcal track): --start=T, the first sample's time (s, or ISO 8601 such as
+2024-05-01T20:00:00Z; a zone-less one is UTC), and --days=N, the samples cut into N
+sessions a day apart (each day's samples --interval-s apart from --start + k days; the
+slow errors decorrelate overnight; no session column). Steps' times T are in the same
+seconds, or ISO 8601 times.
 The truth model written out has the mass centre before any step and the first session's
 sensor biases; its header lists the steps and every session's biases.
 
@@ -253,7 +265,7 @@ const std::set<std::string> kFlags = {
     "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-percent",
     "sensor-bias-spread-kN", "sessions", "session-shift-m", "mass-centre-step",
     "tension-drift-kN", "session-gap-s", "sensor-rezero-kN", "length-offset-spread-m",
-    "length-noise-m"};
+    "length-noise-m", "days", "start", "sensor-step"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -317,14 +329,16 @@ bool SetStepsFromFlags(SimulationOptions* options, std::string* error) {
   std::stringstream list(FLAGS_mass_centre_step);
   std::string item;
   while (!FLAGS_mass_centre_step.empty() && std::getline(list, item, ';')) {
-    const size_t colon = item.find(':');
+    // The shift follows the last ':' (an ISO 8601 time has its own).
+    const size_t colon = item.rfind(':');
     MassCentreStep step;
     std::string why;
-    if (colon == std::string::npos || !ParseNumberItem(item.substr(0, colon), &step.time_s, &why) ||
+    if (colon == std::string::npos ||
+        !ParseTimeValue(item.substr(0, colon), 0, &step.time_s, &why) ||
         !ParseVector3("mass-centre-step", item.substr(colon + 1), &step.shift_m, error)) {
       *error =
-          "--mass-centre-step needs T:dx,dy,dz (time in s, shift in m), several joined by "
-          "';', got " +
+          "--mass-centre-step needs T:dx,dy,dz (time in s or ISO 8601, shift in m), several "
+          "joined by ';', got " +
           internal::Quote(item) + (why.empty() ? "" : ": " + why);
       return false;
     }
@@ -334,6 +348,54 @@ bool SetStepsFromFlags(SimulationOptions* options, std::string* error) {
     *error = "--session-shift-m needs --sessions=N with N >= 2";
     return false;
   }
+  std::stringstream sensors(FLAGS_sensor_step);
+  while (!FLAGS_sensor_step.empty() && std::getline(sensors, item, ';')) {
+    // CABLE and DKN follow the last two ':' (an ISO 8601 time has its own).
+    const size_t second = item.rfind(':');
+    const size_t first = second == std::string::npos || second == 0 ? std::string::npos
+                                                                    : item.rfind(':', second - 1);
+    SensorBiasStep step;
+    double cable = 0.0, shift_kn = 0.0;
+    std::string why;
+    if (first == std::string::npos ||
+        !ParseTimeValue(item.substr(0, first), 0, &step.time_s, &why) ||
+        !ParseNumberItem(item.substr(first + 1, second - first - 1), &cable, &why) ||
+        !ParseNumberItem(item.substr(second + 1), &shift_kn, &why) || cable < 1 ||
+        cable > kNumCables || cable != std::floor(cable)) {
+      *error =
+          "--sensor-step needs T:CABLE:DKN (time in s, cable 1..6, bias change in kN), "
+          "several joined by ';', got " +
+          internal::Quote(item) + (why.empty() ? "" : ": " + why);
+      return false;
+    }
+    step.cable = static_cast<int>(cable) - 1;
+    step.shift_n = shift_kn * kNPerKn;
+    options->sensor_bias_steps.push_back(step);
+  }
+  return true;
+}
+
+// --days: the samples cut into one session a day, each starting 24 h after the one before
+// (needs the trajectory's length, known in RunSimulate).
+bool DaysFromFlags(long long samples, SimulationOptions* options, std::string* error) {
+  if (FLAGS_days == 0) return true;
+  constexpr double kDayS = 86400.0;
+  if (FLAGS_days < 1 || FlagGiven("sessions") || FlagGiven("session-gap-s")) {
+    *error =
+        "--days=N (N >= 1) sets the sessions and the gaps between them: give it without "
+        "--sessions and --session-gap-s";
+    return false;
+  }
+  const double per_day = static_cast<double>(samples) / FLAGS_days;
+  if (samples % FLAGS_days != 0 || per_day * options->sample_interval_s > kDayS) {
+    *error = "--days=" + std::to_string(FLAGS_days) + ": the trajectory's " +
+             std::to_string(samples) +
+             " samples must be a whole number a day, each day's lasting at most 24 h at "
+             "--interval-s";
+    return false;
+  }
+  options->sessions = FLAGS_days;
+  options->session_gap_s = kDayS - per_day * options->sample_interval_s;
   return true;
 }
 
@@ -347,7 +409,8 @@ bool StepsAtSessions(int samples, SimulationOptions* options, std::string* error
     const long long first =
         (static_cast<long long>(k) * samples + options->sessions - 1) / options->sessions;
     options->mass_centre_steps.push_back(
-        {static_cast<double>(first) * options->sample_interval_s + k * options->session_gap_s,
+        {options->start_time_s + static_cast<double>(first) * options->sample_interval_s +
+             k * options->session_gap_s,
          shift});
   }
   return true;
@@ -377,6 +440,14 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->tension_drift_kn = FLAGS_tension_drift_kN;
   options->session_gap_s = FLAGS_session_gap_s;
   options->sensor_rezero_kn = FLAGS_sensor_rezero_kN;
+  if (!FLAGS_start.empty()) {
+    std::string why;
+    if (!ParseTimeValue(FLAGS_start, 0, &options->start_time_s, &why)) {
+      *error = "--start=" + internal::Quote(FLAGS_start) +
+               ": give the first sample's time in s or ISO 8601 (2024-05-01T20:00:00Z): " + why;
+      return false;
+    }
+  }
   for (const char* flag : {"session-gap-s", "sensor-rezero-kN"}) {
     if (FlagGiven(flag) && FLAGS_sessions < 2) {
       *error = std::string("--") + flag + " needs --sessions=N with N >= 2";
@@ -412,7 +483,9 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
                                  {"sessions", "--sessions"},
                                  {"tension_drift_kn", "--tension-drift-kN"},
                                  {"session_gap_s", "--session-gap-s"},
-                                 {"sensor_rezero_kn", "--sensor-rezero-kN"}});
+                                 {"sensor_rezero_kn", "--sensor-rezero-kN"},
+                                 {"start_time_s", "--start"},
+                                 {"sensor_bias_steps", "--sensor-step"}});
     return false;
   }
   return true;
@@ -523,7 +596,9 @@ bool SimulateAndWrite(const CableRobot& truth, const PoseStream& poses,
     }
   };
   DatasetWriter writer;
-  if (!writer.Open(csv_tmp, SimulatedDatasetLayout(options.sessions), csv_header, error)) {
+  // A season's days are not surveys: no session column (a track cuts the data by time).
+  const int labelled = FLAGS_days > 0 ? 1 : options.sessions;
+  if (!writer.Open(csv_tmp, SimulatedDatasetLayout(labelled), csv_header, error)) {
     name_the_users_file();
     return false;
   }
@@ -639,7 +714,8 @@ int RunSimulate(int argc, char** argv) {
     PrintError(kCommand, "no poses to simulate");
     return kExitUsage;
   }
-  if (!StepsAtSessions(static_cast<int>(poses.count), &options, &error)) {
+  if (!DaysFromFlags(poses.count, &options, &error) ||
+      !StepsAtSessions(static_cast<int>(poses.count), &options, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

@@ -334,7 +334,7 @@ void BM_SampleRows(benchmark::State& state) {
     if (part == 0 || part == 3 || part == 4) {
       for (int t = 0; t < count; ++t) {
         const internal::TensionResidual f = samples.At(t);
-        double r[kNumCables];
+        double r[internal::kMaxReadings];  // tensions, and lengths when the spec has them
         if (part == 0) {
           f(theta.data(), r);
         } else if (part == 3) {

@@ -13,6 +13,9 @@ packages=(cmake g++ make libceres-dev libeigen3-dev libgflags-dev libgoogle-glog
           # Optional at run time: .xlsx exports (openpyxl) and DataFrames (pandas) in
           # fastcal.read_dataset / Dataset.from_dataframe; installed so their tests run.
           python3-openpyxl python3-pandas
+          # fastcal.track(client=...): each window's fold a task on a Dask cluster (its
+          # tests run a two-worker LocalCluster on the loopback interface).
+          python3-dask python3-distributed
           locales)  # de_DE.UTF-8: tests/calibration_test.cc, decimal comma
 missing=()
 for p in "${packages[@]}"; do

@@ -14,6 +14,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
+#include "random_cap_poses.h"
 
 namespace fastcal {
 namespace {
@@ -151,18 +152,6 @@ TEST(SessionsTest, SeparateParametersAreCopiedPerSessionInPlace) {
 
 // ---------------------------------------------------------------------------------------
 // The joint fit.
-
-std::vector<Pose> RandomCapPoses(int samples, std::uint64_t seed) {
-  RandomWorkspaceSpec spec;
-  spec.samples = samples;
-  spec.seed = seed;
-  std::vector<Eigen::Vector3d> positions;
-  std::vector<Pose> poses;
-  std::string error;
-  EXPECT_TRUE(RandomWorkspacePositions(spec, &positions, &error)) << error;
-  EXPECT_TRUE(PosesWithAttitudeLaw(positions, FocalAttitudeLaw(), &poses, &error)) << error;
-  return poses;
-}
 
 // Two surveys of `samples` poses, the mass centre moved by `shift_m` between them; the
 // sensor gains drawn once (1%) and the same in both.

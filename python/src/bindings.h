@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <system_error>
@@ -19,6 +20,7 @@
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/column_map.h"
 #include "fastcal/pose.h"
 
 namespace fastcal::python {
@@ -93,12 +95,22 @@ DoubleArray NewArray(const std::vector<py::ssize_t>& shape);
 std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::string& attitude_kind,
                                   const DoubleArray& attitude);
 
+// The column map of `map_text` (YAML; "" for none: null), named `map_source` in messages
+// (InputError otherwise). `csv_layout` (for text the module wrote itself from a
+// spreadsheet or a DataFrame): fields separated by ',' with RFC 4180 quotes;
+// `header_first` also puts the names on the first line with nothing skipped after them
+// (a DataFrame's).
+std::shared_ptr<const ColumnMap> MapOrThrow(const std::string& map_text,
+                                            const std::string& map_source, bool csv_layout,
+                                            bool header_first);
+
 void BindModel(py::module_& m);
 void BindStatics(py::module_& m);
 void BindLocate(py::module_& m);
 void BindData(py::module_& m);
 void BindCalibration(py::module_& m);
 void BindDesign(py::module_& m);
+void BindTrack(py::module_& m);
 
 }  // namespace fastcal::python
 

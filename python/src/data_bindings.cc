@@ -6,6 +6,7 @@
 #include <cmath>
 #include <memory>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "bindings.h"
@@ -57,7 +58,9 @@ SimulationOptions MakeSimulationOptions(const py::dict& kwargs) {
       {"density_mismatch_percent", &o.density_mismatch_percent},
       {"length_offset_spread_m", &o.length_offset_spread_m},
       {"length_noise_m", &o.length_noise_m},
-      {"sample_interval_s", &o.sample_interval_s}};
+      {"sample_interval_s", &o.sample_interval_s},
+      {"start_time_s", &o.start_time_s},
+      {"session_gap_s", &o.session_gap_s}};
   for (const auto& [key, value] : kwargs) {
     const std::string name = py::str(key);
     bool known = false;
@@ -80,6 +83,13 @@ SimulationOptions MakeSimulationOptions(const py::dict& kwargs) {
         }
         o.mass_centre_steps.push_back(
             {pair.first, Eigen::Vector3d(pair.second[0], pair.second[1], pair.second[2])});
+      }
+    } else if (name == "sensor_bias_steps") {
+      // [(time_s, cable 1..6, shift_kN), ...]
+      for (const py::handle step : value) {
+        const auto t = step.cast<std::tuple<double, int, double>>();
+        o.sensor_bias_steps.push_back(
+            {std::get<0>(t), std::get<1>(t) - 1, std::get<2>(t) * kNPerKn});
       }
     } else if (name == "method") {
       if (!ParseStaticsMethod(value.cast<std::string>(), &o.method)) {
@@ -125,10 +135,8 @@ py::dict SummaryDict(const SimulationSummary& s) {
   return d;
 }
 
-// The column map of `map_text` (YAML; "" for none), named `map_source` in messages.
-// `csv_layout` (for text the module wrote itself from a spreadsheet or a DataFrame):
-// fields separated by ',' with RFC 4180 quotes; `header_first` also puts the names on
-// the first line with nothing skipped after them (a DataFrame's).
+}  // namespace
+
 std::shared_ptr<const ColumnMap> MapOrThrow(const std::string& map_text,
                                             const std::string& map_source, bool csv_layout,
                                             bool header_first) {
@@ -144,6 +152,8 @@ std::shared_ptr<const ColumnMap> MapOrThrow(const std::string& map_text,
   }
   return map;
 }
+
+namespace {
 
 // One file, or several merged as one session each (sessions.h).
 Dataset ReadDatasetOrThrow(const std::vector<std::string>& paths, bool skip_invalid_rows,

@@ -158,4 +158,5 @@ PYBIND11_MODULE(_fastcal, m) {
   BindData(m);
   BindCalibration(m);
   BindDesign(m);
+  BindTrack(m);
 }

@@ -61,6 +61,14 @@ struct MassCentreStep {
   Eigen::Vector3d shift_m = Eigen::Vector3d::Zero();
 };
 
+// One sensor re-zeroed: cable `cable`'s bias (0-based) moves by shift_n at time_s and
+// stays there (a maintenance day).
+struct SensorBiasStep {
+  double time_s = 0.0;
+  int cable = 0;
+  double shift_n = 0.0;
+};
+
 struct SimulationOptions {
   // Attitude control error: standard deviation of the actual minus the planned roll,
   // pitch and yaw (deg, each axis independent). >= 0; default 0.
@@ -114,8 +122,12 @@ struct SimulationOptions {
   std::uint64_t seed = 1;
   // Statics method of the truth tensions and lengths; default exact.
   StaticsMethod method = StaticsMethod::kExact;
-  // Time between samples (s): sample n has time_s = n * sample_interval_s. > 0; default 1.
+  // Time between samples (s): sample n has time_s = start_time_s + n * sample_interval_s
+  // (plus the session gaps). > 0; default 1.
   double sample_interval_s = 1.0;
+  // Time of the first sample (s): 0, or a Unix time (e.g. 1714593600 for
+  // 2024-05-01T20:00:00Z) for telemetry with absolute times. Finite; default 0.
+  double start_time_s = 0.0;
   // Steps of the mass centre: from the first sample at or after each time on, the mass
   // centre is moved by the step's shift (steps add up). Finite; default none. The truth
   // model written out keeps the mass centre before the first step.
@@ -132,6 +144,9 @@ struct SimulationOptions {
   // moves by N(0, sensor_rezero_kn) kN. >= 0; default 0. The truth model written out has
   // the first session's biases; SimulationSummary::session_bias_n has every session's.
   double sensor_rezero_kn = 0.0;
+  // Single sensors re-zeroed at given times (steps add up). Finite times and shifts, cables
+  // 0..5; default none. The truth model written out has the biases before any of them.
+  std::vector<SensorBiasStep> sensor_bias_steps;
 
   // False, with the offending field named in *error (may be null), for a value out of range.
   bool IsValid(std::string* error) const;

@@ -484,15 +484,8 @@ std::string PassNote(int pass, int excluded) {
   return s;
 }
 
-// Relative change of the slow error's amplitude and time constant within which a new
-// estimate leaves the process the fit used as it is (the passes stop).
-constexpr double kSlowErrorSettled = 0.05;
 // Fitted samples the slow error's estimate uses at most (contiguous runs beyond).
 constexpr int kSlowErrorEstimateSamples = 100000;
-
-bool Settled(double before, double after) {
-  return std::abs(after - before) <= kSlowErrorSettled * std::max(std::abs(before), 1e-300);
-}
 
 // Stage helper, after each pass's prediction: the slow error re-estimated from the
 // residuals over their white sigma (when the spec estimates a part), and those residuals
@@ -505,18 +498,7 @@ bool ReestimateSlowError(Run& run, bool may_change) {
   if (run.spec.slow_error.estimates_any()) {
     const SlowErrorReport estimate = internal::EstimateSlowError(
         internal::SlowErrorInputs(run.spec, run.View(), kSlowErrorEstimateSamples));
-    const SlowErrorProcess& used = run.slow;
-    const SlowErrorProcess& next = estimate.process;
-    const bool floor = estimate.amplitude_at_floor && report.amplitude_at_floor;
-    settled = used.IsActive() && ((Settled(used.sigma_percent, next.sigma_percent) &&
-                                   Settled(used.sigma_n, next.sigma_n) &&
-                                   Settled(used.time_constant_s, next.time_constant_s)) ||
-                                  floor);
-    const int passes = report.passes + 1;
-    report = estimate;
-    report.passes = passes;
-    if (!settled && may_change) run.slow = next;
-    report.process = run.slow;
+    settled = internal::AdoptSlowErrorEstimate(estimate, may_change, &run.slow, &report);
   }
   internal::WhitenPrediction(run.slow, run.View(), &run.at.whitened);
   return settled;

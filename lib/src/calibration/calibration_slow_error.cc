@@ -1,6 +1,7 @@
 // The calibration's slow-error stages (internal/calibration_slow_error.h).
 #include "fastcal/internal/calibration_slow_error.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "fastcal/internal/slow_error_filter.h"
@@ -71,6 +72,31 @@ SlowErrorEstimateInputs SlowErrorInputs(const CalibrationSpec& spec, const Predi
     in.samples.push_back(e);
   }
   return in;
+}
+
+namespace {
+
+bool Settled(double before, double after) {
+  return std::abs(after - before) <= kSlowErrorSettled * std::max(std::abs(before), 1e-300);
+}
+
+}  // namespace
+
+bool AdoptSlowErrorEstimate(const SlowErrorReport& estimate, bool may_change,
+                            SlowErrorProcess* used, SlowErrorReport* report) {
+  const SlowErrorProcess& next = estimate.process;
+  const bool floor = estimate.amplitude_at_floor && report->amplitude_at_floor;
+  const bool settled =
+      used->IsActive() &&
+      ((Settled(used->sigma_percent, next.sigma_percent) && Settled(used->sigma_n, next.sigma_n) &&
+        Settled(used->time_constant_s, next.time_constant_s)) ||
+       floor);
+  const int passes = report->passes + 1;
+  *report = estimate;
+  report->passes = passes;
+  if (!settled && may_change) *used = next;
+  report->process = *used;
+  return settled;
 }
 
 }  // namespace fastcal::internal

@@ -87,8 +87,7 @@ class Random {
 // x_n = phi x_{n-1} + s sqrt(1 - phi^2) N(0, 1), phi = exp(-dt / tau), 0 for tau = 0.
 class Ar1 {
  public:
-  Ar1(double sigma, double time_s, double dt)
-      : sigma_(sigma), time_s_(time_s), phi_(Phi(dt)) {}
+  Ar1(double sigma, double time_s, double dt) : sigma_(sigma), time_s_(time_s), phi_(Phi(dt)) {}
   double Next(Random* rng) { return Step(rng, phi_); }
   // The next value `dt` after the last, not the sample interval (a gap between sessions).
   double NextAfter(Random* rng, double dt) { return Step(rng, Phi(dt)); }
@@ -209,8 +208,8 @@ struct Processes {
         length_rng(o.seed, kLengthNoiseStream),
         control(o.attitude_control_sigma_deg, o.attitude_control_time_s, o.sample_interval_s),
         mass_centre_drift(o.mass_centre_drift_m, o.mass_centre_drift_time_s, o.sample_interval_s),
-        tension_drift(kNumCables, Ar1(DriftSigma(o), o.tension_drift_time_s,
-                                      o.sample_interval_s)) {}
+        tension_drift(kNumCables, Ar1(DriftSigma(o), o.tension_drift_time_s, o.sample_interval_s)) {
+  }
   // The drift processes' sigma: the relative one (their values are fractions of the
   // reading), or 1 when only the absolute part is given (scaled by it), else 0.
   static double DriftSigma(const SimulationOptions& o) {
@@ -313,9 +312,9 @@ bool MeasureTensions(size_t n, const CableRobot& model, const StaticsSolution& s
       const double relative = options.tension_noise_percent / 100.0 * p->tension_rng.Normal();
       const double absolute_n = options.tension_noise_kn * kNPerKn * p->tension_rng.Normal();
       measured_n = outlier ? reading_n * (1.0 + options.outlier_scale_percent / 100.0 * outlier_u)
-                           : options.tension_drift_kn > 0.0
-                                 ? reading_n * (1.0 + relative) + slow_n + absolute_n
-                                 : reading_n * (1.0 + relative + drift) + absolute_n;
+                   : options.tension_drift_kn > 0.0
+                       ? reading_n * (1.0 + relative) + slow_n + absolute_n
+                       : reading_n * (1.0 + relative + drift) + absolute_n;
     }
     s->tension_n[i] = measured_n;
     const double length_noise_m = options.length_noise_m * p->length_rng.Normal();
@@ -374,6 +373,17 @@ void ReZeroSensors(const SimulationOptions& options, int session, Processes* p, 
   stats->session_bias_n.resize(session + 1, SensorBiases(*model));
 }
 
+// The single sensors re-zeroed at or before time t that were not yet.
+void ApplySensorSteps(const SimulationOptions& options, double t, std::vector<bool>* applied,
+                      CableRobot* model) {
+  for (size_t k = 0; k < options.sensor_bias_steps.size(); ++k) {
+    const SensorBiasStep& step = options.sensor_bias_steps[k];
+    if ((*applied)[k] || step.time_s > t) continue;
+    model->cables[step.cable].sensor_bias_n += step.shift_n;
+    (*applied)[k] = true;
+  }
+}
+
 // Stages: check the inputs, draw the truth model, then per planned pose the actual pose
 // and its statics, the measured pose and the readings; last the summary.
 bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const SimulationOptions& options,
@@ -396,6 +406,7 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
   const CableRobot first_session = model;  // the truth written out: the first session's
   stats.session_bias_n.push_back(SensorBiases(model));
   int session = 0;
+  std::vector<bool> applied_sensor_steps(options.sensor_bias_steps.size(), false);
 
   for (size_t n = 0; n < static_cast<size_t>(planned.count); ++n) {
     const Pose planned_pose = planned.next();
@@ -411,7 +422,9 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
     const bool new_session = n > 0 && s.session != session;
     if (new_session) ReZeroSensors(options, s.session, &processes, &model, &stats);
     session = s.session;
-    s.time_s = static_cast<double>(n) * options.sample_interval_s + session * options.session_gap_s;
+    s.time_s = options.start_time_s + static_cast<double>(n) * options.sample_interval_s +
+               session * options.session_gap_s;
+    ApplySensorSteps(options, s.time_s, &applied_sensor_steps, &model);
     processes.dt = options.sample_interval_s + (new_session ? options.session_gap_s : 0.0);
     s.has_planned_attitude = true;
     s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned_pose.rotation));
@@ -481,6 +494,16 @@ bool SimulationOptions::IsValid(std::string* error) const {
     if (!std::isfinite(step.time_s) || !step.shift_m.allFinite()) {
       return Fail(error, "mass_centre_steps: a step's time and shift must be finite");
     }
+  }
+  for (const SensorBiasStep& step : sensor_bias_steps) {
+    if (!std::isfinite(step.time_s) || !std::isfinite(step.shift_n) || step.cable < 0 ||
+        step.cable >= kNumCables) {
+      return Fail(error,
+                  "sensor_bias_steps: a step needs a finite time and shift and a cable 0..5");
+    }
+  }
+  if (!std::isfinite(start_time_s)) {
+    return Fail(error, "start_time_s must be finite (got " + Num(start_time_s) + ")");
   }
   if (sessions < 1)
     return Fail(error, "sessions must be >= 1 (got " + std::to_string(sessions) + ")");

@@ -41,6 +41,18 @@ void WhitenPrediction(const SlowErrorProcess& process, const PredictionView& at,
 SlowErrorEstimateInputs SlowErrorInputs(const CalibrationSpec& spec, const PredictionView& at,
                                         int budget);
 
+// Relative change of the slow error's amplitude and time constant within which a new
+// estimate leaves the process a fit used as it is (calibrate's passes, the track's
+// Gauss-Newton iterations stop).
+inline constexpr double kSlowErrorSettled = 0.05;
+
+// A new estimate of the process taken in: *report becomes `estimate` (its pass count one
+// more than before) and, unless the process *used stands (active, and each part within
+// kSlowErrorSettled of the estimate's, or both at the amplitude floor) or `may_change` is
+// false, *used becomes the estimate's. Returns whether it stood.
+bool AdoptSlowErrorEstimate(const SlowErrorReport& estimate, bool may_change,
+                            SlowErrorProcess* used, SlowErrorReport* report);
+
 }  // namespace fastcal::internal
 
 #endif  // FASTCAL_INTERNAL_CALIBRATION_SLOW_ERROR_H_

@@ -1,0 +1,260 @@
+// `fastcal track`: the mass centre and the sensors through a season of telemetry, one
+// window (a day by default) at a time, as one joint fit (track.h). Flags -> options ->
+// library; the summary on stdout, progress on stderr.
+#include <gflags/gflags.h>
+
+#include <algorithm>
+#include <iostream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cli_util.h"
+#include "columns_flag.h"
+#include "commands.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/internal/number_text.h"
+#include "fastcal/internal/quote.h"
+#include "fastcal/time_text.h"
+#include "fastcal/track.h"
+
+DECLARE_string(model);
+DECLARE_string(spec);
+DECLARE_string(data);
+DECLARE_string(out);
+DECLARE_bool(force);
+DECLARE_bool(quiet);
+DECLARE_bool(skip_invalid_rows);
+DEFINE_string(window, "1d", "track: window length (1d, 12h, 30m, 3600s) or 'file'.");
+DEFINE_int32(threads, 2, "track: windows folded at once.");
+DEFINE_bool(refold, false, "track: on an update, refold every window at the new point.");
+DEFINE_int64(min_window_samples, 100, "track: windows with fewer samples are left out.");
+DEFINE_double(false_alarm, 0.01,
+              "track: chance that noise alone reports any event of a kind over the track.");
+
+namespace fastcal::cli {
+namespace {
+
+constexpr char kCommand[] = "track";
+// Windows listed on stdout in full up to this many; beyond, the first and last few.
+constexpr size_t kMaxListedWindows = 40;
+constexpr size_t kListedEnds = 10;
+
+const char kHelp[] =
+    R"(fastcal track: the mass centre and the sensors through a season of telemetry.
+
+Usage:
+  fastcal track --spec=SPEC.yaml --data=DIR_OR_FILES --out=DIR [--window=1d] [--model=MODEL.yaml]
+                [--columns=MAP.yaml]
+
+  --spec=FILE         the calibration spec; its sessions.separate groups are fitted per
+                      window, every other free parameter once for all windows
+                      (calibration_data/spec_track.yaml follows the mass centre per day,
+                      with the cables and sensors shared)
+  --data=DIR_OR_FILES telemetry files (docs/data-format.md) with absolute times, in any
+                      order: a directory (its *.csv files), or FILE.csv,FILE.csv,...
+  --out=DIR           the track: a new or empty directory, or a track built before, which
+                      is then updated with the files it does not hold yet (the old windows'
+                      folds are kept: only windows that gained samples are folded)
+  --window=1d         windows: a calendar day in UTC (1d), another duration aligned to
+                      1970-01-01T00:00Z (12h, 30m, 3600s, 7d), or 'file' (one per file)
+  --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
+  --columns=MAP.yaml  read every data file as exported, through a column map (ISO 8601
+                      times, units, delimiters: docs/data-format.md, "Column maps"); an
+                      update must use the same map
+  --threads=2         windows folded at once
+  --min-window-samples=100  windows with fewer samples are left out (and named)
+  --false-alarm=0.01  each kind of event: the chance that noise alone reports any over
+                      the whole track (Bonferroni over its tests)
+  --refold            on an update, refold every window at the new point (and re-estimate
+                      the slow error), as a fresh track would
+  --force             DIR holds a track of another model, spec or windowing, or files that
+                      changed: build it afresh
+  --skip-invalid-rows skip malformed rows (named on stderr) instead of failing
+  --quiet             no progress on stderr
+
+Each window is folded at a linearisation point into its information over its own
+parameters and the shared ones (whitened by the slow sensor error, gross errors screened);
+the shared parameters come from the Schur complement of all windows, each window's from
+back-substitution, Gauss-Newton until every step is below 1% of its sigma. Each estimate
+has sigma_total: the joint fit's covariance widened per window by its misfit and by
+residuals still correlated in time, plus the consider parameters' part.
+
+Events (events.json), each kind at a 1% false-alarm rate over the whole track:
+  sensor     a sensor's bias stepped (re-zeroed) between two windows or inside one: found
+             by a score scan over cables and window boundaries, then fitted per stretch
+             (a window with the step inside gets its own value), so that it does not
+             read as a mass-centre move
+  parameter  a per-window group (the mass centre) changed between consecutive windows,
+             or inside one (then one event from the window before to the window after),
+             beyond the group's wander from window to window (estimated from all the
+             windows' differences and stated: a mass centre that moves about is not a
+             string of steps)
+Time resolution: the window (the event's time is the later window's first sample), or,
+where the window's own telemetry places the step, its block within the window (about
+1/32 of it: "inside the window, at TIME").
+
+Outputs in DIR:
+  track.csv               one row per window: window_start, window_end (ISO 8601 UTC),
+                          samples, NAME, NAME_sigma_total per per-window parameter, each
+                          sensor's offset, chi2/nu, widening, gross errors, window label
+  events.json             the events: time, kind, parameters {shift, sigma_total}, cables,
+                          statistic, p_value (family-wise)
+  model_calibrated@W.yaml the latest window's model, and one per event-free stretch
+                          (@FIRST_to_LAST)
+  track.html              the per-window parameters with bars, the sensors, the events
+  track_state.json, folds/, windows/   the track's state for an update (docs/calibration.md,
+                          "Tracking: files"); windows/ holds each window's samples (160 bytes
+                          a sample)
+
+Exit codes: 0 the track was written, 1 the fit failed (a pose the model cannot solve,
+parameters undetermined), 2 bad input. Python: fastcal.track (also on a Dask cluster).
+
+Example:
+  fastcal simulate --trajectory=random --samples=18000 --days=10 --interval-s=2 \
+      --start=2024-05-01T20:00:00Z --mass-centre-step=2024-05-05T20:00:00Z:0.05,0,0 \
+      --sensor-step=2024-05-08T20:00:00Z:3:5 --out=season.csv
+  fastcal track --spec=calibration_data/spec_track.yaml --data=season.csv --out=track
+)";
+
+std::vector<std::string> SplitPaths(const std::string& text) {
+  std::vector<std::string> out;
+  std::string item;
+  std::istringstream in(text);
+  while (std::getline(in, item, ',')) out.push_back(item);
+  return out;
+}
+
+std::string Estimate(const TrackEstimate& e, const std::string& unit) {
+  return internal::FormatDouble("%.6g", e.value) + " +- " +
+         internal::FormatDouble("%.2g", e.sigma_total) + (unit == "1" ? "" : " " + unit);
+}
+
+std::string Summary(const TrackResult& r, const std::string& out) {
+  std::ostringstream s;
+  s << "fastcal track: " << r.windows.size() << " windows of " << WindowSpecText(r.window);
+  if (!r.windows.empty()) {
+    s << " (" << r.windows.front().label << " to " << r.windows.back().label << ")";
+  }
+  s << ", " << r.samples << " samples from " << r.files.size() << " file(s); " << r.iterations
+    << " Gauss-Newton iterations (" << (r.converged ? "converged" : "NOT converged") << "), "
+    << r.folds << " folds" << (r.updated ? " (an update)" : "") << "; chi2/nu "
+    << internal::FormatDouble("%.3f", r.reduced_chi_square) << "\n";
+  if (r.slow_error.enabled) s << DescribeSlowError(r.slow_error) << "\n";
+  s << "\nShared parameters (sigma_total):\n";
+  for (const TrackShared& p : r.shared) {
+    s << "  " << p.name << " = " << Estimate(p.estimate, p.unit);
+    if (r.shared.size() > 0 &&
+        !(p.from_window == 0 && p.to_window + 1 == static_cast<int>(r.windows.size()))) {
+      s << "   (windows " << r.windows[p.from_window].label << " to "
+        << r.windows[p.to_window].label << ")";
+    }
+    s << "\n";
+  }
+  s << "\nPer window (track.csv):\n  window";
+  for (const std::string& n : r.window_parameters) s << "  " << n;
+  s << "\n";
+  for (size_t w = 0; w < r.windows.size(); ++w) {
+    if (r.windows.size() > kMaxListedWindows && w == kListedEnds) {
+      s << "  ... (" << r.windows.size() - 2 * kListedEnds << " more)\n";
+      w = r.windows.size() - kListedEnds;
+    }
+    s << "  " << r.windows[w].label;
+    for (size_t k = 0; k < r.window_parameters.size(); ++k) {
+      s << "  " << Estimate(r.windows[w].estimates[k], r.window_units[k]);
+    }
+    s << "\n";
+  }
+  s << "\nEvents (events.json; each kind at a "
+    << internal::FormatDouble("%g", 100.0 * r.false_alarm)
+    << "% false-alarm rate over the track): " << r.events.size() << "\n";
+  for (const TrackWander& w : r.wander) {
+    if (w.rms > 0.0) {
+      s << "  (" << w.group << " wanders between windows by "
+        << internal::FormatDouble("%.3g", w.rms) << " " << w.unit
+        << " rms per component beyond its errors: the events are steps beyond that)\n";
+    }
+  }
+  for (const TrackEvent& e : r.events) {
+    s << "  " << r.windows[e.window].label << "  " << e.kind;
+    if (!e.cables.empty()) {
+      s << " (cable";
+      for (int c : e.cables) s << " " << c;
+      s << ")";
+    }
+    if (e.within_window) {
+      s << " inside the window, at "
+        << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
+                                 : internal::FormatDouble("%.17g", e.time_s) + " s");
+    }
+    s << ":";
+    for (const TrackEventParameter& p : e.parameters) {
+      s << " " << p.name << " " << internal::FormatDouble("%+.4g", p.shift) << " +- "
+        << internal::FormatDouble("%.2g", p.sigma_total) << (p.unit == "1" ? "" : " " + p.unit)
+        << ";";
+    }
+    s << " p = " << internal::FormatDouble("%.2g", e.p_value) << "\n";
+  }
+  for (const std::string& n : r.notes) s << "Note: " << n << "\n";
+  s << "\nWritten to " << out << ": track.csv, events.json, track.html, " << r.models.size()
+    << " model_calibrated@*.yaml\n";
+  return s.str();
+}
+
+}  // namespace
+
+int RunTrack(int argc, char** argv) {
+  int exit_code = 0;
+  if (!StartCommand(argc, argv, kCommand, kHelp,
+                    {"model", "spec", "data", "out", "window", "threads", "refold", "force",
+                     "quiet", "skip-invalid-rows", "min-window-samples", "false-alarm", "columns"},
+                    &exit_code)) {
+    return exit_code;
+  }
+  std::string error;
+  const auto usage = [&](const std::string& message) {
+    PrintError(kCommand, message);
+    return kExitUsage;
+  };
+  if (FLAGS_spec.empty()) return usage("--spec=SPEC.yaml is required");
+  if (FLAGS_data.empty()) return usage("--data=DIR_OR_FILES is required");
+  if (FLAGS_out.empty()) return usage("--out=DIR is required");
+  WindowSpec window;
+  if (!ParseWindowSpec(FLAGS_window, &window, &error)) return usage("--" + error);
+  CableRobot model;
+  if (!LoadModelFlag("model", FLAGS_model, &model, &error)) return usage(error);
+  CalibrationSpec spec;
+  if (!LoadCalibrationSpec(FLAGS_spec, model, &spec, &error)) return usage(error);
+  const std::vector<std::string> data = SplitPaths(FLAGS_data);
+  if (std::find(data.begin(), data.end(), "") != data.end()) {
+    return usage("--data=" + internal::Quote(FLAGS_data) +
+                 " has an empty file name (a stray comma?)");
+  }
+  TrackOptions options;
+  options.threads = FLAGS_threads;
+  options.refold_all = FLAGS_refold;
+  options.force = FLAGS_force;
+  options.min_window_samples = FLAGS_min_window_samples;
+  options.false_alarm = FLAGS_false_alarm;
+  options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
+  if (!ColumnsFromFlag(&options.read.columns, &error)) return usage(error);
+  if (!FLAGS_quiet) {
+    options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
+  }
+  if (!options.IsValid(&error)) {
+    return usage(WithFlagNames(error, {{"threads", "--threads"},
+                                       {"false_alarm", "--false-alarm"},
+                                       {"min_window_samples", "--min-window-samples"}}));
+  }
+  TrackResult result;
+  const TrackStatus status =
+      fastcal::RunTrack(model, spec, data, window, FLAGS_out, options, &result, &error);
+  if (status != TrackStatus::kOk) {
+    PrintError(kCommand, error);
+    return status == TrackStatus::kInvalidInput ? kExitUsage : kExitFailure;
+  }
+  std::cout << Summary(result, FLAGS_out);
+  return 0;
+}
+
+}  // namespace fastcal::cli

@@ -1,0 +1,188 @@
+// A season tracked against the same samples calibrated as one survey (issue 27): wall
+// time, CPU time and peak resident memory of each.
+//
+// BM_Track/N/W: `fastcal track` on N samples in W daily windows (one CSV, read, cut into
+// the window store, folded on 2 threads, outputs written), spec
+// calibration_data/spec_track.yaml (mass centre per window; densities, gains and biases
+// shared with priors; the tower tops considered; the slow error estimated).
+// BM_CalibrateOneSurvey/N/W: the same file read and calibrated as one survey with the
+// same spec (one mass centre; Calibrate's whole pipeline, its evaluation included) and the
+// report written, as `fastcal calibrate` does.
+//
+// Each run is a forked child, so that its peak resident memory (peak_rss_MB, from wait4)
+// is its own. Data: W days of N / W random poses over the cap, 2 s apart (10 Hz for
+// 10^5 a day) from
+// 2024-05-01T20:00:00Z, mass centre (0.22, 0.11, 0.5) m, 3% tension noise, a 1% slow
+// sensor error (2 minutes), per-cable spreads of density (1%), gain (1%), bias (1.5 kN);
+// written once, streamed (not timed).
+// Run: build/bench/track_bench --benchmark_filter=/100000/   (about a minute on 2 cores);
+// /1000000/ a few minutes; /10000000/ (the issue's 10^7 samples in 100 windows) about an
+// hour, and 4 GB of CSV plus 1.6 GB of window store in the temporary directory.
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+
+#include "fastcal/calibration.h"
+#include "fastcal/report.h"
+#include "fastcal/simulation.h"
+#include "fastcal/track.h"
+#include "fastcal/trajectory.h"
+
+#ifndef FASTCAL_SOURCE_DIR
+#define FASTCAL_SOURCE_DIR "."
+#endif
+
+namespace fastcal {
+namespace {
+
+constexpr double kStartS = 1714593600.0;  // 2024-05-01T20:00:00Z
+constexpr double kIntervalS = 2.0;
+constexpr double kDayS = 86400.0;
+
+std::string DataFile(long long samples, int days) {
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("fastcal_track_bench_" + std::to_string(getpid()) + "_" +
+                             std::to_string(samples) + "_" + std::to_string(days) + ".csv"))
+                               .string();
+  if (std::filesystem::exists(path)) return path;
+  RandomWorkspaceSpec spec;
+  spec.samples = static_cast<int>(samples);
+  spec.seed = 7;
+  PositionStream positions;
+  std::string error;
+  if (!RandomWorkspacePositionStream(spec, &positions, &error)) return "";
+  PoseStream poses;
+  poses.count = samples;
+  poses.next = [positions, law = FocalAttitudeLaw()]() mutable {
+    Pose pose;
+    pose.position_m = positions.next();
+    pose.rotation = FocalAttitude(pose.position_m, law);
+    return pose;
+  };
+  CableRobot truth = CableRobot::NominalFast();
+  truth.mass_centre_cabin_m = {0.22, 0.11, 0.5};
+  SimulationOptions o;
+  o.seed = 7;
+  // 2 s apart, or at 10 Hz where a day's samples would not fit in half a day (10^5 a day).
+  const double per_day = static_cast<double>(samples / days);
+  o.sample_interval_s = per_day * kIntervalS <= 0.5 * kDayS ? kIntervalS : 0.1;
+  o.start_time_s = kStartS;
+  o.sessions = days;
+  o.session_gap_s = kDayS - per_day * o.sample_interval_s;
+  o.tension_drift_percent = 1.0;
+  o.tension_drift_time_s = 120.0;
+  o.sensor_gain_spread_percent = 1.0;
+  o.sensor_bias_spread_kn = 1.5;
+  o.density_mismatch_percent = 1.0;
+  DatasetWriter writer;
+  if (!writer.Open(path, SimulatedDatasetLayout(1), "track_bench", &error)) return "";
+  const SampleSink sink = [&writer](const Sample& s, std::string* why) {
+    return writer.Write(s, why);
+  };
+  if (!SimulateStream(truth, poses, o, sink, nullptr, nullptr, &error) || !writer.Close(&error)) {
+    std::filesystem::remove(path);
+    return "";
+  }
+  return path;
+}
+
+CalibrationSpec Spec() {
+  CalibrationSpec spec;
+  std::string error;
+  LoadCalibrationSpec(std::string(FASTCAL_SOURCE_DIR) + "/calibration_data/spec_track.yaml",
+                      CableRobot::NominalFast(), &spec, &error);
+  return spec;
+}
+
+int RunTrackChild(const std::string& csv, const std::string& dir) {
+  std::filesystem::remove_all(dir);
+  TrackResult result;
+  std::string error;
+  return RunTrack(CableRobot::NominalFast(), Spec(), {csv}, WindowSpec(), dir, TrackOptions(),
+                  &result, &error) == TrackStatus::kOk
+             ? 0
+             : 1;
+}
+
+int RunCalibrateChild(const std::string& csv, const std::string& dir) {
+  Dataset data;
+  std::string error;
+  DatasetReadOptions read;
+  read.threads = 2;  // as fastcal calibrate reads
+  if (!ReadDataset(csv, read, &data, &error)) return 1;
+  const CableRobot model = CableRobot::NominalFast();
+  const CalibrationSpec spec = Spec();
+  CalibrationResult result;
+  if (Calibrate(model, spec, data, CalibrationOptions(), &result, &error) !=
+      CalibrationStatus::kOk) {
+    return 2;
+  }
+  ReportInputs inputs;
+  inputs.initial_model = &model;
+  inputs.spec = &spec;
+  inputs.data = &data;
+  inputs.result = &result;
+  inputs.variants = std::move(result.variants);
+  std::filesystem::create_directories(dir);
+  return WriteReportFiles(dir, inputs, &error) ? 0 : 3;
+}
+
+// Runs `child` in a forked process; its wall time, CPU time and peak memory as counters.
+template <typename Child>
+void Measure(benchmark::State& state, const Child& child) {
+  const std::string csv = DataFile(state.range(0), static_cast<int>(state.range(1)));
+  if (csv.empty()) {
+    state.SkipWithError("cannot write the dataset file");
+    return;
+  }
+  const std::string dir = csv + ".out";
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = fork();
+    if (pid == 0) _exit(child(csv, dir));
+    int status = 0;
+    rusage usage{};
+    wait4(pid, &status, 0, &usage);
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      state.SkipWithError("the run failed");
+      break;
+    }
+    state.counters["peak_rss_MB"] = usage.ru_maxrss / 1024.0;
+    state.counters["cpu_s"] = usage.ru_utime.tv_sec + usage.ru_utime.tv_usec * 1e-6 +
+                              usage.ru_stime.tv_sec + usage.ru_stime.tv_usec * 1e-6;
+  }
+  std::filesystem::remove_all(dir);
+  state.counters["samples"] = static_cast<double>(state.range(0));
+  state.counters["windows"] = static_cast<double>(state.range(1));
+}
+
+void BM_Track(benchmark::State& state) { Measure(state, RunTrackChild); }
+void BM_CalibrateOneSurvey(benchmark::State& state) { Measure(state, RunCalibrateChild); }
+
+// The same file for both (the track first: DataFile writes it once per process).
+BENCHMARK(BM_Track)
+    ->Args({100000, 100})
+    ->Args({1000000, 100})
+    ->Args({10000000, 100})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseManualTime();
+BENCHMARK(BM_CalibrateOneSurvey)
+    ->Args({100000, 100})
+    ->Args({1000000, 100})
+    ->Args({10000000, 100})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseManualTime();
+
+}  // namespace
+}  // namespace fastcal
+
+BENCHMARK_MAIN();

@@ -1,0 +1,46 @@
+// A track's samples sorted into windows, one binary file per window (docs/calibration.md,
+// "Tracking: files"): what a window's fold reads, on this machine or on a Dask worker
+// that sees the same path, without parsing the telemetry again.
+//
+// Each sample is one 160-byte record of little-endian fields:
+//   time_s (f64), line (i32), file (i32: index into the track's files),
+//   position_m[3] (f64), rotation[9] (f64, row-major: the attitude the fit uses, measured
+//   or planned as the spec says), tension_n[6] (f64)
+// in the order the samples were read; a fold sorts them by time (stably).
+#ifndef FASTCAL_INTERNAL_WINDOW_STORE_H_
+#define FASTCAL_INTERNAL_WINDOW_STORE_H_
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "fastcal/dataset.h"
+
+namespace fastcal::internal {
+
+struct StoredSample {
+  double time_s;
+  std::int32_t line;
+  std::int32_t file;
+  double position_m[3];
+  double rotation[9];
+  double tension_n[6];
+};
+static_assert(sizeof(StoredSample) == 160, "the store's record layout");
+
+// The record of a sample (its attitude: the planned one when `planned`).
+StoredSample ToStored(const Sample& sample, int file, bool planned);
+
+// Appends records to `path` (created if absent).
+bool AppendStoredSamples(const std::string& path, const std::vector<StoredSample>& samples,
+                         std::string* error);
+
+// Reads a window's records into data->samples, sorted by time (stably), and each one's
+// file index into *file_of (parallel to the samples). Refuses a file whose size is not a
+// whole number of records, and a record that is not finite.
+bool ReadStoredWindow(const std::string& path, Dataset* data, std::vector<int>* file_of,
+                      std::string* error);
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_INTERNAL_WINDOW_STORE_H_

@@ -1,0 +1,242 @@
+// Tracking over months (docs/calibration.md, "Tracking"): the mass centre and the sensors
+// through a season of telemetry, as one joint fit whose sessions are windows (days, by
+// default), at a scale where one dense problem is wrong.
+//
+// The telemetry (many files in any order, or one long file; absolute times) is cut into
+// windows: calendar days in UTC ("1d"), another duration aligned to 1970-01-01T00:00Z
+// ("6h", "7d"), or one per file. The spec's sessions.separate groups (sessions.h) are the
+// per-window parameters a_w (the mass centre, in calibration_data/spec_track.yaml); every
+// other free parameter b is shared by all windows (densities, gains, biases), and each
+// consider parameter is held at its value with its sigma propagated. Each window is folded
+// at a linearisation point into its information over (a_w, b) (track_fold.h: whitened by
+// the slow sensor error, gross errors screened), and the block-arrow normal equations are
+// solved by the Schur complement on b and back-substitution (internal/block_arrow.h);
+// Gauss-Newton iterates folds and solves, re-estimating the slow error's amplitude and
+// time constant from the windows' residuals, until every step is below
+// TrackOptions::step_tolerance_sigmas of its sigma.
+//
+// sigma_total per window: the sandwich covariance of the joint fit (uncertainty.h's
+// P = M^-1 (Omega + Lambda) M^-1) with each window's information scaled by its widening
+// f_w = max(its Birge ratio chi2/nu when above the band 1 + 3 sqrt(2/nu), the variance of
+// its block scores over their white value when significant at 1%: residuals correlated in
+// time that the slow-error model left), plus the consider parameters' part.
+//
+// Events, each kind at family-wise false-alarm rate TrackOptions::false_alarm over the
+// whole season (Bonferroni over every test of the kind):
+//   sensor     a shared sensor bias that stepped between two windows (re-zeroed): the
+//              score test of "the bias differs from window w on" (as sensor_steps.h, with
+//              the per-window parameters profiled out), over every cable and window
+//              boundary; the largest significant one is fitted (the bias gets a value per
+//              stretch) and the scan repeated (binary segmentation). A re-zeroed sensor is
+//              then a sensor event, not a mass-centre move.
+//   parameter  a per-window group (the mass centre's three axes together) that changed
+//              between consecutive windows: the Wald test of the difference with its
+//              covariance from the sandwich (consecutive windows share b: their estimates
+//              are correlated, and the shared part cancels).
+// An event's time is the first sample of the later window (resolution: the window; the
+// last sample of the earlier one is given too), refined to a block of a window's samples
+// when the scan within it finds the step inside (a step inside a window shows as a change
+// on both sides of it: one event then, from the window before to the window after).
+//
+// Outputs in DIR (WriteTrack; formats in docs/calibration.md, "Tracking: files"):
+// track.csv, events.json, model_calibrated@WINDOW.yaml (the latest window, and one per
+// event-free stretch), track.html; and the track's state for an update: track_state.json,
+// folds/ (each window's fold at its last point), windows/ (each window's samples).
+// A later run with more files updates the track: only the windows that gained samples are
+// folded; the others keep their folds (their quadratic models at their own points, exact
+// for a linear model, to first order otherwise: TrackOptions::refold_all refolds them).
+#ifndef FASTCAL_TRACK_H_
+#define FASTCAL_TRACK_H_
+
+#include <Eigen/Core>
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+#include "fastcal/slow_error.h"
+#include "fastcal/track_fold.h"
+
+namespace fastcal {
+
+struct WindowSpec {
+  enum class Kind { kDuration, kFile };
+  Kind kind = Kind::kDuration;
+  // kDuration: windows [k d, (k + 1) d) of time_s, k an integer: for Unix times (time_s
+  // >= 1e8) aligned to 1970-01-01T00:00:00Z, so "1d" is a calendar day in UTC. A whole
+  // number of seconds, >= 1.
+  double duration_s = 86400.0;
+  bool IsValid(std::string* error) const;
+};
+
+// "1d" (the default), "12h", "30m", "3600s", "7d"; "file": one window per file.
+bool ParseWindowSpec(const std::string& text, WindowSpec* window, std::string* error);
+std::string WindowSpecText(const WindowSpec& window);
+
+// Runs folds: each task's bytes (SerializeFoldTask) to the fold's bytes
+// (SerializeWindowFold), in the same order. The track's own runner folds on threads;
+// Python's sends them to Dask workers (fastcal.track).
+using FoldRunner = std::function<bool(const std::vector<std::string>& tasks,
+                                      std::vector<std::string>* folds, std::string* error)>;
+
+// Largest data file a track reads (TrackOptions::read).
+inline constexpr long long kTrackMaxFileBytes = 1LL << 40;
+
+struct TrackOptions {
+  // One line per stage and iteration; the library never prints.
+  std::function<void(const std::string&)> progress;
+  // Folds run at once on this machine (one window each; a lone window uses them all).
+  int threads = 2;
+  // Null: fold on this machine's threads.
+  FoldRunner runner;
+  // How the data files are read (DatasetReadOptions: skip_invalid_rows, limits, a
+  // column map). Each file is streamed a chunk at a time into the window store, so that
+  // a season in one long file is read with bounded memory: files up to 1 TiB (not
+  // ReadDataset's 1 GiB).
+  DatasetReadOptions read = [] {
+    DatasetReadOptions r;
+    r.max_file_bytes = kTrackMaxFileBytes;
+    return r;
+  }();
+  // Gauss-Newton iterations (each a fold of the windows that moved) at most.
+  int max_iterations = 20;
+  // Converged when every parameter's step is below this fraction of its formal sigma
+  // (then one more fold at the solution, with the consider parameters' columns: the
+  // estimates' change over it is of the order of the step squared).
+  double step_tolerance_sigmas = 0.05;
+  // Each kind of event: the chance that noise alone reports any over the whole season.
+  double false_alarm = 0.01;
+  // Sensor steps fitted at most (binary segmentation).
+  int max_sensor_steps = 10;
+  // Windows with fewer samples are left out (listed in the notes): a window must
+  // determine its own parameters.
+  long long min_window_samples = 100;
+  // Blocks of each window's fold (track_fold.h) and the slow-error estimate's budget.
+  int blocks = 32;
+  int slow_error_samples = 100000;
+  // An update (DIR holds a track): refold every window at the new point, not only those
+  // that gained samples.
+  bool refold_all = false;
+  // DIR holds a track of another model, spec or windowing, or of files that changed:
+  // build it afresh (else refused).
+  bool force = false;
+  bool IsValid(std::string* error) const;
+};
+
+struct TrackEstimate {
+  double value = 0.0;        // in the parameter's unit
+  double sigma_total = 0.0;  // sandwich (widened) + consider
+  double sigma_formal = 0.0;
+};
+
+struct TrackWindow {
+  std::string label;  // "2024-05-01", "2024-05-01T0600Z", "t86400", or the file's stem
+  double start_s = 0.0, end_s = 0.0;  // bounds (per file: its first and last sample)
+  double first_time_s = 0.0, last_time_s = 0.0;
+  long long samples = 0, readings = 0, gross_errors = 0;
+  double chi_square = 0.0, reduced_chi_square = 0.0;
+  double widening = 1.0;                   // f_w (variance factor)
+  std::vector<TrackEstimate> estimates;    // per TrackResult::window_parameters
+  std::array<double, kNumCables> rms_n{};  // model minus measured, fitted readings
+  // What each shared per-cable bias reads in this window (the shared value of its
+  // stretch plus the window's own departure, one Gauss-Newton step; slow errors included
+  // in its sigma): the sensors' offsets over time. has_offsets false without such biases.
+  bool has_offsets = false;
+  std::array<TrackEstimate, kNumCables> offset_kn{};
+  bool folded = false;  // folded in this run (an update keeps the others' folds)
+};
+
+struct TrackShared {
+  std::string name, unit;  // the spec's
+  TrackEstimate estimate;
+  // A bias split by sensor steps: the windows [from, to] this value holds for.
+  int from_window = 0, to_window = 0;
+};
+
+struct TrackEventParameter {
+  std::string name, unit;
+  double shift = 0.0;  // later minus earlier, in `unit`
+  double sigma_total = 0.0;
+};
+
+struct TrackEvent {
+  std::string kind;              // "parameter" or "sensor"
+  // The first sample of the later window, and the last of the earlier one; or, when the
+  // step is inside a window's telemetry (within_window), the first sample of the block
+  // where it is and the last of the block before.
+  double time_s = 0.0;
+  double previous_time_s = 0.0;
+  bool within_window = false;
+  int window = 0;           // index of the window the new value is first seen in
+  int previous_window = 0;  // index of the last window before the change
+  std::vector<TrackEventParameter> parameters;
+  std::vector<int> cables;  // 1-based, for a sensor event
+  int degrees_of_freedom = 1;
+  double statistic = 0.0;
+  double threshold = 0.0;
+  // Family-wise: min(1, tests x P(chi-square > statistic)); the event's is below
+  // TrackOptions::false_alarm.
+  double p_value = 1.0;
+};
+
+// A per-window group's wander between windows beyond its estimates' errors (a mass
+// centre that moves about within and between days, not in steps): the variance per
+// component that, added to each window's, brings the median of the consecutive windows'
+// difference statistics to the chi-square median; the events are steps beyond it.
+struct TrackWander {
+  std::string group;  // "mass_centre_m", or the parameter's name
+  std::string unit;
+  double rms = 0.0;  // sqrt of the variance per component, in `unit` (0: none seen)
+};
+
+struct TrackResult {
+  std::vector<std::string> files;  // every data file of the track
+  WindowSpec window;
+  std::vector<std::string> window_parameters, window_units;  // a_w, in spec order
+  std::vector<TrackWindow> windows;                          // time order
+  std::vector<TrackShared> shared;
+  std::vector<TrackEvent> events;  // time order
+  double false_alarm = 0.01;
+  int parameter_tests = 0, sensor_tests = 0;
+  std::vector<TrackWander> wander;  // per group tested for parameter events
+  SlowErrorReport slow_error;
+  long long samples = 0, readings = 0, gross_errors = 0;
+  double chi_square = 0.0, reduced_chi_square = 0.0;
+  int iterations = 0;
+  bool converged = false;
+  int folds = 0;         // folds computed in this run
+  bool updated = false;  // an update of an existing track
+  std::vector<std::string> notes;
+  // The models: the latest window's, and each event-free stretch's (its windows'
+  // per-window parameters averaged by their information), labelled as in the file names
+  // model_calibrated@LABEL.yaml.
+  std::vector<std::pair<std::string, CableRobot>> models;
+  std::vector<std::string> model_comments;  // parallel: each model's estimates
+};
+
+enum class TrackStatus {
+  kOk = 0,
+  kInvalidInput,  // spec, data, DIR, options
+  kInfeasible,    // a pose the model cannot solve at the track's point
+  kUndetermined,  // a window's or the shared parameters cannot be determined
+  kFailed,        // a fold runner failed, or the files could not be written
+};
+
+// Builds (or updates) the track in `out_dir` from the data files (a directory stands for
+// its *.csv files, in name order) and writes its outputs. On failure nothing of a new
+// track is left, and an existing one is as it was.
+TrackStatus RunTrack(const CableRobot& model, const CalibrationSpec& spec,
+                     const std::vector<std::string>& data, const WindowSpec& window,
+                     const std::string& out_dir, const TrackOptions& options, TrackResult* result,
+                     std::string* error);
+
+// The files a track's DIR holds (names and folders relative to DIR): what --force may
+// replace.
+bool IsTrackOutput(const std::string& name);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_TRACK_H_

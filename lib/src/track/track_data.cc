@@ -1,0 +1,545 @@
+// A track's data and directory (track.h, track_run.h): the files read into the window
+// store, the state saved for an update (track_state.json), and the directory made whole
+// at the end or put back as it was on failure.
+#include <unistd.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <map>
+#include <system_error>
+
+#include "fastcal/file_digest.h"
+#include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/json.h"
+#include "fastcal/internal/number_text.h"
+#include "fastcal/internal/window_store.h"
+#include "fastcal/sessions.h"
+#include "track/track_run.h"
+
+namespace fastcal::internal {
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr char kStateFile[] = "track_state.json";
+constexpr char kStateFormat[] = "fastcal-track-state-1";
+constexpr size_t kReadChunkSamples = 65536;
+// Samples held in the store's buffers before they are appended to their files.
+constexpr size_t kMaxBufferedSamples = 1 << 18;
+// Rows skipped (skip_invalid_rows) named in the notes at most.
+constexpr size_t kMaxSkippedNamed = 5;
+
+std::string FoldName(const std::string& label, int generation) {
+  return "folds/" + label + ".g" + std::to_string(generation) + ".fold";
+}
+
+// ---------------------------------------------------------------------------------------
+// The saved state.
+
+std::string StateJson(const TrackRun& run) {
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("format").String(kStateFormat);
+  j.Key("window").String(WindowSpecText(run.window));
+  j.Key("generation").Int(run.generation);
+  j.Key("model_yaml").String(run.model_yaml);
+  j.Key("spec_yaml").String(run.spec_yaml);
+  j.Key("columns").String(run.columns_text);
+  j.Key("slow_error").BeginObject();
+  j.Key("sigma_n").ExactNumber(run.slow.sigma_n);
+  j.Key("sigma_percent").ExactNumber(run.slow.sigma_percent);
+  j.Key("time_constant_s").ExactNumber(run.slow.time_constant_s);
+  j.EndObject();
+  j.Key("files").BeginArray();
+  for (const TrackFile& f : run.files) {
+    j.BeginObject();
+    j.Key("path").String(f.path);
+    j.Key("bytes").Int(f.bytes);
+    j.Key("sha256").String(f.sha256);
+    j.Key("samples").Int(f.samples);
+    j.EndObject();
+  }
+  j.EndArray();
+  j.Key("windows").BeginArray();
+  for (const TrackWindowState& w : run.windows) {
+    j.BeginObject();
+    j.Key("label").String(w.label);
+    j.Key("key").Int(w.key);
+    j.Key("start_s").ExactNumber(w.start_s);
+    j.Key("end_s").ExactNumber(w.end_s);
+    j.Key("first_s").ExactNumber(w.first_s);
+    j.Key("last_s").ExactNumber(w.last_s);
+    j.Key("samples").Int(w.samples);
+    j.Key("used").Bool(w.used);
+    j.Key("fold").String(w.fold_file);
+    j.Key("files").BeginArray();
+    for (int f : w.files) j.Int(f);
+    j.EndArray();
+    j.EndObject();
+  }
+  j.EndArray();
+  j.Key("shared").BeginArray();
+  for (const SharedEntry& e : run.shared) {
+    j.BeginObject();
+    j.Key("name").String(run.layout.Column(run.layout.shared_columns[e.column]).name);
+    j.Key("from_s").ExactNumber(std::isfinite(e.from_s) ? e.from_s : -1e308);
+    j.Key("value_si").ExactNumber(e.value_si);
+    if (e.inside) {
+      j.Key("inside").Bool(true);
+      j.Key("step_time_s").ExactNumber(e.step_time_s);
+      j.Key("step_previous_s").ExactNumber(e.step_previous_s);
+    }
+    j.EndObject();
+  }
+  j.EndArray();
+  j.EndObject();
+  return j.str();
+}
+
+double Real(const YAML::Node& node) {
+  double v = 0.0;
+  if (!node || !node.IsScalar() || !ParseDouble(node.Scalar(), &v)) {
+    throw YAML::Exception(node ? node.Mark() : YAML::Mark::null_mark(), "not a number");
+  }
+  return v;
+}
+
+long long Integer(const YAML::Node& node) { return static_cast<long long>(Real(node)); }
+
+std::string Text(const YAML::Node& node) {
+  if (!node || !node.IsScalar()) {
+    throw YAML::Exception(node ? node.Mark() : YAML::Mark::null_mark(), "not a string");
+  }
+  return node.Scalar();
+}
+
+// The saved state into `run` (files, windows, shared values, slow error). Throws
+// YAML::Exception on a malformed file.
+struct SavedState {
+  std::string window, model_yaml, spec_yaml, columns;
+  int generation = 0;
+  SlowErrorProcess slow;
+  std::vector<TrackFile> files;
+  std::vector<TrackWindowState> windows;
+  std::vector<std::pair<std::string, SharedEntry>> shared;  // by name
+};
+SavedState ParseState(const std::string& text) {
+  const YAML::Node root = YAML::Load(text);
+  if (Text(root["format"]) != kStateFormat) {
+    throw YAML::Exception(root["format"].Mark(), "not a " + std::string(kStateFormat));
+  }
+  SavedState s;
+  s.window = Text(root["window"]);
+  s.generation = static_cast<int>(Integer(root["generation"]));
+  s.model_yaml = Text(root["model_yaml"]);
+  s.spec_yaml = Text(root["spec_yaml"]);
+  s.columns = Text(root["columns"]);
+  s.slow.sigma_n = Real(root["slow_error"]["sigma_n"]);
+  s.slow.sigma_percent = Real(root["slow_error"]["sigma_percent"]);
+  s.slow.time_constant_s = Real(root["slow_error"]["time_constant_s"]);
+  for (const YAML::Node& f : root["files"]) {
+    s.files.push_back(
+        {Text(f["path"]), Integer(f["bytes"]), Text(f["sha256"]), Integer(f["samples"])});
+  }
+  for (const YAML::Node& n : root["windows"]) {
+    TrackWindowState w;
+    w.label = Text(n["label"]);
+    w.key = Integer(n["key"]);
+    w.start_s = Real(n["start_s"]);
+    w.end_s = Real(n["end_s"]);
+    w.first_s = Real(n["first_s"]);
+    w.last_s = Real(n["last_s"]);
+    w.samples = Integer(n["samples"]);
+    w.used = Text(n["used"]) == "true";
+    w.fold_file = Text(n["fold"]);
+    for (const YAML::Node& f : n["files"]) w.files.push_back(static_cast<int>(Integer(f)));
+    w.dirty = false;
+    s.windows.push_back(std::move(w));
+  }
+  for (const YAML::Node& e : root["shared"]) {
+    SharedEntry entry;
+    entry.from_s = Real(e["from_s"]);
+    if (entry.from_s <= -1e308) entry.from_s = -std::numeric_limits<double>::infinity();
+    entry.value_si = Real(e["value_si"]);
+    if (e["inside"] && Text(e["inside"]) == "true") {
+      entry.inside = true;
+      entry.step_time_s = Real(e["step_time_s"]);
+      entry.step_previous_s = Real(e["step_previous_s"]);
+    }
+    s.shared.push_back({Text(e["name"]), entry});
+  }
+  return s;
+}
+
+// The saved state's check against this run's inputs: "" when it may be updated.
+std::string Mismatch(const TrackRun& run, const SavedState& s) {
+  if (s.model_yaml != run.model_yaml) return "another model";
+  if (s.spec_yaml != run.spec_yaml) return "another spec";
+  if (s.window != WindowSpecText(run.window)) return "windows of " + s.window;
+  if (s.columns != run.columns_text) {
+    return s.columns.empty() ? "files read without a column map"
+                             : "files read through another column map";
+  }
+  for (const TrackFile& f : s.files) {
+    if (std::find(run.data_paths.begin(), run.data_paths.end(), f.path) == run.data_paths.end()) {
+      return "data of " + f.path + ", not given now";
+    }
+    std::error_code ec;
+    const auto bytes = fs::file_size(f.path, ec);
+    std::string digest, why;
+    if (ec || static_cast<long long>(bytes) != f.bytes || !FileSha256(f.path, &digest, &why) ||
+        digest != f.sha256) {
+      return "data of " + f.path + " as it was (the file changed since)";
+    }
+  }
+  return "";
+}
+
+bool LoadSavedState(TrackRun& run, bool* use) {
+  std::string text;
+  if (!ReadRegularFile(run.Path(kStateFile), 16LL << 20, "track state", &text, run.error)) {
+    return false;
+  }
+  SavedState s;
+  try {
+    s = ParseState(text);
+  } catch (const YAML::Exception& e) {
+    *run.error = run.Path(kStateFile) + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg;
+    return false;
+  }
+  const std::string mismatch = Mismatch(run, s);
+  if (!mismatch.empty()) {
+    if (run.options.force) {
+      *use = false;
+      return true;
+    }
+    *run.error = run.out + " holds a track of " + mismatch +
+                 ": give a new --out, or --force to build it afresh";
+    return false;
+  }
+  run.generation = s.generation + 1;
+  run.slow = s.slow;
+  run.files = std::move(s.files);
+  run.windows = std::move(s.windows);
+  for (TrackWindowState& w : run.windows) {
+    if (w.fold_file.empty()) continue;
+    if (!LoadFold(run, &w, run.error)) return false;
+    w.has_fold = true;
+    w.theta = w.fold.theta_si;
+  }
+  for (const auto& [name, entry] : s.shared) {
+    for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+      if (run.layout.Column(run.layout.shared_columns[j]).name != name) continue;
+      SharedEntry e = entry;
+      e.column = static_cast<int>(j);
+      run.shared.push_back(e);
+    }
+  }
+  *use = true;
+  return true;
+}
+
+bool IsEmptyDirectory(const std::string& path) {
+  std::error_code ec;
+  return fs::is_directory(path, ec) && fs::directory_iterator(path, ec) == fs::directory_iterator();
+}
+
+// ---------------------------------------------------------------------------------------
+// Reading files into the store.
+
+struct Router {
+  TrackRun& run;
+  std::map<long long, int> window_of_key;  // into run.windows
+  std::map<int, std::vector<StoredSample>> buffers;
+  size_t buffered = 0;
+
+  explicit Router(TrackRun& r) : run(r) {
+    for (size_t w = 0; w < run.windows.size(); ++w)
+      window_of_key[run.windows[w].key] = static_cast<int>(w);
+  }
+
+  int WindowFor(long long key, double start_s, double end_s, const std::string& label) {
+    const auto it = window_of_key.find(key);
+    if (it != window_of_key.end()) return it->second;
+    TrackWindowState w;
+    w.key = key;
+    w.label = label;
+    w.start_s = start_s;
+    w.end_s = end_s;
+    w.first_s = std::numeric_limits<double>::infinity();
+    w.last_s = -std::numeric_limits<double>::infinity();
+    run.windows.push_back(std::move(w));
+    return window_of_key[key] = static_cast<int>(run.windows.size() - 1);
+  }
+
+  bool Flush() {
+    for (auto& [w, samples] : buffers) {
+      if (samples.empty()) continue;
+      const std::string path = run.Path("windows/" + run.windows[w].StoreName());
+      std::error_code ec;
+      const auto size = fs::exists(path, ec) ? static_cast<long long>(fs::file_size(path, ec)) : -1;
+      if (run.update && std::none_of(run.appended.begin(), run.appended.end(),
+                                     [&](const auto& a) { return a.first == path; })) {
+        run.appended.push_back({path, size});
+      }
+      if (!AppendStoredSamples(path, samples, run.error)) return false;
+      samples.clear();
+    }
+    buffered = 0;
+    return true;
+  }
+};
+
+// One sample into its window's buffer.
+bool Route(Router& router, const Sample& s, int file_index, const std::string& stem) {
+  TrackRun& run = router.run;
+  int w = 0;
+  if (run.window.kind == WindowSpec::Kind::kFile) {
+    w = router.WindowFor(file_index, s.time_s, s.time_s, stem);
+  } else {
+    const double d = run.window.duration_s;
+    const double k = std::floor(s.time_s / d);
+    w = router.WindowFor(static_cast<long long>(k), k * d, (k + 1.0) * d,
+                         WindowLabel(run.window, k * d));
+  }
+  TrackWindowState& win = run.windows[w];
+  win.first_s = std::min(win.first_s, s.time_s);
+  win.last_s = std::max(win.last_s, s.time_s);
+  if (run.window.kind == WindowSpec::Kind::kFile) {
+    win.start_s = win.first_s;
+    win.end_s = win.last_s;
+  }
+  ++win.samples;
+  win.dirty = true;
+  if (std::find(win.files.begin(), win.files.end(), file_index) == win.files.end()) {
+    win.files.push_back(file_index);
+  }
+  router.buffers[w].push_back(ToStored(s, file_index, run.spec.use_planned_attitude));
+  return ++router.buffered < kMaxBufferedSamples || router.Flush();
+}
+
+bool ReadFile(Router& router, const std::string& path, std::string* error) {
+  TrackRun& run = router.run;
+  TrackFile file;
+  file.path = path;
+  std::error_code ec;
+  file.bytes = static_cast<long long>(fs::file_size(path, ec));
+  if (!FileSha256(path, &file.sha256, error)) return false;
+  const int index = static_cast<int>(run.files.size());
+  const std::string stem = SessionLabelOfPath(path);
+  if (run.window.kind == WindowSpec::Kind::kFile && !IsValidSessionLabel(stem)) {
+    *error = path + ": with a window per file the file's name " + stem +
+             " labels its window: letters, digits, '-' and '_' only";
+    return false;
+  }
+  DatasetReadOptions read = run.options.read;
+  read.threads = std::max(read.threads, run.options.threads);
+  DatasetChunkReader reader;
+  if (!reader.Open(path, read, error)) return false;
+  Dataset chunk;
+  bool done = false;
+  while (!done) {
+    if (!reader.Next(kReadChunkSamples, &chunk, &done, error)) return false;
+    if (run.spec.use_planned_attitude && !chunk.samples.empty() && !chunk.has_planned_attitude) {
+      *error = path +
+               ": the spec fits with the planned attitude but the file has no "
+               "planned_roll_deg, planned_pitch_deg, planned_yaw_deg columns";
+      return false;
+    }
+    for (const std::string& skipped : chunk.skipped) {
+      if (run.files_skipped.size() < kMaxSkippedNamed) run.files_skipped.push_back(skipped);
+    }
+    for (const Sample& s : chunk.samples) {
+      if (!Route(router, s, index, stem)) return false;
+    }
+    file.samples += static_cast<long long>(chunk.samples.size());
+  }
+  run.files.push_back(file);
+  return true;
+}
+
+}  // namespace
+
+TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<std::string>* out,
+                            std::string* error) {
+  out->clear();
+  for (const std::string& path : given) {
+    std::error_code ec;
+    if (!fs::is_directory(path, ec)) {
+      out->push_back(path);
+      continue;
+    }
+    std::vector<std::string> csv;
+    for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
+      if (e.is_regular_file() && e.path().extension() == ".csv") csv.push_back(e.path().string());
+    }
+    std::sort(csv.begin(), csv.end());
+    if (csv.empty()) {
+      *error = path + ": a directory without *.csv files";
+      return TrackStatus::kInvalidInput;
+    }
+    out->insert(out->end(), csv.begin(), csv.end());
+  }
+  if (out->empty()) {
+    *error = "no data files";
+    return TrackStatus::kInvalidInput;
+  }
+  for (size_t a = 0; a < out->size(); ++a) {
+    for (size_t b = a + 1; b < out->size(); ++b) {
+      if (fs::weakly_canonical((*out)[a]) == fs::weakly_canonical((*out)[b])) {
+        *error = (*out)[b] + ": given twice";
+        return TrackStatus::kInvalidInput;
+      }
+    }
+  }
+  return TrackStatus::kOk;
+}
+
+TrackStatus PrepareDirectory(TrackRun& run) {
+  std::error_code ec;
+  const bool exists = fs::exists(run.out, ec);
+  if (exists && !fs::is_directory(run.out, ec)) {
+    return run.Fail(TrackStatus::kInvalidInput, run.out + ": not a directory");
+  }
+  if (exists && fs::exists(run.out + "/" + kStateFile, ec)) {
+    run.dir = run.out;
+    bool use = false;
+    if (!LoadSavedState(run, &use)) return TrackStatus::kInvalidInput;
+    run.update = use;
+    if (use) return TrackStatus::kOk;
+    run.files.clear();
+    run.windows.clear();
+    run.shared.clear();
+  } else if (exists && !IsEmptyDirectory(run.out)) {
+    return run.Fail(TrackStatus::kInvalidInput,
+                    run.out +
+                        " is not empty and holds no track (track_state.json): give a new "
+                        "or empty directory");
+  }
+  // A new track: built beside DIR and moved into place at the end.
+  run.dir = run.out + ".partial-" + std::to_string(::getpid());
+  fs::remove_all(run.dir, ec);
+  if (!fs::create_directories(run.dir + "/windows", ec) ||
+      !fs::create_directories(run.dir + "/folds", ec)) {
+    return run.Fail(TrackStatus::kInvalidInput, run.dir + ": cannot create: " + ec.message());
+  }
+  run.generation = 1;
+  return TrackStatus::kOk;
+}
+
+TrackStatus ReadNewFiles(TrackRun& run) {
+  Router router(run);
+  int read = 0;
+  for (const std::string& path : run.data_paths) {
+    if (std::any_of(run.files.begin(), run.files.end(),
+                    [&](const TrackFile& f) { return f.path == path; })) {
+      continue;
+    }
+    run.Progress("reading " + path);
+    if (!ReadFile(router, path, run.error)) return TrackStatus::kInvalidInput;
+    ++read;
+  }
+  if (!router.Flush()) return TrackStatus::kFailed;
+  std::stable_sort(
+      run.windows.begin(), run.windows.end(),
+      [](const TrackWindowState& a, const TrackWindowState& b) { return a.start_s < b.start_s; });
+  for (size_t a = 1; a < run.windows.size(); ++a) {
+    for (size_t b = 0; b < a; ++b) {
+      if (run.windows[a].label != run.windows[b].label) continue;
+      return run.Fail(TrackStatus::kInvalidInput,
+                      "two windows are labelled " + run.windows[a].label +
+                          " (one per file: give the files distinct names)");
+    }
+  }
+  for (const std::string& s : run.files_skipped) run.result->notes.push_back("skipped: " + s);
+  if (run.update) {
+    run.result->notes.push_back(std::to_string(read) + " new file" + (read == 1 ? "" : "s") +
+                                " added to the track in " + run.out);
+  }
+  return TrackStatus::kOk;
+}
+
+bool LoadFold(const TrackRun& run, TrackWindowState* w, std::string* error) {
+  std::string bytes;
+  const std::string path = run.Path(w->fold_file);
+  if (!ReadRegularFile(path, 1LL << 30, "fold", &bytes, error)) return false;
+  return ParseWindowFold(bytes, path, &w->fold, error);
+}
+
+TrackStatus SaveState(TrackRun& run) {
+  for (TrackWindowState& w : run.windows) {
+    if (!w.folded) continue;
+    w.fold_file = FoldName(w.label, run.generation);
+    // The residual run served this run's slow-error estimate; an update keeps the process.
+    WindowFold kept = w.fold;
+    kept.residuals.clear();
+    if (!WriteFileAtomically(run.Path(w.fold_file), SerializeWindowFold(kept), run.error)) {
+      return TrackStatus::kFailed;
+    }
+  }
+  if (!WriteFileAtomically(run.Path(kStateFile), StateJson(run), run.error)) {
+    return TrackStatus::kFailed;
+  }
+  return TrackStatus::kOk;
+}
+
+TrackStatus FinishDirectory(TrackRun& run) {
+  std::error_code ec;
+  if (run.update) {
+    // Fold files no window uses any more.
+    for (const fs::directory_entry& e : fs::directory_iterator(run.Path("folds"), ec)) {
+      const std::string name = "folds/" + e.path().filename().string();
+      if (std::none_of(run.windows.begin(), run.windows.end(),
+                       [&](const TrackWindowState& w) { return w.fold_file == name; })) {
+        fs::remove(e.path(), ec);
+      }
+    }
+    return TrackStatus::kOk;
+  }
+  if (fs::exists(run.out, ec)) {
+    // Empty, or a track --force replaces: its files go, the new ones move in.
+    for (const fs::directory_entry& e : fs::directory_iterator(run.out, ec)) {
+      if (IsTrackOutput(e.path().filename().string())) fs::remove_all(e.path(), ec);
+    }
+    for (const fs::directory_entry& e : fs::directory_iterator(run.dir, ec)) {
+      fs::rename(e.path(), fs::path(run.out) / e.path().filename(), ec);
+      if (ec)
+        return run.Fail(TrackStatus::kFailed,
+                        run.out + ": cannot move the track in: " + ec.message());
+    }
+    fs::remove_all(run.dir, ec);
+  } else {
+    fs::rename(run.dir, run.out, ec);
+    if (ec) return run.Fail(TrackStatus::kFailed, run.out + ": " + ec.message());
+  }
+  run.dir = run.out;
+  return TrackStatus::kOk;
+}
+
+void RollBack(TrackRun& run) {
+  std::error_code ec;
+  if (run.dir.empty()) return;
+  if (!run.update) {
+    if (run.dir != run.out) fs::remove_all(run.dir, ec);
+    return;
+  }
+  for (const auto& [path, size] : run.appended) {
+    if (size < 0)
+      fs::remove(path, ec);  // made by this run
+    else
+      fs::resize_file(path, size, ec);
+  }
+  const std::string suffix = ".g" + std::to_string(run.generation) + ".fold";
+  for (const fs::directory_entry& e : fs::directory_iterator(run.Path("folds"), ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() > suffix.size() &&
+        name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0) {
+      fs::remove(e.path(), ec);
+    }
+  }
+}
+
+}  // namespace fastcal::internal

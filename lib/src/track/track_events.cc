@@ -1,0 +1,570 @@
+// The track's events (track.h): sensor biases that stepped between windows (a score
+// scan over cables and window boundaries, binary segmentation), and per-window groups
+// that changed between consecutive windows (Wald tests), each kind at a family-wise
+// false-alarm rate over the season (Bonferroni).
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "fastcal/internal/number_text.h"
+#include "track/track_run.h"
+
+namespace fastcal::internal {
+namespace {
+
+struct Candidate {
+  int column = -1;  // shared column (index into layout.shared_columns)
+  int u = 0;        // the first used window of the new stretch
+  double statistic = 0.0;
+};
+
+// The per-cable sensor biases among the shared columns.
+std::vector<int> BiasColumns(const TrackRun& run) {
+  std::vector<int> out;
+  for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+    const ParameterSpec& s = run.layout.Column(run.layout.shared_columns[j]);
+    if (s.kind == ParameterKind::kSensorBias && s.index >= 0) out.push_back(static_cast<int>(j));
+  }
+  return out;
+}
+
+// The score statistic of "bias column j differs from used window u on, within its
+// stretch" (track.h), widened by the windows' information-weighted widening.
+double StepStatistic(const TrackRun& run, int j, int u) {
+  const int column = run.layout.shared_columns[j];
+  const std::vector<int> order = LocalOrder(run);
+  const int entry = run.entry_of[u][j];
+  std::vector<Eigen::VectorXd> local(run.used.size());
+  double g = 0.0, h = 0.0, widened = 0.0;
+  for (size_t v = u; v < run.used.size() && run.entry_of[v][j] == entry; ++v) {
+    const WindowFold& f = run.windows[run.used[v]].fold;
+    g += GradientAtSolution(run, static_cast<int>(v))[column];
+    const double hv = f.information(column, column);
+    h += hv;
+    widened += run.widening[v] * hv;
+    local[v] = Eigen::VectorXd(order.size());
+    for (size_t r = 0; r < order.size(); ++r) local[v][r] = f.information(order[r], column);
+  }
+  const double a = h - InverseQuadratic(run, local);
+  if (!(a > 1e-12 * h) || !(h > 0.0)) return 0.0;
+  return g * g / (a * (widened / h));
+}
+
+Candidate BestStep(const TrackRun& run, const std::vector<int>& columns) {
+  Candidate best;
+  for (int j : columns) {
+    for (size_t u = 1; u < run.used.size(); ++u) {
+      if (run.entry_of[u - 1][j] != run.entry_of[u][j]) continue;  // already split there
+      const double t = StepStatistic(run, j, static_cast<int>(u));
+      if (t > best.statistic) best = {j, static_cast<int>(u), t};
+    }
+  }
+  return best;
+}
+
+std::string WindowText(const TrackRun& run, int u) { return run.windows[run.used[u]].label; }
+
+// An event between used windows `from` (the last with the old value) and `to` (the first
+// with the new one).
+TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind, double statistic,
+                   int dof, double threshold, int tests) {
+  TrackEvent e;
+  e.kind = kind;
+  e.window = to;
+  e.previous_window = from;
+  e.time_s = run.windows[run.used[to]].first_s;
+  e.previous_time_s = run.windows[run.used[from]].last_s;
+  e.degrees_of_freedom = dof;
+  e.statistic = statistic;
+  e.threshold = threshold;
+  e.p_value = std::min(1.0, tests * ChiSquareTailProbability(statistic, dof));
+  return e;
+}
+
+// The Wald test of a split bias's step (entry e after entry e0), from the final fit.
+TrackEvent SensorEvent(const TrackRun& run, int e0, int e, double threshold, int tests) {
+  const SharedEntry& entry = run.shared[e];
+  const ParameterSpec& s = run.layout.Column(run.layout.shared_columns[entry.column]);
+  const double d = run.solver.b()[e] - run.solver.b()[e0];
+  const Eigen::MatrixXd p = run.solver.SandwichBB();
+  double variance = p(e, e) + p(e0, e0) - 2.0 * p(e, e0);
+  for (int c = 0; c < run.consider_sigma.size(); ++c) {
+    variance +=
+        std::pow((run.consider_x.b(e, c) - run.consider_x.b(e0, c)) * run.consider_sigma[c], 2);
+  }
+  int u = 0;
+  while (u < static_cast<int>(run.used.size()) && run.entry_of[u][entry.column] != e) ++u;
+  u = std::max(1, u);
+  TrackEvent event =
+      EventAt(run, u - 1, u, "sensor", d * d / std::max(variance, 1e-300), 1, threshold, tests);
+  event.parameters.push_back(
+      {s.name, s.unit, d / s.to_si, std::sqrt(std::max(variance, 0.0)) / s.to_si});
+  event.cables.push_back(s.index + 1);
+  return event;
+}
+
+// The per-window groups tested together: a vector quantity's axes, or one parameter.
+std::vector<std::vector<int>> WindowGroups(const TrackRun& run) {
+  std::map<std::string, std::vector<int>> by_key;
+  std::vector<std::string> keys;
+  for (size_t a = 0; a < run.layout.window_columns.size(); ++a) {
+    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[a]);
+    const bool vector = s.kind == ParameterKind::kMassCentre ||
+                        s.kind == ParameterKind::kAnchorOffset ||
+                        s.kind == ParameterKind::kTowerOffset;
+    const std::string key =
+        vector ? std::string(ParameterGroupName(s.kind)) + "/" + std::to_string(s.index) : s.name;
+    if (!by_key.count(key)) keys.push_back(key);
+    by_key[key].push_back(static_cast<int>(a));
+  }
+  std::vector<std::vector<int>> groups;
+  for (const std::string& k : keys) groups.push_back(by_key[k]);
+  return groups;
+}
+
+// The Wald test of a group's change from used window `from` to `to` (later minus earlier,
+// its covariance from the sandwich and the consider part: the shared error cancels).
+struct GroupChange {
+  Eigen::VectorXd d;
+  Eigen::MatrixXd covariance;
+  double statistic = 0.0;
+};
+// `wander`: the group's variance per component between windows (GroupWander), added to
+// both windows'.
+GroupChange Change(const TrackRun& run, const std::vector<int>& g, int from, int to,
+                   double wander = 0.0) {
+  const int dof = static_cast<int>(g.size());
+  const Eigen::MatrixXd c = TotalCovariance(run, to, to) + TotalCovariance(run, from, from) -
+                            TotalCovariance(run, to, from) - TotalCovariance(run, from, to);
+  GroupChange out;
+  out.d.resize(dof);
+  out.covariance.resize(dof, dof);
+  for (int x = 0; x < dof; ++x) {
+    out.d[x] = run.solver.a(to)[g[x]] - run.solver.a(from)[g[x]];
+    for (int y = 0; y < dof; ++y) out.covariance(x, y) = c(g[x], g[y]);
+    out.covariance(x, x) += 2.0 * wander;
+  }
+  out.statistic = out.d.dot(Eigen::LDLT<Eigen::MatrixXd>(out.covariance).solve(out.d));
+  return out;
+}
+
+// Fewest window boundaries from which a group's wander is estimated.
+// (A step inside a window changes the two boundaries around it: the median of 8 or more
+// holds against three such.)
+constexpr int kMinWanderBoundaries = 8;
+
+// The group's wander between windows (track.h, TrackWander): the variance v per component
+// (SI) at which the median over consecutive windows of d^T (C + 2 v I)^-1 d is the
+// chi-square median (a random effect per window, estimated robustly: a few steps among
+// the boundaries do not move the median); 0 when the median is already below it.
+double GroupWander(const TrackRun& run, const std::vector<int>& g) {
+  const int boundaries = static_cast<int>(run.used.size()) - 1;
+  if (boundaries < kMinWanderBoundaries) return 0.0;
+  const int dof = static_cast<int>(g.size());
+  std::vector<GroupChange> changes;
+  for (int u = 1; u <= boundaries; ++u) changes.push_back(Change(run, g, u - 1, u));
+  const double target = ChiSquareQuantile(0.5, dof);
+  const auto median_at = [&](double v) {
+    std::vector<double> t;
+    for (const GroupChange& c : changes) {
+      Eigen::MatrixXd m = c.covariance;
+      m.diagonal().array() += 2.0 * v;
+      t.push_back(c.d.dot(Eigen::LDLT<Eigen::MatrixXd>(m).solve(c.d)));
+    }
+    std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
+    return t[t.size() / 2];
+  };
+  if (!(median_at(0.0) > target)) return 0.0;
+  double scale = 0.0;  // the differences' own variance: where to start
+  for (const GroupChange& c : changes) scale = std::max(scale, c.covariance.diagonal().maxCoeff());
+  double lo = 0.0, hi = std::max(scale, 1e-300);
+  for (int k = 0; k < 200 && median_at(hi) > target; ++k) hi *= 4.0;
+  for (int k = 0; k < 100; ++k) {
+    const double mid = 0.5 * (lo + hi);
+    (median_at(mid) > target ? lo : hi) = mid;
+  }
+  return hi;
+}
+
+// A step within used window u's telemetry: the score test of "these parameters differ
+// from block j on", at the joint fit, over the window's block boundaries (the fold's block
+// scores and information rows, moved to the solution), judged against the window's misfit
+// alone (a step inside the window is what its block correlation shows). `rows` index the
+// fold's block information rows (track_fold.h, BlockRowColumns), `columns` the fold
+// columns they are of.
+struct InnerStep {
+  double statistic = 0.0;
+  int block = -1;
+  int splits = 0;
+};
+InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
+                     const std::vector<int>& columns, bool widened = false) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  const int blocks = static_cast<int>(f.block_samples.size());
+  const int pg = static_cast<int>(rows.size());
+  InnerStep best;
+  best.splits = std::max(0, blocks - 1);
+  if (blocks < 2) return best;
+  for (int x : rows) {
+    if (x >= f.block_information[0].rows()) return best;  // a fold without the rows
+  }
+  const std::vector<int> order = LocalOrder(run);
+  const ArrowBlock& k = run.problem.blocks[u];
+  const Eigen::VectorXd d = StepOf(run, u);
+  Eigen::VectorXd score = Eigen::VectorXd::Zero(pg);
+  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pg, f.information.cols());
+  for (int j = blocks - 1; j >= 1; --j) {
+    for (int x = 0; x < pg; ++x) {
+      score[x] += f.block_scores(j, columns[x]) + f.block_information[j].row(rows[x]).dot(d);
+      cross.row(x) += f.block_information[j].row(rows[x]);
+    }
+    Eigen::MatrixXd self(pg, pg);
+    for (int x = 0; x < pg; ++x) {
+      for (int y = 0; y < pg; ++y) self(x, y) = cross(x, columns[y]);
+    }
+    ArrowVector c;
+    for (const ArrowBlock& other : run.problem.blocks)
+      c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
+    c.b = Eigen::MatrixXd::Zero(run.problem.q, pg);
+    for (int x = 0; x < pg; ++x) {
+      for (int r = 0; r < k.p; ++r) c.a[u](r, x) = cross(x, order[r]);
+      for (int m = 0; m < k.m(); ++m) c.b(k.shared_index[m], x) += cross(x, order[k.p + m]);
+    }
+    const ArrowVector solved = run.solver.SolveFor(c);
+    const Eigen::MatrixXd schur =
+        self - c.a[u].transpose() * solved.a[u] - c.b.transpose() * solved.b;
+    const double t = score.dot(Eigen::LDLT<Eigen::MatrixXd>(schur).solve(score)) /
+                     (widened ? std::max(run.birge[u], run.widening[u]) : run.birge[u]);
+    if (std::isfinite(t) && t > best.statistic) {
+      best.statistic = t;
+      best.block = j;
+    }
+  }
+  return best;
+}
+
+// The scan of group g (indices into layout.window_columns: the first block rows). A
+// group that wanders (GroupWander) is judged against the window's whole widening, its
+// residuals' correlation in time included: a wander is not a step.
+InnerStep ScanGroupWithin(const TrackRun& run, int u, const std::vector<int>& g, bool wanders) {
+  std::vector<int> columns;
+  for (int x : g) columns.push_back(run.layout.window_columns[x]);
+  return ScanWithin(run, u, g, columns, wanders);
+}
+
+// Whether the scan of window u found a step inside it (Bonferroni over its splits).
+bool Inside(const TrackRun& run, const InnerStep& step, int dof) {
+  return step.block > 0 &&
+         step.statistic > ChiSquareQuantile(run.options.false_alarm / step.splits, dof);
+}
+
+// The event's time refined to the block of window u where the step is (its first sample,
+// and the block before's last).
+void RefineTime(const TrackRun& run, int u, const InnerStep& step, TrackEvent* e) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  e->time_s = f.block_first_time_s[step.block];
+  e->previous_time_s = f.block_last_time_s[step.block - 1];
+  e->within_window = true;
+}
+
+// The events of group g: each change between consecutive windows beyond the threshold.
+// A step inside window u shows as a change on both sides of it (each about the part of
+// the window after or before the step): when the scan within u finds the step, the two
+// are one event from u - 1 to u + 1, timed at the step's block, whichever side alone was
+// significant; else the event is between the two windows, at the window's resolution.
+void GroupEvents(const TrackRun& run, const std::vector<int>& g, std::vector<TrackEvent>* out) {
+  const TrackResult& r = *run.result;
+  const int dof = static_cast<int>(g.size());
+  const int tests = std::max(1, r.parameter_tests);
+  const double threshold = ChiSquareQuantile(run.options.false_alarm / tests, dof);
+  const ParameterSpec& first = run.layout.Column(run.layout.window_columns[g[0]]);
+  const bool sensor =
+      first.kind == ParameterKind::kSensorBias || first.kind == ParameterKind::kSensorGain;
+  const int windows = static_cast<int>(run.used.size());
+  const double wander = GroupWander(run, g);
+  {
+    TrackWander w;
+    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[0]]);
+    w.group = dof > 1 ? std::string(ParameterGroupName(s.kind)) : s.name;
+    w.unit = s.unit;
+    w.rms = std::sqrt(wander) / s.to_si;
+    run.result->wander.push_back(w);
+  }
+  std::vector<bool> changed(windows, false);
+  for (int u = 1; u < windows; ++u) {
+    changed[u] = Change(run, g, u - 1, u, wander).statistic > threshold;
+  }
+  int last_to = -1;  // the later window of the group's last event: events do not overlap
+  for (int u = 1; u < windows; ++u) {
+    if (!changed[u]) continue;
+    int from = u - 1, to = u, inside = -1;
+    InnerStep step;
+    const InnerStep here = ScanGroupWithin(run, u, g, wander > 0.0);
+    const InnerStep before =
+        u - 1 != last_to ? ScanGroupWithin(run, u - 1, g, wander > 0.0) : InnerStep();
+    const bool in_here = Inside(run, here, dof), in_before = Inside(run, before, dof);
+    // The step inside a window is the change across it, which must stand on its own.
+    const auto across = [&](int a, int b) {
+      return Change(run, g, a, b, wander).statistic > threshold;
+    };
+    if (in_here && (!in_before || here.statistic >= before.statistic) &&
+        across(u - 1, std::min(u + 1, windows - 1))) {
+      inside = u;
+      step = here;
+      to = std::min(u + 1, windows - 1);
+    } else if (in_before && across(std::max(u - 2, 0), u)) {
+      inside = u - 1;
+      step = before;
+      from = std::max(u - 2, 0);
+    }
+    for (int v = u + 1; v <= to; ++v) changed[v] = false;
+    last_to = to;
+    const GroupChange change = Change(run, g, from, to, wander);
+    TrackEvent e = EventAt(run, from, to, sensor ? "sensor" : "parameter", change.statistic, dof,
+                           threshold, tests);
+    if (inside >= 0) {
+      RefineTime(run, inside, step, &e);
+      e.window = inside;
+    }
+    for (int x = 0; x < dof; ++x) {
+      const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[x]]);
+      e.parameters.push_back(
+          {s.name, s.unit, change.d[x] / s.to_si, std::sqrt(change.covariance(x, x)) / s.to_si});
+      if (sensor && s.index >= 0) e.cables.push_back(s.index + 1);
+    }
+    out->push_back(e);
+  }
+}
+
+}  // namespace
+
+namespace {
+
+// The entry of the same column just before entry e (the stretch before its step), or -1.
+int PreviousEntry(const TrackRun& run, int e) {
+  int previous = -1;
+  for (size_t k = 0; k < run.shared.size(); ++k) {
+    if (run.shared[k].column != run.shared[e].column ||
+        !(run.shared[k].from_s < run.shared[e].from_s)) {
+      continue;
+    }
+    if (previous < 0 || run.shared[k].from_s > run.shared[previous].from_s) {
+      previous = static_cast<int>(k);
+    }
+  }
+  return previous;
+}
+
+// The entry a step at entry e is measured from: the one before it, or, when that one is
+// a window with the step inside (SharedEntry::inside), the one before that (-1: none).
+int StepBase(const TrackRun& run, int e) {
+  const int previous = PreviousEntry(run, e);
+  if (previous < 0 || !run.shared[previous].inside) return previous;
+  return PreviousEntry(run, previous);
+}
+
+// The Wald statistic of the step from entry e0 to entry e, widened.
+double StepWald(const TrackRun& run, int e0, int e) {
+  const Eigen::MatrixXd p = run.solver.SandwichBB();
+  const double d = run.solver.b()[e] - run.solver.b()[e0];
+  const double variance = p(e, e) + p(e0, e0) - 2.0 * p(e, e0);
+  return variance > 0.0 ? d * d / variance : 0.0;
+}
+
+void EraseEntry(TrackRun& run, int e) {
+  run.shared.erase(run.shared.begin() + e);
+  run.splits.erase(std::remove(run.splits.begin(), run.splits.end(), e), run.splits.end());
+  for (int& s : run.splits) s -= s > e;
+}
+
+// The first used window whose column takes entry e (-1: none).
+int FirstWindowOf(const TrackRun& run, int e) {
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    if (run.entry_of[u][run.shared[e].column] == e) return static_cast<int>(u);
+  }
+  return -1;
+}
+
+// Steps the fitted track no longer holds significant (the scan's score test is at the
+// fit without them, the Wald test at the fit with them): the weakest is joined back to
+// the stretch before it (with the window of its step, when it is inside one), and the
+// track refitted, until every step stands.
+TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
+  for (;;) {
+    ComputeWidening(run);
+    int weakest = -1;
+    double smallest = threshold;
+    for (size_t e = 0; e < run.shared.size(); ++e) {
+      const int base = StepBase(run, static_cast<int>(e));
+      if (base < 0 || run.shared[e].inside) continue;
+      const double t = StepWald(run, base, static_cast<int>(e));
+      if (t <= smallest) {
+        smallest = t;
+        weakest = static_cast<int>(e);
+      }
+    }
+    if (weakest < 0) return TrackStatus::kOk;
+    run.Progress("sensor step of " +
+                 run.layout.Column(run.layout.shared_columns[run.shared[weakest].column]).name +
+                 " no longer significant once fitted (Wald " + FormatDouble("%.1f", smallest) +
+                 "): joined back");
+    const int previous = PreviousEntry(run, weakest);
+    const bool inside = run.shared[previous].inside;
+    EraseEntry(run, std::max(weakest, inside ? previous : -1));
+    if (inside) EraseEntry(run, std::min(weakest, previous));
+    const TrackStatus status = Iterate(run, false);
+    if (status != TrackStatus::kOk) return status;
+  }
+}
+
+// A sensor re-zeroed inside a window's telemetry: for each step, the windows on either
+// side of it are scanned for a step of that bias inside their own telemetry (the score
+// test over block boundaries, Bonferroni over them); the window that holds it gets an
+// entry of its own (SharedEntry::inside: its readings are of both values), so that the
+// stretches before and after it are of one value each and the step between them is the
+// whole step, timed at its block.
+TrackStatus IsolateInsideSteps(TrackRun& run) {
+  const std::vector<FoldRole>& roles = run.layout.roles;
+  std::vector<ParameterSpec> columns;
+  for (int k = 0; k < run.layout.size(); ++k) columns.push_back(run.layout.Column(k));
+  const std::vector<int> block_columns = BlockRowColumns(columns, roles);
+  bool isolated = false;
+  const int entries = static_cast<int>(run.shared.size());
+  const int windows = static_cast<int>(run.used.size());
+  // A window the scan already cut out (a step found on either side of it: two halves of
+  // one step inside it) whose own scan finds the step: one step, inside it.
+  for (int m = 0; m < entries; ++m) {
+    const int e0 = PreviousEntry(run, m);
+    if (e0 < 0 || run.shared[m].inside || run.shared[e0].inside) continue;
+    bool followed = false;
+    for (int e = 0; e < entries; ++e) followed = followed || PreviousEntry(run, e) == m;
+    const int j = run.shared[m].column;
+    const int v = FirstWindowOf(run, m);
+    if (!followed || v < 1 || (v + 1 < windows && run.entry_of[v + 1][j] == m)) continue;
+    const int column = run.layout.shared_columns[j];
+    const auto row = std::find(block_columns.begin(), block_columns.end(), column);
+    if (row == block_columns.end()) continue;
+    const InnerStep step =
+        ScanWithin(run, v, {static_cast<int>(row - block_columns.begin())}, {column});
+    if (!Inside(run, step, 1)) continue;
+    const WindowFold& f = run.windows[run.used[v]].fold;
+    run.shared[m].inside = true;
+    run.shared[m].step_time_s = f.block_first_time_s[step.block];
+    run.shared[m].step_previous_s = f.block_last_time_s[step.block - 1];
+    run.Progress("sensor steps of " + run.layout.Column(column).name + " on both sides of window " +
+                 WindowText(run, v) + ": one step inside it (statistic " +
+                 FormatDouble("%.1f", step.statistic) + ")");
+  }
+  for (int e = 0; e < entries; ++e) {
+    const int e0 = PreviousEntry(run, e);
+    if (e0 < 0 || run.shared[e].inside || run.shared[e0].inside) continue;
+    const int j = run.shared[e].column;
+    const int u = FirstWindowOf(run, e);
+    if (u < 1) continue;
+    const int column = run.layout.shared_columns[j];
+    const auto row = std::find(block_columns.begin(), block_columns.end(), column);
+    if (row == block_columns.end()) continue;
+    const std::vector<int> rows = {static_cast<int>(row - block_columns.begin())};
+    // A window is isolated only when its stretch keeps another window.
+    const bool before_ok = u >= 2 && run.entry_of[u - 2][j] == e0;
+    const bool here_ok = u + 1 < windows && run.entry_of[u + 1][j] == e;
+    const InnerStep before = before_ok ? ScanWithin(run, u - 1, rows, {column}) : InnerStep();
+    const InnerStep here = here_ok ? ScanWithin(run, u, rows, {column}) : InnerStep();
+    const bool in_before = Inside(run, before, 1), in_here = Inside(run, here, 1);
+    if (!in_before && !in_here) continue;
+    const bool use_here = in_here && (!in_before || here.statistic >= before.statistic);
+    const int v = use_here ? u : u - 1;
+    const InnerStep& step = use_here ? here : before;
+    const WindowFold& f = run.windows[run.used[v]].fold;
+    SharedEntry mixed = run.shared[use_here ? e : e0];
+    mixed.inside = true;
+    mixed.step_time_s = f.block_first_time_s[step.block];
+    mixed.step_previous_s = f.block_last_time_s[step.block - 1];
+    if (use_here) {
+      // Entry e keeps window u alone; the stretch after it gets a new entry.
+      SharedEntry after = run.shared[e];
+      after.from_s = run.windows[run.used[u + 1]].start_s;
+      mixed.from_s = run.shared[e].from_s;
+      run.shared[e] = mixed;
+      run.shared.push_back(after);
+    } else {
+      mixed.from_s = run.windows[run.used[u - 1]].start_s;
+      run.shared.push_back(mixed);
+    }
+    run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
+    run.Progress("sensor step of " + run.layout.Column(column).name + " inside window " +
+                 WindowText(run, v) + " (statistic " + FormatDouble("%.1f", step.statistic) +
+                 "): the window gets a value of its own");
+    isolated = true;
+  }
+  return isolated ? Iterate(run, false) : TrackStatus::kOk;
+}
+
+}  // namespace
+
+TrackStatus ScanSensorSteps(TrackRun& run) {
+  const std::vector<int> columns = BiasColumns(run);
+  const int boundaries = static_cast<int>(run.used.size()) - 1;
+  run.result->sensor_tests = static_cast<int>(columns.size()) * std::max(0, boundaries);
+  if (run.result->sensor_tests == 0) return TrackStatus::kOk;
+  const double threshold = ChiSquareQuantile(run.options.false_alarm / run.result->sensor_tests, 1);
+  for (int round = 0; round < run.options.max_sensor_steps; ++round) {
+    ComputeWidening(run);
+    const Candidate best = BestStep(run, columns);
+    if (!(best.statistic > threshold)) break;
+    const int e = run.entry_of[best.u][best.column];
+    SharedEntry split = run.shared[e];
+    split.from_s = run.windows[run.used[best.u]].start_s;
+    split.inside = false;
+    run.shared.push_back(split);
+    run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
+    run.Progress("sensor step: " + run.layout.Column(run.layout.shared_columns[best.column]).name +
+                 " from window " + WindowText(run, best.u) + " (statistic " +
+                 FormatDouble("%.1f", best.statistic) + ", threshold " +
+                 FormatDouble("%.1f", threshold) + "): fitted per stretch");
+    // The next solve maps the new stretch's windows to the new entry; Gauss-Newton then
+    // refolds the windows that move.
+    const TrackStatus status = Iterate(run, false);
+    if (status != TrackStatus::kOk) return status;
+  }
+  ComputeWidening(run);
+  const TrackStatus status = IsolateInsideSteps(run);
+  if (status != TrackStatus::kOk) return status;
+  return DropWeakSteps(run, threshold);
+}
+
+TrackStatus FindParameterEvents(TrackRun& run) {
+  TrackResult& r = *run.result;
+  r.events.clear();
+  r.wander.clear();
+  // Sensor events: every split bias, tested on the final fit.
+  if (r.sensor_tests > 0) {
+    const double threshold = ChiSquareQuantile(run.options.false_alarm / r.sensor_tests, 1);
+    for (size_t e = 0; e < run.shared.size(); ++e) {
+      const int base = StepBase(run, static_cast<int>(e));
+      if (base < 0 || run.shared[e].inside) continue;
+      TrackEvent event = SensorEvent(run, base, static_cast<int>(e), threshold, r.sensor_tests);
+      const int previous = PreviousEntry(run, static_cast<int>(e));
+      if (run.shared[previous].inside) {
+        // The step inside the window of entry `previous`: timed at its block.
+        const SharedEntry& mixed = run.shared[previous];
+        event.window = std::max(0, FirstWindowOf(run, previous));
+        event.previous_window = std::max(0, event.window - 1);
+        event.time_s = mixed.step_time_s;
+        event.previous_time_s = mixed.step_previous_s;
+        event.within_window = true;
+      }
+      r.events.push_back(event);
+    }
+  }
+  // Parameter events: consecutive windows' per-window groups.
+  const std::vector<std::vector<int>> groups = WindowGroups(run);
+  const int boundaries = static_cast<int>(run.used.size()) - 1;
+  r.parameter_tests = static_cast<int>(groups.size()) * std::max(0, boundaries);
+  for (const std::vector<int>& g : groups) GroupEvents(run, g, &r.events);
+  std::stable_sort(r.events.begin(), r.events.end(),
+                   [](const TrackEvent& a, const TrackEvent& b) { return a.time_s < b.time_s; });
+  return TrackStatus::kOk;
+}
+
+}  // namespace fastcal::internal

@@ -1,0 +1,225 @@
+// The track's outputs (track.h): the models of the latest window and of each event-free
+// stretch, track.csv, events.json, the models' files and track.html.
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/json.h"
+#include "fastcal/internal/number_text.h"
+#include "track/track_run.h"
+
+namespace fastcal::internal {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Num(double v) { return v == 0.0 ? "0" : FormatDouble("%.10g", v); }
+
+std::string ValueText(double value, double sigma, const std::string& unit) {
+  return FormatDouble("%.6g", value) + " +- " + FormatDouble("%.2g", sigma) +
+         (unit == "1" ? "" : " " + unit);
+}
+
+// The model at the window parameters `a` (SI, window columns) with b's entries of used
+// window u, and its comment lines.
+CableRobot ModelAt(const TrackRun& run, const Eigen::VectorXd& a, int u) {
+  CalibrationSpec spec = run.spec;
+  spec.parameters = run.layout.parameters;
+  const CalibrationModel cm(run.model, spec);
+  std::vector<double> theta(run.layout.size());
+  for (size_t k = 0; k < run.layout.window_columns.size(); ++k) {
+    theta[run.layout.window_columns[k]] = a[k];
+  }
+  for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+    theta[run.layout.shared_columns[j]] = run.solver.b()[run.entry_of[u][j]];
+  }
+  for (size_t c = 0; c < run.layout.consider_columns.size(); ++c) {
+    theta[run.layout.consider_columns[c]] = run.consider_si[c];
+  }
+  return cm.ToRobot(theta.data());
+}
+
+std::string ModelComment(const TrackRun& run, const std::string& what, const Eigen::VectorXd& a,
+                         const Eigen::MatrixXd& covariance, int u) {
+  std::string text = "fastcal track: " + what + "\n";
+  for (size_t k = 0; k < run.layout.window_columns.size(); ++k) {
+    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[k]);
+    text +=
+        "  " + s.name + " = " +
+        ValueText(a[k] / s.to_si, std::sqrt(std::max(0.0, covariance(k, k))) / s.to_si, s.unit) +
+        " (sigma_total)\n";
+  }
+  for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+    const TrackShared& s = run.result->shared[run.entry_of[u][j]];
+    text += "  " + s.name + " = " + ValueText(s.estimate.value, s.estimate.sigma_total, s.unit) +
+            " (shared)\n";
+  }
+  return text;
+}
+
+std::string CsvHeader(const TrackResult& r, bool offsets) {
+  std::string h = "window_start,window_end,samples";
+  for (const std::string& name : r.window_parameters) h += "," + name + "," + name + "_sigma_total";
+  for (int i = 1; offsets && i <= kNumCables; ++i) {
+    const std::string name = "sensor_offset_kN[" + std::to_string(i) + "]";
+    h += "," + name + "," + name + "_sigma_total";
+  }
+  return h + ",reduced_chi_square,widening,gross_errors,window\n";
+}
+
+std::string TrackCsv(const TrackResult& r) {
+  const bool offsets = !r.windows.empty() && r.windows.front().has_offsets;
+  std::string csv = CsvHeader(r, offsets);
+  for (const TrackWindow& w : r.windows) {
+    csv +=
+        TrackTimeText(w.start_s) + "," + TrackTimeText(w.end_s) + "," + std::to_string(w.samples);
+    for (const TrackEstimate& e : w.estimates) csv += "," + Num(e.value) + "," + Num(e.sigma_total);
+    for (int i = 0; offsets && i < kNumCables; ++i) {
+      csv += "," + Num(w.offset_kn[i].value) + "," + Num(w.offset_kn[i].sigma_total);
+    }
+    csv += "," + Num(w.reduced_chi_square) + "," + Num(w.widening) + "," +
+           std::to_string(w.gross_errors) + "," + w.label + "\n";
+  }
+  return csv;
+}
+
+std::string EventsJson(const TrackResult& r) {
+  JsonWriter j;
+  j.BeginObject();
+  j.Key("format").String("fastcal-events-1");
+  j.Key("false_alarm").Number(r.false_alarm);
+  j.Key("false_alarm_meaning")
+      .String(
+          "for each kind of event, the chance that noise alone reports any over the whole "
+          "track (Bonferroni over its tests)");
+  j.Key("parameter_tests").Int(r.parameter_tests);
+  j.Key("sensor_tests").Int(r.sensor_tests);
+  j.Key("windows").Int(static_cast<long long>(r.windows.size()));
+  // Each per-window group's wander between windows beyond its errors (track.h): the
+  // parameter events are steps beyond it.
+  j.Key("wander").BeginArray();
+  for (const TrackWander& w : r.wander) {
+    j.BeginObject();
+    j.Key("parameters").String(w.group);
+    j.Key("rms").Number(w.rms);
+    j.Key("unit").String(w.unit);
+    j.EndObject();
+  }
+  j.EndArray();
+  j.Key("events").BeginArray();
+  for (const TrackEvent& e : r.events) {
+    j.BeginObject();
+    j.Key("time").String(TrackTimeText(e.time_s));
+    j.Key("time_s").ExactNumber(e.time_s);
+    j.Key("after").String(TrackTimeText(e.previous_time_s));
+    j.Key("after_s").ExactNumber(e.previous_time_s);
+    j.Key("window").String(r.windows[e.window].label);
+    j.Key("previous_window").String(r.windows[e.previous_window].label);
+    j.Key("within_window").Bool(e.within_window);
+    j.Key("kind").String(e.kind);
+    j.Key("parameters").BeginObject();
+    for (const TrackEventParameter& p : e.parameters) {
+      j.Key(p.name).BeginObject();
+      j.Key("shift").Number(p.shift);
+      j.Key("sigma_total").Number(p.sigma_total);
+      j.Key("unit").String(p.unit);
+      j.EndObject();
+    }
+    j.EndObject();
+    if (e.kind == "sensor") j.Key("cables").NumberArray(e.cables);
+    j.Key("statistic").Number(e.statistic);
+    j.Key("degrees_of_freedom").Int(e.degrees_of_freedom);
+    j.Key("threshold").Number(e.threshold);
+    j.Key("p_value").Number(e.p_value);
+    j.EndObject();
+  }
+  j.EndArray();
+  j.EndObject();
+  return j.str();
+}
+
+}  // namespace
+
+TrackStatus BuildModels(TrackRun& run) {
+  TrackResult& r = *run.result;
+  r.models.clear();
+  r.model_comments.clear();
+  const int windows = static_cast<int>(run.used.size());
+  if (windows == 0) return TrackStatus::kOk;
+  std::vector<bool> boundary(windows + 1, false);
+  for (const TrackEvent& e : r.events) {
+    boundary[e.window] = true;
+    // A step inside a window's telemetry: that window is a stretch of its own (mixed).
+    if (e.within_window) boundary[e.window + 1] = true;
+  }
+  boundary[0] = boundary[windows] = true;
+  const int p = static_cast<int>(run.layout.window_columns.size());
+  for (int first = 0; first < windows;) {
+    int last = first;
+    while (!boundary[last + 1]) ++last;
+    // The stretch's window parameters: its windows' estimates weighted by their
+    // information (their correlation through b left out).
+    Eigen::MatrixXd info = Eigen::MatrixXd::Zero(p, p);
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(p);
+    for (int u = first; u <= last; ++u) {
+      const Eigen::MatrixXd inverse = TotalCovariance(run, u, u).inverse();
+      info += inverse;
+      sum += inverse * run.solver.a(u);
+    }
+    const Eigen::MatrixXd covariance = info.inverse();
+    const Eigen::VectorXd a = covariance * sum;
+    const std::string label = first == last
+                                  ? r.windows[first].label
+                                  : r.windows[first].label + "_to_" + r.windows[last].label;
+    r.models.push_back({label, ModelAt(run, a, first)});
+    r.model_comments.push_back(ModelComment(
+        run,
+        first == last ? "window " + label
+                      : "windows " + r.windows[first].label + " to " + r.windows[last].label +
+                            " (no event between them; their window parameters averaged)",
+        a, covariance, first));
+    first = last + 1;
+  }
+  // The latest window, when its stretch is longer.
+  const int u = windows - 1;
+  if (r.models.back().first != r.windows[u].label) {
+    r.models.push_back({r.windows[u].label, ModelAt(run, run.solver.a(u), u)});
+    r.model_comments.push_back(ModelComment(run, "the latest window, " + r.windows[u].label,
+                                            run.solver.a(u), TotalCovariance(run, u, u), u));
+  }
+  return TrackStatus::kOk;
+}
+
+TrackStatus WriteOutputs(TrackRun& run) {
+  const TrackResult& r = *run.result;
+  const auto write = [&](const std::string& name, const std::string& text) {
+    return WriteFileAtomically(run.Path(name), text, run.error);
+  };
+  if (!write("track.csv", TrackCsv(r)) || !write("events.json", EventsJson(r)) ||
+      !write("track.html", TrackHtml(r))) {
+    return TrackStatus::kFailed;
+  }
+  std::vector<std::string> written;
+  for (size_t k = 0; k < r.models.size(); ++k) {
+    const std::string name = "model_calibrated@" + r.models[k].first + ".yaml";
+    if (!SaveCableRobot(r.models[k].second, run.Path(name), r.model_comments[k], run.error)) {
+      return TrackStatus::kFailed;
+    }
+    written.push_back(name);
+  }
+  // An update's models that no longer hold (a stretch an event now cuts).
+  std::error_code ec;
+  for (const fs::directory_entry& e : fs::directory_iterator(run.dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind("model_calibrated@", 0) == 0 &&
+        std::find(written.begin(), written.end(), name) == written.end()) {
+      fs::remove(e.path(), ec);
+    }
+  }
+  return TrackStatus::kOk;
+}
+
+}  // namespace fastcal::internal

@@ -1,0 +1,179 @@
+// One track's state, passed from stage to stage (track.h): the pipeline is track.cc; the
+// data files, the window store and the saved state are track_data.cc; the folds, the
+// block-arrow solve, Gauss-Newton and the uncertainties track_solve.cc; the events
+// track_events.cc; the outputs track_output.cc and track_html.cc.
+#ifndef FASTCAL_SRC_TRACK_TRACK_RUN_H_
+#define FASTCAL_SRC_TRACK_TRACK_RUN_H_
+
+#include <Eigen/Core>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "fastcal/internal/block_arrow.h"
+#include "fastcal/internal/chi_square.h"
+#include "fastcal/track.h"
+#include "fastcal/track_fold.h"
+
+namespace fastcal::internal {
+
+inline constexpr double kNPerKn = 1e3;
+
+// The fold's columns: the spec's free parameters and its consider ones, in spec order.
+struct TrackLayout {
+  std::vector<ParameterSpec> parameters;  // the spec's, consider parameters made free
+  std::vector<int> spec_index;            // per column
+  std::vector<FoldRole> roles;            // per column
+  std::vector<int> window_columns, shared_columns, consider_columns;
+  const ParameterSpec& Column(int k) const { return parameters[spec_index[k]]; }
+  int size() const { return static_cast<int>(spec_index.size()); }
+};
+
+struct TrackFile {
+  std::string path;
+  long long bytes = 0;
+  std::string sha256;
+  long long samples = 0;
+};
+
+struct TrackWindowState {
+  long long key = 0;  // floor(time / duration), or the file's index
+  std::string label;
+  double start_s = 0.0, end_s = 0.0, first_s = 0.0, last_s = 0.0;
+  long long samples = 0;
+  std::vector<int> files;  // indices into TrackRun::files
+  std::string fold_file;   // in folds/ ("" before its first fold)
+  bool used = true;        // enough samples to be fitted
+  bool dirty = true;       // to fold at its point
+  bool folded = false;     // folded in this run
+  bool has_fold = false;
+  WindowFold fold;
+  std::vector<double> theta;  // its point, per column (SI)
+  std::string StoreName() const { return label + ".samples"; }
+};
+
+// A value of b: shared column `column` (index into TrackLayout::shared_columns) for the
+// windows that start at or after from_s (until the next entry of the same column): a
+// bias split by a sensor step has one entry per stretch.
+struct SharedEntry {
+  int column = 0;
+  double from_s = -std::numeric_limits<double>::infinity();
+  double value_si = 0.0;
+  // A sensor bias's entry for the one window whose telemetry holds its step (the sensor
+  // re-zeroed inside the window: its readings are of both values): the event is between
+  // the entries before and after it, timed at the step's block (its first sample and the
+  // block before's last).
+  bool inside = false;
+  double step_time_s = 0.0, step_previous_s = 0.0;
+};
+
+struct TrackRun {
+  TrackRun(const CableRobot& m, const CalibrationSpec& s, const WindowSpec& w, const std::string& o,
+           const TrackOptions& opt, TrackResult* r, std::string* e)
+      : model(m), spec(s), window(w), out(o), options(opt), result(r), error(e) {}
+
+  const CableRobot& model;
+  const CalibrationSpec& spec;
+  const WindowSpec& window;
+  std::string out;  // the track's DIR
+  const TrackOptions& options;
+  TrackResult* result;
+  std::string* error;
+
+  std::vector<std::string> data_paths;  // the files given (directories expanded)
+  std::string dir;      // where this run writes: a staging directory, or DIR on an update
+  bool update = false;  // DIR held a track
+  int generation = 0;   // of this run's fold files
+  std::string model_yaml, spec_yaml;
+  std::string columns_text;  // the column map the files are read through ("" none)
+  TrackLayout layout;
+  std::vector<TrackFile> files;
+  std::vector<TrackWindowState> windows;  // time order
+  std::vector<SharedEntry> shared;        // b, in column order then stretch order
+  std::vector<double> consider_si;        // per consider column
+  SlowErrorProcess slow;
+  double gross_threshold_sigmas = 5.0;
+  // Store files appended to in this run, with their size before (rolled back on failure).
+  std::vector<std::pair<std::string, long long>> appended;
+  // The solve over the used windows (indices into `windows`).
+  std::vector<int> used;
+  ArrowProblem problem;
+  ArrowSolver solver;
+  // Window w's (index into `used`) shared column j -> entry of b.
+  std::vector<std::vector<int>> entry_of;
+  std::vector<std::string> files_skipped;
+  // After the solve: per used window its widening f_w, and the consider parameters'
+  // M^-1 C (C = J_x^T J_c) and sigmas (SI).
+  std::vector<double> widening;
+  std::vector<double> birge;  // its misfit part alone
+  // The shared entries split by the sensor-step scan in this run (indices into `shared`).
+  std::vector<int> splits;
+  ArrowVector consider_x;
+  Eigen::VectorXd consider_sigma;
+
+  TrackStatus Fail(TrackStatus status, const std::string& why) const {
+    *error = why;
+    return status;
+  }
+  void Progress(const std::string& line) const {
+    if (options.progress) options.progress(line);
+  }
+  std::string Path(const std::string& name) const { return dir + "/" + name; }
+};
+
+// "2024-05-01T12:00:00Z" for a Unix time (the fraction when there is one), else the
+// seconds as a number.
+std::string TrackTimeText(double time_s);
+// The window's label from its key (track.h, TrackWindow::label).
+std::string WindowLabel(const WindowSpec& window, double start_s);
+
+// Stages of track_data.cc.
+TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<std::string>* out,
+                            std::string* error);
+TrackStatus PrepareDirectory(TrackRun& run);
+TrackStatus ReadNewFiles(TrackRun& run);
+TrackStatus SaveState(TrackRun& run);
+TrackStatus FinishDirectory(TrackRun& run);
+void RollBack(TrackRun& run);
+bool LoadFold(const TrackRun& run, TrackWindowState* w, std::string* error);
+
+// Stages of track_solve.cc.
+void InitialPoints(TrackRun& run);
+TrackStatus Iterate(TrackRun& run, bool estimate_slow_error);
+// A last fold of the moving windows at the solution with the consider parameters'
+// columns too (the iterations fold without them: narrower derivatives, the same fit),
+// and the solve over it.
+TrackStatus FoldConsider(TrackRun& run);
+TrackStatus Uncertainties(TrackRun& run);
+// Used window u's solution minus its fold's point, per column (fold order).
+Eigen::VectorXd StepOf(const TrackRun& run, int u);
+// Its fold's gradient at the solution, g + H d (fold order).
+Eigen::VectorXd GradientAtSolution(const TrackRun& run, int u);
+// The local order [a; s] of the block-arrow problem: fold columns of the window's own
+// parameters, then of the shared ones.
+std::vector<int> LocalOrder(const TrackRun& run);
+// c^T M^-1 c for a new parameter's cross information with the track's: per used window
+// its column over the window's local order (empty: none).
+double InverseQuadratic(const TrackRun& run, const std::vector<Eigen::VectorXd>& local);
+// The entry of b that shared column j takes in run.windows[w].
+int EntryOf(const TrackRun& run, int j, int w);
+// The total covariance (sandwich and consider) of the window parameters of used windows
+// u and v.
+Eigen::MatrixXd TotalCovariance(const TrackRun& run, int u, int v);
+
+// Stage helper of track_uncertainty.cc: each used window's widening f_w (run.widening,
+// and the problem's block scales).
+void ComputeWidening(TrackRun& run);
+
+// Stages of track_events.cc.
+TrackStatus ScanSensorSteps(TrackRun& run);
+TrackStatus FindParameterEvents(TrackRun& run);
+
+// Stages of track_output.cc.
+TrackStatus BuildModels(TrackRun& run);
+TrackStatus WriteOutputs(TrackRun& run);
+std::string TrackHtml(const TrackResult& result);
+
+}  // namespace fastcal::internal
+
+#endif  // FASTCAL_SRC_TRACK_TRACK_RUN_H_

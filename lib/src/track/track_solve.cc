@@ -1,0 +1,534 @@
+// The track's fit (track.h): folds run locally or by the caller's runner, the block-arrow
+// solve over them, Gauss-Newton with the slow error re-estimated, and the uncertainties.
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <filesystem>
+#include <thread>
+
+#include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/calibration_slow_error.h"
+#include "fastcal/internal/number_text.h"
+#include "fastcal/internal/slow_error_estimate.h"
+#include "track/track_run.h"
+
+namespace fastcal::internal {
+namespace {
+
+// Step halvings after a step that raised the chi-square or left the model's range.
+constexpr int kMaxHalvings = 6;
+// Residual samples per window for the slow error's estimate: at least, at most.
+constexpr int kMinResidualRun = 100;
+constexpr int kMaxResidualRun = 5000;
+
+// How much a Gauss-Newton step may raise the chi-square before it is halved: the weights
+// follow the predicted readings (iteratively reweighted least squares), so near the
+// solution the chi-square moves by about a part in 10^6 either way.
+double ChiSquareSlack(double chi2) { return std::max(1.0, 1e-6 * chi2); }
+
+// The windows folded this run and whose points move (the others keep their folds).
+bool Moving(const TrackRun& run, const TrackWindowState& w) {
+  return !run.update || run.options.refold_all || w.folded || !w.has_fold;
+}
+
+// The task of window w: its point over every column, or (without `consider`) over the
+// fitted columns alone, the consider parameters then fixed at their values.
+FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_run, bool consider) {
+  FoldTask t;
+  t.label = w.label;
+  // Absolute: a worker of a Dask cluster may run in another directory.
+  std::error_code ec;
+  t.samples_path = std::filesystem::absolute(run.Path("windows/" + w.StoreName()), ec).string();
+  for (int f : w.files) t.files.resize(std::max<size_t>(t.files.size(), f + 1));
+  for (int f : w.files) t.files[f] = run.files[f].path;
+  t.model_yaml = run.model_yaml;
+  t.parameters = run.layout.parameters;
+  for (int k = 0; k < run.layout.size(); ++k) {
+    if (!consider && run.layout.roles[k] == FoldRole::kConsider) {
+      t.parameters[run.layout.spec_index[k]].free = false;
+      continue;
+    }
+    t.roles.push_back(run.layout.roles[k]);
+    t.theta_si.push_back(w.theta[k]);
+  }
+  t.forward_model = run.spec.forward_model;
+  t.tension_sigma_n = run.spec.tension_sigma_n;
+  t.tension_sigma_percent = run.spec.tension_sigma_percent;
+  t.detect_gross_errors = run.spec.detect_gross_errors;
+  t.gross_error_threshold_sigmas = run.gross_threshold_sigmas;
+  t.slow_error = run.slow;
+  t.blocks = run.options.blocks;
+  t.residual_samples = residual_run;
+  return t;
+}
+
+// Runs the tasks on this machine's threads, a window per thread (a lone window on all).
+bool LocalRunner(int threads, const std::vector<std::string>& tasks,
+                 std::vector<std::string>* folds, std::string* error) {
+  folds->assign(tasks.size(), std::string());
+  std::vector<std::string> errors(tasks.size());
+  std::atomic<size_t> next{0};
+  const int workers = std::max(1, std::min<int>(threads, static_cast<int>(tasks.size())));
+  const int inner = std::max(1, threads / workers);
+  const auto work = [&] {
+    for (size_t k = next++; k < tasks.size(); k = next++) {
+      FoldTask task;
+      std::string bytes = tasks[k];
+      if (inner > 1 && ParseFoldTask(tasks[k], &task, &errors[k])) {
+        task.threads = inner;
+        bytes = SerializeFoldTask(task);
+      }
+      if (!RunFoldTask(bytes, &(*folds)[k], &errors[k]) && errors[k].empty()) {
+        errors[k] = "fold failed";
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  for (int t = 1; t < workers; ++t) pool.emplace_back(work);
+  work();
+  for (std::thread& t : pool) t.join();
+  for (size_t k = 0; k < tasks.size(); ++k) {
+    if ((*folds)[k].empty()) {
+      *error = errors[k];
+      return false;
+    }
+  }
+  return true;
+}
+
+int ResidualRun(const TrackRun& run) {
+  const int used = std::max<int>(1, static_cast<int>(run.used.size()));
+  return std::clamp(run.options.slow_error_samples / used, kMinResidualRun, kMaxResidualRun);
+}
+
+// A fold without the consider columns laid out over every column: theirs zero (they are
+// used only after the final pass, which folds them). False when the fold is not of the
+// layout.
+bool ExpandToLayout(const TrackRun& run, WindowFold* f) {
+  const int n = run.layout.size();
+  const int m = static_cast<int>(f->columns.size());
+  if (m == n) return true;
+  std::vector<int> from(n, -1);  // layout column -> fold column
+  int next = 0;
+  for (int k = 0; k < n; ++k) {
+    if (run.layout.roles[k] == FoldRole::kConsider) continue;
+    if (next >= m || f->columns[next] != run.layout.Column(k).name) return false;
+    from[k] = next++;
+  }
+  if (next != m) return false;
+  WindowFold x = *f;
+  x.columns.clear();
+  x.roles = run.layout.roles;
+  x.theta_si.assign(n, 0.0);
+  x.information = Eigen::MatrixXd::Zero(n, n);
+  x.gradient = Eigen::VectorXd::Zero(n);
+  x.block_scores = Eigen::MatrixXd::Zero(f->block_scores.rows(), n);
+  for (Eigen::MatrixXd& rows : x.block_information) rows = Eigen::MatrixXd::Zero(rows.rows(), n);
+  for (int k = 0, c = 0; k < n; ++k) {
+    x.columns.push_back(run.layout.Column(k).name);
+    if (from[k] < 0) {
+      x.theta_si[k] = run.consider_si[c++];
+      continue;
+    }
+    x.theta_si[k] = f->theta_si[from[k]];
+    x.gradient[k] = f->gradient[from[k]];
+    x.block_scores.col(k) = f->block_scores.col(from[k]);
+    for (size_t b = 0; b < x.block_information.size(); ++b) {
+      x.block_information[b].col(k) = f->block_information[b].col(from[k]);
+    }
+    for (int l = 0; l < n; ++l) {
+      if (from[l] >= 0) x.information(k, l) = f->information(from[k], from[l]);
+    }
+  }
+  *f = std::move(x);
+  return true;
+}
+
+// Folds every dirty used window at its point (with the consider columns when `consider`).
+bool FoldDirty(TrackRun& run, bool consider = false) {
+  std::vector<int> which;
+  std::vector<std::string> tasks;
+  const int residual_run = ResidualRun(run);
+  for (int w : run.used) {
+    if (!run.windows[w].dirty) continue;
+    which.push_back(w);
+    tasks.push_back(SerializeFoldTask(TaskFor(run, run.windows[w], residual_run, consider)));
+  }
+  if (tasks.empty()) return true;
+  run.Progress("folding " + std::to_string(tasks.size()) + " window" +
+               (tasks.size() == 1 ? "" : "s"));
+  std::vector<std::string> folds;
+  const bool ok = run.options.runner ? run.options.runner(tasks, &folds, run.error)
+                                     : LocalRunner(run.options.threads, tasks, &folds, run.error);
+  if (!ok) return false;
+  if (folds.size() != tasks.size()) {
+    *run.error = "the fold runner returned " + std::to_string(folds.size()) + " folds for " +
+                 std::to_string(tasks.size()) + " windows";
+    return false;
+  }
+  for (size_t k = 0; k < which.size(); ++k) {
+    TrackWindowState& w = run.windows[which[k]];
+    if (!ParseWindowFold(folds[k], "the fold of window " + w.label, &w.fold, run.error)) {
+      return false;
+    }
+    if (!ExpandToLayout(run, &w.fold) || w.fold.theta_si != w.theta) {
+      *run.error = "the fold of window " + w.label + " is not of the task sent";
+      return false;
+    }
+    w.has_fold = true;
+    w.dirty = false;
+    w.folded = true;
+    ++run.result->folds;
+  }
+  return true;
+}
+
+// The problem over the used windows' folds, with the current entries of b.
+void BuildProblem(TrackRun& run) {
+  const std::vector<int> order = LocalOrder(run);
+  const int p = static_cast<int>(run.layout.window_columns.size());
+  const int m = static_cast<int>(run.layout.shared_columns.size());
+  ArrowProblem& problem = run.problem;
+  problem = ArrowProblem();
+  problem.q = static_cast<int>(run.shared.size());
+  problem.shared_prior_information = Eigen::VectorXd::Zero(problem.q);
+  problem.shared_prior_mean = Eigen::VectorXd::Zero(problem.q);
+  for (int e = 0; e < problem.q; ++e) {
+    const ParameterSpec& s = run.layout.Column(run.layout.shared_columns[run.shared[e].column]);
+    if (!s.has_prior) continue;
+    problem.shared_prior_information[e] = 1.0 / (s.prior_sigma_si * s.prior_sigma_si);
+    problem.shared_prior_mean[e] = s.prior_mean_si;
+  }
+  run.entry_of.assign(run.used.size(), {});
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    const WindowFold& f = run.windows[run.used[u]].fold;
+    ArrowBlock k;
+    k.p = p;
+    k.h.resize(p + m, p + m);
+    k.g.resize(p + m);
+    k.x0.resize(p + m);
+    for (int r = 0; r < p + m; ++r) {
+      k.g[r] = f.gradient[order[r]];
+      k.x0[r] = f.theta_si[order[r]];
+      for (int c = 0; c < p + m; ++c) k.h(r, c) = f.information(order[r], order[c]);
+    }
+    k.c = f.chi_square;
+    k.prior_information = Eigen::VectorXd::Zero(p);
+    k.prior_mean = Eigen::VectorXd::Zero(p);
+    for (int a = 0; a < p; ++a) {
+      const ParameterSpec& s = run.layout.Column(run.layout.window_columns[a]);
+      if (!s.has_prior) continue;
+      k.prior_information[a] = 1.0 / (s.prior_sigma_si * s.prior_sigma_si);
+      k.prior_mean[a] = s.prior_mean_si;
+    }
+    for (int j = 0; j < m; ++j) {
+      k.shared_index.push_back(EntryOf(run, j, run.used[u]));
+      run.entry_of[u].push_back(k.shared_index.back());
+    }
+    problem.blocks.push_back(std::move(k));
+  }
+}
+
+// The window whose own parameters (or the shared ones) the folds cannot determine.
+std::string Undetermined(const TrackRun& run) {
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    const ArrowBlock& k = run.problem.blocks[u];
+    Eigen::MatrixXd a = k.h.topLeftCorner(k.p, k.p);
+    a.diagonal() += k.prior_information;
+    if (Eigen::LLT<Eigen::MatrixXd>(a).info() != Eigen::Success) {
+      return "window " + run.windows[run.used[u]].label + " (" +
+             std::to_string(run.windows[run.used[u]].samples) +
+             " samples) cannot determine its own parameters: its poses do not separate them; "
+             "raise TrackOptions::min_window_samples (--min-window-samples) to leave such "
+             "windows out, or give them priors";
+    }
+  }
+  return "the windows together cannot determine the shared parameters: fix some, or give "
+         "them priors";
+}
+
+// The chi-square of the folds at their points, with the priors there.
+double PointChiSquare(const TrackRun& run) {
+  double chi2 = 0.0;
+  for (int w : run.used) {
+    const WindowFold& f = run.windows[w].fold;
+    chi2 += f.chi_square;
+    for (int k : run.layout.window_columns) {
+      const ParameterSpec& s = run.layout.Column(k);
+      if (!s.has_prior) continue;
+      const double d = (f.theta_si[k] - s.prior_mean_si) / s.prior_sigma_si;
+      chi2 += d * d;
+    }
+  }
+  for (const SharedEntry& e : run.shared) {
+    const ParameterSpec& s = run.layout.Column(run.layout.shared_columns[e.column]);
+    if (!s.has_prior) continue;
+    const double d = (e.value_si - s.prior_mean_si) / s.prior_sigma_si;
+    chi2 += d * d;
+  }
+  return chi2;
+}
+
+// Sets used window w's point from the solution (its own parameters, b, the consider ones).
+void PointFromSolution(TrackRun& run, int u, std::vector<double>* theta) {
+  const std::vector<int> order = LocalOrder(run);
+  const Eigen::VectorXd x = run.solver.LocalSolution(u);
+  for (size_t r = 0; r < order.size(); ++r) (*theta)[order[r]] = x[r];
+}
+
+// The largest step of the moving windows and of b over its formal sigma.
+double LargestStep(const TrackRun& run) {
+  double largest = 0.0;
+  const Eigen::VectorXd b_sigma = run.solver.FormalBB().diagonal().cwiseSqrt();
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    const TrackWindowState& w = run.windows[run.used[u]];
+    if (!Moving(run, w)) continue;
+    const Eigen::VectorXd a_sigma = run.solver.FormalAA(u, u).diagonal().cwiseSqrt();
+    const ArrowBlock& k = run.problem.blocks[u];
+    for (int a = 0; a < k.p; ++a) {
+      largest = std::max(largest, std::abs(run.solver.a(u)[a] - k.x0[a]) / a_sigma[a]);
+    }
+    for (int j = 0; j < k.m(); ++j) {
+      const int e = k.shared_index[j];
+      largest = std::max(largest, std::abs(run.solver.b()[e] - k.x0[k.p + j]) / b_sigma[e]);
+    }
+  }
+  return largest;
+}
+
+// The slow error from the folds' residual runs (each window its own series); true when
+// the process the folds used stands.
+bool ReestimateSlowError(TrackRun& run) {
+  SlowErrorEstimateInputs in;
+  in.spec = run.spec.slow_error;
+  for (int k : run.layout.shared_columns) {
+    in.gain_nuisance = in.gain_nuisance || run.layout.Column(k).kind == ParameterKind::kSensorGain;
+  }
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    for (const FoldResidual& r : run.windows[run.used[u]].fold.residuals) {
+      SlowErrorSample s;
+      s.time_s = r.time_s;
+      s.session = static_cast<int>(u);
+      s.x = r.x;
+      s.sigma_n = r.sigma_n;
+      s.reading_n = r.reading_n;
+      s.excluded = r.excluded;
+      in.samples.push_back(s);
+    }
+  }
+  const bool settled =
+      AdoptSlowErrorEstimate(EstimateSlowError(in), true, &run.slow, &run.result->slow_error);
+  run.Progress("slow error: " + DescribeSlowError(run.result->slow_error));
+  return settled;
+}
+
+void MarkMovingDirty(TrackRun& run) {
+  for (int w : run.used) {
+    if (Moving(run, run.windows[w])) run.windows[w].dirty = true;
+  }
+}
+
+}  // namespace
+
+std::vector<int> LocalOrder(const TrackRun& run) {
+  std::vector<int> order = run.layout.window_columns;
+  order.insert(order.end(), run.layout.shared_columns.begin(), run.layout.shared_columns.end());
+  return order;
+}
+
+int EntryOf(const TrackRun& run, int j, int w) {
+  int best = -1;
+  for (size_t e = 0; e < run.shared.size(); ++e) {
+    const SharedEntry& s = run.shared[e];
+    if (s.column != j || s.from_s > run.windows[w].start_s) continue;
+    if (best < 0 || s.from_s > run.shared[best].from_s) best = static_cast<int>(e);
+  }
+  return best;
+}
+
+void InitialPoints(TrackRun& run) {
+  CalibrationSpec spec = run.spec;
+  spec.parameters = run.layout.parameters;
+  const CalibrationModel cm(run.model, spec);
+  const std::vector<double> initial = cm.InitialTheta();
+  if (run.shared.empty()) {
+    for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+      SharedEntry e;
+      e.column = static_cast<int>(j);
+      e.value_si = initial[run.layout.shared_columns[j]];
+      run.shared.push_back(e);
+    }
+  }
+  run.consider_si.clear();
+  for (int k : run.layout.consider_columns) run.consider_si.push_back(initial[k]);
+  run.used.clear();
+  const std::vector<double>* previous = nullptr;  // the window before's own values
+  for (size_t w = 0; w < run.windows.size(); ++w) {
+    TrackWindowState& win = run.windows[w];
+    win.used = win.samples >= run.options.min_window_samples;
+    if (!win.used) {
+      run.result->notes.push_back(
+          "window " + win.label + " left out: " + std::to_string(win.samples) +
+          " samples, fewer than " + std::to_string(run.options.min_window_samples));
+      continue;
+    }
+    run.used.push_back(static_cast<int>(w));
+    if (win.dirty || run.options.refold_all) {
+      // A new window starts from the one before it (days follow each other).
+      std::vector<double> theta = win.has_fold          ? win.fold.theta_si
+                                  : previous != nullptr ? *previous
+                                                        : initial;
+      for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+        theta[run.layout.shared_columns[j]] = run.shared[EntryOf(run, j, w)].value_si;
+      }
+      for (size_t c = 0; c < run.layout.consider_columns.size(); ++c) {
+        theta[run.layout.consider_columns[c]] = run.consider_si[c];
+      }
+      win.theta = theta;
+      win.dirty = true;
+    }
+    previous = &win.theta;
+  }
+}
+
+TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
+  if (run.used.empty()) {
+    return run.Fail(
+        TrackStatus::kInvalidInput,
+        "no window has " + std::to_string(run.options.min_window_samples) + " samples or more");
+  }
+  bool slow_settled = !estimate_slow_error || !run.spec.slow_error.estimates_any() || run.update;
+  if (run.update && run.spec.slow_error.estimates_any() && estimate_slow_error) {
+    run.result->slow_error.enabled = true;
+    run.result->slow_error.process = run.slow;
+    run.result->notes.push_back(
+        "an update keeps the slow error the track was built with (refold_all re-estimates it)");
+    slow_settled = !run.options.refold_all;
+  }
+  run.result->slow_error.enabled = run.spec.slow_error.enabled;
+  if (!run.spec.slow_error.estimates_any()) run.slow = run.spec.slow_error.Initial();
+  if (run.result->folds == 0 && !run.update) run.slow = run.spec.slow_error.Initial();
+  run.result->slow_error.process = run.slow;
+  double previous_chi2 = std::numeric_limits<double>::infinity();
+  std::vector<std::vector<double>> previous_theta(run.windows.size());
+  int halvings = 0;
+  for (int it = 1; it <= run.options.max_iterations; ++it) {
+    ++run.result->iterations;
+    const bool folded = FoldDirty(run);
+    const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
+    if ((!folded || chi2 > previous_chi2 + ChiSquareSlack(previous_chi2)) &&
+        halvings < kMaxHalvings && std::isfinite(previous_chi2)) {
+      // Back half way to the previous point.
+      for (int w : run.used) {
+        TrackWindowState& win = run.windows[w];
+        if (!Moving(run, win)) continue;
+        for (size_t k = 0; k < win.theta.size(); ++k) {
+          win.theta[k] = 0.5 * (win.theta[k] + previous_theta[w][k]);
+        }
+        win.dirty = true;
+      }
+      ++halvings;
+      run.Progress("step halved (chi-square " + FormatDouble("%.6g", chi2) + ")");
+      continue;
+    }
+    if (!folded) return TrackStatus::kInfeasible;
+    halvings = 0;
+    bool process_changed = false;
+    // The first fold's point is the initial model: its residuals are mostly the model's
+    // error, not the sensors' (calibrate likewise estimates after its first fit).
+    if (!slow_settled && it > 1) {
+      slow_settled = ReestimateSlowError(run);
+      process_changed = !slow_settled;
+    }
+    BuildProblem(run);
+    if (!run.solver.Solve(run.problem)) {
+      return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
+    }
+    const double step = LargestStep(run);
+    run.Progress("iteration " + std::to_string(run.result->iterations) + ": chi-square " +
+                 FormatDouble("%.9g", chi2) + " -> " +
+                 FormatDouble("%.9g", run.solver.ChiSquare()) + ", largest step " +
+                 FormatDouble("%.3g", step) + " sigma");
+    for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
+    if (step < run.options.step_tolerance_sigmas && slow_settled && !process_changed) {
+      run.result->converged = true;
+      return TrackStatus::kOk;
+    }
+    previous_chi2 = process_changed ? std::numeric_limits<double>::infinity() : chi2;
+    for (size_t u = 0; u < run.used.size(); ++u) {
+      TrackWindowState& win = run.windows[run.used[u]];
+      if (!Moving(run, win)) continue;
+      previous_theta[run.used[u]] = win.theta;
+      PointFromSolution(run, static_cast<int>(u), &win.theta);
+    }
+    MarkMovingDirty(run);
+  }
+  run.result->notes.push_back("Gauss-Newton did not converge in " +
+                              std::to_string(run.options.max_iterations) +
+                              " iterations: the estimates are the last step's");
+  // The last solve stands; the windows' points are its folds'.
+  for (int w : run.used) run.windows[w].dirty = false;
+  BuildProblem(run);
+  if (!run.solver.Solve(run.problem))
+    return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
+  return TrackStatus::kOk;
+}
+
+TrackStatus FoldConsider(TrackRun& run) {
+  if (run.layout.consider_columns.empty()) return TrackStatus::kOk;
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    TrackWindowState& w = run.windows[run.used[u]];
+    if (!Moving(run, w)) continue;
+    PointFromSolution(run, static_cast<int>(u), &w.theta);
+    w.dirty = true;
+  }
+  run.Progress("the consider parameters' columns, at the solution:");
+  if (!FoldDirty(run, true)) return TrackStatus::kInfeasible;
+  BuildProblem(run);
+  if (!run.solver.Solve(run.problem))
+    return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
+  for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
+  return TrackStatus::kOk;
+}
+
+Eigen::VectorXd StepOf(const TrackRun& run, int u) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  const std::vector<int> order = LocalOrder(run);
+  const Eigen::VectorXd x = run.solver.LocalSolution(u);
+  Eigen::VectorXd d = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(f.theta_si.size()));
+  for (size_t r = 0; r < order.size(); ++r) d[order[r]] = x[r] - f.theta_si[order[r]];
+  return d;
+}
+
+Eigen::VectorXd GradientAtSolution(const TrackRun& run, int u) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  return f.gradient + f.information * StepOf(run, u);
+}
+
+double InverseQuadratic(const TrackRun& run, const std::vector<Eigen::VectorXd>& local) {
+  ArrowVector c;
+  c.b = Eigen::MatrixXd::Zero(run.problem.q, 1);
+  c.a.assign(run.used.size(), Eigen::MatrixXd());
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    const ArrowBlock& k = run.problem.blocks[u];
+    c.a[u] = Eigen::MatrixXd::Zero(k.p, 1);
+    if (local[u].size() == 0) continue;
+    c.a[u].col(0) = local[u].head(k.p);
+    for (int j = 0; j < k.m(); ++j) c.b(k.shared_index[j], 0) += local[u][k.p + j];
+  }
+  const ArrowVector x = run.solver.SolveFor(c);
+  double value = (c.b.transpose() * x.b)(0, 0);
+  for (size_t u = 0; u < run.used.size(); ++u) value += (c.a[u].transpose() * x.a[u])(0, 0);
+  return value;
+}
+
+Eigen::MatrixXd TotalCovariance(const TrackRun& run, int u, int v) {
+  Eigen::MatrixXd p = run.solver.SandwichAA(u, v);
+  if (run.consider_sigma.size() > 0) {
+    const Eigen::MatrixXd s2 = run.consider_sigma.cwiseAbs2().asDiagonal();
+    p += run.consider_x.a[u] * s2 * run.consider_x.a[v].transpose();
+  }
+  return p;
+}
+
+}  // namespace fastcal::internal

@@ -1,0 +1,155 @@
+// End-to-end tests of `fastcal track` and the season flags of `fastcal simulate` as a user
+// runs them (issue 27): a simulated season's move and re-zeroed sensor found, the files
+// written, a new day's file updating the track, bad flags and directories refused with
+// the flag named and nothing left behind.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "cli_fixture.h"
+
+namespace fastcal {
+namespace {
+
+namespace fs = std::filesystem;
+using test::Fastcal;
+using test::ReadFile;
+using test::Source;
+
+// A week from 2024-05-01T20:00:00Z, 240 samples a day 20 s apart, the mass centre moved
+// before the third day's telemetry and cable 2's sensor re-zeroed (+5 kN) before the
+// sixth's; the season of the issue's tests.
+constexpr char kSeasonFlags[] =
+    " --trajectory=random --samples=1680 --days=7 --interval-s=20 --start=1714593600"
+    " --mass-centre=0.22,0.11,0.5 --tension-drift-percent=1 --tension-drift-time-s=120"
+    " --sensor-gain-spread-percent=1 --sensor-bias-spread-kN=1.5 --seed=4"
+    " --mass-centre-step=1714762800:0.05,0,0 --sensor-step=1715022000:2:5";
+
+class CliTrackTest : public test::CliTest {
+ protected:
+  std::string Spec() const { return Source() + "/calibration_data/spec_track.yaml"; }
+};
+
+TEST_F(CliTrackTest, SeasonMoveAndReZeroedSensorAreFoundAndWritten) {
+  const auto sim = Fastcal("simulate" + std::string(kSeasonFlags) + " --out=" + Path("s.csv"));
+  ASSERT_EQ(sim.code, 0) << sim.output;
+  EXPECT_EQ(ReadFile(Path("s.csv")).find(",session"), std::string::npos);  // days, no sessions
+  const auto run = Fastcal("track --quiet --spec=" + Spec() + " --data=" + Path("s.csv") +
+                           " --out=" + Path("t"));
+  ASSERT_EQ(run.code, 0) << run.output;
+  EXPECT_NE(run.output.find("7 windows of 1d (2024-05-01 to 2024-05-07)"), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("Events (events.json; each kind at a 1% false-alarm rate over the "
+                            "track): 2"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("2024-05-03  parameter: mass_centre_m.x +0.0"), std::string::npos)
+      << run.output;
+  EXPECT_NE(run.output.find("2024-05-06  sensor (cable 2): sensor_bias_kN[2] +"), std::string::npos)
+      << run.output;
+  const std::string csv = ReadFile(Path("t/track.csv"));
+  EXPECT_EQ(csv.rfind("window_start,window_end,samples,mass_centre_m.x,", 0), 0u);
+  EXPECT_NE(csv.find("\n2024-05-07T00:00:00Z,2024-05-08T00:00:00Z,240,"), std::string::npos);
+  const std::string events = ReadFile(Path("t/events.json"));
+  EXPECT_NE(events.find("\"time\": \"2024-05-03T20:00:00Z\""), std::string::npos) << events;
+  EXPECT_NE(events.find("\"cables\": [2]"), std::string::npos) << events;
+  EXPECT_TRUE(fs::exists(Path("t/model_calibrated@2024-05-07.yaml")));
+  EXPECT_TRUE(fs::exists(Path("t/track.html")));
+  // The latest model loads into the other commands.
+  const auto solve = Fastcal("solve --model=" + Path("t/model_calibrated@2024-05-07.yaml") +
+                             " --position=0,0,140");
+  EXPECT_EQ(solve.code, 0) << solve.output;
+}
+
+TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
+  // Two files of a three-day season: the first two days, then the third.
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=480 --days=2 --interval-s=20 "
+                    "--start=1714593600 --seed=3 --out=" +
+                    Path("a.csv"))
+                .code,
+            0);
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=240 --days=1 --interval-s=20 "
+                    "--start=1714766400 --seed=5 --out=" +
+                    Path("b.csv"))
+                .code,
+            0);
+  const std::string track = "track --quiet --spec=" + Spec() + " --out=" + Path("t");
+  const auto first = Fastcal(track + " --data=" + Path("a.csv"));
+  ASSERT_EQ(first.code, 0) << first.output;
+  EXPECT_NE(first.output.find("2 windows"), std::string::npos) << first.output;
+  const auto second = Fastcal(track + " --data=" + Path("a.csv") + "," + Path("b.csv"));
+  ASSERT_EQ(second.code, 0) << second.output;
+  EXPECT_NE(second.output.find("3 windows"), std::string::npos) << second.output;
+  EXPECT_NE(second.output.find("(an update)"), std::string::npos) << second.output;
+  EXPECT_NE(second.output.find("1 new file added"), std::string::npos) << second.output;
+  // A file of the track left out is refused, the track kept.
+  const auto missing = Fastcal(track + " --data=" + Path("b.csv"));
+  EXPECT_EQ(missing.code, 2) << missing.output;
+  EXPECT_NE(missing.output.find("a.csv, not given now"), std::string::npos) << missing.output;
+  EXPECT_NE(ReadFile(Path("t/track.csv")).find("2024-05-03"), std::string::npos);
+  // Another window length: refused unless --force.
+  const auto other = Fastcal(track + " --window=12h --data=" + Path("a.csv") + "," + Path("b.csv"));
+  EXPECT_EQ(other.code, 2) << other.output;
+  EXPECT_NE(other.output.find("--force"), std::string::npos) << other.output;
+}
+
+// An export as it comes (FAST's: Beijing time, decimal commas, mm and N) tracked through
+// its column map: the day in UTC, the numbers of the canonical survey; an update must read
+// the files through the same map.
+TEST_F(CliTrackTest, AnExportIsTrackedThroughItsColumnMap) {
+  const std::string data = Source() + "/calibration_data/fast_export.csv";
+  const std::string map = Source() + "/calibration_data/fast_export.columns.yaml";
+  const std::string track = "track --quiet --spec=" + Spec() + " --out=" + Path("t");
+  const auto run = Fastcal(track + " --data=" + data + " --columns=" + map);
+  ASSERT_EQ(run.code, 0) << run.output;
+  EXPECT_NE(run.output.find("1 windows of 1d (2024-05-01 to 2024-05-01), 1441 samples"),
+            std::string::npos)
+      << run.output;
+  EXPECT_NE(ReadFile(Path("t/track.csv")).find("\n2024-05-01T00:00:00Z,2024-05-02T00:00:00Z,1441,"),
+            std::string::npos);
+  // The same file without its map is not the track's.
+  const auto without = Fastcal(track + " --data=" + data);
+  EXPECT_EQ(without.code, 2) << without.output;
+  EXPECT_NE(without.output.find("column map"), std::string::npos) << without.output;
+}
+
+TEST_F(CliTrackTest, BadFlagsAndDirectoriesAreRefused) {
+  const auto help = Fastcal("track --help");
+  EXPECT_EQ(help.code, 0);
+  EXPECT_NE(help.output.find("--window=1d"), std::string::npos);
+  EXPECT_EQ(Fastcal("track --spec=" + Spec() + " --data=x.csv").code, 2);  // no --out
+  const auto unknown = Fastcal("track --windows=1d");
+  EXPECT_EQ(unknown.code, 2);
+  EXPECT_NE(unknown.output.find("--windows"), std::string::npos) << unknown.output;
+  const auto window =
+      Fastcal("track --spec=" + Spec() + " --data=x.csv --out=" + Path("t") + " --window=1.5d");
+  EXPECT_EQ(window.code, 2);
+  EXPECT_NE(window.output.find("--window '1.5d'"), std::string::npos) << window.output;
+  const auto missing =
+      Fastcal("track --spec=" + Spec() + " --data=" + Path("none.csv") + " --out=" + Path("t"));
+  EXPECT_EQ(missing.code, 2);
+  EXPECT_NE(missing.output.find("none.csv"), std::string::npos) << missing.output;
+  EXPECT_FALSE(fs::exists(Path("t")));
+  // A directory holding something else.
+  fs::create_directories(Path("busy"));
+  std::ofstream(Path("busy/notes.txt")) << "mine";
+  const auto busy =
+      Fastcal("track --spec=" + Spec() + " --data=" + Path("none.csv") + " --out=" + Path("busy"));
+  EXPECT_EQ(busy.code, 2);
+  EXPECT_NE(busy.output.find("holds no track"), std::string::npos) << busy.output;
+  EXPECT_TRUE(fs::exists(Path("busy/notes.txt")));
+  // The season flags of simulate.
+  const auto days =
+      Fastcal("simulate --trajectory=random --samples=100 --days=3 --out=" + Path("d.csv"));
+  EXPECT_EQ(days.code, 2);
+  EXPECT_NE(days.output.find("--days=3"), std::string::npos) << days.output;
+  const auto step = Fastcal(
+      "simulate --trajectory=random --samples=100 --sensor-step=5:7:1 --out=" + Path("d.csv"));
+  EXPECT_EQ(step.code, 2);
+  EXPECT_NE(step.output.find("--sensor-step needs T:CABLE:DKN"), std::string::npos) << step.output;
+}
+
+}  // namespace
+}  // namespace fastcal

@@ -1,0 +1,236 @@
+// The fold of a window (track_fold.h) and the window store (internal/window_store.h):
+// the gradient against numeric differentiation of the fold's own chi-square, the blocks
+// summing to the whole, the same bytes on any number of threads, the bytes' round trip
+// and their refusal when corrupt, gross errors named, an unsolvable pose named.
+#include "fastcal/track_fold.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "fastcal/calibration_spec.h"
+#include "fastcal/internal/window_store.h"
+#include "fastcal/simulation.h"
+#include "fastcal/trajectory.h"
+#include "random_cap_poses.h"
+
+namespace fastcal {
+namespace {
+
+// A spec whose noise is absolute (the weights do not move with the point, so the fold's
+// chi-square is one smooth function of theta) and whose slow error is stated (whitening
+// included, fixed).
+constexpr char kSpec[] = R"(format: fastcal-calibration-spec-1
+noise:
+  tension_sigma_kN: 5
+  tension_sigma_percent: 0
+  slow_error: {sigma_kN: 3, time_constant_s: 60}
+gross_errors: {detect: false}
+parameters:
+  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}
+  linear_density_kg_per_m: {mode: common, free: true}
+  sensor_bias_kN: {mode: per_cable, free: true, prior: {mean: 0, sigma: 2}}
+  tower_offset_m: {all: {free: false, prior: {mean: 0, sigma: 0.01}}}
+)";
+
+// Central differences of the chi-square against 2 g: the rows are exact Jet derivatives
+// of the statics through the whitening, so they agree to the differences' own error.
+constexpr double kGradientTolerance = 2e-4;
+// Per-sample time step of the simulated survey.
+constexpr double kIntervalS = 5.0;
+
+class TrackFoldTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string error;
+    const CableRobot model = CableRobot::NominalFast();
+    CalibrationSpec spec;
+    ASSERT_TRUE(ParseCalibrationSpecYaml(kSpec, "spec.yaml", model, &spec, &error)) << error;
+    CableRobot truth = model;
+    truth.mass_centre_cabin_m = {0.2, 0.1, 0.5};
+    SimulationOptions o;
+    o.seed = 3;
+    o.sample_interval_s = kIntervalS;
+    o.tension_noise_percent = 0.0;
+    o.tension_noise_kn = 5.0;
+    o.tension_drift_kn = 3.0;
+    o.tension_drift_time_s = 60.0;
+    ASSERT_TRUE(Simulate(truth, RandomCapPoses(120, 5), o, &data_, nullptr, nullptr, &error))
+        << error;
+    task_.label = "w";
+    task_.files = {"survey.csv"};
+    task_.model_yaml = CableRobotToYaml(model, "");
+    for (ParameterSpec p : spec.parameters) {
+      if (p.IsConsider()) p.free = true;
+      task_.parameters.push_back(p);
+      if (!p.free) continue;
+      task_.roles.push_back(p.kind == ParameterKind::kMassCentre    ? FoldRole::kWindow
+                            : p.kind == ParameterKind::kTowerOffset ? FoldRole::kConsider
+                                                                    : FoldRole::kShared);
+      task_.theta_si.push_back(p.kind == ParameterKind::kLinearDensity ? 11.718 : 0.0);
+    }
+    task_.theta_si[0] = 0.15;  // off the truth: residuals that are not noise alone
+    task_.theta_si[2] = 0.45;
+    task_.forward_model = spec.forward_model;
+    task_.tension_sigma_n = spec.tension_sigma_n;
+    task_.tension_sigma_percent = spec.tension_sigma_percent;
+    task_.detect_gross_errors = false;
+    task_.slow_error = spec.slow_error.stated;
+    task_.blocks = 8;
+    task_.residual_samples = 50;
+  }
+
+  WindowFold Fold(const FoldTask& task) {
+    WindowFold fold;
+    std::string error;
+    EXPECT_TRUE(FoldSamples(task, data_, {}, &fold, &error)) << error;
+    return fold;
+  }
+
+  Dataset data_;
+  FoldTask task_;
+};
+
+TEST_F(TrackFoldTest, GradientIsHalfTheChiSquaresDerivative) {
+  const WindowFold fold = Fold(task_);
+  ASSERT_EQ(fold.gradient.size(), static_cast<Eigen::Index>(task_.theta_si.size()));
+  EXPECT_EQ(fold.samples, 120);
+  EXPECT_EQ(fold.readings, 720);
+  // Steps of about 1e-6 of each parameter's scale (m, kg/m, N).
+  const std::vector<double> scale = {1e-6, 1e-6, 1e-6, 1e-5, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3};
+  for (size_t k = 0; k < scale.size(); ++k) {
+    FoldTask plus = task_, minus = task_;
+    plus.theta_si[k] += scale[k];
+    minus.theta_si[k] -= scale[k];
+    const double derivative = (Fold(plus).chi_square - Fold(minus).chi_square) / (2.0 * scale[k]);
+    EXPECT_NEAR(derivative, 2.0 * fold.gradient[k],
+                kGradientTolerance * (std::abs(derivative) + std::sqrt(fold.information(k, k))))
+        << fold.columns[k];
+  }
+  // H is J^T J: symmetric, positive semi-definite.
+  EXPECT_LE((fold.information - fold.information.transpose()).norm(),
+            1e-12 * fold.information.norm());
+  EXPECT_GE(
+      Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(fold.information).eigenvalues().minCoeff(),
+      -1e-9 * fold.information.norm());
+}
+
+TEST_F(TrackFoldTest, BlocksSumToTheWindow) {
+  const WindowFold fold = Fold(task_);
+  ASSERT_GE(fold.block_samples.size(), 7u);
+  long long samples = 0;
+  Eigen::VectorXd score = Eigen::VectorXd::Zero(fold.gradient.size());
+  // The rows of the window's own columns, then of the shared sensor biases.
+  std::vector<int> columns;
+  for (size_t k = 0; k < fold.roles.size(); ++k) {
+    if (fold.roles[k] == FoldRole::kWindow) columns.push_back(static_cast<int>(k));
+  }
+  ASSERT_EQ(columns.size(), 3u);
+  for (size_t k = 0; k < fold.roles.size(); ++k) {
+    if (fold.roles[k] == FoldRole::kShared && fold.columns[k].rfind("sensor_bias_kN[", 0) == 0) {
+      columns.push_back(static_cast<int>(k));
+    }
+  }
+  ASSERT_EQ(fold.block_information[0].rows(), static_cast<Eigen::Index>(columns.size()));
+  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(columns.size(), fold.gradient.size());
+  for (size_t b = 0; b < fold.block_samples.size(); ++b) {
+    samples += fold.block_samples[b];
+    score += fold.block_scores.row(b).transpose();
+    rows += fold.block_information[b];
+  }
+  EXPECT_EQ(samples, fold.samples);
+  EXPECT_LE((score - fold.gradient).norm(), 1e-9 * fold.gradient.norm());
+  for (size_t k = 0; k < columns.size(); ++k) {
+    EXPECT_LE((rows.row(k) - fold.information.row(columns[k])).norm(),
+              1e-9 * fold.information.norm())
+        << fold.columns[columns[k]];
+  }
+}
+
+TEST_F(TrackFoldTest, SameBytesOnAnyNumberOfThreads) {
+  FoldTask two = task_;
+  two.threads = 2;
+  EXPECT_EQ(SerializeWindowFold(Fold(task_)), SerializeWindowFold(Fold(two)));
+}
+
+TEST_F(TrackFoldTest, BytesRoundTripAndCorruptionIsRefused) {
+  const WindowFold fold = Fold(task_);
+  const std::string bytes = SerializeWindowFold(fold);
+  WindowFold back;
+  std::string error;
+  ASSERT_TRUE(ParseWindowFold(bytes, "f.fold", &back, &error)) << error;
+  EXPECT_EQ(SerializeWindowFold(back), bytes);
+  EXPECT_EQ(back.information, fold.information);
+  EXPECT_FALSE(ParseWindowFold(bytes.substr(0, bytes.size() - 3), "f.fold", &back, &error));
+  EXPECT_NE(error.find("f.fold: not a valid"), std::string::npos) << error;
+  EXPECT_FALSE(ParseWindowFold("x" + bytes, "f.fold", &back, &error));
+  EXPECT_NE(error.find("f.fold"), std::string::npos) << error;
+  FoldTask task;
+  const std::string task_bytes = SerializeFoldTask(task_);
+  ASSERT_TRUE(ParseFoldTask(task_bytes, &task, &error)) << error;
+  EXPECT_EQ(SerializeFoldTask(task), task_bytes);
+  EXPECT_FALSE(ParseFoldTask(bytes, &task, &error));  // a fold is not a task
+  EXPECT_NE(error.find("fastcal-fold-task-1"), std::string::npos) << error;
+}
+
+TEST_F(TrackFoldTest, GrossErrorIsNamedAndKeptOut) {
+  data_.samples[40].tension_n[2] *= 3.0;
+  data_.samples[40].line = 77;
+  task_.detect_gross_errors = true;
+  task_.theta_si[0] = 0.2;  // the truth: residuals are the noise
+  task_.theta_si[1] = 0.1;
+  task_.theta_si[2] = 0.5;
+  const WindowFold fold = Fold(task_);
+  ASSERT_EQ(fold.gross_error_count, 1);
+  EXPECT_EQ(fold.gross_errors[0].line, 77);
+  EXPECT_EQ(fold.gross_errors[0].cable, 3);
+  EXPECT_EQ(fold.readings, 719);
+}
+
+TEST_F(TrackFoldTest, UnsolvablePoseNamesFileAndLine) {
+  data_.samples[10].pose.position_m = {0.0, 0.0, 400.0};  // above the towers
+  data_.samples[10].line = 12;
+  WindowFold fold;
+  std::string error;
+  EXPECT_FALSE(FoldSamples(task_, data_, std::vector<int>(data_.samples.size(), 0), &fold, &error));
+  EXPECT_NE(error.find("survey.csv:12"), std::string::npos) << error;
+}
+
+TEST(WindowStoreTest, RecordsRoundTripSortedByTime) {
+  const std::string path = ::testing::TempDir() + "/window_store_test.samples";
+  std::remove(path.c_str());
+  std::vector<internal::StoredSample> records;
+  for (int k = 0; k < 3; ++k) {
+    Sample s;
+    s.time_s = 100.0 - k;  // decreasing: the reader sorts
+    s.line = 10 + k;
+    s.pose.position_m = {1.0 * k, 2.0, 150.0};
+    s.tension_n.fill(1e5 + k);
+    records.push_back(internal::ToStored(s, k % 2, false));
+  }
+  std::string error;
+  ASSERT_TRUE(internal::AppendStoredSamples(path, records, &error)) << error;
+  Dataset data;
+  std::vector<int> file_of;
+  ASSERT_TRUE(internal::ReadStoredWindow(path, &data, &file_of, &error)) << error;
+  ASSERT_EQ(data.samples.size(), 3u);
+  EXPECT_EQ(data.samples[0].time_s, 98.0);
+  EXPECT_EQ(data.samples[0].line, 12);
+  EXPECT_EQ(file_of[0], 0);
+  EXPECT_EQ(file_of[1], 1);
+  EXPECT_EQ(data.samples[2].pose.position_m.x(), 0.0);
+  EXPECT_EQ(data.samples[0].tension_n[5], 1e5 + 2);
+  // A truncated store is refused.
+  std::FILE* f = std::fopen(path.c_str(), "ab");
+  std::fputs("abc", f);
+  std::fclose(f);
+  EXPECT_FALSE(internal::ReadStoredWindow(path, &data, &file_of, &error));
+  EXPECT_NE(error.find("not a whole number"), std::string::npos) << error;
+}
+
+}  // namespace
+}  // namespace fastcal
