@@ -3,8 +3,9 @@
 #  1. the whole test suite built with g++ under AddressSanitizer + UndefinedBehaviorSanitizer,
 #     stopping at the first report (build-asan/);
 #  2. the threaded tests built with g++ under ThreadSanitizer (build-tsan/): the chunked
-#     passes, the threaded reader, a calibration on 1 to 3 threads, the design's gradient,
-#     and command lines that run work beside the main thread; any report fails the job;
+#     passes, the threaded reader, a calibration on 1 to 3 threads, the slow error's
+#     likelihood and the track's folds on several threads, the design's gradient, and
+#     command lines that run work beside the main thread; any report fails the job;
 #  3. the four libFuzzer targets of tests/fuzz built with clang (build-fuzz/), each run for
 #     FASTCAL_FUZZ_SECONDS (default 60) from the seed corpus and the regression inputs.
 # Usage: scripts/test-hardening.sh [--sanitizers-only | --tsan-only | --fuzz-only]
@@ -57,6 +58,8 @@ if [ "$mode" = all ] || [ "$mode" = --tsan-only ]; then
     calibration_test '*ThreadsDoNotChangeTheResult*'
     design_test '*GradientMatchesNumericDifferentiation*:*MatchesBruteForce*'
     evaluation_stream_test '*'
+    slow_error_test '*ThreadsDoNotChangeTheLikelihood*'
+    track_fold_test '*SameBytesOnAnyNumberOfThreads*'
     cli_test '*SimulateCalibrateEvaluateRoundTrip*:*ResidualsOfALongCalibrationAreInFileOrder*'
     cli_faults_test '*TwoRuns*:*ADeviceAsData*'
   )
