@@ -176,24 +176,26 @@ std::string Summary(const TrackResult& r, const std::string& out) {
     }
   }
   for (const TrackEvent& e : r.events) {
-    s << "  " << r.windows[e.window].label << "  " << e.kind;
+    std::ostringstream line;  // wrapped at the console's width below
+    line << e.kind;
     if (!e.cables.empty()) {
-      s << " (cable";
-      for (int c : e.cables) s << " " << c;
-      s << ")";
+      line << " (cable";
+      for (int c : e.cables) line << " " << c;
+      line << ")";
     }
     if (e.within_window) {
-      s << " inside the window, at "
-        << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
-                                 : internal::FormatDouble("%.17g", e.time_s) + " s");
+      line << " inside the window, at "
+           << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
+                                    : internal::FormatDouble("%.17g", e.time_s) + " s");
     }
-    s << ":";
+    line << ":";
     for (const TrackEventParameter& p : e.parameters) {
-      s << " " << p.name << " " << internal::FormatDouble("%+.4g", p.shift) << " +- "
-        << internal::FormatDouble("%.2g", p.sigma_total) << (p.unit == "1" ? "" : " " + p.unit)
-        << ";";
+      line << " " << p.name << " " << internal::FormatDouble("%+.4g", p.shift) << " +- "
+           << internal::FormatDouble("%.2g", p.sigma_total) << (p.unit == "1" ? "" : " " + p.unit)
+           << ";";
     }
-    s << " p = " << internal::FormatDouble("%.2g", e.p_value) << "\n";
+    line << " p = " << internal::FormatDouble("%.2g", e.p_value);
+    s << Wrapped(line.str(), "  " + r.windows[e.window].label + "  ", "      ", 8, "events.json");
   }
   for (const std::string& n : r.notes) s << "Note: " << n << "\n";
   s << "\nWritten to " << out << ": track.csv, events.json, track.html, " << r.models.size()
