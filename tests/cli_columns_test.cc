@@ -2,17 +2,13 @@
 // reads telemetry, fastcal import, .xlsx refused with the ways in, absolute times shown
 // as dates, --sessions-at (docs/cli.md, docs/data-format.md "Column maps").
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
-#include <sstream>
 #include <string>
 
+#include "cli_fixture.h"
 #include "fastcal/dataset.h"
 #include "fastcal/file_digest.h"
 
@@ -20,42 +16,10 @@ namespace fastcal {
 namespace {
 
 namespace fs = std::filesystem;
-
-struct CommandResult {
-  int code = -1;
-  std::string output;  // stdout and stderr
-};
-
-std::string Bin() {
-  const char* bin = std::getenv("FASTCAL_BIN") ? std::getenv("FASTCAL_BIN") : FASTCAL_TEST_BIN;
-  return bin ? bin : "";
-}
-std::string Source() {
-  const char* dir = std::getenv("FASTCAL_SOURCE_DIR") ? std::getenv("FASTCAL_SOURCE_DIR")
-                                                      : FASTCAL_TEST_SOURCE_DIR;
-  return dir ? dir : "";
-}
-
-CommandResult Shell(const std::string& command_line) {
-  CommandResult r;
-  FILE* pipe = popen((command_line + " 2>&1").c_str(), "r");
-  if (pipe == nullptr) return r;
-  char buf[4096];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof(buf), pipe)) > 0) r.output.append(buf, n);
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
-
-CommandResult Fastcal(const std::string& args) { return Shell(Bin() + " " + args); }
-
-std::string ReadFile(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
-}
+using test::CommandResult;
+using test::Fastcal;
+using test::ReadFile;
+using test::Source;
 
 ::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
   if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
@@ -63,26 +27,11 @@ std::string ReadFile(const std::string& path) {
                                        << part << "'";
 }
 
-class CliColumnsTest : public ::testing::Test {
+class CliColumnsTest : public test::CliTest {
  protected:
-  void SetUp() override {
-    if (Bin().empty() || Source().empty()) GTEST_SKIP() << "FASTCAL_BIN / FASTCAL_SOURCE_DIR unset";
-    dir_ = fs::path(::testing::TempDir()) /
-           ("fastcal_cli_columns_" +
-            std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()) + "_" +
-            std::to_string(::getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
-  void Write(const std::string& name, const std::string& text) const {
-    std::ofstream(Path(name)) << text;
-  }
   std::string Data(const std::string& name) const {
     return Source() + "/calibration_data/" + name;
   }
-  fs::path dir_;
 };
 
 TEST_F(CliColumnsTest, ImportWritesTheCanonicalFileWithItsProvenance) {
