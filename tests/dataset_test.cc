@@ -510,8 +510,7 @@ TEST_F(DatasetTest, NegativeZeroRoundTripsBitForBit) {
   EXPECT_FALSE(std::signbit(a.time_s));
   EXPECT_FALSE(std::signbit(a.pose.position_m[0]));
   EXPECT_EQ(std::memcmp(&a.time_s, &b.time_s, sizeof(double)), 0);
-  EXPECT_EQ(std::memcmp(a.pose.position_m.data(), b.pose.position_m.data(), 3 * sizeof(double)),
-            0);
+  EXPECT_EQ(std::memcmp(a.pose.position_m.data(), b.pose.position_m.data(), 3 * sizeof(double)), 0);
   EXPECT_EQ(std::memcmp(a.pose.rotation.data(), b.pose.rotation.data(), 9 * sizeof(double)), 0);
 }
 
@@ -913,6 +912,20 @@ TEST_F(DatasetTest, FilesAboveTheSizeLimitAreRefusedBeforeReading) {
 // The readers' number parser accepts what strtod accepts in the "C" locale (the program
 // runs in it: setlocale is never called), with the same value, and refuses the rest;
 // the writers' formatter prints what printf prints there.
+// Text a person reads: a value that rounds to zero has no sign; any other keeps it.
+TEST(NumberTextTest, NegativeZeroLosesItsSignOnlyWhenItReadsAsZero) {
+  EXPECT_EQ(internal::WithoutNegativeZero("-0.00"), "0.00");
+  EXPECT_EQ(internal::WithoutNegativeZero("-0"), "0");
+  EXPECT_EQ(internal::WithoutNegativeZero("-0.000 m"), "0.000 m");
+  EXPECT_EQ(internal::WithoutNegativeZero("-0.000000e+00"), "0.000000e+00");
+  EXPECT_EQ(internal::WithoutNegativeZero("-0.01"), "-0.01");
+  EXPECT_EQ(internal::WithoutNegativeZero("-1e-300"), "-1e-300");
+  EXPECT_EQ(internal::WithoutNegativeZero("-100"), "-100");
+  EXPECT_EQ(internal::WithoutNegativeZero("-"), "-");
+  EXPECT_EQ(internal::WithoutNegativeZero("-x"), "-x");
+  EXPECT_EQ(internal::WithoutNegativeZero("0.00"), "0.00");
+}
+
 TEST(NumberTextTest, ParsesAndFormatsLikeTheCLocale) {
   for (const char* text :
        {"1.5", "-2e-3", "+7", ".5", "5.", "1e308", "1e309", "-1e400", "1e-320", "1e-400", "-0",

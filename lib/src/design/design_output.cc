@@ -1,7 +1,6 @@
 // A survey design's outputs (design.h): poses.csv, design.json and design.html. The map
 // is the cap seen from above (x toward tower 1's side as in the workspace map), in metres.
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -19,12 +18,7 @@ namespace {
 
 // printf's text, except that a value that rounds to zero reads "0.00", not "-0.00".
 std::string Fmt(const char* format, double v) {
-  std::string s = internal::FormatDouble(format, v);
-  const size_t end = s.find_first_not_of("-0.", 1);
-  const bool all_zero =
-      end == std::string::npos || !std::isdigit(static_cast<unsigned char>(s[end]));
-  if (!s.empty() && s[0] == '-' && s.size() > 1 && all_zero) s.erase(0, 1);
-  return s;
+  return internal::WithoutNegativeZero(internal::FormatDouble(format, v));
 }
 
 std::string CommentLines(const std::string& text) {

@@ -43,11 +43,8 @@ std::string Px(double v) {
 }
 
 std::string Fixed(double v, int decimals) {
-  std::string s =
-      internal::FormatDouble("%." + std::to_string(std::clamp(decimals, 0, 20)) + "f", v);
-  // "-0.00" -> "0.00".
-  if (s[0] == '-' && s.find_first_not_of("-0.") == std::string::npos) s.erase(0, 1);
-  return s;
+  return internal::WithoutNegativeZero(
+      internal::FormatDouble("%." + std::to_string(std::clamp(decimals, 0, 20)) + "f", v));
 }
 
 std::string Scientific(double v, int decimals) {
@@ -429,8 +426,8 @@ Axis FitXAxis(double lo, double hi, double plot_w, double margin) {
 
 // A time axis (PlotOptions::x_unix_time): tick steps of round times, from a second to a
 // week, aligned in the axis' zone.
-constexpr double kTimeSteps[] = {1,     2,     5,     10,    15,    30,     60,     120,
-                                 300,   600,   900,   1800,  3600,  7200,   10800,  21600,
+constexpr double kTimeSteps[] = {1,     2,     5,      10,     15,      30,     60,    120,
+                                 300,   600,   900,    1800,   3600,    7200,   10800, 21600,
                                  43200, 86400, 172800, 604800, 1209600, 2419200};
 constexpr double kDaySeconds = 86400.0;
 
@@ -449,10 +446,10 @@ std::vector<double> TimeTicks(double lo, double hi, double step, int offset_s) {
 std::vector<std::string> TimeTickLabels(const std::vector<double>& ticks, double lo, double hi,
                                         double step, int offset_s) {
   const std::string first = FormatUnixTime(lo, offset_s), last = FormatUnixTime(hi, offset_s);
-  const bool one_day = first.size() >= 19 && last.size() >= 19 &&
-                       first.compare(0, 10, last, 0, 10) == 0;
-  const bool one_year = first.size() >= 19 && last.size() >= 19 &&
-                        first.compare(0, 4, last, 0, 4) == 0;
+  const bool one_day =
+      first.size() >= 19 && last.size() >= 19 && first.compare(0, 10, last, 0, 10) == 0;
+  const bool one_year =
+      first.size() >= 19 && last.size() >= 19 && first.compare(0, 4, last, 0, 4) == 0;
   std::vector<std::string> labels;
   for (double t : ticks) {
     const std::string text = FormatUnixTime(t, offset_s);  // "2024-05-01 12:34:56"
@@ -486,15 +483,15 @@ TimeAxis FitTimeAxis(double lo, double hi, double plot_w, double margin, int off
   axis.hi = hi + pad;
   const int target = std::clamp(static_cast<int>(plot_w / 90.0), 2, 10);
   for (double step : kTimeSteps) {
-    if ((axis.hi - axis.lo) / step > target * 1.5 && step != kTimeSteps[std::size(kTimeSteps) - 1]) {
+    if ((axis.hi - axis.lo) / step > target * 1.5 &&
+        step != kTimeSteps[std::size(kTimeSteps) - 1]) {
       continue;
     }
     axis.step = step;
     axis.ticks = TimeTicks(axis.lo, axis.hi, step, offset_s);
     axis.labels = TimeTickLabels(axis.ticks, axis.lo, axis.hi, step, offset_s);
     const double spacing = plot_w * step / (axis.hi - axis.lo);
-    if (axis.ticks.size() >= 2 &&
-        spacing < MaxTextWidth(axis.labels, kTickFontPx) + 12.0) {
+    if (axis.ticks.size() >= 2 && spacing < MaxTextWidth(axis.labels, kTickFontPx) + 12.0) {
       continue;  // labels would overlap: a longer step
     }
     if (axis.ticks.size() >= 2 || step == kTimeSteps[std::size(kTimeSteps) - 1]) break;

@@ -1,6 +1,7 @@
 // Locale-independent number text (declarations: internal/number_text.h).
 #include "fastcal/internal/number_text.h"
 
+#include <cctype>
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -185,6 +186,16 @@ std::string FormatDouble(std::string_view format, double value) {
     converted = true;
   }
   return out;
+}
+
+std::string WithoutNegativeZero(std::string text) {
+  if (text.size() < 2 || text[0] != '-') return text;
+  // The mantissa's digits, up to an exponent, a unit or the end: all zero?
+  const size_t end = text.find_first_not_of("0.", 1);
+  const bool zero = end != 1 && (end == std::string::npos ||
+                                 !std::isdigit(static_cast<unsigned char>(text[end])));
+  if (zero) text.erase(0, 1);
+  return text;
 }
 
 }  // namespace fastcal::internal

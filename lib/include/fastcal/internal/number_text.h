@@ -35,6 +35,11 @@ bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why);
 // "C" locale, whatever the current one.
 std::string FormatDouble(std::string_view format, double value);
 
+// `text` with the minus of a number that reads as zero dropped ("-0.00 m" -> "0.00 m",
+// "-0" -> "0"; "-0.01" and "-1e-300" kept): for text a person reads, where a value that
+// rounds to zero has no sign. FormatDouble itself stays printf's.
+std::string WithoutNegativeZero(std::string text);
+
 }  // namespace fastcal::internal
 
 #endif  // FASTCAL_INTERNAL_NUMBER_TEXT_H_
