@@ -704,3 +704,32 @@ TEST(XmlProblem, DetectsMalformedMarkup) {
 
 }  // namespace
 }  // namespace fastcal
+
+namespace fastcal {
+namespace {
+
+// Labels of circles a few pixels apart (design.html's stops 12 and 13 at the rim) must not
+// overlap; a lone circle's label goes to its right, clear of the circle.
+TEST(PlaceCircleLabelsTest, NearbyCirclesGetLabelsThatDoNotOverlap) {
+  constexpr double kCharPx = 7.0, kHeightPx = 11.0;
+  const std::vector<CircleLabel> labels = {
+      {100.0, 100.0, 8.0, "12"}, {104.0, 101.0, 4.0, "13"}, {103.0, 96.0, 6.0, "14"}};
+  const std::vector<LabelSpot> spots = PlaceCircleLabels(labels, kCharPx, kHeightPx);
+  ASSERT_EQ(spots.size(), labels.size());
+  // The first takes the first spot: right of its circle, just above its centre.
+  EXPECT_DOUBLE_EQ(spots[0].x_px, 100.0 + 8.0 + 2.0);
+  EXPECT_DOUBLE_EQ(spots[0].baseline_px, 100.0 - 3.0);
+  for (size_t a = 0; a < spots.size(); ++a) {
+    for (size_t b = a + 1; b < spots.size(); ++b) {
+      const double wa = kCharPx * labels[a].text.size(), wb = kCharPx * labels[b].text.size();
+      const bool apart = spots[a].x_px + wa <= spots[b].x_px ||
+                         spots[b].x_px + wb <= spots[a].x_px ||
+                         spots[a].baseline_px <= spots[b].baseline_px - kHeightPx ||
+                         spots[b].baseline_px <= spots[a].baseline_px - kHeightPx;
+      EXPECT_TRUE(apart) << labels[a].text << " and " << labels[b].text << " overlap";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace fastcal

@@ -232,6 +232,23 @@ std::string XmlEscape(const std::string& text);
 // Returns an empty vector if lo or hi is not finite.
 std::vector<double> NiceTicks(double lo, double hi, int target);
 
+// A label to put beside a circle (a stop's number on the design's map of the cap).
+struct CircleLabel {
+  double x_px = 0.0, y_px = 0.0, radius_px = 0.0;  // the circle
+  std::string text;
+};
+// Where a label goes: its left edge and its baseline (SVG <text x y>).
+struct LabelSpot {
+  double x_px = 0.0, baseline_px = 0.0;
+};
+
+// Each label at the first of six spots around its circle (right, right below, left, left
+// below, above, below) where its box (char_px a character wide, height_px high) overlaps
+// no label placed before it; where every spot is taken, the first. Labels in the given
+// order: circles a few pixels apart stay readable.
+std::vector<LabelSpot> PlaceCircleLabels(const std::vector<CircleLabel>& labels, double char_px,
+                                         double height_px);
+
 // Colour (e.g. "#0072B2") of series `index` in every chart, for matching tables or text
 // in the report to the plots. Cycles through the 8 Okabe-Ito colours.
 std::string PlotSeriesColour(int index);

@@ -252,45 +252,17 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
 
 namespace {
 
-// A stop's number beside its circle on the map of the cap.
-struct StopNumber {
-  double x_px = 0.0, y_px = 0.0, radius_px = 0.0;
-  std::string label;
-};
-
-// The stops' numbers, each placed at the first of a few spots around its circle (right,
-// left, above, below) where it overlaps no number placed before: stops a few pixels apart
-// (12 and 13 at the rim) stay readable.
-std::string StopNumbers(const std::map<std::string, StopNumber>& numbers) {
-  constexpr double kCharPx = 7.0, kHeightPx = 11.0;  // 11 px bold digits
-  struct Box {
-    double x0, y0, x1, y1;  // y1 the baseline
-  };
-  std::vector<Box> placed;
+// The stops' numbers beside their circles, placed where they overlap no other
+// (PlaceCircleLabels): stops a few pixels apart (12 and 13 at the rim) stay readable.
+std::string StopNumbers(const std::map<std::string, CircleLabel>& numbers) {
+  std::vector<CircleLabel> labels;
+  for (const auto& [at, n] : numbers) labels.push_back(n);
+  const std::vector<LabelSpot> spots = PlaceCircleLabels(labels, 7.0, 11.0);  // 11 px bold
   std::string s;
-  for (const auto& [at, n] : numbers) {
-    const double w = kCharPx * static_cast<double>(n.label.size());
-    const double r = n.radius_px + 2.0;
-    const std::pair<double, double> spots[] = {
-        // (left edge, baseline)
-        {n.x_px + r, n.y_px - 3.0},         {n.x_px + r, n.y_px + kHeightPx},
-        {n.x_px - r - w, n.y_px - 3.0},     {n.x_px - r - w, n.y_px + kHeightPx},
-        {n.x_px - w / 2, n.y_px - r - 1.0}, {n.x_px - w / 2, n.y_px + r + kHeightPx}};
-    Box chosen{spots[0].first, spots[0].second - kHeightPx, spots[0].first + w, spots[0].second};
-    for (const auto& [x, y] : spots) {
-      const Box b{x, y - kHeightPx, x + w, y};
-      const bool free = std::none_of(placed.begin(), placed.end(), [&](const Box& o) {
-        return b.x0 < o.x1 && o.x0 < b.x1 && b.y0 < o.y1 && o.y0 < b.y1;
-      });
-      if (free) {
-        chosen = b;
-        break;
-      }
-    }
-    placed.push_back(chosen);
-    s += "<text class=\"stop-number\" x=\"" + Fmt("%.1f", chosen.x0) + "\" y=\"" +
-         Fmt("%.1f", chosen.y1) + "\" font-size=\"11\" font-weight=\"bold\" fill=\"#222\">" +
-         n.label + "</text>\n";
+  for (size_t k = 0; k < labels.size(); ++k) {
+    s += "<text class=\"stop-number\" x=\"" + Fmt("%.1f", spots[k].x_px) + "\" y=\"" +
+         Fmt("%.1f", spots[k].baseline_px) +
+         "\" font-size=\"11\" font-weight=\"bold\" fill=\"#222\">" + labels[k].text + "</text>\n";
   }
   return s;
 }
@@ -336,7 +308,7 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
          "\" font-weight=\"bold\">start</text>\n";
   }
   int order = 0;
-  std::map<std::string, StopNumber> numbers;  // by drawn position
+  std::map<std::string, CircleLabel> numbers;  // by drawn position
   for (const DesignStop& st : d.stops) {
     const DesignCandidate& c = d.candidates[st.candidate];
     const Eigen::Vector3d rpy = RpyDegFromRotation(c.pose.rotation);
@@ -353,11 +325,11 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
          Fmt("%.3g", c.extra_tilt_deg) + " deg toward " + Fmt("%.3g", c.tilt_direction_deg) +
          " deg, extra yaw " + Fmt("%.3g", c.extra_yaw_deg) + " deg</title></circle>\n";
     // Stops at one position (other attitudes) share one label: "18, 19".
-    StopNumber& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
+    CircleLabel& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
     n.x_px = half + scale * (c.pose.position_m.x() - g.focal_centre_m.x());
     n.y_px = half - scale * (c.pose.position_m.y() - g.focal_centre_m.y());
     n.radius_px = std::max(n.radius_px, radius);
-    n.label += (n.label.empty() ? "" : ", ") + std::to_string(order);
+    n.text += (n.text.empty() ? "" : ", ") + std::to_string(order);
   }
   s += StopNumbers(numbers);
   for (int i = 0; i < kNumCables; ++i) {

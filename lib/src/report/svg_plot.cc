@@ -1370,4 +1370,36 @@ std::string SvgIntervalPlot(const std::vector<IntervalRow>& rows,
   return out;
 }
 
+std::vector<LabelSpot> PlaceCircleLabels(const std::vector<CircleLabel>& labels, double char_px,
+                                         double height_px) {
+  struct Box {
+    double x0, y0, x1, y1;  // y1 the baseline
+  };
+  std::vector<Box> placed;
+  std::vector<LabelSpot> spots_chosen;
+  for (const CircleLabel& n : labels) {
+    const double w = char_px * static_cast<double>(n.text.size());
+    const double r = n.radius_px + 2.0;
+    const std::pair<double, double> spots[] = {
+        // (left edge, baseline)
+        {n.x_px + r, n.y_px - 3.0},         {n.x_px + r, n.y_px + height_px},
+        {n.x_px - r - w, n.y_px - 3.0},     {n.x_px - r - w, n.y_px + height_px},
+        {n.x_px - w / 2, n.y_px - r - 1.0}, {n.x_px - w / 2, n.y_px + r + height_px}};
+    Box chosen{spots[0].first, spots[0].second - height_px, spots[0].first + w, spots[0].second};
+    for (const auto& [x, y] : spots) {
+      const Box b{x, y - height_px, x + w, y};
+      const bool free = std::none_of(placed.begin(), placed.end(), [&](const Box& o) {
+        return b.x0 < o.x1 && o.x0 < b.x1 && b.y0 < o.y1 && o.y0 < b.y1;
+      });
+      if (free) {
+        chosen = b;
+        break;
+      }
+    }
+    placed.push_back(chosen);
+    spots_chosen.push_back({chosen.x0, chosen.y1});
+  }
+  return spots_chosen;
+}
+
 }  // namespace fastcal
