@@ -322,3 +322,35 @@ TEST_F(UsabilityTest, TheReadmeTourWritesUnderOut) {
 }
 
 }  // namespace
+
+namespace {
+
+// A console note cut to its lines ends "... (report.md)" after a whole word of the note,
+// never inside a number (the slow error's likelihood ratio 2.62e+03 once read "2.6"): the
+// word before the mark stands whole in the report, which has every note in full.
+TEST_F(UsabilityTest, ConsoleNotesAreCutAtAWord) {
+  const Streams s = Run("calibrate --spec=" + Source() + "/calibration_data/spec_realistic.yaml" +
+                        " --data=" + Source() + "/calibration_data/realistic_survey.csv" +
+                        " --out=" + Path("out"));
+  ASSERT_EQ(s.code, 0) << s.err;
+  const std::string report = ReadFile(Path("out/report.md"));
+  const std::string mark = " ... (report.md)";
+  int cut = 0;
+  std::istringstream lines(s.out);
+  for (std::string line; std::getline(lines, line);) {
+    const size_t at = line.find(mark);
+    if (at == std::string::npos) continue;
+    ++cut;
+    const std::string before = line.substr(0, at);
+    const std::string word = before.substr(before.find_last_of(' ') + 1);
+    ASSERT_FALSE(word.empty()) << line;
+    // Whole: followed in the report by a space or the end of a sentence, not more digits.
+    const std::regex whole(
+        "(^|[ (])" + std::regex_replace(word, std::regex(R"([.^$|()\[\]{}*+?\\])"), R"(\$&)") +
+        R"(($|[ ;,)]))");
+    EXPECT_TRUE(std::regex_search(report, whole)) << "cut inside a word: " << line;
+  }
+  EXPECT_GT(cut, 0) << "no note was cut; the test no longer tests the cut\n" << s.out;
+}
+
+}  // namespace
