@@ -39,36 +39,6 @@
 #include "util/yaml_document.h"
 
 namespace fastcal {
-
-using spec_rules::AttachmentKindOf;
-using spec_rules::AttachmentShape;
-using spec_rules::CheckAtLeastOne;
-using spec_rules::CheckAtLeastTwo;
-using spec_rules::CheckFraction;
-using spec_rules::CheckHoldoutFraction;
-using spec_rules::CheckInitial;
-using spec_rules::CheckLengthSigma;
-using spec_rules::CheckNoiseSigma;
-using spec_rules::CheckPositive;
-using spec_rules::CheckPriorMean;
-using spec_rules::CheckPriorSigma;
-using spec_rules::CheckSignificance;
-using spec_rules::CheckThreads;
-using spec_rules::CheckTimeConstant;
-using spec_rules::EntryText;
-using spec_rules::GroupInfo;
-using spec_rules::GroupWithoutFreeParameter;
-using spec_rules::IsAttachment;
-using spec_rules::IsPerCableCapable;
-using spec_rules::kAxes;
-using spec_rules::kBothNoiseZero;
-using spec_rules::kFormatName;
-using spec_rules::kGroups;
-using spec_rules::kNewtonsPerKilonewton;
-using spec_rules::kRootPath;
-using spec_rules::MakeParameter;
-using spec_rules::ShapeOf;
-
 namespace {
 
 std::string Join(const std::string& parent, const std::string& key) {

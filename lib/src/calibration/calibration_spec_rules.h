@@ -152,4 +152,43 @@ ParameterSpec MakeParameter(const GroupInfo& g, int index, int component, const 
 
 }  // namespace fastcal::spec_rules
 
+namespace fastcal {
+// The spec's reader and checks (the only includers: this header is private to
+// lib/src/calibration) read the rules as their own names, as when they were one file.
+using spec_rules::AttachmentKindOf;
+using spec_rules::AttachmentShape;
+using spec_rules::CheckAtLeastOne;
+using spec_rules::CheckAtLeastTwo;
+using spec_rules::CheckFraction;
+using spec_rules::CheckHoldoutFraction;
+using spec_rules::CheckInitial;
+using spec_rules::CheckLengthSigma;
+using spec_rules::CheckNoiseSigma;
+using spec_rules::CheckPositive;
+using spec_rules::CheckPriorMean;
+using spec_rules::CheckPriorSigma;
+using spec_rules::CheckSignificance;
+using spec_rules::CheckThreads;
+using spec_rules::CheckTimeConstant;
+using spec_rules::EntryText;
+using spec_rules::GroupInfo;
+using spec_rules::GroupWithoutFreeParameter;
+using spec_rules::InfoOf;
+using spec_rules::IsAttachment;
+using spec_rules::IsKnownMethod;
+using spec_rules::IsPerCableCapable;
+using spec_rules::IsVector;
+using spec_rules::kAxes;
+using spec_rules::kBothNoiseZero;
+using spec_rules::kFormatName;
+using spec_rules::kGroups;
+using spec_rules::kNewtonsPerKilonewton;
+using spec_rules::kRootPath;
+using spec_rules::LengthsProblem;
+using spec_rules::MakeParameter;
+using spec_rules::Num;
+using spec_rules::NumInUnit;
+using spec_rules::ShapeOf;
+}  // namespace fastcal
+
 #endif  // FASTCAL_SRC_CALIBRATION_CALIBRATION_SPEC_RULES_H_
