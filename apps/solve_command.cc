@@ -890,6 +890,16 @@ std::string PlotPage(const std::vector<Pose>& poses, const std::string& provenan
 struct PlotData {
   std::vector<Pose> poses;
   std::vector<StaticsSolution> single, aas, exact;
+
+  void Add(const Pose& pose, bool compare, const Run& one, const Run& a, const Run& e) {
+    poses.push_back(pose);
+    if (compare) {
+      aas.push_back(a.solution);
+      exact.push_back(e.solution);
+    } else {
+      single.push_back(one.solution);
+    }
+  }
 };
 
 // --plot's page, written before the table is renamed into place (RunSolve).
@@ -921,6 +931,37 @@ struct Totals {
   std::array<double, kNumCables> worst_pct{};  // compare: max |aas - exact| / exact
   long long several = 0;  // poses where exact met several equilibria (EquilibriumCode)
 };
+
+// One pose's part of the run's totals: a failure named (without --keep-going it ends the
+// run: false with *error), poses of several equilibria, compare's worst |aas - exact|.
+bool CountPose(long long n, const Pose& pose,
+               const std::vector<std::pair<const Run*, StaticsMethod>>& runs, bool compare,
+               const Run& aas, const Run& exact, const Run& single, Totals* totals,
+               std::string* error) {
+  bool pose_ok = true;
+  for (const auto& [run, method] : runs) {
+    if (run->ok() || !pose_ok) continue;
+    pose_ok = false;
+    const std::string failure = NodeFailure(n, pose, run->solution, method);
+    if (!FLAGS_keep_going) {
+      *error = failure;
+      return false;
+    }
+    if (totals->first_failure.empty()) totals->first_failure = failure;
+  }
+  totals->failed += pose_ok ? 0 : 1;
+  const StaticsSolution& exact_solution = compare ? exact.solution : single.solution;
+  totals->several += exact_solution.other_equilibrium ? 1 : 0;
+  if (compare && pose_ok) {
+    for (int i = 0; i < kNumCables; ++i) {
+      totals->worst_pct[i] = std::max(
+          totals->worst_pct[i], 100.0 * std::abs(aas.solution.cables[i].lower_tension_n /
+                                                     exact.solution.cables[i].lower_tension_n -
+                                                 1.0));
+    }
+  }
+  return true;
+}
 
 // Solves the poses one at a time (one method, or aas and exact for compare), each row
 // formatted and handed to `out` as it is made: memory independent of the number of poses
@@ -955,38 +996,9 @@ bool SolveStream(const CableRobot& robot, const PoseStream& stream, const Static
       single->Solve(robot, pose);
       runs = {{single, options.method}};
     }
-    bool pose_ok = true;
-    for (const auto& [run, method] : runs) {
-      if (run->ok() || !pose_ok) continue;
-      pose_ok = false;
-      const std::string failure = NodeFailure(n, pose, run->solution, method);
-      if (!FLAGS_keep_going) {
-        *error = failure;
-        return false;
-      }
-      if (totals->first_failure.empty()) totals->first_failure = failure;
-    }
-    totals->failed += pose_ok ? 0 : 1;
-    const StaticsSolution& exact_solution = compare ? exact->solution : single->solution;
-    totals->several += exact_solution.other_equilibrium ? 1 : 0;
-    if (compare && pose_ok) {
-      for (int i = 0; i < kNumCables; ++i) {
-        totals->worst_pct[i] = std::max(
-            totals->worst_pct[i], 100.0 * std::abs(aas->solution.cables[i].lower_tension_n /
-                                                       exact->solution.cables[i].lower_tension_n -
-                                                   1.0));
-      }
-    }
+    if (!CountPose(n, pose, runs, compare, *aas, *exact, *single, totals, error)) return false;
     const StaticsSolution* one = compare ? nullptr : &single->solution;
-    if (plot != nullptr) {
-      plot->poses.push_back(pose);
-      if (compare) {
-        plot->aas.push_back(aas->solution);
-        plot->exact.push_back(exact->solution);
-      } else {
-        plot->single.push_back(single->solution);
-      }
-    }
+    if (plot != nullptr) plot->Add(pose, compare, *single, *aas, *exact);
     if (json) {
       AppendJsonPose(n, pose, one, &aas->solution, &exact->solution, &j);
       text += j.Take();
@@ -1013,6 +1025,45 @@ bool SolveStream(const CableRobot& robot, const PoseStream& stream, const Static
     text += j.Take();
   }
   return out->Write(text, error);
+}
+
+// The run's summary: poses, timing, compare's worst error; failures and several equilibria
+// on stderr.
+void PrintSummary(const Totals& totals, bool compare, const StaticsOptions& options,
+                  const Run& single, const Run& aas, const Run& exact,
+                  const std::string& attitude) {
+  std::ostringstream timing;
+  const long long n = totals.poses;
+  if (!compare) {
+    timing << TimingLine(StaticsMethodName(options.method), single, n, options.warm_start);
+  } else {
+    timing << TimingLine("aas", aas, n, options.warm_start) << "; "
+           << TimingLine("exact", exact, n, options.warm_start) << "\n"
+           << "max |aas - exact| / exact per cable (%):";
+    for (double e : totals.worst_pct) timing << " " << FormatDouble(e, 4);
+  }
+  // stdout carries the result: the table itself, else (--output=FILE) this summary of
+  // it (docs/cli.md, "Output streams").
+  std::ostream& summary = FLAGS_output.empty() || FLAGS_output == "-" ? std::cerr : std::cout;
+  summary << "fastcal solve: " << n << (n == 1 ? " pose" : " poses");
+  if (totals.failed > 0) summary << " (" << totals.failed << " failed)";
+  // Paths and flag text on the terminal: control bytes escaped.
+  summary << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", attitude "
+          << internal::Escape(attitude) << "; " << timing.str() << std::endl;
+  if (totals.failed > 0) {
+    std::cerr << "fastcal solve: " << totals.failed << " of " << n
+              << " poses failed; --keep-going wrote them with their status, message and empty "
+                 "numbers "
+                 "(exit 0). First: "
+              << totals.first_failure << std::endl;
+  }
+  if (totals.several > 0) {
+    std::cerr << "fastcal solve: several equilibria hold " << totals.several << " of " << n
+              << (n == 1 ? " pose" : " poses")
+              << " (column equilibrium: several, unreachable); exact returns the one followed "
+                 "from the home pose (docs/model.md, \"Which equilibrium exact returns\")"
+              << std::endl;
+  }
 }
 
 }  // namespace
@@ -1070,38 +1121,7 @@ int RunSolve(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitFailure;
   }
-  std::ostringstream timing;
-  const long long n = totals.poses;
-  if (!compare) {
-    timing << TimingLine(StaticsMethodName(options.method), single, n, options.warm_start);
-  } else {
-    timing << TimingLine("aas", aas, n, options.warm_start) << "; "
-           << TimingLine("exact", exact, n, options.warm_start) << "\n"
-           << "max |aas - exact| / exact per cable (%):";
-    for (double e : totals.worst_pct) timing << " " << FormatDouble(e, 4);
-  }
-  // stdout carries the result: the table itself, else (--output=FILE) this summary of
-  // it (docs/cli.md, "Output streams").
-  std::ostream& summary = FLAGS_output.empty() || FLAGS_output == "-" ? std::cerr : std::cout;
-  summary << "fastcal solve: " << n << (n == 1 ? " pose" : " poses");
-  if (totals.failed > 0) summary << " (" << totals.failed << " failed)";
-  // Paths and flag text on the terminal: control bytes escaped.
-  summary << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", attitude "
-          << internal::Escape(attitude) << "; " << timing.str() << std::endl;
-  if (totals.failed > 0) {
-    std::cerr << "fastcal solve: " << totals.failed << " of " << n
-              << " poses failed; --keep-going wrote them with their status, message and empty "
-                 "numbers "
-                 "(exit 0). First: "
-              << totals.first_failure << std::endl;
-  }
-  if (totals.several > 0) {
-    std::cerr << "fastcal solve: several equilibria hold " << totals.several << " of " << n
-              << (n == 1 ? " pose" : " poses")
-              << " (column equilibrium: several, unreachable); exact returns the one followed "
-                 "from the home pose (docs/model.md, \"Which equilibrium exact returns\")"
-              << std::endl;
-  }
+  PrintSummary(totals, compare, options, single, aas, exact, attitude);
   return 0;
 }
 
