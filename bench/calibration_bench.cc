@@ -51,9 +51,13 @@
 #include "fastcal/report.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
+#include "forked_run.h"
 
 namespace fastcal {
 namespace {
+
+using bench::ForkedIterations;
+using bench::ReadCalibrateReport;
 
 CableRobot Truth() {
   CableRobot truth = CableRobot::NominalFast();
@@ -134,54 +138,6 @@ CalibrationSpec Spec(StaticsMethod forward) {
     spec.parameters.push_back(p);
   }
   return spec;
-}
-
-// In the child: read, calibrate with `spec`, write the report into `dir`. Exit code 0 on
-// success.
-int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& spec,
-                        const std::string& dir) {
-  Dataset data;
-  std::string error;
-  DatasetReadOptions read;
-  read.threads = 2;  // as fastcal calibrate reads
-  if (!ReadDataset(csv, read, &data, &error)) return 1;
-  const CableRobot model = CableRobot::NominalFast();
-  CalibrationResult result;
-  if (Calibrate(model, spec, data, CalibrationOptions(), &result, &error) !=
-      CalibrationStatus::kOk) {
-    return 2;
-  }
-  ReportInputs inputs;
-  inputs.initial_model = &model;
-  inputs.spec = &spec;
-  inputs.data = &data;
-  inputs.result = &result;
-  inputs.variants = std::move(result.variants);
-  std::filesystem::create_directories(dir);
-  return WriteReportFiles(dir, inputs, &error) ? 0 : 3;
-}
-
-// Runs `child` in a forked process per iteration: wall time, its CPU time and peak memory.
-template <typename Child>
-void ForkedIterations(benchmark::State& state, const Child& child) {
-  for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
-    const pid_t pid = fork();
-    if (pid == 0) _exit(child());
-    int status = 0;
-    rusage usage{};
-    wait4(pid, &status, 0, &usage);
-    state.SetIterationTime(
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      state.SkipWithError("the calibration failed");
-      break;
-    }
-    state.counters["peak_rss_MB"] = usage.ru_maxrss / 1024.0;
-    state.counters["cpu_s"] = usage.ru_utime.tv_sec + usage.ru_utime.tv_usec * 1e-6 +
-                              usage.ru_stime.tv_sec + usage.ru_stime.tv_usec * 1e-6;
-  }
-  state.counters["samples"] = static_cast<double>(state.range(0));
 }
 
 // Read, calibrate with `spec` and report `csv` (then removed) in a forked child.

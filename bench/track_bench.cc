@@ -32,6 +32,7 @@
 #include "fastcal/simulation.h"
 #include "fastcal/track.h"
 #include "fastcal/trajectory.h"
+#include "forked_run.h"
 
 #ifndef FASTCAL_SOURCE_DIR
 #define FASTCAL_SOURCE_DIR "."
@@ -110,26 +111,7 @@ int RunTrackChild(const std::string& csv, const std::string& dir) {
 }
 
 int RunCalibrateChild(const std::string& csv, const std::string& dir) {
-  Dataset data;
-  std::string error;
-  DatasetReadOptions read;
-  read.threads = 2;  // as fastcal calibrate reads
-  if (!ReadDataset(csv, read, &data, &error)) return 1;
-  const CableRobot model = CableRobot::NominalFast();
-  const CalibrationSpec spec = Spec();
-  CalibrationResult result;
-  if (Calibrate(model, spec, data, CalibrationOptions(), &result, &error) !=
-      CalibrationStatus::kOk) {
-    return 2;
-  }
-  ReportInputs inputs;
-  inputs.initial_model = &model;
-  inputs.spec = &spec;
-  inputs.data = &data;
-  inputs.result = &result;
-  inputs.variants = std::move(result.variants);
-  std::filesystem::create_directories(dir);
-  return WriteReportFiles(dir, inputs, &error) ? 0 : 3;
+  return bench::ReadCalibrateReport(csv, Spec(), dir);
 }
 
 // Runs `child` in a forked process; its wall time, CPU time and peak memory as counters.
@@ -141,25 +123,8 @@ void Measure(benchmark::State& state, const Child& child) {
     return;
   }
   const std::string dir = csv + ".out";
-  for (auto _ : state) {
-    const auto start = std::chrono::steady_clock::now();
-    const pid_t pid = fork();
-    if (pid == 0) _exit(child(csv, dir));
-    int status = 0;
-    rusage usage{};
-    wait4(pid, &status, 0, &usage);
-    state.SetIterationTime(
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
-      state.SkipWithError("the run failed");
-      break;
-    }
-    state.counters["peak_rss_MB"] = usage.ru_maxrss / 1024.0;
-    state.counters["cpu_s"] = usage.ru_utime.tv_sec + usage.ru_utime.tv_usec * 1e-6 +
-                              usage.ru_stime.tv_sec + usage.ru_stime.tv_usec * 1e-6;
-  }
+  bench::ForkedIterations(state, [&] { return child(csv, dir); });
   std::filesystem::remove_all(dir);
-  state.counters["samples"] = static_cast<double>(state.range(0));
   state.counters["windows"] = static_cast<double>(state.range(1));
 }
 

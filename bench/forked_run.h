@@ -1,0 +1,75 @@
+// What the end-to-end benchmarks share (calibration_bench, track_bench): a survey read,
+// calibrated and reported in a child process, and the forked measurement of a child's
+// wall time, CPU time and peak memory (a fresh process per run, so that the peak is the
+// run's own).
+#ifndef FASTCAL_BENCH_FORKED_RUN_H_
+#define FASTCAL_BENCH_FORKED_RUN_H_
+
+#include <benchmark/benchmark.h>
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <filesystem>
+#include <string>
+#include <utility>
+
+#include "fastcal/calibration.h"
+#include "fastcal/calibration_spec.h"
+#include "fastcal/dataset.h"
+#include "fastcal/report.h"
+
+namespace fastcal::bench {
+
+// In the child: read, calibrate with `spec`, write the report into `dir`. Exit code 0 on
+// success.
+inline int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& spec,
+                               const std::string& dir) {
+  Dataset data;
+  std::string error;
+  DatasetReadOptions read;
+  read.threads = 2;  // as fastcal calibrate reads
+  if (!ReadDataset(csv, read, &data, &error)) return 1;
+  const CableRobot model = CableRobot::NominalFast();
+  CalibrationResult result;
+  if (Calibrate(model, spec, data, CalibrationOptions(), &result, &error) !=
+      CalibrationStatus::kOk) {
+    return 2;
+  }
+  ReportInputs inputs;
+  inputs.initial_model = &model;
+  inputs.spec = &spec;
+  inputs.data = &data;
+  inputs.result = &result;
+  inputs.variants = std::move(result.variants);
+  std::filesystem::create_directories(dir);
+  return WriteReportFiles(dir, inputs, &error) ? 0 : 3;
+}
+
+// Runs `child` in a forked process per iteration: wall time, its CPU time and peak memory.
+template <typename Child>
+inline void ForkedIterations(benchmark::State& state, const Child& child) {
+  for (auto _ : state) {
+    const auto start = std::chrono::steady_clock::now();
+    const pid_t pid = fork();
+    if (pid == 0) _exit(child());
+    int status = 0;
+    rusage usage{};
+    wait4(pid, &status, 0, &usage);
+    state.SetIterationTime(
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+      state.SkipWithError("the run failed");
+      break;
+    }
+    state.counters["peak_rss_MB"] = usage.ru_maxrss / 1024.0;
+    state.counters["cpu_s"] = usage.ru_utime.tv_sec + usage.ru_utime.tv_usec * 1e-6 +
+                              usage.ru_stime.tv_sec + usage.ru_stime.tv_usec * 1e-6;
+  }
+  state.counters["samples"] = static_cast<double>(state.range(0));
+}
+
+}  // namespace fastcal::bench
+
+#endif  // FASTCAL_BENCH_FORKED_RUN_H_
