@@ -269,3 +269,38 @@ TEST(ChangeScanTest, CalibrateFindsAMassCentreStepInSimulatedTelemetry) {
 
 }  // namespace
 }  // namespace fastcal
+
+namespace fastcal {
+namespace {
+
+// The change time's interval and the wandering rule (SetChangeTimeAndWandering): a sharp
+// peak of the scan's statistic is a step at a determined time; a plateau over half the
+// survey is a change whose time is not determined: a wandering.
+TEST(ChangeTimeTest, APlateauIsAWanderingAndAPeakAStep) {
+  constexpr int kScanned = 3;  // the mass centre's axes: chi-square(3) 95% point 7.815
+  ChangeScanResult scan;
+  for (int k = 0; k < 100; ++k) scan.time_s.push_back(10.0 * k);
+  scan.changes.resize(1);
+  scan.best_step_statistic = 60.0;
+  scan.trend_statistic = 20.0;
+  // A peak: 60 at t = 500 s, at least 10 below it elsewhere.
+  for (int k = 0; k < 100; ++k) scan.statistic.push_back(k == 50 ? 60.0 : 40.0);
+  SetChangeTimeAndWandering(kScanned, &scan);
+  EXPECT_EQ(scan.change_time_low_s, 500.0);
+  EXPECT_EQ(scan.change_time_high_s, 500.0);
+  EXPECT_FALSE(scan.wanders);
+  // A plateau: within 7.8 of the best from t = 200 to 700 s (half the survey).
+  for (int k = 0; k < 100; ++k) scan.statistic[k] = k >= 20 && k <= 70 ? 55.0 : 40.0;
+  scan.statistic[50] = 60.0;
+  SetChangeTimeAndWandering(kScanned, &scan);
+  EXPECT_EQ(scan.change_time_low_s, 200.0);
+  EXPECT_EQ(scan.change_time_high_s, 700.0);
+  EXPECT_TRUE(scan.wanders);
+  // No change found: never a wandering, whatever the statistic's shape.
+  scan.changes.clear();
+  SetChangeTimeAndWandering(kScanned, &scan);
+  EXPECT_FALSE(scan.wanders);
+}
+
+}  // namespace
+}  // namespace fastcal

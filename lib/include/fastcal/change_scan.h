@@ -175,6 +175,14 @@ struct ChangeScanResult {
 // gradual (a wandering).
 inline constexpr double kMaxStepTimeFraction = 0.2;
 
+// From the first round's statistic and times (`scan->statistic`, `time_s`) and its
+// changes and trend: the change time's likelihood-ratio interval (change_time_low_s,
+// change_time_high_s; `scanned` parameters, the chi-square's degrees of freedom) and
+// whether the data show a wandering rather than a step (`wanders`: more than one change,
+// a trend that explains at least as much as the best step, or a change time not
+// determined, its interval wider than kMaxStepTimeFraction of the scanned times).
+void SetChangeTimeAndWandering(int scanned, ChangeScanResult* scan);
+
 // One sentence for the verdict: the changes found (when, how much, p), or that none was;
 // with changes, the --sessions-at value that cuts the survey there.
 std::string ChangeScanVerdict(const ChangeScanResult& scan);

@@ -430,38 +430,6 @@ CalibrationStatus TestSensorStepsStage(Run& run) {
   return CalibrationStatus::kOk;
 }
 
-namespace {}  // namespace
-
-namespace {
-
-// The first round's change-time interval (change_scan.h); true when it spans more than
-// kMaxStepTimeFraction of the scanned times.
-bool ChangeTimeInterval(int scanned, ChangeScanResult* scan) {
-  if (scan->statistic.empty()) return false;
-  // Chi-square 95% points for 1, 2, 3 degrees of freedom (the mass centre's axes), and
-  // the Wilson-Hilferty approximation beyond.
-  const double kChiSquare95[] = {3.841, 5.991, 7.815};
-  const double c =
-      scanned <= 3
-          ? kChiSquare95[std::max(scanned, 1) - 1]
-          : scanned *
-                std::pow(1.0 - 2.0 / (9.0 * scanned) + 1.645 * std::sqrt(2.0 / (9.0 * scanned)), 3);
-  const double best = *std::max_element(scan->statistic.begin(), scan->statistic.end());
-  scan->change_time_low_s = std::numeric_limits<double>::infinity();
-  scan->change_time_high_s = -std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < scan->statistic.size(); ++k) {
-    if (scan->statistic[k] < best - c) continue;
-    scan->change_time_low_s = std::min(scan->change_time_low_s, scan->time_s[k]);
-    scan->change_time_high_s = std::max(scan->change_time_high_s, scan->time_s[k]);
-  }
-  const auto [first, last] = std::minmax_element(scan->time_s.begin(), scan->time_s.end());
-  const double span = *last - *first;
-  return span > 0.0 &&
-         scan->change_time_high_s - scan->change_time_low_s > kMaxStepTimeFraction * span;
-}
-
-}  // namespace
-
 // Stage: the scan for a step of the spec's change_scan groups within the survey
 // (change_scan.h), on the linearisation and with the budget's widening.
 CalibrationStatus ScanChanges(Run& run) {
@@ -547,10 +515,7 @@ CalibrationStatus ScanChanges(Run& run) {
     scan.trend_shift.push_back(out.trend_shift[j] / to_si);
     scan.trend_shift_sigma.push_back(out.trend_shift_sigma[j] / to_si);
   }
-  const bool undetermined = ChangeTimeInterval(static_cast<int>(in.scanned.size()), &scan);
-  scan.wanders =
-      !scan.changes.empty() &&
-      (scan.changes.size() > 1 || scan.trend_statistic >= scan.best_step_statistic || undetermined);
+  SetChangeTimeAndWandering(static_cast<int>(in.scanned.size()), &scan);
   return CalibrationStatus::kOk;
 }
 

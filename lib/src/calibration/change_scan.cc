@@ -8,6 +8,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 
 #include "fastcal/internal/atomic_file.h"
@@ -506,8 +507,8 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
                 " +- " + FormatDouble("%.2g", c.shift_sigma[k]) + " " + scan.units[k];
     }
     out += (out.empty() ? "" : "; ") + std::string("a change at ") +
-           Instant(c.time_s, scan.time_display) + " (line " +
-           std::to_string(c.line) + ", p " + FormatDouble("%.2g", c.p_value) + "): " + shifts;
+           Instant(c.time_s, scan.time_display) + " (line " + std::to_string(c.line) + ", p " +
+           FormatDouble("%.2g", c.p_value) + "): " + shifts;
   }
   if (scan.wanders) {
     std::string trend;
@@ -518,8 +519,8 @@ std::string ChangeScanVerdict(const ChangeScanResult& scan) {
     }
     out += "; but the data show a gradual change (a wandering) rather than a step: " +
            std::string(scan.changes.size() > 1 ? "several steps were needed; " : "") +
-           "its time is between " + Instant(scan.change_time_low_s, scan.time_display) +
-           " and " + Instant(scan.change_time_high_s, scan.time_display) +
+           "its time is between " + Instant(scan.change_time_low_s, scan.time_display) + " and " +
+           Instant(scan.change_time_high_s, scan.time_display) +
            " (95%); a steady trend explains " +
            (scan.trend_statistic >= scan.best_step_statistic ? "at least as much as"
                                                              : "some of what") +
@@ -560,8 +561,9 @@ bool ReadSummaryChangeTimes(const std::string& path, std::vector<double>* times_
       return false;
     }
     if (root["change_scan"].IsNull()) {
-      *error = what + "that calibration had no change scan (a spec with change_scan: {...}, "
-                      "docs/calibration.md, \"Change scan\")";
+      *error = what +
+               "that calibration had no change scan (a spec with change_scan: {...}, "
+               "docs/calibration.md, \"Change scan\")";
       return false;
     }
     const YAML::Node changes = root["changes"];
@@ -585,6 +587,34 @@ bool ReadSummaryChangeTimes(const std::string& path, std::vector<double>* times_
     *error = what + "cannot read it as JSON: " + e.what();
     return false;
   }
+}
+
+void SetChangeTimeAndWandering(int scanned, ChangeScanResult* scan) {
+  scan->wanders = false;
+  if (scan->statistic.empty()) return;
+  // Chi-square 95% points for 1, 2, 3 degrees of freedom (the mass centre's axes), and
+  // the Wilson-Hilferty approximation beyond.
+  const double kChiSquare95[] = {3.841, 5.991, 7.815};
+  const double c =
+      scanned <= 3
+          ? kChiSquare95[std::max(scanned, 1) - 1]
+          : scanned *
+                std::pow(1.0 - 2.0 / (9.0 * scanned) + 1.645 * std::sqrt(2.0 / (9.0 * scanned)), 3);
+  const double best = *std::max_element(scan->statistic.begin(), scan->statistic.end());
+  scan->change_time_low_s = std::numeric_limits<double>::infinity();
+  scan->change_time_high_s = -std::numeric_limits<double>::infinity();
+  for (size_t k = 0; k < scan->statistic.size(); ++k) {
+    if (scan->statistic[k] < best - c) continue;
+    scan->change_time_low_s = std::min(scan->change_time_low_s, scan->time_s[k]);
+    scan->change_time_high_s = std::max(scan->change_time_high_s, scan->time_s[k]);
+  }
+  const auto [first, last] = std::minmax_element(scan->time_s.begin(), scan->time_s.end());
+  const double span = *last - *first;
+  const bool undetermined = span > 0.0 && scan->change_time_high_s - scan->change_time_low_s >
+                                              kMaxStepTimeFraction * span;
+  scan->wanders = !scan->changes.empty() &&
+                  (scan->changes.size() > 1 || scan->trend_statistic >= scan->best_step_statistic ||
+                   undetermined);
 }
 
 }  // namespace fastcal
