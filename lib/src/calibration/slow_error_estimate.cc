@@ -27,6 +27,9 @@ constexpr int kMaxEvaluations = 120;
 constexpr double kValueTolerance = 1e-2;
 // Step of the central differences for the curvature, in log units.
 constexpr double kCurvatureStep = 0.1;
+// A nuisance column whose pivot in the unit-diagonal Gram matrix is below this is the
+// others' combination to rounding: the session does not inform it.
+constexpr double kCollinearPivot = 1e-9;
 // Chi-square(2) 99% quantile: a stated process the likelihood rejects at 1%.
 constexpr double kChiSquare2Quantile99 = 9.21034;
 
@@ -45,17 +48,21 @@ struct NuisanceSums {
 };
 
 // log det G - b^T G^-1 b of the first `columns` nuisance columns; a column the session
-// does not inform (the gain's, when the reading hardly changes) is dropped.
+// does not inform (the gain's, when the reading hardly changes) is dropped. Judged on G
+// scaled to a unit diagonal: the columns' units differ by a reading's (1 / s against
+// r / s: ~10^10 in their squares), and a test on G itself dropped an informed gain.
 double RestrictedTerm(const NuisanceSums& sums, int columns) {
   for (int c = columns; c >= 1; --c) {
     const Eigen::MatrixXd g = sums.gram.topLeftCorner(c, c);
-    const double trace = g.trace();
-    if (!(trace > 0.0)) return 0.0;  // no reading of this cable in this session
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(g);
+    const Eigen::VectorXd scale = g.diagonal().cwiseMax(0.0).cwiseSqrt();
+    if (!(scale.minCoeff() > 0.0)) return 0.0;  // no reading of this cable in this session
+    const Eigen::VectorXd inverse = scale.cwiseInverse();
+    const Eigen::MatrixXd unit = inverse.asDiagonal() * g * inverse.asDiagonal();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(unit);
     const Eigen::VectorXd d = ldlt.vectorD();
-    if (d.minCoeff() <= 1e-12 * trace) continue;
-    const Eigen::VectorXd b = sums.cross.head(c);
-    return d.array().log().sum() - b.dot(ldlt.solve(b));
+    if (d.minCoeff() <= kCollinearPivot) continue;
+    const Eigen::VectorXd b = inverse.cwiseProduct(sums.cross.head(c));
+    return d.array().log().sum() + 2.0 * scale.array().log().sum() - b.dot(ldlt.solve(b));
   }
   return 0.0;
 }
@@ -68,22 +75,34 @@ int CountSessions(const std::vector<SlowErrorSample>& samples) {
 
 }  // namespace
 
-double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
-                                      const SlowErrorProcess& process) {
+namespace {
+
+// -2 l_R with the per-reading terms kept in `terms` (reused between evaluations: the
+// search evaluates ~100 times, and a fresh 10 MB a time cost page faults).
+double MinusTwoLogLikelihood(const SlowErrorEstimateInputs& in, const SlowErrorProcess& process,
+                             std::vector<double>* terms) {
   const int nuisance = in.gain_nuisance ? 2 : 1;
   const int columns = 1 + nuisance;
   const int count = static_cast<int>(in.samples.size());
   std::vector<std::array<NuisanceSums, kNumCables>> sums(CountSessions(in.samples));
   // Each cable's filter on its own (cables split among the threads); the terms of -2 l
   // kept per reading and summed afterwards in the order of one thread, so that the total
-  // has the same bits on any number of threads. Each cable's nuisance sums are its own.
-  std::vector<std::array<double, kNumCables>> log_f(count), square(count);
+  // has the same bits on any number of threads. Each cable's terms, and its nuisance sums
+  // while they accumulate, lie apart from the other cables' (cables on different threads
+  // writing one cache line stalled both: two threads were no faster than one).
+  terms->resize(2 * static_cast<size_t>(kNumCables) * count);
+  double* const log_f = terms->data();
+  double* const square = log_f + static_cast<size_t>(kNumCables) * count;
+  const auto at = [count](double* a, int i, int t) -> double& {
+    return a[static_cast<size_t>(i) * count + t];
+  };
   const int groups = std::clamp(in.num_threads, 1, kNumCables);
   const auto whiten_group = [&](int group) {
     const int first = kNumCables * group / groups, end = kNumCables * (group + 1) / groups;
+    std::vector<std::array<NuisanceSums, kNumCables>> own(sums.size());
     // White noise alone: an inactive whitener leaves the rows as they are (F = 1).
     ReadingWhitener whitener(process, columns, first, end);
-    double rows[kNumCables * 3], rho[kNumCables];
+    double rows[kNumCables * 3], rho[kNumCables], log_f_t[kNumCables];
     for (int t = 0; t < count; ++t) {
       const SlowErrorSample& s = in.samples[t];
       for (int i = first; i < end; ++i) {
@@ -92,20 +111,24 @@ double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
         row[1] = 1.0 / s.sigma_n[i];
         if (nuisance == 2) row[2] = s.reading_n[i] / s.sigma_n[i];
         rho[i] = process.IsActive() ? process.SigmaN(s.reading_n[i]) / s.sigma_n[i] : 0.0;
-        log_f[t][i] = 0.0;
+        log_f_t[i] = 0.0;
       }
-      whitener.Whiten(s.time_s, s.session, rho, s.excluded.data(), rows, log_f[t].data());
+      whitener.Whiten(s.time_s, s.session, rho, s.excluded.data(), rows, log_f_t);
       for (int i = first; i < end; ++i) {
-        square[t][i] = 0.0;
+        at(log_f, i, t) = log_f_t[i];
+        at(square, i, t) = 0.0;
         if (s.excluded[i]) continue;  // as if missing: the state only moves on in time
         const double* row = rows + i * columns;
-        square[t][i] = row[0] * row[0];
-        NuisanceSums& n = sums[s.session][i];
+        at(square, i, t) = row[0] * row[0];
+        NuisanceSums& n = own[s.session][i];
         for (int a = 0; a < nuisance; ++a) {
           n.cross[a] += row[1 + a] * row[0];
           for (int b = 0; b < nuisance; ++b) n.gram(a, b) += row[1 + a] * row[1 + b];
         }
       }
+    }
+    for (size_t k = 0; k < sums.size(); ++k) {
+      for (int i = first; i < end; ++i) sums[k][i] = own[k][i];
     }
   };
   // The groups of threads the system refused (OnThreads) are whitened here afterwards.
@@ -115,17 +138,25 @@ double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
     const SlowErrorSample& s = in.samples[t];
     double sample_log_f = 0.0;
     for (int i = 0; i < kNumCables; ++i) {
-      if (!s.excluded[i]) sample_log_f += log_f[t][i];
+      if (!s.excluded[i]) sample_log_f += at(log_f, i, t);
     }
     total += sample_log_f;
     for (int i = 0; i < kNumCables; ++i) {
-      if (!s.excluded[i]) total += square[t][i];
+      if (!s.excluded[i]) total += at(square, i, t);
     }
   }
   for (const auto& session : sums) {
     for (const NuisanceSums& n : session) total += RestrictedTerm(n, nuisance);
   }
   return total;
+}
+
+}  // namespace
+
+double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
+                                      const SlowErrorProcess& process) {
+  std::vector<double> terms;
+  return MinusTwoLogLikelihood(in, process, &terms);
 }
 
 namespace {
@@ -137,6 +168,7 @@ struct Search {
   bool free[2] = {false, false};
   double lower[2] = {0.0, 0.0}, upper[2] = {0.0, 0.0};
   double a_ref = 1.0;  // the amplitude equal to the white sigma at a median reading
+  mutable std::vector<double> terms;  // the likelihood's scratch, kept between evaluations
 
   SlowErrorProcess At(const Eigen::Vector2d& y) const {
     SlowErrorProcess p = in->spec.stated;
@@ -151,7 +183,7 @@ struct Search {
     return y;
   }
   double Value(const Eigen::Vector2d& y) const {
-    return SlowErrorMinusTwoLogLikelihood(*in, At(Clamp(y)));
+    return MinusTwoLogLikelihood(*in, At(Clamp(y)), &terms);
   }
 };
 
