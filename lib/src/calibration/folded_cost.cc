@@ -59,7 +59,10 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
   *rho_sum = 0.0;
   SampleRowWhitener whitener(samples_, n + 1);
   const int failed = ReduceChunksInOrder<Part>(
-      samples_.size(), threads_, [n] { return Part{{}, RowFold(n + 1)}; },
+      samples_.size(), threads_,
+      [n] {
+        return Part{{}, RowFold(n + 1)};
+      },
       [&](int begin, int end, Part* part) {
         part->rows.Reset(begin, end, n + 1, m);
         for (int t = begin; t < end; ++t) {
@@ -121,6 +124,15 @@ bool FoldedTensionCost::Evaluate(double const* const* parameters, double* residu
     for (int k = 0; k < n; ++k) jac[i * n + k] = memo_r_aug_(i, k);
   }
   std::fill(jac + n * n, jac + (n + 1) * n, 0.0);
+  return true;
+}
+
+bool FoldedTensionCost::FoldedAt(const double* theta, Eigen::MatrixXd* r_aug) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!memo_ok_ || memo_theta_.empty() || !std::equal(theta, theta + n_, memo_theta_.begin())) {
+    return false;
+  }
+  *r_aug = memo_r_aug_;
   return true;
 }
 

@@ -227,7 +227,7 @@ struct Search {
   bool free[2] = {false, false};
   double lower[2] = {0.0, 0.0}, upper[2] = {0.0, 0.0};
   double a_ref = 1.0;  // the amplitude equal to the white sigma at a median reading
-  LaidOut laid_out;  // in's readings, laid out for the evaluations
+  LaidOut laid_out;    // in's readings, laid out for the evaluations
 
   SlowErrorProcess At(const Eigen::Vector2d& y) const {
     SlowErrorProcess p = in->spec.stated;

@@ -55,6 +55,9 @@ class FoldedTensionCost : public ceres::CostFunction {
   FoldedTensionCost(const FittedSamples& samples, const ceres::LossFunction* loss, int threads);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  // The last evaluation's folded rows [R z] when it was at theta (no new evaluation);
+  // false otherwise.
+  bool FoldedAt(const double* theta, Eigen::MatrixXd* r_aug) const;
 
  private:
   bool Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const;
