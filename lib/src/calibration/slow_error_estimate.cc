@@ -127,7 +127,8 @@ struct CableTerms {
 
 // Cables [first, end) through the filter of slow_error_filter.h, sample by sample (one
 // exp(-dt / tau) a sample). Per reading: rho = sqrt((sigma_N / s)^2 + (a r / s)^2) from
-// the laid-out 1 / s and r / s; one division (1 / F), two square roots and a logarithm.
+// the laid-out 1 / s and r / s; one division (1 / F) and two square roots (and a
+// logarithm per kLogBatch readings).
 // A reading left out leaves the state as it is (a missing one) and adds nothing.
 template <int kNuisance>
 void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first, int end,
@@ -142,6 +143,14 @@ void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first,
   };
   State state[kNumCables];
   CableTerms own[kNumCables];
+  // log F summed as the log of products of up to kLogBatch F's (F >= 1; a product is
+  // taken early past kLogFlush, far from overflow): one logarithm per kLogBatch readings,
+  // the same sum to rounding.
+  constexpr int kLogBatch = 8;
+  constexpr double kLogFlush = 1e200;
+  double product[kNumCables];
+  int in_product[kNumCables] = {};
+  for (double& p : product) p = 1.0;
   for (int i = first; i < end; ++i) own[i].sums.resize(in.sessions);
   for (int t = 0; t < in.count; ++t) {
     const bool new_series = in.dt_s[t] == LaidOut::kNewSeries;
@@ -175,7 +184,12 @@ void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first,
       }
       st.p -= gain * rho * st.p;
       CableTerms& out = own[i];
-      if (active) out.log_f += std::log(f);
+      product[i] *= f;
+      if (++in_product[i] == kLogBatch || product[i] > kLogFlush) {
+        out.log_f += std::log(product[i]);
+        product[i] = 1.0;
+        in_product[i] = 0;
+      }
       out.square += w[0] * w[0];
       NuisanceSums& n = out.sums[in.session[t]];
       for (int u = 0; u < kNuisance; ++u) {
@@ -184,7 +198,10 @@ void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first,
       }
     }
   }
-  for (int i = first; i < end; ++i) terms[i] = std::move(own[i]);
+  for (int i = first; i < end; ++i) {
+    if (in_product[i] > 0) own[i].log_f += std::log(product[i]);
+    terms[i] = std::move(own[i]);
+  }
 }
 
 // -2 l_R: each cable's filter on its own (cables split among the threads), its terms
