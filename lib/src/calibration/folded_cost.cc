@@ -44,70 +44,48 @@ FoldedTensionCost::FoldedTensionCost(const FittedSamples& samples, const ceres::
     : samples_(samples), loss_(loss), threads_(threads), n_(samples.model->num_free()) {
   set_num_residuals(n_ + 1);
   mutable_parameter_block_sizes()->push_back(n_);
-  if (by_reading) layout_ = LayOutByReading(samples, loss);
+  if (by_reading) reading_columns_ = ReadingColumns(samples, loss);
 }
 
-FoldedTensionCost::ReadingLayout FoldedTensionCost::LayOutByReading(
-    const FittedSamples& samples, const ceres::LossFunction* loss) {
-  ReadingLayout layout;
-  // A loss's correction mixes a sample's rows; lengths' rows are left to the plain fold.
-  if (loss != nullptr || samples.readings() != kNumCables) return layout;
+std::vector<std::vector<int>> ReadingColumns(const FittedSamples& samples,
+                                             const ceres::LossFunction* loss) {
+  if (loss != nullptr || samples.readings() != kNumCables) return {};
   const CalibrationModel& model = *samples.model;
   const int n = model.num_free();
-  std::array<std::vector<int>, kNumCables> own;
+  std::vector<std::vector<int>> columns(kNumCables);
   std::vector<int> shared;
   for (int k = 0; k < n; ++k) {
     const ParameterSpec& p = model.spec().parameters[model.spec_index(k)];
     const bool sensor =
         p.kind == ParameterKind::kSensorGain || p.kind == ParameterKind::kSensorBias;
     if (sensor && p.index >= 0 && p.index < kNumCables) {
-      own[p.index].push_back(k);
+      columns[p.index].push_back(k);
     } else {
       shared.push_back(k);
     }
   }
-  if (shared.size() == static_cast<size_t>(n)) return layout;  // nothing to gain
-  layout.structured = true;
-  for (int i = 0; i < kNumCables; ++i) {
-    layout.columns[i] = own[i];
-    layout.columns[i].insert(layout.columns[i].end(), shared.begin(), shared.end());
-    layout.columns[i].push_back(n);  // the residual
+  if (shared.size() == static_cast<size_t>(n)) return {};  // nothing to gain
+  for (std::vector<int>& c : columns) {
+    c.insert(c.end(), shared.begin(), shared.end());
+    c.push_back(n);  // the residual
   }
-  return layout;
+  return columns;
 }
 
 void FoldedTensionCost::FoldByReading(const SampleRows& rows, int begin, int end, RowFold* fold,
                                       double* rho) const {
   const int n = n_;
-  std::array<RowFold, kNumCables> own;
-  for (int i = 0; i < kNumCables; ++i)
-    own[i] = RowFold(static_cast<int>(layout_.columns[i].size()));
-  double gathered[kMaxFreeParameters + 1];
+  GroupedRowFold grouped(reading_columns_, n + 1);
   for (int t = begin; t < end; ++t) {
     double sq_norm = 0.0;  // as CorrectForLoss sums it without a loss
     for (int i = 0; i < kNumCables; ++i) {
       const double* row = rows.Of(t) + i * rows.columns;
       sq_norm += row[n] * row[n];
-      const std::vector<int>& columns = layout_.columns[i];
-      for (size_t c = 0; c < columns.size(); ++c) gathered[c] = row[columns[c]];
-      own[i].Add(gathered, 1);
+      grouped.Add(i, row);
     }
     *rho += sq_norm;
   }
-  // Each reading's R, its rows put back in the n + 1 columns, folded into the chunk's.
-  std::vector<double> expanded;
-  for (int i = 0; i < kNumCables; ++i) {
-    own[i].Flush();
-    const Eigen::MatrixXd r = own[i].r();
-    const std::vector<int>& columns = layout_.columns[i];
-    const int width = static_cast<int>(columns.size());
-    expanded.assign(static_cast<size_t>(width) * (n + 1), 0.0);
-    for (int a = 0; a < width; ++a) {
-      for (int c = a; c < width; ++c) expanded[a * (n + 1) + columns[c]] = r(a, c);
-    }
-    fold->Add(expanded.data(), width);
-  }
-  fold->Flush();
+  grouped.FlushInto(fold);
 }
 
 bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const {
@@ -136,7 +114,7 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
       },
       [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
       [&](int begin, int end, Part* part) {
-        if (layout_.structured) {
+        if (folds_by_reading()) {
           FoldByReading(part->rows, begin, end, &part->fold, &part->rho);
           return -1;
         }
