@@ -139,7 +139,17 @@ void AddToFold(const std::array<bool, kNumCables>& excluded,
     ++fold->readings[i];
     fold->sse_n2[i] += ri * ri;
     fold->cross_n2[i] += ri * ji;
-    fold->normal_n2[i].noalias() += ji * ji.transpose();
+    // Its lower triangle only (the upper is filled once, SymmetricNormals).
+    fold->normal_n2[i].selfadjointView<Eigen::Lower>().rankUpdate(ji);
+  }
+}
+
+// Each block's per-cable normal matrices, accumulated in their lower triangles, made whole.
+void SymmetricNormals(std::vector<FoldSums>* folds) {
+  for (FoldSums& f : *folds) {
+    for (Eigen::MatrixXd& m : f.normal_n2) {
+      m.triangularView<Eigen::StrictlyUpper>() = m.transpose();
+    }
   }
 }
 
@@ -347,6 +357,7 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   out->chi_square = total.chi_square;
   out->raw_chi_square = total.raw_chi_square;
   out->readings = total.readings;
+  SymmetricNormals(&total.folds);
   out->folds = std::move(total.folds);
   out->session_information = std::move(total.session_information);
   out->session_gradient = std::move(total.session_gradient);
