@@ -830,14 +830,29 @@ TEST(CalibrationTest, ThreadsDoNotChangeTheResult) {
   // noise and with a slow sensor error estimated and whitened (its filters in time order).
   Dataset data = CircleData(Truth(), 2600, 0.03, 33);
   for (size_t t = 0; t < data.samples.size(); ++t) data.samples[t].time_s = static_cast<double>(t);
-  for (bool slow : {false, true}) {
-    SCOPED_TRACE(slow ? "slow error" : "white");
+  // Third case, as the recommended spec: no loss, per-cable sensor gains and biases with
+  // priors (the fold by reading, folded_cost.h) and the slow error.
+  for (int variant : {0, 1, 2}) {
+    const bool slow = variant > 0;
+    SCOPED_TRACE(variant == 2 ? "sensors, no loss" : slow ? "slow error" : "white");
     CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
-    spec.robust_loss = RobustLoss::kHuber;
+    spec.robust_loss = variant == 2 ? RobustLoss::kNone : RobustLoss::kHuber;
     spec.robust_loss_scale = 2.0;
     spec.holdout_fraction = 0.2;
     spec.slow_error.enabled = spec.slow_error.estimate_amplitude = slow;
     spec.slow_error.estimate_time_constant = slow;
+    for (int i = 0; variant == 2 && i < kNumCables; ++i) {
+      const std::string cable = "[" + std::to_string(i + 1) + "]";
+      ParameterSpec gain = Free(ParameterKind::kSensorGain, i, -1, "sensor_gain" + cable);
+      gain.has_prior = true;
+      gain.prior_mean_si = 1.0;
+      gain.prior_sigma_si = 0.01;
+      ParameterSpec bias = Free(ParameterKind::kSensorBias, i, -1, "sensor_bias_kN" + cable);
+      bias.has_prior = true;
+      bias.prior_sigma_si = 2000.0;
+      spec.parameters.push_back(gain);
+      spec.parameters.push_back(bias);
+    }
     CalibrationResult results[3];
     for (int k = 0; k < 3; ++k) {
       spec.num_threads = k + 1;

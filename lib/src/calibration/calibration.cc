@@ -462,7 +462,10 @@ CalibrationStatus CheckIdentifiability(Run& run) {
 ceres::Solver::Options SolverOptions(const Run& run, ProgressCallback* callback) {
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_QR;
-  so.num_threads = internal::MachineThreads(run.spec.num_threads);
+  // One Ceres thread: the data term is one block that folds the samples on the spec's
+  // threads itself; Ceres's threads would only sum the blocks' costs (the priors') in an
+  // order that depends on their number, and the final cost's last bits with it.
+  so.num_threads = 1;
   so.max_num_iterations = run.spec.max_iterations;
   so.function_tolerance = run.spec.function_tolerance;
   so.gradient_tolerance = run.spec.gradient_tolerance;
