@@ -59,6 +59,7 @@ if [ "$mode" = all ] || [ "$mode" = --tsan-only ]; then
     design_test '*GradientMatchesNumericDifferentiation*:*MatchesBruteForce*'
     evaluation_stream_test '*'
     slow_error_test '*ThreadsDoNotChangeTheLikelihood*'
+    uncertainty_test '*ThreadsDoNotChangeTheBudget*'
     track_fold_test '*SameBytesOnAnyNumberOfThreads*'
     cli_test '*SimulateCalibrateEvaluateRoundTrip*:*ResidualsOfALongCalibrationAreInFileOrder*'
     cli_faults_test '*TwoRuns*:*ADeviceAsData*'

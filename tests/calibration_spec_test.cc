@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "bounded_process.h"
+#include "temp_path.h"
 
 namespace fastcal {
 namespace {
@@ -458,8 +459,8 @@ TEST(CalibrationSpecTest, SlowErrorIsReadAndWrittenBack) {
   EXPECT_TRUE(both.slow_error.enabled && both.slow_error.estimate_amplitude &&
               both.slow_error.amplitude_in_percent && both.slow_error.estimate_time_constant);
   EXPECT_FALSE(both.slow_error.Initial().IsActive());  // white until estimated
-  const CalibrationSpec stated = ParseOk(
-      "noise:\n  slow_error: {sigma_percent: 1.5, sigma_kN: 0.5, time_constant_s: 60}\n");
+  const CalibrationSpec stated =
+      ParseOk("noise:\n  slow_error: {sigma_percent: 1.5, sigma_kN: 0.5, time_constant_s: 60}\n");
   EXPECT_FALSE(stated.slow_error.estimates_any());
   EXPECT_DOUBLE_EQ(stated.slow_error.stated.sigma_percent, 1.5);
   EXPECT_DOUBLE_EQ(stated.slow_error.stated.sigma_n, 0.5 * kNewtonsPerKilonewton);
@@ -732,7 +733,7 @@ TEST(CalibrationSpecTest, MissingFileIsReported) {
 }
 
 TEST(CalibrationSpecTest, LoadedFileErrorsNameThePath) {
-  const std::string path = testing::TempDir() + "/bad_spec.yaml";
+  const std::string path = test::TempPath("bad_spec", ".yaml");
   {
     std::ofstream out(path);
     out << "# comment\nholdout:\n  fraction: 2\n";

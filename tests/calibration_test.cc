@@ -25,6 +25,7 @@
 #include "fastcal/report.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
+#include "temp_path.h"
 
 namespace fastcal {
 namespace {
@@ -451,7 +452,7 @@ TEST(CalibrationTest, ZeroReadingsFromAFileAreGrossErrorsAndNothingIsInfinite) {
   for (const auto& [sample, cable] : dropouts) simulated.samples[sample].tension_n[cable] = 0.0;
   const int glitch_sample = 93, glitch_cable = 0;
   simulated.samples[glitch_sample].tension_n[glitch_cable] *= 4.0;
-  const std::string path = ::testing::TempDir() + "calibration_test_dropouts.csv";
+  const std::string path = test::TempPath("calibration_test_dropouts", ".csv");
   std::string error;
   ASSERT_TRUE(WriteDataset(path, simulated, "", &error)) << error;
   Dataset data;

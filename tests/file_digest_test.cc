@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "bounded_process.h"
+#include "temp_path.h"
 
 namespace fastcal {
 namespace {
@@ -22,7 +23,7 @@ namespace fs = std::filesystem;
 class FileDigestTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::path(::testing::TempDir()) / "fastcal_file_digest_test";
+    dir_ = fs::path(test::TempPath("fastcal_file_digest_test"));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }

@@ -70,6 +70,24 @@ CalibrationSpec MassCentreSpec() {
   return spec;
 }
 
+// The mass centre, a common density, and per cable a sensor gain and bias (each enters
+// one cable's reading only: the fold by reading).
+CalibrationSpec SensorSpec() {
+  CalibrationSpec spec = MassCentreSpec();
+  for (ParameterKind kind : {ParameterKind::kSensorGain, ParameterKind::kSensorBias}) {
+    for (int i = 0; i < kNumCables; ++i) {
+      ParameterSpec p;
+      p.kind = kind;
+      p.index = i;
+      p.name = std::string(kind == ParameterKind::kSensorGain ? "sensor_gain" : "sensor_bias_kN") +
+               "[" + std::to_string(i + 1) + "]";
+      p.free = true;
+      spec.parameters.push_back(p);
+    }
+  }
+  return spec;
+}
+
 // The problem's inputs, owned here (FittedSamples points into them).
 struct Fixture {
   Dataset data;
@@ -79,7 +97,8 @@ struct Fixture {
   std::vector<std::array<double, kNumCables>> sigma_n;
   ReadingMask excluded;
 
-  explicit Fixture(int samples) : data(RandomData(samples)) {
+  explicit Fixture(int samples, const CalibrationSpec& with = MassCentreSpec())
+      : data(RandomData(samples)), spec(with), model(CableRobot::NominalFast(), spec) {
     for (size_t t = 0; t < data.samples.size(); ++t) {
       fit.push_back(static_cast<int>(t));
       sigma_n.push_back(TensionSigmas(data.samples[t].tension_n, 0.0, 3.0));
@@ -246,6 +265,35 @@ TEST(FoldedCostTest, SlowErrorGivesDenseGeneralisedLeastSquares) {
   EXPECT_NEAR(cost_only, dense.cost, kRelTol * dense.cost);
 }
 
+// Folding each reading's rows on their own first (sensor gains and biases enter one
+// cable's reading): the cost, gradient and Gauss-Newton matrix of the full-width fold,
+// with a slow error, two sessions and a reading kept out, theta off the truth in every
+// kind of column.
+TEST(FoldedCostTest, FoldByReadingIsTheFullFold) {
+  Fixture f(2 * kSampleChunk + 100, SensorSpec());
+  f.WithSlowError(kSampleChunk + 20);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[2] += 0.4;
+  theta[5] += 0.01;  // a sensor gain
+  theta[12] += 900;  // a sensor bias, in N
+  const FittedSamples samples = f.Samples();
+  ceres::Problem full, by_reading;
+  auto* plain = new FoldedTensionCost(samples, nullptr, 2, /*by_reading=*/false);
+  auto* split = new FoldedTensionCost(samples, nullptr, 2);
+  EXPECT_FALSE(plain->folds_by_reading());
+  ASSERT_TRUE(split->folds_by_reading());
+  full.AddResidualBlock(plain, nullptr, theta.data());
+  by_reading.AddResidualBlock(split, nullptr, theta.data());
+  const Evaluation a = Evaluate(&full);
+  const Evaluation b = Evaluate(&by_reading);
+  EXPECT_NEAR(b.cost, a.cost, kRelTol * a.cost);
+  EXPECT_LT((b.gradient - a.gradient).norm(), kRelTol * a.gradient.norm());
+  EXPECT_LT((b.normal - a.normal).norm(), kRelTol * a.normal.norm());
+  // A loss's correction mixes a sample's rows: then every row is folded at full width.
+  const ceres::HuberLoss huber(1.0);
+  EXPECT_FALSE(FoldedTensionCost(samples, &huber, 2).folds_by_reading());
+}
+
 // The folded block's residuals and Jacobian on `threads` threads, theta moved off the
 // initial model.
 std::vector<double> FoldedOnThreads(const Fixture& f, const ceres::LossFunction* loss,
@@ -267,11 +315,14 @@ TEST(FoldedCostTest, ThreadsGiveTheSameBits) {
   EXPECT_EQ(FoldedOnThreads(f, &huber, 1), FoldedOnThreads(f, &huber, 3));
 }
 
-// With the slow error's filters in the ordered stage too.
+// With the slow error's filters in the ordered stage too, and folded by reading.
 TEST(FoldedCostTest, ThreadsGiveTheSameBitsWithASlowError) {
   Fixture f(3 * kSampleChunk + 7);
   f.WithSlowError(2 * kSampleChunk + 500);
   EXPECT_EQ(FoldedOnThreads(f, nullptr, 1), FoldedOnThreads(f, nullptr, 3));
+  Fixture sensors(3 * kSampleChunk + 7, SensorSpec());
+  sensors.WithSlowError(2 * kSampleChunk + 500);
+  EXPECT_EQ(FoldedOnThreads(sensors, nullptr, 1), FoldedOnThreads(sensors, nullptr, 3));
 }
 
 // A trial step's cost, then the Jacobian at the same theta (the memo): the same numbers
@@ -363,7 +414,8 @@ TEST(SampleChunksTest, OrderedStageRunsInChunkOrder) {
           return -1;
         },
         [&](int begin, int end, std::vector<double>* v) {
-          for (int t = begin; t < end; ++t) (*v)[t - begin] = carried = 0.9 * carried + (*v)[t - begin];
+          for (int t = begin; t < end; ++t)
+            (*v)[t - begin] = carried = 0.9 * carried + (*v)[t - begin];
         },
         [&](int begin, int end, std::vector<double>* v) {
           std::copy(v->begin(), v->end(), out.begin() + begin);

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/QR>
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -47,6 +48,33 @@ TEST(RowFoldTest, NormalMatrixIsTheRowsOwnWhateverThePieces) {
     EXPECT_TRUE(r.isUpperTriangular());
     EXPECT_LT((r.transpose() * r - normal).norm(), kRelTol * normal.norm()) << pieces[0];
   }
+}
+
+TEST(GroupedRowFoldTest, SameNormalMatrixAsTheFullWidthFold) {
+  // Three groups of rows, each zero outside its own columns (two of its own, four shared,
+  // in no particular order), folded by group then into the full width, twice (FlushInto
+  // starts the groups afresh).
+  constexpr double kRelTol = 1e-12;
+  const std::vector<std::vector<int>> columns = {
+      {0, 1, 6, 7, 8, 9}, {2, 3, 6, 7, 8, 9}, {9, 4, 5, 8, 7, 6}};
+  RowMajor a = RandomRows(600, 10, 4);
+  for (int i = 0; i < a.rows(); ++i) {
+    const std::vector<int>& own = columns[i % 3];
+    for (int j = 0; j < a.cols(); ++j) {
+      if (std::find(own.begin(), own.end(), j) == own.end()) a(i, j) = 0.0;
+    }
+  }
+  const Eigen::MatrixXd normal = a.transpose() * a;
+  GroupedRowFold grouped(columns, 10);
+  RowFold fold(10);
+  for (int i = 0; i < a.rows(); ++i) {
+    grouped.Add(i % 3, a.row(i).data());
+    if (i == 299) grouped.FlushInto(&fold);
+  }
+  grouped.FlushInto(&fold);
+  const Eigen::MatrixXd r = fold.r();
+  EXPECT_TRUE(r.isUpperTriangular());
+  EXPECT_LT((r.transpose() * r - normal).norm(), kRelTol * normal.norm());
 }
 
 TEST(RowFoldTest, SameRAsAQrOfAllTheRowsUpToSigns) {

@@ -15,6 +15,7 @@
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
 #include "random_cap_poses.h"
+#include "temp_path.h"
 
 namespace fastcal {
 namespace {
@@ -64,7 +65,7 @@ TEST(SessionsTest, SessionColumnRoundTrips) {
   Dataset d;
   std::string error;
   ASSERT_TRUE(ParseDataset(Rows({"A", "B", "A"}), "s.csv", {}, &d, &error)) << error;
-  const std::string path = ::testing::TempDir() + "/sessions_round_trip.csv";
+  const std::string path = test::TempPath("sessions_round_trip", ".csv");
   ASSERT_TRUE(WriteDataset(path, d, "", &error)) << error;
   Dataset back;
   ASSERT_TRUE(ReadDataset(path, {}, &back, &error)) << error;

@@ -314,6 +314,84 @@ TEST(SlowErrorEstimate, ThreadsDoNotChangeTheLikelihood) {
   }
 }
 
+// -2 l_R of readings whose per-reading ratio rho is the process's SigmaN over s, computed
+// densely: per cable log det Sigma + y^T Sigma^-1 y over the readings kept, and per cable
+// and session log det G - b^T G^-1 b, G = X^T Sigma^-1 X, b = X^T Sigma^-1 y.
+double DenseRestrictedMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
+                                            const SlowErrorProcess& process) {
+  double total = 0.0;
+  for (int i = 0; i < kNumCables; ++i) {
+    std::vector<Reading> times;
+    std::vector<int> session;
+    std::vector<double> y, rho, inv_s, q;
+    for (const SlowErrorSample& s : in.samples) {
+      if (s.excluded[i]) continue;  // a left-out reading is a missing one
+      times.push_back({s.time_s, s.session});
+      session.push_back(s.session);
+      y.push_back(s.x[i]);
+      rho.push_back(process.SigmaN(s.reading_n[i]) / s.sigma_n[i]);
+      inv_s.push_back(1.0 / s.sigma_n[i]);
+      q.push_back(s.reading_n[i] / s.sigma_n[i]);
+    }
+    const int n = static_cast<int>(y.size());
+    const Eigen::MatrixXd sigma = DenseCovariance(
+        times, Eigen::Map<const Eigen::VectorXd>(rho.data(), n), process.time_constant_s);
+    const Eigen::LLT<Eigen::MatrixXd> llt(sigma);
+    const Eigen::VectorXd yv = Eigen::Map<const Eigen::VectorXd>(y.data(), n);
+    total += 2.0 * Eigen::MatrixXd(llt.matrixL()).diagonal().array().log().sum();
+    total += yv.dot(llt.solve(yv));
+    for (int k = 0; k <= session.back(); ++k) {
+      Eigen::MatrixXd x = Eigen::MatrixXd::Zero(n, in.gain_nuisance ? 2 : 1);
+      for (int t = 0; t < n; ++t) {
+        if (session[t] != k) continue;
+        x(t, 0) = inv_s[t];
+        if (in.gain_nuisance) x(t, 1) = q[t];
+      }
+      const Eigen::MatrixXd g = x.transpose() * llt.solve(x);
+      const Eigen::VectorXd b = x.transpose() * llt.solve(yv);
+      total += std::log(g.determinant()) - b.dot(g.ldlt().solve(b));
+    }
+  }
+  return total;
+}
+
+TEST(SlowErrorEstimate, LikelihoodIsTheDenseRestrictedOne) {
+  // Irregular times, a day's gap, two sessions, readings left out, the bias and gain
+  // profiled out; the amplitude relative, absolute, and both.
+  std::mt19937_64 rng(4242);
+  std::normal_distribution<double> normal;
+  constexpr int kReadings = 48;
+  const std::vector<Reading> times = IrregularTimes(kReadings, &rng);
+  SlowErrorEstimateInputs in;
+  in.gain_nuisance = true;
+  for (int t = 0; t < kReadings; ++t) {
+    SlowErrorSample s;
+    s.time_s = times[t].time_s;
+    s.session = times[t].session;
+    for (int i = 0; i < kNumCables; ++i) {
+      s.reading_n[i] = 2e5 * (1.0 + 0.3 * std::sin(0.2 * t + i));
+      s.sigma_n[i] = 500.0 + 0.02 * s.reading_n[i];
+      s.x[i] = normal(rng);
+      s.excluded[i] = (t * 7 + i) % 11 == 0;
+    }
+    in.samples.push_back(s);
+  }
+  SlowErrorProcess relative, absolute, both;
+  relative.sigma_percent = 1.5;
+  absolute.sigma_n = 3000.0;
+  both.sigma_percent = 0.7;
+  both.sigma_n = 1500.0;
+  for (SlowErrorProcess p : {relative, absolute, both}) {
+    for (double tau : {0.8, 6.0}) {
+      p.time_constant_s = tau;
+      const double dense = DenseRestrictedMinusTwoLogLikelihood(in, p);
+      EXPECT_NEAR(internal::SlowErrorMinusTwoLogLikelihood(in, p), dense,
+                  kExactTolerance * std::abs(dense))
+          << p.sigma_percent << " %, " << p.sigma_n << " N, tau " << tau;
+    }
+  }
+}
+
 TEST(SlowErrorEstimate, SamplesForALongDataset) {
   EXPECT_EQ(internal::SlowErrorEstimateSamples(50, 100).size(), 50u);
   const std::vector<int> runs = internal::SlowErrorEstimateSamples(100000, 1000);

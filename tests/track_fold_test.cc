@@ -17,6 +17,7 @@
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
 #include "random_cap_poses.h"
+#include "temp_path.h"
 
 namespace fastcal {
 namespace {
@@ -321,7 +322,7 @@ TEST(WindowStoreTest, RangesReadAsTheWhole) {
 }
 
 TEST(WindowStoreTest, RecordsRoundTripSortedByTime) {
-  const std::string path = ::testing::TempDir() + "/window_store_test.samples";
+  const std::string path = test::TempPath("window_store_test", ".samples");
   std::remove(path.c_str());
   std::vector<internal::StoredSample> records;
   for (int k = 0; k < 3; ++k) {

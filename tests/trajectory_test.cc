@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "temp_path.h"
+
 namespace fastcal {
 namespace {
 
@@ -504,7 +506,10 @@ TEST(TrajectoryArguments, PoseErrorsNameTheParameter) {
 // ---- Pose CSV ----
 
 std::string WriteTempFile(const std::string& name, const std::string& content) {
-  const std::string path = ::testing::TempDir() + name;
+  const size_t dot = name.rfind('.');
+  const std::string path = dot == std::string::npos
+                               ? test::TempPath(name)
+                               : test::TempPath(name.substr(0, dot), name.substr(dot));
   std::ofstream out(path, std::ios::binary);
   out << content;
   return path;

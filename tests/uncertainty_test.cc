@@ -210,6 +210,27 @@ TEST(UncertaintyBudgetTest, CoversTheTruthUnderCorrelatedErrors) {
   EXPECT_LT(z2 / count, kMaxMeanZ2);
 }
 
+TEST(UncertaintyBudgetTest, ThreadsDoNotChangeTheBudget) {
+  // The parameters' influence series measured on several threads: the same bits.
+  std::mt19937_64 rng(17);
+  const LinearFit f = FitAr1Data(4000, 0.8, 3.0, &rng);
+  BudgetInputs in = LinearBudgetInputs(f);
+  UncertaintyBudget one;
+  ASSERT_TRUE(ComputeUncertaintyBudget(in, &one));
+  ASSERT_TRUE(one.correlated);  // the series measured, and their memory used
+  for (int threads : {2, 3, 8}) {
+    in.num_threads = threads;
+    UncertaintyBudget many;
+    ASSERT_TRUE(ComputeUncertaintyBudget(in, &many));
+    EXPECT_EQ(many.tau, one.tau) << threads << " threads";
+    EXPECT_EQ(many.bandwidth, one.bandwidth) << threads << " threads";
+    for (size_t k = 0; k < one.parameters.size(); ++k) {
+      EXPECT_EQ(many.parameters[k].tau, one.parameters[k].tau) << threads << " threads";
+      EXPECT_EQ(many.parameters[k].total, one.parameters[k].total) << threads << " threads";
+    }
+  }
+}
+
 TEST(UncertaintyBudgetTest, WhiteResidualsKeepTheFormalSigmaAndMisfitScalesIt) {
   constexpr int kSamples = 5000;
   constexpr double kRelTol = 0.15;  // the data part's own noise at N / L ~ 600

@@ -164,6 +164,9 @@ struct BudgetInputs {
   Eigen::VectorXd consider_sigma;
   std::vector<int> consider_group;
   std::vector<std::string> consider_groups;
+  // Threads the parameters' influence series are measured on (the results are the same
+  // bits on any number).
+  int num_threads = 1;
 };
 
 struct ParameterBudget {

@@ -21,6 +21,7 @@
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/calibration_slow_error.h"
+#include "fastcal/internal/decrement_stop.h"
 #include "fastcal/internal/folded_cost.h"
 #include "fastcal/internal/identifiability.h"
 #include "fastcal/internal/number_text.h"
@@ -364,9 +365,10 @@ void BuildProblem(Run& run) {
   run.sigma_n.resize(run.fit.size());
   for (size_t j = 0; j < run.fit.size(); ++j) run.sigma_n[j] = run.at.sigma_n[run.fit[j]];
   run.slow_rho = internal::SlowErrorRatios(run.slow, run.View());
-  run.problem->AddResidualBlock(
-      new internal::FoldedTensionCost(run.Samples(), run.loss.get(), run.spec.num_threads), nullptr,
-      run.theta.data());
+  auto* folded =
+      new internal::FoldedTensionCost(run.Samples(), run.loss.get(), run.spec.num_threads);
+  run.folded = folded;
+  run.problem->AddResidualBlock(folded, nullptr, run.theta.data());
   for (int k = 0; k < run.n; ++k) {
     const ParameterSpec& p = run.Free(k);
     if (p.has_prior) {
@@ -467,10 +469,9 @@ ceres::Solver::Options SolverOptions(const Run& run, ProgressCallback* callback)
   so.parameter_tolerance = run.spec.parameter_tolerance;
   so.minimizer_progress_to_stdout = false;
   so.logging_type = ceres::SILENT;
-  if (callback != nullptr) {
-    so.callbacks.push_back(callback);
-    so.update_state_every_iteration = false;
-  }
+  if (callback != nullptr) so.callbacks.push_back(callback);
+  // The decrement stop (SolveAndReweight) reads theta at each iteration's end.
+  so.update_state_every_iteration = true;
   return so;
 }
 
@@ -504,6 +505,22 @@ bool ReestimateSlowError(Run& run, bool may_change) {
   return settled;
 }
 
+// The decrement stop of the current problem (decrement_stop.h): the data term's folded
+// rows as the fold left them, and the priors.
+internal::DecrementStop MakeDecrementStop(const Run& run, double function_tolerance) {
+  std::vector<internal::DecrementPrior> priors;
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    if (p.has_prior) priors.push_back({k, p.prior_mean_si, p.prior_sigma_si});
+  }
+  const internal::FoldedTensionCost* folded = run.folded;
+  return internal::DecrementStop(
+      [folded](const double* theta, Eigen::MatrixXd* r_aug) {
+        return folded->FoldedAt(theta, r_aug);
+      },
+      std::move(priors), run.theta.data(), function_tolerance);
+}
+
 CalibrationStatus SolveAndReweight(Run& run) {
   CalibrationResult& r = *run.result;
   std::unique_ptr<ProgressCallback> callback;
@@ -527,7 +544,14 @@ CalibrationStatus SolveAndReweight(Run& run) {
       BuildProblem(run);
       if (run.options.progress) run.options.progress(PassNote(pass, CountExcluded(run)) + ":");
     }
-    ceres::Solve(pass == 1 ? first : later, run.problem.get(), &summary);
+    ceres::Solver::Options options = pass == 1 ? first : later;
+    internal::DecrementStop stop = MakeDecrementStop(run, options.function_tolerance);
+    options.callbacks.push_back(&stop);
+    ceres::Solve(options, run.problem.get(), &summary);
+    if (stop.stopped()) {  // where Ceres would have stopped after one more cost evaluation
+      summary.termination_type = ceres::CONVERGENCE;
+      summary.message = stop.Reason();
+    }
     iterations += summary.num_successful_steps + summary.num_unsuccessful_steps;
     if (pass == 1) r.initial_cost = summary.initial_cost;  // at the initial parameters
     const std::string label = pass == 1 ? "pass 1 (weights from the initial model)"

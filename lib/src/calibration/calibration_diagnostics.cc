@@ -10,6 +10,7 @@
 #include "calibration/calibration_run.h"
 #include "fastcal/change_scan.h"
 #include "fastcal/internal/identifiability.h"
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/sensor_steps.h"
 #include "fastcal/sessions.h"
@@ -79,6 +80,7 @@ internal::LinearisationInputs LinearisationInputsOf(const Run& run) {
 BudgetInputs MakeBudgetInputs(const Run& run, internal::Linearisation& lin,
                               const std::vector<ParameterSpec>& candidates) {
   BudgetInputs in;
+  in.num_threads = internal::MachineThreads(run.spec.num_threads);
   in.prior_information = Eigen::VectorXd::Zero(run.n);
   for (int k = 0; k < run.n; ++k) {
     const ParameterSpec& p = run.Free(k);

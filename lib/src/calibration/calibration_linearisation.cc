@@ -119,15 +119,23 @@ struct FreeSums {
 void AddToFold(const std::array<bool, kNumCables>& excluded,
                const std::array<double, kNumCables>& sigma_n, const SampleResiduals& r,
                const RowMatrix& j, const SampleResiduals& r_raw, const RowMatrix& j_raw,
-               double weight, FoldSums* fold) {
+               double weight, const Eigen::MatrixXd* information, FoldSums* fold) {
   ++fold->samples;
-  fold->information.noalias() += weight * weight * j.transpose() * j;
+  // The sample's weight^2 J^T J, when the caller has it (without a loss: weight 1).
+  if (information != nullptr) {
+    fold->information += *information;
+  } else {
+    fold->information.noalias() += weight * weight * j.transpose() * j;
+  }
   fold->gradient.noalias() += weight * weight * j.transpose() * r;
+  const int n = static_cast<int>(j.cols());
+  thread_local Eigen::VectorXd ji;  // a reading's row in N: no allocation per reading
+  ji.resize(n);
   for (int i = 0; i < kNumCables; ++i) {
     if (excluded[i]) continue;
     const double s = sigma_n[i];
-    const Eigen::VectorXd ji = s * j_raw.row(i).transpose();  // N per parameter unit
-    const double ri = s * r_raw[i];                           // N
+    ji.noalias() = s * j_raw.row(i).transpose();  // N per parameter unit
+    const double ri = s * r_raw[i];               // N
     ++fold->readings[i];
     fold->sse_n2[i] += ri * ri;
     fold->cross_n2[i] += ri * ji;
@@ -153,13 +161,14 @@ int EvaluateFree(const LinearisationInputs& in, const ModelAtTheta& at, int begi
 }
 
 // The whitened rows of fitted samples [begin, end) into `sums`.
-void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candidate_row,
-                    int begin, int end, Linearisation* out, FreeChunk* chunk) {
+void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candidate_row, int begin,
+                    int end, Linearisation* out, FreeChunk* chunk) {
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   FreeSums* sums = &chunk->sums;
   RowMatrix j, j_raw;
   SampleResiduals r, r_raw;
+  Eigen::MatrixXd jtj(n, n);
   for (int t = begin; t < end; ++t) {
     const std::array<bool, kNumCables> excluded = in.samples.Excluded(t);
     RowsOf(chunk->rows, t, &r, &j);
@@ -177,10 +186,11 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
         out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
       }
     }
-    sums->information.noalias() += jw.transpose() * jw;
+    jtj.noalias() = jw.transpose() * jw;
+    sums->information += jtj;
     if (!sums->session_information.empty()) {
       const int session = in.samples.data->samples[(*in.samples.fit)[t]].session;
-      sums->session_information[session].noalias() += jw.transpose() * jw;
+      sums->session_information[session] += jtj;
       sums->session_gradient[session].noalias() += jw.transpose() * rw;
     }
     if (curvature != 0.0) {
@@ -197,7 +207,7 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
     }
     const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
     AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, r_raw, j_raw, weight,
-              &sums->folds[block]);
+              weight == 1.0 ? &jtj : nullptr, &sums->folds[block]);
   }
   sums->fold.Flush();
 }
@@ -313,10 +323,11 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
   const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
   SampleRowWhitener whitener(in.samples, n + 1);
   const int failed = ReduceChunksInOrder<FreeChunk>(
-      num_fit, in.num_threads, [&] { return FreeChunk{FreeSums(n, blocks, sessions), {}, {}}; },
-      [&](int begin, int end, FreeChunk* chunk) {
-        return EvaluateFree(in, at, begin, end, chunk);
+      num_fit, in.num_threads,
+      [&] {
+        return FreeChunk{FreeSums(n, blocks, sessions), {}, {}};
       },
+      [&](int begin, int end, FreeChunk* chunk) { return EvaluateFree(in, at, begin, end, chunk); },
       [&](int, int, FreeChunk* chunk) {
         chunk->raw = chunk->rows;
         whitener.Whiten(&chunk->rows);
@@ -377,7 +388,9 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
   SampleRowWhitener whitener(in.samples, pass.basis.front().num_free() + 1);
   const int failed = ReduceChunksInOrder<CandidateChunk>(
       static_cast<int>(samples.size()), in.num_threads,
-      [&] { return CandidateChunk{zero(), {}}; },
+      [&] {
+        return CandidateChunk{zero(), {}};
+      },
       [&](int begin, int end, CandidateChunk* chunk) {
         return EvaluateCandidates(pass, samples, begin, end, chunk);
       },

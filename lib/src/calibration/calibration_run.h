@@ -20,6 +20,7 @@
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/compact_start.h"
+#include "fastcal/internal/folded_cost.h"
 #include "fastcal/internal/number_text.h"
 
 namespace fastcal::internal {
@@ -74,6 +75,7 @@ struct Run {
   SlowErrorProcess slow;
   std::vector<std::array<double, kNumCables>> slow_rho;
   std::unique_ptr<ceres::Problem> problem;
+  const internal::FoldedTensionCost* folded = nullptr;  // the problem's data term (it owns it)
   // At the solution: the candidates of the misfit ranking (and consider parameters),
   // the linearisation, and the normal matrix with the priors.
   std::vector<ParameterSpec> candidates;

@@ -40,10 +40,52 @@ double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double
 }
 
 FoldedTensionCost::FoldedTensionCost(const FittedSamples& samples, const ceres::LossFunction* loss,
-                                     int threads)
+                                     int threads, bool by_reading)
     : samples_(samples), loss_(loss), threads_(threads), n_(samples.model->num_free()) {
   set_num_residuals(n_ + 1);
   mutable_parameter_block_sizes()->push_back(n_);
+  if (by_reading) reading_columns_ = ReadingColumns(samples, loss);
+}
+
+std::vector<std::vector<int>> ReadingColumns(const FittedSamples& samples,
+                                             const ceres::LossFunction* loss) {
+  if (loss != nullptr || samples.readings() != kNumCables) return {};
+  const CalibrationModel& model = *samples.model;
+  const int n = model.num_free();
+  std::vector<std::vector<int>> columns(kNumCables);
+  std::vector<int> shared;
+  for (int k = 0; k < n; ++k) {
+    const ParameterSpec& p = model.spec().parameters[model.spec_index(k)];
+    const bool sensor =
+        p.kind == ParameterKind::kSensorGain || p.kind == ParameterKind::kSensorBias;
+    if (sensor && p.index >= 0 && p.index < kNumCables) {
+      columns[p.index].push_back(k);
+    } else {
+      shared.push_back(k);
+    }
+  }
+  if (shared.size() == static_cast<size_t>(n)) return {};  // nothing to gain
+  for (std::vector<int>& c : columns) {
+    c.insert(c.end(), shared.begin(), shared.end());
+    c.push_back(n);  // the residual
+  }
+  return columns;
+}
+
+void FoldedTensionCost::FoldByReading(const SampleRows& rows, int begin, int end, RowFold* fold,
+                                      double* rho) const {
+  const int n = n_;
+  GroupedRowFold grouped(reading_columns_, n + 1);
+  for (int t = begin; t < end; ++t) {
+    double sq_norm = 0.0;  // as CorrectForLoss sums it without a loss
+    for (int i = 0; i < kNumCables; ++i) {
+      const double* row = rows.Of(t) + i * rows.columns;
+      sq_norm += row[n] * row[n];
+      grouped.Add(i, row);
+    }
+    *rho += sq_norm;
+  }
+  grouped.FlushInto(fold);
 }
 
 bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const {
@@ -59,7 +101,10 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
   *rho_sum = 0.0;
   SampleRowWhitener whitener(samples_, n + 1);
   const int failed = ReduceChunksInOrder<Part>(
-      samples_.size(), threads_, [n] { return Part{{}, RowFold(n + 1)}; },
+      samples_.size(), threads_,
+      [n] {
+        return Part{{}, RowFold(n + 1)};
+      },
       [&](int begin, int end, Part* part) {
         part->rows.Reset(begin, end, n + 1, m);
         for (int t = begin; t < end; ++t) {
@@ -69,6 +114,10 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
       },
       [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
       [&](int begin, int end, Part* part) {
+        if (folds_by_reading()) {
+          FoldByReading(part->rows, begin, end, &part->fold, &part->rho);
+          return -1;
+        }
         std::vector<double> j(m * n), rows(m * (n + 1));
         double r[kMaxReadings];
         for (int t = begin; t < end; ++t) {
@@ -121,6 +170,15 @@ bool FoldedTensionCost::Evaluate(double const* const* parameters, double* residu
     for (int k = 0; k < n; ++k) jac[i * n + k] = memo_r_aug_(i, k);
   }
   std::fill(jac + n * n, jac + (n + 1) * n, 0.0);
+  return true;
+}
+
+bool FoldedTensionCost::FoldedAt(const double* theta, Eigen::MatrixXd* r_aug) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (!memo_ok_ || memo_theta_.empty() || !std::equal(theta, theta + n_, memo_theta_.begin())) {
+    return false;
+  }
+  *r_aug = memo_r_aug_;
   return true;
 }
 

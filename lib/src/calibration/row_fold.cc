@@ -4,6 +4,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <utility>
 #include <vector>
 
 namespace fastcal::internal {
@@ -57,6 +58,39 @@ void RowFold::Add(const RowFold& other) {
 }
 
 Eigen::MatrixXd RowFold::r() const { return r_; }
+
+GroupedRowFold::GroupedRowFold(std::vector<std::vector<int>> columns, int cols)
+    : columns_(std::move(columns)), cols_(cols) {
+  size_t widest = 0;
+  for (const std::vector<int>& c : columns_) {
+    groups_.emplace_back(static_cast<int>(c.size()));
+    widest = std::max(widest, c.size());
+  }
+  gathered_.resize(widest);
+}
+
+void GroupedRowFold::Add(int group, const double* row) {
+  const std::vector<int>& columns = columns_[group];
+  for (size_t c = 0; c < columns.size(); ++c) gathered_[c] = row[columns[c]];
+  groups_[group].Add(gathered_.data(), 1);
+}
+
+void GroupedRowFold::FlushInto(RowFold* fold) {
+  for (size_t g = 0; g < groups_.size(); ++g) {
+    RowFold& own = groups_[g];
+    own.Flush();
+    const Eigen::MatrixXd r = own.r();
+    const std::vector<int>& columns = columns_[g];
+    const int width = static_cast<int>(columns.size());
+    expanded_.assign(static_cast<size_t>(width) * cols_, 0.0);
+    for (int a = 0; a < width; ++a) {
+      for (int c = a; c < width; ++c) expanded_[a * cols_ + columns[c]] = r(a, c);
+    }
+    fold->Add(expanded_.data(), width);
+    own = RowFold(width);
+  }
+  fold->Flush();
+}
 
 Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows) {
   // A fold with nothing yet has a 0 x 0 R factor, not 0 x n: Eigen's assert (on in the

@@ -27,6 +27,9 @@ constexpr int kMaxEvaluations = 120;
 constexpr double kValueTolerance = 1e-2;
 // Step of the central differences for the curvature, in log units.
 constexpr double kCurvatureStep = 0.1;
+// A nuisance column whose pivot in the unit-diagonal Gram matrix is below this is the
+// others' combination to rounding: the session does not inform it.
+constexpr double kCollinearPivot = 1e-9;
 // Chi-square(2) 99% quantile: a stated process the likelihood rejects at 1%.
 constexpr double kChiSquare2Quantile99 = 9.21034;
 
@@ -45,17 +48,21 @@ struct NuisanceSums {
 };
 
 // log det G - b^T G^-1 b of the first `columns` nuisance columns; a column the session
-// does not inform (the gain's, when the reading hardly changes) is dropped.
+// does not inform (the gain's, when the reading hardly changes) is dropped. Judged on G
+// scaled to a unit diagonal: the columns' units differ by a reading's (1 / s against
+// r / s: ~10^10 in their squares), and a test on G itself dropped an informed gain.
 double RestrictedTerm(const NuisanceSums& sums, int columns) {
   for (int c = columns; c >= 1; --c) {
     const Eigen::MatrixXd g = sums.gram.topLeftCorner(c, c);
-    const double trace = g.trace();
-    if (!(trace > 0.0)) return 0.0;  // no reading of this cable in this session
-    const Eigen::LDLT<Eigen::MatrixXd> ldlt(g);
+    const Eigen::VectorXd scale = g.diagonal().cwiseMax(0.0).cwiseSqrt();
+    if (!(scale.minCoeff() > 0.0)) return 0.0;  // no reading of this cable in this session
+    const Eigen::VectorXd inverse = scale.cwiseInverse();
+    const Eigen::MatrixXd unit = inverse.asDiagonal() * g * inverse.asDiagonal();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt(unit);
     const Eigen::VectorXd d = ldlt.vectorD();
-    if (d.minCoeff() <= 1e-12 * trace) continue;
-    const Eigen::VectorXd b = sums.cross.head(c);
-    return d.array().log().sum() - b.dot(ldlt.solve(b));
+    if (d.minCoeff() <= kCollinearPivot) continue;
+    const Eigen::VectorXd b = inverse.cwiseProduct(sums.cross.head(c));
+    return d.array().log().sum() + 2.0 * scale.array().log().sum() - b.dot(ldlt.solve(b));
   }
   return 0.0;
 }
@@ -68,64 +75,164 @@ int CountSessions(const std::vector<SlowErrorSample>& samples) {
 
 }  // namespace
 
-double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
-                                      const SlowErrorProcess& process) {
-  const int nuisance = in.gain_nuisance ? 2 : 1;
-  const int columns = 1 + nuisance;
-  const int count = static_cast<int>(in.samples.size());
-  std::vector<std::array<NuisanceSums, kNumCables>> sums(CountSessions(in.samples));
-  // Each cable's filter on its own (cables split among the threads); the terms of -2 l
-  // kept per reading and summed afterwards in the order of one thread, so that the total
-  // has the same bits on any number of threads. Each cable's nuisance sums are its own.
-  std::vector<std::array<double, kNumCables>> log_f(count), square(count);
-  const int groups = std::clamp(in.num_threads, 1, kNumCables);
-  const auto whiten_group = [&](int group) {
+namespace {
+
+// The inputs laid out once for the search's ~100 evaluations: per sample the interval
+// from the previous one (kNewSeries where a series starts) and its session; per cable,
+// its readings contiguous, x, 1 / s, r / s and whether the reading is kept.
+struct LaidOut {
+  static constexpr double kNewSeries = -1.0;
+  int count = 0, sessions = 1, nuisance = 1;
+  std::vector<double> dt_s;
+  std::vector<int> session;
+  std::array<std::vector<double>, kNumCables> x, inverse_s, reading_over_s;
+  std::array<std::vector<unsigned char>, kNumCables> kept;
+};
+
+LaidOut LayOut(const SlowErrorEstimateInputs& in) {
+  LaidOut out;
+  out.count = static_cast<int>(in.samples.size());
+  out.sessions = CountSessions(in.samples);
+  out.nuisance = in.gain_nuisance ? 2 : 1;
+  out.dt_s.resize(out.count);
+  out.session.resize(out.count);
+  for (int i = 0; i < kNumCables; ++i) {
+    out.x[i].resize(out.count);
+    out.inverse_s[i].resize(out.count);
+    out.reading_over_s[i].resize(out.count);
+    out.kept[i].resize(out.count);
+  }
+  for (int t = 0; t < out.count; ++t) {
+    const SlowErrorSample& s = in.samples[t];
+    const bool fresh = t == 0 || StartsNewSeries(in.samples[t - 1].time_s,
+                                                 in.samples[t - 1].session, s.time_s, s.session);
+    out.dt_s[t] = fresh ? LaidOut::kNewSeries : s.time_s - in.samples[t - 1].time_s;
+    out.session[t] = s.session;
+    for (int i = 0; i < kNumCables; ++i) {
+      out.x[i][t] = s.x[i];
+      out.inverse_s[i][t] = 1.0 / s.sigma_n[i];
+      out.reading_over_s[i][t] = s.reading_n[i] / s.sigma_n[i];
+      out.kept[i][t] = !s.excluded[i];
+    }
+  }
+  return out;
+}
+
+// One cable's part of -2 l_R: sum log F and sum x~^2 over its kept readings, and its
+// nuisance sums per session.
+struct CableTerms {
+  double log_f = 0.0, square = 0.0;
+  std::vector<NuisanceSums> sums;
+};
+
+// Cables [first, end) through the filter of slow_error_filter.h, sample by sample (one
+// exp(-dt / tau) a sample). Per reading: rho = sqrt((sigma_N / s)^2 + (a r / s)^2) from
+// the laid-out 1 / s and r / s; one division (1 / F) and two square roots (and a
+// logarithm per kLogBatch readings).
+// A reading left out leaves the state as it is (a missing one) and adds nothing.
+template <int kNuisance>
+void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first, int end,
+                  CableTerms* terms) {
+  constexpr int kColumns = 1 + kNuisance;
+  const bool active = process.IsActive();
+  const double sigma_n = process.sigma_n, relative = process.sigma_percent / 100.0;
+  struct State {
+    double m[kColumns] = {};
+    double p = 1.0;
+    bool fresh = true;
+  };
+  State state[kNumCables];
+  CableTerms own[kNumCables];
+  // log F summed as the log of products of up to kLogBatch F's (F >= 1; a product is
+  // taken early past kLogFlush, far from overflow): one logarithm per kLogBatch readings,
+  // the same sum to rounding.
+  constexpr int kLogBatch = 8;
+  constexpr double kLogFlush = 1e200;
+  double product[kNumCables];
+  int in_product[kNumCables] = {};
+  for (double& p : product) p = 1.0;
+  for (int i = first; i < end; ++i) own[i].sums.resize(in.sessions);
+  for (int t = 0; t < in.count; ++t) {
+    const bool new_series = in.dt_s[t] == LaidOut::kNewSeries;
+    const double phi =
+        new_series || !active ? 0.0 : SlowErrorCorrelation(in.dt_s[t], process.time_constant_s);
+    for (int i = first; i < end; ++i) {
+      State& st = state[i];
+      if (new_series) {
+        st.fresh = true;
+      } else if (!st.fresh) {
+        for (double& m : st.m) m *= phi;
+        st.p = phi * phi * st.p + (1.0 - phi * phi);
+      }
+      if (!in.kept[i][t]) continue;
+      if (st.fresh) {
+        for (double& m : st.m) m = 0.0;
+        st.p = 1.0;
+        st.fresh = false;
+      }
+      const double a = sigma_n * in.inverse_s[i][t], b = relative * in.reading_over_s[i][t];
+      const double rho = !active ? 0.0 : sigma_n == 0.0 ? std::abs(b) : std::sqrt(a * a + b * b);
+      const double f = rho * rho * st.p + 1.0;
+      const double inverse_f = 1.0 / f;
+      const double scale = std::sqrt(inverse_f), gain = st.p * rho * inverse_f;
+      const double row[3] = {in.x[i][t], in.inverse_s[i][t], in.reading_over_s[i][t]};
+      double w[kColumns];
+      for (int c = 0; c < kColumns; ++c) {
+        const double v = row[c] - rho * st.m[c];
+        st.m[c] += gain * v;
+        w[c] = v * scale;
+      }
+      st.p -= gain * rho * st.p;
+      CableTerms& out = own[i];
+      product[i] *= f;
+      if (++in_product[i] == kLogBatch || product[i] > kLogFlush) {
+        out.log_f += std::log(product[i]);
+        product[i] = 1.0;
+        in_product[i] = 0;
+      }
+      out.square += w[0] * w[0];
+      NuisanceSums& n = out.sums[in.session[t]];
+      for (int u = 0; u < kNuisance; ++u) {
+        n.cross[u] += w[1 + u] * w[0];
+        for (int v = 0; v < kNuisance; ++v) n.gram(u, v) += w[1 + u] * w[1 + v];
+      }
+    }
+  }
+  for (int i = first; i < end; ++i) {
+    if (in_product[i] > 0) own[i].log_f += std::log(product[i]);
+    terms[i] = std::move(own[i]);
+  }
+}
+
+// -2 l_R: each cable's filter on its own (cables split among the threads), its terms
+// summed per cable and the cables' sums added in cable order, so that the total has the
+// same bits on any number of threads.
+double MinusTwoLogLikelihood(const LaidOut& in, const SlowErrorProcess& process, int threads) {
+  CableTerms terms[kNumCables];
+  const int groups = std::clamp(threads, 1, kNumCables);
+  const auto filter_group = [&](int group) {
     const int first = kNumCables * group / groups, end = kNumCables * (group + 1) / groups;
-    // White noise alone: an inactive whitener leaves the rows as they are (F = 1).
-    ReadingWhitener whitener(process, columns, first, end);
-    double rows[kNumCables * 3], rho[kNumCables];
-    for (int t = 0; t < count; ++t) {
-      const SlowErrorSample& s = in.samples[t];
-      for (int i = first; i < end; ++i) {
-        double* row = rows + i * columns;
-        row[0] = s.x[i];
-        row[1] = 1.0 / s.sigma_n[i];
-        if (nuisance == 2) row[2] = s.reading_n[i] / s.sigma_n[i];
-        rho[i] = process.IsActive() ? process.SigmaN(s.reading_n[i]) / s.sigma_n[i] : 0.0;
-        log_f[t][i] = 0.0;
-      }
-      whitener.Whiten(s.time_s, s.session, rho, s.excluded.data(), rows, log_f[t].data());
-      for (int i = first; i < end; ++i) {
-        square[t][i] = 0.0;
-        if (s.excluded[i]) continue;  // as if missing: the state only moves on in time
-        const double* row = rows + i * columns;
-        square[t][i] = row[0] * row[0];
-        NuisanceSums& n = sums[s.session][i];
-        for (int a = 0; a < nuisance; ++a) {
-          n.cross[a] += row[1 + a] * row[0];
-          for (int b = 0; b < nuisance; ++b) n.gram(a, b) += row[1 + a] * row[1 + b];
-        }
-      }
+    if (in.nuisance == 2) {
+      FilterCables<2>(in, process, first, end, terms);
+    } else {
+      FilterCables<1>(in, process, first, end, terms);
     }
   };
-  // The groups of threads the system refused (OnThreads) are whitened here afterwards.
-  for (int g = OnThreads(groups, whiten_group); g < groups; ++g) whiten_group(g);
+  // The groups of threads the system refused (OnThreads) are filtered here afterwards.
+  for (int g = OnThreads(groups, filter_group); g < groups; ++g) filter_group(g);
   double total = 0.0;
-  for (int t = 0; t < count; ++t) {
-    const SlowErrorSample& s = in.samples[t];
-    double sample_log_f = 0.0;
-    for (int i = 0; i < kNumCables; ++i) {
-      if (!s.excluded[i]) sample_log_f += log_f[t][i];
-    }
-    total += sample_log_f;
-    for (int i = 0; i < kNumCables; ++i) {
-      if (!s.excluded[i]) total += square[t][i];
-    }
-  }
-  for (const auto& session : sums) {
-    for (const NuisanceSums& n : session) total += RestrictedTerm(n, nuisance);
+  for (const CableTerms& c : terms) total += c.log_f + c.square;
+  for (const CableTerms& c : terms) {
+    for (const NuisanceSums& n : c.sums) total += RestrictedTerm(n, in.nuisance);
   }
   return total;
+}
+
+}  // namespace
+
+double SlowErrorMinusTwoLogLikelihood(const SlowErrorEstimateInputs& in,
+                                      const SlowErrorProcess& process) {
+  return MinusTwoLogLikelihood(LayOut(in), process, in.num_threads);
 }
 
 namespace {
@@ -137,6 +244,7 @@ struct Search {
   bool free[2] = {false, false};
   double lower[2] = {0.0, 0.0}, upper[2] = {0.0, 0.0};
   double a_ref = 1.0;  // the amplitude equal to the white sigma at a median reading
+  LaidOut laid_out;    // in's readings, laid out for the evaluations
 
   SlowErrorProcess At(const Eigen::Vector2d& y) const {
     SlowErrorProcess p = in->spec.stated;
@@ -150,8 +258,9 @@ struct Search {
     for (int k = 0; k < 2; ++k) y[k] = std::clamp(y[k], lower[k], upper[k]);
     return y;
   }
-  double Value(const Eigen::Vector2d& y) const {
-    return SlowErrorMinusTwoLogLikelihood(*in, At(Clamp(y)));
+  double Value(const Eigen::Vector2d& y) const { return ValueOf(At(Clamp(y))); }
+  double ValueOf(const SlowErrorProcess& process) const {
+    return MinusTwoLogLikelihood(laid_out, process, in->num_threads);
   }
 };
 
@@ -166,6 +275,7 @@ double Median(std::vector<double> v) {
 Search MakeSearch(const SlowErrorEstimateInputs& in) {
   Search s;
   s.in = &in;
+  s.laid_out = LayOut(in);
   s.free[0] = in.spec.estimate_amplitude;
   s.free[1] = in.spec.estimate_time_constant;
   std::vector<double> ratio, dt;
@@ -343,12 +453,12 @@ SlowErrorReport EstimateSlowError(const SlowErrorEstimateInputs& in) {
   report.time_constant_estimated = in.spec.estimate_time_constant;
   report.series = CountSeries(in.samples);
   report.samples_used = static_cast<int>(in.samples.size());
-  const double white = SlowErrorMinusTwoLogLikelihood(in, SlowErrorProcess());
   // Both parts free: the maximum-likelihood process (the estimate itself, or the check of
   // a stated one).
   SlowErrorEstimateInputs both = in;
   both.spec.estimate_amplitude = both.spec.estimate_time_constant = true;
   const Search full = MakeSearch(both);
+  const double white = full.ValueOf(SlowErrorProcess());
   const Eigen::Vector2d ml = Maximise(full);
   const double ml_value = full.Value(ml);
   report.maximum_likelihood = full.At(ml);
@@ -357,7 +467,7 @@ SlowErrorReport EstimateSlowError(const SlowErrorEstimateInputs& in) {
   const Search search = MakeSearch(in);
   if (!in.spec.estimate_amplitude || !in.spec.estimate_time_constant) {
     y = in.spec.estimates_any() ? Maximise(search) : Eigen::Vector2d::Zero();
-    value = SlowErrorMinusTwoLogLikelihood(in, search.At(y));
+    value = search.ValueOf(search.At(y));
   }
   report.process = search.At(y);
   report.likelihood_ratio_vs_white = white - value;

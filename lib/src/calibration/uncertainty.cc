@@ -10,6 +10,8 @@
 #include <limits>
 #include <unsupported/Eigen/FFT>
 
+#include "fastcal/internal/sample_chunks.h"
+
 namespace fastcal {
 namespace {
 
@@ -123,19 +125,31 @@ Eigen::MatrixXd StatisticalCovariance(const Eigen::MatrixXd& floor, const Eigen:
 // Sets b->correlated when some tau is above 1 by more than kTauSignificance standard
 // deviations of tau for a white series, sqrt((4 W + 2) / N) with W the window (Madras
 // and Sokal 1988). One series at a time: N doubles, not N x n.
-void ChooseBandwidth(const SampleScores& scores, UncertaintyBudget* b, std::vector<double>* tau) {
+void ChooseBandwidth(const SampleScores& scores, int threads, UncertaintyBudget* b,
+                     std::vector<double>* tau) {
   const int n_samples = static_cast<int>(scores.rows());
   const int n = static_cast<int>(scores.cols());
-  b->tau = 1.0;
-  Eigen::VectorXd influence(n_samples);
-  for (int k = 0; k < n; ++k) {
-    const Eigen::VectorXd p = b->formal.col(k);
-    for (int t = 0; t < n_samples; ++t) {
-      double u = 0.0;  // in double, from the float scores
-      for (int c = 0; c < n; ++c) u += static_cast<double>(scores(t, c)) * p[c];
-      influence[t] = u;
+  // Each parameter's series on its own (parameters split among the threads, each thread
+  // one series of N doubles at a time); combined afterwards in parameter order.
+  std::vector<AutocorrelationTime> times(n);
+  const int workers = std::clamp(threads, 1, std::max(n, 1));
+  const auto series_of = [&](int worker) {
+    Eigen::VectorXd influence(n_samples);
+    for (int k = worker; k < n; k += workers) {
+      const Eigen::VectorXd p = b->formal.col(k);
+      for (int t = 0; t < n_samples; ++t) {
+        double u = 0.0;  // in double, from the float scores
+        for (int c = 0; c < n; ++c) u += static_cast<double>(scores(t, c)) * p[c];
+        influence[t] = u;
+      }
+      times[k] = IntegratedAutocorrelationTime(influence);
     }
-    const AutocorrelationTime a = IntegratedAutocorrelationTime(influence);
+  };
+  // The workers the system refused (OnThreads) run here afterwards.
+  for (int w = internal::OnThreads(workers, series_of); w < workers; ++w) series_of(w);
+  b->tau = 1.0;
+  for (int k = 0; k < n; ++k) {
+    const AutocorrelationTime& a = times[k];
     (*tau)[k] = a.tau;
     b->tau = std::max(b->tau, a.tau);
     b->correlation_reliable = b->correlation_reliable && a.reliable;
@@ -352,7 +366,7 @@ bool ComputeUncertaintyBudget(const BudgetInputs& in, UncertaintyBudget* b) {
   Eigen::MatrixXd data = b->formal;
   b->correlation_measured =
       b->samples >= kMinSamplesForCorrelation && in.scores.cols() == n && dof > 0;
-  if (b->correlation_measured) ChooseBandwidth(in.scores, b, &tau);
+  if (b->correlation_measured) ChooseBandwidth(in.scores, in.num_threads, b, &tau);
   if (b->correlated) data = DataCovariance(in, b);
   b->effective_samples = b->samples / b->tau;
   b->statistical = StatisticalCovariance(MisfitFloor(in, b->formal, b->misfit_factor), data);

@@ -35,10 +35,13 @@
 #include <ceres/loss_function.h>
 
 #include <Eigen/Core>
+#include <array>
 #include <mutex>
 #include <vector>
 
 #include "fastcal/internal/calibration_model.h"
+#include "fastcal/internal/row_fold.h"
+#include "fastcal/internal/sample_rows.h"
 
 namespace fastcal::internal {
 
@@ -49,19 +52,40 @@ namespace fastcal::internal {
 double CorrectForLoss(const ceres::LossFunction* loss, double* residuals, double* jacobian, int n,
                       int readings = kNumCables);
 
+// By reading (issue 28): a sensor's gain and bias enter one cable's reading only, so the
+// rows of reading i are zero outside its own columns and the shared ones (the statics').
+// Per reading, those columns (own, then shared, then the residual's, n), for a
+// GroupedRowFold (row_fold.h: 12 of 22 columns for the recommended spec, a third of the
+// flops); empty when nothing is gained: no cable's own column, or a loss (its correction
+// mixes a sample's rows), or lengths' rows.
+std::vector<std::vector<int>> ReadingColumns(const FittedSamples& samples,
+                                             const ceres::LossFunction* loss);
+
 class FoldedTensionCost : public ceres::CostFunction {
  public:
-  // `samples` and `loss` (may be null) must outlive the cost.
-  FoldedTensionCost(const FittedSamples& samples, const ceres::LossFunction* loss, int threads);
+  // `samples` and `loss` (may be null) must outlive the cost. `by_reading`: each
+  // reading's rows folded on their own first where that saves work (ReadingColumns);
+  // false folds every row at full width (the same R^T R to rounding; for tests).
+  FoldedTensionCost(const FittedSamples& samples, const ceres::LossFunction* loss, int threads,
+                    bool by_reading = true);
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override;
+  // The last evaluation's folded rows [R z] when it was at theta (no new evaluation);
+  // false otherwise.
+  bool FoldedAt(const double* theta, Eigen::MatrixXd* r_aug) const;
+  // Whether each reading's rows are folded on their own first (ReadingColumns).
+  bool folds_by_reading() const { return !reading_columns_.empty(); }
 
  private:
+  // Chunk rows [begin, end) folded by reading into `fold`; their squared norms into rho.
+  void FoldByReading(const SampleRows& rows, int begin, int end, RowFold* fold, double* rho) const;
   bool Fold(const double* theta, Eigen::MatrixXd* r_aug, double* rho_sum) const;
 
   FittedSamples samples_;
   const ceres::LossFunction* loss_;
   int threads_, n_;
+  // Per reading, its columns when the rows are folded by reading; empty otherwise.
+  std::vector<std::vector<int>> reading_columns_;
   // The last evaluation (see Memo above).
   mutable std::mutex mutex_;
   mutable std::vector<double> memo_theta_;

@@ -47,6 +47,28 @@ class RowFold {
 
 // Upper-triangular R with R^T R = A^T A for A the rows of `top` stacked on `rows` (a QR
 // of the stack; `top` may be empty).
+// Rows in groups, each group's rows zero outside its own columns (e.g. one cable's
+// readings: zero in the other cables' sensor columns). Each group's rows are folded into an
+// R over its columns only (a row of p columns costs ~2 p^2), then those R's rows, put back
+// in the full width, into a RowFold: the same R^T R as folding every row at full width.
+class GroupedRowFold {
+ public:
+  // columns[g]: group g's columns, < cols (the full width).
+  GroupedRowFold(std::vector<std::vector<int>> columns, int cols);
+
+  // A full-width row of group g; its entries outside the group's columns are not read.
+  void Add(int group, const double* row);
+  // Folds every group's rows so far into `fold` (cols() wide, flushed after) and starts
+  // the groups afresh.
+  void FlushInto(RowFold* fold);
+
+ private:
+  std::vector<std::vector<int>> columns_;
+  int cols_;
+  std::vector<RowFold> groups_;
+  std::vector<double> gathered_, expanded_;
+};
+
 Eigen::MatrixXd FoldRows(const Eigen::MatrixXd& top, const Eigen::MatrixXd& rows);
 
 }  // namespace fastcal::internal
