@@ -205,8 +205,8 @@ TEST_F(TrackFoldTest, BlocksOfSeveralPiecesFoldEverySample) {
 // (appended out of order), is the fold of the same samples in memory.
 TEST_F(TrackFoldTest, StoreStreamedOrSortedFoldsAsInMemory) {
   Simulate(kLongSamples);
-  const std::string in_order = ::testing::TempDir() + "/track_fold_in_order.samples";
-  const std::string shuffled = ::testing::TempDir() + "/track_fold_shuffled.samples";
+  const std::string in_order = test::TempPath("track_fold_in_order", ".samples");
+  const std::string shuffled = test::TempPath("track_fold_shuffled", ".samples");
   std::remove(in_order.c_str());
   std::remove(shuffled.c_str());
   std::vector<internal::StoredSample> records;
@@ -226,6 +226,8 @@ TEST_F(TrackFoldTest, StoreStreamedOrSortedFoldsAsInMemory) {
     ASSERT_TRUE(FoldWindow(task, &fold, &error)) << error;
     EXPECT_EQ(SerializeWindowFold(fold), expected) << path;
   }
+  std::remove(in_order.c_str());
+  std::remove(shuffled.c_str());
 }
 
 TEST_F(TrackFoldTest, SameBytesOnAnyNumberOfThreads) {
@@ -281,7 +283,7 @@ TEST_F(TrackFoldTest, UnsolvablePoseNamesFileAndLine) {
 
 // Ranges read from a store in time order and from one sorted in memory: the same samples.
 TEST(WindowStoreTest, RangesReadAsTheWhole) {
-  const std::string path = ::testing::TempDir() + "/window_store_ranges.samples";
+  const std::string path = test::TempPath("window_store_ranges", ".samples");
   for (const bool in_order : {true, false}) {
     std::remove(path.c_str());
     std::vector<internal::StoredSample> records;
@@ -319,6 +321,7 @@ TEST(WindowStoreTest, RangesReadAsTheWhole) {
   internal::StoredWindowReader reader;
   EXPECT_FALSE(reader.Open(path, &error));
   EXPECT_NE(error.find("record 1 is not finite"), std::string::npos) << error;
+  std::remove(path.c_str());
 }
 
 TEST(WindowStoreTest, RecordsRoundTripSortedByTime) {
