@@ -130,17 +130,24 @@ std::string Estimate(const TrackEstimate& e, const std::string& unit) {
          internal::FormatDouble("%.2g", e.sigma_total) + (unit == "1" ? "" : " " + unit);
 }
 
+// Lines of a sentence on the console at most (the header, the slow error, notes: whole in
+// track.html and events.json).
+constexpr size_t kSentenceLines = 4;
+
 std::string Summary(const TrackResult& r, const std::string& out) {
-  std::ostringstream s;
-  s << "fastcal track: " << r.windows.size() << " windows of " << WindowSpecText(r.window);
+  std::ostringstream s, head;
+  head << "fastcal track: " << r.windows.size() << " windows of " << WindowSpecText(r.window);
   if (!r.windows.empty()) {
-    s << " (" << r.windows.front().label << " to " << r.windows.back().label << ")";
+    head << " (" << r.windows.front().label << " to " << r.windows.back().label << ")";
   }
-  s << ", " << r.samples << " samples from " << r.files.size() << " file(s); " << r.iterations
-    << " Gauss-Newton iterations (" << (r.converged ? "converged" : "NOT converged") << "), "
-    << r.folds << " folds" << (r.updated ? " (an update)" : "") << "; chi2/nu "
-    << internal::FormatDouble("%.3f", r.reduced_chi_square) << "\n";
-  if (r.slow_error.enabled) s << DescribeSlowError(r.slow_error) << "\n";
+  head << ", " << r.samples << " samples from " << r.files.size() << " file(s); " << r.iterations
+       << " Gauss-Newton iterations (" << (r.converged ? "converged" : "NOT converged") << "), "
+       << r.folds << " folds" << (r.updated ? " (an update)" : "") << "; chi2/nu "
+       << internal::FormatDouble("%.3f", r.reduced_chi_square);
+  s << Wrapped(head.str(), "", "  ", kSentenceLines, "track.html");
+  if (r.slow_error.enabled) {
+    s << Wrapped(DescribeSlowError(r.slow_error), "", "  ", kSentenceLines, "track.html");
+  }
   s << "\nShared parameters (sigma_total):\n";
   for (const TrackShared& p : r.shared) {
     s << "  " << p.name << " = " << Estimate(p.estimate, p.unit);
@@ -170,9 +177,10 @@ std::string Summary(const TrackResult& r, const std::string& out) {
     << "% false-alarm rate over the track): " << r.events.size() << "\n";
   for (const TrackWander& w : r.wander) {
     if (w.rms > 0.0) {
-      s << "  (" << w.group << " wanders between windows by "
-        << internal::FormatDouble("%.3g", w.rms) << " " << w.unit
-        << " rms per component beyond its errors: the events are steps beyond that)\n";
+      s << Wrapped("(" + w.group + " wanders between windows by " +
+                       internal::FormatDouble("%.3g", w.rms) + " " + w.unit +
+                       " rms per component beyond its errors: the events are steps beyond that)",
+                   "  ", "   ", kSentenceLines, "track.html");
     }
   }
   for (const TrackEvent& e : r.events) {
@@ -197,7 +205,8 @@ std::string Summary(const TrackResult& r, const std::string& out) {
     line << " p = " << internal::FormatDouble("%.2g", e.p_value);
     s << Wrapped(line.str(), "  " + r.windows[e.window].label + "  ", "      ", 8, "events.json");
   }
-  for (const std::string& n : r.notes) s << "Note: " << n << "\n";
+  for (const std::string& n : r.notes)
+    s << Wrapped("Note: " + n, "", "  ", kSentenceLines, "track.html");
   s << "\nWritten to " << out << ": track.csv, events.json, track.html, " << r.models.size()
     << " model_calibrated@*.yaml\n";
   return s.str();

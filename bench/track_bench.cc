@@ -15,9 +15,18 @@
 // 2024-05-01T20:00:00Z, mass centre (0.22, 0.11, 0.5) m, 3% tension noise, a 1% slow
 // sensor error (2 minutes), per-cable spreads of density (1%), gain (1%), bias (1.5 kN);
 // written once, streamed (not timed).
-// Run: build/bench/track_bench --benchmark_filter=/100000/   (about a minute on 2 cores);
-// /1000000/ a few minutes; /10000000/ (the 10^7 samples in 100 windows) about an
-// hour, and 4 GB of CSV plus 1.6 GB of window store in the temporary directory.
+// BM_Track/1000000/10 has 10^5 samples a window, as /10000000/100: with /1000000/100 it
+// shows that a window's own samples do not set the memory (each window streamed).
+// Run: build/bench/track_bench --benchmark_filter=/100000/   (half a minute on 2 cores);
+// /1000000/ two minutes; /10000000/ (the 10^7 samples in 100 windows) 3 minutes
+// for the track and 4 minutes for the one survey (8.3 GB of memory), plus 1.5 minutes
+// writing 4 GB of CSV, and 1.6 GB of window store, in the temporary directory.
+// Figures (2026-11-26, load 2.4 to 3; docs/calibration.md, "Speed and memory"):
+//   samples/windows  track: wall, CPU, peak     one survey: wall, CPU, peak
+//   10^5/100         3.5 s, 4.6 s, 128 MB        4.0 s, 7.1 s, 151 MB
+//   10^6/100         14.9 s, 26.4 s, 131 MB      17.4 s, 30.3 s, 852 MB
+//   10^6/10          14.4 s, 26.1 s, 100 MB
+//   10^7/100         162 s, 248 s, 147 MB        220 s, 290 s, 8.3 GB
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -135,6 +144,7 @@ void BM_CalibrateOneSurvey(benchmark::State& state) { Measure(state, RunCalibrat
 BENCHMARK(BM_Track)
     ->Args({100000, 100})
     ->Args({1000000, 100})
+    ->Args({1000000, 10})  // 10^5 a window, as at 10^7 in 100: a window's own memory
     ->Args({10000000, 100})
     ->Iterations(1)
     ->Unit(benchmark::kSecond)

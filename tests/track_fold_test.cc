@@ -41,12 +41,18 @@ parameters:
 // Central differences of the chi-square against 2 g: the rows are exact Jet derivatives
 // of the statics through the whitening, so they agree to the differences' own error.
 constexpr double kGradientTolerance = 2e-4;
-// Per-sample time step of the simulated survey.
+// Per-sample time step of the simulated survey, and its samples.
 constexpr double kIntervalS = 5.0;
+constexpr int kSamples = 120;
+// A window whose blocks are read in several pieces (a piece: 1024 samples at most).
+constexpr int kLongSamples = 2600;
 
 class TrackFoldTest : public ::testing::Test {
  protected:
-  void SetUp() override {
+  void SetUp() override { Simulate(kSamples); }
+
+  // The survey of `samples` samples and the task over it.
+  void Simulate(int samples) {
     std::string error;
     const CableRobot model = CableRobot::NominalFast();
     CalibrationSpec spec;
@@ -60,8 +66,10 @@ class TrackFoldTest : public ::testing::Test {
     o.tension_noise_kn = 5.0;
     o.tension_drift_kn = 3.0;
     o.tension_drift_time_s = 60.0;
-    ASSERT_TRUE(Simulate(truth, RandomCapPoses(120, 5), o, &data_, nullptr, nullptr, &error))
+    ASSERT_TRUE(
+        fastcal::Simulate(truth, RandomCapPoses(samples, 5), o, &data_, nullptr, nullptr, &error))
         << error;
+    task_ = FoldTask();
     task_.label = "w";
     task_.files = {"survey.csv"};
     task_.model_yaml = CableRobotToYaml(model, "");
@@ -92,6 +100,52 @@ class TrackFoldTest : public ::testing::Test {
     return fold;
   }
 
+  // Central differences of the fold's chi-square against 2 g, for the columns in `which`.
+  void ExpectGradientOfChiSquare(const WindowFold& fold, const std::vector<int>& which) {
+    // Steps of about 1e-6 of each parameter's scale (m, kg/m, N).
+    const std::vector<double> scale = {1e-6, 1e-6, 1e-6, 1e-5, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3};
+    for (int k : which) {
+      FoldTask plus = task_, minus = task_;
+      plus.theta_si[k] += scale[k];
+      minus.theta_si[k] -= scale[k];
+      const double derivative = (Fold(plus).chi_square - Fold(minus).chi_square) / (2.0 * scale[k]);
+      EXPECT_NEAR(derivative, 2.0 * fold.gradient[k],
+                  kGradientTolerance * (std::abs(derivative) + std::sqrt(fold.information(k, k))))
+          << fold.columns[k];
+    }
+  }
+
+  // The blocks' samples, scores and information rows sum to the window's.
+  void ExpectBlocksSumToTheWindow(const WindowFold& fold) {
+    long long samples = 0;
+    Eigen::VectorXd score = Eigen::VectorXd::Zero(fold.gradient.size());
+    // The rows of the window's own columns, then of the shared sensor biases.
+    std::vector<int> columns;
+    for (size_t k = 0; k < fold.roles.size(); ++k) {
+      if (fold.roles[k] == FoldRole::kWindow) columns.push_back(static_cast<int>(k));
+    }
+    ASSERT_EQ(columns.size(), 3u);
+    for (size_t k = 0; k < fold.roles.size(); ++k) {
+      if (fold.roles[k] == FoldRole::kShared && fold.columns[k].rfind("sensor_bias_kN[", 0) == 0) {
+        columns.push_back(static_cast<int>(k));
+      }
+    }
+    ASSERT_EQ(fold.block_information[0].rows(), static_cast<Eigen::Index>(columns.size()));
+    Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(columns.size(), fold.gradient.size());
+    for (size_t b = 0; b < fold.block_samples.size(); ++b) {
+      samples += fold.block_samples[b];
+      score += fold.block_scores.row(b).transpose();
+      rows += fold.block_information[b];
+    }
+    EXPECT_EQ(samples, fold.samples);
+    EXPECT_LE((score - fold.gradient).norm(), 1e-9 * fold.gradient.norm());
+    for (size_t k = 0; k < columns.size(); ++k) {
+      EXPECT_LE((rows.row(k) - fold.information.row(columns[k])).norm(),
+                1e-9 * fold.information.norm())
+          << fold.columns[columns[k]];
+    }
+  }
+
   Dataset data_;
   FoldTask task_;
 };
@@ -99,19 +153,9 @@ class TrackFoldTest : public ::testing::Test {
 TEST_F(TrackFoldTest, GradientIsHalfTheChiSquaresDerivative) {
   const WindowFold fold = Fold(task_);
   ASSERT_EQ(fold.gradient.size(), static_cast<Eigen::Index>(task_.theta_si.size()));
-  EXPECT_EQ(fold.samples, 120);
-  EXPECT_EQ(fold.readings, 720);
-  // Steps of about 1e-6 of each parameter's scale (m, kg/m, N).
-  const std::vector<double> scale = {1e-6, 1e-6, 1e-6, 1e-5, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3, 1e-3};
-  for (size_t k = 0; k < scale.size(); ++k) {
-    FoldTask plus = task_, minus = task_;
-    plus.theta_si[k] += scale[k];
-    minus.theta_si[k] -= scale[k];
-    const double derivative = (Fold(plus).chi_square - Fold(minus).chi_square) / (2.0 * scale[k]);
-    EXPECT_NEAR(derivative, 2.0 * fold.gradient[k],
-                kGradientTolerance * (std::abs(derivative) + std::sqrt(fold.information(k, k))))
-        << fold.columns[k];
-  }
+  EXPECT_EQ(fold.samples, kSamples);
+  EXPECT_EQ(fold.readings, kNumCables * kSamples);
+  ExpectGradientOfChiSquare(fold, {0, 1, 2, 3, 4, 5, 6, 7, 8, 9});
   // H is J^T J: symmetric, positive semi-definite.
   EXPECT_LE((fold.information - fold.information.transpose()).norm(),
             1e-12 * fold.information.norm());
@@ -123,36 +167,72 @@ TEST_F(TrackFoldTest, GradientIsHalfTheChiSquaresDerivative) {
 TEST_F(TrackFoldTest, BlocksSumToTheWindow) {
   const WindowFold fold = Fold(task_);
   ASSERT_GE(fold.block_samples.size(), 7u);
-  long long samples = 0;
-  Eigen::VectorXd score = Eigen::VectorXd::Zero(fold.gradient.size());
-  // The rows of the window's own columns, then of the shared sensor biases.
-  std::vector<int> columns;
-  for (size_t k = 0; k < fold.roles.size(); ++k) {
-    if (fold.roles[k] == FoldRole::kWindow) columns.push_back(static_cast<int>(k));
+  ExpectBlocksSumToTheWindow(fold);
+}
+
+// A window streamed in pieces: each block of 1300 samples is read, evaluated and folded in
+// two pieces, whose rows and misfits must all reach the block and the window.
+TEST_F(TrackFoldTest, BlocksOfSeveralPiecesFoldEverySample) {
+  Simulate(kLongSamples);
+  task_.blocks = 2;
+  const WindowFold fold = Fold(task_);
+  ASSERT_EQ(fold.block_samples.size(), 2u);
+  EXPECT_EQ(fold.block_samples[0], kLongSamples / 2);
+  EXPECT_EQ(fold.readings, kNumCables * kLongSamples);
+  EXPECT_EQ(fold.block_first_time_s[1], data_.samples[kLongSamples / 2].time_s);
+  EXPECT_EQ(fold.block_last_time_s[1], data_.samples.back().time_s);
+  ExpectBlocksSumToTheWindow(fold);
+  ExpectGradientOfChiSquare(fold, {0, 2, 4});
+  // Without the slow error the rows are independent: the window's information and
+  // chi-square are its halves', each folded in blocks of a single piece.
+  task_.slow_error = SlowErrorProcess();
+  const WindowFold whole = Fold(task_);
+  Dataset all = data_;
+  WindowFold halves[2];
+  for (int h = 0; h < 2; ++h) {
+    data_.samples.assign(all.samples.begin() + h * kLongSamples / 2,
+                         all.samples.begin() + (h + 1) * kLongSamples / 2);
+    halves[h] = Fold(task_);
+    ASSERT_EQ(halves[h].block_samples.size(), 2u);  // 650 samples a block: one piece each
   }
-  ASSERT_EQ(columns.size(), 3u);
-  for (size_t k = 0; k < fold.roles.size(); ++k) {
-    if (fold.roles[k] == FoldRole::kShared && fold.columns[k].rfind("sensor_bias_kN[", 0) == 0) {
-      columns.push_back(static_cast<int>(k));
-    }
+  EXPECT_NEAR(halves[0].chi_square + halves[1].chi_square, whole.chi_square,
+              1e-10 * whole.chi_square);
+  EXPECT_LE((halves[0].information + halves[1].information - whole.information).norm(),
+            1e-10 * whole.information.norm());
+}
+
+// The fold of a window store, streamed from the file (in time order) or sorted in memory
+// (appended out of order), is the fold of the same samples in memory.
+TEST_F(TrackFoldTest, StoreStreamedOrSortedFoldsAsInMemory) {
+  Simulate(kLongSamples);
+  const std::string in_order = test::TempPath("track_fold_in_order", ".samples");
+  const std::string shuffled = test::TempPath("track_fold_shuffled", ".samples");
+  std::remove(in_order.c_str());
+  std::remove(shuffled.c_str());
+  std::vector<internal::StoredSample> records;
+  for (const Sample& s : data_.samples) records.push_back(internal::ToStored(s, 0, false));
+  std::string error;
+  ASSERT_TRUE(internal::AppendStoredSamples(in_order, records, &error)) << error;
+  // The second half first, as two files given in the wrong order would be.
+  std::vector<internal::StoredSample> later(records.begin() + kLongSamples / 2, records.end());
+  std::vector<internal::StoredSample> earlier(records.begin(), records.begin() + kLongSamples / 2);
+  ASSERT_TRUE(internal::AppendStoredSamples(shuffled, later, &error)) << error;
+  ASSERT_TRUE(internal::AppendStoredSamples(shuffled, earlier, &error)) << error;
+  const std::string expected = SerializeWindowFold(Fold(task_));
+  for (const std::string& path : {in_order, shuffled}) {
+    FoldTask task = task_;
+    task.samples_path = path;
+    WindowFold fold;
+    ASSERT_TRUE(FoldWindow(task, &fold, &error)) << error;
+    EXPECT_EQ(SerializeWindowFold(fold), expected) << path;
   }
-  ASSERT_EQ(fold.block_information[0].rows(), static_cast<Eigen::Index>(columns.size()));
-  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(columns.size(), fold.gradient.size());
-  for (size_t b = 0; b < fold.block_samples.size(); ++b) {
-    samples += fold.block_samples[b];
-    score += fold.block_scores.row(b).transpose();
-    rows += fold.block_information[b];
-  }
-  EXPECT_EQ(samples, fold.samples);
-  EXPECT_LE((score - fold.gradient).norm(), 1e-9 * fold.gradient.norm());
-  for (size_t k = 0; k < columns.size(); ++k) {
-    EXPECT_LE((rows.row(k) - fold.information.row(columns[k])).norm(),
-              1e-9 * fold.information.norm())
-        << fold.columns[columns[k]];
-  }
+  std::remove(in_order.c_str());
+  std::remove(shuffled.c_str());
 }
 
 TEST_F(TrackFoldTest, SameBytesOnAnyNumberOfThreads) {
+  Simulate(kLongSamples);
+  task_.blocks = 2;  // two pieces a block, shared by the threads
   FoldTask two = task_;
   two.threads = 2;
   EXPECT_EQ(SerializeWindowFold(Fold(task_)), SerializeWindowFold(Fold(two)));
@@ -199,6 +279,49 @@ TEST_F(TrackFoldTest, UnsolvablePoseNamesFileAndLine) {
   std::string error;
   EXPECT_FALSE(FoldSamples(task_, data_, std::vector<int>(data_.samples.size(), 0), &fold, &error));
   EXPECT_NE(error.find("survey.csv:12"), std::string::npos) << error;
+}
+
+// Ranges read from a store in time order and from one sorted in memory: the same samples.
+TEST(WindowStoreTest, RangesReadAsTheWhole) {
+  const std::string path = test::TempPath("window_store_ranges", ".samples");
+  for (const bool in_order : {true, false}) {
+    std::remove(path.c_str());
+    std::vector<internal::StoredSample> records;
+    for (int k = 0; k < 10; ++k) {
+      Sample s;
+      s.time_s = in_order ? k : (k * 7) % 10;  // 0, 7, 4, 1, ... when out of order
+      s.line = 100 + k;
+      s.tension_n.fill(1e5 * s.time_s);
+      records.push_back(internal::ToStored(s, k, false));
+    }
+    std::string error;
+    ASSERT_TRUE(internal::AppendStoredSamples(path, records, &error)) << error;
+    internal::StoredWindowReader reader;
+    ASSERT_TRUE(reader.Open(path, &error)) << error;
+    ASSERT_EQ(reader.size(), 10);
+    std::vector<Sample> part;
+    std::vector<int> file_of;
+    ASSERT_TRUE(reader.Read(3, 4, &part, &file_of, &error)) << error;
+    ASSERT_EQ(part.size(), 4u);
+    for (int k = 0; k < 4; ++k) {
+      EXPECT_EQ(part[k].time_s, 3.0 + k) << in_order;
+      EXPECT_EQ(part[k].tension_n[0], 1e5 * (3.0 + k));
+      EXPECT_EQ(records[file_of[k]].time_s, part[k].time_s);  // the file index: its record's
+    }
+    EXPECT_FALSE(reader.Read(8, 3, &part, &file_of, &error));  // past the end
+    EXPECT_NE(error.find(path), std::string::npos) << error;
+  }
+  // A record that is not finite is named by its place in the file.
+  std::remove(path.c_str());
+  Sample bad;
+  bad.tension_n[2] = std::nan("");
+  std::string error;
+  ASSERT_TRUE(internal::AppendStoredSamples(
+      path, {internal::ToStored(Sample(), 0, false), internal::ToStored(bad, 0, false)}, &error));
+  internal::StoredWindowReader reader;
+  EXPECT_FALSE(reader.Open(path, &error));
+  EXPECT_NE(error.find("record 1 is not finite"), std::string::npos) << error;
+  std::remove(path.c_str());
 }
 
 TEST(WindowStoreTest, RecordsRoundTripSortedByTime) {

@@ -20,7 +20,9 @@
 // sigma for the estimate of the slow error's amplitude and time constant.
 //
 // FoldWindow is a pure function of the task: the same task gives the same bits on any
-// machine and any number of threads (sample_chunks.h). Tasks and folds travel as bytes
+// machine and any number of threads (sample_chunks.h). It streams the window: two passes
+// over its samples a piece at a time, keeping ~260 bytes a sample between them, so that
+// a fold's memory is about a quarter of a kB per sample of its window (issue 27). Tasks and folds travel as bytes
 // (SerializeFoldTask, SerializeWindowFold; little-endian IEEE doubles, the layout in
 // docs/calibration.md, "Tracking: files"): a fold file in a track's DIR/folds is
 // SerializeWindowFold's bytes.

@@ -33,17 +33,26 @@ SampleRowWhitener::SampleRowWhitener(const FittedSamples& samples, int columns)
       whitener_(samples.whitened() ? samples.slow_error : SlowErrorProcess(), columns) {}
 
 double SampleRowWhitener::Whiten(SampleRows* rows, const std::vector<int>* index) {
-  if (!whitener_.active()) return 0.0;
+  return WhitenRows(samples_, &whitener_, rows, index);
+}
+
+double SampleRowWhitener::Whiten(const FittedSamples& piece, SampleRows* rows) {
+  return WhitenRows(piece, &whitener_, rows, nullptr);
+}
+
+double SampleRowWhitener::WhitenRows(const FittedSamples& samples, ReadingWhitener* whitener,
+                                     SampleRows* rows, const std::vector<int>* index) {
+  if (!whitener->active()) return 0.0;
   double log_f = 0.0;
   for (int k = rows->begin; k < rows->end; ++k) {
     const int j = index != nullptr ? (*index)[k] : k;
-    const int t = (*samples_.fit)[j];
-    const Sample& sample = samples_.data->samples[t];
+    const int t = (*samples.fit)[j];
+    const Sample& sample = samples.data->samples[t];
     std::array<bool, kNumCables> excluded{};
-    if (samples_.excluded != nullptr && !samples_.excluded->empty()) {
-      excluded = (*samples_.excluded)[t];
+    if (samples.excluded != nullptr && !samples.excluded->empty()) {
+      excluded = (*samples.excluded)[t];
     }
-    log_f += whitener_.Whiten(sample.time_s, sample.session, (*samples_.slow_rho)[j].data(),
+    log_f += whitener->Whiten(sample.time_s, sample.session, (*samples.slow_rho)[j].data(),
                               excluded.data(), rows->Of(k));
     for (int i = 0; i < kNumCables; ++i) {
       if (excluded[i]) std::fill(rows->Row(k, i), rows->Row(k, i) + rows->columns, 0.0);

@@ -22,6 +22,7 @@
 #include <filesystem>
 #include <functional>
 #include <limits>
+#include <new>
 #include <string_view>
 
 #include "fastcal/column_map.h"
@@ -370,8 +371,7 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
 }
 
 bool ParseHeader(std::string_view line, const std::string& where, const std::string& path,
-                 DatasetColumns required,
-                 Header* header, std::string* error) {
+                 DatasetColumns required, Header* header, std::string* error) {
   header->field_of.fill(-1);
   for (int c = 0; c < kNumColumns; ++c) header->label[c] = "column " + Quoted(kColumnNames[c]);
   if (header->map != nullptr) return ParseMappedHeader(line, where, path, required, header, error);
@@ -1115,7 +1115,14 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   Dataset all, chunk;
   std::error_code size_error;
   const auto bytes = std::filesystem::file_size(path, size_error);
-  if (!size_error) all.samples.reserve(static_cast<size_t>(bytes / kMinRowBytes) + 1);
+  if (!size_error) {
+    try {
+      all.samples.reserve(static_cast<size_t>(bytes / kMinRowBytes) + 1);
+    } catch (const std::bad_alloc&) {
+      // More address space than the system grants (a 4 GB file asks for 24 GB, beyond
+      // this 23 GB machine's overcommit): the vector grows as it is read instead.
+    }
+  }
   bool done = false;
   while (!done) {
     if (!reader.Next(kChunkSamples, &chunk, &done, error)) return false;

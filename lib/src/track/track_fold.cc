@@ -1,17 +1,28 @@
 // The fold of one window (track_fold.h): predict at the point, whiten and screen, then
-// the whitened rows folded by QR, block by block, in time order.
+// the whitened rows folded by QR (row_fold.h), block by block, in time order.
+//
+// Streamed (issue 27): the window's samples are read twice, a piece of at most 1024 at a
+// time, from the window store (or from memory): the first pass keeps per sample only
+// what the screen and the second pass need (time, predicted reading, residual, warm
+// start: ~260 bytes, against ~1.2 kB a sample with the samples, their predictions and
+// their sort all in memory); the second evaluates, whitens and folds each piece's rows.
 #include "fastcal/track_fold.h"
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
+#include <limits>
+#include <mutex>
 
 #include "fastcal/gross_errors.h"
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/compact_start.h"
+#include "fastcal/internal/row_fold.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/sample_rows.h"
+#include "fastcal/internal/slow_error_filter.h"
 #include "fastcal/internal/window_store.h"
 
 namespace fastcal {
@@ -23,14 +34,61 @@ using internal::ReadingArrays;
 constexpr int kMinBlockSamples = 16;
 // Rounds of the gross-error screen at most (one more than needed: they settle at once).
 constexpr int kMaxScreenRounds = 4;
+// Samples a pass reads at once: the prediction's chunk (its warm starts run along it), and
+// the most a piece of a block holds (its rows: 1.5 MB at 31 columns).
+constexpr int kPieceSamples = internal::kSampleChunk;
 
-std::string Where(const FoldTask& task, const Dataset& data, const std::vector<int>& file_of,
-                  int t) {
-  const int f = t < static_cast<int>(file_of.size()) ? file_of[t] : -1;
-  const std::string file =
-      f >= 0 && f < static_cast<int>(task.files.size()) ? task.files[f] : data.path;
-  return file + ":" + std::to_string(data.samples[t].line);
+// A window's samples in time order, a range at a time (called from several threads).
+struct SampleSource {
+  long long size = 0;
+  int sessions = 1;  // the model's sessions the samples' session indices need
+  std::string name;  // for messages about a sample whose file is not known
+  std::function<bool(long long first, int count, std::vector<Sample>*, std::vector<int>*,
+                     std::string*)>
+      read;
+};
+
+// What the fold keeps of each sample from its first pass to its second (time order): 110
+// bytes, and the warm start (144 bytes exact, 192 aas). The white sigma and the slow error's
+// ratio follow from the reading (TensionSigmas) and are recomputed where needed.
+struct WindowPrediction {
+  std::vector<double> time_s;
+  ReadingArrays reading_n;  // gain T + bias at the point
+  ReadingArrays x;          // (reading - measured) / sigma_white
+  internal::CompactStarts starts;
+  ReadingMask excluded;  // gross errors
+};
+
+std::array<double, kNumCables> WhiteSigmas(const FoldTask& task,
+                                           const std::array<double, kNumCables>& reading_n) {
+  return internal::TensionSigmas(reading_n, task.tension_sigma_n, task.tension_sigma_percent);
 }
+
+// rho_i = sigma_slow(reading_i) / sigma_white_i (slow_error.h).
+std::array<double, kNumCables> SlowRatios(const FoldTask& task,
+                                          const std::array<double, kNumCables>& reading_n) {
+  const std::array<double, kNumCables> sigma = WhiteSigmas(task, reading_n);
+  std::array<double, kNumCables> rho;
+  for (int i = 0; i < kNumCables; ++i) rho[i] = task.slow_error.SigmaN(reading_n[i]) / sigma[i];
+  return rho;
+}
+
+std::string Where(const FoldTask& task, const SampleSource& source, const Sample& sample,
+                  int file) {
+  const std::string name =
+      file >= 0 && file < static_cast<int>(task.files.size()) ? task.files[file] : source.name;
+  return name + ":" + std::to_string(sample.line);
+}
+
+// The first read error of a pass's threads.
+struct ReadFailure {
+  std::mutex mutex;
+  std::string error;
+  void Keep(const std::string& why) {
+    std::lock_guard<std::mutex> lock(mutex);
+    if (error.empty()) error = why;
+  }
+};
 
 CalibrationSpec FoldSpec(const FoldTask& task) {
   CalibrationSpec spec;
@@ -41,91 +99,104 @@ CalibrationSpec FoldSpec(const FoldTask& task) {
   return spec;
 }
 
-// The model's readings, white sigmas and residuals over them at the point, and the warm
-// starts there. Returns the first sample the statics cannot solve, or -1.
-struct Prediction {
-  ReadingArrays reading_n, sigma_n, x;
-  internal::CompactStarts starts;
-};
-int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Dataset& data,
-            const StaticsOptions& statics, Prediction* at) {
+// The first pass: the model's readings and the residuals over their white sigma at the
+// point, and the warm starts there. Returns the first sample the statics cannot solve (or
+// that cannot be read: *read_failure then says why), or -1.
+int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const SampleSource& source,
+            const StaticsOptions& statics, WindowPrediction* at, ReadFailure* read_failure) {
   StaticsParameters<double> params;
   std::array<double, kNumCables> gain, bias;
   cm.Assemble(task.theta_si.data(), &params, &gain, &bias);
-  const int n = static_cast<int>(data.samples.size());
+  const int n = static_cast<int>(source.size);
+  at->time_s.resize(n);
   at->reading_n.resize(n);
-  at->sigma_n.resize(n);
   at->x.resize(n);
   at->starts = internal::CompactStarts(statics.method);
   at->starts.Reset(n);
   StaticsOptions options = statics;
   options.warm_start = true;
-  return internal::ForEachChunk(n, task.threads, [&](int begin, int end) {
-    StaticsSolution solution;
-    for (int t = begin; t < end; ++t) {
-      const Sample& s = data.samples[t];
-      // Consecutive samples are close: each starts from the one before in its chunk.
-      if (t == begin) solution.status = StaticsStatus::kInvalidInput;
-      if (SolveStaticsWithParameters(params, s.pose, options, &solution) != StaticsStatus::kOk) {
-        return t;
-      }
-      at->starts.Set(t, solution);
-      for (int i = 0; i < kNumCables; ++i) {
-        at->reading_n[t][i] = gain[i] * solution.cables[i].lower_tension_n + bias[i];
-      }
-      at->sigma_n[t] = internal::TensionSigmas(at->reading_n[t], task.tension_sigma_n,
-                                               task.tension_sigma_percent);
-      for (int i = 0; i < kNumCables; ++i) {
-        at->x[t][i] = (at->reading_n[t][i] - s.tension_n[i]) / at->sigma_n[t][i];
-      }
-    }
-    return -1;
-  });
+  return internal::ForEachChunk(
+      n, task.threads,
+      [&](int begin, int end) {
+        std::vector<Sample> samples;
+        std::vector<int> file_of;
+        std::string why;
+        if (!source.read(begin, end - begin, &samples, &file_of, &why)) {
+          read_failure->Keep(why);
+          return begin;
+        }
+        StaticsSolution solution;
+        for (int t = begin; t < end; ++t) {
+          const Sample& s = samples[t - begin];
+          at->time_s[t] = s.time_s;
+          // Consecutive samples are close: each starts from the one before in its chunk.
+          if (t == begin) solution.status = StaticsStatus::kInvalidInput;
+          if (SolveStaticsWithParameters(params, s.pose, options, &solution) !=
+              StaticsStatus::kOk) {
+            return t;
+          }
+          at->starts.Set(t, solution);
+          for (int i = 0; i < kNumCables; ++i) {
+            at->reading_n[t][i] = gain[i] * solution.cables[i].lower_tension_n + bias[i];
+          }
+          const std::array<double, kNumCables> sigma = WhiteSigmas(task, at->reading_n[t]);
+          for (int i = 0; i < kNumCables; ++i) {
+            at->x[t][i] = (at->reading_n[t][i] - s.tension_n[i]) / sigma[i];
+          }
+        }
+        return -1;
+      },
+      kPieceSamples);
+}
+
+// The residuals x whitened in place into innovations, in time order by the slow error's
+// filters (readings in `excluded` innovated without updating them); unchanged for white
+// noise (internal/calibration_slow_error.h, WhitenPrediction, over the window's arrays).
+void WhitenResiduals(const FoldTask& task, const WindowPrediction& at, const ReadingMask& excluded,
+                     ReadingArrays* x) {
+  if (!task.slow_error.IsActive()) return;
+  internal::ReadingWhitener whitener(task.slow_error, 1);
+  for (size_t t = 0; t < x->size(); ++t) {
+    const std::array<double, kNumCables> rho = SlowRatios(task, at.reading_n[t]);
+    whitener.Whiten(at.time_s[t], 0, rho.data(), excluded[t].data(), (*x)[t].data());
+  }
 }
 
 // The gross errors among the innovations (all of them judged): screened, whitened again
 // with them left out of the filter (a gross error that updated it would spoil the
 // innovations after it), screened again, until the set stands.
-void ScreenWindow(const FoldTask& task, const internal::PredictionView& view, const Prediction& at,
-                  ReadingMask* excluded) {
-  const int n = static_cast<int>(at.x.size());
-  excluded->assign(n, {});
+void ScreenWindow(const FoldTask& task, WindowPrediction* at) {
+  const int n = static_cast<int>(at->x.size());
+  at->excluded.assign(n, {});
   if (!task.detect_gross_errors) return;
   for (int round = 0; round < kMaxScreenRounds; ++round) {
-    ReadingArrays whitened = at.x;
-    internal::WhitenPrediction(task.slow_error, view, &whitened);
+    ReadingArrays whitened = at->x;
+    WhitenResiduals(task, *at, at->excluded, &whitened);
     GrossErrorScreen screen = ScreenGrossErrors(whitened, {}, task.gross_error_threshold_sigmas);
-    if (screen.flagged == *excluded) return;
-    *excluded = std::move(screen.flagged);
+    if (screen.flagged == at->excluded) return;
+    at->excluded = std::move(screen.flagged);
   }
 }
 
-// The RMS sums, the gross errors named and the run of residuals the slow-error estimate
-// reads.
-void Summarise(const FoldTask& task, const Dataset& data, const std::vector<int>& file_of,
-               const internal::PredictionView& view, const Prediction& at,
-               const ReadingMask& excluded, WindowFold* fold) {
-  const int n = static_cast<int>(data.samples.size());
+// The gross errors counted and the first ones named (their file, line and measured value
+// are the second pass's: *named gets each one's sample), and the run of residuals the
+// slow-error estimate reads.
+void Summarise(const FoldTask& task, const WindowPrediction& at, WindowFold* fold,
+               std::vector<int>* named) {
+  const int n = static_cast<int>(at.x.size());
   ReadingArrays whitened = at.x;
-  internal::WhitenPrediction(task.slow_error, view, &whitened);
+  WhitenResiduals(task, at, at.excluded, &whitened);
   for (int t = 0; t < n; ++t) {
     for (int i = 0; i < kNumCables; ++i) {
-      const double e = at.reading_n[t][i] - data.samples[t].tension_n[i];
-      if (!excluded[t][i]) {
-        fold->sum_sq_n2[i] += e * e;
-        ++fold->count[i];
-        continue;
-      }
+      if (!at.excluded[t][i]) continue;
       ++fold->gross_error_count;
       if (static_cast<int>(fold->gross_errors.size()) >= kMaxFoldGrossErrors) continue;
       FoldGrossError g;
-      g.file = t < static_cast<int>(file_of.size()) ? file_of[t] : 0;
-      g.line = data.samples[t].line;
       g.cable = i + 1;
-      g.measured_n = data.samples[t].tension_n[i];
       g.predicted_n = at.reading_n[t][i];
       g.residual_sigma = whitened[t][i];
       fold->gross_errors.push_back(g);
+      named->push_back(t);
     }
   }
   // The run: the middle of the window (away from its edges, where the cabin may park).
@@ -133,74 +204,197 @@ void Summarise(const FoldTask& task, const Dataset& data, const std::vector<int>
   const int first = (n - run) / 2;
   for (int t = first; t < first + run; ++t) {
     FoldResidual r;
-    r.time_s = data.samples[t].time_s;
+    r.time_s = at.time_s[t];
     r.x = at.x[t];
-    r.sigma_n = at.sigma_n[t];
+    r.sigma_n = WhiteSigmas(task, at.reading_n[t]);
     r.reading_n = at.reading_n[t];
-    r.excluded = excluded[t];
+    r.excluded = at.excluded[t];
     fold->residuals.push_back(r);
   }
 }
 
-// The whitened rows folded block by block (a block is one chunk of the ordered pass).
-bool FoldRowsInBlocks(const FoldTask& task, const internal::FittedSamples& samples,
-                      const std::vector<int>& block_columns, WindowFold* fold, int* failed) {
-  const int n = samples.model->num_free();
-  const int count = samples.size();
+// A piece of the second pass: samples [begin, end) of one block.
+struct Piece {
+  int begin = 0, end = 0;
+  int block = 0;
+  bool last_of_block = false;
+};
+
+// Blocks of `block` samples (the last one shorter), each cut into pieces of at most
+// kPieceSamples.
+std::vector<Piece> Pieces(int count, int block) {
+  std::vector<Piece> pieces;
+  for (int b = 0, first = 0; first < count; ++b, first += block) {
+    const int last = std::min(count, first + block);
+    for (int begin = first; begin < last; begin += kPieceSamples) {
+      Piece p;
+      p.begin = begin;
+      p.end = std::min(last, begin + kPieceSamples);
+      p.block = b;
+      p.last_of_block = p.end == last;
+      pieces.push_back(p);
+    }
+  }
+  return pieces;
+}
+
+// A piece's samples with what the rows need of them: FittedSamples over the piece.
+struct PieceSamples {
+  Dataset data;
+  std::vector<int> file_of;
+  std::vector<int> fit;  // 0 .. size - 1
+  ReadingArrays sigma_n, rho;
+  internal::CompactStarts starts;
+  ReadingMask excluded;
+  internal::FittedSamples fitted;
+
+  // False (with *error) when the samples cannot be read.
+  bool Load(const FoldTask& task, const SampleSource& source, const WindowPrediction& at,
+            const internal::FittedSamples& window, const Piece& piece, std::string* error) {
+    if (!source.read(piece.begin, piece.end - piece.begin, &data.samples, &file_of, error)) {
+      return false;
+    }
+    const int m = piece.end - piece.begin;
+    fit.resize(m);
+    sigma_n.resize(m);
+    rho.resize(task.slow_error.IsActive() ? m : 0);
+    for (int j = 0; j < m; ++j) {
+      fit[j] = j;
+      sigma_n[j] = WhiteSigmas(task, at.reading_n[piece.begin + j]);
+      if (!rho.empty()) rho[j] = SlowRatios(task, at.reading_n[piece.begin + j]);
+    }
+    starts = at.starts.Slice(piece.begin, piece.end);
+    excluded.assign(at.excluded.begin() + piece.begin, at.excluded.begin() + piece.end);
+    fitted = window;
+    fitted.data = &data;
+    fitted.fit = &fit;
+    fitted.sigma_n = &sigma_n;
+    fitted.starts = &starts;
+    fitted.excluded = &excluded;
+    fitted.slow_rho = rho.empty() ? nullptr : &rho;
+    return true;
+  }
+};
+
+// The second pass's sums over the pieces in time order: per cable the squared misfits, the
+// named gross errors' file, line and measured value, and each block's rows folded.
+struct BlockSums {
+  const WindowPrediction& at;
+  const std::vector<int>& block_columns;
+  const std::vector<int>& named;  // the sample of each of fold->gross_errors
+  int n = 0;
+  internal::RowFold block, total;
+  WindowFold* fold;
+
+  void Add(const Piece& piece, const PieceSamples& p, const internal::RowFold& rows) {
+    const std::vector<Sample>& in = p.data.samples;
+    for (int t = piece.begin; t < piece.end; ++t) {
+      const Sample& s = in[t - piece.begin];
+      for (int i = 0; i < kNumCables; ++i) {
+        if (at.excluded[t][i]) continue;
+        const double e = at.reading_n[t][i] - s.tension_n[i];
+        fold->sum_sq_n2[i] += e * e;
+        ++fold->count[i];
+      }
+    }
+    for (size_t g = 0; g < named.size(); ++g) {
+      if (named[g] < piece.begin || named[g] >= piece.end) continue;
+      FoldGrossError& e = fold->gross_errors[g];
+      e.file = std::max(0, p.file_of[named[g] - piece.begin]);
+      e.line = in[named[g] - piece.begin].line;
+      e.measured_n = in[named[g] - piece.begin].tension_n[e.cable - 1];
+    }
+    if (static_cast<int>(fold->block_samples.size()) == piece.block) {
+      fold->block_samples.push_back(0);
+      fold->block_first_time_s.push_back(in.front().time_s);
+      fold->block_last_time_s.push_back(0.0);
+    }
+    fold->block_samples.back() += piece.end - piece.begin;
+    fold->block_last_time_s.back() = in.back().time_s;
+    block.Add(rows);
+    if (piece.last_of_block) CloseBlock();
+  }
+
+  // The block's score and its information rows of the block columns, its rows into the
+  // window's.
+  void CloseBlock() {
+    const Eigen::MatrixXd r = block.r();
+    const Eigen::MatrixXd rj = r.leftCols(n);
+    const Eigen::VectorXd zj = r.col(n);
+    const Eigen::VectorXd score = rj.transpose() * zj;
+    fold->block_scores.conservativeResize(fold->block_scores.rows() + 1, n);
+    fold->block_scores.row(fold->block_scores.rows() - 1) = score.transpose();
+    const Eigen::MatrixXd info = rj.transpose() * rj;
+    Eigen::MatrixXd rows_of_window(block_columns.size(), n);
+    for (size_t k = 0; k < block_columns.size(); ++k) {
+      rows_of_window.row(k) = info.row(block_columns[k]);
+    }
+    fold->block_information.push_back(rows_of_window);
+    total.Add(block);
+    block = internal::RowFold(n + 1);
+  }
+};
+
+// The second pass: the whitened rows folded piece by piece, in time order, into the blocks
+// and the window. Returns the first sample the statics cannot solve (or that cannot be
+// read), or -1.
+int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const WindowPrediction& at,
+                     const internal::FittedSamples& window, const std::vector<int>& block_columns,
+                     const std::vector<int>& named, WindowFold* fold, ReadFailure* read_failure) {
+  const int n = window.model->num_free();
+  const int count = static_cast<int>(source.size);
   const int blocks = std::max(1, task.blocks);
-  const int block = std::max(kMinBlockSamples, (count + blocks - 1) / blocks);
+  const std::vector<Piece> pieces =
+      Pieces(count, std::max(kMinBlockSamples, (count + blocks - 1) / blocks));
   struct Part {
+    int piece = 0;
+    PieceSamples samples;
     internal::SampleRows rows;
-    Eigen::MatrixXd r;  // (n + 1) x (n + 1)
+    internal::RowFold fold;
   };
-  Eigen::MatrixXd total;
-  std::vector<Eigen::VectorXd> scores;
-  internal::SampleRowWhitener whitener(samples, n + 1);
-  const std::vector<double>& theta = task.theta_si;
-  const internal::ModelAtTheta at(*samples.model, theta.data(), samples.sessions());
-  *failed = internal::ReduceChunksInOrder<Part>(
-      count, task.threads, [] { return Part(); },
-      [&](int begin, int end, Part* part) {
-        part->rows.Reset(begin, end, n + 1);
-        for (int t = begin; t < end; ++t) {
-          if (!internal::EvaluateSampleRows(samples, t, at, t, &part->rows)) return t;
+  std::vector<int> failed_sample(pieces.size(), -1);
+  BlockSums sums{at,  block_columns, named, n, internal::RowFold(n + 1), internal::RowFold(n + 1),
+                 fold};
+  fold->block_scores.resize(0, n);
+  internal::SampleRowWhitener whitener(window, n + 1);
+  const internal::ModelAtTheta model_at(*window.model, task.theta_si.data(), source.sessions);
+  const int failed = internal::ReduceChunksInOrder<Part>(
+      static_cast<int>(pieces.size()), task.threads, [] { return Part(); },
+      [&](int k, int, Part* part) {
+        const Piece& piece = pieces[k];
+        part->piece = k;
+        std::string why;
+        if (!part->samples.Load(task, source, at, window, piece, &why)) {
+          read_failure->Keep(why);
+          failed_sample[k] = piece.begin;
+          return k;
+        }
+        const int m = piece.end - piece.begin;
+        part->rows.Reset(0, m, n + 1);
+        for (int j = 0; j < m; ++j) {
+          if (!internal::EvaluateSampleRows(part->samples.fitted, j, model_at, j, &part->rows)) {
+            failed_sample[k] = piece.begin + j;
+            return k;
+          }
         }
         return -1;
       },
-      [&](int, int, Part* part) { whitener.Whiten(&part->rows); },
-      [&](int begin, int end, Part* part) {
-        const Eigen::Map<
-            const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>
-            rows(part->rows.values.data(), kNumCables * (end - begin), n + 1);
-        part->r = internal::FoldRows(Eigen::MatrixXd(), rows);
+      [&](int, int, Part* part) { whitener.Whiten(part->samples.fitted, &part->rows); },
+      [&](int k, int, Part* part) {
+        const Piece& piece = pieces[k];
+        part->fold = internal::RowFold(n + 1);
+        part->fold.Add(part->rows.values.data(), kNumCables * (piece.end - piece.begin));
+        part->fold.Flush();
         return -1;
       },
-      [&](const Part& part) {
-        const Eigen::MatrixXd rj = part.r.topLeftCorner(part.r.rows(), n);
-        const Eigen::VectorXd zj = part.r.col(n);
-        scores.push_back(rj.transpose() * zj);
-        const Eigen::MatrixXd info = rj.transpose() * rj;
-        Eigen::MatrixXd rows_of_window(block_columns.size(), n);
-        for (size_t k = 0; k < block_columns.size(); ++k) {
-          rows_of_window.row(k) = info.row(block_columns[k]);
-        }
-        fold->block_information.push_back(rows_of_window);
-        fold->block_samples.push_back(part.rows.end - part.rows.begin);
-        const std::vector<Sample>& in = samples.data->samples;
-        fold->block_first_time_s.push_back(in[(*samples.fit)[part.rows.begin]].time_s);
-        fold->block_last_time_s.push_back(in[(*samples.fit)[part.rows.end - 1]].time_s);
-        total = internal::FoldRows(total, part.r);
-      },
-      block);
-  if (*failed >= 0) return false;
-  if (total.rows() == 0) total = Eigen::MatrixXd::Zero(n + 1, n + 1);
-  const Eigen::MatrixXd r = total.topLeftCorner(total.rows(), n);
+      [&](const Part& part) { sums.Add(pieces[part.piece], part.samples, part.fold); }, 1);
+  if (failed >= 0) return failed_sample[failed];
+  const Eigen::MatrixXd total = sums.total.r();
+  const Eigen::MatrixXd r = total.leftCols(n);
   fold->information = r.transpose() * r;
   fold->gradient = r.transpose() * total.col(n);
   fold->chi_square = total.col(n).squaredNorm();
-  fold->block_scores.resize(static_cast<Eigen::Index>(scores.size()), n);
-  for (size_t b = 0; b < scores.size(); ++b) fold->block_scores.row(b) = scores[b].transpose();
-  return true;
+  return -1;
 }
 
 }  // namespace
@@ -220,8 +414,12 @@ std::vector<int> BlockRowColumns(const std::vector<ParameterSpec>& columns,
   return out;
 }
 
-bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<int>& file_of,
-                 WindowFold* fold, std::string* error) {
+namespace {
+
+// The fold of the window `source` reads: the first pass (predictions), the screen, the
+// summary, the second pass (rows).
+bool FoldSource(const FoldTask& task, const SampleSource& source, WindowFold* fold,
+                std::string* error) {
   if (!task.IsValid(error)) return false;
   CableRobot model;
   if (!ParseCableRobotYaml(task.model_yaml, "the fold task's model", &model, error)) return false;
@@ -232,9 +430,18 @@ bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<in
              " values for " + std::to_string(cm.num_free()) + " columns";
     return false;
   }
+  if (source.size == 0) {
+    *error = "fold task " + task.label + ": the window has no samples";
+    return false;
+  }
+  if (source.size > std::numeric_limits<int>::max() / kNumCables) {
+    *error = "fold task " + task.label + ": " + std::to_string(source.size) +
+             " samples in one window; cut the track into shorter windows";
+    return false;
+  }
   *fold = WindowFold();
   fold->label = task.label;
-  fold->samples = static_cast<long long>(data.samples.size());
+  fold->samples = source.size;
   fold->theta_si = task.theta_si;
   fold->roles = task.roles;
   fold->slow_error = task.slow_error;
@@ -245,56 +452,75 @@ bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<in
     columns.push_back(task.parameters[cm.spec_index(k)]);
   }
   const std::vector<int> block_columns = BlockRowColumns(columns, task.roles);
-  const int n = static_cast<int>(data.samples.size());
-  if (n == 0) {
-    *error = "fold task " + task.label + ": the window has no samples";
-    return false;
-  }
-  fold->first_time_s = data.samples.front().time_s;
-  fold->last_time_s = data.samples.back().time_s;
   const StaticsOptions statics = ModelFitStaticsOptions(task.forward_model);
-  Prediction at;
-  const auto cannot_solve = [&](int t) {
-    *error =
-        Where(task, data, file_of, t) + ": the model at the track's point cannot solve this pose";
+  ReadFailure read_failure;
+  const auto failed_at = [&](int t) {
+    if (!read_failure.error.empty()) {
+      *error = read_failure.error;
+      return false;
+    }
+    std::vector<Sample> sample;
+    std::vector<int> file_of;
+    if (!source.read(t, 1, &sample, &file_of, error)) return false;
+    *error = Where(task, source, sample[0], file_of[0]) +
+             ": the model at the track's point cannot solve this pose";
     return false;
   };
-  if (const int failed = Predict(task, cm, data, statics, &at); failed >= 0) {
-    return cannot_solve(failed);
+  WindowPrediction at;
+  if (const int failed = Predict(task, cm, source, statics, &at, &read_failure); failed >= 0) {
+    return failed_at(failed);
   }
-  std::vector<int> fit(n);
-  for (int t = 0; t < n; ++t) fit[t] = t;
-  ReadingMask excluded;
-  internal::PredictionView view;
-  view.data = &data;
-  view.reading_n = &at.reading_n;
-  view.sigma_n = &at.sigma_n;
-  view.fit = &fit;
-  view.excluded = &excluded;
-  ScreenWindow(task, view, at, &excluded);
-  Summarise(task, data, file_of, view, at, excluded, fold);
-  const ReadingArrays rho = internal::SlowErrorRatios(task.slow_error, view);
-  internal::FittedSamples samples;
-  samples.model = &cm;
-  samples.data = &data;
-  samples.fit = &fit;
-  samples.sigma_n = &at.sigma_n;
-  samples.starts = &at.starts;
-  samples.excluded = &excluded;
-  samples.statics = statics;
-  samples.slow_error = task.slow_error;
-  samples.slow_rho = &rho;
-  int failed = -1;
-  if (!FoldRowsInBlocks(task, samples, block_columns, fold, &failed)) return cannot_solve(failed);
+  fold->first_time_s = at.time_s.front();
+  fold->last_time_s = at.time_s.back();
+  ScreenWindow(task, &at);
+  std::vector<int> named;
+  Summarise(task, at, fold, &named);
+  internal::FittedSamples window;
+  window.model = &cm;
+  window.statics = statics;
+  window.slow_error = task.slow_error;
+  // Each piece brings its own ratios; non-null here so that the whitener is made active.
+  const ReadingArrays no_ratios;
+  window.slow_rho = &no_ratios;
+  if (const int failed =
+          FoldRowsInBlocks(task, source, at, window, block_columns, named, fold, &read_failure);
+      failed >= 0) {
+    return failed_at(failed);
+  }
   for (long long c : fold->count) fold->readings += c;
   return true;
 }
 
+}  // namespace
+
+bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<int>& file_of,
+                 WindowFold* fold, std::string* error) {
+  SampleSource source;
+  source.size = static_cast<long long>(data.samples.size());
+  source.sessions = std::max<int>(1, static_cast<int>(data.session_labels.size()));
+  source.name = data.path;
+  source.read = [&](long long first, int count, std::vector<Sample>* samples,
+                    std::vector<int>* files, std::string*) {
+    samples->assign(data.samples.begin() + first, data.samples.begin() + first + count);
+    files->assign(count, -1);
+    for (int k = 0; k < count && first + k < static_cast<long long>(file_of.size()); ++k) {
+      (*files)[k] = file_of[first + k];
+    }
+    return true;
+  };
+  return FoldSource(task, source, fold, error);
+}
+
 bool FoldWindow(const FoldTask& task, WindowFold* fold, std::string* error) {
-  Dataset data;
-  std::vector<int> file_of;
-  if (!internal::ReadStoredWindow(task.samples_path, &data, &file_of, error)) return false;
-  return FoldSamples(task, data, file_of, fold, error);
+  internal::StoredWindowReader reader;
+  if (!reader.Open(task.samples_path, error)) return false;
+  SampleSource source;
+  source.size = reader.size();
+  source.name = task.samples_path;
+  source.read = [&](long long first, int count, std::vector<Sample>* samples,
+                    std::vector<int>* files,
+                    std::string* why) { return reader.Read(first, count, samples, files, why); };
+  return FoldSource(task, source, fold, error);
 }
 
 }  // namespace fastcal

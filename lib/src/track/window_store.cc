@@ -1,12 +1,15 @@
 // A track's per-window sample files (internal/window_store.h).
 #include "fastcal/internal/window_store.h"
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <numeric>
+#include <limits>
 
 namespace fastcal::internal {
 namespace {
@@ -22,6 +25,20 @@ bool IsFinite(const StoredSample& s) {
   for (double v : s.rotation) ok = ok && std::isfinite(v);
   for (double v : s.tension_n) ok = ok && std::isfinite(v);
   return ok;
+}
+
+// Reads up to `bytes` at `offset`, fewer only at the end of the file (pread may return
+// part of a request). -1 on an error.
+long long ReadAt(int fd, void* into, long long bytes, long long offset) {
+  long long done = 0;
+  while (done < bytes) {
+    const ssize_t got = ::pread(fd, static_cast<char*>(into) + done, bytes - done, offset + done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) return -1;
+    if (got == 0) break;
+    done += got;
+  }
+  return done;
 }
 
 }  // namespace
@@ -50,34 +67,72 @@ bool AppendStoredSamples(const std::string& path, const std::vector<StoredSample
   return true;
 }
 
-bool ReadStoredWindow(const std::string& path, Dataset* data, std::vector<int>* file_of,
-                      std::string* error) {
-  std::FILE* file = std::fopen(path.c_str(), "rb");
-  if (file == nullptr) return Fail(path, std::strerror(errno), error);
-  std::vector<StoredSample> records;
-  StoredSample buffer[4096];
-  size_t got = 0;
-  while ((got = std::fread(buffer, 1, sizeof(buffer), file)) > 0) {
-    if (got % sizeof(StoredSample) != 0) {
-      std::fclose(file);
+StoredWindowReader::~StoredWindowReader() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+bool StoredWindowReader::Open(const std::string& path, std::string* error) {
+  path_ = path;
+  fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd_ < 0) return Fail(path, std::strerror(errno), error);
+  // One pass: every record checked, and whether the times ever go back.
+  std::vector<StoredSample> buffer(4096);
+  bool in_order = true;
+  double last_s = -std::numeric_limits<double>::infinity();
+  size_ = 0;
+  for (;;) {
+    const long long got = ReadAt(fd_, buffer.data(), buffer.size() * sizeof(StoredSample),
+                                 size_ * sizeof(StoredSample));
+    if (got < 0) return Fail(path, std::strerror(errno), error);
+    if (got == 0) break;
+    if (got % static_cast<long long>(sizeof(StoredSample)) != 0) {
       return Fail(path, "not a whole number of 160-byte sample records (truncated?)", error);
     }
-    records.insert(records.end(), buffer, buffer + got / sizeof(StoredSample));
+    for (long long k = 0; k < got / static_cast<long long>(sizeof(StoredSample)); ++k) {
+      if (!IsFinite(buffer[k])) {
+        return Fail(path, "record " + std::to_string(size_ + k) + " is not finite", error);
+      }
+      in_order = in_order && buffer[k].time_s >= last_s;
+      last_s = buffer[k].time_s;
+    }
+    size_ += got / static_cast<long long>(sizeof(StoredSample));
   }
-  const bool failed = std::ferror(file) != 0;
-  std::fclose(file);
-  if (failed) return Fail(path, "cannot read the samples", error);
-  std::vector<size_t> order(records.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(),
-                   [&](size_t a, size_t b) { return records[a].time_s < records[b].time_s; });
-  data->samples.assign(records.size(), Sample());
-  file_of->assign(records.size(), 0);
-  for (size_t k = 0; k < order.size(); ++k) {
-    const StoredSample& r = records[order[k]];
-    if (!IsFinite(r))
-      return Fail(path, "record " + std::to_string(order[k]) + " is not finite", error);
-    Sample& s = data->samples[k];
+  if (in_order) return true;
+  sorted_.resize(size_);
+  const long long bytes = size_ * static_cast<long long>(sizeof(StoredSample));
+  if (ReadAt(fd_, sorted_.data(), bytes, 0) != bytes) {
+    return Fail(path, "cannot read the samples", error);
+  }
+  std::stable_sort(
+      sorted_.begin(), sorted_.end(),
+      [](const StoredSample& a, const StoredSample& b) { return a.time_s < b.time_s; });
+  return true;
+}
+
+bool StoredWindowReader::Read(long long first, int count, std::vector<Sample>* samples,
+                              std::vector<int>* file_of, std::string* error) const {
+  if (first < 0 || count < 0 || first + count > size_) {
+    return Fail(path_,
+                "records " + std::to_string(first) + " to " + std::to_string(first + count) +
+                    " of " + std::to_string(size_),
+                error);
+  }
+  std::vector<StoredSample> own;
+  const StoredSample* records = sorted_.data() + first;
+  if (sorted_.empty()) {
+    own.resize(count);
+    const long long bytes = count * static_cast<long long>(sizeof(StoredSample));
+    if (ReadAt(fd_, own.data(), bytes, first * static_cast<long long>(sizeof(StoredSample))) !=
+        bytes) {
+      return Fail(path_, "cannot read the samples", error);
+    }
+    records = own.data();
+  }
+  samples->assign(count, Sample());
+  file_of->assign(count, 0);
+  for (int k = 0; k < count; ++k) {
+    const StoredSample& r = records[k];
+    Sample& s = (*samples)[k];
     s.time_s = r.time_s;
     s.line = r.line;
     s.pose.position_m = Eigen::Vector3d(r.position_m[0], r.position_m[1], r.position_m[2]);
@@ -86,6 +141,16 @@ bool ReadStoredWindow(const std::string& path, Dataset* data, std::vector<int>* 
     }
     for (int i = 0; i < kNumCables; ++i) s.tension_n[i] = r.tension_n[i];
     (*file_of)[k] = r.file;
+  }
+  return true;
+}
+
+bool ReadStoredWindow(const std::string& path, Dataset* data, std::vector<int>* file_of,
+                      std::string* error) {
+  StoredWindowReader reader;
+  if (!reader.Open(path, error)) return false;
+  if (!reader.Read(0, static_cast<int>(reader.size()), &data->samples, file_of, error)) {
+    return false;
   }
   data->path = path;
   return true;

@@ -85,6 +85,13 @@ class CompactStarts {
       for (int k = 0; k < stride_; ++k) v[i * stride_ + k] = c.v[i][k];
     }
   }
+  // The starts of samples [begin, end), as samples 0 .. end - begin (a piece of a pass).
+  CompactStarts Slice(size_t begin, size_t end) const {
+    CompactStarts piece(method_);
+    const size_t per_sample = kNumCables * stride_;
+    piece.values_.assign(values_.begin() + begin * per_sample, values_.begin() + end * per_sample);
+    return piece;
+  }
   // Sample t's start (CompactStart's layout).
   CompactStart At(size_t t) const {
     CompactStart c;

@@ -35,9 +35,37 @@ StoredSample ToStored(const Sample& sample, int file, bool planned);
 bool AppendStoredSamples(const std::string& path, const std::vector<StoredSample>& samples,
                          std::string* error);
 
+// A window's records in time order (stably sorted), read a range at a time: a fold's
+// passes stream a window through it, so that its samples are never all in memory as
+// Samples (issue 27: 10^5 samples a window, ~1 kB each, twice at once). A store appended
+// in time order (files each in time order, given in turn: the usual case) is read where
+// its records lie; one that is not is sorted once in memory, its records alone (160
+// bytes a sample).
+class StoredWindowReader {
+ public:
+  StoredWindowReader() = default;
+  StoredWindowReader(const StoredWindowReader&) = delete;
+  StoredWindowReader& operator=(const StoredWindowReader&) = delete;
+  ~StoredWindowReader();
+
+  // Reads every record once: refuses a file whose size is not a whole number of records,
+  // and a record that is not finite (named by its index in the file).
+  bool Open(const std::string& path, std::string* error);
+  long long size() const { return size_; }
+  // Records [first, first + count) of the time order as samples (pose: the stored
+  // attitude; session 0) and each one's file index. Safe from several threads at once.
+  bool Read(long long first, int count, std::vector<Sample>* samples, std::vector<int>* file_of,
+            std::string* error) const;
+
+ private:
+  std::string path_;
+  int fd_ = -1;
+  long long size_ = 0;
+  std::vector<StoredSample> sorted_;  // the records, when the file is not in time order
+};
+
 // Reads a window's records into data->samples, sorted by time (stably), and each one's
-// file index into *file_of (parallel to the samples). Refuses a file whose size is not a
-// whole number of records, and a record that is not finite.
+// file index into *file_of (parallel to the samples). Refuses what Open refuses.
 bool ReadStoredWindow(const std::string& path, Dataset* data, std::vector<int>* file_of,
                       std::string* error);
 
