@@ -178,6 +178,8 @@ double Step(ParameterKind kind) {
       return 1.0;  // N
     case ParameterKind::kAttachmentMass:
       return 1e-2;  // kg
+    case ParameterKind::kLengthOffset:
+      return 1e-3;  // m
   }
   return 1e-3;
 }
