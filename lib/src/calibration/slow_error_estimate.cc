@@ -125,82 +125,124 @@ struct CableTerms {
   std::vector<NuisanceSums> sums;
 };
 
-// Cables [first, end) through the filter of slow_error_filter.h, sample by sample (one
-// exp(-dt / tau) a sample). Per reading: rho = sqrt((sigma_N / s)^2 + (a r / s)^2) from
-// the laid-out 1 / s and r / s; one division (1 / F) and two square roots (and a
-// logarithm per kLogBatch readings).
-// A reading left out leaves the state as it is (a missing one) and adds nothing.
-template <int kNuisance>
-void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first, int end,
+// Cables first .. first + kCables - 1 through the filter of slow_error_filter.h, sample by
+// sample (the cables' independent chains interleave: a single cable's is bound by the
+// latency of its division and roots). Per reading: rho = sqrt((sigma_N / s)^2 +
+// (a r / s)^2) from the laid-out 1 / s and r / s; one division (1 / F) and two square
+// roots; a logarithm per kLogBatch readings, and exp(-dt / tau) only where dt changes.
+// The state and the current session's sums are the function's own (a fixed number of
+// cables: no indexing through the cable's memory). A reading left out leaves the state
+// as it is (a missing one) and adds nothing.
+template <int kNuisance, int kCables>
+void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first,
                   CableTerms* terms) {
   constexpr int kColumns = 1 + kNuisance;
   const bool active = process.IsActive();
   const double sigma_n = process.sigma_n, relative = process.sigma_percent / 100.0;
-  struct State {
-    double m[kColumns] = {};
-    double p = 1.0;
-    bool fresh = true;
-  };
-  State state[kNumCables];
-  CableTerms own[kNumCables];
   // log F summed as the log of products of up to kLogBatch F's (F >= 1; a product is
-  // taken early past kLogFlush, far from overflow): one logarithm per kLogBatch readings,
-  // the same sum to rounding.
+  // taken early past kLogFlush, far from overflow): the same sum to rounding.
   constexpr int kLogBatch = 8;
   constexpr double kLogFlush = 1e200;
-  double product[kNumCables];
-  int in_product[kNumCables] = {};
-  for (double& p : product) p = 1.0;
-  for (int i = first; i < end; ++i) own[i].sums.resize(in.sessions);
+  struct Cable {
+    double m[kColumns] = {};
+    double p = 1.0, product = 1.0, log_f = 0.0, square = 0.0;
+    bool fresh = true;
+    int in_product = 0, session = -1;
+    NuisanceSums n;  // the current session's
+    const double *x, *inverse_s, *reading_over_s;
+    const unsigned char* kept;
+  };
+  Cable cable[kCables];
+  for (int k = 0; k < kCables; ++k) {
+    const int i = first + k;
+    cable[k].x = in.x[i].data();
+    cable[k].inverse_s = in.inverse_s[i].data();
+    cable[k].reading_over_s = in.reading_over_s[i].data();
+    cable[k].kept = in.kept[i].data();
+    terms[i].sums.assign(in.sessions, NuisanceSums());
+  }
+  const auto flush_session = [&](Cable& c, int i) {
+    if (c.session < 0) return;
+    terms[i].sums[c.session].gram += c.n.gram;
+    terms[i].sums[c.session].cross += c.n.cross;
+  };
+  double last_dt = LaidOut::kNewSeries, phi = 0.0;
   for (int t = 0; t < in.count; ++t) {
-    const bool new_series = in.dt_s[t] == LaidOut::kNewSeries;
-    const double phi =
-        new_series || !active ? 0.0 : SlowErrorCorrelation(in.dt_s[t], process.time_constant_s);
-    for (int i = first; i < end; ++i) {
-      State& st = state[i];
+    const double dt = in.dt_s[t];
+    const bool new_series = dt == LaidOut::kNewSeries;
+    if (!new_series && dt != last_dt) {
+      phi = active ? SlowErrorCorrelation(dt, process.time_constant_s) : 0.0;
+      last_dt = dt;
+    }
+    const int session = in.session[t];
+    for (int k = 0; k < kCables; ++k) {
+      Cable& c = cable[k];
       if (new_series) {
-        st.fresh = true;
-      } else if (!st.fresh) {
-        for (double& m : st.m) m *= phi;
-        st.p = phi * phi * st.p + (1.0 - phi * phi);
+        c.fresh = true;
+      } else if (!c.fresh) {
+        for (double& v : c.m) v *= phi;
+        c.p = phi * phi * c.p + (1.0 - phi * phi);
       }
-      if (!in.kept[i][t]) continue;
-      if (st.fresh) {
-        for (double& m : st.m) m = 0.0;
-        st.p = 1.0;
-        st.fresh = false;
+      if (!c.kept[t]) continue;
+      if (c.fresh) {
+        for (double& v : c.m) v = 0.0;
+        c.p = 1.0;
+        c.fresh = false;
       }
-      const double a = sigma_n * in.inverse_s[i][t], b = relative * in.reading_over_s[i][t];
+      if (session != c.session) {
+        flush_session(c, first + k);
+        c.session = session;
+        c.n = NuisanceSums();
+      }
+      const double a = sigma_n * c.inverse_s[t], b = relative * c.reading_over_s[t];
       const double rho = !active ? 0.0 : sigma_n == 0.0 ? std::abs(b) : std::sqrt(a * a + b * b);
-      const double f = rho * rho * st.p + 1.0;
+      const double f = rho * rho * c.p + 1.0;
       const double inverse_f = 1.0 / f;
-      const double scale = std::sqrt(inverse_f), gain = st.p * rho * inverse_f;
-      const double row[3] = {in.x[i][t], in.inverse_s[i][t], in.reading_over_s[i][t]};
+      const double scale = std::sqrt(inverse_f), gain = c.p * rho * inverse_f;
+      const double row[3] = {c.x[t], c.inverse_s[t], c.reading_over_s[t]};
       double w[kColumns];
-      for (int c = 0; c < kColumns; ++c) {
-        const double v = row[c] - rho * st.m[c];
-        st.m[c] += gain * v;
-        w[c] = v * scale;
+      for (int col = 0; col < kColumns; ++col) {
+        const double v = row[col] - rho * c.m[col];
+        c.m[col] += gain * v;
+        w[col] = v * scale;
       }
-      st.p -= gain * rho * st.p;
-      CableTerms& out = own[i];
-      product[i] *= f;
-      if (++in_product[i] == kLogBatch || product[i] > kLogFlush) {
-        out.log_f += std::log(product[i]);
-        product[i] = 1.0;
-        in_product[i] = 0;
+      c.p -= gain * rho * c.p;
+      c.product *= f;
+      if (++c.in_product == kLogBatch || c.product > kLogFlush) {
+        c.log_f += std::log(c.product);
+        c.product = 1.0;
+        c.in_product = 0;
       }
-      out.square += w[0] * w[0];
-      NuisanceSums& n = out.sums[in.session[t]];
+      c.square += w[0] * w[0];
       for (int u = 0; u < kNuisance; ++u) {
-        n.cross[u] += w[1 + u] * w[0];
-        for (int v = 0; v < kNuisance; ++v) n.gram(u, v) += w[1 + u] * w[1 + v];
+        c.n.cross[u] += w[1 + u] * w[0];
+        for (int v = 0; v < kNuisance; ++v) c.n.gram(u, v) += w[1 + u] * w[1 + v];
       }
     }
   }
-  for (int i = first; i < end; ++i) {
-    if (in_product[i] > 0) own[i].log_f += std::log(product[i]);
-    terms[i] = std::move(own[i]);
+  for (int k = 0; k < kCables; ++k) {
+    Cable& c = cable[k];
+    flush_session(c, first + k);
+    if (c.in_product > 0) c.log_f += std::log(c.product);
+    terms[first + k].log_f = c.log_f;
+    terms[first + k].square = c.square;
+  }
+}
+
+// Cables [first, end) in runs the filter interleaves (at most three at a time).
+template <int kNuisance>
+void FilterCableRange(const LaidOut& in, const SlowErrorProcess& process, int first, int end,
+                      CableTerms* terms) {
+  while (first < end) {
+    const int count = std::min(end - first, 3);
+    if (count == 3) {
+      FilterCables<kNuisance, 3>(in, process, first, terms);
+    } else if (count == 2) {
+      FilterCables<kNuisance, 2>(in, process, first, terms);
+    } else {
+      FilterCables<kNuisance, 1>(in, process, first, terms);
+    }
+    first += count;
   }
 }
 
@@ -213,9 +255,9 @@ double MinusTwoLogLikelihood(const LaidOut& in, const SlowErrorProcess& process,
   const auto filter_group = [&](int group) {
     const int first = kNumCables * group / groups, end = kNumCables * (group + 1) / groups;
     if (in.nuisance == 2) {
-      FilterCables<2>(in, process, first, end, terms);
+      FilterCableRange<2>(in, process, first, end, terms);
     } else {
-      FilterCables<1>(in, process, first, end, terms);
+      FilterCableRange<1>(in, process, first, end, terms);
     }
   };
   // The groups of threads the system refused (OnThreads) are filtered here afterwards.
