@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <iostream>
+#include <limits>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -250,7 +251,10 @@ int RunTrack(int argc, char** argv) {
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   if (!ColumnsFromFlag(&options.read.columns, &error)) return usage(error);
   if (!FLAGS_quiet) {
-    options.progress = [](const std::string& line) { std::cerr << "  " << line << "\n"; };
+    // Wrapped at the console's width, never cut (nothing else holds these lines).
+    options.progress = [](const std::string& line) {
+      std::cerr << Wrapped(line, "  ", "      ", std::numeric_limits<size_t>::max());
+    };
   }
   if (!options.IsValid(&error)) {
     return usage(WithFlagNames(error, {{"threads", "--threads"},

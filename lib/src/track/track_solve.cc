@@ -318,7 +318,7 @@ bool ReestimateSlowError(TrackRun& run) {
   }
   const bool settled =
       AdoptSlowErrorEstimate(EstimateSlowError(in), true, &run.slow, &run.result->slow_error);
-  run.Progress("slow error: " + DescribeSlowError(run.result->slow_error));
+  run.Progress(DescribeSlowError(run.result->slow_error));
   return settled;
 }
 
