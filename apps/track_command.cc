@@ -137,13 +137,21 @@ constexpr size_t kSentenceLines = 4;
 
 std::string Summary(const TrackResult& r, const std::string& out) {
   std::ostringstream s, head;
-  head << "fastcal track: " << r.windows.size() << " windows of " << WindowSpecText(r.window);
-  if (!r.windows.empty()) {
+  const auto count = [](size_t n, const char* one, const char* many) {
+    return std::to_string(n) + " " + (n == 1 ? one : many);
+  };
+  head << "fastcal track: " << count(r.windows.size(), "window", "windows") << " of "
+       << WindowSpecText(r.window);
+  if (r.windows.size() > 1) {
     head << " (" << r.windows.front().label << " to " << r.windows.back().label << ")";
+  } else if (r.windows.size() == 1) {
+    head << " (" << r.windows.front().label << ")";
   }
-  head << ", " << r.samples << " samples from " << r.files.size() << " file(s); " << r.iterations
-       << " Gauss-Newton iterations (" << (r.converged ? "converged" : "NOT converged") << "), "
-       << r.folds << " folds" << (r.updated ? " (an update)" : "") << "; chi2/nu "
+  head << ", " << count(r.samples, "sample", "samples") << " from "
+       << count(r.files.size(), "file", "files") << "; "
+       << count(r.iterations, "Gauss-Newton iteration", "Gauss-Newton iterations") << " ("
+       << (r.converged ? "converged" : "NOT converged") << "), " << count(r.folds, "fold", "folds")
+       << (r.updated ? " (an update)" : "") << "; chi2/nu "
        << internal::FormatDouble("%.3f", r.reduced_chi_square);
   s << Wrapped(head.str(), "", "  ", kSentenceLines, "track.html");
   if (r.slow_error.enabled) {
