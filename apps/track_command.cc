@@ -137,18 +137,18 @@ constexpr size_t kSentenceLines = 4;
 
 std::string Summary(const TrackResult& r, const std::string& out) {
   std::ostringstream s, head;
-  const auto count = [](size_t n, const char* one, const char* many) {
-    return std::to_string(n) + " " + (n == 1 ? one : many);
+  const auto count = [](long long n, const char* one, const char* many) {
+    return internal::Counted(n, one, many);
   };
-  head << "fastcal track: " << count(r.windows.size(), "window", "windows") << " of "
-       << WindowSpecText(r.window);
+  head << "fastcal track: " << count(static_cast<long long>(r.windows.size()), "window", "windows")
+       << " of " << WindowSpecText(r.window);
   if (r.windows.size() > 1) {
     head << " (" << r.windows.front().label << " to " << r.windows.back().label << ")";
   } else if (r.windows.size() == 1) {
     head << " (" << r.windows.front().label << ")";
   }
   head << ", " << count(r.samples, "sample", "samples") << " from "
-       << count(r.files.size(), "file", "files") << "; "
+       << count(static_cast<long long>(r.files.size()), "file", "files") << "; "
        << count(r.iterations, "Gauss-Newton iteration", "Gauss-Newton iterations") << " ("
        << (r.converged ? "converged" : "NOT converged") << "), " << count(r.folds, "fold", "folds")
        << (r.updated ? " (an update)" : "") << "; chi2/nu "

@@ -175,14 +175,15 @@ std::string TrackHtml(const TrackResult& r) {
       "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #ccc;"
       "padding:2px 6px;font-size:90%;text-align:left}svg{max-width:100%;height:auto}"
       "</style></head><body>\n<h1>Track over " +
-      std::to_string(r.windows.size()) + " windows</h1>\n";
+      Counted(static_cast<long long>(r.windows.size()), "window", "windows") + "</h1>\n";
   if (r.windows.empty()) return h + "<p>No window.</p></body></html>\n";
-  h += "<p>" + std::to_string(r.samples) + " samples from " + std::to_string(r.files.size()) +
-       " file(s), windows of " + WindowSpecText(r.window) + " from " +
-       TrackTimeText(r.windows.front().start_s) + " to " + TrackTimeText(r.windows.back().end_s) +
-       "; " + std::to_string(r.iterations) + " Gauss-Newton iterations (" +
-       (r.converged ? "converged" : "NOT converged") + "), " + std::to_string(r.folds) +
-       " folds this run; chi2/nu " + FormatDouble("%.3f", r.reduced_chi_square) + ".</p>\n";
+  h += "<p>" + Counted(r.samples, "sample", "samples") + " from " +
+       Counted(static_cast<long long>(r.files.size()), "file", "files") + ", windows of " +
+       WindowSpecText(r.window) + " from " + TrackTimeText(r.windows.front().start_s) + " to " +
+       TrackTimeText(r.windows.back().end_s) + "; " +
+       Counted(r.iterations, "Gauss-Newton iteration", "Gauss-Newton iterations") + " (" +
+       (r.converged ? "converged" : "NOT converged") + "), " + Counted(r.folds, "fold", "folds") +
+       " this run; chi2/nu " + FormatDouble("%.3f", r.reduced_chi_square) + ".</p>\n";
   if (r.slow_error.enabled) h += "<p>" + Esc(DescribeSlowError(r.slow_error)) + "</p>\n";
   h += "<h2>Events</h2>\n" + EventsTable(r);
   const TimeAxis axis = AxisOf(r);
@@ -193,8 +194,8 @@ std::string TrackHtml(const TrackResult& r) {
        "and a step well inside them can be significant.</p>\n";
   for (const TrackWander& w : r.wander) {
     if (w.rms > 0.0) {
-      h += "<p>" + Esc(w.group) + " wanders between windows by " +
-           FormatDouble("%.3g", w.rms) + " " + Esc(w.unit) +
+      h += "<p>" + Esc(w.group) + " wanders between windows by " + FormatDouble("%.3g", w.rms) +
+           " " + Esc(w.unit) +
            " rms per component beyond its errors (estimated from the differences between "
            "consecutive windows): the events are steps beyond that.</p>\n";
     }

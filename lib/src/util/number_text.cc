@@ -198,4 +198,8 @@ std::string WithoutNegativeZero(std::string text) {
   return text;
 }
 
+std::string Counted(long long n, const char* one, const char* many) {
+  return std::to_string(n) + " " + (n == 1 ? one : many);
+}
+
 }  // namespace fastcal::internal

@@ -40,6 +40,9 @@ std::string FormatDouble(std::string_view format, double value);
 // rounds to zero has no sign. FormatDouble itself stays printf's.
 std::string WithoutNegativeZero(std::string text);
 
+// "1 window", "3 windows": n and the noun in the singular or the plural.
+std::string Counted(long long n, const char* one, const char* many);
+
 }  // namespace fastcal::internal
 
 #endif  // FASTCAL_INTERNAL_NUMBER_TEXT_H_
