@@ -785,7 +785,9 @@ TEST(CalibrationTest, RobustLossKeepsTheVerdictAndTheBudgetHonest) {
 // leave each block out, predicting it with the exact statics.
 TEST(CalibrationTest, BlockCrossValidationMatchesRefitsWithoutEachBlock) {
   constexpr int kNodes = 60, kBlocks = 5;
-  constexpr double kRelTol = 0.01;
+  // The step's quadratic term included, the one-step prediction matches the refits to
+  // 1.3e-4 here (seeded); the per-cable normal matrices half filled moved it by up to 4.5e-4.
+  constexpr double kRelTol = 2e-4;
   const Dataset data = CircleData(Truth(), kNodes, 0.03, 31);
   CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
   spec.cross_validation_blocks = kBlocks;
