@@ -21,7 +21,7 @@ Rates are printed with their binomial standard error sqrt(p (1 - p) / n).
 
 Usage: scripts/slow_error_study.py [--seeds=30] [--cases=all|NAME,...] [--work=DIR]
 Needs build/bin/fastcal (scripts/build.sh). A run of all cases at 30 seeds takes about
-20 minutes on 2 cores.
+2 minutes on 2 cores (20 before issue 28's second round).
 """
 import argparse
 import json
