@@ -135,11 +135,13 @@ std::string Estimate(const TrackEstimate& e, const std::string& unit) {
 // track.html and events.json).
 constexpr size_t kSentenceLines = 4;
 
-std::string Summary(const TrackResult& r, const std::string& out) {
-  std::ostringstream s, head;
+// The summary's stages: the head (windows, samples, convergence, slow error), the shared
+// parameters, the per-window table, and the events.
+std::string SummaryHead(const TrackResult& r) {
   const auto count = [](long long n, const char* one, const char* many) {
     return internal::Counted(n, one, many);
   };
+  std::ostringstream head;
   head << "fastcal track: " << count(static_cast<long long>(r.windows.size()), "window", "windows")
        << " of " << WindowSpecText(r.window);
   if (r.windows.size() > 1) {
@@ -153,20 +155,29 @@ std::string Summary(const TrackResult& r, const std::string& out) {
        << (r.converged ? "converged" : "NOT converged") << "), " << count(r.folds, "fold", "folds")
        << (r.updated ? " (an update)" : "") << "; chi2/nu "
        << internal::FormatDouble("%.3f", r.reduced_chi_square);
-  s << Wrapped(head.str(), "", "  ", kSentenceLines, "track.html");
+  std::string s = Wrapped(head.str(), "", "  ", kSentenceLines, "track.html");
   if (r.slow_error.enabled) {
-    s << Wrapped(DescribeSlowError(r.slow_error), "", "  ", kSentenceLines, "track.html");
+    s += Wrapped(DescribeSlowError(r.slow_error), "", "  ", kSentenceLines, "track.html");
   }
+  return s;
+}
+
+std::string SharedLines(const TrackResult& r) {
+  std::ostringstream s;
   s << "\nShared parameters (sigma_total):\n";
   for (const TrackShared& p : r.shared) {
     s << "  " << p.name << " = " << Estimate(p.estimate, p.unit);
-    if (r.shared.size() > 0 &&
-        !(p.from_window == 0 && p.to_window + 1 == static_cast<int>(r.windows.size()))) {
+    if (!(p.from_window == 0 && p.to_window + 1 == static_cast<int>(r.windows.size()))) {
       s << "   (windows " << r.windows[p.from_window].label << " to "
         << r.windows[p.to_window].label << ")";
     }
     s << "\n";
   }
+  return s.str();
+}
+
+std::string WindowLines(const TrackResult& r) {
+  std::ostringstream s;
   s << "\nPer window (track.csv):\n  window";
   for (const std::string& n : r.window_parameters) s << "  " << n;
   s << "\n";
@@ -181,6 +192,34 @@ std::string Summary(const TrackResult& r, const std::string& out) {
     }
     s << "\n";
   }
+  return s.str();
+}
+
+std::string EventLine(const TrackResult& r, const TrackEvent& e) {
+  std::ostringstream line;  // wrapped at the console's width below
+  line << e.kind;
+  if (!e.cables.empty()) {
+    line << " (cable";
+    for (int c : e.cables) line << " " << c;
+    line << ")";
+  }
+  if (e.within_window) {
+    line << " inside the window, at "
+         << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
+                                  : internal::FormatDouble("%.17g", e.time_s) + " s");
+  }
+  line << ":";
+  for (const TrackEventParameter& p : e.parameters) {
+    line << " " << p.name << " " << internal::FormatDouble("%+.4g", p.shift) << " +- "
+         << internal::FormatDouble("%.2g", p.sigma_total) << (p.unit == "1" ? "" : " " + p.unit)
+         << ";";
+  }
+  line << " p = " << internal::FormatDouble("%.2g", e.p_value);
+  return Wrapped(line.str(), "  " + r.windows[e.window].label + "  ", "      ", 8, "events.json");
+}
+
+std::string EventLines(const TrackResult& r) {
+  std::ostringstream s;
   s << "\nEvents (events.json; each kind at a "
     << internal::FormatDouble("%g", 100.0 * r.false_alarm)
     << "% false-alarm rate over the track): " << r.events.size() << "\n";
@@ -192,33 +231,17 @@ std::string Summary(const TrackResult& r, const std::string& out) {
                    "  ", "   ", kSentenceLines, "track.html");
     }
   }
-  for (const TrackEvent& e : r.events) {
-    std::ostringstream line;  // wrapped at the console's width below
-    line << e.kind;
-    if (!e.cables.empty()) {
-      line << " (cable";
-      for (int c : e.cables) line << " " << c;
-      line << ")";
-    }
-    if (e.within_window) {
-      line << " inside the window, at "
-           << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
-                                    : internal::FormatDouble("%.17g", e.time_s) + " s");
-    }
-    line << ":";
-    for (const TrackEventParameter& p : e.parameters) {
-      line << " " << p.name << " " << internal::FormatDouble("%+.4g", p.shift) << " +- "
-           << internal::FormatDouble("%.2g", p.sigma_total) << (p.unit == "1" ? "" : " " + p.unit)
-           << ";";
-    }
-    line << " p = " << internal::FormatDouble("%.2g", e.p_value);
-    s << Wrapped(line.str(), "  " + r.windows[e.window].label + "  ", "      ", 8, "events.json");
-  }
-  for (const std::string& n : r.notes)
-    s << Wrapped("Note: " + n, "", "  ", kSentenceLines, "track.html");
-  s << "\nWritten to " << out << ": track.csv, events.json, track.html, " << r.models.size()
-    << " model_calibrated@*.yaml\n";
+  for (const TrackEvent& e : r.events) s << EventLine(r, e);
   return s.str();
+}
+
+std::string Summary(const TrackResult& r, const std::string& out) {
+  std::string s = SummaryHead(r) + SharedLines(r) + WindowLines(r) + EventLines(r);
+  for (const std::string& n : r.notes) {
+    s += Wrapped("Note: " + n, "", "  ", kSentenceLines, "track.html");
+  }
+  return s + "\nWritten to " + out + ": track.csv, events.json, track.html, " +
+         std::to_string(r.models.size()) + " model_calibrated@*.yaml\n";
 }
 
 }  // namespace
