@@ -4,8 +4,10 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <tuple>
 #include <utility>
 
@@ -125,47 +127,116 @@ struct CableTerms {
   std::vector<NuisanceSums> sums;
 };
 
-// Cables first .. first + kCables - 1 through the filter of slow_error_filter.h, sample by
-// sample (the cables' independent chains interleave: a single cable's is bound by the
-// latency of its division and roots). Per reading: rho = sqrt((sigma_N / s)^2 +
-// (a r / s)^2) from the laid-out 1 / s and r / s; one division (1 / F) and two square
-// roots; a logarithm per kLogBatch readings, and exp(-dt / tau) only where dt changes.
-// The state and the current session's sums are the function's own (a fixed number of
-// cables: no indexing through the cable's memory). A reading left out leaves the state
-// as it is (a missing one) and adds nothing.
+// One cable's filter (slow_error_filter.h) with its sums of -2 l's terms, the current
+// session's nuisance sums its own until the session changes. Per reading: rho =
+// sqrt((sigma_N / s)^2 + (a r / s)^2) from the laid-out 1 / s and r / s; one division
+// (1 / F) and two square roots; a logarithm per kLogBatch readings (log F summed as the
+// log of products of up to kLogBatch F's, F >= 1, a product taken early past kLogFlush:
+// the same sum to rounding).
+template <int kNuisance>
+class CableFilter {
+ public:
+  CableFilter(const LaidOut& in, const SlowErrorProcess& process, int cable, CableTerms* out)
+      : x_(in.x[cable].data()),
+        inverse_s_(in.inverse_s[cable].data()),
+        reading_over_s_(in.reading_over_s[cable].data()),
+        kept_(in.kept[cable].data()),
+        active_(process.IsActive()),
+        sigma_n_(process.sigma_n),
+        relative_(process.sigma_percent / 100.0),
+        out_(out) {
+    out_->sums.assign(in.sessions, NuisanceSums());
+  }
+
+  // The time between the previous reading and reading t: a new series, or phi.
+  void Advance(bool new_series, double phi) {
+    if (new_series) {
+      fresh_ = true;
+    } else if (!fresh_) {
+      for (double& v : m_) v *= phi;
+      p_ = phi * phi * p_ + (1.0 - phi * phi);
+    }
+  }
+
+  // Reading t of `session`; one left out leaves the state as it is (a missing one).
+  void Take(int t, int session) {
+    if (!kept_[t]) return;
+    if (fresh_) {
+      for (double& v : m_) v = 0.0;
+      p_ = 1.0;
+      fresh_ = false;
+    }
+    if (session != session_) {
+      FlushSession();
+      session_ = session;
+    }
+    const double a = sigma_n_ * inverse_s_[t], b = relative_ * reading_over_s_[t];
+    const double rho = !active_ ? 0.0 : sigma_n_ == 0.0 ? std::abs(b) : std::sqrt(a * a + b * b);
+    const double f = rho * rho * p_ + 1.0;
+    const double inverse_f = 1.0 / f;
+    const double scale = std::sqrt(inverse_f), gain = p_ * rho * inverse_f;
+    const double row[3] = {x_[t], inverse_s_[t], reading_over_s_[t]};
+    double w[kColumns];
+    for (int col = 0; col < kColumns; ++col) {
+      const double v = row[col] - rho * m_[col];
+      m_[col] += gain * v;
+      w[col] = v * scale;
+    }
+    p_ -= gain * rho * p_;
+    product_ *= f;
+    if (++in_product_ == kLogBatch || product_ > kLogFlush) {
+      log_f_ += std::log(product_);
+      product_ = 1.0;
+      in_product_ = 0;
+    }
+    square_ += w[0] * w[0];
+    for (int u = 0; u < kNuisance; ++u) {
+      n_.cross[u] += w[1 + u] * w[0];
+      for (int v = 0; v < kNuisance; ++v) n_.gram(u, v) += w[1 + u] * w[1 + v];
+    }
+  }
+
+  void Finish() {
+    FlushSession();
+    if (in_product_ > 0) log_f_ += std::log(product_);
+    out_->log_f = log_f_;
+    out_->square = square_;
+  }
+
+ private:
+  static constexpr int kColumns = 1 + kNuisance;
+  static constexpr int kLogBatch = 8;
+  static constexpr double kLogFlush = 1e200;
+
+  void FlushSession() {
+    if (session_ < 0) return;
+    out_->sums[session_].gram += n_.gram;
+    out_->sums[session_].cross += n_.cross;
+    n_ = NuisanceSums();
+  }
+
+  const double *x_, *inverse_s_, *reading_over_s_;
+  const unsigned char* kept_;
+  bool active_;
+  double sigma_n_, relative_;
+  CableTerms* out_;
+  double m_[kColumns] = {};
+  double p_ = 1.0, product_ = 1.0, log_f_ = 0.0, square_ = 0.0;
+  bool fresh_ = true;
+  int in_product_ = 0, session_ = -1;
+  NuisanceSums n_;  // the current session's
+};
+
+// Cables first .. first + kCables - 1, sample by sample: the cables' independent chains
+// interleave (a single cable's is bound by the latency of its division and roots), each
+// filter's state its own (a fixed number of cables: no indexing through a cable's
+// memory); exp(-dt / tau) only where dt changes.
 template <int kNuisance, int kCables>
 void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first,
                   CableTerms* terms) {
-  constexpr int kColumns = 1 + kNuisance;
+  std::array<std::optional<CableFilter<kNuisance>>, kCables> cable;
+  for (int k = 0; k < kCables; ++k) cable[k].emplace(in, process, first + k, &terms[first + k]);
   const bool active = process.IsActive();
-  const double sigma_n = process.sigma_n, relative = process.sigma_percent / 100.0;
-  // log F summed as the log of products of up to kLogBatch F's (F >= 1; a product is
-  // taken early past kLogFlush, far from overflow): the same sum to rounding.
-  constexpr int kLogBatch = 8;
-  constexpr double kLogFlush = 1e200;
-  struct Cable {
-    double m[kColumns] = {};
-    double p = 1.0, product = 1.0, log_f = 0.0, square = 0.0;
-    bool fresh = true;
-    int in_product = 0, session = -1;
-    NuisanceSums n;  // the current session's
-    const double *x, *inverse_s, *reading_over_s;
-    const unsigned char* kept;
-  };
-  Cable cable[kCables];
-  for (int k = 0; k < kCables; ++k) {
-    const int i = first + k;
-    cable[k].x = in.x[i].data();
-    cable[k].inverse_s = in.inverse_s[i].data();
-    cable[k].reading_over_s = in.reading_over_s[i].data();
-    cable[k].kept = in.kept[i].data();
-    terms[i].sums.assign(in.sessions, NuisanceSums());
-  }
-  const auto flush_session = [&](Cable& c, int i) {
-    if (c.session < 0) return;
-    terms[i].sums[c.session].gram += c.n.gram;
-    terms[i].sums[c.session].cross += c.n.cross;
-  };
   double last_dt = LaidOut::kNewSeries, phi = 0.0;
   for (int t = 0; t < in.count; ++t) {
     const double dt = in.dt_s[t];
@@ -174,59 +245,12 @@ void FilterCables(const LaidOut& in, const SlowErrorProcess& process, int first,
       phi = active ? SlowErrorCorrelation(dt, process.time_constant_s) : 0.0;
       last_dt = dt;
     }
-    const int session = in.session[t];
     for (int k = 0; k < kCables; ++k) {
-      Cable& c = cable[k];
-      if (new_series) {
-        c.fresh = true;
-      } else if (!c.fresh) {
-        for (double& v : c.m) v *= phi;
-        c.p = phi * phi * c.p + (1.0 - phi * phi);
-      }
-      if (!c.kept[t]) continue;
-      if (c.fresh) {
-        for (double& v : c.m) v = 0.0;
-        c.p = 1.0;
-        c.fresh = false;
-      }
-      if (session != c.session) {
-        flush_session(c, first + k);
-        c.session = session;
-        c.n = NuisanceSums();
-      }
-      const double a = sigma_n * c.inverse_s[t], b = relative * c.reading_over_s[t];
-      const double rho = !active ? 0.0 : sigma_n == 0.0 ? std::abs(b) : std::sqrt(a * a + b * b);
-      const double f = rho * rho * c.p + 1.0;
-      const double inverse_f = 1.0 / f;
-      const double scale = std::sqrt(inverse_f), gain = c.p * rho * inverse_f;
-      const double row[3] = {c.x[t], c.inverse_s[t], c.reading_over_s[t]};
-      double w[kColumns];
-      for (int col = 0; col < kColumns; ++col) {
-        const double v = row[col] - rho * c.m[col];
-        c.m[col] += gain * v;
-        w[col] = v * scale;
-      }
-      c.p -= gain * rho * c.p;
-      c.product *= f;
-      if (++c.in_product == kLogBatch || c.product > kLogFlush) {
-        c.log_f += std::log(c.product);
-        c.product = 1.0;
-        c.in_product = 0;
-      }
-      c.square += w[0] * w[0];
-      for (int u = 0; u < kNuisance; ++u) {
-        c.n.cross[u] += w[1 + u] * w[0];
-        for (int v = 0; v < kNuisance; ++v) c.n.gram(u, v) += w[1 + u] * w[1 + v];
-      }
+      cable[k]->Advance(new_series, phi);
+      cable[k]->Take(t, in.session[t]);
     }
   }
-  for (int k = 0; k < kCables; ++k) {
-    Cable& c = cable[k];
-    flush_session(c, first + k);
-    if (c.in_product > 0) c.log_f += std::log(c.product);
-    terms[first + k].log_f = c.log_f;
-    terms[first + k].square = c.square;
-  }
+  for (int k = 0; k < kCables; ++k) cable[k]->Finish();
 }
 
 // Cables [first, end) in runs the filter interleaves (at most three at a time).
