@@ -118,6 +118,26 @@ void ExpectGoodTicks(const std::vector<double>& ticks, double lo, double hi) {
   }
 }
 
+// PlotOptions::x_span_lo/hi: a lone point's axis spans the given range (its ticks reach
+// both ends), not a padded sliver around the point; without a span it does not.
+TEST(SvgLinePlot, XSpanWidensTheAxis) {
+  PlotSeries dot;
+  dot.name = "estimate";
+  dot.markers_only = true;
+  dot.x = {50.0};
+  dot.y = {1.0};
+  PlotOptions o;
+  o.x_label = "t [s]";
+  const std::string alone = SvgLinePlot({dot}, o);
+  EXPECT_EQ(alone.find(">100<"), std::string::npos);
+  o.x_span_lo = 0.0;
+  o.x_span_hi = 100.0;
+  const std::string spanned = SvgLinePlot({dot}, o);
+  ExpectValidSvg(spanned);
+  EXPECT_NE(spanned.find(">0<"), std::string::npos);
+  EXPECT_NE(spanned.find(">100<"), std::string::npos);
+}
+
 TEST(NiceTicks, UnitInterval) {
   const std::vector<double> ticks = NiceTicks(0.0, 1.0, 5);
   const std::vector<double> expected = {0.0, 0.2, 0.4, 0.6, 0.8, 1.0};

@@ -50,6 +50,11 @@ struct PlotOptions {
   // (1 s to 4 weeks) in the zone x_time_offset_s (seconds east of UTC), not 1.7145e+09.
   bool x_unix_time = false;
   int x_time_offset_s = 0;
+  // SvgLinePlot: the x axis spans at least [x_span_lo, x_span_hi] where both are finite
+  // (e.g. the days a track's windows cover, also when one window's dot is all there is);
+  // by default only the data's range.
+  double x_span_lo = std::numeric_limits<double>::quiet_NaN();
+  double x_span_hi = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Lines (or markers) over shared axes. Each series with at least one finite point is

@@ -595,6 +595,11 @@ std::string SvgLinePlot(const std::vector<PlotSeries>& series, const PlotOptions
     }
   }
   if (x_lo > x_hi) return NoDataSvg(options, "no data");
+  if (std::isfinite(options.x_span_lo) && std::isfinite(options.x_span_hi) &&
+      options.x_span_lo < options.x_span_hi) {
+    x_lo = std::min(x_lo, options.x_span_lo);
+    x_hi = std::max(x_hi, options.x_span_hi);
+  }
 
   std::vector<LegendItem> legend;
   for (size_t i = 0; i < series.size(); ++i) {

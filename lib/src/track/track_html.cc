@@ -23,11 +23,14 @@ std::string Esc(const std::string& s) { return XmlEscape(s); }
 struct TimeAxis {
   bool absolute = false;
   std::string label;
+  double span_lo = kNaN, span_hi = kNaN;  // the windows' bounds: the axis spans them
   double X(double t) const { return t; }
   void Apply(PlotOptions* o) const {
     o->x_label = label;
     o->x_unix_time = absolute;
     o->x_time_offset_s = 0;
+    o->x_span_lo = span_lo;
+    o->x_span_hi = span_hi;
   }
 };
 
@@ -38,6 +41,10 @@ TimeAxis AxisOf(const TrackResult& r) {
   axis.label = axis.absolute ? TimeAxisLabel(r.windows.front().first_time_s,
                                              r.windows.back().last_time_s, display)
                              : "time_s [s]";
+  // The windows' bounds, not only their dots' times: a single window's dot sat alone in an
+  // axis of a minute around it.
+  axis.span_lo = r.windows.front().start_s;
+  axis.span_hi = r.windows.back().end_s;
   return axis;
 }
 
