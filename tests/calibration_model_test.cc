@@ -180,6 +180,10 @@ double Step(ParameterKind kind) {
       return 1e-2;  // kg
     case ParameterKind::kLengthOffset:
       return 1e-3;  // m
+    case ParameterKind::kPartFirstMoment:
+      return 10.0;  // kg m
+    case ParameterKind::kPartMass:
+      return 1.0;  // kg
   }
   return 1e-3;
 }

@@ -25,6 +25,41 @@ inline CableRobot AsBuiltRobot() {
   return robot;
 }
 
+// Issue 35's cabin: an A-B rotator (first moment `rotator_q` about its axes, joints at
+// zero: e.g. 10 t centred 0.6 m below them is (0, 0, -6000) kg m) carrying a Stewart
+// platform of `platform_kg` that translates along x, y, z (columns rotator_a_deg,
+// rotator_b_deg, stewart_x_m, stewart_y_m, stewart_z_m).
+inline CableRobot RotatorRobot(const Eigen::Vector3d& rotator_q = Eigen::Vector3d(0, 0, -6000),
+                               double platform_kg = 2500.0) {
+  CableRobot robot = CableRobot::NominalFast();
+  MovingPart rotator;
+  rotator.name = "rotator";
+  Joint a, b;
+  a.axis = Eigen::Vector3d::UnitX();
+  a.column = "rotator_a_deg";
+  b.axis = Eigen::Vector3d::UnitY();
+  b.column = "rotator_b_deg";
+  a.has_range = b.has_range = true;
+  a.range_low = b.range_low = -40.0;
+  a.range_high = b.range_high = 40.0;
+  rotator.joints = {a, b};
+  rotator.first_moment_kg_m = rotator_q;
+  MovingPart stewart;
+  stewart.name = "stewart";
+  stewart.parent = 0;
+  const char* columns[] = {"stewart_x_m", "stewart_y_m", "stewart_z_m"};
+  for (int c = 0; c < 3; ++c) {
+    Joint j;
+    j.type = JointType::kPrismatic;
+    j.axis = Eigen::Vector3d::Unit(c);
+    j.column = columns[c];
+    stewart.joints.push_back(j);
+  }
+  stewart.mass_kg = platform_kg;
+  robot.moving_parts.parts = {rotator, stewart};
+  return robot;
+}
+
 // `count` random poses up to 35 deg off axis (with the focal law's 2-5 deg extra tilts,
 // inside the model's range), `spread_m` off the focal sphere.
 inline std::vector<Pose> TiltedPoses(int count, std::uint64_t seed, double spread_m = 0.0) {

@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "fastcal/cable_attachment.h"
+#include "fastcal/moving_parts.h"
 
 namespace fastcal {
 
@@ -73,8 +74,11 @@ struct CableRobot {
   std::vector<Eigen::Vector3d> anchor_points_cabin_m;
   std::array<CableProperties, kNumCables> cables;
   double cabin_mass_kg = 30000.0;
-  // Mass centre of the cabin in the cabin frame.
+  // Mass centre of the cabin in the cabin frame, with every moving part's joints at zero.
   Eigen::Vector3d mass_centre_cabin_m = Eigen::Vector3d(0.0, 0.0, 0.5);
+  // The rotator, the Stewart platform: parts whose joints move the mass centre
+  // (moving_parts.h); none by default, and then the mass centre is fixed.
+  MovingParts moving_parts;
   // Gravitational acceleration along z (negative: z is up).
   double gravity_m_per_s2 = -9.8;
   // Optional model data: FAST's reflector in NominalFast(), none in a default-constructed
@@ -88,6 +92,10 @@ struct CableRobot {
   const Eigen::Vector3d& AnchorOfCable(int i) const {
     return anchor_points_cabin_m[cables[i].anchor_index];
   }
+
+  // The mass centre (cabin frame) at joint values `joints` (the model's joint order, SI):
+  // mass_centre_cabin_m plus the parts' shift, eq. (1) of moving_parts.h.
+  Eigen::Vector3d MassCentreAt(const JointValues& joints) const;
 
   // Whether any cable carries attachments (the statics then need exact: statics.h).
   bool HasAttachments() const {

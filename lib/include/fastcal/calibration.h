@@ -79,6 +79,12 @@ struct CalibrationOptions {
   double max_sigma_attachment_density_kg_per_m = 0.5;
   // A winch encoder's zero (length_offset_m): a decimetre says little about a length.
   double max_sigma_length_offset_m = 0.1;
+  // A moving part's first moment: 1500 kg m moves a 30 t cabin's mass centre by 5 cm, the
+  // mass centre's own limit. A component with a prior is held to its prior's sigma instead
+  // (one along the part's own rotation axis is seen only at second order in the angles:
+  // moving_parts.h); a part's mass to 500 kg.
+  double max_sigma_part_first_moment_kg_m = 1500.0;
+  double max_sigma_part_mass_kg = 500.0;
   // A reduced chi-square above this is a fit that failed (the typical residual 5 times
   // the stated noise): the model does not describe the data, and the linearised
   // uncertainties no longer mean anything. Between the band and this the misfit is

@@ -44,6 +44,11 @@ enum class ParameterKind {
   kAttachmentMass,
   kAttachmentDensity,
   kLengthOffset,  // cable = 0..5, or -1 for common
+  // The cabin's moving parts (moving_parts.h): index = the part's position in the model's
+  // cabin.moving_parts; named moving_parts.NAME.first_moment_kg_m.x and
+  // moving_parts.NAME.mass_kg.
+  kPartFirstMoment,  // component = axis 0..2 of the part's frame
+  kPartMass,
 };
 
 struct ParameterSpec {

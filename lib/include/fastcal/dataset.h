@@ -52,6 +52,12 @@ struct Sample {
   // The survey (session) the sample belongs to: an index into Dataset::session_labels,
   // 0 when the dataset has no sessions.
   int session = 0;
+  // The cabin's moving parts' joint values (moving_parts.h), when the file has joint
+  // columns: in Dataset::joint_columns order and in those columns' units (deg for a
+  // column ending in _deg, m for _m), as the file gives them, so that a write/read round
+  // trip is exact; MovingParts::ShiftsAt converts to SI. Read with a model's
+  // columns (DatasetReadOptions::joint_columns), that is the model's joint order.
+  JointValues joint{};
 };
 
 // A session label (the `session` column, or a file's stem): 1 to kMaxSessionLabelLength
@@ -82,6 +88,9 @@ struct Dataset {
   // With files merged (sessions.h): the file each session came from, parallel to
   // session_labels; empty otherwise.
   std::vector<std::string> session_paths;
+  // The joint columns the file has (DatasetReadOptions::joint_columns; Sample::joint);
+  // empty for a cabin without moving parts.
+  std::vector<std::string> joint_columns;
   // One message per row skipped under DatasetReadOptions::skip_invalid_rows, in file
   // order, formatted like the error the row would otherwise have caused ("file:line: ...");
   // then those of samples removed by SkipUnsolvableSamples (evaluation.h).
@@ -122,6 +131,11 @@ struct DatasetReadOptions {
   // in parallel and taken in file order, so the samples, skipped rows and messages are
   // the same on any number. >= 1; default 1.
   int threads = 1;
+  // The moving parts' joint columns the file must have (MovingParts::JointColumns of the
+  // model it is read for, in that order; each ends in _deg or _m): read into
+  // Sample::joint. A file lacking any is an error naming every one it lacks; a joint
+  // column read without being asked for is an unknown column. Empty: none.
+  std::vector<std::string> joint_columns;
   // Read the file as an export through this column map (column_map.h, docs/data-format.md,
   // "Column maps"): its delimiter, decimal mark, header line, source columns, units and
   // time stamps; null: the canonical format above. Messages then name the source column
@@ -129,6 +143,11 @@ struct DatasetReadOptions {
   // number"), and those about the map its file, line and key.
   std::shared_ptr<const ColumnMap> columns;
 };
+
+// Whether `data` has the joint columns the moving parts need, in the model's joint order
+// (as ReadDataset gives them with DatasetReadOptions::joint_columns =
+// parts.JointColumns()). On failure names the file and every column it lacks.
+bool CheckJointColumns(const Dataset& data, const MovingParts& parts, std::string* error);
 
 // How the dataset's times read (time_text.h): dates and times in its zone
 // (Dataset::time_offset_s) when its earliest time is a Unix time (>= 1e8 s), seconds

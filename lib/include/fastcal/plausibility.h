@@ -146,6 +146,10 @@ enum class ModelQuantity {
   kGravityMPerS2,        // negative: z is up
   kReflectorRadiusM,
   kReflectorApertureM,
+  // A moving part's first moment (one component) and mass (moving_parts.h): at most the
+  // whole cabin's mass at the farthest plausible mass centre, and at most the cabin's mass.
+  kPartFirstMomentKgM,
+  kPartMassKg,
 };
 
 // A quantity's plausible range and its nominal FAST value, SI (percent for

@@ -10,7 +10,9 @@
 //                                sigma mass_centre_drift_m and correlation time
 //                                mass_centre_drift_time_s; s_k the steps at times t_k
 //                                (mass_centre_steps: the structure changed)
-//   truth statics       T_i, s0_i = SolveStatics(truth with e_n, (p_act, R(a_act)))
+//   joint values        q_n    = the joint plan's (joint_plan.h), for a model with moving parts
+//   truth statics       T_i, s0_i = SolveStatics(truth with e_n + the parts' shift at q_n,
+//                                               (p_act, R(a_act)))
 //   sensor reading      y_i    = sensor_gain_i T_i + sensor_bias_n_i
 //   measured tension    m_i    = y_i (1 + N(0, tension_noise_percent / 100) + u_i,n)
 //                                + N(0, 1000 tension_noise_kn)
@@ -50,6 +52,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/dataset.h"
+#include "fastcal/joint_plan.h"
 #include "fastcal/pose.h"
 #include "fastcal/statics.h"
 
@@ -147,6 +150,10 @@ struct SimulationOptions {
   // Single sensors re-zeroed at given times (steps add up). Finite times and shifts, cables
   // 0..5; default none. The truth model written out has the biases before any of them.
   std::vector<SensorBiasStep> sensor_bias_steps;
+  // The truth model's moving parts (moving_parts.h): their joint values per sample
+  // (joint_plan.h), written in the dataset's joint columns and moving its mass centre.
+  // Unused for a model without moving parts; default: every joint at zero.
+  JointPlanOptions joints;
 
   // False, with the offending field named in *error (may be null), for a value out of range.
   bool IsValid(std::string* error) const;
@@ -229,9 +236,10 @@ bool SimulateStream(const CableRobot& truth, PoseStream planned, const Simulatio
 
 // The column groups of a simulated dataset (planned attitude, unstretched lengths,
 // roll/pitch/yaw) and, for more than one session, the session labels "1" .. "N"
-// (SimulationOptions::sessions), with no samples: the layout a DatasetWriter of
-// SimulateStream needs.
-Dataset SimulatedDatasetLayout(int sessions = 1);
+// (SimulationOptions::sessions), and the truth model's joint columns, with no samples:
+// the layout a DatasetWriter of SimulateStream needs.
+Dataset SimulatedDatasetLayout(int sessions = 1,
+                               const std::vector<std::string>& joint_columns = {});
 
 }  // namespace fastcal
 

@@ -267,6 +267,11 @@ struct StaticsSolution {
 // failure the forces are zero (never NaN) and `cable`, limit_value and limit say why.
 StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const StaticsOptions& options,
                            StaticsSolution* solution);
+// The same with the cabin's moving parts at `joints` (Sample::joint: the model's joint
+// order, the columns' units): the mass centre at c(q), moving_parts.h eq. (1). A robot
+// without moving parts solves as above.
+StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const JointValues& joints,
+                           const StaticsOptions& options, StaticsSolution* solution);
 
 // Short code for files of which equilibrium a solution is: "taut" (kTaut), "home"
 // (kFromHome), "several" (either, with other_equilibrium), "unreachable" (no equilibrium

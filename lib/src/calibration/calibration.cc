@@ -150,6 +150,9 @@ CalibrationStatus ValidateInputs(Run& run) {
                         " models uniform cables, but the model's cables carry attachments; "
                         "use forward_model: exact");
   }
+  if (!CheckJointColumns(run.data, run.model.moving_parts, &why)) {
+    return run.Fail(CalibrationStatus::kInvalidInput, why);
+  }
   if (run.spec.UsesLengths() && !run.data.has_unstretched_lengths) {
     return run.Fail(CalibrationStatus::kInvalidInput,
                     run.data.path +
@@ -223,10 +226,13 @@ CalibrationStatus MeasureForwardModelError(Run& run) {
   for (size_t index = 0; index < run.data.samples.size(); index += stride) {
     const Sample& s = run.data.samples[index];
     const Pose pose = run.PoseOf(s);
-    if (ModelLowerTensions(p, pose, run.statics, &t_model) != StaticsStatus::kOk ||
-        ModelLowerTensions(p, pose, exact, &t_exact) != StaticsStatus::kOk) {
+    PartShifts shifts;
+    run.cm->robot().moving_parts.ShiftsAt(s.joint, &shifts);
+    const StaticsParameters<double> at = AtJoints(p, shifts);
+    if (ModelLowerTensions(at, pose, run.statics, &t_model) != StaticsStatus::kOk ||
+        ModelLowerTensions(at, pose, exact, &t_exact) != StaticsStatus::kOk) {
       StaticsSolution sol;
-      SolveStatics(run.cm->ToRobot(run.theta.data()), pose, exact, &sol);
+      SolveStatics(run.cm->ToRobot(run.theta.data()), pose, s.joint, exact, &sol);
       return run.Fail(CalibrationStatus::kInfeasible,
                       SampleWhere(run.data, s) +
                           ": the initial model cannot solve this pose: " + DescribeStatus(sol));
@@ -278,8 +284,9 @@ CalibrationStatus Predict(Run& run) {
   const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& sample = run.data.samples[t];
     at.starts.At(t).Restore(run.PoseOf(sample), options.method, solution);
-    return SolveStaticsWithParameters(session_params[sample.session], run.PoseOf(sample), options,
-                                      solution);
+    return SolveStaticsWithParameters(session_params[sample.session],
+                                      run.cm->robot().moving_parts, sample.joint,
+                                      run.PoseOf(sample), options, solution);
   };
   const int failed =
       internal::ForEachChunk(num_samples, run.spec.num_threads, [&](int begin, int end) {
@@ -396,6 +403,27 @@ std::string LengthOffsetHint(const std::vector<ParameterDirection>& directions) 
   return "";
 }
 
+// A free first moment without a prior whose component lies along one of its part's own
+// revolute axes: seen only at second order in the angles (moving_parts.h), it needs one.
+std::string FirstMomentHint(const Run& run) {
+  std::string names;
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    if (p.kind != ParameterKind::kPartFirstMoment || p.has_prior) continue;
+    const MovingPart& part = run.model.moving_parts.parts[p.index];
+    for (const Joint& j : part.joints) {
+      if (j.type == JointType::kRevolute && std::abs(j.axis[p.component]) > 0.5) {
+        names += (names.empty() ? "" : ", ") + p.name;
+        break;
+      }
+    }
+  }
+  if (names.empty()) return "";
+  return "a first moment's component along its part's own rotation axis (" + names +
+         ") moves the mass centre only at second order in the joint angles: give it a prior "
+         "(e.g. first_moment_kg_m: {x: {free: true, prior: {mean: 0, sigma: 3000}}}).\n";
+}
+
 std::string DescribeRefusal(const Run& run) {
   const Identifiability& before = run.result->before;
   std::ostringstream refuse;
@@ -405,7 +433,7 @@ std::string DescribeRefusal(const Run& run) {
       refuse << "  - " << d.Describe() << "   (singular value ratio "
              << RatioText(d.singular_value_ratio) << ")\n";
     }
-    refuse << LengthOffsetHint(before.undetermined);
+    refuse << LengthOffsetHint(before.undetermined) << FirstMomentHint(run);
     return refuse.str();
   }
   bool any = false;
@@ -434,7 +462,7 @@ std::string DescribeRefusal(const Run& run) {
     refuse << "  - " << d.Describe() << "   (singular value ratio "
            << RatioText(d.singular_value_ratio) << ")\n";
   }
-  refuse << LengthOffsetHint(before.poorly_determined);
+  refuse << LengthOffsetHint(before.poorly_determined) << FirstMomentHint(run);
   return refuse.str();
 }
 

@@ -37,7 +37,8 @@ bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset
     } else {
       solution->status = StaticsStatus::kInvalidInput;  // no start: cold
     }
-    return SolveStaticsWithParameters(parameters[model_of(s)], pose, options, solution);
+    return SolveStaticsWithParameters(parameters[model_of(s)], models[model_of(s)]->moving_parts,
+                                      s.joint, pose, options, solution);
   };
   predicted->resize(data.samples.size());
   const int failed =

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 namespace fastcal::internal {
 
@@ -59,6 +60,12 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
         case ParameterKind::kLengthOffset:
           if (cable) base_offset_m_[i] = v;
           break;
+        case ParameterKind::kPartFirstMoment:
+          base_.part_first_moment_kg_m[s.index][s.component] = v;
+          break;
+        case ParameterKind::kPartMass:
+          base_.part_mass_kg[s.index] = v;
+          break;
       }
     }
   }
@@ -107,6 +114,10 @@ double CalibrationModel::BaseValue(const ParameterSpec& s) const {
       for (double d : base_offset_m_) sum += d;
       return sum / kNumCables;
     }
+    case ParameterKind::kPartFirstMoment:
+      return base_.part_first_moment_kg_m[c][s.component];
+    case ParameterKind::kPartMass:
+      return base_.part_mass_kg[c];
   }
   return 0.0;
 }
@@ -148,6 +159,10 @@ CableRobot CalibrationModel::ToRobot(const double* theta, int session) const {
   }
   out.cabin_mass_kg = p.cabin_mass_kg;
   out.mass_centre_cabin_m = p.mass_centre_cabin_m;
+  for (int k = 0; k < p.num_parts; ++k) {
+    out.moving_parts.parts[k].first_moment_kg_m = p.part_first_moment_kg_m[k];
+    out.moving_parts.parts[k].mass_kg = p.part_mass_kg[k];
+  }
   return out;
 }
 
@@ -174,6 +189,7 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
   if (starts != nullptr && !starts->empty()) f.start = starts->At(t);
   if (excluded != nullptr && !excluded->empty()) f.excluded = (*excluded)[t];
   f.session = sample.session;
+  f.joints = sample.joint;
   if (length_sigma_m > 0.0) {
     f.length_sigma_m = length_sigma_m;
     f.measured_length_m = sample.unstretched_length_m;
@@ -186,7 +202,8 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
 
 void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
                                        const std::array<double, kNumCables>& gain, int session,
-                                       double* jacobian) const {
+                                       double* jacobian, const PartShifts* shifts,
+                                       const StaticsParameters<double>* at) const {
   const int n = num_free();
   Eigen::Map<Eigen::Matrix<double, kNumCables, Eigen::Dynamic, Eigen::RowMajor>> j(jacobian,
                                                                                    kNumCables, n);
@@ -202,6 +219,22 @@ void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
         break;
       case ParameterKind::kCabinMass:
         column = gradient.cabin_mass_kg;
+        if (shifts != nullptr && at != nullptr) {
+          const Eigen::Vector3d shift = MassCentreAt(*at, *shifts) - at->mass_centre_cabin_m;
+          column -= gradient.mass_centre_cabin_m * shift / at->cabin_mass_kg;
+        }
+        break;
+      case ParameterKind::kPartFirstMoment:
+        if (shifts != nullptr && at != nullptr) {
+          column = gradient.mass_centre_cabin_m *
+                   (*shifts)[s.index].rotation_minus_identity.col(s.component) / at->cabin_mass_kg;
+        }
+        break;
+      case ParameterKind::kPartMass:
+        if (shifts != nullptr && at != nullptr) {
+          column = gradient.mass_centre_cabin_m * (*shifts)[s.index].translation_m /
+                   at->cabin_mass_kg;
+        }
         break;
       case ParameterKind::kLinearDensity:
         for (int i = 0; i < kNumCables; ++i) {
@@ -262,6 +295,7 @@ struct SampleView {
   const std::array<double, kNumCables>& sigma_n;
   const std::array<bool, kNumCables>* excluded;  // null: none
   int session;
+  const JointValues* joints;  // null: all at zero (a model without moving parts)
 };
 
 // A sample's residuals, and with `jacobian` their analytic Jacobian (exact statics only),
@@ -271,11 +305,19 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
                  const StaticsOptions& statics, const SampleView& x, double* residuals,
                  double* jacobian) {
   if (!m.gains_positive) return false;  // as operator()
+  // With moving parts the mass centre is the sample's own (moving_parts.h eq. (1)).
+  PartShifts shifts;
+  std::optional<StaticsParameters<double>> at_joints;
+  if (model.has_parts()) {
+    model.robot().moving_parts.ShiftsAt(x.joints != nullptr ? *x.joints : JointValues{}, &shifts);
+    at_joints.emplace(AtJoints(m.statics, shifts));
+  }
+  const StaticsParameters<double>& params = at_joints ? *at_joints : m.statics;
   StaticsSolution solution;
   x.start.Restore(x.pose, statics.method, &solution);
   StaticsOptions options = statics;
   options.warm_start = true;
-  if (SolveStaticsWithParameters(m.statics, x.pose, options, &solution) != StaticsStatus::kOk) {
+  if (SolveStaticsWithParameters(params, x.pose, options, &solution) != StaticsStatus::kOk) {
     return false;
   }
   for (int i = 0; i < kNumCables; ++i) {
@@ -285,12 +327,13 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
   }
   if (jacobian == nullptr) return true;
   TensionGradient gradient;
-  if (ExactTensionGradient(m.statics, x.pose, solution, options.catenary.vertical_span_fraction,
+  if (ExactTensionGradient(params, x.pose, solution, options.catenary.vertical_span_fraction,
                            model.frees_geometry(), &gradient) != StaticsStatus::kOk) {
     return false;
   }
   const int n = model.num_free();
-  model.ReadingJacobian(gradient, m.gain, x.session, jacobian);
+  model.ReadingJacobian(gradient, m.gain, x.session, jacobian, at_joints ? &shifts : nullptr,
+                        &m.statics);
   for (int i = 0; i < kNumCables; ++i) {
     const bool out = x.excluded != nullptr && (*x.excluded)[i];
     const double scale = out ? 0.0 : 1.0 / x.sigma_n[i];
@@ -309,8 +352,9 @@ bool TensionResidual::Evaluate(const double* theta, double* residuals, double* j
   ModelAtTheta::Session m;
   model->Assemble(theta, &m.statics, &m.gain, &m.bias, session);
   m.gains_positive = std::all_of(m.gain.begin(), m.gain.end(), [](double g) { return g > 0.0; });
-  return RowsThrough(*model, m, statics, {pose, start, measured_n, sigma_n, &excluded, session},
-                     residuals, jacobian);
+  return RowsThrough(*model, m, statics,
+                     {pose, start, measured_n, sigma_n, &excluded, session, &joints}, residuals,
+                     jacobian);
 }
 
 bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const {
@@ -324,7 +368,8 @@ bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, doubl
                sample.tension_n,
                (*sigma_n)[j],
                excluded != nullptr && !excluded->empty() ? &(*excluded)[t] : nullptr,
-               sample.session};
+               sample.session,
+               &sample.joint};
   if (use_planned_attitude) x.pose.rotation = sample.planned_rotation;
   return RowsThrough(at.model(), at.session(sample.session), statics, x, residuals, jacobian);
 }

@@ -65,6 +65,33 @@ std::vector<std::string> AxisLines(const CalibrationSpec& spec, const GroupInfo&
   return lines;
 }
 
+// parameters.moving_parts: each part's first moment's axes and mass, parts in the order
+// of their first parameter.
+std::string MovingPartsYaml(const CalibrationSpec& spec) {
+  std::vector<std::pair<int, std::string>> parts;  // index, name
+  for (const ParameterSpec& p : spec.parameters) {
+    if (!IsPart(p.kind)) continue;
+    bool seen = false;
+    for (const auto& [index, name] : parts) seen = seen || index == p.index;
+    if (!seen) parts.emplace_back(p.index, PartOfParameterName(p.name));
+  }
+  std::ostringstream out;
+  out << "  " << kMovingPartsKey << ":\n";
+  for (const auto& [index, name] : parts) {
+    out << "    " << name << ":\n";
+    const GroupInfo& moment = *InfoOf(ParameterKind::kPartFirstMoment);
+    const std::vector<std::string> lines = AxisLines(spec, moment, index);
+    if (!lines.empty()) out << "      first_moment_kg_m:\n";
+    for (const std::string& line : lines) out << "        " << line << "\n";
+    for (const ParameterSpec& p : spec.parameters) {
+      if (p.kind == ParameterKind::kPartMass && p.index == index) {
+        out << "      mass_kg: " << EntryYaml(p, *InfoOf(p.kind)) << "\n";
+      }
+    }
+  }
+  return out.str();
+}
+
 }  // namespace
 
 namespace {
@@ -146,6 +173,9 @@ std::string ParameterProblem(const ParameterSpec& p, const std::string& label) {
   if (IsAttachment(p.kind) && (p.index < 0 || p.index >= kNumCables || p.component < 0 ||
                                p.component >= kMaxAttachmentsPerCable)) {
     return label + ": index must be a cable 0..5 and component an attachment 0..7";
+  }
+  if (IsPart(p.kind) && (p.index < 0 || p.index >= kMaxMovingParts)) {
+    return label + ": index must be a moving part 0.." + std::to_string(kMaxMovingParts - 1);
   }
   if (!(std::isfinite(p.to_si) && p.to_si > 0.0)) return label + ": to_si must be > 0";
   if (p.has_initial) {
@@ -293,7 +323,11 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
     for (const ParameterSpec& p : spec.parameters) {
       if (p.kind == g.kind) group.push_back(&p);
     }
-    if (group.empty()) continue;
+    if (group.empty() || g.kind == ParameterKind::kPartMass) continue;
+    if (g.kind == ParameterKind::kPartFirstMoment) {
+      out << MovingPartsYaml(spec);
+      continue;
+    }
     out << "  " << g.key << ":";
     if (g.kind == ParameterKind::kMassCentre) {
       out << "\n";
@@ -353,7 +387,8 @@ std::vector<ParameterSpec> AllModelParameters(int num_anchor_points) {
     } else if (IsPerCableCapable(g.kind)) {
       for (int i = -1; i < kNumCables; ++i) all.push_back(MakeParameter(g, i, -1, fixed));
     } else {
-      if (IsAttachment(g.kind)) continue;  // none without a model (the overload below)
+      // None without a model (the overload below).
+      if (IsAttachment(g.kind) || IsPart(g.kind)) continue;
       const int count = g.kind == ParameterKind::kAnchorOffset ? num_anchor_points : kNumCables;
       for (int j = 0; j < count; ++j) {
         for (int c = 0; c < 3; ++c) all.push_back(MakeParameter(g, j, c, fixed));
@@ -367,6 +402,21 @@ std::vector<ParameterSpec> AllModelParameters(const CableRobot& model) {
   std::vector<ParameterSpec> all =
       AllModelParameters(static_cast<int>(model.anchor_points_cabin_m.size()));
   const EntryText fixed;
+  // The moving parts' first moments, and the masses of parts whose origin moves.
+  const std::vector<MovingPart>& parts = model.moving_parts.parts;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const int part = static_cast<int>(k);
+    for (int c = 0; c < 3; ++c) {
+      ParameterSpec p = MakeParameter(*InfoOf(ParameterKind::kPartFirstMoment), part, c, fixed);
+      p.name = PartParameterName(parts[k].name, p.kind, c);
+      all.push_back(p);
+    }
+    if (model.moving_parts.Translates(part)) {
+      ParameterSpec p = MakeParameter(*InfoOf(ParameterKind::kPartMass), part, -1, fixed);
+      p.name = PartParameterName(parts[k].name, p.kind, -1);
+      all.push_back(p);
+    }
+  }
   for (const GroupInfo& g : kGroups) {
     if (!IsAttachment(g.kind)) continue;
     for (int i = 0; i < kNumCables; ++i) {
@@ -390,6 +440,13 @@ bool ParameterFitsModel(const ParameterSpec& p, const CableRobot& model, std::st
       p.index >= static_cast<int>(model.anchor_points_cabin_m.size())) {
     return fail("the model has " + std::to_string(model.anchor_points_cabin_m.size()) +
                 " anchor points");
+  }
+  if (IsPart(p.kind)) {
+    const auto& parts = model.moving_parts.parts;
+    if (p.index < 0 || p.index >= static_cast<int>(parts.size()) ||
+        PartOfParameterName(p.name) != parts[p.index].name) {
+      return fail("the model has no such moving part (cabin.moving_parts in the model file)");
+    }
   }
   if (IsAttachment(p.kind)) {
     const bool on_cable = p.index >= 0 && p.index < kNumCables && p.component >= 0 &&
@@ -415,6 +472,7 @@ bool SameParameter(const ParameterSpec& a, const ParameterSpec& b) {
     case ParameterKind::kTowerOffset:
     case ParameterKind::kAttachmentMass:
     case ParameterKind::kAttachmentDensity:
+    case ParameterKind::kPartFirstMoment:
       return a.index == b.index && a.component == b.component;
     default:
       return a.index == b.index;

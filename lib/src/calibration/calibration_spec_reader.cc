@@ -78,10 +78,12 @@ EntryText Override(const EntryText& base, const EntryText& over) {
 
 class Reader {
  public:
-  Reader(const std::string& source, int num_anchor_points, AttachmentShape attachments)
+  Reader(const std::string& source, int num_anchor_points, AttachmentShape attachments,
+         std::vector<std::string> parts)
       : source_(source),
         num_anchor_points_(num_anchor_points),
-        attachments_(std::move(attachments)) {}
+        attachments_(std::move(attachments)),
+        parts_(std::move(parts)) {}
 
   const std::string& error() const { return error_; }
 
@@ -807,9 +809,52 @@ class Reader {
     return true;
   }
 
+  // moving_parts: {NAME: {first_moment_kg_m: {x, y, z}, mass_kg: entry}}, NAME a part of
+  // the model's cabin.moving_parts.
+  bool ReadMovingParts(const KeyValue& group, const std::string& path,
+                       std::vector<ParameterSpec>* out) {
+    if (parts_.empty()) {
+      return Fail(group.line, path,
+                  "the model has no moving parts (cabin.moving_parts in the model file, given "
+                  "with --model)");
+    }
+    KeyMap keys;
+    if (!ReadMap(group.value, group.line, path, parts_, &keys,
+                 "not a moving part of the model (its parts: ")) {
+      return false;
+    }
+    for (size_t k = 0; k < parts_.size(); ++k) {
+      const KeyValue* part = Find(keys, parts_[k]);
+      if (part == nullptr) continue;
+      const std::string part_path = Join(path, parts_[k]);
+      KeyMap fields;
+      if (!ReadMap(*part, part_path, {"first_moment_kg_m", "mass_kg"}, &fields)) return false;
+      const size_t before = out->size();
+      if (const KeyValue* kv = Find(fields, "first_moment_kg_m")) {
+        const GroupInfo& g = *InfoOf(ParameterKind::kPartFirstMoment);
+        if (!ReadAxes(kv->value, kv->line, g, static_cast<int>(k),
+                      Join(part_path, "first_moment_kg_m"), out)) {
+          return false;
+        }
+      }
+      if (const KeyValue* kv = Find(fields, "mass_kg")) {
+        const GroupInfo& g = *InfoOf(ParameterKind::kPartMass);
+        EntryText entry;
+        if (!ReadEntry(kv->value, kv->line, g, Join(part_path, "mass_kg"), &entry)) return false;
+        out->push_back(MakeParameter(g, static_cast<int>(k), -1, entry));
+      }
+      for (size_t j = before; j < out->size(); ++j) {
+        (*out)[j].name = PartParameterName(parts_[k], (*out)[j].kind, (*out)[j].component);
+      }
+    }
+    return true;
+  }
+
   bool ReadParameters(const KeyValue& parameters, CalibrationSpec* spec) {
     std::vector<std::string> accepted;
-    for (const GroupInfo& g : kGroups) accepted.push_back(g.key);
+    for (const GroupInfo& g : kGroups) {
+      if (g.kind != ParameterKind::kPartMass) accepted.push_back(g.key);  // one key for both
+    }
     KeyMap keys;
     if (!ReadMap(parameters.value, parameters.line, "parameters", accepted, &keys,
                  "unknown parameter (accepted: ")) {
@@ -821,7 +866,10 @@ class Reader {
       if (kv == nullptr) continue;
       const std::string path = Join("parameters", g.key);
       bool ok = true;
-      if (g.kind == ParameterKind::kMassCentre) {
+      if (g.kind == ParameterKind::kPartMass) continue;  // read with the first moments
+      if (g.kind == ParameterKind::kPartFirstMoment) {
+        ok = ReadMovingParts(*kv, path, &out);
+      } else if (g.kind == ParameterKind::kMassCentre) {
         ok = ReadAxes(kv->value, kv->line, g, -1, path, &out);
       } else if (g.kind == ParameterKind::kCabinMass) {
         EntryText entry;
@@ -843,6 +891,7 @@ class Reader {
   std::string source_;
   int num_anchor_points_;
   AttachmentShape attachments_;
+  std::vector<std::string> parts_;  // the model's moving parts, by name
   std::string error_;
 };
 }  // namespace
@@ -850,8 +899,9 @@ class Reader {
 namespace {
 
 bool ParseSpec(const std::string& text, const std::string& source_name, int num_anchor_points,
-               const AttachmentShape& attachments, CalibrationSpec* spec, std::string* error) {
-  Reader reader(source_name, num_anchor_points, attachments);
+               const AttachmentShape& attachments, const std::vector<std::string>& parts,
+               CalibrationSpec* spec, std::string* error) {
+  Reader reader(source_name, num_anchor_points, attachments, parts);
   CalibrationSpec parsed;
   try {
     const internal::YamlDocuments documents = internal::LoadYamlDocuments(text);
@@ -878,14 +928,20 @@ bool ParseSpec(const std::string& text, const std::string& source_name, int num_
 }
 
 bool LoadSpec(const std::string& path, int num_anchor_points, const AttachmentShape& attachments,
-              CalibrationSpec* spec, std::string* error) {
+              const std::vector<std::string>& parts, CalibrationSpec* spec, std::string* error) {
   std::string text;
   std::string message;
   if (!internal::ReadRegularFile(path, kMaxSpecFileBytes, "calibration spec", &text, &message)) {
     if (error != nullptr) *error = message;
     return false;
   }
-  return ParseSpec(text, path, num_anchor_points, attachments, spec, error);
+  return ParseSpec(text, path, num_anchor_points, attachments, parts, spec, error);
+}
+
+std::vector<std::string> PartNames(const CableRobot& model) {
+  std::vector<std::string> names;
+  for (const MovingPart& p : model.moving_parts.parts) names.push_back(p.name);
+  return names;
 }
 
 }  // namespace
@@ -893,23 +949,23 @@ bool LoadSpec(const std::string& path, int num_anchor_points, const AttachmentSh
 bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
                               const CableRobot& model, CalibrationSpec* spec, std::string* error) {
   return ParseSpec(text, source_name, static_cast<int>(model.anchor_points_cabin_m.size()),
-                   ShapeOf(model), spec, error);
+                   ShapeOf(model), PartNames(model), spec, error);
 }
 
 bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
                               int num_anchor_points, CalibrationSpec* spec, std::string* error) {
-  return ParseSpec(text, source_name, num_anchor_points, AttachmentShape(), spec, error);
+  return ParseSpec(text, source_name, num_anchor_points, AttachmentShape(), {}, spec, error);
 }
 
 bool LoadCalibrationSpec(const std::string& path, const CableRobot& model, CalibrationSpec* spec,
                          std::string* error) {
-  return LoadSpec(path, static_cast<int>(model.anchor_points_cabin_m.size()), ShapeOf(model), spec,
-                  error);
+  return LoadSpec(path, static_cast<int>(model.anchor_points_cabin_m.size()), ShapeOf(model),
+                  PartNames(model), spec, error);
 }
 
 bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
                          std::string* error) {
-  return LoadSpec(path, num_anchor_points, AttachmentShape(), spec, error);
+  return LoadSpec(path, num_anchor_points, AttachmentShape(), {}, spec, error);
 }
 
 }  // namespace fastcal

@@ -71,7 +71,20 @@ bool IsPerCableCapable(ParameterKind kind) {
 
 bool IsVector(ParameterKind kind) {
   return kind == ParameterKind::kMassCentre || kind == ParameterKind::kAnchorOffset ||
-         kind == ParameterKind::kTowerOffset;
+         kind == ParameterKind::kTowerOffset || kind == ParameterKind::kPartFirstMoment;
+}
+
+std::string PartParameterName(const std::string& part, ParameterKind kind, int component) {
+  std::string name = std::string(kMovingPartsKey) + "." + part;
+  if (kind == ParameterKind::kPartMass) return name + ".mass_kg";
+  return name + ".first_moment_kg_m." + std::string(1, kAxes[component < 0 ? 0 : component]);
+}
+
+std::string PartOfParameterName(const std::string& name) {
+  const std::string prefix = std::string(kMovingPartsKey) + ".";
+  if (name.compare(0, prefix.size(), prefix) != 0) return "";
+  const size_t end = name.find('.', prefix.size());
+  return name.substr(prefix.size(), end == std::string::npos ? end : end - prefix.size());
 }
 
 // "mass_centre_m.x", "cabin_mass_kg", "ea_n[3]", "anchor_offset_m[2].z",

@@ -46,7 +46,22 @@ inline constexpr GroupInfo kGroups[] = {
     {ParameterKind::kAttachmentMass, "attachment_mass_kg", "kg", 1.0},
     {ParameterKind::kAttachmentDensity, "attachment_density_kg_per_m", "kg/m", 1.0},
     {ParameterKind::kLengthOffset, "length_offset_m", "m", 1.0},
+    // Both under one key, `moving_parts: {NAME: {first_moment_kg_m: {x, y, z}, mass_kg}}`.
+    {ParameterKind::kPartFirstMoment, "moving_parts", "kg m", 1.0},
+    {ParameterKind::kPartMass, "moving_parts", "kg", 1.0},
 };
+
+inline constexpr char kMovingPartsKey[] = "moving_parts";
+
+// The moving parts' kinds (one key in the spec for both).
+inline bool IsPart(ParameterKind kind) {
+  return kind == ParameterKind::kPartFirstMoment || kind == ParameterKind::kPartMass;
+}
+
+// "moving_parts.NAME.first_moment_kg_m.x", "moving_parts.NAME.mass_kg".
+std::string PartParameterName(const std::string& part, ParameterKind kind, int component);
+// The part's name in such a parameter name ("" if it is not one).
+std::string PartOfParameterName(const std::string& name);
 
 // What the model's cables carry, as the spec reader needs it: each cable's attachment kinds.
 using AttachmentShape = std::array<std::vector<AttachmentKind>, kNumCables>;
@@ -176,6 +191,10 @@ using spec_rules::GroupWithoutFreeParameter;
 using spec_rules::InfoOf;
 using spec_rules::IsAttachment;
 using spec_rules::IsKnownMethod;
+using spec_rules::IsPart;
+using spec_rules::kMovingPartsKey;
+using spec_rules::PartOfParameterName;
+using spec_rules::PartParameterName;
 using spec_rules::IsPerCableCapable;
 using spec_rules::IsVector;
 using spec_rules::kAxes;

@@ -33,7 +33,8 @@ TensionPredictor::TensionPredictor(const CableRobot& robot, AttitudeSource attit
 
 bool TensionPredictor::Predict(const Dataset& data, const Sample& sample,
                                std::array<double, kNumCables>* predicted_n, std::string* error) {
-  if (SolveStatics(robot_, PoseOf(sample, attitude_), options_, &solution_) != StaticsStatus::kOk) {
+  if (SolveStatics(robot_, PoseOf(sample, attitude_), sample.joint, options_, &solution_) !=
+      StaticsStatus::kOk) {
     *error = CannotSolve(data, sample, "the model", "", solution_);
     return false;
   }
@@ -50,6 +51,7 @@ bool PredictTensions(const CableRobot& robot, const Dataset& data, AttitudeSourc
     *error = data.path + ": no planned attitude columns (planned_roll_deg, ...)";
     return false;
   }
+  if (!CheckJointColumns(data, robot.moving_parts, error)) return false;
   TensionPredictor predictor(robot, attitude, method);
   predicted->assign(data.samples.size(), {});
   for (size_t n = 0; n < data.samples.size(); ++n) {
@@ -73,7 +75,8 @@ int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name
       for (StaticsMethod method : methods) {
         options.method = method;
         if (!why.empty() ||
-            SolveStatics(robot, PoseOf(s, attitude), options, &solution) == StaticsStatus::kOk) {
+            SolveStatics(robot, PoseOf(s, attitude), s.joint, options, &solution) ==
+                StaticsStatus::kOk) {
           continue;
         }
         why = CannotSolve(*data, s, model_name,

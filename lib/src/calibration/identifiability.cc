@@ -47,6 +47,13 @@ double MaxSigma(const ParameterSpec& p, double initial, const CalibrationOptions
       return o.max_sigma_attachment_density_kg_per_m;
     case ParameterKind::kLengthOffset:
       return o.max_sigma_length_offset_m;
+    case ParameterKind::kPartFirstMoment:
+      // A prior bounds what the data see only at second order (moving_parts.h).
+      return p.has_prior ? std::max(o.max_sigma_part_first_moment_kg_m, 1.01 * p.prior_sigma_si)
+                         : o.max_sigma_part_first_moment_kg_m;
+    case ParameterKind::kPartMass:
+      return p.has_prior ? std::max(o.max_sigma_part_mass_kg, 1.01 * p.prior_sigma_si)
+                         : o.max_sigma_part_mass_kg;
   }
   return std::numeric_limits<double>::infinity();
 }

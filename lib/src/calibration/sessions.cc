@@ -76,6 +76,7 @@ bool MergeSessionFiles(const std::vector<Dataset>& files, Dataset* merged, std::
   out.has_unstretched_lengths = true;
   out.attitude_as_quaternion = files.front().attitude_as_quaternion;
   out.time_offset_s = files.front().time_offset_s;
+  out.joint_columns = files.front().joint_columns;  // read with the same options
   std::vector<size_t> owner;
   for (size_t f = 0; f < files.size(); ++f) {
     out.path += (f == 0 ? "" : ",") + files[f].path;

@@ -75,6 +75,11 @@ constexpr char kSessionColumn[] = "session";
 constexpr int kSessionField = -1;
 // A field of an export read through a column map that fastcal does not read.
 constexpr int kIgnoredField = -2;
+// The field of moving-part joint j (DatasetReadOptions::joint_columns) is
+// kFirstJointField - j.
+constexpr int kFirstJointField = -10;
+bool IsJointField(int column) { return column <= kFirstJointField; }
+int JointOfField(int column) { return kFirstJointField - column; }
 
 // Files hold tensions in kN, memory in N: the decimal exponent shifts by this much.
 constexpr int kKilo = 3;
@@ -194,6 +199,8 @@ struct Header {
   bool planned = false;
   bool unstretched = false;
   int session_field = -1;  // the field holding the session label, or -1
+  // The moving parts' joint columns asked for (DatasetReadOptions::joint_columns).
+  std::vector<std::string> joint_names;
   // Read through a column map (column_map.h; null: the canonical format): the fields are
   // split at `delimiter` with quotes, numbers have the map's decimal mark and are
   // converted by `conversion`; fields of no column are kIgnoredField.
@@ -307,6 +314,13 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
   }
   // Trailing delimiters (a spreadsheet's empty cells at the end): no columns.
   while (fields.size() > 1 && fields.back().empty()) fields.pop_back();
+  if (!header->joint_names.empty()) {
+    *error = map.path + ": the model's moving parts need the joint column " +
+             Quoted(header->joint_names.front()) +
+             ", which column maps cannot name yet: export the joints to a canonical file "
+             "(docs/data-format.md, \"Moving parts\")";
+    return false;
+  }
   if (!map.has_time) {
     *error = map.path +
              ": time: missing: a dataset needs the time of each row (time: {column: "
@@ -370,6 +384,36 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
   return CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", required, header, error);
 }
 
+// A name a joint column could have: letters, digits and '_' ending in _deg or _m, not a
+// canonical column (for the hint on an unknown column).
+bool IsJointColumnName(std::string_view name) {
+  const auto ends = [&](std::string_view suffix) {
+    return name.size() > suffix.size() && name.substr(name.size() - suffix.size()) == suffix;
+  };
+  return (ends("_deg") || ends("_m")) &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+             std::string_view::npos;
+}
+
+// Every joint column asked for is in the header; else names each one missing.
+bool CheckJointFields(const Header& header, const std::string& where, std::string* error) {
+  std::string missing;
+  int count = 0;
+  for (size_t j = 0; j < header.joint_names.size(); ++j) {
+    const int field = kFirstJointField - static_cast<int>(j);
+    if (std::find(header.column_of_field.begin(), header.column_of_field.end(), field) ==
+        header.column_of_field.end()) {
+      missing += (missing.empty() ? "" : ", ") + Quoted(header.joint_names[j]);
+      ++count;
+    }
+  }
+  if (count == 0) return true;
+  *error = where + (count == 1 ? "missing column " : "missing columns ") + missing +
+           ": the model's moving parts need their joint values in every row (cabin."
+           "moving_parts in the model file; docs/data-format.md, \"Moving parts\")";
+  return false;
+}
+
 bool ParseHeader(std::string_view line, const std::string& where, const std::string& path,
                  DatasetColumns required, Header* header, std::string* error) {
   header->field_of.fill(-1);
@@ -401,10 +445,26 @@ bool ParseHeader(std::string_view line, const std::string& where, const std::str
     for (int c = 0; c < kNumColumns; ++c) {
       if (name == kColumnNames[c]) column = c;
     }
+    const std::vector<std::string>& joints = header->joint_names;
+    const auto joint = std::find(joints.begin(), joints.end(), name);
+    if (column < 0 && joint != joints.end()) {
+      const int field = kFirstJointField - static_cast<int>(joint - joints.begin());
+      if (std::find(header->column_of_field.begin(), header->column_of_field.end(), field) !=
+          header->column_of_field.end()) {
+        *error = where + "duplicate column " + Quoted(name);
+        return false;
+      }
+      header->column_of_field.push_back(field);
+      continue;
+    }
     if (column < 0) {
       *error = where + "unknown column " + Quoted(name) + " (accepted: " + AcceptedColumns() +
                "; an export with other names, units or channels is read through a column map, "
                "--columns=MAP.yaml, docs/data-format.md)";
+      if (IsJointColumnName(name)) {
+        *error += "; if it is a moving part's joint, the model names no joint with it "
+                  "(cabin.moving_parts in the model file, --model)";
+      }
       return false;
     }
     if (header->field_of[column] >= 0) {
@@ -419,6 +479,7 @@ bool ParseHeader(std::string_view line, const std::string& where, const std::str
     header->conversion[c].shift = IsTension(c) ? kKilo : 0;
     header->conversion[c].internal_per_file = IsTension(c) ? 1e3 : 1.0;
   }
+  if (!CheckJointFields(*header, where, error)) return false;
   return CheckColumnGroups(where, "missing column ", required, header, error);
 }
 
@@ -541,6 +602,18 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
   for (size_t f = 0; f < fields.size(); ++f) {
     const int column = header.column_of_field[f];
     if (column == kIgnoredField) continue;
+    if (IsJointField(column)) {
+      const int j = JointOfField(column);
+      std::string why;
+      double v = 0.0;
+      if (!ParseNumber(fields[f], &v, &why) ||
+          !PlausibleJointValue(header.joint_names[j], v, &why)) {
+        *reason = "column " + Quoted(header.joint_names[j]) + ": " + why;
+        return false;
+      }
+      sample->joint[j] = v + 0.0;  // -0 read as 0, as below
+      continue;
+    }
     if (column == kSessionField) {
       if (!IsValidSessionLabel(std::string(fields[f]))) {
         *reason = header.session_label + ": " + Quoted(std::string(fields[f])) +
@@ -704,6 +777,8 @@ class LineParser {
   LineParser(const std::string& source_name, const DatasetReadOptions& options)
       : options_(options) {
     layout_.path = source_name;
+    layout_.joint_columns = options_.joint_columns;
+    header_.joint_names = options_.joint_columns;
     header_.map = options_.columns.get();
     if (header_.map != nullptr) layout_.time_offset_s = header_.map->time.offset_s;
   }
@@ -899,6 +974,7 @@ void TakeLayout(const Dataset& layout, Dataset* data) {
   data->has_tensions = layout.has_tensions;
   data->session_labels = layout.session_labels;
   data->time_offset_s = layout.time_offset_s;
+  data->joint_columns = layout.joint_columns;
 }
 
 bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
@@ -1027,7 +1103,7 @@ std::vector<int> ColumnsOf(const Dataset& layout) {
 // The header comment as '# ' lines, then the column names (and the session column when
 // `sessions`).
 std::string HeaderText(const std::vector<int>& columns, const std::string& header_comment,
-                       bool sessions) {
+                       bool sessions, const std::vector<std::string>& joints) {
   std::string text;
   std::string_view rest(header_comment);
   while (!rest.empty()) {
@@ -1039,6 +1115,7 @@ std::string HeaderText(const std::vector<int>& columns, const std::string& heade
   for (size_t k = 0; k < columns.size(); ++k) {
     text += (k > 0 ? "," : "") + std::string(kColumnNames[columns[k]]);
   }
+  for (const std::string& joint : joints) text += "," + joint;
   if (sessions) text += std::string(",") + kSessionColumn;
   return text + "\n";
 }
@@ -1062,6 +1139,14 @@ bool AppendRow(const Dataset& layout, const std::vector<int>& columns, const Sam
     if (k > 0) *text += ",";
     *text += FormatNumber(value[c], IsTension(c) ? kKilo : 0);
   }
+  for (size_t j = 0; j < layout.joint_columns.size(); ++j) {
+    std::string why;
+    if (!PlausibleJointValue(layout.joint_columns[j], s.joint[j], &why)) {
+      *reason = "column " + Quoted(layout.joint_columns[j]) + ": " + why;
+      return false;
+    }
+    *text += "," + FormatNumber(s.joint[j] + 0.0, 0);
+  }
   *text += label + "\n";
   return true;
 }
@@ -1073,7 +1158,13 @@ bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
     return false;
   }
   const std::vector<int> columns = ColumnsOf(dataset);
-  std::string text = HeaderText(columns, header_comment, !dataset.session_labels.empty());
+  if (dataset.joint_columns.size() > static_cast<size_t>(kMaxJoints)) {
+    *error = path + ": " + std::to_string(dataset.joint_columns.size()) +
+             " joint columns; at most " + std::to_string(kMaxJoints);
+    return false;
+  }
+  std::string text = HeaderText(columns, header_comment, !dataset.session_labels.empty(),
+                                dataset.joint_columns);
   for (size_t i = 0; i < dataset.samples.size(); ++i) {
     std::string reason;
     if (!AppendRow(dataset, columns, dataset.samples[i], &text, &reason)) {
@@ -1085,6 +1176,27 @@ bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
 }
 
 }  // namespace
+
+bool CheckJointColumns(const Dataset& data, const MovingParts& parts, std::string* error) {
+  const std::vector<std::string> wanted = parts.JointColumns();
+  if (data.joint_columns == wanted) return true;
+  std::string missing;
+  for (const std::string& name : wanted) {
+    if (std::find(data.joint_columns.begin(), data.joint_columns.end(), name) ==
+        data.joint_columns.end()) {
+      missing += (missing.empty() ? "" : ", ") + Quoted(name);
+    }
+  }
+  if (error != nullptr) {
+    *error = data.path + ": " +
+             (missing.empty() ? "the joint columns were read for another model (" +
+                                    std::to_string(data.joint_columns.size()) + " of them)"
+                              : "no joint column " + missing) +
+             ": the model's moving parts need their joint values (cabin.moving_parts; "
+             "docs/data-format.md, \"Moving parts\")";
+  }
+  return false;
+}
 
 bool ParseDataset(const std::string& text, const std::string& source_name,
                   const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
@@ -1294,6 +1406,11 @@ bool DatasetWriter::Open(const std::string& path, const Dataset& layout,
   layout_.has_planned_attitude = layout.has_planned_attitude;
   layout_.has_unstretched_lengths = layout.has_unstretched_lengths;
   layout_.session_labels = layout.session_labels;
+  layout_.joint_columns = layout.joint_columns;
+  if (layout_.joint_columns.size() > static_cast<size_t>(kMaxJoints)) {
+    *error = path + ": at most " + std::to_string(kMaxJoints) + " joint columns";
+    return false;
+  }
   columns_ = ColumnsOf(layout_);
   rows_ = 0;
   io_failed_ = false;
@@ -1304,7 +1421,8 @@ bool DatasetWriter::Open(const std::string& path, const Dataset& layout,
     return false;
   }
   ::flock(::fileno(file_), LOCK_EX | LOCK_NB);  // a temporary in use, not a killed run's
-  buffer_ = HeaderText(columns_, header_comment, !layout_.session_labels.empty());
+  buffer_ = HeaderText(columns_, header_comment, !layout_.session_labels.empty(),
+                       layout_.joint_columns);
   return Flush(error);
 }
 

@@ -232,8 +232,9 @@ struct Processes {
 // with the model's mass centre drifted; *actual_rpy_deg for the measurement.
 bool SolveActual(size_t n, const Pose& planned_pose, const Eigen::Vector3d& planned_rpy_deg,
                  const SimulationOptions& options, const Eigen::Vector3d& mass_centre_m,
-                 const StaticsOptions& statics, Processes* p, CableRobot* model,
-                 Eigen::Vector3d* actual_rpy_deg, StaticsSolution* solution, std::string* error) {
+                 const JointValues& joints, const StaticsOptions& statics, Processes* p,
+                 CableRobot* model, Eigen::Vector3d* actual_rpy_deg, StaticsSolution* solution,
+                 std::string* error) {
   const Eigen::Vector3d control_deg = p->control.NextAfter(&p->control_rng, p->dt);
   const Eigen::Vector3d drift_m = p->mass_centre_drift.NextAfter(&p->mass_centre_rng, p->dt);
   model->mass_centre_cabin_m = mass_centre_m + drift_m;
@@ -245,7 +246,7 @@ bool SolveActual(size_t n, const Pose& planned_pose, const Eigen::Vector3d& plan
   actual.position_m = planned_pose.position_m;
   actual.rotation =
       RotationFromRpyDeg((*actual_rpy_deg)[0], (*actual_rpy_deg)[1], (*actual_rpy_deg)[2]);
-  if (SolveStatics(*model, actual, statics, solution) == StaticsStatus::kOk) return true;
+  if (SolveStatics(*model, actual, joints, statics, solution) == StaticsStatus::kOk) return true;
   std::string message =
       "node " + std::to_string(n) + " at position " + Vec(actual.position_m) + " m";
   if (options.attitude_control_sigma_deg > 0.0) {
@@ -407,6 +408,8 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
   stats.session_bias_n.push_back(SensorBiases(model));
   int session = 0;
   std::vector<bool> applied_sensor_steps(options.sensor_bias_steps.size(), false);
+  JointPlan joint_plan;
+  if (!JointPlan::Make(model.moving_parts, options.joints, &joint_plan, error)) return false;
 
   for (size_t n = 0; n < static_cast<size_t>(planned.count); ++n) {
     const Pose planned_pose = planned.next();
@@ -430,10 +433,14 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
     s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned_pose.rotation));
     s.planned_rotation =
         RotationFromRpyDeg(s.planned_rpy_deg[0], s.planned_rpy_deg[1], s.planned_rpy_deg[2]);
+    if (!model.moving_parts.empty() &&
+        !joint_plan.Next(static_cast<long long>(n), planned_pose, &s.joint, error)) {
+      return false;
+    }
     Eigen::Vector3d actual_rpy_deg;
     if (!SolveActual(n, planned_pose, s.planned_rpy_deg, options,
-                     mass_centre_m + StepShiftAt(options, s.time_s), statics, &processes, &model,
-                     &actual_rpy_deg, &solution, error)) {
+                     mass_centre_m + StepShiftAt(options, s.time_s), s.joint, statics,
+                     &processes, &model, &actual_rpy_deg, &solution, error)) {
       return false;
     }
     MeasurePose(planned_pose.position_m, actual_rpy_deg, options, &processes, &s);
@@ -514,8 +521,9 @@ bool SimulationOptions::IsValid(std::string* error) const {
   return true;
 }
 
-Dataset SimulatedDatasetLayout(int sessions) {
+Dataset SimulatedDatasetLayout(int sessions, const std::vector<std::string>& joint_columns) {
   Dataset layout;
+  layout.joint_columns = joint_columns;
   for (int k = 1; sessions > 1 && k <= sessions; ++k) {
     layout.session_labels.push_back(std::to_string(k));
   }
@@ -557,7 +565,7 @@ bool SimulateStream(const CableRobot& truth, const std::vector<Pose>& planned,
 bool Simulate(const CableRobot& truth, const std::vector<Pose>& planned,
               const SimulationOptions& options, Dataset* dataset, CableRobot* truth_used,
               SimulationSummary* summary, std::string* error) {
-  Dataset out = SimulatedDatasetLayout(options.sessions);
+  Dataset out = SimulatedDatasetLayout(options.sessions, truth.moving_parts.JointColumns());
   out.samples.reserve(planned.size());
   const SampleSink keep = [&out](const Sample& s, std::string*) {
     out.samples.push_back(s);

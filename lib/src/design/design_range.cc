@@ -44,6 +44,8 @@ double MarginOf(const ParameterSpec& p, double value, const DesignOptions& o) {
     case ParameterKind::kEa:
     case ParameterKind::kAttachmentMass:
     case ParameterKind::kAttachmentDensity:
+    case ParameterKind::kPartFirstMoment:
+    case ParameterKind::kPartMass:
       return o.range_relative * std::abs(value);
     case ParameterKind::kSensorGain:
     case ParameterKind::kSensorBias:

@@ -92,6 +92,7 @@ bool CableRobot::IsValid(std::string* error) const {
     return fail("cabin_mass_kg", "must be > 0");
   }
   if (!mass_centre_cabin_m.allFinite()) return fail("mass_centre_cabin_m", "must be finite");
+  if (!moving_parts.IsValid(error)) return false;
   if (reflector.has_value()) {
     if (!reflector->centre_m.allFinite()) return fail("reflector.centre_m", "must be finite");
     if (!(reflector->radius_m > 0.0) || !std::isfinite(reflector->radius_m)) {
@@ -105,6 +106,13 @@ bool CableRobot::IsValid(std::string* error) const {
     return fail("gravity_m_per_s2", "must be < 0 (z is up)");
   }
   return true;
+}
+
+Eigen::Vector3d CableRobot::MassCentreAt(const JointValues& joints) const {
+  if (moving_parts.empty()) return mass_centre_cabin_m;
+  PartShifts shifts;
+  moving_parts.ShiftsAt(joints, &shifts);
+  return mass_centre_cabin_m + moving_parts.MassCentreShift(shifts, cabin_mass_kg);
 }
 
 bool CableAttachment::IsValid(std::string* error) const {

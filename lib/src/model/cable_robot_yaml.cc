@@ -176,8 +176,11 @@ class Parser {
     const std::string path = "cabin";
     std::map<std::string, Entry> keys;
     if (!ReadMap(cabin.value, LineOf(cabin.key), path,
-                 {"mass_kg", "mass_centre_m", "anchor_points_m"}, &keys)) {
+                 {"mass_kg", "mass_centre_m", "anchor_points_m", "moving_parts"}, &keys)) {
       return false;
+    }
+    if (const auto it = keys.find("moving_parts"); it != keys.end()) {
+      if (!ReadMovingParts(it->second, &robot->moving_parts)) return false;
     }
     if (const auto it = keys.find("mass_kg"); it != keys.end()) {
       if (!ReadDouble(it->second.value, LineOf(it->second.key), Join(path, "mass_kg"),
@@ -207,6 +210,133 @@ class Parser {
       }
       robot->anchor_points_cabin_m = std::move(points);
     }
+    return true;
+  }
+
+  // cabin.moving_parts: a list of parts (moving_parts.h), each with its joints.
+  bool ReadMovingParts(const Entry& entry, MovingParts* out) {
+    const std::string path = "cabin.moving_parts";
+    const YAML::Node& list = entry.value;
+    const int line = LineOf(entry.key);
+    out->parts.clear();
+    if (list.IsNull()) return true;  // `moving_parts:` with nothing: none
+    if (!list.IsSequence()) return Fail(line, path, "expected a list of parts");
+    for (size_t k = 0; k < list.size(); ++k) {
+      const std::string part_path = Index(path, k);
+      const int part_line = LineOf(list[k]) > 0 ? LineOf(list[k]) : line;
+      lines_[part_path] = part_line;
+      MovingPart part;
+      if (!ReadMovingPart(list[k], part_line, part_path, *out, &part)) return false;
+      out->parts.push_back(std::move(part));
+    }
+    return true;
+  }
+
+  bool ReadMovingPart(const YAML::Node& node, int line, const std::string& path,
+                      const MovingParts& earlier, MovingPart* part) {
+    std::map<std::string, Entry> keys;
+    if (!ReadMap(node, line, path,
+                 {"name", "parent", "joints", "origin_m", "first_moment_kg_m", "mass_kg"}, &keys)) {
+      return false;
+    }
+    for (const char* name : {"name", "joints"}) {
+      if (keys.count(name) == 0) {
+        return Fail(line, Join(path, name), "missing (each part gives a name and its joints)");
+      }
+    }
+    if (!ReadName(keys["name"], Join(path, "name"), &part->name)) return false;
+    if (keys.count("parent")) {
+      std::string parent;
+      if (!ReadName(keys["parent"], Join(path, "parent"), &parent)) return false;
+      if (parent != "cabin") {
+        part->parent = earlier.Find(parent);
+        if (part->parent < 0) {
+          return Fail(keys["parent"].key, Join(path, "parent"),
+                      "'" + parent + "' is not a part listed before this one (or cabin)");
+        }
+      }
+    }
+    const std::vector<std::pair<const char*, Eigen::Vector3d*>> vectors = {
+        {"origin_m", &part->origin_m}, {"first_moment_kg_m", &part->first_moment_kg_m}};
+    for (const auto& [name, value] : vectors) {
+      const auto it = keys.find(name);
+      if (it != keys.end() &&
+          !ReadVector3(it->second.value, LineOf(it->second.key), Join(path, name), value)) {
+        return false;
+      }
+    }
+    if (keys.count("mass_kg") && !ReadDouble(keys["mass_kg"].value, LineOf(keys["mass_kg"].key),
+                                             Join(path, "mass_kg"), &part->mass_kg)) {
+      return false;
+    }
+    return ReadJoints(keys["joints"], Join(path, "joints"), &part->joints);
+  }
+
+  bool ReadName(const Entry& entry, const std::string& path, std::string* out) {
+    if (!entry.value.IsScalar() || entry.value.Scalar().empty()) {
+      return Fail(entry.key, path, "expected a name");
+    }
+    *out = entry.value.Scalar();
+    return true;
+  }
+
+  // A list of {type, axis, column[, range]}; range in the column's unit (deg or m).
+  bool ReadJoints(const Entry& entry, const std::string& path, std::vector<Joint>* out) {
+    const YAML::Node& list = entry.value;
+    if (!list.IsSequence() || list.size() == 0) {
+      return Fail(entry.key, path, "expected a list of at least one joint {type, axis, column}");
+    }
+    for (size_t j = 0; j < list.size(); ++j) {
+      const std::string jpath = Index(path, j);
+      const int jline = LineOf(list[j]) > 0 ? LineOf(list[j]) : LineOf(entry.key);
+      lines_[jpath] = jline;
+      std::map<std::string, Entry> keys;
+      if (!ReadMap(list[j], jline, jpath, {"type", "axis", "column", "range"}, &keys)) return false;
+      for (const char* name : {"type", "axis", "column"}) {
+        if (keys.count(name) == 0) {
+          return Fail(jline, Join(jpath, name), "missing (each joint gives type, axis and column)");
+        }
+      }
+      Joint joint;
+      const YAML::Node& type = keys["type"].value;
+      const std::string type_text = type.IsScalar() ? type.Scalar() : "";
+      if (type_text != "revolute" && type_text != "prismatic") {
+        return Fail(keys["type"].key, Join(jpath, "type"),
+                    "expected revolute or prismatic, got '" + type_text + "'");
+      }
+      joint.type = type_text == "revolute" ? JointType::kRevolute : JointType::kPrismatic;
+      if (!ReadVector3(keys["axis"].value, LineOf(keys["axis"].key), Join(jpath, "axis"),
+                       &joint.axis)) {
+        return false;
+      }
+      if (!(joint.axis.norm() > 0.0)) {
+        return Fail(keys["axis"].key, Join(jpath, "axis"), "must be a non-zero vector");
+      }
+      joint.axis.normalize();
+      if (!ReadName(keys["column"], Join(jpath, "column"), &joint.column)) return false;
+      if (keys.count("range") && !ReadRange(keys["range"], Join(jpath, "range"), &joint)) {
+        return false;
+      }
+      out->push_back(joint);
+    }
+    return true;
+  }
+
+  bool ReadRange(const Entry& entry, const std::string& path, Joint* joint) {
+    const YAML::Node& node = entry.value;
+    const int line = LineOf(entry.key);
+    if (!node.IsSequence() || node.size() != 2) {
+      return Fail(line, path, "expected [low, high] in the column's unit (deg or m)");
+    }
+    double low = 0.0, high = 0.0;
+    if (!ReadDouble(node[0], line, Index(path, 0), &low) ||
+        !ReadDouble(node[1], line, Index(path, 1), &high)) {
+      return false;
+    }
+    if (!(low < high)) return Fail(line, path, "expected low < high");
+    joint->has_range = true;
+    joint->range_low = low;
+    joint->range_high = high;
     return true;
   }
 
@@ -436,6 +566,30 @@ std::string Vec(const Eigen::Vector3d& v) {
   return "[" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + "]";
 }
 
+// cabin.moving_parts as ReadMovingParts reads it (ranges back in the column's unit).
+void WriteMovingParts(const MovingParts& moving, std::ostringstream& out) {
+  if (moving.empty()) return;
+  out << "  moving_parts:  # joints applied in order; values from the data's columns\n";
+  for (const MovingPart& p : moving.parts) {
+    out << "    - name: " << p.name << "\n";
+    if (p.parent >= 0) out << "      parent: " << moving.parts[p.parent].name << "\n";
+    out << "      joints:\n";
+    for (const Joint& j : p.joints) {
+      out << "        - {type: " << JointTypeName(j.type) << ", axis: " << Vec(j.axis)
+          << ", column: " << j.column;
+      if (j.has_range) {
+        out << ", range: [" << Num(j.range_low) << ", " << Num(j.range_high)
+            << "]";
+      }
+      out << "}\n";
+    }
+    out << "      origin_m: " << Vec(p.origin_m) << "  # parent frame\n";
+    out << "      first_moment_kg_m: " << Vec(p.first_moment_kg_m)
+        << "  # own mass x centre, about origin_m, joints at zero\n";
+    if (p.mass_kg != 0.0) out << "      mass_kg: " << Num(p.mass_kg) << "\n";
+  }
+}
+
 }  // namespace
 
 bool ParseCableRobotYaml(const std::string& text, const std::string& source_name, CableRobot* robot,
@@ -492,6 +646,7 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
   out << "  mass_centre_m: " << Vec(robot.mass_centre_cabin_m) << "  # cabin frame\n";
   out << "  anchor_points_m:  # cabin frame, m\n";
   for (const Eigen::Vector3d& a : robot.anchor_points_cabin_m) out << "    - " << Vec(a) << "\n";
+  WriteMovingParts(robot.moving_parts, out);
   out << "cables:  # cable 1 first; tower tops in the global frame, m\n";
   for (int i = 0; i < kNumCables; ++i) {
     const CableProperties& c = robot.cables[i];

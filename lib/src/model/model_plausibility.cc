@@ -46,6 +46,15 @@ std::vector<ModelValue> ModelValues(const CableRobot& robot) {
     values.push_back({std::string("cabin.mass_centre_m.") + kAxes[a], ModelQuantity::kMassCentreM,
                       robot.mass_centre_cabin_m[a], nominal.mass_centre_cabin_m[a]});
   }
+  for (size_t k = 0; k < robot.moving_parts.parts.size(); ++k) {
+    const MovingPart& part = robot.moving_parts.parts[k];
+    const std::string key = "cabin.moving_parts[" + std::to_string(k) + "].";
+    for (int a = 0; a < 3; ++a) {
+      values.push_back({key + "first_moment_kg_m." + kAxes[a], ModelQuantity::kPartFirstMomentKgM,
+                        part.first_moment_kg_m[a], 0.0});
+    }
+    values.push_back({key + "mass_kg", ModelQuantity::kPartMassKg, part.mass_kg, 0.0});
+  }
   for (size_t j = 0; j < robot.anchor_points_cabin_m.size(); ++j) {
     const Eigen::Vector3d nominal_point = j < nominal.anchor_points_cabin_m.size()
                                               ? nominal.anchor_points_cabin_m[j]
@@ -131,6 +140,12 @@ bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity) {
       return true;
     case ParameterKind::kLengthOffset:
       *quantity = ModelQuantity::kLengthOffsetM;
+      return true;
+    case ParameterKind::kPartFirstMoment:
+      *quantity = ModelQuantity::kPartFirstMomentKgM;
+      return true;
+    case ParameterKind::kPartMass:
+      *quantity = ModelQuantity::kPartMassKg;
       return true;
     default:
       return false;

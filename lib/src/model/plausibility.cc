@@ -135,6 +135,12 @@ QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& l
     case ModelQuantity::kReflectorApertureM:
       return {limits.min_reflector_aperture_m, 2.0 * limits.max_reflector_radius_m, 500.0, "m",
               1.0};
+    case ModelQuantity::kPartFirstMomentKgM: {
+      const double max = limits.max_cabin_mass_kg * limits.max_abs_mass_centre_m;
+      return {-max, max, 0.0, "kg m", 1.0};
+    }
+    case ModelQuantity::kPartMassKg:
+      return {0.0, limits.max_cabin_mass_kg, 0.0, "kg", 1.0};
   }
   return {};
 }

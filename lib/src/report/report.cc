@@ -1182,6 +1182,7 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
   if (in.result) {
     AddEstimates(*in.result, &doc);
     AddCablesAsBuilt(in, &doc);
+    internal::AddMovingParts(in, with_plots, &doc);
     internal::AddSessions(*in.result, with_plots, &doc);
     internal::AddChangeScan(*in.result, with_plots, &doc);
     internal::AddUncertaintyBudget(*in.result, &doc);

@@ -1163,6 +1163,11 @@ StaticsParameters<double> MakeStaticsParameters(const CableRobot& robot) {
   }
   p.cabin_mass_kg = robot.cabin_mass_kg;
   p.mass_centre_cabin_m = robot.mass_centre_cabin_m;
+  p.num_parts = static_cast<int>(robot.moving_parts.parts.size());
+  for (int k = 0; k < p.num_parts; ++k) {
+    p.part_first_moment_kg_m[k] = robot.moving_parts.parts[k].first_moment_kg_m;
+    p.part_mass_kg[k] = robot.moving_parts.parts[k].mass_kg;
+  }
   p.gravity_m_per_s2 = robot.gravity_m_per_s2;
   p.reflector = robot.reflector;
   return p;
@@ -1215,8 +1220,25 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
   return status;
 }
 
+StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parameters,
+                                         const MovingParts& parts, const JointValues& joints,
+                                         const Pose& pose, const StaticsOptions& options,
+                                         StaticsSolution* solution) {
+  if (parameters.num_parts == 0 || parts.empty()) {
+    return SolveStaticsWithParameters(parameters, pose, options, solution);
+  }
+  PartShifts shifts;
+  parts.ShiftsAt(joints, &shifts);
+  return SolveStaticsWithParameters(AtJoints(parameters, shifts), pose, options, solution);
+}
+
 StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const StaticsOptions& options,
                            StaticsSolution* solution) {
+  return SolveStatics(robot, pose, JointValues{}, options, solution);
+}
+
+StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const JointValues& joints,
+                           const StaticsOptions& options, StaticsSolution* solution) {
   // MakeStaticsParameters indexes the anchors: a robot without them (default-constructed)
   // is invalid input, not a crash.
   for (const CableProperties& c : robot.cables) {
@@ -1227,7 +1249,10 @@ StaticsStatus SolveStatics(const CableRobot& robot, const Pose& pose, const Stat
       return solution->status = StaticsStatus::kInvalidInput;
     }
   }
-  return SolveStaticsWithParameters(MakeStaticsParameters(robot), pose, options, solution);
+  StaticsParameters<double> p = MakeStaticsParameters(robot);
+  // All joints at zero (a robot without moving parts: always) leave c0 as it is.
+  if (!robot.moving_parts.empty()) p.mass_centre_cabin_m = robot.MassCentreAt(joints);
+  return SolveStaticsWithParameters(p, pose, options, solution);
 }
 
 namespace {

@@ -72,9 +72,17 @@ class CalibrationModel {
   bool frees_geometry() const { return frees_geometry_; }
   // d reading_i / d theta_k (6 x n, row-major) of the readings gain_i T_i + bias_i at a
   // sample of `session`: Assemble's map differentiated, with `gradient` the statics' and
-  // `gain` Assemble's at theta. A parameter of another session has a zero column.
+  // `gain` Assemble's at theta. A parameter of another session has a zero column. With
+  // moving parts, `shifts` are the sample's (A_k, b_k) and `at` Assemble's parameters
+  // (mass centre c0): the parts' columns are the mass centre's through
+  // d c / d Q_k = A_k / M, d c / d m_k = b_k / M, and the cabin mass's gains
+  // d c / d M = -(c(q) - c0) / M (moving_parts.h eq. (1)).
   void ReadingJacobian(const TensionGradient& gradient, const std::array<double, kNumCables>& gain,
-                       int session, double* jacobian) const;
+                       int session, double* jacobian, const PartShifts* shifts = nullptr,
+                       const StaticsParameters<double>* at = nullptr) const;
+  // Whether the model has moving parts: each sample's statics then move the mass centre
+  // to its joint values.
+  bool has_parts() const { return base_.num_parts > 0; }
 
   // The statics parameters and sensor model at theta for a sample of `session`: a
   // parameter of another session (ParameterSpec::session) does not apply.
@@ -137,6 +145,12 @@ class CalibrationModel {
             if (s.index < 0 || s.index == i) offset[i] = v;
           }
           break;
+        case ParameterKind::kPartFirstMoment:
+          p->part_first_moment_kg_m[s.index][s.component] = v;
+          break;
+        case ParameterKind::kPartMass:
+          p->part_mass_kg[s.index] = v;
+          break;
       }
     }
     if (offset_m != nullptr) *offset_m = offset;
@@ -196,6 +210,8 @@ struct TensionResidual {
   std::array<double, kNumCables> measured_length_m{};
   double length_sigma_m = 0.0;
   std::array<bool, kNumCables> length_excluded{};
+  // The sample's joint values (Sample::joint), for a model with moving parts.
+  JointValues joints{};
 
   int readings() const { return length_sigma_m > 0.0 ? kMaxReadings : kNumCables; }
 
@@ -209,6 +225,11 @@ struct TensionResidual {
     std::array<T, kNumCables> gain, bias, tension, offset, length;
     const bool lengths = length_sigma_m > 0.0;
     model->Assemble(theta, &p, &gain, &bias, session, &offset);
+    if (p.num_parts > 0) {
+      PartShifts shifts;
+      model->robot().moving_parts.ShiftsAt(joints, &shifts);
+      p.mass_centre_cabin_m = MassCentreAt(p, shifts);
+    }
     // Physical limits: a non-positive gain here, and non-positive mass, density or EA in
     // the statics, make the evaluation fail, which Ceres treats as an infeasible step.
     for (const T& g : gain) {

@@ -53,6 +53,11 @@ void AddDiagnosticPlots(const ReportInputs& in, Document* doc);
 // (null without them).
 void WriteDiagnosticsJson(const CalibrationResult& r, JsonWriter* w);
 
+// The cabin's moving parts (report_moving_parts.cc): the calibrated first moments and
+// masses in words, the largest shift of the mass centre over the joints' ranges, and its
+// sweep per joint. Nothing for a model without moving parts.
+void AddMovingParts(const ReportInputs& in, bool with_plots, Document* doc);
+
 // A joint fit's sessions (report_sessions.cc): the separate parameters per session with
 // sigma_total, the differences between consecutive sessions, and a plot per parameter.
 // Nothing without sessions.

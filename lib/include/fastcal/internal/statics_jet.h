@@ -14,6 +14,14 @@ StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parame
                                          const Pose& pose, const StaticsOptions& options,
                                          StaticsSolution* solution);
 
+// The same at a sample's joint values: `parameters` with the mass centre moved by the
+// cabin's moving parts `parts` at `joints` (moving_parts.h eq. (1)); without parts, as
+// above, at no cost.
+StaticsStatus SolveStaticsWithParameters(const StaticsParameters<double>& parameters,
+                                         const MovingParts& parts, const JointValues& joints,
+                                         const Pose& pose, const StaticsOptions& options,
+                                         StaticsSolution* solution);
+
 template <typename T>
 StaticsStatus ModelLowerTensions(const StaticsParameters<T>& p, const Pose& pose,
                                  const StaticsOptions& options,
