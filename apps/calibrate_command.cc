@@ -468,6 +468,7 @@ bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   DatasetReadOptions read;
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   read.threads = kReadThreads;
+  read.joint_columns = robot->moving_parts.JointColumns();
   if (!ColumnsFromFlag(&read.columns, error) || !ReadSessionDatasets(paths, read, data, error)) {
     return false;
   }
@@ -665,12 +666,18 @@ std::string EstimatesTable(const CalibrationResult& result) {
     groups[key].push_back(&p);
   }
   std::vector<std::string> rows;
-  char buf[200];
+  char buf[240];
+  // The name column: as wide as the longest name (moving_parts.rotator.first_moment_kg_m.x
+  // is 40), at least 29, at most 44.
+  int width = 29;
+  for (const ParameterEstimate& p : result.parameters) {
+    if (p.free) width = std::max(width, std::min(44, static_cast<int>(p.name.size())));
+  }
   for (const std::string& key : order) {
     const std::vector<const ParameterEstimate*>& g = groups[key];
     if (g.size() < kGroupedFrom) {
       for (const ParameterEstimate* p : g) {
-        std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s", p->name.c_str(),
+        std::snprintf(buf, sizeof(buf), "  %-*.*s %-31s %9s %8s", width, width, p->name.c_str(),
                       ValueWithSigma(p->estimate, p->sigma_total, p->unit).c_str(),
                       SigmaText(p->sigma, p->unit).c_str(),
                       ("x" + FormatDouble(p->widening, 2)).c_str());
@@ -706,12 +713,13 @@ std::string EstimatesTable(const CalibrationResult& result) {
     const std::string unit = g.front()->unit == "1" ? "" : " " + g.front()->unit;
     const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + " +- " +
                               FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2) + unit;
-    std::snprintf(buf, sizeof(buf), "  %-29.29s %-31s %9s %8s", label.c_str(), range.c_str(), "",
+    std::snprintf(buf, sizeof(buf), "  %-*.*s %-31s %9s %8s", width, width, label.c_str(),
+                  range.c_str(), "",
                   ("<= x" + FormatDouble(widest, 2)).c_str());
     rows.push_back(WithNote(buf, flags));
   }
   std::ostringstream s;
-  std::snprintf(buf, sizeof(buf), "  %-29s %-31s %9s %8s  %s\n", "free parameter",
+  std::snprintf(buf, sizeof(buf), "  %-*s %-31s %9s %8s  %s\n", width, "free parameter",
                 "estimate +- sigma_total", "formal", "widening", "note");
   s << buf;
   for (size_t k = 0; k < rows.size() && k < kEstimateRows; ++k) {
@@ -1274,6 +1282,7 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
   options.method = method;
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   options.read.threads = kReadThreads;
+  options.read.joint_columns = model.moving_parts.JointColumns();
   if (!ColumnsFromFlag(&options.read.columns, &error)) {
     PrintError(command, error);
     return kExitUsage;

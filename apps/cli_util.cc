@@ -866,4 +866,58 @@ std::string Wrapped(const std::string& text, const std::string& first_indent,
   return out;
 }
 
+bool ParseNumberList(const std::string& flag, const std::string& text, std::vector<double>* values,
+                     std::string* error) {
+  values->clear();
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    double v = 0.0;
+    std::string why;
+    if (!ParseNumberItem(item, &v, &why)) {
+      *error = "--" + flag + ": " + why;
+      return false;
+    }
+    values->push_back(v);
+  }
+  if (!text.empty() && text.back() == ',') {
+    *error = "--" + flag + ": an empty value after the last comma";
+    return false;
+  }
+  return true;
+}
+
+bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::string* error) {
+  const MovingParts& parts = robot->moving_parts;
+  if (text.empty()) return true;
+  std::string names;
+  for (const std::string& c : parts.JointColumns()) names += (names.empty() ? "" : ",") + c;
+  if (parts.empty()) {
+    *error = "--joints: the model has no moving parts (cabin.moving_parts, --model=MODEL.yaml)";
+    return false;
+  }
+  std::vector<double> values;
+  if (!ParseNumberList("joints", text, &values, error)) return false;
+  if (values.size() != static_cast<size_t>(parts.num_joints())) {
+    *error = "--joints needs " + std::to_string(parts.num_joints()) + " values (" + names +
+             "), got " + internal::Quote(text);
+    return false;
+  }
+  JointValues joints{};
+  const auto all = parts.Joints();
+  for (size_t j = 0; j < values.size(); ++j) {
+    const Joint& joint = *all[j].second;
+    std::string why;
+    if (!PlausibleJointValue(joint.column, values[j], &why) ||
+        (joint.has_range && (values[j] < joint.range_low || values[j] > joint.range_high))) {
+      *error = "--joints: " + joint.column + " = " + internal::Quote(std::to_string(values[j])) +
+               ": " + (why.empty() ? "outside its range in the model" : why);
+      return false;
+    }
+    joints[j] = values[j];
+  }
+  robot->mass_centre_cabin_m = robot->MassCentreAt(joints);
+  robot->moving_parts.parts.clear();
+  return true;
+}
+
 }  // namespace fastcal::cli

@@ -151,6 +151,18 @@ bool ParsePosition(const std::string& name, const std::string& text, Eigen::Vect
 bool ParseRpyDeg(const std::string& name, const std::string& text, Eigen::Vector3d* rpy_deg,
                  std::string* error);
 
+// A comma-separated list of finite numbers for flag `flag` (ParseNumberItem each; an empty
+// item, as after a trailing comma, is an error naming the flag).
+bool ParseNumberList(const std::string& flag, const std::string& text, std::vector<double>* values,
+                     std::string* error);
+
+// --joints=v1,...: the model's moving parts at these joint values (its joint order, the
+// columns' units: deg, m), folded into *robot's mass centre (moving_parts.h eq. (1)); the
+// parts are then fixed. Empty: every joint at 0 (the model's mass_centre_m). A count other
+// than the model's joints, a value out of a joint's range, or --joints for a model without
+// moving parts is an error naming the joints.
+bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::string* error);
+
 // Writes `content` to `path` through a temporary file and a rename, so that a failure
 // leaves no partial file; path "" or "-" writes to stdout (each write checked: "cannot
 // write to standard output: No space left on device ..."). Without `replace` (--force),

@@ -25,6 +25,7 @@ DECLARE_string(data);
 DECLARE_string(rpy);
 DECLARE_string(quat);
 DECLARE_string(output);
+DECLARE_string(joints);  // solve_command.cc
 DECLARE_bool(force);
 DECLARE_bool(keep_going);
 DECLARE_bool(warm_start);
@@ -95,7 +96,9 @@ Measurements:
 
 Model: --model=FILE.yaml (docs/model-format.md; a calibrated model from fastcal
 calibrate works); default the nominal FAST model. Model range: --max-strain=0.05,
---max-length-ratio=1.5, --reflector-clearance=0 (as in solve).
+--max-length-ratio=1.5, --reflector-clearance=0 (as in solve). A model with moving parts
+(cabin.moving_parts) takes each row's joint values from the --data file's joint columns,
+or --joints=v1,... (the model's joint order, deg and m) with --lengths; default all 0.
 
 Output: CSV to stdout or --output=FILE (written only when everything succeeded; an
 existing FILE is refused unless --force). Columns, units in the names:
@@ -133,7 +136,7 @@ const std::set<std::string> kFlags = {
     "model", "data", "lengths", "rpy", "quat", "tensions-kN", "use", "spec", "length-sigma-m",
     "tension-sigma-percent", "tension-sigma-kN", "attitude-sigma-deg", "search-radius-m",
     "warm-start", "output", "force", "keep-going", "max-strain", "max-length-ratio",
-    "reflector-clearance"};
+    "reflector-clearance", "joints"};
 // clang-format on
 
 // One instant to locate, and what the file said of it.
@@ -144,6 +147,7 @@ struct Row {
   bool has_position = false;
   Eigen::Vector3d position_m = Eigen::Vector3d::Zero();  // the file's, compared only
   LocateMeasurement measurement;
+  JointValues joints{};  // a model with moving parts: the row's joint values
 };
 
 // What locate found at one row (LocateSolution is large; only what is written is kept).
@@ -287,7 +291,7 @@ bool RowFromFlags(std::vector<Row>* rows, std::string* error) {
 }
 
 // --data=FILE: a lengths file (dataset.h, DatasetColumns::kLengths).
-bool RowsFromFile(std::vector<Row>* rows, std::string* error) {
+bool RowsFromFile(const CableRobot& robot, std::vector<Row>* rows, std::string* error) {
   if (!FLAGS_lengths.empty() || !FLAGS_rpy.empty() || !FLAGS_quat.empty() ||
       !FLAGS_tensions_kN.empty()) {
     *error =
@@ -297,6 +301,7 @@ bool RowsFromFile(std::vector<Row>* rows, std::string* error) {
   }
   DatasetReadOptions read;
   read.required_columns = DatasetColumns::kLengths;
+  read.joint_columns = robot.moving_parts.JointColumns();
   Dataset data;
   if (!ReadDataset(FLAGS_data, read, &data, error)) return false;
   rows->clear();
@@ -313,6 +318,7 @@ bool RowsFromFile(std::vector<Row>* rows, std::string* error) {
     row.measurement.rotation = s.pose.rotation;
     row.measurement.has_tensions = data.has_tensions;
     row.measurement.tension_n = s.tension_n;
+    row.joints = s.joint;
     rows->push_back(row);
   }
   return true;
@@ -480,7 +486,13 @@ int RunLocate(int argc, char** argv) {
     PrintError(kCommand, "give --lengths=L1,...,L6 or --data=FILE.csv (see fastcal locate --help)");
     return kExitUsage;
   }
-  if (!(from_file ? RowsFromFile(&rows, &error) : RowFromFlags(&rows, &error))) {
+  if (from_file && !FLAGS_joints.empty()) {
+    PrintError(kCommand, "--data brings its own joint values (the model's joint columns): drop "
+                         "--joints");
+    return kExitUsage;
+  }
+  if (!(from_file ? RowsFromFile(robot, &rows, &error) : RowFromFlags(&rows, &error)) ||
+      !MassCentreAtJointsFlag(FLAGS_joints, &robot, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -491,7 +503,14 @@ int RunLocate(int argc, char** argv) {
   for (Row& row : rows) {
     row.measurement.has_attitude = row.measurement.has_attitude && use.attitude;
     row.measurement.has_tensions = row.measurement.has_tensions && use.tensions;
-    LocateFromMeasurements(robot, row.measurement, noise, options, &solution);
+    if (robot.moving_parts.empty()) {
+      LocateFromMeasurements(robot, row.measurement, noise, options, &solution);
+    } else {  // the row's own mass centre (moving_parts.h eq. (1))
+      CableRobot at = robot;
+      at.mass_centre_cabin_m = robot.MassCentreAt(row.joints);
+      at.moving_parts.parts.clear();
+      LocateFromMeasurements(at, row.measurement, noise, options, &solution);
+    }
     answers.push_back(AnswerOf(solution));
   }
   const double seconds =

@@ -93,6 +93,11 @@ DEFINE_int32(days, 0, "simulate: a season: the samples cut into N days, one sess
 DEFINE_string(start, "", "simulate: time of the first sample (s, or ISO 8601).");
 DEFINE_string(sensor_step, "",
               "simulate: sensors re-zeroed: T:CABLE:DKN (s, 1..6, kN), several joined by ';'.");
+DEFINE_string(joint_law, "zero", "simulate: the rotator's angles: zero, focal or grid.");
+DEFINE_string(joint_grid_deg, "-15,0,15",
+              "simulate: with --joint-law=grid, the values each rotator angle visits (deg).");
+DEFINE_double(prismatic_spread_m, 0.0,
+              "simulate: sigma of each prismatic joint (the Stewart platform), m.");
 
 namespace fastcal::cli {
 namespace {
@@ -155,6 +160,18 @@ Truth model:
                                   aas-refined, aas
   (Until 0.2 the units were spelt -kn and -pct: --sensor-bias-kn, --tension-noise-pct...;
   those names still work, with a note on stderr.)
+
+Moving parts (a truth model with cabin.moving_parts, docs/model-format.md): the dataset
+gets each joint's column (rotator_a_deg, stewart_x_m, ...) and the mass centre moves with
+the joints (docs/model.md, "Moving parts"):
+  --joint-law=zero                the rotator's two angles: zero; focal (it completes the
+                                  tilt the cabin does not give: the feed axis along the
+                                  focal sphere's radius, toward --focal-centre); grid
+                                  (sample n visits point n mod G of the grid below, G its
+                                  size squared: the angles vary at fixed cabin poses)
+  --joint-grid-deg=-15,0,15       with grid: the values each of the two angles visits
+  --prismatic-spread-m=0          each prismatic joint (the platform) N(0, m), per sample
+A model without moving parts refuses these flags.
 
 Trajectory (--trajectory=, default circle):
   circle  the paper's measured circle: centre (0,0,156.73), radius 71.11 m, full turn,
@@ -265,7 +282,8 @@ const std::set<std::string> kFlags = {
     "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-percent",
     "sensor-bias-spread-kN", "sessions", "session-shift-m", "mass-centre-step",
     "tension-drift-kN", "session-gap-s", "sensor-rezero-kN", "length-offset-spread-m",
-    "length-noise-m", "days", "start", "sensor-step"};
+    "length-noise-m", "days", "start", "sensor-step", "joint-law", "joint-grid-deg",
+    "prismatic-spread-m"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -416,6 +434,24 @@ bool StepsAtSessions(int samples, SimulationOptions* options, std::string* error
   return true;
 }
 
+// --joint-law, --joint-grid-deg, --prismatic-spread-m (checked against the truth model's
+// parts when the plan is made: Simulate).
+bool SetJointsFromFlags(SimulationOptions* options, std::string* error) {
+  JointPlanOptions& j = options->joints;
+  if (!ParseRevoluteLaw(FLAGS_joint_law, &j.revolute)) {
+    *error = "--joint-law must be zero, focal or grid, got " + internal::Quote(FLAGS_joint_law);
+    return false;
+  }
+  if (FlagGiven("joint-grid-deg") && j.revolute != RevoluteLaw::kGrid) {
+    *error = "--joint-grid-deg needs --joint-law=grid";
+    return false;
+  }
+  if (!ParseNumberList("joint-grid-deg", FLAGS_joint_grid_deg, &j.grid_deg, error)) return false;
+  j.prismatic_sigma_m = FLAGS_prismatic_spread_m;
+  j.seed = FLAGS_seed;
+  return ParseVector3("focal-centre", FLAGS_focal_centre, &j.focal_centre_m, error);
+}
+
 bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->attitude_control_sigma_deg = FLAGS_attitude_control_deg;
   options->attitude_measurement_sigma_deg = FLAGS_attitude_noise_deg;
@@ -454,7 +490,7 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
       return false;
     }
   }
-  if (!SetStepsFromFlags(options, error)) return false;
+  if (!SetStepsFromFlags(options, error) || !SetJointsFromFlags(options, error)) return false;
   options->method = StaticsMethod::kExact;
   if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &options->method)) {
     *error = "--method must be exact, aas-refined or aas, got " + internal::Quote(FLAGS_method);
@@ -598,7 +634,8 @@ bool SimulateAndWrite(const CableRobot& truth, const PoseStream& poses,
   DatasetWriter writer;
   // A season's days are not surveys: no session column (a track cuts the data by time).
   const int labelled = FLAGS_days > 0 ? 1 : options.sessions;
-  if (!writer.Open(csv_tmp, SimulatedDatasetLayout(labelled), csv_header, error)) {
+  if (!writer.Open(csv_tmp, SimulatedDatasetLayout(labelled, truth.moving_parts.JointColumns()),
+                   csv_header, error)) {
     name_the_users_file();
     return false;
   }
@@ -713,6 +750,21 @@ int RunSimulate(int argc, char** argv) {
   if (poses.count == 0) {
     PrintError(kCommand, "no poses to simulate");
     return kExitUsage;
+  }
+  for (const char* flag : {"joint-law", "joint-grid-deg", "prismatic-spread-m"}) {
+    if (truth.moving_parts.empty() && FlagGiven(flag)) {
+      PrintError(kCommand, std::string("--") + flag +
+                               " needs a truth model with moving parts (cabin.moving_parts, "
+                               "--truth=MODEL.yaml)");
+      return kExitUsage;
+    }
+  }
+  {
+    JointPlan plan;  // the plan's own checks (a law without a rotator), before any work
+    if (!JointPlan::Make(truth.moving_parts, options.joints, &plan, &error)) {
+      PrintError(kCommand, "--joint-law: " + error);
+      return kExitUsage;
+    }
   }
   if (!DaysFromFlags(poses.count, &options, &error) ||
       !StepsAtSessions(static_cast<int>(poses.count), &options, &error)) {

@@ -51,6 +51,9 @@ DEFINE_double(focal_radius, 160.0, "grid, random: focal-sphere radius (m).");
 DEFINE_int32(samples, 100, "random: number of poses.");
 DEFINE_uint64(seed, 1, "random: generator seed.");
 DEFINE_double(radial_spread, 0.0, "random: uniform offset along the sphere normal, +-m.");
+DEFINE_string(joints, "",
+              "Moving parts' joint values for every pose, the model's joint order and the "
+              "columns' units (deg, m); default all 0.");
 DEFINE_string(poses, "", "CSV of poses (x_m,y_m,z_m[,roll_deg,pitch_deg,yaw_deg|qw,qx,qy,qz]).");
 DEFINE_string(format, "csv", "csv | json");
 DEFINE_string(output, "", "Output file; empty or - = stdout. Written only on success.");
@@ -142,7 +145,10 @@ may come to the model's reflector).
 
 Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model. solve
 reports the model's true cable tensions: a model's sensor_gain and sensor_bias_kN are
-not applied here (they are in evaluate and calibrate, which compare with readings).
+not applied here (they are in evaluate and calibrate, which compare with readings). A
+model with moving parts (cabin.moving_parts) solves every pose with its joints at
+--joints=v1,... (the model's joint order, in the columns' units: deg and m; the mass
+centre then follows, docs/model.md "Moving parts"); default all 0.
 
 Output: CSV (default) or --format=json, to stdout or --output=FILE (written only when
 everything succeeded; an existing FILE is refused unless --force, which needs --output).
@@ -214,7 +220,7 @@ std::string Help() {
   return help;
 }
 
-const std::set<std::string> kFlags = {"model",
+const std::set<std::string> kFlags = {"model", "joints",
                                       "columns",
                                       "method",
                                       "position",
@@ -1084,6 +1090,10 @@ int RunSolve(int argc, char** argv) {
   }
   CableRobot robot;
   if (!LoadModelFlag("model", FLAGS_model, &robot, &error)) {
+    PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  if (!MassCentreAtJointsFlag(FLAGS_joints, &robot, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }

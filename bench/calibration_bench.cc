@@ -32,6 +32,9 @@
 // statics (TensionCost::EvaluateJet: before issue 28), 5 folding without a loss as
 // spec_realistic.yaml's fit does it, each reading's rows over its own columns first
 // (GroupedRowFold). One thread.
+// BM_RealisticPartsEndToEnd/N (issue 35): the same with calibration_data/moving_parts.yaml
+// (the rotator through a grid of +-15 deg, the platform spread 5 cm) and
+// spec_moving_parts.yaml (the rotator's first moment and the platform's mass freed too).
 // Run: build/bench/calibration_bench --benchmark_filter=EndToEnd   (about a minute)
 //      build/bench/calibration_bench --benchmark_filter='Realistic|SampleRows'  (~2 min)
 #include <benchmark/benchmark.h>
@@ -171,7 +174,8 @@ const char kRealisticSpec[] = FASTCAL_SOURCE_DIR "/calibration_data/spec_realist
 
 // `fastcal simulate --trajectory=random --samples=N --tension-noise-pct=3
 // --sensor-gain-spread-pct=1 --sensor-bias-spread-kn=1.5`'s data, to `sink`.
-bool SimulateRealistic(int samples, const SampleSink& sink) {
+bool SimulateRealistic(int samples, const SampleSink& sink,
+                       const CableRobot& truth = CableRobot::NominalFast()) {
   RandomWorkspaceSpec positions;
   positions.samples = samples;
   positions.seed = 1;
@@ -190,22 +194,32 @@ bool SimulateRealistic(int samples, const SampleSink& sink) {
   options.tension_noise_percent = 3.0;
   options.sensor_gain_spread_percent = 1.0;
   options.sensor_bias_spread_kn = 1.5;
+  // A cabin with moving parts: the rotator through a grid of angles, the platform spread.
+  options.joints.revolute = truth.moving_parts.empty() ? RevoluteLaw::kZero : RevoluteLaw::kGrid;
+  options.joints.grid_deg = {-15.0, 0.0, 15.0};
+  options.joints.prismatic_sigma_m = 0.05;
   CableRobot truth_used;
   SimulationSummary summary;
-  return SimulateStream(CableRobot::NominalFast(), poses, options, sink, &truth_used, &summary,
-                        &error);
+  return SimulateStream(truth, poses, options, sink, &truth_used, &summary, &error);
 }
 
-std::string RealisticDataFile(int samples) {
+// calibration_data/moving_parts.yaml and spec_moving_parts.yaml (issue 35).
+const char kPartsModel[] = FASTCAL_SOURCE_DIR "/calibration_data/moving_parts.yaml";
+const char kPartsSpec[] = FASTCAL_SOURCE_DIR "/calibration_data/spec_moving_parts.yaml";
+
+std::string RealisticDataFile(int samples, const CableRobot& truth = CableRobot::NominalFast()) {
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("fastcal_bench_realistic_" + std::to_string(getpid()) + "_" +
                              std::to_string(samples) + ".csv"))
                                .string();
   DatasetWriter writer;
   std::string error;
-  if (!writer.Open(path, SimulatedDatasetLayout(), "calibration_bench", &error)) return "";
+  if (!writer.Open(path, SimulatedDatasetLayout(1, truth.moving_parts.JointColumns()),
+                   "calibration_bench", &error)) {
+    return "";
+  }
   const bool ok = SimulateRealistic(
-      samples, [&](const Sample& s, std::string* e) { return writer.Write(s, e); });
+      samples, [&](const Sample& s, std::string* e) { return writer.Write(s, e); }, truth);
   return ok && writer.Close(&error) ? path : "";
 }
 
@@ -220,6 +234,29 @@ void BM_RealisticEndToEnd(benchmark::State& state) {
 }
 
 BENCHMARK(BM_RealisticEndToEnd)->Apply(EndToEndSizes);
+
+// The same with the cabin's moving parts (issue 35: within 1.2x of the above).
+void BM_RealisticPartsEndToEnd(benchmark::State& state) {
+  CableRobot model;
+  CalibrationSpec spec;
+  std::string error;
+  if (!LoadCableRobot(kPartsModel, &model, &error) ||
+      !LoadCalibrationSpec(kPartsSpec, model, &spec, &error)) {
+    state.SkipWithError(error.c_str());
+    return;
+  }
+  const std::string csv = RealisticDataFile(static_cast<int>(state.range(0)), model);
+  if (csv.empty()) {
+    state.SkipWithError("cannot write the dataset file");
+    return;
+  }
+  const std::string dir = csv + ".out";
+  ForkedIterations(state, [&] { return ReadCalibrateReport(csv, spec, dir, model); });
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(csv);
+}
+
+BENCHMARK(BM_RealisticPartsEndToEnd)->Apply(EndToEndSizes);
 
 // The per-sample parts of a Jacobian evaluation (file comment), range(0): the part.
 void BM_SampleRows(benchmark::State& state) {

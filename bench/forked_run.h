@@ -26,7 +26,8 @@ namespace fastcal::bench {
 // In the child: read, calibrate with `spec`, write the report into `dir`. Exit code 0 on
 // success; else 1 (read), 2 (calibrate) or 3 (report), the reason on stderr.
 inline int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& spec,
-                               const std::string& dir) {
+                               const std::string& dir,
+                               const CableRobot& model = CableRobot::NominalFast()) {
   Dataset data;
   std::string error;
   const auto failed = [&error](int code) {
@@ -38,8 +39,8 @@ inline int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& sp
   // The library's reader, without the CLI's 1 GiB refusal: track_bench's one survey of
   // 10^7 samples is a 4 GB file (its memory, ~8 GB, is what the comparison shows).
   read.max_file_bytes = 1LL << 40;
+  read.joint_columns = model.moving_parts.JointColumns();
   if (!ReadDataset(csv, read, &data, &error)) return failed(1);
-  const CableRobot model = CableRobot::NominalFast();
   CalibrationResult result;
   if (Calibrate(model, spec, data, CalibrationOptions(), &result, &error) !=
       CalibrationStatus::kOk) {
