@@ -150,5 +150,29 @@ TEST_F(CliMovingPartsTest, LocateTakesEachRowsJoints) {
   EXPECT_GT(std::stod(m[1]), kVisibleM);
 }
 
+TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
+  // Six days, the rotator following the focal law, the mass centre moved 3.6 cm on the
+  // fourth: tracked with the model's parts, the move is found and dated, nothing else.
+  const std::string model = Source() + "/calibration_data/moving_parts.yaml";
+  const CommandResult sim = Fastcal(
+      "simulate --truth=" + model +
+      " --trajectory=random --samples=7200 --days=6 --interval-s=2 "
+      "--start=2024-05-01T20:00:00Z --mass-centre=0.22,0.11,0.5 --joint-law=focal "
+      "--prismatic-spread-m=0.05 --tension-drift-percent=1 --tension-drift-time-s=120 "
+      "--sensor-gain-spread-percent=1 --sensor-bias-spread-kN=1.5 "
+      "--mass-centre-step=2024-05-04T20:00:00Z:0.036,0,0 --seed=5 --out=" +
+      Path("season.csv"));
+  ASSERT_EQ(sim.code, 0) << sim.output;
+  const CommandResult track =
+      Fastcal("track --spec=" + Source() + "/calibration_data/spec_track.yaml --model=" + model +
+              " --data=" + Path("season.csv") + " --out=" + Path("track"));
+  ASSERT_EQ(track.code, 0) << track.output;
+  EXPECT_NE(track.output.find("(converged)"), std::string::npos) << track.output;
+  EXPECT_NE(track.output.find("1% false-alarm rate over the track): 1\n  2024-05-04  parameter: "
+                              "mass_centre_m.x"),
+            std::string::npos)
+      << track.output;
+}
+
 }  // namespace
 }  // namespace fastcal::test

@@ -212,12 +212,12 @@ TEST_F(TrackFoldTest, StoreStreamedOrSortedFoldsAsInMemory) {
   std::vector<internal::StoredSample> records;
   for (const Sample& s : data_.samples) records.push_back(internal::ToStored(s, 0, false));
   std::string error;
-  ASSERT_TRUE(internal::AppendStoredSamples(in_order, records, &error)) << error;
+  ASSERT_TRUE(internal::AppendStoredSamples(in_order, records, 0, &error)) << error;
   // The second half first, as two files given in the wrong order would be.
   std::vector<internal::StoredSample> later(records.begin() + kLongSamples / 2, records.end());
   std::vector<internal::StoredSample> earlier(records.begin(), records.begin() + kLongSamples / 2);
-  ASSERT_TRUE(internal::AppendStoredSamples(shuffled, later, &error)) << error;
-  ASSERT_TRUE(internal::AppendStoredSamples(shuffled, earlier, &error)) << error;
+  ASSERT_TRUE(internal::AppendStoredSamples(shuffled, later, 0, &error)) << error;
+  ASSERT_TRUE(internal::AppendStoredSamples(shuffled, earlier, 0, &error)) << error;
   const std::string expected = SerializeWindowFold(Fold(task_));
   for (const std::string& path : {in_order, shuffled}) {
     FoldTask task = task_;
@@ -295,9 +295,9 @@ TEST(WindowStoreTest, RangesReadAsTheWhole) {
       records.push_back(internal::ToStored(s, k, false));
     }
     std::string error;
-    ASSERT_TRUE(internal::AppendStoredSamples(path, records, &error)) << error;
+    ASSERT_TRUE(internal::AppendStoredSamples(path, records, 0, &error)) << error;
     internal::StoredWindowReader reader;
-    ASSERT_TRUE(reader.Open(path, &error)) << error;
+    ASSERT_TRUE(reader.Open(path, 0, &error)) << error;
     ASSERT_EQ(reader.size(), 10);
     std::vector<Sample> part;
     std::vector<int> file_of;
@@ -317,9 +317,10 @@ TEST(WindowStoreTest, RangesReadAsTheWhole) {
   bad.tension_n[2] = std::nan("");
   std::string error;
   ASSERT_TRUE(internal::AppendStoredSamples(
-      path, {internal::ToStored(Sample(), 0, false), internal::ToStored(bad, 0, false)}, &error));
+      path, {internal::ToStored(Sample(), 0, false), internal::ToStored(bad, 0, false)}, 0,
+      &error));
   internal::StoredWindowReader reader;
-  EXPECT_FALSE(reader.Open(path, &error));
+  EXPECT_FALSE(reader.Open(path, 0, &error));
   EXPECT_NE(error.find("record 1 is not finite"), std::string::npos) << error;
   std::remove(path.c_str());
 }
@@ -337,10 +338,10 @@ TEST(WindowStoreTest, RecordsRoundTripSortedByTime) {
     records.push_back(internal::ToStored(s, k % 2, false));
   }
   std::string error;
-  ASSERT_TRUE(internal::AppendStoredSamples(path, records, &error)) << error;
+  ASSERT_TRUE(internal::AppendStoredSamples(path, records, 0, &error)) << error;
   Dataset data;
   std::vector<int> file_of;
-  ASSERT_TRUE(internal::ReadStoredWindow(path, &data, &file_of, &error)) << error;
+  ASSERT_TRUE(internal::ReadStoredWindow(path, 0, &data, &file_of, &error)) << error;
   ASSERT_EQ(data.samples.size(), 3u);
   EXPECT_EQ(data.samples[0].time_s, 98.0);
   EXPECT_EQ(data.samples[0].line, 12);
@@ -352,8 +353,36 @@ TEST(WindowStoreTest, RecordsRoundTripSortedByTime) {
   std::FILE* f = std::fopen(path.c_str(), "ab");
   std::fputs("abc", f);
   std::fclose(f);
-  EXPECT_FALSE(internal::ReadStoredWindow(path, &data, &file_of, &error));
+  EXPECT_FALSE(internal::ReadStoredWindow(path, 0, &data, &file_of, &error));
   EXPECT_NE(error.find("not a whole number"), std::string::npos) << error;
+}
+
+TEST(WindowStoreTest, JointsRoundTripInWiderRecords) {
+  // A model with moving parts: each record carries its joints (160 + 8 J bytes), and the
+  // store read as another model's width is refused, not misread.
+  constexpr int kJoints = 5;
+  const std::string path = test::TempPath("window_store_joints", ".samples");
+  std::remove(path.c_str());
+  std::vector<internal::StoredSample> records;
+  for (int k = 0; k < 4; ++k) {
+    Sample s;
+    s.time_s = 10.0 + k;
+    s.tension_n.fill(1e5);
+    for (int j = 0; j < kJoints; ++j) s.joint[j] = 0.5 * k + j;
+    records.push_back(internal::ToStored(s, 0, false));
+  }
+  std::string error;
+  ASSERT_TRUE(internal::AppendStoredSamples(path, records, kJoints, &error)) << error;
+  Dataset data;
+  std::vector<int> file_of;
+  ASSERT_TRUE(internal::ReadStoredWindow(path, kJoints, &data, &file_of, &error)) << error;
+  ASSERT_EQ(data.samples.size(), 4u);
+  EXPECT_EQ(data.samples[3].joint[4], 1.5 + 4);
+  EXPECT_EQ(data.samples[3].joint[5], 0.0);  // beyond the model's joints
+  EXPECT_EQ(data.samples[2].tension_n[0], 1e5);
+  EXPECT_FALSE(internal::ReadStoredWindow(path, 2, &data, &file_of, &error));
+  EXPECT_NE(error.find("moving-part joints"), std::string::npos) << error;
+  std::remove(path.c_str());
 }
 
 }  // namespace

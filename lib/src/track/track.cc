@@ -53,14 +53,6 @@ TrackStatus Validate(TrackRun& run) {
   if (!run.window.IsValid(&why)) return run.Fail(TrackStatus::kInvalidInput, "window: " + why);
   if (!run.model.IsValid(&why)) return run.Fail(TrackStatus::kInvalidInput, "model: " + why);
   if (!run.spec.IsValid(&why)) return run.Fail(TrackStatus::kInvalidInput, "spec: " + why);
-  if (!run.model.moving_parts.empty()) {
-    // The window stores keep no joint values yet (window_store.h): a season of a cabin
-    // with moving parts is calibrated one survey or session at a time until they do.
-    return run.Fail(TrackStatus::kInvalidInput,
-                    "model: cabin.moving_parts: track does not follow moving parts yet; "
-                    "calibrate the days as sessions (fastcal calibrate --data=DAY1.csv,DAY2.csv "
-                    "with sessions: {separate: [mass_centre_m]})");
-  }
   for (const ParameterSpec& p : run.spec.parameters) {
     if (!ParameterFitsModel(p, run.model, &why)) {
       return run.Fail(TrackStatus::kInvalidInput, "spec: " + why);

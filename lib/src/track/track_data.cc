@@ -287,7 +287,9 @@ struct Router {
                                      [&](const auto& a) { return a.first == path; })) {
         run.appended.push_back({path, size});
       }
-      if (!AppendStoredSamples(path, samples, run.error)) return false;
+      if (!AppendStoredSamples(path, samples, run.model.moving_parts.num_joints(), run.error)) {
+        return false;
+      }
     }
     // Freed, not cleared: a cleared buffer keeps its capacity, and every window's buffer
     // holding a window's worth was 1.5 GB at 10^7 samples in 100 windows.
@@ -340,6 +342,7 @@ bool ReadFile(Router& router, const std::string& path, std::string* error) {
     return false;
   }
   DatasetReadOptions read = run.options.read;
+  read.joint_columns = run.model.moving_parts.JointColumns();
   read.threads = std::max(read.threads, run.options.threads);
   DatasetChunkReader reader;
   if (!reader.Open(path, read, error)) return false;

@@ -131,8 +131,8 @@ int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Sa
           at->time_s[t] = s.time_s;
           // Consecutive samples are close: each starts from the one before in its chunk.
           if (t == begin) solution.status = StaticsStatus::kInvalidInput;
-          if (SolveStaticsWithParameters(params, s.pose, options, &solution) !=
-              StaticsStatus::kOk) {
+          if (SolveStaticsWithParameters(params, cm.robot().moving_parts, s.joint, s.pose,
+                                         options, &solution) != StaticsStatus::kOk) {
             return t;
           }
           at->starts.Set(t, solution);
@@ -512,8 +512,11 @@ bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<in
 }
 
 bool FoldWindow(const FoldTask& task, WindowFold* fold, std::string* error) {
+  // The store's records carry the model's joints (window_store.h).
+  CableRobot model;
+  if (!ParseCableRobotYaml(task.model_yaml, "the fold task's model", &model, error)) return false;
   internal::StoredWindowReader reader;
-  if (!reader.Open(task.samples_path, error)) return false;
+  if (!reader.Open(task.samples_path, model.moving_parts.num_joints(), error)) return false;
   SampleSource source;
   source.size = reader.size();
   source.name = task.samples_path;

@@ -19,8 +19,18 @@ bool Fail(const std::string& path, const std::string& what, std::string* error) 
   return false;
 }
 
+// The records of `bytes` (whole records of `record` bytes each) into *out.
+void Unpack(const std::vector<char>& bytes, long long count, long long record,
+            StoredSample* out) {
+  for (long long k = 0; k < count; ++k) {
+    out[k] = StoredSample{};
+    std::memcpy(&out[k], bytes.data() + k * record, static_cast<size_t>(record));
+  }
+}
+
 bool IsFinite(const StoredSample& s) {
   bool ok = std::isfinite(s.time_s);
+  for (double v : s.joint) ok = ok && std::isfinite(v);
   for (double v : s.position_m) ok = ok && std::isfinite(v);
   for (double v : s.rotation) ok = ok && std::isfinite(v);
   for (double v : s.tension_n) ok = ok && std::isfinite(v);
@@ -54,14 +64,20 @@ StoredSample ToStored(const Sample& sample, int file, bool planned) {
     for (int col = 0; col < 3; ++col) s.rotation[3 * row + col] = r(row, col);
   }
   for (int i = 0; i < kNumCables; ++i) s.tension_n[i] = sample.tension_n[i];
+  for (int j = 0; j < kMaxJoints; ++j) s.joint[j] = sample.joint[j];
   return s;
 }
 
 bool AppendStoredSamples(const std::string& path, const std::vector<StoredSample>& samples,
-                         std::string* error) {
+                         int joints, std::string* error) {
+  const long long record = RecordBytes(joints);
+  std::vector<char> bytes(samples.size() * record);
+  for (size_t k = 0; k < samples.size(); ++k) {
+    std::memcpy(bytes.data() + k * record, &samples[k], static_cast<size_t>(record));
+  }
   std::FILE* file = std::fopen(path.c_str(), "ab");
   if (file == nullptr) return Fail(path, std::strerror(errno), error);
-  const size_t written = std::fwrite(samples.data(), sizeof(StoredSample), samples.size(), file);
+  const size_t written = std::fwrite(bytes.data(), static_cast<size_t>(record), samples.size(), file);
   const bool closed = std::fclose(file) == 0;
   if (written != samples.size() || !closed) return Fail(path, "cannot write the samples", error);
   return true;
@@ -71,38 +87,47 @@ StoredWindowReader::~StoredWindowReader() {
   if (fd_ >= 0) ::close(fd_);
 }
 
-bool StoredWindowReader::Open(const std::string& path, std::string* error) {
+bool StoredWindowReader::Open(const std::string& path, int joints, std::string* error) {
   path_ = path;
+  joints_ = joints;
+  const long long record = RecordBytes(joints);
   fd_ = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
   if (fd_ < 0) return Fail(path, std::strerror(errno), error);
   // One pass: every record checked, and whether the times ever go back.
-  std::vector<StoredSample> buffer(4096);
+  constexpr long long kChunkRecords = 4096;
+  std::vector<char> bytes(kChunkRecords * record);
+  std::vector<StoredSample> buffer(kChunkRecords);
   bool in_order = true;
   double last_s = -std::numeric_limits<double>::infinity();
   size_ = 0;
   for (;;) {
-    const long long got = ReadAt(fd_, buffer.data(), buffer.size() * sizeof(StoredSample),
-                                 size_ * sizeof(StoredSample));
+    const long long got = ReadAt(fd_, bytes.data(), kChunkRecords * record, size_ * record);
     if (got < 0) return Fail(path, std::strerror(errno), error);
     if (got == 0) break;
-    if (got % static_cast<long long>(sizeof(StoredSample)) != 0) {
-      return Fail(path, "not a whole number of 160-byte sample records (truncated?)", error);
+    if (got % record != 0) {
+      return Fail(path,
+                  "not a whole number of " + std::to_string(record) +
+                      "-byte sample records (truncated, or stored for a model with another "
+                      "number of moving-part joints?)",
+                  error);
     }
-    for (long long k = 0; k < got / static_cast<long long>(sizeof(StoredSample)); ++k) {
+    Unpack(bytes, got / record, record, buffer.data());
+    for (long long k = 0; k < got / record; ++k) {
       if (!IsFinite(buffer[k])) {
         return Fail(path, "record " + std::to_string(size_ + k) + " is not finite", error);
       }
       in_order = in_order && buffer[k].time_s >= last_s;
       last_s = buffer[k].time_s;
     }
-    size_ += got / static_cast<long long>(sizeof(StoredSample));
+    size_ += got / record;
   }
   if (in_order) return true;
   sorted_.resize(size_);
-  const long long bytes = size_ * static_cast<long long>(sizeof(StoredSample));
-  if (ReadAt(fd_, sorted_.data(), bytes, 0) != bytes) {
+  bytes.resize(size_ * record);
+  if (ReadAt(fd_, bytes.data(), size_ * record, 0) != size_ * record) {
     return Fail(path, "cannot read the samples", error);
   }
+  Unpack(bytes, size_, record, sorted_.data());
   std::stable_sort(
       sorted_.begin(), sorted_.end(),
       [](const StoredSample& a, const StoredSample& b) { return a.time_s < b.time_s; });
@@ -120,12 +145,13 @@ bool StoredWindowReader::Read(long long first, int count, std::vector<Sample>* s
   std::vector<StoredSample> own;
   const StoredSample* records = sorted_.data() + first;
   if (sorted_.empty()) {
-    own.resize(count);
-    const long long bytes = count * static_cast<long long>(sizeof(StoredSample));
-    if (ReadAt(fd_, own.data(), bytes, first * static_cast<long long>(sizeof(StoredSample))) !=
-        bytes) {
+    const long long record = RecordBytes(joints_);
+    std::vector<char> bytes(count * record);
+    if (ReadAt(fd_, bytes.data(), count * record, first * record) != count * record) {
       return Fail(path_, "cannot read the samples", error);
     }
+    own.resize(count);
+    Unpack(bytes, count, record, own.data());
     records = own.data();
   }
   samples->assign(count, Sample());
@@ -140,15 +166,16 @@ bool StoredWindowReader::Read(long long first, int count, std::vector<Sample>* s
       for (int col = 0; col < 3; ++col) s.pose.rotation(row, col) = r.rotation[3 * row + col];
     }
     for (int i = 0; i < kNumCables; ++i) s.tension_n[i] = r.tension_n[i];
+    for (int j = 0; j < joints_; ++j) s.joint[j] = r.joint[j];
     (*file_of)[k] = r.file;
   }
   return true;
 }
 
-bool ReadStoredWindow(const std::string& path, Dataset* data, std::vector<int>* file_of,
-                      std::string* error) {
+bool ReadStoredWindow(const std::string& path, int joints, Dataset* data,
+                      std::vector<int>* file_of, std::string* error) {
   StoredWindowReader reader;
-  if (!reader.Open(path, error)) return false;
+  if (!reader.Open(path, joints, error)) return false;
   if (!reader.Read(0, static_cast<int>(reader.size()), &data->samples, file_of, error)) {
     return false;
   }

@@ -2,11 +2,13 @@
 // "Tracking: files"): what a window's fold reads, on this machine or on a Dask worker
 // that sees the same path, without parsing the telemetry again.
 //
-// Each sample is one 160-byte record of little-endian fields:
+// Each sample is one record of little-endian fields:
 //   time_s (f64), line (i32), file (i32: index into the track's files),
 //   position_m[3] (f64), rotation[9] (f64, row-major: the attitude the fit uses, measured
-//   or planned as the spec says), tension_n[6] (f64)
-// in the order the samples were read; a fold sorts them by time (stably).
+//   or planned as the spec says), tension_n[6] (f64),
+//   and for a model with moving parts joint[J] (f64, the model's J joints: Sample::joint)
+// 160 + 8 J bytes (160 for a rigid cabin, as before moving parts), in the order the
+// samples were read; a fold sorts them by time (stably).
 #ifndef FASTCAL_INTERNAL_WINDOW_STORE_H_
 #define FASTCAL_INTERNAL_WINDOW_STORE_H_
 
@@ -25,15 +27,19 @@ struct StoredSample {
   double position_m[3];
   double rotation[9];
   double tension_n[6];
+  double joint[kMaxJoints];  // the first `joints` of them on disk (RecordBytes)
 };
-static_assert(sizeof(StoredSample) == 160, "the store's record layout");
+static_assert(sizeof(StoredSample) == 160 + 8 * kMaxJoints, "the store's record layout");
+
+// A record's bytes on disk for a model of `joints` joints (0..kMaxJoints).
+inline long long RecordBytes(int joints) { return 160 + 8LL * joints; }
 
 // The record of a sample (its attitude: the planned one when `planned`).
 StoredSample ToStored(const Sample& sample, int file, bool planned);
 
-// Appends records to `path` (created if absent).
+// Appends records of `joints` joints each to `path` (created if absent).
 bool AppendStoredSamples(const std::string& path, const std::vector<StoredSample>& samples,
-                         std::string* error);
+                         int joints, std::string* error);
 
 // A window's records in time order (stably sorted), read a range at a time: a fold's
 // passes stream a window through it, so that its samples are never all in memory as
@@ -50,7 +56,7 @@ class StoredWindowReader {
 
   // Reads every record once: refuses a file whose size is not a whole number of records,
   // and a record that is not finite (named by its index in the file).
-  bool Open(const std::string& path, std::string* error);
+  bool Open(const std::string& path, int joints, std::string* error);
   long long size() const { return size_; }
   // Records [first, first + count) of the time order as samples (pose: the stored
   // attitude; session 0) and each one's file index. Safe from several threads at once.
@@ -61,13 +67,14 @@ class StoredWindowReader {
   std::string path_;
   int fd_ = -1;
   long long size_ = 0;
+  int joints_ = 0;
   std::vector<StoredSample> sorted_;  // the records, when the file is not in time order
 };
 
 // Reads a window's records into data->samples, sorted by time (stably), and each one's
 // file index into *file_of (parallel to the samples). Refuses what Open refuses.
-bool ReadStoredWindow(const std::string& path, Dataset* data, std::vector<int>* file_of,
-                      std::string* error);
+bool ReadStoredWindow(const std::string& path, int joints, Dataset* data,
+                      std::vector<int>* file_of, std::string* error);
 
 }  // namespace fastcal::internal
 
