@@ -153,7 +153,7 @@ def calibrate(
     elif not isinstance(model, Model):
         model = Model.load(os.fspath(model))
     if not isinstance(data, Dataset):
-        data = read_dataset(data)
+        data = read_dataset(data, model=model)
     spec_text, is_text, source = _spec_argument(spec)
     try:
         raw = _fastcal.calibrate(model, spec_text, is_text, source, data)
@@ -189,5 +189,5 @@ def evaluate(
     elif not isinstance(model, Model):
         model = Model.load(os.fspath(model))
     if not isinstance(data, Dataset):
-        data = read_dataset(data)
+        data = read_dataset(data, model=model)
     return _fastcal.evaluate(model, data, method)

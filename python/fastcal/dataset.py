@@ -119,6 +119,7 @@ def read_dataset(
     skip_invalid_rows: bool = False,
     columns: Optional[ColumnsLike] = None,
     sheet: Optional[Union[str, int]] = None,
+    model: Optional[Model] = None,
 ) -> Dataset:
     """Reads telemetry (docs/data-format.md): a canonical CSV, an export through a
     column map, or a sheet of an .xlsx workbook; or several files as one session each.
@@ -140,6 +141,9 @@ def read_dataset(
             lines (row numbers in messages are the sheet's), with the map's header_line,
             skip_after_header, units and time stamps; date cells are read as dates and
             times in the map's zone.
+        model: the model the data are for: with moving parts (Model.joint_columns) its
+            joint columns are read (Dataset.joints) and a file lacking any is an error
+            naming them. None: no joint columns.
 
     Raises InputError naming the file (the sheet), line (row) and column, e.g.
     "data.csv:12: column 'T3_kN': 'abc' is not a number" or, through a map,
@@ -151,6 +155,7 @@ def read_dataset(
     else:
         paths = [os.fspath(p) for p in path]
     map_text, map_source = _columns_argument(columns)
+    joints = list(model.joint_columns) if model is not None else []
     for p in paths:
         if str(p).lower().endswith((".xls", ".ods")):
             raise InputError(
@@ -170,13 +175,13 @@ def read_dataset(
         text, source = _spreadsheet_text(paths[0], sheet, decimal)
         return _map_errors(
             lambda: _fastcal.parse_dataset(
-                text, source, skip_invalid_rows, map_text, map_source, False
+                text, source, skip_invalid_rows, map_text, map_source, False, joints
             )
         )
     if sheet is not None:
         raise InputError(f"read_dataset: sheet= is for an .xlsx workbook, not {paths[0]}")
     return _map_errors(
-        lambda: _fastcal.read_dataset(paths, skip_invalid_rows, map_text, map_source)
+        lambda: _fastcal.read_dataset(paths, skip_invalid_rows, map_text, map_source, joints)
     )
 
 

@@ -157,8 +157,10 @@ namespace {
 
 // One file, or several merged as one session each (sessions.h).
 Dataset ReadDatasetOrThrow(const std::vector<std::string>& paths, bool skip_invalid_rows,
-                           const std::string& map_text, const std::string& map_source) {
+                           const std::string& map_text, const std::string& map_source,
+                           const std::vector<std::string>& joint_columns) {
   DatasetReadOptions options;
+  options.joint_columns = joint_columns;
   options.skip_invalid_rows = skip_invalid_rows;
   options.columns = MapOrThrow(map_text, map_source, false, false);
   Dataset data;
@@ -245,6 +247,19 @@ the order of their first sample, empty without; session (n,) each sample's index
                                  for (int k = 0; k < 3; ++k) o[k] = s.planned_rpy_deg[k];
                                });
                              })
+      .def_readonly("joint_columns", &Dataset::joint_columns,
+                    "The moving parts' joint columns read (a model's, read_dataset(model=...)); "
+                    "empty without.")
+      .def_property_readonly("joints",
+                             [](const Dataset& d) -> py::object {
+                               const int n = static_cast<int>(d.joint_columns.size());
+                               if (n == 0) return py::none();
+                               return PerSample(d, n, [n](const Sample& s, double* o) {
+                                 for (int j = 0; j < n; ++j) o[j] = s.joint[j];
+                               });
+                             },
+                             "Joint values (n, J) in joint_columns order and their units (deg, "
+                             "m); None without joint columns.")
       .def_property_readonly("s0_m",
                              [](const Dataset& d) -> py::object {
                                if (!d.has_unstretched_lengths) return py::none();
@@ -295,8 +310,10 @@ py::tuple SimulateFromArrays(const CableRobot& truth_argument, const DoubleArray
 // file is: ParseDataset with the map (if any).
 Dataset ParseDatasetOrThrow(const std::string& text, const std::string& source_name,
                             bool skip_invalid_rows, const std::string& map_text,
-                            const std::string& map_source, bool header_first) {
+                            const std::string& map_source, bool header_first,
+                            const std::vector<std::string>& joint_columns) {
   DatasetReadOptions options;
+  options.joint_columns = joint_columns;
   options.skip_invalid_rows = skip_invalid_rows;
   options.columns = MapOrThrow(map_text, map_source, true, header_first);
   Dataset data;
@@ -372,10 +389,11 @@ std::string CanonicalText(const std::vector<std::string>& names, const DoubleArr
 void BindData(py::module_& m) {
   BindDatasetClass(m);
   m.def("read_dataset", &ReadDatasetOrThrow, py::arg("paths"), py::arg("skip_invalid_rows"),
-        py::arg("map_text") = "", py::arg("map_source") = "");
+        py::arg("map_text") = "", py::arg("map_source") = "",
+        py::arg("joint_columns") = std::vector<std::string>());
   m.def("parse_dataset", &ParseDatasetOrThrow, py::arg("text"), py::arg("source_name"),
         py::arg("skip_invalid_rows"), py::arg("map_text"), py::arg("map_source"),
-        py::arg("header_first"));
+        py::arg("header_first"), py::arg("joint_columns") = std::vector<std::string>());
   m.def("canonical_text", &CanonicalText);
   m.def("column_map_decimal", [](const std::string& map_text, const std::string& map_source) {
     return std::string(1, MapOrThrow(map_text, map_source, false, false)->decimal);

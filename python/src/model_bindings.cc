@@ -1,5 +1,7 @@
 // fastcal.Model: the cable robot's parameters (cable_robot.h), its YAML file, and each
 // field as a number or a numpy array (per cable: shape (6,), per point: (n, 3)).
+#include <pybind11/stl.h>
+
 #include <array>
 #include <cmath>
 #include <string>
@@ -280,6 +282,26 @@ ValueError ("assignment destination is read-only") instead of changing nothing.
             r.mass_centre_cabin_m = ToVector3(v, "mass_centre_cabin_m");
           }),
           "Mass centre of the cabin in the cabin frame, shape (3,).")
+      .def_property_readonly(
+          "joint_columns",
+          [](const CableRobot& r) { return r.moving_parts.JointColumns(); },
+          "The data columns of the moving parts' joints (cabin.moving_parts, "
+          "docs/model-format.md), in the model's joint order; empty for a rigid cabin.")
+      .def(
+          "mass_centre_at",
+          [](const CableRobot& r, const std::vector<double>& joints) {
+            const int n = r.moving_parts.num_joints();
+            if (static_cast<int>(joints.size()) != n) {
+              throw InputError("mass_centre_at: the model has " + std::to_string(n) +
+                               " joints, got " + std::to_string(joints.size()) + " values");
+            }
+            JointValues q{};
+            for (int j = 0; j < n; ++j) q[j] = joints[j];
+            return Vector3(r.MassCentreAt(q));
+          },
+          py::arg("joints"),
+          "The mass centre (cabin frame, m, shape (3,)) with the moving parts at `joints` "
+          "(joint_columns order, deg and m): docs/model.md, \"Moving parts\".")
       .def_property("reflector", &GetReflector, Validated<const py::object&>(&SetReflector),
                     "The reflector cables are checked against: None, or a dict {centre_m (3,), "
                     "radius_m, aperture_m} (a sphere's lower cap; docs/model-format.md). Assign a "
