@@ -5,7 +5,7 @@ from __future__ import annotations
 import os
 import re
 import warnings
-from typing import Any, Dict, List, Mapping, Optional, Union
+from typing import Any, Dict, List, Mapping, Optional, Tuple, Union
 
 import numpy as np
 
@@ -13,7 +13,6 @@ from . import _fastcal
 from ._fastcal import CalibrationError, Dataset, InputError, Model
 
 from ._common import PathLike, _DICT_SPEC, _spec_argument
-from .statics import line
 from .dataset import read_dataset
 
 
@@ -119,6 +118,20 @@ class CalibrationResult:
         return f"<fastcal.CalibrationResult: {self.verdict}; {shown}>"
 
 
+def _model_and_data(
+    model: Optional[Union[Model, PathLike]], data: Union[Dataset, PathLike]
+) -> Tuple[Model, Dataset]:
+    """The model (nominal, or loaded from its file) and the data (read with the model's
+    joint columns when given as a path)."""
+    if model is None:
+        model = Model.nominal()
+    elif not isinstance(model, Model):
+        model = Model.load(os.fspath(model))
+    if not isinstance(data, Dataset):
+        data = read_dataset(data, model=model)
+    return model, data
+
+
 def calibrate(
     spec: Union[PathLike, Mapping[str, Any]],
     data: Union[Dataset, PathLike],
@@ -148,12 +161,7 @@ def calibrate(
             model cannot hold a sample's pose: the line is named), 'solver failed' or
             'mostly gross errors'.
     """
-    if model is None:
-        model = Model.nominal()
-    elif not isinstance(model, Model):
-        model = Model.load(os.fspath(model))
-    if not isinstance(data, Dataset):
-        data = read_dataset(data, model=model)
+    model, data = _model_and_data(model, data)
     spec_text, is_text, source = _spec_argument(spec)
     try:
         raw = _fastcal.calibrate(model, spec_text, is_text, source, data)
@@ -184,10 +192,5 @@ def evaluate(
         InputError: a bad file or method. CalibrationError ('infeasible'): the model
         cannot hold a sample's pose (its line is named).
     """
-    if model is None:
-        model = Model.nominal()
-    elif not isinstance(model, Model):
-        model = Model.load(os.fspath(model))
-    if not isinstance(data, Dataset):
-        data = read_dataset(data, model=model)
+    model, data = _model_and_data(model, data)
     return _fastcal.evaluate(model, data, method)

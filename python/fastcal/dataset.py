@@ -15,7 +15,7 @@ from . import _fastcal
 from ._fastcal import Dataset, InputError, Model
 
 from ._common import ArrayLike, PathLike, _INT32_MAX, _UINT64_MAX, _attitude, _call_with_names, _number, _rows, _whole
-from .statics import ColumnsLike, _DICT_COLUMNS, _SPREADSHEET_SUFFIXES, line, solve
+from .statics import ColumnsLike, _DICT_COLUMNS, _SPREADSHEET_SUFFIXES
 
 
 def _columns_argument(columns: Optional[ColumnsLike]) -> Tuple[str, str]:

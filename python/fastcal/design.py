@@ -10,7 +10,6 @@ from . import _fastcal
 from ._fastcal import InputError, Model
 
 from ._common import PathLike, _DICT_SPEC, _INT32_MAX, _UINT64_MAX, _number, _renamed_keywords, _spec_argument, _whole
-from .calibration import calibrate
 
 
 @_renamed_keywords({"sample_interval_s": "interval_s"})

@@ -9,7 +9,7 @@ import numpy as np
 from . import _fastcal
 from ._fastcal import InputError, Model
 
-from ._common import ArrayLike, PathLike, STATUS_NAMES, _INT32_MAX, _INT32_MIN, _SOLVE_OPTION_FIELDS, _STATUS_NAMES_ARRAY, _UINT64_MAX, _attitude, _call_with_names, _number, _point, _renamed_keywords, _rows, _spec_argument, _whole
+from ._common import ArrayLike, PathLike, _INT32_MAX, _INT32_MIN, _SOLVE_OPTION_FIELDS, _STATUS_NAMES_ARRAY, _UINT64_MAX, _attitude, _call_with_names, _number, _point, _renamed_keywords, _rows, _spec_argument, _whole
 
 
 class StaticsResult:

@@ -2,9 +2,7 @@
 
 from __future__ import annotations
 
-import json
 import os
-import re
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -13,8 +11,8 @@ from . import _fastcal
 from ._fastcal import CalibrationError, InputError, Model
 
 from ._common import PathLike, _spec_argument
-from .statics import ColumnsLike, line, solve
-from .dataset import _columns_argument, _map_errors, read_dataset
+from .statics import ColumnsLike
+from .dataset import _columns_argument, _map_errors
 
 
 class TrackResult:
