@@ -24,6 +24,7 @@
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
+#include "fastcal/version.h"
 
 namespace fastcal::cli {
 
@@ -221,6 +222,13 @@ bool StartCommand(int argc, char** argv, const std::string& command, const char*
     std::cout << help;
     *exit_code = 0;
     return false;
+  }
+  for (int i = 2; i < argc; ++i) {  // `fastcal CMD --version`, as `fastcal --version`
+    if (std::string(argv[i]) == "--version") {
+      std::cout << "fastcal " << FASTCAL_VERSION << "\n";
+      *exit_code = 0;
+      return false;
+    }
   }
   std::vector<std::string> args, notes;
   std::string error;

@@ -39,7 +39,7 @@ Commands:
   import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
              comma), read through a column map, written as the canonical dataset CSV
 
-Run 'fastcal <command> --help' for the flags of a command. Documentation: docs/cli.md.
+Run 'fastcal <command> --help' (or 'fastcal help <command>') for the flags of a command. Documentation: docs/cli.md.
 )";
 }  // namespace
 }  // namespace fastcal::cli
@@ -100,7 +100,11 @@ int main(int argc, char** argv) {
   InstallCheckedStdout();  // every result on stdout checked (FinishStandardOutput)
   const std::string command = argc < 2 ? std::string() : argv[1];
   int code = 0;
-  if (argc < 2 || command == "--help" || command == "-h" || command == "help") {
+  if (command == "help" && argc >= 3) {
+    // `fastcal help CMD`: the command's own help, as `fastcal CMD --help`.
+    std::vector<char*> args = {argv[0], argv[2], const_cast<char*>("--help")};
+    code = RunCommand(argv[2], static_cast<int>(args.size()), args.data());
+  } else if (argc < 2 || command == "--help" || command == "-h" || command == "help") {
     // Asked for: the usage on stdout, exit 0; no command at all is a usage error.
     (argc < 2 ? std::cerr : std::cout) << kUsage;
     code = argc < 2 ? kExitUsage : 0;

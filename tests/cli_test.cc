@@ -196,6 +196,16 @@ TEST_F(CliTest, SimulateCalibrateEvaluateRoundTrip) {
   // The version from its one place, the CMake project version (fastcal/version.h).
   EXPECT_NE(json.find("\"software_version\": \"" FASTCAL_VERSION "\""), std::string::npos);
   EXPECT_EQ(Fastcal("--version").output, "fastcal " FASTCAL_VERSION "\n");
+  // Every command answers --version too, and `fastcal help CMD` is CMD's own help.
+  for (const char* command : {"calibrate", "solve", "track"}) {
+    const CommandResult v = Fastcal(std::string(command) + " --version");
+    EXPECT_EQ(v.code, 0) << command;
+    EXPECT_EQ(v.output, "fastcal " FASTCAL_VERSION "\n") << command;
+    const CommandResult help = Fastcal(std::string("help ") + command);
+    EXPECT_EQ(help.code, 0) << command;
+    EXPECT_EQ(help.output, Fastcal(std::string(command) + " --help").output) << command;
+    EXPECT_NE(help.output.find(std::string("fastcal ") + command + ":"), std::string::npos);
+  }
   EXPECT_NE(json.find("\"model\": {\n      \"path\": null,\n      \"sha256\": null"),
             std::string::npos)
       << "the built-in model has no file";
