@@ -267,6 +267,9 @@ TEST(Design, BadInput) {
   o.time_budget_s = 10.0;  // 20 samples at 1 s need 20 s
   EXPECT_FALSE(DesignSurvey(robot, Spec(), o, &d, &error));
   EXPECT_NE(error.find("infeasible time budget"), std::string::npos) << error;
+  // Minutes as a person reads them, three digits at most ("11.6 min", not "11.6164 min").
+  EXPECT_TRUE(std::regex_search(error, std::regex(R"(\d min)"))) << error;
+  EXPECT_FALSE(std::regex_search(error, std::regex(R"(\d\.\d{4,} min)"))) << error;
   o.time_budget_s = 0.0;
   o.wanted = {"cabin_mass_kg"};
   EXPECT_FALSE(DesignSurvey(robot, Spec(), o, &d, &error));

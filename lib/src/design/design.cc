@@ -33,6 +33,13 @@ std::string Num(double v) {
   return b;
 }
 
+// Minutes for a person: "11.6 min", not "11.6164 min" (issue 39).
+std::string Minutes(double seconds) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.3g min", seconds / 60.0);
+  return b;
+}
+
 DesignSums Combine(const DesignSums& a, double wa, const DesignSums& b, double wb) {
   return {wa * a.m + wb * b.m, wa * a.c + wb * b.c};
 }
@@ -228,17 +235,17 @@ bool KeepWithinBudget(const DesignProblem& pr, const std::vector<DesignCandidate
   if (o.time_budget_s <= 0.0) return true;
   if (d->dwell_s > o.time_budget_s) {
     *error = "infeasible time budget: " + std::to_string(o.samples) + " samples at " +
-             Num(o.sample_interval_s) + " s each take " + Num(d->dwell_s / 60.0) +
-             " min before the cabin moves at all, more than the " + Num(o.time_budget_s / 60.0) +
-             " min allowed; ask for fewer samples or more time";
+             Num(o.sample_interval_s) + " s each take " + Minutes(d->dwell_s) +
+             " before the cabin moves at all, more than the " + Minutes(o.time_budget_s) +
+             " allowed; ask for fewer samples or more time";
     return false;
   }
   while (d->duration_s > o.time_budget_s) {
     if (!DropOneStop(pr, o, counts)) {
       *error = "infeasible time budget: the fewest stops that still determine the parameters (" +
-               std::to_string(d->stops.size()) + ") take " + Num(d->duration_s / 60.0) +
-               " min at " + Num(o.speed_m_per_s) + " m/s, more than the " +
-               Num(o.time_budget_s / 60.0) + " min allowed";
+               std::to_string(d->stops.size()) + ") take " + Minutes(d->duration_s) + " at " +
+               Num(o.speed_m_per_s) + " m/s, more than the " + Minutes(o.time_budget_s) +
+               " allowed";
       return false;
     }
     FlyStops(candidates, *counts, o, d);
