@@ -402,7 +402,7 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     run.result->slow_error.enabled = true;
     run.result->slow_error.process = run.slow;
     run.result->notes.push_back(
-        "an update keeps the slow error the track was built with (refold_all re-estimates it)");
+        "an update keeps the slow error the track was built with (--refold re-estimates it)");
     slow_settled = !run.options.refold_all;
   }
   run.result->slow_error.enabled = run.spec.slow_error.enabled;
