@@ -791,6 +791,18 @@ int RunSimulate(int argc, char** argv) {
                 " s); its average over the samples was (" + FormatDouble(m.x(), 6) + ", " +
                 FormatDouble(m.y(), 6) + ", " + FormatDouble(m.z(), 6) + ") m.";
     }
+    // The steps, as simulate --help promises: the truth written out is before any of them.
+    const TimeDisplay display = TimeDisplayFor(options.start_time_s, 0);
+    for (const MassCentreStep& step : options.mass_centre_steps) {
+      header += "\nMass centre step at " + TimeText(step.time_s, display) + ": (" +
+                FormatDouble(step.shift_m.x(), 6) + ", " + FormatDouble(step.shift_m.y(), 6) +
+                ", " + FormatDouble(step.shift_m.z(), 6) + ") m, added from then on";
+    }
+    for (const SensorBiasStep& step : options.sensor_bias_steps) {
+      header += "\nSensor step at " + TimeText(step.time_s, display) + ": cable " +
+                std::to_string(step.cable + 1) + "'s bias " +
+                FormatDouble(step.shift_n / 1e3, 6) + " kN, added from then on";
+    }
     if (summary.session_bias_n.size() > 1 && options.sensor_rezero_kn > 0.0) {
       header +=
           "\nSensors re-zeroed at each new session; the biases (kN) per session, cables "

@@ -354,3 +354,26 @@ TEST_F(UsabilityTest, ConsoleNotesAreCutAtAWord) {
 }
 
 }  // namespace
+
+namespace fastcal::test {
+namespace {
+
+TEST_F(UsabilityTest, TheTruthFileListsTheStepsAsTheHelpSays) {
+  // simulate --help: "its header lists the steps"; it did not (issue 39).
+  const CommandResult r = Fastcal(
+      "simulate --trajectory=random --samples=50 --days=2 --start=2024-05-01T20:00:00Z "
+      "--mass-centre-step=2024-05-02T20:00:00Z:0.05,0,0 "
+      "--sensor-step=2024-05-02T21:00:00Z:3:5 --out=" +
+      Path("s.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::string truth = ReadFile(Path("s.truth.yaml"));
+  EXPECT_NE(truth.find("# Mass centre step at 2024-05-02 20:00:00 UTC: (0.05, 0, 0) m"),
+            std::string::npos)
+      << truth;
+  EXPECT_NE(truth.find("# Sensor step at 2024-05-02 21:00:00 UTC: cable 3's bias 5 kN"),
+            std::string::npos)
+      << truth;
+}
+
+}  // namespace
+}  // namespace fastcal::test
