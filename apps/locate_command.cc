@@ -376,6 +376,9 @@ std::string RowName(const std::vector<Row>& rows, size_t n) {
 
 std::string Csv(const std::vector<Row>& rows, const std::vector<Answer>& answers) {
   std::ostringstream out;
+  // A string stream that runs out of memory only sets badbit and returns what it has:
+  // a truncated table written with exit 0 (issue 37). Out of memory is thrown instead.
+  out.exceptions(std::ios::badbit);
   out << "row,line,time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status,stability";
   for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
   out << ",sigma_x_m,sigma_y_m,sigma_z_m,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg"
@@ -409,6 +412,9 @@ std::string Csv(const std::vector<Row>& rows, const std::vector<Answer>& answers
 std::string Findings(const std::vector<Row>& rows, const std::vector<Answer>& answers,
                      size_t* failed) {
   std::ostringstream s;
+  // A string stream that runs out of memory only sets badbit and returns what it has:
+  // a truncated table written with exit 0 (issue 37). Out of memory is thrown instead.
+  s.exceptions(std::ios::badbit);
   size_t unstable = 0, others = 0, compared = 0, worst_row = 0, misfits = 0;
   std::string first_unusual, first_misfit;
   double sum2 = 0.0, worst = 0.0;

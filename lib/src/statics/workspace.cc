@@ -171,6 +171,9 @@ std::string WorkspaceNodeCode(const WorkspaceNode& node) {
 
 std::string WorkspaceCsv(const WorkspaceMap& map) {
   std::ostringstream out;
+  // A string stream that runs out of memory only sets badbit and returns what it has:
+  // a truncated table written with exit 0 (issue 37). Out of memory is thrown instead.
+  out.exceptions(std::ios::badbit);
   out << "radial_offset_m,off_axis_deg,azimuth_deg,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,"
          "status,cable,min_tension_kN,min_tension_cable,max_tension_kN,max_tension_cable,"
          "max_upper_tension_kN,message\n";
