@@ -358,6 +358,14 @@ TEST_F(UsabilityTest, ConsoleNotesAreCutAtAWord) {
 namespace fastcal::test {
 namespace {
 
+TEST_F(UsabilityTest, TrackRefusesAnAbsurdThreadCount) {
+  // --threads=100000 was accepted (issue 37): the bound is calibrate's, 256.
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=50 --out=" + Path("s.csv")).code, 0);
+  RunBoundedAndExpect({"track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=" +
+                           Path("s.csv") + " --out=" + Path("t") + " --threads=100000",
+                       2, "--threads must be 1 to 256, got 100000"});
+}
+
 TEST_F(UsabilityTest, TheTruthFileListsTheStepsAsTheHelpSays) {
   // simulate --help: "its header lists the steps"; it did not (issue 39).
   const CommandResult r = Fastcal(

@@ -89,6 +89,7 @@ struct TrackOptions {
   // One line per stage and iteration; the library never prints.
   std::function<void(const std::string&)> progress;
   // Folds run at once on this machine (one window each; a lone window uses them all).
+  // 1 to kMaxCalibrationThreads (256).
   int threads = 2;
   // Null: fold on this machine's threads.
   FoldRunner runner;

@@ -193,8 +193,9 @@ std::string WindowSpecText(const WindowSpec& window) {
 
 bool TrackOptions::IsValid(std::string* error) const {
   std::string why;
-  if (threads < 1)
-    why = "threads must be >= 1";
+  if (threads < 1 || threads > kMaxCalibrationThreads)
+    why = "threads must be 1 to " + std::to_string(kMaxCalibrationThreads) + ", got " +
+          std::to_string(threads);
   else if (max_iterations < 1)
     why = "max_iterations must be >= 1";
   else if (!(step_tolerance_sigmas > 0.0))
