@@ -366,6 +366,23 @@ TEST_F(UsabilityTest, TrackRefusesAnAbsurdThreadCount) {
                        2, "--threads must be 1 to 256, got 100000"});
 }
 
+TEST_F(UsabilityTest, ADataDirectoryReadsCsvInAnyCaseAndNoHiddenFile) {
+  // *.CSV was skipped and a hidden .x.csv read (issue 37).
+  fs::create_directories(Path("days"));
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=300 --start=2024-05-01T20:00:00Z "
+                    "--out=" +
+                    Path("days/A.CSV"))
+                .code,
+            0);
+  Write("days/.x.csv", "not a dataset\n");
+  const CommandResult r = Fastcal("track --spec=" + Source() +
+                                  "/calibration_data/spec_track.yaml --data=" + Path("days") +
+                                  " --out=" + Path("t"));
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("A.CSV"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find(".x.csv"), std::string::npos) << r.output;
+}
+
 TEST_F(UsabilityTest, TheTruthFileListsTheStepsAsTheHelpSays) {
   // simulate --help: "its header lists the steps"; it did not (issue 39).
   const CommandResult r = Fastcal(

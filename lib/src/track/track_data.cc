@@ -5,6 +5,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <limits>
@@ -381,7 +382,14 @@ TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<s
     }
     std::vector<std::string> csv;
     for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
-      if (e.is_regular_file() && e.path().extension() == ".csv") csv.push_back(e.path().string());
+      // *.csv in any case (FAST's exports say .CSV); hidden files (an editor's .x.csv, a
+      // sync tool's) are not data (issue 37).
+      std::string extension = e.path().extension().string();
+      for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      const std::string name = e.path().filename().string();
+      if (e.is_regular_file() && extension == ".csv" && !name.empty() && name[0] != '.') {
+        csv.push_back(e.path().string());
+      }
     }
     std::sort(csv.begin(), csv.end());
     if (csv.empty()) {
