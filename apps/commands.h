@@ -25,6 +25,7 @@ int RunWorkspace(int argc, char** argv);
 int RunDesign(int argc, char** argv);
 int RunImport(int argc, char** argv);
 int RunTrack(int argc, char** argv);
+int RunModes(int argc, char** argv);
 
 // Positions of the trajectory `kind` (circle, line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.
@@ -72,6 +73,11 @@ bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitu
 // The workspace's grid, focal law, tension limits and statics checks from its flags
 // (workspace, design); false with the flags named when invalid.
 bool WorkspaceOptionsFromFlags(WorkspaceOptions* options, std::string* error);
+
+// One cabin pose from --position with its attitude (--rpy, --quat, --rotvec or
+// --attitude-law=focal|none with --tilt-fraction and --focal-centre; R = I without
+// one), as solve takes it; *attitude says which, for summaries.
+bool SinglePoseFromFlags(Pose* pose, std::string* attitude, std::string* error);
 
 // Sets the model-range limits of `options` from --max-strain, --max-length-ratio and
 // --reflector-clearance (solve, workspace); false with the flags named when invalid.
