@@ -79,6 +79,12 @@ bool WorkspaceOptionsFromFlags(WorkspaceOptions* options, std::string* error);
 // one), as solve takes it; *attitude says which, for summaries.
 bool SinglePoseFromFlags(Pose* pose, std::string* attitude, std::string* error);
 
+// `message` of a FocalGridSpec (`grid.`) or FocalAttitudeLaw (`attitude_law.`) field
+// with the flags that set it (--max-off-axis-deg, ..., --tilt-fraction), and the
+// command's own fields in `more` (field, flag) (workspace, modes --cap).
+std::string WithGridFlagNames(const std::string& message,
+                              std::vector<std::pair<std::string, std::string>> more = {});
+
 // Sets the model-range limits of `options` from --max-strain, --max-length-ratio and
 // --reflector-clearance (solve, workspace); false with the flags named when invalid.
 bool ModelRangeFromFlags(StaticsOptions* options, std::string* error);

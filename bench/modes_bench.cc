@@ -1,6 +1,7 @@
 // Time of one pose's modes (modes.h): the exact statics, the chains' assembly and the
 // eigenproblem for the 20 lowest modes, at the zenith and 40 deg off axis (focal law),
-// for several segment counts (range(0)); the default is ModesOptions().segments.
+// for several segment counts (range(0)); the default is ModesOptions().segments. And the
+// map of the focal-sphere cap (193 poses).
 // Run: build/bench/modes_bench --benchmark_min_time=0.5
 #include <benchmark/benchmark.h>
 
@@ -8,6 +9,7 @@
 #include <string>
 
 #include "fastcal/modes.h"
+#include "fastcal/modes_map.h"
 
 namespace fastcal {
 namespace {
@@ -45,6 +47,23 @@ BENCHMARK(BM_Modes)
     ->Args({ModesOptions().segments, 40})
     ->Args({64, 0})
     ->Unit(benchmark::kMillisecond);
+
+// The map of the cap (modes_map.h) at its defaults: 193 poses, 20 modes each.
+void BM_ModesMap(benchmark::State& state) {
+  const CableRobot robot = CableRobot::NominalFast();
+  ModesMapOptions options;
+  ModesMap map;
+  std::string error;
+  for (auto _ : state) {
+    if (!ComputeModesMap(robot, options, &map, &error)) {
+      state.SkipWithError(error.c_str());
+      break;
+    }
+    benchmark::DoNotOptimize(map.nodes.data());
+  }
+  state.counters["poses"] = static_cast<double>(map.nodes.size());
+}
+BENCHMARK(BM_ModesMap)->Unit(benchmark::kSecond)->Iterations(1);
 
 }  // namespace
 }  // namespace fastcal

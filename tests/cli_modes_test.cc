@@ -1,6 +1,7 @@
 // End-to-end tests of `fastcal modes` (apps/modes_command.cc): the CSV and its summary,
 // atomic output and --force, and bad input named by its flag with exit 2 (no output) or a
 // pose without equilibrium with exit 1.
+#include <algorithm>
 #include <string>
 #include <vector>
 
@@ -47,6 +48,24 @@ TEST_F(CliTest, ModesWritesAscendingModesWithSharesSummingToOne) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
   EXPECT_EQ(Fastcal(args + " --force --modes=5 --attitude-law=focal").code, 0);
+}
+
+// --cap: a CSV row per node and the HTML map, written together; flags of one pose refused.
+TEST_F(CliTest, ModesCapWritesCsvAndMap) {
+  const std::string csv = Path("cap.csv"), html = Path("cap.html");
+  const std::string args =
+      "modes --cap --max-off-axis-deg=20 --off-axis-step-deg=10 --azimuth-step-deg=90 "
+      "--segments=12 --output=" +
+      csv + " --html=" + html;
+  CommandResult r = Fastcal(args);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("9 of 9 nodes with modes"), std::string::npos) << r.output;
+  const std::string text = ReadFile(csv);
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 10);
+  EXPECT_NE(ReadFile(html).find("<svg"), std::string::npos);
+  RunBoundedAndExpect({"modes --cap --position=0,0,140", 2, "--position is for one pose"});
+  RunBoundedAndExpect({"modes --position=0,0,140 --html=" + Path("x.html"), 2, "--cap"});
+  RunBoundedAndExpect({"modes --cap --off-axis-step-deg=0", 2, "--off-axis-step-deg"});
 }
 
 TEST_F(CliTest, ModesNamesBadInput) {

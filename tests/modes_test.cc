@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "fastcal/catenary.h"
+#include "fastcal/modes_map.h"
 
 namespace fastcal {
 namespace {
@@ -329,6 +330,48 @@ TEST(ComputeModes, ZenithModesComeInSymmetricPairs) {
     paired += partner;
   }
   EXPECT_GE(paired, 4);  // at least the cabin's two sways and two tilts
+}
+
+// The map of the cap: one node per grid point in the grid's order, each node's figures
+// those of its own modes (the axis node's against ComputeModes at the zenith), a node
+// without equilibrium recorded with its reason, and a CSV row per node.
+TEST(ComputeModesMap, SummarisesEachNodesModes) {
+  ModesMapOptions options;
+  options.grid.max_off_axis_deg = 10.0;
+  options.grid.off_axis_step_deg = 10.0;
+  options.grid.azimuth_step_deg = 120.0;
+  options.modes.segments = 12;
+  ModesMap map;
+  std::string error;
+  ASSERT_TRUE(ComputeModesMap(CableRobot::NominalFast(), options, &map, &error)) << error;
+  ASSERT_EQ(map.nodes.size(), 4u);
+  ModesResult zenith;
+  ASSERT_TRUE(
+      ComputeModes(CableRobot::NominalFast(), FocalPose(0.0, 0.0), options.modes, &zenith, &error));
+  const ModesMapNode& axis = map.nodes[0];
+  ASSERT_TRUE(axis.ok) << axis.reason;
+  EXPECT_EQ(axis.lowest_hz, zenith.modes[0].frequency_hz);
+  ASSERT_GT(axis.first_cabin_mode, 0);
+  const Mode& first = zenith.modes[axis.first_cabin_mode - 1];
+  EXPECT_EQ(axis.first_cabin_hz, first.frequency_hz);
+  EXPECT_GT(first.CabinShare(), 0.5);
+  for (int i = 0; i + 1 < axis.first_cabin_mode; ++i) EXPECT_LE(zenith.modes[i].CabinShare(), 0.5);
+  // The vertical bounce at the zenith is the first cabin-dominated mode (docs/model.md).
+  EXPECT_EQ(axis.motion_hz[2], axis.first_cabin_hz);
+  EXPECT_NEAR(map.nodes[2].azimuth_deg, 120.0, 1e-9);
+  EXPECT_NEAR(map.nodes[2].off_axis_deg, 10.0, 1e-9);
+  const std::string csv = ModesMapCsv(map);
+  EXPECT_EQ(std::count(csv.begin(), csv.end(), '\n'), 5);
+  // The axis node at z = 400 m, above the towers: no equilibrium.
+  options.grid.focal_centre_m.z() = 560.0;
+  options.attitude_law.focal_centre_m = options.grid.focal_centre_m;
+  ASSERT_TRUE(ComputeModesMap(CableRobot::NominalFast(), options, &map, &error)) << error;
+  EXPECT_FALSE(map.nodes[0].ok);
+  EXPECT_NE(map.nodes[0].reason.find("no equilibrium"), std::string::npos) << map.nodes[0].reason;
+  EXPECT_NE(ModesMapCsv(map).find(",no_modes,"), std::string::npos);
+  options.grid.off_axis_step_deg = 0.0;
+  EXPECT_FALSE(ComputeModesMap(CableRobot::NominalFast(), options, &map, &error));
+  EXPECT_NE(error.find("off_axis_step_deg"), std::string::npos) << error;
 }
 
 TEST(ComputeModes, RefusesWhatItCannotLineariseAbout) {
