@@ -42,6 +42,7 @@ except ImportError as _error:  # another interpreter than the build's: say which
         "(docs/python.md)"
     ) from _error
 from ._fastcal import CalibrationError, Dataset, Error, InputError, Model
+from .dynamics import ModesResult, modes
 
 __version__: str = _fastcal.__version__
 
@@ -53,6 +54,7 @@ __all__ = [
     "InputError",
     "LocateResult",
     "Model",
+    "ModesResult",
     "StaticsResult",
     "__version__",
     "arc",
@@ -63,6 +65,7 @@ __all__ = [
     "focal_grid",
     "line",
     "locate",
+    "modes",
     "quat_from_rpy_deg",
     "random_workspace",
     "read_dataset",
