@@ -1,0 +1,262 @@
+// The eigensystem realisation algorithm on free decays, with bootstrap sigmas, and the
+// free decays it is tested on (modal_identification.h has the equations and sources).
+#include "fastcal/modal_identification.h"
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace fastcal {
+namespace {
+
+using Complex = std::complex<double>;
+
+// One identified pole with what the record needs to rebuild its part.
+struct Pole {
+  double frequency_hz = 0.0;
+  double damping_ratio = 0.0;
+  double amplitude = 0.0;
+  Complex z;               // discrete-time eigenvalue
+  Eigen::VectorXcd shape;  // C psi (scaled channels)
+  Complex initial;         // q0
+};
+
+// Block Hankel matrix of y (p x n) from sample `shift`: r block rows, s columns.
+Eigen::MatrixXd Hankel(const Eigen::MatrixXd& y, int rows, int cols, int shift) {
+  const int p = static_cast<int>(y.rows());
+  Eigen::MatrixXd h(rows * p, cols);
+  for (int i = 0; i < rows; ++i) h.middleRows(i * p, p) = y.middleCols(i + shift, cols);
+  return h;
+}
+
+// ERA of the scaled record y at model order `order`: its damped poles (positive
+// frequency, damping in (0, max)), largest amplitude first.
+std::vector<Pole> Realise(const Eigen::MatrixXd& y, double dt, int order, int rows,
+                          double max_damping) {
+  const int p = static_cast<int>(y.rows());
+  const int cols = static_cast<int>(y.cols()) - rows;
+  const Eigen::MatrixXd h0 = Hankel(y, rows, cols, 0), h1 = Hankel(y, rows, cols, 1);
+  // H0 = U S V^T from the eigenpairs of H0 H0^T (rp x rp: small beside H0 itself).
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(h0 * h0.transpose());
+  const int n = static_cast<int>(gram.eigenvalues().size());
+  const Eigen::MatrixXd u = gram.eigenvectors().rightCols(order).rowwise().reverse();
+  const Eigen::VectorXd s = gram.eigenvalues().tail(order).reverse().cwiseMax(1e-300).cwiseSqrt();
+  (void)n;
+  const Eigen::VectorXd s_half = s.cwiseSqrt(), s_inv_half = s_half.cwiseInverse();
+  // A = S^-1/2 U^T H1 V S^-1/2 with V = H0^T U S^-1.
+  const Eigen::MatrixXd a = s_inv_half.asDiagonal() * u.transpose() * (h1 * h0.transpose()) * u *
+                            s.cwiseInverse().asDiagonal() * s_inv_half.asDiagonal();
+  const Eigen::MatrixXd c = u.topRows(p) * s_half.asDiagonal();
+  const Eigen::VectorXd x0 = s_inv_half.asDiagonal() * (u.transpose() * h0.col(0));
+  const Eigen::EigenSolver<Eigen::MatrixXd> eigen(a);
+  const Eigen::MatrixXcd psi = eigen.eigenvectors();
+  const Eigen::VectorXcd q0 = psi.partialPivLu().solve(x0.cast<Complex>());
+  std::vector<Pole> poles;
+  for (int i = 0; i < order; ++i) {
+    const Complex z = eigen.eigenvalues()[i];
+    if (!(z.imag() > 0.0)) continue;  // one of each conjugate pair; real poles are no modes
+    const Complex pole = std::log(z) / dt;
+    Pole m;
+    m.frequency_hz = std::abs(pole) / (2.0 * M_PI);
+    m.damping_ratio = -pole.real() / std::abs(pole);
+    if (!(m.damping_ratio > 0.0 && m.damping_ratio < max_damping)) continue;
+    m.z = z;
+    m.shape = c.cast<Complex>() * psi.col(i);
+    m.initial = q0[i];
+    m.amplitude = 2.0 * m.shape.norm() * std::abs(q0[i]);
+    poles.push_back(m);
+  }
+  std::sort(poles.begin(), poles.end(),
+            [](const Pole& a, const Pole& b) { return a.amplitude > b.amplitude; });
+  return poles;
+}
+
+// The record the poles describe: y_k = sum 2 Re(C psi z^k q0).
+Eigen::MatrixXd Rebuild(const std::vector<Pole>& poles, int channels, int samples) {
+  Eigen::MatrixXd y = Eigen::MatrixXd::Zero(channels, samples);
+  for (const Pole& m : poles) {
+    Complex zk = m.initial;
+    for (int k = 0; k < samples; ++k) {
+      y.col(k) += 2.0 * (m.shape * zk).real();
+      zk *= m.z;
+    }
+  }
+  return y;
+}
+
+// The `count` largest modes of y, or fewer when the record has fewer.
+std::vector<Pole> Identify(const Eigen::MatrixXd& y, double dt, const EraOptions& o, int rows) {
+  std::vector<Pole> poles = Realise(y, dt, 2 * o.modes + o.extra_order, rows, o.max_damping_ratio);
+  if (static_cast<int>(poles.size()) > o.modes) poles.resize(o.modes);
+  return poles;
+}
+
+// A moving-block bootstrap copy of `residual` (channels x samples).
+Eigen::MatrixXd ResampleBlocks(const Eigen::MatrixXd& residual, int block, std::mt19937_64* rng) {
+  const int n = static_cast<int>(residual.cols());
+  const int b = std::min(block, n);
+  std::uniform_int_distribution<int> start(0, n - b);
+  Eigen::MatrixXd out(residual.rows(), n);
+  for (int k = 0; k < n; k += b) {
+    const int len = std::min(b, n - k);
+    out.middleCols(k, len) = residual.middleCols(start(*rng), len);
+  }
+  return out;
+}
+
+// Each mode's sigma from `records` bootstrap records: the nearest mode in frequency of each
+// record's identification.
+void BootstrapSigmas(const Eigen::MatrixXd& y, double dt, const EraOptions& o, int rows,
+                     const std::vector<Pole>& poles, std::vector<IdentifiedMode>* modes) {
+  const Eigen::MatrixXd fit =
+      Rebuild(poles, static_cast<int>(y.rows()), static_cast<int>(y.cols()));
+  const Eigen::MatrixXd residual = y - fit;
+  std::mt19937_64 rng(o.seed);
+  std::vector<std::vector<double>> f(poles.size()), zeta(poles.size());
+  for (int b = 0; b < o.bootstrap_records; ++b) {
+    const std::vector<Pole> again =
+        Identify(fit + ResampleBlocks(residual, o.bootstrap_block, &rng), dt, o, rows);
+    for (size_t i = 0; i < poles.size() && !again.empty(); ++i) {
+      const Pole* nearest = &again[0];
+      for (const Pole& m : again) {
+        if (std::abs(m.frequency_hz - poles[i].frequency_hz) <
+            std::abs(nearest->frequency_hz - poles[i].frequency_hz)) {
+          nearest = &m;
+        }
+      }
+      f[i].push_back(nearest->frequency_hz);
+      zeta[i].push_back(nearest->damping_ratio);
+    }
+  }
+  auto sigma = [](const std::vector<double>& v) {
+    if (v.size() < 2) return 0.0;
+    double mean = 0.0, sum2 = 0.0;
+    for (double x : v) mean += x / v.size();
+    for (double x : v) sum2 += (x - mean) * (x - mean);
+    return std::sqrt(sum2 / (v.size() - 1));
+  };
+  for (size_t i = 0; i < poles.size(); ++i) {
+    (*modes)[i].frequency_sigma_hz = sigma(f[i]);
+    (*modes)[i].damping_sigma = sigma(zeta[i]);
+  }
+}
+
+}  // namespace
+
+bool EraOptions::IsValid(std::string* error) const {
+  if (!(min_frequency_hz > 0.0) || !(max_frequency_hz > min_frequency_hz) ||
+      !std::isfinite(max_frequency_hz)) {
+    *error = "era options: 0 < min_frequency_hz < max_frequency_hz (finite) is needed";
+    return false;
+  }
+  if (modes < 1 || extra_order < 0 || block_rows < 0 || !(max_damping_ratio > 0.0) ||
+      !(max_damping_ratio < 1.0) || bootstrap_records < 2 || bootstrap_block < 1) {
+    *error =
+        "era options: modes >= 1, extra_order >= 0, block_rows >= 0, max_damping_ratio in (0, "
+        "1), bootstrap_records >= 2 and bootstrap_block >= 1 are needed";
+    return false;
+  }
+  return true;
+}
+
+namespace {
+
+// The record averaged over blocks of `factor` samples, each channel centred and scaled by
+// its spread (metres, degrees and kN then weigh alike).
+Eigen::MatrixXd Prepare(const Eigen::MatrixXd& channels, int factor) {
+  const int n = static_cast<int>(channels.cols()) / factor;
+  Eigen::MatrixXd y(channels.rows(), n);
+  for (int k = 0; k < n; ++k) y.col(k) = channels.middleCols(k * factor, factor).rowwise().mean();
+  y = y.colwise() - y.rowwise().mean();
+  for (int c = 0; c < y.rows(); ++c) {
+    const double spread = std::sqrt(y.row(c).squaredNorm() / n);
+    if (spread > 0.0) y.row(c) /= spread;
+  }
+  return y;
+}
+
+}  // namespace
+
+bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
+                      std::vector<IdentifiedMode>* modes, std::string* error) {
+  if (!options.IsValid(error)) return false;
+  const int p = static_cast<int>(record.channels.rows());
+  if (p < 1 || !(record.sample_interval_s > 0.0) || !record.channels.allFinite()) {
+    *error = "record: needs at least one channel, finite samples and sample_interval_s > 0";
+    return false;
+  }
+  const int factor = std::max(
+      1, static_cast<int>(1.0 / (4.0 * options.max_frequency_hz * record.sample_interval_s)));
+  const double dt = factor * record.sample_interval_s;
+  const int n = static_cast<int>(record.channels.cols()) / factor;
+  const int order = 2 * options.modes + options.extra_order;
+  const int rows =
+      options.block_rows > 0
+          ? options.block_rows
+          : std::max((order + p - 1) / p + 1,
+                     static_cast<int>(std::ceil(2.0 / (options.min_frequency_hz * dt))));
+  if (n < 4 * rows) {
+    *error = "record: " + std::to_string(record.channels.cols()) + " samples every " +
+             std::to_string(record.sample_interval_s) + " s are too few for " +
+             std::to_string(rows) + " block rows of " + std::to_string(dt) +
+             " s (two periods of min_frequency_hz): need four times as long";
+    return false;
+  }
+  const Eigen::MatrixXd y = Prepare(record.channels, factor);
+  const std::vector<Pole> poles = Identify(y, dt, options, rows);
+  if (static_cast<int>(poles.size()) < options.modes) {
+    *error = "found " + std::to_string(poles.size()) + " damped modes, fewer than the " +
+             std::to_string(options.modes) + " asked for";
+    return false;
+  }
+  modes->assign(poles.size(), IdentifiedMode());
+  for (size_t i = 0; i < poles.size(); ++i) {
+    (*modes)[i].frequency_hz = poles[i].frequency_hz;
+    (*modes)[i].damping_ratio = poles[i].damping_ratio;
+    (*modes)[i].amplitude = poles[i].amplitude;
+  }
+  BootstrapSigmas(y, dt, options, rows, poles, modes);
+  std::sort(modes->begin(), modes->end(), [](const IdentifiedMode& a, const IdentifiedMode& b) {
+    return a.frequency_hz < b.frequency_hz;
+  });
+  return true;
+}
+
+bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::string* error) {
+  const size_t m = spec.frequency_hz.size();
+  const int channels = static_cast<int>(spec.shape.rows());
+  if (m == 0 || spec.damping_ratio.size() != m || spec.shape.cols() != static_cast<int>(m) ||
+      (!spec.phase_rad.empty() && spec.phase_rad.size() != m) ||
+      spec.noise_sigma.size() != channels || !(spec.sample_interval_s > 0.0) ||
+      !(spec.duration_s > spec.sample_interval_s)) {
+    *error =
+        "free decay: one frequency, damping (and phase) per mode, a shape column per mode, "
+        "a noise sigma per channel, sample_interval_s > 0 and a longer duration_s";
+    return false;
+  }
+  const int n = static_cast<int>(spec.duration_s / spec.sample_interval_s) + 1;
+  record->sample_interval_s = spec.sample_interval_s;
+  record->channels = Eigen::MatrixXd::Zero(channels, n);
+  for (size_t j = 0; j < m; ++j) {
+    const double w = 2.0 * M_PI * spec.frequency_hz[j], zeta = spec.damping_ratio[j];
+    const double wd = w * std::sqrt(1.0 - zeta * zeta);
+    const double phase = spec.phase_rad.empty() ? 0.0 : spec.phase_rad[j];
+    for (int k = 0; k < n; ++k) {
+      const double t = k * spec.sample_interval_s;
+      record->channels.col(k) +=
+          spec.shape.col(j) * (std::exp(-zeta * w * t) * std::cos(wd * t + phase));
+    }
+  }
+  std::mt19937_64 rng(spec.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int k = 0; k < n; ++k) {
+    for (int c = 0; c < channels; ++c) record->channels(c, k) += spec.noise_sigma[c] * normal(rng);
+  }
+  return true;
+}
+
+}  // namespace fastcal
