@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cli_util.h"
+#include "fastcal/modes.h"
 #include "fastcal/pose.h"
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
@@ -26,6 +27,8 @@ int RunDesign(int argc, char** argv);
 int RunImport(int argc, char** argv);
 int RunTrack(int argc, char** argv);
 int RunModes(int argc, char** argv);
+// modes --data: the identified modes of a record against the prediction (modes_identify.cc).
+int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool to_file);
 
 // Positions of the trajectory `kind` (circle, line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.

@@ -19,6 +19,7 @@ DECLARE_string(position);
 DECLARE_string(output);
 DECLARE_bool(force);
 DECLARE_string(html);
+DECLARE_string(data);
 DECLARE_string(focal_centre);
 DECLARE_double(tilt_fraction);
 DECLARE_double(max_off_axis_deg);
@@ -42,7 +43,9 @@ const char kHelp[] =
 
 Usage:
   fastcal modes --position=X,Y,Z [--attitude-law=focal | --rpy=R,P,Y | --quat=W,X,Y,Z]
-                [--model=FILE.yaml] [--segments=24] [--modes=20] [--output=modes.csv]
+                [--model=FILE.yaml] [--segments=48] [--modes=20] [--output=modes.csv]
+  fastcal modes --cap [grid flags] [--output=cap.csv] [--html=cap.html]
+  fastcal modes --data=RECORD.csv [--columns=MAP.yaml] [--identified-modes=3]
 
 The system linearised about the exact static equilibrium of the pose (docs/model.md,
 "Vibrations"): each cable a lumped-mass chain of --segments segments with its nodes on the
@@ -70,6 +73,17 @@ rx, ry, rz the frequency and share of the mode holding the most of it, message);
 --html draws the lowest, the first cabin-dominated and the vertical mode's frequency as
 polar maps of the cap, as workspace draws tensions.
 
+Identified modes: --data=RECORD.csv (a dataset, docs/data-format.md, or an export read
+through --columns=MAP.yaml) holding a free vibration, evenly sampled (e.g. inertial
+navigation at 1-100 Hz after a disturbance): its --identified-modes=3 dominant modes by
+the eigensystem realisation algorithm (Juang and Pappa 1985) on the pose (x, y, z, roll,
+pitch, yaw) and the tensions, with bootstrap sigmas; each compared with the nearest
+predicted mode at the record's mean pose, and the differences fitted by each parameter
+alone (the cables' density, the cabin's mass, its inertia): the smallest chi2 is what they
+point to. CSV: mode, frequency_hz, frequency_sigma_hz, damping_ratio, damping_sigma,
+predicted_mode, predicted_hz, predicted_kind, difference_percent,
+difference_sigma_percent, dlnf_dln_<parameter> (the predicted mode's sensitivity).
+
 Output: CSV to stdout or --output=FILE.csv (written only on success; an existing file
 only with --force), one row per mode, ascending:
   mode, frequency_hz, period_s
@@ -91,7 +105,8 @@ Examples:
 const std::set<std::string> kFlags = {
     "model", "position", "attitude-law", "rpy", "quat", "rotvec", "tilt-fraction",
     "focal-centre", "segments", "modes", "output", "force", "cap", "max-off-axis-deg",
-    "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "html"};
+    "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "html", "data", "columns",
+    "identified-modes"};
 // clang-format on
 
 // "mode 4, 0.18208 Hz; cabin 56.5% (most z 56.5%), cables 43.5% (most cable 1 7.24%)".
@@ -277,6 +292,7 @@ int RunModes(int argc, char** argv) {
     PrintError(kCommand, WithFlagNames(error, {{"segments", "--segments"}, {"modes", "--modes"}}));
     return kExitUsage;
   }
+  if (!FLAGS_data.empty()) return RunModesIdentify(robot, options, to_file);
   return FLAGS_cap ? RunCap(argc, argv, robot, options, to_file) : RunPose(robot, options, to_file);
 }
 

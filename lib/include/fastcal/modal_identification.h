@@ -20,9 +20,14 @@
 #define FASTCAL_MODAL_IDENTIFICATION_H_
 
 #include <Eigen/Core>
+#include <array>
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/modes.h"
+#include "fastcal/pose.h"
 
 namespace fastcal {
 
@@ -87,6 +92,53 @@ struct FreeDecaySpec {
   std::uint64_t seed = 1;
 };
 bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::string* error);
+
+// The model's parameters whose change the comparison measures: the cables' linear
+// density (all six together), the cabin's mass and its inertia (scaled as a whole).
+inline constexpr int kModeParameters = 3;
+const char* ModeParameterName(int parameter);  // "linear_density", "cabin_mass", "cabin_inertia"
+
+// One identified mode against the prediction at the record's pose.
+struct ModeComparison {
+  IdentifiedMode identified;
+  int predicted_mode = 0;  // 1-based, the nearest predicted in frequency
+  double predicted_hz = 0.0;
+  double predicted_cabin_share = 0.0;
+  // (identified - predicted) / predicted, and its sigma from the identification's.
+  double difference = 0.0;
+  double difference_sigma = 0.0;
+  // d ln f / d ln p of the predicted mode for each parameter (by a 1% step).
+  std::array<double, kModeParameters> sensitivity{};
+};
+
+// What the differences point to: for each parameter alone, the relative change that best
+// explains them (weighted least squares over the modes, weights 1/sigma^2), its sigma and
+// the fit's chi-square (degrees of freedom: modes - 1). The smallest chi-square is the
+// best single explanation; none is when every chi-square is large.
+struct ParameterFit {
+  double relative_change = 0.0;
+  double sigma = 0.0;
+  double chi2 = 0.0;
+};
+
+struct ModesComparisonResult {
+  std::vector<ModeComparison> modes;
+  std::array<ParameterFit, kModeParameters> fits{};
+  int best = 0;  // the parameter with the smallest chi-square
+  // sum (difference / sigma)^2 with no parameter changed (degrees of freedom: modes), and
+  // whether it lies within what noise gives (below modes + 3 sqrt(2 modes)): then the
+  // record agrees with the model and the fits point to nothing.
+  double chi2_model = 0.0;
+  bool agrees = false;
+};
+
+// Compares `identified` with the predicted modes at `pose` (ComputeModes with `options`;
+// its `modes` lowest are searched for the nearest). False with *error when the prediction
+// fails.
+bool CompareWithPrediction(const CableRobot& robot, const Pose& pose,
+                           const std::vector<IdentifiedMode>& identified,
+                           const ModesOptions& options, ModesComparisonResult* result,
+                           std::string* error);
 
 }  // namespace fastcal
 

@@ -259,4 +259,97 @@ bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::
   return true;
 }
 
+const char* ModeParameterName(int parameter) {
+  static const char* const kNames[kModeParameters] = {"linear_density", "cabin_mass",
+                                                      "cabin_inertia"};
+  return parameter >= 0 && parameter < kModeParameters ? kNames[parameter] : "";
+}
+
+namespace {
+
+// `robot` with parameter `p` scaled by `factor`.
+CableRobot Scaled(CableRobot robot, int p, double factor) {
+  if (p == 0) {
+    for (CableProperties& c : robot.cables) c.linear_density_kg_per_m *= factor;
+  } else if (p == 1) {
+    robot.cabin_mass_kg *= factor;
+  } else {
+    robot.cabin_inertia_kg_m2 *= factor;
+  }
+  return robot;
+}
+
+// Each parameter's single-parameter weighted least-squares fit of the differences.
+void FitParameters(ModesComparisonResult* result) {
+  for (const ModeComparison& m : result->modes) {
+    const double r = m.difference / std::max(m.difference_sigma, 1e-15);
+    result->chi2_model += r * r;
+  }
+  const double dof = static_cast<double>(result->modes.size());
+  result->agrees = result->chi2_model <= dof + 3.0 * std::sqrt(2.0 * dof);
+  for (int p = 0; p < kModeParameters; ++p) {
+    double sw = 0.0, sd = 0.0;
+    for (const ModeComparison& m : result->modes) {
+      const double w = 1.0 / std::max(m.difference_sigma * m.difference_sigma, 1e-30);
+      sw += w * m.sensitivity[p] * m.sensitivity[p];
+      sd += w * m.sensitivity[p] * m.difference;
+    }
+    ParameterFit& fit = result->fits[p];
+    fit.relative_change = sw > 0.0 ? sd / sw : 0.0;
+    fit.sigma = sw > 0.0 ? 1.0 / std::sqrt(sw) : HUGE_VAL;
+    fit.chi2 = 0.0;
+    for (const ModeComparison& m : result->modes) {
+      const double r = (m.difference - m.sensitivity[p] * fit.relative_change) /
+                       std::max(m.difference_sigma, 1e-15);
+      fit.chi2 += r * r;
+    }
+    if (fit.chi2 < result->fits[result->best].chi2) result->best = p;
+  }
+}
+
+}  // namespace
+
+bool CompareWithPrediction(const CableRobot& robot, const Pose& pose,
+                           const std::vector<IdentifiedMode>& identified,
+                           const ModesOptions& options, ModesComparisonResult* result,
+                           std::string* error) {
+  constexpr double kStep = 0.01;  // each parameter's relative step for the sensitivities
+  ModesResult nominal;
+  if (!ComputeModes(robot, pose, options, &nominal, error)) return false;
+  std::array<ModesResult, kModeParameters> stepped;
+  for (int p = 0; p < kModeParameters; ++p) {
+    if (!ComputeModes(Scaled(robot, p, 1.0 + kStep), pose, options, &stepped[p], error)) {
+      return false;
+    }
+  }
+  *result = ModesComparisonResult();
+  for (const IdentifiedMode& id : identified) {
+    ModeComparison c;
+    c.identified = id;
+    size_t nearest = 0;
+    for (size_t i = 0; i < nominal.modes.size(); ++i) {
+      if (std::abs(nominal.modes[i].frequency_hz - id.frequency_hz) <
+          std::abs(nominal.modes[nearest].frequency_hz - id.frequency_hz)) {
+        nearest = i;
+      }
+    }
+    const Mode& m = nominal.modes[nearest];
+    c.predicted_mode = static_cast<int>(nearest) + 1;
+    c.predicted_hz = m.frequency_hz;
+    c.predicted_cabin_share = m.CabinShare();
+    c.difference = id.frequency_hz / m.frequency_hz - 1.0;
+    c.difference_sigma = id.frequency_sigma_hz / m.frequency_hz;
+    for (int p = 0; p < kModeParameters; ++p) {
+      // The same mode after the step (a 1% step moves no mode past its neighbour's
+      // frequency, except in a cluster; the index is kept).
+      const double hz =
+          stepped[p].modes[std::min(nearest, stepped[p].modes.size() - 1)].frequency_hz;
+      c.sensitivity[p] = std::log(hz / m.frequency_hz) / std::log1p(kStep);
+    }
+    result->modes.push_back(c);
+  }
+  FitParameters(result);
+  return true;
+}
+
 }  // namespace fastcal
