@@ -4,6 +4,7 @@
 #define FASTCAL_APPS_COMMANDS_H_
 
 #include <Eigen/Core>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ int RunTrack(int argc, char** argv);
 int RunModes(int argc, char** argv);
 // modes --data: the identified modes of a record against the prediction (modes_identify.cc).
 int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool to_file);
+// simulate --vibration (simulate_vibration.cc): its flags, and the run after StartCommand.
+const std::set<std::string>& VibrationFlags();
+int RunSimulateVibration(int argc, char** argv);
 
 // Positions of the trajectory `kind` (circle, line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.

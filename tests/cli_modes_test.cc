@@ -153,6 +153,40 @@ TEST_F(CliTest, ModesDataIdentifiesAndComparesWithThePrediction) {
                        "does not apply to --data"});
 }
 
+// simulate --vibration writes a record modes --data identifies: the excited modes back.
+TEST_F(CliTest, SimulateVibrationRoundTripsThroughModesData) {
+  const std::string record = Path("record.csv"), out = Path("identified.csv");
+  CommandResult r = Fastcal(
+      "simulate --vibration --position=102.846,0,177.433 --attitude-law=focal --excite=2,7,18 "
+      "--damping=0.005,0.01,0.015 --position-noise-m=0.002 --attitude-noise-deg=0.005 "
+      "--tension-noise-kN=0.5 --segments=24 --out=" +
+      record);
+  ASSERT_EQ(r.code, 0) << r.output;
+  r = Fastcal("modes --data=" + record + " --segments=24 --output=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::istringstream lines(ReadFile(out));
+  std::string line;
+  std::getline(lines, line);
+  const char* predicted[3] = {"2", "7", "18"};
+  const double damping[3] = {0.005, 0.01, 0.015};
+  for (int j = 0; j < 3; ++j) {
+    ASSERT_TRUE(std::getline(lines, line));
+    const std::vector<std::string> f = CsvFields(line);
+    EXPECT_EQ(f[5], predicted[j]) << line;
+    EXPECT_NEAR(std::stod(f[3]) / damping[j], 1.0, 0.25) << line;
+    EXPECT_LT(std::abs(std::stod(f[8])), 1.0) << line;  // difference_percent
+  }
+  RunBoundedAndExpect({"simulate --vibration --trajectory=line --out=" + Path("x.csv"), 2,
+                       "--trajectory does not apply to --vibration"});
+  RunBoundedAndExpect(
+      {"simulate --excite=1 --out=" + Path("x.csv"), 2, "--excite applies to --vibration only"});
+  RunBoundedAndExpect(
+      {"simulate --vibration --position=0,0,140 --excite=1,2 --damping=0.01 "
+       "--out=" +
+           Path("x.csv"),
+       2, "--damping gives 1 ratios for 2 --excite modes"});
+}
+
 TEST_F(CliTest, ModesNamesBadInput) {
   const std::string out = " --output=" + Path("never.csv");
   const std::vector<ExpectedRun> runs = {

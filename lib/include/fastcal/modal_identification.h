@@ -93,6 +93,29 @@ struct FreeDecaySpec {
 };
 bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::string* error);
 
+// A record of the cabin's free vibration at a pose from the linearised model (modal
+// superposition of predicted modes): channels x, y, z (m), roll, pitch, yaw (deg) and the
+// six lower-end tensions (kN), absolute (the equilibrium plus the motion plus noise). The
+// pose channels follow the modes' cabin shapes; the tensions follow the cabin's motion
+// quasi-statically (their change with the pose at fixed unstretched lengths, by central
+// differences of the catenary): a record for the tests and the docs, not a simulation of
+// the cables' own tension waves.
+struct VibrationRecordSpec {
+  std::vector<int> modes = {1, 2, 3};                        // 1-based predicted modes excited
+  std::vector<double> damping_ratio = {0.005, 0.01, 0.015};  // one per mode
+  double amplitude_m = 0.05;  // each mode's largest displacement of O' at t = 0
+  double sample_interval_s = 0.1;
+  double duration_s = 400.0;
+  double position_noise_m = 0.002;
+  double attitude_noise_deg = 0.005;
+  double tension_noise_kn = 0.5;
+  std::uint64_t seed = 1;
+  ModesOptions modes_options;
+};
+bool SimulateVibrationRecord(const CableRobot& robot, const Pose& pose,
+                             const VibrationRecordSpec& spec, VibrationRecord* record,
+                             std::string* error);
+
 // The model's parameters whose change the comparison measures: the cables' linear
 // density (all six together), the cabin's mass and its inertia (scaled as a whole).
 inline constexpr int kModeParameters = 3;

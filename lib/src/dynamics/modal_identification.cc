@@ -3,12 +3,16 @@
 #include "fastcal/modal_identification.h"
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <random>
 #include <string>
 #include <vector>
+
+#include "fastcal/catenary.h"
+#include "fastcal/statics.h"
 
 namespace fastcal {
 namespace {
@@ -349,6 +353,104 @@ bool CompareWithPrediction(const CableRobot& robot, const Pose& pose,
     result->modes.push_back(c);
   }
   FitParameters(result);
+  return true;
+}
+
+namespace {
+
+// The six lower-end tensions (kN) at `pose` with the unstretched lengths of `statics`.
+Eigen::Matrix<double, 6, 1> TensionsAtFixedLengths(const CableRobot& robot, const Pose& pose,
+                                                   const StaticsSolution& statics) {
+  Eigen::Matrix<double, 6, 1> t;
+  for (int i = 0; i < kNumCables; ++i) {
+    const CableProperties& c = robot.cables[i];
+    const Eigen::Vector3d chord =
+        c.tower_top_m - (pose.position_m + pose.rotation * robot.AnchorOfCable(i));
+    CatenaryForces f;
+    int iterations = 0;
+    SolveCatenaryForcesDouble(chord.head<2>().norm(), chord.z(),
+                              statics.cables[i].unstretched_length_m, c.ea_n,
+                              c.linear_density_kg_per_m * robot.gravity_m_per_s2,
+                              CatenarySolverOptions(), nullptr, &f, &iterations);
+    t[i] = std::hypot(f.fl_n, f.fz_n) / 1e3;
+  }
+  return t;
+}
+
+// d(tension kN)/d(u, theta) by central differences (R -> exp(theta) R).
+Eigen::Matrix<double, 6, 6> TensionPerCabinMotion(const CableRobot& robot, const Pose& pose,
+                                                  const StaticsSolution& statics) {
+  constexpr double kStepM = 1e-3, kStepRad = 1e-5;
+  Eigen::Matrix<double, 6, 6> j;
+  for (int k = 0; k < 6; ++k) {
+    const double h = k < 3 ? kStepM : kStepRad;
+    Pose plus = pose, minus = pose;
+    if (k < 3) {
+      plus.position_m[k] += h;
+      minus.position_m[k] -= h;
+    } else {
+      const Eigen::Vector3d axis = Eigen::Vector3d::Unit(k - 3);
+      plus.rotation = Eigen::AngleAxisd(h, axis).toRotationMatrix() * pose.rotation;
+      minus.rotation = Eigen::AngleAxisd(-h, axis).toRotationMatrix() * pose.rotation;
+    }
+    j.col(k) = (TensionsAtFixedLengths(robot, plus, statics) -
+                TensionsAtFixedLengths(robot, minus, statics)) /
+               (2.0 * h);
+  }
+  return j;
+}
+
+}  // namespace
+
+bool SimulateVibrationRecord(const CableRobot& robot, const Pose& pose,
+                             const VibrationRecordSpec& spec, VibrationRecord* record,
+                             std::string* error) {
+  if (spec.modes.empty() || spec.damping_ratio.size() != spec.modes.size() ||
+      !(spec.amplitude_m > 0.0) || !(spec.position_noise_m >= 0.0) ||
+      !(spec.attitude_noise_deg >= 0.0) || !(spec.tension_noise_kn >= 0.0)) {
+    *error =
+        "vibration record: one damping ratio per excited mode, amplitude_m > 0 and "
+        "noise sigmas >= 0 are needed";
+    return false;
+  }
+  ModesOptions options = spec.modes_options;
+  options.modes = std::max(options.modes, *std::max_element(spec.modes.begin(), spec.modes.end()));
+  ModesResult predicted;
+  if (!ComputeModes(robot, pose, options, &predicted, error)) return false;
+  const Eigen::Matrix<double, 6, 6> tension = TensionPerCabinMotion(robot, pose, predicted.statics);
+  FreeDecaySpec decay;
+  decay.shape.resize(12, static_cast<int>(spec.modes.size()));
+  for (size_t j = 0; j < spec.modes.size(); ++j) {
+    const int m = spec.modes[j];
+    if (m < 1 || m > static_cast<int>(predicted.modes.size())) {
+      *error = "vibration record: mode " + std::to_string(m) + " is not among the " +
+               std::to_string(predicted.modes.size()) + " predicted";
+      return false;
+    }
+    const Mode& mode = predicted.modes[m - 1];
+    const double scale =
+        spec.amplitude_m / std::max(mode.cabin_shape.head<3>().cwiseAbs().maxCoeff(), 1e-300);
+    const Eigen::Matrix<double, 6, 1> motion = scale * mode.cabin_shape;
+    decay.shape.col(j).head<3>() = motion.head<3>();
+    decay.shape.col(j).segment<3>(3) = motion.tail<3>() * (180.0 / M_PI);
+    decay.shape.col(j).tail<6>() = tension * motion;
+    decay.frequency_hz.push_back(mode.frequency_hz);
+    decay.damping_ratio.push_back(spec.damping_ratio[j]);
+    decay.phase_rad.push_back(0.0);
+  }
+  decay.noise_sigma.resize(12);
+  decay.noise_sigma << Eigen::Vector3d::Constant(spec.position_noise_m),
+      Eigen::Vector3d::Constant(spec.attitude_noise_deg),
+      Eigen::Matrix<double, 6, 1>::Constant(spec.tension_noise_kn);
+  decay.sample_interval_s = spec.sample_interval_s;
+  decay.duration_s = spec.duration_s;
+  decay.seed = spec.seed;
+  if (!SimulateFreeDecay(decay, record, error)) return false;
+  Eigen::Matrix<double, 12, 1> base;
+  base << pose.position_m, RpyDegFromRotation(pose.rotation), Eigen::Matrix<double, 6, 1>::Zero();
+  for (int i = 0; i < kNumCables; ++i)
+    base[6 + i] = predicted.statics.cables[i].lower_tension_n / 1e3;
+  record->channels.colwise() += base;
   return true;
 }
 
