@@ -603,8 +603,8 @@ TEST(CableRobotYaml, CabinInertiaDiagonalOrFullRoundTripsAndValidates) {
   EXPECT_EQ(nominal, Eigen::Matrix3d(Eigen::Vector3d(3.5e5, 3.5e5, 5.0e5).asDiagonal()));
   CableRobot robot, back;
   std::string error;
-  ASSERT_TRUE(ParseCableRobotYaml("cabin:\n  inertia_kg_m2: [3e5, 4e5, 6e5]\n", "m.yaml", &robot,
-                                  &error))
+  ASSERT_TRUE(
+      ParseCableRobotYaml("cabin:\n  inertia_kg_m2: [3e5, 4e5, 6e5]\n", "m.yaml", &robot, &error))
       << error;
   EXPECT_EQ(robot.cabin_inertia_kg_m2.diagonal(), Eigen::Vector3d(3e5, 4e5, 6e5));
   ASSERT_TRUE(ParseCableRobotYaml(
