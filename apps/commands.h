@@ -4,10 +4,12 @@
 #define FASTCAL_APPS_COMMANDS_H_
 
 #include <Eigen/Core>
+#include <set>
 #include <string>
 #include <vector>
 
 #include "cli_util.h"
+#include "fastcal/modes.h"
 #include "fastcal/pose.h"
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
@@ -25,6 +27,12 @@ int RunWorkspace(int argc, char** argv);
 int RunDesign(int argc, char** argv);
 int RunImport(int argc, char** argv);
 int RunTrack(int argc, char** argv);
+int RunModes(int argc, char** argv);
+// modes --data: the identified modes of a record against the prediction (modes_identify.cc).
+int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool to_file);
+// simulate --vibration (simulate_vibration.cc): its flags, and the run after StartCommand.
+const std::set<std::string>& VibrationFlags();
+int RunSimulateVibration(int argc, char** argv);
 
 // Positions of the trajectory `kind` (circle, line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.
@@ -72,6 +80,17 @@ bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitu
 // The workspace's grid, focal law, tension limits and statics checks from its flags
 // (workspace, design); false with the flags named when invalid.
 bool WorkspaceOptionsFromFlags(WorkspaceOptions* options, std::string* error);
+
+// One cabin pose from --position with its attitude (--rpy, --quat, --rotvec or
+// --attitude-law=focal|none with --tilt-fraction and --focal-centre; R = I without
+// one), as solve takes it; *attitude says which, for summaries.
+bool SinglePoseFromFlags(Pose* pose, std::string* attitude, std::string* error);
+
+// `message` of a FocalGridSpec (`grid.`) or FocalAttitudeLaw (`attitude_law.`) field
+// with the flags that set it (--max-off-axis-deg, ..., --tilt-fraction), and the
+// command's own fields in `more` (field, flag) (workspace, modes --cap).
+std::string WithGridFlagNames(const std::string& message,
+                              std::vector<std::pair<std::string, std::string>> more = {});
 
 // Sets the model-range limits of `options` from --max-strain, --max-length-ratio and
 // --reflector-clearance (solve, workspace); false with the flags named when invalid.

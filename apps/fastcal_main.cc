@@ -36,6 +36,8 @@ Commands:
              (day) at a time as one joint fit, with the events (moves, re-zeroed sensors)
   design     the calibration survey that determines the wanted parameters best: poses,
              samples per pose and flight order, with predicted sigma_total
+  modes      natural frequencies and modes of the cabin on its sagging cables at a pose
+             (the equilibrium linearised, each cable a lumped-mass chain): modes.csv
   import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
              comma), read through a column map, written as the canonical dataset CSV
 
@@ -59,6 +61,7 @@ int Dispatch(const std::string& command, int argc, char** argv, bool* known) {
   if (command == "design") return RunDesign(argc, argv);
   if (command == "import") return RunImport(argc, argv);
   if (command == "track") return RunTrack(argc, argv);
+  if (command == "modes") return RunModes(argc, argv);
   *known = false;
   return kExitUsage;
 }

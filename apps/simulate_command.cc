@@ -55,6 +55,7 @@ DECLARE_double(radial_spread);
 DECLARE_string(poses);
 DECLARE_string(out);
 DECLARE_bool(force);
+DECLARE_bool(vibration);
 
 DEFINE_string(truth, "", "simulate: truth model YAML; empty = nominal FAST.");
 DEFINE_string(mass_centre, "", "simulate: truth mass centre x,y,z in the cabin frame (m).");
@@ -110,6 +111,16 @@ const char kHelp[] =
 
 Usage:
   fastcal simulate --out=FILE.csv [--force] [--truth=MODEL.yaml] [trajectory] [errors]
+  fastcal simulate --vibration --position=X,Y,Z [attitude] --out=FILE.csv [--excite=1,2,3]
+                   [--damping=0.005,0.01,0.015] [--amplitude-m=0.05] [--duration-s=400]
+                   [--interval-s=0.1] [--position-noise-m=M] [--attitude-noise-deg=D]
+                   [--tension-noise-kN=T] [--segments=48] [--seed=1]
+
+--vibration: a record of the cabin's free vibration at one pose from the linearised model
+(fastcal modes): the predicted modes --excite'd (1-based) with the given damping ratios,
+each moving O' by --amplitude-m at t = 0, superposed; the tensions follow the cabin's
+motion quasi-statically; white noise of the given sigmas. A dataset CSV (time_s, the pose,
+T1_kN..T6_kN) that `fastcal modes --data` identifies. Only the flags shown apply.
 
 Writes FILE.csv (the dataset format calibrate and evaluate read, docs/data-format.md) and
 the truth model actually used beside it as FILE.truth.yaml (FILE.csv minus ".csv", plus
@@ -283,7 +294,10 @@ const std::set<std::string> kFlags = {
     "sensor-bias-spread-kN", "sessions", "session-shift-m", "mass-centre-step",
     "tension-drift-kN", "session-gap-s", "sensor-rezero-kN", "length-offset-spread-m",
     "length-noise-m", "days", "start", "sensor-step", "joint-law", "joint-grid-deg",
-    "prismatic-spread-m"};
+    "prismatic-spread-m",
+    // --vibration (simulate_vibration.cc)
+    "vibration", "position", "rpy", "quat", "rotvec", "excite", "damping", "amplitude-m",
+    "duration-s", "segments"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -724,6 +738,19 @@ std::string Summary(const SimulationSummary& s, const SimulationOptions& options
 int RunSimulate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
+  for (const std::string& flag : kFlags) {
+    const bool vibration = VibrationFlags().count(flag) > 0;
+    if (FlagGiven(flag) && vibration != FLAGS_vibration && flag != "truth" && flag != "seed" &&
+        flag != "out" && flag != "force" && flag != "attitude-law" && flag != "tilt-fraction" &&
+        flag != "focal-centre" && flag != "interval-s" && flag != "position-noise-m" &&
+        flag != "attitude-noise-deg" && flag != "tension-noise-kN") {
+      PrintError(kCommand, "--" + flag +
+                               (FLAGS_vibration ? " does not apply to --vibration"
+                                                : " applies to --vibration only"));
+      return kExitUsage;
+    }
+  }
+  if (FLAGS_vibration) return RunSimulateVibration(argc, argv);
   if (FlagGiven("columns") && FLAGS_poses.empty()) {
     PrintError(kCommand, "--columns applies to --poses=FILE (a pose file read as exported)");
     return kExitUsage;

@@ -696,6 +696,16 @@ bool SetOptionsFromFlags(StaticsOptions* options, bool* compare, std::string* er
 
 }  // namespace
 
+bool SinglePoseFromFlags(Pose* pose, std::string* attitude, std::string* error) {
+  FocalAttitudeLaw law;
+  PoseStream poses;
+  if (!AttitudeLawFromFlags(&law, error) || !SinglePose(law, &poses, attitude, error)) {
+    return false;
+  }
+  *pose = poses.next();
+  return true;
+}
+
 bool ModelRangeFromFlags(StaticsOptions* options, std::string* error) {
   options->max_strain = FLAGS_max_strain;
   options->max_length_ratio = FLAGS_max_length_ratio;

@@ -188,18 +188,22 @@ bool WorkspaceOptionsFromFlags(WorkspaceOptions* o, std::string* error) {
   }
   if (!ModelRangeFromFlags(&o->statics, error)) return false;
   if (o->IsValid(error)) return true;
-  *error = WithFlagNames(WithTrajectoryFlagNames(*error),
-                         {{"grid.max_off_axis_deg", "--max-off-axis-deg"},
-                          {"grid.off_axis_step_deg", "--off-axis-step-deg"},
-                          {"grid.azimuth_step_deg", "--azimuth-step-deg"},
-                          {"grid.focal_radius_m", "--focal-radius"},
-                          {"grid.focal_centre_m", "--focal-centre"},
-                          {"radial_offset_m", "--radial-offset"},
-                          {"min_tension_n", "--min-tension-kN"},
-                          {"max_tension_n", "--max-tension-kN"},
-                          {"attitude_law.focal_centre_m", "--focal-centre"},
-                          {"attitude_law.tilt_fraction", "--tilt-fraction"}});
+  *error = WithGridFlagNames(*error, {{"radial_offset_m", "--radial-offset"},
+                                      {"min_tension_n", "--min-tension-kN"},
+                                      {"max_tension_n", "--max-tension-kN"}});
   return false;
+}
+
+std::string WithGridFlagNames(const std::string& message,
+                              std::vector<std::pair<std::string, std::string>> more) {
+  more.insert(more.end(), {{"grid.max_off_axis_deg", "--max-off-axis-deg"},
+                           {"grid.off_axis_step_deg", "--off-axis-step-deg"},
+                           {"grid.azimuth_step_deg", "--azimuth-step-deg"},
+                           {"grid.focal_radius_m", "--focal-radius"},
+                           {"grid.focal_centre_m", "--focal-centre"},
+                           {"attitude_law.focal_centre_m", "--focal-centre"},
+                           {"attitude_law.tilt_fraction", "--tilt-fraction"}});
+  return WithFlagNames(WithTrajectoryFlagNames(message), more);
 }
 
 int RunWorkspace(int argc, char** argv) {

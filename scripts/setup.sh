@@ -7,6 +7,7 @@ packages=(cmake g++ make libceres-dev libeigen3-dev libgflags-dev libgoogle-glog
           libyaml-cpp-dev libgtest-dev libbenchmark-dev
           libssl-dev  # libcrypto: SHA-256 of the input files (provenance)
           libhowardhinnant-date-dev  # date/date.h: ISO 8601 time stamps of column maps
+          libspectra-dev  # Spectra (headers): shift-invert Lanczos for the lowest modes
           # The Python module: pybind11's headers and CMake package, Python's headers,
           # NumPy; pytest runs its tests, matplotlib the plot of docs/python.md.
           pybind11-dev python3-dev python3-numpy python3-pytest python3-matplotlib

@@ -54,6 +54,7 @@ void ExpectIdentical(const CableRobot& a, const CableRobot& b) {
   }
   EXPECT_EQ(a.cabin_mass_kg, b.cabin_mass_kg);
   for (int k = 0; k < 3; ++k) EXPECT_EQ(a.mass_centre_cabin_m[k], b.mass_centre_cabin_m[k]);
+  EXPECT_EQ(a.cabin_inertia_kg_m2, b.cabin_inertia_kg_m2);
   EXPECT_EQ(a.gravity_m_per_s2, b.gravity_m_per_s2);
   ASSERT_EQ(a.reflector.has_value(), b.reflector.has_value());
   if (a.reflector.has_value()) {
@@ -592,6 +593,39 @@ TEST(CableRobotYaml, SensorGainAndBiasRoundTripAndValidate) {
   robot.cables[1].sensor_gain = 0.0;
   EXPECT_FALSE(robot.IsValid(&error));
   EXPECT_NE(error.find("cables[1].sensor_gain"), std::string::npos) << error;
+}
+
+// The cabin's inertia (vibrations only): an assumed diagonal default, [Ixx, Iyy, Izz] or
+// three rows in the file, an exact round trip of either, and a tensor no rigid body has
+// refused with its key.
+TEST(CableRobotYaml, CabinInertiaDiagonalOrFullRoundTripsAndValidates) {
+  const Eigen::Matrix3d nominal = CableRobot::NominalFast().cabin_inertia_kg_m2;
+  EXPECT_EQ(nominal, Eigen::Matrix3d(Eigen::Vector3d(3.5e5, 3.5e5, 5.0e5).asDiagonal()));
+  CableRobot robot, back;
+  std::string error;
+  ASSERT_TRUE(
+      ParseCableRobotYaml("cabin:\n  inertia_kg_m2: [3e5, 4e5, 6e5]\n", "m.yaml", &robot, &error))
+      << error;
+  EXPECT_EQ(robot.cabin_inertia_kg_m2.diagonal(), Eigen::Vector3d(3e5, 4e5, 6e5));
+  ASSERT_TRUE(ParseCableRobotYaml(
+      "cabin:\n  inertia_kg_m2: [[3e5, 1e4, 0], [1e4, 4e5, -2e3], [0, -2e3, 6e5]]\n", "m.yaml",
+      &robot, &error))
+      << error;
+  EXPECT_EQ(robot.cabin_inertia_kg_m2(1, 2), -2e3);
+  ASSERT_TRUE(ParseCableRobotYaml(CableRobotToYaml(robot, ""), "m.yaml", &back, &error)) << error;
+  ExpectIdentical(back, robot);
+  const std::pair<const char*, const char*> bad[] = {
+      {"cabin:\n  inertia_kg_m2: [1, 2]\n", "cabin.inertia_kg_m2: expected"},
+      {"cabin:\n  inertia_kg_m2: [3e5, -1, 6e5]\n",
+       "m.yaml:2: cabin.inertia_kg_m2: must be positive definite"},
+      {"cabin:\n  inertia_kg_m2: [1e5, 1e5, 6e5]\n", "cabin.inertia_kg_m2: principal moments"},
+      {"cabin:\n  inertia_kg_m2: [[3e5, 1e4, 0], [0, 4e5, 0], [0, 0, 6e5]]\n",
+       "cabin.inertia_kg_m2: must be symmetric"},
+  };
+  for (const auto& [text, expect] : bad) {
+    EXPECT_FALSE(ParseCableRobotYaml(text, "m.yaml", &robot, &error)) << text;
+    EXPECT_NE(error.find(expect), std::string::npos) << error;
+  }
 }
 
 // The reflector is optional model data: FAST's in the nominal model (design notes: a

@@ -47,6 +47,7 @@ __all__ = [
     "InputError",
     "LocateResult",
     "Model",
+    "ModesResult",
     "StaticsResult",
     "__version__",
     "arc",
@@ -57,6 +58,7 @@ __all__ = [
     "focal_grid",
     "line",
     "locate",
+    "modes",
     "quat_from_rpy_deg",
     "random_workspace",
     "read_dataset",
@@ -94,3 +96,4 @@ from .dataset import read_dataset, simulate  # noqa: F401
 from .calibration import CalibrationResult, calibrate, evaluate  # noqa: F401
 from .design import design  # noqa: F401
 from .track import TrackResult, track  # noqa: F401
+from .dynamics import ModesResult, modes  # noqa: F401

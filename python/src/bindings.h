@@ -111,6 +111,7 @@ void BindData(py::module_& m);
 void BindCalibration(py::module_& m);
 void BindDesign(py::module_& m);
 void BindTrack(py::module_& m);
+void BindModes(py::module_& m);
 
 }  // namespace fastcal::python
 

@@ -129,6 +129,26 @@ Eigen::Vector3d ToVector3(const DoubleArray& a, const char* name) {
   return Eigen::Vector3d(a.data()[0], a.data()[1], a.data()[2]);
 }
 
+// The cabin's inertia as a (3, 3) array, and back: (3,) is its diagonal, as in the file.
+DoubleArray Matrix3(const Eigen::Matrix3d& m) {
+  DoubleArray out = NewArray({3, 3});
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) out.mutable_data()[3 * r + c] = m(r, c);
+  }
+  return out;
+}
+Eigen::Matrix3d ToInertia(const DoubleArray& a) {
+  if (a.ndim() == 1 && a.shape(0) == 3) return ToVector3(a, "cabin_inertia_kg_m2").asDiagonal();
+  if (a.ndim() != 2 || a.shape(0) != 3 || a.shape(1) != 3) {
+    throw InputError("cabin_inertia_kg_m2 must have shape (3,) or (3, 3)");
+  }
+  Eigen::Matrix3d m;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m(r, c) = a.data()[3 * r + c];
+  }
+  return m;
+}
+
 CableRobot Load(const std::string& path) {
   CableRobot robot;
   std::string error;
@@ -302,6 +322,14 @@ ValueError ("assignment destination is read-only") instead of changing nothing.
           py::arg("joints"),
           "The mass centre (cabin frame, m, shape (3,)) with the moving parts at `joints` "
           "(joint_columns order, deg and m): docs/model.md, \"Moving parts\".")
+      .def_property(
+          "cabin_inertia_kg_m2",
+          [](const CableRobot& r) { return ReadOnly(Matrix3(r.cabin_inertia_kg_m2)); },
+          Validated<const DoubleArray&>(
+              [](CableRobot& r, const DoubleArray& v) { r.cabin_inertia_kg_m2 = ToInertia(v); }),
+          "The cabin's inertia about its mass centre, cabin frame (kg m^2), shape (3, 3); "
+          "assign (3,) for a diagonal. An assumed default (docs/model-format.md); only the "
+          "vibrations (fastcal.modes) use it.")
       .def_property("reflector", &GetReflector, Validated<const py::object&>(&SetReflector),
                     "The reflector cables are checked against: None, or a dict {centre_m (3,), "
                     "radius_m, aperture_m} (a sphere's lower cap; docs/model-format.md). Assign a "

@@ -159,4 +159,5 @@ PYBIND11_MODULE(_fastcal, m) {
   BindCalibration(m);
   BindDesign(m);
   BindTrack(m);
+  BindModes(m);
 }

@@ -79,6 +79,10 @@ struct CableRobot {
   // The rotator, the Stewart platform: parts whose joints move the mass centre
   // (moving_parts.h); none by default, and then the mass centre is fixed.
   MovingParts moving_parts;
+  // The cabin's inertia tensor about its mass centre, cabin frame (kg m^2; YAML
+  // cabin.inertia_kg_m2). Only the vibrations (modes.h) use it. The default is assumed,
+  // not measured: diag(3.5e5, 3.5e5, 5.0e5), about a 30 t cabin of ~13 m diameter.
+  Eigen::Matrix3d cabin_inertia_kg_m2 = Eigen::Vector3d(3.5e5, 3.5e5, 5.0e5).asDiagonal();
   // Gravitational acceleration along z (negative: z is up).
   double gravity_m_per_s2 = -9.8;
   // Optional model data: FAST's reflector in NominalFast(), none in a default-constructed
@@ -106,6 +110,7 @@ struct CableRobot {
   }
 
   // Checks physical sense: EA > 0, density > 0, mass > 0, g < 0, finite coordinates,
+  // a symmetric positive definite cabin inertia,
   // attachments valid (CableAttachment::IsValid) and at most kMaxAttachmentsPerCable,
   // a reflector (if any) with radius > 0 and aperture in (0, 2 radius], anchor indices in range, no
   // two tower tops coincident, no two distinct anchor points coincident. On failure returns false

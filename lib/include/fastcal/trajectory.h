@@ -116,6 +116,10 @@ struct FocalGridSpec {
 // The defaults give 1 + 8 * 24 = 193 points.
 bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d>* positions,
                           std::string* error);
+// Off-axis angle and azimuth (deg, azimuth in [0, 360)) of `position_m` about the focal
+// centre: the grid's own coordinates, recovered from its positions.
+void FocalGridAngles(const Eigen::Vector3d& position_m, const Eigen::Vector3d& centre_m,
+                     double* off_axis_deg, double* azimuth_deg);
 
 // Random positions spread uniformly over the area of the focal sphere's lower cap.
 struct RandomWorkspaceSpec {

@@ -240,6 +240,15 @@ bool PaperCircleMatcher::Matches() const {
          std::all_of(visited_.begin(), visited_.end(), [](bool v) { return v; });
 }
 
+void FocalGridAngles(const Eigen::Vector3d& position_m, const Eigen::Vector3d& centre_m,
+                     double* off_axis_deg, double* azimuth_deg) {
+  const Eigen::Vector3d d = position_m - centre_m;
+  *off_axis_deg = std::atan2(d.head<2>().norm(), -d.z()) * 180.0 / M_PI;
+  *azimuth_deg = d.head<2>().norm() > 0.0 ? std::atan2(d.y(), d.x()) * 180.0 / M_PI : 0.0;
+  if (*azimuth_deg < 0.0) *azimuth_deg += 360.0;
+  if (*azimuth_deg >= 360.0 - 1e-9) *azimuth_deg = 0.0;
+}
+
 bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d>* positions,
                           std::string* error) {
   if (positions == nullptr) return Fail(error, "positions must not be null");

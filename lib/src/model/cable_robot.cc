@@ -2,6 +2,7 @@
 // Table 1).
 #include "fastcal/cable_robot.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <sstream>
 
@@ -9,6 +10,23 @@ namespace fastcal {
 namespace {
 // Two tower tops or two anchor points closer than this are "coincident".
 constexpr double kCoincidentDistanceM = 1e-6;
+// A rigid body's inertia about its mass centre: finite, symmetric (to rounding), positive
+// definite, and its principal moments obey the triangle inequality (I1 + I2 >= I3), which
+// every real mass distribution does.
+bool IsCabinInertiaValid(const Eigen::Matrix3d& inertia, std::string* why) {
+  if (!inertia.allFinite()) return *why = "must be finite", false;
+  const double scale = inertia.cwiseAbs().maxCoeff();
+  if (!((inertia - inertia.transpose()).cwiseAbs().maxCoeff() <= 1e-9 * scale)) {
+    return *why = "must be symmetric", false;
+  }
+  const Eigen::Vector3d moments =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia, Eigen::EigenvaluesOnly).eigenvalues();
+  if (!(moments[0] > 0.0)) return *why = "must be positive definite (kg m^2)", false;
+  if (moments[0] + moments[1] < moments[2] * (1.0 - 1e-12)) {
+    return *why = "principal moments must obey I1 + I2 >= I3 (no rigid body has these)", false;
+  }
+  return true;
+}
 }  // namespace
 
 CableRobot CableRobot::NominalFast() {
@@ -93,6 +111,9 @@ bool CableRobot::IsValid(std::string* error) const {
   }
   if (!mass_centre_cabin_m.allFinite()) return fail("mass_centre_cabin_m", "must be finite");
   if (!moving_parts.IsValid(error)) return false;
+  if (std::string why; !IsCabinInertiaValid(cabin_inertia_kg_m2, &why)) {
+    return fail("cabin_inertia_kg_m2", why);
+  }
   if (reflector.has_value()) {
     if (!reflector->centre_m.allFinite()) return fail("reflector.centre_m", "must be finite");
     if (!(reflector->radius_m > 0.0) || !std::isfinite(reflector->radius_m)) {

@@ -172,15 +172,46 @@ class Parser {
     return true;
   }
 
+  // The cabin's inertia: [Ixx, Iyy, Izz] (principal axes along the cabin frame's) or a
+  // 3x3 list of rows.
+  bool ReadInertia(const YAML::Node& node, int line, const std::string& path,
+                   Eigen::Matrix3d* value) {
+    if (node.IsSequence() && node.size() == 3 && !node[0].IsSequence()) {
+      Eigen::Vector3d diagonal;
+      if (!ReadVector3(node, line, path, &diagonal)) return false;
+      *value = diagonal.asDiagonal();
+      return true;
+    }
+    if (!node.IsSequence() || node.size() != 3) {
+      return Fail(line, path, "expected [Ixx, Iyy, Izz] or three rows [[Ixx, Ixy, Ixz], ...]");
+    }
+    Eigen::Matrix3d m;
+    for (size_t r = 0; r < 3; ++r) {
+      Eigen::Vector3d row;
+      const int row_line = LineOf(node[r]) > 0 ? LineOf(node[r]) : line;
+      if (!ReadVector3(node[r], row_line, Index(path, r), &row)) return false;
+      m.row(r) = row.transpose();
+    }
+    *value = m;
+    return true;
+  }
+
   bool ReadCabin(const Entry& cabin, CableRobot* robot) {
     const std::string path = "cabin";
     std::map<std::string, Entry> keys;
     if (!ReadMap(cabin.value, LineOf(cabin.key), path,
-                 {"mass_kg", "mass_centre_m", "anchor_points_m", "moving_parts"}, &keys)) {
+                 {"mass_kg", "mass_centre_m", "inertia_kg_m2", "anchor_points_m", "moving_parts"},
+                 &keys)) {
       return false;
     }
     if (const auto it = keys.find("moving_parts"); it != keys.end()) {
       if (!ReadMovingParts(it->second, &robot->moving_parts)) return false;
+    }
+    if (const auto it = keys.find("inertia_kg_m2"); it != keys.end()) {
+      if (!ReadInertia(it->second.value, LineOf(it->second.key), Join(path, "inertia_kg_m2"),
+                       &robot->cabin_inertia_kg_m2)) {
+        return false;
+      }
     }
     if (const auto it = keys.find("mass_kg"); it != keys.end()) {
       if (!ReadDouble(it->second.value, LineOf(it->second.key), Join(path, "mass_kg"),
@@ -528,6 +559,7 @@ class Parser {
         {"anchor_points_cabin_m", "cabin.anchor_points_m"},
         {"mass_centre_cabin_m", "cabin.mass_centre_m"},
         {"cabin_mass_kg", "cabin.mass_kg"},
+        {"cabin_inertia_kg_m2", "cabin.inertia_kg_m2"},
     };
     for (const auto& [from, to] : kRenames) {
       for (size_t pos = message.find(from); pos != std::string::npos;
@@ -590,6 +622,12 @@ void WriteMovingParts(const MovingParts& moving, std::ostringstream& out) {
   }
 }
 
+// [Ixx, Iyy, Izz] when the tensor is diagonal, else its three rows.
+std::string InertiaText(const Eigen::Matrix3d& inertia) {
+  if (inertia.isDiagonal(0.0)) return Vec(inertia.diagonal());
+  return "[" + Vec(inertia.row(0)) + ", " + Vec(inertia.row(1)) + ", " + Vec(inertia.row(2)) + "]";
+}
+
 }  // namespace
 
 bool ParseCableRobotYaml(const std::string& text, const std::string& source_name, CableRobot* robot,
@@ -644,6 +682,8 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
   out << "cabin:\n";
   out << "  mass_kg: " << Num(robot.cabin_mass_kg) << "\n";
   out << "  mass_centre_m: " << Vec(robot.mass_centre_cabin_m) << "  # cabin frame\n";
+  out << "  inertia_kg_m2: " << InertiaText(robot.cabin_inertia_kg_m2)
+      << "  # about the mass centre, cabin frame (vibrations only)\n";
   out << "  anchor_points_m:  # cabin frame, m\n";
   for (const Eigen::Vector3d& a : robot.anchor_points_cabin_m) out << "    - " << Vec(a) << "\n";
   WriteMovingParts(robot.moving_parts, out);

@@ -18,7 +18,6 @@ namespace fastcal {
 namespace {
 
 constexpr double kNPerKn = 1e3;
-constexpr double kRadToDeg = 180.0 / M_PI;
 
 // `value` with `digits` significant digits (no trailing zeros), for files and text.
 std::string Num(double value, int digits = 10) {
@@ -32,17 +31,6 @@ std::string CableName(int cable) { return "cable " + std::to_string(cable + 1); 
 std::vector<double> Layers(double radial_offset_m) {
   if (radial_offset_m > 0.0) return {-radial_offset_m, 0.0, radial_offset_m};
   return {0.0};
-}
-
-// Off-axis angle and azimuth (deg, azimuth in [0, 360)) of `position` about the focal
-// centre: the grid's own coordinates, recovered from its positions.
-void GridAngles(const Eigen::Vector3d& position_m, const Eigen::Vector3d& centre_m,
-                double* off_axis_deg, double* azimuth_deg) {
-  const Eigen::Vector3d d = position_m - centre_m;
-  *off_axis_deg = std::atan2(d.head<2>().norm(), -d.z()) * kRadToDeg;
-  *azimuth_deg = d.head<2>().norm() > 0.0 ? std::atan2(d.y(), d.x()) * kRadToDeg : 0.0;
-  if (*azimuth_deg < 0.0) *azimuth_deg += 360.0;
-  if (*azimuth_deg >= 360.0 - 1e-9) *azimuth_deg = 0.0;
 }
 
 // Judges a solved node against the tension limits (the statics' own checks came first).
@@ -137,7 +125,7 @@ bool ComputeWorkspace(const CableRobot& robot, const WorkspaceOptions& options, 
       WorkspaceNode node;
       node.pose = pose;
       node.radial_offset_m = offset_m;
-      GridAngles(pose.position_m, layer.focal_centre_m, &node.off_axis_deg, &node.azimuth_deg);
+      FocalGridAngles(pose.position_m, layer.focal_centre_m, &node.off_axis_deg, &node.azimuth_deg);
       SolveStatics(robot, pose, options.statics, &solution);
       Judge(solution, options, &node);
       out.nodes.push_back(node);

@@ -1,0 +1,162 @@
+// `fastcal modes --data=FILE`: the dominant modes of a record of the cabin's free
+// vibration (ERA, modal_identification.h), compared with the prediction at the record's
+// pose, and what the differences point to.
+#include <gflags/gflags.h>
+
+#include <algorithm>
+#include <cmath>
+#include <iostream>
+#include <sstream>
+
+#include "cli_util.h"
+#include "columns_flag.h"
+#include "commands.h"
+#include "fastcal/dataset.h"
+#include "fastcal/internal/csv.h"
+#include "fastcal/modal_identification.h"
+
+DECLARE_string(data);
+DECLARE_string(output);
+DECLARE_bool(force);
+
+DEFINE_int32(identified_modes, 3, "modes --data: how many dominant modes to identify.");
+
+namespace fastcal::cli {
+namespace {
+
+constexpr char kCommand[] = "modes";
+constexpr double kNPerKn = 1e3;
+// Samples further than this fraction of the mean interval from even spacing make a record
+// that ERA (evenly sampled by its construction) cannot take.
+constexpr double kSpacingTolerance = 0.01;
+
+// The record's channels (x, y, z in m, roll, pitch, yaw in deg, and the six tensions in kN
+// when the file has them) and its mean pose; false when its times are not evenly spaced.
+bool RecordFromDataset(const Dataset& data, VibrationRecord* record, Pose* mean_pose,
+                       std::string* error) {
+  const int n = static_cast<int>(data.samples.size());
+  if (n < 2) {
+    *error = "--data=" + data.path + ": a record needs many samples, it has " + std::to_string(n);
+    return false;
+  }
+  const double dt = (data.samples.back().time_s - data.samples.front().time_s) / (n - 1);
+  for (int k = 1; k < n && dt > 0.0; ++k) {
+    const double step = data.samples[k].time_s - data.samples[k - 1].time_s;
+    if (std::abs(step - dt) > kSpacingTolerance * dt) {
+      *error = SampleWhere(data, data.samples[k]) + ": time_s steps by " + FormatDouble(step) +
+               " s where the record's mean interval is " + FormatDouble(dt) +
+               " s: the identification needs evenly spaced samples (one record, no gaps)";
+      return false;
+    }
+  }
+  if (!(dt > 0.0)) {
+    *error = "--data=" + data.path + ": time_s must increase";
+    return false;
+  }
+  const int channels = data.has_tensions ? 12 : 6;
+  record->sample_interval_s = dt;
+  record->channels.resize(channels, n);
+  Eigen::Vector3d mean_position = Eigen::Vector3d::Zero(), mean_rpy = Eigen::Vector3d::Zero();
+  for (int k = 0; k < n; ++k) {
+    const Sample& s = data.samples[k];
+    const Eigen::Vector3d rpy = RpyDegFromRotation(s.pose.rotation);
+    record->channels.col(k).head<3>() = s.pose.position_m;
+    record->channels.col(k).segment<3>(3) = rpy;
+    for (int i = 0; i < channels - 6; ++i) record->channels(6 + i, k) = s.tension_n[i] / kNPerKn;
+    mean_position += s.pose.position_m / n;
+    mean_rpy += rpy / n;  // FAST's attitudes stay far from the +-180 deg wrap
+  }
+  mean_pose->position_m = mean_position;
+  mean_pose->rotation = RotationFromRpyDeg(mean_rpy[0], mean_rpy[1], mean_rpy[2]);
+  return true;
+}
+
+std::string ComparisonCsv(const ModesComparisonResult& r) {
+  std::ostringstream out;
+  out << "mode,frequency_hz,frequency_sigma_hz,damping_ratio,damping_sigma,predicted_mode,"
+         "predicted_hz,predicted_kind,difference_percent,difference_sigma_percent";
+  for (int p = 0; p < kModeParameters; ++p) out << ",dlnf_dln_" << ModeParameterName(p);
+  out << "\n";
+  for (size_t i = 0; i < r.modes.size(); ++i) {
+    const ModeComparison& c = r.modes[i];
+    const IdentifiedMode& m = c.identified;
+    out << i + 1 << "," << FormatDouble(m.frequency_hz) << "," << FormatDouble(m.frequency_sigma_hz)
+        << "," << FormatDouble(m.damping_ratio) << "," << FormatDouble(m.damping_sigma) << ","
+        << c.predicted_mode << "," << FormatDouble(c.predicted_hz) << ","
+        << (c.predicted_cabin_share > 0.5 ? "cabin" : "cable") << ","
+        << FormatDouble(100 * c.difference) << "," << FormatDouble(100 * c.difference_sigma);
+    for (int p = 0; p < kModeParameters; ++p) out << "," << FormatDouble(c.sensitivity[p], 4);
+    out << "\n";
+  }
+  return out.str();
+}
+
+std::string ComparisonSummary(const ModesComparisonResult& r, const Pose& pose) {
+  std::ostringstream s;
+  s << "fastcal modes --data: " << r.modes.size() << " modes identified (ERA), predicted at the "
+    << "record's mean pose (" << FormatDouble(pose.position_m.x(), 5) << ", "
+    << FormatDouble(pose.position_m.y(), 5) << ", " << FormatDouble(pose.position_m.z(), 5)
+    << ") m";
+  for (const ModeComparison& c : r.modes) {
+    s << "\n  " << FormatDouble(c.identified.frequency_hz, 5) << " +- "
+      << FormatDouble(c.identified.frequency_sigma_hz, 2) << " Hz, damping "
+      << FormatDouble(100 * c.identified.damping_ratio, 3) << " +- "
+      << FormatDouble(100 * c.identified.damping_sigma, 2) << "%; predicted mode "
+      << c.predicted_mode << " " << FormatDouble(c.predicted_hz, 5) << " Hz ("
+      << (c.predicted_cabin_share > 0.5 ? "cabin" : "cable")
+      << "): " << FormatDouble(100 * c.difference, 3) << " +- "
+      << FormatDouble(100 * c.difference_sigma, 2) << "%";
+  }
+  s << "\n  against the model as it is: chi2 " << FormatDouble(r.chi2_model, 3) << " for "
+    << r.modes.size() << " degrees of freedom: "
+    << (r.agrees ? "the record agrees with the model" : "the record disagrees with the model");
+  s << "\n  each parameter alone (the change that explains the differences best, chi2 for "
+    << (r.modes.size() > 0 ? r.modes.size() - 1 : 0) << " degrees of freedom):";
+  for (int p = 0; p < kModeParameters; ++p) {
+    const ParameterFit& f = r.fits[p];
+    s << "\n    " << ModeParameterName(p) << " " << FormatDouble(100 * f.relative_change, 3)
+      << " +- " << FormatDouble(100 * f.sigma, 2) << "%, chi2 " << FormatDouble(f.chi2, 3)
+      << (p == r.best && !r.agrees ? "  <- the best single explanation" : "");
+  }
+  return s.str();
+}
+
+}  // namespace
+
+int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool to_file) {
+  std::string error;
+  for (const char* flag : {"position", "rpy", "quat", "rotvec", "attitude-law", "cap"}) {
+    if (FlagGiven(flag)) {
+      PrintError(kCommand, std::string("--") + flag +
+                               " does not apply to --data: the record gives its own pose");
+      return kExitUsage;
+    }
+  }
+  DatasetReadOptions read;
+  Dataset data;
+  VibrationRecord record;
+  Pose pose;
+  EraOptions era;
+  era.modes = FLAGS_identified_modes;
+  if (!era.IsValid(&error) || !ColumnsFromFlag(&read.columns, &error) ||
+      !ReadDataset(FLAGS_data, read, &data, &error) ||
+      !RecordFromDataset(data, &record, &pose, &error)) {
+    PrintError(kCommand, WithFlagNames(error, {{"modes", "--identified-modes"}}));
+    return kExitUsage;
+  }
+  std::vector<IdentifiedMode> identified;
+  ModesComparisonResult comparison;
+  if (!IdentifyModesEra(record, era, &identified, &error) ||
+      !CompareWithPrediction(robot, pose, identified, options, &comparison, &error)) {
+    PrintError(kCommand, error);
+    return kExitFailure;
+  }
+  if (!WriteOutput(to_file ? FLAGS_output : "-", ComparisonCsv(comparison), &error, FLAGS_force)) {
+    PrintError(kCommand, error);
+    return kExitFailure;
+  }
+  (to_file ? std::cout : std::cerr) << ComparisonSummary(comparison, pose) << std::endl;
+  return 0;
+}
+
+}  // namespace fastcal::cli

@@ -1,0 +1,170 @@
+// `fastcal simulate --vibration`: a record of the cabin's free vibration at one pose from
+// the linearised model (modal superposition of predicted modes with the damping and noise
+// given; modal_identification.h, SimulateVibrationRecord), as a dataset CSV that
+// `fastcal modes --data` identifies.
+#include <gflags/gflags.h>
+
+#include <iostream>
+#include <sstream>
+
+#include "cli_util.h"
+#include "commands.h"
+#include "fastcal/modal_identification.h"
+#include "fastcal/version.h"
+
+DECLARE_string(truth);
+DECLARE_string(out);
+DECLARE_bool(force);
+DECLARE_uint64(seed);
+DECLARE_double(interval_s);
+DECLARE_double(position_noise_m);
+DECLARE_double(attitude_noise_deg);
+DECLARE_double(tension_noise_kN);
+DECLARE_int32(segments);
+
+DEFINE_bool(vibration, false, "simulate: a free vibration at --position (docs/cli.md).");
+DEFINE_string(excite, "1,2,3", "simulate --vibration: the predicted modes excited (1-based).");
+DEFINE_string(damping, "0.005,0.01,0.015", "simulate --vibration: a damping ratio per mode.");
+DEFINE_double(amplitude_m, 0.05, "simulate --vibration: each mode's largest initial motion (m).");
+DEFINE_double(duration_s, 400.0, "simulate --vibration: the record's length (s).");
+
+namespace fastcal::cli {
+namespace {
+
+constexpr char kCommand[] = "simulate";
+// The record's sampling when --interval-s is not given (a survey's default is 1 s).
+constexpr double kVibrationIntervalS = 0.1;
+
+// "1,2,3" as numbers, each finite (any count: one per excited mode).
+bool ParseList(const std::string& flag, const std::string& text, std::vector<double>* values,
+               std::string* error) {
+  values->clear();
+  std::stringstream ss(text);
+  for (std::string item; std::getline(ss, item, ',');) {
+    double v = 0.0;
+    std::string why;
+    if (!ParseNumberItem(item, &v, &why)) {
+      *error = "--" + flag + "=" + text + ": " + why;
+      return false;
+    }
+    values->push_back(v);
+  }
+  return true;
+}
+
+bool SpecFromFlags(VibrationRecordSpec* spec, std::string* error) {
+  std::vector<double> excite;
+  if (!ParseList("excite", FLAGS_excite, &excite, error) ||
+      !ParseList("damping", FLAGS_damping, &spec->damping_ratio, error)) {
+    return false;
+  }
+  spec->modes.clear();
+  for (double m : excite) {
+    if (m != static_cast<int>(m) || m < 1 || m > 200) {
+      *error = "--excite=" + FLAGS_excite + ": modes are whole numbers from 1 to 200";
+      return false;
+    }
+    spec->modes.push_back(static_cast<int>(m));
+  }
+  for (double z : spec->damping_ratio) {
+    if (!(z > 0.0 && z < 0.5)) {
+      *error = "--damping=" + FLAGS_damping + ": each damping ratio in (0, 0.5)";
+      return false;
+    }
+  }
+  if (spec->damping_ratio.size() != spec->modes.size()) {
+    *error = "--damping gives " + std::to_string(spec->damping_ratio.size()) + " ratios for " +
+             std::to_string(spec->modes.size()) + " --excite modes";
+    return false;
+  }
+  spec->sample_interval_s = FlagGiven("interval-s") ? FLAGS_interval_s : kVibrationIntervalS;
+  if (!(spec->sample_interval_s > 0.0) || !(FLAGS_duration_s > 10 * spec->sample_interval_s) ||
+      !(FLAGS_duration_s <= 1e6)) {
+    *error = "--interval-s > 0 and --duration-s of at least 10 intervals (at most 1e6 s)";
+    return false;
+  }
+  spec->duration_s = FLAGS_duration_s;
+  spec->amplitude_m = FLAGS_amplitude_m;
+  spec->position_noise_m = FLAGS_position_noise_m;
+  spec->attitude_noise_deg = FLAGS_attitude_noise_deg;
+  spec->tension_noise_kn = FLAGS_tension_noise_kN;
+  spec->seed = FLAGS_seed;
+  spec->modes_options.segments = FLAGS_segments;
+  return spec->modes_options.IsValid(error);
+}
+
+std::string RecordCsv(const VibrationRecord& record, const std::string& header) {
+  std::ostringstream out;
+  out << header;
+  out << "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n";
+  for (int k = 0; k < record.channels.cols(); ++k) {
+    out << FormatDouble(k * record.sample_interval_s, 12);
+    for (int c = 0; c < record.channels.rows(); ++c) {
+      out << "," << FormatDouble(record.channels(c, k), 12);
+    }
+    out << "\n";
+  }
+  return out.str();
+}
+
+}  // namespace
+
+const std::set<std::string>& VibrationFlags() {
+  static const std::set<std::string> flags = {"vibration",
+                                              "truth",
+                                              "position",
+                                              "rpy",
+                                              "quat",
+                                              "rotvec",
+                                              "attitude-law",
+                                              "tilt-fraction",
+                                              "focal-centre",
+                                              "excite",
+                                              "damping",
+                                              "amplitude-m",
+                                              "duration-s",
+                                              "interval-s",
+                                              "position-noise-m",
+                                              "attitude-noise-deg",
+                                              "tension-noise-kN",
+                                              "seed",
+                                              "segments",
+                                              "out",
+                                              "force"};
+  return flags;
+}
+
+int RunSimulateVibration(int argc, char** argv) {
+  std::string error, attitude;
+  CableRobot robot;
+  Pose pose;
+  VibrationRecordSpec spec;
+  if (FLAGS_out.empty() || FLAGS_out == "-") {
+    PrintError(kCommand, "give --out=FILE.csv");
+    return kExitUsage;
+  }
+  if (!CheckCanWrite("out", FLAGS_out, FLAGS_force, &error) ||
+      !LoadModelFlag("truth", FLAGS_truth, &robot, &error) ||
+      !SinglePoseFromFlags(&pose, &attitude, &error) || !SpecFromFlags(&spec, &error)) {
+    PrintError(kCommand, WithFlagNames(error, {{"segments", "--segments"}}));
+    return kExitUsage;
+  }
+  VibrationRecord record;
+  if (!SimulateVibrationRecord(robot, pose, spec, &record, &error)) {
+    PrintError(kCommand, error);
+    return kExitFailure;
+  }
+  const std::string header = "# Simulated by fastcal " + std::string(FASTCAL_VERSION) +
+                             ": a free vibration from the linearised model\n# " +
+                             CommandLine(argc, argv, {"force"}) + "\n";
+  if (!WriteOutput(FLAGS_out, RecordCsv(record, header), &error, FLAGS_force)) {
+    PrintError(kCommand, error);
+    return kExitFailure;
+  }
+  std::cout << "fastcal simulate --vibration: " << record.channels.cols() << " samples every "
+            << FormatDouble(spec.sample_interval_s) << " s of modes " << FLAGS_excite << " at "
+            << attitude << ", written to " << FLAGS_out << std::endl;
+  return 0;
+}
+
+}  // namespace fastcal::cli
