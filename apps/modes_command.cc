@@ -21,6 +21,7 @@ DECLARE_bool(force);
 DECLARE_string(html);
 DECLARE_string(data);
 DECLARE_string(focal_centre);
+DECLARE_string(joints);  // solve_command.cc
 DECLARE_double(tilt_fraction);
 DECLARE_double(max_off_axis_deg);
 DECLARE_double(off_axis_step_deg);
@@ -61,7 +62,9 @@ Pose: --position=X,Y,Z (m) of the cabin frame's origin; its attitude from
 (deg, R = Rz(yaw) Ry(pitch) Rx(roll)), --quat=W,X,Y,Z or --rotvec=X,Y,Z (rad); R = I
 without one (as solve).
 Model: --model=FILE.yaml (docs/model-format.md); default the nominal FAST model. A model
-whose cables carry attachments is refused (not described yet).
+whose cables carry attachments is refused (not described yet). A model with moving parts
+(cabin.moving_parts) is linearised with its mass centre at --joints=v1,... (the model's
+joint order, deg and m; default all 0); the parts' own inertia is in the cabin's.
 
 Over the cap: --cap [--max-off-axis-deg=40 --off-axis-step-deg=5 --azimuth-step-deg=15
 --focal-radius=160 --focal-centre=0,0,300 --tilt-fraction=0.41] [--html=PAGE.html]: the
@@ -106,7 +109,7 @@ const std::set<std::string> kFlags = {
     "model", "position", "attitude-law", "rpy", "quat", "rotvec", "tilt-fraction",
     "focal-centre", "segments", "modes", "output", "force", "cap", "max-off-axis-deg",
     "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "html", "data", "columns",
-    "identified-modes"};
+    "identified-modes", "joints"};
 // clang-format on
 
 // "mode 4, 0.18208 Hz; cabin 56.5% (most z 56.5%), cables 43.5% (most cable 1 7.24%)".
@@ -288,7 +291,7 @@ int RunModes(int argc, char** argv) {
   options.segments = FLAGS_segments;
   options.modes = FLAGS_modes;
   if (!CheckOutputs(to_file, &error) || !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
-      !options.IsValid(&error)) {
+      !MassCentreAtJointsFlag(FLAGS_joints, &robot, &error) || !options.IsValid(&error)) {
     PrintError(kCommand, WithFlagNames(error, {{"segments", "--segments"}, {"modes", "--modes"}}));
     return kExitUsage;
   }

@@ -120,6 +120,12 @@ TEST_F(CliMovingPartsTest, RefusalsNameWhatIsMissing) {
                        "--joints needs 5 values"});
   RunBoundedAndExpect(
       {"solve --model=" + model + " --position=0,0,140 --joints=10,-5,0,0,0.1", 0, "exact"});
+  // The vibrations at given joints (modes.h): the mass centre moves, the count is checked.
+  RunBoundedAndExpect({"modes --model=" + model + " --position=0,0,140 --segments=8 --modes=3 "
+                           "--joints=20,0,0,0,0",
+                       0, "frequency_hz"});
+  RunBoundedAndExpect({"modes --model=" + model + " --position=0,0,140 --joints=20", 2,
+                       "--joints needs 5 values"});
 }
 
 TEST_F(CliMovingPartsTest, LocateTakesEachRowsJoints) {
