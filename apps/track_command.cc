@@ -77,7 +77,7 @@ Usage:
 Each window is folded at a linearisation point into its information over its own
 parameters and the shared ones (whitened by the slow sensor error, gross errors screened);
 the shared parameters come from the Schur complement of all windows, each window's from
-back-substitution, Gauss-Newton until every step is below 1% of its sigma. Each estimate
+back-substitution, Gauss-Newton until every step is below 5% of its sigma. Each estimate
 has sigma_total: the joint fit's covariance widened per window by its misfit and by
 residuals still correlated in time, plus the consider parameters' part.
 
@@ -176,19 +176,54 @@ std::string SharedLines(const TrackResult& r) {
   return s.str();
 }
 
+// The per-window table: each estimate's value right-aligned in its column and its
+// sigma_total after it, so that the digits line up.
 std::string WindowLines(const TrackResult& r) {
-  std::ostringstream s;
-  s << "\nPer window (track.csv):\n  window";
-  for (const std::string& n : r.window_parameters) s << "  " << n;
-  s << "\n";
+  std::vector<size_t> listed;
   for (size_t w = 0; w < r.windows.size(); ++w) {
-    if (r.windows.size() > kMaxListedWindows && w == kListedEnds) {
-      s << "  ... (" << r.windows.size() - 2 * kListedEnds << " more)\n";
+    if (r.windows.size() > kMaxListedWindows && w == kListedEnds)
       w = r.windows.size() - kListedEnds;
+    listed.push_back(w);
+  }
+  const size_t n = r.window_parameters.size();
+  std::vector<size_t> value_width(n, 0), sigma_width(n, 0);
+  size_t label_width = std::string("window").size();
+  const auto value = [&](size_t w, size_t k) {
+    return internal::FormatDouble("%.6g", r.windows[w].estimates[k].value);
+  };
+  const auto sigma = [&](size_t w, size_t k) {
+    return internal::FormatDouble("%.2g", r.windows[w].estimates[k].sigma_total);
+  };
+  for (size_t w : listed) {
+    label_width = std::max(label_width, r.windows[w].label.size());
+    for (size_t k = 0; k < n; ++k) {
+      value_width[k] = std::max(value_width[k], value(w, k).size());
+      sigma_width[k] = std::max(sigma_width[k], sigma(w, k).size());
     }
-    s << "  " << r.windows[w].label;
-    for (size_t k = 0; k < r.window_parameters.size(); ++k) {
-      s << "  " << Estimate(r.windows[w].estimates[k], r.window_units[k]);
+  }
+  const auto pad = [](const std::string& text, size_t width, bool right) {
+    const std::string fill(width > text.size() ? width - text.size() : 0, ' ');
+    return right ? fill + text : text + fill;
+  };
+  std::vector<std::string> cells(n);
+  std::ostringstream s;
+  s << "\nPer window (track.csv):\n  " << pad("window", label_width, false);
+  for (size_t k = 0; k < n; ++k) {
+    const std::string unit = r.window_units[k] == "1" ? "" : " " + r.window_units[k];
+    const size_t width = value_width[k] + 4 + sigma_width[k] + unit.size();
+    s << "  " << (k + 1 < n ? pad(r.window_parameters[k], width, false) : r.window_parameters[k]);
+  }
+  s << "\n";
+  for (size_t i = 0; i < listed.size(); ++i) {
+    const size_t w = listed[i];
+    if (i > 0 && w != listed[i - 1] + 1) {
+      s << "  ... (" << w - listed[i - 1] - 1 << " more)\n";
+    }
+    s << "  " << pad(r.windows[w].label, label_width, false);
+    for (size_t k = 0; k < n; ++k) {
+      const std::string unit = r.window_units[k] == "1" ? "" : " " + r.window_units[k];
+      s << "  " << pad(value(w, k), value_width[k], true) << " +- "
+        << pad(sigma(w, k), sigma_width[k], false) << unit;
     }
     s << "\n";
   }
@@ -203,10 +238,15 @@ std::string EventLine(const TrackResult& r, const TrackEvent& e) {
     for (int c : e.cables) line << " " << c;
     line << ")";
   }
+  const auto time = [&r](double t) {
+    return IsUnixTime(t) ? IsoUnixTime(t, r.time_offset_s)
+                         : internal::FormatDouble("%.17g", t) + " s";
+  };
   if (e.within_window) {
-    line << " inside the window, at "
-         << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
-                                  : internal::FormatDouble("%.17g", e.time_s) + " s");
+    line << " inside the window, at " << time(e.time_s) << " (" << time(e.time_low_s) << " to "
+         << time(e.time_high_s) << ")";
+  } else {
+    line << " between " << time(e.previous_time_s) << " and " << time(e.time_s);
   }
   line << ":";
   for (const TrackEventParameter& p : e.parameters) {

@@ -163,13 +163,18 @@ struct TrackEventParameter {
 };
 
 struct TrackEvent {
-  std::string kind;              // "parameter" or "sensor"
+  std::string kind;  // "parameter" or "sensor"
   // The first sample of the later window, and the last of the earlier one; or, when the
   // step is inside a window's telemetry (within_window), the first sample of the block
   // where it is and the last of the block before.
   double time_s = 0.0;
   double previous_time_s = 0.0;
   bool within_window = false;
+  // The change's likelihood interval (Hinkley 1970): between windows, the last sample
+  // before and the first after (previous_time_s, time_s); inside a window, the cuts
+  // between its blocks whose likelihood is within the chi-square(1) 95% point of the
+  // best's.
+  double time_low_s = 0.0, time_high_s = 0.0;
   int window = 0;           // index of the window the new value is first seen in
   int previous_window = 0;  // index of the last window before the change
   std::vector<TrackEventParameter> parameters;
@@ -202,6 +207,10 @@ struct TrackResult {
   double false_alarm = 0.01;
   int parameter_tests = 0, sensor_tests = 0;
   std::vector<TrackWander> wander;  // per group tested for parameter events
+  // The zone times are shown in (events.json, track.csv, the console), seconds east of
+  // UTC: the column map's (ColumnMapTime::offset_s), as calibrate and import show them;
+  // 0 (UTC) without a map. The windows are cut in UTC all the same.
+  int time_offset_s = 0;
   SlowErrorReport slow_error;
   long long samples = 0, readings = 0, gross_errors = 0;
   double chi_square = 0.0, reduced_chi_square = 0.0;

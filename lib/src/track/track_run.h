@@ -18,6 +18,9 @@
 namespace fastcal::internal {
 
 inline constexpr double kNPerKn = 1e3;
+// A change's likelihood interval in time (Hinkley 1970): the cuts whose statistic is within
+// the chi-square(1) point of this upper tail (95%) of the best's.
+inline constexpr double kIntervalLevel = 0.05;
 
 // The fold's columns: the spec's free parameters and its consider ones, in spec order.
 struct TrackLayout {
@@ -121,9 +124,9 @@ struct TrackRun {
   std::string Path(const std::string& name) const { return dir + "/" + name; }
 };
 
-// "2024-05-01T12:00:00Z" for a Unix time (the fraction when there is one), else the
-// seconds as a number.
-std::string TrackTimeText(double time_s);
+// "2024-05-01T12:00:00Z" for a Unix time (the fraction when there is one) in the zone
+// offset_s east of UTC ("2024-05-01T20:00:00+08:00"), else the seconds as a number.
+std::string TrackTimeText(double time_s, int offset_s);
 // The window's label from its key (track.h, TrackWindow::label).
 std::string WindowLabel(const WindowSpec& window, double start_s);
 
@@ -168,6 +171,43 @@ void ComputeWidening(TrackRun& run);
 // Stages of track_events.cc.
 TrackStatus ScanSensorSteps(TrackRun& run);
 TrackStatus FindParameterEvents(TrackRun& run);
+// An event between used windows `from` (the last with the old value) and `to` (the first
+// with the new one), timed between them (the last sample of one, the first of the other).
+TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind, double statistic,
+                   int dof, double threshold, int tests);
+// The score test of a step inside used window u's telemetry before block j, at the joint
+// fit: per block j (0 unused) the score s of "these parameters differ from block j on"
+// (the fold's block scores and information rows moved to the solution), its information
+// S with everything else profiled out, the statistic s^T S^-1 s / scale, and the
+// information of blocks j.. of the scanned columns. `rows` index the fold's block
+// information rows (BlockRowColumns), `columns` the fold columns they are of.
+struct SplitScore {
+  bool valid = false;
+  double statistic = 0.0;
+  Eigen::VectorXd score;
+  Eigen::MatrixXd schur;
+  Eigen::MatrixXd after_information;
+};
+std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector<int>& rows,
+                                   const std::vector<int>& columns, double scale);
+// The likelihood interval of a step inside a window from its scan (the contiguous blocks
+// whose statistic is within the chi-square(1) 95% point of block j's): the last sample
+// before the first such cut and the first after the last.
+std::pair<double, double> SplitInterval(const TrackRun& run, int u,
+                                        const std::vector<SplitScore>& scores, int j);
+
+// Stages of track_segment.cc: a per-window group's changes on one time line.
+struct GroupTest {
+  std::string kind;  // "parameter", or "sensor" for a per-window sensor group
+  int tests = 1;     // Bonferroni's count
+};
+// Candidate cuts of the time line: every window boundary, and every block boundary
+// inside a window.
+int TimelineCandidates(const TrackRun& run);
+// Appends group g's events (indices into layout.window_columns) and sets its wander (SI
+// variance per component).
+void SegmentGroup(const TrackRun& run, const std::vector<int>& g, const GroupTest& test,
+                  std::vector<TrackEvent>* out, double* wander);
 
 // Stages of track_output.cc.
 TrackStatus BuildModels(TrackRun& run);
