@@ -111,6 +111,7 @@ struct InnerStep {
   double statistic = 0.0;
   int block = -1;
   int splits = 0;
+  int window = -1;  // MoveStep's
 };
 InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
                      const std::vector<int>& columns) {
@@ -213,6 +214,39 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
   }
 }
 
+// Where a sensor step found at the boundary before used window u (the bias `size` higher
+// from u on) most likely is, on one time line: at that boundary, or inside window u - 1
+// (its blocks j.. already of the new value) or u (its blocks ..j-1 still of the old).
+// Moving it changes the chi-square by 2 s delta + S delta^2 (s the score of the part that
+// changes, S its information with everything else profiled out, delta the bias change
+// it gets: ScanSplits), over the window's misfit widening. Its place is the smallest;
+// it stays at the boundary (block -1) when the boundary is within the likelihood interval
+// (chi-square(1) 95% point) of it: an overnight re-zeroing is not put in an edge block.
+InnerStep MoveStep(const TrackRun& run, int u, const std::vector<int>& rows, int column,
+                   double size, bool before_ok, bool here_ok) {
+  InnerStep best;
+  double smallest = 0.0;  // the boundary's
+  for (const int v : {u - 1, u}) {
+    if (v == u - 1 ? !before_ok : !here_ok) continue;
+    const bool head = v == u;
+    const double delta = head ? -size : size;
+    const std::vector<SplitScore> scores = ScanSplits(run, v, rows, {column}, run.birge[v], head);
+    for (size_t j = 1; j < scores.size(); ++j) {
+      if (!scores[j].valid) continue;
+      const double change =
+          (2.0 * scores[j].score[0] * delta + scores[j].schur(0, 0) * delta * delta) / run.birge[v];
+      if (change < smallest) {
+        smallest = change;
+        best.window = v;
+        best.block = static_cast<int>(j);
+        best.statistic = -change;
+      }
+    }
+  }
+  if (!(best.statistic > ChiSquareQuantile(kIntervalLevel, 1))) return InnerStep();
+  return best;
+}
+
 // A sensor re-zeroed inside a window's telemetry: for each step, the windows on either
 // side of it are scanned for a step of that bias inside their own telemetry (the score
 // test over block boundaries, Bonferroni over them); the window that holds it gets an
@@ -264,13 +298,11 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     // A window is isolated only when its stretch keeps another window.
     const bool before_ok = u >= 2 && run.entry_of[u - 2][j] == e0;
     const bool here_ok = u + 1 < windows && run.entry_of[u + 1][j] == e;
-    const InnerStep before = before_ok ? ScanWithin(run, u - 1, rows, {column}) : InnerStep();
-    const InnerStep here = here_ok ? ScanWithin(run, u, rows, {column}) : InnerStep();
-    const bool in_before = Inside(run, before, 1), in_here = Inside(run, here, 1);
-    if (!in_before && !in_here) continue;
-    const bool use_here = in_here && (!in_before || here.statistic >= before.statistic);
-    const int v = use_here ? u : u - 1;
-    const InnerStep& step = use_here ? here : before;
+    const double size = run.shared[e].value_si - run.shared[e0].value_si;
+    const InnerStep step = MoveStep(run, u, rows, column, size, before_ok, here_ok);
+    if (step.block < 0) continue;
+    const bool use_here = step.window == u;
+    const int v = step.window;
     const WindowFold& f = run.windows[run.used[v]].fold;
     SharedEntry mixed = run.shared[use_here ? e : e0];
     mixed.inside = true;
@@ -289,8 +321,8 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     }
     run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
     run.Progress("sensor step of " + run.layout.Column(column).name + " inside window " +
-                 WindowText(run, v) + " (statistic " + FormatDouble("%.1f", step.statistic) +
-                 "): the window gets a value of its own");
+                 WindowText(run, v) + " (more likely than at the boundary, by a chi-square of " +
+                 FormatDouble("%.1f", step.statistic) + "): the window gets a value of its own");
     isolated = true;
   }
   return isolated ? Iterate(run, false) : TrackStatus::kOk;
@@ -316,7 +348,7 @@ TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kin
 }
 
 std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector<int>& rows,
-                                   const std::vector<int>& columns, double scale) {
+                                   const std::vector<int>& columns, double scale, bool head) {
   const WindowFold& f = run.windows[run.used[u]].fold;
   const int blocks = static_cast<int>(f.block_samples.size());
   const int pg = static_cast<int>(rows.size());
@@ -329,10 +361,14 @@ std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector
   const Eigen::VectorXd d = StepOf(run, u);
   Eigen::VectorXd score = Eigen::VectorXd::Zero(pg);
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pg, f.information.cols());
-  for (int j = blocks - 1; j >= 1; --j) {
+  for (int n = 1; n < blocks; ++n) {
+    // The part grows a block at a time: blocks j.. from the end, or ..j-1 from the start.
+    const int j = head ? n : blocks - n;
+    const int block = head ? n - 1 : j;
     for (int x = 0; x < pg; ++x) {
-      score[x] += f.block_scores(j, columns[x]) + f.block_information[j].row(rows[x]).dot(d);
-      cross.row(x) += f.block_information[j].row(rows[x]);
+      score[x] +=
+          f.block_scores(block, columns[x]) + f.block_information[block].row(rows[x]).dot(d);
+      cross.row(x) += f.block_information[block].row(rows[x]);
     }
     Eigen::MatrixXd self(pg, pg);
     for (int x = 0; x < pg; ++x) {
@@ -368,7 +404,9 @@ std::pair<double, double> SplitInterval(const TrackRun& run, int u,
   int first = j, last = j;
   while (within(first - 1)) --first;
   while (within(last + 1)) ++last;
-  return {f.block_last_time_s[first - 1], f.block_first_time_s[last]};
+  // A block's samples are one unit of the scan: the change may be anywhere in the blocks
+  // either side of a cut.
+  return {f.block_first_time_s[first - 1], f.block_last_time_s[last]};
 }
 
 TrackStatus ScanSensorSteps(TrackRun& run) {

@@ -177,22 +177,25 @@ TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kin
                    int dof, double threshold, int tests);
 // The score test of a step inside used window u's telemetry before block j, at the joint
 // fit: per block j (0 unused) the score s of "these parameters differ from block j on"
-// (the fold's block scores and information rows moved to the solution), its information
-// S with everything else profiled out, the statistic s^T S^-1 s / scale, and the
-// information of blocks j.. of the scanned columns. `rows` index the fold's block
-// information rows (BlockRowColumns), `columns` the fold columns they are of.
+// (or, with `head`, "differ before block j"; the fold's block scores and information rows
+// moved to the solution: the gradient of chi-square / 2 in the fold's convention), its
+// information S with everything else profiled out, the statistic s^T S^-1 s / scale, and
+// the information of the part's blocks of the scanned columns. `rows` index the fold's
+// block information rows (BlockRowColumns), `columns` the fold columns they are of.
 struct SplitScore {
   bool valid = false;
   double statistic = 0.0;
   Eigen::VectorXd score;
   Eigen::MatrixXd schur;
-  Eigen::MatrixXd after_information;
+  Eigen::MatrixXd after_information;  // of the part scanned
 };
 std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector<int>& rows,
-                                   const std::vector<int>& columns, double scale);
+                                   const std::vector<int>& columns, double scale,
+                                   bool head = false);
 // The likelihood interval of a step inside a window from its scan (the contiguous blocks
-// whose statistic is within the chi-square(1) 95% point of block j's): the last sample
-// before the first such cut and the first after the last.
+// whose statistic is within the chi-square(1) 95% point of block j's), widened to the
+// blocks either side of them: the first sample of the block before the first such cut and
+// the last of the block after the last.
 std::pair<double, double> SplitInterval(const TrackRun& run, int u,
                                         const std::vector<SplitScore>& scores, int j);
 

@@ -550,8 +550,14 @@ void SegmentGroup(const TrackRun& run, const std::vector<int>& g, const GroupTes
     e.time_s = times.second;
     e.within_window = cut.j > 0;
     const Span span = Interval(line, s, b[k - 1], cut, b[k + 1], c.statistic);
-    e.time_low_s = CutTimes(run, span.first).first;
-    e.time_high_s = CutTimes(run, span.last).second;
+    // A cut inside a window stands for a change anywhere in the blocks either side of it
+    // (a block's samples are one unit of the scan): the interval spans them.
+    const WindowFold& lo = run.windows[run.used[span.first.u]].fold;
+    const WindowFold& hi = run.windows[run.used[span.last.u]].fold;
+    e.time_low_s = span.first.j > 0 ? lo.block_first_time_s[span.first.j - 1]
+                                    : CutTimes(run, span.first).first;
+    e.time_high_s =
+        span.last.j > 0 ? hi.block_last_time_s[span.last.j] : CutTimes(run, span.last).second;
     for (int x = 0; x < p; ++x) {
       const ParameterSpec& spec = run.layout.Column(run.layout.window_columns[g[x]]);
       e.parameters.push_back(
