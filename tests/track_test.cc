@@ -106,6 +106,18 @@ TrackResult Track(const CalibrationSpec& spec, const std::vector<std::string>& f
   return result;
 }
 
+// A simulated season (Season) tracked with the slow error estimated, in a directory of
+// its own named `name`.
+TrackResult TrackSeason(int days, int per_day, std::uint64_t seed, const SimulationOptions& o,
+                        const std::string& name) {
+  CableRobot truth;
+  const Dataset data = Season(days, per_day, seed, o, &truth);
+  const std::string dir = TempDir(name);
+  fs::create_directories(dir);
+  return Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
+               {Write(data, dir + "/season.csv")}, dir + "/track");
+}
+
 std::string ReadText(const std::string& path) {
   std::ifstream in(path);
   std::stringstream s;
@@ -421,13 +433,7 @@ TEST(TrackTest, StepInsideADayIsOneEventAtItsBlock) {
   const double step_s = kStartS + 2 * kDayS + 0.5 * kPerDay * kIntervalS;  // mid-day 3
   SimulationOptions o;
   o.mass_centre_steps.push_back({step_s, {0.05, 0.0, 0.0}});
-  CableRobot truth;
-  const Dataset data = Season(kDays, kPerDay, 31, o, &truth);
-  const std::string dir = TempDir("inside");
-  fs::create_directories(dir);
-  const TrackResult r =
-      Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
-            {Write(data, dir + "/season.csv")}, dir + "/track");
+  const TrackResult r = TrackSeason(kDays, kPerDay, 31, o, "inside");
   ASSERT_EQ(r.events.size(), 1u);
   const TrackEvent& e = r.events[0];
   EXPECT_TRUE(e.within_window);
@@ -446,13 +452,7 @@ TEST(TrackTest, SensorReZeroedInsideADayIsTimedAtItsBlock) {
   const double step_s = kStartS + 2 * kDayS + 0.5 * kPerDay * kIntervalS;  // mid-day 3
   SimulationOptions o;
   o.sensor_bias_steps.push_back({step_s, 1, 6000.0});  // cable 2, +6 kN
-  CableRobot truth;
-  const Dataset data = Season(kDays, kPerDay, 41, o, &truth);
-  const std::string dir = TempDir("sensor_inside");
-  fs::create_directories(dir);
-  const TrackResult r =
-      Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
-            {Write(data, dir + "/season.csv")}, dir + "/track");
+  const TrackResult r = TrackSeason(kDays, kPerDay, 41, o, "sensor_inside");
   ASSERT_EQ(r.events.size(), 1u);
   const TrackEvent& e = r.events[0];
   EXPECT_EQ(e.kind, "sensor");
@@ -568,13 +568,7 @@ TEST(TrackTest, EveryMoveFoundAndDated) {
     if (t.kind == "sensor")
       o.sensor_bias_steps.push_back({t.time_s, t.cable - 1, 1e3 * t.shift[0]});
   }
-  CableRobot model;
-  const Dataset data = Season(kDays, kPerDay, 71, o, &model);
-  const std::string dir = TempDir("month");
-  fs::create_directories(dir);
-  const TrackResult r =
-      Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
-            {Write(data, dir + "/month.csv")}, dir + "/track");
+  const TrackResult r = TrackSeason(kDays, kPerDay, 71, o, "month");
   for (const TrackEvent& e : r.events) {
     std::printf("%s %s %.0f [%.0f, %.0f] %s %+.4g +- %.2g\n", e.kind.c_str(),
                 e.within_window ? "inside" : "between", e.time_s - kStartS, e.time_low_s - kStartS,
