@@ -81,26 +81,28 @@ back-substitution, Gauss-Newton until every step is below 5% of its sigma. Each 
 has sigma_total: the joint fit's covariance widened per window by its misfit and by
 residuals still correlated in time, plus the consider parameters' part.
 
-Events (events.json), each kind at a 1% false-alarm rate over the whole track:
-  sensor     a sensor's bias stepped (re-zeroed) between two windows or inside one: found
-             by a score scan over cables and window boundaries, then fitted per stretch
-             (a window with the step inside gets its own value), so that it does not
-             read as a mass-centre move
-  parameter  a per-window group (the mass centre) changed between consecutive windows,
-             or inside one (then one event from the window before to the window after),
-             beyond the group's wander from window to window (estimated from all the
-             windows' differences and stated: a mass centre that moves about is not a
-             string of steps)
-Time resolution: the window (the event's time is the later window's first sample), or,
-where the window's own telemetry places the step, its block within the window (about
-1/32 of it: "inside the window, at TIME").
+Events (events.json), each kind at a 1% false-alarm rate over the whole track, on one
+time line: a change may happen between two windows or inside one.
+  sensor     a sensor's bias stepped (re-zeroed): found by a score scan over cables and
+             window boundaries, fitted per stretch, then placed at its most likely time
+             (overnight, or inside the day before or after; a window with the step
+             inside gets its own value), so that it does not read as a mass-centre move
+  parameter  a per-window group (the mass centre) changed: each candidate time, between
+             windows or between blocks of one (about 1/32 of it), tested with all the
+             data before and after it; several found in turn; beyond the group's wander
+             from window to window (estimated with the steps found taken out, and
+             stated: a mass centre that moves about is not a string of steps)
+Dating: a change between windows lies between the last sample before it and the first
+after ("between A and B"); one inside a window at its most likely block, with its
+likelihood interval (inside the window, at TIME, from LOW to HIGH; events.json: time,
+after, time_low, time_high). Times in the column map's zone (UTC without a map).
 
 Outputs in DIR:
   track.csv               one row per window: window_start, window_end (ISO 8601 UTC),
                           samples, NAME, NAME_sigma_total per per-window parameter, each
                           sensor's offset, chi2/nu, widening, gross errors, window label
-  events.json             the events: time, kind, parameters {shift, sigma_total}, cables,
-                          statistic, p_value (family-wise)
+  events.json             the events: time, after, time_low, time_high, kind, parameters
+                          {shift, sigma_total}, cables, statistic, p_value (family-wise)
   model_calibrated@W.yaml the latest window's model, and one per event-free stretch
                           (@FIRST_to_LAST)
   track.html              the per-window parameters with bars, the sensors, the events

@@ -221,7 +221,7 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
 // changes, S its information with everything else profiled out, delta the bias change
 // it gets: ScanSplits), over the window's misfit widening. Its place is the smallest;
 // it stays at the boundary (block -1) when the boundary is within the likelihood interval
-// (chi-square(1) 95% point) of it: an overnight re-zeroing is not put in an edge block.
+// (LocationDrop(), 95%) of it: an overnight re-zeroing is not put in an edge block.
 InnerStep MoveStep(const TrackRun& run, int u, const std::vector<int>& rows, int column,
                    double size, bool before_ok, bool here_ok) {
   InnerStep best;
@@ -243,7 +243,7 @@ InnerStep MoveStep(const TrackRun& run, int u, const std::vector<int>& rows, int
       }
     }
   }
-  if (!(best.statistic > ChiSquareQuantile(kIntervalLevel, 1))) return InnerStep();
+  if (!(best.statistic > LocationDrop())) return InnerStep();
   return best;
 }
 
@@ -396,7 +396,7 @@ std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector
 std::pair<double, double> SplitInterval(const TrackRun& run, int u,
                                         const std::vector<SplitScore>& scores, int j) {
   const WindowFold& f = run.windows[run.used[u]].fold;
-  const double floor = scores[j].statistic - ChiSquareQuantile(kIntervalLevel, 1);
+  const double floor = scores[j].statistic - LocationDrop();
   const auto within = [&](int k) {
     return k >= 1 && k < static_cast<int>(scores.size()) && scores[k].valid &&
            scores[k].statistic >= floor;

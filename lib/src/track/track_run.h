@@ -6,6 +6,7 @@
 #define FASTCAL_SRC_TRACK_TRACK_RUN_H_
 
 #include <Eigen/Core>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -18,9 +19,16 @@
 namespace fastcal::internal {
 
 inline constexpr double kNPerKn = 1e3;
-// A change's likelihood interval in time (Hinkley 1970): the cuts whose statistic is within
-// the chi-square(1) point of this upper tail (95%) of the best's.
-inline constexpr double kIntervalLevel = 0.05;
+// A change's likelihood interval in time (Hinkley 1970, Biometrika 57): the cuts whose
+// statistic (twice the log-likelihood) is within LocationDrop() of the best's, at this
+// level (95%). The drop is not chi-square(1)'s 3.84: twice the log-likelihood ratio of
+// the true change time against the best is the largest of a two-sided random walk with
+// drift, in the limit of small steps max over t of 2 W(t) - |t| (W a standard Brownian
+// motion), whose sides exceed x each with probability exp(-x / 2): the drop is
+// -2 ln(1 - sqrt(level)), 7.35 at 95% (3.84 left an overnight re-zeroing in the previous
+// day's blocks, the maximum over a day's cuts of noise alone).
+inline constexpr double kIntervalLevel = 0.95;
+inline double LocationDrop() { return -2.0 * std::log(1.0 - std::sqrt(kIntervalLevel)); }
 
 // The fold's columns: the spec's free parameters and its consider ones, in spec order.
 struct TrackLayout {
@@ -193,7 +201,7 @@ std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector
                                    const std::vector<int>& columns, double scale,
                                    bool head = false);
 // The likelihood interval of a step inside a window from its scan (the contiguous blocks
-// whose statistic is within the chi-square(1) 95% point of block j's), widened to the
+// whose statistic is within LocationDrop() of block j's), widened to the
 // blocks either side of them: the first sample of the block before the first such cut and
 // the last of the block after the last.
 std::pair<double, double> SplitInterval(const TrackRun& run, int u,

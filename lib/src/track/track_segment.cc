@@ -24,7 +24,7 @@
 // c_i c_i^T. For a Gaussian model T(tau) is, up to a constant, twice the profile
 // log-likelihood of a change at tau with the stretches' values free: the best cut is its
 // maximum likelihood estimate, and its likelihood interval (Hinkley 1970, Biometrika 57)
-// the contiguous cuts with T >= T_max - chi-square(1) 95% point.
+// the contiguous cuts with T >= T_max - 7.35 (95%; track_run.h, LocationDrop).
 //
 // Several changes: binary segmentation (Scott and Knott 1974; Vostrikova 1981: scan every
 // stretch between the changes found, add the best significant cut, repeat), with the
@@ -448,14 +448,14 @@ std::pair<double, double> CutTimes(const TrackRun& run, const Cut& c) {
 }
 
 // The change's likelihood interval: the contiguous candidates around it (between its
-// neighbours lo and hi) whose T is within the chi-square(1) 95% point of its own.
+// neighbours lo and hi) whose T is within LocationDrop() of its own.
 struct Span {
   Cut first, last;
 };
 Span Interval(const Line& line, const Sums& s, const Cut& lo, const Cut& cut, const Cut& hi,
               double t) {
   const std::vector<Cut> candidates = Candidates(line);
-  const double floor = t - ChiSquareQuantile(kIntervalLevel, 1);
+  const double floor = t - LocationDrop();
   const int at =
       static_cast<int>(std::find(candidates.begin(), candidates.end(), cut) - candidates.begin());
   const auto inside = [&](int k) {
