@@ -231,7 +231,7 @@ InnerStep MoveStep(const TrackRun& run, int u, const std::vector<int>& rows, int
     const bool head = v == u;
     const double delta = head ? -size : size;
     const std::vector<SplitScore> scores = ScanSplits(run, v, rows, {column}, run.birge[v], head);
-    for (size_t j = 1; j < scores.size(); ++j) {
+    for (size_t j = kMinPartBlocks; j + kMinPartBlocks <= scores.size(); ++j) {
       if (!scores[j].valid) continue;
       const double change =
           (2.0 * scores[j].score[0] * delta + scores[j].schur(0, 0) * delta * delta) / run.birge[v];

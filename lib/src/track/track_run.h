@@ -28,6 +28,11 @@ inline constexpr double kNPerKn = 1e3;
 // -2 ln(1 - sqrt(level)), 7.35 at 95% (3.84 left an overnight re-zeroing in the previous
 // day's blocks, the maximum over a day's cuts of noise alone).
 inline constexpr double kIntervalLevel = 0.95;
+// A change inside a window leaves at least this many of its blocks on either side: a
+// window's edge block (a minute or two of telemetry, its errors correlated over about as
+// long) placed an overnight move of 3 cm inside the day before in 1 of 7 months; a change
+// in a window's first or last blocks is dated at the boundary beside them.
+inline constexpr int kMinPartBlocks = 2;
 inline double LocationDrop() { return -2.0 * std::log(1.0 - std::sqrt(kIntervalLevel)); }
 
 // The fold's columns: the spec's free parameters and its consider ones, in spec order.

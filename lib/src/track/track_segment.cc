@@ -334,12 +334,13 @@ Contrast ContrastAt(const Line& line, const Sums& s, const Cut& lo, const Cut& m
 }
 
 // Every cut of the line in time order: between windows, and inside each before each of
-// its blocks.
+// its blocks that leaves kMinPartBlocks on either side.
 std::vector<Cut> Candidates(const Line& line) {
   std::vector<Cut> out;
   for (int u = 0; u < line.windows; ++u) {
     if (u > 0) out.push_back({u, 0});
-    for (size_t j = 1; j < line.splits[u].size(); ++j) out.push_back({u, static_cast<int>(j)});
+    const int blocks = static_cast<int>(line.splits[u].size());
+    for (int j = kMinPartBlocks; j <= blocks - kMinPartBlocks; ++j) out.push_back({u, j});
   }
   return out;
 }
@@ -524,7 +525,8 @@ std::vector<Cut> FindCuts(const TrackRun& run, const std::vector<int>& g, double
 int TimelineCandidates(const TrackRun& run) {
   int count = std::max(0, static_cast<int>(run.used.size()) - 1);
   for (int w : run.used) {
-    count += std::max(0, static_cast<int>(run.windows[w].fold.block_samples.size()) - 1);
+    const int blocks = static_cast<int>(run.windows[w].fold.block_samples.size());
+    count += std::max(0, blocks - 2 * kMinPartBlocks + 1);
   }
   return count;
 }
