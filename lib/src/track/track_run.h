@@ -218,7 +218,7 @@ struct GroupTest {
   int tests = 1;     // Bonferroni's count
 };
 // Candidate cuts of the time line: every window boundary, and every block boundary
-// inside a window.
+// inside a window that leaves kMinPartBlocks on either side.
 int TimelineCandidates(const TrackRun& run);
 // Appends group g's events (indices into layout.window_columns) and sets its wander (SI
 // variance per component).
