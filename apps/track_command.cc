@@ -77,30 +77,32 @@ Usage:
 Each window is folded at a linearisation point into its information over its own
 parameters and the shared ones (whitened by the slow sensor error, gross errors screened);
 the shared parameters come from the Schur complement of all windows, each window's from
-back-substitution, Gauss-Newton until every step is below 1% of its sigma. Each estimate
+back-substitution, Gauss-Newton until every step is below 5% of its sigma. Each estimate
 has sigma_total: the joint fit's covariance widened per window by its misfit and by
 residuals still correlated in time, plus the consider parameters' part.
 
-Events (events.json), each kind at a 1% false-alarm rate over the whole track:
-  sensor     a sensor's bias stepped (re-zeroed) between two windows or inside one: found
-             by a score scan over cables and window boundaries, then fitted per stretch
-             (a window with the step inside gets its own value), so that it does not
-             read as a mass-centre move
-  parameter  a per-window group (the mass centre) changed between consecutive windows,
-             or inside one (then one event from the window before to the window after),
-             beyond the group's wander from window to window (estimated from all the
-             windows' differences and stated: a mass centre that moves about is not a
-             string of steps)
-Time resolution: the window (the event's time is the later window's first sample), or,
-where the window's own telemetry places the step, its block within the window (about
-1/32 of it: "inside the window, at TIME").
+Events (events.json), each kind at a 1% false-alarm rate over the whole track, on one
+time line: a change may happen between two windows or inside one.
+  sensor     a sensor's bias stepped (re-zeroed): found by a score scan over cables and
+             window boundaries, fitted per stretch, then placed at its most likely time
+             (overnight, or inside the day before or after; a window with the step
+             inside gets its own value), so that it does not read as a mass-centre move
+  parameter  a per-window group (the mass centre) changed: each candidate time, between
+             windows or between blocks of one (about 1/32 of it), tested with all the
+             data before and after it; several found in turn; beyond the group's wander
+             from window to window (estimated with the steps found taken out, and
+             stated: a mass centre that moves about is not a string of steps)
+Dating: a change between windows lies between the last sample before it and the first
+after ("between A and B"); one inside a window at its most likely block, with its
+likelihood interval (inside the window, at TIME, from LOW to HIGH; events.json: time,
+after, time_low, time_high). Times in the column map's zone (UTC without a map).
 
 Outputs in DIR:
   track.csv               one row per window: window_start, window_end (ISO 8601 UTC),
                           samples, NAME, NAME_sigma_total per per-window parameter, each
                           sensor's offset, chi2/nu, widening, gross errors, window label
-  events.json             the events: time, kind, parameters {shift, sigma_total}, cables,
-                          statistic, p_value (family-wise)
+  events.json             the events: time, after, time_low, time_high, kind, parameters
+                          {shift, sigma_total}, cables, statistic, p_value (family-wise)
   model_calibrated@W.yaml the latest window's model, and one per event-free stretch
                           (@FIRST_to_LAST)
   track.html              the per-window parameters with bars, the sensors, the events
@@ -176,19 +178,54 @@ std::string SharedLines(const TrackResult& r) {
   return s.str();
 }
 
+// The per-window table: each estimate's value right-aligned in its column and its
+// sigma_total after it, so that the digits line up.
 std::string WindowLines(const TrackResult& r) {
-  std::ostringstream s;
-  s << "\nPer window (track.csv):\n  window";
-  for (const std::string& n : r.window_parameters) s << "  " << n;
-  s << "\n";
+  std::vector<size_t> listed;
   for (size_t w = 0; w < r.windows.size(); ++w) {
-    if (r.windows.size() > kMaxListedWindows && w == kListedEnds) {
-      s << "  ... (" << r.windows.size() - 2 * kListedEnds << " more)\n";
+    if (r.windows.size() > kMaxListedWindows && w == kListedEnds)
       w = r.windows.size() - kListedEnds;
+    listed.push_back(w);
+  }
+  const size_t n = r.window_parameters.size();
+  std::vector<size_t> value_width(n, 0), sigma_width(n, 0);
+  size_t label_width = std::string("window").size();
+  const auto value = [&](size_t w, size_t k) {
+    return internal::FormatDouble("%.6g", r.windows[w].estimates[k].value);
+  };
+  const auto sigma = [&](size_t w, size_t k) {
+    return internal::FormatDouble("%.2g", r.windows[w].estimates[k].sigma_total);
+  };
+  for (size_t w : listed) {
+    label_width = std::max(label_width, r.windows[w].label.size());
+    for (size_t k = 0; k < n; ++k) {
+      value_width[k] = std::max(value_width[k], value(w, k).size());
+      sigma_width[k] = std::max(sigma_width[k], sigma(w, k).size());
     }
-    s << "  " << r.windows[w].label;
-    for (size_t k = 0; k < r.window_parameters.size(); ++k) {
-      s << "  " << Estimate(r.windows[w].estimates[k], r.window_units[k]);
+  }
+  const auto pad = [](const std::string& text, size_t width, bool right) {
+    const std::string fill(width > text.size() ? width - text.size() : 0, ' ');
+    return right ? fill + text : text + fill;
+  };
+  std::vector<std::string> cells(n);
+  std::ostringstream s;
+  s << "\nPer window (track.csv):\n  " << pad("window", label_width, false);
+  for (size_t k = 0; k < n; ++k) {
+    const std::string unit = r.window_units[k] == "1" ? "" : " " + r.window_units[k];
+    const size_t width = value_width[k] + 4 + sigma_width[k] + unit.size();
+    s << "  " << (k + 1 < n ? pad(r.window_parameters[k], width, false) : r.window_parameters[k]);
+  }
+  s << "\n";
+  for (size_t i = 0; i < listed.size(); ++i) {
+    const size_t w = listed[i];
+    if (i > 0 && w != listed[i - 1] + 1) {
+      s << "  ... (" << w - listed[i - 1] - 1 << " more)\n";
+    }
+    s << "  " << pad(r.windows[w].label, label_width, false);
+    for (size_t k = 0; k < n; ++k) {
+      const std::string unit = r.window_units[k] == "1" ? "" : " " + r.window_units[k];
+      s << "  " << pad(value(w, k), value_width[k], true) << " +- "
+        << pad(sigma(w, k), sigma_width[k], false) << unit;
     }
     s << "\n";
   }
@@ -203,10 +240,15 @@ std::string EventLine(const TrackResult& r, const TrackEvent& e) {
     for (int c : e.cables) line << " " << c;
     line << ")";
   }
+  const auto time = [&r](double t) {
+    return IsUnixTime(t) ? IsoUnixTime(t, r.time_offset_s)
+                         : internal::FormatDouble("%.17g", t) + " s";
+  };
   if (e.within_window) {
-    line << " inside the window, at "
-         << (IsUnixTime(e.time_s) ? IsoUnixTime(e.time_s, 0)
-                                  : internal::FormatDouble("%.17g", e.time_s) + " s");
+    line << " inside the window, at " << time(e.time_s) << " (" << time(e.time_low_s) << " to "
+         << time(e.time_high_s) << ")";
+  } else {
+    line << " between " << time(e.previous_time_s) << " and " << time(e.time_s);
   }
   line << ":";
   for (const TrackEventParameter& p : e.parameters) {

@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <vector>
 
 #include "cli_fixture.h"
 
@@ -45,10 +46,32 @@ TEST_F(CliTrackTest, SeasonMoveAndReZeroedSensorAreFoundAndWritten) {
                             "track): 2"),
             std::string::npos)
       << run.output;
-  EXPECT_NE(run.output.find("2024-05-03  parameter: mass_centre_m.x +0.0"), std::string::npos)
+  // Overnight: between the last sample before and the first after.
+  EXPECT_NE(run.output.find("2024-05-03  parameter between 2024-05-02T"), std::string::npos)
       << run.output;
-  EXPECT_NE(run.output.find("2024-05-06  sensor (cable 2): sensor_bias_kN[2] +"), std::string::npos)
+  EXPECT_NE(run.output.find("2024-05-06  sensor (cable 2) between "), std::string::npos)
       << run.output;
+  // The per-window table aligned: each row's "+-" at the same columns as the first's.
+  const size_t table = run.output.find("Per window (track.csv):\n");
+  ASSERT_NE(table, std::string::npos);
+  std::vector<std::string> rows;
+  for (size_t at = run.output.find('\n', table) + 1;
+       run.output.compare(at, 4, "  20") == 0 || run.output.compare(at, 8, "  window") == 0;
+       at = run.output.find('\n', at) + 1) {
+    rows.push_back(run.output.substr(at, run.output.find('\n', at) - at));
+  }
+  ASSERT_EQ(rows.size(), 8u) << run.output;
+  const auto pluses = [](const std::string& row) {
+    std::vector<size_t> at;
+    for (size_t k = row.find("+-"); k != std::string::npos; k = row.find("+-", k + 1))
+      at.push_back(k);
+    return at;
+  };
+  for (size_t k = 2; k < rows.size(); ++k) EXPECT_EQ(pluses(rows[k]), pluses(rows[1])) << rows[k];
+  EXPECT_EQ(rows[0].find("mass_centre_m.y") - rows[0].find("mass_centre_m.x"),
+            rows[1].find(" 0.1") - rows[1].find(" 0.2"))
+      << rows[0] << "\n"
+      << rows[1];
   const std::string csv = ReadFile(Path("t/track.csv"));
   EXPECT_EQ(csv.rfind("window_start,window_end,samples,mass_centre_m.x,", 0), 0u);
   EXPECT_NE(csv.find("\n2024-05-07T00:00:00Z,2024-05-08T00:00:00Z,240,"), std::string::npos);
@@ -84,6 +107,17 @@ TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
   EXPECT_NE(second.output.find("3 windows"), std::string::npos) << second.output;
   EXPECT_NE(second.output.find("(an update)"), std::string::npos) << second.output;
   EXPECT_NE(second.output.find("1 new file added"), std::string::npos) << second.output;
+  // The same files given from another directory are the track's (known by their bytes):
+  // an update that reads and folds nothing (issue 36).
+  fs::create_directories(Path("elsewhere"));
+  fs::copy_file(Path("a.csv"), Path("elsewhere/a.csv"));
+  fs::copy_file(Path("b.csv"), Path("elsewhere/b.csv"));
+  const auto moved =
+      Fastcal(track + " --data=" + Path("elsewhere/a.csv") + "," + Path("elsewhere/b.csv"));
+  ASSERT_EQ(moved.code, 0) << moved.output;
+  EXPECT_NE(moved.output.find("0 folds (an update)"), std::string::npos) << moved.output;
+  EXPECT_NE(moved.output.find("0 new files added"), std::string::npos) << moved.output;
+  EXPECT_NE(ReadFile(Path("t/track_state.json")).find("elsewhere/a.csv"), std::string::npos);
   // A file of the track left out is refused, the track kept.
   const auto missing = Fastcal(track + " --data=" + Path("b.csv"));
   EXPECT_EQ(missing.code, 2) << missing.output;
@@ -106,8 +140,12 @@ TEST_F(CliTrackTest, AnExportIsTrackedThroughItsColumnMap) {
   ASSERT_EQ(run.code, 0) << run.output;
   EXPECT_NE(run.output.find("1 window of 1d (2024-05-01), 1441 samples"), std::string::npos)
       << run.output;
-  EXPECT_NE(ReadFile(Path("t/track.csv")).find("\n2024-05-01T00:00:00Z,2024-05-02T00:00:00Z,1441,"),
-            std::string::npos);
+  // Its times in the map's zone (Beijing), as calibrate and import show them: the day is
+  // cut in UTC all the same.
+  EXPECT_NE(ReadFile(Path("t/track.csv"))
+                .find("\n2024-05-01T08:00:00+08:00,2024-05-02T08:00:00+08:00,1441,"),
+            std::string::npos)
+      << ReadFile(Path("t/track.csv"));
   // The same file without its map is not the track's.
   const auto without = Fastcal(track + " --data=" + data);
   EXPECT_EQ(without.code, 2) << without.output;
@@ -117,6 +155,8 @@ TEST_F(CliTrackTest, AnExportIsTrackedThroughItsColumnMap) {
 TEST_F(CliTrackTest, BadFlagsAndDirectoriesAreRefused) {
   const auto help = Fastcal("track --help");
   EXPECT_EQ(help.code, 0);
+  // When the fit stops, as TrackOptions::step_tolerance_sigmas says (issue 36).
+  EXPECT_NE(help.output.find("below 5% of its sigma"), std::string::npos) << help.output;
   EXPECT_NE(help.output.find("--window=1d"), std::string::npos);
   EXPECT_EQ(Fastcal("track --spec=" + Spec() + " --data=x.csv").code, 2);  // no --out
   const auto unknown = Fastcal("track --windows=1d");

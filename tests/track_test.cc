@@ -106,6 +106,18 @@ TrackResult Track(const CalibrationSpec& spec, const std::vector<std::string>& f
   return result;
 }
 
+// A simulated season (Season) tracked with the slow error estimated, in a directory of
+// its own named `name`.
+TrackResult TrackSeason(int days, int per_day, std::uint64_t seed, const SimulationOptions& o,
+                        const std::string& name) {
+  CableRobot truth;
+  const Dataset data = Season(days, per_day, seed, o, &truth);
+  const std::string dir = TempDir(name);
+  fs::create_directories(dir);
+  return Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
+               {Write(data, dir + "/season.csv")}, dir + "/track");
+}
+
 std::string ReadText(const std::string& path) {
   std::ifstream in(path);
   std::stringstream s;
@@ -421,13 +433,7 @@ TEST(TrackTest, StepInsideADayIsOneEventAtItsBlock) {
   const double step_s = kStartS + 2 * kDayS + 0.5 * kPerDay * kIntervalS;  // mid-day 3
   SimulationOptions o;
   o.mass_centre_steps.push_back({step_s, {0.05, 0.0, 0.0}});
-  CableRobot truth;
-  const Dataset data = Season(kDays, kPerDay, 31, o, &truth);
-  const std::string dir = TempDir("inside");
-  fs::create_directories(dir);
-  const TrackResult r =
-      Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
-            {Write(data, dir + "/season.csv")}, dir + "/track");
+  const TrackResult r = TrackSeason(kDays, kPerDay, 31, o, "inside");
   ASSERT_EQ(r.events.size(), 1u);
   const TrackEvent& e = r.events[0];
   EXPECT_TRUE(e.within_window);
@@ -446,13 +452,7 @@ TEST(TrackTest, SensorReZeroedInsideADayIsTimedAtItsBlock) {
   const double step_s = kStartS + 2 * kDayS + 0.5 * kPerDay * kIntervalS;  // mid-day 3
   SimulationOptions o;
   o.sensor_bias_steps.push_back({step_s, 1, 6000.0});  // cable 2, +6 kN
-  CableRobot truth;
-  const Dataset data = Season(kDays, kPerDay, 41, o, &truth);
-  const std::string dir = TempDir("sensor_inside");
-  fs::create_directories(dir);
-  const TrackResult r =
-      Track(LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
-            {Write(data, dir + "/season.csv")}, dir + "/track");
+  const TrackResult r = TrackSeason(kDays, kPerDay, 41, o, "sensor_inside");
   ASSERT_EQ(r.events.size(), 1u);
   const TrackEvent& e = r.events[0];
   EXPECT_EQ(e.kind, "sensor");
@@ -497,6 +497,113 @@ TEST(TrackTest, AWanderingMassCentreIsNotAStringOfSteps) {
     EXPECT_EQ(r.windows[r.events[0].window].label, "2024-05-07");
     EXPECT_NEAR(r.events[0].parameters[0].shift, 0.1, 3.0 * r.events[0].parameters[0].sigma_total);
   }
+}
+
+// Issue 36: a month with three mass-centre moves of 3 cm (two inside a day's telemetry,
+// one overnight), a sensor re-zeroed overnight and another inside a day. Every event is
+// reported once, of its kind and cable; an overnight one is dated between the two days'
+// data, one inside a day within 15 minutes of its true time and inside its likelihood
+// interval; each size within 2.5 sigma_total; no other event.
+struct TrueEvent {
+  std::string kind;
+  double time_s = 0.0;
+  bool overnight = false;
+  int cable = 0;          // a sensor's, 1-based
+  Eigen::Vector3d shift;  // m; a sensor's in kN in x
+};
+
+// Tolerances of the issue's "done when".
+constexpr double kDatingToleranceS = 15.0 * 60.0;
+constexpr double kSizeSigmas = 2.5;
+
+void ExpectEventsFoundAndDated(const TrackResult& r, const std::vector<TrueEvent>& truth) {
+  ASSERT_EQ(r.events.size(), truth.size());
+  for (const TrueEvent& t : truth) {
+    const TrackEvent* found = nullptr;
+    for (const TrackEvent& e : r.events) {
+      const bool cable = t.kind == "parameter" || e.cables == std::vector<int>{t.cable};
+      if (e.kind == t.kind && cable && e.time_low_s <= t.time_s + kDatingToleranceS &&
+          e.time_high_s >= t.time_s - kDatingToleranceS) {
+        found = &e;
+      }
+    }
+    ASSERT_NE(found, nullptr) << t.kind << " at " << t.time_s;
+    const TrackEvent& e = *found;
+    if (t.overnight) {
+      EXPECT_FALSE(e.within_window) << t.time_s;
+      EXPECT_LT(e.previous_time_s, t.time_s);
+      EXPECT_GT(e.time_s, t.time_s);
+      EXPECT_EQ(e.time_s, r.windows[e.window].first_time_s);
+      EXPECT_EQ(e.previous_time_s, r.windows[e.window - 1].last_time_s);
+    } else {
+      EXPECT_TRUE(e.within_window) << t.time_s;
+      EXPECT_NEAR(e.time_s, t.time_s, kDatingToleranceS);
+      EXPECT_LE(e.time_low_s, t.time_s);
+      EXPECT_GE(e.time_high_s, t.time_s);
+    }
+    const int components = t.kind == "sensor" ? 1 : 3;
+    ASSERT_EQ(e.parameters.size(), static_cast<size_t>(components));
+    for (int a = 0; a < components; ++a) {
+      EXPECT_NEAR(e.parameters[a].shift, t.shift[a], kSizeSigmas * e.parameters[a].sigma_total)
+          << t.kind << " at " << t.time_s << ": " << e.parameters[a].name;
+    }
+  }
+}
+
+TEST(TrackTest, EveryMoveFoundAndDated) {
+  constexpr int kDays = 30, kPerDay = 300;  // 100 minutes of telemetry a day
+  const auto in_day = [&](int day, double fraction) {
+    return kStartS + day * kDayS + fraction * kPerDay * kIntervalS;
+  };
+  const double night = 3600.0;  // before the day's telemetry
+  const std::vector<TrueEvent> truth = {
+      {"parameter", in_day(5, 0.4), false, 0, {0.03, 0.0, 0.0}},
+      {"sensor", kStartS + 9 * kDayS - night, true, 3, {4.0, 0.0, 0.0}},
+      {"parameter", kStartS + 13 * kDayS - night, true, 0, {0.0, 0.03, 0.0}},
+      {"sensor", in_day(18, 0.35), false, 5, {-3.5, 0.0, 0.0}},
+      {"parameter", in_day(23, 0.7), false, 0, {-0.03, 0.0, 0.0}}};
+  SimulationOptions o;
+  for (const TrueEvent& t : truth) {
+    if (t.kind == "parameter") o.mass_centre_steps.push_back({t.time_s, t.shift});
+    if (t.kind == "sensor")
+      o.sensor_bias_steps.push_back({t.time_s, t.cable - 1, 1e3 * t.shift[0]});
+  }
+  const TrackResult r = TrackSeason(kDays, kPerDay, 71, o, "month");
+  for (const TrackEvent& e : r.events) {
+    std::printf("%s %s %.0f [%.0f, %.0f] %s %+.4g +- %.2g\n", e.kind.c_str(),
+                e.within_window ? "inside" : "between", e.time_s - kStartS, e.time_low_s - kStartS,
+                e.time_high_s - kStartS, e.parameters[0].name.c_str(), e.parameters[0].shift,
+                e.parameters[0].sigma_total);
+  }
+  ExpectEventsFoundAndDated(r, truth);
+}
+
+// Each kind of event at 1% over the season: seasons without any event report one of a
+// kind in about 1% (scripts/track_false_alarms.sh runs hundreds; docs/calibration.md has
+// the figures). 20 seasons of ten days: at 1%, two or more of a kind come by chance in
+// 1.7% of such suites (seeded: the same every run).
+TEST(TrackTest, SeasonsWithoutAnEventReportNone) {
+  constexpr int kSeasons = 20, kDays = 10, kPerDay = 200;
+  constexpr int kMaxAlarmed = 1;
+  const CalibrationSpec spec =
+      LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}"));
+  const std::string dir = TempDir("null");
+  fs::create_directories(dir);
+  int parameter = 0, sensor = 0;
+  for (int k = 0; k < kSeasons; ++k) {
+    CableRobot truth;
+    const Dataset data = Season(kDays, kPerDay, 500 + 11 * k, SimulationOptions(), &truth);
+    const std::string out = dir + "/" + std::to_string(k);
+    const TrackResult r = Track(spec, {Write(data, out + ".csv")}, out);
+    bool p = false, s = false;
+    for (const TrackEvent& e : r.events) (e.kind == "sensor" ? s : p) = true;
+    parameter += p;
+    sensor += s;
+  }
+  std::printf("seasons with a false alarm: %d parameter, %d sensor of %d\n", parameter, sensor,
+              kSeasons);
+  EXPECT_LE(parameter, kMaxAlarmed);
+  EXPECT_LE(sensor, kMaxAlarmed);
 }
 
 TEST(TrackBadInputTest, RefusesWhatItCannotTrack) {

@@ -26,8 +26,10 @@ class TrackResult:
             reduced_chi_square, widening, folded (in this run), estimates (name ->
             {value, sigma_total, sigma_formal}, in the spec's units) and
             sensor_offset_kN (cable 1..6 -> the same, when the biases are shared).
-        events: dicts of kind ('parameter' or 'sensor'), time_s (the later window's first
-            sample), after_s (the earlier one's last), window, previous_window,
+        events: dicts of kind ('parameter' or 'sensor'), time_s (the first sample after
+            the change: the later window's first, or its block's inside a window),
+            after_s (the last before), time_low_s and time_high_s (its likelihood
+            interval), window, previous_window, within_window,
             parameters (name -> {shift, sigma_total, unit}), cables (for a sensor),
             statistic, degrees_of_freedom, threshold, p_value (family-wise).
         wander: per per-window group, its wander between windows beyond its errors

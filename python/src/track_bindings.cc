@@ -55,6 +55,8 @@ py::dict EventDict(const TrackResult& r, const TrackEvent& e) {
   d["kind"] = e.kind;
   d["time_s"] = e.time_s;
   d["after_s"] = e.previous_time_s;
+  d["time_low_s"] = e.time_low_s;
+  d["time_high_s"] = e.time_high_s;
   d["window"] = r.windows[e.window].label;
   d["previous_window"] = r.windows[e.previous_window].label;
   d["within_window"] = e.within_window;

@@ -22,21 +22,24 @@
 // time that the slow-error model left), plus the consider parameters' part.
 //
 // Events, each kind at family-wise false-alarm rate TrackOptions::false_alarm over the
-// whole season (Bonferroni over every test of the kind):
-//   sensor     a shared sensor bias that stepped between two windows (re-zeroed): the
-//              score test of "the bias differs from window w on" (as sensor_steps.h, with
-//              the per-window parameters profiled out), over every cable and window
-//              boundary; the largest significant one is fitted (the bias gets a value per
-//              stretch) and the scan repeated (binary segmentation). A re-zeroed sensor is
-//              then a sensor event, not a mass-centre move.
-//   parameter  a per-window group (the mass centre's three axes together) that changed
-//              between consecutive windows: the Wald test of the difference with its
-//              covariance from the sandwich (consecutive windows share b: their estimates
-//              are correlated, and the shared part cancels).
-// An event's time is the first sample of the later window (resolution: the window; the
-// last sample of the earlier one is given too), refined to a block of a window's samples
-// when the scan within it finds the step inside (a step inside a window shows as a change
-// on both sides of it: one event then, from the window before to the window after).
+// whole season (Bonferroni over every test of the kind), on one time line: a change may
+// happen between two windows or inside one (before any block of its fold).
+//   sensor     a shared sensor bias that stepped (re-zeroed): the score test of "the bias
+//              differs from window w on" (as sensor_steps.h, with the per-window
+//              parameters profiled out, over the whole stretch), over every cable and
+//              window boundary; the largest significant one is fitted (the bias gets a
+//              value per stretch) and the scan repeated (binary segmentation); then each
+//              step is moved to its most likely cut (into the window before or after,
+//              unless the boundary is within the likelihood interval). A re-zeroed sensor
+//              is then a sensor event, not a mass-centre move.
+//   parameter  a per-window group (the mass centre's three axes together) that changed:
+//              each candidate cut tested with the whole stretches before and after it
+//              (their windows' estimates, the window's two parts from its block rows:
+//              track_segment.cc), several by binary segmentation with re-testing, the
+//              group's wander estimated with the steps found taken out.
+// An event between windows is dated between the last sample before it and the first
+// after; one inside a window at the block of largest likelihood, with its likelihood
+// interval (TrackEvent::time_low_s, time_high_s).
 //
 // Outputs in DIR (WriteTrack; formats in docs/calibration.md, "Tracking: files"):
 // track.csv, events.json, model_calibrated@WINDOW.yaml (the latest window, and one per
@@ -164,13 +167,18 @@ struct TrackEventParameter {
 };
 
 struct TrackEvent {
-  std::string kind;              // "parameter" or "sensor"
+  std::string kind;  // "parameter" or "sensor"
   // The first sample of the later window, and the last of the earlier one; or, when the
   // step is inside a window's telemetry (within_window), the first sample of the block
   // where it is and the last of the block before.
   double time_s = 0.0;
   double previous_time_s = 0.0;
   bool within_window = false;
+  // The change's likelihood interval (Hinkley 1970): between windows, the last sample
+  // before and the first after (previous_time_s, time_s); inside a window, the cuts
+  // between its blocks whose likelihood is within the 95% drop (7.35) of the
+  // best's.
+  double time_low_s = 0.0, time_high_s = 0.0;
   int window = 0;           // index of the window the new value is first seen in
   int previous_window = 0;  // index of the last window before the change
   std::vector<TrackEventParameter> parameters;
@@ -203,6 +211,10 @@ struct TrackResult {
   double false_alarm = 0.01;
   int parameter_tests = 0, sensor_tests = 0;
   std::vector<TrackWander> wander;  // per group tested for parameter events
+  // The zone times are shown in (events.json, track.csv, the console), seconds east of
+  // UTC: the column map's (ColumnMapTime::offset_s), as calibrate and import show them;
+  // 0 (UTC) without a map. The windows are cut in UTC all the same.
+  int time_offset_s = 0;
   SlowErrorReport slow_error;
   long long samples = 0, readings = 0, gross_errors = 0;
   double chi_square = 0.0, reduced_chi_square = 0.0;

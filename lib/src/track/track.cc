@@ -92,7 +92,10 @@ TrackStatus Validate(TrackRun& run) {
   }
   run.model_yaml = CableRobotToYaml(run.model, "");
   run.spec_yaml = CalibrationSpecToYaml(run.spec);
-  if (run.options.read.columns) run.columns_text = run.options.read.columns->text;
+  if (run.options.read.columns) {
+    run.columns_text = run.options.read.columns->text;
+    run.result->time_offset_s = run.options.read.columns->time.offset_s;
+  }
   run.result->window = run.window;
   run.result->false_alarm = run.options.false_alarm;
   for (int k : run.layout.window_columns) {
@@ -125,8 +128,8 @@ TrackStatus Solve(TrackRun& run) { return internal::Iterate(run, true); }
 
 namespace internal {
 
-std::string TrackTimeText(double time_s) {
-  return IsUnixTime(time_s) ? IsoUnixTime(time_s, 0) : TimeValueText(time_s, TimeDisplay());
+std::string TrackTimeText(double time_s, int offset_s) {
+  return IsUnixTime(time_s) ? IsoUnixTime(time_s, offset_s) : TimeValueText(time_s, TimeDisplay());
 }
 
 std::string WindowLabel(const WindowSpec& window, double start_s) {

@@ -177,6 +177,30 @@ SavedState ParseState(const std::string& text) {
   return s;
 }
 
+// A file of the track given now at another path (from another directory, or moved) is
+// the same file when its content is: its bytes and SHA-256. Its path becomes the one
+// given, so that it is not read again.
+void RelocateFiles(const TrackRun& run, SavedState* s) {
+  for (TrackFile& f : s->files) {
+    if (std::find(run.data_paths.begin(), run.data_paths.end(), f.path) != run.data_paths.end()) {
+      continue;
+    }
+    for (const std::string& given : run.data_paths) {
+      const bool taken = std::any_of(s->files.begin(), s->files.end(),
+                                     [&](const TrackFile& g) { return g.path == given; });
+      std::error_code ec;
+      const auto bytes = fs::file_size(given, ec);
+      std::string digest, why;
+      if (taken || ec || static_cast<long long>(bytes) != f.bytes ||
+          !FileSha256(given, &digest, &why) || digest != f.sha256) {
+        continue;
+      }
+      f.path = given;
+      break;
+    }
+  }
+}
+
 // The saved state's check against this run's inputs: "" when it may be updated.
 std::string Mismatch(const TrackRun& run, const SavedState& s) {
   if (s.model_yaml != run.model_yaml) return "another model";
@@ -213,6 +237,7 @@ bool LoadSavedState(TrackRun& run, bool* use) {
     *run.error = run.Path(kStateFile) + ": line " + std::to_string(e.mark.line + 1) + ": " + e.msg;
     return false;
   }
+  RelocateFiles(run, &s);
   const std::string mismatch = Mismatch(run, s);
   if (!mismatch.empty()) {
     if (run.options.force) {

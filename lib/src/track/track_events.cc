@@ -64,23 +64,6 @@ Candidate BestStep(const TrackRun& run, const std::vector<int>& columns) {
 
 std::string WindowText(const TrackRun& run, int u) { return run.windows[run.used[u]].label; }
 
-// An event between used windows `from` (the last with the old value) and `to` (the first
-// with the new one).
-TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind, double statistic,
-                   int dof, double threshold, int tests) {
-  TrackEvent e;
-  e.kind = kind;
-  e.window = to;
-  e.previous_window = from;
-  e.time_s = run.windows[run.used[to]].first_s;
-  e.previous_time_s = run.windows[run.used[from]].last_s;
-  e.degrees_of_freedom = dof;
-  e.statistic = statistic;
-  e.threshold = threshold;
-  e.p_value = std::min(1.0, tests * ChiSquareTailProbability(statistic, dof));
-  return e;
-}
-
 // The Wald test of a split bias's step (entry e after entry e0), from the final fit.
 TrackEvent SensorEvent(const TrackRun& run, int e0, int e, double threshold, int tests) {
   const SharedEntry& entry = run.shared[e];
@@ -122,218 +105,32 @@ std::vector<std::vector<int>> WindowGroups(const TrackRun& run) {
   return groups;
 }
 
-// The Wald test of a group's change from used window `from` to `to` (later minus earlier,
-// its covariance from the sandwich and the consider part: the shared error cancels).
-struct GroupChange {
-  Eigen::VectorXd d;
-  Eigen::MatrixXd covariance;
-  double statistic = 0.0;
-};
-// `wander`: the group's variance per component between windows (GroupWander), added to
-// both windows'.
-GroupChange Change(const TrackRun& run, const std::vector<int>& g, int from, int to,
-                   double wander = 0.0) {
-  const int dof = static_cast<int>(g.size());
-  const Eigen::MatrixXd c = TotalCovariance(run, to, to) + TotalCovariance(run, from, from) -
-                            TotalCovariance(run, to, from) - TotalCovariance(run, from, to);
-  GroupChange out;
-  out.d.resize(dof);
-  out.covariance.resize(dof, dof);
-  for (int x = 0; x < dof; ++x) {
-    out.d[x] = run.solver.a(to)[g[x]] - run.solver.a(from)[g[x]];
-    for (int y = 0; y < dof; ++y) out.covariance(x, y) = c(g[x], g[y]);
-    out.covariance(x, x) += 2.0 * wander;
-  }
-  out.statistic = out.d.dot(Eigen::LDLT<Eigen::MatrixXd>(out.covariance).solve(out.d));
-  return out;
-}
-
-// Fewest window boundaries from which a group's wander is estimated.
-// (A step inside a window changes the two boundaries around it: the median of 8 or more
-// holds against three such.)
-constexpr int kMinWanderBoundaries = 8;
-
-// The group's wander between windows (track.h, TrackWander): the variance v per component
-// (SI) at which the median over consecutive windows of d^T (C + 2 v I)^-1 d is the
-// chi-square median (a random effect per window, estimated robustly: a few steps among
-// the boundaries do not move the median); 0 when the median is already below it.
-double GroupWander(const TrackRun& run, const std::vector<int>& g) {
-  const int boundaries = static_cast<int>(run.used.size()) - 1;
-  if (boundaries < kMinWanderBoundaries) return 0.0;
-  const int dof = static_cast<int>(g.size());
-  std::vector<GroupChange> changes;
-  for (int u = 1; u <= boundaries; ++u) changes.push_back(Change(run, g, u - 1, u));
-  const double target = ChiSquareQuantile(0.5, dof);
-  const auto median_at = [&](double v) {
-    std::vector<double> t;
-    for (const GroupChange& c : changes) {
-      Eigen::MatrixXd m = c.covariance;
-      m.diagonal().array() += 2.0 * v;
-      t.push_back(c.d.dot(Eigen::LDLT<Eigen::MatrixXd>(m).solve(c.d)));
-    }
-    std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
-    return t[t.size() / 2];
-  };
-  if (!(median_at(0.0) > target)) return 0.0;
-  double scale = 0.0;  // the differences' own variance: where to start
-  for (const GroupChange& c : changes) scale = std::max(scale, c.covariance.diagonal().maxCoeff());
-  double lo = 0.0, hi = std::max(scale, 1e-300);
-  for (int k = 0; k < 200 && median_at(hi) > target; ++k) hi *= 4.0;
-  for (int k = 0; k < 100; ++k) {
-    const double mid = 0.5 * (lo + hi);
-    (median_at(mid) > target ? lo : hi) = mid;
-  }
-  return hi;
-}
-
-// A step within used window u's telemetry: the score test of "these parameters differ
-// from block j on", at the joint fit, over the window's block boundaries (the fold's block
-// scores and information rows, moved to the solution), judged against the window's misfit
-// alone (a step inside the window is what its block correlation shows). `rows` index the
-// fold's block information rows (track_fold.h, BlockRowColumns), `columns` the fold
-// columns they are of.
+// The largest of ScanSplits' statistics over window u's block boundaries, judged against
+// its misfit alone (a step inside the window is what its block correlation shows).
 struct InnerStep {
   double statistic = 0.0;
   int block = -1;
   int splits = 0;
+  int window = -1;  // MoveStep's
 };
 InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
-                     const std::vector<int>& columns, bool widened = false) {
-  const WindowFold& f = run.windows[run.used[u]].fold;
-  const int blocks = static_cast<int>(f.block_samples.size());
-  const int pg = static_cast<int>(rows.size());
+                     const std::vector<int>& columns) {
   InnerStep best;
-  best.splits = std::max(0, blocks - 1);
-  if (blocks < 2) return best;
-  for (int x : rows) {
-    if (x >= f.block_information[0].rows()) return best;  // a fold without the rows
-  }
-  const std::vector<int> order = LocalOrder(run);
-  const ArrowBlock& k = run.problem.blocks[u];
-  const Eigen::VectorXd d = StepOf(run, u);
-  Eigen::VectorXd score = Eigen::VectorXd::Zero(pg);
-  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pg, f.information.cols());
-  for (int j = blocks - 1; j >= 1; --j) {
-    for (int x = 0; x < pg; ++x) {
-      score[x] += f.block_scores(j, columns[x]) + f.block_information[j].row(rows[x]).dot(d);
-      cross.row(x) += f.block_information[j].row(rows[x]);
-    }
-    Eigen::MatrixXd self(pg, pg);
-    for (int x = 0; x < pg; ++x) {
-      for (int y = 0; y < pg; ++y) self(x, y) = cross(x, columns[y]);
-    }
-    ArrowVector c;
-    for (const ArrowBlock& other : run.problem.blocks)
-      c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
-    c.b = Eigen::MatrixXd::Zero(run.problem.q, pg);
-    for (int x = 0; x < pg; ++x) {
-      for (int r = 0; r < k.p; ++r) c.a[u](r, x) = cross(x, order[r]);
-      for (int m = 0; m < k.m(); ++m) c.b(k.shared_index[m], x) += cross(x, order[k.p + m]);
-    }
-    const ArrowVector solved = run.solver.SolveFor(c);
-    const Eigen::MatrixXd schur =
-        self - c.a[u].transpose() * solved.a[u] - c.b.transpose() * solved.b;
-    const double t = score.dot(Eigen::LDLT<Eigen::MatrixXd>(schur).solve(score)) /
-                     (widened ? std::max(run.birge[u], run.widening[u]) : run.birge[u]);
-    if (std::isfinite(t) && t > best.statistic) {
-      best.statistic = t;
-      best.block = j;
+  const std::vector<SplitScore> scores = ScanSplits(run, u, rows, columns, run.birge[u]);
+  best.splits = std::max(0, static_cast<int>(scores.size()) - 1);
+  for (size_t j = 1; j < scores.size(); ++j) {
+    if (scores[j].valid && scores[j].statistic > best.statistic) {
+      best.statistic = scores[j].statistic;
+      best.block = static_cast<int>(j);
     }
   }
   return best;
-}
-
-// The scan of group g (indices into layout.window_columns: the first block rows). A
-// group that wanders (GroupWander) is judged against the window's whole widening, its
-// residuals' correlation in time included: a wander is not a step.
-InnerStep ScanGroupWithin(const TrackRun& run, int u, const std::vector<int>& g, bool wanders) {
-  std::vector<int> columns;
-  for (int x : g) columns.push_back(run.layout.window_columns[x]);
-  return ScanWithin(run, u, g, columns, wanders);
 }
 
 // Whether the scan of window u found a step inside it (Bonferroni over its splits).
 bool Inside(const TrackRun& run, const InnerStep& step, int dof) {
   return step.block > 0 &&
          step.statistic > ChiSquareQuantile(run.options.false_alarm / step.splits, dof);
-}
-
-// The event's time refined to the block of window u where the step is (its first sample,
-// and the block before's last).
-void RefineTime(const TrackRun& run, int u, const InnerStep& step, TrackEvent* e) {
-  const WindowFold& f = run.windows[run.used[u]].fold;
-  e->time_s = f.block_first_time_s[step.block];
-  e->previous_time_s = f.block_last_time_s[step.block - 1];
-  e->within_window = true;
-}
-
-// The events of group g: each change between consecutive windows beyond the threshold.
-// A step inside window u shows as a change on both sides of it (each about the part of
-// the window after or before the step): when the scan within u finds the step, the two
-// are one event from u - 1 to u + 1, timed at the step's block, whichever side alone was
-// significant; else the event is between the two windows, at the window's resolution.
-void GroupEvents(const TrackRun& run, const std::vector<int>& g, std::vector<TrackEvent>* out) {
-  const TrackResult& r = *run.result;
-  const int dof = static_cast<int>(g.size());
-  const int tests = std::max(1, r.parameter_tests);
-  const double threshold = ChiSquareQuantile(run.options.false_alarm / tests, dof);
-  const ParameterSpec& first = run.layout.Column(run.layout.window_columns[g[0]]);
-  const bool sensor =
-      first.kind == ParameterKind::kSensorBias || first.kind == ParameterKind::kSensorGain;
-  const int windows = static_cast<int>(run.used.size());
-  const double wander = GroupWander(run, g);
-  {
-    TrackWander w;
-    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[0]]);
-    w.group = dof > 1 ? std::string(ParameterGroupName(s.kind)) : s.name;
-    w.unit = s.unit;
-    w.rms = std::sqrt(wander) / s.to_si;
-    run.result->wander.push_back(w);
-  }
-  std::vector<bool> changed(windows, false);
-  for (int u = 1; u < windows; ++u) {
-    changed[u] = Change(run, g, u - 1, u, wander).statistic > threshold;
-  }
-  int last_to = -1;  // the later window of the group's last event: events do not overlap
-  for (int u = 1; u < windows; ++u) {
-    if (!changed[u]) continue;
-    int from = u - 1, to = u, inside = -1;
-    InnerStep step;
-    const InnerStep here = ScanGroupWithin(run, u, g, wander > 0.0);
-    const InnerStep before =
-        u - 1 != last_to ? ScanGroupWithin(run, u - 1, g, wander > 0.0) : InnerStep();
-    const bool in_here = Inside(run, here, dof), in_before = Inside(run, before, dof);
-    // The step inside a window is the change across it, which must stand on its own.
-    const auto across = [&](int a, int b) {
-      return Change(run, g, a, b, wander).statistic > threshold;
-    };
-    if (in_here && (!in_before || here.statistic >= before.statistic) &&
-        across(u - 1, std::min(u + 1, windows - 1))) {
-      inside = u;
-      step = here;
-      to = std::min(u + 1, windows - 1);
-    } else if (in_before && across(std::max(u - 2, 0), u)) {
-      inside = u - 1;
-      step = before;
-      from = std::max(u - 2, 0);
-    }
-    for (int v = u + 1; v <= to; ++v) changed[v] = false;
-    last_to = to;
-    const GroupChange change = Change(run, g, from, to, wander);
-    TrackEvent e = EventAt(run, from, to, sensor ? "sensor" : "parameter", change.statistic, dof,
-                           threshold, tests);
-    if (inside >= 0) {
-      RefineTime(run, inside, step, &e);
-      e.window = inside;
-    }
-    for (int x = 0; x < dof; ++x) {
-      const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[x]]);
-      e.parameters.push_back(
-          {s.name, s.unit, change.d[x] / s.to_si, std::sqrt(change.covariance(x, x)) / s.to_si});
-      if (sensor && s.index >= 0) e.cables.push_back(s.index + 1);
-    }
-    out->push_back(e);
-  }
 }
 
 }  // namespace
@@ -417,6 +214,39 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
   }
 }
 
+// Where a sensor step found at the boundary before used window u (the bias `size` higher
+// from u on) most likely is, on one time line: at that boundary, or inside window u - 1
+// (its blocks j.. already of the new value) or u (its blocks ..j-1 still of the old).
+// Moving it changes the chi-square by 2 s delta + S delta^2 (s the score of the part that
+// changes, S its information with everything else profiled out, delta the bias change
+// it gets: ScanSplits), over the window's misfit widening. Its place is the smallest;
+// it stays at the boundary (block -1) when the boundary is within the likelihood interval
+// (LocationDrop(), 95%) of it: an overnight re-zeroing is not put in an edge block.
+InnerStep MoveStep(const TrackRun& run, int u, const std::vector<int>& rows, int column,
+                   double size, bool before_ok, bool here_ok) {
+  InnerStep best;
+  double smallest = 0.0;  // the boundary's
+  for (const int v : {u - 1, u}) {
+    if (v == u - 1 ? !before_ok : !here_ok) continue;
+    const bool head = v == u;
+    const double delta = head ? -size : size;
+    const std::vector<SplitScore> scores = ScanSplits(run, v, rows, {column}, run.birge[v], head);
+    for (size_t j = kMinPartBlocks; j + kMinPartBlocks <= scores.size(); ++j) {
+      if (!scores[j].valid) continue;
+      const double change =
+          (2.0 * scores[j].score[0] * delta + scores[j].schur(0, 0) * delta * delta) / run.birge[v];
+      if (change < smallest) {
+        smallest = change;
+        best.window = v;
+        best.block = static_cast<int>(j);
+        best.statistic = -change;
+      }
+    }
+  }
+  if (!(best.statistic > LocationDrop())) return InnerStep();
+  return best;
+}
+
 // A sensor re-zeroed inside a window's telemetry: for each step, the windows on either
 // side of it are scanned for a step of that bias inside their own telemetry (the score
 // test over block boundaries, Bonferroni over them); the window that holds it gets an
@@ -468,13 +298,11 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     // A window is isolated only when its stretch keeps another window.
     const bool before_ok = u >= 2 && run.entry_of[u - 2][j] == e0;
     const bool here_ok = u + 1 < windows && run.entry_of[u + 1][j] == e;
-    const InnerStep before = before_ok ? ScanWithin(run, u - 1, rows, {column}) : InnerStep();
-    const InnerStep here = here_ok ? ScanWithin(run, u, rows, {column}) : InnerStep();
-    const bool in_before = Inside(run, before, 1), in_here = Inside(run, here, 1);
-    if (!in_before && !in_here) continue;
-    const bool use_here = in_here && (!in_before || here.statistic >= before.statistic);
-    const int v = use_here ? u : u - 1;
-    const InnerStep& step = use_here ? here : before;
+    const double size = run.shared[e].value_si - run.shared[e0].value_si;
+    const InnerStep step = MoveStep(run, u, rows, column, size, before_ok, here_ok);
+    if (step.block < 0) continue;
+    const bool use_here = step.window == u;
+    const int v = step.window;
     const WindowFold& f = run.windows[run.used[v]].fold;
     SharedEntry mixed = run.shared[use_here ? e : e0];
     mixed.inside = true;
@@ -493,14 +321,93 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     }
     run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
     run.Progress("sensor step of " + run.layout.Column(column).name + " inside window " +
-                 WindowText(run, v) + " (statistic " + FormatDouble("%.1f", step.statistic) +
-                 "): the window gets a value of its own");
+                 WindowText(run, v) + " (more likely than at the boundary, by a chi-square of " +
+                 FormatDouble("%.1f", step.statistic) + "): the window gets a value of its own");
     isolated = true;
   }
   return isolated ? Iterate(run, false) : TrackStatus::kOk;
 }
 
 }  // namespace
+
+TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind, double statistic,
+                   int dof, double threshold, int tests) {
+  TrackEvent e;
+  e.kind = kind;
+  e.window = to;
+  e.previous_window = from;
+  e.time_s = run.windows[run.used[to]].first_s;
+  e.previous_time_s = run.windows[run.used[from]].last_s;
+  e.time_low_s = e.previous_time_s;
+  e.time_high_s = e.time_s;
+  e.degrees_of_freedom = dof;
+  e.statistic = statistic;
+  e.threshold = threshold;
+  e.p_value = std::min(1.0, tests * ChiSquareTailProbability(statistic, dof));
+  return e;
+}
+
+std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector<int>& rows,
+                                   const std::vector<int>& columns, double scale, bool head) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  const int blocks = static_cast<int>(f.block_samples.size());
+  const int pg = static_cast<int>(rows.size());
+  std::vector<SplitScore> out(std::max(blocks, 1));
+  for (int x : rows) {
+    if (blocks < 2 || x >= f.block_information[0].rows()) return out;  // a fold without rows
+  }
+  const std::vector<int> order = LocalOrder(run);
+  const ArrowBlock& k = run.problem.blocks[u];
+  const Eigen::VectorXd d = StepOf(run, u);
+  Eigen::VectorXd score = Eigen::VectorXd::Zero(pg);
+  Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pg, f.information.cols());
+  for (int n = 1; n < blocks; ++n) {
+    // The part grows a block at a time: blocks j.. from the end, or ..j-1 from the start.
+    const int j = head ? n : blocks - n;
+    const int block = head ? n - 1 : j;
+    for (int x = 0; x < pg; ++x) {
+      score[x] +=
+          f.block_scores(block, columns[x]) + f.block_information[block].row(rows[x]).dot(d);
+      cross.row(x) += f.block_information[block].row(rows[x]);
+    }
+    Eigen::MatrixXd self(pg, pg);
+    for (int x = 0; x < pg; ++x) {
+      for (int y = 0; y < pg; ++y) self(x, y) = cross(x, columns[y]);
+    }
+    ArrowVector c;
+    for (const ArrowBlock& other : run.problem.blocks)
+      c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
+    c.b = Eigen::MatrixXd::Zero(run.problem.q, pg);
+    for (int x = 0; x < pg; ++x) {
+      for (int r = 0; r < k.p; ++r) c.a[u](r, x) = cross(x, order[r]);
+      for (int m = 0; m < k.m(); ++m) c.b(k.shared_index[m], x) += cross(x, order[k.p + m]);
+    }
+    const ArrowVector solved = run.solver.SolveFor(c);
+    SplitScore& s = out[j];
+    s.score = score;
+    s.schur = self - c.a[u].transpose() * solved.a[u] - c.b.transpose() * solved.b;
+    s.after_information = self;
+    s.statistic = score.dot(Eigen::LDLT<Eigen::MatrixXd>(s.schur).solve(score)) / scale;
+    s.valid = std::isfinite(s.statistic);
+  }
+  return out;
+}
+
+std::pair<double, double> SplitInterval(const TrackRun& run, int u,
+                                        const std::vector<SplitScore>& scores, int j) {
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  const double floor = scores[j].statistic - LocationDrop();
+  const auto within = [&](int k) {
+    return k >= 1 && k < static_cast<int>(scores.size()) && scores[k].valid &&
+           scores[k].statistic >= floor;
+  };
+  int first = j, last = j;
+  while (within(first - 1)) --first;
+  while (within(last + 1)) ++last;
+  // A block's samples are one unit of the scan: the change may be anywhere in the blocks
+  // either side of a cut.
+  return {f.block_first_time_s[first - 1], f.block_last_time_s[last]};
+}
 
 TrackStatus ScanSensorSteps(TrackRun& run) {
   const std::vector<int> columns = BiasColumns(run);
@@ -533,6 +440,31 @@ TrackStatus ScanSensorSteps(TrackRun& run) {
   return DropWeakSteps(run, threshold);
 }
 
+namespace {
+
+// The likelihood interval of a sensor step inside used window u (bias column j of the
+// shared ones), from the scan of its blocks at the final fit.
+void TimeSensorStep(const TrackRun& run, int u, int j, TrackEvent* e) {
+  std::vector<ParameterSpec> columns;
+  for (int k = 0; k < run.layout.size(); ++k) columns.push_back(run.layout.Column(k));
+  const std::vector<int> block_columns = BlockRowColumns(columns, run.layout.roles);
+  const int column = run.layout.shared_columns[j];
+  const auto row = std::find(block_columns.begin(), block_columns.end(), column);
+  if (row == block_columns.end()) return;
+  const std::vector<SplitScore> scores =
+      ScanSplits(run, u, {static_cast<int>(row - block_columns.begin())}, {column}, run.birge[u]);
+  const WindowFold& f = run.windows[run.used[u]].fold;
+  for (size_t k = 1; k < scores.size(); ++k) {
+    if (f.block_first_time_s[k] != e->time_s) continue;
+    if (!scores[k].valid) return;
+    const std::pair<double, double> interval = SplitInterval(run, u, scores, static_cast<int>(k));
+    e->time_low_s = interval.first;
+    e->time_high_s = interval.second;
+  }
+}
+
+}  // namespace
+
 TrackStatus FindParameterEvents(TrackRun& run) {
   TrackResult& r = *run.result;
   r.events.clear();
@@ -553,15 +485,28 @@ TrackStatus FindParameterEvents(TrackRun& run) {
         event.time_s = mixed.step_time_s;
         event.previous_time_s = mixed.step_previous_s;
         event.within_window = true;
+        TimeSensorStep(run, event.window, run.shared[previous].column, &event);
       }
       r.events.push_back(event);
     }
   }
-  // Parameter events: consecutive windows' per-window groups.
+  // Parameter events: each per-window group's changes on one time line.
   const std::vector<std::vector<int>> groups = WindowGroups(run);
-  const int boundaries = static_cast<int>(run.used.size()) - 1;
-  r.parameter_tests = static_cast<int>(groups.size()) * std::max(0, boundaries);
-  for (const std::vector<int>& g : groups) GroupEvents(run, g, &r.events);
+  const int candidates = TimelineCandidates(run);
+  r.parameter_tests = static_cast<int>(groups.size()) * candidates;
+  for (const std::vector<int>& g : groups) {
+    if (candidates == 0) break;
+    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[0]]);
+    const bool sensor =
+        s.kind == ParameterKind::kSensorBias || s.kind == ParameterKind::kSensorGain;
+    double wander = 0.0;
+    SegmentGroup(run, g, {sensor ? "sensor" : "parameter", r.parameter_tests}, &r.events, &wander);
+    TrackWander w;
+    w.group = g.size() > 1 ? std::string(ParameterGroupName(s.kind)) : s.name;
+    w.unit = s.unit;
+    w.rms = std::sqrt(wander) / s.to_si;
+    r.wander.push_back(w);
+  }
   std::stable_sort(r.events.begin(), r.events.end(),
                    [](const TrackEvent& a, const TrackEvent& b) { return a.time_s < b.time_s; });
   return TrackStatus::kOk;

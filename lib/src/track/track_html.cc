@@ -18,17 +18,18 @@ const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string Esc(const std::string& s) { return XmlEscape(s); }
 
-// The time axis: dates and clock times in UTC for Unix times (svg_plot.h's clock-time
-// axis), seconds otherwise.
+// The time axis: dates and clock times in the track's zone (TrackResult::time_offset_s) for Unix
+// times (svg_plot.h's clock-time axis), seconds otherwise.
 struct TimeAxis {
   bool absolute = false;
+  int offset_s = 0;
   std::string label;
   double span_lo = kNaN, span_hi = kNaN;  // the windows' bounds: the axis spans them
   double X(double t) const { return t; }
   void Apply(PlotOptions* o) const {
     o->x_label = label;
     o->x_unix_time = absolute;
-    o->x_time_offset_s = 0;
+    o->x_time_offset_s = offset_s;
     o->x_span_lo = span_lo;
     o->x_span_hi = span_hi;
   }
@@ -36,7 +37,8 @@ struct TimeAxis {
 
 TimeAxis AxisOf(const TrackResult& r) {
   TimeAxis axis;
-  const TimeDisplay display = TimeDisplayFor(r.windows.front().first_time_s, 0);
+  const TimeDisplay display = TimeDisplayFor(r.windows.front().first_time_s, r.time_offset_s);
+  axis.offset_s = r.time_offset_s;
   axis.absolute = display.absolute;
   axis.label = axis.absolute ? TimeAxisLabel(r.windows.front().first_time_s,
                                              r.windows.back().last_time_s, display)
@@ -132,10 +134,11 @@ std::string EventsTable(const TrackResult& r) {
       what += (what.empty() ? "" : "<br>") + Esc(p.name) + " " + FormatDouble("%+.4g", p.shift) +
               " +- " + FormatDouble("%.2g", p.sigma_total) + " " + Esc(p.unit);
     }
-    h += "<tr><td>" + TrackTimeText(e.time_s) + "</td><td>" + TrackTimeText(e.previous_time_s) +
-         "</td><td>" + e.kind + "</td><td>" + what + "</td><td>" +
-         FormatDouble("%.1f", e.statistic) + " (threshold " + FormatDouble("%.1f", e.threshold) +
-         ")</td><td>" + FormatDouble("%.2g", e.p_value) + "</td></tr>\n";
+    h += "<tr><td>" + TrackTimeText(e.time_s, r.time_offset_s) + "</td><td>" +
+         TrackTimeText(e.previous_time_s, r.time_offset_s) + "</td><td>" + e.kind + "</td><td>" +
+         what + "</td><td>" + FormatDouble("%.1f", e.statistic) + " (threshold " +
+         FormatDouble("%.1f", e.threshold) + ")</td><td>" + FormatDouble("%.2g", e.p_value) +
+         "</td></tr>\n";
   }
   return h + "</table>\n";
 }
@@ -186,8 +189,9 @@ std::string TrackHtml(const TrackResult& r) {
   if (r.windows.empty()) return h + "<p>No window.</p></body></html>\n";
   h += "<p>" + Counted(r.samples, "sample", "samples") + " from " +
        Counted(static_cast<long long>(r.files.size()), "file", "files") + ", windows of " +
-       WindowSpecText(r.window) + " from " + TrackTimeText(r.windows.front().start_s) + " to " +
-       TrackTimeText(r.windows.back().end_s) + "; " +
+       WindowSpecText(r.window) + " from " +
+       TrackTimeText(r.windows.front().start_s, r.time_offset_s) + " to " +
+       TrackTimeText(r.windows.back().end_s, r.time_offset_s) + "; " +
        Counted(r.iterations, "Gauss-Newton iteration", "Gauss-Newton iterations") + " (" +
        (r.converged ? "converged" : "NOT converged") + "), " + Counted(r.folds, "fold", "folds") +
        " this run; chi2/nu " + FormatDouble("%.3f", r.reduced_chi_square) + ".</p>\n";

@@ -74,8 +74,8 @@ std::string TrackCsv(const TrackResult& r) {
   const bool offsets = !r.windows.empty() && r.windows.front().has_offsets;
   std::string csv = CsvHeader(r, offsets);
   for (const TrackWindow& w : r.windows) {
-    csv +=
-        TrackTimeText(w.start_s) + "," + TrackTimeText(w.end_s) + "," + std::to_string(w.samples);
+    csv += TrackTimeText(w.start_s, r.time_offset_s) + "," +
+           TrackTimeText(w.end_s, r.time_offset_s) + "," + std::to_string(w.samples);
     for (const TrackEstimate& e : w.estimates) csv += "," + Num(e.value) + "," + Num(e.sigma_total);
     for (int i = 0; offsets && i < kNumCables; ++i) {
       csv += "," + Num(w.offset_kn[i].value) + "," + Num(w.offset_kn[i].sigma_total);
@@ -112,10 +112,15 @@ std::string EventsJson(const TrackResult& r) {
   j.Key("events").BeginArray();
   for (const TrackEvent& e : r.events) {
     j.BeginObject();
-    j.Key("time").String(TrackTimeText(e.time_s));
+    j.Key("time").String(TrackTimeText(e.time_s, r.time_offset_s));
     j.Key("time_s").ExactNumber(e.time_s);
-    j.Key("after").String(TrackTimeText(e.previous_time_s));
+    j.Key("after").String(TrackTimeText(e.previous_time_s, r.time_offset_s));
     j.Key("after_s").ExactNumber(e.previous_time_s);
+    // The likelihood interval of the change's time (track.h).
+    j.Key("time_low").String(TrackTimeText(e.time_low_s, r.time_offset_s));
+    j.Key("time_low_s").ExactNumber(e.time_low_s);
+    j.Key("time_high").String(TrackTimeText(e.time_high_s, r.time_offset_s));
+    j.Key("time_high_s").ExactNumber(e.time_high_s);
     j.Key("window").String(r.windows[e.window].label);
     j.Key("previous_window").String(r.windows[e.previous_window].label);
     j.Key("within_window").Bool(e.within_window);

@@ -6,6 +6,7 @@
 #define FASTCAL_SRC_TRACK_TRACK_RUN_H_
 
 #include <Eigen/Core>
+#include <cmath>
 #include <limits>
 #include <string>
 #include <vector>
@@ -18,6 +19,21 @@
 namespace fastcal::internal {
 
 inline constexpr double kNPerKn = 1e3;
+// A change's likelihood interval in time (Hinkley 1970, Biometrika 57): the cuts whose
+// statistic (twice the log-likelihood) is within LocationDrop() of the best's, at this
+// level (95%). The drop is not chi-square(1)'s 3.84: twice the log-likelihood ratio of
+// the true change time against the best is the largest of a two-sided random walk with
+// drift, in the limit of small steps max over t of 2 W(t) - |t| (W a standard Brownian
+// motion), whose sides exceed x each with probability exp(-x / 2): the drop is
+// -2 ln(1 - sqrt(level)), 7.35 at 95% (3.84 left an overnight re-zeroing in the previous
+// day's blocks, the maximum over a day's cuts of noise alone).
+inline constexpr double kIntervalLevel = 0.95;
+// A change inside a window leaves at least this many of its blocks on either side: a
+// window's edge block (a minute or two of telemetry, its errors correlated over about as
+// long) placed an overnight move of 3 cm inside the day before in 1 of 7 months; a change
+// in a window's first or last blocks is dated at the boundary beside them.
+inline constexpr int kMinPartBlocks = 2;
+inline double LocationDrop() { return -2.0 * std::log(1.0 - std::sqrt(kIntervalLevel)); }
 
 // The fold's columns: the spec's free parameters and its consider ones, in spec order.
 struct TrackLayout {
@@ -121,9 +137,9 @@ struct TrackRun {
   std::string Path(const std::string& name) const { return dir + "/" + name; }
 };
 
-// "2024-05-01T12:00:00Z" for a Unix time (the fraction when there is one), else the
-// seconds as a number.
-std::string TrackTimeText(double time_s);
+// "2024-05-01T12:00:00Z" for a Unix time (the fraction when there is one) in the zone
+// offset_s east of UTC ("2024-05-01T20:00:00+08:00"), else the seconds as a number.
+std::string TrackTimeText(double time_s, int offset_s);
 // The window's label from its key (track.h, TrackWindow::label).
 std::string WindowLabel(const WindowSpec& window, double start_s);
 
@@ -168,6 +184,46 @@ void ComputeWidening(TrackRun& run);
 // Stages of track_events.cc.
 TrackStatus ScanSensorSteps(TrackRun& run);
 TrackStatus FindParameterEvents(TrackRun& run);
+// An event between used windows `from` (the last with the old value) and `to` (the first
+// with the new one), timed between them (the last sample of one, the first of the other).
+TrackEvent EventAt(const TrackRun& run, int from, int to, const std::string& kind, double statistic,
+                   int dof, double threshold, int tests);
+// The score test of a step inside used window u's telemetry before block j, at the joint
+// fit: per block j (0 unused) the score s of "these parameters differ from block j on"
+// (or, with `head`, "differ before block j"; the fold's block scores and information rows
+// moved to the solution: the gradient of chi-square / 2 in the fold's convention), its
+// information S with everything else profiled out, the statistic s^T S^-1 s / scale, and
+// the information of the part's blocks of the scanned columns. `rows` index the fold's
+// block information rows (BlockRowColumns), `columns` the fold columns they are of.
+struct SplitScore {
+  bool valid = false;
+  double statistic = 0.0;
+  Eigen::VectorXd score;
+  Eigen::MatrixXd schur;
+  Eigen::MatrixXd after_information;  // of the part scanned
+};
+std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector<int>& rows,
+                                   const std::vector<int>& columns, double scale,
+                                   bool head = false);
+// The likelihood interval of a step inside a window from its scan (the contiguous blocks
+// whose statistic is within LocationDrop() of block j's), widened to the
+// blocks either side of them: the first sample of the block before the first such cut and
+// the last of the block after the last.
+std::pair<double, double> SplitInterval(const TrackRun& run, int u,
+                                        const std::vector<SplitScore>& scores, int j);
+
+// Stages of track_segment.cc: a per-window group's changes on one time line.
+struct GroupTest {
+  std::string kind;  // "parameter", or "sensor" for a per-window sensor group
+  int tests = 1;     // Bonferroni's count
+};
+// Candidate cuts of the time line: every window boundary, and every block boundary
+// inside a window that leaves kMinPartBlocks on either side.
+int TimelineCandidates(const TrackRun& run);
+// Appends group g's events (indices into layout.window_columns) and sets its wander (SI
+// variance per component).
+void SegmentGroup(const TrackRun& run, const std::vector<int>& g, const GroupTest& test,
+                  std::vector<TrackEvent>* out, double* wander);
 
 // Stages of track_output.cc.
 TrackStatus BuildModels(TrackRun& run);
