@@ -35,27 +35,10 @@ constexpr char kCommand[] = "simulate";
 // The record's sampling when --interval-s is not given (a survey's default is 1 s).
 constexpr double kVibrationIntervalS = 0.1;
 
-// "1,2,3" as numbers, each finite (any count: one per excited mode).
-bool ParseList(const std::string& flag, const std::string& text, std::vector<double>* values,
-               std::string* error) {
-  values->clear();
-  std::stringstream ss(text);
-  for (std::string item; std::getline(ss, item, ',');) {
-    double v = 0.0;
-    std::string why;
-    if (!ParseNumberItem(item, &v, &why)) {
-      *error = "--" + flag + "=" + text + ": " + why;
-      return false;
-    }
-    values->push_back(v);
-  }
-  return true;
-}
-
 bool SpecFromFlags(VibrationRecordSpec* spec, std::string* error) {
   std::vector<double> excite;
-  if (!ParseList("excite", FLAGS_excite, &excite, error) ||
-      !ParseList("damping", FLAGS_damping, &spec->damping_ratio, error)) {
+  if (!ParseNumberList("excite", FLAGS_excite, &excite, error) ||
+      !ParseNumberList("damping", FLAGS_damping, &spec->damping_ratio, error)) {
     return false;
   }
   spec->modes.clear();
