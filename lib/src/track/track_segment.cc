@@ -171,7 +171,8 @@ Line BuildLine(const TrackRun& run, const std::vector<int>& g, bool wanders) {
   for (int u = 0; u < n; ++u) {
     for (int v = u; v < n; ++v) {
       line.cov[u * n + v] = Select(TotalCovariance(run, u, v), g, g);
-      line.cov[v * n + u] = line.cov[u * n + v].transpose();
+      // u == v is the same matrix: a transpose onto itself aliases.
+      if (v != u) line.cov[v * n + u] = line.cov[u * n + v].transpose();
     }
   }
   return line;
