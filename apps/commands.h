@@ -72,10 +72,14 @@ bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
                                 std::string* error);
 
 // The poses of --poses=FILE (solve, simulate) under --attitude-law: "focal" replaces the
-// file's attitudes by the law's, "none" by R = I, "" keeps them.
+// file's attitudes by the law's, "none" by R = I, "" keeps them. With `joint_columns`
+// (a model's moving parts) the file's joint columns too, into *joints (left empty when the
+// file has none; a column map's export is read without them).
 bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitude_law,
                               const FocalAttitudeLaw& law, std::vector<Pose>* poses,
-                              std::string* error);
+                              std::string* error,
+                              const std::vector<std::string>* joint_columns = nullptr,
+                              std::vector<JointValues>* joints = nullptr);
 
 // The workspace's grid, focal law, tension limits and statics checks from its flags
 // (workspace, design); false with the flags named when invalid.

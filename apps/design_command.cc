@@ -2,6 +2,7 @@
 // order, for a calibration with a given spec to learn the most (design.h).
 #include <gflags/gflags.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <iostream>
@@ -22,13 +23,22 @@ DECLARE_string(model);
 DECLARE_int32(samples);
 DECLARE_uint64(seed);
 DECLARE_double(interval_s);
+DECLARE_string(joint_grid_deg);  // simulate's: the same grid of rotator angles
 
+DEFINE_double(slow_error_percent, 2.0,
+              "design: the sensors' slow error (% of the reading) where the spec estimates it.");
+DEFINE_double(slow_error_kN, 1.0,
+              "design: the sensors' slow error (kN) where the spec estimates sigma_kN.");
+DEFINE_double(slow_error_time_s, 120.0,
+              "design: the slow error's time constant (s) where the spec estimates it.");
 DEFINE_double(max_extra_tilt_deg, 0.0, "design: largest tilt of z' off the focal law (deg).");
 DEFINE_double(max_extra_yaw_deg, 0.0, "design: largest turn about z' off the focal law (deg).");
 DEFINE_double(speed_m_per_s, 0.0, "design: cabin speed between stops (m/s); 0: no duration.");
 DEFINE_double(minutes, 0.0, "design: time budget of the survey (min); 0: none.");
 DEFINE_string(criterion, "A", "design: A (sum of variances) or D (log-determinant).");
 DEFINE_string(parameters, "", "design: wanted parameters, comma-separated; default: see --help.");
+DEFINE_double(hold_probability, 1e-4,
+              "design: largest probability over the priors that a designed pose breaks a limit.");
 DEFINE_double(range_prior_sigmas, 2.0,
               "design: plausible range of a parameter with a prior, in its sigmas.");
 DEFINE_double(range_mass_centre_m, 0.25,
@@ -51,6 +61,8 @@ Usage:
   fastcal design --spec=SPEC.yaml --samples=N --out=DIR [--model=MODEL.yaml]
                  [--max-extra-tilt-deg=A] [--max-extra-yaw-deg=B] [--criterion=A|D]
                  [--parameters=NAME,...] [--seed=1] [--speed-m-per-s=V] [--minutes=T]
+                 [--joint-grid-deg=-15,0,15] [--slow-error-percent=2]
+                 [--slow-error-time-s=120]
 
 Chooses N samples among candidate poses (the workspace grid of the focal-sphere cap at
 the focal attitude law, and with --max-extra-tilt-deg / --max-extra-yaw-deg also tilted
@@ -80,20 +92,38 @@ Grid and limits, as fastcal workspace: --max-off-axis-deg=40 --off-axis-step-deg
   own margins (the optimum lies on the workspace's edge, where cables near slack sag by
   metres for a small error of the model): --min-tension-kN=50 --reflector-clearance=5
 
+Slow sensor errors (docs/design.md): the predictions use the spec's whole noise model.
+Where the spec has a slow error (noise.slow_error) each cable's readings are whitened in
+flight order as the calibration whitens them, so a stop's samples, whose slow errors
+agree, count for less than independent ones; a part the spec estimates is taken as
+--slow-error-percent=2 (or --slow-error-kN=1 for sigma_kN) and --slow-error-time-s=120
+(what the recommended spec found on realistic telemetry: say what your sensors do).
+
+Moving parts (docs/design.md): with a model whose cabin has an A-B rotator
+(cabin.moving_parts), its two angles are design variables: each candidate pose is offered
+at every pair of --joint-grid-deg=-15,0,15 values (within the joints' ranges; other joints
+at zero), and a stop is a pose with its angles, so the survey separates the rotator's
+first moment from the fixed mass centre. --joint-grid-deg=0 holds the rotator at zero.
+poses.csv then carries the joint columns and design.json each stop's joints; the circle
+and the random survey compared with fly the rotator by the focal law.
+
 Poses that hold (docs/design.md): a candidate must also hold over the plausible range of
-the spec's statics parameters (free or considered; not the sensors'): each at its initial
-value +- --range-prior-sigmas=2 of its prior's sigma, or, free without a prior, +-
+the spec's statics parameters (free or considered; not the sensors'). A parameter with a
+prior: with probability 1 - --hold-probability=1e-4 over the priors' joint distribution
+(each pose breaks a limit in at most 1 of 10^4 plausible truths: first-order reliability,
+then solved exactly at the design point). Free without a prior, at every value within +-
 --range-mass-centre-m=0.25 (mass centre, per axis), --range-offset-m=0.05 (anchor and
 tower offsets) or --range-relative=0.03 of its value (mass, densities, EA, attachments).
-At the corner of that box where each cable's tension is lowest (found from each
-parameter's effect, then solved exactly) the statics must be ok, every tension at least
---min-tension-kN and every cable --reflector-clearance clear of the reflector. All four
-0: the initial values only. The summary names what binds (the tightest stop, its cable
-and the corner); design.json has it per stop.
+There the statics must be ok, every tension at least --min-tension-kN and every cable
+--reflector-clearance clear of the reflector. --hold-probability=0: the priors too over
+a box, +- --range-prior-sigmas=2 of each sigma at once (the corner rule; stricter, and
+less efficient). The summary names what binds (the tightest stop, its cable and the
+point); design.json has it per stop.
 
 Outputs (written only when everything succeeded):
-  poses.csv    x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg, one row per sample in flight
-               order: read by `fastcal simulate --poses` and `fastcal solve --poses`
+  poses.csv    x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg (and the joint columns), one row
+               per sample in flight order: read by `fastcal simulate --poses` and
+               `fastcal solve --poses`
   design.json  the stops, the path, and parameters[]: {name, sigma_total} predicted for
                the design, the paper's circle and a random survey of N samples
   design.html  the stops and path on the cap, the predicted sigmas side by side, what
@@ -132,7 +162,12 @@ const std::set<std::string> kFlags = {"spec",
                                       "range-prior-sigmas",
                                       "range-mass-centre-m",
                                       "range-offset-m",
-                                      "range-relative"};
+                                      "range-relative",
+                                      "joint-grid-deg",
+                                      "slow-error-percent",
+                                      "slow-error-kN",
+                                      "slow-error-time-s",
+                                      "hold-probability"};
 
 bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   // The candidates' grid and limits exactly as `fastcal workspace` reads them.
@@ -142,9 +177,16 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
     o->workspace.statics.min_reflector_clearance_m = kDesignReflectorClearanceM;
   }
   if (!FlagGiven("min-tension-kN")) o->workspace.min_tension_n = kDesignMinTensionN;
+  if (!ParseNumberList("joint-grid-deg", FLAGS_joint_grid_deg, &o->joint_grid_deg, error)) {
+    return false;
+  }
+  o->slow_error_percent = FLAGS_slow_error_percent;
+  o->slow_error_kn = FLAGS_slow_error_kN;
+  o->slow_error_time_s = FLAGS_slow_error_time_s;
   o->max_extra_tilt_deg = FLAGS_max_extra_tilt_deg;
   o->max_extra_yaw_deg = FLAGS_max_extra_yaw_deg;
   o->range_prior_sigmas = FLAGS_range_prior_sigmas;
+  o->hold_probability = FLAGS_hold_probability;
   o->range_mass_centre_m = FLAGS_range_mass_centre_m;
   o->range_offset_m = FLAGS_range_offset_m;
   o->range_relative = FLAGS_range_relative;
@@ -180,8 +222,44 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
                           {"range_prior_sigmas", "--range-prior-sigmas"},
                           {"range_mass_centre_m", "--range-mass-centre-m"},
                           {"range_offset_m", "--range-offset-m"},
-                          {"range_relative", "--range-relative"}});
+                          {"range_relative", "--range-relative"},
+                          {"joint_grid_deg", "--joint-grid-deg"},
+                          {"slow_error_percent", "--slow-error-percent"},
+                          {"slow_error_kn", "--slow-error-kN"},
+                          {"slow_error_time_s", "--slow-error-time-s"},
+                          {"hold_probability", "--hold-probability"}});
   return false;
+}
+
+// What noise the predictions assumed: white, or with the slow error.
+std::string NoiseText(const Design& d) {
+  const SlowErrorProcess& p = d.slow_error;
+  if (!p.IsActive()) return "predicted with white noise (the spec has no slow error)";
+  std::string amplitude = p.sigma_percent > 0.0 ? FormatDouble(p.sigma_percent, 3) + " %" : "";
+  if (p.sigma_n > 0.0) {
+    amplitude += (amplitude.empty() ? "" : " and ") + FormatDouble(p.sigma_n / 1e3, 3) + " kN";
+  }
+  return "predicted with a slow sensor error of " + amplitude + " over " +
+         FormatDouble(p.time_constant_s, 3) + " s (whitened in flight order)";
+}
+
+// With moving parts: how many joint points the stops visit at how many poses.
+std::string JointStopsText(const Design& d) {
+  std::set<std::vector<double>> poses;
+  std::set<int> points;
+  for (const DesignStop& stop : d.stops) {
+    const DesignCandidate& c = d.candidates[stop.candidate];
+    const Eigen::Vector3d rpy = RpyDegFromRotation(c.pose.rotation);
+    poses.insert({c.pose.position_m.x(), c.pose.position_m.y(), c.pose.position_m.z(), rpy[0],
+                  rpy[1], rpy[2]});
+    points.insert(c.joint_point);
+  }
+  if (points.size() == 1 && *points.begin() < 0) {
+    return "moving parts: no rotator to design for (joints at zero)";
+  }
+  return "moving parts: " + std::to_string(d.stops.size()) + " stops at " +
+         std::to_string(poses.size()) + " poses, " + std::to_string(points.size()) +
+         " rotator angle pairs in all (design.json: stops[].joints)";
 }
 
 // The result, on stdout: what was chosen, and the predicted sigma_total of each wanted
@@ -194,20 +272,25 @@ std::string Summary(const Design& d) {
   if (d.options.speed_m_per_s > 0.0) {
     s << ", " << FormatDouble(d.duration_s / kSecondsPerMinute, 4) << " min";
   }
-  char row[160];
-  std::snprintf(row, sizeof(row), "\n  %-30s %-6s %11s %15s %14s", "predicted sigma_total", "unit",
-                "design", "paper's circle", "random survey");
+  // The name column as wide as the longest wanted name (a moving part's are long).
+  int width = 28;
+  for (int k : d.wanted) width = std::max(width, static_cast<int>(d.free_names[k].size()));
+  char row[256];
+  std::snprintf(row, sizeof(row), "\n  %-*s %-6s %11s %15s %14s", width + 2,
+                "predicted sigma_total", "unit", "design", "paper's circle", "random survey");
   s << row;
   for (int k : d.wanted) {
     auto sig = [&d, k](const DesignPrediction& p) {
       return p.ok ? FormatDouble(p.budget.parameters[k].total / d.free_to_si[k], 4)
                   : std::string("n/a");
     };
-    std::snprintf(row, sizeof(row), "\n    %-28s %-6s %11s %15s %14s", d.free_names[k].c_str(),
-                  d.free_units[k] == "1" ? "" : d.free_units[k].c_str(), sig(d.design).c_str(),
-                  sig(d.circle).c_str(), sig(d.random).c_str());
+    std::snprintf(row, sizeof(row), "\n    %-*s %-6s %11s %15s %14s", width,
+                  d.free_names[k].c_str(), d.free_units[k] == "1" ? "" : d.free_units[k].c_str(),
+                  sig(d.design).c_str(), sig(d.circle).c_str(), sig(d.random).c_str());
     s << row;
   }
+  if (!d.joint_columns.empty()) s << "\n  " << JointStopsText(d);
+  s << "\n  " << NoiseText(d);
   s << "\n  limited by " << d.limiting_part << " (" << FormatDouble(100.0 * d.limiting_share, 3)
     << "% of the wanted variance)";
   // Each finding wrapped to the console's width; design.html has the stops' detail.
@@ -241,8 +324,7 @@ int RunDesign(int argc, char** argv) {
   };
   if (!CheckOutputDirectory("out", FLAGS_out, &error) ||
       !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
-      !LoadCalibrationSpec(FLAGS_spec, static_cast<int>(robot.anchor_points_cabin_m.size()), &spec,
-                           &error) ||
+      !LoadCalibrationSpec(FLAGS_spec, robot, &spec, &error) ||
       !SetOptionsFromFlags(&options, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;

@@ -194,9 +194,10 @@ Trajectory (--trajectory=, default circle):
   random  --samples=100 --max-off-axis-deg=40 --radial-spread=0 (m, off the sphere),
           positions drawn with --seed
   poses   --poses=FILE.csv: x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or
-          qw,qx,qy,qz (the planned attitudes); --poses alone implies this trajectory;
-          --columns=MAP.yaml reads it as exported, through a column map
-          (docs/data-format.md, "Column maps")
+          qw,qx,qy,qz (the planned attitudes), and with a truth model with moving parts
+          its joint columns (a design's poses.csv: each row's joints, then no joint law);
+          --poses alone implies this trajectory; --columns=MAP.yaml reads it as
+          exported, through a column map (docs/data-format.md, "Column maps")
 Planned attitude (--attitude-law): focal (default for trajectories: tilt z' toward
 --focal-centre=0,0,300 by --tilt-fraction=0.41 of the off-axis angle) or none (R = I).
 A --poses file keeps its own attitudes unless --attitude-law is given.
@@ -567,7 +568,10 @@ bool CheckFlagsApplyToTrajectory(const std::string& trajectory, std::string* err
   return CheckFlagsApply(scopes, mode, error);
 }
 
-bool BuildPoses(PoseStream* poses, std::string* error) {
+// The poses to fly; from a pose file with the truth model's joint columns, their values
+// per sample (*joints; else left empty).
+bool BuildPoses(const CableRobot& truth, PoseStream* poses, std::vector<JointValues>* joints,
+                std::string* error) {
   FocalAttitudeLaw law;
   law.tilt_fraction = FLAGS_tilt_fraction;
   if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
@@ -589,7 +593,9 @@ bool BuildPoses(PoseStream* poses, std::string* error) {
 
   if (trajectory == "poses") {
     std::vector<Pose> from_file;
-    if (!ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, &from_file, error)) {
+    const std::vector<std::string> joint_columns = truth.moving_parts.JointColumns();
+    if (!ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, &from_file, error,
+                                  &joint_columns, joints)) {
       return false;
     }
     *poses = StreamOf(std::move(from_file));
@@ -770,8 +776,15 @@ int RunSimulate(int argc, char** argv) {
   SimulationOptions options;
   PoseStream poses;
   if (!LoadTruth(&truth, &error) || !SetOptionsFromFlags(&options, &error) ||
-      !BuildPoses(&poses, &error)) {
+      !BuildPoses(truth, &poses, &options.joints.given, &error)) {
     PrintError(kCommand, error);
+    return kExitUsage;
+  }
+  if (!options.joints.given.empty() &&
+      (FlagGiven("joint-law") || FlagGiven("joint-grid-deg") || FlagGiven("prismatic-spread-m"))) {
+    PrintError(kCommand, "--poses=" + FLAGS_poses +
+                             " gives the joint values (its joint columns): --joint-law, "
+                             "--joint-grid-deg and --prismatic-spread-m cannot also set them");
     return kExitUsage;
   }
   if (poses.count == 0) {

@@ -336,11 +336,15 @@ bool PosesWithFocalLawFromFlags(const std::vector<Eigen::Vector3d>& positions,
 
 bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitude_law,
                               const FocalAttitudeLaw& law, std::vector<Pose>* poses,
-                              std::string* error) {
+                              std::string* error, const std::vector<std::string>* joint_columns,
+                              std::vector<JointValues>* joints) {
   std::shared_ptr<const ColumnMap> columns;  // --columns: the file as exported
   if (!ColumnsFromFlag(&columns, error)) return false;
-  if (columns != nullptr ? !ReadPosesCsv(path, *columns, poses, nullptr, error)
-                         : !ReadPosesCsv(path, poses, nullptr, error)) {
+  if (joints != nullptr) joints->clear();
+  const bool with_joints = joint_columns != nullptr && !joint_columns->empty() && joints != nullptr;
+  if (columns != nullptr      ? !ReadPosesCsv(path, *columns, poses, nullptr, error)
+      : with_joints ? !ReadPosesCsv(path, *joint_columns, poses, joints, nullptr, error)
+                              : !ReadPosesCsv(path, poses, nullptr, error)) {
     return false;
   }
   if (attitude_law == "focal") {

@@ -184,3 +184,40 @@ TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
 
 }  // namespace
 }  // namespace fastcal::test
+
+namespace fastcal::test {
+namespace {
+
+// The design's joints from the command line (design.h, "Moving parts"): poses.csv carries
+// the joint columns, simulate flies them, and a joint law beside them is refused.
+TEST_F(CliMovingPartsTest, DesignVisitsRotatorAnglesAndSimulateFliesThem) {
+  const std::string model = Source() + "/calibration_data/moving_parts.yaml";
+  const std::string spec = Source() + "/calibration_data/spec_moving_parts.yaml";
+  const CommandResult design = Fastcal(
+      "design --model=" + model + " --spec=" + spec +
+      " --samples=60 --off-axis-step-deg=20 --azimuth-step-deg=90 --joint-grid-deg=-15,15 "
+      "--parameters=moving_parts.rotator.first_moment_kg_m.z --out=" + Path("design"));
+  ASSERT_EQ(design.code, 0) << design.output;
+  EXPECT_NE(design.output.find("rotator angle pairs"), std::string::npos) << design.output;
+  EXPECT_NE(design.output.find("slow sensor error of 2 % over 120 s"), std::string::npos)
+      << design.output;
+  const std::string poses = ReadFile(Path("design") + "/poses.csv");
+  EXPECT_NE(poses.find("yaw_deg,rotator_a_deg,rotator_b_deg,stewart_x_m"), std::string::npos);
+  EXPECT_NE(ReadFile(Path("design") + "/design.json").find("\"joints\": {"), std::string::npos);
+  // simulate takes each row's joints: the dataset's joint columns are the design's.
+  ASSERT_EQ(Fastcal("simulate --truth=" + model + " --poses=" + Path("design") +
+                    "/poses.csv --out=" + Path("flown.csv"))
+                .code,
+            0);
+  const std::string flown = ReadFile(Path("flown.csv"));
+  EXPECT_NE(flown.find(",15,-15,0,0,0"), std::string::npos) << flown.substr(0, 2000);
+  RunBoundedAndExpect({"simulate --truth=" + model + " --poses=" + Path("design") +
+                           "/poses.csv --joint-law=focal --out=" + Path("both.csv"),
+                       2, "gives the joint values (its joint columns)"});
+  RunBoundedAndExpect({"design --model=" + model + " --spec=" + spec +
+                           " --samples=60 --hold-probability=0.7 --out=" + Path("bad"),
+                       2, "--hold-probability"});
+}
+
+}  // namespace
+}  // namespace fastcal::test

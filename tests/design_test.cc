@@ -71,7 +71,7 @@ TEST(Design, GradientMatchesNumericDifferentiation) {
   for (DesignCriterion criterion : {DesignCriterion::kA, DesignCriterion::kD}) {
     internal::DesignProblem pr;
     ASSERT_TRUE(internal::SetUpDesignProblem(spec, &pr, &error)) << error;
-    ASSERT_TRUE(internal::AddPoseRows(robot, spec, poses, &pr, &error)) << error;
+    ASSERT_TRUE(internal::AddPoseRows(robot, spec, poses, {}, &pr, &error)) << error;
     pr.wanted = {0, 1, 2};
     pr.wanted_weight = Eigen::VectorXd::Zero(pr.n);
     pr.wanted_weight.head(3) << 1.0, 2.0, 0.5;  // A: unequal weights (D ignores them)
@@ -374,6 +374,7 @@ TEST(Design, EveryStopHoldsAtEveryCornerOfThePlausibleRange) {
   const CableRobot robot = CableRobot::NominalFast();
   const CalibrationSpec spec = Spec(kRangeSpec);
   DesignOptions o = TiltedCap();
+  o.hold_probability = 0.0;  // the corner rule (design_probability_test: the default rule)
   o.max_extra_yaw_deg = 10.0;
   Design d;
   std::string error;

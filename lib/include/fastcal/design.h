@@ -48,6 +48,21 @@
 // statics must be ok and the tensions and clearance within the workspace's limits
 // (min_tension_n is the margin kept there). What binds each stop is reported.
 //
+// Slow sensor errors (docs/design.md): the predictions whiten each cable's rows in flight
+// order by the spec's slow error (PredictionSlowError; internal/slow_error_filter.h, as the
+// calibration whitens its readings), so that samples whose errors are correlated count
+// for what they are worth; the optimisation above weighs the candidates' samples as white.
+//
+// Moving parts (docs/design.md, "Moving parts"): with a model whose cabin has an A-B
+// rotator (joint_plan.h), the rotator's two angles are design variables. Each candidate
+// pose is offered at every point of the grid joint_grid_deg x joint_grid_deg (within the
+// joints' ranges; other joints at zero), each point a candidate of its own judged over
+// the plausible range at its mass centre c(q): at one pose the angles vary independently
+// of the cabin's tilt, which separates the rotator's first moment from the fixed mass
+// centre (methods.md). A stop is a pose and a joint point; stops at one pose are flown
+// one after another. The paper's circle and the random survey, compared with, fly the
+// rotator by the focal law (joint_plan.h), as observing does.
+//
 // A time budget: flying the stops in order takes path_length / speed plus N samples
 // times the sample interval. When that is over the budget the design drops its least
 // useful stops one at a time (their samples go to the others: dwell) until it fits.
@@ -62,6 +77,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/moving_parts.h"
 #include "fastcal/pose.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/uncertainty.h"
@@ -111,9 +127,32 @@ struct DesignOptions {
   // (anchor and tower offsets, 0.05 m), or range_relative of the value (cabin mass,
   // densities, EA, attachments; 3%). All 0: the nominal point only, as before issue 29.
   double range_prior_sigmas = 2.0;
+  // How the priors' part of the range is held: with hold_probability p > 0, each designed
+  // pose breaks a limit (a tension, the reflector's clearance) with probability at most p
+  // over the priors' joint distribution, to first order and checked exactly at the design
+  // point (internal/design_range.h); every value within the margins (range_*) is held as
+  // before. 0: the corner rule, each prior +- range_prior_sigmas at once (issue 29's).
+  // 1e-4: one pose in 10^4 of plausible truths comes nearer its limit than the margin.
+  double hold_probability = 1e-4;
   double range_mass_centre_m = 0.25;
   double range_offset_m = 0.05;
   double range_relative = 0.03;
+  // With a rotator in the model (design.h, "Moving parts"): the values (deg) each of its
+  // two angles may take at a stop; the grid's points outside a joint's range are left
+  // out. Empty: the rotator at zero.
+  std::vector<double> joint_grid_deg = {-15.0, 0.0, 15.0};
+  // The slow sensor error the predictions assume where the spec estimates it
+  // (noise.slow_error: estimate; slow_error.h): its amplitude in percent of the reading
+  // (or in kN, for a spec that estimates sigma_kN) and its time constant (s). 2 % and
+  // 120 s: what the recommended spec found on realistic simulated telemetry
+  // (docs/calibration.md, "Slow sensor errors"); say what your sensors do. A part the spec
+  // states is the spec's; a spec without a slow error predicts with white noise. The
+  // optimisation itself weighs samples as white (docs/design.md); the predictions, of the
+  // design and of the surveys compared with, whiten each cable's readings in flight order
+  // as the calibration does.
+  double slow_error_percent = 2.0;
+  double slow_error_kn = 1.0;
+  double slow_error_time_s = 120.0;
   // Samples in the survey (>= the number of free parameters).
   int samples = 360;
   DesignCriterion criterion = DesignCriterion::kA;
@@ -154,6 +193,10 @@ struct DesignCandidate {
   double extra_tilt_deg = 0.0;                   // 0 or max_extra_tilt_deg
   double tilt_direction_deg = 0.0;               // about z', from x'
   double extra_yaw_deg = 0.0;                    // 0 or +-max_extra_yaw_deg
+  // The moving parts' joint values there (the model's joint order, the columns' units),
+  // and the joint grid's point (-1: no rotator in the model).
+  JointValues joints{};
+  int joint_point = -1;
 };
 
 // The predicted uncertainty of a survey.
@@ -184,8 +227,9 @@ struct DesignRangeParameter {
   std::string name;  // the spec's, e.g. "mass_centre_m.x"
   std::string unit;  // its unit in files (SI value = file value * to_si)
   double to_si = 1.0;
-  double delta_si = 0.0;    // +- this
+  double delta_si = 0.0;    // +- this (the corner rule; a margin under either rule)
   bool from_prior = false;  // range_prior_sigmas x its prior's sigma; else a range_* margin
+  double sigma_si = 0.0;    // its prior's sigma (from_prior), held with hold_probability
 };
 
 // What binds a designed pose: its tightest limit over the plausible range.
@@ -221,18 +265,28 @@ struct Design {
   std::vector<int> wanted;              // indices into free_names
   std::vector<DesignStop> stops;        // in flight order
   std::vector<Pose> poses;              // one per sample, in flight order
+  // With moving parts: the model's joint columns, and each sample's joint values
+  // (parallel to poses); both empty for a rigid cabin.
+  std::vector<std::string> joint_columns;
+  std::vector<JointValues> joints;
   double path_length_m = 0.0;
   double travel_s = 0.0, dwell_s = 0.0, duration_s = 0.0;  // 0 without a speed
   // Distinct stops the optimum had before the time budget dropped some (= stops.size()
   // without a budget).
   int unconstrained_stops = 0;
   DesignPrediction design, circle, random;
+  // The slow sensor error the predictions assumed (PredictionSlowError; inactive: white).
+  SlowErrorProcess slow_error;
   // The largest part of the wanted parameters' summed variance in the design:
   // "noise" or a group name, and its share of the sum.
   std::string limiting_part;
   double limiting_share = 0.0;
   std::vector<DesignPriorEffect> prior_effects;
 };
+
+// The slow error a design's predictions assume: the spec's, with the options' values for
+// the parts it estimates; inactive for a spec without one.
+SlowErrorProcess PredictionSlowError(const CalibrationSpec& spec, const DesignOptions& options);
 
 // Designs the survey. False with *error for invalid options, a spec with nothing free,
 // more free plus consider parameters than the calibration handles, fewer samples than
@@ -241,15 +295,21 @@ struct Design {
 bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                   const DesignOptions& options, Design* design, std::string* error);
 
-// The prediction for any survey (one sample per pose), with the design's criterion and
-// wanted parameters. False with *error when the statics fail at a pose.
+// The prediction for any survey (one sample per pose, flown options.sample_interval_s
+// apart), with the design's criterion, wanted parameters and slow error. False with
+// *error when the statics fail at a pose.
 bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                    const DesignOptions& options, const std::vector<Pose>& poses,
                    DesignPrediction* prediction, std::string* error);
+// The same with each pose's joint values (parallel to poses; empty: all zero).
+bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
+                   const DesignOptions& options, const std::vector<Pose>& poses,
+                   const std::vector<JointValues>& joints, DesignPrediction* prediction,
+                   std::string* error);
 
 // The design's outputs (design_output.cc). Poses, one row per sample in flight order:
 // x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg (the format ReadPosesCsv reads), after
-// '#' comment lines with `provenance`.
+// '#' comment lines with `provenance`; with moving parts, then the joint columns.
 std::string DesignPosesCsv(const Design& design, const std::string& provenance);
 // design.json: options, stops, path, and for the design, the circle and the random
 // survey `parameters[]: {name, unit, wanted, sigma_total, formal, systematic}`, the

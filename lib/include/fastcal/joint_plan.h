@@ -16,6 +16,8 @@
 // The rotator is the first part whose first two joints are revolute about x then y.
 // Prismatic joints (the Stewart platform's translation): N(0, prismatic_sigma_m) per joint
 // and sample, from a generator of their own (seeded), within the joint's range.
+// Given values (a pose file's joint columns, e.g. a design's): sample n takes given[n mod
+// size] as they are, every joint; the laws and the spread are then not used.
 #ifndef FASTCAL_JOINT_PLAN_H_
 #define FASTCAL_JOINT_PLAN_H_
 
@@ -44,6 +46,9 @@ struct JointPlanOptions {
   // Spread of every prismatic joint (m), >= 0; 0: at zero.
   double prismatic_sigma_m = 0.0;
   std::uint64_t seed = 1;
+  // Joint values per sample given (the model's joint order, the columns' units); empty:
+  // the laws above.
+  std::vector<JointValues> given;
 };
 
 // Joint values of sample n at planned pose `pose` (the model's joint order, the columns'

@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "fastcal/column_map.h"
+#include "fastcal/moving_parts.h"
 #include "fastcal/pose.h"
 
 namespace fastcal {
@@ -219,6 +220,20 @@ bool ReadPosesCsv(const std::string& path, const ColumnMap& columns, std::vector
 bool ParsePosesCsv(const std::string& text, const std::string& source_name,
                    const ColumnMap& columns, std::vector<Pose>* poses,
                    std::vector<double>* times_s, std::string* error);
+
+// The same with the moving parts' joint columns of a model (MovingParts::JointColumns(),
+// in the columns' units, deg or m): the file gives all of them or none. *joints receives
+// one JointValues per pose (the model's joint order) when it gives them, and is left empty
+// when it gives none (the command's flag or law sets the joints then); some but not all is
+// an error naming the missing ones. A value outside PlausibleJointValue is an error naming
+// the column. (The column-map readers do not take joint columns yet.)
+bool ReadPosesCsv(const std::string& path, const std::vector<std::string>& joint_columns,
+                  std::vector<Pose>* poses, std::vector<JointValues>* joints,
+                  std::vector<double>* times_s, std::string* error);
+bool ParsePosesCsv(const std::string& text, const std::string& source_name,
+                   const std::vector<std::string>& joint_columns, std::vector<Pose>* poses,
+                   std::vector<JointValues>* joints, std::vector<double>* times_s,
+                   std::string* error);
 
 // Largest pose file ReadPosesCsv reads, as for a dataset (DatasetReadOptions).
 inline constexpr long long kMaxPoseFileBytes = 1LL << 30;  // 1 GiB

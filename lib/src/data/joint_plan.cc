@@ -64,6 +64,13 @@ bool JointPlan::Make(const MovingParts& parts, const JointPlanOptions& options, 
   plan->options_ = options;
   plan->rotator_first_joint_ = RotatorFirstJoint(parts);
   plan->engine_.seed(options.seed ^ 0x6a6f696e74706c61ULL);  // "jointpla": a stream of its own
+  if (!options.given.empty()) {
+    if (options.revolute != RevoluteLaw::kZero || options.prismatic_sigma_m > 0.0) {
+      return Fail(error, "joint values given per sample (the pose file's joint columns) "
+                         "and a joint law or prismatic spread: give one");
+    }
+    return true;
+  }
   if (options.revolute != RevoluteLaw::kZero && plan->rotator_first_joint_ < 0) {
     return Fail(error, std::string("joint law ") + RevoluteLawName(options.revolute) +
                            " needs a rotator: a moving part whose first two joints are "
@@ -87,7 +94,9 @@ bool JointPlan::Make(const MovingParts& parts, const JointPlanOptions& options, 
 bool JointPlan::Next(long long n, const Pose& pose, JointValues* joints, std::string* error) {
   joints->fill(0.0);
   const int r = rotator_first_joint_;
-  if (options_.revolute == RevoluteLaw::kFocal) {
+  if (!options_.given.empty()) {
+    *joints = options_.given[static_cast<size_t>(n) % options_.given.size()];
+  } else if (options_.revolute == RevoluteLaw::kFocal) {
     const Eigen::Vector3d to_centre = options_.focal_centre_m - pose.position_m;
     if (!(to_centre.norm() > 0.0)) return Fail(error, "focal law: the pose is at the centre");
     const Eigen::Vector3d v = pose.rotation.transpose() * to_centre.normalized();

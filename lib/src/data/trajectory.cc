@@ -411,7 +411,29 @@ struct PoseColumns {
   std::array<std::string, kNumColumns> label;
   std::string position_label = "columns 'x_m,y_m,z_m'";
   std::string quaternion_label = "columns 'qw,qx,qy,qz'";
+  // The moving parts' joint columns asked for (null: none), and where each stands (-1:
+  // absent; the file has all of them or none).
+  const std::vector<std::string>* joint_names = nullptr;
+  std::vector<int> joint_index;
 };
+
+// A pose file gives every joint column the model names or none of them (the command's
+// flag or law then sets the joints).
+bool CheckJointColumnsPresent(const PoseColumns& columns, const std::string& where,
+                              std::string* error) {
+  std::string missing;
+  int present = 0;
+  for (size_t j = 0; j < columns.joint_index.size(); ++j) {
+    if (columns.joint_index[j] >= 0) {
+      ++present;
+    } else {
+      missing += (missing.empty() ? "" : ", ") + internal::Quote((*columns.joint_names)[j]);
+    }
+  }
+  if (present == 0 || missing.empty()) return true;
+  return Fail(error, where + "the file gives some of the moving parts' joint columns but not " +
+                         missing + " (give every joint column of the model, or none)");
+}
 
 // The header of a pose file read through a column map: x, y, z, the attitude and the
 // time as the map names them (its other entries are not read).
@@ -494,11 +516,28 @@ bool ParsePoseHeader(const std::string& line, const std::vector<std::string_view
       }
       known = true;
     }
+    for (size_t j = 0; columns->joint_names != nullptr && j < columns->joint_names->size(); ++j) {
+      if (fields[i] != (*columns->joint_names)[j]) continue;
+      if (columns->joint_index[j] >= 0) {
+        return Fail(error, where + "duplicate column " + internal::Quote(fields[i]));
+      }
+      columns->joint_index[j] = static_cast<int>(i);
+      known = true;
+    }
     if (!known) {
+      const auto ends_with = [&](std::string_view suffix) {
+        return fields[i].size() > suffix.size() &&
+               fields[i].substr(fields[i].size() - suffix.size()) == suffix;
+      };
+      const bool joint_like = ends_with("_deg") || ends_with("_m");
       return Fail(error, where + column + " " + internal::Quote(fields[i]) +
-                             ": unknown column name (accepted: " + AcceptedColumns() + ")");
+                             ": unknown column name (accepted: " + AcceptedColumns() + ")" +
+                             (joint_like ? "; a moving part's joint column is read only with "
+                                           "a model that names it (cabin.moving_parts)"
+                                         : ""));
     }
   }
+  if (!CheckJointColumnsPresent(*columns, where, error)) return false;
   columns->has_rpy = index[kRoll] >= 0 || index[kPitch] >= 0 || index[kYaw] >= 0;
   columns->has_quaternion =
       index[kQw] >= 0 || index[kQx] >= 0 || index[kQy] >= 0 || index[kQz] >= 0;
@@ -520,7 +559,7 @@ bool ParsePoseHeader(const std::string& line, const std::vector<std::string_view
 // set when the file has time_s.
 bool ParsePoseRow(std::vector<std::string_view> fields, const std::string& where,
                   const PoseColumns& columns, const PlausibilityLimits& limits, Pose* pose,
-                  double* time_s, std::string* error) {
+                  double* time_s, JointValues* joints, std::string* error) {
   while (columns.map != nullptr && fields.size() > columns.num_fields && fields.back().empty()) {
     fields.pop_back();  // trailing delimiters
   }
@@ -560,6 +599,16 @@ bool ParsePoseRow(std::vector<std::string_view> fields, const std::string& where
     }
   }
   *time_s = values[kTime];
+  joints->fill(0.0);
+  for (size_t j = 0; j < columns.joint_index.size(); ++j) {
+    if (columns.joint_index[j] < 0) continue;
+    const std::string& name = (*columns.joint_names)[j];
+    std::string why;
+    if (!ParseNumber(fields[columns.joint_index[j]], &(*joints)[j], &why) ||
+        !PlausibleJointValue(name, (*joints)[j], &why)) {
+      return Fail(error, where + "column " + internal::Quote(name) + ": " + why);
+    }
+  }
   return true;
 }
 
@@ -567,7 +616,8 @@ namespace {
 
 // The pose file read through `map` (null: the canonical columns).
 bool ParsePosesCsvImpl(const std::string& text, const std::string& path, const ColumnMap* map,
-                       std::vector<Pose>* poses, std::vector<double>* times_s,
+                       const std::vector<std::string>* joint_names, std::vector<Pose>* poses,
+                       std::vector<JointValues>* joints, std::vector<double>* times_s,
                        std::string* error) {
   if (poses == nullptr) return Fail(error, "poses must not be null");
   if (const std::string spreadsheet =
@@ -578,11 +628,14 @@ bool ParsePosesCsvImpl(const std::string& text, const std::string& path, const C
   const PlausibilityLimits limits;  // as for a dataset, by default
   PoseColumns columns;
   columns.map = map;
+  columns.joint_names = joint_names;
+  if (joint_names != nullptr) columns.joint_index.assign(joint_names->size(), -1);
   for (int c = 0; c < kNumColumns; ++c) {
     columns.label[c] = std::string("column '") + kColumnNames[c] + "'";
   }
   bool has_header = false;
   std::vector<Pose> out_poses;
+  std::vector<JointValues> out_joints;
   std::vector<double> out_times;
   std::string line;
   long line_number = 0;
@@ -638,20 +691,29 @@ bool ParsePosesCsvImpl(const std::string& text, const std::string& path, const C
     }
     Pose pose;
     double time_s = 0.0;
-    if (!ParsePoseRow(fields, where, columns, limits, &pose, &time_s, error)) return false;
+    JointValues row_joints{};
+    if (!ParsePoseRow(fields, where, columns, limits, &pose, &time_s, &row_joints, error)) {
+      return false;
+    }
     out_poses.push_back(pose);
+    if (!columns.joint_index.empty() && columns.joint_index[0] >= 0) {
+      out_joints.push_back(row_joints);
+    }
     if (columns.index[kTime] >= 0) out_times.push_back(time_s);
   }
   if (!has_header) return Fail(error, path + ": no header line (empty file)");
   if (out_poses.empty()) return Fail(error, path + ": no data rows");
 
   *poses = std::move(out_poses);
+  if (joints != nullptr) *joints = std::move(out_joints);
   if (times_s != nullptr) *times_s = std::move(out_times);
   return true;
 }
 
-bool ReadPosesCsvImpl(const std::string& path, const ColumnMap* map, std::vector<Pose>* poses,
-                      std::vector<double>* times_s, std::string* error) {
+bool ReadPosesCsvImpl(const std::string& path, const ColumnMap* map,
+                      const std::vector<std::string>* joint_names, std::vector<Pose>* poses,
+                      std::vector<JointValues>* joints, std::vector<double>* times_s,
+                      std::string* error) {
   if (const std::string spreadsheet = internal::SpreadsheetMessage(path, "");
       !spreadsheet.empty()) {
     return Fail(error, spreadsheet);
@@ -660,27 +722,39 @@ bool ReadPosesCsvImpl(const std::string& path, const ColumnMap* map, std::vector
   if (!internal::ReadRegularFile(path, kMaxPoseFileBytes, "pose", &text, &message)) {
     return Fail(error, message);
   }
-  return ParsePosesCsvImpl(text, path, map, poses, times_s, error);
+  return ParsePosesCsvImpl(text, path, map, joint_names, poses, joints, times_s, error);
 }
 
 }  // namespace
 
 bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector<Pose>* poses,
                    std::vector<double>* times_s, std::string* error) {
-  return ParsePosesCsvImpl(text, path, nullptr, poses, times_s, error);
+  return ParsePosesCsvImpl(text, path, nullptr, nullptr, poses, nullptr, times_s, error);
 }
 bool ParsePosesCsv(const std::string& text, const std::string& source_name,
                    const ColumnMap& columns, std::vector<Pose>* poses,
                    std::vector<double>* times_s, std::string* error) {
-  return ParsePosesCsvImpl(text, source_name, &columns, poses, times_s, error);
+  return ParsePosesCsvImpl(text, source_name, &columns, nullptr, poses, nullptr, times_s, error);
+}
+bool ParsePosesCsv(const std::string& text, const std::string& source_name,
+                   const std::vector<std::string>& joint_columns, std::vector<Pose>* poses,
+                   std::vector<JointValues>* joints, std::vector<double>* times_s,
+                   std::string* error) {
+  return ParsePosesCsvImpl(text, source_name, nullptr, &joint_columns, poses, joints, times_s,
+                           error);
 }
 bool ReadPosesCsv(const std::string& path, std::vector<Pose>* poses, std::vector<double>* times_s,
                   std::string* error) {
-  return ReadPosesCsvImpl(path, nullptr, poses, times_s, error);
+  return ReadPosesCsvImpl(path, nullptr, nullptr, poses, nullptr, times_s, error);
 }
 bool ReadPosesCsv(const std::string& path, const ColumnMap& columns, std::vector<Pose>* poses,
                   std::vector<double>* times_s, std::string* error) {
-  return ReadPosesCsvImpl(path, &columns, poses, times_s, error);
+  return ReadPosesCsvImpl(path, &columns, nullptr, poses, nullptr, times_s, error);
+}
+bool ReadPosesCsv(const std::string& path, const std::vector<std::string>& joint_columns,
+                  std::vector<Pose>* poses, std::vector<JointValues>* joints,
+                  std::vector<double>* times_s, std::string* error) {
+  return ReadPosesCsvImpl(path, nullptr, &joint_columns, poses, joints, times_s, error);
 }
 
 }  // namespace fastcal

@@ -188,9 +188,14 @@ void FlyStops(const std::vector<DesignCandidate>& candidates, const std::vector<
   d->path_length_m = PathLength(points, order);
   d->stops.clear();
   d->poses.clear();
+  d->joints.clear();
   for (int k : order) {
+    const DesignCandidate& c = candidates[support[k]];
     d->stops.push_back({support[k], counts[support[k]], {}});
-    for (int s = 0; s < counts[support[k]]; ++s) d->poses.push_back(candidates[support[k]].pose);
+    for (int s = 0; s < counts[support[k]]; ++s) {
+      d->poses.push_back(c.pose);
+      if (!d->joint_columns.empty()) d->joints.push_back(c.joints);
+    }
   }
   d->dwell_s = o.samples * o.sample_interval_s;
   d->travel_s = o.speed_m_per_s > 0.0 ? d->path_length_m / o.speed_m_per_s : 0.0;
@@ -259,6 +264,18 @@ const char* DesignCriterionName(DesignCriterion criterion) {
   return criterion == DesignCriterion::kA ? "A" : "D";
 }
 
+SlowErrorProcess PredictionSlowError(const CalibrationSpec& spec, const DesignOptions& options) {
+  const SlowErrorSpec& slow = spec.slow_error;
+  if (!slow.enabled) return SlowErrorProcess();
+  SlowErrorProcess p = slow.stated;
+  if (slow.estimate_amplitude) {
+    p.sigma_percent = slow.amplitude_in_percent ? options.slow_error_percent : 0.0;
+    p.sigma_n = slow.amplitude_in_percent ? 0.0 : options.slow_error_kn * 1e3;
+  }
+  if (slow.estimate_time_constant) p.time_constant_s = options.slow_error_time_s;
+  return p;
+}
+
 bool DesignOptions::IsValid(std::string* error) const {
   auto fail = [error](const std::string& message) {
     if (error != nullptr) *error = message;
@@ -286,6 +303,29 @@ bool DesignOptions::IsValid(std::string* error) const {
   }
   if (!(range_relative < 1.0)) {
     return fail("range_relative must be below 1 (got " + Num(range_relative) + ")");
+  }
+  if (!(hold_probability >= 0.0 && hold_probability < 0.5)) {
+    return fail("hold_probability must be in [0, 0.5) (got " + Num(hold_probability) + ")");
+  }
+  for (const auto& [name, value] :
+       {std::pair<const char*, double>{"slow_error_percent", slow_error_percent},
+        {"slow_error_kn", slow_error_kn},
+        {"slow_error_time_s", slow_error_time_s}}) {
+    if (!(value >= 0.0) || !std::isfinite(value) || value > 1e8) {
+      return fail(std::string(name) + " must be >= 0 and finite (got " + Num(value) + ")");
+    }
+  }
+  // Each grid value a candidate of its own per pose: 9 values give 81 per pose already.
+  constexpr size_t kMaxJointGridValues = 9;
+  if (joint_grid_deg.size() > kMaxJointGridValues) {
+    return fail("joint_grid_deg: at most " + std::to_string(kMaxJointGridValues) + " values (got " +
+                std::to_string(joint_grid_deg.size()) + ")");
+  }
+  for (double v : joint_grid_deg) {
+    if (!std::isfinite(v) || std::abs(v) > 180.0) {
+      return fail("joint_grid_deg: values must be finite angles within +-180 deg (got " + Num(v) +
+                  ")");
+    }
   }
   if (samples < 1 || samples > 1000000) {
     return fail("samples must be in [1, 1e6] (got " + std::to_string(samples) + ")");
@@ -507,14 +547,54 @@ void ExplainLimits(const CalibrationSpec& spec, const DesignProblem& pr, const D
   }
 }
 
-// The comparison surveys' predictions (a failure is a note, not an error).
+// A survey's samples (in time order at times_s) as a problem of their own, one candidate
+// per sample, whitened by the slow error `slow` as the calibration whitens its readings.
+bool SurveyProblem(const CableRobot& robot, const CalibrationSpec& spec, const DesignProblem& base,
+                   const std::vector<Pose>& poses, const std::vector<JointValues>& joints,
+                   const std::vector<double>& times_s, const SlowErrorProcess& slow,
+                   DesignProblem* out, std::string* error) {
+  *out = base;
+  out->x_rows.resize(0, out->n);
+  out->z_rows.resize(0, out->q);
+  out->reading.resize(0);
+  out->white_sigma.resize(0);
+  if (!internal::AddPoseRows(robot, spec, poses, joints, out, error)) return false;
+  internal::WhitenInTimeOrder(slow, times_s, out);
+  return true;
+}
+
+// Sample n of a survey flown without travel at time n x interval.
+std::vector<double> EvenTimes(size_t samples, double interval_s) {
+  std::vector<double> times(samples);
+  for (size_t n = 0; n < samples; ++n) times[n] = static_cast<double>(n) * interval_s;
+  return times;
+}
+
+// The design's samples' times: each stop's samples an interval apart, the travel between
+// stops at the cabin's speed (none without a speed: the slow error then correlates the
+// stops' samples most).
+std::vector<double> FlightTimes(const Design& d, const DesignOptions& o) {
+  std::vector<double> times;
+  double t = 0.0;
+  for (size_t k = 0; k < d.stops.size(); ++k) {
+    const Eigen::Vector3d& here = d.candidates[d.stops[k].candidate].pose.position_m;
+    if (k > 0 && o.speed_m_per_s > 0.0) {
+      t += (here - d.candidates[d.stops[k - 1].candidate].pose.position_m).norm() / o.speed_m_per_s;
+    }
+    for (int n = 0; n < d.stops[k].samples; ++n, t += o.sample_interval_s) times.push_back(t);
+  }
+  return times;
+}
+
+// The comparison surveys' predictions (a failure is a note, not an error): flown evenly
+// in time, the rotator by the focal law.
 DesignPrediction PredictPoses(const CableRobot& robot, const CalibrationSpec& spec,
-                              const DesignProblem& base, const std::vector<Pose>& poses) {
-  DesignProblem pr = base;
-  pr.x_rows.resize(0, pr.n);
-  pr.z_rows.resize(0, pr.q);
+                              const DesignProblem& base, const std::vector<Pose>& poses,
+                              const SlowErrorProcess& slow, double interval_s) {
+  DesignProblem pr;
   std::string error;
-  if (!internal::AddPoseRows(robot, spec, poses, &pr, &error)) {
+  if (!SurveyProblem(robot, spec, base, poses, internal::ObservingJoints(robot, poses),
+                     EvenTimes(poses.size(), interval_s), slow, &pr, &error)) {
     DesignPrediction p;
     p.note = error;
     return p;
@@ -529,7 +609,7 @@ bool KeepThoseThatHold(const internal::PlausibleRange& range, Design* d, std::st
   d->range = range.parameters();
   std::vector<DesignCandidate> kept;
   for (const DesignCandidate& c : d->candidates) {
-    if (range.Holds(c.pose, nullptr)) kept.push_back(c);
+    if (range.Holds(c.pose, c.joints, nullptr)) kept.push_back(c);
   }
   d->rejected_off_nominal = static_cast<int>(d->candidates.size() - kept.size());
   d->rejected_candidates += d->rejected_off_nominal;
@@ -580,6 +660,8 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
   if (!internal::DesignCandidates(robot, options, &d.candidates, &d.rejected_candidates, error)) {
     return false;
   }
+  d.joint_columns = robot.moving_parts.JointColumns();
+  if (!internal::ExpandJointGrid(robot, options, &d.candidates, error)) return false;
   say(std::to_string(d.candidates.size()) + " feasible candidates (" +
       std::to_string(d.rejected_candidates) +
       " infeasible); those that hold over the parameters' plausible range");
@@ -587,8 +669,12 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
   if (!KeepThoseThatHold(range, &d, error)) return false;
   say(std::to_string(d.candidates.size()) + " candidates hold; their information (Jacobians)");
   std::vector<Pose> poses;
-  for (const DesignCandidate& c : d.candidates) poses.push_back(c.pose);
-  if (!internal::AddPoseRows(robot, spec, poses, &pr, error)) return false;
+  std::vector<JointValues> joints;
+  for (const DesignCandidate& c : d.candidates) {
+    poses.push_back(c.pose);
+    joints.push_back(c.joints);
+  }
+  if (!internal::AddPoseRows(robot, spec, poses, joints, &pr, error)) return false;
   NormaliseWeights(spec, options.samples, &pr);
   say("approximate design (" + std::to_string(options.approximate_iterations) +
       " Frank-Wolfe iterations at most)");
@@ -609,20 +695,29 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
   say("path through the stops" +
       std::string(options.time_budget_s > 0.0 ? " within the time budget" : ""));
   if (!KeepWithinBudget(pr, d.candidates, options, &counts, &d, error)) return false;
-  for (DesignStop& stop : d.stops) range.Holds(d.candidates[stop.candidate].pose, &stop.binding);
-  const DesignSums s = internal::SumsOf(pr, ToWeights(counts));
+  for (DesignStop& stop : d.stops) {
+    const DesignCandidate& c = d.candidates[stop.candidate];
+    range.Holds(c.pose, c.joints, &stop.binding);
+  }
   say("predictions for the design, the paper's circle and a random survey");
-  d.design = PredictWithParts(spec, pr, s, options.samples);
-  ExplainLimits(spec, pr, s, &d);
+  d.slow_error = PredictionSlowError(spec, options);
+  DesignProblem flown;
+  if (!SurveyProblem(robot, spec, pr, d.poses, d.joints, FlightTimes(d, options), d.slow_error,
+                     &flown, error)) {
+    return false;
+  }
+  const DesignSums s = internal::SumsOf(flown, Eigen::VectorXd::Ones(flown.candidates()));
+  d.design = PredictWithParts(spec, flown, s, options.samples);
+  ExplainLimits(spec, flown, s, &d);
   std::vector<Pose> reference;
   std::string why;
   if (internal::CirclePoses(options, options.samples, &reference, &why)) {
-    d.circle = PredictPoses(robot, spec, pr, reference);
+    d.circle = PredictPoses(robot, spec, pr, reference, d.slow_error, options.sample_interval_s);
   } else {
     d.circle.note = why;
   }
   if (internal::RandomSurveyPoses(robot, options, options.samples, &reference, &why)) {
-    d.random = PredictPoses(robot, spec, pr, reference);
+    d.random = PredictPoses(robot, spec, pr, reference, d.slow_error, options.sample_interval_s);
   } else {
     d.random.note = why;
   }
@@ -633,13 +728,29 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
 bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                    const DesignOptions& options, const std::vector<Pose>& poses,
                    DesignPrediction* prediction, std::string* error) {
+  return PredictSurvey(robot, spec, options, poses, {}, prediction, error);
+}
+
+bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
+                   const DesignOptions& options, const std::vector<Pose>& poses,
+                   const std::vector<JointValues>& joints, DesignPrediction* prediction,
+                   std::string* error) {
+  if (!joints.empty() && joints.size() != poses.size()) {
+    *error = "joints: " + std::to_string(joints.size()) + " joint values for " +
+             std::to_string(poses.size()) + " poses";
+    return false;
+  }
   DesignOptions o = options;
   o.samples = std::max<int>(1, static_cast<int>(poses.size()));
   DesignProblem pr;
   if (!SetUp(robot, spec, o, &pr, error)) return false;
-  if (!internal::AddPoseRows(robot, spec, poses, &pr, error)) return false;
-  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(pr.candidates());
-  *prediction = PredictWithParts(spec, pr, internal::SumsOf(pr, ones), o.samples);
+  DesignProblem flown;
+  if (!SurveyProblem(robot, spec, pr, poses, joints, EvenTimes(poses.size(), o.sample_interval_s),
+                     PredictionSlowError(spec, o), &flown, error)) {
+    return false;
+  }
+  const Eigen::VectorXd ones = Eigen::VectorXd::Ones(flown.candidates());
+  *prediction = PredictWithParts(spec, flown, internal::SumsOf(flown, ones), o.samples);
   return true;
 }
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "fastcal/internal/design_information.h"
+#include "fastcal/joint_plan.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/workspace.h"
 
@@ -94,6 +95,51 @@ bool DesignCandidates(const CableRobot& robot, const DesignOptions& options,
     return false;
   }
   return true;
+}
+
+bool ExpandJointGrid(const CableRobot& robot, const DesignOptions& options,
+                     std::vector<DesignCandidate>* candidates, std::string* error) {
+  JointPlanOptions grid;
+  grid.revolute = RevoluteLaw::kGrid;
+  grid.grid_deg = options.joint_grid_deg;
+  JointPlan plan;
+  if (options.joint_grid_deg.empty() ||
+      !JointPlan::Make(robot.moving_parts, grid, &plan, nullptr)) {
+    return true;  // a rigid cabin, no rotator, or the rotator held at zero
+  }
+  const long long points =
+      static_cast<long long>(options.joint_grid_deg.size() * options.joint_grid_deg.size());
+  std::vector<DesignCandidate> out;
+  std::string out_of_range;
+  for (const DesignCandidate& c : *candidates) {
+    for (long long g = 0; g < points; ++g) {
+      DesignCandidate k = c;
+      // Out of a joint's range: that point is not offered (the plan says why).
+      if (!plan.Next(g, c.pose, &k.joints, &out_of_range)) continue;
+      k.joint_point = static_cast<int>(g);
+      out.push_back(k);
+    }
+  }
+  if (out.empty()) {
+    *error = "joint grid: no point of it is within the rotator's ranges (" + out_of_range + ")";
+    return false;
+  }
+  *candidates = std::move(out);
+  return true;
+}
+
+std::vector<JointValues> ObservingJoints(const CableRobot& robot, const std::vector<Pose>& poses) {
+  if (robot.moving_parts.empty()) return {};
+  JointPlanOptions focal;
+  focal.revolute = RevoluteLaw::kFocal;
+  JointPlan plan;
+  const bool rotator = JointPlan::Make(robot.moving_parts, focal, &plan, nullptr);
+  std::vector<JointValues> joints(poses.size(), JointValues{});
+  for (size_t n = 0; rotator && n < poses.size(); ++n) {
+    // A law's angle out of a joint's range: that pose flies the rotator at zero.
+    if (!plan.Next(static_cast<long long>(n), poses[n], &joints[n], nullptr)) joints[n].fill(0.0);
+  }
+  return joints;
 }
 
 bool CirclePoses(const DesignOptions& options, int samples, std::vector<Pose>* poses,

@@ -14,6 +14,7 @@
 
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/sample_chunks.h"
+#include "fastcal/internal/slow_error_filter.h"
 #include "fastcal/statics.h"
 
 namespace fastcal::internal {
@@ -90,7 +91,8 @@ bool SetUpDesignProblem(const CalibrationSpec& spec, DesignProblem* problem, std
 }
 
 bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
-                 const std::vector<Pose>& poses, DesignProblem* problem, std::string* error) {
+                 const std::vector<Pose>& poses, const std::vector<JointValues>& joints,
+                 DesignProblem* problem, std::string* error) {
   DesignProblem& pr = *problem;
   // The consider parameters freed: one Jet pass differentiates against both kinds.
   CalibrationSpec both = spec;
@@ -110,13 +112,17 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
   if (spec.UsesLengths()) f.length_sigma_m = 1.0;  // residual = s0 + offset; likewise
   const int rows = pr.rows;
   const int first = static_cast<int>(pr.x_rows.rows());
-  pr.x_rows.conservativeResize(first + rows * static_cast<int>(poses.size()), pr.n);
-  pr.z_rows.conservativeResize(first + rows * static_cast<int>(poses.size()), pr.q);
+  const int total_rows = first + rows * static_cast<int>(poses.size());
+  pr.x_rows.conservativeResize(total_rows, pr.n);
+  pr.z_rows.conservativeResize(total_rows, pr.q);
+  pr.reading.conservativeResize(total_rows);
+  pr.white_sigma.conservativeResize(total_rows);
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> jac(rows,
                                                                              model.num_free());
   std::array<double, kMaxReadings> reading{};
   for (size_t t = 0; t < poses.size(); ++t) {
     f.pose = poses[t];
+    if (!joints.empty()) f.joints = joints[t];
     const TensionCost cost(f);
     const double* parameters[1] = {theta.data()};
     double* jacobians[1] = {jac.data()};
@@ -127,6 +133,8 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
                ") m: the statics of the spec's initial model fail there";
       pr.x_rows.conservativeResize(first, pr.n);
       pr.z_rows.conservativeResize(first, pr.q);
+      pr.reading.conservativeResize(first);
+      pr.white_sigma.conservativeResize(first);
       return false;
     }
     std::array<double, kNumCables> tension{};
@@ -136,6 +144,8 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
     for (int i = 0; i < rows; ++i) {
       const int row = first + rows * static_cast<int>(t) + i;
       const double sigma_i = i < kNumCables ? sigma[i] : spec.length_sigma_m;
+      pr.reading[row] = reading[i];
+      pr.white_sigma[row] = sigma_i;
       for (int k = 0; k < model.num_free(); ++k) {
         const double v = jac(i, k) / sigma_i;
         if (column[k] < pr.n) {
@@ -147,6 +157,29 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
     }
   }
   return true;
+}
+
+void WhitenInTimeOrder(const SlowErrorProcess& process, const std::vector<double>& times_s,
+                       DesignProblem* problem) {
+  DesignProblem& pr = *problem;
+  const int columns = pr.n + pr.q;
+  ReadingWhitener whitener(process, columns);
+  if (!whitener.active()) return;
+  std::vector<double> rows(static_cast<size_t>(kNumCables) * columns);
+  std::array<double, kNumCables> rho{};
+  for (int t = 0; t < pr.candidates() && t < static_cast<int>(times_s.size()); ++t) {
+    const int first = pr.rows * t;  // the tension rows come first (AddPoseRows)
+    for (int i = 0; i < kNumCables; ++i) {
+      rho[i] = process.SigmaN(std::abs(pr.reading[first + i])) / pr.white_sigma[first + i];
+      for (int k = 0; k < pr.n; ++k) rows[i * columns + k] = pr.x_rows(first + i, k);
+      for (int c = 0; c < pr.q; ++c) rows[i * columns + pr.n + c] = pr.z_rows(first + i, c);
+    }
+    whitener.Whiten(times_s[t], 0, rho.data(), nullptr, rows.data());
+    for (int i = 0; i < kNumCables; ++i) {
+      for (int k = 0; k < pr.n; ++k) pr.x_rows(first + i, k) = rows[i * columns + k];
+      for (int c = 0; c < pr.q; ++c) pr.z_rows(first + i, c) = rows[i * columns + pr.n + c];
+    }
+  }
 }
 
 DesignSums SumsOf(const DesignProblem& pr, const Eigen::VectorXd& weights) {

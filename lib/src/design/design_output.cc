@@ -42,6 +42,17 @@ Shown ShownUnit(const Design& d, int k) {
 // library is SI inside, the files speak as the spec and calibrate's outputs do.
 double InSpecUnit(const Design& d, size_t k, double si_value) { return si_value / d.free_to_si[k]; }
 
+// A range parameter's group: its name before '.' or '[' ("mass_centre_m"), a moving
+// part's up to its quantity ("moving_parts.rotator.first_moment_kg_m").
+std::string RangeGroup(const std::string& name) {
+  const std::string parts = "moving_parts.";
+  if (name.compare(0, parts.size(), parts) == 0) {
+    const size_t part_end = name.find('.', parts.size());
+    return part_end == std::string::npos ? name : name.substr(0, name.find('.', part_end + 1));
+  }
+  return name.substr(0, name.find_first_of(".["));
+}
+
 // The range's parameters grouped by name before '.' or '[' with their offset in file
 // units, e.g. "mass_centre_m +-0.25 m (margin); linear_density_kg_per_m +-0.36 kg/m (2
 // sigma)".
@@ -49,7 +60,7 @@ std::string RangeText(const Design& d) {
   std::string out;
   for (size_t j = 0; j < d.range.size(); ++j) {
     const DesignRangeParameter& r = d.range[j];
-    const std::string group = r.name.substr(0, r.name.find_first_of(".["));
+    const std::string group = RangeGroup(r.name);
     const std::string text =
         group + " +-" + Fmt("%.3g", r.delta_si / r.to_si) + " " + r.unit +
         (r.from_prior ? " (" + Fmt("%.3g", d.options.range_prior_sigmas) + " sigma of its prior)"
@@ -68,7 +79,7 @@ std::string CornerText(const Design& d, const DesignBinding& b) {
   bool off = false;
   for (size_t j = 0; j < b.corner_si.size() && j < d.range.size(); ++j) {
     const DesignRangeParameter& r = d.range[j];
-    const std::string g = r.name.substr(0, r.name.find_first_of(".["));
+    const std::string g = RangeGroup(r.name);
     if (g != group) {
       group = g;
       out += (out.empty() ? "" : "; ") + g + " +-" + Fmt("%.3g", r.delta_si / r.to_si) + " " +
@@ -84,6 +95,15 @@ std::string CornerText(const Design& d, const DesignBinding& b) {
 bool IsTension(const DesignBinding& b) { return b.constraint != "reflector_clearance"; }
 double BindingShown(const DesignBinding& b, double si) { return IsTension(b) ? si / 1e3 : si; }
 std::string BindingUnit(const DesignBinding& b) { return IsTension(b) ? "kN" : "m"; }
+
+// A stop's joint values for a person ("; rotator_a_deg 15, rotator_b_deg -15"), or "".
+std::string JointsText(const Design& d, const DesignCandidate& c) {
+  std::string out;
+  for (size_t k = 0; k < d.joint_columns.size(); ++k) {
+    out += (k == 0 ? "; " : ", ") + d.joint_columns[k] + " " + Fmt("%.3g", c.joints[k]);
+  }
+  return out;
+}
 
 // The stop whose binding has the least slack (its value nearest its limit, relatively).
 int TightestStop(const Design& d) {
@@ -137,12 +157,19 @@ void WritePrediction(JsonWriter& j, const Design& d, const DesignPrediction& p) 
 
 std::string DesignPosesCsv(const Design& design, const std::string& provenance) {
   std::string out = CommentLines(provenance);
-  out += "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg\n";
-  for (const Pose& p : design.poses) {
+  out += "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg";
+  for (const std::string& column : design.joint_columns) out += "," + column;
+  out += "\n";
+  for (size_t n = 0; n < design.poses.size(); ++n) {
+    const Pose& p = design.poses[n];
     const Eigen::Vector3d rpy = RpyDegFromRotation(p.rotation);
     out += Fmt("%.6f", p.position_m[0]) + "," + Fmt("%.6f", p.position_m[1]) + "," +
            Fmt("%.6f", p.position_m[2]) + "," + Fmt("%.8f", rpy[0]) + "," + Fmt("%.8f", rpy[1]) +
-           "," + Fmt("%.8f", rpy[2]) + "\n";
+           "," + Fmt("%.8f", rpy[2]);
+    for (size_t j = 0; j < design.joint_columns.size() && n < design.joints.size(); ++j) {
+      out += "," + Fmt("%.8f", design.joints[n][j]);
+    }
+    out += "\n";
   }
   return out;
 }
@@ -158,6 +185,21 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
   j.Key("max_extra_tilt_deg").Number(o.max_extra_tilt_deg);
   j.Key("max_extra_yaw_deg").Number(o.max_extra_yaw_deg);
   j.Key("seed").Int(static_cast<long long>(o.seed));
+  if (!d.joint_columns.empty()) j.Key("joint_grid_deg").NumberArray(o.joint_grid_deg);
+  // The noise the predictions assumed: null for white, else the slow error's parts.
+  j.Key("slow_error");
+  if (d.slow_error.IsActive()) {
+    j.BeginObject()
+        .Key("sigma_percent")
+        .Number(d.slow_error.sigma_percent)
+        .Key("sigma_kN")
+        .Number(d.slow_error.sigma_n / 1e3)
+        .Key("time_constant_s")
+        .Number(d.slow_error.time_constant_s)
+        .EndObject();
+  } else {
+    j.Null();
+  }
   j.Key("candidates").Int(static_cast<long long>(d.candidates.size()));
   j.Key("rejected_candidates").Int(d.rejected_candidates);
   j.Key("wanted").BeginArray();
@@ -187,6 +229,13 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
     j.Key("extra_tilt_deg").Number(c.extra_tilt_deg);
     j.Key("tilt_direction_deg").Number(c.tilt_direction_deg);
     j.Key("extra_yaw_deg").Number(c.extra_yaw_deg);
+    if (!d.joint_columns.empty()) {
+      j.Key("joints").BeginObject();
+      for (size_t k = 0; k < d.joint_columns.size(); ++k) {
+        j.Key(d.joint_columns[k]).Number(c.joints[k]);
+      }
+      j.EndObject();
+    }
     const DesignBinding& b = s.binding;
     if (!b.constraint.empty()) {
       const std::string unit = BindingUnit(b);
@@ -323,7 +372,8 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
          Fmt("%.2f", c.pose.position_m.z()) + ") m, rpy (" + Fmt("%.2f", rpy[0]) + ", " +
          Fmt("%.2f", rpy[1]) + ", " + Fmt("%.2f", rpy[2]) + ") deg; extra tilt " +
          Fmt("%.3g", c.extra_tilt_deg) + " deg toward " + Fmt("%.3g", c.tilt_direction_deg) +
-         " deg, extra yaw " + Fmt("%.3g", c.extra_yaw_deg) + " deg</title></circle>\n";
+         " deg, extra yaw " + Fmt("%.3g", c.extra_yaw_deg) + " deg" + JointsText(d, c) +
+         "</title></circle>\n";
     // Stops at one position (other attitudes) share one label: "18, 19".
     CircleLabel& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
     n.x_px = half + scale * (c.pose.position_m.x() - g.focal_centre_m.x());

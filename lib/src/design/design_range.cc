@@ -3,13 +3,20 @@
 //   range:   delta_j = range_prior_sigmas sigma_j (a prior), or the kind's range_* margin
 //   effects: dT_ij = T_i(theta_0 + delta_j e_j) - T_i(theta_0)
 //   corners: theta_0 - sum_j sign(dT_ij) delta_j e_j (cable i lowest), + for the highest
+//   probabilistic (hold_probability p > 0): margins as corners; the priors' part at
+//     -beta g_i / |g_i| sigmas, g_ij = dT_ij / sigma_j per sigma, beta = Phi^-1(1 - p / L)
+//     with L the limits (six minima, six maxima when set, the clearance): a pose then
+//     breaks a limit with probability <= p over the priors, to first order (the point is
+//     solved exactly)
 #include "fastcal/internal/design_range.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <functional>
 #include <limits>
 
+#include "fastcal/gross_errors.h"
 #include "fastcal/statics.h"
 
 namespace fastcal::internal {
@@ -78,7 +85,10 @@ PlausibleRange::PlausibleRange(const CableRobot& robot, const CalibrationSpec& s
     r.from_prior = p.has_prior;
     r.delta_si = p.has_prior ? options.range_prior_sigmas * p.prior_sigma_si
                              : MarginOf(p, theta0_[k], options);
-    if (!(r.delta_si > 0.0)) continue;
+    r.sigma_si = p.has_prior ? p.prior_sigma_si : 0.0;
+    // Under the probabilistic rule a prior's sigma counts even with range_prior_sigmas 0.
+    const bool counts = r.delta_si > 0.0 || (options.hold_probability > 0.0 && r.sigma_si > 0.0);
+    if (!counts) continue;
     parameters_.push_back(r);
     theta_index_.push_back(k);
   }
@@ -86,8 +96,9 @@ PlausibleRange::PlausibleRange(const CableRobot& robot, const CalibrationSpec& s
 
 // The statics at theta_0 + offset (one entry per range parameter), warm from *start
 // when it is not null. True when ok.
-bool PlausibleRange::Evaluate(const Pose& pose, const std::vector<double>& offset,
-                              const StaticsSolution* start, StaticsSolution* out) const {
+bool PlausibleRange::Evaluate(const Pose& pose, const JointValues& joints,
+                              const std::vector<double>& offset, const StaticsSolution* start,
+                              StaticsSolution* out) const {
   std::vector<double> theta = theta0_;
   for (size_t j = 0; j < offset.size(); ++j) theta[theta_index_[j]] += offset[j];
   StaticsParameters<double> p;
@@ -97,12 +108,95 @@ bool PlausibleRange::Evaluate(const Pose& pose, const std::vector<double>& offse
   StaticsOptions o = options_.workspace.statics;
   o.warm_start = start != nullptr;
   if (start != nullptr) *out = *start;
-  return SolveStaticsWithParameters(p, pose, o, out) == StaticsStatus::kOk;
+  return SolveStaticsWithParameters(p, model_.robot().moving_parts, joints, pose, o, out) ==
+         StaticsStatus::kOk;
 }
 
-bool PlausibleRange::Holds(const Pose& pose, DesignBinding* binding) const {
-  const WorkspaceOptions& w = options_.workspace;
+// Stage: the nominal point's statics and each parameter's effect on the six lower-end
+// tensions and the clearance, per its step (the corner rule's delta; else its prior's
+// sigma, or its margin). False, with *failed, where a solve fails.
+bool PlausibleRange::Effects(const Pose& pose, const JointValues& joints, StaticsSolution* nominal,
+                             std::vector<Effect>* effects, std::vector<double>* failed,
+                             StaticsSolution* failed_solution) const {
   const int n = static_cast<int>(parameters_.size());
+  std::vector<double> offset(n, 0.0);
+  if (!Evaluate(pose, joints, offset, nullptr, nominal)) {
+    *failed = offset;
+    *failed_solution = *nominal;
+    return false;
+  }
+  effects->assign(n, Effect{});
+  StaticsSolution s;
+  for (int j = 0; j < n; ++j) {
+    offset.assign(n, 0.0);
+    offset[j] = Step(j);
+    if (!(offset[j] > 0.0)) continue;
+    if (!Evaluate(pose, joints, offset, nominal, &s)) {
+      *failed = offset;
+      *failed_solution = s;
+      return false;
+    }
+    for (int i = 0; i < kNumCables; ++i) {
+      (*effects)[j].tension_n[i] = s.cables[i].lower_tension_n - nominal->cables[i].lower_tension_n;
+    }
+    (*effects)[j].clearance_m = s.reflector_clearance_m - nominal->reflector_clearance_m;
+  }
+  return true;
+}
+
+double PlausibleRange::Step(int j) const {
+  const DesignRangeParameter& r = parameters_[j];
+  if (options_.hold_probability <= 0.0 || !r.from_prior) return r.delta_si;
+  return r.sigma_si;
+}
+
+// Stage: where to check. The corner rule: for each cable the corner of the box where it is
+// lowest (and highest). The probabilistic rule: each margin at its worst end, and the
+// priors' part at the design point of the first-order reliability method (Hasofer and
+// Lind 1974): with g the limit's gradient per prior sigma, -beta g / |g| sigmas, beta the
+// normal quantile of the probability shared among the limits.
+std::vector<std::vector<double>> PlausibleRange::Points(const std::vector<Effect>& effects,
+                                                        bool has_max) const {
+  const int n = static_cast<int>(parameters_.size());
+  const bool form = options_.hold_probability > 0.0;
+  // Limits shared among: each cable's minimum (and maximum) and the clearance.
+  const int limits = kNumCables * (has_max ? 2 : 1) + 1;
+  const double beta = form ? TwoSidedNormalQuantile(2.0 * options_.hold_probability / limits) : 0.0;
+  std::vector<std::vector<double>> points = {std::vector<double>(n, 0.0)};
+  // An effect per unit of the parameter's step (0 where it has none).
+  const auto PerStep = [this](double effect, int j) {
+    return Step(j) > 0.0 ? effect / Step(j) : 0.0;
+  };
+  // The point lowering quantity q (its effect per step: effect(j)) the most.
+  auto worst = [&](const std::function<double(int)>& effect) {
+    std::vector<double> c(n, 0.0);
+    double norm = 0.0;
+    for (int j = 0; j < n; ++j) {
+      if (form && parameters_[j].from_prior) {
+        norm += effect(j) * effect(j);
+      } else {
+        c[j] = (effect(j) < 0.0 ? 1.0 : -1.0) * parameters_[j].delta_si;
+      }
+    }
+    norm = std::sqrt(norm);
+    for (int j = 0; j < n && norm > 0.0; ++j) {
+      if (form && parameters_[j].from_prior) c[j] = -beta * effect(j) / norm * Step(j);
+    }
+    if (std::find(points.begin(), points.end(), c) == points.end()) points.push_back(c);
+  };
+  for (int side = 0; side < (has_max ? 2 : 1); ++side) {
+    const double sign = side == 0 ? 1.0 : -1.0;  // lowest, then highest
+    for (int i = 0; i < kNumCables; ++i) {
+      worst([&](int j) { return PerStep(sign * effects[j].tension_n[i], j); });
+    }
+  }
+  if (form) worst([&](int j) { return PerStep(effects[j].clearance_m, j); });
+  return points;
+}
+
+bool PlausibleRange::Holds(const Pose& pose, const JointValues& joints,
+                           DesignBinding* binding) const {
+  const WorkspaceOptions& w = options_.workspace;
   DesignBinding broken;
   auto fail = [&](const StaticsSolution& s, const std::vector<double>& at) {
     broken.constraint = StaticsStatusName(s.status);
@@ -111,39 +205,18 @@ bool PlausibleRange::Holds(const Pose& pose, DesignBinding* binding) const {
     if (binding != nullptr) *binding = broken;
     return false;
   };
-  // The nominal point, then each parameter alone at +delta: the tensions' effects.
-  std::vector<double> offset(n, 0.0);
-  StaticsSolution nominal;
-  if (!Evaluate(pose, offset, nullptr, &nominal)) return fail(nominal, offset);
-  std::vector<std::array<double, kNumCables>> effect(n);
-  StaticsSolution s;
-  for (int j = 0; j < n; ++j) {
-    offset.assign(n, 0.0);
-    offset[j] = parameters_[j].delta_si;
-    if (!Evaluate(pose, offset, &nominal, &s)) return fail(s, offset);
-    for (int i = 0; i < kNumCables; ++i) {
-      effect[j][i] = s.cables[i].lower_tension_n - nominal.cables[i].lower_tension_n;
-    }
-  }
-  // The corners: the nominal point, each cable's lowest, and with a maximum its highest.
-  std::vector<std::vector<double>> corners = {std::vector<double>(n, 0.0)};
+  StaticsSolution nominal, s;
+  std::vector<Effect> effects;
+  std::vector<double> failed;
+  if (!Effects(pose, joints, &nominal, &effects, &failed, &s)) return fail(s, failed);
   const bool has_max = std::isfinite(w.max_tension_n);
-  for (int side = 0; side < (has_max ? 2 : 1); ++side) {
-    for (int i = 0; i < kNumCables; ++i) {
-      std::vector<double> c(n);
-      for (int j = 0; j < n; ++j) {
-        const bool lowers = effect[j][i] < 0.0;
-        c[j] = (lowers == (side == 0) ? 1.0 : -1.0) * parameters_[j].delta_si;
-      }
-      if (std::find(corners.begin(), corners.end(), c) == corners.end()) corners.push_back(c);
-    }
-  }
+  const std::vector<std::vector<double>> points = Points(effects, has_max);
   constexpr double kInfinity = std::numeric_limits<double>::infinity();
   DesignBinding low{"min_tension", -1, kInfinity, w.min_tension_n, {}},
       high{"max_tension", -1, -kInfinity, w.max_tension_n, {}},
       clear{"reflector_clearance", -1, kInfinity, w.statics.min_reflector_clearance_m, {}};
-  for (const std::vector<double>& c : corners) {
-    const bool ok = c == corners[0] ? (s = nominal, true) : Evaluate(pose, c, &nominal, &s);
+  for (const std::vector<double>& c : points) {
+    const bool ok = c == points[0] ? (s = nominal, true) : Evaluate(pose, joints, c, &nominal, &s);
     if (!ok) return fail(s, c);
     for (int i = 0; i < kNumCables; ++i) {
       const double t = s.cables[i].lower_tension_n;

@@ -32,6 +32,9 @@ struct DesignProblem {
   // Whitened Jacobian rows, `rows` per candidate (candidate k's rows rows k .. rows k +
   // rows - 1): free (X) and consider (Z) columns.
   Eigen::MatrixXd x_rows, z_rows;
+  // Per row: the reading its Jacobian is of (N for a tension, m for a length) and the
+  // white sigma it was whitened by, for the slow error's whitening (WhitenInTimeOrder).
+  Eigen::VectorXd reading, white_sigma;
   int candidates() const { return static_cast<int>(x_rows.rows() / rows); }
 };
 
@@ -42,8 +45,17 @@ bool SetUpDesignProblem(const CalibrationSpec& spec, DesignProblem* problem, std
 // Whitened Jacobian rows of each pose (appended to problem->x_rows and z_rows), at the
 // spec's initial values with its noise model. False with *error naming the pose when the
 // statics fail there.
+// `joints`: each pose's joint values (moving parts), parallel to poses; empty: all zero.
 bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
-                 const std::vector<Pose>& poses, DesignProblem* problem, std::string* error);
+                 const std::vector<Pose>& poses, const std::vector<JointValues>& joints,
+                 DesignProblem* problem, std::string* error);
+
+// The rows of a survey's samples (one candidate per sample, in time order at times_s)
+// whitened by the slow sensor error `process` as the calibration whitens its readings
+// (internal/slow_error_filter.h: each cable's Kalman filter over its readings in time
+// order; the lengths' rows are left white). Nothing changes when the process is inactive.
+void WhitenInTimeOrder(const SlowErrorProcess& process, const std::vector<double>& times_s,
+                       DesignProblem* problem);
 
 // Information sums of a design with weights w (one per candidate): M (data part, no
 // priors) and C.
@@ -73,6 +85,14 @@ bool CriterionGradient(const DesignProblem& problem, const DesignSums& sums,
 // variants (design.h), and how many were infeasible.
 bool DesignCandidates(const CableRobot& robot, const DesignOptions& options,
                       std::vector<DesignCandidate>* candidates, int* rejected, std::string* error);
+// With a rotator in the model and options.joint_grid_deg not empty, each candidate
+// replaced by one per point of the joint grid within the joints' ranges (design.h,
+// "Moving parts"); otherwise unchanged. False with *error when no point is in range.
+bool ExpandJointGrid(const CableRobot& robot, const DesignOptions& options,
+                     std::vector<DesignCandidate>* candidates, std::string* error);
+// Each pose's joints for the surveys compared with: the rotator by the focal law when the
+// model has one, else zero (empty for a rigid cabin).
+std::vector<JointValues> ObservingJoints(const CableRobot& robot, const std::vector<Pose>& poses);
 // The paper's circle with `samples` poses at the focal law.
 bool CirclePoses(const DesignOptions& options, int samples, std::vector<Pose>* poses,
                  std::string* error);

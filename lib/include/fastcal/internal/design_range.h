@@ -11,6 +11,7 @@
 #ifndef FASTCAL_INTERNAL_DESIGN_RANGE_H_
 #define FASTCAL_INTERNAL_DESIGN_RANGE_H_
 
+#include <array>
 #include <string>
 #include <vector>
 
@@ -36,11 +37,22 @@ class PlausibleRange {
   // tensions within the workspace limits. *binding (may be null): its tightest limit
   // there, when it holds; else the one broken (constraint: the statics' status code,
   // StaticsStatusName, where a solve fails).
-  bool Holds(const Pose& pose, DesignBinding* binding) const;
+  // With moving parts, at the joint values `joints` (the mass centre at c(q)).
+  bool Holds(const Pose& pose, const JointValues& joints, DesignBinding* binding) const;
 
  private:
-  bool Evaluate(const Pose& pose, const std::vector<double>& offset, const StaticsSolution* start,
-                StaticsSolution* out) const;
+  // A parameter's effect on the six lower-end tensions (N) and the clearance (m), per step.
+  struct Effect {
+    std::array<double, kNumCables> tension_n{};
+    double clearance_m = 0.0;
+  };
+  bool Evaluate(const Pose& pose, const JointValues& joints, const std::vector<double>& offset,
+                const StaticsSolution* start, StaticsSolution* out) const;
+  bool Effects(const Pose& pose, const JointValues& joints, StaticsSolution* nominal,
+               std::vector<Effect>* effects, std::vector<double>* failed,
+               StaticsSolution* failed_solution) const;
+  double Step(int j) const;  // parameter j's step for its effect (SI)
+  std::vector<std::vector<double>> Points(const std::vector<Effect>& effects, bool has_max) const;
 
   DesignOptions options_;
   CalibrationModel model_;        // the spec with every ranged parameter free
