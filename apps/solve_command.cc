@@ -148,7 +148,9 @@ reports the model's true cable tensions: a model's sensor_gain and sensor_bias_k
 not applied here (they are in evaluate and calibrate, which compare with readings). A
 model with moving parts (cabin.moving_parts) solves every pose with its joints at
 --joints=v1,... (the model's joint order, in the columns' units: deg and m; the mass
-centre then follows, docs/model.md "Moving parts"); default all 0.
+centre then follows, docs/model.md "Moving parts"); default all 0. A --poses file may
+carry the model's joint columns instead (rotator_a_deg, ...: all or none), each pose then
+solved at its own joints; --joints beside them is refused.
 
 Output: CSV (default) or --format=json, to stdout or --output=FILE (written only when
 everything succeeded; an existing FILE is refused unless --force, which needs --output).
@@ -514,8 +516,8 @@ bool AttitudeLawFromFlags(FocalAttitudeLaw* law, std::string* error) {
 constexpr char kIdentityByFlag[] = "R = I (--attitude-law=none)";
 
 // --poses=FILE: its poses, their attitudes replaced only by --attitude-law.
-bool PosesFromFile(const FocalAttitudeLaw& law, PoseStream* poses, std::string* attitude,
-                   std::string* error) {
+bool PosesFromFile(const FocalAttitudeLaw& law, const MovingParts& parts, PoseStream* poses,
+                   std::vector<JointValues>* joints, std::string* attitude, std::string* error) {
   if (FLAGS_trajectory != "point" || !FLAGS_position.empty()) {
     *error = "--poses cannot be combined with --position or --trajectory";
     return false;
@@ -529,7 +531,13 @@ bool PosesFromFile(const FocalAttitudeLaw& law, PoseStream* poses, std::string* 
                   ? std::string(kIdentityByFlag)
                   : "as in " + FLAGS_poses + " (R = I if it has no attitude columns)";
   std::vector<Pose> from_file;
-  if (!ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, &from_file, error)) {
+  const std::vector<std::string> joint_columns = parts.JointColumns();
+  if (!ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, &from_file, error,
+                                &joint_columns, joints)) {
+    return false;
+  }
+  if (!joints->empty() && !FLAGS_joints.empty()) {
+    *error = FLAGS_poses + " brings its own joint values (the model's joint columns): drop --joints";
     return false;
   }
   *poses = StreamOf(std::move(from_file));
@@ -628,10 +636,14 @@ bool TrajectoryPoses(const FocalAttitudeLaw& law, PoseStream* poses, std::string
 
 // The poses to solve from the pose, trajectory and attitude flags; *attitude says in words
 // which attitude they have (for the summary line).
-bool BuildPoses(PoseStream* poses, std::string* attitude, std::string* error) {
+// A --poses file with the model's joint columns fills *joints, one per pose; otherwise it
+// is left empty (the joints of --joints, or all 0, are already in the model).
+bool BuildPoses(const MovingParts& parts, PoseStream* poses, std::vector<JointValues>* joints,
+                std::string* attitude, std::string* error) {
   FocalAttitudeLaw law;
+  joints->clear();
   if (!AttitudeLawFromFlags(&law, error)) return false;
-  if (!FLAGS_poses.empty()) return PosesFromFile(law, poses, attitude, error);
+  if (!FLAGS_poses.empty()) return PosesFromFile(law, parts, poses, joints, attitude, error);
   if (FLAGS_trajectory == "point") return SinglePose(law, poses, attitude, error);
   return TrajectoryPoses(law, poses, attitude, error);
 }
@@ -986,7 +998,8 @@ bool CountPose(long long n, const Pose& pose,
 // Solves the poses one at a time (one method, or aas and exact for compare), each row
 // formatted and handed to `out` as it is made: memory independent of the number of poses
 // (issue 29). A failure without --keep-going stops the run with the node named.
-bool SolveStream(const CableRobot& robot, const PoseStream& stream, const StaticsOptions& options,
+bool SolveStream(const CableRobot& robot, const PoseStream& stream,
+                 const std::vector<JointValues>& joints, const StaticsOptions& options,
                  bool compare, ResultStream* out, Run* single, Run* aas, Run* exact, Totals* totals,
                  PlotData* plot, std::string* error) {
   const bool json = FLAGS_format == "json";
@@ -1004,16 +1017,22 @@ bool SolveStream(const CableRobot& robot, const PoseStream& stream, const Static
     text = CsvHeader(!compare);
   }
   PoseStream poses = stream;
+  // Each pose at its own joints (a --poses file's joint columns): the model with its mass
+  // centre moved there, as locate does per row.
+  CableRobot at_joints = robot;
+  at_joints.moving_parts.parts.clear();
+  const CableRobot& model = joints.empty() ? robot : at_joints;
   constexpr size_t kWriteBytes = 1 << 20;
   for (long long n = 0; n < poses.count; ++n) {
     const Pose pose = poses.next();
+    if (!joints.empty()) at_joints.mass_centre_cabin_m = robot.MassCentreAt(joints[n]);
     std::vector<std::pair<const Run*, StaticsMethod>> runs;
     if (compare) {
-      aas->Solve(robot, pose);
-      exact->Solve(robot, pose);
+      aas->Solve(model, pose);
+      exact->Solve(model, pose);
       runs = {{aas, StaticsMethod::kAas}, {exact, StaticsMethod::kExact}};
     } else {
-      single->Solve(robot, pose);
+      single->Solve(model, pose);
       runs = {{single, options.method}};
     }
     if (!CountPose(n, pose, runs, compare, *aas, *exact, *single, totals, error)) return false;
@@ -1107,6 +1126,7 @@ int RunSolve(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
+  const MovingParts parts = robot.moving_parts;  // before --joints fixes the mass centre
   if (!MassCentreAtJointsFlag(FLAGS_joints, &robot, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
@@ -1114,15 +1134,21 @@ int RunSolve(int argc, char** argv) {
   StaticsOptions options;
   bool compare = false;
   PoseStream poses;
+  std::vector<JointValues> joints;
   std::string attitude;
   if (!SetOptionsFromFlags(&options, &compare, &error) || !CheckFlagsApplyToMode(&error) ||
-      !BuildPoses(&poses, &attitude, &error)) {
+      !BuildPoses(parts, &poses, &joints, &attitude, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
   if (poses.count == 0) {
     PrintError(kCommand, "no poses to solve");
     return kExitUsage;
+  }
+  if (!parts.empty()) {  // the summary says at which joints the moving parts were
+    attitude += !joints.empty()        ? ", joints per pose from " + FLAGS_poses
+                : !FLAGS_joints.empty() ? ", joints --joints=" + FLAGS_joints
+                                        : ", joints all 0 (no --joints)";
   }
 
   ResultStream out;
@@ -1133,7 +1159,7 @@ int RunSolve(int argc, char** argv) {
   Run single, aas, exact;
   Totals totals;
   PlotData plot;
-  if (!SolveStream(robot, poses, options, compare, &out, &single, &aas, &exact, &totals,
+  if (!SolveStream(robot, poses, joints, options, compare, &out, &single, &aas, &exact, &totals,
                    FLAGS_plot.empty() ? nullptr : &plot, &error) ||
       !WritePlot(argc, argv, attitude, compare, plot, &error)) {
     PrintError(kCommand, error);

@@ -156,6 +156,42 @@ TEST_F(CliMovingPartsTest, LocateTakesEachRowsJoints) {
   EXPECT_GT(std::stod(m[1]), kVisibleM);
 }
 
+TEST_F(CliMovingPartsTest, SolveTakesEachPosesJointsFromThePoseFile) {
+  // A pose file with the model's joint columns: each row solved at its own joints gives the
+  // tensions --joints gives for that row alone; the rotator turned visibly changes them.
+  constexpr double kSameKn = 1e-6;     // the same solve, printed to 10 digits
+  constexpr double kVisibleKn = 0.5;   // 10 deg of a 6000 kg m rotator moves T1 by ~2 kN
+  const std::string model = Source() + "/calibration_data/moving_parts.yaml";
+  Write("poses.csv",
+        "x_m,y_m,z_m,rotator_a_deg,rotator_b_deg,stewart_x_m,stewart_y_m,stewart_z_m\n"
+        "0,0,150,0,0,0,0,0\n"
+        "10,-5,148,10,-5,0.1,0,0\n");
+  const CommandResult both = Fastcal("solve --model=" + model + " --poses=" + Path("poses.csv"));
+  ASSERT_EQ(both.code, 0) << both.output;
+  EXPECT_NE(both.output.find("joints per pose from"), std::string::npos) << both.output;
+  // T1_kN is the 9th column of solve's CSV.
+  auto t1 = [](const std::string& out, int node) {
+    const std::regex row("\n" + std::to_string(node) + R"(,(?:[^,]*,){7}([^,]+),)");
+    std::smatch m;
+    EXPECT_TRUE(std::regex_search(out, m, row)) << out;
+    return m.empty() ? 0.0 : std::stod(m[1]);
+  };
+  const CommandResult one = Fastcal("solve --model=" + model +
+                                    " --position=10,-5,148 --joints=10,-5,0.1,0,0");
+  ASSERT_EQ(one.code, 0) << one.output;
+  EXPECT_NEAR(t1(both.output, 1), t1(one.output, 0), kSameKn);
+  EXPECT_GT(std::abs(t1(both.output, 1) - t1(both.output, 0)), kVisibleKn);
+  // Both ways at once, or some joint columns but not all, are refused by name.
+  const CommandResult twice = Fastcal("solve --model=" + model + " --poses=" +
+                                      Path("poses.csv") + " --joints=0,0,0,0,0");
+  EXPECT_NE(twice.code, 0);
+  EXPECT_NE(twice.output.find("drop --joints"), std::string::npos) << twice.output;
+  Write("some.csv", "x_m,y_m,z_m,rotator_a_deg\n0,0,150,0\n");
+  const CommandResult some = Fastcal("solve --model=" + model + " --poses=" + Path("some.csv"));
+  EXPECT_NE(some.code, 0);
+  EXPECT_NE(some.output.find("rotator_b_deg"), std::string::npos) << some.output;
+}
+
 TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
   // Six days, the rotator following the focal law, the mass centre moved 3.6 cm on the
   // fourth: tracked with the model's parts, the move is found and dated, nothing else.
