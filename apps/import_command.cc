@@ -148,6 +148,7 @@ int RunImport(int argc, char** argv) {
   }
   DatasetReadOptions read;
   read.columns = map;
+  read.joint_columns = JointColumnsOf(*map);  // the moving parts' joints, carried through
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   read.threads = 2;
   DatasetChunkReader reader;

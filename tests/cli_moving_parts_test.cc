@@ -3,6 +3,7 @@
 // errors, calibrate it with calibration_data/spec_moving_parts.yaml, and find the fixed
 // mass centre, the rotator's first moment and the platform's mass within 2.5 sigma_total;
 // and the refusals a user meets on the way.
+#include <cmath>
 #include <regex>
 #include <string>
 
@@ -190,6 +191,45 @@ TEST_F(CliMovingPartsTest, SolveTakesEachPosesJointsFromThePoseFile) {
   const CommandResult some = Fastcal("solve --model=" + model + " --poses=" + Path("some.csv"));
   EXPECT_NE(some.code, 0);
   EXPECT_NE(some.output.find("rotator_b_deg"), std::string::npos) << some.output;
+}
+
+TEST_F(CliMovingPartsTest, ImportCarriesTheJointColumnsAMapNames) {
+  // An export whose joint channels have their own names and units: import writes them as
+  // the model's joint columns in deg and m, and evaluate reads the export through the map
+  // with the same result as the imported file.
+  constexpr double kRadToDeg = 180.0 / M_PI;
+  const std::string model = Source() + "/calibration_data/moving_parts.yaml";
+  Write("export.csv",
+        "t,X,Y,Z,R,P,W,F1,F2,F3,F4,F5,F6,ROT_A,ROT_B,SX,SY,SZ\n"
+        "0,0,0,150,0,0,0,171,171,171,171,171,171,0.1,-0.05,0,0,20\n");
+  std::string map = "format: fastcal-columns-1\ntime: {column: t}\ncolumns:\n";
+  const char* pairs[][2] = {{"x_m", "X"},   {"y_m", "Y"},   {"z_m", "Z"},   {"roll_deg", "R"},
+                            {"pitch_deg", "P"}, {"yaw_deg", "W"}, {"T1_kN", "F1"}, {"T2_kN", "F2"},
+                            {"T3_kN", "F3"}, {"T4_kN", "F4"}, {"T5_kN", "F5"}, {"T6_kN", "F6"}};
+  for (const auto& p : pairs) map += std::string("  ") + p[0] + ": " + p[1] + "\n";
+  map += "  rotator_a_deg: {column: ROT_A, unit: rad}\n  rotator_b_deg: {column: ROT_B, unit: rad}\n"
+         "  stewart_x_m: SX\n  stewart_y_m: SY\n  stewart_z_m: {column: SZ, unit: mm}\n";
+  Write("map.yaml", map);
+  const CommandResult imported = Fastcal("import --columns=" + Path("map.yaml") + " --data=" +
+                                         Path("export.csv") + " --out=" + Path("i.csv"));
+  ASSERT_EQ(imported.code, 0) << imported.output;
+  const std::string text = ReadFile(Path("i.csv"));
+  const std::regex row(R"(rotator_a_deg,rotator_b_deg,stewart_x_m,stewart_y_m,stewart_z_m\n(?:[^,\n]*,){13}([^,]+),([^,]+),0,0,([^,\n]+)\n)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(text, m, row)) << text;
+  EXPECT_DOUBLE_EQ(std::stod(m[1]), 0.1 * kRadToDeg);
+  EXPECT_DOUBLE_EQ(std::stod(m[2]), -0.05 * kRadToDeg);
+  EXPECT_DOUBLE_EQ(std::stod(m[3]), 0.02);
+  // A model without moving parts refuses the map's joint entries by name.
+  const CommandResult rigid = Fastcal("evaluate --columns=" + Path("map.yaml") + " --data=" +
+                                      Path("export.csv"));
+  EXPECT_NE(rigid.code, 0);
+  EXPECT_NE(rigid.output.find("columns.rotator_a_deg: the model has no moving parts"),
+            std::string::npos)
+      << rigid.output;
+  const CommandResult with = Fastcal("evaluate --model=" + model + " --columns=" +
+                                     Path("map.yaml") + " --data=" + Path("export.csv"));
+  EXPECT_EQ(with.code, 0) << with.output;
 }
 
 TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {

@@ -200,6 +200,40 @@ TEST(ColumnMapTest, ASourceColumnNotInTheHeaderIsNamedWithTheMapsKeyAndANearName
                               "'sdp_phapos_x'?)"));
 }
 
+TEST(ColumnMapTest, ReadsTheModelsJointColumnsInTheirUnits) {
+  // A moving part's joints through a map (issue 35): a revolute joint in rad, a prismatic
+  // one in mm, read into Sample::joint in deg and m for the model's joint columns.
+  const std::string map = MapText("time: {column: t}\n" + Columns() +
+                                  "  rotator_a_deg: {column: ROT_A, unit: rad}\n"
+                                  "  stewart_z_m: {column: SP_Z, unit: mm}\n");
+  const std::string data = std::string(kCanonicalHeader) + ",ROT_A,SP_Z\n" + kRow + ",0.1,25\n";
+  DatasetReadOptions options;
+  options.joint_columns = {"rotator_a_deg", "stewart_z_m"};
+  options.columns = std::make_shared<ColumnMap>(Map(map));
+  Dataset d;
+  std::string error;
+  ASSERT_TRUE(ParseDataset(data, "data.csv", options, &d, &error)) << error;
+  ASSERT_EQ(d.samples.size(), 1u);
+  EXPECT_DOUBLE_EQ(d.samples[0].joint[0], 0.1 * 180.0 / M_PI);
+  EXPECT_EQ(d.samples[0].joint[1], 0.025);
+  EXPECT_EQ(JointColumnsOf(*options.columns),
+            (std::vector<std::string>{"rotator_a_deg", "stewart_z_m"}));
+  // A joint of the model the map does not name, and one the model does not have.
+  options.joint_columns = {"rotator_a_deg", "stewart_z_m", "rotator_b_deg"};
+  EXPECT_FALSE(ParseDataset(data, "data.csv", options, &d, &error));
+  EXPECT_TRUE(Contains(error, "map.yaml:3: columns: no entry for 'rotator_b_deg'")) << error;
+  options.joint_columns = {"rotator_a_deg"};
+  EXPECT_FALSE(ParseDataset(data, "data.csv", options, &d, &error));
+  EXPECT_TRUE(Contains(error, "columns.stewart_z_m: the model's moving parts have no joint of "
+                              "that name (theirs: rotator_a_deg)"))
+      << error;
+  options.joint_columns.clear();
+  EXPECT_FALSE(ParseDataset(data, "data.csv", options, &d, &error));
+  EXPECT_TRUE(Contains(error, "the model has no moving parts")) << error;
+  // A name neither fastcal's nor a joint's is still refused by the map's reader.
+  EXPECT_TRUE(Contains(MapError(MapText("columns:\n  rotator: ROT\n")), "unknown fastcal name"));
+}
+
 TEST(ColumnMapTest, ReadsEveryUnit) {
   const std::string map = MapText(
       "time: {column: t}\ncolumns:\n"

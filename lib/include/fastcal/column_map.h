@@ -23,6 +23,7 @@
 #define FASTCAL_COLUMN_MAP_H_
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace fastcal {
@@ -96,6 +97,14 @@ bool ParseColumnMap(const std::string& text, const std::string& source_name, Col
 // `time`), and the unit each is in inside fastcal's files ("m", "deg", "kN", "1", "").
 const std::vector<std::string>& ColumnMapNames();
 std::string CanonicalUnitOf(const std::string& name);
+
+// A name a moving part's joint column could have (cabin.moving_parts, docs/model-format.md):
+// letters, digits and '_' ending in _deg (a revolute joint) or _m (a prismatic one), not
+// one of ColumnMapNames(). A map may name such columns; the reader that uses the map
+// checks them against the model's joints (a joint the model does not have is an error).
+bool IsJointColumnName(std::string_view name);
+// The joint columns a map names, in its order (fastcal import carries them through).
+std::vector<std::string> JointColumnsOf(const ColumnMap& map);
 
 }  // namespace fastcal
 

@@ -226,7 +226,7 @@ bool ParsePosesCsv(const std::string& text, const std::string& source_name,
 // one JointValues per pose (the model's joint order) when it gives them, and is left empty
 // when it gives none (the command's flag or law sets the joints then); some but not all is
 // an error naming the missing ones. A value outside PlausibleJointValue is an error naming
-// the column. (The column-map readers do not take joint columns yet.)
+// the column. (The column-map pose reader does not take joint columns yet.)
 bool ReadPosesCsv(const std::string& path, const std::vector<std::string>& joint_columns,
                   std::vector<Pose>* poses, std::vector<JointValues>* joints,
                   std::vector<double>* times_s, std::string* error);

@@ -261,8 +261,12 @@ class MapReader {
                     "the time is given by the map's time: {column: NAME, format: seconds | "
                     "unix_s | unix_ms | iso8601, zone: ...}, not under columns");
       }
-      if (std::find(names.begin(), names.end(), entry.name) == names.end()) {
-        return Fail(line, path, "unknown fastcal name (accepted: " + Join(names) + ")");
+      if (std::find(names.begin(), names.end(), entry.name) == names.end() &&
+          !IsJointColumnName(entry.name)) {
+        return Fail(line, path,
+                    "unknown fastcal name (accepted: " + Join(names) +
+                        "; and a moving part's joint column, NAME_deg or NAME_m, as the "
+                        "model's cabin.moving_parts names it)");
       }
       if (map->Find(entry.name) != nullptr) return Fail(line, path, "given twice");
       const std::vector<std::string> units = UnitsOf(entry.name);
@@ -334,6 +338,25 @@ const ColumnMapEntry* ColumnMap::Find(const std::string& name) const {
 const std::vector<std::string>& ColumnMapNames() {
   static const std::vector<std::string> names = MakeNames();
   return names;
+}
+
+bool IsJointColumnName(std::string_view name) {
+  const auto ends = [&](std::string_view suffix) {
+    return name.size() > suffix.size() && name.substr(name.size() - suffix.size()) == suffix;
+  };
+  const std::vector<std::string>& names = ColumnMapNames();
+  return (ends("_deg") || ends("_m")) &&
+         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+             std::string_view::npos &&
+         std::find(names.begin(), names.end(), name) == names.end();
+}
+
+std::vector<std::string> JointColumnsOf(const ColumnMap& map) {
+  std::vector<std::string> joints;
+  for (const ColumnMapEntry& e : map.columns) {
+    if (IsJointColumnName(e.name)) joints.push_back(e.name);
+  }
+  return joints;
 }
 
 std::string CanonicalUnitOf(const std::string& name) {

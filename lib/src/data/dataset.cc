@@ -207,6 +207,7 @@ struct Header {
   const ColumnMap* map = nullptr;
   char delimiter = ',';
   std::array<internal::ValueConversion, kNumColumns> conversion{};
+  std::vector<internal::ValueConversion> joint_conversion;  // per joint, through a map
   // How messages name a column: "column 'x_m'", or through a map "column 'SDP_PhaPos_X'
   // (x_m)"; the position's three and the quaternion's four together.
   std::array<std::string, kNumColumns> label;
@@ -298,6 +299,28 @@ bool CheckColumnGroups(const std::string& where, const char* missing, DatasetCol
   return ok;
 }
 
+// Every joint column asked for is in the header; else names each one missing.
+bool CheckJointFields(const Header& header, const std::string& where, std::string* error) {
+  std::string missing;
+  int count = 0;
+  for (size_t j = 0; j < header.joint_names.size(); ++j) {
+    const int field = kFirstJointField - static_cast<int>(j);
+    if (std::find(header.column_of_field.begin(), header.column_of_field.end(), field) ==
+        header.column_of_field.end()) {
+      missing += (missing.empty() ? "" : ", ") + Quoted(header.joint_names[j]);
+      ++count;
+    }
+  }
+  if (count == 0) return true;
+  *error = where +
+           (header.map != nullptr ? (count == 1 ? "no entry for " : "no entries for ")
+                                  : (count == 1 ? "missing column " : "missing columns ")) +
+           missing +
+           ": the model's moving parts need their joint values in every row (cabin."
+           "moving_parts in the model file; docs/data-format.md, \"Moving parts\")";
+  return false;
+}
+
 // The header of an export read through a column map: its source columns matched to the
 // map's (column_reading.h), the conversions, the labels of messages.
 bool ParseMappedHeader(std::string_view line, const std::string& where, const std::string& path,
@@ -314,12 +337,19 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
   }
   // Trailing delimiters (a spreadsheet's empty cells at the end): no columns.
   while (fields.size() > 1 && fields.back().empty()) fields.pop_back();
-  if (!header->joint_names.empty()) {
-    *error = map.path + ": the model's moving parts need the joint column " +
-             Quoted(header->joint_names.front()) +
-             ", which column maps cannot name yet: export the joints to a canonical file "
-             "(docs/data-format.md, \"Moving parts\")";
-    return false;
+  for (const ColumnMapEntry& e : map.columns) {  // a joint the model does not have
+    if (IsJointColumnName(e.name) &&
+        std::find(header->joint_names.begin(), header->joint_names.end(), e.name) ==
+            header->joint_names.end()) {
+      std::string joints;
+      for (const std::string& j : header->joint_names) joints += (joints.empty() ? "" : ", ") + j;
+      *error = internal::EntryWhere(map, e) +
+               (joints.empty() ? "the model has no moving parts (cabin.moving_parts), so no "
+                                 "joint column"
+                               : "the model's moving parts have no joint of that name (theirs: " +
+                                     joints + ")");
+      return false;
+    }
   }
   if (!map.has_time) {
     *error = map.path +
@@ -339,8 +369,13 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
       return false;
     }
   }
+  // The model's joint columns after the map's own names: target index size + j.
+  std::vector<std::string> targets = ColumnMapNames();
+  const int first_joint_target = static_cast<int>(targets.size());
+  targets.insert(targets.end(), header->joint_names.begin(), header->joint_names.end());
+  header->joint_conversion.assign(header->joint_names.size(), {});
   internal::MappedHeader mapped;
-  if (!internal::ResolveMappedHeader(map, fields, ColumnMapNames(), where, path, &mapped, error)) {
+  if (!internal::ResolveMappedHeader(map, fields, targets, where, path, &mapped, error)) {
     return false;
   }
   constexpr int kSessionTarget = kNumColumns - 1;  // ColumnMapNames(): the columns after
@@ -353,6 +388,11 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
       header->field_of[kTime] = static_cast<int>(f);
       header->label[kTime] = "column " + Quoted(map.time.column) + " (time_s, " +
                              TimeFormatName(map.time.format, map.time.pattern) + ")";
+    } else if (target >= first_joint_target) {
+      const int j = target - first_joint_target;
+      const ColumnMapEntry& entry = *mapped.entry_of_target[target];
+      header->column_of_field[f] = kFirstJointField - j;
+      header->joint_conversion[j] = internal::ConversionOf(entry.name, entry.unit);
     } else if (target == kSessionTarget) {
       header->column_of_field[f] = kSessionField;
       header->session_field = static_cast<int>(f);
@@ -381,37 +421,8 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
   if (header->field_of[kRoll] >= 0) {
     header->rpy_label = names(kRoll, 3).substr(8);
   }
-  return CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", required, header, error);
-}
-
-// A name a joint column could have: letters, digits and '_' ending in _deg or _m, not a
-// canonical column (for the hint on an unknown column).
-bool IsJointColumnName(std::string_view name) {
-  const auto ends = [&](std::string_view suffix) {
-    return name.size() > suffix.size() && name.substr(name.size() - suffix.size()) == suffix;
-  };
-  return (ends("_deg") || ends("_m")) &&
-         name.find_first_not_of("abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
-             std::string_view::npos;
-}
-
-// Every joint column asked for is in the header; else names each one missing.
-bool CheckJointFields(const Header& header, const std::string& where, std::string* error) {
-  std::string missing;
-  int count = 0;
-  for (size_t j = 0; j < header.joint_names.size(); ++j) {
-    const int field = kFirstJointField - static_cast<int>(j);
-    if (std::find(header.column_of_field.begin(), header.column_of_field.end(), field) ==
-        header.column_of_field.end()) {
-      missing += (missing.empty() ? "" : ", ") + Quoted(header.joint_names[j]);
-      ++count;
-    }
-  }
-  if (count == 0) return true;
-  *error = where + (count == 1 ? "missing column " : "missing columns ") + missing +
-           ": the model's moving parts need their joint values in every row (cabin."
-           "moving_parts in the model file; docs/data-format.md, \"Moving parts\")";
-  return false;
+  return CheckJointFields(*header, internal::ColumnsWhere(map), error) &&
+         CheckColumnGroups(internal::ColumnsWhere(map), "no entry for ", required, header, error);
 }
 
 bool ParseHeader(std::string_view line, const std::string& where, const std::string& path,
@@ -605,9 +616,13 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     if (IsJointField(column)) {
       const int j = JointOfField(column);
       std::string why;
-      double v = 0.0;
-      if (!ParseNumber(fields[f], &v, &why) ||
-          !PlausibleJointValue(header.joint_names[j], v, &why)) {
+      double v = 0.0, file_value = 0.0;
+      const bool read = header.map != nullptr
+                            ? internal::ReadConvertedNumber(fields[f], header.map->decimal,
+                                                            header.joint_conversion[j],
+                                                            &file_value, &v, &why)
+                            : ParseNumber(fields[f], &v, &why);
+      if (!read || !PlausibleJointValue(header.joint_names[j], v, &why)) {
         *reason = "column " + Quoted(header.joint_names[j]) + ": " + why;
         return false;
       }
