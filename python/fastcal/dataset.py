@@ -195,6 +195,8 @@ def _dataset_from_arrays(
     s0_m: Optional[ArrayLike] = None,
     session: Optional[Sequence[str]] = None,
     skip_invalid_rows: bool = False,
+    joints: Optional[ArrayLike] = None,
+    model: Optional[Model] = None,
 ) -> Dataset:
     """A Dataset from numpy arrays, checked as a file is read (docs/data-format.md).
 
@@ -207,6 +209,8 @@ def _dataset_from_arrays(
         planned_rpy_deg: (n, 3), optional; s0_m: (n, 6) unstretched lengths, optional.
         session: n labels (letters, digits, '-', '_'), optional.
         skip_invalid_rows: leave bad rows out (Dataset.skipped) instead of raising.
+        joints: (n, J) the moving parts' joint values (deg and m) in the order of
+            model.joint_columns; needed, and only allowed, with a model that has them.
 
     The same checks as the file reader (finite values, plausible positions, angles and
     tensions, unit quaternions, attitudes in radians): a bad value raises InputError
@@ -240,15 +244,33 @@ def _dataset_from_arrays(
         "planned_rpy_deg")
     add([f"T{i}_kN" for i in range(1, 7)], tension_kN, "tension_kN")
     add([f"s0_{i}_m" for i in range(1, 7)], s0_m, "s0_m")
+    joint_columns = list(model.joint_columns) if model is not None else []
+    if joints is not None and not joint_columns:
+        raise InputError(
+            "from_arrays: joints= needs model= with moving parts (cabin.moving_parts)"
+        )
+    if joint_columns and joints is None:
+        raise InputError(
+            "from_arrays: the model's moving parts need joints= of shape "
+            f"({n}, {len(joint_columns)}): {', '.join(joint_columns)}"
+        )
+    add(joint_columns, joints, "joints")
     names = [name for group, _ in parts for name in group]
     values = np.ascontiguousarray(np.hstack([a for _, a in parts]))
     labels = [] if session is None else [str(s) for s in session]
     text = _fastcal.canonical_text(names, values, labels)
-    return _fastcal.parse_dataset(text, "arrays", skip_invalid_rows, "", "", True)
+    return _map_errors(
+        lambda: _fastcal.parse_dataset(
+            text, "arrays", skip_invalid_rows, "", "", True, joint_columns
+        )
+    )
 
 
 def _dataset_from_dataframe(
-    df: Any, columns: Optional[ColumnsLike] = None, skip_invalid_rows: bool = False
+    df: Any,
+    columns: Optional[ColumnsLike] = None,
+    skip_invalid_rows: bool = False,
+    model: Optional[Model] = None,
 ) -> Dataset:
     """A Dataset from a pandas DataFrame, checked as a file is read.
 
@@ -258,9 +280,11 @@ def _dataset_from_dataframe(
     header_line, skip_after_header and decimal do not apply: a DataFrame has its names
     and its numbers). Datetime columns are read as dates and times (the map's zone when
     they have none). Messages name the row (1-based, in the DataFrame's order) and the
-    column: "DataFrame, row 3: column 'CableForce2' (T2_kN, N): ...".
+    column: "DataFrame, row 3: column 'CableForce2' (T2_kN, N): ...". With a model that
+    has moving parts its joint columns are read too (by those names, or through the map).
     """
     map_text, map_source = _columns_argument(columns)
+    joints = list(model.joint_columns) if model is not None else []
     frame = df.reset_index(drop=True) if hasattr(df, "reset_index") else df
     try:
         text = frame.to_csv(index=False, lineterminator="\n")
@@ -268,7 +292,7 @@ def _dataset_from_dataframe(
         text = frame.to_csv(index=False, line_terminator="\n")
     return _map_errors(
         lambda: _fastcal.parse_dataset(
-            text, "DataFrame", skip_invalid_rows, map_text, map_source, True
+            text, "DataFrame", skip_invalid_rows, map_text, map_source, True, joints
         )
     )
 
