@@ -256,6 +256,21 @@ TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
                               "mass_centre_m.x"),
             std::string::npos)
       << track.output;
+  // The parts' parameters shared by the windows and fitted from a first moment of 0
+  // (spec_track_moving_parts.yaml): the same single event, and the first moment found.
+  constexpr double kSigmas = 2.5;
+  const std::string start = Truth("start.yaml", "[0, 0, 0]", "[0, 0, 0.5]");
+  const CommandResult shared =
+      Fastcal("track --spec=" + Source() + "/calibration_data/spec_track_moving_parts.yaml " +
+              "--model=" + start + " --data=" + Path("season.csv") + " --out=" + Path("shared"));
+  ASSERT_EQ(shared.code, 0) << shared.output;
+  EXPECT_NE(shared.output.find("(converged)"), std::string::npos) << shared.output;
+  EXPECT_NE(shared.output.find("over the track): 1\n  2024-05-04  parameter"), std::string::npos)
+      << shared.output;
+  const std::regex qz(R"(first_moment_kg_m.z = (\S+) \+- (\S+) kg m)");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(shared.output, m, qz)) << shared.output;
+  EXPECT_LT(std::abs(std::stod(m[1]) + 6000), kSigmas * std::stod(m[2])) << m[0];
 }
 
 }  // namespace

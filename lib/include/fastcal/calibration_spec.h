@@ -50,6 +50,9 @@ enum class ParameterKind {
   kPartFirstMoment,  // component = axis 0..2 of the part's frame
   kPartMass,
 };
+// The last kind: readers of stored parameters (track's fold tasks) accept kinds up to it,
+// so a kind added above is not refused as corrupt.
+inline constexpr ParameterKind kLastParameterKind = ParameterKind::kPartMass;
 
 struct ParameterSpec {
   ParameterKind kind = ParameterKind::kMassCentre;

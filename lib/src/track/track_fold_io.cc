@@ -147,7 +147,7 @@ void WriteParameter(const ParameterSpec& p, Writer* w) {
 ParameterSpec ReadParameter(Reader* r) {
   ParameterSpec p;
   const std::int64_t kind = r->Int();
-  if (kind < 0 || kind > static_cast<int>(ParameterKind::kAttachmentDensity)) r->Count();
+  if (kind < 0 || kind > static_cast<int>(kLastParameterKind)) r->Count();
   p.kind = static_cast<ParameterKind>(kind);
   p.index = static_cast<int>(r->Int());
   p.component = static_cast<int>(r->Int());
