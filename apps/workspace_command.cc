@@ -11,6 +11,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/version.h"
@@ -27,6 +28,8 @@ DECLARE_double(azimuth_step_deg);
 DECLARE_double(focal_radius);
 DECLARE_string(output);
 DECLARE_bool(force);
+DECLARE_string(joints);     // solve_command.cc
+DECLARE_string(joint_law);  // simulate_command.cc
 
 DEFINE_double(radial_offset, 0.0,
               "workspace: > 0 adds the grid this far (m) inside and outside the focal sphere.");
@@ -66,6 +69,10 @@ Limits:
   --reflector-clearance=0                   m, how close a cable may come to the reflector
 Statics: --method=exact (default), aas-refined or aas. Model: --model=FILE.yaml (default
 the nominal FAST model, whose reflector is checked; docs/model-format.md).
+Moving parts (a model with cabin.moving_parts): --joint-law=zero (default) or focal (the
+rotator completes the tilt the cabin does not give, as the telescope flies; its mass
+centre moves with it at every node), or --joints=v1,... for every node (the model's joint
+order, deg and m). Prismatic joints at 0 under a law.
 
 Output: CSV to stdout or --output=FILE.csv, one row per node: radial_offset_m,
 off_axis_deg, azimuth_deg, x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg, status (feasible,
@@ -98,7 +105,9 @@ const std::set<std::string> kFlags = {"model",
                                       "reflector-clearance",
                                       "output",
                                       "html",
-                                      "force"};
+                                      "force",
+                                      "joints",
+                                      "joint-law"};
 
 // Every node, on each layer, where the cabin can be (the limits of solve's trajectories
 // and of the data files): a focal radius of 1e6 m is a typo, not a map.
@@ -125,9 +134,9 @@ bool CheckGridPlausible(const WorkspaceOptions& o, std::string* error) {
 }
 
 // "2881 nodes on the focal sphere: 2881 feasible, lower-end tensions 112.3 to 316 kN".
-std::string Summary(const WorkspaceMap& map) {
+std::string Summary(const WorkspaceMap& map, const std::string& joints) {
   std::ostringstream s;
-  s << "fastcal workspace: " << map.nodes.size() << " nodes";
+  s << "fastcal workspace: " << map.nodes.size() << " nodes" << joints;
   for (double offset_m : map.layers_m) {
     int nodes = 0, feasible = 0;
     double lo = HUGE_VAL, hi = 0.0;
@@ -152,6 +161,34 @@ std::string Summary(const WorkspaceMap& map) {
     for (const auto& [code, count] : reasons) s << "; " << code << " " << count;
   }
   return s.str();
+}
+
+// --joints or --joint-law for a model with moving parts: the joints fixed in the model
+// (MassCentreAtJointsFlag) or the law in the options; *said is the summary's words.
+bool JointsFromFlags(CableRobot* robot, WorkspaceOptions* options, std::string* said,
+                     std::string* error) {
+  const bool law = FlagGiven("joint-law");
+  if (law && !FLAGS_joints.empty()) {
+    *error = "give --joints (every node's joints) or --joint-law, not both";
+    return false;
+  }
+  if (law && robot->moving_parts.empty()) {
+    *error = "--joint-law: the model has no moving parts (cabin.moving_parts, --model=MODEL.yaml)";
+    return false;
+  }
+  if (law && (!ParseRevoluteLaw(FLAGS_joint_law, &options->joint_law) ||
+              options->joint_law == RevoluteLaw::kGrid)) {
+    *error = "--joint-law must be zero or focal, got " + internal::Quote(FLAGS_joint_law);
+    return false;
+  }
+  const bool parts = !robot->moving_parts.empty();
+  if (!MassCentreAtJointsFlag(FLAGS_joints, robot, error)) return false;
+  if (!parts) return true;
+  *said = !FLAGS_joints.empty() ? ", moving parts at --joints=" + FLAGS_joints
+          : options->joint_law == RevoluteLaw::kFocal
+              ? ", the rotator following the focal law"
+              : ", moving parts at joints 0 (--joint-law=focal: as the telescope flies)";
+  return true;
 }
 
 }  // namespace
@@ -233,8 +270,10 @@ int RunWorkspace(int argc, char** argv) {
   }
   CableRobot robot;
   WorkspaceOptions options;
+  std::string joints;  // the summary's words on the moving parts
   if (!LoadModelFlag("model", FLAGS_model, &robot, &error) ||
-      !WorkspaceOptionsFromFlags(&options, &error) || !CheckGridPlausible(options, &error)) {
+      !WorkspaceOptionsFromFlags(&options, &error) || !CheckGridPlausible(options, &error) ||
+      !JointsFromFlags(&robot, &options, &joints, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -259,7 +298,7 @@ int RunWorkspace(int argc, char** argv) {
   }
   // stdout carries the result: the CSV itself, else the summary of what was written
   // (docs/cli.md, "Output streams").
-  (to_file ? std::cout : std::cerr) << Summary(map) << std::endl;
+  (to_file ? std::cout : std::cerr) << Summary(map, joints) << std::endl;
   return 0;
 }
 

@@ -232,6 +232,38 @@ TEST_F(CliMovingPartsTest, ImportCarriesTheJointColumnsAMapNames) {
   EXPECT_EQ(with.code, 0) << with.output;
 }
 
+TEST_F(CliMovingPartsTest, WorkspaceFollowsTheRotator) {
+  // The workspace with the rotator following the focal law: on the axis the law's angles
+  // are 0 (the same node as with the joints at zero); off the axis the rotator turns and
+  // the 6000 kg m first moment moves the mass centre, so the tensions change.
+  constexpr double kSameKn = 1e-9;
+  constexpr double kVisibleKn = 0.5;
+  const std::string model = Source() + "/calibration_data/moving_parts.yaml";
+  const std::string grid = " --off-axis-step-deg=20 --azimuth-step-deg=90";
+  const CommandResult zero = Fastcal("workspace --model=" + model + grid);
+  const CommandResult focal = Fastcal("workspace --model=" + model + grid + " --joint-law=focal");
+  ASSERT_EQ(zero.code, 0) << zero.output;
+  ASSERT_EQ(focal.code, 0) << focal.output;
+  EXPECT_NE(focal.output.find("the rotator following the focal law"), std::string::npos);
+  // min_tension_kN, the 12th column, at a node "off_axis,azimuth".
+  auto min_tension = [](const std::string& out, const std::string& node) {
+    const std::regex row("\n0," + node + R"(,(?:[^,]*,){8}([^,]+),)");
+    std::smatch m;
+    EXPECT_TRUE(std::regex_search(out, m, row)) << node << "\n" << out;
+    return m.empty() ? 0.0 : std::stod(m[1]);
+  };
+  EXPECT_NEAR(min_tension(focal.output, "0,0"), min_tension(zero.output, "0,0"), kSameKn);
+  EXPECT_GT(std::abs(min_tension(focal.output, "40,0") - min_tension(zero.output, "40,0")),
+            kVisibleKn);
+  const CommandResult both =
+      Fastcal("workspace --model=" + model + " --joint-law=focal --joints=0,0,0,0,0");
+  EXPECT_NE(both.code, 0);
+  EXPECT_NE(both.output.find("not both"), std::string::npos) << both.output;
+  const CommandResult rigid = Fastcal("workspace --joint-law=focal");
+  EXPECT_NE(rigid.code, 0);
+  EXPECT_NE(rigid.output.find("no moving parts"), std::string::npos) << rigid.output;
+}
+
 TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
   // Six days, the rotator following the focal law, the mass centre moved 3.6 cm on the
   // fourth: tracked with the model's parts, the move is found and dated, nothing else.

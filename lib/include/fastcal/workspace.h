@@ -13,6 +13,10 @@
 // The tension limits apply to the lower-end tensions: what the cabin-side sensors read,
 // the paper's tables give and `fastcal solve` writes as T<i>_kN. The tower end carries
 // the cable's weight on top (~10 kN more on FAST); each node reports that maximum too.
+//
+// A model with moving parts (moving_parts.h) is solved at each node's joints: the rotator
+// at zero, or following the focal law (joint_plan.h, RevoluteLaw::kFocal: it completes
+// the tilt the cabin does not give, as the telescope flies), the mass centre with them.
 #ifndef FASTCAL_WORKSPACE_H_
 #define FASTCAL_WORKSPACE_H_
 
@@ -21,6 +25,7 @@
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/joint_plan.h"
 #include "fastcal/pose.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
@@ -37,6 +42,9 @@ struct WorkspaceOptions {
   double radial_offset_m = 0.0;
   // The attitude at every node; its focal centre is normally the grid's.
   FocalAttitudeLaw attitude_law;
+  // A model with moving parts: the rotator's angles at each node, kZero (default) or
+  // kFocal (toward attitude_law's focal centre); kGrid is refused. Prismatic joints at 0.
+  RevoluteLaw joint_law = RevoluteLaw::kZero;
   // Limits on every cable's lower-end tension (N); 0 and +infinity: none.
   double min_tension_n = 0.0;
   double max_tension_n = std::numeric_limits<double>::infinity();
@@ -50,7 +58,8 @@ struct WorkspaceOptions {
   }();
 
   // False with *error naming the field (grid.*, radial_offset_m, min_tension_n,
-  // max_tension_n, attitude_law.*, or the statics option) when an option is invalid.
+  // max_tension_n, attitude_law.*, joint_law, or the statics option) when an option is
+  // invalid.
   bool IsValid(std::string* error) const;
 };
 

@@ -102,6 +102,9 @@ bool WorkspaceOptions::IsValid(std::string* error) const {
                 Num(attitude_law.tilt_fraction) + ")");
   }
   if (!statics.IsValid(&why)) return fail("statics: " + why);
+  if (joint_law == RevoluteLaw::kGrid) {
+    return fail("joint_law: grid is for surveys; a workspace node takes zero or focal");
+  }
   return true;
 }
 
@@ -111,6 +114,16 @@ bool ComputeWorkspace(const CableRobot& robot, const WorkspaceOptions& options, 
   WorkspaceMap out;
   out.options = options;
   out.layers_m = Layers(options.radial_offset_m);
+  JointPlan plan;  // the joints of each node (a model with moving parts)
+  JointPlanOptions joint_options;
+  joint_options.revolute = options.joint_law;
+  joint_options.focal_centre_m = options.attitude_law.focal_centre_m;
+  if (!robot.moving_parts.empty() &&
+      !JointPlan::Make(robot.moving_parts, joint_options, &plan, error)) {
+    *error = "joint_law: " + *error;
+    return false;
+  }
+  JointValues joints{};
   for (double offset_m : out.layers_m) {
     FocalGridSpec layer = options.grid;
     layer.focal_radius_m += offset_m;
@@ -126,7 +139,11 @@ bool ComputeWorkspace(const CableRobot& robot, const WorkspaceOptions& options, 
       node.pose = pose;
       node.radial_offset_m = offset_m;
       FocalGridAngles(pose.position_m, layer.focal_centre_m, &node.off_axis_deg, &node.azimuth_deg);
-      SolveStatics(robot, pose, options.statics, &solution);
+      if (!robot.moving_parts.empty() &&
+          !plan.Next(static_cast<long long>(out.nodes.size()), pose, &joints, error)) {
+        return false;  // a law's angle outside a joint's range, named
+      }
+      SolveStatics(robot, pose, joints, options.statics, &solution);
       Judge(solution, options, &node);
       out.nodes.push_back(node);
     }
