@@ -344,9 +344,13 @@ bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitu
   if (!ColumnsFromFlag(&columns, error)) return false;
   if (joints != nullptr) joints->clear();
   const bool with_joints = joint_columns != nullptr && !joint_columns->empty() && joints != nullptr;
-  if (columns != nullptr      ? !ReadPosesCsv(path, *columns, poses, nullptr, error)
-      : with_joints ? !ReadPosesCsv(path, *joint_columns, poses, joints, nullptr, error)
-                              : !ReadPosesCsv(path, poses, nullptr, error)) {
+  const bool read =
+      columns != nullptr
+          ? (with_joints ? ReadPosesCsv(path, *columns, *joint_columns, poses, joints, nullptr, error)
+                         : ReadPosesCsv(path, *columns, poses, nullptr, error))
+      : with_joints ? ReadPosesCsv(path, *joint_columns, poses, joints, nullptr, error)
+                    : ReadPosesCsv(path, poses, nullptr, error);
+  if (!read) {
     return false;
   }
   if (attitude_law == "focal") {

@@ -234,6 +234,32 @@ TEST(ColumnMapTest, ReadsTheModelsJointColumnsInTheirUnits) {
   EXPECT_TRUE(Contains(MapError(MapText("columns:\n  rotator: ROT\n")), "unknown fastcal name"));
 }
 
+TEST(ColumnMapTest, PoseFilesReadTheModelsJointColumnsThroughAMap) {
+  // A pose file as exported, its joints in rad and mm: read in deg and m; a map with only
+  // some of the model's joints is refused by name.
+  const fs::path dir = fs::temp_directory_path() / "fastcal_pose_map_joints";
+  fs::create_directories(dir);
+  const std::string path = (dir / "poses.csv").string();
+  std::ofstream(path) << "X;Y;Z;ROT_A;SP_Z\n1;2;150;0,2;-30\n";
+  const ColumnMap map = Map(MapText(
+      "delimiter: ';'\ndecimal: ','\ncolumns:\n  x_m: X\n  y_m: Y\n  z_m: Z\n"
+      "  rotator_a_deg: {column: ROT_A, unit: rad}\n  stewart_z_m: {column: SP_Z, unit: mm}\n"
+      "unmapped: ignore\n"));
+  std::vector<Pose> poses;
+  std::vector<JointValues> joints;
+  std::string error;
+  ASSERT_TRUE(ReadPosesCsv(path, map, {"rotator_a_deg", "stewart_z_m"}, &poses, &joints, nullptr,
+                           &error))
+      << error;
+  ASSERT_EQ(joints.size(), 1u);
+  EXPECT_DOUBLE_EQ(joints[0][0], 0.2 * 180.0 / M_PI);
+  EXPECT_EQ(joints[0][1], -0.03);
+  EXPECT_FALSE(ReadPosesCsv(path, map, {"rotator_a_deg", "stewart_z_m", "rotator_b_deg"}, &poses,
+                            &joints, nullptr, &error));
+  EXPECT_TRUE(Contains(error, "not 'rotator_b_deg'")) << error;
+  fs::remove_all(dir);
+}
+
 TEST(ColumnMapTest, ReadsEveryUnit) {
   const std::string map = MapText(
       "time: {column: t}\ncolumns:\n"

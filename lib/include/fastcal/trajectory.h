@@ -226,10 +226,16 @@ bool ParsePosesCsv(const std::string& text, const std::string& source_name,
 // one JointValues per pose (the model's joint order) when it gives them, and is left empty
 // when it gives none (the command's flag or law sets the joints then); some but not all is
 // an error naming the missing ones. A value outside PlausibleJointValue is an error naming
-// the column. (The column-map pose reader does not take joint columns yet.)
+// the column.
 bool ReadPosesCsv(const std::string& path, const std::vector<std::string>& joint_columns,
                   std::vector<Pose>* poses, std::vector<JointValues>* joints,
                   std::vector<double>* times_s, std::string* error);
+// The same through a column map, which names the joint columns as any quantity (in deg or
+// rad, m, cm or mm): all of the model's joints or none.
+bool ReadPosesCsv(const std::string& path, const ColumnMap& columns,
+                  const std::vector<std::string>& joint_columns, std::vector<Pose>* poses,
+                  std::vector<JointValues>* joints, std::vector<double>* times_s,
+                  std::string* error);
 bool ParsePosesCsv(const std::string& text, const std::string& source_name,
                    const std::vector<std::string>& joint_columns, std::vector<Pose>* poses,
                    std::vector<JointValues>* joints, std::vector<double>* times_s,

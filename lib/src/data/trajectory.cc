@@ -415,6 +415,7 @@ struct PoseColumns {
   // absent; the file has all of them or none).
   const std::vector<std::string>* joint_names = nullptr;
   std::vector<int> joint_index;
+  std::vector<internal::ValueConversion> joint_conversion;  // through a map, per joint
 };
 
 // A pose file gives every joint column the model names or none of them (the command's
@@ -435,15 +436,26 @@ bool CheckJointColumnsPresent(const PoseColumns& columns, const std::string& whe
                          missing + " (give every joint column of the model, or none)");
 }
 
-// The header of a pose file read through a column map: x, y, z, the attitude and the
-// time as the map names them (its other entries are not read).
+// The header of a pose file read through a column map: x, y, z, the attitude, the time
+// and the model's joint columns as the map names them (its other entries are not read).
 bool ParseMappedPoseHeader(const std::vector<std::string_view>& fields, const std::string& where,
                            const std::string& path, PoseColumns* columns, std::string* error) {
   const ColumnMap& map = *columns->map;
   std::vector<std::string> names;
   for (int c = 0; c < kTime; ++c) names.push_back(kColumnNames[c]);
+  if (columns->joint_names != nullptr) {  // targets kTime + j
+    names.insert(names.end(), columns->joint_names->begin(), columns->joint_names->end());
+  }
   internal::MappedHeader mapped;
   if (!internal::ResolveMappedHeader(map, fields, names, where, path, &mapped, error)) return false;
+  columns->joint_conversion.assign(columns->joint_index.size(), {});
+  for (size_t j = 0; j < columns->joint_index.size(); ++j) {
+    columns->joint_index[j] = mapped.field_of_target[kTime + j];
+    if (const ColumnMapEntry* e = mapped.entry_of_target[kTime + j]; e != nullptr) {
+      columns->joint_conversion[j] = internal::ConversionOf(e->name, e->unit);
+    }
+  }
+  if (!CheckJointColumnsPresent(*columns, internal::ColumnsWhere(map), error)) return false;
   std::array<int, kNumColumns>& index = columns->index;
   index.fill(-1);
   columns->num_fields = fields.size();
@@ -604,8 +616,14 @@ bool ParsePoseRow(std::vector<std::string_view> fields, const std::string& where
     if (columns.joint_index[j] < 0) continue;
     const std::string& name = (*columns.joint_names)[j];
     std::string why;
-    if (!ParseNumber(fields[columns.joint_index[j]], &(*joints)[j], &why) ||
-        !PlausibleJointValue(name, (*joints)[j], &why)) {
+    double file_value = 0.0;
+    const std::string_view field = fields[columns.joint_index[j]];
+    const bool read = columns.map == nullptr
+                          ? ParseNumber(field, &(*joints)[j], &why)
+                          : internal::ReadConvertedNumber(field, columns.map->decimal,
+                                                          columns.joint_conversion[j],
+                                                          &file_value, &(*joints)[j], &why);
+    if (!read || !PlausibleJointValue(name, (*joints)[j], &why)) {
       return Fail(error, where + "column " + internal::Quote(name) + ": " + why);
     }
   }
@@ -755,6 +773,12 @@ bool ReadPosesCsv(const std::string& path, const std::vector<std::string>& joint
                   std::vector<Pose>* poses, std::vector<JointValues>* joints,
                   std::vector<double>* times_s, std::string* error) {
   return ReadPosesCsvImpl(path, nullptr, &joint_columns, poses, joints, times_s, error);
+}
+bool ReadPosesCsv(const std::string& path, const ColumnMap& columns,
+                  const std::vector<std::string>& joint_columns, std::vector<Pose>* poses,
+                  std::vector<JointValues>* joints, std::vector<double>* times_s,
+                  std::string* error) {
+  return ReadPosesCsvImpl(path, &columns, &joint_columns, poses, joints, times_s, error);
 }
 
 }  // namespace fastcal
