@@ -5,7 +5,8 @@
 // mm, tensions in N, the planned attitude, two channels fastcal does not read), each read
 // by ReadDataset on two threads as the command line reads them (best wall time of
 // several rounds, each reading every file once; wall and CPU time). Also: the export with Unix milliseconds instead of ISO time stamps, and
-// the canonical file through an identity map.
+// the canonical file through an identity map, and the canonical file gzipped (zlib level 6,
+// as gzip writes it), read by content (internal/atomic_file.h).
 // Run: build/bench/dataset_read_bench [samples, default 1000000] [rounds, default 5]
 #include <chrono>
 #include <cmath>
@@ -19,6 +20,7 @@
 #include <random>
 #include <string>
 #include <unistd.h>
+#include <zlib.h>
 
 #include "fastcal/column_map.h"
 #include "fastcal/dataset.h"
@@ -91,6 +93,22 @@ Files Write(long long samples, const fs::path& dir) {
     ms << ms_since << fields << forces << extra;
   }
   return f;
+}
+
+// `path` gzipped to path + ".gz" (level 6, gzip's default).
+std::string Gzipped(const std::string& path) {
+  const std::string out = path + ".gz";
+  gzFile gz = gzopen(out.c_str(), "wb6");
+  std::ifstream in(path, std::ios::binary);
+  std::vector<char> buffer(1 << 20);
+  while (in.read(buffer.data(), static_cast<std::streamsize>(buffer.size())) || in.gcount() > 0) {
+    if (gz == nullptr || gzwrite(gz, buffer.data(), static_cast<unsigned>(in.gcount())) <= 0) {
+      std::fprintf(stderr, "cannot write %s\n", out.c_str());
+      std::exit(1);
+    }
+  }
+  gzclose(gz);
+  return out;
 }
 
 std::string MapText(const std::string& time) {
@@ -168,6 +186,7 @@ int main(int argc, char** argv) {
   std::vector<Case> cases = {
       {"canonical CSV", f.canonical, nullptr, {}},
       {"canonical CSV through an identity map", f.canonical, Map(identity), {}},
+      {"canonical CSV gzipped (.csv.gz)", Gzipped(f.canonical), nullptr, {}},
       {"export through a map: ISO 8601 (+08:00), mm, N, ';' and ','", f.iso,
        Map(MapText("{column: SysTime, format: iso8601, zone: \"+08:00\"}")), {}},
       {"export through a map: unix_ms, mm, N, ';' and ','", f.unix_ms,

@@ -407,18 +407,22 @@ TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<s
     }
     std::vector<std::string> csv;
     for (const fs::directory_entry& e : fs::directory_iterator(path, ec)) {
-      // *.csv in any case (FAST's exports say .CSV); hidden files (an editor's .x.csv, a
-      // sync tool's) are not data (issue 37).
-      std::string extension = e.path().extension().string();
-      for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      // *.csv and *.csv.gz in any case (FAST's exports say .CSV; months are kept
+      // gzipped); hidden files (an editor's .x.csv, a sync tool's) are not data (issue 37).
       const std::string name = e.path().filename().string();
-      if (e.is_regular_file() && extension == ".csv" && !name.empty() && name[0] != '.') {
+      std::string lower = name;
+      for (char& c : lower) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+      const auto ends = [&](const std::string& suffix) {
+        return lower.size() > suffix.size() &&
+               lower.compare(lower.size() - suffix.size(), suffix.size(), suffix) == 0;
+      };
+      if (e.is_regular_file() && (ends(".csv") || ends(".csv.gz")) && name[0] != '.') {
         csv.push_back(e.path().string());
       }
     }
     std::sort(csv.begin(), csv.end());
     if (csv.empty()) {
-      *error = path + ": a directory without *.csv files";
+      *error = path + ": a directory without *.csv or *.csv.gz files";
       return TrackStatus::kInvalidInput;
     }
     out->insert(out->end(), csv.begin(), csv.end());

@@ -293,6 +293,7 @@ RegularFileReader::~RegularFileReader() {
 bool RegularFileReader::Fail(const std::string& why, std::string* error) {
   if (fd_ >= 0) ::close(fd_);
   fd_ = -1;
+  gzip_.reset();
   *error = name_ + ": " + why;
   return false;
 }
@@ -324,10 +325,11 @@ bool RegularFileReader::Open(const std::string& path, long long max_bytes, const
     return Fail(std::to_string(static_cast<long long>(st.st_size)) + " bytes is " + too_large_,
                 error);
   }
-  return true;
+  return StartGzipIfCompressed(error);
 }
 
 bool RegularFileReader::Read(size_t max, std::string* text, bool* end, std::string* error) {
+  if (gzip_ != nullptr) return ReadGzip(max, text, end, error);
   *end = fd_ < 0;
   char buffer[1 << 16];
   for (size_t got = 0; fd_ >= 0 && got < max;) {

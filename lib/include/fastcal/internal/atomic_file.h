@@ -14,6 +14,7 @@
 #include <cstddef>
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <string>
 #include <string_view>
 
@@ -112,6 +113,13 @@ bool ReadRegularFile(const std::string& path, long long max_bytes, const std::st
 // makes its checks before reading; Read appends up to `max` further bytes to *text, sets
 // *end at the end of the file, and refuses a file that grows past max_bytes; the same
 // messages. The file is closed at the end, on failure and by the destructor.
+//
+// A gzip file (known by its first two bytes, 1f 8b, whatever its name) is decompressed as
+// it is read (zlib, streamed: memory as for the plain file): Read gives its content, and
+// max_bytes bounds the decompressed bytes too ("decompresses to more than ..."), so that a
+// small file that inflates without end is refused. Concatenated gzip members are read one
+// after the other (as gunzip does); a truncated or corrupt stream is an error naming the
+// file and the decompressed byte it reached.
 class RegularFileReader {
  public:
   RegularFileReader() = default;
@@ -121,14 +129,24 @@ class RegularFileReader {
   bool Open(const std::string& path, long long max_bytes, const std::string& what,
             std::string* error);
   bool Read(size_t max, std::string* text, bool* end, std::string* error);
-  // The file's size when opened (bytes).
+  // The file's size when opened (bytes; compressed for a gzip file).
   long long size() const { return size_; }
+  // Whether the file is gzip-compressed (decompressed by Read).
+  bool gzip() const { return gzip_ != nullptr; }
 
  private:
+  struct Gzip;  // zlib's state, kept out of this header
+  struct GzipDeleter {
+    void operator()(Gzip* g) const;
+  };
   bool Fail(const std::string& why, std::string* error);
+  // Open's last step: a gzip file's first bytes start the decompression (gzip_reader.cc).
+  bool StartGzipIfCompressed(std::string* error);
+  bool ReadGzip(size_t max, std::string* text, bool* end, std::string* error);
   int fd_ = -1;
   std::string name_, too_large_;
   long long max_bytes_ = 0, read_bytes_ = 0, size_ = 0;
+  std::unique_ptr<Gzip, GzipDeleter> gzip_;
 };
 
 // Reads a whole regular file, of any size, in chunks handed to `sink` in order, for files
