@@ -4,16 +4,21 @@
 #include <gflags/gflags.h>
 
 #include <chrono>
+#include <deque>
 #include <cmath>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "cli_util.h"
+#include "columns_flag.h"
 #include "commands.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/gross_errors.h"
+#include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/column_reading.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/locate.h"
@@ -129,6 +134,12 @@ Examples:
   fastcal locate --lengths=312.61,312.61,312.61,312.61,312.61,312.61
   fastcal simulate --trajectory=random --samples=50 --out=out/survey.csv  # s0 columns
   fastcal locate --data=out/survey.csv --output=out/located.csv
+  fastcal solve --trajectory=circle --output=out/solved.csv  # solve's own output
+  fastcal locate --data=out/solved.csv --use=lengths     # back to its poses
+
+--data may also be solve's output (its x_m..yaw_deg, T<i>_kN and s0_<i>_m columns; rows
+whose status is not ok are left out and counted), or an export read through
+--columns=MAP.yaml (docs/data-format.md, "Column maps"); .gz files are read as they are.
 )";
 
 // clang-format off
@@ -136,7 +147,7 @@ const std::set<std::string> kFlags = {
     "model", "data", "lengths", "rpy", "quat", "tensions-kN", "use", "spec", "length-sigma-m",
     "tension-sigma-percent", "tension-sigma-kN", "attitude-sigma-deg", "search-radius-m",
     "warm-start", "output", "force", "keep-going", "max-strain", "max-length-ratio",
-    "reflector-clearance", "joints"};
+    "reflector-clearance", "joints", "columns"};
 // clang-format on
 
 // One instant to locate, and what the file said of it.
@@ -291,6 +302,79 @@ bool RowFromFlags(std::vector<Row>* rows, std::string* error) {
 }
 
 // --data=FILE: a lengths file (dataset.h, DatasetColumns::kLengths).
+// solve's output (its header starts "node," and has status and message columns) as a
+// lengths file: the pose, tension and s0 columns kept, the rows solve did not solve
+// (status not ok) and the other columns left out, and every other line kept as a comment,
+// so that messages name the file's own lines. *text is left empty for any other file.
+bool SolveOutputAsLengths(const std::string& path, std::string* text, int* left_out,
+                          std::string* error) {
+  constexpr long long kMaxBytes = 1LL << 30;  // solve's output of ~10^6 poses
+  {  // Its first bytes say whether it is solve's output (a dataset is read as one below).
+    internal::RegularFileReader reader;
+    std::string start;
+    bool end = false;
+    if (!reader.Open(path, std::numeric_limits<long long>::max(), "dataset", error) ||
+        !reader.Read(5, &start, &end, error)) {
+      return false;
+    }
+    if (start != "node,") return true;
+  }
+  std::string content;
+  if (!internal::ReadRegularFile(path, kMaxBytes, "solve output", &content, error)) return false;
+  std::vector<std::string> keep = {"x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"};
+  for (int i = 1; i <= kNumCables; ++i) keep.push_back("T" + std::to_string(i) + "_kN");
+  for (int i = 1; i <= kNumCables; ++i) keep.push_back("s0_" + std::to_string(i) + "_m");
+  std::vector<int> field_of(keep.size(), -1);
+  int status_field = -1;
+  std::vector<std::string_view> fields;
+  std::deque<std::string> scratch;
+  std::string out, why;
+  size_t start = 0;
+  for (long line = 1; start < content.size(); ++line) {
+    const size_t end = std::min(content.find('\n', start), content.size());
+    const std::string_view record(content.data() + start, end - start);
+    start = end + 1;
+    scratch.clear();
+    if (!internal::SplitRecord(record, ',', &fields, &scratch, &why)) {
+      *error = path + ":" + std::to_string(line) + ": " + why;
+      return false;
+    }
+    if (line == 1) {
+      for (size_t f = 0; f < fields.size(); ++f) {
+        if (fields[f] == "status") status_field = static_cast<int>(f);
+        for (size_t k = 0; k < keep.size(); ++k) {
+          if (fields[f] == keep[k]) field_of[k] = static_cast<int>(f);
+        }
+      }
+      for (size_t k = 0; k < keep.size(); ++k) {
+        if (field_of[k] < 0 || status_field < 0) {
+          *error = path + ":1: solve's output without its column " +
+                   internal::Quote(field_of[k] < 0 ? keep[k] : "status") +
+                   " (locate reads solve's CSV, --format=csv)";
+          return false;
+        }
+      }
+    }
+    const bool ok = line == 1 || (static_cast<int>(fields.size()) > status_field &&
+                                  fields[status_field] == "ok");
+    if (!ok) {
+      *left_out += record.empty() ? 0 : 1;
+      out += "#\n";  // the line kept, so that messages name the file's own lines
+      continue;
+    }
+    for (size_t k = 0; k < keep.size(); ++k) {
+      out += (k > 0 ? "," : "");
+      out += line == 1 ? keep[k]
+             : static_cast<int>(fields.size()) > field_of[k]
+                 ? std::string(fields[field_of[k]])
+                 : std::string();
+    }
+    out += "\n";
+  }
+  *text = std::move(out);
+  return true;
+}
+
 bool RowsFromFile(const CableRobot& robot, std::vector<Row>* rows, std::string* error) {
   if (!FLAGS_lengths.empty() || !FLAGS_rpy.empty() || !FLAGS_quat.empty() ||
       !FLAGS_tensions_kN.empty()) {
@@ -302,8 +386,22 @@ bool RowsFromFile(const CableRobot& robot, std::vector<Row>* rows, std::string* 
   DatasetReadOptions read;
   read.required_columns = DatasetColumns::kLengths;
   read.joint_columns = robot.moving_parts.JointColumns();
+  if (!ColumnsFromFlag(&read.columns, error)) return false;
   Dataset data;
-  if (!ReadDataset(FLAGS_data, read, &data, error)) return false;
+  std::string solved;  // solve's output as a lengths file, when --data is one
+  int left_out = 0;
+  if (read.columns == nullptr && !SolveOutputAsLengths(FLAGS_data, &solved, &left_out, error)) {
+    return false;
+  }
+  if (!(solved.empty() ? ReadDataset(FLAGS_data, read, &data, error)
+                       : ParseDataset(solved, FLAGS_data, read, &data, error))) {
+    return false;
+  }
+  if (left_out > 0) {
+    std::cerr << "fastcal locate: " << left_out << " of " << left_out + data.samples.size()
+              << " rows of " << FLAGS_data << " left out: solve did not solve them (status)"
+              << std::endl;
+  }
   rows->clear();
   rows->reserve(data.samples.size());
   for (const Sample& s : data.samples) {

@@ -78,6 +78,48 @@ TEST_F(CliTest, LocateInvertsSolve) {
   }
 }
 
+// solve's own output is a lengths file: its rows located back to their poses (the rows
+// solve could not solve left out and counted, the lines named as the file's), gzipped
+// too; and an export whose length channels have other names is read through --columns.
+TEST_F(CliTest, LocateReadsSolvesOutputAndAnExportThroughAMap) {
+  constexpr double kRoundTripM = 1e-6;  // the forward statics' tolerance is far below
+  Write("p.csv", "x_m,y_m,z_m\n0,0,150\n200,0,150\n10,5,148\n");
+  CommandResult r = Fastcal("solve --poses=" + Path("p.csv") + " --keep-going --output=" +
+                            Path("solved.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(Shell("gzip -k " + Path("solved.csv")).code, 0);
+  r = Fastcal("locate --use=lengths --data=" + Path("solved.csv.gz") + " --output=" +
+              Path("back.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("1 of 3 rows of " + Path("solved.csv.gz") + " left out"),
+            std::string::npos)
+      << r.output;
+  const auto back = CsvRows(ReadFile(Path("back.csv")));
+  ASSERT_EQ(back.size(), 2u);
+  EXPECT_EQ(back[1].at("line"), "4");  // the file's own line, past the row left out
+  EXPECT_NEAR(std::stod(back[1].at("x_m")), 10.0, kRoundTripM);
+  EXPECT_NEAR(std::stod(back[1].at("z_m")), 148.0, kRoundTripM);
+  // An export: the lengths as L1..L6 in mm, through a map.
+  const auto rows = CsvRows(ReadFile(Path("solved.csv")));
+  std::string text = "t;X;Y;Z;L1;L2;L3;L4;L5;L6\n0;10;5;148";
+  for (int i = 1; i <= 6; ++i) {
+    text += ";" + std::to_string(1e3 * std::stod(rows[2].at("s0_" + std::to_string(i) + "_m")));
+  }
+  Write("export.csv", text + "\n");
+  std::string map = "format: fastcal-columns-1\ntime: {column: t}\ncolumns:\n"
+                    "  x_m: X\n  y_m: Y\n  z_m: Z\n";
+  for (int i = 1; i <= 6; ++i) {
+    map += "  s0_" + std::to_string(i) + "_m: {column: L" + std::to_string(i) + ", unit: mm}\n";
+  }
+  Write("map.yaml", map);
+  r = Fastcal("locate --data=" + Path("export.csv") + " --columns=" + Path("map.yaml") +
+              " --output=" + Path("mapped.csv"));
+  ASSERT_EQ(r.code, 0) << r.output;
+  const auto mapped = CsvRows(ReadFile(Path("mapped.csv")));
+  ASSERT_EQ(mapped.size(), 1u);
+  EXPECT_NEAR(std::stod(mapped[0].at("y_m")), 5.0, 1e-3);  // lengths written to 1 um
+}
+
 // A dataset of simulate (it has s0 columns) is a lengths file: each row located, its
 // position compared with the file's in the summary; with the measured attitude and
 // tensions the fit uses 15 readings, with --use=lengths 6.
