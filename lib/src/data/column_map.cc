@@ -236,6 +236,15 @@ class MapReader {
       if (!ParseUtcOffset(text, &time.offset_s, &why)) return Fail(it->second.line, "time.zone", why);
       time.zone_given = true;
     }
+    // Clock times without a zone were read as UTC: Beijing's export silently 8 hours off
+    // (issue 39). The zone is a choice the map states, UTC included.
+    if ((time.format == TimeFormat::kIso8601 || time.format == TimeFormat::kPattern) &&
+        !time.zone_given) {
+      return Fail(kv.line, "time.zone",
+                  "missing: clock times need the zone they were written in, e.g. zone: "
+                  "\"+08:00\" for Beijing time, or zone: UTC (a stamp that carries its own "
+                  "offset, 2024-05-01T12:00:00+08:00, keeps it)");
+    }
     map->has_time = true;
     return true;
   }
