@@ -356,6 +356,16 @@ TEST(ColumnMapTest, ReadsEachTimeFormatAndZone) {
             kUnix + 0.5);
   EXPECT_EQ(TimeOf("01.05.2024 12:34", "{column: t, format: \"%d.%m.%Y %H:%M\", zone: UTC}"),
             kUnix - 56);
+  // A date cell or a datetime column arrives as ISO text whatever the pattern: read as
+  // the instant it is, in the map's zone; text neither the pattern nor ISO still fails.
+  const std::string slashes = "{column: t, format: \"%Y/%m/%d %H:%M:%S\", zone: \"+08:00\"}";
+  EXPECT_EQ(TimeOf("2024-05-01 20:34:56", slashes), kUnix);
+  EXPECT_EQ(TimeOf("2024-05-01T20:34:56.5", slashes), kUnix + 0.5);
+  EXPECT_TRUE(Contains(MappedError(std::string(kCanonicalHeader) + "\n01.05.2024 20:34:56" +
+                                       std::string(kRow).substr(std::string(kRow).find(',')) +
+                                       "\n",
+                                   MapText("time: " + slashes + "\n" + Columns())),
+                       "data.csv:2: column 't'"));
   // Clock times without a zone in the map: an error that asks for one (issue 39; they
   // were read as UTC, a Beijing export 8 hours off).
   for (const char* time : {"{column: t, format: iso8601}", "{column: t, format: \"%Y %H\"}"}) {

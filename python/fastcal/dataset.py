@@ -266,6 +266,36 @@ def _dataset_from_arrays(
     )
 
 
+def _frame_with_time_column(df: Any, mapped: bool) -> Any:
+    """The DataFrame with a time index (a DatetimeIndex, or any named index) made a column
+    (named as the index, an unnamed DatetimeIndex as time_s), and, without a map, a
+    datetime time_s column as Unix seconds: zone-aware stamps only (a naive one's zone is
+    the map's to state, docs/data-format.md)."""
+    if not hasattr(df, "reset_index"):
+        return df
+    import pandas
+
+    index = df.index
+    is_time = pandas.api.types.is_datetime64_any_dtype(index)
+    if index.name is not None or is_time:
+        frame = df.reset_index()
+        if index.name is None:
+            frame = frame.rename(columns={"index": "time_s"})
+    else:
+        frame = df.reset_index(drop=True)
+    if not mapped and "time_s" in frame.columns and \
+            pandas.api.types.is_datetime64_any_dtype(frame["time_s"]):
+        stamps = frame["time_s"]
+        if stamps.dt.tz is None:
+            raise InputError(
+                "DataFrame: time_s holds dates and times without a zone: localise them "
+                "(df.index.tz_localize('Asia/Shanghai')) or read through a column map with "
+                "time: {column: time_s, format: iso8601, zone: \"+08:00\"}")
+        frame = frame.copy()
+        frame["time_s"] = (stamps - pandas.Timestamp(0, tz="UTC")).dt.total_seconds()
+    return frame
+
+
 def _dataset_from_dataframe(
     df: Any,
     columns: Optional[ColumnsLike] = None,
@@ -285,7 +315,7 @@ def _dataset_from_dataframe(
     """
     map_text, map_source = _columns_argument(columns)
     joints = list(model.joint_columns) if model is not None else []
-    frame = df.reset_index(drop=True) if hasattr(df, "reset_index") else df
+    frame = _frame_with_time_column(df, bool(map_text))
     try:
         text = frame.to_csv(index=False, lineterminator="\n")
     except TypeError:  # pandas before 1.5

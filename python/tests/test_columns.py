@@ -165,6 +165,22 @@ def test_from_dataframe(data_dir: pathlib.Path) -> None:
     np.testing.assert_allclose(mapped.position_m, survey.position_m, rtol=1e-15, atol=1e-12)
     np.testing.assert_allclose(mapped.tension_kN, survey.tension_kN, rtol=1e-15)
     np.testing.assert_array_equal(mapped.time_s, START + survey.time_s)
+    # A map whose time is a text pattern (for the CSV export) reads the datetime column too.
+    patterned = dict(FAST_MAP)
+    patterned["time"] = {"column": "SysTime", "format": "%Y/%m/%d %H:%M:%S", "zone": "+08:00"}
+    np.testing.assert_array_equal(
+        fastcal.Dataset.from_dataframe(export, columns=patterned).time_s, START + survey.time_s)
+    # Indexed by time: the index is the time column (a DataFrame's usual shape).
+    indexed = export.set_index("SysTime")
+    np.testing.assert_array_equal(
+        fastcal.Dataset.from_dataframe(indexed, columns=FAST_MAP).time_s, START + survey.time_s)
+    canonical = frame.copy()
+    canonical.index = pd.to_datetime(START + survey.time_s, unit="s", utc=True)
+    canonical = canonical.drop(columns="time_s")
+    np.testing.assert_array_equal(
+        fastcal.Dataset.from_dataframe(canonical).time_s, START + survey.time_s)
+    with pytest.raises(fastcal.InputError, match="without a zone"):
+        fastcal.Dataset.from_dataframe(canonical.tz_localize(None))
     export.loc[7, "CableForce2"] = -3.0
     with pytest.raises(fastcal.InputError, match=r"^DataFrame, row 8: column 'CableForce2' \(T2_kN, N\)"):
         fastcal.Dataset.from_dataframe(export, columns=FAST_MAP)
@@ -207,6 +223,12 @@ def test_reads_an_xlsx_workbook_through_a_map(tmp_path: pathlib.Path, data_dir: 
     np.testing.assert_array_equal(data.time_s, START + survey.time_s[:40])
     same = fastcal.read_dataset(path, columns=columns, sheet="Telemetry")
     np.testing.assert_array_equal(same.time_s, data.time_s)
+    # The map of the CSV export (a text pattern for SysTime) reads the workbook's date cells
+    # as the instants they are: one map serves both files (issue 39).
+    patterned = dict(columns)
+    patterned["time"] = {"column": "SysTime", "format": "%Y/%m/%d %H:%M:%S", "zone": "+08:00"}
+    from_pattern = fastcal.read_dataset(path, columns=patterned)
+    np.testing.assert_array_equal(from_pattern.time_s, data.time_s)
     with pytest.raises(fastcal.InputError, match=r"no sheet 'Other' \(sheets: Telemetry\)"):
         fastcal.read_dataset(path, columns=columns, sheet="Other")
     # A bad cell: the sheet's row and the source column.

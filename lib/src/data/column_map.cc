@@ -652,8 +652,21 @@ bool ReadTimeField(std::string_view field, const ColumnMapTime& time, char decim
   switch (time.format) {
     case TimeFormat::kIso8601:
       return ParseIso8601(field, time.offset_s, time_s, why);
-    case TimeFormat::kPattern:
-      return ParseTimePattern(field, time.pattern, time.offset_s, time_s, why);
+    case TimeFormat::kPattern: {
+      if (ParseTimePattern(field, time.pattern, time.offset_s, time_s, why)) return true;
+      // A spreadsheet's date cell or a DataFrame's datetime column reaches the reader as
+      // ISO 8601 text ("2024-05-01 20:00:00"), whatever the pattern the map's CSV export
+      // needs: one map serves both (issue 39). Only where the pattern fails, and only a
+      // whole ISO date and time (the year first is unambiguous), in the map's zone.
+      double iso = 0.0;
+      std::string ignored;
+      if (field.size() >= 16 && field[4] == '-' && field[7] == '-' &&
+          ParseIso8601(field, time.offset_s, &iso, &ignored)) {
+        *time_s = iso;
+        return true;
+      }
+      return false;
+    }
     default:
       break;
   }
