@@ -277,7 +277,7 @@ TEST_F(CliTest, LocateRefusesBadInputAndNamesIt) {
            {"locate " + k1 + " --rpy=0,0,0 --quat=1,0,0,0", 2, "at most one of --rpy and --quat"},
            {"locate " + k1 + " --tensions-kN=1,2", 2, "--tensions-kN needs 6"},
            {"locate " + k1 + " --force", 2, "--force applies to --output=FILE"},
-           {"locate --data=" + Path("short.csv"), 2, "short.csv:1: missing column 's0_3_m'"},
+           {"locate --data=" + Path("short.csv"), 2, "short.csv:1: missing columns 's0_3_m', 's0_4_m', 's0_5_m', 's0_6_m'"},
            {"locate --data=" + Path("bad_value.csv"), 2,
             "bad_value.csv:3: column 's0_3_m': 'x' is not a number"},
            {"locate --data=" + Path("short.csv") + " " + k1, 2, "drop --lengths"},

@@ -147,7 +147,7 @@ TEST(ColumnMapTest, BadMapsNameTheKeyAndTheLine) {
                        "map.yaml:3: columns.x_m.scale: unknown key (allowed here: column, unit)"));
   // An unknown fastcal name; time_s under columns.
   EXPECT_TRUE(Contains(MapError(MapText("columns:\n  x_mm: X\n")),
-                       "map.yaml:3: columns.x_mm: unknown fastcal name (accepted: x_m, y_m"));
+                       "map.yaml:3: columns.x_mm: unknown fastcal name (did you mean 'x_m'?) (accepted: x_m, y_m"));
   EXPECT_TRUE(Contains(MapError(MapText("columns:\n  time_s: T\n")),
                        "map.yaml:3: columns.time_s: the time is given by the map's time:"));
   // The format, missing or wrong.
@@ -258,6 +258,46 @@ TEST(ColumnMapTest, PoseFilesReadTheModelsJointColumnsThroughAMap) {
                             &joints, nullptr, &error));
   EXPECT_TRUE(Contains(error, "not 'rotator_b_deg'")) << error;
   fs::remove_all(dir);
+}
+
+TEST(ColumnMapTest, MapErrorsNameTheLikelyFix) {
+  // Issue 39: a unit 1000x off names the unit that fits, a decimal comma under '.' asks
+  // for decimal: ",", a unit row asks for skip_after_header, every missing entry is
+  // named at once, and a typo in a source column or a fastcal name gets its near name.
+  const std::string header = "t,X,Y,Z,R,P,W,F1,F2,F3,F4,F5,F6\n";
+  const std::string forces_in_n = "0,70.96,4.65,156.73,0.35,-5.3,0.09,214000,190200,141800,149900,188600,207100\n";
+  const std::string map = MapText(
+      "time: t\ncolumns:\n  x_m: X\n  y_m: Y\n  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
+      "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n  T3_kN: F3\n  T4_kN: F4\n  T5_kN: F5\n"
+      "  T6_kN: F6\n");
+  EXPECT_TRUE(Contains(MappedError(header + forces_in_n, map),
+                       "214000 kN is above the plausible maximum of 5000 kN; in N it would be "
+                       "plausible: is the column's unit N (unit: N)?"));
+  const std::string mm = "0,70960,4650,156730,0.35,-5.3,0.09,214,190.2,141.8,149.9,188.6,207.1\n";
+  EXPECT_TRUE(Contains(MappedError(header + mm, map),
+                       "in mm it would be plausible: are the columns' units mm (unit: mm)?"));
+  const std::string comma = "0,70.96,4.65,156.73,\"0,35\",-5.3,0.09,214,190.2,141.8,149.9,188.6,207.1\n";
+  EXPECT_TRUE(Contains(MappedError(header + comma, map), "(give decimal: \",\")"));
+  EXPECT_TRUE(Contains(MappedError(header + "s,m,m,m,deg,deg,deg,kN,kN,kN,kN,kN,kN\n", map),
+                       "a unit row? (skip_after_header: 1)"));
+  EXPECT_TRUE(Contains(MappedError(header, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: Y\n"
+                                                   "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
+                                                   "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
+                                                   "unmapped: ignore\n")),
+                       "no entry for 'T3_kN', 'T4_kN', 'T5_kN', 'T6_kN'"));
+  const std::string typos = "t,X,SDP_PhasPos_Y,Z,R,P,W,F1,F2,CableForcee3,F4,F5,F6\n";
+  EXPECT_TRUE(Contains(MappedError(typos, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: SDP_PhaPos_Y\n"
+                                                  "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
+                                                  "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
+                                                  "  T3_kN: F3\n  T4_kN: F4\n  T5_kN: F5\n"
+                                                  "  T6_kN: F6\nunmapped: ignore\n")),
+                       "(did you mean 'SDP_PhasPos_Y'?)"));
+  EXPECT_TRUE(Contains(MappedError(typos, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: SDP_PhasPos_Y\n"
+                                                  "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
+                                                  "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
+                                                  "  T3_kN: CableForce3\n  T4_kN: F4\n  T5_kN: F5\n"
+                                                  "  T6_kN: F6\nunmapped: ignore\n")),
+                       "(did you mean 'CableForcee3'?)"));
 }
 
 TEST(ColumnMapTest, ReadsEveryUnit) {

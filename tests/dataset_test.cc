@@ -366,7 +366,7 @@ TEST_F(DatasetTest, ErrorsNameFileLineAndColumn) {
        {"data.csv:1: missing column 'planned_pitch_deg' (the planned attitude needs all three"}},
       {"partial unstretched lengths",
        "s0_1_m,s0_2_m," + std::string(kHeader),
-       {"data.csv:1: missing column 's0_3_m' (the unstretched lengths need all six"}},
+       {"data.csv:1: missing columns 's0_3_m', 's0_4_m', 's0_5_m', 's0_6_m' (the unstretched lengths need all six"}},
       {"non-positive unstretched length",
        "s0_1_m,s0_2_m,s0_3_m,s0_4_m,s0_5_m,s0_6_m," + std::string(kHeader) +
            "300,300,300,300,-1,300," + kRow,
@@ -475,7 +475,7 @@ TEST_F(DatasetTest, LengthsFileNeedsOnlyTheLengths) {
   EXPECT_TRUE(Contains(error, "missing column 'z_m' (the position needs all three or none)"));
   EXPECT_FALSE(ParseDataset("T1_kN," + lengths + "\n150,300,301,302,303,304,305\n", "l.csv",
                             options, &d, &error));
-  EXPECT_TRUE(Contains(error, "missing column 'T2_kN' (the measured tensions need all six"));
+  EXPECT_TRUE(Contains(error, "missing columns 'T2_kN', 'T3_kN', 'T4_kN', 'T5_kN', 'T6_kN' (the measured tensions need all six"));
   // A measurement file still needs its columns, and keeps its flags.
   EXPECT_TRUE(Contains(ParseError(lengths + "\n300,301,302,303,304,305\n"), "missing column"));
   const Dataset full = ParseOk(std::string(kHeader) + kRow);

@@ -44,7 +44,7 @@ bool EndsWith(const std::string& s, const char* suffix) {
 }
 
 // The units a quantity may come in, its canonical one first.
-std::vector<std::string> UnitsOf(const std::string& name) {
+std::vector<std::string> UnitsOfName(const std::string& name) {
   const std::string unit = CanonicalUnitOf(name);
   if (unit == "m") return {"m", "cm", "mm"};
   if (unit == "deg") return {"deg", "rad"};
@@ -273,12 +273,13 @@ class MapReader {
       if (std::find(names.begin(), names.end(), entry.name) == names.end() &&
           !IsJointColumnName(entry.name)) {
         return Fail(line, path,
-                    "unknown fastcal name (accepted: " + Join(names) +
+                    "unknown fastcal name" + internal::DidYouMean(entry.name, names) +
+                        " (accepted: " + Join(names) +
                         "; and a moving part's joint column, NAME_deg or NAME_m, as the "
                         "model's cabin.moving_parts names it)");
       }
       if (map->Find(entry.name) != nullptr) return Fail(line, path, "given twice");
-      const std::vector<std::string> units = UnitsOf(entry.name);
+      const std::vector<std::string> units = UnitsOfName(entry.name);
       entry.unit = units.empty() ? "" : units.front();
       if (item.second.IsScalar()) {  // x_m: SDP_PhaPos_X  (in the canonical unit)
         entry.column = item.second.Scalar();
@@ -647,6 +648,98 @@ bool ReadConvertedNumber(std::string_view field, char decimal, const ValueConver
   return true;
 }
 
+std::vector<std::string> UnitsOf(const std::string& name) { return UnitsOfName(name); }
+
+namespace {
+
+// A name as compared for "did you mean": lower case, without spaces, '_' and '-'.
+std::string NameKey(std::string_view s) {
+  std::string out;
+  for (char c : s) {
+    if (c == ' ' || c == '_' || c == '-') continue;
+    out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  }
+  return out;
+}
+
+// Levenshtein distance (Wagner-Fischer, one row).
+size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<size_t> row(b.size() + 1);
+  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (size_t i = 1; i <= a.size(); ++i) {
+    size_t diagonal = row[0];
+    row[0] = i;
+    for (size_t j = 1; j <= b.size(); ++j) {
+      const size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = up;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+std::string DidYouMean(std::string_view name, const std::vector<std::string_view>& candidates) {
+  const std::string wanted = NameKey(name);
+  // A typo's reach: one edit in a short name, up to three in a long one.
+  // (A name of one or two letters is only matched but for case and separators: one
+  // edit away from it lies every other short name.)
+  const size_t reach = wanted.size() < 3 ? 0 : std::clamp<size_t>(wanted.size() / 4, 1, 3);
+  size_t best = reach + 1;
+  std::string_view found;
+  const auto letters = [](const std::string& key) {
+    std::string out;
+    for (char ch : key) {
+      if (!std::isdigit(static_cast<unsigned char>(ch))) out += ch;
+    }
+    return out;
+  };
+  for (std::string_view c : candidates) {
+    const std::string key = NameKey(c);
+    // Names that differ only in their numbers (T7_kN, T1_kN) are other channels, not typos.
+    if (key != wanted && letters(key) == letters(wanted)) continue;
+    const size_t d = EditDistance(wanted, key);
+    if (d < best) {
+      best = d;
+      found = c;
+    }
+  }
+  return best <= reach ? " (did you mean " + Quote(found) + "?)" : "";
+}
+
+std::string DidYouMean(std::string_view name, const std::vector<std::string>& candidates) {
+  return DidYouMean(name, std::vector<std::string_view>(candidates.begin(), candidates.end()));
+}
+
+std::string UnitHint(const std::string& name, const std::string& unit, std::string_view field,
+                     char decimal, const std::function<bool(double)>& plausible) {
+  for (const std::string& other : UnitsOfName(name)) {
+    if (other == unit) continue;
+    double file_value = 0.0, internal = 0.0;
+    std::string why;
+    if (ReadConvertedNumber(field, decimal, ConversionOf(name, other), &file_value, &internal,
+                            &why) &&
+        plausible(file_value)) {
+      return "; in " + other + " it would be plausible: is the column's unit " + other +
+             " (unit: " + other + ")?";
+    }
+  }
+  return "";
+}
+
+std::string NotANumberHint(std::string_view field, char decimal, bool first_data_row) {
+  const bool digits = field.find_first_of("0123456789") != std::string_view::npos;
+  if (decimal == '.' && digits && field.find(',') != std::string_view::npos &&
+      field.find('.') == std::string_view::npos) {
+    return "; a decimal comma? the map says decimal: \".\" (give decimal: \",\")";
+  }
+  if (first_data_row && !digits) {
+    return "; the first row under the header is text: a unit row? (skip_after_header: 1)";
+  }
+  return "";
+}
+
 bool ReadTimeField(std::string_view field, const ColumnMapTime& time, char decimal,
                    double* time_s, std::string* why) {
   switch (time.format) {
@@ -696,21 +789,8 @@ std::string Lower(std::string_view s) {
   return out;
 }
 
-// " (did you mean 'X'?)" for a header name equal to `name` but for case, spaces,
-// '_' and '-'; "" when none is.
 std::string NearName(const std::string& name, const std::vector<std::string_view>& fields) {
-  const auto key = [](std::string_view s) {
-    std::string out;
-    for (char c : Lower(s)) {
-      if (c != ' ' && c != '_' && c != '-') out += c;
-    }
-    return out;
-  };
-  const std::string wanted = key(name);
-  for (std::string_view f : fields) {
-    if (key(f) == wanted) return " (did you mean " + Quote(f) + "?)";
-  }
-  return "";
+  return DidYouMean(name, fields);
 }
 
 }  // namespace

@@ -208,6 +208,7 @@ struct Header {
   char delimiter = ',';
   std::array<internal::ValueConversion, kNumColumns> conversion{};
   std::vector<internal::ValueConversion> joint_conversion;  // per joint, through a map
+  std::array<const ColumnMapEntry*, kNumColumns> entry{};   // through a map, per column
   // How messages name a column: "column 'x_m'", or through a map "column 'SDP_PhaPos_X'
   // (x_m)"; the position's three and the quaternion's four together.
   std::array<std::string, kNumColumns> label;
@@ -220,18 +221,35 @@ struct Header {
 // Checks that a group of columns is all present or all absent; on a partial group names
 // the first missing column (`missing`: "missing column ", or a map's "no entry for ").
 // Returns whether the group is present.
+// "missing columns " before a list of several, else `missing` as it is.
+std::string Plural(const char* missing, const std::string& names) {
+  const std::string m = missing;
+  return m == "missing column " && names.find(',') != std::string::npos ? "missing columns " : m;
+}
+
 bool GroupPresent(const Header& header, int first, int count, const std::string& where,
                   const char* group_note, const char* missing, bool* ok, std::string* error) {
   int present = 0;
   for (int c = first; c < first + count; ++c) present += header.field_of[c] >= 0 ? 1 : 0;
   if (present == 0 || present == count) return present == count;
+  std::string names;  // every one missing, not only the first (issue 39)
   for (int c = first; c < first + count; ++c) {
-    if (header.field_of[c] < 0) {
-      *error = where + missing + Quoted(kColumnNames[c]) + " (" + group_note + ")";
-      break;
-    }
+    if (header.field_of[c] < 0) names += (names.empty() ? "" : ", ") + Quoted(kColumnNames[c]);
   }
+  *error = where + Plural(missing, names) + names + " (" + group_note + ")";
   *ok = false;
+  return false;
+}
+
+// Columns [first, end) all present; else every one missing named at once (issue 39).
+bool RequireAll(const std::string& where, const char* missing, int first, int end,
+                const Header& header, std::string* error) {
+  std::string names;
+  for (int c = first; c < end; ++c) {
+    if (header.field_of[c] < 0) names += (names.empty() ? "" : ", ") + Quoted(kColumnNames[c]);
+  }
+  if (names.empty()) return true;
+  *error = where + Plural(missing, names) + names;
   return false;
 }
 
@@ -239,11 +257,6 @@ bool GroupPresent(const Header& header, int first, int count, const std::string&
 // "file:line: " (or the map's "map.yaml:5: columns: "), `missing` as in GroupPresent.
 bool CheckColumnGroups(const std::string& where, const char* missing, DatasetColumns required,
                        Header* header, std::string* error) {
-  const auto require = [&](int column) {
-    if (header->field_of[column] >= 0) return true;
-    *error = where + missing + Quoted(kColumnNames[column]);
-    return false;
-  };
   bool ok = true;
   const bool lengths_file = required == DatasetColumns::kLengths;
   if (lengths_file) {
@@ -257,9 +270,7 @@ bool CheckColumnGroups(const std::string& where, const char* missing, DatasetCol
                      "the measured tensions need all six or none", missing, &ok, error);
     if (!ok) return false;
   } else {
-    for (int c = kTime; c <= kZ; ++c) {
-      if (!require(c)) return false;
-    }
+    if (!RequireAll(where, missing, kTime, kZ + 1, *header, error)) return false;
   }
   const bool rpy =
       GroupPresent(*header, kRoll, 3, where, "the measured attitude as angles needs all three",
@@ -281,8 +292,9 @@ bool CheckColumnGroups(const std::string& where, const char* missing, DatasetCol
   }
   header->attitude = rpy || quaternion;
   header->quaternion = quaternion;
-  for (int i = 0; i < kNumCables && !lengths_file; ++i) {
-    if (!require(kTension1 + i)) return false;
+  if (!lengths_file &&
+      !RequireAll(where, missing, kTension1, kTension1 + kNumCables, *header, error)) {
+    return false;
   }
   header->planned =
       GroupPresent(*header, kPlannedRoll, 3, where, "the planned attitude needs all three or none",
@@ -403,6 +415,7 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
       header->column_of_field[f] = column;
       header->field_of[column] = static_cast<int>(f);
       header->conversion[column] = internal::ConversionOf(entry.name, entry.unit);
+      header->entry[column] = &entry;
       const std::string unit = entry.unit == CanonicalUnitOf(entry.name) ? "" : ", " + entry.unit;
       header->label[column] = "column " + Quoted(entry.column) + " (" + entry.name + unit + ")";
     }
@@ -469,8 +482,11 @@ bool ParseHeader(std::string_view line, const std::string& where, const std::str
       continue;
     }
     if (column < 0) {
-      *error = where + "unknown column " + Quoted(name) + " (accepted: " + AcceptedColumns() +
-               "; an export with other names, units or channels is read through a column map, "
+      std::vector<std::string> known(std::begin(kColumnNames), std::end(kColumnNames));
+      known.push_back(kSessionColumn);
+      known.insert(known.end(), joints.begin(), joints.end());
+      *error = where + "unknown column " + Quoted(name) + internal::DidYouMean(name, known) +
+               " (accepted: " + AcceptedColumns() + "; an export with other names, units or channels is read through a column map, "
                "--columns=MAP.yaml, docs/data-format.md)";
       if (IsJointColumnName(name)) {
         *error += "; if it is a moving part's joint, the model names no joint with it "
@@ -515,6 +531,12 @@ bool CheckValue(int column, double value, const PlausibilityLimits& limits, std:
 
 // The numbers of one row, by column (tensions in N; columns the file lacks stay 0).
 using FieldValues = std::array<double, kNumColumns>;
+
+// Through a map whose x, y, z share a unit: the other unit in which the row's position
+// would be plausible, as a hint (issue 39: mm declared as m put the cabin above the
+// towers); "" otherwise.
+std::string PositionUnitHint(std::string_view line, const Header& header,
+                             const PlausibilityLimits& limits);
 
 // Parses one data row into *sample and *values; on failure *reason says why (without
 // file:line). `previous` (may be null): the last valid row, for the decimal-comma hint.
@@ -592,6 +614,37 @@ bool SplitMappedRow(std::string_view line, const Header& header,
   return false;
 }
 
+std::string PositionUnitHint(std::string_view line, const Header& header,
+                             const PlausibilityLimits& limits) {
+  const ColumnMapEntry* x = header.entry[kX];
+  if (header.map == nullptr || x == nullptr || header.entry[kY] == nullptr ||
+      header.entry[kZ] == nullptr || header.entry[kY]->unit != x->unit ||
+      header.entry[kZ]->unit != x->unit) {
+    return "";
+  }
+  std::vector<std::string_view> fields;
+  std::string ignored;
+  if (!SplitMappedRow(line, header, &fields, &ignored)) return "";
+  for (const std::string& unit : internal::UnitsOf(x->name)) {
+    if (unit == x->unit) continue;
+    Eigen::Vector3d p;
+    bool read = true;
+    for (int c = kX; c <= kZ && read; ++c) {
+      double file_value = 0.0;
+      const int field = header.field_of[c];
+      read = field >= 0 && field < static_cast<int>(fields.size()) &&
+             internal::ReadConvertedNumber(fields[field], header.map->decimal,
+                                           internal::ConversionOf(x->name, unit), &file_value,
+                                           &p[c - kX], &ignored);
+    }
+    if (read && CheckPosition(p, limits, &ignored)) {
+      return "; in " + unit + " it would be plausible: are the columns' units " + unit +
+             " (unit: " + unit + ")?";
+    }
+  }
+  return "";
+}
+
 bool ParseRow(std::string_view line, const Header& header, const PlausibilityLimits& limits,
               const FieldValues* previous, Sample* sample, FieldValues* values,
               std::string* reason) {
@@ -647,15 +700,25 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
       if (column == kTime) {
         if (!internal::ReadTimeField(fields[f], header.map->time, header.map->decimal,
                                      &value[column], &why)) {
-          return fail(why);
+          return fail(why + internal::NotANumberHint(fields[f], '\0', previous == nullptr));
         }
         continue;
       }
       double file_value = 0.0;
-      if (!internal::ReadConvertedNumber(fields[f], header.map->decimal, header.conversion[column],
-                                         &file_value, &value[column], &why) ||
-          !CheckValue(column, file_value, limits, &why)) {
-        return fail(why);
+      const char decimal = header.map->decimal;
+      if (!internal::ReadConvertedNumber(fields[f], decimal, header.conversion[column],
+                                         &file_value, &value[column], &why)) {
+        return fail(why + internal::NotANumberHint(fields[f], decimal, previous == nullptr));
+      }
+      if (!CheckValue(column, file_value, limits, &why)) {
+        const ColumnMapEntry* e = header.entry[column];
+        const auto plausible = [&](double v) {
+          std::string ignored;
+          return CheckValue(column, v, limits, &ignored);
+        };
+        return fail(why + (e == nullptr ? std::string()
+                                        : internal::UnitHint(e->name, e->unit, fields[f],
+                                                             decimal, plausible)));
       }
       continue;
     }
@@ -670,7 +733,7 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     const Eigen::Vector3d position(value[kX], value[kY], value[kZ]);
     std::string why;
     if (!CheckPosition(position, limits, &why)) {
-      *reason = header.position_label + ": " + why;
+      *reason = header.position_label + ": " + why + PositionUnitHint(line, header, limits);
       return false;
     }
   }

@@ -7,6 +7,7 @@
 #define FASTCAL_INTERNAL_COLUMN_READING_H_
 
 #include <deque>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -49,6 +50,26 @@ struct ValueConversion {
 
 // The conversion of fastcal name `name` from `unit` (checked by the map's reader).
 ValueConversion ConversionOf(const std::string& name, const std::string& unit);
+
+// The units fastcal name `name` may come in (m, cm, mm; deg, rad; kN, N, tf), canonical
+// first; none for a label or a quaternion.
+std::vector<std::string> UnitsOf(const std::string& name);
+
+// The hint for a value the map's unit makes implausible (issue 39): the other unit of
+// `name` in which `field` would pass `plausible` (a test of the canonical file's value),
+// as "; in N it would be plausible: is the column's unit N (unit: N)?", else "".
+std::string UnitHint(const std::string& name, const std::string& unit, std::string_view field,
+                     char decimal, const std::function<bool(double)>& plausible);
+
+// " (did you mean 'X'?)" for the candidate nearest `name` when it is a likely typo: the
+// same but for case, spaces, '_' and '-', or within a few edits of it (Levenshtein: one
+// in a short name, up to three in a long one); "" otherwise.
+std::string DidYouMean(std::string_view name, const std::vector<std::string_view>& candidates);
+std::string DidYouMean(std::string_view name, const std::vector<std::string>& candidates);
+
+// The hint for a field that is not a number (issue 39): a decimal comma under the map's
+// '.', or a unit row ("mm", "N") under the header: "; ... (decimal: \",\")", else "".
+std::string NotANumberHint(std::string_view field, char decimal, bool first_data_row);
 
 // Reads one field as a number with `decimal` as its decimal mark and converts it:
 // *file_value in the canonical file's unit (for the limits), *internal in memory's.
