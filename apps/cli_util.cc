@@ -20,6 +20,7 @@
 #include <memory>
 #include <sstream>
 
+#include "fastcal/internal/edit_distance.h"
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
@@ -66,27 +67,7 @@ std::string DeprecatedFlagName(const std::string& old_name) {
   return "";
 }
 
-namespace {
-
-// Levenshtein distance of a and b, ignoring case (--min-tension-KN is one slip away).
-size_t EditDistance(const std::string& a, const std::string& b) {
-  std::vector<size_t> row(b.size() + 1);
-  for (size_t j = 0; j <= b.size(); ++j) row[j] = j;
-  for (size_t i = 1; i <= a.size(); ++i) {
-    size_t diagonal = row[0];
-    row[0] = i;
-    for (size_t j = 1; j <= b.size(); ++j) {
-      const bool same = std::tolower(static_cast<unsigned char>(a[i - 1])) ==
-                        std::tolower(static_cast<unsigned char>(b[j - 1]));
-      const size_t next = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (same ? 0 : 1)});
-      diagonal = row[j];
-      row[j] = next;
-    }
-  }
-  return row[b.size()];
-}
-
-}  // namespace
+using internal::EditDistance;
 
 std::vector<std::string> ClosestNames(const std::string& name,
                                       const std::set<std::string>& allowed) {

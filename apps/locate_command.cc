@@ -4,8 +4,8 @@
 #include <gflags/gflags.h>
 
 #include <chrono>
-#include <deque>
 #include <cmath>
+#include <deque>
 #include <iostream>
 #include <limits>
 #include <sstream>
@@ -364,10 +364,9 @@ bool SolveOutputAsLengths(const std::string& path, std::string* text, int* left_
     }
     for (size_t k = 0; k < keep.size(); ++k) {
       out += (k > 0 ? "," : "");
-      out += line == 1 ? keep[k]
-             : static_cast<int>(fields.size()) > field_of[k]
-                 ? std::string(fields[field_of[k]])
-                 : std::string();
+      out += line == 1                                       ? keep[k]
+             : static_cast<int>(fields.size()) > field_of[k] ? std::string(fields[field_of[k]])
+                                                             : std::string();
     }
     out += "\n";
   }
@@ -591,8 +590,9 @@ int RunLocate(int argc, char** argv) {
     return kExitUsage;
   }
   if (from_file && !FLAGS_joints.empty()) {
-    PrintError(kCommand, "--data brings its own joint values (the model's joint columns): drop "
-                         "--joints");
+    PrintError(kCommand,
+               "--data brings its own joint values (the model's joint columns): drop "
+               "--joints");
     return kExitUsage;
   }
   if (!(from_file ? RowsFromFile(robot, &rows, &error) : RowFromFlags(&rows, &error)) ||
