@@ -270,7 +270,7 @@ std::string Summary(const Design& d) {
     << d.candidates.size() << " feasible candidates (" << d.rejected_candidates
     << " infeasible); path " << FormatDouble(d.path_length_m, 5) << " m";
   if (d.options.speed_m_per_s > 0.0) {
-    s << ", " << FormatDouble(d.duration_s / kSecondsPerMinute, 4) << " min";
+    s << ", " << FormatDouble(d.duration_s / kSecondsPerMinute, 3) << " min";
   }
   // The name column as wide as the longest wanted name (a moving part's are long).
   int width = 28;

@@ -550,12 +550,12 @@ std::string SurveyText(const Design& d) {
                   " deg, extra yaw up to " + Fmt("%.3g", o.max_extra_yaw_deg) +
                   " deg off the focal law. Path " + Fmt("%.4g", d.path_length_m) + " m";
   if (o.speed_m_per_s > 0.0) {
-    h += ", " + Fmt("%.4g", d.duration_s / 60.0) + " min at " + Fmt("%.3g", o.speed_m_per_s) +
-         " m/s (" + Fmt("%.4g", d.travel_s / 60.0) + " min flying, " +
-         Fmt("%.4g", d.dwell_s / 60.0) + " min sampling)";
+    h += ", " + Fmt("%.3g", d.duration_s / 60.0) + " min at " + Fmt("%.3g", o.speed_m_per_s) +
+         " m/s (" + Fmt("%.3g", d.travel_s / 60.0) + " min flying, " +
+         Fmt("%.3g", d.dwell_s / 60.0) + " min sampling)";
   }
   if (o.time_budget_s > 0.0) {
-    h += "; time budget " + Fmt("%.4g", o.time_budget_s / 60.0) + " min (" +
+    h += "; time budget " + Fmt("%.3g", o.time_budget_s / 60.0) + " min (" +
          std::to_string(d.unconstrained_stops) + " stops without it)";
   }
   return h + ".";
