@@ -110,6 +110,35 @@ class CalibrationResult:
         self.change_scan: Optional[Dict[str, Any]] = raw["change_scan"]
         self.changes: List[Dict[str, Any]] = raw["changes"]
 
+    def report_html(self, path: Optional[PathLike] = None) -> str:
+        """The calibration's report as the command line writes report.html (plots
+        inline, self-contained); written to `path` too when given (refused if it exists).
+        In a notebook: IPython.display.HTML(result.report_html())."""
+        return self._report_text("html", path)
+
+    def report_markdown(self, path: Optional[PathLike] = None) -> str:
+        """The report as Markdown (report.md); written to `path` too when given."""
+        return self._report_text("md", path)
+
+    def _report_text(self, kind: str, path: Optional[PathLike]) -> str:
+        state, data, data_name = self._report
+        text = _fastcal.calibration_report(state, data, kind, data_name)
+        if path is not None:
+            with open(os.fspath(path), "x", encoding="utf-8") as f:  # x: never over a file
+                f.write(text)
+        return text
+
+    def to_dataframe(self) -> Any:
+        """The parameters as a pandas DataFrame, one row per parameter (index: its name):
+        unit, free, estimate, sigma, sigma_total, sigma_statistical, sigma_systematic,
+        prior_mean, prior_sigma, note."""
+        import pandas
+
+        keys = ["unit", "free", "consider", "initial", "estimate", "sigma", "sigma_total",
+                "sigma_statistical", "sigma_systematic", "prior_mean", "prior_sigma", "note"]
+        rows = [{k: p.get(k) for k in keys} for p in self.parameters]
+        return pandas.DataFrame(rows, index=[p["name"] for p in self.parameters])
+
     def __repr__(self) -> str:
         shown = ", ".join(
             f"{name} = {self.estimates[name]:.6g} +- {self.sigma_total[name]:.2g}"
@@ -136,6 +165,7 @@ def calibrate(
     spec: Union[PathLike, Mapping[str, Any]],
     data: Union[Dataset, PathLike],
     model: Optional[Union[Model, PathLike]] = None,
+    quiet: bool = False,
 ) -> CalibrationResult:
     """Estimates model parameters from measured poses and tensions (docs/calibration.md).
 
@@ -149,6 +179,8 @@ def calibrate(
              "parameters": {"mass_centre_m": {"x": {"free": True}, "y": {"free": True}}}}.
         data: a Dataset, or the path of a telemetry CSV.
         model: the starting model (a Model or a model file); None for Model.nominal().
+        quiet: no progress lines (one per solver iteration, "fastcal.calibrate: ..." on
+            sys.stderr, which a notebook shows).
 
     Returns:
         A CalibrationResult. A fit whose verdict is 'failed' is returned, with a
@@ -161,15 +193,17 @@ def calibrate(
             model cannot hold a sample's pose: the line is named), 'solver failed' or
             'mostly gross errors'.
     """
+    data_name = os.fspath(data) if not isinstance(data, Dataset) else "Dataset"
     model, data = _model_and_data(model, data)
     spec_text, is_text, source = _spec_argument(spec)
     try:
-        raw = _fastcal.calibrate(model, spec_text, is_text, source, data)
+        raw, state = _fastcal.calibrate(model, spec_text, is_text, source, data, quiet)
     except InputError as error:
         # A dict has no lines: its messages name the key path alone.
         message = re.sub(rf"^{re.escape(_DICT_SPEC)}:\d+: ", f"{_DICT_SPEC}: ", str(error))
         raise InputError(message) from None
     result = CalibrationResult(raw)
+    result._report = (state, data, data_name)  # for report_html() and report_markdown()
     if result.verdict == "failed":
         warnings.warn(f"the fit failed: {result.verdict_text}", RuntimeWarning, stacklevel=2)
     return result

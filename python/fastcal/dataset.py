@@ -327,6 +327,36 @@ def _dataset_from_dataframe(
     )
 
 
+def _dataset_to_dataframe(self: Dataset) -> Any:
+    """The samples as a pandas DataFrame in fastcal's column names and units (the
+    canonical CSV's: time_s, x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg, the planned
+    attitude, T1_kN..T6_kN, s0_1_m..s0_6_m and the joint columns where the data have
+    them, session with its label), one row per sample; `line` is the file's line."""
+    import pandas
+
+    columns: Dict[str, Any] = {"time_s": self.time_s}
+    for k, name in enumerate(("x_m", "y_m", "z_m")):
+        columns[name] = self.position_m[:, k]
+    for k, name in enumerate(("roll_deg", "pitch_deg", "yaw_deg")):
+        columns[name] = self.rpy_deg[:, k]
+    if self.planned_rpy_deg is not None:
+        for k, name in enumerate(("planned_roll_deg", "planned_pitch_deg", "planned_yaw_deg")):
+            columns[name] = self.planned_rpy_deg[:, k]
+    for i in range(6):
+        columns[f"T{i + 1}_kN"] = self.tension_kN[:, i]
+    if self.s0_m is not None:
+        for i in range(6):
+            columns[f"s0_{i + 1}_m"] = self.s0_m[:, i]
+    if self.joints is not None:
+        for j, name in enumerate(self.joint_columns):
+            columns[name] = self.joints[:, j]
+    if self.session_labels:
+        columns["session"] = [self.session_labels[k] for k in self.session]
+    columns["line"] = self.line
+    return pandas.DataFrame(columns)
+
+
+Dataset.to_dataframe = _dataset_to_dataframe  # type: ignore[attr-defined]
 Dataset.from_arrays = staticmethod(_dataset_from_arrays)  # type: ignore[attr-defined]
 Dataset.from_dataframe = staticmethod(_dataset_from_dataframe)  # type: ignore[attr-defined]
 

@@ -27,8 +27,9 @@ class TrackResult:
             {value, sigma_total, sigma_formal}, in the spec's units) and
             sensor_offset_kN (cable 1..6 -> the same, when the biases are shared).
         events: dicts of kind ('parameter' or 'sensor'), time_s (the first sample after
-            the change: the later window's first, or its block's inside a window),
-            after_s (the last before), time_low_s and time_high_s (its likelihood
+            the change: the later window's first, or its block's inside a window) and
+            time (the same as events.json writes it, ISO 8601 for Unix times), after_s
+            and after (the last before), time_low/time_high as text too, time_low_s and time_high_s (its likelihood
             interval), window, previous_window, within_window,
             parameters (name -> {shift, sigma_total, unit}), cables (for a sensor),
             statistic, degrees_of_freedom, threshold, p_value (family-wise).
@@ -48,6 +49,7 @@ class TrackResult:
         self.out: str = out
         self.windows: List[Dict[str, Any]] = raw["windows"]
         self.events: List[Dict[str, Any]] = raw["events"]
+        self._add_event_times()
         self.wander: List[Dict[str, Any]] = raw["wander"]
         self.shared: List[Dict[str, Any]] = raw["shared"]
         self.window_parameters: List[str] = raw["window_parameters"]
@@ -62,6 +64,38 @@ class TrackResult:
         self.folds: int = raw["folds"]
         self.updated: bool = raw["updated"]
         self.notes: List[str] = raw["notes"]
+
+    def _add_event_times(self) -> None:
+        """The events' times as events.json writes them (ISO 8601 in the data's zone for
+        Unix times): time, after, time_low, time_high beside their _s numbers."""
+        import json
+
+        try:
+            with open(os.path.join(self.out, "events.json"), encoding="utf-8") as f:
+                written = json.load(f).get("events", [])
+        except (OSError, ValueError):
+            return
+        if len(written) != len(self.events):
+            return
+        for event, text in zip(self.events, written):
+            for key in ("time", "after", "time_low", "time_high"):
+                if key in text and key not in event:
+                    event[key] = text[key]
+
+    def to_dataframe(self) -> Any:
+        """The windows as a pandas DataFrame, one row per window (index: its label):
+        start_s, end_s, samples, reduced_chi_square, and per per-window parameter its
+        value and NAME_sigma_total, as track.csv has them."""
+        import pandas
+
+        rows = []
+        for w in self.windows:
+            row = {k: w[k] for k in ("start_s", "end_s", "samples", "reduced_chi_square")}
+            for name, e in w["estimates"].items():
+                row[name] = e["value"]
+                row[f"{name}_sigma_total"] = e["sigma_total"]
+            rows.append(row)
+        return pandas.DataFrame(rows, index=[w["label"] for w in self.windows])
 
     def estimates(self, name: str) -> Tuple[np.ndarray, np.ndarray]:
         """A per-window parameter's estimates and sigma_total over the windows, (n,) each."""
@@ -108,6 +142,7 @@ def track(
     refold: bool = False,
     force: bool = False,
     columns: Optional[ColumnsLike] = None,
+    quiet: bool = False,
 ) -> TrackResult:
     """The mass centre and the sensors through a season of telemetry (`fastcal track`).
 
@@ -136,6 +171,8 @@ def track(
         force: `out` holds a track of another model, spec or windowing: build it afresh.
         columns: a column map (a file or a dict, as read_dataset takes) through which
             every data file is read: an export as it comes, ISO 8601 times included.
+        quiet: no progress lines ("fastcal.track: ..." on sys.stderr, as the command
+            line prints them).
 
     Raises:
         InputError: bad data, spec, window or directory. CalibrationError: a pose the
@@ -163,7 +200,7 @@ def track(
     raw = _map_errors(
         lambda: _fastcal.track(
             model, spec_text, is_text, source, paths, os.fspath(out), window, threads, refold,
-            force, map_text, map_source, fold_many,
+            force, map_text, map_source, fold_many, quiet,
         )
     )
     return TrackResult(raw, os.fspath(out))

@@ -12,6 +12,7 @@
 
 #include <Eigen/Core>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -26,6 +27,18 @@
 namespace fastcal::python {
 
 namespace py = pybind11;
+
+// Progress lines on Python's sys.stderr (a notebook shows them; the C++ stream it does
+// not), the GIL taken for each write; an error in writing is not the computation's.
+inline std::function<void(const std::string&)> ProgressTo(const std::string& prefix) {
+  return [prefix](const std::string& line) {
+    py::gil_scoped_acquire gil;
+    try {
+      py::module_::import("sys").attr("stderr").attr("write")(prefix + line + "\n");
+    } catch (const py::error_already_set&) {
+    }
+  };
+}
 
 inline constexpr double kNPerKn = 1e3;
 

@@ -2,6 +2,8 @@
 // values and numpy arrays, in the units of the spec and the report (tensions in kN).
 #include <pybind11/stl.h>
 
+#include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -11,6 +13,8 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/report.h"
+#include "fastcal/version.h"
 
 namespace fastcal::python {
 namespace {
@@ -271,24 +275,60 @@ CalibrationSpec Spec(const CableRobot& model, const std::string& path_or_text, b
   return spec;
 }
 
-py::dict Calibrate(const CableRobot& model_argument, const std::string& spec_path_or_text,
-                   bool spec_is_text, const std::string& spec_source, const Dataset& data) {
+// What a calibration's report needs after the call (CalibrationResult.report_html()):
+// held by the Python result, opaque there. The data stay the caller's Dataset object.
+struct CalibrationState {
+  CableRobot model;
+  CalibrationSpec spec;
+  CalibrationResult result;
+  std::string spec_source;
+};
+
+py::tuple Calibrate(const CableRobot& model_argument, const std::string& spec_path_or_text,
+                    bool spec_is_text, const std::string& spec_source, const Dataset& data,
+                    bool quiet) {
   // A copy, taken with the GIL held: the fit runs without it, while another thread may
   // assign to the model's fields (issue 29). The Dataset has no setters.
-  const CableRobot model = model_argument;
-  ValidateModel(model);
-  const CalibrationSpec spec = Spec(model, spec_path_or_text, spec_is_text, spec_source);
-  CalibrationResult result;
+  auto state = std::make_shared<CalibrationState>();
+  state->model = model_argument;
+  ValidateModel(state->model);
+  state->spec = Spec(state->model, spec_path_or_text, spec_is_text, spec_source);
+  state->spec_source = spec_source;
   std::string error;
   CalibrationStatus status;
+  CalibrationOptions options;
+  if (!quiet) options.progress = ProgressTo("fastcal.calibrate: ");
   {
     py::gil_scoped_release release;
     // Calibrate's evaluation stage fills result.variants (the before/after table).
-    status = fastcal::Calibrate(model, spec, data, CalibrationOptions(), &result, &error);
+    status = fastcal::Calibrate(state->model, state->spec, data, options, &state->result, &error);
   }
   if (status == CalibrationStatus::kInvalidInput) throw InputError(error);
   if (status != CalibrationStatus::kOk) throw CalibrationError(StatusName(status), error);
-  return ResultDict(result);
+  return py::make_tuple(ResultDict(state->result), state);
+}
+
+// The report of a calibration (report.h) as Markdown or HTML, from its state and data.
+std::string CalibrationReport(const CalibrationState& state, const Dataset& data,
+                              const std::string& kind, const std::string& data_name) {
+  ReportInputs inputs;
+  inputs.spec_path = state.spec_source;
+  inputs.data_path = data_name;
+  inputs.software_version = FASTCAL_VERSION;
+  inputs.command_line = "fastcal.calibrate (Python)";
+  inputs.initial_model = &state.model;
+  inputs.spec = &state.spec;
+  inputs.data = &data;
+  inputs.result = &state.result;
+  inputs.variants = state.result.variants;
+  inputs.evaluation_method = "exact";
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    text = kind == "html" ? ReportHtml(inputs) : ReportMarkdown(inputs);
+  }
+  if (text.empty()) throw std::bad_alloc();
+  return text;
 }
 
 py::dict Evaluate(const CableRobot& model_argument, const Dataset& data,
@@ -330,8 +370,11 @@ py::dict SpecNoise(const CableRobot& model, const std::string& spec_path_or_text
 void BindCalibration(py::module_& m) {
   m.def("spec_noise", &SpecNoise, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
         py::arg("spec_source"));
+  py::class_<CalibrationState, std::shared_ptr<CalibrationState>>(m, "_CalibrationState");
   m.def("calibrate", &Calibrate, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
-        py::arg("spec_source"), py::arg("data"));
+        py::arg("spec_source"), py::arg("data"), py::arg("quiet") = true);
+  m.def("calibration_report", &CalibrationReport, py::arg("state"), py::arg("data"),
+        py::arg("kind"), py::arg("data_name"));
   m.def("evaluate", &Evaluate, py::arg("model"), py::arg("data"), py::arg("method"));
 }
 

@@ -141,7 +141,7 @@ py::dict Track(const CableRobot& model, const std::string& spec_path_or_text, bo
                const std::string& spec_source, const std::vector<std::string>& data,
                const std::string& out, const std::string& window_text, int threads, bool refold,
                bool force, const std::string& map_text, const std::string& map_source,
-               const py::object& fold_many) {
+               const py::object& fold_many, bool quiet) {
   CalibrationSpec spec;
   std::string error;
   if (!spec_is_text) RequireExistingFile(spec_path_or_text, "spec");
@@ -156,6 +156,7 @@ py::dict Track(const CableRobot& model, const std::string& spec_path_or_text, bo
   options.threads = threads;
   options.refold_all = refold;
   options.force = force;
+  if (!quiet) options.progress = ProgressTo("fastcal.track: ");
   options.read.columns = MapOrThrow(map_text, map_source, false, false);
   if (!fold_many.is_none()) {
     options.runner = [&fold_many](const std::vector<std::string>& tasks,
@@ -203,7 +204,7 @@ void BindTrack(py::module_& m) {
   m.def("track", &Track, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
         py::arg("spec_source"), py::arg("data"), py::arg("out"), py::arg("window"),
         py::arg("threads"), py::arg("refold"), py::arg("force"), py::arg("map_text"),
-        py::arg("map_source"), py::arg("fold_many"));
+        py::arg("map_source"), py::arg("fold_many"), py::arg("quiet") = true);
   m.def("fold_task", &FoldTaskBytes, py::arg("task"));
 }
 
