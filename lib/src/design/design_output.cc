@@ -28,15 +28,13 @@ std::string CommentLines(const std::string& text) {
   return out;
 }
 
-// Unit of free parameter k for display: mm for lengths, else the spec's unit.
+// Unit of free parameter k for display: the spec's, the one in its name, as on the
+// console and in design.json (issue 39: the page said mm where they said m).
 struct Shown {
   double scale;  // displayed value = SI value * scale
   std::string unit;
 };
-Shown ShownUnit(const Design& d, int k) {
-  if (d.free_units[k] == "m") return {1e3, "mm"};
-  return {1.0 / d.free_to_si[k], d.free_units[k]};
-}
+Shown ShownUnit(const Design& d, int k) { return {1.0 / d.free_to_si[k], d.free_units[k]}; }
 
 // A free parameter's value in the spec's unit, its name's (sensor_bias_kN in kN): the
 // library is SI inside, the files speak as the spec and calibrate's outputs do.
