@@ -77,6 +77,7 @@ def __dir__() -> List[str]:
 
 # The modules mirror the library's layers; this file only gathers what they offer.
 from ._common import STATUS_NAMES, ArrayLike, PathLike  # noqa: F401
+from . import model as _model_names  # noqa: F401  (Model.mass_centre_m)
 from .statics import (  # noqa: F401
     STABILITY_NAMES,
     ColumnsLike,

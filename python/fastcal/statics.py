@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from typing import Any, Dict, List, Mapping, Optional, Union
 
 import numpy as np
@@ -34,8 +35,10 @@ class StaticsResult:
         messages: per failed pose index, the full account (the CLI's words).
         end_residual_m: per pose, how far the returned state misses the catenaries' end
             conditions (largest over the cables), (n,); ~0 for 'exact'.
-        error_estimate: per pose, the relative tension error those misses imply, (n,):
-            the check behind every 'ok' (docs/model.md, "Checks and statuses").
+        error_estimate_pct: per pose, the relative tension error those misses imply, in
+            percent as the command line's error_estimate_pct, (n,): the check behind
+            every 'ok' (docs/model.md, "Checks and statuses"). (error_estimate, the same
+            as a fraction, is deprecated.)
 
     A failed pose has NaN tensions, forces and unstretched lengths (its chord is
     geometry and stays), with `status` saying why: np.nanmean skips it, a plain mean
@@ -54,10 +57,19 @@ class StaticsResult:
         self.force_kN: np.ndarray = pick(raw["force_kN"])
         self.chord_m: np.ndarray = pick(raw["chord_m"])
         self.end_residual_m = pick(raw["end_residual_m"])
-        self.error_estimate = pick(raw["error_estimate"])
+        self.error_estimate_pct = pick(100.0 * raw["error_estimate"])
+        self._error_fraction = pick(raw["error_estimate"])
         self.status = pick(status)
         self.ok = pick(codes == 0)
         self.cable = pick(raw["cable"] + 1)
+
+    @property
+    def error_estimate(self) -> Any:
+        """Deprecated: error_estimate_pct / 100 (the command line's name and unit)."""
+        warnings.warn("StaticsResult.error_estimate (a fraction) is now error_estimate_pct "
+                      "(percent), as the command line's column", DeprecationWarning,
+                      stacklevel=2)
+        return self._error_fraction
 
     def __len__(self) -> int:
         return 1 if self._single else len(self.ok)

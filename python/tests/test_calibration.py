@@ -65,7 +65,7 @@ def test_estimates_sigmas_and_tables(result: fastcal.CalibrationResult) -> None:
     before = result.rms_kN["initial model, measured attitude"]
     after = result.rms_kN["calibrated model, measured attitude"]
     assert after.shape == (6,) and (after < before).all()
-    np.testing.assert_array_equal(result.model.mass_centre_cabin_m[:2], [
+    np.testing.assert_array_equal(result.model.mass_centre_m[:2], [
         result.estimates["mass_centre_m.x"], result.estimates["mass_centre_m.y"]])
 
 

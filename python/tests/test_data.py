@@ -81,7 +81,7 @@ def test_attitudes_in_radians_are_refused_as_the_cli_does(
 
 def test_simulate_is_reproducible_and_round_trips(tmp_path: pathlib.Path) -> None:
     truth = fastcal.Model.nominal()
-    truth.mass_centre_cabin_m = [0.22, 0.11, 0.5]
+    truth.mass_centre_m = [0.22, 0.11, 0.5]
     p = fastcal.arc(centre_m=(0, 0, 156.73), radius_m=71.11, nodes=24)
     q = fastcal.focal_attitude(p)
     data, used, summary = fastcal.simulate(
@@ -90,7 +90,7 @@ def test_simulate_is_reproducible_and_round_trips(tmp_path: pathlib.Path) -> Non
     again, _, _ = fastcal.simulate(p, quat=q, model=truth, seed=3, tension_noise_percent=1.0)
     np.testing.assert_array_equal(data.tension_kN, again.tension_kN)
     assert summary["samples"] == 24 and summary["tension_noise_rms_kN"].shape == (6,)
-    np.testing.assert_array_equal(used.mass_centre_cabin_m, [0.22, 0.11, 0.5])
+    np.testing.assert_array_equal(used.mass_centre_m, [0.22, 0.11, 0.5])
     # Noise-free, the readings are the truth's tensions.
     clean, _, _ = fastcal.simulate(p, quat=q, model=truth, tension_noise_percent=0.0)
     exact = fastcal.solve(p, rpy_deg=clean.planned_rpy_deg, model=truth)

@@ -84,7 +84,7 @@ def test_setters_refuse_what_the_model_file_reader_refuses(tmp_path: pathlib.Pat
         ("gravity_m_per_s2", -1.0, r"model: gravity_m_per_s2: -1 m/s\^2 is above"),
         ("sensor_gain", [math.nan, 1, 1, 1, 1, 1], r"model: sensor_gain\[0\]: must be > 0"),
         ("linear_density_kg_per_m", [11.718] * 5 + [0.011718], r"linear_density_kg_per_m\[5\]"),
-        ("mass_centre_cabin_m", [0.0, 0.0, 500.0], r"mass_centre_cabin_m\[2\]: 500 m"),
+        ("mass_centre_m", [0.0, 0.0, 500.0], r"mass_centre_m\[2\]: 500 m"),
         ("reflector", {"radius_m": 1e-9, "aperture_m": 1e-9}, r"reflector\.radius_m"),
         ("tower_top_m", np.tile([300.0, 0.0, 270.0], (6, 1)), r"tower_top_m\[1\]"),
         ("anchor_index", [0, 0, 1, 1, 2, 7], r"anchor_index\[5\]"),

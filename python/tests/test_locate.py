@@ -74,11 +74,11 @@ def test_top_heavy_cabin_is_refused_as_implausible() -> None:
     # and not unique (tests/locate_test.cc); Python, like the model files, refuses such a
     # model before locating with it, naming the value and the plausible range.
     model = fastcal.Model.nominal()
-    with pytest.raises(fastcal.InputError, match=r"mass_centre_cabin_m\[2\]: 12 m is beyond"):
-        model.mass_centre_cabin_m = [0.0, 0.0, 12.0]
+    with pytest.raises(fastcal.InputError, match=r"mass_centre_m\[2\]: 12 m is beyond"):
+        model.mass_centre_m = [0.0, 0.0, 12.0]
         fastcal.locate([K1_LENGTH_M] * 6, model=model)
     # 4.9 m up, within the range, it still hangs stable and alone at K1.
-    model.mass_centre_cabin_m = [0.0, 0.0, 4.9]
+    model.mass_centre_m = [0.0, 0.0, 4.9]
     lengths = fastcal.solve([0.0, 0.0, 140.0], model=model).s0_m
     r = fastcal.locate(lengths, model=model)
     assert r.ok and r.stability == "stable" and r.other_equilibria == 0

@@ -22,7 +22,7 @@ def test_nominal_fields_are_numbers_and_arrays() -> None:
     model = fastcal.Model.nominal()
     assert model.cabin_mass_kg == 30000.0
     assert model.gravity_m_per_s2 == -9.8
-    np.testing.assert_array_equal(model.mass_centre_cabin_m, [0.0, 0.0, 0.5])
+    np.testing.assert_array_equal(model.mass_centre_m, [0.0, 0.0, 0.5])
     assert model.anchor_points_cabin_m.shape == (3, 3)
     assert model.tower_top_m.shape == (6, 3)
     np.testing.assert_array_equal(model.tower_top_m[:, 2], np.full(6, 270.0))
@@ -85,13 +85,13 @@ def test_a_missing_file_is_file_not_found_as_open_raises(
 
 def test_fields_are_set_by_whole_arrays(tmp_path: pathlib.Path) -> None:
     model = fastcal.Model.nominal()
-    model.mass_centre_cabin_m = [0.22, 0.11, 0.5]
+    model.mass_centre_m = [0.22, 0.11, 0.5]
     model.linear_density_kg_per_m = np.linspace(11.0, 12.0, 6)
     model.cabin_mass_kg = 30500.0
     path = tmp_path / "model.yaml"
     model.save(str(path), "edited in Python")
     again = fastcal.Model.load(str(path))
-    np.testing.assert_array_equal(again.mass_centre_cabin_m, [0.22, 0.11, 0.5])
+    np.testing.assert_array_equal(again.mass_centre_m, [0.22, 0.11, 0.5])
     np.testing.assert_array_equal(again.linear_density_kg_per_m, np.linspace(11.0, 12.0, 6))
     assert again.cabin_mass_kg == 30500.0
     assert path.read_text().startswith("# edited in Python")
@@ -101,8 +101,8 @@ def test_wrong_shape_is_an_input_error_naming_the_field() -> None:
     model = fastcal.Model.nominal()
     with pytest.raises(fastcal.InputError, match="ea_n must have shape \\(6,\\)"):
         model.ea_n = [1.0, 2.0]
-    with pytest.raises(ValueError, match="mass_centre_cabin_m"):
-        model.mass_centre_cabin_m = [0.0, 0.0]
+    with pytest.raises(ValueError, match="mass_centre_m"):
+        model.mass_centre_m = [0.0, 0.0]
 
 
 def test_bad_model_file_names_file_and_key(tmp_path: pathlib.Path) -> None:

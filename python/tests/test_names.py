@@ -26,7 +26,7 @@ def test_model_arrays_cannot_be_edited_in_place_to_no_effect() -> None:
         "linear_density_kg_per_m",
         "sensor_gain",
         "sensor_bias_kN",
-        "mass_centre_cabin_m",
+        "mass_centre_m",
         "anchor_points_cabin_m",
         "tower_top_m",
         "anchor_index",
@@ -107,3 +107,17 @@ def test_design_sigmas_are_in_the_units_their_names_carry() -> None:
     assert d["design"]["sigma_total"]["mass_centre_m.x"] < 0.1  # metres
     with pytest.warns(DeprecationWarning, match="sample_interval_s"):
         fastcal.design(spec, 30, off_axis_step_deg=5.0, azimuth_step_deg=30.0, sample_interval_s=2)
+
+
+def test_one_name_per_quantity_and_the_old_ones_warn() -> None:
+    # The model's mass centre as the model file and calibrate name it; the statics'
+    # error estimate in percent as the command line's column.
+    model = fastcal.Model.nominal()
+    np.testing.assert_array_equal(model.mass_centre_m, [0.0, 0.0, 0.5])
+    with pytest.warns(DeprecationWarning, match="mass_centre_m"):
+        np.testing.assert_array_equal(model.mass_centre_cabin_m, model.mass_centre_m)
+    with pytest.raises(ValueError, match=r"mass_centre_m\[2\]"):
+        model.mass_centre_m = [0.0, 0.0, 500.0]
+    result = fastcal.solve([0.0, 0.0, 150.0])
+    with pytest.warns(DeprecationWarning, match="error_estimate_pct"):
+        assert result.error_estimate * 100 == result.error_estimate_pct

@@ -26,7 +26,7 @@ def _circle(nodes: int) -> np.ndarray:
 def _survey(mass_centre_m, seed: int, **options) -> fastcal.Dataset:
     positions = _circle(120)
     truth = fastcal.Model.nominal()
-    truth.mass_centre_cabin_m = np.asarray(mass_centre_m, dtype=float)
+    truth.mass_centre_m = np.asarray(mass_centre_m, dtype=float)
     data, _, _ = fastcal.simulate(
         positions, quat=fastcal.focal_attitude(positions), model=truth, seed=seed, **options
     )
@@ -49,7 +49,7 @@ def test_two_files_are_two_sessions_and_the_joint_fit_finds_the_move(
     assert (x["from"], x["to"]) == ("before", "after")
     assert abs(x["difference"] - 0.06) < 4.0 * x["sigma_total"]
     assert x["difference"] / x["sigma_total"] > 3.0
-    after = result.session_models["after"].mass_centre_cabin_m
+    after = result.session_models["after"].mass_centre_m
     assert after[0] == pytest.approx(result.estimates["mass_centre_m.x@after"])
     assert "moved mass_centre_m.x" in result.verdict_text
     assert result.change_scan is None and result.changes == []

@@ -26,7 +26,7 @@ def _season(path: pathlib.Path, days: int = DAYS) -> None:
     and cable 5's sensor re-zeroed before day 4."""
     positions = fastcal.random_workspace(samples=days * PER_DAY, seed=5)
     truth = fastcal.Model.nominal()
-    truth.mass_centre_cabin_m = np.array([0.22, 0.11, 0.5])
+    truth.mass_centre_m = np.array([0.22, 0.11, 0.5])
     data, _, _ = fastcal.simulate(
         positions,
         quat=fastcal.focal_attitude(positions),
