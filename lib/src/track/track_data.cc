@@ -1,12 +1,15 @@
 // A track's data and directory (track.h, track_run.h): the files read into the window
 // store, the state saved for an update (track_state.json), and the directory made whole
 // at the end or put back as it was on failure.
+#include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <map>
@@ -18,9 +21,16 @@
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/window_store.h"
 #include "fastcal/sessions.h"
+#include "fastcal/time_text.h"
 #include "track/track_run.h"
+#include "util/yaml_document.h"
 
 namespace fastcal::internal {
+
+TrackRun::Lock::~Lock() {
+  if (fd >= 0) ::close(fd);  // releases the flock
+}
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -78,6 +88,8 @@ std::string StateJson(const TrackRun& run) {
     j.Key("samples").Int(w.samples);
     j.Key("used").Bool(w.used);
     j.Key("fold").String(w.fold_file);
+    j.Key("fold_sha256").String(w.fold_sha256);
+    j.Key("store_bytes").Int(w.store_bytes);
     j.Key("files").BeginArray();
     for (int f : w.files) j.Int(f);
     j.EndArray();
@@ -129,8 +141,19 @@ struct SavedState {
   std::vector<TrackWindowState> windows;
   std::vector<std::pair<std::string, SharedEntry>> shared;  // by name
 };
+// A window label as this program makes them (a date, "t123", a file's stem): names a
+// store and a fold inside DIR, so one that could reach outside it is refused.
+bool IsSafeLabel(const std::string& label) {
+  if (label.empty() || label.size() > 200 || label[0] == '.') return false;
+  return std::all_of(label.begin(), label.end(), [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '-' || c == '_' || c == '.' ||
+           c == ':' || c == '+' || c == ' ';
+  });
+}
+
 SavedState ParseState(const std::string& text) {
-  const YAML::Node root = YAML::Load(text);
+  // The nesting guard of every YAML reader (16 MiB of '[' took 3.9 GB through YAML::Load).
+  const YAML::Node root = LoadYamlDocuments(text).first;
   if (Text(root["format"]) != kStateFormat) {
     throw YAML::Exception(root["format"].Mark(), "not a " + std::string(kStateFormat));
   }
@@ -158,6 +181,14 @@ SavedState ParseState(const std::string& text) {
     w.samples = Integer(n["samples"]);
     w.used = Text(n["used"]) == "true";
     w.fold_file = Text(n["fold"]);
+    if (!IsSafeLabel(w.label) ||
+        (!w.fold_file.empty() && w.fold_file.rfind("folds/" + w.label + ".g", 0) != 0)) {
+      throw YAML::Exception(n["label"].Mark(),
+                            "window label or fold '" + w.label + "' is not one this program "
+                            "writes (a path outside the track?)");
+    }
+    if (n["fold_sha256"]) w.fold_sha256 = Text(n["fold_sha256"]);
+    if (n["store_bytes"]) w.store_bytes = Integer(n["store_bytes"]);
     for (const YAML::Node& f : n["files"]) w.files.push_back(static_cast<int>(Integer(f)));
     w.dirty = false;
     s.windows.push_back(std::move(w));
@@ -225,6 +256,87 @@ std::string Mismatch(const TrackRun& run, const SavedState& s) {
   return "";
 }
 
+// The window stores as the state records them (issue 37): a store longer than its
+// committed length holds an interrupted run's samples, cut off (they are read again with
+// their file); a shorter one, or a file index out of range, is a damaged track; stores
+// of windows the state does not know are an interrupted run's, removed.
+bool CheckStores(TrackRun& run) {
+  std::error_code ec;
+  for (const TrackWindowState& w : run.windows) {
+    for (int f : w.files) {
+      if (f < 0 || f >= static_cast<int>(run.files.size())) {
+        *run.error = run.Path(kStateFile) + ": window " + w.label + " names file " +
+                     std::to_string(f) + " of " + std::to_string(run.files.size()) +
+                     ": a damaged state; --force rebuilds the track from the data";
+        return false;
+      }
+    }
+    const std::string store = run.Path("windows/" + w.StoreName());
+    if (w.store_bytes < 0) continue;  // a state of an older version: not recorded
+    const auto size = fs::exists(store, ec) ? static_cast<long long>(fs::file_size(store, ec)) : 0;
+    if (ec || size < w.store_bytes) {
+      *run.error = store + ": " + std::to_string(size) + " bytes where the state records " +
+                   std::to_string(w.store_bytes) +
+                   ": the track's samples are damaged; --force rebuilds it from the data";
+      return false;
+    }
+    if (size > w.store_bytes) {
+      fs::resize_file(store, static_cast<std::uintmax_t>(w.store_bytes), ec);
+      if (ec) {
+        *run.error = store + ": cannot cut back an interrupted run's samples: " + ec.message();
+        return false;
+      }
+      run.result->notes.push_back("repaired " + w.StoreName() + ": " +
+                                  std::to_string(size - w.store_bytes) +
+                                  " bytes an interrupted run appended were removed (their "
+                                  "files are read again)");
+    }
+  }
+  for (const fs::directory_entry& e : fs::directory_iterator(run.Path("windows"), ec)) {
+    const std::string name = e.path().filename().string();
+    if (std::none_of(run.windows.begin(), run.windows.end(),
+                     [&](const TrackWindowState& w) { return w.StoreName() == name; })) {
+      fs::remove(e.path(), ec);
+      run.result->notes.push_back("repaired: " + name + " of an interrupted run removed");
+    }
+  }
+  return true;
+}
+
+// Each window's fold, checked against the state's SHA-256 (a fold copied from another
+// window or run, or edited, is refused by name) and read. With --refold a bad fold is
+// dropped instead: the window is folded again from its store.
+bool LoadFolds(TrackRun& run) {
+  for (TrackWindowState& w : run.windows) {
+    if (w.fold_file.empty()) continue;
+    const std::string path = run.Path(w.fold_file);
+    std::string digest, why;
+    bool ok = true;
+    if (!w.fold_sha256.empty() && (!FileSha256(path, &digest, &why) || digest != w.fold_sha256)) {
+      why = path + ": " + (why.empty() ? "not the fold this track wrote (its SHA-256 differs "
+                                         "from track_state.json's)"
+                                       : why);
+      ok = false;
+    }
+    if (ok && !LoadFold(run, &w, &why)) ok = false;
+    if (!ok) {
+      if (!run.options.refold_all) {
+        *run.error = why + "; --refold folds the window again from its samples";
+        return false;
+      }
+      run.result->notes.push_back("refolded " + w.label + ": " + why);
+      w.fold_file.clear();
+      w.fold_sha256.clear();
+      w.has_fold = false;
+      w.dirty = true;
+      continue;
+    }
+    w.has_fold = true;
+    w.theta = w.fold.theta_si;
+  }
+  return true;
+}
+
 bool LoadSavedState(TrackRun& run, bool* use) {
   std::string text;
   if (!ReadRegularFile(run.Path(kStateFile), 16LL << 20, "track state", &text, run.error)) {
@@ -252,12 +364,7 @@ bool LoadSavedState(TrackRun& run, bool* use) {
   run.slow = s.slow;
   run.files = std::move(s.files);
   run.windows = std::move(s.windows);
-  for (TrackWindowState& w : run.windows) {
-    if (w.fold_file.empty()) continue;
-    if (!LoadFold(run, &w, run.error)) return false;
-    w.has_fold = true;
-    w.theta = w.fold.theta_si;
-  }
+  if (!CheckStores(run) || !LoadFolds(run)) return false;
   for (const auto& [name, entry] : s.shared) {
     for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
       if (run.layout.Column(run.layout.shared_columns[j]).name != name) continue;
@@ -283,6 +390,7 @@ struct Router {
   std::map<long long, int> window_of_key;  // into run.windows
   std::map<int, std::vector<StoredSample>> buffers;
   size_t buffered = 0;
+  int relative_file = -1;  // the file (index) whose times are relative, if one is
 
   explicit Router(TrackRun& r) : run(r) {
     for (size_t w = 0; w < run.windows.size(); ++w)
@@ -360,6 +468,15 @@ bool ReadFile(Router& router, const std::string& path, std::string* error) {
   std::error_code ec;
   file.bytes = static_cast<long long>(fs::file_size(path, ec));
   if (!FileSha256(path, &file.sha256, error)) return false;
+  // Data given twice (a copy, a hard link, a day re-sent; a .csv and its .csv.gz) would
+  // be folded twice: refused by content (issue 37).
+  for (const TrackFile& f : run.files) {
+    if (f.sha256 != file.sha256) continue;
+    *error = path + ": the same data as " + f.path +
+             (run.update ? ", already in the track" : ", given too") +
+             " (SHA-256 of the content): each sample is folded once; drop one";
+    return false;
+  }
   const int index = static_cast<int>(run.files.size());
   const std::string stem = SessionLabelOfPath(path);
   if (run.window.kind == WindowSpec::Kind::kFile && !IsValidSessionLabel(stem)) {
@@ -386,6 +503,19 @@ bool ReadFile(Router& router, const std::string& path, std::string* error) {
       if (run.files_skipped.size() < kMaxSkippedNamed) run.files_skipped.push_back(skipped);
     }
     for (const Sample& s : chunk.samples) {
+      // Relative times (seconds from a file's own start) of two files on one time line of
+      // windows would merge unrelated days (a 10 cm move hidden): one file's relative
+      // times are its own line, two need a window each (issue 37).
+      if (run.window.kind != WindowSpec::Kind::kFile && !IsUnixTime(s.time_s)) {
+        if (router.relative_file >= 0 && router.relative_file != index) {
+          *error = path + ": relative times (" + FormatDouble("%g", s.time_s) +
+                   " s, not Unix times) as in " + run.files[router.relative_file].path +
+                   ": two such files cannot share windows of time; give --window=file (a "
+                   "window per file), or files with Unix or ISO 8601 times";
+          return false;
+        }
+        router.relative_file = index;
+      }
       if (!Route(router, s, index, stem)) return false;
     }
     file.samples += static_cast<long long>(chunk.samples.size());
@@ -442,7 +572,35 @@ TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<s
   return TrackStatus::kOk;
 }
 
+// The exclusive lock on DIR for the run's life: a lock file beside DIR, ".NAME.lock"
+// (beside it, so that a new track's DIR, made only at the end, is locked too). A second
+// run on the same DIR is refused at once, naming it. Leftover staging directories of
+// runs that died (DIR.partial-PID) are removed once the lock is held: none is alive.
+TrackStatus LockDirectory(TrackRun& run) {
+  fs::path out = fs::path(run.out).lexically_normal();
+  if (out.filename().empty()) out = out.parent_path();
+  const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  const std::string lock = (parent / ("." + out.filename().string() + ".lock")).string();
+  run.lock.fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (run.lock.fd < 0) {
+    return run.Fail(TrackStatus::kInvalidInput,
+                    lock + ": cannot create the track's lock: " + std::strerror(errno));
+  }
+  if (::flock(run.lock.fd, LOCK_EX | LOCK_NB) != 0) {
+    return run.Fail(TrackStatus::kFailed,
+                    run.out + ": another fastcal track is running on it (" + lock +
+                        " is locked): wait for it to finish, or give another --out");
+  }
+  std::error_code ec;
+  const std::string partial = out.filename().string() + ".partial-";
+  for (const fs::directory_entry& e : fs::directory_iterator(parent, ec)) {
+    if (e.path().filename().string().rfind(partial, 0) == 0) fs::remove_all(e.path(), ec);
+  }
+  return TrackStatus::kOk;
+}
+
 TrackStatus PrepareDirectory(TrackRun& run) {
+  if (const TrackStatus locked = LockDirectory(run); locked != TrackStatus::kOk) return locked;
   std::error_code ec;
   const bool exists = fs::exists(run.out, ec);
   if (exists && !fs::is_directory(run.out, ec)) {
@@ -520,9 +678,16 @@ TrackStatus SaveState(TrackRun& run) {
     // The residual run served this run's slow-error estimate; an update keeps the process.
     WindowFold kept = w.fold;
     kept.residuals.clear();
-    if (!WriteFileAtomically(run.Path(w.fold_file), SerializeWindowFold(kept), run.error)) {
+    if (!WriteFileAtomically(run.Path(w.fold_file), SerializeWindowFold(kept), run.error) ||
+        !FileSha256(run.Path(w.fold_file), &w.fold_sha256, run.error)) {
       return TrackStatus::kFailed;
     }
+  }
+  // Each store's committed length: appends past it are an interrupted run's (CheckStores).
+  for (TrackWindowState& w : run.windows) {
+    std::error_code ec;
+    const std::string store = run.Path("windows/" + w.StoreName());
+    w.store_bytes = fs::exists(store, ec) ? static_cast<long long>(fs::file_size(store, ec)) : 0;
   }
   if (!WriteFileAtomically(run.Path(kStateFile), StateJson(run), run.error)) {
     return TrackStatus::kFailed;

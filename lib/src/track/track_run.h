@@ -65,6 +65,10 @@ struct TrackWindowState {
   bool has_fold = false;
   WindowFold fold;
   std::vector<double> theta;  // its point, per column (SI)
+  // As the saved state records them (issue 37): the store's committed length (bytes; -1
+  // unknown) and the fold file's SHA-256 ("" unknown).
+  long long store_bytes = -1;
+  std::string fold_sha256;
   std::string StoreName() const { return label + ".samples"; }
 };
 
@@ -111,6 +115,12 @@ struct TrackRun {
   double gross_threshold_sigmas = 5.0;
   // Store files appended to in this run, with their size before (rolled back on failure).
   std::vector<std::pair<std::string, long long>> appended;
+  // The exclusive lock on DIR for the run's whole life (issue 37): a descriptor of
+  // DIR's lock file beside it, closed (and so released) with the run.
+  struct Lock {
+    int fd = -1;
+    ~Lock();
+  } lock;
   // The solve over the used windows (indices into `windows`).
   std::vector<int> used;
   ArrowProblem problem;

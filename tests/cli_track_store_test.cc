@@ -1,0 +1,123 @@
+// The season's store survives interruption, duplication and tampering (issue 37): one
+// run at a time on a track; an update killed after appending samples leaves nothing
+// counted twice; a fold copied from elsewhere is refused (and --refold rebuilds it); the
+// same data given twice, two files of relative times on one time line, a window label
+// reaching outside the track and a state nested without end are refused by name.
+#include <regex>
+#include <string>
+
+#include "cli_fixture.h"
+
+namespace fastcal::test {
+namespace {
+
+class CliTrackStoreTest : public CliTest {
+ protected:
+  void SetUp() override {
+    CliTest::SetUp();
+    // Three days of an hour each from 20:00 UTC, one file per day.
+    for (int d = 1; d <= 3; ++d) {
+      const std::string day = "2024-05-0" + std::to_string(d);
+      ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=1800 --interval-s=2 --seed=" +
+                        std::to_string(d) + " --start=" + day +
+                        "T20:00:00Z --mass-centre=0.22,0.11,0.5 --out=" + Path(day + ".csv"))
+                    .code,
+                0);
+    }
+  }
+  CommandResult Track(const std::string& files, const std::string& out,
+                      const std::string& more = "") {
+    return Fastcal("track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=" +
+                   files + " --out=" + Path(out) + " " + more);
+  }
+  std::string Day(int d) const { return Path("2024-05-0" + std::to_string(d) + ".csv"); }
+};
+
+TEST_F(CliTrackStoreTest, ASecondRunOnTheSameTrackIsRefused) {
+  // The lock is held as a running track holds it: the second run exits 1 at once.
+  const CommandResult r = Shell("flock " + Path(".t.lock") + " " + Bin() + " track --spec=" +
+                                Source() + "/calibration_data/spec_track.yaml --data=" + Day(1) +
+                                " --out=" + Path("t"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("another fastcal track is running on it"), std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(Path("t")));
+}
+
+TEST_F(CliTrackStoreTest, AnInterruptedUpdateCountsNothingTwice) {
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "clean").code, 0);
+  ASSERT_EQ(Track(Day(1) + "," + Day(2) + "," + Day(3), "clean").code, 0);  // its update
+  // An update killed after appending day 2's samples again and day 3's to a new store,
+  // before the state was saved: what the stores hold then.
+  ASSERT_EQ(Shell("cd " + Path("t/windows") + " && cp 2024-05-02.samples 2024-05-03.samples" +
+                  " && cp 2024-05-02.samples again && cat again >> 2024-05-02.samples && rm again")
+                .code,
+            0);
+  const CommandResult r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("interrupted run"), std::string::npos) << r.output;
+  // The repaired track is the one an uninterrupted update gives, to the digit (samples
+  // appended twice would change every window's numbers and counts).
+  const std::string kept = ReadFile(Path("t/track.csv"));
+  const std::string clean = ReadFile(Path("clean/track.csv"));
+  EXPECT_EQ(kept.substr(kept.find('\n')), clean.substr(clean.find('\n')));
+}
+
+TEST_F(CliTrackStoreTest, AFoldFromElsewhereIsRefusedAndRefoldRebuildsIt) {
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
+  ASSERT_EQ(Shell("cd " + Path("t/folds") + " && cp 2024-05-01.g1.fold 2024-05-02.g1.fold").code,
+            0);
+  CommandResult r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("2024-05-02.g1.fold: not the fold this track wrote"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("--refold"), std::string::npos) << r.output;
+  r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t", "--refold");
+  EXPECT_EQ(r.code, 0) << r.output;
+}
+
+TEST_F(CliTrackStoreTest, TheSameDataTwiceIsRefusedByContent) {
+  ASSERT_EQ(Shell("cp " + Day(1) + " " + Path("copy.csv") + " && gzip -k " + Day(2)).code, 0);
+  CommandResult r = Track(Day(1) + "," + Path("copy.csv"), "a");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("copy.csv: the same data as"), std::string::npos) << r.output;
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "b").code, 0);
+  r = Track(Day(1) + "," + Day(2) + "," + Day(2) + ".gz", "b");  // the day re-sent gzipped
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("already in the track"), std::string::npos) << r.output;
+}
+
+TEST_F(CliTrackStoreTest, RelativeTimesOfTwoFilesNeedAWindowEach) {
+  for (int k = 1; k <= 2; ++k) {
+    ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=300 --seed=" + std::to_string(k) +
+                      " --out=" + Path("rel" + std::to_string(k) + ".csv"))
+                  .code,
+              0);
+  }
+  const std::string both = Path("rel1.csv") + "," + Path("rel2.csv");
+  CommandResult r = Track(both, "a", "--window=1h");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("give --window=file"), std::string::npos) << r.output;
+  r = Track(both, "b", "--window=file");
+  EXPECT_EQ(r.code, 0) << r.output;
+}
+
+TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
+  const std::string state = ReadFile(Path("t/track_state.json"));
+  Write("t/track_state.json",
+        std::regex_replace(state, std::regex("\"label\": \"2024-05-02\""),
+                           "\"label\": \"../../escape\""));
+  CommandResult r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("is not one this program writes"), std::string::npos) << r.output;
+  Write("t/track_state.json", std::string(1 << 20, '['));
+  r = RunBoundedAndExpect({"track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=" +
+                               Day(1) + " --out=" + Path("t"),
+                           2, "nesting deeper than"});
+}
+
+}  // namespace
+}  // namespace fastcal::test
