@@ -1,5 +1,8 @@
 // fastcal: statics and calibration of the FAST cable robot from the command line.
 #include <gflags/gflags.h>
+#include <unistd.h>
+
+#include <csignal>
 #include <glog/logging.h>
 
 #include <cstring>
@@ -12,6 +15,7 @@
 #include "cli_util.h"
 #include "commands.h"
 #include "fastcal/internal/quote.h"
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/version.h"
 
 namespace fastcal::cli {
@@ -96,8 +100,33 @@ int RunCommand(const std::string& command, int argc, char** argv) {
 }  // namespace
 }  // namespace fastcal::cli
 
+namespace {
+
+// SIGINT (Ctrl-C) and SIGTERM stop a command cleanly (issue 37): the temporaries it was
+// writing are removed, nothing half-written is left where a result goes, and it exits
+// 128 + the signal (130, 143) as a shell expects. What a killed run leaves (a staging
+// directory, a track store's uncommitted samples) the next run removes or repairs.
+extern "C" void StopOnSignal(int signal_number) {
+  fastcal::internal::RemoveTemporariesOnSignal();
+  const char message[] = "\nfastcal: interrupted: stopped, nothing half-written left\n";
+  const ssize_t ignored = ::write(2, message, sizeof(message) - 1);
+  (void)ignored;
+  ::_exit(128 + signal_number);
+}
+
+void InstallSignalHandlers() {
+  struct sigaction action {};
+  action.sa_handler = StopOnSignal;
+  sigemptyset(&action.sa_mask);
+  ::sigaction(SIGINT, &action, nullptr);
+  ::sigaction(SIGTERM, &action, nullptr);
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   using namespace fastcal::cli;
+  InstallSignalHandlers();
   google::InitGoogleLogging(argv[0]);
   FLAGS_logtostderr = true;
   InstallCheckedStdout();  // every result on stdout checked (FinishStandardOutput)

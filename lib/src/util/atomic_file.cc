@@ -71,9 +71,43 @@ void RemoveTree(const std::string& path) {
 
 }  // namespace
 
+namespace {
+
+// The temporaries this process named (TemporaryNameFor), for RemoveTemporariesOnSignal:
+// a ring of fixed slots (no allocation in a signal handler). A name stays after its file
+// is renamed into place: unlinking it then finds nothing, and a temporary's name is never
+// a result's. The oldest names give way first; they are long done.
+constexpr int kTemporarySlots = 64;
+constexpr size_t kTemporaryPathBytes = 4096;
+struct TemporarySlot {
+  std::atomic<bool> ready{false};
+  char path[kTemporaryPathBytes];
+};
+TemporarySlot g_temporaries[kTemporarySlots];
+std::atomic<unsigned> g_next_temporary{0};
+
+void RegisterTemporary(const std::string& path) {
+  if (path.size() >= kTemporaryPathBytes) return;
+  TemporarySlot& slot = g_temporaries[g_next_temporary.fetch_add(1) % kTemporarySlots];
+  slot.ready.store(false);
+  std::memcpy(slot.path, path.c_str(), path.size() + 1);
+  slot.ready.store(true);
+}
+
+}  // namespace
+
 std::string TemporaryNameFor(const std::string& path) {
   static std::atomic<unsigned> counter{0};
-  return path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
+  const std::string name =
+      path + ".tmp." + std::to_string(::getpid()) + "." + std::to_string(counter.fetch_add(1));
+  RegisterTemporary(name);
+  return name;
+}
+
+void RemoveTemporariesOnSignal() {
+  for (TemporarySlot& slot : g_temporaries) {
+    if (slot.ready.load()) ::unlink(slot.path);  // async-signal-safe
+  }
 }
 
 int RemoveStaleTemporaries(const std::string& path) {

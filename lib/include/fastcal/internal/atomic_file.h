@@ -29,6 +29,12 @@ bool WriteFileAtomically(const std::string& path, const std::string& content, st
 // A new unique temporary name beside `path` ("<path>.tmp.<pid>.<n>").
 std::string TemporaryNameFor(const std::string& path);
 
+// Unlinks every temporary this process named with TemporaryNameFor that still exists:
+// async-signal-safe (no allocation, no lock), for a SIGINT/SIGTERM handler, so that an
+// interrupted command leaves no half-written file (issue 37). Staging directories are
+// left to the next run, which removes them once their process is gone.
+void RemoveTemporariesOnSignal();
+
 // Removes what killed runs left beside `path` (the names above), only when the process
 // that made them is gone: its pid no longer runs, or the pid was reused (it runs, but
 // nobody holds the temporary's lock and it is over a minute old). A moved-aside previous
