@@ -104,9 +104,13 @@ void Store(const LocateSolution& s, py::ssize_t k, LocateOutputs* out) {
   out->readings.mutable_data()[k] = s.fit.readings;
 }
 
-py::dict Locate(const CableRobot& robot, const DoubleArray& lengths_m,
+py::dict Locate(const CableRobot& model_argument, const DoubleArray& lengths_m,
                 const std::string& attitude_kind, const DoubleArray& attitude,
                 const DoubleArray& tensions_kn, const py::dict& settings) {
+  // A copy taken with the GIL held: the solves run without it while another thread may
+  // assign to the model's fields (issue 37: a segfault before).
+  const CableRobot robot = model_argument;
+  ValidateModel(robot);
   LocateOptions options;
   LocateNoise noise;
   MakeLocateSettings(settings, &options, &noise);

@@ -11,8 +11,10 @@ namespace fastcal::python {
 void BindModes(py::module_& m) {
   m.def(
       "modes",
-      [](const CableRobot& robot, const DoubleArray& position_m, const std::string& attitude_kind,
+      [](const CableRobot& model_argument, const DoubleArray& position_m,
+         const std::string& attitude_kind,
          const DoubleArray& attitude, int segments, int count, bool cable_inertia) {
+        const CableRobot robot = model_argument;  // a copy with the GIL held (issue 37)
         ValidateModel(robot);
         const std::vector<Pose> poses = PosesFromArrays(position_m, attitude_kind, attitude);
         if (poses.size() != 1) throw InputError("modes take one pose");

@@ -137,11 +137,16 @@ const char* StatusName(TrackStatus status) {
 }
 
 // fold_many(list of task bytes) -> list of fold bytes, or None to fold on threads.
-py::dict Track(const CableRobot& model, const std::string& spec_path_or_text, bool spec_is_text,
+py::dict Track(const CableRobot& model_argument, const std::string& spec_path_or_text,
+               bool spec_is_text,
                const std::string& spec_source, const std::vector<std::string>& data,
                const std::string& out, const std::string& window_text, int threads, bool refold,
                bool force, const std::string& map_text, const std::string& map_source,
                const py::object& fold_many, bool quiet) {
+  // A copy with the GIL held: the track runs without it, and wrote another model than the
+  // one it fitted when another thread assigned to this one meanwhile (issue 37).
+  const CableRobot model = model_argument;
+  ValidateModel(model);
   CalibrationSpec spec;
   std::string error;
   if (!spec_is_text) RequireExistingFile(spec_path_or_text, "spec");

@@ -56,6 +56,8 @@ RACE = textwrap.dedent(
         torn += not any(np.array_equal(got, e) for e in expected)
         fastcal.evaluate(data, model=model)
         fastcal.simulate(p[:50], quat=q[:50], model=model, seed=2)
+        # locate too (issue 37: it segfaulted), on its own copy.
+        fastcal.locate(fastcal.solve(p[:5], quat=q[:5]).s0_m, model=model)
     stop = True
     thread.join()
     print("torn", torn)
