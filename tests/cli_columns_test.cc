@@ -241,3 +241,34 @@ TEST_F(CliColumnsTest, AbsoluteTimesReadAsDatesAndSessionsAtTakesTheScansAnswer)
 
 }  // namespace
 }  // namespace fastcal
+
+namespace fastcal {
+namespace {
+
+// Issue 37: tensions in kN under a map's `unit: N` were read 1000x small and calibrate
+// exited 0 with gains of 0.001. The whole file's tensions against the cabin's weight
+// now refuse it, naming the slip.
+TEST_F(CliColumnsTest, TensionsReadInTheWrongUnitAreRefused) {
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=200 --seed=2 --out=" +
+                    Path("s.csv"))
+                .code,
+            0);
+  std::string map = "format: fastcal-columns-1\ntime: time_s\nunmapped: ignore\ncolumns:\n";
+  for (const char* name : {"x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"}) {
+    map += std::string("  ") + name + ": " + name + "\n";
+  }
+  for (int i = 1; i <= 6; ++i) {
+    const std::string t = "T" + std::to_string(i) + "_kN";
+    map += "  " + t + ": {column: " + t + ", unit: N}\n";
+  }
+  Write("map.yaml", map);
+  const test::CommandResult r =
+      Fastcal("calibrate --spec=" + Source() + "/calibration_data/spec_realistic.yaml --data=" +
+              Path("s.csv") + " --columns=" + Path("map.yaml") + " --out=" + Path("cal"));
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("read 1000x small"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(Path("cal")));
+}
+
+}  // namespace
+}  // namespace fastcal

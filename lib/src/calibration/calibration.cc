@@ -2,6 +2,7 @@
 // (Run), called in order by Calibrate. The least-squares problem and its identifiability
 // are here; the linearisation at the solution is calibration_linearisation.cc, the budget
 // and the score test uncertainty.cc, the gross-error screen gross_errors.cc.
+#include "fastcal/tension_scale.h"
 #include "fastcal/calibration.h"
 
 #include <ceres/ceres.h>
@@ -150,7 +151,8 @@ CalibrationStatus ValidateInputs(Run& run) {
                         " models uniform cables, but the model's cables carry attachments; "
                         "use forward_model: exact");
   }
-  if (!CheckJointColumns(run.data, run.model.moving_parts, &why)) {
+  if (!CheckJointColumns(run.data, run.model.moving_parts, &why) ||
+      !CheckTensionScale(run.data, run.model, &why)) {
     return run.Fail(CalibrationStatus::kInvalidInput, why);
   }
   if (run.spec.UsesLengths() && !run.data.has_unstretched_lengths) {

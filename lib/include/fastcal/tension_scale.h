@@ -1,0 +1,25 @@
+// A whole-file check of the tension readings' scale (issue 37): the six cables hold the
+// cabin, so the tensions of a sample sum to at least its weight, m g (the vertical
+// components alone make m g; FAST: 30 t, 294 kN, ~180 kN a cable). A file whose median
+// sum is a third of that or less, or thirty times more, was read in the wrong unit (N
+// declared as kN: 1000x small), not measured so: refused with the likely slip named.
+#ifndef FASTCAL_TENSION_SCALE_H_
+#define FASTCAL_TENSION_SCALE_H_
+
+#include <string>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/dataset.h"
+
+namespace fastcal {
+
+// True when `data` has no tensions or their median sum per sample is within
+// [kMinWeightFraction, kMaxWeightMultiple] of the model's cabin weight; else false with
+// *error naming the file, the median sum and the weight.
+inline constexpr double kMinWeightFraction = 1.0 / 3.0;
+inline constexpr double kMaxWeightMultiple = 30.0;
+bool CheckTensionScale(const Dataset& data, const CableRobot& model, std::string* error);
+
+}  // namespace fastcal
+
+#endif  // FASTCAL_TENSION_SCALE_H_
