@@ -260,6 +260,25 @@ TEST(ColumnMapTest, PoseFilesReadTheModelsJointColumnsThroughAMap) {
   fs::remove_all(dir);
 }
 
+TEST(ColumnMapTest, AThousandsSeparatorUnderADecimalCommaIsRefused) {
+  // "1.234" under decimal: "," is 1234 written German style: read as 1.234 it was 1000x
+  // small (issue 37); now refused, naming the field.
+  const std::string map = MapText(
+      "decimal: \",\"\ndelimiter: \";\"\ntime: t\ncolumns:\n  x_m: X\n  y_m: Y\n  z_m: Z\n"
+      "  roll_deg: R\n  pitch_deg: P\n  yaw_deg: W\n  T1_kN: {column: F1, unit: N}\n"
+      "  T2_kN: F2\n  T3_kN: F3\n  T4_kN: F4\n  T5_kN: F5\n  T6_kN: F6\n");
+  const std::string header = "t;X;Y;Z;R;P;W;F1;F2;F3;F4;F5;F6\n";
+  const std::string row = "0;70,96;4,65;156,73;0,35;-5,3;0,09;214.000;190,2;141,8;149,9;188,6;207,1\n";
+  EXPECT_TRUE(Contains(MappedError(header + row, map),
+                       "column 'F1' (T1_kN, N): '214.000' has a '.' where the map says "
+                       "decimal: \",\": a thousands separator?"));
+  // The same row without the separator reads.
+  const Dataset d = Mapped(header + std::string(row).replace(row.find("214.000"), 7, "214000"),
+                           map);
+  ASSERT_EQ(d.samples.size(), 1u);
+  EXPECT_EQ(d.samples[0].tension_n[0], 214000.0);
+}
+
 TEST(ColumnMapTest, MapErrorsNameTheLikelyFix) {
   // Issue 39: a unit 1000x off names the unit that fits, a decimal comma under '.' asks
   // for decimal: ",", a unit row asks for skip_after_header, every missing entry is
@@ -406,6 +425,10 @@ TEST(ColumnMapTest, ReadsEachTimeFormatAndZone) {
                                        "\n",
                                    MapText("time: " + slashes + "\n" + Columns())),
                        "data.csv:2: column 't'"));
+  // A zone's name is not read (issue 37): %Z refused at the map's line.
+  EXPECT_TRUE(Contains(MapError(MapText("time: {column: t, format: \"%Y-%m-%d %H:%M %Z\", "
+                                        "zone: UTC}\ncolumns: {}\n")),
+                       "map.yaml:2: time.format: %Z (a zone's name) is not read"));
   // Clock times without a zone in the map: an error that asks for one (issue 39; they
   // were read as UTC, a Beijing export 8 hours off).
   for (const char* time : {"{column: t, format: iso8601}", "{column: t, format: \"%Y %H\"}"}) {

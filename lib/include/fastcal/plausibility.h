@@ -42,6 +42,10 @@ struct PlausibilityLimits {
   // Longest unstretched cable length, m: a cable from a tower top to the far side of
   // the workspace is under 700 m.
   double max_unstretched_length_m = 1000.0;
+  // Largest |time_s|, s: Unix times to the year 2286 (FAST saw first light in 2016), or
+  // seconds from a survey's start; one time of 1e300 once moved a calibration by 1.9 cm
+  // through its time-correlated noise (issue 37).
+  double max_abs_time_s = 1.0e10;
 
   // Model and calibration-spec values (model_plausibility.h checks model files with them,
   // calibration_spec.h initial values, priors and noise): wide enough for any real FAST

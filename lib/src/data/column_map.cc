@@ -221,6 +221,12 @@ class MapReader {
           {"iso8601", TimeFormat::kIso8601}};
       if (const auto f = kFormats.find(text); f != kFormats.end()) {
         time.format = f->second;
+      } else if (text.find("%Z") != std::string::npos) {
+        // A zone's name ("CST") was parsed and ignored: a silent hour at a DST change
+        // (issue 37). The offset is read (%z) or stated (zone:).
+        return Fail(it->second.line, "time.format",
+                    "%Z (a zone's name) is not read: give the zone's offset with zone: "
+                    "\"+08:00\", or %z if the text carries the offset (+0800)");
       } else if (text.find('%') != std::string::npos) {
         time.format = TimeFormat::kPattern;
         time.pattern = text;
@@ -627,6 +633,14 @@ std::string_view DecimalPoint(std::string_view field, char decimal, char* stack,
 
 bool ReadConvertedNumber(std::string_view field, char decimal, const ValueConversion& conversion,
                          double* file_value, double* internal, std::string* why) {
+  // Under a decimal comma a '.' is a thousands separator ("1.234" for 1234, German
+  // style) that would read 1000x small: refused, not guessed (issue 37).
+  if (decimal == ',' && field.find('.') != std::string_view::npos) {
+    *why = Quote(field) + " has a '.' where the map says decimal: \",\": a thousands "
+           "separator? (fastcal reads none: remove them from the export, or give "
+           "decimal: \".\" if '.' is the decimal point)";
+    return false;
+  }
   char stack[64];
   std::string heap;
   const std::string_view text = DecimalPoint(field, decimal, stack, &heap);

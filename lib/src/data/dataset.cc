@@ -513,6 +513,13 @@ bool ParseHeader(std::string_view line, const std::string& where, const std::str
 // Parses one data row into *sample; on failure *reason says why (without file:line).
 // Checks a parsed value (kN for a tension) against the plausibility limits.
 bool CheckValue(int column, double value, const PlausibilityLimits& limits, std::string* why) {
+  if (column == kTime && !(std::abs(value) <= limits.max_abs_time_s)) {
+    *why = internal::FormatDouble("%.6g", value) +
+           " s is beyond any time of a telescope's telemetry (|time_s| <= " +
+           internal::FormatDouble("%.6g", limits.max_abs_time_s) +
+           " s: Unix times to 2286, or seconds from a survey's start)";
+    return false;
+  }
   if (IsTension(column)) {
     // Compared in kN as read, so that 1e308 kN is called implausible, not "not finite"
     // after the conversion to N.
@@ -702,6 +709,7 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
                                      &value[column], &why)) {
           return fail(why + internal::NotANumberHint(fields[f], '\0', previous == nullptr));
         }
+        if (!CheckValue(column, value[column], limits, &why)) return fail(why);
         continue;
       }
       double file_value = 0.0;
