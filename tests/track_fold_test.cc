@@ -258,6 +258,31 @@ TEST_F(TrackFoldTest, BytesRoundTripAndCorruptionIsRefused) {
   EXPECT_NE(error.find("fastcal-fold-task-1"), std::string::npos) << error;
 }
 
+TEST_F(TrackFoldTest, FiniteNonsenseInAFoldIsRefused) {
+  // Issue 37: a NaN in the point, a sigma of 1e-150 (information 1e300), an asymmetric
+  // information or a negative count passed the byte-level checks; each is refused by name.
+  const WindowFold good = Fold(task_);
+  WindowFold back;
+  std::string error;
+  ASSERT_TRUE(ParseWindowFold(SerializeWindowFold(good), "f.fold", &back, &error)) << error;
+  const auto refused = [&](const WindowFold& bad, const std::string& why) {
+    EXPECT_FALSE(ParseWindowFold(SerializeWindowFold(bad), "f.fold", &back, &error)) << why;
+    EXPECT_NE(error.find("f.fold: " + why), std::string::npos) << error;
+  };
+  WindowFold bad = good;
+  bad.theta_si[0] = std::nan("");
+  refused(bad, "a point that is not finite");
+  bad = good;
+  bad.information(0, 0) = 1e300;
+  refused(bad, "information beyond any telemetry's");
+  bad = good;
+  bad.information(0, 1) += 1.0 + std::abs(bad.information(0, 1));
+  refused(bad, "an information matrix that is not symmetric");
+  bad = good;
+  bad.samples = -1;
+  refused(bad, "a negative count");
+}
+
 TEST_F(TrackFoldTest, TasksCarryEveryParameterKind) {
   // A task's parameters of every kind, the moving parts' and the length offsets' among
   // them, travel as bytes and back (a kind the reader did not know made every track with

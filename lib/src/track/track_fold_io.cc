@@ -2,6 +2,7 @@
 // number little-endian (int64 for integers and counts, IEEE double for reals), each string
 // as its length (int64) then its bytes, each matrix as rows, columns, then its entries
 // row by row. docs/calibration.md, "Tracking: files", lists the fields.
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -320,6 +321,61 @@ std::string SerializeWindowFold(const WindowFold& f) {
   return std::move(w.str());
 }
 
+namespace {
+
+// Largest |entry| of a fold's information in SI (issue 37: finite nonsense passed, a
+// sigma_total of 1e-150 m): a sigma of 1e-15 in any SI unit is far below any telemetry's.
+constexpr double kMaxInformation = 1e30;
+// Relative asymmetry of the information beyond rounding: not a fold's.
+constexpr double kAsymmetry = 1e-9;
+
+bool AllFinite(const Eigen::MatrixXd& m) { return m.allFinite(); }
+
+// "" when every number of a parsed fold is in range; else which is not.
+std::string OutOfRange(const WindowFold& f) {
+  const auto finite_all = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); });
+  };
+  if (f.samples < 0 || f.readings < 0 || f.gross_error_count < 0) return "a negative count";
+  if (!std::isfinite(f.first_time_s) || !std::isfinite(f.last_time_s) ||
+      f.first_time_s > f.last_time_s) {
+    return "its time span is not one";
+  }
+  if (!finite_all(f.theta_si)) return "a point that is not finite";
+  std::string why;
+  if (!f.slow_error.IsValid(&why)) return "its slow error: " + why;
+  if (!AllFinite(f.information) || !AllFinite(f.gradient) || !std::isfinite(f.chi_square) ||
+      f.chi_square < 0.0) {
+    return "information, gradient or chi-square not finite";
+  }
+  const double scale = f.information.size() > 0 ? f.information.cwiseAbs().maxCoeff() : 0.0;
+  if (scale > kMaxInformation) return "information beyond any telemetry's";
+  if ((f.information - f.information.transpose()).cwiseAbs().maxCoeff() > kAsymmetry * scale) {
+    return "an information matrix that is not symmetric";
+  }
+  for (Eigen::Index k = 0; k < f.information.rows(); ++k) {
+    if (f.information(k, k) < 0.0) return "a negative information";
+  }
+  for (long long n : f.block_samples) {
+    if (n < 0) return "a negative block";
+  }
+  if (!AllFinite(f.block_scores)) return "a block score not finite";
+  for (const Eigen::MatrixXd& m : f.block_information) {
+    if (!AllFinite(m)) return "a block's information not finite";
+  }
+  for (int i = 0; i < kNumCables; ++i) {
+    if (f.count[i] < 0 || !(f.sum_sq_n2[i] >= 0.0) || !std::isfinite(f.sum_sq_n2[i])) {
+      return "a cable's residual sums out of range";
+    }
+  }
+  for (const FoldGrossError& g : f.gross_errors) {
+    if (g.cable < 1 || g.cable > kNumCables) return "a gross error's cable out of range";  // 1..6
+  }
+  return "";
+}
+
+}  // namespace
+
 bool ParseWindowFold(const std::string& bytes, const std::string& source, WindowFold* fold,
                      std::string* error) {
   Reader r(bytes, source);
@@ -382,6 +438,10 @@ bool ParseWindowFold(const std::string& bytes, const std::string& source, Window
                       f.gradient.size() == static_cast<Eigen::Index>(n);
   if (!r.ok() || !r.AtEnd() || !shapes) {
     *error = r.Error();
+    return false;
+  }
+  if (const std::string why = OutOfRange(f); !why.empty()) {
+    *error = source + ": " + why + " (a damaged fold: --refold folds the window again)";
     return false;
   }
   *fold = std::move(f);
