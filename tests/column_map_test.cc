@@ -425,6 +425,10 @@ TEST(ColumnMapTest, ReadsEachTimeFormatAndZone) {
                                        "\n",
                                    MapText("time: " + slashes + "\n" + Columns())),
                        "data.csv:2: column 't'"));
+  // A leap second (2016-12-31T23:59:60Z, the last one) reads as the next day's first
+  // second; :60 at another minute is refused (issue 37).
+  EXPECT_EQ(TimeOf("2016-12-31T23:59:60.5Z", iso), 1483228800.5);
+  EXPECT_EQ(TimeOf("2017-01-01T07:59:60+08:00", iso), 1483228800.0);
   // A zone's name is not read (issue 37): %Z refused at the map's line.
   EXPECT_TRUE(Contains(MapError(MapText("time: {column: t, format: \"%Y-%m-%d %H:%M %Z\", "
                                         "zone: UTC}\ncolumns: {}\n")),
@@ -449,7 +453,8 @@ TEST(ColumnMapTest, BadTimeStampsNameTheSourceColumnAndTheFastcalName) {
   const std::string header = "SysTime" + std::string(kCanonicalHeader).substr(1);
   const std::string row = std::string(kRow).substr(std::string(kRow).find(','));
   for (const char* bad : {"2024-02-30 00:00:00", "2024-05-01 25:00:00", "2024-05-01",
-                          "2024-05-01 12:00:61", "12:00:00", "2024-05-01 12:00:00+25:00"}) {
+                          "2024-05-01 12:00:61", "2024-05-01 12:00:60", "12:00:00",
+                          "2024-05-01 12:00:00+25:00"}) {
     const std::string error = MappedError(header + "\n" + bad + row + "\n", map);
     EXPECT_TRUE(Contains(error, "data.csv:2: column 'SysTime' (time_s, iso8601): ")) << bad;
     EXPECT_TRUE(Contains(error, "is not an ISO 8601 date and time")) << bad;

@@ -163,7 +163,8 @@ bool ParseIso8601(std::string_view text, int default_offset_s, double* unix_s, s
     }
     const auto [end, ec] = std::from_chars(digits, digits + s.size(), seconds);
     if (ec != std::errc() || end != digits + s.size()) return fail("");
-    if (!(seconds < 60.0)) return fail(": seconds beyond 59");
+    // :60 is a leap second (issue 37: one was refused); checked at 23:59 UTC below.
+    if (!(seconds < 61.0)) return fail(": seconds beyond 60");
   }
   // The date, hour and minute: the date library's, cached per thread (rows of one minute
   // share them).
@@ -185,7 +186,14 @@ bool ParseIso8601(std::string_view text, int default_offset_s, double* unix_s, s
     cached_text.assign(minute_text);
     cached_minutes = minutes;
   }
-  *unix_s = static_cast<double>(minutes * 60 - offset_s) + seconds;
+  const std::int64_t minute_utc_s = minutes * 60 - offset_s;
+  constexpr std::int64_t kDayS = 86400, kLastMinuteS = kDayS - 60;
+  if (seconds >= 60.0 && ((minute_utc_s % kDayS) + kDayS) % kDayS != kLastMinuteS) {
+    return fail(": seconds beyond 59 (a leap second, :60, is only at 23:59 UTC)");
+  }
+  // A leap second reads as the next day's first second (POSIX time has no 86401st):
+  // 23:59:60.5 is 00:00:00.5, one second after 23:59:59.5, as the telemetry went on.
+  *unix_s = static_cast<double>(minute_utc_s) + seconds;
   return true;
 }
 
