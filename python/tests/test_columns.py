@@ -272,3 +272,32 @@ def test_the_bundled_export_is_what_its_script_writes(source_dir: pathlib.Path) 
         capture_output=True, text=True, check=False,
     )
     assert run.returncode == 0, run.stdout + run.stderr
+
+
+def test_an_xlsx_with_a_stale_dimension_reads_every_row_and_a_bomb_is_refused(
+    tmp_path: pathlib.Path, data_dir: pathlib.Path
+) -> None:
+    # Issue 37: a workbook whose <dimension> says A1:N53 while it holds 203 rows lost 150
+    # of them silently; a zip bomb took 84 s and 1.9 GB before it was refused.
+    import re
+    import zipfile
+
+    survey = _survey_arrays(data_dir)
+    path = tmp_path / "export.xlsx"
+    _write_workbook(path, survey, 200)
+    stale = tmp_path / "stale.xlsx"
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(stale, "w", zipfile.ZIP_DEFLATED) as dst:
+        for item in src.infolist():
+            data = src.read(item.filename)
+            if item.filename.startswith("xl/worksheets/sheet"):
+                data = re.sub(rb'<dimension ref="[^"]*"/>', b'<dimension ref="A1:N53"/>', data)
+            dst.writestr(item, data)
+    columns = dict(FAST_MAP)
+    del columns["delimiter"]
+    columns["decimal"] = "."
+    assert len(fastcal.read_dataset(stale, columns=columns)) == 200
+    bomb = tmp_path / "bomb.xlsx"
+    with zipfile.ZipFile(bomb, "w", zipfile.ZIP_DEFLATED) as z:
+        z.writestr("xl/worksheets/sheet1.xml", b"\0" * (64 << 20))
+    with pytest.raises(fastcal.InputError, match="inflates .* times"):
+        fastcal.read_dataset(bomb, columns=columns)
