@@ -106,7 +106,7 @@ if [ "$mode" = all ] || [ "$mode" = --fuzz-only ]; then
     -DFASTCAL_BUILD_BENCHMARKS=OFF -DFASTCAL_BUILD_PYTHON=OFF -DFASTCAL_INSTALL=OFF >/dev/null
   cmake --build "$root/build-fuzz" -j "$jobs"
   summary=()
-  for target in dataset_csv pose_csv model_yaml spec_yaml; do
+  for target in dataset_csv pose_csv model_yaml spec_yaml window_fold track_state; do
     work="$root/build-fuzz/fuzz-work/$target"
     artifacts="$root/build-fuzz/fuzz-artifacts"
     mkdir -p "$work" "$artifacts"

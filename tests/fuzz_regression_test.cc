@@ -58,6 +58,8 @@ TEST(FuzzRegressionTest, DatasetCsv) { Replay("dataset_csv", fuzz::DatasetCsv, k
 TEST(FuzzRegressionTest, PoseCsv) { Replay("pose_csv", fuzz::PoseCsv, kMinFiles); }
 TEST(FuzzRegressionTest, ModelYaml) { Replay("model_yaml", fuzz::ModelYaml, kMinFiles); }
 TEST(FuzzRegressionTest, SpecYaml) { Replay("spec_yaml", fuzz::SpecYaml, kMinFiles); }
+TEST(FuzzRegressionTest, WindowFold) { Replay("window_fold", fuzz::WindowFoldBytes, kMinFiles); }
+TEST(FuzzRegressionTest, TrackState) { Replay("track_state", fuzz::TrackStateJson, kMinFiles); }
 
 }  // namespace
 }  // namespace fastcal

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/internal/track_state.h"
+#include "fastcal/track_fold.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
@@ -83,6 +85,38 @@ void CompareSamples(const Sample& a, const Sample& b) {
 }
 
 }  // namespace
+
+void WindowFoldBytes(const uint8_t* data, size_t size) {
+  const std::string bytes(reinterpret_cast<const char*>(data), size);
+  WindowFold fold;
+  std::string error;
+  if (!ParseWindowFold(bytes, "fuzz.fold", &fold, &error)) {
+    if (error.empty()) Violation("a refused fold without a message");
+    return;
+  }
+  // A fold read has its numbers in the reader's ranges, and what the writer makes of it
+  // reads back to the same bytes (the reader may normalise: a flag 2 is true, written 1).
+  if (!fold.information.allFinite() || !std::isfinite(fold.chi_square)) {
+    Violation("a fold read with numbers out of range");
+  }
+  const std::string written = SerializeWindowFold(fold);
+  WindowFold again;
+  if (!ParseWindowFold(written, "fuzz.fold", &again, &error)) {
+    Violation("the reader refuses what the writer wrote: " + error);
+  }
+  if (SerializeWindowFold(again) != written) Violation("a fold differs after write and read");
+}
+
+void TrackStateJson(const uint8_t* data, size_t size) {
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  int windows = 0;
+  std::string error;
+  if (!internal::ParseTrackStateText(text, &windows, &error)) {
+    if (error.empty()) Violation("a refused state without a message");
+    return;
+  }
+  if (windows < 0) Violation("a negative number of windows");
+}
 
 void Violation(const std::string& what) {
   std::fprintf(stderr, "fastcal fuzz invariant broken: %s\n", what.c_str());

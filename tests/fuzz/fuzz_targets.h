@@ -23,6 +23,10 @@ void ModelYaml(const uint8_t* data, size_t size);
 // Calibration spec YAML: ParseCalibrationSpecYaml, CalibrationSpecToYaml, parse again:
 // the same YAML text.
 void SpecYaml(const uint8_t* data, size_t size);
+// A track's stored fold (track_fold.h) and its state (internal/track_state.h): refused
+// with a message, or read and, for a fold, written back to the same bytes.
+void WindowFoldBytes(const uint8_t* data, size_t size);
+void TrackStateJson(const uint8_t* data, size_t size);
 
 // Prints `what` and aborts: a broken invariant of the target.
 [[noreturn]] void Violation(const std::string& what);

@@ -19,6 +19,7 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/track_state.h"
 #include "fastcal/internal/window_store.h"
 #include "fastcal/sessions.h"
 #include "fastcal/time_text.h"
@@ -525,6 +526,26 @@ bool ReadFile(Router& router, const std::string& path, std::string* error) {
 }
 
 }  // namespace
+
+bool ParseTrackStateText(const std::string& text, int* windows, std::string* error) {
+  SavedState s;
+  try {
+    s = ParseState(text);
+  } catch (const YAML::Exception& e) {
+    *error = "line " + std::to_string(e.mark.line + 1) + ": " + e.msg;
+    return false;
+  }
+  for (const TrackWindowState& w : s.windows) {
+    for (int f : w.files) {
+      if (f < 0 || f >= static_cast<int>(s.files.size())) {
+        *error = "window " + w.label + " names a file out of range";
+        return false;
+      }
+    }
+  }
+  *windows = static_cast<int>(s.windows.size());
+  return true;
+}
 
 TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<std::string>* out,
                             std::string* error) {

@@ -350,7 +350,8 @@ std::string OutOfRange(const WindowFold& f) {
   }
   const double scale = f.information.size() > 0 ? f.information.cwiseAbs().maxCoeff() : 0.0;
   if (scale > kMaxInformation) return "information beyond any telemetry's";
-  if ((f.information - f.information.transpose()).cwiseAbs().maxCoeff() > kAsymmetry * scale) {
+  if (f.information.size() > 0 &&
+      (f.information - f.information.transpose()).cwiseAbs().maxCoeff() > kAsymmetry * scale) {
     return "an information matrix that is not symmetric";
   }
   for (Eigen::Index k = 0; k < f.information.rows(); ++k) {
