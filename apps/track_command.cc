@@ -29,6 +29,9 @@ DECLARE_bool(skip_invalid_rows);
 DEFINE_string(window, "1d", "track: window length (1d, 12h, 30m, 3600s) or 'file'.");
 DEFINE_int32(threads, 2, "track: windows folded at once.");
 DEFINE_bool(refold, false, "track: on an update, refold every window at the new point.");
+DEFINE_bool(keep_overlapping, false,
+            "track: fold files whose time spans overlap (refused otherwise: the same "
+            "instants given twice).");
 DEFINE_int64(min_window_samples, 100, "track: windows with fewer samples are left out.");
 DEFINE_double(false_alarm, 0.01,
               "track: chance that noise alone reports any event of a kind over the track.");
@@ -71,6 +74,8 @@ Usage:
                       the slow error), as a fresh track would
   --force             DIR holds a track of another model, spec or windowing, or files that
                       changed: build it afresh
+  --keep-overlapping  fold files whose time spans overlap (refused otherwise: the same
+                      instants given twice would be folded twice)
   --skip-invalid-rows skip malformed rows (named on stderr) instead of failing
   --quiet             no progress on stderr
 
@@ -291,7 +296,7 @@ std::string Summary(const TrackResult& r, const std::string& out) {
 int RunTrack(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp,
-                    {"model", "spec", "data", "out", "window", "threads", "refold", "force",
+                    {"model", "spec", "data", "out", "window", "threads", "refold", "force", "keep-overlapping",
                      "quiet", "skip-invalid-rows", "min-window-samples", "false-alarm", "columns"},
                     &exit_code)) {
     return exit_code;
@@ -318,6 +323,7 @@ int RunTrack(int argc, char** argv) {
   TrackOptions options;
   options.threads = FLAGS_threads;
   options.refold_all = FLAGS_refold;
+  options.keep_overlapping = FLAGS_keep_overlapping;
   options.force = FLAGS_force;
   options.min_window_samples = FLAGS_min_window_samples;
   options.false_alarm = FLAGS_false_alarm;

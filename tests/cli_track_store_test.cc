@@ -89,6 +89,25 @@ TEST_F(CliTrackStoreTest, TheSameDataTwiceIsRefusedByContent) {
   EXPECT_NE(r.output.find("already in the track"), std::string::npos) << r.output;
 }
 
+TEST_F(CliTrackStoreTest, FilesOverlappingInTimeAreRefusedUnlessKept) {
+  // The same hour simulated again with another seed (another name, other numbers): its
+  // instants are day 1's; folded both, day 1 would count twice (issue 37).
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=1800 --interval-s=2 --seed=9 "
+                    "--start=2024-05-01T20:00:00Z --out=" + Path("again.csv"))
+                .code,
+            0);
+  CommandResult r = Track(Day(1) + "," + Path("again.csv"), "a");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("again.csv (2024-05-01T20:00:00Z to 2024-05-01T20:59:58Z) overlaps"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("--keep-overlapping"), std::string::npos) << r.output;
+  r = Track(Day(1) + "," + Path("again.csv"), "b", "--keep-overlapping");
+  EXPECT_EQ(r.code, 0) << r.output;
+  // Days that follow each other do not overlap.
+  EXPECT_EQ(Track(Day(1) + "," + Day(2), "c").code, 0);
+}
+
 TEST_F(CliTrackStoreTest, RelativeTimesOfTwoFilesNeedAWindowEach) {
   for (int k = 1; k <= 2; ++k) {
     ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=300 --seed=" + std::to_string(k) +

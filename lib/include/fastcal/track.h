@@ -127,6 +127,11 @@ struct TrackOptions {
   // DIR holds a track of another model, spec or windowing, or of files that changed:
   // build it afresh (else refused).
   bool force = false;
+  // Files whose time spans overlap are refused (the same instants given twice, e.g. a day
+  // re-sent with another name, would be folded twice); true folds them all, for files
+  // that really are of one time (two exports split by channel would not be: one sample
+  // per instant is what a dataset holds).
+  bool keep_overlapping = false;
   bool IsValid(std::string* error) const;
 };
 

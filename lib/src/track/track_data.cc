@@ -74,6 +74,10 @@ std::string StateJson(const TrackRun& run) {
     j.Key("bytes").Int(f.bytes);
     j.Key("sha256").String(f.sha256);
     j.Key("samples").Int(f.samples);
+    if (std::isfinite(f.first_s)) {
+      j.Key("first_s").ExactNumber(f.first_s);
+      j.Key("last_s").ExactNumber(f.last_s);
+    }
     j.EndObject();
   }
   j.EndArray();
@@ -168,8 +172,12 @@ SavedState ParseState(const std::string& text) {
   s.slow.sigma_percent = Real(root["slow_error"]["sigma_percent"]);
   s.slow.time_constant_s = Real(root["slow_error"]["time_constant_s"]);
   for (const YAML::Node& f : root["files"]) {
-    s.files.push_back(
-        {Text(f["path"]), Integer(f["bytes"]), Text(f["sha256"]), Integer(f["samples"])});
+    TrackFile file{Text(f["path"]), Integer(f["bytes"]), Text(f["sha256"]), Integer(f["samples"])};
+    if (f["first_s"]) {
+      file.first_s = Real(f["first_s"]);
+      file.last_s = Real(f["last_s"]);
+    }
+    s.files.push_back(file);
   }
   for (const YAML::Node& n : root["windows"]) {
     TrackWindowState w;
@@ -518,6 +526,8 @@ bool ReadFile(Router& router, const std::string& path, std::string* error) {
         router.relative_file = index;
       }
       if (!Route(router, s, index, stem)) return false;
+      file.first_s = std::isnan(file.first_s) ? s.time_s : std::min(file.first_s, s.time_s);
+      file.last_s = std::isnan(file.last_s) ? s.time_s : std::max(file.last_s, s.time_s);
     }
     file.samples += static_cast<long long>(chunk.samples.size());
   }
@@ -653,6 +663,26 @@ TrackStatus PrepareDirectory(TrackRun& run) {
   return TrackStatus::kOk;
 }
 
+// Two files whose time spans overlap (issue 37: overlapping files were double-counted
+// with a false sensor event): named, unless TrackOptions::keep_overlapping. Files of
+// relative times have a line each (--window=file) and are not compared.
+std::string Overlap(const TrackRun& run) {
+  if (run.options.keep_overlapping || run.window.kind == WindowSpec::Kind::kFile) return "";
+  for (size_t a = 0; a < run.files.size(); ++a) {
+    for (size_t b = a + 1; b < run.files.size(); ++b) {
+      const TrackFile& f = run.files[a];
+      const TrackFile& g = run.files[b];
+      if (!(f.first_s <= g.last_s && g.first_s <= f.last_s)) continue;  // NaN: unknown
+      return g.path + " (" + TrackTimeText(g.first_s, 0) + " to " + TrackTimeText(g.last_s, 0) +
+             ") overlaps " + f.path + " (" + TrackTimeText(f.first_s, 0) + " to " +
+             TrackTimeText(f.last_s, 0) +
+             ") in time: the same instants given twice would be folded twice; drop one, or "
+             "give --keep-overlapping if both belong";
+    }
+  }
+  return "";
+}
+
 TrackStatus ReadNewFiles(TrackRun& run) {
   Router router(run);
   int read = 0;
@@ -666,6 +696,9 @@ TrackStatus ReadNewFiles(TrackRun& run) {
     ++read;
   }
   if (!router.Flush()) return TrackStatus::kFailed;
+  if (const std::string overlap = Overlap(run); !overlap.empty()) {
+    return run.Fail(TrackStatus::kInvalidInput, overlap);
+  }
   std::stable_sort(
       run.windows.begin(), run.windows.end(),
       [](const TrackWindowState& a, const TrackWindowState& b) { return a.start_s < b.start_s; });

@@ -50,6 +50,9 @@ struct TrackFile {
   long long bytes = 0;
   std::string sha256;
   long long samples = 0;
+  // Its first and last sample's time (NaN: not recorded, a state of an older version).
+  double first_s = std::numeric_limits<double>::quiet_NaN();
+  double last_s = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct TrackWindowState {
