@@ -163,7 +163,9 @@ TEST(ColumnMapTest, BadMapsNameTheKeyAndTheLine) {
   EXPECT_TRUE(Contains(MapError(MapText("decimal: \",\"\ndelimiter: \",\"\ncolumns: {}\n")),
                        "map.yaml:3: delimiter: the same as the decimal mark"));
   EXPECT_TRUE(Contains(MapError(MapText("header_line: 0\ncolumns: {}\n")),
-                       "map.yaml:2: header_line: '0' is not a whole number >= 1"));
+                       "map.yaml:2: header_line: '0' is not a whole number from 1 to 10000"));
+  EXPECT_TRUE(Contains(MapError(MapText("skip_after_header: 2147483647\ncolumns: {}\n")),
+                       "skip_after_header: '2147483647' is not a whole number from 0 to 10000"));
   EXPECT_TRUE(Contains(MapError(MapText("unmapped: drop\ncolumns: {}\n")),
                        "map.yaml:2: unmapped: 'drop' is neither ignore nor error"));
   EXPECT_TRUE(Contains(MapError(MapText("columns:\n  x_m: {column: X}\n  x_m: {column: Y}\n")),

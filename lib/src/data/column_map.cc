@@ -113,14 +113,20 @@ class MapReader {
     return true;
   }
 
+  // A line count of a header: no export has a title of more lines than this, and the
+  // reader adds it to line numbers (issue 37: 2^31 - 1 overflowed a signed int).
+  static constexpr int kMaxHeaderLines = 10000;
+
   bool ReadInt(const KeyValue& kv, const std::string& path, int lowest, int* value) {
     std::string text;
     if (!ReadText(kv, path, &text)) return false;
     int v = 0;
     const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), v);
-    if (ec != std::errc() || end != text.data() + text.size() || v < lowest) {
+    if (ec != std::errc() || end != text.data() + text.size() || v < lowest ||
+        v > kMaxHeaderLines) {
       return Fail(kv.line, path,
-                  internal::Quote(text) + " is not a whole number >= " + std::to_string(lowest));
+                  internal::Quote(text) + " is not a whole number from " +
+                      std::to_string(lowest) + " to " + std::to_string(kMaxHeaderLines));
     }
     *value = v;
     return true;
