@@ -452,6 +452,14 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
     if (step < run.options.step_tolerance_sigmas && slow_settled && !process_changed) {
       run.result->converged = true;
+      // An earlier pass's "did not converge" no longer holds (issue 37: the summary said
+      // "(converged)" beside it).
+      std::vector<std::string>& notes = run.result->notes;
+      notes.erase(std::remove_if(notes.begin(), notes.end(),
+                                 [](const std::string& n) {
+                                   return n.rfind("Gauss-Newton did not converge", 0) == 0;
+                                 }),
+                  notes.end());
       return TrackStatus::kOk;
     }
     previous_chi2 = process_changed ? std::numeric_limits<double>::infinity() : chi2;
@@ -463,6 +471,7 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     }
     MarkMovingDirty(run);
   }
+  run.result->converged = false;
   run.result->notes.push_back("Gauss-Newton did not converge in " +
                               std::to_string(run.options.max_iterations) +
                               " iterations: the estimates are the last step's");
