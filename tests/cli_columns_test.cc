@@ -272,3 +272,32 @@ TEST_F(CliColumnsTest, TensionsReadInTheWrongUnitAreRefused) {
 
 }  // namespace
 }  // namespace fastcal
+
+namespace fastcal {
+namespace {
+
+// Issue 37: a file whose times never advance (every sample at one time_s) gave the slow
+// sensor error any value at all, fitted silently; a spec with noise.slow_error refuses it.
+TEST_F(CliColumnsTest, TimesThatNeverAdvanceAreRefusedForASlowError) {
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=200 --seed=3 --out=" +
+                    Path("s.csv"))
+                .code,
+            0);
+  ASSERT_EQ(test::Shell("awk -F, 'BEGIN{OFS=\",\"} /^#/ {print; next} $1 != \"time_s\" {$1 = 0} "
+                        "{print}' " + Path("s.csv") + " > " + Path("still.csv"))
+                .code,
+            0);
+  const std::string spec = Source() + "/calibration_data/spec_realistic.yaml";
+  const test::CommandResult r =
+      Fastcal("calibrate --spec=" + spec + " --data=" + Path("still.csv") + " --out=" + Path("c"));
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("every sample has time_s = 0"), std::string::npos) << r.output;
+  // The same file with its times calibrates.
+  EXPECT_EQ(Fastcal("calibrate --spec=" + spec + " --data=" + Path("s.csv") + " --out=" +
+                    Path("d"))
+                .code,
+            0);
+}
+
+}  // namespace
+}  // namespace fastcal

@@ -155,6 +155,21 @@ CalibrationStatus ValidateInputs(Run& run) {
       !CheckTensionScale(run.data, run.model, &why)) {
     return run.Fail(CalibrationStatus::kInvalidInput, why);
   }
+  if (run.spec.slow_error.enabled && run.data.samples.size() > 1) {
+    // A slow error correlates readings by their times: times that never advance (every
+    // sample at one time_s) make it any value at all, fitted silently before (issue 37).
+    const auto [lo, hi] = std::minmax_element(
+        run.data.samples.begin(), run.data.samples.end(),
+        [](const Sample& a, const Sample& b) { return a.time_s < b.time_s; });
+    if (lo->time_s == hi->time_s) {
+      return run.Fail(CalibrationStatus::kInvalidInput,
+                      run.data.path + ": every sample has time_s = " +
+                          internal::FormatDouble("%g", lo->time_s) +
+                          ": the slow sensor error (spec noise.slow_error) correlates "
+                          "readings by their times; give the samples' times, or drop "
+                          "slow_error from the spec");
+    }
+  }
   if (run.spec.UsesLengths() && !run.data.has_unstretched_lengths) {
     return run.Fail(CalibrationStatus::kInvalidInput,
                     run.data.path +
