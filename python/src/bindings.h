@@ -28,6 +28,28 @@ namespace fastcal::python {
 
 namespace py = pybind11;
 
+// Ctrl-C inside a long call with the GIL released (issue 37): every `every` pieces of
+// work the GIL is taken for a moment to ask Python whether a signal is pending; true
+// stops the loop, and the caller raises it (ThrowIfInterrupted) once it holds the GIL.
+class InterruptCheck {
+ public:
+  explicit InterruptCheck(long long every = 2048) : every_(every) {}
+  bool Stop(long long k) {
+    if (k % every_ != 0 || k == 0) return false;
+    py::gil_scoped_acquire gil;
+    interrupted_ = PyErr_CheckSignals() != 0;
+    return interrupted_;
+  }
+  // With the GIL held: KeyboardInterrupt (or what the signal's handler raised).
+  void ThrowIfInterrupted() const {
+    if (interrupted_) throw py::error_already_set();
+  }
+
+ private:
+  long long every_;
+  bool interrupted_ = false;
+};
+
 // Progress lines on Python's sys.stderr (a notebook shows them; the C++ stream it does
 // not), the GIL taken for each write; an error in writing is not the computation's.
 inline std::function<void(const std::string&)> ProgressTo(const std::string& prefix) {

@@ -133,10 +133,11 @@ py::dict Locate(const CableRobot& model_argument, const DoubleArray& lengths_m,
                     py::array_t<int>(n),
                     py::array_t<int>(n)};
   std::vector<std::pair<py::ssize_t, std::string>> messages;
+  InterruptCheck interrupt(64);  // a locate is slower than a solve
   {
     py::gil_scoped_release release;
     LocateSolution solution;  // reused: the warm start's source
-    for (py::ssize_t k = 0; k < n; ++k) {
+    for (py::ssize_t k = 0; k < n && !interrupt.Stop(k); ++k) {
       LocateFromMeasurements(robot, rows[static_cast<size_t>(k)], noise, options, &solution);
       Store(solution, k, &out);
       if (solution.status != StaticsStatus::kOk || solution.stability != Stability::kStable ||
@@ -145,6 +146,7 @@ py::dict Locate(const CableRobot& model_argument, const DoubleArray& lengths_m,
       }
     }
   }
+  interrupt.ThrowIfInterrupted();
   py::dict result, text;
   for (const auto& [k, message] : messages) text[py::int_(k)] = message;
   result["position_m"] = out.position_m;

@@ -77,10 +77,11 @@ py::dict Solve(const CableRobot& model, const DoubleArray& positions_m,
   int* status = out.status.mutable_data();
   int* cable = out.cable.mutable_data();
   std::vector<std::pair<py::ssize_t, std::string>> failed;
+  InterruptCheck interrupt;
   {
     py::gil_scoped_release release;
     StaticsSolution solution;  // reused: no allocation per pose, and the warm start's source
-    for (py::ssize_t k = 0; k < n; ++k) {
+    for (py::ssize_t k = 0; k < n && !interrupt.Stop(k); ++k) {
       const StaticsStatus s =
           SolveStatics(robot, poses[static_cast<size_t>(k)], options, &solution);
       status[k] = static_cast<int>(s);
@@ -102,6 +103,7 @@ py::dict Solve(const CableRobot& model, const DoubleArray& positions_m,
       }
     }
   }
+  interrupt.ThrowIfInterrupted();
   for (const auto& [k, text] : failed) out.failures[py::int_(k)] = text;
   py::dict result;
   result["lower_tension_kN"] = out.lower_kn;

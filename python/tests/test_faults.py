@@ -144,3 +144,31 @@ def test_a_nul_byte_in_a_path_is_refused_not_cut(tmp_path: pathlib.Path,
     with pytest.raises(fastcal.InputError, match="NUL byte"):
         fastcal.calibrate(str(data_dir / "spec_mass_centre.yaml") + "\0x", data)
     assert list(tmp_path.iterdir()) == []  # nothing written under the cut name
+
+
+KEYBOARD_INTERRUPT = textwrap.dedent(
+    """
+    import os, signal, threading, time
+    import fastcal
+    p = fastcal.random_workspace(2_000_000, seed=1)  # a solve of minutes
+    def interrupt():
+        time.sleep(0.5)
+        os.kill(os.getpid(), signal.SIGINT)
+    threading.Thread(target=interrupt).start()
+    start = time.time()
+    try:
+        fastcal.solve(p)
+        print("finished")
+    except KeyboardInterrupt:
+        print("interrupted", time.time() - start < 30)
+    """
+)
+
+
+def test_ctrl_c_stops_a_long_solve() -> None:
+    # Issue 37: Ctrl-C acted only when the C++ call returned (minutes later). The loop
+    # now asks Python every 2048 poses.
+    run = subprocess.run([sys.executable, "-c", KEYBOARD_INTERRUPT], capture_output=True,
+                         text=True, timeout=120)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.strip() == "interrupted True"
