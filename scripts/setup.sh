@@ -7,6 +7,7 @@ packages=(cmake g++ make libceres-dev libeigen3-dev libgflags-dev libgoogle-glog
           libyaml-cpp-dev libgtest-dev libbenchmark-dev
           libssl-dev  # libcrypto: SHA-256 of the input files (provenance)
           help2man  # the man pages, from each command's --help
+          pkgconf  # pkg-config: the C interface's fastcal.pc, used by its example's test
           zlib1g-dev  # zlib: every reader takes gzipped files (telemetry kept as .csv.gz)
           libhowardhinnant-date-dev  # date/date.h: ISO 8601 time stamps of column maps
           libspectra-dev  # Spectra (headers): shift-invert Lanczos for the lowest modes

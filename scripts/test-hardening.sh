@@ -102,7 +102,7 @@ if [ "$mode" = all ] || [ "$mode" = --fuzz-only ]; then
   cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" \
     -DCMAKE_CXX_FLAGS="$fuzz_flags $eigen_flags" \
-    -DFASTCAL_BUILD_FUZZERS=ON -DFASTCAL_BUILD_APPS=OFF -DFASTCAL_BUILD_TESTS=OFF \
+    -DFASTCAL_BUILD_FUZZERS=ON -DFASTCAL_BUILD_APPS=OFF -DFASTCAL_BUILD_TESTS=OFF -DFASTCAL_BUILD_C_API=OFF \
     -DFASTCAL_BUILD_BENCHMARKS=OFF -DFASTCAL_BUILD_PYTHON=OFF -DFASTCAL_INSTALL=OFF >/dev/null
   cmake --build "$root/build-fuzz" -j "$jobs"
   summary=()

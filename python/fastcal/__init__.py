@@ -42,6 +42,7 @@ __version__: str = _fastcal.__version__
 __all__ = [
     "CalibrationError",
     "CalibrationResult",
+    "ControlCycleResult",
     "Dataset",
     "Error",
     "InputError",
@@ -52,6 +53,7 @@ __all__ = [
     "__version__",
     "arc",
     "calibrate",
+    "control_cycle",
     "design",
     "evaluate",
     "focal_attitude",
@@ -93,6 +95,7 @@ from .statics import (  # noqa: F401
     rpy_deg_from_quat,
     solve,
 )
+from .control import ControlCycleResult, control_cycle  # noqa: F401
 from .dataset import read_dataset, simulate  # noqa: F401
 from .calibration import CalibrationResult, calibrate, evaluate  # noqa: F401
 from .design import design  # noqa: F401

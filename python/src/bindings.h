@@ -141,6 +141,7 @@ std::shared_ptr<const ColumnMap> MapOrThrow(const std::string& map_text,
 
 void BindModel(py::module_& m);
 void BindStatics(py::module_& m);
+void BindControl(py::module_& m);
 void BindLocate(py::module_& m);
 void BindData(py::module_& m);
 void BindCalibration(py::module_& m);

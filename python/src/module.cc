@@ -154,6 +154,7 @@ PYBIND11_MODULE(_fastcal, m) {
   RegisterExceptions(m);
   BindModel(m);
   BindStatics(m);
+  BindControl(m);
   BindLocate(m);
   BindData(m);
   BindCalibration(m);

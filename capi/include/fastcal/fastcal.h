@@ -1,0 +1,168 @@
+/* fastcal's C interface: the statics of FAST's cable robot for a control loop.
+ *
+ * The same solvers as the C++ library (fastcal/statics.h, fastcal/locate.h), behind opaque
+ * handles, for controllers that are not C++ (C, LabVIEW, MATLAB, a PLC runtime, Python
+ * through ctypes). docs/embedding.md has the examples, the guarantees and the latency.
+ *
+ * The guarantees of a solve, once a handle is created:
+ *  - no heap allocation, no lock, nothing thrown: every failure is a status (int) and a
+ *    message kept in the handle (fastcal_solver_error), written into a fixed buffer;
+ *  - a bounded number of iterations (docs/embedding.md, "A bounded time"): Newton from
+ *    the last solve of the handle (warm), else from the paper's AAS (cold), else the
+ *    continuation from the home pose, each with its own cap.
+ * A handle is not thread-safe: one handle per thread (each keeps its own warm start).
+ *
+ * Units at this edge: positions m, angles deg (roll, pitch, yaw: R = Rz(yaw) Ry(pitch)
+ * Rx(roll), cabin frame to global), forces and tensions kN, lengths m; joint values in
+ * the model's joint order and the joint columns' units (deg revolute, m prismatic).
+ *
+ * Statuses: 0 ok; 1..12 the statics' own (fastcal_status_name: "invalid_input",
+ * "no_equilibrium", ...; StaticsStatus of fastcal/statics.h, same numbers); 100..102 a
+ * control cycle's limits; negative: the call itself was wrong (a NULL handle or array, a
+ * handle whose model did not load). */
+#ifndef FASTCAL_FASTCAL_H_
+#define FASTCAL_FASTCAL_H_
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+#if defined(_WIN32)
+#define FASTCAL_C_API __declspec(dllimport)
+#else
+#define FASTCAL_C_API __attribute__((visibility("default")))
+#endif
+
+#define FASTCAL_NUM_CABLES 6
+#define FASTCAL_MAX_JOINTS 8
+
+enum fastcal_status {
+  FASTCAL_OK = 0,
+  /* 1..12: the statics' own (StaticsStatus of fastcal/statics.h, same numbers). */
+  FASTCAL_INVALID_INPUT = 1, /* a non-finite pose or joint value */
+  FASTCAL_VERTICAL_CABLE = 2,
+  FASTCAL_NO_EQUILIBRIUM = 3,      /* no equilibrium with every cable pulling */
+  FASTCAL_SAGGING_CABLE = 4,       /* beyond the model's range: s0/k too large */
+  FASTCAL_OVERSTRETCHED_CABLE = 5, /* beyond it: strain over the model's max_strain */
+  FASTCAL_REFLECTOR_CONTACT = 6,   /* a cable touches the reflector */
+  FASTCAL_SINGULAR = 7,
+  FASTCAL_CATENARY_FAILED = 8,
+  FASTCAL_NOT_CONVERGED = 9, /* out of iterations (the bound of a solve's time) */
+  FASTCAL_INACCURATE = 10,
+  FASTCAL_ATTACHMENT_BEYOND_CABLE = 11,
+  FASTCAL_UNSUPPORTED_MODEL = 12,
+  /* A control cycle's limits (fastcal_cycle_limits): the statics are ok and its numbers
+   * filled, but a cable's tension or clearance is outside them. */
+  FASTCAL_BELOW_MIN_TENSION = 100,
+  FASTCAL_ABOVE_MAX_TENSION = 101,
+  FASTCAL_INSIDE_REFLECTOR_MARGIN = 102,
+  /* The call itself. */
+  FASTCAL_ERROR_NULL_ARGUMENT = -1, /* a NULL handle or a required array NULL */
+  FASTCAL_ERROR_NO_MODEL = -2,      /* the handle's model did not load (its error says why) */
+  FASTCAL_ERROR_BAD_LIMITS = -3,    /* fastcal_cycle_limits out of range */
+  FASTCAL_ERROR_INTERNAL = -4       /* a C++ exception was caught: a defect, please report */
+};
+
+/* The library's version, "major.minor.patch" (FASTCAL_VERSION of fastcal/version.h). */
+FASTCAL_C_API const char* fastcal_version(void);
+/* The short code of a status: "ok", "no_equilibrium", "below_min_tension",
+ * "null_argument", ...; "unknown" for a number that is none. Static storage. */
+FASTCAL_C_API const char* fastcal_status_name(int status);
+
+typedef struct fastcal_solver fastcal_solver;
+
+/* A solver for the model in `model_path` (a fastcal model YAML, e.g. a calibration's
+ * model_calibrated.yaml), or the nominal FAST model for NULL. Exact statics (Newton to
+ * 1e-12), the model's checks (strain, sag, reflector). Returns NULL only when out of
+ * memory; a model that does not load still gives a handle, whose fastcal_solver_error
+ * names the file and what is wrong, and whose solves return FASTCAL_ERROR_NO_MODEL
+ * (as sqlite3_open does: the message needs a handle). Allocates; not for the cycle. */
+FASTCAL_C_API fastcal_solver* fastcal_solver_create(const char* model_path);
+/* The last failure of this handle's calls, or "" after a success. Valid until the next
+ * call on the handle. For NULL: a message saying the handle is NULL. */
+FASTCAL_C_API const char* fastcal_solver_error(const fastcal_solver* s);
+/* The number of joint values the model's moving parts take (0 without), in order. */
+FASTCAL_C_API int fastcal_solver_num_joints(const fastcal_solver* s);
+/* The data column of joint `j` ("rotator_a_deg"), or NULL out of range. */
+FASTCAL_C_API const char* fastcal_solver_joint_name(const fastcal_solver* s, int j);
+/* Forget the warm start: the next solve and locate start cold. */
+FASTCAL_C_API void fastcal_solver_reset(fastcal_solver* s);
+FASTCAL_C_API void fastcal_solver_destroy(fastcal_solver* s);
+
+/* The statics of one pose: lower-end (cabin) tensions in kN and unstretched lengths in
+ * m, warm from this handle's last successful solve. `joints`: the moving parts' values
+ * (fastcal_solver_num_joints of them), or NULL for all at zero. Returns 0 (ok) or a
+ * status; on failure the outputs are zero, never NaN. */
+FASTCAL_C_API int fastcal_solve_pose(fastcal_solver* s, const double position_m[3],
+                                     const double rpy_deg[3], const double* joints,
+                                     double tension_kN[6], double unstretched_m[6]);
+
+/* Everything a solve gives. */
+typedef struct fastcal_statics {
+  double tension_kN[6];         /* lower-end (cabin) tension |F_i| */
+  double upper_tension_kN[6];   /* at the tower top */
+  double force_kN[6][3];        /* on cable i at its lower end, global frame (the cabin
+                                   feels minus this) */
+  double unstretched_m[6];      /* s0_i, the model's unstretched length */
+  double error_estimate;        /* largest relative tension error a Newton step would fix */
+  double reflector_clearance_m; /* smallest cable clearance (+inf: none could reach it) */
+  int status;                   /* as returned */
+  int cable;                    /* 0-based cable a failure concerns, or -1 */
+  int iterations;               /* Newton iterations (all starts) */
+  int continuation;             /* 1: the warm and cold starts failed; followed from home */
+} fastcal_statics;
+
+/* fastcal_solve_pose with every output. */
+FASTCAL_C_API int fastcal_solve_pose_full(fastcal_solver* s, const double position_m[3],
+                                          const double rpy_deg[3], const double* joints,
+                                          fastcal_statics* out);
+
+/* The pose at which the cabin hangs with unstretched lengths `unstretched_m` (the
+ * model's s0: winch encoder readings minus the model's length_offset_m), warm from this
+ * handle's last locate; the lower-end tensions there. `joints` as for a solve. Returns 0
+ * or a status (no_equilibrium: the lengths cannot hold the cabin). tension_kN may be
+ * NULL. */
+FASTCAL_C_API int fastcal_locate(fastcal_solver* s, const double unstretched_m[6],
+                                 const double* joints, double position_m[3], double rpy_deg[3],
+                                 double tension_kN[6]);
+
+/* The limits a control cycle checks beyond the model's own range. */
+typedef struct fastcal_cycle_limits {
+  double min_tension_kN;            /* every lower-end tension at least this */
+  double max_tension_kN;            /* and at most this (upper-end tensions too) */
+  double min_reflector_clearance_m; /* every cable this far from the reflector */
+} fastcal_cycle_limits;
+/* The defaults: 50 kN, +infinity (the model states no rated load: set the cables'),
+ * 5 m (docs/embedding.md says why). */
+FASTCAL_C_API fastcal_cycle_limits fastcal_default_cycle_limits(void);
+
+/* What the winches and tension sensors should show at a planned pose. */
+typedef struct fastcal_cycle {
+  double winch_length_m[6];     /* the encoders' readings to command: s0 + length_offset_m */
+  double unstretched_m[6];      /* s0, the model's */
+  double tension_kN[6];         /* lower-end tension, true */
+  double sensor_reading_kN[6];  /* what each tension sensor should read (gain, bias) */
+  double upper_tension_kN[6];   /* at the tower top */
+  double error_estimate;        /* the statics' relative error estimate */
+  double reflector_clearance_m; /* smallest cable clearance (+inf: none could reach) */
+  double min_tension_margin_kN; /* min over cables of tension - min_tension_kN */
+  double max_tension_margin_kN; /* min over cables of max_tension_kN - max(lower, upper) */
+  int status;                   /* as returned */
+  int cable;                    /* 0-based cable a failure or limit concerns, or -1 */
+} fastcal_cycle;
+
+/* One control cycle: at the planned pose (and joints), the winch lengths to pay out and
+ * the expected tensions, with the model's checks (strain, sag, reflector) and `limits`
+ * (NULL: fastcal_default_cycle_limits()). Warm from the handle's last solve. A limit
+ * broken returns FASTCAL_BELOW_MIN_TENSION, FASTCAL_ABOVE_MAX_TENSION or
+ * FASTCAL_INSIDE_REFLECTOR_MARGIN with every number filled (the controller decides); a
+ * statics failure returns its status with the numbers zero. */
+FASTCAL_C_API int fastcal_control_cycle(fastcal_solver* s, const double position_m[3],
+                                        const double rpy_deg[3], const double* joints,
+                                        const fastcal_cycle_limits* limits, fastcal_cycle* out);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* FASTCAL_FASTCAL_H_ */

@@ -1,0 +1,403 @@
+// fastcal's C interface (fastcal/fastcal.h): handles around the C++ statics.
+//
+// Every entry point is noexcept and catches what the C++ side could throw, so that no
+// exception crosses into C. The cycle's calls (solve, locate, control cycle) allocate
+// nothing: the handle holds the model, both warm starts and a fixed message buffer, and
+// a failure's message is written with snprintf into that buffer from the status' numbers
+// (not DescribeStatus, which builds a std::string). tests/capi_test.cc counts allocations
+// and locks over 10^4 warm, cold and failing solves.
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <exception>
+#include <limits>
+#include <new>
+#include <string>
+#include <vector>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/control_cycle.h"
+#include "fastcal/fastcal.h"
+#include "fastcal/locate.h"
+#include "fastcal/pose.h"
+#include "fastcal/statics.h"
+#include "fastcal/version.h"
+
+using fastcal::CableRobot;
+using fastcal::JointValues;
+using fastcal::kNumCables;
+using fastcal::StaticsSolution;
+using fastcal::StaticsStatus;
+
+struct fastcal_solver {
+  CableRobot robot;
+  // The same model without moving parts, its mass centre set per locate (Locate takes a
+  // robot, not joints): kept here so that a locate copies nothing.
+  CableRobot fixed_robot;
+  bool ready = false;
+  int num_joints = 0;
+  std::vector<std::string> joint_names;
+  fastcal::StaticsOptions options;
+  fastcal::LocateOptions locate_options;
+  StaticsSolution last;   // the last ok solve: the next one's warm start
+  StaticsSolution trial;  // the solve in progress (a failure leaves `last` as it was)
+  fastcal::LocateSolution located;
+  fastcal::LocateSolution locate_trial;
+  fastcal::ControlCycleResult cycle;
+  char error[512] = "";
+};
+
+namespace {
+
+constexpr double kKnPerN = 1e-3;
+constexpr double kNPerKn = 1e3;
+
+// A joint value the model could mean: an angle within one turn, a shift within 100 m
+// (as PlausibleJointValue, without its message strings).
+constexpr double kMaxJointDeg = 360.0;
+constexpr double kMaxJointM = 100.0;
+
+void SetError(fastcal_solver* s, const char* text) {
+  std::snprintf(s->error, sizeof(s->error), "%s", text);
+}
+
+// "no_equilibrium: cable 3, ..." from a solution's numbers, into the handle's buffer.
+void DescribeFailure(fastcal_solver* s, const char* what, const StaticsSolution& sol) {
+  const char* name = fastcal::StaticsStatusName(sol.status);
+  char cable[32] = "";
+  if (sol.cable >= 0) std::snprintf(cable, sizeof(cable), ", cable %d", sol.cable + 1);
+  const char* detail = "";
+  switch (sol.status) {
+    case StaticsStatus::kSaggingCable:
+      detail = ": s0/k %.4g over the model's limit %.4g";
+      break;
+    case StaticsStatus::kOverstretchedCable:
+      detail = ": strain (or s0/k where s0 <= 0) %.4g beyond the model's limit %.4g";
+      break;
+    case StaticsStatus::kReflectorContact:
+      detail = ": clearance %.4g m under %.4g m";
+      break;
+    case StaticsStatus::kNotConverged:
+    case StaticsStatus::kInaccurate:
+      detail = ": error estimate %.3g over %.3g";
+      break;
+    case StaticsStatus::kAttachmentBeyondCable:
+      detail = ": an attachment at %.4g m, beyond s0 %.4g m";
+      break;
+    default:
+      break;
+  }
+  char numbers[160] = "";
+  if (*detail != '\0') std::snprintf(numbers, sizeof(numbers), detail, sol.limit_value, sol.limit);
+  std::snprintf(s->error, sizeof(s->error), "%s: %s%s%s", what, name, cable, numbers);
+}
+
+// Reads the joints into *q: FASTCAL_OK, or FASTCAL_INVALID_INPUT naming the joint.
+int ReadJoints(fastcal_solver* s, const double* joints, JointValues* q) {
+  *q = {};
+  if (joints == nullptr || s->num_joints == 0) return FASTCAL_OK;
+  for (int j = 0; j < s->num_joints; ++j) {
+    const std::string& name = s->joint_names[j];
+    const bool angle = name.size() > 4 && name.compare(name.size() - 4, 4, "_deg") == 0;
+    const double limit = angle ? kMaxJointDeg : kMaxJointM;
+    if (!std::isfinite(joints[j]) || std::fabs(joints[j]) > limit) {
+      std::snprintf(s->error, sizeof(s->error),
+                    "invalid_input: joint %d (%s) = %g is not a %s within %g", j, name.c_str(),
+                    joints[j], angle ? "finite angle (deg)" : "finite shift (m)", limit);
+      return FASTCAL_INVALID_INPUT;
+    }
+    (*q)[j] = joints[j];
+  }
+  return FASTCAL_OK;
+}
+
+fastcal::Pose PoseOf(const double position_m[3], const double rpy_deg[3]) {
+  fastcal::Pose pose;
+  pose.position_m = Eigen::Vector3d(position_m[0], position_m[1], position_m[2]);
+  pose.rotation = fastcal::RotationFromRpyDeg(rpy_deg[0], rpy_deg[1], rpy_deg[2]);
+  return pose;
+}
+
+// Common entry checks: a handle, a loaded model, the arrays.
+int Enter(fastcal_solver* s, bool arrays_given) {
+  if (s == nullptr) return FASTCAL_ERROR_NULL_ARGUMENT;
+  if (!s->ready) return FASTCAL_ERROR_NO_MODEL;  // the creation's message stays
+  if (!arrays_given) {
+    SetError(s, "null_argument: a required array is NULL");
+    return FASTCAL_ERROR_NULL_ARGUMENT;
+  }
+  s->error[0] = '\0';
+  return FASTCAL_OK;
+}
+
+// The exact statics at a pose, warm from s->last; on ok, s->last is the answer.
+int Solve(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
+          const double* joints) {
+  JointValues q;
+  if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
+  s->trial = s->last;
+  const StaticsStatus status =
+      fastcal::SolveStatics(s->robot, PoseOf(position_m, rpy_deg), q, s->options, &s->trial);
+  if (status != StaticsStatus::kOk) {
+    DescribeFailure(s, "solve", s->trial);
+    return static_cast<int>(status);
+  }
+  s->last = s->trial;
+  return FASTCAL_OK;
+}
+
+void FillStatics(const StaticsSolution& sol, int status, fastcal_statics* out) {
+  std::memset(out, 0, sizeof(*out));
+  out->status = status;
+  out->cable = sol.cable;
+  out->iterations = sol.outer_iterations;
+  out->continuation = sol.continuation ? 1 : 0;
+  if (status != FASTCAL_OK) return;
+  for (int i = 0; i < kNumCables; ++i) {
+    const fastcal::CableSolution& c = sol.cables[i];
+    out->tension_kN[i] = c.lower_tension_n * kKnPerN;
+    out->upper_tension_kN[i] = c.upper_tension_n * kKnPerN;
+    for (int k = 0; k < 3; ++k) out->force_kN[i][k] = c.force_n[k] * kKnPerN;
+    out->unstretched_m[i] = c.unstretched_length_m;
+  }
+  out->error_estimate = sol.error_estimate;
+  out->reflector_clearance_m = sol.reflector_clearance_m;
+}
+
+}  // namespace
+
+extern "C" {
+
+const char* fastcal_version(void) { return FASTCAL_VERSION; }
+
+const char* fastcal_status_name(int status) {
+  if (status >= 0 && status <= static_cast<int>(fastcal::kLastStaticsStatus)) {
+    return fastcal::StaticsStatusName(static_cast<StaticsStatus>(status));
+  }
+  switch (status) {
+    case FASTCAL_BELOW_MIN_TENSION:
+      return "below_min_tension";
+    case FASTCAL_ABOVE_MAX_TENSION:
+      return "above_max_tension";
+    case FASTCAL_INSIDE_REFLECTOR_MARGIN:
+      return "inside_reflector_margin";
+    case FASTCAL_ERROR_NULL_ARGUMENT:
+      return "null_argument";
+    case FASTCAL_ERROR_NO_MODEL:
+      return "no_model";
+    case FASTCAL_ERROR_BAD_LIMITS:
+      return "bad_limits";
+    case FASTCAL_ERROR_INTERNAL:
+      return "internal_error";
+    default:
+      return "unknown";
+  }
+}
+
+fastcal_solver* fastcal_solver_create(const char* model_path) {
+  fastcal_solver* s = new (std::nothrow) fastcal_solver;
+  if (s == nullptr) return nullptr;
+  try {
+    std::string error;
+    if (model_path == nullptr) {
+      s->robot = CableRobot::NominalFast();
+    } else if (!fastcal::LoadCableRobot(model_path, &s->robot, &error)) {
+      SetError(s, error.c_str());
+      return s;
+    }
+    s->num_joints = s->robot.moving_parts.num_joints();
+    s->joint_names = s->robot.moving_parts.JointColumns();
+    s->fixed_robot = s->robot;
+    s->fixed_robot.moving_parts = {};
+    s->options.warm_start = true;
+    s->locate_options.warm_start = true;
+    // A controller asks for the pose, not for other equilibria near it: the search's 12
+    // extra Newton runs would only add time (fastcal locate reports them).
+    s->locate_options.search_radius_m = 0.0;
+    s->locate_options.statics = s->options;
+    s->locate_options.statics.warm_start = false;
+    s->ready = true;
+  } catch (const std::exception& e) {
+    SetError(s, e.what());
+  } catch (...) {
+    SetError(s, "fastcal_solver_create: unknown exception");
+  }
+  return s;
+}
+
+const char* fastcal_solver_error(const fastcal_solver* s) {
+  return s == nullptr ? "null_argument: the fastcal_solver handle is NULL "
+                        "(fastcal_solver_create returns NULL only when out of memory)"
+                      : s->error;
+}
+
+int fastcal_solver_num_joints(const fastcal_solver* s) {
+  return s == nullptr || !s->ready ? 0 : s->num_joints;
+}
+
+const char* fastcal_solver_joint_name(const fastcal_solver* s, int j) {
+  if (s == nullptr || !s->ready || j < 0 || j >= s->num_joints) return nullptr;
+  return s->joint_names[j].c_str();
+}
+
+void fastcal_solver_reset(fastcal_solver* s) {
+  if (s == nullptr) return;
+  s->last.status = StaticsStatus::kInvalidInput;
+  s->located.status = StaticsStatus::kInvalidInput;
+  s->cycle.statics.status = StaticsStatus::kInvalidInput;
+}
+
+void fastcal_solver_destroy(fastcal_solver* s) { delete s; }
+
+int fastcal_solve_pose(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
+                       const double* joints, double tension_kN[6], double unstretched_m[6]) {
+  if (const int e = Enter(s, position_m && rpy_deg && tension_kN && unstretched_m); e != 0) {
+    return e;
+  }
+  try {
+    const int status = Solve(s, position_m, rpy_deg, joints);
+    for (int i = 0; i < kNumCables; ++i) {
+      const bool ok = status == FASTCAL_OK;
+      tension_kN[i] = ok ? s->last.cables[i].lower_tension_n * kKnPerN : 0.0;
+      unstretched_m[i] = ok ? s->last.cables[i].unstretched_length_m : 0.0;
+    }
+    return status;
+  } catch (...) {
+    SetError(s, "internal_error: an exception in fastcal_solve_pose");
+    return FASTCAL_ERROR_INTERNAL;
+  }
+}
+
+int fastcal_solve_pose_full(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
+                            const double* joints, fastcal_statics* out) {
+  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) return e;
+  try {
+    const int status = Solve(s, position_m, rpy_deg, joints);
+    FillStatics(status == FASTCAL_OK ? s->last : s->trial, status, out);
+    return status;
+  } catch (...) {
+    SetError(s, "internal_error: an exception in fastcal_solve_pose_full");
+    return FASTCAL_ERROR_INTERNAL;
+  }
+}
+
+int fastcal_locate(fastcal_solver* s, const double unstretched_m[6], const double* joints,
+                   double position_m[3], double rpy_deg[3], double tension_kN[6]) {
+  if (const int e = Enter(s, unstretched_m && position_m && rpy_deg); e != 0) return e;
+  try {
+    for (int k = 0; k < 3; ++k) position_m[k] = rpy_deg[k] = 0.0;
+    if (tension_kN != nullptr) std::fill(tension_kN, tension_kN + kNumCables, 0.0);
+    JointValues q;
+    if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
+    s->fixed_robot.mass_centre_cabin_m = s->robot.MassCentreAt(q);
+    std::array<double, kNumCables> lengths;
+    std::copy(unstretched_m, unstretched_m + kNumCables, lengths.begin());
+    s->locate_trial = s->located;
+    const StaticsStatus status =
+        fastcal::Locate(s->fixed_robot, lengths, s->locate_options, &s->locate_trial);
+    if (status != StaticsStatus::kOk) {
+      DescribeFailure(s, "locate", s->locate_trial.statics);
+      return static_cast<int>(status);
+    }
+    s->located = s->locate_trial;
+    const fastcal::Pose& pose = s->located.pose;
+    const Eigen::Vector3d rpy = fastcal::RpyDegFromRotation(pose.rotation);
+    for (int k = 0; k < 3; ++k) {
+      position_m[k] = pose.position_m[k];
+      rpy_deg[k] = rpy[k];
+    }
+    if (tension_kN != nullptr) {
+      for (int i = 0; i < kNumCables; ++i) {
+        tension_kN[i] = s->located.statics.cables[i].lower_tension_n * kKnPerN;
+      }
+    }
+    return FASTCAL_OK;
+  } catch (...) {
+    SetError(s, "internal_error: an exception in fastcal_locate");
+    return FASTCAL_ERROR_INTERNAL;
+  }
+}
+
+fastcal_cycle_limits fastcal_default_cycle_limits(void) {
+  const fastcal::ControlLimits d;
+  return {d.min_tension_n * kKnPerN, d.max_tension_n * kKnPerN, d.min_reflector_clearance_m};
+}
+
+int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
+                          const double* joints, const fastcal_cycle_limits* limits,
+                          fastcal_cycle* out) {
+  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) return e;
+  try {
+    std::memset(out, 0, sizeof(*out));
+    out->cable = -1;
+    fastcal::ControlLimits lim;
+    if (limits != nullptr) {
+      lim.min_tension_n = limits->min_tension_kN * kNPerKn;
+      lim.max_tension_n = limits->max_tension_kN * kNPerKn;
+      lim.min_reflector_clearance_m = limits->min_reflector_clearance_m;
+      if (!lim.IsValid(nullptr)) {
+        std::snprintf(s->error, sizeof(s->error),
+                      "bad_limits: min_tension_kN %g (finite, >= 0), max_tension_kN %g "
+                      "(>= min), min_reflector_clearance_m %g (finite, >= 0)",
+                      limits->min_tension_kN, limits->max_tension_kN,
+                      limits->min_reflector_clearance_m);
+        return out->status = FASTCAL_ERROR_BAD_LIMITS;
+      }
+    }
+    JointValues q;
+    if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) {
+      return out->status = status;
+    }
+    // Warm from the handle's last solve, whichever call made it.
+    s->cycle.statics = s->last;
+    const fastcal::ControlStatus status =
+        fastcal::ControlCycle(s->robot, PoseOf(position_m, rpy_deg), q, lim, s->options, &s->cycle);
+    const fastcal::ControlCycleResult& r = s->cycle;
+    out->cable = r.cable;
+    if (status == fastcal::ControlStatus::kStaticsFailed) {
+      DescribeFailure(s, "control cycle", r.statics);
+      return out->status = static_cast<int>(r.statics.status);
+    }
+    s->last = r.statics;
+    for (int i = 0; i < kNumCables; ++i) {
+      const fastcal::CableSolution& c = r.statics.cables[i];
+      out->winch_length_m[i] = r.winch_length_m[i];
+      out->unstretched_m[i] = c.unstretched_length_m;
+      out->tension_kN[i] = c.lower_tension_n * kKnPerN;
+      out->sensor_reading_kN[i] = r.sensor_reading_n[i] * kKnPerN;
+      out->upper_tension_kN[i] = c.upper_tension_n * kKnPerN;
+    }
+    out->error_estimate = r.statics.error_estimate;
+    out->reflector_clearance_m = r.statics.reflector_clearance_m;
+    out->min_tension_margin_kN = r.min_tension_margin_n * kKnPerN;
+    out->max_tension_margin_kN = r.max_tension_margin_n * kKnPerN;
+    switch (status) {
+      case fastcal::ControlStatus::kBelowMinTension:
+        out->status = FASTCAL_BELOW_MIN_TENSION;
+        std::snprintf(s->error, sizeof(s->error),
+                      "below_min_tension: cable %d at %.1f kN, under %.1f kN", r.cable + 1,
+                      out->tension_kN[r.cable], lim.min_tension_n * kKnPerN);
+        break;
+      case fastcal::ControlStatus::kAboveMaxTension:
+        out->status = FASTCAL_ABOVE_MAX_TENSION;
+        std::snprintf(s->error, sizeof(s->error),
+                      "above_max_tension: cable %d over %.1f kN by %.1f kN", r.cable + 1,
+                      lim.max_tension_n * kKnPerN, -out->max_tension_margin_kN);
+        break;
+      case fastcal::ControlStatus::kInsideReflectorMargin:
+        out->status = FASTCAL_INSIDE_REFLECTOR_MARGIN;
+        std::snprintf(s->error, sizeof(s->error),
+                      "inside_reflector_margin: a cable %.3g m from the reflector, under %.3g m",
+                      out->reflector_clearance_m, lim.min_reflector_clearance_m);
+        break;
+      default:
+        out->status = FASTCAL_OK;
+    }
+    return out->status;
+  } catch (...) {
+    SetError(s, "internal_error: an exception in fastcal_control_cycle");
+    return FASTCAL_ERROR_INTERNAL;
+  }
+}
+
+}  // extern "C"
