@@ -125,6 +125,39 @@ TEST(CalibrationTest, NoiseFreeDataRecoversTruth) {
   EXPECT_TRUE(result.before.undetermined.empty());
 }
 
+// Ctrl-C from Python (issue 37): CalibrationOptions::should_stop is asked before each
+// stage and after each solver iteration; true stops the calibration with kCancelled,
+// and it is not asked again. One that never says stop changes nothing.
+TEST(CalibrationTest, ShouldStopCancelsBetweenStagesAndIterations) {
+  const Dataset data = CircleData(Truth(), 36, 0.0, 1);
+  const CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+  CalibrationResult plain;
+  ASSERT_TRUE(CalibrateNominal(spec, data, &plain));
+  // 0: before the first stage; 3: before the fourth; 6: inside the solve (five stages
+  // are asked before it, then Ceres after its iteration 0).
+  for (int allowed : {0, 3, 6}) {
+    int asked = 0;
+    CalibrationOptions options;
+    options.should_stop = [&] { return ++asked > allowed; };
+    CalibrationResult result;
+    std::string error;
+    EXPECT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, options, &result, &error),
+              CalibrationStatus::kCancelled)
+        << "after " << allowed << " asks";
+    EXPECT_NE(error.find("stopped on request"), std::string::npos) << error;
+    EXPECT_EQ(asked, allowed + 1);
+  }
+  CalibrationOptions never;
+  never.should_stop = [] { return false; };
+  CalibrationResult result;
+  std::string error;
+  ASSERT_EQ(Calibrate(CableRobot::NominalFast(), spec, data, never, &result, &error),
+            CalibrationStatus::kOk)
+      << error;
+  EXPECT_EQ(result.final_cost, plain.final_cost);
+  EXPECT_EQ(result.calibrated.mass_centre_cabin_m, plain.calibrated.mass_centre_cabin_m);
+}
+
 // A fit through AAS converges like one through exact: Calibrate solves with
 // ModelFitStaticsOptions. With AAS's loose control-loop tolerances (the default
 // StaticsOptions) Ceres took 17 iterations instead of 6 on 1e4 samples.

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -359,6 +360,55 @@ TEST_F(SeasonTest, UpdateFoldsOnlyTheNewDay) {
   // Nothing new: nothing folded.
   const TrackResult again = Track(*spec_, {a, b}, dir + "/track");
   EXPECT_EQ(again.folds, 0);
+}
+
+// A run told to stop (TrackOptions::should_stop: a Python caller's Ctrl-C, issue 37) at
+// any point before its outputs returns kCancelled and leaves an existing track exactly
+// as it was; the next run updates it as if nothing had happened.
+TEST_F(SeasonTest, ACancelledUpdateLeavesTheTrackAsItWas) {
+  Dataset first = *data_, last = *data_;
+  first.samples.clear();
+  last.samples.clear();
+  for (const Sample& s : data_->samples) {
+    (s.time_s < kStartS + (kDays - 1) * kDayS - 3600.0 ? first : last).samples.push_back(s);
+  }
+  const std::string dir = *dir_ + "/cancel";
+  fs::create_directories(dir);
+  const std::string a = Write(first, dir + "/a.csv"), b = Write(last, dir + "/b.csv");
+  const std::string out = dir + "/track";
+  Track(*spec_, {a}, out);
+  // Every file of the track, with its bytes.
+  auto snapshot = [&] {
+    std::map<std::string, std::string> files;
+    for (const auto& e : fs::recursive_directory_iterator(out)) {
+      if (!e.is_regular_file()) continue;
+      std::ifstream in(e.path(), std::ios::binary);
+      std::ostringstream bytes;
+      bytes << in.rdbuf();
+      files[e.path().string()] = bytes.str();
+    }
+    return files;
+  };
+  const auto before = snapshot();
+  // Stops at the 1st ask (before any stage), the 4th (reading the new file), the 8th
+  // (inside the iterations).
+  for (int allowed : {0, 3, 7}) {
+    int asked = 0;
+    TrackOptions options;
+    options.should_stop = [&] { return ++asked > allowed; };
+    TrackResult result;
+    std::string error;
+    EXPECT_EQ(RunTrack(CableRobot::NominalFast(), *spec_, {a, b}, WindowSpec(), out, options,
+                       &result, &error),
+              TrackStatus::kCancelled)
+        << "after " << allowed << " asks: " << error;
+    EXPECT_NE(error.find("stopped on request"), std::string::npos) << error;
+    EXPECT_EQ(asked, allowed + 1);  // not asked again once it said stop
+    EXPECT_TRUE(snapshot() == before) << "after " << allowed << " asks the track changed";
+  }
+  const TrackResult after = Track(*spec_, {a, b}, out);
+  EXPECT_TRUE(after.updated);
+  EXPECT_EQ(after.windows.size(), static_cast<size_t>(kDays));
 }
 
 // The per-window estimates cover the truth at their stated rate: over seasons drawn with

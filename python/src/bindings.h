@@ -40,6 +40,18 @@ class InterruptCheck {
     interrupted_ = PyErr_CheckSignals() != 0;
     return interrupted_;
   }
+  // Asks now, whatever the count: the library's should_stop (CalibrationOptions,
+  // TrackOptions), called between pieces of work that each take long enough. Once true,
+  // stays true without asking again.
+  bool Now() {
+    if (interrupted_) return true;
+    py::gil_scoped_acquire gil;
+    interrupted_ = PyErr_CheckSignals() != 0;
+    return interrupted_;
+  }
+  std::function<bool()> AsShouldStop() {
+    return [this] { return Now(); };
+  }
   // With the GIL held: KeyboardInterrupt (or what the signal's handler raised).
   void ThrowIfInterrupted() const {
     if (interrupted_) throw py::error_already_set();

@@ -258,6 +258,8 @@ const char* StatusName(CalibrationStatus status) {
       return "solver failed";
     case CalibrationStatus::kMostlyGrossErrors:
       return "mostly gross errors";
+    case CalibrationStatus::kCancelled:
+      return "cancelled";
   }
   return "unknown";
 }
@@ -298,11 +300,14 @@ py::tuple Calibrate(const CableRobot& model_argument, const std::string& spec_pa
   CalibrationStatus status;
   CalibrationOptions options;
   if (!quiet) options.progress = ProgressTo("fastcal.calibrate: ");
+  InterruptCheck interrupt;  // Ctrl-C between stages and solver iterations
+  options.should_stop = interrupt.AsShouldStop();
   {
     py::gil_scoped_release release;
     // Calibrate's evaluation stage fills result.variants (the before/after table).
     status = fastcal::Calibrate(state->model, state->spec, data, options, &state->result, &error);
   }
+  interrupt.ThrowIfInterrupted();
   if (status == CalibrationStatus::kInvalidInput) throw InputError(error);
   if (status != CalibrationStatus::kOk) throw CalibrationError(StatusName(status), error);
   return py::make_tuple(ResultDict(state->result), state);

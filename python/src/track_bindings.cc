@@ -132,16 +132,18 @@ const char* StatusName(TrackStatus status) {
       return "undetermined";
     case TrackStatus::kFailed:
       return "failed";
+    case TrackStatus::kCancelled:
+      return "cancelled";
   }
   return "unknown";
 }
 
 // fold_many(list of task bytes) -> list of fold bytes, or None to fold on threads.
 py::dict Track(const CableRobot& model_argument, const std::string& spec_path_or_text,
-               bool spec_is_text,
-               const std::string& spec_source, const std::vector<std::string>& data,
-               const std::string& out, const std::string& window_text, int threads, bool refold,
-               bool force, const std::string& map_text, const std::string& map_source,
+               bool spec_is_text, const std::string& spec_source,
+               const std::vector<std::string>& data, const std::string& out,
+               const std::string& window_text, int threads, bool refold, bool force,
+               const std::string& map_text, const std::string& map_source,
                const py::object& fold_many, bool quiet) {
   // A copy with the GIL held: the track runs without it, and wrote another model than the
   // one it fitted when another thread assigned to this one meanwhile (issue 37).
@@ -162,6 +164,8 @@ py::dict Track(const CableRobot& model_argument, const std::string& spec_path_or
   options.refold_all = refold;
   options.force = force;
   if (!quiet) options.progress = ProgressTo("fastcal.track: ");
+  InterruptCheck interrupt;  // Ctrl-C between files, stages and iterations
+  options.should_stop = interrupt.AsShouldStop();
   options.read.columns = MapOrThrow(map_text, map_source, false, false);
   if (!fold_many.is_none()) {
     options.runner = [&fold_many](const std::vector<std::string>& tasks,
@@ -185,6 +189,7 @@ py::dict Track(const CableRobot& model_argument, const std::string& spec_path_or
     py::gil_scoped_release release;
     status = RunTrack(model, spec, data, window, out, options, &result, &error);
   }
+  interrupt.ThrowIfInterrupted();
   if (status == TrackStatus::kInvalidInput) throw InputError(error);
   if (status != TrackStatus::kOk) throw CalibrationError(StatusName(status), error);
   return ResultDict(result);

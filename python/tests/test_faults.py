@@ -165,6 +165,42 @@ KEYBOARD_INTERRUPT = textwrap.dedent(
 )
 
 
+KEYBOARD_INTERRUPT_CALIBRATE = textwrap.dedent(
+    """
+    import os, signal, sys, threading, time
+    import fastcal
+    positions = fastcal.random_workspace(200_000, seed=2)
+    data, _, _ = fastcal.simulate(positions, quat=fastcal.focal_attitude(positions), seed=3)
+    start = time.time()
+    fastcal.calibrate(sys.argv[1], data)
+    whole = time.time() - start  # seconds here, most of them in the solve
+    def interrupt():
+        time.sleep(0.2 * whole)
+        os.kill(os.getpid(), signal.SIGINT)
+    threading.Thread(target=interrupt).start()
+    start = time.time()
+    try:
+        fastcal.calibrate(sys.argv[1], data)
+        print("finished")
+    except KeyboardInterrupt:
+        print("interrupted", (time.time() - start) / whole)
+    """
+)
+
+
+def test_ctrl_c_stops_a_long_calibration(data_dir) -> None:
+    # Issue 37: fastcal.calibrate (and fastcal.track) ask Python between stages and solver
+    # iterations (CalibrationOptions::should_stop) and raise KeyboardInterrupt there, not
+    # once the whole calibration has run (as before: the signal came at 20% of it).
+    run = subprocess.run(
+        [sys.executable, "-c", KEYBOARD_INTERRUPT_CALIBRATE, str(data_dir / "spec_realistic.yaml")],
+        capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    word, fraction = run.stdout.split()
+    assert word == "interrupted"
+    assert float(fraction) < 0.7, run.stdout  # the signal at 0.2, a stage or iteration later
+
+
 def test_ctrl_c_stops_a_long_solve() -> None:
     # Issue 37: Ctrl-C acted only when the C++ call returned (minutes later). The loop
     # now asks Python every 2048 poses.

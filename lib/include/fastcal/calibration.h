@@ -52,6 +52,10 @@ namespace fastcal {
 struct CalibrationOptions {
   // Called once per solver iteration with a one-line summary; the library never prints.
   std::function<void(const std::string&)> progress;
+  // Asked between pieces of work (before each stage, after each solver iteration), on the
+  // calling thread: true stops the calibration, which returns kCancelled with nothing
+  // more computed (a Python caller's Ctrl-C). Null: never stops.
+  std::function<bool()> should_stop;
   // Singular-value ratio below which a direction counts as undetermined (refused).
   double undetermined_ratio = 1e-8;
   // Ratio below which a direction counts as poorly determined (reported).
@@ -378,6 +382,7 @@ enum class CalibrationStatus {
   kInfeasible,         // the initial model cannot hold a sample's pose
   kSolverFailed,       // Ceres failed
   kMostlyGrossErrors,  // more than max_gross_error_fraction of the readings flagged
+  kCancelled,          // CalibrationOptions::should_stop said so
 };
 
 // The model the calibration starts from: `model` with the spec's initial values applied

@@ -91,6 +91,10 @@ inline constexpr long long kTrackMaxFileBytes = 1LL << 40;
 struct TrackOptions {
   // One line per stage and iteration; the library never prints.
   std::function<void(const std::string&)> progress;
+  // Asked between pieces of work (before each stage, each data file read, each
+  // iteration's folds), on the calling thread: true stops the run, which returns
+  // kCancelled and leaves the track as it was (a Python caller's Ctrl-C). Null: never.
+  std::function<bool()> should_stop;
   // Folds run at once on this machine (one window each; a lone window uses them all).
   // 1 to kMaxCalibrationThreads (256).
   int threads = 2;
@@ -241,6 +245,7 @@ enum class TrackStatus {
   kInfeasible,    // a pose the model cannot solve at the track's point
   kUndetermined,  // a window's or the shared parameters cannot be determined
   kFailed,        // a fold runner failed, or the files could not be written
+  kCancelled,     // TrackOptions::should_stop said so (the track is left as it was)
 };
 
 // Builds (or updates) the track in `out_dir` from the data files (a directory stands for

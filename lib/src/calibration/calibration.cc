@@ -2,7 +2,6 @@
 // (Run), called in order by Calibrate. The least-squares problem and its identifiability
 // are here; the linearisation at the solution is calibration_linearisation.cc, the budget
 // and the score test uncertainty.cc, the gross-error screen gross_errors.cc.
-#include "fastcal/tension_scale.h"
 #include "fastcal/calibration.h"
 
 #include <ceres/ceres.h>
@@ -28,6 +27,7 @@
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/model_plausibility.h"
+#include "fastcal/tension_scale.h"
 
 namespace fastcal {
 
@@ -122,6 +122,23 @@ class ProgressCallback : public ceres::IterationCallback {
   std::function<void(const std::string&)> f_;
 };
 
+// Ceres asks after each iteration whether to go on: CalibrationOptions::should_stop.
+class StopCallback : public ceres::IterationCallback {
+ public:
+  explicit StopCallback(const std::function<bool()>& should_stop) : should_stop_(should_stop) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    stopped_ = stopped_ || should_stop_();
+    return stopped_ ? ceres::SOLVER_ABORT : ceres::SOLVER_CONTINUE;
+  }
+  bool stopped() const { return stopped_; }
+
+ private:
+  std::function<bool()> should_stop_;
+  bool stopped_ = false;
+};
+
+constexpr char kCancelledMessage[] = "stopped on request (CalibrationOptions::should_stop)";
+
 std::unique_ptr<ceres::LossFunction> MakeLoss(const CalibrationSpec& spec) {
   if (spec.robust_loss == RobustLoss::kHuber) {
     return std::make_unique<ceres::HuberLoss>(spec.robust_loss_scale);
@@ -158,9 +175,9 @@ CalibrationStatus ValidateInputs(Run& run) {
   if (run.spec.slow_error.enabled && run.data.samples.size() > 1) {
     // A slow error correlates readings by their times: times that never advance (every
     // sample at one time_s) make it any value at all, fitted silently before (issue 37).
-    const auto [lo, hi] = std::minmax_element(
-        run.data.samples.begin(), run.data.samples.end(),
-        [](const Sample& a, const Sample& b) { return a.time_s < b.time_s; });
+    const auto [lo, hi] =
+        std::minmax_element(run.data.samples.begin(), run.data.samples.end(),
+                            [](const Sample& a, const Sample& b) { return a.time_s < b.time_s; });
     if (lo->time_s == hi->time_s) {
       return run.Fail(CalibrationStatus::kInvalidInput,
                       run.data.path + ": every sample has time_s = " +
@@ -301,9 +318,8 @@ CalibrationStatus Predict(Run& run) {
   const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& sample = run.data.samples[t];
     at.starts.At(t).Restore(run.PoseOf(sample), options.method, solution);
-    return SolveStaticsWithParameters(session_params[sample.session],
-                                      run.cm->robot().moving_parts, sample.joint,
-                                      run.PoseOf(sample), options, solution);
+    return SolveStaticsWithParameters(session_params[sample.session], run.cm->robot().moving_parts,
+                                      sample.joint, run.PoseOf(sample), options, solution);
   };
   const int failed =
       internal::ForEachChunk(num_samples, run.spec.num_threads, [&](int begin, int end) {
@@ -595,7 +611,15 @@ CalibrationStatus SolveAndReweight(Run& run) {
     ceres::Solver::Options options = pass == 1 ? first : later;
     internal::DecrementStop stop = MakeDecrementStop(run, options.function_tolerance);
     options.callbacks.push_back(&stop);
+    std::unique_ptr<StopCallback> cancel;
+    if (run.options.should_stop) {
+      cancel = std::make_unique<StopCallback>(run.options.should_stop);
+      options.callbacks.push_back(cancel.get());
+    }
     ceres::Solve(options, run.problem.get(), &summary);
+    if (cancel && cancel->stopped()) {
+      return run.Fail(CalibrationStatus::kCancelled, kCancelledMessage);
+    }
     if (stop.stopped()) {  // where Ceres would have stopped after one more cost evaluation
       summary.termination_type = ceres::CONVERGENCE;
       summary.message = stop.Reason();
@@ -765,6 +789,9 @@ CalibrationStatus RunPipeline(const CableRobot& model, const CalibrationSpec& sp
                                {"conclude", Conclude},
                                {"evaluate", Evaluate}};
   for (const NamedStage& s : stages) {
+    if (options.should_stop && options.should_stop()) {
+      return run.Fail(CalibrationStatus::kCancelled, kCancelledMessage);
+    }
     const auto start = std::chrono::steady_clock::now();
     const Usage before = ProcessUsage();
     const CalibrationStatus status = s.stage(run);

@@ -255,6 +255,13 @@ TrackStatus RunTrack(const CableRobot& model, const CalibrationSpec& spec,
                                {"finish", internal::FinishDirectory}};
   for (const NamedStage& s : stages) {
     TrackStatus status = TrackStatus::kOk;
+    // Up to the outputs: once they are written, the state and the directory's commit
+    // follow, so that a stop there would leave more to roll back than it saves.
+    const bool may_stop = std::string(s.name) != "state" && std::string(s.name) != "finish";
+    if (may_stop && run.StopRequested()) {
+      internal::RollBack(run);
+      return run.Cancel();
+    }
     if (std::string(s.name) == "prepare") {
       status = Expand(run, data);
       if (status == TrackStatus::kOk) status = s.stage(run);

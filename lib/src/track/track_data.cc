@@ -192,9 +192,9 @@ SavedState ParseState(const std::string& text) {
     w.fold_file = Text(n["fold"]);
     if (!IsSafeLabel(w.label) ||
         (!w.fold_file.empty() && w.fold_file.rfind("folds/" + w.label + ".g", 0) != 0)) {
-      throw YAML::Exception(n["label"].Mark(),
-                            "window label or fold '" + w.label + "' is not one this program "
-                            "writes (a path outside the track?)");
+      throw YAML::Exception(n["label"].Mark(), "window label or fold '" + w.label +
+                                                   "' is not one this program "
+                                                   "writes (a path outside the track?)");
     }
     if (n["fold_sha256"]) w.fold_sha256 = Text(n["fold_sha256"]);
     if (n["store_bytes"]) w.store_bytes = Integer(n["store_bytes"]);
@@ -322,9 +322,10 @@ bool LoadFolds(TrackRun& run) {
     std::string digest, why;
     bool ok = true;
     if (!w.fold_sha256.empty() && (!FileSha256(path, &digest, &why) || digest != w.fold_sha256)) {
-      why = path + ": " + (why.empty() ? "not the fold this track wrote (its SHA-256 differs "
-                                         "from track_state.json's)"
-                                       : why);
+      why = path + ": " +
+            (why.empty() ? "not the fold this track wrote (its SHA-256 differs "
+                           "from track_state.json's)"
+                         : why);
       ok = false;
     }
     if (ok && !LoadFold(run, &w, &why)) ok = false;
@@ -691,6 +692,7 @@ TrackStatus ReadNewFiles(TrackRun& run) {
                     [&](const TrackFile& f) { return f.path == path; })) {
       continue;
     }
+    if (run.StopRequested()) return run.Cancel();
     run.Progress("reading " + path);
     if (!ReadFile(router, path, run.error)) return TrackStatus::kInvalidInput;
     ++read;

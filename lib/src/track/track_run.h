@@ -144,6 +144,12 @@ struct TrackRun {
     *error = why;
     return status;
   }
+  // TrackOptions::should_stop asked between pieces of work; true: the caller returns
+  // Cancel().
+  bool StopRequested() const { return options.should_stop && options.should_stop(); }
+  TrackStatus Cancel() const {
+    return Fail(TrackStatus::kCancelled, "stopped on request (TrackOptions::should_stop)");
+  }
   void Progress(const std::string& line) const {
     if (options.progress) options.progress(line);
   }

@@ -413,6 +413,7 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
   std::vector<std::vector<double>> previous_theta(run.windows.size());
   int halvings = 0;
   for (int it = 1; it <= run.options.max_iterations; ++it) {
+    if (run.StopRequested()) return run.Cancel();
     ++run.result->iterations;
     const bool folded = FoldDirty(run);
     const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
