@@ -14,6 +14,7 @@
 #include <atomic>
 #include <cmath>
 #include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <new>
@@ -247,6 +248,20 @@ TEST(CapiTest, MovingPartsTakeTheJoints) {
       << fastcal_solver_error(solver.s);
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[k], position[k], kRoundTripM);
 
+  // A joint outside the range the model states for it: invalid input, the range named.
+  int ranged = -1;
+  for (int j = 0; j < n && ranged < 0; ++j) {
+    if (robot.moving_parts.Joints()[j].second->has_range) ranged = j;
+  }
+  ASSERT_GE(ranged, 0) << "moving_parts.yaml states no joint range";
+  std::vector<double> beyond = joints;
+  beyond[ranged] = robot.moving_parts.Joints()[ranged].second->range_high + 1.0;
+  EXPECT_EQ(fastcal_solve_pose(solver.s, position, rpy, beyond.data(), tension, s0),
+            FASTCAL_INVALID_INPUT);
+  EXPECT_NE(std::string(fastcal_solver_error(solver.s)).find("outside the range"),
+            std::string::npos)
+      << fastcal_solver_error(solver.s);
+
   // A joint value that cannot be: named in the message, outputs zero.
   joints[1] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(fastcal_solve_pose(solver.s, position, rpy, joints.data(), tension, s0),
@@ -319,6 +334,27 @@ TEST(CapiTest, ControlCycleGivesWinchReadingsAndChecksLimits) {
   EXPECT_EQ(fastcal_control_cycle(solver.s, position, rpy, nullptr, &limits, &cycle),
             FASTCAL_ERROR_BAD_LIMITS);
   EXPECT_NE(std::string(fastcal_solver_error(solver.s)).find("min_tension_kN"), std::string::npos);
+  fastcal_cycle_limits zeroed;
+  std::memset(&zeroed, 0, sizeof(zeroed));  // refused: it would call every pose overloaded
+  EXPECT_EQ(fastcal_control_cycle(solver.s, position, rpy, nullptr, &zeroed, &cycle),
+            FASTCAL_ERROR_BAD_LIMITS);
+  EXPECT_NE(std::string(fastcal_solver_error(solver.s)).find("fastcal_default_cycle_limits"),
+            std::string::npos);
+
+  // The winch lengths it commands locate the pose, through the model's offsets.
+  ASSERT_EQ(fastcal_control_cycle(solver.s, position, rpy, nullptr, nullptr, &cycle), FASTCAL_OK);
+  double back[3], back_rpy[3];
+  ASSERT_EQ(fastcal_locate_winch(solver.s, cycle.winch_length_m, nullptr, back, back_rpy, nullptr),
+            FASTCAL_OK)
+      << fastcal_solver_error(solver.s);
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(back[k], position[k], kRoundTripM);
+  double offsets[6], gains[6], biases_kn[6];
+  ASSERT_EQ(fastcal_solver_sensors(solver.s, offsets, gains, biases_kn), FASTCAL_OK);
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_EQ(offsets[i], robot.cables[i].length_offset_m);
+    EXPECT_EQ(gains[i], robot.cables[i].sensor_gain);
+    EXPECT_NEAR(biases_kn[i] * kNPerKn, robot.cables[i].sensor_bias_n, 1e-9);
+  }
   std::remove(path.c_str());
 }
 
@@ -330,8 +366,17 @@ TEST(CapiTest, BadInputIsAStatusWithAMessageAndZeros) {
   EXPECT_NE(std::string(fastcal_solver_error(bad.s)).find(missing), std::string::npos)
       << fastcal_solver_error(bad.s);
   double position[3] = {0.0, 0.0, 140.0}, rpy[3] = {0.0, 0.0, 0.0}, tension[6], s0[6];
+  for (double& t : tension) t = -1.0;
   EXPECT_EQ(fastcal_solve_pose(bad.s, position, rpy, nullptr, tension, s0), FASTCAL_ERROR_NO_MODEL);
   EXPECT_NE(std::string(fastcal_solver_error(bad.s)).find(missing), std::string::npos);
+  for (double t : tension) EXPECT_EQ(t, 0.0);  // zeroed, not left as they were
+  fastcal_cycle cycle;
+  std::memset(&cycle, 0x7f, sizeof(cycle));
+  EXPECT_EQ(fastcal_control_cycle(bad.s, position, rpy, nullptr, nullptr, &cycle),
+            FASTCAL_ERROR_NO_MODEL);
+  EXPECT_EQ(cycle.status, FASTCAL_ERROR_NO_MODEL);
+  EXPECT_EQ(cycle.winch_length_m[0], 0.0);
+  EXPECT_EQ(cycle.cable, -1);
 
   // NULL handle and arrays.
   EXPECT_EQ(fastcal_solve_pose(nullptr, position, rpy, nullptr, tension, s0),
@@ -349,6 +394,8 @@ TEST(CapiTest, BadInputIsAStatusWithAMessageAndZeros) {
   EXPECT_EQ(fastcal_solve_pose(solver.s, bad_position, rpy, nullptr, tension, s0),
             FASTCAL_INVALID_INPUT);
   for (double t : tension) EXPECT_EQ(t, 0.0);
+  EXPECT_NE(std::string(fastcal_solver_error(solver.s)).find("position_m[0]"), std::string::npos)
+      << fastcal_solver_error(solver.s);
   double far[3] = {0.0, 0.0, 260.0};  // above the towers' reach: the cables cannot hold it
   const int status = fastcal_solve_pose(solver.s, far, rpy, nullptr, tension, s0);
   EXPECT_NE(status, FASTCAL_OK);
@@ -360,6 +407,21 @@ TEST(CapiTest, BadInputIsAStatusWithAMessageAndZeros) {
   // The handle recovers: the next good pose solves, and the message is cleared.
   EXPECT_EQ(fastcal_solve_pose(solver.s, position, rpy, nullptr, tension, s0), FASTCAL_OK);
   EXPECT_STREQ(fastcal_solver_error(solver.s), "");
+  // A mass centre 4 m off the axis: nothing holds it; the message says what was tried, not
+  // "error estimate 0 over 0" (a fresh-eyes review).
+  CableRobot tipping = CableRobot::NominalFast();
+  tipping.mass_centre_cabin_m = Eigen::Vector3d(4.0, 0.0, 0.5);
+  const std::string tipping_path = test::TempPath("capi_tipping.yaml");
+  std::string error;
+  ASSERT_TRUE(SaveCableRobot(tipping, tipping_path, "capi_test", &error)) << error;
+  Solver tipped(tipping_path.c_str());
+  const int tipped_status = fastcal_solve_pose(tipped.s, position, rpy, nullptr, tension, s0);
+  EXPECT_NE(tipped_status, FASTCAL_OK);
+  const std::string why = fastcal_solver_error(tipped.s);
+  EXPECT_EQ(why.find("over 0"), std::string::npos) << why;
+  EXPECT_GT(why.size(), 40u) << why;
+  std::remove(tipping_path.c_str());
+
   // Lengths that cannot hold the cabin.
   double slack[6] = {400, 400, 400, 400, 400, 400}, back[3], back_rpy[3];
   EXPECT_NE(fastcal_locate(solver.s, slack, nullptr, back, back_rpy, nullptr), FASTCAL_OK);
@@ -502,6 +564,8 @@ TEST_F(CapiAllocationTest, LocateAndControlCycleAllocateNothing) {
                                             nullptr, &cycle) < 0;
           failures += fastcal_locate(solver.s, lengths[n].data(), joints.data(), position, rpy,
                                      tension) != 0;
+          failures += fastcal_locate_winch(solver.s, cycle.winch_length_m, joints.data(), position,
+                                           rpy, tension) != 0;
         }
       },
       &allocations, &locks);

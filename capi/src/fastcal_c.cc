@@ -6,6 +6,8 @@
 // a failure's message is written with snprintf into that buffer from the status' numbers
 // (not DescribeStatus, which builds a std::string). tests/capi_test.cc counts allocations
 // and locks over 10^4 warm, cold and failing solves.
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -37,6 +39,9 @@ struct fastcal_solver {
   bool ready = false;
   int num_joints = 0;
   std::vector<std::string> joint_names;
+  // Each joint's range as the model file states it (columns' units), if it does.
+  std::vector<bool> joint_has_range;
+  std::vector<double> joint_low, joint_high;
   fastcal::StaticsOptions options;
   fastcal::LocateOptions locate_options;
   StaticsSolution last;   // the last ok solve: the next one's warm start
@@ -72,14 +77,24 @@ void DescribeFailure(fastcal_solver* s, const char* what, const StaticsSolution&
       detail = ": s0/k %.4g over the model's limit %.4g";
       break;
     case StaticsStatus::kOverstretchedCable:
-      detail = ": strain (or s0/k where s0 <= 0) %.4g beyond the model's limit %.4g";
+      detail = sol.limit_value > 0.0 ? ": strain %.4g over the model's max_strain %.4g"
+                                     : ": its unstretched length would be <= 0 (s0/k %.4g)";
       break;
     case StaticsStatus::kReflectorContact:
       detail = ": clearance %.4g m under %.4g m";
       break;
     case StaticsStatus::kNotConverged:
     case StaticsStatus::kInaccurate:
-      detail = ": error estimate %.3g over %.3g";
+      detail = sol.limit > 0.0
+                   ? ": error estimate %.3g over %.3g"
+                   : ": neither Newton from the start nor the continuation from the home pose "
+                     "found an equilibrium within their iteration bounds (a mass centre, with "
+                     "the joints, beyond what the cables can hold?)";
+      break;
+    case StaticsStatus::kNoEquilibrium:
+      detail =
+          ": the equilibrium followed from the home pose ends before this pose (the "
+          "cables cannot hold the cabin there with every cable pulling)";
       break;
     case StaticsStatus::kAttachmentBeyondCable:
       detail = ": an attachment at %.4g m, beyond s0 %.4g m";
@@ -87,7 +102,7 @@ void DescribeFailure(fastcal_solver* s, const char* what, const StaticsSolution&
     default:
       break;
   }
-  char numbers[160] = "";
+  char numbers[256] = "";
   if (*detail != '\0') std::snprintf(numbers, sizeof(numbers), detail, sol.limit_value, sol.limit);
   std::snprintf(s->error, sizeof(s->error), "%s: %s%s%s", what, name, cable, numbers);
 }
@@ -106,9 +121,33 @@ int ReadJoints(fastcal_solver* s, const double* joints, JointValues* q) {
                     joints[j], angle ? "finite angle (deg)" : "finite shift (m)", limit);
       return FASTCAL_INVALID_INPUT;
     }
+    if (s->joint_has_range[j] && !(joints[j] >= s->joint_low[j] && joints[j] <= s->joint_high[j])) {
+      std::snprintf(s->error, sizeof(s->error),
+                    "invalid_input: joint %d (%s) = %g is outside the range [%g, %g] the model "
+                    "states for it",
+                    j, name.c_str(), joints[j], s->joint_low[j], s->joint_high[j]);
+      return FASTCAL_INVALID_INPUT;
+    }
     (*q)[j] = joints[j];
   }
   return FASTCAL_OK;
+}
+
+// A non-finite position or attitude, named: FASTCAL_INVALID_INPUT.
+int CheckPose(fastcal_solver* s, const double position_m[3], const double rpy_deg[3]) {
+  for (int k = 0; k < 3; ++k) {
+    const bool position = !std::isfinite(position_m[k]);
+    if (position || !std::isfinite(rpy_deg[k])) {
+      std::snprintf(s->error, sizeof(s->error), "invalid_input: %s[%d] = %g is not finite",
+                    position ? "position_m" : "rpy_deg", k, position ? position_m[k] : rpy_deg[k]);
+      return FASTCAL_INVALID_INPUT;
+    }
+  }
+  return FASTCAL_OK;
+}
+
+void Zero(double* a, int n) {
+  if (a != nullptr) std::fill(a, a + n, 0.0);
 }
 
 fastcal::Pose PoseOf(const double position_m[3], const double rpy_deg[3]) {
@@ -133,6 +172,7 @@ int Enter(fastcal_solver* s, bool arrays_given) {
 // The exact statics at a pose, warm from s->last; on ok, s->last is the answer.
 int Solve(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
           const double* joints) {
+  if (const int status = CheckPose(s, position_m, rpy_deg); status != FASTCAL_OK) return status;
   JointValues q;
   if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
   s->trial = s->last;
@@ -207,6 +247,11 @@ fastcal_solver* fastcal_solver_create(const char* model_path) {
     }
     s->num_joints = s->robot.moving_parts.num_joints();
     s->joint_names = s->robot.moving_parts.JointColumns();
+    for (const auto& [part, joint] : s->robot.moving_parts.Joints()) {
+      s->joint_has_range.push_back(joint->has_range);
+      s->joint_low.push_back(joint->range_low);
+      s->joint_high.push_back(joint->range_high);
+    }
     s->fixed_robot = s->robot;
     s->fixed_robot.moving_parts = {};
     s->options.warm_start = true;
@@ -251,17 +296,17 @@ void fastcal_solver_destroy(fastcal_solver* s) { delete s; }
 
 int fastcal_solve_pose(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                        const double* joints, double tension_kN[6], double unstretched_m[6]) {
-  if (const int e = Enter(s, position_m && rpy_deg && tension_kN && unstretched_m); e != 0) {
-    return e;
-  }
+  Zero(tension_kN, kNumCables);
+  Zero(unstretched_m, kNumCables);
+  if (const int e = Enter(s, position_m && rpy_deg); e != 0) return e;
   try {
     const int status = Solve(s, position_m, rpy_deg, joints);
+    if (status != FASTCAL_OK) return status;
     for (int i = 0; i < kNumCables; ++i) {
-      const bool ok = status == FASTCAL_OK;
-      tension_kN[i] = ok ? s->last.cables[i].lower_tension_n * kKnPerN : 0.0;
-      unstretched_m[i] = ok ? s->last.cables[i].unstretched_length_m : 0.0;
+      if (tension_kN != nullptr) tension_kN[i] = s->last.cables[i].lower_tension_n * kKnPerN;
+      if (unstretched_m != nullptr) unstretched_m[i] = s->last.cables[i].unstretched_length_m;
     }
-    return status;
+    return FASTCAL_OK;
   } catch (...) {
     SetError(s, "internal_error: an exception in fastcal_solve_pose");
     return FASTCAL_ERROR_INTERNAL;
@@ -270,10 +315,21 @@ int fastcal_solve_pose(fastcal_solver* s, const double position_m[3], const doub
 
 int fastcal_solve_pose_full(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                             const double* joints, fastcal_statics* out) {
-  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) return e;
+  if (out != nullptr) {
+    std::memset(out, 0, sizeof(*out));
+    out->cable = -1;
+  }
+  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) {
+    if (out != nullptr) out->status = e;
+    return e;
+  }
   try {
     const int status = Solve(s, position_m, rpy_deg, joints);
     FillStatics(status == FASTCAL_OK ? s->last : s->trial, status, out);
+    if (status == FASTCAL_INVALID_INPUT) {  // refused before a solve: nothing of one
+      out->cable = -1;
+      out->iterations = out->continuation = 0;
+    }
     return status;
   } catch (...) {
     SetError(s, "internal_error: an exception in fastcal_solve_pose_full");
@@ -283,10 +339,11 @@ int fastcal_solve_pose_full(fastcal_solver* s, const double position_m[3], const
 
 int fastcal_locate(fastcal_solver* s, const double unstretched_m[6], const double* joints,
                    double position_m[3], double rpy_deg[3], double tension_kN[6]) {
+  Zero(position_m, 3);
+  Zero(rpy_deg, 3);
+  Zero(tension_kN, kNumCables);
   if (const int e = Enter(s, unstretched_m && position_m && rpy_deg); e != 0) return e;
   try {
-    for (int k = 0; k < 3; ++k) position_m[k] = rpy_deg[k] = 0.0;
-    if (tension_kN != nullptr) std::fill(tension_kN, tension_kN + kNumCables, 0.0);
     JointValues q;
     if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
     s->fixed_robot.mass_centre_cabin_m = s->robot.MassCentreAt(q);
@@ -296,7 +353,11 @@ int fastcal_locate(fastcal_solver* s, const double unstretched_m[6], const doubl
     const StaticsStatus status =
         fastcal::Locate(s->fixed_robot, lengths, s->locate_options, &s->locate_trial);
     if (status != StaticsStatus::kOk) {
-      DescribeFailure(s, "locate", s->locate_trial.statics);
+      if (status == StaticsStatus::kInvalidInput) {
+        SetError(s, "invalid_input: a length is not finite or not > 0 (unstretched_m, m)");
+      } else {
+        DescribeFailure(s, "locate", s->locate_trial.statics);
+      }
       return static_cast<int>(status);
     }
     s->located = s->locate_trial;
@@ -318,6 +379,33 @@ int fastcal_locate(fastcal_solver* s, const double unstretched_m[6], const doubl
   }
 }
 
+int fastcal_locate_winch(fastcal_solver* s, const double winch_length_m[6], const double* joints,
+                         double position_m[3], double rpy_deg[3], double tension_kN[6]) {
+  double unstretched_m[kNumCables];
+  const bool ready = s != nullptr && s->ready && winch_length_m != nullptr;
+  for (int i = 0; i < kNumCables; ++i) {
+    unstretched_m[i] = ready ? winch_length_m[i] - s->robot.cables[i].length_offset_m : 0.0;
+  }
+  return fastcal_locate(s, winch_length_m != nullptr ? unstretched_m : nullptr, joints, position_m,
+                        rpy_deg, tension_kN);
+}
+
+int fastcal_solver_sensors(const fastcal_solver* s, double length_offset_m[6],
+                           double sensor_gain[6], double sensor_bias_kN[6]) {
+  Zero(length_offset_m, kNumCables);
+  Zero(sensor_gain, kNumCables);
+  Zero(sensor_bias_kN, kNumCables);
+  if (s == nullptr) return FASTCAL_ERROR_NULL_ARGUMENT;
+  if (!s->ready) return FASTCAL_ERROR_NO_MODEL;
+  for (int i = 0; i < kNumCables; ++i) {
+    const fastcal::CableProperties& c = s->robot.cables[i];
+    if (length_offset_m != nullptr) length_offset_m[i] = c.length_offset_m;
+    if (sensor_gain != nullptr) sensor_gain[i] = c.sensor_gain;
+    if (sensor_bias_kN != nullptr) sensor_bias_kN[i] = c.sensor_bias_n * kKnPerN;
+  }
+  return FASTCAL_OK;
+}
+
 fastcal_cycle_limits fastcal_default_cycle_limits(void) {
   const fastcal::ControlLimits d;
   return {d.min_tension_n * kKnPerN, d.max_tension_n * kKnPerN, d.min_reflector_clearance_m};
@@ -326,10 +414,15 @@ fastcal_cycle_limits fastcal_default_cycle_limits(void) {
 int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                           const double* joints, const fastcal_cycle_limits* limits,
                           fastcal_cycle* out) {
-  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) return e;
-  try {
+  if (out != nullptr) {
     std::memset(out, 0, sizeof(*out));
     out->cable = -1;
+  }
+  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) {
+    if (out != nullptr) out->status = e;
+    return e;
+  }
+  try {
     fastcal::ControlLimits lim;
     if (limits != nullptr) {
       lim.min_tension_n = limits->min_tension_kN * kNPerKn;
@@ -338,11 +431,15 @@ int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const d
       if (!lim.IsValid(nullptr)) {
         std::snprintf(s->error, sizeof(s->error),
                       "bad_limits: min_tension_kN %g (finite, >= 0), max_tension_kN %g "
-                      "(>= min), min_reflector_clearance_m %g (finite, >= 0)",
+                      "(> min), min_reflector_clearance_m %g (finite, >= 0); start from "
+                      "fastcal_default_cycle_limits()",
                       limits->min_tension_kN, limits->max_tension_kN,
                       limits->min_reflector_clearance_m);
         return out->status = FASTCAL_ERROR_BAD_LIMITS;
       }
+    }
+    if (const int status = CheckPose(s, position_m, rpy_deg); status != FASTCAL_OK) {
+      return out->status = status;
     }
     JointValues q;
     if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) {

@@ -19,7 +19,17 @@
  * Statuses: 0 ok; 1..12 the statics' own (fastcal_status_name: "invalid_input",
  * "no_equilibrium", ...; StaticsStatus of fastcal/statics.h, same numbers); 100..102 a
  * control cycle's limits; negative: the call itself was wrong (a NULL handle or array, a
- * handle whose model did not load). */
+ * handle whose model did not load). On any status but 0 and 100..102, every output
+ * the caller gave is zeroed (never NaN, never left as it was; a struct's status and
+ * cable set); `cable` fields count from 0 (an index into the arrays), messages name
+ * cables 1 to 6 as operators do.
+ *
+ * Warm starts: solve, solve_full and control_cycle share one (the last ok solve of the
+ * handle, a limit status included); locate keeps its own. A failure leaves them as they
+ * were: no reset is needed after one. The answer does not depend on the start (to the
+ * solver's 1e-12), only its cost does.
+ *
+ * The header is C89; the examples of docs/embedding.md are C99. */
 #ifndef FASTCAL_FASTCAL_H_
 #define FASTCAL_FASTCAL_H_
 
@@ -27,8 +37,16 @@
 extern "C" {
 #endif
 
+/* FASTCAL_VERSION ("0.2.0"), FASTCAL_VERSION_MAJOR, _MINOR, _PATCH: the version this
+ * header belongs to. The library's soname changes with the minor version (0.x). */
+#include "fastcal/version.h"
+
 #if defined(_WIN32)
+#if defined(FASTCAL_C_BUILD) /* set while building libfastcal_c itself */
+#define FASTCAL_C_API __declspec(dllexport)
+#else
 #define FASTCAL_C_API __declspec(dllimport)
+#endif
 #else
 #define FASTCAL_C_API __attribute__((visibility("default")))
 #endif
@@ -90,9 +108,12 @@ FASTCAL_C_API void fastcal_solver_reset(fastcal_solver* s);
 FASTCAL_C_API void fastcal_solver_destroy(fastcal_solver* s);
 
 /* The statics of one pose: lower-end (cabin) tensions in kN and unstretched lengths in
- * m, warm from this handle's last successful solve. `joints`: the moving parts' values
- * (fastcal_solver_num_joints of them), or NULL for all at zero. Returns 0 (ok) or a
- * status; on failure the outputs are zero, never NaN. */
+ * m, warm from this handle's last successful solve. `joints`: the moving parts' values,
+ * an array of at least fastcal_solver_num_joints(s) values in the model's order, or NULL
+ * for all at zero (check fastcal_solver_num_joints once at start-up: NULL on a model
+ * with joints is not an error). A joint outside the range the model file states for it
+ * is invalid input. tension_kN or unstretched_m may be NULL (not written then). Returns
+ * 0 (ok) or a status; on failure the outputs are zero, never NaN. */
 FASTCAL_C_API int fastcal_solve_pose(fastcal_solver* s, const double position_m[3],
                                      const double rpy_deg[3], const double* joints,
                                      double tension_kN[6], double unstretched_m[6]);
@@ -118,15 +139,29 @@ FASTCAL_C_API int fastcal_solve_pose_full(fastcal_solver* s, const double positi
                                           fastcal_statics* out);
 
 /* The pose at which the cabin hangs with unstretched lengths `unstretched_m` (the
- * model's s0: winch encoder readings minus the model's length_offset_m), warm from this
- * handle's last locate; the lower-end tensions there. `joints` as for a solve. Returns 0
- * or a status (no_equilibrium: the lengths cannot hold the cabin). tension_kN may be
- * NULL. */
+ * model's s0, as the solves return them; from encoder readings: fastcal_locate_winch),
+ * warm from this handle's last locate; the lower-end tensions there. `joints` as for a
+ * solve. Returns 0 or a status (no_equilibrium: the lengths cannot hold the cabin).
+ * tension_kN may be NULL. Where several equilibria share the lengths (cables near
+ * slack), the one returned is the one found from the start; `fastcal locate` on the
+ * command line searches for the others. */
 FASTCAL_C_API int fastcal_locate(fastcal_solver* s, const double unstretched_m[6],
                                  const double* joints, double position_m[3], double rpy_deg[3],
                                  double tension_kN[6]);
+/* The same from the winch encoders' readings (what fastcal_control_cycle's
+ * winch_length_m commands): each minus the model's length_offset_m, then located. */
+FASTCAL_C_API int fastcal_locate_winch(fastcal_solver* s, const double winch_length_m[6],
+                                       const double* joints, double position_m[3],
+                                       double rpy_deg[3], double tension_kN[6]);
+/* The model's encoder offsets (m) and tension sensors' gains and biases (kN), as the
+ * control cycle applies them: winch = s0 + offset, reading = gain * tension + bias. Any
+ * array may be NULL. 0, or -1/-2 for a NULL handle or one without a model. */
+FASTCAL_C_API int fastcal_solver_sensors(const fastcal_solver* s, double length_offset_m[6],
+                                         double sensor_gain[6], double sensor_bias_kN[6]);
 
-/* The limits a control cycle checks beyond the model's own range. */
+/* The limits a control cycle checks beyond the model's own range. Start from
+ * fastcal_default_cycle_limits() and change what you need: a zeroed struct is refused
+ * (max_tension_kN must exceed min_tension_kN). */
 typedef struct fastcal_cycle_limits {
   double min_tension_kN;            /* every lower-end tension at least this */
   double max_tension_kN;            /* and at most this (upper-end tensions too) */
@@ -144,9 +179,11 @@ typedef struct fastcal_cycle {
   double sensor_reading_kN[6];  /* what each tension sensor should read (gain, bias) */
   double upper_tension_kN[6];   /* at the tower top */
   double error_estimate;        /* the statics' relative error estimate */
-  double reflector_clearance_m; /* smallest cable clearance (+inf: none could reach) */
+  double reflector_clearance_m; /* smallest cable clearance: +inf where no cable dips
+                                   toward the reflector (the cap) */
   double min_tension_margin_kN; /* min over cables of tension - min_tension_kN */
-  double max_tension_margin_kN; /* min over cables of max_tension_kN - max(lower, upper) */
+  double max_tension_margin_kN; /* min over cables of max_tension_kN - max(lower, upper):
+                                   +inf with the default limits (no maximum) */
   int status;                   /* as returned */
   int cable;                    /* 0-based cable a failure or limit concerns, or -1 */
 } fastcal_cycle;

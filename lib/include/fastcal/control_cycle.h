@@ -38,7 +38,7 @@ struct ControlLimits {
   // Every cable at least this far from the reflector (m; kDesignReflectorClearanceM).
   double min_reflector_clearance_m = 5.0;
 
-  // False with *error naming the field: non-finite minimums, negative values, min > max.
+  // False with *error naming the field: non-finite minimums, negative values, max <= min.
   bool IsValid(std::string* error) const;
 };
 

@@ -15,9 +15,11 @@ bool ControlLimits::IsValid(std::string* error) const {
   if (!std::isfinite(min_tension_n) || min_tension_n < 0.0) {
     return fail("the minimum tension (min_tension) must be finite and >= 0");
   }
-  // +infinity is allowed (no rated load); NaN and values below the minimum are not.
-  if (!(max_tension_n >= min_tension_n))
-    return fail("the maximum tension (max_tension) must be >= the minimum (min_tension)");
+  // +infinity is allowed (no rated load); NaN and values up to the minimum are not (a
+  // zeroed struct from C would otherwise call every pose above its maximum).
+  if (!(max_tension_n > min_tension_n)) {
+    return fail("the maximum tension (max_tension) must be > the minimum (min_tension)");
+  }
   if (!std::isfinite(min_reflector_clearance_m) || min_reflector_clearance_m < 0.0) {
     return fail("min_reflector_clearance_m must be finite and >= 0");
   }
