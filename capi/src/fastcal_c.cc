@@ -169,6 +169,19 @@ int Enter(fastcal_solver* s, bool arrays_given) {
   return FASTCAL_OK;
 }
 
+// Enter for a call that fills a struct (fastcal_statics, fastcal_cycle): the struct is
+// zeroed first (cable -1), and carries the status of a refused call.
+template <typename Out>
+int EnterWithStruct(fastcal_solver* s, bool arrays_given, Out* out) {
+  if (out != nullptr) {
+    std::memset(out, 0, sizeof(*out));
+    out->cable = -1;
+  }
+  const int e = Enter(s, arrays_given && out != nullptr);
+  if (e != 0 && out != nullptr) out->status = e;
+  return e;
+}
+
 // The exact statics at a pose, warm from s->last; on ok, s->last is the answer.
 int Solve(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
           const double* joints) {
@@ -315,14 +328,7 @@ int fastcal_solve_pose(fastcal_solver* s, const double position_m[3], const doub
 
 int fastcal_solve_pose_full(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                             const double* joints, fastcal_statics* out) {
-  if (out != nullptr) {
-    std::memset(out, 0, sizeof(*out));
-    out->cable = -1;
-  }
-  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) {
-    if (out != nullptr) out->status = e;
-    return e;
-  }
+  if (const int e = EnterWithStruct(s, position_m && rpy_deg, out); e != 0) return e;
   try {
     const int status = Solve(s, position_m, rpy_deg, joints);
     FillStatics(status == FASTCAL_OK ? s->last : s->trial, status, out);
@@ -414,14 +420,7 @@ fastcal_cycle_limits fastcal_default_cycle_limits(void) {
 int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                           const double* joints, const fastcal_cycle_limits* limits,
                           fastcal_cycle* out) {
-  if (out != nullptr) {
-    std::memset(out, 0, sizeof(*out));
-    out->cable = -1;
-  }
-  if (const int e = Enter(s, position_m && rpy_deg && out); e != 0) {
-    if (out != nullptr) out->status = e;
-    return e;
-  }
+  if (const int e = EnterWithStruct(s, position_m && rpy_deg, out); e != 0) return e;
   try {
     fastcal::ControlLimits lim;
     if (limits != nullptr) {
