@@ -20,8 +20,8 @@
 #include <memory>
 #include <sstream>
 
-#include "fastcal/internal/edit_distance.h"
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/edit_distance.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
@@ -792,6 +792,9 @@ bool WriteDirectoryAtomically(const std::string& dir,
   }
   internal::TemporaryLock lock;
   lock.Lock(tmp.string());
+  // Ctrl-C or SIGTERM while the files are written: the handler removes the staging
+  // directory with what it holds (issue 37), not only the temporaries it named.
+  internal::RegisterTemporaryDirectory(tmp.string());
   auto fail = [&](std::string why) {
     lock.Release();
     std::filesystem::remove_all(tmp, ec);

@@ -3,7 +3,9 @@
 #include <gflags/gflags.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <iostream>
@@ -15,6 +17,7 @@
 #include "commands.h"
 #include "fastcal/dataset.h"
 #include "fastcal/file_digest.h"
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/sessions.h"
 #include "fastcal/time_text.h"
@@ -97,20 +100,12 @@ std::string Provenance(int argc, char** argv, const ColumnMap& map) {
     if (!line.empty() && line.back() == '\r') line.pop_back();
     s << "  | " << line << "\n";
   }
-  s << "time_s: " << (map.time.format == TimeFormat::kSeconds
-                          ? "as the export gives it (seconds)"
-                          : "Unix seconds (UTC) of the export's " +
-                                TimeFormatName(map.time.format, map.time.pattern) +
-                                " time stamps");
+  s << "time_s: "
+    << (map.time.format == TimeFormat::kSeconds
+            ? "as the export gives it (seconds)"
+            : "Unix seconds (UTC) of the export's " +
+                  TimeFormatName(map.time.format, map.time.pattern) + " time stamps");
   return s.str();
-}
-
-// A temporary file beside `path`, for the atomic write.
-std::string TemporaryPath(const std::string& path) {
-  const fs::path p(path);
-  return (p.parent_path() / ("." + p.filename().string() + ".import-" +
-                             std::to_string(::getpid()) + ".tmp"))
-      .string();
 }
 
 int Fail(const std::string& message, const std::string& temporary = "") {
@@ -133,8 +128,9 @@ int RunImport(int argc, char** argv) {
     return exit_code;
   }
   if (FLAGS_columns.empty() || FLAGS_data.empty() || FLAGS_out.empty() || FLAGS_out == "-") {
-    return Fail("--columns=MAP.yaml, --data=EXPORT and --out=FILE.csv are required (see "
-                "fastcal import --help)");
+    return Fail(
+        "--columns=MAP.yaml, --data=EXPORT and --out=FILE.csv are required (see "
+        "fastcal import --help)");
   }
   std::string error;
   std::shared_ptr<const ColumnMap> map;
@@ -173,12 +169,16 @@ int RunImport(int argc, char** argv) {
       layout.session_labels.push_back(SessionCutLabel(static_cast<int>(k)));
     }
   }
-  const std::string temporary = TemporaryPath(FLAGS_out);
-  fs::remove(temporary, ec);
+  // The library's temporary name beside --out: unlinked by the SIGINT/SIGTERM handler, and
+  // removed by the next run once this process is gone (a SIGKILL's leftover); locked, so
+  // that a reused pid cannot make a live run's temporary look stale (issue 37).
+  const std::string temporary = internal::TemporaryNameFor(FLAGS_out);
   DatasetWriter writer;
   if (!writer.Open(temporary, layout, Provenance(argc, argv, *map), &error)) {
     return Fail(error, temporary);
   }
+  internal::TemporaryLock lock;
+  lock.Lock(temporary);
   long long samples = 0;
   std::vector<long long> per_session(cuts.size() + 1, 0);
   double first = std::numeric_limits<double>::infinity(), last = -first;
@@ -207,8 +207,17 @@ int RunImport(int argc, char** argv) {
                 temporary);
   }
   if (!writer.Close(&error)) return Fail(error, temporary);
-  fs::rename(temporary, FLAGS_out, ec);
-  if (ec) return Fail(FLAGS_out + ": cannot write: " + ec.message(), temporary);
+  // Without --force, a file that appeared at --out while this ran (another import) is kept
+  // and this run fails, rather than both saying "wrote" and one result lost.
+  if (FLAGS_force) {
+    fs::rename(temporary, FLAGS_out, ec);
+    if (ec) return Fail(FLAGS_out + ": cannot write: " + ec.message(), temporary);
+  } else if (int err = 0; !internal::RenameNoReplace(temporary, FLAGS_out, &err)) {
+    return Fail(FLAGS_out + (err == EEXIST ? ": written by another run meanwhile; kept (--force "
+                                             "replaces it)"
+                                           : ": cannot write: " + std::string(std::strerror(err))),
+                temporary);
+  }
 
   const TimeDisplay display = TimeDisplayFor(first, chunk.time_offset_s);
   std::cout << "fastcal import: " << samples << (samples == 1 ? " sample" : " samples") << " from "

@@ -152,6 +152,58 @@ void BM_TimerAlone(benchmark::State& state) {
 }
 BENCHMARK(BM_TimerAlone)->Iterations(1)->Unit(benchmark::kSecond);
 
+// The control cycle and the locate along the same tracks as BM_WarmObservationTracks
+// (the first 10^5 poses; each warm from the one before): a cycle is a solve plus its
+// readings and limits, a locate the forward statics from the cycle's winch lengths.
+void BM_ControlCycleAndLocateWarm(benchmark::State& state) {
+  std::vector<int> starts;
+  const std::vector<PoseArray> poses = ObservationTracks(kWarmPoses / 10, &starts);
+  fastcal_solver* s = fastcal_solver_create(nullptr);
+  std::vector<std::array<double, 6>> winch(poses.size());
+  std::vector<double> cycle_us, locate_us;
+  int failures = 0;
+  double cycle_first_max = 0.0, locate_first_max = 0.0;
+  for (auto _ : state) {
+    cycle_first_max = MinOverPasses(
+        poses.size(),
+        [&](int pass, std::vector<double>* times) {
+          fastcal_solver_reset(s);
+          fastcal_cycle cycle;
+          for (size_t n = 0; n < poses.size(); ++n) {
+            const PoseArray& a = poses[n];
+            int status = 0;
+            (*times)[n] = TimeUs(
+                [&] { status = fastcal_control_cycle(s, &a[0], &a[3], nullptr, nullptr, &cycle); });
+            if (pass == 0) failures += status != 0;
+            std::copy(cycle.winch_length_m, cycle.winch_length_m + 6, winch[n].begin());
+          }
+        },
+        &cycle_us);
+    locate_first_max = MinOverPasses(
+        poses.size(),
+        [&](int pass, std::vector<double>* times) {
+          fastcal_solver_reset(s);
+          double position[3], rpy[3];
+          for (size_t n = 0; n < poses.size(); ++n) {
+            int status = 0;
+            (*times)[n] = TimeUs([&] {
+              status = fastcal_locate_winch(s, winch[n].data(), nullptr, position, rpy, nullptr);
+            });
+            if (pass == 0) failures += status != 0;
+          }
+        },
+        &locate_us);
+  }
+  fastcal_solver_destroy(s);
+  Report(state, &cycle_us, cycle_first_max, failures, 0);
+  const Latency l = Summarise(&locate_us);
+  state.counters["locate_p50_us"] = l.p50;
+  state.counters["locate_p99.9_us"] = l.p999;
+  state.counters["locate_max_us"] = l.max;
+  state.counters["locate_max_single_pass_us"] = locate_first_max;
+}
+BENCHMARK(BM_ControlCycleAndLocateWarm)->Iterations(1)->Unit(benchmark::kSecond);
+
 // Each of `arrays` solved cold (the handle reset before each), timed, kPasses times; the
 // counters from the first pass.
 struct ColdRun {

@@ -35,12 +35,11 @@ class CliTrackStoreTest : public CliTest {
 
 TEST_F(CliTrackStoreTest, ASecondRunOnTheSameTrackIsRefused) {
   // The lock is held as a running track holds it: the second run exits 1 at once.
-  const CommandResult r = Shell("flock " + Path(".t.lock") + " " + Bin() + " track --spec=" +
-                                Source() + "/calibration_data/spec_track.yaml --data=" + Day(1) +
-                                " --out=" + Path("t"));
+  const CommandResult r =
+      Shell("flock " + Path(".t.lock") + " " + Bin() + " track --spec=" + Source() +
+            "/calibration_data/spec_track.yaml --data=" + Day(1) + " --out=" + Path("t"));
   EXPECT_EQ(r.code, 1) << r.output;
-  EXPECT_NE(r.output.find("another fastcal track is running on it"), std::string::npos)
-      << r.output;
+  EXPECT_NE(r.output.find("another fastcal track is running on it"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(Path("t")));
 }
 
@@ -70,8 +69,7 @@ TEST_F(CliTrackStoreTest, AFoldFromElsewhereIsRefusedAndRefoldRebuildsIt) {
             0);
   CommandResult r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
   EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find("2024-05-02.g1.fold: not the fold this track wrote"),
-            std::string::npos)
+  EXPECT_NE(r.output.find("2024-05-02.g1.fold: not the fold this track wrote"), std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("--refold"), std::string::npos) << r.output;
   r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t", "--refold");
@@ -93,7 +91,8 @@ TEST_F(CliTrackStoreTest, FilesOverlappingInTimeAreRefusedUnlessKept) {
   // The same hour simulated again with another seed (another name, other numbers): its
   // instants are day 1's; folded both, day 1 would count twice (issue 37).
   ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=1800 --interval-s=2 --seed=9 "
-                    "--start=2024-05-01T20:00:00Z --out=" + Path("again.csv"))
+                    "--start=2024-05-01T20:00:00Z --out=" +
+                    Path("again.csv"))
                 .code,
             0);
   CommandResult r = Track(Day(1) + "," + Path("again.csv"), "a");
@@ -121,20 +120,26 @@ TEST_F(CliTrackStoreTest, RelativeTimesOfTwoFilesNeedAWindowEach) {
   EXPECT_NE(r.output.find("give --window=file"), std::string::npos) << r.output;
   r = Track(both, "b", "--window=file");
   EXPECT_EQ(r.code, 0) << r.output;
+  // Nor in an update: the second relative file added to a track of the first (a review
+  // found them joined in window t0, exit 0), with --keep-overlapping too.
+  ASSERT_EQ(Track(Path("rel1.csv"), "c", "--window=1h").code, 0);
+  r = Track(both, "c", "--window=1h --keep-overlapping");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("give --window=file"), std::string::npos) << r.output;
 }
 
 TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
   ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
   const std::string state = ReadFile(Path("t/track_state.json"));
-  Write("t/track_state.json",
-        std::regex_replace(state, std::regex("\"label\": \"2024-05-02\""),
-                           "\"label\": \"../../escape\""));
+  Write("t/track_state.json", std::regex_replace(state, std::regex("\"label\": \"2024-05-02\""),
+                                                 "\"label\": \"../../escape\""));
   CommandResult r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("is not one this program writes"), std::string::npos) << r.output;
   Write("t/track_state.json", std::string(1 << 20, '['));
-  r = RunBoundedAndExpect({"track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=" +
-                               Day(1) + " --out=" + Path("t"),
+  r = RunBoundedAndExpect({"track --spec=" + Source() +
+                               "/calibration_data/spec_track.yaml --data=" + Day(1) +
+                               " --out=" + Path("t"),
                            2, "nesting deeper than"});
 }
 

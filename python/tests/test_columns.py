@@ -301,3 +301,21 @@ def test_an_xlsx_with_a_stale_dimension_reads_every_row_and_a_bomb_is_refused(
         z.writestr("xl/worksheets/sheet1.xml", b"\0" * (64 << 20))
     with pytest.raises(fastcal.InputError, match="inflates .* times"):
         fastcal.read_dataset(bomb, columns=columns)
+    # A bomb within the ratio: 2^20 + 1 empty rows after the data, with random text that
+    # keeps the compression under 200x (a review's took 8 GB and minutes): refused by the
+    # sheet's row count, read as it goes.
+    import base64
+    import random
+
+    filler = base64.b64encode(random.Random(37).randbytes(96 << 10))
+    rows_bomb = tmp_path / "rows_bomb.xlsx"
+    with zipfile.ZipFile(path) as src, zipfile.ZipFile(rows_bomb, "w", zipfile.ZIP_DEFLATED) as dst:
+        for item in src.infolist():
+            data = src.read(item.filename)
+            if item.filename.startswith("xl/worksheets/sheet"):
+                data = data.replace(b"</sheetData>",
+                                    b"<row/>" * ((1 << 20) + 1) + b"</sheetData><!-- " + filler
+                                    + b" -->")
+            dst.writestr(item, data)
+    with pytest.raises(fastcal.InputError, match="more than 1048576 rows"):
+        fastcal.read_dataset(rows_bomb, columns=columns)

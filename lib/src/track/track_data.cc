@@ -405,6 +405,18 @@ struct Router {
   explicit Router(TrackRun& r) : run(r) {
     for (size_t w = 0; w < run.windows.size(); ++w)
       window_of_key[run.windows[w].key] = static_cast<int>(w);
+    // A file of relative times already in the track (an update adds to it): a new one
+    // would share its windows (issue 37: an update joined two in window t0).
+    for (size_t f = 0; f < run.files.size(); ++f) {
+      if (!std::isnan(run.files[f].first_s) && !IsUnixTime(run.files[f].first_s)) {
+        relative_file = static_cast<int>(f);
+      }
+    }
+    for (const TrackWindowState& w : run.windows) {
+      if (!IsUnixTime(w.start_s) && !w.files.empty() && relative_file < 0) {
+        relative_file = w.files.front();
+      }
+    }
   }
 
   int WindowFor(long long key, double start_s, double end_s, const std::string& label) {

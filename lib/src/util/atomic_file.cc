@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <sys/file.h>
 #include <sys/stat.h>
+#include <sys/syscall.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -104,9 +105,59 @@ std::string TemporaryNameFor(const std::string& path) {
   return name;
 }
 
+namespace {
+
+// Staging directories (RegisterTemporaryDirectory), the same way.
+constexpr int kDirectorySlots = 8;
+TemporarySlot g_directories[kDirectorySlots];
+std::atomic<unsigned> g_next_directory{0};
+
+// Empties and removes `dir` with system calls only (getdents64, unlinkat, rmdir: no
+// allocation, no lock), one level deep: a staging directory holds files. A few passes,
+// since removing entries while listing may skip some.
+void RemoveDirectoryOnSignal(const char* dir) {
+  const int fd = ::open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;  // published or removed meanwhile
+  static char buffer[8192];
+  for (int pass = 0; pass < 4; ++pass) {
+    bool removed = false;
+    long n = 0;
+    ::lseek(fd, 0, SEEK_SET);
+    while ((n = ::syscall(SYS_getdents64, fd, buffer, sizeof(buffer))) > 0) {
+      for (long at = 0; at < n;) {
+        // struct linux_dirent64: ino (8), off (8), reclen (2), type (1), name.
+        unsigned short reclen = 0;
+        std::memcpy(&reclen, buffer + at + 16, sizeof(reclen));
+        const char* name = buffer + at + 19;
+        const bool dots = name[0] == '.' && (name[1] == 0 || (name[1] == '.' && name[2] == 0));
+        if (!dots && (::unlinkat(fd, name, 0) == 0 || ::unlinkat(fd, name, AT_REMOVEDIR) == 0)) {
+          removed = true;
+        }
+        at += reclen;
+      }
+    }
+    if (!removed) break;
+  }
+  ::close(fd);
+  ::rmdir(dir);
+}
+
+}  // namespace
+
+void RegisterTemporaryDirectory(const std::string& dir) {
+  if (dir.size() >= kTemporaryPathBytes) return;
+  TemporarySlot& slot = g_directories[g_next_directory.fetch_add(1) % kDirectorySlots];
+  slot.ready.store(false);
+  std::memcpy(slot.path, dir.c_str(), dir.size() + 1);
+  slot.ready.store(true);
+}
+
 void RemoveTemporariesOnSignal() {
   for (TemporarySlot& slot : g_temporaries) {
     if (slot.ready.load()) ::unlink(slot.path);  // async-signal-safe
+  }
+  for (TemporarySlot& slot : g_directories) {
+    if (slot.ready.load()) RemoveDirectoryOnSignal(slot.path);
   }
 }
 

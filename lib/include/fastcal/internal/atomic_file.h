@@ -29,10 +29,15 @@ bool WriteFileAtomically(const std::string& path, const std::string& content, st
 // A new unique temporary name beside `path` ("<path>.tmp.<pid>.<n>").
 std::string TemporaryNameFor(const std::string& path);
 
-// Unlinks every temporary this process named with TemporaryNameFor that still exists:
-// async-signal-safe (no allocation, no lock), for a SIGINT/SIGTERM handler, so that an
-// interrupted command leaves no half-written file (issue 37). Staging directories are
-// left to the next run, which removes them once their process is gone.
+// A staging directory this process writes a result into before publishing it (renamed to
+// its place): RemoveTemporariesOnSignal removes it with what it holds.
+void RegisterTemporaryDirectory(const std::string& dir);
+
+// Unlinks every temporary this process named with TemporaryNameFor that still exists, and
+// empties and removes every registered staging directory that still exists (the files in
+// it, one level deep): async-signal-safe (system calls only: no allocation, no lock), for
+// a SIGINT/SIGTERM handler, so that an interrupted command leaves no half-written file
+// (issue 37). What a SIGKILL leaves, the next run removes once its process is gone.
 void RemoveTemporariesOnSignal();
 
 // Removes what killed runs left beside `path` (the names above), only when the process
