@@ -1,5 +1,6 @@
 // The tension readings' scale against the cabin's weight (fastcal/tension_scale.h):
-// FAST's tensions pass, the same read 1000x small or large are refused naming the slip,
+// FAST's tensions pass, the same read 1000x small or large, or in tonne-force, are
+// refused naming the slip,
 // and a lengths file without tensions is not judged.
 #include "fastcal/tension_scale.h"
 
@@ -34,7 +35,13 @@ TEST(TensionScaleTest, FastsTensionsPassAndAUnitSlipIsNamed) {
   EXPECT_NE(error.find("read 1000x small"), std::string::npos) << error;
   EXPECT_FALSE(CheckTensionScale(Uniform(kCableN * 1e3), fast, &error));
   EXPECT_NE(error.find("read 1000x large"), std::string::npos) << error;
-  // The bounds: a third of the weight passes, a little less does not.
+  // Tonne-force read as kN (9.8x small: a sum of ~0.37 of the weight; a review found it
+  // passed the former floor of a third) is named as such.
+  constexpr double kNPerTonneForce = 9806.65;
+  EXPECT_FALSE(CheckTensionScale(Uniform(kCableN / kNPerTonneForce * 1e3), fast, &error));
+  EXPECT_NE(error.find("tonne-force"), std::string::npos) << error;
+  // The bounds: 0.8 of the weight passes (sensors 20% low), a little less does not.
+  EXPECT_DOUBLE_EQ(kMinWeightFraction, 0.8);
   const double weight_n = fast.cabin_mass_kg * std::abs(fast.gravity_m_per_s2);
   EXPECT_TRUE(CheckTensionScale(Uniform(weight_n * kMinWeightFraction / 6 * 1.001), fast, &error));
   EXPECT_FALSE(CheckTensionScale(Uniform(weight_n * kMinWeightFraction / 6 * 0.999), fast, &error));

@@ -24,17 +24,23 @@ bool CheckTensionScale(const Dataset& data, const CableRobot& model, std::string
   std::nth_element(sums.begin(), middle, sums.end());
   const double median_n = *middle;
   const double weight_n = model.cabin_mass_kg * std::abs(model.gravity_m_per_s2);
-  if (median_n >= kMinWeightFraction * weight_n && median_n <= kMaxWeightMultiple * weight_n) {
-    return true;
-  }
+  const auto plausible = [&](double sum_n) {
+    return sum_n >= kMinWeightFraction * weight_n && sum_n <= kMaxWeightMultiple * weight_n;
+  };
+  if (plausible(median_n)) return true;
+  constexpr double kNPerKgf = 9.80665;  // a tonne-force per kN, a kgf per N
   const bool small = median_n < kMinWeightFraction * weight_n;
   *error = (data.path.empty() ? std::string("the data") : data.path) +
            ": the six tensions sum to " + internal::FormatDouble("%.4g", median_n / 1e3) +
            " kN a sample (median), where the cabin's weight alone (" +
            internal::FormatDouble("%.4g", model.cabin_mass_kg) + " kg, " +
            internal::FormatDouble("%.4g", weight_n / 1e3) + " kN) needs at least that much: " +
-           (small ? "read 1000x small? (tensions in N where the column map says kN)"
-                  : "read 1000x large? (tensions in kN where the column map says N)") +
+           (!small ? "read 1000x large? (tensions in kN where the column map says N)"
+            : plausible(median_n * 1e3)
+                ? "read 1000x small? (tensions in N where the column map says kN)"
+            : plausible(median_n * kNPerKgf)
+                ? "read 9.8x small? (tonne-force or kgf where the column map says kN or N)"
+                : "read in the wrong unit?") +
            "; check the tension columns' unit (T1_kN ... T6_kN are in kN)";
   return false;
 }
