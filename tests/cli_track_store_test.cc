@@ -128,6 +128,21 @@ TEST_F(CliTrackStoreTest, RelativeTimesOfTwoFilesNeedAWindowEach) {
   EXPECT_NE(r.output.find("give --window=file"), std::string::npos) << r.output;
 }
 
+TEST_F(CliTrackStoreTest, ASymbolicLinkInsideATrackIsRefused) {
+  // A store linked to a file outside the track was truncated there (a review, issue 37).
+  ASSERT_EQ(Track(Day(1), "t").code, 0);
+  const std::string store = Path("t/windows/2024-05-01.samples");
+  ASSERT_TRUE(fs::exists(store));
+  fs::rename(store, Path("outside.samples"));
+  const auto size = fs::file_size(Path("outside.samples"));
+  fs::create_symlink(Path("outside.samples"), store);
+  const CommandResult r = Track(Day(1) + "," + Day(2), "t");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("a symbolic link inside a track is refused"), std::string::npos)
+      << r.output;
+  EXPECT_EQ(fs::file_size(Path("outside.samples")), size);
+}
+
 TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
   ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
   const std::string state = ReadFile(Path("t/track_state.json"));
@@ -136,6 +151,13 @@ TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
   CommandResult r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("is not one this program writes"), std::string::npos) << r.output;
+  // A negative count (a day dropped silently before) is refused by name.
+  Write("t/track_state.json",
+        std::regex_replace(state, std::regex("\"samples\": ([0-9]+)"), "\"samples\": -5",
+                           std::regex_constants::format_first_only));
+  r = Track(Day(1) + "," + Day(2), "t");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("not a count"), std::string::npos) << r.output;
   Write("t/track_state.json", std::string(1 << 20, '['));
   r = RunBoundedAndExpect({"track --spec=" + Source() +
                                "/calibration_data/spec_track.yaml --data=" + Day(1) +

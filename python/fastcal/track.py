@@ -10,7 +10,7 @@ import numpy as np
 from . import _fastcal
 from ._fastcal import CalibrationError, InputError, Model
 
-from ._common import PathLike, _spec_argument
+from ._common import PathLike, _spec_argument, _whole
 from .statics import ColumnsLike
 from .dataset import _columns_argument, _map_errors
 
@@ -188,6 +188,7 @@ def track(
     else:
         paths = [os.fspath(p) for p in data]
     spec_text, is_text, source = _spec_argument(spec)
+    threads = _whole(threads, "threads", 1, 256)  # not True, not 2**40 (a raw TypeError)
     fold_many = None
     if client is not None:
         dask_client = _dask_client(client)

@@ -135,3 +135,10 @@ def test_a_scheduler_address_without_dask_names_the_packages(
 def test_bad_window_is_an_input_error(season: pathlib.Path, spec: pathlib.Path, tmp_path) -> None:
     with pytest.raises(fastcal.InputError, match="window '2x'"):
         fastcal.track(season, spec, out=tmp_path / "t", window="2x")
+
+
+def test_bad_threads_is_an_input_error(season: pathlib.Path, spec: pathlib.Path, tmp_path) -> None:
+    # A review (issue 37): 2**40 raised pybind11's raw TypeError, True was taken as 1.
+    for threads in (2**40, True, 0, 2.5):
+        with pytest.raises(fastcal.InputError, match="threads"):
+            fastcal.track(season, spec, out=tmp_path / "t", threads=threads)

@@ -129,6 +129,16 @@ double Real(const YAML::Node& node) {
 
 long long Integer(const YAML::Node& node) { return static_cast<long long>(Real(node)); }
 
+// A count or a size: a whole number from 0 to 2^53 (a review's "samples": -5 dropped a day
+// silently, issue 37).
+long long Count(const YAML::Node& node) {
+  const double v = Real(node);
+  if (!(v >= 0.0 && v <= 9007199254740992.0) || v != std::floor(v)) {
+    throw YAML::Exception(node.Mark(), "not a count (a whole number >= 0)");
+  }
+  return static_cast<long long>(v);
+}
+
 std::string Text(const YAML::Node& node) {
   if (!node || !node.IsScalar()) {
     throw YAML::Exception(node ? node.Mark() : YAML::Mark::null_mark(), "not a string");
@@ -172,7 +182,7 @@ SavedState ParseState(const std::string& text) {
   s.slow.sigma_percent = Real(root["slow_error"]["sigma_percent"]);
   s.slow.time_constant_s = Real(root["slow_error"]["time_constant_s"]);
   for (const YAML::Node& f : root["files"]) {
-    TrackFile file{Text(f["path"]), Integer(f["bytes"]), Text(f["sha256"]), Integer(f["samples"])};
+    TrackFile file{Text(f["path"]), Count(f["bytes"]), Text(f["sha256"]), Count(f["samples"])};
     if (f["first_s"]) {
       file.first_s = Real(f["first_s"]);
       file.last_s = Real(f["last_s"]);
@@ -187,7 +197,7 @@ SavedState ParseState(const std::string& text) {
     w.end_s = Real(n["end_s"]);
     w.first_s = Real(n["first_s"]);
     w.last_s = Real(n["last_s"]);
-    w.samples = Integer(n["samples"]);
+    w.samples = Count(n["samples"]);
     w.used = Text(n["used"]) == "true";
     w.fold_file = Text(n["fold"]);
     if (!IsSafeLabel(w.label) ||
@@ -197,7 +207,7 @@ SavedState ParseState(const std::string& text) {
                                                    "writes (a path outside the track?)");
     }
     if (n["fold_sha256"]) w.fold_sha256 = Text(n["fold_sha256"]);
-    if (n["store_bytes"]) w.store_bytes = Integer(n["store_bytes"]);
+    if (n["store_bytes"]) w.store_bytes = Count(n["store_bytes"]);
     for (const YAML::Node& f : n["files"]) w.files.push_back(static_cast<int>(Integer(f)));
     w.dirty = false;
     s.windows.push_back(std::move(w));
@@ -651,6 +661,17 @@ TrackStatus PrepareDirectory(TrackRun& run) {
     return run.Fail(TrackStatus::kInvalidInput, run.out + ": not a directory");
   }
   if (exists && fs::exists(run.out + "/" + kStateFile, ec)) {
+    // A symbolic link inside the track would read, truncate or delete files outside it
+    // (a review's symlinked store was cut in half elsewhere, issue 37): none is followed.
+    for (auto it = fs::recursive_directory_iterator(run.out, ec);
+         !ec && it != fs::recursive_directory_iterator(); it.increment(ec)) {
+      if (it->is_symlink(ec)) {
+        return run.Fail(TrackStatus::kInvalidInput,
+                        it->path().string() +
+                            ": a symbolic link inside a track is refused (it would read or "
+                            "write outside the track); replace it with the file or directory");
+      }
+    }
     run.dir = run.out;
     bool use = false;
     if (!LoadSavedState(run, &use)) return TrackStatus::kInvalidInput;
