@@ -1,6 +1,7 @@
 // The season's store survives interruption, duplication and tampering (issue 37): one
 // run at a time on a track; an update killed after appending samples leaves nothing
-// counted twice; a fold copied from elsewhere is refused (and --refold rebuilds it); the
+// counted twice; a fold copied from elsewhere is refused (and --refold rebuilds it), as is
+// a store copied from elsewhere (by its digest) and a fold of another window; the
 // same data given twice, two files of relative times on one time line, a window label
 // reaching outside the track and a state nested without end are refused by name.
 #include <regex>
@@ -74,6 +75,34 @@ TEST_F(CliTrackStoreTest, AFoldFromElsewhereIsRefusedAndRefoldRebuildsIt) {
   EXPECT_NE(r.output.find("--refold"), std::string::npos) << r.output;
   r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t", "--refold");
   EXPECT_EQ(r.code, 0) << r.output;
+}
+
+TEST_F(CliTrackStoreTest, AStoreFromElsewhereIsRefusedEvenOnRefold) {
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
+  // Same length (1800 samples a day): only the digest tells the two days apart.
+  ASSERT_EQ(Shell("cd " + Path("t/windows") + " && cp 2024-05-01.samples 2024-05-02.samples").code,
+            0);
+  const CommandResult r = Track(Day(1) + "," + Day(2), "t", "--refold");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("2024-05-02.samples: not the samples this track stored"),
+            std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
+}
+
+TEST_F(CliTrackStoreTest, AFoldOfAnotherWindowIsRefusedEvenWithItsDigestForged) {
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
+  const std::string one = Path("t/folds/2024-05-01.g1.fold");
+  const std::string two = Path("t/folds/2024-05-02.g1.fold");
+  const std::string sha_one = Shell("sha256sum " + one).output.substr(0, 64);
+  const std::string sha_two = Shell("sha256sum " + two).output.substr(0, 64);
+  ASSERT_EQ(Shell("cp " + one + " " + two).code, 0);
+  const std::string state = ReadFile(Path("t/track_state.json"));
+  ASSERT_NE(state.find(sha_two), std::string::npos);
+  Write("t/track_state.json", std::regex_replace(state, std::regex(sha_two), sha_one));
+  const CommandResult r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("the fold of window '2024-05-01'"), std::string::npos) << r.output;
 }
 
 TEST_F(CliTrackStoreTest, TheSameDataTwiceIsRefusedByContent) {

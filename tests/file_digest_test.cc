@@ -70,6 +70,24 @@ TEST_F(FileDigestTest, AgreesWithSha256sum) {
   EXPECT_EQ(Sha256(path), std::string(line).substr(0, 64));
 }
 
+// A prefix's digest is the digest of a file holding those bytes alone (a track's store
+// checked up to its committed length, issue 37), across many reads; a file shorter than
+// the prefix is an error naming both lengths.
+TEST_F(FileDigestTest, APrefixDigestIsTheDigestOfThoseBytes) {
+  const std::string bytes(200000, 'a');
+  const std::string whole = Write("whole", bytes + "appended later");
+  std::string hex, error;
+  for (long long n : {0LL, 3LL, 65536LL, 65537LL, 200000LL}) {
+    ASSERT_TRUE(FileSha256Prefix(whole, n, &hex, &error)) << error;
+    EXPECT_EQ(hex, Sha256(Write("prefix", bytes.substr(0, n)))) << n << " bytes";
+  }
+  hex = "untouched";
+  EXPECT_FALSE(FileSha256Prefix(whole, 300000, &hex, &error));
+  EXPECT_NE(error.find("200014 bytes where 300000 were expected"), std::string::npos) << error;
+  EXPECT_EQ(hex, "untouched");
+  EXPECT_FALSE(FileSha256Prefix(whole, -1, &hex, &error));
+}
+
 TEST_F(FileDigestTest, MissingFileOrDirectoryIsAnErrorNamingIt) {
   std::string hex = "untouched", error;
   EXPECT_FALSE(FileSha256((dir_ / "absent.csv").string(), &hex, &error));

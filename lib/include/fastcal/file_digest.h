@@ -14,6 +14,12 @@ namespace fastcal {
 // false and names the file and the reason in *error (may be null); *hex is then untouched.
 bool FileSha256(const std::string& path, std::string* hex, std::string* error);
 
+// SHA-256 of the file's first `bytes` bytes (>= 0): a file appended to since, checked
+// against what it held (a track's sample store, issue 37). False, naming the file, when it
+// is shorter than that.
+bool FileSha256Prefix(const std::string& path, long long bytes, std::string* hex,
+                      std::string* error);
+
 }  // namespace fastcal
 
 #endif  // FASTCAL_FILE_DIGEST_H_

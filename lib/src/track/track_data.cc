@@ -95,6 +95,7 @@ std::string StateJson(const TrackRun& run) {
     j.Key("fold").String(w.fold_file);
     j.Key("fold_sha256").String(w.fold_sha256);
     j.Key("store_bytes").Int(w.store_bytes);
+    j.Key("store_sha256").String(w.store_sha256);
     j.Key("files").BeginArray();
     for (int f : w.files) j.Int(f);
     j.EndArray();
@@ -208,6 +209,7 @@ SavedState ParseState(const std::string& text) {
     }
     if (n["fold_sha256"]) w.fold_sha256 = Text(n["fold_sha256"]);
     if (n["store_bytes"]) w.store_bytes = Count(n["store_bytes"]);
+    if (n["store_sha256"]) w.store_sha256 = Text(n["store_sha256"]);
     for (const YAML::Node& f : n["files"]) w.files.push_back(static_cast<int>(Integer(f)));
     w.dirty = false;
     s.windows.push_back(std::move(w));
@@ -339,6 +341,14 @@ bool LoadFolds(TrackRun& run) {
       ok = false;
     }
     if (ok && !LoadFold(run, &w, &why)) ok = false;
+    // A fold of another window passes its digest only with a forged state: its own label
+    // and count still tell.
+    if (ok && (w.fold.label != w.label || w.fold.samples != w.samples)) {
+      why = path + ": the fold of window '" + w.fold.label + "' (" +
+            std::to_string(w.fold.samples) + " samples), not of " + w.label + " (" +
+            std::to_string(w.samples) + ")";
+      ok = false;
+    }
     if (!ok) {
       if (!run.options.refold_all) {
         *run.error = why + "; --refold folds the window again from its samples";
@@ -772,11 +782,18 @@ TrackStatus SaveState(TrackRun& run) {
       return TrackStatus::kFailed;
     }
   }
-  // Each store's committed length: appends past it are an interrupted run's (CheckStores).
+  // Each store's committed length (appends past it are an interrupted run's: CheckStores)
+  // and digest, hashed again only where this run appended.
   for (TrackWindowState& w : run.windows) {
     std::error_code ec;
     const std::string store = run.Path("windows/" + w.StoreName());
-    w.store_bytes = fs::exists(store, ec) ? static_cast<long long>(fs::file_size(store, ec)) : 0;
+    const long long bytes =
+        fs::exists(store, ec) ? static_cast<long long>(fs::file_size(store, ec)) : 0;
+    if (bytes != w.store_bytes || w.store_sha256.empty()) {
+      w.store_sha256.clear();
+      if (bytes > 0 && !FileSha256(store, &w.store_sha256, run.error)) return TrackStatus::kFailed;
+    }
+    w.store_bytes = bytes;
   }
   if (!WriteFileAtomically(run.Path(kStateFile), StateJson(run), run.error)) {
     return TrackStatus::kFailed;

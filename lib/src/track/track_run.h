@@ -72,6 +72,10 @@ struct TrackWindowState {
   // unknown) and the fold file's SHA-256 ("" unknown).
   long long store_bytes = -1;
   std::string fold_sha256;
+  // The committed store's SHA-256 ("" unknown), checked before the store is first read in
+  // a run (store_checked): a store copied from another window or track is refused.
+  std::string store_sha256;
+  bool store_checked = false;
   std::string StoreName() const { return label + ".samples"; }
 };
 

@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "fastcal/file_digest.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/number_text.h"
@@ -141,6 +142,24 @@ bool ExpandToLayout(const TrackRun& run, WindowFold* f) {
     }
   }
   *f = std::move(x);
+  return true;
+}
+
+// The window's store holds, up to its committed length, the bytes the state recorded
+// (checked once a run, before its first fold): a store copied from another window or
+// track, or edited, would otherwise be folded as this window's samples.
+bool CheckStoreDigest(TrackRun& run, TrackWindowState* w) {
+  if (w->store_checked || w->store_sha256.empty() || w->store_bytes < 0) return true;
+  const std::string store = run.Path("windows/" + w->StoreName());
+  std::string digest;
+  if (!FileSha256Prefix(store, w->store_bytes, &digest, run.error)) return false;
+  if (digest != w->store_sha256) {
+    *run.error = store +
+                 ": not the samples this track stored (its SHA-256 differs from "
+                 "track_state.json's); --force rebuilds the track from the data";
+    return false;
+  }
+  w->store_checked = true;
   return true;
 }
 
@@ -396,6 +415,11 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     return run.Fail(
         TrackStatus::kInvalidInput,
         "no window has " + std::to_string(run.options.min_window_samples) + " samples or more");
+  }
+  for (int w : run.used) {
+    if (Moving(run, run.windows[w]) && !CheckStoreDigest(run, &run.windows[w])) {
+      return TrackStatus::kInvalidInput;
+    }
   }
   bool slow_settled = !estimate_slow_error || !run.spec.slow_error.estimates_any() || run.update;
   if (run.update && run.spec.slow_error.estimates_any() && estimate_slow_error) {
