@@ -30,8 +30,8 @@ bool Sha256Of(const std::string& path, long long limit, std::string* hex, std::s
              path,
              [&](const char* data, size_t n) {
                const long long room = limit < 0 ? static_cast<long long>(n) : limit - seen;
-               const size_t take = static_cast<size_t>(
-                   std::max(0LL, std::min(room, static_cast<long long>(n))));
+               const size_t take =
+                   static_cast<size_t>(std::max(0LL, std::min(room, static_cast<long long>(n))));
                seen += static_cast<long long>(n);
                if (take > 0) {
                  updated = updated && EVP_DigestUpdate(context.get(), data, take) == 1;
