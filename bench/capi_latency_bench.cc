@@ -198,6 +198,7 @@ void BM_ControlCycleAndLocateWarm(benchmark::State& state) {
   Report(state, &cycle_us, cycle_first_max, failures, 0);
   const Latency l = Summarise(&locate_us);
   state.counters["locate_p50_us"] = l.p50;
+  state.counters["locate_p99_us"] = l.p99;
   state.counters["locate_p99.9_us"] = l.p999;
   state.counters["locate_max_us"] = l.max;
   state.counters["locate_max_single_pass_us"] = locate_first_max;
