@@ -32,10 +32,16 @@
 // statics (TensionCost::EvaluateJet: before issue 28), 5 folding without a loss as
 // spec_realistic.yaml's fit does it, each reading's rows over its own columns first
 // (GroupedRowFold). One thread.
+// BM_RealisticStages/N (issue 41): the same run, with each stage's wall time (read, the
+// pipeline's stages grouped, write) and the yardstick beside it: N bare AAS solves
+// (SolveStatics, method aas, cold) on one thread over the same samples, measured in the
+// same run; x_yardstick is the end-to-end wall time over it.
 // BM_RealisticPartsEndToEnd/N (issue 35): the same with calibration_data/moving_parts.yaml
 // (the rotator through a grid of +-15 deg, the platform spread 5 cm) and
 // spec_moving_parts.yaml (the rotator's first moment and the platform's mass freed too).
 // Run: build/bench/calibration_bench --benchmark_filter=EndToEnd   (about a minute)
+//      build/bench/calibration_bench --benchmark_filter=RealisticStages
+//          --benchmark_counters_tabular=true   (the stages and the yardstick, ~1 min)
 //      build/bench/calibration_bench --benchmark_filter='Realistic|SampleRows'  (~2 min)
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
@@ -43,9 +49,13 @@
 #include <unistd.h>
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <map>
 #include <random>
+#include <string>
 
 #include "fastcal/calibration.h"
 #include "fastcal/internal/calibration_linearisation.h"
@@ -55,6 +65,7 @@
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/report.h"
 #include "fastcal/simulation.h"
+#include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
 #include "forked_run.h"
 
@@ -223,17 +234,122 @@ std::string RealisticDataFile(int samples, const CableRobot& truth = CableRobot:
   return ok && writer.Close(&error) ? path : "";
 }
 
+// spec_realistic.yaml into *spec; false (the benchmark skipped, saying why) when it fails.
+bool RealisticSpec(benchmark::State& state, CalibrationSpec* spec) {
+  std::string error;
+  if (LoadCalibrationSpec(kRealisticSpec, CableRobot::NominalFast(), spec, &error)) return true;
+  state.SkipWithError(error.c_str());
+  return false;
+}
+
 void BM_RealisticEndToEnd(benchmark::State& state) {
   CalibrationSpec spec;
-  std::string error;
-  if (!LoadCalibrationSpec(kRealisticSpec, CableRobot::NominalFast(), &spec, &error)) {
-    state.SkipWithError(error.c_str());
-    return;
-  }
+  if (!RealisticSpec(state, &spec)) return;
   EndToEnd(state, RealisticDataFile(static_cast<int>(state.range(0))), spec);
 }
 
 BENCHMARK(BM_RealisticEndToEnd)->Apply(EndToEndSizes);
+
+// Runs `child` in a forked process and waits: true when it exited 0.
+template <typename Child>
+bool ForkedChild(const Child& child) {
+  const pid_t pid = fork();
+  if (pid == 0) _exit(child());
+  int status = 0;
+  waitpid(pid, &status, 0);
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+// The yardstick of issue 41: one bare AAS solve (SolveStatics, StaticsOptions' defaults
+// but method kAas, cold) per sample of `csv`, on one thread, in a forked child (the
+// dataset read first, not timed). Seconds; NaN on failure.
+double AasYardstickSeconds(const std::string& csv) {
+  const std::string out = csv + ".yardstick";
+  const bool ok = ForkedChild([&] {
+    Dataset data;
+    DatasetReadOptions read;
+    read.max_file_bytes = 1LL << 40;
+    std::string error;
+    if (!ReadDataset(csv, read, &data, &error)) return 1;
+    const CableRobot model = CableRobot::NominalFast();
+    StaticsOptions options;
+    options.method = StaticsMethod::kAas;
+    StaticsSolution solution;
+    int solved = 0;
+    const auto start = std::chrono::steady_clock::now();
+    for (const Sample& s : data.samples) {
+      solved += SolveStatics(model, s.pose, options, &solution) == StaticsStatus::kOk;
+    }
+    const double seconds = bench::SecondsSince(start);
+    benchmark::DoNotOptimize(solved);
+    std::FILE* f = std::fopen(out.c_str(), "w");
+    if (f == nullptr) return 1;
+    std::fprintf(f, "%.6f\n", seconds);
+    return std::fclose(f) == 0 ? 0 : 1;
+  });
+  double seconds = std::nan("");
+  if (std::FILE* f = ok ? std::fopen(out.c_str(), "r") : nullptr) {
+    if (std::fscanf(f, "%lf", &seconds) != 1) seconds = std::nan("");
+    std::fclose(f);
+  }
+  std::filesystem::remove(out);
+  return seconds;
+}
+
+// The stages' wall times of a child's run (bench::ReadCalibrateReport's file) as counters,
+// grouped: read, predict (and screen), check (build and identifiability), solve (and
+// reweight: the IRLS passes), linearise, uncertainty, evaluate (the RMS table), write
+// (report.html, report.md, summary.json), other (the rest of the pipeline).
+void StageCounters(const std::string& path, benchmark::State& state) {
+  static const std::map<std::string, std::string> kGroup = {{"read", "read_s"},
+                                                            {"predict and screen", "predict_s"},
+                                                            {"build and check", "check_s"},
+                                                            {"solve and reweight", "solve_s"},
+                                                            {"linearise", "linearise_s"},
+                                                            {"uncertainty", "uncertainty_s"},
+                                                            {"evaluate", "evaluate_s"},
+                                                            {"write", "write_s"}};
+  for (const auto& [name, counter] : kGroup) state.counters[counter] = 0.0;
+  state.counters["other_s"] = 0.0;
+  std::ifstream in(path);
+  std::string line;
+  while (std::getline(in, line)) {
+    const size_t tab = line.find('\t');
+    if (tab == std::string::npos) continue;
+    const auto group = kGroup.find(line.substr(0, tab));
+    state.counters[group == kGroup.end() ? "other_s" : group->second] +=
+        std::stod(line.substr(tab + 1));
+  }
+}
+
+// BM_RealisticStages/N (issue 41): BM_RealisticEndToEnd's run with the wall time of each
+// stage, beside the yardstick measured in the same run: N bare AAS solves on one thread
+// (x_yardstick = the end-to-end wall time over it; the issue's goal is 2.0 at 10^6).
+void BM_RealisticStages(benchmark::State& state) {
+  CalibrationSpec spec;
+  if (!RealisticSpec(state, &spec)) return;
+  const std::string csv = RealisticDataFile(static_cast<int>(state.range(0)));
+  if (csv.empty()) {
+    state.SkipWithError("cannot write the dataset file");
+    return;
+  }
+  const std::string dir = csv + ".out";
+  const std::string stages = csv + ".stages";
+  const auto start = std::chrono::steady_clock::now();
+  ForkedIterations(state, [&] {
+    return ReadCalibrateReport(csv, spec, dir, CableRobot::NominalFast(), stages);
+  });
+  const double wall_s = bench::SecondsSince(start);
+  StageCounters(stages, state);
+  const double yardstick_s = AasYardstickSeconds(csv);
+  state.counters["yardstick_s"] = yardstick_s;
+  state.counters["x_yardstick"] = wall_s / yardstick_s;
+  std::filesystem::remove_all(dir);
+  std::filesystem::remove(stages);
+  std::filesystem::remove(csv);
+}
+
+BENCHMARK(BM_RealisticStages)->Apply(EndToEndSizes);
 
 // The same with the cabin's moving parts (issue 35: within 1.2x of the above).
 void BM_RealisticPartsEndToEnd(benchmark::State& state) {

@@ -23,11 +23,20 @@
 
 namespace fastcal::bench {
 
+// Seconds since `start` (steady clock).
+inline double SecondsSince(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
 // In the child: read, calibrate with `spec`, write the report into `dir`. Exit code 0 on
-// success; else 1 (read), 2 (calibrate) or 3 (report), the reason on stderr.
+// success; else 1 (read), 2 (calibrate) or 3 (report), the reason on stderr. With
+// `stages_path`, each stage's wall time there as lines "NAME<TAB>SECONDS": "read", the
+// pipeline's stages (CalibrationResult::stages), "write".
 inline int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& spec,
                                const std::string& dir,
-                               const CableRobot& model = CableRobot::NominalFast()) {
+                               const CableRobot& model = CableRobot::NominalFast(),
+                               const std::string& stages_path = "") {
+  auto lap = std::chrono::steady_clock::now();
   Dataset data;
   std::string error;
   const auto failed = [&error](int code) {
@@ -41,6 +50,7 @@ inline int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& sp
   read.max_file_bytes = 1LL << 40;
   read.joint_columns = model.moving_parts.JointColumns();
   if (!ReadDataset(csv, read, &data, &error)) return failed(1);
+  const double read_s = SecondsSince(lap);
   CalibrationResult result;
   if (Calibrate(model, spec, data, CalibrationOptions(), &result, &error) !=
       CalibrationStatus::kOk) {
@@ -52,8 +62,20 @@ inline int ReadCalibrateReport(const std::string& csv, const CalibrationSpec& sp
   inputs.data = &data;
   inputs.result = &result;
   inputs.variants = std::move(result.variants);
+  lap = std::chrono::steady_clock::now();
   std::filesystem::create_directories(dir);
-  return WriteReportFiles(dir, inputs, &error) ? 0 : failed(3);
+  if (!WriteReportFiles(dir, inputs, &error)) return failed(3);
+  if (!stages_path.empty()) {
+    std::FILE* out = std::fopen(stages_path.c_str(), "w");
+    if (out == nullptr) return 3;
+    std::fprintf(out, "read\t%.6f\n", read_s);
+    for (const CalibrationResult::Stage& stage : result.stages) {
+      std::fprintf(out, "%s\t%.6f\n", stage.name.c_str(), stage.seconds);
+    }
+    std::fprintf(out, "write\t%.6f\n", SecondsSince(lap));
+    if (std::fclose(out) != 0) return 3;
+  }
+  return 0;
 }
 
 // Runs `child` in a forked process per iteration: wall time, its CPU time and peak memory.
