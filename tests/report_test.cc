@@ -902,13 +902,21 @@ class ReportFilesTest : public ReportTest {
   fs::path dir_;
 };
 
-TEST_F(ReportFilesTest, WritesThreeFiles) {
-  std::string error;
-  ASSERT_TRUE(WriteReportFiles(dir_.string(), inputs_, &error)) << error;
-  EXPECT_EQ(Entries(dir_), (std::vector<std::string>{"report.html", "report.md", "summary.json"}));
-  EXPECT_EQ(ReadFile(dir_ / "report.md"), ReportMarkdown(inputs_));
-  EXPECT_EQ(ReadFile(dir_ / "report.html"), ReportHtml(inputs_));
-  EXPECT_EQ(ReadFile(dir_ / "summary.json"), SummaryJson(inputs_));
+// Rendered on the spec's threads (issue 41), each file is the one rendering gives alone.
+TEST_F(ReportFilesTest, WritesThreeFilesTheSameOnAnyNumberOfThreads) {
+  for (int threads : {1, 2, 3, 8}) {
+    CalibrationSpec spec = spec_;
+    spec.num_threads = threads;
+    ReportInputs inputs = inputs_;
+    inputs.spec = &spec;
+    std::string error;
+    ASSERT_TRUE(WriteReportFiles(dir_.string(), inputs, &error)) << error;
+    EXPECT_EQ(Entries(dir_),
+              (std::vector<std::string>{"report.html", "report.md", "summary.json"}));
+    EXPECT_EQ(ReadFile(dir_ / "report.md"), ReportMarkdown(inputs)) << threads;
+    EXPECT_EQ(ReadFile(dir_ / "report.html"), ReportHtml(inputs)) << threads;
+    EXPECT_EQ(ReadFile(dir_ / "summary.json"), SummaryJson(inputs)) << threads;
+  }
 }
 
 TEST_F(ReportFilesTest, MissingDirectoryFailsAndLeavesNothing) {

@@ -586,8 +586,9 @@ ValueConversion ConversionOf(const std::string& name, const std::string& unit) {
 double ScaleDecimal(std::string_view field, double parsed, int shift) {
   if (shift == 0) return parsed;
   constexpr long kMaxShiftableExponent = 100000;
-  const double fallback = parsed * std::pow(10.0, shift);
-  if (field.find_first_of("xX") != std::string_view::npos) return fallback;  // hex float
+  // Only where the text cannot be shifted (a pow a field was 4.5% of reading 10^6 rows).
+  const auto fallback = [&] { return parsed * std::pow(10.0, shift); };
+  if (field.find_first_of("xX") != std::string_view::npos) return fallback();  // hex float
   const size_t e = field.find_first_of("eE");
   long exponent = 0;
   std::string_view mantissa = field;
@@ -596,7 +597,7 @@ double ScaleDecimal(std::string_view field, double parsed, int shift) {
     if (!exponent_text.empty() && exponent_text.front() == '+') exponent_text.remove_prefix(1);
     const auto [ptr, ec] = std::from_chars(exponent_text.data(),
                                            exponent_text.data() + exponent_text.size(), exponent);
-    if (ec != std::errc() || std::labs(exponent) > kMaxShiftableExponent) return fallback;
+    if (ec != std::errc() || std::labs(exponent) > kMaxShiftableExponent) return fallback();
     mantissa = field.substr(0, e);
   }
   // "<mantissa>e<exponent + shift>", on the stack for the usual field (no allocation a
@@ -612,8 +613,10 @@ double ScaleDecimal(std::string_view field, double parsed, int shift) {
   char* end = out + mantissa.size();
   *end++ = 'e';
   end = std::to_chars(end, out + mantissa.size() + 24, exponent + shift).ptr;
-  double scaled = fallback;
-  ParseDouble(std::string_view(out, static_cast<size_t>(end - out)), &scaled);
+  double scaled = 0.0;
+  if (!ParseDouble(std::string_view(out, static_cast<size_t>(end - out)), &scaled)) {
+    return fallback();
+  }
   return scaled;
 }
 
