@@ -33,6 +33,10 @@ TEST(AtomicFileTest, SignalCleanUpRemovesTemporariesAndStagingDirectories) {
     std::ofstream(staging + "/file_with_a_long_name_" + std::to_string(k) + ".csv") << "x";
   }
   std::ofstream(staging + "/residuals.csv") << "time_s,cable,half a ro";
+  // A new track's staging directory: its stores in subdirectories, two levels down too.
+  fs::create_directories(staging + "/windows/deeper");
+  std::ofstream(staging + "/windows/2024-05-01.samples") << "records";
+  std::ofstream(staging + "/windows/deeper/x") << "x";
   RegisterTemporaryDirectory(staging);
   // A temporary file named for a result, and a result already published (kept).
   const std::string temporary = TemporaryNameFor(dir + "/data.csv");

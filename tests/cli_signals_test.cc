@@ -24,14 +24,36 @@ class CliSignalsTest : public CliTest {
 
 TEST_F(CliSignalsTest, SigintAndSigtermLeaveNothingHalfWritten) {
   constexpr double kDelayS = 0.7;  // the runs below take minutes
-  EXPECT_EQ(Interrupted("simulate --trajectory=random --samples=10000000 --out=s.csv", "INT",
-                        kDelayS),
-            130);
+  EXPECT_EQ(
+      Interrupted("simulate --trajectory=random --samples=10000000 --out=s.csv", "INT", kDelayS),
+      130);
   EXPECT_TRUE(DirectoryEmpty());
-  EXPECT_EQ(Interrupted("solve --trajectory=random --samples=10000000 --output=p.csv", "TERM",
-                        kDelayS),
-            143);
+  EXPECT_EQ(
+      Interrupted("solve --trajectory=random --samples=10000000 --output=p.csv", "TERM", kDelayS),
+      143);
   EXPECT_TRUE(DirectoryEmpty());
+}
+
+// A new track stopped while it writes its window stores (issue 37: the staging directory
+// DIR.partial-PID and its windows/*.samples stayed, beside a message that nothing was
+// left): nothing of it remains but the lock file beside DIR.
+TEST_F(CliSignalsTest, AStoppedNewTrackLeavesNoStagingDirectory) {
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=200000 --interval-s=1 --seed=2 "
+                    "--start=2024-05-01T00:00:00Z --out=" +
+                    Path("days.csv"))
+                .code,
+            0);
+  for (const char* signal : {"INT", "TERM"}) {
+    const int code = Interrupted(
+        "track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=days.csv --out=t",
+        signal, 1.0);
+    EXPECT_EQ(code, signal[0] == 'I' ? 130 : 143);
+    for (const fs::directory_entry& e : fs::directory_iterator(dir_)) {
+      const std::string name = e.path().filename().string();
+      EXPECT_TRUE(name == "days.csv" || name == "days.truth.yaml" || name == ".t.lock")
+          << name << " left after SIG" << signal;
+    }
+  }
 }
 
 }  // namespace

@@ -699,6 +699,9 @@ TrackStatus PrepareDirectory(TrackRun& run) {
   // A new track: built beside DIR and moved into place at the end.
   run.dir = run.out + ".partial-" + std::to_string(::getpid());
   fs::remove_all(run.dir, ec);
+  // Removed with what it holds when SIGINT or SIGTERM stops the run (a signal handler's
+  // work: atomic_file.h; issue 37: a stopped new track left its window stores).
+  internal::RegisterTemporaryDirectory(run.dir);
   if (!fs::create_directories(run.dir + "/windows", ec) ||
       !fs::create_directories(run.dir + "/folds", ec)) {
     return run.Fail(TrackStatus::kInvalidInput, run.dir + ": cannot create: " + ec.message());

@@ -112,33 +112,47 @@ constexpr int kDirectorySlots = 8;
 TemporarySlot g_directories[kDirectorySlots];
 std::atomic<unsigned> g_next_directory{0};
 
-// Empties and removes `dir` with system calls only (getdents64, unlinkat, rmdir: no
-// allocation, no lock), one level deep: a staging directory holds files. A few passes,
-// since removing entries while listing may skip some.
-void RemoveDirectoryOnSignal(const char* dir) {
-  const int fd = ::open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (fd < 0) return;  // published or removed meanwhile
-  static char buffer[8192];
+// Empties the directory open as `fd` with system calls only (getdents64, openat,
+// unlinkat: no allocation, no lock), its subdirectories too down to kSignalDepth levels (a
+// new track's staging directory holds windows/ and folds/: issue 37). A few passes, since
+// removing entries while listing may skip some. Closes fd.
+constexpr int kSignalDepth = 3;
+void EmptyDirectoryOnSignal(int fd, int depth) {
+  static char buffers[kSignalDepth][8192];  // one per level: a level's listing survives
+  char* buffer = buffers[depth];
   for (int pass = 0; pass < 4; ++pass) {
     bool removed = false;
     long n = 0;
     ::lseek(fd, 0, SEEK_SET);
-    while ((n = ::syscall(SYS_getdents64, fd, buffer, sizeof(buffer))) > 0) {
+    while ((n = ::syscall(SYS_getdents64, fd, buffer, sizeof(buffers[0]))) > 0) {
       for (long at = 0; at < n;) {
         // struct linux_dirent64: ino (8), off (8), reclen (2), type (1), name.
         unsigned short reclen = 0;
         std::memcpy(&reclen, buffer + at + 16, sizeof(reclen));
         const char* name = buffer + at + 19;
-        const bool dots = name[0] == '.' && (name[1] == 0 || (name[1] == '.' && name[2] == 0));
-        if (!dots && (::unlinkat(fd, name, 0) == 0 || ::unlinkat(fd, name, AT_REMOVEDIR) == 0)) {
-          removed = true;
-        }
         at += reclen;
+        const bool dots = name[0] == '.' && (name[1] == 0 || (name[1] == '.' && name[2] == 0));
+        if (dots) continue;
+        if (::unlinkat(fd, name, 0) == 0) {
+          removed = true;
+          continue;
+        }
+        if (depth + 1 < kSignalDepth) {
+          const int sub = ::openat(fd, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW | O_CLOEXEC);
+          if (sub >= 0) EmptyDirectoryOnSignal(sub, depth + 1);
+        }
+        if (::unlinkat(fd, name, AT_REMOVEDIR) == 0) removed = true;
       }
     }
     if (!removed) break;
   }
   ::close(fd);
+}
+
+void RemoveDirectoryOnSignal(const char* dir) {
+  const int fd = ::open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) return;  // published or removed meanwhile
+  EmptyDirectoryOnSignal(fd, 0);
   ::rmdir(dir);
 }
 

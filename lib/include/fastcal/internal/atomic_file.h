@@ -34,9 +34,9 @@ std::string TemporaryNameFor(const std::string& path);
 void RegisterTemporaryDirectory(const std::string& dir);
 
 // Unlinks every temporary this process named with TemporaryNameFor that still exists, and
-// empties and removes every registered staging directory that still exists (the files in
-// it, one level deep): async-signal-safe (system calls only: no allocation, no lock), for
-// a SIGINT/SIGTERM handler, so that an interrupted command leaves no half-written file
+// empties and removes every registered staging directory that still exists (its files and
+// subdirectories, three levels deep): async-signal-safe (system calls only: no allocation, no
+// lock), for a SIGINT/SIGTERM handler, so that an interrupted command leaves no half-written file
 // (issue 37). What a SIGKILL leaves, the next run removes once its process is gone.
 void RemoveTemporariesOnSignal();
 
