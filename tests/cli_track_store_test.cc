@@ -44,6 +44,21 @@ TEST_F(CliTrackStoreTest, ASecondRunOnTheSameTrackIsRefused) {
   EXPECT_FALSE(fs::exists(Path("t")));
 }
 
+// The same track by another name: a symbolic link to DIR, even before DIR exists (two
+// runs on `t` and `sym -> t` both exited 0 before, and one result was lost).
+TEST_F(CliTrackStoreTest, ARunThroughASymbolicLinkIsRefusedToo) {
+  ASSERT_EQ(Shell("cd " + Path("") + " && ln -s t sym").code, 0);
+  const CommandResult r =
+      Shell("flock " + Path(".t.lock") + " " + Bin() + " track --spec=" + Source() +
+            "/calibration_data/spec_track.yaml --data=" + Day(1) + " --out=" + Path("sym"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("another fastcal track is running on it"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(Path("t")));
+  // Unlocked, the run builds the track where the link points.
+  EXPECT_EQ(Track(Day(1), "sym").code, 0);
+  EXPECT_TRUE(fs::exists(Path("t/track_state.json")));
+}
+
 TEST_F(CliTrackStoreTest, AnInterruptedUpdateCountsNothingTwice) {
   ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
   ASSERT_EQ(Track(Day(1) + "," + Day(2), "clean").code, 0);

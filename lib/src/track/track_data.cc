@@ -636,11 +636,31 @@ TrackStatus ExpandDataPaths(const std::vector<std::string>& given, std::vector<s
   return TrackStatus::kOk;
 }
 
+// `out` with its own symbolic links followed (up to 40, as the kernel does; a dangling one
+// to where it points), as a canonical path; `out` itself when it is no link. (A linked
+// parent needs nothing: the lock file beside DIR is then the same file either way.)
+std::string ResolvedTrackPath(const std::string& out) {
+  std::error_code ec;
+  fs::path p = fs::path(out);
+  if (!fs::is_symlink(p, ec)) return out;
+  for (int hop = 0; hop < 40 && fs::is_symlink(p, ec); ++hop) {
+    const fs::path target = fs::read_symlink(p, ec);
+    if (ec) return out;
+    p = target.is_absolute() ? target : p.parent_path() / target;
+  }
+  const fs::path resolved = fs::weakly_canonical(p, ec);
+  return ec ? p.lexically_normal().string() : resolved.string();
+}
+
 // The exclusive lock on DIR for the run's life: a lock file beside DIR, ".NAME.lock"
 // (beside it, so that a new track's DIR, made only at the end, is locked too). A second
 // run on the same DIR is refused at once, naming it. Leftover staging directories of
 // runs that died (DIR.partial-PID) are removed once the lock is held: none is alive.
 TrackStatus LockDirectory(TrackRun& run) {
+  // One lock per track, however DIR is spelled: a symbolic link (even one to a DIR not yet
+  // made) or a linked parent is followed to the track itself (issue 37: two runs on `n`
+  // and on `sym -> n` both ran, and one result was lost).
+  run.out = ResolvedTrackPath(run.out);
   fs::path out = fs::path(run.out).lexically_normal();
   if (out.filename().empty()) out = out.parent_path();
   const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
