@@ -72,8 +72,9 @@ Usage:
                       the whole track (Bonferroni over its tests)
   --refold            on an update, refold every window at the new point (and re-estimate
                       the slow error), as a fresh track would
-  --force             DIR holds a track of another model, spec or windowing, or files that
-                      changed: build it afresh
+  --force             build the track afresh from the data, whatever DIR holds (needed
+                      when DIR holds a track of another model, spec or windowing, of
+                      files that changed, or a damaged one)
   --keep-overlapping  fold files whose time spans overlap (refused otherwise: the same
                       instants given twice would be folded twice)
   --skip-invalid-rows skip malformed rows (named on stderr) instead of failing

@@ -103,6 +103,24 @@ TEST_F(CliTrackStoreTest, AStoreFromElsewhereIsRefusedEvenOnRefold) {
             std::string::npos)
       << r.output;
   EXPECT_NE(r.output.find("--force"), std::string::npos) << r.output;
+  // As it says: --force builds the track afresh from the data, the day's own numbers.
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "clean").code, 0);
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "t", "--force").code, 0);
+  const std::string rebuilt = ReadFile(Path("t/track.csv"));
+  const std::string clean = ReadFile(Path("clean/track.csv"));
+  EXPECT_EQ(rebuilt.substr(rebuilt.find('\n')), clean.substr(clean.find('\n')));
+}
+
+// A fold that cannot be read is cleared by --force as by --refold (issue 37: --force kept
+// refusing it).
+TEST_F(CliTrackStoreTest, ACorruptFoldIsClearedByForce) {
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);
+  Write("t/folds/2024-05-02.g1.fold", "not a fold");
+  EXPECT_EQ(Track(Day(1) + "," + Day(2), "t").code, 2);
+  const CommandResult r = Track(Day(1) + "," + Day(2), "t", "--force");
+  EXPECT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(ReadFile(Path("t/folds/2024-05-02.g1.fold")), "not a fold");  // the day folded afresh
+  EXPECT_EQ(Track(Day(1) + "," + Day(2), "t").code, 0);                   // and read back
 }
 
 TEST_F(CliTrackStoreTest, AFoldOfAnotherWindowIsRefusedEvenWithItsDigestForged) {

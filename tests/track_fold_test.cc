@@ -281,6 +281,22 @@ TEST_F(TrackFoldTest, FiniteNonsenseInAFoldIsRefused) {
   bad = good;
   bad.samples = -1;
   refused(bad, "a negative count");
+  // Found again from outside with the state's digest recomputed: a block's information
+  // x1e200 (NaN sigma_totals in every window) and a chi-square of 1e300 (a sigma_total of
+  // 2.4e145 m).
+  ASSERT_FALSE(good.block_information.empty());
+  bad = good;
+  bad.block_information[0] *= 1e200;
+  refused(bad, "a block's information beyond any telemetry's");
+  bad = good;
+  bad.chi_square = 1e300;
+  refused(bad, "a chi-square beyond any telemetry's");
+  bad = good;
+  bad.block_scores *= 1e200;
+  refused(bad, "a block score beyond any telemetry's");
+  bad = good;
+  bad.gradient *= 1e200;
+  refused(bad, "a gradient beyond any telemetry's");
 }
 
 TEST_F(TrackFoldTest, TasksCarryEveryParameterKind) {

@@ -128,8 +128,9 @@ struct TrackOptions {
   // An update (DIR holds a track): refold every window at the new point, not only those
   // that gained samples.
   bool refold_all = false;
-  // DIR holds a track of another model, spec or windowing, or of files that changed:
-  // build it afresh (else refused).
+  // Build the track afresh from the data whatever DIR holds (else a track of another
+  // model, spec or windowing, of files that changed, or a damaged one is refused; a
+  // matching one is updated).
   bool force = false;
   // Files whose time spans overlap are refused (the same instants given twice, e.g. a day
   // re-sent with another name, would be folded twice); true folds them all, for files

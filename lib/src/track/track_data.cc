@@ -351,7 +351,9 @@ bool LoadFolds(TrackRun& run) {
     }
     if (!ok) {
       if (!run.options.refold_all) {
-        *run.error = why + "; --refold folds the window again from its samples";
+        *run.error = why +
+                     "; --refold folds the window again from its samples (--force rebuilds "
+                     "the track from the data)";
         return false;
       }
       run.result->notes.push_back("refolded " + w.label + ": " + why);
@@ -368,6 +370,13 @@ bool LoadFolds(TrackRun& run) {
 }
 
 bool LoadSavedState(TrackRun& run, bool* use) {
+  // --force builds the track afresh from the data whatever DIR holds: another model's
+  // track, or a damaged one (a corrupt fold or state, a store from elsewhere), which is
+  // then never read (issue 37: a corrupt fold could not be cleared by --force).
+  if (run.options.force) {
+    *use = false;
+    return true;
+  }
   std::string text;
   if (!ReadRegularFile(run.Path(kStateFile), 16LL << 20, "track state", &text, run.error)) {
     return false;
@@ -382,10 +391,6 @@ bool LoadSavedState(TrackRun& run, bool* use) {
   RelocateFiles(run, &s);
   const std::string mismatch = Mismatch(run, s);
   if (!mismatch.empty()) {
-    if (run.options.force) {
-      *use = false;
-      return true;
-    }
     *run.error = run.out + " holds a track of " + mismatch +
                  ": give a new --out, or --force to build it afresh";
     return false;

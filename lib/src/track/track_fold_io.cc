@@ -328,6 +328,10 @@ namespace {
 constexpr double kMaxInformation = 1e30;
 // Relative asymmetry of the information beyond rounding: not a fold's.
 constexpr double kAsymmetry = 1e-9;
+// Largest chi-square a reading contributes: residuals of 10^6 sigmas (a unit slip of 1000x
+// gives about 10^3); beyond it a fold's chi-square is no telemetry's (issue 37: 1e300 gave
+// a sigma_total of 2.4e145 m through the misfit's widening).
+constexpr double kMaxChiSquarePerReading = 1e12;
 
 bool AllFinite(const Eigen::MatrixXd& m) { return m.allFinite(); }
 
@@ -350,6 +354,14 @@ std::string OutOfRange(const WindowFold& f) {
   }
   const double scale = f.information.size() > 0 ? f.information.cwiseAbs().maxCoeff() : 0.0;
   if (scale > kMaxInformation) return "information beyond any telemetry's";
+  if (f.gradient.size() > 0 && f.gradient.cwiseAbs().maxCoeff() > kMaxInformation) {
+    return "a gradient beyond any telemetry's";
+  }
+  const double readings = static_cast<double>(std::max<long long>(1, f.readings));
+  if (f.chi_square > kMaxChiSquarePerReading * readings) {
+    return "a chi-square beyond any telemetry's (" + std::to_string(f.chi_square) + " for " +
+           std::to_string(f.readings) + " readings)";
+  }
   if (f.information.size() > 0 &&
       (f.information - f.information.transpose()).cwiseAbs().maxCoeff() > kAsymmetry * scale) {
     return "an information matrix that is not symmetric";
@@ -361,11 +373,21 @@ std::string OutOfRange(const WindowFold& f) {
     if (n < 0) return "a negative block";
   }
   if (!AllFinite(f.block_scores)) return "a block score not finite";
+  if (f.block_scores.size() > 0 && f.block_scores.cwiseAbs().maxCoeff() > kMaxInformation) {
+    return "a block score beyond any telemetry's";
+  }
+  // A block's information is part of the window's: no larger in any entry (issue 37:
+  // x1e200 gave NaN sigma_totals in every window).
   for (const Eigen::MatrixXd& m : f.block_information) {
     if (!AllFinite(m)) return "a block's information not finite";
+    if (m.size() > 0 && m.cwiseAbs().maxCoeff() > kMaxInformation) {
+      return "a block's information beyond any telemetry's";
+    }
   }
+  constexpr double kMaxSquaredReadingN2 = 1e18;  // a reading's residual of 10^9 N, squared
   for (int i = 0; i < kNumCables; ++i) {
-    if (f.count[i] < 0 || !(f.sum_sq_n2[i] >= 0.0) || !std::isfinite(f.sum_sq_n2[i])) {
+    if (f.count[i] < 0 || !(f.sum_sq_n2[i] >= 0.0) || !std::isfinite(f.sum_sq_n2[i]) ||
+        f.sum_sq_n2[i] > kMaxSquaredReadingN2 * static_cast<double>(std::max(1LL, f.count[i]))) {
       return "a cable's residual sums out of range";
     }
   }
