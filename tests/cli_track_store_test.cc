@@ -138,6 +138,24 @@ TEST_F(CliTrackStoreTest, AFoldOfAnotherWindowIsRefusedEvenWithItsDigestForged) 
   EXPECT_NE(r.output.find("the fold of window '2024-05-01'"), std::string::npos) << r.output;
 }
 
+// One tension column in another unit (its kN read as N: 1000x small) is named before
+// anything is folded, as calibrate names it (track said "cannot solve this pose").
+TEST_F(CliTrackStoreTest, ATensionColumnInAnotherUnitIsNamed) {
+  ASSERT_EQ(Shell("awk -F, 'BEGIN {OFS = \",\"} /^#/ {print; next} !h {for (i = 1; i <= NF; "
+                  "++i) if ($i == \"T3_kN\") c = i; h = 1; print; next} {$c = $c / 1000; "
+                  "print}' " +
+                  Day(1) + " > " + Path("slipped.csv"))
+                .code,
+            0);
+  const CommandResult r = Track(Path("slipped.csv"), "t");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("cable 3's tensions"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("read 1000x small? (T3 in kN where the column map says N)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(Path("t")));
+}
+
 TEST_F(CliTrackStoreTest, TheSameDataTwiceIsRefusedByContent) {
   ASSERT_EQ(Shell("cp " + Day(1) + " " + Path("copy.csv") + " && gzip -k " + Day(2)).code, 0);
   CommandResult r = Track(Day(1) + "," + Path("copy.csv"), "a");
@@ -220,7 +238,36 @@ TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
   r = Track(Day(1) + "," + Day(2), "t");
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("not a count"), std::string::npos) << r.output;
-  Write("t/track_state.json", std::string(1 << 20, '['));
+  // Window times that are no window's (1e400 was written to track.csv as inf).
+  Write("t/track_state.json",
+        std::regex_replace(state, std::regex("\"start_s\": [-0-9.e+]+"), "\"start_s\": 1e400",
+                           std::regex_constants::format_first_only));
+  r = Track(Day(1) + "," + Day(2), "t");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("times are not a window's"), std::string::npos) << r.output;
+  // The windows emptied by hand: an update dropped every earlier day, exit 0.
+  const size_t windows = state.find("\"windows\": [");
+  const size_t shared = state.find("\"shared\": [");
+  ASSERT_NE(windows, std::string::npos);
+  ASSERT_NE(shared, std::string::npos);
+  Write("t/track_state.json",
+        state.substr(0, windows) + "\"windows\": [],\n  " + state.substr(shared));
+  r = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("samples are in no window: a damaged state"), std::string::npos)
+      << r.output;
+  // Millions of empty lists: each a yaml-cpp node (16 MiB of them took 2.7 GB); refused by
+  // their count before they are parsed, under a memory limit.
+  std::string lists = "{\"format\": [";
+  while (lists.size() < (8u << 20)) lists += "[],";
+  Write("t/track_state.json", lists + "[]]}");
+  r = Shell(std::string(kUnderSanitizer ? "" : "ulimit -v 1500000; ") + "timeout 60 " + Bin() +
+            " track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=" + Day(1) +
+            " --out=" + Path("t"));
+  EXPECT_EQ(r.code, 2) << r.output.substr(0, 2000);
+  EXPECT_NE(r.output.find("entries, more than any track's state holds"), std::string::npos)
+      << r.output.substr(0, 2000);
+  Write("t/track_state.json", std::string(100000, '['));  // under the entries bound
   r = RunBoundedAndExpect({"track --spec=" + Source() +
                                "/calibration_data/spec_track.yaml --data=" + Day(1) +
                                " --out=" + Path("t"),

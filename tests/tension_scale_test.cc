@@ -1,6 +1,6 @@
 // The tension readings' scale against the cabin's weight (fastcal/tension_scale.h):
 // FAST's tensions pass, the same read 1000x small or large, or in tonne-force, are
-// refused naming the slip,
+// refused naming the slip, as is one cable's column in another unit,
 // and a lengths file without tensions is not judged.
 #include "fastcal/tension_scale.h"
 
@@ -32,9 +32,13 @@ TEST(TensionScaleTest, FastsTensionsPassAndAUnitSlipIsNamed) {
   EXPECT_NE(error.find("data.csv: the six tensions sum to 1.08 kN a sample (median)"),
             std::string::npos)
       << error;
-  EXPECT_NE(error.find("read 1000x small"), std::string::npos) << error;
+  EXPECT_NE(error.find("read 1000x small? (tensions in kN where the column map says N)"),
+            std::string::npos)
+      << error;
   EXPECT_FALSE(CheckTensionScale(Uniform(kCableN * 1e3), fast, &error));
-  EXPECT_NE(error.find("read 1000x large"), std::string::npos) << error;
+  EXPECT_NE(error.find("read 1000x large? (tensions in N where the column map says kN)"),
+            std::string::npos)
+      << error;
   // Tonne-force read as kN (9.8x small: a sum of ~0.37 of the weight; a review found it
   // passed the former floor of a third) is named as such.
   constexpr double kNPerTonneForce = 9806.65;
@@ -45,6 +49,26 @@ TEST(TensionScaleTest, FastsTensionsPassAndAUnitSlipIsNamed) {
   const double weight_n = fast.cabin_mass_kg * std::abs(fast.gravity_m_per_s2);
   EXPECT_TRUE(CheckTensionScale(Uniform(weight_n * kMinWeightFraction / 6 * 1.001), fast, &error));
   EXPECT_FALSE(CheckTensionScale(Uniform(weight_n * kMinWeightFraction / 6 * 0.999), fast, &error));
+  // One column in another unit (issue 37: T3 under `unit: N` in a kN export gave
+  // sensor_gain[3] = 0.001 and exit 0): the sum stays plausible, the cable is named.
+  Dataset one = Uniform(kCableN);
+  for (Sample& s : one.samples) s.tension_n[2] /= 1e3;
+  EXPECT_FALSE(CheckTensionScale(one, fast, &error));
+  EXPECT_NE(error.find("cable 3's tensions (median 0.18 kN) are 0.001 times the other "
+                       "cables' (median 180 kN): read 1000x small? (T3 in kN where the "
+                       "column map says N)"),
+            std::string::npos)
+      << error;
+  one = Uniform(kCableN);
+  for (Sample& s : one.samples) s.tension_n[4] *= 1e3;
+  EXPECT_FALSE(CheckTensionScale(one, fast, &error));
+  EXPECT_NE(error.find("read 1000x large? (T5 in N where the column map says kN)"),
+            std::string::npos)
+      << error;
+  // Cables as unequal as FAST's anywhere on the cap (50 to 800 kN) pass.
+  Dataset unequal = Uniform(kCableN);
+  for (Sample& s : unequal.samples) s.tension_n = {50e3, 800e3, 300e3, 200e3, 600e3, 400e3};
+  EXPECT_TRUE(CheckTensionScale(unequal, fast, &error)) << error;
   Dataset lengths = Uniform(0.0);
   lengths.has_tensions = false;
   EXPECT_TRUE(CheckTensionScale(lengths, fast, &error));

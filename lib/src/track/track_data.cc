@@ -22,6 +22,7 @@
 #include "fastcal/internal/track_state.h"
 #include "fastcal/internal/window_store.h"
 #include "fastcal/sessions.h"
+#include "fastcal/tension_scale.h"
 #include "fastcal/time_text.h"
 #include "track/track_run.h"
 #include "util/yaml_document.h"
@@ -167,7 +168,35 @@ bool IsSafeLabel(const std::string& label) {
   });
 }
 
+// The entries of a JSON text outside its strings: each ',', '[' and '{'.
+long long JsonEntries(const std::string& text) {
+  long long entries = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '"') {
+      for (++i; i < text.size() && text[i] != '"'; ++i) {
+        if (text[i] == '\\') ++i;
+      }
+    } else if (c == ',' || c == '[' || c == '{') {
+      ++entries;
+    }
+  }
+  return entries;
+}
+
+// More entries than any track's state holds (a year of hourly files and daily windows is
+// ~10^5): each costs yaml-cpp ~0.5 kB, and 16 MiB of "[]," took 2.7 GB (issue 37).
+constexpr long long kMaxStateEntries = 250000;
+
 SavedState ParseState(const std::string& text) {
+  if (const long long entries = JsonEntries(text); entries > kMaxStateEntries) {
+    YAML::Mark start;
+    start.line = 0;
+    throw YAML::Exception(start, std::to_string(entries) + " entries, more than any track's " +
+                                     "state holds (" + std::to_string(kMaxStateEntries) +
+                                     "): a damaged state; --force rebuilds the track from the "
+                                     "data");
+  }
   // The nesting guard of every YAML reader (16 MiB of '[' took 3.9 GB through YAML::Load).
   const YAML::Node root = LoadYamlDocuments(text).first;
   if (Text(root["format"]) != kStateFormat) {
@@ -211,8 +240,33 @@ SavedState ParseState(const std::string& text) {
     if (n["store_bytes"]) w.store_bytes = Count(n["store_bytes"]);
     if (n["store_sha256"]) w.store_sha256 = Text(n["store_sha256"]);
     for (const YAML::Node& f : n["files"]) w.files.push_back(static_cast<int>(Integer(f)));
+    // Times as the track writes them (issue 37: a start_s of 1e400 was written to
+    // track.csv as inf): finite, within data's plausible times, in order.
+    const auto plausible = [](double t) {
+      return std::isfinite(t) && std::abs(t) <= kUnixTimeUntilS;  // year 10000 (time_text.h)
+    };
+    if (!plausible(w.start_s) || !plausible(w.end_s) || w.start_s > w.end_s ||
+        (w.samples > 0 &&
+         (!plausible(w.first_s) || !plausible(w.last_s) || w.first_s > w.last_s))) {
+      throw YAML::Exception(n["start_s"].Mark(),
+                            "window " + w.label + "'s times are not a window's");
+    }
     w.dirty = false;
     s.windows.push_back(std::move(w));
+  }
+  // Each file with samples has them in a window (issue 37: a state's windows emptied by
+  // hand made an update drop every earlier day, exit 0).
+  for (size_t f = 0; f < s.files.size(); ++f) {
+    if (s.files[f].samples == 0) continue;
+    const bool held = std::any_of(s.windows.begin(), s.windows.end(), [&](const auto& w) {
+      return std::find(w.files.begin(), w.files.end(), static_cast<int>(f)) != w.files.end();
+    });
+    if (!held) {
+      throw YAML::Exception(root["windows"].Mark(),
+                            "file " + s.files[f].path + "'s " + std::to_string(s.files[f].samples) +
+                                " samples are in no window: a damaged state; --force rebuilds "
+                                "the track from the data");
+    }
   }
   for (const YAML::Node& e : root["shared"]) {
     SharedEntry entry;
@@ -538,8 +592,17 @@ bool ReadFile(Router& router, const std::string& path, std::string* error) {
   if (!reader.Open(path, read, error)) return false;
   Dataset chunk;
   bool done = false;
+  bool scale_checked = false;
   while (!done) {
     if (!reader.Next(kReadChunkSamples, &chunk, &done, error)) return false;
+    // The tensions' unit, on the file's first chunk (a slip is in every row), as calibrate
+    // checks a survey (issue 37: a map's kN read as N made track fail with "cannot solve
+    // this pose", naming no unit).
+    if (!scale_checked && !chunk.samples.empty()) {
+      chunk.path = path;
+      if (!CheckTensionScale(chunk, run.model, error)) return false;
+      scale_checked = true;
+    }
     if (run.spec.use_planned_attitude && !chunk.samples.empty() && !chunk.has_planned_attitude) {
       *error = path +
                ": the spec fits with the planned attitude but the file has no "
