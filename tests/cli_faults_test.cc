@@ -97,6 +97,33 @@ TEST_F(CliFaultsTest, AFullDiskIsTheMachinesFailureAndNamesTheUsersFile) {
   EXPECT_TRUE(Entries(dir_).empty()) << ::testing::PrintToString(Entries(dir_));
 }
 
+// The machine refusing threads (200 MB stacks under a 500 MB address-space limit: no
+// second thread fits) is met with fewer threads, the same results (issue 37: Ceres's own
+// pool, asked for the identifiability check's Jacobian, made calibrate exit 1); memory
+// itself running out is the machine's failure, exit 1, not bad input (it was "FILE:
+// std::bad_alloc", exit 2).
+TEST_F(CliFaultsTest, RefusedThreadsAndMemoryAreTheMachinesNotTheInputs) {
+  if (kUnderSanitizer) GTEST_SKIP() << "address-space limits do not apply under a sanitizer";
+  const std::string data = Path("d.csv");
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=600 --out=" + data).code, 0);
+  const std::string calibrate =
+      "calibrate --spec=" + Source() + "/calibration_data/spec_realistic.yaml --data=" + data;
+  CommandResult r = Shell("ulimit -s 200000; ulimit -v 500000; " + Bin() + " " + calibrate +
+                          " --out=" + Path("limited"));
+  EXPECT_EQ(r.code, 0) << r.output;
+  ASSERT_EQ(Fastcal(calibrate + " --out=" + Path("free")).code, 0);
+  const auto estimates = [](const std::string& summary) {
+    return summary.substr(summary.find("\"parameters\""));
+  };
+  EXPECT_EQ(estimates(ReadFile(Path("limited/summary.json"))),
+            estimates(ReadFile(Path("free/summary.json"))));
+  r = Shell("ulimit -v 60000; " + Bin() + " " + calibrate + " --out=" + Path("oom"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("out of memory"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("bad_alloc"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(Path("oom")));
+}
+
 TEST_F(CliFaultsTest, EvaluateSpillsWhereTmpdirSays) {
   // Before: std::tmpfile, in /tmp whatever TMPDIR said, and a failure there was exit 2.
   const CommandResult r =

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <system_error>
 
 #include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/sample_chunks.h"
@@ -142,7 +143,17 @@ bool JacobianR(ceres::Problem* problem, int num_threads, Eigen::MatrixXd* r) {
   ceres::Problem::EvaluateOptions eo;
   eo.num_threads = MachineThreads(num_threads);
   ceres::CRSMatrix j;
-  if (!problem->Evaluate(eo, nullptr, nullptr, nullptr, &j)) return false;
+  bool evaluated = false;
+  try {
+    evaluated = problem->Evaluate(eo, nullptr, nullptr, nullptr, &j);
+  } catch (const std::system_error&) {
+    // Ceres's own thread pool refused a thread (a process limit, `ulimit -v` with a large
+    // stack: issue 37, exit 1 where the fit runs on fewer threads): on this thread. The
+    // Jacobian's entries are the blocks' own, the same on any number of threads.
+    eo.num_threads = 1;
+    evaluated = problem->Evaluate(eo, nullptr, nullptr, nullptr, &j);
+  }
+  if (!evaluated) return false;
   *r = RFactor(j);
   return true;
 }

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <map>
+#include <new>
 #include <set>
 
 #include "fastcal/internal/edit_distance.h"
@@ -408,6 +409,8 @@ bool ParseColumnMap(const std::string& text, const std::string& source_name, Col
     }
   } catch (const YAML::Exception& e) {
     reader.Fail(e.mark.line < 0 ? 0 : e.mark.line + 1, "YAML syntax error", e.msg);
+  } catch (const std::bad_alloc&) {
+    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
   } catch (const std::exception& e) {
     reader.Fail(0, "format", std::string("cannot read: ") + e.what());
   }

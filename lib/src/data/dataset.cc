@@ -1290,6 +1290,8 @@ bool ParseDataset(const std::string& text, const std::string& source_name,
   bool ok = false;
   try {
     ok = ParseDatasetImpl(text, source_name, options, dataset, &message);
+  } catch (const std::bad_alloc&) {
+    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
   } catch (const std::exception& e) {
     message = source_name + ": " + e.what();
     ok = false;
@@ -1435,6 +1437,8 @@ bool DatasetChunkReader::Next(size_t max_samples, Dataset* chunk, bool* done, st
     }
     TakeLayout(st.parser.layout(), chunk);
     *done = st.done;
+  } catch (const std::bad_alloc&) {
+    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
   } catch (const std::exception& e) {
     message = state_->parser.layout().path + ": " + e.what();
     ok = false;
@@ -1472,6 +1476,8 @@ bool WriteDataset(const std::string& path, const Dataset& dataset,
   bool ok = false;
   try {
     ok = WriteDatasetImpl(path, dataset, header_comment, &message);
+  } catch (const std::bad_alloc&) {
+    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
   } catch (const std::exception& e) {
     message = path + ": " + e.what();
     ok = false;

@@ -7,6 +7,7 @@
 #include <exception>
 #include <limits>
 #include <memory>
+#include <new>
 
 #include "fastcal/internal/atomic_file.h"
 
@@ -39,6 +40,8 @@ bool Sha256Of(const std::string& path, long long limit, std::string* hex, std::s
              },
              &message) &&
          updated && EVP_DigestFinal_ex(context.get(), digest, &size) == 1;
+  } catch (const std::bad_alloc&) {
+    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
   } catch (const std::exception& e) {
     message = path + ": " + e.what();
     ok = false;
