@@ -156,6 +156,21 @@ TEST_F(CliTrackStoreTest, ATensionColumnInAnotherUnitIsNamed) {
   EXPECT_FALSE(fs::exists(Path("t")));
 }
 
+// A file holding its rows twice (two exports concatenated): refused naming the repeated
+// line, where every sample was folded twice with exit 0.
+TEST_F(CliTrackStoreTest, AFileHoldingItsRowsTwiceIsRefused) {
+  ASSERT_EQ(Shell("(cat " + Day(1) + "; grep -v '^#' " + Day(1) + " | sed -n '2,$p') > " +
+                  Path("twice.csv"))
+                .code,
+            0);
+  const CommandResult r = Track(Path("twice.csv") + "," + Day(2), "t");
+  EXPECT_NE(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("twice.csv:1805 repeats line 5 (the same time, pose and tensions)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(Path("t")));
+}
+
 TEST_F(CliTrackStoreTest, TheSameDataTwiceIsRefusedByContent) {
   ASSERT_EQ(Shell("cp " + Day(1) + " " + Path("copy.csv") + " && gzip -k " + Day(2)).code, 0);
   CommandResult r = Track(Day(1) + "," + Path("copy.csv"), "a");

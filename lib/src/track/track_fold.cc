@@ -131,8 +131,8 @@ int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Sa
           at->time_s[t] = s.time_s;
           // Consecutive samples are close: each starts from the one before in its chunk.
           if (t == begin) solution.status = StaticsStatus::kInvalidInput;
-          if (SolveStaticsWithParameters(params, cm.robot().moving_parts, s.joint, s.pose,
-                                         options, &solution) != StaticsStatus::kOk) {
+          if (SolveStaticsWithParameters(params, cm.robot().moving_parts, s.joint, s.pose, options,
+                                         &solution) != StaticsStatus::kOk) {
             return t;
           }
           at->starts.Set(t, solution);
@@ -418,6 +418,52 @@ namespace {
 
 // The fold of the window `source` reads: the first pass (predictions), the screen, the
 // summary, the second pass (rows).
+// No row of a file given twice in the window (issue 37: a file holding its rows twice was
+// folded twice, exit 0). In time order (stable) the copies lie in one run of equal times;
+// two samples there whose residuals agree to 1e-6 sigma on every cable (the same pose and
+// readings, solved from different warm starts) are read back and compared exactly: the same file,
+// time, pose and tensions (and joints) is one row given twice. Samples of two files at one instant
+// are the overlap check's (track.cc), allowed by --keep-overlapping. Runs of equal times longer
+// than kMaxEqualTimes (coarse time stamps) are compared over their first kMaxEqualTimes.
+bool NoSampleTwice(const FoldTask& task, const SampleSource& source, const WindowPrediction& at,
+                   std::string* error) {
+  constexpr int kMaxEqualTimes = 64;
+  constexpr double kAlikeSigmas = 1e-6;  // candidates only: confirmed on the raw samples
+  const int n = static_cast<int>(at.time_s.size());
+  for (int a = 0; a < n;) {
+    int b = a + 1;
+    while (b < n && at.time_s[b] == at.time_s[a]) ++b;
+    const int end = std::min(b, a + kMaxEqualTimes);
+    for (int p = a; p < end; ++p) {
+      for (int q = p + 1; q < end; ++q) {
+        bool alike = true;  // to the statics' convergence (each warm from its neighbour)
+        for (int i = 0; i < kNumCables && alike; ++i) {
+          alike = std::abs(at.x[p][i] - at.x[q][i]) <= kAlikeSigmas;
+        }
+        if (!alike) continue;
+        std::vector<Sample> one, two;
+        std::vector<int> file_one, file_two;
+        if (!source.read(p, 1, &one, &file_one, error) ||
+            !source.read(q, 1, &two, &file_two, error)) {
+          return false;
+        }
+        const Sample& s = one[0];
+        const Sample& t = two[0];
+        if (file_one[0] != file_two[0] || s.tension_n != t.tension_n || s.joint != t.joint ||
+            s.pose.position_m != t.pose.position_m || s.pose.rotation != t.pose.rotation) {
+          continue;
+        }
+        *error = Where(task, source, t, file_two[0]) + " repeats line " + std::to_string(s.line) +
+                 " (the same time, pose and tensions): each sample is folded once; remove "
+                 "the repeated rows from the file";
+        return false;
+      }
+    }
+    a = b;
+  }
+  return true;
+}
+
 bool FoldSource(const FoldTask& task, const SampleSource& source, WindowFold* fold,
                 std::string* error) {
   if (!task.IsValid(error)) return false;
@@ -470,6 +516,7 @@ bool FoldSource(const FoldTask& task, const SampleSource& source, WindowFold* fo
   if (const int failed = Predict(task, cm, source, statics, &at, &read_failure); failed >= 0) {
     return failed_at(failed);
   }
+  if (!NoSampleTwice(task, source, at, error)) return false;
   fold->first_time_s = at.time_s.front();
   fold->last_time_s = at.time_s.back();
   ScreenWindow(task, &at);

@@ -4,12 +4,12 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
-#include <thread>
 
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/slow_error_estimate.h"
 #include "track/track_run.h"
 
@@ -84,10 +84,8 @@ bool LocalRunner(int threads, const std::vector<std::string>& tasks,
       }
     }
   };
-  std::vector<std::thread> pool;
-  for (int t = 1; t < workers; ++t) pool.emplace_back(work);
-  work();
-  for (std::thread& t : pool) t.join();
+  // Windows on `workers` threads, fewer where the system refuses one (internal::OnThreads).
+  internal::OnThreads(workers, [&](int) { work(); });
   for (size_t k = 0; k < tasks.size(); ++k) {
     if ((*folds)[k].empty()) {
       *error = errors[k];
