@@ -23,22 +23,19 @@ using test::Source;
 
 ::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
   if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
-  return ::testing::AssertionFailure() << "'" << text.substr(0, 3000) << "' does not contain '"
-                                       << part << "'";
+  return ::testing::AssertionFailure()
+         << "'" << text.substr(0, 3000) << "' does not contain '" << part << "'";
 }
 
 class CliColumnsTest : public test::CliTest {
  protected:
-  std::string Data(const std::string& name) const {
-    return Source() + "/calibration_data/" + name;
-  }
+  std::string Data(const std::string& name) const { return Source() + "/calibration_data/" + name; }
 };
 
 TEST_F(CliColumnsTest, ImportWritesTheCanonicalFileWithItsProvenance) {
   const std::string map = Data("fast_export.columns.yaml"), data = Data("fast_export.csv");
   const std::string out = Path("survey.csv");
-  const CommandResult r =
-      Fastcal("import --columns=" + map + " --data=" + data + " --out=" + out);
+  const CommandResult r = Fastcal("import --columns=" + map + " --data=" + data + " --out=" + out);
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(Contains(r.output, "1441 samples from"));
   EXPECT_TRUE(Contains(r.output, "2024-05-01 20:00:00 to 20:48:00 UTC+08:00"));
@@ -74,8 +71,8 @@ TEST_F(CliColumnsTest, ImportWritesTheCanonicalFileWithItsProvenance) {
 TEST_F(CliColumnsTest, ImportErrorsNameTheMapsKeyOrTheExportsColumnAndLeaveNoFile) {
   Write("map.yaml",
         "format: fastcal-columns-1\ntime: {column: t}\ncolumns:\n  x_m: {column: X, unit: ft}\n");
-  CommandResult r = Fastcal("import --columns=" + Path("map.yaml") + " --data=" +
-                            Data("fast_export.csv") + " --out=" + Path("out.csv"));
+  CommandResult r = Fastcal("import --columns=" + Path("map.yaml") +
+                            " --data=" + Data("fast_export.csv") + " --out=" + Path("out.csv"));
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(Contains(r.output, "map.yaml:4: columns.x_m.unit: unknown unit 'ft' for a length"));
   EXPECT_FALSE(fs::exists(Path("out.csv")));
@@ -86,8 +83,8 @@ TEST_F(CliColumnsTest, ImportErrorsNameTheMapsKeyOrTheExportsColumnAndLeaveNoFil
   const size_t field = text.find(';', line_start) + 1;  // SDP_PhaPos_X
   text.replace(field, text.find(';', field) - field, "12,3,4");
   Write("export.csv", text);
-  r = Fastcal("import --columns=" + Data("fast_export.columns.yaml") + " --data=" +
-              Path("export.csv") + " --out=" + Path("out.csv"));
+  r = Fastcal("import --columns=" + Data("fast_export.columns.yaml") +
+              " --data=" + Path("export.csv") + " --out=" + Path("out.csv"));
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(Contains(r.output, "export.csv:20: column 'SDP_PhaPos_X' (x_m, mm): '12,3,4'"));
   EXPECT_FALSE(fs::exists(Path("out.csv")));
@@ -99,8 +96,8 @@ TEST_F(CliColumnsTest, ImportErrorsNameTheMapsKeyOrTheExportsColumnAndLeaveNoFil
 TEST_F(CliColumnsTest, EveryCommandThatReadsTelemetryTakesTheMap) {
   const std::string columns = " --columns=" + Data("fast_export.columns.yaml");
   // evaluate: through the map, the table of the canonical survey, times as dates.
-  const CommandResult mapped = Fastcal("evaluate --data=" + Data("fast_export.csv") + columns +
-                                       " --out=" + Path("eval"));
+  const CommandResult mapped =
+      Fastcal("evaluate --data=" + Data("fast_export.csv") + columns + " --out=" + Path("eval"));
   ASSERT_EQ(mapped.code, 0) << mapped.output;
   const CommandResult canonical = Fastcal("evaluate --data=" + Data("realistic_survey.csv"));
   ASSERT_EQ(canonical.code, 0) << canonical.output;
@@ -121,11 +118,12 @@ TEST_F(CliColumnsTest, EveryCommandThatReadsTelemetryTakesTheMap) {
   // calibrate: the same estimates as from the canonical survey (only the lines differ: the
   // export has one line less above its rows).
   const std::string spec = " --quiet --spec=" + Data("spec_realistic.yaml");
-  const CommandResult fit_mapped = Fastcal("calibrate" + spec + columns + " --data=" +
-                                           Data("fast_export.csv") + " --out=" + Path("fit1"));
+  const CommandResult fit_mapped =
+      Fastcal("calibrate" + spec + columns + " --data=" + Data("fast_export.csv") +
+              " --out=" + Path("fit1"));
   ASSERT_EQ(fit_mapped.code, 0) << fit_mapped.output;
-  const CommandResult fit = Fastcal("calibrate" + spec + " --data=" +
-                                    Data("realistic_survey.csv") + " --out=" + Path("fit2"));
+  const CommandResult fit = Fastcal("calibrate" + spec + " --data=" + Data("realistic_survey.csv") +
+                                    " --out=" + Path("fit2"));
   ASSERT_EQ(fit.code, 0) << fit.output;
   const auto estimates = [](const std::string& out) {
     const size_t from = out.find("free parameter");
@@ -152,8 +150,8 @@ TEST_F(CliColumnsTest, EveryCommandThatReadsTelemetryTakesTheMap) {
   EXPECT_TRUE(Contains(r.output, "a spreadsheet, not CSV text"));
   EXPECT_TRUE(Contains(r.output, "fastcal.read_dataset("));
   EXPECT_TRUE(Contains(r.output, "xlsx2csv"));
-  r = Fastcal("import --columns=" + Data("fast_export.columns.yaml") + " --data=" +
-              Path("export.xlsx") + " --out=" + Path("x.csv"));
+  r = Fastcal("import --columns=" + Data("fast_export.columns.yaml") +
+              " --data=" + Path("export.xlsx") + " --out=" + Path("x.csv"));
   EXPECT_EQ(r.code, 2);
   EXPECT_TRUE(Contains(r.output, "xlsx2csv"));
 }
@@ -196,15 +194,14 @@ TEST_F(CliColumnsTest, AbsoluteTimesReadAsDatesAndSessionsAtTakesTheScansAnswer)
   Write("sessions.yaml",
         "parameters:\n  mass_centre_m: {x: {free: true}, y: {free: true}, z: {free: true}}\n"
         "sessions: {separate: [mass_centre_m]}\n");
-  r = Fastcal("calibrate --quiet --spec=" + Path("sessions.yaml") + " --data=" +
-              Path("unix.csv") + " --sessions-at=" + Path("scan/summary.json") + " --out=" +
-              Path("by_json"));
+  r = Fastcal("calibrate --quiet --spec=" + Path("sessions.yaml") + " --data=" + Path("unix.csv") +
+              " --sessions-at=" + Path("scan/summary.json") + " --out=" + Path("by_json"));
   ASSERT_EQ(r.code, 0) << r.output;
   EXPECT_TRUE(Contains(r.output, "mass_centre_m.x"));
   EXPECT_TRUE(Contains(r.output, "s1 -> s2"));
   const CommandResult by_time =
-      Fastcal("calibrate --quiet --spec=" + Path("sessions.yaml") + " --data=" +
-              Path("unix.csv") + " --sessions-at=" + sessions_at + " --out=" + Path("by_time"));
+      Fastcal("calibrate --quiet --spec=" + Path("sessions.yaml") + " --data=" + Path("unix.csv") +
+              " --sessions-at=" + sessions_at + " --out=" + Path("by_time"));
   ASSERT_EQ(by_time.code, 0) << by_time.output;
   const std::string between = "between sessions";
   EXPECT_EQ(r.output.substr(r.output.find(between), 300),
@@ -249,10 +246,9 @@ namespace {
 // exited 0 with gains of 0.001. The whole file's tensions against the cabin's weight
 // now refuse it, naming the slip.
 TEST_F(CliColumnsTest, TensionsReadInTheWrongUnitAreRefused) {
-  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=200 --seed=2 --out=" +
-                    Path("s.csv"))
-                .code,
-            0);
+  ASSERT_EQ(
+      Fastcal("simulate --trajectory=random --samples=200 --seed=2 --out=" + Path("s.csv")).code,
+      0);
   std::string map = "format: fastcal-columns-1\ntime: time_s\nunmapped: ignore\ncolumns:\n";
   for (const char* name : {"x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg"}) {
     map += std::string("  ") + name + ": " + name + "\n";
@@ -266,7 +262,24 @@ TEST_F(CliColumnsTest, TensionsReadInTheWrongUnitAreRefused) {
       Fastcal("calibrate --spec=" + Source() + "/calibration_data/spec_realistic.yaml --data=" +
               Path("s.csv") + " --columns=" + Path("map.yaml") + " --out=" + Path("cal"));
   EXPECT_EQ(r.code, 2) << r.output;
-  EXPECT_NE(r.output.find("read 1000x small"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("read 1000x small? (tensions in kN where the column map says N)"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(fs::exists(Path("cal")));
+  // evaluate checks it too (it gave an RMS of 99.9% and exit 0).
+  const test::CommandResult e = Fastcal("evaluate --data=" + Path("s.csv") +
+                                        " --columns=" + Path("map.yaml") + " --out=" + Path("ev"));
+  EXPECT_EQ(e.code, 2) << e.output;
+  EXPECT_NE(e.output.find("read 1000x small"), std::string::npos) << e.output;
+  EXPECT_FALSE(fs::exists(Path("ev")));
+  // One column alone under `unit: N` (sensor_gain[3] = 0.001, exit 0): the cable named.
+  Write("one.yaml",
+        std::regex_replace(map, std::regex("T([1245-6])_kN, unit: N"), "T$1_kN, unit: kN"));
+  const test::CommandResult one =
+      Fastcal("calibrate --spec=" + Source() + "/calibration_data/spec_realistic.yaml --data=" +
+              Path("s.csv") + " --columns=" + Path("one.yaml") + " --out=" + Path("cal"));
+  EXPECT_EQ(one.code, 2) << one.output;
+  EXPECT_NE(one.output.find("cable 3's tensions"), std::string::npos) << one.output;
   EXPECT_FALSE(fs::exists(Path("cal")));
 }
 
@@ -279,12 +292,12 @@ namespace {
 // Issue 37: a file whose times never advance (every sample at one time_s) gave the slow
 // sensor error any value at all, fitted silently; a spec with noise.slow_error refuses it.
 TEST_F(CliColumnsTest, TimesThatNeverAdvanceAreRefusedForASlowError) {
-  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=200 --seed=3 --out=" +
-                    Path("s.csv"))
-                .code,
-            0);
+  ASSERT_EQ(
+      Fastcal("simulate --trajectory=random --samples=200 --seed=3 --out=" + Path("s.csv")).code,
+      0);
   ASSERT_EQ(test::Shell("awk -F, 'BEGIN{OFS=\",\"} /^#/ {print; next} $1 != \"time_s\" {$1 = 0} "
-                        "{print}' " + Path("s.csv") + " > " + Path("still.csv"))
+                        "{print}' " +
+                        Path("s.csv") + " > " + Path("still.csv"))
                 .code,
             0);
   const std::string spec = Source() + "/calibration_data/spec_realistic.yaml";
@@ -293,10 +306,9 @@ TEST_F(CliColumnsTest, TimesThatNeverAdvanceAreRefusedForASlowError) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("every sample has time_s = 0"), std::string::npos) << r.output;
   // The same file with its times calibrates.
-  EXPECT_EQ(Fastcal("calibrate --spec=" + spec + " --data=" + Path("s.csv") + " --out=" +
-                    Path("d"))
-                .code,
-            0);
+  EXPECT_EQ(
+      Fastcal("calibrate --spec=" + spec + " --data=" + Path("s.csv") + " --out=" + Path("d")).code,
+      0);
 }
 
 }  // namespace

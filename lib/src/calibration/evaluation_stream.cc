@@ -13,6 +13,7 @@
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/sessions.h"
+#include "fastcal/tension_scale.h"
 
 namespace fastcal {
 namespace {
@@ -234,13 +235,24 @@ EvaluationStreamStatus StreamedEvaluation::Run(const CableRobot& robot,
     return EvaluationStreamStatus::kSystemError;
   }
   Pass1 p;
-  bool unsolvable = false, write_failed = false;
+  bool unsolvable = false, write_failed = false, wrong_unit = false;
+  std::string checked_path;
   const auto pass1 = [&](Dataset* chunk) {
+    // The tensions' unit on each file's first chunk (a slip is in every row), as calibrate
+    // and track check it (issue 37: kN read as N gave an RMS of 99.9% and exit 0).
+    if (!chunk->samples.empty() && chunk->path != checked_path) {
+      checked_path = chunk->path;
+      if (!CheckTensionScale(*chunk, robot, error)) {
+        wrong_unit = true;
+        return false;
+      }
+    }
     if (PassOneChunk(robot, options, chunk, &p, &unsolvable, error)) return true;
     write_failed = !unsolvable;
     return false;
   };
-  if (!Chunks(paths, options, pass1, error) || write_failed) {
+  if (!Chunks(paths, options, pass1, error) || write_failed || wrong_unit) {
+    if (wrong_unit) return EvaluationStreamStatus::kInvalidInput;
     return write_failed ? EvaluationStreamStatus::kSystemError
                         : EvaluationStreamStatus::kInvalidInput;
   }
