@@ -89,6 +89,59 @@ def _check_workbook_size(path: str) -> None:
                              f" times (beyond {_MAX_WORKBOOK_RATIO}): not a sheet of telemetry")
 
 
+# No cell holds more text than this (a telemetry value is a number or a time stamp): one
+# cell of 0.9 GB, within the workbook's limits, took 25 s and 6.2 GB (issue 37).
+_MAX_CELL_BYTES = 1 << 20
+
+
+def _prescan_workbook(path: str) -> None:
+    """Streams the sheets' and shared strings' XML once, a MiB at a time, before openpyxl
+    builds anything: refuses a text run longer than any cell of telemetry and a sheet of
+    more rows than a spreadsheet program writes (3.3 million took openpyxl 118 s to reach
+    the limit, issue 37). The runs between '<' and '>' are measured with numpy."""
+    import re
+    import zipfile
+
+    def refuse_text(name: str) -> None:
+        raise InputError(f"{path}: {name} holds a text of more than {_MAX_CELL_BYTES} bytes "
+                         "between two tags: not a sheet of telemetry")
+
+    with zipfile.ZipFile(path) as archive:
+        for member in archive.infolist():
+            name = member.filename
+            sheet = re.fullmatch(r"xl/worksheets/[^/]+\.xml", name) is not None
+            if not sheet and name != "xl/sharedStrings.xml":
+                continue
+            rows = 0
+            run = 0  # bytes since the last '<' or '>'
+            tail = b""  # the chunk before's last bytes: a "<row" cut in two counts once
+            with archive.open(member) as stream:
+                while True:
+                    chunk = stream.read(1 << 20)
+                    if not chunk:
+                        break
+                    codes = np.frombuffer(chunk, dtype=np.uint8)
+                    marks = np.flatnonzero((codes == 60) | (codes == 62))  # '<', '>'
+                    if marks.size == 0:
+                        run += len(chunk)
+                    else:
+                        if run + int(marks[0]) > _MAX_CELL_BYTES:
+                            refuse_text(name)
+                        if marks.size > 1 and int(np.diff(marks).max()) - 1 > _MAX_CELL_BYTES:
+                            refuse_text(name)
+                        run = len(chunk) - int(marks[-1]) - 1
+                    if run > _MAX_CELL_BYTES:
+                        refuse_text(name)
+                    if sheet:
+                        rows += (tail + chunk).count(b"<row") - tail.count(b"<row")
+                        tail = chunk[-4:]
+                        if rows > _MAX_SHEET_ROWS:
+                            raise InputError(
+                                f"{path}: {name} has more than {_MAX_SHEET_ROWS} rows, more "
+                                "than a spreadsheet program writes: not a sheet of telemetry "
+                                "(export it as CSV)")
+
+
 def _spreadsheet_text(path: str, sheet: Optional[Union[str, int]], decimal: str) -> Tuple[str, str]:
     """The rows of a sheet of an .xlsx workbook as CSV text, one line per sheet row (so
     messages name the sheet's row numbers), and the source name for messages."""
@@ -106,6 +159,7 @@ def _spreadsheet_text(path: str, sheet: Optional[Union[str, int]], decimal: str)
     if not os.path.exists(path):
         raise FileNotFoundError(2, "No such file or directory", path)
     _check_workbook_size(path)
+    _prescan_workbook(path)
     book = openpyxl.load_workbook(path, read_only=True, data_only=True)
     try:
         if sheet is None:
