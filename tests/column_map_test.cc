@@ -100,11 +100,11 @@ constexpr char kRow[] = "2.5,70.96,4.65,156.73,0.35,-5.30,0.09,214.0,190.2,141.8
 std::string PlainMap() { return MapText("time: {column: t}\n" + Columns()); }
 
 TEST(ColumnMapTest, ReadsAMapWithEveryKey) {
-  const ColumnMap map = Map(MapText(
-      "delimiter: \";\"\ndecimal: \",\"\nheader_line: 2\nskip_after_header: 1\n"
-      "time: {column: SysTime, format: iso8601, zone: \"+08:00\"}\n"
-      "columns:\n  x_m: {column: SDP_PhaPos_X, unit: mm}\n  T1_kN: CableForce1\n"
-      "unmapped: ignore\n"));
+  const ColumnMap map =
+      Map(MapText("delimiter: \";\"\ndecimal: \",\"\nheader_line: 2\nskip_after_header: 1\n"
+                  "time: {column: SysTime, format: iso8601, zone: \"+08:00\"}\n"
+                  "columns:\n  x_m: {column: SDP_PhaPos_X, unit: mm}\n  T1_kN: CableForce1\n"
+                  "unmapped: ignore\n"));
   EXPECT_EQ(map.delimiter, ';');
   EXPECT_EQ(map.decimal, ',');
   EXPECT_EQ(map.header_line, 2);
@@ -141,13 +141,15 @@ TEST(ColumnMapTest, BadMapsNameTheKeyAndTheLine) {
   // Unknown keys, at every level.
   EXPECT_TRUE(Contains(MapError(MapText("delimeter: \";\"\ncolumns: {}\n")),
                        "map.yaml:2: delimeter: unknown key (allowed here: format, delimiter"));
-  EXPECT_TRUE(Contains(MapError(MapText("time: {column: T, fromat: iso8601}\ncolumns: {}\n")),
-                       "map.yaml:2: time.fromat: unknown key (allowed here: column, format, zone)"));
+  EXPECT_TRUE(
+      Contains(MapError(MapText("time: {column: T, fromat: iso8601}\ncolumns: {}\n")),
+               "map.yaml:2: time.fromat: unknown key (allowed here: column, format, zone)"));
   EXPECT_TRUE(Contains(MapError(MapText("columns:\n  x_m: {column: X, scale: 2}\n")),
                        "map.yaml:3: columns.x_m.scale: unknown key (allowed here: column, unit)"));
   // An unknown fastcal name; time_s under columns.
-  EXPECT_TRUE(Contains(MapError(MapText("columns:\n  x_mm: X\n")),
-                       "map.yaml:3: columns.x_mm: unknown fastcal name (did you mean 'x_m'?) (accepted: x_m, y_m"));
+  EXPECT_TRUE(Contains(
+      MapError(MapText("columns:\n  x_mm: X\n")),
+      "map.yaml:3: columns.x_mm: unknown fastcal name (did you mean 'x_m'?) (accepted: x_m, y_m"));
   EXPECT_TRUE(Contains(MapError(MapText("columns:\n  time_s: T\n")),
                        "map.yaml:3: columns.time_s: the time is given by the map's time:"));
   // The format, missing or wrong.
@@ -186,9 +188,9 @@ TEST(ColumnMapTest, AMissingRequiredQuantityNamesTheMapsColumnsLine) {
                           "  T3_kN: T3_kN\n  T4_kN: T4_kN\n  T5_kN: T5_kN\n  T6_kN: T6_kN\n")),
       "columns: no entry for 'qz' (the measured attitude as a quaternion needs all four)"));
   // No time at all.
-  EXPECT_TRUE(Contains(MappedError(std::string(kCanonicalHeader) + "\n" + kRow + "\n",
-                                   MapText(Columns())),
-                       "map.yaml: time: missing: a dataset needs the time of each row"));
+  EXPECT_TRUE(
+      Contains(MappedError(std::string(kCanonicalHeader) + "\n" + kRow + "\n", MapText(Columns())),
+               "map.yaml: time: missing: a dataset needs the time of each row"));
 }
 
 TEST(ColumnMapTest, ASourceColumnNotInTheHeaderIsNamedWithTheMapsKeyAndANearName) {
@@ -197,9 +199,10 @@ TEST(ColumnMapTest, ASourceColumnNotInTheHeaderIsNamedWithTheMapsKeyAndANearName
   const std::string error = MappedError(
       "t,sdp_phapos_x,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n",
       map);
-  EXPECT_TRUE(Contains(error, "map.yaml:4: columns.x_m: source column 'SDP_PhaPos_X' is not in "
-                              "the header of data.csv (data.csv:1) (did you mean "
-                              "'sdp_phapos_x'?)"));
+  EXPECT_TRUE(Contains(error,
+                       "map.yaml:4: columns.x_m: source column 'SDP_PhaPos_X' is not in "
+                       "the header of data.csv (data.csv:1) (did you mean "
+                       "'sdp_phapos_x'?)"));
 }
 
 TEST(ColumnMapTest, ReadsTheModelsJointColumnsInTheirUnits) {
@@ -226,8 +229,9 @@ TEST(ColumnMapTest, ReadsTheModelsJointColumnsInTheirUnits) {
   EXPECT_TRUE(Contains(error, "map.yaml:3: columns: no entry for 'rotator_b_deg'")) << error;
   options.joint_columns = {"rotator_a_deg"};
   EXPECT_FALSE(ParseDataset(data, "data.csv", options, &d, &error));
-  EXPECT_TRUE(Contains(error, "columns.stewart_z_m: the model's moving parts have no joint of "
-                              "that name (theirs: rotator_a_deg)"))
+  EXPECT_TRUE(Contains(error,
+                       "columns.stewart_z_m: the model's moving parts have no joint of "
+                       "that name (theirs: rotator_a_deg)"))
       << error;
   options.joint_columns.clear();
   EXPECT_FALSE(ParseDataset(data, "data.csv", options, &d, &error));
@@ -250,8 +254,8 @@ TEST(ColumnMapTest, PoseFilesReadTheModelsJointColumnsThroughAMap) {
   std::vector<Pose> poses;
   std::vector<JointValues> joints;
   std::string error;
-  ASSERT_TRUE(ReadPosesCsv(path, map, {"rotator_a_deg", "stewart_z_m"}, &poses, &joints, nullptr,
-                           &error))
+  ASSERT_TRUE(
+      ReadPosesCsv(path, map, {"rotator_a_deg", "stewart_z_m"}, &poses, &joints, nullptr, &error))
       << error;
   ASSERT_EQ(joints.size(), 1u);
   EXPECT_DOUBLE_EQ(joints[0][0], 0.2 * 180.0 / M_PI);
@@ -270,13 +274,14 @@ TEST(ColumnMapTest, AThousandsSeparatorUnderADecimalCommaIsRefused) {
       "  roll_deg: R\n  pitch_deg: P\n  yaw_deg: W\n  T1_kN: {column: F1, unit: N}\n"
       "  T2_kN: F2\n  T3_kN: F3\n  T4_kN: F4\n  T5_kN: F5\n  T6_kN: F6\n");
   const std::string header = "t;X;Y;Z;R;P;W;F1;F2;F3;F4;F5;F6\n";
-  const std::string row = "0;70,96;4,65;156,73;0,35;-5,3;0,09;214.000;190,2;141,8;149,9;188,6;207,1\n";
+  const std::string row =
+      "0;70,96;4,65;156,73;0,35;-5,3;0,09;214.000;190,2;141,8;149,9;188,6;207,1\n";
   EXPECT_TRUE(Contains(MappedError(header + row, map),
                        "column 'F1' (T1_kN, N): '214.000' has a '.' where the map says "
                        "decimal: \",\": a thousands separator?"));
   // The same row without the separator reads.
-  const Dataset d = Mapped(header + std::string(row).replace(row.find("214.000"), 7, "214000"),
-                           map);
+  const Dataset d =
+      Mapped(header + std::string(row).replace(row.find("214.000"), 7, "214000"), map);
   ASSERT_EQ(d.samples.size(), 1u);
   EXPECT_EQ(d.samples[0].tension_n[0], 214000.0);
 }
@@ -286,7 +291,8 @@ TEST(ColumnMapTest, MapErrorsNameTheLikelyFix) {
   // for decimal: ",", a unit row asks for skip_after_header, every missing entry is
   // named at once, and a typo in a source column or a fastcal name gets its near name.
   const std::string header = "t,X,Y,Z,R,P,W,F1,F2,F3,F4,F5,F6\n";
-  const std::string forces_in_n = "0,70.96,4.65,156.73,0.35,-5.3,0.09,214000,190200,141800,149900,188600,207100\n";
+  const std::string forces_in_n =
+      "0,70.96,4.65,156.73,0.35,-5.3,0.09,214000,190200,141800,149900,188600,207100\n";
   const std::string map = MapText(
       "time: t\ncolumns:\n  x_m: X\n  y_m: Y\n  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
       "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n  T3_kN: F3\n  T4_kN: F4\n  T5_kN: F5\n"
@@ -297,28 +303,37 @@ TEST(ColumnMapTest, MapErrorsNameTheLikelyFix) {
   const std::string mm = "0,70960,4650,156730,0.35,-5.3,0.09,214,190.2,141.8,149.9,188.6,207.1\n";
   EXPECT_TRUE(Contains(MappedError(header + mm, map),
                        "in mm it would be plausible: are the columns' units mm (unit: mm)?"));
-  const std::string comma = "0,70.96,4.65,156.73,\"0,35\",-5.3,0.09,214,190.2,141.8,149.9,188.6,207.1\n";
+  const std::string comma =
+      "0,70.96,4.65,156.73,\"0,35\",-5.3,0.09,214,190.2,141.8,149.9,188.6,207.1\n";
   EXPECT_TRUE(Contains(MappedError(header + comma, map), "(give decimal: \",\")"));
   EXPECT_TRUE(Contains(MappedError(header + "s,m,m,m,deg,deg,deg,kN,kN,kN,kN,kN,kN\n", map),
                        "a unit row? (skip_after_header: 1)"));
+  // Issue 37: "inf" or "nan" is a value that is not finite, not a unit row.
+  const std::string not_finite =
+      "0,70.96,4.65,156.73,0.35,-5.3,0.09,-INF,190.2,141.8,149.9,188.6,nan\n";
+  const std::string why = MappedError(header + not_finite, map);
+  EXPECT_TRUE(Contains(why, "not finite")) << why;
+  EXPECT_FALSE(Contains(why, "a unit row?")) << why;
   EXPECT_TRUE(Contains(MappedError(header, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: Y\n"
                                                    "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
                                                    "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
                                                    "unmapped: ignore\n")),
                        "no entry for 'T3_kN', 'T4_kN', 'T5_kN', 'T6_kN'"));
   const std::string typos = "t,X,SDP_PhasPos_Y,Z,R,P,W,F1,F2,CableForcee3,F4,F5,F6\n";
-  EXPECT_TRUE(Contains(MappedError(typos, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: SDP_PhaPos_Y\n"
-                                                  "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
-                                                  "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
-                                                  "  T3_kN: F3\n  T4_kN: F4\n  T5_kN: F5\n"
-                                                  "  T6_kN: F6\nunmapped: ignore\n")),
-                       "(did you mean 'SDP_PhasPos_Y'?)"));
-  EXPECT_TRUE(Contains(MappedError(typos, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: SDP_PhasPos_Y\n"
-                                                  "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
-                                                  "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
-                                                  "  T3_kN: CableForce3\n  T4_kN: F4\n  T5_kN: F5\n"
-                                                  "  T6_kN: F6\nunmapped: ignore\n")),
-                       "(did you mean 'CableForcee3'?)"));
+  EXPECT_TRUE(
+      Contains(MappedError(typos, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: SDP_PhaPos_Y\n"
+                                          "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
+                                          "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
+                                          "  T3_kN: F3\n  T4_kN: F4\n  T5_kN: F5\n"
+                                          "  T6_kN: F6\nunmapped: ignore\n")),
+               "(did you mean 'SDP_PhasPos_Y'?)"));
+  EXPECT_TRUE(
+      Contains(MappedError(typos, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: SDP_PhasPos_Y\n"
+                                          "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
+                                          "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"
+                                          "  T3_kN: CableForce3\n  T4_kN: F4\n  T5_kN: F5\n"
+                                          "  T6_kN: F6\nunmapped: ignore\n")),
+               "(did you mean 'CableForcee3'?)"));
 }
 
 TEST(ColumnMapTest, ReadsEveryUnit) {
@@ -379,10 +394,9 @@ TEST(ColumnMapTest, ThroughAMapTheSameNumbersAsTheCanonicalFile) {
 
 // The time stamps of one row in `format` (and `zone`), read.
 double TimeOf(const std::string& stamp, const std::string& time_map) {
-  const Dataset d =
-      Mapped(std::string(kCanonicalHeader) + "\n\"" + stamp + "\"" +
-                 std::string(kRow).substr(std::string(kRow).find(',')) + "\n",
-             MapText("time: " + time_map + "\n" + Columns()));
+  const Dataset d = Mapped(std::string(kCanonicalHeader) + "\n\"" + stamp + "\"" +
+                               std::string(kRow).substr(std::string(kRow).find(',')) + "\n",
+                           MapText("time: " + time_map + "\n" + Columns()));
   return d.samples.empty() ? NAN : d.samples[0].time_s;
 }
 
@@ -423,8 +437,7 @@ TEST(ColumnMapTest, ReadsEachTimeFormatAndZone) {
   EXPECT_EQ(TimeOf("2024-05-01 20:34:56", slashes), kUnix);
   EXPECT_EQ(TimeOf("2024-05-01T20:34:56.5", slashes), kUnix + 0.5);
   EXPECT_TRUE(Contains(MappedError(std::string(kCanonicalHeader) + "\n01.05.2024 20:34:56" +
-                                       std::string(kRow).substr(std::string(kRow).find(',')) +
-                                       "\n",
+                                       std::string(kRow).substr(std::string(kRow).find(',')) + "\n",
                                    MapText("time: " + slashes + "\n" + Columns())),
                        "data.csv:2: column 't'"));
   // A leap second (2016-12-31T23:59:60Z, the last one) reads as the next day's first
@@ -454,31 +467,29 @@ TEST(ColumnMapTest, BadTimeStampsNameTheSourceColumnAndTheFastcalName) {
       MapText("time: {column: SysTime, format: iso8601, zone: UTC}\n" + Columns());
   const std::string header = "SysTime" + std::string(kCanonicalHeader).substr(1);
   const std::string row = std::string(kRow).substr(std::string(kRow).find(','));
-  for (const char* bad : {"2024-02-30 00:00:00", "2024-05-01 25:00:00", "2024-05-01",
-                          "2024-05-01 12:00:61", "2024-05-01 12:00:60", "12:00:00",
-                          "2024-05-01 12:00:00+25:00"}) {
+  for (const char* bad :
+       {"2024-02-30 00:00:00", "2024-05-01 25:00:00", "2024-05-01", "2024-05-01 12:00:61",
+        "2024-05-01 12:00:60", "12:00:00", "2024-05-01 12:00:00+25:00"}) {
     const std::string error = MappedError(header + "\n" + bad + row + "\n", map);
     EXPECT_TRUE(Contains(error, "data.csv:2: column 'SysTime' (time_s, iso8601): ")) << bad;
     EXPECT_TRUE(Contains(error, "is not an ISO 8601 date and time")) << bad;
   }
-  EXPECT_TRUE(Contains(
-      MappedError(header + "\n1714566896abc" + row + "\n",
-                  MapText("time: {column: SysTime, format: unix_ms}\n" + Columns())),
-      "data.csv:2: column 'SysTime' (time_s, unix_ms): '1714566896abc' is not a number"));
+  EXPECT_TRUE(
+      Contains(MappedError(header + "\n1714566896abc" + row + "\n",
+                           MapText("time: {column: SysTime, format: unix_ms}\n" + Columns())),
+               "data.csv:2: column 'SysTime' (time_s, unix_ms): '1714566896abc' is not a number"));
 }
 
 TEST(ColumnMapTest, ValueErrorsNameTheFileLineSourceColumnAndFastcalName) {
-  const std::string map = MapText("time: {column: t}\n" +
-                                  Columns({{"T3_kN", "{column: CableForce3, unit: N}"},
-                                           {"z_m", "{column: PosZ, unit: mm}"}}));
+  const std::string map =
+      MapText("time: {column: t}\n" + Columns({{"T3_kN", "{column: CableForce3, unit: N}"},
+                                               {"z_m", "{column: PosZ, unit: mm}"}}));
   const std::string header =
       "t,x_m,y_m,PosZ,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,CableForce3,T4_kN,T5_kN,T6_kN";
-  EXPECT_TRUE(Contains(
-      MappedError(header + "\n0,1,2,150000,0,0,0,200,200,abc,200,200,200\n", map),
-      "data.csv:2: column 'CableForce3' (T3_kN, N): 'abc' is not a number"));
-  EXPECT_TRUE(Contains(
-      MappedError(header + "\n0,1,2,150000,0,0,0,200,200,-5,200,200,200\n", map),
-      "data.csv:2: column 'CableForce3' (T3_kN, N): -0.005 kN is negative"));
+  EXPECT_TRUE(Contains(MappedError(header + "\n0,1,2,150000,0,0,0,200,200,abc,200,200,200\n", map),
+                       "data.csv:2: column 'CableForce3' (T3_kN, N): 'abc' is not a number"));
+  EXPECT_TRUE(Contains(MappedError(header + "\n0,1,2,150000,0,0,0,200,200,-5,200,200,200\n", map),
+                       "data.csv:2: column 'CableForce3' (T3_kN, N): -0.005 kN is negative"));
   // The position's three columns, named as the export names them.
   EXPECT_TRUE(Contains(
       MappedError(header + "\n0,1,2,-150,0,0,0,200,200,200000,200,200,200\n", map),
@@ -504,7 +515,8 @@ TEST(ColumnMapTest, DelimitersAndDecimalCommas) {
     for (bool comma : {false, true}) {
       const std::string decimal = comma ? "decimal: \",\"\n" : "";
       // Detected from the header line.
-      const Dataset d = Mapped(with(delimiter, comma), MapText(decimal + "time: {column: t}\n" + Columns()));
+      const Dataset d =
+          Mapped(with(delimiter, comma), MapText(decimal + "time: {column: t}\n" + Columns()));
       ASSERT_EQ(d.samples.size(), 1u) << delimiter;
       EXPECT_EQ(d.samples[0].tension_n, expected.samples[0].tension_n);
       EXPECT_EQ(d.samples[0].pose.position_m, expected.samples[0].pose.position_m);
@@ -512,22 +524,27 @@ TEST(ColumnMapTest, DelimitersAndDecimalCommas) {
     }
   }
   // Said in the map, by character and by name.
-  EXPECT_EQ(Mapped(with(';', true), MapText("delimiter: \";\"\ndecimal: \",\"\ntime: {column: t}\n" + Columns()))
-                .samples[0].time_s,
+  EXPECT_EQ(Mapped(with(';', true),
+                   MapText("delimiter: \";\"\ndecimal: \",\"\ntime: {column: t}\n" + Columns()))
+                .samples[0]
+                .time_s,
             2.5);
   EXPECT_EQ(Mapped(with('\t', false), MapText("delimiter: tab\ntime: {column: t}\n" + Columns()))
-                .samples[0].time_s,
+                .samples[0]
+                .time_s,
             2.5);
   // Runs of spaces.
   std::string spaced = with(' ', false);
   spaced.replace(spaced.find(' '), 1, "   ");
   EXPECT_EQ(Mapped("  " + spaced, MapText("delimiter: spaces\ntime: {column: t}\n" + Columns()))
-                .samples[0].time_s,
+                .samples[0]
+                .time_s,
             2.5);
   // Quoted numbers with a decimal comma, the delimiter detected (not ',': the decimal mark).
-  const Dataset quoted = Mapped(with(';', false).substr(0, base.find('\n') + 1) +
-                                    "\"2,5\";\"70,96\";4;\"156,73\";0;0;0;214;190;141;149;188;207\n",
-                                MapText("decimal: \",\"\ntime: {column: t}\n" + Columns()));
+  const Dataset quoted =
+      Mapped(with(';', false).substr(0, base.find('\n') + 1) +
+                 "\"2,5\";\"70,96\";4;\"156,73\";0;0;0;214;190;141;149;188;207\n",
+             MapText("decimal: \",\"\ntime: {column: t}\n" + Columns()));
   ASSERT_EQ(quoted.samples.size(), 1u);
   EXPECT_EQ(quoted.samples[0].time_s, 2.5);
   EXPECT_EQ(quoted.samples[0].pose.position_m.x(), 70.96);
@@ -569,8 +586,8 @@ TEST(ColumnMapTest, HeaderLineUnitRowQuotesAndTrailingDelimiters) {
 }
 
 TEST(ColumnMapTest, AQuotedHeaderMayBreakALine) {
-  const std::string map = MapText("time: {column: t}\n" +
-                                  Columns({{"T1_kN", "{column: \"Force 1\\n(N)\", unit: N}"}}));
+  const std::string map =
+      MapText("time: {column: t}\n" + Columns({{"T1_kN", "{column: \"Force 1\\n(N)\", unit: N}"}}));
   const std::string text =
       "t,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,\"Force 1\n(N)\",T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n"
       "2.5,70.96,4.65,156.73,0.35,-5.30,0.09,214000,190.2,141.8,149.9,188.6,207.1\n";
@@ -674,17 +691,18 @@ TEST(ColumnMapTest, ChunkedReadingThroughAMapGivesTheWholeRead) {
 }
 
 TEST(ColumnMapTest, PoseFilesThroughAMap) {
-  const ColumnMap map = Map(MapText(
-      "delimiter: \";\"\ndecimal: \",\"\ntime: {column: SysTime, format: iso8601, zone: "
-      "\"+08:00\"}\ncolumns:\n  x_m: {column: X, unit: mm}\n  y_m: {column: Y, unit: mm}\n"
-      "  z_m: {column: Z, unit: mm}\n  yaw_deg: {column: Yaw, unit: rad}\n"
-      "  pitch_deg: P\n  roll_deg: R\n  T1_kN: {column: F1, unit: N}\nunmapped: ignore\n"));
+  const ColumnMap map = Map(
+      MapText("delimiter: \";\"\ndecimal: \",\"\ntime: {column: SysTime, format: iso8601, zone: "
+              "\"+08:00\"}\ncolumns:\n  x_m: {column: X, unit: mm}\n  y_m: {column: Y, unit: mm}\n"
+              "  z_m: {column: Z, unit: mm}\n  yaw_deg: {column: Yaw, unit: rad}\n"
+              "  pitch_deg: P\n  roll_deg: R\n  T1_kN: {column: F1, unit: N}\nunmapped: ignore\n"));
   std::vector<Pose> poses;
   std::vector<double> times;
   std::string error;
-  ASSERT_TRUE(ParsePosesCsv("SysTime;X;Y;Z;Yaw;P;R;Wind\n"
-                            "2024-05-01 20:00:00;1000;-2500,5;150000;0;0;0;3,2\n",
-                            "poses.csv", map, &poses, &times, &error))
+  ASSERT_TRUE(
+      ParsePosesCsv("SysTime;X;Y;Z;Yaw;P;R;Wind\n"
+                    "2024-05-01 20:00:00;1000;-2500,5;150000;0;0;0;3,2\n",
+                    "poses.csv", map, &poses, &times, &error))
       << error;
   ASSERT_EQ(poses.size(), 1u);
   EXPECT_EQ(poses[0].position_m, Eigen::Vector3d(1.0, -2.5005, 150.0));

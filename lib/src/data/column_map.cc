@@ -746,7 +746,12 @@ std::string NotANumberHint(std::string_view field, char decimal, bool first_data
       field.find('.') == std::string_view::npos) {
     return "; a decimal comma? the map says decimal: \".\" (give decimal: \",\")";
   }
-  if (first_data_row && !digits) {
+  // "inf" or "nan" is a value that is not finite (its own message says so), not a unit.
+  std::string word(field.substr(!field.empty() && (field[0] == '-' || field[0] == '+')));
+  std::transform(word.begin(), word.end(), word.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const bool not_finite = word == "inf" || word == "infinity" || word == "nan";
+  if (first_data_row && !digits && !not_finite) {
     return "; the first row under the header is text: a unit row? (skip_after_header: 1)";
   }
   return "";
