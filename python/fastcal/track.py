@@ -168,7 +168,9 @@ def track(
         model: the starting model (a Model or a model file); None for Model.nominal().
         threads: windows folded at once without a client.
         refold: on an update, refold every window (as a fresh track would).
-        force: `out` holds a track of another model, spec or windowing: build it afresh.
+        force: build the track in `out` afresh from the data, whatever it holds (needed
+            when it holds a track of another model, spec or windowing, of files that
+            changed, or a damaged one).
         columns: a column map (a file or a dict, as read_dataset takes) through which
             every data file is read: an export as it comes, ISO 8601 times included.
         quiet: no progress lines ("fastcal.track: ..." on sys.stderr, as the command
