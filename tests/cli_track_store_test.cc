@@ -271,6 +271,27 @@ TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
   EXPECT_EQ(r.code, 2) << r.output;
   EXPECT_NE(r.output.find("samples are in no window: a damaged state"), std::string::npos)
       << r.output;
+  // Edits that crashed the next run or gave another day's numbers under a date, exit 0:
+  // a shared value twice (SIGSEGV or abort), a shared value of no column (abort: invalid
+  // pointer), a window's key (a later day's samples merged into it), a count.
+  const auto refused_after = [&](const std::string& edited, const std::string& why) {
+    Write("t/track_state.json", edited);
+    const CommandResult after = Track(Day(1) + "," + Day(2) + "," + Day(3), "t");
+    EXPECT_EQ(after.code, 2) << why << "\n" << after.output;
+    EXPECT_NE(after.output.find(why), std::string::npos) << after.output;
+  };
+  refused_after(
+      std::regex_replace(state, std::regex("(\"shared\": \\[\\s*)(\\{[^}]*\\})"), "$1$2, $2"),
+      "two shared values of linear_density_kg_per_m[1] from one time");
+  refused_after(
+      std::regex_replace(state, std::regex("\"linear_density_kg_per_m\\[1\\]\""), "\"bogus[9]\""),
+      "a shared value of 'bogus[9]', not a column");
+  refused_after(std::regex_replace(state, std::regex("\"key\": ([0-9]+)"), "\"key\": 19850",
+                                   std::regex_constants::format_first_only),
+                "is not the window of key 19850");
+  refused_after(std::regex_replace(state, std::regex("\"samples\": 1800"), "\"samples\": 900",
+                                   std::regex_constants::format_first_only),
+                "its windows hold");
   // Millions of empty lists: each a yaml-cpp node (16 MiB of them took 2.7 GB); refused by
   // their count before they are parsed, under a memory limit.
   std::string lists = "{\"format\": [";

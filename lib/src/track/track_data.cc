@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <set>
 #include <system_error>
 
 #include "fastcal/file_digest.h"
@@ -423,6 +424,73 @@ bool LoadFolds(TrackRun& run) {
   return true;
 }
 
+bool DamagedState(TrackRun& run, const std::string& why) {
+  *run.error = run.Path(kStateFile) + ": " + why +
+               ": a damaged state; --force rebuilds the track from the data";
+  return false;
+}
+
+// "" when the shared values are as the track writes them: each column's first from the
+// start of time (-inf), the others' starts in order, none twice, every value finite (issue
+// 37: a shared entry duplicated by hand crashed the next run, SIGSEGV or abort).
+std::string SharedEntriesProblem(const TrackRun& run) {
+  if (run.shared.empty()) return "";  // none saved: every column from the model's values
+  for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
+    std::vector<double> starts;
+    for (const SharedEntry& e : run.shared) {
+      if (e.column != static_cast<int>(j)) continue;
+      if (!std::isfinite(e.value_si)) return "a shared value that is not finite";
+      if (e.inside && !(std::isfinite(e.step_time_s) && std::isfinite(e.step_previous_s))) {
+        return "a shared value's step time that is not finite";
+      }
+      starts.push_back(e.from_s);
+    }
+    const std::string name = run.layout.Column(run.layout.shared_columns[j]).name;
+    std::sort(starts.begin(), starts.end());
+    if (starts.empty() || starts.front() != -std::numeric_limits<double>::infinity()) {
+      return "no shared value of " + name + " from the start";
+    }
+    if (std::adjacent_find(starts.begin(), starts.end()) != starts.end()) {
+      return "two shared values of " + name + " from one time";
+    }
+  }
+  return "";
+}
+
+// "" when the windows are as the track writes them for its window spec (issue 37: a key,
+// start or end edited by hand merged a day's samples into another window or showed one
+// day's data under another date, exit 0): each a duration window's key, its bounds and
+// its label from the key, or a file window's key its file; no key twice; the windows'
+// samples those of the files.
+std::string WindowsProblem(const TrackRun& run, const SavedState& s) {
+  std::set<long long> keys;
+  long long in_windows = 0, in_files = 0;
+  for (const TrackWindowState& w : s.windows) {
+    if (!keys.insert(w.key).second) return "two windows of key " + std::to_string(w.key);
+    in_windows += w.samples;
+    if (run.window.kind == WindowSpec::Kind::kFile) {
+      if (w.key < 0 || w.key >= static_cast<long long>(s.files.size()) ||
+          w.files != std::vector<int>{static_cast<int>(w.key)}) {
+        return "window " + w.label + " is not its file's";
+      }
+      continue;
+    }
+    const double d = run.window.duration_s;
+    const double start_s = static_cast<double>(w.key) * d;
+    if (w.start_s != start_s || w.end_s != start_s + d ||
+        w.label != WindowLabel(run.window, start_s) ||
+        (w.samples > 0 && (w.first_s < w.start_s || w.last_s >= w.end_s))) {
+      return "window " + w.label + " is not the window of key " + std::to_string(w.key);
+    }
+  }
+  for (const TrackFile& f : s.files) in_files += f.samples;
+  if (in_windows != in_files) {
+    return "its windows hold " + std::to_string(in_windows) + " samples, its files " +
+           std::to_string(in_files);
+  }
+  return "";
+}
+
 bool LoadSavedState(TrackRun& run, bool* use) {
   // --force builds the track afresh from the data whatever DIR holds: another model's
   // track, or a damaged one (a corrupt fold or state, a store from elsewhere), which is
@@ -449,18 +517,25 @@ bool LoadSavedState(TrackRun& run, bool* use) {
                  ": give a new --out, or --force to build it afresh";
     return false;
   }
+  if (const std::string why = WindowsProblem(run, s); !why.empty()) return DamagedState(run, why);
   run.generation = s.generation + 1;
   run.slow = s.slow;
   run.files = std::move(s.files);
   run.windows = std::move(s.windows);
   if (!CheckStores(run) || !LoadFolds(run)) return false;
   for (const auto& [name, entry] : s.shared) {
+    bool known = false;
     for (size_t j = 0; j < run.layout.shared_columns.size(); ++j) {
       if (run.layout.Column(run.layout.shared_columns[j]).name != name) continue;
       SharedEntry e = entry;
       e.column = static_cast<int>(j);
       run.shared.push_back(e);
+      known = true;
     }
+    if (!known) return DamagedState(run, "a shared value of '" + name + "', not a column");
+  }
+  if (const std::string why = SharedEntriesProblem(run); !why.empty()) {
+    return DamagedState(run, why);
   }
   *use = true;
   return true;
