@@ -89,22 +89,36 @@ def _check_workbook_size(path: str) -> None:
                              f" times (beyond {_MAX_WORKBOOK_RATIO}): not a sheet of telemetry")
 
 
-# No cell holds more text than this (a telemetry value is a number or a time stamp): one
-# cell of 0.9 GB, within the workbook's limits, took 25 s and 6.2 GB (issue 37).
-_MAX_CELL_BYTES = 1 << 20
+# No cell holds more text than this (a telemetry value is a number or a time stamp, a
+# header a name): one cell of 0.9 GB, within the workbook's limits, took 25 s and 6.2 GB,
+# a thousand of 900 KB 2.75 GB (issue 37).
+_MAX_CELL_BYTES = 1 << 16
+# A sheet's row element, with or without a namespace prefix (<row ...>, <x:row ...>).
+_ROW_TAG = re.compile(rb"<(?:[A-Za-z_][\w.-]*:)?row[\s/>]")
 
 
 def _prescan_workbook(path: str) -> None:
     """Streams the sheets' and shared strings' XML once, a MiB at a time, before openpyxl
-    builds anything: refuses a text run longer than any cell of telemetry and a sheet of
-    more rows than a spreadsheet program writes (3.3 million took openpyxl 118 s to reach
-    the limit, issue 37). The runs between '<' and '>' are measured with numpy."""
-    import re
+    builds anything: refuses a run of more than _MAX_CELL_BYTES without a '<' (text may
+    hold '>', never an unescaped '<': no cell's text is longer) and a sheet of more rows
+    than a spreadsheet program writes (3.3 million took openpyxl 118 s to reach the
+    limit, issue 37). The runs are measured with numpy."""
     import zipfile
+    import zlib
 
     def refuse_text(name: str) -> None:
         raise InputError(f"{path}: {name} holds a text of more than {_MAX_CELL_BYTES} bytes "
-                         "between two tags: not a sheet of telemetry")
+                         "in one cell or tag: not a sheet of telemetry")
+
+    try:
+        _prescan_members(path, refuse_text)
+    except (zipfile.BadZipFile, zlib.error, EOFError) as error:
+        raise InputError(f"{path}: a damaged .xlsx workbook: {error}") from None
+
+
+def _prescan_members(path: str, refuse_text) -> None:
+    """_prescan_workbook's pass over the members."""
+    import zipfile
 
     with zipfile.ZipFile(path) as archive:
         for member in archive.infolist():
@@ -113,15 +127,22 @@ def _prescan_workbook(path: str) -> None:
             if not sheet and name != "xl/sharedStrings.xml":
                 continue
             rows = 0
-            run = 0  # bytes since the last '<' or '>'
-            tail = b""  # the chunk before's last bytes: a "<row" cut in two counts once
+            run = 0  # bytes since the last '<'
+            tail = b""  # the chunk before's last bytes: a row tag cut in two counts once
             with archive.open(member) as stream:
                 while True:
                     chunk = stream.read(1 << 20)
                     if not chunk:
                         break
-                    codes = np.frombuffer(chunk, dtype=np.uint8)
-                    marks = np.flatnonzero((codes == 60) | (codes == 62))  # '<', '>'
+                    if sheet:
+                        rows += len(_ROW_TAG.findall(tail + chunk)) - len(_ROW_TAG.findall(tail))
+                        tail = chunk[-64:]
+                        if rows > _MAX_SHEET_ROWS:
+                            raise InputError(
+                                f"{path}: {name} has more than {_MAX_SHEET_ROWS} rows, more "
+                                "than a spreadsheet program writes: not a sheet of telemetry "
+                                "(export it as CSV)")
+                    marks = np.flatnonzero(np.frombuffer(chunk, dtype=np.uint8) == 60)  # '<'
                     if marks.size == 0:
                         run += len(chunk)
                     else:
@@ -132,14 +153,6 @@ def _prescan_workbook(path: str) -> None:
                         run = len(chunk) - int(marks[-1]) - 1
                     if run > _MAX_CELL_BYTES:
                         refuse_text(name)
-                    if sheet:
-                        rows += (tail + chunk).count(b"<row") - tail.count(b"<row")
-                        tail = chunk[-4:]
-                        if rows > _MAX_SHEET_ROWS:
-                            raise InputError(
-                                f"{path}: {name} has more than {_MAX_SHEET_ROWS} rows, more "
-                                "than a spreadsheet program writes: not a sheet of telemetry "
-                                "(export it as CSV)")
 
 
 def _spreadsheet_text(path: str, sheet: Optional[Union[str, int]], decimal: str) -> Tuple[str, str]:

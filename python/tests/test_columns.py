@@ -331,5 +331,38 @@ def test_an_xlsx_with_a_stale_dimension_reads_every_row_and_a_bomb_is_refused(
                                     b'<row r="300"><c r="A300" t="inlineStr"><is><t>' + cell
                                     + b"</t></is></c></row></sheetData>")
             dst.writestr(item, data)
-    with pytest.raises(fastcal.InputError, match="holds a text of more than 1048576 bytes"):
+    with pytest.raises(fastcal.InputError, match="holds a text of more than 65536 bytes"):
         fastcal.read_dataset(text_bomb, columns=columns)
+    # A second re-check's variants: the text broken by a '>' every 16 KiB (legal in XML
+    # text: 6.5 GB before), and rows with a namespace prefix (<x:row>: not counted, 89 s).
+    gt_bomb = tmp_path / "gt_bomb.xlsx"
+    broken = b">".join(cell[k:k + (16 << 10)] for k in range(0, len(cell), 16 << 10))
+    prefixed = tmp_path / "prefixed.xlsx"
+    with zipfile.ZipFile(path) as src, \
+            zipfile.ZipFile(gt_bomb, "w", zipfile.ZIP_DEFLATED) as gt, \
+            zipfile.ZipFile(prefixed, "w", zipfile.ZIP_DEFLATED) as px:
+        for item in src.infolist():
+            data = src.read(item.filename)
+            if item.filename.startswith("xl/worksheets/sheet"):
+                gt.writestr(item.filename, data.replace(
+                    b"</sheetData>", b'<row r="300"><c r="A300" t="inlineStr"><is><t>' + broken
+                    + b"</t></is></c></row></sheetData>"))
+                px.writestr(item.filename, data.replace(
+                    b"</sheetData>", b"<x:row/>" * ((1 << 20) + 1) + b"</sheetData><!-- "
+                    + filler[:60000] + b" -->"))
+            else:
+                gt.writestr(item.filename, data)
+                px.writestr(item.filename, data)
+    with pytest.raises(fastcal.InputError, match="holds a text of more than 65536 bytes"):
+        fastcal.read_dataset(gt_bomb, columns=columns)
+    with pytest.raises(fastcal.InputError, match="more than 1048576 rows"):
+        fastcal.read_dataset(prefixed, columns=columns)
+    # A member whose bytes do not match its CRC: a damaged workbook, not a raw BadZipFile.
+    damaged = tmp_path / "damaged.xlsx"
+    with zipfile.ZipFile(damaged, "w", zipfile.ZIP_STORED) as z:
+        z.writestr("xl/worksheets/sheet1.xml", b"<sheetData>" + b"<row/>" * 10 + b"</sheetData>")
+    raw = damaged.read_bytes()
+    at = raw.index(b"<row/>")
+    damaged.write_bytes(raw[:at] + b"<rox/>" + raw[at + 6:])
+    with pytest.raises(fastcal.InputError, match="a damaged .xlsx workbook"):
+        fastcal.read_dataset(damaged, columns=columns)
