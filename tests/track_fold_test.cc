@@ -297,6 +297,23 @@ TEST_F(TrackFoldTest, FiniteNonsenseInAFoldIsRefused) {
   bad = good;
   bad.gradient *= 1e200;
   refused(bad, "a gradient beyond any telemetry's");
+  // A second re-check: within the bounds, x1e10 of one part (sigma_totals of 3e5 m); the
+  // blocks must add up to the window.
+  bad = good;
+  bad.block_information[0] *= 1e10;
+  refused(bad, "block informations that do not add up to the window's");
+  bad = good;
+  bad.information *= 1e10;
+  refused(bad, "block informations that do not add up to the window's");
+  bad = good;
+  bad.block_scores *= 1e10;
+  refused(bad, "a block score larger than the window's information and chi-square allow");
+  bad = good;
+  bad.gradient *= 1e10;
+  refused(bad, "block scores that do not add up to the gradient");
+  bad = good;
+  bad.block_samples[0] += 1;
+  refused(bad, "blocks of other samples than the window's");
 }
 
 TEST_F(TrackFoldTest, TasksCarryEveryParameterKind) {

@@ -335,6 +335,64 @@ constexpr double kMaxChiSquarePerReading = 1e12;
 
 bool AllFinite(const Eigen::MatrixXd& m) { return m.allFinite(); }
 
+// "" when the blocks are parts of the window as a fold's are (track_fold.h); else which is
+// not (issue 37: a block's information or score scaled by 1e10, with the state's digest
+// forged, gave sigma_totals of 3e5 m, exit 0). Their samples add up to the window's, their
+// scores to its gradient and each row of their information to a row of its information
+// (to rounding); and by Cauchy-Schwarz over a block's whitened rows, no entry of a block's
+// information exceeds sqrt(H_kk H_cc) of the window's, nor a block's score sqrt(H_cc c).
+std::string BlocksDisagree(const WindowFold& f) {
+  if (f.block_samples.empty()) return "";
+  const Eigen::Index n = f.gradient.size();
+  constexpr double kRelative = 1e-6;  // the identities hold to rounding (~1e-12)
+  constexpr double kTiny = 1e-300;
+  long long samples = 0;
+  for (long long b : f.block_samples) samples += b;
+  if (samples != f.samples) return "blocks of other samples than the window's";
+  if (f.block_scores.cols() != n ||
+      static_cast<size_t>(f.block_scores.rows()) != f.block_samples.size()) {
+    return "block scores of another shape";
+  }
+  const Eigen::VectorXd root_h = f.information.diagonal().cwiseMax(0.0).cwiseSqrt();
+  const double root_c = std::sqrt(std::max(f.chi_square, 0.0));
+  for (Eigen::Index b = 0; b < f.block_scores.rows(); ++b) {
+    for (Eigen::Index c = 0; c < n; ++c) {
+      if (std::abs(f.block_scores(b, c)) > (1.0 + kRelative) * root_h[c] * root_c + kTiny) {
+        return "a block score larger than the window's information and chi-square allow";
+      }
+    }
+  }
+  const Eigen::VectorXd scores = f.block_scores.colwise().sum().transpose();
+  if ((scores - f.gradient).norm() > kRelative * root_h.norm() * root_c + kTiny) {
+    return "block scores that do not add up to the gradient";
+  }
+  if (f.block_information.empty()) return "";
+  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(f.block_information[0].rows(), n);
+  for (const Eigen::MatrixXd& m : f.block_information) {
+    if (m.rows() != rows.rows() || m.cols() != n) return "block informations of another shape";
+    rows += m;
+  }
+  std::vector<Eigen::Index> column_of(rows.rows(), -1);
+  for (Eigen::Index r = 0; r < rows.rows(); ++r) {
+    for (Eigen::Index k = 0; k < f.information.rows() && column_of[r] < 0; ++k) {
+      // Relative to the two rows themselves: the whole information scaled matches none.
+      const double scale = rows.row(r).norm() + f.information.row(k).norm() + kTiny;
+      if ((rows.row(r) - f.information.row(k)).norm() <= kRelative * scale) column_of[r] = k;
+    }
+    if (column_of[r] < 0) return "block informations that do not add up to the window's";
+  }
+  for (const Eigen::MatrixXd& m : f.block_information) {
+    for (Eigen::Index r = 0; r < m.rows(); ++r) {
+      for (Eigen::Index c = 0; c < n; ++c) {
+        if (std::abs(m(r, c)) > (1.0 + kRelative) * root_h[column_of[r]] * root_h[c] + kTiny) {
+          return "a block's information larger than the window's";
+        }
+      }
+    }
+  }
+  return "";
+}
+
 // "" when every number of a parsed fold is in range; else which is not.
 std::string OutOfRange(const WindowFold& f) {
   const auto finite_all = [](const std::vector<double>& v) {
@@ -384,6 +442,7 @@ std::string OutOfRange(const WindowFold& f) {
       return "a block's information beyond any telemetry's";
     }
   }
+  if (const std::string why = BlocksDisagree(f); !why.empty()) return why;
   constexpr double kMaxSquaredReadingN2 = 1e18;  // a reading's residual of 10^9 N, squared
   for (int i = 0; i < kNumCables; ++i) {
     if (f.count[i] < 0 || !(f.sum_sq_n2[i] >= 0.0) || !std::isfinite(f.sum_sq_n2[i]) ||
