@@ -44,6 +44,11 @@ TEST(TensionScaleTest, FastsTensionsPassAndAUnitSlipIsNamed) {
   constexpr double kNPerTonneForce = 9806.65;
   EXPECT_FALSE(CheckTensionScale(Uniform(kCableN / kNPerTonneForce * 1e3), fast, &error));
   EXPECT_NE(error.find("tonne-force"), std::string::npos) << error;
+  // kN declared tonne-force: 9.8x large, named as such (it said 1000x large, N for kN).
+  EXPECT_FALSE(CheckTensionScale(Uniform(kCableN * kNPerTonneForce / 1e3), fast, &error));
+  EXPECT_NE(error.find("read 9.8x large? (kN where the column map says tonne-force"),
+            std::string::npos)
+      << error;
   // The bounds: 0.8 of the weight passes (sensors 20% low), a little less does not.
   EXPECT_DOUBLE_EQ(kMinWeightFraction, 0.8);
   const double weight_n = fast.cabin_mass_kg * std::abs(fast.gravity_m_per_s2);

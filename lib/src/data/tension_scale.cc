@@ -50,7 +50,12 @@ bool CheckSum(const Dataset& data, const CableRobot& model, std::string* error) 
            " kN a sample (median), where the cabin's weight alone (" +
            internal::FormatDouble("%.4g", model.cabin_mass_kg) + " kg, " +
            internal::FormatDouble("%.4g", weight_n / 1e3) + " kN) needs at least that much: " +
-           (!small ? "read 1000x large? (tensions in N where the column map says kN)"
+           (!small && plausible(median_n / 1e3)
+                ? "read 1000x large? (tensions in N where the column map says kN)"
+            : !small && plausible(median_n / kNPerKgf)
+                ? "read 9.8x large? (kN where the column map says tonne-force, or N where it "
+                  "says kgf)"
+            : !small ? "read in the wrong unit?"
             : plausible(median_n * 1e3)
                 ? "read 1000x small? (tensions in kN where the column map says N)"
             : plausible(median_n * kNPerKgf)
