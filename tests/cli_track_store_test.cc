@@ -169,6 +169,17 @@ TEST_F(CliTrackStoreTest, AFileHoldingItsRowsTwiceIsRefused) {
             std::string::npos)
       << r.output;
   EXPECT_FALSE(fs::exists(Path("t")));
+  // The copy written with 9 significant digits (a second re-check: folded twice, exit 0).
+  ASSERT_EQ(Shell("(cat " + Day(1) + "; grep -v '^#' " + Day(1) +
+                  " | sed -n '2,$p' | awk -F, 'BEGIN {OFS = \",\"} {for (i = 2; i <= NF; ++i) "
+                  "$i = sprintf(\"%.9g\", $i); print}') > " +
+                  Path("rounded.csv"))
+                .code,
+            0);
+  const CommandResult rounded = Track(Path("rounded.csv") + "," + Day(2), "t");
+  EXPECT_NE(rounded.code, 0) << rounded.output;
+  EXPECT_NE(rounded.output.find("rounded.csv:1805 repeats line 5"), std::string::npos)
+      << rounded.output;
 }
 
 TEST_F(CliTrackStoreTest, TheSameDataTwiceIsRefusedByContent) {

@@ -416,19 +416,33 @@ std::vector<int> BlockRowColumns(const std::vector<ParameterSpec>& columns,
 
 namespace {
 
-// The fold of the window `source` reads: the first pass (predictions), the screen, the
-// summary, the second pass (rows).
 // No row of a file given twice in the window (issue 37: a file holding its rows twice was
 // folded twice, exit 0). In time order (stable) the copies lie in one run of equal times;
-// two samples there whose residuals agree to 1e-6 sigma on every cable (the same pose and
-// readings, solved from different warm starts) are read back and compared exactly: the same file,
-// time, pose and tensions (and joints) is one row given twice. Samples of two files at one instant
+// two samples there whose residuals agree to 1e-3 sigma on every cable are read back and
+// compared: the same file and time, and the pose, joints and tensions the same to the
+// digits an export keeps, is one row given twice. Samples of two files at one instant
 // are the overlap check's (track.cc), allowed by --keep-overlapping. Runs of equal times longer
 // than kMaxEqualTimes (coarse time stamps) are compared over their first kMaxEqualTimes.
 bool NoSampleTwice(const FoldTask& task, const SampleSource& source, const WindowPrediction& at,
                    std::string* error) {
   constexpr int kMaxEqualTimes = 64;
-  constexpr double kAlikeSigmas = 1e-6;  // candidates only: confirmed on the raw samples
+  constexpr double kAlikeSigmas = 1e-3;  // candidates only: confirmed on the raw samples
+  // A copy written with fewer digits (9 significant: a second re-check) is the same row:
+  // FAST's readings differ between two samples by far more (3% noise, the cabin moving).
+  constexpr double kSamePositionM = 1e-5, kSameRotation = 1e-7, kSameTensionRelative = 1e-5;
+  constexpr double kSameJoint = 1e-6;  // in the file's units (deg or m)
+  const auto same = [&](const Sample& s, const Sample& t) {
+    bool alike = (s.pose.position_m - t.pose.position_m).cwiseAbs().maxCoeff() <= kSamePositionM &&
+                 (s.pose.rotation - t.pose.rotation).cwiseAbs().maxCoeff() <= kSameRotation;
+    for (int i = 0; i < kNumCables && alike; ++i) {
+      alike = std::abs(s.tension_n[i] - t.tension_n[i]) <=
+              kSameTensionRelative * std::max(std::abs(s.tension_n[i]), std::abs(t.tension_n[i]));
+    }
+    for (size_t j = 0; j < s.joint.size() && alike; ++j) {
+      alike = std::abs(s.joint[j] - t.joint[j]) <= kSameJoint;
+    }
+    return alike;
+  };
   const int n = static_cast<int>(at.time_s.size());
   for (int a = 0; a < n;) {
     int b = a + 1;
@@ -449,10 +463,7 @@ bool NoSampleTwice(const FoldTask& task, const SampleSource& source, const Windo
         }
         const Sample& s = one[0];
         const Sample& t = two[0];
-        if (file_one[0] != file_two[0] || s.tension_n != t.tension_n || s.joint != t.joint ||
-            s.pose.position_m != t.pose.position_m || s.pose.rotation != t.pose.rotation) {
-          continue;
-        }
+        if (file_one[0] != file_two[0] || !same(s, t)) continue;
         *error = Where(task, source, t, file_two[0]) + " repeats line " + std::to_string(s.line) +
                  " (the same time, pose and tensions): each sample is folded once; remove "
                  "the repeated rows from the file";
@@ -464,6 +475,8 @@ bool NoSampleTwice(const FoldTask& task, const SampleSource& source, const Windo
   return true;
 }
 
+// The fold of the window `source` reads: the first pass (predictions), the screen, the
+// summary, the second pass (rows).
 bool FoldSource(const FoldTask& task, const SampleSource& source, WindowFold* fold,
                 std::string* error) {
   if (!task.IsValid(error)) return false;
