@@ -303,6 +303,10 @@ TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
   refused_after(std::regex_replace(state, std::regex("\"samples\": 1800"), "\"samples\": 900",
                                    std::regex_constants::format_first_only),
                 "its windows hold");
+  refused_after(
+      std::regex_replace(state, std::regex("\"sigma_percent\": [^,\n]+"), "\"sigma_percent\": 50",
+                         std::regex_constants::format_first_only),
+      "whitened by another slow error than track_state.json records");
   // Millions of empty lists: each a yaml-cpp node (16 MiB of them took 2.7 GB); refused by
   // their count before they are parsed, under a memory limit.
   std::string lists = "{\"format\": [";

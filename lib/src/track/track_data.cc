@@ -396,6 +396,14 @@ bool LoadFolds(TrackRun& run) {
       ok = false;
     }
     if (ok && !LoadFold(run, &w, &why)) ok = false;
+    // Whitened by the process the state records (issue 37: the state's slow error edited
+    // by hand shifted every estimate, exit 0).
+    const SlowErrorProcess& p = w.fold.slow_error;
+    if (ok && (p.sigma_n != run.slow.sigma_n || p.sigma_percent != run.slow.sigma_percent ||
+               p.time_constant_s != run.slow.time_constant_s)) {
+      why = path + ": whitened by another slow error than track_state.json records";
+      ok = false;
+    }
     // A fold of another window passes its digest only with a forged state: its own label
     // and count still tell.
     if (ok && (w.fold.label != w.label || w.fold.samples != w.samples)) {
