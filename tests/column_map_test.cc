@@ -314,6 +314,17 @@ TEST(ColumnMapTest, MapErrorsNameTheLikelyFix) {
   const std::string why = MappedError(header + not_finite, map);
   EXPECT_TRUE(Contains(why, "not finite")) << why;
   EXPECT_FALSE(Contains(why, "a unit row?")) << why;
+  // Nor where the map already skips the unit row: "#NV" under it is a missing value.
+  const std::string skipping = MapText(
+      "time: t\nskip_after_header: 1\ncolumns:\n  x_m: X\n  y_m: Y\n  z_m: Z\n  roll_deg: R\n"
+      "  pitch_deg: P\n  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n  T3_kN: F3\n  T4_kN: F4\n"
+      "  T5_kN: F5\n  T6_kN: F6\n");
+  const std::string missing =
+      MappedError(header + "s,m,m,m,deg,deg,deg,kN,kN,kN,kN,kN,kN\n" +
+                      "0,70.96,4.65,156.73,0.35,-5.3,0.09,#NV,190.2,141.8,149.9,188.6,207.1\n",
+                  skipping);
+  EXPECT_TRUE(Contains(missing, "is not a number")) << missing;
+  EXPECT_FALSE(Contains(missing, "a unit row?")) << missing;
   EXPECT_TRUE(Contains(MappedError(header, MapText("time: t\ncolumns:\n  x_m: X\n  y_m: Y\n"
                                                    "  z_m: Z\n  roll_deg: R\n  pitch_deg: P\n"
                                                    "  yaw_deg: W\n  T1_kN: F1\n  T2_kN: F2\n"

@@ -355,11 +355,12 @@ bool ParseMappedHeader(std::string_view line, const std::string& where, const st
             header->joint_names.end()) {
       std::string joints;
       for (const std::string& j : header->joint_names) joints += (joints.empty() ? "" : ", ") + j;
-      *error = internal::EntryWhere(map, e) +
-               (joints.empty() ? "the model has no moving parts (cabin.moving_parts), so no "
-                                 "joint column"
-                               : "the model's moving parts have no joint of that name (theirs: " +
-                                     joints + ")");
+      *error =
+          internal::EntryWhere(map, e) +
+          (joints.empty()
+               ? "the model has no moving parts (cabin.moving_parts), so no "
+                 "joint column"
+               : "the model's moving parts have no joint of that name (theirs: " + joints + ")");
       return false;
     }
   }
@@ -486,11 +487,13 @@ bool ParseHeader(std::string_view line, const std::string& where, const std::str
       known.push_back(kSessionColumn);
       known.insert(known.end(), joints.begin(), joints.end());
       *error = where + "unknown column " + Quoted(name) + internal::DidYouMean(name, known) +
-               " (accepted: " + AcceptedColumns() + "; an export with other names, units or channels is read through a column map, "
+               " (accepted: " + AcceptedColumns() +
+               "; an export with other names, units or channels is read through a column map, "
                "--columns=MAP.yaml, docs/data-format.md)";
       if (IsJointColumnName(name)) {
-        *error += "; if it is a moving part's joint, the model names no joint with it "
-                  "(cabin.moving_parts in the model file, --model)";
+        *error +=
+            "; if it is a moving part's joint, the model names no joint with it "
+            "(cabin.moving_parts in the model file, --model)";
       }
       return false;
     }
@@ -677,11 +680,11 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
       const int j = JointOfField(column);
       std::string why;
       double v = 0.0, file_value = 0.0;
-      const bool read = header.map != nullptr
-                            ? internal::ReadConvertedNumber(fields[f], header.map->decimal,
-                                                            header.joint_conversion[j],
-                                                            &file_value, &v, &why)
-                            : ParseNumber(fields[f], &v, &why);
+      const bool read =
+          header.map != nullptr
+              ? internal::ReadConvertedNumber(fields[f], header.map->decimal,
+                                              header.joint_conversion[j], &file_value, &v, &why)
+              : ParseNumber(fields[f], &v, &why);
       if (!read || !PlausibleJointValue(header.joint_names[j], v, &why)) {
         *reason = "column " + Quoted(header.joint_names[j]) + ": " + why;
         return false;
@@ -704,19 +707,22 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     };
     std::string why;
     if (header.map != nullptr) {
+      // The unit-row hint only where the map skips no row after the header (a second
+      // re-check of issue 37: "#NV" in the first row suggested what the map already said).
+      const bool first_row = previous == nullptr && header.map->skip_after_header == 0;
       if (column == kTime) {
         if (!internal::ReadTimeField(fields[f], header.map->time, header.map->decimal,
                                      &value[column], &why)) {
-          return fail(why + internal::NotANumberHint(fields[f], '\0', previous == nullptr));
+          return fail(why + internal::NotANumberHint(fields[f], '\0', first_row));
         }
         if (!CheckValue(column, value[column], limits, &why)) return fail(why);
         continue;
       }
       double file_value = 0.0;
       const char decimal = header.map->decimal;
-      if (!internal::ReadConvertedNumber(fields[f], decimal, header.conversion[column],
-                                         &file_value, &value[column], &why)) {
-        return fail(why + internal::NotANumberHint(fields[f], decimal, previous == nullptr));
+      if (!internal::ReadConvertedNumber(fields[f], decimal, header.conversion[column], &file_value,
+                                         &value[column], &why)) {
+        return fail(why + internal::NotANumberHint(fields[f], decimal, first_row));
       }
       if (!CheckValue(column, file_value, limits, &why)) {
         const ColumnMapEntry* e = header.entry[column];
@@ -725,8 +731,8 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
           return CheckValue(column, v, limits, &ignored);
         };
         return fail(why + (e == nullptr ? std::string()
-                                        : internal::UnitHint(e->name, e->unit, fields[f],
-                                                             decimal, plausible)));
+                                        : internal::UnitHint(e->name, e->unit, fields[f], decimal,
+                                                             plausible)));
       }
       continue;
     }
@@ -1249,8 +1255,8 @@ bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
              " joint columns; at most " + std::to_string(kMaxJoints);
     return false;
   }
-  std::string text = HeaderText(columns, header_comment, !dataset.session_labels.empty(),
-                                dataset.joint_columns);
+  std::string text =
+      HeaderText(columns, header_comment, !dataset.session_labels.empty(), dataset.joint_columns);
   for (size_t i = 0; i < dataset.samples.size(); ++i) {
     std::string reason;
     if (!AppendRow(dataset, columns, dataset.samples[i], &text, &reason)) {
@@ -1513,8 +1519,8 @@ bool DatasetWriter::Open(const std::string& path, const Dataset& layout,
     return false;
   }
   ::flock(::fileno(file_), LOCK_EX | LOCK_NB);  // a temporary in use, not a killed run's
-  buffer_ = HeaderText(columns_, header_comment, !layout_.session_labels.empty(),
-                       layout_.joint_columns);
+  buffer_ =
+      HeaderText(columns_, header_comment, !layout_.session_labels.empty(), layout_.joint_columns);
   return Flush(error);
 }
 
