@@ -189,6 +189,65 @@ long long JsonEntries(const std::string& text) {
 // ~10^5): each costs yaml-cpp ~0.5 kB, and 16 MiB of "[]," took 2.7 GB (issue 37).
 constexpr long long kMaxStateEntries = 250000;
 
+// A file of the state.
+TrackFile ParseFile(const YAML::Node& f) {
+  TrackFile file{Text(f["path"]), Count(f["bytes"]), Text(f["sha256"]), Count(f["samples"])};
+  if (f["first_s"]) {
+    file.first_s = Real(f["first_s"]);
+    file.last_s = Real(f["last_s"]);
+  }
+  return file;
+}
+
+// A window of the state: its label one the track writes (no path outside DIR), its times
+// as the track writes them (issue 37: a start_s of 1e400 was written to track.csv as inf):
+// finite, within data's plausible times, in order.
+TrackWindowState ParseWindow(const YAML::Node& n) {
+  TrackWindowState w;
+  w.label = Text(n["label"]);
+  w.key = Integer(n["key"]);
+  w.start_s = Real(n["start_s"]);
+  w.end_s = Real(n["end_s"]);
+  w.first_s = Real(n["first_s"]);
+  w.last_s = Real(n["last_s"]);
+  w.samples = Count(n["samples"]);
+  w.used = Text(n["used"]) == "true";
+  w.fold_file = Text(n["fold"]);
+  if (!IsSafeLabel(w.label) ||
+      (!w.fold_file.empty() && w.fold_file.rfind("folds/" + w.label + ".g", 0) != 0)) {
+    throw YAML::Exception(n["label"].Mark(), "window label or fold '" + w.label +
+                                                 "' is not one this program "
+                                                 "writes (a path outside the track?)");
+  }
+  if (n["fold_sha256"]) w.fold_sha256 = Text(n["fold_sha256"]);
+  if (n["store_bytes"]) w.store_bytes = Count(n["store_bytes"]);
+  if (n["store_sha256"]) w.store_sha256 = Text(n["store_sha256"]);
+  for (const YAML::Node& f : n["files"]) w.files.push_back(static_cast<int>(Integer(f)));
+  const auto plausible = [](double t) {
+    return std::isfinite(t) && std::abs(t) <= kUnixTimeUntilS;  // year 10000 (time_text.h)
+  };
+  if (!plausible(w.start_s) || !plausible(w.end_s) || w.start_s > w.end_s ||
+      (w.samples > 0 && (!plausible(w.first_s) || !plausible(w.last_s) || w.first_s > w.last_s))) {
+    throw YAML::Exception(n["start_s"].Mark(), "window " + w.label + "'s times are not a window's");
+  }
+  w.dirty = false;
+  return w;
+}
+
+// A shared value of the state, by its column's name.
+std::pair<std::string, SharedEntry> ParseShared(const YAML::Node& e) {
+  SharedEntry entry;
+  entry.from_s = Real(e["from_s"]);
+  if (entry.from_s <= -1e308) entry.from_s = -std::numeric_limits<double>::infinity();
+  entry.value_si = Real(e["value_si"]);
+  if (e["inside"] && Text(e["inside"]) == "true") {
+    entry.inside = true;
+    entry.step_time_s = Real(e["step_time_s"]);
+    entry.step_previous_s = Real(e["step_previous_s"]);
+  }
+  return {Text(e["name"]), entry};
+}
+
 SavedState ParseState(const std::string& text) {
   if (const long long entries = JsonEntries(text); entries > kMaxStateEntries) {
     YAML::Mark start;
@@ -212,75 +271,9 @@ SavedState ParseState(const std::string& text) {
   s.slow.sigma_n = Real(root["slow_error"]["sigma_n"]);
   s.slow.sigma_percent = Real(root["slow_error"]["sigma_percent"]);
   s.slow.time_constant_s = Real(root["slow_error"]["time_constant_s"]);
-  for (const YAML::Node& f : root["files"]) {
-    TrackFile file{Text(f["path"]), Count(f["bytes"]), Text(f["sha256"]), Count(f["samples"])};
-    if (f["first_s"]) {
-      file.first_s = Real(f["first_s"]);
-      file.last_s = Real(f["last_s"]);
-    }
-    s.files.push_back(file);
-  }
-  for (const YAML::Node& n : root["windows"]) {
-    TrackWindowState w;
-    w.label = Text(n["label"]);
-    w.key = Integer(n["key"]);
-    w.start_s = Real(n["start_s"]);
-    w.end_s = Real(n["end_s"]);
-    w.first_s = Real(n["first_s"]);
-    w.last_s = Real(n["last_s"]);
-    w.samples = Count(n["samples"]);
-    w.used = Text(n["used"]) == "true";
-    w.fold_file = Text(n["fold"]);
-    if (!IsSafeLabel(w.label) ||
-        (!w.fold_file.empty() && w.fold_file.rfind("folds/" + w.label + ".g", 0) != 0)) {
-      throw YAML::Exception(n["label"].Mark(), "window label or fold '" + w.label +
-                                                   "' is not one this program "
-                                                   "writes (a path outside the track?)");
-    }
-    if (n["fold_sha256"]) w.fold_sha256 = Text(n["fold_sha256"]);
-    if (n["store_bytes"]) w.store_bytes = Count(n["store_bytes"]);
-    if (n["store_sha256"]) w.store_sha256 = Text(n["store_sha256"]);
-    for (const YAML::Node& f : n["files"]) w.files.push_back(static_cast<int>(Integer(f)));
-    // Times as the track writes them (issue 37: a start_s of 1e400 was written to
-    // track.csv as inf): finite, within data's plausible times, in order.
-    const auto plausible = [](double t) {
-      return std::isfinite(t) && std::abs(t) <= kUnixTimeUntilS;  // year 10000 (time_text.h)
-    };
-    if (!plausible(w.start_s) || !plausible(w.end_s) || w.start_s > w.end_s ||
-        (w.samples > 0 &&
-         (!plausible(w.first_s) || !plausible(w.last_s) || w.first_s > w.last_s))) {
-      throw YAML::Exception(n["start_s"].Mark(),
-                            "window " + w.label + "'s times are not a window's");
-    }
-    w.dirty = false;
-    s.windows.push_back(std::move(w));
-  }
-  // Each file with samples has them in a window (issue 37: a state's windows emptied by
-  // hand made an update drop every earlier day, exit 0).
-  for (size_t f = 0; f < s.files.size(); ++f) {
-    if (s.files[f].samples == 0) continue;
-    const bool held = std::any_of(s.windows.begin(), s.windows.end(), [&](const auto& w) {
-      return std::find(w.files.begin(), w.files.end(), static_cast<int>(f)) != w.files.end();
-    });
-    if (!held) {
-      throw YAML::Exception(root["windows"].Mark(),
-                            "file " + s.files[f].path + "'s " + std::to_string(s.files[f].samples) +
-                                " samples are in no window: a damaged state; --force rebuilds "
-                                "the track from the data");
-    }
-  }
-  for (const YAML::Node& e : root["shared"]) {
-    SharedEntry entry;
-    entry.from_s = Real(e["from_s"]);
-    if (entry.from_s <= -1e308) entry.from_s = -std::numeric_limits<double>::infinity();
-    entry.value_si = Real(e["value_si"]);
-    if (e["inside"] && Text(e["inside"]) == "true") {
-      entry.inside = true;
-      entry.step_time_s = Real(e["step_time_s"]);
-      entry.step_previous_s = Real(e["step_previous_s"]);
-    }
-    s.shared.push_back({Text(e["name"]), entry});
-  }
+  for (const YAML::Node& f : root["files"]) s.files.push_back(ParseFile(f));
+  for (const YAML::Node& n : root["windows"]) s.windows.push_back(ParseWindow(n));
+  for (const YAML::Node& e : root["shared"]) s.shared.push_back(ParseShared(e));
   return s;
 }
 
@@ -491,7 +484,19 @@ std::string WindowsProblem(const TrackRun& run, const SavedState& s) {
       return "window " + w.label + " is not the window of key " + std::to_string(w.key);
     }
   }
-  for (const TrackFile& f : s.files) in_files += f.samples;
+  // Each file with samples has them in a window (issue 37: a state's windows emptied by
+  // hand made an update drop every earlier day, exit 0).
+  for (size_t f = 0; f < s.files.size(); ++f) {
+    in_files += s.files[f].samples;
+    if (s.files[f].samples == 0) continue;
+    const bool held = std::any_of(s.windows.begin(), s.windows.end(), [&](const auto& w) {
+      return std::find(w.files.begin(), w.files.end(), static_cast<int>(f)) != w.files.end();
+    });
+    if (!held) {
+      return "file " + s.files[f].path + "'s " + std::to_string(s.files[f].samples) +
+             " samples are in no window";
+    }
+  }
   if (in_windows != in_files) {
     return "its windows hold " + std::to_string(in_windows) + " samples, its files " +
            std::to_string(in_files);

@@ -161,6 +161,14 @@ bool CheckStoreDigest(TrackRun& run, TrackWindowState* w) {
   return true;
 }
 
+// The stores of the windows this run folds, each checked against the state's digest.
+bool CheckMovingStores(TrackRun& run) {
+  for (int w : run.used) {
+    if (Moving(run, run.windows[w]) && !CheckStoreDigest(run, &run.windows[w])) return false;
+  }
+  return true;
+}
+
 // Folds every dirty used window at its point (with the consider columns when `consider`).
 bool FoldDirty(TrackRun& run, bool consider = false) {
   std::vector<int> which;
@@ -414,11 +422,7 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
         TrackStatus::kInvalidInput,
         "no window has " + std::to_string(run.options.min_window_samples) + " samples or more");
   }
-  for (int w : run.used) {
-    if (Moving(run, run.windows[w]) && !CheckStoreDigest(run, &run.windows[w])) {
-      return TrackStatus::kInvalidInput;
-    }
-  }
+  if (!CheckMovingStores(run)) return TrackStatus::kInvalidInput;
   bool slow_settled = !estimate_slow_error || !run.spec.slow_error.estimates_any() || run.update;
   if (run.update && run.spec.slow_error.estimates_any() && estimate_slow_error) {
     run.result->slow_error.enabled = true;
