@@ -300,6 +300,11 @@ TEST_F(CliTrackStoreTest, ADamagedStateIsRefusedByName) {
   refused_after(std::regex_replace(state, std::regex("\"key\": ([0-9]+)"), "\"key\": 19850",
                                    std::regex_constants::format_first_only),
                 "is not the window of key 19850");
+  // Its end moved a day on, key and label kept (one day's data shown under two dates).
+  refused_after(
+      std::regex_replace(state, std::regex("\"end_s\": [-0-9.e+]+"), "\"end_s\": 1714780800",
+                         std::regex_constants::format_first_only),
+      "is not the window of key");
   refused_after(std::regex_replace(state, std::regex("\"samples\": 1800"), "\"samples\": 900",
                                    std::regex_constants::format_first_only),
                 "its windows hold");
