@@ -78,6 +78,93 @@ def test_a_model_changed_by_another_thread_never_crashes_a_call() -> None:
     assert run.stdout.strip() == "torn 0"
 
 
+# Each remaining binding that takes a model and releases the GIL, raced on its own while
+# another thread swaps the model's attachments (the modes: its cabin mass): a copy taken with the GIL held makes the
+# call see one model or the other, never a crash nor a mix (a fix applied to a list of
+# bindings once missed the two added after it). The call's result with the model as it
+# was and as it became are both accepted; anything else is a mix.
+RACE_ONE = textwrap.dedent(
+    """
+    import os, sys, tempfile, threading, time
+    import numpy as np
+    import fastcal
+
+    call, data_dir = sys.argv[2], sys.argv[3]
+    model = fastcal.Model.nominal()
+    p = fastcal.random_workspace(samples=40, seed=1)
+    q = fastcal.focal_attitude(p)
+    # The field swapped: the attachments (a list the copy must take whole), or for the
+    # modes, which do not take attachments, the cabin's mass.
+    field = "cabin_mass_kg" if call == "modes" else "attachments"
+    bare = 30000.0 if call == "modes" else [[] for _ in range(6)]
+    loaded = (32000.0 if call == "modes"
+              else [[{"at_m": 10.0 + k, "mass_kg": 30.0} for k in range(8)] for _ in range(6)])
+    data, _, _ = fastcal.simulate(p, quat=q, seed=1)
+    if call == "track":  # a window needs 100 samples
+        p2 = fastcal.random_workspace(samples=150, seed=2)
+        data, _, _ = fastcal.simulate(p2, quat=fastcal.focal_attitude(p2), seed=2)
+    spec = os.path.join(data_dir, "spec_mass_centre.yaml")
+    work = tempfile.mkdtemp()
+    runs = [0]
+
+    def once(m):
+        if call == "control_cycle":
+            return fastcal.control_cycle(p, quat=q, model=m).winch_length_m
+        if call == "modes":
+            return fastcal.modes(p[0], quat=q[0], model=m, count=4).frequency_hz
+        if call == "calibrate":
+            return sorted(fastcal.calibrate(spec, data, model=m, quiet=True).estimates.items())
+        if call == "track":
+            runs[0] += 1
+            path = os.path.join(work, "day.csv")
+            if not os.path.exists(path):
+                data.save(path)
+            out = os.path.join(work, "t%d" % runs[0])
+            result = fastcal.track(path, os.path.join(data_dir, "spec_track.yaml"), out,
+                                   window="file", model=m, quiet=True)
+            return result.estimates("mass_centre_m.z")[0]
+        raise SystemExit("unknown call " + call)
+
+    def expected_of(value):
+        m = model.copy()
+        setattr(m, field, value)
+        return np.asarray(once(m))
+
+    expected = (expected_of(bare), expected_of(loaded))
+    stop = False
+
+    def writer():
+        while not stop:
+            setattr(model, field, loaded)
+            setattr(model, field, bare)
+
+    thread = threading.Thread(target=writer)
+    thread.start()
+    torn = 0
+    end = time.time() + float(sys.argv[1])
+    while time.time() < end:
+        got = np.asarray(once(model))
+        torn += not any(np.array_equal(got, e) for e in expected)
+    stop = True
+    thread.join()
+    print("torn", torn)
+    """
+)
+
+
+@pytest.mark.parametrize("call", ["control_cycle", "modes", "calibrate", "track"])
+def test_each_binding_sees_one_model_while_another_thread_changes_it(
+        call: str, data_dir: pathlib.Path) -> None:
+    run = subprocess.run(
+        [sys.executable, "-c", RACE_ONE, str(RACE_SECONDS), call, str(data_dir)],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+    assert run.returncode == 0, f"exit {run.returncode}: {run.stderr[-2000:]}"
+    assert run.stdout.strip().splitlines()[-1] == "torn 0"
+
+
 def test_setters_refuse_what_the_model_file_reader_refuses(tmp_path: pathlib.Path) -> None:
     model = fastcal.Model.nominal()
     refused = [
