@@ -151,6 +151,15 @@ std::shared_ptr<const ColumnMap> MapOrThrow(const std::string& map_text,
                                             const std::string& map_source, bool csv_layout,
                                             bool header_first);
 
+// The names of an enum's values 0 .. last, in order (the statuses' short codes Python
+// maps its arrays of codes through).
+template <typename Enum, typename NameOf>
+py::list EnumNames(Enum last, NameOf name_of) {
+  py::list names;
+  for (int s = 0; s <= static_cast<int>(last); ++s) names.append(name_of(static_cast<Enum>(s)));
+  return names;
+}
+
 void BindModel(py::module_& m);
 void BindStatics(py::module_& m);
 void BindControl(py::module_& m);

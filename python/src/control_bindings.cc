@@ -110,11 +110,7 @@ py::dict ControlCycles(const CableRobot& model, const DoubleArray& positions_m,
 
 void BindControl(py::module_& m) {
   m.def("control_status_names", [] {
-    py::list names;
-    for (int s = 0; s <= static_cast<int>(ControlStatus::kInsideReflectorMargin); ++s) {
-      names.append(ControlStatusName(static_cast<ControlStatus>(s)));
-    }
-    return names;
+    return EnumNames(ControlStatus::kInsideReflectorMargin, ControlStatusName);
   });
   m.def("control_cycle", &ControlCycles, py::arg("model"), py::arg("position_m"),
         py::arg("attitude_kind"), py::arg("attitude"), py::arg("joints"), py::arg("min_tension_kN"),

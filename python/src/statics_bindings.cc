@@ -156,12 +156,8 @@ DoubleArray QuaternionsOf(const std::vector<Pose>& poses) {
 
 void BindStatics(py::module_& m) {
   m.def("statics_status_names", [] {
-    py::list names;
     // kUnsupportedModel is the enum's last status.
-    for (int s = 0; s <= static_cast<int>(StaticsStatus::kUnsupportedModel); ++s) {
-      names.append(StaticsStatusName(static_cast<StaticsStatus>(s)));
-    }
-    return names;
+    return EnumNames(StaticsStatus::kUnsupportedModel, StaticsStatusName);
   });
   m.def("solve", &Solve, py::arg("model"), py::arg("position_m"), py::arg("attitude_kind"),
         py::arg("attitude"), py::arg("method"), py::arg("settings"));
