@@ -425,6 +425,44 @@ TEST(CalibrationTest, WorstReadingsAreTheLargestResiduals) {
   }
 }
 
+// The RMS table's initial-model row is the input model's own evaluation, whether the fit's
+// first prediction stands in for it (exact statics, no spec value in place of the
+// model's: issue 41) or not (an initial value in the spec: the fit starts elsewhere), with
+// held-out samples and a reading kept out as a gross error.
+TEST(CalibrationTest, InitialModelRowIsTheInputModelsEvaluation) {
+  constexpr double kRelTol = 1e-9;  // warm and cold statics, to the solver's tolerance
+  Dataset data = CircleData(Truth(), 240, 0.03, 43);
+  data.samples[17].tension_n[2] *= 3.0;  // a gross error, left out of both rows
+  for (bool initial_value : {false, true}) {
+    CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+    spec.holdout_fraction = 0.25;
+    if (initial_value) {
+      spec.parameters[2].has_initial = true;
+      spec.parameters[2].initial_si = 0.3;  // mass_centre_m.z: not the nominal model's
+    }
+    CalibrationResult result;
+    ASSERT_TRUE(CalibrateNominal(spec, data, &result));
+    ASSERT_EQ(result.excluded.size(), data.samples.size());
+    ASSERT_TRUE(result.excluded[17][2]);
+    VariantEvaluation plain;
+    std::string error;
+    ASSERT_TRUE(EvaluateVariant("plain", CableRobot::NominalFast(), data, AttitudeSource::kMeasured,
+                                StaticsMethod::kExact, result.held_out, &plain, &error,
+                                result.excluded))
+        << error;
+    const VariantEvaluation& initial = result.variants.front();
+    ASSERT_EQ(initial.name, "initial model, measured attitude");
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_NEAR(initial.fit.rms_n[i], plain.fit.rms_n[i], kRelTol * plain.fit.rms_n[i])
+          << "initial value " << initial_value << " cable " << i;
+      EXPECT_NEAR(initial.holdout.rms_n[i], plain.holdout.rms_n[i],
+                  kRelTol * plain.holdout.rms_n[i])
+          << "initial value " << initial_value << " cable " << i;
+      EXPECT_EQ(initial.fit.excluded[i], plain.fit.excluded[i]);
+    }
+  }
+}
+
 // Gross errors: readings several times off, a dropout near zero and one 150 kN too high
 // are named by line and cable and kept out of the fit, which then agrees with the fit of
 // the clean data within its sigma.

@@ -354,6 +354,66 @@ TEST(FoldedCostTest, CostThenJacobianAtTheSameTheta) {
   EXPECT_NE(trial[m - 1] * trial[m - 1], trial_cost);
 }
 
+// What an evaluation solved (FittedSamples::solved) is the prediction at its theta: each
+// fitted sample's readings as SolveStatics gives them from cold, its solution the next
+// start; SolvedAt says so at that theta only, and not after a failed evaluation (Predict
+// would otherwise take stale readings for the new weights).
+TEST(FoldedCostTest, LeavesWhatItSolvedForThePredictionAtTheSameTheta) {
+  Fixture f(kSampleChunk + 30, SensorSpec());
+  f.fit.erase(f.fit.begin() + 5);  // a held-out sample: not written
+  std::vector<std::array<double, kNumCables>> reading_n(f.data.samples.size(), {-1.0});
+  CompactStarts starts;
+  starts.Reset(f.data.samples.size());
+  FittedSamples samples = f.Samples();
+  samples.starts = &starts;
+  samples.solved = {&reading_n, &starts};
+  const FoldedTensionCost cost(samples, nullptr, 2);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[0] += 0.1;
+  theta[5] = 1.01;  // sensor_gain[2]
+  EXPECT_FALSE(cost.SolvedAt(theta.data()));
+  std::vector<double> residuals(cost.num_residuals());
+  const double* parameters[1] = {theta.data()};
+  ASSERT_TRUE(cost.Evaluate(parameters, residuals.data(), nullptr));
+  EXPECT_TRUE(cost.SolvedAt(theta.data()));
+  const CableRobot robot = f.model.ToRobot(theta.data());
+  // The fold solved warm from nothing (cold) and SolveStatics from cold: to the solver's
+  // tolerance, not bit for bit.
+  constexpr double kReadingRelTol = 1e-9;
+  for (size_t t = 0; t < f.data.samples.size(); ++t) {
+    if (t == 5) {
+      EXPECT_EQ(reading_n[t][0], -1.0);
+      EXPECT_FALSE(starts.At(t).has_start());
+      continue;
+    }
+    StaticsSolution s;
+    ASSERT_EQ(SolveStatics(robot, f.data.samples[t].pose,
+                           ModelFitStaticsOptions(StaticsMethod::kExact), &s),
+              StaticsStatus::kOk);
+    for (int i = 0; i < kNumCables; ++i) {
+      const double expected = robot.cables[i].SensorReadingN(s.cables[i].lower_tension_n);
+      ASSERT_NEAR(reading_n[t][i], expected, kReadingRelTol * expected) << t << " " << i;
+    }
+    ASSERT_TRUE(starts.At(t).has_start()) << t;
+  }
+  std::vector<double> other = theta;
+  other[1] += 0.01;
+  EXPECT_FALSE(cost.SolvedAt(other.data()));
+  other[3] = -1.0;  // a density the statics cannot hold: the evaluation fails
+  const double* failing[1] = {other.data()};
+  EXPECT_FALSE(cost.Evaluate(failing, residuals.data(), nullptr));
+  EXPECT_FALSE(cost.SolvedAt(other.data()));
+  EXPECT_FALSE(cost.SolvedAt(theta.data()));
+  // Nowhere to leave them (the default), or a path that is not the prediction's: never.
+  const FoldedTensionCost plain(f.Samples(), nullptr, 2);
+  ASSERT_TRUE(plain.Evaluate(parameters, residuals.data(), nullptr));
+  EXPECT_FALSE(plain.SolvedAt(theta.data()));
+  samples.statics = ModelFitStaticsOptions(StaticsMethod::kAas);
+  const FoldedTensionCost aas(samples, nullptr, 2);
+  ASSERT_TRUE(aas.Evaluate(parameters, residuals.data(), nullptr));
+  EXPECT_FALSE(aas.SolvedAt(theta.data()));
+}
+
 // A sample the statics cannot solve (a non-positive density) fails the evaluation, as one
 // per-sample block would: Ceres then rejects the step.
 TEST(FoldedCostTest, AnUnsolvableSampleFailsTheEvaluation) {

@@ -315,6 +315,8 @@ CalibrationStatus Predict(Run& run) {
   }
   StaticsOptions options = run.statics;
   options.warm_start = true;
+  // After a solve, the fit's last evaluation at theta has solved every fitted sample.
+  const bool solved = run.folded != nullptr && run.folded->SolvedAt(run.theta.data());
   const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& sample = run.data.samples[t];
     at.starts.At(t).Restore(run.PoseOf(sample), options.method, solution);
@@ -326,12 +328,14 @@ CalibrationStatus Predict(Run& run) {
         StaticsSolution solution;
         for (int t = begin; t < end; ++t) {
           const Sample& sample = run.data.samples[t];
-          if (solve(t, &solution) != StaticsStatus::kOk) return t;
-          at.starts.Set(t, solution);
-          const std::array<double, kNumCables>& gain = session_gain[sample.session];
-          const std::array<double, kNumCables>& bias = session_bias[sample.session];
-          for (int i = 0; i < kNumCables; ++i) {
-            at.reading_n[t][i] = gain[i] * solution.cables[i].lower_tension_n + bias[i];
+          if (!solved || !run.is_fit[t]) {
+            if (solve(t, &solution) != StaticsStatus::kOk) return t;
+            at.starts.Set(t, solution);
+            const std::array<double, kNumCables>& gain = session_gain[sample.session];
+            const std::array<double, kNumCables>& bias = session_bias[sample.session];
+            for (int i = 0; i < kNumCables; ++i) {
+              at.reading_n[t][i] = gain[i] * solution.cables[i].lower_tension_n + bias[i];
+            }
           }
           at.sigma_n[t] = internal::TensionSigmas(at.reading_n[t], run.spec.tension_sigma_n,
                                                   run.spec.tension_sigma_percent);
@@ -405,8 +409,11 @@ void BuildProblem(Run& run) {
   run.sigma_n.resize(run.fit.size());
   for (size_t j = 0; j < run.fit.size(); ++j) run.sigma_n[j] = run.at.sigma_n[run.fit[j]];
   run.slow_rho = internal::SlowErrorRatios(run.slow, run.View());
-  auto* folded =
-      new internal::FoldedTensionCost(run.Samples(), run.loss.get(), run.spec.num_threads);
+  // The fit's last evaluation leaves the statics it solved where the next prediction
+  // reads them (Predict): a pass of statics saved after every solve.
+  internal::FittedSamples samples = run.Samples();
+  samples.solved = {&run.at.reading_n, &run.at.starts};
+  auto* folded = new internal::FoldedTensionCost(samples, run.loss.get(), run.spec.num_threads);
   run.folded = folded;
   run.problem->AddResidualBlock(folded, nullptr, run.theta.data());
   for (int k = 0; k < run.n; ++k) {
@@ -745,10 +752,20 @@ CalibrationStatus NameGrossErrors(Run& run) {
           (first.length ? " length of cable " : " cable ") + std::to_string(first.cable));
 }
 
+// Whether the first prediction is the RMS table's initial-model row at the fit's attitude:
+// the table's statics (exact) of the input model itself (no spec value in place of one of
+// its parameters; Evaluate predicts with `run.model`).
+bool PredictionIsInitialRow(const Run& run) {
+  if (!run.options.evaluate || run.spec.forward_model != StaticsMethod::kExact) return false;
+  return std::none_of(run.spec.parameters.begin(), run.spec.parameters.end(),
+                      [](const ParameterSpec& p) { return p.has_initial; });
+}
+
 // Stage: the initial model's readings, screened for gross errors.
 CalibrationStatus PredictAndScreen(Run& run) {
   const CalibrationStatus status = Predict(run);
   if (status != CalibrationStatus::kOk) return status;
+  if (PredictionIsInitialRow(run)) run.initial_reading_n = run.at.reading_n;
   internal::WhitenPrediction(run.slow, run.View(), &run.at.whitened);
   run.excluded = ScreenReadings(run, &run.length_excluded);
   run.initial_length_m = run.at.length_m;

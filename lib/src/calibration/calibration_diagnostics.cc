@@ -390,6 +390,7 @@ namespace {}  // namespace
 // for the candidates).
 CalibrationStatus LineariseAtSolution(Run& run) {
   run.problem.reset();
+  run.folded = nullptr;  // the problem owned it
   run.candidates = Candidates(run, &run.candidate_value_si);
   return Linearise(run, run.candidates, &run.lin);
 }

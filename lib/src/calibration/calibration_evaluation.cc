@@ -68,6 +68,7 @@ bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec
                             const RmsTableInputs& inputs, std::vector<VariantEvaluation>* variants,
                             std::string* error) {
   std::vector<std::array<double, kNumCables>>* calibrated_readings = inputs.calibrated_readings;
+  std::vector<std::array<double, kNumCables>>* initial_readings = inputs.initial_readings;
   struct Variant {
     std::string name;
     const CableRobot* robot;
@@ -99,6 +100,9 @@ bool EvaluateBeforeAndAfter(const CableRobot& model, const CalibrationSpec& spec
     if (v.robot == &result.calibrated && calibrated_readings != nullptr &&
         calibrated_readings->size() == data.samples.size()) {
       e.predicted_n = std::move(*calibrated_readings);
+    } else if (v.robot == &model && v.attitude == inputs.initial_attitude &&
+               initial_readings != nullptr && initial_readings->size() == data.samples.size()) {
+      e.predicted_n = std::move(*initial_readings);
     } else if (!PredictReadings(models, data, v.attitude, spec.num_threads, inputs.starts,
                                 &e.predicted_n, error)) {
       *error = v.name + ": " + *error;

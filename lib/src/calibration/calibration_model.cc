@@ -301,9 +301,15 @@ struct SampleView {
 // A sample's residuals, and with `jacobian` their analytic Jacobian (exact statics only),
 // through assembled parameters: TensionResidual's operator() in double, and its
 // implicit-function derivatives.
+// What RowsThrough solved: the readings gain T + bias and the solution as a start.
+struct SolvedSample {
+  std::array<double, kNumCables> reading_n;
+  CompactStart start;
+};
+
 bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
                  const StaticsOptions& statics, const SampleView& x, double* residuals,
-                 double* jacobian) {
+                 double* jacobian, SolvedSample* solved = nullptr) {
   if (!m.gains_positive) return false;  // as operator()
   // With moving parts the mass centre is the sample's own (moving_parts.h eq. (1)).
   PartShifts shifts;
@@ -322,9 +328,11 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
   }
   for (int i = 0; i < kNumCables; ++i) {
     const bool out = x.excluded != nullptr && (*x.excluded)[i];
-    const double t = solution.cables[i].lower_tension_n;
-    residuals[i] = out ? 0.0 : (m.gain[i] * t + m.bias[i] - x.measured_n[i]) / x.sigma_n[i];
+    const double reading = m.gain[i] * solution.cables[i].lower_tension_n + m.bias[i];
+    residuals[i] = out ? 0.0 : (reading - x.measured_n[i]) / x.sigma_n[i];
+    if (solved != nullptr) solved->reading_n[i] = reading;
   }
+  if (solved != nullptr) solved->start = CompactStart::Of(solution);
   if (jacobian == nullptr) return true;
   TensionGradient gradient;
   if (ExactTensionGradient(params, x.pose, solution, options.catenary.vertical_span_fraction,
@@ -371,7 +379,16 @@ bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, doubl
                sample.session,
                &sample.joint};
   if (use_planned_attitude) x.pose.rotation = sample.planned_rotation;
-  return RowsThrough(at.model(), at.session(sample.session), statics, x, residuals, jacobian);
+  if (!FillsSolved()) {
+    return RowsThrough(at.model(), at.session(sample.session), statics, x, residuals, jacobian);
+  }
+  SolvedSample s;
+  if (!RowsThrough(at.model(), at.session(sample.session), statics, x, residuals, jacobian, &s)) {
+    return false;
+  }
+  (*solved.reading_n)[t] = s.reading_n;
+  solved.starts->Set(t, s.start);
+  return true;
 }
 
 std::array<bool, kNumCables> FittedSamples::Excluded(int j) const {

@@ -70,6 +70,9 @@ struct Run {
   // model's predicted lengths (for the table before and after).
   ReadingMask length_excluded;
   std::vector<std::array<double, kNumCables>> initial_length_m;
+  // The first prediction's readings when they are the RMS table's initial-model row at the
+  // fit's attitude (PredictAndScreen; else empty), for Evaluate: a pass over the data saved.
+  std::vector<std::array<double, kNumCables>> initial_reading_n;
   // The slow sensor error the current problem whitens by (inactive: white noise only),
   // and per fitted sample each reading's sigma_slow / sigma_white (sample_rows.h).
   SlowErrorProcess slow;

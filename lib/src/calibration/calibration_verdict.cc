@@ -316,10 +316,14 @@ CalibrationStatus Evaluate(Run& run) {
     inputs.calibrated_readings = &calibrated;
     inputs.starts = &run.at.starts;
   }
+  inputs.initial_readings = &run.initial_reading_n;  // empty unless PredictAndScreen kept it
+  inputs.initial_attitude =
+      run.spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured;
   std::string why;
   const bool ok =
       internal::EvaluateBeforeAndAfter(run.model, run.spec, run.data, r, inputs, &r.variants, &why);
   run.at = Prediction();
+  run.initial_reading_n = std::vector<std::array<double, kNumCables>>();
   if (!ok) {
     return run.Fail(CalibrationStatus::kInfeasible, why);
   }

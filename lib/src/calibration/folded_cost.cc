@@ -173,6 +173,12 @@ bool FoldedTensionCost::Evaluate(double const* const* parameters, double* residu
   return true;
 }
 
+bool FoldedTensionCost::SolvedAt(const double* theta) const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return samples_.FillsSolved() && memo_ok_ && !memo_theta_.empty() &&
+         std::equal(theta, theta + n_, memo_theta_.begin());
+}
+
 bool FoldedTensionCost::FoldedAt(const double* theta, Eigen::MatrixXd* r_aug) const {
   std::lock_guard<std::mutex> lock(mutex_);
   if (!memo_ok_ || memo_theta_.empty() || !std::equal(theta, theta + n_, memo_theta_.begin())) {

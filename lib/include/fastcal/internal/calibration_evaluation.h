@@ -23,6 +23,10 @@ struct RmsTableInputs {
   // The calibrated model's readings of every sample, when already predicted with exact
   // statics at the fit's attitude (may be null; moved from: saves a pass over the data).
   std::vector<std::array<double, kNumCables>>* calibrated_readings = nullptr;
+  // The initial model's readings of every sample at `initial_attitude`, when already
+  // predicted with exact statics (may be null; moved from): the fit's first prediction.
+  std::vector<std::array<double, kNumCables>>* initial_readings = nullptr;
+  AttitudeSource initial_attitude = AttitudeSource::kMeasured;
 };
 
 // The rows, in table order. Predictions run on spec.num_threads threads, each sample on

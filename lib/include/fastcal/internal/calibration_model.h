@@ -256,6 +256,14 @@ struct TensionResidual {
   }
 };
 
+// Where a pass over the fitted samples leaves what their statics solved, per dataset
+// sample (FittedSamples::FillsSolved): the model's readings gain T + bias, as a prediction
+// at the same parameters computes them, and each solution as the sample's next warm start.
+struct SolvedSamples {
+  std::vector<std::array<double, kNumCables>>* reading_n = nullptr;
+  CompactStarts* starts = nullptr;
+};
+
 // The fitted samples of one problem, by reference: nothing per sample is copied (at 10^6
 // samples every copy is ~50 MB). The residual of fitted sample j is At(j).
 struct FittedSamples {
@@ -279,6 +287,10 @@ struct FittedSamples {
   // dataset sample, the lengths kept out (may be null or empty).
   double length_sigma_m = 0.0;
   const ReadingMask* length_excluded = nullptr;
+  // Where Rows leaves what it solved (FillsSolved), so that a prediction at the same
+  // parameters need not solve again (issue 41); nowhere by default. It may be `starts`
+  // itself: a sample's start is read before its own is written.
+  SolvedSamples solved;
 
   int size() const { return static_cast<int>(fit->size()); }
   // Rows per sample: the six tensions, twelve with the lengths.
@@ -291,6 +303,12 @@ struct FittedSamples {
   // model `at` was made for, with at least as many sessions as the data). The same
   // numbers as At(j, &at.model()).Evaluate(at.theta(), ...).
   bool Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const;
+  // Whether Rows fills `solved`: with somewhere to put it, on the path of exact statics
+  // without lengths (the readings of another path are not a prediction's).
+  bool FillsSolved() const {
+    return solved.reading_n != nullptr && solved.starts != nullptr && length_sigma_m <= 0.0 &&
+           statics.method == StaticsMethod::kExact;
+  }
   // The number of sessions a ModelAtTheta for these samples needs.
   int sessions() const;
   // Fitted sample j's readings kept out of the fit, and its lengths kept out.

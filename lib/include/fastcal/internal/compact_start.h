@@ -78,8 +78,8 @@ class CompactStarts {
   // `count` samples, every one without a start.
   void Reset(size_t count) { values_.assign(count * kNumCables * stride_, 0.0); }
   // Sample t's start from a solution of method() (none when it did not succeed).
-  void Set(size_t t, const StaticsSolution& s) {
-    const CompactStart c = CompactStart::Of(s);
+  void Set(size_t t, const StaticsSolution& s) { Set(t, CompactStart::Of(s)); }
+  void Set(size_t t, const CompactStart& c) {
     double* v = values_.data() + t * kNumCables * stride_;
     for (int i = 0; i < kNumCables; ++i) {
       for (int k = 0; k < stride_; ++k) v[i * stride_ + k] = c.v[i][k];

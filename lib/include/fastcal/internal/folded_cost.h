@@ -73,6 +73,10 @@ class FoldedTensionCost : public ceres::CostFunction {
   // The last evaluation's folded rows [R z] when it was at theta (no new evaluation);
   // false otherwise.
   bool FoldedAt(const double* theta, Eigen::MatrixXd* r_aug) const;
+  // Whether the last evaluation folded every fitted sample at theta and left what their
+  // statics solved in the samples' `solved` (FittedSamples::FillsSolved): the readings a
+  // prediction at theta would compute, without solving again.
+  bool SolvedAt(const double* theta) const;
   // Whether each reading's rows are folded on their own first (ReadingColumns).
   bool folds_by_reading() const { return !reading_columns_.empty(); }
 
