@@ -11,6 +11,7 @@
 #include <random>
 #include <vector>
 
+#include "fastcal/internal/calibration_linearisation.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/trajectory.h"
 
@@ -412,6 +413,28 @@ TEST(FoldedCostTest, LeavesWhatItSolvedForThePredictionAtTheSameTheta) {
   const FoldedTensionCost aas(samples, nullptr, 2);
   ASSERT_TRUE(aas.Evaluate(parameters, residuals.data(), nullptr));
   EXPECT_FALSE(aas.SolvedAt(theta.data()));
+}
+
+// The linearisation at a point folds each reading's rows over its own columns first
+// (issue 41): its R factor must still give R^T R = J^T J, the information it sums row by
+// row, with sensors per cable, a slow error and a reading kept out.
+TEST(FoldedCostTest, LinearisationRFactorIsTheInformation) {
+  Fixture f(kSampleChunk + 30, SensorSpec());
+  f.WithSlowError(kSampleChunk / 2);
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[0] += 0.1;
+  LinearisationInputs in;
+  in.samples = f.Samples();
+  in.theta = theta.data();
+  in.num_threads = 2;
+  Linearisation lin;
+  std::string error;
+  ASSERT_TRUE(Linearise(in, &lin, &error)) << error;
+  const Eigen::MatrixXd rtr = lin.r_factor.transpose() * lin.r_factor;
+  EXPECT_LE((rtr - lin.information).norm(), kRelTol * lin.information.norm());
+  for (int k = 0; k < lin.information.rows(); ++k) {
+    EXPECT_NEAR(rtr(k, k), lin.information(k, k), kRelTol * lin.information(k, k)) << k;
+  }
 }
 
 // A sample the statics cannot solve (a non-positive density) fails the evaluation, as one

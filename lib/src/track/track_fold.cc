@@ -19,6 +19,7 @@
 #include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/compact_start.h"
+#include "fastcal/internal/folded_cost.h"
 #include "fastcal/internal/row_fold.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/sample_rows.h"
@@ -358,6 +359,9 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
   fold->block_scores.resize(0, n);
   internal::SampleRowWhitener whitener(window, n + 1);
   const internal::ModelAtTheta model_at(*window.model, task.theta_si.data(), source.sessions);
+  // Each reading's rows over its own columns first where its sensor has some (issue 41:
+  // the full-width fold was a sixth of a track's time; folded_cost.h, ReadingColumns).
+  const std::vector<std::vector<int>> reading_columns = internal::ReadingColumns(window, nullptr);
   const int failed = internal::ReduceChunksInOrder<Part>(
       static_cast<int>(pieces.size()), task.threads, [] { return Part(); },
       [&](int k, int, Part* part) {
@@ -383,8 +387,16 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
       [&](int k, int, Part* part) {
         const Piece& piece = pieces[k];
         part->fold = internal::RowFold(n + 1);
-        part->fold.Add(part->rows.values.data(), kNumCables * (piece.end - piece.begin));
-        part->fold.Flush();
+        if (reading_columns.empty()) {
+          part->fold.Add(part->rows.values.data(), kNumCables * (piece.end - piece.begin));
+          part->fold.Flush();
+          return -1;
+        }
+        internal::GroupedRowFold grouped(reading_columns, n + 1);
+        for (int j = 0; j < piece.end - piece.begin; ++j) {
+          for (int i = 0; i < kNumCables; ++i) grouped.Add(i, part->rows.Row(j, i));
+        }
+        grouped.FlushInto(&part->fold);
         return -1;
       },
       [&](const Part& part) { sums.Add(pieces[part.piece], part.samples, part.fold); }, 1);
