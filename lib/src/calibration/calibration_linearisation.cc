@@ -141,11 +141,12 @@ void AddToFold(const std::array<bool, kNumCables>& excluded,
                const RowMatrix& j, const SampleResiduals& r_raw, const RowMatrix& j_raw,
                double weight, const Eigen::MatrixXd* information, FoldSums* fold) {
   ++fold->samples;
-  // The sample's weight^2 J^T J, when the caller has it (without a loss: weight 1).
+  // The sample's weight^2 J^T J in the lower triangle (SymmetricNormals fills the upper),
+  // when the caller has it (without a loss: weight 1).
   if (information != nullptr) {
     fold->information += *information;
   } else {
-    fold->information.noalias() += weight * weight * j.transpose() * j;
+    fold->information.selfadjointView<Eigen::Lower>().rankUpdate(j.transpose(), weight * weight);
   }
   fold->gradient.noalias() += weight * weight * j.transpose() * r;
   const int n = static_cast<int>(j.cols());
@@ -164,12 +165,15 @@ void AddToFold(const std::array<bool, kNumCables>& excluded,
   }
 }
 
-// Each block's per-cable normal matrices, accumulated in their lower triangles, made whole.
+// A matrix accumulated in its lower triangle, made whole.
+void Symmetric(Eigen::MatrixXd* m) { m->triangularView<Eigen::StrictlyUpper>() = m->transpose(); }
+
+// Each block's information and per-cable normal matrices, accumulated in their lower
+// triangles, made whole.
 void SymmetricNormals(std::vector<FoldSums>* folds) {
   for (FoldSums& f : *folds) {
-    for (Eigen::MatrixXd& m : f.normal_n2) {
-      m.triangularView<Eigen::StrictlyUpper>() = m.transpose();
-    }
+    Symmetric(&f.information);
+    for (Eigen::MatrixXd& m : f.normal_n2) Symmetric(&m);
   }
 }
 
@@ -196,8 +200,10 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
   const int n = in.samples.model->num_free();
   const int num_fit = in.samples.size();
   FreeSums* sums = &chunk->sums;
-  RowMatrix j, j_raw;
-  SampleResiduals r, r_raw;
+  // Workspaces kept across samples: no allocation per sample (issue 41).
+  RowMatrix j, j_raw, j_weighted;
+  SampleResiduals r, r_raw, r_weighted;
+  Eigen::RowVectorXd score(n);
   Eigen::MatrixXd jtj(n, n);
   for (int t = begin; t < end; ++t) {
     const std::array<bool, kNumCables> excluded = in.samples.Excluded(t);
@@ -205,10 +211,14 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
     RowsOf(chunk->raw, t, &r_raw, &j_raw);
     double curvature = 0.0;
     const double weight = LossWeight(in.loss, r, &curvature);
-    const RowMatrix jw = weight * j;
-    const Eigen::VectorXd rw = weight * r;
+    if (weight != 1.0) {
+      j_weighted = weight * j;
+      r_weighted = weight * r;
+    }
+    const RowMatrix& jw = weight != 1.0 ? j_weighted : j;
+    const SampleResiduals& rw = weight != 1.0 ? r_weighted : r;
     out->residuals.row(t) = r.transpose();
-    const Eigen::RowVectorXd score = rw.transpose() * jw;
+    score.noalias() = rw.transpose() * jw;
     out->scores.row(t) = score.cast<float>();
     if (candidate_row[t] >= 0) out->candidate_free_scores.row(candidate_row[t]) = score;
     if (in.keep_jacobians) {
@@ -216,7 +226,9 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
         out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
       }
     }
-    jtj.noalias() = jw.transpose() * jw;
+    // Lower triangles only (half the flops), made whole after the pass.
+    jtj.setZero();
+    jtj.selfadjointView<Eigen::Lower>().rankUpdate(jw.transpose());
     sums->information += jtj;
     if (!sums->session_information.empty()) {
       const int session = in.samples.data->samples[(*in.samples.fit)[t]].session;
@@ -375,6 +387,8 @@ bool LineariseFree(const LinearisationInputs& in, Linearisation* out, std::strin
     *error = CannotSolve(in, failed);
     return false;
   }
+  Symmetric(&total.information);
+  for (Eigen::MatrixXd& m : total.session_information) Symmetric(&m);
   out->information = std::move(total.information);
   out->loss_curvature = std::move(total.curvature);
   out->r_factor = total.fold.r();
