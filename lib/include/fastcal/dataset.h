@@ -196,6 +196,9 @@ class DatasetChunkReader {
   // *done: the file is finished and passed the whole-file checks (the chunk may still
   // hold samples). False, with the message ReadDataset would give, on an error.
   bool Next(size_t max_samples, Dataset* chunk, bool* done, std::string* error);
+  // As Next, but appends the samples and skipped rows to data->samples and data->skipped
+  // (ReadDataset: no copy of each chunk into the whole).
+  bool Append(size_t max_samples, Dataset* data, bool* done, std::string* error);
 
  private:
   struct State;
