@@ -1331,7 +1331,7 @@ bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dat
   }
   bool done = false;
   while (!done) {
-    // Appended in place: copying each chunk into the whole cost 7% of reading 10^6 rows.
+    // Appended in place: no copy of each chunk into the whole (a serial pass over it).
     if (!reader.Append(kChunkSamples, &all, &done, error)) return false;
   }
   // The layout (path, column flags, session labels) is the last chunk's: the whole file's.
