@@ -298,15 +298,15 @@ struct SampleView {
   const JointValues* joints;  // null: all at zero (a model without moving parts)
 };
 
-// A sample's residuals, and with `jacobian` their analytic Jacobian (exact statics only),
-// through assembled parameters: TensionResidual's operator() in double, and its
-// implicit-function derivatives.
 // What RowsThrough solved: the readings gain T + bias and the solution as a start.
 struct SolvedSample {
   std::array<double, kNumCables> reading_n;
   CompactStart start;
 };
 
+// A sample's residuals, and with `jacobian` their analytic Jacobian (exact statics only),
+// through assembled parameters: TensionResidual's operator() in double, and its
+// implicit-function derivatives; with `solved`, what the statics solved.
 bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
                  const StaticsOptions& statics, const SampleView& x, double* residuals,
                  double* jacobian, SolvedSample* solved = nullptr) {
