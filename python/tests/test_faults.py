@@ -78,11 +78,12 @@ def test_a_model_changed_by_another_thread_never_crashes_a_call() -> None:
     assert run.stdout.strip() == "torn 0"
 
 
-# Each remaining binding that takes a model and releases the GIL, raced on its own while
-# another thread swaps the model's attachments (the modes: its cabin mass): a copy taken with the GIL held makes the
-# call see one model or the other, never a crash nor a mix (a fix applied to a list of
-# bindings once missed the two added after it). The call's result with the model as it
-# was and as it became are both accepted; anything else is a mix.
+# Each binding that takes a model and releases the GIL, raced on its own while another
+# thread swaps the model's attachments (the modes: its cabin mass): a copy taken with the
+# GIL held makes the call see one model or the other, never a crash nor a mix (a fix
+# applied to a list of bindings once missed the two added after it; evaluate, simulate
+# and locate were raced above for crashes only, design not at all). The call's result
+# with the model as it was and as it became are both accepted; anything else is a mix.
 RACE_ONE = textwrap.dedent(
     """
     import os, sys, tempfile, threading, time
@@ -104,10 +105,22 @@ RACE_ONE = textwrap.dedent(
         p2 = fastcal.random_workspace(samples=150, seed=2)
         data, _, _ = fastcal.simulate(p2, quat=fastcal.focal_attitude(p2), seed=2)
     spec = os.path.join(data_dir, "spec_mass_centre.yaml")
+    s0 = fastcal.solve(p[:5], quat=q[:5]).s0_m
     work = tempfile.mkdtemp()
     runs = [0]
 
     def once(m):
+        if call == "solve":
+            return fastcal.solve(p, quat=q, model=m).lower_tension_kN
+        if call == "evaluate":
+            return repr(fastcal.evaluate(data, model=m))
+        if call == "simulate":
+            return fastcal.simulate(p[:20], quat=q[:20], model=m, seed=2)[0].tension_kN
+        if call == "locate":
+            return fastcal.locate(s0, model=m).position_m
+        if call == "design":
+            return repr(fastcal.design(spec, samples=6, model=m, max_off_axis_deg=20,
+                                       off_axis_step_deg=10, azimuth_step_deg=60)["design"])
         if call == "control_cycle":
             return fastcal.control_cycle(p, quat=q, model=m).winch_length_m
         if call == "modes":
@@ -131,6 +144,8 @@ RACE_ONE = textwrap.dedent(
         return np.asarray(once(m))
 
     expected = (expected_of(bare), expected_of(loaded))
+    # The two models must give different results, or a mix could not be seen.
+    assert not np.array_equal(*expected), "the swap changes nothing in " + call
     stop = False
 
     def writer():
@@ -152,7 +167,10 @@ RACE_ONE = textwrap.dedent(
 )
 
 
-@pytest.mark.parametrize("call", ["control_cycle", "modes", "calibrate", "track"])
+@pytest.mark.parametrize(
+    "call",
+    ["solve", "evaluate", "simulate", "locate", "design", "control_cycle", "modes", "calibrate",
+     "track"])
 def test_each_binding_sees_one_model_while_another_thread_changes_it(
         call: str, data_dir: pathlib.Path) -> None:
     run = subprocess.run(
