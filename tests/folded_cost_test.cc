@@ -417,7 +417,8 @@ TEST(FoldedCostTest, LeavesWhatItSolvedForThePredictionAtTheSameTheta) {
 
 // The linearisation at a point folds each reading's rows over its own columns first
 // (issue 41): its R factor must still give R^T R = J^T J, the information it sums row by
-// row, with sensors per cable, a slow error and a reading kept out.
+// row (in lower triangles, as its blocks and sessions), with sensors per cable, a slow
+// error over two sessions and a reading kept out.
 TEST(FoldedCostTest, LinearisationRFactorIsTheInformation) {
   Fixture f(kSampleChunk + 30, SensorSpec());
   f.WithSlowError(kSampleChunk / 2);
@@ -435,6 +436,15 @@ TEST(FoldedCostTest, LinearisationRFactorIsTheInformation) {
   for (int k = 0; k < lin.information.rows(); ++k) {
     EXPECT_NEAR(rtr(k, k), lin.information(k, k), kRelTol * lin.information(k, k)) << k;
   }
+  // The blocks' and the two sessions' information, summed in lower triangles and made
+  // whole, add up to the whole (every entry, both triangles).
+  const double scale = lin.information.norm();
+  Eigen::MatrixXd blocks = Eigen::MatrixXd::Zero(lin.information.rows(), lin.information.cols());
+  for (const FoldSums& b : lin.folds) blocks += b.information;
+  EXPECT_LE((blocks - lin.information).cwiseAbs().maxCoeff(), kRelTol * scale);
+  ASSERT_EQ(lin.session_information.size(), 2u);
+  const Eigen::MatrixXd sessions = lin.session_information[0] + lin.session_information[1];
+  EXPECT_LE((sessions - lin.information).cwiseAbs().maxCoeff(), kRelTol * scale);
 }
 
 // A sample the statics cannot solve (a non-positive density) fails the evaluation, as one
