@@ -425,40 +425,55 @@ TEST(CalibrationTest, WorstReadingsAreTheLargestResiduals) {
   }
 }
 
-// The RMS table's initial-model row is the input model's own evaluation, whether the fit's
-// first prediction stands in for it (exact statics, no spec value in place of the
-// model's: issue 41) or not (an initial value in the spec: the fit starts elsewhere), with
-// held-out samples and a reading kept out as a gross error.
+// The RMS table's initial-model rows are the input model's own evaluation, whether the
+// fit's first prediction stands in for one (exact statics, no spec value in place of the
+// model's: issue 41) or not (an initial value in the spec: the fit starts elsewhere), at
+// the measured and at the planned attitude (0.3 deg apart), fitting either, with held-out
+// samples and a reading kept out as a gross error.
 TEST(CalibrationTest, InitialModelRowIsTheInputModelsEvaluation) {
   constexpr double kRelTol = 1e-9;  // warm and cold statics, to the solver's tolerance
   Dataset data = CircleData(Truth(), 240, 0.03, 43);
-  data.samples[17].tension_n[2] *= 3.0;  // a gross error, left out of both rows
+  data.samples[17].tension_n[2] *= 3.0;  // a gross error, left out of every row
+  data.has_planned_attitude = true;
+  const Eigen::Matrix3d off = RotationFromRpyDeg(0.3, -0.2, 0.1);
+  for (Sample& s : data.samples) {
+    s.has_planned_attitude = true;
+    s.planned_rotation = s.pose.rotation * off;
+  }
   for (bool initial_value : {false, true}) {
-    CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
-    spec.holdout_fraction = 0.25;
-    if (initial_value) {
-      spec.parameters[2].has_initial = true;
-      spec.parameters[2].initial_si = 0.3;  // mass_centre_m.z: not the nominal model's
-    }
-    CalibrationResult result;
-    ASSERT_TRUE(CalibrateNominal(spec, data, &result));
-    ASSERT_EQ(result.excluded.size(), data.samples.size());
-    ASSERT_TRUE(result.excluded[17][2]);
-    VariantEvaluation plain;
-    std::string error;
-    ASSERT_TRUE(EvaluateVariant("plain", CableRobot::NominalFast(), data, AttitudeSource::kMeasured,
-                                StaticsMethod::kExact, result.held_out, &plain, &error,
-                                result.excluded))
-        << error;
-    const VariantEvaluation& initial = result.variants.front();
-    ASSERT_EQ(initial.name, "initial model, measured attitude");
-    for (int i = 0; i < kNumCables; ++i) {
-      EXPECT_NEAR(initial.fit.rms_n[i], plain.fit.rms_n[i], kRelTol * plain.fit.rms_n[i])
-          << "initial value " << initial_value << " cable " << i;
-      EXPECT_NEAR(initial.holdout.rms_n[i], plain.holdout.rms_n[i],
-                  kRelTol * plain.holdout.rms_n[i])
-          << "initial value " << initial_value << " cable " << i;
-      EXPECT_EQ(initial.fit.excluded[i], plain.fit.excluded[i]);
+    for (bool planned : {false, true}) {
+      CalibrationSpec spec = MassCentreAndDensitySpec(StaticsMethod::kExact);
+      spec.holdout_fraction = 0.25;
+      spec.use_planned_attitude = planned;
+      if (initial_value) {
+        spec.parameters[2].has_initial = true;
+        spec.parameters[2].initial_si = 0.3;  // mass_centre_m.z: not the nominal model's
+      }
+      CalibrationResult result;
+      ASSERT_TRUE(CalibrateNominal(spec, data, &result));
+      ASSERT_TRUE(result.excluded[17][2]);
+      ASSERT_EQ(result.variants.size(), 3u);
+      for (AttitudeSource attitude : {AttitudeSource::kPlanned, AttitudeSource::kMeasured}) {
+        const bool is_planned = attitude == AttitudeSource::kPlanned;
+        const VariantEvaluation& initial = result.variants[is_planned ? 0 : 1];
+        ASSERT_EQ(initial.name, std::string("initial model, ") +
+                                    (is_planned ? "planned" : "measured") + " attitude");
+        VariantEvaluation plain;
+        std::string error;
+        ASSERT_TRUE(EvaluateVariant("plain", CableRobot::NominalFast(), data, attitude,
+                                    StaticsMethod::kExact, result.held_out, &plain, &error,
+                                    result.excluded))
+            << error;
+        for (int i = 0; i < kNumCables; ++i) {
+          EXPECT_NEAR(initial.fit.rms_n[i], plain.fit.rms_n[i], kRelTol * plain.fit.rms_n[i])
+              << initial.name << ", initial value " << initial_value << ", fit planned " << planned
+              << ", cable " << i;
+          EXPECT_NEAR(initial.holdout.rms_n[i], plain.holdout.rms_n[i],
+                      kRelTol * plain.holdout.rms_n[i])
+              << initial.name << ", initial value " << initial_value << ", cable " << i;
+          EXPECT_EQ(initial.fit.excluded[i], plain.fit.excluded[i]);
+        }
+      }
     }
   }
 }
