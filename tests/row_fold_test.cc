@@ -7,23 +7,12 @@
 
 #include <Eigen/QR>
 #include <algorithm>
-#include <random>
 #include <vector>
+
+#include "random_rows.h"
 
 namespace fastcal::internal {
 namespace {
-
-using RowMajor = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
-
-RowMajor RandomRows(int rows, int cols, std::uint64_t seed) {
-  std::mt19937_64 rng(seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  RowMajor a(rows, cols);
-  for (int i = 0; i < rows; ++i) {
-    for (int j = 0; j < cols; ++j) a(i, j) = normal(rng) * (1.0 + j);  // columns of unlike size
-  }
-  return a;
-}
 
 // The rows of `a` added in pieces of the given sizes, cycling.
 RowFold Folded(const RowMajor& a, const std::vector<int>& pieces) {

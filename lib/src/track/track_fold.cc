@@ -1,5 +1,7 @@
 // The fold of one window (track_fold.h): predict at the point, whiten and screen, then
-// the whitened rows folded by QR (row_fold.h), block by block, in time order.
+// the whitened rows [J z] summed into their Gram matrix G = [J z]^T [J z] (gram_fold.h),
+// block by block, in time order: a window gives only G's parts (the information J^T J,
+// the gradient J^T z, chi-square z^T z, each block's score and information rows).
 //
 // Streamed (issue 27): the window's samples are read twice, a piece of at most 1024 at a
 // time, from the window store (or from memory): the first pass keeps per sample only
@@ -20,7 +22,7 @@
 #include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/compact_start.h"
 #include "fastcal/internal/folded_cost.h"
-#include "fastcal/internal/row_fold.h"
+#include "fastcal/internal/gram_fold.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/sample_rows.h"
 #include "fastcal/internal/slow_error_filter.h"
@@ -278,16 +280,16 @@ struct PieceSamples {
 };
 
 // The second pass's sums over the pieces in time order: per cable the squared misfits, the
-// named gross errors' file, line and measured value, and each block's rows folded.
+// named gross errors' file, line and measured value, and each block's rows summed.
 struct BlockSums {
   const WindowPrediction& at;
   const std::vector<int>& block_columns;
   const std::vector<int>& named;  // the sample of each of fold->gross_errors
   int n = 0;
-  internal::RowFold block, total;
+  internal::GramFold block, total;
   WindowFold* fold;
 
-  void Add(const Piece& piece, const PieceSamples& p, const internal::RowFold& rows) {
+  void Add(const Piece& piece, const PieceSamples& p, internal::GramFold& rows) {
     const std::vector<Sample>& in = p.data.samples;
     for (int t = piece.begin; t < piece.end; ++t) {
       const Sample& s = in[t - piece.begin];
@@ -316,23 +318,20 @@ struct BlockSums {
     if (piece.last_of_block) CloseBlock();
   }
 
-  // The block's score and its information rows of the block columns, its rows into the
-  // window's.
+  // The block's score J_b^T z_b and its information rows of the block columns, its sums
+  // into the window's.
   void CloseBlock() {
-    const Eigen::MatrixXd r = block.r();
-    const Eigen::MatrixXd rj = r.leftCols(n);
-    const Eigen::VectorXd zj = r.col(n);
-    const Eigen::VectorXd score = rj.transpose() * zj;
+    block.Flush();
+    const Eigen::MatrixXd g = block.Gram();
     fold->block_scores.conservativeResize(fold->block_scores.rows() + 1, n);
-    fold->block_scores.row(fold->block_scores.rows() - 1) = score.transpose();
-    const Eigen::MatrixXd info = rj.transpose() * rj;
+    fold->block_scores.row(fold->block_scores.rows() - 1) = g.col(n).head(n).transpose();
     Eigen::MatrixXd rows_of_window(block_columns.size(), n);
     for (size_t k = 0; k < block_columns.size(); ++k) {
-      rows_of_window.row(k) = info.row(block_columns[k]);
+      rows_of_window.row(k) = g.row(block_columns[k]).head(n);
     }
     fold->block_information.push_back(rows_of_window);
     total.Add(block);
-    block = internal::RowFold(n + 1);
+    block.Reset();
   }
 };
 
@@ -351,16 +350,16 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
     int piece = 0;
     PieceSamples samples;
     internal::SampleRows rows;
-    internal::RowFold fold;
+    internal::GramFold fold;
   };
   std::vector<int> failed_sample(pieces.size(), -1);
-  BlockSums sums{at,  block_columns, named, n, internal::RowFold(n + 1), internal::RowFold(n + 1),
+  BlockSums sums{at,  block_columns, named, n, internal::GramFold(n + 1), internal::GramFold(n + 1),
                  fold};
   fold->block_scores.resize(0, n);
   internal::SampleRowWhitener whitener(window, n + 1);
   const internal::ModelAtTheta model_at(*window.model, task.theta_si.data(), source.sessions);
   // Each reading's rows over its own columns first where its sensor has some (issue 41:
-  // the full-width fold was a sixth of a track's time; folded_cost.h, ReadingColumns).
+  // the full-width QR fold was a sixth of a track's time; folded_cost.h, ReadingColumns).
   const std::vector<std::vector<int>> reading_columns = internal::ReadingColumns(window, nullptr);
   const int failed = internal::ReduceChunksInOrder<Part>(
       static_cast<int>(pieces.size()), task.threads, [] { return Part(); },
@@ -386,26 +385,29 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
       [&](int, int, Part* part) { whitener.Whiten(part->samples.fitted, &part->rows); },
       [&](int k, int, Part* part) {
         const Piece& piece = pieces[k];
-        part->fold = internal::RowFold(n + 1);
+        part->fold = internal::GramFold(n + 1);
+        const int m = piece.end - piece.begin;
         if (reading_columns.empty()) {
-          part->fold.Add(part->rows.values.data(), kNumCables * (piece.end - piece.begin));
+          for (int j = 0; j < m; ++j) {
+            for (int i = 0; i < kNumCables; ++i) part->fold.Add(part->rows.Row(j, i));
+          }
           part->fold.Flush();
           return -1;
         }
-        internal::GroupedRowFold grouped(reading_columns, n + 1);
-        for (int j = 0; j < piece.end - piece.begin; ++j) {
+        internal::GroupedGramFold grouped(reading_columns);
+        for (int j = 0; j < m; ++j) {
           for (int i = 0; i < kNumCables; ++i) grouped.Add(i, part->rows.Row(j, i));
         }
         grouped.FlushInto(&part->fold);
         return -1;
       },
-      [&](const Part& part) { sums.Add(pieces[part.piece], part.samples, part.fold); }, 1);
+      [&](Part& part) { sums.Add(pieces[part.piece], part.samples, part.fold); }, 1);
   if (failed >= 0) return failed_sample[failed];
-  const Eigen::MatrixXd total = sums.total.r();
-  const Eigen::MatrixXd r = total.leftCols(n);
-  fold->information = r.transpose() * r;
-  fold->gradient = r.transpose() * total.col(n);
-  fold->chi_square = total.col(n).squaredNorm();
+  sums.total.Flush();
+  const Eigen::MatrixXd g = sums.total.Gram();
+  fold->information = g.topLeftCorner(n, n);
+  fold->gradient = g.col(n).head(n);
+  fold->chi_square = g(n, n);
   return -1;
 }
 
