@@ -415,6 +415,50 @@ TEST(FoldedCostTest, LeavesWhatItSolvedForThePredictionAtTheSameTheta) {
   EXPECT_FALSE(aas.SolvedAt(theta.data()));
 }
 
+// A window's second pass (track_fold.cc) evaluates its rows where its first pass solved:
+// from those solutions taken as solved (FittedSamples::starts_solved), the readings are the
+// first pass's bit for bit and the rows those of a solve from the same starts to the
+// solver's tolerance; a sample without a start is solved.
+TEST(FoldedCostTest, RowsTakeASolvedStartAsTheSolution) {
+  constexpr double kRowRelTol = 1e-9;  // the solves' 1e-12, through the derivatives
+  Fixture f(40, SensorSpec());
+  const int n = f.model.num_free();
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[0] += 0.1;
+  theta[5] = 1.01;  // sensor_gain[2]
+  const ModelAtTheta at(f.model, theta.data(), 1);
+  std::vector<std::array<double, kNumCables>> reading_n(f.data.samples.size());
+  CompactStarts starts;
+  starts.Reset(f.data.samples.size());
+  FittedSamples first = f.Samples();
+  first.solved = {&reading_n, &starts};
+  std::array<double, kNumCables> r{};
+  for (int j = 0; j < first.size(); ++j) ASSERT_TRUE(first.Rows(j, at, r.data(), nullptr)) << j;
+  CompactStarts some = starts;
+  some.Set(3, StaticsSolution());  // no start: solved
+  FittedSamples taken = f.Samples(), solved = f.Samples();
+  taken.starts = solved.starts = &some;
+  taken.starts_solved = true;
+  std::vector<double> jt(kNumCables * n), js(kNumCables * n);
+  std::array<double, kNumCables> rt{}, rs{};
+  for (int j = 0; j < taken.size(); ++j) {
+    ASSERT_TRUE(taken.Rows(j, at, rt.data(), jt.data())) << j;
+    ASSERT_TRUE(solved.Rows(j, at, rs.data(), js.data())) << j;
+    const Sample& sample = f.data.samples[j];
+    for (int i = 0; i < kNumCables; ++i) {
+      if (f.excluded[j][i]) continue;
+      if (j != 3) {
+        EXPECT_EQ(rt[i], (reading_n[j][i] - sample.tension_n[i]) / f.sigma_n[j][i]) << j << i;
+      }
+      EXPECT_NEAR(rt[i], rs[i], kRowRelTol * std::abs(reading_n[j][i] / f.sigma_n[j][i]));
+    }
+    const double scale = Eigen::Map<Eigen::VectorXd>(js.data(), js.size()).cwiseAbs().maxCoeff();
+    for (size_t k = 0; k < jt.size(); ++k) {
+      ASSERT_NEAR(jt[k], js[k], kRowRelTol * scale) << j << " " << k;
+    }
+  }
+}
+
 // The linearisation at a point folds each reading's rows over its own columns first
 // (issue 41): its R factor must still give R^T R = J^T J, the information it sums row by
 // row (in lower triangles, as its blocks and sessions), with sensors per cable, a slow

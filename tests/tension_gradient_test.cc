@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/internal/compact_start.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
 #include "test_robots.h"
@@ -150,6 +151,34 @@ TEST(TensionGradientTest, MovingThePoseIsMovingEveryTowerTheOtherWay) {
       for (int i = 0; i < kNumCables; ++i) {
         EXPECT_NEAR(-towers[i], numeric[i], kRelTol * scale) << "axis " << c << " cable " << i + 1;
       }
+    }
+  }
+}
+
+TEST(TensionGradientTest, FromTheStateAloneTheSameTensionsAndColumns) {
+  // A solution's state (Fl, Fz, s0), all a CompactStart keeps: the tensions evaluated
+  // there are the solver's own, bit for bit (its last check's end evaluation), on uniform
+  // cables and on cables with attachments; the columns are the solution's.
+  for (const CableRobot& robot : {CableRobot::NominalFast(), AsBuiltRobot()}) {
+    const StaticsParameters<double> p = MakeStaticsParameters(robot);
+    const StaticsOptions options = ModelFitStaticsOptions(StaticsMethod::kExact);
+    for (const Pose& pose : TiltedPoses(3, 31, 3.0)) {
+      StaticsSolution solved;
+      ASSERT_EQ(SolveStaticsWithParameters(p, pose, options, &solved), StaticsStatus::kOk);
+      StaticsSolution state;
+      internal::CompactStart::Of(solved).Restore(pose, StaticsMethod::kExact, &state);
+      TensionGradient from_solution, from_state;
+      const double fraction = options.catenary.vertical_span_fraction;
+      ASSERT_EQ(internal::ExactTensionGradient(p, pose, solved, fraction, true, &from_solution),
+                StaticsStatus::kOk);
+      ASSERT_EQ(internal::ExactTensionGradient(p, pose, state, fraction, true, &from_state,
+                                               /*tensions_from_state=*/true),
+                StaticsStatus::kOk);
+      for (int i = 0; i < kNumCables; ++i) {
+        EXPECT_EQ(from_state.tension_n[i], solved.cables[i].lower_tension_n) << i;
+      }
+      EXPECT_EQ(from_state.mass_centre_cabin_m, from_solution.mass_centre_cabin_m);
+      EXPECT_EQ(from_state.linear_density_kg_per_m[0], from_solution.linear_density_kg_per_m[0]);
     }
   }
 }

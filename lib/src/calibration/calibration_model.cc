@@ -296,6 +296,8 @@ struct SampleView {
   const std::array<bool, kNumCables>* excluded;  // null: none
   int session;
   const JointValues* joints;  // null: all at zero (a model without moving parts)
+  // `start` is the solution of these statics (FittedSamples::starts_solved).
+  bool start_solved = false;
 };
 
 // What RowsThrough solved: the readings gain T + bias and the solution as a start.
@@ -323,7 +325,20 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
   x.start.Restore(x.pose, statics.method, &solution);
   StaticsOptions options = statics;
   options.warm_start = true;
-  if (SolveStaticsWithParameters(params, x.pose, options, &solution) != StaticsStatus::kOk) {
+  // A start that is these statics' solution is not solved again (issue 41: from a
+  // converged start the solve still costs half a cold one): its tensions come with the
+  // gradient, from the end evaluation the solver's last check made there.
+  const bool as_solved = x.start_solved && jacobian != nullptr &&
+                         statics.method == StaticsMethod::kExact && x.start.has_start();
+  TensionGradient gradient;
+  if (as_solved) {
+    if (ExactTensionGradient(params, x.pose, solution, options.catenary.vertical_span_fraction,
+                             model.frees_geometry(), &gradient,
+                             /*tensions_from_state=*/true) != StaticsStatus::kOk) {
+      return false;
+    }
+    for (int i = 0; i < kNumCables; ++i) solution.cables[i].lower_tension_n = gradient.tension_n[i];
+  } else if (SolveStaticsWithParameters(params, x.pose, options, &solution) != StaticsStatus::kOk) {
     return false;
   }
   for (int i = 0; i < kNumCables; ++i) {
@@ -334,8 +349,8 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
   }
   if (solved != nullptr) solved->start = CompactStart::Of(solution);
   if (jacobian == nullptr) return true;
-  TensionGradient gradient;
-  if (ExactTensionGradient(params, x.pose, solution, options.catenary.vertical_span_fraction,
+  if (!as_solved &&
+      ExactTensionGradient(params, x.pose, solution, options.catenary.vertical_span_fraction,
                            model.frees_geometry(), &gradient) != StaticsStatus::kOk) {
     return false;
   }
@@ -361,8 +376,8 @@ bool TensionResidual::Evaluate(const double* theta, double* residuals, double* j
   model->Assemble(theta, &m.statics, &m.gain, &m.bias, session);
   m.gains_positive = std::all_of(m.gain.begin(), m.gain.end(), [](double g) { return g > 0.0; });
   return RowsThrough(*model, m, statics,
-                     {pose, start, measured_n, sigma_n, &excluded, session, &joints}, residuals,
-                     jacobian);
+                     {pose, start, measured_n, sigma_n, &excluded, session, &joints, false},
+                     residuals, jacobian);
 }
 
 bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, double* jacobian) const {
@@ -377,7 +392,8 @@ bool FittedSamples::Rows(int j, const ModelAtTheta& at, double* residuals, doubl
                (*sigma_n)[j],
                excluded != nullptr && !excluded->empty() ? &(*excluded)[t] : nullptr,
                sample.session,
-               &sample.joint};
+               &sample.joint,
+               starts_solved};
   if (use_planned_attitude) x.pose.rotation = sample.planned_rotation;
   if (!FillsSolved()) {
     return RowsThrough(at.model(), at.session(sample.session), statics, x, residuals, jacobian);

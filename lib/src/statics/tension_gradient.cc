@@ -120,7 +120,8 @@ void GeometryColumns(const PoseGeometry<double>& g, const Matrix6d& k, int i, co
 
 StaticsStatus ExactTensionGradient(const StaticsParameters<double>& p, const Pose& pose,
                                    const StaticsSolution& solution, double vertical_span_fraction,
-                                   bool geometry, TensionGradient* gradient) {
+                                   bool geometry, TensionGradient* gradient,
+                                   bool tensions_from_state) {
   TensionGradient& out = *gradient;
   PoseGeometry<double> g;
   int cable = -1;
@@ -145,7 +146,14 @@ StaticsStatus ExactTensionGradient(const StaticsParameters<double>& p, const Pos
     c.a = -(n0 * e.dspan[0] + n1 * e.drise[0]) * inv_qq;
     c.nu0 = -n0 * inv_qq;
     c.nu1 = -n1 * inv_qq;
-    const double t = s.lower_tension_n;
+    // From the state alone: the solver's own end evaluation (EvaluateEnds' CableEndpoint,
+    // which a uniform cable's end above is; a chain's is evaluated again in double).
+    double t = s.lower_tension_n;
+    if (tensions_from_state) {
+      t = p.chain[i].empty()
+              ? e.lower_tension_n
+              : CableEndpoint(p, i, c.fl, c.fz, s.unstretched_length_m, g.w[i]).lower_tension_n;
+    }
     out.tension_n[i] = t;
     d1[i] = (c.fl + c.a * c.fz) / t;
     const Vector3T<double>& r = g.r[i];

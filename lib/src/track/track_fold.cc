@@ -272,7 +272,9 @@ struct PieceSamples {
     fitted.data = &data;
     fitted.fit = &fit;
     fitted.sigma_n = &sigma_n;
+    // The first pass's solutions at the same point: the rows need not solve again.
     fitted.starts = &starts;
+    fitted.starts_solved = true;
     fitted.excluded = &excluded;
     fitted.slow_rho = rho.empty() ? nullptr : &rho;
     return true;

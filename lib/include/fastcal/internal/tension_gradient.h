@@ -64,9 +64,14 @@ struct TensionGradient {
 // and anchor columns only with `geometry` (36 of the ~100 columns, a fifth of the cost).
 // Returns kSingular where the equilibrium system cannot be factored (it was solved, so
 // only at a pose the solver itself barely held), kVerticalCable as ComputeGeometry.
+// With `tensions_from_state`, only each cable's state (Fl, Fz, s0) is read from
+// `solution` (CompactStart::Restore's): gradient->tension_n are the lower end tensions
+// evaluated there, by the end evaluation the solver's last check makes (so the same
+// numbers as its solution's, for a state it converged to).
 StaticsStatus ExactTensionGradient(const StaticsParameters<double>& p, const Pose& pose,
                                    const StaticsSolution& solution, double vertical_span_fraction,
-                                   bool geometry, TensionGradient* gradient);
+                                   bool geometry, TensionGradient* gradient,
+                                   bool tensions_from_state = false);
 
 }  // namespace fastcal::internal
 
