@@ -459,6 +459,56 @@ TEST(FoldedCostTest, RowsTakeASolvedStartAsTheSolution) {
   }
 }
 
+// The calibration's prediction marks its starts as solved at its theta (compact_start.h):
+// a fold there takes them as solved (the readings it leaves are the prediction's bit for
+// bit, its R the same to rounding) and keeps the mark; a fold anywhere else forgets it.
+TEST(FoldedCostTest, AFoldWhereTheStartsWereSolvedTakesThemAsSolved) {
+  Fixture f(kSampleChunk + 30, SensorSpec());
+  std::vector<double> theta = f.model.InitialTheta();
+  theta[0] += 0.1;
+  theta[5] = 1.01;  // sensor_gain[2]
+  const int n = f.model.num_free();
+  std::vector<std::array<double, kNumCables>> predicted(f.data.samples.size());
+  CompactStarts starts;
+  starts.Reset(f.data.samples.size());
+  FittedSamples samples = f.Samples();
+  samples.starts = &starts;
+  samples.solved = {&predicted, &starts};
+  std::vector<double> residuals(n + 1), jacobian((n + 1) * n);
+  double* jacobians[1] = {jacobian.data()};
+  const double* at_theta[1] = {theta.data()};
+  {  // the prediction's pass (Predict solves every sample at theta the same way)
+    const FoldedTensionCost first(samples, nullptr, 2);
+    ASSERT_TRUE(first.Evaluate(at_theta, residuals.data(), nullptr));
+  }
+  starts.MarkSolvedAt(theta.data(), n);
+  std::vector<std::array<double, kNumCables>> reading_n(f.data.samples.size());
+  samples.solved = {&reading_n, &starts};
+  CompactStarts unmarked = starts;
+  unmarked.ForgetSolved();
+  FittedSamples solving = f.Samples();
+  solving.starts = &unmarked;
+  const FoldedTensionCost taking(samples, nullptr, 2), solving_cost(solving, nullptr, 2);
+  ASSERT_TRUE(taking.Evaluate(at_theta, residuals.data(), jacobians));
+  EXPECT_TRUE(starts.SolvedAt(theta.data(), n));
+  for (size_t t = 0; t < reading_n.size(); ++t) {
+    for (int i = 0; i < kNumCables; ++i) ASSERT_EQ(reading_n[t][i], predicted[t][i]) << t << i;
+  }
+  Eigen::MatrixXd r_taking, r_solving;
+  ASSERT_TRUE(taking.FoldedAt(theta.data(), &r_taking));
+  ASSERT_TRUE(solving_cost.Evaluate(at_theta, residuals.data(), jacobians));
+  ASSERT_TRUE(solving_cost.FoldedAt(theta.data(), &r_solving));
+  const Eigen::MatrixXd normal_taking = r_taking.transpose() * r_taking;
+  const Eigen::MatrixXd normal_solving = r_solving.transpose() * r_solving;
+  EXPECT_LT((normal_taking - normal_solving).norm(), kRelTol * normal_solving.norm());
+  std::vector<double> other = theta;
+  other[1] += 0.01;
+  const double* elsewhere[1] = {other.data()};
+  ASSERT_TRUE(taking.Evaluate(elsewhere, residuals.data(), jacobians));
+  EXPECT_FALSE(starts.SolvedAt(theta.data(), n));
+  EXPECT_FALSE(starts.SolvedAt(other.data(), n));
+}
+
 // The linearisation at a point folds each reading's rows over its own columns first
 // (issue 41): its R factor must still give R^T R = J^T J, the information it sums row by
 // row (in lower triangles, as its blocks and sessions), with sensors per cable, a slow

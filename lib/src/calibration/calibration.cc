@@ -352,12 +352,16 @@ CalibrationStatus Predict(Run& run) {
         return -1;
       });
   if (failed >= 0) {
+    at.starts.ForgetSolved();
     StaticsSolution solution;  // the first failure again, for its message
     solve(failed, &solution);
     return run.Fail(CalibrationStatus::kInfeasible,
                     SampleWhere(run.data, run.data.samples[failed]) +
                         ": the model cannot solve this pose: " + DescribeStatus(solution));
   }
+  // Every sample's start is now its solution at theta (the fitted ones the fold's, when
+  // `solved`): the next pass at theta need not solve them again.
+  at.starts.MarkSolvedAt(run.theta.data(), run.n);
   return CalibrationStatus::kOk;
 }
 

@@ -498,7 +498,13 @@ bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* e
   out->candidate_rows = in.samples.whitened()
                             ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
                             : CandidateSamples(in.samples.size(), in.max_candidate_samples);
-  return LineariseFree(in, out, error) && LineariseCandidates(in, out, error);
+  // At the prediction's theta the free pass takes its starts as solved (compact_start.h);
+  // the candidates' pass goes through another model and solves.
+  LinearisationInputs free = in;
+  const FittedSamples& s = in.samples;
+  free.samples.starts_solved =
+      s.starts != nullptr && s.starts->SolvedAt(in.theta, s.model->num_free());
+  return LineariseFree(free, out, error) && LineariseCandidates(in, out, error);
 }
 
 bool ReplayFreeJacobians(const LinearisationInputs& in,

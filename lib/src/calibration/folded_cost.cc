@@ -97,9 +97,16 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
   const int n = n_;
   const int m = samples_.readings();
   const ModelAtTheta at(*samples_.model, theta, samples_.sessions());
+  // Starts solved at this very theta (the prediction's, compact_start.h) are taken as
+  // solved; a fold anywhere else makes whatever it writes them into no longer so.
+  FittedSamples samples = samples_;
+  samples.starts_solved = samples_.starts != nullptr && samples_.starts->SolvedAt(theta, n);
+  if (samples_.solved.starts != nullptr && !samples_.solved.starts->SolvedAt(theta, n)) {
+    samples_.solved.starts->ForgetSolved();
+  }
   RowFold total(n + 1);
   *rho_sum = 0.0;
-  SampleRowWhitener whitener(samples_, n + 1);
+  SampleRowWhitener whitener(samples, n + 1);
   const int failed = ReduceChunksInOrder<Part>(
       samples_.size(), threads_,
       [n] {
@@ -108,7 +115,7 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
       [&](int begin, int end, Part* part) {
         part->rows.Reset(begin, end, n + 1, m);
         for (int t = begin; t < end; ++t) {
-          if (!EvaluateSampleRows(samples_, t, at, t, &part->rows)) return t;
+          if (!EvaluateSampleRows(samples, t, at, t, &part->rows)) return t;
         }
         return -1;
       },
