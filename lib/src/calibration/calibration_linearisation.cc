@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "fastcal/internal/folded_cost.h"
+#include "fastcal/internal/gram_fold.h"
 #include "fastcal/internal/row_fold.h"
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/sample_rows.h"
@@ -133,37 +134,65 @@ struct FreeSums {
   }
 };
 
-// The cross-validation block sums of one sample: the whitened rows r, j for the
-// prediction, the rows as evaluated (r_raw, j_raw: before the slow-error whitening; the
-// same without it) in newtons for the RMS.
+// The cross-validation block sums of one sample that are not Gram matrices (those are
+// summed over a run of samples, RunSums): the whitened rows r, j for the prediction, the
+// rows as evaluated (r_raw: before the slow-error whitening; the same without it) in
+// newtons for the RMS.
 void AddToFold(const std::array<bool, kNumCables>& excluded,
                const std::array<double, kNumCables>& sigma_n, const SampleResiduals& r,
                const RowMatrix& j, const SampleResiduals& r_raw, const RowMatrix& j_raw,
-               double weight, const Eigen::MatrixXd* information, FoldSums* fold) {
+               double weight, FoldSums* fold) {
   ++fold->samples;
-  // The sample's weight^2 J^T J in the lower triangle (SymmetricNormals fills the upper),
-  // when the caller has it (without a loss: weight 1).
-  if (information != nullptr) {
-    fold->information += *information;
-  } else {
-    fold->information.selfadjointView<Eigen::Lower>().rankUpdate(j.transpose(), weight * weight);
-  }
   fold->gradient.noalias() += weight * weight * j.transpose() * r;
-  const int n = static_cast<int>(j.cols());
-  thread_local Eigen::VectorXd ji;  // a reading's row in N: no allocation per reading
-  ji.resize(n);
   for (int i = 0; i < kNumCables; ++i) {
     if (excluded[i]) continue;
     const double s = sigma_n[i];
-    ji.noalias() = s * j_raw.row(i).transpose();  // N per parameter unit
-    const double ri = s * r_raw[i];               // N
+    const double ri = s * r_raw[i];  // N
     ++fold->readings[i];
     fold->sse_n2[i] += ri * ri;
-    fold->cross_n2[i] += ri * ji;
-    // Its lower triangle only (the upper is filled once, SymmetricNormals).
-    fold->normal_n2[i].selfadjointView<Eigen::Lower>().rankUpdate(ji);
+    fold->cross_n2[i].noalias() += ri * (s * j_raw.row(i).transpose());  // N^2 per unit
   }
 }
+
+// The Gram matrices of a run of consecutive samples in one cross-validation block and one
+// session, summed a batch of rows at a time (gram_fold.h: a sample's rank-6 update and
+// its six rank-1 updates were as costly as its statics, issue 41), then added into the
+// total's, the session's and the block's lower triangles.
+struct RunSums {
+  GramFold information;                     // the weighted whitened rows
+  std::array<GramFold, kNumCables> normal;  // sigma_i times each raw row i (N per unit)
+  int block = -1, session = -1;
+
+  explicit RunSums(int n) : information(n) {
+    for (GramFold& g : normal) g = GramFold(n);
+  }
+  void Add(const RowMatrix& jw, const std::array<bool, kNumCables>& excluded,
+           const std::array<double, kNumCables>& sigma_n, const RowMatrix& j_raw) {
+    for (int i = 0; i < jw.rows(); ++i) information.Add(jw.row(i).data());
+    thread_local Eigen::RowVectorXd ji;  // no allocation per reading
+    for (int i = 0; i < kNumCables; ++i) {
+      if (excluded[i]) continue;
+      ji.noalias() = sigma_n[i] * j_raw.row(i);
+      normal[i].Add(ji.data());
+    }
+  }
+  void FlushInto(FreeSums* sums) {
+    if (block < 0) return;
+    information.Flush();
+    const Eigen::MatrixXd& lower = information.lower();
+    sums->information += lower;
+    if (!sums->session_information.empty()) sums->session_information[session] += lower;
+    FoldSums& fold = sums->folds[block];
+    fold.information += lower;
+    for (int i = 0; i < kNumCables; ++i) {
+      normal[i].Flush();
+      fold.normal_n2[i] += normal[i].lower();
+      normal[i].Reset();
+    }
+    information.Reset();
+    block = session = -1;
+  }
+};
 
 // A matrix accumulated in its lower triangle, made whole.
 void Symmetric(Eigen::MatrixXd* m) { m->triangularView<Eigen::StrictlyUpper>() = m->transpose(); }
@@ -204,7 +233,7 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
   RowMatrix j, j_raw, j_weighted;
   SampleResiduals r, r_raw, r_weighted;
   Eigen::RowVectorXd score(n);
-  Eigen::MatrixXd jtj(n, n);
+  RunSums run(n);
   for (int t = begin; t < end; ++t) {
     const std::array<bool, kNumCables> excluded = in.samples.Excluded(t);
     RowsOf(chunk->rows, t, &r, &j);
@@ -226,13 +255,15 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
         out->jacobians.row(t).segment(i * n, n) = jw.row(i).cast<float>();
       }
     }
-    // Lower triangles only (half the flops), made whole after the pass.
-    jtj.setZero();
-    jtj.selfadjointView<Eigen::Lower>().rankUpdate(jw.transpose());
-    sums->information += jtj;
+    const int session = in.samples.data->samples[(*in.samples.fit)[t]].session;
+    const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
+    if (block != run.block || (!sums->session_information.empty() && session != run.session)) {
+      run.FlushInto(sums);
+      run.block = block;
+      run.session = session;
+    }
+    run.Add(jw, excluded, (*in.samples.sigma_n)[t], j_raw);
     if (!sums->session_information.empty()) {
-      const int session = in.samples.data->samples[(*in.samples.fit)[t]].session;
-      sums->session_information[session] += jtj;
       sums->session_gradient[session].noalias() += jw.transpose() * rw;
     }
     if (curvature != 0.0) {
@@ -247,10 +278,9 @@ void AccumulateFree(const LinearisationInputs& in, const std::vector<int>& candi
       const std::array<bool, kNumCables> length_excluded = in.samples.LengthExcluded(t);
       for (bool e : length_excluded) sums->readings += !e;
     }
-    const int block = BlockOfSample(t, num_fit, static_cast<int>(sums->folds.size()));
-    AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, r_raw, j_raw, weight,
-              weight == 1.0 ? &jtj : nullptr, &sums->folds[block]);
+    AddToFold(excluded, (*in.samples.sigma_n)[t], r, j, r_raw, j_raw, weight, &sums->folds[block]);
   }
+  run.FlushInto(sums);
   sums->Flush();
 }
 
