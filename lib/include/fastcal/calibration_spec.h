@@ -146,7 +146,7 @@ struct CalibrationSpec {
   double gradient_tolerance = 1e-12;
   double parameter_tolerance = 1e-12;
   // Threads of every pass over the samples (the fit, the linearisation, the RMS table):
-  // the results are the same bits on any number (calibration.md, "At 10^5 and 10^6
+  // the results are the same bits on any number (docs/speed.md, "At 10^5 and 10^6
   // samples"). 1 to kMaxCalibrationThreads.
   int num_threads = 2;
   // Joint fit of several sessions (`sessions: {separate: [...]}`, sessions.h): the free
