@@ -94,8 +94,6 @@ TEST(DesignPartsTest, TheRotatorsAnglesSeparateItsFirstMomentFromTheMassCentre) 
   ASSERT_EQ(d.joints.size(), d.poses.size());
   // Every stop at a point of the grid, the platform at zero; some pose visited at more
   // than one pair of angles (that is what separates Q_z from c0_z).
-  std::set<std::vector<double>> pairs_at_first_pose;
-  const Eigen::Vector3d first = d.candidates[d.stops[0].candidate].pose.position_m;
   const std::set<double> grid = {-15.0, 0.0, 15.0};
   int revisits = 0;
   for (size_t k = 0; k < d.stops.size(); ++k) {

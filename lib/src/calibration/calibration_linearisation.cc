@@ -521,6 +521,20 @@ std::vector<int> BasisColumns(const ParameterSpec& p, const CableRobot& model, b
   return columns;
 }
 
+namespace {
+
+// The inputs of a pass through the fit's own model: at the prediction's theta its starts
+// are taken as solved (compact_start.h, FittedSamples::starts_solved).
+LinearisationInputs AtSolvedStarts(const LinearisationInputs& in) {
+  LinearisationInputs out = in;
+  const FittedSamples& s = in.samples;
+  out.samples.starts_solved =
+      s.starts != nullptr && s.starts->SolvedAt(in.theta, s.model->num_free());
+  return out;
+}
+
+}  // namespace
+
 bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* error) {
   *out = Linearisation();
   // The candidate pass's samples. With a slow error the whitening needs neighbours:
@@ -528,17 +542,14 @@ bool Linearise(const LinearisationInputs& in, Linearisation* out, std::string* e
   out->candidate_rows = in.samples.whitened()
                             ? SlowErrorEstimateSamples(in.samples.size(), in.max_candidate_samples)
                             : CandidateSamples(in.samples.size(), in.max_candidate_samples);
-  // At the prediction's theta the free pass takes its starts as solved (compact_start.h);
-  // the candidates' pass goes through another model and solves.
-  LinearisationInputs free = in;
-  const FittedSamples& s = in.samples;
-  free.samples.starts_solved =
-      s.starts != nullptr && s.starts->SolvedAt(in.theta, s.model->num_free());
-  return LineariseFree(free, out, error) && LineariseCandidates(in, out, error);
+  // The candidates' pass goes through another model and solves.
+  return LineariseFree(AtSolvedStarts(in), out, error) && LineariseCandidates(in, out, error);
 }
 
-bool ReplayFreeJacobians(const LinearisationInputs& in,
+bool ReplayFreeJacobians(const LinearisationInputs& given,
                          const std::function<void(int t, const float* jacobian)>& visit) {
+  // The free pass's rows: from the same starts, taken as solved where it took them so.
+  const LinearisationInputs in = AtSolvedStarts(given);
   const int n = in.samples.model->num_free();
   const ModelAtTheta at(*in.samples.model, in.theta, in.samples.sessions());
   SampleRowWhitener whitener(in.samples, n + 1);

@@ -272,9 +272,10 @@ struct PieceSamples {
     fitted.data = &data;
     fitted.fit = &fit;
     fitted.sigma_n = &sigma_n;
-    // The first pass's solutions at the same point: the rows need not solve again.
+    // The first pass's solutions at the same point: the rows need not solve again. Only
+    // with one session: the first pass assembles the model of session 0 for every sample.
     fitted.starts = &starts;
-    fitted.starts_solved = true;
+    fitted.starts_solved = source.sessions == 1;
     fitted.excluded = &excluded;
     fitted.slow_rho = rho.empty() ? nullptr : &rho;
     return true;
