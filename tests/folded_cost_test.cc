@@ -459,8 +459,8 @@ TEST(FoldedCostTest, RowsTakeASolvedStartAsTheSolution) {
   }
 }
 
-// The calibration's prediction marks its starts as solved at its theta (compact_start.h):
-// a fold there takes them as solved (the readings it leaves are the prediction's bit for
+// The calibration's prediction marks its starts as solved at its model's theta
+// (compact_start.h): a fold there takes them as solved (the readings it leaves are the prediction's bit for
 // bit, its R the same to rounding) and keeps the mark; a fold anywhere else forgets it.
 TEST(FoldedCostTest, AFoldWhereTheStartsWereSolvedTakesThemAsSolved) {
   Fixture f(kSampleChunk + 30, SensorSpec());
@@ -481,7 +481,7 @@ TEST(FoldedCostTest, AFoldWhereTheStartsWereSolvedTakesThemAsSolved) {
     const FoldedTensionCost first(samples, nullptr, 2);
     ASSERT_TRUE(first.Evaluate(at_theta, residuals.data(), nullptr));
   }
-  starts.MarkSolvedAt(theta.data(), n);
+  starts.MarkSolvedAt(&f.model, theta.data(), n);
   std::vector<std::array<double, kNumCables>> reading_n(f.data.samples.size());
   samples.solved = {&reading_n, &starts};
   CompactStarts unmarked = starts;
@@ -490,7 +490,10 @@ TEST(FoldedCostTest, AFoldWhereTheStartsWereSolvedTakesThemAsSolved) {
   solving.starts = &unmarked;
   const FoldedTensionCost taking(samples, nullptr, 2), solving_cost(solving, nullptr, 2);
   ASSERT_TRUE(taking.Evaluate(at_theta, residuals.data(), jacobians));
-  EXPECT_TRUE(starts.SolvedAt(theta.data(), n));
+  EXPECT_TRUE(starts.SolvedAt(&f.model, theta.data(), n));
+  // Another model of the same width at the same theta: not these statics.
+  const CalibrationModel twin(CableRobot::NominalFast(), f.spec);
+  EXPECT_FALSE(starts.SolvedAt(&twin, theta.data(), n));
   for (size_t t = 0; t < reading_n.size(); ++t) {
     for (int i = 0; i < kNumCables; ++i) ASSERT_EQ(reading_n[t][i], predicted[t][i]) << t << i;
   }
@@ -505,8 +508,8 @@ TEST(FoldedCostTest, AFoldWhereTheStartsWereSolvedTakesThemAsSolved) {
   other[1] += 0.01;
   const double* elsewhere[1] = {other.data()};
   ASSERT_TRUE(taking.Evaluate(elsewhere, residuals.data(), jacobians));
-  EXPECT_FALSE(starts.SolvedAt(theta.data(), n));
-  EXPECT_FALSE(starts.SolvedAt(other.data(), n));
+  EXPECT_FALSE(starts.SolvedAt(&f.model, theta.data(), n));
+  EXPECT_FALSE(starts.SolvedAt(&f.model, other.data(), n));
 }
 
 // The linearisation at a point folds each reading's rows over its own columns first

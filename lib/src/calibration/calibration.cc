@@ -361,7 +361,7 @@ CalibrationStatus Predict(Run& run) {
   }
   // Every sample's start is now its solution at theta (the fitted ones the fold's, when
   // `solved`): the next pass at theta need not solve them again.
-  at.starts.MarkSolvedAt(run.theta.data(), run.n);
+  at.starts.MarkSolvedAt(run.cm.get(), run.theta.data(), run.n);
   return CalibrationStatus::kOk;
 }
 

@@ -529,7 +529,7 @@ LinearisationInputs AtSolvedStarts(const LinearisationInputs& in) {
   LinearisationInputs out = in;
   const FittedSamples& s = in.samples;
   out.samples.starts_solved =
-      s.starts != nullptr && s.starts->SolvedAt(in.theta, s.model->num_free());
+      s.starts != nullptr && s.starts->SolvedAt(s.model, in.theta, s.model->num_free());
   return out;
 }
 

@@ -100,8 +100,9 @@ bool FoldedTensionCost::Fold(const double* theta, Eigen::MatrixXd* r_aug, double
   // Starts solved at this very theta (the prediction's, compact_start.h) are taken as
   // solved; a fold anywhere else makes whatever it writes them into no longer so.
   FittedSamples samples = samples_;
-  samples.starts_solved = samples_.starts != nullptr && samples_.starts->SolvedAt(theta, n);
-  if (samples_.solved.starts != nullptr && !samples_.solved.starts->SolvedAt(theta, n)) {
+  const CalibrationModel* model = samples_.model;
+  samples.starts_solved = samples_.starts != nullptr && samples_.starts->SolvedAt(model, theta, n);
+  if (samples_.solved.starts != nullptr && !samples_.solved.starts->SolvedAt(model, theta, n)) {
     samples_.solved.starts->ForgetSolved();
   }
   RowFold total(n + 1);

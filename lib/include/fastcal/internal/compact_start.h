@@ -103,16 +103,23 @@ class CompactStarts {
     return c;
   }
 
-  // The parameters theta (of the calibration's model) at which every start is its
-  // sample's converged solution: said by a pass that solved them all there (the
-  // calibration's Predict), so that a pass evaluating rows at the same theta takes them as
-  // solved (FittedSamples::starts_solved; issue 41). A pass that writes starts at any
-  // other theta must Forget first; one at the same theta keeps it (its solutions are
-  // solutions there too). Set does not forget: it runs on many threads at once.
-  void MarkSolvedAt(const double* theta, int n) { solved_at_.assign(theta, theta + n); }
-  void ForgetSolved() { solved_at_.clear(); }
-  bool SolvedAt(const double* theta, int n) const {
-    return !solved_at_.empty() && static_cast<int>(solved_at_.size()) == n &&
+  // The parameters theta of a model (identified by its address: the calibration's
+  // CalibrationModel) at which every start is its sample's converged solution: said by a
+  // pass that solved them all there (the calibration's Predict), so that a pass
+  // evaluating rows through the same model at the same theta takes them as solved
+  // (FittedSamples::starts_solved; issue 41). A pass that writes starts at any other
+  // theta must Forget first; one at the same theta keeps it (its solutions are solutions
+  // there too). Set does not forget: it runs on many threads at once.
+  void MarkSolvedAt(const void* model, const double* theta, int n) {
+    solved_model_ = model;
+    solved_at_.assign(theta, theta + n);
+  }
+  void ForgetSolved() {
+    solved_model_ = nullptr;
+    solved_at_.clear();
+  }
+  bool SolvedAt(const void* model, const double* theta, int n) const {
+    return model != nullptr && model == solved_model_ && static_cast<int>(solved_at_.size()) == n &&
            std::equal(theta, theta + n, solved_at_.begin());
   }
 
@@ -120,7 +127,8 @@ class CompactStarts {
   StaticsMethod method_;
   int stride_;
   std::vector<double> values_;
-  std::vector<double> solved_at_;  // empty: not known
+  const void* solved_model_ = nullptr;  // null: not known
+  std::vector<double> solved_at_;
 };
 
 }  // namespace fastcal::internal
