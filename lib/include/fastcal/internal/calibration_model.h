@@ -275,9 +275,10 @@ struct FittedSamples {
   // Per dataset sample: warm starts (may be null or empty: cold starts).
   const CompactStarts* starts = nullptr;
   // Whether each start is the converged solution of the very statics Rows evaluates (the
-  // same parameters and pose: a window's second pass at its first's point, track_fold.cc):
-  // Rows with a Jacobian then takes it as solved instead of solving again (exact only; a
-  // sample without a start is solved). The caller's promise: nothing checks it.
+  // same parameters and pose: a window's second pass at its first's point, track_fold.cc;
+  // a fold or the linearisation at the prediction's theta, CompactStarts::SolvedAt): Rows
+  // with a Jacobian then takes it as solved instead of solving again (exact only; a
+  // sample without a start is solved). The caller's promise: Rows does not check it.
   bool starts_solved = false;
   // Per dataset sample: readings kept out of the fit (may be null or empty).
   const ReadingMask* excluded = nullptr;
