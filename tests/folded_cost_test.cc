@@ -542,6 +542,25 @@ TEST(FoldedCostTest, LinearisationRFactorIsTheInformation) {
   ASSERT_EQ(lin.session_information.size(), 2u);
   const Eigen::MatrixXd sessions = lin.session_information[0] + lin.session_information[1];
   EXPECT_LE((sessions - lin.information).cwiseAbs().maxCoeff(), kRelTol * scale);
+  // And each session's is its own samples': the second session linearised alone (the slow
+  // error's filters start afresh at a session, so its rows are the same) has it as its
+  // whole. The sums run over runs of samples: a run must end where the session does.
+  std::vector<int> fit_b;
+  std::vector<std::array<double, kNumCables>> sigma_b, rho_b;
+  for (size_t j = 0; j < f.fit.size(); ++j) {
+    if (f.data.samples[f.fit[j]].session != 1) continue;
+    fit_b.push_back(f.fit[j]);
+    sigma_b.push_back(f.sigma_n[j]);
+    rho_b.push_back(f.slow_rho[j]);
+  }
+  LinearisationInputs only_b = in;
+  only_b.samples.fit = &fit_b;
+  only_b.samples.sigma_n = &sigma_b;
+  only_b.samples.slow_rho = &rho_b;
+  Linearisation lin_b;
+  ASSERT_TRUE(Linearise(only_b, &lin_b, &error)) << error;
+  EXPECT_LE((lin_b.information - lin.session_information[1]).cwiseAbs().maxCoeff(),
+            kRelTol * scale);
 }
 
 // A sample the statics cannot solve (a non-positive density) fails the evaluation, as one
