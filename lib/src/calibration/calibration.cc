@@ -512,7 +512,7 @@ std::string DescribeRefusal(const Run& run) {
 
 CalibrationStatus CheckIdentifiability(Run& run) {
   Eigen::MatrixXd r;
-  if (!JacobianR(run.problem.get(), run.spec.num_threads, &r)) {
+  if (!JacobianR(run.problem.get(), &r)) {
     return run.Fail(CalibrationStatus::kInfeasible,
                     "the initial model cannot be evaluated on every sample");
   }

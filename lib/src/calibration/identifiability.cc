@@ -8,10 +8,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <system_error>
 
 #include "fastcal/internal/calibration_linearisation.h"
-#include "fastcal/internal/sample_chunks.h"
 
 namespace fastcal::internal {
 namespace {
@@ -139,20 +137,17 @@ Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>
 }
 
 // R factor of the whitened Jacobian (data and prior rows) at the current parameters.
-bool JacobianR(ceres::Problem* problem, int num_threads, Eigen::MatrixXd* r) {
+// On one Ceres thread, as the solver (calibration.cc): the data term is one block that
+// folds the samples on the spec's threads itself, so Ceres's threads had only the priors
+// to share out. And Ceres 2.1's ParallelFor is not safe when memory runs out: a task left
+// in its pool after the caller's bad_alloc ran an empty std::function when the problem
+// was destroyed, and the process aborted (under `ulimit -v`, about 1 run in 50) instead
+// of saying "out of memory".
+bool JacobianR(ceres::Problem* problem, Eigen::MatrixXd* r) {
   ceres::Problem::EvaluateOptions eo;
-  eo.num_threads = MachineThreads(num_threads);
+  eo.num_threads = 1;
   ceres::CRSMatrix j;
-  bool evaluated = false;
-  try {
-    evaluated = problem->Evaluate(eo, nullptr, nullptr, nullptr, &j);
-  } catch (const std::system_error&) {
-    // Ceres's own thread pool refused a thread (a process limit, `ulimit -v` with a large
-    // stack: issue 37, exit 1 where the fit runs on fewer threads): on this thread. The
-    // Jacobian's entries are the blocks' own, the same on any number of threads.
-    eo.num_threads = 1;
-    evaluated = problem->Evaluate(eo, nullptr, nullptr, nullptr, &j);
-  }
+  const bool evaluated = problem->Evaluate(eo, nullptr, nullptr, nullptr, &j);
   if (!evaluated) return false;
   *r = RFactor(j);
   return true;

@@ -30,8 +30,9 @@ Identifiability Analyse(const Eigen::MatrixXd& r, const std::vector<std::string>
                         const CalibrationOptions& options);
 
 // R factor of the whitened Jacobian (data and prior rows) of `problem` at its current
-// parameters. False when the evaluation fails.
-bool JacobianR(ceres::Problem* problem, int num_threads, Eigen::MatrixXd* r);
+// parameters, evaluated on one Ceres thread (the data term threads itself). False when
+// the evaluation fails.
+bool JacobianR(ceres::Problem* problem, Eigen::MatrixXd* r);
 
 }  // namespace fastcal::internal
 
