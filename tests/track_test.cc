@@ -18,6 +18,7 @@
 #include "fastcal/calibration.h"
 #include "fastcal/internal/chi_square.h"
 #include "fastcal/simulation.h"
+#include "fastcal/track_fold.h"
 #include "fastcal/trajectory.h"
 #include "random_cap_poses.h"
 
@@ -193,6 +194,78 @@ TEST(TrackTest, EqualsTheJointFitWithASessionPerDay) {
       EXPECT_NEAR(s.estimate.value, e.estimate, 0.05 * e.sigma) << s.name;
       EXPECT_NEAR(s.estimate.sigma_formal, e.sigma, 0.01 * e.sigma) << s.name;
     }
+  }
+}
+
+// The consider parameters' columns ride on the fold that may be the last (issue 41: a
+// separate fold of every window at the solution was a fifth of a track's time); where
+// the last fold has none (a track started at its own solution converges at its first
+// fold), the windows are folded at the solution as before, and the uncertainties are the
+// same either way.
+TEST(TrackTest, ConsiderColumnsComeWithTheLastFoldOrAreFoldedAtTheSolution) {
+  CableRobot truth;
+  const Dataset data = Season(1, 400, 13, {}, &truth);
+  const CalibrationSpec spec = LoadSpec(Spec("{sigma_percent: 1, time_constant_s: 120}"));
+  const std::string dir = TempDir("consider");
+  fs::create_directories(dir);
+  const std::string csv = Write(data, dir + "/day.csv");
+  // Per round of folds: whether its tasks carry the consider columns.
+  std::vector<bool> rounds;
+  TrackOptions options;
+  options.runner = [&rounds](const std::vector<std::string>& tasks,
+                             std::vector<std::string>* folds, std::string* error) {
+    bool consider = false;
+    for (const std::string& t : tasks) {
+      FoldTask task;
+      if (!ParseFoldTask(t, &task, error)) return false;
+      for (FoldRole r : task.roles) consider = consider || r == FoldRole::kConsider;
+    }
+    rounds.push_back(consider);
+    folds->clear();
+    for (const std::string& t : tasks) {
+      folds->emplace_back();
+      if (!RunFoldTask(t, &folds->back(), error)) return false;
+    }
+    return true;
+  };
+  const TrackResult first = Track(spec, {csv}, dir + "/first", options);
+  ASSERT_TRUE(first.converged);
+  ASSERT_GE(rounds.size(), 2u);
+  EXPECT_FALSE(rounds.front()) << "the first fold's step is not the last";
+  EXPECT_TRUE(rounds.back());
+  EXPECT_EQ(static_cast<int>(rounds.size()), first.iterations) << "no fold of their own";
+
+  // Again from the model the first track calibrated.
+  CableRobot solved;
+  std::string error;
+  ASSERT_TRUE(LoadCableRobot(dir + "/first/model_calibrated@2024-05-01.yaml", &solved, &error))
+      << error;
+  rounds.clear();
+  TrackResult again;
+  ASSERT_EQ(RunTrack(solved, spec, {csv}, WindowSpec(), dir + "/again", options, &again, &error),
+            TrackStatus::kOk)
+      << error;
+  ASSERT_TRUE(again.converged);
+  ASSERT_EQ(again.iterations, 1);
+  ASSERT_EQ(rounds.size(), 2u);
+  EXPECT_FALSE(rounds[0]);
+  EXPECT_TRUE(rounds[1]) << "the consider columns folded at the solution";
+  // The two solutions within the step tolerance (0.05 sigma) of each other, and their
+  // sigmas (each at a point within it of the solution) the same to well under a percent.
+  constexpr double kStepToleranceSigmas = 0.05;
+  constexpr double kSameSigmaRelative = 1e-3;
+  const auto same = [&](const TrackEstimate& a, const TrackEstimate& b, const std::string& name) {
+    EXPECT_NEAR(b.value, a.value, kStepToleranceSigmas * a.sigma_total) << name;
+    EXPECT_NEAR(b.sigma_total, a.sigma_total, kSameSigmaRelative * a.sigma_total) << name;
+  };
+  ASSERT_EQ(again.windows.size(), 1u);
+  ASSERT_EQ(first.windows.size(), 1u);
+  for (size_t k = 0; k < first.windows[0].estimates.size(); ++k) {
+    same(first.windows[0].estimates[k], again.windows[0].estimates[k], std::to_string(k));
+  }
+  ASSERT_EQ(again.shared.size(), first.shared.size());
+  for (size_t e = 0; e < first.shared.size(); ++e) {
+    same(first.shared[e].estimate, again.shared[e].estimate, first.shared[e].name);
   }
 }
 

@@ -111,9 +111,11 @@ struct TrackOptions {
   }();
   // Gauss-Newton iterations (each a fold of the windows that moved) at most.
   int max_iterations = 20;
-  // Converged when every parameter's step is below this fraction of its formal sigma
-  // (then one more fold at the solution, with the consider parameters' columns: the
-  // estimates' change over it is of the order of the step squared).
+  // Converged when every parameter's step is below this fraction of its formal sigma.
+  // The consider parameters' columns are folded with an iteration whose step may be the
+  // last (the step before it below about sqrt(500 x this) sigma); where the converged
+  // iteration's fold lacks them, one more fold at the solution adds them (the estimates'
+  // change over it is of the order of the step squared).
   double step_tolerance_sigmas = 0.05;
   // Each kind of event: the chance that noise alone reports any over the whole season.
   double false_alarm = 0.01;

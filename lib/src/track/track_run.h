@@ -65,6 +65,7 @@ struct TrackWindowState {
   bool used = true;        // enough samples to be fitted
   bool dirty = true;       // to fold at its point
   bool folded = false;     // folded in this run
+  bool fold_considered = false;  // its fold, of this run, has the consider columns
   bool has_fold = false;
   WindowFold fold;
   std::vector<double> theta;  // its point, per column (SI)
