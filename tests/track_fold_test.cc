@@ -251,6 +251,41 @@ TEST_F(TrackFoldTest, SameBytesOnAnyNumberOfThreads) {
   EXPECT_EQ(SerializeWindowFold(Fold(task_)), SerializeWindowFold(Fold(two)));
 }
 
+// A fold through every k-th sample (a track's first step, FoldTask::stride) is the fold
+// of those samples alone, from memory and from the window's store.
+TEST_F(TrackFoldTest, AStrideFoldsEveryKthSampleAsTheirOwnWindow) {
+  Simulate(kLongSamples);
+  constexpr int kStride = 3;
+  Dataset every_kth = data_;
+  every_kth.samples.clear();
+  for (size_t t = 0; t < data_.samples.size(); t += kStride) {
+    every_kth.samples.push_back(data_.samples[t]);
+  }
+  FoldTask strided = task_;
+  strided.stride = kStride;
+  WindowFold alone;
+  std::string error;
+  ASSERT_TRUE(FoldSamples(task_, every_kth, {}, &alone, &error)) << error;
+  EXPECT_EQ(alone.samples, (kLongSamples + kStride - 1) / kStride);
+  const std::string expected = SerializeWindowFold(alone);
+  EXPECT_EQ(SerializeWindowFold(Fold(strided)), expected);
+
+  const std::string store = test::TempPath("track_fold_strided", ".samples");
+  std::remove(store.c_str());
+  std::vector<internal::StoredSample> records;
+  for (const Sample& s : data_.samples) records.push_back(internal::ToStored(s, 0, false));
+  ASSERT_TRUE(internal::AppendStoredSamples(store, records, 0, &error)) << error;
+  strided.samples_path = store;
+  WindowFold stored;
+  ASSERT_TRUE(FoldWindow(strided, &stored, &error)) << error;
+  EXPECT_EQ(SerializeWindowFold(stored), expected);
+  std::remove(store.c_str());
+
+  strided.stride = 0;
+  EXPECT_FALSE(FoldSamples(strided, data_, {}, &stored, &error));
+  EXPECT_NE(error.find("stride"), std::string::npos) << error;
+}
+
 TEST_F(TrackFoldTest, BytesRoundTripAndCorruptionIsRefused) {
   const WindowFold fold = Fold(task_);
   const std::string bytes = SerializeWindowFold(fold);
@@ -268,7 +303,7 @@ TEST_F(TrackFoldTest, BytesRoundTripAndCorruptionIsRefused) {
   ASSERT_TRUE(ParseFoldTask(task_bytes, &task, &error)) << error;
   EXPECT_EQ(SerializeFoldTask(task), task_bytes);
   EXPECT_FALSE(ParseFoldTask(bytes, &task, &error));  // a fold is not a task
-  EXPECT_NE(error.find("fastcal-fold-task-1"), std::string::npos) << error;
+  EXPECT_NE(error.find("fastcal-fold-task-2"), std::string::npos) << error;
 }
 
 TEST_F(TrackFoldTest, FiniteNonsenseInAFoldIsRefused) {

@@ -21,6 +21,7 @@
 #include "fastcal/track_fold.h"
 #include "fastcal/trajectory.h"
 #include "random_cap_poses.h"
+#include "temp_path.h"
 
 namespace fastcal {
 namespace {
@@ -77,8 +78,7 @@ Dataset Season(int days, int per_day, std::uint64_t seed, SimulationOptions o, C
 
 // A directory of this process's own (ctest runs each test in a process, in parallel).
 std::string TempDir(const std::string& name) {
-  const std::string dir =
-      ::testing::TempDir() + "/track_test_" + name + "_" + std::to_string(::getpid());
+  const std::string dir = test::TempPath("track_test_" + name);
   fs::remove_all(dir);
   return dir;
 }
@@ -267,6 +267,92 @@ TEST(TrackTest, ConsiderColumnsComeWithTheLastFoldOrAreFoldedAtTheSolution) {
   for (size_t e = 0; e < first.shared.size(); ++e) {
     same(first.shared[e].estimate, again.shared[e].estimate, first.shared[e].name);
   }
+}
+
+// A new track's first fold reads one sample in k of a large window (issue 41); the folds
+// after it read them all, and the track ends where one of every sample throughout does.
+TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
+  CableRobot truth;
+  const Dataset data = Season(1, 2000, 17, {}, &truth);  // one "day" of samples
+  const CalibrationSpec spec = LoadSpec(Spec("{sigma_percent: 1, time_constant_s: 120}"));
+  const std::string dir = TempDir("first_step");
+  fs::create_directories(dir);
+  const std::string csv = Write(data, dir + "/day.csv");
+  std::vector<int> strides;  // per round of folds, the largest
+  TrackOptions options;
+  options.runner = [&strides](const std::vector<std::string>& tasks,
+                              std::vector<std::string>* folds, std::string* error) {
+    int largest = 0;
+    folds->clear();
+    for (const std::string& t : tasks) {
+      FoldTask task;
+      if (!ParseFoldTask(t, &task, error)) return false;
+      largest = std::max(largest, task.stride);
+      folds->emplace_back();
+      if (!RunFoldTask(t, &folds->back(), error)) return false;
+    }
+    strides.push_back(largest);
+    return true;
+  };
+  // No step taken back: the subsample's chi-square is not compared with the whole's.
+  std::string halved;
+  options.progress = [&halved](const std::string& line) {
+    if (line.find("halved") != std::string::npos) halved += line + "\n";
+  };
+  // 2000 samples from 20:00 UTC, 20 s apart: 720 on the first day, 1280 on the second.
+  options.first_fold_samples = 300;
+  const TrackResult first_step = Track(spec, {csv}, dir + "/first_step", options);
+  ASSERT_TRUE(first_step.converged);
+  ASSERT_EQ(first_step.windows.size(), 2u);
+  EXPECT_EQ(first_step.windows[1].samples, 1280);
+  ASSERT_GE(strides.size(), 2u);
+  EXPECT_EQ(strides[0], 4);  // 1280 / 300, rounded down
+  for (size_t r = 1; r < strides.size(); ++r) EXPECT_EQ(strides[r], 1) << r;
+  EXPECT_EQ(halved, "");
+
+  strides.clear();
+  options.first_fold_samples = 0;
+  const TrackResult whole = Track(spec, {csv}, dir + "/whole", options);
+  ASSERT_TRUE(whole.converged);
+  for (int s : strides) EXPECT_EQ(s, 1);
+  constexpr double kStepToleranceSigmas = 0.05;
+  constexpr double kSameSigmaRelative = 1e-3;
+  const auto same = [&](const TrackEstimate& a, const TrackEstimate& b, const std::string& name) {
+    EXPECT_NEAR(b.value, a.value, kStepToleranceSigmas * a.sigma_total) << name;
+    EXPECT_NEAR(b.sigma_total, a.sigma_total, kSameSigmaRelative * a.sigma_total) << name;
+  };
+  ASSERT_EQ(whole.windows.size(), 2u);
+  for (size_t w = 0; w < 2; ++w) {
+    for (size_t k = 0; k < whole.windows[w].estimates.size(); ++k) {
+      same(whole.windows[w].estimates[k], first_step.windows[w].estimates[k],
+           std::to_string(w) + " " + std::to_string(k));
+    }
+  }
+  ASSERT_EQ(first_step.shared.size(), whole.shared.size());
+  for (size_t e = 0; e < whole.shared.size(); ++e) {
+    same(whole.shared[e].estimate, first_step.shared[e].estimate, whole.shared[e].name);
+  }
+
+  // From the solution: the whole's chi-square after the first step is about k times the
+  // subsample's, which is no reason to take that step back.
+  CableRobot solved;
+  std::string error;
+  ASSERT_TRUE(LoadCableRobot(dir + "/whole/model_calibrated@2024-05-02.yaml", &solved, &error))
+      << error;
+  options.first_fold_samples = 300;
+  TrackResult again;
+  ASSERT_EQ(RunTrack(solved, spec, {csv}, WindowSpec(), dir + "/again", options, &again, &error),
+            TrackStatus::kOk)
+      << error;
+  EXPECT_TRUE(again.converged);
+  EXPECT_EQ(halved, "");
+
+  options.first_fold_samples = -1;
+  TrackResult bad;
+  EXPECT_EQ(RunTrack(CableRobot::NominalFast(), spec, {csv}, WindowSpec(), dir + "/bad", options,
+                     &bad, &error),
+            TrackStatus::kInvalidInput);
+  EXPECT_NE(error.find("first_fold_samples"), std::string::npos) << error;
 }
 
 class SeasonTest : public ::testing::Test {

@@ -9,18 +9,19 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
-#include "fastcal/internal/track_state.h"
-#include "fastcal/track_fold.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
+#include "fastcal/internal/track_state.h"
 #include "fastcal/plausibility.h"
 #include "fastcal/pose.h"
+#include "fastcal/track_fold.h"
 #include "fastcal/trajectory.h"
 
 namespace fastcal::fuzz {
@@ -31,15 +32,23 @@ constexpr int kNumAnchorPoints = 3;
 // A rotation the readers return is orthonormal to rounding.
 constexpr double kRotationTolerance = 1e-9;
 
-// A private directory for the round trips' files, made once per process.
+// A private directory for the round trips' files, made once per process and removed when
+// it exits.
+struct Scratch {
+  std::string dir;
+  ~Scratch() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir, ec);
+  }
+};
 const std::string& ScratchDir() {
-  static const std::string dir = [] {
+  static const Scratch scratch{[] {
     const char* tmp = std::getenv("TMPDIR");
     std::string pattern = std::string(tmp != nullptr ? tmp : "/tmp") + "/fastcal_fuzz_XXXXXX";
     if (mkdtemp(pattern.data()) == nullptr) Violation("cannot make a scratch directory");
     return pattern;
-  }();
-  return dir;
+  }()};
+  return scratch.dir;
 }
 
 bool IsRotation(const Eigen::Matrix3d& r) {

@@ -111,9 +111,14 @@ struct TrackOptions {
   }();
   // Gauss-Newton iterations (each a fold of the windows that moved) at most.
   int max_iterations = 20;
+  // A new track's first fold, at the initial model, reads every k-th sample of a window
+  // of at least twice this many (k = samples / this, rounded down): its step only brings
+  // the point near the solution, which the later folds, of every sample, reach (issue 41:
+  // that fold was a quarter of a track of 10^7 samples). 0: every sample.
+  long long first_fold_samples = 20000;
   // Converged when every parameter's step is below this fraction of its formal sigma.
   // The consider parameters' columns are folded with an iteration whose step may be the
-  // last (the step before it below about sqrt(500 x this) sigma); where the converged
+  // last (the step before it below about sqrt(5000 x this) sigma); where the converged
   // iteration's fold lacks them, one more fold at the solution adds them (the estimates'
   // change over it is of the order of the step squared).
   double step_tolerance_sigmas = 0.05;

@@ -201,6 +201,8 @@ bool TrackOptions::IsValid(std::string* error) const {
           std::to_string(threads);
   else if (max_iterations < 1)
     why = "max_iterations must be >= 1";
+  else if (first_fold_samples < 0)
+    why = "first_fold_samples must be >= 0";
   else if (!(step_tolerance_sigmas > 0.0))
     why = "step_tolerance_sigmas must be > 0";
   else if (!(false_alarm > 0.0 && false_alarm < 0.5))

@@ -492,11 +492,34 @@ bool NoSampleTwice(const FoldTask& task, const SampleSource& source, const Windo
   return true;
 }
 
+// Every `stride`-th sample of `all` (its first, then every stride-th after it).
+SampleSource Strided(const SampleSource& all, int stride) {
+  SampleSource s = all;
+  s.size = (all.size + stride - 1) / stride;
+  s.read = [all, stride](long long first, int count, std::vector<Sample>* samples,
+                         std::vector<int>* files, std::string* why) {
+    if (count < 1) return all.read(first, count, samples, files, why);
+    const long long from = first * stride;
+    const int span = static_cast<int>(
+        std::min<long long>(all.size - from, static_cast<long long>(count - 1) * stride + 1));
+    if (!all.read(from, span, samples, files, why)) return false;
+    for (int k = 0; k < count; ++k) {
+      (*samples)[k] = std::move((*samples)[static_cast<size_t>(k) * stride]);
+      (*files)[k] = (*files)[static_cast<size_t>(k) * stride];
+    }
+    samples->resize(count);
+    files->resize(count);
+    return true;
+  };
+  return s;
+}
+
 // The fold of the window `source` reads: the first pass (predictions), the screen, the
 // summary, the second pass (rows).
-bool FoldSource(const FoldTask& task, const SampleSource& source, WindowFold* fold,
+bool FoldSource(const FoldTask& task, const SampleSource& all, WindowFold* fold,
                 std::string* error) {
   if (!task.IsValid(error)) return false;
+  const SampleSource source = task.stride > 1 ? Strided(all, task.stride) : all;
   CableRobot model;
   if (!ParseCableRobotYaml(task.model_yaml, "the fold task's model", &model, error)) return false;
   const CalibrationSpec spec = FoldSpec(task);

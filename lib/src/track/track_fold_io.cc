@@ -12,7 +12,7 @@
 namespace fastcal {
 namespace {
 
-constexpr char kTaskTag[] = "fastcal-fold-task-1";
+constexpr char kTaskTag[] = "fastcal-fold-task-2";
 constexpr char kFoldTag[] = "fastcal-fold-1";
 // Bounds on what a reader accepts, against corrupt or hostile bytes.
 constexpr std::int64_t kMaxCount = 1LL << 31;
@@ -205,6 +205,8 @@ bool FoldTask::IsValid(std::string* error) const {
     why = "slow error: " + why;
   } else if (blocks < 1 || threads < 1 || residual_samples < 0) {
     why = "blocks and threads must be >= 1";
+  } else if (stride < 1) {
+    why = "the stride must be >= 1";
   }
   for (double v : theta_si) {
     if (why.empty() && !std::isfinite(v)) why = "a value is not finite";
@@ -235,6 +237,7 @@ std::string SerializeFoldTask(const FoldTask& t) {
   w.Int(t.blocks);
   w.Int(t.residual_samples);
   w.Int(t.threads);
+  w.Int(t.stride);
   return std::move(w.str());
 }
 
@@ -260,6 +263,7 @@ bool ParseFoldTask(const std::string& bytes, FoldTask* task, std::string* error)
   t.blocks = static_cast<int>(r.Int());
   t.residual_samples = static_cast<int>(r.Int());
   t.threads = static_cast<int>(r.Int());
+  t.stride = static_cast<int>(r.Int());
   if (!r.ok() || !r.AtEnd()) {
     *error = r.Error();
     return false;

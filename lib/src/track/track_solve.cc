@@ -22,14 +22,14 @@ constexpr int kMaxHalvings = 6;
 constexpr int kMinResidualRun = 100;
 constexpr int kMaxResidualRun = 5000;
 
-// Gauss-Newton's next step, in sigmas, is about kNextStepPerSquaredStep times the square
-// of the step before it near the solution (measured on 10^6 random samples in 10 days:
-// 0.0105 sigma after 3.09, 10.4 after 296). A fold whose step may be the last
-// (kNextStepPerSquaredStep s^2 <= step_tolerance_sigmas, s the step before: 5 sigma at the
-// default 0.05) carries the consider columns too, so that the converged track needs no
-// fold of its own for them (FoldConsider): a wrong guess costs their share of one fold
-// (about 14% there), a right one a whole fold.
-constexpr double kNextStepPerSquaredStep = 2e-3;
+// Gauss-Newton's next step, in sigmas, was 1e-4 to 1e-3 times the square of the step
+// before it where the slow error stayed (10^6 random samples in 10 days: 0.0105 sigma
+// after 3.09, 10.4 after 296; 10^7 in 100: 0.0261 after 10.6, 30.1 after 873). A fold
+// whose step may be the last (kNextStepPerSquaredStep s^2 <= step_tolerance_sigmas, s the
+// step before: 16 sigma at the default 0.05) carries the consider columns too, so that
+// the converged track needs no fold of its own for them (FoldConsider): a wrong guess
+// costs their share of one fold (about 14% there), a right one a whole fold.
+constexpr double kNextStepPerSquaredStep = 2e-4;
 
 // How much a Gauss-Newton step may raise the chi-square before it is halved: the weights
 // follow the predicted readings (iteratively reweighted least squares), so near the
@@ -43,7 +43,8 @@ bool Moving(const TrackRun& run, const TrackWindowState& w) {
 
 // The task of window w: its point over every column, or (without `consider`) over the
 // fitted columns alone, the consider parameters then fixed at their values.
-FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_run, bool consider) {
+FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_run, bool consider,
+                 bool first_step) {
   FoldTask t;
   t.label = w.label;
   // Absolute: a worker of a Dask cluster may run in another directory.
@@ -69,6 +70,8 @@ FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_ru
   t.slow_error = run.slow;
   t.blocks = run.options.blocks;
   t.residual_samples = residual_run;
+  const long long most = run.options.first_fold_samples;
+  if (first_step && most > 0) t.stride = static_cast<int>(std::max(1LL, w.samples / most));
   return t;
 }
 
@@ -178,19 +181,29 @@ bool CheckMovingStores(TrackRun& run) {
   return true;
 }
 
-// Folds every dirty used window at its point (with the consider columns when `consider`).
-bool FoldDirty(TrackRun& run, bool consider = false) {
+// Folds every dirty used window at its point (with the consider columns when `consider`;
+// of every k-th sample of the larger windows when `first_step`, TrackOptions::
+// first_fold_samples). *strided (if not null) says whether any window was.
+bool FoldDirty(TrackRun& run, bool consider = false, bool first_step = false,
+               bool* strided = nullptr) {
   std::vector<int> which;
   std::vector<std::string> tasks;
   const int residual_run = ResidualRun(run);
+  int largest_stride = 1;
   for (int w : run.used) {
     if (!run.windows[w].dirty) continue;
     which.push_back(w);
-    tasks.push_back(SerializeFoldTask(TaskFor(run, run.windows[w], residual_run, consider)));
+    const FoldTask task = TaskFor(run, run.windows[w], residual_run, consider, first_step);
+    largest_stride = std::max(largest_stride, task.stride);
+    tasks.push_back(SerializeFoldTask(task));
   }
+  if (strided != nullptr) *strided = largest_stride > 1;
   if (tasks.empty()) return true;
-  run.Progress("folding " + std::to_string(tasks.size()) + " window" +
-               (tasks.size() == 1 ? "" : "s"));
+  run.Progress(
+      "folding " + std::to_string(tasks.size()) + " window" + (tasks.size() == 1 ? "" : "s") +
+      (largest_stride > 1
+           ? ", a first step on one sample in " + std::to_string(largest_stride) + " at most"
+           : ""));
   std::vector<std::string> folds;
   const bool ok = run.options.runner ? run.options.runner(tasks, &folds, run.error)
                                      : LocalRunner(run.options.threads, tasks, &folds, run.error);
@@ -454,7 +467,10 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     ++run.result->iterations;
     const bool may_be_last =
         kNextStepPerSquaredStep * last_step * last_step <= run.options.step_tolerance_sigmas;
-    const bool folded = FoldDirty(run, may_be_last);
+    // A new track's first step, from the initial model, through a subsample.
+    const bool first_step = estimate_slow_error && it == 1 && !run.update;
+    bool strided = false;
+    const bool folded = FoldDirty(run, may_be_last && !first_step, first_step, &strided);
     const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
     if ((!folded || chi2 > previous_chi2 + ChiSquareSlack(previous_chi2)) &&
         halvings < kMaxHalvings && std::isfinite(previous_chi2)) {
@@ -491,7 +507,7 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
                  FormatDouble("%.9g", run.solver.ChiSquare()) + ", largest step " +
                  FormatDouble("%.3g", step) + " sigma");
     for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
-    if (step < run.options.step_tolerance_sigmas && slow_settled && !process_changed) {
+    if (step < run.options.step_tolerance_sigmas && slow_settled && !process_changed && !strided) {
       run.result->converged = true;
       // An earlier pass's "did not converge" no longer holds (issue 37: the summary said
       // "(converged)" beside it).
@@ -503,7 +519,8 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
                   notes.end());
       return TrackStatus::kOk;
     }
-    previous_chi2 = process_changed ? std::numeric_limits<double>::infinity() : chi2;
+    // A subsample's chi-square is not comparable with the whole's.
+    previous_chi2 = process_changed || strided ? std::numeric_limits<double>::infinity() : chi2;
     for (size_t u = 0; u < run.used.size(); ++u) {
       TrackWindowState& win = run.windows[run.used[u]];
       if (!Moving(run, win)) continue;
