@@ -197,6 +197,30 @@ TEST(TrackTest, EqualsTheJointFitWithASessionPerDay) {
   }
 }
 
+// Two tracks of the same data that stop at the same minimum by different paths: every
+// estimate within the step tolerance (0.05 sigma) of the other's, every sigma (each at a
+// point within it of the solution) the same to well under a percent.
+void ExpectSameTrack(const TrackResult& a, const TrackResult& b) {
+  constexpr double kStepToleranceSigmas = 0.05;
+  constexpr double kSameSigmaRelative = 1e-3;
+  const auto same = [&](const TrackEstimate& x, const TrackEstimate& y, const std::string& name) {
+    EXPECT_NEAR(y.value, x.value, kStepToleranceSigmas * x.sigma_total) << name;
+    EXPECT_NEAR(y.sigma_total, x.sigma_total, kSameSigmaRelative * x.sigma_total) << name;
+  };
+  ASSERT_EQ(b.windows.size(), a.windows.size());
+  for (size_t w = 0; w < a.windows.size(); ++w) {
+    ASSERT_EQ(b.windows[w].estimates.size(), a.windows[w].estimates.size());
+    for (size_t k = 0; k < a.windows[w].estimates.size(); ++k) {
+      same(a.windows[w].estimates[k], b.windows[w].estimates[k],
+           a.windows[w].label + " " + std::to_string(k));
+    }
+  }
+  ASSERT_EQ(b.shared.size(), a.shared.size());
+  for (size_t e = 0; e < a.shared.size(); ++e) {
+    same(a.shared[e].estimate, b.shared[e].estimate, a.shared[e].name);
+  }
+}
+
 // The consider parameters' columns ride on the fold that may be the last (issue 41: a
 // separate fold of every window at the solution was a fifth of a track's time); where
 // the last fold has none (a track started at its own solution converges at its first
@@ -250,23 +274,7 @@ TEST(TrackTest, ConsiderColumnsComeWithTheLastFoldOrAreFoldedAtTheSolution) {
   ASSERT_EQ(rounds.size(), 2u);
   EXPECT_FALSE(rounds[0]);
   EXPECT_TRUE(rounds[1]) << "the consider columns folded at the solution";
-  // The two solutions within the step tolerance (0.05 sigma) of each other, and their
-  // sigmas (each at a point within it of the solution) the same to well under a percent.
-  constexpr double kStepToleranceSigmas = 0.05;
-  constexpr double kSameSigmaRelative = 1e-3;
-  const auto same = [&](const TrackEstimate& a, const TrackEstimate& b, const std::string& name) {
-    EXPECT_NEAR(b.value, a.value, kStepToleranceSigmas * a.sigma_total) << name;
-    EXPECT_NEAR(b.sigma_total, a.sigma_total, kSameSigmaRelative * a.sigma_total) << name;
-  };
-  ASSERT_EQ(again.windows.size(), 1u);
-  ASSERT_EQ(first.windows.size(), 1u);
-  for (size_t k = 0; k < first.windows[0].estimates.size(); ++k) {
-    same(first.windows[0].estimates[k], again.windows[0].estimates[k], std::to_string(k));
-  }
-  ASSERT_EQ(again.shared.size(), first.shared.size());
-  for (size_t e = 0; e < first.shared.size(); ++e) {
-    same(first.shared[e].estimate, again.shared[e].estimate, first.shared[e].name);
-  }
+  ExpectSameTrack(first, again);
 }
 
 // A new track's first fold reads one sample in k of a large window (issue 41); the folds
@@ -315,23 +323,7 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   const TrackResult whole = Track(spec, {csv}, dir + "/whole", options);
   ASSERT_TRUE(whole.converged);
   for (int s : strides) EXPECT_EQ(s, 1);
-  constexpr double kStepToleranceSigmas = 0.05;
-  constexpr double kSameSigmaRelative = 1e-3;
-  const auto same = [&](const TrackEstimate& a, const TrackEstimate& b, const std::string& name) {
-    EXPECT_NEAR(b.value, a.value, kStepToleranceSigmas * a.sigma_total) << name;
-    EXPECT_NEAR(b.sigma_total, a.sigma_total, kSameSigmaRelative * a.sigma_total) << name;
-  };
-  ASSERT_EQ(whole.windows.size(), 2u);
-  for (size_t w = 0; w < 2; ++w) {
-    for (size_t k = 0; k < whole.windows[w].estimates.size(); ++k) {
-      same(whole.windows[w].estimates[k], first_step.windows[w].estimates[k],
-           std::to_string(w) + " " + std::to_string(k));
-    }
-  }
-  ASSERT_EQ(first_step.shared.size(), whole.shared.size());
-  for (size_t e = 0; e < whole.shared.size(); ++e) {
-    same(whole.shared[e].estimate, first_step.shared[e].estimate, whole.shared[e].name);
-  }
+  ExpectSameTrack(whole, first_step);
 
   // From the solution: the whole's chi-square after the first step is about k times the
   // subsample's, which is no reason to take that step back.
