@@ -86,7 +86,7 @@ def test_a_model_changed_by_another_thread_never_crashes_a_call() -> None:
 # with the model as it was and as it became are both accepted; anything else is a mix.
 RACE_ONE = textwrap.dedent(
     """
-    import os, sys, tempfile, threading, time
+    import atexit, os, shutil, sys, tempfile, threading, time
     import numpy as np
     import fastcal
 
@@ -107,6 +107,7 @@ RACE_ONE = textwrap.dedent(
     spec = os.path.join(data_dir, "spec_mass_centre.yaml")
     s0 = fastcal.solve(p[:5], quat=q[:5]).s0_m
     work = tempfile.mkdtemp()
+    atexit.register(shutil.rmtree, work, True)  # the tracks' directories, at exit
     runs = [0]
 
     def once(m):
