@@ -17,7 +17,8 @@ namespace fastcal::test {
 
 // The paths handed out, removed (files or whole directories) when the test program
 // exits, whether its tests passed or not: the suite left ~6 MB a run in /tmp (a track
-// test's season). FASTCAL_KEEP_TEST_FILES=1 keeps them for a look.
+// test's season). FASTCAL_KEEP_TEST_FILES=1 keeps them for a look. Only by the process
+// that handed them out: a death test's child exits too.
 class TempPaths {
  public:
   static TempPaths& Get() {
@@ -29,7 +30,7 @@ class TempPaths {
     paths_.insert(path);
   }
   ~TempPaths() {
-    if (std::getenv("FASTCAL_KEEP_TEST_FILES") != nullptr) return;
+    if (std::getenv("FASTCAL_KEEP_TEST_FILES") != nullptr || ::getpid() != owner_) return;
     for (const std::string& p : paths_) {
       std::error_code ec;
       std::filesystem::remove_all(p, ec);
@@ -39,6 +40,7 @@ class TempPaths {
  private:
   std::mutex mutex_;
   std::set<std::string> paths_;
+  pid_t owner_ = ::getpid();
 };
 
 // TempDir() + name + "_" + the process id (+ extension, e.g. ".csv"); removed at exit.

@@ -252,37 +252,47 @@ TEST_F(TrackFoldTest, SameBytesOnAnyNumberOfThreads) {
 }
 
 // A fold through every k-th sample (a track's first step, FoldTask::stride) is the fold
-// of those samples alone, from memory and from the window's store.
+// of those samples alone, from memory and from the window's store: a window's end that is
+// not a multiple of k, one span of the window read or several (Strided reads at most
+// 4096 samples at once: 1000 strided samples of 5 are two spans), one thread or two.
 TEST_F(TrackFoldTest, AStrideFoldsEveryKthSampleAsTheirOwnWindow) {
-  Simulate(kLongSamples);
-  constexpr int kStride = 3;
-  Dataset every_kth = data_;
-  every_kth.samples.clear();
-  for (size_t t = 0; t < data_.samples.size(); t += kStride) {
-    every_kth.samples.push_back(data_.samples[t]);
+  struct Case {
+    int samples, stride, threads;
+  };
+  for (const Case c : {Case{kLongSamples, 3, 1}, Case{5000, 5, 2}}) {
+    SCOPED_TRACE(std::to_string(c.samples) + " samples, stride " + std::to_string(c.stride));
+    Simulate(c.samples);
+    Dataset every_kth = data_;
+    every_kth.samples.clear();
+    for (size_t t = 0; t < data_.samples.size(); t += c.stride) {
+      every_kth.samples.push_back(data_.samples[t]);
+    }
+    FoldTask strided = task_;
+    strided.stride = c.stride;
+    strided.threads = c.threads;
+    WindowFold alone;
+    std::string error;
+    ASSERT_TRUE(FoldSamples(task_, every_kth, {}, &alone, &error)) << error;
+    EXPECT_EQ(alone.samples, (c.samples + c.stride - 1) / c.stride);
+    const std::string expected = SerializeWindowFold(alone);
+    EXPECT_EQ(SerializeWindowFold(Fold(strided)), expected);
+
+    const std::string store = test::TempPath("track_fold_strided", ".samples");
+    std::remove(store.c_str());
+    std::vector<internal::StoredSample> records;
+    for (const Sample& s : data_.samples) records.push_back(internal::ToStored(s, 0, false));
+    ASSERT_TRUE(internal::AppendStoredSamples(store, records, 0, &error)) << error;
+    strided.samples_path = store;
+    WindowFold stored;
+    ASSERT_TRUE(FoldWindow(strided, &stored, &error)) << error;
+    EXPECT_EQ(SerializeWindowFold(stored), expected);
+    std::remove(store.c_str());
   }
   FoldTask strided = task_;
-  strided.stride = kStride;
-  WindowFold alone;
-  std::string error;
-  ASSERT_TRUE(FoldSamples(task_, every_kth, {}, &alone, &error)) << error;
-  EXPECT_EQ(alone.samples, (kLongSamples + kStride - 1) / kStride);
-  const std::string expected = SerializeWindowFold(alone);
-  EXPECT_EQ(SerializeWindowFold(Fold(strided)), expected);
-
-  const std::string store = test::TempPath("track_fold_strided", ".samples");
-  std::remove(store.c_str());
-  std::vector<internal::StoredSample> records;
-  for (const Sample& s : data_.samples) records.push_back(internal::ToStored(s, 0, false));
-  ASSERT_TRUE(internal::AppendStoredSamples(store, records, 0, &error)) << error;
-  strided.samples_path = store;
-  WindowFold stored;
-  ASSERT_TRUE(FoldWindow(strided, &stored, &error)) << error;
-  EXPECT_EQ(SerializeWindowFold(stored), expected);
-  std::remove(store.c_str());
-
   strided.stride = 0;
-  EXPECT_FALSE(FoldSamples(strided, data_, {}, &stored, &error));
+  WindowFold fold;
+  std::string error;
+  EXPECT_FALSE(FoldSamples(strided, data_, {}, &fold, &error));
   EXPECT_NE(error.find("stride"), std::string::npos) << error;
 }
 

@@ -339,7 +339,16 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   EXPECT_TRUE(again.converged);
   EXPECT_EQ(halved, "");
 
-  options.first_fold_samples = -1;
+  // A track of one iteration takes no first step through a subsample: its folds are the
+  // track's (and its saved state's).
+  strides.clear();
+  options.max_iterations = 1;
+  Track(spec, {csv}, dir + "/one", options);
+  ASSERT_EQ(strides.size(), 2u);  // the iteration, then the consider columns
+  EXPECT_EQ(strides[0], 1);
+  options.max_iterations = TrackOptions().max_iterations;
+
+  options.first_fold_samples = 99;  // below min_window_samples: a window of one sample
   TrackResult bad;
   EXPECT_EQ(RunTrack(CableRobot::NominalFast(), spec, {csv}, WindowSpec(), dir + "/bad", options,
                      &bad, &error),

@@ -114,7 +114,8 @@ struct TrackOptions {
   // A new track's first fold, at the initial model, reads every k-th sample of a window
   // of at least twice this many (k = samples / this, rounded down): its step only brings
   // the point near the solution, which the later folds, of every sample, reach (issue 41:
-  // that fold was a quarter of a track of 10^7 samples). 0: every sample.
+  // that fold was a quarter of a track of 10^7 samples). 0: every sample; otherwise at
+  // least min_window_samples. Not with max_iterations = 1.
   long long first_fold_samples = 20000;
   // Converged when every parameter's step is below this fraction of its formal sigma.
   // The consider parameters' columns are folded with an iteration whose step may be the

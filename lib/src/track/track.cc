@@ -201,8 +201,9 @@ bool TrackOptions::IsValid(std::string* error) const {
           std::to_string(threads);
   else if (max_iterations < 1)
     why = "max_iterations must be >= 1";
-  else if (first_fold_samples < 0)
-    why = "first_fold_samples must be >= 0";
+  else if (first_fold_samples != 0 && first_fold_samples < min_window_samples)
+    why = "first_fold_samples must be 0 (every sample) or at least min_window_samples (" +
+          std::to_string(min_window_samples) + "), got " + std::to_string(first_fold_samples);
   else if (!(step_tolerance_sigmas > 0.0))
     why = "step_tolerance_sigmas must be > 0";
   else if (!(false_alarm > 0.0 && false_alarm < 0.5))

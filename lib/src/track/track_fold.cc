@@ -492,23 +492,31 @@ bool NoSampleTwice(const FoldTask& task, const SampleSource& source, const Windo
   return true;
 }
 
-// Every `stride`-th sample of `all` (its first, then every stride-th after it).
+// Every `stride`-th sample of `all` (its first, then every stride-th after it), read in
+// spans of at most kStridedSpanSamples (a large stride reads its samples one by one: the
+// fold's memory stays that of a piece whatever the stride).
+constexpr int kStridedSpanSamples = 4096;
 SampleSource Strided(const SampleSource& all, int stride) {
   SampleSource s = all;
   s.size = (all.size + stride - 1) / stride;
   s.read = [all, stride](long long first, int count, std::vector<Sample>* samples,
                          std::vector<int>* files, std::string* why) {
-    if (count < 1) return all.read(first, count, samples, files, why);
-    const long long from = first * stride;
-    const int span = static_cast<int>(
-        std::min<long long>(all.size - from, static_cast<long long>(count - 1) * stride + 1));
-    if (!all.read(from, span, samples, files, why)) return false;
-    for (int k = 0; k < count; ++k) {
-      (*samples)[k] = std::move((*samples)[static_cast<size_t>(k) * stride]);
-      (*files)[k] = (*files)[static_cast<size_t>(k) * stride];
+    samples->clear();
+    files->clear();
+    std::vector<Sample> span;
+    std::vector<int> span_files;
+    const int per_span = std::max(1, (kStridedSpanSamples - 1) / stride + 1);
+    for (int k = 0; k < count; k += per_span) {
+      const int m = std::min(per_span, count - k);
+      const long long from = (first + k) * stride;
+      const int length = static_cast<int>(
+          std::min<long long>(all.size - from, static_cast<long long>(m - 1) * stride + 1));
+      if (!all.read(from, length, &span, &span_files, why)) return false;
+      for (int j = 0; j < m; ++j) {
+        samples->push_back(std::move(span[static_cast<size_t>(j) * stride]));
+        files->push_back(span_files[static_cast<size_t>(j) * stride]);
+      }
     }
-    samples->resize(count);
-    files->resize(count);
     return true;
   };
   return s;

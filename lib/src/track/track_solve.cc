@@ -460,20 +460,28 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
   run.result->slow_error.process = run.slow;
   double previous_chi2 = std::numeric_limits<double>::infinity();
   std::vector<std::vector<double>> previous_theta(run.windows.size());
+  bool has_previous_point = false;  // previous_theta holds a point folded in full
   int halvings = 0;
   double last_step = std::numeric_limits<double>::infinity();  // sigmas
+  bool folds_strided = false;  // the windows' folds are a first step's, of a subsample
   for (int it = 1; it <= run.options.max_iterations; ++it) {
     if (run.StopRequested()) return run.Cancel();
     ++run.result->iterations;
     const bool may_be_last =
         kNextStepPerSquaredStep * last_step * last_step <= run.options.step_tolerance_sigmas;
-    // A new track's first step, from the initial model, through a subsample.
-    const bool first_step = estimate_slow_error && it == 1 && !run.update;
+    // A new track's first step, from the initial model, through a subsample (never the
+    // last one: the track's folds are each of every sample).
+    const bool first_step =
+        estimate_slow_error && it == 1 && !run.update && run.options.max_iterations > 1;
     bool strided = false;
     const bool folded = FoldDirty(run, may_be_last && !first_step, first_step, &strided);
+    if (folded) folds_strided = strided;
     const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
-    if ((!folded || chi2 > previous_chi2 + ChiSquareSlack(previous_chi2)) &&
-        halvings < kMaxHalvings && std::isfinite(previous_chi2)) {
+    // A fold that failed (the point left the model's range), or a chi-square that rose
+    // where the one before is comparable (not a subsample's, nor another slow error's).
+    const bool worse = !folded || (std::isfinite(previous_chi2) &&
+                                   chi2 > previous_chi2 + ChiSquareSlack(previous_chi2));
+    if (worse && halvings < kMaxHalvings && has_previous_point) {
       // Back half way to the previous point.
       for (int w : run.used) {
         TrackWindowState& win = run.windows[w];
@@ -501,7 +509,8 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
       return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
     }
     const double step = LargestStep(run);
-    last_step = step;
+    // A subsample's sigmas are sqrt(k) times the whole's: its step says little of the next.
+    last_step = strided ? std::numeric_limits<double>::infinity() : step;
     run.Progress("iteration " + std::to_string(run.result->iterations) + ": chi-square " +
                  FormatDouble("%.9g", chi2) + " -> " +
                  FormatDouble("%.9g", run.solver.ChiSquare()) + ", largest step " +
@@ -527,14 +536,21 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
       previous_theta[run.used[u]] = win.theta;
       PointFromSolution(run, static_cast<int>(u), &win.theta);
     }
+    has_previous_point = true;
     MarkMovingDirty(run);
   }
   run.result->converged = false;
   run.result->notes.push_back("Gauss-Newton did not converge in " +
                               std::to_string(run.options.max_iterations) +
                               " iterations: the estimates are the last step's");
-  // The last solve stands; the windows' points are its folds'.
-  for (int w : run.used) run.windows[w].dirty = false;
+  // The last solve stands; the windows' points are its folds'. Folds of a subsample (a
+  // first step whose next fold failed on the last iteration) are folded again in full.
+  for (int w : run.used) {
+    TrackWindowState& win = run.windows[w];
+    win.dirty = folds_strided && Moving(run, win);
+    if (win.dirty) win.theta = win.fold.theta_si;
+  }
+  if (folds_strided && !FoldDirty(run)) return TrackStatus::kInfeasible;
   BuildProblem(run);
   if (!run.solver.Solve(run.problem))
     return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
