@@ -348,6 +348,28 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   EXPECT_EQ(strides[0], 1);
   options.max_iterations = TrackOptions().max_iterations;
 
+  // A fold that fails after the first step (as where that step left the model's range) is
+  // halved back towards the initial point, not the end of the track.
+  halved.clear();
+  int round = 0;
+  TrackOptions failing = options;
+  failing.runner = [&round, &options](const std::vector<std::string>& tasks,
+                                      std::vector<std::string>* folds, std::string* error) {
+    if (++round == 2) {
+      *error = "day.csv:7: the model at the track's point cannot solve this pose";
+      return false;
+    }
+    return options.runner(tasks, folds, error);
+  };
+  TrackResult recovered;
+  ASSERT_EQ(RunTrack(CableRobot::NominalFast(), spec, {csv}, WindowSpec(), dir + "/recovered",
+                     failing, &recovered, &error),
+            TrackStatus::kOk)
+      << error;
+  EXPECT_NE(halved.find("step halved"), std::string::npos);
+  EXPECT_TRUE(recovered.converged);
+  ExpectSameTrack(whole, recovered);
+
   options.first_fold_samples = 99;  // below min_window_samples: a window of one sample
   TrackResult bad;
   EXPECT_EQ(RunTrack(CableRobot::NominalFast(), spec, {csv}, WindowSpec(), dir + "/bad", options,
