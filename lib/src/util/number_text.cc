@@ -4,6 +4,7 @@
 #include <cctype>
 #include <charconv>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <system_error>
 
@@ -107,7 +108,70 @@ bool IsDecimalText(std::string_view text) {
 
 }  // namespace
 
+bool ParseDecimalFastPath(std::string_view text, int shift, double* value) {
+  constexpr int kMaxDigits = 19;  // any 19 digits fit in 64 bits
+  constexpr std::uint64_t kMaxExact = 1ULL << 53;
+  constexpr int kMaxPower = 22;  // 10^22 is the largest exact power of ten
+  static constexpr double kPowers[kMaxPower + 1] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
+                                                    1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+                                                    1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const size_t n = text.size();
+  size_t i = 0;
+  bool negative = false;
+  if (i < n && (text[i] == '+' || text[i] == '-')) negative = text[i++] == '-';
+  std::uint64_t m = 0;
+  int digits = 0;      // significant digits in m (leading zeros not counted)
+  long power = shift;  // m * 10^power
+  bool any = false;
+  const auto digit = [&](bool fraction) {
+    const int d = text[i] - '0';
+    any = true;
+    if (m == 0 && d == 0) {  // a leading zero
+      if (fraction) --power;
+      return true;
+    }
+    if (digits == kMaxDigits) return false;
+    m = m * 10 + static_cast<std::uint64_t>(d);
+    ++digits;
+    if (fraction) --power;
+    return true;
+  };
+  for (; i < n && text[i] >= '0' && text[i] <= '9'; ++i) {
+    if (!digit(false)) return false;
+  }
+  if (i < n && text[i] == '.') {
+    for (++i; i < n && text[i] >= '0' && text[i] <= '9'; ++i) {
+      if (!digit(true)) return false;
+    }
+  }
+  if (!any) return false;
+  if (i < n && (text[i] == 'e' || text[i] == 'E')) {
+    ++i;
+    bool negative_exponent = false;
+    if (i < n && (text[i] == '+' || text[i] == '-')) negative_exponent = text[i++] == '-';
+    long exponent = 0;
+    const size_t first = i;
+    for (; i < n && text[i] >= '0' && text[i] <= '9'; ++i) {
+      if (exponent > 1000) return false;  // far out of the fast path's range
+      exponent = exponent * 10 + (text[i] - '0');
+    }
+    if (i == first) return false;
+    power += negative_exponent ? -exponent : exponent;
+  }
+  if (i != n) return false;
+  if (m == 0) {
+    *value = negative ? -0.0 : 0.0;
+    return true;
+  }
+  if (m > kMaxExact || power < -kMaxPower || power > kMaxPower) return false;
+  const double v = power < 0 ? static_cast<double>(m) / kPowers[-power]
+                             : static_cast<double>(m) * kPowers[power];
+  *value = negative ? -v : v;
+  return true;
+}
+
 bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why) {
+  if (ParseDecimalFastPath(text, 0, value)) return true;
   if (text.empty()) {
     *why = "missing value";
     return false;
