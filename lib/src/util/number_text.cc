@@ -108,75 +108,96 @@ bool IsDecimalText(std::string_view text) {
 
 }  // namespace
 
-bool ParseDecimalFastPath(std::string_view text, int shift, double* value) {
-  constexpr int kMaxDigits = 19;  // any 19 digits fit in 64 bits
+namespace {
+
+enum class Decimal {
+  kExact,  // Clinger's fast path gave the value
+  kPlain,  // the grammar of a plain decimal, beyond the fast path: std::from_chars reads it
+  kOther,  // not a plain decimal (empty, hexadecimal, inf, nan, a stray character...)
+};
+
+// One pass over `text`: its grammar ([+-]digits[.digits][(e|E)[+-]digits]) and, while the
+// mantissa fits (at most 2^53, beyond which digits are only checked), the value times
+// 10^shift by Clinger's fast path.
+Decimal ScanDecimal(std::string_view text, int shift, double* value) {
   constexpr std::uint64_t kMaxExact = 1ULL << 53;
   constexpr int kMaxPower = 22;  // 10^22 is the largest exact power of ten
   static constexpr double kPowers[kMaxPower + 1] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
-  const size_t n = text.size();
-  size_t i = 0;
+  const char* p = text.data();
+  const char* const end = p + text.size();
   bool negative = false;
-  if (i < n && (text[i] == '+' || text[i] == '-')) negative = text[i++] == '-';
+  if (p != end && (*p == '+' || *p == '-')) negative = *p++ == '-';
   std::uint64_t m = 0;
-  int digits = 0;      // significant digits in m (leading zeros not counted)
-  long power = shift;  // m * 10^power
-  bool any = false;
-  const auto digit = [&](bool fraction) {
-    const int d = text[i] - '0';
-    any = true;
-    if (m == 0 && d == 0) {  // a leading zero
-      if (fraction) --power;
-      return true;
+  long power = shift;  // the value is m * 10^power while `exact`
+  bool exact = true, any = false;
+  const auto is_digit = [](char c) { return static_cast<unsigned char>(c - '0') < 10; };
+  // A digit of the mantissa (m < 10^18 keeps m * 10 + 9 within 64 bits).
+  const auto take = [&](char c, bool fraction) {
+    if (!exact) return;
+    if (m >= 100000000000000000ULL) {
+      exact = false;
+      return;
     }
-    if (digits == kMaxDigits) return false;
-    m = m * 10 + static_cast<std::uint64_t>(d);
-    ++digits;
-    if (fraction) --power;
-    return true;
+    m = m * 10 + static_cast<std::uint64_t>(c - '0');
+    power -= fraction;
   };
-  for (; i < n && text[i] >= '0' && text[i] <= '9'; ++i) {
-    if (!digit(false)) return false;
+  for (; p != end && is_digit(*p); ++p) take(*p, false), any = true;
+  if (p != end && *p == '.') {
+    for (++p; p != end && is_digit(*p); ++p) take(*p, true), any = true;
   }
-  if (i < n && text[i] == '.') {
-    for (++i; i < n && text[i] >= '0' && text[i] <= '9'; ++i) {
-      if (!digit(true)) return false;
-    }
-  }
-  if (!any) return false;
-  if (i < n && (text[i] == 'e' || text[i] == 'E')) {
-    ++i;
+  if (!any) return Decimal::kOther;
+  if (p != end && (*p == 'e' || *p == 'E')) {
+    ++p;
     bool negative_exponent = false;
-    if (i < n && (text[i] == '+' || text[i] == '-')) negative_exponent = text[i++] == '-';
+    if (p != end && (*p == '+' || *p == '-')) negative_exponent = *p++ == '-';
+    if (p == end || !is_digit(*p)) return Decimal::kOther;
     long exponent = 0;
-    const size_t first = i;
-    for (; i < n && text[i] >= '0' && text[i] <= '9'; ++i) {
-      if (exponent > 1000) return false;  // far out of the fast path's range
-      exponent = exponent * 10 + (text[i] - '0');
+    for (; p != end && is_digit(*p); ++p) {
+      if (exponent < 100000) exponent = exponent * 10 + (*p - '0');  // beyond: not exact
     }
-    if (i == first) return false;
+    if (exponent >= 100000) exact = false;
     power += negative_exponent ? -exponent : exponent;
   }
-  if (i != n) return false;
+  if (p != end) return Decimal::kOther;
+  if (!exact) return Decimal::kPlain;
   if (m == 0) {
     *value = negative ? -0.0 : 0.0;
-    return true;
+    return Decimal::kExact;
   }
-  if (m > kMaxExact || power < -kMaxPower || power > kMaxPower) return false;
+  if (m > kMaxExact || power < -kMaxPower || power > kMaxPower) return Decimal::kPlain;
   const double v = power < 0 ? static_cast<double>(m) / kPowers[-power]
                              : static_cast<double>(m) * kPowers[power];
   *value = negative ? -v : v;
-  return true;
+  return Decimal::kExact;
+}
+
+}  // namespace
+
+bool ParseDecimalFastPath(std::string_view text, int shift, double* value) {
+  return ScanDecimal(text, shift, value) == Decimal::kExact;
 }
 
 bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why) {
-  if (ParseDecimalFastPath(text, 0, value)) return true;
+  double parsed = 0.0;
+  switch (ScanDecimal(text, 0, &parsed)) {
+    case Decimal::kExact:
+      *value = parsed;
+      return true;
+    case Decimal::kPlain:  // the grammar is checked: std::from_chars alone
+      if (ParseDouble(text, &parsed) && std::isfinite(parsed)) {
+        *value = parsed;
+        return true;
+      }
+      break;  // out of range: said below
+    case Decimal::kOther:
+      break;
+  }
   if (text.empty()) {
     *why = "missing value";
     return false;
   }
-  double parsed = 0.0;
   const bool number = ParseDouble(text, &parsed);
   if (number && !IsDecimalText(text)) {
     if (std::isfinite(parsed)) {
