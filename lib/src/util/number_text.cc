@@ -116,56 +116,64 @@ enum class Decimal {
   kOther,  // not a plain decimal (empty, hexadecimal, inf, nan, a stray character...)
 };
 
-// One pass over `text`: its grammar ([+-]digits[.digits][(e|E)[+-]digits]) and, while the
-// mantissa fits (at most 2^53, beyond which digits are only checked), the value times
-// 10^shift by Clinger's fast path.
+// `text`'s grammar ([+-]digits[.digits][(e|E)[+-]digits]) in one scan, then, when it has
+// at most 16 significant digits (2^53 has 16: a 17-digit mantissa is above it), its
+// value times 10^shift by Clinger's fast path.
 Decimal ScanDecimal(std::string_view text, int shift, double* value) {
+  constexpr int kMaxDigits = 16;
   constexpr std::uint64_t kMaxExact = 1ULL << 53;
   constexpr int kMaxPower = 22;  // 10^22 is the largest exact power of ten
+  constexpr long kMaxExponent = 100000;  // beyond: the exponent is only checked
   static constexpr double kPowers[kMaxPower + 1] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
                                                     1e16, 1e17, 1e18, 1e19, 1e20, 1e21, 1e22};
+  const auto is_digit = [](char c) { return static_cast<unsigned char>(c - '0') < 10; };
   const char* p = text.data();
   const char* const end = p + text.size();
   bool negative = false;
   if (p != end && (*p == '+' || *p == '-')) negative = *p++ == '-';
-  std::uint64_t m = 0;
-  long power = shift;  // the value is m * 10^power while `exact`
-  bool exact = true, any = false;
-  const auto is_digit = [](char c) { return static_cast<unsigned char>(c - '0') < 10; };
-  // A digit of the mantissa (m < 10^18 keeps m * 10 + 9 within 64 bits).
-  const auto take = [&](char c, bool fraction) {
-    if (!exact) return;
-    if (m >= 100000000000000000ULL) {
-      exact = false;
-      return;
-    }
-    m = m * 10 + static_cast<std::uint64_t>(c - '0');
-    power -= fraction;
-  };
-  for (; p != end && is_digit(*p); ++p) take(*p, false), any = true;
+  const char* const whole = p;  // the integer digits [whole, whole_end)
+  while (p != end && is_digit(*p)) ++p;
+  const char* const whole_end = p;
+  const char* fraction = p;  // the fraction digits [fraction, fraction_end)
   if (p != end && *p == '.') {
-    for (++p; p != end && is_digit(*p); ++p) take(*p, true), any = true;
+    fraction = ++p;
+    while (p != end && is_digit(*p)) ++p;
   }
-  if (!any) return Decimal::kOther;
+  const char* const fraction_end = p;
+  if (whole == whole_end && fraction == fraction_end) return Decimal::kOther;
+  long exponent = 0;
   if (p != end && (*p == 'e' || *p == 'E')) {
     ++p;
     bool negative_exponent = false;
     if (p != end && (*p == '+' || *p == '-')) negative_exponent = *p++ == '-';
     if (p == end || !is_digit(*p)) return Decimal::kOther;
-    long exponent = 0;
     for (; p != end && is_digit(*p); ++p) {
-      if (exponent < 100000) exponent = exponent * 10 + (*p - '0');  // beyond: not exact
+      if (exponent <= kMaxExponent) exponent = exponent * 10 + (*p - '0');
     }
-    if (exponent >= 100000) exact = false;
-    power += negative_exponent ? -exponent : exponent;
+    if (negative_exponent) exponent = -exponent;
   }
   if (p != end) return Decimal::kOther;
-  if (!exact) return Decimal::kPlain;
-  if (m == 0) {
+  // The significant digits: from the first non-zero one.
+  const char* first = whole;
+  while (first != whole_end && *first == '0') ++first;
+  const char* first_fraction = fraction;
+  if (first == whole_end) {
+    while (first_fraction != fraction_end && *first_fraction == '0') ++first_fraction;
+  }
+  const long digits = first != whole_end ? (whole_end - first) + (fraction_end - fraction)
+                                         : fraction_end - first_fraction;
+  if (digits == 0) {  // zero, whatever the exponent
     *value = negative ? -0.0 : 0.0;
     return Decimal::kExact;
   }
+  if (digits > kMaxDigits || std::labs(exponent) > kMaxExponent) return Decimal::kPlain;
+  std::uint64_t m = 0;
+  for (const char* d = first; d < whole_end; ++d) m = m * 10 + static_cast<std::uint64_t>(*d - '0');
+  for (const char* d = first != whole_end ? fraction : first_fraction; d < fraction_end; ++d) {
+    m = m * 10 + static_cast<std::uint64_t>(*d - '0');
+  }
+  const long power = shift + exponent - (fraction_end - fraction);
   if (m > kMaxExact || power < -kMaxPower || power > kMaxPower) return Decimal::kPlain;
   const double v = power < 0 ? static_cast<double>(m) / kPowers[-power]
                              : static_cast<double>(m) * kPowers[power];
