@@ -236,8 +236,8 @@ TEST(TrackTest, ConsiderColumnsComeWithTheLastFoldOrAreFoldedAtTheSolution) {
   // Per round of folds: whether its tasks carry the consider columns.
   std::vector<bool> rounds;
   TrackOptions options;
-  options.runner = [&rounds](const std::vector<std::string>& tasks,
-                             std::vector<std::string>* folds, std::string* error) {
+  options.runner = [&rounds](const std::vector<std::string>& tasks, std::vector<std::string>* folds,
+                             std::string* error) {
     bool consider = false;
     for (const std::string& t : tasks) {
       FoldTask task;

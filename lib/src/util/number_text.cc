@@ -122,7 +122,7 @@ enum class Decimal {
 Decimal ScanDecimal(std::string_view text, int shift, double* value) {
   constexpr int kMaxDigits = 16;
   constexpr std::uint64_t kMaxExact = 1ULL << 53;
-  constexpr int kMaxPower = 22;  // 10^22 is the largest exact power of ten
+  constexpr int kMaxPower = 22;          // 10^22 is the largest exact power of ten
   constexpr long kMaxExponent = 100000;  // beyond: the exponent is only checked
   static constexpr double kPowers[kMaxPower + 1] = {1e0,  1e1,  1e2,  1e3,  1e4,  1e5,  1e6,  1e7,
                                                     1e8,  1e9,  1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
