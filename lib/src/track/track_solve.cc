@@ -439,13 +439,24 @@ void InitialPoints(TrackRun& run) {
   }
 }
 
-TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
-  if (run.used.empty()) {
-    return run.Fail(
-        TrackStatus::kInvalidInput,
-        "no window has " + std::to_string(run.options.min_window_samples) + " samples or more");
-  }
-  if (!CheckMovingStores(run)) return TrackStatus::kInvalidInput;
+namespace {
+
+// Where Gauss-Newton stands between its iterations (Iterate).
+struct GaussNewton {
+  // The last full fold's chi-square, infinite when the next fold's is not comparable (a
+  // subsample's, or before another slow error).
+  double previous_chi2 = std::numeric_limits<double>::infinity();
+  std::vector<std::vector<double>> previous_theta;  // per window, the point before the step
+  bool has_previous_point = false;                  // previous_theta holds one
+  int halvings = 0;
+  // The last step in sigmas, infinite when it says nothing of the next (a subsample's).
+  double last_step = std::numeric_limits<double>::infinity();
+  bool folds_strided = false;  // the windows' folds are a first step's, of a subsample
+};
+
+// The slow error at the start of the iterations (the spec's initial one for a new track;
+// an update keeps the track's). Returns whether it is settled (not to be re-estimated).
+bool StartSlowError(TrackRun& run, bool estimate_slow_error) {
   bool slow_settled = !estimate_slow_error || !run.spec.slow_error.estimates_any() || run.update;
   if (run.update && run.spec.slow_error.estimates_any() && estimate_slow_error) {
     run.result->slow_error.enabled = true;
@@ -458,45 +469,101 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
   if (!run.spec.slow_error.estimates_any()) run.slow = run.spec.slow_error.Initial();
   if (run.result->folds == 0 && !run.update) run.slow = run.spec.slow_error.Initial();
   run.result->slow_error.process = run.slow;
-  double previous_chi2 = std::numeric_limits<double>::infinity();
-  std::vector<std::vector<double>> previous_theta(run.windows.size());
-  bool has_previous_point = false;  // previous_theta holds a point folded in full
-  int halvings = 0;
-  double last_step = std::numeric_limits<double>::infinity();  // sigmas
-  bool folds_strided = false;  // the windows' folds are a first step's, of a subsample
+  return slow_settled;
+}
+
+// After a fold that failed (the point left the model's range) or raised the chi-square
+// over a comparable one: the moving windows back half way to the previous point. True
+// when so (the caller folds again).
+bool HalveBack(TrackRun& run, GaussNewton& gn, bool folded, double chi2) {
+  const bool worse = !folded || (std::isfinite(gn.previous_chi2) &&
+                                 chi2 > gn.previous_chi2 + ChiSquareSlack(gn.previous_chi2));
+  if (!worse || gn.halvings >= kMaxHalvings || !gn.has_previous_point) return false;
+  for (int w : run.used) {
+    TrackWindowState& win = run.windows[w];
+    if (!Moving(run, win)) continue;
+    for (size_t k = 0; k < win.theta.size(); ++k) {
+      win.theta[k] = 0.5 * (win.theta[k] + gn.previous_theta[w][k]);
+    }
+    win.dirty = true;
+  }
+  ++gn.halvings;
+  run.Progress("step halved (chi-square " + FormatDouble("%.6g", chi2) + ")");
+  return true;
+}
+
+void MarkConverged(TrackRun& run) {
+  run.result->converged = true;
+  // An earlier pass's "did not converge" no longer holds (issue 37: the summary said
+  // "(converged)" beside it).
+  std::vector<std::string>& notes = run.result->notes;
+  notes.erase(std::remove_if(notes.begin(), notes.end(),
+                             [](const std::string& n) {
+                               return n.rfind("Gauss-Newton did not converge", 0) == 0;
+                             }),
+              notes.end());
+}
+
+// The moving windows' points to the solve's solution (the old ones kept for a halving).
+void StepToSolution(TrackRun& run, GaussNewton& gn) {
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    TrackWindowState& win = run.windows[run.used[u]];
+    if (!Moving(run, win)) continue;
+    gn.previous_theta[run.used[u]] = win.theta;
+    PointFromSolution(run, static_cast<int>(u), &win.theta);
+  }
+  gn.has_previous_point = true;
+  MarkMovingDirty(run);
+}
+
+// Out of iterations: the last solve stands, the windows' points its folds'. Folds of a
+// subsample (a first step whose next fold failed on the last iteration) are folded again
+// in full: the track's folds are each of every sample.
+TrackStatus EndUnconverged(TrackRun& run, const GaussNewton& gn) {
+  run.result->converged = false;
+  run.result->notes.push_back("Gauss-Newton did not converge in " +
+                              std::to_string(run.options.max_iterations) +
+                              " iterations: the estimates are the last step's");
+  for (int w : run.used) {
+    TrackWindowState& win = run.windows[w];
+    win.dirty = gn.folds_strided && Moving(run, win);
+    if (win.dirty) win.theta = win.fold.theta_si;
+  }
+  if (gn.folds_strided && !FoldDirty(run)) return TrackStatus::kInfeasible;
+  BuildProblem(run);
+  if (!run.solver.Solve(run.problem))
+    return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
+  return TrackStatus::kOk;
+}
+
+}  // namespace
+
+TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
+  if (run.used.empty()) {
+    return run.Fail(
+        TrackStatus::kInvalidInput,
+        "no window has " + std::to_string(run.options.min_window_samples) + " samples or more");
+  }
+  if (!CheckMovingStores(run)) return TrackStatus::kInvalidInput;
+  // A new track's first fold is at the initial model: its step is taken through a
+  // subsample (never as the last one, the track's folds being each of every sample).
+  const bool new_track = run.result->folds == 0 && !run.update;
+  bool slow_settled = StartSlowError(run, estimate_slow_error);
+  GaussNewton gn;
+  gn.previous_theta.resize(run.windows.size());
   for (int it = 1; it <= run.options.max_iterations; ++it) {
     if (run.StopRequested()) return run.Cancel();
     ++run.result->iterations;
     const bool may_be_last =
-        kNextStepPerSquaredStep * last_step * last_step <= run.options.step_tolerance_sigmas;
-    // A new track's first step, from the initial model, through a subsample (never the
-    // last one: the track's folds are each of every sample).
-    const bool first_step =
-        estimate_slow_error && it == 1 && !run.update && run.options.max_iterations > 1;
+        kNextStepPerSquaredStep * gn.last_step * gn.last_step <= run.options.step_tolerance_sigmas;
+    const bool first_step = new_track && it == 1 && run.options.max_iterations > 1;
     bool strided = false;
     const bool folded = FoldDirty(run, may_be_last && !first_step, first_step, &strided);
-    if (folded) folds_strided = strided;
+    if (folded) gn.folds_strided = strided;
     const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
-    // A fold that failed (the point left the model's range), or a chi-square that rose
-    // where the one before is comparable (not a subsample's, nor another slow error's).
-    const bool worse = !folded || (std::isfinite(previous_chi2) &&
-                                   chi2 > previous_chi2 + ChiSquareSlack(previous_chi2));
-    if (worse && halvings < kMaxHalvings && has_previous_point) {
-      // Back half way to the previous point.
-      for (int w : run.used) {
-        TrackWindowState& win = run.windows[w];
-        if (!Moving(run, win)) continue;
-        for (size_t k = 0; k < win.theta.size(); ++k) {
-          win.theta[k] = 0.5 * (win.theta[k] + previous_theta[w][k]);
-        }
-        win.dirty = true;
-      }
-      ++halvings;
-      run.Progress("step halved (chi-square " + FormatDouble("%.6g", chi2) + ")");
-      continue;
-    }
+    if (HalveBack(run, gn, folded, chi2)) continue;
     if (!folded) return TrackStatus::kInfeasible;
-    halvings = 0;
+    gn.halvings = 0;
     bool process_changed = false;
     // The first fold's point is the initial model: its residuals are mostly the model's
     // error, not the sensors' (calibrate likewise estimates after its first fit).
@@ -510,51 +577,21 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     }
     const double step = LargestStep(run);
     // A subsample's sigmas are sqrt(k) times the whole's: its step says little of the next.
-    last_step = strided ? std::numeric_limits<double>::infinity() : step;
+    gn.last_step = strided ? std::numeric_limits<double>::infinity() : step;
     run.Progress("iteration " + std::to_string(run.result->iterations) + ": chi-square " +
                  FormatDouble("%.9g", chi2) + " -> " +
                  FormatDouble("%.9g", run.solver.ChiSquare()) + ", largest step " +
                  FormatDouble("%.3g", step) + " sigma");
     for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
     if (step < run.options.step_tolerance_sigmas && slow_settled && !process_changed && !strided) {
-      run.result->converged = true;
-      // An earlier pass's "did not converge" no longer holds (issue 37: the summary said
-      // "(converged)" beside it).
-      std::vector<std::string>& notes = run.result->notes;
-      notes.erase(std::remove_if(notes.begin(), notes.end(),
-                                 [](const std::string& n) {
-                                   return n.rfind("Gauss-Newton did not converge", 0) == 0;
-                                 }),
-                  notes.end());
+      MarkConverged(run);
       return TrackStatus::kOk;
     }
     // A subsample's chi-square is not comparable with the whole's.
-    previous_chi2 = process_changed || strided ? std::numeric_limits<double>::infinity() : chi2;
-    for (size_t u = 0; u < run.used.size(); ++u) {
-      TrackWindowState& win = run.windows[run.used[u]];
-      if (!Moving(run, win)) continue;
-      previous_theta[run.used[u]] = win.theta;
-      PointFromSolution(run, static_cast<int>(u), &win.theta);
-    }
-    has_previous_point = true;
-    MarkMovingDirty(run);
+    gn.previous_chi2 = process_changed || strided ? std::numeric_limits<double>::infinity() : chi2;
+    StepToSolution(run, gn);
   }
-  run.result->converged = false;
-  run.result->notes.push_back("Gauss-Newton did not converge in " +
-                              std::to_string(run.options.max_iterations) +
-                              " iterations: the estimates are the last step's");
-  // The last solve stands; the windows' points are its folds'. Folds of a subsample (a
-  // first step whose next fold failed on the last iteration) are folded again in full.
-  for (int w : run.used) {
-    TrackWindowState& win = run.windows[w];
-    win.dirty = folds_strided && Moving(run, win);
-    if (win.dirty) win.theta = win.fold.theta_si;
-  }
-  if (folds_strided && !FoldDirty(run)) return TrackStatus::kInfeasible;
-  BuildProblem(run);
-  if (!run.solver.Solve(run.problem))
-    return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
-  return TrackStatus::kOk;
+  return EndUnconverged(run, gn);
 }
 
 // The consider parameters' columns at the solution: a converged track whose last folds
