@@ -164,6 +164,8 @@ TEST(NumberTextTest, DeclinedTextIsReadOrRefusedAsBefore) {
   EXPECT_NE(why.find("out of the range"), std::string::npos) << why;
   EXPECT_FALSE(ParseFiniteDecimal("", &v, &why));
   EXPECT_EQ(why, "missing value");
+  EXPECT_FALSE(ParseFiniteDecimal("-inf", &v, &why));
+  EXPECT_EQ(why, "value is not finite");
   EXPECT_FALSE(ParseFiniteDecimal("1.5.", &v, &why));
   EXPECT_NE(why.find("is not a number"), std::string::npos) << why;
 }

@@ -83,33 +83,6 @@ bool ParseDouble(std::string_view text, double* value) {
 
 namespace {
 
-// Whether `text` is [+-](digits[.digits] | .digits)[(e|E)[+-]digits] exactly.
-bool IsDecimalText(std::string_view text) {
-  size_t i = 0;
-  const auto digits = [&] {
-    const size_t start = i;
-    while (i < text.size() && text[i] >= '0' && text[i] <= '9') ++i;
-    return i - start;
-  };
-  if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
-  size_t mantissa = digits();
-  if (i < text.size() && text[i] == '.') {
-    ++i;
-    mantissa += digits();
-  }
-  if (mantissa == 0) return false;
-  if (i < text.size() && (text[i] == 'e' || text[i] == 'E')) {
-    ++i;
-    if (i < text.size() && (text[i] == '+' || text[i] == '-')) ++i;
-    if (digits() == 0) return false;
-  }
-  return i == text.size();
-}
-
-}  // namespace
-
-namespace {
-
 enum class Decimal {
   kExact,  // Clinger's fast path gave the value
   kPlain,  // the grammar of a plain decimal, beyond the fast path: std::from_chars reads it
@@ -189,42 +162,29 @@ bool ParseDecimalFastPath(std::string_view text, int shift, double* value) {
 
 bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why) {
   double parsed = 0.0;
-  switch (ScanDecimal(text, 0, &parsed)) {
-    case Decimal::kExact:
-      *value = parsed;
-      return true;
-    case Decimal::kPlain:  // the grammar is checked: std::from_chars alone
-      if (ParseDouble(text, &parsed) && std::isfinite(parsed)) {
-        *value = parsed;
-        return true;
-      }
-      break;  // out of range: said below
-    case Decimal::kOther:
-      break;
+  const Decimal kind = ScanDecimal(text, 0, &parsed);
+  if (kind == Decimal::kExact) {
+    *value = parsed;
+    return true;
+  }
+  // A plain decimal beyond the fast path: std::from_chars alone (its grammar is checked).
+  const bool number = ParseDouble(text, &parsed);
+  if (kind == Decimal::kPlain && number && std::isfinite(parsed)) {
+    *value = parsed;
+    return true;
   }
   if (text.empty()) {
     *why = "missing value";
-    return false;
-  }
-  const bool number = ParseDouble(text, &parsed);
-  if (number && !IsDecimalText(text)) {
-    if (std::isfinite(parsed)) {
-      *why = Quote(text) + " is not a decimal number (hexadecimal is not accepted)";
-    } else {
-      *why = "value is not finite";
-    }
-    return false;
-  }
-  if (!number) {
+  } else if (number && kind == Decimal::kOther) {
+    *why = std::isfinite(parsed)
+               ? Quote(text) + " is not a decimal number (hexadecimal is not accepted)"
+               : "value is not finite";
+  } else if (!number) {
     *why = Quote(text) + " is not a number";
-    return false;
-  }
-  if (!std::isfinite(parsed)) {
+  } else {
     *why = Quote(text) + " is out of the range of a double";
-    return false;
   }
-  *value = parsed;
-  return true;
+  return false;
 }
 
 std::string FormatDouble(std::string_view format, double value) {

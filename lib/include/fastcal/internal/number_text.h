@@ -31,7 +31,7 @@ bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why);
 
 // The decimal text's value times 10^shift, correctly rounded, when `text` is a plain
 // decimal ([+-]digits[.digits][(e|E)[+-]digits], as ParseFiniteDecimal reads) of at
-// most 19 significant digits whose integer mantissa m is at most 2^53 and whose power of
+// most 16 significant digits whose integer mantissa m is at most 2^53 and whose power of
 // ten p (the exponent, the point's place and `shift` together) is within [-22, 22]:
 // then m and 10^|p| are exact doubles and their one product or quotient is rounded
 // correctly by IEEE arithmetic (Clinger's fast path, W. D. Clinger, "How to read
