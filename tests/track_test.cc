@@ -370,6 +370,39 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   EXPECT_TRUE(recovered.converged);
   ExpectSameTrack(whole, recovered);
 
+  // The same failure on the last iteration, without consider columns (no fold at the
+  // solution follows): the subsample's folds are folded again in full, never left as the
+  // track's, whose sigmas would then be sqrt(k) times too large.
+  std::string no_consider = Spec("{sigma_percent: 1, time_constant_s: 120}");
+  no_consider.erase(no_consider.find("  tower_offset_m"),
+                    no_consider.find('\n', no_consider.find("  tower_offset_m")) + 1 -
+                        no_consider.find("  tower_offset_m"));
+  const CalibrationSpec plain = LoadSpec(no_consider);
+  strides.clear();
+  round = 0;
+  failing.max_iterations = 2;
+  TrackResult last;
+  ASSERT_EQ(RunTrack(CableRobot::NominalFast(), plain, {csv}, WindowSpec(), dir + "/last",
+                     failing, &last, &error),
+            TrackStatus::kOk)
+      << error;
+  EXPECT_FALSE(last.converged);
+  EXPECT_EQ(strides, (std::vector<int>{4, 1}));  // the first step, then the whole again
+  const TrackResult plain_whole = [&] {
+    TrackOptions o = options;
+    o.first_fold_samples = 0;
+    return Track(plain, {csv}, dir + "/plain_whole", o);
+  }();
+  constexpr double kSigmaAtAnotherPointRelative = 0.25;  // a strided fold's: 2x at k = 4
+  for (size_t w = 0; w < 2; ++w) {
+    for (size_t k = 0; k < 3; ++k) {
+      EXPECT_NEAR(last.windows[w].estimates[k].sigma_formal,
+                  plain_whole.windows[w].estimates[k].sigma_formal,
+                  kSigmaAtAnotherPointRelative * plain_whole.windows[w].estimates[k].sigma_formal)
+          << w << " " << k;
+    }
+  }
+
   options.first_fold_samples = 99;  // below min_window_samples: a window of one sample
   TrackResult bad;
   EXPECT_EQ(RunTrack(CableRobot::NominalFast(), spec, {csv}, WindowSpec(), dir + "/bad", options,
