@@ -77,13 +77,16 @@ int RunCommand(const std::string& command, int argc, char** argv) {
   try {
     code = Dispatch(command, argc, argv, &known);
   } catch (const std::bad_alloc&) {
-    // Outputs are written last and atomically: nothing is left behind.
+    // Outputs are written last and atomically; what was being written (a temporary, a new
+    // track's staging directory DIR.partial-PID) is removed here, as on SIGINT.
+    fastcal::internal::RemoveTemporariesOnSignal();
     std::cerr << "fastcal " << command
               << ": out of memory: the input or the flags ask for more than this machine has\n";
     return kExitFailure;
   } catch (const std::system_error& e) {
     // The library falls back to fewer threads; this is what remains (e.g. a thread the
     // command line itself could not start): a failure of the machine, not of the input.
+    fastcal::internal::RemoveTemporariesOnSignal();
     std::cerr << "fastcal " << command << ": the system refused a resource: " << e.what() << "\n";
     return kExitFailure;
   }

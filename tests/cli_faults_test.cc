@@ -122,6 +122,27 @@ TEST_F(CliFaultsTest, RefusedThreadsAndMemoryAreTheMachinesNotTheInputs) {
   EXPECT_NE(r.output.find("out of memory"), std::string::npos) << r.output;
   EXPECT_EQ(r.output.find("bad_alloc"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(Path("oom")));
+
+  // A new track out of memory once its staging directory (DIR.partial-PID) is made: that
+  // is removed too, not left beside DIR (it was, until the next run on DIR).
+  const std::string season = Path("season.csv");
+  // 10^5 samples: the track's reading needs tens of MB more than the command's start, so
+  // that 60 MB of address space runs out after the staging directory is made (45-80 MB
+  // did, the build before this fix leaving DIR.partial-PID each time).
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=100000 --days=2 --interval-s=1 "
+                    "--start=2024-05-01T20:00:00Z --out=" +
+                    season)
+                .code,
+            0);
+  const std::string track =
+      "track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=" + season;
+  r = Shell("ulimit -v 60000; " + Bin() + " " + track + " --out=" + Path("oom_track"));
+  EXPECT_EQ(r.code, 1) << r.output;
+  EXPECT_NE(r.output.find("out of memory"), std::string::npos) << r.output;
+  for (const std::string& name : Entries(dir_)) {
+    EXPECT_NE(name.rfind("oom_track", 0), 0u) << name << " left behind";
+  }
+  ASSERT_EQ(Fastcal(track + " --out=" + Path("oom_track")).code, 0);  // and it runs again
 }
 
 TEST_F(CliFaultsTest, EvaluateSpillsWhereTmpdirSays) {
