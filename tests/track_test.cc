@@ -382,8 +382,8 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   round = 0;
   failing.max_iterations = 2;
   TrackResult last;
-  ASSERT_EQ(RunTrack(CableRobot::NominalFast(), plain, {csv}, WindowSpec(), dir + "/last",
-                     failing, &last, &error),
+  ASSERT_EQ(RunTrack(CableRobot::NominalFast(), plain, {csv}, WindowSpec(), dir + "/last", failing,
+                     &last, &error),
             TrackStatus::kOk)
       << error;
   EXPECT_FALSE(last.converged);
