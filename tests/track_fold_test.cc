@@ -251,8 +251,9 @@ TEST_F(TrackFoldTest, SameBytesOnAnyNumberOfThreads) {
   EXPECT_EQ(SerializeWindowFold(Fold(task_)), SerializeWindowFold(Fold(two)));
 }
 
-// A fold through every k-th sample (a track's first step, FoldTask::stride) is the fold
-// of those samples alone, from memory and from the window's store: a window's end that is
+// A fold through every k-th sample (a new track's first steps, FoldTask::stride), but the
+// residual run's samples all, is the fold of those samples alone, from memory and from
+// the window's store, and its residual run is the whole window's: a window's end that is
 // not a multiple of k, one span of the window read or several (Strided reads at most
 // 4096 samples at once: 1000 strided samples of 5 are two spans), one thread or two.
 TEST_F(TrackFoldTest, AStrideFoldsEveryKthSampleAsTheirOwnWindow) {
@@ -262,20 +263,41 @@ TEST_F(TrackFoldTest, AStrideFoldsEveryKthSampleAsTheirOwnWindow) {
   for (const Case c : {Case{kLongSamples, 3, 1}, Case{5000, 5, 2}}) {
     SCOPED_TRACE(std::to_string(c.samples) + " samples, stride " + std::to_string(c.stride));
     Simulate(c.samples);
+    // Every k-th sample before the residual run (the middle residual_samples), the run
+    // whole, then every k-th from its end.
+    const int n = c.samples, run = task_.residual_samples;
+    const int run_first = (n - run) / 2, run_end = run_first + run;
     Dataset every_kth = data_;
     every_kth.samples.clear();
-    for (size_t t = 0; t < data_.samples.size(); t += c.stride) {
-      every_kth.samples.push_back(data_.samples[t]);
-    }
+    for (int t = 0; t < run_first; t += c.stride) every_kth.samples.push_back(data_.samples[t]);
+    for (int t = run_first; t < run_end; ++t) every_kth.samples.push_back(data_.samples[t]);
+    for (int t = run_end; t < n; t += c.stride) every_kth.samples.push_back(data_.samples[t]);
     FoldTask strided = task_;
     strided.stride = c.stride;
     strided.threads = c.threads;
     WindowFold alone;
     std::string error;
+    // The subsample's own residual run: the one it holds whole.
     ASSERT_TRUE(FoldSamples(task_, every_kth, {}, &alone, &error)) << error;
-    EXPECT_EQ(alone.samples, (c.samples + c.stride - 1) / c.stride);
+    const int before = (run_first + c.stride - 1) / c.stride;
+    EXPECT_EQ(alone.samples, before + run + (n - run_end + c.stride - 1) / c.stride);
+    const WindowFold whole = Fold(task_);
+    WindowFold through = Fold(strided);
+    // The residual run is the whole window's (the slow error's estimate reads the same
+    // samples whatever the stride); the alone fold's run is its middle, elsewhere.
+    ASSERT_EQ(through.residuals.size(), whole.residuals.size());
+    for (size_t k = 0; k < whole.residuals.size(); ++k) {
+      EXPECT_EQ(through.residuals[k].time_s, whole.residuals[k].time_s);
+      for (int i = 0; i < kNumCables; ++i) {
+        // Each sample's statics starts from another sample's (the one before it in the
+        // pass): the same solution to the solver's tolerance, not to the bit.
+        constexpr double kSameResidualSigmas = 1e-6;
+        EXPECT_NEAR(through.residuals[k].x[i], whole.residuals[k].x[i], kSameResidualSigmas);
+      }
+    }
+    through.residuals = alone.residuals;
     const std::string expected = SerializeWindowFold(alone);
-    EXPECT_EQ(SerializeWindowFold(Fold(strided)), expected);
+    EXPECT_EQ(SerializeWindowFold(through), expected);
 
     const std::string store = test::TempPath("track_fold_strided", ".samples");
     std::remove(store.c_str());
@@ -285,6 +307,7 @@ TEST_F(TrackFoldTest, AStrideFoldsEveryKthSampleAsTheirOwnWindow) {
     strided.samples_path = store;
     WindowFold stored;
     ASSERT_TRUE(FoldWindow(strided, &stored, &error)) << error;
+    stored.residuals = alone.residuals;
     EXPECT_EQ(SerializeWindowFold(stored), expected);
     std::remove(store.c_str());
   }
@@ -313,7 +336,7 @@ TEST_F(TrackFoldTest, BytesRoundTripAndCorruptionIsRefused) {
   ASSERT_TRUE(ParseFoldTask(task_bytes, &task, &error)) << error;
   EXPECT_EQ(SerializeFoldTask(task), task_bytes);
   EXPECT_FALSE(ParseFoldTask(bytes, &task, &error));  // a fold is not a task
-  EXPECT_NE(error.find("fastcal-fold-task-2"), std::string::npos) << error;
+  EXPECT_NE(error.find("fastcal-fold-task-3"), std::string::npos) << error;
 }
 
 TEST_F(TrackFoldTest, FiniteNonsenseInAFoldIsRefused) {

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -16,6 +17,7 @@
 #include <vector>
 
 #include "fastcal/calibration.h"
+#include "fastcal/internal/calibration_slow_error.h"
 #include "fastcal/internal/chi_square.h"
 #include "fastcal/simulation.h"
 #include "fastcal/track_fold.h"
@@ -277,8 +279,8 @@ TEST(TrackTest, ConsiderColumnsComeWithTheLastFoldOrAreFoldedAtTheSolution) {
   ExpectSameTrack(first, again);
 }
 
-// A new track's first fold reads one sample in k of a large window (issue 41); the folds
-// after it read them all, and the track ends where one of every sample throughout does.
+// A new track's first folds read one sample in k of a large window (issue 41); the folds
+// after them read them all, and the track ends where one of every sample throughout does.
 TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   CableRobot truth;
   const Dataset data = Season(1, 2000, 17, {}, &truth);  // one "day" of samples
@@ -314,9 +316,36 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   ASSERT_EQ(first_step.windows.size(), 2u);
   EXPECT_EQ(first_step.windows[1].samples, 1280);
   ASSERT_GE(strides.size(), 2u);
-  EXPECT_EQ(strides[0], 4);  // 1280 / 300, rounded down
-  for (size_t r = 1; r < strides.size(); ++r) EXPECT_EQ(strides[r], 1) << r;
+  // The rounds through the subsample first (1280 / 300 = 4, rounded down; the slow error
+  // estimated from the second), at most 4 of them, then every sample.
+  const size_t subsampled = static_cast<size_t>(std::count(strides.begin(), strides.end(), 4));
+  EXPECT_GE(subsampled, 1u);
+  EXPECT_LE(subsampled, 4u);
+  for (size_t r = 0; r < strides.size(); ++r) EXPECT_EQ(strides[r], r < subsampled ? 4 : 1) << r;
   EXPECT_EQ(halved, "");
+
+  // The slow error estimated: from a subsample's round after the first (whose point is
+  // the initial model), over the residual run's samples, all of them; the first fold of
+  // every sample estimates it again. The track ends where the whole's does, with the
+  // slow error the whole's within the change that lets a process stand.
+  {
+    const CalibrationSpec estimated =
+        LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}"));
+    strides.clear();
+    const TrackResult sub = Track(estimated, {csv}, dir + "/estimated_sub", options);
+    const size_t rounds = static_cast<size_t>(std::count(strides.begin(), strides.end(), 4));
+    EXPECT_GE(rounds, 2u);
+    TrackOptions o = options;
+    o.first_fold_samples = 0;
+    const TrackResult all = Track(estimated, {csv}, dir + "/estimated_all", o);
+    ASSERT_TRUE(sub.converged && all.converged);
+    const SlowErrorProcess& p = sub.slow_error.process;
+    const SlowErrorProcess& q = all.slow_error.process;
+    EXPECT_NEAR(p.sigma_percent, q.sigma_percent, internal::kSlowErrorSettled * q.sigma_percent);
+    EXPECT_NEAR(p.time_constant_s, q.time_constant_s,
+                internal::kSlowErrorSettled * q.time_constant_s);
+    ExpectSameTrack(all, sub);
+  }
 
   strides.clear();
   options.first_fold_samples = 0;

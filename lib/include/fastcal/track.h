@@ -111,12 +111,15 @@ struct TrackOptions {
   }();
   // Gauss-Newton iterations (each a fold of the windows that moved) at most.
   int max_iterations = 20;
-  // A new track's first fold, at the initial model, reads every k-th sample of a window
-  // of at least twice this many (k = samples / this, rounded down): its step only brings
-  // the point near the solution, which the later folds, of every sample, reach (issue 41:
-  // that fold was a quarter of a track of 10^7 samples). 0: every sample; otherwise at
-  // least min_window_samples. Not with max_iterations = 1.
-  long long first_fold_samples = 20000;
+  // A new track's first folds, from the initial model, read every k-th sample of a window
+  // of at least twice this many (k = samples / this, rounded down), and every sample of
+  // the run the slow error is estimated from (FoldTask::stride): their steps only bring
+  // the point to within the subsample's noise of the solution and settle the slow error
+  // (at most 4 of them), and the folds of every sample after them reach the solution in
+  // two (issue 41: at 10^7 samples, 3 folds of every sample and one of a fifth became
+  // 2 and 3 of a twentieth). 0: every sample; otherwise at least min_window_samples. Not
+  // with max_iterations = 1.
+  long long first_fold_samples = 5000;
   // Converged when every parameter's step is below this fraction of its formal sigma.
   // The consider parameters' columns are folded with an iteration whose step may be the
   // last (the step before it below about sqrt(5000 x this) sigma); where the converged

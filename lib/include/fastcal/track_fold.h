@@ -75,8 +75,9 @@ struct FoldTask {
   std::vector<double> theta_si;               // the point, per column (SI)
   int blocks = 32;              // contiguous blocks of samples (at least 16 samples each)
   int residual_samples = 1000;  // the run of residuals kept for the slow-error estimate
-  // Every `stride`-th sample of the window is folded (1: all; a first step, TrackOptions::
-  // first_fold_samples).
+  // Every `stride`-th sample of the window is folded (1: all; a new track's first steps,
+  // TrackOptions::first_fold_samples), and every sample of the residual run (the middle
+  // residual_samples): its slow-error estimate is then the one of a fold of every sample.
   int stride = 1;
   int threads = 1;              // threads of the passes over the samples
 

@@ -46,6 +46,8 @@ struct SampleSource {
   long long size = 0;
   int sessions = 1;  // the model's sessions the samples' session indices need
   std::string name;  // for messages about a sample whose file is not known
+  // Where the run of residuals for the slow-error estimate starts (-1: the middle).
+  long long residual_first = -1;
   std::function<bool(long long first, int count, std::vector<Sample>*, std::vector<int>*,
                      std::string*)>
       read;
@@ -184,8 +186,8 @@ void ScreenWindow(const FoldTask& task, WindowPrediction* at) {
 // The gross errors counted and the first ones named (their file, line and measured value
 // are the second pass's: *named gets each one's sample), and the run of residuals the
 // slow-error estimate reads.
-void Summarise(const FoldTask& task, const WindowPrediction& at, WindowFold* fold,
-               std::vector<int>* named) {
+void Summarise(const FoldTask& task, const SampleSource& source, const WindowPrediction& at,
+               WindowFold* fold, std::vector<int>* named) {
   const int n = static_cast<int>(at.x.size());
   ReadingArrays whitened = at.x;
   WhitenResiduals(task, at, at.excluded, &whitened);
@@ -204,7 +206,9 @@ void Summarise(const FoldTask& task, const WindowPrediction& at, WindowFold* fol
   }
   // The run: the middle of the window (away from its edges, where the cabin may park).
   const int run = std::min(n, std::max(0, task.residual_samples));
-  const int first = (n - run) / 2;
+  const int first = source.residual_first >= 0
+                        ? static_cast<int>(std::min<long long>(source.residual_first, n - run))
+                        : (n - run) / 2;
   for (int t = first; t < first + run; ++t) {
     FoldResidual r;
     r.time_s = at.time_s[t];
@@ -492,29 +496,56 @@ bool NoSampleTwice(const FoldTask& task, const SampleSource& source, const Windo
   return true;
 }
 
-// Every `stride`-th sample of `all` (its first, then every stride-th after it), read in
-// spans of at most kStridedSpanSamples (a large stride reads its samples one by one: the
-// fold's memory stays that of a piece whatever the stride).
+// Every `stride`-th sample of `all` (its first, then every stride-th after it), but the
+// middle `run` samples, the run of residuals the slow-error estimate reads (Summarise),
+// all of them: a subsample's fold then gives the estimate a fold of every sample gives
+// (its residuals a step away; of every k-th sample, they spanned k times the time). Read
+// in spans of at most kStridedSpanSamples (a large stride reads its samples one by one:
+// the fold's memory stays that of a piece whatever the stride).
 constexpr int kStridedSpanSamples = 4096;
-SampleSource Strided(const SampleSource& all, int stride) {
+SampleSource Strided(const SampleSource& all, int stride, int run) {
+  // The sample positions in three parts: [0, run_first) strided, the run, then strided
+  // from run_end.
+  run = static_cast<int>(std::min<long long>(all.size, std::max(0, run)));
+  const long long run_first = (all.size - run) / 2, run_end = run_first + run;
+  const long long before = (run_first + stride - 1) / stride;
+  const long long after = (all.size - run_end + stride - 1) / stride;
   SampleSource s = all;
-  s.size = (all.size + stride - 1) / stride;
-  s.read = [all, stride](long long first, int count, std::vector<Sample>* samples,
-                         std::vector<int>* files, std::string* why) {
-    samples->clear();
-    files->clear();
+  s.size = before + run + after;
+  s.residual_first = before;
+  // Samples [from, from + count) of one part, every `step`-th from position `at`.
+  const auto read_part = [all](long long at, int step, int count, std::vector<Sample>* samples,
+                               std::vector<int>* files, std::string* why) {
     std::vector<Sample> span;
     std::vector<int> span_files;
-    const int per_span = std::max(1, (kStridedSpanSamples - 1) / stride + 1);
+    const int per_span = std::max(1, (kStridedSpanSamples - 1) / step + 1);
     for (int k = 0; k < count; k += per_span) {
       const int m = std::min(per_span, count - k);
-      const long long from = (first + k) * stride;
+      const long long from = at + static_cast<long long>(k) * step;
       const int length = static_cast<int>(
-          std::min<long long>(all.size - from, static_cast<long long>(m - 1) * stride + 1));
+          std::min<long long>(all.size - from, static_cast<long long>(m - 1) * step + 1));
       if (!all.read(from, length, &span, &span_files, why)) return false;
       for (int j = 0; j < m; ++j) {
-        samples->push_back(std::move(span[static_cast<size_t>(j) * stride]));
-        files->push_back(span_files[static_cast<size_t>(j) * stride]);
+        samples->push_back(std::move(span[static_cast<size_t>(j) * step]));
+        files->push_back(span_files[static_cast<size_t>(j) * step]);
+      }
+    }
+    return true;
+  };
+  s.read = [=](long long first, int count, std::vector<Sample>* samples, std::vector<int>* files,
+               std::string* why) {
+    samples->clear();
+    files->clear();
+    const long long last = first + count;  // source indices [first, last)
+    const long long bounds[4] = {0, before, before + run, before + run + after};
+    const long long starts[3] = {0, run_first, run_end};
+    const int steps[3] = {stride, 1, stride};
+    for (int part = 0; part < 3; ++part) {
+      const long long lo = std::max(first, bounds[part]), hi = std::min(last, bounds[part + 1]);
+      if (lo >= hi) continue;
+      const long long at = starts[part] + (lo - bounds[part]) * steps[part];
+      if (!read_part(at, steps[part], static_cast<int>(hi - lo), samples, files, why)) {
+        return false;
       }
     }
     return true;
@@ -527,7 +558,8 @@ SampleSource Strided(const SampleSource& all, int stride) {
 bool FoldSource(const FoldTask& task, const SampleSource& all, WindowFold* fold,
                 std::string* error) {
   if (!task.IsValid(error)) return false;
-  const SampleSource source = task.stride > 1 ? Strided(all, task.stride) : all;
+  const SampleSource source =
+      task.stride > 1 ? Strided(all, task.stride, task.residual_samples) : all;
   CableRobot model;
   if (!ParseCableRobotYaml(task.model_yaml, "the fold task's model", &model, error)) return false;
   const CalibrationSpec spec = FoldSpec(task);
@@ -582,7 +614,7 @@ bool FoldSource(const FoldTask& task, const SampleSource& all, WindowFold* fold,
   fold->last_time_s = at.time_s.back();
   ScreenWindow(task, &at);
   std::vector<int> named;
-  Summarise(task, at, fold, &named);
+  Summarise(task, source, at, fold, &named);
   internal::FittedSamples window;
   window.model = &cm;
   window.statics = statics;

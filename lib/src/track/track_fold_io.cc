@@ -12,7 +12,7 @@
 namespace fastcal {
 namespace {
 
-constexpr char kTaskTag[] = "fastcal-fold-task-2";
+constexpr char kTaskTag[] = "fastcal-fold-task-3";
 constexpr char kFoldTag[] = "fastcal-fold-1";
 // Bounds on what a reader accepts, against corrupt or hostile bytes.
 constexpr std::int64_t kMaxCount = 1LL << 31;

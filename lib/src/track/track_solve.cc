@@ -31,6 +31,11 @@ constexpr int kMaxResidualRun = 5000;
 // costs their share of one fold (about 14% there), a right one a whole fold.
 constexpr double kNextStepPerSquaredStep = 2e-4;
 
+// A new track's iterations through subsamples at most (TrackOptions::first_fold_samples):
+// from the initial model, 873 sigma away at 10^7 samples, with the slow error estimated
+// from the second, they take 3.
+constexpr int kMaxSubsampleIterations = 4;
+
 // How much a Gauss-Newton step may raise the chi-square before it is halved: the weights
 // follow the predicted readings (iteratively reweighted least squares), so near the
 // solution the chi-square moves by about a part in 10^6 either way.
@@ -44,7 +49,7 @@ bool Moving(const TrackRun& run, const TrackWindowState& w) {
 // The task of window w: its point over every column, or (without `consider`) over the
 // fitted columns alone, the consider parameters then fixed at their values.
 FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_run, bool consider,
-                 bool first_step) {
+                 bool subsample) {
   FoldTask t;
   t.label = w.label;
   // Absolute: a worker of a Dask cluster may run in another directory.
@@ -71,7 +76,7 @@ FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_ru
   t.blocks = run.options.blocks;
   t.residual_samples = residual_run;
   const long long most = run.options.first_fold_samples;
-  if (first_step && most > 0) t.stride = static_cast<int>(std::max(1LL, w.samples / most));
+  if (subsample && most > 0) t.stride = static_cast<int>(std::max(1LL, w.samples / most));
   return t;
 }
 
@@ -182,9 +187,9 @@ bool CheckMovingStores(TrackRun& run) {
 }
 
 // Folds every dirty used window at its point (with the consider columns when `consider`;
-// of every k-th sample of the larger windows when `first_step`, TrackOptions::
+// of every k-th sample of the larger windows when `subsample`, TrackOptions::
 // first_fold_samples). *strided (if not null) says whether any window was.
-bool FoldDirty(TrackRun& run, bool consider = false, bool first_step = false,
+bool FoldDirty(TrackRun& run, bool consider = false, bool subsample = false,
                bool* strided = nullptr) {
   std::vector<int> which;
   std::vector<std::string> tasks;
@@ -193,7 +198,7 @@ bool FoldDirty(TrackRun& run, bool consider = false, bool first_step = false,
   for (int w : run.used) {
     if (!run.windows[w].dirty) continue;
     which.push_back(w);
-    const FoldTask task = TaskFor(run, run.windows[w], residual_run, consider, first_step);
+    const FoldTask task = TaskFor(run, run.windows[w], residual_run, consider, subsample);
     largest_stride = std::max(largest_stride, task.stride);
     tasks.push_back(SerializeFoldTask(task));
   }
@@ -202,7 +207,7 @@ bool FoldDirty(TrackRun& run, bool consider = false, bool first_step = false,
   run.Progress(
       "folding " + std::to_string(tasks.size()) + " window" + (tasks.size() == 1 ? "" : "s") +
       (largest_stride > 1
-           ? ", a first step on one sample in " + std::to_string(largest_stride) + " at most"
+           ? ", a step through one sample in " + std::to_string(largest_stride) + " at most"
            : ""));
   std::vector<std::string> folds;
   const bool ok = run.options.runner ? run.options.runner(tasks, &folds, run.error)
@@ -452,7 +457,18 @@ struct GaussNewton {
   // The last step in sigmas, infinite when it says nothing of the next (a subsample's).
   double last_step = std::numeric_limits<double>::infinity();
   bool folds_strided = false;  // the windows' folds are a first step's, of a subsample
+  int subsample_iterations = 0;
 };
+
+// After an iteration through a subsample: whether the next is too. Until the next step
+// would be within the subsample's noise (a sigma of its own: the whole's solution lies
+// about that far from the subsample's) with the slow error standing, and with two
+// iterations left for the folds of every sample.
+bool KeepSubsampling(const TrackRun& run, GaussNewton& gn, int it, bool slow_stands, double step) {
+  const bool near = kNextStepPerSquaredStep * step * step <= 1.0;
+  return ++gn.subsample_iterations < kMaxSubsampleIterations &&
+         it + 2 < run.options.max_iterations && !(near && slow_stands);
+}
 
 // The slow error at the start of the iterations (the spec's initial one for a new track;
 // an update keeps the track's). Returns whether it is settled (not to be re-estimated).
@@ -545,10 +561,12 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
         "no window has " + std::to_string(run.options.min_window_samples) + " samples or more");
   }
   if (!CheckMovingStores(run)) return TrackStatus::kInvalidInput;
-  // A new track's first fold is at the initial model: its step is taken through a
-  // subsample (never as the last one, the track's folds being each of every sample).
-  const bool new_track = run.result->folds == 0 && !run.update;
-  bool slow_settled = StartSlowError(run, estimate_slow_error);
+  // A new track's first folds are far from the solution: their steps are taken through
+  // subsamples (KeepSubsampling; never as the last, the track's folds being each of every
+  // sample).
+  bool subsample = run.result->folds == 0 && !run.update && run.options.max_iterations > 1;
+  const bool initially_settled = StartSlowError(run, estimate_slow_error);
+  bool slow_settled = initially_settled;
   GaussNewton gn;
   gn.previous_theta.resize(run.windows.size());
   for (int it = 1; it <= run.options.max_iterations; ++it) {
@@ -556,9 +574,8 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     ++run.result->iterations;
     const bool may_be_last =
         kNextStepPerSquaredStep * gn.last_step * gn.last_step <= run.options.step_tolerance_sigmas;
-    const bool first_step = new_track && it == 1 && run.options.max_iterations > 1;
     bool strided = false;
-    const bool folded = FoldDirty(run, may_be_last && !first_step, first_step, &strided);
+    const bool folded = FoldDirty(run, may_be_last && !subsample, subsample, &strided);
     if (folded) gn.folds_strided = strided;
     const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
     if (HalveBack(run, gn, folded, chi2)) continue;
@@ -589,6 +606,9 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     }
     // A subsample's chi-square is not comparable with the whole's.
     gn.previous_chi2 = process_changed || strided ? std::numeric_limits<double>::infinity() : chi2;
+    subsample = strided && KeepSubsampling(run, gn, it, slow_settled && !process_changed, step);
+    // The slow error estimated again from the first fold of every sample.
+    if (strided && !subsample) slow_settled = initially_settled;
     StepToSolution(run, gn);
   }
   return EndUnconverged(run, gn);
