@@ -309,6 +309,14 @@ TEST_F(TrackFoldTest, AStrideFoldsEveryKthSampleAsTheirOwnWindow) {
     ASSERT_TRUE(FoldWindow(strided, &stored, &error)) << error;
     stored.residuals = alone.residuals;
     EXPECT_EQ(SerializeWindowFold(stored), expected);
+    // A store not in time order (sorted in memory by its reader) reads the same.
+    std::remove(store.c_str());
+    std::reverse(records.begin(), records.end());
+    ASSERT_TRUE(internal::AppendStoredSamples(store, records, 0, &error)) << error;
+    WindowFold reversed;
+    ASSERT_TRUE(FoldWindow(strided, &reversed, &error)) << error;
+    reversed.residuals = alone.residuals;
+    EXPECT_EQ(SerializeWindowFold(reversed), expected);
     std::remove(store.c_str());
   }
   FoldTask strided = task_;

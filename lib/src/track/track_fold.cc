@@ -48,6 +48,11 @@ struct SampleSource {
   std::string name;  // for messages about a sample whose file is not known
   // Where the run of residuals for the slow-error estimate starts (-1: the middle).
   long long residual_first = -1;
+  // Optional: `count` samples, every `step`-th from `first`, converting only those (else
+  // Strided reads whole spans and keeps every step-th).
+  std::function<bool(long long first, int count, int step, std::vector<Sample>*, std::vector<int>*,
+                     std::string*)>
+      read_every;
   std::function<bool(long long first, int count, std::vector<Sample>*, std::vector<int>*,
                      std::string*)>
       read;
@@ -522,6 +527,14 @@ SampleSource Strided(const SampleSource& all, int stride, int run) {
     for (int k = 0; k < count; k += per_span) {
       const int m = std::min(per_span, count - k);
       const long long from = at + static_cast<long long>(k) * step;
+      if (all.read_every) {
+        if (!all.read_every(from, m, step, &span, &span_files, why)) return false;
+        for (int j = 0; j < m; ++j) {
+          samples->push_back(std::move(span[j]));
+          files->push_back(span_files[j]);
+        }
+        continue;
+      }
       const int length = static_cast<int>(
           std::min<long long>(all.size - from, static_cast<long long>(m - 1) * step + 1));
       if (!all.read(from, length, &span, &span_files, why)) return false;
@@ -663,6 +676,10 @@ bool FoldWindow(const FoldTask& task, WindowFold* fold, std::string* error) {
   source.read = [&](long long first, int count, std::vector<Sample>* samples,
                     std::vector<int>* files,
                     std::string* why) { return reader.Read(first, count, samples, files, why); };
+  source.read_every = [&](long long first, int count, int step, std::vector<Sample>* samples,
+                          std::vector<int>* files, std::string* why) {
+    return reader.ReadEvery(first, count, step, samples, files, why);
+  };
   return FoldSource(task, source, fold, error);
 }
 

@@ -354,6 +354,9 @@ double LargestStep(const TrackRun& run) {
 bool ReestimateSlowError(TrackRun& run) {
   SlowErrorEstimateInputs in;
   in.spec = run.spec.slow_error;
+  // The cables' filters on the track's threads (the same bits on any number): serial, the
+  // estimate was a second or two of every round with one core idle.
+  in.num_threads = std::max(1, run.options.threads);
   for (int k : run.layout.shared_columns) {
     in.gain_nuisance = in.gain_nuisance || run.layout.Column(k).kind == ParameterKind::kSensorGain;
   }

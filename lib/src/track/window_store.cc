@@ -20,11 +20,12 @@ bool Fail(const std::string& path, const std::string& what, std::string* error) 
 }
 
 // The records of `bytes` (whole records of `record` bytes each) into *out.
-void Unpack(const std::vector<char>& bytes, long long count, long long record,
-            StoredSample* out) {
+// `count` records of `record` bytes from `bytes`, every `step`-th of them.
+void Unpack(const std::vector<char>& bytes, long long count, long long record, StoredSample* out,
+            long long step = 1) {
   for (long long k = 0; k < count; ++k) {
     out[k] = StoredSample{};
-    std::memcpy(&out[k], bytes.data() + k * record, static_cast<size_t>(record));
+    std::memcpy(&out[k], bytes.data() + k * step * record, static_cast<size_t>(record));
   }
 }
 
@@ -136,28 +137,37 @@ bool StoredWindowReader::Open(const std::string& path, int joints, std::string* 
 
 bool StoredWindowReader::Read(long long first, int count, std::vector<Sample>* samples,
                               std::vector<int>* file_of, std::string* error) const {
-  if (first < 0 || count < 0 || first + count > size_) {
+  return ReadEvery(first, count, 1, samples, file_of, error);
+}
+
+bool StoredWindowReader::ReadEvery(long long first, int count, int step,
+                                   std::vector<Sample>* samples, std::vector<int>* file_of,
+                                   std::string* error) const {
+  const long long span = count > 0 ? static_cast<long long>(count - 1) * step + 1 : 0;
+  if (first < 0 || count < 0 || step < 1 || first + span > size_) {
     return Fail(path_,
-                "records " + std::to_string(first) + " to " + std::to_string(first + count) +
+                "records " + std::to_string(first) + " to " + std::to_string(first + span) +
                     " of " + std::to_string(size_),
                 error);
   }
   std::vector<StoredSample> own;
   const StoredSample* records = sorted_.data() + first;
+  long long apart = step;  // records between two read, in `records`
   if (sorted_.empty()) {
     const long long record = RecordBytes(joints_);
-    std::vector<char> bytes(count * record);
-    if (ReadAt(fd_, bytes.data(), count * record, first * record) != count * record) {
+    std::vector<char> bytes(span * record);
+    if (ReadAt(fd_, bytes.data(), span * record, first * record) != span * record) {
       return Fail(path_, "cannot read the samples", error);
     }
     own.resize(count);
-    Unpack(bytes, count, record, own.data());
+    Unpack(bytes, count, record, own.data(), step);
     records = own.data();
+    apart = 1;
   }
   samples->assign(count, Sample());
   file_of->assign(count, 0);
   for (int k = 0; k < count; ++k) {
-    const StoredSample& r = records[k];
+    const StoredSample& r = records[k * apart];
     Sample& s = (*samples)[k];
     s.time_s = r.time_s;
     s.line = r.line;

@@ -62,6 +62,10 @@ class StoredWindowReader {
   // attitude; session 0) and each one's file index. Safe from several threads at once.
   bool Read(long long first, int count, std::vector<Sample>* samples, std::vector<int>* file_of,
             std::string* error) const;
+  // As Read, of the records first, first + step, ... (count of them): only those are
+  // converted (a subsample's fold read and converted every record of its spans).
+  bool ReadEvery(long long first, int count, int step, std::vector<Sample>* samples,
+                 std::vector<int>* file_of, std::string* error) const;
 
  private:
   std::string path_;
