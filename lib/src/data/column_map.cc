@@ -588,7 +588,14 @@ ValueConversion ConversionOf(const std::string& name, const std::string& unit) {
 
 double ScaleDecimal(std::string_view field, double parsed, int shift) {
   if (shift == 0) return parsed;
-  if (double fast = 0.0; ParseDecimalFastPath(field, shift, &fast)) return fast;
+  // The fast path where the field may have 16 significant digits or fewer: 16 digits and
+  // a point. A longer field has more digits, but for a sign, leading zeros or an
+  // exponent; the shifted text below gives it the same bits, one scan instead of two.
+  constexpr size_t kFastPathLongest = 17;
+  if (double fast = 0.0;
+      field.size() <= kFastPathLongest && ParseDecimalFastPath(field, shift, &fast)) {
+    return fast;
+  }
   constexpr long kMaxShiftableExponent = 100000;
   // Only where the text cannot be shifted (a pow a field was 4.5% of reading 10^6 rows).
   const auto fallback = [&] { return parsed * std::pow(10.0, shift); };
