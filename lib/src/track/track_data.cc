@@ -690,6 +690,9 @@ class ChunksAhead {
     changed_.wait(lock, [this] { return ready_; });
     Chunk c = std::move(next_);
     ready_ = false;
+    // The caller's chunk before, back to the reader to be filled again: a new one (6 MB
+    // of samples) was faulted in for every chunk.
+    spare_ = std::move(*chunk);
     lock.unlock();
     changed_.notify_all();
     if (c.thrown) std::rethrow_exception(c.thrown);
@@ -710,6 +713,10 @@ class ChunksAhead {
   void Produce() {
     for (;;) {
       Chunk c;
+      {
+        std::lock_guard<std::mutex> lock(mutex_);
+        c.data = std::move(spare_);
+      }
       try {
         c.ok = reader_->Next(kReadChunkSamples, &c.data, &c.done, &c.error);
       } catch (...) {
@@ -732,6 +739,7 @@ class ChunksAhead {
   std::mutex mutex_;
   std::condition_variable changed_;
   Chunk next_;          // read, not yet taken
+  Dataset spare_;       // a chunk the caller is done with, to be filled again
   bool ready_ = false;  // next_ holds a chunk
   bool stop_ = false;   // the caller is gone
 };
