@@ -82,6 +82,11 @@ TEST(NumberTextTest, FastPathAndParseFiniteDecimalAreFromCharsBitForBit) {
     std::string why;
     ASSERT_TRUE(ParseFiniteDecimal(text, &read, &why)) << text << ": " << why;
     ASSERT_TRUE(SameBits(read, Reference(text, 0))) << text;
+    for (const int shift : {3, -3}) {  // a kN field to N, and back
+      double shifted = 0.0;
+      ASSERT_TRUE(ParseShiftedDecimal(text, shift, &shifted)) << text;
+      ASSERT_TRUE(SameBits(shifted, Reference(text, shift))) << text << " shift " << shift;
+    }
     for (const int shift : {0, 3, -3}) {
       double fast = 0.0;
       if (!ParseDecimalFastPath(text, shift, &fast)) continue;
@@ -147,6 +152,32 @@ TEST(NumberTextTest, FastPathEdges) {
   double v = 0.0;
   ASSERT_TRUE(ParseDecimalFastPath("-0", 0, &v));
   EXPECT_TRUE(std::signbit(v));
+}
+
+TEST(NumberTextTest, ShiftedDecimalTakesOnlyAPlainDecimal) {
+  // Past the fast path (more than 17 characters) and on it, with a sign of either kind.
+  for (const char* text : {"+271.73286881555006", "-271.73286881555006", "271.7", "+1e-5",
+                           "0.000000000000000000001234567", "1234567890123456789012e-3"}) {
+    double v = 0.0;
+    ASSERT_TRUE(ParseShiftedDecimal(text, 3, &v)) << text;
+    EXPECT_TRUE(SameBits(v, Reference(text, 3))) << text;
+  }
+  for (const char* text : {"",      ".",
+                           "-",     "+",
+                           "1e",    "1e+",
+                           "1x",    "0x10",
+                           "0x1p3", "inf",
+                           "-inf",  "nan",
+                           "+-1",   "--1",
+                           "++1",   "1.2.3",
+                           "1e5e3", "1e3.5",
+                           "e5",    "1e999999",
+                           "1e306", "123456789012345678e306",
+                           " 1"}) {
+    double v = 12345.0;
+    EXPECT_FALSE(ParseShiftedDecimal(text, 3, &v)) << text;
+    EXPECT_EQ(v, 12345.0) << text << ": untouched";
+  }
 }
 
 TEST(NumberTextTest, DeclinedTextIsReadOrRefusedAsBefore) {

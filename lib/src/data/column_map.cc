@@ -588,47 +588,10 @@ ValueConversion ConversionOf(const std::string& name, const std::string& unit) {
 
 double ScaleDecimal(std::string_view field, double parsed, int shift) {
   if (shift == 0) return parsed;
-  // The fast path where the field may have 16 significant digits or fewer: 16 digits and
-  // a point. A longer field has more digits, but for a sign, leading zeros or an
-  // exponent; the shifted text below gives it the same bits, one scan instead of two.
-  constexpr size_t kFastPathLongest = 17;
-  if (double fast = 0.0;
-      field.size() <= kFastPathLongest && ParseDecimalFastPath(field, shift, &fast)) {
-    return fast;
-  }
-  constexpr long kMaxShiftableExponent = 100000;
-  // Only where the text cannot be shifted (a pow a field was 4.5% of reading 10^6 rows).
-  const auto fallback = [&] { return parsed * std::pow(10.0, shift); };
-  if (field.find_first_of("xX") != std::string_view::npos) return fallback();  // hex float
-  const size_t e = field.find_first_of("eE");
-  long exponent = 0;
-  std::string_view mantissa = field;
-  if (e != std::string_view::npos) {
-    std::string_view exponent_text = field.substr(e + 1);
-    if (!exponent_text.empty() && exponent_text.front() == '+') exponent_text.remove_prefix(1);
-    const auto [ptr, ec] = std::from_chars(exponent_text.data(),
-                                           exponent_text.data() + exponent_text.size(), exponent);
-    if (ec != std::errc() || std::labs(exponent) > kMaxShiftableExponent) return fallback();
-    mantissa = field.substr(0, e);
-  }
-  // "<mantissa>e<exponent + shift>", on the stack for the usual field (no allocation a
-  // field: 10^6 rows of them).
-  char stack[96];
-  std::string heap;
-  char* out = stack;
-  if (mantissa.size() + 24 > sizeof(stack)) {
-    heap.resize(mantissa.size() + 24);
-    out = heap.data();
-  }
-  std::memcpy(out, mantissa.data(), mantissa.size());
-  char* end = out + mantissa.size();
-  *end++ = 'e';
-  end = std::to_chars(end, out + mantissa.size() + 24, exponent + shift).ptr;
-  double scaled = 0.0;
-  if (!ParseDouble(std::string_view(out, static_cast<size_t>(end - out)), &scaled)) {
-    return fallback();
-  }
-  return scaled;
+  if (double shifted = 0.0; ParseShiftedDecimal(field, shift, &shifted)) return shifted;
+  // Only where the text cannot be shifted (hexadecimal, a '+', out of range once
+  // shifted): a pow a field was 4.5% of reading 10^6 rows.
+  return parsed * std::pow(10.0, shift);
 }
 
 namespace {

@@ -746,6 +746,14 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
       }
       continue;
     }
+    // A tension read straight to N, its text shifted (one scan, not a parse in kN and
+    // another shifted), and checked in kN; any text it refuses, or a value the check
+    // refuses, is read the general way below for its message.
+    if (double n = 0.0; IsTension(column) && internal::ParseShiftedDecimal(fields[f], kKilo, &n) &&
+                        CheckValue(column, n * 1e-3, limits, &why)) {
+      value[column] = n;
+      continue;
+    }
     if (!ParseNumber(fields[f], &value[column], &why)) return fail(why);
     if (!CheckValue(column, value[column], limits, &why)) return fail(why);
     if (IsTension(column)) value[column] = ScaleByKilo(fields[f], value[column]);

@@ -5,7 +5,9 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
+#include <string>
 #include <system_error>
 
 #include "fastcal/internal/quote.h"
@@ -158,6 +160,54 @@ Decimal ScanDecimal(std::string_view text, int shift, double* value) {
 
 bool ParseDecimalFastPath(std::string_view text, int shift, double* value) {
   return ScanDecimal(text, shift, value) == Decimal::kExact;
+}
+
+bool ParseShiftedDecimal(std::string_view text, int shift, double* value) {
+  // The fast path where the text may have 16 significant digits or fewer: 16 digits and
+  // a point. A longer text has more, but for a sign, leading zeros or an exponent; the
+  // shifted text gives it the same bits, one scan instead of two.
+  constexpr size_t kFastPathLongest = 17;
+  if (!text.empty() && text.front() == '+') {  // from_chars takes no '+': dropped here
+    text.remove_prefix(1);
+    if (text.empty() || text.front() == '+' || text.front() == '-') return false;
+  }
+  if (text.size() <= kFastPathLongest) {
+    const Decimal kind = ScanDecimal(text, shift, value);
+    if (kind == Decimal::kExact) return true;
+    if (kind == Decimal::kOther) return false;
+  }
+  constexpr long kMaxShiftableExponent = 100000;
+  const size_t e = text.find_first_of("eE");
+  const std::string_view mantissa = text.substr(0, e);
+  long exponent = 0;
+  if (e != std::string_view::npos) {
+    std::string_view x = text.substr(e + 1);
+    if (!x.empty() && x.front() == '+') x.remove_prefix(1);
+    const auto [end, ec] = std::from_chars(x.data(), x.data() + x.size(), exponent);
+    if (ec != std::errc() || end != x.data() + x.size() ||
+        std::labs(exponent) > kMaxShiftableExponent) {
+      return false;
+    }
+  }
+  // "<mantissa>e<exponent + shift>", on the stack for the usual field (no allocation a
+  // field: 10^6 rows of them). from_chars checks the mantissa's grammar: "inf", "nan" and
+  // "0x..." stop it before the 'e'.
+  char stack[96];
+  std::string heap;
+  char* out = stack;
+  if (mantissa.size() + 24 > sizeof(stack)) {
+    heap.resize(mantissa.size() + 24);
+    out = heap.data();
+  }
+  std::memcpy(out, mantissa.data(), mantissa.size());
+  char* end = out + mantissa.size();
+  *end++ = 'e';
+  end = std::to_chars(end, out + mantissa.size() + 24, exponent + shift).ptr;
+  double shifted = 0.0;
+  const auto [stop, ec] = std::from_chars(out, end, shifted, std::chars_format::general);
+  if (ec != std::errc() || stop != end || !std::isfinite(shifted)) return false;
+  *value = shifted;
+  return true;
 }
 
 bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why) {

@@ -41,6 +41,14 @@ bool ParseFiniteDecimal(std::string_view text, double* value, std::string* why);
 // grammar check were a quarter of reading a CSV (issue 41).
 bool ParseDecimalFastPath(std::string_view text, int shift, double* value);
 
+// `text`, a plain decimal ([+-]digits[.digits][(e|E)[+-]digits]), times 10^shift: the
+// correctly rounded value of the decimal number with its exponent shifted (so a kN field
+// read as N is the value a reader of "<digits>e<exponent + 3>" gets), in one scan of the
+// text (the fast path above where it may hold, else std::from_chars of the shifted
+// text). False, *value untouched, for other text (hexadecimal, inf, nan) and for
+// a value out of range: read it the general way.
+bool ParseShiftedDecimal(std::string_view text, int shift, double* value);
+
 // `value` formatted by a printf format with exactly one floating-point conversion,
 // %[+][width][.precision](f|e|g), and literal text around it ('%%' for a percent sign),
 // e.g. FormatDouble("%+.3f", x), FormatDouble("%.6g kN", t). Output as printf's in the
