@@ -327,6 +327,10 @@ int RunTrack(int argc, char** argv) {
   options.keep_overlapping = FLAGS_keep_overlapping;
   options.force = FLAGS_force;
   options.min_window_samples = FLAGS_min_window_samples;
+  // A subsample never smaller than a window the track keeps (TrackOptions::IsValid): a
+  // --min-window-samples above the default subsample raises it, not refused.
+  options.first_fold_samples =
+      std::max<long long>(options.first_fold_samples, options.min_window_samples);
   options.false_alarm = FLAGS_false_alarm;
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   if (!ColumnsFromFlag(&options.read.columns, &error)) return usage(error);

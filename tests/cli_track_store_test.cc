@@ -4,6 +4,9 @@
 // a store copied from elsewhere (by its digest) and a fold of another window; the
 // same data given twice, two files of relative times on one time line, a window label
 // reaching outside the track and a state nested without end are refused by name.
+#include <cstdint>
+#include <filesystem>
+#include <map>
 #include <regex>
 #include <string>
 
@@ -188,9 +191,30 @@ TEST_F(CliTrackStoreTest, TheSameDataTwiceIsRefusedByContent) {
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("copy.csv: the same data as"), std::string::npos) << r.output;
   ASSERT_EQ(Track(Day(1) + "," + Day(2), "b").code, 0);
+  // The copy is found once it is read (its digest computed beside the read): the samples
+  // it appended are cut back with the refusal.
+  std::map<std::string, std::uintmax_t> stores;
+  for (const auto& e : fs::directory_iterator(Path("b/windows"))) {
+    stores[e.path().filename().string()] = fs::file_size(e.path());
+  }
   r = Track(Day(1) + "," + Day(2) + "," + Day(2) + ".gz", "b");  // the day re-sent gzipped
   EXPECT_EQ(r.code, 2);
   EXPECT_NE(r.output.find("already in the track"), std::string::npos) << r.output;
+  std::map<std::string, std::uintmax_t> after;
+  for (const auto& e : fs::directory_iterator(Path("b/windows"))) {
+    after[e.path().filename().string()] = fs::file_size(e.path());
+  }
+  EXPECT_EQ(after, stores);
+  // Two copies of a file of relative times: the copy is named, not the time line the two
+  // would share.
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=300 --interval-s=2 --seed=4 --out=" +
+                    Path("rel.csv"))
+                .code,
+            0);
+  ASSERT_EQ(Shell("cp " + Path("rel.csv") + " " + Path("rel_copy.csv")).code, 0);
+  r = Track(Path("rel.csv") + "," + Path("rel_copy.csv"), "r");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("rel_copy.csv: the same data as"), std::string::npos) << r.output;
 }
 
 TEST_F(CliTrackStoreTest, FilesOverlappingInTimeAreRefusedUnlessKept) {

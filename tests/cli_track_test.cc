@@ -132,6 +132,22 @@ TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
 // An export as it comes (FAST's: Beijing time, decimal commas, mm and N) tracked through
 // its column map: the day in UTC, the numbers of the canonical survey; an update must read
 // the files through the same map.
+// --min-window-samples above the subsample of a new track's first steps
+// (TrackOptions::first_fold_samples, 5000) raises the subsample: it was refused, naming
+// an option the command line does not have.
+TEST_F(CliTrackTest, AWindowMinimumAboveTheSubsampleIsTaken) {
+  ASSERT_EQ(Fastcal("simulate --trajectory=random --samples=480 --days=2 --interval-s=20 "
+                    "--start=1714593600 --seed=3 --out=" +
+                    Path("a.csv"))
+                .code,
+            0);
+  const auto r = Fastcal("track --quiet --spec=" + Spec() + " --out=" + Path("t") +
+                         " --data=" + Path("a.csv") + " --min-window-samples=6000");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("no window has 6000 samples or more"), std::string::npos) << r.output;
+  EXPECT_EQ(r.output.find("first_fold_samples"), std::string::npos) << r.output;
+}
+
 TEST_F(CliTrackTest, AnExportIsTrackedThroughItsColumnMap) {
   const std::string data = Source() + "/calibration_data/fast_export.csv";
   const std::string map = Source() + "/calibration_data/fast_export.columns.yaml";

@@ -299,6 +299,9 @@ TEST_F(DatasetTest, ErrorsNameFileLineAndColumn) {
       {"implausible tension",
        header + "0,1,2,140,0,0,0,150,151,1e30,153,154,155\n",
        {"data.csv:5: column 'T3_kN': 1e+30 kN is above the plausible maximum of 5000 kN"}},
+      {"tension a hair above the maximum",  // 5e6 N once shifted: decided in kN as read
+       header + "0,1,2,140,0,0,0,150,151,5000.00000000000046,153,154,155\n",
+       {"data.csv:5: column 'T3_kN': 5000 kN is above the plausible maximum of 5000 kN"}},
       {"tension near the largest double",
        header + "0,1,2,140,0,0,0,150,151,1e308,153,154,155\n",
        {"data.csv:5: column 'T3_kN': 1e+308 kN is above the plausible maximum of 5000 kN"}},
@@ -369,7 +372,8 @@ TEST_F(DatasetTest, ErrorsNameFileLineAndColumn) {
        {"data.csv:1: missing column 'planned_pitch_deg' (the planned attitude needs all three"}},
       {"partial unstretched lengths",
        "s0_1_m,s0_2_m," + std::string(kHeader),
-       {"data.csv:1: missing columns 's0_3_m', 's0_4_m', 's0_5_m', 's0_6_m' (the unstretched lengths need all six"}},
+       {"data.csv:1: missing columns 's0_3_m', 's0_4_m', 's0_5_m', 's0_6_m' (the unstretched "
+        "lengths need all six"}},
       {"non-positive unstretched length",
        "s0_1_m,s0_2_m,s0_3_m,s0_4_m,s0_5_m,s0_6_m," + std::string(kHeader) +
            "300,300,300,300,-1,300," + kRow,

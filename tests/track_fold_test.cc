@@ -307,6 +307,10 @@ TEST_F(TrackFoldTest, AStrideFoldsEveryKthSampleAsTheirOwnWindow) {
     strided.samples_path = store;
     WindowFold stored;
     ASSERT_TRUE(FoldWindow(strided, &stored, &error)) << error;
+    ASSERT_EQ(stored.residuals.size(), whole.residuals.size());  // the run, read from the store
+    for (size_t k = 0; k < whole.residuals.size(); ++k) {
+      EXPECT_EQ(stored.residuals[k].time_s, whole.residuals[k].time_s);
+    }
     stored.residuals = alone.residuals;
     EXPECT_EQ(SerializeWindowFold(stored), expected);
     // A store not in time order (sorted in memory by its reader) reads the same.

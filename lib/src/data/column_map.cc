@@ -589,8 +589,8 @@ ValueConversion ConversionOf(const std::string& name, const std::string& unit) {
 double ScaleDecimal(std::string_view field, double parsed, int shift) {
   if (shift == 0) return parsed;
   if (double shifted = 0.0; ParseShiftedDecimal(field, shift, &shifted)) return shifted;
-  // Only where the text cannot be shifted (hexadecimal, a '+', out of range once
-  // shifted): a pow a field was 4.5% of reading 10^6 rows.
+  // Only where the text cannot be shifted (hexadecimal, out of range once shifted): a
+  // pow a field was 4.5% of reading 10^6 rows.
   return parsed * std::pow(10.0, shift);
 }
 

@@ -747,10 +747,13 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
       continue;
     }
     // A tension read straight to N, its text shifted (one scan, not a parse in kN and
-    // another shifted), and checked in kN; any text it refuses, or a value the check
-    // refuses, is read the general way below for its message.
+    // another shifted), and checked in kN a few ulps either side (the kN value read is
+    // within one of n * 1e-3, and the limits are an interval): any text it refuses, or a
+    // value near a limit, is read the general way below, which decides as before.
+    constexpr double kUlpsMargin = 1e-15;
     if (double n = 0.0; IsTension(column) && internal::ParseShiftedDecimal(fields[f], kKilo, &n) &&
-                        CheckValue(column, n * 1e-3, limits, &why)) {
+                        CheckValue(column, n * 1e-3 * (1.0 - kUlpsMargin), limits, &why) &&
+                        CheckValue(column, n * 1e-3 * (1.0 + kUlpsMargin), limits, &why)) {
       value[column] = n;
       continue;
     }

@@ -786,23 +786,10 @@ class DigestAhead {
   std::thread thread_;
 };
 
-bool ReadFile(Router& router, const std::string& path, std::string* error) {
+// The samples of file `index` (`path`) into the store, and its span and count into *file.
+bool ReadSamples(Router& router, const std::string& path, int index, const std::string& stem,
+                 TrackFile* file, std::string* error) {
   TrackRun& run = router.run;
-  TrackFile file;
-  file.path = path;
-  std::error_code ec;
-  file.bytes = static_cast<long long>(fs::file_size(path, ec));
-  // The digest beside the reading (a pass of its own before it was a tenth of reading a
-  // season): the file's samples are in the store when a copy is found, and go with the
-  // run's failure (a new track's directory removed, an update's stores cut back).
-  DigestAhead digest(path);
-  const int index = static_cast<int>(run.files.size());
-  const std::string stem = SessionLabelOfPath(path);
-  if (run.window.kind == WindowSpec::Kind::kFile && !IsValidSessionLabel(stem)) {
-    *error = path + ": with a window per file the file's name " + stem +
-             " labels its window: letters, digits, '-' and '_' only";
-    return false;
-  }
   DatasetReadOptions read = run.options.read;
   read.joint_columns = run.model.moving_parts.JointColumns();
   read.threads = std::max(read.threads, run.options.threads);
@@ -846,19 +833,57 @@ bool ReadFile(Router& router, const std::string& path, std::string* error) {
         router.relative_file = index;
       }
       if (!Route(router, s, index, stem)) return false;
-      file.first_s = std::isnan(file.first_s) ? s.time_s : std::min(file.first_s, s.time_s);
-      file.last_s = std::isnan(file.last_s) ? s.time_s : std::max(file.last_s, s.time_s);
+      file->first_s = std::isnan(file->first_s) ? s.time_s : std::min(file->first_s, s.time_s);
+      file->last_s = std::isnan(file->last_s) ? s.time_s : std::max(file->last_s, s.time_s);
     }
-    file.samples += static_cast<long long>(chunk.samples.size());
+    file->samples += static_cast<long long>(chunk.samples.size());
   }
-  if (!digest.Get(&file.sha256, error)) return false;
-  // Data given twice (a copy, a hard link, a day re-sent; a .csv and its .csv.gz) would
-  // be folded twice: refused by content (issue 37).
+  return true;
+}
+
+// Data given twice (a copy, a hard link, a day re-sent; a .csv and its .csv.gz) would be
+// folded twice: refused by content (issue 37). "" when `file` is no copy.
+std::string CopyOf(const TrackRun& run, const TrackFile& file) {
   for (const TrackFile& f : run.files) {
     if (f.sha256 != file.sha256) continue;
-    *error = path + ": the same data as " + f.path +
-             (run.update ? ", already in the track" : ", given too") +
-             " (SHA-256 of the content): each sample is folded once; drop one";
+    return file.path + ": the same data as " + f.path +
+           (run.update ? ", already in the track" : ", given too") +
+           " (SHA-256 of the content): each sample is folded once; drop one";
+  }
+  return "";
+}
+
+bool ReadFile(Router& router, const std::string& path, std::string* error) {
+  TrackRun& run = router.run;
+  TrackFile file;
+  file.path = path;
+  std::error_code ec;
+  file.bytes = static_cast<long long>(fs::file_size(path, ec));
+  const int index = static_cast<int>(run.files.size());
+  const std::string stem = SessionLabelOfPath(path);
+  if (run.window.kind == WindowSpec::Kind::kFile && !IsValidSessionLabel(stem)) {
+    *error = path + ": with a window per file the file's name " + stem +
+             " labels its window: letters, digits, '-' and '_' only";
+    return false;
+  }
+  // The digest beside the reading (a pass of its own before it was a tenth of reading a
+  // season): a copy's samples are in the store when it is found, and go with the run's
+  // failure (a new track's directory removed, an update's stores cut back). A copy is
+  // named whatever else its read met (two copies of a file of relative times would be
+  // told to take a window each).
+  DigestAhead digest(path);
+  std::string read_error, digest_error;
+  const bool read = ReadSamples(router, path, index, stem, &file, &read_error);
+  if (!digest.Get(&file.sha256, &digest_error)) {
+    *error = read ? digest_error : read_error;
+    return false;
+  }
+  if (std::string copy = CopyOf(run, file); !copy.empty()) {
+    *error = std::move(copy);
+    return false;
+  }
+  if (!read) {
+    *error = read_error;
     return false;
   }
   run.files.push_back(file);

@@ -545,11 +545,17 @@ SampleSource Strided(const SampleSource& all, int stride, int run) {
     }
     return true;
   };
+  s.read_every = nullptr;  // all's, over all's indices
   s.read = [=](long long first, int count, std::vector<Sample>* samples, std::vector<int>* files,
                std::string* why) {
     samples->clear();
     files->clear();
     const long long last = first + count;  // source indices [first, last)
+    if (first < 0 || count < 0 || last > before + run + after) {
+      *why = all.name + ": samples " + std::to_string(first) + " to " + std::to_string(last) +
+             " of a subsample of " + std::to_string(before + run + after);
+      return false;
+    }
     const long long bounds[4] = {0, before, before + run, before + run + after};
     const long long starts[3] = {0, run_first, run_end};
     const int steps[3] = {stride, 1, stride};

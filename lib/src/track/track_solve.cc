@@ -536,8 +536,8 @@ void StepToSolution(TrackRun& run, GaussNewton& gn) {
 }
 
 // Out of iterations: the last solve stands, the windows' points its folds'. Folds of a
-// subsample (a first step whose next fold failed on the last iteration) are folded again
-// in full: the track's folds are each of every sample.
+// subsample (its rounds' last, where the folds after it failed to the last iteration) are
+// folded again in full: the track's folds are each of every sample.
 TrackStatus EndUnconverged(TrackRun& run, const GaussNewton& gn) {
   run.result->converged = false;
   run.result->notes.push_back("Gauss-Newton did not converge in " +

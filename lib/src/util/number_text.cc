@@ -182,7 +182,10 @@ bool ParseShiftedDecimal(std::string_view text, int shift, double* value) {
   long exponent = 0;
   if (e != std::string_view::npos) {
     std::string_view x = text.substr(e + 1);
-    if (!x.empty() && x.front() == '+') x.remove_prefix(1);
+    if (!x.empty() && x.front() == '+') {
+      x.remove_prefix(1);
+      if (!x.empty() && (x.front() == '-' || x.front() == '+')) return false;  // "e+-5"
+    }
     const auto [end, ec] = std::from_chars(x.data(), x.data() + x.size(), exponent);
     if (ec != std::errc() || end != x.data() + x.size() ||
         std::labs(exponent) > kMaxShiftableExponent) {
