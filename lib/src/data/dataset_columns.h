@@ -1,0 +1,70 @@
+// The columns of the measurement dataset CSV (docs/data-format.md), shared by its reader
+// (dataset.cc) and writer (dataset_write.cc): their identifiers in the order WriteDataset
+// writes them, their names, and the plausibility check of one value as read.
+#ifndef FASTCAL_DATA_DATASET_COLUMNS_H_
+#define FASTCAL_DATA_DATASET_COLUMNS_H_
+
+#include <string>
+#include <string_view>
+
+#include "fastcal/cable_robot.h"
+#include "fastcal/internal/quote.h"
+#include "fastcal/plausibility.h"
+
+namespace fastcal::internal::dataset_columns {
+
+enum Column : int {
+  kTime,
+  kX,
+  kY,
+  kZ,
+  kRoll,
+  kPitch,
+  kYaw,
+  kQw,
+  kQx,
+  kQy,
+  kQz,
+  kPlannedRoll,
+  kPlannedPitch,
+  kPlannedYaw,
+  kTension1,
+  kUnstretched1 = kTension1 + kNumCables,
+  kNumColumns = kUnstretched1 + kNumCables,
+};
+
+// clang-format off
+inline constexpr const char* kColumnNames[kNumColumns] = {
+    "time_s", "x_m", "y_m", "z_m",
+    "roll_deg", "pitch_deg", "yaw_deg",
+    "qw", "qx", "qy", "qz",
+    "planned_roll_deg", "planned_pitch_deg", "planned_yaw_deg",
+    "T1_kN", "T2_kN", "T3_kN", "T4_kN", "T5_kN", "T6_kN",
+    "s0_1_m", "s0_2_m", "s0_3_m", "s0_4_m", "s0_5_m", "s0_6_m"};
+// clang-format on
+
+// The optional label column (docs/data-format.md, "Sessions").
+inline constexpr char kSessionColumn[] = "session";
+
+// Files hold tensions in kN, memory in N: the decimal exponent shifts by this much.
+inline constexpr int kKilo = 3;
+
+inline bool IsTension(int column) { return column >= kTension1 && column < kTension1 + kNumCables; }
+inline bool IsUnstretched(int column) {
+  return column >= kUnstretched1 && column < kUnstretched1 + kNumCables;
+}
+inline bool IsAngle(int column) {
+  return (column >= kRoll && column <= kYaw) || (column >= kPlannedRoll && column <= kPlannedYaw);
+}
+
+// User text in messages is escaped and capped (a binary file's header, a 10 MB line);
+// the names of our own columns are quoted the same way.
+inline std::string Quoted(std::string_view s) { return Quote(s); }
+
+// Checks a value as read (kN for a tension) against the plausibility limits; false with
+// *why otherwise.
+bool CheckValue(int column, double value, const PlausibilityLimits& limits, std::string* why);
+
+}  // namespace fastcal::internal::dataset_columns
+
+#endif  // FASTCAL_DATA_DATASET_COLUMNS_H_
