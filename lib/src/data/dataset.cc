@@ -1073,18 +1073,9 @@ bool CheckJointColumns(const Dataset& data, const MovingParts& parts, std::strin
 
 bool ParseDataset(const std::string& text, const std::string& source_name,
                   const DatasetReadOptions& options, Dataset* dataset, std::string* error) {
-  std::string message;
-  bool ok = false;
-  try {
-    ok = ParseDatasetImpl(text, source_name, options, dataset, &message);
-  } catch (const std::bad_alloc&) {
-    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
-  } catch (const std::exception& e) {
-    message = source_name + ": " + e.what();
-    ok = false;
-  }
-  if (!ok && error != nullptr) *error = message;
-  return ok;
+  return FileErrors(source_name, error, [&](std::string* message) {
+    return ParseDatasetImpl(text, source_name, options, dataset, message);
+  });
 }
 
 bool ReadDataset(const std::string& path, const DatasetReadOptions& options, Dataset* dataset,
@@ -1136,6 +1127,51 @@ struct DatasetChunkReader::State {
   bool first = true;  // before the first line (a byte order mark may open it)
   bool end = false;   // the whole file is in `text`
   bool done = false;  // the whole-file checks passed
+
+  // The complete lines of `text` from `start` (a record through a map), numbered, up to
+  // `room` of them (each gives at most one sample); false with *message on a spreadsheet
+  // or a line too long to be a dataset's.
+  bool TakeLines(size_t room, std::vector<std::pair<int, std::string_view>>* lines,
+                 std::string* message) {
+    while (lines->size() < room) {
+      if (first && start == 0) {
+        if (!end && text.size() < 8) break;  // the first bytes, to tell a spreadsheet
+        const std::string spreadsheet =
+            internal::SpreadsheetMessage(parser.layout().path, std::string_view(text).substr(0, 8));
+        if (!spreadsheet.empty()) {
+          *message = spreadsheet;
+          return false;
+        }
+      }
+      // A record ends at the first newline outside quotes. Without quotes each read is
+      // searched once (`searched`); with them the record is rescanned, bounded by
+      // kMaxMappedRecordBytes.
+      const bool quotes = parser.quotes();
+      int breaks = 0;  // line breaks inside a quoted field of the record
+      const size_t newline = quotes ? internal::RecordEnd(text, start, true, &breaks)
+                                    : text.find('\n', start + searched);
+      searched = newline == std::string::npos ? text.size() - start : 0;
+      if (newline == std::string::npos &&
+          searched > (quotes ? kMaxMappedRecordBytes : kMaxDatasetLineBytes)) {
+        // A quote left open would make the rest of the file one record; a file without
+        // line breaks is no dataset.
+        *message = parser.layout().path + ":" + std::to_string(line_number + 1) +
+                   (quotes ? ": a record longer than 16 MiB (a quote not closed?)"
+                           : ": a line longer than " + std::to_string(kMaxDatasetLineBytes >> 20) +
+                                 " MiB: not a dataset (its lines are under 1 KiB)");
+        return false;
+      }
+      if (newline == std::string::npos && (!end || start == text.size())) break;
+      std::string_view line(text);
+      line = line.substr(start, newline == std::string::npos ? std::string::npos : newline - start);
+      start = newline == std::string::npos ? text.size() : newline + 1;
+      if (first && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
+      first = false;
+      lines->emplace_back(++line_number, line);
+      line_number += breaks;
+    }
+    return true;
+  }
 };
 
 DatasetChunkReader::DatasetChunkReader() = default;
@@ -1166,79 +1202,32 @@ bool DatasetChunkReader::Append(size_t max_samples, Dataset* chunk, bool* done,
   // Read at a time (~10 000 rows of 24 columns): the rows of one read are parsed on the
   // threads together, and 1 MiB (~2500 rows in 5 parts) left a thread idle for a fifth.
   constexpr size_t kReadBytes = 4 << 20;
-  std::string message;
-  bool ok = true;
-  try {
-    State& st = *state_;
-    const size_t wanted = chunk->samples.size() + std::max<size_t>(max_samples, 1);
-    std::vector<std::pair<int, std::string_view>> lines;
-    while (ok && !st.done && chunk->samples.size() < wanted) {
-      // The complete lines read so far (each gives at most one sample), parsed together.
-      lines.clear();
-      while (chunk->samples.size() + lines.size() < wanted) {
-        if (st.first && st.start == 0) {
-          if (!st.end && st.text.size() < 8) break;  // the first bytes, to tell a spreadsheet
-          const std::string spreadsheet = internal::SpreadsheetMessage(
-              st.parser.layout().path, std::string_view(st.text).substr(0, 8));
-          if (!spreadsheet.empty()) {
-            message = spreadsheet;
-            ok = false;
-            break;
+  State& st = *state_;
+  return internal::dataset_columns::FileErrors(
+      st.parser.layout().path, error, [&](std::string* message) {
+        const size_t wanted = chunk->samples.size() + std::max<size_t>(max_samples, 1);
+        std::vector<std::pair<int, std::string_view>> lines;
+        bool ok = true;
+        while (ok && !st.done && chunk->samples.size() < wanted) {
+          // The complete lines read so far, parsed together; else more of the file.
+          lines.clear();
+          ok = st.TakeLines(wanted - chunk->samples.size(), &lines, message);
+          if (!ok) break;
+          if (!lines.empty()) {
+            ok = st.parser.Lines(lines, chunk, message);
+          } else if (!st.end) {
+            st.text.erase(0, st.start);  // keep the unfinished line only
+            st.start = 0;
+            ok = st.file.Read(kReadBytes, &st.text, &st.end, message);
+          } else {
+            ok = st.parser.Finish(message);
+            st.done = ok;
           }
         }
-        // A record ends at the first newline outside quotes. Without quotes each read is
-        // searched once (`searched`); with them the record is rescanned, bounded by
-        // kMaxMappedRecordBytes.
-        const bool quotes = st.parser.quotes();
-        int breaks = 0;  // line breaks inside a quoted field of the record
-        const size_t newline = quotes ? internal::RecordEnd(st.text, st.start, true, &breaks)
-                                      : st.text.find('\n', st.start + st.searched);
-        st.searched = newline == std::string::npos ? st.text.size() - st.start : 0;
-        if (newline == std::string::npos &&
-            st.searched > (quotes ? kMaxMappedRecordBytes : kMaxDatasetLineBytes)) {
-          // A quote left open would make the rest of the file one record; a file without
-          // line breaks is no dataset.
-          message = st.parser.layout().path + ":" + std::to_string(st.line_number + 1) +
-                    (quotes ? ": a record longer than 16 MiB (a quote not closed?)"
-                            : ": a line longer than " + std::to_string(kMaxDatasetLineBytes >> 20) +
-                                  " MiB: not a dataset (its lines are under 1 KiB)");
-          ok = false;
-          break;
-        }
-        if (newline == std::string::npos && (!st.end || st.start == st.text.size())) break;
-        std::string_view line(st.text);
-        line = line.substr(st.start,
-                           newline == std::string::npos ? std::string::npos : newline - st.start);
-        st.start = newline == std::string::npos ? st.text.size() : newline + 1;
-        if (st.first && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
-        st.first = false;
-        lines.emplace_back(++st.line_number, line);
-        st.line_number += breaks;
-      }
-      if (!ok) break;
-      if (!lines.empty()) {
-        ok = st.parser.Lines(lines, chunk, &message);
-        continue;
-      }
-      if (!st.end) {
-        st.text.erase(0, st.start);  // keep the unfinished line only
-        st.start = 0;
-        ok = st.file.Read(kReadBytes, &st.text, &st.end, &message);
-        continue;
-      }
-      ok = st.parser.Finish(&message);
-      st.done = ok;
-    }
-    TakeLayout(st.parser.layout(), chunk);
-    *done = st.done;
-  } catch (const std::bad_alloc&) {
-    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
-  } catch (const std::exception& e) {
-    message = state_->parser.layout().path + ": " + e.what();
-    ok = false;
-  }
-  if (!ok && error != nullptr) *error = message;
-  return ok;
+        TakeLayout(st.parser.layout(), chunk);
+        *done = st.done;
+        return ok;
+      });
 }
 
 TimeDisplay TimeDisplayOf(const Dataset& data) {

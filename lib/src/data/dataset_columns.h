@@ -4,6 +4,8 @@
 #ifndef FASTCAL_DATA_DATASET_COLUMNS_H_
 #define FASTCAL_DATA_DATASET_COLUMNS_H_
 
+#include <exception>
+#include <new>
 #include <string>
 #include <string_view>
 
@@ -60,6 +62,26 @@ inline bool IsAngle(int column) {
 // User text in messages is escaped and capped (a binary file's header, a 10 MB line);
 // the names of our own columns are quoted the same way.
 inline std::string Quoted(std::string_view s) { return Quote(s); }
+
+// `body` (returning bool, its message in *message) with an exception it throws made the
+// message "NAME: what()": a library error (yaml-cpp's, a bad conversion) is the file's.
+// Out of memory is the machine's, not the file's: rethrown (the caller says "out of
+// memory", exit 1). *error (may be null) gets the message on failure.
+template <typename Body>
+bool FileErrors(const std::string& name, std::string* error, const Body& body) {
+  std::string message;
+  bool ok = false;
+  try {
+    ok = body(&message);
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    message = name + ": " + e.what();
+    ok = false;
+  }
+  if (!ok && error != nullptr) *error = message;
+  return ok;
+}
 
 // Checks a value as read (kN for a tension) against the plausibility limits; false with
 // *why otherwise.

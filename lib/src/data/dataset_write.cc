@@ -248,18 +248,9 @@ bool WriteDatasetImpl(const std::string& path, const Dataset& dataset,
 
 bool WriteDataset(const std::string& path, const Dataset& dataset,
                   const std::string& header_comment, std::string* error) {
-  std::string message;
-  bool ok = false;
-  try {
-    ok = WriteDatasetImpl(path, dataset, header_comment, &message);
-  } catch (const std::bad_alloc&) {
-    throw;  // the machine's, not the file's: the caller says "out of memory" (exit 1)
-  } catch (const std::exception& e) {
-    message = path + ": " + e.what();
-    ok = false;
-  }
-  if (!ok && error != nullptr) *error = message;
-  return ok;
+  return internal::dataset_columns::FileErrors(path, error, [&](std::string* message) {
+    return WriteDatasetImpl(path, dataset, header_comment, message);
+  });
 }
 
 DatasetWriter::~DatasetWriter() {
