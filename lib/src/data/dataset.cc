@@ -575,108 +575,92 @@ std::string PositionUnitHint(std::string_view line, const Header& header,
   return "";
 }
 
-bool ParseRow(std::string_view line, const Header& header, const PlausibilityLimits& limits,
-              const FieldValues* previous, Sample* sample, FieldValues* values,
+// The row's fields, as many as the header's; false with *reason otherwise.
+bool SplitRow(std::string_view line, const Header& header, const PlausibilityLimits& limits,
+              const FieldValues* previous, std::vector<std::string_view>* fields,
               std::string* reason) {
   // Room for the header's fields at once: growing from empty took six allocations a row.
   // (Not one vector kept across rows: TooManyFieldsMessage parses the row again.)
-  std::vector<std::string_view> fields;
-  fields.reserve(header.column_of_field.size() + 1);
-  if (header.map != nullptr) {
-    if (!SplitMappedRow(line, header, &fields, reason)) return false;
-  } else {
-    SplitFields(line, &fields);
-    if (fields.size() != header.column_of_field.size()) {
-      *reason = fields.size() > header.column_of_field.size()
-                    ? TooManyFieldsMessage(fields, header, limits, previous)
-                    : "expected " + std::to_string(header.column_of_field.size()) +
-                          " fields (as in the header), found " + std::to_string(fields.size());
-      return false;
-    }
+  fields->reserve(header.column_of_field.size() + 1);
+  if (header.map != nullptr) return SplitMappedRow(line, header, fields, reason);
+  SplitFields(line, fields);
+  if (fields->size() == header.column_of_field.size()) return true;
+  *reason = fields->size() > header.column_of_field.size()
+                ? TooManyFieldsMessage(*fields, header, limits, previous)
+                : "expected " + std::to_string(header.column_of_field.size()) +
+                      " fields (as in the header), found " + std::to_string(fields->size());
+  return false;
+}
+
+// Moving-part joint j's field into sample->joint[j].
+bool ReadJointField(const Header& header, std::string_view field, int j, Sample* sample,
+                    std::string* reason) {
+  std::string why;
+  double v = 0.0, file_value = 0.0;
+  const bool read = header.map != nullptr ? internal::ReadConvertedNumber(
+                                                field, header.map->decimal,
+                                                header.joint_conversion[j], &file_value, &v, &why)
+                                          : ParseNumber(field, &v, &why);
+  if (!read || !PlausibleJointValue(header.joint_names[j], v, &why)) {
+    *reason = "column " + Quoted(header.joint_names[j]) + ": " + why;
+    return false;
   }
-  FieldValues& value = *values;
-  value.fill(0.0);
-  for (size_t f = 0; f < fields.size(); ++f) {
-    const int column = header.column_of_field[f];
-    if (column == kIgnoredField) continue;
-    if (IsJointField(column)) {
-      const int j = JointOfField(column);
-      std::string why;
-      double v = 0.0, file_value = 0.0;
-      const bool read =
-          header.map != nullptr
-              ? internal::ReadConvertedNumber(fields[f], header.map->decimal,
-                                              header.joint_conversion[j], &file_value, &v, &why)
-              : ParseNumber(fields[f], &v, &why);
-      if (!read || !PlausibleJointValue(header.joint_names[j], v, &why)) {
-        *reason = "column " + Quoted(header.joint_names[j]) + ": " + why;
-        return false;
-      }
-      sample->joint[j] = v + 0.0;  // -0 read as 0, as below
-      continue;
-    }
-    if (column == kSessionField) {
-      if (!IsValidSessionLabel(std::string(fields[f]))) {
-        *reason = header.session_label + ": " + Quoted(std::string(fields[f])) +
-                  " is not a session label (letters, digits, '-' and '_', at most " +
-                  std::to_string(kMaxSessionLabelLength) + ")";
-        return false;
-      }
-      continue;
-    }
-    const auto fail = [&](const std::string& why) {
-      *reason = header.label[column] + ": " + why;
+  sample->joint[j] = v + 0.0;  // -0 read as 0, as ParseRow's values
+  return true;
+}
+
+// A field read through the column map into *value (SI); false with *why (the column's
+// label not yet in it).
+bool ReadMappedField(const Header& header, const PlausibilityLimits& limits, int column,
+                     std::string_view field, bool first_row, double* value, std::string* why) {
+  if (column == kTime) {
+    if (!internal::ReadTimeField(field, header.map->time, header.map->decimal, value, why)) {
+      *why += internal::NotANumberHint(field, '\0', first_row);
       return false;
+    }
+    return CheckValue(column, *value, limits, why);
+  }
+  double file_value = 0.0;
+  const char decimal = header.map->decimal;
+  if (!internal::ReadConvertedNumber(field, decimal, header.conversion[column], &file_value, value,
+                                     why)) {
+    *why += internal::NotANumberHint(field, decimal, first_row);
+    return false;
+  }
+  if (CheckValue(column, file_value, limits, why)) return true;
+  if (const ColumnMapEntry* e = header.entry[column]; e != nullptr) {
+    const auto plausible = [&](double v) {
+      std::string ignored;
+      return CheckValue(column, v, limits, &ignored);
     };
-    std::string why;
-    if (header.map != nullptr) {
-      // The unit-row hint only where the map skips no row after the header (a second
-      // re-check of issue 37: "#NV" in the first row suggested what the map already said).
-      const bool first_row = previous == nullptr && header.map->skip_after_header == 0;
-      if (column == kTime) {
-        if (!internal::ReadTimeField(fields[f], header.map->time, header.map->decimal,
-                                     &value[column], &why)) {
-          return fail(why + internal::NotANumberHint(fields[f], '\0', first_row));
-        }
-        if (!CheckValue(column, value[column], limits, &why)) return fail(why);
-        continue;
-      }
-      double file_value = 0.0;
-      const char decimal = header.map->decimal;
-      if (!internal::ReadConvertedNumber(fields[f], decimal, header.conversion[column], &file_value,
-                                         &value[column], &why)) {
-        return fail(why + internal::NotANumberHint(fields[f], decimal, first_row));
-      }
-      if (!CheckValue(column, file_value, limits, &why)) {
-        const ColumnMapEntry* e = header.entry[column];
-        const auto plausible = [&](double v) {
-          std::string ignored;
-          return CheckValue(column, v, limits, &ignored);
-        };
-        return fail(why + (e == nullptr ? std::string()
-                                        : internal::UnitHint(e->name, e->unit, fields[f], decimal,
-                                                             plausible)));
-      }
-      continue;
-    }
-    // A tension read straight to N, its text shifted (one scan, not a parse in kN and
-    // another shifted), and checked in kN a few ulps either side (the kN value read is
-    // within one of n * 1e-3, and the limits are an interval): any text it refuses, or a
-    // value near a limit, is read the general way below, which decides as before.
-    constexpr double kUlpsMargin = 1e-15;
-    if (double n = 0.0; IsTension(column) && internal::ParseShiftedDecimal(fields[f], kKilo, &n) &&
-                        CheckValue(column, n * 1e-3 * (1.0 - kUlpsMargin), limits, &why) &&
-                        CheckValue(column, n * 1e-3 * (1.0 + kUlpsMargin), limits, &why)) {
-      value[column] = n;
-      continue;
-    }
-    if (!ParseNumber(fields[f], &value[column], &why)) return fail(why);
-    if (!CheckValue(column, value[column], limits, &why)) return fail(why);
-    if (IsTension(column)) value[column] = ScaleByKilo(fields[f], value[column]);
+    *why += internal::UnitHint(e->name, e->unit, field, decimal, plausible);
   }
-  // "-0" is the reading 0, and the writer writes it so: a written and re-read dataset then
-  // holds the same bits (the fuzzer's round trip), and -0 never reaches a sign test.
-  for (double& v : value) v += 0.0;
+  return false;
+}
+
+// A field of the canonical format into *value (SI: a tension's kN shifted to N, exactly);
+// false with *why.
+bool ReadPlainField(const PlausibilityLimits& limits, int column, std::string_view field,
+                    double* value, std::string* why) {
+  // A tension read straight to N, its text shifted (one scan, not a parse in kN and
+  // another shifted), and checked in kN a few ulps either side (the kN value read is
+  // within one of n * 1e-3, and the limits are an interval): any text it refuses, or a
+  // value near a limit, is read the general way below, which decides as before.
+  constexpr double kUlpsMargin = 1e-15;
+  if (double n = 0.0; IsTension(column) && internal::ParseShiftedDecimal(field, kKilo, &n) &&
+                      CheckValue(column, n * 1e-3 * (1.0 - kUlpsMargin), limits, why) &&
+                      CheckValue(column, n * 1e-3 * (1.0 + kUlpsMargin), limits, why)) {
+    *value = n;
+    return true;
+  }
+  if (!ParseNumber(field, value, why) || !CheckValue(column, *value, limits, why)) return false;
+  if (IsTension(column)) *value = ScaleByKilo(field, *value);
+  return true;
+}
+
+// The sample of a row's values: the position checked, the attitude made a rotation.
+bool SampleFromValues(std::string_view line, const Header& header, const PlausibilityLimits& limits,
+                      const FieldValues& value, Sample* sample, std::string* reason) {
   if (header.position) {
     const Eigen::Vector3d position(value[kX], value[kY], value[kZ]);
     std::string why;
@@ -717,6 +701,47 @@ bool ParseRow(std::string_view line, const Header& header, const PlausibilityLim
     }
   }
   return true;
+}
+
+bool ParseRow(std::string_view line, const Header& header, const PlausibilityLimits& limits,
+              const FieldValues* previous, Sample* sample, FieldValues* values,
+              std::string* reason) {
+  std::vector<std::string_view> fields;
+  if (!SplitRow(line, header, limits, previous, &fields, reason)) return false;
+  // The unit-row hint only where the map skips no row after the header (a second re-check
+  // of issue 37: "#NV" in the first row suggested what the map already said).
+  const bool first_row =
+      header.map != nullptr && previous == nullptr && header.map->skip_after_header == 0;
+  FieldValues& value = *values;
+  value.fill(0.0);
+  for (size_t f = 0; f < fields.size(); ++f) {
+    const int column = header.column_of_field[f];
+    if (column == kIgnoredField) continue;
+    if (IsJointField(column)) {
+      if (!ReadJointField(header, fields[f], JointOfField(column), sample, reason)) return false;
+      continue;
+    }
+    if (column == kSessionField) {
+      if (IsValidSessionLabel(std::string(fields[f]))) continue;
+      *reason = header.session_label + ": " + Quoted(std::string(fields[f])) +
+                " is not a session label (letters, digits, '-' and '_', at most " +
+                std::to_string(kMaxSessionLabelLength) + ")";
+      return false;
+    }
+    std::string why;
+    const bool read =
+        header.map != nullptr
+            ? ReadMappedField(header, limits, column, fields[f], first_row, &value[column], &why)
+            : ReadPlainField(limits, column, fields[f], &value[column], &why);
+    if (!read) {
+      *reason = header.label[column] + ": " + why;
+      return false;
+    }
+  }
+  // "-0" is the reading 0, and the writer writes it so: a written and re-read dataset then
+  // holds the same bits (the fuzzer's round trip), and -0 never reaches a sign test.
+  for (double& v : value) v += 0.0;
+  return SampleFromValues(line, header, limits, value, sample, reason);
 }
 
 // Attitudes written in radians under *_deg columns: a unit slip the per-value limits
