@@ -38,7 +38,7 @@ void WhitenPrediction(const SlowErrorProcess& process, const PredictionView& at,
     const Sample& s = at.data->samples[t];
     std::array<bool, kNumCables> excluded{};
     for (int i = 0; i < kNumCables; ++i) excluded[i] = Excluded(at, t, i);
-    whitener.Whiten(s.time_s, s.session, rho[j].data(), excluded.data(), (*x)[t].data());
+    whitener.WhitenOnly(s.time_s, s.session, rho[j].data(), excluded.data(), (*x)[t].data());
   }
   for (size_t t = 0; t < at.data->samples.size(); ++t) {
     if (fitted[t]) continue;

@@ -32,18 +32,17 @@ SampleRowWhitener::SampleRowWhitener(const FittedSamples& samples, int columns)
     : samples_(samples),
       whitener_(samples.whitened() ? samples.slow_error : SlowErrorProcess(), columns) {}
 
-double SampleRowWhitener::Whiten(SampleRows* rows, const std::vector<int>* index) {
-  return WhitenRows(samples_, &whitener_, rows, index);
+void SampleRowWhitener::Whiten(SampleRows* rows, const std::vector<int>* index) {
+  WhitenRows(samples_, &whitener_, rows, index);
 }
 
-double SampleRowWhitener::Whiten(const FittedSamples& piece, SampleRows* rows) {
-  return WhitenRows(piece, &whitener_, rows, nullptr);
+void SampleRowWhitener::Whiten(const FittedSamples& piece, SampleRows* rows) {
+  WhitenRows(piece, &whitener_, rows, nullptr);
 }
 
-double SampleRowWhitener::WhitenRows(const FittedSamples& samples, ReadingWhitener* whitener,
-                                     SampleRows* rows, const std::vector<int>* index) {
-  if (!whitener->active()) return 0.0;
-  double log_f = 0.0;
+void SampleRowWhitener::WhitenRows(const FittedSamples& samples, ReadingWhitener* whitener,
+                                   SampleRows* rows, const std::vector<int>* index) {
+  if (!whitener->active()) return;
   for (int k = rows->begin; k < rows->end; ++k) {
     const int j = index != nullptr ? (*index)[k] : k;
     const int t = (*samples.fit)[j];
@@ -52,13 +51,12 @@ double SampleRowWhitener::WhitenRows(const FittedSamples& samples, ReadingWhiten
     if (samples.excluded != nullptr && !samples.excluded->empty()) {
       excluded = (*samples.excluded)[t];
     }
-    log_f += whitener->Whiten(sample.time_s, sample.session, (*samples.slow_rho)[j].data(),
-                              excluded.data(), rows->Of(k));
+    whitener->WhitenOnly(sample.time_s, sample.session, (*samples.slow_rho)[j].data(),
+                         excluded.data(), rows->Of(k));
     for (int i = 0; i < kNumCables; ++i) {
       if (excluded[i]) std::fill(rows->Row(k, i), rows->Row(k, i) + rows->columns, 0.0);
     }
   }
-  return log_f;
 }
 
 }  // namespace fastcal::internal

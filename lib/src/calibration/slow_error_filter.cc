@@ -43,16 +43,29 @@ ReadingWhitener::ReadingWhitener(const SlowErrorProcess& process, int columns, i
   for (SlowErrorFilter& f : filters_) f = SlowErrorFilter(columns);
 }
 
-double ReadingWhitener::Whiten(double time_s, int session, const double* rho, const bool* excluded,
-                               double* rows, double* log_f_each) {
-  if (!active_) return 0.0;
-  const bool fresh =
-      !started_ || StartsNewSeries(previous_time_s_, previous_session_, time_s, session);
-  const double phi =
-      fresh ? 0.0 : SlowErrorCorrelation(time_s - previous_time_s_, time_constant_s_);
+double ReadingWhitener::Advance(double time_s, int session, bool* fresh) {
+  *fresh = !started_ || StartsNewSeries(previous_time_s_, previous_session_, time_s, session);
+  double phi = 0.0;
+  if (!*fresh) {
+    const double dt_s = time_s - previous_time_s_;
+    if (dt_s != last_dt_s_) {
+      last_dt_s_ = dt_s;
+      last_phi_ = SlowErrorCorrelation(dt_s, time_constant_s_);
+    }
+    phi = last_phi_;
+  }
   started_ = true;
   previous_time_s_ = time_s;
   previous_session_ = session;
+  return phi;
+}
+
+template <bool kLikelihood>
+double ReadingWhitener::Step(double time_s, int session, const double* rho, const bool* excluded,
+                             double* rows, double* log_f_each) {
+  if (!active_) return 0.0;
+  bool fresh = false;
+  const double phi = Advance(time_s, session, &fresh);
   double log_f = 0.0;
   for (int i = first_cable_; i < end_cable_; ++i) {
     SlowErrorFilter& filter = filters_[i];
@@ -63,11 +76,23 @@ double ReadingWhitener::Whiten(double time_s, int session, const double* rho, co
     }
     const bool update = excluded == nullptr || !excluded[i];
     const double f = filter.Innovate(rho[i], rows + i * columns_, update);
-    const double term = update ? std::log(f) : 0.0;
-    if (update) log_f += term;
-    if (log_f_each != nullptr) log_f_each[i] = term;
+    if constexpr (kLikelihood) {
+      const double term = update ? std::log(f) : 0.0;
+      if (update) log_f += term;
+      if (log_f_each != nullptr) log_f_each[i] = term;
+    }
   }
   return log_f;
+}
+
+double ReadingWhitener::Whiten(double time_s, int session, const double* rho, const bool* excluded,
+                               double* rows, double* log_f_each) {
+  return Step<true>(time_s, session, rho, excluded, rows, log_f_each);
+}
+
+void ReadingWhitener::WhitenOnly(double time_s, int session, const double* rho,
+                                 const bool* excluded, double* rows) {
+  Step<false>(time_s, session, rho, excluded, rows, nullptr);
 }
 
 }  // namespace fastcal::internal

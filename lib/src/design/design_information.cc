@@ -174,7 +174,7 @@ void WhitenInTimeOrder(const SlowErrorProcess& process, const std::vector<double
       for (int k = 0; k < pr.n; ++k) rows[i * columns + k] = pr.x_rows(first + i, k);
       for (int c = 0; c < pr.q; ++c) rows[i * columns + pr.n + c] = pr.z_rows(first + i, c);
     }
-    whitener.Whiten(times_s[t], 0, rho.data(), nullptr, rows.data());
+    whitener.WhitenOnly(times_s[t], 0, rho.data(), nullptr, rows.data());
     for (int i = 0; i < kNumCables; ++i) {
       for (int k = 0; k < pr.n; ++k) pr.x_rows(first + i, k) = rows[i * columns + k];
       for (int c = 0; c < pr.q; ++c) pr.z_rows(first + i, c) = rows[i * columns + pr.n + c];

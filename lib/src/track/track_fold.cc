@@ -168,34 +168,41 @@ void WhitenResiduals(const FoldTask& task, const WindowPrediction& at, const Rea
   internal::ReadingWhitener whitener(task.slow_error, 1);
   for (size_t t = 0; t < x->size(); ++t) {
     const std::array<double, kNumCables> rho = SlowRatios(task, at.reading_n[t]);
-    whitener.Whiten(at.time_s[t], 0, rho.data(), excluded[t].data(), (*x)[t].data());
+    whitener.WhitenOnly(at.time_s[t], 0, rho.data(), excluded[t].data(), (*x)[t].data());
   }
+}
+
+// The innovations x whitened with the readings in `excluded` left out of the filter.
+ReadingArrays Whitened(const FoldTask& task, const WindowPrediction& at,
+                       const ReadingMask& excluded) {
+  ReadingArrays whitened = at.x;
+  WhitenResiduals(task, at, excluded, &whitened);
+  return whitened;
 }
 
 // The gross errors among the innovations (all of them judged): screened, whitened again
 // with them left out of the filter (a gross error that updated it would spoil the
-// innovations after it), screened again, until the set stands.
-void ScreenWindow(const FoldTask& task, WindowPrediction* at) {
+// innovations after it), screened again, until the set stands. Returns the innovations
+// whitened with the final set left out (the last round's, when it stood).
+ReadingArrays ScreenWindow(const FoldTask& task, WindowPrediction* at) {
   const int n = static_cast<int>(at->x.size());
   at->excluded.assign(n, {});
-  if (!task.detect_gross_errors) return;
+  if (!task.detect_gross_errors) return Whitened(task, *at, at->excluded);
   for (int round = 0; round < kMaxScreenRounds; ++round) {
-    ReadingArrays whitened = at->x;
-    WhitenResiduals(task, *at, at->excluded, &whitened);
+    ReadingArrays whitened = Whitened(task, *at, at->excluded);
     GrossErrorScreen screen = ScreenGrossErrors(whitened, {}, task.gross_error_threshold_sigmas);
-    if (screen.flagged == at->excluded) return;
+    if (screen.flagged == at->excluded) return whitened;
     at->excluded = std::move(screen.flagged);
   }
+  return Whitened(task, *at, at->excluded);
 }
 
 // The gross errors counted and the first ones named (their file, line and measured value
 // are the second pass's: *named gets each one's sample), and the run of residuals the
-// slow-error estimate reads.
+// slow-error estimate reads. `whitened`: ScreenWindow's innovations.
 void Summarise(const FoldTask& task, const SampleSource& source, const WindowPrediction& at,
-               WindowFold* fold, std::vector<int>* named) {
+               const ReadingArrays& whitened, WindowFold* fold, std::vector<int>* named) {
   const int n = static_cast<int>(at.x.size());
-  ReadingArrays whitened = at.x;
-  WhitenResiduals(task, at, at.excluded, &whitened);
   for (int t = 0; t < n; ++t) {
     for (int i = 0; i < kNumCables; ++i) {
       if (!at.excluded[t][i]) continue;
@@ -631,9 +638,8 @@ bool FoldSource(const FoldTask& task, const SampleSource& all, WindowFold* fold,
   if (!NoSampleTwice(task, source, at, error)) return false;
   fold->first_time_s = at.time_s.front();
   fold->last_time_s = at.time_s.back();
-  ScreenWindow(task, &at);
   std::vector<int> named;
-  Summarise(task, source, at, fold, &named);
+  Summarise(task, source, at, ScreenWindow(task, &at), fold, &named);
   internal::FittedSamples window;
   window.model = &cm;
   window.statics = statics;

@@ -54,16 +54,16 @@ class SampleRowWhitener {
   bool active() const { return whitener_.active(); }
   // Whitens the rows of fitted samples rows->begin .. end (`index` maps a row's position
   // to its fitted sample when the pass runs over a subset; null: the identity). Call for
-  // the chunks of a pass in order. Returns the sum of log F over the readings taken in.
-  double Whiten(SampleRows* rows, const std::vector<int>* index = nullptr);
+  // the chunks of a pass in order.
+  void Whiten(SampleRows* rows, const std::vector<int>* index = nullptr);
   // The same for the rows of `piece`, samples that continue the pass (a window streamed a
   // piece at a time: the filters carry on from the pieces before; its slow error must be
   // the one the whitener was made with).
-  double Whiten(const FittedSamples& piece, SampleRows* rows);
+  void Whiten(const FittedSamples& piece, SampleRows* rows);
 
  private:
-  static double WhitenRows(const FittedSamples& samples, ReadingWhitener* whitener,
-                           SampleRows* rows, const std::vector<int>* index);
+  static void WhitenRows(const FittedSamples& samples, ReadingWhitener* whitener,
+                         SampleRows* rows, const std::vector<int>* index);
 
   const FittedSamples& samples_;
   ReadingWhitener whitener_;
