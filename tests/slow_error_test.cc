@@ -290,6 +290,36 @@ TEST(SlowErrorEstimate, StatedTimeConstantEstimatedAmplitude) {
   EXPECT_NEAR(r.process.sigma_percent, truth.slow_percent, 3.0 * r.amplitude_sigma);
 }
 
+TEST(SlowErrorEstimate, AStartReachesTheGridsMaximum) {
+  // A re-estimate starts at the previous maximum (a track's next step): from the grid's
+  // own maximum moved by a fifth in amplitude and by half in tau (a step of the fit), it
+  // ends at the grid's maximum, to the search's tolerance in -2 l and to a tenth of the
+  // estimate's sigma.
+  constexpr double kValueTolerance = 2e-2;  // twice Nelder-Mead's stop, in -2 l
+  constexpr double kSigmaFraction = 0.1;
+  const Truth truth;
+  SlowErrorEstimateInputs in = Simulate(truth, 8);
+  const SlowErrorReport grid = internal::EstimateSlowError(in);
+  SlowErrorProcess moved = grid.maximum_likelihood;
+  moved.sigma_percent *= 1.2;
+  moved.time_constant_s *= 0.5;
+  in.start = moved;
+  const SlowErrorReport started = internal::EstimateSlowError(in);
+  const double grid_value = internal::SlowErrorMinusTwoLogLikelihood(in, grid.process);
+  const double started_value = internal::SlowErrorMinusTwoLogLikelihood(in, started.process);
+  EXPECT_LT(std::abs(started_value - grid_value), kValueTolerance);
+  EXPECT_NEAR(started.process.sigma_percent, grid.process.sigma_percent,
+              kSigmaFraction * grid.amplitude_sigma);
+  EXPECT_NEAR(started.process.time_constant_s, grid.process.time_constant_s,
+              kSigmaFraction * grid.time_constant_sigma_s);
+  // The start is where the search begins: a start with no amplitude falls back to the grid
+  // (the same result, bit for bit).
+  in.start = SlowErrorProcess();
+  const SlowErrorReport fallback = internal::EstimateSlowError(in);
+  EXPECT_EQ(fallback.process.sigma_percent, grid.process.sigma_percent);
+  EXPECT_EQ(fallback.process.time_constant_s, grid.process.time_constant_s);
+}
+
 TEST(SlowErrorEstimate, ThreadsDoNotChangeTheLikelihood) {
   // The cables' filters split among threads: the same bits on any number, with readings
   // left out, two sessions and the gain profiled out too.

@@ -499,13 +499,29 @@ int CountSeries(const std::vector<SlowErrorSample>& samples) {
   return series;
 }
 
-// The maximum over the free coordinates of `search`, from the stated values.
+// (log a, log tau) of a process, a in the spec's units of the amplitude.
+Eigen::Vector2d LogCoordinates(const SlowErrorEstimateInputs& in, const SlowErrorProcess& p) {
+  const double a = in.spec.amplitude_in_percent ? p.sigma_percent : p.sigma_n;
+  return Eigen::Vector2d(std::log(std::max(a, 1e-300)),
+                         std::log(std::max(p.time_constant_s, 1e-300)));
+}
+
+// The maximum over the free coordinates of `search`, from the stated values: the search
+// starts at the inputs' start where it has one, else at the grid's best node.
 Eigen::Vector2d Maximise(const Search& search) {
-  const SlowErrorProcess& stated = search.in->spec.stated;
-  const double stated_a =
-      search.in->spec.amplitude_in_percent ? stated.sigma_percent : stated.sigma_n;
-  Eigen::Vector2d fixed(std::log(std::max(stated_a, 1e-300)),
-                        std::log(std::max(stated.time_constant_s, 1e-300)));
+  const SlowErrorEstimateInputs& in = *search.in;
+  const Eigen::Vector2d fixed = LogCoordinates(in, in.spec.stated);
+  if (in.start.has_value()) {
+    const double a = in.spec.amplitude_in_percent ? in.start->sigma_percent : in.start->sigma_n;
+    if (a > 0.0 && std::isfinite(a) && in.start->time_constant_s > 0.0 &&
+        std::isfinite(in.start->time_constant_s)) {
+      Eigen::Vector2d y = LogCoordinates(in, *in.start);
+      for (int k = 0; k < 2; ++k) {
+        if (!search.free[k]) y[k] = fixed[k];
+      }
+      return NelderMead(search, search.Clamp(y));
+    }
+  }
   return NelderMead(search, GridStart(search, fixed));
 }
 

@@ -360,6 +360,9 @@ bool ReestimateSlowError(TrackRun& run) {
   for (int k : run.layout.shared_columns) {
     in.gain_nuisance = in.gain_nuisance || run.layout.Column(k).kind == ParameterKind::kSensorGain;
   }
+  // After the first estimate, each starts at the one before's maximum (a step of the point
+  // away), not at a grid over the whole range.
+  if (run.result->slow_error.passes > 0) in.start = run.result->slow_error.maximum_likelihood;
   for (size_t u = 0; u < run.used.size(); ++u) {
     for (const FoldResidual& r : run.windows[run.used[u]].fold.residuals) {
       SlowErrorSample s;

@@ -19,6 +19,7 @@
 #define FASTCAL_INTERNAL_SLOW_ERROR_ESTIMATE_H_
 
 #include <array>
+#include <optional>
 #include <vector>
 
 #include "fastcal/cable_robot.h"
@@ -49,6 +50,12 @@ struct SlowErrorEstimateInputs {
   // Threads the likelihood's filters run on (the cables split among them); the results
   // are the same bits on any number.
   int num_threads = 1;
+  // A previous estimate's maximum-likelihood process, where the searches start instead of
+  // at a coarse grid's best node (the grid guards a first estimate against a ridge along
+  // which Nelder-Mead alone would stall; a re-estimate after a step of the fit starts
+  // next to its maximum, and the grid was a third of its likelihood evaluations). Unset,
+  // or without a positive amplitude and time constant: the grid.
+  std::optional<SlowErrorProcess> start;
 };
 
 // -2 l_R of `process` (white noise only when inactive), up to a constant.
