@@ -9,6 +9,8 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <cstring>
 #include <cstdio>
 #include <functional>
 #include <string>
@@ -476,6 +478,37 @@ TEST(WindowStoreTest, RangesReadAsTheWhole) {
   internal::StoredWindowReader reader;
   EXPECT_FALSE(reader.Open(path, 0, &error));
   EXPECT_NE(error.find("record 1 is not finite"), std::string::npos) << error;
+  std::remove(path.c_str());
+}
+
+// Open checks each record on its bytes: a value that is not finite in any of its doubles
+// (time, position, rotation, tensions, the model's joints) is named, while the line and
+// file, two int32 whose bits together may read as a NaN, are not values.
+TEST(WindowStoreTest, EveryValueOfARecordIsChecked) {
+  constexpr int kJoints = 3;
+  const std::string path = test::TempPath("window_store_finite", ".samples");
+  const long long words = internal::RecordBytes(kJoints) / 8;
+  Sample good;
+  good.time_s = 1.0;
+  good.line = -1;  // with file -1: the word at offset 8 all ones, a NaN's bits
+  const internal::StoredSample first = internal::ToStored(good, -1, false);
+  for (long long w = 0; w < words; ++w) {
+    for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+      internal::StoredSample second = internal::ToStored(good, -1, false);
+      second.time_s = 2.0;
+      if (w != 1) std::memcpy(reinterpret_cast<char*>(&second) + 8 * w, &bad, sizeof(bad));
+      std::remove(path.c_str());
+      std::string error;
+      ASSERT_TRUE(internal::AppendStoredSamples(path, {first, second}, kJoints, &error)) << error;
+      internal::StoredWindowReader reader;
+      if (w == 1) {
+        EXPECT_TRUE(reader.Open(path, kJoints, &error)) << error;
+      } else {
+        EXPECT_FALSE(reader.Open(path, kJoints, &error)) << "word " << w;
+        EXPECT_NE(error.find("record 1 is not finite"), std::string::npos) << error;
+      }
+    }
+  }
   std::remove(path.c_str());
 }
 

@@ -581,13 +581,18 @@ SampleSource Strided(const SampleSource& all, int stride, int run) {
 
 // The fold of the window `source` reads: the first pass (predictions), the screen, the
 // summary, the second pass (rows).
-bool FoldSource(const FoldTask& task, const SampleSource& all, WindowFold* fold,
-                std::string* error) {
-  if (!task.IsValid(error)) return false;
+// The task checked and its model read (once a fold: FoldWindow needs the model's joints
+// before it reads the store).
+bool ModelOfTask(const FoldTask& task, CableRobot* model, std::string* error) {
+  return task.IsValid(error) &&
+         ParseCableRobotYaml(task.model_yaml, "the fold task's model", model, error);
+}
+
+// `model`: the task's (ModelOfTask).
+bool FoldSource(const FoldTask& task, const CableRobot& model, const SampleSource& all,
+                WindowFold* fold, std::string* error) {
   const SampleSource source =
       task.stride > 1 ? Strided(all, task.stride, task.residual_samples) : all;
-  CableRobot model;
-  if (!ParseCableRobotYaml(task.model_yaml, "the fold task's model", &model, error)) return false;
   const CalibrationSpec spec = FoldSpec(task);
   const internal::CalibrationModel cm(model, spec);
   if (cm.num_free() != static_cast<int>(task.theta_si.size())) {
@@ -673,13 +678,14 @@ bool FoldSamples(const FoldTask& task, const Dataset& data, const std::vector<in
     }
     return true;
   };
-  return FoldSource(task, source, fold, error);
+  CableRobot model;
+  return ModelOfTask(task, &model, error) && FoldSource(task, model, source, fold, error);
 }
 
 bool FoldWindow(const FoldTask& task, WindowFold* fold, std::string* error) {
   // The store's records carry the model's joints (window_store.h).
   CableRobot model;
-  if (!ParseCableRobotYaml(task.model_yaml, "the fold task's model", &model, error)) return false;
+  if (!ModelOfTask(task, &model, error)) return false;
   internal::StoredWindowReader reader;
   if (!reader.Open(task.samples_path, model.moving_parts.num_joints(), error)) return false;
   SampleSource source;
@@ -692,7 +698,7 @@ bool FoldWindow(const FoldTask& task, WindowFold* fold, std::string* error) {
                           std::vector<int>* files, std::string* why) {
     return reader.ReadEvery(first, count, step, samples, files, why);
   };
-  return FoldSource(task, source, fold, error);
+  return FoldSource(task, model, source, fold, error);
 }
 
 }  // namespace fastcal
