@@ -288,20 +288,24 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   const std::string dir = TempDir("first_step");
   fs::create_directories(dir);
   const std::string csv = Write(data, dir + "/day.csv");
-  std::vector<int> strides;  // per round of folds, the largest
+  std::vector<int> strides;        // per round of folds, the largest
+  std::vector<int> residual_runs;  // per round of folds, the largest run of residuals
   TrackOptions options;
-  options.runner = [&strides](const std::vector<std::string>& tasks,
-                              std::vector<std::string>* folds, std::string* error) {
-    int largest = 0;
+  options.runner = [&strides, &residual_runs](const std::vector<std::string>& tasks,
+                                              std::vector<std::string>* folds,
+                                              std::string* error) {
+    int largest = 0, run = 0;
     folds->clear();
     for (const std::string& t : tasks) {
       FoldTask task;
       if (!ParseFoldTask(t, &task, error)) return false;
       largest = std::max(largest, task.stride);
+      run = std::max(run, task.residual_samples);
       folds->emplace_back();
       if (!RunFoldTask(t, &folds->back(), error)) return false;
     }
     strides.push_back(largest);
+    residual_runs.push_back(run);
     return true;
   };
   // No step taken back: the subsample's chi-square is not compared with the whole's.
@@ -316,12 +320,15 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   ASSERT_EQ(first_step.windows.size(), 2u);
   EXPECT_EQ(first_step.windows[1].samples, 1280);
   ASSERT_GE(strides.size(), 2u);
-  // The rounds through the subsample first (1280 / 300 = 4, rounded down; the slow error
-  // estimated from the second), at most 4 of them, then every sample.
+  // The rounds through the subsample first (1280 / 300 = 4, rounded down), at most 4 of
+  // them, each with its run of residuals, then every sample.
   const size_t subsampled = static_cast<size_t>(std::count(strides.begin(), strides.end(), 4));
   EXPECT_GE(subsampled, 1u);
   EXPECT_LE(subsampled, 4u);
-  for (size_t r = 0; r < strides.size(); ++r) EXPECT_EQ(strides[r], r < subsampled ? 4 : 1) << r;
+  for (size_t r = 0; r < strides.size(); ++r) {
+    EXPECT_EQ(strides[r], r < subsampled ? 4 : 1) << r;
+    EXPECT_GT(residual_runs[r], 0) << r;
+  }
   EXPECT_EQ(halved, "");
 
   // The slow error estimated: from a subsample's round after the first (whose point is
@@ -332,6 +339,7 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
     const CalibrationSpec estimated =
         LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}"));
     strides.clear();
+    residual_runs.clear();
     // Each round's progress: "s" a fold of the subsample, "f" of every sample, "e" an
     // estimate of the slow error.
     std::string rounds_seen;
@@ -343,8 +351,16 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
       if (line.find("slow sensor error") != std::string::npos) rounds_seen += "e";
     };
     const TrackResult sub = Track(estimated, {csv}, dir + "/estimated_sub", seen);
+    // With the slow error estimated, the very first round is coarser and has no run of
+    // residuals (a quarter of 300, raised to min_window_samples = 100: 1280 / 100 = 12):
+    // the estimate starts from the second, which the first is never the last before.
+    ASSERT_GE(strides.size(), 3u);
+    EXPECT_EQ(strides[0], 12);
+    EXPECT_EQ(residual_runs[0], 0);
     const size_t rounds = static_cast<size_t>(std::count(strides.begin(), strides.end(), 4));
-    EXPECT_GE(rounds, 2u);
+    EXPECT_GE(rounds, 1u);
+    EXPECT_EQ(strides[1], 4);
+    EXPECT_GT(residual_runs[1], 0);
     // The subsample rounds leave the slow error standing: the first fold of every sample
     // estimates it again (and the track reports that estimate), the second converges
     // with the consider columns. Before, a subsample's run of residuals spanning k times
