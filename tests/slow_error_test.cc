@@ -312,12 +312,17 @@ TEST(SlowErrorEstimate, AStartReachesTheGridsMaximum) {
               kSigmaFraction * grid.amplitude_sigma);
   EXPECT_NEAR(started.process.time_constant_s, grid.process.time_constant_s,
               kSigmaFraction * grid.time_constant_sigma_s);
-  // The start is where the search begins: a start with no amplitude falls back to the grid
-  // (the same result, bit for bit).
-  in.start = SlowErrorProcess();
-  const SlowErrorReport fallback = internal::EstimateSlowError(in);
-  EXPECT_EQ(fallback.process.sigma_percent, grid.process.sigma_percent);
-  EXPECT_EQ(fallback.process.time_constant_s, grid.process.time_constant_s);
+  // A start without amplitude, or at a bound of the search (a time constant beyond the
+  // data's span: the simplex's first step would be clamped back onto it and the search
+  // could not leave the bound), falls back to the grid: the same result, bit for bit.
+  SlowErrorProcess at_bound = grid.maximum_likelihood;
+  at_bound.time_constant_s = 1e12;
+  for (const SlowErrorProcess& start : {SlowErrorProcess(), at_bound}) {
+    in.start = start;
+    const SlowErrorReport fallback = internal::EstimateSlowError(in);
+    EXPECT_EQ(fallback.process.sigma_percent, grid.process.sigma_percent);
+    EXPECT_EQ(fallback.process.time_constant_s, grid.process.time_constant_s);
+  }
 }
 
 TEST(SlowErrorEstimate, ThreadsDoNotChangeTheLikelihood) {

@@ -507,7 +507,10 @@ Eigen::Vector2d LogCoordinates(const SlowErrorEstimateInputs& in, const SlowErro
 }
 
 // The maximum over the free coordinates of `search`, from the stated values: the search
-// starts at the inputs' start where it has one, else at the grid's best node.
+// starts at the inputs' start where it has one inside the search's range, else at the
+// grid's best node. A start at a bound is not taken: the simplex's first steps (+0.5 in
+// each free coordinate) would be clamped back onto it, and the search could not leave
+// the bound.
 Eigen::Vector2d Maximise(const Search& search) {
   const SlowErrorEstimateInputs& in = *search.in;
   const Eigen::Vector2d fixed = LogCoordinates(in, in.spec.stated);
@@ -519,7 +522,7 @@ Eigen::Vector2d Maximise(const Search& search) {
       for (int k = 0; k < 2; ++k) {
         if (!search.free[k]) y[k] = fixed[k];
       }
-      return NelderMead(search, search.Clamp(y));
+      if (!AtBound(search, y, 0) && !AtBound(search, y, 1)) return NelderMead(search, y);
     }
   }
   return NelderMead(search, GridStart(search, fixed));
