@@ -11,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <string>
@@ -290,21 +291,24 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
   const std::string csv = Write(data, dir + "/day.csv");
   std::vector<int> strides;        // per round of folds, the largest
   std::vector<int> residual_runs;  // per round of folds, the largest run of residuals
+  std::vector<int> smallest;       // per round of folds, the smallest stride
   TrackOptions options;
-  options.runner = [&strides, &residual_runs](const std::vector<std::string>& tasks,
-                                              std::vector<std::string>* folds,
-                                              std::string* error) {
-    int largest = 0, run = 0;
+  options.runner = [&strides, &residual_runs, &smallest](const std::vector<std::string>& tasks,
+                                                         std::vector<std::string>* folds,
+                                                         std::string* error) {
+    int largest = 0, run = 0, least = std::numeric_limits<int>::max();
     folds->clear();
     for (const std::string& t : tasks) {
       FoldTask task;
       if (!ParseFoldTask(t, &task, error)) return false;
       largest = std::max(largest, task.stride);
+      least = std::min(least, task.stride);
       run = std::max(run, task.residual_samples);
       folds->emplace_back();
       if (!RunFoldTask(t, &folds->back(), error)) return false;
     }
     strides.push_back(largest);
+    smallest.push_back(least);
     residual_runs.push_back(run);
     return true;
   };
@@ -379,6 +383,24 @@ TEST(TrackTest, AFirstStepThroughASubsampleEndsWhereTheWholeDoes) {
     EXPECT_NEAR(p.time_constant_s, q.time_constant_s,
                 internal::kSlowErrorSettled * q.time_constant_s);
     ExpectSameTrack(all, sub);
+
+    // The coarser round strides only the windows the later rounds stride (720 / 400 = 1:
+    // every sample of the first day; 1280 / 400 = 3, then 4 x 3 = 12 in the first round),
+    // and is not taken where max_iterations leaves no room for a round after it.
+    TrackOptions wider = options;
+    wider.first_fold_samples = 400;
+    strides.clear();
+    smallest.clear();
+    Track(estimated, {csv}, dir + "/estimated_wider", wider);
+    ASSERT_GE(strides.size(), 2u);
+    EXPECT_EQ(strides[0], 12);
+    EXPECT_EQ(smallest[0], 1);
+    EXPECT_EQ(strides[1], 3);
+    wider.max_iterations = 3;
+    strides.clear();
+    Track(estimated, {csv}, dir + "/estimated_three", wider);
+    ASSERT_GE(strides.size(), 1u);
+    EXPECT_EQ(strides[0], 3);
   }
 
   strides.clear();

@@ -117,10 +117,11 @@ struct TrackOptions {
   // the point to within the subsample's noise of the solution and settle the slow error
   // (at most 4 of them), and the folds of every sample after them reach the solution in
   // two (issue 41: at 10^7 samples, 3 folds of every sample and one of a fifth became
-  // 2 and 3 of a twentieth). Where the slow error is estimated, the very first of them
-  // reads a quarter of these (at least min_window_samples) and no residual run: its step
-  // only brings the point near, and the estimate starts from the second. 0: every sample;
-  // otherwise at least min_window_samples. Not with max_iterations = 1.
+  // 2 and 3 of a twentieth). Where the slow error is estimated (and max_iterations > 3),
+  // the very first of them reads one sample in 4k of the windows the others stride (at
+  // least min_window_samples) and no residual run: its step only brings the point near,
+  // and the estimate starts from the second. 0: every sample; otherwise at least
+  // min_window_samples. Not with max_iterations = 1.
   long long first_fold_samples = 5000;
   // Converged when every parameter's step is below this fraction of its formal sigma.
   // The consider parameters' columns are folded with an iteration whose step may be the

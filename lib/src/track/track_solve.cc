@@ -31,19 +31,20 @@ constexpr int kMaxResidualRun = 5000;
 // costs their share of one fold (about 14% there), a right one a whole fold.
 constexpr double kNextStepPerSquaredStep = 2e-4;
 
-// A new track's iterations through subsamples at most (TrackOptions::first_fold_samples):
-// from the initial model, 873 sigma away at 10^7 samples, with the slow error estimated
-// from the second, they take 3.
+// A new track's iterations through subsamples at most (TrackOptions::first_fold_samples;
+// the coarser first one below included): from the initial model, 873 sigma away at 10^7
+// samples, with the slow error estimated from the second, they take 3.
 constexpr int kMaxSubsampleIterations = 4;
 // Where the slow error is estimated, the very first fold, at the initial model, reads this
-// fraction of the later subsamples' samples (at least min_window_samples) and no run of
-// residuals: its step only brings the point from the initial model (hundreds of sigma
-// away) to near the solution, the slow error is estimated from the second fold on (the
-// first point's residuals are mostly the model's error), and the subsample's rounds go on
-// until it stands, so that the folds of every sample start from a subsample of the usual
-// size. At 10^7 samples in 100 windows that first fold read 5950 samples a window, 1000
-// of them the residual run's, for a step the next fold takes again. (With a stated slow
-// error the first round may be the last: it keeps the usual size.)
+// fraction of the later subsamples' samples of the windows they stride (one in 4k, at
+// least min_window_samples) and no run of residuals: its step only brings the point from
+// the initial model (hundreds of sigma away) to near the solution, the slow error is
+// estimated from the second fold on (the first point's residuals are mostly the model's
+// error), and the subsample's rounds go on until it stands, so that the folds of every
+// sample start from a subsample of the usual size. At 10^7 samples in 100 windows that
+// first fold read 5950 samples a window, 1000 of them the residual run's, for a step the
+// next fold takes again. (With a stated slow error the first round may be the last: it
+// keeps the usual size; so it does where max_iterations leaves no room for another.)
 constexpr long long kFirstFoldFraction = 4;
 
 // How much a Gauss-Newton step may raise the chi-square before it is halved: the weights
@@ -86,12 +87,15 @@ FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_ru
   t.slow_error = run.slow;
   t.blocks = run.options.blocks;
   t.residual_samples = residual_run;
-  long long most = run.options.first_fold_samples;
-  if (subsample && most > 0 && coarse) {
-    most = std::max(most / kFirstFoldFraction, run.options.min_window_samples);
-  }
+  const long long most = run.options.first_fold_samples;
   if (subsample && most > 0) t.stride = static_cast<int>(std::max(1LL, w.samples / most));
-  if (coarse && t.stride > 1) t.residual_samples = 0;
+  if (coarse && t.stride > 1) {
+    // One sample in 4k, at least min_window_samples of them; no run of residuals.
+    const long long fewest = std::max(1LL, run.options.min_window_samples);
+    t.stride = static_cast<int>(std::max<long long>(
+        t.stride, std::min<long long>(kFirstFoldFraction * t.stride, w.samples / fewest)));
+    t.residual_samples = 0;
+  }
   return t;
 }
 
@@ -598,7 +602,10 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     const bool may_be_last =
         kNextStepPerSquaredStep * gn.last_step * gn.last_step <= run.options.step_tolerance_sigmas;
     bool strided = false;
-    const bool coarse = subsample && it == 1 && !initially_settled;
+    // Never the last round through the subsample: the estimate keeps them going, and the
+    // iterations leave room for one more (KeepSubsampling).
+    const bool coarse =
+        subsample && it == 1 && !initially_settled && run.options.max_iterations > 3;
     const bool folded = FoldDirty(run, may_be_last && !subsample, subsample, &strided, coarse);
     if (folded) gn.folds_strided = strided;
     const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
