@@ -218,8 +218,7 @@ bool FoldDirty(TrackRun& run, bool consider = false, bool subsample = false,
   for (int w : run.used) {
     if (!run.windows[w].dirty) continue;
     which.push_back(w);
-    const FoldTask task =
-        TaskFor(run, run.windows[w], residual_run, consider, subsample, coarse);
+    const FoldTask task = TaskFor(run, run.windows[w], residual_run, consider, subsample, coarse);
     largest_stride = std::max(largest_stride, task.stride);
     tasks.push_back(SerializeFoldTask(task));
   }

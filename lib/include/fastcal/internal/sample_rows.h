@@ -62,8 +62,8 @@ class SampleRowWhitener {
   void Whiten(const FittedSamples& piece, SampleRows* rows);
 
  private:
-  static void WhitenRows(const FittedSamples& samples, ReadingWhitener* whitener,
-                         SampleRows* rows, const std::vector<int>* index);
+  static void WhitenRows(const FittedSamples& samples, ReadingWhitener* whitener, SampleRows* rows,
+                         const std::vector<int>* index);
 
   const FittedSamples& samples_;
   ReadingWhitener whitener_;
