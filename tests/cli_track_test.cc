@@ -129,9 +129,6 @@ TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
   EXPECT_NE(other.output.find("--force"), std::string::npos) << other.output;
 }
 
-// An export as it comes (FAST's: Beijing time, decimal commas, mm and N) tracked through
-// its column map: the day in UTC, the numbers of the canonical survey; an update must read
-// the files through the same map.
 // --min-window-samples above the subsample of a new track's first steps
 // (TrackOptions::first_fold_samples, 5000) raises the subsample: it was refused, naming
 // an option the command line does not have.
@@ -148,6 +145,9 @@ TEST_F(CliTrackTest, AWindowMinimumAboveTheSubsampleIsTaken) {
   EXPECT_EQ(r.output.find("first_fold_samples"), std::string::npos) << r.output;
 }
 
+// An export as it comes (FAST's: Beijing time, decimal commas, mm and N) tracked through
+// its column map: the day in UTC, the numbers of the canonical survey; an update must read
+// the files through the same map.
 TEST_F(CliTrackTest, AnExportIsTrackedThroughItsColumnMap) {
   const std::string data = Source() + "/calibration_data/fast_export.csv";
   const std::string map = Source() + "/calibration_data/fast_export.columns.yaml";

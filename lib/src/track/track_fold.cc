@@ -579,8 +579,6 @@ SampleSource Strided(const SampleSource& all, int stride, int run) {
   return s;
 }
 
-// The fold of the window `source` reads: the first pass (predictions), the screen, the
-// summary, the second pass (rows).
 // The task checked and its model read (once a fold: FoldWindow needs the model's joints
 // before it reads the store).
 bool ModelOfTask(const FoldTask& task, CableRobot* model, std::string* error) {
@@ -588,7 +586,9 @@ bool ModelOfTask(const FoldTask& task, CableRobot* model, std::string* error) {
          ParseCableRobotYaml(task.model_yaml, "the fold task's model", model, error);
 }
 
-// `model`: the task's (ModelOfTask).
+// The fold of the window `all` reads (or of its subsample, the task's stride): the first
+// pass (predictions), the screen, the summary, the second pass (rows). `model`: the task's
+// (ModelOfTask).
 bool FoldSource(const FoldTask& task, const CableRobot& model, const SampleSource& all,
                 WindowFold* fold, std::string* error) {
   const SampleSource source =

@@ -57,11 +57,15 @@ bool Moving(const TrackRun& run, const TrackWindowState& w) {
   return !run.update || run.options.refold_all || w.folded || !w.has_fold;
 }
 
+// Which samples a round of folds reads: every one, or of the windows of at least twice
+// TrackOptions::first_fold_samples one in k (k = samples / first_fold_samples), or one in
+// 4k without the run of residuals (the coarser first round, kFirstFoldFraction).
+enum class Sampling { kEvery, kSubsample, kCoarse };
+
 // The task of window w: its point over every column, or (without `consider`) over the
 // fitted columns alone, the consider parameters then fixed at their values.
-// `coarse` (with `subsample`): the coarser first fold (kFirstFoldFraction).
 FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_run, bool consider,
-                 bool subsample, bool coarse) {
+                 Sampling sampling) {
   FoldTask t;
   t.label = w.label;
   // Absolute: a worker of a Dask cluster may run in another directory.
@@ -88,8 +92,10 @@ FoldTask TaskFor(const TrackRun& run, const TrackWindowState& w, int residual_ru
   t.blocks = run.options.blocks;
   t.residual_samples = residual_run;
   const long long most = run.options.first_fold_samples;
-  if (subsample && most > 0) t.stride = static_cast<int>(std::max(1LL, w.samples / most));
-  if (coarse && t.stride > 1) {
+  if (sampling != Sampling::kEvery && most > 0) {
+    t.stride = static_cast<int>(std::max(1LL, w.samples / most));
+  }
+  if (sampling == Sampling::kCoarse && t.stride > 1) {
     // One sample in 4k, at least min_window_samples of them; no run of residuals.
     const long long fewest = std::max(1LL, run.options.min_window_samples);
     t.stride = static_cast<int>(std::max<long long>(
@@ -205,12 +211,11 @@ bool CheckMovingStores(TrackRun& run) {
   return true;
 }
 
-// Folds every dirty used window at its point (with the consider columns when `consider`;
-// of every k-th sample of the larger windows when `subsample`, TrackOptions::
-// first_fold_samples; of a coarser subsample also when `coarse`, kFirstFoldFraction).
-// *strided (if not null) says whether any window was.
-bool FoldDirty(TrackRun& run, bool consider = false, bool subsample = false,
-               bool* strided = nullptr, bool coarse = false) {
+// Folds every dirty used window at its point (with the consider columns when `consider`),
+// reading the samples `sampling` says. *strided (if not null) says whether any window was
+// read through a subsample.
+bool FoldDirty(TrackRun& run, bool consider = false, Sampling sampling = Sampling::kEvery,
+               bool* strided = nullptr) {
   std::vector<int> which;
   std::vector<std::string> tasks;
   const int residual_run = ResidualRun(run);
@@ -218,7 +223,7 @@ bool FoldDirty(TrackRun& run, bool consider = false, bool subsample = false,
   for (int w : run.used) {
     if (!run.windows[w].dirty) continue;
     which.push_back(w);
-    const FoldTask task = TaskFor(run, run.windows[w], residual_run, consider, subsample, coarse);
+    const FoldTask task = TaskFor(run, run.windows[w], residual_run, consider, sampling);
     largest_stride = std::max(largest_stride, task.stride);
     tasks.push_back(SerializeFoldTask(task));
   }
@@ -486,14 +491,20 @@ struct GaussNewton {
   int subsample_iterations = 0;
 };
 
+// Whether iteration `it`, the `rounds`-th through a subsample, may be followed by another:
+// at most kMaxSubsampleIterations of them, and two iterations left after it for the folds
+// of every sample.
+bool RoomForSubsampleRound(const TrackRun& run, int rounds, int it) {
+  return rounds < kMaxSubsampleIterations && it + 2 < run.options.max_iterations;
+}
+
 // After an iteration through a subsample: whether the next is too. Until the next step
 // would be within the subsample's noise (a sigma of its own: the whole's solution lies
 // about that far from the subsample's) with the slow error standing, and with two
 // iterations left for the folds of every sample.
 bool KeepSubsampling(const TrackRun& run, GaussNewton& gn, int it, bool slow_stands, double step) {
   const bool near = kNextStepPerSquaredStep * step * step <= 1.0;
-  return ++gn.subsample_iterations < kMaxSubsampleIterations &&
-         it + 2 < run.options.max_iterations && !(near && slow_stands);
+  return RoomForSubsampleRound(run, ++gn.subsample_iterations, it) && !(near && slow_stands);
 }
 
 // The slow error at the start of the iterations (the spec's initial one for a new track;
@@ -601,11 +612,14 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
     const bool may_be_last =
         kNextStepPerSquaredStep * gn.last_step * gn.last_step <= run.options.step_tolerance_sigmas;
     bool strided = false;
-    // Never the last round through the subsample: the estimate keeps them going, and the
-    // iterations leave room for one more (KeepSubsampling).
+    // Never the last round through the subsample: the estimate keeps them going, where the
+    // iterations leave room for one more after it.
     const bool coarse =
-        subsample && it == 1 && !initially_settled && run.options.max_iterations > 3;
-    const bool folded = FoldDirty(run, may_be_last && !subsample, subsample, &strided, coarse);
+        subsample && it == 1 && !initially_settled && RoomForSubsampleRound(run, 1, it);
+    const Sampling sampling = coarse      ? Sampling::kCoarse
+                              : subsample ? Sampling::kSubsample
+                                          : Sampling::kEvery;
+    const bool folded = FoldDirty(run, may_be_last && !subsample, sampling, &strided);
     if (folded) gn.folds_strided = strided;
     const double chi2 = folded ? PointChiSquare(run) : std::numeric_limits<double>::infinity();
     if (HalveBack(run, gn, folded, chi2)) continue;
