@@ -312,6 +312,10 @@ TEST(SlowErrorEstimate, AStartReachesTheGridsMaximum) {
               kSigmaFraction * grid.amplitude_sigma);
   EXPECT_NEAR(started.process.time_constant_s, grid.process.time_constant_s,
               kSigmaFraction * grid.time_constant_sigma_s);
+  // And the start is where the search began: without the grid's 6 x 8 nodes.
+  constexpr int kGridNodes = 48;
+  EXPECT_LT(started.likelihood_evaluations, grid.likelihood_evaluations - kGridNodes / 2)
+      << started.likelihood_evaluations << " against " << grid.likelihood_evaluations;
   // A start without amplitude, or at a bound of the search (a time constant beyond the
   // data's span: the simplex's first step would be clamped back onto it and the search
   // could not leave the bound), falls back to the grid: the same result, bit for bit.

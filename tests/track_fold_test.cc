@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "fastcal/calibration_spec.h"
+#include "fastcal/internal/calibration_model.h"
 #include "fastcal/internal/window_store.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
@@ -426,6 +427,25 @@ TEST_F(TrackFoldTest, GrossErrorIsNamedAndKeptOut) {
   EXPECT_EQ(fold.gross_errors[0].line, 77);
   EXPECT_EQ(fold.gross_errors[0].cable, 3);
   EXPECT_EQ(fold.readings, 719);
+  // Its residual is named as the innovation the screen judged: whitened by the slow error
+  // (the fixture's stated one), not the residual over its white sigma; without a slow error
+  // the two are one.
+  const auto raw_sigmas = [&](const FoldGrossError& g) {
+    std::array<double, kNumCables> reading{};
+    reading.fill(g.predicted_n);
+    const double sigma = internal::TensionSigmas(reading, task_.tension_sigma_n,
+                                                 task_.tension_sigma_percent)[g.cable - 1];
+    return (g.predicted_n - g.measured_n) / sigma;
+  };
+  constexpr double kWhitenedApart = 1e-3;  // relative: the slow error moves it by far more
+  constexpr double kSameRelative = 1e-9;
+  const double raw = raw_sigmas(fold.gross_errors[0]);
+  EXPECT_GT(std::abs(fold.gross_errors[0].residual_sigma - raw), kWhitenedApart * std::abs(raw));
+  task_.slow_error = SlowErrorProcess();
+  const WindowFold white = Fold(task_);
+  ASSERT_EQ(white.gross_error_count, 1);
+  EXPECT_NEAR(white.gross_errors[0].residual_sigma, raw_sigmas(white.gross_errors[0]),
+              kSameRelative * std::abs(raw));
 }
 
 TEST_F(TrackFoldTest, UnsolvablePoseNamesFileAndLine) {

@@ -71,6 +71,10 @@ struct SlowErrorReport {
   int series = 0;        // independent series in the fitted samples (sessions, gaps)
   int samples_used = 0;  // fitted samples the estimate used (a subset on long data)
   int passes = 0;        // fits the process was re-estimated over
+  // The likelihood's evaluations the searches took (each a filter over every sample used):
+  // the estimate's cost, and whether a re-estimate started at the one before (internal::
+  // SlowErrorEstimateInputs::start) or at the grid.
+  int likelihood_evaluations = 0;
 };
 
 // One paragraph for consoles and reports: the process, estimated or stated, with its

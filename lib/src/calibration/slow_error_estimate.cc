@@ -326,8 +326,10 @@ struct Search {
   }
   double Value(const Eigen::Vector2d& y) const { return ValueOf(At(Clamp(y))); }
   double ValueOf(const SlowErrorProcess& process) const {
+    ++evaluations;
     return MinusTwoLogLikelihood(laid_out, process, in->num_threads);
   }
+  mutable int evaluations = 0;  // of the likelihood, each a filter over every sample
 };
 
 double Median(std::vector<double> v) {
@@ -499,9 +501,14 @@ int CountSeries(const std::vector<SlowErrorSample>& samples) {
   return series;
 }
 
+// A process's amplitude in the spec's units (percent of the reading, or N).
+double AmplitudeOf(const SlowErrorEstimateInputs& in, const SlowErrorProcess& p) {
+  return in.spec.amplitude_in_percent ? p.sigma_percent : p.sigma_n;
+}
+
 // (log a, log tau) of a process, a in the spec's units of the amplitude.
 Eigen::Vector2d LogCoordinates(const SlowErrorEstimateInputs& in, const SlowErrorProcess& p) {
-  const double a = in.spec.amplitude_in_percent ? p.sigma_percent : p.sigma_n;
+  const double a = AmplitudeOf(in, p);
   return Eigen::Vector2d(std::log(std::max(a, 1e-300)),
                          std::log(std::max(p.time_constant_s, 1e-300)));
 }
@@ -515,7 +522,7 @@ Eigen::Vector2d Maximise(const Search& search) {
   const SlowErrorEstimateInputs& in = *search.in;
   const Eigen::Vector2d fixed = LogCoordinates(in, in.spec.stated);
   if (in.start.has_value()) {
-    const double a = in.spec.amplitude_in_percent ? in.start->sigma_percent : in.start->sigma_n;
+    const double a = AmplitudeOf(in, *in.start);
     if (a > 0.0 && std::isfinite(a) && in.start->time_constant_s > 0.0 &&
         std::isfinite(in.start->time_constant_s)) {
       Eigen::Vector2d y = LogCoordinates(in, *in.start);
@@ -560,19 +567,18 @@ SlowErrorReport EstimateSlowError(const SlowErrorEstimateInputs& in) {
     report.stated_likelihood_ratio = std::max(0.0, value - ml_value);
     report.stated_p_value = std::exp(-report.stated_likelihood_ratio / 2.0);  // chi-square(2)
     report.stated_contradicted = report.stated_likelihood_ratio > kChiSquare2Quantile99;
+    report.likelihood_evaluations = full.evaluations + search.evaluations;
     return report;
   }
   report.amplitude_at_floor = in.spec.estimate_amplitude && y[0] <= search.lower[0] + 0.05;
   report.time_constant_at_bound = AtBound(search, y, 1);
   const Eigen::Vector2d log_sigma = LogSigmas(search, y, value);
-  if (in.spec.estimate_amplitude) {
-    const double a =
-        in.spec.amplitude_in_percent ? report.process.sigma_percent : report.process.sigma_n;
-    report.amplitude_sigma = a * log_sigma[0];
-  }
+  if (in.spec.estimate_amplitude)
+    report.amplitude_sigma = AmplitudeOf(in, report.process) * log_sigma[0];
   if (in.spec.estimate_time_constant) {
     report.time_constant_sigma_s = report.process.time_constant_s * log_sigma[1];
   }
+  report.likelihood_evaluations = full.evaluations + search.evaluations;
   return report;
 }
 
