@@ -3,6 +3,7 @@
 // own gain and bias, the 28 shared), as calibration_data/spec_track.yaml folds them.
 //   BM_GroupedRowFold:  the QR fold by reading, then into the full width (row_fold.h)
 //   BM_GroupedGramFold: the Gram matrix by reading, then into the full width (gram_fold.h)
+//   BM_GramKernel:      one batch's sum into G by the portable and the wide kernel
 // Run: build/bench/fold_bench
 #include <benchmark/benchmark.h>
 
@@ -63,8 +64,34 @@ void BM_GroupedGramFold(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * kSamples);
 }
 
+// One batch of GramFold::kBatchRows rows of 31 columns (a track's reading and its
+// residual) summed into G's lower triangle by each kernel; arg 0 portable, 1 wide (AVX2
+// and FMA, skipped where the processor lacks them).
+void BM_GramKernel(benchmark::State& state) {
+  const GramKernel kernel = state.range(0) == 0 ? GramKernel::kPortable : GramKernel::kWide;
+  if (kernel == GramKernel::kWide && !WideGramKernelAvailable()) {
+    state.SkipWithError("no AVX2 and FMA on this processor");
+    return;
+  }
+  constexpr int kWidth = 31;
+  const int ld = GramBatchStride(kWidth);
+  std::vector<double> batch(static_cast<size_t>(ld) * GramFold::kBatchRows, 0.0);
+  const std::vector<double> rows = Rows();
+  for (int r = 0; r < GramFold::kBatchRows; ++r) {
+    for (int c = 0; c < kWidth; ++c) batch[static_cast<size_t>(r) * ld + c] = rows[r * kCols + c];
+  }
+  Eigen::MatrixXd lower = Eigen::MatrixXd::Zero(kWidth, kWidth);
+  for (auto _ : state) {
+    AddBatchToLower(batch.data(), ld, GramFold::kBatchRows, kWidth, lower.data(), kWidth, kernel);
+    benchmark::DoNotOptimize(lower.data());
+  }
+  // Multiply-adds of the lower triangle a row.
+  state.SetItemsProcessed(state.iterations() * GramFold::kBatchRows * kWidth * (kWidth + 1) / 2);
+}
+
 BENCHMARK(BM_GroupedRowFold)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_GroupedGramFold)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_GramKernel)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
 }  // namespace
 }  // namespace fastcal::internal

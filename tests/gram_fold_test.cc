@@ -87,6 +87,37 @@ TEST(GramFoldTest, SameAsTheQrFoldsNormalMatrix) {
   EXPECT_LT((gram.Gram() - from_qr).norm(), kRelTol * from_qr.norm());
 }
 
+TEST(GramFoldTest, EveryWidthEitherKernelIsTheRowsGram) {
+  // Widths about the 8 x 4 tiles' edges and the batch stride's padding, rows not a whole
+  // number of batches; G's strict upper triangle never written.
+  const int rows = GramFold::kBatchRows + 37;
+  for (int cols = 1; cols <= 41; ++cols) {
+    const RowMajor a = RandomRows(rows, cols, 100 + cols);
+    const int ld = GramBatchStride(cols);
+    ASSERT_GE(ld, cols);
+    ASSERT_EQ(ld % 8, 0);
+    std::vector<double> batch(static_cast<size_t>(ld) * rows, 0.0);
+    for (int r = 0; r < rows; ++r) {
+      for (int c = 0; c < cols; ++c) batch[static_cast<size_t>(r) * ld + c] = a(r, c);
+    }
+    const Eigen::MatrixXd normal = a.transpose() * a;
+    for (GramKernel kernel : {GramKernel::kPortable, GramKernel::kWide, GramKernel::kBest}) {
+      // Ones above the diagonal: left as they are.
+      Eigen::MatrixXd lower = Eigen::MatrixXd::Ones(cols, cols);
+      lower.triangularView<Eigen::Lower>().setZero();
+      AddBatchToLower(batch.data(), ld, rows, cols, lower.data(), cols, kernel);
+      const Eigen::MatrixXd upper_ones = lower.triangularView<Eigen::StrictlyUpper>();
+      Eigen::MatrixXd expected_upper = Eigen::MatrixXd::Ones(cols, cols);
+      expected_upper.triangularView<Eigen::Lower>().setZero();
+      EXPECT_EQ(upper_ones, expected_upper) << cols << " columns";
+      Eigen::MatrixXd g = lower.triangularView<Eigen::Lower>();
+      g.triangularView<Eigen::StrictlyUpper>() = g.transpose();
+      EXPECT_LT((g - normal).norm(), kRelTol * normal.norm())
+          << cols << " columns, kernel " << static_cast<int>(kernel);
+    }
+  }
+}
+
 TEST(GramFoldTest, NoRowsIsZero) {
   GramFold fold(3);
   fold.Flush();

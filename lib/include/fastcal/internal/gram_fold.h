@@ -9,6 +9,15 @@
 // from the information, folding by QR first keeps no digit that reaches it. Where R itself
 // is needed (Ceres's residuals, the identifiability check's singular values) RowFold
 // stays.
+//
+// The batch's update is GEMM's register tiling (Goto and van de Geijn, "Anatomy of
+// high-performance matrix multiplication", ACM TOMS 34, 2008): each 8 x 4 tile of G that
+// touches its lower triangle sums its products over the batch's rows in registers, the
+// batch stored row after row, so that a row's 8 entries of the tile are one load and its
+// 4 are broadcasts; no packing (the batch is the panel). On x86-64 with AVX2 and FMA
+// (checked at run time) the same code runs 4 doubles a register and fused; elsewhere 2
+// (SSE2). Issue 41: Eigen's rank update summed a track's 30-column readings at 2.7 GFMA/s
+// (bench/fold_bench.cc).
 #ifndef FASTCAL_INTERNAL_GRAM_FOLD_H_
 #define FASTCAL_INTERNAL_GRAM_FOLD_H_
 
@@ -17,16 +26,34 @@
 
 namespace fastcal::internal {
 
+// Which code sums a batch into G: kPortable (vectors of the build's own instruction set)
+// or kWide (AVX2 and FMA, x86-64 only; where the processor has them); kBest the widest
+// the processor has. The two differ by rounding only (fused multiply-adds).
+enum class GramKernel { kBest, kPortable, kWide };
+bool WideGramKernelAvailable();
+
+// lower(i, j) += sum over the batch's `rows` rows r of b_r[i] b_r[j], for j <= i < cols:
+// row r's entries at batch[r * ld ...], ld >= cols rounded up to a multiple of 8 and
+// entries cols..ld-1 zero; `lower` column-major with leading dimension ldl. Entries above
+// the diagonal are not touched.
+void AddBatchToLower(const double* batch, int ld, int rows, int cols, double* lower, int ldl,
+                     GramKernel kernel = GramKernel::kBest);
+// The batch's leading dimension for `cols` columns (AddBatchToLower).
+int GramBatchStride(int cols);
+
 class GramFold {
  public:
-  // Rows gathered before they are summed (cols x kBatchRows doubles: 80 kB at 40 columns).
-  static constexpr int kBatchRows = 256;
+  // Rows gathered before they are summed (40 kB at 40 columns: in a core's L1 or L2
+  // cache while its tiles run over it).
+  static constexpr int kBatchRows = 128;
 
   explicit GramFold(int cols = 0);
 
   int cols() const { return cols_; }
   // Adds one row of cols() entries.
   void Add(const double* row);
+  // Adds the row whose entry c is full_row[columns[c]] (columns.size() == cols()).
+  void AddGathered(const double* full_row, const std::vector<int>& columns);
   // Sums the rows gathered so far into G (the result depends on where batches end: a
   // function of the sequence of calls only, so the same on any number of threads).
   void Flush();
@@ -45,8 +72,9 @@ class GramFold {
  private:
   int cols_;
   Eigen::MatrixXd lower_;  // G's lower triangle; the strict upper stays zero
-  Eigen::MatrixXd batch_;  // cols x kBatchRows: each gathered row is a column
-  int pending_ = 0;        // rows in batch_
+  int ld_;                 // a gathered row's stride in batch_ (GramBatchStride)
+  std::vector<double> batch_;  // kBatchRows rows of ld_ entries, the last ld_ - cols_ zero
+  int pending_ = 0;            // rows in batch_
 };
 
 // Rows in groups, each group's rows zero outside its own columns (one cable's readings:
@@ -65,7 +93,6 @@ class GroupedGramFold {
  private:
   std::vector<std::vector<int>> columns_;
   std::vector<GramFold> groups_;
-  std::vector<double> gathered_;
 };
 
 }  // namespace fastcal::internal
