@@ -204,6 +204,31 @@ TEST_F(BlockArrowTest, SolveForIsTheInverseTimesTheRightHandSide) {
   ExpectNear(x.b, expected.bottomRows(problem_.q));
 }
 
+TEST_F(BlockArrowTest, QuadraticFormOfSomeWindowsIsTheDenseOne) {
+  // C zero but in windows 1 and 3 and in b: C^T M^-1 C from the dense inverse.
+  std::mt19937_64 rng(11);
+  std::normal_distribution<double> normal;
+  const std::vector<int> windows = {1, 3};
+  std::vector<Eigen::MatrixXd> c_a;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(dense_.m.rows(), 2);
+  for (int w : windows) {
+    c_a.push_back(Eigen::MatrixXd(3, 2));
+    for (int r = 0; r < 3; ++r) {
+      for (int k = 0; k < 2; ++k) dense(dense_.a_offset[w] + r, k) = c_a.back()(r, k) = normal(rng);
+    }
+  }
+  Eigen::MatrixXd c_b(problem_.q, 2);
+  for (int r = 0; r < problem_.q; ++r) {
+    for (int k = 0; k < 2; ++k) dense(dense_.b_offset + r, k) = c_b(r, k) = normal(rng);
+  }
+  ExpectNear(solver_.QuadraticForm(windows, c_a, c_b), dense.transpose() * inverse_ * dense);
+  // One window alone, no b part.
+  const Eigen::MatrixXd zero_b = Eigen::MatrixXd::Zero(problem_.q, 2);
+  Eigen::MatrixXd one = Eigen::MatrixXd::Zero(dense_.m.rows(), 2);
+  one.middleRows(dense_.a_offset[3], 3) = c_a[1];
+  ExpectNear(solver_.QuadraticForm({3}, {c_a[1]}, zero_b), one.transpose() * inverse_ * one);
+}
+
 TEST_F(BlockArrowTest, RefusesAWindowThatCannotDetermineItsParameters) {
   ArrowProblem bad = problem_;
   bad.blocks[2].h.row(1).setZero();

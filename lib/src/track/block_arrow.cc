@@ -100,6 +100,20 @@ ArrowVector ArrowSolver::SolveFor(const ArrowVector& c) const {
   return x;
 }
 
+Eigen::MatrixXd ArrowSolver::QuadraticForm(const std::vector<int>& windows,
+                                           const std::vector<Eigen::MatrixXd>& c_a,
+                                           const Eigen::MatrixXd& c_b) const {
+  Eigen::MatrixXd r = c_b;
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(c_b.cols(), c_b.cols());
+  for (size_t i = 0; i < windows.size(); ++i) {
+    const int w = windows[i];
+    r -= e_[w].transpose() * c_a[i];
+    out += c_a[i].transpose() * a_inverse_[w] * c_a[i];
+  }
+  out += r.transpose() * s_inverse_ * r;
+  return out;
+}
+
 Eigen::MatrixXd ArrowSolver::FormalAA(int w, int u) const {
   Eigen::MatrixXd out = e_[w] * s_inverse_ * e_[u].transpose();
   if (w == u) out += a_inverse_[w];

@@ -374,18 +374,16 @@ std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector
     for (int x = 0; x < pg; ++x) {
       for (int y = 0; y < pg; ++y) self(x, y) = cross(x, columns[y]);
     }
-    ArrowVector c;
-    for (const ArrowBlock& other : run.problem.blocks)
-      c.a.push_back(Eigen::MatrixXd::Zero(other.p, pg));
-    c.b = Eigen::MatrixXd::Zero(run.problem.q, pg);
+    // The right-hand side is window u's alone (QuadraticForm: O(1), not O(windows)).
+    std::vector<Eigen::MatrixXd> c_a(1, Eigen::MatrixXd::Zero(k.p, pg));
+    Eigen::MatrixXd c_b = Eigen::MatrixXd::Zero(run.problem.q, pg);
     for (int x = 0; x < pg; ++x) {
-      for (int r = 0; r < k.p; ++r) c.a[u](r, x) = cross(x, order[r]);
-      for (int m = 0; m < k.m(); ++m) c.b(k.shared_index[m], x) += cross(x, order[k.p + m]);
+      for (int r = 0; r < k.p; ++r) c_a[0](r, x) = cross(x, order[r]);
+      for (int m = 0; m < k.m(); ++m) c_b(k.shared_index[m], x) += cross(x, order[k.p + m]);
     }
-    const ArrowVector solved = run.solver.SolveFor(c);
     SplitScore& s = out[j];
     s.score = score;
-    s.schur = self - c.a[u].transpose() * solved.a[u] - c.b.transpose() * solved.b;
+    s.schur = self - run.solver.QuadraticForm({u}, c_a, c_b);
     s.after_information = self;
     s.statistic = score.dot(Eigen::LDLT<Eigen::MatrixXd>(s.schur).solve(score)) / scale;
     s.valid = std::isfinite(s.statistic);

@@ -697,20 +697,18 @@ Eigen::VectorXd GradientAtSolution(const TrackRun& run, int u) {
 }
 
 double InverseQuadratic(const TrackRun& run, const std::vector<Eigen::VectorXd>& local) {
-  ArrowVector c;
-  c.b = Eigen::MatrixXd::Zero(run.problem.q, 1);
-  c.a.assign(run.used.size(), Eigen::MatrixXd());
+  // Only the windows `local` names (QuadraticForm: a score test's stretch, not the track).
+  std::vector<int> windows;
+  std::vector<Eigen::MatrixXd> c_a;
+  Eigen::MatrixXd c_b = Eigen::MatrixXd::Zero(run.problem.q, 1);
   for (size_t u = 0; u < run.used.size(); ++u) {
-    const ArrowBlock& k = run.problem.blocks[u];
-    c.a[u] = Eigen::MatrixXd::Zero(k.p, 1);
     if (local[u].size() == 0) continue;
-    c.a[u].col(0) = local[u].head(k.p);
-    for (int j = 0; j < k.m(); ++j) c.b(k.shared_index[j], 0) += local[u][k.p + j];
+    const ArrowBlock& k = run.problem.blocks[u];
+    windows.push_back(static_cast<int>(u));
+    c_a.push_back(local[u].head(k.p));
+    for (int j = 0; j < k.m(); ++j) c_b(k.shared_index[j], 0) += local[u][k.p + j];
   }
-  const ArrowVector x = run.solver.SolveFor(c);
-  double value = (c.b.transpose() * x.b)(0, 0);
-  for (size_t u = 0; u < run.used.size(); ++u) value += (c.a[u].transpose() * x.a[u])(0, 0);
-  return value;
+  return run.solver.QuadraticForm(windows, c_a, c_b)(0, 0);
 }
 
 Eigen::MatrixXd TotalCovariance(const TrackRun& run, int u, int v) {

@@ -19,6 +19,9 @@
 //   (M^-1)_wu = delta_wu A_w^-1 + E_w S^-1 E_u^T,   (M^-1)_wb = -E_w S^-1,   (M^-1)_bb = S^-1
 // and M X = C for C = (C_w per window, C_b) is X_b = S^-1 (C_b - sum_w E_w^T C_w),
 // X_w = A_w^-1 C_w - E_w X_b: O(windows) work and memory for any number of windows.
+// Where C is zero but in the windows of a set V, C^T M^-1 C needs only theirs:
+//   C^T M^-1 C = sum_{w in V} C_w^T A_w^-1 C_w + R^T S^-1 R,   R = C_b - sum_{w in V} E_w^T C_w
+// (O(|V|): the track's score tests ask it once per window and column, issue 41).
 //
 // Sandwich covariance (uncertainty.h: P = M^-1 (Omega + Lambda) M^-1) with window w's
 // information scaled by f_w >= 1 (its misfit and time-correlation widening),
@@ -79,6 +82,11 @@ class ArrowSolver {
 
   // M^-1 C.
   ArrowVector SolveFor(const ArrowVector& c) const;
+  // C^T M^-1 C (k x k) for C zero but in windows[i]'s block (c_a[i], p x k) and in b's
+  // (c_b, q x k): the same as from SolveFor, in O(windows.size()).
+  Eigen::MatrixXd QuadraticForm(const std::vector<int>& windows,
+                                const std::vector<Eigen::MatrixXd>& c_a,
+                                const Eigen::MatrixXd& c_b) const;
   // Blocks of M^-1 (the formal covariance).
   Eigen::MatrixXd FormalAA(int w, int u) const;
   Eigen::MatrixXd FormalAB(int w) const;
