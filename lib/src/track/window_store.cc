@@ -22,12 +22,10 @@ bool Fail(const std::string& path, const std::string& what, std::string* error) 
 }
 
 // The records of `bytes` (whole records of `record` bytes each) into *out.
-// `count` records of `record` bytes from `bytes`, every `step`-th of them.
-void Unpack(const std::vector<char>& bytes, long long count, long long record, StoredSample* out,
-            long long step = 1) {
+void Unpack(const std::vector<char>& bytes, long long count, long long record, StoredSample* out) {
   for (long long k = 0; k < count; ++k) {
     out[k] = StoredSample{};
-    std::memcpy(&out[k], bytes.data() + k * step * record, static_cast<size_t>(record));
+    std::memcpy(&out[k], bytes.data() + k * record, static_cast<size_t>(record));
   }
 }
 
@@ -172,24 +170,29 @@ bool StoredWindowReader::ReadEvery(long long first, int count, int step,
                     " of " + std::to_string(size_),
                 error);
   }
-  std::vector<StoredSample> own;
-  const StoredSample* records = sorted_.data() + first;
-  long long apart = step;  // records between two read, in `records`
+  // Unsorted, the range is read at once into a buffer kept by the thread: a new vector
+  // for each range was zeroed before the read filled it, as many bytes again as the read
+  // (a pass over 10^7 samples reads 1.6 GB; so does a subsample's round, its strides
+  // spanning every window; issue 41).
+  thread_local std::vector<char> buffer;
+  const long long record = RecordBytes(joints_);
   if (sorted_.empty()) {
-    const long long record = RecordBytes(joints_);
-    std::vector<char> bytes(span * record);
-    if (ReadAt(fd_, bytes.data(), span * record, first * record) != span * record) {
+    if (static_cast<long long>(buffer.size()) < span * record) buffer.resize(span * record);
+    if (ReadAt(fd_, buffer.data(), span * record, first * record) != span * record) {
       return Fail(path_, "cannot read the samples", error);
     }
-    own.resize(count);
-    Unpack(bytes, count, record, own.data(), step);
-    records = own.data();
-    apart = 1;
   }
+  const auto record_at = [&](int k) {
+    if (!sorted_.empty()) return sorted_[first + static_cast<long long>(k) * step];
+    StoredSample r{};
+    std::memcpy(&r, buffer.data() + static_cast<long long>(k) * step * record,
+                static_cast<size_t>(record));
+    return r;
+  };
   samples->assign(count, Sample());
   file_of->assign(count, 0);
   for (int k = 0; k < count; ++k) {
-    const StoredSample& r = records[k * apart];
+    const StoredSample r = record_at(k);
     Sample& s = (*samples)[k];
     s.time_s = r.time_s;
     s.line = r.line;
