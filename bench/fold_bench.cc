@@ -65,12 +65,12 @@ void BM_GroupedGramFold(benchmark::State& state) {
 }
 
 // One batch of GramFold::kBatchRows rows of 31 columns (a track's reading and its
-// residual) summed into G's lower triangle by each kernel; arg 0 portable, 1 wide (AVX2
-// and FMA, skipped where the processor lacks them).
+// residual) summed into G's lower triangle by each kernel; arg 0 portable, 1 wide (AVX2,
+// skipped where the processor lacks it).
 void BM_GramKernel(benchmark::State& state) {
   const GramKernel kernel = state.range(0) == 0 ? GramKernel::kPortable : GramKernel::kWide;
   if (kernel == GramKernel::kWide && !WideGramKernelAvailable()) {
-    state.SkipWithError("no AVX2 and FMA on this processor");
+    state.SkipWithError("no AVX2 on this processor");
     return;
   }
   constexpr int kWidth = 31;

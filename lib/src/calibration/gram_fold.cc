@@ -81,8 +81,8 @@ void TilesPortable(const double* batch, int ld, int rows, int cols, double* lowe
 #endif
 
 #if defined(__x86_64__) && defined(__GNUC__)
-__attribute__((target("avx2,fma"))) void TilesWide(const double* batch, int ld, int rows, int cols,
-                                                   double* lower, int ldl) {
+__attribute__((target("avx2"))) void TilesWide(const double* batch, int ld, int rows, int cols,
+                                               double* lower, int ldl) {
   Tiles<Quad>(batch, ld, rows, cols, lower, ldl);
 }
 #endif
@@ -91,7 +91,7 @@ __attribute__((target("avx2,fma"))) void TilesWide(const double* batch, int ld, 
 
 bool WideGramKernelAvailable() {
 #if defined(__x86_64__) && defined(__GNUC__)
-  static const bool available = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  static const bool available = __builtin_cpu_supports("avx2");
   return available;
 #else
   return false;

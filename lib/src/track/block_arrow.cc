@@ -103,6 +103,7 @@ ArrowVector ArrowSolver::SolveFor(const ArrowVector& c) const {
 Eigen::MatrixXd ArrowSolver::QuadraticForm(const std::vector<int>& windows,
                                            const std::vector<Eigen::MatrixXd>& c_a,
                                            const Eigen::MatrixXd& c_b) const {
+  eigen_assert(c_a.size() == windows.size());
   Eigen::MatrixXd r = c_b;
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(c_b.cols(), c_b.cols());
   for (size_t i = 0; i < windows.size(); ++i) {

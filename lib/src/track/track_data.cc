@@ -1146,7 +1146,7 @@ TrackStatus SaveState(TrackRun& run) {
     w.store_bytes = bytes;
   }
   std::vector<std::string> errors(to_hash.size());
-  internal::ForEachChunk(
+  const int failed = internal::ForEachChunk(
       static_cast<int>(to_hash.size()), run.options.threads,
       [&](int begin, int end) {
         for (int i = begin; i < end; ++i) {
@@ -1158,9 +1158,8 @@ TrackStatus SaveState(TrackRun& run) {
         return -1;
       },
       1);
-  for (const std::string& e : errors) {
-    if (e.empty()) continue;
-    *run.error = e;
+  if (failed >= 0) {
+    *run.error = errors[failed];
     return TrackStatus::kFailed;
   }
   if (!WriteFileAtomically(run.Path(kStateFile), StateJson(run), run.error)) {

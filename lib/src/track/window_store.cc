@@ -176,6 +176,16 @@ bool StoredWindowReader::ReadEvery(long long first, int count, int step,
   // spanning every window; issue 41).
   thread_local std::vector<char> buffer;
   const long long record = RecordBytes(joints_);
+  // A fold's ranges span at most a few MB; a larger one (a whole window read at once) is
+  // not kept after it.
+  constexpr long long kKeptBufferBytes = 16LL << 20;
+  struct Release {
+    std::vector<char>& buffer;
+    ~Release() {
+      if (static_cast<long long>(buffer.size()) > kKeptBufferBytes)
+        std::vector<char>().swap(buffer);
+    }
+  } release{buffer};
   if (sorted_.empty()) {
     if (static_cast<long long>(buffer.size()) < span * record) buffer.resize(span * record);
     if (ReadAt(fd_, buffer.data(), span * record, first * record) != span * record) {

@@ -83,7 +83,8 @@ class ArrowSolver {
   // M^-1 C.
   ArrowVector SolveFor(const ArrowVector& c) const;
   // C^T M^-1 C (k x k) for C zero but in windows[i]'s block (c_a[i], p x k) and in b's
-  // (c_b, q x k): the same as from SolveFor, in O(windows.size()).
+  // (c_b, q x k): the same as from SolveFor, in O(windows.size()). Each window once
+  // (c_a.size() == windows.size()); a window named twice would lose their cross term.
   Eigen::MatrixXd QuadraticForm(const std::vector<int>& windows,
                                 const std::vector<Eigen::MatrixXd>& c_a,
                                 const Eigen::MatrixXd& c_b) const;

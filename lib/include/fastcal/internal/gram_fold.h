@@ -14,10 +14,12 @@
 // high-performance matrix multiplication", ACM TOMS 34, 2008): each 8 x 4 tile of G that
 // touches its lower triangle sums its products over the batch's rows in registers, the
 // batch stored row after row, so that a row's 8 entries of the tile are one load and its
-// 4 are broadcasts; no packing (the batch is the panel). On x86-64 with AVX2 and FMA
-// (checked at run time) the same code runs 4 doubles a register and fused; elsewhere 2
-// (SSE2). Issue 41: Eigen's rank update summed a track's 30-column readings at 2.7 GFMA/s
-// (bench/fold_bench.cc).
+// 4 are broadcasts; no packing (the batch is the panel). On x86-64 with AVX2 (checked at
+// run time) the same code runs 4 doubles a register, elsewhere 2 (SSE2). Every entry of G
+// is one sum over the rows in row order, in one lane, unfused (gram_fold.cc is compiled
+// with -ffp-contract=off): the same bits from either kernel, so a fold is the same on any
+// machine. Issue 41: Eigen's rank update summed a track's 30-column readings at 2.7
+// GFMA/s (bench/fold_bench.cc).
 #ifndef FASTCAL_INTERNAL_GRAM_FOLD_H_
 #define FASTCAL_INTERNAL_GRAM_FOLD_H_
 
@@ -27,8 +29,8 @@
 namespace fastcal::internal {
 
 // Which code sums a batch into G: kPortable (vectors of the build's own instruction set)
-// or kWide (AVX2 and FMA, x86-64 only; where the processor has them); kBest the widest
-// the processor has. The two differ by rounding only (fused multiply-adds).
+// or kWide (AVX2, x86-64 only; where the processor has it, else kPortable); kBest the
+// widest the processor has. The same bits from each (see above).
 enum class GramKernel { kBest, kPortable, kWide };
 bool WideGramKernelAvailable();
 
