@@ -1116,22 +1116,13 @@ bool LoadFold(const TrackRun& run, TrackWindowState* w, std::string* error) {
   return ParseWindowFold(bytes, path, &w->fold, error);
 }
 
-TrackStatus SaveState(TrackRun& run) {
-  for (TrackWindowState& w : run.windows) {
-    if (!w.folded) continue;
-    w.fold_file = FoldName(w.label, run.generation);
-    // The residual run served this run's slow-error estimate; an update keeps the process.
-    WindowFold kept = w.fold;
-    kept.residuals.clear();
-    if (!WriteFileAtomically(run.Path(w.fold_file), SerializeWindowFold(kept), run.error) ||
-        !FileSha256(run.Path(w.fold_file), &w.fold_sha256, run.error)) {
-      return TrackStatus::kFailed;
-    }
-  }
-  // Each store's committed length (appends past it are an interrupted run's: CheckStores)
-  // and digest, hashed again only where this run appended; the stores on the run's
-  // threads (1.5 GB of them at 10^7 samples: a second on one core, issue 41), the first
-  // failure in window order reported.
+namespace {
+
+// Each store's committed length (appends past it are an interrupted run's: CheckStores)
+// and digest, hashed again only where this run appended; the stores on the run's threads
+// (1.5 GB of them at 10^7 samples: a second on one core, issue 41). False with the first
+// failure in window order.
+bool DigestStores(TrackRun& run) {
   std::vector<int> to_hash;
   for (size_t k = 0; k < run.windows.size(); ++k) {
     TrackWindowState& w = run.windows[k];
@@ -1158,10 +1149,26 @@ TrackStatus SaveState(TrackRun& run) {
         return -1;
       },
       1);
-  if (failed >= 0) {
-    *run.error = errors[failed];
-    return TrackStatus::kFailed;
+  if (failed < 0) return true;
+  *run.error = errors[failed];
+  return false;
+}
+
+}  // namespace
+
+TrackStatus SaveState(TrackRun& run) {
+  for (TrackWindowState& w : run.windows) {
+    if (!w.folded) continue;
+    w.fold_file = FoldName(w.label, run.generation);
+    // The residual run served this run's slow-error estimate; an update keeps the process.
+    WindowFold kept = w.fold;
+    kept.residuals.clear();
+    if (!WriteFileAtomically(run.Path(w.fold_file), SerializeWindowFold(kept), run.error) ||
+        !FileSha256(run.Path(w.fold_file), &w.fold_sha256, run.error)) {
+      return TrackStatus::kFailed;
+    }
   }
+  if (!DigestStores(run)) return TrackStatus::kFailed;
   if (!WriteFileAtomically(run.Path(kStateFile), StateJson(run), run.error)) {
     return TrackStatus::kFailed;
   }
