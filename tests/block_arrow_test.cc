@@ -229,6 +229,29 @@ TEST_F(BlockArrowTest, QuadraticFormOfSomeWindowsIsTheDenseOne) {
   ExpectNear(solver_.QuadraticForm({3}, {c_a[1]}, zero_b), one.transpose() * inverse_ * one);
 }
 
+TEST_F(BlockArrowTest, QuadraticFormOfLocalScattersTheSharedRows) {
+  // C in windows 0 and 2 given in their local order [a; s]: the s rows land in b at each
+  // window's shared_index, both windows' adding up where they share a parameter.
+  std::mt19937_64 rng(13);
+  std::normal_distribution<double> normal;
+  const std::vector<int> windows = {0, 2};
+  std::vector<Eigen::MatrixXd> local;
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(dense_.m.rows(), 2);
+  for (int w : windows) {
+    const ArrowBlock& k = problem_.blocks[w];
+    local.push_back(Eigen::MatrixXd(k.p + k.m(), 2));
+    for (int r = 0; r < k.p + k.m(); ++r) {
+      for (int c = 0; c < 2; ++c) {
+        const double v = local.back()(r, c) = normal(rng);
+        const int row =
+            r < k.p ? dense_.a_offset[w] + r : dense_.b_offset + k.shared_index[r - k.p];
+        dense(row, c) += v;
+      }
+    }
+  }
+  ExpectNear(solver_.QuadraticFormOfLocal(windows, local), dense.transpose() * inverse_ * dense);
+}
+
 TEST_F(BlockArrowTest, RefusesAWindowThatCannotDetermineItsParameters) {
   ArrowProblem bad = problem_;
   bad.blocks[2].h.row(1).setZero();

@@ -115,6 +115,20 @@ Eigen::MatrixXd ArrowSolver::QuadraticForm(const std::vector<int>& windows,
   return out;
 }
 
+Eigen::MatrixXd ArrowSolver::QuadraticFormOfLocal(const std::vector<int>& windows,
+                                                  const std::vector<Eigen::MatrixXd>& local) const {
+  eigen_assert(local.size() == windows.size());
+  const int q = problem_->q;
+  std::vector<Eigen::MatrixXd> c_a;
+  Eigen::MatrixXd c_b = Eigen::MatrixXd::Zero(q, local.empty() ? 0 : local.front().cols());
+  for (size_t i = 0; i < windows.size(); ++i) {
+    const ArrowBlock& k = problem_->blocks[windows[i]];
+    c_a.push_back(local[i].topRows(k.p));
+    c_b += Scatter(k, local[i].bottomRows(k.m()), q);
+  }
+  return QuadraticForm(windows, c_a, c_b);
+}
+
 Eigen::MatrixXd ArrowSolver::FormalAA(int w, int u) const {
   Eigen::MatrixXd out = e_[w] * s_inverse_ * e_[u].transpose();
   if (w == u) out += a_inverse_[w];

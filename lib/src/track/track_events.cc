@@ -375,15 +375,13 @@ std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector
       for (int y = 0; y < pg; ++y) self(x, y) = cross(x, columns[y]);
     }
     // The right-hand side is window u's alone (QuadraticForm: O(1), not O(windows)).
-    std::vector<Eigen::MatrixXd> c_a(1, Eigen::MatrixXd::Zero(k.p, pg));
-    Eigen::MatrixXd c_b = Eigen::MatrixXd::Zero(run.problem.q, pg);
+    Eigen::MatrixXd local(k.p + k.m(), pg);
     for (int x = 0; x < pg; ++x) {
-      for (int r = 0; r < k.p; ++r) c_a[0](r, x) = cross(x, order[r]);
-      for (int m = 0; m < k.m(); ++m) c_b(k.shared_index[m], x) += cross(x, order[k.p + m]);
+      for (int r = 0; r < k.p + k.m(); ++r) local(r, x) = cross(x, order[r]);
     }
     SplitScore& s = out[j];
     s.score = score;
-    s.schur = self - run.solver.QuadraticForm({u}, c_a, c_b);
+    s.schur = self - run.solver.QuadraticFormOfLocal({u}, {local});
     s.after_information = self;
     s.statistic = score.dot(Eigen::LDLT<Eigen::MatrixXd>(s.schur).solve(score)) / scale;
     s.valid = std::isfinite(s.statistic);

@@ -699,16 +699,14 @@ Eigen::VectorXd GradientAtSolution(const TrackRun& run, int u) {
 double InverseQuadratic(const TrackRun& run, const std::vector<Eigen::VectorXd>& local) {
   // Only the windows `local` names (QuadraticForm: a score test's stretch, not the track).
   std::vector<int> windows;
-  std::vector<Eigen::MatrixXd> c_a;
-  Eigen::MatrixXd c_b = Eigen::MatrixXd::Zero(run.problem.q, 1);
+  std::vector<Eigen::MatrixXd> named;
   for (size_t u = 0; u < run.used.size(); ++u) {
     if (local[u].size() == 0) continue;
-    const ArrowBlock& k = run.problem.blocks[u];
     windows.push_back(static_cast<int>(u));
-    c_a.push_back(local[u].head(k.p));
-    for (int j = 0; j < k.m(); ++j) c_b(k.shared_index[j], 0) += local[u][k.p + j];
+    named.push_back(local[u]);
   }
-  return run.solver.QuadraticForm(windows, c_a, c_b)(0, 0);
+  if (windows.empty()) return 0.0;
+  return run.solver.QuadraticFormOfLocal(windows, named)(0, 0);
 }
 
 Eigen::MatrixXd TotalCovariance(const TrackRun& run, int u, int v) {

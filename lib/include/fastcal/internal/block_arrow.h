@@ -88,6 +88,10 @@ class ArrowSolver {
   Eigen::MatrixXd QuadraticForm(const std::vector<int>& windows,
                                 const std::vector<Eigen::MatrixXd>& c_a,
                                 const Eigen::MatrixXd& c_b) const;
+  // The same for C given per window in its own variables' order [a; s] (local[i],
+  // (p + m) x k, as ArrowBlock's): the s rows go to b by shared_index, summed over windows.
+  Eigen::MatrixXd QuadraticFormOfLocal(const std::vector<int>& windows,
+                                       const std::vector<Eigen::MatrixXd>& local) const;
   // Blocks of M^-1 (the formal covariance).
   Eigen::MatrixXd FormalAA(int w, int u) const;
   Eigen::MatrixXd FormalAB(int w) const;
