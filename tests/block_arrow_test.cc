@@ -204,23 +204,28 @@ TEST_F(BlockArrowTest, SolveForIsTheInverseTimesTheRightHandSide) {
   ExpectNear(x.b, expected.bottomRows(problem_.q));
 }
 
+// A rows x cols matrix of seeded standard normal entries.
+Eigen::MatrixXd NormalMatrix(int rows, int cols, std::mt19937_64* rng) {
+  std::normal_distribution<double> normal;
+  Eigen::MatrixXd m(rows, cols);
+  for (int c = 0; c < cols; ++c) {
+    for (int r = 0; r < rows; ++r) m(r, c) = normal(*rng);
+  }
+  return m;
+}
+
 TEST_F(BlockArrowTest, QuadraticFormOfSomeWindowsIsTheDenseOne) {
   // C zero but in windows 1 and 3 and in b: C^T M^-1 C from the dense inverse.
   std::mt19937_64 rng(11);
-  std::normal_distribution<double> normal;
   const std::vector<int> windows = {1, 3};
   std::vector<Eigen::MatrixXd> c_a;
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(dense_.m.rows(), 2);
   for (int w : windows) {
-    c_a.push_back(Eigen::MatrixXd(3, 2));
-    for (int r = 0; r < 3; ++r) {
-      for (int k = 0; k < 2; ++k) dense(dense_.a_offset[w] + r, k) = c_a.back()(r, k) = normal(rng);
-    }
+    c_a.push_back(NormalMatrix(3, 2, &rng));
+    dense.middleRows(dense_.a_offset[w], 3) = c_a.back();
   }
-  Eigen::MatrixXd c_b(problem_.q, 2);
-  for (int r = 0; r < problem_.q; ++r) {
-    for (int k = 0; k < 2; ++k) dense(dense_.b_offset + r, k) = c_b(r, k) = normal(rng);
-  }
+  const Eigen::MatrixXd c_b = NormalMatrix(problem_.q, 2, &rng);
+  dense.middleRows(dense_.b_offset, problem_.q) = c_b;
   ExpectNear(solver_.QuadraticForm(windows, c_a, c_b), dense.transpose() * inverse_ * dense);
   // One window alone, no b part.
   const Eigen::MatrixXd zero_b = Eigen::MatrixXd::Zero(problem_.q, 2);
@@ -233,20 +238,15 @@ TEST_F(BlockArrowTest, QuadraticFormOfLocalScattersTheSharedRows) {
   // C in windows 0 and 2 given in their local order [a; s]: the s rows land in b at each
   // window's shared_index, both windows' adding up where they share a parameter.
   std::mt19937_64 rng(13);
-  std::normal_distribution<double> normal;
   const std::vector<int> windows = {0, 2};
   std::vector<Eigen::MatrixXd> local;
   Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(dense_.m.rows(), 2);
   for (int w : windows) {
     const ArrowBlock& k = problem_.blocks[w];
-    local.push_back(Eigen::MatrixXd(k.p + k.m(), 2));
-    for (int r = 0; r < k.p + k.m(); ++r) {
-      for (int c = 0; c < 2; ++c) {
-        const double v = local.back()(r, c) = normal(rng);
-        const int row =
-            r < k.p ? dense_.a_offset[w] + r : dense_.b_offset + k.shared_index[r - k.p];
-        dense(row, c) += v;
-      }
+    local.push_back(NormalMatrix(k.p + k.m(), 2, &rng));
+    dense.middleRows(dense_.a_offset[w], k.p) += local.back().topRows(k.p);
+    for (int j = 0; j < k.m(); ++j) {
+      dense.row(dense_.b_offset + k.shared_index[j]) += local.back().row(k.p + j);
     }
   }
   ExpectNear(solver_.QuadraticFormOfLocal(windows, local), dense.transpose() * inverse_ * dense);
