@@ -36,6 +36,9 @@
 // pipeline's stages grouped, write) and the yardstick beside it: N bare AAS solves
 // (SolveStatics, method aas, cold) on one thread over the same samples, measured in the
 // same run; x_yardstick is the end-to-end wall time over it.
+// BM_RealisticFloor/N (issue 41): a lower bound on that x_yardstick for this method, the
+// same data read, predicted and folded twice as a one-step fit at least must (FloorChild),
+// with each lap and the yardstick of the same run: floor_x_yardstick.
 // BM_RealisticPartsEndToEnd/N (issue 35): the same with calibration_data/moving_parts.yaml
 // (the rotator through a grid of +-15 deg, the platform spread 5 cm) and
 // spec_moving_parts.yaml (the rotator's first moment and the platform's mass freed too).
@@ -43,6 +46,8 @@
 //      build/bench/calibration_bench --benchmark_filter=RealisticStages
 //          --benchmark_counters_tabular=true   (the stages and the yardstick, ~1 min)
 //      build/bench/calibration_bench --benchmark_filter='Realistic|SampleRows'  (~2 min)
+//      build/bench/calibration_bench --benchmark_filter=RealisticFloor/1000000
+//          --benchmark_counters_tabular=true   (the floor and its yardstick, ~1 min)
 #include <benchmark/benchmark.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
@@ -351,6 +356,142 @@ void BM_RealisticStages(benchmark::State& state) {
 
 BENCHMARK(BM_RealisticStages)->Apply(EndToEndSizes);
 
+// The fit's samples over `data` as the calibration builds them (exact statics, no loss, no
+// slow error): every sample fitted, whitened by `sigma`, started from `starts`.
+internal::FittedSamples ExactFittedSamples(const internal::CalibrationModel& cm,
+                                           const Dataset& data, const std::vector<int>& fit,
+                                           const std::vector<std::array<double, kNumCables>>& sigma,
+                                           const internal::CompactStarts& starts) {
+  internal::FittedSamples samples;
+  samples.model = &cm;
+  samples.data = &data;
+  samples.fit = &fit;
+  samples.sigma_n = &sigma;
+  samples.starts = &starts;
+  samples.statics = ModelFitStaticsOptions(StaticsMethod::kExact);
+  return samples;
+}
+
+// A fit step away from `theta`: the mass centre moved by 2 cm, the gains by 0.5%.
+void StepAway(const CalibrationSpec& spec, const internal::CalibrationModel& cm,
+              std::vector<double>* theta) {
+  for (int k = 0; k < cm.num_free(); ++k) {
+    const ParameterKind kind = spec.parameters[cm.spec_index(k)].kind;
+    if (kind == ParameterKind::kMassCentre) (*theta)[k] += 0.02;
+    if (kind == ParameterKind::kSensorGain) (*theta)[k] *= 1.005;
+  }
+}
+
+// The floor's child: read `csv` as the command line does, then the least a Gauss-Newton
+// fit of spec_realistic.yaml does on the spec's 2 threads, with the library's own passes:
+// the prediction (one exact solve per sample, cold: no start is known before), the
+// Jacobian fold at the initial parameters (FoldedTensionCost::Fold, which takes the
+// prediction's solutions as solved: derivatives and fold only), and the fold one step
+// away (statics warm from the prediction, derivatives, fold), where any fit must look at
+// least once to know that it has converged, and linearises. Each lap's seconds to
+// `out_path`, one per line: read, predict, fold at the start, fold a step away.
+int FloorChild(const std::string& csv, const std::string& out_path) {
+  auto lap = std::chrono::steady_clock::now();
+  Dataset data;
+  DatasetReadOptions read;
+  read.threads = 2;  // as fastcal calibrate reads
+  read.max_file_bytes = 1LL << 40;
+  std::string error;
+  if (!ReadDataset(csv, read, &data, &error)) return 1;
+  std::vector<double> laps = {bench::SecondsSince(lap)};
+  const CableRobot model = CableRobot::NominalFast();
+  CalibrationSpec spec;
+  if (!LoadCalibrationSpec(kRealisticSpec, model, &spec, &error)) return 1;
+  const internal::CalibrationModel cm(model, spec);
+  const int n = cm.num_free();
+  const int count = static_cast<int>(data.samples.size());
+  std::vector<double> theta = cm.InitialTheta();
+  StaticsParameters<double> params;
+  std::array<double, kNumCables> gain, bias;
+  cm.Assemble(theta.data(), &params, &gain, &bias);
+  std::vector<int> fit(count);
+  std::vector<std::array<double, kNumCables>> sigma(count);
+  internal::CompactStarts starts(StaticsMethod::kExact);
+  starts.Reset(count);
+  const StaticsOptions statics = ModelFitStaticsOptions(StaticsMethod::kExact);
+  lap = std::chrono::steady_clock::now();
+  const int failed = internal::ForEachChunk(count, spec.num_threads, [&](int begin, int end) {
+    StaticsSolution s;
+    for (int t = begin; t < end; ++t) {
+      fit[t] = t;
+      if (SolveStaticsWithParameters(params, data.samples[t].pose, statics, &s) !=
+          StaticsStatus::kOk) {
+        return t;
+      }
+      starts.Set(t, s);
+      std::array<double, kNumCables> reading;
+      for (int i = 0; i < kNumCables; ++i) {
+        reading[i] = gain[i] * s.cables[i].lower_tension_n + bias[i];
+      }
+      sigma[t] = internal::TensionSigmas(reading, spec.tension_sigma_n, spec.tension_sigma_percent);
+    }
+    return -1;
+  });
+  if (failed >= 0) return 1;
+  starts.MarkSolvedAt(&cm, theta.data(), n);
+  laps.push_back(bench::SecondsSince(lap));
+  const internal::FittedSamples samples = ExactFittedSamples(cm, data, fit, sigma, starts);
+  const internal::FoldedTensionCost cost(samples, nullptr, spec.num_threads, true);
+  // Through Ceres's entry point, as the solver calls it (the fold is the cost's whole work).
+  std::vector<double> residuals(n + 1), jacobian((n + 1) * n);
+  double* jacobians[] = {jacobian.data()};
+  for (int step = 0; step < 2; ++step) {
+    if (step == 1) StepAway(spec, cm, &theta);
+    lap = std::chrono::steady_clock::now();
+    const double* parameters[] = {theta.data()};
+    if (!cost.Evaluate(parameters, residuals.data(), jacobians)) return 1;
+    laps.push_back(bench::SecondsSince(lap));
+  }
+  benchmark::DoNotOptimize(residuals[n]);
+  std::FILE* f = std::fopen(out_path.c_str(), "w");
+  if (f == nullptr) return 1;
+  for (const double s : laps) std::fprintf(f, "%.6f\n", s);
+  return std::fclose(f) == 0 ? 0 : 1;
+}
+
+// BM_RealisticFloor/N (issue 41): a lower bound on BM_RealisticStages's x_yardstick for
+// this method: FloorChild's laps (read, predict, the two folds; no screening, no second
+// IRLS pass, no identifiability check, no uncertainty, nothing written), in a forked
+// child, beside the yardstick measured in the same run.
+void BM_RealisticFloor(benchmark::State& state) {
+  const std::string csv = RealisticDataFile(static_cast<int>(state.range(0)));
+  if (csv.empty()) {
+    state.SkipWithError("cannot write the dataset file");
+    return;
+  }
+  const std::string laps_path = csv + ".floor";
+  const bool ok = ForkedChild([&] { return FloorChild(csv, laps_path); });
+  std::vector<double> laps;
+  if (std::FILE* f = ok ? std::fopen(laps_path.c_str(), "r") : nullptr) {
+    double s = 0.0;
+    while (std::fscanf(f, "%lf", &s) == 1) laps.push_back(s);
+    std::fclose(f);
+  }
+  std::filesystem::remove(laps_path);
+  if (laps.size() != 4) {
+    std::filesystem::remove(csv);
+    state.SkipWithError("the floor's child failed");
+    return;
+  }
+  const double floor_s = laps[0] + laps[1] + laps[2] + laps[3];
+  for (auto _ : state) state.SetIterationTime(floor_s);
+  state.counters["read_s"] = laps[0];
+  state.counters["predict_s"] = laps[1];
+  state.counters["fold_start_s"] = laps[2];
+  state.counters["fold_step_s"] = laps[3];
+  const double yardstick_s = AasYardstickSeconds(csv);
+  state.counters["yardstick_s"] = yardstick_s;
+  state.counters["floor_x_yardstick"] = floor_s / yardstick_s;
+  std::filesystem::remove(csv);
+}
+
+BENCHMARK(BM_RealisticFloor)->Apply(EndToEndSizes);
+
 // The same with the cabin's moving parts (issue 35: within 1.2x of the above).
 void BM_RealisticPartsEndToEnd(benchmark::State& state) {
   CableRobot model;
@@ -404,20 +545,9 @@ void BM_SampleRows(benchmark::State& state) {
     starts.Set(t, s);
     sigma[t] = internal::TensionSigmas(data.samples[t].tension_n, 0.0, 3.0);
   }
-  internal::FittedSamples samples;
-  samples.model = &cm;
-  samples.data = &data;
-  samples.fit = &fit;
-  samples.sigma_n = &sigma;
-  samples.starts = &starts;
-  samples.statics = statics;
-  // A fit step away from the starts: the mass centre moved by 2 cm, the gains by 0.5%.
+  const internal::FittedSamples samples = ExactFittedSamples(cm, data, fit, sigma, starts);
   std::vector<double> theta = cm.InitialTheta();
-  for (int k = 0; k < n; ++k) {
-    const ParameterKind kind = spec.parameters[cm.spec_index(k)].kind;
-    if (kind == ParameterKind::kMassCentre) theta[k] += 0.02;
-    if (kind == ParameterKind::kSensorGain) theta[k] *= 1.005;
-  }
+  StepAway(spec, cm, &theta);
   std::vector<StaticsParameters<double>> params(1);
   std::array<double, kNumCables> gain, bias;
   cm.Assemble(theta.data(), &params[0], &gain, &bias);
