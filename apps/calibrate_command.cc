@@ -770,8 +770,16 @@ std::string ThresholdLine(const std::string& indent, const GrossErrorThreshold& 
   return buf;
 }
 
-// The first few readings of `list`, one line each, then how many more.
-std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::string& indent) {
+// Where the whole list of outliers goes: summary.json when the run writes one (with --out),
+// else how to get it.
+std::string OutlierListPlace(bool summary_written) {
+  return summary_written ? "in summary.json (outliers)"
+                         : "listed in summary.json (outliers) with --out=DIR";
+}
+
+// The first few readings of `list`, one line each, then how many more and where they are.
+std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::string& indent,
+                         bool summary_written = true) {
   constexpr size_t kShown = 5;
   std::ostringstream s;
   for (size_t k = 0; k < std::min(list.size(), kShown); ++k) {
@@ -792,7 +800,8 @@ std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::st
     s << buf;
   }
   if (list.size() > kShown) {
-    s << indent << "... " << list.size() - kShown << " more in summary.json (outliers)\n";
+    s << indent << "... " << list.size() - kShown << " more " << OutlierListPlace(summary_written)
+      << "\n";
   }
   return s.str();
 }
@@ -1200,10 +1209,12 @@ std::string EvaluationGrossErrorLines(const EvaluationScreen& screen) {
     << (count == 1 ? " reading" : " readings")
     << (count > 0 ? ", left out of the rows \"... - gross errors\"" : "") << "\n"
     << ThresholdLine("  ", screen.threshold);
-  s << ReadingLines(screen.gross_errors, "  ");
+  const bool summary_written = !FLAGS_out.empty();
+  s << ReadingLines(screen.gross_errors, "  ", summary_written);
   if (count > static_cast<long long>(screen.gross_errors.size())) {
-    s << "  (" << screen.gross_errors.size() << " of the " << count
-      << " named in summary.json: the first in file order)\n";
+    s << "  (" << screen.gross_errors.size() << " of the " << count << " named "
+      << (summary_written ? "in summary.json" : "in summary.json with --out=DIR")
+      << ": the first in file order)\n";
   }
   return s.str();
 }
