@@ -209,6 +209,7 @@ class ReportTest : public ::testing::Test {
     held_out_ = HoldoutMask(kNumSamples, 0.2, 1);
 
     spec_.tension_sigma_percent = 3.0;
+    spec_.forward_model = StaticsMethod::kAas;  // its error against exact is in the result
     spec_.holdout_fraction = 0.2;
     spec_.holdout_seed = 1;
 
@@ -358,6 +359,19 @@ class ReportTest : public ::testing::Test {
   CalibrationResult result_;
   ReportInputs inputs_;
 };
+
+// An exact fit has no forward model error to quote: the provenance says so instead of "max
+// 0 %", which read like a measurement that found nothing.
+TEST_F(ReportTest, AnExactFitSaysItHasNoForwardModelError) {
+  EXPECT_TRUE(Contains(ReportMarkdown(inputs_), "max 0.021 %, RMS 0.008 %"));
+  spec_.forward_model = StaticsMethod::kExact;
+  const std::string md = ReportMarkdown(inputs_);
+  EXPECT_TRUE(Contains(md,
+                       "| Forward model error vs exact | none: the fit's forward model is "
+                       "exact |"))
+      << md;
+  EXPECT_FALSE(Contains(md, "max 0.021 %")) << md;
+}
 
 TEST_F(ReportTest, MarkdownHasEstimatesAndRmsTables) {
   const std::string md = ReportMarkdown(inputs_);

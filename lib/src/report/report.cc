@@ -202,7 +202,9 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
   if (in.spec) {
     const CalibrationSpec& s = *in.spec;
     row("Forward model (in the fit)", Text().Code(StaticsMethodName(s.forward_model)));
-    if (in.result) {
+    if (in.result && s.forward_model == StaticsMethod::kExact) {
+      row("Forward model error vs exact", "none: the fit's forward model is exact");
+    } else if (in.result) {
       row("Forward model error vs exact",
           Text("max " + Pct(in.result->forward_model_max_rel_error) + " %, RMS " +
                Pct(in.result->forward_model_rms_rel_error) +
