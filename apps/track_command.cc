@@ -55,8 +55,10 @@ Usage:
                       window, every other free parameter once for all windows
                       (calibration_data/spec_track.yaml follows the mass centre per day,
                       with the cables and sensors shared)
-  --data=DIR_OR_FILES telemetry files (docs/data-format.md) with absolute times, in any
-                      order: a directory (its *.csv files), or FILE.csv,FILE.csv,...
+  --data=DIR_OR_FILES telemetry files (docs/data-format.md) with Unix or ISO 8601 times,
+                      in any order: a directory (its *.csv files), or FILE.csv,FILE.csv,...
+                      (one file of relative times, from its own start, is windowed on its
+                      own time line; two need --window=file)
   --out=DIR           the track: a new or empty directory, or a track built before, which
                       is then updated with the files it does not hold yet (the old windows'
                       folds are kept: only windows that gained samples are folded)
