@@ -770,11 +770,11 @@ std::string ThresholdLine(const std::string& indent, const GrossErrorThreshold& 
   return buf;
 }
 
-// Where the whole list of outliers goes: summary.json when the run writes one (with --out),
-// else how to get it.
-std::string OutlierListPlace(bool summary_written) {
-  return summary_written ? "in summary.json (outliers)"
-                         : "listed in summary.json (outliers) with --out=DIR";
+// Where a list cut short on the console is whole: summary.json when the run writes one
+// (with --out), else that --out would write it. `key`: the list's key there, or empty.
+std::string SummaryPlace(bool summary_written, const std::string& key = "") {
+  return std::string("in summary.json") + (key.empty() ? "" : " (" + key + ")") +
+         (summary_written ? "" : " with --out=DIR");
 }
 
 // The first few readings of `list`, one line each, then how many more and where they are.
@@ -800,8 +800,8 @@ std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::st
     s << buf;
   }
   if (list.size() > kShown) {
-    s << indent << "... " << list.size() - kShown << " more " << OutlierListPlace(summary_written)
-      << "\n";
+    s << indent << "... " << list.size() - kShown << " more " << (summary_written ? "" : "listed ")
+      << SummaryPlace(summary_written, "outliers") << "\n";
   }
   return s.str();
 }
@@ -1213,8 +1213,7 @@ std::string EvaluationGrossErrorLines(const EvaluationScreen& screen) {
   s << ReadingLines(screen.gross_errors, "  ", summary_written);
   if (count > static_cast<long long>(screen.gross_errors.size())) {
     s << "  (" << screen.gross_errors.size() << " of the " << count << " named "
-      << (summary_written ? "in summary.json" : "in summary.json with --out=DIR")
-      << ": the first in file order)\n";
+      << SummaryPlace(summary_written) << ": the first in file order)\n";
   }
   return s.str();
 }
