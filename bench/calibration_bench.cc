@@ -59,6 +59,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <random>
 #include <string>
 
@@ -516,122 +517,177 @@ void BM_RealisticPartsEndToEnd(benchmark::State& state) {
 BENCHMARK(BM_RealisticPartsEndToEnd)->Apply(EndToEndSizes);
 
 // The per-sample parts of a Jacobian evaluation (file comment), range(0): the part.
-void BM_SampleRows(benchmark::State& state) {
-  constexpr int kSamples = 4096;
+// BM_SampleRows's inputs: 4096 samples of the realistic data, each solved at the initial
+// parameters (the starts), a fit step away from there (theta), each sample's statics there
+// (solutions, for the derivatives alone) and its rows there (rows, for the folding alone).
+// Built in place: `samples` points into the members.
+struct SampleRowsSetup {
+  static constexpr int kSamples = 4096;
   Dataset data;
-  SimulateRealistic(kSamples, [&](const Sample& s, std::string*) {
-    data.samples.push_back(s);
-    return true;
-  });
-  const CableRobot model = CableRobot::NominalFast();
   CalibrationSpec spec;
-  std::string error;
-  if (!LoadCalibrationSpec(kRealisticSpec, model, &spec, &error)) {
-    state.SkipWithError(error.c_str());
-    return;
-  }
-  const internal::CalibrationModel cm(model, spec);
-  const int n = cm.num_free();
-  const int count = static_cast<int>(data.samples.size());
-  std::vector<int> fit(count);
-  std::vector<std::array<double, kNumCables>> sigma(count);
-  internal::CompactStarts starts(StaticsMethod::kExact);
-  starts.Reset(count);
-  const StaticsOptions statics = ModelFitStaticsOptions(StaticsMethod::kExact);
-  for (int t = 0; t < count; ++t) {
-    fit[t] = t;
-    StaticsSolution s;
-    SolveStatics(model, data.samples[t].pose, statics, &s);
-    starts.Set(t, s);
-    sigma[t] = internal::TensionSigmas(data.samples[t].tension_n, 0.0, 3.0);
-  }
-  const internal::FittedSamples samples = ExactFittedSamples(cm, data, fit, sigma, starts);
-  std::vector<double> theta = cm.InitialTheta();
-  StepAway(spec, cm, &theta);
-  std::vector<StaticsParameters<double>> params(1);
+  std::unique_ptr<internal::CalibrationModel> cm;
+  std::vector<int> fit;
+  std::vector<std::array<double, kNumCables>> sigma;
+  internal::CompactStarts starts{StaticsMethod::kExact};
+  StaticsOptions statics = ModelFitStaticsOptions(StaticsMethod::kExact);
+  internal::FittedSamples samples;
+  std::vector<double> theta;
+  StaticsParameters<double> params;
   std::array<double, kNumCables> gain, bias;
-  cm.Assemble(theta.data(), &params[0], &gain, &bias);
-  // The solutions, for the derivatives alone; the rows, for the folding alone.
-  std::vector<StaticsSolution> solutions(count);
-  Eigen::MatrixXd rows(kNumCables * count, n + 1);
-  std::vector<double> j(kNumCables * n);
-  for (int t = 0; t < count; ++t) {
-    const internal::TensionResidual f = samples.At(t);
-    f.start.Restore(f.pose, statics.method, &solutions[t]);
+  std::vector<StaticsSolution> solutions;
+  Eigen::MatrixXd rows;
+  std::string error;
+
+  int n() const { return cm->num_free(); }
+  int count() const { return static_cast<int>(data.samples.size()); }
+
+  // False with `error` when the spec does not load.
+  bool Build() {
+    SimulateRealistic(kSamples, [&](const Sample& s, std::string*) {
+      data.samples.push_back(s);
+      return true;
+    });
+    const CableRobot model = CableRobot::NominalFast();
+    if (!LoadCalibrationSpec(kRealisticSpec, model, &spec, &error)) return false;
+    cm = std::make_unique<internal::CalibrationModel>(model, spec);
+    fit.resize(count());
+    sigma.resize(count());
+    starts.Reset(count());
+    for (int t = 0; t < count(); ++t) {
+      fit[t] = t;
+      StaticsSolution s;
+      SolveStatics(model, data.samples[t].pose, statics, &s);
+      starts.Set(t, s);
+      sigma[t] = internal::TensionSigmas(data.samples[t].tension_n, 0.0, 3.0);
+    }
+    samples = ExactFittedSamples(*cm, data, fit, sigma, starts);
+    theta = cm->InitialTheta();
+    StepAway(spec, *cm, &theta);
+    cm->Assemble(theta.data(), &params, &gain, &bias);
+    SolveAndRow();
+    return true;
+  }
+
+  // Each sample's statics and rows at theta.
+  void SolveAndRow() {
+    const int n = this->n();
+    solutions.resize(count());
+    rows.resize(kNumCables * count(), n + 1);
+    std::vector<double> j(kNumCables * n);
     StaticsOptions warm = statics;
     warm.warm_start = true;
-    SolveStaticsWithParameters(params[0], f.pose, warm, &solutions[t]);
-    double r[kNumCables];
-    f.Evaluate(theta.data(), r, j.data());
-    for (int i = 0; i < kNumCables; ++i) {
-      for (int k = 0; k < n; ++k) rows(kNumCables * t + i, k) = j[i * n + k];
-      rows(kNumCables * t + i, n) = r[i];
+    for (int t = 0; t < count(); ++t) {
+      const internal::TensionResidual f = samples.At(t);
+      f.start.Restore(f.pose, statics.method, &solutions[t]);
+      SolveStaticsWithParameters(params, f.pose, warm, &solutions[t]);
+      double r[kNumCables];
+      f.Evaluate(theta.data(), r, j.data());
+      for (int i = 0; i < kNumCables; ++i) {
+        for (int k = 0; k < n; ++k) rows(kNumCables * t + i, k) = j[i * n + k];
+        rows(kNumCables * t + i, n) = r[i];
+      }
     }
+  }
+};
+
+// Parts 0, 3 and 4: every sample's residuals (0), with their Jacobian (3), by Jets (4).
+double EvaluateEverySample(const SampleRowsSetup& in, int part) {
+  std::vector<double> j(kNumCables * in.n());
+  double sink = 0.0;
+  for (int t = 0; t < in.count(); ++t) {
+    const internal::TensionResidual f = in.samples.At(t);
+    double r[internal::kMaxReadings];  // tensions, and lengths when the spec has them
+    if (part == 0) {
+      f(in.theta.data(), r);
+    } else if (part == 3) {
+      f.Evaluate(in.theta.data(), r, j.data());
+    } else {
+      internal::TensionCost::EvaluateJet(f, in.theta.data(), r, j.data());
+    }
+    sink += r[0];
+  }
+  return sink;
+}
+
+// Part 1: the derivatives alone, from the solutions.
+double DerivativesOfEverySample(const SampleRowsSetup& in) {
+  std::vector<double> j(kNumCables * in.n());
+  double sink = 0.0;
+  for (int t = 0; t < in.count(); ++t) {
+    internal::TensionGradient g;
+    internal::ExactTensionGradient(in.params, in.data.samples[t].pose, in.solutions[t],
+                                   in.statics.catenary.vertical_span_fraction,
+                                   in.cm->frees_geometry(), &g);
+    in.cm->ReadingJacobian(g, in.gain, 0, j.data());
+    sink += j[0];
+  }
+  return sink;
+}
+
+// Part 5: as FoldedTensionCost::Fold without a loss (the recommended spec's): each
+// reading's rows over its own columns first (GroupedRowFold), then into R.
+double FoldByReading(const SampleRowsSetup& in) {
+  const int n = in.n();
+  internal::RowFold fold(n + 1);
+  internal::GroupedRowFold grouped(internal::ReadingColumns(in.samples, nullptr), n + 1);
+  double sink = 0.0;
+  for (int t = 0; t < in.count(); ++t) {
+    for (int i = 0; i < kNumCables; ++i) {
+      sink += in.rows(kNumCables * t + i, n) * in.rows(kNumCables * t + i, n);
+      const Eigen::RowVectorXd row = in.rows.row(kNumCables * t + i);
+      grouped.Add(i, row.data());
+    }
+  }
+  grouped.FlushInto(&fold);
+  return sink + fold.r()(0, 0);
+}
+
+// Part 2: as FoldedTensionCost::Fold with a loss: each sample's rows corrected for the
+// loss and folded into R at full width (row_fold.h).
+double FoldWithLoss(const SampleRowsSetup& in, const ceres::LossFunction& loss) {
+  const int n = in.n();
+  internal::RowFold fold(n + 1);
+  std::vector<double> jt(kNumCables * n), block(kNumCables * (n + 1));
+  double sink = 0.0;
+  for (int t = 0; t < in.count(); ++t) {
+    double r[kNumCables];
+    for (int i = 0; i < kNumCables; ++i) {
+      r[i] = in.rows(kNumCables * t + i, n);
+      for (int k = 0; k < n; ++k) jt[i * n + k] = in.rows(kNumCables * t + i, k);
+    }
+    sink += internal::CorrectForLoss(&loss, r, jt.data(), n);
+    for (int i = 0; i < kNumCables; ++i) {
+      std::copy(&jt[i * n], &jt[i * n] + n, &block[i * (n + 1)]);
+      block[i * (n + 1) + n] = r[i];
+    }
+    fold.Add(block.data(), kNumCables);
+  }
+  fold.Flush();
+  return sink + fold.r()(0, 0);
+}
+
+void BM_SampleRows(benchmark::State& state) {
+  SampleRowsSetup in;
+  if (!in.Build()) {
+    state.SkipWithError(in.error.c_str());
+    return;
   }
   const ceres::HuberLoss huber(3.0);
   const int part = static_cast<int>(state.range(0));
   for (auto _ : state) {
     double sink = 0.0;
     if (part == 0 || part == 3 || part == 4) {
-      for (int t = 0; t < count; ++t) {
-        const internal::TensionResidual f = samples.At(t);
-        double r[internal::kMaxReadings];  // tensions, and lengths when the spec has them
-        if (part == 0) {
-          f(theta.data(), r);
-        } else if (part == 3) {
-          f.Evaluate(theta.data(), r, j.data());
-        } else {
-          internal::TensionCost::EvaluateJet(f, theta.data(), r, j.data());
-        }
-        sink += r[0];
-      }
+      sink = EvaluateEverySample(in, part);
     } else if (part == 1) {
-      for (int t = 0; t < count; ++t) {
-        internal::TensionGradient g;
-        internal::ExactTensionGradient(params[0], data.samples[t].pose, solutions[t],
-                                       statics.catenary.vertical_span_fraction, cm.frees_geometry(),
-                                       &g);
-        cm.ReadingJacobian(g, gain, 0, j.data());
-        sink += j[0];
-      }
+      sink = DerivativesOfEverySample(in);
     } else if (part == 5) {
-      // As FoldedTensionCost::Fold without a loss (the recommended spec's): each
-      // reading's rows over its own columns first (GroupedRowFold), then into R.
-      internal::RowFold fold(n + 1);
-      internal::GroupedRowFold grouped(internal::ReadingColumns(samples, nullptr), n + 1);
-      for (int t = 0; t < count; ++t) {
-        for (int i = 0; i < kNumCables; ++i) {
-          sink += rows(kNumCables * t + i, n) * rows(kNumCables * t + i, n);
-          const Eigen::RowVectorXd row = rows.row(kNumCables * t + i);
-          grouped.Add(i, row.data());
-        }
-      }
-      grouped.FlushInto(&fold);
-      sink += fold.r()(0, 0);
+      sink = FoldByReading(in);
     } else {
-      // As FoldedTensionCost::Fold with a loss: each sample's rows corrected for the loss
-      // and folded into R at full width (row_fold.h).
-      internal::RowFold fold(n + 1);
-      std::vector<double> jt(kNumCables * n), block(kNumCables * (n + 1));
-      for (int t = 0; t < count; ++t) {
-        double r[kNumCables];
-        for (int i = 0; i < kNumCables; ++i) {
-          r[i] = rows(kNumCables * t + i, n);
-          for (int k = 0; k < n; ++k) jt[i * n + k] = rows(kNumCables * t + i, k);
-        }
-        sink += internal::CorrectForLoss(&huber, r, jt.data(), n);
-        for (int i = 0; i < kNumCables; ++i) {
-          std::copy(&jt[i * n], &jt[i * n] + n, &block[i * (n + 1)]);
-          block[i * (n + 1) + n] = r[i];
-        }
-        fold.Add(block.data(), kNumCables);
-      }
-      fold.Flush();
-      sink += fold.r()(0, 0);
+      sink = FoldWithLoss(in, huber);
     }
     benchmark::DoNotOptimize(sink);
   }
-  state.SetItemsProcessed(state.iterations() * count);
+  state.SetItemsProcessed(state.iterations() * in.count());
   const char* names[] = {"statics",
                          "derivatives",
                          "folding with a loss",
