@@ -148,6 +148,7 @@ void ArrowSolver::FormSandwich() const {
   for (int w = 0; w < windows(); ++w) {
     const ArrowBlock& k = problem_->blocks[w];
     Eigen::MatrixXd omega = k.scale * k.h;
+    if (k.extra.size() > 0) omega += k.extra;
     omega.diagonal().head(k.p) += k.prior_information;
     // G_w^T = [E_w; -P_w] ((p + m) x q).
     Eigen::MatrixXd gt(k.p + k.m(), q);
@@ -167,6 +168,7 @@ Eigen::MatrixXd ArrowSolver::SandwichAA(int w, int u) const {
   if (w == u) {
     const ArrowBlock& k = problem_->blocks[w];
     Eigen::MatrixXd omega_aa = k.scale * k.h.topLeftCorner(k.p, k.p);
+    if (k.extra.size() > 0) omega_aa += k.extra.topLeftCorner(k.p, k.p);
     omega_aa.diagonal() += k.prior_information;
     out += a_inverse_[w] * omega_aa * a_inverse_[w];
   }

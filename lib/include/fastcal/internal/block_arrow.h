@@ -24,8 +24,10 @@
 // (O(|V|): the track's score tests ask it once per window and column, issue 41).
 //
 // Sandwich covariance (uncertainty.h: P = M^-1 (Omega + Lambda) M^-1) with window w's
-// information scaled by f_w >= 1 (its misfit and time-correlation widening),
-// Omega_w = f_w H_w + diag(Lambda_a, 0): with G_w = [E_w^T, -P_w^T] (x_w's columns mapped
+// information scaled by f_w >= 1 (its misfit and time-correlation widening) and, where
+// given, a covariance of its scores beyond the white one (a process its rows share, such
+// as a wander of its own parameters inside the window: track_wander.cc),
+// Omega_w = f_w H_w + X_w + diag(Lambda_a, 0): with G_w = [E_w^T, -P_w^T] (x_w's columns mapped
 // to b), Q = sum_w G_w Omega_w G_w^T + Lambda_b and T_w = A_w^-1 (Omega_w)_{a.} G_w^T,
 //   P_wu = delta_wu A_w^-1 (Omega_w)_aa A_w^-1 + T_w S^-1 E_u^T + E_w S^-1 T_u^T
 //          + E_w S^-1 Q S^-1 E_u^T
@@ -51,6 +53,9 @@ struct ArrowBlock {
   Eigen::VectorXd prior_information;  // p (diagonal; 0: no prior)
   Eigen::VectorXd prior_mean;         // p
   double scale = 1.0;                 // f_w of the sandwich (>= 1)
+  // X_w of the sandwich ((p + m) x (p + m), the local order; empty: none): the covariance
+  // of the window's scores beyond scale * h.
+  Eigen::MatrixXd extra;
   int m() const { return static_cast<int>(shared_index.size()); }
 };
 
@@ -105,6 +110,9 @@ class ArrowSolver {
   // For the block's variables: the shared ones' entry in b (shared_index), and the
   // problem (kept by reference: it must outlive the solver's use).
   const ArrowProblem& problem() const { return *problem_; }
+  // The blocks' scale or extra changed since the sandwich was formed: form it again on
+  // next use.
+  void ResetSandwich() const { sandwich_ready_ = false; }
   // E_w = A_w^-1 B_w (p x q) and A_w^-1.
   const Eigen::MatrixXd& E(int w) const { return e_[w]; }
   const Eigen::MatrixXd& AInverse(int w) const { return a_inverse_[w]; }
