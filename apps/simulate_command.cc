@@ -80,6 +80,11 @@ DEFINE_double(sensor_rezero_kN, 0.0,
               "simulate: sensors re-zeroed at each new session, bias change sigma (kN).");
 DEFINE_double(mass_centre_drift_m, 0.0, "simulate: mass-centre drift sigma per axis (m).");
 DEFINE_double(mass_centre_drift_time_s, 0.0, "simulate: its correlation time (s).");
+DEFINE_bool(mass_centre_drift_centred, false,
+            "simulate: each session's (day's) drift made of zero mean: a wander inside days "
+            "around a constant level.");
+DEFINE_string(track_minutes, "20,60",
+              "simulate: tracks: each source tracked for a time in this range (min).");
 DEFINE_double(sensor_gain_spread_percent, 0.0, "simulate: per-cable gain spread drawn once (%).");
 DEFINE_double(sensor_bias_spread_kN, 0.0, "simulate: per-cable bias spread drawn once (kN).");
 DEFINE_double(length_offset_spread_m, 0.0,
@@ -193,6 +198,11 @@ Trajectory (--trajectory=, default circle):
           --azimuth-step-deg=15 --focal-radius=160
   random  --samples=100 --max-off-axis-deg=40 --radial-spread=0 (m, off the sphere),
           positions drawn with --seed
+  tracks  --samples at --interval-s: sources tracked at the sidereal rate (the feed's
+          focal point moving on the focal sphere, ~11 mm/s), each for --track-minutes=20,60
+          (a time drawn in the range) or until it leaves the cap to --max-off-axis-deg=40,
+          then the next (the slew not sampled); with --days each day starts a source;
+          drawn with --seed
   poses   --poses=FILE.csv: x_m,y_m,z_m and optionally roll_deg,pitch_deg,yaw_deg or
           qw,qx,qy,qz (the planned attitudes), and with a truth model with moving parts
           its joint columns (a design's poses.csv: each row's joints, then no joint law);
@@ -212,6 +222,8 @@ source with its own generator, so changing one sigma leaves the others' numbers 
   --mass-centre-drift-m=0         drift of the mass centre about the truth model's, per
                                   axis (m)
   --mass-centre-drift-time-s=0    its correlation time (s)
+  --mass-centre-drift-centred     each session's (day's) drift made of zero mean: a
+                                  wander inside days about a level that does not move
   --tension-drift-percent=0       slow relative tension error per cable (%)
   --tension-drift-time-s=0        its correlation time (s)
   --tension-drift-kN=0            absolute part of the slow error (kN): its sd is then
@@ -291,7 +303,8 @@ const std::set<std::string> kFlags = {
     "attitude-control-deg", "attitude-noise-deg", "position-noise-m", "tension-noise-percent",
     "tension-noise-kN", "outlier-fraction", "outlier-scale-percent", "seed", "interval-s", "out",
     "force", "attitude-control-time-s", "tension-drift-percent", "tension-drift-time-s",
-    "mass-centre-drift-m", "mass-centre-drift-time-s", "sensor-gain-spread-percent",
+    "mass-centre-drift-m", "mass-centre-drift-time-s", "mass-centre-drift-centred",
+    "track-minutes", "sensor-gain-spread-percent",
     "sensor-bias-spread-kN", "sessions", "session-shift-m", "mass-centre-step",
     "tension-drift-kN", "session-gap-s", "sensor-rezero-kN", "length-offset-spread-m",
     "length-noise-m", "days", "start", "sensor-step", "joint-law", "joint-grid-deg",
@@ -481,6 +494,7 @@ bool SetOptionsFromFlags(SimulationOptions* options, std::string* error) {
   options->tension_drift_time_s = FLAGS_tension_drift_time_s;
   options->mass_centre_drift_m = FLAGS_mass_centre_drift_m;
   options->mass_centre_drift_time_s = FLAGS_mass_centre_drift_time_s;
+  options->mass_centre_drift_centred = FLAGS_mass_centre_drift_centred;
   options->sensor_gain_spread_percent = FLAGS_sensor_gain_spread_percent;
   options->sensor_bias_spread_kn = FLAGS_sensor_bias_spread_kN;
   options->length_offset_spread_m = FLAGS_length_offset_spread_m;
@@ -568,6 +582,63 @@ bool CheckFlagsApplyToTrajectory(const std::string& trajectory, std::string* err
   return CheckFlagsApply(scopes, mode, error);
 }
 
+// --trajectory=tracks (trajectory.h, SourceTrackSpec): --samples at --interval-s, sources
+// tracked --track-minutes=MIN,MAX each on the cap to --max-off-axis-deg, a new one each
+// --days' day.
+bool SourceTracksFromFlags(const Eigen::Vector3d& focal_centre_m, PositionStream* positions,
+                           std::string* error) {
+  SourceTrackSpec spec;
+  spec.samples = FLAGS_samples;
+  spec.interval_s = FLAGS_interval_s;
+  spec.max_off_axis_deg = FLAGS_max_off_axis_deg;
+  spec.sphere.focal_centre_m = focal_centre_m;
+  spec.sphere.focal_radius_m = FLAGS_focal_radius;
+  spec.days = std::max(0, FLAGS_days);
+  spec.seed = FLAGS_seed;
+  std::vector<double> minutes;
+  if (!ParseNumberList("track-minutes", FLAGS_track_minutes, &minutes, error)) return false;
+  if (minutes.size() != 2) {
+    *error = "--track-minutes takes MIN,MAX (minutes), got " + internal::Quote(FLAGS_track_minutes);
+    return false;
+  }
+  if (!(minutes[0] > 0.0 && minutes[1] >= minutes[0])) {
+    *error = "--track-minutes=MIN,MAX must satisfy 0 < MIN <= MAX (got " +
+             internal::Quote(FLAGS_track_minutes) + ")";
+    return false;
+  }
+  spec.min_track_s = 60.0 * minutes[0];
+  spec.max_track_s = 60.0 * minutes[1];
+  if (SourceTrackPositionStream(spec, positions, error)) return true;
+  *error = "--trajectory=tracks: " +
+           WithFlagNames(*error, {{"min_track_s and max_track_s", "--track-minutes"},
+                                  {"max_off_axis_deg", "--max-off-axis-deg"},
+                                  {"interval_s", "--interval-s"},
+                                  {"samples", "--samples"},
+                                  {"days", "--days"},
+                                  {"sphere.focal_radius_m", "--focal-radius"}});
+  return false;
+}
+
+// The flags --trajectory=tracks takes, of the trajectories' (CheckFlagsApplyToTrajectory).
+bool CheckTrackFlags(const std::string& trajectory, std::string* error) {
+  if (trajectory != "tracks") {
+    if (FlagGiven("track-minutes")) {
+      *error = "--track-minutes applies to --trajectory=tracks";
+      return false;
+    }
+    return true;
+  }
+  for (const char* flag : {"nodes", "from", "to", "centre", "radius", "start-deg", "end-deg",
+                           "off-axis-step-deg", "azimuth-step-deg", "radial-spread"}) {
+    if (FlagGiven(flag)) {
+      *error = std::string("--") + flag + " does not apply to --trajectory=tracks (it takes " +
+               "--samples, --max-off-axis-deg, --focal-radius, --track-minutes, --seed)";
+      return false;
+    }
+  }
+  return true;
+}
+
 // The poses to fly; from a pose file with the truth model's joint columns, their values
 // per sample (*joints; else left empty).
 bool BuildPoses(const CableRobot& truth, PoseStream* poses, std::vector<JointValues>* joints,
@@ -589,7 +660,9 @@ bool BuildPoses(const CableRobot& truth, PoseStream* poses, std::vector<JointVal
     *error = "--trajectory=poses and --poses=FILE go together";
     return false;
   }
-  if (!CheckFlagsApplyToTrajectory(trajectory, error)) return false;
+  if (!CheckFlagsApplyToTrajectory(trajectory, error) || !CheckTrackFlags(trajectory, error)) {
+    return false;
+  }
 
   if (trajectory == "poses") {
     std::vector<Pose> from_file;
@@ -603,11 +676,15 @@ bool BuildPoses(const CableRobot& truth, PoseStream* poses, std::vector<JointVal
   }
 
   PositionStream positions;
+  if (trajectory == "tracks") {
+    if (!SourceTracksFromFlags(law.focal_centre_m, &positions, error)) return false;
+    return PosesFromPositions(positions, FLAGS_attitude_law != "none", law, poses, error);
+  }
   bool known = false;
   const bool ok =
       TrajectoryPositionStreamFromFlags(trajectory, law.focal_centre_m, &positions, &known, error);
   if (!known) {
-    *error = "--trajectory must be circle, line, arc, grid, random or poses, got " +
+    *error = "--trajectory must be circle, line, arc, grid, random, tracks or poses, got " +
              internal::Quote(trajectory);
     return false;
   }
@@ -840,8 +917,8 @@ int RunSimulate(int argc, char** argv) {
     }
     for (const SensorBiasStep& step : options.sensor_bias_steps) {
       header += "\nSensor step at " + TimeText(step.time_s, display) + ": cable " +
-                std::to_string(step.cable + 1) + "'s bias " +
-                FormatDouble(step.shift_n / 1e3, 6) + " kN, added from then on";
+                std::to_string(step.cable + 1) + "'s bias " + FormatDouble(step.shift_n / 1e3, 6) +
+                " kN, added from then on";
     }
     if (summary.session_bias_n.size() > 1 && options.sensor_rezero_kn > 0.0) {
       header +=

@@ -637,6 +637,34 @@ TEST(SimulationTest, MassCentreStepsAndSessions) {
   EXPECT_NE(error.find("mass_centre_steps"), std::string::npos) << error;
 }
 
+// The wander inside days about a level that stays (mass_centre_drift_centred): each
+// session's drift has zero mean, so the samples' average mass centre is the truth's; drawn
+// as the plain process it is not.
+TEST(SimulationTest, CentredDriftKeepsEachSessionsMeanMassCentre) {
+  const std::vector<Pose> poses = Circle(60);
+  const CableRobot truth = CableRobot::NominalFast();
+  SimulationOptions o = NoNoise();
+  o.sample_interval_s = 10.0;
+  o.sessions = 3;
+  o.session_gap_s = 80000.0;
+  o.mass_centre_drift_m = 0.01;
+  o.mass_centre_drift_time_s = 300.0;
+  for (const bool centred : {true, false}) {
+    o.mass_centre_drift_centred = centred;
+    Dataset d;
+    SimulationSummary summary;
+    std::string error;
+    ASSERT_TRUE(Simulate(truth, poses, o, &d, nullptr, &summary, &error)) << error;
+    const double off = (summary.mass_centre_mean_m - truth.mass_centre_cabin_m).norm();
+    EXPECT_GT(summary.mass_centre_drift_rms_m, 0.004) << "centred " << centred;
+    if (centred) {
+      EXPECT_LT(off, 1e-12);
+    } else {
+      EXPECT_GT(off, 1e-4);  // three sessions of 200 s, tau 300 s: their means wander
+    }
+  }
+}
+
 std::string FileText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());

@@ -355,6 +355,61 @@ TEST(RandomPosesAroundFocalLaw, FocalLawTimesABoundedExtraRotation) {
   EXPECT_NE(error.find("min_extra_rotation_deg"), std::string::npos) << error;
 }
 
+// Sources tracked at the sidereal rate: every position on the focal sphere within the cap,
+// consecutive samples of one source a sidereal turn apart about the celestial pole (the
+// feed moves at omega R sin(angle to the pole) <= 11.7 mm/s), a new source after each
+// track and at each day's first sample, the same positions for a seed and from a copy of
+// the stream.
+TEST(SourceTrackPositionStream, SiderealTracksOnTheCap) {
+  SourceTrackSpec spec;
+  spec.samples = 4 * 1800;
+  spec.interval_s = 2.0;
+  spec.days = 4;
+  spec.min_track_s = 600.0;
+  spec.max_track_s = 1200.0;
+  spec.max_off_axis_deg = 35.0;
+  spec.seed = 5;
+  PositionStream stream;
+  std::string error;
+  ASSERT_TRUE(SourceTrackPositionStream(spec, &stream, &error)) << error;
+  PositionStream copy = stream;
+  const Eigen::Vector3d centre(0.0, 0.0, 300.0);
+  constexpr double kSiderealRate = 2.0 * M_PI / 86164.0905;  // rad/s
+  const Eigen::Vector3d pole(0.0, std::cos(spec.latitude_deg * kDegToRad),
+                             std::sin(spec.latitude_deg * kDegToRad));
+  Eigen::Vector3d previous = Eigen::Vector3d::Zero();
+  int sources = 0, day_starts_new = 0;
+  for (int n = 0; n < spec.samples; ++n) {
+    const Eigen::Vector3d p = stream.next();
+    ASSERT_EQ(p, copy.next()) << "sample " << n;
+    const Eigen::Vector3d s = (centre - p) / kFocalRadius_m;  // the source's direction
+    EXPECT_NEAR(s.norm(), 1.0, 1e-12);
+    EXPECT_GE(s.z(), std::cos(spec.max_off_axis_deg * kDegToRad) - 1e-12) << "sample " << n;
+    if (n > 0) {
+      const Eigen::Vector3d before = (centre - previous) / kFocalRadius_m;
+      // The sidereal step about the pole, or a new source.
+      const double expected =
+          kSiderealRate * spec.interval_s * kFocalRadius_m * before.cross(pole).norm();
+      const bool same = std::abs((p - previous).norm() - expected) < 1e-9;
+      sources += !same;
+      if (n % 1800 == 0) day_starts_new += !same;
+    }
+    previous = p;
+  }
+  EXPECT_EQ(day_starts_new, 3);
+  // Tracks of 10-20 minutes (300-600 samples) in 4 days of an hour: 12 to 24 sources.
+  EXPECT_GE(sources + 1, 12);
+  EXPECT_LE(sources + 1, 28);
+  SourceTrackSpec bad = spec;
+  bad.min_track_s = 0.0;
+  EXPECT_FALSE(SourceTrackPositionStream(bad, &stream, &error));
+  EXPECT_NE(error.find("min_track_s"), std::string::npos) << error;
+  bad = spec;
+  bad.interval_s = -1.0;
+  EXPECT_FALSE(SourceTrackPositionStream(bad, &stream, &error));
+  EXPECT_NE(error.find("interval_s"), std::string::npos) << error;
+}
+
 TEST(PosesWithAttitudeLaw, MatchesFocalAttitude) {
   std::vector<Eigen::Vector3d> positions;
   ASSERT_TRUE(FocalSpherePositions(FocalGridSpec(), &positions, nullptr));

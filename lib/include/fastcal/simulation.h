@@ -8,8 +8,9 @@
 //   actual position     p_act  = p                        (the position is held exactly)
 //   mass centre         e_n    = e + d_n + sum_{k: t_k <= t_n} s_k, d per axis AR(1) with
 //                                sigma mass_centre_drift_m and correlation time
-//                                mass_centre_drift_time_s; s_k the steps at times t_k
-//                                (mass_centre_steps: the structure changed)
+//                                mass_centre_drift_time_s (with mass_centre_drift_centred,
+//                                minus its mean over the sample's session); s_k the steps
+//                                at times t_k (mass_centre_steps: the structure changed)
 //   joint values        q_n    = the joint plan's (joint_plan.h), for a model with moving parts
 //   truth statics       T_i, s0_i = SolveStatics(truth with e_n + the parts' shift at q_n,
 //                                               (p_act, R(a_act)))
@@ -91,6 +92,11 @@ struct SimulationOptions {
   // written out keeps the mean; SimulationSummary has the realised average.
   double mass_centre_drift_m = 0.0;
   double mass_centre_drift_time_s = 0.0;
+  // Each session's drift made of zero mean (the process drawn for the session, its mean
+  // over the session's samples subtracted per axis): a wander inside each day about a
+  // level that stays the truth model's. Default false (the process as drawn: its day
+  // means differ by about sigma sqrt(2 tau / day) when tau is short).
+  bool mass_centre_drift_centred = false;
   // Spread of the per-cable sensor gains (percent) and biases (kN) drawn once about the
   // truth model's. >= 0; default 0.
   double sensor_gain_spread_percent = 0.0;

@@ -161,6 +161,29 @@ bool PosesWithAttitudeLaw(const std::vector<Eigen::Vector3d>& positions,
 // c uniform in [-A, A]. The rotations come from a second generator seeded with
 // positions.seed + 1, so the positions are RandomWorkspacePositions' own; the same spec
 // gives the same poses on every platform.
+// Sources tracked across the sky at the sidereal rate, as the telescope observes: the
+// feed follows each source's focal point on the focal sphere, F = C - R s(t), s the unit
+// vector to the source, turning about the celestial pole p = (0, cos(lat), sin(lat)) (the
+// y axis taken as north) at omega = 2 pi / 86164.0905 s^-1 (a sidereal day): 11.7 mm/s at
+// R = 160 m on the equator, less toward the pole. Each source is drawn uniformly over the
+// cap (cos(theta) and azimuth uniform) and tracked for a time uniform in [min_track_s,
+// max_track_s], or until it leaves the cap (a source whose path leaves it sooner than
+// min_track_s is drawn again, up to 100 times); then the next, at once (the slew between
+// them is not sampled). With days > 0 the samples are cut into days as a season's
+// sessions are (sample n is in day floor(n days / samples)) and each day starts a source.
+struct SourceTrackSpec {
+  int samples = 3600;                                 // 1 to 1e7
+  double interval_s = 1.0;                            // between samples, > 0
+  double min_track_s = 1200.0, max_track_s = 3600.0;  // 0 < min <= max
+  double max_off_axis_deg = 40.0;                     // (0, 90)
+  double latitude_deg = 25.647;                       // FAST's site; [-90, 90]
+  int days = 0;                                       // >= 0
+  FocalGridSpec sphere;                               // focal_centre_m and focal_radius_m
+  std::uint64_t seed = 0;
+};
+bool SourceTrackPositionStream(const SourceTrackSpec& spec, PositionStream* stream,
+                               std::string* error);
+
 struct RandomPoseSpec {
   RandomWorkspaceSpec positions;
   FocalAttitudeLaw law;
@@ -218,8 +241,8 @@ bool ParsePosesCsv(const std::string& text, const std::string& source_name,
 bool ReadPosesCsv(const std::string& path, const ColumnMap& columns, std::vector<Pose>* poses,
                   std::vector<double>* times_s, std::string* error);
 bool ParsePosesCsv(const std::string& text, const std::string& source_name,
-                   const ColumnMap& columns, std::vector<Pose>* poses,
-                   std::vector<double>* times_s, std::string* error);
+                   const ColumnMap& columns, std::vector<Pose>* poses, std::vector<double>* times_s,
+                   std::string* error);
 
 // The same with the moving parts' joint columns of a model (MovingParts::JointColumns(),
 // in the columns' units, deg or m): the file gives all of them or none. *joints receives

@@ -220,6 +220,10 @@ struct Processes {
       mass_centre_rng, rezero_rng, length_rng;
   // The time since the previous sample (the interval, or more across a session gap).
   double dt = 0.0;
+  // With mass_centre_drift_centred: the session's drift, drawn at its start (its mean
+  // taken out), and the next sample's index in it.
+  std::vector<Eigen::Vector3d> session_drift;
+  size_t session_drift_next = 0;
   Ar1Vector control, mass_centre_drift;
   std::vector<Ar1> tension_drift;
   // Sums over the samples.
@@ -236,7 +240,9 @@ bool SolveActual(size_t n, const Pose& planned_pose, const Eigen::Vector3d& plan
                  CableRobot* model, Eigen::Vector3d* actual_rpy_deg, StaticsSolution* solution,
                  std::string* error) {
   const Eigen::Vector3d control_deg = p->control.NextAfter(&p->control_rng, p->dt);
-  const Eigen::Vector3d drift_m = p->mass_centre_drift.NextAfter(&p->mass_centre_rng, p->dt);
+  const Eigen::Vector3d drift_m = options.mass_centre_drift_centred
+                                      ? p->session_drift[p->session_drift_next++]
+                                      : p->mass_centre_drift.NextAfter(&p->mass_centre_rng, p->dt);
   model->mass_centre_cabin_m = mass_centre_m + drift_m;
   p->mass_centre_sum += model->mass_centre_cabin_m;
   p->mass_centre_sq += drift_m.squaredNorm();
@@ -349,6 +355,31 @@ void Summarise(const Processes& p, double count, SimulationSummary* stats) {
   stats->position_measurement_rms_m = std::sqrt(p.position_sq / (3.0 * count));
 }
 
+// With mass_centre_drift_centred, at the first sample of a session of `count` samples: its
+// drift drawn (the process goes on from the session before, across the gap `gap_s`) and
+// its mean over the session taken out.
+void DrawSessionDrift(const SimulationOptions& options, long long count, double gap_s,
+                      Processes* p) {
+  p->session_drift.assign(static_cast<size_t>(count), Eigen::Vector3d::Zero());
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (long long k = 0; k < count; ++k) {
+    const double dt = k == 0 ? options.sample_interval_s + gap_s : options.sample_interval_s;
+    p->session_drift[k] = p->mass_centre_drift.NextAfter(&p->mass_centre_rng, dt);
+    mean += p->session_drift[k] / static_cast<double>(count);
+  }
+  for (Eigen::Vector3d& d : p->session_drift) d -= mean;
+  p->session_drift_next = 0;
+}
+
+// The samples of session `session` of `sessions` over `count` (as SimulateImpl cuts them:
+// sample n is in session floor(n sessions / count)).
+long long SessionSamples(long long count, int sessions, int session) {
+  const auto first = [&](int k) {
+    return (static_cast<long long>(k) * count + sessions - 1) / sessions;
+  };
+  return first(session + 1) - first(session);
+}
+
 // The sum of the mass-centre steps at or before time t.
 Eigen::Vector3d StepShiftAt(const SimulationOptions& options, double t) {
   Eigen::Vector3d shift = Eigen::Vector3d::Zero();
@@ -429,6 +460,11 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
                session * options.session_gap_s;
     ApplySensorSteps(options, s.time_s, &applied_sensor_steps, &model);
     processes.dt = options.sample_interval_s + (new_session ? options.session_gap_s : 0.0);
+    if (options.mass_centre_drift_centred && (n == 0 || new_session)) {
+      DrawSessionDrift(options,
+                       SessionSamples(planned.count, std::max(1, options.sessions), session),
+                       n == 0 ? 0.0 : options.session_gap_s, &processes);
+    }
     s.has_planned_attitude = true;
     s.planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned_pose.rotation));
     s.planned_rotation =
@@ -439,8 +475,8 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
     }
     Eigen::Vector3d actual_rpy_deg;
     if (!SolveActual(n, planned_pose, s.planned_rpy_deg, options,
-                     mass_centre_m + StepShiftAt(options, s.time_s), s.joint, statics,
-                     &processes, &model, &actual_rpy_deg, &solution, error)) {
+                     mass_centre_m + StepShiftAt(options, s.time_s), s.joint, statics, &processes,
+                     &model, &actual_rpy_deg, &solution, error)) {
       return false;
     }
     MeasurePose(planned_pose.position_m, actual_rpy_deg, options, &processes, &s);

@@ -2,11 +2,13 @@
 // and the pose CSV reader (conventions: trajectory.h).
 #include "fastcal/trajectory.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
 #include <deque>
+#include <memory>
 #include <random>
 #include <set>
 #include <sstream>
@@ -55,6 +57,15 @@ bool CheckSphere(const FocalGridSpec& sphere, const std::string& prefix, std::st
   if (!IsPositiveFinite(sphere.focal_radius_m)) {
     return Fail(error, prefix + "focal_radius_m must be > 0 and finite (got " +
                            Num(sphere.focal_radius_m) + ")");
+  }
+  return true;
+}
+
+// A stream's sample count: 1 to kMaxPositions.
+bool CheckSamples(int samples, std::string* error) {
+  if (samples > kMaxPositions) return Fail(error, TooMany("samples", samples));
+  if (samples < 1) {
+    return Fail(error, "samples must be >= 1 (got " + std::to_string(samples) + ")");
   }
   return true;
 }
@@ -293,11 +304,9 @@ bool FocalSpherePositions(const FocalGridSpec& spec, std::vector<Eigen::Vector3d
 bool RandomWorkspacePositionStream(const RandomWorkspaceSpec& spec, PositionStream* stream,
                                    std::string* error) {
   if (stream == nullptr) return Fail(error, "positions must not be null");
-  if (spec.samples > kMaxPositions) return Fail(error, TooMany("samples", spec.samples));
-  if (spec.samples < 1) {
-    return Fail(error, "samples must be >= 1 (got " + std::to_string(spec.samples) + ")");
+  if (!CheckSamples(spec.samples, error) || !CheckMaxOffAxis(spec.max_off_axis_deg, error)) {
+    return false;
   }
-  if (!CheckMaxOffAxis(spec.max_off_axis_deg, error)) return false;
   if (!CheckSphere(spec.sphere, "sphere.", error)) return false;
   if (!(std::isfinite(spec.radial_spread_m) && spec.radial_spread_m >= 0.0 &&
         spec.radial_spread_m < spec.sphere.focal_radius_m)) {
@@ -315,6 +324,104 @@ bool RandomWorkspacePositionStream(const RandomWorkspaceSpec& spec, PositionStre
     return OnSphere(spec.sphere.focal_centre_m, spec.sphere.focal_radius_m + offset_m, cos_theta,
                     sin_theta, phi_rad);
   };
+  return true;
+}
+
+namespace {
+
+// A sidereal day (s): the sky turns once about the celestial pole.
+constexpr double kSiderealDayS = 86164.0905;
+// Draws of a source whose path stays on the cap for min_track_s, at most.
+constexpr int kMaxSourceDraws = 100;
+
+// The sources a SourceTrackSpec tracks, one sample at a time.
+class SourceTracker {
+ public:
+  explicit SourceTracker(const SourceTrackSpec& spec)
+      : spec_(spec),
+        rng_(spec.seed),
+        cos_max_(std::cos(spec.max_off_axis_deg * kDegToRad)),
+        pole_(0.0, std::cos(spec.latitude_deg * kDegToRad),
+              std::sin(spec.latitude_deg * kDegToRad)),
+        step_(Eigen::AngleAxisd(2.0 * M_PI * spec.interval_s / kSiderealDayS, pole_)) {}
+
+  Eigen::Vector3d Next() {
+    const int day = spec_.days > 0
+                        ? static_cast<int>(static_cast<long long>(n_) * spec_.days / spec_.samples)
+                        : 0;
+    if (n_ == 0 || day != day_ || left_ <= 0 || source_.z() < cos_max_) NewSource();
+    day_ = day;
+    ++n_;
+    --left_;
+    const Eigen::Vector3d feed =
+        spec_.sphere.focal_centre_m - spec_.sphere.focal_radius_m * source_;
+    source_ = step_ * source_;
+    return feed;
+  }
+
+ private:
+  // Samples the source at s stays on the cap from now (at most `limit`).
+  long long OnCap(Eigen::Vector3d s, long long limit) const {
+    long long k = 0;
+    for (; k < limit && s.z() >= cos_max_; ++k) s = step_ * s;
+    return k;
+  }
+  void NewSource() {
+    const long long shortest =
+        std::max(1LL, static_cast<long long>(std::ceil(spec_.min_track_s / spec_.interval_s)));
+    for (int draw = 0; draw < kMaxSourceDraws; ++draw) {
+      const double cos_theta = 1.0 - Uniform01(rng_) * (1.0 - cos_max_);
+      const double phi = 2.0 * M_PI * Uniform01(rng_);
+      const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+      source_ = Eigen::Vector3d(sin_theta * std::cos(phi), sin_theta * std::sin(phi), cos_theta);
+      if (OnCap(source_, shortest) >= shortest) break;
+    }
+    const double track_s =
+        spec_.min_track_s + (spec_.max_track_s - spec_.min_track_s) * Uniform01(rng_);
+    left_ = std::max(1LL, static_cast<long long>(std::llround(track_s / spec_.interval_s)));
+  }
+
+  SourceTrackSpec spec_;
+  std::mt19937_64 rng_;
+  double cos_max_;
+  Eigen::Vector3d pole_;
+  Eigen::Matrix3d step_;
+  Eigen::Vector3d source_ = Eigen::Vector3d::UnitZ();
+  long long n_ = 0, left_ = 0;
+  int day_ = 0;
+};
+
+}  // namespace
+
+bool SourceTrackPositionStream(const SourceTrackSpec& spec, PositionStream* stream,
+                               std::string* error) {
+  if (stream == nullptr) return Fail(error, "positions must not be null");
+  if (!CheckSamples(spec.samples, error) || !CheckMaxOffAxis(spec.max_off_axis_deg, error)) {
+    return false;
+  }
+  if (!(spec.max_off_axis_deg > 0.0 && spec.max_off_axis_deg < 90.0)) {
+    return Fail(error, "max_off_axis_deg must be in (0, 90) for source tracks (got " +
+                           Num(spec.max_off_axis_deg) + ")");
+  }
+  if (!CheckSphere(spec.sphere, "sphere.", error)) return false;
+  if (!(std::isfinite(spec.interval_s) && spec.interval_s > 0.0)) {
+    return Fail(error, "interval_s must be > 0 (got " + Num(spec.interval_s) + ")");
+  }
+  if (!(std::isfinite(spec.min_track_s) && std::isfinite(spec.max_track_s) &&
+        spec.min_track_s > 0.0 && spec.max_track_s >= spec.min_track_s)) {
+    return Fail(error, "min_track_s and max_track_s must satisfy 0 < min <= max (got " +
+                           Num(spec.min_track_s) + ", " + Num(spec.max_track_s) + ")");
+  }
+  if (!(std::abs(spec.latitude_deg) <= 90.0)) {
+    return Fail(error, "latitude_deg must be in [-90, 90] (got " + Num(spec.latitude_deg) + ")");
+  }
+  if (spec.days < 0 || spec.days > spec.samples) {
+    return Fail(error, "days must be in [0, samples] (got " + std::to_string(spec.days) + ")");
+  }
+  stream->count = spec.samples;
+  // Held by value: a copy of the stream starts where the original stands (the CLI checks
+  // every node on a copy).
+  stream->next = [tracker = SourceTracker(spec)]() mutable { return tracker.Next(); };
   return true;
 }
 
@@ -486,7 +593,8 @@ bool ParseMappedPoseHeader(const std::vector<std::string_view>& fields, const st
       index[kQw] >= 0 || index[kQx] >= 0 || index[kQy] >= 0 || index[kQz] >= 0;
   const std::string map_where = internal::ColumnsWhere(map);
   if (columns->has_rpy && columns->has_quaternion) {
-    return Fail(error, map_where + "both roll/pitch/yaw and quaternion (qw,qx,qy,qz); give one attitude");
+    return Fail(error,
+                map_where + "both roll/pitch/yaw and quaternion (qw,qx,qy,qz); give one attitude");
   }
   std::vector<int> required = {kX, kY, kZ};
   if (columns->has_rpy) required.insert(required.end(), {kRoll, kPitch, kYaw});
@@ -585,14 +693,12 @@ bool ParsePoseRow(std::vector<std::string_view> fields, const std::string& where
     if (index[c] < 0) continue;
     std::string why;
     double file_value = 0.0;
-    const bool read =
-        columns.map == nullptr
-            ? ParseNumber(fields[index[c]], &values[c], &why)
-        : c == kTime ? internal::ReadTimeField(fields[index[c]], columns.map->time,
-                                               columns.map->decimal, &values[c], &why)
-                     : internal::ReadConvertedNumber(fields[index[c]], columns.map->decimal,
-                                                     columns.conversion[c], &file_value,
-                                                     &values[c], &why);
+    const bool read = columns.map == nullptr ? ParseNumber(fields[index[c]], &values[c], &why)
+                      : c == kTime ? internal::ReadTimeField(fields[index[c]], columns.map->time,
+                                                             columns.map->decimal, &values[c], &why)
+                                   : internal::ReadConvertedNumber(
+                                         fields[index[c]], columns.map->decimal,
+                                         columns.conversion[c], &file_value, &values[c], &why);
     if (!read || (c >= kRoll && c <= kYaw && !CheckAngleDeg(values[c], limits, &why))) {
       return Fail(error, where + columns.label[c] + ": " + why);
     }
@@ -621,8 +727,8 @@ bool ParsePoseRow(std::vector<std::string_view> fields, const std::string& where
     const bool read = columns.map == nullptr
                           ? ParseNumber(field, &(*joints)[j], &why)
                           : internal::ReadConvertedNumber(field, columns.map->decimal,
-                                                          columns.joint_conversion[j],
-                                                          &file_value, &(*joints)[j], &why);
+                                                          columns.joint_conversion[j], &file_value,
+                                                          &(*joints)[j], &why);
     if (!read || !PlausibleJointValue(name, (*joints)[j], &why)) {
       return Fail(error, where + "column " + internal::Quote(name) + ": " + why);
     }
@@ -687,8 +793,8 @@ bool ParsePosesCsvImpl(const std::string& text, const std::string& path, const C
       scratch.clear();
       std::string why;
       if (!has_header) {
-        columns.delimiter = map->delimiter != 0 ? map->delimiter
-                                                : internal::DetectDelimiter(line, map->decimal);
+        columns.delimiter =
+            map->delimiter != 0 ? map->delimiter : internal::DetectDelimiter(line, map->decimal);
       }
       if (!internal::SplitRecord(line, columns.delimiter, &fields, &scratch, &why)) {
         return Fail(error, where + why);
@@ -750,8 +856,8 @@ bool ParsePosesCsv(const std::string& text, const std::string& path, std::vector
   return ParsePosesCsvImpl(text, path, nullptr, nullptr, poses, nullptr, times_s, error);
 }
 bool ParsePosesCsv(const std::string& text, const std::string& source_name,
-                   const ColumnMap& columns, std::vector<Pose>* poses,
-                   std::vector<double>* times_s, std::string* error) {
+                   const ColumnMap& columns, std::vector<Pose>* poses, std::vector<double>* times_s,
+                   std::string* error) {
   return ParsePosesCsvImpl(text, source_name, &columns, nullptr, poses, nullptr, times_s, error);
 }
 bool ParsePosesCsv(const std::string& text, const std::string& source_name,
