@@ -248,17 +248,7 @@ std::string EventLine(const TrackResult& r, const TrackEvent& e) {
     for (int c : e.cables) line << " " << c;
     line << ")";
   }
-  const auto time = [&r](double t) {
-    return IsUnixTime(t) ? IsoUnixTime(t, r.time_offset_s)
-                         : internal::FormatDouble("%.17g", t) + " s";
-  };
-  if (e.within_window) {
-    line << " inside the window, at " << time(e.time_s) << " (" << time(e.time_low_s) << " to "
-         << time(e.time_high_s) << ")";
-  } else {
-    line << " between " << time(e.previous_time_s) << " and " << time(e.time_s);
-  }
-  line << ":";
+  line << " " << DescribeEventTime(r, e) << ":";
   for (const TrackEventParameter& p : e.parameters) {
     line << " " << p.name << " " << internal::FormatDouble("%+.4g", p.shift) << " +- "
          << internal::FormatDouble("%.2g", p.sigma_total) << (p.unit == "1" ? "" : " " + p.unit)
@@ -274,12 +264,8 @@ std::string EventLines(const TrackResult& r) {
     << internal::FormatDouble("%g", 100.0 * r.false_alarm)
     << "% false-alarm rate over the track): " << r.events.size() << "\n";
   for (const TrackWander& w : r.wander) {
-    if (w.rms > 0.0) {
-      s << Wrapped("(" + w.group + " wanders between windows by " +
-                       internal::FormatDouble("%.3g", w.rms) + " " + w.unit +
-                       " rms per component beyond its errors: the events are steps beyond that)",
-                   "  ", "   ", kSentenceLines, "track.html");
-    }
+    const std::string text = DescribeWander(w);
+    if (!text.empty()) s << Wrapped("(" + text + ")", "  ", "   ", kSentenceLines, "track.html");
   }
   for (const TrackEvent& e : r.events) s << EventLine(r, e);
   return s.str();
@@ -299,8 +285,9 @@ std::string Summary(const TrackResult& r, const std::string& out) {
 int RunTrack(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp,
-                    {"model", "spec", "data", "out", "window", "threads", "refold", "force", "keep-overlapping",
-                     "quiet", "skip-invalid-rows", "min-window-samples", "false-alarm", "columns"},
+                    {"model", "spec", "data", "out", "window", "threads", "refold", "force",
+                     "keep-overlapping", "quiet", "skip-invalid-rows", "min-window-samples",
+                     "false-alarm", "columns"},
                     &exit_code)) {
     return exit_code;
   }

@@ -283,9 +283,11 @@ TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
   ASSERT_EQ(track.code, 0) << track.output;
   EXPECT_NE(track.output.find("(converged)"), std::string::npos) << track.output;
   // One event, the move, dated between the last sample before it and the first after.
-  EXPECT_NE(track.output.find("1% false-alarm rate over the track): 1\n  2024-05-04  parameter "
-                              "between 2024-05-03T20:39:58Z and 2024-05-04T20:00:00Z: "
-                              "mass_centre_m.x"),
+  // (A line on the wander may stand between the count and the event.)
+  EXPECT_NE(track.output.find("1% false-alarm rate over the track): 1\n"), std::string::npos)
+      << track.output;
+  EXPECT_NE(track.output.find("\n  2024-05-04  parameter between 2024-05-03T20:39:58Z and "
+                              "2024-05-04T20:00:00Z: mass_centre_m.x"),
             std::string::npos)
       << track.output;
   // The parts' parameters shared by the windows and fitted from a first moment of 0
@@ -297,7 +299,8 @@ TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
               "--model=" + start + " --data=" + Path("season.csv") + " --out=" + Path("shared"));
   ASSERT_EQ(shared.code, 0) << shared.output;
   EXPECT_NE(shared.output.find("(converged)"), std::string::npos) << shared.output;
-  EXPECT_NE(shared.output.find("over the track): 1\n  2024-05-04  parameter"), std::string::npos)
+  EXPECT_NE(shared.output.find("over the track): 1\n"), std::string::npos) << shared.output;
+  EXPECT_NE(shared.output.find("\n  2024-05-04  parameter between"), std::string::npos)
       << shared.output;
   const std::regex qz(R"(first_moment_kg_m.z = (\S+) \+- (\S+) kg m)");
   std::smatch m;

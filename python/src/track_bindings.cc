@@ -111,6 +111,18 @@ py::dict ResultDict(const TrackResult& r) {
     x["parameters"] = w.group;
     x["rms"] = w.rms;
     x["unit"] = w.unit;
+    py::dict inside;
+    inside["components"] = w.components;
+    inside["rms"] = w.inside_rms;
+    inside["rms_sigma"] = w.inside_rms_sigma;
+    inside["time_constant_s"] = w.inside_time_constant_s;
+    inside["log_time_constant_sigma"] = w.inside_log_time_constant_sigma;
+    inside["windows"] = w.inside_windows;
+    inside["likelihood_ratio"] = w.inside_likelihood_ratio;
+    inside["significant"] = w.inside_significant;
+    inside["left_out"] = w.inside_left_out;
+    x["inside"] = inside;
+    x["description"] = DescribeWander(w);
     wander.append(x);
   }
   d["wander"] = wander;

@@ -215,14 +215,33 @@ struct TrackEvent {
   double p_value = 1.0;
 };
 
-// A per-window group's wander between windows beyond its estimates' errors (a mass
-// centre that moves about within and between days, not in steps): the variance per
-// component that, added to each window's, brings the median of the consecutive windows'
-// difference statistics to the chi-square median; the events are steps beyond it.
+// A per-window group's wander, in two parts: between windows (day to day) beyond its
+// estimates' errors, and inside the windows. The events are steps beyond both.
+//   rms     between windows: the variance per component that, added to each window's,
+//           brings the median of the consecutive windows' difference statistics to the
+//           chi-square median (a wander of the days' levels);
+//   inside  a first-order Gauss-Markov process per component within each window (the mass
+//           centre moving about within an observing day), its variances and time constant
+//           estimated by REML from the windows' block scores (internal/inner_wander.h); in
+//           every window's, shift's and shared parameter's sigma_total.
 struct TrackWander {
   std::string group;  // "mass_centre_m", or the parameter's name
   std::string unit;
-  double rms = 0.0;  // sqrt of the variance per component, in `unit` (0: none seen)
+  double rms = 0.0;  // between windows: sqrt of the variance per component, in `unit`
+  std::vector<std::string> components;  // the group's parameters
+  // Inside the windows, per component: the process's standard deviation and its
+  // standard error (in `unit`; 0 where none is seen), and the time constant with the
+  // standard error of its logarithm (0 when there is no wander).
+  std::vector<double> inside_rms, inside_rms_sigma;
+  double inside_time_constant_s = 0.0;
+  double inside_log_time_constant_sigma = 0.0;
+  int inside_windows = 0;                    // the windows it was estimated from
+  std::vector<std::string> inside_left_out;  // windows the model could not explain
+  // Twice the log-likelihood gain of the wander over none (its likelihood-ratio statistic,
+  // p + 1 parameters), and whether it is beyond chance at 5 % (chi-square(p + 1)): a
+  // wander not beyond chance is still in the sigmas (the data cannot rule it out).
+  double inside_likelihood_ratio = 0.0;
+  bool inside_significant = false;
 };
 
 struct TrackResult {
@@ -253,6 +272,15 @@ struct TrackResult {
   std::vector<std::pair<std::string, CableRobot>> models;
   std::vector<std::string> model_comments;  // parallel: each model's estimates
 };
+
+// One sentence on a group's wander inside and between windows, for the console and
+// track.html ("" when neither is seen).
+std::string DescribeWander(const TrackWander& wander);
+// When an event happened, for the console and track.html: "between A and B" (an event
+// between windows) or "inside the window, at T", then its likelihood interval when it is
+// not just that night ("95% interval LOW to HIGH"), and, where the interval spans a night
+// and a window's telemetry, that the data cannot tell them apart. Times as TrackTimeText.
+std::string DescribeEventTime(const TrackResult& result, const TrackEvent& event);
 
 enum class TrackStatus {
   kOk = 0,

@@ -4,6 +4,7 @@
 // false-alarm rate over the season (Bonferroni).
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "fastcal/internal/number_text.h"
@@ -84,25 +85,6 @@ TrackEvent SensorEvent(const TrackRun& run, int e0, int e, double threshold, int
       {s.name, s.unit, d / s.to_si, std::sqrt(std::max(variance, 0.0)) / s.to_si});
   event.cables.push_back(s.index + 1);
   return event;
-}
-
-// The per-window groups tested together: a vector quantity's axes, or one parameter.
-std::vector<std::vector<int>> WindowGroups(const TrackRun& run) {
-  std::map<std::string, std::vector<int>> by_key;
-  std::vector<std::string> keys;
-  for (size_t a = 0; a < run.layout.window_columns.size(); ++a) {
-    const ParameterSpec& s = run.layout.Column(run.layout.window_columns[a]);
-    const bool vector = s.kind == ParameterKind::kMassCentre ||
-                        s.kind == ParameterKind::kAnchorOffset ||
-                        s.kind == ParameterKind::kTowerOffset;
-    const std::string key =
-        vector ? std::string(ParameterGroupName(s.kind)) + "/" + std::to_string(s.index) : s.name;
-    if (!by_key.count(key)) keys.push_back(key);
-    by_key[key].push_back(static_cast<int>(a));
-  }
-  std::vector<std::vector<int>> groups;
-  for (const std::string& k : keys) groups.push_back(by_key[k]);
-  return groups;
 }
 
 // The largest of ScanSplits' statistics over window u's block boundaries, judged against
@@ -215,32 +197,70 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
 }
 
 // Where a sensor step found at the boundary before used window u (the bias `size` higher
-// from u on) most likely is, on one time line: at that boundary, or inside window u - 1
-// (its blocks j.. already of the new value) or u (its blocks ..j-1 still of the old).
-// Moving it changes the chi-square by 2 s delta + S delta^2 (s the score of the part that
-// changes, S its information with everything else profiled out, delta the bias change
-// it gets: ScanSplits), over the window's misfit widening. Its place is the smallest;
-// it stays at the boundary (block -1) when the boundary is within the likelihood interval
-// (LocationDrop(), 95%) of it: an overnight re-zeroing is not put in an edge block.
-InnerStep MoveStep(const TrackRun& run, int u, const std::vector<int>& rows, int column,
-                   double size, bool before_ok, bool here_ok) {
-  InnerStep best;
-  double smallest = 0.0;  // the boundary's
+// from u on) may be, on one time line: at that boundary, or inside window u - 1 (its blocks
+// j.. already of the new value) or u (its blocks ..j-1 still of the old). Moving it changes
+// the chi-square by 2 s delta + S delta^2 (s the score of the part that changes, S its
+// information with everything else profiled out, delta the bias change it gets:
+// ScanSplits), over the window's misfit widening.
+struct Placement {
+  int window = -1;  // used window; -1: the boundary
+  int block = 0;    // the cut before this block of `window`
+  double change = 0.0;
+};
+std::vector<Placement> StepPlacements(const TrackRun& run, int u, const std::vector<int>& rows,
+                                      int column, double size) {
+  std::vector<Placement> out = {{-1, 0, 0.0}};
   for (const int v : {u - 1, u}) {
-    if (v == u - 1 ? !before_ok : !here_ok) continue;
     const bool head = v == u;
     const double delta = head ? -size : size;
     const std::vector<SplitScore> scores = ScanSplits(run, v, rows, {column}, run.birge[v], head);
     for (size_t j = kMinPartBlocks; j + kMinPartBlocks <= scores.size(); ++j) {
       if (!scores[j].valid) continue;
-      const double change =
-          (2.0 * scores[j].score[0] * delta + scores[j].schur(0, 0) * delta * delta) / run.birge[v];
-      if (change < smallest) {
-        smallest = change;
-        best.window = v;
-        best.block = static_cast<int>(j);
-        best.statistic = -change;
-      }
+      out.push_back({v, static_cast<int>(j),
+                     (2.0 * scores[j].score[0] * delta + scores[j].schur(0, 0) * delta * delta) /
+                         run.birge[v]});
+    }
+  }
+  return out;
+}
+
+// The step's likelihood interval over its placements (Hinkley 1970): from the earliest to
+// the latest whose change is within LocationDrop() of the least; a cut stands for a change
+// anywhere in the blocks either side of it, the boundary for the night between the windows.
+std::pair<double, double> PlacementInterval(const TrackRun& run, int u,
+                                            const std::vector<Placement>& placements) {
+  double least = 0.0;
+  for (const Placement& x : placements) least = std::min(least, x.change);
+  double low = std::numeric_limits<double>::infinity();
+  double high = -std::numeric_limits<double>::infinity();
+  for (const Placement& x : placements) {
+    if (x.change > least + LocationDrop()) continue;
+    if (x.window < 0) {
+      low = std::min(low, run.windows[run.used[u - 1]].last_s);
+      high = std::max(high, run.windows[run.used[u]].first_s);
+      continue;
+    }
+    const WindowFold& f = run.windows[run.used[x.window]].fold;
+    low = std::min(low, f.block_first_time_s[x.block - 1]);
+    high = std::max(high, f.block_last_time_s[x.block]);
+  }
+  return {low, high};
+}
+
+// Where the step most likely is: the placement of least change among those allowed (a
+// window is moved into only when its stretch keeps another window), unless the boundary is
+// within LocationDrop() of it (block -1: it stays there; an overnight re-zeroing is not put
+// in an edge block).
+InnerStep MoveStep(const std::vector<Placement>& placements, bool before_ok, bool here_ok, int u) {
+  InnerStep best;
+  double smallest = 0.0;  // the boundary's
+  for (const Placement& x : placements) {
+    if (x.window < 0 || !(x.window == u - 1 ? before_ok : here_ok)) continue;
+    if (x.change < smallest) {
+      smallest = x.change;
+      best.window = x.window;
+      best.block = x.block;
+      best.statistic = -x.change;
     }
   }
   if (!(best.statistic > LocationDrop())) return InnerStep();
@@ -299,7 +319,12 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     const bool before_ok = u >= 2 && run.entry_of[u - 2][j] == e0;
     const bool here_ok = u + 1 < windows && run.entry_of[u + 1][j] == e;
     const double size = run.shared[e].value_si - run.shared[e0].value_si;
-    const InnerStep step = MoveStep(run, u, rows, column, size, before_ok, here_ok);
+    const std::vector<Placement> placements = StepPlacements(run, u, rows, column, size);
+    const std::pair<double, double> interval = PlacementInterval(run, u, placements);
+    run.shared[e].has_interval = true;
+    run.shared[e].interval_low_s = interval.first;
+    run.shared[e].interval_high_s = interval.second;
+    const InnerStep step = MoveStep(placements, before_ok, here_ok, u);
     if (step.block < 0) continue;
     const bool use_here = step.window == u;
     const int v = step.window;
@@ -308,6 +333,9 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     mixed.inside = true;
     mixed.step_time_s = f.block_first_time_s[step.block];
     mixed.step_previous_s = f.block_last_time_s[step.block - 1];
+    mixed.has_interval = true;
+    mixed.interval_low_s = interval.first;
+    mixed.interval_high_s = interval.second;
     if (use_here) {
       // Entry e keeps window u alone; the stretch after it gets a new entry.
       SharedEntry after = run.shared[e];
@@ -393,13 +421,12 @@ std::pair<double, double> SplitInterval(const TrackRun& run, int u,
                                         const std::vector<SplitScore>& scores, int j) {
   const WindowFold& f = run.windows[run.used[u]].fold;
   const double floor = scores[j].statistic - LocationDrop();
-  const auto within = [&](int k) {
-    return k >= 1 && k < static_cast<int>(scores.size()) && scores[k].valid &&
-           scores[k].statistic >= floor;
-  };
   int first = j, last = j;
-  while (within(first - 1)) --first;
-  while (within(last + 1)) ++last;
+  for (int k = 1; k < static_cast<int>(scores.size()); ++k) {
+    if (!scores[k].valid || scores[k].statistic < floor) continue;
+    first = std::min(first, k);
+    last = std::max(last, k);
+  }
   // A block's samples are one unit of the scan: the change may be anywhere in the blocks
   // either side of a cut.
   return {f.block_first_time_s[first - 1], f.block_last_time_s[last]};
@@ -473,6 +500,7 @@ TrackStatus FindParameterEvents(TrackRun& run) {
       if (base < 0 || run.shared[e].inside) continue;
       TrackEvent event = SensorEvent(run, base, static_cast<int>(e), threshold, r.sensor_tests);
       const int previous = PreviousEntry(run, static_cast<int>(e));
+      const SharedEntry& timed = run.shared[previous].inside ? run.shared[previous] : run.shared[e];
       if (run.shared[previous].inside) {
         // The step inside the window of entry `previous`: timed at its block.
         const SharedEntry& mixed = run.shared[previous];
@@ -481,7 +509,11 @@ TrackStatus FindParameterEvents(TrackRun& run) {
         event.time_s = mixed.step_time_s;
         event.previous_time_s = mixed.step_previous_s;
         event.within_window = true;
-        TimeSensorStep(run, event.window, run.shared[previous].column, &event);
+        if (!timed.has_interval) TimeSensorStep(run, event.window, timed.column, &event);
+      }
+      if (timed.has_interval) {
+        event.time_low_s = timed.interval_low_s;
+        event.time_high_s = timed.interval_high_s;
       }
       r.events.push_back(event);
     }
@@ -490,22 +522,27 @@ TrackStatus FindParameterEvents(TrackRun& run) {
   const std::vector<std::vector<int>> groups = WindowGroups(run);
   const int candidates = TimelineCandidates(run);
   r.parameter_tests = static_cast<int>(groups.size()) * candidates;
-  for (const std::vector<int>& g : groups) {
+  for (size_t gi = 0; gi < groups.size(); ++gi) {
     if (candidates == 0) break;
+    const std::vector<int>& g = groups[gi];
     const ParameterSpec& s = run.layout.Column(run.layout.window_columns[g[0]]);
     const bool sensor =
         s.kind == ParameterKind::kSensorBias || s.kind == ParameterKind::kSensorGain;
     double wander = 0.0;
-    SegmentGroup(run, g, {sensor ? "sensor" : "parameter", r.parameter_tests}, &r.events, &wander);
+    SegmentGroup(run, g, static_cast<int>(gi), {sensor ? "sensor" : "parameter", r.parameter_tests},
+                 &r.events, &wander);
     TrackWander w;
     w.group = g.size() > 1 ? std::string(ParameterGroupName(s.kind)) : s.name;
     w.unit = s.unit;
     w.rms = std::sqrt(wander) / s.to_si;
+    DescribeWanderInside(run, static_cast<int>(gi), &w);
     r.wander.push_back(w);
   }
   std::stable_sort(r.events.begin(), r.events.end(),
                    [](const TrackEvent& a, const TrackEvent& b) { return a.time_s < b.time_s; });
-  return TrackStatus::kOk;
+  // The windows' and shared estimates again: the wander inside windows in their sandwich
+  // is now the one estimated without the windows the changes are inside.
+  return Results(run);
 }
 
 }  // namespace fastcal::internal

@@ -126,8 +126,8 @@ std::string EventsTable(const TrackResult& r) {
            FormatDouble("%g", 100.0 * r.false_alarm) + "% false-alarm rate over the track).</p>\n";
   }
   std::string h =
-      "<table><tr><th>time (UTC)</th><th>last sample before</th><th>kind</th><th>what changed</th>"
-      "<th>statistic</th><th>p (family-wise)</th></tr>\n";
+      "<table><tr><th>time (UTC)</th><th>last sample before</th><th>when</th><th>kind</th>"
+      "<th>what changed</th><th>statistic</th><th>p (family-wise)</th></tr>\n";
   for (const TrackEvent& e : r.events) {
     std::string what;
     for (const TrackEventParameter& p : e.parameters) {
@@ -135,10 +135,10 @@ std::string EventsTable(const TrackResult& r) {
               " +- " + FormatDouble("%.2g", p.sigma_total) + " " + Esc(p.unit);
     }
     h += "<tr><td>" + TrackTimeText(e.time_s, r.time_offset_s) + "</td><td>" +
-         TrackTimeText(e.previous_time_s, r.time_offset_s) + "</td><td>" + e.kind + "</td><td>" +
-         what + "</td><td>" + FormatDouble("%.1f", e.statistic) + " (threshold " +
-         FormatDouble("%.1f", e.threshold) + ")</td><td>" + FormatDouble("%.2g", e.p_value) +
-         "</td></tr>\n";
+         TrackTimeText(e.previous_time_s, r.time_offset_s) + "</td><td>" +
+         Esc(DescribeEventTime(r, e)) + "</td><td>" + e.kind + "</td><td>" + what + "</td><td>" +
+         FormatDouble("%.1f", e.statistic) + " (threshold " + FormatDouble("%.1f", e.threshold) +
+         ")</td><td>" + FormatDouble("%.2g", e.p_value) + "</td></tr>\n";
   }
   return h + "</table>\n";
 }
@@ -204,12 +204,8 @@ std::string TrackHtml(const TrackResult& r) {
        "between windows, which the events test: the dots can scatter less than the bars suggest, "
        "and a step well inside them can be significant.</p>\n";
   for (const TrackWander& w : r.wander) {
-    if (w.rms > 0.0) {
-      h += "<p>" + Esc(w.group) + " wanders between windows by " + FormatDouble("%.3g", w.rms) +
-           " " + Esc(w.unit) +
-           " rms per component beyond its errors (estimated from the differences between "
-           "consecutive windows): the events are steps beyond that.</p>\n";
-    }
+    const std::string text = DescribeWander(w);
+    if (!text.empty()) h += "<p>" + Esc(text) + ".</p>\n";
   }
   for (size_t k = 0; k < r.window_parameters.size(); ++k) h += ParameterPlot(r, axis, k) + "\n";
   if (r.windows.front().has_offsets) {

@@ -106,6 +106,26 @@ std::string EventsJson(const TrackResult& r) {
     j.Key("parameters").String(w.group);
     j.Key("rms").Number(w.rms);
     j.Key("unit").String(w.unit);
+    // Inside the windows (track.h, TrackWander): per component, and the time constant.
+    j.Key("inside").BeginObject();
+    j.Key("components").BeginArray();
+    for (size_t x = 0; x < w.components.size(); ++x) {
+      j.BeginObject();
+      j.Key("parameter").String(w.components[x]);
+      j.Key("rms").Number(w.inside_rms[x]);
+      j.Key("rms_sigma").Number(w.inside_rms_sigma[x]);
+      j.EndObject();
+    }
+    j.EndArray();
+    j.Key("time_constant_s").Number(w.inside_time_constant_s);
+    j.Key("log_time_constant_sigma").Number(w.inside_log_time_constant_sigma);
+    j.Key("windows").Int(w.inside_windows);
+    j.Key("likelihood_ratio").Number(w.inside_likelihood_ratio);
+    j.Key("significant").Bool(w.inside_significant);
+    j.Key("left_out").BeginArray();
+    for (const std::string& label : w.inside_left_out) j.String(label);
+    j.EndArray();
+    j.EndObject();
     j.EndObject();
   }
   j.EndArray();
@@ -228,3 +248,73 @@ TrackStatus WriteOutputs(TrackRun& run) {
 }
 
 }  // namespace fastcal::internal
+
+namespace fastcal {
+
+std::string DescribeEventTime(const TrackResult& r, const TrackEvent& e) {
+  using internal::TrackTimeText;
+  const auto time = [&](double t) { return TrackTimeText(t, r.time_offset_s); };
+  std::string s = e.within_window ? "inside the window, at " + time(e.time_s)
+                                  : "between " + time(e.previous_time_s) + " and " + time(e.time_s);
+  const bool night_only =
+      !e.within_window && e.time_low_s >= e.previous_time_s && e.time_high_s <= e.time_s;
+  if (night_only) return s;
+  s += " (" + internal::FormatDouble("%g", 100.0 * internal::kIntervalLevel) + "% interval " +
+       time(e.time_low_s) + " to " + time(e.time_high_s);
+  // The nights the interval spans (between consecutive windows' data) and the telemetry.
+  bool night = false, telemetry = false;
+  for (size_t w = 0; w < r.windows.size(); ++w) {
+    const TrackWindow& x = r.windows[w];
+    telemetry = telemetry || (e.time_low_s < x.last_time_s && e.time_high_s > x.first_time_s);
+    if (w + 1 < r.windows.size()) {
+      night = night ||
+              (e.time_low_s <= x.last_time_s && e.time_high_s >= r.windows[w + 1].first_time_s);
+    }
+  }
+  if (night && telemetry) {
+    s += ": it spans a night and a day's telemetry, which the data cannot tell apart";
+  }
+  return s + ")";
+}
+
+std::string DescribeWander(const TrackWander& w) {
+  using internal::FormatDouble;
+  const bool inside = w.inside_time_constant_s > 0.0;
+  if (!inside && !(w.rms > 0.0)) return "";
+  std::string s = w.group + " wanders";
+  if (inside) {
+    s += " inside the windows by";
+    for (size_t x = 0; x < w.components.size(); ++x) {
+      const std::string& name = w.components[x];
+      const size_t dot = name.rfind('.');
+      s += std::string(x > 0 ? "," : "") + " " +
+           (dot == std::string::npos ? name : name.substr(dot + 1)) + " " +
+           FormatDouble("%.2g", w.inside_rms[x]) + " +- " +
+           FormatDouble("%.1g", w.inside_rms_sigma[x]);
+    }
+    const double tau = w.inside_time_constant_s;
+    const std::string tau_text = tau >= 7200.0  ? FormatDouble("%.3g h", tau / 3600.0)
+                                 : tau >= 120.0 ? FormatDouble("%.3g min", tau / 60.0)
+                                                : FormatDouble("%.3g s", tau);
+    s += " " + w.unit + " rms (a Gauss-Markov process, time constant " + tau_text;
+    if (w.inside_log_time_constant_sigma > 0.0) {
+      s += " x/ " + FormatDouble("%.2g", std::exp(w.inside_log_time_constant_sigma));
+    }
+    s += "; from " + std::to_string(w.inside_windows) + " windows";
+    if (!w.inside_significant) {
+      s += "; not beyond chance: likelihood ratio " +
+           FormatDouble("%.2g", w.inside_likelihood_ratio) + " against none";
+    }
+    if (!w.inside_left_out.empty()) {
+      s += ", " + std::to_string(w.inside_left_out.size()) + " left out as beyond it";
+    }
+    s += ")";
+  }
+  if (w.rms > 0.0) {
+    s += std::string(inside ? " and" : "") + " between windows by " + FormatDouble("%.3g", w.rms) +
+         " " + w.unit + " rms per component beyond " + (inside ? "that" : "its errors");
+  }
+  return s + ": the events are steps beyond " + (inside && w.rms > 0.0 ? "both" : "that");
+}
+
+}  // namespace fastcal

@@ -13,6 +13,7 @@
 
 #include "fastcal/internal/block_arrow.h"
 #include "fastcal/internal/chi_square.h"
+#include "fastcal/internal/inner_wander.h"
 #include "fastcal/track.h"
 #include "fastcal/track_fold.h"
 
@@ -28,11 +29,13 @@ inline constexpr double kNPerKn = 1e3;
 // -2 ln(1 - sqrt(level)), 7.35 at 95% (3.84 left an overnight re-zeroing in the previous
 // day's blocks, the maximum over a day's cuts of noise alone).
 inline constexpr double kIntervalLevel = 0.95;
-// A change inside a window leaves at least this many of its blocks on either side: a
-// window's edge block (a minute or two of telemetry, its errors correlated over about as
-// long) placed an overnight move of 3 cm inside the day before in 1 of 7 months; a change
-// in a window's first or last blocks is dated at the boundary beside them.
-inline constexpr int kMinPartBlocks = 2;
+// A change inside a window leaves at least this many of its blocks on either side: every
+// boundary between a window's blocks is a candidate, the first and last minutes of a day
+// too (issue 53: with two, a re-zeroing 14 minutes before a day's end was put overnight,
+// its interval the night alone). A change on a window's edge and one between the windows
+// are then told apart, or not, by their likelihoods: the interval spans both where the
+// data cannot tell them apart.
+inline constexpr int kMinPartBlocks = 1;
 inline double LocationDrop() { return -2.0 * std::log(1.0 - std::sqrt(kIntervalLevel)); }
 
 // The fold's columns: the spec's free parameters and its consider ones, in spec order.
@@ -60,11 +63,11 @@ struct TrackWindowState {
   std::string label;
   double start_s = 0.0, end_s = 0.0, first_s = 0.0, last_s = 0.0;
   long long samples = 0;
-  std::vector<int> files;  // indices into TrackRun::files
-  std::string fold_file;   // in folds/ ("" before its first fold)
-  bool used = true;        // enough samples to be fitted
-  bool dirty = true;       // to fold at its point
-  bool folded = false;     // folded in this run
+  std::vector<int> files;        // indices into TrackRun::files
+  std::string fold_file;         // in folds/ ("" before its first fold)
+  bool used = true;              // enough samples to be fitted
+  bool dirty = true;             // to fold at its point
+  bool folded = false;           // folded in this run
   bool fold_considered = false;  // its fold, of this run, has the consider columns
   bool has_fold = false;
   WindowFold fold;
@@ -93,6 +96,19 @@ struct SharedEntry {
   // block before's last).
   bool inside = false;
   double step_time_s = 0.0, step_previous_s = 0.0;
+  // The likelihood interval of the step into this entry (or, for an entry `inside`, of the
+  // step inside its window): over the boundary and both windows' cuts (issue 53: a
+  // re-zeroing in a day's last minutes may be indistinguishable from one overnight).
+  bool has_interval = false;
+  double interval_low_s = 0.0, interval_high_s = 0.0;
+};
+
+// A per-window group's wander inside the windows (internal/inner_wander.h): a
+// Gauss-Markov process of its components within each window, estimated by REML from the
+// windows' block scores, in every covariance of the group once applied (ApplyWanderInside).
+struct GroupWanderState {
+  std::vector<int> group;  // indices into layout.window_columns
+  InnerWander inner;
 };
 
 struct TrackRun {
@@ -144,6 +160,11 @@ struct TrackRun {
   std::vector<int> splits;
   ArrowVector consider_x;
   Eigen::VectorXd consider_sigma;
+  // Each per-window group's wander inside the windows (WindowGroups' order), and whether
+  // it is in the problem's sandwich (ApplyWanderInside: each window's scale is then its
+  // misfit alone, run.birge, the time correlation being the wander's).
+  std::vector<GroupWanderState> wander_inside;
+  bool wander_applied = false;
 
   TrackStatus Fail(TrackStatus status, const std::string& why) const {
     *error = why;
@@ -185,6 +206,9 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error);
 // and the solve over it.
 TrackStatus FoldConsider(TrackRun& run);
 TrackStatus Uncertainties(TrackRun& run);
+// The windows' and the shared parameters' estimates with sigma_total (TrackResult), from
+// the solution and the sandwich as they stand.
+TrackStatus Results(TrackRun& run);
 // Used window u's solution minus its fold's point, per column (fold order).
 Eigen::VectorXd StepOf(const TrackRun& run, int u);
 // Its fold's gradient at the solution, g + H d (fold order).
@@ -204,6 +228,36 @@ Eigen::MatrixXd TotalCovariance(const TrackRun& run, int u, int v);
 // Stage helper of track_uncertainty.cc: each used window's widening f_w (run.widening,
 // and the problem's block scales).
 void ComputeWidening(TrackRun& run);
+
+// Stages of track_wander.cc: the wander of the per-window groups inside the windows.
+// The groups tested together: a vector quantity's axes, or one parameter (indices into
+// layout.window_columns).
+std::vector<std::vector<int>> WindowGroups(const TrackRun& run);
+// Group g's blocks in used window u at the joint fit (scores at the solution).
+WanderWindow WanderWindowOf(const TrackRun& run, int u, const std::vector<int>& g);
+// Estimates run.wander_inside[gi] over the used windows with use[u] (a change inside a
+// window leaves it out).
+void EstimateWanderInside(TrackRun& run, int gi, const std::vector<bool>& use);
+// Puts every group's wander into the problem's sandwich (ArrowBlock::extra; the scale each
+// window's misfit alone) and sets run.widening to it.
+void ApplyWanderInside(TrackRun& run);
+// What a covariance over used window u's scores needs of group gi's wander: K (Bp x Bp,
+// the blocks' averages; zero without a wander) and the blocks' rows of the group's
+// columns as columns (n x Bp over the fold's columns: column b p + x is block b's row of
+// component x). A linear function e^T (scores) then has wander variance (R^T e)^T K (R^T e).
+struct WanderExposure {
+  bool active = false;
+  Eigen::MatrixXd k;
+  Eigen::MatrixXd rows;
+  // The same rows in the window's local order [a; s] (LocalOrder), and M^-1 over those
+  // local variables times them (the joint fit's response to the window's scores).
+  Eigen::MatrixXd local_rows, formal_local_rows;
+};
+WanderExposure ExposureOf(const TrackRun& run, int u, int gi);
+// Group gi's wander inside windows as the result states it (TrackWander's inside_ fields).
+void DescribeWanderInside(const TrackRun& run, int gi, TrackWander* out);
+// The formal covariance M^-1 of used window u's local variables [a; s].
+Eigen::MatrixXd LocalFormal(const TrackRun& run, int u);
 
 // Stages of track_events.cc.
 TrackStatus ScanSensorSteps(TrackRun& run);
@@ -229,10 +283,9 @@ struct SplitScore {
 std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector<int>& rows,
                                    const std::vector<int>& columns, double scale,
                                    bool head = false);
-// The likelihood interval of a step inside a window from its scan (the contiguous blocks
-// whose statistic is within LocationDrop() of block j's), widened to the
-// blocks either side of them: the first sample of the block before the first such cut and
-// the last of the block after the last.
+// The likelihood interval of a step inside a window from its scan (the cuts whose statistic
+// is within LocationDrop() of cut j's), widened to the blocks either side of them: the first
+// sample of the block before the first such cut and the last of the block after the last.
 std::pair<double, double> SplitInterval(const TrackRun& run, int u,
                                         const std::vector<SplitScore>& scores, int j);
 
@@ -244,9 +297,10 @@ struct GroupTest {
 // Candidate cuts of the time line: every window boundary, and every block boundary
 // inside a window that leaves kMinPartBlocks on either side.
 int TimelineCandidates(const TrackRun& run);
-// Appends group g's events (indices into layout.window_columns) and sets its wander (SI
-// variance per component).
-void SegmentGroup(const TrackRun& run, const std::vector<int>& g, const GroupTest& test,
+// Appends group g's events (indices into layout.window_columns; run.wander_inside[gi] its
+// wander inside windows, estimated again without the windows its changes are inside) and
+// sets its day-to-day wander (SI variance per component).
+void SegmentGroup(TrackRun& run, const std::vector<int>& g, int gi, const GroupTest& test,
                   std::vector<TrackEvent>* out, double* wander);
 
 // Stages of track_output.cc.

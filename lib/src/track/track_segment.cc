@@ -71,18 +71,20 @@ bool operator==(const Cut& a, const Cut& b) { return a.u == b.u && a.j == b.j; }
 struct Split {
   bool valid = false;
   Eigen::VectorXd delta;       // the step inside the window (tail minus head)
-  Eigen::MatrixXd v;           // its covariance
+  Eigen::MatrixXd v;           // its covariance (the wander inside the window included)
   Eigen::MatrixXd g;           // I^-1 I+
-  Eigen::MatrixXd head, tail;  // the parts' covariances given b (widened)
+  Eigen::MatrixXd head, tail;  // the parts' covariances given b (their weights)
+  // Cov(delta, a_u) through the wander inside the window (zero without one: the step is a
+  // contrast of the window's white residuals, uncorrelated with its estimate).
+  Eigen::MatrixXd x;
 };
 
 // The group's time line at the joint fit.
 struct Line {
   int p = 0, windows = 0;
-  bool wanders = false;              // the steps inside windows judged against the whole widening
-  std::vector<Eigen::VectorXd> a;    // per window
-  std::vector<Eigen::MatrixXd> own;  // per window: its covariance given b (widened)
-  std::vector<Eigen::MatrixXd> cov;  // P_uv, u * windows + v
+  std::vector<Eigen::VectorXd> a;          // per window
+  std::vector<Eigen::MatrixXd> own;        // per window: its covariance given b (widened)
+  std::vector<Eigen::MatrixXd> cov;        // P_uv, u * windows + v
   std::vector<std::vector<Split>> splits;  // per window, per block j (0 unused)
   const Eigen::MatrixXd& P(int u, int v) const { return cov[u * windows + v]; }
 };
@@ -121,17 +123,43 @@ Eigen::MatrixXd Select(const Eigen::MatrixXd& m, const std::vector<int>& rows,
   return out;
 }
 
-// Window u's parts at each cut inside it (Split), from the scan of its blocks.
+// The blocks' information of the group, [I_b 1(lo <= b < hi)] as a p x Bp matrix.
+Eigen::MatrixXd BlockInformation(const WindowFold& f, const std::vector<int>& g,
+                                 const std::vector<int>& columns, int lo, int hi) {
+  const int p = static_cast<int>(g.size());
+  const int blocks = static_cast<int>(f.block_samples.size());
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(p, blocks * p);
+  for (int b = lo; b < hi; ++b) {
+    for (int x = 0; x < p; ++x) {
+      for (int y = 0; y < p; ++y) out(x, b * p + y) = f.block_information[b](g[x], columns[y]);
+    }
+  }
+  return out;
+}
+
+// Window u's parts at each cut inside it (Split), from the scan of its blocks; with the
+// wander inside the window (track_wander.cc) each part's exposure to it: the step's
+// efficient score is s = sum_{b >= j} s_b - L^T M_loc^-1 (scores), L the tail's cross
+// information with the window's local variables, so delta = -S^-1 s moves by
+// E_delta eta, E_delta = -S^-1 ([I_b 1(b >= j)] - L^T M_loc^-1 R^T); a_u by
+// E_a eta = -(M_loc^-1 R^T)_g eta; a part's own estimate given b by -I_part^-1 [I_b].
 std::vector<Split> WindowSplits(const TrackRun& run, int u, const std::vector<int>& g,
-                                bool wanders) {
+                                const WanderExposure& wander) {
   std::vector<int> columns;
   for (int x : g) columns.push_back(run.layout.window_columns[x]);
-  const double scale = wanders ? std::max(run.birge[u], run.widening[u]) : run.birge[u];
+  const double scale = run.birge[u];
   const std::vector<SplitScore> scores = ScanSplits(run, u, g, columns, scale);
   const WindowFold& f = run.windows[run.used[u]].fold;
   const Eigen::MatrixXd info = Select(f.information, columns, columns);
+  const int p = static_cast<int>(g.size());
+  const int blocks = static_cast<int>(scores.size());
+  Eigen::MatrixXd e_a;
+  if (wander.active) {
+    e_a.resize(p, wander.k.cols());
+    for (int x = 0; x < p; ++x) e_a.row(x) = -wander.formal_local_rows.row(g[x]);
+  }
   std::vector<Split> out(scores.size());
-  for (size_t j = 1; j < scores.size(); ++j) {
+  for (int j = 1; j < blocks; ++j) {
     const SplitScore& s = scores[j];
     const Eigen::MatrixXd after = s.after_information;
     const Eigen::MatrixXd before = info - after;
@@ -141,19 +169,34 @@ std::vector<Split> WindowSplits(const TrackRun& run, int u, const std::vector<in
     }
     Split& x = out[j];
     const Eigen::MatrixXd s_inverse = Inverse(s.schur);
+    const Eigen::MatrixXd before_inverse = Inverse(before), after_inverse = Inverse(after);
     x.delta = -s_inverse * s.score;
     x.v = s_inverse * scale;
     x.g = info.ldlt().solve(after);
-    x.head = Inverse(before) * run.widening[u];
-    x.tail = Inverse(after) * run.widening[u];
+    x.head = before_inverse * scale;
+    x.tail = after_inverse * scale;
+    x.x = Eigen::MatrixXd::Zero(p, p);
+    if (wander.active) {
+      // The tail's cross information with the local variables, from the blocks' rows.
+      Eigen::MatrixXd local = Eigen::MatrixXd::Zero(wander.local_rows.rows(), p);
+      for (int b = j; b < blocks; ++b) local += wander.local_rows.middleCols(b * p, p);
+      const Eigen::MatrixXd tail_blocks = BlockInformation(f, g, columns, j, blocks);
+      const Eigen::MatrixXd e_delta =
+          -s_inverse * (tail_blocks - local.transpose() * wander.formal_local_rows);
+      const Eigen::MatrixXd e_head = -before_inverse * BlockInformation(f, g, columns, 0, j);
+      const Eigen::MatrixXd e_tail = -after_inverse * tail_blocks;
+      x.v += e_delta * wander.k * e_delta.transpose();
+      x.x = e_delta * wander.k * e_a.transpose();
+      x.head += e_head * wander.k * e_head.transpose();
+      x.tail += e_tail * wander.k * e_tail.transpose();
+    }
     x.valid = true;
   }
   return out;
 }
 
-Line BuildLine(const TrackRun& run, const std::vector<int>& g, bool wanders) {
+Line BuildLine(const TrackRun& run, const std::vector<int>& g, int gi) {
   Line line;
-  line.wanders = wanders;
   line.p = static_cast<int>(g.size());
   line.windows = static_cast<int>(run.used.size());
   const int n = line.windows;
@@ -161,11 +204,22 @@ Line BuildLine(const TrackRun& run, const std::vector<int>& g, bool wanders) {
     const ArrowBlock& k = run.problem.blocks[u];
     Eigen::MatrixXd own = k.h.topLeftCorner(k.p, k.p);
     own.diagonal() += k.prior_information;
-    line.own.push_back(Select(Inverse(own), g, g) * run.widening[u]);
+    const Eigen::MatrixXd own_inverse = Inverse(own);
+    const WanderExposure wander = ExposureOf(run, u, gi);
+    Eigen::MatrixXd c = Select(own_inverse, g, g) * run.widening[u];
+    if (wander.active) {
+      // The window's estimate given b moves by -A^-1 (R^T eta)_a.
+      Eigen::MatrixXd e(line.p, wander.k.cols());
+      for (int x = 0; x < line.p; ++x) {
+        e.row(x) = -own_inverse.row(g[x]) * wander.local_rows.topRows(k.p);
+      }
+      c += e * wander.k * e.transpose();
+    }
+    line.own.push_back(c);
     Eigen::VectorXd a(line.p);
     for (int x = 0; x < line.p; ++x) a[x] = run.solver.a(u)[g[x]];
     line.a.push_back(a);
-    line.splits.push_back(WindowSplits(run, u, g, wanders));
+    line.splits.push_back(WindowSplits(run, u, g, wander));
   }
   line.cov.resize(static_cast<size_t>(n) * n);
   for (int u = 0; u < n; ++u) {
@@ -272,7 +326,10 @@ struct Contrast {
   double statistic = 0.0;
 };
 
-// Var(d) for d = sum over the sides (sign -1 before, +1 after) of K (sum W x).
+// Var(d) for d = sum over the sides (sign -1 before, +1 after) of K (sum W x). A part of
+// window u is a_u + gain delta: its a_u through the joint sandwich (P), its delta through
+// V, the two through the wander inside the window (Split::x); the day-to-day wander v is
+// one effect per window, which the two parts of a window share.
 Eigen::MatrixXd ContrastCovariance(const Line& line, const Sums& s, const Side* sides) {
   const int p = line.p;
   struct Single {
@@ -286,7 +343,6 @@ Eigen::MatrixXd ContrastCovariance(const Line& line, const Sums& s, const Side* 
     for (const Part& part : sides[x].parts) {
       const Eigen::MatrixXd alpha = sign * sides[x].k * PartWeight(line, s, part);
       singles.push_back({part.u, part.j, alpha, alpha * PartGain(line, part)});
-      out += s.v * alpha * alpha.transpose();
     }
     out += s.v * sides[x].k * (s.sww[sides[x].hi] - s.sww[sides[x].lo]) * sides[x].k.transpose();
   }
@@ -302,7 +358,15 @@ Eigen::MatrixXd ContrastCovariance(const Line& line, const Sums& s, const Side* 
     }
   }
   for (const Single& i : singles) {
-    for (const Single& k : singles) out += i.alpha * line.P(i.u, k.u) * k.alpha.transpose();
+    for (const Single& k : singles) {
+      out += i.alpha * line.P(i.u, k.u) * k.alpha.transpose();
+      if (i.u != k.u) continue;
+      // One window's parts: the day's wander once, and delta with a_u through the wander
+      // inside the window (the parts of one window are of one split).
+      out += s.v * i.alpha * k.alpha.transpose();
+      const Eigen::MatrixXd t = i.beta * line.splits[i.u][i.j].x * k.alpha.transpose();
+      out += t + t.transpose();
+    }
   }
   // The steps inside windows: the two parts of one split share its delta.
   std::vector<bool> done(singles.size(), false);
@@ -449,27 +513,24 @@ std::pair<double, double> CutTimes(const TrackRun& run, const Cut& c) {
   return {w.fold.block_last_time_s[c.j - 1], w.fold.block_first_time_s[c.j]};
 }
 
-// The change's likelihood interval: the contiguous candidates around it (between its
-// neighbours lo and hi) whose T is within LocationDrop() of its own.
+// The change's likelihood interval: the candidates between its neighbours lo and hi whose
+// T is within LocationDrop() of its own (Hinkley 1970), as their first and last: a set of
+// moments that may span a window's last blocks, the night and the next one's first.
 struct Span {
   Cut first, last;
 };
 Span Interval(const Line& line, const Sums& s, const Cut& lo, const Cut& cut, const Cut& hi,
               double t) {
-  const std::vector<Cut> candidates = Candidates(line);
   const double floor = t - LocationDrop();
-  const int at =
-      static_cast<int>(std::find(candidates.begin(), candidates.end(), cut) - candidates.begin());
-  const auto inside = [&](int k) {
-    if (k < 0 || k >= static_cast<int>(candidates.size())) return false;
-    if (!(lo < candidates[k]) || !(candidates[k] < hi)) return false;
-    const Contrast c = ContrastAt(line, s, lo, candidates[k], hi);
-    return c.valid && c.statistic >= floor;
-  };
-  int first = at, last = at;
-  while (inside(first - 1)) --first;
-  while (inside(last + 1)) ++last;
-  return {candidates[first], candidates[last]};
+  Span span{cut, cut};
+  for (const Cut& c : Candidates(line)) {
+    if (!(lo < c) || !(c < hi)) continue;
+    const Contrast k = ContrastAt(line, s, lo, c, hi);
+    if (!k.valid || k.statistic < floor) continue;
+    if (c < span.first) span.first = c;
+    if (span.last < c) span.last = c;
+  }
+  return span;
 }
 
 // A change on a window's edge cannot be told from one between the windows: when a
@@ -494,29 +555,44 @@ void PreferBoundaries(const Line& line, const Sums& s, std::vector<Cut>* cuts) {
   }
 }
 
-// The changes of the group and its wander (track_segment.cc's header): the wander from
-// every boundary first (robust to a few steps), then from those no change found
-// touches, until the changes stand.
-std::vector<Cut> FindCuts(const TrackRun& run, const std::vector<int>& g, double threshold,
+// The used windows the wander inside windows is estimated from: not those a change is
+// inside (a cut of the group, or a sensor's step inside a window).
+std::vector<bool> WanderWindows(const TrackRun& run, const std::vector<Cut>& cuts) {
+  std::vector<bool> use(run.used.size(), true);
+  for (const Cut& c : cuts) {
+    if (c.j > 0) use[c.u] = false;
+  }
+  for (size_t u = 0; u < run.used.size(); ++u) {
+    for (int e : run.entry_of[u]) use[u] = use[u] && !run.shared[e].inside;
+  }
+  return use;
+}
+
+// The changes of the group and its wanders (track_segment.cc's header): the wander inside
+// windows and the day-to-day wander from every window and boundary first (a few steps
+// leave the median alone; the estimate inside windows leaves out those it cannot explain),
+// then without the windows and boundaries the changes found touch, until they stand.
+std::vector<Cut> FindCuts(TrackRun& run, const std::vector<int>& g, int gi, double threshold,
                           Line* line, double* wander) {
-  *line = BuildLine(run, g, false);
+  *line = BuildLine(run, g, gi);
   double v = CleanWander(*line, {});
   std::vector<Cut> cuts;
   for (int round = 0; round < kMaxWanderRounds; ++round) {
-    // A group that wanders is scanned inside a window against the window's whole
-    // widening, its residuals' correlation in time included: a wander is not a step.
-    if (line->wanders != (v > 0.0)) *line = BuildLine(run, g, v > 0.0);
     const Sums s = BuildSums(*line, v);
     std::vector<Cut> found = Segment(*line, s, threshold);
     PreferBoundaries(*line, s, &found);
-    const double next = CleanWander(*line, found);
     const bool same =
         found.size() == cuts.size() && std::equal(found.begin(), found.end(), cuts.begin());
+    if (!same) {
+      EstimateWanderInside(run, gi, WanderWindows(run, found));
+      ApplyWanderInside(run);
+      *line = BuildLine(run, g, gi);
+    }
+    const double next = CleanWander(*line, found);
     cuts = found;
     if (same && std::abs(next - v) <= kWanderSettled * v) break;
     v = next;
   }
-  if (line->wanders != (v > 0.0)) *line = BuildLine(run, g, v > 0.0);
   *wander = v;
   return cuts;
 }
@@ -532,13 +608,13 @@ int TimelineCandidates(const TrackRun& run) {
   return count;
 }
 
-void SegmentGroup(const TrackRun& run, const std::vector<int>& g, const GroupTest& test,
+void SegmentGroup(TrackRun& run, const std::vector<int>& g, int gi, const GroupTest& test,
                   std::vector<TrackEvent>* out, double* wander) {
   const int p = static_cast<int>(g.size());
   const double threshold = ChiSquareQuantile(run.options.false_alarm / test.tests, p);
   Line line;
   double v = 0.0;
-  const std::vector<Cut> cuts = FindCuts(run, g, threshold, &line, &v);
+  const std::vector<Cut> cuts = FindCuts(run, g, gi, threshold, &line, &v);
   *wander = v;
   const Sums s = BuildSums(line, v);
   const std::vector<Cut> b = Bounded(line, cuts);

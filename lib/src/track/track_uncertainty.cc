@@ -61,6 +61,21 @@ void ConsiderSensitivity(TrackRun& run) {
   run.consider_x = run.solver.SolveFor(cross);
 }
 
+// The wander variance (every group's, inside window u) of the score of fold column
+// `column` profiled over the window's local variables (`local`: its cross information with
+// them): e = R_c - R^T M_loc^-1 local, var = e^T K e per group.
+double WanderScoreVariance(const TrackRun& run, int u, int column, const Eigen::VectorXd& local) {
+  double variance = 0.0;
+  for (size_t gi = 0; gi < run.wander_inside.size(); ++gi) {
+    const WanderExposure x = ExposureOf(run, u, static_cast<int>(gi));
+    if (!x.active) continue;
+    const Eigen::VectorXd e =
+        x.rows.row(column).transpose() - x.formal_local_rows.transpose() * local;
+    variance += e.dot(x.k * e);
+  }
+  return variance;
+}
+
 // Variance of entry e of b: sandwich plus consider.
 double SharedVariance(const TrackRun& run, int e) {
   double v = run.solver.SandwichBB()(e, e);
@@ -89,7 +104,8 @@ void SensorOffsets(const TrackRun& run, int u, TrackWindow* out) {
     TrackEstimate& o = out->offset_kn[s.index];
     o.value = (run.solver.b()[e] - gradient[column] / a) / s.to_si;
     o.sigma_formal = std::sqrt(1.0 / a + run.solver.FormalBB()(e, e)) / s.to_si;
-    o.sigma_total = std::sqrt(run.widening[u] / a + SharedVariance(run, e)) / s.to_si;
+    const double wander = WanderScoreVariance(run, u, column, local[u]) / (a * a);
+    o.sigma_total = std::sqrt(run.widening[u] / a + wander + SharedVariance(run, e)) / s.to_si;
     out->has_offsets = true;
   }
 }
@@ -143,16 +159,35 @@ void ComputeWidening(TrackRun& run) {
     double birge = 1.0;
     if (nu > 0.0 && chi2 / nu > 1.0 + 3.0 * std::sqrt(2.0 / nu)) birge = chi2 / nu;
     run.birge[u] = birge;
-    run.widening[u] = std::max(birge, BlockWidening(run, f, d));
+    // With the groups' wander inside the windows in the sandwich, the scores' correlation
+    // in time is its (ApplyWanderInside); before, the blocks' spread stands for it.
+    run.widening[u] = run.wander_applied ? birge : std::max(birge, BlockWidening(run, f, d));
     run.problem.blocks[u].scale = run.widening[u];
   }
 }
 
 TrackStatus Uncertainties(TrackRun& run) {
-  TrackResult& r = *run.result;
   ComputeWidening(run);
   ConsiderSensitivity(run);
+  // Each group's wander inside the windows, from every window (those the model cannot
+  // explain, a change inside them, left out by the estimate itself); the events' stage
+  // estimates it again without the windows its changes are in.
+  run.wander_inside.clear();
+  run.wander_applied = false;
+  const std::vector<bool> every(run.used.size(), true);
+  for (const std::vector<int>& g : WindowGroups(run)) {
+    run.wander_inside.push_back({g, InnerWander()});
+    EstimateWanderInside(run, static_cast<int>(run.wander_inside.size()) - 1, every);
+  }
+  ApplyWanderInside(run);
+  return Results(run);
+}
+
+TrackStatus Results(TrackRun& run) {
+  TrackResult& r = *run.result;
   r.windows.clear();
+  r.samples = r.readings = r.gross_errors = 0;
+  r.chi_square = 0.0;
   r.files.clear();
   for (const TrackFile& f : run.files) r.files.push_back(f.path);
   r.updated = run.update;
