@@ -1,0 +1,322 @@
+#!/usr/bin/env python3
+"""Coverage study of a season's answers (issue 53; docs/calibration.md, "Tracking over a
+season", "Events: intervals, sizes and false alarms on independent seasons"): events at
+moments drawn at random over a season's observing time and nights, on telemetry with
+errors the track does not model.
+
+Each season: DAYS observing days of HOURS h from 20:00 UTC (sources tracked at the
+sidereal rate, `simulate --trajectory=tracks`, 2 s apart), each day simulated on its own
+(its own seed; a cabin with moving parts splits the feed's tilt between the cabin and the
+rotator by a fraction drawn per day from 0.25-0.55), with
+  3 % white tension noise, a 1.5 % slow sensor error of ~70 s, gain and bias spreads of
+  1 % and 1.5 kN, an attitude-control error of 0.3 deg AR(1) with a 60 s memory, 1 cm of
+  position noise, and the mass centre wandering inside each day by WANDER mm per axis (a
+  Gauss-Markov process of time constant TAU, made of zero mean over each day or not),
+the conditions drawn per season from CONDITIONS below. EVENTS events per season, at least
+two days apart: a move of the mass centre of 1-4 cm in a random horizontal direction, or a sensor
+re-zeroed by 2-5 kN (either sign, a random cable), each at a moment drawn uniformly over
+one of: a day's observing time (mid-track or between tracks), the first or last 15
+minutes of a day, or a night. Tracked with calibration_data/spec_track.yaml (or
+spec_track_moving_parts.yaml from a first moment of 0).
+
+Per event: found (one event of its kind, and cable, within a day of the truth), the
+truth inside the stated interval [time_low, time_high], the shifts' pulls (shift - truth)
+/ sigma_total per component, the interval's width, dated to 15 minutes; per season: the
+events reported that match no truth. `null` seasons have no event: the fraction that
+report any is the false-alarm rate.
+
+Usage: scripts/season_answers_study.py events|null [--seasons=40] [--first-seed=1]
+           [--days=15] [--hours=2] [--events=5] [--parts] [--work=DIR] [--jobs=2]
+Prints one line per season, then the table (docs/calibration.md's). Needs build/bin/fastcal
+(scripts/build.sh).
+"""
+import argparse
+import datetime
+import json
+import math
+import multiprocessing
+import os
+import random
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+BIN = os.environ.get("FASTCAL_BIN", os.path.join(ROOT, "build", "bin", "fastcal"))
+START = datetime.datetime(2024, 5, 1, 20, 0, 0, tzinfo=datetime.timezone.utc)
+DAY = 86400.0
+INTERVAL = 2.0
+MASS_CENTRE = (0.22, 0.11, 0.5)
+# (wander per axis in m, its time constant in s, centred per day): drawn per season.
+CONDITIONS = [(0.005, 600.0, True), (0.005, 1800.0, True), (0.003, 300.0, False),
+              (0.008, 900.0, True), (0.005, 7200.0, True), (0.005, 600.0, False)]
+COMMON = ["--trajectory=tracks", "--interval-s=%g" % INTERVAL, "--track-minutes=20,60",
+          "--max-off-axis-deg=35", "--tension-noise-percent=3", "--tension-drift-percent=1.5",
+          "--tension-drift-time-s=70", "--attitude-control-deg=0.3",
+          "--attitude-control-time-s=60", "--position-noise-m=0.01",
+          "--sensor-gain-spread-percent=1", "--sensor-bias-spread-kN=1.5"]
+EDGE_S = 15 * 60.0   # the first or last minutes of a day
+DATED_S = 15 * 60.0  # "pinned": the point within this of the truth
+
+
+def iso(t):
+    return datetime.datetime.fromtimestamp(t, datetime.timezone.utc).strftime(
+        "%Y-%m-%dT%H:%M:%SZ")
+
+
+def draw_events(rng, days, hours, count):
+    """Events at least two days apart: (kind, time_s, place, shift, cable)."""
+    day_s = hours * 3600.0
+    start = START.timestamp()
+    slots = list(range(1, days - 1))
+    rng.shuffle(slots)
+    chosen = []
+    for d in slots:
+        if all(abs(d - c) >= 2 for c in chosen):
+            chosen.append(d)
+        if len(chosen) == count:
+            break
+    events = []
+    for d in sorted(chosen):
+        place = rng.choice(["day", "day", "edge", "night", "night"])
+        day0 = start + d * DAY
+        if place == "day":
+            t = day0 + rng.uniform(EDGE_S, day_s - EDGE_S)
+        elif place == "edge":
+            t = day0 + (rng.uniform(0, EDGE_S) if rng.random() < 0.5
+                        else rng.uniform(day_s - EDGE_S, day_s - INTERVAL))
+        else:  # the night before day d
+            t = day0 - DAY + day_s + rng.uniform(0, DAY - day_s)
+        if rng.random() < 0.5:
+            # Horizontal: a move along z shows only through the tilt, by a tenth as much.
+            size = rng.uniform(0.01, 0.04)
+            phi = rng.uniform(0, 2 * math.pi)
+            shift = (size * math.cos(phi), size * math.sin(phi), 0.0)
+            events.append(("parameter", t, place, shift, 0))
+        else:
+            size = rng.uniform(2.0, 5.0) * rng.choice([-1, 1])
+            events.append(("sensor", t, place, (size,), rng.randint(1, 6)))
+    return events
+
+
+def simulate_season(work, seed, args, events, condition):
+    rng = random.Random(seed * 7919)
+    wander, tau, centred = condition
+    truth = os.path.join(ROOT, "calibration_data", "moving_parts.yaml") if args.parts else None
+    model = None
+    if args.parts:
+        moment = rng.choice([1500, 6000])
+        text = open(truth).read()
+        with open(os.path.join(work, "truth.yaml"), "w") as f:
+            f.write(text.replace("first_moment_kg_m: [0, 0, -6000]",
+                                 "first_moment_kg_m: [0, 0, -%d]" % moment))
+        with open(os.path.join(work, "start.yaml"), "w") as f:
+            f.write(text.replace("first_moment_kg_m: [0, 0, -6000]",
+                                 "first_moment_kg_m: [0, 0, 0]"))
+        truth = os.path.join(work, "truth.yaml")
+        model = os.path.join(work, "start.yaml")
+    steps = ";".join("%s:%.6f,%.6f,%.6f" % ((iso(e[1]),) + e[3])
+                     for e in events if e[0] == "parameter")
+    rezero = ";".join("%s:%d:%.4f" % (iso(e[1]), e[4], e[3][0])
+                      for e in events if e[0] == "sensor")
+    files = []
+    samples = int(args.hours * 3600 / INTERVAL)
+    for d in range(args.days):
+        out = os.path.join(work, "d%02d.csv" % d)
+        flags = COMMON + ["--samples=%d" % samples, "--start=%s" % iso(START.timestamp() + d * DAY),
+                          "--mass-centre=%g,%g,%g" % MASS_CENTRE,
+                          "--mass-centre-drift-m=%g" % wander,
+                          "--mass-centre-drift-time-s=%g" % tau, "--force", "--out=" + out]
+        if centred:
+            flags.append("--mass-centre-drift-centred")
+        if steps:
+            flags.append("--mass-centre-step=" + steps)
+        if rezero:
+            flags.append("--sensor-step=" + rezero)
+        if truth:
+            flags += ["--truth=" + truth, "--joint-law=focal", "--prismatic-spread-m=0.05",
+                      "--tilt-fraction=%.3f" % rng.uniform(0.25, 0.55)]
+        # The truth's sensor spreads drawn once: the same seed's draws for every day would
+        # repeat the day's noise, so each day has its own seed and the spreads come from
+        # the first day's truth model.
+        if d > 0:
+            flags += ["--truth=" + first_truth]
+            flags = [f for f in flags if not f.startswith("--sensor-gain-spread") and
+                     not f.startswith("--sensor-bias-spread")]
+            if truth:
+                flags.remove("--truth=" + truth)
+        ok = False
+        for attempt in range(5):
+            r = subprocess.run([BIN, "simulate"] + flags + ["--seed=%d" % (seed * 1000 + d * 10
+                                                                         + attempt)],
+                               capture_output=True, text=True)
+            if r.returncode == 0:
+                ok = True
+                break
+        if not ok:
+            raise RuntimeError("simulate day %d: %s" % (d, r.stderr.strip()))
+        if d == 0:
+            first_truth = os.path.join(work, "first.truth.yaml")
+            shutil.copy(out[:-4] + ".truth.yaml", first_truth)
+        files.append(out)
+    return files, model
+
+
+def track(work, files, model, args):
+    spec = "spec_track_moving_parts.yaml" if args.parts else "spec_track.yaml"
+    cmd = [BIN, "track", "--quiet", "--spec=" + os.path.join(ROOT, "calibration_data", spec),
+           "--data=" + ",".join(files), "--out=" + os.path.join(work, "track")]
+    if model:
+        cmd.append("--model=" + model)
+    r = subprocess.run(cmd, capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError("track: " + r.stderr.strip()[-400:])
+    with open(os.path.join(work, "track", "events.json")) as f:
+        return json.load(f), r.stdout
+
+
+def judge(events, reported):
+    """Per true event its verdict; the reported events no truth claims."""
+    claimed = set()
+    verdicts = []
+    for kind, t, place, shift, cable in events:
+        best = None
+        for k, e in enumerate(reported["events"]):
+            if k in claimed or e["kind"] != kind:
+                continue
+            if kind == "sensor" and e.get("cables") != [cable]:
+                continue
+            if abs(e["time_s"] - t) > 1.5 * DAY and abs(e["after_s"] - t) > 1.5 * DAY:
+                continue
+            if best is None or abs(e["time_s"] - t) < abs(reported["events"][best]["time_s"] - t):
+                best = k
+        v = {"kind": kind, "place": place, "found": best is not None, "time": iso(t),
+             "truth": list(shift), "cable": cable}
+        if best is not None:
+            claimed.add(best)
+            e = reported["events"][best]
+            v["covered"] = e["time_low_s"] <= t <= e["time_high_s"]
+            v["width_s"] = e["time_high_s"] - e["time_low_s"]
+            point = e["time_s"] if e["within_window"] else None
+            v["dated"] = (point is not None and abs(point - t) <= DATED_S) or (
+                not e["within_window"] and e["after_s"] <= t <= e["time_s"])
+            names = list(e["parameters"].keys())
+            truth = shift if kind == "parameter" else shift
+            v["pulls"] = [(e["parameters"][n]["shift"] - truth[i]) / e["parameters"][n]["sigma_total"]
+                          for i, n in enumerate(names)]
+            v["size"] = math.sqrt(sum(x * x for x in shift))
+        verdicts.append(v)
+    false = [e for k, e in enumerate(reported["events"]) if k not in claimed]
+    return verdicts, false
+
+
+def run_season(job):
+    seed, args = job
+    rng = random.Random(seed)
+    condition = CONDITIONS[seed % len(CONDITIONS)]
+    events = [] if args.mode == "null" else draw_events(rng, args.days, args.hours, args.events)
+    work = os.path.join(args.work, "season_%d" % seed)
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    try:
+        files, model = simulate_season(work, seed, args, events, condition)
+        reported, console = track(work, files, model, args)
+    except RuntimeError as e:
+        return {"seed": seed, "error": str(e)}
+    verdicts, false = judge(events, reported)
+    state = json.load(open(os.path.join(work, "track", "track_state.json")))
+    converged = "did not converge" not in console
+    if not args.keep:
+        shutil.rmtree(work, ignore_errors=True)
+    return {"seed": seed, "condition": condition, "verdicts": verdicts,
+            "false": [(e["kind"], e["time"]) for e in false], "converged": converged,
+            "wander": reported["wander"]}
+
+
+def rate(k, n):
+    if n == 0:
+        return "-"
+    p = k / n
+    return "%d/%d = %.3f +- %.3f" % (k, n, p, math.sqrt(max(p * (1 - p), 1e-12) / n))
+
+
+def summarise(results, args):
+    verdicts = [v for r in results if "verdicts" in r for v in r["verdicts"]]
+    found = [v for v in verdicts if v["found"]]
+    print("\nseasons %d (errors %d), events %d, found %s" % (
+        len(results), sum("error" in r for r in results), len(verdicts),
+        rate(len(found), len(verdicts))))
+    print("seasons with a false event: %s; false events %d" % (
+        rate(sum(bool(r.get("false")) for r in results if "verdicts" in r),
+             sum("verdicts" in r for r in results)),
+        sum(len(r.get("false", [])) for r in results)))
+    print("not converged: %d" % sum(not r.get("converged", True) for r in results))
+    for label, sel in [("all", lambda v: True), ("mass centre", lambda v: v["kind"] == "parameter"),
+                       ("sensor", lambda v: v["kind"] == "sensor"),
+                       ("inside a day", lambda v: v["place"] == "day"),
+                       ("a day's edge", lambda v: v["place"] == "edge"),
+                       ("overnight", lambda v: v["place"] == "night")]:
+        group = [v for v in found if sel(v)]
+        if not group:
+            continue
+        pulls = [p for v in group for p in v["pulls"]]
+        spread = statistics.pstdev(pulls) if len(pulls) > 1 else float("nan")
+        within = sum(abs(p) <= 2.5 for p in pulls)
+        widths = sorted(v["width_s"] for v in group if v["place"] != "night")
+        median_width = ("%.1f min" % (statistics.median(widths) / 60.0)) if widths else "-"
+        print("  %-13s found %3d  interval holds the truth %s  pulls sd %.2f (|pull| <= 2.5: %s)"
+              "  median width (in days) %s  dated %s" % (
+                  label, len(group), rate(sum(v["covered"] for v in group), len(group)), spread,
+                  rate(within, len(pulls)), median_width,
+                  rate(sum(v["dated"] for v in group), len(group))))
+    moves = [v for v in found if v["kind"] == "parameter" and v["place"] in ("day", "edge")]
+    for lo, hi in [(0.01, 0.02), (0.02, 0.03), (0.03, 0.04)]:
+        group = [v for v in moves if lo <= v["size"] < hi]
+        print("  moves of %d-%d cm inside a day: pinned to 15 min %s" % (
+            lo * 100, hi * 100, rate(sum(v["dated"] for v in group), len(group))))
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("mode", choices=["events", "null"])
+    parser.add_argument("--seasons", type=int, default=40)
+    parser.add_argument("--first-seed", type=int, default=1)
+    parser.add_argument("--days", type=int, default=15)
+    parser.add_argument("--hours", type=float, default=2.0)
+    parser.add_argument("--events", type=int, default=5)
+    parser.add_argument("--parts", action="store_true", help="a cabin with moving parts")
+    parser.add_argument("--work", default=None)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--keep", action="store_true", help="keep each season's files")
+    args = parser.parse_args()
+    if args.work is None:
+        args.work = tempfile.mkdtemp(prefix="season_answers_")
+    os.makedirs(args.work, exist_ok=True)
+    jobs = [(s, args) for s in range(args.first_seed, args.first_seed + args.seasons)]
+    results = []
+    with multiprocessing.Pool(args.jobs) as pool:
+        for r in pool.imap_unordered(run_season, jobs):
+            results.append(r)
+            if "error" in r:
+                print("seed %d: %s" % (r["seed"], r["error"]), flush=True)
+                continue
+            v = r["verdicts"]
+            print("seed %d %s: events %d found %d covered %d false %s%s" % (
+                r["seed"], r["condition"], len(v), sum(x["found"] for x in v),
+                sum(x.get("covered", False) for x in v), r["false"],
+                "" if r["converged"] else " NOT CONVERGED"), flush=True)
+            for x in v:
+                if not x["found"] or not x["covered"]:
+                    print("    %s %s %s at %s %s%s" % (
+                        "missed" if not x["found"] else "not covered", x["kind"], x["place"],
+                        x["time"], ["%.4g" % y for y in x["truth"]],
+                        " cable %d" % x["cable"] if x["kind"] == "sensor" else ""), flush=True)
+    with open(os.path.join(args.work, "results.json"), "w") as f:
+        json.dump(results, f)
+    summarise(results, args)
+
+
+if __name__ == "__main__":
+    main()
