@@ -75,6 +75,8 @@ double ReadingWhitener::Step(double time_s, int session, const double* rho, cons
       filter.Predict(phi);
     }
     const bool update = excluded == nullptr || !excluded[i];
+    if (observer_ != nullptr)
+      observer_->Reading(i, fresh ? 0.0 : phi, fresh, rho[i], update, filter);
     const double f = filter.Innovate(rho[i], rows + i * columns_, update);
     if constexpr (kLikelihood) {
       const double term = update ? std::log(f) : 0.0;

@@ -52,6 +52,8 @@ class SampleRowWhitener {
  public:
   SampleRowWhitener(const FittedSamples& samples, int columns);
   bool active() const { return whitener_.active(); }
+  // ReadingWhitener::set_observer of the pass's filters.
+  void set_observer(WhitenObserver* observer) { whitener_.set_observer(observer); }
   // Whitens the rows of fitted samples rows->begin .. end (`index` maps a row's position
   // to its fitted sample when the pass runs over a subset; null: the identity). Call for
   // the chunks of a pass in order.

@@ -41,11 +41,28 @@ class SlowErrorFilter {
   // Whitens row[0 .. columns) in place (x -> x~) and returns F; the state takes the
   // reading in when `update`.
   double Innovate(double rho, double* row, bool update);
+  // Before the next Innovate (after Predict or Reset): its prior P- and the prior mean m-
+  // of column c (a series' first reading: 1 and 0).
+  double PriorVariance() const { return fresh_ ? 1.0 : p_; }
+  // The next reading starts the filter afresh (nothing taken in yet).
+  bool Fresh() const { return fresh_; }
+  double PriorMean(int c) const { return fresh_ ? 0.0 : mean_[c]; }
 
  private:
   std::vector<double> mean_;  // E[u | readings so far], per column
   double p_ = 1.0;            // Var[u | readings so far]
   bool fresh_ = true;         // the next reading starts a series
+};
+
+// What a pass's filters did to each reading, for the exact whitening of a step that starts
+// at a reading (internal/step_scan.h): called for each cable's reading before it is
+// innovated, with the prediction's phi (0 where the reading starts a series), rho, and the
+// filter's prior (its variance, and its mean of each column).
+class WhitenObserver {
+ public:
+  virtual ~WhitenObserver() = default;
+  virtual void Reading(int cable, double phi, bool fresh, double rho, bool update,
+                       const SlowErrorFilter& prior) = 0;
 };
 
 // The six cables' filters over a pass's samples in time order (file order); or those of
@@ -58,6 +75,8 @@ class ReadingWhitener {
                   int end_cable = kNumCables);
 
   bool active() const { return active_; }
+  // Told of every reading from now on (null: none); not owned.
+  void set_observer(WhitenObserver* observer) { observer_ = observer; }
   // One sample: `rows` holds its six readings' rows, cable i's at rows + i * columns;
   // rho[i] = sigma_e / s of cable i's reading; excluded (may be null) the readings that do
   // not update the state. Returns sum log F over the readings that updated it (in cable
@@ -88,6 +107,7 @@ class ReadingWhitener {
   double previous_time_s_ = 0.0;
   int previous_session_ = 0;
   double last_dt_s_ = -1.0, last_phi_ = 0.0;
+  WhitenObserver* observer_ = nullptr;
 };
 
 }  // namespace fastcal::internal
