@@ -161,8 +161,7 @@ std::string SummaryHead(const TrackResult& r) {
   }
   head << ", " << count(r.samples, "sample", "samples") << " from "
        << count(static_cast<long long>(r.files.size()), "file", "files") << "; "
-       << count(r.iterations, "Gauss-Newton iteration", "Gauss-Newton iterations") << " ("
-       << (r.converged ? "converged" : "NOT converged") << "), " << count(r.folds, "fold", "folds")
+       << DescribeGaussNewton(r) << ", " << count(r.folds, "fold", "folds")
        << (r.updated ? " (an update)" : "") << "; chi2/nu "
        << internal::FormatDouble("%.3f", r.reduced_chi_square);
   std::string s = Wrapped(head.str(), "", "  ", kSentenceLines, "track.html");

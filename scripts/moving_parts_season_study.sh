@@ -65,7 +65,7 @@ for day, row in enumerate(rows):
 qz = re.search(r"first_moment_kg_m.z = (\S+) \+- (\S+)", log)
 dated = "between 2024-05-08T20:39:58Z and 2024-05-09T20:00:00Z: mass_centre_m.x" in log
 print(f"seed {seed}: events {events.group(1) if events else '?'}, within 2.5 sigma "
-      f"{inside}/{total}, converged {'(converged)' in log}, Q_z {qz.group(1)} +- "
+      f"{inside}/{total}, converged {'converged in' in ' '.join(log.split())}, Q_z {qz.group(1)} +- "
       f"{qz.group(2)} kg m (truth {-moment:g}), move dated {dated}")
 PY
 done

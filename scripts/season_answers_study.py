@@ -212,6 +212,33 @@ def judge(events, reported):
     return verdicts, false
 
 
+def judge_days(work, events, condition):
+    """Per day-axis of the mass centre: within 2.5 sigma_total of the truth (the level the
+    day's wander is about, plus the moves before the day; days with a move inside left
+    out, and every day where the wander is not made of zero mean per day)."""
+    if not condition[2]:
+        return []
+    import csv
+    out = []
+    with open(os.path.join(work, "track", "track.csv")) as f:
+        for row in csv.DictReader(f):
+            start = datetime.datetime.strptime(row["window_start"], "%Y-%m-%dT%H:%M:%SZ").replace(
+                tzinfo=datetime.timezone.utc).timestamp()
+            first, last = start + 20 * 3600.0, start + DAY
+            moves = [e for e in events if e[0] == "parameter"]
+            if any(first <= e[1] < last for e in moves):
+                continue
+            truth = list(MASS_CENTRE)
+            for e in moves:
+                if e[1] < first:
+                    truth = [truth[a] + e[3][a] for a in range(3)]
+            for a, axis in enumerate("xyz"):
+                value = float(row["mass_centre_m.%s" % axis])
+                sigma = float(row["mass_centre_m.%s_sigma_total" % axis])
+                out.append(abs(value - truth[a]) / sigma)
+    return out
+
+
 def run_season(job):
     seed, args = job
     rng = random.Random(seed)
@@ -226,13 +253,13 @@ def run_season(job):
     except RuntimeError as e:
         return {"seed": seed, "error": str(e)}
     verdicts, false = judge(events, reported)
-    state = json.load(open(os.path.join(work, "track", "track_state.json")))
-    converged = "did not converge" not in console
+    day_axes = judge_days(work, events, condition)
+    converged = "did not converge" not in " ".join(console.split())
     if not args.keep:
         shutil.rmtree(work, ignore_errors=True)
     return {"seed": seed, "condition": condition, "verdicts": verdicts,
             "false": [(e["kind"], e["time"]) for e in false], "converged": converged,
-            "wander": reported["wander"]}
+            "wander": reported["wander"], "day_axes": day_axes}
 
 
 def rate(k, n):
@@ -253,6 +280,11 @@ def summarise(results, args):
              sum("verdicts" in r for r in results)),
         sum(len(r.get("false", [])) for r in results)))
     print("not converged: %d" % sum(not r.get("converged", True) for r in results))
+    days = [z for r in results for z in r.get("day_axes", [])]
+    if days:
+        print("day-axes of the mass centre within 2.5 sigma_total: %s (rms z %.2f)" % (
+            rate(sum(z <= 2.5 for z in days), len(days)),
+            math.sqrt(sum(z * z for z in days) / len(days))))
     for label, sel in [("all", lambda v: True), ("mass centre", lambda v: v["kind"] == "parameter"),
                        ("sensor", lambda v: v["kind"] == "sensor"),
                        ("inside a day", lambda v: v["place"] == "day"),

@@ -281,7 +281,7 @@ TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
       Fastcal("track --spec=" + Source() + "/calibration_data/spec_track.yaml --model=" + model +
               " --data=" + Path("season.csv") + " --out=" + Path("track"));
   ASSERT_EQ(track.code, 0) << track.output;
-  EXPECT_NE(track.output.find("(converged)"), std::string::npos) << track.output;
+  EXPECT_NE(track.output.find("converged in"), std::string::npos) << track.output;
   // One event, the move, dated between the last sample before it and the first after.
   // (A line on the wander may stand between the count and the event.)
   EXPECT_NE(track.output.find("1% false-alarm rate over the track): 1\n"), std::string::npos)
@@ -298,7 +298,7 @@ TEST_F(CliMovingPartsTest, TrackFollowsTheJointsAndFindsTheMove) {
       Fastcal("track --spec=" + Source() + "/calibration_data/spec_track_moving_parts.yaml " +
               "--model=" + start + " --data=" + Path("season.csv") + " --out=" + Path("shared"));
   ASSERT_EQ(shared.code, 0) << shared.output;
-  EXPECT_NE(shared.output.find("(converged)"), std::string::npos) << shared.output;
+  EXPECT_NE(shared.output.find("converged in"), std::string::npos) << shared.output;
   EXPECT_NE(shared.output.find("over the track): 1\n"), std::string::npos) << shared.output;
   EXPECT_NE(shared.output.find("\n  2024-05-04  parameter between"), std::string::npos)
       << shared.output;

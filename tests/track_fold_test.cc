@@ -52,6 +52,10 @@ constexpr int kSamples = 120;
 // A window whose blocks are read in several pieces (a piece: 1024 samples at most).
 constexpr int kLongSamples = 2600;
 
+// Sums of squares of whitened readings over a window, compared after a change of the data:
+// the digits double arithmetic keeps over a few thousand terms.
+constexpr double kChiSquareRoundOff = 1e-10;
+
 class TrackFoldTest : public ::testing::Test {
  protected:
   void SetUp() override { Simulate(kSamples); }
@@ -351,7 +355,70 @@ TEST_F(TrackFoldTest, BytesRoundTripAndCorruptionIsRefused) {
   ASSERT_TRUE(ParseFoldTask(task_bytes, &task, &error)) << error;
   EXPECT_EQ(SerializeFoldTask(task), task_bytes);
   EXPECT_FALSE(ParseFoldTask(bytes, &task, &error));  // a fold is not a task
-  EXPECT_NE(error.find("fastcal-fold-task-3"), std::string::npos) << error;
+  EXPECT_NE(error.find("fastcal-fold-task-4"), std::string::npos) << error;
+  // A fine scan's blocks and columns travel with the task (version 4); a version 3 task,
+  // written before them, is read as one without.
+  FoldTask fine = task_;
+  fine.fine_first_block = 3;
+  fine.fine_end_block = 5;
+  fine.fine_columns = {0};
+  ASSERT_TRUE(ParseFoldTask(SerializeFoldTask(fine), &task, &error)) << error;
+  EXPECT_EQ(task.fine_first_block, 3);
+  EXPECT_EQ(task.fine_end_block, 5);
+  EXPECT_EQ(task.fine_columns, std::vector<int>{0});
+  std::string version3 = task_bytes;
+  const std::string tag4 = "fastcal-fold-task-4";
+  version3.replace(version3.find(tag4), tag4.size(), "fastcal-fold-task-3");
+  version3.resize(version3.size() - 3 * sizeof(std::int64_t));  // two blocks, no columns
+  ASSERT_TRUE(ParseFoldTask(version3, &task, &error)) << error;
+  EXPECT_TRUE(task.fine_columns.empty());
+  EXPECT_EQ(task.stride, task_.stride);
+}
+
+// A fine scan (FoldTask::fine_columns) against its definition: with the readings of one
+// cable shifted by delta from a cut's sample on (the same as its bias stepping there), the
+// window's chi-square is the plain fold's plus 2 delta score + delta^2 self of the step at
+// that cut, exactly (the model is linear in the bias and the whitening in the readings),
+// with the slow error's transient; the fine fold's own sums are the plain fold's.
+TEST_F(TrackFoldTest, FineScanIsTheChiSquareOfAStepAtEachSample) {
+  const WindowFold plain = Fold(task_);
+  const int column =
+      static_cast<int>(std::find(plain.columns.begin(), plain.columns.end(), "sensor_bias_kN[3]") -
+                       plain.columns.begin());
+  ASSERT_LT(column, static_cast<int>(plain.columns.size()));
+  FoldTask fine_task = task_;
+  fine_task.fine_first_block = 2;
+  fine_task.fine_end_block = 4;
+  fine_task.fine_columns = {column};
+  const WindowFold fine = Fold(fine_task);
+  EXPECT_EQ(fine.chi_square, plain.chi_square);
+  EXPECT_EQ(fine.information, plain.information);
+  const size_t cuts = fine.fine.cross.size();
+  ASSERT_EQ(cuts, static_cast<size_t>(plain.block_samples[2] + plain.block_samples[3]));
+  EXPECT_EQ(fine.fine.after_s.front(), plain.block_first_time_s[2]);
+  const int n = static_cast<int>(plain.columns.size());
+  constexpr double kDeltaN = 2000.0;  // a 2 kN step: a few sigma of a reading
+  for (const size_t k : {size_t{0}, cuts / 3, cuts - 1}) {
+    Dataset stepped = data_;
+    for (Sample& sample : stepped.samples) {
+      if (sample.time_s >= fine.fine.after_s[k]) sample.tension_n[2] -= kDeltaN;
+    }
+    WindowFold fold;
+    std::string error;
+    ASSERT_TRUE(FoldSamples(task_, stepped, {}, &fold, &error)) << error;
+    const double expected =
+        2.0 * kDeltaN * fine.fine.cross[k](0, n) + kDeltaN * kDeltaN * fine.fine.self[k](0, 0);
+    EXPECT_NEAR(fold.chi_square - plain.chi_square, expected,
+                kChiSquareRoundOff * (std::abs(expected) + fold.chi_square))
+        << "cut " << k;
+  }
+  // The bytes of a fold with a fine scan round-trip; a plain fold's end where they did.
+  WindowFold back;
+  std::string error;
+  ASSERT_TRUE(ParseWindowFold(SerializeWindowFold(fine), "f.fold", &back, &error)) << error;
+  EXPECT_EQ(SerializeWindowFold(back), SerializeWindowFold(fine));
+  EXPECT_EQ(back.fine.self.size(), cuts);
+  EXPECT_TRUE(plain.fine.empty());
 }
 
 TEST_F(TrackFoldTest, FiniteNonsenseInAFoldIsRefused) {

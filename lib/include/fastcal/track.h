@@ -263,6 +263,11 @@ struct TrackResult {
   double chi_square = 0.0, reduced_chi_square = 0.0;
   int iterations = 0;
   bool converged = false;
+  // The last Gauss-Newton step's largest change of a parameter over its formal sigma, and
+  // the tolerance it was held to (TrackOptions::step_tolerance_sigmas): why the iterations
+  // stopped (DescribeGaussNewton).
+  double last_step_sigmas = 0.0;
+  double step_tolerance_sigmas = 0.0;
   int folds = 0;         // folds computed in this run
   bool updated = false;  // an update of an existing track
   std::vector<std::string> notes;
@@ -272,6 +277,10 @@ struct TrackResult {
   std::vector<std::pair<std::string, CableRobot>> models;
   std::vector<std::string> model_comments;  // parallel: each model's estimates
 };
+
+// "Gauss-Newton converged in N iterations (the last step S sigma, below T)" or "Gauss-Newton
+// did not converge in N iterations (the last step S sigma, above T)".
+std::string DescribeGaussNewton(const TrackResult& result);
 
 // One sentence on a group's wander inside and between windows, for the console and
 // track.html ("" when neither is seen).

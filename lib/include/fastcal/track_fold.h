@@ -22,9 +22,9 @@
 // FoldWindow is a pure function of the task: the same task gives the same bits on any
 // machine and any number of threads (sample_chunks.h). It streams the window: two passes
 // over its samples a piece at a time, keeping ~260 bytes a sample between them, so that
-// a fold's memory is about a quarter of a kB per sample of its window (issue 27). Tasks and folds travel as bytes
-// (SerializeFoldTask, SerializeWindowFold; little-endian IEEE doubles, the layout in
-// docs/calibration.md, "Tracking: files"): a fold file in a track's DIR/folds is
+// a fold's memory is about a quarter of a kB per sample of its window (issue 27). Tasks and folds
+// travel as bytes (SerializeFoldTask, SerializeWindowFold; little-endian IEEE doubles, the layout
+// in docs/calibration.md, "Tracking: files"): a fold file in a track's DIR/folds is
 // SerializeWindowFold's bytes.
 #ifndef FASTCAL_TRACK_FOLD_H_
 #define FASTCAL_TRACK_FOLD_H_
@@ -79,9 +79,27 @@ struct FoldTask {
   // TrackOptions::first_fold_samples), and every sample of the residual run (the middle
   // residual_samples): its slow-error estimate is then the one of a fold of every sample.
   int stride = 1;
-  int threads = 1;              // threads of the passes over the samples
+  int threads = 1;  // threads of the passes over the samples
+  // A fine scan (issue 53; WindowFold::fine): the exact whitened columns of a step of each
+  // of `fine_columns` (fold columns among BlockRowColumns) at every gap between the samples
+  // of blocks [fine_first_block, fine_end_block). An empty range: none (a track's folds);
+  // only with stride 1.
+  int fine_first_block = 0, fine_end_block = 0;
+  std::vector<int> fine_columns;
 
   bool IsValid(std::string* error) const;
+};
+
+// A fold's fine scan (FoldTask::fine_columns; internal/step_scan.h): per cut before each
+// sample of the scanned blocks, the step columns' (a step of the column from the cut on,
+// whitened as the readings are) sums with every fold column and, last, the residual (the
+// score: steps x (columns + 1)), and among themselves (steps x steps), from the cut to the
+// window's end; the cut's first sample's time and the last before's.
+struct FoldFineScan {
+  std::vector<int> columns;
+  std::vector<double> after_s, before_s;
+  std::vector<Eigen::MatrixXd> cross, self;
+  bool empty() const { return cross.empty(); }
 };
 
 // One reading named a gross error.
@@ -129,6 +147,7 @@ struct WindowFold {
   long long gross_error_count = 0;
   std::vector<FoldGrossError> gross_errors;  // the first kMaxFoldGrossErrors, time order
   std::vector<FoldResidual> residuals;       // the run for the slow-error estimate
+  FoldFineScan fine;                         // a fine scan's (FoldTask::fine_columns)
 };
 
 inline constexpr int kMaxFoldGrossErrors = 20;

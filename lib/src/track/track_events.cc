@@ -93,7 +93,6 @@ struct InnerStep {
   double statistic = 0.0;
   int block = -1;
   int splits = 0;
-  int window = -1;  // MoveStep's
 };
 InnerStep ScanWithin(const TrackRun& run, int u, const std::vector<int>& rows,
                      const std::vector<int>& columns) {
@@ -197,73 +196,132 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
 }
 
 // Where a sensor step found at the boundary before used window u (the bias `size` higher
-// from u on) may be, on one time line: at that boundary, or inside window u - 1 (its blocks
-// j.. already of the new value) or u (its blocks ..j-1 still of the old). Moving it changes
+// from u on) may be, on one time line: at that boundary, or inside window u - 1 (from a
+// cut on already of the new value) or u (before a cut still of the old). Moving it changes
 // the chi-square by 2 s delta + S delta^2 (s the score of the part that changes, S its
-// information with everything else profiled out, delta the bias change it gets:
-// ScanSplits), over the window's misfit widening.
+// information with everything else profiled out, delta the bias change it gets), over the
+// window's misfit widening. A placement stands for a change between `before_s` and
+// `after_s`: a block cut for anywhere in the blocks either side of it, a sample cut for the
+// gap between two samples, the boundary for the night.
 struct Placement {
   int window = -1;  // used window; -1: the boundary
-  int block = 0;    // the cut before this block of `window`
+  int block = 0;    // a block cut: before this block of `window` (-1: a sample cut)
   double change = 0.0;
+  double before_s = 0.0, after_s = 0.0;
 };
+
+// The boundary and every block cut of windows u - 1 and u (ScanSplits).
 std::vector<Placement> StepPlacements(const TrackRun& run, int u, const std::vector<int>& rows,
                                       int column, double size) {
-  std::vector<Placement> out = {{-1, 0, 0.0}};
+  std::vector<Placement> out = {
+      {-1, 0, 0.0, run.windows[run.used[u - 1]].last_s, run.windows[run.used[u]].first_s}};
   for (const int v : {u - 1, u}) {
     const bool head = v == u;
     const double delta = head ? -size : size;
     const std::vector<SplitScore> scores = ScanSplits(run, v, rows, {column}, run.birge[v], head);
+    const WindowFold& f = run.windows[run.used[v]].fold;
     for (size_t j = kMinPartBlocks; j + kMinPartBlocks <= scores.size(); ++j) {
       if (!scores[j].valid) continue;
       out.push_back({v, static_cast<int>(j),
                      (2.0 * scores[j].score[0] * delta + scores[j].schur(0, 0) * delta * delta) /
-                         run.birge[v]});
+                         run.birge[v],
+                     f.block_first_time_s[j - 1], f.block_last_time_s[j]});
     }
   }
   return out;
 }
 
+// Window v's placements at every gap between the samples of its fine fold's scan: the
+// exact step columns (internal/step_scan.h) of bias fold column `column`, the part from
+// each cut on (or, with `head`, before it: the window's sums minus the step's).
+std::vector<Placement> SamplePlacements(const TrackRun& run, int v, const WindowFold& f, int column,
+                                        double delta, bool head) {
+  const std::vector<int> order = LocalOrder(run);
+  const ArrowBlock& k = run.problem.blocks[v];
+  const int n = static_cast<int>(f.information.cols());
+  std::vector<Placement> out;
+  for (size_t c = 0; c < f.fine.cross.size(); ++c) {
+    const Eigen::MatrixXd& cross = f.fine.cross[c];
+    double score = cross(0, n), self = f.fine.self[c](0, 0);
+    Eigen::MatrixXd local(k.p + k.m(), 1);
+    for (int r = 0; r < k.p + k.m(); ++r) local(r, 0) = cross(0, order[r]);
+    if (head) {
+      score = f.gradient[column] - score;
+      self = f.information(column, column) - 2.0 * cross(0, column) + self;
+      for (int r = 0; r < k.p + k.m(); ++r) {
+        local(r, 0) = f.information(order[r], column) - local(r, 0);
+      }
+    }
+    const double schur = self - run.solver.QuadraticFormOfLocal({v}, {local})(0, 0);
+    if (!(schur > 0.0)) continue;
+    out.push_back({v, -1, (2.0 * score * delta + schur * delta * delta) / run.birge[v],
+                   f.fine.before_s[c], f.fine.after_s[c]});
+  }
+  return out;
+}
+
+// The placements at every gap between samples where the block cuts within the drop of the
+// least lie (with a block either side), from fine folds of windows u - 1 and u; the block
+// cuts of a window with none there stay. False (run.error) when a fine fold fails.
+bool RefinePlacements(TrackRun& run, int u, int column, double size,
+                      std::vector<Placement>* placements) {
+  double least = 0.0;
+  for (const Placement& x : *placements) least = std::min(least, x.change);
+  std::vector<Placement> out;
+  for (const int v : {u - 1, u}) {
+    int lo = std::numeric_limits<int>::max(), hi = -1;
+    for (const Placement& x : *placements) {
+      if (x.window != v || x.change > least + LocationDrop()) continue;
+      lo = std::min(lo, x.block);
+      hi = std::max(hi, x.block);
+    }
+    if (hi < 0) {
+      for (const Placement& x : *placements) {
+        if (x.window == v) out.push_back(x);
+      }
+      continue;
+    }
+    const int blocks = static_cast<int>(run.windows[run.used[v]].fold.block_samples.size());
+    WindowFold fine;
+    if (!FineFold(run, v, std::max(0, lo - 1), std::min(blocks, hi + 1), {column}, &fine)) {
+      return false;
+    }
+    const bool head = v == u;
+    const std::vector<Placement> at =
+        SamplePlacements(run, v, fine, column, head ? -size : size, head);
+    out.insert(out.end(), at.begin(), at.end());
+  }
+  out.insert(out.begin(), placements->front());  // the boundary
+  *placements = std::move(out);
+  return true;
+}
+
 // The step's likelihood interval over its placements (Hinkley 1970): from the earliest to
-// the latest whose change is within LocationDrop() of the least; a cut stands for a change
-// anywhere in the blocks either side of it, the boundary for the night between the windows.
-std::pair<double, double> PlacementInterval(const TrackRun& run, int u,
-                                            const std::vector<Placement>& placements) {
+// the latest whose change is within LocationDrop() of the least.
+std::pair<double, double> PlacementInterval(const std::vector<Placement>& placements) {
   double least = 0.0;
   for (const Placement& x : placements) least = std::min(least, x.change);
   double low = std::numeric_limits<double>::infinity();
   double high = -std::numeric_limits<double>::infinity();
   for (const Placement& x : placements) {
     if (x.change > least + LocationDrop()) continue;
-    if (x.window < 0) {
-      low = std::min(low, run.windows[run.used[u - 1]].last_s);
-      high = std::max(high, run.windows[run.used[u]].first_s);
-      continue;
-    }
-    const WindowFold& f = run.windows[run.used[x.window]].fold;
-    low = std::min(low, f.block_first_time_s[x.block - 1]);
-    high = std::max(high, f.block_last_time_s[x.block]);
+    low = std::min(low, x.before_s);
+    high = std::max(high, x.after_s);
   }
   return {low, high};
 }
 
 // Where the step most likely is: the placement of least change among those allowed (a
 // window is moved into only when its stretch keeps another window), unless the boundary is
-// within LocationDrop() of it (block -1: it stays there; an overnight re-zeroing is not put
-// in an edge block).
-InnerStep MoveStep(const std::vector<Placement>& placements, bool before_ok, bool here_ok, int u) {
-  InnerStep best;
-  double smallest = 0.0;  // the boundary's
+// within LocationDrop() of it (window -1: it stays there; an overnight re-zeroing is not
+// put in an edge block).
+Placement MoveStep(const std::vector<Placement>& placements, bool before_ok, bool here_ok, int u) {
+  Placement best;  // the boundary's
   for (const Placement& x : placements) {
     if (x.window < 0 || !(x.window == u - 1 ? before_ok : here_ok)) continue;
-    if (x.change < smallest) {
-      smallest = x.change;
-      best.window = x.window;
-      best.block = x.block;
-      best.statistic = -x.change;
-    }
+    if (x.change < best.change) best = x;
   }
-  if (!(best.statistic > LocationDrop())) return InnerStep();
+  if (!(-best.change > LocationDrop())) return Placement();
   return best;
 }
 
@@ -319,20 +377,20 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     const bool before_ok = u >= 2 && run.entry_of[u - 2][j] == e0;
     const bool here_ok = u + 1 < windows && run.entry_of[u + 1][j] == e;
     const double size = run.shared[e].value_si - run.shared[e0].value_si;
-    const std::vector<Placement> placements = StepPlacements(run, u, rows, column, size);
-    const std::pair<double, double> interval = PlacementInterval(run, u, placements);
+    std::vector<Placement> placements = StepPlacements(run, u, rows, column, size);
+    if (!RefinePlacements(run, u, column, size, &placements)) return TrackStatus::kFailed;
+    const std::pair<double, double> interval = PlacementInterval(placements);
     run.shared[e].has_interval = true;
     run.shared[e].interval_low_s = interval.first;
     run.shared[e].interval_high_s = interval.second;
-    const InnerStep step = MoveStep(placements, before_ok, here_ok, u);
-    if (step.block < 0) continue;
+    const Placement step = MoveStep(placements, before_ok, here_ok, u);
+    if (step.window < 0) continue;
     const bool use_here = step.window == u;
     const int v = step.window;
-    const WindowFold& f = run.windows[run.used[v]].fold;
     SharedEntry mixed = run.shared[use_here ? e : e0];
     mixed.inside = true;
-    mixed.step_time_s = f.block_first_time_s[step.block];
-    mixed.step_previous_s = f.block_last_time_s[step.block - 1];
+    mixed.step_time_s = step.after_s;
+    mixed.step_previous_s = step.before_s;
     mixed.has_interval = true;
     mixed.interval_low_s = interval.first;
     mixed.interval_high_s = interval.second;
@@ -350,7 +408,7 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     run.splits.push_back(static_cast<int>(run.shared.size()) - 1);
     run.Progress("sensor step of " + run.layout.Column(column).name + " inside window " +
                  WindowText(run, v) + " (more likely than at the boundary, by a chi-square of " +
-                 FormatDouble("%.1f", step.statistic) + "): the window gets a value of its own");
+                 FormatDouble("%.1f", -step.change) + "): the window gets a value of its own");
     isolated = true;
   }
   return isolated ? Iterate(run, false) : TrackStatus::kOk;

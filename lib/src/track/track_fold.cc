@@ -14,6 +14,7 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <mutex>
 
 #include "fastcal/gross_errors.h"
@@ -26,6 +27,7 @@
 #include "fastcal/internal/sample_chunks.h"
 #include "fastcal/internal/sample_rows.h"
 #include "fastcal/internal/slow_error_filter.h"
+#include "fastcal/internal/step_scan.h"
 #include "fastcal/internal/window_store.h"
 
 namespace fastcal {
@@ -37,6 +39,10 @@ using internal::ReadingArrays;
 constexpr int kMinBlockSamples = 16;
 // Rounds of the gross-error screen at most (one more than needed: they settle at once).
 constexpr int kMaxScreenRounds = 4;
+// A fine scan's readings after its last cut that carry the steps' transients (the slow
+// error's filter forgets a step's start within a few of its time constants: at FAST's
+// 1.5 %, 70 s and 2 s sampling, to 1e-10 within 200 readings).
+constexpr int kFineMarginSamples = 4000;
 // Samples a pass reads at once: the prediction's chunk (its warm starts run along it), and
 // the most a piece of a block holds (its rows: 1.5 MB at 31 columns).
 constexpr int kPieceSamples = internal::kSampleChunk;
@@ -354,6 +360,48 @@ struct BlockSums {
   }
 };
 
+// The recorder of a fine scan's readings (FoldTask::fine_columns; null: none), told of the
+// whitening from the first sample of its first block to kFineMarginSamples past its last.
+std::unique_ptr<internal::StepScanRecorder> FineRecorder(const FoldTask& task, int count,
+                                                         int block_samples, int n) {
+  if (task.fine_columns.empty() || task.fine_end_block <= task.fine_first_block) return nullptr;
+  const long long first = std::min<long long>(count, 1LL * task.fine_first_block * block_samples);
+  const long long end = std::min<long long>(count, 1LL * task.fine_end_block * block_samples);
+  const long long captured = std::min<long long>(count, end + kFineMarginSamples) - first;
+  if (end <= first) return nullptr;
+  return std::make_unique<internal::StepScanRecorder>(
+      n + 1, task.fine_columns, first, static_cast<int>(end - first), static_cast<int>(captured));
+}
+
+// The fine scan from its recorder: the rows after its cuts are the window's blocks' from
+// fine_end_block on (their sums of the step columns' rows and scores).
+void FinishFineScan(const FoldTask& task, const WindowPrediction& at,
+                    const std::vector<int>& block_columns, internal::StepScanRecorder* recorder,
+                    WindowFold* fold) {
+  internal::StepScanInput& in = recorder->input();
+  const int n = in.columns - 1;
+  const int nf = static_cast<int>(in.steps.size());
+  in.after = Eigen::MatrixXd::Zero(nf, n + 1);
+  for (int f = 0; f < nf; ++f) {
+    const int row = static_cast<int>(
+        std::find(block_columns.begin(), block_columns.end(), in.steps[f]) - block_columns.begin());
+    for (size_t b = task.fine_end_block; b < fold->block_information.size(); ++b) {
+      in.after.row(f).head(n) += fold->block_information[b].row(row);
+      in.after(f, n) += fold->block_scores(b, in.steps[f]);
+    }
+  }
+  internal::StepScan scan = internal::ScanSteps(in);
+  const long long first = recorder->first();
+  FoldFineScan& out = fold->fine;
+  out.columns = in.steps;
+  for (int k = 0; k < in.cuts; ++k) {
+    out.after_s.push_back(at.time_s[first + k]);
+    out.before_s.push_back(first + k > 0 ? at.time_s[first + k - 1] : at.time_s[first + k]);
+  }
+  out.cross = std::move(scan.cross);
+  out.self = std::move(scan.self);
+}
+
 // The second pass: the whitened rows folded piece by piece, in time order, into the blocks
 // and the window. Returns the first sample the statics cannot solve (or that cannot be
 // read), or -1.
@@ -363,8 +411,9 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
   const int n = window.model->num_free();
   const int count = static_cast<int>(source.size);
   const int blocks = std::max(1, task.blocks);
-  const std::vector<Piece> pieces =
-      Pieces(count, std::max(kMinBlockSamples, (count + blocks - 1) / blocks));
+  const int block_samples = std::max(kMinBlockSamples, (count + blocks - 1) / blocks);
+  const std::vector<Piece> pieces = Pieces(count, block_samples);
+  std::unique_ptr<internal::StepScanRecorder> fine = FineRecorder(task, count, block_samples, n);
   struct Part {
     int piece = 0;
     PieceSamples samples;
@@ -376,6 +425,7 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
                  fold};
   fold->block_scores.resize(0, n);
   internal::SampleRowWhitener whitener(window, n + 1);
+  if (fine != nullptr) whitener.set_observer(fine.get());
   const internal::ModelAtTheta model_at(*window.model, task.theta_si.data(), source.sessions);
   // Each reading's rows over its own columns first where its sensor has some (issue 41:
   // the full-width QR fold was a sixth of a track's time; folded_cost.h, ReadingColumns).
@@ -401,7 +451,12 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
         }
         return -1;
       },
-      [&](int, int, Part* part) { whitener.Whiten(part->samples.fitted, &part->rows); },
+      [&](int, int, Part* part) {
+        whitener.Whiten(part->samples.fitted, &part->rows);
+        if (fine == nullptr) return;
+        const int begin = pieces[part->piece].begin;
+        for (int j = 0; j < part->rows.end; ++j) fine->Rows(begin + j, part->rows.Of(j));
+      },
       [&](int k, int, Part* part) {
         const Piece& piece = pieces[k];
         part->fold = internal::GramFold(n + 1);
@@ -427,6 +482,7 @@ int FoldRowsInBlocks(const FoldTask& task, const SampleSource& source, const Win
   fold->information = g.topLeftCorner(n, n);
   fold->gradient = g.col(n).head(n);
   fold->chi_square = g(n, n);
+  if (fine != nullptr) FinishFineScan(task, at, block_columns, fine.get(), fold);
   return -1;
 }
 

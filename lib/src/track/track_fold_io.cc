@@ -12,7 +12,10 @@
 namespace fastcal {
 namespace {
 
-constexpr char kTaskTag[] = "fastcal-fold-task-3";
+// Version 4 added the fine scan's blocks and columns; a version 3 task is read as one
+// without them.
+constexpr char kTaskTag[] = "fastcal-fold-task-4";
+constexpr char kTaskTag3[] = "fastcal-fold-task-3";
 constexpr char kFoldTag[] = "fastcal-fold-1";
 // Bounds on what a reader accepts, against corrupt or hostile bytes.
 constexpr std::int64_t kMaxCount = 1LL << 31;
@@ -207,6 +210,21 @@ bool FoldTask::IsValid(std::string* error) const {
     why = "blocks and threads must be >= 1";
   } else if (stride < 1) {
     why = "the stride must be >= 1";
+  } else if (!fine_columns.empty() && (fine_first_block < 0 || fine_end_block < fine_first_block ||
+                                       fine_end_block > blocks || stride != 1)) {
+    why = "the fine scan's blocks must lie in [0, blocks], with every sample (stride 1)";
+  }
+  if (why.empty() && !fine_columns.empty()) {
+    std::vector<ParameterSpec> columns;
+    for (const ParameterSpec& p : parameters) {
+      if (p.free) columns.push_back(p);
+    }
+    const std::vector<int> rows = BlockRowColumns(columns, roles);
+    for (int c : fine_columns) {
+      if (std::find(rows.begin(), rows.end(), c) == rows.end()) {
+        why = "a fine scan's column is not one of the blocks' rows";
+      }
+    }
   }
   for (double v : theta_si) {
     if (why.empty() && !std::isfinite(v)) why = "a value is not finite";
@@ -238,12 +256,18 @@ std::string SerializeFoldTask(const FoldTask& t) {
   w.Int(t.residual_samples);
   w.Int(t.threads);
   w.Int(t.stride);
+  w.Int(t.fine_first_block);
+  w.Int(t.fine_end_block);
+  w.Int(static_cast<std::int64_t>(t.fine_columns.size()));
+  for (int c : t.fine_columns) w.Int(c);
   return std::move(w.str());
 }
 
 bool ParseFoldTask(const std::string& bytes, FoldTask* task, std::string* error) {
+  Reader peek(bytes, "fold task");
+  const bool version3 = peek.Text() == kTaskTag3 && peek.ok();
   Reader r(bytes, "fold task");
-  if (!CheckTag(&r, kTaskTag, "fold task", error)) return false;
+  if (!CheckTag(&r, version3 ? kTaskTag3 : kTaskTag, "fold task", error)) return false;
   FoldTask t;
   t.label = r.Text();
   t.samples_path = r.Text();
@@ -264,6 +288,12 @@ bool ParseFoldTask(const std::string& bytes, FoldTask* task, std::string* error)
   t.residual_samples = static_cast<int>(r.Int());
   t.threads = static_cast<int>(r.Int());
   t.stride = static_cast<int>(r.Int());
+  if (!version3) {
+    t.fine_first_block = static_cast<int>(r.Int());
+    t.fine_end_block = static_cast<int>(r.Int());
+    t.fine_columns.resize(r.Count());
+    for (int& c : t.fine_columns) c = static_cast<int>(r.Int());
+  }
   if (!r.ok() || !r.AtEnd()) {
     *error = r.Error();
     return false;
@@ -320,6 +350,19 @@ std::string SerializeWindowFold(const WindowFold& f) {
       w.Real(r.sigma_n[i]);
       w.Real(r.reading_n[i]);
       w.Int(r.excluded[i]);
+    }
+  }
+  // A fine scan's cuts (a fold of a track's window has none: its bytes end here, as
+  // before the fine scans).
+  if (!f.fine.empty()) {
+    w.Int(static_cast<std::int64_t>(f.fine.columns.size()));
+    for (int c : f.fine.columns) w.Int(c);
+    w.Reals(f.fine.after_s);
+    w.Reals(f.fine.before_s);
+    w.Int(static_cast<std::int64_t>(f.fine.cross.size()));
+    for (size_t k = 0; k < f.fine.cross.size(); ++k) {
+      w.Matrix(f.fine.cross[k]);
+      w.Matrix(f.fine.self[k]);
     }
   }
   return std::move(w.str());
@@ -515,6 +558,18 @@ bool ParseWindowFold(const std::string& bytes, const std::string& source, Window
       x.sigma_n[i] = r.Real();
       x.reading_n[i] = r.Real();
       x.excluded[i] = r.Int() != 0;
+    }
+  }
+  if (r.ok() && !r.AtEnd()) {
+    f.fine.columns.resize(r.Count());
+    for (int& c : f.fine.columns) c = static_cast<int>(r.Int());
+    f.fine.after_s = r.Reals();
+    f.fine.before_s = r.Reals();
+    f.fine.cross.resize(r.Count());
+    f.fine.self.resize(f.fine.cross.size());
+    for (size_t k = 0; k < f.fine.cross.size(); ++k) {
+      f.fine.cross[k] = r.Matrix();
+      f.fine.self[k] = r.Matrix();
     }
   }
   const size_t n = f.columns.size();

@@ -191,10 +191,9 @@ std::string TrackHtml(const TrackResult& r) {
        Counted(static_cast<long long>(r.files.size()), "file", "files") + ", windows of " +
        WindowSpecText(r.window) + " from " +
        TrackTimeText(r.windows.front().start_s, r.time_offset_s) + " to " +
-       TrackTimeText(r.windows.back().end_s, r.time_offset_s) + "; " +
-       Counted(r.iterations, "Gauss-Newton iteration", "Gauss-Newton iterations") + " (" +
-       (r.converged ? "converged" : "NOT converged") + "), " + Counted(r.folds, "fold", "folds") +
-       " this run; chi2/nu " + FormatDouble("%.3f", r.reduced_chi_square) + ".</p>\n";
+       TrackTimeText(r.windows.back().end_s, r.time_offset_s) + "; " + Esc(DescribeGaussNewton(r)) +
+       ", " + Counted(r.folds, "fold", "folds") + " this run; chi2/nu " +
+       FormatDouble("%.3f", r.reduced_chi_square) + ".</p>\n";
   if (r.slow_error.enabled) h += "<p>" + Esc(DescribeSlowError(r.slow_error)) + "</p>\n";
   h += "<h2>Events</h2>\n" + EventsTable(r);
   const TimeAxis axis = AxisOf(r);

@@ -251,6 +251,15 @@ TrackStatus WriteOutputs(TrackRun& run) {
 
 namespace fastcal {
 
+std::string DescribeGaussNewton(const TrackResult& r) {
+  const std::string iterations =
+      std::to_string(r.iterations) + " iteration" + (r.iterations == 1 ? "" : "s");
+  return std::string("Gauss-Newton ") + (r.converged ? "converged in " : "did not converge in ") +
+         iterations + " (the last step " + internal::FormatDouble("%.2g", r.last_step_sigmas) +
+         " sigma, " + (r.converged ? "below " : "above ") +
+         internal::FormatDouble("%g", r.step_tolerance_sigmas) + ")";
+}
+
 std::string DescribeEventTime(const TrackResult& r, const TrackEvent& e) {
   using internal::TrackTimeText;
   const auto time = [&](double t) { return TrackTimeText(t, r.time_offset_s); };

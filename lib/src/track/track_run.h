@@ -209,6 +209,11 @@ TrackStatus Uncertainties(TrackRun& run);
 // The windows' and the shared parameters' estimates with sigma_total (TrackResult), from
 // the solution and the sandwich as they stand.
 TrackStatus Results(TrackRun& run);
+// Used window u folded at the solution with a fine scan (FoldTask::fine_columns) of its
+// blocks [first_block, end_block) and fold columns `columns` (laid out over the track's
+// columns); false with run.error.
+bool FineFold(TrackRun& run, int u, int first_block, int end_block, const std::vector<int>& columns,
+              WindowFold* out);
 // Used window u's solution minus its fold's point, per column (fold order).
 Eigen::VectorXd StepOf(const TrackRun& run, int u);
 // Its fold's gradient at the solution, g + H d (fold order).

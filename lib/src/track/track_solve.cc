@@ -664,6 +664,8 @@ TrackStatus Iterate(TrackRun& run, bool estimate_slow_error) {
       gn.previous_shared[e] = run.shared[e].value_si;
       run.shared[e].value_si = run.solver.b()[e];
     }
+    run.result->last_step_sigmas = step;
+    run.result->step_tolerance_sigmas = run.options.step_tolerance_sigmas;
     if (step < run.options.step_tolerance_sigmas && slow_settled && !process_changed && !strided) {
       MarkConverged(run);
       return TrackStatus::kOk;
@@ -700,6 +702,29 @@ TrackStatus FoldConsider(TrackRun& run) {
     return run.Fail(TrackStatus::kUndetermined, Undetermined(run));
   for (size_t e = 0; e < run.shared.size(); ++e) run.shared[e].value_si = run.solver.b()[e];
   return TrackStatus::kOk;
+}
+
+bool FineFold(TrackRun& run, int u, int first_block, int end_block, const std::vector<int>& columns,
+              WindowFold* out) {
+  TrackWindowState& w = run.windows[run.used[u]];
+  if (!CheckStoreDigest(run, &w)) return false;
+  std::vector<double> theta = w.theta;
+  PointFromSolution(run, u, &theta);
+  TrackWindowState at = w;
+  at.theta = theta;
+  // With the consider columns: the fold's columns are the layout's, as the scan's are.
+  FoldTask task = TaskFor(run, at, 0, true, Sampling::kEvery);
+  task.fine_first_block = first_block;
+  task.fine_end_block = end_block;
+  task.fine_columns = columns;
+  std::vector<std::string> folds;
+  const std::vector<std::string> tasks = {SerializeFoldTask(task)};
+  const bool ok = run.options.runner ? run.options.runner(tasks, &folds, run.error)
+                                     : LocalRunner(run.options.threads, tasks, &folds, run.error);
+  if (!ok || folds.size() != 1) return false;
+  if (!ParseWindowFold(folds[0], "the fine fold of window " + w.label, out, run.error))
+    return false;
+  return ExpandToLayout(run, out);
 }
 
 Eigen::VectorXd StepOf(const TrackRun& run, int u) {
