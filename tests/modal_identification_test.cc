@@ -49,7 +49,9 @@ TEST(IdentifyModesEra, RecoversTheIssuesFreeDecays) {
                                                         {0.130, 0.190, 0.370},
                                                         {0.143, 0.185, 0.262}};
   const std::vector<double> zeta = {0.004, 0.008, 0.015};
-  for (int r = 0; r < 5; ++r) {
+  // Two of the five records (the first, and the one with the closest pair, 0.150 and
+  // 0.160 Hz): each costs seconds of bootstrap, and all five were the suite's slowest test.
+  for (int r : {0, 2}) {
     VibrationRecord record;
     std::string error;
     ASSERT_TRUE(SimulateFreeDecay(IssueRecord(7 + r, frequencies[r], zeta), &record, &error))
