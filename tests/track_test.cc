@@ -938,6 +938,59 @@ TEST(TrackTest, EveryMoveFoundAndDated) {
   ExpectEventsFoundAndDated(r, truth);
 }
 
+// Issue 53: a sensor re-zeroed (+3.5 kN) 14 minutes before the end of a day's telemetry
+// was reported overnight with an interval of the night alone, the truth outside it. Now
+// the interval holds the moment, and the size is within 2.5 sigma_total.
+TEST(TrackTest, AReZeroingInADaysLastMinutesIsInsideItsInterval) {
+  constexpr int kDays = 8, kPerDay = 300;  // 100 minutes a day
+  const double t = kStartS + 4 * kDayS + kPerDay * kIntervalS - 14.0 * 60.0;
+  SimulationOptions o;
+  o.sensor_bias_steps.push_back({t, 3, 3.5e3});
+  const TrackResult r = TrackSeason(kDays, kPerDay, 53, o, "edge");
+  ASSERT_EQ(r.events.size(), 1u);
+  const TrackEvent& e = r.events[0];
+  EXPECT_EQ(e.kind, "sensor");
+  EXPECT_EQ(e.cables, std::vector<int>{4});
+  EXPECT_LE(e.time_low_s, t) << DescribeEventTime(r, e);
+  EXPECT_GE(e.time_high_s, t) << DescribeEventTime(r, e);
+  ASSERT_EQ(e.parameters.size(), 1u);
+  EXPECT_NEAR(e.parameters[0].shift, 3.5, kSizeSigmas * e.parameters[0].sigma_total);
+}
+
+// The console's and track.html's words for when an event happened: a night alone is
+// "between A and B"; an interval reaching into a day's telemetry says so, as the issue's
+// "between <end of day> and <start of next day>" did not; one inside a window is dated.
+TEST(TrackTest, EventTimesSayWhenTheIntervalSpansANightAndADay) {
+  TrackResult r;
+  r.windows.resize(2);
+  r.windows[0].first_time_s = 0.0;
+  r.windows[0].last_time_s = 3600.0;
+  r.windows[1].first_time_s = 86400.0;
+  r.windows[1].last_time_s = 90000.0;
+  TrackEvent e;
+  e.window = 1;
+  e.within_window = false;
+  e.previous_time_s = 3600.0;
+  e.time_s = 86400.0;
+  e.time_low_s = 3600.0;
+  e.time_high_s = 86400.0;
+  const std::string night = DescribeEventTime(r, e);
+  EXPECT_EQ(night.find("interval"), std::string::npos) << night;
+  EXPECT_EQ(night.rfind("between ", 0), 0u) << night;
+  e.time_low_s = 3000.0;  // into the first day's last ten minutes
+  const std::string spans = DescribeEventTime(r, e);
+  EXPECT_NE(spans.find("95% interval"), std::string::npos) << spans;
+  EXPECT_NE(spans.find("spans a night and a day's telemetry"), std::string::npos) << spans;
+  e.within_window = true;
+  e.time_s = 88000.0;
+  e.time_low_s = 87500.0;
+  e.time_high_s = 88500.0;
+  const std::string inside = DescribeEventTime(r, e);
+  EXPECT_EQ(inside.rfind("inside the window, at ", 0), 0u) << inside;
+  EXPECT_NE(inside.find("95% interval"), std::string::npos) << inside;
+  EXPECT_EQ(inside.find("spans"), std::string::npos) << inside;
+}
+
 // Each kind of event at 1% over the season: seasons without any event report one of a
 // kind in about 1% (scripts/track_false_alarms.sh runs hundreds; docs/calibration.md has
 // the figures). 20 seasons of ten days: at 1%, two or more of a kind come by chance in
