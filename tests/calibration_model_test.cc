@@ -164,6 +164,7 @@ double Step(ParameterKind kind) {
     case ParameterKind::kMassCentre:
     case ParameterKind::kAnchorOffset:
     case ParameterKind::kTowerOffset:
+    case ParameterKind::kMeasuredOffset:
       return 1e-3;  // m
     case ParameterKind::kCabinMass:
       return 1.0;  // kg

@@ -586,7 +586,7 @@ const ErrorCase kErrorCases[] = {
     {"parameters:\n  mass_center_m: {x: {free: true}}\n", 2, "parameters.mass_center_m",
      "unknown parameter (accepted: mass_centre_m, cabin_mass_kg, linear_density_kg_per_m, ea_n, "
      "anchor_offset_m, tower_offset_m, sensor_gain, sensor_bias_kN, attachment_mass_kg, "
-     "attachment_density_kg_per_m, length_offset_m, moving_parts)"},
+     "attachment_density_kg_per_m, length_offset_m, moving_parts, measured_frame)"},
     {"parameters:\n  mass_centre_m:\n    w: {free: true}\n", 3, "parameters.mass_centre_m.w",
      "unknown key"},
     {"parameters:\n  cabin_mass_kg: {free: true, inital: 3}\n", 2,

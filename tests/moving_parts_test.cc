@@ -8,8 +8,8 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <random>
 #include <string>
 #include <vector>
@@ -21,26 +21,18 @@
 #include "fastcal/joint_plan.h"
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
+#include "jacobian_check.h"
 #include "temp_path.h"
 #include "test_robots.h"
 
 namespace fastcal {
 namespace {
 
+using testing::RotatorJoints;
 using testing::RotatorRobot;
 using testing::TiltedPoses;
 
 constexpr double kPi = 3.14159265358979323846;
-
-JointValues Joints(double a_deg, double b_deg, double x_m, double y_m, double z_m) {
-  JointValues q{};
-  q[0] = a_deg;
-  q[1] = b_deg;
-  q[2] = x_m;
-  q[3] = y_m;
-  q[4] = z_m;
-  return q;
-}
 
 TEST(MovingPartsTest, MassCentreIsTheIssuesClosedForm) {
   // c(q) = c0 + ((R - I) Q + R d m_s) / M, R = R_x(a) R_y(b) (issue 35).
@@ -58,7 +50,7 @@ TEST(MovingPartsTest, MassCentreIsTheIssuesClosedForm) {
     const Eigen::Vector3d expected =
         robot.mass_centre_cabin_m +
         ((r - Eigen::Matrix3d::Identity()) * q + r * d * 2500.0) / robot.cabin_mass_kg;
-    const Eigen::Vector3d got = robot.MassCentreAt(Joints(a, b, d.x(), d.y(), d.z()));
+    const Eigen::Vector3d got = robot.MassCentreAt(RotatorJoints(a, b, d.x(), d.y(), d.z()));
     EXPECT_LT((got - expected).cwiseAbs().maxCoeff(), kTolM) << trial;
   }
 }
@@ -191,7 +183,7 @@ TEST(MovingPartsTest, StaticsAtTheJointsAreTheStaticsOfTheMovedMassCentre) {
   const CableRobot robot = RotatorRobot();
   const StaticsOptions options;
   for (const Pose& pose : TiltedPoses(5, 351)) {
-    const JointValues q = Joints(12.0, -9.0, 0.05, -0.02, 0.01);
+    const JointValues q = RotatorJoints(12.0, -9.0, 0.05, -0.02, 0.01);
     CableRobot moved = CableRobot::NominalFast();
     moved.mass_centre_cabin_m = robot.MassCentreAt(q);
     StaticsSolution a, b, zero, rigid;
@@ -256,39 +248,23 @@ TEST(MovingPartsTest, AllModelParametersNameTheParts) {
 
 TEST(MovingPartsTest, AnalyticColumnsMatchJetsAndCentralDifferences) {
   constexpr double kRelTol = 1e-7;
+  constexpr double kDifferenceRelTol = 1e-5;
   const CableRobot robot = RotatorRobot(Eigen::Vector3d(400.0, -300.0, -6000.0), 2500.0);
   const CalibrationSpec spec = PartsFree(robot);
   const internal::CalibrationModel model(robot, spec);
-  const int n = model.num_free();
   const std::vector<double> theta = model.InitialTheta();
-  const JointValues q = Joints(11.0, -7.0, 0.04, -0.03, 0.02);
+  const JointValues q = RotatorJoints(11.0, -7.0, 0.04, -0.03, 0.02);
   for (const Pose& pose : TiltedPoses(3, 352)) {
-    internal::TensionResidual f = ResidualAt(model, pose, q);
-    std::vector<double> analytic(kNumCables * n), jet(kNumCables * n);
-    double ra[kNumCables], rj[kNumCables];
-    ASSERT_TRUE(f.Evaluate(theta.data(), ra, analytic.data()));
-    ASSERT_TRUE(internal::TensionCost::EvaluateJet(f, theta.data(), rj, jet.data()));
-    for (int k = 0; k < n; ++k) {
-      const ParameterSpec& p = spec.parameters[model.spec_index(k)];
-      // Central differences in double: steps inside the linear range, well above 1e-12.
-      const double h = p.kind == ParameterKind::kMassCentre ? 1e-3
-                       : p.kind == ParameterKind::kCabinMass ? 1.0
-                                                             : 10.0;  // kg m, kg
-      std::vector<double> up = theta, down = theta;
-      up[k] += h;
-      down[k] -= h;
-      double ru[kNumCables], rd[kNumCables];
-      ASSERT_TRUE(f.Evaluate(up.data(), ru, nullptr));
-      ASSERT_TRUE(f.Evaluate(down.data(), rd, nullptr));
-      double scale = 0.0;
-      for (int i = 0; i < kNumCables; ++i) scale = std::max(scale, std::abs(jet[i * n + k]));
-      ASSERT_GT(scale, 0.0) << p.name;
-      for (int i = 0; i < kNumCables; ++i) {
-        EXPECT_NEAR(analytic[i * n + k], jet[i * n + k], kRelTol * scale) << p.name << " " << i;
-        EXPECT_NEAR(analytic[i * n + k], (ru[i] - rd[i]) / (2 * h), 1e-5 * scale)
-            << p.name << " cable " << i + 1;
-      }
-    }
+    const internal::TensionResidual f = ResidualAt(model, pose, q);
+    // Central differences in double: steps inside the linear range, well above 1e-12.
+    testing::ExpectColumnsMatchJetsAndDifferences(
+        f, model, theta,
+        [](const ParameterSpec& p) {
+          return p.kind == ParameterKind::kMassCentre  ? 1e-3
+                 : p.kind == ParameterKind::kCabinMass ? 1.0
+                                                       : 10.0;  // kg m, kg
+        },
+        kRelTol, kDifferenceRelTol, "");
   }
 }
 

@@ -60,6 +60,18 @@ inline CableRobot RotatorRobot(const Eigen::Vector3d& rotator_q = Eigen::Vector3
   return robot;
 }
 
+// Joint values of RotatorRobot: the rotator's angles (deg) and the platform's shift (m).
+inline JointValues RotatorJoints(double a_deg, double b_deg, double x_m = 0.0, double y_m = 0.0,
+                                 double z_m = 0.0) {
+  JointValues q{};
+  q[0] = a_deg;
+  q[1] = b_deg;
+  q[2] = x_m;
+  q[3] = y_m;
+  q[4] = z_m;
+  return q;
+}
+
 // `count` random poses up to 35 deg off axis (with the focal law's 2-5 deg extra tilts,
 // inside the model's range), `spread_m` off the focal sphere.
 inline std::vector<Pose> TiltedPoses(int count, std::uint64_t seed, double spread_m = 0.0) {

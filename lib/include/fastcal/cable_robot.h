@@ -22,7 +22,9 @@
 #include <vector>
 
 #include "fastcal/cable_attachment.h"
+#include "fastcal/measured_frame.h"
 #include "fastcal/moving_parts.h"
+#include "fastcal/pose.h"
 
 namespace fastcal {
 
@@ -79,6 +81,11 @@ struct CableRobot {
   // The rotator, the Stewart platform: parts whose joints move the mass centre
   // (moving_parts.h); none by default, and then the mass centre is fixed.
   MovingParts moving_parts;
+  // Whose pose the data's x_m..z_m and attitude give (measured_frame.h; YAML
+  // cabin.measured_frame): a point of a moving part's frame (FAST's feed on the Stewart
+  // platform), or of the cabin's. None (the default): the cabin's own frame, and every
+  // pose of the data is the cabin's as it stands.
+  std::optional<MeasuredFrame> measured_frame;
   // The cabin's inertia tensor about its mass centre, cabin frame (kg m^2; YAML
   // cabin.inertia_kg_m2). Only the vibrations (modes.h) use it. The default is assumed,
   // not measured: diag(3.5e5, 3.5e5, 5.0e5), about a 30 t cabin of ~13 m diameter.
@@ -101,6 +108,13 @@ struct CableRobot {
   // mass_centre_cabin_m plus the parts' shift, eq. (1) of moving_parts.h.
   Eigen::Vector3d MassCentreAt(const JointValues& joints) const;
 
+  // The cabin's pose from the data's (the measured frame's, measured_frame.h (3)-(4)) at
+  // `joints` (the model's joint order, columns' units); the pose itself, bit for bit,
+  // without a measured frame.
+  Pose CabinPose(const Pose& measured, const JointValues& joints) const;
+  // The data's pose (the measured frame's) from the cabin's at `joints`: the inverse.
+  Pose MeasuredPose(const Pose& cabin, const JointValues& joints) const;
+
   // Whether any cable carries attachments (the statics then need exact: statics.h).
   bool HasAttachments() const {
     for (const CableProperties& c : cables) {
@@ -110,7 +124,7 @@ struct CableRobot {
   }
 
   // Checks physical sense: EA > 0, density > 0, mass > 0, g < 0, finite coordinates,
-  // a symmetric positive definite cabin inertia,
+  // a symmetric positive definite cabin inertia, a measured frame on a part of the model,
   // attachments valid (CableAttachment::IsValid) and at most kMaxAttachmentsPerCable,
   // a reflector (if any) with radius > 0 and aperture in (0, 2 radius], anchor indices in range, no
   // two tower tops coincident, no two distinct anchor points coincident. On failure returns false

@@ -17,6 +17,10 @@
 //   length_offset_m / length_offset_m[i]  m  a winch encoder's zero: measured length =
 //                                         unstretched length + offset (needs the lengths
 //                                         in the fit: noise.length_sigma_m)
+//   moving_parts.NAME.first_moment_kg_m.{x,y,z}  kg m, moving_parts.NAME.mass_kg  kg
+//   measured_frame.offset_m.{x,y,z}  m    the measured point in its part's frame
+//                                         (measured_frame.h; the model must declare
+//                                         cabin.measured_frame)
 // Values in the file are in the unit the name carries (kN for the bias); inside
 // everything is SI (ParameterSpec::to_si converts).
 #ifndef FASTCAL_CALIBRATION_SPEC_H_
@@ -49,10 +53,13 @@ enum class ParameterKind {
   // moving_parts.NAME.mass_kg.
   kPartFirstMoment,  // component = axis 0..2 of the part's frame
   kPartMass,
+  // The measured frame's point (measured_frame.h), component = axis 0..2 of its part's
+  // frame; named measured_frame.offset_m.x.
+  kMeasuredOffset,
 };
 // The last kind: readers of stored parameters (track's fold tasks) accept kinds up to it,
 // so a kind added above is not refused as corrupt.
-inline constexpr ParameterKind kLastParameterKind = ParameterKind::kPartMass;
+inline constexpr ParameterKind kLastParameterKind = ParameterKind::kMeasuredOffset;
 
 struct ParameterSpec {
   ParameterKind kind = ParameterKind::kMassCentre;

@@ -197,6 +197,10 @@ struct DesignCandidate {
   // and the joint grid's point (-1: no rotator in the model).
   JointValues joints{};
   int joint_point = -1;
+  // `pose` in the data's frame: the model's measured frame (measured_frame.h) at `joints`,
+  // what the telemetry shows there and what poses.csv and design.json give; `pose` itself
+  // for a model without one.
+  Pose data_pose;
 };
 
 // The predicted uncertainty of a survey.
@@ -264,7 +268,8 @@ struct Design {
   std::vector<double> free_to_si;       // SI value = file value * to_si
   std::vector<int> wanted;              // indices into free_names
   std::vector<DesignStop> stops;        // in flight order
-  std::vector<Pose> poses;              // one per sample, in flight order
+  std::vector<Pose> poses;              // one per sample, in flight order (the cabin's)
+  std::vector<Pose> data_poses;         // the same in the data's frame (DesignCandidate)
   // With moving parts: the model's joint columns, and each sample's joint values
   // (parallel to poses); both empty for a rigid cabin.
   std::vector<std::string> joint_columns;
@@ -296,8 +301,9 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                   const DesignOptions& options, Design* design, std::string* error);
 
 // The prediction for any survey (one sample per pose, flown options.sample_interval_s
-// apart), with the design's criterion, wanted parameters and slow error. False with
-// *error when the statics fail at a pose.
+// apart), with the design's criterion, wanted parameters and slow error. The poses are the
+// data's (the model's measured frame's at the joints, as a poses.csv gives them). False
+// with *error when the statics fail at a pose.
 bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                    const DesignOptions& options, const std::vector<Pose>& poses,
                    DesignPrediction* prediction, std::string* error);
@@ -307,7 +313,8 @@ bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                    const std::vector<JointValues>& joints, DesignPrediction* prediction,
                    std::string* error);
 
-// The design's outputs (design_output.cc). Poses, one row per sample in flight order:
+// The design's outputs (design_output.cc), every pose in the data's frame (the model's
+// measured frame; Design::data_poses). Poses, one row per sample in flight order:
 // x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg (the format ReadPosesCsv reads), after
 // '#' comment lines with `provenance`; with moving parts, then the joint columns.
 std::string DesignPosesCsv(const Design& design, const std::string& provenance);

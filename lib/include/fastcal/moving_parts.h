@@ -82,6 +82,15 @@ struct PartShift {
 };
 using PartShifts = std::array<PartShift, kMaxMovingParts>;
 
+// Part k's frame in the cabin frame at q: R_k(q), t_k(q), and t_k(0) (the sum of its
+// chain's origins). The measured frame (measured_frame.h) reads it.
+struct PartFrame {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d origin_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d origin_at_zero_m = Eigen::Vector3d::Zero();
+};
+using PartFrames = std::array<PartFrame, kMaxMovingParts>;
+
 // The cabin's moving parts, in file order (parents before children).
 struct MovingParts {
   std::vector<MovingPart> parts;
@@ -98,6 +107,8 @@ struct MovingParts {
   // or a revolute one above an offset origin): only then does its mass enter (1).
   bool Translates(int k) const;
 
+  // Every part's frame at `joints` (the model's joint order, columns' units).
+  void FramesAt(const JointValues& joints, PartFrames* frames) const;
   // A_k and b_k of (1) for every part at `joints` (the model's joint order, columns' units).
   void ShiftsAt(const JointValues& joints, PartShifts* shifts) const;
   // c(q) - c0 of (1) at the parts' current first moments and masses, for a cabin of

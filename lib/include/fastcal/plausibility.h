@@ -154,6 +154,9 @@ enum class ModelQuantity {
   // whole cabin's mass at the farthest plausible mass centre, and at most the cabin's mass.
   kPartFirstMomentKgM,
   kPartMassKg,
+  // One component of the measured frame's point in its part's frame (measured_frame.h): a
+  // point of the cabin, within max_abs_anchor_point_m like its anchors.
+  kMeasuredOffsetM,
 };
 
 // A quantity's plausible range and its nominal FAST value, SI (percent for

@@ -28,6 +28,9 @@
 //                                o_i its zero offset: the truth model's length_offset_m)
 //   measured attitude   a_meas = a_act + N(0, attitude_measurement_sigma_deg)  per rpy angle
 //   measured position   p_meas = p + N(0, position_measurement_sigma_m)        per axis
+//   with a measured frame (the truth's cabin.measured_frame, measured_frame.h), p, a_act
+//   and a_plan above are that frame's at q_n (its pose from the cabin's: (1)-(2) there):
+//   the data are what the telescope's pose sensors see, the statics the cabin's
 // with R(a) = RotationFromRpyDeg(a) and a_plan = RpyDegFromRotation(planned rotation).
 // An AR(1) process x with sigma s and correlation time tau starts stationary,
 // x_0 = s N(0, 1), and steps x_n = phi x_{n-1} + s sqrt(1 - phi^2) N(0, 1),

@@ -249,7 +249,8 @@ CalibrationStatus ValidateInputs(Run& run) {
 CalibrationStatus MeasureForwardModelError(Run& run) {
   StaticsParameters<double> p;
   std::array<double, kNumCables> gain, bias, t_model, t_exact;
-  run.cm->Assemble(run.theta.data(), &p, &gain, &bias);
+  Eigen::Vector3d measured_offset;
+  run.cm->Assemble<double>(run.theta.data(), &p, &gain, &bias, 0, nullptr, &measured_offset);
   StaticsOptions exact = run.statics;
   exact.method = StaticsMethod::kExact;
   double sum2 = 0.0;
@@ -259,7 +260,7 @@ CalibrationStatus MeasureForwardModelError(Run& run) {
   const size_t stride = std::max<size_t>(1, run.data.samples.size() / kForwardErrorSamples);
   for (size_t index = 0; index < run.data.samples.size(); index += stride) {
     const Sample& s = run.data.samples[index];
-    const Pose pose = run.PoseOf(s);
+    const Pose pose = run.PoseOf(s, measured_offset);
     PartShifts shifts;
     run.cm->robot().moving_parts.ShiftsAt(s.joint, &shifts);
     const StaticsParameters<double> at = AtJoints(p, shifts);
@@ -295,9 +296,10 @@ CalibrationStatus Predict(Run& run) {
   std::vector<StaticsParameters<double>> session_params(sessions);
   std::vector<std::array<double, kNumCables>> session_gain(sessions), session_bias(sessions),
       session_offset(sessions);
+  std::vector<Eigen::Vector3d> session_measured_offset(sessions);
   for (size_t k = 0; k < sessions; ++k) {
     run.cm->Assemble(run.theta.data(), &session_params[k], &session_gain[k], &session_bias[k],
-                     static_cast<int>(k), &session_offset[k]);
+                     static_cast<int>(k), &session_offset[k], &session_measured_offset[k]);
   }
   const bool lengths = run.spec.UsesLengths();
   const int num_samples = static_cast<int>(run.data.samples.size());
@@ -319,9 +321,10 @@ CalibrationStatus Predict(Run& run) {
   const bool solved = run.folded != nullptr && run.folded->SolvedAt(run.theta.data());
   const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& sample = run.data.samples[t];
-    at.starts.At(t).Restore(run.PoseOf(sample), options.method, solution);
+    const Pose pose = run.PoseOf(sample, session_measured_offset[sample.session]);
+    at.starts.At(t).Restore(pose, options.method, solution);
     return SolveStaticsWithParameters(session_params[sample.session], run.cm->robot().moving_parts,
-                                      sample.joint, run.PoseOf(sample), options, solution);
+                                      sample.joint, pose, options, solution);
   };
   const int failed =
       internal::ForEachChunk(num_samples, run.spec.num_threads, [&](int begin, int end) {
@@ -468,6 +471,24 @@ std::string FirstMomentHint(const Run& run) {
          "(e.g. first_moment_kg_m: {x: {free: true, prior: {mean: 0, sigma: 3000}}}).\n";
 }
 
+// A free offset of the measured frame without a prior: it moves only the cabin's
+// position, which the tensions see through the cables' geometry alone (measured_frame.h).
+std::string MeasuredOffsetHint(const Run& run) {
+  std::string names;
+  for (int k = 0; k < run.n; ++k) {
+    const ParameterSpec& p = run.Free(k);
+    if (p.kind == ParameterKind::kMeasuredOffset && !p.has_prior) {
+      names += (names.empty() ? "" : ", ") + p.name;
+    }
+  }
+  if (names.empty()) return "";
+  return "the measured point's offset (" + names +
+         ") moves only the cabin's position, which the tensions see through the cables' "
+         "geometry alone (and the z offset trades against mass_centre_m.z where the cabin "
+         "tilts with the pointing): give it a prior from the drawings (e.g. measured_frame: "
+         "{offset_m: {z: {free: true, prior: {mean: -1.2, sigma: 0.5}}}}).\n";
+}
+
 std::string DescribeRefusal(const Run& run) {
   const Identifiability& before = run.result->before;
   std::ostringstream refuse;
@@ -477,7 +498,8 @@ std::string DescribeRefusal(const Run& run) {
       refuse << "  - " << d.Describe() << "   (singular value ratio "
              << RatioText(d.singular_value_ratio) << ")\n";
     }
-    refuse << LengthOffsetHint(before.undetermined) << FirstMomentHint(run);
+    refuse << LengthOffsetHint(before.undetermined) << FirstMomentHint(run)
+           << MeasuredOffsetHint(run);
     return refuse.str();
   }
   bool any = false;
@@ -506,7 +528,8 @@ std::string DescribeRefusal(const Run& run) {
     refuse << "  - " << d.Describe() << "   (singular value ratio "
            << RatioText(d.singular_value_ratio) << ")\n";
   }
-  refuse << LengthOffsetHint(before.poorly_determined) << FirstMomentHint(run);
+  refuse << LengthOffsetHint(before.poorly_determined) << FirstMomentHint(run)
+         << MeasuredOffsetHint(run);
   return refuse.str();
 }
 

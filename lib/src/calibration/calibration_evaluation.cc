@@ -23,12 +23,13 @@ bool PredictReadings(const std::vector<const CableRobot*>& models, const Dataset
   options.warm_start = true;
   std::vector<StaticsParameters<double>> parameters;
   for (const CableRobot* m : models) parameters.push_back(MakeStaticsParameters(*m));
+  const auto model_of = [&](const Sample& s) { return models.size() > 1 ? s.session : 0; };
+  // The cabin's pose: the data's, through the model's measured frame (measured_frame.h).
   const auto pose_of = [&](const Sample& s) {
     Pose pose = s.pose;
     if (attitude == AttitudeSource::kPlanned) pose.rotation = s.planned_rotation;
-    return pose;
+    return models[model_of(s)]->CabinPose(pose, s.joint);
   };
-  const auto model_of = [&](const Sample& s) { return models.size() > 1 ? s.session : 0; };
   const auto solve = [&](int t, StaticsSolution* solution) {
     const Sample& s = data.samples[t];
     const Pose pose = pose_of(s);

@@ -5,6 +5,8 @@
 #include <cmath>
 #include <optional>
 
+#include "fastcal/measured_frame.h"
+
 namespace fastcal::internal {
 
 CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpec& spec)
@@ -15,12 +17,15 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
     base_bias_n_[i] = robot.cables[i].sensor_bias_n;
     base_offset_m_[i] = robot.cables[i].length_offset_m;
   }
+  if (robot.measured_frame.has_value()) base_measured_offset_m_ = robot.measured_frame->offset_m;
   for (size_t j = 0; j < spec.parameters.size(); ++j) {
     const ParameterSpec& s = spec.parameters[j];
     if (s.free) {
       free_.push_back(static_cast<int>(j));
+      // The measured point's offset moves the cabin: the towers' columns give it.
       frees_geometry_ = frees_geometry_ || s.kind == ParameterKind::kAnchorOffset ||
-                        s.kind == ParameterKind::kTowerOffset;
+                        s.kind == ParameterKind::kTowerOffset ||
+                        s.kind == ParameterKind::kMeasuredOffset;
       continue;
     }
     if (!s.has_initial) continue;
@@ -66,9 +71,20 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
         case ParameterKind::kPartMass:
           base_.part_mass_kg[s.index] = v;
           break;
+        case ParameterKind::kMeasuredOffset:
+          base_measured_offset_m_[s.component] = v;
+          break;
       }
     }
   }
+}
+
+Pose CalibrationModel::CabinPose(const Pose& measured, const JointValues& joints,
+                                 const Eigen::Vector3d& offset_m) const {
+  if (!robot_.measured_frame.has_value()) return measured;
+  MeasuredFrame frame = *robot_.measured_frame;
+  frame.offset_m = offset_m;
+  return CabinPoseFromMeasured(frame, robot_.moving_parts, measured, joints);
 }
 
 double CalibrationModel::BaseValue(const ParameterSpec& s) const {
@@ -118,6 +134,8 @@ double CalibrationModel::BaseValue(const ParameterSpec& s) const {
       return base_.part_first_moment_kg_m[c][s.component];
     case ParameterKind::kPartMass:
       return base_.part_mass_kg[c];
+    case ParameterKind::kMeasuredOffset:
+      return base_measured_offset_m_[s.component];
   }
   return 0.0;
 }
@@ -134,8 +152,10 @@ std::vector<double> CalibrationModel::InitialTheta() const {
 CableRobot CalibrationModel::ToRobot(const double* theta, int session) const {
   StaticsParameters<double> p;
   std::array<double, kNumCables> gain, bias, offset;
-  Assemble(theta, &p, &gain, &bias, session, &offset);
+  Eigen::Vector3d measured_offset;
+  Assemble(theta, &p, &gain, &bias, session, &offset, &measured_offset);
   CableRobot out = robot_;
+  if (out.measured_frame.has_value()) out.measured_frame->offset_m = measured_offset;
   // Anchor points: the offset of the first cable tied to each point (all its cables
   // carry the same offset by construction).
   for (size_t j = 0; j < out.anchor_points_cabin_m.size(); ++j) {
@@ -203,7 +223,8 @@ TensionResidual FittedSamples::At(int j, const CalibrationModel* through) const 
 void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
                                        const std::array<double, kNumCables>& gain, int session,
                                        double* jacobian, const PartShifts* shifts,
-                                       const StaticsParameters<double>* at) const {
+                                       const StaticsParameters<double>* at,
+                                       const Eigen::Matrix3d* measured_rotation) const {
   const int n = num_free();
   Eigen::Map<Eigen::Matrix<double, kNumCables, Eigen::Dynamic, Eigen::RowMajor>> j(jacobian,
                                                                                    kNumCables, n);
@@ -254,6 +275,14 @@ void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
       case ParameterKind::kTowerOffset:
         column = gradient.tower_top_m[s.index].col(s.component);
         break;
+      case ParameterKind::kMeasuredOffset:
+        // dp_c = -R_m e_j: the cabin's translation is every tower's opposite one.
+        if (measured_rotation != nullptr) {
+          for (int i = 0; i < kNumCables; ++i) {
+            column += gradient.tower_top_m[i] * measured_rotation->col(s.component);
+          }
+        }
+        break;
       case ParameterKind::kAttachmentMass:
       case ParameterKind::kAttachmentDensity:
         column = gradient.chain_value[s.index][s.component];
@@ -280,7 +309,8 @@ ModelAtTheta::ModelAtTheta(const CalibrationModel& model, const double* theta, i
     : model_(&model), theta_(theta), sessions_(std::max(1, sessions)) {
   for (size_t k = 0; k < sessions_.size(); ++k) {
     Session& s = sessions_[k];
-    model.Assemble(theta, &s.statics, &s.gain, &s.bias, static_cast<int>(k));
+    model.Assemble<double>(theta, &s.statics, &s.gain, &s.bias, static_cast<int>(k), nullptr,
+                           &s.measured_offset_m);
     s.gains_positive = std::all_of(s.gain.begin(), s.gain.end(), [](double g) { return g > 0.0; });
   }
 }
@@ -321,8 +351,11 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
     at_joints.emplace(AtJoints(m.statics, shifts));
   }
   const StaticsParameters<double>& params = at_joints ? *at_joints : m.statics;
+  // The statics' pose is the cabin's: the data's own without a measured frame.
+  const Pose pose =
+      model.CabinPose(x.pose, x.joints != nullptr ? *x.joints : JointValues{}, m.measured_offset_m);
   StaticsSolution solution;
-  x.start.Restore(x.pose, statics.method, &solution);
+  x.start.Restore(pose, statics.method, &solution);
   StaticsOptions options = statics;
   options.warm_start = true;
   // A start that is these statics' solution is not solved again (issue 41: from a
@@ -332,13 +365,13 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
                          statics.method == StaticsMethod::kExact && x.start.has_start();
   TensionGradient gradient;
   if (as_solved) {
-    if (ExactTensionGradient(params, x.pose, solution, options.catenary.vertical_span_fraction,
+    if (ExactTensionGradient(params, pose, solution, options.catenary.vertical_span_fraction,
                              model.frees_geometry(), &gradient,
                              /*tensions_from_state=*/true) != StaticsStatus::kOk) {
       return false;
     }
     for (int i = 0; i < kNumCables; ++i) solution.cables[i].lower_tension_n = gradient.tension_n[i];
-  } else if (SolveStaticsWithParameters(params, x.pose, options, &solution) != StaticsStatus::kOk) {
+  } else if (SolveStaticsWithParameters(params, pose, options, &solution) != StaticsStatus::kOk) {
     return false;
   }
   for (int i = 0; i < kNumCables; ++i) {
@@ -350,13 +383,13 @@ bool RowsThrough(const CalibrationModel& model, const ModelAtTheta::Session& m,
   if (solved != nullptr) solved->start = CompactStart::Of(solution);
   if (jacobian == nullptr) return true;
   if (!as_solved &&
-      ExactTensionGradient(params, x.pose, solution, options.catenary.vertical_span_fraction,
+      ExactTensionGradient(params, pose, solution, options.catenary.vertical_span_fraction,
                            model.frees_geometry(), &gradient) != StaticsStatus::kOk) {
     return false;
   }
   const int n = model.num_free();
   model.ReadingJacobian(gradient, m.gain, x.session, jacobian, at_joints ? &shifts : nullptr,
-                        &m.statics);
+                        &m.statics, &x.pose.rotation);
   for (int i = 0; i < kNumCables; ++i) {
     const bool out = x.excluded != nullptr && (*x.excluded)[i];
     const double scale = out ? 0.0 : 1.0 / x.sigma_n[i];
@@ -373,7 +406,8 @@ bool TensionResidual::Evaluate(const double* theta, double* residuals, double* j
     return TensionCost::EvaluateJet(*this, theta, residuals, jacobian);
   }
   ModelAtTheta::Session m;
-  model->Assemble(theta, &m.statics, &m.gain, &m.bias, session);
+  model->Assemble<double>(theta, &m.statics, &m.gain, &m.bias, session, nullptr,
+                          &m.measured_offset_m);
   m.gains_positive = std::all_of(m.gain.begin(), m.gain.end(), [](double g) { return g > 0.0; });
   return RowsThrough(*model, m, statics,
                      {pose, start, measured_n, sigma_n, &excluded, session, &joints, false},

@@ -86,10 +86,12 @@ struct Run {
   internal::Linearisation lin;
   Eigen::MatrixXd information;
 
-  Pose PoseOf(const Sample& s) const {
+  // The cabin's pose of sample `s` (its planned attitude with attitude: planned), with the
+  // measured frame's point at `measured_offset_m` (Assemble's at theta): measured_frame.h.
+  Pose PoseOf(const Sample& s, const Eigen::Vector3d& measured_offset_m) const {
     Pose pose = s.pose;
     if (spec.use_planned_attitude) pose.rotation = s.planned_rotation;
-    return pose;
+    return cm->CabinPose(pose, s.joint, measured_offset_m);
   }
   const ParameterSpec& Free(int k) const { return spec.parameters[cm->spec_index(k)]; }
   // The current prediction, the fitted samples and their exclusions.

@@ -229,8 +229,9 @@ bool CalibrationSpec::IsValid(std::string* error) const {
     const ParameterSpec& p = parameters[k];
     const std::string label = p.name.empty() ? "parameters[" + std::to_string(k) + "]" : p.name;
     if (const std::string w = ParameterProblem(p, label); !w.empty()) return fail(w);
-    const bool indexed =
-        p.kind != ParameterKind::kMassCentre && p.kind != ParameterKind::kCabinMass;
+    const bool indexed = p.kind != ParameterKind::kMassCentre &&
+                         p.kind != ParameterKind::kCabinMass &&
+                         p.kind != ParameterKind::kMeasuredOffset;
     const auto key =
         std::make_tuple(static_cast<int>(p.kind), indexed ? p.index : -1,
                         IsVector(p.kind) || IsAttachment(p.kind) ? p.component : -1, p.session);
@@ -328,6 +329,11 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
       out << MovingPartsYaml(spec);
       continue;
     }
+    if (g.kind == ParameterKind::kMeasuredOffset) {
+      out << "  " << kMeasuredFrameKey << ":\n    offset_m:\n";
+      for (const std::string& line : AxisLines(spec, g, -1)) out << "      " << line << "\n";
+      continue;
+    }
     out << "  " << g.key << ":";
     if (g.kind == ParameterKind::kMassCentre) {
       out << "\n";
@@ -388,7 +394,9 @@ std::vector<ParameterSpec> AllModelParameters(int num_anchor_points) {
       for (int i = -1; i < kNumCables; ++i) all.push_back(MakeParameter(g, i, -1, fixed));
     } else {
       // None without a model (the overload below).
-      if (IsAttachment(g.kind) || IsPart(g.kind)) continue;
+      if (IsAttachment(g.kind) || IsPart(g.kind) || g.kind == ParameterKind::kMeasuredOffset) {
+        continue;
+      }
       const int count = g.kind == ParameterKind::kAnchorOffset ? num_anchor_points : kNumCables;
       for (int j = 0; j < count; ++j) {
         for (int c = 0; c < 3; ++c) all.push_back(MakeParameter(g, j, c, fixed));
@@ -414,6 +422,13 @@ std::vector<ParameterSpec> AllModelParameters(const CableRobot& model) {
     if (model.moving_parts.Translates(part)) {
       ParameterSpec p = MakeParameter(*InfoOf(ParameterKind::kPartMass), part, -1, fixed);
       p.name = PartParameterName(parts[k].name, p.kind, -1);
+      all.push_back(p);
+    }
+  }
+  if (model.measured_frame.has_value()) {  // the measured point's offset
+    for (int c = 0; c < 3; ++c) {
+      ParameterSpec p = MakeParameter(*InfoOf(ParameterKind::kMeasuredOffset), -1, c, fixed);
+      p.name = MeasuredOffsetName(c);
       all.push_back(p);
     }
   }
@@ -448,6 +463,9 @@ bool ParameterFitsModel(const ParameterSpec& p, const CableRobot& model, std::st
       return fail("the model has no such moving part (cabin.moving_parts in the model file)");
     }
   }
+  if (p.kind == ParameterKind::kMeasuredOffset && !model.measured_frame.has_value()) {
+    return fail("the model declares no measured frame (cabin.measured_frame in the model file)");
+  }
   if (IsAttachment(p.kind)) {
     const bool on_cable = p.index >= 0 && p.index < kNumCables && p.component >= 0 &&
                           p.component < static_cast<int>(model.cables[p.index].attachments.size());
@@ -465,6 +483,7 @@ bool SameParameter(const ParameterSpec& a, const ParameterSpec& b) {
   if (a.kind != b.kind) return false;
   switch (a.kind) {
     case ParameterKind::kMassCentre:
+    case ParameterKind::kMeasuredOffset:
       return a.component == b.component;
     case ParameterKind::kCabinMass:
       return true;

@@ -78,12 +78,12 @@ EntryText Override(const EntryText& base, const EntryText& over) {
 
 class Reader {
  public:
-  Reader(const std::string& source, int num_anchor_points, AttachmentShape attachments,
-         std::vector<std::string> parts)
+  Reader(const std::string& source, const ModelShape& model)
       : source_(source),
-        num_anchor_points_(num_anchor_points),
-        attachments_(std::move(attachments)),
-        parts_(std::move(parts)) {}
+        num_anchor_points_(model.num_anchor_points),
+        attachments_(model.attachments),
+        parts_(model.parts),
+        measured_frame_(model.measured_frame) {}
 
   const std::string& error() const { return error_; }
 
@@ -850,6 +850,30 @@ class Reader {
     return true;
   }
 
+  // measured_frame: {offset_m: {x, y, z}} (measured_frame.h), for a model that declares
+  // cabin.measured_frame.
+  bool ReadMeasuredFrame(const KeyValue& group, const std::string& path,
+                         std::vector<ParameterSpec>* out) {
+    if (!measured_frame_) {
+      return Fail(group.line, path,
+                  "the model declares no measured frame (cabin.measured_frame in the model "
+                  "file, given with --model: whose pose the data's x_m..z_m and attitude give)");
+    }
+    KeyMap keys;
+    if (!ReadMap(group, path, {"offset_m"}, &keys)) return false;
+    const KeyValue* kv = Find(keys, "offset_m");
+    if (kv == nullptr) return true;
+    const size_t before = out->size();
+    if (!ReadAxes(kv->value, kv->line, *InfoOf(ParameterKind::kMeasuredOffset), -1,
+                  Join(path, "offset_m"), out)) {
+      return false;
+    }
+    for (size_t j = before; j < out->size(); ++j) {
+      (*out)[j].name = MeasuredOffsetName((*out)[j].component);
+    }
+    return true;
+  }
+
   bool ReadParameters(const KeyValue& parameters, CalibrationSpec* spec) {
     std::vector<std::string> accepted;
     for (const GroupInfo& g : kGroups) {
@@ -869,6 +893,8 @@ class Reader {
       if (g.kind == ParameterKind::kPartMass) continue;  // read with the first moments
       if (g.kind == ParameterKind::kPartFirstMoment) {
         ok = ReadMovingParts(*kv, path, &out);
+      } else if (g.kind == ParameterKind::kMeasuredOffset) {
+        ok = ReadMeasuredFrame(*kv, path, &out);
       } else if (g.kind == ParameterKind::kMassCentre) {
         ok = ReadAxes(kv->value, kv->line, g, -1, path, &out);
       } else if (g.kind == ParameterKind::kCabinMass) {
@@ -892,16 +918,16 @@ class Reader {
   int num_anchor_points_;
   AttachmentShape attachments_;
   std::vector<std::string> parts_;  // the model's moving parts, by name
+  bool measured_frame_;             // the model declares cabin.measured_frame
   std::string error_;
 };
 }  // namespace
 
 namespace {
 
-bool ParseSpec(const std::string& text, const std::string& source_name, int num_anchor_points,
-               const AttachmentShape& attachments, const std::vector<std::string>& parts,
+bool ParseSpec(const std::string& text, const std::string& source_name, const ModelShape& model,
                CalibrationSpec* spec, std::string* error) {
-  Reader reader(source_name, num_anchor_points, attachments, parts);
+  Reader reader(source_name, model);
   CalibrationSpec parsed;
   try {
     const internal::YamlDocuments documents = internal::LoadYamlDocuments(text);
@@ -927,45 +953,52 @@ bool ParseSpec(const std::string& text, const std::string& source_name, int num_
   return true;
 }
 
-bool LoadSpec(const std::string& path, int num_anchor_points, const AttachmentShape& attachments,
-              const std::vector<std::string>& parts, CalibrationSpec* spec, std::string* error) {
+bool LoadSpec(const std::string& path, const ModelShape& model, CalibrationSpec* spec,
+              std::string* error) {
   std::string text;
   std::string message;
   if (!internal::ReadRegularFile(path, kMaxSpecFileBytes, "calibration spec", &text, &message)) {
     if (error != nullptr) *error = message;
     return false;
   }
-  return ParseSpec(text, path, num_anchor_points, attachments, parts, spec, error);
+  return ParseSpec(text, path, model, spec, error);
 }
 
-std::vector<std::string> PartNames(const CableRobot& model) {
-  std::vector<std::string> names;
-  for (const MovingPart& p : model.moving_parts.parts) names.push_back(p.name);
-  return names;
+ModelShape ShapeOfModel(const CableRobot& model) {
+  ModelShape shape;
+  shape.num_anchor_points = static_cast<int>(model.anchor_points_cabin_m.size());
+  shape.attachments = ShapeOf(model);
+  for (const MovingPart& p : model.moving_parts.parts) shape.parts.push_back(p.name);
+  shape.measured_frame = model.measured_frame.has_value();
+  return shape;
+}
+
+ModelShape ShapeOfAnchors(int num_anchor_points) {
+  ModelShape shape;
+  shape.num_anchor_points = num_anchor_points;
+  return shape;
 }
 
 }  // namespace
 
 bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
                               const CableRobot& model, CalibrationSpec* spec, std::string* error) {
-  return ParseSpec(text, source_name, static_cast<int>(model.anchor_points_cabin_m.size()),
-                   ShapeOf(model), PartNames(model), spec, error);
+  return ParseSpec(text, source_name, ShapeOfModel(model), spec, error);
 }
 
 bool ParseCalibrationSpecYaml(const std::string& text, const std::string& source_name,
                               int num_anchor_points, CalibrationSpec* spec, std::string* error) {
-  return ParseSpec(text, source_name, num_anchor_points, AttachmentShape(), {}, spec, error);
+  return ParseSpec(text, source_name, ShapeOfAnchors(num_anchor_points), spec, error);
 }
 
 bool LoadCalibrationSpec(const std::string& path, const CableRobot& model, CalibrationSpec* spec,
                          std::string* error) {
-  return LoadSpec(path, static_cast<int>(model.anchor_points_cabin_m.size()), ShapeOf(model),
-                  PartNames(model), spec, error);
+  return LoadSpec(path, ShapeOfModel(model), spec, error);
 }
 
 bool LoadCalibrationSpec(const std::string& path, int num_anchor_points, CalibrationSpec* spec,
                          std::string* error) {
-  return LoadSpec(path, num_anchor_points, AttachmentShape(), {}, spec, error);
+  return LoadSpec(path, ShapeOfAnchors(num_anchor_points), spec, error);
 }
 
 }  // namespace fastcal

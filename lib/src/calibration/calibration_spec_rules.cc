@@ -71,7 +71,13 @@ bool IsPerCableCapable(ParameterKind kind) {
 
 bool IsVector(ParameterKind kind) {
   return kind == ParameterKind::kMassCentre || kind == ParameterKind::kAnchorOffset ||
-         kind == ParameterKind::kTowerOffset || kind == ParameterKind::kPartFirstMoment;
+         kind == ParameterKind::kTowerOffset || kind == ParameterKind::kPartFirstMoment ||
+         kind == ParameterKind::kMeasuredOffset;
+}
+
+std::string MeasuredOffsetName(int component) {
+  return std::string(kMeasuredFrameKey) + ".offset_m." +
+         std::string(1, kAxes[component < 0 ? 0 : component]);
 }
 
 std::string PartParameterName(const std::string& part, ParameterKind kind, int component) {

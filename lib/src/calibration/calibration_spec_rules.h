@@ -49,9 +49,15 @@ inline constexpr GroupInfo kGroups[] = {
     // Both under one key, `moving_parts: {NAME: {first_moment_kg_m: {x, y, z}, mass_kg}}`.
     {ParameterKind::kPartFirstMoment, "moving_parts", "kg m", 1.0},
     {ParameterKind::kPartMass, "moving_parts", "kg", 1.0},
+    // `measured_frame: {offset_m: {x, y, z}}`.
+    {ParameterKind::kMeasuredOffset, "measured_frame", "m", 1.0},
 };
 
 inline constexpr char kMovingPartsKey[] = "moving_parts";
+inline constexpr char kMeasuredFrameKey[] = "measured_frame";
+
+// "measured_frame.offset_m.x".
+std::string MeasuredOffsetName(int component);
 
 // The moving parts' kinds (one key in the spec for both).
 inline bool IsPart(ParameterKind kind) {
@@ -65,6 +71,14 @@ std::string PartOfParameterName(const std::string& name);
 
 // What the model's cables carry, as the spec reader needs it: each cable's attachment kinds.
 using AttachmentShape = std::array<std::vector<AttachmentKind>, kNumCables>;
+
+// What the spec reader needs of the model: what its groups may name.
+struct ModelShape {
+  int num_anchor_points = 3;
+  AttachmentShape attachments;
+  std::vector<std::string> parts;  // the moving parts, by name
+  bool measured_frame = false;     // cabin.measured_frame declared
+};
 
 inline constexpr char kBothNoiseZero[] =
     "tension_sigma_kN and tension_sigma_percent are both 0 (the residuals could not be "
@@ -192,21 +206,24 @@ using spec_rules::InfoOf;
 using spec_rules::IsAttachment;
 using spec_rules::IsKnownMethod;
 using spec_rules::IsPart;
-using spec_rules::kMovingPartsKey;
-using spec_rules::PartOfParameterName;
-using spec_rules::PartParameterName;
 using spec_rules::IsPerCableCapable;
 using spec_rules::IsVector;
 using spec_rules::kAxes;
 using spec_rules::kBothNoiseZero;
 using spec_rules::kFormatName;
 using spec_rules::kGroups;
+using spec_rules::kMeasuredFrameKey;
+using spec_rules::kMovingPartsKey;
 using spec_rules::kNewtonsPerKilonewton;
 using spec_rules::kRootPath;
 using spec_rules::LengthsProblem;
 using spec_rules::MakeParameter;
+using spec_rules::MeasuredOffsetName;
+using spec_rules::ModelShape;
 using spec_rules::Num;
 using spec_rules::NumInUnit;
+using spec_rules::PartOfParameterName;
+using spec_rules::PartParameterName;
 using spec_rules::ShapeOf;
 }  // namespace fastcal
 

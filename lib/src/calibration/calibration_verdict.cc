@@ -42,6 +42,39 @@ std::string IdentifiabilityNote(const CalibrationResult& r, const ParameterSpec&
   return note;
 }
 
+// The largest angle (deg) between the measured frame's axis `component` in the world,
+// R_m e_j, over the fitted samples and its mean direction: how far the survey turns it.
+// An offset along an axis the data never turn moves every sample's cabin by the same
+// vector (measured_frame.h (4)), which the tensions see only through the cables'
+// geometry, like a common shift of the towers.
+double MeasuredAxisTurnDeg(const Run& run, int component) {
+  const auto axis = [&](int t) -> Eigen::Vector3d {
+    const Sample& s = run.data.samples[t];
+    return (run.spec.use_planned_attitude ? s.planned_rotation : s.pose.rotation).col(component);
+  };
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (int t : run.fit) mean += axis(t);
+  if (!(mean.norm() > 0.0)) return 180.0;
+  mean.normalize();
+  double smallest_cos = 1.0;
+  for (int t : run.fit) smallest_cos = std::min(smallest_cos, mean.dot(axis(t)));
+  constexpr double kDegPerRad = 57.29577951308232;
+  return std::acos(std::clamp(smallest_cos, -1.0, 1.0)) * kDegPerRad;
+}
+
+// A measured frame's offset along an axis the survey turns by less than this (deg) is
+// marked: the survey gives it only the constant shift of every cabin position.
+constexpr double kUnturnedAxisDeg = 1.0;
+
+std::string MeasuredOffsetNote(const Run& run, const ParameterSpec& p) {
+  if (p.kind != ParameterKind::kMeasuredOffset || run.fit.empty()) return "";
+  const double turn = MeasuredAxisTurnDeg(run, p.component);
+  if (turn >= kUnturnedAxisDeg) return "";
+  return "the data never turn this axis (by " + Fixed("%.2g", turn) +
+         " deg at most): it shifts every cabin position alike, seen only through the cables' "
+         "geometry";
+}
+
 void FillParameterTable(Run& run) {
   CalibrationResult& r = *run.result;
   std::vector<int> free_of_spec(run.spec.parameters.size(), -1);
@@ -77,6 +110,9 @@ void FillParameterTable(Run& run) {
       for (double g : b.systematic_by_group) e.systematic_by_group.push_back(g / p.to_si);
     }
     e.note = IdentifiabilityNote(r, p, e, run.options);
+    if (const std::string unturned = MeasuredOffsetNote(run, p); !unturned.empty()) {
+      e.note = unturned + (e.note.empty() ? "" : "; " + e.note);
+    }
     r.parameters.push_back(e);
   }
   r.calibrated = run.cm->ToRobot(run.theta.data());

@@ -9,10 +9,12 @@
 namespace fastcal {
 namespace {
 
-Pose PoseOf(const Sample& sample, AttitudeSource attitude) {
+// The cabin's pose of a sample: its data pose (the model's measured frame's, at its
+// joints: measured_frame.h), with the planned attitude when asked.
+Pose PoseOf(const CableRobot& robot, const Sample& sample, AttitudeSource attitude) {
   Pose pose = sample.pose;
   if (attitude == AttitudeSource::kPlanned) pose.rotation = sample.planned_rotation;
-  return pose;
+  return robot.CabinPose(pose, sample.joint);
 }
 
 // "<file>:<line>: <model> cannot solve this pose<detail>: <why>".
@@ -33,7 +35,7 @@ TensionPredictor::TensionPredictor(const CableRobot& robot, AttitudeSource attit
 
 bool TensionPredictor::Predict(const Dataset& data, const Sample& sample,
                                std::array<double, kNumCables>* predicted_n, std::string* error) {
-  if (SolveStatics(robot_, PoseOf(sample, attitude_), sample.joint, options_, &solution_) !=
+  if (SolveStatics(robot_, PoseOf(robot_, sample, attitude_), sample.joint, options_, &solution_) !=
       StaticsStatus::kOk) {
     *error = CannotSolve(data, sample, "the model", "", solution_);
     return false;
@@ -74,9 +76,8 @@ int SkipUnsolvableSamples(const CableRobot& robot, const std::string& model_name
       if (attitude == AttitudeSource::kPlanned && !data->has_planned_attitude) continue;
       for (StaticsMethod method : methods) {
         options.method = method;
-        if (!why.empty() ||
-            SolveStatics(robot, PoseOf(s, attitude), s.joint, options, &solution) ==
-                StaticsStatus::kOk) {
+        if (!why.empty() || SolveStatics(robot, PoseOf(robot, s, attitude), s.joint, options,
+                                         &solution) == StaticsStatus::kOk) {
           continue;
         }
         why = CannotSolve(*data, s, model_name,

@@ -53,6 +53,10 @@ double MaxSigma(const ParameterSpec& p, double initial, const CalibrationOptions
     case ParameterKind::kPartMass:
       return p.has_prior ? std::max(o.max_sigma_part_mass_kg, 1.01 * p.prior_sigma_si)
                          : o.max_sigma_part_mass_kg;
+    case ParameterKind::kMeasuredOffset:
+      // Seen only through the cables' geometry (measured_frame.h): a prior bounds it.
+      return p.has_prior ? std::max(o.max_sigma_measured_offset_m, 1.01 * p.prior_sigma_si)
+                         : o.max_sigma_measured_offset_m;
   }
   return std::numeric_limits<double>::infinity();
 }

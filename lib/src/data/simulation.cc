@@ -277,6 +277,25 @@ void MeasurePose(const Eigen::Vector3d& position_m, const Eigen::Vector3d& actua
   p->position_sq += position_noise_m.squaredNorm();
 }
 
+// Where the truth model declares a measured frame (measured_frame.h (1)-(2)), the pose
+// sensors see that frame: the planned attitude and the actual position and attitude
+// become its own, at the sample's joints. The cabin's are left as they are without one.
+void ToDataFrame(const CableRobot& model, const Pose& planned_pose, Eigen::Vector3d* position_m,
+                 Eigen::Vector3d* actual_rpy_deg, Sample* s) {
+  if (!model.measured_frame.has_value()) return;
+  const Pose planned = model.MeasuredPose(planned_pose, s->joint);
+  s->planned_rpy_deg = NoNegativeZero(RpyDegFromRotation(planned.rotation));
+  s->planned_rotation =
+      RotationFromRpyDeg(s->planned_rpy_deg[0], s->planned_rpy_deg[1], s->planned_rpy_deg[2]);
+  Pose actual;
+  actual.position_m = *position_m;
+  actual.rotation =
+      RotationFromRpyDeg((*actual_rpy_deg)[0], (*actual_rpy_deg)[1], (*actual_rpy_deg)[2]);
+  const Pose data = model.MeasuredPose(actual, s->joint);
+  *position_m = data.position_m;
+  *actual_rpy_deg = RpyDegFromRotation(data.rotation);
+}
+
 double SlowErrorN(const SimulationOptions& o, double reading_n, double drift) {
   if (!(o.tension_drift_kn > 0.0)) return reading_n * drift;
   const double relative = o.tension_drift_percent / 100.0;
@@ -479,7 +498,9 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
                      &model, &actual_rpy_deg, &solution, error)) {
       return false;
     }
-    MeasurePose(planned_pose.position_m, actual_rpy_deg, options, &processes, &s);
+    Eigen::Vector3d position_m = planned_pose.position_m;
+    ToDataFrame(model, planned_pose, &position_m, &actual_rpy_deg, &s);
+    MeasurePose(position_m, actual_rpy_deg, options, &processes, &s);
     if (!MeasureTensions(n, model, solution, options, &processes, &stats, &s, error)) return false;
     if (!sink(s, error)) return false;
   }

@@ -188,12 +188,14 @@ void FlyStops(const std::vector<DesignCandidate>& candidates, const std::vector<
   d->path_length_m = PathLength(points, order);
   d->stops.clear();
   d->poses.clear();
+  d->data_poses.clear();
   d->joints.clear();
   for (int k : order) {
     const DesignCandidate& c = candidates[support[k]];
     d->stops.push_back({support[k], counts[support[k]], {}});
     for (int s = 0; s < counts[support[k]]; ++s) {
       d->poses.push_back(c.pose);
+      d->data_poses.push_back(c.data_pose);
       if (!d->joint_columns.empty()) d->joints.push_back(c.joints);
     }
   }
@@ -662,6 +664,7 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
   }
   d.joint_columns = robot.moving_parts.JointColumns();
   if (!internal::ExpandJointGrid(robot, options, &d.candidates, error)) return false;
+  for (DesignCandidate& c : d.candidates) c.data_pose = robot.MeasuredPose(c.pose, c.joints);
   say(std::to_string(d.candidates.size()) + " feasible candidates (" +
       std::to_string(d.rejected_candidates) +
       " infeasible); those that hold over the parameters' plausible range");
@@ -744,8 +747,13 @@ bool PredictSurvey(const CableRobot& robot, const CalibrationSpec& spec,
   o.samples = std::max<int>(1, static_cast<int>(poses.size()));
   DesignProblem pr;
   if (!SetUp(robot, spec, o, &pr, error)) return false;
+  // The survey's poses are the data's: the cabin's follow through the measured frame.
+  std::vector<Pose> cabin(poses.size());
+  for (size_t n = 0; n < poses.size(); ++n) {
+    cabin[n] = robot.CabinPose(poses[n], joints.empty() ? JointValues{} : joints[n]);
+  }
   DesignProblem flown;
-  if (!SurveyProblem(robot, spec, pr, poses, joints, EvenTimes(poses.size(), o.sample_interval_s),
+  if (!SurveyProblem(robot, spec, pr, cabin, joints, EvenTimes(poses.size(), o.sample_interval_s),
                      PredictionSlowError(spec, o), &flown, error)) {
     return false;
   }

@@ -121,8 +121,9 @@ bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
                                                                              model.num_free());
   std::array<double, kMaxReadings> reading{};
   for (size_t t = 0; t < poses.size(); ++t) {
-    f.pose = poses[t];
     if (!joints.empty()) f.joints = joints[t];
+    // The residual reads the data's pose (the measured frame's): the cabin's through it.
+    f.pose = robot.MeasuredPose(poses[t], f.joints);
     const TensionCost cost(f);
     const double* parameters[1] = {theta.data()};
     double* jacobians[1] = {jac.data()};

@@ -158,8 +158,8 @@ std::string DesignPosesCsv(const Design& design, const std::string& provenance) 
   out += "x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg";
   for (const std::string& column : design.joint_columns) out += "," + column;
   out += "\n";
-  for (size_t n = 0; n < design.poses.size(); ++n) {
-    const Pose& p = design.poses[n];
+  for (size_t n = 0; n < design.data_poses.size(); ++n) {
+    const Pose& p = design.data_poses[n];
     const Eigen::Vector3d rpy = RpyDegFromRotation(p.rotation);
     out += Fmt("%.6f", p.position_m[0]) + "," + Fmt("%.6f", p.position_m[1]) + "," +
            Fmt("%.6f", p.position_m[2]) + "," + Fmt("%.8f", rpy[0]) + "," + Fmt("%.8f", rpy[1]) +
@@ -217,11 +217,11 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
   j.Key("stops").BeginArray();
   for (const DesignStop& s : d.stops) {
     const DesignCandidate& c = d.candidates[s.candidate];
-    const Eigen::Vector3d rpy = RpyDegFromRotation(c.pose.rotation);
+    const Eigen::Vector3d rpy = RpyDegFromRotation(c.data_pose.rotation);
     j.BeginObject().Key("samples").Int(s.samples);
     j.Key("position_m")
-        .NumberArray(
-            std::vector<double>{c.pose.position_m[0], c.pose.position_m[1], c.pose.position_m[2]});
+        .NumberArray(std::vector<double>{c.data_pose.position_m[0], c.data_pose.position_m[1],
+                                         c.data_pose.position_m[2]});
     j.Key("rpy_deg").NumberArray(std::vector<double>{rpy[0], rpy[1], rpy[2]});
     j.Key("off_axis_deg").Number(c.off_axis_deg).Key("azimuth_deg").Number(c.azimuth_deg);
     j.Key("extra_tilt_deg").Number(c.extra_tilt_deg);
@@ -329,8 +329,8 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   s += "<circle cx=\"" + X(g.focal_centre_m.x()) + "\" cy=\"" + Y(g.focal_centre_m.y()) +
        "\" r=\"" + Fmt("%.1f", scale * rim_m) + "\" fill=\"#f7f7f7\" stroke=\"#999\"/>\n";
   for (const DesignCandidate& c : d.candidates) {
-    s += "<circle cx=\"" + X(c.pose.position_m.x()) + "\" cy=\"" + Y(c.pose.position_m.y()) +
-         "\" r=\"0.8\" fill=\"#bbb\"/>\n";
+    s += "<circle cx=\"" + X(c.data_pose.position_m.x()) + "\" cy=\"" +
+         Y(c.data_pose.position_m.y()) + "\" r=\"0.8\" fill=\"#bbb\"/>\n";
   }
   const double r_circle = d.options.circle_radius_m;
   s += "<circle cx=\"" + X(d.options.circle_centre_m.x()) + "\" cy=\"" +
@@ -339,7 +339,7 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
        "</title></circle>\n";
   std::string path;
   for (const DesignStop& st : d.stops) {
-    const Eigen::Vector3d& p = d.candidates[st.candidate].pose.position_m;
+    const Eigen::Vector3d& p = d.candidates[st.candidate].data_pose.position_m;
     path += (path.empty() ? "M" : " L") + X(p.x()) + " " + Y(p.y());
   }
   s += "<path class=\"path\" d=\"" + path +
@@ -347,7 +347,7 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   // The flight order: each stop's number beside it, the first also marked "start" with a
   // ring, so that the path reads without its tooltips.
   if (!d.stops.empty()) {
-    const Eigen::Vector3d& p0 = d.candidates[d.stops.front().candidate].pose.position_m;
+    const Eigen::Vector3d& p0 = d.candidates[d.stops.front().candidate].data_pose.position_m;
     s += "<circle class=\"start\" cx=\"" + X(p0.x()) + "\" cy=\"" + Y(p0.y()) +
          "\" r=\"13\" fill=\"none\" stroke=\"#111\" stroke-width=\"2\"/>\n<text x=\"" +
          Fmt("%.1f", half + scale * (p0.x() - g.focal_centre_m.x()) + 16.0) + "\" y=\"" +
@@ -358,24 +358,24 @@ std::string CapSvg(const Design& d, const CableRobot& robot) {
   std::map<std::string, CircleLabel> numbers;  // by drawn position
   for (const DesignStop& st : d.stops) {
     const DesignCandidate& c = d.candidates[st.candidate];
-    const Eigen::Vector3d rpy = RpyDegFromRotation(c.pose.rotation);
+    const Eigen::Vector3d rpy = RpyDegFromRotation(c.data_pose.rotation);
     const double radius = 2.5 + 1.5 * std::sqrt(static_cast<double>(st.samples));
     const std::string fill =
         c.extra_tilt_deg > 0.0 ? "#009E73" : (c.extra_yaw_deg != 0.0 ? "#CC79A7" : "#0072B2");
-    s += "<circle class=\"stop\" cx=\"" + X(c.pose.position_m.x()) + "\" cy=\"" +
-         Y(c.pose.position_m.y()) + "\" r=\"" + Fmt("%.1f", radius) + "\" fill=\"" + fill +
+    s += "<circle class=\"stop\" cx=\"" + X(c.data_pose.position_m.x()) + "\" cy=\"" +
+         Y(c.data_pose.position_m.y()) + "\" r=\"" + Fmt("%.1f", radius) + "\" fill=\"" + fill +
          "\" fill-opacity=\"0.7\" stroke=\"#333\" stroke-width=\"0.5\"><title>stop " +
          std::to_string(++order) + ": " + std::to_string(st.samples) + " samples at (" +
-         Fmt("%.2f", c.pose.position_m.x()) + ", " + Fmt("%.2f", c.pose.position_m.y()) + ", " +
-         Fmt("%.2f", c.pose.position_m.z()) + ") m, rpy (" + Fmt("%.2f", rpy[0]) + ", " +
-         Fmt("%.2f", rpy[1]) + ", " + Fmt("%.2f", rpy[2]) + ") deg; extra tilt " +
+         Fmt("%.2f", c.data_pose.position_m.x()) + ", " + Fmt("%.2f", c.data_pose.position_m.y()) +
+         ", " + Fmt("%.2f", c.data_pose.position_m.z()) + ") m, rpy (" + Fmt("%.2f", rpy[0]) +
+         ", " + Fmt("%.2f", rpy[1]) + ", " + Fmt("%.2f", rpy[2]) + ") deg; extra tilt " +
          Fmt("%.3g", c.extra_tilt_deg) + " deg toward " + Fmt("%.3g", c.tilt_direction_deg) +
          " deg, extra yaw " + Fmt("%.3g", c.extra_yaw_deg) + " deg" + JointsText(d, c) +
          "</title></circle>\n";
     // Stops at one position (other attitudes) share one label: "18, 19".
-    CircleLabel& n = numbers[X(c.pose.position_m.x()) + "," + Y(c.pose.position_m.y())];
-    n.x_px = half + scale * (c.pose.position_m.x() - g.focal_centre_m.x());
-    n.y_px = half - scale * (c.pose.position_m.y() - g.focal_centre_m.y());
+    CircleLabel& n = numbers[X(c.data_pose.position_m.x()) + "," + Y(c.data_pose.position_m.y())];
+    n.x_px = half + scale * (c.data_pose.position_m.x() - g.focal_centre_m.x());
+    n.y_px = half - scale * (c.data_pose.position_m.y() - g.focal_centre_m.y());
     n.radius_px = std::max(n.radius_px, radius);
     n.text += (n.text.empty() ? "" : ", ") + std::to_string(order);
   }
@@ -523,7 +523,7 @@ void AddRange(const Design& d, internal::Document* doc) {
   t.right_align = {true, false, false, false, false};
   for (size_t k = 0; k < d.stops.size(); ++k) {
     const DesignBinding& b = d.stops[k].binding;
-    const Eigen::Vector3d& p = d.candidates[d.stops[k].candidate].pose.position_m;
+    const Eigen::Vector3d& p = d.candidates[d.stops[k].candidate].data_pose.position_m;
     const bool bold = static_cast<int>(k) == tightest;
     std::vector<internal::Text> row;
     for (const std::string& cell :

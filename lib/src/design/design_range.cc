@@ -45,6 +45,7 @@ double MarginOf(const ParameterSpec& p, double value, const DesignOptions& o) {
       return o.range_mass_centre_m;
     case ParameterKind::kAnchorOffset:
     case ParameterKind::kTowerOffset:
+    case ParameterKind::kMeasuredOffset:
       return o.range_offset_m;
     case ParameterKind::kCabinMass:
     case ParameterKind::kLinearDensity:
@@ -75,6 +76,11 @@ constexpr double kClearanceScaleM = 1.0;
 PlausibleRange::PlausibleRange(const CableRobot& robot, const CalibrationSpec& spec,
                                const DesignOptions& options)
     : options_(options), model_(robot, WithRangeFree(spec)), theta0_(model_.InitialTheta()) {
+  {
+    StaticsParameters<double> p;
+    std::array<double, kNumCables> gain, bias;
+    model_.Assemble<double>(theta0_.data(), &p, &gain, &bias, 0, nullptr, &measured_offset0_);
+  }
   for (int k = 0; k < model_.num_free(); ++k) {
     const ParameterSpec& p = model_.spec().parameters[model_.spec_index(k)];
     if (!MovesTheForces(p.kind)) continue;
@@ -103,12 +109,23 @@ bool PlausibleRange::Evaluate(const Pose& pose, const JointValues& joints,
   for (size_t j = 0; j < offset.size(); ++j) theta[theta_index_[j]] += offset[j];
   StaticsParameters<double> p;
   std::array<double, kNumCables> gain, bias;
-  model_.Assemble(theta.data(), &p, &gain, &bias);
+  Eigen::Vector3d measured_offset;
+  model_.Assemble<double>(theta.data(), &p, &gain, &bias, 0, nullptr, &measured_offset);
   p.reflector = model_.base().reflector;  // Assemble leaves it out (checked in double only)
+  // The measured point off its initial value: the same data pose holds the cabin
+  // elsewhere, dp_c = -R_m d(offset) (measured_frame.h (5)).
+  Pose cabin = pose;
+  if (model_.has_measured_frame() && measured_offset != measured_offset0_) {
+    const CableRobot& robot = model_.robot();
+    const Eigen::Matrix3d r_m =
+        pose.rotation *
+        MeasuredFrameInCabin(*robot.measured_frame, robot.moving_parts, joints).rotation;
+    cabin.position_m -= r_m * (measured_offset - measured_offset0_);
+  }
   StaticsOptions o = options_.workspace.statics;
   o.warm_start = start != nullptr;
   if (start != nullptr) *out = *start;
-  return SolveStaticsWithParameters(p, model_.robot().moving_parts, joints, pose, o, out) ==
+  return SolveStaticsWithParameters(p, model_.robot().moving_parts, joints, cabin, o, out) ==
          StaticsStatus::kOk;
 }
 

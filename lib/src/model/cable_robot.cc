@@ -111,6 +111,7 @@ bool CableRobot::IsValid(std::string* error) const {
   }
   if (!mass_centre_cabin_m.allFinite()) return fail("mass_centre_cabin_m", "must be finite");
   if (!moving_parts.IsValid(error)) return false;
+  if (measured_frame.has_value() && !measured_frame->IsValid(moving_parts, error)) return false;
   if (std::string why; !IsCabinInertiaValid(cabin_inertia_kg_m2, &why)) {
     return fail("cabin_inertia_kg_m2", why);
   }
@@ -134,6 +135,16 @@ Eigen::Vector3d CableRobot::MassCentreAt(const JointValues& joints) const {
   PartShifts shifts;
   moving_parts.ShiftsAt(joints, &shifts);
   return mass_centre_cabin_m + moving_parts.MassCentreShift(shifts, cabin_mass_kg);
+}
+
+Pose CableRobot::CabinPose(const Pose& measured, const JointValues& joints) const {
+  if (!measured_frame.has_value()) return measured;
+  return CabinPoseFromMeasured(*measured_frame, moving_parts, measured, joints);
+}
+
+Pose CableRobot::MeasuredPose(const Pose& cabin, const JointValues& joints) const {
+  if (!measured_frame.has_value()) return cabin;
+  return MeasuredPoseFromCabin(*measured_frame, moving_parts, cabin, joints);
 }
 
 bool CableAttachment::IsValid(std::string* error) const {

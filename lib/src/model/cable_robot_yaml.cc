@@ -200,12 +200,18 @@ class Parser {
     const std::string path = "cabin";
     std::map<std::string, Entry> keys;
     if (!ReadMap(cabin.value, LineOf(cabin.key), path,
-                 {"mass_kg", "mass_centre_m", "inertia_kg_m2", "anchor_points_m", "moving_parts"},
+                 {"mass_kg", "mass_centre_m", "inertia_kg_m2", "anchor_points_m", "moving_parts",
+                  "measured_frame"},
                  &keys)) {
       return false;
     }
     if (const auto it = keys.find("moving_parts"); it != keys.end()) {
       if (!ReadMovingParts(it->second, &robot->moving_parts)) return false;
+    }
+    if (const auto it = keys.find("measured_frame"); it != keys.end()) {  // names a part
+      MeasuredFrame frame;
+      if (!ReadMeasuredFrame(it->second, robot->moving_parts, &frame)) return false;
+      robot->measured_frame = frame;
     }
     if (const auto it = keys.find("inertia_kg_m2"); it != keys.end()) {
       if (!ReadInertia(it->second.value, LineOf(it->second.key), Join(path, "inertia_kg_m2"),
@@ -240,6 +246,34 @@ class Parser {
         if (!ReadVector3(list[j], point_line, point_path, &points[j])) return false;
       }
       robot->anchor_points_cabin_m = std::move(points);
+    }
+    return true;
+  }
+
+  // cabin.measured_frame: {part: NAME or cabin, offset_m: [x, y, z]} (measured_frame.h).
+  bool ReadMeasuredFrame(const Entry& entry, const MovingParts& parts, MeasuredFrame* frame) {
+    const std::string path = "cabin.measured_frame";
+    std::map<std::string, Entry> keys;
+    if (!ReadMap(entry.value, LineOf(entry.key), path, {"part", "offset_m"}, &keys)) return false;
+    if (const auto it = keys.find("part"); it != keys.end()) {
+      std::string name;
+      if (!ReadName(it->second, Join(path, "part"), &name)) return false;
+      if (name != "cabin") {
+        frame->part = parts.Find(name);
+        if (frame->part < 0) {
+          std::string names;
+          for (const MovingPart& p : parts.parts) names += p.name + ", ";
+          return Fail(it->second.key, Join(path, "part"),
+                      "'" + name + "' is not a moving part of the model (" +
+                          (parts.empty() ? std::string("it has none; cabin.moving_parts")
+                                         : "its parts: " + names.substr(0, names.size() - 2)) +
+                          "; or cabin)");
+        }
+      }
+    }
+    if (const auto it = keys.find("offset_m"); it != keys.end()) {
+      return ReadVector3(it->second.value, LineOf(it->second.key), Join(path, "offset_m"),
+                         &frame->offset_m);
     }
     return true;
   }
@@ -687,6 +721,13 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
   out << "  anchor_points_m:  # cabin frame, m\n";
   for (const Eigen::Vector3d& a : robot.anchor_points_cabin_m) out << "    - " << Vec(a) << "\n";
   WriteMovingParts(robot.moving_parts, out);
+  if (robot.measured_frame.has_value()) {
+    const MeasuredFrame& f = *robot.measured_frame;
+    out << "  measured_frame:  # whose pose the data's x_m..z_m and attitude give\n";
+    out << "    part: "
+        << (f.part < 0 ? std::string("cabin") : robot.moving_parts.parts[f.part].name) << "\n";
+    out << "    offset_m: " << Vec(f.offset_m) << "  # the measured point, in that part's frame\n";
+  }
   out << "cables:  # cable 1 first; tower tops in the global frame, m\n";
   for (int i = 0; i < kNumCables; ++i) {
     const CableProperties& c = robot.cables[i];

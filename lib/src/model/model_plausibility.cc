@@ -55,6 +55,12 @@ std::vector<ModelValue> ModelValues(const CableRobot& robot) {
     }
     values.push_back({key + "mass_kg", ModelQuantity::kPartMassKg, part.mass_kg, 0.0});
   }
+  if (robot.measured_frame.has_value()) {
+    for (int a = 0; a < 3; ++a) {
+      values.push_back({std::string("cabin.measured_frame.offset_m.") + kAxes[a],
+                        ModelQuantity::kMeasuredOffsetM, robot.measured_frame->offset_m[a], 0.0});
+    }
+  }
   for (size_t j = 0; j < robot.anchor_points_cabin_m.size(); ++j) {
     const Eigen::Vector3d nominal_point = j < nominal.anchor_points_cabin_m.size()
                                               ? nominal.anchor_points_cabin_m[j]
@@ -146,6 +152,9 @@ bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity) {
       return true;
     case ParameterKind::kPartMass:
       *quantity = ModelQuantity::kPartMassKg;
+      return true;
+    case ParameterKind::kMeasuredOffset:
+      *quantity = ModelQuantity::kMeasuredOffsetM;
       return true;
     default:
       return false;

@@ -89,33 +89,38 @@ bool MovingParts::Translates(int k) const {
   return false;
 }
 
-void MovingParts::ShiftsAt(const JointValues& joints, PartShifts* shifts) const {
+void MovingParts::FramesAt(const JointValues& joints, PartFrames* frames) const {
   // Frames in file order: a parent's is ready before its children's (IsValid).
-  std::array<Eigen::Matrix3d, kMaxMovingParts> rotation;
-  std::array<Eigen::Vector3d, kMaxMovingParts> origin, origin_at_zero;
   int next = 0;
   for (size_t k = 0; k < parts.size(); ++k) {
     const MovingPart& part = parts[k];
-    Eigen::Matrix3d r = Eigen::Matrix3d::Identity();
-    Eigen::Vector3d t = part.origin_m, t0 = part.origin_m;
+    PartFrame& f = (*frames)[k];
+    f.rotation.setIdentity();
+    f.origin_m = part.origin_m;
+    f.origin_at_zero_m = part.origin_m;
     if (part.parent >= 0) {
-      r = rotation[part.parent];
-      t = origin[part.parent] + r * part.origin_m;
-      t0 = origin_at_zero[part.parent] + part.origin_m;
+      const PartFrame& parent = (*frames)[part.parent];
+      f.rotation = parent.rotation;
+      f.origin_m = parent.origin_m + parent.rotation * part.origin_m;
+      f.origin_at_zero_m = parent.origin_at_zero_m + part.origin_m;
     }
     for (const Joint& j : part.joints) {
       const double q = joints[next++] * j.ToSi();
       if (j.type == JointType::kRevolute) {
-        r = r * Eigen::AngleAxisd(q, j.axis).toRotationMatrix();
+        f.rotation = f.rotation * Eigen::AngleAxisd(q, j.axis).toRotationMatrix();
       } else {
-        t += r * (j.axis * q);
+        f.origin_m += f.rotation * (j.axis * q);
       }
     }
-    rotation[k] = r;
-    origin[k] = t;
-    origin_at_zero[k] = t0;
-    (*shifts)[k].rotation_minus_identity = r - Eigen::Matrix3d::Identity();
-    (*shifts)[k].translation_m = t - t0;
+  }
+}
+
+void MovingParts::ShiftsAt(const JointValues& joints, PartShifts* shifts) const {
+  PartFrames frames;
+  FramesAt(joints, &frames);
+  for (size_t k = 0; k < parts.size(); ++k) {
+    (*shifts)[k].rotation_minus_identity = frames[k].rotation - Eigen::Matrix3d::Identity();
+    (*shifts)[k].translation_m = frames[k].origin_m - frames[k].origin_at_zero_m;
   }
 }
 

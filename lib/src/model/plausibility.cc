@@ -141,6 +141,8 @@ QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& l
     }
     case ModelQuantity::kPartMassKg:
       return {0.0, limits.max_cabin_mass_kg, 0.0, "kg", 1.0};
+    case ModelQuantity::kMeasuredOffsetM:
+      return {-limits.max_abs_anchor_point_m, limits.max_abs_anchor_point_m, 0.0, "m", 1.0};
   }
   return {};
 }
@@ -159,6 +161,7 @@ SlipHints SlipHintsOf(ModelQuantity quantity) {
     case ModelQuantity::kMassCentreM:
     case ModelQuantity::kAnchorPointM:
     case ModelQuantity::kOffsetM:
+    case ModelQuantity::kMeasuredOffsetM:
       return {nullptr, "mm written as m?"};
     case ModelQuantity::kLinearDensityKgPerM:
     case ModelQuantity::kAttachmentDensityKgPerM:

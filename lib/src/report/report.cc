@@ -193,6 +193,16 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
     data.Plain(" (no dataset given)");
   }
   row("Data", data);
+  if (const CableRobot* model = in.initial_model != nullptr ? in.initial_model
+                                : in.result != nullptr      ? &in.result->calibrated
+                                                            : nullptr) {
+    // Whose pose x_m..z_m and the attitude give (measured_frame.h): the cabin's own, or
+    // the model's cabin.measured_frame, through which every statics call goes.
+    const MeasuredFrame* frame = model->measured_frame ? &*model->measured_frame : nullptr;
+    row("Data's poses", "x_m, y_m, z_m and the attitude are those of " +
+                            DescribeMeasuredFrame(frame, model->moving_parts) +
+                            (frame ? "" : "; a model declares another with cabin.measured_frame"));
+  }
   row("Software",
       Text("fastcal ")
           .Plain(in.software_version.empty() ? "(version unknown)" : in.software_version));

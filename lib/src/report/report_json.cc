@@ -139,6 +139,15 @@ void JsonProvenance(const ReportInputs& in, JsonWriter* w) {
   JsonFile(w, "data", in.data_path, in.data_digest);
   JsonFile(w, "columns", in.columns_path, in.columns_digest);
   w->EndObject();
+  // Whose pose the data give (measured_frame.h): null for the cabin's own frame.
+  const CableRobot* model = in.initial_model != nullptr ? in.initial_model
+                            : r != nullptr              ? &r->calibrated
+                                                        : nullptr;
+  ObjectOrNull(w, "data_frame", model != nullptr && model->measured_frame.has_value(), [&] {
+    const MeasuredFrame& f = *model->measured_frame;
+    w->Key("part").String(f.part < 0 ? "cabin" : model->moving_parts.parts[f.part].name);
+    w->Key("offset_m").NumberArray(f.offset_m);
+  });
   w->Key("spec_yaml");
   if (spec)
     w->String(CalibrationSpecToYaml(*spec));

@@ -122,7 +122,8 @@ int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Sa
             const StaticsOptions& statics, WindowPrediction* at, ReadFailure* read_failure) {
   StaticsParameters<double> params;
   std::array<double, kNumCables> gain, bias;
-  cm.Assemble(task.theta_si.data(), &params, &gain, &bias);
+  Eigen::Vector3d measured_offset;
+  cm.Assemble<double>(task.theta_si.data(), &params, &gain, &bias, 0, nullptr, &measured_offset);
   const int n = static_cast<int>(source.size);
   at->time_s.resize(n);
   at->reading_n.resize(n);
@@ -147,7 +148,9 @@ int Predict(const FoldTask& task, const internal::CalibrationModel& cm, const Sa
           at->time_s[t] = s.time_s;
           // Consecutive samples are close: each starts from the one before in its chunk.
           if (t == begin) solution.status = StaticsStatus::kInvalidInput;
-          if (SolveStaticsWithParameters(params, cm.robot().moving_parts, s.joint, s.pose, options,
+          // The cabin's pose: the data's through the measured frame (measured_frame.h).
+          const Pose pose = cm.CabinPose(s.pose, s.joint, measured_offset);
+          if (SolveStaticsWithParameters(params, cm.robot().moving_parts, s.joint, pose, options,
                                          &solution) != StaticsStatus::kOk) {
             return t;
           }

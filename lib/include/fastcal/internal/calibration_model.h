@@ -77,20 +77,35 @@ class CalibrationModel {
   // (mass centre c0): the parts' columns are the mass centre's through
   // d c / d Q_k = A_k / M, d c / d m_k = b_k / M, and the cabin mass's gains
   // d c / d M = -(c(q) - c0) / M (moving_parts.h eq. (1)).
+  // With a measured frame, `measured_rotation` is the sample's R_m (the data's attitude):
+  // the offset's columns are the statics' position partials times -R_m e_j
+  // (measured_frame.h (5)), a translation of the cabin being the towers' opposite one.
   void ReadingJacobian(const TensionGradient& gradient, const std::array<double, kNumCables>& gain,
                        int session, double* jacobian, const PartShifts* shifts = nullptr,
-                       const StaticsParameters<double>* at = nullptr) const;
+                       const StaticsParameters<double>* at = nullptr,
+                       const Eigen::Matrix3d* measured_rotation = nullptr) const;
   // Whether the model has moving parts: each sample's statics then move the mass centre
   // to its joint values.
   bool has_parts() const { return base_.num_parts > 0; }
+  // Whether the data's poses are a measured frame's (cable_robot.h, measured_frame.h):
+  // each sample's cabin pose then follows from its joints and the offset at theta.
+  bool has_measured_frame() const { return robot_.measured_frame.has_value(); }
+  // A sample's cabin pose from its data pose `measured` at `joints`, with the measured
+  // point at `offset_m` (Assemble's at theta): measured_frame.h (3)-(4); `measured` itself
+  // without a measured frame.
+  Pose CabinPose(const Pose& measured, const JointValues& joints,
+                 const Eigen::Vector3d& offset_m) const;
 
   // The statics parameters and sensor model at theta for a sample of `session`: a
   // parameter of another session (ParameterSpec::session) does not apply.
+  // With `measured_offset_m`, the measured frame's point (measured_frame.h) too.
   template <typename T>
   void Assemble(const T* theta, StaticsParameters<T>* p, std::array<T, kNumCables>* gain,
                 std::array<T, kNumCables>* bias, int session = 0,
-                std::array<T, kNumCables>* offset_m = nullptr) const {
+                std::array<T, kNumCables>* offset_m = nullptr,
+                Vector3T<T>* measured_offset_m = nullptr) const {
     CastParametersInto(base_, p);
+    Vector3T<T> measured_offset = base_measured_offset_m_.cast<T>();
     std::array<T, kNumCables> offset;
     for (int i = 0; i < kNumCables; ++i) {
       (*gain)[i] = T(base_gain_[i]);
@@ -151,9 +166,13 @@ class CalibrationModel {
         case ParameterKind::kPartMass:
           p->part_mass_kg[s.index] = v;
           break;
+        case ParameterKind::kMeasuredOffset:
+          measured_offset[s.component] = v;
+          break;
       }
     }
     if (offset_m != nullptr) *offset_m = offset;
+    if (measured_offset_m != nullptr) *measured_offset_m = measured_offset;
   }
 
  private:
@@ -164,6 +183,7 @@ class CalibrationModel {
   std::array<int, kNumCables> anchor_of_cable_{};
   StaticsParameters<double> base_;  // the robot with fixed overrides applied
   std::array<double, kNumCables> base_gain_{}, base_bias_n_{}, base_offset_m_{};
+  Eigen::Vector3d base_measured_offset_m_ = Eigen::Vector3d::Zero();
 };
 
 // The model at one theta for a pass over many samples: the statics parameters, gains and
@@ -174,6 +194,7 @@ class ModelAtTheta {
   struct Session {
     StaticsParameters<double> statics;
     std::array<double, kNumCables> gain, bias;
+    Eigen::Vector3d measured_offset_m = Eigen::Vector3d::Zero();  // measured_frame.h
     bool gains_positive = false;  // else every evaluation fails (TensionResidual)
   };
   // `theta` must outlive this; sessions >= 1.
@@ -194,6 +215,8 @@ std::array<double, kNumCables> TensionSigmas(const std::array<double, kNumCables
 
 struct TensionResidual {
   const CalibrationModel* model;
+  // The data's pose: the measured frame's when the model declares one (the cabin's pose
+  // then follows from the joints and the offset at theta: CalibrationModel::CabinPose).
   Pose pose;
   std::array<double, kNumCables> measured_n;
   std::array<double, kNumCables> sigma_n;
@@ -223,8 +246,9 @@ struct TensionResidual {
   bool operator()(const T* theta, T* residuals) const {
     StaticsParameters<T> p;
     std::array<T, kNumCables> gain, bias, tension, offset, length;
+    Vector3T<T> measured_offset;
     const bool lengths = length_sigma_m > 0.0;
-    model->Assemble(theta, &p, &gain, &bias, session, &offset);
+    model->Assemble(theta, &p, &gain, &bias, session, &offset, &measured_offset);
     if (p.num_parts > 0) {
       PartShifts shifts;
       model->robot().moving_parts.ShiftsAt(joints, &shifts);
@@ -235,11 +259,22 @@ struct TensionResidual {
     for (const T& g : gain) {
       if (!(ScalarValue(g) > 0.0)) return false;
     }
+    // The cabin's pose at the offset's value, and the offset's derivative as the towers'
+    // opposite translation (measured_frame.h (5)): dp_c = -R_m d(offset), whose value
+    // part is zero, so the double solve is the pose's own.
+    Pose cabin = pose;
+    if (model->has_measured_frame()) {
+      Eigen::Vector3d value;
+      for (int k = 0; k < 3; ++k) value[k] = ScalarValue(measured_offset[k]);
+      cabin = model->CabinPose(pose, joints, value);
+      const Vector3T<T> shift = pose.rotation.cast<T>() * (measured_offset - value.cast<T>());
+      for (int i = 0; i < kNumCables; ++i) p.tower_top_m[i] += shift;
+    }
     StaticsSolution solution;
-    start.Restore(pose, statics.method, &solution);
+    start.Restore(cabin, statics.method, &solution);
     StaticsOptions options = statics;
     options.warm_start = true;
-    if (ModelLowerTensions(p, pose, options, &tension, &solution, lengths ? &length : nullptr) !=
+    if (ModelLowerTensions(p, cabin, options, &tension, &solution, lengths ? &length : nullptr) !=
         StaticsStatus::kOk) {
       return false;
     }

@@ -46,6 +46,7 @@ bool SetUpDesignProblem(const CalibrationSpec& spec, DesignProblem* problem, std
 // spec's initial values with its noise model. False with *error naming the pose when the
 // statics fail there.
 // `joints`: each pose's joint values (moving parts), parallel to poses; empty: all zero.
+// The poses are the cabin's (the residual is given the data's: measured_frame.h).
 bool AddPoseRows(const CableRobot& robot, const CalibrationSpec& spec,
                  const std::vector<Pose>& poses, const std::vector<JointValues>& joints,
                  DesignProblem* problem, std::string* error);

@@ -37,7 +37,8 @@ class PlausibleRange {
   // tensions within the workspace limits. *binding (may be null): its tightest limit
   // there, when it holds; else the one broken (constraint: the statics' status code,
   // StaticsStatusName, where a solve fails).
-  // With moving parts, at the joint values `joints` (the mass centre at c(q)).
+  // With moving parts, at the joint values `joints` (the mass centre at c(q)). `pose` is
+  // the cabin's at the initial values.
   bool Holds(const Pose& pose, const JointValues& joints, DesignBinding* binding) const;
 
  private:
@@ -57,6 +58,7 @@ class PlausibleRange {
   DesignOptions options_;
   CalibrationModel model_;        // the spec with every ranged parameter free
   std::vector<double> theta0_;    // initial values of model_'s free parameters
+  Eigen::Vector3d measured_offset0_ = Eigen::Vector3d::Zero();  // the measured point there
   std::vector<int> theta_index_;  // of each range parameter in theta
   std::vector<DesignRangeParameter> parameters_;
 };
