@@ -631,6 +631,9 @@ std::string EstimateFlags(const ParameterEstimate& p) {
              " sigma ";
   }
   if (p.note.find("set mostly by its prior") != std::string::npos) flags += "prior-dominated ";
+  // A measured frame's offset along an axis the survey never turns (calibration_verdict.cc).
+  if (p.note.find("the data never turn this axis") != std::string::npos)
+    flags += "axis never turned ";
   if (p.note.find("not determined by the data alone") != std::string::npos) {
     flags += "data cannot determine ";
   } else if (p.note.find("poorly determined") != std::string::npos) {

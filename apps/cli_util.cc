@@ -878,7 +878,8 @@ bool ParseNumberList(const std::string& flag, const std::string& text, std::vect
   return true;
 }
 
-bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::string* error) {
+bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::string* error,
+                            JointValues* joints_out) {
   const MovingParts& parts = robot->moving_parts;
   if (text.empty()) return true;
   std::string names;
@@ -909,6 +910,9 @@ bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::str
   }
   robot->mass_centre_cabin_m = robot->MassCentreAt(joints);
   robot->moving_parts.parts.clear();
+  // Its part is gone with the parts: the caller converts poses with the model as loaded.
+  robot->measured_frame.reset();
+  if (joints_out != nullptr) *joints_out = joints;
   return true;
 }
 

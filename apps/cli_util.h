@@ -160,8 +160,11 @@ bool ParseNumberList(const std::string& flag, const std::string& text, std::vect
 // columns' units: deg, m), folded into *robot's mass centre (moving_parts.h eq. (1)); the
 // parts are then fixed. Empty: every joint at 0 (the model's mass_centre_m). A count other
 // than the model's joints, a value out of a joint's range, or --joints for a model without
-// moving parts is an error naming the joints.
-bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::string* error);
+// moving parts is an error naming the joints. With the parts fixed the model's measured
+// frame (which names a part) is dropped too: convert the data's poses with the model as
+// loaded, at *joints_out (may be null; left as it is for an empty --joints).
+bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::string* error,
+                            JointValues* joints_out = nullptr);
 
 // Writes `content` to `path` through a temporary file and a rename, so that a failure
 // leaves no partial file; path "" or "-" writes to stdout (each write checked: "cannot

@@ -166,7 +166,8 @@ struct Answer {
   StaticsStatus status = StaticsStatus::kInvalidInput;
   Stability stability = Stability::kUnknown;
   std::string message;
-  Pose pose;
+  Pose pose;   // the data's frame's (the model's measured frame; else the cabin's)
+  Pose cabin;  // the cabin's, as located
   std::array<double, kNumCables> tension_n{};
   Eigen::Matrix<double, 6, 1> sigma = Eigen::Matrix<double, 6, 1>::Zero();  // m, deg
   double min_stiffness_n_per_m = 0.0;
@@ -421,10 +422,16 @@ bool RowsFromFile(const CableRobot& robot, std::vector<Row>* rows, std::string* 
   return true;
 }
 
-// The answer's sigmas: position (m) and roll, pitch, yaw (deg) from the covariance.
-Eigen::Matrix<double, 6, 1> Sigmas(const LocateSolution& s) {
-  const Eigen::Matrix<double, 6, 6>& c = s.fit.covariance;
-  const Eigen::Matrix3d j = RpyDegPerRotationVector(s.pose.rotation);
+// The sigmas of the data's pose: position (m) and roll, pitch, yaw (deg), from the
+// covariance of the cabin's (r_p, rotation vector in global axes). The measured point
+// m = r_p + w, w = m - r_p fixed to the cabin, moves by dr_p - [w]x dtheta, and the
+// measured frame turns with the cabin (measured_frame.h (1)-(2)).
+Eigen::Matrix<double, 6, 1> Sigmas(const LocateSolution& s, const Pose& data) {
+  Eigen::Matrix<double, 6, 6> to_data = Eigen::Matrix<double, 6, 6>::Identity();
+  const Eigen::Vector3d w = data.position_m - s.pose.position_m;
+  to_data.topRightCorner<3, 3>() << 0.0, w.z(), -w.y(), -w.z(), 0.0, w.x(), w.y(), -w.x(), 0.0;
+  const Eigen::Matrix<double, 6, 6> c = to_data * s.fit.covariance * to_data.transpose();
+  const Eigen::Matrix3d j = RpyDegPerRotationVector(data.rotation);
   const Eigen::Matrix3d rpy = j * c.bottomRightCorner<3, 3>() * j.transpose();
   Eigen::Matrix<double, 6, 1> sigma;
   for (int k = 0; k < 3; ++k) {
@@ -434,7 +441,8 @@ Eigen::Matrix<double, 6, 1> Sigmas(const LocateSolution& s) {
   return sigma;
 }
 
-Answer AnswerOf(const LocateSolution& s) {
+// `loaded`: the model as loaded (its measured frame and parts), `joints` the row's.
+Answer AnswerOf(const LocateSolution& s, const CableRobot& loaded, const JointValues& joints) {
   Answer a;
   a.status = s.status;
   a.stability = s.stability;
@@ -442,9 +450,10 @@ Answer AnswerOf(const LocateSolution& s) {
   a.message = ok && s.stability == Stability::kStable && s.other_equilibria == 0
                   ? ""
                   : DescribeLocateStatus(s);
-  a.pose = s.pose;
+  a.cabin = s.pose;
+  a.pose = loaded.MeasuredPose(s.pose, joints);
   for (int i = 0; i < kNumCables; ++i) a.tension_n[i] = s.statics.cables[i].lower_tension_n;
-  if (ok) a.sigma = Sigmas(s);
+  if (ok) a.sigma = Sigmas(s, a.pose);
   a.min_stiffness_n_per_m = s.min_stiffness_n_per_m;
   a.other_equilibria = s.other_equilibria;
   a.nearest_other_m = s.nearest_other.distance_m;
@@ -471,12 +480,16 @@ std::string RowName(const std::vector<Row>& rows, size_t n) {
                            : "");
 }
 
-std::string Csv(const std::vector<Row>& rows, const std::vector<Answer>& answers) {
+// `cabin`: the model declares a measured frame: x_m..yaw_deg are its pose (the data's)
+// and cabin_x_m..cabin_yaw_deg the cabin's.
+std::string Csv(const std::vector<Row>& rows, const std::vector<Answer>& answers, bool cabin) {
   std::ostringstream out;
   // A string stream that runs out of memory only sets badbit and returns what it has:
   // a truncated table written with exit 0 (issue 37). Out of memory is thrown instead.
   out.exceptions(std::ios::badbit);
-  out << "row,line,time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status,stability";
+  out << "row,line,time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg";
+  if (cabin) out << ",cabin_x_m,cabin_y_m,cabin_z_m,cabin_roll_deg,cabin_pitch_deg,cabin_yaw_deg";
+  out << ",status,stability";
   for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
   out << ",sigma_x_m,sigma_y_m,sigma_z_m,sigma_roll_deg,sigma_pitch_deg,sigma_yaw_deg"
          ",min_stiffness_kN_per_m,other_equilibria,nearest_other_m,readings,chi2,"
@@ -487,9 +500,12 @@ std::string Csv(const std::vector<Row>& rows, const std::vector<Answer>& answers
     auto put = [&](double v) { out << "," << (ok ? FormatDouble(v) : ""); };
     out << n << "," << (rows[n].line > 0 ? std::to_string(rows[n].line) : "") << ","
         << (rows[n].has_time ? FormatDouble(rows[n].time_s, 17) : "");
-    for (int k = 0; k < 3; ++k) put(a.pose.position_m[k]);
-    const Eigen::Vector3d rpy = RpyDegFromRotation(a.pose.rotation);
-    for (int k = 0; k < 3; ++k) put(rpy[k]);
+    for (const Pose* p : {&a.pose, cabin ? &a.cabin : nullptr}) {
+      if (p == nullptr) continue;
+      for (int k = 0; k < 3; ++k) put(p->position_m[k]);
+      const Eigen::Vector3d rpy = RpyDegFromRotation(p->rotation);
+      for (int k = 0; k < 3; ++k) put(rpy[k]);
+    }
     out << "," << StaticsStatusName(a.status) << "," << StabilityName(a.stability);
     for (double t : a.tension_n) put(t / kNPerKn);
     for (int k = 0; k < 6; ++k) put(a.sigma[k]);
@@ -595,11 +611,15 @@ int RunLocate(int argc, char** argv) {
                "--joints");
     return kExitUsage;
   }
+  // As loaded: its parts and measured frame, before --joints fixes the mass centre.
+  const CableRobot loaded = robot;
+  JointValues flag_joints{};
   if (!(from_file ? RowsFromFile(robot, &rows, &error) : RowFromFlags(&rows, &error)) ||
-      !MassCentreAtJointsFlag(FLAGS_joints, &robot, &error)) {
+      !MassCentreAtJointsFlag(FLAGS_joints, &robot, &error, &flag_joints)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
+  if (!from_file) rows.front().joints = flag_joints;
   std::vector<Answer> answers;
   answers.reserve(rows.size());
   LocateSolution solution;
@@ -607,6 +627,10 @@ int RunLocate(int argc, char** argv) {
   for (Row& row : rows) {
     row.measurement.has_attitude = row.measurement.has_attitude && use.attitude;
     row.measurement.has_tensions = row.measurement.has_tensions && use.tensions;
+    // The measured attitude is the data's frame's: the cabin's follows from the joints.
+    Pose attitude;
+    attitude.rotation = row.measurement.rotation;
+    row.measurement.rotation = loaded.CabinPose(attitude, row.joints).rotation;
     if (robot.moving_parts.empty()) {
       LocateFromMeasurements(robot, row.measurement, noise, options, &solution);
     } else {  // the row's own mass centre (moving_parts.h eq. (1))
@@ -615,7 +639,7 @@ int RunLocate(int argc, char** argv) {
       at.moving_parts.parts.clear();
       LocateFromMeasurements(at, row.measurement, noise, options, &solution);
     }
-    answers.push_back(AnswerOf(solution));
+    answers.push_back(AnswerOf(solution, loaded, row.joints));
   }
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -626,7 +650,8 @@ int RunLocate(int argc, char** argv) {
     }
   }
   // The output was checked before the work: a failure now is the machine's (a full disk).
-  if (!WriteOutput(FLAGS_output, Csv(rows, answers), &error, FLAGS_force)) {
+  if (!WriteOutput(FLAGS_output, Csv(rows, answers, loaded.measured_frame.has_value()), &error,
+                   FLAGS_force)) {
     PrintError(kCommand, error);
     return kExitFailure;
   }

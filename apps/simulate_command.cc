@@ -639,6 +639,29 @@ bool CheckTrackFlags(const std::string& trajectory, std::string* error) {
   return true;
 }
 
+// A pose file's poses are the data's (the truth's measured frame's, measured_frame.h):
+// the cabin's to fly follow from each row's joints, which a frame on a moving part needs.
+bool CabinPosesOfFile(const CableRobot& truth, const std::vector<JointValues>& joints,
+                      std::vector<Pose>* poses, std::string* error) {
+  if (!truth.measured_frame.has_value()) return true;
+  if (truth.measured_frame->part >= 0 && joints.empty()) {
+    std::string names;
+    for (const std::string& c : truth.moving_parts.JointColumns()) {
+      names += (names.empty() ? "" : ",") + c;
+    }
+    *error = "--poses=" + FLAGS_poses +
+             " gives the measured frame's poses (the truth model's cabin.measured_frame, on " +
+             truth.moving_parts.parts[truth.measured_frame->part].name +
+             "): the cabin's follow from the joints, so the file needs the joint columns (" +
+             names + ")";
+    return false;
+  }
+  for (size_t n = 0; n < poses->size(); ++n) {
+    (*poses)[n] = truth.CabinPose((*poses)[n], joints.empty() ? JointValues{} : joints[n]);
+  }
+  return true;
+}
+
 // The poses to fly; from a pose file with the truth model's joint columns, their values
 // per sample (*joints; else left empty).
 bool BuildPoses(const CableRobot& truth, PoseStream* poses, std::vector<JointValues>* joints,
@@ -668,7 +691,8 @@ bool BuildPoses(const CableRobot& truth, PoseStream* poses, std::vector<JointVal
     std::vector<Pose> from_file;
     const std::vector<std::string> joint_columns = truth.moving_parts.JointColumns();
     if (!ReadPosesWithAttitudeLaw(FLAGS_poses, FLAGS_attitude_law, law, &from_file, error,
-                                  &joint_columns, joints)) {
+                                  &joint_columns, joints) ||
+        !CabinPosesOfFile(truth, *joints, &from_file, error)) {
       return false;
     }
     *poses = StreamOf(std::move(from_file));

@@ -775,9 +775,13 @@ std::pair<std::string, std::string> StatusAndMessage(const StaticsSolution& s,
           (method != nullptr ? std::string(method) + ": " : "") + DescribeStatus(s)};
 }
 
-std::string CsvHeader(bool single) {
+// `cabin`: the model declares a measured frame, so x_m..yaw_deg are its pose (the data's)
+// and cabin_x_m..cabin_yaw_deg the cabin's that the statics solved.
+std::string CsvHeader(bool single, bool cabin) {
   std::ostringstream out;
-  out << "node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,status";
+  out << "node,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg";
+  if (cabin) out << ",cabin_x_m,cabin_y_m,cabin_z_m,cabin_roll_deg,cabin_pitch_deg,cabin_yaw_deg";
+  out << ",status";
   if (single) {
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_kN";
     for (int i = 1; i <= kNumCables; ++i) out << ",T" << i << "_upper_kN";
@@ -796,14 +800,18 @@ std::string CsvHeader(bool single) {
   return out.str();
 }
 
-// One CSV row: `single` (one method), else `aas` against `exact`.
-void AppendCsvRow(long long n, const Pose& pose, const StaticsSolution* single,
+// One CSV row: `single` (one method), else `aas` against `exact`; `cabin` (null without a
+// measured frame): the cabin's pose the statics solved.
+void AppendCsvRow(long long n, const Pose& pose, const Pose* cabin, const StaticsSolution* single,
                   const StaticsSolution* aas, const StaticsSolution* exact, std::string* text) {
   std::ostringstream out;
-  const Eigen::Vector3d rpy = RpyDegFromRotation(pose.rotation);
   out << n;
-  for (int j = 0; j < 3; ++j) out << "," << FormatDouble(pose.position_m[j]);
-  for (int j = 0; j < 3; ++j) out << "," << FormatDouble(rpy[j]);
+  for (const Pose* p : {&pose, cabin}) {
+    if (p == nullptr) continue;
+    const Eigen::Vector3d rpy = RpyDegFromRotation(p->rotation);
+    for (int j = 0; j < 3; ++j) out << "," << FormatDouble(p->position_m[j]);
+    for (int j = 0; j < 3; ++j) out << "," << FormatDouble(rpy[j]);
+  }
   std::pair<std::string, std::string> status;
   if (single != nullptr) {
     const StaticsSolution& s = *single;
@@ -872,12 +880,16 @@ void JsonSolution(JsonWriter* j, const StaticsSolution& s) {
   j->Key("outer_iterations").Int(s.outer_iterations);
 }
 
-void AppendJsonPose(long long n, const Pose& pose, const StaticsSolution* single,
+void AppendJsonPose(long long n, const Pose& pose, const Pose* cabin, const StaticsSolution* single,
                     const StaticsSolution* aas, const StaticsSolution* exact, JsonWriter* j) {
   j->BeginObject();
   j->Key("node").Int(n);
   j->Key("position_m").NumberArray(pose.position_m);
   j->Key("rpy_deg").NumberArray(RpyDegFromRotation(pose.rotation));
+  if (cabin != nullptr) {
+    j->Key("cabin_position_m").NumberArray(cabin->position_m);
+    j->Key("cabin_rpy_deg").NumberArray(RpyDegFromRotation(cabin->rotation));
+  }
   if (single != nullptr) {
     JsonSolution(j, *single);
   } else {
@@ -1002,10 +1014,14 @@ bool CountPose(long long n, const Pose& pose,
 // Solves the poses one at a time (one method, or aas and exact for compare), each row
 // formatted and handed to `out` as it is made: memory independent of the number of poses
 // (issue 29). A failure without --keep-going stops the run with the node named.
-bool SolveStream(const CableRobot& robot, const PoseStream& stream,
-                 const std::vector<JointValues>& joints, const StaticsOptions& options,
-                 bool compare, ResultStream* out, Run* single, Run* aas, Run* exact, Totals* totals,
-                 PlotData* plot, std::string* error) {
+// The poses are the data's (the model's measured frame's when `loaded` declares one,
+// measured_frame.h): each is solved at the cabin's pose that follows from its joints (the
+// pose file's, else `flag_joints`). `loaded` is the model as loaded (its parts and measured
+// frame), `robot` the one with --joints' mass centre fixed.
+bool SolveStream(const CableRobot& robot, const CableRobot& loaded, const PoseStream& stream,
+                 const std::vector<JointValues>& joints, const JointValues& flag_joints,
+                 const StaticsOptions& options, bool compare, ResultStream* out, Run* single,
+                 Run* aas, Run* exact, Totals* totals, PlotData* plot, std::string* error) {
   const bool json = FLAGS_format == "json";
   single->options = aas->options = exact->options = options;
   aas->options.method = StaticsMethod::kAas;
@@ -1018,7 +1034,7 @@ bool SolveStream(const CableRobot& robot, const PoseStream& stream,
     j.Key("model").String(ModelName(FLAGS_model));
     j.Key("poses").BeginArray();
   } else {
-    text = CsvHeader(!compare);
+    text = CsvHeader(!compare, loaded.measured_frame.has_value());
   }
   PoseStream poses = stream;
   // Each pose at its own joints (a --poses file's joint columns): the model with its mass
@@ -1028,8 +1044,10 @@ bool SolveStream(const CableRobot& robot, const PoseStream& stream,
   const CableRobot& model = joints.empty() ? robot : at_joints;
   constexpr size_t kWriteBytes = 1 << 20;
   for (long long n = 0; n < poses.count; ++n) {
-    const Pose pose = poses.next();
+    const Pose data = poses.next();
     if (!joints.empty()) at_joints.mass_centre_cabin_m = robot.MassCentreAt(joints[n]);
+    const Pose pose = loaded.CabinPose(data, joints.empty() ? flag_joints : joints[n]);
+    const Pose* cabin = loaded.measured_frame.has_value() ? &pose : nullptr;
     std::vector<std::pair<const Run*, StaticsMethod>> runs;
     if (compare) {
       aas->Solve(model, pose);
@@ -1039,14 +1057,14 @@ bool SolveStream(const CableRobot& robot, const PoseStream& stream,
       single->Solve(model, pose);
       runs = {{single, options.method}};
     }
-    if (!CountPose(n, pose, runs, compare, *aas, *exact, *single, totals, error)) return false;
+    if (!CountPose(n, data, runs, compare, *aas, *exact, *single, totals, error)) return false;
     const StaticsSolution* one = compare ? nullptr : &single->solution;
-    if (plot != nullptr) plot->Add(pose, compare, *single, *aas, *exact);
+    if (plot != nullptr) plot->Add(data, compare, *single, *aas, *exact);
     if (json) {
-      AppendJsonPose(n, pose, one, &aas->solution, &exact->solution, &j);
+      AppendJsonPose(n, data, cabin, one, &aas->solution, &exact->solution, &j);
       text += j.Take();
     } else {
-      AppendCsvRow(n, pose, one, &aas->solution, &exact->solution, &text);
+      AppendCsvRow(n, data, cabin, one, &aas->solution, &exact->solution, &text);
     }
     if (text.size() >= kWriteBytes) {
       if (!out->Write(text, error)) return false;
@@ -1130,8 +1148,11 @@ int RunSolve(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
-  const MovingParts parts = robot.moving_parts;  // before --joints fixes the mass centre
-  if (!MassCentreAtJointsFlag(FLAGS_joints, &robot, &error)) {
+  // As loaded: its parts and measured frame, before --joints fixes the mass centre.
+  const CableRobot loaded = robot;
+  const MovingParts& parts = loaded.moving_parts;
+  JointValues flag_joints{};
+  if (!MassCentreAtJointsFlag(FLAGS_joints, &robot, &error, &flag_joints)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -1163,8 +1184,12 @@ int RunSolve(int argc, char** argv) {
   Run single, aas, exact;
   Totals totals;
   PlotData plot;
-  if (!SolveStream(robot, poses, joints, options, compare, &out, &single, &aas, &exact, &totals,
-                   FLAGS_plot.empty() ? nullptr : &plot, &error) ||
+  if (loaded.measured_frame.has_value()) {  // the summary says whose pose was given
+    attitude += "; poses of the measured frame (" +
+                DescribeMeasuredFrame(&*loaded.measured_frame, loaded.moving_parts) + ")";
+  }
+  if (!SolveStream(robot, loaded, poses, joints, flag_joints, options, compare, &out, &single, &aas,
+                   &exact, &totals, FLAGS_plot.empty() ? nullptr : &plot, &error) ||
       !WritePlot(argc, argv, attitude, compare, plot, &error)) {
     PrintError(kCommand, error);
     return kExitFailure;  // a pose that cannot be held, or the output (a full disk)

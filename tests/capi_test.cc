@@ -271,6 +271,67 @@ TEST(CapiTest, MovingPartsTakeTheJoints) {
       << fastcal_solver_error(solver.s);
 }
 
+TEST(CapiTest, AMeasuredFramesPoseIsWhatTheCallsTakeAndGive) {
+  // calibration_data/fast_feed.yaml: the data's pose is the feed's phase centre, 1.2 m
+  // below the Stewart platform, with the platform's attitude. Rotator at a = 10 deg and the
+  // platform rolled 10 deg: the cabin level, p_c = m - R_c t - R_m d with t = (0, 0, -0.8),
+  // d = (0, 0, -1.2): m + (0, 0, 0.8) + 1.2 (0, -sin 10, cos 10) (issue 58).
+  constexpr double kHandM = 1e-12;
+  const std::string path = ModelPath("fast_feed.yaml");
+  Solver solver(path.c_str());
+  ASSERT_STREQ(fastcal_solver_error(solver.s), "");
+  CableRobot robot;
+  std::string error;
+  ASSERT_TRUE(LoadCableRobot(path, &robot, &error)) << error;
+  const double position[3] = {0, 0, 140}, rpy[3] = {10, 0, 0};
+  const double joints[5] = {10, 0, 0, 0, 0};
+  double cabin[3], cabin_rpy[3];
+  ASSERT_EQ(fastcal_cabin_pose(solver.s, position, rpy, joints, cabin, cabin_rpy), FASTCAL_OK);
+  const double hand[3] = {0, -1.2 * 0.17364817766693033, 140 + 0.8 + 1.2 * 0.984807753012208};
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(cabin[k], hand[k], kHandM) << k;
+    EXPECT_NEAR(cabin_rpy[k], 0.0, kHandM) << k;
+  }
+  // The solve at the data's pose is the plain model's at the cabin's.
+  double tension[6], s0[6];
+  ASSERT_EQ(fastcal_solve_pose(solver.s, position, rpy, joints, tension, s0), FASTCAL_OK)
+      << fastcal_solver_error(solver.s);
+  CableRobot plain = robot;
+  plain.measured_frame.reset();
+  Pose at_hand;
+  at_hand.position_m = Eigen::Vector3d(hand[0], hand[1], hand[2]);
+  JointValues q{};
+  q[0] = 10.0;
+  StaticsSolution ref;
+  ASSERT_EQ(SolveStatics(plain, at_hand, q, StaticsOptions(), &ref), StaticsStatus::kOk);
+  for (int i = 0; i < kNumCables; ++i) {
+    EXPECT_NEAR(tension[i] * kNPerKn, ref.cables[i].lower_tension_n,
+                1e-9 * ref.cables[i].lower_tension_n);
+  }
+  // Locate gives the data's pose back, not the cabin's.
+  double back[3], back_rpy[3];
+  ASSERT_EQ(fastcal_locate(solver.s, s0, joints, back, back_rpy, nullptr), FASTCAL_OK)
+      << fastcal_solver_error(solver.s);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_NEAR(back[k], position[k], kRoundTripM) << k;
+    EXPECT_NEAR(back_rpy[k], rpy[k], kRoundTripDeg) << k;
+  }
+  // The nominal model has no frame: fastcal_cabin_pose gives the pose itself; bad input
+  // is a status with zeros.
+  Solver nominal;
+  ASSERT_EQ(fastcal_cabin_pose(nominal.s, position, rpy, nullptr, cabin, cabin_rpy), FASTCAL_OK);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(cabin[k], position[k]);
+    EXPECT_NEAR(cabin_rpy[k], rpy[k], 1e-12);
+  }
+  const double nan_position[3] = {0, std::numeric_limits<double>::quiet_NaN(), 140};
+  EXPECT_EQ(fastcal_cabin_pose(solver.s, nan_position, rpy, joints, cabin, cabin_rpy),
+            FASTCAL_INVALID_INPUT);
+  EXPECT_EQ(cabin[2], 0.0);
+  EXPECT_EQ(fastcal_cabin_pose(solver.s, position, rpy, joints, nullptr, cabin_rpy),
+            FASTCAL_ERROR_NULL_ARGUMENT);
+}
+
 TEST(CapiTest, ControlCycleGivesWinchReadingsAndChecksLimits) {
   // A model with encoder offsets and sensor gains, as a calibration writes one.
   CableRobot robot = CableRobot::NominalFast();
@@ -533,6 +594,32 @@ TEST_F(CapiAllocationTest, WarmColdAndFailingSolvesAllocateNothing) {
       &allocations, &locks);
   EXPECT_EQ(ok, 0);
   EXPECT_EQ(cycle.status, FASTCAL_INSIDE_REFLECTOR_MARGIN);
+  EXPECT_EQ(allocations, 0);
+  EXPECT_EQ(locks, 0);
+}
+
+TEST_F(CapiAllocationTest, AMeasuredFrameAllocatesNothing) {
+  const std::string path = ModelPath("fast_feed.yaml");
+  Solver solver(path.c_str());
+  ASSERT_STREQ(fastcal_solver_error(solver.s), "");
+  const double position[3] = {0, 0, 140}, rpy[3] = {10, 0, 0};
+  const double joints[5] = {10, 0, 0, 0, 0};
+  double cabin[3], cabin_rpy[3], tension[6], s0[6], back[3], back_rpy[3];
+  fastcal_cycle cycle;
+  ASSERT_EQ(fastcal_solve_pose(solver.s, position, rpy, joints, tension, s0), FASTCAL_OK);
+  long allocations = 0, locks = 0;
+  int failures = 0;
+  CountDuring(
+      [&] {
+        for (int n = 0; n < kCountedSolves / 10; ++n) {
+          failures += fastcal_cabin_pose(solver.s, position, rpy, joints, cabin, cabin_rpy) != 0;
+          failures += fastcal_solve_pose(solver.s, position, rpy, joints, tension, s0) != 0;
+          failures += fastcal_control_cycle(solver.s, position, rpy, joints, nullptr, &cycle) < 0;
+          failures += fastcal_locate(solver.s, s0, joints, back, back_rpy, nullptr) != 0;
+        }
+      },
+      &allocations, &locks);
+  EXPECT_EQ(failures, 0);
   EXPECT_EQ(allocations, 0);
   EXPECT_EQ(locks, 0);
 }

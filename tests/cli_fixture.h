@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -78,6 +79,18 @@ inline std::vector<std::string> CsvFields(const std::string& line) {
     }
   }
   return fields;
+}
+
+// The estimate and sigma_total of parameter `name` in calibrate's console table
+// ("  NAME   value +- sigma unit").
+inline void ConsoleEstimate(const std::string& output, const std::string& name, double* value,
+                            double* sigma) {
+  const std::regex row("\n  " + std::regex_replace(name, std::regex(R"([.\[\]])"), R"(\$&)") +
+                       R"( +(\S+) \+- (\S+))");
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(output, m, row)) << name << "\n" << output;
+  *value = std::stod(m[1]);
+  *sigma = std::stod(m[2]);
 }
 
 class CliTest : public ::testing::Test {

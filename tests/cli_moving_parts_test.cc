@@ -26,16 +26,6 @@ class CliMovingPartsTest : public CliTest {
     Write(name, text);
     return Path(name);
   }
-  // The estimate and sigma_total of `name` on calibrate's console.
-  static void Estimate(const std::string& output, const std::string& name, double* value,
-                       double* sigma) {
-    const std::regex row("\n  " + std::regex_replace(name, std::regex(R"([.\[\]])"), R"(\$&)") +
-                         R"( +(\S+) \+- (\S+))");
-    std::smatch m;
-    ASSERT_TRUE(std::regex_search(output, m, row)) << name << "\n" << output;
-    *value = std::stod(m[1]);
-    *sigma = std::stod(m[2]);
-  }
 };
 
 TEST_F(CliMovingPartsTest, ASurveyOfRotatorAnglesFindsTheFirstMomentAndThePlatformsMass) {
@@ -68,17 +58,17 @@ TEST_F(CliMovingPartsTest, ASurveyOfRotatorAnglesFindsTheFirstMomentAndThePlatfo
     const double centre[] = {0.22, 0.11, 0.5};
     for (int a = 0; a < 3; ++a) {
       double v = 0, s = 0;
-      Estimate(cal.output, std::string("mass_centre_m.") + axes[a], &v, &s);
+      ConsoleEstimate(cal.output, std::string("mass_centre_m.") + axes[a], &v, &s);
       EXPECT_LT(std::abs(v - centre[a]), kSigmas * s) << c.moment << " " << axes[a];
-      Estimate(cal.output, std::string("moving_parts.rotator.first_moment_kg_m.") + axes[a], &v,
-               &s);
+      ConsoleEstimate(cal.output, std::string("moving_parts.rotator.first_moment_kg_m.") + axes[a],
+                      &v, &s);
       EXPECT_LT(std::abs(v - c.q[a]), kSigmas * s) << c.moment << " " << axes[a];
       if (a == 2) {
         EXPECT_LE(s, kMaxZSigmaKgM) << c.moment;
       }
     }
     double m = 0, s = 0;
-    Estimate(cal.output, "moving_parts.stewart.mass_kg", &m, &s);
+    ConsoleEstimate(cal.output, "moving_parts.stewart.mass_kg", &m, &s);
     EXPECT_LT(std::abs(m - 2500.0), kSigmas * s);
     const std::string report = ReadFile(Path("cal") + "/report.md");
     EXPECT_NE(report.find("## Moving parts"), std::string::npos);

@@ -189,8 +189,9 @@ int Solve(fastcal_solver* s, const double position_m[3], const double rpy_deg[3]
   JointValues q;
   if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
   s->trial = s->last;
-  const StaticsStatus status =
-      fastcal::SolveStatics(s->robot, PoseOf(position_m, rpy_deg), q, s->options, &s->trial);
+  // The pose given is the data's (the model's measured frame's): the cabin's follows.
+  const StaticsStatus status = fastcal::SolveStatics(
+      s->robot, s->robot.CabinPose(PoseOf(position_m, rpy_deg), q), q, s->options, &s->trial);
   if (status != StaticsStatus::kOk) {
     DescribeFailure(s, "solve", s->trial);
     return static_cast<int>(status);
@@ -267,6 +268,7 @@ fastcal_solver* fastcal_solver_create(const char* model_path) {
     }
     s->fixed_robot = s->robot;
     s->fixed_robot.moving_parts = {};
+    s->fixed_robot.measured_frame.reset();  // its part is gone: poses convert with `robot`
     s->options.warm_start = true;
     s->locate_options.warm_start = true;
     // A controller asks for the pose, not for other equilibria near it: the search's 12
@@ -367,7 +369,8 @@ int fastcal_locate(fastcal_solver* s, const double unstretched_m[6], const doubl
       return static_cast<int>(status);
     }
     s->located = s->locate_trial;
-    const fastcal::Pose& pose = s->located.pose;
+    // The answer in the data's frame (the model's measured frame), as the solves take it.
+    const fastcal::Pose pose = s->robot.MeasuredPose(s->located.pose, q);
     const Eigen::Vector3d rpy = fastcal::RpyDegFromRotation(pose.rotation);
     for (int k = 0; k < 3; ++k) {
       position_m[k] = pose.position_m[k];
@@ -394,6 +397,30 @@ int fastcal_locate_winch(fastcal_solver* s, const double winch_length_m[6], cons
   }
   return fastcal_locate(s, winch_length_m != nullptr ? unstretched_m : nullptr, joints, position_m,
                         rpy_deg, tension_kN);
+}
+
+int fastcal_cabin_pose(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
+                       const double* joints, double cabin_position_m[3], double cabin_rpy_deg[3]) {
+  Zero(cabin_position_m, 3);
+  Zero(cabin_rpy_deg, 3);
+  if (const int e = Enter(s, position_m && rpy_deg && cabin_position_m && cabin_rpy_deg); e != 0) {
+    return e;
+  }
+  try {
+    if (const int status = CheckPose(s, position_m, rpy_deg); status != FASTCAL_OK) return status;
+    JointValues q;
+    if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
+    const fastcal::Pose cabin = s->robot.CabinPose(PoseOf(position_m, rpy_deg), q);
+    const Eigen::Vector3d rpy = fastcal::RpyDegFromRotation(cabin.rotation);
+    for (int k = 0; k < 3; ++k) {
+      cabin_position_m[k] = cabin.position_m[k];
+      cabin_rpy_deg[k] = rpy[k];
+    }
+    return FASTCAL_OK;
+  } catch (...) {
+    SetError(s, "internal_error: an exception in fastcal_cabin_pose");
+    return FASTCAL_ERROR_INTERNAL;
+  }
 }
 
 int fastcal_solver_sensors(const fastcal_solver* s, double length_offset_m[6],
@@ -447,7 +474,8 @@ int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const d
     // Warm from the handle's last solve, whichever call made it.
     s->cycle.statics = s->last;
     const fastcal::ControlStatus status =
-        fastcal::ControlCycle(s->robot, PoseOf(position_m, rpy_deg), q, lim, s->options, &s->cycle);
+        fastcal::ControlCycle(s->robot, s->robot.CabinPose(PoseOf(position_m, rpy_deg), q), q, lim,
+                              s->options, &s->cycle);
     const fastcal::ControlCycleResult& r = s->cycle;
     out->cable = r.cable;
     if (status == fastcal::ControlStatus::kStaticsFailed) {

@@ -90,7 +90,9 @@ def control_cycle(
     the limits below. The same computation as the C interface's fastcal_control_cycle.
 
     Args:
-        position_m: the planned cabin position(s), global frame: (3,) or (n, 3).
+        position_m: the planned cabin position(s), global frame: (3,) or (n, 3); with
+            the attitude, the model's measured frame's pose where it declares one
+            (Model.measured_frame), the cabin's following from the joints.
         rpy_deg, quat: the planned attitude(s), as fastcal.solve takes them.
         joints: the moving parts' values (Model.joint_columns order and units: deg, m):
             (J,) for every pose or (n, J); None for all at zero.

@@ -95,6 +95,7 @@ def solve(
     method: str = "exact",
     model: Optional[Model] = None,
     *,
+    joints: Optional[ArrayLike] = None,
     warm_start: bool = False,
     max_refinement_steps: int = 8,
     refined_tolerance: float = 1e-6,
@@ -107,7 +108,10 @@ def solve(
     """Cable forces, tensions and unstretched lengths at one pose or many.
 
     Args:
-        position_m: position of the cabin-frame origin, global frame: (3,) or (n, 3).
+        position_m: position of the cabin-frame origin, global frame: (3,) or (n, 3); of
+            the model's measured frame's point where it declares one (Model.measured_frame:
+            the data's frame, e.g. the feed's phase centre), the cabin's pose then
+            following from the joints.
         rpy_deg: attitude as roll, pitch, yaw in degrees, R = Rz(yaw) Ry(pitch) Rx(roll):
             (3,) or (n, 3); one (3,) attitude applies to every position. At most one of
             rpy_deg and quat; neither means R = I.
@@ -119,6 +123,9 @@ def solve(
             refined_tolerance) or 'aas' (the paper's; 'inaccurate' when its error
             estimate exceeds aas_max_error).
         model: the model; None for Model.nominal().
+        joints: the moving parts' values (Model.joint_columns order and units: deg, m):
+            (J,) for every pose or (n, J); None: all at zero. They move the mass centre and,
+            with a measured frame on a part, the cabin's pose under the given one.
         warm_start: start each pose from the previous pose's solution (a trajectory);
             off, each pose is solved on its own and the order does not matter.
         max_refinement_steps: at most this many steps of 'aas-refined' (>= 1), then
@@ -165,6 +172,7 @@ def solve(
             "max_length_ratio": max_length_ratio,
             "min_reflector_clearance_m": reflector_clearance_m,
         },
+        _joint_array(joints),
     )
     return StaticsResult(raw, single)
 
@@ -182,9 +190,13 @@ class LocateResult:
     ((6,)) it has none, and `status`, `ok`, `stability` are scalars.
 
     Attributes:
-        position_m: the cabin-frame origin, global frame, (n, 3).
+        position_m: the cabin-frame origin, global frame, (n, 3); the measured frame's
+            point where the model declares one (Model.measured_frame), as the data give it.
         quat: the attitude as unit quaternions (w, x, y, z), (n, 4); rpy_deg the same as
-            roll, pitch, yaw, R = Rz(yaw) Ry(pitch) Rx(roll), (n, 3).
+            roll, pitch, yaw, R = Rz(yaw) Ry(pitch) Rx(roll), (n, 3). The measured frame's
+            where the model declares one.
+        cabin_position_m, cabin_quat: the cabin's own pose (equal to the above without a
+            measured frame).
         lower_tension_kN: the tensions at the cabin ends there, (n, 6).
         s0_m: the lengths of the answer's equilibrium, (n, 6): the given ones for lengths
             alone, the fitted pose's with a measured attitude or tensions.
@@ -195,7 +207,7 @@ class LocateResult:
             energy with the lengths held (rotations scaled by the cabin's size): < 0 unstable.
         other_equilibria: other equilibria of the same lengths found within
             search_radius_m; nearest_other_m their nearest's distance (NaN: none).
-        covariance: of (position (m), rotation vector (rad, global axes)), (n, 6, 6);
+        covariance: of (position_m (m), rotation vector (rad, global axes)), (n, 6, 6);
             sigma_position_m (n, 3) and sigma_rpy_deg (n, 3) from it.
         pose_per_length: d(position, rotation vector)/d s0_j, (n, 6, 6).
         readings, chi2: readings the pose fits and their whitened residuals squared
@@ -213,6 +225,8 @@ class LocateResult:
         codes = raw["status_code"]
         self.position_m: np.ndarray = pick(raw["position_m"])
         self.quat: np.ndarray = pick(raw["quat"])
+        self.cabin_position_m: np.ndarray = pick(raw["cabin_position_m"])
+        self.cabin_quat: np.ndarray = pick(raw["cabin_quat"])
         rpy = np.full((len(codes), 3), np.nan)
         ok = codes == 0
         if ok.any():
@@ -263,6 +277,7 @@ def locate(
     tensions_kN: Optional[ArrayLike] = None,
     model: Optional[Model] = None,
     *,
+    joints: Optional[ArrayLike] = None,
     warm_start: bool = True,
     search_radius_m: float = 2.0,
     spec: Optional[Union[PathLike, Mapping[str, Any]]] = None,
@@ -283,6 +298,9 @@ def locate(
         tensions_kN: measured tension readings per row, (6,) or (n, 6) (the model's
             sensor gain and bias apply): fitted too.
         model: the model; None for Model.nominal().
+        joints: the moving parts' values per row ((J,) for all or (n, J); None: zero), as
+            solve(): the mass centre there; a measured attitude and the answers are the
+            model's measured frame's where it declares one.
         warm_start: each row starts from the previous row's answer (a trajectory); the
             first, and any whose warm start fails, follows the equilibrium from the home
             pose as the lengths move from its lengths to the row's.
@@ -342,8 +360,15 @@ def locate(
             "max_length_ratio": max_length_ratio,
             "min_reflector_clearance_m": reflector_clearance_m,
         },
+        _joint_array(joints),
     )
     return LocateResult(raw, single)
+
+
+def _joint_array(joints: Optional[ArrayLike]) -> np.ndarray:
+    """The joints for the C++ side: an empty array for None (all at zero)."""
+    array = np.zeros((0,)) if joints is None else np.asarray(joints, dtype=np.float64)
+    return np.ascontiguousarray(array)
 
 
 def line(from_m: ArrayLike, to_m: ArrayLike, nodes: int = 101) -> np.ndarray:

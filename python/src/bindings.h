@@ -142,6 +142,10 @@ DoubleArray NewArray(const std::vector<py::ssize_t>& shape);
 std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::string& attitude_kind,
                                   const DoubleArray& attitude);
 
+// The joints as (n, J) rows: an empty array (no joints: all at zero), one row (J,) for
+// every pose, or one row per pose. InputError naming the shape or the value otherwise.
+std::vector<JointValues> JointRows(const DoubleArray& joints, py::ssize_t n, int num_joints);
+
 // The column map of `map_text` (YAML; "" for none: null), named `map_source` in messages
 // (InputError otherwise). `csv_layout` (for text the module wrote itself from a
 // spreadsheet or a DataFrame): fields separated by ',' with RFC 4180 quotes;

@@ -24,11 +24,12 @@ py::dict Prediction(const Design& d, const DesignPrediction& p) {
 
 py::dict DesignDict(const Design& d) {
   py::dict out;
-  DoubleArray poses = NewArray({static_cast<py::ssize_t>(d.poses.size()), 6});
-  for (size_t n = 0; n < d.poses.size(); ++n) {
-    const Eigen::Vector3d rpy = RpyDegFromRotation(d.poses[n].rotation);
+  // In the data's frame (the model's measured frame), as poses.csv.
+  DoubleArray poses = NewArray({static_cast<py::ssize_t>(d.data_poses.size()), 6});
+  for (size_t n = 0; n < d.data_poses.size(); ++n) {
+    const Eigen::Vector3d rpy = RpyDegFromRotation(d.data_poses[n].rotation);
     for (int c = 0; c < 3; ++c) {
-      poses.mutable_data()[6 * n + c] = d.poses[n].position_m[c];
+      poses.mutable_data()[6 * n + c] = d.data_poses[n].position_m[c];
       poses.mutable_data()[6 * n + 3 + c] = rpy[c];
     }
   }
@@ -39,7 +40,7 @@ py::dict DesignDict(const Design& d) {
     py::dict stop;
     stop["samples"] = s.samples;
     stop["position_m"] =
-        std::vector<double>(c.pose.position_m.data(), c.pose.position_m.data() + 3);
+        std::vector<double>(c.data_pose.position_m.data(), c.data_pose.position_m.data() + 3);
     stop["extra_tilt_deg"] = c.extra_tilt_deg;
     stop["tilt_direction_deg"] = c.tilt_direction_deg;
     stop["extra_yaw_deg"] = c.extra_yaw_deg;

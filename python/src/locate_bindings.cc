@@ -3,6 +3,7 @@
 // tensions, stability, other equilibria and sigmas out.
 #include <cmath>
 #include <string>
+#include <tuple>
 #include <type_traits>
 #include <vector>
 
@@ -69,19 +70,30 @@ std::vector<LocateMeasurement> Measurements(const DoubleArray& lengths_m,
 }
 
 struct LocateOutputs {
-  DoubleArray position_m, quat, lower_kn, s0_m, covariance, pose_per_length, min_stiffness,
-      nearest_other_m, chi2, error_estimate_m;
+  DoubleArray position_m, quat, cabin_position_m, cabin_quat, lower_kn, s0_m, covariance,
+      pose_per_length, min_stiffness, nearest_other_m, chi2, error_estimate_m;
   py::array_t<int> status, stability, other_equilibria, readings;
 };
 
 // One row's answer into the arrays at index k (NaN where it failed: its status says why).
-void Store(const LocateSolution& s, py::ssize_t k, LocateOutputs* out) {
+// `data`: the answer in the data's frame (the model's measured frame's; the cabin's
+// without one). The covariance and pose_per_length are the data pose's: the measured
+// point m = r_p + w moves by dr_p - [w]x dtheta, and the frame turns with the cabin.
+void Store(const LocateSolution& s, const Pose& data, py::ssize_t k, LocateOutputs* out) {
   const bool ok = s.status == StaticsStatus::kOk;
   const double none = ok ? 1.0 : std::nan("");
-  const Eigen::Vector4d q = QuaternionFromRotation(s.pose.rotation);
-  for (int d = 0; d < 3; ++d)
-    out->position_m.mutable_data()[3 * k + d] = none * s.pose.position_m[d];
-  for (int d = 0; d < 4; ++d) out->quat.mutable_data()[4 * k + d] = none * q[d];
+  for (const auto& [pose, position, quat] :
+       {std::tuple{&data, &out->position_m, &out->quat},
+        std::tuple{&s.pose, &out->cabin_position_m, &out->cabin_quat}}) {
+    const Eigen::Vector4d q = QuaternionFromRotation(pose->rotation);
+    for (int d = 0; d < 3; ++d) position->mutable_data()[3 * k + d] = none * pose->position_m[d];
+    for (int d = 0; d < 4; ++d) quat->mutable_data()[4 * k + d] = none * q[d];
+  }
+  Eigen::Matrix<double, 6, 6> to_data = Eigen::Matrix<double, 6, 6>::Identity();
+  const Eigen::Vector3d w = data.position_m - s.pose.position_m;
+  to_data.topRightCorner<3, 3>() << 0.0, w.z(), -w.y(), -w.z(), 0.0, w.x(), w.y(), -w.x(), 0.0;
+  const Eigen::Matrix<double, 6, 6> covariance = to_data * s.fit.covariance * to_data.transpose();
+  const Eigen::Matrix<double, 6, kNumCables> per_length = to_data * s.pose_per_length;
   for (int i = 0; i < kNumCables; ++i) {
     out->lower_kn.mutable_data()[kNumCables * k + i] =
         none * s.statics.cables[i].lower_tension_n / kNPerKn;
@@ -89,8 +101,8 @@ void Store(const LocateSolution& s, py::ssize_t k, LocateOutputs* out) {
   }
   for (int r = 0; r < 6; ++r) {
     for (int c = 0; c < 6; ++c) {
-      out->covariance.mutable_data()[36 * k + 6 * r + c] = none * s.fit.covariance(r, c);
-      out->pose_per_length.mutable_data()[36 * k + 6 * r + c] = none * s.pose_per_length(r, c);
+      out->covariance.mutable_data()[36 * k + 6 * r + c] = none * covariance(r, c);
+      out->pose_per_length.mutable_data()[36 * k + 6 * r + c] = none * per_length(r, c);
     }
   }
   out->min_stiffness.mutable_data()[k] = none * s.min_stiffness_n_per_m / kNPerKn;
@@ -104,9 +116,13 @@ void Store(const LocateSolution& s, py::ssize_t k, LocateOutputs* out) {
   out->readings.mutable_data()[k] = s.fit.readings;
 }
 
+// The measured attitudes and the answers are the data's (the model's measured frame's,
+// measured_frame.h), each row at its joints (all zero without), which also move the mass
+// centre.
 py::dict Locate(const CableRobot& model_argument, const DoubleArray& lengths_m,
                 const std::string& attitude_kind, const DoubleArray& attitude,
-                const DoubleArray& tensions_kn, const py::dict& settings) {
+                const DoubleArray& tensions_kn, const py::dict& settings,
+                const DoubleArray& joints) {
   // A copy taken with the GIL held: the solves run without it while another thread may
   // assign to the model's fields (issue 37: a segfault before).
   const CableRobot robot = model_argument;
@@ -114,11 +130,25 @@ py::dict Locate(const CableRobot& model_argument, const DoubleArray& lengths_m,
   LocateOptions options;
   LocateNoise noise;
   MakeLocateSettings(settings, &options, &noise);
-  const std::vector<LocateMeasurement> rows =
+  std::vector<LocateMeasurement> rows =
       Measurements(lengths_m, attitude_kind, attitude, tensions_kn);
   const auto n = static_cast<py::ssize_t>(rows.size());
+  const std::vector<JointValues> q = JointRows(joints, n, robot.moving_parts.num_joints());
+  // The model each row is located with: its mass centre at the row's joints, the parts
+  // then fixed (Locate takes a robot), so the measured frame is converted here.
+  CableRobot at = robot;
+  at.moving_parts.parts.clear();
+  at.measured_frame.reset();
+  for (py::ssize_t k = 0; k < n; ++k) {
+    Pose attitude_only;
+    attitude_only.rotation = rows[static_cast<size_t>(k)].rotation;
+    rows[static_cast<size_t>(k)].rotation =
+        robot.CabinPose(attitude_only, q[static_cast<size_t>(k)]).rotation;
+  }
   using Shape = std::vector<py::ssize_t>;
   LocateOutputs out{DoubleArray(Shape{n, 3}),
+                    DoubleArray(Shape{n, 4}),
+                    DoubleArray(Shape{n, 3}),
                     DoubleArray(Shape{n, 4}),
                     DoubleArray(Shape{n, kNumCables}),
                     DoubleArray(Shape{n, kNumCables}),
@@ -138,8 +168,10 @@ py::dict Locate(const CableRobot& model_argument, const DoubleArray& lengths_m,
     py::gil_scoped_release release;
     LocateSolution solution;  // reused: the warm start's source
     for (py::ssize_t k = 0; k < n && !interrupt.Stop(k); ++k) {
-      LocateFromMeasurements(robot, rows[static_cast<size_t>(k)], noise, options, &solution);
-      Store(solution, k, &out);
+      const JointValues& joints_k = q[static_cast<size_t>(k)];
+      at.mass_centre_cabin_m = robot.MassCentreAt(joints_k);
+      LocateFromMeasurements(at, rows[static_cast<size_t>(k)], noise, options, &solution);
+      Store(solution, robot.MeasuredPose(solution.pose, joints_k), k, &out);
       if (solution.status != StaticsStatus::kOk || solution.stability != Stability::kStable ||
           solution.other_equilibria > 0) {
         messages.emplace_back(k, DescribeLocateStatus(solution));
@@ -151,6 +183,8 @@ py::dict Locate(const CableRobot& model_argument, const DoubleArray& lengths_m,
   for (const auto& [k, message] : messages) text[py::int_(k)] = message;
   result["position_m"] = out.position_m;
   result["quat"] = out.quat;
+  result["cabin_position_m"] = out.cabin_position_m;
+  result["cabin_quat"] = out.cabin_quat;
   result["lower_tension_kN"] = out.lower_kn;
   result["s0_m"] = out.s0_m;
   result["covariance"] = out.covariance;
@@ -179,7 +213,8 @@ void BindLocate(py::module_& m) {
     return names;
   });
   m.def("locate", &Locate, py::arg("model"), py::arg("lengths_m"), py::arg("attitude_kind"),
-        py::arg("attitude"), py::arg("tensions_kN"), py::arg("settings"));
+        py::arg("attitude"), py::arg("tensions_kN"), py::arg("settings"),
+        py::arg("joints") = DoubleArray());
   m.def("rpy_deg_per_rotation_vector", [](const DoubleArray& quat) {
     const std::vector<Pose> poses =
         PosesFromArrays(NewArray({quat.ndim() == 2 ? quat.shape(0) : 0, 3}), "quat", quat);

@@ -303,8 +303,7 @@ ValueError ("assignment destination is read-only") instead of changing nothing.
           }),
           "Mass centre of the cabin in the cabin frame, shape (3,).")
       .def_property_readonly(
-          "joint_columns",
-          [](const CableRobot& r) { return r.moving_parts.JointColumns(); },
+          "joint_columns", [](const CableRobot& r) { return r.moving_parts.JointColumns(); },
           "The data columns of the moving parts' joints (cabin.moving_parts, "
           "docs/model-format.md), in the model's joint order; empty for a rigid cabin.")
       .def(
@@ -322,6 +321,76 @@ ValueError ("assignment destination is read-only") instead of changing nothing.
           py::arg("joints"),
           "The mass centre (cabin frame, m, shape (3,)) with the moving parts at `joints` "
           "(joint_columns order, deg and m): docs/model.md, \"Moving parts\".")
+      .def_property(
+          "measured_frame",
+          [](const CableRobot& r) -> py::object {
+            if (!r.measured_frame.has_value()) return py::none();
+            const MeasuredFrame& f = *r.measured_frame;
+            py::dict d;
+            d["part"] = f.part < 0 ? std::string("cabin") : r.moving_parts.parts[f.part].name;
+            d["offset_m"] = ReadOnly(Vector3(f.offset_m));
+            return d;
+          },
+          Validated<const py::object&>([](CableRobot& r, const py::object& v) {
+            if (v.is_none()) {
+              r.measured_frame.reset();
+              return;
+            }
+            if (!py::isinstance<py::dict>(v)) {
+              throw InputError("measured_frame must be None or a dict {part, offset_m}");
+            }
+            const py::dict d = v.cast<py::dict>();
+            for (const auto& item : d) {
+              const std::string key = py::str(item.first);
+              if (key != "part" && key != "offset_m") {
+                throw InputError("measured_frame: unknown key '" + key +
+                                 "' (allowed: part, offset_m)");
+              }
+            }
+            MeasuredFrame f;
+            if (d.contains("part")) {
+              const std::string part = py::str(d["part"]);
+              f.part = part == "cabin" ? -1 : r.moving_parts.Find(part);
+              if (part != "cabin" && f.part < 0) {
+                throw InputError("measured_frame.part: '" + part +
+                                 "' is not a moving part of the model (or cabin)");
+              }
+            }
+            if (d.contains("offset_m")) {
+              f.offset_m = ToVector3(d["offset_m"].cast<DoubleArray>(), "measured_frame.offset_m");
+            }
+            r.measured_frame = f;
+          }),
+          "Whose pose the data give (cabin.measured_frame, docs/model-format.md): None for the "
+          "cabin's own frame, or {'part': a moving part's name or 'cabin', 'offset_m': (3,) the "
+          "measured point in that part's frame}. solve, locate, control_cycle and every "
+          "dataset then give that frame's pose; the cabin's follows from the joints.")
+      .def(
+          "cabin_pose",
+          [](const CableRobot& r, const DoubleArray& position_m, const DoubleArray& rpy_deg,
+             const std::vector<double>& joints) {
+            const int n = r.moving_parts.num_joints();
+            if (!joints.empty() && static_cast<int>(joints.size()) != n) {
+              throw InputError("cabin_pose: the model has " + std::to_string(n) + " joints, got " +
+                               std::to_string(joints.size()) + " values");
+            }
+            JointValues q{};
+            for (size_t j = 0; j < joints.size(); ++j) q[j] = joints[j];
+            const Eigen::Vector3d rpy = ToVector3(rpy_deg, "rpy_deg");
+            Pose data;
+            data.position_m = ToVector3(position_m, "position_m");
+            data.rotation = RotationFromRpyDeg(rpy[0], rpy[1], rpy[2]);
+            if (!data.position_m.allFinite() || !rpy.allFinite()) {
+              throw InputError("cabin_pose: position_m and rpy_deg must be finite");
+            }
+            const Pose cabin = r.CabinPose(data, q);
+            return py::make_tuple(Vector3(cabin.position_m),
+                                  Vector3(RpyDegFromRotation(cabin.rotation)));
+          },
+          py::arg("position_m"), py::arg("rpy_deg"), py::arg("joints") = std::vector<double>{},
+          "The cabin's own pose (position (3,) m, rpy (3,) deg) where the model's measured "
+          "frame has this pose at `joints` (joint_columns order; empty: all zero); the same "
+          "pose without a measured frame (docs/model.md, \"The measured frame\").")
       .def_property(
           "cabin_inertia_kg_m2",
           [](const CableRobot& r) { return ReadOnly(Matrix3(r.cabin_inertia_kg_m2)); },

@@ -2,6 +2,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cerrno>
+#include <cmath>
 #include <regex>
 #include <utility>
 
@@ -60,6 +61,32 @@ std::vector<Pose> PosesFromArrays(const DoubleArray& positions_m, const std::str
     }
   }
   return poses;
+}
+
+// The joints as (n, J) rows: an empty array (no joints: all at zero), one row (J,) for
+// every pose, or one row per pose.
+std::vector<JointValues> JointRows(const DoubleArray& joints, py::ssize_t n, int num_joints) {
+  std::vector<JointValues> rows(static_cast<size_t>(n), JointValues{});
+  if (joints.size() == 0) return rows;
+  if (num_joints == 0) throw InputError("joints: the model has no moving parts");
+  const bool one = joints.ndim() == 1;
+  if ((one && joints.shape(0) != num_joints) ||
+      (!one && (joints.ndim() != 2 || joints.shape(0) != n || joints.shape(1) != num_joints))) {
+    throw InputError("joints must have shape (" + std::to_string(num_joints) + ",) or (" +
+                     std::to_string(n) + ", " + std::to_string(num_joints) +
+                     "): the model's joints in order (Model.joint_columns)");
+  }
+  for (py::ssize_t k = 0; k < n; ++k) {
+    for (int j = 0; j < num_joints; ++j) {
+      const double v = joints.data()[(one ? 0 : k * num_joints) + j];
+      if (!std::isfinite(v)) {
+        throw InputError("joints: row " + std::to_string(k) + ", joint " + std::to_string(j) +
+                         " is not finite");
+      }
+      rows[static_cast<size_t>(k)][j] = v;
+    }
+  }
+  return rows;
 }
 
 namespace {

@@ -45,9 +45,11 @@ struct SolveOutputs {
   py::dict failures;  // pose index -> DescribeStatus, for the failed poses only
 };
 
+// The poses are the data's (the model's measured frame's, measured_frame.h), each solved
+// at the cabin's pose and mass centre that follow from its joints (all zero without).
 py::dict Solve(const CableRobot& model, const DoubleArray& positions_m,
                const std::string& attitude_kind, const DoubleArray& attitude,
-               const std::string& method, const py::dict& settings) {
+               const std::string& method, const py::dict& settings, const DoubleArray& joints) {
   // A copy, taken with the GIL held: the loop below runs without it, while another
   // thread may assign to the model's fields (issue 29: a crash in the statics).
   const CableRobot robot = model;
@@ -55,6 +57,7 @@ py::dict Solve(const CableRobot& model, const DoubleArray& positions_m,
   const StaticsOptions options = MakeStaticsOptions(method, settings);
   const std::vector<Pose> poses = PosesFromArrays(positions_m, attitude_kind, attitude);
   const auto n = static_cast<py::ssize_t>(poses.size());
+  const std::vector<JointValues> q = JointRows(joints, n, robot.moving_parts.num_joints());
   // Every element is written below: no zero-filling.
   using Shape = std::vector<py::ssize_t>;
   SolveOutputs out{DoubleArray(Shape{n, kNumCables}),
@@ -82,8 +85,9 @@ py::dict Solve(const CableRobot& model, const DoubleArray& positions_m,
     py::gil_scoped_release release;
     StaticsSolution solution;  // reused: no allocation per pose, and the warm start's source
     for (py::ssize_t k = 0; k < n && !interrupt.Stop(k); ++k) {
-      const StaticsStatus s =
-          SolveStatics(robot, poses[static_cast<size_t>(k)], options, &solution);
+      const JointValues& at = q[static_cast<size_t>(k)];
+      const StaticsStatus s = SolveStatics(
+          robot, robot.CabinPose(poses[static_cast<size_t>(k)], at), at, options, &solution);
       status[k] = static_cast<int>(s);
       cable[k] = solution.cable;
       end_residual[k] = solution.end_residual_m;
@@ -160,7 +164,8 @@ void BindStatics(py::module_& m) {
     return EnumNames(StaticsStatus::kUnsupportedModel, StaticsStatusName);
   });
   m.def("solve", &Solve, py::arg("model"), py::arg("position_m"), py::arg("attitude_kind"),
-        py::arg("attitude"), py::arg("method"), py::arg("settings"));
+        py::arg("attitude"), py::arg("method"), py::arg("settings"),
+        py::arg("joints") = DoubleArray());
   m.def("line", [](const DoubleArray& from_m, const DoubleArray& to_m, int nodes) {
     return Generated([&](std::vector<Eigen::Vector3d>* p, std::string* e) {
       return LinePositions(Point(from_m, "from_m"), Point(to_m, "to_m"), nodes, p, e);

@@ -13,8 +13,13 @@
  * A handle is not thread-safe: one handle per thread (each keeps its own warm start).
  *
  * Units at this edge: positions m, angles deg (roll, pitch, yaw: R = Rz(yaw) Ry(pitch)
- * Rx(roll), cabin frame to global), forces and tensions kN, lengths m; joint values in
- * the model's joint order and the joint columns' units (deg revolute, m prismatic).
+ * Rx(roll), frame to global), forces and tensions kN, lengths m; joint values in the
+ * model's joint order and the joint columns' units (deg revolute, m prismatic).
+ *
+ * Poses, in and out, are the data's: those of the model's measured frame when it declares
+ * one (cabin.measured_frame, docs/model-format.md: FAST's feed phase centre and Stewart
+ * platform attitude, SDP_PhaPos and SDP_SwtDPose), else the cabin's own frame. The
+ * cabin's pose then follows from the joints (fastcal_cabin_pose gives it).
  *
  * Statuses: 0 ok; 1..12 the statics' own (fastcal_status_name: "invalid_input",
  * "no_equilibrium", ...; StaticsStatus of fastcal/statics.h, same numbers); 100..102 a
@@ -153,6 +158,14 @@ FASTCAL_C_API int fastcal_locate(fastcal_solver* s, const double unstretched_m[6
 FASTCAL_C_API int fastcal_locate_winch(fastcal_solver* s, const double winch_length_m[6],
                                        const double* joints, double position_m[3],
                                        double rpy_deg[3], double tension_kN[6]);
+/* The cabin's own pose (its anchor plane's centre, its attitude) where the model's measured
+ * frame has `position_m`, `rpy_deg` at `joints` (as for a solve; NULL: all zero): the same
+ * pose without a measured frame. 0, or a status as a solve's (invalid_input naming the
+ * value); the outputs are zero on failure. No allocation: callable in the cycle. */
+FASTCAL_C_API int fastcal_cabin_pose(fastcal_solver* s, const double position_m[3],
+                                     const double rpy_deg[3], const double* joints,
+                                     double cabin_position_m[3], double cabin_rpy_deg[3]);
+
 /* The model's encoder offsets (m) and tension sensors' gains and biases (kN), as the
  * control cycle applies them: winch = s0 + offset, reading = gain * tension + bias. Any
  * array may be NULL. 0, or -1/-2 for a NULL handle or one without a model. */
