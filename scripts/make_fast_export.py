@@ -12,6 +12,19 @@ numbers); and two channels fastcal does not need (wind speed, air temperature).
 
     python3 scripts/make_fast_export.py            # rewrites the bundled file
     python3 scripts/make_fast_export.py --check    # exit 1 if it differs
+
+With --feed it writes calibration_data/fast_feed_export.csv the same way from
+calibration_data/fast_feed_survey.csv (a survey simulated with calibration_data/fast_feed.yaml:
+the data's poses are the feed's phase centre and the Stewart platform's attitude), with the
+rotator's angles and the platform's shifts as channels of their own (ABRot_A, ABRot_B in
+deg, SwtD_Shift_X/Y/Z in mm; the example's names), read through
+calibration_data/fast_feed_export.columns.yaml with the model fast_feed.yaml. The survey:
+
+    build/bin/fastcal simulate --truth=calibration_data/fast_feed.yaml --trajectory=random \
+        --max-off-axis-deg=40 --samples=360 --seed=58 --joint-law=focal \
+        --prismatic-spread-m=0.05 --interval-s=8 --mass-centre=0.22,0.11,0.5 \
+        --tension-noise-percent=3 --sensor-gain-spread-percent=1 --sensor-bias-spread-kN=1.5 \
+        --out=calibration_data/fast_feed_survey.csv
 """
 import datetime
 import decimal
@@ -20,9 +33,16 @@ import pathlib
 import sys
 
 ROOT = pathlib.Path(__file__).resolve().parent.parent
-SOURCE = ROOT / "calibration_data" / "realistic_survey.csv"
-TARGET = ROOT / "calibration_data" / "fast_export.csv"
-START = datetime.datetime(2024, 5, 1, 20, 0, 0)  # Beijing time (UTC+8), as SysTime holds it
+FEED = "--feed" in sys.argv[1:]
+SOURCE = ROOT / "calibration_data" / ("fast_feed_survey.csv" if FEED else "realistic_survey.csv")
+TARGET = ROOT / "calibration_data" / ("fast_feed_export.csv" if FEED else "fast_export.csv")
+# Beijing time (UTC+8), as SysTime holds it.
+START = datetime.datetime(2024, 5, 2 if FEED else 1, 20, 0, 0)
+# The rotator's and platform's channels (--feed): fastcal's joint column, the export's
+# name, its unit, and the decimal digits moved (mm: 3).
+JOINTS = [("rotator_a_deg", "ABRot_A", "deg", 0), ("rotator_b_deg", "ABRot_B", "deg", 0),
+          ("stewart_x_m", "SwtD_Shift_X", "mm", 3), ("stewart_y_m", "SwtD_Shift_Y", "mm", 3),
+          ("stewart_z_m", "SwtD_Shift_Z", "mm", 3)]
 
 
 def shifted(text: str, digits: int) -> str:
@@ -50,12 +70,17 @@ def main() -> int:
          "TRP_SwtDPose_R"]
         + [f"CableForce{i}" for i in range(1, 7)]
         + [f"TRP_CableLen{i}" for i in range(1, 7)]
+        + ([name for _, name, _, _ in JOINTS] if FEED else [])
         + ["WindSpeed", "AirTemp"]
     )
     units = ["(Beijing time)", "mm", "mm", "mm", "deg", "deg", "deg", "deg", "deg", "deg"]
-    units += ["N"] * 6 + ["mm"] * 6 + ["m/s", "degC"]
+    units += ["N"] * 6 + ["mm"] * 6 + ([unit for _, _, unit, _ in JOINTS] if FEED else [])
+    units += ["m/s", "degC"]
+    title = ("FAST feed cabin telemetry;export of 2024-05-02;survey 2024-05-02 20:00 to 20:48"
+             if FEED else
+             "FAST feed cabin telemetry;export of 2024-05-01;survey 2024-05-01 20:00 to 20:48")
     out = [
-        "FAST feed cabin telemetry;export of 2024-05-01;survey 2024-05-01 20:00 to 20:48",
+        title,
         ";".join(header),
         ";".join(units),
     ]
@@ -70,6 +95,8 @@ def main() -> int:
                 for n in ("planned_yaw_deg", "planned_pitch_deg", "planned_roll_deg")]
         row += [shifted(f[column[f"T{i}_kN"]], 3) for i in range(1, 7)]
         row += [shifted(f[column[f"s0_{i}_m"]], 3) for i in range(1, 7)]
+        if FEED:
+            row += [shifted(f[column[name]], digits) for name, _, _, digits in JOINTS]
         row += [f"{2.0 + 0.8 * math.sin(t / 317.0):.2f}".replace(".", ","),
                 f"{18.5 - 0.6 * t / 2880.0:.1f}".replace(".", ",")]
         out.append(";".join(row))

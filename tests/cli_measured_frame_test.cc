@@ -2,7 +2,7 @@
 // frame against the plain model at the cabin's pose derived by hand (a frame on the cabin
 // and one on the rotated platform), a survey with a 2 m lever arm and the rotator
 // following the pointing calibrated to its truth with the offset estimated, locate's two
-// poses, and the refusals a user meets.
+// poses, the bundled FAST export read as the feed's, and the refusals a user meets.
 #include <cmath>
 #include <regex>
 #include <string>
@@ -160,6 +160,27 @@ TEST_F(CliMeasuredFrameTest, LocateGivesTheDataFramesPoseAndTheCabins) {
                dy = Column(csv, "y_m") - Column(csv, "cabin_y_m"),
                dz = Column(csv, "z_m") - Column(csv, "cabin_z_m");
   EXPECT_NEAR(std::sqrt(dx * dx + dy * dy + dz * dz), 2.0, 0.1);
+}
+
+TEST_F(CliMeasuredFrameTest, TheBundledFeedExportIsReadAsTheFeeds) {
+  const std::string data = Source() + "/calibration_data/";
+  const CommandResult cal =
+      Fastcal("calibrate --spec=" + data + "spec_measured_frame.yaml --model=" + data +
+              "fast_feed.yaml --columns=" + data + "fast_feed_export.columns.yaml --data=" + data +
+              "fast_feed_export.csv --out=" + Path("feed") + " --force");
+  ASSERT_EQ(cal.code, 0) << cal.output;
+  EXPECT_NE(cal.output.find("verdict: ok"), std::string::npos) << cal.output;
+  // The same numbers as the canonical survey it was exported from.
+  const CommandResult canonical =
+      Fastcal("calibrate --spec=" + data + "spec_measured_frame.yaml --model=" + data +
+              "fast_feed.yaml --data=" + data + "fast_feed_survey.csv --out=" + Path("canonical") +
+              " --force");
+  ASSERT_EQ(canonical.code, 0) << canonical.output;
+  double a = 0, sa = 0, b = 0, sb = 0;
+  ConsoleEstimate(cal.output, "measured_frame.offset_m.z", &a, &sa);
+  ConsoleEstimate(canonical.output, "measured_frame.offset_m.z", &b, &sb);
+  EXPECT_EQ(a, b);
+  EXPECT_EQ(sa, sb);
 }
 
 TEST_F(CliMeasuredFrameTest, RefusalsNameWhatToDeclare) {
