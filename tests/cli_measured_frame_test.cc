@@ -183,6 +183,55 @@ TEST_F(CliMeasuredFrameTest, TheBundledFeedExportIsReadAsTheFeeds) {
   EXPECT_EQ(sa, sb);
 }
 
+TEST_F(CliMeasuredFrameTest, ATrackOfTheFeedsDataFindsTheMassCentreEachDay) {
+  constexpr double kSigmas = 2.5;
+  // Two days of the feed's telemetry, the measured frame's offset shared by the season.
+  const CommandResult sim = Fastcal(
+      "simulate --truth=" + FeedModel() +
+      " --trajectory=random --max-off-axis-deg=40 --samples=400 --seed=23 --joint-law=focal "
+      "--interval-s=10 --days=2 --start=2024-05-01T20:00:00Z --mass-centre=0.22,0.11,0.5 "
+      "--tension-noise-percent=3 --out=" +
+      Path("season.csv") + " --force");
+  ASSERT_EQ(sim.code, 0) << sim.output;
+  std::string spec = ReadFile(Source() + "/calibration_data/spec_track.yaml");
+  spec = std::regex_replace(spec, std::regex("\nsessions:"),
+                            "\n  measured_frame:\n    offset_m:\n"
+                            "      x: {free: true, prior: {mean: 0, sigma: 0.2}}\n"
+                            "      y: {free: true, prior: {mean: 0, sigma: 0.2}}\n"
+                            "      z: {free: true, prior: {mean: -1.2, sigma: 0.2}}\nsessions:");
+  Write("spec.yaml", spec);
+  const CommandResult track =
+      Fastcal("track --spec=" + Path("spec.yaml") + " --model=" + FeedModel() +
+              " --data=" + Path("season.csv") + " --out=" + Path("track"));
+  ASSERT_EQ(track.code, 0) << track.output;
+  // Each day's mass centre, from track.csv: estimate and sigma_total columns by name.
+  const std::string csv = ReadFile(Path("track/track.csv"));
+  std::vector<std::string> lines;
+  for (size_t at = 0, end; at < csv.size(); at = end + 1) {
+    end = csv.find('\n', at);
+    if (end == std::string::npos) end = csv.size();
+    if (csv[at] != '#') lines.push_back(csv.substr(at, end - at));
+  }
+  ASSERT_GE(lines.size(), 3u) << csv;
+  const std::vector<std::string> header = CsvFields(lines[0]);
+  const char axes[] = "xyz";
+  const double truth[] = {0.22, 0.11, 0.5};
+  for (size_t row = 1; row < lines.size(); ++row) {
+    const std::vector<std::string> f = CsvFields(lines[row]);
+    for (int a = 0; a < 3; ++a) {
+      const std::string name = std::string("mass_centre_m.") + axes[a];
+      double value = NAN, sigma = NAN;
+      for (size_t k = 0; k < header.size() && k < f.size(); ++k) {
+        if (header[k] == name) value = std::stod(f[k]);
+        if (header[k] == name + "_sigma_total") sigma = std::stod(f[k]);
+      }
+      ASSERT_TRUE(std::isfinite(value) && std::isfinite(sigma)) << lines[0];
+      EXPECT_LT(std::abs(value - truth[a]), kSigmas * sigma) << "day " << row << " " << axes[a];
+    }
+  }
+  EXPECT_NE(ReadFile(Path("track/track.html")).find("cabin.measured_frame)"), std::string::npos);
+}
+
 TEST_F(CliMeasuredFrameTest, RefusalsNameWhatToDeclare) {
   const std::string data = Source() + "/calibration_data/";
   // An offset to calibrate in a model that declares no frame: the spec's key and line.

@@ -90,6 +90,12 @@ TrackStatus Validate(TrackRun& run) {
     run.result->notes.push_back(
         "the spec's change_scan is calibrate's only: a track tests changes between windows");
   }
+  if (run.model.measured_frame.has_value()) {  // whose pose the data give (measured_frame.h)
+    run.result->notes.push_back(
+        "the data's poses are those of " +
+        DescribeMeasuredFrame(&*run.model.measured_frame, run.model.moving_parts) +
+        " (the model's cabin.measured_frame)");
+  }
   run.model_yaml = CableRobotToYaml(run.model, "");
   run.spec_yaml = CalibrationSpecToYaml(run.spec);
   if (run.options.read.columns) {
