@@ -20,6 +20,8 @@
 #include <system_error>
 #include <thread>
 
+#include "fastcal/calibration.h"
+#include "fastcal/evaluation.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/json.h"
@@ -816,6 +818,17 @@ bool ReadSamples(Router& router, const std::string& path, int index, const std::
                "planned_roll_deg, planned_pitch_deg, planned_yaw_deg columns";
       return false;
     }
+    if (read.skip_invalid_rows && !chunk.samples.empty()) {
+      // As calibrate --skip-invalid-rows: a pose the track's start cannot solve (near the
+      // workspace's edge the measured attitude's error can loop a cable the cabin held taut)
+      // goes the way of a malformed row, named in the notes; without the flag the fold
+      // refuses it, naming it and why.
+      chunk.path = path;
+      run.unsolvable_skipped += SkipUnsolvableSamples(
+          InitialCalibrationModel(run.model, run.spec), "the initial model",
+          {run.spec.use_planned_attitude ? AttitudeSource::kPlanned : AttitudeSource::kMeasured},
+          {run.spec.forward_model}, &chunk);
+    }
     for (const std::string& skipped : chunk.skipped) {
       if (run.files_skipped.size() < kMaxSkippedNamed) run.files_skipped.push_back(skipped);
     }
@@ -1102,6 +1115,11 @@ TrackStatus ReadNewFiles(TrackRun& run) {
     }
   }
   for (const std::string& s : run.files_skipped) run.result->notes.push_back("skipped: " + s);
+  if (run.unsolvable_skipped > 0) {
+    run.result->notes.push_back(std::to_string(run.unsolvable_skipped) + " sample" +
+                                (run.unsolvable_skipped == 1 ? "" : "s") +
+                                " the initial model cannot solve left out (--skip-invalid-rows)");
+  }
   if (run.update) {
     run.result->notes.push_back(std::to_string(read) + " new file" + (read == 1 ? "" : "s") +
                                 " added to the track in " + run.out);

@@ -96,6 +96,24 @@ std::string Where(const FoldTask& task, const SampleSource& source, const Sample
   return name + ":" + std::to_string(sample.line);
 }
 
+// Why the model at the task's point cannot solve `sample` (the statics' account, from a
+// cold start: a fold's warm starts follow the samples before).
+std::string WhyUnsolvable(const FoldTask& task, const internal::CalibrationModel& cm,
+                          const Sample& sample) {
+  StaticsParameters<double> params;
+  std::array<double, kNumCables> gain, bias;
+  Eigen::Vector3d measured_offset;
+  cm.Assemble<double>(task.theta_si.data(), &params, &gain, &bias, 0, nullptr, &measured_offset);
+  StaticsSolution solution;
+  const StaticsOptions options = ModelFitStaticsOptions(task.forward_model);
+  const Pose pose = cm.CabinPose(sample.pose, sample.joint, measured_offset);
+  if (SolveStaticsWithParameters(params, cm.robot().moving_parts, sample.joint, pose, options,
+                                 &solution) == StaticsStatus::kOk) {
+    return "a warm start from the samples before fails, a cold one does not";
+  }
+  return DescribeStatus(solution);
+}
+
 // The first read error of a pass's threads.
 struct ReadFailure {
   std::mutex mutex;
@@ -692,7 +710,9 @@ bool FoldSource(const FoldTask& task, const CableRobot& model, const SampleSourc
     std::vector<int> file_of;
     if (!source.read(t, 1, &sample, &file_of, error)) return false;
     *error = Where(task, source, sample[0], file_of[0]) +
-             ": the model at the track's point cannot solve this pose";
+             ": the model at the track's point cannot solve this pose: " +
+             WhyUnsolvable(task, cm, sample[0]) +
+             " (--skip-invalid-rows leaves out the samples the initial model cannot solve)";
     return false;
   };
   WindowPrediction at;

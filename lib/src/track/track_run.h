@@ -152,6 +152,7 @@ struct TrackRun {
   // Window w's (index into `used`) shared column j -> entry of b.
   std::vector<std::vector<int>> entry_of;
   std::vector<std::string> files_skipped;
+  long long unsolvable_skipped = 0;  // samples the initial model cannot solve (skip_invalid_rows)
   // After the solve: per used window its widening f_w, and the consider parameters'
   // M^-1 C (C = J_x^T J_c) and sigmas (SI).
   std::vector<double> widening;
