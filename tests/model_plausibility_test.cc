@@ -69,6 +69,31 @@ TEST(ModelPlausibilityTest, TheModelsWorldIsCheckedAtItsKey) {
   EXPECT_EQ(refused(robot).rfind("cables[5].tower_top_m: z = 130 m is below 150 m", 0), 0u) << why;
 }
 
+// Issue 57: the cabin's inertia had no range; 1e300 kg m^2 aborted `modes` (Spectra's
+// exception, exit 134), 1e100 gave a mode of 0 Hz, 1e-300 and 3.5e12 were accepted. Each
+// principal moment is refused at its key, given as a diagonal or as a full tensor.
+TEST(ModelPlausibilityTest, TheCabinsInertiaHasAPlausibleRange) {
+  std::string why;
+  for (const double moment : {1e300, 1e100, 3.5e12, 1e-300, 350.0}) {
+    CableRobot robot = CableRobot::NominalFast();
+    robot.cabin_inertia_kg_m2 = Eigen::Vector3d::Constant(moment).asDiagonal();
+    EXPECT_FALSE(CheckModel(robot, &why)) << moment;
+    EXPECT_EQ(why.rfind("cabin.inertia_kg_m2[", 0), 0u) << why;
+    EXPECT_NE(why.find("kg m^2 is " + std::string(moment > 1e8 ? "above" : "below")),
+              std::string::npos)
+        << why;
+  }
+  CableRobot robot = CableRobot::NominalFast();
+  robot.cabin_inertia_kg_m2 << 3.5e5, 1e5, 0.0, 1e5, 3.5e5, 0.0, 0.0, 0.0, 2e8;
+  EXPECT_FALSE(CheckModel(robot, &why));  // the triangle inequality first: no rigid body
+  robot.cabin_inertia_kg_m2 << 2e8, 1e5, 0.0, 1e5, 2e8, 0.0, 0.0, 0.0, 3e8;
+  EXPECT_FALSE(CheckModel(robot, &why));
+  EXPECT_EQ(why.rfind("cabin.inertia_kg_m2 (principal moment", 0), 0u) << why;
+  robot.cabin_inertia_kg_m2 << 4e5, 1e4, 0.0, 1e4, 4e5, 0.0, 0.0, 0.0, 6e5;
+  EXPECT_TRUE(CheckModel(robot, &why)) << why;
+  EXPECT_TRUE(CheckModel(CableRobot::NominalFast(), &why)) << why;
+}
+
 TEST(ModelPlausibilityTest, QuantityMessagesGiveTheNominalValueAndTheLikelySlip) {
   const PlausibilityLimits limits;
   std::string why;

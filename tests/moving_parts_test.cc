@@ -169,6 +169,27 @@ TEST(MovingPartsTest, BadModelFilesNameTheKey) {
       {"      joints:\n        - {type: revolute, axis: [1, 0, 0], column: a_deg}\n"
        "      mass_kg: -1\n",
        "cabin.moving_parts[0].mass_kg"},
+      // Issue 57: a joint named as a column of the dataset itself (simulate wrote x_m
+      // twice, and every reader then refused the file); a part heavier than the cabin, an
+      // origin a kilometre off, a range of +-1e9 deg.
+      {"      joints:\n        - {type: prismatic, axis: [1, 0, 0], column: x_m}\n",
+       "cabin.moving_parts[0].joints[0].column: 'x_m' is a column of the dataset itself"},
+      {"      joints:\n        - {type: revolute, axis: [1, 0, 0], column: roll_deg}\n",
+       "cabin.moving_parts[0].joints[0].column: 'roll_deg' is a column of the dataset"},
+      {"      joints:\n        - {type: prismatic, axis: [1, 0, 0], column: s0_1_m}\n",
+       "cabin.moving_parts[0].joints[0].column: 's0_1_m' is a column of the dataset"},
+      {"      joints:\n        - {type: revolute, axis: [1, 0, 0], column: planned_roll_deg}\n",
+       "cabin.moving_parts[0].joints[0].column: 'planned_roll_deg' is a column of the dataset"},
+      {"      joints:\n        - {type: prismatic, axis: [1, 0, 0], column: d_m}\n"
+       "      mass_kg: 40000\n",
+       "cabin.moving_parts[0].mass_kg: 40000 kg brings the moving parts to 40000 kg, more than "
+       "the whole cabin's 30000 kg"},
+      {"      origin_m: [1e6, 0, 0]\n      joints:\n        - {type: revolute, axis: [1, 0, 0], "
+       "column: a_deg}\n",
+       "cabin.moving_parts[0].origin_m.x: 1e+06 m is beyond the plausible +-20 m"},
+      {"      joints:\n        - {type: revolute, axis: [1, 0, 0], column: a_deg, range: [-1e9, "
+       "1e9]}\n",
+       "cabin.moving_parts[0].joints[0].range: [-1e+09, 1e+09]: a joint angle beyond one turn"},
   };
   for (const auto& c : cases) {
     CableRobot robot;
@@ -198,8 +219,8 @@ TEST(MovingPartsTest, StaticsAtTheJointsAreTheStaticsOfTheMovedMassCentre) {
     double largest = 0.0;
     for (int i = 0; i < kNumCables; ++i) {
       EXPECT_EQ(zero.cables[i].lower_tension_n, rigid.cables[i].lower_tension_n);
-      largest = std::max(largest, std::abs(a.cables[i].lower_tension_n -
-                                           rigid.cables[i].lower_tension_n));
+      largest = std::max(largest,
+                         std::abs(a.cables[i].lower_tension_n - rigid.cables[i].lower_tension_n));
     }
     constexpr double kVisibleN = 100.0;  // 12 deg of a 6000 kg m rotator: kN, not noise
     EXPECT_GT(largest, kVisibleN);

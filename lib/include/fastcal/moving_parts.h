@@ -126,6 +126,17 @@ struct MovingParts {
 // plausible: an angle within one turn, a shift within 100 m. On failure says why.
 bool PlausibleJointValue(const std::string& column, double value, std::string* error);
 
+// A value `joint` can take (its column's unit): plausible (PlausibleJointValue) and, when
+// the model states a range, within it (issue 57: Python's control_cycle and `evaluate`
+// took 400 deg on a joint of +-40 deg). On failure *why (may be null) says so, with the
+// digits that tell the value from the limit: "40.0000001 is outside the range [-40, 40]
+// the model states for it".
+bool CheckJointValue(const Joint& joint, double value, std::string* why);
+
+// The index (the model's joint order) of the first of `joints` that CheckJointValue
+// refuses, or -1. Allocates nothing: the C interface's cycle calls it.
+int FirstRefusedJoint(const MovingParts& parts, const JointValues& joints);
+
 }  // namespace fastcal
 
 #endif  // FASTCAL_MOVING_PARTS_H_

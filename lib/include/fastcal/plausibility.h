@@ -113,6 +113,14 @@ struct PlausibilityLimits {
   double min_tower_top_z_m = 150.0;
   double max_tower_gap_deg = 150.0;
 
+  // The cabin's principal moments of inertia, kg m^2 (cabin.inertia_kg_m2; only the
+  // vibrations read it; issue 57: 1e300 aborted `modes`, 1e100 gave a mode of 0 Hz). The
+  // assumed default is diag(3.5e5, 3.5e5, 5e5), a 30 t cabin of ~13 m diameter; a 10 t
+  // cabin of 2.5 m radius has about m r^2 / 4 = 1.6e4, a 100 t one of 20 m about
+  // m r^2 / 2 = 2e7. A factor of 1000 either way (t m^2 typed as kg m^2) falls outside.
+  double min_cabin_inertia_kg_m2 = 1.0e4;
+  double max_cabin_inertia_kg_m2 = 1.0e8;
+
   // False, naming the field, when a limit is not finite or not > 0.
   bool IsValid(std::string* error) const;
 };
@@ -157,6 +165,11 @@ enum class ModelQuantity {
   // One component of the measured frame's point in its part's frame (measured_frame.h): a
   // point of the cabin, within max_abs_anchor_point_m like its anchors.
   kMeasuredOffsetM,
+  // A moving part's origin_m (one component, its parent's frame): inside the cabin, as an
+  // anchor point is (max_abs_anchor_point_m).
+  kPartOriginM,
+  // One principal moment of the cabin's inertia.
+  kCabinInertiaKgM2,
 };
 
 // A quantity's plausible range and its nominal FAST value, SI (percent for

@@ -10,6 +10,7 @@
 #include <string_view>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/internal/dataset_column_names.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
 
@@ -35,18 +36,13 @@ enum Column : int {
   kNumColumns = kUnstretched1 + kNumCables,
 };
 
-// clang-format off
-inline constexpr const char* kColumnNames[kNumColumns] = {
-    "time_s", "x_m", "y_m", "z_m",
-    "roll_deg", "pitch_deg", "yaw_deg",
-    "qw", "qx", "qy", "qz",
-    "planned_roll_deg", "planned_pitch_deg", "planned_yaw_deg",
-    "T1_kN", "T2_kN", "T3_kN", "T4_kN", "T5_kN", "T6_kN",
-    "s0_1_m", "s0_2_m", "s0_3_m", "s0_4_m", "s0_5_m", "s0_6_m"};
-// clang-format on
+// Their names, in the order above (internal/dataset_column_names.h holds the list).
+inline constexpr auto& kColumnNames = kDatasetColumnNames;
+static_assert(sizeof(kDatasetColumnNames) / sizeof(kDatasetColumnNames[0]) == kNumColumns,
+              "one name per column");
 
 // The optional label column (docs/data-format.md, "Sessions").
-inline constexpr char kSessionColumn[] = "session";
+inline constexpr auto& kSessionColumn = kSessionColumnName;
 
 // Files hold tensions in kN, memory in N: the decimal exponent shifts by this much.
 inline constexpr int kKilo = 3;

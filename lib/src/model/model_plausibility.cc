@@ -2,8 +2,10 @@
 // (model_plausibility.h).
 #include "fastcal/model_plausibility.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <utility>
 
@@ -26,6 +28,30 @@ struct ModelValue {
   double nominal_si;
 };
 
+// The cabin's principal moments of inertia: the diagonal as given when the tensor is
+// diagonal in the cabin frame (the file's usual [Ixx, Iyy, Izz], named by index), else its
+// eigenvalues, ascending.
+void AddInertiaValues(const Eigen::Matrix3d& inertia, const Eigen::Matrix3d& nominal,
+                      std::vector<ModelValue>* values) {
+  const std::string key = "cabin.inertia_kg_m2";
+  if (inertia.isDiagonal(0.0)) {
+    for (int a = 0; a < 3; ++a) {
+      values->push_back({key + "[" + std::to_string(a) + "]", ModelQuantity::kCabinInertiaKgM2,
+                         inertia(a, a), nominal(a, a)});
+    }
+    return;
+  }
+  const Eigen::Vector3d moments =
+      inertia.allFinite()
+          ? Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia, Eigen::EigenvaluesOnly)
+                .eigenvalues()
+          : Eigen::Vector3d::Constant(std::numeric_limits<double>::quiet_NaN());
+  for (int a = 0; a < 3; ++a) {
+    values->push_back({key + " (principal moment " + std::to_string(a + 1) + ")",
+                       ModelQuantity::kCabinInertiaKgM2, moments[a], nominal(a, a)});
+  }
+}
+
 // Every scalar value of `robot` that has a plausible range, with the nominal FAST
 // model's value beside it (components of vectors each on their own).
 std::vector<ModelValue> ModelValues(const CableRobot& robot) {
@@ -46,12 +72,17 @@ std::vector<ModelValue> ModelValues(const CableRobot& robot) {
     values.push_back({std::string("cabin.mass_centre_m.") + kAxes[a], ModelQuantity::kMassCentreM,
                       robot.mass_centre_cabin_m[a], nominal.mass_centre_cabin_m[a]});
   }
+  AddInertiaValues(robot.cabin_inertia_kg_m2, nominal.cabin_inertia_kg_m2, &values);
   for (size_t k = 0; k < robot.moving_parts.parts.size(); ++k) {
     const MovingPart& part = robot.moving_parts.parts[k];
     const std::string key = "cabin.moving_parts[" + std::to_string(k) + "].";
     for (int a = 0; a < 3; ++a) {
       values.push_back({key + "first_moment_kg_m." + kAxes[a], ModelQuantity::kPartFirstMomentKgM,
                         part.first_moment_kg_m[a], 0.0});
+    }
+    for (int a = 0; a < 3; ++a) {
+      values.push_back(
+          {key + "origin_m." + kAxes[a], ModelQuantity::kPartOriginM, part.origin_m[a], 0.0});
     }
     values.push_back({key + "mass_kg", ModelQuantity::kPartMassKg, part.mass_kg, 0.0});
   }
@@ -217,6 +248,36 @@ bool CheckTowerLayout(const CableRobot& robot, const PlausibilityLimits& limits,
   return true;
 }
 
+// The moving parts within the cabin they belong to (issue 57: a part of 40 t in a 30 t
+// cabin and a joint range of +-1e9 deg were accepted): their masses together at most the
+// whole cabin's (cabin.mass_kg includes them), and each joint's stated range within what a
+// joint value may be (PlausibleJointValue: one turn, or 100 m).
+bool CheckMovingPartsPlausible(const CableRobot& robot, std::string* why) {
+  double parts_kg = 0.0;
+  for (size_t k = 0; k < robot.moving_parts.parts.size(); ++k) {
+    const MovingPart& part = robot.moving_parts.parts[k];
+    const std::string key = "cabin.moving_parts[" + std::to_string(k) + "]";
+    parts_kg += part.mass_kg;
+    if (parts_kg > robot.cabin_mass_kg) {
+      *why = key + ".mass_kg: " + Num(part.mass_kg) + " kg brings the moving parts to " +
+             Num(parts_kg) + " kg, more than the whole cabin's " + Num(robot.cabin_mass_kg) +
+             " kg (cabin.mass_kg includes its moving parts)";
+      return false;
+    }
+    for (size_t j = 0; j < part.joints.size(); ++j) {
+      const Joint& joint = part.joints[j];
+      std::string what;
+      if (joint.has_range && (!PlausibleJointValue(joint.column, joint.range_low, &what) ||
+                              !PlausibleJointValue(joint.column, joint.range_high, &what))) {
+        *why = key + ".joints[" + std::to_string(j) + "].range: [" + Num(joint.range_low) + ", " +
+               Num(joint.range_high) + "]: " + what;
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
 }  // namespace
 
 bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limits,
@@ -239,6 +300,10 @@ bool CheckModelPlausible(const CableRobot& robot, const PlausibilityLimits& limi
     }
   }
   if (!CheckTowerLayout(robot, limits, &what)) {
+    if (why != nullptr) *why = what;
+    return false;
+  }
+  if (!CheckMovingPartsPlausible(robot, &what)) {
     if (why != nullptr) *why = what;
     return false;
   }

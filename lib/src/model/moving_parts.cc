@@ -7,6 +7,9 @@
 #include <cmath>
 #include <set>
 
+#include "fastcal/internal/dataset_column_names.h"
+#include "fastcal/internal/number_text.h"
+
 namespace fastcal {
 namespace {
 
@@ -16,7 +19,8 @@ constexpr double kMaxPlausibleAngleDeg = 360.0;
 constexpr double kMaxPlausibleShiftM = 100.0;
 
 bool EndsWith(const std::string& s, const std::string& suffix) {
-  return s.size() > suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+  return s.size() > suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
 bool ValidName(const std::string& name) {
@@ -160,7 +164,8 @@ bool MovingParts::IsValid(std::string* error) const {
     }
     if (!p.origin_m.allFinite()) return fail(key + ".origin_m", "must be finite");
     if (!p.first_moment_kg_m.allFinite()) return fail(key + ".first_moment_kg_m", "must be finite");
-    if (!(p.mass_kg >= 0.0) || !std::isfinite(p.mass_kg)) return fail(key + ".mass_kg", "must be >= 0");
+    if (!(p.mass_kg >= 0.0) || !std::isfinite(p.mass_kg))
+      return fail(key + ".mass_kg", "must be >= 0");
     for (size_t j = 0; j < p.joints.size(); ++j) {
       const Joint& joint = p.joints[j];
       const std::string jkey = key + ".joints[" + std::to_string(j) + "]";
@@ -171,7 +176,14 @@ bool MovingParts::IsValid(std::string* error) const {
       if (!ValidColumn(joint.column) || !EndsWith(joint.column, suffix)) {
         return fail(jkey + ".column", std::string("a ") + JointTypeName(joint.type) +
                                           " joint's column is a name (letters, digits, '_') "
-                                          "ending in " + suffix + ", got '" + joint.column + "'");
+                                          "ending in " +
+                                          suffix + ", got '" + joint.column + "'");
+      }
+      if (internal::IsDatasetColumnName(joint.column)) {
+        return fail(jkey + ".column",
+                    "'" + joint.column +
+                        "' is a column of the dataset itself (docs/data-format.md); "
+                        "a joint's column needs a name of its own");
       }
       if (!columns.insert(joint.column).second) {
         return fail(jkey + ".column", "'" + joint.column + "' is used by another joint");
@@ -194,6 +206,29 @@ bool PlausibleJointValue(const std::string& column, double value, std::string* e
                    : "a joint shift beyond 100 m is not plausible";
   }
   return false;
+}
+
+bool CheckJointValue(const Joint& joint, double value, std::string* why) {
+  if (!PlausibleJointValue(joint.column, value, why)) return false;
+  if (!joint.has_range || (value >= joint.range_low && value <= joint.range_high)) return true;
+  if (why != nullptr) {
+    const double limit = value < joint.range_low ? joint.range_low : joint.range_high;
+    *why = internal::FormatBeyond(value, limit) + " is outside the range [" +
+           internal::FormatDouble("%.6g", joint.range_low) + ", " +
+           internal::FormatDouble("%.6g", joint.range_high) + "] the model states for it";
+  }
+  return false;
+}
+
+int FirstRefusedJoint(const MovingParts& parts, const JointValues& joints) {
+  int j = 0;
+  for (const MovingPart& part : parts.parts) {
+    for (const Joint& joint : part.joints) {
+      if (!CheckJointValue(joint, joints[j], nullptr)) return j;
+      ++j;
+    }
+  }
+  return -1;
 }
 
 }  // namespace fastcal

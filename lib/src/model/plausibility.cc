@@ -13,13 +13,7 @@ std::string Num(double value) { return internal::FormatDouble("%.6g", value); }
 
 // `value` beyond `limit`, with as many digits as it takes to look different from it
 // ("300.00001 m is above 300 m", not "300 m is above 300 m").
-std::string NumBeyond(double value, double limit) {
-  for (const char* format : {"%.6g", "%.10g"}) {
-    const std::string shown = internal::FormatDouble(format, value);
-    if (shown != Num(limit)) return shown;
-  }
-  return internal::FormatDouble("%.17g", value);
-}
+std::string NumBeyond(double value, double limit) { return internal::FormatBeyond(value, limit); }
 
 bool Fail(std::string* why, const std::string& message) {
   if (why != nullptr) *why = message;
@@ -68,7 +62,9 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
       {"max_reflector_offset_m", max_reflector_offset_m},
       {"min_tower_radius_m", min_tower_radius_m},
       {"min_tower_top_z_m", min_tower_top_z_m},
-      {"max_tower_gap_deg", max_tower_gap_deg}};
+      {"max_tower_gap_deg", max_tower_gap_deg},
+      {"min_cabin_inertia_kg_m2", min_cabin_inertia_kg_m2},
+      {"max_cabin_inertia_kg_m2", max_cabin_inertia_kg_m2}};
   for (const auto& [name, value] : fields) {
     if (!(std::isfinite(value) && value > 0.0)) {
       return Fail(error, std::string(name) + ": must be > 0 and finite (got " + Num(value) + ")");
@@ -83,7 +79,8 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
       {"ea_n", {min_ea_n, max_ea_n}},
       {"sensor_gain", {min_sensor_gain, max_sensor_gain}},
       {"abs_gravity_m_per_s2", {min_abs_gravity_m_per_s2, max_abs_gravity_m_per_s2}},
-      {"reflector_radius_m", {min_reflector_radius_m, max_reflector_radius_m}}};
+      {"reflector_radius_m", {min_reflector_radius_m, max_reflector_radius_m}},
+      {"cabin_inertia_kg_m2", {min_cabin_inertia_kg_m2, max_cabin_inertia_kg_m2}}};
   for (const auto& [name, range] : ranges) {
     if (range.first > range.second) {
       return Fail(error, std::string("min_") + name + ": must be <= max_" + name);
@@ -95,6 +92,7 @@ bool PlausibilityLimits::IsValid(std::string* error) const {
 QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& limits) {
   // Nominal FAST values: docs/model.md, Table 1 (CableRobot::NominalFast()).
   constexpr double kNominalMassKg = 30000.0, kNominalDensity = 11.718, kNominalEaN = 2.4656e7;
+  constexpr double kNominalInertiaKgM2 = 3.5e5;  // CableRobot's assumed default (x, y)
   switch (quantity) {
     case ModelQuantity::kCabinMassKg:
       return {limits.min_cabin_mass_kg, limits.max_cabin_mass_kg, kNominalMassKg, "kg", 1.0};
@@ -143,6 +141,11 @@ QuantityRange PlausibleRange(ModelQuantity quantity, const PlausibilityLimits& l
       return {0.0, limits.max_cabin_mass_kg, 0.0, "kg", 1.0};
     case ModelQuantity::kMeasuredOffsetM:
       return {-limits.max_abs_anchor_point_m, limits.max_abs_anchor_point_m, 0.0, "m", 1.0};
+    case ModelQuantity::kPartOriginM:
+      return {-limits.max_abs_anchor_point_m, limits.max_abs_anchor_point_m, 0.0, "m", 1.0};
+    case ModelQuantity::kCabinInertiaKgM2:
+      return {limits.min_cabin_inertia_kg_m2, limits.max_cabin_inertia_kg_m2, kNominalInertiaKgM2,
+              "kg m^2", 1.0};
   }
   return {};
 }
@@ -169,11 +172,14 @@ SlipHints SlipHintsOf(ModelQuantity quantity) {
     case ModelQuantity::kAttachmentMassKg:
       return {nullptr, "grams written as kg?"};
     case ModelQuantity::kAttachmentPositionM:
+    case ModelQuantity::kPartOriginM:
     case ModelQuantity::kLengthOffsetM:
     case ModelQuantity::kLengthSigmaM:
       return {nullptr, "mm written as m?"};
     case ModelQuantity::kEaN:
       return {"kN written as N?", nullptr};
+    case ModelQuantity::kCabinInertiaKgM2:
+      return {"t m^2 written as kg m^2?", nullptr};
     case ModelQuantity::kSensorBiasN:
     case ModelQuantity::kTensionSigmaN:
       return {nullptr, "N written as kN?"};

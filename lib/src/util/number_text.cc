@@ -316,6 +316,15 @@ std::string WithoutNegativeZero(std::string text) {
   return text;
 }
 
+std::string FormatBeyond(double value, double limit) {
+  const std::string shown_limit = FormatDouble("%.6g", limit);
+  for (const char* format : {"%.6g", "%.10g"}) {
+    const std::string shown = FormatDouble(format, value);
+    if (shown != shown_limit) return shown;
+  }
+  return FormatDouble("%.17g", value);
+}
+
 std::string Counted(long long n, const char* one, const char* many) {
   return std::to_string(n) + " " + (n == 1 ? one : many);
 }

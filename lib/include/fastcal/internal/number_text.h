@@ -60,6 +60,11 @@ std::string FormatDouble(std::string_view format, double value);
 // rounds to zero has no sign. FormatDouble itself stays printf's.
 std::string WithoutNegativeZero(std::string text);
 
+// `value` with the fewest of 6, 10 or 17 significant digits that tell it from `limit`
+// ("40.0000001", not "40", beside a limit of 40; issue 57): for "VALUE is beyond LIMIT"
+// messages, the limit itself written with 6 ("%.6g").
+std::string FormatBeyond(double value, double limit);
+
 // "1 window", "3 windows": n and the noun in the singular or the plural.
 std::string Counted(long long n, const char* one, const char* many);
 
