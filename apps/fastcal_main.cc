@@ -1,10 +1,9 @@
 // fastcal: statics and calibration of the FAST cable robot from the command line.
 #include <gflags/gflags.h>
+#include <glog/logging.h>
 #include <unistd.h>
 
 #include <csignal>
-#include <glog/logging.h>
-
 #include <cstring>
 #include <iostream>
 #include <new>
@@ -14,8 +13,8 @@
 
 #include "cli_util.h"
 #include "commands.h"
-#include "fastcal/internal/quote.h"
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/quote.h"
 #include "fastcal/version.h"
 
 namespace fastcal::cli {
@@ -89,10 +88,18 @@ int RunCommand(const std::string& command, int argc, char** argv) {
     fastcal::internal::RemoveTemporariesOnSignal();
     std::cerr << "fastcal " << command << ": the system refused a resource: " << e.what() << "\n";
     return kExitFailure;
+  } catch (const std::exception& e) {
+    // What a command did not turn into a message (issue 57: a library's exception ended in
+    // std::terminate, exit 134): named with the command, what was being written removed.
+    fastcal::internal::RemoveTemporariesOnSignal();
+    std::cerr << "fastcal " << command << ": unexpected error: " << e.what()
+              << " (a defect of fastcal: please report it with the command line)\n";
+    return kExitFailure;
   }
   if (!known) {
-    const std::vector<std::string> closest = ClosestNames(
-        command, {"solve", "calibrate", "evaluate", "simulate", "workspace", "design", "import"});
+    const std::vector<std::string> closest =
+        ClosestNames(command, {"solve", "locate", "calibrate", "evaluate", "simulate", "workspace",
+                               "track", "design", "modes", "import"});
     std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command)
               << (closest.empty() ? "" : "; did you mean " + closest.front() + "?") << "\n\n"
               << kUsage;

@@ -14,6 +14,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/modal_identification.h"
+#include "fastcal/vibration_record.h"
 
 DECLARE_string(data);
 DECLARE_string(output);
@@ -25,52 +26,6 @@ namespace fastcal::cli {
 namespace {
 
 constexpr char kCommand[] = "modes";
-constexpr double kNPerKn = 1e3;
-// Samples further than this fraction of the mean interval from even spacing make a record
-// that ERA (evenly sampled by its construction) cannot take.
-constexpr double kSpacingTolerance = 0.01;
-
-// The record's channels (x, y, z in m, roll, pitch, yaw in deg, and the six tensions in kN
-// when the file has them) and its mean pose; false when its times are not evenly spaced.
-bool RecordFromDataset(const Dataset& data, VibrationRecord* record, Pose* mean_pose,
-                       std::string* error) {
-  const int n = static_cast<int>(data.samples.size());
-  if (n < 2) {
-    *error = "--data=" + data.path + ": a record needs many samples, it has " + std::to_string(n);
-    return false;
-  }
-  const double dt = (data.samples.back().time_s - data.samples.front().time_s) / (n - 1);
-  for (int k = 1; k < n && dt > 0.0; ++k) {
-    const double step = data.samples[k].time_s - data.samples[k - 1].time_s;
-    if (std::abs(step - dt) > kSpacingTolerance * dt) {
-      *error = SampleWhere(data, data.samples[k]) + ": time_s steps by " + FormatDouble(step) +
-               " s where the record's mean interval is " + FormatDouble(dt) +
-               " s: the identification needs evenly spaced samples (one record, no gaps)";
-      return false;
-    }
-  }
-  if (!(dt > 0.0)) {
-    *error = "--data=" + data.path + ": time_s must increase";
-    return false;
-  }
-  const int channels = data.has_tensions ? 12 : 6;
-  record->sample_interval_s = dt;
-  record->channels.resize(channels, n);
-  Eigen::Vector3d mean_position = Eigen::Vector3d::Zero(), mean_rpy = Eigen::Vector3d::Zero();
-  for (int k = 0; k < n; ++k) {
-    const Sample& s = data.samples[k];
-    const Eigen::Vector3d rpy = RpyDegFromRotation(s.pose.rotation);
-    record->channels.col(k).head<3>() = s.pose.position_m;
-    record->channels.col(k).segment<3>(3) = rpy;
-    for (int i = 0; i < channels - 6; ++i) record->channels(6 + i, k) = s.tension_n[i] / kNPerKn;
-    mean_position += s.pose.position_m / n;
-    mean_rpy += rpy / n;  // FAST's attitudes stay far from the +-180 deg wrap
-  }
-  mean_pose->position_m = mean_position;
-  mean_pose->rotation = RotationFromRpyDeg(mean_rpy[0], mean_rpy[1], mean_rpy[2]);
-  return true;
-}
-
 std::string ComparisonCsv(const ModesComparisonResult& r) {
   std::ostringstream out;
   out << "mode,frequency_hz,frequency_sigma_hz,damping_ratio,damping_sigma,predicted_mode,"
@@ -133,21 +88,29 @@ int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool 
     }
   }
   DatasetReadOptions read;
-  Dataset data;
-  VibrationRecord record;
-  Pose pose;
+  VibrationRecordFile file;
   EraOptions era;
   era.modes = FLAGS_identified_modes;
-  if (!era.IsValid(&error) || !ColumnsFromFlag(&read.columns, &error) ||
-      !ReadDataset(FLAGS_data, read, &data, &error) ||
-      !RecordFromDataset(data, &record, &pose, &error)) {
+  if (!era.IsValid(&error)) {
     PrintError(kCommand, WithFlagNames(error, {{"modes", "--identified-modes"}}));
     return kExitUsage;
   }
+  if (!ColumnsFromFlag(&read.columns, &error) ||
+      !ReadVibrationRecord(FLAGS_data, read, &file, &error) ||
+      !CheckRecordSampling(file.record, era, &error)) {
+    PrintError(kCommand,
+               (error.rfind("the record", 0) == 0 ? "--data=" + FLAGS_data + ": " : "") + error);
+    return kExitUsage;
+  }
+  const Pose& pose = file.mean_pose;
   std::vector<IdentifiedMode> identified;
   ModesComparisonResult comparison;
-  if (!IdentifyModesEra(record, era, &identified, &error) ||
-      !CompareWithPrediction(robot, pose, identified, options, &comparison, &error)) {
+  if (!IdentifyModesEra(file.record, era, &identified, &error)) {
+    PrintError(kCommand, "--data=" + FLAGS_data + " --identified-modes=" +
+                             std::to_string(FLAGS_identified_modes) + ": " + error);
+    return kExitFailure;
+  }
+  if (!CompareWithPrediction(robot, pose, identified, options, &comparison, &error)) {
     PrintError(kCommand, error);
     return kExitFailure;
   }

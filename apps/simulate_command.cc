@@ -123,8 +123,11 @@ Usage:
 
 --vibration: a record of the cabin's free vibration at one pose from the linearised model
 (fastcal modes): the predicted modes --excite'd (1-based) with the given damping ratios,
-each moving O' by --amplitude-m at t = 0, superposed; the tensions follow the cabin's
-motion quasi-statically; white noise of the given sigmas. A dataset CSV (time_s, the pose,
+each moving a point of the cabin (O' or an anchor point) by at most --amplitude-m at
+t = 0 (at most 1 m: the linearisation's small motions), superposed; the tensions follow
+the cabin's motion quasi-statically; white noise of the given sigmas. At most 10^6 samples
+(--duration-s / --interval-s); a mode with under 0.1% of its energy in the cabin, and a
+motion that would slacken a cable, are refused. A dataset CSV (time_s, the pose,
 T1_kN..T6_kN) that `fastcal modes --data` identifies. Only the flags shown apply.
 
 Writes FILE.csv (the dataset format calibrate and evaluate read, docs/data-format.md) and

@@ -25,7 +25,9 @@ DECLARE_int32(segments);
 DEFINE_bool(vibration, false, "simulate: a free vibration at --position (docs/cli.md).");
 DEFINE_string(excite, "1,2,3", "simulate --vibration: the predicted modes excited (1-based).");
 DEFINE_string(damping, "0.005,0.01,0.015", "simulate --vibration: a damping ratio per mode.");
-DEFINE_double(amplitude_m, 0.05, "simulate --vibration: each mode's largest initial motion (m).");
+DEFINE_double(amplitude_m, 0.05,
+              "simulate --vibration: each mode's largest initial motion of a point of the "
+              "cabin (m, at most 1).");
 DEFINE_double(duration_s, 400.0, "simulate --vibration: the record's length (s).");
 
 namespace fastcal::cli {
@@ -73,7 +75,12 @@ bool SpecFromFlags(VibrationRecordSpec* spec, std::string* error) {
   spec->tension_noise_kn = FLAGS_tension_noise_kN;
   spec->seed = FLAGS_seed;
   spec->modes_options.segments = FLAGS_segments;
-  return spec->modes_options.IsValid(error);
+  if (spec->IsValid(error)) return true;
+  *error = WithFlagNames(*error, {{"amplitude_m", "--amplitude-m"},
+                                  {"sample_interval_s", "--interval-s"},
+                                  {"duration_s", "--duration-s"},
+                                  {"segments", "--segments"}});
+  return false;
 }
 
 std::string RecordCsv(const VibrationRecord& record, const std::string& header) {
@@ -129,12 +136,12 @@ int RunSimulateVibration(int argc, char** argv) {
   if (!CheckCanWrite("out", FLAGS_out, FLAGS_force, &error) ||
       !LoadModelFlag("truth", FLAGS_truth, &robot, &error) ||
       !SinglePoseFromFlags(&pose, &attitude, &error) || !SpecFromFlags(&spec, &error)) {
-    PrintError(kCommand, WithFlagNames(error, {{"segments", "--segments"}}));
+    PrintError(kCommand, error);
     return kExitUsage;
   }
   VibrationRecord record;
   if (!SimulateVibrationRecord(robot, pose, spec, &record, &error)) {
-    PrintError(kCommand, error);
+    PrintError(kCommand, WithFlagNames(error, {{"amplitude_m", "--amplitude-m"}}));
     return kExitFailure;
   }
   const std::string header = "# Simulated by fastcal " + std::string(FASTCAL_VERSION) +

@@ -6,7 +6,7 @@
 #     passes, the threaded reader, a calibration on 1 to 3 threads, the slow error's
 #     likelihood and the track's folds on several threads, the design's gradient, and
 #     command lines that run work beside the main thread; any report fails the job;
-#  3. the four libFuzzer targets of tests/fuzz built with clang (build-fuzz/), each run for
+#  3. the libFuzzer targets of tests/fuzz built with clang (build-fuzz/), each run for
 #     FASTCAL_FUZZ_SECONDS (default 60) from the seed corpus and the regression inputs.
 # Usage: scripts/test-hardening.sh [--sanitizers-only | --tsan-only | --fuzz-only]
 set -euo pipefail
@@ -30,7 +30,9 @@ export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 start=$SECONDS
 
 if [ "$mode" = all ] || [ "$mode" = --sanitizers-only ]; then
-  sanitize="-fsanitize=address,undefined -fno-sanitize-recover=all -fno-omit-frame-pointer"
+  # float-cast-overflow: not in g++'s "undefined" (issue 57: an int cast of a record's
+  # length overflowed below 1e-10 s, and the job did not see it).
+  sanitize="-fsanitize=address,undefined,float-cast-overflow -fno-sanitize-recover=all -fno-omit-frame-pointer"
   # g++ 12 under ASan at -O1 warns "may be used uninitialized" inside <regex>'s
   # std::function (a false positive of the instrumented code; none without ASan).
   warnings=-Wno-maybe-uninitialized
@@ -99,7 +101,7 @@ if [ "$mode" = all ] || [ "$mode" = --tsan-only ]; then
 fi
 
 if [ "$mode" = all ] || [ "$mode" = --fuzz-only ]; then
-  fuzz_flags="-fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=all"
+  fuzz_flags="-fsanitize=fuzzer-no-link,address,undefined,float-cast-overflow -fno-sanitize-recover=all"
   cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_CXX_COMPILER=clang++ \
     -DCMAKE_BUILD_TYPE=Sanitize -DCMAKE_CXX_FLAGS_SANITIZE="-O1 -g1" \
     -DCMAKE_CXX_FLAGS="$fuzz_flags $eigen_flags" \
@@ -107,7 +109,7 @@ if [ "$mode" = all ] || [ "$mode" = --fuzz-only ]; then
     -DFASTCAL_BUILD_BENCHMARKS=OFF -DFASTCAL_BUILD_PYTHON=OFF -DFASTCAL_INSTALL=OFF >/dev/null
   cmake --build "$root/build-fuzz" -j "$jobs"
   summary=()
-  for target in dataset_csv pose_csv model_yaml spec_yaml window_fold track_state; do
+  for target in dataset_csv pose_csv model_yaml spec_yaml window_fold track_state vibration_record; do
     work="$root/build-fuzz/fuzz-work/$target"
     artifacts="$root/build-fuzz/fuzz-artifacts"
     mkdir -p "$work" "$artifacts"

@@ -189,7 +189,17 @@ TEST_F(CliTest, SimulateVibrationRoundTripsThroughModesData) {
 
 TEST_F(CliTest, ModesNamesBadInput) {
   const std::string out = " --output=" + Path("never.csv");
+  // Issue 57: an inertia of 1e300 kg m^2 ended `modes`, --cap and simulate --vibration in
+  // std::terminate (exit 134); now refused where the model is read, at its key.
+  Write("inertia.yaml", "cabin:\n  inertia_kg_m2: [1e300, 1e300, 1e300]\n");
+  const std::string inertia = " --model=" + Path("inertia.yaml");
   const std::vector<ExpectedRun> runs = {
+      {"modes --position=0,0,140" + inertia + out, 2, "cabin.inertia_kg_m2[0]: 1e+300 kg m^2"},
+      {"modes --cap --max-off-axis-deg=5" + inertia + out, 2, "cabin.inertia_kg_m2[0]"},
+      {"simulate --vibration --position=0,0,140 --truth=" + Path("inertia.yaml") +
+           " --out=" + Path("never.csv"),
+       2, "cabin.inertia_kg_m2[0]"},
+      {"modes --position=0,0,140 --modes=201" + out, 2, "--modes: must be in [1, 200]"},
       {"modes" + out, 2, "--position"},
       {"modes --position=0,0,140 --segments=1" + out, 2, "--segments"},
       {"modes --position=0,0,140 --modes=0" + out, 2, "--modes"},
@@ -200,6 +210,127 @@ TEST_F(CliTest, ModesNamesBadInput) {
   };
   for (const ExpectedRun& run : runs) RunBoundedAndExpect(run);
   EXPECT_FALSE(fs::exists(Path("never.csv")));
+}
+
+// The record's rows as CSV lines (the header first), comments dropped.
+std::vector<std::string> RecordRows(const std::string& text) {
+  std::vector<std::string> rows;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] != '#') rows.push_back(line);
+  }
+  return rows;
+}
+
+// Writes `rows` with time_s made by time_of(k, t) for row k (t its time as it was).
+template <typename TimeOf>
+std::string Restamped(const std::vector<std::string>& rows, TimeOf time_of) {
+  std::ostringstream out;
+  out.precision(17);
+  out << rows[0] << "\n";
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const size_t comma = rows[k].find(',');
+    out << time_of(k - 1, std::stod(rows[k].substr(0, comma))) << rows[k].substr(comma) << "\n";
+  }
+  return out.str();
+}
+
+// Issue 57, 1: with the default modes at the zenith, mode 3 is a pure yaw, which barely
+// moves O': scaled by O' alone it wrote a yaw of -4.7e10 deg and tensions of +-1.5e11 kN,
+// exit 0. Each mode is now scaled by the largest motion of a point of the cabin (O' or an
+// anchor point, 7.5 m out): a yaw of amplitude/7.5 m rad, tensions a few kN about the
+// equilibrium's. An amplitude beyond the linearisation's small motions, and more samples
+// than a record holds, are refused naming their flag, with nothing written.
+TEST_F(CliTest, SimulateVibrationKeepsEveryModesMotionSmall) {
+  // The yaw of a 5 cm motion of the rim, 7.5 m from the axis, plus rounding of the file.
+  constexpr double kMaxYawDeg = 0.05 / 7.5 * 180.0 / M_PI * 1.001;
+  // FAST's tensions at the zenith are about 160 kN; a 5 cm motion moves them by a few kN.
+  constexpr double kMinTensionKn = 100.0, kMaxTensionKn = 250.0;
+  const std::string record = Path("record.csv");
+  const CommandResult r = Fastcal("simulate --vibration --position=0,0,140 --out=" + record);
+  ASSERT_EQ(r.code, 0) << r.output;
+  const std::vector<std::string> rows = RecordRows(ReadFile(record));
+  ASSERT_EQ(rows.size(), 4002u);
+  for (size_t k = 1; k < rows.size(); ++k) {
+    const std::vector<std::string> f = CsvFields(rows[k]);
+    ASSERT_LE(std::abs(std::stod(f[6])), kMaxYawDeg) << rows[k];
+    for (int i = 7; i < 13; ++i) {
+      ASSERT_GT(std::stod(f[i]), kMinTensionKn) << rows[k];
+      ASSERT_LT(std::stod(f[i]), kMaxTensionKn) << rows[k];
+    }
+  }
+  const std::string never = " --out=" + Path("never.csv");
+  const std::vector<ExpectedRun> runs = {
+      {"simulate --vibration --position=0,0,140 --amplitude-m=1e6" + never, 2,
+       "--amplitude-m = 1e+06 m: must be in (0, 1] m"},
+      {"simulate --vibration --position=0,0,140 --interval-s=1e-300" + never, 2,
+       "--duration-s 400 s every --interval-s 1e-300 s is 4e+302 samples, more than the "
+       "1000000"},
+      // Mode 5 at the zenith is a cable's alone: the cabin's motion cannot show it.
+      {"simulate --vibration --position=0,0,140 --excite=5 --damping=0.01" + never, 1,
+       "mode 5 holds"},
+  };
+  for (const ExpectedRun& run : runs) RunBoundedAndExpect(run);
+  EXPECT_FALSE(fs::exists(Path("never.csv")));
+}
+
+// Issue 57, 3 and 13: a record re-stamped every 1e-12 s gave modes at 1.5e10 Hz (below
+// 1e-10 s an int cast overflowed), every 1000 s modes at 1.5e-8 Hz and a cabin mass change
+// of -280%, exit 0; "every 0.000000 s"; a clock jump at line 2004 blamed on line 3; a
+// noise-free record of the model itself "disagreed" at chi2 1e11; asked for 6 modes where
+// 3 were excited, noise was matched at +113%. Each is now refused naming the file and
+// what it lacks, or answered right.
+TEST_F(CliTest, ModesDataRefusesRecordsThatCannotHoldTheModes) {
+  const std::string record = Path("record.csv");
+  ASSERT_EQ(Fastcal("simulate --vibration --position=0,0,140 --position-noise-m=0 "
+                    "--attitude-noise-deg=0 --tension-noise-kN=0 --out=" +
+                    record)
+                .code,
+            0);
+  const std::vector<std::string> rows = RecordRows(ReadFile(record));
+  CommandResult r = Fastcal("modes --data=" + record);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("the record agrees with the model"), std::string::npos) << r.output;
+  Write("pico.csv", Restamped(rows, [](size_t k, double) { return k * 1e-12; }));
+  Write("slow.csv", Restamped(rows, [](size_t k, double) { return k * 1e3; }));
+  Write("jump.csv", Restamped(rows, [](size_t k, double t) { return k >= 2002 ? t + 3600 : t; }));
+  const std::vector<ExpectedRun> runs = {
+      {"modes --data=" + Path("pico.csv"), 2,
+       "(4001 samples every 1e-12 s) spans 4e-09 s, too short for the band searched, 0.1 to "
+       "0.5 Hz: at least 80 s are needed"},
+      {"modes --data=" + Path("slow.csv"), 2,
+       "(4001 samples every 1000 s) is sampled too slowly for the band searched"},
+      {"modes --data=" + Path("jump.csv"), 2,
+       "jump.csv:2004: time_s steps by 3600.1 s where the record steps by 0.1 s"},
+      {"modes --data=" + record + " --identified-modes=6", 1,
+       "the record determines 3 of the 6 modes asked for"},
+      {"modes --data=" + record + " --identified-modes=21", 2, "--identified-modes in [1, 20]"},
+  };
+  for (const ExpectedRun& run : runs) RunBoundedAndExpect(run);
+}
+
+// Issue 57, 7: a record of more than 10^6 rows is refused at the first row beyond, read a
+// chunk at a time (before: 2.2 KB a sample held, 10^6 rows took over 600 s and 2.2 GB),
+// within the fixture's memory and time limits.
+TEST_F(CliTest, ModesDataRefusesMoreSamplesThanARecordHolds) {
+  std::ostringstream csv;
+  csv << "time_s,x_m,y_m,z_m,roll_deg,pitch_deg,yaw_deg,T1_kN,T2_kN,T3_kN,T4_kN,T5_kN,T6_kN\n";
+  for (long long k = 0; k <= kMaxRecordSamples; ++k) {
+    csv << k << ",0,0,140,0,0,0,160,160,160,160,160,160\n";
+  }
+  Write("long.csv", csv.str());
+  RunBoundedAndExpect({"modes --data=" + Path("long.csv"), 2,
+                       "long.csv:1000002: the record has more than 1000000 samples"});
+}
+
+// Issue 57, 7: K and M were dense, 1000 segments took 5 GB and ran out of memory; sparse,
+// it fits in a fraction of a GB (docs/hardening.md gives the measured figures).
+TEST_F(CliTest, ModesAtAThousandSegmentsFitsInLittleMemory) {
+  if (kUnderSanitizer) GTEST_SKIP() << "a sanitizer reserves terabytes: no memory limit";
+  const CommandResult r = Shell("ulimit -v 1000000; timeout 120 " + Bin() +
+                                " modes --position=0,0,140 --segments=1000");
+  EXPECT_EQ(r.code, 0) << r.output.substr(0, 2000);
+  EXPECT_NE(r.output.find("20 lowest of 17988 degrees of freedom"), std::string::npos) << r.output;
 }
 
 }  // namespace

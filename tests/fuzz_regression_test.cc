@@ -60,6 +60,9 @@ TEST(FuzzRegressionTest, ModelYaml) { Replay("model_yaml", fuzz::ModelYaml, kMin
 TEST(FuzzRegressionTest, SpecYaml) { Replay("spec_yaml", fuzz::SpecYaml, kMinFiles); }
 TEST(FuzzRegressionTest, WindowFold) { Replay("window_fold", fuzz::WindowFoldBytes, kMinFiles); }
 TEST(FuzzRegressionTest, TrackState) { Replay("track_state", fuzz::TrackStateJson, kMinFiles); }
+TEST(FuzzRegressionTest, VibrationRecord) {
+  Replay("vibration_record", fuzz::VibrationRecordCsv, kMinFiles);
+}
 
 }  // namespace
 }  // namespace fastcal

@@ -400,6 +400,39 @@ TEST(ComputeModes, RefusesWhatItCannotLineariseAbout) {
   robot.cabin_inertia_kg_m2(0, 0) = -1.0;
   EXPECT_FALSE(ComputeModes(robot, FocalPose(0.0, 0.0), ModesOptions(), &result, &error));
   EXPECT_NE(error.find("cabin_inertia_kg_m2"), std::string::npos) << error;
+  // Issue 57: 1e300 kg m^2 (finite, positive definite) threw from Spectra's eigensolver;
+  // now the model's plausible range refuses it, whoever built the model.
+  robot.cabin_inertia_kg_m2 = Eigen::Vector3d::Constant(1e300).asDiagonal();
+  EXPECT_FALSE(ComputeModes(robot, FocalPose(0.0, 0.0), ModesOptions(), &result, &error));
+  EXPECT_NE(error.find("cabin.inertia_kg_m2[0]: 1e+300 kg m^2"), std::string::npos) << error;
+  options = ModesOptions();
+  options.modes = kMaxModes + 1;
+  EXPECT_FALSE(
+      ComputeModes(CableRobot::NominalFast(), FocalPose(0.0, 0.0), options, &result, &error));
+  EXPECT_NE(error.find("modes: must be in [1, 200]"), std::string::npos) << error;
+}
+
+// Issue 57, 7: K and M are sparse (each cable a chain: its rows couple its neighbouring
+// nodes and, at the anchor, the cabin's six dofs), so memory grows with the segments, not
+// their square: 1000 segments (17 988 dofs) solve as 48 do, the lowest frequency within
+// the chain's 1/N^2 convergence of the default's. Dense, they took 5 GB.
+TEST(ComputeModes, AThousandSegmentsSolveAsFortyEightDo) {
+  // The 48-segment chain's lowest frequency is within 0.021% of the converged one
+  // (modes.h, ModesOptions::segments); a thousand segments are converged far closer.
+  constexpr double kConvergenceTol = 3e-4;
+  ModesOptions options;
+  ModesResult fine, coarse;
+  std::string error;
+  ASSERT_TRUE(
+      ComputeModes(CableRobot::NominalFast(), FocalPose(0.0, 0.0), options, &coarse, &error))
+      << error;
+  options.segments = 1000;
+  ASSERT_TRUE(ComputeModes(CableRobot::NominalFast(), FocalPose(0.0, 0.0), options, &fine, &error))
+      << error;
+  EXPECT_EQ(fine.degrees_of_freedom, 6 + 6 * 3 * 999);
+  ASSERT_EQ(fine.modes.size(), 20u);
+  EXPECT_NEAR(fine.modes[0].frequency_hz / coarse.modes[0].frequency_hz, 1.0, kConvergenceTol);
+  EXPECT_GE(fine.modes[0].frequency_hz, coarse.modes[0].frequency_hz);  // converges from below
 }
 
 }  // namespace

@@ -23,6 +23,7 @@
 #include "fastcal/pose.h"
 #include "fastcal/track_fold.h"
 #include "fastcal/trajectory.h"
+#include "fastcal/vibration_record.h"
 
 namespace fastcal::fuzz {
 namespace {
@@ -159,6 +160,45 @@ void DatasetCsv(const uint8_t* data, size_t size) {
   }
   for (size_t n = 0; n < first.samples.size(); ++n) {
     CompareSamples(first.samples[n], second.samples[n]);
+  }
+}
+
+void VibrationRecordCsv(const uint8_t* data, size_t size) {
+  // The identification of a record the reader accepts, when it is short enough that an
+  // execution stays well under the fuzzer's 10 s (ERA and a bootstrap of 2 records).
+  constexpr long long kMaxIdentifiedSamples = 4000;
+  const std::string text(reinterpret_cast<const char*>(data), size);
+  VibrationRecordFile file;
+  std::string error;
+  if (!ParseVibrationRecord(text, "fuzz.csv", DatasetReadOptions(), &file, &error)) {
+    if (error.empty()) Violation("a refused record without a message");
+    return;
+  }
+  const VibrationRecord& record = file.record;
+  if (record.channels.cols() < 2 || record.channels.cols() > kMaxRecordSamples ||
+      !(record.sample_interval_s > 0.0) || !std::isfinite(record.sample_interval_s) ||
+      !record.channels.allFinite() || !IsRotation(file.mean_pose.rotation) ||
+      !file.mean_pose.position_m.allFinite()) {
+    Violation("an accepted record that is not finite, evenly sampled and bounded");
+  }
+  EraOptions options;
+  options.bootstrap_records = 2;
+  if (!CheckRecordSampling(record, options, &error)) {
+    if (error.empty()) Violation("a refused sampling without a message");
+    return;
+  }
+  if (record.channels.cols() > kMaxIdentifiedSamples) return;
+  std::vector<IdentifiedMode> modes;
+  if (!IdentifyModesEra(record, options, &modes, &error)) {
+    if (error.empty()) Violation("a failed identification without a message");
+    return;
+  }
+  for (const IdentifiedMode& m : modes) {
+    if (!(m.frequency_hz >= options.min_frequency_hz &&
+          m.frequency_hz <= options.max_frequency_hz) ||
+        !std::isfinite(m.frequency_sigma_hz) || !std::isfinite(m.damping_ratio)) {
+      Violation("an identified mode outside the band or not finite");
+    }
   }
 }
 

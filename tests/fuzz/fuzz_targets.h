@@ -1,4 +1,4 @@
-// The four file readers of fastcal as fuzz targets (tests/fuzz/README.md): each takes any
+// The file readers of fastcal as fuzz targets (tests/fuzz/README.md): each takes any
 // bytes, goes through the public API as a user's file would, and where there is a writer
 // checks the round trip read, write, read: equal. A broken invariant aborts, which
 // libFuzzer and the test suite both report; a rejected input is simply not interesting.
@@ -27,6 +27,12 @@ void SpecYaml(const uint8_t* data, size_t size);
 // with a message, or read and, for a fold, written back to the same bytes.
 void WindowFoldBytes(const uint8_t* data, size_t size);
 void TrackStateJson(const uint8_t* data, size_t size);
+
+// A vibration record (`fastcal modes --data`, vibration_record.h): ParseVibrationRecord,
+// then CheckRecordSampling and, for a short record it accepts, IdentifyModesEra; every
+// accepted record finite, evenly sampled and within kMaxRecordSamples, every identified
+// mode in the band.
+void VibrationRecordCsv(const uint8_t* data, size_t size);
 
 // Prints `what` and aborts: a broken invariant of the target.
 [[noreturn]] void Violation(const std::string& what);

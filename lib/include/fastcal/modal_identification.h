@@ -38,6 +38,21 @@ struct VibrationRecord {
   Eigen::MatrixXd channels;  // channels x samples
 };
 
+// EraOptions' bounds (its IsValid): the Hankel matrices' Grams, (block rows x channels)^2,
+// stay within tens of MB and their eigenproblem within seconds.
+inline constexpr int kMaxIdentifiedModes = 20;  // FAST's band holds about 20 modes
+inline constexpr int kMaxEraExtraOrder = 50;
+inline constexpr int kMaxEraBlockRows = 200;
+inline constexpr double kMaxEraBandRatio = 10.0;  // max_frequency_hz / min_frequency_hz
+inline constexpr int kMaxBootstrapRecords = 1000;
+
+// Which identified poles are modes (IdentifyModesEra): FAST's lowest modes lie 2-20% apart,
+// so a frequency uncertain by more than 5% cannot be told from its neighbours; and a
+// mode carries at least 1e-3 of the largest one's amplitude (below, a numerical residue
+// of the realisation, not a vibration a record shows).
+inline constexpr double kMaxRelativeFrequencySigma = 0.05;
+inline constexpr double kMinRelativeAmplitude = 1e-3;
+
 struct EraOptions {
   // Physical modes sought: the record's `modes` largest are returned.
   int modes = 3;
@@ -73,8 +88,25 @@ struct IdentifiedMode {
   double amplitude = 0.0;  // in the record's scaled units: the mode's share of the motion
 };
 
-// The record's modes, ascending in frequency. False with *error for a record too short or
-// options invalid, or when fewer modes than asked are found.
+// The most periods of EraOptions::min_frequency_hz a record may span: a mode damped by
+// 0.5% (FAST's least damped) has decayed to 3e-6 of its start after 400 periods; longer
+// is no free decay (issue 57: 10^6 rows every 0.1 s took over 600 s and 2.2 GB).
+inline constexpr double kMaxRecordPeriods = 400.0;
+
+// Whether `record` can show modes in the options' band, before any work: a sample at
+// least every 1 / (4 max_frequency_hz) s (4 a period of the fastest mode sought), a span
+// of at most kMaxRecordPeriods periods of min_frequency_hz and of at least four times the
+// Hankel matrices' block rows (two periods of min_frequency_hz), at most
+// kMaxRecordSamples samples. False with *error saying which, in seconds (issue 57: a
+// record re-stamped every 1e-12 s gave modes at 1.5e10 Hz, one every 1000 s modes at
+// 1.5e-8 Hz, and a cabin mass change of -280%).
+bool CheckRecordSampling(const VibrationRecord& record, const EraOptions& options,
+                         std::string* error);
+
+// The record's modes, ascending in frequency. False with *error for a record that
+// CheckRecordSampling refuses, samples not finite, options invalid, or when fewer modes
+// than asked are found in the band or determined by the record (kMaxRelativeFrequencySigma,
+// kMinRelativeAmplitude).
 bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
                       std::vector<IdentifiedMode>* modes, std::string* error);
 
@@ -93,6 +125,19 @@ struct FreeDecaySpec {
 };
 bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::string* error);
 
+// The largest amplitude a simulated free vibration may have: the linearisation about the
+// equilibrium holds for small motions (FAST's cabin vibrates by millimetres to
+// centimetres); a metre is already far beyond them.
+inline constexpr double kMaxVibrationAmplitudeM = 1.0;
+// The smallest share of an excited mode's kinetic energy in the cabin: below it the
+// cables carry the rest, and scaling the cabin's motion to amplitude_m swings them
+// sqrt((1 - share) / share * m_cabin / m_cables) times further (FAST: 37 times at 1e-3).
+inline constexpr double kMinExcitedCabinShare = 1e-3;
+// The most samples a vibration record may hold (simulated or read: modes --data): a free
+// decay of FAST's modes (0.1-0.5 Hz, damped by 0.5-1.5%) is over within an hour, which is
+// 3.6e5 samples at 100 Hz. A record holds 96 bytes a sample (12 channels of doubles).
+inline constexpr long long kMaxRecordSamples = 1000000;
+
 // A record of the cabin's free vibration at a pose from the linearised model (modal
 // superposition of predicted modes): channels x, y, z (m), roll, pitch, yaw (deg) and the
 // six lower-end tensions (kN), absolute (the equilibrium plus the motion plus noise). The
@@ -103,15 +148,29 @@ bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::
 struct VibrationRecordSpec {
   std::vector<int> modes = {1, 2, 3};                        // 1-based predicted modes excited
   std::vector<double> damping_ratio = {0.005, 0.01, 0.015};  // one per mode
-  double amplitude_m = 0.05;  // each mode's largest displacement of O' at t = 0
+  // Each mode's largest displacement at t = 0 of a point of the cabin: its origin O' or
+  // an anchor point (issue 57: scaled by O' alone, a pure yaw mode, which barely moves
+  // O', was scaled by 1e11). In (0, kMaxVibrationAmplitudeM].
+  double amplitude_m = 0.05;
   double sample_interval_s = 0.1;
+  // At most kMaxRecordSamples samples: duration_s / sample_interval_s + 1.
   double duration_s = 400.0;
   double position_noise_m = 0.002;
   double attitude_noise_deg = 0.005;
   double tension_noise_kn = 0.5;
   std::uint64_t seed = 1;
   ModesOptions modes_options;
+
+  // False with *error naming the field: no modes, a damping ratio short, amplitude_m
+  // outside (0, kMaxVibrationAmplitudeM], noise < 0, more than kMaxRecordSamples samples,
+  // invalid modes_options.
+  bool IsValid(std::string* error) const;
 };
+
+// False with *error (naming the spec's field) for a spec IsValid refuses, a mode
+// with too little of its energy in the cabin to be seen in its motion (under
+// kMinExcitedCabinShare), or a motion that leaves what the linearisation and the cables
+// can take (a cable's tension below zero, a pose beyond the plausibility limits).
 bool SimulateVibrationRecord(const CableRobot& robot, const Pose& pose,
                              const VibrationRecordSpec& spec, VibrationRecord* record,
                              std::string* error);
@@ -127,9 +186,12 @@ struct ModeComparison {
   int predicted_mode = 0;  // 1-based, the nearest predicted in frequency
   double predicted_hz = 0.0;
   double predicted_cabin_share = 0.0;
-  // (identified - predicted) / predicted, and its sigma from the identification's.
+  // (identified - predicted) / predicted, and its sigma: the identification's and the
+  // prediction's own (prediction_sigma, relative: the lumped chain's discretisation,
+  // (f_N - f_N/2) / 3 of N and N/2 segments), in quadrature.
   double difference = 0.0;
   double difference_sigma = 0.0;
+  double prediction_sigma = 0.0;
   // d ln f / d ln p of the predicted mode for each parameter (by a 1% step).
   std::array<double, kModeParameters> sensitivity{};
 };

@@ -25,6 +25,11 @@
 
 namespace fastcal {
 
+// The most modes ModesOptions may ask for: ten times the default. The Lanczos basis holds
+// about twice as many vectors of every degree of freedom, and a problem with fewer
+// degrees of freedom than twice the modes is solved densely.
+inline constexpr int kMaxModes = 200;
+
 struct ModesOptions {
   // Segments per cable (N >= 2). The lumped chain's frequencies fall short of the
   // converged ones by ~C/N^2: at 48 the 10 lowest of the nominal FAST model are within
@@ -32,7 +37,7 @@ struct ModesOptions {
   // deg off axis (at 24: 0.085% and 0.28%; docs/model.md, "Vibrations", the table), in
   // ~20 ms a pose.
   int segments = 48;
-  // How many of the lowest modes to return (>= 1); fewer when the model has fewer
+  // How many of the lowest modes to return, 1 to kMaxModes; fewer when the model has fewer
   // degrees of freedom.
   int modes = 20;
   // false: the cables' inertia is ignored (their weight still shapes the equilibrium and

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "fastcal/catenary.h"
+#include "fastcal/internal/number_text.h"
+#include "fastcal/plausibility.h"
 #include "fastcal/statics.h"
 
 namespace fastcal {
@@ -29,33 +31,64 @@ struct Pole {
   Complex initial;         // q0
 };
 
-// Block Hankel matrix of y (p x n) from sample `shift`: r block rows, s columns.
-Eigen::MatrixXd Hankel(const Eigen::MatrixXd& y, int rows, int cols, int shift) {
-  const int p = static_cast<int>(y.rows());
-  Eigen::MatrixXd h(rows * p, cols);
-  for (int i = 0; i < rows; ++i) h.middleRows(i * p, p) = y.middleCols(i + shift, cols);
-  return h;
-}
-
-// ERA of the scaled record y at model order `order`: its damped poles (positive
-// frequency, damping in (0, max)), largest amplitude first.
-std::vector<Pole> Realise(const Eigen::MatrixXd& y, double dt, int order, int rows,
-                          double max_damping) {
+// G0 = H0 H0^T and G1 = H1 H0^T of the block Hankel matrices of y (p x n), r block rows
+// and s = n - r columns, H0 = [y_{i+j}], H1 = [y_{i+j+1}] (block row i, column j),
+// without forming them: block (i, k) of G0 is sum_j y_{i+j} y_{k+j}^T, and each block a
+// step down the diagonal differs from the one before by the first term and the one past
+// the last, G0(i, k) = G0(i-1, k-1) - y_{i-1} y_{k-1}^T + y_{i-1+s} y_{k-1+s}^T (and
+// G1(i, k) = G1(i-1, k-1) - y_i y_{k-1}^T + y_{i+s} y_{k-1+s}^T). Only the first block row
+// and column take a pass over the record: about 3 r p^2 s operations, not 2 (r p)^2 s,
+// and memory (r p)^2, not the Hankel matrices' 2 r p s (issue 57).
+void HankelGrams(const Eigen::MatrixXd& y, int rows, Eigen::MatrixXd* g0, Eigen::MatrixXd* g1) {
   const int p = static_cast<int>(y.rows());
   const int cols = static_cast<int>(y.cols()) - rows;
-  const Eigen::MatrixXd h0 = Hankel(y, rows, cols, 0), h1 = Hankel(y, rows, cols, 1);
+  g0->resize(rows * p, rows * p);
+  g1->resize(rows * p, rows * p);
+  auto sum = [&](int a, int b) {  // sum_{j < cols} y_{a+j} y_{b+j}^T
+    return Eigen::MatrixXd(y.middleCols(a, cols) * y.middleCols(b, cols).transpose());
+  };
+  auto outer = [&](int a, int b) { return Eigen::MatrixXd(y.col(a) * y.col(b).transpose()); };
+  for (int k = 0; k < rows; ++k) {
+    g0->block(0, k * p, p, p) = sum(0, k);
+    g1->block(0, k * p, p, p) = sum(1, k);
+    g1->block(k * p, 0, p, p) = sum(k + 1, 0);
+  }
+  for (int i = 1; i < rows; ++i) {
+    for (int k = i; k < rows; ++k) {
+      g0->block(i * p, k * p, p, p) = g0->block((i - 1) * p, (k - 1) * p, p, p) -
+                                      outer(i - 1, k - 1) + outer(i - 1 + cols, k - 1 + cols);
+    }
+    for (int k = 1; k < rows; ++k) {
+      g1->block(i * p, k * p, p, p) = g1->block((i - 1) * p, (k - 1) * p, p, p) - outer(i, k - 1) +
+                                      outer(i + cols, k - 1 + cols);
+    }
+  }
+  for (int i = 1; i < rows; ++i) {  // G0 is symmetric: its lower blocks from the upper
+    for (int k = 0; k < i; ++k) {
+      g0->block(i * p, k * p, p, p) = g0->block(k * p, i * p, p, p).transpose();
+    }
+  }
+}
+
+// ERA of the scaled record y at model order `order`: its damped poles in the band
+// (frequency in [min, max], damping in (0, max)), largest amplitude first.
+std::vector<Pole> Realise(const Eigen::MatrixXd& y, double dt, int order, int rows,
+                          const EraOptions& options) {
+  const int p = static_cast<int>(y.rows());
+  Eigen::MatrixXd g0, g1;
+  HankelGrams(y, rows, &g0, &g1);
   // H0 = U S V^T from the eigenpairs of H0 H0^T (rp x rp: small beside H0 itself).
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(h0 * h0.transpose());
-  const int n = static_cast<int>(gram.eigenvalues().size());
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> gram(g0);
   const Eigen::MatrixXd u = gram.eigenvectors().rightCols(order).rowwise().reverse();
   const Eigen::VectorXd s = gram.eigenvalues().tail(order).reverse().cwiseMax(1e-300).cwiseSqrt();
-  (void)n;
   const Eigen::VectorXd s_half = s.cwiseSqrt(), s_inv_half = s_half.cwiseInverse();
   // A = S^-1/2 U^T H1 V S^-1/2 with V = H0^T U S^-1.
-  const Eigen::MatrixXd a = s_inv_half.asDiagonal() * u.transpose() * (h1 * h0.transpose()) * u *
+  const Eigen::MatrixXd a = s_inv_half.asDiagonal() * u.transpose() * g1 * u *
                             s.cwiseInverse().asDiagonal() * s_inv_half.asDiagonal();
   const Eigen::MatrixXd c = u.topRows(p) * s_half.asDiagonal();
-  const Eigen::VectorXd x0 = s_inv_half.asDiagonal() * (u.transpose() * h0.col(0));
+  // H0's first column: y_0 .. y_{r-1} stacked (y is column-major: they are contiguous).
+  const Eigen::VectorXd h0_first = Eigen::Map<const Eigen::VectorXd>(y.data(), rows * p);
+  const Eigen::VectorXd x0 = s_inv_half.asDiagonal() * (u.transpose() * h0_first);
   const Eigen::EigenSolver<Eigen::MatrixXd> eigen(a);
   const Eigen::MatrixXcd psi = eigen.eigenvectors();
   const Eigen::VectorXcd q0 = psi.partialPivLu().solve(x0.cast<Complex>());
@@ -67,7 +100,13 @@ std::vector<Pole> Realise(const Eigen::MatrixXd& y, double dt, int order, int ro
     Pole m;
     m.frequency_hz = std::abs(pole) / (2.0 * M_PI);
     m.damping_ratio = -pole.real() / std::abs(pole);
-    if (!(m.damping_ratio > 0.0 && m.damping_ratio < max_damping)) continue;
+    if (!(m.damping_ratio > 0.0 && m.damping_ratio < options.max_damping_ratio)) continue;
+    // Outside the band sought: not one of its modes (issue 57: 0.87 Hz, fitting the
+    // noise, was matched to a predicted mode at +136%).
+    if (!(m.frequency_hz >= options.min_frequency_hz &&
+          m.frequency_hz <= options.max_frequency_hz)) {
+      continue;
+    }
     m.z = z;
     m.shape = c.cast<Complex>() * psi.col(i);
     m.initial = q0[i];
@@ -94,7 +133,7 @@ Eigen::MatrixXd Rebuild(const std::vector<Pole>& poles, int channels, int sample
 
 // The `count` largest modes of y, or fewer when the record has fewer.
 std::vector<Pole> Identify(const Eigen::MatrixXd& y, double dt, const EraOptions& o, int rows) {
-  std::vector<Pole> poles = Realise(y, dt, 2 * o.modes + o.extra_order, rows, o.max_damping_ratio);
+  std::vector<Pole> poles = Realise(y, dt, 2 * o.modes + o.extra_order, rows, o);
   if (static_cast<int>(poles.size()) > o.modes) poles.resize(o.modes);
   return poles;
 }
@@ -157,11 +196,23 @@ bool EraOptions::IsValid(std::string* error) const {
     *error = "era options: 0 < min_frequency_hz < max_frequency_hz (finite) is needed";
     return false;
   }
-  if (modes < 1 || extra_order < 0 || block_rows < 0 || !(max_damping_ratio > 0.0) ||
-      !(max_damping_ratio < 1.0) || bootstrap_records < 2 || bootstrap_block < 1) {
-    *error =
-        "era options: modes >= 1, extra_order >= 0, block_rows >= 0, max_damping_ratio in (0, "
-        "1), bootstrap_records >= 2 and bootstrap_block >= 1 are needed";
+  // The Hankel matrices' block rows grow with the band's width (up to 16 times
+  // max_frequency_hz / min_frequency_hz) and with the order; their Grams with the square:
+  // bounded, so that no option asks for gigabytes (issue 57).
+  if (max_frequency_hz > kMaxEraBandRatio * min_frequency_hz) {
+    *error = "era options: max_frequency_hz must be at most " +
+             std::to_string(static_cast<int>(kMaxEraBandRatio)) + " times min_frequency_hz";
+    return false;
+  }
+  if (modes < 1 || modes > kMaxIdentifiedModes || extra_order < 0 ||
+      extra_order > kMaxEraExtraOrder || block_rows < 0 || block_rows > kMaxEraBlockRows ||
+      !(max_damping_ratio > 0.0) || !(max_damping_ratio < 1.0) || bootstrap_records < 2 ||
+      bootstrap_records > kMaxBootstrapRecords || bootstrap_block < 1) {
+    *error = "era options: modes in [1, " + std::to_string(kMaxIdentifiedModes) +
+             "], extra_order in [0, " + std::to_string(kMaxEraExtraOrder) +
+             "], block_rows in [0, " + std::to_string(kMaxEraBlockRows) +
+             "], max_damping_ratio in (0, 1), bootstrap_records in [2, " +
+             std::to_string(kMaxBootstrapRecords) + "] and bootstrap_block >= 1 are needed";
     return false;
   }
   return true;
@@ -183,33 +234,121 @@ Eigen::MatrixXd Prepare(const Eigen::MatrixXd& channels, int factor) {
   return y;
 }
 
+// How ERA takes a record (EraOptions): averaged over blocks of `factor` samples into
+// `samples` samples `interval_s` apart, with `rows` block rows. Counted in double: a
+// record re-stamped every 1e-12 s asked for blocks of 5e11 samples (issue 57: the int cast
+// overflowed, which is undefined).
+struct EraPlan {
+  double factor = 1.0;
+  double interval_s = 0.0;
+  double samples = 0.0;
+  double rows = 0.0;
+};
+
+EraPlan PlanOf(const VibrationRecord& record, const EraOptions& options) {
+  EraPlan plan;
+  const double p = static_cast<double>(record.channels.rows());
+  const double order = 2.0 * options.modes + options.extra_order;
+  plan.factor =
+      std::max(1.0, std::floor(1.0 / (4.0 * options.max_frequency_hz * record.sample_interval_s)));
+  plan.interval_s = plan.factor * record.sample_interval_s;
+  plan.samples = std::floor(static_cast<double>(record.channels.cols()) / plan.factor);
+  plan.rows = options.block_rows > 0
+                  ? options.block_rows
+                  : std::max(std::ceil(order / p) + 1.0,
+                             std::ceil(2.0 / (options.min_frequency_hz * plan.interval_s)));
+  return plan;
+}
+
+std::string Num(double value) { return internal::FormatDouble("%.6g", value); }
+
+// The modes the record determines (issue 57: asked for 6 where 3 were excited, ERA's
+// extra poles, fitting the noise, were matched to predicted modes at +113%): a frequency
+// sigma under kMaxRelativeFrequencySigma of the frequency (the noise's poles wander by
+// 20-30% from one bootstrap record to the next), and an amplitude of at least
+// kMinRelativeAmplitude of the largest mode's (a noise-free record's extra poles, whose
+// bootstrap cannot wander, carry 1e-10 of it). False, saying how many are determined,
+// when fewer than the modes asked for remain.
+bool KeepDeterminedModes(const EraOptions& options, std::vector<IdentifiedMode>* modes,
+                         std::string* error) {
+  double largest = 0.0;
+  for (const IdentifiedMode& m : *modes) largest = std::max(largest, m.amplitude);
+  std::vector<IdentifiedMode> kept;
+  for (const IdentifiedMode& m : *modes) {
+    if (m.frequency_sigma_hz <= kMaxRelativeFrequencySigma * m.frequency_hz &&
+        m.amplitude >= kMinRelativeAmplitude * largest) {
+      kept.push_back(m);
+    }
+  }
+  if (static_cast<int>(kept.size()) < options.modes) {
+    *error = "the record determines " + std::to_string(kept.size()) + " of the " +
+             std::to_string(options.modes) +
+             " modes asked for (the others' frequencies wander by more than " +
+             Num(100 * kMaxRelativeFrequencySigma) +
+             "% between bootstrap records, or they carry under " + Num(kMinRelativeAmplitude) +
+             " of the largest mode's amplitude: noise, not "
+             "vibration): ask for " +
+             std::to_string(kept.size());
+    return false;
+  }
+  *modes = std::move(kept);
+  return true;
+}
+
 }  // namespace
+
+bool CheckRecordSampling(const VibrationRecord& record, const EraOptions& options,
+                         std::string* error) {
+  if (!options.IsValid(error)) return false;
+  const long long n = record.channels.cols();
+  if (record.channels.rows() < 1 || !(record.sample_interval_s > 0.0) ||
+      !std::isfinite(record.sample_interval_s) || n > kMaxRecordSamples) {
+    *error = "record: needs at least one channel, sample_interval_s > 0 and at most " +
+             std::to_string(kMaxRecordSamples) + " samples";
+    return false;
+  }
+  const std::string what = "the record (" + std::to_string(n) + " samples every " +
+                           Num(record.sample_interval_s) + " s)";
+  const std::string band = "the band searched, " + Num(options.min_frequency_hz) + " to " +
+                           Num(options.max_frequency_hz) + " Hz";
+  const double fastest_interval_s = 1.0 / (4.0 * options.max_frequency_hz);
+  if (record.sample_interval_s > fastest_interval_s) {
+    *error = what + " is sampled too slowly for " + band +
+             ": 4 samples a period of its top, one every " + Num(fastest_interval_s) +
+             " s or faster, are needed";
+    return false;
+  }
+  const double span_s = (n - 1) * record.sample_interval_s;
+  const double longest_s = kMaxRecordPeriods / options.min_frequency_hz;
+  if (span_s > longest_s) {
+    *error = what + " spans " + Num(span_s) + " s, longer than any free decay in " + band +
+             " lasts (at most " + Num(longest_s) + " s, " + Num(kMaxRecordPeriods) +
+             " periods of its bottom): cut the record to the decay";
+    return false;
+  }
+  const EraPlan plan = PlanOf(record, options);
+  if (plan.samples < 4.0 * plan.rows) {
+    const double shortest_s = 4.0 * plan.rows * plan.interval_s;
+    *error = what + " spans " + Num(span_s) + " s, too short for " + band + ": at least " +
+             Num(shortest_s) + " s are needed (four times " + Num(plan.rows) + " block rows of " +
+             Num(plan.interval_s) + " s, two periods of its bottom)";
+    return false;
+  }
+  return true;
+}
 
 bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
                       std::vector<IdentifiedMode>* modes, std::string* error) {
-  if (!options.IsValid(error)) return false;
-  const int p = static_cast<int>(record.channels.rows());
-  if (p < 1 || !(record.sample_interval_s > 0.0) || !record.channels.allFinite()) {
-    *error = "record: needs at least one channel, finite samples and sample_interval_s > 0";
+  if (!CheckRecordSampling(record, options, error)) return false;
+  if (!record.channels.allFinite()) {
+    *error = "record: its samples must be finite";
     return false;
   }
-  const int factor = std::max(
-      1, static_cast<int>(1.0 / (4.0 * options.max_frequency_hz * record.sample_interval_s)));
-  const double dt = factor * record.sample_interval_s;
-  const int n = static_cast<int>(record.channels.cols()) / factor;
-  const int order = 2 * options.modes + options.extra_order;
-  const int rows =
-      options.block_rows > 0
-          ? options.block_rows
-          : std::max((order + p - 1) / p + 1,
-                     static_cast<int>(std::ceil(2.0 / (options.min_frequency_hz * dt))));
-  if (n < 4 * rows) {
-    *error = "record: " + std::to_string(record.channels.cols()) + " samples every " +
-             std::to_string(record.sample_interval_s) + " s are too few for " +
-             std::to_string(rows) + " block rows of " + std::to_string(dt) +
-             " s (two periods of min_frequency_hz): need four times as long";
-    return false;
-  }
+  // Within int now: CheckRecordSampling bounds the samples, so the block and the rows.
+  const EraPlan plan = PlanOf(record, options);
+  const int factor = static_cast<int>(plan.factor);
+  const double dt = plan.interval_s;
+  const int rows = static_cast<int>(plan.rows);
   const Eigen::MatrixXd y = Prepare(record.channels, factor);
   const std::vector<Pole> poles = Identify(y, dt, options, rows);
   if (static_cast<int>(poles.size()) < options.modes) {
@@ -224,6 +363,7 @@ bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
     (*modes)[i].amplitude = poles[i].amplitude;
   }
   BootstrapSigmas(y, dt, options, rows, poles, modes);
+  if (!KeepDeterminedModes(options, modes, error)) return false;
   std::sort(modes->begin(), modes->end(), [](const IdentifiedMode& a, const IdentifiedMode& b) {
     return a.frequency_hz < b.frequency_hz;
   });
@@ -242,7 +382,16 @@ bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::
         "a noise sigma per channel, sample_interval_s > 0 and a longer duration_s";
     return false;
   }
-  const int n = static_cast<int>(spec.duration_s / spec.sample_interval_s) + 1;
+  // Counted in double first: the int cast of a count beyond its range is undefined (issue
+  // 57: an interval of 1e-300 s asked for 4e302 samples).
+  const double samples = std::floor(spec.duration_s / spec.sample_interval_s) + 1.0;
+  if (!(samples <= static_cast<double>(kMaxRecordSamples))) {
+    *error = "free decay: duration_s / sample_interval_s = " +
+             internal::FormatDouble("%.3g", spec.duration_s / spec.sample_interval_s) +
+             " samples, more than the " + std::to_string(kMaxRecordSamples) + " a record may hold";
+    return false;
+  }
+  const int n = static_cast<int>(samples);
   record->sample_interval_s = spec.sample_interval_s;
   record->channels = Eigen::MatrixXd::Zero(channels, n);
   for (size_t j = 0; j < m; ++j) {
@@ -318,8 +467,14 @@ bool CompareWithPrediction(const CableRobot& robot, const Pose& pose,
                            const ModesOptions& options, ModesComparisonResult* result,
                            std::string* error) {
   constexpr double kStep = 0.01;  // each parameter's relative step for the sensitivities
-  ModesResult nominal;
+  ModesResult nominal, coarse;
   if (!ComputeModes(robot, pose, options, &nominal, error)) return false;
+  // The prediction's own error: the lumped chain's frequencies converge as 1/N^2, so a
+  // chain of N/2 segments tells it, (f_N - f_N/2) / 3 (issue 57: a noise-free record of
+  // the model itself, identified to 1e-12, "disagreed with the model" at chi2 1e11).
+  ModesOptions coarse_options = options;
+  coarse_options.segments = std::max(2, options.segments / 2);
+  if (!ComputeModes(robot, pose, coarse_options, &coarse, error)) return false;
   std::array<ModesResult, kModeParameters> stepped;
   for (int p = 0; p < kModeParameters; ++p) {
     if (!ComputeModes(Scaled(robot, p, 1.0 + kStep), pose, options, &stepped[p], error)) {
@@ -342,7 +497,11 @@ bool CompareWithPrediction(const CableRobot& robot, const Pose& pose,
     c.predicted_hz = m.frequency_hz;
     c.predicted_cabin_share = m.CabinShare();
     c.difference = id.frequency_hz / m.frequency_hz - 1.0;
-    c.difference_sigma = id.frequency_sigma_hz / m.frequency_hz;
+    c.prediction_sigma =
+        nearest < coarse.modes.size()
+            ? std::abs(m.frequency_hz - coarse.modes[nearest].frequency_hz) / (3.0 * m.frequency_hz)
+            : 0.0;
+    c.difference_sigma = std::hypot(id.frequency_sigma_hz / m.frequency_hz, c.prediction_sigma);
     for (int p = 0; p < kModeParameters; ++p) {
       // The same mode after the step (a 1% step moves no mode past its neighbour's
       // frequency, except in a cluster; the index is kept).
@@ -358,30 +517,32 @@ bool CompareWithPrediction(const CableRobot& robot, const Pose& pose,
 
 namespace {
 
-// The six lower-end tensions (kN) at `pose` with the unstretched lengths of `statics`.
-Eigen::Matrix<double, 6, 1> TensionsAtFixedLengths(const CableRobot& robot, const Pose& pose,
-                                                   const StaticsSolution& statics) {
-  Eigen::Matrix<double, 6, 1> t;
+// The six lower-end tensions (kN) at `pose` with the unstretched lengths of `statics`;
+// false where a catenary has no solution.
+bool TensionsAtFixedLengths(const CableRobot& robot, const Pose& pose,
+                            const StaticsSolution& statics, Eigen::Matrix<double, 6, 1>* t) {
   for (int i = 0; i < kNumCables; ++i) {
     const CableProperties& c = robot.cables[i];
     const Eigen::Vector3d chord =
         c.tower_top_m - (pose.position_m + pose.rotation * robot.AnchorOfCable(i));
     CatenaryForces f;
     int iterations = 0;
-    SolveCatenaryForcesDouble(chord.head<2>().norm(), chord.z(),
-                              statics.cables[i].unstretched_length_m, c.ea_n,
-                              c.linear_density_kg_per_m * robot.gravity_m_per_s2,
-                              CatenarySolverOptions(), nullptr, &f, &iterations);
-    t[i] = std::hypot(f.fl_n, f.fz_n) / 1e3;
+    if (SolveCatenaryForcesDouble(
+            chord.head<2>().norm(), chord.z(), statics.cables[i].unstretched_length_m, c.ea_n,
+            c.linear_density_kg_per_m * robot.gravity_m_per_s2, CatenarySolverOptions(), nullptr,
+            &f, &iterations) != CatenaryStatus::kOk) {
+      return false;
+    }
+    (*t)[i] = std::hypot(f.fl_n, f.fz_n) / 1e3;
   }
-  return t;
+  return true;
 }
 
-// d(tension kN)/d(u, theta) by central differences (R -> exp(theta) R).
-Eigen::Matrix<double, 6, 6> TensionPerCabinMotion(const CableRobot& robot, const Pose& pose,
-                                                  const StaticsSolution& statics) {
+// d(tension kN)/d(u, theta) by central differences (R -> exp(theta) R) into *j.
+bool TensionPerCabinMotion(const CableRobot& robot, const Pose& pose,
+                           const StaticsSolution& statics, Eigen::Matrix<double, 6, 6>* j,
+                           std::string* error) {
   constexpr double kStepM = 1e-3, kStepRad = 1e-5;
-  Eigen::Matrix<double, 6, 6> j;
   for (int k = 0; k < 6; ++k) {
     const double h = k < 3 ? kStepM : kStepRad;
     Pose plus = pose, minus = pose;
@@ -393,11 +554,89 @@ Eigen::Matrix<double, 6, 6> TensionPerCabinMotion(const CableRobot& robot, const
       plus.rotation = Eigen::AngleAxisd(h, axis).toRotationMatrix() * pose.rotation;
       minus.rotation = Eigen::AngleAxisd(-h, axis).toRotationMatrix() * pose.rotation;
     }
-    j.col(k) = (TensionsAtFixedLengths(robot, plus, statics) -
-                TensionsAtFixedLengths(robot, minus, statics)) /
-               (2.0 * h);
+    Eigen::Matrix<double, 6, 1> t_plus, t_minus;
+    if (!TensionsAtFixedLengths(robot, plus, statics, &t_plus) ||
+        !TensionsAtFixedLengths(robot, minus, statics, &t_minus)) {
+      *error = "vibration record: a cable's catenary has no solution a step from the pose";
+      return false;
+    }
+    j->col(k) = (t_plus - t_minus) / (2.0 * h);
   }
-  return j;
+  return true;
+}
+
+}  // namespace
+
+bool VibrationRecordSpec::IsValid(std::string* error) const {
+  const VibrationRecordSpec& spec = *this;
+  if (spec.modes.empty() || spec.damping_ratio.size() != spec.modes.size()) {
+    *error = "vibration record: modes and damping_ratio: one damping ratio per excited mode";
+    return false;
+  }
+  if (!(spec.amplitude_m > 0.0 && spec.amplitude_m <= kMaxVibrationAmplitudeM)) {
+    *error = "vibration record: amplitude_m = " + internal::FormatDouble("%g", spec.amplitude_m) +
+             " m: must be in (0, " + internal::FormatDouble("%g", kMaxVibrationAmplitudeM) +
+             "] m (the linearisation holds for small motions)";
+    return false;
+  }
+  if (!(spec.position_noise_m >= 0.0) || !(spec.attitude_noise_deg >= 0.0) ||
+      !(spec.tension_noise_kn >= 0.0) || !std::isfinite(spec.position_noise_m) ||
+      !std::isfinite(spec.attitude_noise_deg) || !std::isfinite(spec.tension_noise_kn)) {
+    *error = "vibration record: noise sigmas must be >= 0 and finite";
+    return false;
+  }
+  if (!(spec.sample_interval_s > 0.0) || !(spec.duration_s > spec.sample_interval_s) ||
+      !std::isfinite(spec.duration_s)) {
+    *error = "vibration record: sample_interval_s > 0 and a finite, longer duration_s";
+    return false;
+  }
+  const double samples = spec.duration_s / spec.sample_interval_s + 1.0;
+  if (!(samples <= static_cast<double>(kMaxRecordSamples))) {
+    *error = "vibration record: duration_s " + internal::FormatDouble("%g", spec.duration_s) +
+             " s every sample_interval_s " + internal::FormatDouble("%g", spec.sample_interval_s) +
+             " s is " + internal::FormatDouble("%.3g", samples) + " samples, more than the " +
+             std::to_string(kMaxRecordSamples) + " a record may hold";
+    return false;
+  }
+  return modes_options.IsValid(error);
+}
+
+namespace {
+
+// The largest displacement of a point of the cabin, its origin O' or an anchor point (the
+// cabin's rim), under the cabin's motion `shape` = (u, theta), global axes.
+double LargestCabinDisplacement(const CableRobot& robot, const Pose& pose,
+                                const Eigen::Matrix<double, 6, 1>& shape) {
+  const Eigen::Vector3d u = shape.head<3>(), theta = shape.tail<3>();
+  double largest = u.norm();
+  for (const Eigen::Vector3d& a : robot.anchor_points_cabin_m) {
+    largest = std::max(largest, (u + theta.cross(pose.rotation * a)).norm());
+  }
+  return largest;
+}
+
+// The record's motion within what the cables and the plausibility limits take: every
+// tension above zero (no cable slackens), every position plausible.
+bool CheckRecordedMotion(const VibrationRecord& record, std::string* error) {
+  const PlausibilityLimits limits;
+  for (int k = 0; k < record.channels.cols(); ++k) {
+    std::string why;
+    if (!CheckPosition(record.channels.col(k).head<3>(), limits, &why)) {
+      *error = "vibration record: amplitude_m: at t = " +
+               internal::FormatDouble("%g", k * record.sample_interval_s) + " s " + why;
+      return false;
+    }
+    for (int i = 0; i < kNumCables; ++i) {
+      if (record.channels(6 + i, k) > 0.0) continue;
+      *error = "vibration record: amplitude_m: cable " + std::to_string(i + 1) +
+               "'s tension falls to " + internal::FormatDouble("%.4g", record.channels(6 + i, k)) +
+               " kN at t = " + internal::FormatDouble("%g", k * record.sample_interval_s) +
+               " s: a motion the taut cables of the linearised model cannot make (a smaller "
+               "amplitude)";
+      return false;
+    }
+  }
+  return true;
 }
 
 }  // namespace
@@ -405,19 +644,13 @@ Eigen::Matrix<double, 6, 6> TensionPerCabinMotion(const CableRobot& robot, const
 bool SimulateVibrationRecord(const CableRobot& robot, const Pose& pose,
                              const VibrationRecordSpec& spec, VibrationRecord* record,
                              std::string* error) {
-  if (spec.modes.empty() || spec.damping_ratio.size() != spec.modes.size() ||
-      !(spec.amplitude_m > 0.0) || !(spec.position_noise_m >= 0.0) ||
-      !(spec.attitude_noise_deg >= 0.0) || !(spec.tension_noise_kn >= 0.0)) {
-    *error =
-        "vibration record: one damping ratio per excited mode, amplitude_m > 0 and "
-        "noise sigmas >= 0 are needed";
-    return false;
-  }
+  if (!spec.IsValid(error)) return false;
   ModesOptions options = spec.modes_options;
   options.modes = std::max(options.modes, *std::max_element(spec.modes.begin(), spec.modes.end()));
   ModesResult predicted;
   if (!ComputeModes(robot, pose, options, &predicted, error)) return false;
-  const Eigen::Matrix<double, 6, 6> tension = TensionPerCabinMotion(robot, pose, predicted.statics);
+  Eigen::Matrix<double, 6, 6> tension;
+  if (!TensionPerCabinMotion(robot, pose, predicted.statics, &tension, error)) return false;
   FreeDecaySpec decay;
   decay.shape.resize(12, static_cast<int>(spec.modes.size()));
   for (size_t j = 0; j < spec.modes.size(); ++j) {
@@ -428,8 +661,15 @@ bool SimulateVibrationRecord(const CableRobot& robot, const Pose& pose,
       return false;
     }
     const Mode& mode = predicted.modes[m - 1];
-    const double scale =
-        spec.amplitude_m / std::max(mode.cabin_shape.head<3>().cwiseAbs().maxCoeff(), 1e-300);
+    if (!(mode.CabinShare() >= kMinExcitedCabinShare)) {
+      *error = "vibration record: mode " + std::to_string(m) + " holds " +
+               internal::FormatDouble("%.2g", 100 * mode.CabinShare()) +
+               "% of its energy in the cabin, under " +
+               internal::FormatDouble("%g", 100 * kMinExcitedCabinShare) +
+               "%: a cable's mode, which the cabin's motion cannot show; excite another";
+      return false;
+    }
+    const double scale = spec.amplitude_m / LargestCabinDisplacement(robot, pose, mode.cabin_shape);
     const Eigen::Matrix<double, 6, 1> motion = scale * mode.cabin_shape;
     decay.shape.col(j).head<3>() = motion.head<3>();
     decay.shape.col(j).segment<3>(3) = motion.tail<3>() * (180.0 / M_PI);
@@ -451,7 +691,7 @@ bool SimulateVibrationRecord(const CableRobot& robot, const Pose& pose,
   for (int i = 0; i < kNumCables; ++i)
     base[6 + i] = predicted.statics.cables[i].lower_tension_n / 1e3;
   record->channels.colwise() += base;
-  return true;
+  return CheckRecordedMotion(*record, error);
 }
 
 }  // namespace fastcal

@@ -58,6 +58,7 @@
 
 #include "fastcal/catenary.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/model_plausibility.h"
 
 namespace fastcal {
 namespace {
@@ -69,6 +70,9 @@ constexpr double kMaxClosureFraction = 1e-7;
 // An eigenvalue below -this times the largest is a true negative stiffness (an unstable
 // equilibrium), not rounding.
 constexpr double kNegativeEigenvalueFraction = 1e-10;
+// The dense solver (a check) holds K and M as n x n and takes O(n^3): at 4000 degrees of
+// freedom (223 segments) 128 MB a matrix and seconds; beyond, it is refused.
+constexpr int kMaxDenseDofs = 4000;
 
 Eigen::Matrix3d Cross(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
@@ -132,8 +136,23 @@ struct NodeMap {
 NodeMap FixedNode() { return NodeMap{}; }
 NodeMap FreeNode(int dof) { return NodeMap{dof, Eigen::Matrix3d::Identity()}; }
 
+// K and M as (row, column, value) entries, summed where they repeat: sparse (issue 57: dense,
+// 1000 segments took 5 GB). Each cable is a chain, so its rows couple only its
+// neighbouring nodes (a band of 3 nodes' width) and, at its anchor, the cabin's 6 dofs.
+using Entries = std::vector<Eigen::Triplet<double>>;
+
+// Adds block `b` at (row, col) to `entries`, skipping exact zeros.
+template <typename Block>
+void AddBlock(int row, int col, const Block& b, Entries* entries) {
+  for (int c = 0; c < b.cols(); ++c) {
+    for (int r = 0; r < b.rows(); ++r) {
+      if (b(r, c) != 0.0) entries->emplace_back(row + r, col + c, b(r, c));
+    }
+  }
+}
+
 // Adds a segment's energy (1/2)(v_b - v_a)^T H (v_b - v_a) to K.
-void AddSegment(const Eigen::Matrix3d& h, const NodeMap& a, const NodeMap& b, Eigen::MatrixXd* k) {
+void AddSegment(const Eigen::Matrix3d& h, const NodeMap& a, const NodeMap& b, Entries* k) {
   const NodeMap* ends[2] = {&a, &b};
   for (int r = 0; r < 2; ++r) {
     for (int c = 0; c < 2; ++c) {
@@ -141,7 +160,7 @@ void AddSegment(const Eigen::Matrix3d& h, const NodeMap& a, const NodeMap& b, Ei
       const NodeMap& y = *ends[c];
       if (x.dof < 0 || y.dof < 0) continue;
       const double sign = r == c ? 1.0 : -1.0;
-      k->block(x.dof, y.dof, x.map.cols(), y.map.cols()) += sign * x.map.transpose() * h * y.map;
+      AddBlock(x.dof, y.dof, Eigen::MatrixXd(sign * x.map.transpose() * h * y.map), k);
     }
   }
 }
@@ -149,8 +168,7 @@ void AddSegment(const Eigen::Matrix3d& h, const NodeMap& a, const NodeMap& b, Ei
 // Adds a chain's stiffness and its moving nodes' masses. Interior node j (1..N-1) is free
 // at first_dof + 3 (j - 1); the lower node follows `lower` and carries half a node's mass;
 // the upper node is fixed.
-void AddChain(const Chain& chain, const NodeMap& lower, int first_dof, Eigen::MatrixXd* k,
-              Eigen::MatrixXd* m) {
+void AddChain(const Chain& chain, const NodeMap& lower, int first_dof, Entries* k, Entries* m) {
   const int segments = static_cast<int>(chain.tension_n.size());
   auto node = [&](int j) {
     if (j == 0) return lower;
@@ -164,12 +182,22 @@ void AddChain(const Chain& chain, const NodeMap& lower, int first_dof, Eigen::Ma
     AddSegment(h, node(j), node(j + 1), k);
   }
   for (int j = 1; j < segments; ++j) {
-    m->diagonal().segment<3>(first_dof + 3 * (j - 1)).array() += chain.node_mass_kg;
+    for (int a = 0; a < 3; ++a) {
+      const int dof = first_dof + 3 * (j - 1) + a;
+      m->emplace_back(dof, dof, chain.node_mass_kg);
+    }
   }
   if (lower.dof >= 0) {
-    m->block(lower.dof, lower.dof, lower.map.cols(), lower.map.cols()) +=
-        0.5 * chain.node_mass_kg * lower.map.transpose() * lower.map;
+    AddBlock(lower.dof, lower.dof,
+             Eigen::MatrixXd(0.5 * chain.node_mass_kg * lower.map.transpose() * lower.map), m);
   }
+}
+
+// The n x n sparse matrix of `entries` (repeated entries summed).
+Eigen::SparseMatrix<double> SparseOf(int n, const Entries& entries) {
+  Eigen::SparseMatrix<double> a(n, n);
+  a.setFromTriplets(entries.begin(), entries.end());
+  return a;
 }
 
 // (K - sigma M)^-1 x by a sparse LDL^T: the shift-invert operator of Spectra's
@@ -200,11 +228,11 @@ constexpr char kUnstable[] = "the equilibrium is unstable: its stiffness has ";
 // definite at a stable equilibrium, which K's LDL^T tells by Sylvester's law of inertia:
 // as many negative eigenvalues as negative pivots). False when the Lanczos iteration
 // needs more vectors than the problem has (the caller then solves it densely).
-bool SolveLowestLanczos(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m, int count,
-                        Eigen::VectorXd* lambda, Eigen::MatrixXd* phi, std::string* error) {
-  const Eigen::SparseMatrix<double> ks = k.sparseView(), ms = m.sparseView();
-  ShiftInvertLdlt op(ks, ms);
-  Spectra::SparseSymMatProd<double> mop(ms);
+bool SolveLowestLanczos(const Eigen::SparseMatrix<double>& k, const Eigen::SparseMatrix<double>& m,
+                        int count, Eigen::VectorXd* lambda, Eigen::MatrixXd* phi,
+                        std::string* error) {
+  ShiftInvertLdlt op(k, m);
+  Spectra::SparseSymMatProd<double> mop(m);
   const int ncv = std::min<int>(static_cast<int>(k.rows()), std::max(2 * count + 1, count + 20));
   Spectra::SymGEigsShiftSolver<ShiftInvertLdlt, Spectra::SparseSymMatProd<double>,
                                Spectra::GEigsMode::ShiftInvert>
@@ -219,7 +247,15 @@ bool SolveLowestLanczos(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m, int 
     return false;
   }
   solver.init();
-  solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12, Spectra::SortRule::SmallestAlge);
+  try {
+    // Spectra throws where its tridiagonal eigensolver fails (issue 57: an inertia of
+    // 1e300 kg m^2 ended the command in std::terminate); the model's ranges now keep such
+    // matrices out, and what remains is a failure with its reason, not an exception.
+    solver.compute(Spectra::SortRule::LargestMagn, 1000, 1e-12, Spectra::SortRule::SmallestAlge);
+  } catch (const std::runtime_error& e) {
+    *error = std::string("the Lanczos iteration for the lowest modes failed: ") + e.what();
+    return false;
+  }
   if (solver.info() != Spectra::CompInfo::Successful) {
     *error = "the Lanczos iteration for the lowest modes did not converge";
     return false;
@@ -254,14 +290,19 @@ bool SolveLowestDense(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m, int co
 }
 
 // The lowest `count` eigenpairs of K phi = lambda M phi, ascending, phi^T M phi = 1.
-bool SolveLowest(const Eigen::MatrixXd& k, const Eigen::MatrixXd& m, int count,
-                 ModesOptions::Solver solver, Eigen::VectorXd* lambda, Eigen::MatrixXd* phi,
-                 std::string* error) {
+bool SolveLowest(const Eigen::SparseMatrix<double>& k, const Eigen::SparseMatrix<double>& m,
+                 int count, ModesOptions::Solver solver, Eigen::VectorXd* lambda,
+                 Eigen::MatrixXd* phi, std::string* error) {
   // Lanczos needs count + 1 < n; below ~kMinLanczosDofs dense costs less anyway.
   constexpr int kMinLanczosDofs = 120;
   const int n = static_cast<int>(k.rows());
+  if (solver == ModesOptions::Solver::kDense && n > kMaxDenseDofs) {
+    *error = "solver: dense is a check for at most " + std::to_string(kMaxDenseDofs) +
+             " degrees of freedom (this problem has " + std::to_string(n) + ")";
+    return false;
+  }
   if (solver == ModesOptions::Solver::kDense || n < kMinLanczosDofs || 2 * count + 1 > n) {
-    return SolveLowestDense(k, m, count, lambda, phi, error);
+    return SolveLowestDense(Eigen::MatrixXd(k), Eigen::MatrixXd(m), count, lambda, phi, error);
   }
   return SolveLowestLanczos(k, m, count, lambda, phi, error);
 }
@@ -295,7 +336,7 @@ Eigen::Matrix3d LoadStiffness(const CableRobot& robot, const Pose& pose,
 
 // K and M of the whole system, and what the modes' energies need.
 struct Assembly {
-  Eigen::MatrixXd k, m;
+  Eigen::SparseMatrix<double> k, m;
   std::array<Chain, kNumCables> chains;
   std::array<NodeMap, kNumCables> anchors;  // each cable's lower node: T_i on the cabin's dofs
   std::array<int, kNumCables> first_dof{};  // each cable's first interior node
@@ -306,8 +347,7 @@ bool Assemble(const CableRobot& robot, const Pose& pose, const StaticsSolution& 
               int segments, Assembly* a, std::string* error) {
   const int per_cable = 3 * (segments - 1);
   const int dofs = 6 + kNumCables * per_cable;
-  a->k = Eigen::MatrixXd::Zero(dofs, dofs);
-  a->m = Eigen::MatrixXd::Zero(dofs, dofs);
+  Entries k, m;
   for (int i = 0; i < kNumCables; ++i) {
     const CableProperties& c = robot.cables[i];
     const CableSolution& s = statics.cables[i];
@@ -326,25 +366,32 @@ bool Assemble(const CableRobot& robot, const Pose& pose, const StaticsSolution& 
     a->anchors[i].map.resize(3, 6);
     a->anchors[i].map << Eigen::Matrix3d::Identity(), -Cross(r);
     a->first_dof[i] = 6 + i * per_cable;
-    AddChain(a->chains[i], a->anchors[i], a->first_dof[i], &a->k, &a->m);
+    AddChain(a->chains[i], a->anchors[i], a->first_dof[i], &k, &m);
   }
-  a->m.topLeftCorner<6, 6>() += CabinMass(robot, pose.rotation);
-  a->k.block<3, 3>(3, 3) += LoadStiffness(robot, pose, statics);
-  const double largest = a->k.cwiseAbs().maxCoeff();
-  a->asymmetry = (a->k - a->k.transpose()).cwiseAbs().maxCoeff() / largest;
-  a->k = 0.5 * (a->k + a->k.transpose()).eval();
+  AddBlock(0, 0, CabinMass(robot, pose.rotation), &m);
+  AddBlock(3, 3, LoadStiffness(robot, pose, statics), &k);
+  a->k = SparseOf(dofs, k);
+  a->m = SparseOf(dofs, m);
+  const Eigen::SparseMatrix<double> transpose = a->k.transpose();
+  const double largest = a->k.coeffs().cwiseAbs().maxCoeff();
+  const Eigen::SparseMatrix<double> antisymmetric = a->k - transpose;
+  a->asymmetry =
+      antisymmetric.nonZeros() == 0 ? 0.0 : antisymmetric.coeffs().cwiseAbs().maxCoeff() / largest;
+  a->k = 0.5 * (a->k + transpose);
   return true;
 }
 
 // The stiffness at the cabin's dofs with the cables' interior nodes condensed out
 // (Guyan): K_cc - sum_i K_ci K_ii^-1 K_ic, each cable's block on its own.
 Eigen::Matrix<double, 6, 6> CondensedStiffness(const Assembly& a, int per_cable) {
-  Eigen::Matrix<double, 6, 6> k = a.k.topLeftCorner<6, 6>();
+  Eigen::Matrix<double, 6, 6> k = Eigen::MatrixXd(a.k.topLeftCorner(6, 6));
   for (int i = 0; i < kNumCables; ++i) {
     const int f = a.first_dof[i];
     const Eigen::MatrixXd kci = a.k.block(0, f, 6, per_cable);
-    const Eigen::LDLT<Eigen::MatrixXd> kii(a.k.block(f, f, per_cable, per_cable));
-    k -= kci * kii.solve(kci.transpose());
+    const Eigen::SparseMatrix<double> block = a.k.block(f, f, per_cable, per_cable);
+    const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> kii(block);
+    const Eigen::MatrixXd kic = kci.transpose();
+    k -= kci * kii.solve(kic);
   }
   return 0.5 * (k + k.transpose());
 }
@@ -390,8 +437,9 @@ bool ModesOptions::IsValid(std::string* error) const {
     *error = "segments: must be in [2, 1000] (got " + std::to_string(segments) + ")";
     return false;
   }
-  if (modes < 1) {
-    *error = "modes: must be >= 1 (got " + std::to_string(modes) + ")";
+  if (modes < 1 || modes > kMaxModes) {
+    *error = "modes: must be in [1, " + std::to_string(kMaxModes) + "] (got " +
+             std::to_string(modes) + ")";
     return false;
   }
   if (statics.method != StaticsMethod::kExact) {
@@ -431,11 +479,14 @@ bool ComputeFixedCableModes(const FixedCable& cable, const ModesOptions& options
     return false;
   }
   const int dofs = 3 * (n - 1);
-  Eigen::MatrixXd k = Eigen::MatrixXd::Zero(dofs, dofs), m = Eigen::MatrixXd::Zero(dofs, dofs);
+  Entries k, m;
   AddChain(chain, FixedNode(), 0, &k, &m);
   Eigen::VectorXd lambda;
   Eigen::MatrixXd phi;
-  if (!SolveLowest(k, m, options.modes, options.solver, &lambda, &phi, error)) return false;
+  if (!SolveLowest(SparseOf(dofs, k), SparseOf(dofs, m), options.modes, options.solver, &lambda,
+                   &phi, error)) {
+    return false;
+  }
   modes->assign(lambda.size(), CableMode());
   const int mid = n / 2;  // the node nearest mid-span (exactly at it for even N)
   for (int i = 0; i < lambda.size(); ++i) {
@@ -457,7 +508,9 @@ bool ComputeFixedCableModes(const FixedCable& cable, const ModesOptions& options
 // The equilibrium of `pose` by the exact statics, with its failure said in words.
 bool SolveEquilibrium(const CableRobot& robot, const Pose& pose, const ModesOptions& options,
                       StaticsSolution* statics, std::string* error) {
-  if (!robot.IsValid(error)) {
+  // The model file's checks, plausibility included (issue 57: an inertia of 1e300 kg m^2
+  // broke the eigensolver), for callers that built the model themselves.
+  if (!CheckModel(robot, error)) {
     *error = "model: " + *error;
     return false;
   }
@@ -495,8 +548,9 @@ bool ComputeModes(const CableRobot& robot, const Pose& pose, const ModesOptions&
     result->degrees_of_freedom = 6;
     result->cabin_stiffness = CondensedStiffness(a, 3 * (options.segments - 1));
     const Eigen::MatrixXd mass = CabinMass(robot, pose.rotation);
-    if (!SolveLowest(result->cabin_stiffness, mass, options.modes, ModesOptions::Solver::kDense,
-                     &lambda, &phi, error)) {
+    const Eigen::MatrixXd stiffness = result->cabin_stiffness;
+    if (!SolveLowest(stiffness.sparseView(), mass.sparseView(), options.modes,
+                     ModesOptions::Solver::kDense, &lambda, &phi, error)) {
       return false;
     }
   }
