@@ -468,7 +468,7 @@ bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   DatasetReadOptions read;
   read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   read.threads = kReadThreads;
-  read.joint_columns = robot->moving_parts.JointColumns();
+  SetJointColumns(robot->moving_parts, &read);
   if (!ColumnsFromFlag(&read.columns, error) || !ReadSessionDatasets(paths, read, data, error)) {
     return false;
   }
@@ -717,8 +717,7 @@ std::string EstimatesTable(const CalibrationResult& result) {
     const std::string range = FormatDouble(lo, 4) + ".." + FormatDouble(hi, 4) + " +- " +
                               FormatDouble(sigma_lo, 2) + ".." + FormatDouble(sigma_hi, 2) + unit;
     std::snprintf(buf, sizeof(buf), "  %-*.*s %-31s %9s %8s", width, width, label.c_str(),
-                  range.c_str(), "",
-                  ("<= x" + FormatDouble(widest, 2)).c_str());
+                  range.c_str(), "", ("<= x" + FormatDouble(widest, 2)).c_str());
     rows.push_back(WithNote(buf, flags));
   }
   std::ostringstream s;
@@ -1295,7 +1294,7 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
   options.method = method;
   options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
   options.read.threads = kReadThreads;
-  options.read.joint_columns = model.moving_parts.JointColumns();
+  SetJointColumns(model.moving_parts, &options.read);
   if (!ColumnsFromFlag(&options.read.columns, &error)) {
     PrintError(command, error);
     return kExitUsage;

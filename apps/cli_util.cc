@@ -900,10 +900,8 @@ bool MassCentreAtJointsFlag(const std::string& text, CableRobot* robot, std::str
   for (size_t j = 0; j < values.size(); ++j) {
     const Joint& joint = *all[j].second;
     std::string why;
-    if (!PlausibleJointValue(joint.column, values[j], &why) ||
-        (joint.has_range && (values[j] < joint.range_low || values[j] > joint.range_high))) {
-      *error = "--joints: " + joint.column + " = " + internal::Quote(std::to_string(values[j])) +
-               ": " + (why.empty() ? "outside its range in the model" : why);
+    if (!CheckJointValue(joint, values[j], &why)) {
+      *error = "--joints: " + joint.column + ": " + why;
       return false;
     }
     joints[j] = values[j];

@@ -385,7 +385,7 @@ bool RowsFromFile(const CableRobot& robot, std::vector<Row>* rows, std::string* 
   }
   DatasetReadOptions read;
   read.required_columns = DatasetColumns::kLengths;
-  read.joint_columns = robot.moving_parts.JointColumns();
+  SetJointColumns(robot.moving_parts, &read);
   if (!ColumnsFromFlag(&read.columns, error)) return false;
   Dataset data;
   std::string solved;  // solve's output as a lengths file, when --data is one

@@ -66,6 +66,7 @@ if [ "$mode" = all ] || [ "$mode" = --tsan-only ]; then
     cli_test '*SimulateCalibrateEvaluateRoundTrip*:*ResidualsOfALongCalibrationAreInFileOrder*'
     cli_faults_test '*TwoRuns*:*ADeviceAsData*'
     report_test '*ReportFiles*'
+    capi_test '*SharedByTwoThreads*'
   )
   targets=(fastcal_cli)
   for ((k = 0; k < ${#tsan_tests[@]}; k += 2)); do targets+=("${tsan_tests[k]}"); done

@@ -8,6 +8,7 @@
 // and locks over 10^4 warm, cold and failing solves.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -21,6 +22,7 @@
 #include "fastcal/control_cycle.h"
 #include "fastcal/fastcal.h"
 #include "fastcal/locate.h"
+#include "fastcal/plausibility.h"
 #include "fastcal/pose.h"
 #include "fastcal/statics.h"
 #include "fastcal/version.h"
@@ -50,17 +52,16 @@ struct fastcal_solver {
   fastcal::LocateSolution locate_trial;
   fastcal::ControlCycleResult cycle;
   char error[512] = "";
+  // Set while a call uses the handle (issue 57: two threads sharing one got each other's
+  // tensions, 241 times in 400 000 calls): a second call meanwhile returns
+  // FASTCAL_ERROR_BUSY without touching anything. An atomic flag, not a lock: nothing waits.
+  std::atomic<bool> busy{false};
 };
 
 namespace {
 
 constexpr double kKnPerN = 1e-3;
 constexpr double kNPerKn = 1e3;
-
-// A joint value the model could mean: an angle within one turn, a shift within 100 m
-// (as PlausibleJointValue, without its message strings).
-constexpr double kMaxJointDeg = 360.0;
-constexpr double kMaxJointM = 100.0;
 
 void SetError(fastcal_solver* s, const char* text) {
   std::snprintf(s->error, sizeof(s->error), "%s", text);
@@ -107,39 +108,76 @@ void DescribeFailure(fastcal_solver* s, const char* what, const StaticsSolution&
   std::snprintf(s->error, sizeof(s->error), "%s: %s%s%s", what, name, cable, numbers);
 }
 
-// Reads the joints into *q: FASTCAL_OK, or FASTCAL_INVALID_INPUT naming the joint.
+// `value` with the fewest of 6, 10 or 17 significant digits that tell it from `limit`
+// (internal::FormatBeyond's rule, without allocating: "40.0000001", not "40", beside 40).
+void FormatBeyond(double value, double limit, char* out, size_t size) {
+  char shown_limit[32];
+  std::snprintf(shown_limit, sizeof(shown_limit), "%.6g", limit);
+  for (const char* format : {"%.6g", "%.10g"}) {
+    std::snprintf(out, size, format, value);
+    if (std::strcmp(out, shown_limit) != 0) return;
+  }
+  std::snprintf(out, size, "%.17g", value);
+}
+
+// Reads the joints into *q: FASTCAL_OK, or FASTCAL_INVALID_INPUT naming the joint (the
+// library's rule, fastcal::CheckJointValue: plausible and within the model's range).
 int ReadJoints(fastcal_solver* s, const double* joints, JointValues* q) {
   *q = {};
   if (joints == nullptr || s->num_joints == 0) return FASTCAL_OK;
-  for (int j = 0; j < s->num_joints; ++j) {
-    const std::string& name = s->joint_names[j];
-    const bool angle = name.size() > 4 && name.compare(name.size() - 4, 4, "_deg") == 0;
-    const double limit = angle ? kMaxJointDeg : kMaxJointM;
-    if (!std::isfinite(joints[j]) || std::fabs(joints[j]) > limit) {
-      std::snprintf(s->error, sizeof(s->error),
-                    "invalid_input: joint %d (%s) = %g is not a %s within %g", j, name.c_str(),
-                    joints[j], angle ? "finite angle (deg)" : "finite shift (m)", limit);
-      return FASTCAL_INVALID_INPUT;
-    }
-    if (s->joint_has_range[j] && !(joints[j] >= s->joint_low[j] && joints[j] <= s->joint_high[j])) {
-      std::snprintf(s->error, sizeof(s->error),
-                    "invalid_input: joint %d (%s) = %g is outside the range [%g, %g] the model "
-                    "states for it",
-                    j, name.c_str(), joints[j], s->joint_low[j], s->joint_high[j]);
-      return FASTCAL_INVALID_INPUT;
-    }
-    (*q)[j] = joints[j];
+  std::copy(joints, joints + s->num_joints, q->begin());
+  const int j = fastcal::FirstRefusedJoint(s->robot.moving_parts, *q);
+  if (j < 0) return FASTCAL_OK;
+  const std::string& name = s->joint_names[j];
+  const bool angle = name.size() > 4 && name.compare(name.size() - 4, 4, "_deg") == 0;
+  if (!std::isfinite((*q)[j]) || !fastcal::PlausibleJointValue(name, (*q)[j], nullptr)) {
+    std::snprintf(s->error, sizeof(s->error),
+                  "invalid_input: joint %d (%s) = %g is not a %s within %g", j, name.c_str(),
+                  (*q)[j], angle ? "finite angle (deg)" : "finite shift (m)",
+                  angle ? 360.0 : 100.0);
+  } else {
+    const double limit = (*q)[j] < s->joint_low[j] ? s->joint_low[j] : s->joint_high[j];
+    char value[32];
+    FormatBeyond((*q)[j], limit, value, sizeof(value));
+    std::snprintf(s->error, sizeof(s->error),
+                  "invalid_input: joint %d (%s) = %s is outside the range [%g, %g] the model "
+                  "states for it",
+                  j, name.c_str(), value, s->joint_low[j], s->joint_high[j]);
   }
-  return FASTCAL_OK;
+  *q = {};
+  return FASTCAL_INVALID_INPUT;
 }
 
-// A non-finite position or attitude, named: FASTCAL_INVALID_INPUT.
+// A position or attitude that is not finite, or that no pose of FAST can have (issue 57:
+// a position of 1e300 m answered "vertical_cable"), named: FASTCAL_INVALID_INPUT. The
+// plausibility limits of the files and flags (plausibility.h), without their messages'
+// strings.
 int CheckPose(fastcal_solver* s, const double position_m[3], const double rpy_deg[3]) {
   for (int k = 0; k < 3; ++k) {
     const bool position = !std::isfinite(position_m[k]);
     if (position || !std::isfinite(rpy_deg[k])) {
       std::snprintf(s->error, sizeof(s->error), "invalid_input: %s[%d] = %g is not finite",
                     position ? "position_m" : "rpy_deg", k, position ? position_m[k] : rpy_deg[k]);
+      return FASTCAL_INVALID_INPUT;
+    }
+  }
+  const fastcal::PlausibilityLimits limits;
+  const double rho = std::hypot(position_m[0], position_m[1]);
+  const double lowest = fastcal::LowestPlausibleZ(rho, limits);
+  if (!(rho <= limits.max_horizontal_radius_m) || !(position_m[2] <= limits.max_height_m) ||
+      !(position_m[2] >= lowest)) {
+    std::snprintf(s->error, sizeof(s->error),
+                  "invalid_input: position_m (%g, %g, %g) is not a place the cabin can be: "
+                  "within %g m of the axis, z from %g m (the reflector there) to %g m",
+                  position_m[0], position_m[1], position_m[2], limits.max_horizontal_radius_m,
+                  lowest, limits.max_height_m);
+    return FASTCAL_INVALID_INPUT;
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (!(std::fabs(rpy_deg[k]) <= limits.max_abs_angle_deg)) {
+      std::snprintf(s->error, sizeof(s->error),
+                    "invalid_input: rpy_deg[%d] = %g is beyond the plausible +-%g deg", k,
+                    rpy_deg[k], limits.max_abs_angle_deg);
       return FASTCAL_INVALID_INPUT;
     }
   }
@@ -157,9 +195,46 @@ fastcal::Pose PoseOf(const double position_m[3], const double rpy_deg[3]) {
   return pose;
 }
 
-// Common entry checks: a handle, a loaded model, the arrays.
-int Enter(fastcal_solver* s, bool arrays_given) {
+// A call's hold on its handle (fastcal_solver::busy) for its duration, if no other call
+// has it.
+class Claim {
+ public:
+  explicit Claim(fastcal_solver* s)
+      : s_(s), held_(s != nullptr && !s->busy.exchange(true, std::memory_order_acquire)) {}
+  Claim(const Claim&) = delete;
+  Claim& operator=(const Claim&) = delete;
+  ~Claim() {
+    if (held_) s_->busy.store(false, std::memory_order_release);
+  }
+  bool held() const { return held_; }
+
+ private:
+  fastcal_solver* s_;
+  bool held_;
+};
+
+// An input array copied before any output is written, since outputs may overlap it
+// (issue 57: fastcal_solve_pose(s, buf, buf + 3, NULL, buf, NULL) solved at (0, 0, 0):
+// zeroing the tensions zeroed the position). `p` is null for a null input.
+template <int N>
+struct InputCopy {
+  InputCopy(const double* from, int count = N) {
+    if (from == nullptr) return;
+    std::copy(from, from + std::min(count, N), v);
+    p = v;
+  }
+  double v[N] = {};
+  const double* p = nullptr;
+};
+
+// The joint values a handle's calls read (0 for a handle without a model): fixed at
+// creation, so read without the call's claim.
+int JointsOf(const fastcal_solver* s) { return s != nullptr && s->ready ? s->num_joints : 0; }
+
+// Common entry checks: a handle, no other call on it, a loaded model, the arrays.
+int Enter(fastcal_solver* s, const Claim& claim, bool arrays_given) {
   if (s == nullptr) return FASTCAL_ERROR_NULL_ARGUMENT;
+  if (!claim.held()) return FASTCAL_ERROR_BUSY;  // the other call's state left alone
   if (!s->ready) return FASTCAL_ERROR_NO_MODEL;  // the creation's message stays
   if (!arrays_given) {
     SetError(s, "null_argument: a required array is NULL");
@@ -172,12 +247,12 @@ int Enter(fastcal_solver* s, bool arrays_given) {
 // Enter for a call that fills a struct (fastcal_statics, fastcal_cycle): the struct is
 // zeroed first (cable -1), and carries the status of a refused call.
 template <typename Out>
-int EnterWithStruct(fastcal_solver* s, bool arrays_given, Out* out) {
+int EnterWithStruct(fastcal_solver* s, const Claim& claim, bool arrays_given, Out* out) {
   if (out != nullptr) {
     std::memset(out, 0, sizeof(*out));
     out->cable = -1;
   }
-  const int e = Enter(s, arrays_given && out != nullptr);
+  const int e = Enter(s, claim, arrays_given && out != nullptr);
   if (e != 0 && out != nullptr) out->status = e;
   return e;
 }
@@ -243,6 +318,8 @@ const char* fastcal_status_name(int status) {
       return "bad_limits";
     case FASTCAL_ERROR_INTERNAL:
       return "internal_error";
+    case FASTCAL_ERROR_BUSY:
+      return "busy";
     default:
       return "unknown";
   }
@@ -301,7 +378,8 @@ const char* fastcal_solver_joint_name(const fastcal_solver* s, int j) {
 }
 
 void fastcal_solver_reset(fastcal_solver* s) {
-  if (s == nullptr) return;
+  const Claim claim(s);
+  if (!claim.held()) return;  // NULL, or another call using the handle: nothing to reset
   s->last.status = StaticsStatus::kInvalidInput;
   s->located.status = StaticsStatus::kInvalidInput;
   s->cycle.statics.status = StaticsStatus::kInvalidInput;
@@ -311,11 +389,14 @@ void fastcal_solver_destroy(fastcal_solver* s) { delete s; }
 
 int fastcal_solve_pose(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                        const double* joints, double tension_kN[6], double unstretched_m[6]) {
+  const InputCopy<3> position(position_m), rpy(rpy_deg);
+  const InputCopy<FASTCAL_MAX_JOINTS> q(joints, JointsOf(s));
   Zero(tension_kN, kNumCables);
   Zero(unstretched_m, kNumCables);
-  if (const int e = Enter(s, position_m && rpy_deg); e != 0) return e;
+  const Claim claim(s);
+  if (const int e = Enter(s, claim, position.p && rpy.p); e != 0) return e;
   try {
-    const int status = Solve(s, position_m, rpy_deg, joints);
+    const int status = Solve(s, position.p, rpy.p, q.p);
     if (status != FASTCAL_OK) return status;
     for (int i = 0; i < kNumCables; ++i) {
       if (tension_kN != nullptr) tension_kN[i] = s->last.cables[i].lower_tension_n * kKnPerN;
@@ -330,9 +411,12 @@ int fastcal_solve_pose(fastcal_solver* s, const double position_m[3], const doub
 
 int fastcal_solve_pose_full(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                             const double* joints, fastcal_statics* out) {
-  if (const int e = EnterWithStruct(s, position_m && rpy_deg, out); e != 0) return e;
+  const InputCopy<3> position(position_m), rpy(rpy_deg);
+  const InputCopy<FASTCAL_MAX_JOINTS> q(joints, JointsOf(s));
+  const Claim claim(s);
+  if (const int e = EnterWithStruct(s, claim, position.p && rpy.p, out); e != 0) return e;
   try {
-    const int status = Solve(s, position_m, rpy_deg, joints);
+    const int status = Solve(s, position.p, rpy.p, q.p);
     FillStatics(status == FASTCAL_OK ? s->last : s->trial, status, out);
     if (status == FASTCAL_INVALID_INPUT) {  // refused before a solve: nothing of one
       out->cable = -1;
@@ -347,16 +431,19 @@ int fastcal_solve_pose_full(fastcal_solver* s, const double position_m[3], const
 
 int fastcal_locate(fastcal_solver* s, const double unstretched_m[6], const double* joints,
                    double position_m[3], double rpy_deg[3], double tension_kN[6]) {
+  const InputCopy<kNumCables> given(unstretched_m);
+  const InputCopy<FASTCAL_MAX_JOINTS> joint_values(joints, JointsOf(s));
   Zero(position_m, 3);
   Zero(rpy_deg, 3);
   Zero(tension_kN, kNumCables);
-  if (const int e = Enter(s, unstretched_m && position_m && rpy_deg); e != 0) return e;
+  const Claim claim(s);
+  if (const int e = Enter(s, claim, given.p && position_m && rpy_deg); e != 0) return e;
   try {
     JointValues q;
-    if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
+    if (const int status = ReadJoints(s, joint_values.p, &q); status != FASTCAL_OK) return status;
     s->fixed_robot.mass_centre_cabin_m = s->robot.MassCentreAt(q);
     std::array<double, kNumCables> lengths;
-    std::copy(unstretched_m, unstretched_m + kNumCables, lengths.begin());
+    std::copy(given.v, given.v + kNumCables, lengths.begin());
     s->locate_trial = s->located;
     const StaticsStatus status =
         fastcal::Locate(s->fixed_robot, lengths, s->locate_options, &s->locate_trial);
@@ -447,7 +534,10 @@ fastcal_cycle_limits fastcal_default_cycle_limits(void) {
 int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                           const double* joints, const fastcal_cycle_limits* limits,
                           fastcal_cycle* out) {
-  if (const int e = EnterWithStruct(s, position_m && rpy_deg, out); e != 0) return e;
+  const InputCopy<3> position(position_m), rpy(rpy_deg);
+  const InputCopy<FASTCAL_MAX_JOINTS> joint_values(joints, JointsOf(s));
+  const Claim claim(s);
+  if (const int e = EnterWithStruct(s, claim, position.p && rpy.p, out); e != 0) return e;
   try {
     fastcal::ControlLimits lim;
     if (limits != nullptr) {
@@ -464,17 +554,17 @@ int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const d
         return out->status = FASTCAL_ERROR_BAD_LIMITS;
       }
     }
-    if (const int status = CheckPose(s, position_m, rpy_deg); status != FASTCAL_OK) {
+    if (const int status = CheckPose(s, position.p, rpy.p); status != FASTCAL_OK) {
       return out->status = status;
     }
     JointValues q;
-    if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) {
+    if (const int status = ReadJoints(s, joint_values.p, &q); status != FASTCAL_OK) {
       return out->status = status;
     }
     // Warm from the handle's last solve, whichever call made it.
     s->cycle.statics = s->last;
     const fastcal::ControlStatus status =
-        fastcal::ControlCycle(s->robot, s->robot.CabinPose(PoseOf(position_m, rpy_deg), q), q, lim,
+        fastcal::ControlCycle(s->robot, s->robot.CabinPose(PoseOf(position.p, rpy.p), q), q, lim,
                               s->options, &s->cycle);
     const fastcal::ControlCycleResult& r = s->cycle;
     out->cable = r.cable;
@@ -499,13 +589,13 @@ int fastcal_control_cycle(fastcal_solver* s, const double position_m[3], const d
       case fastcal::ControlStatus::kBelowMinTension:
         out->status = FASTCAL_BELOW_MIN_TENSION;
         std::snprintf(s->error, sizeof(s->error),
-                      "below_min_tension: cable %d at %.1f kN, under %.1f kN", r.cable + 1,
+                      "below_min_tension: cable %d at %.4g kN, under %.4g kN", r.cable + 1,
                       out->tension_kN[r.cable], lim.min_tension_n * kKnPerN);
         break;
       case fastcal::ControlStatus::kAboveMaxTension:
         out->status = FASTCAL_ABOVE_MAX_TENSION;
         std::snprintf(s->error, sizeof(s->error),
-                      "above_max_tension: cable %d over %.1f kN by %.1f kN", r.cable + 1,
+                      "above_max_tension: cable %d over %.4g kN by %.4g kN", r.cable + 1,
                       lim.max_tension_n * kKnPerN, -out->max_tension_margin_kN);
         break;
       case fastcal::ControlStatus::kInsideReflectorMargin:

@@ -95,7 +95,8 @@ def control_cycle(
             (Model.measured_frame), the cabin's following from the joints.
         rpy_deg, quat: the planned attitude(s), as fastcal.solve takes them.
         joints: the moving parts' values (Model.joint_columns order and units: deg, m):
-            (J,) for every pose or (n, J); None for all at zero.
+            (J,) for every pose or (n, J); None for all at zero. Each within the range
+            the model states for its joint, as the C interface and the command line check.
         model: the model (e.g. a calibration's); None for Model.nominal().
         min_tension_kN: every lower-end tension at least this (default 50 kN: the survey
             design's margin; below it a sagging cable's length is uncertain by metres).
@@ -110,7 +111,8 @@ def control_cycle(
 
     Raises:
         InputError: a wrong shape, limits out of range (named), joints for a model
-            without moving parts.
+            without moving parts, a joint beyond one turn (or 100 m) or outside the range
+            the model states for it (named with its row and column).
     """
     positions, single = _rows(position_m, 3, "position_m")
     n = positions.shape[0]

@@ -12,6 +12,24 @@
 namespace fastcal::python {
 namespace {
 
+// The joints as JointRows reads them (module.cc), each within the model's range: as the
+// C interface and the command line refuse it (issue 57).
+std::vector<JointValues> CheckedJointRows(const DoubleArray& joints, py::ssize_t n,
+                                          const MovingParts& parts) {
+  std::vector<JointValues> rows = JointRows(joints, n, parts.num_joints());
+  const auto model_joints = parts.Joints();
+  for (size_t k = 0; k < rows.size(); ++k) {
+    for (int j = 0; j < parts.num_joints(); ++j) {
+      std::string why;
+      if (!CheckJointValue(*model_joints[j].second, rows[k][j], &why)) {
+        throw InputError("joints: row " + std::to_string(k) + ", joint " + std::to_string(j) +
+                         " (" + model_joints[j].second->column + "): " + why);
+      }
+    }
+  }
+  return rows;
+}
+
 py::dict ControlCycles(const CableRobot& model, const DoubleArray& positions_m,
                        const std::string& attitude_kind, const DoubleArray& attitude,
                        const DoubleArray& joints, double min_tension_kn, double max_tension_kn,
@@ -26,7 +44,7 @@ py::dict ControlCycles(const CableRobot& model, const DoubleArray& positions_m,
   if (!limits.IsValid(&error)) throw InputError(error);
   const std::vector<Pose> poses = PosesFromArrays(positions_m, attitude_kind, attitude);
   const auto n = static_cast<py::ssize_t>(poses.size());
-  const std::vector<JointValues> q = JointRows(joints, n, robot.moving_parts.num_joints());
+  const std::vector<JointValues> q = CheckedJointRows(joints, n, robot.moving_parts);
 
   using Shape = std::vector<py::ssize_t>;
   DoubleArray winch(Shape{n, kNumCables}), s0(Shape{n, kNumCables}), tension(Shape{n, kNumCables}),
@@ -86,9 +104,8 @@ py::dict ControlCycles(const CableRobot& model, const DoubleArray& positions_m,
 }  // namespace
 
 void BindControl(py::module_& m) {
-  m.def("control_status_names", [] {
-    return EnumNames(ControlStatus::kInsideReflectorMargin, ControlStatusName);
-  });
+  m.def("control_status_names",
+        [] { return EnumNames(ControlStatus::kInsideReflectorMargin, ControlStatusName); });
   m.def("control_cycle", &ControlCycles, py::arg("model"), py::arg("position_m"),
         py::arg("attitude_kind"), py::arg("attitude"), py::arg("joints"), py::arg("min_tension_kN"),
         py::arg("max_tension_kN"), py::arg("min_reflector_clearance_m"));

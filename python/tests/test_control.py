@@ -78,6 +78,14 @@ def test_joints_move_the_tensions(data_dir):
         fastcal.control_cycle(position, joints=joints[:-1], model=model)
     with pytest.raises(fastcal.InputError, match="no moving parts"):
         fastcal.control_cycle(position, joints=[1.0])
+    # Issue 57: a joint outside the range the model states for it (+-40 deg) came back
+    # 'ok'; the C interface and the command line refused it, and so does Python now.
+    for value, why in ((400.0, "beyond one turn"),
+                       (40.0000001, r"40.0000001 is outside the range \[-40, 40\]")):
+        beyond = list(joints)
+        beyond[0] = value
+        with pytest.raises(fastcal.InputError, match=why):
+            fastcal.control_cycle(position, joints=beyond, model=model)
 
 
 def test_bad_limits_are_named():

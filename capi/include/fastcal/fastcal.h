@@ -10,7 +10,13 @@
  *  - a bounded number of iterations (docs/embedding.md, "A bounded time"): Newton from
  *    the last solve of the handle (warm), else from the paper's AAS (cold), else the
  *    continuation from the home pose, each with its own cap.
- * A handle is not thread-safe: one handle per thread (each keeps its own warm start).
+ * A handle is not thread-safe: one handle per thread (each keeps its own warm start). A
+ * call on a handle another call is still using (two threads sharing one) returns
+ * FASTCAL_ERROR_BUSY at once, with its outputs zeroed and the handle untouched: the other
+ * call's answer is never mixed into this one's (one atomic flag; no lock, no wait).
+ *
+ * Outputs may overlap inputs (e.g. fastcal_solve_pose(s, buf, buf + 3, NULL, buf, NULL)):
+ * every input is copied before any output is written.
  *
  * Units at this edge: positions m, angles deg (roll, pitch, yaw: R = Rz(yaw) Ry(pitch)
  * Rx(roll), frame to global), forces and tensions kN, lengths m; joint values in the
@@ -24,7 +30,7 @@
  * Statuses: 0 ok; 1..12 the statics' own (fastcal_status_name: "invalid_input",
  * "no_equilibrium", ...; StaticsStatus of fastcal/statics.h, same numbers); 100..102 a
  * control cycle's limits; negative: the call itself was wrong (a NULL handle or array, a
- * handle whose model did not load). On any status but 0 and 100..102, every output
+ * handle whose model did not load, a handle in use). On any status but 0 and 100..102, every output
  * the caller gave is zeroed (never NaN, never left as it was; a struct's status and
  * cable set); `cable` fields count from 0 (an index into the arrays), messages name
  * cables 1 to 6 as operators do.
@@ -62,7 +68,7 @@ extern "C" {
 enum fastcal_status {
   FASTCAL_OK = 0,
   /* 1..12: the statics' own (StaticsStatus of fastcal/statics.h, same numbers). */
-  FASTCAL_INVALID_INPUT = 1, /* a non-finite pose or joint value */
+  FASTCAL_INVALID_INPUT = 1, /* a pose or joint value that is not finite or not plausible */
   FASTCAL_VERTICAL_CABLE = 2,
   FASTCAL_NO_EQUILIBRIUM = 3,      /* no equilibrium with every cable pulling */
   FASTCAL_SAGGING_CABLE = 4,       /* beyond the model's range: s0/k too large */
@@ -83,7 +89,9 @@ enum fastcal_status {
   FASTCAL_ERROR_NULL_ARGUMENT = -1, /* a NULL handle or a required array NULL */
   FASTCAL_ERROR_NO_MODEL = -2,      /* the handle's model did not load (its error says why) */
   FASTCAL_ERROR_BAD_LIMITS = -3,    /* fastcal_cycle_limits out of range */
-  FASTCAL_ERROR_INTERNAL = -4       /* a C++ exception was caught: a defect, please report */
+  FASTCAL_ERROR_INTERNAL = -4,      /* a C++ exception was caught: a defect, please report */
+  FASTCAL_ERROR_BUSY = -5           /* another call is using the handle (another thread):
+                                       nothing done; fastcal_solver_error is that call's */
 };
 
 /* The library's version, "major.minor.patch" (FASTCAL_VERSION of fastcal/version.h). */

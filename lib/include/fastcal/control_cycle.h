@@ -67,8 +67,9 @@ struct ControlCycleResult {
 
 // One cycle. `options` are the statics' (exact, warm_start true for a trajectory: the
 // previous cycle's result->statics starts it). `joints`: the model's joint order, columns'
-// units. Returns result->status. Limits that IsValid refuses return kStaticsFailed with
-// statics.status kInvalidInput.
+// units. Returns result->status. Limits that IsValid refuses, and joints that
+// CheckJointValue refuses (not plausible, or outside the range the model states), return
+// kStaticsFailed with statics.status kInvalidInput.
 ControlStatus ControlCycle(const CableRobot& robot, const Pose& pose, const JointValues& joints,
                            const ControlLimits& limits, const StaticsOptions& options,
                            ControlCycleResult* result);

@@ -136,6 +136,11 @@ struct DatasetReadOptions {
   // Sample::joint. A file lacking any is an error naming every one it lacks; a joint
   // column read without being asked for is an unknown column. Empty: none.
   std::vector<std::string> joint_columns;
+  // The model's joints in that order (MovingParts::Joints), when their stated ranges are
+  // checked: a value outside its joint's range is refused as an implausible one is (issue
+  // 57: `evaluate` took joints outside the model's range). Empty: plausibility only.
+  // SetJointColumns fills both from a model's moving parts.
+  std::vector<Joint> joints;
   // Read the file as an export through this column map (column_map.h, docs/data-format.md,
   // "Column maps"): its delimiter, decimal mark, header line, source columns, units and
   // time stamps; null: the canonical format above. Messages then name the source column
@@ -143,6 +148,10 @@ struct DatasetReadOptions {
   // number"), and those about the map its file, line and key.
   std::shared_ptr<const ColumnMap> columns;
 };
+
+// The read options for a model's moving parts: DatasetReadOptions::joint_columns and
+// ::joints (their ranges checked as each value is read).
+void SetJointColumns(const MovingParts& parts, DatasetReadOptions* options);
 
 // Whether `data` has the joint columns the moving parts need, in the model's joint order
 // (as ReadDataset gives them with DatasetReadOptions::joint_columns =

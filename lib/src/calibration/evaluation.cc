@@ -35,6 +35,15 @@ TensionPredictor::TensionPredictor(const CableRobot& robot, AttitudeSource attit
 
 bool TensionPredictor::Predict(const Dataset& data, const Sample& sample,
                                std::array<double, kNumCables>* predicted_n, std::string* error) {
+  // Joints outside the ranges the model states are not the model's (issue 57: Python's
+  // evaluate took them), whichever reader the data came through.
+  if (const int j = FirstRefusedJoint(robot_.moving_parts, sample.joint); j >= 0) {
+    const Joint& joint = *robot_.moving_parts.Joints()[j].second;
+    std::string why;
+    CheckJointValue(joint, sample.joint[j], &why);
+    *error = SampleWhere(data, sample) + ": column '" + joint.column + "': " + why;
+    return false;
+  }
   if (SolveStatics(robot_, PoseOf(robot_, sample, attitude_), sample.joint, options_, &solution_) !=
       StaticsStatus::kOk) {
     *error = CannotSolve(data, sample, "the model", "", solution_);

@@ -112,8 +112,10 @@ struct Header {
   bool planned = false;
   bool unstretched = false;
   int session_field = -1;  // the field holding the session label, or -1
-  // The moving parts' joint columns asked for (DatasetReadOptions::joint_columns).
+  // The moving parts' joint columns asked for (DatasetReadOptions::joint_columns), and
+  // their joints when the ranges are checked (DatasetReadOptions::joints).
   std::vector<std::string> joint_names;
+  std::vector<Joint> joints;
   // Read through a column map (column_map.h; null: the canonical format): the fields are
   // split at `delimiter` with quotes, numbers have the map's decimal mark and are
   // converted by `conversion`; fields of no column are kIgnoredField.
@@ -601,7 +603,9 @@ bool ReadJointField(const Header& header, std::string_view field, int j, Sample*
                                                 field, header.map->decimal,
                                                 header.joint_conversion[j], &file_value, &v, &why)
                                           : ParseNumber(field, &v, &why);
-  if (!read || !PlausibleJointValue(header.joint_names[j], v, &why)) {
+  if (!read || !(j < static_cast<int>(header.joints.size())
+                     ? CheckJointValue(header.joints[j], v, &why)
+                     : PlausibleJointValue(header.joint_names[j], v, &why))) {
     *reason = "column " + Quoted(header.joint_names[j]) + ": " + why;
     return false;
   }
@@ -835,6 +839,7 @@ class LineParser {
     layout_.path = source_name;
     layout_.joint_columns = options_.joint_columns;
     header_.joint_names = options_.joint_columns;
+    if (options_.joints.size() == options_.joint_columns.size()) header_.joints = options_.joints;
     header_.map = options_.columns.get();
     if (header_.map != nullptr) layout_.time_offset_s = header_.map->time.offset_s;
   }
@@ -1074,6 +1079,12 @@ bool ParseDatasetImpl(const std::string& text, const std::string& source_name,
 }
 
 }  // namespace
+
+void SetJointColumns(const MovingParts& parts, DatasetReadOptions* options) {
+  options->joint_columns = parts.JointColumns();
+  options->joints.clear();
+  for (const auto& [part, joint] : parts.Joints()) options->joints.push_back(*joint);
+}
 
 bool CheckJointColumns(const Dataset& data, const MovingParts& parts, std::string* error) {
   const std::vector<std::string> wanted = parts.JointColumns();

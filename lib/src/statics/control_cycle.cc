@@ -84,7 +84,9 @@ ControlStatus ControlCycle(const CableRobot& robot, const Pose& pose, const Join
   result->sensor_reading_n = {};
   result->min_tension_margin_n = result->max_tension_margin_n = 0.0;
   result->cable = -1;
-  if (!limits.IsValid(nullptr)) {
+  // Limits IsValid refuses, or a joint outside what the model states for it (issue 57:
+  // 400 deg on a joint of +-40 deg came back ok): invalid input, nothing solved.
+  if (!limits.IsValid(nullptr) || FirstRefusedJoint(robot.moving_parts, joints) >= 0) {
     result->statics.status = StaticsStatus::kInvalidInput;
     result->statics.cables = {};
     return result->status = ControlStatus::kStaticsFailed;
