@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <map>
 #include <regex>
+#include <sstream>
 #include <string>
 
 #include "cli_fixture.h"
@@ -60,6 +61,84 @@ TEST_F(CliTrackStoreTest, ARunThroughASymbolicLinkIsRefusedToo) {
   // Unlocked, the run builds the track where the link points.
   EXPECT_EQ(Track(Day(1), "sym").code, 0);
   EXPECT_TRUE(fs::exists(Path("t/track_state.json")));
+}
+
+// Issue 57, 4: the lock was keyed on DIR as written: a run on `--out=/p/t` and one from
+// inside it on `--out=.` locked /p/.t.lock and ./..lock, and both wrote the track. The lock
+// is now the resolved track's, however it is spelled ('.', a trailing '/', '..').
+TEST_F(CliTrackStoreTest, ARunFromInsideTheTrackTakesTheSameLock) {
+  ASSERT_EQ(Track(Day(1), "t").code, 0);
+  const std::string track = Bin() + " track --spec=" + Source() +
+                            "/calibration_data/spec_track.yaml --data=" + Day(1) + "," + Day(2);
+  for (const char* out : {".", "./", "../t", "../t/."}) {
+    const CommandResult r =
+        Shell("cd " + Path("t") + " && flock " + Path(".t.lock") + " " + track + " --out=" + out);
+    EXPECT_EQ(r.code, 1) << out << "\n" << r.output;
+    EXPECT_NE(r.output.find("another fastcal track is running on it"), std::string::npos)
+        << r.output;
+  }
+  EXPECT_EQ(Shell("cd " + Path("t") + " && " + track + " --out=.").code, 0);  // unlocked: updates
+  EXPECT_FALSE(fs::exists(Path("t/..lock")));
+}
+
+// Issue 57, 10: refused runs left lock files outside --out (`--out=/` made /..lock,
+// `--out=season.csv` .season.csv.lock). What cannot be a track is refused before any
+// lock, and the lock file goes with the run that held it, refused or not.
+TEST_F(CliTrackStoreTest, NoRunLeavesALockFileBehind) {
+  const bool root_had_one = fs::exists("/..lock");
+  CommandResult r = Track(Day(1), "2024-05-01.csv");  // the data file itself as --out
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("2024-05-01.csv: not a directory"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(Path(".2024-05-01.csv.lock")));
+  r = Fastcal("track --spec=" + Source() + "/calibration_data/spec_track.yaml --data=" + Day(1) +
+              " --out=/");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.output.find("/: the root directory cannot hold a track"), std::string::npos)
+      << r.output;
+  if (!root_had_one && fs::exists("/..lock")) {
+    fs::remove("/..lock");
+    ADD_FAILURE() << "a refused run made /..lock";
+  }
+  Write("bad.csv", "time_s,x_m\n1,2\n");
+  r = Track(Day(1) + "," + Path("bad.csv"), "t");  // refused after the lock was taken
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_FALSE(fs::exists(Path(".t.lock")));
+  EXPECT_EQ(Track(Day(1), "t").code, 0);
+  EXPECT_FALSE(fs::exists(Path(".t.lock")));
+}
+
+// Issue 57, 6: a day sent again with its times shifted (a re-export in Beijing time, +8 h)
+// passed the SHA-256 and repeated-row checks, which include the time, and was folded
+// twice; shifted by 9 days it made a false event at p = 3e-84. The readings without their
+// times tell it, in one run and in an update.
+TEST_F(CliTrackStoreTest, ADayReSentWithShiftedTimesIsRefused) {
+  const auto shifted = [&](const std::string& name, double shift_s) {
+    std::istringstream in(ReadFile(Day(1)));
+    std::ostringstream out;
+    out.precision(17);
+    for (std::string line; std::getline(in, line);) {
+      if (line.empty() || line[0] == '#' || line.rfind("time_s", 0) == 0) {
+        out << line << "\n";
+        continue;
+      }
+      const size_t comma = line.find(',');
+      out << std::stod(line.substr(0, comma)) + shift_s << line.substr(comma) << "\n";
+    }
+    Write(name, out.str());
+    return Path(name);
+  };
+  CommandResult r = Track(Day(1) + "," + shifted("beijing.csv", 8 * 3600.0), "a");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("beijing.csv: the same readings as"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("its times shifted by +8 h"), std::string::npos) << r.output;
+  EXPECT_FALSE(fs::exists(Path("a")));
+  ASSERT_EQ(Track(Day(1) + "," + Day(2), "b").code, 0);
+  r = Track(Day(1) + "," + Day(2) + "," + shifted("later.csv", 9 * 86400.0), "b");
+  EXPECT_EQ(r.code, 2) << r.output;
+  EXPECT_NE(r.output.find("later.csv: the same readings as"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("already in the track, its times shifted by +216 h (+9 d)"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST_F(CliTrackStoreTest, AnInterruptedUpdateCountsNothingTwice) {

@@ -225,6 +225,14 @@ TEST_F(CliTrackTest, BadFlagsAndDirectoriesAreRefused) {
       Fastcal("track --spec=" + Spec() + " --data=x.csv --out=" + Path("t") + " --window=1.5d");
   EXPECT_EQ(window.code, 2);
   EXPECT_NE(window.output.find("--window '1.5d'"), std::string::npos) << window.output;
+  // Issue 57: 2.7 million years was a window.
+  const auto eon =
+      Fastcal("track --spec=" + Spec() + " --data=x.csv --out=" + Path("t") + " --window=1e9d");
+  EXPECT_EQ(eon.code, 2);
+  EXPECT_NE(eon.output.find("--window '1e9d': duration_s must be a whole number of seconds from 1 "
+                            "to 31622400"),
+            std::string::npos)
+      << eon.output;
   const auto missing =
       Fastcal("track --spec=" + Spec() + " --data=" + Path("none.csv") + " --out=" + Path("t"));
   EXPECT_EQ(missing.code, 2);

@@ -65,12 +65,17 @@
 
 namespace fastcal {
 
+// The longest window: a year (366 d). A window is a part of a season (a day, a week);
+// one longer than the season holds it all and tracks nothing (issue 57: --window=1e9d,
+// 2.7 million years, was accepted).
+inline constexpr double kMaxWindowS = 366.0 * 86400.0;
+
 struct WindowSpec {
   enum class Kind { kDuration, kFile };
   Kind kind = Kind::kDuration;
   // kDuration: windows [k d, (k + 1) d) of time_s, k an integer: for Unix times (time_s
   // >= 1e8) aligned to 1970-01-01T00:00:00Z, so "1d" is a calendar day in UTC. A whole
-  // number of seconds, >= 1.
+  // number of seconds, from 1 to kMaxWindowS.
   double duration_s = 86400.0;
   bool IsValid(std::string* error) const;
 };

@@ -151,10 +151,13 @@ std::string WindowLabel(const WindowSpec& window, double start_s) {
 
 bool WindowSpec::IsValid(std::string* error) const {
   if (kind == Kind::kFile) return true;
-  if (std::isfinite(duration_s) && duration_s >= 1.0 && duration_s == std::floor(duration_s)) {
+  if (std::isfinite(duration_s) && duration_s >= 1.0 && duration_s == std::floor(duration_s) &&
+      duration_s <= kMaxWindowS) {
     return true;
   }
-  *error = "duration_s must be a whole number of seconds >= 1 (got " +
+  *error = "duration_s must be a whole number of seconds from 1 to " +
+           internal::FormatDouble("%.0f", kMaxWindowS) +
+           " (a year: a window is a part of a season) (got " +
            internal::FormatDouble("%g", duration_s) + ")";
   return false;
 }
@@ -186,7 +189,10 @@ bool ParseWindowSpec(const std::string& text, WindowSpec* window, std::string* e
     return bad();
   }
   w.duration_s = count * scale;
-  if (!w.IsValid(error)) return false;
+  if (std::string why; !w.IsValid(&why)) {
+    *error = "window '" + text + "': " + why;
+    return false;
+  }
   *window = w;
   return true;
 }

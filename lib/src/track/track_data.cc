@@ -3,6 +3,7 @@
 // at the end or put back as it was on failure.
 #include <fcntl.h>
 #include <sys/file.h>
+#include <sys/stat.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
@@ -10,6 +11,8 @@
 #include <cctype>
 #include <cmath>
 #include <condition_variable>
+#include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -38,7 +41,11 @@
 namespace fastcal::internal {
 
 TrackRun::Lock::~Lock() {
-  if (fd >= 0) ::close(fd);  // releases the flock
+  if (fd < 0) return;
+  // Unlinked while held: a run that opened the file meanwhile finds, once it holds the
+  // lock, that the name is no longer this file, and opens it anew (LockDirectory).
+  ::unlink(path.c_str());
+  ::close(fd);  // releases the flock
 }
 
 namespace {
@@ -83,6 +90,7 @@ std::string StateJson(const TrackRun& run) {
     j.Key("bytes").Int(f.bytes);
     j.Key("sha256").String(f.sha256);
     j.Key("samples").Int(f.samples);
+    if (!f.content.empty()) j.Key("content").String(f.content);
     if (std::isfinite(f.first_s)) {
       j.Key("first_s").ExactNumber(f.first_s);
       j.Key("last_s").ExactNumber(f.last_s);
@@ -198,7 +206,12 @@ constexpr long long kMaxStateEntries = 250000;
 
 // A file of the state.
 TrackFile ParseFile(const YAML::Node& f) {
-  TrackFile file{Text(f["path"]), Count(f["bytes"]), Text(f["sha256"]), Count(f["samples"])};
+  TrackFile file;
+  file.path = Text(f["path"]);
+  file.bytes = Count(f["bytes"]);
+  file.sha256 = Text(f["sha256"]);
+  file.samples = Count(f["samples"]);
+  if (f["content"]) file.content = Text(f["content"]);
   if (f["first_s"]) {
     file.first_s = Real(f["first_s"]);
     file.last_s = Real(f["last_s"]);
@@ -789,17 +802,68 @@ class DigestAhead {
   std::thread thread_;
 };
 
+// A file's readings without their times (issue 57: a day re-sent with its times shifted
+// by 8 h, a Beijing-time re-export, passed the SHA-256 and repeated-row checks, which
+// include the time, and was folded twice; shifted by 9 days it made a false event at
+// p = 3e-84): every sample's position, attitude as read, planned attitude, tensions,
+// lengths and joints, in order, mixed into two 64-bit lanes (a multiply and xor-shift per
+// value, each lane its own constants). Not a cryptographic digest: it tells the same
+// readings sent again, which no one forges; telemetry's noise makes two real files'
+// readings differ in the first row.
+class ContentWithoutTime {
+ public:
+  void Add(const Sample& s, int joints) {
+    for (int k = 0; k < 3; ++k) Mix(s.pose.position_m[k]);
+    for (int k = 0; k < 3; ++k) Mix(s.measured_rpy_deg[k]);
+    for (int k = 0; k < 4; ++k) Mix(s.measured_quaternion_wxyz[k]);
+    if (s.has_planned_attitude) {
+      for (int k = 0; k < 3; ++k) Mix(s.planned_rpy_deg[k]);
+    }
+    for (double t : s.tension_n) Mix(t);
+    if (s.has_unstretched_lengths) {
+      for (double l : s.unstretched_length_m) Mix(l);
+    }
+    for (int j = 0; j < joints; ++j) Mix(s.joint[j]);
+  }
+  std::string Hex() const {
+    char text[33];
+    std::snprintf(text, sizeof(text), "%016llx%016llx", static_cast<unsigned long long>(Final(a_)),
+                  static_cast<unsigned long long>(Final(b_)));
+    return text;
+  }
+
+ private:
+  void Mix(double value) {
+    std::uint64_t bits = 0;
+    std::memcpy(&bits, &value, sizeof(bits));
+    a_ = (a_ ^ bits) * 0x9E3779B97F4A7C15ULL;
+    a_ ^= a_ >> 32;
+    b_ = (b_ + bits) * 0xC2B2AE3D27D4EB4FULL;
+    b_ ^= b_ >> 29;
+  }
+  static std::uint64_t Final(std::uint64_t h) {  // splitmix64's finaliser
+    h ^= h >> 30;
+    h *= 0xBF58476D1CE4E5B9ULL;
+    h ^= h >> 27;
+    h *= 0x94D049BB133111EBULL;
+    return h ^ (h >> 31);
+  }
+  std::uint64_t a_ = 0x243F6A8885A308D3ULL, b_ = 0x13198A2E03707344ULL;
+};
+
 // The samples of file `index` (`path`) into the store, and its span and count into *file.
 bool ReadSamples(Router& router, const std::string& path, int index, const std::string& stem,
                  TrackFile* file, std::string* error) {
   TrackRun& run = router.run;
   DatasetReadOptions read = run.options.read;
-  read.joint_columns = run.model.moving_parts.JointColumns();
+  SetJointColumns(run.model.moving_parts, &read);
   read.threads = std::max(read.threads, run.options.threads);
   DatasetChunkReader reader;
   if (!reader.Open(path, read, error)) return false;
   ChunksAhead ahead(&reader);
   Dataset chunk;
+  ContentWithoutTime content;
+  const int joints = run.model.moving_parts.num_joints();
   bool done = false;
   bool scale_checked = false;
   while (!done) {
@@ -847,11 +911,13 @@ bool ReadSamples(Router& router, const std::string& path, int index, const std::
         router.relative_file = index;
       }
       if (!Route(router, s, index, stem)) return false;
+      content.Add(s, joints);
       file->first_s = std::isnan(file->first_s) ? s.time_s : std::min(file->first_s, s.time_s);
       file->last_s = std::isnan(file->last_s) ? s.time_s : std::max(file->last_s, s.time_s);
     }
     file->samples += static_cast<long long>(chunk.samples.size());
   }
+  if (file->samples > 0) file->content = content.Hex();
   return true;
 }
 
@@ -863,6 +929,20 @@ std::string CopyOf(const TrackRun& run, const TrackFile& file) {
     return file.path + ": the same data as " + f.path +
            (run.update ? ", already in the track" : ", given too") +
            " (SHA-256 of the content): each sample is folded once; drop one";
+  }
+  // The same readings at other times: a re-export in another zone, or re-stamped.
+  for (const TrackFile& f : run.files) {
+    if (file.content.empty() || f.content != file.content) continue;
+    std::string shift;
+    if (std::isfinite(f.first_s) && std::isfinite(file.first_s)) {
+      const double hours = (file.first_s - f.first_s) / 3600.0;
+      shift = ", its times shifted by " + FormatDouble("%+.6g", hours) + " h";
+      if (std::abs(hours) >= 48.0) shift += " (" + FormatDouble("%+.4g", hours / 24.0) + " d)";
+    }
+    return file.path + ": the same readings as " + f.path +
+           (run.update ? ", already in the track" : ", given too") + shift +
+           " (a re-export in another time zone, or re-stamped?): each sample is folded once; "
+           "drop one";
   }
   return "";
 }
@@ -988,29 +1068,88 @@ std::string ResolvedTrackPath(const std::string& out) {
   return ec ? p.lexically_normal().string() : resolved.string();
 }
 
+// The track `out` names, however it is spelled: its links followed, then made absolute
+// and canonical (issue 57: `--out=/p/t` and, from inside it, `--out=.` locked two
+// different files, ./..lock and /p/.t.lock, and both runs wrote the track). "" with
+// *error when it cannot be a track's directory: the root, or an existing non-directory.
+std::string TrackDirectoryOf(const std::string& out, std::string* error) {
+  std::error_code ec;
+  fs::path p = fs::absolute(fs::path(ResolvedTrackPath(out)), ec);
+  if (!ec) p = fs::weakly_canonical(p, ec);
+  if (ec) p = fs::absolute(fs::path(out)).lexically_normal();
+  if (p.filename().empty() && p.has_parent_path() && p.parent_path() != p) p = p.parent_path();
+  if (p.filename().empty() || p == p.root_path()) {
+    *error = out +
+             ": the root directory cannot hold a track; give --out=DIR, a new or empty "
+             "directory or a track";
+    return "";
+  }
+  if (fs::exists(p, ec) && !fs::is_directory(p, ec)) {
+    *error = out +
+             ": not a directory (a track is a directory: give a new or empty one, or a "
+             "track)";
+    return "";
+  }
+  return p.string();
+}
+
+// Opens and locks `path` (created if missing) into *fd. A lock whose file was unlinked
+// between the open and the lock (its holder released it) is no lock: opened again. False
+// with errno's reason in *error, or with *busy when another process holds it.
+bool LockFile(const std::string& path, int* fd, bool* busy, std::string* error) {
+  constexpr int kMaxReopens = 100;  // each reopen means another run released it meanwhile
+  *busy = false;
+  for (int attempt = 0; attempt < kMaxReopens; ++attempt) {
+    *fd = ::open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+    if (*fd < 0) {
+      *error = std::strerror(errno);
+      return false;
+    }
+    if (::flock(*fd, LOCK_EX | LOCK_NB) != 0) {
+      ::close(*fd);
+      *fd = -1;
+      *busy = true;
+      return false;
+    }
+    struct stat held {
+    }, named{};
+    if (::fstat(*fd, &held) == 0 && ::stat(path.c_str(), &named) == 0 &&
+        held.st_dev == named.st_dev && held.st_ino == named.st_ino) {
+      return true;
+    }
+    ::close(*fd);
+    *fd = -1;
+  }
+  *error = "the lock file kept being replaced";
+  return false;
+}
+
 // The exclusive lock on DIR for the run's life: a lock file beside DIR, ".NAME.lock"
-// (beside it, so that a new track's DIR, made only at the end, is locked too). A second
-// run on the same DIR is refused at once, naming it. Leftover staging directories of
-// runs that died (DIR.partial-PID) are removed once the lock is held: none is alive.
+// (beside it, so that a new track's DIR, made only at the end, is locked too), named from
+// the resolved track (TrackDirectoryOf). A second run on the same DIR is refused at once,
+// naming it. Leftover staging directories of runs that died (DIR.partial-PID) are removed
+// once the lock is held: none is alive.
 TrackStatus LockDirectory(TrackRun& run) {
   // One lock per track, however DIR is spelled: a symbolic link (even one to a DIR not yet
-  // made) or a linked parent is followed to the track itself (issue 37: two runs on `n`
-  // and on `sym -> n` both ran, and one result was lost).
-  run.out = ResolvedTrackPath(run.out);
-  fs::path out = fs::path(run.out).lexically_normal();
-  if (out.filename().empty()) out = out.parent_path();
-  const fs::path parent = out.has_parent_path() ? out.parent_path() : fs::path(".");
+  // made), a linked parent, '.', '..' or a relative path (issue 37: two runs on `n` and on
+  // `sym -> n` both ran, and one result was lost; issue 57: `.` from inside it).
+  std::string why;
+  const std::string resolved = TrackDirectoryOf(run.out, &why);
+  if (resolved.empty()) return run.Fail(TrackStatus::kInvalidInput, why);
+  run.out = resolved;
+  const fs::path out(run.out);
+  const fs::path parent = out.parent_path();
   const std::string lock = (parent / ("." + out.filename().string() + ".lock")).string();
-  run.lock.fd = ::open(lock.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
-  if (run.lock.fd < 0) {
-    return run.Fail(TrackStatus::kInvalidInput,
-                    lock + ": cannot create the track's lock: " + std::strerror(errno));
+  bool busy = false;
+  if (!LockFile(lock, &run.lock.fd, &busy, &why)) {
+    if (busy) {
+      return run.Fail(TrackStatus::kFailed,
+                      run.out + ": another fastcal track is running on it (" + lock +
+                          " is locked): wait for it to finish, or give another --out");
+    }
+    return run.Fail(TrackStatus::kInvalidInput, lock + ": cannot create the track's lock: " + why);
   }
-  if (::flock(run.lock.fd, LOCK_EX | LOCK_NB) != 0) {
-    return run.Fail(TrackStatus::kFailed,
-                    run.out + ": another fastcal track is running on it (" + lock +
-                        " is locked): wait for it to finish, or give another --out");
-  }
+  run.lock.path = lock;
   std::error_code ec;
   const std::string partial = out.filename().string() + ".partial-";
   for (const fs::directory_entry& e : fs::directory_iterator(parent, ec)) {

@@ -53,6 +53,9 @@ struct TrackFile {
   long long bytes = 0;
   std::string sha256;
   long long samples = 0;
+  // Its readings without their times, digested (ContentWithoutTime in track_data.cc): the
+  // same day re-sent with shifted times has the same ("" unknown: an older state's file).
+  std::string content;
   // Its first and last sample's time (NaN: not recorded, a state of an older version).
   double first_s = std::numeric_limits<double>::quiet_NaN();
   double last_s = std::numeric_limits<double>::quiet_NaN();
@@ -140,9 +143,12 @@ struct TrackRun {
   // Store files appended to in this run, with their size before (rolled back on failure).
   std::vector<std::pair<std::string, long long>> appended;
   // The exclusive lock on DIR for the run's whole life (issue 37): a descriptor of
-  // DIR's lock file beside it, closed (and so released) with the run.
+  // DIR's lock file beside it, named after the resolved track (issue 57). Released with
+  // the run, the file removed first (while still locked), so that no run, refused or not,
+  // leaves it behind; a run killed meanwhile leaves it, and the next one takes it.
   struct Lock {
     int fd = -1;
+    std::string path;
     ~Lock();
   } lock;
   // The solve over the used windows (indices into `windows`).
