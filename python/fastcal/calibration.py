@@ -124,8 +124,9 @@ class CalibrationResult:
         state, data, data_name = self._report
         text = _fastcal.calibration_report(state, data, kind, data_name)
         if path is not None:
-            with open(os.fspath(path), "x", encoding="utf-8") as f:  # x: never over a file
-                f.write(text)
+            # As the command line publishes: a temporary renamed into place, never over a
+            # file (FileExistsError); a failure (a full disk) leaves nothing at `path`.
+            _fastcal.write_new_file(os.fspath(path), text)
         return text
 
     def to_dataframe(self) -> Any:

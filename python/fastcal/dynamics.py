@@ -3,12 +3,14 @@ cables at one pose (the C++ library's modes.h; docs/model.md, "Vibrations")."""
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from typing import Optional, Sequence, Union
 
 import numpy as np
 
 from . import _fastcal
+from ._common import PathLike, _whole
 from ._fastcal import InputError, Model
 
 ArrayLike = Union[np.ndarray, Sequence[float]]
@@ -50,7 +52,7 @@ def modes(
     position_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,
     quat: Optional[ArrayLike] = None,
-    model: Optional[Model] = None,
+    model: Optional[Union[Model, PathLike]] = None,
     *,
     attitude_law: Optional[str] = None,
     tilt_fraction: float = 0.41,
@@ -64,15 +66,18 @@ def modes(
     Args:
         position_m: (3,) the cabin frame's origin.
         rpy_deg, quat: its attitude (at most one, or attitude_law); R = I without one.
-        model: the model (its cabin_inertia_kg_m2 among the rest); None for the nominal.
+        model: the model (its cabin_inertia_kg_m2 among the rest), or its file's path;
+            None for the nominal.
         attitude_law: "focal" for the focal law (tilt_fraction, focal_centre).
-        segments: per cable (the default puts the 20 lowest within 0.1% of converged).
-        count: how many of the lowest modes.
+        segments: per cable, 2 to 1000 (the default puts the 20 lowest within 0.1% of
+            converged; memory and time grow linearly with it).
+        count: how many of the lowest modes, 1 to 200.
         cable_inertia: False ignores the cables' inertia (the cabin on their static
             stiffness; at most six modes): a check, not the physics.
 
     Raises:
-        InputError: a wrong shape, several attitudes, bad segments or count.
+        InputError: a wrong shape, several attitudes, bad segments, count, cable_inertia or
+            model (a model file that does not load, named).
         RuntimeError: the pose has no equilibrium, or it is unstable.
     """
     position = np.asarray(position_m, dtype=np.float64)
@@ -92,16 +97,25 @@ def modes(
         kind, attitude = "rpy", np.asarray(rpy_deg, dtype=np.float64).reshape(1, -1)
     elif quat is not None:
         kind, attitude = "quat", np.asarray(quat, dtype=np.float64).reshape(1, -1)
-    for name, value in (("segments", segments), ("count", count)):
-        if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-            raise InputError(f"{name} must be a whole number, got {value!r}")
+    # Each argument checked with its name (issue 57: segments=2**31 and model='path.yaml'
+    # raised pybind11's TypeError, cable_inertia='no' was taken as True).
+    segments = _whole(segments, "segments", 2, 1000)
+    count = _whole(count, "count", 1, 200)
+    if not isinstance(cable_inertia, (bool, np.bool_)):
+        raise InputError(f"cable_inertia must be True or False, got {cable_inertia!r}")
+    if model is None:
+        model = Model.nominal()
+    elif not isinstance(model, Model):
+        if not isinstance(model, (str, os.PathLike)):
+            raise InputError(f"model must be a fastcal.Model or a model file's path, got {model!r}")
+        model = Model.load(os.fspath(model))
     out = _fastcal.modes(
-        model if model is not None else Model.nominal(),
+        model,
         position.reshape(1, 3),
         kind,
         np.ascontiguousarray(attitude),
-        int(segments),
-        int(count),
+        segments,
+        count,
         bool(cable_inertia),
     )
     return ModesResult(

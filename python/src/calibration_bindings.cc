@@ -2,6 +2,8 @@
 // values and numpy arrays, in the units of the spec and the report (tensions in kN).
 #include <pybind11/stl.h>
 
+#include <cerrno>
+#include <filesystem>
 #include <functional>
 #include <memory>
 #include <string>
@@ -13,6 +15,7 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/report.h"
 #include "fastcal/version.h"
 
@@ -370,9 +373,31 @@ py::dict SpecNoise(const CableRobot& model, const std::string& spec_path_or_text
   return d;
 }
 
+// Writes `text` to the new file `path` as the command line publishes its outputs (issue
+// 57: report_html(path) under a file-size limit left a partial file): a temporary beside
+// it, written, fsynced and renamed into place without replacing anything; a failure leaves
+// nothing. FileExistsError when `path` exists (as open(path, "x") raised), OSError with
+// the library's message otherwise (a full disk, a file-size limit).
+void WriteNewFile(const std::string& path, const std::string& text) {
+  CheckPath(path, "output");
+  std::error_code ec;
+  std::string error = path + ": exists (never written over)";
+  bool ok = !std::filesystem::exists(path, ec);
+  if (ok) {
+    py::gil_scoped_release release;
+    ok = internal::WriteFileAtomically(path, text, &error, /*replace=*/false);
+  }
+  if (ok) return;
+  PyObject* kind = std::filesystem::exists(path, ec) ? PyExc_FileExistsError : PyExc_OSError;
+  PyErr_SetObject(kind,
+                  py::make_tuple(kind == PyExc_FileExistsError ? EEXIST : EIO, error, path).ptr());
+  throw py::error_already_set();
+}
+
 }  // namespace
 
 void BindCalibration(py::module_& m) {
+  m.def("write_new_file", &WriteNewFile, py::arg("path"), py::arg("text"));
   m.def("spec_noise", &SpecNoise, py::arg("model"), py::arg("spec"), py::arg("spec_is_text"),
         py::arg("spec_source"));
   py::class_<CalibrationState, std::shared_ptr<CalibrationState>>(m, "_CalibrationState");

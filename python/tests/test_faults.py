@@ -317,3 +317,36 @@ def test_ctrl_c_stops_a_long_solve() -> None:
                          text=True, timeout=120)
     assert run.returncode == 0, run.stderr[-2000:]
     assert run.stdout.strip() == "interrupted True"
+
+
+REPORT_UNDER_A_FILE_SIZE_LIMIT = textwrap.dedent(
+    """
+    import resource, sys
+    import fastcal
+    survey = fastcal.read_dataset(sys.argv[1])
+    result = fastcal.calibrate(sys.argv[2], survey, quiet=True)
+    assert len(result.report_html()) > 4096 and len(result.report_markdown()) > 4096
+    resource.setrlimit(resource.RLIMIT_FSIZE, (4096, 4096))  # the report is far larger
+    for write in (result.report_html, result.report_markdown):
+        try:
+            write(sys.argv[3])
+            print("written")
+        except OSError as error:
+            print("refused", type(error).__name__)
+    """
+)
+
+
+def test_a_report_that_cannot_be_written_leaves_nothing(data_dir, tmp_path: pathlib.Path) -> None:
+    # Issue 57: report_html(path) and report_markdown(path) wrote in place; under a file-size
+    # limit they left a partial file at `path`. They now publish as the command line does (a
+    # temporary renamed into place): the failure is an OSError and nothing is at `path`.
+    target = tmp_path / "report.html"
+    run = subprocess.run(
+        [sys.executable, "-c", REPORT_UNDER_A_FILE_SIZE_LIMIT,
+         str(data_dir / "circle_paper.csv"), str(data_dir / "spec_mass_centre.yaml"), str(target)],
+        capture_output=True, text=True, timeout=300)
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.split("\n")[:2] == ["refused OSError", "refused OSError"], run.stdout
+    assert not target.exists()
+    assert [p.name for p in tmp_path.iterdir()] == []

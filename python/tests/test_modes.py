@@ -45,3 +45,23 @@ def test_bad_input_is_named() -> None:
         fastcal.Model.nominal().cabin_inertia_kg_m2 = (1.0, -1.0, 1.0)
     with pytest.raises(RuntimeError, match="no equilibrium"):
         fastcal.modes((0, 0, 268))
+
+
+def test_arguments_of_the_wrong_kind_are_named(tmp_path) -> None:
+    # Issue 57: segments=2**31 and model='path.yaml' raised pybind11's TypeError, and
+    # cable_inertia='no' was taken as True.
+    with pytest.raises(fastcal.InputError, match="segments must be from 2 to 1000"):
+        fastcal.modes((0, 0, 140), segments=2**31)
+    with pytest.raises(fastcal.InputError, match="count must be from 1 to 200"):
+        fastcal.modes((0, 0, 140), count=10**6)
+    with pytest.raises(fastcal.InputError, match="cable_inertia must be True or False"):
+        fastcal.modes((0, 0, 140), cable_inertia="no")
+    with pytest.raises(fastcal.InputError, match="model must be a fastcal.Model"):
+        fastcal.modes((0, 0, 140), model=42)
+    path = tmp_path / "model.yaml"
+    fastcal.Model.nominal().save(str(path))
+    by_path = fastcal.modes((0, 0, 140), model=str(path), segments=8, count=3)
+    assert by_path.frequency_hz.tolist() == fastcal.modes((0, 0, 140), segments=8, count=3).frequency_hz.tolist()
+    path.write_text("cabin:\n  inertia_kg_m2: [1e300, 1e300, 1e300]\n")
+    with pytest.raises(fastcal.InputError, match=r"cabin.inertia_kg_m2\[0\]: 1e\+300 kg m\^2"):
+        fastcal.modes((0, 0, 140), model=path)
