@@ -20,6 +20,7 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/sessions.h"
+#include "fastcal/tension_scale.h"
 #include "fastcal/time_text.h"
 #include "fastcal/version.h"
 
@@ -154,6 +155,10 @@ int RunImport(int argc, char** argv) {
   Dataset chunk;
   bool done = false;
   if (!reader.Next(kChunk, &chunk, &done, &error)) return Fail(error);
+  // The tensions' unit, on the first chunk (a slip is in every row): here, where the map's
+  // units are known, not in calibrate, which can only refuse the imported file (issue 57).
+  chunk.path = FLAGS_data;
+  if (!CheckTensionScaleOfAnyCabin(chunk, &error)) return Fail(error);
   std::vector<double> cuts;
   if (!SessionCutsFromFlag(chunk, &cuts, &error)) return Fail(error);
   const bool cut = !cuts.empty();

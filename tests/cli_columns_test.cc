@@ -281,6 +281,21 @@ TEST_F(CliColumnsTest, TensionsReadInTheWrongUnitAreRefused) {
   EXPECT_EQ(one.code, 2) << one.output;
   EXPECT_NE(one.output.find("cable 3's tensions"), std::string::npos) << one.output;
   EXPECT_FALSE(fs::exists(Path("cal")));
+  // Issue 57, 12: import, where the map's units are known, wrote both (1000x small, exit 0),
+  // and only calibrate refused the imported file. It refuses them itself, writing nothing.
+  for (const char* map_name : {"map.yaml", "one.yaml"}) {
+    const test::CommandResult imported =
+        Fastcal("import --columns=" + Path(map_name) + " --data=" + Path("s.csv") +
+                " --out=" + Path("imported.csv"));
+    EXPECT_EQ(imported.code, 2) << imported.output;
+    EXPECT_NE(imported.output.find(std::string(map_name) == "map.yaml"
+                                       ? "read 1000x small? (tensions in kN where the column "
+                                         "map says N)"
+                                       : "cable 3's tensions"),
+              std::string::npos)
+        << imported.output;
+    EXPECT_FALSE(fs::exists(Path("imported.csv")));
+  }
 }
 
 }  // namespace

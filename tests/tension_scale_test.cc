@@ -79,5 +79,30 @@ TEST(TensionScaleTest, FastsTensionsPassAndAUnitSlipIsNamed) {
   EXPECT_TRUE(CheckTensionScale(lengths, fast, &error));
 }
 
+// Issue 57, 12: import knows the map's units, not the cabin: against the lightest cabin the
+// plausibility limits allow (10 t), FAST's tensions pass at any plausible mass, a 1000x
+// slip and one column 1000x off are refused; a 9.8x slip of the whole file passes here
+// (calibrate, with its model, refuses it).
+TEST(TensionScaleTest, WithoutAModelTheLightestPlausibleCabinBoundsTheUnit) {
+  constexpr double kCableN = 180e3;
+  constexpr double kNPerTonneForce = 9806.65;
+  std::string error;
+  EXPECT_TRUE(CheckTensionScaleOfAnyCabin(Uniform(kCableN), &error)) << error;
+  // A 10 t cabin hanging nearly vertically: its six tensions sum to about its weight.
+  EXPECT_TRUE(CheckTensionScaleOfAnyCabin(Uniform(1e4 * 9.8 / 6.0), &error)) << error;
+  EXPECT_FALSE(CheckTensionScaleOfAnyCabin(Uniform(kCableN / 1e3), &error));
+  EXPECT_NE(error.find("where the lightest plausible cabin's weight alone (10000 kg, 98 kN)"),
+            std::string::npos)
+      << error;
+  EXPECT_NE(error.find("read 1000x small? (tensions in kN where the column map says N)"),
+            std::string::npos)
+      << error;
+  Dataset one = Uniform(kCableN);
+  for (Sample& s : one.samples) s.tension_n[2] /= 1e3;
+  EXPECT_FALSE(CheckTensionScaleOfAnyCabin(one, &error));
+  EXPECT_NE(error.find("cable 3's tensions"), std::string::npos) << error;
+  EXPECT_TRUE(CheckTensionScaleOfAnyCabin(Uniform(kCableN / kNPerTonneForce * 1e3), &error));
+}
+
 }  // namespace
 }  // namespace fastcal

@@ -25,6 +25,14 @@ inline constexpr double kMinWeightFraction = 0.8;
 inline constexpr double kMaxWeightMultiple = 30.0;
 bool CheckTensionScale(const Dataset& data, const CableRobot& model, std::string* error);
 
+// The same where the cabin is not known (`fastcal import`, where the map's units are known
+// and the model is not; issue 57: an export in kN under a map declaring N was written,
+// 1000x small, exit 0): against the lightest cabin the plausibility limits allow (10 t,
+// 98 kN), which still tells a 1000x slip (FAST's six tensions sum to about 1000 kN: 1 kN
+// read 1000x small) and one column 30x off the others, but not a 9.8x slip of the whole
+// file (calibrate, evaluate and track tell it against their model's cabin).
+bool CheckTensionScaleOfAnyCabin(const Dataset& data, std::string* error);
+
 }  // namespace fastcal
 
 #endif  // FASTCAL_TENSION_SCALE_H_

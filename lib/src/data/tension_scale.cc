@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "fastcal/internal/number_text.h"
+#include "fastcal/plausibility.h"
 
 namespace fastcal {
 
@@ -27,7 +28,7 @@ std::string Where(const Dataset& data) {
 }
 
 // The whole sample's check: the median sum of the six against the weight.
-bool CheckSum(const Dataset& data, const CableRobot& model, std::string* error) {
+bool CheckSum(const Dataset& data, const CableRobot& model, const char* whose, std::string* error) {
   std::vector<double> sums;
   sums.reserve(data.samples.size());
   for (const Sample& s : data.samples) {
@@ -46,10 +47,10 @@ bool CheckSum(const Dataset& data, const CableRobot& model, std::string* error) 
   // Read 1000x small: the file's kN declared N (its 180 read as 180 N); 1000x large: N
   // declared kN.
   *error = Where(data) + ": the six tensions sum to " +
-           internal::FormatDouble("%.4g", median_n / 1e3) +
-           " kN a sample (median), where the cabin's weight alone (" +
-           internal::FormatDouble("%.4g", model.cabin_mass_kg) + " kg, " +
-           internal::FormatDouble("%.4g", weight_n / 1e3) + " kN) needs at least that much: " +
+           internal::FormatDouble("%.4g", median_n / 1e3) + " kN a sample (median), where " +
+           whose + " weight alone (" + internal::FormatDouble("%.6g", model.cabin_mass_kg) +
+           " kg, " + internal::FormatDouble("%.4g", weight_n / 1e3) +
+           " kN) needs at least that much: " +
            (!small && plausible(median_n / 1e3)
                 ? "read 1000x large? (tensions in N where the column map says kN)"
             : !small && plausible(median_n / kNPerKgf)
@@ -109,7 +110,15 @@ bool CheckEachCable(const Dataset& data, std::string* error) {
 bool CheckTensionScale(const Dataset& data, const CableRobot& model, std::string* error) {
   if (!data.has_tensions || data.samples.empty()) return true;
   // The cable first: one column slipped 1000x large makes the sum implausible too.
-  return CheckEachCable(data, error) && CheckSum(data, model, error);
+  return CheckEachCable(data, error) && CheckSum(data, model, "the cabin's", error);
+}
+
+bool CheckTensionScaleOfAnyCabin(const Dataset& data, std::string* error) {
+  if (!data.has_tensions || data.samples.empty()) return true;
+  CableRobot lightest = CableRobot::NominalFast();
+  lightest.cabin_mass_kg = PlausibilityLimits().min_cabin_mass_kg;
+  return CheckEachCable(data, error) &&
+         CheckSum(data, lightest, "the lightest plausible cabin's", error);
 }
 
 }  // namespace fastcal
