@@ -61,9 +61,12 @@ Usage:
                       own time line; two need --window=file)
   --out=DIR           the track: a new or empty directory, or a track built before, which
                       is then updated with the files it does not hold yet (the old windows'
-                      folds are kept: only windows that gained samples are folded)
+                      folds are kept: only windows that gained samples are folded); one run
+                      at a time, however DIR is spelled (its lock .DIR.lock beside it, gone
+                      when the run ends)
   --window=1d         windows: a calendar day in UTC (1d), another duration aligned to
-                      1970-01-01T00:00Z (12h, 30m, 3600s, 7d), or 'file' (one per file)
+                      1970-01-01T00:00Z (12h, 30m, 3600s, 7d, at most 366d), or 'file' (one
+                      per file)
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
   --columns=MAP.yaml  read every data file as exported, through a column map (ISO 8601
                       times, units, delimiters: docs/data-format.md, "Column maps"); an
