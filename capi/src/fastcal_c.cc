@@ -488,16 +488,21 @@ int fastcal_locate_winch(fastcal_solver* s, const double winch_length_m[6], cons
 
 int fastcal_cabin_pose(fastcal_solver* s, const double position_m[3], const double rpy_deg[3],
                        const double* joints, double cabin_position_m[3], double cabin_rpy_deg[3]) {
+  // Inputs copied before the outputs are zeroed: the outputs may alias them (issue 57).
+  const InputCopy<3> position(position_m), rpy(rpy_deg);
+  const InputCopy<FASTCAL_MAX_JOINTS> joint_copy(joints, JointsOf(s));
   Zero(cabin_position_m, 3);
   Zero(cabin_rpy_deg, 3);
-  if (const int e = Enter(s, position_m && rpy_deg && cabin_position_m && cabin_rpy_deg); e != 0) {
+  const Claim claim(s);
+  if (const int e = Enter(s, claim, position.p && rpy.p && cabin_position_m && cabin_rpy_deg);
+      e != 0) {
     return e;
   }
   try {
-    if (const int status = CheckPose(s, position_m, rpy_deg); status != FASTCAL_OK) return status;
+    if (const int status = CheckPose(s, position.p, rpy.p); status != FASTCAL_OK) return status;
     JointValues q;
-    if (const int status = ReadJoints(s, joints, &q); status != FASTCAL_OK) return status;
-    const fastcal::Pose cabin = s->robot.CabinPose(PoseOf(position_m, rpy_deg), q);
+    if (const int status = ReadJoints(s, joint_copy.p, &q); status != FASTCAL_OK) return status;
+    const fastcal::Pose cabin = s->robot.CabinPose(PoseOf(position.p, rpy.p), q);
     const Eigen::Vector3d rpy = fastcal::RpyDegFromRotation(cabin.rotation);
     for (int k = 0; k < 3; ++k) {
       cabin_position_m[k] = cabin.position_m[k];
