@@ -106,7 +106,9 @@ struct TrackOptions {
   // Null: fold on this machine's threads.
   FoldRunner runner;
   // How the data files are read (DatasetReadOptions: skip_invalid_rows, limits, a
-  // column map). Each file is streamed a chunk at a time into the window store, so that
+  // column map). skip_invalid_rows also leaves out the samples the initial model cannot
+  // solve (as calibrate's), named in the notes; without it such a sample stops the run
+  // naming its file, line and why. Each file is streamed a chunk at a time into the window store, so that
   // a season in one long file is read with bounded memory: files up to 1 TiB (not
   // ReadDataset's 1 GiB).
   DatasetReadOptions read = [] {
