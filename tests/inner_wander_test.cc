@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Cholesky>
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -71,7 +72,7 @@ struct Season {
 };
 
 Season DrawSeason(int windows, int blocks, int p, const Eigen::VectorXd& q, double tau,
-                  double white, unsigned seed, int step_window = -1,
+                  double white, unsigned seed, const std::vector<int>& step_windows = {},
                   const Eigen::VectorXd& step = Eigen::VectorXd()) {
   std::mt19937_64 rng(seed);
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -100,7 +101,9 @@ Season DrawSeason(int windows, int blocks, int p, const Eigen::VectorXd& q, doub
       }
       win.last_s.push_back(time + kBlockS);
       time += kBlockS + kGapS;
-      if (w == step_window && b >= blocks / 2) mean += step;
+      const bool stepped =
+          std::find(step_windows.begin(), step_windows.end(), w) != step_windows.end();
+      if (stepped && b >= blocks / 2) mean += step;
       Eigen::MatrixXd a(p, p);
       for (int i = 0; i < p * p; ++i) a.data()[i] = 0.3 * normal(rng);
       Eigen::MatrixXd info = Eigen::MatrixXd::Identity(p, p) + a * a.transpose();
@@ -170,7 +173,7 @@ TEST(InnerWanderTest, WhiteScoresShowLittleWander) {
 TEST(InnerWanderTest, AWindowWithAStepInsideIsLeftOut) {
   const Eigen::Vector2d q(4e-4, 1e-4);
   const Eigen::Vector2d step(0.3, -0.2);  // 15 and 20 sigma of the process
-  const Season season = DrawSeason(40, 32, 2, q, 900.0, 1.0, 11, 17, step);
+  const Season season = DrawSeason(40, 32, 2, q, 900.0, 1.0, 11, {17}, step);
   const InnerWander w = EstimateInnerWander(season.windows);
   ASSERT_EQ(w.windows_left_out.size(), 1u);
   EXPECT_EQ(w.windows_left_out[0], 17);
@@ -181,6 +184,55 @@ TEST(InnerWanderTest, AWindowWithAStepInsideIsLeftOut) {
   const InnerWander m = EstimateInnerWander(marked.windows);
   EXPECT_TRUE(m.windows_left_out.empty());
   for (int k = 0; k < 2; ++k) EXPECT_NEAR(m.variance[k], w.variance[k], 1e-6 * q[k]);
+}
+
+// When the wander is everywhere (most windows beyond the white model), steps inside
+// several windows are still left out and the wander is the rest's. (The estimate that
+// judges them is made over the half the white model explains best, issue 53; on these
+// draws one over all the windows judges the same, it is the study's seasons with moving
+// parts that told them apart.)
+TEST(InnerWanderTest, StepsInsideAFewWindowsDoNotSetAWanderThatIsEverywhere) {
+  const Eigen::Vector2d q(4e-4, 1e-4);     // the blocks' scores 4x their white variance
+  const Eigen::Vector2d step(0.15, -0.1);  // 7.5 and 10 sigma of the process
+  const std::vector<int> stepped = {2, 5, 8, 11, 14, 17};
+  const Season season = DrawSeason(20, 32, 2, q, 900.0, 1.0, 5, stepped, step);
+  const InnerWander w = EstimateInnerWander(season.windows);
+  EXPECT_EQ(w.windows_left_out, stepped);
+  for (int k = 0; k < 2; ++k) EXPECT_NEAR(w.variance[k], q[k], 2.0 * kVarianceTolerance * q[k]);
+}
+
+// A time constant beyond the windows' span is not searched: inside a window it cannot be
+// told from a drift across it on top of an offset of the window, and the offset is the
+// wander between windows' (issue 53: with moving parts, a smooth drift of the apparent
+// mass centre inside each day read as a wander of 2 cm over 20 hours). Here each window
+// drifts linearly by 2 cm across it (a random direction), on white scores.
+TEST(InnerWanderTest, ADriftAcrossEachWindowIsNotAWanderOfDays) {
+  Season season = DrawSeason(30, 32, 2, Eigen::Vector2d::Zero(), 600.0, 1.0, 3);
+  std::mt19937_64 rng(4);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  double span_s = 0.0;
+  for (WanderWindow& w : season.windows) {
+    const double t0 = w.first_s.front(), t1 = w.last_s.back();
+    span_s = std::max(span_s, t1 - t0);
+    const Eigen::Vector2d drift = 0.02 * Eigen::Vector2d(normal(rng), normal(rng)).normalized();
+    Eigen::MatrixXd total = Eigen::MatrixXd::Zero(2, 2);
+    Eigen::VectorXd sum = Eigen::VectorXd::Zero(2);
+    for (size_t b = 0; b < w.info.size(); ++b) {
+      const double mid = 0.5 * (w.first_s[b] + w.last_s[b]);
+      const Eigen::Vector2d at = drift * ((mid - t0) / (t1 - t0) - 0.5);
+      w.score.row(b) += (w.info[b] * at).transpose();
+      total += w.info[b];
+      sum += w.score.row(b).transpose();
+    }
+    const Eigen::VectorXd fitted = total.ldlt().solve(sum);
+    for (size_t b = 0; b < w.info.size(); ++b) w.score.row(b) -= (w.info[b] * fitted).transpose();
+  }
+  const InnerWander w = EstimateInnerWander(season.windows);
+  ASSERT_TRUE(w.Active());
+  EXPECT_LE(w.time_constant_s, span_s * (1.0 + 1e-9));
+  // The drift's own size, not a wander of days: a process of tau <= the window whose
+  // changes across it are the drift's 2 cm (its rms per axis ~1.4 cm) is of that order.
+  for (int k = 0; k < 2; ++k) EXPECT_LT(std::sqrt(w.variance[k]), 0.02) << "component " << k;
 }
 
 TEST(InnerWanderTest, NoBlocksNoWander) {
