@@ -28,6 +28,8 @@ int RunDesign(int argc, char** argv);
 int RunImport(int argc, char** argv);
 int RunTrack(int argc, char** argv);
 int RunModes(int argc, char** argv);
+// `fastcal dynamics` (dynamics_command.cc).
+int RunDynamicsCommand(int argc, char** argv);
 // modes --data: the identified modes of a record against the prediction (modes_identify.cc).
 int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool to_file);
 // simulate --vibration (simulate_vibration.cc): its flags, and the run after StartCommand.
