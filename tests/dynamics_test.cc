@@ -10,7 +10,10 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <iostream>
 #include <memory>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -23,6 +26,14 @@ namespace fastcal {
 namespace {
 
 using testing::FocalSpherePose;
+
+// A measured figure on stdout, for docs/model.md ("Dynamics", the checks).
+void Figure(const std::string& text) { std::cout << "[ figure   ] " << text << std::endl; }
+std::string Num(double v) {
+  std::ostringstream s;
+  s << std::setprecision(3) << v;
+  return s.str();
+}
 
 std::unique_ptr<CableDynamics> Make(const Pose& pose, const DynamicsOptions& options,
                                     double duration_s = 400.0) {
@@ -86,6 +97,9 @@ TEST(CableDynamics, StaticEquilibriumIsAFixedPoint) {
       }
     });
     EXPECT_LT(drift, kDriftM) << pose.position_m.transpose();
+    Figure("fixed point at z = " + Num(pose.position_m.z()) + " m: drift " + Num(drift) +
+           " m, tensions " + Num(tension_drift) + ", start offset " +
+           Num(d->start().position_offset_m) + " m, " + Num(d->start().tension_offset));
     EXPECT_LT(tension_drift, kTensionDrift);
     EXPECT_EQ(d->stats().halvings, 0);
   }
@@ -116,6 +130,7 @@ TEST(CableDynamics, EnergyConservedWithoutDamping) {
     largest_kinetic = std::max(largest_kinetic, d->Energy().kinetic_j);
   });
   EXPECT_LT(worst, kEnergy);
+  Figure("energy: " + Num(start) + " J given, largest relative change " + Num(worst));
   EXPECT_GT(largest_kinetic, 0.5 * start);  // it did move
 
   options = DynamicsOptions();  // damped: 0.004 on the lowest mode, drag
@@ -207,6 +222,10 @@ TEST(CableDynamics, FreeDecayFrequenciesAgreeWithModes) {
     ModesResult predicted;
     std::string error;
     ASSERT_TRUE(ComputeModes(CableRobot::NominalFast(), pose, modes_options, &predicted, &error));
+    Figure(std::to_string(c.zenith_deg) + " deg mode " + std::to_string(c.mode) + ": " +
+           Num(decay.frequency_hz) + " Hz, modes " + Num(predicted.modes[c.mode - 1].frequency_hz) +
+           ", relative " +
+           Num(decay.frequency_hz / predicted.modes[c.mode - 1].frequency_hz - 1.0));
     EXPECT_NEAR(decay.frequency_hz / predicted.modes[c.mode - 1].frequency_hz, 1.0, kFrequency)
         << c.zenith_deg << " deg, mode " << c.mode << ", channel " << decay.channel;
   }
@@ -232,6 +251,9 @@ TEST(CableDynamics, FreeDecayDampingAsStated) {
     ASSERT_TRUE(d);
     const std::string where = std::to_string(c.zenith_deg) + " deg, mode " + std::to_string(c.mode);
     EXPECT_NEAR(decay.damping_ratio / d->start().damping_ratio[c.mode - 1], 1.0, kEach) << where;
+    Figure(where + ": zeta " + Num(decay.damping_ratio) + " against " +
+           Num(d->start().damping_ratio[c.mode - 1]) + " (first order); f " +
+           Num(decay.frequency_hz) + " Hz, undamped " + Num(d->start().frequency_hz[c.mode - 1]));
     if (c.mode == 1) {
       EXPECT_NEAR(decay.damping_ratio / options.damping_ratio, 1.0, kLowest) << where;
     }
@@ -257,6 +279,8 @@ TEST(CableDynamics, ConvergesInStepAndSegments) {
   std::vector<double> x;
   for (double h : {0.04, 0.02, 0.01}) x.push_back(x_at_30(h));
   EXPECT_NEAR((x[0] - x[1]) / (x[1] - x[2]), 4.0, kOrder);
+  Figure("step ratio " + Num((x[0] - x[1]) / (x[1] - x[2])) + ", x(30 s) change at 20 ms " +
+         Num(x[1] - x[2]) + " m");
   std::vector<double> f;
   for (int n : {10, 20, 40}) {
     DynamicsOptions options;
@@ -264,6 +288,7 @@ TEST(CableDynamics, ConvergesInStepAndSegments) {
     f.push_back(Make(FocalSpherePose(0.0, 0.0), options, 1.0)->start().frequency_hz[0]);
   }
   EXPECT_NEAR((f[1] - f[0]) / (f[2] - f[1]), 4.0, kOrder);
+  Figure("segments ratio " + Num((f[1] - f[0]) / (f[2] - f[1])));
 }
 
 // A taut cable between fixed points (gravity 1e-3 of the Earth's: straight to 1e-7),
@@ -313,6 +338,9 @@ TEST(FixedCableDynamics, TautStringAndBarWaves) {
     const double x = c.harmonic * M_PI / (2.0 * kSegments);
     const double chain_hz = c.continuum_hz * std::sin(x) / x;
     EXPECT_NEAR(measured / chain_hz, 1.0, kChain) << c.harmonic;
+    Figure(std::string(c.kind == FixedCableRelease::Kind::kAxial ? "axial" : "transverse") +
+           " n = " + std::to_string(c.harmonic) + ": " + Num(measured) + " Hz, chain " +
+           Num(measured / chain_hz - 1.0) + ", continuum " + Num(measured / c.continuum_hz - 1.0));
     EXPECT_NEAR(measured / c.continuum_hz, 1.0, x * x / 6.0 + kChain) << c.harmonic;
   }
 }
