@@ -134,23 +134,7 @@ bool OptionsFromFlags(DynamicsOptions* o, std::string* error) {
       return false;
     }
   }
-  if (!FLAGS_wind.empty()) {
-    std::vector<double> wind;
-    if (!ParseNumberList("wind", FLAGS_wind, &wind, error)) return false;
-    if (wind.size() != 2) {
-      *error = "--wind=" + FLAGS_wind + ": give SPEED,DIRECTION_DEG (m/s, deg)";
-      return false;
-    }
-    o->wind.mean_speed_m_per_s = wind[0];
-    o->wind.direction_deg = wind[1];
-  }
-  if (!ParseGustSpectrum(FLAGS_gust_spectrum, &o->wind.spectrum)) {
-    *error =
-        "--gust-spectrum must be kaimal or davenport, got " + internal::Quote(FLAGS_gust_spectrum);
-    return false;
-  }
-  o->wind.turbulence_intensity = FLAGS_turbulence_intensity;
-  o->wind.seed = FLAGS_seed;
+  if (!WindFromFlags(&o->wind, error)) return false;
   if (o->IsValid(error)) return true;
   *error = WithFlagNames(*error, {{"segments", "--segments"},
                                   {"damping_ratio", "--damping-ratio"},
@@ -335,6 +319,27 @@ bool CheckOutputs(bool to_file, std::string* error) {
 }
 
 }  // namespace
+
+bool WindFromFlags(WindOptions* wind, std::string* error) {
+  if (!FLAGS_wind.empty()) {
+    std::vector<double> v;
+    if (!ParseNumberList("wind", FLAGS_wind, &v, error)) return false;
+    if (v.size() != 2) {
+      *error = "--wind=" + FLAGS_wind + ": give SPEED,DIRECTION_DEG (m/s, deg)";
+      return false;
+    }
+    wind->mean_speed_m_per_s = v[0];
+    wind->direction_deg = v[1];
+  }
+  if (!ParseGustSpectrum(FLAGS_gust_spectrum, &wind->spectrum)) {
+    *error =
+        "--gust-spectrum must be kaimal or davenport, got " + internal::Quote(FLAGS_gust_spectrum);
+    return false;
+  }
+  wind->turbulence_intensity = FLAGS_turbulence_intensity;
+  wind->seed = FLAGS_seed;
+  return true;
+}
 
 int RunDynamicsCommand(int argc, char** argv) {
   int exit_code = 0;

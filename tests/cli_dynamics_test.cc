@@ -112,5 +112,36 @@ TEST_F(CliTest, DynamicsRefusesBadInput) {
   EXPECT_FALSE(std::filesystem::exists(Path("never.csv")));
 }
 
+// simulate --dynamics: a survey flown in time, written as a dataset calibrate reads; its
+// flags refused without it, and what it excludes refused with it.
+TEST_F(CliTest, SimulateFliesASurveyInTime) {
+  const std::string out = Path("flown.csv");
+  const CommandResult r = Fastcal(
+      "simulate --dynamics --trajectory=line --from=0,0,140 --to=6,0,140 --nodes=3 "
+      "--segments=12 --wait-s=5 --min-move-s=15 --wind=3,0 --seed=2 --out=" +
+      out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("flown in time (--dynamics): 40 s"), std::string::npos) << r.output;
+  std::istringstream lines(ReadFile(out));
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) {
+    if (!line.empty() && line[0] != '#') rows.push_back(line);
+  }
+  ASSERT_EQ(rows.size(), 4u);  // the header and three samples
+  EXPECT_EQ(CsvFields(rows[0])[0], "time_s");
+  EXPECT_EQ(CsvFields(rows[2])[0], "20");
+  EXPECT_EQ(CsvFields(rows[3])[0], "40");
+  RunBoundedAndExpect(
+      {"simulate --trajectory=random --samples=3 --wait-s=5 --out=" + Path("never.csv"), 2,
+       "--wait-s applies to --dynamics only"});
+  RunBoundedAndExpect(
+      {"simulate --dynamics --trajectory=random --samples=3 "
+       "--mass-centre-drift-m=0.01 --out=" +
+           Path("never.csv"),
+       2, "--dynamics"});
+  EXPECT_FALSE(std::filesystem::exists(Path("never.csv")));
+}
+
 }  // namespace
 }  // namespace fastcal::test

@@ -135,6 +135,10 @@ std::string DynamicsSummaryJson(const DynamicsRunResult& result);
 
 // The minimum-jerk fraction s(u) for u in [0, 1] (0 before, 1 after).
 double MinimumJerk(double u);
+// The pose a fraction `u` (0..1) of the way through a minimum-jerk move from `from` to
+// `to`: the position by s(u); the attitude the focal law's there when `law` is given,
+// else turned from from's toward to's by s(u) of their relative rotation.
+Pose MinimumJerkPose(const Pose& from, const Pose& to, double u, const FocalAttitudeLaw* law);
 
 }  // namespace fastcal
 

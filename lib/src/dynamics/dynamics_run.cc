@@ -46,16 +46,8 @@ std::vector<std::string> Fields(const std::string& line) {
 
 // The pose of a move at time t (dynamics_run.h).
 Pose MovePose(const DynamicsRunSpec& spec, double t) {
-  const double s = MinimumJerk(t / spec.move_s);
-  Pose p;
-  p.position_m = spec.start.position_m + s * (spec.end.position_m - spec.start.position_m);
-  if (spec.focal_law) {
-    p.rotation = FocalAttitude(p.position_m, *spec.focal_law);
-  } else {
-    const Eigen::AngleAxisd turn(spec.end.rotation * spec.start.rotation.transpose());
-    p.rotation = Eigen::AngleAxisd(s * turn.angle(), turn.axis()) * spec.start.rotation;
-  }
-  return p;
+  return MinimumJerkPose(spec.start, spec.end, t / spec.move_s,
+                         spec.focal_law ? &*spec.focal_law : nullptr);
 }
 
 std::string DescribePose(const Pose& p) {
@@ -233,6 +225,19 @@ double MinimumJerk(double u) {
   if (!(u > 0.0)) return 0.0;
   if (u >= 1.0) return 1.0;
   return u * u * u * (10.0 + u * (-15.0 + 6.0 * u));
+}
+
+Pose MinimumJerkPose(const Pose& from, const Pose& to, double u, const FocalAttitudeLaw* law) {
+  const double s = MinimumJerk(u);
+  Pose p;
+  p.position_m = from.position_m + s * (to.position_m - from.position_m);
+  if (law != nullptr) {
+    p.rotation = FocalAttitude(p.position_m, *law);
+  } else {
+    const Eigen::AngleAxisd turn(to.rotation * from.rotation.transpose());
+    p.rotation = Eigen::AngleAxisd(s * turn.angle(), turn.axis()) * from.rotation;
+  }
+  return p;
 }
 
 bool ParseWinchTable(const std::string& text, const std::string& source_name, WinchTable* table,
