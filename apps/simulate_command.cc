@@ -864,7 +864,9 @@ int RunSimulate(int argc, char** argv) {
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
   for (const std::string& flag : kFlags) {
     const bool dynamics = SimulateDynamicsFlags().count(flag) > 0;
-    if (FlagGiven(flag) && dynamics && !FLAGS_dynamics) {
+    // --segments is --vibration's too (the modes' segments).
+    const bool shared = FLAGS_vibration && VibrationFlags().count(flag) > 0;
+    if (FlagGiven(flag) && dynamics && !FLAGS_dynamics && !shared) {
       PrintError(kCommand, "--" + flag + " applies to --dynamics only");
       return kExitUsage;
     }
