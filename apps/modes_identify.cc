@@ -1,6 +1,7 @@
-// `fastcal modes --data=FILE`: the dominant modes of a record of the cabin's free
-// vibration (ERA, modal_identification.h), compared with the prediction at the record's
-// pose, and what the differences point to.
+// `fastcal modes --data=FILE`: the dominant modes of a record of the cabin's vibration,
+// free (ERA, modal_identification.h) or ambient (SSI-cov, subspace_identification.h; by
+// --identification, or chosen by the record's envelope: a falling one is a free decay),
+// compared with the prediction at the record's pose, and what the differences point to.
 #include <gflags/gflags.h>
 
 #include <algorithm>
@@ -14,12 +15,17 @@
 #include "fastcal/dataset.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/modal_identification.h"
+#include "fastcal/subspace_identification.h"
 
 DECLARE_string(data);
 DECLARE_string(output);
 DECLARE_bool(force);
 
 DEFINE_int32(identified_modes, 3, "modes --data: how many dominant modes to identify.");
+DEFINE_string(identification, "auto",
+              "modes --data: era (a free decay) | ssi (an ambient record) | auto (era when "
+              "the record's envelope falls by 4x in mean square from its first quarter to its "
+              "last, else ssi).");
 
 namespace fastcal::cli {
 namespace {
@@ -91,9 +97,11 @@ std::string ComparisonCsv(const ModesComparisonResult& r) {
   return out.str();
 }
 
-std::string ComparisonSummary(const ModesComparisonResult& r, const Pose& pose) {
+std::string ComparisonSummary(const ModesComparisonResult& r, const Pose& pose,
+                              const std::string& method) {
   std::ostringstream s;
-  s << "fastcal modes --data: " << r.modes.size() << " modes identified (ERA), predicted at the "
+  s << "fastcal modes --data: " << r.modes.size() << " modes identified (" << method
+    << "), predicted at the "
     << "record's mean pose (" << FormatDouble(pose.position_m.x(), 5) << ", "
     << FormatDouble(pose.position_m.y(), 5) << ", " << FormatDouble(pose.position_m.z(), 5)
     << ") m";
@@ -132,22 +140,47 @@ int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool 
       return kExitUsage;
     }
   }
+  if (FLAGS_identification != "auto" && FLAGS_identification != "era" &&
+      FLAGS_identification != "ssi") {
+    PrintError(kCommand, "--identification=" + FLAGS_identification +
+                             ": must be era (a free decay), ssi (an ambient record) or auto");
+    return kExitUsage;
+  }
   DatasetReadOptions read;
   Dataset data;
   VibrationRecord record;
   Pose pose;
   EraOptions era;
-  era.modes = FLAGS_identified_modes;
-  if (!era.IsValid(&error) || !ColumnsFromFlag(&read.columns, &error) ||
+  SsiOptions ssi;
+  era.modes = ssi.modes = FLAGS_identified_modes;
+  if (!era.IsValid(&error) || !ssi.IsValid(&error) || !ColumnsFromFlag(&read.columns, &error) ||
       !ReadDataset(FLAGS_data, read, &data, &error) ||
       !RecordFromDataset(data, &record, &pose, &error)) {
     PrintError(kCommand, WithFlagNames(error, {{"modes", "--identified-modes"}}));
     return kExitUsage;
   }
+  std::string method = FLAGS_identification;
+  const double decay = EnvelopeDecayRatio(record);
+  if (method == "auto") method = decay >= kFreeDecayRatio ? "era" : "ssi";
+  const std::string described =
+      (method == "era" ? "ERA" : "SSI-cov") +
+      (FLAGS_identification == "auto"
+           ? std::string(", chosen: the envelope's mean square falls ") + FormatDouble(decay, 3) +
+                 "x from the first quarter to the last, " +
+                 (method == "era" ? "a free decay" : "an ambient record") + " (era from " +
+                 FormatDouble(kFreeDecayRatio, 2) + "x)"
+           : std::string());
   std::vector<IdentifiedMode> identified;
   ModesComparisonResult comparison;
-  if (!IdentifyModesEra(record, era, &identified, &error) ||
-      !CompareWithPrediction(robot, pose, identified, options, &comparison, &error)) {
+  const bool found = method == "era" ? IdentifyModesEra(record, era, &identified, &error)
+                                     : IdentifyModesSsi(record, ssi, &identified, &error);
+  if (!found) {
+    PrintError(kCommand, "--data=" + FLAGS_data + ": " + described + ": " + error +
+                             " (--identified-modes=" + std::to_string(FLAGS_identified_modes) +
+                             ")");
+    return kExitFailure;
+  }
+  if (!CompareWithPrediction(robot, pose, identified, options, &comparison, &error)) {
     PrintError(kCommand, error);
     return kExitFailure;
   }
@@ -155,7 +188,7 @@ int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool 
     PrintError(kCommand, error);
     return kExitFailure;
   }
-  (to_file ? std::cout : std::cerr) << ComparisonSummary(comparison, pose) << std::endl;
+  (to_file ? std::cout : std::cerr) << ComparisonSummary(comparison, pose, described) << std::endl;
   return 0;
 }
 

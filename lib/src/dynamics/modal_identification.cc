@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "dynamics/record_preparation.h"
 #include "fastcal/catenary.h"
 #include "fastcal/statics.h"
 
@@ -167,24 +168,6 @@ bool EraOptions::IsValid(std::string* error) const {
   return true;
 }
 
-namespace {
-
-// The record averaged over blocks of `factor` samples, each channel centred and scaled by
-// its spread (metres, degrees and kN then weigh alike).
-Eigen::MatrixXd Prepare(const Eigen::MatrixXd& channels, int factor) {
-  const int n = static_cast<int>(channels.cols()) / factor;
-  Eigen::MatrixXd y(channels.rows(), n);
-  for (int k = 0; k < n; ++k) y.col(k) = channels.middleCols(k * factor, factor).rowwise().mean();
-  y = y.colwise() - y.rowwise().mean();
-  for (int c = 0; c < y.rows(); ++c) {
-    const double spread = std::sqrt(y.row(c).squaredNorm() / n);
-    if (spread > 0.0) y.row(c) /= spread;
-  }
-  return y;
-}
-
-}  // namespace
-
 bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
                       std::vector<IdentifiedMode>* modes, std::string* error) {
   if (!options.IsValid(error)) return false;
@@ -193,8 +176,7 @@ bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
     *error = "record: needs at least one channel, finite samples and sample_interval_s > 0";
     return false;
   }
-  const int factor = std::max(
-      1, static_cast<int>(1.0 / (4.0 * options.max_frequency_hz * record.sample_interval_s)));
+  const int factor = internal::DecimationFactor(record.sample_interval_s, options.max_frequency_hz);
   const double dt = factor * record.sample_interval_s;
   const int n = static_cast<int>(record.channels.cols()) / factor;
   const int order = 2 * options.modes + options.extra_order;
@@ -210,7 +192,7 @@ bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
              " s (two periods of min_frequency_hz): need four times as long";
     return false;
   }
-  const Eigen::MatrixXd y = Prepare(record.channels, factor);
+  const Eigen::MatrixXd y = internal::DecimatedScaled(record.channels, factor);
   const std::vector<Pole> poles = Identify(y, dt, options, rows);
   if (static_cast<int>(poles.size()) < options.modes) {
     *error = "found " + std::to_string(poles.size()) + " damped modes, fewer than the " +
@@ -228,6 +210,14 @@ bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
     return a.frequency_hz < b.frequency_hz;
   });
   return true;
+}
+
+double EnvelopeDecayRatio(const VibrationRecord& record) {
+  const Eigen::Index quarter = record.channels.cols() / 4;
+  if (quarter < 1 || record.channels.rows() < 1) return 1.0;
+  const Eigen::MatrixXd y = internal::DecimatedScaled(record.channels, 1);
+  const double last = y.rightCols(quarter).squaredNorm();
+  return last > 0.0 ? y.leftCols(quarter).squaredNorm() / last : 1.0;
 }
 
 bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::string* error) {
