@@ -14,6 +14,7 @@
 #include "fastcal/simulation.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
+#include "fastcal/wind.h"
 #include "fastcal/workspace.h"
 
 namespace fastcal::cli {
@@ -28,11 +29,21 @@ int RunDesign(int argc, char** argv);
 int RunImport(int argc, char** argv);
 int RunTrack(int argc, char** argv);
 int RunModes(int argc, char** argv);
+// `fastcal dynamics` (dynamics_command.cc).
+int RunDynamicsCommand(int argc, char** argv);
+// The wind from --wind=SPEED,DIRECTION_DEG, --gust-spectrum, --turbulence-intensity and
+// --seed (dynamics, simulate --dynamics); false with the flag named.
+bool WindFromFlags(WindOptions* wind, std::string* error);
 // modes --data: the identified modes of a record against the prediction (modes_identify.cc).
 int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool to_file);
 // simulate --vibration (simulate_vibration.cc): its flags, and the run after StartCommand.
 const std::set<std::string>& VibrationFlags();
 int RunSimulateVibration(int argc, char** argv);
+// simulate --dynamics (simulate_dynamics.cc): its flags, and the flight's source put into
+// *options from the poses to fly (a copy of the stream is drawn); *note for the summary.
+const std::set<std::string>& SimulateDynamicsFlags();
+bool SurveyFlightFromFlags(const PoseStream& poses, SimulationOptions* options, std::string* note,
+                           std::string* error);
 
 // Positions of the trajectory `kind` (circle, line, arc, grid, random) from the shared trajectory
 // flags; *known is false for any other kind.

@@ -41,6 +41,8 @@ Commands:
              samples per pose and flight order, with predicted sigma_total
   modes      natural frequencies and modes of the cabin on its sagging cables at a pose
              (the equilibrium linearised, each cable a lumped-mass chain): modes.csv
+  dynamics   the cabin and its cables in time (a move, winch lengths, a free decay, wind)
+             against the quasi-static answer: the departures and the settle time
   import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
              comma), read through a column map, written as the canonical dataset CSV
 
@@ -65,6 +67,7 @@ int Dispatch(const std::string& command, int argc, char** argv, bool* known) {
   if (command == "import") return RunImport(argc, argv);
   if (command == "track") return RunTrack(argc, argv);
   if (command == "modes") return RunModes(argc, argv);
+  if (command == "dynamics") return RunDynamicsCommand(argc, argv);
   *known = false;
   return kExitUsage;
 }

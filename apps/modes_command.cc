@@ -47,6 +47,7 @@ Usage:
                 [--model=FILE.yaml] [--segments=48] [--modes=20] [--output=modes.csv]
   fastcal modes --cap [grid flags] [--output=cap.csv] [--html=cap.html]
   fastcal modes --data=RECORD.csv [--columns=MAP.yaml] [--identified-modes=3]
+                [--identification=auto|era|ssi]
 
 The system linearised about the exact static equilibrium of the pose (docs/model.md,
 "Vibrations"): each cable a lumped-mass chain of --segments segments with its nodes on the
@@ -79,11 +80,16 @@ rx, ry, rz the frequency and share of the mode holding the most of it, message);
 polar maps of the cap, as workspace draws tensions.
 
 Identified modes: --data=RECORD.csv (a dataset, docs/data-format.md, or an export read
-through --columns=MAP.yaml) holding a free vibration, evenly sampled (e.g. inertial
-navigation at 1-100 Hz after a disturbance; a sample at least every 0.5 s, 80 to 4000 s
-long, at most 10^6 samples): its --identified-modes=3 (1 to 20) dominant modes by
-the eigensystem realisation algorithm (Juang and Pappa 1985) on the pose (x, y, z, roll,
-pitch, yaw) and the tensions, with bootstrap sigmas; each compared with the nearest
+through --columns=MAP.yaml), evenly sampled (e.g. inertial navigation at 1-100 Hz; a
+sample at least every 0.5 s, 80 to 4000 s long, at most 10^6 samples): a free vibration
+after a disturbance, its --identified-modes=3 (1 to 20) dominant modes by the eigensystem
+realisation algorithm (ERA, Juang and Pappa 1985) with bootstrap sigmas; or an ambient
+record (the cabin in the wind, ordinary operation), its most stable modes by
+covariance-driven stochastic subspace identification (SSI-cov, Peeters and De Roeck 1999)
+with jackknife sigmas (at least 8 x 100 s). --identification=auto (the default) takes ERA
+when the record's envelope falls (its mean square 4x lower in the last quarter than in
+the first: a free decay), SSI otherwise, and says which and why; era or ssi forces one.
+Both use the pose (x, y, z, roll, pitch, yaw) and the tensions; each mode compared with the nearest
 predicted mode at the record's mean pose, and the differences fitted by each parameter
 alone (the cables' density, the cabin's mass, its inertia): the smallest chi2 is what they
 point to. CSV: mode, frequency_hz, frequency_sigma_hz, damping_ratio, damping_sigma,
@@ -112,7 +118,7 @@ const std::set<std::string> kFlags = {
     "model", "position", "attitude-law", "rpy", "quat", "rotvec", "tilt-fraction",
     "focal-centre", "segments", "modes", "output", "force", "cap", "max-off-axis-deg",
     "off-axis-step-deg", "azimuth-step-deg", "focal-radius", "html", "data", "columns",
-    "identified-modes", "joints"};
+    "identified-modes", "identification", "joints"};
 // clang-format on
 
 // "mode 4, 0.18208 Hz; cabin 56.5% (most z 56.5%), cables 43.5% (most cable 1 7.24%)".

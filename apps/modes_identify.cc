@@ -1,6 +1,7 @@
-// `fastcal modes --data=FILE`: the dominant modes of a record of the cabin's free
-// vibration (ERA, modal_identification.h), compared with the prediction at the record's
-// pose, and what the differences point to.
+// `fastcal modes --data=FILE`: the dominant modes of a record of the cabin's vibration,
+// free (ERA, modal_identification.h) or ambient (SSI-cov, subspace_identification.h; by
+// --identification, or chosen by the record's envelope: a falling one is a free decay),
+// compared with the prediction at the record's pose, and what the differences point to.
 #include <gflags/gflags.h>
 
 #include <algorithm>
@@ -14,6 +15,7 @@
 #include "fastcal/dataset.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/modal_identification.h"
+#include "fastcal/subspace_identification.h"
 #include "fastcal/vibration_record.h"
 
 DECLARE_string(data);
@@ -21,6 +23,10 @@ DECLARE_string(output);
 DECLARE_bool(force);
 
 DEFINE_int32(identified_modes, 3, "modes --data: how many dominant modes to identify.");
+DEFINE_string(identification, "auto",
+              "modes --data: era (a free decay) | ssi (an ambient record) | auto (era when "
+              "the record's envelope falls by 4x in mean square from its first quarter to its "
+              "last, else ssi).");
 
 namespace fastcal::cli {
 namespace {
@@ -46,9 +52,11 @@ std::string ComparisonCsv(const ModesComparisonResult& r) {
   return out.str();
 }
 
-std::string ComparisonSummary(const ModesComparisonResult& r, const Pose& pose) {
+std::string ComparisonSummary(const ModesComparisonResult& r, const Pose& pose,
+                              const std::string& method) {
   std::ostringstream s;
-  s << "fastcal modes --data: " << r.modes.size() << " modes identified (ERA), predicted at the "
+  s << "fastcal modes --data: " << r.modes.size() << " modes identified (" << method
+    << "), predicted at the "
     << "record's mean pose (" << FormatDouble(pose.position_m.x(), 5) << ", "
     << FormatDouble(pose.position_m.y(), 5) << ", " << FormatDouble(pose.position_m.z(), 5)
     << ") m";
@@ -87,27 +95,54 @@ int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool 
       return kExitUsage;
     }
   }
+  if (FLAGS_identification != "auto" && FLAGS_identification != "era" &&
+      FLAGS_identification != "ssi") {
+    PrintError(kCommand, "--identification=" + FLAGS_identification +
+                             ": must be era (a free decay), ssi (an ambient record) or auto");
+    return kExitUsage;
+  }
   DatasetReadOptions read;
   VibrationRecordFile file;
   EraOptions era;
-  era.modes = FLAGS_identified_modes;
-  if (!era.IsValid(&error)) {
+  SsiOptions ssi;
+  era.modes = ssi.modes = FLAGS_identified_modes;
+  if (!era.IsValid(&error) || !ssi.IsValid(&error)) {
     PrintError(kCommand, WithFlagNames(error, {{"modes", "--identified-modes"}}));
     return kExitUsage;
   }
   if (!ColumnsFromFlag(&read.columns, &error) ||
-      !ReadVibrationRecord(FLAGS_data, read, &file, &error) ||
-      !CheckRecordSampling(file.record, era, &error)) {
+      !ReadVibrationRecord(FLAGS_data, read, &file, &error)) {
     PrintError(kCommand,
                (error.rfind("the record", 0) == 0 ? "--data=" + FLAGS_data + ": " : "") + error);
     return kExitUsage;
   }
+  const VibrationRecord& record = file.record;
   const Pose& pose = file.mean_pose;
+  std::string method = FLAGS_identification;
+  const double decay = EnvelopeDecayRatio(record);
+  if (method == "auto") method = decay >= kFreeDecayRatio ? "era" : "ssi";
+  // A free decay's sampling and length are checked before the work (issue 57); an
+  // ambient record may run for hours, and SSI says itself when it is too short.
+  if (method == "era" && !CheckRecordSampling(record, era, &error)) {
+    PrintError(kCommand, "--data=" + FLAGS_data + ": " + error);
+    return kExitUsage;
+  }
+  const std::string described =
+      (method == "era" ? "ERA" : "SSI-cov") +
+      (FLAGS_identification == "auto"
+           ? std::string(", chosen: the envelope's mean square falls ") + FormatDouble(decay, 3) +
+                 "x from the first quarter to the last, " +
+                 (method == "era" ? "a free decay" : "an ambient record") + " (era from " +
+                 FormatDouble(kFreeDecayRatio, 2) + "x)"
+           : std::string());
   std::vector<IdentifiedMode> identified;
   ModesComparisonResult comparison;
-  if (!IdentifyModesEra(file.record, era, &identified, &error)) {
-    PrintError(kCommand, "--data=" + FLAGS_data + " --identified-modes=" +
-                             std::to_string(FLAGS_identified_modes) + ": " + error);
+  const bool found = method == "era" ? IdentifyModesEra(record, era, &identified, &error)
+                                     : IdentifyModesSsi(record, ssi, &identified, &error);
+  if (!found) {
+    PrintError(kCommand, "--data=" + FLAGS_data + ": " + described + ": " + error +
+                             " (--identified-modes=" + std::to_string(FLAGS_identified_modes) +
+                             ")");
     return kExitFailure;
   }
   if (!CompareWithPrediction(robot, pose, identified, options, &comparison, &error)) {
@@ -118,7 +153,7 @@ int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool 
     PrintError(kCommand, error);
     return kExitFailure;
   }
-  (to_file ? std::cout : std::cerr) << ComparisonSummary(comparison, pose) << std::endl;
+  (to_file ? std::cout : std::cerr) << ComparisonSummary(comparison, pose, described) << std::endl;
   return 0;
 }
 

@@ -56,6 +56,7 @@ DECLARE_string(poses);
 DECLARE_string(out);
 DECLARE_bool(force);
 DECLARE_bool(vibration);
+DECLARE_bool(dynamics);  // simulate_dynamics.cc
 
 DEFINE_string(truth, "", "simulate: truth model YAML; empty = nominal FAST.");
 DEFINE_string(mass_centre, "", "simulate: truth mass centre x,y,z in the cabin frame (m).");
@@ -120,6 +121,19 @@ Usage:
                    [--damping=0.005,0.01,0.015] [--amplitude-m=0.05] [--duration-s=400]
                    [--interval-s=0.1] [--position-noise-m=M] [--attitude-noise-deg=D]
                    [--tension-noise-kN=T] [--segments=48] [--seed=1]
+  fastcal simulate --dynamics --out=FILE.csv [trajectory] [errors] [--speed-m-per-s=0.5]
+                   [--min-move-s=10] [--wait-s=30] [--interval-s=1] [--wind=SPEED,DIR_DEG]
+                   [--gust-spectrum=kaimal] [--turbulence-intensity=0.15] [--segments=40]
+                   [--damping-ratio=0.004] [--step-s=0.02]
+
+--dynamics: the survey flown in time (fastcal dynamics' model) instead of the cabin
+standing at each planned pose: to each new pose a minimum-jerk move lasting the longer of
+--min-move-s and its distance over --speed-m-per-s, the winches paying out the truth
+statics' lengths, then --wait-s before the sample; a pose that repeats the one before
+(a stop's further samples, or the same pose throughout: an ambient record) is sampled
+--interval-s later. The samples' time, pose, tensions and lengths are the dynamics' (in
+--wind, seeded by --seed), then measured with the errors below. Not with an attitude
+control error, a mass-centre drift or steps, sensor steps, sessions or moving parts.
 
 --vibration: a record of the cabin's free vibration at one pose from the linearised model
 (fastcal modes): the predicted modes --excite'd (1-based) with the given damping ratios,
@@ -314,7 +328,10 @@ const std::set<std::string> kFlags = {
     "prismatic-spread-m",
     // --vibration (simulate_vibration.cc)
     "vibration", "position", "rpy", "quat", "rotvec", "excite", "damping", "amplitude-m",
-    "duration-s", "segments"};
+    "duration-s", "segments",
+    // --dynamics (simulate_dynamics.cc)
+    "dynamics", "wait-s", "min-move-s", "speed-m-per-s", "wind", "damping-ratio",
+    "turbulence-intensity", "gust-spectrum", "step-s"};
 // clang-format on
 
 // "v" (the same for every cable) or "v1,...,v6": finite numbers.
@@ -849,6 +866,14 @@ int RunSimulate(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp, kFlags, &exit_code)) return exit_code;
   for (const std::string& flag : kFlags) {
+    const bool dynamics = SimulateDynamicsFlags().count(flag) > 0;
+    // --segments is --vibration's too (the modes' segments).
+    const bool shared = FLAGS_vibration && VibrationFlags().count(flag) > 0;
+    if (FlagGiven(flag) && dynamics && !FLAGS_dynamics && !shared) {
+      PrintError(kCommand, "--" + flag + " applies to --dynamics only");
+      return kExitUsage;
+    }
+    if (dynamics && FLAGS_dynamics && !FLAGS_vibration) continue;
     const bool vibration = VibrationFlags().count(flag) > 0;
     if (FlagGiven(flag) && vibration != FLAGS_vibration && flag != "truth" && flag != "seed" &&
         flag != "out" && flag != "force" && flag != "attitude-law" && flag != "tilt-fraction" &&
@@ -915,6 +940,18 @@ int RunSimulate(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
+  std::string flight_note;
+  if (FLAGS_dynamics) {
+    if (!SurveyFlightFromFlags(poses, &options, &flight_note, &error) || !options.IsValid(&error)) {
+      PrintError(kCommand,
+                 "--dynamics: " + WithFlagNames(error, {{"actual_source", "--dynamics"}}));
+      return kExitUsage;
+    }
+    if (!truth.moving_parts.empty()) {
+      PrintError(kCommand, "--dynamics: a truth model with moving parts is not flown in time");
+      return kExitUsage;
+    }
+  }
 
   const std::string csv_path = FLAGS_out;
   const std::string yaml_path = TruthPathFor(csv_path);
@@ -966,7 +1003,8 @@ int RunSimulate(int argc, char** argv) {
     return failure_code;
   }
   // The summary of what was written is the result: stdout (docs/cli.md, "Output streams").
-  std::cout << Summary(summary, options, csv_path, yaml_path) << std::endl;
+  std::cout << Summary(summary, options, csv_path, yaml_path)
+            << (flight_note.empty() ? "" : "\n  " + flight_note) << std::endl;
   return 0;
 }
 

@@ -4,11 +4,13 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstdint>
 #include <string>
 #include <vector>
 
 #include "fastcal/cable_robot.h"
+#include "fastcal/pose.h"
 #include "fastcal/trajectory.h"
 
 namespace fastcal::testing {
@@ -84,6 +86,18 @@ inline std::vector<Pose> TiltedPoses(int count, std::uint64_t seed, double sprea
   std::string error;
   EXPECT_TRUE(RandomPosesAroundFocalLaw(spec, &poses, &error)) << error;
   return poses;
+}
+
+// The focal law's pose `zenith_deg` off axis at azimuth `azimuth_deg` on the focal sphere
+// (radius 160 m about (0, 0, 300) m, docs/model.md).
+inline Pose FocalSpherePose(double zenith_deg, double azimuth_deg) {
+  const double z = zenith_deg * M_PI / 180.0, a = azimuth_deg * M_PI / 180.0;
+  Pose pose;
+  pose.position_m =
+      Eigen::Vector3d(0.0, 0.0, 300.0) +
+      160.0 * Eigen::Vector3d(std::sin(z) * std::cos(a), std::sin(z) * std::sin(a), -std::cos(z));
+  pose.rotation = FocalAttitude(pose.position_m, FocalAttitudeLaw());
+  return pose;
 }
 
 }  // namespace fastcal::testing

@@ -55,6 +55,7 @@ __all__ = [
     "calibrate",
     "control_cycle",
     "design",
+    "dynamics",
     "evaluate",
     "focal_attitude",
     "focal_grid",
@@ -100,4 +101,4 @@ from .dataset import read_dataset, simulate  # noqa: F401
 from .calibration import CalibrationResult, calibrate, evaluate  # noqa: F401
 from .design import design  # noqa: F401
 from .track import TrackResult, track  # noqa: F401
-from .dynamics import ModesResult, modes  # noqa: F401
+from .dynamics import ModesResult, dynamics, modes  # noqa: F401

@@ -1,11 +1,14 @@
-"""The vibrations layer: the natural frequencies and modes of the cabin on its six sagging
-cables at one pose (the C++ library's modes.h; docs/model.md, "Vibrations")."""
+"""The dynamics layer: the natural frequencies and modes of the cabin on its six sagging
+cables at one pose (the C++ library's modes.h; docs/model.md, "Vibrations"), and the
+cabin and its cables moving in time beside the quasi-static answer (dynamics_run.h;
+docs/model.md, "Dynamics")."""
 
 from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from typing import Optional, Sequence, Union
+import json
+from typing import Any, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -48,6 +51,36 @@ class ModesResult:
         return self.shares[:, :6].sum(axis=1)
 
 
+def _pose_arrays(
+    position_m: ArrayLike,
+    rpy_deg: Optional[ArrayLike],
+    quat: Optional[ArrayLike],
+    attitude_law: Optional[str],
+    tilt_fraction: float,
+    focal_centre: ArrayLike,
+) -> Tuple[np.ndarray, str, np.ndarray]:
+    """One pose as the bindings take it: the (3,) position, the attitude's kind ("none",
+    "rpy", "quat") and its (1, k) array; InputError for a wrong shape or two attitudes."""
+    position = np.asarray(position_m, dtype=np.float64)
+    if position.shape != (3,):
+        raise InputError(f"position_m must have shape (3,), got {position.shape}")
+    given = [a is not None for a in (rpy_deg, quat, attitude_law)]
+    if sum(given) > 1:
+        raise InputError("give at most one of rpy_deg, quat, attitude_law")
+    kind, attitude = "none", np.zeros((1, 3))
+    if attitude_law is not None:
+        if attitude_law != "focal":
+            raise InputError(f"attitude_law must be 'focal', got {attitude_law!r}")
+        centre = np.asarray(focal_centre, dtype=np.float64)
+        kind = "quat"
+        attitude = _fastcal.focal_attitude(position.reshape(1, 3), float(tilt_fraction), centre)
+    elif rpy_deg is not None:
+        kind, attitude = "rpy", np.asarray(rpy_deg, dtype=np.float64).reshape(1, -1)
+    elif quat is not None:
+        kind, attitude = "quat", np.asarray(quat, dtype=np.float64).reshape(1, -1)
+    return position, kind, np.ascontiguousarray(attitude)
+
+
 def modes(
     position_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,
@@ -80,40 +113,21 @@ def modes(
             model (a model file that does not load, named).
         RuntimeError: the pose has no equilibrium, or it is unstable.
     """
-    position = np.asarray(position_m, dtype=np.float64)
-    if position.shape != (3,):
-        raise InputError(f"position_m must have shape (3,), got {position.shape}")
-    given = [a is not None for a in (rpy_deg, quat, attitude_law)]
-    if sum(given) > 1:
-        raise InputError("give at most one of rpy_deg, quat, attitude_law")
-    kind, attitude = "none", np.zeros((1, 3))
-    if attitude_law is not None:
-        if attitude_law != "focal":
-            raise InputError(f"attitude_law must be 'focal', got {attitude_law!r}")
-        centre = np.asarray(focal_centre, dtype=np.float64)
-        kind = "quat"
-        attitude = _fastcal.focal_attitude(position.reshape(1, 3), float(tilt_fraction), centre)
-    elif rpy_deg is not None:
-        kind, attitude = "rpy", np.asarray(rpy_deg, dtype=np.float64).reshape(1, -1)
-    elif quat is not None:
-        kind, attitude = "quat", np.asarray(quat, dtype=np.float64).reshape(1, -1)
+    position, kind, attitude = _pose_arrays(
+        position_m, rpy_deg, quat, attitude_law, tilt_fraction, focal_centre
+    )
     # Each argument checked with its name (issue 57: segments=2**31 and model='path.yaml'
     # raised pybind11's TypeError, cable_inertia='no' was taken as True).
     segments = _whole(segments, "segments", 2, 1000)
     count = _whole(count, "count", 1, 200)
     if not isinstance(cable_inertia, (bool, np.bool_)):
         raise InputError(f"cable_inertia must be True or False, got {cable_inertia!r}")
-    if model is None:
-        model = Model.nominal()
-    elif not isinstance(model, Model):
-        if not isinstance(model, (str, os.PathLike)):
-            raise InputError(f"model must be a fastcal.Model or a model file's path, got {model!r}")
-        model = Model.load(os.fspath(model))
+    model = _model(model)
     out = _fastcal.modes(
         model,
         position.reshape(1, 3),
         kind,
-        np.ascontiguousarray(attitude),
+        attitude,
         segments,
         count,
         bool(cable_inertia),
@@ -126,3 +140,167 @@ def modes(
         cabin_shape=out["cabin_shape"],
         degrees_of_freedom=int(out["degrees_of_freedom"]),
     )
+
+
+#: The record's columns, as `fastcal dynamics` writes its CSV (docs/cli.md).
+_POSE_COLUMNS = ("x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg")
+_QS_POSE_COLUMNS = ("x_qs_m", "y_qs_m", "z_qs_m", "roll_qs_deg", "pitch_qs_deg", "yaw_qs_deg")
+
+
+def _model(model: Any) -> Model:
+    """None (the nominal), a Model, or a model file's path; InputError for anything else."""
+    if model is None:
+        return Model.nominal()
+    if isinstance(model, Model):
+        return model
+    if not isinstance(model, (str, os.PathLike)):
+        raise InputError(f"model must be a fastcal.Model or a model file's path, got {model!r}")
+    return Model.load(os.fspath(model))
+
+
+def _winch_table(lengths: Any) -> Tuple[np.ndarray, np.ndarray]:
+    """A DataFrame (or a mapping of arrays) with time_s and s0_1_m .. s0_6_m as the
+    binding's (n,) times and (n, 6) lengths."""
+    names = ["s0_%d_m" % i for i in range(1, 7)]
+    missing = [c for c in ["time_s"] + names if c not in lengths]
+    if missing:
+        raise InputError("lengths: missing columns " + ", ".join(missing))
+    time = np.ascontiguousarray(np.asarray(lengths["time_s"], dtype=np.float64))
+    s0 = np.ascontiguousarray(
+        np.column_stack([np.asarray(lengths[c], dtype=np.float64) for c in names])
+    )
+    return time, s0
+
+
+def dynamics(
+    position_m: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    model: Optional[Model] = None,
+    *,
+    attitude_law: Optional[str] = None,
+    tilt_fraction: float = 0.41,
+    focal_centre: ArrayLike = (0.0, 0.0, 300.0),
+    to: Optional[ArrayLike] = None,
+    to_rpy_deg: Optional[ArrayLike] = None,
+    move_s: float = 60.0,
+    lengths: Any = None,
+    initial_offset: Optional[ArrayLike] = None,
+    hold_s: float = 120.0,
+    rate_hz: float = 10.0,
+    settle_fraction: float = 0.005,
+    segments: int = 40,
+    damping_ratio: float = 0.004,
+    step_s: float = 0.02,
+    wind: Optional[Tuple[float, float]] = None,
+    gust_spectrum: str = "kaimal",
+    turbulence_intensity: float = 0.15,
+    seed: int = 1,
+):
+    """The cabin and its six cables in time beside the quasi-static answer, as
+    `fastcal dynamics` (docs/cli.md; docs/model.md, "Dynamics").
+
+    Args:
+        position_m, rpy_deg, quat, attitude_law, tilt_fraction, focal_centre: the start
+            pose, as `modes` takes it.
+        model: None for the nominal.
+        to: (3,) a move's end (with move_s, s; the attitude flies the focal law with
+            attitude_law="focal", else turns to to_rpy_deg, or stays); or
+        lengths: a winch table, a DataFrame (or mapping) with time_s and s0_1_m .. s0_6_m
+            (from 0 s, increasing; linear between rows, held after); or
+        initial_offset: (3,) or (6,) a free decay: dx, dy, dz (m) [, rx, ry, rz (deg)];
+            none of the three: the winches hold (a record in the wind).
+        hold_s: after the winches stop; rate_hz: samples a second; settle_fraction: the
+            settle time's band.
+        segments, damping_ratio, step_s: the model and its integration step.
+        wind: (speed m/s, direction deg toward, from +x toward +y), with gust_spectrum
+            ("kaimal" | "davenport"), turbulence_intensity and seed.
+
+    Returns:
+        A pandas DataFrame, one row per sample, with the CSV's columns: time_s, x_m .. yaw_deg,
+        T1_kN .. T6_kN, x_qs_m .. yaw_qs_deg, T1_qs_kN .. T6_qs_kN, s0_1_m .. s0_6_m,
+        wind_m_per_s; frame.attrs["summary"] holds the summary JSON as a dict ("run",
+        "start" with the lowest modes, "departure", "residual", "settle" with settle_s,
+        "integrator").
+
+    Raises:
+        InputError: a wrong shape, two of to/lengths/initial_offset, bad options.
+        RuntimeError: a pose the statics cannot hold, or a step that does not converge.
+    """
+    import pandas
+
+    start, kind, attitude = _pose_arrays(
+        position_m, rpy_deg, quat, attitude_law, tilt_fraction, focal_centre
+    )
+    if sum(x is not None for x in (to, lengths, initial_offset)) > 1:
+        raise InputError("give one of to (a move), lengths (a winch table), initial_offset")
+    run = "decay"
+    end, end_kind, end_attitude = np.zeros(3), "same", np.zeros((1, 3))
+    table_time, table_s0 = np.zeros(0), np.zeros((0, 6))
+    offset = np.zeros(6)
+    if to is not None:
+        run = "move"
+        if attitude_law is not None and to_rpy_deg is not None:
+            raise InputError("to_rpy_deg: with attitude_law='focal' every pose flies the law")
+        end, end_kind, end_attitude = _pose_arrays(
+            to, to_rpy_deg, None, attitude_law, tilt_fraction, focal_centre
+        )
+        if end_kind == "none":
+            end_kind = "same"
+    elif to_rpy_deg is not None:
+        raise InputError("to_rpy_deg applies to a move (to)")
+    elif lengths is not None:
+        run = "lengths"
+        table_time, table_s0 = _winch_table(lengths)
+    elif initial_offset is not None:
+        given = np.asarray(initial_offset, dtype=np.float64).ravel()
+        if given.shape not in ((3,), (6,)):
+            raise InputError(
+                f"initial_offset must have 3 or 6 values (m, deg), got {given.shape}"
+            )
+        offset[: given.size] = given
+    speed, direction = (0.0, 0.0) if wind is None else wind
+    out = _fastcal.dynamics(
+        _model(model),
+        start.reshape(1, 3),
+        kind,
+        attitude,
+        run,
+        end.reshape(1, 3),
+        end_kind,
+        end_attitude,
+        attitude_law is not None,
+        np.asarray(focal_centre, dtype=np.float64).reshape(1, 3),
+        float(tilt_fraction),
+        float(move_s),
+        table_time,
+        table_s0,
+        offset.reshape(1, 6),
+        float(hold_s),
+        float(rate_hz),
+        float(settle_fraction),
+        _whole(segments, "segments", 2, 1000),
+        float(damping_ratio),
+        float(step_s),
+        float(speed),
+        float(direction),
+        str(gust_spectrum),
+        float(turbulence_intensity),
+        _whole(seed, "seed", 0, 2**63 - 1),
+    )
+    columns = {"time_s": out["time_s"]}
+    tensions = ["T%d_kN" % i for i in range(1, 7)]
+    qs_tensions = ["T%d_qs_kN" % i for i in range(1, 7)]
+    for block, names in (
+        ("pose", _POSE_COLUMNS),
+        ("tension_kN", tensions),
+        ("quasi_static_pose", _QS_POSE_COLUMNS),
+        ("quasi_static_tension_kN", qs_tensions),
+        ("s0_m", ["s0_%d_m" % i for i in range(1, 7)]),
+    ):
+        for j, name in enumerate(names):
+            columns[name] = out[block][:, j]
+    columns["wind_m_per_s"] = out["wind_m_per_s"]
+    frame = pandas.DataFrame(columns)
+    frame.attrs["summary"] = json.loads(out["summary_json"])
+    return frame

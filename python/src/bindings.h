@@ -173,6 +173,7 @@ void BindCalibration(py::module_& m);
 void BindDesign(py::module_& m);
 void BindTrack(py::module_& m);
 void BindModes(py::module_& m);
+void BindDynamics(py::module_& m);
 
 }  // namespace fastcal::python
 

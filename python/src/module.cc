@@ -188,4 +188,5 @@ PYBIND11_MODULE(_fastcal, m) {
   BindDesign(m);
   BindTrack(m);
   BindModes(m);
+  BindDynamics(m);
 }

@@ -110,6 +110,18 @@ bool CheckRecordSampling(const VibrationRecord& record, const EraOptions& option
 bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
                       std::vector<IdentifiedMode>* modes, std::string* error);
 
+// Whether a record is a free decay (ERA) or ambient (SSI, subspace_identification.h): a
+// free decay's envelope falls, an ambient record's is stationary. The ratio
+//     rho = (mean square of the first quarter) / (mean square of the last quarter)
+// of the channels, each centred and scaled by its spread and summed, is about
+// exp(1.5 zeta omega T) for a free decay of length T (the quarters' centres 3T/4 apart:
+// 9.6 for zeta 0.004 at 0.15 Hz over 400 s, 290 for 0.01) and about 1 for a stationary
+// record. 1 for a record of fewer than 4 samples or a flat last quarter.
+double EnvelopeDecayRatio(const VibrationRecord& record);
+// A record whose rho reaches this is taken for a free decay (`fastcal modes --data
+// --identification=auto`): its amplitude halves from the first quarter to the last.
+inline constexpr double kFreeDecayRatio = 4.0;
+
 // A free decay by modal superposition: channel c at time t = k dt is
 //   sum_j shape(c, j) exp(-zeta_j w_j t) cos(w_d,j t + phase_j) + noise_c,
 // w_j = 2 pi f_j, w_d = w_j sqrt(1 - zeta^2), noise white Gaussian with sigma noise_sigma[c].

@@ -76,6 +76,22 @@ struct SensorBiasStep {
   double shift_n = 0.0;
 };
 
+// The cabin's actual state at a sample when something other than the statics at the
+// planned pose gives it (SimulationOptions::actual_source; the dynamics in time,
+// dynamic_survey.h): the sample's time from the first (start_time_s is added), the actual
+// pose, the true lower-end tensions and the winches' unstretched lengths.
+struct ActualSample {
+  double time_s = 0.0;
+  Pose pose;
+  std::array<double, kNumCables> lower_tension_n{};
+  std::array<double, kNumCables> unstretched_length_m{};
+};
+// Called for each sample n = 0, 1, ... in order with its planned pose and the truth model
+// in use (after the drawn density mismatch and sensor spreads); false with *error stops
+// the simulation.
+using ActualSource = std::function<bool(long long n, const Pose& planned, const CableRobot& truth,
+                                        ActualSample* actual, std::string* error)>;
+
 struct SimulationOptions {
   // Attitude control error: standard deviation of the actual minus the planned roll,
   // pitch and yaw (deg, each axis independent). >= 0; default 0.
@@ -163,6 +179,11 @@ struct SimulationOptions {
   // (joint_plan.h), written in the dataset's joint columns and moving its mass centre.
   // Unused for a model without moving parts; default: every joint at zero.
   JointPlanOptions joints;
+  // The actual state from elsewhere (empty: the statics at the planned pose, the
+  // default): the sample times, poses, tensions and lengths it gives are measured as
+  // above. Then no attitude control error, mass-centre drift or steps, one session, and a
+  // truth model without moving parts: the source's model has its own.
+  ActualSource actual_source;
 
   // False, with the offending field named in *error (may be null), for a value out of range.
   bool IsValid(std::string* error) const;

@@ -186,6 +186,9 @@ bool CheckInputs(const CableRobot& truth, const PoseStream& planned,
   std::string why;
   if (!truth.IsValid(&why)) return Fail(error, "truth model: " + why);
   if (planned.count <= 0) return Fail(error, "no planned poses");
+  if (options.actual_source && !truth.moving_parts.empty()) {
+    return Fail(error, "actual_source: the truth model's moving parts are not simulated with it");
+  }
   if (options.sessions > planned.count) {
     return Fail(error, std::to_string(options.sessions) + " sessions for " +
                            std::to_string(planned.count) + " poses: at most one per pose");
@@ -260,6 +263,28 @@ bool SolveActual(size_t n, const Pose& planned_pose, const Eigen::Vector3d& plan
   }
   return Fail(error, message + ": " + DescribeStatus(*solution) + " [truth model, method " +
                          StaticsMethodName(options.method) + "]");
+}
+
+// The actual state of sample n from options.actual_source: its time (and the time since
+// the previous sample, for the slow processes), pose, and the tensions and lengths
+// `solution` carries to MeasureTensions.
+bool ActualFromSource(size_t n, const Pose& planned_pose, const SimulationOptions& options,
+                      const CableRobot& model, double last_time_s, double* time_s, double* dt,
+                      Eigen::Vector3d* position_m, Eigen::Vector3d* rpy_deg,
+                      StaticsSolution* solution, std::string* error) {
+  ActualSample a;
+  if (!options.actual_source(static_cast<long long>(n), planned_pose, model, &a, error)) {
+    return false;
+  }
+  *time_s = options.start_time_s + a.time_s;
+  *dt = n == 0 ? options.sample_interval_s : std::max(*time_s - last_time_s, 0.0);
+  *position_m = a.pose.position_m;
+  *rpy_deg = NoNegativeZero(RpyDegFromRotation(a.pose.rotation));
+  for (int i = 0; i < kNumCables; ++i) {
+    solution->cables[i].lower_tension_n = a.lower_tension_n[i];
+    solution->cables[i].unstretched_length_m = a.unstretched_length_m[i];
+  }
+  return true;
 }
 
 // The measured pose: the actual one with attitude and position noise.
@@ -460,6 +485,7 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
   std::vector<bool> applied_sensor_steps(options.sensor_bias_steps.size(), false);
   JointPlan joint_plan;
   if (!JointPlan::Make(model.moving_parts, options.joints, &joint_plan, error)) return false;
+  double last_time_s = 0.0;  // the previous sample's (an actual source's times are its own)
 
   for (size_t n = 0; n < static_cast<size_t>(planned.count); ++n) {
     const Pose planned_pose = planned.next();
@@ -493,15 +519,21 @@ bool SimulateImpl(const CableRobot& truth, PoseStream& planned, const Simulation
       return false;
     }
     Eigen::Vector3d actual_rpy_deg;
-    if (!SolveActual(n, planned_pose, s.planned_rpy_deg, options,
-                     mass_centre_m + StepShiftAt(options, s.time_s), s.joint, statics, &processes,
-                     &model, &actual_rpy_deg, &solution, error)) {
+    Eigen::Vector3d actual_position_m = planned_pose.position_m;
+    if (options.actual_source) {
+      if (!ActualFromSource(n, planned_pose, options, model, last_time_s, &s.time_s, &processes.dt,
+                            &actual_position_m, &actual_rpy_deg, &solution, error)) {
+        return false;
+      }
+    } else if (!SolveActual(n, planned_pose, s.planned_rpy_deg, options,
+                            mass_centre_m + StepShiftAt(options, s.time_s), s.joint, statics,
+                            &processes, &model, &actual_rpy_deg, &solution, error)) {
       return false;
     }
-    Eigen::Vector3d position_m = planned_pose.position_m;
-    ToDataFrame(model, planned_pose, &position_m, &actual_rpy_deg, &s);
-    MeasurePose(position_m, actual_rpy_deg, options, &processes, &s);
+    ToDataFrame(model, planned_pose, &actual_position_m, &actual_rpy_deg, &s);
+    MeasurePose(actual_position_m, actual_rpy_deg, options, &processes, &s);
     if (!MeasureTensions(n, model, solution, options, &processes, &stats, &s, error)) return false;
+    last_time_s = s.time_s;
     if (!sink(s, error)) return false;
   }
   Summarise(processes, static_cast<double>(planned.count), &stats);
@@ -574,6 +606,12 @@ bool SimulationOptions::IsValid(std::string* error) const {
   if (!(std::isfinite(sample_interval_s) && sample_interval_s > 0.0)) {
     return Fail(error,
                 "sample_interval_s must be finite and > 0 (got " + Num(sample_interval_s) + ")");
+  }
+  if (actual_source && (attitude_control_sigma_deg > 0.0 || mass_centre_drift_m > 0.0 ||
+                        !mass_centre_steps.empty() || !sensor_bias_steps.empty() || sessions > 1)) {
+    return Fail(error,
+                "actual_source: the actual state and the times come from it, so no attitude "
+                "control error, mass-centre drift or steps, sensor steps, and one session");
   }
   return true;
 }

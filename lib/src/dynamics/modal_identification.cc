@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "dynamics/record_preparation.h"
 #include "fastcal/catenary.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/plausibility.h"
@@ -220,20 +221,6 @@ bool EraOptions::IsValid(std::string* error) const {
 
 namespace {
 
-// The record averaged over blocks of `factor` samples, each channel centred and scaled by
-// its spread (metres, degrees and kN then weigh alike).
-Eigen::MatrixXd Prepare(const Eigen::MatrixXd& channels, int factor) {
-  const int n = static_cast<int>(channels.cols()) / factor;
-  Eigen::MatrixXd y(channels.rows(), n);
-  for (int k = 0; k < n; ++k) y.col(k) = channels.middleCols(k * factor, factor).rowwise().mean();
-  y = y.colwise() - y.rowwise().mean();
-  for (int c = 0; c < y.rows(); ++c) {
-    const double spread = std::sqrt(y.row(c).squaredNorm() / n);
-    if (spread > 0.0) y.row(c) /= spread;
-  }
-  return y;
-}
-
 // How ERA takes a record (EraOptions): averaged over blocks of `factor` samples into
 // `samples` samples `interval_s` apart, with `rows` block rows. Counted in double: a
 // record re-stamped every 1e-12 s asked for blocks of 5e11 samples (issue 57: the int cast
@@ -349,7 +336,7 @@ bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
   const int factor = static_cast<int>(plan.factor);
   const double dt = plan.interval_s;
   const int rows = static_cast<int>(plan.rows);
-  const Eigen::MatrixXd y = Prepare(record.channels, factor);
+  const Eigen::MatrixXd y = internal::DecimatedScaled(record.channels, factor);
   const std::vector<Pole> poles = Identify(y, dt, options, rows);
   if (static_cast<int>(poles.size()) < options.modes) {
     *error = "found " + std::to_string(poles.size()) + " damped modes, fewer than the " +
@@ -368,6 +355,14 @@ bool IdentifyModesEra(const VibrationRecord& record, const EraOptions& options,
     return a.frequency_hz < b.frequency_hz;
   });
   return true;
+}
+
+double EnvelopeDecayRatio(const VibrationRecord& record) {
+  const Eigen::Index quarter = record.channels.cols() / 4;
+  if (quarter < 1 || record.channels.rows() < 1) return 1.0;
+  const Eigen::MatrixXd y = internal::DecimatedScaled(record.channels, 1);
+  const double last = y.rightCols(quarter).squaredNorm();
+  return last > 0.0 ? y.leftCols(quarter).squaredNorm() / last : 1.0;
 }
 
 bool SimulateFreeDecay(const FreeDecaySpec& spec, VibrationRecord* record, std::string* error) {
