@@ -35,6 +35,8 @@ DEFINE_double(max_extra_tilt_deg, 0.0, "design: largest tilt of z' off the focal
 DEFINE_double(max_extra_yaw_deg, 0.0, "design: largest turn about z' off the focal law (deg).");
 DEFINE_double(speed_m_per_s, 0.0, "design: cabin speed between stops (m/s); 0: no duration.");
 DEFINE_double(minutes, 0.0, "design: time budget of the survey (min); 0: none.");
+// Shared with dynamics (dynamics_command.cc): the same band, the same default.
+DECLARE_double(settle_fraction);
 DEFINE_string(criterion, "A", "design: A (sum of variances) or D (log-determinant).");
 DEFINE_string(parameters, "", "design: wanted parameters, comma-separated; default: see --help.");
 DEFINE_double(hold_probability, 1e-4,
@@ -86,6 +88,11 @@ draws the random survey compared against).
   --interval-s=1         time per sample (s)
   --minutes=0            time budget; needs --speed-m-per-s. Over it, the design drops
                          its least useful stops (their samples dwell at the others)
+  --settle-fraction=0.005  with a speed: after each move (a minimum-jerk profile of
+                         its length / speed), wait until every tension is within this
+                         fraction of quasi-static, from the time-domain model (moves
+                         that cannot leave the band are not simulated); the waits are
+                         in the duration, outside the time budget; 0: no waits
 Grid and limits, as fastcal workspace: --max-off-axis-deg=40 --off-axis-step-deg=1
   --azimuth-step-deg=5 --focal-radius=160 --focal-centre=0,0,300 --tilt-fraction=0.41
   --max-tension-kN=inf --max-strain=0.05 --max-length-ratio=1.5, and with the design's
@@ -193,6 +200,8 @@ bool SetOptionsFromFlags(DesignOptions* o, std::string* error) {
   o->samples = FLAGS_samples;
   o->seed = FLAGS_seed;
   o->speed_m_per_s = FLAGS_speed_m_per_s;
+  o->settle_after_moves = FLAGS_settle_fraction != 0.0;
+  if (o->settle_after_moves) o->settle.fraction = FLAGS_settle_fraction;
   o->sample_interval_s = FLAGS_interval_s;
   if (!(FLAGS_minutes >= 0.0) || !std::isfinite(FLAGS_minutes)) {
     *error = "--minutes must be >= 0 and finite (got " + FormatDouble(FLAGS_minutes) + ")";
@@ -262,6 +271,39 @@ std::string JointStopsText(const Design& d) {
          " rotator angle pairs in all (design.json: stops[].joints)";
 }
 
+// The waits after the moves (move_settle.h), and whether they pass the time budget.
+std::string SettleText(const Design& d) {
+  int simulated = 0, unsettled = 0;
+  const int moves = d.stops.empty() ? 0 : static_cast<int>(d.stops.size()) - 1;
+  size_t longest = 0;
+  for (size_t k = 0; k < d.stops.size(); ++k) {
+    simulated += d.stops[k].settle.simulated;
+    unsettled += !d.stops[k].settle.settled;
+    if (d.stops[k].settle.wait_s > d.stops[longest].settle.wait_s) longest = k;
+  }
+  const double band = 100.0 * d.options.settle.fraction;
+  std::string s = "waits after moves (every tension within " + FormatDouble(band, 3) +
+                  "% of quasi-static): " + FormatDouble(d.settle_s / kSecondsPerMinute, 3) +
+                  " min in all; " + std::to_string(simulated) + " of " + std::to_string(moves) +
+                  " moves run in time" +
+                  (simulated < moves ? " (the others too gentle to leave the band)" : "");
+  if (d.settle_s > 0.0) {
+    s += "; the longest " + FormatDouble(d.stops[longest].settle.wait_s, 3) + " s before stop " +
+         std::to_string(longest + 1);
+  }
+  if (unsettled > 0) {
+    s += "; " + std::to_string(unsettled) + " still outside after " +
+         FormatDouble(d.options.settle.max_wait_s, 3) + " s (waited that long)";
+  }
+  if (!d.settle_note.empty()) s += "; " + d.settle_note;
+  if (d.options.time_budget_s > 0.0 && d.duration_s > d.options.time_budget_s) {
+    s += "; with them the survey takes " + FormatDouble(d.duration_s / kSecondsPerMinute, 3) +
+         " min, over the " + FormatDouble(d.options.time_budget_s / kSecondsPerMinute, 3) +
+         "-min budget (which holds travel and dwell)";
+  }
+  return s;
+}
+
 // The result, on stdout: what was chosen, and the predicted sigma_total of each wanted
 // parameter in its own unit (the one in its name: kN for sensor_bias_kN).
 std::string Summary(const Design& d) {
@@ -290,6 +332,7 @@ std::string Summary(const Design& d) {
     s << row;
   }
   if (!d.joint_columns.empty()) s << "\n  " << JointStopsText(d);
+  if (d.options.speed_m_per_s > 0.0 && d.options.settle_after_moves) s << "\n  " << SettleText(d);
   s << "\n  " << NoiseText(d);
   s << "\n  limited by " << d.limiting_part << " (" << FormatDouble(100.0 * d.limiting_share, 3)
     << "% of the wanted variance)";

@@ -42,7 +42,8 @@ DEFINE_string(to_rpy, "", "dynamics --to: the end attitude roll,pitch,yaw (deg).
 DEFINE_string(initial_offset, "",
               "dynamics: a free decay from dx,dy,dz[,rx,ry,rz] (m, deg) off the equilibrium.");
 DEFINE_double(settle_fraction, 0.005,
-              "dynamics: the settle band, a fraction of each quasi-static tension.");
+              "dynamics, design: the settle band, a fraction of each quasi-static tension "
+              "(design: 0, no waits after moves).");
 DEFINE_double(step_s, fastcal::DynamicsOptions().max_step_s,
               "dynamics: the largest integration step (s).");
 DEFINE_string(summary, "", "dynamics: the summary as JSON to this file.");

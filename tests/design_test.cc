@@ -321,6 +321,31 @@ TEST(Design, OutputsAreInTheSpecsUnitsAndThePageShowsTheOrder) {
   EXPECT_NE(html.find(".banner-good"), std::string::npos);  // the report's style sheet
 }
 
+// Issue 55: with a speed, each move is followed by its wait (move_settle.h), in the
+// stops, the duration and design.json; none at the first stop, none when turned off.
+TEST(Design, WaitsAfterMovesAreInTheDuration) {
+  const CableRobot robot = CableRobot::NominalFast();
+  DesignOptions o = SmallGrid();
+  o.samples = 20;
+  o.speed_m_per_s = 5.0;  // fast legs: some leave the band
+  Design d;
+  std::string error;
+  ASSERT_TRUE(DesignSurvey(robot, Spec(), o, &d, &error)) << error;
+  ASSERT_GE(d.stops.size(), 2u);
+  EXPECT_EQ(d.stops[0].settle.wait_s, 0.0);
+  double waits = 0.0;
+  for (const DesignStop& stop : d.stops) waits += stop.settle.wait_s;
+  EXPECT_EQ(waits, d.settle_s);
+  EXPECT_GT(d.settle_s, 0.0);
+  EXPECT_NEAR(d.duration_s, d.travel_s + d.dwell_s + d.settle_s, 1e-9 * d.duration_s);
+  EXPECT_NE(DesignJson(d, "test").find("\"settle_s\": "), std::string::npos);
+  o.settle_after_moves = false;
+  Design without;
+  ASSERT_TRUE(DesignSurvey(robot, Spec(), o, &without, &error)) << error;
+  EXPECT_EQ(without.settle_s, 0.0);
+  EXPECT_NEAR(without.duration_s, without.travel_s + without.dwell_s, 1e-9 * without.duration_s);
+}
+
 TEST(Design, TimeBudgetIsKept) {
   const CableRobot robot = CableRobot::NominalFast();
   DesignOptions o = TiltedCap();

@@ -129,6 +129,37 @@ TEST(RunDynamics, MoveRecordAndSummary) {
 
 // Winches held at the start's lengths by a table: nothing moves, dynamic is
 // quasi-static to rounding.
+// The quasi-static reference does not depend on the sampling: a move of 40 m in 16 s
+// sampled once a second (the winches' lengths change by metres between samples) gives the
+// same reference as at 4 Hz at the common times. It failed before the reference went in
+// pieces from the last sample's ("the chains' stiffness is singular"), found by design's
+// waits after its moves (issue 55).
+TEST(RunDynamics, QuasiStaticReferenceDoesNotDependOnTheSampling) {
+  constexpr double kSameN = 1e-3;  // Newton's tolerance on the chains, in N
+  DynamicsRunSpec spec;
+  spec.start.position_m = Eigen::Vector3d(0.0, 0.0, 140.0);
+  spec.end.position_m = Eigen::Vector3d(40.0, 0.0, 145.0);
+  spec.move_s = 16.0;
+  spec.hold_s = 2.0;
+  DynamicsOptions options = Quick();
+  options.segments = 8;
+  const CableRobot robot = CableRobot::NominalFast();
+  DynamicsRunResult coarse, fine;
+  std::string error;
+  spec.rate_hz = 1.0;
+  ASSERT_TRUE(RunDynamics(robot, spec, options, &coarse, &error)) << error;
+  spec.rate_hz = 4.0;
+  ASSERT_TRUE(RunDynamics(robot, spec, options, &fine, &error)) << error;
+  ASSERT_EQ(fine.samples.size(), 4 * (coarse.samples.size() - 1) + 1);
+  for (size_t k = 0; k < coarse.samples.size(); ++k) {
+    for (int i = 0; i < kNumCables; ++i) {
+      EXPECT_NEAR(coarse.samples[k].quasi_static_tension_n[i],
+                  fine.samples[4 * k].quasi_static_tension_n[i], kSameN)
+          << "t = " << coarse.samples[k].time_s << " s, cable " << i + 1;
+    }
+  }
+}
+
 TEST(RunDynamics, HeldTableStaysQuasiStatic) {
   DynamicsRunSpec spec;
   spec.kind = DynamicsRunSpec::Kind::kLengths;

@@ -26,6 +26,7 @@ def design(
     speed_m_per_s: float = 0.0,
     interval_s: float = 1.0,
     minutes: float = 0.0,
+    settle_fraction: float = 0.005,
     min_tension_kN: Optional[float] = None,
     max_tension_kN: Optional[float] = None,
     reflector_clearance_m: Optional[float] = None,
@@ -50,6 +51,9 @@ def design(
         speed_m_per_s, interval_s: the path's duration (cabin speed, time per sample);
             minutes: a time budget (needs a speed). (interval_s was sample_interval_s:
             the old name still works, with a DeprecationWarning.)
+        settle_fraction: with a speed, after each move wait until every tension is within
+            this fraction of quasi-static (the time-domain model; docs/design.md); 0: no
+            waits.
         min_tension_kN, max_tension_kN, reflector_clearance_m: the candidates' limits;
             None: the design's defaults (50 kN, none, 5 m).
         max_off_axis_deg, off_axis_step_deg, azimuth_step_deg: the grid; None: the
@@ -59,6 +63,7 @@ def design(
         A dict: 'poses', a (samples, 6) array of x_m, y_m, z_m, roll_deg, pitch_deg,
         yaw_deg in flight order (what poses.csv holds); 'stops' (dicts: samples,
         position_m, extra_tilt_deg, tilt_direction_deg, extra_yaw_deg); 'wanted';
+        'settle_s' (the waits after moves, in duration_s; stops[]['settle_s'] each);
         'design', 'circle', 'random': {'ok', 'note', 'criterion', 'sigma_total':
         {name: value}}; 'units' ({name: unit}); 'path_length_m', 'duration_s' (nan
         without a speed), 'candidates', 'rejected_candidates', 'limiting_part',
@@ -85,6 +90,7 @@ def design(
         "speed_m_per_s": _number(speed_m_per_s, "speed_m_per_s"),
         "sample_interval_s": _number(interval_s, "interval_s"),
         "time_budget_s": 60.0 * _number(minutes, "minutes"),
+        "settle_fraction": _number(settle_fraction, "settle_fraction"),
     }
     for key, value in (
         ("min_tension_kN", min_tension_kN),

@@ -44,6 +44,7 @@ py::dict DesignDict(const Design& d) {
     stop["extra_tilt_deg"] = c.extra_tilt_deg;
     stop["tilt_direction_deg"] = c.tilt_direction_deg;
     stop["extra_yaw_deg"] = c.extra_yaw_deg;
+    stop["settle_s"] = s.settle.wait_s;
     stops.append(stop);
   }
   out["stops"] = stops;
@@ -54,6 +55,7 @@ py::dict DesignDict(const Design& d) {
   out["rejected_candidates"] = d.rejected_candidates;
   out["path_length_m"] = d.path_length_m;
   out["duration_s"] = d.options.speed_m_per_s > 0.0 ? d.duration_s : NAN;
+  out["settle_s"] = d.settle_s;
   py::dict units;
   for (size_t k = 0; k < d.free_names.size(); ++k)
     units[py::str(d.free_names[k])] = d.free_units[k];
@@ -102,6 +104,9 @@ py::dict RunDesign(const CableRobot& model_argument, const std::string& spec_pat
   options.speed_m_per_s = o["speed_m_per_s"].cast<double>();
   options.sample_interval_s = o["sample_interval_s"].cast<double>();
   options.time_budget_s = o["time_budget_s"].cast<double>();
+  const double settle_fraction = o["settle_fraction"].cast<double>();
+  options.settle_after_moves = settle_fraction != 0.0;
+  if (options.settle_after_moves) options.settle.fraction = settle_fraction;
   // None keeps the library's default (design.h: the workspace grid, the design's margins).
   auto set = [&o](const char* key, double scale, double* value) {
     if (!o[key].is_none()) *value = o[key].cast<double>() * scale;

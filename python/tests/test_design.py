@@ -28,7 +28,14 @@ def test_design_returns_poses_in_flight_order_and_predictions():
     for name in d["wanted"]:
         assert d["design"]["sigma_total"][name] < d["circle"]["sigma_total"][name]
         assert d["design"]["sigma_total"][name] < d["random"]["sigma_total"][name]
-    assert d["duration_s"] == pytest.approx(d["path_length_m"] / 0.5 + 60.0)
+    # Travel, dwell and the waits after the moves (issue 55), each stop's wait beside it.
+    assert d["settle_s"] == pytest.approx(sum(s["settle_s"] for s in d["stops"]))
+    assert d["duration_s"] == pytest.approx(d["path_length_m"] / 0.5 + 60.0 + d["settle_s"])
+    without = fastcal.design(
+        SPEC, 60, max_extra_tilt_deg=5.0, speed_m_per_s=0.5, settle_fraction=0.0, **GRID
+    )
+    assert without["settle_s"] == 0.0
+    assert without["duration_s"] == pytest.approx(without["path_length_m"] / 0.5 + 60.0)
     # The poses are ones the statics can hold.
     sol = fastcal.solve(poses[:, :3], rpy_deg=poses[:, 3:])
     assert np.all(sol.lower_tension_kN >= 50.0)

@@ -77,6 +77,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/move_settle.h"
 #include "fastcal/moving_parts.h"
 #include "fastcal/pose.h"
 #include "fastcal/trajectory.h"
@@ -173,6 +174,13 @@ struct DesignOptions {
   double speed_m_per_s = 0.0;
   double sample_interval_s = 1.0;
   double time_budget_s = 0.0;
+  // With a speed: the wait after each move until every tension is within
+  // settle.fraction of quasi-static (move_settle.h: the time-domain model, each leg a
+  // minimum-jerk move of its length / speed), added to the duration and the samples'
+  // times. The time budget holds travel and dwell; the waits come on top (the console
+  // says when they pass it). False: no waits.
+  bool settle_after_moves = true;
+  MoveSettleOptions settle;
   // The paper's measured circle, compared with: radius 71.11 m about (0, 0, 156.73) m,
   // N samples evenly spaced on one turn, attitude by the focal law.
   Eigen::Vector3d circle_centre_m = Eigen::Vector3d(0.0, 0.0, 156.73);
@@ -253,6 +261,9 @@ struct DesignStop {
   int candidate = 0;  // index into Design::candidates
   int samples = 0;    // samples taken there (dwell = samples x sample interval)
   DesignBinding binding;
+  // The wait before the first sample, after the move here (move_settle.h; 0 at the first
+  // stop, without a speed or with settle_after_moves false).
+  MoveSettle settle;
 };
 
 struct Design {
@@ -276,6 +287,10 @@ struct Design {
   std::vector<JointValues> joints;
   double path_length_m = 0.0;
   double travel_s = 0.0, dwell_s = 0.0, duration_s = 0.0;  // 0 without a speed
+  // The waits after moves (in duration_s), and the moves the dynamics could not run
+  // (they wait 0; empty when none).
+  double settle_s = 0.0;
+  std::string settle_note;
   // Distinct stops the optimum had before the time budget dropped some (= stops.size()
   // without a budget).
   int unconstrained_stops = 0;

@@ -192,7 +192,7 @@ void FlyStops(const std::vector<DesignCandidate>& candidates, const std::vector<
   d->joints.clear();
   for (int k : order) {
     const DesignCandidate& c = candidates[support[k]];
-    d->stops.push_back({support[k], counts[support[k]], {}});
+    d->stops.push_back({support[k], counts[support[k]], {}, {}});
     for (int s = 0; s < counts[support[k]]; ++s) {
       d->poses.push_back(c.pose);
       d->data_poses.push_back(c.data_pose);
@@ -350,6 +350,7 @@ bool DesignOptions::IsValid(std::string* error) const {
   if (!circle_centre_m.allFinite() || !(circle_radius_m > 0.0) || !std::isfinite(circle_radius_m)) {
     return fail("circle_centre_m must be finite and circle_radius_m > 0");
   }
+  if (settle_after_moves && !settle.IsValid(error)) return false;
   return true;
 }
 
@@ -583,6 +584,7 @@ std::vector<double> FlightTimes(const Design& d, const DesignOptions& o) {
     if (k > 0 && o.speed_m_per_s > 0.0) {
       t += (here - d.candidates[d.stops[k - 1].candidate].pose.position_m).norm() / o.speed_m_per_s;
     }
+    t += d.stops[k].settle.wait_s;
     for (int n = 0; n < d.stops[k].samples; ++n, t += o.sample_interval_s) times.push_back(t);
   }
   return times;
@@ -641,6 +643,33 @@ bool SetUp(const CableRobot& robot, const CalibrationSpec& spec, const DesignOpt
 }
 
 }  // namespace
+
+// Stage: the wait after each move (move_settle.h), into the stops and the duration. A move
+// the dynamics cannot run (its straight path leaves the workspace, say) waits 0 and is
+// named in settle_note; the design stands without.
+void SettleAfterMoves(const CableRobot& robot, const DesignOptions& o, Design* d) {
+  if (!o.settle_after_moves || !(o.speed_m_per_s > 0.0)) return;
+  int failed = 0;
+  std::string first;
+  for (size_t k = 1; k < d->stops.size(); ++k) {
+    const Pose& from = d->candidates[d->stops[k - 1].candidate].pose;
+    const Pose& to = d->candidates[d->stops[k].candidate].pose;
+    const double move_s = (to.position_m - from.position_m).norm() / o.speed_m_per_s;
+    MoveSettle settle;
+    std::string why;
+    if (!MoveSettleTime(robot, from, to, move_s, o.settle, &settle, &why)) {
+      if (failed++ == 0) first = "the move to stop " + std::to_string(k + 1) + ": " + why;
+      continue;
+    }
+    d->stops[k].settle = settle;
+    d->settle_s += settle.wait_s;
+  }
+  if (failed > 0) {
+    d->settle_note = std::to_string(failed) + " of " + std::to_string(d->stops.size() - 1) +
+                     " moves could not be run in time and wait 0 (" + first + ")";
+  }
+  d->duration_s += d->settle_s;
+}
 
 bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                   const DesignOptions& options, Design* design, std::string* error) {
@@ -701,6 +730,12 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
   for (DesignStop& stop : d.stops) {
     const DesignCandidate& c = d.candidates[stop.candidate];
     range.Holds(c.pose, c.joints, &stop.binding);
+  }
+  if (options.settle_after_moves && options.speed_m_per_s > 0.0 && d.stops.size() > 1) {
+    say("waits after the " + std::to_string(d.stops.size() - 1) +
+        " moves: each run in time where it could leave a tension beyond " +
+        Num(100 * options.settle.fraction) + "% of quasi-static");
+    SettleAfterMoves(robot, options, &d);
   }
   say("predictions for the design, the paper's circle and a random survey");
   d.slow_error = PredictionSlowError(spec, options);

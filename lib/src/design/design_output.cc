@@ -212,6 +212,9 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
   j.Key("time_budget_s").Number(o.time_budget_s > 0.0 ? o.time_budget_s : NAN);
   j.Key("travel_s").Number(o.speed_m_per_s > 0.0 ? d.travel_s : NAN);
   j.Key("dwell_s").Number(d.dwell_s);
+  j.Key("settle_s").Number(o.speed_m_per_s > 0.0 && o.settle_after_moves ? d.settle_s : NAN);
+  j.Key("settle_fraction").Number(o.settle_after_moves ? o.settle.fraction : NAN);
+  if (!d.settle_note.empty()) j.Key("settle_note").String(d.settle_note);
   j.Key("duration_s").Number(o.speed_m_per_s > 0.0 ? d.duration_s : NAN);
   j.EndObject();
   j.Key("stops").BeginArray();
@@ -219,6 +222,19 @@ std::string DesignJson(const Design& d, const std::string& provenance) {
     const DesignCandidate& c = d.candidates[s.candidate];
     const Eigen::Vector3d rpy = RpyDegFromRotation(c.data_pose.rotation);
     j.BeginObject().Key("samples").Int(s.samples);
+    // The wait before its samples (move_settle.h): simulated or screened out, settled or
+    // still outside the band at the longest wait.
+    j.Key("settle")
+        .BeginObject()
+        .Key("wait_s")
+        .Number(s.settle.wait_s)
+        .Key("move_s")
+        .Number(s.settle.move_s)
+        .Key("simulated")
+        .Bool(s.settle.simulated)
+        .Key("settled")
+        .Bool(s.settle.settled)
+        .EndObject();
     j.Key("position_m")
         .NumberArray(std::vector<double>{c.data_pose.position_m[0], c.data_pose.position_m[1],
                                          c.data_pose.position_m[2]});
@@ -550,7 +566,11 @@ std::string SurveyText(const Design& d) {
   if (o.speed_m_per_s > 0.0) {
     h += ", " + Fmt("%.3g", d.duration_s / 60.0) + " min at " + Fmt("%.3g", o.speed_m_per_s) +
          " m/s (" + Fmt("%.3g", d.travel_s / 60.0) + " min flying, " +
-         Fmt("%.3g", d.dwell_s / 60.0) + " min sampling)";
+         Fmt("%.3g", d.dwell_s / 60.0) + " min sampling" +
+         (o.settle_after_moves
+              ? ", " + Fmt("%.3g", d.settle_s / 60.0) + " min waiting for the tensions to settle"
+              : std::string()) +
+         ")";
   }
   if (o.time_budget_s > 0.0) {
     h += "; time budget " + Fmt("%.3g", o.time_budget_s / 60.0) + " min (" +

@@ -17,6 +17,9 @@
 namespace fastcal {
 namespace {
 
+// The most pieces the quasi-static reference splits a change of the winches into.
+constexpr int kMaxQuasiStaticPieces = 64;
+
 // The lowest modes computed at the start (for the damping and DynamicsStart).
 constexpr int kStartModes = 10;
 
@@ -432,13 +435,32 @@ double CableDynamics::WindSpeed(double time_s) const { return impl_->wind.Speed(
 
 bool CableDynamics::QuasiStatic(const std::array<double, kNumCables>& s0_m, QuasiStaticState* out,
                                 std::string* error) {
+  // From the last equilibrium found (the start's or the previous sample's), in as many
+  // equal pieces of the winches' change as Newton needs: a move of 40 m in 16 s sampled at
+  // 1 Hz changes the lengths by metres between samples, beyond one Newton solve's reach.
   internal::ChainState& state = impl_->quasi_static;
-  state.s0_m.assign(s0_m.begin(), s0_m.end());
+  const internal::ChainState last = state;
+  const bool continuable = last.s0_m.size() == s0_m.size();
   int iterations = 0;
-  if (!internal::SolveChainStatics(impl_->model, internal::ChainStaticsOptions(), &state,
-                                   &iterations, error)) {
-    *error = "the quasi-static reference: " + *error;
-    return false;
+  for (int pieces = 1;; pieces *= 2) {
+    state = last;
+    bool ok = true;
+    for (int k = 1; k <= pieces && ok; ++k) {
+      for (size_t i = 0; i < s0_m.size(); ++i) {
+        state.s0_m.resize(s0_m.size());
+        state.s0_m[i] = continuable && k < pieces
+                            ? last.s0_m[i] + (s0_m[i] - last.s0_m[i]) * k / pieces
+                            : s0_m[i];
+      }
+      ok = internal::SolveChainStatics(impl_->model, internal::ChainStaticsOptions(), &state,
+                                       &iterations, error);
+    }
+    if (ok) break;
+    if (!continuable || pieces >= kMaxQuasiStaticPieces) {
+      state = last;
+      *error = "the quasi-static reference: " + *error;
+      return false;
+    }
   }
   internal::ChainForces forces;
   internal::EvaluateForces(impl_->model, state, Eigen::Vector3d::Zero(), false, &forces);
