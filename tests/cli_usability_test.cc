@@ -289,9 +289,24 @@ TEST_F(UsabilityTest, ThePapersTable6IsBesideTheRmsTableOnItsCircle) {
   EXPECT_TRUE(Has(ReadFile(Path("c/report.md")),
                   "| AAS with actual attitudes | initial model, "
                   "measured attitude | 23.942 |"));
+  // Issue 59: the file is the simulate's (its header says so): the report says so in its
+  // first lines, and the console's Table 6 with the caveat.
+  const std::string report = ReadFile(Path("c/report.md"));
+  EXPECT_LT(report.find("**Simulated data.**"), report.find("## Provenance")) << report;
+  EXPECT_TRUE(Has(calibrated.out, "THESE DATA\n  ARE SIMULATED (fastcal simulate)"))
+      << calibrated.out;
   const Streams evaluated =
       Run("evaluate --model=" + Path("c/model_calibrated.yaml") + " --data=" + renamed);
   EXPECT_TRUE(Has(evaluated.out, "paper's Table 6: actual attitudes")) << evaluated.out;
+  EXPECT_TRUE(Has(evaluated.out, "ARE SIMULATED")) << evaluated.out;
+  // The same samples without the header: the paper's table as before, no caveat.
+  std::string data = ReadFile(renamed);
+  while (data.rfind("#", 0) == 0) data.erase(0, data.find('\n') + 1);
+  Write("flight_0413.csv", data);
+  const Streams plain = Run("evaluate --data=" + Path("flight_0413.csv"));
+  EXPECT_TRUE(Has(plain.out, "the same circle on the telescope (the paper's published RMS, kN):"))
+      << plain.out;
+  EXPECT_FALSE(Has(plain.out, "SIMULATED")) << plain.out;
   // Another survey: no paper values.
   const Streams other =
       Run("evaluate --data=" + Source() + "/calibration_data/workspace_multi_zenith.csv");
