@@ -652,10 +652,16 @@ std::string ChiSquareWarning(const CalibrationResult& result) {
   return "";
 }
 
-// "0.0012 m", "0.031 kg/m": a sigma in the parameter's unit (the one its name carries, as
-// its estimate beside it), 2 significant digits.
+// "0.0012 m", "0.031 kg/m", "655 kg m": a sigma in the parameter's unit (the one its name
+// carries, as its estimate beside it), 2 significant digits, and from 100 up in whole
+// units as the estimate's "+- sigma" is (issue 59: "-310 +- 655 kg m" stood beside
+// "6.6e+02 kg m").
 std::string SigmaText(double sigma, const std::string& unit) {
-  return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
+  constexpr double kWholeFrom = 100.0;  // where %.2g turns to an exponent
+  const std::string text = std::abs(sigma) >= kWholeFrom && std::isfinite(sigma)
+                               ? internal::FormatDouble("%.0f", sigma)
+                               : FormatDouble(sigma, 2);
+  return text + (unit == "1" ? "" : " " + unit);
 }
 
 // Long notes are cut to kNoteLines lines on the console (the report has them whole).

@@ -336,6 +336,29 @@ TEST_F(UsabilityTest, TheReadmeTourWritesUnderOut) {
   EXPECT_TRUE(Has(tour, "mkdir -p out"));
 }
 
+// Issue 59: the README's moving-parts example starts from a first moment of zero, not from
+// calibration_data/moving_parts.yaml, which holds the truth it is meant to find.
+TEST_F(UsabilityTest, TheReadmeMovingPartsExampleStartsFromZero) {
+  const std::string readme = ReadFile(Source() + "/README.md");
+  const size_t calibrate = readme.find("calibrate --spec=calibration_data/spec_moving_parts.yaml");
+  ASSERT_NE(calibrate, std::string::npos);
+  const std::string command =
+      readme.substr(calibrate, readme.find("--out=", calibrate) - calibrate);
+  const std::smatch model = [&command] {
+    std::smatch m;
+    std::regex_search(command, m, std::regex("--model=(\\S+)"));
+    return m;
+  }();
+  ASSERT_FALSE(model.empty()) << command;
+  EXPECT_NE(model[1].str(), "calibration_data/moving_parts.yaml") << command;
+  // The start model is the truth with its first moment zeroed, made just before.
+  EXPECT_TRUE(Has(readme.substr(0, calibrate),
+                  "sed 's/\\[0, 0, -6000\\]/[0, 0, 0]/' calibration_data/moving_parts.yaml \\\n"
+                  "        > " +
+                      model[1].str()))
+      << readme.substr(calibrate - 400, 400);
+}
+
 }  // namespace
 
 namespace {
