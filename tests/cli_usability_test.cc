@@ -117,6 +117,20 @@ TEST_F(UsabilityTest, AMisspeltFlagGetsDidYouMean) {
       << far.output;
 }
 
+// A misspelt command gets the closest command, every command among them (issue 59:
+// `fastcal trak` suggests track; `fastcal dynamcs` suggested nothing, dynamics missing
+// from the list).
+TEST_F(UsabilityTest, AMisspeltCommandGetsDidYouMean) {
+  for (const auto& [command, expected] :
+       std::vector<std::pair<std::string, std::string>>{{"trak", "did you mean track?"},
+                                                        {"dynamcs", "did you mean dynamics?"},
+                                                        {"mode", "did you mean modes?"}}) {
+    const CommandResult r = Fastcal(command);
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_TRUE(Has(r.output, "unknown command '" + command + "'; " + expected)) << r.output;
+  }
+}
+
 // solve --help names every status the library can give, from the library's own list.
 TEST_F(UsabilityTest, SolveHelpListsEveryStatus) {
   const std::string help = Fastcal("solve --help").output;
