@@ -70,6 +70,27 @@ TEST_F(CliTest, ModesCapWritesCsvAndMap) {
   const std::string text = ReadFile(csv);
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 10);
   EXPECT_NE(ReadFile(html).find("<svg"), std::string::npos);
+  // Issue 59: it says what it does before the seconds of work, and the vertical map says
+  // where no mode is mostly vertical (z_share under 0.5 in the CSV).
+  EXPECT_NE(r.output.find("fastcal modes --cap: the 20 lowest modes at 9 nodes of the cap (12 "
+                          "segments per cable"),
+            std::string::npos)
+      << r.output;
+  std::istringstream rows(text);
+  std::string row;
+  std::getline(rows, row);
+  const std::vector<std::string> header = CsvFields(row);
+  const size_t z_share = std::find(header.begin(), header.end(), "z_share") - header.begin();
+  ASSERT_LT(z_share, header.size());
+  int split = 0;
+  while (std::getline(rows, row)) split += std::stod(CsvFields(row)[z_share]) < 0.5;
+  ASSERT_GT(split, 0);
+  EXPECT_NE(ReadFile(html).find("At " + std::to_string(split) +
+                                " of 9 nodes no mode holds over half its kinetic energy in the "
+                                "cabin's vertical motion"),
+            std::string::npos);
+  EXPECT_NE(ReadFile(html).find("% of its energy vertical: under half, no single vertical mode)"),
+            std::string::npos);
   RunBoundedAndExpect({"modes --cap --position=0,0,140", 2, "--position is for one pose"});
   RunBoundedAndExpect({"modes --position=0,0,140 --html=" + Path("x.html"), 2, "--cap"});
   RunBoundedAndExpect({"modes --cap --off-axis-step-deg=0", 2, "--off-axis-step-deg"});
