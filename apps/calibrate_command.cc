@@ -18,6 +18,7 @@
 #include <functional>
 #include <future>
 #include <iostream>
+#include <limits>
 #include <map>
 #include <sstream>
 
@@ -33,6 +34,7 @@
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/evaluation_stream.h"
 #include "fastcal/file_digest.h"
+#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/internal/report_document.h"
@@ -410,11 +412,18 @@ std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
 
 // The paper's published Table 6 under the RMS table when the data fly its measured circle
 // (PaperCircleMatcher: by the positions, whoever made the file); "" otherwise.
-std::string PaperTable6Lines(const PaperCircleMatcher& positions) {
+// With `simulated` data (SimulatedProvenance), the lines say that the comparison is a
+// simulation's noise against the telescope's (issue 59).
+std::string PaperTable6Lines(const PaperCircleMatcher& positions, bool simulated) {
   if (!positions.Matches()) return "";
   const char* labels[] = {"paper's Table 6: AAS", "paper's Table 6: actual attitudes",
                           "paper's Table 6: + corrected mass centre"};
   std::string s = "  the same circle on the telescope (the paper's published RMS, kN):\n";
+  if (simulated) {
+    s = "  the same circle on the real telescope (the paper's published RMS, kN); THESE DATA\n"
+        "  ARE SIMULATED (fastcal simulate): their RMS is the simulation's noise, not an\n"
+        "  improvement over the paper's:\n";
+  }
   for (size_t k = 0; k < internal::kPaperTable6.size(); ++k) {
     s += CableRow(labels[k], internal::kPaperTable6[k].rms_kn, 1.0);
   }
@@ -440,6 +449,37 @@ std::vector<std::string> DataPaths() {
     if (comma == std::string_view::npos) return paths;
     rest.remove_prefix(comma + 1);
   }
+}
+
+// Issue 59: the data files' provenance when `fastcal simulate` made them (the leading
+// comment it writes: "# Simulated by fastcal VERSION", the command, the truth model),
+// their lines without "# " joined by '\n' (each prefixed with its file's name when --data
+// names several); "" when no file says so. Only the first 8 KiB of each are read (a
+// gzipped file decompressed); a file that cannot be read says nothing here (its reader
+// says why).
+std::string SimulatedProvenance() {
+  constexpr char kMark[] = "# Simulated by fastcal";
+  const std::vector<std::string> paths = DataPaths();
+  std::string out;
+  for (const std::string& path : paths) {
+    internal::RegularFileReader reader;
+    std::string text, error;
+    bool end = false;
+    if (!reader.Open(path, std::numeric_limits<long long>::max(), "--data", &error) ||
+        !reader.Read(8192, &text, &end, &error) || text.rfind(kMark, 0) != 0) {
+      continue;
+    }
+    for (size_t start = 0; start < text.size() && text[start] == '#';) {
+      const size_t newline = text.find('\n', start);
+      if (newline == std::string::npos) break;  // a line cut by the 8 KiB
+      std::string line = text.substr(start, newline - start);
+      line.erase(0, line.find_first_not_of("# "));
+      if (!line.empty() && line.back() == '\r') line.pop_back();
+      out += (out.empty() ? "" : "\n") + (paths.size() > 1 ? path + ": " : "") + line;
+      start = newline + 1;
+    }
+  }
+  return out;
 }
 
 // --model's model and --data's files (checked: given, no empty name).
@@ -612,10 +652,16 @@ std::string ChiSquareWarning(const CalibrationResult& result) {
   return "";
 }
 
-// "0.0012 m", "0.031 kg/m": a sigma in the parameter's unit (the one its name carries, as
-// its estimate beside it), 2 significant digits.
+// "0.0012 m", "0.031 kg/m", "655 kg m": a sigma in the parameter's unit (the one its name
+// carries, as its estimate beside it), 2 significant digits, and from 100 up in whole
+// units as the estimate's "+- sigma" is (issue 59: "-310 +- 655 kg m" stood beside
+// "6.6e+02 kg m").
 std::string SigmaText(double sigma, const std::string& unit) {
-  return FormatDouble(sigma, 2) + (unit == "1" ? "" : " " + unit);
+  constexpr double kWholeFrom = 100.0;  // where %.2g turns to an exponent
+  const std::string text = std::abs(sigma) >= kWholeFrom && std::isfinite(sigma)
+                               ? internal::FormatDouble("%.0f", sigma)
+                               : FormatDouble(sigma, 2);
+  return text + (unit == "1" ? "" : " " + unit);
 }
 
 // Long notes are cut to kNoteLines lines on the console (the report has them whole).
@@ -971,8 +1017,8 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
   }
   s << GrossErrorLines(result) << MisfitLine(result) << "\n"
     << RmsTable(variants) << CrossValidationLine(result) << LengthTable(result.lengths)
-    << PaperTable6Lines(PositionsOf(data)) << "\nwrote " << FLAGS_out
-    << "/{model_calibrated.yaml, ";
+    << PaperTable6Lines(PositionsOf(data), !SimulatedProvenance().empty()) << "\nwrote "
+    << FLAGS_out << "/{model_calibrated.yaml, ";
   // One model a session when the spec separates parameters by session.
   for (size_t k = 0; k < result.session_models.size(); ++k) {
     s << "model_calibrated@" << result.session_labels[k] << ".yaml, ";
@@ -1057,6 +1103,7 @@ ReportInputs ReportProvenance(int argc, char** argv, bool with_spec,
   report.software_version = FASTCAL_VERSION;
   report.command_line = CommandLine(argc, argv);
   report.run_utc = UtcNow();
+  report.simulated_provenance = SimulatedProvenance();
   return report;
 }
 
@@ -1230,7 +1277,7 @@ std::string EvaluationConsole(const Dataset& data, long long samples, StaticsMet
   s << SkippedNote(data);
   s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
     << StaticsMethodName(method) << "\n\n"
-    << RmsTable(variants) << PaperTable6Lines(positions);
+    << RmsTable(variants) << PaperTable6Lines(positions, !SimulatedProvenance().empty());
   for (const VariantEvaluation& v : variants) {
     s << "\n" << CableHeader(v.name + ":");
     s << CableRow("  RMS (%)", v.fit.rms_percent, 1.0);

@@ -102,7 +102,7 @@ int RunCommand(const std::string& command, int argc, char** argv) {
   if (!known) {
     const std::vector<std::string> closest =
         ClosestNames(command, {"solve", "locate", "calibrate", "evaluate", "simulate", "workspace",
-                               "track", "design", "modes", "import"});
+                               "track", "design", "modes", "dynamics", "import"});
     std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command)
               << (closest.empty() ? "" : "; did you mean " + closest.front() + "?") << "\n\n"
               << kUsage;

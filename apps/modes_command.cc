@@ -12,6 +12,7 @@
 #include "commands.h"
 #include "fastcal/modes.h"
 #include "fastcal/modes_map.h"
+#include "fastcal/trajectory.h"
 #include "fastcal/version.h"
 
 DECLARE_string(model);
@@ -240,6 +241,14 @@ int RunCap(int argc, char** argv, const CableRobot& robot, const ModesOptions& m
   if (!CapOptionsFromFlags(modes, &options, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
+  }
+  // Issue 59: seconds of silence read as a hang; say what is being done first.
+  std::vector<Eigen::Vector3d> positions;
+  if (FocalSpherePositions(options.grid, &positions, &error)) {
+    std::cerr << "fastcal modes --cap: the " << options.modes.modes << " lowest modes at "
+              << positions.size() << " nodes of the cap (" << options.modes.segments
+              << " segments per cable; about 2 to 5 s for 193 nodes at 48 on 2 cores)..."
+              << std::endl;
   }
   const auto start = std::chrono::steady_clock::now();
   ModesMap map;

@@ -136,10 +136,12 @@ statics' lengths, then --wait-s before the sample; a pose that repeats the one b
 control error, a mass-centre drift or steps, sensor steps, sessions or moving parts.
 
 --vibration: a record of the cabin's free vibration at one pose from the linearised model
-(fastcal modes): the predicted modes --excite'd (1-based) with the given damping ratios,
-each moving a point of the cabin (O' or an anchor point) by at most --amplitude-m at
-t = 0 (at most 1 m: the linearisation's small motions), superposed; the tensions follow
-the cabin's motion quasi-statically; white noise of the given sigmas. At most 10^6 samples
+(fastcal modes): the predicted modes --excite'd (1-based) with the given damping ratios
+(0.01 each without --damping for other modes than 1,2,3), each moving a point of the cabin
+(O' or an anchor point) by at most --amplitude-m at t = 0 (at most 1 m: the
+linearisation's small motions), superposed; the tensions follow the cabin's motion
+quasi-statically; white noise of the given sigmas, none unless given (each noise flag
+defaults to 0; the summary says the damping and the noise). At most 10^6 samples
 (--duration-s / --interval-s); a mode with under 0.1% of its energy in the cabin, and a
 motion that would slacken a cable, are refused. A dataset CSV (time_s, the pose,
 T1_kN..T6_kN) that `fastcal modes --data` identifies. Only the flags shown apply.

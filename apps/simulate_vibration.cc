@@ -5,6 +5,7 @@
 #include <gflags/gflags.h>
 
 #include <iostream>
+#include <vector>
 
 #include "cli_util.h"
 #include "commands.h"
@@ -24,7 +25,9 @@ DECLARE_int32(segments);
 
 DEFINE_bool(vibration, false, "simulate: a free vibration at --position (docs/cli.md).");
 DEFINE_string(excite, "1,2,3", "simulate --vibration: the predicted modes excited (1-based).");
-DEFINE_string(damping, "0.005,0.01,0.015", "simulate --vibration: a damping ratio per mode.");
+DEFINE_string(damping, "0.005,0.01,0.015",
+              "simulate --vibration: a damping ratio per mode (without it: 0.005,0.01,0.015 "
+              "for the default modes 1,2,3, else 0.01 each).");
 DEFINE_double(amplitude_m, 0.05,
               "simulate --vibration: each mode's largest initial motion of a point of the "
               "cabin (m, at most 1).");
@@ -36,6 +39,10 @@ namespace {
 constexpr char kCommand[] = "simulate";
 // The record's sampling when --interval-s is not given (a survey's default is 1 s).
 constexpr double kVibrationIntervalS = 0.1;
+// Each excited mode's damping ratio when --damping is not given and --excite is not the
+// default's modes (issue 59: --excite=25 complained of a --damping never given): 1%, in
+// the middle of FAST's 0.4-1.5%.
+constexpr double kDefaultDampingRatio = 0.01;
 
 bool SpecFromFlags(VibrationRecordSpec* spec, std::string* error) {
   std::vector<double> excite;
@@ -57,9 +64,12 @@ bool SpecFromFlags(VibrationRecordSpec* spec, std::string* error) {
       return false;
     }
   }
+  if (!FlagGiven("damping") && spec->modes != std::vector<int>{1, 2, 3}) {
+    spec->damping_ratio.assign(spec->modes.size(), kDefaultDampingRatio);
+  }
   if (spec->damping_ratio.size() != spec->modes.size()) {
     *error = "--damping gives " + std::to_string(spec->damping_ratio.size()) + " ratios for " +
-             std::to_string(spec->modes.size()) + " --excite modes";
+             std::to_string(spec->modes.size()) + " --excite modes: give one ratio per mode";
     return false;
   }
   spec->sample_interval_s = FlagGiven("interval-s") ? FLAGS_interval_s : kVibrationIntervalS;
@@ -106,6 +116,24 @@ bool WriteRecordCsv(const std::string& path, const VibrationRecord& record,
     chunk.clear();
   }
   return writer.Write(chunk, error) && writer.Commit(replace, error);
+}
+
+// "damping ratios 0.005, 0.01, 0.015; noise: none (...)": what the record holds besides
+// the modes (issue 59: the summary said nothing of the noise, which is 0 by default).
+std::string DampingAndNoise(const VibrationRecordSpec& spec) {
+  std::string text = "damping ratios";
+  for (size_t i = 0; i < spec.damping_ratio.size(); ++i) {
+    text += (i == 0 ? " " : ", ") + FormatDouble(spec.damping_ratio[i], 4);
+  }
+  if (spec.position_noise_m == 0.0 && spec.attitude_noise_deg == 0.0 &&
+      spec.tension_noise_kn == 0.0) {
+    return text +
+           "; noise: none (--position-noise-m, --attitude-noise-deg and --tension-noise-kN "
+           "are 0 unless given)";
+  }
+  return text + "; white noise, sigma: position " + FormatDouble(spec.position_noise_m, 4) +
+         " m, attitude " + FormatDouble(spec.attitude_noise_deg, 4) + " deg, tensions " +
+         FormatDouble(spec.tension_noise_kn, 4) + " kN";
 }
 
 }  // namespace
@@ -164,7 +192,8 @@ int RunSimulateVibration(int argc, char** argv) {
   }
   std::cout << "fastcal simulate --vibration: " << record.channels.cols() << " samples every "
             << FormatDouble(spec.sample_interval_s) << " s of modes " << FLAGS_excite << " at "
-            << attitude << ", written to " << FLAGS_out << std::endl;
+            << attitude << ", written to " << FLAGS_out << "\n  " << DampingAndNoise(spec)
+            << std::endl;
   return 0;
 }
 

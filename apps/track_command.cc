@@ -109,9 +109,10 @@ likelihood interval (inside the window, at TIME, from LOW to HIGH; events.json: 
 after, time_low, time_high). Times in the column map's zone (UTC without a map).
 
 Outputs in DIR:
-  track.csv               one row per window: window_start, window_end (ISO 8601 UTC),
-                          samples, NAME, NAME_sigma_total per per-window parameter, each
-                          sensor's offset, chi2/nu, widening, gross errors, window label
+  track.csv               one row per window: window_start, window_end (ISO 8601 in
+                          the column map's zone, UTC without a map), samples, NAME,
+                          NAME_sigma_total per per-window parameter, each sensor's
+                          offset, chi2/nu, widening, gross errors, window label
   events.json             the events: time, after, time_low, time_high, kind, parameters
                           {shift, sigma_total}, cables, statistic, p_value (family-wise)
   model_calibrated@W.yaml the latest window's model, and one per event-free stretch

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <regex>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -78,6 +79,23 @@ TEST_F(CliMovingPartsTest, ASurveyOfRotatorAnglesFindsTheFirstMomentAndThePlatfo
     EXPECT_NE(report.find("rotating assembly has its centre"), std::string::npos);
     const std::string json = ReadFile(Path("cal") + "/summary.json");
     EXPECT_NE(json.find("\"moving_parts.rotator.first_moment_kg_m.z\""), std::string::npos);
+    // Issue 59: the console's formal sigma written as its sigma_total is ("-310 +- 655 kg
+    // m" stood beside "6.6e+02 kg m"), and a part's components set mostly by their prior
+    // marked in "Moving parts" as Estimates marks them (the platform's mass here: 270 kg
+    // against its 300 kg prior; the first moment's z, determined, is not).
+    std::istringstream console(cal.output);
+    for (std::string line; std::getline(console, line);) {
+      if (line.find("  moving_parts.") == 0) {
+        EXPECT_EQ(line.find("e+0"), std::string::npos) << line;
+      }
+    }
+    const bool mass_marked = std::regex_search(
+        cal.output, std::regex("moving_parts\\.stewart\\.mass_kg[^\\n]*\\n? *prior-dominated"));
+    EXPECT_TRUE(mass_marked) << cal.output;
+    EXPECT_TRUE(std::regex_search(
+        report, std::regex("mass [0-9]+ kg ± [0-9]+ kg \\(set mostly by the prior\\)")))
+        << report.substr(report.find("## Moving parts"), 2000);
+    EXPECT_EQ(report.find("z set mostly by the prior"), std::string::npos);
   }
 }
 

@@ -205,6 +205,12 @@ TEST_F(CliTrackTest, AnExportIsTrackedThroughItsColumnMap) {
                 .find("\n2024-05-01T08:00:00+08:00,2024-05-02T08:00:00+08:00,1441,"),
             std::string::npos)
       << ReadFile(Path("t/track.csv"));
+  // track --help says so (issue 59: it said window_start was UTC).
+  const std::string help = Fastcal("track --help").output;
+  EXPECT_NE(help.find("window_start, window_end (ISO 8601 in\n                          the "
+                      "column map's zone, UTC without a map)"),
+            std::string::npos)
+      << help;
   // The same file without its map is not the track's.
   const auto without = Fastcal(track + " --data=" + data);
   EXPECT_EQ(without.code, 2) << without.output;

@@ -117,6 +117,20 @@ TEST_F(UsabilityTest, AMisspeltFlagGetsDidYouMean) {
       << far.output;
 }
 
+// A misspelt command gets the closest command, every command among them (issue 59:
+// `fastcal trak` suggests track; `fastcal dynamcs` suggested nothing, dynamics missing
+// from the list).
+TEST_F(UsabilityTest, AMisspeltCommandGetsDidYouMean) {
+  for (const auto& [command, expected] :
+       std::vector<std::pair<std::string, std::string>>{{"trak", "did you mean track?"},
+                                                        {"dynamcs", "did you mean dynamics?"},
+                                                        {"mode", "did you mean modes?"}}) {
+    const CommandResult r = Fastcal(command);
+    EXPECT_EQ(r.code, 2) << command;
+    EXPECT_TRUE(Has(r.output, "unknown command '" + command + "'; " + expected)) << r.output;
+  }
+}
+
 // solve --help names every status the library can give, from the library's own list.
 TEST_F(UsabilityTest, SolveHelpListsEveryStatus) {
   const std::string help = Fastcal("solve --help").output;
@@ -289,9 +303,24 @@ TEST_F(UsabilityTest, ThePapersTable6IsBesideTheRmsTableOnItsCircle) {
   EXPECT_TRUE(Has(ReadFile(Path("c/report.md")),
                   "| AAS with actual attitudes | initial model, "
                   "measured attitude | 23.942 |"));
+  // Issue 59: the file is the simulate's (its header says so): the report says so in its
+  // first lines, and the console's Table 6 with the caveat.
+  const std::string report = ReadFile(Path("c/report.md"));
+  EXPECT_LT(report.find("**Simulated data.**"), report.find("## Provenance")) << report;
+  EXPECT_TRUE(Has(calibrated.out, "THESE DATA\n  ARE SIMULATED (fastcal simulate)"))
+      << calibrated.out;
   const Streams evaluated =
       Run("evaluate --model=" + Path("c/model_calibrated.yaml") + " --data=" + renamed);
   EXPECT_TRUE(Has(evaluated.out, "paper's Table 6: actual attitudes")) << evaluated.out;
+  EXPECT_TRUE(Has(evaluated.out, "ARE SIMULATED")) << evaluated.out;
+  // The same samples without the header: the paper's table as before, no caveat.
+  std::string data = ReadFile(renamed);
+  while (data.rfind("#", 0) == 0) data.erase(0, data.find('\n') + 1);
+  Write("flight_0413.csv", data);
+  const Streams plain = Run("evaluate --data=" + Path("flight_0413.csv"));
+  EXPECT_TRUE(Has(plain.out, "the same circle on the telescope (the paper's published RMS, kN):"))
+      << plain.out;
+  EXPECT_FALSE(Has(plain.out, "SIMULATED")) << plain.out;
   // Another survey: no paper values.
   const Streams other =
       Run("evaluate --data=" + Source() + "/calibration_data/workspace_multi_zenith.csv");
@@ -319,6 +348,29 @@ TEST_F(UsabilityTest, TheReadmeTourWritesUnderOut) {
   }
   EXPECT_GE(outputs, 10);
   EXPECT_TRUE(Has(tour, "mkdir -p out"));
+}
+
+// Issue 59: the README's moving-parts example starts from a first moment of zero, not from
+// calibration_data/moving_parts.yaml, which holds the truth it is meant to find.
+TEST_F(UsabilityTest, TheReadmeMovingPartsExampleStartsFromZero) {
+  const std::string readme = ReadFile(Source() + "/README.md");
+  const size_t calibrate = readme.find("calibrate --spec=calibration_data/spec_moving_parts.yaml");
+  ASSERT_NE(calibrate, std::string::npos);
+  const std::string command =
+      readme.substr(calibrate, readme.find("--out=", calibrate) - calibrate);
+  const std::smatch model = [&command] {
+    std::smatch m;
+    std::regex_search(command, m, std::regex("--model=(\\S+)"));
+    return m;
+  }();
+  ASSERT_FALSE(model.empty()) << command;
+  EXPECT_NE(model[1].str(), "calibration_data/moving_parts.yaml") << command;
+  // The start model is the truth with its first moment zeroed, made just before.
+  EXPECT_TRUE(Has(readme.substr(0, calibrate),
+                  "sed 's/\\[0, 0, -6000\\]/[0, 0, 0]/' calibration_data/moving_parts.yaml \\\n"
+                  "        > " +
+                      model[1].str()))
+      << readme.substr(calibrate - 400, 400);
 }
 
 }  // namespace

@@ -619,6 +619,36 @@ TEST_F(ReportTest, ThePapersTable6FollowsTheRmsTableOnItsCircle) {
                        "18.687 | 17.167 | 18.190 |"));
 }
 
+// Issue 59: a report on data fastcal simulate made says so before anything else, and
+// sets the paper's Table 6 beside its RMS only with that caveat.
+TEST_F(ReportTest, AReportOnSimulatedDataSaysSoFirst) {
+  for (int k = 0; k < 40; ++k) {  // the paper's whole circle, as above
+    Sample s = data_.samples.front();
+    const double a = 2.0 * M_PI * (k + 0.5) / 40.0;
+    s.pose.position_m = Eigen::Vector3d(71.11 * std::cos(a), 71.11 * std::sin(a), 156.73);
+    data_.samples.push_back(s);
+  }
+  EXPECT_FALSE(Contains(ReportMarkdown(inputs_), "Simulated data"));
+  inputs_.simulated_provenance =
+      "Simulated by fastcal 0.2.0\nfastcal simulate --seed=1 --out=c.csv\nTruth model: c.yaml";
+  const std::string md = ReportMarkdown(inputs_);
+  const size_t note = md.find(
+      "**Simulated data.** The data file says it was made by fastcal "
+      "simulate (`Simulated by fastcal 0.2.0`");
+  ASSERT_NE(note, std::string::npos) << md.substr(0, 1500);
+  EXPECT_LT(note, md.find("## Provenance"));
+  EXPECT_TRUE(Contains(md,
+                       "| Data's header | simulated: `Simulated by fastcal 0.2.0`; `fastcal "
+                       "simulate --seed=1 --out=c.csv`; `Truth model: c.yaml` |"))
+      << md;
+  EXPECT_TRUE(Contains(md,
+                       "**The paper's Table 6, the same circle on the real telescope (these "
+                       "data are simulated): RMS [kN]**"))
+      << md;
+  EXPECT_TRUE(Contains(md, "**These data are simulated** (made by fastcal simulate"));
+  EXPECT_TRUE(Contains(ReportHtml(inputs_), "Simulated data."));
+}
+
 // A pose axis the data move along is plotted (a spiral: the off-axis angle varies).
 TEST_F(ReportTest, APlotAgainstAnAxisThatVariesIsDrawn) {
   for (size_t n = 0; n < data_.samples.size(); ++n) data_.samples[n].pose.position_m.z() += 3.0 * n;

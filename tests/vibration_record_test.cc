@@ -66,5 +66,27 @@ TEST(VibrationRecordTest, AStepThatIsNotTheRecordsIsNamedAtItsLine) {
   EXPECT_NE(error.find("a record needs many samples, it has 1"), std::string::npos) << error;
 }
 
+// Issue 59: a survey day (poses tens of metres apart) is not a vibration about one pose;
+// refused at the line furthest from the mean, with the spread and the bound. A cabin that
+// stays within kMaxPoseSpreadM of its mean is read.
+TEST(VibrationRecordTest, ARecordThatIsNotAboutOnePoseIsRefused) {
+  VibrationRecordFile file;
+  std::string error;
+  std::string csv = kHeader;
+  for (int k = 0; k < 100; ++k) {
+    csv += std::to_string(0.1 * k) + "," + (k == 60 ? "30" : "0") +
+           ",0,140,0,0,0,160,161,162,163,164,165\n";
+  }
+  EXPECT_FALSE(ParseVibrationRecord(csv, "day.csv", DatasetReadOptions(), &file, &error));
+  EXPECT_EQ(error.rfind("day.csv:62: the cabin is 29.7 m from the record's mean position (0.3, "
+                        "0, 140) m, beyond the 2 m a vibration about one pose may spread",
+                        0),
+            0u)
+      << error;
+  // 0 to 3.9 m along x: 1.95 m from the mean at most, within the bound.
+  EXPECT_TRUE(ParseVibrationRecord(Record(3901, 0.1), "r.csv", DatasetReadOptions(), &file, &error))
+      << error;
+}
+
 }  // namespace
 }  // namespace fastcal

@@ -87,6 +87,11 @@ struct ReportInputs {
   std::string command_line;
   // When the run happened, UTC, e.g. "2026-11-22T15:04:05Z"; empty: not recorded.
   std::string run_utc;
+  // The data file's provenance when `fastcal simulate` made it (its header comment, e.g.
+  // "Simulated by fastcal 0.2.0\nfastcal simulate --seed=1 ...", lines joined by '\n');
+  // empty: data not known to be simulated. The report then says so in its first lines,
+  // and sets the paper's Table 6 beside its RMS only with that caveat (issue 59).
+  std::string simulated_provenance;
   // Not owned; must outlive the calls. `data` is required. `spec` and `result` are null
   // for an evaluation-only report (`fastcal evaluate`); `initial_model` may be null.
   const CableRobot* initial_model = nullptr;

@@ -69,7 +69,7 @@ class RecordBuilder {
     out->mean_pose.position_m = mean.head<3>();
     // FAST's attitudes stay far from the +-180 deg wrap: the angles' mean is the attitude's.
     out->mean_pose.rotation = RotationFromRpyDeg(mean[3], mean[4], mean[5]);
-    return true;
+    return CheckPoseSpread(*out, error);
   }
 
  private:
@@ -99,6 +99,23 @@ class RecordBuilder {
       return false;
     }
     return true;
+  }
+
+  // No sample's position further than kMaxPoseSpreadM from the mean: one pose's vibration.
+  bool CheckPoseSpread(const VibrationRecordFile& out, std::string* error) const {
+    const Eigen::MatrixXd& c = out.record.channels;
+    Eigen::Index far = 0;
+    const double spread =
+        (c.topRows<3>().colwise() - out.mean_pose.position_m).colwise().norm().maxCoeff(&far);
+    if (spread <= kMaxPoseSpreadM) return true;
+    const Eigen::Vector3d& m = out.mean_pose.position_m;
+    *error = Where(lines_[far]) + ": the cabin is " + Num(spread) +
+             " m from the record's mean position (" + Num(m.x()) + ", " + Num(m.y()) + ", " +
+             Num(m.z()) + ") m, beyond the " + Num(kMaxPoseSpreadM) +
+             " m a vibration about one pose may spread (the modes are predicted at that mean, "
+             "and they change by about 0.4% a metre): not a vibration record (a survey, a "
+             "move?); cut it to a stretch where the cabin holds one pose";
+    return false;
   }
 
   std::string path_;

@@ -34,14 +34,17 @@ std::string CapMap(const ModesMap& map, const CableRobot& robot, const std::stri
     c.angle_lo_deg = axis ? 0.0 : n.azimuth_deg - half_azimuth;
     c.angle_hi_deg = axis ? 360.0 : n.azimuth_deg + half_azimuth;
     c.value = n.ok ? value(n) : std::nan("");
-    c.tooltip = "off-axis " + Num(n.off_axis_deg, 4) + "\u00b0, azimuth " + Num(n.azimuth_deg, 4) +
-                "\u00b0: " +
-                (n.ok ? "lowest " + Num(n.lowest_hz, 5) + " Hz (cabin " +
-                            Num(100 * n.lowest_cabin_share, 3) + "%), first cabin-dominated " +
-                            (n.first_cabin_mode > 0 ? Num(n.first_cabin_hz, 5) + " Hz"
-                                                    : std::string("none")) +
-                            ", vertical " + Num(n.motion_hz[2], 5) + " Hz"
-                      : n.reason);
+    c.tooltip =
+        "off-axis " + Num(n.off_axis_deg, 4) + "\u00b0, azimuth " + Num(n.azimuth_deg, 4) +
+        "\u00b0: " +
+        (n.ok ? "lowest " + Num(n.lowest_hz, 5) + " Hz (cabin " +
+                    Num(100 * n.lowest_cabin_share, 3) + "%), first cabin-dominated " +
+                    (n.first_cabin_mode > 0 ? Num(n.first_cabin_hz, 5) + " Hz"
+                                            : std::string("none")) +
+                    ", vertical " + Num(n.motion_hz[2], 5) + " Hz (" +
+                    Num(100 * n.motion_share[2], 3) + "% of its energy vertical" +
+                    (n.motion_share[2] < 0.5 ? ": under half, no single vertical mode" : "") + ")"
+              : n.reason);
     cells.push_back(c);
   }
   PolarMapOptions o;
@@ -96,7 +99,18 @@ std::string ModesMapHtml(const ModesMap& map, const CableRobot& robot,
        "the first mode in which the cabin holds over half the kinetic energy (grey: none "
        "among the modes searched). Right: the mode with the most vertical motion of the "
        "cabin (its bounce). Hover over a cell for its numbers; the CSV has every cabin "
-       "motion's mode.</p>\n<div class=\"maps\">\n";
+       "motion's mode.</p>\n";
+  // Issue 59: where no mode is mostly vertical, the right map's mode changes between
+  // neighbouring nodes; say how often.
+  int split = 0;
+  for (const ModesMapNode& n : map.nodes) split += n.ok && n.motion_share[2] < 0.5;
+  if (split > 0) {
+    h += "<p>At " + std::to_string(split) + " of " + std::to_string(ok) +
+         " nodes no mode holds over half its kinetic energy in the cabin's vertical motion: the "
+         "bounce is shared by neighbouring modes, and the right map shows the one with the "
+         "largest share (z_share in the CSV), which can change from node to node.</p>\n";
+  }
+  h += "<div class=\"maps\">\n";
   h += CapMap(map, robot, "Lowest frequency", "f [Hz]",
               [](const ModesMapNode& n) { return n.lowest_hz; }) +
        "\n";

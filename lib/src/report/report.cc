@@ -193,6 +193,17 @@ void AddProvenance(const ReportInputs& in, Document* doc) {
     data.Plain(" (no dataset given)");
   }
   row("Data", data);
+  if (!in.simulated_provenance.empty()) {
+    Text header("simulated: ");
+    size_t start = 0;
+    while (start < in.simulated_provenance.size()) {
+      const size_t end =
+          std::min(in.simulated_provenance.find('\n', start), in.simulated_provenance.size());
+      header.Plain(start == 0 ? "" : "; ").Code(in.simulated_provenance.substr(start, end - start));
+      start = end + 1;
+    }
+    row("Data's header", header);
+  }
   if (const CableRobot* model = in.initial_model != nullptr ? in.initial_model
                                 : in.result != nullptr      ? &in.result->calibrated
                                                             : nullptr) {
@@ -657,9 +668,11 @@ bool FliesPaperCircle(const ReportInputs& in) {
 
 // The paper's published RMS (its Table 6, real telemetry of FAST on that circle), each
 // row beside the variant of this report it corresponds to.
-void AddPaperTable6(Document* doc) {
+void AddPaperTable6(bool simulated, Document* doc) {
   Table t;
-  t.caption = "The paper's Table 6, the same circle on the telescope: RMS [kN]";
+  t.caption = simulated ? "The paper's Table 6, the same circle on the real telescope (these "
+                          "data are simulated): RMS [kN]"
+                        : "The paper's Table 6, the same circle on the telescope: RMS [kN]";
   t.header = {"", "as this report's", "T1", "T2", "T3", "T4", "T5", "T6"};
   t.right_align = {false, false, true, true, true, true, true, true};
   for (const internal::PaperRmsRow& row : internal::kPaperTable6) {
@@ -673,6 +686,15 @@ void AddPaperTable6(Document* doc) {
       "so its published RMS is shown for comparison. The paper's come from the real "
       "telescope's sensors under PID control, with the AAS statics and the mass centre moved "
       "by hand to about (0.22, 0.11, 0.5) m; sensor error about 3%.");
+  if (simulated) {
+    doc->Paragraph(Text()
+                       .Bold("These data are simulated")
+                       .Plain(" (made by fastcal simulate, see the top of this report): their "
+                              "RMS is the noise the simulation was given, not the telescope's. "
+                              "A smaller RMS here than the paper's is no improvement over its "
+                              "calibration; only the same measurement on the telescope can "
+                              "show one."));
+  }
 }
 
 void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
@@ -691,7 +713,7 @@ void AddRmsTables(const ReportInputs& in, bool with_plots, Document* doc) {
   doc->AddTable(StatsTable(
       in, "RMS of model - measured [kN], " + FitSamplesLabel(in) + " (n = " + Int(fit_n) + ")",
       &CableErrorStats::rms_n, true, StatsRows::kFit, nullptr));
-  if (FliesPaperCircle(in)) AddPaperTable6(doc);
+  if (FliesPaperCircle(in)) AddPaperTable6(!in.simulated_provenance.empty(), doc);
   const bool holdout = AnyHoldout(in);
   if (holdout) {
     int n = 0;
@@ -1180,6 +1202,20 @@ void AddAppendices(const ReportInputs& in, Document* doc) {
   }
 }
 
+// Issue 59: a report on data `fastcal simulate` made says so before anything else (the
+// demo's calibrated RMS stood beside the paper's Table 6 with nothing saying the data were
+// not the telescope's).
+void AddSimulatedDataNote(const std::string& provenance, Document* doc) {
+  std::string first = provenance.substr(0, provenance.find('\n'));
+  doc->Paragraph(Text()
+                     .Bold("Simulated data.")
+                     .Plain(" The data file says it was made by fastcal simulate (")
+                     .Code(first)
+                     .Plain("; its header is under Provenance): the estimates and errors below "
+                            "are those of a simulation with the noise its command gave, not of "
+                            "the telescope."));
+}
+
 Document BuildDocument(const ReportInputs& in, bool with_plots) {
   Document doc;
   doc.title = in.result ? "fastcal calibration report" : "fastcal evaluation report";
@@ -1190,6 +1226,7 @@ Document BuildDocument(const ReportInputs& in, bool with_plots) {
                       "before and after. Tensions in kN."
                     : "FAST feed-cabin cable robot: model tensions checked against measured cable "
                       "tensions. Tensions in kN.");
+  if (!in.simulated_provenance.empty()) AddSimulatedDataNote(in.simulated_provenance, &doc);
   AddProvenance(in, &doc);
   AddVerdict(in, &doc);
   if (in.result) {

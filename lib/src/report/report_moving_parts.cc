@@ -115,9 +115,20 @@ Text PartText(const CalibrationResult& r, const MovingPart& part) {
   for (const Joint& j : part.joints) {
     if (j.type == JointType::kRevolute) off -= j.axis * j.axis.dot(off);
   }
+  // Issue 59: the components only their prior holds, marked as docs/calibration.md says.
+  const auto prior_set = [](const ParameterEstimate* p) {
+    return p != nullptr && p->free && p->note.find("set mostly by its prior") != std::string::npos;
+  };
+  std::string held;
+  for (int a = 0; a < 3; ++a) {
+    if (prior_set(Find(r, stem + "first_moment_kg_m." + std::string(1, "xyz"[a])))) {
+      held += std::string(held.empty() ? "" : ", ") + "xyz"[a];
+    }
+  }
   std::vector<std::string> phrases;
   if (any_free || q.norm() > 0.0) {
-    phrases.push_back("first moment (" + moment + ") kg m, sigma_total (" + sigma + ") kg m");
+    phrases.push_back("first moment (" + moment + ") kg m, sigma_total (" + sigma + ") kg m" +
+                      (held.empty() ? "" : " (" + held + " set mostly by the prior)"));
   }
   if (q.norm() > 0.0 && !part.joints.empty() && part.joints.front().type == JointType::kRevolute) {
     // d = |Q| / m: the distance of the assembly's centre from its axes' origin, for a mass.
@@ -130,7 +141,8 @@ Text PartText(const CalibrationResult& r, const MovingPart& part) {
   }
   if (const ParameterEstimate* p = Find(r, stem + "mass_kg")) {
     phrases.push_back("mass " + Printf("%.0f", p->estimate) + " kg" +
-                      (p->free ? " ± " + Printf("%.0f", p->sigma_total) + " kg" : " (fixed)"));
+                      (p->free ? " ± " + Printf("%.0f", p->sigma_total) + " kg" : " (fixed)") +
+                      (prior_set(p) ? " (set mostly by the prior)" : ""));
   }
   for (size_t k = 0; k < phrases.size(); ++k) t.Plain((k ? "; " : ": ") + phrases[k]);
   return t;
@@ -147,7 +159,9 @@ void AddMovingParts(const ReportInputs& in, bool with_plots, Document* doc) {
       "The cabin's mass centre follows its moving parts' joints: c(q) = c0 + sum_k [(R_k(q) - "
       "I) Q_k + (t_k(q) - t_k(0)) m_k] / M (docs/model.md, \"Moving parts\"), c0 the mass centre "
       "with every joint at zero. A first moment's component along its part's own rotation axis "
-      "is seen only at second order in the angles: its estimate leans on its prior.");
+      "is seen only at second order in the angles: where the survey turns the part little, its "
+      "estimate leans on its prior. A component set mostly by its prior (its posterior σ over "
+      "half the prior's, as Estimates marks any parameter) is marked below.");
   std::vector<Text> items;
   for (const MovingPart& part : m.moving_parts.parts) items.push_back(PartText(r, part));
   doc->List(items);
