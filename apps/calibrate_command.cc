@@ -39,10 +39,10 @@
 #include "fastcal/internal/quote.h"
 #include "fastcal/internal/report_document.h"
 #include "fastcal/internal/sample_chunks.h"
-#include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/sessions.h"
 #include "fastcal/trajectory.h"
+#include "fastcal/unsolvable_rows.h"
 #include "fastcal/version.h"
 
 DECLARE_string(model);
@@ -554,7 +554,7 @@ std::string SkipHint() {
 
 // When `model` cannot solve at least two rows and the nominal FAST model solves most of
 // them, the model or spec, not the data, is the likely cause: the message that says so,
-// naming the values furthest from nominal; "" otherwise (model_plausibility.h).
+// naming the values furthest from nominal; "" otherwise (unsolvable_rows.h).
 std::string BlameText(const UnsolvableRows& d, const std::string& model_name) {
   if (!d.model_likely) return "";
   return DescribeUnsolvableRows(d, model_name) +

@@ -20,11 +20,11 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/internal/exact_selection.h"
-#include "fastcal/model_plausibility.h"
 #include "fastcal/report.h"
 #include "fastcal/sessions.h"
 #include "fastcal/simulation.h"
 #include "fastcal/trajectory.h"
+#include "fastcal/unsolvable_rows.h"
 
 namespace fastcal {
 namespace {

@@ -1,7 +1,7 @@
 // Tests of the model plausibility checks and the unsolvable-rows diagnosis
-// (fastcal/model_plausibility.h): the nominal model passes, each slip is named at its key,
-// the furthest-from-nominal list ranks by the plausible range, and a model that cannot
-// solve what the nominal model solves is blamed while rows outside the workspace are not.
+// (fastcal/model_plausibility.h, fastcal/unsolvable_rows.h): the nominal model passes, each slip is
+// named at its key, the furthest-from-nominal list ranks by the plausible range, and a model that
+// cannot solve what the nominal model solves is blamed while rows outside the workspace are not.
 #include "fastcal/model_plausibility.h"
 
 #include <gtest/gtest.h>
@@ -9,6 +9,8 @@
 #include <cmath>
 #include <string>
 #include <vector>
+
+#include "fastcal/unsolvable_rows.h"
 
 namespace fastcal {
 namespace {

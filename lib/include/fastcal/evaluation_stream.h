@@ -33,8 +33,8 @@
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/internal/exact_selection.h"
-#include "fastcal/model_plausibility.h"
 #include "fastcal/statics.h"
+#include "fastcal/unsolvable_rows.h"
 
 namespace fastcal {
 

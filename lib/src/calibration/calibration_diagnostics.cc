@@ -11,7 +11,7 @@
 #include "fastcal/change_scan.h"
 #include "fastcal/internal/identifiability.h"
 #include "fastcal/internal/sample_chunks.h"
-#include "fastcal/model_plausibility.h"
+#include "fastcal/parameter_plausibility.h"
 #include "fastcal/sensor_steps.h"
 #include "fastcal/sessions.h"
 #include "fastcal/uncertainty.h"

@@ -1,7 +1,7 @@
 // The calibration spec's rules (calibration_spec_rules.h): the parameter groups' names,
 // the checks of each value shared by the reader and CalibrationSpec::IsValid, and the
 // writer's exact number text. Values are checked against the plausible ranges of
-// plausibility.h and model_plausibility.h.
+// plausibility.h and parameter_plausibility.h.
 #include "calibration/calibration_spec_rules.h"
 
 #include <yaml-cpp/yaml.h>
@@ -28,7 +28,7 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
-#include "fastcal/model_plausibility.h"
+#include "fastcal/parameter_plausibility.h"
 #include "fastcal/plausibility.h"
 #include "util/yaml_document.h"
 

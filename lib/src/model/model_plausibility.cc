@@ -1,12 +1,10 @@
-// Plausibility of a whole model, and the diagnosis of a model that cannot solve many rows
-// (model_plausibility.h).
+// Plausibility of a whole model (model_plausibility.h).
 #include "fastcal/model_plausibility.h"
 
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <set>
 #include <utility>
 
 #include "fastcal/internal/number_text.h"
@@ -142,63 +140,6 @@ std::string InFileUnit(double value_si, const QuantityRange& range) {
   const std::string unit = range.file_unit;
   return Num(value_si / range.si_per_file_unit) + (unit.empty() ? "" : " " + unit);
 }
-
-}  // namespace
-
-bool QuantityOfParameter(ParameterKind kind, ModelQuantity* quantity) {
-  switch (kind) {
-    case ParameterKind::kMassCentre:
-      *quantity = ModelQuantity::kMassCentreM;
-      return true;
-    case ParameterKind::kCabinMass:
-      *quantity = ModelQuantity::kCabinMassKg;
-      return true;
-    case ParameterKind::kLinearDensity:
-      *quantity = ModelQuantity::kLinearDensityKgPerM;
-      return true;
-    case ParameterKind::kEa:
-      *quantity = ModelQuantity::kEaN;
-      return true;
-    case ParameterKind::kAnchorOffset:
-    case ParameterKind::kTowerOffset:
-      *quantity = ModelQuantity::kOffsetM;
-      return true;
-    case ParameterKind::kSensorGain:
-      *quantity = ModelQuantity::kSensorGain;
-      return true;
-    case ParameterKind::kSensorBias:
-      *quantity = ModelQuantity::kSensorBiasN;
-      return true;
-    case ParameterKind::kAttachmentMass:
-      *quantity = ModelQuantity::kAttachmentMassKg;
-      return true;
-    case ParameterKind::kAttachmentDensity:
-      *quantity = ModelQuantity::kAttachmentDensityKgPerM;
-      return true;
-    case ParameterKind::kLengthOffset:
-      *quantity = ModelQuantity::kLengthOffsetM;
-      return true;
-    case ParameterKind::kPartFirstMoment:
-      *quantity = ModelQuantity::kPartFirstMomentKgM;
-      return true;
-    case ParameterKind::kPartMass:
-      *quantity = ModelQuantity::kPartMassKg;
-      return true;
-    case ParameterKind::kMeasuredOffset:
-      *quantity = ModelQuantity::kMeasuredOffsetM;
-      return true;
-    default:
-      return false;
-  }
-}
-
-bool CheckParameterValue(ParameterKind kind, double value_si, const PlausibilityLimits& limits,
-                         std::string* why) {
-  ModelQuantity quantity;
-  return !QuantityOfParameter(kind, &quantity) || CheckQuantity(quantity, value_si, limits, why);
-}
-
-namespace {
 
 // The reflector's centre near (0, 0, radius): the global origin is its lowest point.
 bool CheckReflectorCentre(const Reflector& reflector, const PlausibilityLimits& limits,
@@ -342,49 +283,6 @@ std::vector<std::string> FurthestFromNominal(const CableRobot& robot,
   std::vector<std::string> names;
   for (size_t k = 0; k < std::min(count, found.size()); ++k) names.push_back(found[k].second);
   return names;
-}
-
-UnsolvableRows DiagnoseUnsolvableRows(const CableRobot& model, const std::string& model_name,
-                                      const Dataset& data,
-                                      const std::vector<AttitudeSource>& attitudes,
-                                      const std::vector<StaticsMethod>& methods) {
-  constexpr size_t kNamed = 3;
-  constexpr int kFewestForNominalTest = 2;
-  UnsolvableRows d;
-  d.rows = static_cast<int>(data.samples.size());
-  Dataset kept = data;
-  const size_t skipped_before = kept.skipped.size();
-  d.failed = SkipUnsolvableSamples(model, model_name, attitudes, methods, &kept);
-  if (d.failed == 0) return d;
-  d.first = kept.skipped[skipped_before];
-  // The failed rows alone, tried with the nominal model.
-  std::set<int> kept_lines;
-  for (const Sample& s : kept.samples) kept_lines.insert(s.line);
-  Dataset failed = data;
-  failed.samples.clear();
-  for (const Sample& s : data.samples) {
-    if (!kept_lines.count(s.line)) failed.samples.push_back(s);
-  }
-  d.solved_by_nominal =
-      d.failed - SkipUnsolvableSamples(CableRobot::NominalFast(), "the nominal FAST model",
-                                       attitudes, methods, &failed);
-  d.model_likely = d.failed >= kFewestForNominalTest && 2 * d.solved_by_nominal >= d.failed;
-  d.furthest_from_nominal = FurthestFromNominal(model, PlausibilityLimits(), kNamed);
-  return d;
-}
-
-std::string DescribeUnsolvableRows(const UnsolvableRows& d, const std::string& model_name) {
-  std::string text = model_name + " cannot solve " + std::to_string(d.failed) + " of " +
-                     std::to_string(d.rows) + " rows (the nominal FAST model solves " +
-                     std::to_string(d.solved_by_nominal) +
-                     " of them): the model or the spec is the likely cause, not the data";
-  if (!d.furthest_from_nominal.empty()) {
-    text += "; furthest from nominal: ";
-    for (size_t k = 0; k < d.furthest_from_nominal.size(); ++k) {
-      text += (k ? ", " : "") + d.furthest_from_nominal[k];
-    }
-  }
-  return text + ". First: " + d.first;
 }
 
 }  // namespace fastcal

@@ -12,7 +12,6 @@
 
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
-#include "fastcal/svg_plot.h"
 
 namespace fastcal {
 namespace {
