@@ -258,3 +258,6 @@ std::string CommandLine(int argc, char** argv, const std::vector<std::string>& o
 }  // namespace fastcal::cli
 
 #endif  // FASTCAL_APPS_CLI_UTIL_H_
+// The current date and time, UTC, ISO 8601 ("2026-11-22T15:04:05Z"): when a run was made.
+std::string UtcNow();
+
