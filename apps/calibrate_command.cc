@@ -66,7 +66,6 @@ namespace fastcal::cli {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kNPerKn = 1e3;
 
 const char kCalibrateHelp[] =
     R"(fastcal calibrate: estimate model parameters from measured cabin poses and cable tensions.
