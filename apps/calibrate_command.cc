@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <functional>
@@ -69,7 +68,6 @@ namespace fastcal::cli {
 namespace {
 
 namespace fs = std::filesystem;
-constexpr double kNPerKn = 1e3;
 
 const char kCalibrateHelp[] =
     R"(fastcal calibrate: estimate model parameters from measured cabin poses and cable tensions.
@@ -581,16 +579,6 @@ std::string DataDigest() {
   const std::vector<std::string> paths = DataPaths();
   for (size_t k = 0; k < paths.size(); ++k) digests += (k ? "," : "") + Digest(paths[k]);
   return digests;
-}
-
-// The current date and time, UTC, ISO 8601 ("2026-11-22T15:04:05Z").
-std::string UtcNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return text;
 }
 
 // "0.192 +- 0.034 m": the estimate to the precision its sigma_total supports (a tiny

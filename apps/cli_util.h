@@ -16,8 +16,11 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/units.h"
 
 namespace fastcal::cli {
+
+using internal::kNPerKn;
 
 // The console is one screen: at most kConsoleWidth columns (calibrate's and design's
 // summaries).
@@ -254,6 +257,9 @@ std::string FormatDouble(double value, int significant_digits = 10);
 // "fastcal <arguments>" as typed, for the headers of written files; the flags named in
 // `omit` (without dashes, e.g. "force") left out, with their "no" forms.
 std::string CommandLine(int argc, char** argv, const std::vector<std::string>& omit = {});
+
+// The current date and time, UTC, ISO 8601 ("2026-11-22T15:04:05Z"): when a run was made.
+std::string UtcNow();
 
 }  // namespace fastcal::cli
 

@@ -6,7 +6,6 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
-#include <ctime>
 #include <filesystem>
 #include <iostream>
 #include <limits>
@@ -74,16 +73,6 @@ Example (the bundled FAST-style export):
   fastcal import --columns=calibration_data/fast_export.columns.yaml \
     --data=calibration_data/fast_export.csv --out=out/fast_survey.csv
 )";
-}
-
-// The current time, UTC, ISO 8601.
-std::string UtcNow() {
-  const std::time_t now = std::time(nullptr);
-  std::tm utc{};
-  gmtime_r(&now, &utc);
-  char text[32];
-  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
-  return text;
 }
 
 std::string Provenance(int argc, char** argv, const ColumnMap& map) {

@@ -53,7 +53,6 @@ namespace fastcal::cli {
 namespace {
 
 constexpr char kCommand[] = "locate";
-constexpr double kNPerKn = 1e3;
 
 const char kHelp[] =
     R"(fastcal locate: where the FAST cabin hangs, from the six unstretched cable lengths.

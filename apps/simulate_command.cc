@@ -110,7 +110,6 @@ namespace fastcal::cli {
 namespace {
 
 constexpr char kCommand[] = "simulate";
-constexpr double kNPerKn = 1e3;
 
 const char kHelp[] =
     R"(fastcal simulate: synthetic telemetry of the FAST cable robot from a known truth model.

@@ -79,7 +79,6 @@ namespace fastcal::cli {
 namespace {
 
 constexpr char kCommand[] = "solve";
-constexpr double kNPerKn = 1e3;
 
 const char kHelp[] =
     R"(fastcal solve: cable forces of the FAST cable robot at a pose or along a trajectory.

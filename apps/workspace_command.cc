@@ -42,7 +42,6 @@ namespace fastcal::cli {
 namespace {
 
 constexpr char kCommand[] = "workspace";
-constexpr double kNPerKn = 1e3;
 // Its grid defaults, finer than solve's --trajectory=grid (the flags are shared).
 constexpr double kOffAxisStepDeg = 1.0, kAzimuthStepDeg = 5.0;
 

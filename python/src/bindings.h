@@ -22,6 +22,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/column_map.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/pose.h"
 
 namespace fastcal::python {
@@ -74,7 +75,7 @@ inline std::function<void(const std::string&)> ProgressTo(const std::string& pre
   };
 }
 
-inline constexpr double kNPerKn = 1e3;
+using internal::kNPerKn;
 
 // Bad input (a file, a spec, an argument): raised as fastcal.InputError, a ValueError,
 // with the library's message (the one the command line prints before exiting with 2).

@@ -22,12 +22,12 @@
 #include "fastcal/internal/compact_start.h"
 #include "fastcal/internal/folded_cost.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/units.h"
 
 namespace fastcal::internal {
 
 // A parameter with at least this weight in a weak direction gets a note.
 inline constexpr double kNoteWeight = 0.3;
-inline constexpr double kNPerKn = 1e3;
 // Chance that noise alone makes some candidate of the misfit ranking "significant".
 inline constexpr double kMisfitFamilyError = 0.01;
 

@@ -34,6 +34,9 @@
 #include "util/yaml_document.h"
 
 namespace fastcal {
+
+using internal::ShortestNumber;
+
 namespace {
 
 // ---------------------------------------------------------------------------------------
@@ -264,7 +267,7 @@ std::string SessionsYaml(const CalibrationSpec& spec) {
   if (!spec.change_scan_groups.empty()) {
     out << "change_scan: {parameters: " << list(spec.change_scan_groups)
         << ", min_segment_samples: " << spec.change_scan_min_segment
-        << ", significance: " << Num(spec.change_scan_significance)
+        << ", significance: " << ShortestNumber(spec.change_scan_significance)
         << ", max_changes: " << spec.change_scan_max_changes << "}\n";
   }
   return out.str();
@@ -277,10 +280,10 @@ std::string SlowErrorYaml(const SlowErrorSpec& slow) {
   };
   const bool percent = slow.estimate_amplitude && slow.amplitude_in_percent;
   const bool kn = slow.estimate_amplitude && !slow.amplitude_in_percent;
-  return "{sigma_percent: " + part(percent, Num(slow.stated.sigma_percent)) +
-         ", sigma_kN: " + part(kn, NumInUnit(slow.stated.sigma_n, kNewtonsPerKilonewton)) +
+  return "{sigma_percent: " + part(percent, ShortestNumber(slow.stated.sigma_percent)) +
+         ", sigma_kN: " + part(kn, NumInUnit(slow.stated.sigma_n, kNPerKn)) +
          ", time_constant_s: " +
-         part(slow.estimate_time_constant, Num(slow.stated.time_constant_s)) + "}";
+         part(slow.estimate_time_constant, ShortestNumber(slow.stated.time_constant_s)) + "}";
 }
 
 }  // namespace
@@ -294,25 +297,25 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
   std::ostringstream out;
   out << "format: " << kFormatName << "\n";
   out << "forward_model: " << StaticsMethodName(spec.forward_model) << "\n";
-  out << "noise: {tension_sigma_kN: " << NumInUnit(spec.tension_sigma_n, kNewtonsPerKilonewton)
-      << ", tension_sigma_percent: " << Num(spec.tension_sigma_percent)
+  out << "noise: {tension_sigma_kN: " << NumInUnit(spec.tension_sigma_n, kNPerKn)
+      << ", tension_sigma_percent: " << ShortestNumber(spec.tension_sigma_percent)
       << ", slow_error: " << SlowErrorYaml(spec.slow_error);
-  if (spec.UsesLengths()) out << ", length_sigma_m: " << Num(spec.length_sigma_m);
+  if (spec.UsesLengths()) out << ", length_sigma_m: " << ShortestNumber(spec.length_sigma_m);
   out << "}\n";
   const char* loss = RobustLossName(spec.robust_loss);
   out << "robust_loss: {type: " << (loss != nullptr ? loss : "unknown")
-      << ", scale: " << Num(spec.robust_loss_scale) << "}\n";
+      << ", scale: " << ShortestNumber(spec.robust_loss_scale) << "}\n";
   out << "gross_errors: {detect: " << (spec.detect_gross_errors ? "true" : "false")
-      << ", threshold_sigmas: " << Num(spec.gross_error_threshold_sigmas)
-      << ", max_fraction: " << Num(spec.max_gross_error_fraction) << "}\n";
-  out << "holdout: {fraction: " << Num(spec.holdout_fraction) << ", seed: " << spec.holdout_seed
-      << ", blocks: " << spec.holdout_blocks << "}\n";
+      << ", threshold_sigmas: " << ShortestNumber(spec.gross_error_threshold_sigmas)
+      << ", max_fraction: " << ShortestNumber(spec.max_gross_error_fraction) << "}\n";
+  out << "holdout: {fraction: " << ShortestNumber(spec.holdout_fraction)
+      << ", seed: " << spec.holdout_seed << ", blocks: " << spec.holdout_blocks << "}\n";
   out << "cross_validation: {blocks: " << spec.cross_validation_blocks << "}\n";
   out << "attitude: " << (spec.use_planned_attitude ? "planned" : "measured") << "\n";
   out << "solver: {max_iterations: " << spec.max_iterations
-      << ", function_tolerance: " << Num(spec.function_tolerance)
-      << ", gradient_tolerance: " << Num(spec.gradient_tolerance)
-      << ", parameter_tolerance: " << Num(spec.parameter_tolerance)
+      << ", function_tolerance: " << ShortestNumber(spec.function_tolerance)
+      << ", gradient_tolerance: " << ShortestNumber(spec.gradient_tolerance)
+      << ", parameter_tolerance: " << ShortestNumber(spec.parameter_tolerance)
       << ", threads: " << spec.num_threads << "}\n";
   if (spec.parameters.empty()) {
     out << "parameters: {}\n";

@@ -41,17 +41,14 @@
 namespace fastcal {
 namespace {
 
+using internal::LineOf;
+
 std::string Join(const std::string& parent, const std::string& key) {
   return parent.empty() || parent == kRootPath ? key : parent + "." + key;
 }
 // Key paths number list elements from 1, like the parameter names.
 std::string Element(const std::string& parent, size_t i) {
   return parent + "[" + std::to_string(i + 1) + "]";
-}
-
-int LineOf(const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  return mark.line < 0 ? 0 : mark.line + 1;
 }
 
 std::string ListOf(const std::vector<std::string>& names) {
@@ -76,25 +73,14 @@ EntryText Override(const EntryText& base, const EntryText& over) {
   return e;
 }
 
-class Reader {
+class Reader : public internal::YamlErrorRecorder {
  public:
   Reader(const std::string& source, const ModelShape& model)
-      : source_(source),
+      : YamlErrorRecorder(source),
         num_anchor_points_(model.num_anchor_points),
         attachments_(model.attachments),
         parts_(model.parts),
         measured_frame_(model.measured_frame) {}
-
-  const std::string& error() const { return error_; }
-
-  // Records "<source>:<line>: <path>: <what>" (":<line>" left out when 0).
-  bool Fail(int line, const std::string& path, const std::string& what) {
-    error_ = source_;
-    if (line > 0) error_ += ":" + std::to_string(line);
-    // Key names come from the file: escaped like the values (internal/quote.h).
-    error_ += ": " + internal::Escape(path) + ": " + what;
-    return false;
-  }
 
   bool ReadRoot(const YAML::Node& root, CalibrationSpec* spec) {
     KeyMap keys;
@@ -306,11 +292,10 @@ class Reader {
       const std::string path = "noise.tension_sigma_kN";
       double kn = 0.0;
       if (!ReadDouble(*kv, path, &kn) ||
-          !Check(CheckNoiseSigma(ModelQuantity::kTensionSigmaN, kn * kNewtonsPerKilonewton),
-                 kv->line, path)) {
+          !Check(CheckNoiseSigma(ModelQuantity::kTensionSigmaN, kn * kNPerKn), kv->line, path)) {
         return false;
       }
-      spec->tension_sigma_n = kn * kNewtonsPerKilonewton;
+      spec->tension_sigma_n = kn * kNPerKn;
     }
     if (const KeyValue* kv = Find(keys, "tension_sigma_percent")) {
       const std::string path = "noise.tension_sigma_percent";
@@ -361,7 +346,7 @@ class Reader {
     bool percent_estimated = false, kn_estimated = false;
     if (!part("sigma_percent", 1.0, &percent_estimated, &slow->stated.sigma_percent,
               [](double v) { return CheckNoiseSigma(ModelQuantity::kTensionSigmaPercent, v); }) ||
-        !part("sigma_kN", kNewtonsPerKilonewton, &kn_estimated, &slow->stated.sigma_n,
+        !part("sigma_kN", kNPerKn, &kn_estimated, &slow->stated.sigma_n,
               [](double v) { return CheckNoiseSigma(ModelQuantity::kTensionSigmaN, v); }) ||
         !part("time_constant_s", 1.0, &slow->estimate_time_constant, &slow->stated.time_constant_s,
               CheckTimeConstant)) {
@@ -914,12 +899,10 @@ class Reader {
     return true;
   }
 
-  std::string source_;
   int num_anchor_points_;
   AttachmentShape attachments_;
   std::vector<std::string> parts_;  // the model's moving parts, by name
   bool measured_frame_;             // the model declares cabin.measured_frame
-  std::string error_;
 };
 }  // namespace
 

@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <array>
-#include <charconv>
 #include <cmath>
 #include <exception>
 #include <filesystem>
@@ -33,6 +32,8 @@
 #include "util/yaml_document.h"
 
 namespace fastcal::spec_rules {
+
+using internal::ShortestNumber;
 
 // ---------------------------------------------------------------------------------------
 // Facts about each parameter group, in canonical order (the order of ParameterKind).
@@ -184,13 +185,12 @@ std::string CheckNoiseSigma(ModelQuantity quantity, double value_si) {
   const bool absolute = quantity == ModelQuantity::kTensionSigmaN;
   const double floor = absolute ? limits.min_tension_sigma_n : limits.min_tension_sigma_percent;
   if (value_si > 0.0 && value_si < floor) {
-    return absolute
-               ? internal::FormatDouble("%.6g kN", value_si / kNewtonsPerKilonewton) +
-                     " is below " + internal::FormatDouble("%g kN", floor / kNewtonsPerKilonewton) +
-                     ", finer than any tension sensor resolves (0 means no absolute part)"
-               : internal::FormatDouble("%.6g %%", value_si) + " is below " +
-                     internal::FormatDouble("%g %%", floor) +
-                     ", finer than any tension sensor resolves (0 means no relative part)";
+    return absolute ? internal::FormatDouble("%.6g kN", value_si / kNPerKn) + " is below " +
+                          internal::FormatDouble("%g kN", floor / kNPerKn) +
+                          ", finer than any tension sensor resolves (0 means no absolute part)"
+                    : internal::FormatDouble("%.6g %%", value_si) + " is below " +
+                          internal::FormatDouble("%g %%", floor) +
+                          ", finer than any tension sensor resolves (0 means no relative part)";
   }
   std::string why;
   return CheckQuantity(quantity, value_si, limits, &why) ? "" : why;
@@ -282,15 +282,6 @@ bool IsKnownMethod(StaticsMethod method) {
 // ---------------------------------------------------------------------------------------
 // Number text.
 
-// Shortest decimal text that reads back to exactly `value`.
-std::string Num(double value) {
-  if (std::isnan(value)) return ".nan";
-  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
-}
-
 // A value stored in SI, as text in a unit `to_si` times larger: the shortest text t with
 // parse(t) * to_si == si when there is one, so that writing and reading back is exact.
 // For values the reader produced (si = file value * to_si) si / to_si already is such a
@@ -298,16 +289,16 @@ std::string Num(double value) {
 std::string NumInUnit(double si, double to_si) {
   constexpr int kMaxUlpSteps = 4;
   const double guess = si / to_si;
-  if (!std::isfinite(guess) || guess * to_si == si) return Num(guess);
+  if (!std::isfinite(guess) || guess * to_si == si) return ShortestNumber(guess);
   double down = guess;
   double up = guess;
   for (int step = 0; step < kMaxUlpSteps; ++step) {
     down = std::nextafter(down, -HUGE_VAL);
     up = std::nextafter(up, HUGE_VAL);
-    if (down * to_si == si) return Num(down);
-    if (up * to_si == si) return Num(up);
+    if (down * to_si == si) return ShortestNumber(down);
+    if (up * to_si == si) return ShortestNumber(up);
   }
-  return Num(guess);  // no exact preimage: the nearest
+  return ShortestNumber(guess);  // no exact preimage: the nearest
 }
 
 ParameterSpec MakeParameter(const GroupInfo& g, int index, int component, const EntryText& e) {

@@ -14,6 +14,7 @@
 
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/model_plausibility.h"
 #include "fastcal/statics.h"
 
@@ -21,7 +22,6 @@ namespace fastcal::spec_rules {
 
 inline constexpr char kFormatName[] = "fastcal-calibration-spec-1";
 inline constexpr char kRootPath[] = "(top level)";
-inline constexpr double kNewtonsPerKilonewton = 1e3;
 inline constexpr char kAxes[] = "xyz";
 
 // ---------------------------------------------------------------------------------------
@@ -42,7 +42,7 @@ inline constexpr GroupInfo kGroups[] = {
     {ParameterKind::kAnchorOffset, "anchor_offset_m", "m", 1.0},
     {ParameterKind::kTowerOffset, "tower_offset_m", "m", 1.0},
     {ParameterKind::kSensorGain, "sensor_gain", "1", 1.0},
-    {ParameterKind::kSensorBias, "sensor_bias_kN", "kN", kNewtonsPerKilonewton},
+    {ParameterKind::kSensorBias, "sensor_bias_kN", "kN", internal::kNPerKn},
     {ParameterKind::kAttachmentMass, "attachment_mass_kg", "kg", 1.0},
     {ParameterKind::kAttachmentDensity, "attachment_density_kg_per_m", "kg/m", 1.0},
     {ParameterKind::kLengthOffset, "length_offset_m", "m", 1.0},
@@ -168,9 +168,6 @@ bool IsKnownMethod(StaticsMethod method);
 // ---------------------------------------------------------------------------------------
 // Number text.
 
-// Shortest decimal text that reads back to exactly `value`.
-std::string Num(double value);
-
 // A value stored in SI, as text in a unit `to_si` times larger: the shortest text t with
 // parse(t) * to_si == si when there is one, so that writing and reading back is exact.
 // For values the reader produced (si = file value * to_si) si / to_si already is such a
@@ -184,6 +181,7 @@ ParameterSpec MakeParameter(const GroupInfo& g, int index, int component, const 
 namespace fastcal {
 // The spec's reader and checks (the only includers: this header is private to
 // lib/src/calibration) read the rules as their own names, as when they were one file.
+using internal::kNPerKn;
 using spec_rules::AttachmentKindOf;
 using spec_rules::AttachmentShape;
 using spec_rules::CheckAtLeastOne;
@@ -214,13 +212,11 @@ using spec_rules::kFormatName;
 using spec_rules::kGroups;
 using spec_rules::kMeasuredFrameKey;
 using spec_rules::kMovingPartsKey;
-using spec_rules::kNewtonsPerKilonewton;
 using spec_rules::kRootPath;
 using spec_rules::LengthsProblem;
 using spec_rules::MakeParameter;
 using spec_rules::MeasuredOffsetName;
 using spec_rules::ModelShape;
-using spec_rules::Num;
 using spec_rules::NumInUnit;
 using spec_rules::PartOfParameterName;
 using spec_rules::PartParameterName;

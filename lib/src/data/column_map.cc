@@ -25,6 +25,8 @@
 namespace fastcal {
 namespace {
 
+using internal::LineOf;
+
 constexpr char kFormat[] = "fastcal-columns-1";
 constexpr double kDegPerRad = 57.29577951308232;
 constexpr double kNewtonsPerTonneForce = 9806.65;  // standard gravity x 1000 kg
@@ -66,23 +68,10 @@ std::string Join(const std::vector<std::string>& items, const char* separator = 
   return out;
 }
 
-int LineOf(const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  return mark.line < 0 ? 0 : mark.line + 1;
-}
-
 // The reader of one map: fails with "<file>:<line>: <key path>: <what>".
-class MapReader {
+class MapReader : public internal::YamlErrorRecorder {
  public:
-  explicit MapReader(std::string source) : source_(std::move(source)) {}
-
-  bool Fail(int line, const std::string& path, const std::string& what) {
-    error_ = source_;
-    if (line > 0) error_ += ":" + std::to_string(line);
-    error_ += ": " + internal::Escape(path) + ": " + what;
-    return false;
-  }
-  const std::string& error() const { return error_; }
+  explicit MapReader(std::string source) : YamlErrorRecorder(std::move(source)) {}
 
   struct KeyValue {
     YAML::Node value;
@@ -326,10 +315,6 @@ class MapReader {
     }
     return true;
   }
-
- private:
-  std::string source_;
-  std::string error_;
 };
 
 }  // namespace

@@ -8,11 +8,12 @@
 #include <random>
 
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/units.h"
 
 namespace fastcal {
 namespace {
 
-constexpr double kNPerKn = 1e3;
+using internal::kNPerKn;
 // Redraws allowed for one reading or density before giving up: the noise must be absurd
 // for one draw in a thousand to be acceptable.
 constexpr int kMaxRedraws = 1000;

@@ -12,11 +12,12 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/units.h"
 
 namespace fastcal {
 namespace {
 
-constexpr double kNPerKn = 1e3;
+using internal::kNPerKn;
 constexpr double kMmPerM = 1e3;
 constexpr double kDegPerRad = 180.0 / M_PI;
 // A lengths file: about 60 bytes a row; a day at 100 Hz is 0.5 GB, beyond any winch plan.

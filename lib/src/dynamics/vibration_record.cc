@@ -8,11 +8,12 @@
 #include <vector>
 
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/units.h"
 
 namespace fastcal {
 namespace {
 
-constexpr double kNPerKn = 1e3;
+using internal::kNPerKn;
 constexpr int kPoseChannels = 6;
 constexpr int kAllChannels = kPoseChannels + kNumCables;
 // Samples read at a time: the dataset's chunk (about 2 KB a sample) stays small beside

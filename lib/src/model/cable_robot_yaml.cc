@@ -33,6 +33,9 @@
 namespace fastcal {
 namespace {
 
+using internal::LineOf;
+using internal::ShortestNumber;
+
 constexpr char kFormatName[] = "fastcal-model-1";
 constexpr char kRootPath[] = "(top level)";
 
@@ -44,37 +47,17 @@ std::string Index(const std::string& parent, size_t i) {
   return parent + "[" + std::to_string(i) + "]";
 }
 
-// 1-based line of a node, or 0 when yaml-cpp does not know it.
-int LineOf(const YAML::Node& node) {
-  const YAML::Mark mark = node.Mark();
-  return mark.line < 0 ? 0 : mark.line + 1;
-}
-
 // One key of a YAML mapping with its value.
 struct Entry {
   YAML::Node key;
   YAML::Node value;
 };
 
-class Parser {
+class Parser : public internal::YamlErrorRecorder {
  public:
-  explicit Parser(const std::string& source) : source_(source) {}
+  explicit Parser(const std::string& source) : YamlErrorRecorder(source) {}
 
-  const std::string& error() const { return error_; }
-
-  // Records the error "<source>:<line>: <path>: <what>" (":<line>" omitted when 0).
-  bool Fail(int line, const std::string& path, const std::string& what) {
-    error_ = source_;
-    if (line > 0) error_ += ":" + std::to_string(line);
-    // Key names come from the file: escaped like the values (internal/quote.h).
-    error_ += ": " + internal::Escape(path) + ": " + what;
-    return false;
-  }
-  // Records "<source>: <what>": a problem of the whole file.
-  bool FailFile(const std::string& what) {
-    error_ = source_ + ": " + what;
-    return false;
-  }
+  using YamlErrorRecorder::Fail;
   bool Fail(const YAML::Node& node, const std::string& path, const std::string& what) {
     return Fail(LineOf(node), path, what);
   }
@@ -613,23 +596,13 @@ class Parser {
     return s;
   }
 
-  std::string source_;
-  std::string error_;
   // Line of each key path read from the file, for validation errors.
   std::map<std::string, int> lines_;
 };
 
-// Shortest decimal text that reads back to exactly `value` (at most 17 digits).
-std::string Num(double value) {
-  if (std::isnan(value)) return ".nan";
-  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
-  char buffer[64];
-  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
-  return std::string(buffer, result.ptr);
-}
-
 std::string Vec(const Eigen::Vector3d& v) {
-  return "[" + Num(v.x()) + ", " + Num(v.y()) + ", " + Num(v.z()) + "]";
+  return "[" + ShortestNumber(v.x()) + ", " + ShortestNumber(v.y()) + ", " + ShortestNumber(v.z()) +
+         "]";
 }
 
 // cabin.moving_parts as ReadMovingParts reads it (ranges back in the column's unit).
@@ -644,7 +617,7 @@ void WriteMovingParts(const MovingParts& moving, std::ostringstream& out) {
       out << "        - {type: " << JointTypeName(j.type) << ", axis: " << Vec(j.axis)
           << ", column: " << j.column;
       if (j.has_range) {
-        out << ", range: [" << Num(j.range_low) << ", " << Num(j.range_high)
+        out << ", range: [" << ShortestNumber(j.range_low) << ", " << ShortestNumber(j.range_high)
             << "]";
       }
       out << "}\n";
@@ -652,7 +625,7 @@ void WriteMovingParts(const MovingParts& moving, std::ostringstream& out) {
     out << "      origin_m: " << Vec(p.origin_m) << "  # parent frame\n";
     out << "      first_moment_kg_m: " << Vec(p.first_moment_kg_m)
         << "  # own mass x centre, about origin_m, joints at zero\n";
-    if (p.mass_kg != 0.0) out << "      mass_kg: " << Num(p.mass_kg) << "\n";
+    if (p.mass_kg != 0.0) out << "      mass_kg: " << ShortestNumber(p.mass_kg) << "\n";
   }
 }
 
@@ -712,9 +685,9 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
     }
   }
   out << "format: " << kFormatName << "\n";
-  out << "gravity_m_per_s2: " << Num(robot.gravity_m_per_s2) << "  # m/s^2, z up\n";
+  out << "gravity_m_per_s2: " << ShortestNumber(robot.gravity_m_per_s2) << "  # m/s^2, z up\n";
   out << "cabin:\n";
-  out << "  mass_kg: " << Num(robot.cabin_mass_kg) << "\n";
+  out << "  mass_kg: " << ShortestNumber(robot.cabin_mass_kg) << "\n";
   out << "  mass_centre_m: " << Vec(robot.mass_centre_cabin_m) << "  # cabin frame\n";
   out << "  inertia_kg_m2: " << InertiaText(robot.cabin_inertia_kg_m2)
       << "  # about the mass centre, cabin frame (vibrations only)\n";
@@ -733,24 +706,27 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
     const CableProperties& c = robot.cables[i];
     out << "  - tower_top_m: " << Vec(c.tower_top_m) << "  # cable " << i + 1 << "\n";
     out << "    anchor: " << c.anchor_index << "  # index into cabin.anchor_points_m\n";
-    out << "    ea_n: " << Num(c.ea_n) << "  # N\n";
-    out << "    linear_density_kg_per_m: " << Num(c.linear_density_kg_per_m) << "\n";
+    out << "    ea_n: " << ShortestNumber(c.ea_n) << "  # N\n";
+    out << "    linear_density_kg_per_m: " << ShortestNumber(c.linear_density_kg_per_m) << "\n";
     if (c.sensor_gain != 1.0 || c.sensor_bias_n != 0.0) {
-      out << "    sensor_gain: " << Num(c.sensor_gain) << "  # reading = gain * tension + bias\n";
-      out << "    sensor_bias_kN: " << Num(c.sensor_bias_n / 1e3) << "\n";
+      out << "    sensor_gain: " << ShortestNumber(c.sensor_gain)
+          << "  # reading = gain * tension + bias\n";
+      out << "    sensor_bias_kN: " << ShortestNumber(c.sensor_bias_n / 1e3) << "\n";
     }
     if (c.length_offset_m != 0.0) {
-      out << "    length_offset_m: " << Num(c.length_offset_m)
+      out << "    length_offset_m: " << ShortestNumber(c.length_offset_m)
           << "  # encoder reading = unstretched length + offset\n";
     }
     if (!c.attachments.empty()) {
       out << "    attachments:  # arc length from the lower (cabin) end, unstretched, m\n";
       for (const CableAttachment& a : c.attachments) {
         if (a.kind == AttachmentKind::kPointMass) {
-          out << "      - {at_m: " << Num(a.at_m) << ", mass_kg: " << Num(a.mass_kg) << "}\n";
+          out << "      - {at_m: " << ShortestNumber(a.at_m)
+              << ", mass_kg: " << ShortestNumber(a.mass_kg) << "}\n";
         } else {
-          out << "      - {from_m: " << Num(a.from_m) << ", to_m: " << Num(a.to_m)
-              << ", added_density_kg_per_m: " << Num(a.added_density_kg_per_m) << "}\n";
+          out << "      - {from_m: " << ShortestNumber(a.from_m)
+              << ", to_m: " << ShortestNumber(a.to_m)
+              << ", added_density_kg_per_m: " << ShortestNumber(a.added_density_kg_per_m) << "}\n";
         }
       }
     }
@@ -758,8 +734,8 @@ std::string CableRobotToYaml(const CableRobot& robot, const std::string& header_
   if (robot.reflector.has_value()) {
     out << "reflector:  # lower cap of a sphere, global frame, m\n";
     out << "  centre_m: " << Vec(robot.reflector->centre_m) << "\n";
-    out << "  radius_m: " << Num(robot.reflector->radius_m) << "\n";
-    out << "  aperture_m: " << Num(robot.reflector->aperture_m) << "  # rim diameter\n";
+    out << "  radius_m: " << ShortestNumber(robot.reflector->radius_m) << "\n";
+    out << "  aperture_m: " << ShortestNumber(robot.reflector->aperture_m) << "  # rim diameter\n";
   } else {
     out << "reflector: none  # not modelled: no contact check\n";
   }

@@ -22,12 +22,14 @@
 #include <utility>
 #include <vector>
 
+#include "fastcal/calibration.h"
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/report_document.h"
 #include "fastcal/internal/report_sections.h"
 #include "fastcal/internal/sample_chunks.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/svg_plot.h"
 #include "fastcal/trajectory.h"
 
@@ -55,11 +57,12 @@ using internal::Table;
 using internal::Target;
 using internal::Text;
 
-constexpr double kNPerKn = 1000.0;
-// Defaults of CalibrationOptions, quoted in the text (the result does not carry them).
-constexpr double kDefaultPoorlyDeterminedRatio = 1e-3;
-constexpr double kDefaultUndeterminedRatio = 1e-8;
-constexpr double kDefaultStrongCorrelation = 0.9;
+using internal::kNPerKn;
+// Defaults of CalibrationOptions, quoted in the text (the result does not carry them):
+// taken from the struct, so that the text follows a change of them.
+const double kDefaultPoorlyDeterminedRatio = CalibrationOptions().poorly_determined_ratio;
+const double kDefaultUndeterminedRatio = CalibrationOptions().undetermined_ratio;
+const double kDefaultStrongCorrelation = CalibrationOptions().strong_correlation;
 // Plot geometry (px) and histogram bins.
 constexpr int kCablePlotWidthPx = 540, kCablePlotHeightPx = 280;
 constexpr int kWidePlotWidthPx = 1000, kWidePlotHeightPx = 320;

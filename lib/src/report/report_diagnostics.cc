@@ -9,12 +9,12 @@
 #include <vector>
 
 #include "fastcal/internal/report_sections.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/svg_plot.h"
 
 namespace fastcal::internal {
 namespace {
 
-constexpr double kNPerKn = kReportNPerKn;
 // The focal centre of the off-axis angle and azimuth (docs/model.md, "Workspace").
 const Eigen::Vector3d kFocalCentre_m(0.0, 0.0, 300.0);
 // Rows at most in the report's tables of readings (summary.json has them all).

@@ -11,6 +11,7 @@
 
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/report_sections.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/report.h"
 
 namespace fastcal::internal {
@@ -46,8 +47,6 @@ bool CorrelationUsable(const CalibrationResult& r) {
 }
 
 namespace {
-
-constexpr double kNPerKn = 1000.0;
 
 void JsonFile(JsonWriter* w, const std::string& key, const std::string& path,
               const std::string& digest) {

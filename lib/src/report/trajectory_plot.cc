@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "fastcal/internal/report_document.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/svg_plot.h"
 
 namespace fastcal {
@@ -23,7 +24,7 @@ using internal::Printf;
 using internal::Table;
 using internal::Text;
 
-constexpr double kNPerKn = 1000.0;
+using internal::kNPerKn;
 constexpr double kPercent = 100.0;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr int kPlotWidthPx = 540, kPlotHeightPx = 340;

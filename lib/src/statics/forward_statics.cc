@@ -231,4 +231,17 @@ Eigen::Vector3d RotationDifference(const Eigen::Matrix3d& to, const Eigen::Matri
   return turn.angle() * turn.axis();
 }
 
+Pose HomePose(const StaticsParameters<double>& p) {
+  constexpr double kHomeDepthPerTowerRadius = 130.0 / 300.0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& t : p.tower_top_m) centroid += t / kNumCables;
+  double radius_m = 0.0;
+  for (const Eigen::Vector3d& t : p.tower_top_m) {
+    radius_m += (t - centroid).head<2>().norm() / kNumCables;
+  }
+  Pose home;
+  home.position_m = centroid - Eigen::Vector3d(0.0, 0.0, kHomeDepthPerTowerRadius * radius_m);
+  return home;
+}
+
 }  // namespace fastcal::internal

@@ -31,6 +31,7 @@ constexpr double kLooseRelativeTolerance = 1e-8;
 using internal::ForwardLinearisation;
 using internal::ForwardScales;
 using internal::ForwardState;
+using internal::HomePose;
 using internal::Lengths;
 using internal::Matrix6d;
 using internal::Vector6d;
@@ -61,9 +62,6 @@ constexpr double kPathPointToleranceM = 1e-6;
 constexpr double kFirstPathStep = 1.0;
 constexpr double kMinPathStep = 1e-3;
 constexpr int kPathPointIterations = 8;
-// The home pose, as the inverse solver's (statics.cc): level, below the tower tops'
-// centroid by this fraction of their mean distance from the axis (K1 for FAST).
-constexpr double kHomeDepthPerTowerRadius = 130.0 / 300.0;
 
 // What the stages of one solve share.
 struct Solver {
@@ -143,18 +141,6 @@ Eigen::Matrix<double, kNumCables, 1> Difference(const Lengths& to, const Lengths
   Eigen::Matrix<double, kNumCables, 1> d;
   for (int i = 0; i < kNumCables; ++i) d[i] = to[i] - from[i];
   return d;
-}
-
-Pose HomePose(const StaticsParameters<double>& p) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& t : p.tower_top_m) centroid += t / kNumCables;
-  double radius_m = 0.0;
-  for (const Eigen::Vector3d& t : p.tower_top_m) {
-    radius_m += (t - centroid).head<2>().norm() / kNumCables;
-  }
-  Pose home;
-  home.position_m = centroid - Eigen::Vector3d(0.0, 0.0, kHomeDepthPerTowerRadius * radius_m);
-  return home;
 }
 
 // The home pose's equilibrium and lengths (the inverse statics, its model range relaxed:

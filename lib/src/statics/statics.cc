@@ -28,6 +28,7 @@ namespace {
 using internal::CableLinearisation;
 using internal::CableState;
 using internal::EquilibriumResponse;
+using internal::HomePose;
 using Geometry = internal::PoseGeometry<double>;
 using State = std::array<CableState<double>, kNumCables>;
 
@@ -60,10 +61,6 @@ constexpr double kFirstPathStep = 0.5;
 // the seeded 10,000-pose sweep (tests/statics_test.cc) no pose that has an in-range
 // equilibrium needed steps below 1e-2.
 constexpr double kMinPathStep = 1e-3;
-// The home pose the continuation starts from: level (R = I), below the centroid of the
-// tower tops by this fraction of their mean horizontal distance from it. For FAST that is
-// K1 = (0, 0, 140) m (130 m below 270 m tower tops at 300 m), where all cables are taut.
-constexpr double kHomeDepthPerTowerRadius = 130.0 / 300.0;
 
 bool ParametersUsable(const StaticsParameters<double>& p) {
   for (int i = 0; i < kNumCables; ++i) {
@@ -515,19 +512,6 @@ bool SameEquilibrium(const State& a, const State& b) {
     apart = std::max(apart, std::max(std::abs(a[i].fl - b[i].fl), std::abs(a[i].fz - b[i].fz)));
   }
   return apart <= kSameRelative * largest;
-}
-
-// The home pose of the continuation (kHomeDepthPerTowerRadius).
-Pose HomePose(const StaticsParameters<double>& p) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (const Eigen::Vector3d& t : p.tower_top_m) centroid += t / kNumCables;
-  double radius_m = 0.0;
-  for (const Eigen::Vector3d& t : p.tower_top_m) {
-    radius_m += (t - centroid).head<2>().norm() / kNumCables;
-  }
-  Pose home;
-  home.position_m = centroid - Eigen::Vector3d(0.0, 0.0, kHomeDepthPerTowerRadius * radius_m);
-  return home;
 }
 
 Pose PoseOnPath(const Pose& from, const Pose& to, double t) {

@@ -14,12 +14,12 @@
 #include "fastcal/internal/block_arrow.h"
 #include "fastcal/internal/chi_square.h"
 #include "fastcal/internal/inner_wander.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/track.h"
 #include "fastcal/track_fold.h"
 
 namespace fastcal::internal {
 
-inline constexpr double kNPerKn = 1e3;
 // A change's likelihood interval in time (Hinkley 1970, Biometrika 57): the cuts whose
 // statistic (twice the log-likelihood) is within LocationDrop() of the best's, at this
 // level (95%). The drop is not chi-square(1)'s 3.84: twice the log-likelihood ratio of

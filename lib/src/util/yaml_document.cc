@@ -4,6 +4,8 @@
 #include <yaml-cpp/eventhandler.h>
 
 #include <algorithm>
+#include <charconv>
+#include <cmath>
 #include <sstream>
 #include <string_view>
 #include <vector>
@@ -160,6 +162,32 @@ YamlDocuments LoadYamlDocuments(const std::string& text) {
   // that document again, now into nodes.
   if (result.count > 0) result.first = YAML::Load(text);
   return result;
+}
+
+std::string ShortestNumber(double value) {
+  if (std::isnan(value)) return ".nan";
+  if (std::isinf(value)) return value > 0 ? ".inf" : "-.inf";
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+int LineOf(const YAML::Node& node) {
+  const YAML::Mark mark = node.Mark();
+  return mark.line < 0 ? 0 : mark.line + 1;
+}
+
+bool YamlErrorRecorder::Fail(int line, const std::string& path, const std::string& what) {
+  error_ = source_;
+  if (line > 0) error_ += ":" + std::to_string(line);
+  // Key names come from the file: escaped like the values (internal/quote.h).
+  error_ += ": " + Escape(path) + ": " + what;
+  return false;
+}
+
+bool YamlErrorRecorder::FailFile(const std::string& what) {
+  error_ = source_ + ": " + what;
+  return false;
 }
 
 }  // namespace fastcal::internal

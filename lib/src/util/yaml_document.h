@@ -14,6 +14,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <string>
+#include <utility>
 
 namespace fastcal::internal {
 
@@ -36,6 +37,33 @@ struct YamlDocuments {
 // (with the mark of the problem) on a syntax error, including the text yaml-cpp 0.7 would loop on:
 // "unexpected ',' after the end of the document" at its line and column.
 YamlDocuments LoadYamlDocuments(const std::string& text);
+
+// The shortest decimal text that reads back to exactly `value` (at most 17 significant
+// digits, std::to_chars), so that a model or spec file written and read again is
+// bit-exact; YAML's ".nan", ".inf" and "-.inf" for the others.
+std::string ShortestNumber(double value);
+
+// 1-based line of a node, or 0 when yaml-cpp does not know it.
+int LineOf(const YAML::Node& node);
+
+// The error of a strict reader of a model, spec or column map (each derives from it), as
+// "<source>:<line>: <key path>: <what>".
+class YamlErrorRecorder {
+ public:
+  explicit YamlErrorRecorder(std::string source) : source_(std::move(source)) {}
+
+  const std::string& error() const { return error_; }
+
+  // Records "<source>:<line>: <path>: <what>" (":<line>" left out when 0); false, for
+  // `return Fail(...)`.
+  bool Fail(int line, const std::string& path, const std::string& what);
+  // Records "<source>: <what>": a problem of the whole file.
+  bool FailFile(const std::string& what);
+
+ private:
+  std::string source_;
+  std::string error_;
+};
 
 }  // namespace fastcal::internal
 

@@ -12,11 +12,12 @@
 
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/units.h"
 
 namespace fastcal {
 namespace {
 
-constexpr double kNPerKn = 1e3;
+using internal::kNPerKn;
 
 // `value` with `digits` significant digits (no trailing zeros), for files and text.
 std::string Num(double value, int digits = 10) {

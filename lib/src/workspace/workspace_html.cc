@@ -6,13 +6,14 @@
 #include <cstdio>
 #include <map>
 
+#include "fastcal/internal/units.h"
 #include "fastcal/svg_plot.h"
 #include "fastcal/workspace.h"
 
 namespace fastcal {
 namespace {
 
-constexpr double kNPerKn = 1e3;
+using internal::kNPerKn;
 
 std::string Num(double value, int digits) {
   char buf[40];

@@ -134,6 +134,12 @@ Eigen::Matrix3d InverseLeftJacobian(const Eigen::Vector3d& phi);
 // [v]x, the cross-product matrix: [v]x u = v x u.
 Eigen::Matrix3d Skew(const Eigen::Vector3d& v);
 
+// The home pose the inverse statics' continuation (statics.cc) and the forward solver
+// (locate.cc) start from: level (R = I), below the centroid of the tower tops by 130/300
+// of their mean horizontal distance from it. For FAST that is K1 = (0, 0, 140) m (130 m
+// below 270 m tower tops at 300 m), where all cables are taut.
+Pose HomePose(const StaticsParameters<double>& p);
+
 }  // namespace fastcal::internal
 
 namespace fastcal {

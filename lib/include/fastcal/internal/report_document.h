@@ -13,10 +13,10 @@
 #include <vector>
 
 #include "fastcal/internal/number_text.h"
+#include "fastcal/internal/units.h"
 
 namespace fastcal::internal {
 
-inline constexpr double kReportNPerKn = 1000.0;
 inline constexpr double kReportPercent = 100.0;
 
 // "-0.000" and "+0.00" -> "0.000", "0.00".
@@ -34,7 +34,7 @@ inline std::string Printf(const char* format, double v) {
 }
 inline std::string Sig6(double v) { return Printf("%.6g", v); }
 inline std::string Sig3(double v) { return Printf("%.3g", v); }
-inline std::string Kn3(double v_n) { return Printf("%.3f", v_n / kReportNPerKn); }
+inline std::string Kn3(double v_n) { return Printf("%.3f", v_n / kNPerKn); }
 inline std::string Pct(double fraction, const char* format = "%.3g") {
   return Printf(format, fraction * kReportPercent);
 }
