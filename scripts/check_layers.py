@@ -40,6 +40,7 @@ HEADER_ONLY = {
     "catenary_chain.h": "statics",
     "internal/csv.h": "util",
     "internal/json.h": "util",
+    "internal/units.h": "util",
     "internal/sample_chunks.h": "util",
     "internal/dataset_column_names.h": "model",
     "internal/statics_core.h": "statics",
