@@ -26,14 +26,27 @@ try:
 
     from . import _fastcal
 except ImportError as _error:  # another interpreter than the build's: say which to use
+    import sys as _sys
+
     try:
         from ._build import PYTHON as _BUILT_FOR
     except ImportError:  # an installed package: no build tree
+        _BUILT_FOR = None
+    _where = f"; it was built for {_BUILT_FOR}" if _BUILT_FOR else ""
+    if getattr(_error, "name", None) == "numpy" or "numpy" in str(_error):
+        # Issue 59: an installed package under another interpreter said only "No module
+        # named numpy".
+        raise ImportError(
+            f"fastcal needs numpy, which this Python interpreter ({_sys.executable}) does "
+            f"not have{_where}: run fastcal with an interpreter that has numpy, or install "
+            "it for this one (Debian: apt-get install python3-numpy; docs/python.md)"
+        ) from _error
+    if _BUILT_FOR is None:
         raise _error from None
     raise ImportError(
         f"fastcal was built for {_BUILT_FOR}; this is another Python interpreter "
-        f"({_error}). Run it with {_BUILT_FOR}, or build/python/python3 in the build tree "
-        "(docs/python.md)"
+        f"({_sys.executable}: {_error}). Run it with {_BUILT_FOR}, or build/python/python3 in "
+        "the build tree (docs/python.md)"
     ) from _error
 from ._fastcal import CalibrationError, Dataset, Error, InputError, Model
 

@@ -64,6 +64,28 @@ def test_the_build_names_its_interpreter_and_runs_it() -> None:
     assert out.stdout == "0.0\n"
 
 
+@pytest.mark.parametrize("installed", [False, True])
+def test_an_interpreter_without_numpy_is_told_so(installed: bool) -> None:
+    """Issue 59: under an interpreter without numpy, the installed package said only 'No
+    module named numpy'. numpy is hidden from a child interpreter (and, for the installed
+    package, the build tree's record too)."""
+    hide = "import sys; sys.modules['numpy'] = None"
+    if installed:
+        hide += "; sys.modules['fastcal._build'] = None"
+    package = pathlib.Path(fastcal.__file__).parents[1]
+    out = subprocess.run(
+        [sys.executable, "-c", hide + "; import fastcal"],
+        env={"PYTHONPATH": str(package), "PATH": "/nonexistent"},
+        capture_output=True,
+        text=True,
+    )
+    assert out.returncode != 0
+    assert "fastcal needs numpy" in out.stderr, out.stderr
+    assert sys.executable in out.stderr, out.stderr
+    assert "python3-numpy" in out.stderr, out.stderr
+    assert ("it was built for" in out.stderr) != installed, out.stderr
+
+
 def test_a_missing_file_is_file_not_found_as_open_raises(
     tmp_path: pathlib.Path, data_dir: pathlib.Path
 ) -> None:
