@@ -442,7 +442,10 @@ def _dataset_to_dataframe(self: Dataset) -> Any:
     """The samples as a pandas DataFrame in fastcal's column names and units (the
     canonical CSV's: time_s, x_m, y_m, z_m, roll_deg, pitch_deg, yaw_deg, the planned
     attitude, T1_kN..T6_kN, s0_1_m..s0_6_m and the joint columns where the data have
-    them, session with its label), one row per sample; `line` is the file's line."""
+    them, session with its label), one row per sample; `line` is the file's line. When
+    the times are Unix seconds (all after 1973), the index is their UTC DatetimeIndex
+    named `time`, so that events and plots line up in dates (issue 59); otherwise a
+    plain RangeIndex."""
     import pandas
 
     columns: Dict[str, Any] = {"time_s": self.time_s}
@@ -464,7 +467,17 @@ def _dataset_to_dataframe(self: Dataset) -> Any:
     if self.session_labels:
         columns["session"] = [self.session_labels[k] for k in self.session]
     columns["line"] = self.line
-    return pandas.DataFrame(columns)
+    frame = pandas.DataFrame(columns)
+    if len(self.time_s) > 0 and np.all(np.asarray(self.time_s) >= _UNIX_TIMES_FROM_S):
+        frame.index = pandas.DatetimeIndex(
+            pandas.to_datetime(np.asarray(self.time_s), unit="s", utc=True), name="time"
+        )
+    return frame
+
+
+# Times at or after this are read as Unix seconds (1973-03-03); before, as seconds from
+# any start (a simulated survey's 0, 1, 2 ...).
+_UNIX_TIMES_FROM_S = 1e8
 
 
 Dataset.to_dataframe = _dataset_to_dataframe  # type: ignore[attr-defined]

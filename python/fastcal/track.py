@@ -83,19 +83,38 @@ class TrackResult:
                     event[key] = text[key]
 
     def to_dataframe(self) -> Any:
-        """The windows as a pandas DataFrame, one row per window (index: its label):
-        start_s, end_s, samples, reduced_chi_square, and per per-window parameter its
-        value and NAME_sigma_total, as track.csv has them."""
+        """The windows as a pandas DataFrame, one row per window, every column of
+        track.csv: window (its label), start_s, end_s, first_time_s, last_time_s,
+        samples, readings, per per-window parameter its value and NAME_sigma_total, each
+        shared sensor's offset sensor_offset_kN[i] and its _sigma_total, the window's
+        reduced_chi_square, widening, gross_errors and folded. The index is the windows'
+        start as a UTC DatetimeIndex (`window_start`) for Unix times, else the labels
+        (issue 59: label strings beside float seconds would not line up with dates)."""
         import pandas
 
         rows = []
         for w in self.windows:
-            row = {k: w[k] for k in ("start_s", "end_s", "samples", "reduced_chi_square")}
+            row = {"window": w["label"]}
+            for k in ("start_s", "end_s", "first_time_s", "last_time_s", "samples", "readings"):
+                row[k] = w[k]
             for name, e in w["estimates"].items():
                 row[name] = e["value"]
                 row[f"{name}_sigma_total"] = e["sigma_total"]
+            for cable, e in sorted(w.get("sensor_offset_kN", {}).items(), key=lambda x: int(x[0])):
+                row[f"sensor_offset_kN[{cable}]"] = e["value"]
+                row[f"sensor_offset_kN[{cable}]_sigma_total"] = e["sigma_total"]
+            for k in ("reduced_chi_square", "widening", "gross_errors", "folded"):
+                row[k] = w[k]
             rows.append(row)
-        return pandas.DataFrame(rows, index=[w["label"] for w in self.windows])
+        frame = pandas.DataFrame(rows)
+        starts = np.array([w["start_s"] for w in self.windows], dtype=np.float64)
+        if len(starts) > 0 and np.all(starts >= 1e8):  # Unix seconds
+            frame.index = pandas.DatetimeIndex(
+                pandas.to_datetime(starts, unit="s", utc=True), name="window_start"
+            )
+        else:
+            frame.index = pandas.Index([w["label"] for w in self.windows], name="window")
+        return frame
 
     def estimates(self, name: str) -> Tuple[np.ndarray, np.ndarray]:
         """A per-window parameter's estimates and sigma_total over the windows, (n,) each."""

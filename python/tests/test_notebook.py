@@ -76,3 +76,16 @@ def test_track_events_carry_iso_times(tmp_path: pathlib.Path, cli) -> None:
     frame = result.to_dataframe()
     assert len(frame) == len(result.windows)
     assert "mass_centre_m.x_sigma_total" in frame.columns
+    # Issue 59: every column of track.csv (its bounds as the index), and dates that line
+    # up with the data's.
+    header = (tmp_path / "track" / "track.csv").read_text().splitlines()
+    header = [line for line in header if not line.startswith("#")][0].split(",")
+    missing = set(header) - set(frame.columns) - {"window_start", "window_end"}
+    assert not missing, missing
+    assert str(frame.index.tz) == "UTC"
+    assert frame.index[0].isoformat().startswith("2024-05-01T00:00:00")
+    assert list(frame["window"]) == [w["label"] for w in result.windows]
+    data = fastcal.read_dataset(season).to_dataframe()
+    assert data.index.name == "time" and str(data.index.tz) == "UTC"
+    assert data.index[0].isoformat().startswith("2024-05-01T20:00:00")
+    assert data.index[0] >= frame.index[0]  # the same axis: plotting events on it works
