@@ -657,6 +657,13 @@ TEST_F(SeasonTest, UpdateFoldsOnlyTheNewDay) {
     }
   }
   ASSERT_EQ(after.events.size(), 2u);
+  // The slow error an update keeps is said to be the track's, not "likelihood ratio
+  // against white noise 0" (issue 59).
+  EXPECT_FALSE(before.slow_error.kept_from_track);
+  EXPECT_TRUE(after.slow_error.kept_from_track);
+  const std::string said = DescribeSlowError(after.slow_error);
+  EXPECT_NE(said.find("kept by this update"), std::string::npos) << said;
+  EXPECT_EQ(said.find("likelihood ratio"), std::string::npos) << said;
   // Nothing new: nothing folded.
   const TrackResult again = Track(*spec_, {a, b}, dir + "/track");
   EXPECT_EQ(again.folds, 0);

@@ -61,6 +61,9 @@ struct SlowErrorReport {
   bool time_constant_at_bound = false;
   // 2 (l(process) - l(white noise alone)), l the restricted log-likelihood.
   double likelihood_ratio_vs_white = 0.0;
+  // A track's update kept the process the track was built with (not re-estimated: the
+  // fields above but `process` are not this run's).
+  bool kept_from_track = false;
   // Where the spec states both parts: the maximum-likelihood process, the likelihood-ratio
   // statistic of the stated one against it (chi-square, 2 degrees of freedom), its
   // p-value, and whether the residuals contradict the stated process (p < 1%).

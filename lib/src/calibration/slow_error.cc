@@ -66,6 +66,16 @@ std::string Amplitude(const SlowErrorReport& r) {
 
 std::string DescribeSlowError(const SlowErrorReport& r) {
   if (!r.enabled) return "";
+  if (r.kept_from_track) {
+    // Issue 59: an update said "likelihood ratio against white noise 0", which read as a
+    // finding; it had not been estimated.
+    const bool percent = r.amplitude_in_percent;
+    return "slow sensor error (the track's, kept by this update; --refold re-estimates it): sd " +
+           Num("%.3g", percent ? r.process.sigma_percent : r.process.sigma_n / 1e3) +
+           (percent ? " % of the reading" : " kN") + ", time constant " +
+           Num("%.3g", r.process.time_constant_s) +
+           " s; the fit whitens the readings by it (generalised least squares)";
+  }
   const bool estimated = r.amplitude_estimated || r.time_constant_estimated;
   std::string text = std::string("slow sensor error (") + (estimated ? "estimated" : "stated") +
                      ", a Gauss-Markov process per cable): ";

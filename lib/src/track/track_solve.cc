@@ -527,6 +527,7 @@ bool StartSlowError(TrackRun& run, bool estimate_slow_error) {
     run.result->notes.push_back(
         "an update keeps the slow error the track was built with (--refold re-estimates it)");
     slow_settled = !run.options.refold_all;
+    run.result->slow_error.kept_from_track = slow_settled;
   }
   run.result->slow_error.enabled = run.spec.slow_error.enabled;
   if (!run.spec.slow_error.estimates_any()) run.slow = run.spec.slow_error.Initial();
