@@ -644,6 +644,8 @@ bool SetUp(const CableRobot& robot, const CalibrationSpec& spec, const DesignOpt
 
 }  // namespace
 
+namespace {
+
 // Stage: the wait after each move (move_settle.h), into the stops and the duration. A move
 // the dynamics cannot run (its straight path leaves the workspace, say) waits 0 and is
 // named in settle_note; the design stands without.
@@ -670,6 +672,37 @@ void SettleAfterMoves(const CableRobot& robot, const DesignOptions& o, Design* d
   }
   d->duration_s += d->settle_s;
 }
+
+// Stage: the predictions of the design as flown (its samples' times, the slow error), of
+// the paper's circle and of a random survey (a comparison that cannot be made is a note),
+// and what limits the design.
+bool PredictAll(const CableRobot& robot, const CalibrationSpec& spec, const DesignOptions& options,
+                const DesignProblem& pr, Design* d, std::string* error) {
+  d->slow_error = PredictionSlowError(spec, options);
+  DesignProblem flown;
+  if (!SurveyProblem(robot, spec, pr, d->poses, d->joints, FlightTimes(*d, options), d->slow_error,
+                     &flown, error)) {
+    return false;
+  }
+  const DesignSums s = internal::SumsOf(flown, Eigen::VectorXd::Ones(flown.candidates()));
+  d->design = PredictWithParts(spec, flown, s, options.samples);
+  ExplainLimits(spec, flown, s, d);
+  std::vector<Pose> reference;
+  std::string why;
+  if (internal::CirclePoses(options, options.samples, &reference, &why)) {
+    d->circle = PredictPoses(robot, spec, pr, reference, d->slow_error, options.sample_interval_s);
+  } else {
+    d->circle.note = why;
+  }
+  if (internal::RandomSurveyPoses(robot, options, options.samples, &reference, &why)) {
+    d->random = PredictPoses(robot, spec, pr, reference, d->slow_error, options.sample_interval_s);
+  } else {
+    d->random.note = why;
+  }
+  return true;
+}
+
+}  // namespace
 
 bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
                   const DesignOptions& options, Design* design, std::string* error) {
@@ -738,27 +771,7 @@ bool DesignSurvey(const CableRobot& robot, const CalibrationSpec& spec,
     SettleAfterMoves(robot, options, &d);
   }
   say("predictions for the design, the paper's circle and a random survey");
-  d.slow_error = PredictionSlowError(spec, options);
-  DesignProblem flown;
-  if (!SurveyProblem(robot, spec, pr, d.poses, d.joints, FlightTimes(d, options), d.slow_error,
-                     &flown, error)) {
-    return false;
-  }
-  const DesignSums s = internal::SumsOf(flown, Eigen::VectorXd::Ones(flown.candidates()));
-  d.design = PredictWithParts(spec, flown, s, options.samples);
-  ExplainLimits(spec, flown, s, &d);
-  std::vector<Pose> reference;
-  std::string why;
-  if (internal::CirclePoses(options, options.samples, &reference, &why)) {
-    d.circle = PredictPoses(robot, spec, pr, reference, d.slow_error, options.sample_interval_s);
-  } else {
-    d.circle.note = why;
-  }
-  if (internal::RandomSurveyPoses(robot, options, options.samples, &reference, &why)) {
-    d.random = PredictPoses(robot, spec, pr, reference, d.slow_error, options.sample_interval_s);
-  } else {
-    d.random.note = why;
-  }
+  if (!PredictAll(robot, spec, options, pr, &d, error)) return false;
   *design = std::move(d);
   return true;
 }
