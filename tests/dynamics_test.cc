@@ -409,6 +409,18 @@ TEST(CableDynamics, RefusesAPoseTheStaticsCannotHold) {
   EXPECT_NE(error.find("statics cannot hold"), std::string::npos) << error;
 }
 
+// The modes' model checks (issue 57's plausibility) hold for the dynamics too: one check of
+// what the chains describe (it took only IsValid before, which passes 1e300 kg m^2).
+TEST(CableDynamics, RefusesAnImplausibleModelAsTheModesDo) {
+  CableRobot robot = CableRobot::NominalFast();
+  robot.cabin_inertia_kg_m2 = Eigen::Vector3d::Constant(1e300).asDiagonal();
+  Pose pose;
+  pose.position_m = Eigen::Vector3d(0.0, 0.0, 140.0);
+  std::string error;
+  EXPECT_FALSE(CableDynamics::Create(robot, pose, DynamicsOptions(), 10.0, &error));
+  EXPECT_NE(error.find("model: cabin.inertia_kg_m2[0]: 1e+300 kg m^2"), std::string::npos) << error;
+}
+
 // Per-cable damping: each cable's tau from its own first axial mode's ratio.
 TEST(CableDynamics, PerCableDamping) {
   DynamicsOptions options;

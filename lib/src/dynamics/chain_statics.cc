@@ -24,6 +24,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fastcal/model_plausibility.h"
+
 namespace fastcal::internal {
 namespace {
 
@@ -82,6 +84,24 @@ bool DenseModes(const Eigen::SparseMatrix<double>& k, const Eigen::SparseMatrix<
 }
 
 }  // namespace
+
+bool CheckChainInputs(const CableRobot& robot, const Pose& pose, const std::string& user,
+                      std::string* error) {
+  if (!CheckModel(robot, error)) {
+    *error = "model: " + *error;
+    return false;
+  }
+  if (robot.HasAttachments()) {
+    *error = "model: the cables carry attachments, which " + user +
+             " do not describe yet (a uniform cable's lumped masses only)";
+    return false;
+  }
+  if (!IsFinite(pose)) {
+    *error = "pose: must be finite";
+    return false;
+  }
+  return true;
+}
 
 bool SolveChainStatics(const ChainModel& model, const ChainStaticsOptions& options,
                        ChainState* state, int* iterations, std::string* error) {

@@ -8,6 +8,8 @@
 #include <vector>
 
 #include "dynamics/chain_system.h"
+#include "fastcal/cable_robot.h"
+#include "fastcal/pose.h"
 
 namespace fastcal::internal {
 
@@ -38,6 +40,14 @@ bool LowestModes(const ChainModel& model, const ChainState& state, int count,
 // (over the degrees of freedom) puts in cable i's segments, per unit damping time.
 std::vector<double> AxialQuadratic(const ChainModel& model, const ChainState& state,
                                    const Eigen::VectorXd& phi);
+
+// What the lumped chains can describe, checked once for the modes and the dynamics in
+// time: the model file's checks with plausibility (issue 57: an inertia of 1e300 kg m^2
+// broke the eigensolver), uniform cables (no attachments) and a finite pose. `user` names
+// the caller in the attachments' message ("the modes", "the dynamics"). False with *error
+// ("model: ...", "pose: ...").
+bool CheckChainInputs(const CableRobot& robot, const Pose& pose, const std::string& user,
+                      std::string* error);
 
 }  // namespace fastcal::internal
 

@@ -223,20 +223,7 @@ std::unique_ptr<CableDynamics> CableDynamics::Create(const CableRobot& robot, co
                                                      const DynamicsOptions& options,
                                                      double duration_s, std::string* error) {
   if (!options.IsValid(error)) return nullptr;
-  if (!robot.IsValid(error)) {
-    *error = "model: " + *error;
-    return nullptr;
-  }
-  if (robot.HasAttachments()) {
-    *error =
-        "model: the cables carry attachments, which the dynamics do not describe yet "
-        "(uniform cables only, as the modes)";
-    return nullptr;
-  }
-  if (!IsFinite(pose)) {
-    *error = "pose: must be finite";
-    return nullptr;
-  }
+  if (!internal::CheckChainInputs(robot, pose, "the dynamics", error)) return nullptr;
   auto impl = std::make_unique<Impl>();
   impl->options = options;
   DynamicsStart& start = impl->start;

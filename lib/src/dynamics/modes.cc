@@ -56,6 +56,7 @@
 #include <string>
 #include <vector>
 
+#include "dynamics/chain_statics.h"
 #include "fastcal/catenary.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/model_plausibility.h"
@@ -508,22 +509,8 @@ bool ComputeFixedCableModes(const FixedCable& cable, const ModesOptions& options
 // The equilibrium of `pose` by the exact statics, with its failure said in words.
 bool SolveEquilibrium(const CableRobot& robot, const Pose& pose, const ModesOptions& options,
                       StaticsSolution* statics, std::string* error) {
-  // The model file's checks, plausibility included (issue 57: an inertia of 1e300 kg m^2
-  // broke the eigensolver), for callers that built the model themselves.
-  if (!CheckModel(robot, error)) {
-    *error = "model: " + *error;
-    return false;
-  }
-  if (robot.HasAttachments()) {
-    *error =
-        "model: the cables carry attachments, which the modes do not describe yet (a uniform "
-        "cable's lumped masses only)";
-    return false;
-  }
-  if (!IsFinite(pose)) {
-    *error = "pose: must be finite";
-    return false;
-  }
+  // For callers that built the model themselves, as a model file is checked.
+  if (!internal::CheckChainInputs(robot, pose, "the modes", error)) return false;
   if (SolveStatics(robot, pose, options.statics, statics) != StaticsStatus::kOk) {
     *error = "no equilibrium to linearise about: " + DescribeStatus(*statics);
     return false;
