@@ -1405,6 +1405,9 @@ TEST_F(CliTest, DesignWritesPosesSimulateReadsAndRefusesBadInput) {
       {"design --spec=" + spec + " --samples=40" + grid + " --criterion=E --out=" + Path("never"),
        2, "--criterion must be A or D"},
       {"design --spec=" + spec + " --samples=40" + grid +
+           " --speed-m-per-s=0.5 --settle-fraction=2 --out=" + Path("never"),
+       2, "--settle-fraction must be in (0, 1)"},
+      {"design --spec=" + spec + " --samples=40" + grid +
            " --parameters=cabin_mass_kg --out=" + Path("never"),
        2, "'cabin_mass_kg' is not a free parameter"},
       {"design --spec=" + spec + " --out=" + Path("never"), 2, "--samples=N"},
