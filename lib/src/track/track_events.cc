@@ -200,45 +200,169 @@ TrackStatus DropWeakSteps(TrackRun& run, double threshold) {
 // cut on already of the new value) or u (before a cut still of the old). Moving it changes
 // the chi-square by 2 s delta + S delta^2 (s the score of the part that changes, S its
 // information with everything else profiled out, delta the bias change it gets), over the
-// window's misfit widening. A placement stands for a change between `before_s` and
-// `after_s`: a block cut for anywhere in the blocks either side of it, a sample cut for the
-// gap between two samples, the boundary for the night.
+// noise of s (PlacementNoise): `change`, with the wander's share of the part (what the
+// interval and the choice against the boundary are judged by), and `fit`, over the
+// window's white and block-scale misfit alone, a scale that is the same for every cut of
+// the window (where in the window the step most likely is: a scale growing with the part
+// would pull the point towards the short parts). A placement stands for a change between `before_s`
+// and `after_s`: a block cut for anywhere in the blocks either side of it, a sample cut for the gap
+// between two samples, the boundary for the night.
 struct Placement {
   int window = -1;  // used window; -1: the boundary
   int block = 0;    // a block cut: before this block of `window` (-1: a sample cut)
   double change = 0.0;
+  double fit = 0.0;
   double before_s = 0.0, after_s = 0.0;
 };
+
+// The noise a placement's score s is judged against in window v, Var(s) / S (S its
+// information with everything else profiled out), where the tracked model is white at the
+// samples' scale but not at the blocks' (issue 53: an attitude-control error with a
+// minute's memory, the mass centre wandering inside a day, both move the tensions as a
+// sensor step would, for minutes to tens of minutes; judged against the samples' misfit
+// alone a dip anywhere in a day outweighed the night where the step was):
+//   Var(s) / S = f_w phi + e^T K e / S,
+// f_w the window's misfit widening (run.birge); phi the bias's block dispersion, the
+// variance of its blocks' scores at the solution, less the wander's expected share of it,
+// over their white value (at least 1: the misfit at the blocks' scale); e^T K e per group the
+// wander inside the window on the part's score (blocks weighing weight[b]: 1 inside the part, 0
+// outside, the share of a block a cut splits), e the part's blocks' cross information with the
+// group profiled over the window's local variables (as WanderScoreVariance).
+class PlacementNoise {
+ public:
+  // Bias fold column `column`, block row `row` (BlockRowColumns).
+  PlacementNoise(const TrackRun& run, int v, int column, int row)
+      : fold_(run.windows[run.used[v]].fold), order_(LocalOrder(run)), column_(column), row_(row) {
+    for (size_t gi = 0; gi < run.wander_inside.size(); ++gi) {
+      WanderExposure x = ExposureOf(run, v, static_cast<int>(gi));
+      if (x.active) exposures_.push_back(std::move(x));
+    }
+    white_ = run.birge[v] * BlockDispersion(run, v);
+  }
+  double Scale(const Eigen::VectorXd& weight, double schur) const {
+    return white_ + std::max(0.0, WanderVariance(weight)) / schur;
+  }
+  double white() const { return white_; }
+  // The weights of the part from block j on (or, with `head`, before it); `share` of block
+  // j - 1 is in the tail too (a cut inside it).
+  Eigen::VectorXd Part(int j, bool head, double share = 0.0) const {
+    const int blocks = static_cast<int>(fold_.block_samples.size());
+    Eigen::VectorXd w(blocks);
+    for (int b = 0; b < blocks; ++b) w[b] = b >= j ? 1.0 : (b == j - 1 ? share : 0.0);
+    if (head) w = Eigen::VectorXd::Ones(blocks) - w;
+    return w;
+  }
+
+ private:
+  double BlockDispersion(const TrackRun& run, int v) const {
+    const int blocks = static_cast<int>(fold_.block_samples.size());
+    const double information = fold_.information(column_, column_);
+    if (blocks < 2 || !(information > 0.0)) return 1.0;
+    const Eigen::VectorXd d = StepOf(run, v);
+    Eigen::VectorXd w(blocks);
+    for (int b = 0; b < blocks; ++b) {
+      w[b] = fold_.block_scores(b, column_) + fold_.block_information[b].row(row_).dot(d);
+    }
+    // The wander's expected sum of squares about the mean, tr C - 1^T C 1 / B, with C the
+    // blocks' scores' wander covariance.
+    double wander = 0.0;
+    for (const WanderExposure& x : exposures_) {
+      const int p = static_cast<int>(x.rows.cols() / blocks);
+      Eigen::MatrixXd r = Eigen::MatrixXd::Zero(blocks * p, blocks);
+      for (int b = 0; b < blocks; ++b) {
+        for (int c = 0; c < p; ++c) r(b * p + c, b) = x.rows(column_, b * p + c);
+      }
+      const Eigen::MatrixXd c = r.transpose() * x.k * r;
+      wander += c.trace() - c.sum() / blocks;
+    }
+    const double squares = (w.array() - w.mean()).square().sum() - wander;
+    return std::max(1.0, squares * blocks / (blocks - 1.0) / (information * run.birge[v]));
+  }
+  double WanderVariance(const Eigen::VectorXd& weight) const {
+    if (exposures_.empty()) return 0.0;
+    Eigen::VectorXd local = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(order_.size()));
+    for (int b = 0; b < weight.size(); ++b) {
+      if (weight[b] == 0.0) continue;
+      for (size_t r = 0; r < order_.size(); ++r) {
+        local[r] += weight[b] * fold_.block_information[b](row_, order_[r]);
+      }
+    }
+    double variance = 0.0;
+    for (const WanderExposure& x : exposures_) {
+      const int p = static_cast<int>(x.rows.cols() / weight.size());
+      Eigen::VectorXd e = -x.formal_local_rows.transpose() * local;
+      for (int b = 0; b < weight.size(); ++b) {
+        for (int c = 0; c < p; ++c) e[b * p + c] += weight[b] * x.rows(column_, b * p + c);
+      }
+      variance += e.dot(x.k * e);
+    }
+    return variance;
+  }
+
+  const WindowFold& fold_;
+  std::vector<int> order_;
+  int column_, row_;
+  double white_ = 1.0;
+  std::vector<WanderExposure> exposures_;
+};
+
+// A placement at a cut whose part has score s and information S, for a step of delta:
+// its change of chi-square 2 s delta + S delta^2 over the noise of s (quasi-likelihood: s
+// and S both divided by Var(s) / S, PlacementNoise), with and without the wander.
+Placement PlaceAt(int window, int block, double score, double schur, double delta,
+                  const PlacementNoise& noise, const Eigen::VectorXd& part, double before_s,
+                  double after_s) {
+  const double change = 2.0 * score * delta + schur * delta * delta;
+  return {window,   block,  change / noise.Scale(part, schur), change / noise.white(),
+          before_s, after_s};
+}
 
 // The boundary and every block cut of windows u - 1 and u (ScanSplits).
 std::vector<Placement> StepPlacements(const TrackRun& run, int u, const std::vector<int>& rows,
                                       int column, double size) {
   std::vector<Placement> out = {
-      {-1, 0, 0.0, run.windows[run.used[u - 1]].last_s, run.windows[run.used[u]].first_s}};
+      {-1, 0, 0.0, 0.0, run.windows[run.used[u - 1]].last_s, run.windows[run.used[u]].first_s}};
   for (const int v : {u - 1, u}) {
     const bool head = v == u;
     const double delta = head ? -size : size;
     const std::vector<SplitScore> scores = ScanSplits(run, v, rows, {column}, run.birge[v], head);
     const WindowFold& f = run.windows[run.used[v]].fold;
+    const PlacementNoise noise(run, v, column, rows[0]);
     for (size_t j = kMinPartBlocks; j + kMinPartBlocks <= scores.size(); ++j) {
       if (!scores[j].valid) continue;
-      out.push_back({v, static_cast<int>(j),
-                     (2.0 * scores[j].score[0] * delta + scores[j].schur(0, 0) * delta * delta) /
-                         run.birge[v],
-                     f.block_first_time_s[j - 1], f.block_last_time_s[j]});
+      out.push_back(PlaceAt(v, static_cast<int>(j), scores[j].score[0], scores[j].schur(0, 0),
+                            delta, noise, noise.Part(static_cast<int>(j), head),
+                            f.block_first_time_s[j - 1], f.block_last_time_s[j]));
     }
   }
   return out;
 }
 
+// The block holding a cut between samples at before_s and after_s, +1 (the tail's first
+// whole block), and the share of that block after the cut.
+std::pair<int, double> CutShare(const WindowFold& f, double before_s, double after_s) {
+  const int blocks = static_cast<int>(f.block_samples.size());
+  for (int b = 0; b < blocks; ++b) {
+    if (after_s > f.block_last_time_s[b]) continue;
+    if (after_s <= f.block_first_time_s[b]) return {b, 0.0};
+    const double gap = after_s - before_s;
+    const double span = f.block_last_time_s[b] - f.block_first_time_s[b] + gap;
+    return {b + 1, span > 0.0 ? (f.block_last_time_s[b] - after_s + gap) / span : 0.0};
+  }
+  return {blocks, 0.0};
+}
+
 // Window v's placements at every gap between the samples of its fine fold's scan: the
-// exact step columns (internal/step_scan.h) of bias fold column `column`, the part from
-// each cut on (or, with `head`, before it: the window's sums minus the step's).
+// exact step columns (internal/step_scan.h) of bias fold column `column` (block row
+// `row`), the part from each cut on (or, with `head`, before it: the window's sums minus
+// the step's).
 std::vector<Placement> SamplePlacements(const TrackRun& run, int v, const WindowFold& f, int column,
-                                        double delta, bool head) {
+                                        int row, double delta, bool head) {
   const std::vector<int> order = LocalOrder(run);
   const ArrowBlock& k = run.problem.blocks[v];
   const int n = static_cast<int>(f.information.cols());
+  const WindowFold& coarse = run.windows[run.used[v]].fold;
+  const PlacementNoise noise(run, v, column, row);
   std::vector<Placement> out;
   for (size_t c = 0; c < f.fine.cross.size(); ++c) {
     const Eigen::MatrixXd& cross = f.fine.cross[c];
@@ -254,8 +378,10 @@ std::vector<Placement> SamplePlacements(const TrackRun& run, int v, const Window
     }
     const double schur = self - run.solver.QuadraticFormOfLocal({v}, {local})(0, 0);
     if (!(schur > 0.0)) continue;
-    out.push_back({v, -1, (2.0 * score * delta + schur * delta * delta) / run.birge[v],
-                   f.fine.before_s[c], f.fine.after_s[c]});
+    const std::pair<int, double> cut = CutShare(coarse, f.fine.before_s[c], f.fine.after_s[c]);
+    out.push_back(PlaceAt(v, -1, score, schur, delta, noise,
+                          noise.Part(cut.first, head, cut.second), f.fine.before_s[c],
+                          f.fine.after_s[c]));
   }
   return out;
 }
@@ -263,7 +389,7 @@ std::vector<Placement> SamplePlacements(const TrackRun& run, int v, const Window
 // The placements at every gap between samples where the block cuts within the drop of the
 // least lie (with a block either side), from fine folds of windows u - 1 and u; the block
 // cuts of a window with none there stay. False (run.error) when a fine fold fails.
-bool RefinePlacements(TrackRun& run, int u, int column, double size,
+bool RefinePlacements(TrackRun& run, int u, int column, int row, double size,
                       std::vector<Placement>* placements) {
   double least = 0.0;
   for (const Placement& x : *placements) least = std::min(least, x.change);
@@ -288,7 +414,7 @@ bool RefinePlacements(TrackRun& run, int u, int column, double size,
     }
     const bool head = v == u;
     const std::vector<Placement> at =
-        SamplePlacements(run, v, fine, column, head ? -size : size, head);
+        SamplePlacements(run, v, fine, column, row, head ? -size : size, head);
     out.insert(out.end(), at.begin(), at.end());
   }
   out.insert(out.begin(), placements->front());  // the boundary
@@ -311,17 +437,25 @@ std::pair<double, double> PlacementInterval(const std::vector<Placement>& placem
   return {low, high};
 }
 
-// Where the step most likely is: the placement of least change among those allowed (a
-// window is moved into only when its stretch keeps another window), unless the boundary is
-// within LocationDrop() of it (window -1: it stays there; an overnight re-zeroing is not
-// put in an edge block).
+// Where the step most likely is: in a window only when its least change among those
+// allowed (a window is moved into only when its stretch keeps another window) is more than
+// LocationDrop() below the boundary's (else window -1: it stays there; an overnight
+// re-zeroing is not put in an edge block), and then at the least `fit` of the allowed
+// placements within LocationDrop() of that least.
 Placement MoveStep(const std::vector<Placement>& placements, bool before_ok, bool here_ok, int u) {
-  Placement best;  // the boundary's
+  const auto allowed = [&](const Placement& x) {
+    return x.window >= 0 && (x.window == u - 1 ? before_ok : here_ok);
+  };
+  double least = 0.0;
   for (const Placement& x : placements) {
-    if (x.window < 0 || !(x.window == u - 1 ? before_ok : here_ok)) continue;
-    if (x.change < best.change) best = x;
+    if (allowed(x)) least = std::min(least, x.change);
   }
-  if (!(-best.change > LocationDrop())) return Placement();
+  if (!(-least > LocationDrop())) return Placement();
+  Placement best;
+  best.fit = std::numeric_limits<double>::infinity();
+  for (const Placement& x : placements) {
+    if (allowed(x) && x.change <= least + LocationDrop() && x.fit < best.fit) best = x;
+  }
   return best;
 }
 
@@ -378,7 +512,7 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     const bool here_ok = u + 1 < windows && run.entry_of[u + 1][j] == e;
     const double size = run.shared[e].value_si - run.shared[e0].value_si;
     std::vector<Placement> placements = StepPlacements(run, u, rows, column, size);
-    if (!RefinePlacements(run, u, column, size, &placements)) return TrackStatus::kFailed;
+    if (!RefinePlacements(run, u, column, rows[0], size, &placements)) return TrackStatus::kFailed;
     const std::pair<double, double> interval = PlacementInterval(placements);
     run.shared[e].has_interval = true;
     run.shared[e].interval_low_s = interval.first;
@@ -516,6 +650,15 @@ TrackStatus ScanSensorSteps(TrackRun& run) {
     if (status != TrackStatus::kOk) return status;
   }
   ComputeWidening(run);
+  // Each group's wander inside the windows at the fit so far: the noise a step's placement
+  // inside a day is judged against (PartWander). Not applied to the sandwich; Uncertainties
+  // estimates it again at the final fit.
+  run.wander_inside.clear();
+  const std::vector<bool> every(run.used.size(), true);
+  for (const std::vector<int>& g : WindowGroups(run)) {
+    run.wander_inside.push_back({g, InnerWander()});
+    EstimateWanderInside(run, static_cast<int>(run.wander_inside.size()) - 1, every);
+  }
   const TrackStatus status = IsolateInsideSteps(run);
   if (status != TrackStatus::kOk) return status;
   return DropWeakSteps(run, threshold);
