@@ -712,65 +712,6 @@ std::string FormatDouble(double value, int significant_digits) {
   return buf;
 }
 
-namespace {
-
-// Puts the complete directory `tmp` in place as `target` (WriteDirectoryAtomically): false
-// with *why on failure, `tmp` then still there. A target another run filled meanwhile is
-// never replaced without --force (`replaceable`); with it, the previous results are
-// swapped out in one step (RENAME_EXCHANGE) or, where the file system lacks that, moved
-// aside first: a crash between the two renames leaves them in ".<name>.old.<pid>", which
-// the next run puts back (internal::RemoveStaleTemporaries).
-bool PublishDirectory(const std::filesystem::path& tmp, const std::filesystem::path& target,
-                      const std::string& dir, const std::vector<std::string>* replaceable,
-                      std::string* why) {
-  std::error_code ec;
-  int err = 0;
-  // An empty target (a new --out made beforehand) is removed first; rmdir refuses one
-  // that another run has filled meanwhile.
-  if (std::filesystem::is_directory(target, ec) && std::filesystem::is_empty(target, ec)) {
-    ::rmdir(target.c_str());
-  }
-  if (internal::RenameNoReplace(tmp, target, &err)) return true;
-  if (err != EEXIST) {
-    *why = std::string("cannot move the results into place: ") + std::strerror(err);
-    return false;
-  }
-  if (replaceable == nullptr) {
-    *why =
-        "another run wrote its results there meanwhile (kept as they are); these results "
-        "were not written: choose a new --out, or --force to replace";
-    return false;
-  }
-  // --force: what is there now must still be a previous run's results only.
-  if (!CheckOutputDirectory("out", dir, why, replaceable)) return false;
-  if (internal::RenameExchange(tmp, target, &err)) {
-    std::filesystem::remove_all(tmp, ec);  // now the previous results
-    return true;
-  }
-  if (err != EINVAL && err != ENOSYS) {
-    *why = std::string("cannot replace the previous results: ") + std::strerror(err);
-    return false;
-  }
-  const std::filesystem::path previous =
-      target.parent_path() /
-      ("." + target.filename().string() + ".old." + std::to_string(::getpid()));
-  std::filesystem::remove_all(previous, ec);
-  std::filesystem::rename(target, previous, ec);
-  if (ec) {
-    *why = "cannot move the previous results aside: " + ec.message();
-    return false;
-  }
-  if (!internal::RenameNoReplace(tmp, target, &err)) {
-    std::filesystem::rename(previous, target, ec);
-    *why = std::string("cannot move the results into place: ") + std::strerror(err);
-    return false;
-  }
-  std::filesystem::remove_all(previous, ec);
-  return true;
-}
-
-}  // namespace
-
 // Writes the given files into a fresh temporary sibling of `dir` (locked while this run
 // writes it), syncs it, then publishes it as `dir` and syncs the parent; on any failure
 // removes the temporary directory.
@@ -825,7 +766,15 @@ bool WriteDirectoryAtomically(const std::string& dir,
   if (!internal::SyncDirectory(tmp.string(), &err)) {
     return fail(std::string("cannot write: ") + std::strerror(err));
   }
-  if (!PublishDirectory(tmp, target, dir, replaceable, &why)) return fail(why);
+  // --force: what is there at the moment of replacing must still be a previous run's
+  // results only.
+  std::function<bool(std::string*)> may_replace;
+  if (replaceable != nullptr) {
+    may_replace = [&](std::string* w) { return CheckOutputDirectory("out", dir, w, replaceable); };
+  }
+  if (!internal::PublishDirectory(tmp.string(), target.string(), may_replace, &why)) {
+    return fail(why);
+  }
   // The new name is durable only once the directory holding it is synced.
   if (!internal::SyncDirectory(parent.string(), &err)) {
     *error = where + "written, but its directory cannot be synced: " + std::strerror(err);

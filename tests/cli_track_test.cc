@@ -127,6 +127,25 @@ TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
   const auto other = Fastcal(track + " --window=12h --data=" + Path("a.csv") + "," + Path("b.csv"));
   EXPECT_EQ(other.code, 2) << other.output;
   EXPECT_NE(other.output.find("--force"), std::string::npos) << other.output;
+  // With it the track is built afresh and put in place in one step (issue 54: one way to
+  // publish a directory), nothing left beside it.
+  const auto forced =
+      Fastcal(track + " --force --window=12h --data=" + Path("a.csv") + "," + Path("b.csv"));
+  ASSERT_EQ(forced.code, 0) << forced.output;
+  EXPECT_NE(ReadFile(Path("t/track_state.json")).find("12h"), std::string::npos);
+  for (const auto& e : fs::directory_iterator(Path(""))) {
+    const std::string name = e.path().filename().string();
+    EXPECT_EQ(name.find(".partial-"), std::string::npos) << name;
+    EXPECT_EQ(name.find(".old."), std::string::npos) << name;
+  }
+  // A file of the user's inside the track: --force replaces a track, never anything else.
+  { std::ofstream(Path("t/notes.txt")) << "mine\n"; }
+  const auto mixed = Fastcal(track + " --force --data=" + Path("a.csv") + "," + Path("b.csv"));
+  EXPECT_EQ(mixed.code, 2) << mixed.output;
+  EXPECT_NE(mixed.output.find("notes.txt"), std::string::npos) << mixed.output;
+  EXPECT_NE(mixed.output.find("never anything else"), std::string::npos) << mixed.output;
+  EXPECT_EQ(ReadFile(Path("t/notes.txt")), "mine\n");
+  EXPECT_NE(ReadFile(Path("t/track_state.json")).find("12h"), std::string::npos);
 }
 
 // --min-window-samples above the subsample of a new track's first steps

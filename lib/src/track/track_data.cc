@@ -16,6 +16,7 @@
 #include <cstring>
 #include <exception>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
@@ -1158,8 +1159,33 @@ TrackStatus LockDirectory(TrackRun& run) {
   return TrackStatus::kOk;
 }
 
+namespace {
+
+// What in track directory `dir` is not the track's (IsTrackOutput), as the message that
+// refuses to replace it ("" when nothing).
+std::string OtherFiles(const std::string& dir) {
+  std::error_code ec;
+  std::vector<std::string> other;
+  for (const fs::directory_entry& e : fs::directory_iterator(dir, ec)) {
+    const std::string name = e.path().filename().string();
+    if (!IsTrackOutput(name)) other.push_back(name);
+  }
+  if (other.empty()) return "";
+  std::sort(other.begin(), other.end());
+  std::string list;
+  for (size_t k = 0; k < other.size() && k < 3; ++k) list += (k ? ", " : "") + other[k];
+  if (other.size() > 3) list += " and " + std::to_string(other.size() - 3) + " more";
+  return "holds files that are not the track's (" + list +
+         "): --force replaces a track, never anything else; move them, or give another --out";
+}
+
+}  // namespace
+
 TrackStatus PrepareDirectory(TrackRun& run) {
   if (const TrackStatus locked = LockDirectory(run); locked != TrackStatus::kOk) return locked;
+  // A track --force was replacing when a crash came between the fallback's two renames
+  // (no RENAME_EXCHANGE): put back (internal::PublishDirectory).
+  RemoveStaleTemporaries(run.out);
   std::error_code ec;
   const bool exists = fs::exists(run.out, ec);
   if (exists && !fs::is_directory(run.out, ec)) {
@@ -1175,6 +1201,11 @@ TrackStatus PrepareDirectory(TrackRun& run) {
                         it->path().string() +
                             ": a symbolic link inside a track is refused (it would read or "
                             "write outside the track); replace it with the file or directory");
+      }
+    }
+    if (run.options.force) {
+      if (const std::string other = OtherFiles(run.out); !other.empty()) {
+        return run.Fail(TrackStatus::kInvalidInput, run.out + ": " + other);
       }
     }
     run.dir = run.out;
@@ -1345,21 +1376,32 @@ TrackStatus FinishDirectory(TrackRun& run) {
     }
     return TrackStatus::kOk;
   }
-  if (fs::exists(run.out, ec)) {
-    // Empty, or a track --force replaces: its files go, the new ones move in.
-    for (const fs::directory_entry& e : fs::directory_iterator(run.out, ec)) {
-      if (IsTrackOutput(e.path().filename().string())) fs::remove_all(e.path(), ec);
+  // A new track: synced where it was built, then put in place in one step as every
+  // command's results are (internal::PublishDirectory): DIR empty or missing, or a track
+  // --force replaces, swapped with it (RENAME_EXCHANGE); never a mix of the two.
+  int err = 0;
+  for (const char* sub : {"/windows", "/folds", ""}) {
+    if (!SyncDirectory(run.dir + sub, &err)) {
+      return run.Fail(TrackStatus::kFailed,
+                      run.out + ": cannot write the track: " + std::strerror(err));
     }
-    for (const fs::directory_entry& e : fs::directory_iterator(run.dir, ec)) {
-      fs::rename(e.path(), fs::path(run.out) / e.path().filename(), ec);
-      if (ec)
-        return run.Fail(TrackStatus::kFailed,
-                        run.out + ": cannot move the track in: " + ec.message());
-    }
-    fs::remove_all(run.dir, ec);
-  } else {
-    fs::rename(run.dir, run.out, ec);
-    if (ec) return run.Fail(TrackStatus::kFailed, run.out + ": " + ec.message());
+  }
+  std::function<bool(std::string*)> may_replace;
+  if (run.options.force) {
+    may_replace = [&run](std::string* why) {
+      *why = OtherFiles(run.out);
+      if (!why->empty()) *why = run.out + ": " + *why;
+      return why->empty();
+    };
+  }
+  std::string why;
+  if (!PublishDirectory(run.dir, run.out, may_replace, &why)) {
+    return run.Fail(TrackStatus::kFailed, why.rfind(run.out, 0) == 0 ? why : run.out + ": " + why);
+  }
+  if (!SyncDirectory(ParentDirectory(run.out), &err)) {
+    return run.Fail(
+        TrackStatus::kFailed,
+        run.out + ": written, but its directory cannot be synced: " + std::strerror(err));
   }
   run.dir = run.out;
   return TrackStatus::kOk;

@@ -254,6 +254,51 @@ bool SyncDirectory(const std::string& dir, int* err) {
   return ok;
 }
 
+bool PublishDirectory(const std::string& tmp, const std::string& target,
+                      const std::function<bool(std::string*)>& may_replace, std::string* why) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  // rmdir refuses a target that another run has filled meanwhile.
+  if (fs::is_directory(target, ec) && fs::is_empty(target, ec)) ::rmdir(target.c_str());
+  int err = 0;
+  if (RenameNoReplace(tmp, target, &err)) return true;
+  if (err != EEXIST) {
+    *why = std::string("cannot move the results into place: ") + std::strerror(err);
+    return false;
+  }
+  if (!may_replace) {
+    *why =
+        "another run wrote its results there meanwhile (kept as they are); these results "
+        "were not written: choose a new --out, or --force to replace";
+    return false;
+  }
+  if (!may_replace(why)) return false;
+  if (RenameExchange(tmp, target, &err)) {
+    fs::remove_all(tmp, ec);  // now the previous results
+    return true;
+  }
+  if (err != EINVAL && err != ENOSYS) {
+    *why = std::string("cannot replace the previous results: ") + std::strerror(err);
+    return false;
+  }
+  const fs::path to(target);
+  const fs::path previous =
+      to.parent_path() / ("." + to.filename().string() + ".old." + std::to_string(::getpid()));
+  fs::remove_all(previous, ec);
+  fs::rename(to, previous, ec);
+  if (ec) {
+    *why = "cannot move the previous results aside: " + ec.message();
+    return false;
+  }
+  if (!RenameNoReplace(tmp, target, &err)) {
+    fs::rename(previous, to, ec);
+    *why = std::string("cannot move the results into place: ") + std::strerror(err);
+    return false;
+  }
+  fs::remove_all(previous, ec);
+  return true;
+}
+
 std::string ParentDirectory(const std::string& path) {
   const size_t slash = path.find_last_of('/');
   if (slash == std::string::npos) return ".";

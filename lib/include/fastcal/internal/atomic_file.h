@@ -56,6 +56,16 @@ bool RenameNoReplace(const std::string& from, const std::string& to, int* err);
 // False with *err = EINVAL or ENOSYS where the file system or kernel lacks it.
 bool RenameExchange(const std::string& a, const std::string& b, int* err);
 
+// Puts the complete directory `tmp` (synced by the caller) in place as `target`: false with
+// *why on failure, `tmp` then still there. An empty `target` (a new --out made beforehand)
+// is removed first. A `target` that holds something is replaced only with `may_replace`,
+// asked at that moment (another run may have filled it meanwhile; false with *why: kept):
+// swapped in one step (RENAME_EXCHANGE) or, where the file system lacks that, moved aside
+// first, ".<name>.old.<pid>", which RemoveStaleTemporaries puts back after a crash between
+// the two renames. The previous contents are then removed. Sync the parent after it.
+bool PublishDirectory(const std::string& tmp, const std::string& target,
+                      const std::function<bool(std::string*)>& may_replace, std::string* why);
+
 // fsync of directory `dir`, after a rename into it (false, with *err, on failure).
 bool SyncDirectory(const std::string& dir, int* err);
 // The directory holding `path` ("." for a bare name).
