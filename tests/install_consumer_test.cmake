@@ -52,6 +52,27 @@ foreach(f lib/cmake/fastcal/fastcalConfig.cmake lib/cmake/fastcal/fastcalConfigV
   endif()
 endforeach()
 
+# Only the public headers and the internal ones they include (issue 54): the library's own
+# stay out of the prefix.
+foreach(f include/fastcal/internal/atomic_file.h include/fastcal/internal/json.h)
+  if(EXISTS ${prefix}/${f})
+    message(FATAL_ERROR "installed, though no public header includes it: ${f}")
+  endif()
+endforeach()
+# Every installed header compiles on its own against the prefix: nothing it includes was
+# left out.
+file(GLOB_RECURSE installed RELATIVE ${prefix}/include ${prefix}/include/fastcal/*.h)
+set(each "")
+foreach(h IN LISTS installed)
+  string(APPEND each "#include \"${h}\"\n")
+endforeach()
+file(MAKE_DIRECTORY ${WORK_DIR}/headers)
+file(WRITE ${WORK_DIR}/headers/all.cc "${each}int main() { return 0; }\n")
+file(WRITE ${WORK_DIR}/headers/CMakeLists.txt
+  "cmake_minimum_required(VERSION 3.18)\nproject(headers CXX)\n"
+  "find_package(fastcal CONFIG REQUIRED)\nadd_executable(every_header all.cc)\n"
+  "target_link_libraries(every_header PRIVATE fastcal::fastcal)\n")
+
 file(READ ${SOURCE_DIR}/README.md readme)
 foreach(name main.cc CMakeLists.txt)
   readme_block("${readme}" ${name} block)
@@ -65,6 +86,9 @@ endif()
 run(COMMAND ${CMAKE_COMMAND} -S ${consumer} -B ${consumer}/build ${generator_args}
   -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
 run(COMMAND ${CMAKE_COMMAND} --build ${consumer}/build)
+run(COMMAND ${CMAKE_COMMAND} -S ${WORK_DIR}/headers -B ${WORK_DIR}/headers/build ${generator_args}
+  -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH=${prefix})
+run(COMMAND ${CMAKE_COMMAND} --build ${WORK_DIR}/headers/build)
 
 # The example with the bundled nominal model: six tensions, and the version it was built
 # against.
