@@ -24,6 +24,7 @@
 #include "cli_util.h"
 #include "columns_flag.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration.h"
 #include "fastcal/calibration_spec.h"
@@ -44,20 +45,6 @@
 #include "fastcal/unsolvable_rows.h"
 #include "fastcal/version.h"
 
-DECLARE_string(model);
-DECLARE_string(method);
-DECLARE_bool(force);
-DECLARE_string(columns);
-DECLARE_string(sessions_at);
-DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
-DEFINE_string(data, "",
-              "Measurement CSV (docs/data-format.md); several, comma-separated, are one "
-              "session each, labelled by file name.");
-DEFINE_string(out, "", "Output directory (must not exist, or be empty).");
-DEFINE_bool(skip_invalid_rows, false,
-            "Skip dataset rows that are malformed or whose pose the model cannot solve "
-            "(listed on stderr and in the report) instead of failing.");
-DEFINE_bool(quiet, false, "calibrate: no per-iteration progress.");
 DEFINE_bool(timings, false,
             "calibrate: print the wall time of reading, of each stage of the fit and of "
             "writing, on stderr.");

@@ -6,19 +6,12 @@
 #include <filesystem>
 #include <string_view>
 
+#include "common_flags.h"
 #include "fastcal/change_scan.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/sessions.h"
 #include "fastcal/time_text.h"
-
-DEFINE_string(columns, "",
-              "A column map (docs/data-format.md, \"Column maps\"): read the telemetry export "
-              "as it comes (its column names, units, time stamps, delimiter, decimal comma).");
-DEFINE_string(sessions_at, "",
-              "calibrate, import: cut one survey into sessions at these times "
-              "(TIME[,TIME...]: time_s or ISO 8601), or at the changes of a previous "
-              "calibrate's summary.json.");
 
 namespace fastcal::cli {
 

@@ -11,18 +11,13 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/design.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/version.h"
 
 // Shared with the other commands.
-DECLARE_string(spec);
-DECLARE_string(out);
-DECLARE_string(model);
-DECLARE_int32(samples);
-DECLARE_uint64(seed);
-DECLARE_double(interval_s);
 DECLARE_string(joint_grid_deg);  // simulate's: the same grid of rotator angles
 
 DEFINE_double(slow_error_percent, 2.0,
@@ -33,10 +28,8 @@ DEFINE_double(slow_error_time_s, 120.0,
               "design: the slow error's time constant (s) where the spec estimates it.");
 DEFINE_double(max_extra_tilt_deg, 0.0, "design: largest tilt of z' off the focal law (deg).");
 DEFINE_double(max_extra_yaw_deg, 0.0, "design: largest turn about z' off the focal law (deg).");
-DEFINE_double(speed_m_per_s, 0.0, "design: cabin speed between stops (m/s); 0: no duration.");
 DEFINE_double(minutes, 0.0, "design: time budget of the survey (min); 0: none.");
 // Shared with dynamics (dynamics_command.cc): the same band, the same default.
-DECLARE_double(settle_fraction);
 DEFINE_string(criterion, "A", "design: A (sum of variances) or D (log-determinant).");
 DEFINE_string(parameters, "", "design: wanted parameters, comma-separated; default: see --help.");
 DEFINE_double(hold_probability, 1e-4,

@@ -9,26 +9,11 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/dynamics_run.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/version.h"
 
-DECLARE_string(model);
-DECLARE_string(position);
-DECLARE_string(attitude_law);
-DECLARE_string(rpy);
-DECLARE_string(focal_centre);
-DECLARE_double(tilt_fraction);
-DECLARE_string(joints);
-DECLARE_string(output);
-DECLARE_bool(force);
-DECLARE_uint64(seed);
-DECLARE_int32(segments);
-DECLARE_string(to);
-DECLARE_string(lengths);
-
-DEFINE_double(damping_ratio, fastcal::DynamicsOptions().damping_ratio,
-              "dynamics: the lowest mode's damping ratio (strain-rate damping).");
 DEFINE_string(cable_damping_ratio, "",
               "dynamics: six damping ratios, each cable's first axial mode's.");
 DEFINE_string(wind, "", "dynamics: SPEED,DIRECTION_DEG, the mean wind (m/s) and where it blows.");
@@ -41,11 +26,6 @@ DEFINE_double(hold_s, 120.0, "dynamics: the time after the winches stop (s).");
 DEFINE_string(to_rpy, "", "dynamics --to: the end attitude roll,pitch,yaw (deg).");
 DEFINE_string(initial_offset, "",
               "dynamics: a free decay from dx,dy,dz[,rx,ry,rz] (m, deg) off the equilibrium.");
-DEFINE_double(settle_fraction, 0.005,
-              "dynamics, design: the settle band, a fraction of each quasi-static tension "
-              "(design: 0, no waits after moves).");
-DEFINE_double(step_s, fastcal::DynamicsOptions().max_step_s,
-              "dynamics: the largest integration step (s).");
 DEFINE_string(summary, "", "dynamics: the summary as JSON to this file.");
 
 namespace fastcal::cli {

@@ -14,6 +14,7 @@
 #include "cli_util.h"
 #include "columns_flag.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/dataset.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/atomic_file.h"
@@ -22,13 +23,6 @@
 #include "fastcal/tension_scale.h"
 #include "fastcal/time_text.h"
 #include "fastcal/version.h"
-
-DECLARE_string(columns);
-DECLARE_string(sessions_at);
-DECLARE_string(data);
-DECLARE_string(out);
-DECLARE_bool(force);
-DECLARE_bool(skip_invalid_rows);
 
 namespace fastcal::cli {
 namespace {

@@ -13,6 +13,7 @@
 #include "cli_util.h"
 #include "columns_flag.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/dataset.h"
@@ -24,21 +25,9 @@
 #include "fastcal/locate.h"
 #include "fastcal/plausibility.h"
 
-DECLARE_string(model);
-DECLARE_string(spec);  // calibrate_command.cc; here the sigmas of its noise
-DECLARE_string(data);
-DECLARE_string(rpy);
-DECLARE_string(quat);
-DECLARE_string(output);
+DECLARE_string(spec);    // calibrate_command.cc; here the sigmas of its noise
 DECLARE_string(joints);  // solve_command.cc
-DECLARE_bool(force);
-DECLARE_bool(keep_going);
-DECLARE_bool(warm_start);
-DECLARE_double(max_strain);
-DECLARE_double(max_length_ratio);
-DECLARE_double(reflector_clearance);
 
-DEFINE_string(lengths, "", "locate: the six unstretched lengths L1,...,L6 (m), cable 1 first.");
 DEFINE_string(tensions_kN, "", "locate: with --lengths, the six measured tensions (kN).");
 DEFINE_string(use, "",
               "locate: what the pose fits: lengths[,attitude][,tensions]; default all given.");

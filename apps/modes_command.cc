@@ -10,27 +10,14 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/modes.h"
 #include "fastcal/modes_map.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/version.h"
 
-DECLARE_string(model);
-DECLARE_string(position);
-DECLARE_string(output);
-DECLARE_bool(force);
-DECLARE_string(html);
-DECLARE_string(data);
-DECLARE_string(focal_centre);
 DECLARE_string(joints);  // solve_command.cc
-DECLARE_double(tilt_fraction);
-DECLARE_double(max_off_axis_deg);
-DECLARE_double(off_axis_step_deg);
-DECLARE_double(azimuth_step_deg);
-DECLARE_double(focal_radius);
 
-DEFINE_int32(segments, fastcal::ModesOptions().segments,
-             "modes: segments per cable (the lumped-mass chain's resolution).");
 DEFINE_int32(modes, fastcal::ModesOptions().modes, "modes: how many of the lowest modes.");
 DEFINE_bool(cap, false,
             "modes: over a grid on the focal-sphere cap (the focal law) instead of a pose.");

@@ -12,15 +12,12 @@
 #include "cli_util.h"
 #include "columns_flag.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/dataset.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/modal_identification.h"
 #include "fastcal/subspace_identification.h"
 #include "fastcal/vibration_record.h"
-
-DECLARE_string(data);
-DECLARE_string(output);
-DECLARE_bool(force);
 
 DEFINE_int32(identified_modes, 3, "modes --data: how many dominant modes to identify.");
 DEFINE_string(identification, "auto",

@@ -21,6 +21,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/dataset.h"
 #include "fastcal/internal/atomic_file.h"
@@ -33,44 +34,16 @@
 
 // Shared with solve (solve_command.cc) and calibrate (calibrate_command.cc): gflags flags
 // are process-global, so they are defined once and declared here.
-DECLARE_string(method);
-DECLARE_string(attitude_law);
-DECLARE_double(tilt_fraction);
-DECLARE_string(focal_centre);
-DECLARE_string(trajectory);
-DECLARE_string(from);
-DECLARE_string(to);
-DECLARE_int32(nodes);
-DECLARE_string(centre);
-DECLARE_double(radius);
-DECLARE_double(start_deg);
-DECLARE_double(end_deg);
-DECLARE_double(max_off_axis_deg);
-DECLARE_double(off_axis_step_deg);
-DECLARE_double(azimuth_step_deg);
-DECLARE_double(focal_radius);
-DECLARE_int32(samples);
-DECLARE_uint64(seed);
-DECLARE_double(radial_spread);
-DECLARE_string(poses);
-DECLARE_string(out);
-DECLARE_bool(force);
-DECLARE_bool(vibration);
 DECLARE_bool(dynamics);  // simulate_dynamics.cc
 
-DEFINE_string(truth, "", "simulate: truth model YAML; empty = nominal FAST.");
 DEFINE_string(mass_centre, "", "simulate: truth mass centre x,y,z in the cabin frame (m).");
 DEFINE_double(attitude_control_deg, 0.0, "simulate: sigma of actual - planned rpy (deg).");
-DEFINE_double(attitude_noise_deg, 0.0, "simulate: sigma of measured - actual rpy (deg).");
-DEFINE_double(position_noise_m, 0.0, "simulate: sigma of measured - actual position (m).");
 DEFINE_double(tension_noise_percent, 3.0, "simulate: relative tension noise sigma (%).");
-DEFINE_double(tension_noise_kN, 0.0, "simulate: absolute tension noise sigma (kN).");
 DEFINE_double(outlier_fraction, 0.0, "simulate: probability of an outlier reading.");
 DEFINE_double(outlier_scale_percent, 30.0, "simulate: outlier = reading (1 + U(-s, s)/100).");
 DEFINE_double(density_mismatch_percent, 0.0, "simulate: per-cable density factor sigma (%).");
 DEFINE_string(sensor_gain, "", "simulate: sensor gains g1,...,g6 or one for all.");
 DEFINE_string(sensor_bias_kN, "", "simulate: sensor biases b1,...,b6 or one for all (kN).");
-DEFINE_double(interval_s, 1.0, "simulate: time between samples (s).");
 DEFINE_double(attitude_control_time_s, 0.0,
               "simulate: correlation time of the attitude control error (s); 0 = white.");
 DEFINE_double(tension_drift_percent, 0.0, "simulate: slow tension error sigma per cable (%).");

@@ -7,13 +7,8 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/dynamic_survey.h"
-
-DECLARE_int32(segments);
-DECLARE_double(damping_ratio);
-DECLARE_double(step_s);
-DECLARE_double(speed_m_per_s);
-DECLARE_double(interval_s);
 
 DEFINE_bool(dynamics, false, "simulate: fly the survey in time (docs/cli.md, simulate).");
 DEFINE_double(wait_s, 30.0, "simulate --dynamics: the wait after each move (s).");

@@ -9,21 +9,11 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/modal_identification.h"
 #include "fastcal/version.h"
 
-DECLARE_string(truth);
-DECLARE_string(out);
-DECLARE_bool(force);
-DECLARE_uint64(seed);
-DECLARE_double(interval_s);
-DECLARE_double(position_noise_m);
-DECLARE_double(attitude_noise_deg);
-DECLARE_double(tension_noise_kN);
-DECLARE_int32(segments);
-
-DEFINE_bool(vibration, false, "simulate: a free vibration at --position (docs/cli.md).");
 DEFINE_string(excite, "1,2,3", "simulate --vibration: the predicted modes excited (1-based).");
 DEFINE_string(damping, "0.005,0.01,0.015",
               "simulate --vibration: a damping ratio per mode (without it: 0.005,0.01,0.015 "

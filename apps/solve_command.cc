@@ -15,6 +15,7 @@
 #include "cli_util.h"
 #include "columns_flag.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/internal/csv.h"
 #include "fastcal/internal/json.h"
@@ -25,39 +26,8 @@
 #include "fastcal/trajectory_plot.h"
 #include "fastcal/version.h"
 
-DEFINE_string(model, "", "Model YAML (docs/model-format.md); empty = nominal FAST.");
-DEFINE_string(method, "exact", "exact | aas | aas-refined | compare");
-DEFINE_string(position, "", "Single pose: x,y,z of the cabin frame origin (m).");
-DEFINE_string(rpy, "", "Attitude roll,pitch,yaw (deg), R = Rz(yaw) Ry(pitch) Rx(roll).");
-DEFINE_string(quat, "", "Attitude as unit quaternion w,x,y,z.");
 DEFINE_string(rotvec, "", "Attitude as rotation vector x,y,z (rad).");
-DEFINE_string(attitude_law, "",
-              "'focal': attitude from the focal law; 'none': R = I. Default: focal for "
-              "trajectories, R = I for one --position, the file's own for --poses.");
-DEFINE_double(tilt_fraction, 0.41, "Focal law: fraction of the off-axis angle.");
-DEFINE_string(focal_centre, "0,0,300", "Focal law and grids: focal-sphere centre x,y,z (m).");
-DEFINE_string(trajectory, "point", "point | circle | line | arc | grid | random");
-DEFINE_string(from, "50,0,150", "line: first node x,y,z (m).");
-DEFINE_string(to, "-50,0,150", "line: last node x,y,z (m).");
-DEFINE_int32(nodes, 101, "line, arc (101), circle (360): number of nodes.");
-DEFINE_string(centre, "0,0,150", "arc: centre x,y,z (m); the arc is horizontal.");
-DEFINE_double(radius, 50.0, "arc: radius (m).");
-DEFINE_double(start_deg, 0.0, "arc: first angle from +x toward +y (deg).");
-DEFINE_double(end_deg, 180.0, "arc: last angle (deg); 360 from start = full circle.");
-DEFINE_double(max_off_axis_deg, 40.0, "grid, random: largest off-axis angle (deg).");
-DEFINE_double(off_axis_step_deg, 5.0, "grid: ring spacing (deg).");
-DEFINE_double(azimuth_step_deg, 15.0, "grid: azimuth spacing (deg).");
-DEFINE_double(focal_radius, 160.0, "grid, random: focal-sphere radius (m).");
-DEFINE_int32(samples, 100, "random: number of poses.");
-DEFINE_uint64(seed, 1, "random: generator seed.");
-DEFINE_double(radial_spread, 0.0, "random: uniform offset along the sphere normal, +-m.");
-DEFINE_string(joints, "",
-              "Moving parts' joint values for every pose, the model's joint order and the "
-              "columns' units (deg, m); default all 0.");
-DEFINE_string(poses, "", "CSV of poses (x_m,y_m,z_m[,roll_deg,pitch_deg,yaw_deg|qw,qx,qy,qz]).");
 DEFINE_string(format, "csv", "csv | json");
-DEFINE_string(output, "", "Output file; empty or - = stdout. Written only on success.");
-DEFINE_bool(force, false, "Replace an existing output file (solve --output, simulate --out).");
 DEFINE_double(secant_low, 0.99, "AAS: low secant length as a fraction of the chord.");
 DEFINE_double(secant_high, 1.01, "AAS: high secant length as a fraction of the chord.");
 DEFINE_int32(max_refinement_steps, 8, "aas-refined: at most this many tangent steps.");
@@ -66,13 +36,6 @@ DEFINE_double(refined_tolerance, 1e-6,
 DEFINE_double(aas_max_error, 0.01,
               "aas, compare: aas is ok only when its tension error estimate is at most this.");
 DEFINE_double(exact_tolerance, 1e-12, "exact: relative tolerance on the tensions.");
-DEFINE_double(max_strain, 0.05, "Model range: largest cable strain (tension / EA).");
-DEFINE_double(max_length_ratio, 1.5, "Model range: largest unstretched length / chord, s0/k.");
-DEFINE_double(reflector_clearance, 0.0,
-              "Smallest clearance (m) of a cable from the model's reflector surface.");
-DEFINE_bool(warm_start, true, "Start each trajectory node from the previous solution.");
-DEFINE_bool(keep_going, false,
-            "Write infeasible poses as rows with their status instead of failing.");
 DEFINE_string(plot, "", "solve: the tensions along a trajectory as a self-contained HTML page.");
 
 namespace fastcal::cli {
@@ -221,7 +184,8 @@ std::string Help() {
   return help;
 }
 
-const std::set<std::string> kFlags = {"model", "joints",
+const std::set<std::string> kFlags = {"model",
+                                      "joints",
                                       "columns",
                                       "method",
                                       "position",
@@ -345,8 +309,9 @@ bool ReadPosesWithAttitudeLaw(const std::string& path, const std::string& attitu
   const bool with_joints = joint_columns != nullptr && !joint_columns->empty() && joints != nullptr;
   const bool read =
       columns != nullptr
-          ? (with_joints ? ReadPosesCsv(path, *columns, *joint_columns, poses, joints, nullptr, error)
-                         : ReadPosesCsv(path, *columns, poses, nullptr, error))
+          ? (with_joints
+                 ? ReadPosesCsv(path, *columns, *joint_columns, poses, joints, nullptr, error)
+                 : ReadPosesCsv(path, *columns, poses, nullptr, error))
       : with_joints ? ReadPosesCsv(path, *joint_columns, poses, joints, nullptr, error)
                     : ReadPosesCsv(path, poses, nullptr, error);
   if (!read) {
@@ -540,7 +505,8 @@ bool PosesFromFile(const FocalAttitudeLaw& law, const MovingParts& parts, PoseSt
     return false;
   }
   if (!joints->empty() && !FLAGS_joints.empty()) {
-    *error = FLAGS_poses + " brings its own joint values (the model's joint columns): drop --joints";
+    *error =
+        FLAGS_poses + " brings its own joint values (the model's joint columns): drop --joints";
     return false;
   }
   *poses = StreamOf(std::move(from_file));
@@ -1170,7 +1136,7 @@ int RunSolve(int argc, char** argv) {
     return kExitUsage;
   }
   if (!parts.empty()) {  // the summary says at which joints the moving parts were
-    attitude += !joints.empty()        ? ", joints per pose from " + FLAGS_poses
+    attitude += !joints.empty()         ? ", joints per pose from " + FLAGS_poses
                 : !FLAGS_joints.empty() ? ", joints --joints=" + FLAGS_joints
                                         : ", joints all 0 (no --joints)";
   }

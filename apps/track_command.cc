@@ -13,19 +13,13 @@
 #include "cli_util.h"
 #include "columns_flag.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/calibration_spec.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/time_text.h"
 #include "fastcal/track.h"
 
-DECLARE_string(model);
-DECLARE_string(spec);
-DECLARE_string(data);
-DECLARE_string(out);
-DECLARE_bool(force);
-DECLARE_bool(quiet);
-DECLARE_bool(skip_invalid_rows);
 DEFINE_string(window, "1d", "track: window length (1d, 12h, 30m, 3600s) or 'file'.");
 DEFINE_int32(threads, 2, "track: windows folded at once.");
 DEFINE_bool(refold, false, "track: on an update, refold every window at the new point.");

@@ -11,6 +11,7 @@
 
 #include "cli_util.h"
 #include "commands.h"
+#include "common_flags.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
 #include "fastcal/trajectory.h"
@@ -18,16 +19,6 @@
 #include "fastcal/workspace.h"
 
 // Shared with solve (solve_command.cc).
-DECLARE_string(model);
-DECLARE_string(method);
-DECLARE_double(tilt_fraction);
-DECLARE_string(focal_centre);
-DECLARE_double(max_off_axis_deg);
-DECLARE_double(off_axis_step_deg);
-DECLARE_double(azimuth_step_deg);
-DECLARE_double(focal_radius);
-DECLARE_string(output);
-DECLARE_bool(force);
 DECLARE_string(joints);     // solve_command.cc
 DECLARE_string(joint_law);  // simulate_command.cc
 
@@ -36,7 +27,6 @@ DEFINE_double(radial_offset, 0.0,
 DEFINE_double(min_tension_kN, 0.0, "workspace: smallest lower-end tension allowed (kN).");
 DEFINE_double(max_tension_kN, std::numeric_limits<double>::infinity(),
               "workspace: largest lower-end tension allowed (kN); inf: none.");
-DEFINE_string(html, "", "workspace: also write the map as a self-contained HTML file.");
 
 namespace fastcal::cli {
 namespace {
