@@ -346,6 +346,38 @@ TEST(Design, WaitsAfterMovesAreInTheDuration) {
   EXPECT_NEAR(without.duration_s, without.travel_s + without.dwell_s, 1e-9 * without.duration_s);
 }
 
+// Issue 55: the waits are in the samples' times the predictions take (the slow error
+// correlates the samples of consecutive stops less when a wait separates them): the same
+// stops with and without the waits predict different sigmas. Without the waits in those
+// times the two predictions were the same.
+TEST(Design, WaitsAreInThePredictionsTimes) {
+  const CableRobot robot = CableRobot::NominalFast();
+  const std::string slow = std::string(kSpec) +
+                           "noise:\n  tension_sigma_percent: 3\n"
+                           "  slow_error: {sigma_percent: estimate, time_constant_s: estimate}\n";
+  DesignOptions o = SmallGrid();
+  o.samples = 20;
+  o.speed_m_per_s = 5.0;
+  Design with, without;
+  std::string error;
+  ASSERT_TRUE(DesignSurvey(robot, Spec(slow.c_str()), o, &with, &error)) << error;
+  o.settle_after_moves = false;
+  ASSERT_TRUE(DesignSurvey(robot, Spec(slow.c_str()), o, &without, &error)) << error;
+  ASSERT_GT(with.settle_s, 0.0);
+  ASSERT_TRUE(with.slow_error.IsActive());
+  ASSERT_EQ(with.stops.size(), without.stops.size());
+  for (size_t k = 0; k < with.stops.size(); ++k) {
+    ASSERT_EQ(with.stops[k].candidate, without.stops[k].candidate) << k;
+  }
+  ASSERT_TRUE(with.design.ok && without.design.ok);
+  // Relative change of the mass centre's x sigma at least this: the waits are tens of
+  // seconds against the slow error's 120 s.
+  constexpr double kMinRelativeChange = 1e-4;
+  const double a = with.design.budget.parameters[0].total;
+  const double b = without.design.budget.parameters[0].total;
+  EXPECT_GT(std::abs(a - b), kMinRelativeChange * b) << a << " " << b;
+}
+
 TEST(Design, TimeBudgetIsKept) {
   const CableRobot robot = CableRobot::NominalFast();
   DesignOptions o = TiltedCap();
