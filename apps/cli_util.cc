@@ -21,6 +21,7 @@
 #include <memory>
 #include <sstream>
 
+#include "common_flags.h"
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/edit_distance.h"
 #include "fastcal/internal/number_text.h"
@@ -781,6 +782,34 @@ bool WriteDirectoryAtomically(const std::string& dir,
     return false;
   }
   return true;
+}
+
+bool CheckRecordOutputs(const std::string& name, const std::string& path, std::string* error) {
+  const bool to_file = !FLAGS_output.empty() && FLAGS_output != "-";
+  if (FLAGS_force && !to_file && path.empty()) {
+    *error = "--force applies to --output=FILE or --" + name + "=FILE";
+    return false;
+  }
+  if (path == "-") {
+    *error = "--" + name + "=-: only the record goes to stdout; give this file a name";
+    return false;
+  }
+  if (to_file && !path.empty() && ResolveOutputPath(FLAGS_output) == ResolveOutputPath(path)) {
+    *error = "--output and --" + name + " name the same file; give two names";
+    return false;
+  }
+  return (!to_file || CheckCanWrite("output", FLAGS_output, FLAGS_force, error)) &&
+         (path.empty() || CheckCanWrite(name, path, FLAGS_force, error));
+}
+
+bool WriteRecordOutputs(const std::string& record, const std::string& path,
+                        const std::string& content, std::string* error) {
+  const bool to_file = !FLAGS_output.empty() && FLAGS_output != "-";
+  std::vector<std::pair<std::string, std::string>> files;
+  if (to_file) files.push_back({FLAGS_output, record});
+  if (!path.empty()) files.push_back({path, content});
+  return WriteOutputsTogether(files, FLAGS_force, error) &&
+         (to_file || WriteOutput("-", record, error));
 }
 
 std::string Wrapped(const std::string& text, const std::string& first_indent,

@@ -206,6 +206,15 @@ class ResultStream {
   std::string spill_directory_;
 };
 
+// A record (--output=FILE, or stdout when empty or "-") and a companion file (--NAME=FILE:
+// a summary, a page; never stdout): refused before any work when --force applies to
+// neither, the companion is "-", both name one file, or either cannot be written.
+bool CheckRecordOutputs(const std::string& name, const std::string& path, std::string* error);
+// Writes the record and the companion (empty path: none) together, the record to stdout
+// without --output (WriteOutputsTogether).
+bool WriteRecordOutputs(const std::string& record, const std::string& path,
+                        const std::string& content, std::string* error);
+
 // Writes every (path, content) to a temporary file beside it, and renames them into place
 // only once all were written: a failure to write (disk full, no permission) leaves none
 // of the paths changed. On failure removes its temporary files and returns false with the

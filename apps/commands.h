@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "cli_util.h"
+#include "fastcal/dynamics.h"
 #include "fastcal/modes.h"
 #include "fastcal/pose.h"
 #include "fastcal/simulation.h"
@@ -34,6 +35,10 @@ int RunDynamicsCommand(int argc, char** argv);
 // The wind from --wind=SPEED,DIRECTION_DEG, --gust-spectrum, --turbulence-intensity and
 // --seed (dynamics, simulate --dynamics); false with the flag named.
 bool WindFromFlags(WindOptions* wind, std::string* error);
+// The dynamics' options from --segments, --damping-ratio, --cable-damping-ratio, --step-s
+// and the wind's flags (dynamics, loop).
+bool DynamicsOptionsFromFlags(DynamicsOptions* options, std::string* error);
+int RunLoopCommand(int argc, char** argv);
 // modes --data: the identified modes of a record against the prediction (modes_identify.cc).
 int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool to_file);
 // simulate --vibration (simulate_vibration.cc): its flags, and the run after StartCommand.

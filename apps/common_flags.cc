@@ -4,6 +4,7 @@
 
 #include "fastcal/dynamics.h"
 #include "fastcal/modes.h"
+#include "fastcal/wind.h"
 
 // First calibrate's.
 DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
@@ -29,6 +30,16 @@ DEFINE_string(sessions_at, "",
 DEFINE_double(speed_m_per_s, 0.0, "design: cabin speed between stops (m/s); 0: no duration.");
 
 // First dynamics's.
+DEFINE_string(cable_damping_ratio, "",
+              "dynamics: six damping ratios, each cable's first axial mode's.");
+DEFINE_string(wind, "", "dynamics: SPEED,DIRECTION_DEG, the mean wind (m/s) and where it blows.");
+DEFINE_string(gust_spectrum, "kaimal", "dynamics: kaimal | davenport.");
+DEFINE_double(turbulence_intensity, fastcal::WindOptions().turbulence_intensity,
+              "dynamics: the gusts' sigma / mean speed.");
+DEFINE_double(move_s, 60.0, "dynamics --to: the move's duration (s).");
+DEFINE_double(hold_s, 120.0, "dynamics: the time after the winches stop (s).");
+DEFINE_string(to_rpy, "", "dynamics --to: the end attitude roll,pitch,yaw (deg).");
+DEFINE_string(summary, "", "dynamics: the summary as JSON to this file.");
 DEFINE_double(damping_ratio, fastcal::DynamicsOptions().damping_ratio,
               "dynamics: the lowest mode's damping ratio (strain-rate damping).");
 DEFINE_double(settle_fraction, 0.005,

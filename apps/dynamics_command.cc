@@ -14,19 +14,9 @@
 #include "fastcal/internal/quote.h"
 #include "fastcal/version.h"
 
-DEFINE_string(cable_damping_ratio, "",
-              "dynamics: six damping ratios, each cable's first axial mode's.");
-DEFINE_string(wind, "", "dynamics: SPEED,DIRECTION_DEG, the mean wind (m/s) and where it blows.");
-DEFINE_string(gust_spectrum, "kaimal", "dynamics: kaimal | davenport.");
-DEFINE_double(turbulence_intensity, fastcal::WindOptions().turbulence_intensity,
-              "dynamics: the gusts' sigma / mean speed.");
 DEFINE_double(rate_hz, 10.0, "dynamics: samples a second in the record.");
-DEFINE_double(move_s, 60.0, "dynamics --to: the move's duration (s).");
-DEFINE_double(hold_s, 120.0, "dynamics: the time after the winches stop (s).");
-DEFINE_string(to_rpy, "", "dynamics --to: the end attitude roll,pitch,yaw (deg).");
 DEFINE_string(initial_offset, "",
               "dynamics: a free decay from dx,dy,dz[,rx,ry,rz] (m, deg) off the equilibrium.");
-DEFINE_string(summary, "", "dynamics: the summary as JSON to this file.");
 
 namespace fastcal::cli {
 namespace {
@@ -101,7 +91,9 @@ const std::set<std::string> kFlags = {
     "force"};
 // clang-format on
 
-bool OptionsFromFlags(DynamicsOptions* o, std::string* error) {
+}  // namespace
+
+bool DynamicsOptionsFromFlags(DynamicsOptions* o, std::string* error) {
   if (FlagGiven("segments")) o->segments = FLAGS_segments;
   o->damping_ratio = FLAGS_damping_ratio;
   o->max_step_s = FLAGS_step_s;
@@ -126,6 +118,8 @@ bool OptionsFromFlags(DynamicsOptions* o, std::string* error) {
                                   {"wind.turbulence_intensity", "--turbulence-intensity"}});
   return false;
 }
+
+namespace {
 
 // The winches' part of the spec from --to, --lengths or --initial-offset (at most one).
 bool KindFromFlags(DynamicsRunSpec* spec, std::string* mode, std::string* error) {
@@ -281,24 +275,6 @@ std::string Summary(const DynamicsRunResult& r, const std::string& attitude,
   return s.str();
 }
 
-bool CheckOutputs(bool to_file, std::string* error) {
-  if (FLAGS_force && !to_file && FLAGS_summary.empty()) {
-    *error = "--force applies to --output=FILE or --summary=FILE";
-    return false;
-  }
-  if (FLAGS_summary == "-") {
-    *error = "--summary=-: the summary JSON goes to a file; give its name";
-    return false;
-  }
-  if (to_file && !FLAGS_summary.empty() &&
-      ResolveOutputPath(FLAGS_output) == ResolveOutputPath(FLAGS_summary)) {
-    *error = "--output and --summary name the same file; give two names";
-    return false;
-  }
-  return (!to_file || CheckCanWrite("output", FLAGS_output, FLAGS_force, error)) &&
-         (FLAGS_summary.empty() || CheckCanWrite("summary", FLAGS_summary, FLAGS_force, error));
-}
-
 }  // namespace
 
 bool WindFromFlags(WindOptions* wind, std::string* error) {
@@ -330,9 +306,11 @@ int RunDynamicsCommand(int argc, char** argv) {
   CableRobot robot;
   DynamicsOptions options;
   DynamicsRunSpec spec;
-  if (!CheckOutputs(to_file, &error) || !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
+  if (!CheckRecordOutputs("summary", FLAGS_summary, &error) ||
+      !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
       !MassCentreAtJointsFlag(FLAGS_joints, &robot, &error) ||
-      !OptionsFromFlags(&options, &error) || !SpecFromFlags(&spec, &attitude, &mode, &error)) {
+      !DynamicsOptionsFromFlags(&options, &error) ||
+      !SpecFromFlags(&spec, &attitude, &mode, &error)) {
     PrintError(kCommand, error);
     return kExitUsage;
   }
@@ -353,11 +331,8 @@ int RunDynamicsCommand(int argc, char** argv) {
     PrintError(kCommand, error);
     return kExitFailure;
   }
-  std::vector<std::pair<std::string, std::string>> files;
-  if (to_file) files.push_back({FLAGS_output, DynamicsCsv(result)});
-  if (!FLAGS_summary.empty()) files.push_back({FLAGS_summary, DynamicsSummaryJson(result)});
-  if (!WriteOutputsTogether(files, FLAGS_force, &error) ||
-      (!to_file && !WriteOutput("-", DynamicsCsv(result), &error))) {
+  if (!WriteRecordOutputs(DynamicsCsv(result), FLAGS_summary,
+                          FLAGS_summary.empty() ? "" : DynamicsSummaryJson(result), &error)) {
     PrintError(kCommand, error);
     return kExitFailure;
   }

@@ -43,6 +43,8 @@ Commands:
              (the equilibrium linearised, each cable a lumped-mass chain): modes.csv
   dynamics   the cabin and its cables in time (a move, winch lengths, a free decay, wind)
              against the quasi-static answer: the departures and the settle time
+  loop       the cabin in its control loop: a truth model against the controller's model
+             (feed-forward and PID): the cabin's error in mm, and the feed's efficiency
   import     a telemetry export as it comes (its columns, units, ISO time stamps, decimal
              comma), read through a column map, written as the canonical dataset CSV
 
@@ -68,6 +70,7 @@ int Dispatch(const std::string& command, int argc, char** argv, bool* known) {
   if (command == "track") return RunTrack(argc, argv);
   if (command == "modes") return RunModes(argc, argv);
   if (command == "dynamics") return RunDynamicsCommand(argc, argv);
+  if (command == "loop") return RunLoopCommand(argc, argv);
   *known = false;
   return kExitUsage;
 }
@@ -102,7 +105,7 @@ int RunCommand(const std::string& command, int argc, char** argv) {
   if (!known) {
     const std::vector<std::string> closest =
         ClosestNames(command, {"solve", "locate", "calibrate", "evaluate", "simulate", "workspace",
-                               "track", "design", "modes", "dynamics", "import"});
+                               "track", "design", "modes", "dynamics", "loop", "import"});
     std::cerr << "fastcal: unknown command " << fastcal::internal::Quote(command)
               << (closest.empty() ? "" : "; did you mean " + closest.front() + "?") << "\n\n"
               << kUsage;

@@ -261,27 +261,13 @@ int RunCap(int argc, char** argv, const CableRobot& robot, const ModesOptions& m
   return 0;
 }
 
-// Refuses outputs that cannot be written before any work; false with the exit printed.
-bool CheckOutputs(bool to_file, std::string* error) {
-  if (FLAGS_force && !to_file && FLAGS_html.empty()) {
-    *error = "--force applies to --output=FILE or --html=FILE";
-    return false;
-  }
+// Refuses outputs that cannot be written before any work.
+bool CheckOutputs(std::string* error) {
   if (!FLAGS_html.empty() && !FLAGS_cap) {
     *error = "--html applies to --cap (the map of the cap)";
     return false;
   }
-  if (FLAGS_html == "-") {
-    *error = "--html=-: the map goes to a file; give its name";
-    return false;
-  }
-  if (to_file && !FLAGS_html.empty() &&
-      ResolveOutputPath(FLAGS_output) == ResolveOutputPath(FLAGS_html)) {
-    *error = "--output and --html name the same file; give two names";
-    return false;
-  }
-  return (!to_file || CheckCanWrite("output", FLAGS_output, FLAGS_force, error)) &&
-         (FLAGS_html.empty() || CheckCanWrite("html", FLAGS_html, FLAGS_force, error));
+  return CheckRecordOutputs("html", FLAGS_html, error);
 }
 
 }  // namespace
@@ -295,7 +281,7 @@ int RunModes(int argc, char** argv) {
   ModesOptions options;
   options.segments = FLAGS_segments;
   options.modes = FLAGS_modes;
-  if (!CheckOutputs(to_file, &error) || !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
+  if (!CheckOutputs(&error) || !LoadModelFlag("model", FLAGS_model, &robot, &error) ||
       !MassCentreAtJointsFlag(FLAGS_joints, &robot, &error) || !options.IsValid(&error)) {
     PrintError(kCommand, WithFlagNames(error, {{"segments", "--segments"}, {"modes", "--modes"}}));
     return kExitUsage;
