@@ -74,6 +74,7 @@ __all__ = [
     "focal_grid",
     "line",
     "locate",
+    "loop",
     "modes",
     "quat_from_rpy_deg",
     "random_workspace",
@@ -114,4 +115,4 @@ from .dataset import read_dataset, simulate  # noqa: F401
 from .calibration import CalibrationResult, calibrate, evaluate  # noqa: F401
 from .design import design  # noqa: F401
 from .track import TrackResult, track  # noqa: F401
-from .dynamics import ModesResult, dynamics, modes  # noqa: F401
+from .dynamics import ModesResult, dynamics, loop, modes  # noqa: F401

@@ -1,7 +1,8 @@
 """The dynamics layer: the natural frequencies and modes of the cabin on its six sagging
 cables at one pose (the C++ library's modes.h; docs/model.md, "Vibrations"), and the
 cabin and its cables moving in time beside the quasi-static answer (dynamics_run.h;
-docs/model.md, "Dynamics")."""
+docs/model.md, "Dynamics"), and the cabin in its control loop (closed_loop.h;
+docs/model.md, "The closed loop")."""
 
 from __future__ import annotations
 
@@ -302,5 +303,125 @@ def dynamics(
             columns[name] = out[block][:, j]
     columns["wind_m_per_s"] = out["wind_m_per_s"]
     frame = pandas.DataFrame(columns)
+    frame.attrs["summary"] = json.loads(out["summary_json"])
+    return frame
+
+
+def loop(
+    position_m: ArrayLike,
+    rpy_deg: Optional[ArrayLike] = None,
+    quat: Optional[ArrayLike] = None,
+    truth: Optional[Model] = None,
+    controller: Optional[Model] = None,
+    *,
+    attitude_law: Optional[str] = None,
+    tilt_fraction: float = 0.41,
+    focal_centre: ArrayLike = (0.0, 0.0, 300.0),
+    to: Optional[ArrayLike] = None,
+    to_rpy_deg: Optional[ArrayLike] = None,
+    move_s: float = 60.0,
+    hold_s: float = 120.0,
+    pid: Tuple[float, float, float] = (0.2, 0.05, 0.0),
+    control_period_s: float = 0.1,
+    measurement_noise_mm: float = 0.0,
+    measurement_delay_s: float = 0.0,
+    max_winch_speed: float = 0.5,
+    max_winch_acceleration: float = 0.2,
+    summary_from_s: float = 0.0,
+    frequency_ghz: float = 3.0,
+    segments: int = 40,
+    damping_ratio: float = 0.004,
+    step_s: float = 0.02,
+    wind: Optional[Tuple[float, float]] = None,
+    gust_spectrum: str = "kaimal",
+    turbulence_intensity: float = 0.15,
+    seed: int = 1,
+):
+    """The cabin in its control loop, a truth model against the controller's model, as
+    `fastcal loop` (docs/cli.md; docs/model.md, "The closed loop").
+
+    Args:
+        position_m, rpy_deg, quat, attitude_law, tilt_fraction, focal_centre: the start
+            pose, as `dynamics` takes it; to, to_rpy_deg, move_s: a slew's end and its
+            duration (s), then hold_s.
+        truth: the plant; controller: the model the control cycle solves with (None: the
+            nominal, for either).
+        pid: (Kp, Ki 1/s, Kd s); (0, 0, 0) is the feed-forward alone.
+        control_period_s, measurement_noise_mm (per axis), measurement_delay_s,
+            max_winch_speed (m/s), max_winch_acceleration (m/s^2): the controller.
+        summary_from_s: the summary from this time on; frequency_ghz: of the efficiency
+            estimate.
+        segments, damping_ratio, step_s, wind, gust_spectrum, turbulence_intensity, seed:
+            the plant, as `dynamics` takes them (the seed also the measurement noise's).
+
+    Returns:
+        A pandas DataFrame, one row per control cycle, with the CSV's columns: time_s, x_m,
+        y_m, z_m, x_cmd_m .. z_cmd_m, x_meas_m .. z_meas_m, error_mm, lateral_mm,
+        axial_mm, T1_kN .. T6_kN, T1_plan_kN .. T6_plan_kN, s0_1_m .. s0_6_m;
+        frame.attrs["summary"] holds the summary JSON as a dict (error_rms_mm,
+        error_peak_mm, lateral_*, axial_*, tension_error_rms_kN, winch_travel_m,
+        efficiency, controller).
+
+    Raises:
+        InputError: a wrong shape, bad options (named).
+        RuntimeError: a pose the controller's statics cannot solve, or a failed step.
+    """
+    import io
+
+    import pandas
+
+    start, kind, attitude = _pose_arrays(
+        position_m, rpy_deg, quat, attitude_law, tilt_fraction, focal_centre
+    )
+    end, end_kind, end_attitude = np.zeros(3), "same", np.zeros((1, 3))
+    if to is not None:
+        if attitude_law is not None and to_rpy_deg is not None:
+            raise InputError("to_rpy_deg: with attitude_law='focal' every pose flies the law")
+        end, end_kind, end_attitude = _pose_arrays(
+            to, to_rpy_deg, None, attitude_law, tilt_fraction, focal_centre
+        )
+        if end_kind == "none":
+            end_kind = "same"
+    elif to_rpy_deg is not None:
+        raise InputError("to_rpy_deg applies to a slew (to)")
+    gains = np.asarray(pid, dtype=np.float64).ravel()
+    if gains.shape != (3,):
+        raise InputError(f"pid must be (Kp, Ki, Kd), got shape {gains.shape}")
+    speed, direction = (0.0, 0.0) if wind is None else wind
+    out = _fastcal.loop(
+        _model(truth),
+        _model(controller),
+        start.reshape(1, 3),
+        kind,
+        attitude,
+        to is not None,
+        end.reshape(1, 3),
+        end_kind,
+        end_attitude,
+        attitude_law is not None,
+        np.asarray(focal_centre, dtype=np.float64).reshape(1, 3),
+        float(tilt_fraction),
+        float(move_s),
+        float(hold_s),
+        float(gains[0]),
+        float(gains[1]),
+        float(gains[2]),
+        float(control_period_s),
+        float(measurement_noise_mm) * 1e-3,
+        float(measurement_delay_s),
+        float(max_winch_speed),
+        float(max_winch_acceleration),
+        float(summary_from_s),
+        _whole(segments, "segments", 2, 1000),
+        float(damping_ratio),
+        float(step_s),
+        float(speed),
+        float(direction),
+        str(gust_spectrum),
+        float(turbulence_intensity),
+        _whole(seed, "seed", 0, 2**63 - 1),
+        float(frequency_ghz) * 1e9,
+    )
+    frame = pandas.read_csv(io.StringIO(out["csv"]))
     frame.attrs["summary"] = json.loads(out["summary_json"])
     return frame

@@ -1,11 +1,15 @@
 // The dynamics in time (dynamics_run.h) on numpy arrays: a start pose, what the winches do
 // (a move, a table of lengths, or nothing after a displacement) and the model's options
 // in; the record's columns (as `fastcal dynamics` writes them) and its summary JSON out.
+// The closed loop (closed_loop.h): the same start (and a slew's end), the controller's
+// options in; the record as `fastcal loop` writes it and its summary JSON out.
 #include <array>
+#include <cmath>
 #include <string>
 #include <vector>
 
 #include "bindings.h"
+#include "fastcal/closed_loop.h"
 #include "fastcal/dynamics_run.h"
 
 namespace fastcal::python {
@@ -90,9 +94,116 @@ void WinchesFromArguments(const std::string& kind, const DoubleArray& end_m,
   }
 }
 
+// The loop's options from the arguments; InputError for invalid ones.
+LoopOptions LoopOptionsOf(double kp, double ki, double kd, double period_s, double noise_m,
+                          double delay_s, double max_speed, double max_acceleration,
+                          double summary_from_s, std::uint64_t seed) {
+  LoopOptions o;
+  o.kp = kp;
+  o.ki_per_s = ki;
+  o.kd_s = kd;
+  o.control_period_s = period_s;
+  o.measurement_noise_m = noise_m;
+  o.measurement_delay_s = delay_s;
+  o.max_winch_speed_m_per_s = max_speed;
+  o.max_winch_acceleration_m_per_s2 = max_acceleration;
+  o.summary_from_s = summary_from_s;
+  o.seed = seed;
+  std::string error;
+  if (!o.IsValid(&error)) throw InputError(error);
+  return o;
+}
+
+DynamicsOptions PlantOptions(int segments, double damping_ratio, double step_s, double wind_speed,
+                             double wind_direction_deg, const std::string& gust_spectrum,
+                             double intensity, std::uint64_t seed) {
+  DynamicsOptions options;
+  options.segments = segments;
+  options.damping_ratio = damping_ratio;
+  options.max_step_s = step_s;
+  options.wind.mean_speed_m_per_s = wind_speed;
+  options.wind.direction_deg = wind_direction_deg;
+  options.wind.turbulence_intensity = intensity;
+  options.wind.seed = seed;
+  if (!ParseGustSpectrum(gust_spectrum, &options.wind.spectrum)) {
+    throw InputError("gust_spectrum must be 'kaimal' or 'davenport', got '" + gust_spectrum + "'");
+  }
+  std::string error;
+  if (!options.IsValid(&error)) throw InputError(error);
+  return options;
+}
+
 }  // namespace
 
 void BindDynamics(py::module_& m) {
+  m.def(
+      "loop",
+      [](const CableRobot& truth_argument, const CableRobot& controller_argument,
+         const DoubleArray& start_m, const std::string& attitude_kind, const DoubleArray& attitude,
+         bool has_end, const DoubleArray& end_m, const std::string& end_kind,
+         const DoubleArray& end_attitude, bool focal, const DoubleArray& focal_centre_m,
+         double tilt_fraction, double move_s, double hold_s, double kp, double ki, double kd,
+         double period_s, double noise_m, double delay_s, double max_speed, double max_acceleration,
+         double summary_from_s, int segments, double damping_ratio, double step_s,
+         double wind_speed, double wind_direction_deg, const std::string& gust_spectrum,
+         double intensity, std::uint64_t seed, double frequency_hz) {
+        // Copies with the GIL held (issue 37): another thread may change the models.
+        const CableRobot truth = truth_argument;
+        const CableRobot controller = controller_argument;
+        ValidateModel(truth);
+        ValidateModel(controller);
+        const std::vector<Pose> start = PosesFromArrays(start_m, attitude_kind, attitude);
+        if (start.size() != 1) throw InputError("loop takes one start pose");
+        LoopSpec spec;
+        spec.start = start[0];
+        spec.hold_s = hold_s;
+        if (focal) {
+          FocalAttitudeLaw law;
+          law.tilt_fraction = tilt_fraction;
+          CheckRows(focal_centre_m, 3, "focal_centre");
+          law.focal_centre_m = Eigen::Vector3d(focal_centre_m.at(0, 0), focal_centre_m.at(0, 1),
+                                               focal_centre_m.at(0, 2));
+          spec.focal_law = law;
+        }
+        if (has_end) {
+          spec.move_s = move_s;
+          Pose end =
+              PosesFromArrays(end_m, end_kind == "same" ? "none" : end_kind, end_attitude)[0];
+          if (end_kind == "same") end.rotation = spec.start.rotation;
+          if (focal) end.rotation = FocalAttitude(end.position_m, *spec.focal_law);
+          spec.end = end;
+        }
+        if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz)) {
+          throw InputError("frequency_ghz must be > 0");
+        }
+        const LoopOptions options = LoopOptionsOf(kp, ki, kd, period_s, noise_m, delay_s, max_speed,
+                                                  max_acceleration, summary_from_s, seed);
+        const DynamicsOptions plant =
+            PlantOptions(segments, damping_ratio, step_s, wind_speed, wind_direction_deg,
+                         gust_spectrum, intensity, seed);
+        std::string error;
+        if (!spec.IsValid(&error)) throw InputError(error);
+        LoopResult result;
+        bool ok = false;
+        {
+          py::gil_scoped_release release;
+          ok = RunLoop(truth, controller, spec, options, plant, &result, &error);
+        }
+        if (!ok) throw std::runtime_error(error);
+        py::dict out;
+        out["csv"] = LoopCsv(result);
+        out["summary_json"] = LoopSummaryJson(result, frequency_hz);
+        return out;
+      },
+      py::arg("truth"), py::arg("controller"), py::arg("start_m"), py::arg("attitude_kind"),
+      py::arg("attitude"), py::arg("has_end"), py::arg("end_m"), py::arg("end_kind"),
+      py::arg("end_attitude"), py::arg("focal"), py::arg("focal_centre_m"),
+      py::arg("tilt_fraction"), py::arg("move_s"), py::arg("hold_s"), py::arg("kp"), py::arg("ki"),
+      py::arg("kd"), py::arg("period_s"), py::arg("noise_m"), py::arg("delay_s"),
+      py::arg("max_speed"), py::arg("max_acceleration"), py::arg("summary_from_s"),
+      py::arg("segments"), py::arg("damping_ratio"), py::arg("step_s"), py::arg("wind_speed"),
+      py::arg("wind_direction_deg"), py::arg("gust_spectrum"), py::arg("intensity"),
+      py::arg("seed"), py::arg("frequency_hz"));
   m.def(
       "dynamics",
       [](const CableRobot& model_argument, const DoubleArray& start_m,
@@ -115,20 +226,11 @@ void BindDynamics(py::module_& m) {
         spec.settle_fraction = settle_fraction;
         WinchesFromArguments(kind, end_m, end_kind, end_attitude, focal, focal_centre_m,
                              tilt_fraction, move_s, lengths_time_s, lengths_s0_m, offset, &spec);
-        DynamicsOptions options;
-        options.segments = segments;
-        options.damping_ratio = damping_ratio;
-        options.max_step_s = step_s;
-        options.wind.mean_speed_m_per_s = wind_speed;
-        options.wind.direction_deg = wind_direction_deg;
-        options.wind.turbulence_intensity = intensity;
-        options.wind.seed = seed;
-        if (!ParseGustSpectrum(gust_spectrum, &options.wind.spectrum)) {
-          throw InputError("gust_spectrum must be 'kaimal' or 'davenport', got '" + gust_spectrum +
-                           "'");
-        }
+        const DynamicsOptions options =
+            PlantOptions(segments, damping_ratio, step_s, wind_speed, wind_direction_deg,
+                         gust_spectrum, intensity, seed);
         std::string error;
-        if (!spec.IsValid(&error) || !options.IsValid(&error)) throw InputError(error);
+        if (!spec.IsValid(&error)) throw InputError(error);
         DynamicsRunResult result;
         bool ok = false;
         {

@@ -22,7 +22,7 @@ def test_worked_example(
     source_dir: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     blocks = example_blocks(source_dir)
-    assert set(blocks) == {"main", "plot", "columns"}
+    assert set(blocks) == {"main", "plot", "columns", "loop"}
     # Run where the example expects to be: beside calibration_data/.
     (tmp_path / "calibration_data").symlink_to(source_dir / "calibration_data")
     monkeypatch.chdir(tmp_path)
@@ -50,3 +50,24 @@ def test_columns_example(
     exec(compile(blocks["columns"], "docs/python.md (columns)", "exec"), namespace)
     assert len(namespace["export"]) == 1441
     assert len(namespace["arrays"]) == 1441
+
+
+def test_loop_example(
+    source_dir: pathlib.Path, tmp_path: pathlib.Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """docs/python.md's "The cabin in its control loop" runs as written: the nominal
+    model's error where the feed-forward alone holds the cabin, a few mm with the PID."""
+    blocks = example_blocks(source_dir)
+    (tmp_path / "calibration_data").symlink_to(source_dir / "calibration_data")
+    monkeypatch.chdir(tmp_path)
+    if importlib.util.find_spec("matplotlib") is not None:
+        monkeypatch.setenv("MPLBACKEND", "Agg")
+    namespace: dict = {}
+    exec(compile(blocks["loop"], "docs/python.md (loop)", "exec"), namespace)
+    runs = namespace["runs"]
+    alone = runs["feed-forward alone"].attrs["summary"]["error_rms_mm"]
+    pid = runs["with the PID"]
+    assert alone > 30.0
+    assert pid.error_mm.to_numpy()[-300:].mean() < 5.0
+    if importlib.util.find_spec("matplotlib") is not None:
+        assert (tmp_path / "out" / "loop.png").stat().st_size > 0

@@ -82,7 +82,7 @@ def test_a_model_changed_by_another_thread_never_crashes_a_call() -> None:
 
 
 # Each binding that takes a model and releases the GIL, raced on its own while another
-# thread swaps the model's attachments (the modes: its cabin mass): a copy taken with the
+# thread swaps the model's attachments (the modes and the loop: its cabin mass): a copy taken with the
 # GIL held makes the call see one model or the other, never a crash nor a mix (a fix
 # applied to a list of bindings once missed the two added after it; evaluate, simulate
 # and locate were raced above for crashes only, design not at all). The call's result
@@ -99,9 +99,10 @@ RACE_ONE = textwrap.dedent(
     q = fastcal.focal_attitude(p)
     # The field swapped: the attachments (a list the copy must take whole), or for the
     # modes, which do not take attachments, the cabin's mass.
-    field = "cabin_mass_kg" if call == "modes" else "attachments"
-    bare = 30000.0 if call == "modes" else [[] for _ in range(6)]
-    loaded = (32000.0 if call == "modes"
+    massed = call in ("modes", "loop")  # the lumped chains refuse attachments
+    field = "cabin_mass_kg" if massed else "attachments"
+    bare = 30000.0 if massed else [[] for _ in range(6)]
+    loaded = (32000.0 if massed
               else [[{"at_m": 10.0 + k, "mass_kg": 30.0} for k in range(8)] for _ in range(6)])
     data, _, _ = fastcal.simulate(p, quat=q, seed=1)
     if call == "track":  # a window needs 100 samples
@@ -129,6 +130,9 @@ RACE_ONE = textwrap.dedent(
             return fastcal.control_cycle(p, quat=q, model=m).winch_length_m
         if call == "modes":
             return fastcal.modes(p[0], quat=q[0], model=m, count=4).frequency_hz
+        if call == "loop":  # both models the one raced
+            return fastcal.loop(p[0], quat=q[0], truth=m, controller=m, hold_s=0.5,
+                                segments=6, pid=(0, 0, 0))["T1_kN"].to_numpy()
         if call == "calibrate":
             return sorted(fastcal.calibrate(spec, data, model=m, quiet=True).estimates.items())
         if call == "track":
@@ -174,7 +178,7 @@ RACE_ONE = textwrap.dedent(
 @pytest.mark.parametrize(
     "call",
     ["solve", "evaluate", "simulate", "locate", "design", "control_cycle", "modes", "calibrate",
-     "track"])
+     "track", "loop"])
 def test_each_binding_sees_one_model_while_another_thread_changes_it(
         call: str, data_dir: pathlib.Path) -> None:
     run = subprocess.run(
