@@ -1,6 +1,7 @@
 // fastcal loop: the cabin in its control loop (closed_loop.h; docs/cli.md, "loop").
 #include <gflags/gflags.h>
 
+#include <cmath>
 #include <iostream>
 #include <set>
 #include <sstream>
@@ -18,6 +19,8 @@ DEFINE_string(controller_model, "",
 DEFINE_string(pid, "", "loop: KP,KI,KD (1, 1/s, s); 0,0,0 is the feed-forward alone.");
 DEFINE_double(control_period_s, fastcal::LoopOptions().control_period_s,
               "loop: the controller's period (s).");
+DEFINE_double(error_filter_hz, fastcal::LoopOptions().error_filter_hz,
+              "loop: the PID's error low-passed twice at this frequency (Hz; 0: none).");
 DEFINE_double(measurement_noise_mm, 0.0, "loop: the position measurement's noise per axis (mm).");
 DEFINE_double(measurement_delay_s, 0.0, "loop: the position measurement's delay (s).");
 DEFINE_double(max_winch_speed, fastcal::LoopOptions().max_winch_speed_m_per_s,
@@ -26,6 +29,11 @@ DEFINE_double(max_winch_acceleration, fastcal::LoopOptions().max_winch_accelerat
               "loop: the winches' largest acceleration (m/s^2).");
 DEFINE_double(frequency_ghz, 3.0, "loop: the observing frequency of the efficiency estimate.");
 DEFINE_double(summary_from_s, 0.0, "loop: the summary from this time on (s).");
+DEFINE_double(path_ramp_s, 60.0,
+              "loop --trajectory: the path's speed eases in over this long (s; minimum jerk).");
+DEFINE_double(path_speed, 0.0116,
+              "loop --trajectory: the cabin's speed along the path (m/s; 0.0116, a source "
+              "tracked at the sidereal rate on the 160 m focal sphere).");
 
 namespace fastcal::cli {
 namespace {
@@ -40,13 +48,16 @@ Usage:
                [--hold-s=120] [options]                                  hold a pose
   fastcal loop ... --position=X,Y,Z [attitude] --to=X,Y,Z [--to-rpy=R,P,Y] [--move-s=60]
                [--hold-s=120] [options]                                  a slew, then hold
+  fastcal loop ... --trajectory=arc|circle|line [its flags] [--path-speed=0.0116]
+               [--attitude-law=focal] [--hold-s=120] [options]          a path, then hold
 
 The plant is TRUTH in time (as fastcal dynamics: lumped-mass cables, the cabin, structural
 damping, the wind's drag); the controller is the telescope's control cycle (the C
 interface's fastcal_control_cycle) on MODEL. Every --control-period-s it measures the
 cabin's position (with --measurement-noise-mm per axis and --measurement-delay-s), runs a
-PID on the error to the command (--pid=KP,KI,KD; default 0.2,0.05,0: a crossover near 0.01
-Hz, well below the 0.13-0.2 Hz modes), solves the commanded pose plus the PID's correction
+PID on the error to the command, low-passed twice at --error-filter-hz=0.02 (--pid=KP,KI,KD;
+default 0.05,0.02,0: a crossover near 0.003 Hz; the 0.13-0.2 Hz modes, damped 0.004, would
+ring up under a faster loop), solves the commanded pose plus the PID's correction
 with MODEL's exact statics and pays out those winch lengths, within --max-winch-speed and
 --max-winch-acceleration. --pid=0,0,0 is the feed-forward alone: the model's error is
 then the cabin's. The plant starts at rest where TRUTH hangs at MODEL's lengths for the
@@ -56,7 +67,12 @@ Start pose: --position=X,Y,Z (m) and its attitude as solve takes one pose:
 --attitude-law=focal (--tilt-fraction=0.41 --focal-centre=0,0,300), --rpy=R,P,Y (deg),
 --quat=W,X,Y,Z or --rotvec=X,Y,Z (rad); R = I without one. --to=X,Y,Z: a minimum-jerk
 slew over --move-s seconds to the end pose (its attitude the focal law's with
---attitude-law=focal, else --to-rpy, else the start's), then --hold-s.
+--attitude-law=focal, else --to-rpy, else the start's), then --hold-s. --trajectory:
+the command follows solve's trajectory (arc: --centre --radius --start-deg --end-deg
+--nodes; circle: the paper's; line: --from --to --nodes) at --path-speed along it (the
+default is a source tracked at the sidereal rate: 15 deg an hour on the 160 m focal
+sphere), easing in over --path-ramp-s=60 (a path taken at full speed from rest rings the
+modes), flying the focal law (the default) or --attitude-law=none, then --hold-s.
 
 Options: [--joints=v1,...] (both models' moving parts held there) [--segments=40]
   [--damping-ratio=0.004 | --cable-damping-ratio=z1,...,z6] [--wind=SPEED,DIRECTION_DEG
@@ -86,10 +102,11 @@ Examples:
 const std::set<std::string> kFlags = {
     "truth", "controller-model", "position", "attitude-law", "rpy", "quat", "rotvec",
     "tilt-fraction", "focal-centre", "joints", "to", "to-rpy", "move-s", "hold-s", "pid",
-    "control-period-s", "measurement-noise-mm", "measurement-delay-s", "max-winch-speed",
+    "control-period-s", "error-filter-hz", "measurement-noise-mm", "measurement-delay-s", "max-winch-speed",
     "max-winch-acceleration", "segments", "damping-ratio", "cable-damping-ratio", "wind",
     "gust-spectrum", "turbulence-intensity", "seed", "step-s", "frequency-ghz",
-    "summary-from-s", "output", "summary", "force"};
+    "summary-from-s", "output", "summary", "force", "trajectory", "from", "nodes", "centre",
+    "radius", "start-deg", "end-deg", "path-speed", "path-ramp-s"};
 // clang-format on
 
 bool LoopOptionsFromFlags(LoopOptions* o, std::string* error) {
@@ -105,6 +122,7 @@ bool LoopOptionsFromFlags(LoopOptions* o, std::string* error) {
     o->kd_s = v[2];
   }
   o->control_period_s = FLAGS_control_period_s;
+  o->error_filter_hz = FLAGS_error_filter_hz;
   o->measurement_noise_m = FLAGS_measurement_noise_mm * 1e-3;
   o->measurement_delay_s = FLAGS_measurement_delay_s;
   o->max_winch_speed_m_per_s = FLAGS_max_winch_speed;
@@ -119,6 +137,7 @@ bool LoopOptionsFromFlags(LoopOptions* o, std::string* error) {
   *error = WithFlagNames(*error, {{"control_period_s", "--control-period-s"},
                                   {"the PID's gains (kp, ki_per_s, kd_s)", "--pid"},
                                   {"measurement_noise_m", "--measurement-noise-mm"},
+                                  {"error_filter_hz", "--error-filter-hz"},
                                   {"measurement_delay_s", "--measurement-delay-s"},
                                   {"max_winch_speed_m_per_s", "--max-winch-speed"},
                                   {"max_winch_acceleration_m_per_s2", "--max-winch-acceleration"},
@@ -126,7 +145,58 @@ bool LoopOptionsFromFlags(LoopOptions* o, std::string* error) {
   return false;
 }
 
+// A path: solve's trajectory (arc, circle, line) at --path-speed, the focal law's attitude
+// unless --attitude-law=none.
+bool PathFromFlags(LoopSpec* spec, std::string* attitude, std::string* error) {
+  const std::string kind = FLAGS_trajectory;
+  if (kind != "arc" && kind != "circle" && kind != "line") {
+    *error = "--trajectory=" + kind + ": loop follows an arc, the circle or a line";
+    return false;
+  }
+  for (const char* flag : {"position", "rpy", "quat", "rotvec", "to-rpy", "move-s"}) {
+    if (FlagGiven(flag)) {
+      *error = std::string("--") + flag + " applies to a hold or a slew, not to --trajectory";
+      return false;
+    }
+  }
+  if (!(FLAGS_path_speed > 0.0) || !std::isfinite(FLAGS_path_speed)) {
+    *error = "--path-speed must be > 0";
+    return false;
+  }
+  FocalAttitudeLaw law;
+  law.tilt_fraction = FLAGS_tilt_fraction;
+  if (!ParseVector3("focal-centre", FLAGS_focal_centre, &law.focal_centre_m, error)) return false;
+  std::vector<Eigen::Vector3d> positions;
+  bool known = true;
+  if (!TrajectoryPositionsFromFlags(kind, law.focal_centre_m, &positions, &known, error)) {
+    return false;
+  }
+  const bool focal = FLAGS_attitude_law != "none";
+  if (focal) spec->focal_law = law;
+  double t = 0.0;
+  for (size_t k = 0; k < positions.size(); ++k) {
+    if (k > 0) t += (positions[k] - positions[k - 1]).norm() / FLAGS_path_speed;
+    if (k > 0 && !(t > spec->path_time_s.back())) continue;  // a repeated node
+    Pose pose;
+    pose.position_m = positions[k];
+    if (focal) pose.rotation = FocalAttitude(pose.position_m, law);
+    spec->path.push_back(pose);
+    spec->path_time_s.push_back(t);
+  }
+  spec->start = spec->path.front();
+  spec->path_ramp_s = FLAGS_path_ramp_s;
+  *attitude = focal ? "the focal law along the path" : "R = I along the path";
+  return true;
+}
+
 bool SpecFromFlags(LoopSpec* spec, std::string* attitude, std::string* error) {
+  if (FlagGiven("trajectory")) {
+    spec->hold_s = FLAGS_hold_s;
+    if (!PathFromFlags(spec, attitude, error)) return false;
+    if (spec->IsValid(error)) return true;
+    *error = WithFlagNames(*error, {{"hold_s", "--hold-s"}, {"path_ramp_s", "--path-ramp-s"}});
+    return false;
+  }
   if (!SinglePoseFromFlags(&spec->start, attitude, error)) return false;
   spec->hold_s = FLAGS_hold_s;
   if (!CheckFlagsApply({{"move-s", FlagGiven("to"), "--to"}, {"to-rpy", FlagGiven("to"), "--to"}},
@@ -180,7 +250,10 @@ std::string Summary(const LoopResult& r, const std::string& attitude) {
   const LoopSummary& s = r.summary;
   std::ostringstream o;
   o << "fastcal loop: ";
-  if (r.spec.end) {
+  if (!r.spec.path.empty()) {
+    o << "a path of " << r.spec.path.size() << " nodes in "
+      << FormatDouble(r.spec.path_time_s.back(), 5) << " s, then ";
+  } else if (r.spec.end) {
     o << "a slew of " << FormatDouble((r.spec.end->position_m - r.spec.start.position_m).norm(), 4)
       << " m in " << FormatDouble(r.spec.move_s, 4) << " s, then ";
   }

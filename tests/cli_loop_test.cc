@@ -71,6 +71,31 @@ TEST_F(CliTest, LoopFeedForwardLeavesTheModelsErrorAndThePidTakesIt) {
   EXPECT_LT(std::stod(pid.substr(at + 16)), 1.0) << pid;
 }
 
+// A path: solve's line at --path-speed, eased in and out, the record's command moving
+// along it.
+TEST_F(CliTest, LoopFollowsATrajectory) {
+  const std::string csv = Path("line.csv");
+  const CommandResult r =
+      Fastcal("loop --truth=" + Source() +
+              "/calibration_data/nominal_fast.yaml --trajectory=line --from=0,0,140 --to=1,0,140 "
+              "--nodes=11 --path-speed=0.05 --path-ramp-s=5 --hold-s=2 --segments=8 --output=" +
+              csv);
+  ASSERT_EQ(r.code, 0) << r.output;
+  EXPECT_NE(r.output.find("a path of 11 nodes in 20 s"), std::string::npos) << r.output;
+  std::istringstream lines(ReadFile(csv));
+  std::string line;
+  std::getline(lines, line);
+  std::vector<std::string> first, last;
+  int rows = 0;
+  while (std::getline(lines, line)) {
+    last = CsvFields(line);
+    if (rows++ == 0) first = last;
+  }
+  EXPECT_EQ(rows, 271);             // 20 s + 5 s of easing + 2 s held, at 10 Hz
+  EXPECT_EQ(first[4], "0.000000");  // x_cmd_m at the line's start
+  EXPECT_EQ(last[4], "1.000000");   // and at its end
+}
+
 TEST_F(CliTest, LoopBadFlagsAreNamed) {
   const std::string truth = "--truth=" + Source() + "/calibration_data/nominal_fast.yaml ";
   struct Case {
@@ -85,6 +110,12 @@ TEST_F(CliTest, LoopBadFlagsAreNamed) {
       {"loop " + truth + "--position=0,0,140 --hold-s=0", "--hold-s"},
       {"loop " + truth + "--position=0,0,140 --frequency-ghz=0", "--frequency-ghz"},
       {"loop --truth=" + Path("missing.yaml") + " --position=0,0,140", "missing.yaml"},
+      {"loop " + truth + "--trajectory=grid", "loop follows an arc, the circle or a line"},
+      {"loop " + truth + "--trajectory=arc --position=0,0,140", "--position applies to a hold"},
+      {"loop " + truth + "--trajectory=line --from=0,0,140 --to=1,0,140 --path-speed=0",
+       "--path-speed"},
+      {"loop " + truth + "--trajectory=line --from=0,0,140 --to=1,0,140 --path-ramp-s=1000",
+       "--path-ramp-s"},
   };
   for (const Case& c : cases) {
     const CommandResult r = Fastcal(c.args + " --output=" + Path("x.csv"));

@@ -321,7 +321,8 @@ def loop(
     to_rpy_deg: Optional[ArrayLike] = None,
     move_s: float = 60.0,
     hold_s: float = 120.0,
-    pid: Tuple[float, float, float] = (0.2, 0.05, 0.0),
+    pid: Tuple[float, float, float] = (0.05, 0.02, 0.0),
+    error_filter_hz: float = 0.02,
     control_period_s: float = 0.1,
     measurement_noise_mm: float = 0.0,
     measurement_delay_s: float = 0.0,
@@ -346,7 +347,8 @@ def loop(
             duration (s), then hold_s.
         truth: the plant; controller: the model the control cycle solves with (None: the
             nominal, for either).
-        pid: (Kp, Ki 1/s, Kd s); (0, 0, 0) is the feed-forward alone.
+        pid: (Kp, Ki 1/s, Kd s); (0, 0, 0) is the feed-forward alone; error_filter_hz:
+            the error low-passed twice there before the PID (0: none).
         control_period_s, measurement_noise_mm (per axis), measurement_delay_s,
             max_winch_speed (m/s), max_winch_acceleration (m/s^2): the controller.
         summary_from_s: the summary from this time on; frequency_ghz: of the efficiency
@@ -406,6 +408,7 @@ def loop(
         float(gains[0]),
         float(gains[1]),
         float(gains[2]),
+        float(error_filter_hz),
         float(control_period_s),
         float(measurement_noise_mm) * 1e-3,
         float(measurement_delay_s),

@@ -95,13 +95,14 @@ void WinchesFromArguments(const std::string& kind, const DoubleArray& end_m,
 }
 
 // The loop's options from the arguments; InputError for invalid ones.
-LoopOptions LoopOptionsOf(double kp, double ki, double kd, double period_s, double noise_m,
-                          double delay_s, double max_speed, double max_acceleration,
+LoopOptions LoopOptionsOf(double kp, double ki, double kd, double filter_hz, double period_s,
+                          double noise_m, double delay_s, double max_speed, double max_acceleration,
                           double summary_from_s, std::uint64_t seed) {
   LoopOptions o;
   o.kp = kp;
   o.ki_per_s = ki;
   o.kd_s = kd;
+  o.error_filter_hz = filter_hz;
   o.control_period_s = period_s;
   o.measurement_noise_m = noise_m;
   o.measurement_delay_s = delay_s;
@@ -143,10 +144,11 @@ void BindDynamics(py::module_& m) {
          bool has_end, const DoubleArray& end_m, const std::string& end_kind,
          const DoubleArray& end_attitude, bool focal, const DoubleArray& focal_centre_m,
          double tilt_fraction, double move_s, double hold_s, double kp, double ki, double kd,
-         double period_s, double noise_m, double delay_s, double max_speed, double max_acceleration,
-         double summary_from_s, int segments, double damping_ratio, double step_s,
-         double wind_speed, double wind_direction_deg, const std::string& gust_spectrum,
-         double intensity, std::uint64_t seed, double frequency_hz) {
+         double filter_hz, double period_s, double noise_m, double delay_s, double max_speed,
+         double max_acceleration, double summary_from_s, int segments, double damping_ratio,
+         double step_s, double wind_speed, double wind_direction_deg,
+         const std::string& gust_spectrum, double intensity, std::uint64_t seed,
+         double frequency_hz) {
         // Copies with the GIL held (issue 37): another thread may change the models.
         const CableRobot truth = truth_argument;
         const CableRobot controller = controller_argument;
@@ -176,8 +178,9 @@ void BindDynamics(py::module_& m) {
         if (!(frequency_hz > 0.0) || !std::isfinite(frequency_hz)) {
           throw InputError("frequency_ghz must be > 0");
         }
-        const LoopOptions options = LoopOptionsOf(kp, ki, kd, period_s, noise_m, delay_s, max_speed,
-                                                  max_acceleration, summary_from_s, seed);
+        const LoopOptions options =
+            LoopOptionsOf(kp, ki, kd, filter_hz, period_s, noise_m, delay_s, max_speed,
+                          max_acceleration, summary_from_s, seed);
         const DynamicsOptions plant =
             PlantOptions(segments, damping_ratio, step_s, wind_speed, wind_direction_deg,
                          gust_spectrum, intensity, seed);
@@ -199,11 +202,11 @@ void BindDynamics(py::module_& m) {
       py::arg("attitude"), py::arg("has_end"), py::arg("end_m"), py::arg("end_kind"),
       py::arg("end_attitude"), py::arg("focal"), py::arg("focal_centre_m"),
       py::arg("tilt_fraction"), py::arg("move_s"), py::arg("hold_s"), py::arg("kp"), py::arg("ki"),
-      py::arg("kd"), py::arg("period_s"), py::arg("noise_m"), py::arg("delay_s"),
-      py::arg("max_speed"), py::arg("max_acceleration"), py::arg("summary_from_s"),
-      py::arg("segments"), py::arg("damping_ratio"), py::arg("step_s"), py::arg("wind_speed"),
-      py::arg("wind_direction_deg"), py::arg("gust_spectrum"), py::arg("intensity"),
-      py::arg("seed"), py::arg("frequency_hz"));
+      py::arg("kd"), py::arg("filter_hz"), py::arg("period_s"), py::arg("noise_m"),
+      py::arg("delay_s"), py::arg("max_speed"), py::arg("max_acceleration"),
+      py::arg("summary_from_s"), py::arg("segments"), py::arg("damping_ratio"), py::arg("step_s"),
+      py::arg("wind_speed"), py::arg("wind_direction_deg"), py::arg("gust_spectrum"),
+      py::arg("intensity"), py::arg("seed"), py::arg("frequency_hz"));
   m.def(
       "dynamics",
       [](const CableRobot& model_argument, const DoubleArray& start_m,

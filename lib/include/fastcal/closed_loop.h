@@ -8,10 +8,11 @@
 //
 //   measured      m_k = p(t_k - d) + n_k              (d the measurement's delay, rounded
 //                                                      to whole periods; n_k ~ N(0, s^2 I))
-//   error         e_k = c(t_k - d) - m_k              (c the commanded position)
-//   PID           u_k = Kp e_k + Ki sum_j<=k e_j T + Kd (e_k - e_k-1) / T
-//   feed-forward  w_k = ControlCycle(controller model, pose (c(t_k) + u_k, R_c(t_k)))
-//                       .winch_length_m
+//   error         e_k = c(t_k - d) - m_k              (c the commanded position), low-passed
+//                 twice at error_filter_hz: f_k
+//   PID           u_k = Kp f_k + Ki sum_j<=k f_j T + Kd (f_k - f_k-1) / T
+//   feed-forward  w_k = ControlCycle(controller model, pose (c(t_k + T) + u_k,
+//                       R_c(t_k + T))).winch_length_m   (reached at t_k + T)
 //   winches       s0_k = w_k - length_offset_m (the truth's), its rate limited to v_max and
 //                 the rate's change to a_max T, reached linearly over the next period.
 //
@@ -50,13 +51,18 @@ namespace fastcal {
 struct LoopOptions {
   // The controller's period (s, > 0): 0.1, a 10 Hz cycle.
   double control_period_s = 0.1;
-  // The PID on the position error (Kp dimensionless, Ki in 1/s, Kd in s; >= 0). The
-  // defaults (0.2, 0.05, 0) keep the loop's crossover near 0.01 Hz, an order below the
-  // 0.13-0.2 Hz modes it must not excite, and remove a model's static error in about a
-  // minute (docs/model.md, "The closed loop", measures it).
-  double kp = 0.2;
-  double ki_per_s = 0.05;
+  // The PID on the position error (Kp dimensionless, Ki in 1/s, Kd in s; >= 0), the
+  // error first low-passed by two first-order filters at error_filter_hz (> 0; 0: none).
+  // Why the filter: the cabin's modes (0.13-0.2 Hz) are damped 0.004, so that a correction
+  // at their frequency comes back 125 times larger; unfiltered, Kp = 0.2 with a 0.24 s
+  // measurement delay rang up over ten minutes in still air (to 300 mm; the wind's drag
+  // damped it). The defaults (Kp 0.05, Ki 0.02 /s, 0.02 Hz) put the crossover near
+  // 0.003 Hz with ~70 deg of phase margin and a loop gain of ~0.2 at 0.15 Hz; a static
+  // error goes with a time constant of ~50 s.
+  double kp = 0.05;
+  double ki_per_s = 0.02;
   double kd_s = 0.0;
+  double error_filter_hz = 0.02;
   // The position measurement: per-axis noise (m, >= 0) and delay (s, >= 0): a total
   // station's 0.4 mm at 240 ms is (0.0004, 0.24).
   double measurement_noise_m = 0.0;
@@ -78,14 +84,25 @@ struct LoopOptions {
   bool IsValid(std::string* error) const;
 };
 
-// What the loop is asked to do: hold `start` for hold_s, or move from `start` to `end` in
-// move_s along a minimum-jerk profile (dynamics_run.h, MinimumJerkPose) and then hold.
+// What the loop is asked to do: hold `start` for hold_s; or move from `start` to `end` in
+// move_s along a minimum-jerk profile (dynamics_run.h, MinimumJerkPose) and then hold; or
+// follow `path` (a source tracked, a circle): its poses at path_time_s (from 0,
+// increasing), the position linear between them, the attitude the focal law's when given
+// (else the nodes' turned along the shortest rotation), then hold the last for hold_s.
 struct LoopSpec {
   Pose start;
   std::optional<Pose> end;
   double move_s = 60.0;
   double hold_s = 120.0;
   std::optional<FocalAttitudeLaw> focal_law;  // the path's attitude, when given
+  std::vector<double> path_time_s;
+  std::vector<Pose> path;  // start is path[0] when given
+  // The path's clock eases in and out over this long (s, >= 0, at most the path's
+  // duration): its speed goes from 0 to the path's along a minimum-jerk profile,
+  // tau(t) = T (2.5 u^4 - 3 u^5 + u^6), u = t / T, then tau = t - T / 2, and back to 0 at
+  // the end (the path ends T later). A path started or stopped at full speed rings the
+  // 0.13-0.2 Hz modes: ~45 mm at 0.1 m/s.
+  double path_ramp_s = 0.0;
 
   bool IsValid(std::string* error) const;
   double DurationS() const;

@@ -1,6 +1,7 @@
 // The cabin in its control loop: the equations are closed_loop.h's opening.
 #include "fastcal/closed_loop.h"
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -26,6 +27,8 @@ bool NonNegative(double v) { return std::isfinite(v) && v >= 0.0; }
 // The controller's state between cycles: the PID's sums, the winches' last command and
 // rate, the warm start of the control cycle.
 struct Controller {
+  std::array<Eigen::Vector3d, 2> filtered = {Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()};
+  bool filter_started = false;
   Eigen::Vector3d integral = Eigen::Vector3d::Zero();
   Eigen::Vector3d last_error = Eigen::Vector3d::Zero();
   bool has_last_error = false;
@@ -38,8 +41,18 @@ struct Controller {
 // The PID's correction for error e. The integral holds while a winch is at its limit
 // (conditional integration: Astrom and Hagglund, "Advanced PID control", 2006, 3.5): what
 // the winches cannot follow, during a slew, would otherwise wind it up and overshoot.
-Eigen::Vector3d Pid(const LoopOptions& o, const Eigen::Vector3d& e, Controller* c) {
+Eigen::Vector3d Pid(const LoopOptions& o, const Eigen::Vector3d& raw, Controller* c) {
   const double t = o.control_period_s;
+  // Two first-order low-passes (started at the first error: no step into the loop).
+  Eigen::Vector3d e = raw;
+  if (o.error_filter_hz > 0.0) {
+    const double alpha = 1.0 - std::exp(-kTwoPi * o.error_filter_hz * t);
+    if (!c->filter_started) c->filtered = {raw, raw};
+    c->filter_started = true;
+    c->filtered[0] += alpha * (raw - c->filtered[0]);
+    c->filtered[1] += alpha * (c->filtered[0] - c->filtered[1]);
+    e = c->filtered[1];
+  }
   if (!c->saturated) c->integral += e * t;
   const Eigen::Vector3d derivative =
       c->has_last_error ? Eigen::Vector3d((e - c->last_error) / t) : Eigen::Vector3d::Zero();
@@ -162,6 +175,7 @@ bool LoopOptions::IsValid(std::string* error) const {
   if (!NonNegative(kp) || !NonNegative(ki_per_s) || !NonNegative(kd_s)) {
     return fail("the PID's gains (kp, ki_per_s, kd_s) must be finite and >= 0");
   }
+  if (!NonNegative(error_filter_hz)) return fail("error_filter_hz must be >= 0");
   if (!NonNegative(measurement_noise_m)) return fail("measurement_noise_m must be >= 0");
   if (!NonNegative(measurement_delay_s) || measurement_delay_s > 60.0) {
     return fail("measurement_delay_s must be in [0, 60] s");
@@ -179,6 +193,28 @@ bool LoopSpec::IsValid(std::string* error) const {
     *error = "the loop's poses must be finite";
     return false;
   }
+  if (!path.empty() || !path_time_s.empty()) {
+    if (end) {
+      *error = "give a slew's end or a path, not both";
+      return false;
+    }
+    if (!NonNegative(path_ramp_s) || (!path_time_s.empty() && path_ramp_s > path_time_s.back())) {
+      *error = "path_ramp_s must be >= 0 and at most the path's duration";
+      return false;
+    }
+    if (path.size() != path_time_s.size() || path.size() < 2) {
+      *error = "a path needs two or more poses, each with its time";
+      return false;
+    }
+    for (size_t k = 0; k < path.size(); ++k) {
+      const bool increasing = k == 0 ? path_time_s[0] == 0.0 : path_time_s[k] > path_time_s[k - 1];
+      if (!IsFinite(path[k]) || !std::isfinite(path_time_s[k]) || !increasing) {
+        *error = "path node " + std::to_string(k) +
+                 ": its pose must be finite and the times increase from 0";
+        return false;
+      }
+    }
+  }
   if (end && !Positive(move_s)) {
     *error = "move_s must be > 0";
     return false;
@@ -190,11 +226,38 @@ bool LoopSpec::IsValid(std::string* error) const {
   return true;
 }
 
-double LoopSpec::DurationS() const { return (end ? move_s : 0.0) + hold_s; }
+// The path's clock at time t, with a minimum-jerk ease-in and ease-out of ramp_s around a
+// path of `length_s` at full speed (closed_loop.h).
+static double PathClock(double t, double ramp_s, double length_s) {
+  if (!(ramp_s > 0.0)) return t;
+  const auto in = [](double u) { return u * u * u * u * (2.5 - 3.0 * u + u * u); };
+  if (t < ramp_s) return ramp_s * in(std::max(0.0, t / ramp_s));
+  if (t <= length_s) return t - 0.5 * ramp_s;
+  const double u = std::min(1.0, (t - length_s) / ramp_s);
+  return length_s - 0.5 * ramp_s + ramp_s * (u - in(u));
+}
+
+double LoopSpec::DurationS() const {
+  if (!path.empty()) return path_time_s.back() + path_ramp_s + hold_s;
+  return (end ? move_s : 0.0) + hold_s;
+}
 
 Pose LoopSpec::CommandAt(double time_s) const {
   Pose command = start;
-  if (end) {
+  if (!path.empty()) {
+    time_s = PathClock(time_s, path_ramp_s, path_time_s.back());
+    // The segment [k, k + 1] holding time_s (the last one after the path's end).
+    size_t k = static_cast<size_t>(
+        std::upper_bound(path_time_s.begin(), path_time_s.end(), time_s) - path_time_s.begin());
+    k = std::min(k == 0 ? 0 : k - 1, path.size() - 2);
+    const size_t next = k + 1;
+    const double u =
+        std::clamp((time_s - path_time_s[k]) / (path_time_s[next] - path_time_s[k]), 0.0, 1.0);
+    command.position_m = (1.0 - u) * path[k].position_m + u * path[next].position_m;
+    const Eigen::Quaterniond a(path[k].rotation), b(path[next].rotation);
+    command.rotation = a.slerp(u, b).toRotationMatrix();
+    if (focal_law) command.rotation = FocalAttitude(command.position_m, *focal_law);
+  } else if (end) {
     command = MinimumJerkPose(start, *end, time_s / move_s, focal_law ? &*focal_law : nullptr);
   } else if (focal_law) {
     command.rotation = FocalAttitude(start.position_m, *focal_law);
@@ -229,6 +292,7 @@ bool RunLoop(const CableRobot& truth, const CableRobot& controller, const LoopSp
   }
   c.integral.setZero();
   c.has_last_error = false;
+  c.filter_started = false;
   if (!plant->StartAt(c.s0, error)) return false;
   result->start = plant->start();
   std::mt19937_64 random(options.seed);
@@ -246,7 +310,11 @@ bool RunLoop(const CableRobot& truth, const CableRobot& controller, const LoopSp
     result->samples.push_back(Sample(t, *plant, command, measured, c.cycle, c.s0));
     if (k == cycles) break;
     const Eigen::Vector3d e = spec.CommandAt(seen * period).position_m - measured;
-    if (!Control(truth, controller, options, command, e, t, &c, &summary, error) ||
+    // The winches reach this cycle's lengths at the period's end: the feed-forward solves
+    // the command there (a controller knows its trajectory a period ahead; solved for now,
+    // the cabin lagged it by the path's speed times the period, 9.5 mm at 0.1 m/s).
+    if (!Control(truth, controller, options, spec.CommandAt(t + period), e, t, &c, &summary,
+                 error) ||
         !plant->Advance(t + period, c.s0, error)) {
       return false;
     }
@@ -325,6 +393,7 @@ std::string LoopSummaryJson(const LoopResult& r, double frequency_hz) {
   j.Key("kp").Number(r.options.kp);
   j.Key("ki_per_s").Number(r.options.ki_per_s);
   j.Key("kd_s").Number(r.options.kd_s);
+  j.Key("error_filter_hz").Number(r.options.error_filter_hz);
   j.Key("measurement_noise_m").Number(r.options.measurement_noise_m);
   j.Key("measurement_delay_s").Number(r.options.measurement_delay_s);
   j.Key("max_winch_speed_m_per_s").Number(r.options.max_winch_speed_m_per_s);
