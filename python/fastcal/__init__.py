@@ -76,6 +76,7 @@ __all__ = [
     "locate",
     "loop",
     "modes",
+    "modes_cap",
     "quat_from_rpy_deg",
     "random_workspace",
     "read_dataset",
@@ -115,4 +116,4 @@ from .dataset import read_dataset, simulate  # noqa: F401
 from .calibration import CalibrationResult, calibrate, evaluate  # noqa: F401
 from .design import design  # noqa: F401
 from .track import TrackResult, track  # noqa: F401
-from .dynamics import ModesResult, dynamics, loop, modes  # noqa: F401
+from .dynamics import ModesResult, dynamics, loop, modes, modes_cap  # noqa: F401

@@ -307,6 +307,56 @@ def dynamics(
     return frame
 
 
+def modes_cap(
+    model: Optional[Union[Model, PathLike]] = None,
+    *,
+    max_off_axis_deg: float = 40.0,
+    off_axis_step_deg: float = 5.0,
+    azimuth_step_deg: float = 15.0,
+    focal_radius: float = 160.0,
+    focal_centre: ArrayLike = (0.0, 0.0, 300.0),
+    tilt_fraction: float = 0.41,
+    segments: int = 48,
+    count: int = 20,
+):
+    """The modes over the focal-sphere cap, as `fastcal modes --cap` (docs/model.md,
+    "Vibrations"): at every node of the grid, on the focal law, the lowest frequency, the
+    first mode the cabin dominates, and for each of the cabin's six motions the mode that
+    holds most of it.
+
+    Args:
+        model: the model or its file's path; None for the nominal.
+        max_off_axis_deg, off_axis_step_deg, azimuth_step_deg, focal_radius, focal_centre:
+            the grid (193 nodes by default); tilt_fraction: the focal law's.
+        segments, count: as `modes` takes them, at every node.
+
+    Returns:
+        A pandas DataFrame, one row per node, with the CSV's columns: off_axis_deg,
+        azimuth_deg, x_m .. yaw_deg, status ("ok" or "no_modes", with `message`),
+        lowest_hz, lowest_cabin_share, first_cabin_mode, first_cabin_hz, x_hz, x_share, ..,
+        rz_hz, rz_share.
+
+    Raises:
+        InputError: bad options or model (named).
+    """
+    import io
+
+    import pandas
+
+    csv = _fastcal.modes_cap(
+        _model(model),
+        float(max_off_axis_deg),
+        float(off_axis_step_deg),
+        float(azimuth_step_deg),
+        float(focal_radius),
+        np.asarray(focal_centre, dtype=np.float64).reshape(1, 3),
+        float(tilt_fraction),
+        _whole(segments, "segments", 2, 1000),
+        _whole(count, "count", 1, 200),
+    )
+    return pandas.read_csv(io.StringIO(csv), keep_default_na=False, na_values=[""])
+
+
 def loop(
     position_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,

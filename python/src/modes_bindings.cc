@@ -1,10 +1,13 @@
 // The vibrations of one pose (modes.h) on numpy arrays: a position and an attitude in, the
-// lowest modes' frequencies, energy shares and dominant cables out.
+// lowest modes' frequencies, energy shares and dominant cables out. The map of the cap
+// (modes_map.h): the grid and the modes' options in, the CSV `fastcal modes --cap` writes
+// out.
 #include <string>
 #include <vector>
 
 #include "bindings.h"
 #include "fastcal/modes.h"
+#include "fastcal/modes_map.h"
 
 namespace fastcal::python {
 
@@ -12,8 +15,8 @@ void BindModes(py::module_& m) {
   m.def(
       "modes",
       [](const CableRobot& model_argument, const DoubleArray& position_m,
-         const std::string& attitude_kind,
-         const DoubleArray& attitude, int segments, int count, bool cable_inertia) {
+         const std::string& attitude_kind, const DoubleArray& attitude, int segments, int count,
+         bool cable_inertia) {
         const CableRobot robot = model_argument;  // a copy with the GIL held (issue 37)
         ValidateModel(robot);
         const std::vector<Pose> poses = PosesFromArrays(position_m, attitude_kind, attitude);
@@ -61,6 +64,39 @@ void BindModes(py::module_& m) {
       },
       py::arg("model"), py::arg("position_m"), py::arg("attitude_kind"), py::arg("attitude"),
       py::arg("segments"), py::arg("modes"), py::arg("cable_inertia"));
+  m.def(
+      "modes_cap",
+      [](const CableRobot& model_argument, double max_off_axis_deg, double off_axis_step_deg,
+         double azimuth_step_deg, double focal_radius_m, const DoubleArray& focal_centre_m,
+         double tilt_fraction, int segments, int count) {
+        const CableRobot robot = model_argument;  // a copy with the GIL held (issue 37)
+        ValidateModel(robot);
+        ModesMapOptions options;
+        options.grid.max_off_axis_deg = max_off_axis_deg;
+        options.grid.off_axis_step_deg = off_axis_step_deg;
+        options.grid.azimuth_step_deg = azimuth_step_deg;
+        options.grid.focal_radius_m = focal_radius_m;
+        CheckRows(focal_centre_m, 3, "focal_centre");
+        options.grid.focal_centre_m = Eigen::Vector3d(
+            focal_centre_m.at(0, 0), focal_centre_m.at(0, 1), focal_centre_m.at(0, 2));
+        options.attitude_law.focal_centre_m = options.grid.focal_centre_m;
+        options.attitude_law.tilt_fraction = tilt_fraction;
+        options.modes.segments = segments;
+        options.modes.modes = count;
+        std::string error;
+        if (!options.IsValid(&error)) throw InputError(error);
+        ModesMap map;
+        bool ok = false;
+        {
+          py::gil_scoped_release release;
+          ok = ComputeModesMap(robot, options, &map, &error);
+        }
+        if (!ok) throw InputError(error);
+        return ModesMapCsv(map);
+      },
+      py::arg("model"), py::arg("max_off_axis_deg"), py::arg("off_axis_step_deg"),
+      py::arg("azimuth_step_deg"), py::arg("focal_radius_m"), py::arg("focal_centre_m"),
+      py::arg("tilt_fraction"), py::arg("segments"), py::arg("modes"));
 }
 
 }  // namespace fastcal::python

@@ -99,7 +99,7 @@ RACE_ONE = textwrap.dedent(
     q = fastcal.focal_attitude(p)
     # The field swapped: the attachments (a list the copy must take whole), or for the
     # modes, which do not take attachments, the cabin's mass.
-    massed = call in ("modes", "loop")  # the lumped chains refuse attachments
+    massed = call in ("modes", "modes_cap", "loop")  # the lumped chains refuse attachments
     field = "cabin_mass_kg" if massed else "attachments"
     bare = 30000.0 if massed else [[] for _ in range(6)]
     loaded = (32000.0 if massed
@@ -130,6 +130,10 @@ RACE_ONE = textwrap.dedent(
             return fastcal.control_cycle(p, quat=q, model=m).winch_length_m
         if call == "modes":
             return fastcal.modes(p[0], quat=q[0], model=m, count=4).frequency_hz
+        if call == "modes_cap":
+            return fastcal.modes_cap(m, max_off_axis_deg=10, off_axis_step_deg=10,
+                                     azimuth_step_deg=180, segments=8,
+                                     count=4)["lowest_hz"].to_numpy()
         if call == "loop":  # both models the one raced
             return fastcal.loop(p[0], quat=q[0], truth=m, controller=m, hold_s=0.5,
                                 segments=6, pid=(0, 0, 0))["T1_kN"].to_numpy()
@@ -178,7 +182,7 @@ RACE_ONE = textwrap.dedent(
 @pytest.mark.parametrize(
     "call",
     ["solve", "evaluate", "simulate", "locate", "design", "control_cycle", "modes", "calibrate",
-     "track", "loop"])
+     "track", "loop", "modes_cap"])
 def test_each_binding_sees_one_model_while_another_thread_changes_it(
         call: str, data_dir: pathlib.Path) -> None:
     run = subprocess.run(
