@@ -148,6 +148,17 @@ _POSE_COLUMNS = ("x_m", "y_m", "z_m", "roll_deg", "pitch_deg", "yaw_deg")
 _QS_POSE_COLUMNS = ("x_qs_m", "y_qs_m", "z_qs_m", "roll_qs_deg", "pitch_qs_deg", "yaw_qs_deg")
 
 
+def _end_arrays(to, to_rpy_deg, attitude_law, tilt_fraction, focal_centre):
+    """A move's or a slew's end as the binding takes it: its position, and "same" (the
+    start's attitude), a turn to to_rpy_deg, or the focal law's."""
+    if attitude_law is not None and to_rpy_deg is not None:
+        raise InputError("to_rpy_deg: with attitude_law='focal' every pose flies the law")
+    end, end_kind, end_attitude = _pose_arrays(
+        to, to_rpy_deg, None, attitude_law, tilt_fraction, focal_centre
+    )
+    return end, ("same" if end_kind == "none" else end_kind), end_attitude
+
+
 def _model(model: Any) -> Model:
     """None (the nominal), a Model, or a model file's path; InputError for anything else."""
     if model is None:
@@ -241,13 +252,9 @@ def dynamics(
     offset = np.zeros(6)
     if to is not None:
         run = "move"
-        if attitude_law is not None and to_rpy_deg is not None:
-            raise InputError("to_rpy_deg: with attitude_law='focal' every pose flies the law")
-        end, end_kind, end_attitude = _pose_arrays(
-            to, to_rpy_deg, None, attitude_law, tilt_fraction, focal_centre
+        end, end_kind, end_attitude = _end_arrays(
+            to, to_rpy_deg, attitude_law, tilt_fraction, focal_centre
         )
-        if end_kind == "none":
-            end_kind = "same"
     elif to_rpy_deg is not None:
         raise InputError("to_rpy_deg applies to a move (to)")
     elif lengths is not None:
@@ -427,13 +434,9 @@ def loop(
     )
     end, end_kind, end_attitude = np.zeros(3), "same", np.zeros((1, 3))
     if to is not None:
-        if attitude_law is not None and to_rpy_deg is not None:
-            raise InputError("to_rpy_deg: with attitude_law='focal' every pose flies the law")
-        end, end_kind, end_attitude = _pose_arrays(
-            to, to_rpy_deg, None, attitude_law, tilt_fraction, focal_centre
+        end, end_kind, end_attitude = _end_arrays(
+            to, to_rpy_deg, attitude_law, tilt_fraction, focal_centre
         )
-        if end_kind == "none":
-            end_kind = "same"
     elif to_rpy_deg is not None:
         raise InputError("to_rpy_deg applies to a slew (to)")
     gains = np.asarray(pid, dtype=np.float64).ravel()

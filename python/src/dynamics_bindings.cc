@@ -51,6 +51,16 @@ py::dict RecordColumns(const DynamicsRunResult& r) {
   return out;
 }
 
+// The focal law from its centre ((1, 3)) and tilt fraction; InputError for a wrong shape.
+FocalAttitudeLaw FocalLawOf(const DoubleArray& focal_centre_m, double tilt_fraction) {
+  FocalAttitudeLaw law;
+  law.tilt_fraction = tilt_fraction;
+  CheckRows(focal_centre_m, 3, "focal_centre");
+  law.focal_centre_m =
+      Eigen::Vector3d(focal_centre_m.at(0, 0), focal_centre_m.at(0, 1), focal_centre_m.at(0, 2));
+  return law;
+}
+
 // What the winches do (a "move", "lengths" or a "decay") into `spec`; InputError for a
 // wrong shape.
 void WinchesFromArguments(const std::string& kind, const DoubleArray& end_m,
@@ -65,14 +75,7 @@ void WinchesFromArguments(const std::string& kind, const DoubleArray& end_m,
     // "same": the start's attitude throughout (as the command line without --to-rpy).
     spec.end = PosesFromArrays(end_m, end_kind == "same" ? "none" : end_kind, end_attitude)[0];
     if (end_kind == "same") spec.end.rotation = spec.start.rotation;
-    if (focal) {
-      FocalAttitudeLaw law;
-      law.tilt_fraction = tilt_fraction;
-      CheckRows(focal_centre_m, 3, "focal_centre");
-      law.focal_centre_m = Eigen::Vector3d(focal_centre_m.at(0, 0), focal_centre_m.at(0, 1),
-                                           focal_centre_m.at(0, 2));
-      spec.focal_law = law;
-    }
+    if (focal) spec.focal_law = FocalLawOf(focal_centre_m, tilt_fraction);
   } else if (kind == "lengths") {
     spec.kind = DynamicsRunSpec::Kind::kLengths;
     CheckRows(lengths_s0_m, kNumCables, "lengths (s0_1_m .. s0_6_m)");
@@ -159,14 +162,7 @@ void BindDynamics(py::module_& m) {
         LoopSpec spec;
         spec.start = start[0];
         spec.hold_s = hold_s;
-        if (focal) {
-          FocalAttitudeLaw law;
-          law.tilt_fraction = tilt_fraction;
-          CheckRows(focal_centre_m, 3, "focal_centre");
-          law.focal_centre_m = Eigen::Vector3d(focal_centre_m.at(0, 0), focal_centre_m.at(0, 1),
-                                               focal_centre_m.at(0, 2));
-          spec.focal_law = law;
-        }
+        if (focal) spec.focal_law = FocalLawOf(focal_centre_m, tilt_fraction);
         if (has_end) {
           spec.move_s = move_s;
           Pose end =
