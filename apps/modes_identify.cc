@@ -29,26 +29,6 @@ namespace fastcal::cli {
 namespace {
 
 constexpr char kCommand[] = "modes";
-std::string ComparisonCsv(const ModesComparisonResult& r) {
-  std::ostringstream out;
-  out << "mode,frequency_hz,frequency_sigma_hz,damping_ratio,damping_sigma,predicted_mode,"
-         "predicted_hz,predicted_kind,difference_percent,difference_sigma_percent";
-  for (int p = 0; p < kModeParameters; ++p) out << ",dlnf_dln_" << ModeParameterName(p);
-  out << "\n";
-  for (size_t i = 0; i < r.modes.size(); ++i) {
-    const ModeComparison& c = r.modes[i];
-    const IdentifiedMode& m = c.identified;
-    out << i + 1 << "," << FormatDouble(m.frequency_hz) << "," << FormatDouble(m.frequency_sigma_hz)
-        << "," << FormatDouble(m.damping_ratio) << "," << FormatDouble(m.damping_sigma) << ","
-        << c.predicted_mode << "," << FormatDouble(c.predicted_hz) << ","
-        << (c.predicted_cabin_share > 0.5 ? "cabin" : "cable") << ","
-        << FormatDouble(100 * c.difference) << "," << FormatDouble(100 * c.difference_sigma);
-    for (int p = 0; p < kModeParameters; ++p) out << "," << FormatDouble(c.sensitivity[p], 4);
-    out << "\n";
-  }
-  return out.str();
-}
-
 std::string ComparisonSummary(const ModesComparisonResult& r, const Pose& pose,
                               const std::string& method) {
   std::ostringstream s;
@@ -146,7 +126,7 @@ int RunModesIdentify(const CableRobot& robot, const ModesOptions& options, bool 
     PrintError(kCommand, error);
     return kExitFailure;
   }
-  if (!WriteOutput(to_file ? FLAGS_output : "-", ComparisonCsv(comparison), &error, FLAGS_force)) {
+  if (!WriteOutput(to_file ? FLAGS_output : "-", ModesComparisonCsv(comparison), &error, FLAGS_force)) {
     PrintError(kCommand, error);
     return kExitFailure;
   }

@@ -72,6 +72,7 @@ __all__ = [
     "evaluate",
     "focal_attitude",
     "focal_grid",
+    "identify_modes",
     "line",
     "locate",
     "loop",
@@ -116,4 +117,4 @@ from .dataset import read_dataset, simulate  # noqa: F401
 from .calibration import CalibrationResult, calibrate, evaluate  # noqa: F401
 from .design import design  # noqa: F401
 from .track import TrackResult, track  # noqa: F401
-from .dynamics import ModesResult, dynamics, loop, modes, modes_cap  # noqa: F401
+from .dynamics import ModesResult, dynamics, identify_modes, loop, modes, modes_cap  # noqa: F401

@@ -364,6 +364,61 @@ def modes_cap(
     return pandas.read_csv(io.StringIO(csv), keep_default_na=False, na_values=[""])
 
 
+def identify_modes(
+    data: PathLike,
+    model: Optional[Union[Model, PathLike]] = None,
+    *,
+    identification: str = "auto",
+    identified_modes: int = 3,
+    segments: int = 48,
+    count: int = 20,
+):
+    """Modes identified from a vibration record and compared with the model's prediction,
+    as `fastcal modes --data` (docs/model.md, "Identified modes", "Modes from ordinary
+    operation").
+
+    Args:
+        data: the record's CSV (the dataset's columns: time_s, the pose and T1_kN ..
+            T6_kN at a steady rate, about one pose).
+        model: the model predicted at the record's mean pose; None for the nominal.
+        identification: "era" (a free decay), "ssi" (an ambient record) or "auto" (era
+            when the envelope's mean square falls 4x from the first quarter to the last).
+        identified_modes: how many dominant modes; segments, count: the prediction's.
+
+    Returns:
+        A pandas DataFrame, one row per identified mode, with the command's CSV columns
+        (frequency_hz and its sigma, damping_ratio and its sigma, the predicted mode it
+        matches, the difference in percent with its sigma, d ln f / d ln of each
+        parameter); frame.attrs holds "method", "chi2_model", "agrees" (the record
+        agrees with the model), "best" (the parameter whose change explains the
+        differences best) and "fits" (per parameter: relative_change, sigma, chi2), and
+        "mean_position_m".
+
+    Raises:
+        InputError: bad options, or a record that is not one (named with its file).
+        RuntimeError: the identification or the prediction fails.
+    """
+    import io
+
+    import pandas
+
+    path = os.fspath(data)
+    if not os.path.exists(path):  # as open() says it (the package's convention)
+        raise FileNotFoundError(2, "No such file or directory", path)
+    out = _fastcal.identify_modes(
+        _model(model),
+        path,
+        str(identification),
+        _whole(identified_modes, "identified_modes", 1, 20),
+        _whole(segments, "segments", 2, 1000),
+        _whole(count, "count", 1, 200),
+    )
+    frame = pandas.read_csv(io.StringIO(out["csv"]))
+    for key in ("method", "chi2_model", "agrees", "best", "fits", "mean_position_m"):
+        frame.attrs[key] = out[key]
+    return frame
+
+
 def loop(
     position_m: ArrayLike,
     rpy_deg: Optional[ArrayLike] = None,

@@ -1,13 +1,17 @@
 // The vibrations of one pose (modes.h) on numpy arrays: a position and an attitude in, the
 // lowest modes' frequencies, energy shares and dominant cables out. The map of the cap
 // (modes_map.h): the grid and the modes' options in, the CSV `fastcal modes --cap` writes
-// out.
+// out. Modes identified from a record (modal_identification.h, subspace_identification.h)
+// and compared with the prediction: the CSV `fastcal modes --data` writes, and its verdict.
 #include <string>
 #include <vector>
 
 #include "bindings.h"
+#include "fastcal/modal_identification.h"
 #include "fastcal/modes.h"
 #include "fastcal/modes_map.h"
+#include "fastcal/subspace_identification.h"
+#include "fastcal/vibration_record.h"
 
 namespace fastcal::python {
 
@@ -97,6 +101,71 @@ void BindModes(py::module_& m) {
       py::arg("model"), py::arg("max_off_axis_deg"), py::arg("off_axis_step_deg"),
       py::arg("azimuth_step_deg"), py::arg("focal_radius_m"), py::arg("focal_centre_m"),
       py::arg("tilt_fraction"), py::arg("segments"), py::arg("modes"));
+  m.def(
+      "identify_modes",
+      [](const CableRobot& model_argument, const std::string& path, std::string method,
+         int identified_modes, int segments, int count) {
+        const CableRobot robot = model_argument;  // a copy with the GIL held (issue 37)
+        ValidateModel(robot);
+        if (method != "auto" && method != "era" && method != "ssi") {
+          throw InputError(
+              "identification must be 'era' (a free decay), 'ssi' (an ambient "
+              "record) or 'auto', got '" +
+              method + "'");
+        }
+        EraOptions era;
+        SsiOptions ssi;
+        era.modes = ssi.modes = identified_modes;
+        ModesOptions options;
+        options.segments = segments;
+        options.modes = count;
+        std::string error;
+        if (!era.IsValid(&error) || !ssi.IsValid(&error) || !options.IsValid(&error)) {
+          throw InputError(error);
+        }
+        VibrationRecordFile file;
+        if (!ReadVibrationRecord(path, DatasetReadOptions(), &file, &error)) {
+          throw InputError(error.rfind("the record", 0) == 0 ? path + ": " + error : error);
+        }
+        if (method == "auto") {
+          method = EnvelopeDecayRatio(file.record) >= kFreeDecayRatio ? "era" : "ssi";
+        }
+        if (method == "era" && !CheckRecordSampling(file.record, era, &error)) {
+          throw InputError(path + ": " + error);
+        }
+        std::vector<IdentifiedMode> identified;
+        ModesComparisonResult comparison;
+        bool ok = false;
+        {
+          py::gil_scoped_release release;
+          ok = (method == "era" ? IdentifyModesEra(file.record, era, &identified, &error)
+                                : IdentifyModesSsi(file.record, ssi, &identified, &error)) &&
+               CompareWithPrediction(robot, file.mean_pose, identified, options, &comparison,
+                                     &error);
+        }
+        if (!ok) throw std::runtime_error(path + ": " + error);
+        py::dict out;
+        out["csv"] = ModesComparisonCsv(comparison);
+        out["method"] = method;
+        out["chi2_model"] = comparison.chi2_model;
+        out["agrees"] = comparison.agrees;
+        out["best"] = std::string(ModeParameterName(comparison.best));
+        py::dict fits;
+        for (int p = 0; p < kModeParameters; ++p) {
+          py::dict f;
+          f["relative_change"] = comparison.fits[p].relative_change;
+          f["sigma"] = comparison.fits[p].sigma;
+          f["chi2"] = comparison.fits[p].chi2;
+          fits[py::str(ModeParameterName(p))] = f;
+        }
+        out["fits"] = fits;
+        DoubleArray position = NewArray({3});
+        for (int j = 0; j < 3; ++j) position.mutable_at(j) = file.mean_pose.position_m[j];
+        out["mean_position_m"] = position;
+        return out;
+      },
+      py::arg("model"), py::arg("path"), py::arg("identification"), py::arg("identified_modes"),
+      py::arg("segments"), py::arg("modes"));
 }
 
 }  // namespace fastcal::python

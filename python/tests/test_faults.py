@@ -99,7 +99,7 @@ RACE_ONE = textwrap.dedent(
     q = fastcal.focal_attitude(p)
     # The field swapped: the attachments (a list the copy must take whole), or for the
     # modes, which do not take attachments, the cabin's mass.
-    massed = call in ("modes", "modes_cap", "loop")  # the lumped chains refuse attachments
+    massed = call in ("modes", "modes_cap", "loop", "identify_modes")  # chains refuse attachments
     field = "cabin_mass_kg" if massed else "attachments"
     bare = 30000.0 if massed else [[] for _ in range(6)]
     loaded = (32000.0 if massed
@@ -134,6 +134,15 @@ RACE_ONE = textwrap.dedent(
             return fastcal.modes_cap(m, max_off_axis_deg=10, off_axis_step_deg=10,
                                      azimuth_step_deg=180, segments=8,
                                      count=4)["lowest_hz"].to_numpy()
+        if call == "identify_modes":  # a record of the nominal model, made once
+            if not os.path.exists(os.path.join(work, "decay.csv")):
+                import subprocess
+                subprocess.run([os.environ["FASTCAL_BIN"], "simulate", "--vibration",
+                                "--position=102.846,0,177.433", "--attitude-law=focal",
+                                "--excite=2,7,18",
+                                "--out=" + os.path.join(work, "decay.csv")], check=True)
+            return fastcal.identify_modes(os.path.join(work, "decay.csv"), m,
+                                          segments=8)["predicted_hz"].to_numpy()
         if call == "loop":  # both models the one raced
             return fastcal.loop(p[0], quat=q[0], truth=m, controller=m, hold_s=0.5,
                                 segments=6, pid=(0, 0, 0))["T1_kN"].to_numpy()
@@ -182,7 +191,7 @@ RACE_ONE = textwrap.dedent(
 @pytest.mark.parametrize(
     "call",
     ["solve", "evaluate", "simulate", "locate", "design", "control_cycle", "modes", "calibrate",
-     "track", "loop", "modes_cap"])
+     "track", "loop", "modes_cap", "identify_modes"])
 def test_each_binding_sees_one_model_while_another_thread_changes_it(
         call: str, data_dir: pathlib.Path) -> None:
     run = subprocess.run(

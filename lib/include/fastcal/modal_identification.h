@@ -237,6 +237,12 @@ bool CompareWithPrediction(const CableRobot& robot, const Pose& pose,
                            const ModesOptions& options, ModesComparisonResult* result,
                            std::string* error);
 
+// The comparison as CSV (`fastcal modes --data`, docs/cli.md): mode, frequency_hz,
+// frequency_sigma_hz, damping_ratio, damping_sigma, predicted_mode, predicted_hz,
+// predicted_kind (cabin or cable), difference_percent, difference_sigma_percent, then
+// dlnf_dln_<parameter> per ModeParameterName.
+std::string ModesComparisonCsv(const ModesComparisonResult& result);
+
 }  // namespace fastcal
 
 #endif  // FASTCAL_MODAL_IDENTIFICATION_H_

@@ -689,4 +689,29 @@ bool SimulateVibrationRecord(const CableRobot& robot, const Pose& pose,
   return CheckRecordedMotion(*record, error);
 }
 
+std::string ModesComparisonCsv(const ModesComparisonResult& r) {
+  // Ten significant digits, "0" for zero (the command line's numbers).
+  const auto num = [](double v, int digits = 10) {
+    return v == 0.0 ? std::string("0")
+                    : internal::FormatDouble("%." + std::to_string(digits) + "g", v);
+  };
+  std::string out =
+      "mode,frequency_hz,frequency_sigma_hz,damping_ratio,damping_sigma,predicted_mode,"
+      "predicted_hz,predicted_kind,difference_percent,difference_sigma_percent";
+  for (int p = 0; p < kModeParameters; ++p) out += std::string(",dlnf_dln_") + ModeParameterName(p);
+  out += "\n";
+  for (size_t i = 0; i < r.modes.size(); ++i) {
+    const ModeComparison& c = r.modes[i];
+    const IdentifiedMode& m = c.identified;
+    out += std::to_string(i + 1) + "," + num(m.frequency_hz) + "," + num(m.frequency_sigma_hz) +
+           "," + num(m.damping_ratio) + "," + num(m.damping_sigma) + "," +
+           std::to_string(c.predicted_mode) + "," + num(c.predicted_hz) + "," +
+           (c.predicted_cabin_share > 0.5 ? "cabin" : "cable") + "," + num(100 * c.difference) +
+           "," + num(100 * c.difference_sigma);
+    for (int p = 0; p < kModeParameters; ++p) out += "," + num(c.sensitivity[p], 4);
+    out += "\n";
+  }
+  return out;
+}
+
 }  // namespace fastcal
