@@ -94,14 +94,17 @@ Usage:
                    [--interval-s=0.1] [--position-noise-m=M] [--attitude-noise-deg=D]
                    [--tension-noise-kN=T] [--segments=48] [--seed=1]
   fastcal simulate --dynamics --out=FILE.csv [trajectory] [errors] [--speed-m-per-s=0.5]
-                   [--min-move-s=10] [--wait-s=30] [--interval-s=1] [--wind=SPEED,DIR_DEG]
+                   [--min-move-s=10] [--wait-s=30 | --waits=design.json] [--interval-s=1]
+                   [--wind=SPEED,DIR_DEG]
                    [--gust-spectrum=kaimal] [--turbulence-intensity=0.15] [--segments=40]
                    [--damping-ratio=0.004] [--step-s=0.02]
 
 --dynamics: the survey flown in time (fastcal dynamics' model) instead of the cabin
 standing at each planned pose: to each new pose a minimum-jerk move lasting the longer of
 --min-move-s and its distance over --speed-m-per-s, the winches paying out the truth
-statics' lengths, then --wait-s before the sample; a pose that repeats the one before
+statics' lengths, then --wait-s before the sample (or, with --waits=design.json, each
+move's own wait, fastcal design's stops[].settle.wait_s: one per move, the design's poses
+flown in its order); a pose that repeats the one before
 (a stop's further samples, or the same pose throughout: an ambient record) is sampled
 --interval-s later. The samples' time, pose, tensions and lengths are the dynamics' (in
 --wind, seeded by --seed), then measured with the errors below. Not with an attitude
@@ -304,7 +307,7 @@ const std::set<std::string> kFlags = {
     "vibration", "position", "rpy", "quat", "rotvec", "excite", "damping", "amplitude-m",
     "duration-s", "segments",
     // --dynamics (simulate_dynamics.cc)
-    "dynamics", "wait-s", "min-move-s", "speed-m-per-s", "wind", "damping-ratio",
+    "dynamics", "wait-s", "waits", "min-move-s", "speed-m-per-s", "wind", "damping-ratio",
     "turbulence-intensity", "gust-spectrum", "step-s"};
 // clang-format on
 

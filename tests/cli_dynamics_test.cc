@@ -143,5 +143,38 @@ TEST_F(CliTest, SimulateFliesASurveyInTime) {
   EXPECT_FALSE(std::filesystem::exists(Path("never.csv")));
 }
 
+// simulate --dynamics --waits=design.json: each move followed by its design's wait (issue
+// 55: the flight took one --wait-s for every move), the count checked against the moves.
+TEST_F(CliTest, SimulateFliesTheDesignsWaits) {
+  Write("design.json",
+        "{\"stops\": [{\"settle\": {\"wait_s\": 0}}, {\"settle\": {\"wait_s\": 3}},"
+        " {\"settle\": {\"wait_s\": 12}}]}\n");
+  const std::string out = Path("flown.csv");
+  const std::string base =
+      "simulate --dynamics --trajectory=line --from=0,0,140 --to=6,0,140 --nodes=3 "
+      "--segments=12 --min-move-s=15 --seed=2 ";
+  const CommandResult r = Fastcal(base + "--waits=" + Path("design.json") + " --out=" + out);
+  ASSERT_EQ(r.code, 0) << r.output;
+  std::istringstream lines(ReadFile(out));
+  std::string line;
+  std::vector<std::string> rows;
+  while (std::getline(lines, line)) {
+    if (!line.empty() && line[0] != '#') rows.push_back(line);
+  }
+  ASSERT_EQ(rows.size(), 4u);
+  EXPECT_EQ(CsvFields(rows[2])[0], "18");  // a 15 s move, then 3 s
+  EXPECT_EQ(CsvFields(rows[3])[0], "45");  // and 15 s, then 12 s
+  Write("short.json", "{\"stops\": [{\"settle\": {\"wait_s\": 0}}]}\n");
+  RunBoundedAndExpect({base + "--waits=" + Path("short.json") + " --out=" + Path("never.csv"), 2,
+                       "0 waits (one per move), but the poses make 2 moves"});
+  Write("bad.json", "{\"stops\": [{}, {\"settle\": {\"wait_s\": \"soon\"}}, {}]}\n");
+  RunBoundedAndExpect({base + "--waits=" + Path("bad.json") + " --out=" + Path("never.csv"), 2,
+                       "stops[1].settle.wait_s is missing"});
+  RunBoundedAndExpect(
+      {base + "--waits=" + Path("design.json") + " --wait-s=5 --out=" + Path("never.csv"), 2,
+       "not both"});
+  EXPECT_FALSE(std::filesystem::exists(Path("never.csv")));
+}
+
 }  // namespace
 }  // namespace fastcal::test

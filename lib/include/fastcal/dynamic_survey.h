@@ -33,6 +33,11 @@ struct SurveyFlightOptions {
   // samples at one pose (s, > 0).
   double wait_s = 30.0;
   double sample_interval_s = 1.0;
+  // Or, with per_move_waits, a wait of its own after each move, in the flight's order (s,
+  // >= 0; exactly one per move: `fastcal design`'s stops[k].settle.wait_s for k >= 1, the
+  // time each move's tensions take to settle).
+  bool per_move_waits = false;
+  std::vector<double> move_waits_s;
 
   bool IsValid(std::string* error) const;
 };

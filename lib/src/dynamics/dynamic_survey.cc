@@ -24,9 +24,17 @@ struct Leg {
   double sample_s = 0.0;
 };
 
+// The moves of a flight over `planned` (consecutive samples at different poses).
+size_t Moves(const std::vector<Pose>& planned) {
+  size_t moves = 0;
+  for (size_t n = 1; n < planned.size(); ++n) moves += !SamePose(planned[n], planned[n - 1]);
+  return moves;
+}
+
 std::vector<Leg> Plan(const std::vector<Pose>& planned, const SurveyFlightOptions& o) {
   std::vector<Leg> legs(planned.size());
   double t = 0.0;
+  size_t moves = 0;
   for (size_t n = 1; n < planned.size(); ++n) {
     Leg& leg = legs[n];
     if (SamePose(planned[n], planned[n - 1])) {
@@ -35,7 +43,8 @@ std::vector<Leg> Plan(const std::vector<Pose>& planned, const SurveyFlightOption
       leg.move_start_s = t;
       const double distance = (planned[n].position_m - planned[n - 1].position_m).norm();
       leg.move_s = std::max(o.min_move_s, distance / o.speed_m_per_s);
-      t += leg.move_s + o.wait_s;
+      t += leg.move_s + (o.per_move_waits ? o.move_waits_s[moves] : o.wait_s);
+      ++moves;
     }
     leg.sample_s = t;
   }
@@ -111,6 +120,12 @@ bool SurveyFlightOptions::IsValid(std::string* error) const {
     *error = "wait_s (>= 0) and sample_interval_s (> 0): must be finite";
     return false;
   }
+  for (size_t k = 0; k < move_waits_s.size(); ++k) {
+    if (!(move_waits_s[k] >= 0.0) || !std::isfinite(move_waits_s[k])) {
+      *error = "move_waits_s[" + std::to_string(k) + "]: must be finite and >= 0";
+      return false;
+    }
+  }
   return dynamics.IsValid(error);
 }
 
@@ -119,6 +134,12 @@ bool MakeSurveyFlight(const std::vector<Pose>& planned, const SurveyFlightOption
   if (!options.IsValid(error)) return false;
   if (planned.empty()) {
     *error = "no planned poses";
+    return false;
+  }
+  if (options.per_move_waits && options.move_waits_s.size() != Moves(planned)) {
+    *error = std::to_string(options.move_waits_s.size()) +
+             " waits (one per move), but the poses make " + std::to_string(Moves(planned)) +
+             " moves";
     return false;
   }
   auto flight = std::make_shared<Flight>();
