@@ -1,6 +1,6 @@
-// `fastcal calibrate` and `fastcal evaluate`: fit model parameters to a telemetry export
-// and report; or evaluate a model against one. Outputs go to a temporary directory that
-// is renamed into place only when everything has been written.
+// `fastcal calibrate`: fit model parameters to a telemetry export and report (what it
+// shares with evaluate: calibrate_common.h). Outputs go to a temporary directory that is
+// renamed into place only when everything has been written.
 #include <gflags/gflags.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -21,6 +21,7 @@
 #include <map>
 #include <sstream>
 
+#include "calibrate_common.h"
 #include "cli_util.h"
 #include "columns_flag.h"
 #include "commands.h"
@@ -48,8 +49,6 @@
 DEFINE_bool(timings, false,
             "calibrate: print the wall time of reading, of each stage of the fit and of "
             "writing, on stderr.");
-DEFINE_int32(residuals_every, 1,
-             "calibrate, evaluate: residuals.csv keeps every K-th sample (1: all; 0: no file).");
 
 namespace fastcal::cli {
 namespace {
@@ -163,128 +162,12 @@ Example (the bundled paper-like circle):
     --data=calibration_data/circle_paper.csv --out=out/circle
 )";
 
-const char kEvaluateHelp[] = R"(fastcal evaluate: model-minus-measured tension statistics per cable.
-
-Usage:
-  fastcal evaluate --data=DATA.csv [--model=MODEL.yaml] [--out=DIR] [--method=exact]
-
-  --model=FILE   model to evaluate (e.g. DIR/model_calibrated.yaml from calibrate);
-                 default the nominal FAST model
-  --data=FILE    telemetry export (docs/data-format.md); several, comma-separated, are
-                 read together (one session each)
-  --columns=MAP.yaml  read --data as exported, through a column map (docs/data-format.md,
-                 "Column maps")
-  --method=M     statics method: exact (default), aas-refined, aas
-  --out=DIR      also write report.html, report.md, summary.json and residuals.csv
-  --force        let --out be a previous evaluate's results, replaced when complete
-  --residuals-every=K   residuals.csv keeps one sample in K (1: all, the default; 0: none)
-  --skip-invalid-rows   skip rows that are malformed or whose pose the model cannot solve
-                 (with --method, at each attitude) instead of failing; each is listed
-                 with its line on stderr and, with --out, in the report and summary.json
-
-Prints RMS, mean and max |model - measured| per cable in kN and percent, with the measured
-attitude and, when the data has it, the planned attitude. Gross errors are screened as calibrate
-screens them (against the measured attitude's predictions, with the default noise model
-of 3 % of the reading and a threshold that grows with the number of readings), named by
-line and cable, and each row of the RMS table is repeated without them. The model's sensor gain and
-bias (if any) are applied: predicted reading = gain * tension + bias.
-
-The data is read in chunks, so memory does not grow with it (about 20 MB at 10^6 samples);
-each sample is kept meanwhile in an unnamed temporary file in $TMPDIR, else /tmp (about 200
-bytes a sample); a full disk there is exit 1, naming the directory.
-)";
-
 // The files calibrate (kCalibrateOutputs) and evaluate write into --out: what --force may
 // replace there.
 // "A*B": any name from A to B (a joint fit of sessions writes one model per session).
 const std::vector<std::string> kCalibrateOutputs = {
     "model_calibrated.yaml", "model_calibrated@*.yaml", "report.html", "report.md", "summary.json",
     "residuals.csv"};
-const std::vector<std::string> kEvaluateOutputs = {"report.html", "report.md", "summary.json",
-                                                   "residuals.csv"};
-
-// --residuals-every must be >= 0 (0: no residuals.csv).
-bool CheckResidualsEvery(std::string* error) {
-  if (FLAGS_residuals_every >= 0) return true;
-  *error = "--residuals-every=" + std::to_string(FLAGS_residuals_every) +
-           ": must be 0 (no residuals.csv), 1 (every sample) or more (one sample in K)";
-  return false;
-}
-
-// CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
-bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
-  return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
-}
-
-// residuals.csv's comment lines and column line: `variants` are the RMS table's rows, of
-// which those with predictions (`predicted[v]`) get columns; `samples` how many the file
-// is one in K of.
-std::string ResidualsHeader(const std::vector<VariantEvaluation>& variants,
-                            const std::vector<bool>& predicted, size_t samples) {
-  const size_t every = static_cast<size_t>(std::max(1, FLAGS_residuals_every));
-  std::ostringstream head;
-  for (size_t v = 0; v < variants.size(); ++v) {
-    if (predicted[v]) head << "# v" << v + 1 << " = " << variants[v].name << "\n";
-  }
-  head << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
-  if (every > 1) {
-    head << "# one sample in " << every << " of the " << samples << " (--residuals-every=" << every
-         << "), from the first\n";
-  }
-  head << "line,time_s,held_out,gross_error_cables";
-  for (int i = 1; i <= kNumCables; ++i) head << ",T" << i << "_kN";
-  for (size_t v = 0; v < variants.size(); ++v) {
-    if (!predicted[v]) continue;
-    for (int i = 1; i <= kNumCables; ++i) head << ",v" << v + 1 << "_T" << i << "_kN";
-  }
-  head << "\n";
-  return head.str();
-}
-
-// Appends FormatDouble(value) (10 significant digits, printf's %.10g, no "-0"): by
-// to_chars, several times faster than snprintf, which counts at 10^6 rows of 27 numbers.
-void AppendNumber(double value, std::string* out) {
-  if (value == 0.0) {
-    *out += '0';
-    return;
-  }
-  char buf[48];
-  const std::to_chars_result r =
-      std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::general, 10);
-  out->append(buf, r.ptr);
-}
-
-// One row of residuals.csv: the sample's line and time, whether it was held out, the
-// cables whose reading was a gross error ("3", "1 4"; empty for none), the measured and
-// each drawn variant's predicted tensions.
-void AppendResidualsRow(int line, double time_s, bool held_out,
-                        const std::array<bool, kNumCables>* gross,
-                        const std::array<double, kNumCables>& measured_n,
-                        const std::vector<const std::array<double, kNumCables>*>& predicted_n,
-                        std::string* out) {
-  *out += std::to_string(line);
-  *out += ',';
-  AppendNumber(time_s, out);
-  *out += held_out ? ",1," : ",0,";
-  bool first = true;
-  for (int i = 0; gross != nullptr && i < kNumCables; ++i) {
-    if (!(*gross)[i]) continue;
-    if (!first) *out += ' ';
-    *out += static_cast<char>('1' + i);
-    first = false;
-  }
-  for (double t : measured_n) {
-    *out += ',';
-    AppendNumber(t / kNPerKn, out);
-  }
-  for (const std::array<double, kNumCables>* p : predicted_n) {
-    for (double t : *p) {
-      *out += ',';
-      AppendNumber(t / kNPerKn, out);
-    }
-  }
-  *out += '\n';
-}
 
 // calibrate's residuals.csv, one row per sample (one in --residuals-every): measured and
 // each variant's predicted tensions, the held_out flag and the gross errors
@@ -345,32 +228,6 @@ bool WriteResidualsFile(const std::string& dir, const Dataset& data,
   return true;
 }
 
-// The per-cable tables of calibrate's and evaluate's consoles share one layout: a label
-// column, then T1..T6, so that every row lines up under its header.
-constexpr int kLabelWidth = 40;
-
-std::string CableHeader(const std::string& title, const char* prefix = "T") {
-  char buf[160];
-  std::string names[kNumCables];
-  for (int i = 0; i < kNumCables; ++i) names[i] = prefix + std::to_string(i + 1);
-  std::snprintf(buf, sizeof(buf), "  %-*s %8s %8s %8s %8s %8s %8s\n", kLabelWidth, title.c_str(),
-                names[0].c_str(), names[1].c_str(), names[2].c_str(), names[3].c_str(),
-                names[4].c_str(), names[5].c_str());
-  return buf;
-}
-
-std::string CableRow(const std::string& label, const std::array<double, kNumCables>& values,
-                     double scale) {
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "  %-*.*s", kLabelWidth, kLabelWidth, label.c_str());
-  std::string row = buf;
-  for (double v : values) {
-    std::snprintf(buf, sizeof(buf), " %8.3f", v * scale + 0.0);  // + 0.0: no "-0.000"
-    row += std::string(buf) == " -0.000" ? "    0.000" : buf;
-  }
-  return row + "\n";
-}
-
 // With lengths in the fit: their RMS per cable before and after (mm), else "".
 std::string LengthTable(const LengthEvaluation& l) {
   if (!l.used) return "";
@@ -383,109 +240,14 @@ std::string LengthTable(const LengthEvaluation& l) {
   return s;
 }
 
-std::string RmsTable(const std::vector<VariantEvaluation>& variants) {
-  std::string s = CableHeader("RMS model - measured (kN)");
-  for (const VariantEvaluation& v : variants) {
-    for (int part = 0; part < 2; ++part) {
-      const CableErrorStats& st = part == 0 ? v.fit : v.holdout;
-      if (st.samples == 0) continue;
-      s += CableRow(v.name + (part == 1 ? " [hold-out]" : ""), st.rms_n, 1.0 / kNPerKn);
-    }
-  }
-  return s;
-}
-
-// The paper's published Table 6 under the RMS table when the data fly its measured circle
-// (PaperCircleMatcher: by the positions, whoever made the file); "" otherwise.
-// With `simulated` data (SimulatedProvenance), the lines say that the comparison is a
-// simulation's noise against the telescope's (issue 59).
-std::string PaperTable6Lines(const PaperCircleMatcher& positions, bool simulated) {
-  if (!positions.Matches()) return "";
-  const char* labels[] = {"paper's Table 6: AAS", "paper's Table 6: actual attitudes",
-                          "paper's Table 6: + corrected mass centre"};
-  std::string s = "  the same circle on the telescope (the paper's published RMS, kN):\n";
-  if (simulated) {
-    s = "  the same circle on the real telescope (the paper's published RMS, kN); THESE DATA\n"
-        "  ARE SIMULATED (fastcal simulate): their RMS is the simulation's noise, not an\n"
-        "  improvement over the paper's:\n";
-  }
-  for (size_t k = 0; k < internal::kPaperTable6.size(); ++k) {
-    s += CableRow(labels[k], internal::kPaperTable6[k].rms_kn, 1.0);
-  }
-  return s;
-}
-
 PaperCircleMatcher PositionsOf(const Dataset& data) {
   PaperCircleMatcher matcher;
   for (const Sample& sample : data.samples) matcher.Add(sample.pose.position_m);
   return matcher;
 }
 
-// --data's files: split at ',' (one session each, sessions.h), unless the whole value names
-// an existing file.
-std::vector<std::string> DataPaths() {
-  std::error_code ec;
-  if (fs::exists(FLAGS_data, ec)) return {FLAGS_data};
-  std::vector<std::string> paths;
-  std::string_view rest(FLAGS_data);
-  while (true) {
-    const size_t comma = rest.find(',');
-    paths.emplace_back(rest.substr(0, comma));
-    if (comma == std::string_view::npos) return paths;
-    rest.remove_prefix(comma + 1);
-  }
-}
-
-// Issue 59: the data files' provenance when `fastcal simulate` made them (the leading
-// comment it writes: "# Simulated by fastcal VERSION", the command, the truth model),
-// their lines without "# " joined by '\n' (each prefixed with its file's name when --data
-// names several); "" when no file says so. Only the first 8 KiB of each are read (a
-// gzipped file decompressed); a file that cannot be read says nothing here (its reader
-// says why).
-std::string SimulatedProvenance() {
-  constexpr char kMark[] = "# Simulated by fastcal";
-  const std::vector<std::string> paths = DataPaths();
-  std::string out;
-  for (const std::string& path : paths) {
-    internal::RegularFileReader reader;
-    std::string text, error;
-    bool end = false;
-    if (!reader.Open(path, std::numeric_limits<long long>::max(), "--data", &error) ||
-        !reader.Read(8192, &text, &end, &error) || text.rfind(kMark, 0) != 0) {
-      continue;
-    }
-    for (size_t start = 0; start < text.size() && text[start] == '#';) {
-      const size_t newline = text.find('\n', start);
-      if (newline == std::string::npos) break;  // a line cut by the 8 KiB
-      std::string line = text.substr(start, newline - start);
-      line.erase(0, line.find_first_not_of("# "));
-      if (!line.empty() && line.back() == '\r') line.pop_back();
-      out += (out.empty() ? "" : "\n") + (paths.size() > 1 ? path + ": " : "") + line;
-      start = newline + 1;
-    }
-  }
-  return out;
-}
-
-// --model's model and --data's files (checked: given, no empty name).
-bool LoadModelAndDataPaths(CableRobot* robot, std::vector<std::string>* paths, std::string* error) {
-  if (!LoadModelFlag("model", FLAGS_model, robot, error)) return false;
-  if (FLAGS_data.empty()) {
-    *error = "--data=FILE.csv is required";
-    return false;
-  }
-  *paths = DataPaths();
-  if (std::find(paths->begin(), paths->end(), "") != paths->end()) {
-    *error = "--data=" + internal::Quote(FLAGS_data) +
-             " has an empty file name (a stray comma?); several files are FILE.csv,FILE.csv";
-    return false;
-  }
-  return true;
-}
-
 // Threads that parse the data files (the same samples on any number): the machine FAST's
 // tools run on has two cores, as the spec's default solver.threads.
-constexpr int kReadThreads = 2;
 
 bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   std::vector<std::string> paths;
@@ -508,64 +270,12 @@ bool LoadInputs(CableRobot* robot, Dataset* data, std::string* error) {
   return true;
 }
 
-// Lists the rows --skip-invalid-rows skipped (malformed, or a pose the model cannot solve)
-// on stderr. False, with the message, when no sample is left.
-// `samples`: how many are left (data.samples.size() unless streamed).
-bool ReportSkipped(const char* command, const Dataset& data, long long samples,
-                   std::string* error) {
-  if (data.skipped.empty()) return true;
-  std::cerr << "fastcal " << command << ": --skip-invalid-rows skipped " << data.skipped.size()
-            << (data.skipped.size() == 1 ? " row" : " rows") << " of " << data.path << ", "
-            << samples << " left:\n";
-  for (const std::string& s : data.skipped) std::cerr << "  " << s << "\n";
-  if (samples > 0) return true;
-  *error = data.path + ": no sample left: the model cannot solve any valid row";
-  return false;
-}
-bool ReportSkipped(const char* command, const Dataset& data, std::string* error) {
-  return ReportSkipped(command, data, static_cast<long long>(data.samples.size()), error);
-}
-
-// " (3 rows skipped)" for the summary line; "" when none was.
-std::string SkippedNote(const Dataset& data) {
-  const size_t n = data.skipped.size();
-  return n == 0 ? "" : " (" + std::to_string(n) + (n == 1 ? " row" : " rows") + " skipped)";
-}
-
-// What to add to the message of a pose the model cannot solve.
-std::string SkipHint() {
-  return FLAGS_skip_invalid_rows ? "" : " (--skip-invalid-rows skips such rows, and lists them)";
-}
-
-// When `model` cannot solve at least two rows and the nominal FAST model solves most of
-// them, the model or spec, not the data, is the likely cause: the message that says so,
-// naming the values furthest from nominal; "" otherwise (unsolvable_rows.h).
-std::string BlameText(const UnsolvableRows& d, const std::string& model_name) {
-  if (!d.model_likely) return "";
-  return DescribeUnsolvableRows(d, model_name) +
-         (FLAGS_skip_invalid_rows ? " (not skipped: --skip-invalid-rows is for bad rows, and "
-                                    "would fit the rest with this model)"
-                                  : "");
-}
 std::string BlameTheModel(const CableRobot& model, const std::string& model_name,
                           const Dataset& data, const std::vector<StaticsMethod>& methods) {
   return BlameText(
       DiagnoseUnsolvableRows(model, model_name, data,
                              {AttitudeSource::kPlanned, AttitudeSource::kMeasured}, methods),
       model_name);
-}
-
-std::string Digest(const std::string& path) {
-  std::string hex, error;
-  return !path.empty() && FileSha256(path, &hex, &error) ? hex : "";
-}
-
-// The digests of --data's files, joined by ',' like the names.
-std::string DataDigest() {
-  std::string digests;
-  const std::vector<std::string> paths = DataPaths();
-  for (size_t k = 0; k < paths.size(); ++k) digests += (k ? "," : "") + Digest(paths[k]);
-  return digests;
 }
 
 // "0.192 +- 0.034 m": the estimate to the precision its sigma_total supports (a tiny
@@ -782,53 +492,6 @@ std::string ConsiderLines(const CalibrationResult& result) {
   return s.str();
 }
 
-// Which threshold the gross-error screen used, one console line (the report and
-// summary.json have the sentence, DescribeGrossErrorThreshold).
-std::string ThresholdLine(const std::string& indent, const GrossErrorThreshold& t) {
-  char buf[200];
-  std::snprintf(buf, sizeof(buf),
-                "%sthreshold: %s (floor %.3g, family-wise %.3g for %lld readings)\n",
-                indent.c_str(), t.family_wise_decides() ? "family-wise" : "the floor",
-                t.floor_sigmas, t.family_wise_sigmas, t.readings);
-  return buf;
-}
-
-// Where a list cut short on the console is whole: summary.json when the run writes one
-// (with --out), else that --out would write it. `key`: the list's key there, or empty.
-std::string SummaryPlace(bool summary_written, const std::string& key = "") {
-  return std::string("in summary.json") + (key.empty() ? "" : " (" + key + ")") +
-         (summary_written ? "" : " with --out=DIR");
-}
-
-// The first few readings of `list`, one line each, then how many more and where they are.
-std::string ReadingLines(const std::vector<ReadingResidual>& list, const std::string& indent,
-                         bool summary_written = true) {
-  constexpr size_t kShown = 5;
-  std::ostringstream s;
-  for (size_t k = 0; k < std::min(list.size(), kShown); ++k) {
-    const ReadingResidual& e = list[k];
-    char buf[200];
-    if (e.length) {
-      std::snprintf(buf, sizeof(buf),
-                    "%sline %d, length of cable %d: measured %.4f m, predicted %.4f m, %+.1f "
-                    "sigma%s\n",
-                    indent.c_str(), e.line, e.cable, e.measured_m, e.predicted_m, e.residual_sigma,
-                    e.held_out ? " (held out)" : "");
-    } else {
-      std::snprintf(buf, sizeof(buf),
-                    "%sline %d, cable %d: measured %.3f kN, predicted %.3f kN, %+.1f sigma%s\n",
-                    indent.c_str(), e.line, e.cable, e.measured_n / kNPerKn,
-                    e.predicted_n / kNPerKn, e.residual_sigma, e.held_out ? " (held out)" : "");
-    }
-    s << buf;
-  }
-  if (list.size() > kShown) {
-    s << indent << "... " << list.size() - kShown << " more " << (summary_written ? "" : "listed ")
-      << SummaryPlace(summary_written, "outliers") << "\n";
-  }
-  return s.str();
-}
-
 std::string GrossErrorLines(const CalibrationResult& result) {
   const GrossErrorSummary& g = result.gross_error_summary;
   if (!g.enabled) return "  gross errors: not screened (gross_errors.detect: false)\n";
@@ -1003,84 +666,7 @@ std::string CalibrationConsole(const CalibrationResult& result, const Dataset& d
   return s.str();
 }
 
-// Writes `files` and the report files into --out as one directory (built as a hidden
-// sibling and renamed into place). False, with the error printed, on failure.
-// `more` (may be null) writes further files into the directory being built.
-// `more` writes further files into the directory; with `more_beside_report` it runs on
-// its own thread while the report is rendered (both only read their inputs: calibrate's
-// residuals.csv, ~1 s each at 10^6 samples).
-bool WriteOutDirectory(const char* command,
-                       const std::vector<std::pair<std::string, std::string>>& files,
-                       const ReportInputs& report, const std::vector<std::string>& outputs,
-                       const std::function<bool(const std::string&, std::string*)>& more = nullptr,
-                       bool more_beside_report = false) {
-  std::string error;
-  const auto write = [&](const std::string& dir, std::string* why) {
-    if (!more) return WriteReportFiles(dir, report, why);
-    if (!more_beside_report) return WriteReportFiles(dir, report, why) && more(dir, why);
-    std::string more_why;
-    std::future<bool> extra = AsyncOrDeferred([&] { return more(dir, &more_why); });
-    const bool reported = WriteReportFiles(dir, report, why);
-    const bool extra_written = extra.get();
-    if (reported && !extra_written) *why = more_why;
-    return reported && extra_written;
-  };
-  if (WriteDirectoryAtomically(FLAGS_out, files, write, FLAGS_force ? &outputs : nullptr, &error)) {
-    return true;
-  }
-  PrintError(command, error);
-  return false;
-}
-
-// A dataset beside `data_path` to check a calibrated model on: the first other .csv file
-// of its directory (by name) whose header is a dataset's; "" when there is none.
-std::string OtherDataset(const std::string& data_path) {
-  std::error_code ec;
-  const fs::path data = fs::path(data_path);
-  const fs::path dir = data.has_parent_path() ? data.parent_path() : fs::path(".");
-  std::vector<fs::path> candidates;
-  for (const auto& entry : fs::directory_iterator(dir, ec)) {
-    if (entry.path().extension() == ".csv" && entry.is_regular_file(ec) &&
-        !fs::equivalent(entry.path(), data, ec)) {
-      candidates.push_back(entry.path());
-    }
-  }
-  std::sort(candidates.begin(), candidates.end());
-  for (const fs::path& candidate : candidates) {
-    std::ifstream in(candidate);
-    std::string line;
-    while (std::getline(in, line) && (line.empty() || line[0] == '#')) {
-    }
-    if (line.find("T1_kN") != std::string::npos && line.find("x_m") != std::string::npos) {
-      return (data.has_parent_path() ? dir / candidate.filename() : candidate.filename()).string();
-    }
-  }
-  return "";
-}
-
 }  // namespace
-
-// The report's provenance, common to calibrate and evaluate: the input files (the spec's
-// only when there is one), their digests, the software, the command line and the time.
-ReportInputs ReportProvenance(int argc, char** argv, bool with_spec,
-                              const std::string* data_digest) {
-  ReportInputs report;
-  report.model_path = FLAGS_model;
-  report.data_path = FLAGS_data;
-  report.model_digest = Digest(FLAGS_model);
-  report.columns_path = FLAGS_columns;
-  report.columns_digest = ColumnsDigest();
-  report.data_digest = data_digest != nullptr ? *data_digest : DataDigest();
-  if (with_spec) {
-    report.spec_path = FLAGS_spec;
-    report.spec_digest = Digest(FLAGS_spec);
-  }
-  report.software_version = FASTCAL_VERSION;
-  report.command_line = CommandLine(argc, argv);
-  report.run_utc = UtcNow();
-  report.simulated_provenance = SimulatedProvenance();
-  return report;
-}
 
 // --skip-invalid-rows for calibrate: what must solve are the "initial model" rows of the
 // table (exact, every attitude the data has) and the fit's start, the spec's initial
@@ -1223,177 +809,6 @@ int RunCalibrate(int argc, char** argv) {
   std::cout << CalibrationConsole(result, data, result.variants) << std::flush;
   std::cerr << ChiSquareWarning(result);
   return 0;
-}
-
-// evaluate's gross errors: how many, the threshold and why, the first few by line and cable.
-std::string EvaluationGrossErrorLines(const EvaluationScreen& screen) {
-  std::ostringstream s;
-  const long long count = screen.count;
-  s << "gross errors (against \"" << screen.variant << "\"): " << count
-    << (count == 1 ? " reading" : " readings")
-    << (count > 0 ? ", left out of the rows \"... - gross errors\"" : "") << "\n"
-    << ThresholdLine("  ", screen.threshold);
-  const bool summary_written = !FLAGS_out.empty();
-  s << ReadingLines(screen.gross_errors, "  ", summary_written);
-  if (count > static_cast<long long>(screen.gross_errors.size())) {
-    s << "  (" << screen.gross_errors.size() << " of the " << count << " named "
-      << SummaryPlace(summary_written) << ": the first in file order)\n";
-  }
-  return s.str();
-}
-
-// evaluate's console: the RMS table, then per variant the RMS (%), mean and largest
-// error (kN) per cable, then the gross errors.
-std::string EvaluationConsole(const Dataset& data, long long samples, StaticsMethod method,
-                              const std::vector<VariantEvaluation>& variants,
-                              const EvaluationScreen& screen, const PaperCircleMatcher& positions) {
-  std::ostringstream s;
-  s << "fastcal evaluate: " << samples << " samples";
-  s << SkippedNote(data);
-  s << ", model " << internal::Escape(ModelName(FLAGS_model)) << ", method "
-    << StaticsMethodName(method) << "\n\n"
-    << RmsTable(variants) << PaperTable6Lines(positions, !SimulatedProvenance().empty());
-  for (const VariantEvaluation& v : variants) {
-    s << "\n" << CableHeader(v.name + ":");
-    s << CableRow("  RMS (%)", v.fit.rms_percent, 1.0);
-    s << CableRow("  mean (kN)", v.fit.mean_n, 1.0 / kNPerKn);
-    s << CableRow("  max |error| (kN)", v.fit.max_abs_n, 1.0 / kNPerKn);
-  }
-  s << "\n" << EvaluationGrossErrorLines(screen);
-  if (!FLAGS_out.empty())
-    s << "\nwrote " << FLAGS_out << "/{report.html, report.md, summary.json"
-      << (FLAGS_residuals_every > 0 ? ", residuals.csv" : "") << "}\n";
-  return s.str();
-}
-
-// residuals.csv of a streamed evaluation, written into `dir` a sample at a time (the
-// same bytes WriteResidualsFile gives for the same samples).
-bool WriteStreamedResiduals(const std::string& dir, const StreamedEvaluation& evaluation,
-                            std::string* error) {
-  constexpr size_t kFlushBytes = 1 << 20;
-  const std::string path = dir + "/residuals.csv";
-  std::FILE* file = std::fopen(path.c_str(), "wbx");
-  if (file == nullptr) {
-    *error = path + ": cannot create: " + std::strerror(errno);
-    return false;
-  }
-  const std::vector<VariantEvaluation>& variants = evaluation.variants();
-  std::vector<bool> predicted(variants.size(), false);
-  for (int v = 0; v < evaluation.predicted_variants(); ++v) predicted[v] = true;
-  std::string buffer = ResidualsHeader(variants, predicted, evaluation.samples());
-  const long long every = std::max(1, FLAGS_residuals_every);
-  bool written = true;
-  std::vector<const std::array<double, kNumCables>*> row_predicted;
-  const bool read = evaluation.ForEach(
-      [&](const EvaluatedSample& s) {
-        if (s.index % every != 0) return;
-        row_predicted.clear();
-        for (const auto& p : s.predicted_n) row_predicted.push_back(&p);
-        AppendResidualsRow(s.line, s.time_s, false, &s.gross, s.measured_n, row_predicted, &buffer);
-        if (buffer.size() < kFlushBytes) return;
-        written = written && std::fwrite(buffer.data(), 1, buffer.size(), file) == buffer.size();
-        buffer.clear();
-      },
-      error);
-  written = written && std::fwrite(buffer.data(), 1, buffer.size(), file) == buffer.size() &&
-            std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
-  const bool closed = std::fclose(file) == 0;
-  if (!read) return false;
-  if (!written || !closed) {
-    *error = path + ": cannot write: " + std::strerror(errno);
-    return false;
-  }
-  return true;
-}
-
-// evaluate: the data read, predicted and screened a chunk at a time (evaluation_stream.h),
-// so that memory does not grow with the number of samples.
-int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
-                        const std::vector<std::string>& paths, StaticsMethod method) {
-  const char* command = "evaluate";
-  std::string error;
-  EvaluationStreamOptions options;
-  options.method = method;
-  options.read.skip_invalid_rows = FLAGS_skip_invalid_rows;
-  options.read.threads = kReadThreads;
-  SetJointColumns(model.moving_parts, &options.read);
-  if (!ColumnsFromFlag(&options.read.columns, &error)) {
-    PrintError(command, error);
-    return kExitUsage;
-  }
-  StreamedEvaluation evaluation;
-  const EvaluationStreamStatus status = evaluation.Run(model, paths, options, &error);
-  if (status == EvaluationStreamStatus::kInvalidInput ||
-      status == EvaluationStreamStatus::kSystemError) {
-    PrintError(command, error);
-    // A full disk is a failure of the machine, not bad input.
-    return status == EvaluationStreamStatus::kSystemError ? kExitFailure : kExitUsage;
-  }
-  if (const std::string blame = BlameText(evaluation.diagnosis(), "the model"); !blame.empty()) {
-    PrintError(command, blame);
-    return kExitFailure;
-  }
-  if (status == EvaluationStreamStatus::kUnsolvable) {
-    PrintError(command, error + SkipHint());
-    return kExitFailure;
-  }
-  const Dataset& data = evaluation.layout();
-  if (!ReportSkipped(command, data, evaluation.samples(), &error)) {
-    PrintError(command, error);
-    return kExitFailure;
-  }
-  if (!FLAGS_out.empty()) {
-    ReportInputs report = ReportProvenance(argc, argv, /*with_spec=*/false, nullptr);
-    report.initial_model = &model;
-    report.data = &data;
-    report.variants = evaluation.variants();
-    report.evaluation_method = StaticsMethodName(method);
-    report.evaluation_screen = &evaluation.screen();
-    const ReportSampleStream samples = ReportSamplesOf(evaluation);
-    report.sample_stream = &samples;
-    const auto residuals = [&evaluation](const std::string& dir, std::string* why) {
-      return FLAGS_residuals_every <= 0 || WriteStreamedResiduals(dir, evaluation, why);
-    };
-    // The output was checked before the work: a failure now is the machine's (a full
-    // disk), not the input's.
-    if (!WriteOutDirectory(command, {}, report, kEvaluateOutputs, residuals)) return kExitFailure;
-  }
-  PaperCircleMatcher positions;
-  if (!evaluation.ForEach([&positions](const EvaluatedSample& s) { positions.Add(s.position_m); },
-                          &error)) {
-    PrintError(command, error);
-    return kExitFailure;
-  }
-  std::cout << EvaluationConsole(data, evaluation.samples(), method, evaluation.variants(),
-                                 evaluation.screen(), positions);
-  return 0;
-}
-
-int RunEvaluate(int argc, char** argv) {
-  const char* command = "evaluate";
-  int exit_code = 0;
-  if (!StartCommand(argc, argv, command, kEvaluateHelp,
-                    {"model", "data", "out", "method", "skip-invalid-rows", "force",
-                     "residuals-every", "columns"},
-                    &exit_code)) {
-    return exit_code;
-  }
-  std::string error;
-  StaticsMethod method = StaticsMethod::kExact;
-  if (FlagGiven("method") && !ParseStaticsMethod(FLAGS_method, &method)) {
-    PrintError(command,
-               "--method must be aas, aas-refined or exact, got " + internal::Quote(FLAGS_method));
-    return kExitUsage;
-  }
-  CableRobot model;
-  std::vector<std::string> paths;
-  if (!CheckResidualsEvery(&error) ||
-      (!FLAGS_out.empty() && !CheckOutFlag(kEvaluateOutputs, &error)) ||
-      !LoadModelAndDataPaths(&model, &paths, &error)) {
-    PrintError(command, error);
-    return kExitUsage;
-  }
-  return RunEvaluateStreamed(argc, argv, model, paths, method);
 }
 
 }  // namespace fastcal::cli

@@ -7,6 +7,8 @@
 #include "fastcal/wind.h"
 
 // First calibrate's.
+DEFINE_int32(residuals_every, 1,
+             "calibrate, evaluate: residuals.csv keeps every K-th sample (1: all; 0: no file).");
 DEFINE_string(spec, "", "calibrate: calibration spec YAML (docs/calibration.md).");
 DEFINE_string(data, "",
               "Measurement CSV (docs/data-format.md); several, comma-separated, are one "

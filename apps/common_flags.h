@@ -43,6 +43,7 @@ DECLARE_bool(quiet);
 DECLARE_double(radial_spread);
 DECLARE_double(radius);
 DECLARE_double(reflector_clearance);
+DECLARE_int32(residuals_every);
 DECLARE_string(rpy);
 DECLARE_int32(samples);
 DECLARE_uint64(seed);
