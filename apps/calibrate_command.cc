@@ -2,12 +2,10 @@
 // shares with evaluate: calibrate_common.h). Outputs go to a temporary directory that is
 // renamed into place only when everything has been written.
 #include <gflags/gflags.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
-#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -33,10 +31,8 @@
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
-#include "fastcal/evaluation_stream.h"
 #include "fastcal/file_digest.h"
 #include "fastcal/internal/atomic_file.h"
-#include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/internal/report_document.h"
 #include "fastcal/internal/sample_chunks.h"

@@ -1,48 +1,24 @@
 // What calibrate and evaluate share (calibrate_common.h).
 #include "calibrate_common.h"
 
-#include <gflags/gflags.h>
-#include <sys/stat.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <future>
-#include <iostream>
-#include <limits>
-#include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "cli_util.h"
 #include "columns_flag.h"
-#include "commands.h"
 #include "common_flags.h"
-#include "fastcal/cable_robot.h"
-#include "fastcal/calibration.h"
-#include "fastcal/calibration_spec.h"
-#include "fastcal/change_scan.h"
-#include "fastcal/dataset.h"
-#include "fastcal/evaluation.h"
-#include "fastcal/evaluation_screen.h"
-#include "fastcal/evaluation_stream.h"
 #include "fastcal/file_digest.h"
-#include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/quote.h"
-#include "fastcal/internal/report_document.h"
-#include "fastcal/internal/sample_chunks.h"
-#include "fastcal/report.h"
-#include "fastcal/sessions.h"
-#include "fastcal/trajectory.h"
-#include "fastcal/unsolvable_rows.h"
 #include "fastcal/version.h"
 
 namespace fastcal::cli {

@@ -2,24 +2,17 @@
 // (evaluation_stream.h), with the report (calibrate_common.h for what it shares with
 // calibrate).
 #include <gflags/gflags.h>
-#include <sys/stat.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
-#include <charconv>
-#include <chrono>
-#include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
-#include <fstream>
-#include <functional>
-#include <future>
 #include <iostream>
-#include <limits>
-#include <map>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "calibrate_common.h"
 #include "cli_util.h"
@@ -27,24 +20,15 @@
 #include "commands.h"
 #include "common_flags.h"
 #include "fastcal/cable_robot.h"
-#include "fastcal/calibration.h"
-#include "fastcal/calibration_spec.h"
-#include "fastcal/change_scan.h"
 #include "fastcal/dataset.h"
 #include "fastcal/evaluation.h"
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/evaluation_stream.h"
-#include "fastcal/file_digest.h"
-#include "fastcal/internal/atomic_file.h"
-#include "fastcal/internal/paper_reference.h"
 #include "fastcal/internal/quote.h"
-#include "fastcal/internal/report_document.h"
-#include "fastcal/internal/sample_chunks.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/report.h"
-#include "fastcal/sessions.h"
+#include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
-#include "fastcal/unsolvable_rows.h"
-#include "fastcal/version.h"
 
 namespace fastcal::cli {
 namespace {
