@@ -165,65 +165,6 @@ const std::vector<std::string> kCalibrateOutputs = {
     "model_calibrated.yaml", "model_calibrated@*.yaml", "report.html", "report.md", "summary.json",
     "residuals.csv"};
 
-// calibrate's residuals.csv, one row per sample (one in --residuals-every): measured and
-// each variant's predicted tensions, the held_out flag and the gross errors
-// (`excluded`). Written into `dir` a batch of rows at a time, the rows of a batch
-// formatted on `threads` threads and written in file order: memory independent of the
-// number of samples (the whole file was one ~300 MB string at 10^6 samples).
-bool WriteResidualsFile(const std::string& dir, const Dataset& data,
-                        const std::vector<VariantEvaluation>& variants,
-                        const std::vector<bool>& held_out, const ReadingMask& excluded, int threads,
-                        std::string* error) {
-  constexpr int kChunkRows = 2048, kBatchChunks = 16;
-  const std::string path = dir + "/residuals.csv";
-  std::FILE* file = std::fopen(path.c_str(), "wbx");
-  if (file == nullptr) {
-    *error = path + ": cannot create: " + std::strerror(errno);
-    return false;
-  }
-  const size_t every = static_cast<size_t>(std::max(1, FLAGS_residuals_every));
-  std::vector<bool> predicted;
-  for (const VariantEvaluation& v : variants) predicted.push_back(!v.predicted_n.empty());
-  const std::string header = ResidualsHeader(variants, predicted, data.samples.size());
-  bool written = std::fwrite(header.data(), 1, header.size(), file) == header.size();
-  const long long rows = static_cast<long long>((data.samples.size() + every - 1) / every);
-  std::vector<std::string> texts(kBatchChunks);
-  for (long long first = 0; written && first < rows; first += kChunkRows * kBatchChunks) {
-    const int batch_rows =
-        static_cast<int>(std::min<long long>(kChunkRows * kBatchChunks, rows - first));
-    internal::ForEachChunk(
-        batch_rows, threads,
-        [&](int begin, int end) {
-          std::string& text = texts[begin / kChunkRows];
-          text.clear();
-          std::vector<const std::array<double, kNumCables>*> row_predicted;
-          for (int k = begin; k < end; ++k) {
-            const size_t n = static_cast<size_t>(first + k) * every;
-            row_predicted.clear();
-            for (const VariantEvaluation& v : variants) {
-              if (!v.predicted_n.empty()) row_predicted.push_back(&v.predicted_n[n]);
-            }
-            const Sample& s = data.samples[n];
-            AppendResidualsRow(s.line, s.time_s, !held_out.empty() && held_out[n],
-                               n < excluded.size() ? &excluded[n] : nullptr, s.tension_n,
-                               row_predicted, &text);
-          }
-          return -1;
-        },
-        kChunkRows);
-    for (int c = 0; written && c * kChunkRows < batch_rows; ++c) {
-      written = std::fwrite(texts[c].data(), 1, texts[c].size(), file) == texts[c].size();
-    }
-  }
-  written = written && std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
-  const bool closed = std::fclose(file) == 0;
-  if (!written || !closed) {
-    *error = path + ": cannot write: " + std::strerror(errno);
-    return false;
-  }
-  return true;
-}
-
 // With lengths in the fit: their RMS per cable before and after (mm), else "".
 std::string LengthTable(const LengthEvaluation& l) {
   if (!l.used) return "";
@@ -713,7 +654,7 @@ bool WriteCalibrationOutputs(int argc, char** argv, const CableRobot& model,
       [&](const std::string& dir, std::string* why) {
         return FLAGS_residuals_every <= 0 ||
                WriteResidualsFile(dir, data, variants, result.held_out, result.excluded,
-                                  spec.num_threads, why);
+                                  FLAGS_residuals_every, spec.num_threads, why);
       },
       /*more_beside_report=*/true);
   calibration->variants = std::move(report.variants);

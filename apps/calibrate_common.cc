@@ -30,19 +30,6 @@ namespace fs = std::filesystem;
 // column, then T1..T6, so that every row lines up under its header.
 constexpr int kLabelWidth = 40;
 
-// Appends FormatDouble(value) (10 significant digits, printf's %.10g, no "-0"): by
-// to_chars, several times faster than snprintf, which counts at 10^6 rows of 27 numbers.
-void AppendNumber(double value, std::string* out) {
-  if (value == 0.0) {
-    *out += '0';
-    return;
-  }
-  char buf[48];
-  const std::to_chars_result r =
-      std::to_chars(buf, buf + sizeof(buf), value, std::chars_format::general, 10);
-  out->append(buf, r.ptr);
-}
-
 std::string Digest(const std::string& path) {
   std::string hex, error;
   return !path.empty() && FileSha256(path, &hex, &error) ? hex : "";
@@ -69,63 +56,6 @@ bool CheckResidualsEvery(std::string* error) {
 // CheckOutputDirectory for --out, with --force: `outputs` may be replaced.
 bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error) {
   return CheckOutputDirectory("out", FLAGS_out, error, FLAGS_force ? &outputs : nullptr);
-}
-
-// residuals.csv's comment lines and column line: `variants` are the RMS table's rows, of
-// which those with predictions (`predicted[v]`) get columns; `samples` how many the file
-// is one in K of.
-std::string ResidualsHeader(const std::vector<VariantEvaluation>& variants,
-                            const std::vector<bool>& predicted, size_t samples) {
-  const size_t every = static_cast<size_t>(std::max(1, FLAGS_residuals_every));
-  std::ostringstream head;
-  for (size_t v = 0; v < variants.size(); ++v) {
-    if (predicted[v]) head << "# v" << v + 1 << " = " << variants[v].name << "\n";
-  }
-  head << "# model minus measured is <variant>_T<i>_kN - T<i>_kN\n";
-  if (every > 1) {
-    head << "# one sample in " << every << " of the " << samples << " (--residuals-every=" << every
-         << "), from the first\n";
-  }
-  head << "line,time_s,held_out,gross_error_cables";
-  for (int i = 1; i <= kNumCables; ++i) head << ",T" << i << "_kN";
-  for (size_t v = 0; v < variants.size(); ++v) {
-    if (!predicted[v]) continue;
-    for (int i = 1; i <= kNumCables; ++i) head << ",v" << v + 1 << "_T" << i << "_kN";
-  }
-  head << "\n";
-  return head.str();
-}
-
-// One row of residuals.csv: the sample's line and time, whether it was held out, the
-// cables whose reading was a gross error ("3", "1 4"; empty for none), the measured and
-// each drawn variant's predicted tensions.
-void AppendResidualsRow(int line, double time_s, bool held_out,
-                        const std::array<bool, kNumCables>* gross,
-                        const std::array<double, kNumCables>& measured_n,
-                        const std::vector<const std::array<double, kNumCables>*>& predicted_n,
-                        std::string* out) {
-  *out += std::to_string(line);
-  *out += ',';
-  AppendNumber(time_s, out);
-  *out += held_out ? ",1," : ",0,";
-  bool first = true;
-  for (int i = 0; gross != nullptr && i < kNumCables; ++i) {
-    if (!(*gross)[i]) continue;
-    if (!first) *out += ' ';
-    *out += static_cast<char>('1' + i);
-    first = false;
-  }
-  for (double t : measured_n) {
-    *out += ',';
-    AppendNumber(t / kNPerKn, out);
-  }
-  for (const std::array<double, kNumCables>* p : predicted_n) {
-    for (double t : *p) {
-      *out += ',';
-      AppendNumber(t / kNPerKn, out);
-    }
-  }
-  *out += '\n';
 }
 
 std::string CableHeader(const std::string& title, const char* prefix) {

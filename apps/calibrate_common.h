@@ -17,6 +17,7 @@
 #include "fastcal/evaluation_screen.h"
 #include "fastcal/internal/paper_reference.h"
 #include "fastcal/report.h"
+#include "fastcal/residuals_csv.h"
 #include "fastcal/trajectory.h"
 #include "fastcal/unsolvable_rows.h"
 
@@ -27,13 +28,6 @@ inline constexpr int kReadThreads = 2;
 
 bool CheckResidualsEvery(std::string* error);
 bool CheckOutFlag(const std::vector<std::string>& outputs, std::string* error);
-std::string ResidualsHeader(const std::vector<VariantEvaluation>& variants,
-                            const std::vector<bool>& predicted, size_t samples);
-void AppendResidualsRow(int line, double time_s, bool held_out,
-                        const std::array<bool, kNumCables>* gross,
-                        const std::array<double, kNumCables>& measured_n,
-                        const std::vector<const std::array<double, kNumCables>*>& predicted_n,
-                        std::string* out);
 std::string CableHeader(const std::string& title, const char* prefix = "T");
 std::string CableRow(const std::string& label, const std::array<double, kNumCables>& values,
                      double scale);

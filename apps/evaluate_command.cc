@@ -108,46 +108,6 @@ std::string EvaluationConsole(const Dataset& data, long long samples, StaticsMet
   return s.str();
 }
 
-// residuals.csv of a streamed evaluation, written into `dir` a sample at a time (the
-// same bytes WriteResidualsFile gives for the same samples).
-bool WriteStreamedResiduals(const std::string& dir, const StreamedEvaluation& evaluation,
-                            std::string* error) {
-  constexpr size_t kFlushBytes = 1 << 20;
-  const std::string path = dir + "/residuals.csv";
-  std::FILE* file = std::fopen(path.c_str(), "wbx");
-  if (file == nullptr) {
-    *error = path + ": cannot create: " + std::strerror(errno);
-    return false;
-  }
-  const std::vector<VariantEvaluation>& variants = evaluation.variants();
-  std::vector<bool> predicted(variants.size(), false);
-  for (int v = 0; v < evaluation.predicted_variants(); ++v) predicted[v] = true;
-  std::string buffer = ResidualsHeader(variants, predicted, evaluation.samples());
-  const long long every = std::max(1, FLAGS_residuals_every);
-  bool written = true;
-  std::vector<const std::array<double, kNumCables>*> row_predicted;
-  const bool read = evaluation.ForEach(
-      [&](const EvaluatedSample& s) {
-        if (s.index % every != 0) return;
-        row_predicted.clear();
-        for (const auto& p : s.predicted_n) row_predicted.push_back(&p);
-        AppendResidualsRow(s.line, s.time_s, false, &s.gross, s.measured_n, row_predicted, &buffer);
-        if (buffer.size() < kFlushBytes) return;
-        written = written && std::fwrite(buffer.data(), 1, buffer.size(), file) == buffer.size();
-        buffer.clear();
-      },
-      error);
-  written = written && std::fwrite(buffer.data(), 1, buffer.size(), file) == buffer.size() &&
-            std::fflush(file) == 0 && ::fsync(::fileno(file)) == 0;
-  const bool closed = std::fclose(file) == 0;
-  if (!read) return false;
-  if (!written || !closed) {
-    *error = path + ": cannot write: " + std::strerror(errno);
-    return false;
-  }
-  return true;
-}
-
 // evaluate: the data read, predicted and screened a chunk at a time (evaluation_stream.h),
 // so that memory does not grow with the number of samples.
 int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
@@ -194,7 +154,8 @@ int RunEvaluateStreamed(int argc, char** argv, const CableRobot& model,
     const ReportSampleStream samples = ReportSamplesOf(evaluation);
     report.sample_stream = &samples;
     const auto residuals = [&evaluation](const std::string& dir, std::string* why) {
-      return FLAGS_residuals_every <= 0 || WriteStreamedResiduals(dir, evaluation, why);
+      return FLAGS_residuals_every <= 0 ||
+             WriteStreamedResiduals(dir, evaluation, FLAGS_residuals_every, why);
     };
     // The output was checked before the work: a failure now is the machine's (a full
     // disk), not the input's.
