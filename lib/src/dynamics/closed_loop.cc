@@ -77,6 +77,17 @@ void MoveWinches(const LoopOptions& o, const std::array<double, kNumCables>& wan
   }
 }
 
+// The path's clock at time t, with a minimum-jerk ease-in and ease-out of ramp_s around a
+// path of `length_s` at full speed (closed_loop.h).
+double PathClock(double t, double ramp_s, double length_s) {
+  if (!(ramp_s > 0.0)) return t;
+  const auto in = [](double u) { return u * u * u * u * (2.5 - 3.0 * u + u * u); };
+  if (t < ramp_s) return ramp_s * in(std::max(0.0, t / ramp_s));
+  if (t <= length_s) return t - 0.5 * ramp_s;
+  const double u = std::min(1.0, (t - length_s) / ramp_s);
+  return length_s - 0.5 * ramp_s + ramp_s * (u - in(u));
+}
+
 // The sample at the cycle's time: the cabin against the command.
 LoopSample Sample(double time_s, const CableDynamics& plant, const Pose& command,
                   const Eigen::Vector3d& measured, const ControlCycleResult& plan,
@@ -224,17 +235,6 @@ bool LoopSpec::IsValid(std::string* error) const {
     return false;
   }
   return true;
-}
-
-// The path's clock at time t, with a minimum-jerk ease-in and ease-out of ramp_s around a
-// path of `length_s` at full speed (closed_loop.h).
-static double PathClock(double t, double ramp_s, double length_s) {
-  if (!(ramp_s > 0.0)) return t;
-  const auto in = [](double u) { return u * u * u * u * (2.5 - 3.0 * u + u * u); };
-  if (t < ramp_s) return ramp_s * in(std::max(0.0, t / ramp_s));
-  if (t <= length_s) return t - 0.5 * ramp_s;
-  const double u = std::min(1.0, (t - length_s) / ramp_s);
-  return length_s - 0.5 * ramp_s + ramp_s * (u - in(u));
 }
 
 double LoopSpec::DurationS() const {
