@@ -21,6 +21,8 @@
 #include "fastcal/track.h"
 
 DEFINE_string(window, "1d", "track: window length (1d, 12h, 30m, 3600s) or 'file'.");
+DEFINE_string(window_origin, "",
+              "track: where the windows' boundaries fall, HH:MM with a zone (12:00+08:00).");
 DEFINE_int32(threads, 2, "track: windows folded at once.");
 DEFINE_bool(refold, false, "track: on an update, refold every window at the new point.");
 DEFINE_bool(keep_overlapping, false,
@@ -61,6 +63,9 @@ Usage:
   --window=1d         windows: a calendar day in UTC (1d), another duration aligned to
                       1970-01-01T00:00Z (12h, 30m, 3600s, 7d, at most 366d), or 'file' (one
                       per file)
+  --window-origin=HH:MM+ZZ:ZZ  the windows' boundaries at this time of day on that clock
+                      (12:00+08:00: local noon in Beijing, a night's observing one window;
+                      labels are then dates on that clock); an update must keep it
   --model=FILE        starting model (docs/model-format.md); default the nominal FAST model
   --columns=MAP.yaml  read every data file as exported, through a column map (ISO 8601
                       times, units, delimiters: docs/data-format.md, "Column maps"); an
@@ -282,9 +287,9 @@ std::string Summary(const TrackResult& r, const std::string& out) {
 int RunTrack(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp,
-                    {"model", "spec", "data", "out", "window", "threads", "refold", "force",
-                     "keep-overlapping", "quiet", "skip-invalid-rows", "min-window-samples",
-                     "false-alarm", "columns"},
+                    {"model", "spec", "data", "out", "window", "window-origin", "threads", "refold",
+                     "force", "keep-overlapping", "quiet", "skip-invalid-rows",
+                     "min-window-samples", "false-alarm", "columns"},
                     &exit_code)) {
     return exit_code;
   }
@@ -297,7 +302,14 @@ int RunTrack(int argc, char** argv) {
   if (FLAGS_data.empty()) return usage("--data=DIR_OR_FILES is required");
   if (FLAGS_out.empty()) return usage("--out=DIR is required");
   WindowSpec window;
-  if (!ParseWindowSpec(FLAGS_window, &window, &error)) return usage("--" + error);
+  std::string window_text = FLAGS_window;
+  if (!FLAGS_window_origin.empty()) {
+    if (window_text.find('@') != std::string::npos) {
+      return usage("--window-origin: --window=" + FLAGS_window + " already has an origin");
+    }
+    window_text += "@" + FLAGS_window_origin;
+  }
+  if (!ParseWindowSpec(window_text, &window, &error)) return usage("--" + error);
   CableRobot model;
   if (!LoadModelFlag("model", FLAGS_model, &model, &error)) return usage(error);
   CalibrationSpec spec;

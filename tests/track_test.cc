@@ -148,6 +148,46 @@ TEST(TrackWindowTest, WindowFlags) {
   }
 }
 
+// Issue 59: windows cut at a time of day on a clock ("@12:00+08:00": local noon in
+// Beijing, 04:00 UTC), written back as they were given; bad origins refused by name.
+TEST(TrackWindowTest, AnOriginMovesTheBoundaries) {
+  WindowSpec w;
+  std::string error;
+  ASSERT_TRUE(ParseWindowSpec("1d@12:00+08:00", &w, &error)) << error;
+  EXPECT_EQ(w.origin_s, 4.0 * 3600.0);
+  EXPECT_EQ(w.label_offset_s, 8 * 3600);
+  EXPECT_EQ(WindowSpecText(w), "1d@12:00+08:00");
+  ASSERT_TRUE(ParseWindowSpec("12h@06:00-0500", &w, &error)) << error;
+  EXPECT_EQ(w.origin_s, 11.0 * 3600.0 - 43200.0 * std::floor(11.0 / 12.0));
+  EXPECT_EQ(WindowSpecText(w), "12h@06:00-05:00");
+  ASSERT_TRUE(ParseWindowSpec("1d@00:00Z", &w, &error)) << error;
+  EXPECT_EQ(w.origin_s, 0.0);
+  EXPECT_EQ(WindowSpecText(w), "1d@00:00Z");
+  for (const char* bad :
+       {"1d@25:00", "1d@12:00+8", "1d@12:00+15:00", "1d@1200", "file@12:00", "1d@12:00UTC"}) {
+    EXPECT_FALSE(ParseWindowSpec(bad, &w, &error)) << bad;
+    EXPECT_NE(error.find(bad), std::string::npos) << error;
+  }
+  // A season cut there: every window starts at 04:00 UTC, labelled by its date in UTC+8.
+  ASSERT_TRUE(ParseWindowSpec("1d@12:00+08:00", &w, &error));
+  CableRobot truth;
+  const Dataset data = Season(3, 120, 7, SimulationOptions(), &truth);
+  const std::string dir = TempDir("origin");
+  fs::create_directories(dir);
+  TrackResult r;
+  ASSERT_EQ(
+      RunTrack(CableRobot::NominalFast(),
+               LoadSpec(Spec("{sigma_percent: estimate, time_constant_s: estimate}")),
+               {Write(data, dir + "/season.csv")}, w, dir + "/track", TrackOptions(), &r, &error),
+      TrackStatus::kOk)
+      << error;
+  ASSERT_EQ(r.windows.size(), 3u);
+  for (const TrackWindow& window : r.windows) {
+    EXPECT_EQ(std::fmod(window.start_s, kDayS), 4.0 * 3600.0) << window.label;
+    EXPECT_EQ(window.label, FormatUnixTime(window.start_s, 8 * 3600).substr(0, 10));
+  }
+}
+
 TEST(TrackChiSquareTest, TailAndQuantileAgainstTables) {
   // Tabulated 5% and 1% points (Abramowitz and Stegun, table 26.8).
   EXPECT_NEAR(internal::ChiSquareTailProbability(3.841459, 1), 0.05, 1e-6);

@@ -77,10 +77,19 @@ struct WindowSpec {
   // >= 1e8) aligned to 1970-01-01T00:00:00Z, so "1d" is a calendar day in UTC. A whole
   // number of seconds, from 1 to kMaxWindowS.
   double duration_s = 86400.0;
+  // The windows' boundaries moved from the epoch's alignment by origin_s (s, in [0,
+  // duration_s)): with "@12:00+08:00" they fall at local noon in UTC+8 (04:00 UTC), so
+  // that a night's observing in Beijing is one day's window (issue 59). The labels are
+  // then the window start's date (and time) on that clock, label_offset_s east of UTC.
+  double origin_s = 0.0;
+  int label_offset_s = 0;
+  bool has_origin = false;
   bool IsValid(std::string* error) const;
 };
 
-// "1d" (the default), "12h", "30m", "3600s", "7d"; "file": one window per file.
+// "1d" (the default), "12h", "30m", "3600s", "7d", each optionally "@HH:MM" with a zone
+// ("@12:00+08:00", "@00:00Z"; none: UTC) where its boundaries fall; "file": one window per
+// file.
 bool ParseWindowSpec(const std::string& text, WindowSpec* window, std::string* error);
 std::string WindowSpecText(const WindowSpec& window);
 
@@ -108,8 +117,8 @@ struct TrackOptions {
   // How the data files are read (DatasetReadOptions: skip_invalid_rows, limits, a
   // column map). skip_invalid_rows also leaves out the samples the initial model cannot
   // solve (as calibrate's), named in the notes; without it such a sample stops the run
-  // naming its file, line and why. Each file is streamed a chunk at a time into the window store, so that
-  // a season in one long file is read with bounded memory: files up to 1 TiB (not
+  // naming its file, line and why. Each file is streamed a chunk at a time into the window store,
+  // so that a season in one long file is read with bounded memory: files up to 1 TiB (not
   // ReadDataset's 1 GiB).
   DatasetReadOptions read = [] {
     DatasetReadOptions r;

@@ -140,11 +140,18 @@ std::string TrackTimeText(double time_s, int offset_s) {
 
 std::string WindowLabel(const WindowSpec& window, double start_s) {
   if (!IsUnixTime(start_s)) return "t" + FormatDouble("%.0f", start_s);
-  const std::string text = FormatUnixTime(start_s, 0);  // "2024-05-01 06:00:00"
+  // "2024-05-01 06:00:00", on the origin's clock.
+  const std::string text = FormatUnixTime(start_s, window.label_offset_s);
   if (std::fmod(window.duration_s, kSecondsPerDay) == 0.0) return text.substr(0, 10);
   std::string label = text.substr(0, 10) + "T" + text.substr(11, 2) + text.substr(14, 2);
   if (text.substr(17, 2) != "00") label += text.substr(17, 2);
-  return label + "Z";
+  if (window.label_offset_s == 0) return label + "Z";
+  // "+0800": no ':' in a label (it names files).
+  const int minutes = std::abs(window.label_offset_s) / 60;
+  char zone[16];
+  std::snprintf(zone, sizeof(zone), "%c%02d%02d", window.label_offset_s < 0 ? '-' : '+',
+                minutes / 60, minutes % 60);
+  return label + zone;
 }
 
 }  // namespace internal
@@ -162,8 +169,52 @@ bool WindowSpec::IsValid(std::string* error) const {
   return false;
 }
 
-bool ParseWindowSpec(const std::string& text, WindowSpec* window, std::string* error) {
+namespace {
+
+// "HH:MM" with a zone ("Z", "+08:00", "-0530"; none: UTC) into the boundary's offset from
+// the epoch's alignment of windows of duration d, and the zone's offset. False for
+// anything else.
+bool ParseWindowOrigin(const std::string& text, double d, double* origin_s, int* zone_s) {
+  // Two digits of `s` at `at`.
+  const auto two = [](const std::string& s, size_t at, int* value) {
+    if (at + 2 > s.size() || !std::isdigit(static_cast<unsigned char>(s[at])) ||
+        !std::isdigit(static_cast<unsigned char>(s[at + 1]))) {
+      return false;
+    }
+    *value = (s[at] - '0') * 10 + (s[at + 1] - '0');
+    return true;
+  };
+  int hours = 0, minutes = 0;
+  if (!two(text, 0, &hours) || text.size() < 5 || text[2] != ':' || !two(text, 3, &minutes) ||
+      hours > 23 || minutes > 59) {
+    return false;
+  }
+  std::string zone = text.substr(5);
+  *zone_s = 0;
+  if (!zone.empty() && zone != "Z") {
+    if (zone.size() == 6 && zone[3] == ':') zone.erase(3, 1);  // "+08:00" -> "+0800"
+    int zh = 0, zm = 0;
+    if (zone.size() != 5 || (zone[0] != '+' && zone[0] != '-') || !two(zone, 1, &zh) ||
+        !two(zone, 3, &zm) || zh > 14 || zm > 59) {
+      return false;
+    }
+    *zone_s = (zone[0] == '-' ? -1 : 1) * (zh * 3600 + zm * 60);
+  }
+  const double local_s = hours * 3600.0 + minutes * 60.0 - *zone_s;
+  *origin_s = local_s - d * std::floor(local_s / d);
+  return true;
+}
+
+}  // namespace
+
+bool ParseWindowSpec(const std::string& text_in, WindowSpec* window, std::string* error) {
   WindowSpec w;
+  const size_t at = text_in.find('@');
+  const std::string text = text_in.substr(0, at);
+  if (at != std::string::npos && text == "file") {
+    *error = "window '" + text_in + "': a window per file has no origin ('@')";
+    return false;
+  }
   if (text == "file") {
     w.kind = WindowSpec::Kind::kFile;
     *window = w;
@@ -190,8 +241,17 @@ bool ParseWindowSpec(const std::string& text, WindowSpec* window, std::string* e
   }
   w.duration_s = count * scale;
   if (std::string why; !w.IsValid(&why)) {
-    *error = "window '" + text + "': " + why;
+    *error = "window '" + text_in + "': " + why;
     return false;
+  }
+  if (at != std::string::npos) {
+    if (!ParseWindowOrigin(text_in.substr(at + 1), w.duration_s, &w.origin_s, &w.label_offset_s)) {
+      *error = "window '" + text_in +
+               "': the origin after '@' must be HH:MM with an optional zone (12:00+08:00, "
+               "00:00Z)";
+      return false;
+    }
+    w.has_origin = true;
   }
   *window = w;
   return true;
@@ -200,10 +260,24 @@ bool ParseWindowSpec(const std::string& text, WindowSpec* window, std::string* e
 std::string WindowSpecText(const WindowSpec& window) {
   if (window.kind == WindowSpec::Kind::kFile) return "file";
   const double d = window.duration_s;
-  if (std::fmod(d, 86400.0) == 0.0) return internal::FormatDouble("%.0fd", d / 86400.0);
-  if (std::fmod(d, 3600.0) == 0.0) return internal::FormatDouble("%.0fh", d / 3600.0);
-  if (std::fmod(d, 60.0) == 0.0) return internal::FormatDouble("%.0fm", d / 60.0);
-  return internal::FormatDouble("%.0fs", d);
+  std::string text = std::fmod(d, 86400.0) == 0.0  ? internal::FormatDouble("%.0fd", d / 86400.0)
+                     : std::fmod(d, 3600.0) == 0.0 ? internal::FormatDouble("%.0fh", d / 3600.0)
+                     : std::fmod(d, 60.0) == 0.0   ? internal::FormatDouble("%.0fm", d / 60.0)
+                                                   : internal::FormatDouble("%.0fs", d);
+  if (!window.has_origin) return text;
+  // The origin on its own clock: (origin + zone) within the day.
+  const double local = std::fmod(window.origin_s + window.label_offset_s + 86400.0 * 400, 86400.0);
+  const int minutes_of_day = static_cast<int>(std::lround(local / 60.0)) % 1440;
+  const int zone_minutes = std::abs(window.label_offset_s) / 60;
+  char buf[32];
+  if (window.label_offset_s == 0) {
+    std::snprintf(buf, sizeof(buf), "@%02d:%02dZ", minutes_of_day / 60, minutes_of_day % 60);
+  } else {
+    std::snprintf(buf, sizeof(buf), "@%02d:%02d%c%02d:%02d", minutes_of_day / 60,
+                  minutes_of_day % 60, window.label_offset_s < 0 ? '-' : '+', zone_minutes / 60,
+                  zone_minutes % 60);
+  }
+  return text + buf;
 }
 
 bool TrackOptions::IsValid(std::string* error) const {

@@ -498,7 +498,7 @@ std::string WindowsProblem(const TrackRun& run, const SavedState& s) {
       continue;
     }
     const double d = run.window.duration_s;
-    const double start_s = static_cast<double>(w.key) * d;
+    const double start_s = static_cast<double>(w.key) * d + run.window.origin_s;
     if (w.start_s != start_s || w.end_s != start_s + d ||
         w.label != WindowLabel(run.window, start_s) ||
         (w.samples > 0 && (w.first_s < w.start_s || w.last_s >= w.end_s))) {
@@ -651,13 +651,14 @@ bool Route(Router& router, const Sample& s, int file_index, const std::string& s
     w = router.WindowFor(file_index, s.time_s, s.time_s, stem);
   } else {
     const double d = run.window.duration_s;
-    const double k = std::floor(s.time_s / d);
+    const double o = run.window.origin_s;
+    const double k = std::floor((s.time_s - o) / d);
     // The label only for a new window (formatting it was 5% of reading a season).
     const auto known = router.window_of_key.find(static_cast<long long>(k));
     w = known != router.window_of_key.end()
             ? known->second
-            : router.WindowFor(static_cast<long long>(k), k * d, (k + 1.0) * d,
-                               WindowLabel(run.window, k * d));
+            : router.WindowFor(static_cast<long long>(k), k * d + o, (k + 1.0) * d + o,
+                               WindowLabel(run.window, k * d + o));
   }
   TrackWindowState& win = run.windows[w];
   win.first_s = std::min(win.first_s, s.time_s);
