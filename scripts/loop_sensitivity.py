@@ -43,39 +43,35 @@ def focal_position(zenith_deg, azimuth_deg):
                      300.0 - 160.0 * math.cos(z)])
 
 
+def cable_index(name):
+    """The 0-based cable of "name[i]..." (1-based in the name), or None for a common one."""
+    return int(name[name.index("[") + 1:name.index("]")]) - 1 if "[" in name else None
+
+
 def perturbed(model, name, step):
     """The model with parameter `name` moved by `step` (SI), or None when it does not move
     the lengths."""
     m = model.copy()
-    if name.startswith("mass_centre_m."):
-        c = np.array(m.mass_centre_m, dtype=float)
-        c["xyz".index(name[-1])] += step
-        m.mass_centre_m = c
-    elif name.startswith("linear_density_kg_per_m"):
-        d = np.array(m.linear_density_kg_per_m, dtype=float)
-        if "[" in name:
-            d[int(name[name.index("[") + 1:name.index("]")]) - 1] += step
+    # (the name's prefix, the model's attribute, the axis its last letter names)
+    fields = [("mass_centre_m.", "mass_centre_m", True), ("linear_density_kg_per_m",
+              "linear_density_kg_per_m", False), ("ea_n", "ea_n", False),
+              ("tower_offset_m[", "tower_top_m", True), ("length_offset_m", "length_offset_m",
+                                                          False)]
+    for prefix, attribute, axis in fields:
+        if not name.startswith(prefix):
+            continue
+        value = np.array(getattr(m, attribute), dtype=float)
+        cable = cable_index(name)
+        where = () if cable is None else (cable,)
+        if axis:
+            where = where + ("xyz".index(name[-1]),)
+        if where:
+            value[where] += step
         else:
-            d += step
-        m.linear_density_kg_per_m = d
-    elif name.startswith("ea_n"):
-        e = np.array(m.ea_n, dtype=float)
-        if "[" in name:
-            e[int(name[name.index("[") + 1:name.index("]")]) - 1] += step
-        else:
-            e += step
-        m.ea_n = e
-    elif name.startswith("tower_offset_m["):
-        t = np.array(m.tower_top_m, dtype=float)
-        t[int(name[name.index("[") + 1:name.index("]")]) - 1, "xyz".index(name[-1])] += step
-        m.tower_top_m = t
-    elif name.startswith("length_offset_m"):
-        o = np.array(m.length_offset_m, dtype=float)
-        o[int(name[name.index("[") + 1:name.index("]")]) - 1] += step
-        m.length_offset_m = o
-    else:
-        return None
-    return m
+            value += step
+        setattr(m, attribute, value)
+        return m
+    return None
 
 
 def displacement(plant, controller, position, quat):
