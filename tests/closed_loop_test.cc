@@ -173,6 +173,31 @@ TEST(ClosedLoop, TheDefaultLoopDoesNotRingUpTheModesInStillAir) {
   EXPECT_LT(TailRms(r, 300.0), kQuietRmsM) << TailRms(r, 300.0);
 }
 
+// The winches reach a cycle's lengths at the period's end, so the feed-forward solves the
+// command there: a straight 10 m path at 0.1 m/s is followed to the chains' own offset plus
+// ~1.6 mm. Solved for the cycle's own time (the cabin lagging by speed x period) the peak
+// was 9.0 mm, the offset plus 5.
+TEST(ClosedLoop, TheFeedForwardSolvesWhereTheWinchesArrive) {
+  LoopSpec spec;
+  spec.focal_law = FocalAttitudeLaw();
+  const Pose start = FocalSpherePose(20.0, 0.0);
+  for (int k = 0; k < 3; ++k) {
+    Pose p = start;
+    p.position_m.x() += 5.0 * k;
+    spec.path.push_back(p);
+    spec.path_time_s.push_back(50.0 * k);  // 0.1 m/s
+  }
+  spec.start = spec.path[0];
+  spec.path_ramp_s = 60.0;
+  spec.hold_s = 0.0;
+  LoopOptions feed_forward;
+  feed_forward.kp = feed_forward.ki_per_s = 0.0;
+  const LoopResult r = Loop(CableRobot::NominalFast(), spec, feed_forward);
+  constexpr double kFollowedM = 4e-3;  // beyond the chains' offset; measured 1.6 mm
+  EXPECT_LT(r.summary.error_peak_m, r.start.position_offset_m + kFollowedM)
+      << r.summary.error_peak_m << " against the chains' " << r.start.position_offset_m;
+}
+
 TEST(ClosedLoop, FeedEfficiencyLossIsGansFigure) {
   // 10 mm RMS at 3 GHz: 8.2% (the factor's calibration point).
   EXPECT_NEAR(FeedEfficiencyLoss(0.010, 3e9), 0.082, 1e-3);
