@@ -168,10 +168,11 @@ TEST(TrackWindowTest, AnOriginMovesTheBoundaries) {
     EXPECT_FALSE(ParseWindowSpec(bad, &w, &error)) << bad;
     EXPECT_NE(error.find(bad), std::string::npos) << error;
   }
-  // A season cut there: every window starts at 04:00 UTC, labelled by its date in UTC+8.
+  // A season cut there: nights of 9 h from 20:00 UTC cross 04:00 UTC, where the windows
+  // now start (labelled by their dates in UTC+8); every sample lies in its window.
   ASSERT_TRUE(ParseWindowSpec("1d@12:00+08:00", &w, &error));
   CableRobot truth;
-  const Dataset data = Season(3, 120, 7, SimulationOptions(), &truth);
+  const Dataset data = Season(2, 1620, 7, SimulationOptions(), &truth);
   const std::string dir = TempDir("origin");
   fs::create_directories(dir);
   TrackResult r;
@@ -181,9 +182,11 @@ TEST(TrackWindowTest, AnOriginMovesTheBoundaries) {
                {Write(data, dir + "/season.csv")}, w, dir + "/track", TrackOptions(), &r, &error),
       TrackStatus::kOk)
       << error;
-  ASSERT_EQ(r.windows.size(), 3u);
+  ASSERT_EQ(r.windows.size(), 3u);  // 20:00-04:00, 04:00-05:00 + 20:00-04:00, 04:00-05:00
   for (const TrackWindow& window : r.windows) {
     EXPECT_EQ(std::fmod(window.start_s, kDayS), 4.0 * 3600.0) << window.label;
+    EXPECT_GE(window.first_time_s, window.start_s) << window.label;
+    EXPECT_LT(window.last_time_s, window.end_s) << window.label;
     EXPECT_EQ(window.label, FormatUnixTime(window.start_s, 8 * 3600).substr(0, 10));
   }
 }
