@@ -137,9 +137,8 @@ DynamicsOptions PlantOptions(int segments, double damping_ratio, double step_s, 
   return options;
 }
 
-}  // namespace
-
-void BindDynamics(py::module_& m) {
+// fastcal.loop.
+void BindLoop(py::module_& m) {
   m.def(
       "loop",
       [](const CableRobot& truth_argument, const CableRobot& controller_argument,
@@ -203,6 +202,10 @@ void BindDynamics(py::module_& m) {
       py::arg("summary_from_s"), py::arg("segments"), py::arg("damping_ratio"), py::arg("step_s"),
       py::arg("wind_speed"), py::arg("wind_direction_deg"), py::arg("gust_spectrum"),
       py::arg("intensity"), py::arg("seed"), py::arg("frequency_hz"));
+}
+
+// fastcal.dynamics.
+void BindDynamicsRun(py::module_& m) {
   m.def(
       "dynamics",
       [](const CableRobot& model_argument, const DoubleArray& start_m,
@@ -246,6 +249,13 @@ void BindDynamics(py::module_& m) {
       py::arg("rate_hz"), py::arg("settle_fraction"), py::arg("segments"), py::arg("damping_ratio"),
       py::arg("step_s"), py::arg("wind_speed"), py::arg("wind_direction_deg"),
       py::arg("gust_spectrum"), py::arg("intensity"), py::arg("seed"));
+}
+
+}  // namespace
+
+void BindDynamics(py::module_& m) {
+  BindLoop(m);
+  BindDynamicsRun(m);
 }
 
 }  // namespace fastcal::python

@@ -15,7 +15,10 @@
 
 namespace fastcal::python {
 
-void BindModes(py::module_& m) {
+namespace {
+
+// fastcal.modes.
+void BindPoseModes(py::module_& m) {
   m.def(
       "modes",
       [](const CableRobot& model_argument, const DoubleArray& position_m,
@@ -68,6 +71,10 @@ void BindModes(py::module_& m) {
       },
       py::arg("model"), py::arg("position_m"), py::arg("attitude_kind"), py::arg("attitude"),
       py::arg("segments"), py::arg("modes"), py::arg("cable_inertia"));
+}
+
+// fastcal.modes_cap.
+void BindModesCap(py::module_& m) {
   m.def(
       "modes_cap",
       [](const CableRobot& model_argument, double max_off_axis_deg, double off_axis_step_deg,
@@ -101,6 +108,10 @@ void BindModes(py::module_& m) {
       py::arg("model"), py::arg("max_off_axis_deg"), py::arg("off_axis_step_deg"),
       py::arg("azimuth_step_deg"), py::arg("focal_radius_m"), py::arg("focal_centre_m"),
       py::arg("tilt_fraction"), py::arg("segments"), py::arg("modes"));
+}
+
+// fastcal.identify_modes.
+void BindIdentifyModes(py::module_& m) {
   m.def(
       "identify_modes",
       [](const CableRobot& model_argument, const std::string& path, std::string method,
@@ -166,6 +177,14 @@ void BindModes(py::module_& m) {
       },
       py::arg("model"), py::arg("path"), py::arg("identification"), py::arg("identified_modes"),
       py::arg("segments"), py::arg("modes"));
+}
+
+}  // namespace
+
+void BindModes(py::module_& m) {
+  BindPoseModes(m);
+  BindModesCap(m);
+  BindIdentifyModes(m);
 }
 
 }  // namespace fastcal::python
