@@ -29,37 +29,11 @@
 #include <string>
 #include <vector>
 
+#include "fastcal/parameter_table.h"
 #include "fastcal/slow_error.h"
 #include "fastcal/statics.h"
 
 namespace fastcal {
-
-enum class ParameterKind {
-  kMassCentre,  // component = axis 0..2
-  kCabinMass,
-  kLinearDensity,  // cable = 0..5, or -1 for common
-  kEa,             // cable = 0..5, or -1 for common
-  kAnchorOffset,   // index = anchor point, component = axis
-  kTowerOffset,    // index = cable/tower, component = axis
-  kSensorGain,     // cable = 0..5, or -1 for common
-  kSensorBias,     // cable = 0..5, or -1 for common
-  // index = cable 0..5, component = the attachment's 0-based position in the model's
-  // cables[index].attachments (of the matching kind).
-  kAttachmentMass,
-  kAttachmentDensity,
-  kLengthOffset,  // cable = 0..5, or -1 for common
-  // The cabin's moving parts (moving_parts.h): index = the part's position in the model's
-  // cabin.moving_parts; named moving_parts.NAME.first_moment_kg_m.x and
-  // moving_parts.NAME.mass_kg.
-  kPartFirstMoment,  // component = axis 0..2 of the part's frame
-  kPartMass,
-  // The measured frame's point (measured_frame.h), component = axis 0..2 of its part's
-  // frame; named measured_frame.offset_m.x.
-  kMeasuredOffset,
-};
-// The last kind: readers of stored parameters (track's fold tasks) accept kinds up to it,
-// so a kind added above is not refused as corrupt.
-inline constexpr ParameterKind kLastParameterKind = ParameterKind::kMeasuredOffset;
 
 struct ParameterSpec {
   ParameterKind kind = ParameterKind::kMassCentre;

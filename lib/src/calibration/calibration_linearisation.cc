@@ -20,16 +20,10 @@ using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 // A sample's residuals: its readings (FittedSamples::readings), six or twelve.
 using SampleResiduals = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxReadings, 1>;
 
-bool IsPerCableGroup(ParameterKind kind) {
-  return kind == ParameterKind::kLinearDensity || kind == ParameterKind::kEa ||
-         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias ||
-         kind == ParameterKind::kLengthOffset;
-}
-
 // Whether basis parameter `b` is part of parameter `p`: itself, or one cable of a
 // per-cable group's common parameter.
 bool Covers(const ParameterSpec& p, const ParameterSpec& b) {
-  return SameParameter(p, b) || (p.kind == b.kind && IsPerCableGroup(p.kind) && p.index < 0);
+  return SameParameter(p, b) || (p.kind == b.kind && IsPerCableCapable(p.kind) && p.index < 0);
 }
 
 // The robust loss's IRLS weight sqrt(rho'(|r|^2)) of a sample's residuals (1 without a
@@ -504,7 +498,7 @@ bool LineariseCandidates(const LinearisationInputs& in, Linearisation* out, std:
 std::vector<ParameterSpec> BasisParameters(const CableRobot& model, bool lengths) {
   std::vector<ParameterSpec> basis;
   for (ParameterSpec p : AllModelParameters(model)) {
-    if (IsPerCableGroup(p.kind) && p.index < 0) continue;
+    if (IsPerCableCapable(p.kind) && p.index < 0) continue;
     if (p.kind == ParameterKind::kLengthOffset && !lengths) continue;
     p.free = true;
     basis.push_back(p);

@@ -23,59 +23,13 @@ CalibrationModel::CalibrationModel(const CableRobot& robot, const CalibrationSpe
     if (s.free) {
       free_.push_back(static_cast<int>(j));
       // The measured point's offset moves the cabin: the towers' columns give it.
-      frees_geometry_ = frees_geometry_ || s.kind == ParameterKind::kAnchorOffset ||
-                        s.kind == ParameterKind::kTowerOffset ||
-                        s.kind == ParameterKind::kMeasuredOffset;
+      frees_geometry_ = frees_geometry_ || KindInfo(s.kind).moves_geometry;
       continue;
     }
     if (!s.has_initial) continue;
     // A fixed parameter with a value overrides the model: fold it into the base.
-    const double v = s.initial_si;
-    for (int i = 0; i < kNumCables; ++i) {
-      const bool cable = s.index < 0 || s.index == i;
-      switch (s.kind) {
-        case ParameterKind::kMassCentre:
-          base_.mass_centre_cabin_m[s.component] = v;
-          break;
-        case ParameterKind::kCabinMass:
-          base_.cabin_mass_kg = v;
-          break;
-        case ParameterKind::kLinearDensity:
-          if (cable) base_.linear_density_kg_per_m[i] = v;
-          break;
-        case ParameterKind::kEa:
-          if (cable) base_.ea_n[i] = v;
-          break;
-        case ParameterKind::kAnchorOffset:
-          if (anchor_of_cable_[i] == s.index) base_.anchor_cabin_m[i][s.component] += v;
-          break;
-        case ParameterKind::kTowerOffset:
-          if (i == s.index) base_.tower_top_m[i][s.component] += v;
-          break;
-        case ParameterKind::kSensorGain:
-          if (cable) base_gain_[i] = v;
-          break;
-        case ParameterKind::kSensorBias:
-          if (cable) base_bias_n_[i] = v;
-          break;
-        case ParameterKind::kAttachmentMass:
-        case ParameterKind::kAttachmentDensity:
-          if (i == s.index) base_.chain[i].value[s.component] = v;
-          break;
-        case ParameterKind::kLengthOffset:
-          if (cable) base_offset_m_[i] = v;
-          break;
-        case ParameterKind::kPartFirstMoment:
-          base_.part_first_moment_kg_m[s.index][s.component] = v;
-          break;
-        case ParameterKind::kPartMass:
-          base_.part_mass_kg[s.index] = v;
-          break;
-        case ParameterKind::kMeasuredOffset:
-          base_measured_offset_m_[s.component] = v;
-          break;
-      }
-    }
+    Apply(s, s.initial_si, &base_, &base_gain_, &base_bias_n_, &base_offset_m_,
+          &base_measured_offset_m_);
   }
 }
 
@@ -253,8 +207,8 @@ void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
         break;
       case ParameterKind::kPartMass:
         if (shifts != nullptr && at != nullptr) {
-          column = gradient.mass_centre_cabin_m * (*shifts)[s.index].translation_m /
-                   at->cabin_mass_kg;
+          column =
+              gradient.mass_centre_cabin_m * (*shifts)[s.index].translation_m / at->cabin_mass_kg;
         }
         break;
       case ParameterKind::kLinearDensity:
@@ -290,7 +244,7 @@ void CalibrationModel::ReadingJacobian(const TensionGradient& gradient,
       case ParameterKind::kSensorGain:
       case ParameterKind::kSensorBias:
       case ParameterKind::kLengthOffset:  // no tension depends on it (lengths: Jets)
-        break;  // after the statics: below
+        break;                            // after the statics: below
     }
     // The readings are gain_i T_i + bias_i.
     for (int i = 0; i < kNumCables; ++i) {

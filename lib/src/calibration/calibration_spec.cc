@@ -43,7 +43,7 @@ namespace {
 // Writer.
 
 // {free: ..., initial: ..., prior: {mean: ..., sigma: ...}} in the group's file unit.
-std::string EntryYaml(const ParameterSpec& p, const GroupInfo& g) {
+std::string EntryYaml(const ParameterSpec& p, const ParameterKindInfo& g) {
   std::string s = std::string("free: ") + (p.free ? "true" : "false");
   if (p.has_initial) s += ", initial: " + NumInUnit(p.initial_si, g.to_si);
   if (p.has_prior) {
@@ -54,12 +54,13 @@ std::string EntryYaml(const ParameterSpec& p, const GroupInfo& g) {
 }
 
 // The named axes of one point (index ignored for the mass centre), "x: {...}" each.
-std::vector<std::string> AxisLines(const CalibrationSpec& spec, const GroupInfo& g, int index) {
+std::vector<std::string> AxisLines(const CalibrationSpec& spec, const ParameterKindInfo& g,
+                                   int index) {
   std::vector<std::string> lines;
   for (int c = 0; c < 3; ++c) {
     for (const ParameterSpec& p : spec.parameters) {
       if (p.kind == g.kind && p.component == c &&
-          (g.kind == ParameterKind::kMassCentre || p.index == index)) {
+          (g.shape == ParameterShape::kAxes || p.index == index)) {
         lines.push_back(std::string(1, kAxes[c]) + ": " + EntryYaml(p, g));
         break;
       }
@@ -82,13 +83,13 @@ std::string MovingPartsYaml(const CalibrationSpec& spec) {
   out << "  " << kMovingPartsKey << ":\n";
   for (const auto& [index, name] : parts) {
     out << "    " << name << ":\n";
-    const GroupInfo& moment = *InfoOf(ParameterKind::kPartFirstMoment);
+    const ParameterKindInfo& moment = *FindParameterKind(ParameterKind::kPartFirstMoment);
     const std::vector<std::string> lines = AxisLines(spec, moment, index);
     if (!lines.empty()) out << "      first_moment_kg_m:\n";
     for (const std::string& line : lines) out << "        " << line << "\n";
     for (const ParameterSpec& p : spec.parameters) {
       if (p.kind == ParameterKind::kPartMass && p.index == index) {
-        out << "      mass_kg: " << EntryYaml(p, *InfoOf(p.kind)) << "\n";
+        out << "      mass_kg: " << EntryYaml(p, *FindParameterKind(p.kind)) << "\n";
       }
     }
   }
@@ -159,7 +160,7 @@ std::string OptionsProblem(const CalibrationSpec& s) {
 // The first problem with one listed parameter on its own (kind, index, component, initial
 // value, prior), as "label: why"; empty when there is none.
 std::string ParameterProblem(const ParameterSpec& p, const std::string& label) {
-  if (InfoOf(p.kind) == nullptr) return label + ": unknown parameter kind";
+  if (FindParameterKind(p.kind) == nullptr) return label + ": unknown parameter kind";
   if (p.name.empty()) return label + ": has no name";
   if (IsVector(p.kind) && (p.component < 0 || p.component > 2)) {
     return label + ": component must be 0, 1 or 2 (x, y, z)";
@@ -232,9 +233,8 @@ bool CalibrationSpec::IsValid(std::string* error) const {
     const ParameterSpec& p = parameters[k];
     const std::string label = p.name.empty() ? "parameters[" + std::to_string(k) + "]" : p.name;
     if (const std::string w = ParameterProblem(p, label); !w.empty()) return fail(w);
-    const bool indexed = p.kind != ParameterKind::kMassCentre &&
-                         p.kind != ParameterKind::kCabinMass &&
-                         p.kind != ParameterKind::kMeasuredOffset;
+    const ParameterShape shape = KindInfo(p.kind).shape;
+    const bool indexed = shape != ParameterShape::kAxes && shape != ParameterShape::kOne;
     const auto key =
         std::make_tuple(static_cast<int>(p.kind), indexed ? p.index : -1,
                         IsVector(p.kind) || IsAttachment(p.kind) ? p.component : -1, p.session);
@@ -243,7 +243,7 @@ bool CalibrationSpec::IsValid(std::string* error) const {
       (p.index < 0 ? kinds_common : kinds_per_cable).insert(static_cast<int>(p.kind));
       if (kinds_common.count(static_cast<int>(p.kind)) != 0 &&
           kinds_per_cable.count(static_cast<int>(p.kind)) != 0) {
-        return fail(label + ": " + InfoOf(p.kind)->key +
+        return fail(label + ": " + FindParameterKind(p.kind)->key +
                     " is listed both for all cables (common) and per cable; choose one mode");
       }
     }
@@ -322,7 +322,7 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
     return out.str();
   }
   out << "parameters:\n";
-  for (const GroupInfo& g : kGroups) {
+  for (const ParameterKindInfo& g : ParameterKinds()) {
     std::vector<const ParameterSpec*> group;
     for (const ParameterSpec& p : spec.parameters) {
       if (p.kind == g.kind) group.push_back(&p);
@@ -338,10 +338,10 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
       continue;
     }
     out << "  " << g.key << ":";
-    if (g.kind == ParameterKind::kMassCentre) {
+    if (g.shape == ParameterShape::kAxes) {
       out << "\n";
       for (const std::string& line : AxisLines(spec, g, -1)) out << "    " << line << "\n";
-    } else if (g.kind == ParameterKind::kCabinMass) {
+    } else if (g.shape == ParameterShape::kOne) {
       out << " " << EntryYaml(*group.front(), g) << "\n";
     } else if (IsPerCableCapable(g.kind)) {
       if (group.front()->index < 0) {
@@ -388,18 +388,18 @@ std::string CalibrationSpecToYaml(const CalibrationSpec& spec) {
 std::vector<ParameterSpec> AllModelParameters(int num_anchor_points) {
   std::vector<ParameterSpec> all;
   const EntryText fixed;
-  for (const GroupInfo& g : kGroups) {
-    if (g.kind == ParameterKind::kMassCentre) {
+  for (const ParameterKindInfo& g : ParameterKinds()) {
+    // None without a model (the overload below).
+    if (IsAttachment(g.kind) || IsPart(g.kind) || g.kind == ParameterKind::kMeasuredOffset) {
+      continue;
+    }
+    if (g.shape == ParameterShape::kAxes) {
       for (int c = 0; c < 3; ++c) all.push_back(MakeParameter(g, -1, c, fixed));
-    } else if (g.kind == ParameterKind::kCabinMass) {
+    } else if (g.shape == ParameterShape::kOne) {
       all.push_back(MakeParameter(g, -1, -1, fixed));
     } else if (IsPerCableCapable(g.kind)) {
       for (int i = -1; i < kNumCables; ++i) all.push_back(MakeParameter(g, i, -1, fixed));
     } else {
-      // None without a model (the overload below).
-      if (IsAttachment(g.kind) || IsPart(g.kind) || g.kind == ParameterKind::kMeasuredOffset) {
-        continue;
-      }
       const int count = g.kind == ParameterKind::kAnchorOffset ? num_anchor_points : kNumCables;
       for (int j = 0; j < count; ++j) {
         for (int c = 0; c < 3; ++c) all.push_back(MakeParameter(g, j, c, fixed));
@@ -418,24 +418,27 @@ std::vector<ParameterSpec> AllModelParameters(const CableRobot& model) {
   for (size_t k = 0; k < parts.size(); ++k) {
     const int part = static_cast<int>(k);
     for (int c = 0; c < 3; ++c) {
-      ParameterSpec p = MakeParameter(*InfoOf(ParameterKind::kPartFirstMoment), part, c, fixed);
+      ParameterSpec p =
+          MakeParameter(*FindParameterKind(ParameterKind::kPartFirstMoment), part, c, fixed);
       p.name = PartParameterName(parts[k].name, p.kind, c);
       all.push_back(p);
     }
     if (model.moving_parts.Translates(part)) {
-      ParameterSpec p = MakeParameter(*InfoOf(ParameterKind::kPartMass), part, -1, fixed);
+      ParameterSpec p =
+          MakeParameter(*FindParameterKind(ParameterKind::kPartMass), part, -1, fixed);
       p.name = PartParameterName(parts[k].name, p.kind, -1);
       all.push_back(p);
     }
   }
   if (model.measured_frame.has_value()) {  // the measured point's offset
     for (int c = 0; c < 3; ++c) {
-      ParameterSpec p = MakeParameter(*InfoOf(ParameterKind::kMeasuredOffset), -1, c, fixed);
+      ParameterSpec p =
+          MakeParameter(*FindParameterKind(ParameterKind::kMeasuredOffset), -1, c, fixed);
       p.name = MeasuredOffsetName(c);
       all.push_back(p);
     }
   }
-  for (const GroupInfo& g : kGroups) {
+  for (const ParameterKindInfo& g : ParameterKinds()) {
     if (!IsAttachment(g.kind)) continue;
     for (int i = 0; i < kNumCables; ++i) {
       const std::vector<CableAttachment>& on = model.cables[i].attachments;
@@ -484,25 +487,26 @@ bool ParameterFitsModel(const ParameterSpec& p, const CableRobot& model, std::st
 
 bool SameParameter(const ParameterSpec& a, const ParameterSpec& b) {
   if (a.kind != b.kind) return false;
-  switch (a.kind) {
-    case ParameterKind::kMassCentre:
-    case ParameterKind::kMeasuredOffset:
-      return a.component == b.component;
-    case ParameterKind::kCabinMass:
+  const ParameterKindInfo* row = FindParameterKind(a.kind);
+  if (row == nullptr) return a.index == b.index;
+  switch (row->shape) {
+    case ParameterShape::kOne:
       return true;
-    case ParameterKind::kAnchorOffset:
-    case ParameterKind::kTowerOffset:
-    case ParameterKind::kAttachmentMass:
-    case ParameterKind::kAttachmentDensity:
-    case ParameterKind::kPartFirstMoment:
-      return a.index == b.index && a.component == b.component;
-    default:
+    case ParameterShape::kAxes:
+      return a.component == b.component;
+    case ParameterShape::kPerCable:
+    case ParameterShape::kPart:
       return a.index == b.index;
+    case ParameterShape::kPointAxes:
+    case ParameterShape::kAttachment:
+    case ParameterShape::kPartAxes:
+      return a.index == b.index && a.component == b.component;
   }
+  return false;
 }
 
 const char* ParameterGroupName(ParameterKind kind) {
-  const GroupInfo* g = InfoOf(kind);
+  const ParameterKindInfo* g = FindParameterKind(kind);
   return g != nullptr ? g->key : "unknown";
 }
 

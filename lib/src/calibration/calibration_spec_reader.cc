@@ -459,7 +459,7 @@ class Reader : public internal::YamlErrorRecorder {
                      std::vector<std::string>* groups) {
     if (!kv.value.IsSequence()) return Fail(kv.line, path, "expected a list of parameter groups");
     std::vector<std::string> keys;
-    for (const GroupInfo& g : kGroups) keys.push_back(g.key);
+    for (const ParameterKindInfo& g : ParameterKinds()) keys.push_back(g.key);
     for (const YAML::Node& item : kv.value) {
       const int line = LineOf(item) > 0 ? LineOf(item) : kv.line;
       if (!item.IsScalar()) return Fail(line, path, "expected a parameter group name");
@@ -561,7 +561,7 @@ class Reader : public internal::YamlErrorRecorder {
   }
 
   // The entry keys free / initial / prior out of `keys` (already read as a mapping).
-  bool ReadEntryKeys(const KeyMap& keys, const GroupInfo& g, const std::string& path,
+  bool ReadEntryKeys(const KeyMap& keys, const ParameterKindInfo& g, const std::string& path,
                      EntryText* entry) {
     if (const KeyValue* kv = Find(keys, "free")) {
       bool free = false;
@@ -607,15 +607,15 @@ class Reader : public internal::YamlErrorRecorder {
   }
 
   // A plain entry: {free, initial, prior}, all optional.
-  bool ReadEntry(const YAML::Node& node, int line, const GroupInfo& g, const std::string& path,
-                 EntryText* entry) {
+  bool ReadEntry(const YAML::Node& node, int line, const ParameterKindInfo& g,
+                 const std::string& path, EntryText* entry) {
     KeyMap keys;
     return ReadMap(node, line, path, {"free", "initial", "prior"}, &keys) &&
            ReadEntryKeys(keys, g, path, entry);
   }
 
   // {x: entry, y: entry, z: entry}, each optional; a named axis yields a parameter.
-  bool ReadAxes(const YAML::Node& node, int line, const GroupInfo& g, int index,
+  bool ReadAxes(const YAML::Node& node, int line, const ParameterKindInfo& g, int index,
                 const std::string& path, std::vector<ParameterSpec>* out) {
     KeyMap keys;
     if (!ReadMap(node, line, path, {"x", "y", "z"}, &keys)) return false;
@@ -630,7 +630,7 @@ class Reader : public internal::YamlErrorRecorder {
     return true;
   }
 
-  bool ReadPerCableGroup(const KeyValue& group, const GroupInfo& g, const std::string& path,
+  bool ReadPerCableGroup(const KeyValue& group, const ParameterKindInfo& g, const std::string& path,
                          std::vector<ParameterSpec>* out) {
     KeyMap keys;
     if (!ReadMap(group, path, {"mode", "free", "initial", "prior", "cables"}, &keys)) {
@@ -674,7 +674,7 @@ class Reader : public internal::YamlErrorRecorder {
   }
 
   // {all: entry} or a list of {x, y, z} maps, one per anchor point / tower.
-  bool ReadOffsets(const KeyValue& group, const GroupInfo& g, const std::string& path,
+  bool ReadOffsets(const KeyValue& group, const ParameterKindInfo& g, const std::string& path,
                    std::vector<ParameterSpec>* out) {
     const bool anchors = g.kind == ParameterKind::kAnchorOffset;
     const int count = anchors ? num_anchor_points_ : kNumCables;
@@ -715,7 +715,7 @@ class Reader : public internal::YamlErrorRecorder {
   // {all: entry} (every attachment of the group's kind on every cable), or a list of
   // entries each naming its `cable` (1..6) and `attachment` (1.., its position in the
   // model's cables[cable - 1].attachments).
-  bool ReadAttachments(const KeyValue& group, const GroupInfo& g, const std::string& path,
+  bool ReadAttachments(const KeyValue& group, const ParameterKindInfo& g, const std::string& path,
                        std::vector<ParameterSpec>* out) {
     const AttachmentKind kind = AttachmentKindOf(g.kind);
     const char* what = kind == AttachmentKind::kPointMass ? "point mass" : "added density";
@@ -816,14 +816,14 @@ class Reader : public internal::YamlErrorRecorder {
       if (!ReadMap(*part, part_path, {"first_moment_kg_m", "mass_kg"}, &fields)) return false;
       const size_t before = out->size();
       if (const KeyValue* kv = Find(fields, "first_moment_kg_m")) {
-        const GroupInfo& g = *InfoOf(ParameterKind::kPartFirstMoment);
+        const ParameterKindInfo& g = *FindParameterKind(ParameterKind::kPartFirstMoment);
         if (!ReadAxes(kv->value, kv->line, g, static_cast<int>(k),
                       Join(part_path, "first_moment_kg_m"), out)) {
           return false;
         }
       }
       if (const KeyValue* kv = Find(fields, "mass_kg")) {
-        const GroupInfo& g = *InfoOf(ParameterKind::kPartMass);
+        const ParameterKindInfo& g = *FindParameterKind(ParameterKind::kPartMass);
         EntryText entry;
         if (!ReadEntry(kv->value, kv->line, g, Join(part_path, "mass_kg"), &entry)) return false;
         out->push_back(MakeParameter(g, static_cast<int>(k), -1, entry));
@@ -849,7 +849,7 @@ class Reader : public internal::YamlErrorRecorder {
     const KeyValue* kv = Find(keys, "offset_m");
     if (kv == nullptr) return true;
     const size_t before = out->size();
-    if (!ReadAxes(kv->value, kv->line, *InfoOf(ParameterKind::kMeasuredOffset), -1,
+    if (!ReadAxes(kv->value, kv->line, *FindParameterKind(ParameterKind::kMeasuredOffset), -1,
                   Join(path, "offset_m"), out)) {
       return false;
     }
@@ -861,7 +861,7 @@ class Reader : public internal::YamlErrorRecorder {
 
   bool ReadParameters(const KeyValue& parameters, CalibrationSpec* spec) {
     std::vector<std::string> accepted;
-    for (const GroupInfo& g : kGroups) {
+    for (const ParameterKindInfo& g : ParameterKinds()) {
       if (g.kind != ParameterKind::kPartMass) accepted.push_back(g.key);  // one key for both
     }
     KeyMap keys;
@@ -870,7 +870,7 @@ class Reader : public internal::YamlErrorRecorder {
       return false;
     }
     std::vector<ParameterSpec> out;
-    for (const GroupInfo& g : kGroups) {  // canonical order
+    for (const ParameterKindInfo& g : ParameterKinds()) {  // canonical order
       const KeyValue* kv = Find(keys, g.key);
       if (kv == nullptr) continue;
       const std::string path = Join("parameters", g.key);
@@ -880,9 +880,9 @@ class Reader : public internal::YamlErrorRecorder {
         ok = ReadMovingParts(*kv, path, &out);
       } else if (g.kind == ParameterKind::kMeasuredOffset) {
         ok = ReadMeasuredFrame(*kv, path, &out);
-      } else if (g.kind == ParameterKind::kMassCentre) {
+      } else if (g.shape == ParameterShape::kAxes) {
         ok = ReadAxes(kv->value, kv->line, g, -1, path, &out);
-      } else if (g.kind == ParameterKind::kCabinMass) {
+      } else if (g.shape == ParameterShape::kOne) {
         EntryText entry;
         ok = ReadEntry(kv->value, kv->line, g, path, &entry);
         if (ok) out.push_back(MakeParameter(g, -1, -1, entry));

@@ -38,10 +38,6 @@ using internal::ShortestNumber;
 // ---------------------------------------------------------------------------------------
 // Facts about each parameter group, in canonical order (the order of ParameterKind).
 
-bool IsAttachment(ParameterKind kind) {
-  return kind == ParameterKind::kAttachmentMass || kind == ParameterKind::kAttachmentDensity;
-}
-
 AttachmentKind AttachmentKindOf(ParameterKind kind) {
   return kind == ParameterKind::kAttachmentMass ? AttachmentKind::kPointMass
                                                 : AttachmentKind::kAddedDensity;
@@ -53,27 +49,6 @@ AttachmentShape ShapeOf(const CableRobot& model) {
     for (const CableAttachment& a : model.cables[i].attachments) shape[i].push_back(a.kind);
   }
   return shape;
-}
-
-// Null for a kind outside the enum (a spec built in code from a bad cast).
-const GroupInfo* InfoOf(ParameterKind kind) {
-  for (const GroupInfo& g : kGroups) {
-    if (g.kind == kind) return &g;
-  }
-  return nullptr;
-}
-
-// Groups that are either one parameter for all cables or one per cable.
-bool IsPerCableCapable(ParameterKind kind) {
-  return kind == ParameterKind::kLinearDensity || kind == ParameterKind::kEa ||
-         kind == ParameterKind::kSensorGain || kind == ParameterKind::kSensorBias ||
-         kind == ParameterKind::kLengthOffset;
-}
-
-bool IsVector(ParameterKind kind) {
-  return kind == ParameterKind::kMassCentre || kind == ParameterKind::kAnchorOffset ||
-         kind == ParameterKind::kTowerOffset || kind == ParameterKind::kPartFirstMoment ||
-         kind == ParameterKind::kMeasuredOffset;
 }
 
 std::string MeasuredOffsetName(int component) {
@@ -96,7 +71,7 @@ std::string PartOfParameterName(const std::string& name) {
 
 // "mass_centre_m.x", "cabin_mass_kg", "ea_n[3]", "anchor_offset_m[2].z",
 // "attachment_mass_kg[3][1]" (1-based).
-std::string ParameterName(const GroupInfo& g, int index, int component) {
+std::string ParameterName(const ParameterKindInfo& g, int index, int component) {
   std::string name = g.key;
   if (IsAttachment(g.kind)) {
     return name + "[" + std::to_string(index + 1) + "][" + std::to_string(component + 1) + "]";
@@ -118,27 +93,12 @@ std::string CheckPlausible(ParameterKind kind, double value_si) {
 
 std::string CheckInitial(ParameterKind kind, double initial_si) {
   if (!std::isfinite(initial_si)) return "must be finite";
-  const char* what = nullptr;
-  switch (kind) {
-    case ParameterKind::kCabinMass:
-      what = "a mass";
-      break;
-    case ParameterKind::kLinearDensity:
-      what = "a linear density";
-      break;
-    case ParameterKind::kEa:
-      what = "an axial stiffness EA";
-      break;
-    case ParameterKind::kSensorGain:
-      what = "a sensor gain";
-      break;
-    default:
-      break;
-  }
+  const ParameterKindInfo* row = FindParameterKind(kind);
+  const char* what = row != nullptr ? row->positive : nullptr;
   if (what != nullptr && !(initial_si > 0.0)) {
     return std::string("must be > 0 (") + what + " is positive)";
   }
-  if (IsAttachment(kind) && !(initial_si >= 0.0)) {
+  if (row != nullptr && row->non_negative && !(initial_si >= 0.0)) {
     return "must be >= 0 (an attachment adds weight)";
   }
   return CheckPlausible(kind, initial_si);
@@ -301,7 +261,8 @@ std::string NumInUnit(double si, double to_si) {
   return ShortestNumber(guess);  // no exact preimage: the nearest
 }
 
-ParameterSpec MakeParameter(const GroupInfo& g, int index, int component, const EntryText& e) {
+ParameterSpec MakeParameter(const ParameterKindInfo& g, int index, int component,
+                            const EntryText& e) {
   ParameterSpec p;
   p.kind = g.kind;
   p.index = index;

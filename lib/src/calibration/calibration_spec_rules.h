@@ -16,6 +16,7 @@
 #include "fastcal/calibration_spec.h"
 #include "fastcal/internal/units.h"
 #include "fastcal/model_plausibility.h"
+#include "fastcal/parameter_table.h"
 #include "fastcal/statics.h"
 
 namespace fastcal::spec_rules {
@@ -24,45 +25,14 @@ inline constexpr char kFormatName[] = "fastcal-calibration-spec-1";
 inline constexpr char kRootPath[] = "(top level)";
 inline constexpr char kAxes[] = "xyz";
 
-// ---------------------------------------------------------------------------------------
-// Facts about each parameter group, in canonical order (the order of ParameterKind).
-
-struct GroupInfo {
-  ParameterKind kind;
-  const char* key;   // key under `parameters:` and stem of the parameter names
-  const char* unit;  // unit of the values in the file
-  double to_si;      // SI value = file value * to_si
-};
-
-inline constexpr GroupInfo kGroups[] = {
-    {ParameterKind::kMassCentre, "mass_centre_m", "m", 1.0},
-    {ParameterKind::kCabinMass, "cabin_mass_kg", "kg", 1.0},
-    {ParameterKind::kLinearDensity, "linear_density_kg_per_m", "kg/m", 1.0},
-    {ParameterKind::kEa, "ea_n", "N", 1.0},
-    {ParameterKind::kAnchorOffset, "anchor_offset_m", "m", 1.0},
-    {ParameterKind::kTowerOffset, "tower_offset_m", "m", 1.0},
-    {ParameterKind::kSensorGain, "sensor_gain", "1", 1.0},
-    {ParameterKind::kSensorBias, "sensor_bias_kN", "kN", internal::kNPerKn},
-    {ParameterKind::kAttachmentMass, "attachment_mass_kg", "kg", 1.0},
-    {ParameterKind::kAttachmentDensity, "attachment_density_kg_per_m", "kg/m", 1.0},
-    {ParameterKind::kLengthOffset, "length_offset_m", "m", 1.0},
-    // Both under one key, `moving_parts: {NAME: {first_moment_kg_m: {x, y, z}, mass_kg}}`.
-    {ParameterKind::kPartFirstMoment, "moving_parts", "kg m", 1.0},
-    {ParameterKind::kPartMass, "moving_parts", "kg", 1.0},
-    // `measured_frame: {offset_m: {x, y, z}}`.
-    {ParameterKind::kMeasuredOffset, "measured_frame", "m", 1.0},
-};
+// The parameter groups' facts (key, unit, shape) are the table of kinds:
+// parameter_table.h, in canonical order (the order of ParameterKind).
 
 inline constexpr char kMovingPartsKey[] = "moving_parts";
 inline constexpr char kMeasuredFrameKey[] = "measured_frame";
 
 // "measured_frame.offset_m.x".
 std::string MeasuredOffsetName(int component);
-
-// The moving parts' kinds (one key in the spec for both).
-inline bool IsPart(ParameterKind kind) {
-  return kind == ParameterKind::kPartFirstMoment || kind == ParameterKind::kPartMass;
-}
 
 // "moving_parts.NAME.first_moment_kg_m.x", "moving_parts.NAME.mass_kg".
 std::string PartParameterName(const std::string& part, ParameterKind kind, int component);
@@ -92,23 +62,13 @@ struct EntryText {
   std::optional<std::pair<double, double>> prior;  // mean, sigma; file unit
 };
 
-bool IsAttachment(ParameterKind kind);
-
 AttachmentKind AttachmentKindOf(ParameterKind kind);
 
 AttachmentShape ShapeOf(const CableRobot& model);
 
-// Null for a kind outside the enum (a spec built in code from a bad cast).
-const GroupInfo* InfoOf(ParameterKind kind);
-
-// Groups that are either one parameter for all cables or one per cable.
-bool IsPerCableCapable(ParameterKind kind);
-
-bool IsVector(ParameterKind kind);
-
 // "mass_centre_m.x", "cabin_mass_kg", "ea_n[3]", "anchor_offset_m[2].z",
 // "attachment_mass_kg[3][1]" (1-based).
-std::string ParameterName(const GroupInfo& g, int index, int component);
+std::string ParameterName(const ParameterKindInfo& g, int index, int component);
 
 // ---------------------------------------------------------------------------------------
 // Checks shared by the reader and CalibrationSpec::IsValid. Each returns what is wrong,
@@ -174,7 +134,8 @@ bool IsKnownMethod(StaticsMethod method);
 // t; the search of the neighbours is a guard for values set in code.
 std::string NumInUnit(double si, double to_si);
 
-ParameterSpec MakeParameter(const GroupInfo& g, int index, int component, const EntryText& e);
+ParameterSpec MakeParameter(const ParameterKindInfo& g, int index, int component,
+                            const EntryText& e);
 
 }  // namespace fastcal::spec_rules
 
@@ -198,18 +159,11 @@ using spec_rules::CheckSignificance;
 using spec_rules::CheckThreads;
 using spec_rules::CheckTimeConstant;
 using spec_rules::EntryText;
-using spec_rules::GroupInfo;
 using spec_rules::GroupWithoutFreeParameter;
-using spec_rules::InfoOf;
-using spec_rules::IsAttachment;
 using spec_rules::IsKnownMethod;
-using spec_rules::IsPart;
-using spec_rules::IsPerCableCapable;
-using spec_rules::IsVector;
 using spec_rules::kAxes;
 using spec_rules::kBothNoiseZero;
 using spec_rules::kFormatName;
-using spec_rules::kGroups;
 using spec_rules::kMeasuredFrameKey;
 using spec_rules::kMovingPartsKey;
 using spec_rules::kRootPath;

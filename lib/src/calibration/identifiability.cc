@@ -23,42 +23,7 @@ constexpr double kDirectionWeightFloor = 0.1;
 
 // The largest sigma with which a parameter counts as determined (CalibrationOptions).
 double MaxSigma(const ParameterSpec& p, double initial, const CalibrationOptions& o) {
-  switch (p.kind) {
-    case ParameterKind::kMassCentre:
-      return o.max_sigma_mass_centre_m;
-    case ParameterKind::kCabinMass:
-      return o.max_sigma_cabin_mass_fraction * std::abs(initial);
-    case ParameterKind::kLinearDensity:
-      return o.max_sigma_density_fraction * std::abs(initial);
-    case ParameterKind::kEa:
-      return o.max_sigma_ea_fraction * std::abs(initial);
-    case ParameterKind::kAnchorOffset:
-      return o.max_sigma_anchor_offset_m;
-    case ParameterKind::kTowerOffset:
-      return o.max_sigma_tower_offset_m;
-    case ParameterKind::kSensorGain:
-      return o.max_sigma_sensor_gain;
-    case ParameterKind::kSensorBias:
-      return o.max_sigma_sensor_bias_n;
-    case ParameterKind::kAttachmentMass:
-      return o.max_sigma_attachment_mass_kg;
-    case ParameterKind::kAttachmentDensity:
-      return o.max_sigma_attachment_density_kg_per_m;
-    case ParameterKind::kLengthOffset:
-      return o.max_sigma_length_offset_m;
-    case ParameterKind::kPartFirstMoment:
-      // A prior bounds what the data see only at second order (moving_parts.h).
-      return p.has_prior ? std::max(o.max_sigma_part_first_moment_kg_m, 1.01 * p.prior_sigma_si)
-                         : o.max_sigma_part_first_moment_kg_m;
-    case ParameterKind::kPartMass:
-      return p.has_prior ? std::max(o.max_sigma_part_mass_kg, 1.01 * p.prior_sigma_si)
-                         : o.max_sigma_part_mass_kg;
-    case ParameterKind::kMeasuredOffset:
-      // Seen only through the cables' geometry (measured_frame.h): a prior bounds it.
-      return p.has_prior ? std::max(o.max_sigma_measured_offset_m, 1.01 * p.prior_sigma_si)
-                         : o.max_sigma_measured_offset_m;
-  }
-  return std::numeric_limits<double>::infinity();
+  return MaxSigmaOf(p.kind, initial, p.has_prior ? p.prior_sigma_si : 0.0, o);
 }
 
 // Upper-triangular R with R^T R = J^T J, folded from the CRS Jacobian chunk by chunk so

@@ -22,11 +22,8 @@
 namespace fastcal::internal {
 namespace {
 
-bool MovesTheForces(ParameterKind kind) {
-  // The sensors' gains and biases and the length encoders' offsets are of the readings.
-  return kind != ParameterKind::kSensorGain && kind != ParameterKind::kSensorBias &&
-         kind != ParameterKind::kLengthOffset;
-}
+// The sensors' gains and biases and the length encoders' offsets are of the readings.
+bool MovesTheForces(ParameterKind kind) { return KindInfo(kind).moves_forces; }
 
 // The spec with every statics parameter that has a prior freed (a considered one held
 // fixed otherwise), so that theta holds every parameter of the range.
@@ -40,24 +37,14 @@ CalibrationSpec WithRangeFree(const CalibrationSpec& spec) {
 
 // The margin of a free parameter without a prior (DesignOptions::range_*), at `value`.
 double MarginOf(const ParameterSpec& p, double value, const DesignOptions& o) {
-  switch (p.kind) {
-    case ParameterKind::kMassCentre:
+  switch (KindInfo(p.kind).design_margin) {
+    case DesignMargin::kMassCentre:
       return o.range_mass_centre_m;
-    case ParameterKind::kAnchorOffset:
-    case ParameterKind::kTowerOffset:
-    case ParameterKind::kMeasuredOffset:
+    case DesignMargin::kOffset:
       return o.range_offset_m;
-    case ParameterKind::kCabinMass:
-    case ParameterKind::kLinearDensity:
-    case ParameterKind::kEa:
-    case ParameterKind::kAttachmentMass:
-    case ParameterKind::kAttachmentDensity:
-    case ParameterKind::kPartFirstMoment:
-    case ParameterKind::kPartMass:
+    case DesignMargin::kRelative:
       return o.range_relative * std::abs(value);
-    case ParameterKind::kSensorGain:
-    case ParameterKind::kSensorBias:
-    case ParameterKind::kLengthOffset:
+    case DesignMargin::kNone:
       break;  // of the readings, not of the statics: no range to hold over
   }
   return 0.0;

@@ -26,9 +26,9 @@ std::vector<std::vector<int>> WindowGroups(const TrackRun& run) {
   std::vector<std::string> keys;
   for (size_t a = 0; a < run.layout.window_columns.size(); ++a) {
     const ParameterSpec& s = run.layout.Column(run.layout.window_columns[a]);
-    const bool vector = s.kind == ParameterKind::kMassCentre ||
-                        s.kind == ParameterKind::kAnchorOffset ||
-                        s.kind == ParameterKind::kTowerOffset;
+    // A point's axes are one group (a moving part's are named apart: by name).
+    const ParameterShape shape = KindInfo(s.kind).shape;
+    const bool vector = shape == ParameterShape::kAxes || shape == ParameterShape::kPointAxes;
     const std::string key =
         vector ? std::string(ParameterGroupName(s.kind)) + "/" + std::to_string(s.index) : s.name;
     if (!by_key.count(key)) keys.push_back(key);

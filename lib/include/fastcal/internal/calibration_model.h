@@ -96,6 +96,64 @@ class CalibrationModel {
   Pose CabinPose(const Pose& measured, const JointValues& joints,
                  const Eigen::Vector3d& offset_m) const;
 
+  // Puts the value `v` of parameter `s` where it enters: the statics parameters, the
+  // sensors' gains and biases, the encoders' zeros or the measured point; offsets of the
+  // geometry are added to the points they move. The switch over kinds that writes.
+  template <typename T>
+  void Apply(const ParameterSpec& s, const T& v, StaticsParameters<T>* p,
+             std::array<T, kNumCables>* gain, std::array<T, kNumCables>* bias,
+             std::array<T, kNumCables>* offset, Vector3T<T>* measured_offset) const {
+    const auto set_cables = [&s, &v](std::array<T, kNumCables>* values) {
+      for (int i = 0; i < kNumCables; ++i) {
+        if (s.index < 0 || s.index == i) (*values)[i] = v;
+      }
+    };
+    switch (s.kind) {
+      case ParameterKind::kMassCentre:
+        p->mass_centre_cabin_m[s.component] = v;
+        break;
+      case ParameterKind::kCabinMass:
+        p->cabin_mass_kg = v;
+        break;
+      case ParameterKind::kLinearDensity:
+        set_cables(&p->linear_density_kg_per_m);
+        break;
+      case ParameterKind::kEa:
+        set_cables(&p->ea_n);
+        break;
+      case ParameterKind::kAnchorOffset:
+        for (int i = 0; i < kNumCables; ++i) {
+          if (anchor_of_cable_[i] == s.index) p->anchor_cabin_m[i][s.component] += v;
+        }
+        break;
+      case ParameterKind::kTowerOffset:
+        p->tower_top_m[s.index][s.component] += v;
+        break;
+      case ParameterKind::kSensorGain:
+        set_cables(gain);
+        break;
+      case ParameterKind::kSensorBias:
+        set_cables(bias);
+        break;
+      case ParameterKind::kAttachmentMass:
+      case ParameterKind::kAttachmentDensity:
+        p->chain[s.index].value[s.component] = v;
+        break;
+      case ParameterKind::kLengthOffset:
+        set_cables(offset);
+        break;
+      case ParameterKind::kPartFirstMoment:
+        p->part_first_moment_kg_m[s.index][s.component] = v;
+        break;
+      case ParameterKind::kPartMass:
+        p->part_mass_kg[s.index] = v;
+        break;
+      case ParameterKind::kMeasuredOffset:
+        (*measured_offset)[s.component] = v;
+        break;
+    }
+  }
+
   // The statics parameters and sensor model at theta for a sample of `session`: a
   // parameter of another session (ParameterSpec::session) does not apply.
   // With `measured_offset_m`, the measured frame's point (measured_frame.h) too.
@@ -115,61 +173,7 @@ class CalibrationModel {
     for (int k = 0; k < num_free(); ++k) {
       const ParameterSpec& s = spec_.parameters[free_[k]];
       if (s.session >= 0 && s.session != session) continue;
-      const T& v = theta[k];
-      switch (s.kind) {
-        case ParameterKind::kMassCentre:
-          p->mass_centre_cabin_m[s.component] = v;
-          break;
-        case ParameterKind::kCabinMass:
-          p->cabin_mass_kg = v;
-          break;
-        case ParameterKind::kLinearDensity:
-          for (int i = 0; i < kNumCables; ++i) {
-            if (s.index < 0 || s.index == i) p->linear_density_kg_per_m[i] = v;
-          }
-          break;
-        case ParameterKind::kEa:
-          for (int i = 0; i < kNumCables; ++i) {
-            if (s.index < 0 || s.index == i) p->ea_n[i] = v;
-          }
-          break;
-        case ParameterKind::kAnchorOffset:
-          for (int i = 0; i < kNumCables; ++i) {
-            if (anchor_of_cable_[i] == s.index) p->anchor_cabin_m[i][s.component] += v;
-          }
-          break;
-        case ParameterKind::kTowerOffset:
-          p->tower_top_m[s.index][s.component] += v;
-          break;
-        case ParameterKind::kSensorGain:
-          for (int i = 0; i < kNumCables; ++i) {
-            if (s.index < 0 || s.index == i) (*gain)[i] = v;
-          }
-          break;
-        case ParameterKind::kSensorBias:
-          for (int i = 0; i < kNumCables; ++i) {
-            if (s.index < 0 || s.index == i) (*bias)[i] = v;
-          }
-          break;
-        case ParameterKind::kAttachmentMass:
-        case ParameterKind::kAttachmentDensity:
-          p->chain[s.index].value[s.component] = v;
-          break;
-        case ParameterKind::kLengthOffset:
-          for (int i = 0; i < kNumCables; ++i) {
-            if (s.index < 0 || s.index == i) offset[i] = v;
-          }
-          break;
-        case ParameterKind::kPartFirstMoment:
-          p->part_first_moment_kg_m[s.index][s.component] = v;
-          break;
-        case ParameterKind::kPartMass:
-          p->part_mass_kg[s.index] = v;
-          break;
-        case ParameterKind::kMeasuredOffset:
-          measured_offset[s.component] = v;
-          break;
-      }
+      Apply(s, theta[k], p, gain, bias, &offset, &measured_offset);
     }
     if (offset_m != nullptr) *offset_m = offset;
     if (measured_offset_m != nullptr) *measured_offset_m = measured_offset;
