@@ -53,6 +53,7 @@ from ._fastcal import CalibrationError, Dataset, Error, InputError, Model
 __version__: str = _fastcal.__version__
 
 __all__ = [
+    "Cable",
     "CalibrationError",
     "CalibrationResult",
     "ControlCycleResult",
@@ -99,6 +100,7 @@ from ._common import STATUS_NAMES, ArrayLike, PathLike  # noqa: F401
 from . import model as _model_names  # noqa: F401  (Model.mass_centre_m)
 from .statics import (  # noqa: F401
     STABILITY_NAMES,
+    Cable,
     ColumnsLike,
     LocateResult,
     StaticsResult,

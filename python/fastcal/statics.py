@@ -8,7 +8,7 @@ from typing import Any, Dict, List, Mapping, Optional, Union
 import numpy as np
 
 from . import _fastcal
-from ._fastcal import InputError, Model
+from ._fastcal import Cable, InputError, Model  # noqa: F401  (Cable: one cable, cable.h)
 
 from ._common import ArrayLike, PathLike, _INT32_MAX, _INT32_MIN, _SOLVE_OPTION_FIELDS, _STATUS_NAMES_ARRAY, _UINT64_MAX, _attitude, _call_with_names, _number, _point, _renamed_keywords, _rows, _spec_argument, _whole
 

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "bindings.h"
+#include "fastcal/cable.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/statics.h"
 #include "fastcal/trajectory.h"
@@ -156,9 +157,94 @@ DoubleArray QuaternionsOf(const std::vector<Pose>& poses) {
   return quat;
 }
 
+// One cable (cable.h): its end point and partials, the inverse, tension, mass and lumped
+// chain, for fastcal.Cable.
+void BindCable(py::module_& m) {
+  constexpr double kGravity = -9.8;
+  py::class_<Cable>(m, "Cable")
+      .def(py::init([](double ea_n, double linear_density_kg_per_m) {
+             Cable cable(ea_n, linear_density_kg_per_m);
+             std::string error;
+             if (!cable.IsValid(&error)) throw InputError(error);
+             return cable;
+           }),
+           py::arg("ea_n"), py::arg("linear_density_kg_per_m"))
+      .def_static(
+          "of",
+          [](const CableRobot& model, int cable) {
+            if (cable < 1 || cable > kNumCables) {
+              throw InputError("cable must be 1..6, got " + std::to_string(cable));
+            }
+            return Cable::Of(model.cables[cable - 1]);
+          },
+          py::arg("model"), py::arg("cable"))
+      .def_property_readonly("ea_n", &Cable::ea_n)
+      .def_property_readonly("linear_density_kg_per_m", &Cable::linear_density_kg_per_m)
+      .def_property_readonly("uniform", &Cable::uniform)
+      .def(
+          "end",
+          [](const Cable& c, double fl_n, double fz_n, double s0_m, double gravity_m_per_s2) {
+            if (!(fl_n > 0.0) || !(s0_m > 0.0) || !std::isfinite(fz_n) || !(gravity_m_per_s2 < 0)) {
+              throw InputError("end: fl_n > 0, s0_m > 0, finite fz_n and gravity_m_per_s2 < 0");
+            }
+            const CatenaryEnd<double> e = c.End(fl_n, fz_n, s0_m, gravity_m_per_s2);
+            py::dict out;
+            out["span_m"] = e.span_m;
+            out["rise_m"] = e.rise_m;
+            out["d_span"] = py::make_tuple(e.dspan[0], e.dspan[1], e.dspan[2]);
+            out["d_rise"] = py::make_tuple(e.drise[0], e.drise[1], e.drise[2]);
+            out["lower_tension_n"] = e.lower_tension_n;
+            out["upper_tension_n"] = e.upper_tension_n;
+            return out;
+          },
+          py::arg("fl_n"), py::arg("fz_n"), py::arg("s0_m"), py::arg("gravity_m_per_s2") = kGravity)
+      .def(
+          "forces",
+          [](const Cable& c, double span_m, double rise_m, double s0_m, double gravity_m_per_s2) {
+            CatenaryForces f;
+            int iterations = 0;
+            const CatenaryStatus status =
+                c.Forces(span_m, rise_m, s0_m, gravity_m_per_s2, CatenarySolverOptions(), nullptr,
+                         &f, &iterations);
+            if (status != CatenaryStatus::kOk) {
+              throw InputError(std::string("forces: ") + CatenaryStatusName(status));
+            }
+            return py::make_tuple(f.fl_n, f.fz_n);
+          },
+          py::arg("span_m"), py::arg("rise_m"), py::arg("s0_m"),
+          py::arg("gravity_m_per_s2") = kGravity)
+      .def("tension", &Cable::Tension, py::arg("fl_n"), py::arg("fz_n"), py::arg("s_m"),
+           py::arg("gravity_m_per_s2") = kGravity)
+      .def("mass_kg", &Cable::MassKg, py::arg("s0_m"))
+      .def(
+          "lumped",
+          [](const Cable& c, const DoubleArray& lower_m, const DoubleArray& upper_m, double fl_n,
+             double fz_n, double s0_m, int segments, double gravity_m_per_s2) {
+            LumpedChain chain;
+            std::string error;
+            if (!c.Lumped(Point(lower_m, "lower_m"), Point(upper_m, "upper_m"), fl_n, fz_n, s0_m,
+                          gravity_m_per_s2, segments, &chain, &error)) {
+              throw InputError("lumped: " + error);
+            }
+            DoubleArray nodes = NewArray({static_cast<py::ssize_t>(chain.nodes_m.size()), 3});
+            for (size_t j = 0; j < chain.nodes_m.size(); ++j) {
+              for (int k = 0; k < 3; ++k) nodes.mutable_data()[3 * j + k] = chain.nodes_m[j][k];
+            }
+            py::dict out;
+            out["nodes_m"] = nodes;
+            out["tension_n"] = py::array_t<double>(chain.tension_n.size(), chain.tension_n.data());
+            out["segment_length_m"] = chain.segment_length_m;
+            out["node_mass_kg"] = chain.node_mass_kg;
+            return out;
+          },
+          py::arg("lower_m"), py::arg("upper_m"), py::arg("fl_n"), py::arg("fz_n"), py::arg("s0_m"),
+          py::arg("segments"), py::arg("gravity_m_per_s2") = kGravity);
+}
+
 }  // namespace
 
 void BindStatics(py::module_& m) {
+  BindCable(m);
   m.def("statics_status_names", [] {
     // kUnsupportedModel is the enum's last status.
     return EnumNames(StaticsStatus::kUnsupportedModel, StaticsStatusName);

@@ -42,6 +42,8 @@
 #include <cmath>
 #include <limits>
 
+#include "fastcal/cable.h"
+
 namespace fastcal::internal {
 namespace {
 
@@ -160,10 +162,8 @@ void EvaluateCable(const ChainModel& model, const ChainState& state, int i,
     if (k + 1 < n) force.col(k) += half_drag - pull;
     if (tangents) {
       if (taut) {
-        const Eigen::Matrix3d nn = u * u.transpose();
-        f->stiffness[i][k] =
-            (c.ea_n / l0) * nn + (tension / l) * (Eigen::Matrix3d::Identity() - nn);
-        f->damping[i][k] = (damping_n_s / l0) * nn;
+        f->stiffness[i][k] = Cable::SegmentStiffnessAlong(u, l, tension, c.ea_n, l0);
+        f->damping[i][k] = (damping_n_s / l0) * (u * u.transpose());
       } else {
         f->stiffness[i][k].setZero();
         f->damping[i][k].setZero();

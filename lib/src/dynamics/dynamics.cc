@@ -12,6 +12,7 @@
 #include "dynamics/chain_integrator.h"
 #include "dynamics/chain_statics.h"
 #include "dynamics/chain_system.h"
+#include "fastcal/cable.h"
 #include "fastcal/catenary.h"
 
 namespace fastcal {
@@ -23,22 +24,20 @@ constexpr int kMaxQuasiStaticPieces = 64;
 // The lowest modes computed at the start (for the damping and DynamicsStart).
 constexpr int kStartModes = 10;
 
-// Nodes of a cable on its elastic catenary (catenary.h) from `lower_m` toward `upper_m`,
-// lower-end forces (fl, fz) on the cable: the interior nodes 1..N-1 at s = j s0/N.
-Eigen::Matrix3Xd CatenaryNodes(const Eigen::Vector3d& lower_m, const Eigen::Vector3d& upper_m,
-                               double fl_n, double fz_n, double s0_m, double ea_n, double w_n_per_m,
-                               int segments) {
-  Eigen::Vector3d horizontal = upper_m - lower_m;
-  horizontal.z() = 0.0;
-  horizontal.normalize();
-  const std::vector<CatenaryPoint> points =
-      CatenaryShape(fl_n, fz_n, s0_m, ea_n, w_n_per_m, segments + 1);
-  Eigen::Matrix3Xd nodes(3, segments - 1);
-  for (int j = 1; j < segments; ++j) {
-    nodes.col(j - 1) =
-        lower_m + points[j].span_m * horizontal + Eigen::Vector3d(0.0, 0.0, points[j].rise_m);
+// The interior nodes 1..N-1 (at s = j s0/N) of a cable's lumped chain on its elastic
+// catenary (cable.h) from `lower_m` to `upper_m`, lower-end forces (fl, fz) on the cable.
+bool CatenaryNodes(const Cable& cable, const Eigen::Vector3d& lower_m,
+                   const Eigen::Vector3d& upper_m, double fl_n, double fz_n, double s0_m,
+                   double gravity_m_per_s2, int segments, Eigen::Matrix3Xd* nodes,
+                   std::string* error) {
+  LumpedChain chain;
+  if (!cable.Lumped(lower_m, upper_m, fl_n, fz_n, s0_m, gravity_m_per_s2, segments, &chain,
+                    error)) {
+    return false;
   }
-  return nodes;
+  nodes->resize(3, segments - 1);
+  for (int j = 1; j < segments; ++j) nodes->col(j - 1) = chain.nodes_m[j];
+  return true;
 }
 
 internal::IntegratorSettings Settings(const DynamicsOptions& o) {
@@ -239,10 +238,14 @@ std::unique_ptr<CableDynamics> CableDynamics::Create(const CableRobot& robot, co
   for (int i = 0; i < kNumCables; ++i) {
     const CableSolution& s = start.statics.cables[i];
     const CableProperties& c = robot.cables[i];
-    state.node_m.push_back(
-        CatenaryNodes(pose.position_m + pose.rotation * robot.AnchorOfCable(i), c.tower_top_m,
-                      s.horizontal_force_n, s.force_n.z(), s.unstretched_length_m, c.ea_n,
-                      c.linear_density_kg_per_m * robot.gravity_m_per_s2, options.segments));
+    Eigen::Matrix3Xd nodes;
+    if (!CatenaryNodes(Cable::Of(c), pose.position_m + pose.rotation * robot.AnchorOfCable(i),
+                       c.tower_top_m, s.horizontal_force_n, s.force_n.z(), s.unstretched_length_m,
+                       robot.gravity_m_per_s2, options.segments, &nodes, error)) {
+      *error = "cable " + std::to_string(i + 1) + ": " + *error;
+      return nullptr;
+    }
+    state.node_m.push_back(nodes);
     state.node_velocity_m_per_s.push_back(Eigen::Matrix3Xd::Zero(3, options.segments - 1));
     state.s0_m.push_back(s.unstretched_length_m);
     state.s0_rate_m_per_s.push_back(0.0);
@@ -474,12 +477,11 @@ bool SimulateFixedCable(const FixedCable& cable, const DynamicsOptions& options,
     *error = "release: harmonic in [1, segments), finite amplitude, 0 < interval <= duration";
     return false;
   }
-  const double w = cable.linear_density_kg_per_m * cable.gravity_m_per_s2;
+  const Cable bare(cable.ea_n, cable.linear_density_kg_per_m);
   CatenaryForces forces;
   int iterations = 0;
-  if (SolveCatenaryForcesDouble(cable.span_m, cable.rise_m, cable.unstretched_length_m, cable.ea_n,
-                                w, CatenarySolverOptions(), nullptr, &forces,
-                                &iterations) != CatenaryStatus::kOk) {
+  if (bare.Forces(cable.span_m, cable.rise_m, cable.unstretched_length_m, cable.gravity_m_per_s2,
+                  CatenarySolverOptions(), nullptr, &forces, &iterations) != CatenaryStatus::kOk) {
     *error = "cable: the catenary has no solution for this span, rise and length";
     return false;
   }
@@ -495,8 +497,12 @@ bool SimulateFixedCable(const FixedCable& cable, const DynamicsOptions& options,
   model.cables.push_back(c);
   const int n = options.segments;
   internal::ChainState state;
-  state.node_m.push_back(CatenaryNodes(Eigen::Vector3d::Zero(), c.upper_m, forces.fl_n, forces.fz_n,
-                                       cable.unstretched_length_m, cable.ea_n, w, n));
+  Eigen::Matrix3Xd nodes;
+  if (!CatenaryNodes(bare, Eigen::Vector3d::Zero(), c.upper_m, forces.fl_n, forces.fz_n,
+                     cable.unstretched_length_m, cable.gravity_m_per_s2, n, &nodes, error)) {
+    return false;
+  }
+  state.node_m.push_back(nodes);
   state.node_velocity_m_per_s.push_back(Eigen::Matrix3Xd::Zero(3, n - 1));
   state.s0_m = {cable.unstretched_length_m};
   state.s0_rate_m_per_s = {0.0};

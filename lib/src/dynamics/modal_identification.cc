@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "dynamics/record_preparation.h"
+#include "fastcal/cable.h"
 #include "fastcal/catenary.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/plausibility.h"
@@ -525,10 +526,10 @@ bool TensionsAtFixedLengths(const CableRobot& robot, const Pose& pose,
         c.tower_top_m - (pose.position_m + pose.rotation * robot.AnchorOfCable(i));
     CatenaryForces f;
     int iterations = 0;
-    if (SolveCatenaryForcesDouble(
-            chord.head<2>().norm(), chord.z(), statics.cables[i].unstretched_length_m, c.ea_n,
-            c.linear_density_kg_per_m * robot.gravity_m_per_s2, CatenarySolverOptions(), nullptr,
-            &f, &iterations) != CatenaryStatus::kOk) {
+    if (Cable::Of(c).Forces(chord.head<2>().norm(), chord.z(),
+                            statics.cables[i].unstretched_length_m, robot.gravity_m_per_s2,
+                            CatenarySolverOptions(), nullptr, &f,
+                            &iterations) != CatenaryStatus::kOk) {
       return false;
     }
     (*t)[i] = std::hypot(f.fl_n, f.fz_n) / 1e3;

@@ -57,6 +57,7 @@
 #include <vector>
 
 #include "dynamics/chain_statics.h"
+#include "fastcal/cable.h"
 #include "fastcal/catenary.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/model_plausibility.h"
@@ -65,9 +66,6 @@ namespace fastcal {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
-// The catenary's nodes must close on the tower to this fraction of the chord: the
-// statics' exact solution closes to ~1e-12; more means the forces do not belong to s0.
-constexpr double kMaxClosureFraction = 1e-7;
 // An eigenvalue below -this times the largest is a true negative stiffness (an unstable
 // equilibrium), not rounding.
 constexpr double kNegativeEigenvalueFraction = 1e-10;
@@ -79,54 +77,6 @@ Eigen::Matrix3d Cross(const Eigen::Vector3d& v) {
   Eigen::Matrix3d m;
   m << 0.0, -v.z(), v.y(), v.z(), 0.0, -v.x(), -v.y(), v.x(), 0.0;
   return m;
-}
-
-// One cable as a chain: its N + 1 nodes (global frame, node 0 at the lower end) and the
-// tension of each of its N segments.
-struct Chain {
-  std::vector<Eigen::Vector3d> nodes_m;
-  std::vector<double> tension_n;
-  double segment_length_m = 0.0;  // unstretched, l0
-  double node_mass_kg = 0.0;      // rho l0, an interior node's
-  double ea_n = 0.0;
-};
-
-// Puts the N + 1 nodes on the elastic catenary with lower end `lower_m`, lower-end forces
-// (Fl, Fz) on the cable and its horizontal direction `horizontal` (unit, toward the upper
-// end); `upper_m` is where the upper end must land.
-bool BuildChain(const Eigen::Vector3d& lower_m, const Eigen::Vector3d& upper_m,
-                const Eigen::Vector3d& horizontal, double fl_n, double fz_n, double s0_m,
-                double ea_n, double density_kg_per_m, double gravity_m_per_s2, int segments,
-                Chain* chain, std::string* error) {
-  const double w = density_kg_per_m * gravity_m_per_s2;
-  const std::vector<CatenaryPoint> points = CatenaryShape(fl_n, fz_n, s0_m, ea_n, w, segments + 1);
-  chain->nodes_m.resize(points.size());
-  for (size_t j = 0; j < points.size(); ++j) {
-    chain->nodes_m[j] =
-        lower_m + points[j].span_m * horizontal + Eigen::Vector3d(0.0, 0.0, points[j].rise_m);
-  }
-  const double miss_m = (chain->nodes_m.back() - upper_m).norm();
-  if (!(miss_m <= kMaxClosureFraction * (upper_m - lower_m).norm())) {
-    *error = "the catenary misses its upper end by " + std::to_string(miss_m) + " m";
-    return false;
-  }
-  chain->segment_length_m = s0_m / segments;
-  chain->node_mass_kg = density_kg_per_m * chain->segment_length_m;
-  chain->ea_n = ea_n;
-  chain->tension_n.resize(segments);
-  for (int j = 0; j < segments; ++j) {
-    chain->tension_n[j] = CatenaryTension(fl_n, fz_n, (j + 0.5) * chain->segment_length_m, w);
-  }
-  return true;
-}
-
-// (EA/l0) n n^T + (T/l)(I - n n^T) of the segment with end-to-end vector d.
-Eigen::Matrix3d SegmentStiffness(const Eigen::Vector3d& d, double tension_n, double ea_n,
-                                 double l0_m) {
-  const double l = d.norm();
-  const Eigen::Vector3d n = d / l;
-  const Eigen::Matrix3d nn = n * n.transpose();
-  return (ea_n / l0_m) * nn + (tension_n / l) * (Eigen::Matrix3d::Identity() - nn);
 }
 
 // How a node's displacement follows the degrees of freedom: v = map * q[dof .. dof + cols).
@@ -169,7 +119,8 @@ void AddSegment(const Eigen::Matrix3d& h, const NodeMap& a, const NodeMap& b, En
 // Adds a chain's stiffness and its moving nodes' masses. Interior node j (1..N-1) is free
 // at first_dof + 3 (j - 1); the lower node follows `lower` and carries half a node's mass;
 // the upper node is fixed.
-void AddChain(const Chain& chain, const NodeMap& lower, int first_dof, Entries* k, Entries* m) {
+void AddChain(const LumpedChain& chain, const NodeMap& lower, int first_dof, Entries* k,
+              Entries* m) {
   const int segments = static_cast<int>(chain.tension_n.size());
   auto node = [&](int j) {
     if (j == 0) return lower;
@@ -178,8 +129,8 @@ void AddChain(const Chain& chain, const NodeMap& lower, int first_dof, Entries* 
   };
   for (int j = 0; j < segments; ++j) {
     const Eigen::Matrix3d h =
-        SegmentStiffness(chain.nodes_m[j + 1] - chain.nodes_m[j], chain.tension_n[j], chain.ea_n,
-                         chain.segment_length_m);
+        Cable::SegmentStiffness(chain.nodes_m[j + 1] - chain.nodes_m[j], chain.tension_n[j],
+                                chain.ea_n, chain.segment_length_m);
     AddSegment(h, node(j), node(j + 1), k);
   }
   for (int j = 1; j < segments; ++j) {
@@ -338,7 +289,7 @@ Eigen::Matrix3d LoadStiffness(const CableRobot& robot, const Pose& pose,
 // K and M of the whole system, and what the modes' energies need.
 struct Assembly {
   Eigen::SparseMatrix<double> k, m;
-  std::array<Chain, kNumCables> chains;
+  std::array<LumpedChain, kNumCables> chains;
   std::array<NodeMap, kNumCables> anchors;  // each cable's lower node: T_i on the cabin's dofs
   std::array<int, kNumCables> first_dof{};  // each cable's first interior node
   double asymmetry = 0.0;
@@ -354,12 +305,9 @@ bool Assemble(const CableRobot& robot, const Pose& pose, const StaticsSolution& 
     const CableSolution& s = statics.cables[i];
     const Eigen::Vector3d r = pose.rotation * robot.AnchorOfCable(i);
     const Eigen::Vector3d lower = pose.position_m + r;
-    Eigen::Vector3d horizontal = c.tower_top_m - lower;
-    horizontal.z() = 0.0;
-    horizontal.normalize();
-    if (!BuildChain(lower, c.tower_top_m, horizontal, s.horizontal_force_n, s.force_n.z(),
-                    s.unstretched_length_m, c.ea_n, c.linear_density_kg_per_m,
-                    robot.gravity_m_per_s2, segments, &a->chains[i], error)) {
+    if (!Cable::Of(c).Lumped(lower, c.tower_top_m, s.horizontal_force_n, s.force_n.z(),
+                             s.unstretched_length_m, robot.gravity_m_per_s2, segments,
+                             &a->chains[i], error)) {
       *error = "cable " + std::to_string(i + 1) + ": " + *error;
       return false;
     }
@@ -412,7 +360,7 @@ Mode DescribeMode(const CableRobot& robot, const Pose& pose, const Assembly& a, 
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> root(inertia);
   mode.cabin_rotation_share = (root.operatorSqrt() * theta).cwiseAbs2();
   for (int i = 0; cables && i < kNumCables; ++i) {
-    const Chain& chain = a.chains[i];
+    const LumpedChain& chain = a.chains[i];
     const int interior = static_cast<int>(chain.tension_n.size()) - 1;
     mode.cable_share[i] =
         0.5 * chain.node_mass_kg * (a.anchors[i].map * phi.head<6>()).squaredNorm() +
@@ -462,21 +410,19 @@ bool ComputeFixedCableModes(const FixedCable& cable, const ModesOptions& options
     *error = "cable: span, unstretched length, EA and density must be > 0 and finite, g < 0";
     return false;
   }
-  const double w = cable.linear_density_kg_per_m * cable.gravity_m_per_s2;
+  const Cable bare(cable.ea_n, cable.linear_density_kg_per_m);
   CatenaryForces forces;
   int iterations = 0;
-  if (SolveCatenaryForcesDouble(cable.span_m, cable.rise_m, cable.unstretched_length_m, cable.ea_n,
-                                w, CatenarySolverOptions(), nullptr, &forces,
-                                &iterations) != CatenaryStatus::kOk) {
+  if (bare.Forces(cable.span_m, cable.rise_m, cable.unstretched_length_m, cable.gravity_m_per_s2,
+                  CatenarySolverOptions(), nullptr, &forces, &iterations) != CatenaryStatus::kOk) {
     *error = "cable: the catenary has no solution for this span, rise and length";
     return false;
   }
   const int n = options.segments;
-  Chain chain;
-  if (!BuildChain(Eigen::Vector3d::Zero(), Eigen::Vector3d(cable.span_m, 0.0, cable.rise_m),
-                  Eigen::Vector3d::UnitX(), forces.fl_n, forces.fz_n, cable.unstretched_length_m,
-                  cable.ea_n, cable.linear_density_kg_per_m, cable.gravity_m_per_s2, n, &chain,
-                  error)) {
+  LumpedChain chain;
+  if (!bare.Lumped(Eigen::Vector3d::Zero(), Eigen::Vector3d(cable.span_m, 0.0, cable.rise_m),
+                   forces.fl_n, forces.fz_n, cable.unstretched_length_m, cable.gravity_m_per_s2, n,
+                   &chain, error)) {
     return false;
   }
   const int dofs = 3 * (n - 1);
