@@ -29,6 +29,8 @@ DEFINE_bool(keep_overlapping, false,
             "track: fold files whose time spans overlap (refused otherwise: the same "
             "instants given twice).");
 DEFINE_int64(min_window_samples, 100, "track: windows with fewer samples are left out.");
+DEFINE_bool(exit_new_events, false,
+            "track: exit with status 3 when the run reports an event the previous one did not.");
 DEFINE_double(false_alarm, 0.01,
               "track: chance that noise alone reports any event of a kind over the track.");
 
@@ -74,6 +76,9 @@ Usage:
   --min-window-samples=100  windows with fewer samples are left out (and named)
   --false-alarm=0.01  each kind of event: the chance that noise alone reports any over
                       the whole track (Bonferroni over its tests)
+  --exit-new-events   exit with status 3 (the track written) when an event is new: not
+                      reported by the track's previous run (events.json: each event's
+                      "new", "new_events"); every event of a track built afresh is new
   --refold            on an update, refold every window at the new point (and re-estimate
                       the slow error), as a fresh track would
   --force             build the track afresh from the data, whatever DIR holds (needed
@@ -114,6 +119,8 @@ Outputs in DIR:
                           offset, chi2/nu, widening, gross errors, window label
   events.json             the events: time, after, time_low, time_high, kind, parameters
                           {shift, sigma_total}, cables, statistic, p_value (family-wise)
+  model_calibrated.yaml   the current model, at a stable path: the event-free stretch
+                          of the latest window (its windows averaged), as below
   model_calibrated@W.yaml the latest window's model, and one per event-free stretch
                           (@FIRST_to_LAST)
   track.html              the per-window parameters with bars, the sensors, the events
@@ -122,7 +129,8 @@ Outputs in DIR:
                           a sample)
 
 Exit codes: 0 the track was written, 1 the fit failed (a pose the model cannot solve,
-parameters undetermined), 2 bad input. Python: fastcal.track (also on a Dask cluster).
+parameters undetermined), 2 bad input, 3 the track was written and holds new events
+(with --exit-new-events only). Python: fastcal.track (also on a Dask cluster).
 
 Example:
   fastcal simulate --trajectory=random --samples=18000 --days=10 --interval-s=2 \
@@ -244,7 +252,7 @@ std::string WindowLines(const TrackResult& r) {
 
 std::string EventLine(const TrackResult& r, const TrackEvent& e) {
   std::ostringstream line;  // wrapped at the console's width below
-  line << e.kind;
+  line << (e.is_new && r.updated ? "new " : "") << e.kind;
   if (!e.cables.empty()) {
     line << " (cable";
     for (int c : e.cables) line << " " << c;
@@ -264,7 +272,9 @@ std::string EventLines(const TrackResult& r) {
   std::ostringstream s;
   s << "\nEvents (events.json; each kind at a "
     << internal::FormatDouble("%g", 100.0 * r.false_alarm)
-    << "% false-alarm rate over the track): " << r.events.size() << "\n";
+    << "% false-alarm rate over the track): " << r.events.size();
+  if (r.updated) s << " (" << r.NewEvents() << " new since the previous run)";
+  s << "\n";
   for (const TrackWander& w : r.wander) {
     const std::string text = DescribeWander(w);
     if (!text.empty()) s << Wrapped("(" + text + ")", "  ", "   ", kSentenceLines, "track.html");
@@ -279,6 +289,7 @@ std::string Summary(const TrackResult& r, const std::string& out) {
     s += Wrapped("Note: " + n, "", "  ", kSentenceLines, "track.html");
   }
   return s + "\nWritten to " + out + ": track.csv, events.json, track.html, " +
+         (r.current_model >= 0 ? "model_calibrated.yaml (the current model), " : "") +
          std::to_string(r.models.size()) + " model_calibrated@*.yaml\n";
 }
 
@@ -288,7 +299,7 @@ int RunTrack(int argc, char** argv) {
   int exit_code = 0;
   if (!StartCommand(argc, argv, kCommand, kHelp,
                     {"model", "spec", "data", "out", "window", "window-origin", "threads", "refold",
-                     "force", "keep-overlapping", "quiet", "skip-invalid-rows",
+                     "force", "keep-overlapping", "quiet", "skip-invalid-rows", "exit-new-events",
                      "min-window-samples", "false-alarm", "columns"},
                     &exit_code)) {
     return exit_code;
@@ -351,7 +362,9 @@ int RunTrack(int argc, char** argv) {
     return status == TrackStatus::kInvalidInput ? kExitUsage : kExitFailure;
   }
   std::cout << Summary(result, FLAGS_out);
-  return 0;
+  // An operator's script learns from the status alone that something changed.
+  constexpr int kExitNewEvents = 3;
+  return FLAGS_exit_new_events && result.NewEvents() > 0 ? kExitNewEvents : 0;
 }
 
 }  // namespace fastcal::cli

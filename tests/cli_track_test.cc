@@ -148,6 +148,60 @@ TEST_F(CliTrackTest, ANewDaysFileUpdatesTheTrack) {
   EXPECT_NE(ReadFile(Path("t/track_state.json")).find("12h"), std::string::npos);
 }
 
+// Issue 59: a track for operations. The current model sits at a stable path
+// (model_calibrated.yaml, the latest event-free stretch's model), events.json marks the
+// events the previous run did not report, and --exit-new-events makes the exit status say
+// so: 3 when the run holds a new event, 0 when it holds none.
+TEST_F(CliTrackTest, AnUpdateMarksItsNewEventsAndTheCurrentModelKeepsItsPath) {
+  // The season of kSeasonFlags in two files: days 1-4 (the move before day 3), days 5-7
+  // (cable 2 re-zeroed before day 6).
+  const std::string steps =
+      " --trajectory=random --interval-s=20 --mass-centre=0.22,0.11,0.5 --seed=4"
+      " --sensor-gain-spread-percent=1 --sensor-bias-spread-kN=1.5"
+      " --mass-centre-step=1714762800:0.05,0,0 --sensor-step=1715022000:2:5";
+  ASSERT_EQ(Fastcal("simulate" + steps +
+                    " --samples=960 --days=4 --start=1714593600 --out=" + Path("a.csv"))
+                .code,
+            0);
+  ASSERT_EQ(Fastcal("simulate" + steps +
+                    " --samples=720 --days=3 --start=1714939200 --out=" + Path("b.csv"))
+                .code,
+            0);
+  const std::string track =
+      "track --quiet --exit-new-events --spec=" + Spec() + " --out=" + Path("t") + " --data=";
+  constexpr int kExitNewEvents = 3;
+  const auto first = Fastcal(track + Path("a.csv"));
+  ASSERT_EQ(first.code, kExitNewEvents) << first.output;  // a new track: its move is new
+  EXPECT_NE(first.output.find("model_calibrated.yaml (the current model)"), std::string::npos)
+      << first.output;
+  // The current model is the latest stretch's, with its own header.
+  const std::string current = ReadFile(Path("t/model_calibrated.yaml"));
+  const std::string stretch = ReadFile(Path("t/model_calibrated@2024-05-03_to_2024-05-04.yaml"));
+  ASSERT_FALSE(stretch.empty());
+  EXPECT_NE(current.find("The current model"), std::string::npos) << current;
+  const auto body = [](const std::string& yaml) { return yaml.substr(yaml.find("\nformat:")); };
+  EXPECT_EQ(body(current), body(stretch));
+
+  const auto second = Fastcal(track + Path("a.csv") + "," + Path("b.csv"));
+  ASSERT_EQ(second.code, kExitNewEvents) << second.output;  // the re-zeroing is new
+  EXPECT_NE(second.output.find("(1 new since the previous run)"), std::string::npos)
+      << second.output;
+  EXPECT_NE(second.output.find("new sensor (cable 2)"), std::string::npos) << second.output;
+  EXPECT_EQ(second.output.find("new parameter"), std::string::npos) << second.output;
+  const std::string events = ReadFile(Path("t/events.json"));
+  EXPECT_NE(events.find("\"new_events\": 1"), std::string::npos) << events;
+  const size_t move = events.find("\"kind\": \"parameter\"");
+  ASSERT_NE(move, std::string::npos) << events;
+  EXPECT_NE(events.rfind("\"new\": false", move), std::string::npos) << events;
+  // The path did not change; its model is now the stretch after the re-zeroing's.
+  EXPECT_NE(ReadFile(Path("t/model_calibrated.yaml")).find("2024-05-07"), std::string::npos);
+
+  // The same data again: nothing new, exit 0.
+  const auto third = Fastcal(track + Path("a.csv") + "," + Path("b.csv"));
+  EXPECT_EQ(third.code, 0) << third.output;
+  EXPECT_NE(third.output.find("(0 new since the previous run)"), std::string::npos) << third.output;
+}
+
 // --min-window-samples above the subsample of a new track's first steps
 // (TrackOptions::first_fold_samples, 5000) raises the subsample: it was refused, naming
 // an option the command line does not have.

@@ -30,7 +30,8 @@ class TrackResult:
             the change: the later window's first, or its block's inside a window) and
             time (the same as events.json writes it, ISO 8601 for Unix times), after_s
             and after (the last before), time_low/time_high as text too, time_low_s and time_high_s (its likelihood
-            interval), window, previous_window, within_window,
+            interval), window, previous_window, within_window, new (not reported by the
+            track's previous run; every event of a track built afresh),
             parameters (name -> {shift, sigma_total, unit}), cables (for a sensor),
             statistic, degrees_of_freedom, threshold, p_value (family-wise).
         wander: per per-window group, its wander between windows beyond its errors

@@ -60,6 +60,7 @@ py::dict EventDict(const TrackResult& r, const TrackEvent& e) {
   d["window"] = r.windows[e.window].label;
   d["previous_window"] = r.windows[e.previous_window].label;
   d["within_window"] = e.within_window;
+  d["new"] = e.is_new;
   py::dict parameters;
   for (const TrackEventParameter& p : e.parameters) {
     py::dict q;

@@ -229,6 +229,10 @@ struct TrackEvent {
   // Family-wise: min(1, tests x P(chi-square > statistic)); the event's is below
   // TrackOptions::false_alarm.
   double p_value = 1.0;
+  // Not among the events the track's previous run reported (track_state.json): none of
+  // them of its kind and cables has an interval that overlaps this one's. Every event of
+  // a track built afresh (a new DIR, --force) is new.
+  bool is_new = true;
 };
 
 // A per-window group's wander, in two parts: between windows (day to day) beyond its
@@ -292,6 +296,14 @@ struct TrackResult {
   // model_calibrated@LABEL.yaml.
   std::vector<std::pair<std::string, CableRobot>> models;
   std::vector<std::string> model_comments;  // parallel: each model's estimates
+  // The current model, written also as model_calibrated.yaml (a stable path): the one of
+  // the stretch that holds the latest window (an index into `models`; -1 without one).
+  int current_model = -1;
+  int NewEvents() const {
+    int n = 0;
+    for (const TrackEvent& e : events) n += e.is_new ? 1 : 0;
+    return n;
+  }
 };
 
 // "Gauss-Newton converged in N iterations (the last step S sigma, below T)" or "Gauss-Newton

@@ -308,8 +308,13 @@ bool TrackOptions::IsValid(std::string* error) const {
 }
 
 bool IsTrackOutput(const std::string& name) {
-  static const char* const kNames[] = {"track.csv",        "events.json", "track.html",
-                                       "track_state.json", "folds",       "windows"};
+  static const char* const kNames[] = {"track.csv",
+                                       "events.json",
+                                       "track.html",
+                                       "track_state.json",
+                                       "folds",
+                                       "windows",
+                                       internal::kCurrentModelFile};
   for (const char* n : kNames) {
     if (name == n) return true;
   }

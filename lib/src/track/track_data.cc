@@ -99,6 +99,19 @@ std::string StateJson(const TrackRun& run) {
     j.EndObject();
   }
   j.EndArray();
+  // The events reported now, so that the next run can tell its new ones (is_new).
+  j.Key("events").BeginArray();
+  for (const TrackEvent& e : run.result->events) {
+    j.BeginObject();
+    j.Key("kind").String(e.kind);
+    j.Key("cables").BeginArray();
+    for (int c : e.cables) j.Int(c);
+    j.EndArray();
+    j.Key("time_low_s").ExactNumber(e.time_low_s);
+    j.Key("time_high_s").ExactNumber(e.time_high_s);
+    j.EndObject();
+  }
+  j.EndArray();
   j.Key("windows").BeginArray();
   for (const TrackWindowState& w : run.windows) {
     j.BeginObject();
@@ -174,6 +187,7 @@ struct SavedState {
   std::vector<TrackFile> files;
   std::vector<TrackWindowState> windows;
   std::vector<std::pair<std::string, SharedEntry>> shared;  // by name
+  std::vector<KnownEvent> events;  // reported by the run that saved it (none before 0.2)
 };
 // A window label as this program makes them (a date, "t123", a file's stem): names a
 // store and a fold inside DIR, so one that could reach outside it is refused.
@@ -295,6 +309,14 @@ SavedState ParseState(const std::string& text) {
   for (const YAML::Node& f : root["files"]) s.files.push_back(ParseFile(f));
   for (const YAML::Node& n : root["windows"]) s.windows.push_back(ParseWindow(n));
   for (const YAML::Node& e : root["shared"]) s.shared.push_back(ParseShared(e));
+  for (const YAML::Node& e : root["events"]) {
+    KnownEvent k;
+    k.kind = Text(e["kind"]);
+    for (const YAML::Node& c : e["cables"]) k.cables.push_back(static_cast<int>(Integer(c)));
+    k.time_low_s = Real(e["time_low_s"]);
+    k.time_high_s = Real(e["time_high_s"]);
+    s.events.push_back(k);
+  }
   return s;
 }
 
@@ -554,6 +576,7 @@ bool LoadSavedState(TrackRun& run, bool* use) {
   if (const std::string why = WindowsProblem(run, s); !why.empty()) return DamagedState(run, why);
   run.generation = s.generation + 1;
   run.slow = s.slow;
+  run.previous_events = std::move(s.events);
   run.files = std::move(s.files);
   run.windows = std::move(s.windows);
   if (!CheckStores(run) || !LoadFolds(run)) return false;

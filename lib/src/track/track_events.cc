@@ -689,6 +689,15 @@ void TimeSensorStep(const TrackRun& run, int u, int j, TrackEvent* e) {
 
 }  // namespace
 
+void MarkNewEvents(const std::vector<KnownEvent>& known, std::vector<TrackEvent>* events) {
+  for (TrackEvent& e : *events) {
+    e.is_new = std::none_of(known.begin(), known.end(), [&e](const KnownEvent& k) {
+      return k.kind == e.kind && k.cables == e.cables && k.time_low_s <= e.time_high_s &&
+             e.time_low_s <= k.time_high_s;
+    });
+  }
+}
+
 TrackStatus FindParameterEvents(TrackRun& run) {
   TrackResult& r = *run.result;
   r.events.clear();
@@ -741,6 +750,7 @@ TrackStatus FindParameterEvents(TrackRun& run) {
   }
   std::stable_sort(r.events.begin(), r.events.end(),
                    [](const TrackEvent& a, const TrackEvent& b) { return a.time_s < b.time_s; });
+  MarkNewEvents(run.previous_events, &r.events);
   // The windows' and shared estimates again: the wander inside windows in their sandwich
   // is now the one estimated without the windows the changes are inside.
   return Results(run);

@@ -98,6 +98,8 @@ std::string EventsJson(const TrackResult& r) {
   j.Key("parameter_tests").Int(r.parameter_tests);
   j.Key("sensor_tests").Int(r.sensor_tests);
   j.Key("windows").Int(static_cast<long long>(r.windows.size()));
+  // Events not reported by the track's previous run (each event's `new`).
+  j.Key("new_events").Int(r.NewEvents());
   // Each per-window group's wander between windows beyond its errors (track.h): the
   // parameter events are steps beyond it.
   j.Key("wander").BeginArray();
@@ -144,6 +146,7 @@ std::string EventsJson(const TrackResult& r) {
     j.Key("window").String(r.windows[e.window].label);
     j.Key("previous_window").String(r.windows[e.previous_window].label);
     j.Key("within_window").Bool(e.within_window);
+    j.Key("new").Bool(e.is_new);
     j.Key("kind").String(e.kind);
     j.Key("parameters").BeginObject();
     for (const TrackEventParameter& p : e.parameters) {
@@ -208,6 +211,7 @@ TrackStatus BuildModels(TrackRun& run) {
         a, covariance, first));
     first = last + 1;
   }
+  r.current_model = static_cast<int>(r.models.size()) - 1;  // the stretch of the latest window
   // The latest window, when its stretch is longer.
   const int u = windows - 1;
   if (r.models.back().first != r.windows[u].label) {
@@ -234,6 +238,14 @@ TrackStatus WriteOutputs(TrackRun& run) {
       return TrackStatus::kFailed;
     }
     written.push_back(name);
+  }
+  // The current model at a stable path, for a controller or a nightly script.
+  if (r.current_model >= 0 &&
+      !SaveCableRobot(r.models[r.current_model].second, run.Path(kCurrentModelFile),
+                      "The current model: " + r.model_comments[r.current_model] +
+                          "\n(also model_calibrated@" + r.models[r.current_model].first + ".yaml)",
+                      run.error)) {
+    return TrackStatus::kFailed;
   }
   // An update's models that no longer hold (a stretch an event now cuts).
   std::error_code ec;

@@ -29,6 +29,8 @@ namespace fastcal::internal {
 // -2 ln(1 - sqrt(level)), 7.35 at 95% (3.84 left an overnight re-zeroing in the previous
 // day's blocks, the maximum over a day's cuts of noise alone).
 inline constexpr double kIntervalLevel = 0.95;
+// The current model at a stable path (TrackResult::current_model).
+inline constexpr char kCurrentModelFile[] = "model_calibrated.yaml";
 // A change inside a window leaves at least this many of its blocks on either side: every
 // boundary between a window's blocks is a candidate, the first and last minutes of a day
 // too (issue 53: with two, a re-zeroing 14 minutes before a day's end was put overnight,
@@ -114,6 +116,18 @@ struct GroupWanderState {
   InnerWander inner;
 };
 
+// An event of the track's previous run, as its state recorded it: what tells a new event
+// from one reported before (TrackEvent::is_new).
+struct KnownEvent {
+  std::string kind;
+  std::vector<int> cables;
+  double time_low_s = 0.0, time_high_s = 0.0;
+};
+
+// Marks each of the run's events new unless a known one of its kind and cables has an
+// interval that overlaps its own.
+void MarkNewEvents(const std::vector<KnownEvent>& known, std::vector<TrackEvent>* events);
+
 struct TrackRun {
   TrackRun(const CableRobot& m, const CalibrationSpec& s, const WindowSpec& w, const std::string& o,
            const TrackOptions& opt, TrackResult* r, std::string* e)
@@ -130,7 +144,8 @@ struct TrackRun {
   std::vector<std::string> data_paths;  // the files given (directories expanded)
   std::string dir;      // where this run writes: a staging directory, or DIR on an update
   bool update = false;  // DIR held a track
-  int generation = 0;   // of this run's fold files
+  std::vector<KnownEvent> previous_events;  // the previous run's (track_state.json)
+  int generation = 0;                       // of this run's fold files
   std::string model_yaml, spec_yaml;
   std::string columns_text;  // the column map the files are read through ("" none)
   TrackLayout layout;

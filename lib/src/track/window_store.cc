@@ -103,7 +103,8 @@ bool AppendStoredSamples(const std::string& path, const std::vector<StoredSample
   }
   std::FILE* file = std::fopen(path.c_str(), "ab");
   if (file == nullptr) return Fail(path, std::strerror(errno), error);
-  const size_t written = std::fwrite(bytes.data(), static_cast<size_t>(record), samples.size(), file);
+  const size_t written =
+      std::fwrite(bytes.data(), static_cast<size_t>(record), samples.size(), file);
   const bool closed = std::fclose(file) == 0;
   if (written != samples.size() || !closed) return Fail(path, "cannot write the samples", error);
   return true;
@@ -217,8 +218,8 @@ bool StoredWindowReader::ReadEvery(long long first, int count, int step,
   return true;
 }
 
-bool ReadStoredWindow(const std::string& path, int joints, Dataset* data,
-                      std::vector<int>* file_of, std::string* error) {
+bool ReadStoredWindow(const std::string& path, int joints, Dataset* data, std::vector<int>* file_of,
+                      std::string* error) {
   StoredWindowReader reader;
   if (!reader.Open(path, joints, error)) return false;
   if (!reader.Read(0, static_cast<int>(reader.size()), &data->samples, file_of, error)) {
