@@ -24,7 +24,11 @@ and reports paired closest first, a report whose interval holds the truth before
 near it), the truth inside the stated interval [time_low, time_high], the shifts' pulls
 (shift - truth) / sigma_total per component (the truth: the sum of the true moves of that
 kind inside the interval, the change between the stretches either side), the interval's
-width, dated to 15 minutes; per season: the events reported that match no truth. `null` seasons have no event: the fraction that
+width, dated to 15 minutes, and for a move the pulls against the true change between the
+stretches either side of its interval too (the true daily means of the whole days up to
+the neighbouring reported changes, from `simulate`'s truth files: what the shift
+estimates when a move nearby went unreported); per season: the events reported that match
+no truth. `null` seasons have no event: the fraction that
 report any is the false-alarm rate.
 
 Usage: scripts/season_answers_study.py events|null [--seasons=40] [--first-seed=1]
@@ -182,7 +186,47 @@ def track(work, files, model, args):
         return json.load(f), r.stdout
 
 
-def judge(events, reported):
+
+def daily_means(work, days):
+    """Each day's true mean of the mass centre over its samples (moves and wander included),
+    as `simulate` states it in the day's truth file."""
+    import re
+    means = []
+    for d in range(days):
+        text = open(os.path.join(work, "d%02d.truth.yaml" % d)).read()
+        m = re.search(r"its average over the samples was \(([^)]*)\)", text)
+        means.append([float(x) for x in m.group(1).split(",")] if m else None)
+    return means
+
+
+def stretch_truth(e, reported, means, hours):
+    """The true change between the stretches either side of reported parameter event `e`:
+    the mean of the true daily means of the days after its interval up to the next reported
+    change, less that of the days before it back to the previous one (days in equal weight;
+    a day holding a change's interval left out). What the shift estimates when a change
+    nearby went unreported; None without a whole day on either side."""
+    others = sorted((x for x in reported["events"] if x["kind"] == "parameter" and x is not e),
+                    key=lambda x: x["time_s"])
+    low = max([x["time_high_s"] for x in others if x["time_high_s"] <= e["time_low_s"]],
+              default=-math.inf)
+    high = min([x["time_low_s"] for x in others if x["time_low_s"] >= e["time_high_s"]],
+               default=math.inf)
+    before, after = [], []
+    for d, m in enumerate(means):
+        first = START.timestamp() + d * DAY
+        last = first + hours * 3600.0
+        if m is None:
+            continue
+        if low < first and last < e["time_low_s"]:
+            before.append(m)
+        elif e["time_high_s"] < first and last < high:
+            after.append(m)
+    if not before or not after:
+        return None
+    return [sum(a[c] for a in after) / len(after) - sum(b[c] for b in before) / len(before)
+            for c in range(3)]
+
+def judge(events, reported, means=None, hours=2.0):
     """Per true event its verdict; the reported events no truth claims. Truths and reports
     are paired closest first (a report whose interval holds the truth before one that only
     lies within 1.5 days of it), so that a small move that is missed does not claim the
@@ -225,6 +269,12 @@ def judge(events, reported):
             v["pulls"] = [(e["parameters"][n]["shift"] - total[j]) / e["parameters"][n]["sigma_total"]
                           for j, n in enumerate(names)]
             v["size"] = math.sqrt(sum(x * x for x in shift))
+            stretches = stretch_truth(e, reported, means, hours) if kind == "parameter" and \
+                means else None
+            if stretches is not None:
+                v["pulls_stretch"] = [
+                    (e["parameters"][n]["shift"] - stretches[j]) / e["parameters"][n]["sigma_total"]
+                    for j, n in enumerate(names)]
         verdicts.append(v)
     # A truth not found whose moment is inside a found one's interval was reported within it.
     for i, v in enumerate(verdicts):
@@ -280,7 +330,7 @@ def run_season(job):
         reported, console = track(work, files, model, args)
     except RuntimeError as e:
         return {"seed": seed, "error": str(e)}
-    verdicts, false = judge(events, reported)
+    verdicts, false = judge(events, reported, daily_means(work, args.days), args.hours)
     day_axes = judge_days(work, events, condition)
     converged = "did not converge" not in " ".join(console.split())
     if not args.keep:
@@ -331,6 +381,15 @@ def summarise(results, args):
                   label, len(group), rate(sum(v["covered"] for v in group), len(group)), spread,
                   rate(within, len(pulls)), median_width,
                   rate(sum(v["dated"] for v in group), len(group))))
+    # The mass centre's shifts against the true change between their stretches (the day
+    # means either side, stretch_truth): what the shift estimates when a move nearby went
+    # unreported, where the pull against the move itself counts that move as error.
+    against = [v for v in found if "pulls_stretch" in v]
+    if against:
+        pulls = [p for v in against for p in v["pulls_stretch"]]
+        print("  mass centre's shifts against their stretches' true change (%d events): pulls sd "
+              "%.2f (|pull| <= 2.5: %s)" % (len(against), statistics.pstdev(pulls),
+                                             rate(sum(abs(p) <= 2.5 for p in pulls), len(pulls))))
     within = [v for v in verdicts if not v["found"] and v.get("within_another")]
     print("  not found alone but inside a found event's interval (its shift the sum): %d" %
           len(within))
