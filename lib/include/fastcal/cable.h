@@ -30,6 +30,7 @@
 #include "fastcal/cable_attachment.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/catenary.h"
+#include "fastcal/catenary_chain.h"
 
 namespace fastcal {
 
@@ -84,6 +85,18 @@ class Cable {
               double fz_n, double s0_m, double gravity_m_per_s2, int segments, LumpedChain* chain,
               std::string* error) const;
 
+  // The end point in any scalar (T may be a ceres::Jet): a cable of axial stiffness EA,
+  // weight per length w and attachments `chain` (empty: uniform). The one kernel End and
+  // the statics' templated core (internal/statics_core.h, so the calibration) evaluate.
+  template <typename T>
+  FASTCAL_ALWAYS_INLINE static CatenaryEnd<T> EndOf(const T& fl_n, const T& fz_n, const T& s0_m,
+                                                    const T& ea_n, const T& w_n_per_m,
+                                                    const CatenaryChain<T>& chain,
+                                                    double gravity_m_per_s2) {
+    if (chain.empty()) return CatenaryEndpoint(fl_n, fz_n, s0_m, ea_n, w_n_per_m);
+    return CatenaryChainEndpoint(fl_n, fz_n, s0_m, ea_n, w_n_per_m, chain, gravity_m_per_s2);
+  }
+
   // A taut segment's tangent stiffness: chord d (m), tension T, unstretched length l0.
   static Eigen::Matrix3d SegmentStiffness(const Eigen::Vector3d& chord_m, double tension_n,
                                           double ea_n, double l0_m);
@@ -98,6 +111,7 @@ class Cable {
   double ea_n_ = 0.0;
   double linear_density_kg_per_m_ = 0.0;
   std::vector<CableAttachment> attachments_;
+  CatenaryChain<double> chain_;  // the attachments as the kernels take them
 };
 
 // How far the lumped chain's upper node may miss the upper end, as a fraction of the

@@ -8,8 +8,6 @@
 #include <cmath>
 #include <utility>
 
-#include "fastcal/catenary_chain.h"
-
 namespace fastcal {
 namespace {
 
@@ -21,7 +19,8 @@ constexpr int kMaxHalvings = 30;
 Cable::Cable(double ea_n, double linear_density_kg_per_m, std::vector<CableAttachment> attachments)
     : ea_n_(ea_n),
       linear_density_kg_per_m_(linear_density_kg_per_m),
-      attachments_(std::move(attachments)) {}
+      attachments_(std::move(attachments)),
+      chain_(MakeCatenaryChain(attachments_)) {}
 
 Cable Cable::Of(const CableProperties& properties) {
   return Cable(properties.ea_n, properties.linear_density_kg_per_m, properties.attachments);
@@ -49,10 +48,8 @@ bool Cable::IsValid(std::string* error) const {
 
 CatenaryEnd<double> Cable::End(double fl_n, double fz_n, double s0_m,
                                double gravity_m_per_s2) const {
-  const double w = WeightPerLengthN(gravity_m_per_s2);
-  if (uniform()) return CatenaryEndpoint(fl_n, fz_n, s0_m, ea_n_, w);
-  return CatenaryChainEndpoint(fl_n, fz_n, s0_m, ea_n_, w, MakeCatenaryChain(attachments_),
-                               gravity_m_per_s2);
+  return EndOf(fl_n, fz_n, s0_m, ea_n_, WeightPerLengthN(gravity_m_per_s2), chain_,
+               gravity_m_per_s2);
 }
 
 CatenaryStatus Cable::Forces(double span_m, double rise_m, double s0_m, double gravity_m_per_s2,
@@ -67,12 +64,10 @@ CatenaryStatus Cable::Forces(double span_m, double rise_m, double s0_m, double g
     return start;
   }
   if (guess != nullptr) *forces = *guess;
-  const CatenaryChain<double> chain = MakeCatenaryChain(attachments_);
   const double tolerance_m = options.relative_tolerance * std::hypot(span_m, rise_m);
   for (int k = 1; k <= options.max_iterations; ++k) {
     *iterations = k;
-    const CatenaryEnd<double> e =
-        CatenaryChainEndpoint(forces->fl_n, forces->fz_n, s0_m, ea_n_, w, chain, gravity_m_per_s2);
+    const CatenaryEnd<double> e = End(forces->fl_n, forces->fz_n, s0_m, gravity_m_per_s2);
     const Eigen::Vector2d miss(e.span_m - span_m, e.rise_m - rise_m);
     if (!miss.allFinite()) return CatenaryStatus::kNotConverged;
     if (miss.cwiseAbs().maxCoeff() <= tolerance_m) return CatenaryStatus::kOk;

@@ -18,6 +18,7 @@
 #include <limits>
 #include <optional>
 
+#include "fastcal/cable.h"
 #include "fastcal/cable_robot.h"
 #include "fastcal/catenary.h"
 #include "fastcal/catenary_chain.h"
@@ -70,7 +71,8 @@ StaticsParameters<double> ScalarParameters(const StaticsParameters<T>& p) {
   for (int j = 0; j < 3; ++j) d.mass_centre_cabin_m[j] = ScalarValue(p.mass_centre_cabin_m[j]);
   d.num_parts = p.num_parts;
   for (int k = 0; k < p.num_parts; ++k) {
-    for (int j = 0; j < 3; ++j) d.part_first_moment_kg_m[k][j] = ScalarValue(p.part_first_moment_kg_m[k][j]);
+    for (int j = 0; j < 3; ++j)
+      d.part_first_moment_kg_m[k][j] = ScalarValue(p.part_first_moment_kg_m[k][j]);
     d.part_mass_kg[k] = ScalarValue(p.part_mass_kg[k]);
   }
   d.gravity_m_per_s2 = p.gravity_m_per_s2;
@@ -134,9 +136,7 @@ template <typename T>
 FASTCAL_ALWAYS_INLINE CatenaryEnd<T> CableEndpoint(const StaticsParameters<T>& p, int i,
                                                    const T& fl_n, const T& fz_n, const T& s0_m,
                                                    const T& w_n_per_m) {
-  if (p.chain[i].empty()) return CatenaryEndpoint(fl_n, fz_n, s0_m, p.ea_n[i], w_n_per_m);
-  return CatenaryChainEndpoint(fl_n, fz_n, s0_m, p.ea_n[i], w_n_per_m, p.chain[i],
-                               p.gravity_m_per_s2);
+  return Cable::EndOf(fl_n, fz_n, s0_m, p.ea_n[i], w_n_per_m, p.chain[i], p.gravity_m_per_s2);
 }
 
 // Cable chords and lever arms at one pose.
