@@ -4,6 +4,7 @@
 // the flag named and nothing left behind.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -200,6 +201,45 @@ TEST_F(CliTrackTest, AnUpdateMarksItsNewEventsAndTheCurrentModelKeepsItsPath) {
   const auto third = Fastcal(track + Path("a.csv") + "," + Path("b.csv"));
   EXPECT_EQ(third.code, 0) << third.output;
   EXPECT_NE(third.output.find("(0 new since the previous run)"), std::string::npos) << third.output;
+}
+
+// Issue 53: a step's likelihood interval runs over every night the data allow, not only
+// the two beside the night it is placed at. Cable 2 re-zeroed (+3 kN) in the night before
+// a day of 40 samples (13 minutes) between days of 240: that short day cannot tell the
+// night before it from the night after it, where the step is placed. The interval held
+// only the night after and the short day's telemetry; the true moment was outside it.
+TEST_F(CliTrackTest, AStepBesideAShortDaySpansBothNightsAroundIt) {
+  const std::string flags =
+      " --trajectory=random --interval-s=20 --mass-centre=0.22,0.11,0.5"
+      " --tension-drift-percent=1 --tension-drift-time-s=120 --sensor-gain-spread-percent=1"
+      " --sensor-bias-spread-kN=1.5 --seed=4 --sensor-step=1714867200:2:3";
+  constexpr double kStepS = 1714867200.0;  // 2024-05-05T00:00:00Z
+  ASSERT_EQ(Fastcal("simulate" + flags +
+                    " --samples=960 --days=4 --start=1714593600 --out=" + Path("a.csv"))
+                .code,
+            0);
+  ASSERT_EQ(Fastcal("simulate" + flags +
+                    " --samples=40 --days=1 --start=1714939200 --out=" + Path("b.csv"))
+                .code,
+            0);
+  ASSERT_EQ(Fastcal("simulate" + flags +
+                    " --samples=960 --days=4 --start=1715025600 --out=" + Path("c.csv"))
+                .code,
+            0);
+  const auto run =
+      Fastcal("track --quiet --min-window-samples=30 --spec=" + Spec() + " --out=" + Path("t") +
+              " --data=" + Path("a.csv") + "," + Path("b.csv") + "," + Path("c.csv"));
+  ASSERT_EQ(run.code, 0) << run.output;
+  EXPECT_NE(run.output.find("sensor (cable 2)"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("it spans 2 nights and 2 days' telemetry"), std::string::npos)
+      << run.output;
+  const std::string events = ReadFile(Path("t/events.json"));
+  const auto number = [&](const std::string& key) {
+    const size_t at = events.find("\"" + key + "\": ");
+    return at == std::string::npos ? std::nan("") : std::stod(events.substr(at + key.size() + 4));
+  };
+  EXPECT_LE(number("time_low_s"), kStepS) << events;
+  EXPECT_GE(number("time_high_s"), kStepS) << events;
 }
 
 // --min-window-samples above the subsample of a new track's first steps

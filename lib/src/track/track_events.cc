@@ -338,6 +338,48 @@ std::vector<Placement> StepPlacements(const TrackRun& run, int u, const std::vec
   return out;
 }
 
+// The step placed at the other boundaries of its two stretches (entries e0 before window u,
+// e from it on, bias column j): at the boundary before window w < u the windows w..u-1 take
+// the new value (a step of `size` each), at the one after window w >= u the windows u..w
+// keep the old one (-size); each boundary's change is the sum of its windows' whole-window
+// changes (PlaceAt, the scan's j = 0), so that a step the data cannot tell from one a night
+// or two away gets an interval over those nights too (issue 53: a re-zeroing reported two
+// days early, its interval the one night). A stretch keeps at least one window.
+void AddOtherBoundaries(const TrackRun& run, int u, int e0, int e, int j,
+                        const std::vector<int>& rows, int column, double size,
+                        std::vector<Placement>* placements) {
+  const int windows = static_cast<int>(run.used.size());
+  const auto whole = [&](int w, double delta) {
+    const std::vector<SplitScore> scores = ScanSplits(run, w, rows, {column}, run.birge[w]);
+    if (scores.empty() || !scores[0].valid) return Placement();
+    const PlacementNoise noise(run, w, column, rows[0]);
+    return PlaceAt(w, 0, scores[0].score[0], scores[0].schur(0, 0), delta, noise,
+                   noise.Part(0, false), 0.0, 0.0);
+  };
+  const auto boundary = [&](int before, double change, double fit) {
+    return Placement{-1,
+                     0,
+                     change,
+                     fit,
+                     run.windows[run.used[before]].last_s,
+                     run.windows[run.used[before + 1]].first_s};
+  };
+  double change = 0.0, fit = 0.0;
+  for (int w = u - 1; w >= 1 && run.entry_of[w][j] == e0 && run.entry_of[w - 1][j] == e0; --w) {
+    const Placement x = whole(w, size);
+    change += x.change;
+    fit += x.fit;
+    placements->push_back(boundary(w - 1, change, fit));
+  }
+  change = fit = 0.0;
+  for (int w = u; w + 1 < windows && run.entry_of[w][j] == e && run.entry_of[w + 1][j] == e; ++w) {
+    const Placement x = whole(w, -size);
+    change += x.change;
+    fit += x.fit;
+    placements->push_back(boundary(w, change, fit));
+  }
+}
+
 // The block holding a cut between samples at before_s and after_s, +1 (the tail's first
 // whole block), and the share of that block after the cut.
 std::pair<int, double> CutShare(const WindowFold& f, double before_s, double after_s) {
@@ -513,6 +555,7 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
     const double size = run.shared[e].value_si - run.shared[e0].value_si;
     std::vector<Placement> placements = StepPlacements(run, u, rows, column, size);
     if (!RefinePlacements(run, u, column, rows[0], size, &placements)) return TrackStatus::kFailed;
+    AddOtherBoundaries(run, u, e0, e, j, rows, column, size, &placements);
     const std::pair<double, double> interval = PlacementInterval(placements);
     run.shared[e].has_interval = true;
     run.shared[e].interval_low_s = interval.first;
@@ -581,7 +624,9 @@ std::vector<SplitScore> ScanSplits(const TrackRun& run, int u, const std::vector
   const Eigen::VectorXd d = StepOf(run, u);
   Eigen::VectorXd score = Eigen::VectorXd::Zero(pg);
   Eigen::MatrixXd cross = Eigen::MatrixXd::Zero(pg, f.information.cols());
-  for (int n = 1; n < blocks; ++n) {
+  // The tail's last part is the whole window (j = 0: every caller's cuts start at 1; the
+  // step placements at other nights use it).
+  for (int n = 1; n < blocks + (head ? 0 : 1); ++n) {
     // The part grows a block at a time: blocks j.. from the end, or ..j-1 from the start.
     const int j = head ? n : blocks - n;
     const int block = head ? n - 1 : j;

@@ -282,18 +282,23 @@ std::string DescribeEventTime(const TrackResult& r, const TrackEvent& e) {
   if (night_only) return s;
   s += " (" + internal::FormatDouble("%g", 100.0 * internal::kIntervalLevel) + "% interval " +
        time(e.time_low_s) + " to " + time(e.time_high_s);
-  // The nights the interval spans (between consecutive windows' data) and the telemetry.
-  bool night = false, telemetry = false;
+  // The nights the interval spans (between consecutive windows' data) and the windows whose
+  // telemetry it reaches into.
+  int nights = 0, windows = 0;
   for (size_t w = 0; w < r.windows.size(); ++w) {
     const TrackWindow& x = r.windows[w];
-    telemetry = telemetry || (e.time_low_s < x.last_time_s && e.time_high_s > x.first_time_s);
+    windows += e.time_low_s < x.last_time_s && e.time_high_s > x.first_time_s ? 1 : 0;
     if (w + 1 < r.windows.size()) {
-      night = night ||
-              (e.time_low_s <= x.last_time_s && e.time_high_s >= r.windows[w + 1].first_time_s);
+      nights += e.time_low_s <= x.last_time_s && e.time_high_s >= r.windows[w + 1].first_time_s;
     }
   }
-  if (night && telemetry) {
-    s += ": it spans a night and a day's telemetry, which the data cannot tell apart";
+  if (nights > 0 && windows > 0) {
+    const auto count = [](int n, const char* one, const char* many) {
+      return n == 1 ? std::string(one) : std::to_string(n) + " " + many;
+    };
+    s += ": it spans " + count(nights, "a night", "nights") + " and " +
+         count(windows, "a day's telemetry", "days' telemetry") +
+         ", which the data cannot tell apart";
   }
   return s + ")";
 }
