@@ -21,6 +21,7 @@
 #include "fastcal/cable_robot.h"
 #include "fastcal/control_cycle.h"
 #include "fastcal/fastcal.h"
+#include "fastcal/internal/units.h"
 #include "fastcal/locate.h"
 #include "fastcal/plausibility.h"
 #include "fastcal/pose.h"
@@ -60,8 +61,8 @@ struct fastcal_solver {
 
 namespace {
 
-constexpr double kKnPerN = 1e-3;
-constexpr double kNPerKn = 1e3;
+using fastcal::internal::kNPerKn;  // the one kN constant (internal/units.h)
+constexpr double kKnPerN = 1.0 / kNPerKn;
 
 void SetError(fastcal_solver* s, const char* text) {
   std::snprintf(s->error, sizeof(s->error), "%s", text);
