@@ -122,7 +122,8 @@ Outputs in DIR:
   model_calibrated.yaml   the current model, at a stable path: the event-free stretch
                           of the latest window (its windows averaged), as below
   model_calibrated@W.yaml the latest window's model, and one per event-free stretch
-                          (@FIRST_to_LAST)
+                          (@FIRST_to_LAST); a window with a move inside its telemetry in
+                          its two parts (@W_before, @W_after; track.csv's rows too)
   track.html              the per-window parameters with bars, the sensors, the events
   track_state.json, folds/, windows/   the track's state for an update (docs/calibration.md,
                           "Tracking: files"); windows/ holds each window's samples (160 bytes

@@ -844,6 +844,49 @@ TEST(TrackTest, StepInsideADayIsOneEventAtItsBlock) {
   EXPECT_NEAR(e.parameters[0].shift, 0.05, 3.0 * e.parameters[0].sigma_total);
 }
 
+// Issue 59: a window with a move inside its telemetry is reported in its two parts, before
+// and after, in track.csv and as two models, not as one average (a mass centre the cabin
+// never had); the current model is the part after. The move: +5 cm in x mid-day 3.
+TEST(TrackTest, AWindowWithAMoveInsideIsReportedInItsTwoParts) {
+  constexpr int kDays = 5, kPerDay = 300;
+  constexpr double kMoveM = 0.05;
+  const double step_s = kStartS + 2 * kDayS + 0.5 * kPerDay * kIntervalS;  // mid-day 3
+  SimulationOptions o;
+  o.mass_centre_steps.push_back({step_s, {kMoveM, 0.0, 0.0}});
+  const TrackResult r = TrackSeason(kDays, kPerDay, 31, o, "inside_parts");
+  ASSERT_EQ(r.events.size(), 1u);
+  const TrackEvent& e = r.events[0];
+  ASSERT_TRUE(e.within_window);
+  ASSERT_EQ(e.parts.size(), 2u);
+  EXPECT_EQ(e.parts[0].samples + e.parts[1].samples, r.windows[e.window].samples);
+  EXPECT_EQ(e.parts[0].end_s, e.time_s);
+  EXPECT_EQ(e.parts[1].start_s, e.time_s);
+  // Each part holds its own level: x before within 3 sigma_total of the days before, after
+  // of the days after; the window's own estimate lies between them.
+  const double x0 = r.windows[1].estimates[0].value, x1 = r.windows[3].estimates[0].value;
+  const TrackEstimate& before = e.parts[0].estimates[0];
+  const TrackEstimate& after = e.parts[1].estimates[0];
+  EXPECT_NEAR(before.value, x0, 3.0 * before.sigma_total);
+  EXPECT_NEAR(after.value, x1, 3.0 * after.sigma_total);
+  EXPECT_NEAR(after.value - before.value, kMoveM, 3.0 * e.parameters[0].sigma_total);
+  const double mixed = r.windows[e.window].estimates[0].value;
+  EXPECT_GT(mixed, before.value);
+  EXPECT_LT(mixed, after.value);
+  // track.csv: the day's two rows, labelled; two model files, the current one the after's.
+  const std::string dir = test::TempPath("track_test_inside_parts") + "/track";  // TempDir clears
+  const std::string csv = ReadText(dir + "/track.csv");
+  EXPECT_NE(csv.find(",2024-05-03_before\n"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",2024-05-03_after\n"), std::string::npos) << csv;
+  EXPECT_EQ(csv.find(",2024-05-03\n"), std::string::npos) << csv;
+  CableRobot part_model;
+  std::string error;
+  ASSERT_TRUE(LoadCableRobot(dir + "/model_calibrated@2024-05-03_after.yaml", &part_model, &error))
+      << error;
+  EXPECT_NEAR(part_model.mass_centre_cabin_m.x(), after.value, 1e-9);
+  EXPECT_TRUE(fs::exists(dir + "/model_calibrated@2024-05-03_before.yaml"));
+  EXPECT_FALSE(fs::exists(dir + "/model_calibrated@2024-05-03.yaml"));
+}
+
 // A sensor re-zeroed inside a day's telemetry: one sensor event, timed at its block within
 // the day, the whole step between the days before and after (that day's bias its own),
 // and no move of the mass centre.

@@ -206,6 +206,17 @@ struct TrackEventParameter {
   double sigma_total = 0.0;
 };
 
+// A window's per-window parameters in one part of it, before or after a change inside its
+// telemetry (TrackEvent::before, ::after).
+struct TrackWindowPart {
+  double start_s = 0.0, end_s = 0.0;  // the part's bounds: the window's and the change's
+  long long samples = 0;
+  // The event's parameters in this part (value in their unit, sigma_total): to first
+  // order the window's estimate less (before) or plus (after) its share of the step, with
+  // the part's own covariance in place of the window's.
+  std::vector<TrackEstimate> estimates;
+};
+
 struct TrackEvent {
   std::string kind;  // "parameter" or "sensor"
   // The first sample of the later window, and the last of the earlier one; or, when the
@@ -233,6 +244,10 @@ struct TrackEvent {
   // them of its kind and cables has an interval that overlaps this one's. Every event of
   // a track built afresh (a new DIR, --force) is new.
   bool is_new = true;
+  // A parameter change inside a window's telemetry (within_window): the window in its two
+  // parts, reported in track.csv and as two models instead of the window's average, a
+  // value the cabin never had. Empty otherwise.
+  std::vector<TrackWindowPart> parts;
 };
 
 // A per-window group's wander, in two parts: between windows (day to day) beyond its

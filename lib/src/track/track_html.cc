@@ -76,9 +76,9 @@ std::string ParameterPlot(const TrackResult& r, const TimeAxis& axis, size_t k) 
   bars.name = "+- sigma_total";
   bars.opacity = 0.6;
   double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-  for (const TrackWindow& w : r.windows) {
+  for (const TrackRow& w : TrackRows(r)) {  // a window with a change inside: its parts
     const TrackEstimate& e = w.estimates[k];
-    const double x = axis.X(Middle(w));
+    const double x = axis.X(0.5 * (w.first_time_s + w.last_time_s));
     value.x.push_back(x);
     value.y.push_back(e.value);
     bars.x.insert(bars.x.end(), {x, x, kNaN});
@@ -162,9 +162,10 @@ std::string WindowsTable(const TrackResult& r) {
                   ")</summary>\n<table><tr><th>window</th><th>samples</th>";
   for (const std::string& n : r.window_parameters) h += "<th>" + Esc(n) + "</th>";
   h += "<th>chi2/nu</th><th>widening</th><th>gross errors</th></tr>\n";
-  for (const TrackWindow& w : r.windows) {
-    h += "<tr><td>" + Esc(w.label) + "</td><td>" + std::to_string(w.samples) + "</td>";
-    for (const TrackEstimate& e : w.estimates) {
+  for (const TrackRow& row : TrackRows(r)) {  // a window with a change inside: its parts
+    const TrackWindow& w = *row.window;
+    h += "<tr><td>" + Esc(row.label) + "</td><td>" + std::to_string(row.samples) + "</td>";
+    for (const TrackEstimate& e : row.estimates) {
       h += "<td>" + FormatDouble("%.5g", e.value) + " +- " + FormatDouble("%.2g", e.sigma_total) +
            "</td>";
     }

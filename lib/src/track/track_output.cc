@@ -18,6 +18,9 @@ namespace fs = std::filesystem;
 
 std::string Num(double v) { return v == 0.0 ? "0" : FormatDouble("%.10g", v); }
 
+// The labels of a window's two parts around a change inside it (TrackEvent::parts).
+constexpr const char* kPartSuffix[2] = {"_before", "_after"};
+
 std::string ValueText(double value, double sigma, const std::string& unit) {
   return FormatDouble("%.6g", value) + " +- " + FormatDouble("%.2g", sigma) +
          (unit == "1" ? "" : " " + unit);
@@ -70,18 +73,41 @@ std::string CsvHeader(const TrackResult& r, bool offsets) {
   return h + ",reduced_chi_square,widening,gross_errors,window\n";
 }
 
+// The parameter event inside window w with its two parts, or null.
+const TrackEvent* SplitEventOf(const TrackResult& r, size_t w) {
+  for (const TrackEvent& e : r.events) {
+    if (e.within_window && e.window == static_cast<int>(w) && e.parts.size() == 2) return &e;
+  }
+  return nullptr;
+}
+
+// Window w's estimates with the event's parameters taken from one of its parts.
+std::vector<TrackEstimate> PartEstimates(const TrackResult& r, const TrackWindow& w,
+                                         const TrackEvent& e, const TrackWindowPart& part) {
+  std::vector<TrackEstimate> out = w.estimates;
+  for (size_t x = 0; x < e.parameters.size() && x < part.estimates.size(); ++x) {
+    for (size_t k = 0; k < r.window_parameters.size(); ++k) {
+      if (r.window_parameters[k] == e.parameters[x].name) out[k] = part.estimates[x];
+    }
+  }
+  return out;
+}
+
 std::string TrackCsv(const TrackResult& r) {
   const bool offsets = !r.windows.empty() && r.windows.front().has_offsets;
   std::string csv = CsvHeader(r, offsets);
-  for (const TrackWindow& w : r.windows) {
-    csv += TrackTimeText(w.start_s, r.time_offset_s) + "," +
-           TrackTimeText(w.end_s, r.time_offset_s) + "," + std::to_string(w.samples);
-    for (const TrackEstimate& e : w.estimates) csv += "," + Num(e.value) + "," + Num(e.sigma_total);
+  for (const TrackRow& row : TrackRows(r)) {
+    const TrackWindow& w = *row.window;
+    csv += TrackTimeText(row.start_s, r.time_offset_s) + "," +
+           TrackTimeText(row.end_s, r.time_offset_s) + "," + std::to_string(row.samples);
+    for (const TrackEstimate& e : row.estimates) {
+      csv += "," + Num(e.value) + "," + Num(e.sigma_total);
+    }
     for (int i = 0; offsets && i < kNumCables; ++i) {
       csv += "," + Num(w.offset_kn[i].value) + "," + Num(w.offset_kn[i].sigma_total);
     }
     csv += "," + Num(w.reduced_chi_square) + "," + Num(w.widening) + "," +
-           std::to_string(w.gross_errors) + "," + w.label + "\n";
+           std::to_string(w.gross_errors) + "," + row.label + "\n";
   }
   return csv;
 }
@@ -171,6 +197,34 @@ std::string EventsJson(const TrackResult& r) {
 
 }  // namespace
 
+// A window with a change inside it: a model for each of its two parts (the event's
+// parameters from the part, the rest from the window), in place of the window's average.
+void AddPartModels(TrackRun& run, const TrackEvent& e, int u) {
+  TrackResult& r = *run.result;
+  for (size_t x = 0; x < 2; ++x) {
+    Eigen::VectorXd a = run.solver.a(u);
+    Eigen::MatrixXd covariance = TotalCovariance(run, u, u);
+    for (size_t k = 0; k < run.layout.window_columns.size(); ++k) {
+      const ParameterSpec& s = run.layout.Column(run.layout.window_columns[k]);
+      for (size_t i = 0; i < e.parameters.size() && i < e.parts[x].estimates.size(); ++i) {
+        if (e.parameters[i].name != s.name) continue;
+        const TrackEstimate& part = e.parts[x].estimates[i];
+        a[k] = part.value * s.to_si;
+        covariance.row(k).setZero();
+        covariance.col(k).setZero();
+        covariance(k, k) = std::pow(part.sigma_total * s.to_si, 2);
+      }
+    }
+    const std::string label = r.windows[u].label + kPartSuffix[x];
+    r.models.push_back({label, ModelAt(run, a, u)});
+    r.model_comments.push_back(
+        ModelComment(run,
+                     "window " + r.windows[u].label + (x == 0 ? ", before" : ", after") +
+                         " the change at " + TrackTimeText(e.time_s, r.time_offset_s),
+                     a, covariance, u));
+  }
+}
+
 TrackStatus BuildModels(TrackRun& run) {
   TrackResult& r = *run.result;
   r.models.clear();
@@ -199,6 +253,11 @@ TrackStatus BuildModels(TrackRun& run) {
     }
     const Eigen::MatrixXd covariance = info.inverse();
     const Eigen::VectorXd a = covariance * sum;
+    if (first == last && SplitEventOf(r, first) != nullptr) {
+      AddPartModels(run, *SplitEventOf(r, first), first);
+      first = last + 1;
+      continue;
+    }
     const std::string label = first == last
                                   ? r.windows[first].label
                                   : r.windows[first].label + "_to_" + r.windows[last].label;
@@ -214,12 +273,34 @@ TrackStatus BuildModels(TrackRun& run) {
   r.current_model = static_cast<int>(r.models.size()) - 1;  // the stretch of the latest window
   // The latest window, when its stretch is longer.
   const int u = windows - 1;
-  if (r.models.back().first != r.windows[u].label) {
+  if (SplitEventOf(r, u) == nullptr && r.models.back().first != r.windows[u].label) {
     r.models.push_back({r.windows[u].label, ModelAt(run, run.solver.a(u), u)});
     r.model_comments.push_back(ModelComment(run, "the latest window, " + r.windows[u].label,
                                             run.solver.a(u), TotalCovariance(run, u, u), u));
   }
   return TrackStatus::kOk;
+}
+
+std::vector<TrackRow> TrackRows(const TrackResult& r) {
+  std::vector<TrackRow> rows;
+  for (size_t k = 0; k < r.windows.size(); ++k) {
+    const TrackWindow& w = r.windows[k];
+    const TrackEvent* e = SplitEventOf(r, k);
+    if (e == nullptr) {
+      rows.push_back(
+          {&w, w.label, w.start_s, w.end_s, w.first_time_s, w.last_time_s, w.samples, w.estimates});
+      continue;
+    }
+    // A window with a change inside: its two parts, not the average of both.
+    for (size_t x = 0; x < 2; ++x) {
+      const TrackWindowPart& part = e->parts[x];
+      rows.push_back({&w, w.label + kPartSuffix[x], part.start_s, part.end_s,
+                      x == 0 ? w.first_time_s : e->time_s,
+                      x == 0 ? e->previous_time_s : w.last_time_s, part.samples,
+                      PartEstimates(r, w, *e, part)});
+    }
+  }
+  return rows;
 }
 
 TrackStatus WriteOutputs(TrackRun& run) {

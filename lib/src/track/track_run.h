@@ -335,6 +335,18 @@ TrackStatus BuildModels(TrackRun& run);
 TrackStatus WriteOutputs(TrackRun& run);
 std::string TrackHtml(const TrackResult& result);
 
+// A row of track.csv and track.html's windows: a window, or one part of a window a
+// parameter change is inside (TrackEvent::parts: before, then after), with the event's
+// parameters from the part and everything else the window's.
+struct TrackRow {
+  const TrackWindow* window = nullptr;
+  std::string label;  // the window's, or LABEL_before / LABEL_after
+  double start_s = 0.0, end_s = 0.0, first_time_s = 0.0, last_time_s = 0.0;
+  long long samples = 0;
+  std::vector<TrackEstimate> estimates;  // per TrackResult::window_parameters
+};
+std::vector<TrackRow> TrackRows(const TrackResult& result);
+
 }  // namespace fastcal::internal
 
 #endif  // FASTCAL_SRC_TRACK_TRACK_RUN_H_

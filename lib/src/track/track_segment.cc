@@ -597,6 +597,38 @@ std::vector<Cut> FindCuts(TrackRun& run, const std::vector<int>& g, int gi, doub
   return cuts;
 }
 
+// Window u's two parts at a cut j inside it (track.h, TrackEvent::parts): each part's
+// estimate a_u + gain delta (PartGain), its covariance the part's own given b plus b's
+// share of the window's (P_uu less its own), in the group's units.
+std::vector<TrackWindowPart> WindowParts(const TrackRun& run, const Line& line,
+                                         const std::vector<int>& g, const Cut& cut,
+                                         double change_s) {
+  const Split& split = line.splits[cut.u][cut.j];
+  const TrackWindowState& w = run.windows[run.used[cut.u]];
+  long long before = 0;
+  for (int b = 0; b < cut.j; ++b) before += w.fold.block_samples[b];
+  const Eigen::MatrixXd shared = line.P(cut.u, cut.u) - line.own[cut.u];
+  std::vector<TrackWindowPart> parts;
+  for (const bool tail : {false, true}) {
+    const Part x{cut.u, cut.j, tail};
+    const Eigen::VectorXd value = line.a[cut.u] + PartGain(line, x) * split.delta;
+    const Eigen::MatrixXd& own = tail ? split.tail : split.head;
+    TrackWindowPart part;
+    part.start_s = tail ? change_s : w.start_s;
+    part.end_s = tail ? w.end_s : change_s;
+    part.samples = tail ? w.samples - before : before;
+    for (size_t k = 0; k < g.size(); ++k) {
+      const double to_si = run.layout.Column(run.layout.window_columns[g[k]]).to_si;
+      const int x = static_cast<int>(k);
+      part.estimates.push_back({value[x] / to_si,
+                                std::sqrt(std::max(0.0, own(x, x) + shared(x, x))) / to_si,
+                                std::sqrt(std::max(0.0, own(x, x))) / to_si});
+    }
+    parts.push_back(part);
+  }
+  return parts;
+}
+
 }  // namespace
 
 int TimelineCandidates(const TrackRun& run) {
@@ -628,6 +660,7 @@ void SegmentGroup(TrackRun& run, const std::vector<int>& g, int gi, const GroupT
     e.previous_time_s = times.first;
     e.time_s = times.second;
     e.within_window = cut.j > 0;
+    if (e.within_window) e.parts = WindowParts(run, line, g, cut, e.time_s);
     const Span span = Interval(line, s, b[k - 1], cut, b[k + 1], c.statistic);
     // A cut inside a window stands for a change anywhere in the blocks either side of it
     // (a block's samples are one unit of the scan): the interval spans them.
