@@ -31,7 +31,10 @@ class TrackResult:
             time (the same as events.json writes it, ISO 8601 for Unix times), after_s
             and after (the last before), time_low/time_high as text too, time_low_s and time_high_s (its likelihood
             interval), window, previous_window, within_window, new (not reported by the
-            track's previous run; every event of a track built afresh),
+            track's previous run; every event of a track built afresh), parts (a move
+            inside a window: the window before and after it, each start_s, end_s,
+            samples and estimates {name: {value, sigma_total}}, as track.csv's
+            LABEL_before and LABEL_after rows; empty otherwise),
             parameters (name -> {shift, sigma_total, unit}), cables (for a sensor),
             statistic, degrees_of_freedom, threshold, p_value (family-wise).
         wander: per per-window group, its wander between windows beyond its errors

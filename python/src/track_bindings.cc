@@ -70,6 +70,24 @@ py::dict EventDict(const TrackResult& r, const TrackEvent& e) {
     parameters[py::str(p.name)] = q;
   }
   d["parameters"] = parameters;
+  // A change inside a window: the window's two parts (track.h, TrackEvent::parts).
+  py::list parts;
+  for (const TrackWindowPart& part : e.parts) {
+    py::dict x;
+    x["start_s"] = part.start_s;
+    x["end_s"] = part.end_s;
+    x["samples"] = part.samples;
+    py::dict estimates;
+    for (size_t k = 0; k < part.estimates.size() && k < e.parameters.size(); ++k) {
+      py::dict v;
+      v["value"] = part.estimates[k].value;
+      v["sigma_total"] = part.estimates[k].sigma_total;
+      estimates[py::str(e.parameters[k].name)] = v;
+    }
+    x["estimates"] = estimates;
+    parts.append(x);
+  }
+  d["parts"] = parts;
   d["cables"] = e.cables;
   d["statistic"] = e.statistic;
   d["degrees_of_freedom"] = e.degrees_of_freedom;
