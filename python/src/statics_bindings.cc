@@ -157,6 +157,27 @@ DoubleArray QuaternionsOf(const std::vector<Pose>& poses) {
   return quat;
 }
 
+// Cable::Lumped as a dict of arrays (fastcal.Cable.lumped).
+py::dict CableLumped(const Cable& c, const DoubleArray& lower_m, const DoubleArray& upper_m,
+                     double fl_n, double fz_n, double s0_m, int segments, double gravity_m_per_s2) {
+  LumpedChain chain;
+  std::string error;
+  if (!c.Lumped(Point(lower_m, "lower_m"), Point(upper_m, "upper_m"), fl_n, fz_n, s0_m,
+                gravity_m_per_s2, segments, &chain, &error)) {
+    throw InputError("lumped: " + error);
+  }
+  DoubleArray nodes = NewArray({static_cast<py::ssize_t>(chain.nodes_m.size()), 3});
+  for (size_t j = 0; j < chain.nodes_m.size(); ++j) {
+    for (int k = 0; k < 3; ++k) nodes.mutable_data()[3 * j + k] = chain.nodes_m[j][k];
+  }
+  py::dict out;
+  out["nodes_m"] = nodes;
+  out["tension_n"] = py::array_t<double>(chain.tension_n.size(), chain.tension_n.data());
+  out["segment_length_m"] = chain.segment_length_m;
+  out["node_mass_kg"] = chain.node_mass_kg;
+  return out;
+}
+
 // One cable (cable.h): its end point and partials, the inverse, tension, mass and lumped
 // chain, for fastcal.Cable.
 void BindCable(py::module_& m) {
@@ -216,29 +237,9 @@ void BindCable(py::module_& m) {
       .def("tension", &Cable::Tension, py::arg("fl_n"), py::arg("fz_n"), py::arg("s_m"),
            py::arg("gravity_m_per_s2") = kGravity)
       .def("mass_kg", &Cable::MassKg, py::arg("s0_m"))
-      .def(
-          "lumped",
-          [](const Cable& c, const DoubleArray& lower_m, const DoubleArray& upper_m, double fl_n,
-             double fz_n, double s0_m, int segments, double gravity_m_per_s2) {
-            LumpedChain chain;
-            std::string error;
-            if (!c.Lumped(Point(lower_m, "lower_m"), Point(upper_m, "upper_m"), fl_n, fz_n, s0_m,
-                          gravity_m_per_s2, segments, &chain, &error)) {
-              throw InputError("lumped: " + error);
-            }
-            DoubleArray nodes = NewArray({static_cast<py::ssize_t>(chain.nodes_m.size()), 3});
-            for (size_t j = 0; j < chain.nodes_m.size(); ++j) {
-              for (int k = 0; k < 3; ++k) nodes.mutable_data()[3 * j + k] = chain.nodes_m[j][k];
-            }
-            py::dict out;
-            out["nodes_m"] = nodes;
-            out["tension_n"] = py::array_t<double>(chain.tension_n.size(), chain.tension_n.data());
-            out["segment_length_m"] = chain.segment_length_m;
-            out["node_mass_kg"] = chain.node_mass_kg;
-            return out;
-          },
-          py::arg("lower_m"), py::arg("upper_m"), py::arg("fl_n"), py::arg("fz_n"), py::arg("s0_m"),
-          py::arg("segments"), py::arg("gravity_m_per_s2") = kGravity);
+      .def("lumped", &CableLumped, py::arg("lower_m"), py::arg("upper_m"), py::arg("fl_n"),
+           py::arg("fz_n"), py::arg("s0_m"), py::arg("segments"),
+           py::arg("gravity_m_per_s2") = kGravity);
 }
 
 }  // namespace

@@ -501,22 +501,11 @@ Placement MoveStep(const std::vector<Placement>& placements, bool before_ok, boo
   return best;
 }
 
-// A sensor re-zeroed inside a window's telemetry: for each step, the windows on either
-// side of it are scanned for a step of that bias inside their own telemetry (the score
-// test over block boundaries, Bonferroni over them); the window that holds it gets an
-// entry of its own (SharedEntry::inside: its readings are of both values), so that the
-// stretches before and after it are of one value each and the step between them is the
-// whole step, timed at its block.
-TrackStatus IsolateInsideSteps(TrackRun& run) {
-  const std::vector<FoldRole>& roles = run.layout.roles;
-  std::vector<ParameterSpec> columns;
-  for (int k = 0; k < run.layout.size(); ++k) columns.push_back(run.layout.Column(k));
-  const std::vector<int> block_columns = BlockRowColumns(columns, roles);
-  bool isolated = false;
+// A window the scan already cut out (a step found on either side of it: two halves of one
+// step inside it) whose own scan finds the step: one step, inside it.
+void JoinHalvesOfOneStep(TrackRun& run, const std::vector<int>& block_columns) {
   const int entries = static_cast<int>(run.shared.size());
   const int windows = static_cast<int>(run.used.size());
-  // A window the scan already cut out (a step found on either side of it: two halves of
-  // one step inside it) whose own scan finds the step: one step, inside it.
   for (int m = 0; m < entries; ++m) {
     const int e0 = PreviousEntry(run, m);
     if (e0 < 0 || run.shared[m].inside || run.shared[e0].inside) continue;
@@ -539,6 +528,23 @@ TrackStatus IsolateInsideSteps(TrackRun& run) {
                  WindowText(run, v) + ": one step inside it (statistic " +
                  FormatDouble("%.1f", step.statistic) + ")");
   }
+}
+
+// A sensor re-zeroed inside a window's telemetry: for each step, the windows on either
+// side of it are scanned for a step of that bias inside their own telemetry (the score
+// test over block boundaries, Bonferroni over them); the window that holds it gets an
+// entry of its own (SharedEntry::inside: its readings are of both values), so that the
+// stretches before and after it are of one value each and the step between them is the
+// whole step, timed at its block.
+TrackStatus IsolateInsideSteps(TrackRun& run) {
+  const std::vector<FoldRole>& roles = run.layout.roles;
+  std::vector<ParameterSpec> columns;
+  for (int k = 0; k < run.layout.size(); ++k) columns.push_back(run.layout.Column(k));
+  const std::vector<int> block_columns = BlockRowColumns(columns, roles);
+  bool isolated = false;
+  const int entries = static_cast<int>(run.shared.size());
+  const int windows = static_cast<int>(run.used.size());
+  JoinHalvesOfOneStep(run, block_columns);
   for (int e = 0; e < entries; ++e) {
     const int e0 = PreviousEntry(run, e);
     if (e0 < 0 || run.shared[e].inside || run.shared[e0].inside) continue;

@@ -112,6 +112,40 @@ std::string TrackCsv(const TrackResult& r) {
   return csv;
 }
 
+// Each per-window group's wander between windows beyond its errors (track.h): the
+// parameter events are steps beyond it.
+void WanderJson(const TrackResult& r, JsonWriter* j) {
+  j->Key("wander").BeginArray();
+  for (const TrackWander& w : r.wander) {
+    j->BeginObject();
+    j->Key("parameters").String(w.group);
+    j->Key("rms").Number(w.rms);
+    j->Key("unit").String(w.unit);
+    // Inside the windows (track.h, TrackWander): per component, and the time constant.
+    j->Key("inside").BeginObject();
+    j->Key("components").BeginArray();
+    for (size_t x = 0; x < w.components.size(); ++x) {
+      j->BeginObject();
+      j->Key("parameter").String(w.components[x]);
+      j->Key("rms").Number(w.inside_rms[x]);
+      j->Key("rms_sigma").Number(w.inside_rms_sigma[x]);
+      j->EndObject();
+    }
+    j->EndArray();
+    j->Key("time_constant_s").Number(w.inside_time_constant_s);
+    j->Key("log_time_constant_sigma").Number(w.inside_log_time_constant_sigma);
+    j->Key("windows").Int(w.inside_windows);
+    j->Key("likelihood_ratio").Number(w.inside_likelihood_ratio);
+    j->Key("significant").Bool(w.inside_significant);
+    j->Key("left_out").BeginArray();
+    for (const std::string& label : w.inside_left_out) j->String(label);
+    j->EndArray();
+    j->EndObject();
+    j->EndObject();
+  }
+  j->EndArray();
+}
+
 std::string EventsJson(const TrackResult& r) {
   JsonWriter j;
   j.BeginObject();
@@ -126,37 +160,7 @@ std::string EventsJson(const TrackResult& r) {
   j.Key("windows").Int(static_cast<long long>(r.windows.size()));
   // Events not reported by the track's previous run (each event's `new`).
   j.Key("new_events").Int(r.NewEvents());
-  // Each per-window group's wander between windows beyond its errors (track.h): the
-  // parameter events are steps beyond it.
-  j.Key("wander").BeginArray();
-  for (const TrackWander& w : r.wander) {
-    j.BeginObject();
-    j.Key("parameters").String(w.group);
-    j.Key("rms").Number(w.rms);
-    j.Key("unit").String(w.unit);
-    // Inside the windows (track.h, TrackWander): per component, and the time constant.
-    j.Key("inside").BeginObject();
-    j.Key("components").BeginArray();
-    for (size_t x = 0; x < w.components.size(); ++x) {
-      j.BeginObject();
-      j.Key("parameter").String(w.components[x]);
-      j.Key("rms").Number(w.inside_rms[x]);
-      j.Key("rms_sigma").Number(w.inside_rms_sigma[x]);
-      j.EndObject();
-    }
-    j.EndArray();
-    j.Key("time_constant_s").Number(w.inside_time_constant_s);
-    j.Key("log_time_constant_sigma").Number(w.inside_log_time_constant_sigma);
-    j.Key("windows").Int(w.inside_windows);
-    j.Key("likelihood_ratio").Number(w.inside_likelihood_ratio);
-    j.Key("significant").Bool(w.inside_significant);
-    j.Key("left_out").BeginArray();
-    for (const std::string& label : w.inside_left_out) j.String(label);
-    j.EndArray();
-    j.EndObject();
-    j.EndObject();
-  }
-  j.EndArray();
+  WanderJson(r, &j);
   j.Key("events").BeginArray();
   for (const TrackEvent& e : r.events) {
     j.BeginObject();
