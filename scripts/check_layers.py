@@ -39,6 +39,7 @@ HEADER_ONLY = {
     "cable_attachment.h": "model",
     "catenary_chain.h": "statics",
     "internal/csv.h": "util",
+    "internal/fail.h": "util",
     "internal/json.h": "util",
     "internal/units.h": "util",
     "internal/sample_chunks.h": "util",

@@ -5,6 +5,7 @@
 
 #include <cmath>
 
+#include "fastcal/internal/fail.h"
 #include "fastcal/internal/number_text.h"
 
 namespace fastcal {
@@ -13,10 +14,7 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDegPerRad = 180.0 / kPi;
 
-bool Fail(std::string* error, const std::string& what) {
-  if (error != nullptr) *error = what;
-  return false;
-}
+using internal::Fail;
 
 // The first joint index of the first part whose first two joints are revolute about x and
 // then y (the A-B rotator), or -1.
@@ -66,8 +64,9 @@ bool JointPlan::Make(const MovingParts& parts, const JointPlanOptions& options, 
   plan->engine_.seed(options.seed ^ 0x6a6f696e74706c61ULL);  // "jointpla": a stream of its own
   if (!options.given.empty()) {
     if (options.revolute != RevoluteLaw::kZero || options.prismatic_sigma_m > 0.0) {
-      return Fail(error, "joint values given per sample (the pose file's joint columns) "
-                         "and a joint law or prismatic spread: give one");
+      return Fail(error,
+                  "joint values given per sample (the pose file's joint columns) "
+                  "and a joint law or prismatic spread: give one");
     }
     return true;
   }

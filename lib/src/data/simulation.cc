@@ -7,6 +7,7 @@
 #include <exception>
 #include <random>
 
+#include "fastcal/internal/fail.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/units.h"
 
@@ -34,10 +35,7 @@ enum Stream : std::uint64_t {
   kLengthNoiseStream,
 };
 
-bool Fail(std::string* error, const std::string& message) {
-  if (error != nullptr) *error = message;
-  return false;
-}
+using internal::Fail;
 
 std::string Num(double value) { return internal::FormatDouble("%.10g", value); }
 

@@ -19,6 +19,7 @@
 #include "fastcal/internal/atomic_file.h"
 #include "fastcal/internal/column_reading.h"
 #include "fastcal/internal/csv.h"
+#include "fastcal/internal/fail.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/quote.h"
 #include "fastcal/plausibility.h"
@@ -40,10 +41,7 @@ std::string TooMany(const std::string& what, int count) {
          std::to_string(count) + ")";
 }
 
-bool Fail(std::string* error, const std::string& message) {
-  if (error != nullptr) *error = message;
-  return false;
-}
+using internal::Fail;
 
 std::string Num(double value) { return internal::FormatDouble("%g", value); }
 

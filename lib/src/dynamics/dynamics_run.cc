@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "fastcal/internal/atomic_file.h"
+#include "fastcal/internal/fail.h"
 #include "fastcal/internal/json.h"
 #include "fastcal/internal/number_text.h"
 #include "fastcal/internal/units.h"
@@ -25,10 +26,7 @@ constexpr long long kMaxWinchTableBytes = 256LL << 20;
 // The longest run (s): ten days, the wind's limit.
 constexpr double kMaxDurationS = 10 * 86400.0;
 
-bool Fail(std::string* error, const std::string& message) {
-  *error = message;
-  return false;
-}
+using internal::Fail;
 
 std::string Num(double v) { return internal::FormatDouble("%.10g", v); }
 

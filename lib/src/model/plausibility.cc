@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "fastcal/internal/fail.h"
 #include "fastcal/internal/number_text.h"
 
 namespace fastcal {
@@ -15,10 +16,7 @@ std::string Num(double value) { return internal::FormatDouble("%.6g", value); }
 // ("300.00001 m is above 300 m", not "300 m is above 300 m").
 std::string NumBeyond(double value, double limit) { return internal::FormatBeyond(value, limit); }
 
-bool Fail(std::string* why, const std::string& message) {
-  if (why != nullptr) *why = message;
-  return false;
-}
+using internal::Fail;
 
 }  // namespace
 
