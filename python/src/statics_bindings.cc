@@ -234,9 +234,25 @@ void BindCable(py::module_& m) {
           },
           py::arg("span_m"), py::arg("rise_m"), py::arg("s0_m"),
           py::arg("gravity_m_per_s2") = kGravity)
-      .def("tension", &Cable::Tension, py::arg("fl_n"), py::arg("fz_n"), py::arg("s_m"),
-           py::arg("gravity_m_per_s2") = kGravity)
-      .def("mass_kg", &Cable::MassKg, py::arg("s0_m"))
+      .def(
+          "tension",
+          [](const Cable& c, double fl_n, double fz_n, double s_m, double gravity_m_per_s2) {
+            if (!(fl_n > 0.0) || !std::isfinite(fl_n) || !std::isfinite(fz_n) || !(s_m >= 0.0) ||
+                !std::isfinite(s_m) || !(gravity_m_per_s2 < 0.0)) {
+              throw InputError("tension: finite fl_n > 0, fz_n, s_m >= 0 and gravity_m_per_s2 < 0");
+            }
+            return c.Tension(fl_n, fz_n, s_m, gravity_m_per_s2);
+          },
+          py::arg("fl_n"), py::arg("fz_n"), py::arg("s_m"), py::arg("gravity_m_per_s2") = kGravity)
+      .def(
+          "mass_kg",
+          [](const Cable& c, double s0_m) {
+            if (!(s0_m > 0.0) || !std::isfinite(s0_m)) {
+              throw InputError("mass_kg: s0_m must be finite and > 0");
+            }
+            return c.MassKg(s0_m);
+          },
+          py::arg("s0_m"))
       .def("lumped", &CableLumped, py::arg("lower_m"), py::arg("upper_m"), py::arg("fl_n"),
            py::arg("fz_n"), py::arg("s0_m"), py::arg("segments"),
            py::arg("gravity_m_per_s2") = kGravity);

@@ -57,6 +57,10 @@ def test_bad_cables_and_calls_are_named() -> None:
     cable = fastcal.Cable(2.4656e7, 11.718)
     with pytest.raises(fastcal.InputError, match="fl_n > 0"):
         cable.end(-1.0, 0.0, 277.0)
+    with pytest.raises(fastcal.InputError, match="tension: finite"):
+        cable.tension(float("nan"), -1e5, 10.0)
+    with pytest.raises(fastcal.InputError, match="mass_kg: s0_m"):
+        cable.mass_kg(float("inf"))
     with pytest.raises(fastcal.InputError, match="forces: "):
         cable.forces(250.0, 120.0, -1.0)
     with pytest.raises(fastcal.InputError, match="misses its upper end"):
