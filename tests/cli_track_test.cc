@@ -194,6 +194,10 @@ TEST_F(CliTrackTest, AnUpdateMarksItsNewEventsAndTheCurrentModelKeepsItsPath) {
   const size_t move = events.find("\"kind\": \"parameter\"");
   ASSERT_NE(move, std::string::npos) << events;
   EXPECT_NE(events.rfind("\"new\": false", move), std::string::npos) << events;
+  // track.html's events table marks the new one.
+  const std::string html = ReadFile(Path("t/track.html"));
+  EXPECT_NE(html.find("<b>new</b> sensor"), std::string::npos);
+  EXPECT_EQ(html.find("<b>new</b> parameter"), std::string::npos);
   // The path did not change; its model is now the stretch after the re-zeroing's.
   EXPECT_NE(ReadFile(Path("t/model_calibrated.yaml")).find("2024-05-07"), std::string::npos);
 

@@ -136,9 +136,10 @@ std::string EventsTable(const TrackResult& r) {
     }
     h += "<tr><td>" + TrackTimeText(e.time_s, r.time_offset_s) + "</td><td>" +
          TrackTimeText(e.previous_time_s, r.time_offset_s) + "</td><td>" +
-         Esc(DescribeEventTime(r, e)) + "</td><td>" + e.kind + "</td><td>" + what + "</td><td>" +
-         FormatDouble("%.1f", e.statistic) + " (threshold " + FormatDouble("%.1f", e.threshold) +
-         ")</td><td>" + FormatDouble("%.2g", e.p_value) + "</td></tr>\n";
+         Esc(DescribeEventTime(r, e)) + "</td><td>" + (e.is_new && r.updated ? "<b>new</b> " : "") +
+         e.kind + "</td><td>" + what + "</td><td>" + FormatDouble("%.1f", e.statistic) +
+         " (threshold " + FormatDouble("%.1f", e.threshold) + ")</td><td>" +
+         FormatDouble("%.2g", e.p_value) + "</td></tr>\n";
   }
   return h + "</table>\n";
 }
